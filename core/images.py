@@ -1,0 +1,243 @@
+"""Image reading, EXIF camera priors and GPS, camera groups.
+
+Images are read through GDAL (JPEG, TIFF 8/16-bit, RGB, single-band NIR or
+grey).  Everything here is plain Python + GDAL + numpy: no qgis, no Qt.
+"""
+from __future__ import annotations
+
+import math
+import os
+import re
+from dataclasses import asdict, dataclass, field
+from typing import Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+IMAGE_EXTENSIONS = (".jpg", ".jpeg", ".tif", ".tiff", ".png")
+
+# one camera per distinct (make, model, focal, size) / one for all / one per image
+GROUP_AUTO = "auto"
+GROUP_SINGLE = "single"
+GROUP_PER_IMAGE = "per_image"
+
+FULL_FRAME_DIAGONAL_MM = math.hypot(36.0, 24.0)
+DEFAULT_FOCAL_FACTOR = 1.2  # focal = 1.2 x long side when nothing is known (COLMAP's guess)
+
+
+class ImageError(ValueError):
+    """An image that cannot be used; the message names the file and the problem."""
+
+
+@dataclass
+class ImageInfo:
+    name: str  # file name relative to the images folder
+    path: str
+    width: int
+    height: int
+    bands: int
+    dtype: str
+    make: str = ""
+    model: str = ""
+    focal_mm: Optional[float] = None
+    focal_35mm: Optional[float] = None
+    focal_px: Optional[float] = None  # best prior for the focal length in pixels
+    focal_source: str = "default"  # exif35 / exif_plane / manual / default
+    gps: Optional[Tuple[float, float, float]] = None  # lon, lat, ellipsoidal(ish) alt (WGS84)
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["gps"] = list(self.gps) if self.gps else None
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "ImageInfo":
+        d = dict(d)
+        if d.get("gps"):
+            d["gps"] = tuple(d["gps"])
+        return cls(**d)
+
+
+@dataclass
+class CameraGroup:
+    camera_id: int
+    key: str
+    make: str
+    model: str
+    width: int
+    height: int
+    focal_px: float
+    focal_source: str
+    images: List[str] = field(default_factory=list)
+
+
+def _gdal():
+    from osgeo import gdal
+
+    gdal.UseExceptions()
+    return gdal
+
+
+def _rational(value: str) -> List[float]:
+    """Parse GDAL's EXIF rationals: '(3.61)' or '(41) (32) (57.8681)'."""
+    nums = re.findall(r"[-+]?\d*\.?\d+(?:[eE][-+]?\d+)?", value or "")
+    return [float(n) for n in nums]
+
+
+def _dms(value: str, ref: str) -> Optional[float]:
+    parts = _rational(value)
+    if not parts:
+        return None
+    deg = parts[0] + (parts[1] / 60.0 if len(parts) > 1 else 0.0) + (parts[2] / 3600.0 if len(parts) > 2 else 0.0)
+    if ref.strip().upper() in ("S", "W"):
+        deg = -deg
+    return deg
+
+
+def list_images(folder: str) -> List[str]:
+    """Names (relative to ``folder``) of files with an image extension, sorted; no recursion."""
+    if not os.path.isdir(folder):
+        raise ImageError(f"image folder {folder} does not exist or is not a folder")
+    return sorted(
+        n for n in os.listdir(folder)
+        if n.lower().endswith(IMAGE_EXTENSIONS) and os.path.isfile(os.path.join(folder, n))
+    )
+
+
+def read_image_info(path: str, name: Optional[str] = None, manual_focal_mm: Optional[float] = None,
+                    manual_sensor_width_mm: Optional[float] = None,
+                    manual_focal_px: Optional[float] = None) -> ImageInfo:
+    """Open the image header, check that its pixels decode, read EXIF.  Raises ImageError."""
+    gdal = _gdal()
+    name = name or os.path.basename(path)
+    if os.path.getsize(path) == 0:
+        raise ImageError(f"{path}: empty file (0 bytes)")
+    try:
+        ds = gdal.Open(path)
+    except RuntimeError as e:
+        raise ImageError(f"{path}: not a readable image ({str(e).strip()})") from e
+    if ds is None or ds.RasterCount == 0:
+        raise ImageError(f"{path}: not a readable image")
+    w, h, nb = ds.RasterXSize, ds.RasterYSize, ds.RasterCount
+    # decode a strip at the bottom: truncated JPEGs fail there
+    try:
+        band = ds.GetRasterBand(1)
+        arr = band.ReadAsArray(0, max(0, h - 8), w, min(8, h))
+        if arr is None:
+            raise RuntimeError("no pixels")
+    except RuntimeError as e:
+        raise ImageError(f"{path}: image data is corrupt or truncated ({str(e).strip()})") from e
+    dtype = gdal.GetDataTypeName(band.DataType)
+    md = ds.GetMetadata() or {}
+    info = ImageInfo(name=name, path=os.path.abspath(path), width=w, height=h, bands=nb, dtype=dtype)
+    info.make = md.get("EXIF_Make", "").strip().strip("\x00")
+    info.model = md.get("EXIF_Model", "").strip().strip("\x00")
+    fmm = _rational(md.get("EXIF_FocalLength", ""))
+    info.focal_mm = fmm[0] if fmm and fmm[0] > 0 else None
+    f35 = _rational(md.get("EXIF_FocalLengthIn35mmFilm", ""))
+    info.focal_35mm = f35[0] if f35 and f35[0] > 0 else None
+    info.focal_px, info.focal_source = _focal_prior(info, md, manual_focal_mm, manual_sensor_width_mm, manual_focal_px)
+    lat = _dms(md.get("EXIF_GPSLatitude", ""), md.get("EXIF_GPSLatitudeRef", "N"))
+    lon = _dms(md.get("EXIF_GPSLongitude", ""), md.get("EXIF_GPSLongitudeRef", "E"))
+    if lat is not None and lon is not None and (abs(lat) > 1e-9 or abs(lon) > 1e-9):
+        alt_v = _rational(md.get("EXIF_GPSAltitude", ""))
+        alt = alt_v[0] if alt_v else 0.0
+        if md.get("EXIF_GPSAltitudeRef", "0x00").strip() in ("0x01", "1"):
+            alt = -alt
+        info.gps = (lon, lat, alt)
+    return info
+
+
+def _focal_prior(info: ImageInfo, md: dict, manual_focal_mm, manual_sensor_width_mm, manual_focal_px):
+    w, h = info.width, info.height
+    long_side = max(w, h)
+    if manual_focal_px:
+        return float(manual_focal_px), "manual"
+    if manual_focal_mm and manual_sensor_width_mm:
+        # sensor width is the long side of the frame as scanned/recorded
+        return float(manual_focal_mm) / float(manual_sensor_width_mm) * long_side, "manual"
+    if info.focal_35mm:
+        diag = math.hypot(w, h)
+        return info.focal_35mm / FULL_FRAME_DIAGONAL_MM * diag, "exif35"
+    if info.focal_mm:
+        res = _rational(md.get("EXIF_FocalPlaneXResolution", ""))
+        unit = md.get("EXIF_FocalPlaneResolutionUnit", "2").strip()
+        orig_w = _rational(md.get("EXIF_PixelXDimension", ""))
+        if res and res[0] > 0 and orig_w and orig_w[0] > 0:
+            mm_per_unit = {"2": 25.4, "3": 10.0, "4": 1.0}.get(unit, 25.4)
+            px_per_mm = res[0] / mm_per_unit
+            f_orig = info.focal_mm * px_per_mm
+            ow = orig_w[0]
+            oh = (_rational(md.get("EXIF_PixelYDimension", "")) or [0])[0]
+            # the stored image may have been resized: scale by the long side if the aspect matches
+            if oh and abs(ow / oh - w / h) < 0.02:
+                return f_orig * w / ow, "exif_plane"
+    return DEFAULT_FOCAL_FACTOR * long_side, "default"
+
+
+def scan_images(folder: str, manual_focal_mm: Optional[float] = None,
+                manual_sensor_width_mm: Optional[float] = None,
+                manual_focal_px: Optional[float] = None,
+                progress=None) -> Tuple[List[ImageInfo], List[str]]:
+    """Read every image in ``folder``.  Returns (usable images, warnings naming skipped files)."""
+    if not os.path.isdir(folder):
+        raise ImageError(f"image folder {folder} does not exist or is not a folder")
+    names = sorted(n for n in os.listdir(folder) if os.path.isfile(os.path.join(folder, n)))
+    good: List[ImageInfo] = []
+    warnings: List[str] = []
+    for i, n in enumerate(names):
+        path = os.path.join(folder, n)
+        if n.startswith("."):
+            continue
+        if not n.lower().endswith(IMAGE_EXTENSIONS):
+            warnings.append(f"{path}: skipped, not an image file (extension)")
+            continue
+        try:
+            good.append(read_image_info(path, n, manual_focal_mm, manual_sensor_width_mm, manual_focal_px))
+        except ImageError as e:
+            warnings.append(f"skipped {e}")
+        if progress is not None:
+            progress.report((i + 1) / max(1, len(names)), f"read {n}")
+    return good, warnings
+
+
+def group_cameras(images: Sequence[ImageInfo], mode: str = GROUP_AUTO) -> List[CameraGroup]:
+    """One camera per distinct (make, model, focal, image size), or one for all, or one per image."""
+    groups: Dict[str, CameraGroup] = {}
+    for im in images:
+        if mode == GROUP_SINGLE:
+            key = "all"
+        elif mode == GROUP_PER_IMAGE:
+            key = im.name
+        else:
+            key = f"{im.make}|{im.model}|{round(im.focal_px or 0, 1)}|{im.width}x{im.height}"
+        g = groups.get(key)
+        if g is None:
+            g = CameraGroup(camera_id=len(groups) + 1, key=key, make=im.make, model=im.model,
+                            width=im.width, height=im.height, focal_px=float(im.focal_px or 0),
+                            focal_source=im.focal_source)
+            groups[key] = g
+        elif mode == GROUP_SINGLE and (im.width, im.height) != (g.width, g.height):
+            raise ImageError(
+                f"{im.path}: size {im.width}x{im.height} differs from {g.width}x{g.height}; "
+                "one camera for all images needs images of one size"
+            )
+        g.images.append(im.name)
+    return list(groups.values())
+
+
+def read_image(path: str, max_size: Optional[int] = None) -> np.ndarray:
+    """Pixels as (rows, cols, bands) array in the file's data type, optionally downscaled."""
+    gdal = _gdal()
+    ds = gdal.Open(path)
+    w, h = ds.RasterXSize, ds.RasterYSize
+    if max_size and max(w, h) > max_size:
+        s = max_size / max(w, h)
+        bw, bh = max(1, round(w * s)), max(1, round(h * s))
+        arr = ds.ReadAsArray(buf_xsize=bw, buf_ysize=bh, resample_alg=gdal.GRIORA_Average)
+    else:
+        arr = ds.ReadAsArray()
+    if arr.ndim == 2:
+        arr = arr[:, :, None]
+    else:
+        arr = np.moveaxis(arr, 0, -1)
+    return arr
