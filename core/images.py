@@ -118,7 +118,9 @@ def read_image_info(path: str, name: Optional[str] = None, manual_focal_mm: Opti
     if ds is None or ds.RasterCount == 0:
         raise ImageError(f"{path}: not a readable image")
     w, h, nb = ds.RasterXSize, ds.RasterYSize, ds.RasterCount
-    # decode a strip at the bottom: truncated JPEGs fail there
+    # decode a strip at the bottom: truncated JPEGs fail there (libjpeg only warns unless told)
+    old = gdal.GetConfigOption("GDAL_ERROR_ON_LIBJPEG_WARNING")
+    gdal.SetConfigOption("GDAL_ERROR_ON_LIBJPEG_WARNING", "TRUE")
     try:
         band = ds.GetRasterBand(1)
         arr = band.ReadAsArray(0, max(0, h - 8), w, min(8, h))
@@ -126,6 +128,8 @@ def read_image_info(path: str, name: Optional[str] = None, manual_focal_mm: Opti
             raise RuntimeError("no pixels")
     except RuntimeError as e:
         raise ImageError(f"{path}: image data is corrupt or truncated ({str(e).strip()})") from e
+    finally:
+        gdal.SetConfigOption("GDAL_ERROR_ON_LIBJPEG_WARNING", old)
     dtype = gdal.GetDataTypeName(band.DataType)
     md = ds.GetMetadata() or {}
     info = ImageInfo(name=name, path=os.path.abspath(path), width=w, height=h, bands=nb, dtype=dtype)

@@ -34,6 +34,7 @@ import numpy as np
 
 from .images import GROUP_AUTO, GROUP_SINGLE, CameraGroup, ImageError, ImageInfo, group_cameras, scan_images
 from .progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
+from .vector import write_cameras_gpkg
 from .workspace import CANCELLED, DONE, FAILED, Workspace, atomic_output, atomic_write_text, fingerprint
 
 PAIRINGS = ("auto", "exhaustive", "sequential", "spatial")
@@ -74,6 +75,7 @@ class AlignOptions:
 class AlignResult:
     workspace: str
     model_dir: str
+    cameras_path: str
     images_given: int
     registered: int
     mean_reprojection_error: float
@@ -124,9 +126,11 @@ class _CancelWatcher:
         self._thread.start()
         return self.token
 
-    def __exit__(self, *exc):
+    def __exit__(self, exc_type, exc, tb):
         self._stop.set()
         self._thread.join(timeout=1)
+        if exc_type is not None and issubclass(exc_type, InterruptedError) and self.token.is_cancelled:
+            raise Cancelled("cancelled by the user") from exc
         return False
 
 
@@ -509,17 +513,19 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
         with atomic_output(model_dir) as tmp:
             os.makedirs(tmp)
             rec.write_binary(tmp)
+        cameras_path = write_cameras_gpkg(ws.root, camera_rows(rec), crs=None)
         mre = float(rec.compute_mean_reprojection_error())
         result = AlignResult(
-            workspace=ws.root, model_dir=model_dir, images_given=len(infos), registered=len(registered),
+            workspace=ws.root, model_dir=model_dir, cameras_path=cameras_path, images_given=len(infos), registered=len(registered),
             mean_reprojection_error=mre, num_points3d=int(rec.num_points3D()), unregistered=unregistered,
             other_components=others, skipped_files=skipped, pairing_used=pairing_used, num_pairs=len(pairs),
             timings={k: round(v, 3) for k, v in timings.items()}, cameras=camera_summary(rec),
         )
-        figures = {k: v for k, v in asdict(result).items() if k not in ("workspace", "model_dir")}
+        figures = {k: v for k, v in asdict(result).items() if k not in ("workspace", "model_dir", "cameras_path")}
         figures["principal_point_refined"] = pp
         atomic_write_text(os.path.join(sfm_dir, "alignment.json"), _json(figures))
-        ws.end_stage(STAGE, DONE, outputs={"model": os.path.relpath(model_dir, ws.root)},
+        ws.end_stage(STAGE, DONE, outputs={"model": os.path.relpath(model_dir, ws.root),
+                                            "cameras": os.path.relpath(cameras_path, ws.root)},
                      results={"registered": result.registered, "images": len(infos),
                               "mean_reprojection_error": mre, "points3d": result.num_points3d,
                               "pairing": pairing_used, "pairs": len(pairs),

@@ -113,6 +113,7 @@ class Workspace:
     def __init__(self, root: str, data: Dict[str, Any]):
         self.root = os.path.abspath(root)
         self.data = data
+        self._t0: Dict[str, float] = {}
 
     # --- opening -------------------------------------------------------
     @classmethod
@@ -208,7 +209,7 @@ class Workspace:
             }
         )
         rec.setdefault("timings", {})
-        rec["_t0"] = time.time()
+        self._t0[name] = time.time()
         self.save()
 
     def record_timing(self, name: str, step: str, seconds: float) -> None:
@@ -224,7 +225,7 @@ class Workspace:
         error: Optional[str] = None,
     ) -> None:
         rec = self.data["stages"].setdefault(name, {})
-        t0 = rec.pop("_t0", None)
+        t0 = self._t0.pop(name, None)
         rec["status"] = status
         rec["finished"] = _now()
         if t0 is not None:

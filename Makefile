@@ -1,0 +1,89 @@
+# ArchaeoOrtho - developer and user entry points.  Every target installs what it needs.
+SHELL := /bin/bash
+ROOT := $(CURDIR)
+VENV ?= $(ROOT)/.venv
+PY := $(VENV)/bin/python
+SYSPY := /usr/bin/python3
+BUILD := $(ROOT)/build
+PLUGINS := $(BUILD)/qgis-plugins
+QGIS_CONFIG := $(BUILD)/qgis-profile
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+APT_PACKAGES := qgis python3-qgis qgis-providers python3-gdal python3-numpy python3-scipy \
+                python3-matplotlib python3-venv python3-pip qttools5-dev-tools pyqt5-dev-tools xvfb zip
+QGIS_PROCESS := $(shell command -v qgis_process.bin || command -v qgis_process || echo /usr/bin/qgis_process.bin)
+PYTEST_ARGS ?=
+ARGS ?=
+
+# qgis_process and tests see the venv's packages, the plugin and a private QGIS profile
+export QT_QPA_PLATFORM ?= offscreen
+export QGIS_PLUGINPATH := $(PLUGINS)
+PROCESS_ENV = PYTHONPATH="$$($(PY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])'):$$PYTHONPATH" \
+              QGIS_CUSTOM_CONFIG_PATH=$(QGIS_CONFIG) QGIS_PLUGINPATH=$(PLUGINS) QT_QPA_PLATFORM=offscreen
+
+.PHONY: help setup apt venv plugin-link demo test process package lint transup transcompile bench clean
+
+help:
+	@echo "make setup | demo | test [PYTEST_ARGS=...] | process ARGS='...' | package | lint | transup | transcompile | bench"
+
+apt: $(BUILD)/.apt-stamp
+$(BUILD)/.apt-stamp:
+	@mkdir -p $(BUILD)
+	@if ! dpkg -s $(APT_PACKAGES) >/dev/null 2>&1; then \
+	  echo "Installing Debian packages: $(APT_PACKAGES)"; \
+	  $(SUDO) apt-get update -q && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -q --no-install-recommends $(APT_PACKAGES); \
+	fi
+	@touch $@
+
+venv: $(VENV)/.stamp
+$(VENV)/.stamp: requirements.txt requirements-dev.txt $(BUILD)/.apt-stamp
+	@test -x $(PY) || $(SYSPY) -m venv --system-site-packages $(VENV)
+	$(PY) -m pip install -q --disable-pip-version-check -r requirements-dev.txt
+	@$(PY) -c "import numpy, pycolmap, cv2; from osgeo import gdal_array; import qgis.core; \
+	  assert numpy.__version__.startswith('1.'), numpy.__version__; \
+	  print('venv ok: numpy', numpy.__version__, 'pycolmap', pycolmap.__version__, 'cv2', cv2.__version__)"
+	@touch $@
+
+plugin-link: $(PLUGINS)/archaeoortho
+$(PLUGINS)/archaeoortho:
+	@mkdir -p $(PLUGINS) $(QGIS_CONFIG)
+	@ln -sfn $(ROOT) $@
+
+setup: apt venv plugin-link transcompile
+	@$(PROCESS_ENV) $(QGIS_PROCESS) plugins enable archaeoortho >/dev/null 2>&1 || true
+	@echo "setup done: $(PY), plugin linked at $(PLUGINS)/archaeoortho, qgis_process = $(QGIS_PROCESS)" >&2
+
+process: setup
+	@$(PROCESS_ENV) $(QGIS_PROCESS) $(ARGS)
+
+test: setup
+	QGIS_PROCESS=$(QGIS_PROCESS) QGIS_CUSTOM_CONFIG_PATH=$(QGIS_CONFIG) $(PY) -m pytest tests $(PYTEST_ARGS)
+
+demo: setup
+	$(PY) sample/demo.py --qgis-process "$(QGIS_PROCESS)" --build $(BUILD)
+
+bench: setup
+	@dpkg -s colmap >/dev/null 2>&1 || (DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -q colmap)
+	$(PY) benchmarks/align.py $(ARGS)
+
+lint: venv
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/flake8 --select=QGS --exclude=.venv,build .
+
+I18N_SOURCES := $(shell ls *.py core/*.py processing_provider/*.py ui/*.py 2>/dev/null)
+transup: apt
+	pylupdate5 -noobsolete $(I18N_SOURCES) -ts i18n/archaeoortho_de.ts i18n/archaeoortho_it.ts
+
+transcompile: apt
+	@for ts in i18n/*.ts; do [ -e "$$ts" ] && lrelease -silent "$$ts" -qm "$${ts%.ts}.qm" || true; done
+
+package: transcompile
+	@rm -rf $(BUILD)/package && mkdir -p $(BUILD)/package/archaeoortho dist
+	@git ls-files -co --exclude-standard | grep -vE '^(tests/|benchmarks/|sample/|\.ci/|\.git|Makefile|requirements-dev|\.gitignore|ruff\.toml|setup\.cfg)' \
+	  | while read f; do [ -f "$$f" ] && install -D -m 644 "$$f" "$(BUILD)/package/archaeoortho/$$f"; done
+	@cp i18n/*.qm $(BUILD)/package/archaeoortho/i18n/ 2>/dev/null || true
+	@cd $(BUILD)/package && rm -f $(ROOT)/dist/archaeoortho.zip && zip -qr $(ROOT)/dist/archaeoortho.zip archaeoortho
+	@echo "dist/archaeoortho.zip: $$(unzip -l dist/archaeoortho.zip | tail -1)"
+
+clean:
+	rm -rf $(BUILD) dist .pytest_cache

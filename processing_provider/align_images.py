@@ -1,0 +1,108 @@
+"""Align images: thin adapter over core.sfm.align."""
+from qgis.core import (
+    QgsProcessingOutputNumber,
+    QgsProcessingOutputVectorLayer,
+    QgsProcessingParameterBoolean,
+    QgsProcessingParameterEnum,
+    QgsProcessingParameterFile,
+    QgsProcessingParameterFolderDestination,
+    QgsProcessingParameterNumber,
+)
+
+from .base import AlgorithmBase, FeedbackProgress
+
+PAIRINGS = ["auto", "exhaustive", "sequential", "spatial"]
+CAMERA_MODELS = ["AUTO", "SIMPLE_RADIAL", "RADIAL", "OPENCV", "FULL_OPENCV"]
+
+
+class AlignImagesAlgorithm(AlgorithmBase):
+    NAME = "alignimages"
+    DISPLAY = "Align images"
+    IMAGES = "IMAGES"
+    WORKSPACE = "WORKSPACE"
+    PAIRING = "PAIRING"
+    CAMERA_MODEL = "CAMERA_MODEL"
+    MAX_IMAGE_SIZE = "MAX_IMAGE_SIZE"
+    MAX_FEATURES = "MAX_FEATURES"
+    AFFINE_FEATURES = "AFFINE_FEATURES"
+    FOCAL_MM = "FOCAL_MM"
+    SENSOR_WIDTH_MM = "SENSOR_WIDTH_MM"
+    SINGLE_CAMERA = "SINGLE_CAMERA"
+    CAMERAS = "CAMERAS"
+    REGISTERED_IMAGES = "REGISTERED_IMAGES"
+    MEAN_REPROJECTION_ERROR = "MEAN_REPROJECTION_ERROR"
+    HELP = (
+        "Structure from motion: SIFT features, pair selection, robust matching (RANSAC), incremental mapping "
+        "with self-calibration (focal length, principal point, lens distortion) and a final bundle adjustment. "
+        "The result is stored in the WORKSPACE folder, which the following stages (Georeference, Build DSM, "
+        "Build orthophoto) take as input. A re-run resumes: features and matches already computed are reused.\n\n"
+        "PAIRING: 'auto' uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images "
+        "otherwise, and sequential pairs with loop pairs for larger sets without GPS.\n"
+        "CAMERA_MODEL: 'AUTO' estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with "
+        "10 or more images, and a simpler radial model below.\n"
+        "FOCAL_MM and SENSOR_WIDTH_MM: interior orientation when EXIF is missing (scanned film): the focal "
+        "length and the width of the long side of the frame, in millimetres."
+    )
+
+    def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
+        self.addParameter(QgsProcessingParameterFile(
+            self.IMAGES, self.tr("Folder of images"), behavior=QgsProcessingParameterFile.Folder))
+        self.addParameter(QgsProcessingParameterFolderDestination(self.WORKSPACE, self.tr("Workspace folder")))
+        self.addParameter(QgsProcessingParameterEnum(
+            self.PAIRING, self.tr("Pair selection"), options=PAIRINGS, defaultValue=0))
+        self.addParameter(QgsProcessingParameterEnum(
+            self.CAMERA_MODEL, self.tr("Camera model"), options=CAMERA_MODELS, defaultValue=0))
+        self.addParameter(QgsProcessingParameterNumber(
+            self.MAX_IMAGE_SIZE, self.tr("Largest image side for matching (0 = full size)"),
+            type=QgsProcessingParameterNumber.Integer, defaultValue=0, minValue=0))
+        self.addParameter(QgsProcessingParameterNumber(
+            self.MAX_FEATURES, self.tr("Largest number of features per image"),
+            type=QgsProcessingParameterNumber.Integer, defaultValue=8192, minValue=500))
+        self.addParameter(QgsProcessingParameterBoolean(
+            self.AFFINE_FEATURES, self.tr("Affine-invariant features (oblique views; slower)"), defaultValue=False))
+        self.addParameter(QgsProcessingParameterNumber(
+            self.FOCAL_MM, self.tr("Focal length in mm when EXIF is missing (0 = from EXIF)"),
+            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
+        self.addParameter(QgsProcessingParameterNumber(
+            self.SENSOR_WIDTH_MM, self.tr("Sensor (frame) width in mm, long side (0 = unknown)"),
+            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
+        self.addParameter(QgsProcessingParameterBoolean(
+            self.SINGLE_CAMERA, self.tr("One camera for all images"), defaultValue=False))
+        self.addOutput(QgsProcessingOutputVectorLayer(self.CAMERAS, self.tr("Camera centres")))
+        self.addOutput(QgsProcessingOutputNumber(self.REGISTERED_IMAGES, self.tr("Registered images")))
+        self.addOutput(QgsProcessingOutputNumber(
+            self.MEAN_REPROJECTION_ERROR, self.tr("Mean reprojection error (px)")))
+
+    def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
+        from ..core import sfm
+        from ..core.images import GROUP_AUTO, GROUP_SINGLE
+
+        images = self.parameterAsFile(parameters, self.IMAGES, context)
+        workspace = self.parameterAsString(parameters, self.WORKSPACE, context)
+        focal_mm = self.parameterAsDouble(parameters, self.FOCAL_MM, context)
+        sensor_mm = self.parameterAsDouble(parameters, self.SENSOR_WIDTH_MM, context)
+        options = sfm.AlignOptions(
+            pairing=PAIRINGS[self.parameterAsEnum(parameters, self.PAIRING, context)],
+            camera_model=CAMERA_MODELS[self.parameterAsEnum(parameters, self.CAMERA_MODEL, context)],
+            max_image_size=self.parameterAsInt(parameters, self.MAX_IMAGE_SIZE, context),
+            max_features=self.parameterAsInt(parameters, self.MAX_FEATURES, context),
+            affine_features=self.parameterAsBoolean(parameters, self.AFFINE_FEATURES, context),
+            grouping=GROUP_SINGLE if self.parameterAsBoolean(parameters, self.SINGLE_CAMERA, context) else GROUP_AUTO,
+            focal_mm=focal_mm or None,
+            sensor_width_mm=sensor_mm or None,
+        )
+        result = self.run_core(sfm.align, images, workspace, options, FeedbackProgress(feedback))
+        feedback.pushInfo(self.tr("Registered {} of {} images, mean reprojection error {:.3f} px, {} points").format(
+            result.registered, result.images_given, result.mean_reprojection_error, result.num_points3d))
+        if result.unregistered:
+            feedback.pushInfo(self.tr("Images not registered:"))
+            for name, why in result.unregistered.items():
+                feedback.pushInfo(f"  {name}: {why}")
+        feedback.pushInfo(self.tr("Seconds per step: {}").format(
+            ", ".join(f"{k} {v:.1f}" for k, v in result.timings.items())))
+        return {
+            self.WORKSPACE: result.workspace,
+            self.CAMERAS: result.cameras_path,
+            self.REGISTERED_IMAGES: result.registered,
+            self.MEAN_REPROJECTION_ERROR: result.mean_reprojection_error,
+        }

@@ -1,0 +1,26 @@
+"""The "ArchaeoOrtho" Processing provider (id ``archaeoortho``)."""
+import os
+
+from qgis.core import QgsProcessingProvider
+from qgis.PyQt.QtCore import QCoreApplication
+from qgis.PyQt.QtGui import QIcon
+
+
+class ArchaeoOrthoProvider(QgsProcessingProvider):
+    def id(self):
+        return "archaeoortho"
+
+    def name(self):
+        return "ArchaeoOrtho"
+
+    def longName(self):  # noqa: N802 (QGIS API name)
+        return QCoreApplication.translate("ArchaeoOrthoProvider", "ArchaeoOrtho photogrammetry")
+
+    def icon(self):
+        return QIcon(os.path.join(os.path.dirname(os.path.dirname(__file__)), "icon.svg"))
+
+    def loadAlgorithms(self):  # noqa: N802 (QGIS API name)
+        from .align_images import AlignImagesAlgorithm
+
+        for alg in (AlignImagesAlgorithm(),):
+            self.addAlgorithm(alg)

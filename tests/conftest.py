@@ -1,0 +1,41 @@
+"""Shared fixtures.  Core tests need no QGIS; QGIS tests use pytest-qgis (offscreen)."""
+import os
+import shutil
+import sys
+
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SHARED_DATA = os.environ.get("ARCHAEOORTHO_DATA", os.path.join(os.path.dirname(ROOT), "shared", "data"))
+SAMPLE = os.path.join(ROOT, "sample", "toledo")
+PLUGINS = os.path.join(ROOT, "build", "qgis-plugins")
+
+for p in (ROOT, PLUGINS, "/usr/share/qgis/python/plugins"):
+    if os.path.isdir(p) and p not in sys.path:
+        sys.path.insert(0 if p == ROOT else len(sys.path), p)
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+
+def shared(*parts):
+    path = os.path.join(SHARED_DATA, *parts)
+    if not os.path.exists(path):
+        pytest.skip(f"shared data not available: {path}")
+    return path
+
+
+def copy_images(src_dir, names, dst_dir):
+    os.makedirs(dst_dir, exist_ok=True)
+    for n in names:
+        shutil.copyfile(os.path.join(src_dir, n), os.path.join(dst_dir, n))
+    return dst_dir
+
+
+# A strip of overlapping Toledo images (shipped in sample/ so tests never depend on ../shared)
+TOLEDO_STRIP = ["1JI_0064.JPG", "1JI_0065.JPG", "1JI_0066.JPG", "1JI_0067.JPG", "1JI_0068.JPG", "1JI_0076.JPG"]
+
+
+@pytest.fixture(scope="session")
+def toledo_strip(tmp_path_factory):
+    d = tmp_path_factory.mktemp("toledo strip")
+    return copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP, str(d / "imáges ü"))

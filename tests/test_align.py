@@ -1,0 +1,174 @@
+"""Alignment stage in plain Python (no QGIS): real pycolmap on real images."""
+import json
+import os
+import re
+import shutil
+
+import pytest
+
+from core import sfm
+from core.images import ImageInfo
+from core.progress import Cancelled, NullProgress
+from core.workspace import Workspace, WorkspaceError
+from tests.conftest import SAMPLE, TOLEDO_STRIP, copy_images, shared
+
+FAST = dict(max_image_size=800, max_features=2048)
+
+
+class Recorder(NullProgress):
+    def __init__(self, cancel_on=None):
+        self.messages, self.warnings, self.fractions = [], [], []
+        self.cancel_on = cancel_on
+        self.cancelled = False
+
+    def report(self, fraction, message=""):
+        self.fractions.append(fraction)
+        self.messages.append(message)
+        if self.cancel_on and message.startswith(self.cancel_on):
+            self.cancelled = True
+
+    def info(self, message):
+        self.messages.append(message)
+
+    def warning(self, message):
+        self.warnings.append(message)
+
+    def is_cancelled(self):
+        return self.cancelled
+
+
+def _info(name, gps=None):
+    return ImageInfo(name=name, path=name, width=100, height=100, bands=3, dtype="Byte", gps=gps)
+
+
+def test_pair_selection_spatial_and_fallback():
+    # a 2 x 10 grid of GPS positions ~20 m apart
+    imgs = [_info(f"i{r}{c:02d}.jpg", (10 + c * 0.00025, 50 + r * 0.00018, 100)) for r in range(2) for c in range(10)]
+    pairs, used, warnings = sfm.select_pairs(imgs, "auto", spatial_neighbours=4)
+    assert used == "spatial" and not warnings
+    assert ("i000.jpg", "i001.jpg") in pairs
+    assert ("i000.jpg", "i009.jpg") not in pairs  # far apart: not paired
+    assert len(pairs) < 20 * 19 // 2
+    imgs[3].gps = None
+    pairs, used, warnings = sfm.select_pairs(imgs, "spatial", spatial_neighbours=4)
+    assert used == "exhaustive" and "falling back to exhaustive" in warnings[0]
+    assert len(pairs) == 190
+
+
+def test_pair_selection_sequential_has_loop_pairs():
+    imgs = [_info(f"{i:03d}.jpg") for i in range(150)]
+    pairs, used, _ = sfm.select_pairs(imgs, "auto")
+    assert used == "sequential"
+    assert ("000.jpg", "001.jpg") in pairs and ("000.jpg", "012.jpg") in pairs
+    assert ("005.jpg", "140.jpg") in pairs  # loop pair to every 10th image
+    assert len(pairs) < 150 * 149 // 4
+
+
+def test_camera_model_choice():
+    assert sfm.choose_camera_model("AUTO", 20) == "OPENCV"
+    assert sfm.choose_camera_model("AUTO", 5) == "RADIAL"
+    assert sfm.choose_camera_model("full_opencv", 2) == "FULL_OPENCV"
+    with pytest.raises(sfm.AlignError, match="unknown camera model"):
+        sfm.choose_camera_model("FISHEYE9", 5)
+
+
+@pytest.mark.slow
+def test_align_skips_bad_files_in_unicode_path(tmp_path):
+    images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP, str(tmp_path / "fotos äö ü"))
+    good = open(os.path.join(images, TOLEDO_STRIP[0]), "rb").read()
+    with open(os.path.join(images, "broken.jpg"), "wb") as f:
+        f.write(good[: len(good) // 4])
+    open(os.path.join(images, "zero.JPG"), "wb").close()
+    with open(os.path.join(images, "readme.txt"), "w") as f:
+        f.write("flight notes")
+    rec = Recorder()
+    ws_dir = str(tmp_path / "work space ø")
+    result = sfm.align(images, ws_dir, sfm.AlignOptions(**FAST), rec)
+    assert result.registered == len(TOLEDO_STRIP)
+    assert result.mean_reprojection_error < 1.0
+    warned = "\n".join(rec.warnings)
+    for bad in ("broken.jpg", "zero.JPG", "readme.txt"):
+        assert bad in warned
+    ws = Workspace.open(ws_dir)
+    assert ws.stage("align")["status"] == "done"
+    assert ws.stage("align")["results"]["registered"] == len(TOLEDO_STRIP)
+    assert set(ws.stage("align")["timings"]) >= {"features", "matching", "mapping", "total"}
+    figures = json.load(open(os.path.join(ws_dir, "sfm", "alignment.json")))
+    assert figures["registered"] == len(TOLEDO_STRIP)
+    model = sfm.load_model(ws_dir)
+    assert model.num_reg_images() == len(TOLEDO_STRIP)
+    from osgeo import ogr
+
+    ds = ogr.Open(result.cameras_path)
+    assert ds.GetLayer(0).GetFeatureCount() == len(TOLEDO_STRIP)
+    # progress was reported per image, per matching block and per registered image
+    assert any(m.startswith("features:") for m in rec.messages)
+    assert any(m.startswith("matching:") for m in rec.messages)
+    assert any(m.startswith("mapping:") for m in rec.messages)
+    assert rec.fractions == sorted(rec.fractions)
+
+
+@pytest.mark.slow
+def test_cancel_leaves_no_model_and_rerun_resumes(tmp_path):
+    images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:5], str(tmp_path / "img"))
+    ws_dir = str(tmp_path / "ws")
+    rec = Recorder(cancel_on="mapping")
+    with pytest.raises(Cancelled):
+        sfm.align(images, ws_dir, sfm.AlignOptions(**FAST), rec)
+    ws = Workspace.open(ws_dir)
+    assert ws.stage("align")["status"] == "cancelled"
+    assert not os.path.exists(os.path.join(ws_dir, "sfm", "model"))
+    assert os.path.exists(os.path.join(ws_dir, "sfm", "database.db"))
+    rec2 = Recorder()
+    result = sfm.align(images, ws_dir, sfm.AlignOptions(**FAST), rec2)
+    assert result.registered == 5
+    assert any("already extracted, reused" in m for m in rec2.messages)
+    assert any("already matched, reused" in m for m in rec2.messages)
+    assert not any(re.match(r"features: \d+/\d+ images", m) for m in rec2.messages)
+
+
+def test_one_image_or_empty_folder_is_a_clear_error(tmp_path):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    with pytest.raises(sfm.AlignError, match="no readable images"):
+        sfm.align(str(empty), str(tmp_path / "ws1"))
+    one = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:1], str(tmp_path / "one"))
+    with pytest.raises(sfm.AlignError, match="only one readable image.*1JI_0064.JPG"):
+        sfm.align(one, str(tmp_path / "ws2"))
+
+
+def test_unwritable_workspace_fails_before_work(tmp_path):
+    images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:2], str(tmp_path / "img"))
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    with pytest.raises(WorkspaceError, match="not a folder"):
+        sfm.align(images, str(blocker))
+    with pytest.raises(WorkspaceError, match="cannot create workspace folder"):
+        sfm.align(images, "/proc/archaeoortho-workspace")
+
+
+@pytest.mark.slow
+def test_images_without_overlap_are_named(tmp_path):
+    # three disjoint crops of one photo: they share no ground, nothing can be built
+    import cv2
+
+    photo = cv2.imread(os.path.join(SAMPLE, "images", "1JI_0064.JPG"))
+    images = tmp_path / "img"
+    images.mkdir()
+    for k in range(3):
+        cv2.imwrite(str(images / f"crop{k}.jpg"), photo[:, k * 400:(k + 1) * 400])
+    with pytest.raises(sfm.AlignError, match="do not overlap") as err:
+        sfm.align(str(images), str(tmp_path / "ws"), sfm.AlignOptions(**FAST))
+    assert "crop0.jpg" in str(err.value) and "crop2.jpg" in str(err.value)
+
+
+@pytest.mark.slow
+def test_foreign_images_are_reported_not_registered(tmp_path):
+    copr = shared("copr", "images")
+    images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:5], str(tmp_path / "img"))
+    shutil.copyfile(os.path.join(copr, "IMG_0037.jpg"), os.path.join(images, "IMG_0037.jpg"))
+    rec = Recorder()
+    result = sfm.align(images, str(tmp_path / "ws"), sfm.AlignOptions(**FAST), rec)
+    assert result.registered == 5
+    assert "IMG_0037.jpg" in result.unregistered
+    assert any("IMG_0037.jpg" in w for w in rec.warnings)

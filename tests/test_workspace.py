@@ -1,0 +1,93 @@
+import json
+import os
+import stat
+
+import pytest
+
+from core import workspace as wsmod
+from core.workspace import Workspace, WorkspaceError, atomic_output
+
+
+def test_create_reopen_and_stage_records(tmp_path):
+    ws = Workspace.create_or_open(str(tmp_path / "ws"))
+    ws.begin_stage("align", {"pairing": "auto"}, {"images": "abc"})
+    ws.record_timing("align", "features", 1.25)
+    ws.end_stage("align", wsmod.DONE, outputs={"model": "sfm/model"}, results={"registered": 5})
+    again = Workspace.open(str(tmp_path / "ws"))
+    rec = again.stage("align")
+    assert rec["status"] == "done"
+    assert rec["parameters"] == {"pairing": "auto"}
+    assert rec["timings"]["features"] == 1.25 and "total" in rec["timings"]
+    assert rec["outputs"]["model"] == "sfm/model"
+    assert again.data["format_version"] == wsmod.FORMAT_VERSION
+    # no temp files left beside the manifest
+    assert sorted(os.listdir(tmp_path / "ws")) == ["workspace.json"]
+
+
+def test_invalidate_later_stages(tmp_path):
+    ws = Workspace.create_or_open(str(tmp_path))
+    for s in ("align", "georeference", "dsm"):
+        ws.begin_stage(s, {})
+        ws.end_stage(s, wsmod.DONE)
+    ws.invalidate_after("align", wsmod.STAGE_ORDER)
+    assert ws.stage("align")["status"] == "done"
+    assert ws.stage("georeference")["status"] == "stale"
+    assert ws.stage("dsm")["status"] == "stale"
+
+
+def test_damaged_manifest_is_reported_and_left_alone(tmp_path):
+    path = tmp_path / "workspace.json"
+    path.write_text('{"format_version": 1, "images": [')
+    before = path.read_bytes()
+    with pytest.raises(WorkspaceError, match="damaged"):
+        Workspace.create_or_open(str(tmp_path))
+    assert path.read_bytes() == before
+
+
+def test_newer_format_is_refused_and_left_alone(tmp_path):
+    path = tmp_path / "workspace.json"
+    path.write_text(json.dumps({"format_version": wsmod.FORMAT_VERSION + 1, "stages": {}}))
+    before = path.read_bytes()
+    with pytest.raises(WorkspaceError, match="newer"):
+        Workspace.open(str(tmp_path))
+    assert path.read_bytes() == before
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root ignores directory permissions")
+def test_read_only_folder_refused_before_work(tmp_path):
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(stat.S_IRUSR | stat.S_IXUSR)
+    try:
+        with pytest.raises(WorkspaceError, match="not writable"):
+            Workspace.create_or_open(str(ro))
+    finally:
+        ro.chmod(stat.S_IRWXU)
+
+
+def test_atomic_output_keeps_old_product_on_failure(tmp_path):
+    target = tmp_path / "dsm.tif"
+    target.write_text("complete old product")
+    with pytest.raises(RuntimeError):
+        with atomic_output(str(target)) as tmp:
+            with open(tmp, "w") as f:
+                f.write("half")
+            raise RuntimeError("cancelled in the middle")
+    assert target.read_text() == "complete old product"
+    assert os.listdir(tmp_path) == ["dsm.tif"]
+    with atomic_output(str(target)) as tmp:
+        with open(tmp, "w") as f:
+            f.write("new")
+    assert target.read_text() == "new"
+
+
+def test_atomic_output_replaces_folders(tmp_path):
+    target = tmp_path / "model"
+    target.mkdir()
+    (target / "old.bin").write_text("x")
+    with atomic_output(str(target)) as tmp:
+        os.makedirs(tmp)
+        with open(os.path.join(tmp, "new.bin"), "w") as f:
+            f.write("y")
+    assert os.listdir(target) == ["new.bin"]
+    assert sorted(os.listdir(tmp_path)) == ["model"]
