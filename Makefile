@@ -68,9 +68,9 @@ bench: setup
 
 lint: venv
 	$(VENV)/bin/ruff check .
-	$(VENV)/bin/flake8 --select=QGS --exclude=.venv,build .
+	$(VENV)/bin/flake8 .
 
-I18N_SOURCES := $(shell ls *.py core/*.py processing_provider/*.py ui/*.py 2>/dev/null)
+I18N_SOURCES := $(shell ls *.py processing_provider/*.py ui/*.py 2>/dev/null)
 transup: apt
 	pylupdate5 -noobsolete $(I18N_SOURCES) -ts i18n/archaeoortho_de.ts i18n/archaeoortho_it.ts
 

@@ -50,7 +50,7 @@ class ImageInfo:
         return d
 
     @classmethod
-    def from_dict(cls, d: dict) -> "ImageInfo":
+    def from_dict(cls, d: dict) -> ImageInfo:
         d = dict(d)
         if d.get("gps"):
             d["gps"] = tuple(d["gps"])

@@ -32,7 +32,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .images import GROUP_AUTO, GROUP_SINGLE, CameraGroup, ImageError, ImageInfo, group_cameras, scan_images
+from .images import GROUP_AUTO, CameraGroup, ImageError, ImageInfo, group_cameras, scan_images
 from .progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
 from .vector import write_cameras_gpkg
 from .workspace import CANCELLED, DONE, FAILED, Workspace, atomic_output, atomic_write_text, fingerprint
@@ -58,7 +58,7 @@ class AlignOptions:
     pairing: str = "auto"
     camera_model: str = "AUTO"
     max_image_size: int = 0  # 0 = full size; downscale for feature extraction only
-    max_features: int = 8192
+    max_features: int = 0  # 0 = auto: about 4000 per megapixel, between 2048 and 8192
     affine_features: bool = False  # affine-shape SIFT + domain-size pooling (oblique sets)
     grouping: str = GROUP_AUTO  # auto / single / per_image
     focal_mm: Optional[float] = None
@@ -247,9 +247,18 @@ def _setup_database(pycolmap, db_path: str, groups: List[CameraGroup], options: 
         db.close()
 
 
+def auto_max_features(width: int, height: int, max_image_size: int = 0) -> int:
+    """Features per image when the user leaves it at 0: ~4000 per megapixel matched, 2048..8192."""
+    scale = min(1.0, max_image_size / max(width, height)) if max_image_size else 1.0
+    mp = width * height * scale * scale / 1e6
+    return int(min(8192, max(2048, round(4000 * mp, -2))))
+
+
 def _extract(pycolmap, db_path, images_dir, groups, camera_ids, options, progress: Progress):
     eo = pycolmap.FeatureExtractionOptions()
-    eo.sift.max_num_features = int(options.max_features)
+    g0 = max(groups, key=lambda g: g.width * g.height)
+    eo.sift.max_num_features = int(options.max_features or auto_max_features(g0.width, g0.height,
+                                                                              options.max_image_size))
     if options.max_image_size and options.max_image_size > 0:
         eo.max_image_size = int(options.max_image_size)
     eo.num_threads = options.num_threads

@@ -37,7 +37,7 @@ class WorkspaceError(RuntimeError):
 
 
 def _now() -> str:
-    return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    return _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
 
 
 def atomic_write_text(path: str, text: str) -> None:
@@ -117,7 +117,7 @@ class Workspace:
 
     # --- opening -------------------------------------------------------
     @classmethod
-    def open(cls, root: str) -> "Workspace":
+    def open(cls, root: str) -> Workspace:
         path = os.path.join(root, MANIFEST)
         if not os.path.isfile(path):
             raise WorkspaceError(f"{root} is not an ArchaeoOrtho workspace: {MANIFEST} is missing")
@@ -143,7 +143,7 @@ class Workspace:
         return cls(root, data)
 
     @classmethod
-    def create_or_open(cls, root: str) -> "Workspace":
+    def create_or_open(cls, root: str) -> Workspace:
         root = os.path.abspath(root)
         if os.path.isfile(os.path.join(root, MANIFEST)):
             return cls.open(root)

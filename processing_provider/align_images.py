@@ -56,8 +56,8 @@ class AlignImagesAlgorithm(AlgorithmBase):
             self.MAX_IMAGE_SIZE, self.tr("Largest image side for matching (0 = full size)"),
             type=QgsProcessingParameterNumber.Integer, defaultValue=0, minValue=0))
         self.addParameter(QgsProcessingParameterNumber(
-            self.MAX_FEATURES, self.tr("Largest number of features per image"),
-            type=QgsProcessingParameterNumber.Integer, defaultValue=8192, minValue=500))
+            self.MAX_FEATURES, self.tr("Largest number of features per image (0 = auto, ~4000 per megapixel)"),
+            type=QgsProcessingParameterNumber.Integer, defaultValue=0, minValue=0))
         self.addParameter(QgsProcessingParameterBoolean(
             self.AFFINE_FEATURES, self.tr("Affine-invariant features (oblique views; slower)"), defaultValue=False))
         self.addParameter(QgsProcessingParameterNumber(

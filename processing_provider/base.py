@@ -75,6 +75,7 @@ class AlgorithmBase(QgsProcessingAlgorithm):
         try:
             return func(*args, **kwargs)
         except Cancelled as e:
-            raise QgsProcessingException(QCoreApplication.translate("AlgorithmBase", "Cancelled: {}").format(e))
+            raise QgsProcessingException(
+                QCoreApplication.translate("AlgorithmBase", "Cancelled: {}").format(e)) from e
         except (ValueError, RuntimeError, OSError) as e:
-            raise QgsProcessingException(str(e))
+            raise QgsProcessingException(str(e)) from e

@@ -4,7 +4,15 @@ import os
 import numpy as np
 import pytest
 
-from core.images import GROUP_PER_IMAGE, GROUP_SINGLE, ImageError, group_cameras, read_image, read_image_info, scan_images
+from core.images import (
+    GROUP_PER_IMAGE,
+    GROUP_SINGLE,
+    ImageError,
+    group_cameras,
+    read_image,
+    read_image_info,
+    scan_images,
+)
 from tests.conftest import SAMPLE, shared
 
 

@@ -1,0 +1,148 @@
+"""Alignment benchmark: ArchaeoOrtho vs the COLMAP command line on the same images.
+
+Prints per-stage seconds and peak memory for our alignment, then the same work done by
+the COLMAP CLI (Debian package ``colmap``): feature_extractor + matcher + mapper, and the
+ratio.  "Same work" means the same images, the same camera model (OPENCV, one camera per
+camera type), the same number of features and the same pairs: with GPS, COLMAP's
+spatial_matcher with the same neighbour count; without, its exhaustive_matcher.
+``--colmap-defaults`` runs COLMAP with its own defaults instead (exhaustive matching,
+8192 features), the reference the issues quote.
+
+    python benchmarks/align.py [--images DIR] [--workdir DIR] [--skip-colmap] [--colmap-defaults]
+"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+from _util import run_measured  # noqa: E402
+
+DEFAULT_IMAGES = os.path.join(os.path.dirname(ROOT), "shared", "data", "toledo", "images")
+
+
+def ours(images, work, threads):
+    ws = os.path.join(work, "archaeoortho-ws")
+    shutil.rmtree(ws, ignore_errors=True)
+    code = ("import sys, json; sys.path.insert(0, %r); from core.sfm import align, AlignOptions;"
+            "r = align(%r, %r, AlignOptions(num_threads=%d));"
+            "print('RESULT', json.dumps({'registered': r.registered, 'images': r.images_given,"
+            "'mre': r.mean_reprojection_error, 'timings': r.timings, 'pairs': r.num_pairs,"
+            "'pairing': r.pairing_used, 'points': r.num_points3d}))") % (ROOT, images, ws, threads)
+    log = os.path.join(work, "archaeoortho.log")
+    rc, wall, rss = run_measured([sys.executable, "-c", code], log_path=log)
+    if rc != 0:
+        raise SystemExit(f"our alignment failed, see {log}")
+    result = [json.loads(line[7:]) for line in open(log) if line.startswith("RESULT ")][0]
+    return result, wall, rss
+
+
+def colmap(images, work, threads, defaults, neighbours, max_features):
+    exe = shutil.which("colmap")
+    if not exe:
+        raise SystemExit("colmap is not installed: apt-get install colmap (make bench does it)")
+    d = os.path.join(work, "colmap")
+    shutil.rmtree(d, ignore_errors=True)
+    os.makedirs(os.path.join(d, "sparse"))
+    db = os.path.join(d, "database.db")
+    env = dict(os.environ, QT_QPA_PLATFORM="offscreen")
+    common = ["--SiftExtraction.num_threads", str(threads), "--SiftExtraction.use_gpu", "0"]
+    steps = []
+    fe = [exe, "feature_extractor", "--database_path", db, "--image_path", images] + common
+    if not defaults:
+        fe += ["--ImageReader.camera_model", "OPENCV", "--SiftExtraction.max_num_features", str(max_features)]
+    steps.append(("features", fe))
+    with_gps = _has_gps(images)
+    if defaults or not with_gps:
+        steps.append(("matching", [exe, "exhaustive_matcher", "--database_path", db,
+                                   "--SiftMatching.num_threads", str(threads), "--SiftMatching.use_gpu", "0"]))
+    else:
+        steps.append(("matching", [exe, "spatial_matcher", "--database_path", db, "--SpatialMatching.is_gps", "1",
+                                   "--SpatialMatching.ignore_z", "1",
+                                   "--SpatialMatching.max_num_neighbors", str(neighbours + 3),
+                                   "--SpatialMatching.max_distance", "100000",
+                                   "--SiftMatching.num_threads", str(threads), "--SiftMatching.use_gpu", "0"]))
+    steps.append(("mapping", [exe, "mapper", "--database_path", db, "--image_path", images,
+                              "--output_path", os.path.join(d, "sparse"), "--Mapper.num_threads", str(threads)]))
+    timings, peak = {}, 0.0
+    for name, cmd in steps:
+        rc, wall, rss = run_measured(cmd, env=env, log_path=os.path.join(d, f"{name}.log"))
+        if rc != 0:
+            raise SystemExit(f"colmap {name} failed, see {d}/{name}.log")
+        timings[name] = round(wall, 1)
+        peak = max(peak, rss)
+    models = sorted(os.listdir(os.path.join(d, "sparse")))
+    best = None
+    for m in models:
+        out = subprocess.run([exe, "model_analyzer", "--path", os.path.join(d, "sparse", m)],
+                             capture_output=True, text=True, env=env)
+        text = out.stdout + out.stderr
+        reg = _grab(text, "Registered images:")
+        mre = _grab(text, "Mean reprojection error:")
+        if best is None or (reg or 0) > best[0]:
+            best = (reg, mre)
+    return timings, peak, best
+
+
+def _grab(text, key):
+    for line in text.splitlines():
+        if key in line:
+            v = line.split(key)[1].strip().replace("px", "").strip()
+            try:
+                return float(v)
+            except ValueError:
+                return None
+    return None
+
+
+def _has_gps(images):
+    sys.path.insert(0, ROOT)
+    from core.images import read_image_info
+
+    names = [n for n in os.listdir(images) if n.lower().endswith((".jpg", ".jpeg", ".tif", ".tiff"))]
+    return all(read_image_info(os.path.join(images, n)).gps for n in names[:5])
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--images", default=DEFAULT_IMAGES)
+    ap.add_argument("--workdir", default=os.path.join(ROOT, "build", "bench-align"))
+    ap.add_argument("--threads", type=int, default=os.cpu_count())
+    ap.add_argument("--skip-colmap", action="store_true")
+    ap.add_argument("--colmap-defaults", action="store_true")
+    a = ap.parse_args()
+    os.makedirs(a.workdir, exist_ok=True)
+    n = len([f for f in os.listdir(a.images) if f.lower().endswith((".jpg", ".jpeg", ".tif", ".tiff"))])
+    print(f"images: {a.images} ({n}); cores: {os.cpu_count()}; threads: {a.threads}", flush=True)
+    r, wall, rss = ours(a.images, a.workdir, a.threads)
+    print("\nArchaeoOrtho align")
+    for k, v in r["timings"].items():
+        print(f"  {k:<18} {v:8.1f} s")
+    print(f"  {'wall':<18} {wall:8.1f} s   peak RSS {rss:7.0f} MiB")
+    print(f"  registered {r['registered']}/{r['images']}, mean reprojection error {r['mre']:.3f} px, "
+          f"{r['points']} points, pairing {r['pairing']} ({r['pairs']} pairs)", flush=True)
+    if a.skip_colmap:
+        return
+    from core.sfm import auto_max_features
+    from core.images import read_image_info
+
+    first = sorted(f for f in os.listdir(a.images) if f.lower().endswith((".jpg", ".jpeg", ".tif", ".tiff")))[0]
+    info = read_image_info(os.path.join(a.images, first))
+    feats = auto_max_features(info.width, info.height)
+    t, peak, (reg, mre) = colmap(a.images, a.workdir, a.threads, a.colmap_defaults, 12, feats)
+    total = sum(t.values())
+    label = "COLMAP CLI (its defaults)" if a.colmap_defaults else "COLMAP CLI (same settings)"
+    print(f"\n{label}")
+    for k, v in t.items():
+        print(f"  {k:<18} {v:8.1f} s")
+    print(f"  {'wall':<18} {total:8.1f} s   peak RSS {peak:7.0f} MiB")
+    print(f"  registered {reg}, mean reprojection error {mre} px")
+    print(f"\nratio ArchaeoOrtho / COLMAP wall time: {wall / total:.2f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,142 @@
+"""The plugin as QGIS loads it: classFactory, provider registration, processing.run (pytest-qgis)."""
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from tests.conftest import PLUGINS, ROOT, SAMPLE, TOLEDO_STRIP, copy_images
+
+pytestmark = pytest.mark.usefixtures("qgis_processing")
+
+
+def _providers():
+    from qgis.core import QgsApplication
+
+    return [p for p in QgsApplication.processingRegistry().providers() if p.id() == "archaeoortho"]
+
+
+@pytest.fixture(scope="module")
+def plugin(qgis_iface, qgis_processing):
+    import archaeoortho
+
+    p = archaeoortho.classFactory(qgis_iface)
+    p.initProcessing()
+    p.initGui()
+    yield p
+    p.unload()
+
+
+def test_provider_registered_once(plugin):
+    plugin.initProcessing()  # QGIS may call both initProcessing and initGui
+    provs = _providers()
+    assert len(provs) == 1
+    assert provs[0].name() == "ArchaeoOrtho"
+    assert "archaeoortho:alignimages" in [a.id() for a in provs[0].algorithms()]
+
+
+def test_algorithm_parameters_are_the_interface(plugin):
+    from qgis.core import QgsApplication
+
+    alg = QgsApplication.processingRegistry().algorithmById("archaeoortho:alignimages")
+    names = {p.name() for p in alg.parameterDefinitions()}
+    assert {"IMAGES", "WORKSPACE", "PAIRING", "CAMERA_MODEL", "MAX_IMAGE_SIZE", "FOCAL_MM",
+            "SENSOR_WIDTH_MM", "SINGLE_CAMERA"} <= names
+    outs = {o.name() for o in alg.outputDefinitions()}
+    assert {"WORKSPACE", "CAMERAS", "REGISTERED_IMAGES", "MEAN_REPROJECTION_ERROR"} <= outs
+    assert alg.shortHelpString()
+
+
+@pytest.mark.slow
+def test_processing_run_align(plugin, tmp_path):
+    from qgis import processing
+    from qgis.core import QgsProcessingFeedback, QgsVectorLayer
+
+    images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:4], str(tmp_path / "img"))
+    feedback = QgsProcessingFeedback()
+    progress = []
+    feedback.progressChanged.connect(progress.append)
+    res = processing.run("archaeoortho:alignimages", {
+        "IMAGES": images, "WORKSPACE": str(tmp_path / "ws"), "MAX_IMAGE_SIZE": 800, "MAX_FEATURES": 2048,
+    }, feedback=feedback)
+    assert res["REGISTERED_IMAGES"] == 4
+    assert 0 < res["MEAN_REPROJECTION_ERROR"] < 1.0
+    assert os.path.isfile(os.path.join(res["WORKSPACE"], "workspace.json"))
+    layer = QgsVectorLayer(res["CAMERAS"], "cameras", "ogr")
+    assert layer.isValid() and layer.featureCount() == 4
+    assert progress and max(progress) == pytest.approx(100.0)
+
+
+@pytest.mark.slow
+def test_cancel_button_stops_the_stage(plugin, tmp_path):
+    from qgis import processing
+    from qgis.core import QgsProcessingException, QgsProcessingFeedback
+
+    images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:4], str(tmp_path / "img"))
+    feedback = QgsProcessingFeedback()
+
+    def maybe_cancel(value):
+        if value > 40:  # matching has started
+            feedback.cancel()
+
+    feedback.progressChanged.connect(maybe_cancel)
+    with pytest.raises(QgsProcessingException, match="[Cc]ancel"):
+        processing.run("archaeoortho:alignimages", {
+            "IMAGES": images, "WORKSPACE": str(tmp_path / "ws"), "MAX_IMAGE_SIZE": 800, "MAX_FEATURES": 2048,
+        }, feedback=feedback)
+    manifest = json.load(open(tmp_path / "ws" / "workspace.json"))
+    assert manifest["stages"]["align"]["status"] == "cancelled"
+    assert not os.path.exists(tmp_path / "ws" / "sfm" / "model")
+
+
+def _qgis_process_env():
+    import sysconfig
+
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([sysconfig.get_paths()["purelib"], env.get("PYTHONPATH", "")])
+    env["QGIS_PLUGINPATH"] = PLUGINS
+    env["QT_QPA_PLATFORM"] = "offscreen"
+    env.setdefault("QGIS_CUSTOM_CONFIG_PATH", os.path.join(ROOT, "build", "qgis-profile"))
+    return env
+
+
+def _qgis_process():
+    exe = os.environ.get("QGIS_PROCESS") or "/usr/bin/qgis_process.bin"
+    if not os.path.exists(exe):
+        pytest.skip("qgis_process not installed")
+    return exe
+
+
+@pytest.mark.slow
+def test_qgis_process_cli_end_to_end(tmp_path):
+    """Exactly as a user runs it headless: qgis_process --json run archaeoortho:alignimages."""
+    exe, env = _qgis_process(), _qgis_process_env()
+    if not os.path.islink(os.path.join(PLUGINS, "archaeoortho")):
+        pytest.skip("plugin link missing: run 'make setup'")
+    subprocess.run([exe, "plugins", "enable", "archaeoortho"], env=env, capture_output=True, timeout=120)
+    images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:4], str(tmp_path / "my photos ä"))
+    ws = str(tmp_path / "work space")
+    out = subprocess.run([exe, "--json", "run", "archaeoortho:alignimages", "--", f"IMAGES={images}",
+                          f"WORKSPACE={ws}", "MAX_IMAGE_SIZE=800", "MAX_FEATURES=2048"],
+                         env=env, capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-3000:]
+    result = json.loads(out.stdout)["results"]
+    assert result["REGISTERED_IMAGES"] == 4
+    assert result["MEAN_REPROJECTION_ERROR"] < 1.0
+    assert os.path.samefile(result["WORKSPACE"], ws)
+    # a bad input gives a clear message and a non-zero exit
+    bad = subprocess.run([exe, "run", "archaeoortho:alignimages", "--", f"IMAGES={tmp_path}/nothing-here",
+                          f"WORKSPACE={tmp_path}/ws2"], env=env, capture_output=True, text=True, timeout=300)
+    assert bad.returncode != 0
+    assert "nothing-here" in (bad.stdout + bad.stderr)
+
+
+def test_plugin_imports_nothing_gui_only_headless():
+    """Importing the plugin and its provider in plain Python pulls in none of the plugin's ui modules (docks, map tools)."""
+    code = (f"import sys; sys.path.insert(0, {PLUGINS!r}); import archaeoortho, archaeoortho.processing_provider.provider;"
+            "import archaeoortho.processing_provider.align_images;"
+            "bad=[m for m in sys.modules if m.startswith('archaeoortho.ui')];"
+            "print(bad); sys.exit(1 if bad else 0)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stdout + out.stderr
