@@ -200,7 +200,7 @@ def scan_images(folder: str, manual_focal_mm: Optional[float] = None,
         except ImageError as e:
             warnings.append(f"skipped {e}")
         if progress is not None:
-            progress.report((i + 1) / max(1, len(names)), f"read {n}")
+            progress.report((i + 1) / max(1, len(names)), "reading images")
     return good, warnings
 
 

@@ -44,8 +44,8 @@ SPATIAL_NEIGHBOURS = 12
 SEQUENTIAL_OVERLAP = 12
 LOOP_STRIDE = 10
 AUTO_EXHAUSTIVE_MAX = 100
-MATCH_BLOCK = 60  # pairs per matching call: the unit of progress and cancel
-EXTRACT_BLOCK = 4  # images per extraction call
+MATCH_BLOCK = 24  # pairs per matching call: the unit of progress and cancel
+EXTRACT_BLOCK = 2  # images per extraction call: the unit of progress and cancel
 STAGE = "align"
 
 
@@ -372,6 +372,7 @@ def _final_ba(pycolmap, rec, options: AlignOptions, progress: Progress):
     ba.refine_principal_point = bool(options.refine_principal_point and counts
                                      and min(counts.values()) >= options.min_images_opencv)
     ba.ceres.loss_function_type = pycolmap.LossFunctionType.CAUCHY
+    ba.ceres.solver_options.max_num_iterations = 30  # the mapper's last global BA has already converged
     with _CancelWatcher(progress) as token:
         pycolmap.bundle_adjustment(rec, ba, cancellation_token=token)
     check_cancel(progress)
