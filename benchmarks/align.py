@@ -20,6 +20,7 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
+sys.path.insert(0, ROOT)
 from _util import run_measured  # noqa: E402
 
 DEFAULT_IMAGES = os.path.join(os.path.dirname(ROOT), "shared", "data", "toledo", "images")
@@ -100,7 +101,6 @@ def _grab(text, key):
 
 
 def _has_gps(images):
-    sys.path.insert(0, ROOT)
     from core.images import read_image_info
 
     names = [n for n in os.listdir(images) if n.lower().endswith((".jpg", ".jpeg", ".tif", ".tiff"))]
