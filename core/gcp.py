@@ -3,11 +3,57 @@
 Pixel coordinates: origin at the upper-left corner of the upper-left pixel,
 x to the right, y down (the same convention as COLMAP, whose pixel centres
 sit at +0.5).
+
+Formats
+-------
+OpenDroneMap ``gcp_list.txt``
+    The first line that is neither blank nor a ``#`` comment holds the CRS: an
+    EPSG code (``EPSG:32617``, or a bare ``32617``), ``WGS84 UTM 17N``, a proj
+    string or one-line WKT (a WKT spread over several lines is joined until its
+    brackets balance); trailing blanks and tabs are ignored.  Every further
+    line is ``x y z px py image [name] [extra ...]``, fields separated by tabs
+    or spaces; blank lines, ``#`` comment lines and anything from a field that
+    starts with ``#`` are skipped.  Lines without a name (the older form) are
+    grouped by identical coordinates: a group whose coordinates equal those of
+    a named point joins it, any other group gets the name ``gcp_<n>``, where n
+    is the point's position in the file (1-based).  An extra field ``check``
+    right after the name marks a check point (our writer puts it there; ODM
+    ignores extra fields).
+
+CSV (a pair of files)
+    Points ``name,x,y,z[,sx,sy,sz,role]`` and observations
+    ``name,image,px,py``, each with a header row (column order free, names
+    case-insensitive, a few aliases accepted; ``,``, ``;`` or tab separated).
+    The observations file defaults to ``<points stem>_observations.csv`` next to
+    the points file.  The CRS comes from the ``crs`` argument, or a comment line
+    ``# crs: EPSG:32617`` (or a bare CRS line) before the header.
+    ``sigma_xy`` is the larger of ``sx`` and ``sy`` (the conservative choice: a
+    single horizontal sigma must not claim more precision than the worse axis);
+    ``sz`` gives ``sigma_z``; empty cells keep the defaults; ``role`` is
+    ``control`` (default, also ``gcp``) or ``check`` (also ``checkpoint``,
+    ``cp``).
+
+Camera positions (see ``read_camera_positions``)
+    ``image,x,y,z[,sigma[,sigma_z]]`` rows (comma or whitespace separated, an
+    optional header row), or ``x y [z] image`` rows as in OpenDroneMap's
+    ``geo.txt``; optionally preceded by a CRS line.
+
+Problems that make a file unusable raise ``GCPError`` with ``file:line: reason``;
+problems that leave it usable are collected in ``GCPSet.warnings`` in the same
+form.
 """
 from __future__ import annotations
 
+import contextlib
+import csv
+import math
+import os
+import re
+import warnings as _warnings
 from dataclasses import dataclass, field
-from typing import List, Optional
+from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
 
 CONTROL = "control"
 CHECK = "check"
@@ -35,18 +81,61 @@ class GroundPoint:
     role: str = CONTROL  # CONTROL or CHECK
     observations: List[Observation] = field(default_factory=list)
 
+    def images(self) -> List[str]:
+        """Names of the images this point is observed in, in order, without repeats."""
+        return list(dict.fromkeys(o.image for o in self.observations))
+
 
 @dataclass
 class GCPSet:
     crs: str  # as given: "EPSG:xxxx", WKT or a proj string
     points: List[GroundPoint] = field(default_factory=list)
     warnings: List[str] = field(default_factory=list)
+    source: str = ""  # the file it was read from, if any
 
     def by_name(self, name: str) -> Optional[GroundPoint]:
         for p in self.points:
             if p.name == name:
                 return p
         return None
+
+    def control_points(self) -> List[GroundPoint]:
+        return [p for p in self.points if p.role == CONTROL]
+
+    def check_points(self) -> List[GroundPoint]:
+        return [p for p in self.points if p.role == CHECK]
+
+    def n_observations(self) -> int:
+        return sum(len(p.observations) for p in self.points)
+
+    def image_names(self) -> List[str]:
+        """Every image with at least one observation, in order of first appearance."""
+        return list(dict.fromkeys(o.image for p in self.points for o in p.observations))
+
+    def to_dict(self) -> Dict[str, Any]:
+        """A JSON-ready dict (e.g. for georef/control.json); ``from_dict`` reads it back."""
+        return {
+            "crs": self.crs,
+            "points": [
+                {"name": p.name, "x": p.x, "y": p.y, "z": p.z, "sigma_xy": p.sigma_xy, "sigma_z": p.sigma_z,
+                 "role": p.role,
+                 "observations": [{"image": o.image, "x": o.x, "y": o.y} for o in p.observations]}
+                for p in self.points
+            ],
+            "warnings": list(self.warnings),
+            "source": self.source,
+        }
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> GCPSet:
+        pts = []
+        for p in d.get("points", []):
+            obs = [Observation(str(o["image"]), float(o["x"]), float(o["y"]))
+                   for o in p.get("observations", [])]
+            pts.append(GroundPoint(str(p["name"]), float(p["x"]), float(p["y"]), float(p["z"]),
+                                   float(p.get("sigma_xy", 0.02)), float(p.get("sigma_z", 0.05)),
+                                   str(p.get("role", CONTROL)), obs))
+        return cls(str(d.get("crs", "")), pts, list(d.get("warnings", [])), str(d.get("source", "")))
 
 
 @dataclass
@@ -57,3 +146,1087 @@ class CameraPosition:
     z: float
     sigma_xy: float = 5.0
     sigma_z: float = 10.0
+
+
+PathLike = Union[str, "os.PathLike[str]"]
+ImageSizes = Mapping[str, Tuple[int, int]]
+
+# --------------------------------------------------------------------------------------------------
+# CRS helpers (GDAL/osr, else pyproj, else no validation)
+# --------------------------------------------------------------------------------------------------
+
+_WKT_START = re.compile(r"^\s*(PROJCS|GEOGCS|GEOCCS|COMPD_CS|LOCAL_CS|VERT_CS|PROJCRS|GEOGCRS|GEODCRS|"
+                        r"GEODETICCRS|BASEGEOGCRS|COMPOUNDCRS|BOUNDCRS|ENGCRS|ENGINEERINGCRS|VERTCRS|VERTICALCRS|"
+                        r"PROJECTEDCRS)\s*[\[(]", re.IGNORECASE)
+_UTM_NAME = re.compile(r"^WGS\s*-?\s*84\s+UTM\s+(?:ZONE\s*)?(\d{1,2})\s*([NS])$", re.IGNORECASE)
+_AUTH_CODE = re.compile(r"^([A-Za-z][A-Za-z0-9_]*)\s*:\s*(\S+)$")
+
+
+def _osr():
+    try:
+        from osgeo import osr
+    except ImportError:
+        return None
+    return osr
+
+
+def _pyproj():
+    try:
+        import pyproj
+    except ImportError:
+        return None
+    return pyproj
+
+
+@contextlib.contextmanager
+def _quiet_gdal():
+    """Silence GDAL's error printing (we report problems ourselves) and reset its last error."""
+    try:
+        from osgeo import gdal
+    except ImportError:
+        yield None
+        return
+    gdal.PushErrorHandler("CPLQuietErrorHandler")
+    gdal.ErrorReset()
+    try:
+        yield gdal
+    finally:
+        gdal.PopErrorHandler()
+
+
+def normalize_crs(text: str) -> str:
+    """Tidy a CRS string: strip blanks, ``32617`` -> ``EPSG:32617``, ``epsg : 32617`` -> ``EPSG:32617``,
+    ``WGS84 UTM 17N`` -> ``EPSG:32617`` (a form OpenDroneMap accepts); anything else is returned stripped
+    of surrounding blanks."""
+    s = (text or "").strip()
+    if re.fullmatch(r"\d+", s):
+        return f"EPSG:{int(s)}"
+    m = re.fullmatch(r"(?i)epsg\s*:\s*(\d+)", s)
+    if m:
+        return f"EPSG:{int(m.group(1))}"
+    m = _UTM_NAME.match(s)
+    if m and 1 <= int(m.group(1)) <= 60:
+        return f"EPSG:{(32600 if m.group(2).upper() == 'N' else 32700) + int(m.group(1))}"
+    return s
+
+
+def looks_like_crs(text: str) -> bool:
+    """True when a line reads as a CRS definition (EPSG code, authority:code, proj string, WKT, UTM name)."""
+    s = (text or "").strip()
+    if not s:
+        return False
+    if re.fullmatch(r"\d+", s) or _UTM_NAME.match(s) or _WKT_START.match(s):
+        return True
+    if s.startswith("+proj=") or s.startswith("+init=") or s.lower().startswith("urn:ogc:def:crs"):
+        return True
+    return bool(_AUTH_CODE.match(s))
+
+
+def _srs(crs: str):
+    """osr.SpatialReference with GIS axis order (x = lon/easting), or raise GCPError."""
+    osr = _osr()
+    ok, reason = _crs_status(crs)
+    if ok is False:
+        raise GCPError(f"unknown or unparsable CRS {crs!r}: {reason}")
+    srs = osr.SpatialReference()
+    with _quiet_gdal():
+        srs.SetFromUserInput(normalize_crs(crs))
+    srs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+    return srs
+
+
+def _crs_status(crs: str) -> Tuple[Optional[bool], str]:
+    """(True, '') valid; (False, reason) invalid; (None, reason) cannot be checked here."""
+    s = normalize_crs(crs)
+    if not s:
+        return False, "empty CRS"
+    if re.match(r"(?i)^(https?|ftp)://", s):
+        return False, "a CRS must be given inline (EPSG code, proj string or WKT), not as a URL"
+    if os.path.isfile(s):
+        return False, "a CRS must be given inline (EPSG code, proj string or WKT), not as a file name"
+    osr = _osr()
+    if osr is not None:
+        srs = osr.SpatialReference()
+        with _quiet_gdal() as gdal:
+            try:
+                err = srs.SetFromUserInput(s)
+            except RuntimeError as e:  # osr.UseExceptions() enabled elsewhere
+                return False, str(e) or "not recognised by GDAL/PROJ"
+            msg = gdal.GetLastErrorMsg() if gdal is not None else ""
+        if err != 0:
+            return False, msg or f"not recognised by GDAL/PROJ (OGRErr {err})"
+        return True, ""
+    pyproj = _pyproj()
+    if pyproj is not None:
+        try:
+            pyproj.CRS.from_user_input(s)
+        except Exception as e:  # pyproj.exceptions.CRSError and friends
+            return False, str(e)
+        return True, ""
+    return None, "neither GDAL (osgeo) nor pyproj is available"
+
+
+def validate_crs(crs: str) -> Optional[str]:
+    """Check a CRS string with GDAL (osgeo.osr), else pyproj.
+
+    Returns None when it is valid, a warning text when it cannot be checked (no CRS library);
+    raises GCPError when it is unknown or unparsable.
+    """
+    ok, reason = _crs_status(crs)
+    if ok is False:
+        raise GCPError(f"unknown or unparsable CRS {crs!r}: {reason}")
+    return None if ok else reason
+
+
+def _crs_kind(crs: str) -> Optional[str]:
+    """'geographic', 'projected', 'other' (geocentric, local, vertical), or None when unknown."""
+    s = normalize_crs(crs)
+    osr = _osr()
+    if osr is not None:
+        ok, _ = _crs_status(s)
+        if not ok:
+            return None
+        srs = osr.SpatialReference()
+        with _quiet_gdal():
+            srs.SetFromUserInput(s)
+        if srs.IsProjected():
+            return "projected"
+        if srs.IsGeographic():
+            return "geographic"
+        return "other"
+    pyproj = _pyproj()
+    if pyproj is not None:
+        try:
+            c = pyproj.CRS.from_user_input(s)
+        except Exception:
+            return None
+        if c.is_projected:
+            return "projected"
+        if c.is_geographic:
+            return "geographic"
+        return "other"
+    low = s.lower()  # last resort: recognise the common spellings
+    if low in ("epsg:4326", "epsg:4979", "epsg:4258", "epsg:4269", "ogc:crs84") or "+proj=longlat" in low \
+            or "+proj=latlong" in low or low.startswith(("geogcs[", "geogcrs[")):
+        return "geographic"
+    if low.startswith(("epsg:326", "epsg:327", "projcs[", "projcrs[")) or "+proj=utm" in low:
+        return "projected"
+    return None
+
+
+def crs_is_geographic(crs_string: str) -> bool:
+    """True for a geographic (longitude/latitude, degrees) CRS, 2-D or 3-D, also as the horizontal part of a
+    compound CRS.  Raises GCPError for an unknown CRS."""
+    validate_crs(crs_string)
+    return _crs_kind(crs_string) == "geographic"
+
+
+def check_coordinates_match_crs(crs: str, xy: Any, what: str = "coordinates", source: str = "") -> None:
+    """Catch coordinates given in the wrong units for their CRS; raise GCPError with a clear message.
+
+    * projected CRS but every |x| <= 180 and |y| <= 90 and the points span less than 1 unit: these are
+      degrees (longitude/latitude) labelled with a metric CRS.  (A real block in a projected CRS spans
+      more than one metre; the spread test keeps small local grids near the origin from tripping it.)
+    * geographic CRS but some |x| > 180 or |y| > 90: these are projected metres (or latitude and
+      longitude swapped) labelled as degrees.
+
+    Nothing is checked when the CRS kind cannot be determined (no CRS library).
+    """
+    a = np.asarray(xy, dtype=float)
+    if a.size == 0:
+        return
+    a = a.reshape(-1, a.shape[-1])[:, :2]
+    a = a[np.all(np.isfinite(a), axis=1)]
+    if len(a) == 0:
+        return
+    kind = _crs_kind(crs)
+    where = f"{source}: " if source else ""
+    x, y = a[:, 0], a[:, 1]
+    if kind == "projected":
+        degree_like = bool(np.all(np.abs(x) <= 180.0) and np.all(np.abs(y) <= 90.0))
+        span = float(max(np.ptp(x), np.ptp(y)))
+        if degree_like and span < 1.0:
+            raise GCPError(
+                f"{where}{what} look like degrees (longitude/latitude, e.g. x={x[0]:.6f}, y={y[0]:.6f}) "
+                f"but the CRS {crs!r} is projected (metres or feet): give the coordinates in that CRS, or "
+                f"declare the geographic CRS they are in (e.g. EPSG:4326)")
+    elif kind == "geographic":
+        bad_x = np.abs(x) > 180.0
+        bad_y = np.abs(y) > 90.0
+        if np.any(bad_x | bad_y):
+            i = int(np.argmax(bad_x | bad_y))
+            if not np.any(bad_x) and np.all(np.abs(y) <= 180.0) and np.all(np.abs(x) <= 90.0):
+                hint = ("latitude and longitude look swapped: x must be the longitude (east), "
+                        "y the latitude (north)")
+            else:
+                hint = ("they look like projected coordinates (e.g. UTM metres): declare the projected CRS "
+                        "they are in (e.g. EPSG:326xx for UTM north)")
+            raise GCPError(
+                f"{where}{what} out of range for the geographic CRS {crs!r} (degrees): x={x[i]:.3f}, "
+                f"y={y[i]:.3f}; {hint}")
+
+
+def utm_epsg_for_lonlat(lon: float, lat: float) -> int:
+    """EPSG code of the WGS 84 / UTM zone holding (lon, lat) in degrees: 326zz north, 327zz south.
+
+    Follows the UTM grid's exceptions (zone 32V over south-west Norway, zones 31X/33X/35X/37X over
+    Svalbard).  Beyond the UTM latitude range (north of 84 N, south of 80 S) returns the polar
+    stereographic UPS codes 32661 (north) and 32761 (south).
+    """
+    lon = float(lon)
+    lat = float(lat)
+    if not (math.isfinite(lon) and math.isfinite(lat)) or abs(lat) > 90.0 or abs(lon) > 360.0:
+        raise ValueError(f"not a longitude/latitude in degrees: {lon}, {lat}")
+    if lat > 84.0:
+        return 32661
+    if lat < -80.0:
+        return 32761
+    lon = (lon + 180.0) % 360.0 - 180.0  # wrap to [-180, 180)
+    zone = int(math.floor((lon + 180.0) / 6.0)) + 1
+    zone = min(max(zone, 1), 60)
+    if 56.0 <= lat < 64.0 and 3.0 <= lon < 12.0:
+        zone = 32
+    elif 72.0 <= lat <= 84.0 and 0.0 <= lon < 42.0:
+        zone = 31 if lon < 9.0 else 33 if lon < 21.0 else 35 if lon < 33.0 else 37
+    return (32600 if lat >= 0.0 else 32700) + zone
+
+
+def transform_points(xyz: Any, src_crs: str, dst_crs: str) -> np.ndarray:
+    """Transform an (N, 2) or (N, 3) array of points between CRSs; returns float64 of the same shape.
+
+    Axis order is the GIS one on both sides (x = longitude / easting, y = latitude / northing), whatever
+    the CRS's official axis order.  Heights follow PROJ's rules: for EXIF GPS give
+    EPSG:4979 (WGS 84 lon/lat + ellipsoidal height) as source; a 2-D projected target (e.g. EPSG:32617)
+    keeps that ellipsoidal height unchanged.  A NaN height (unknown) stays NaN; x and y are still
+    transformed.  Uses GDAL (osr), else pyproj; raises GCPError if a point cannot be transformed.
+    """
+    a = np.array(xyz, dtype=float)
+    if a.ndim == 1:
+        a = a.reshape(1, -1)
+        squeeze = True
+    else:
+        squeeze = False
+    if a.ndim != 2 or a.shape[1] not in (2, 3):
+        raise ValueError(f"expected an (N, 2) or (N, 3) array of points, got shape {np.shape(xyz)}")
+    if len(a) == 0:
+        return a
+    three = a.shape[1] == 3
+    z = a[:, 2].copy() if three else np.zeros(len(a))
+    z_nan = ~np.isfinite(z)
+    z_in = np.where(z_nan, 0.0, z)
+    osr = _osr()
+    if osr is not None:
+        src, dst = _srs(src_crs), _srs(dst_crs)
+        with _quiet_gdal() as gdal:
+            try:
+                ct = osr.CoordinateTransformation(src, dst)
+            except RuntimeError as e:
+                ct = None
+                msg = str(e)
+            else:
+                msg = gdal.GetLastErrorMsg() if gdal is not None else ""
+            if ct is None:
+                raise GCPError(f"no transformation from {src_crs!r} to {dst_crs!r}: {msg}")
+            pts = np.column_stack([a[:, 0], a[:, 1], z_in]).tolist()
+            try:
+                out = np.array(ct.TransformPoints(pts), dtype=float)
+            except RuntimeError:  # exceptions enabled (osr.UseExceptions) and some point failed: one by one
+                out = np.array([_transform_one(ct, p) for p in pts], dtype=float)
+    else:
+        pyproj = _pyproj()
+        if pyproj is None:
+            raise GCPError("transforming coordinates needs GDAL (osgeo) or pyproj; neither is installed")
+        try:
+            tr = pyproj.Transformer.from_crs(normalize_crs(src_crs), normalize_crs(dst_crs), always_xy=True)
+            ox, oy, oz = tr.transform(a[:, 0], a[:, 1], z_in)
+        except Exception as e:
+            raise GCPError(f"no transformation from {src_crs!r} to {dst_crs!r}: {e}") from e
+        out = np.column_stack([ox, oy, oz]).astype(float)
+    bad = ~np.all(np.isfinite(out[:, :2]), axis=1)
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise GCPError(f"point {i} ({a[i, 0]}, {a[i, 1]}) cannot be transformed from {src_crs!r} to "
+                       f"{dst_crs!r} (outside the CRS's domain?)")
+    out[z_nan, 2] = np.nan
+    res = out if three else out[:, :2]
+    return res[0] if squeeze else res
+
+
+def _transform_one(ct, p: Sequence[float]) -> Tuple[float, float, float]:
+    try:
+        return tuple(ct.TransformPoint(*p))[:3]
+    except RuntimeError:
+        return (math.inf, math.inf, math.inf)
+
+
+# --------------------------------------------------------------------------------------------------
+# reading helpers
+# --------------------------------------------------------------------------------------------------
+
+def _read_lines(path: PathLike) -> List[str]:
+    try:
+        with open(path, "rb") as f:
+            raw = f.read()
+    except OSError as e:
+        raise GCPError(f"{path}: cannot read: {e.strerror or e}") from e
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        text = raw.decode("latin-1")
+    return text.splitlines()
+
+
+def _num(tok: str, what: str, path: PathLike, lineno: int) -> float:
+    try:
+        v = float(tok)
+    except ValueError:
+        raise GCPError(f"{path}:{lineno}: {what} is not a number: {tok!r}") from None
+    if not math.isfinite(v):
+        raise GCPError(f"{path}:{lineno}: {what} is not a finite number: {tok!r}")
+    return v
+
+
+def _is_number(tok: str) -> bool:
+    try:
+        return math.isfinite(float(tok))
+    except ValueError:
+        return False
+
+
+def _check_crs_for_file(crs: str, path: PathLike, lineno: Optional[int], warnings: List[str]) -> None:
+    where = f"{path}:{lineno}" if lineno else f"{path}"
+    ok, reason = _crs_status(crs)
+    if ok is False:
+        raise GCPError(f"{where}: unknown or unparsable CRS {crs!r}: {reason}")
+    if ok is None:
+        warnings.append(f"{where}: CRS {crs!r} not validated: {reason}")
+
+
+class _ImageLookup:
+    """Match image names from a control file to the block's names: exactly, then by base name, then by base
+    name ignoring case (only when that is unambiguous)."""
+
+    def __init__(self, names: Optional[Iterable[str]]):
+        self.names = None if names is None else list(names)
+        self.exact = set(self.names or [])
+        self.base: Dict[str, List[str]] = {}
+        self.lower: Dict[str, List[str]] = {}
+        for n in self.names or []:
+            b = os.path.basename(n.replace("\\", "/"))
+            self.base.setdefault(b, []).append(n)
+            self.lower.setdefault(b.lower(), []).append(n)
+
+    def find(self, image: str) -> Optional[str]:
+        if self.names is None or image in self.exact:
+            return image
+        b = os.path.basename(image.replace("\\", "/"))
+        for table, key in ((self.base, b), (self.lower, b.lower())):
+            hit = table.get(key, [])
+            if len(hit) == 1:
+                return hit[0]
+        return None
+
+
+def _finish(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike,
+            image_names: Optional[Iterable[str]], image_sizes: Optional[ImageSizes],
+            unknown_images: str = "error", point_where: Optional[Dict[int, str]] = None,
+            unit: str = "line") -> GCPSet:
+    """Shared validation: unknown images, duplicate observations, bounds, points seen in < 2 images.
+
+    ``obs_lines[id(point)]`` holds the source line (in ``path``) of each observation of that point;
+    ``point_where[id(point)]`` where the point itself is defined, when that is elsewhere ("file:line").
+    ``unit``: "line" (file:line) or "row" (source: row n) in messages.
+    """
+
+    def loc(n: int) -> str:
+        if not n:
+            return f"{path}"
+        return f"{path}:{n}" if unit == "line" else f"{path}: row {n}"
+
+    if unknown_images not in ("error", "warn"):
+        raise ValueError("unknown_images must be 'error' or 'warn'")
+    names = _ImageLookup(image_names)
+    sizes_lookup = _ImageLookup(image_sizes.keys()) if image_sizes is not None else None
+    unknown: List[str] = []
+    for p in gs.points:
+        lines = obs_lines.get(id(p), [0] * len(p.observations))
+        kept: List[Observation] = []
+        kept_lines: List[int] = []
+        seen: Dict[str, int] = {}
+        for o, ln in zip(p.observations, lines):
+            at = loc(ln)
+            img = names.find(o.image)
+            if img is None:
+                if unknown_images == "error":
+                    unknown.append(f"{unit} {ln}: {o.image}" if ln else o.image)
+                else:
+                    gs.warnings.append(f"{at}: image {o.image!r} (point {p.name}) is not in the block; "
+                                       "observation ignored")
+                continue
+            o = Observation(img, o.x, o.y)
+            if img in seen:
+                first = f"{unit} {seen[img]}" if seen[img] else f"an earlier {unit}"
+                gs.warnings.append(f"{at}: duplicate observation of point {p.name} in image {img} "
+                                   f"(first on {first}); keeping the first")
+                continue
+            if sizes_lookup is not None:
+                key = sizes_lookup.find(img)
+                if key is not None and key in image_sizes:
+                    w, h = image_sizes[key]
+                    if not (0.0 <= o.x <= float(w) and 0.0 <= o.y <= float(h)):
+                        gs.warnings.append(
+                            f"{at}: observation of point {p.name} at ({o.x:g}, {o.y:g}) lies outside image "
+                            f"{img} ({w} x {h} px); dropped")
+                        continue
+            seen[img] = ln
+            kept.append(o)
+            kept_lines.append(ln)
+        p.observations = kept
+        obs_lines[id(p)] = kept_lines
+    if unknown:
+        shown = "; ".join(unknown[:20]) + (f"; ... ({len(unknown)} in all)" if len(unknown) > 20 else "")
+        known = names.names or []
+        raise GCPError(f"{path}: observation(s) in image(s) that are not in the block ({len(known)} images): "
+                       f"{shown}")
+    for p in gs.points:
+        n = len(p.images())
+        first = next(iter(obs_lines.get(id(p)) or []), 0)
+        at = (point_where or {}).get(id(p)) or loc(first)
+        if n == 0:
+            gs.warnings.append(f"{at}: point {p.name} has no usable observation")
+        elif n == 1:
+            gs.warnings.append(f"{at}: point {p.name} is observed in only 1 image "
+                               f"({p.observations[0].image}): usable only for single-image work (space "
+                               "resection, orthorectifying that image), not for triangulation in the block")
+    return gs
+
+
+def _check_units(gs: GCPSet, path: PathLike) -> None:
+    if gs.points:
+        check_coordinates_match_crs(gs.crs, [(p.x, p.y) for p in gs.points], "GCP coordinates", str(path))
+
+
+# --------------------------------------------------------------------------------------------------
+# OpenDroneMap gcp_list.txt
+# --------------------------------------------------------------------------------------------------
+
+def read_odm_gcp_list(path: PathLike, image_names: Optional[Iterable[str]] = None,
+                      image_sizes: Optional[ImageSizes] = None, *, unknown_images: str = "error") -> GCPSet:
+    """Read an OpenDroneMap ``gcp_list.txt`` (format in the module docstring).
+
+    ``image_names``: the block's images; an observation in any other image raises GCPError (or, with
+    ``unknown_images="warn"``, is dropped with a warning).  Names match exactly, else by base name, else by
+    base name ignoring case; the block's spelling is kept.  ``image_sizes``: {image: (width, height)};
+    observations outside [0, w] x [0, h] are dropped with a warning.
+    """
+    lines = _read_lines(path)
+    i = 0
+    while i < len(lines) and (not lines[i].strip() or lines[i].lstrip().startswith("#")):
+        i += 1
+    if i == len(lines):
+        raise GCPError(f"{path}: empty: no CRS line and no observations")
+    crs_line = i + 1
+    header = lines[i].strip()
+    i += 1
+    if _WKT_START.match(header):  # WKT spread over several lines: join until the brackets balance
+        def _open(t: str) -> int:
+            return t.count("[") + t.count("(") - t.count("]") - t.count(")")
+
+        while _open(header) > 0 and i < len(lines):
+            header += " " + lines[i].strip()
+            i += 1
+    toks = header.split()
+    if len(toks) >= 6 and all(_is_number(t) for t in toks[:5]):
+        raise GCPError(f"{path}:{crs_line}: expected the CRS line (e.g. 'EPSG:32617', a proj string or WKT) "
+                       f"before the first observation, found an observation line")
+    crs = normalize_crs(header)
+    gs = GCPSet(crs=crs, source=str(path))
+    _check_crs_for_file(crs, path, crs_line, gs.warnings)
+
+    # parse: (line, x, y, z, px, py, image, name or None, is_check)
+    recs: List[Tuple[int, float, float, float, float, float, str, Optional[str], bool]] = []
+    for ln in range(i, len(lines)):
+        s = lines[ln].strip()
+        if not s or s.startswith("#"):
+            continue
+        toks = s.split()
+        for k, t in enumerate(toks):
+            if t.startswith("#"):
+                toks = toks[:k]
+                break
+        lineno = ln + 1
+        if len(toks) < 6:
+            raise GCPError(f"{path}:{lineno}: expected 'x y z px py image [name]', found {len(toks)} "
+                           f"field(s): {s!r}")
+        x, y, z = (_num(toks[k], w, path, lineno) for k, w in ((0, "x"), (1, "y"), (2, "z")))
+        px = _num(toks[3], "pixel x", path, lineno)
+        py = _num(toks[4], "pixel y", path, lineno)
+        name = toks[6] if len(toks) > 6 else None
+        is_check = len(toks) > 7 and toks[7].lower() == CHECK
+        recs.append((lineno, x, y, z, px, py, toks[5], name, is_check))
+
+    # build points in file order
+    named: Dict[str, Tuple[GroundPoint, int]] = {}
+    by_xyz_named: Dict[Tuple[float, float, float], List[str]] = {}
+    for lineno, x, y, z, _px, _py, _img, name, _chk in recs:
+        if name is None:
+            continue
+        if name in named:
+            p, first = named[name]
+            if (p.x, p.y, p.z) != (x, y, z):
+                raise GCPError(f"{path}:{lineno}: point {name} has coordinates ({x}, {y}, {z}) here but "
+                               f"({p.x}, {p.y}, {p.z}) on line {first}")
+        else:
+            named[name] = (GroundPoint(name, x, y, z), lineno)
+            by_xyz_named.setdefault((x, y, z), []).append(name)
+    order: List[GroundPoint] = []
+    placed = set()
+    groups: Dict[Tuple[float, float, float], GroundPoint] = {}
+    generated: List[Tuple[GroundPoint, int]] = []
+    obs_lines: Dict[int, List[int]] = {}
+    for lineno, x, y, z, px, py, img, name, is_check in recs:
+        if name is not None:
+            p = named[name][0]
+        else:
+            key = (x, y, z)
+            twins = by_xyz_named.get(key, [])
+            if len(twins) == 1:
+                p = named[twins[0]][0]
+            elif key in groups:
+                p = groups[key]
+            else:
+                p = GroundPoint("", x, y, z)
+                groups[key] = p
+                generated.append((p, lineno))
+        if id(p) not in placed:
+            placed.add(id(p))
+            order.append(p)
+        if is_check:
+            p.role = CHECK
+        p.observations.append(Observation(img, px, py))
+        obs_lines.setdefault(id(p), []).append(lineno)
+    used = set(named)
+    for p, lineno in generated:
+        n = order.index(p) + 1
+        name = f"gcp_{n}"
+        k = 2
+        while name in used:
+            name = f"gcp_{n}_{k}"
+            k += 1
+        p.name = name
+        used.add(name)
+        gs.warnings.append(f"{path}:{lineno}: observations without a point name grouped by their coordinates "
+                           f"({p.x}, {p.y}, {p.z}) as point {name} ({len(p.observations)} observation(s))")
+    gs.points = order
+    if not order:
+        gs.warnings.append(f"{path}: no observations")
+    _finish(gs, obs_lines, path, image_names, image_sizes, unknown_images)
+    _check_units(gs, path)
+    return gs
+
+
+def _fmt(v: float) -> str:
+    """Shortest text that reads back as the same float."""
+    return repr(float(v))
+
+
+def _writable_token(s: str, what: str) -> str:
+    if not s or any(c.isspace() for c in s) or s.startswith("#"):
+        raise GCPError(f"cannot write {what} {s!r} to gcp_list.txt: names must be non-empty, without blanks, "
+                       "and must not start with '#'")
+    return s
+
+
+def write_odm_gcp_list(gcpset: GCPSet, path: PathLike) -> None:
+    """Write an OpenDroneMap ``gcp_list.txt``: the CRS line, then one tab-separated line per observation
+    ``x y z px py image name`` (plus ``check`` for check points).  Numbers are written so that they read back
+    exactly; sigmas are not part of the format (they revert to the defaults on reading).  Points without
+    observations cannot be expressed in the format and are listed in ``#`` comments."""
+    crs = " ".join(gcpset.crs.split())
+    if not crs:
+        raise GCPError("cannot write gcp_list.txt without a CRS")
+    out = [crs]
+    for p in gcpset.points:
+        name = _writable_token(p.name, "point name")
+        if not p.observations:
+            out.append(f"# point {name} has no observations: {_fmt(p.x)} {_fmt(p.y)} {_fmt(p.z)}")
+        for o in p.observations:
+            fields = [_fmt(p.x), _fmt(p.y), _fmt(p.z), _fmt(o.x), _fmt(o.y),
+                      _writable_token(o.image, "image name"), name]
+            if p.role == CHECK:
+                fields.append(CHECK)
+            out.append("\t".join(fields))
+    _write_text(path, "\n".join(out) + "\n")
+
+
+def _write_text(path: PathLike, text: str) -> None:
+    tmp = f"{path}.tmp{os.getpid()}"
+    with open(tmp, "w", encoding="utf-8", newline="\n") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
+# --------------------------------------------------------------------------------------------------
+# CSV pair
+# --------------------------------------------------------------------------------------------------
+
+_POINT_COLS = {
+    "name": ("name", "id", "label", "point", "gcp", "point_name", "gcp_name", "pointname"),
+    "x": ("x", "easting", "east", "lon", "longitude", "map_x", "mapx"),
+    "y": ("y", "northing", "north", "lat", "latitude", "map_y", "mapy"),
+    "z": ("z", "elevation", "height", "h", "alt", "altitude"),
+    "sx": ("sx", "sigma_x", "std_x", "stdx", "sigmax"),
+    "sy": ("sy", "sigma_y", "std_y", "stdy", "sigmay"),
+    "sxy": ("sigma_xy", "sxy", "sigmaxy", "std_xy"),
+    "sz": ("sz", "sigma_z", "std_z", "stdz", "sigmaz"),
+    "role": ("role", "type", "kind", "use"),
+}
+_OBS_COLS = {
+    "name": _POINT_COLS["name"],
+    "image": ("image", "image_name", "imagename", "photo", "file", "filename", "file_name"),
+    "px": ("px", "pixel_x", "pixelx", "image_x", "col", "column", "u", "x"),
+    "py": ("py", "pixel_y", "pixely", "image_y", "row", "v", "y"),
+}
+_ROLES = {"control": CONTROL, "gcp": CONTROL, "ctrl": CONTROL, "control point": CONTROL, "c": CONTROL,
+          "": CONTROL, "check": CHECK, "checkpoint": CHECK, "check point": CHECK, "check_point": CHECK,
+          "cp": CHECK,
+          "chk": CHECK}
+_CRS_COMMENT = re.compile(r"^#\s*crs\s*[:=]\s*(.+)$", re.IGNORECASE)
+
+
+def _delimiter(line: str) -> str:
+    counts = {d: line.count(d) for d in (",", ";", "\t")}
+    d = max(counts, key=lambda k: counts[k])
+    return d if counts[d] else ","
+
+
+def _header_map(cells: Sequence[str], spec: Mapping[str, Sequence[str]]) -> Dict[str, int]:
+    norm = [re.sub(r"\s+", "_", c.strip().lower()) for c in cells]
+    cols: Dict[str, int] = {}
+    for key, aliases in spec.items():
+        for k, c in enumerate(norm):
+            if c in aliases and k not in cols.values():
+                cols[key] = k
+                break
+    return cols
+
+
+def _csv_table(path: PathLike, spec: Mapping[str, Sequence[str]], required: Sequence[str], what: str):
+    """-> (crs or None, crs line, column map, [(lineno, cells)]).  Leading '#' lines and a bare CRS line
+    before the header are read for a CRS."""
+    lines = _read_lines(path)
+    crs, crs_line, i = None, None, 0
+    while i < len(lines):
+        s = lines[i].strip()
+        if not s:
+            i += 1
+            continue
+        if s.startswith("#"):
+            m = _CRS_COMMENT.match(s)
+            if m and crs is None:
+                crs, crs_line = normalize_crs(m.group(1)), i + 1
+            i += 1
+            continue
+        cells = next(csv.reader([s], delimiter=_delimiter(s)))
+        cols = _header_map(cells, spec)
+        if all(k in cols for k in required):
+            break
+        if crs is None and looks_like_crs(s):
+            crs, crs_line = normalize_crs(s), i + 1
+            i += 1
+            continue
+        raise GCPError(f"{path}:{i + 1}: expected a header row naming the columns "
+                       f"{', '.join(required)} of the {what} file, found {s!r}")
+    if i == len(lines):
+        raise GCPError(f"{path}: no header row (expected columns {', '.join(required)})")
+    header_line = lines[i].strip()
+    delim = _delimiter(header_line)
+    cols = _header_map(next(csv.reader([header_line], delimiter=delim)), spec)
+    rows = []
+    for ln in range(i + 1, len(lines)):
+        s = lines[ln].strip()
+        if not s or s.startswith("#"):
+            continue
+        cells = [c.strip() for c in next(csv.reader([s], delimiter=delim))]
+        rows.append((ln + 1, cells))
+    return crs, crs_line, cols, rows
+
+
+def _cell(cells: Sequence[str], cols: Mapping[str, int], key: str) -> str:
+    k = cols.get(key)
+    return cells[k] if k is not None and k < len(cells) else ""
+
+
+def default_observations_path(points_path: PathLike) -> str:
+    """``<dir>/<stem>_observations.csv`` for a points file ``<dir>/<stem>.csv``."""
+    stem, _ = os.path.splitext(os.fspath(points_path))
+    return f"{stem}_observations.csv"
+
+
+def read_csv_gcps(points_path: PathLike, observations_path: Optional[PathLike] = None, *,
+                  crs: Optional[str] = None, image_names: Optional[Iterable[str]] = None,
+                  image_sizes: Optional[ImageSizes] = None, unknown_images: str = "error") -> GCPSet:
+    """Read GCPs from a points CSV and an observations CSV (format in the module docstring).
+
+    ``crs`` overrides a CRS found in the points file; one of the two is required.  Without
+    ``observations_path`` the file ``default_observations_path(points_path)`` is read if it exists.
+    Validation as for ``read_odm_gcp_list``.
+    """
+    file_crs, crs_line, cols, rows = _csv_table(points_path, _POINT_COLS, ("name", "x", "y", "z"), "points")
+    use_crs = normalize_crs(crs) if crs else file_crs
+    if not use_crs:
+        raise GCPError(f"{points_path}: no CRS: give it as the crs argument or as a line '# crs: EPSG:xxxx' "
+                       "before the header")
+    gs = GCPSet(crs=use_crs, source=str(points_path))
+    _check_crs_for_file(use_crs, points_path, crs_line if not crs else None, gs.warnings)
+    defaults = GroundPoint("", 0.0, 0.0, 0.0)
+    first_line: Dict[str, int] = {}
+    for lineno, cells in rows:
+        name = _cell(cells, cols, "name")
+        if not name:
+            raise GCPError(f"{points_path}:{lineno}: empty point name")
+        if name in first_line:
+            raise GCPError(f"{points_path}:{lineno}: point {name} already defined on line {first_line[name]}")
+        x, y, z = (_num(_cell(cells, cols, k), k, points_path, lineno) for k in ("x", "y", "z"))
+        sig = {}
+        for k in ("sx", "sy", "sxy", "sz"):
+            t = _cell(cells, cols, k)
+            if t:
+                v = _num(t, {"sx": "sx", "sy": "sy", "sxy": "sigma_xy", "sz": "sz"}[k], points_path, lineno)
+                if v <= 0:
+                    raise GCPError(f"{points_path}:{lineno}: sigma {k} must be positive, got {t!r}")
+                sig[k] = v
+        if "sxy" in sig:
+            sigma_xy = sig["sxy"]
+        elif "sx" in sig or "sy" in sig:
+            sigma_xy = max(sig.get("sx", 0.0), sig.get("sy", 0.0))
+        else:
+            sigma_xy = defaults.sigma_xy
+        role_text = _cell(cells, cols, "role").strip().lower()
+        if role_text not in _ROLES:
+            raise GCPError(f"{points_path}:{lineno}: unknown role {role_text!r} for point {name} "
+                           f"(use '{CONTROL}' or '{CHECK}')")
+        sigma_z = sig.get("sz", defaults.sigma_z)
+        gs.points.append(GroundPoint(name, x, y, z, sigma_xy, sigma_z, _ROLES[role_text]))
+        first_line[name] = lineno
+    if not gs.points:
+        gs.warnings.append(f"{points_path}: no points")
+
+    obs_lines: Dict[int, List[int]] = {}
+    obs_path = observations_path if observations_path is not None else default_observations_path(points_path)
+    if observations_path is None and not os.path.exists(obs_path):
+        gs.warnings.append(f"{points_path}: no observations file ({obs_path} does not exist): the points "
+                           "have no image observations")
+    else:
+        _, _, ocols, orows = _csv_table(obs_path, _OBS_COLS, ("name", "image", "px", "py"), "observations")
+        for lineno, cells in orows:
+            name = _cell(cells, ocols, "name")
+            p = gs.by_name(name)
+            if p is None:
+                raise GCPError(f"{obs_path}:{lineno}: observation of unknown point {name!r} "
+                               f"(not in {points_path})")
+            img = _cell(cells, ocols, "image")
+            if not img:
+                raise GCPError(f"{obs_path}:{lineno}: empty image name")
+            px = _num(_cell(cells, ocols, "px"), "px", obs_path, lineno)
+            py = _num(_cell(cells, ocols, "py"), "py", obs_path, lineno)
+            p.observations.append(Observation(img, px, py))
+            obs_lines.setdefault(id(p), []).append(lineno)
+    where = {id(p): f"{points_path}:{first_line[p.name]}" for p in gs.points}
+    _finish(gs, obs_lines, obs_path, image_names, image_sizes, unknown_images, where)
+    _check_units(gs, points_path)
+    return gs
+
+
+def _csv_text(rows: Iterable[Sequence[Any]]) -> str:
+    import io
+
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    for r in rows:
+        w.writerow(r)
+    return buf.getvalue()
+
+
+def write_csv_gcps(gcpset: GCPSet, points_path: PathLike,
+                   observations_path: Optional[PathLike] = None) -> Tuple[str, str]:
+    """Write the CSV pair; returns (points path, observations path).  The points file starts with a
+    ``# crs: ...`` comment line, then ``name,x,y,z,sx,sy,sz,role`` (sx = sy = sigma_xy)."""
+    obs_path = os.fspath(observations_path) if observations_path is not None \
+        else default_observations_path(points_path)
+    head = f"# crs: {' '.join(gcpset.crs.split())}\n"
+    pts = [("name", "x", "y", "z", "sx", "sy", "sz", "role")]
+    obs = [("name", "image", "px", "py")]
+    for p in gcpset.points:
+        pts.append((p.name, _fmt(p.x), _fmt(p.y), _fmt(p.z), _fmt(p.sigma_xy), _fmt(p.sigma_xy),
+                    _fmt(p.sigma_z), p.role))
+        for o in p.observations:
+            obs.append((p.name, o.image, _fmt(o.x), _fmt(o.y)))
+    _write_text(points_path, head + _csv_text(pts))
+    _write_text(obs_path, _csv_text(obs))
+    return os.fspath(points_path), obs_path
+
+
+# --------------------------------------------------------------------------------------------------
+# dispatch
+# --------------------------------------------------------------------------------------------------
+
+def detect_gcp_format(path: PathLike) -> str:
+    """'csv' or 'odm': by extension (.csv), else by content (a header row naming name, x, y columns)."""
+    if os.fspath(path).lower().endswith(".csv"):
+        return "csv"
+    for line in _read_lines(path):
+        s = line.strip()
+        if not s or s.startswith("#"):
+            continue
+        cells = next(csv.reader([s], delimiter=_delimiter(s)))
+        if all(k in _header_map(cells, _POINT_COLS) for k in ("name", "x", "y")) and len(cells) >= 4:
+            return "csv"
+        if looks_like_crs(s):
+            continue  # a CRS line: the next line decides
+        return "odm"
+    return "odm"
+
+
+def read_gcps(path: PathLike, image_names: Optional[Iterable[str]] = None,
+              image_sizes: Optional[ImageSizes] = None, *, observations_path: Optional[PathLike] = None,
+              crs: Optional[str] = None, unknown_images: str = "error") -> GCPSet:
+    """Read ground control from an OpenDroneMap gcp_list.txt or a CSV points file (+ observations file).
+
+    ``crs`` and ``observations_path`` apply to the CSV form only.  See ``read_odm_gcp_list`` for
+    ``image_names``, ``image_sizes`` and ``unknown_images``.
+    """
+    if detect_gcp_format(path) == "csv":
+        return read_csv_gcps(path, observations_path, crs=crs, image_names=image_names,
+                             image_sizes=image_sizes, unknown_images=unknown_images)
+    return read_odm_gcp_list(path, image_names, image_sizes, unknown_images=unknown_images)
+
+
+def write_gcps(gcpset: GCPSet, path: PathLike, observations_path: Optional[PathLike] = None) -> None:
+    """Write ``gcpset`` as CSV (``.csv``: points + observations files) or as an ODM gcp_list.txt."""
+    if os.fspath(path).lower().endswith(".csv"):
+        write_csv_gcps(gcpset, path, observations_path)
+    else:
+        write_odm_gcp_list(gcpset, path)
+
+
+def gcps_from_rows(rows: Iterable[Mapping[str, Any]], crs: str, *, source_name: str = "layer",
+                   image_names: Optional[Iterable[str]] = None, image_sizes: Optional[ImageSizes] = None,
+                   unknown_images: str = "error") -> GCPSet:
+    """Ground control from table rows, one row per observation (e.g. the features of a QGIS point layer).
+
+    Each row is a mapping with keys (case-insensitive) ``name``, ``x``, ``y``, ``z``, ``image``, ``px``,
+    ``py`` and optionally ``sx``, ``sy``, ``sigma_xy``, ``sz``, ``role`` (same meaning as in the CSV form).
+    Rows of the same name must carry the same coordinates; sigmas and role come from the point's first row.
+    Messages name ``source_name`` and the row number (1-based).  Validation as for ``read_odm_gcp_list``.
+    """
+    gs = GCPSet(crs=normalize_crs(crs), source=source_name)
+    _check_crs_for_file(gs.crs, source_name, None, gs.warnings)
+    first: Dict[str, int] = {}
+    obs_lines: Dict[int, List[int]] = {}
+    defaults = GroundPoint("", 0.0, 0.0, 0.0)
+
+    def num(v: Any, what: str, row: int) -> float:
+        tok = "" if v is None else str(v).strip()
+        try:
+            return _num(tok, what, source_name, row)
+        except GCPError as e:
+            raise GCPError(str(e).replace(f"{source_name}:{row}:", f"{source_name}: row {row}:", 1)) from None
+
+    for k, raw in enumerate(rows, start=1):
+        r = {str(key).strip().lower(): v for key, v in raw.items()}
+        name = str(r.get("name") if r.get("name") is not None else "").strip()
+        if not name:
+            raise GCPError(f"{source_name}: row {k}: empty point name")
+        x, y, z = (num(r.get(c), c, k) for c in ("x", "y", "z"))
+        image = str(r.get("image") if r.get("image") is not None else "").strip()
+        if not image:
+            raise GCPError(f"{source_name}: row {k}: empty image name (point {name})")
+        px, py = num(r.get("px"), "px", k), num(r.get("py"), "py", k)
+        p = gs.by_name(name)
+        if p is None:
+            sig = {c: num(r[c], c, k) for c in ("sx", "sy", "sigma_xy", "sz")
+                   if r.get(c) is not None and str(r[c]).strip() != ""}
+            if any(v <= 0 for v in sig.values()):
+                raise GCPError(f"{source_name}: row {k}: sigmas must be positive (point {name})")
+            sxy = sig.get("sigma_xy", max(sig.get("sx", 0.0), sig.get("sy", 0.0)) or defaults.sigma_xy)
+            role_text = str(r.get("role") or "").strip().lower()
+            if role_text not in _ROLES:
+                raise GCPError(f"{source_name}: row {k}: unknown role {role_text!r} for point {name} "
+                               f"(use '{CONTROL}' or '{CHECK}')")
+            p = GroundPoint(name, x, y, z, sxy, sig.get("sz", defaults.sigma_z), _ROLES[role_text])
+            gs.points.append(p)
+            first[name] = k
+        elif (p.x, p.y, p.z) != (x, y, z):
+            raise GCPError(f"{source_name}: row {k}: point {name} has coordinates ({x}, {y}, {z}) here but "
+                           f"({p.x}, {p.y}, {p.z}) in row {first[name]}")
+        p.observations.append(Observation(image, px, py))
+        obs_lines.setdefault(id(p), []).append(k)
+    if not gs.points:
+        gs.warnings.append(f"{source_name}: no ground control rows")
+    _finish(gs, obs_lines, source_name, image_names, image_sizes, unknown_images, unit="row")
+    _check_units(gs, source_name)
+    return gs
+
+
+def check_units(gcpset: GCPSet, target_crs: Optional[str] = None) -> None:
+    """Raise GCPError when the points' coordinates do not fit the CRS they are expressed in
+    (``gcpset.crs``; ``target_crs`` only when the set has none) - degrees labelled as metres or the reverse.
+    ``read_gcps`` and ``gcps_from_rows`` already run this check."""
+    crs = gcpset.crs or target_crs
+    if crs and gcpset.points:
+        check_coordinates_match_crs(crs, [(p.x, p.y) for p in gcpset.points], "GCP coordinates",
+                                    gcpset.source)
+
+
+def apply_check_points(gcpset: GCPSet, names: Union[str, Iterable[str], None]) -> GCPSet:
+    """Mark the named points as check points (role CHECK); ``names`` is a comma-separated string or an
+    iterable of names (blanks ignored).  An unknown name raises GCPError listing the known names.  Other
+    points keep their role.  Returns ``gcpset`` (changed in place)."""
+    if names is None:
+        return gcpset
+    items = names.split(",") if isinstance(names, str) else list(names)
+    wanted = [n.strip() for n in items if n and n.strip()]
+    missing = [n for n in wanted if gcpset.by_name(n) is None]
+    if missing:
+        known = ", ".join(p.name for p in gcpset.points) or "(none)"
+        raise GCPError(f"unknown check point name(s): {', '.join(missing)}; known points: {known}")
+    for n in wanted:
+        gcpset.by_name(n).role = CHECK
+    return gcpset
+
+
+# --------------------------------------------------------------------------------------------------
+# camera positions
+# --------------------------------------------------------------------------------------------------
+
+_CAM_COLS = {
+    "image": ("image", "image_name", "imagename", "name", "file", "filename", "file_name", "photo", "label"),
+    "x": ("x", "easting", "east", "lon", "longitude"),
+    "y": ("y", "northing", "north", "lat", "latitude"),
+    "z": ("z", "alt", "altitude", "height", "h", "elevation", "ellipsoidal_height"),
+    "sigma": ("sigma", "accuracy", "std", "sigma_xyz", "acc"),
+    "sxy": ("sigma_xy", "sxy", "accuracy_xy", "std_xy", "horizontal_accuracy"),
+    "sz": ("sigma_z", "sz", "accuracy_z", "std_z", "vertical_accuracy"),
+}
+
+
+def _split_row(s: str) -> List[str]:
+    if "," in s:
+        return [c.strip() for c in next(csv.reader([s]))]
+    if ";" in s:
+        return [c.strip() for c in s.split(";")]
+    return s.split()
+
+
+def read_camera_positions(path: PathLike, default_sigma_xy: float = 5.0, default_sigma_z: float = 10.0, *,
+                          crs: Optional[str] = None, warnings: Optional[List[str]] = None
+                          ) -> Tuple[Optional[str], List[CameraPosition]]:
+    """Read projection-centre positions, one image per row.  Returns (crs or None, positions).
+
+    Accepted rows (comma, semicolon or whitespace separated; blank and ``#`` lines skipped):
+
+    * an optional first line holding the CRS (as in gcp_list.txt; e.g. ``EPSG:32617``);
+    * an optional header row naming the columns (image, x, y, z, sigma | sigma_xy, sigma_z);
+    * without a header: ``image x y [z [sigma [sigma_z]]]`` (image first) or ``x y [z] image`` (image last,
+      OpenDroneMap's geo.txt order).
+
+    One ``sigma`` applies to all three axes; ``sigma_xy`` / ``sigma_z`` columns set them separately; missing
+    sigmas take ``default_sigma_xy`` / ``default_sigma_z``.  A missing z (e.g. ``x y image`` rows) is NaN,
+    meaning unknown height: a consumer must then constrain only x and y of that camera.
+
+    The returned CRS is the file's CRS line, else ``crs`` (None when neither: the caller's CRS, usually the
+    GCPs', is meant).  Unparsable numbers and invalid CRSs raise GCPError (file:line: reason); duplicate
+    images keep the first row and add a warning to ``warnings`` (a list you pass), or issue a Python
+    warning when no list is given.
+    """
+    if not (default_sigma_xy > 0 and default_sigma_z > 0):
+        raise ValueError("default sigmas must be positive")
+    warn_list: List[str] = []
+    lines = _read_lines(path)
+    file_crs: Optional[str] = None
+    crs_line = None
+    cols: Optional[Dict[str, int]] = None
+    out: List[CameraPosition] = []
+    first_row: Dict[str, int] = {}
+    seen_content = False
+    for ln, raw in enumerate(lines, start=1):
+        s = raw.strip()
+        if not s or s.startswith("#"):
+            continue
+        if not seen_content:
+            seen_content = True
+            if looks_like_crs(s):
+                file_crs, crs_line = normalize_crs(s), ln
+                continue
+        cells = _split_row(s)
+        if cols is None and not out:
+            hm = _header_map(cells, _CAM_COLS)
+            if all(k in hm for k in ("image", "x", "y")) and not any(_is_number(c) for c in cells):
+                cols = hm
+                continue
+        if cols is not None:
+            image = _cell(cells, cols, "image")
+            vals = {k: _cell(cells, cols, k) for k in ("x", "y", "z", "sigma", "sxy", "sz")}
+        else:
+            nonnum = [k for k, c in enumerate(cells) if not _is_number(c)]
+            if len(cells) < 3:
+                raise GCPError(f"{path}:{ln}: expected 'image x y [z] [sigma]' or 'x y [z] image', "
+                               f"found {s!r}")
+            if nonnum and nonnum[0] == 0 and len(nonnum) == 1 and 3 <= len(cells) <= 6:
+                image, nums = cells[0], cells[1:]
+                keys = ("x", "y", "z", "sigma", "sz")[:len(nums)]
+                if len(nums) == 5:
+                    keys = ("x", "y", "z", "sxy", "sz")
+            elif nonnum == [len(cells) - 1] and len(cells) in (3, 4):
+                image, nums = cells[-1], cells[:-1]
+                keys = ("x", "y", "z")[:len(nums)]
+            else:
+                bad = next((cells[k] for k in nonnum if 0 < k < len(cells) - 1), None)
+                if bad is not None:
+                    raise GCPError(f"{path}:{ln}: not a number: {bad!r} (expected 'image x y [z] [sigma]' or "
+                                   f"'x y [z] image')")
+                raise GCPError(f"{path}:{ln}: cannot tell the image name from the coordinates in {s!r} "
+                               "(expected 'image x y [z] [sigma]' or 'x y [z] image')")
+            vals = dict(zip(keys, nums))
+        if not image:
+            raise GCPError(f"{path}:{ln}: empty image name")
+        x = _num(vals.get("x", ""), "x", path, ln)
+        y = _num(vals.get("y", ""), "y", path, ln)
+        z = _num(vals["z"], "z", path, ln) if vals.get("z") else float("nan")
+        sig = {}
+        for k in ("sigma", "sxy", "sz"):
+            if vals.get(k):
+                v = _num(vals[k], {"sigma": "sigma", "sxy": "sigma_xy", "sz": "sigma_z"}[k], path, ln)
+                if v <= 0:
+                    raise GCPError(f"{path}:{ln}: sigma must be positive, got {vals[k]!r}")
+                sig[k] = v
+        sxy = sig.get("sxy", sig.get("sigma", default_sigma_xy))
+        sz = sig.get("sz", sig.get("sigma", default_sigma_z))
+        if image in first_row:
+            warn_list.append(f"{path}:{ln}: second position for image {image} (first on line "
+                             f"{first_row[image]}); keeping the first")
+            continue
+        first_row[image] = ln
+        out.append(CameraPosition(image, x, y, z, sxy, sz))
+    use_crs = file_crs or (normalize_crs(crs) if crs else None)
+    if use_crs:
+        _check_crs_for_file(use_crs, path, crs_line if file_crs else None, warn_list)
+        if out:
+            check_coordinates_match_crs(use_crs, [(c.x, c.y) for c in out], "camera positions", str(path))
+    if warnings is not None:
+        warnings.extend(warn_list)
+    else:
+        for w in warn_list:
+            _warnings.warn(w, stacklevel=2)
+    return use_crs, out
+
+
+__all__ = [
+    "CHECK", "CONTROL", "CameraPosition", "GCPError", "GCPSet", "GroundPoint", "Observation",
+    "apply_check_points", "check_coordinates_match_crs", "check_units", "crs_is_geographic",
+    "default_observations_path", "gcps_from_rows",
+    "detect_gcp_format", "looks_like_crs", "normalize_crs", "read_camera_positions", "read_csv_gcps",
+    "read_gcps", "read_odm_gcp_list", "transform_points", "utm_epsg_for_lonlat", "validate_crs",
+    "write_csv_gcps", "write_gcps", "write_odm_gcp_list",
+]
