@@ -9,7 +9,7 @@ PLUGINS := $(BUILD)/qgis-plugins
 QGIS_CONFIG := $(BUILD)/qgis-profile
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 APT_PACKAGES := qgis python3-qgis qgis-providers python3-gdal python3-numpy python3-scipy \
-                python3-matplotlib python3-venv python3-pip qttools5-dev-tools pyqt5-dev-tools xvfb zip
+                python3-matplotlib python3-venv python3-pip qttools5-dev-tools pyqt5-dev-tools xvfb xauth zip
 QGIS_PROCESS := $(shell command -v qgis_process.bin || command -v qgis_process || echo /usr/bin/qgis_process.bin)
 PYTEST_ARGS ?=
 ARGS ?=
@@ -29,19 +29,20 @@ apt: $(BUILD)/.apt-stamp
 $(BUILD)/.apt-stamp:
 	@mkdir -p $(BUILD)
 	@if ! dpkg -s $(APT_PACKAGES) >/dev/null 2>&1; then \
-	  echo "Installing Debian packages: $(APT_PACKAGES)"; \
-	  $(SUDO) apt-get update -q && \
-	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -q --no-install-recommends $(APT_PACKAGES); \
+	  echo "Installing Debian packages: $(APT_PACKAGES)" >&2; \
+	  $(SUDO) apt-get update -q >&2 && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -q $(APT_PACKAGES) >&2; \
 	fi
 	@touch $@
 
 venv: $(VENV)/.stamp
 $(VENV)/.stamp: requirements.txt requirements-dev.txt $(BUILD)/.apt-stamp
 	@test -x $(PY) || $(SYSPY) -m venv --system-site-packages $(VENV)
-	$(PY) -m pip install -q --disable-pip-version-check -r requirements-dev.txt
+	@echo "Installing Python packages into $(VENV)" >&2
+	@$(PY) -m pip install -q --disable-pip-version-check -r requirements-dev.txt >&2
 	@$(PY) -c "import numpy, pycolmap, cv2; from osgeo import gdal_array; import qgis.core; \
 	  assert numpy.__version__.startswith('1.'), numpy.__version__; \
-	  print('venv ok: numpy', numpy.__version__, 'pycolmap', pycolmap.__version__, 'cv2', cv2.__version__)"
+	  print('venv ok: numpy', numpy.__version__, 'pycolmap', pycolmap.__version__, 'cv2', cv2.__version__)" >&2
 	@touch $@
 
 plugin-link: $(PLUGINS)/archaeoortho
