@@ -349,6 +349,7 @@ def _map(pycolmap, db_path, images_dir, out_dir, n_images, options, progress: Pr
     opts.mapper.random_seed = options.seed
     opts.triangulation.random_seed = options.seed
     opts.ba_refine_principal_point = False
+    opts.min_model_size = 3  # keep small separate components so they can be reported by name
     state = {"n": 0}
 
     def on_next():
