@@ -127,8 +127,8 @@ def main():
           f"{r['points']} points, pairing {r['pairing']} ({r['pairs']} pairs)", flush=True)
     if a.skip_colmap:
         return
-    from core.sfm import auto_max_features
     from core.images import read_image_info
+    from core.sfm import auto_max_features
 
     first = sorted(f for f in os.listdir(a.images) if f.lower().endswith((".jpg", ".jpeg", ".tif", ".tiff")))[0]
     info = read_image_info(os.path.join(a.images, first))

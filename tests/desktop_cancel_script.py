@@ -6,12 +6,11 @@ import json
 import os
 import time
 
+from qgis import processing
 from qgis.core import QgsApplication
 from qgis.PyQt.QtCore import QTimer
 from qgis.PyQt.QtWidgets import QApplication, QProgressBar, QPushButton
 from qgis.utils import iface, plugins
-
-from qgis import processing
 
 OUT = os.environ["AO_OUT"]
 state = {"log": []}
