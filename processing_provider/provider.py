@@ -21,6 +21,7 @@ class ArchaeoOrthoProvider(QgsProcessingProvider):
 
     def loadAlgorithms(self):  # noqa: N802 (QGIS API name)
         from .align_images import AlignImagesAlgorithm
+        from .georeference import GeoreferenceAlgorithm
 
-        for alg in (AlignImagesAlgorithm(),):
+        for alg in (AlignImagesAlgorithm(), GeoreferenceAlgorithm()):
             self.addAlgorithm(alg)

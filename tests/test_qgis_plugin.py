@@ -140,3 +140,24 @@ def test_plugin_imports_nothing_gui_only_headless():
             "print(bad); sys.exit(1 if bad else 0)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stdout + out.stderr
+
+
+@pytest.mark.slow
+def test_processing_align_then_georeference_with_exif_gps(plugin, tmp_path):
+    from qgis import processing
+    from qgis.core import QgsProcessingException, QgsVectorLayer
+
+    images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:5], str(tmp_path / "img"))
+    ws = processing.run("archaeoortho:alignimages", {
+        "IMAGES": images, "WORKSPACE": str(tmp_path / "ws"), "MAX_IMAGE_SIZE": 800, "MAX_FEATURES": 2048,
+    })["WORKSPACE"]
+    with pytest.raises(QgsProcessingException, match="Give ground control"):
+        processing.run("archaeoortho:georeference", {"WORKSPACE": ws})
+    res = processing.run("archaeoortho:georeference", {"WORKSPACE": ws, "USE_EXIF_GPS": True, "CRS": "EPSG:32617"})
+    assert res["WORKSPACE"] == ws
+    assert res["CAMERA_RMSE_XYZ"] < 5.0
+    cams = QgsVectorLayer(res["CAMERAS"], "cameras", "ogr")
+    assert cams.isValid() and cams.featureCount() == 5
+    assert cams.crs().authid() == "EPSG:32617"
+    x = [f.geometry().asPoint().x() for f in cams.getFeatures()]
+    assert all(274800 < v < 275100 for v in x)

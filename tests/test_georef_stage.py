@@ -1,0 +1,76 @@
+"""The georeference stage on a real aligned workspace (sample Toledo strip, EXIF GPS) and its bad inputs."""
+import os
+
+import numpy as np
+import pytest
+
+from core import pipeline, sfm
+from core.gcp import GCPSet, GroundPoint, Observation
+from core.workspace import Workspace
+from tests.conftest import SAMPLE, TOLEDO_STRIP, copy_images
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def aligned(tmp_path_factory):
+    d = tmp_path_factory.mktemp("georef")
+    images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP, str(d / "img"))
+    ws = str(d / "ws")
+    sfm.align(images, ws, sfm.AlignOptions(max_image_size=800, max_features=2048))
+    return ws
+
+
+def _reference_positions():
+    ref = {}
+    with open(os.path.join(SAMPLE, "cameras_32617.txt")) as f:
+        for line in f:
+            parts = line.split()
+            if len(parts) == 3:
+                ref[parts[2]] = np.array([float(parts[0]), float(parts[1])])
+    return ref
+
+
+def test_exif_gps_georeferencing_lines_up_with_surveyed_positions(aligned):
+    result = pipeline.georeference_workspace(aligned, use_exif_gps=True, crs="EPSG:32617")
+    assert result.crs == "EPSG:32617"
+    assert result.figures["CAMERA_RMSE_XYZ"] is not None and result.figures["CAMERA_RMSE_XYZ"] < 5.0
+    from osgeo import ogr
+
+    ref = _reference_positions()
+    ds = ogr.Open(result.cameras_path)
+    lyr = ds.GetLayer(0)
+    assert lyr.GetSpatialRef().GetAuthorityCode(None) == "32617"
+    dists = []
+    for feat in lyr:
+        g = feat.GetGeometryRef()
+        dists.append(np.hypot(*(np.array([g.GetX(), g.GetY()]) - ref[feat.GetField("image")])))
+    assert len(dists) == len(TOLEDO_STRIP)
+    assert max(dists) < 5.0  # consumer GPS: a few metres
+    ws = Workspace.open(aligned)
+    assert ws.stage("georeference")["status"] == "done"
+    assert ws.crs == "EPSG:32617"
+    assert os.path.isfile(os.path.join(aligned, "georef", "transform.json"))
+    rec, transform = pipeline.load_georef_model(aligned)
+    assert rec.num_reg_images() == len(TOLEDO_STRIP)
+    # the adjusted model stays near the origin: world = local + offset
+    centres = np.array([im.projection_center() for im in rec.images.values()])
+    assert np.abs(centres).max() < 1000
+    assert transform["offset"][0] > 200000
+
+
+def test_too_few_control_points_is_a_clear_error(aligned):
+    gcps = GCPSet(crs="EPSG:32617", points=[
+        GroundPoint("A", 274900.0, 4603270.0, 180.0, observations=[Observation("1JI_0064.JPG", 500, 400),
+                                                                  Observation("1JI_0065.JPG", 500, 300)]),
+        GroundPoint("B", 274905.0, 4603290.0, 180.0, observations=[Observation("1JI_0066.JPG", 600, 400),
+                                                                  Observation("1JI_0067.JPG", 600, 300)]),
+    ])
+    with pytest.raises(pipeline.StageError, match="at least 3 control points.*found 2"):
+        pipeline.georeference_workspace(aligned, gcps=gcps)
+
+
+def test_unaligned_workspace_is_refused(tmp_path):
+    Workspace.create_or_open(str(tmp_path / "ws"))
+    with pytest.raises(pipeline.StageError, match="run 'Align images' first"):
+        pipeline.georeference_workspace(str(tmp_path / "ws"), use_exif_gps=True)
