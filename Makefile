@@ -58,7 +58,7 @@ process: setup
 	@$(PROCESS_ENV) $(QGIS_PROCESS) $(ARGS)
 
 test: setup
-	QGIS_PROCESS=$(QGIS_PROCESS) QGIS_CUSTOM_CONFIG_PATH=$(QGIS_CONFIG) $(PY) -m pytest tests $(PYTEST_ARGS)
+	QGIS_PROCESS=$(QGIS_PROCESS) QGIS_CUSTOM_CONFIG_PATH=$(QGIS_CONFIG) $(PY) -m pytest $(PYTEST_ARGS)
 
 demo: setup
 	$(PY) sample/demo.py --qgis-process "$(QGIS_PROCESS)" --build $(BUILD)

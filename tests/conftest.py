@@ -39,3 +39,22 @@ TOLEDO_STRIP = ["1JI_0064.JPG", "1JI_0065.JPG", "1JI_0066.JPG", "1JI_0067.JPG", 
 def toledo_strip(tmp_path_factory):
     d = tmp_path_factory.mktemp("toledo strip")
     return copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP, str(d / "imáges ü"))
+
+
+# QGIS 3.22's Python bindings can crash while the interpreter tears itself down after
+# exitQgis() (a known teardown-order problem of sip-wrapped singletons): every test has
+# passed and been reported, yet the process dies with SIGSEGV and make fails.  Once pytest
+# has written all its reports, leave without running the interpreter's finalisers.
+_EXIT_STATUS = {}
+
+
+def pytest_sessionfinish(session, exitstatus):
+    _EXIT_STATUS["status"] = int(exitstatus)
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_unconfigure(config):
+    if "status" in _EXIT_STATUS and os.environ.get("ARCHAEOORTHO_HARD_EXIT", "1") == "1":
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(_EXIT_STATUS["status"])
