@@ -262,6 +262,26 @@ def helmert_ransac(src, dst, threshold: float, max_iterations: int = 2000, seed:
 # ----------------------------------------------------------------------------
 
 
+def _inv3(m: np.ndarray) -> np.ndarray:
+    """Inverse of a stack of 3x3 matrices by the adjugate (numpy's batched inv calls LAPACK per
+    matrix, through BLAS threads: 100x slower on busy cores)."""
+    a, b, c = m[:, 0, 0], m[:, 0, 1], m[:, 0, 2]
+    d, e, f = m[:, 1, 0], m[:, 1, 1], m[:, 1, 2]
+    g, h, i = m[:, 2, 0], m[:, 2, 1], m[:, 2, 2]
+    co = np.empty_like(m)
+    co[:, 0, 0] = e * i - f * h
+    co[:, 0, 1] = c * h - b * i
+    co[:, 0, 2] = b * f - c * e
+    co[:, 1, 0] = f * g - d * i
+    co[:, 1, 1] = a * i - c * g
+    co[:, 1, 2] = c * d - a * f
+    co[:, 2, 0] = d * h - e * g
+    co[:, 2, 1] = b * g - a * h
+    co[:, 2, 2] = a * e - b * d
+    det = a * co[:, 0, 0] + b * co[:, 1, 0] + c * co[:, 2, 0]
+    return co / det[:, None, None]
+
+
 def _rodrigues(w: np.ndarray) -> np.ndarray:
     """Rotation matrices (N,3,3) from rotation vectors (N,3)."""
     w = np.asarray(w, dtype=float).reshape(-1, 3)
@@ -786,7 +806,7 @@ class _BundleProblem:
         dgp = np.einsum("nii->ni", blocks)
         floor = 1e-9 * max(float(dgp.max()) if dgp.size else 1.0, 1e-12)
         blocks = blocks + (lam * np.maximum(dgp, floor) + floor)[:, :, None] * np.eye(3)[None]
-        vinv = np.linalg.inv(blocks)
+        vinv = _inv3(blocks)
         gc, gp = g[:nc], g[nc:]
         vinv_sp = sp.bsr_matrix((vinv, np.arange(self.npt), np.arange(self.npt + 1)),
                                 shape=(3 * self.npt, 3 * self.npt)).tocsr()
@@ -1142,7 +1162,7 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
                  gcp_pixel_sigma: float = 1.0, tie_pixel_sigma: float = 1.0, huber_px: float = 2.0,
                  max_observations: int = 200_000, max_iterations: int = 50, max_outlier_rounds: int = 10,
                  min_intrinsics_images: int = 3, adjust: bool = True, crs: Optional[str] = None,
-                 copy_model: bool = True) -> GeorefResult:
+                 copy_model: bool = True, placeholder_sigma_z: float = 1.0) -> GeorefResult:
     """Georeference a sparse model with GCPs and/or camera positions.
 
     ``reconstruction``: pycolmap.Reconstruction in the model frame (copied unless
@@ -1160,6 +1180,9 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
     best-observed tie points are kept (every image covered) and the others are
     re-triangulated with the adjusted cameras afterwards.
     ``adjust=False`` stops after the Helmert step.
+    Camera positions with a non-finite ``z`` constrain X and Y only.  When every control
+    point has the same Z (a placeholder such as 0), their sigma Z is raised to
+    ``placeholder_sigma_z`` and a warning says so (``statistics["placeholder_z"]``).
     Returns a GeorefResult whose reconstruction lies in the local frame world - offset.
     """
     import pycolmap
@@ -1217,6 +1240,8 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
     cam_pos: List[Tuple[CameraPosition, Any]] = []
     unmatched = []
     for cp in camera_positions or []:
+        if not (math.isfinite(cp.x) and math.isfinite(cp.y)):
+            raise GeorefError(f"camera position of {cp.image}: X or Y is not a number")
         im = lookup.get(cp.image)
         if im is None:
             unmatched.append(cp.image)
@@ -1225,6 +1250,25 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
     if unmatched:
         _warn(progress, warnings, f"{len(unmatched)} camera position(s) for images not registered in the model, "
                                   f"ignored: {', '.join(unmatched[:10])}" + (" ..." if len(unmatched) > 10 else ""))
+    no_height = [cp.image for cp, _ in cam_pos if not math.isfinite(cp.z)]
+    if no_height:
+        _warn(progress, warnings, f"{len(no_height)} camera position(s) without a height (Z): they constrain "
+                                  "X and Y only")
+
+    # placeholder heights: every control point at the same Z (e.g. 0 when heights were not surveyed)
+    placeholder_z = None
+    if len(usable) >= 3 and len({float(p.z) for p in usable}) == 1:
+        placeholder_z = float(usable[0].z)
+        loose = [p for p in usable if p.sigma_z < placeholder_sigma_z]
+        _warn(progress, warnings,
+              f"every control point has Z = {placeholder_z:g}: treated as a placeholder, not a surveyed height; "
+              f"the points are taken to lie near one level surface (sigma Z {placeholder_sigma_z:g} m) and the "
+              "Z figures measure the departure from that level, not height accuracy")
+        if loose:
+            import dataclasses
+
+            repl = {p.name: dataclasses.replace(p, sigma_z=placeholder_sigma_z) for p in loose}
+            usable = [repl.get(p.name, p) for p in usable]
 
     # 2. initial similarity model -> local
     if len(usable) >= 3:
@@ -1233,12 +1277,13 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
         model = np.array([tri[p.name].xyz for p in usable])
         sig = np.array([max(p.sigma_xy, p.sigma_z) for p in usable])
         objs = usable
-    elif len(cam_pos) >= 3:
+    elif len(cam_pos) - len(no_height) >= 3:
         source = "camera positions"
-        world = np.array([[cp.x, cp.y, cp.z] for cp, _ in cam_pos])
-        model = np.array([im.projection_center() for _, im in cam_pos])
-        sig = np.array([max(cp.sigma_xy, cp.sigma_z) for cp, _ in cam_pos])
-        objs = [cp for cp, _ in cam_pos]
+        with_z = [(cp, im) for cp, im in cam_pos if math.isfinite(cp.z)]
+        world = np.array([[cp.x, cp.y, cp.z] for cp, _ in with_z])
+        model = np.array([im.projection_center() for _, im in with_z])
+        sig = np.array([max(cp.sigma_xy, cp.sigma_z) for cp, _ in with_z])
+        objs = [cp for cp, _ in with_z]
     else:
         msg = (f"georeferencing needs at least 3 control points, each seen in at least 2 registered images, "
                f"or camera positions for at least 3 registered images; found {len(control)} control point(s), "
@@ -1248,6 +1293,9 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
         msg += f"; {len(cam_pos)} camera position(s) matched to registered images"
         if camera_positions:
             msg += f" (of {len(camera_positions)} given)"
+        if no_height and len(cam_pos) >= 3:
+            msg += (f", {len(no_height)} of them without a height (Z): positions without heights cannot fix the "
+                    "block's vertical datum; give Z or add control points")
         raise GeorefError(msg)
     offset = _round_offset(world)
     world_local = world - offset
@@ -1284,7 +1332,7 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
     result = GeorefResult(rec, model_to_local, offset, crs, source, helmert_points=helmert_rows,
                           warnings=warnings, outliers=outliers, adjusted=False)
     stats: Dict[str, Any] = {"helmert_threshold_m": thr, "helmert_inliers": int(hel.inliers.sum()),
-                             "helmert_scale": model_to_local.scale}
+                             "helmert_scale": model_to_local.scale, "placeholder_z": placeholder_z}
     if not adjust:
         result.points = helmert_rows
         result.cameras = _camera_rows(rec, cam_pos, offset, lookup)
@@ -1489,8 +1537,9 @@ def _build_problem(rec, lookup, ba_points, tri, cam_pos, offset, model_to_local,
     obs = _Obs(np.asarray(o_img, dtype=int), np.asarray(o_pt, dtype=int), np.asarray(o_xy, dtype=float).reshape(-1, 2),
                np.asarray(o_sigma, dtype=float), np.asarray(o_robust, dtype=bool), np.ones(len(o_img), dtype=bool))
     cp_img = [img_index[im.image_id] for _, im in cam_pos]
-    cp_xyz = [np.array([cp.x, cp.y, cp.z]) - offset for cp, _ in cam_pos]
-    cp_sig = [[cp.sigma_xy, cp.sigma_xy, cp.sigma_z] for cp, _ in cam_pos]
+    # a position without a height: Z residual 0 with a huge sigma, i.e. X and Y only
+    cp_xyz = [np.array([cp.x, cp.y, cp.z if math.isfinite(cp.z) else offset[2]]) - offset for cp, _ in cam_pos]
+    cp_sig = [[cp.sigma_xy, cp.sigma_xy, cp.sigma_z if math.isfinite(cp.z) else 1e12] for cp, _ in cam_pos]
     if np.any(np.asarray(cp_sig, dtype=float) <= 0):
         raise GeorefError("camera position sigmas must be positive")
     prob = _BundleProblem(np.asarray(frames_r).reshape(-1, 3, 3), np.asarray(frames_c).reshape(-1, 3), img_frame,

@@ -197,17 +197,26 @@ def _figures(result, accuracy) -> Dict[str, Optional[float]]:
     ctl = result.rmse(gcpmod.CONTROL)
     chk = result.rmse(gcpmod.CHECK)
     cam = [c for c in result.cameras if c.used]
-    cam_rmse = (float(np.sqrt(np.mean([c.dx ** 2 + c.dy ** 2 + c.dz ** 2 for c in cam]))) if cam else None)
+    cam_xy = [c.dx ** 2 + c.dy ** 2 for c in cam]
+    cam_z = [c.dz ** 2 for c in cam if np.isfinite(c.dz)]
+    cam_rmse_xy = float(np.sqrt(np.mean(cam_xy))) if cam_xy else None
+    cam_rmse_z = float(np.sqrt(np.mean(cam_z))) if cam_z else None
+    cam_rmse = (float(np.sqrt(np.mean(cam_xy) + np.mean(cam_z))) if cam_xy and len(cam_z) == len(cam_xy)
+                else None)
     ref = chk if chk["n"] else ctl
     nssda_h = nssda_v = None
     if ref["n"]:
         nssda_h = accuracy.nssda_horizontal(ref["x"], ref["y"])
-        nssda_v = accuracy.nssda_vertical(ref["z"])
+        # against placeholder heights there is no vertical accuracy to state
+        if result.statistics.get("placeholder_z") is None:
+            nssda_v = accuracy.nssda_vertical(ref["z"])
     return {
         "GCP_RMSE_XY": ctl["xy"], "GCP_RMSE_Z": ctl["z"], "GCP_N": ctl["n"],
         "CHECK_RMSE_XY": chk["xy"], "CHECK_RMSE_Z": chk["z"], "CHECK_N": chk["n"],
         "CHECK_RMSE_X": chk["x"], "CHECK_RMSE_Y": chk["y"],
-        "CAMERA_RMSE_XYZ": cam_rmse, "NSSDA_H": nssda_h, "NSSDA_V": nssda_v,
+        "CAMERA_RMSE_XYZ": cam_rmse, "CAMERA_RMSE_XY": cam_rmse_xy, "CAMERA_RMSE_Z": cam_rmse_z,
+        "PLACEHOLDER_Z": result.statistics.get("placeholder_z") is not None,
+        "NSSDA_H": nssda_h, "NSSDA_V": nssda_v,
         "MEAN_REPROJECTION_ERROR": float(result.mean_reprojection_error),
         "HELMERT_CHECK_RMSE_XY": result.rmse(gcpmod.CHECK, helmert=True)["xy"],
     }

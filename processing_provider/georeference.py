@@ -30,7 +30,8 @@ class GeoreferenceAlgorithm(AlgorithmBase):
     OUT_WORKSPACE = "WORKSPACE"  # the same name as the input: models chain stages through it
     RESIDUALS = "RESIDUALS"
     CAMERAS = "CAMERAS"
-    NUMBERS = ("GCP_RMSE_XY", "GCP_RMSE_Z", "CHECK_RMSE_XY", "CHECK_RMSE_Z", "CAMERA_RMSE_XYZ", "NSSDA_H", "NSSDA_V")
+    NUMBERS = ("GCP_RMSE_XY", "GCP_RMSE_Z", "CHECK_RMSE_XY", "CHECK_RMSE_Z", "CAMERA_RMSE_XYZ", "CAMERA_RMSE_XY",
+               "NSSDA_H", "NSSDA_V")
     HELP = (
         "Fixes the aligned block in a real coordinate reference system with ground control points (GCPs) "
         "and/or camera positions, used inside the bundle adjustment so that they also remove the block's "
