@@ -1,0 +1,635 @@
+"""Digital surface models: points -> raster, Cloud-Optimized GeoTIFF, reading, LAS point clouds.
+
+This is the one module that writes and reads DSMs, so the orthophoto stage reads
+ours and an external one (an ALS DSM the user has) through the same helpers:
+:func:`open_dsm`, :class:`DsmReader` (window reads, bilinear sampling, optional
+reprojection into the workspace CRS).
+
+Rasterisation (:func:`rasterize_points`) works tile by tile over point files, so
+memory is bounded by the points of one tile.  Per cell it takes the median of
+the *highest cluster* of heights (the points within ``cluster_tol`` of the
+cell's 90th percentile), so a cell on a roof edge shows the roof, not a mean of
+roof and ground, and a lone low point under a crown does not pull it down.
+Small holes (at most ``max_hole_cells`` cells) are filled from their borders;
+larger ones stay nodata.
+
+Outputs are written to a temporary name and renamed when complete
+(:func:`core.workspace.atomic_output`).
+"""
+from __future__ import annotations
+
+import math
+import os
+import struct
+from dataclasses import dataclass, field
+from typing import Callable, Iterable, Optional, Sequence, Tuple
+
+import numpy as np
+
+from .progress import NullProgress, Progress, check_cancel
+from .workspace import atomic_output
+
+NODATA = -9999.0
+TILE = 1024  # cells per tile side for rasterisation
+
+
+class DsmError(RuntimeError):
+    """A DSM cannot be written or read; the message says why."""
+
+
+def _gdal():
+    from osgeo import gdal, osr
+
+    gdal.UseExceptions()
+    osr.UseExceptions()
+    return gdal, osr
+
+
+def crs_to_wkt(crs: Optional[str]) -> str:
+    """WKT of a CRS given as 'EPSG:xxxx', WKT or PROJ string; '' for None (local frame)."""
+    if not crs:
+        return ""
+    _, osr = _gdal()
+    srs = osr.SpatialReference()
+    try:
+        srs.SetFromUserInput(crs)
+    except RuntimeError as e:
+        raise DsmError(f"unknown CRS {crs!r}: {e}") from e
+    return srs.ExportToWkt()
+
+
+def crs_epsg(crs: Optional[str]) -> Tuple[Optional[int], bool]:
+    """(EPSG code or None, is_geographic) of a CRS string."""
+    if not crs:
+        return None, False
+    _, osr = _gdal()
+    srs = osr.SpatialReference()
+    srs.SetFromUserInput(crs)
+    srs.AutoIdentifyEPSG()
+    code = srs.GetAuthorityCode(None)
+    return (int(code) if code and code.isdigit() else None), bool(srs.IsGeographic())
+
+
+# ---------------------------------------------------------------------------
+# grid and rasterisation
+# ---------------------------------------------------------------------------
+
+@dataclass
+class Grid:
+    """A north-up raster grid in world coordinates: x0, y0 = upper-left corner."""
+
+    x0: float
+    y0: float
+    resolution: float
+    width: int
+    height: int
+
+    @property
+    def geotransform(self) -> Tuple[float, float, float, float, float, float]:
+        return (self.x0, self.resolution, 0.0, self.y0, 0.0, -self.resolution)
+
+    @classmethod
+    def covering(cls, xmin: float, ymin: float, xmax: float, ymax: float, resolution: float) -> Grid:
+        """The grid with cell edges on multiples of ``resolution`` that covers the box."""
+        if not (resolution > 0 and math.isfinite(resolution)):
+            raise DsmError(f"resolution must be positive, got {resolution}")
+        x0 = math.floor(xmin / resolution) * resolution
+        y0 = math.ceil(ymax / resolution) * resolution
+        w = max(1, int(math.ceil((xmax - x0) / resolution)))
+        h = max(1, int(math.ceil((y0 - ymin) / resolution)))
+        if w * h > 2_000_000_000:
+            raise DsmError(f"a {w} x {h} DSM at {resolution} m is too large: choose a coarser RESOLUTION")
+        return cls(x0, y0, resolution, w, h)
+
+    def cell_centres(self) -> Tuple[np.ndarray, np.ndarray]:
+        xs = self.x0 + (np.arange(self.width) + 0.5) * self.resolution
+        ys = self.y0 - (np.arange(self.height) + 0.5) * self.resolution
+        return xs, ys
+
+
+@dataclass
+class PointFile:
+    """Points of one source (one image's fused depth map) on disk, with their bounding box
+    in the local frame; ``load`` returns (xyz float32 local, rgb uint8)."""
+
+    path: str
+    bbox: Tuple[float, float, float, float]  # xmin, ymin, xmax, ymax (local frame)
+    count: int
+
+    def load(self) -> Tuple[np.ndarray, np.ndarray]:
+        with np.load(self.path) as d:
+            return d["xyz"], d["rgb"]
+
+
+def cell_statistic(cells: np.ndarray, z: np.ndarray, n_cells: int, cluster_tol: float,
+                   upper_quantile: float = 0.9) -> Tuple[np.ndarray, np.ndarray]:
+    """Per cell: (value, count), value = median of the points within ``cluster_tol`` below the
+    cell's ``upper_quantile`` height (the highest cluster).  NaN where a cell has no point."""
+    value = np.full(n_cells, np.nan, dtype=np.float32)
+    count = np.zeros(n_cells, dtype=np.int32)
+    if len(z) == 0:
+        return value, count
+    order = np.lexsort((z, cells))
+    c = cells[order]
+    zs = z[order].astype(np.float64)
+    starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
+    ends = np.r_[starts[1:], len(c)]
+    n = ends - starts
+    ucell = c[starts]
+    q_idx = starts + np.floor((n - 1) * upper_quantile).astype(np.int64)
+    q = zs[q_idx]
+    # first index in each cell with z >= q - tol: search on a key that is sorted by (cell, z)
+    zmin = zs.min()
+    span = zs.max() - zmin + 2 * cluster_tol + 1.0
+    key = (np.arange(len(starts)).repeat(n) * span) + (zs - zmin)
+    first = np.searchsorted(key, np.arange(len(starts)) * span + (q - cluster_tol - zmin), side="left")
+    first = np.clip(first, starts, q_idx)
+    last = np.maximum(q_idx, first)  # include up to the quantile point (higher ones are outlier candidates)
+    mid_lo = (first + last) // 2
+    mid_hi = (first + last + 1) // 2
+    value[ucell] = (0.5 * (zs[mid_lo] + zs[mid_hi])).astype(np.float32)
+    count[ucell] = n
+    return value, count
+
+
+def fill_small_holes(dsm: np.ndarray, max_hole_cells: int = 16, iterations: int = 0) -> np.ndarray:
+    """Fill nodata holes (NaN) of at most ``max_hole_cells`` cells by averaging their valid
+    neighbours inwards; holes that touch the raster edge or are larger stay NaN."""
+    from scipy import ndimage
+
+    out = dsm.copy()
+    holes = ~np.isfinite(out)
+    if not holes.any() or max_hole_cells <= 0:
+        return out
+    lab, n = ndimage.label(holes)
+    if n == 0:
+        return out
+    sizes = np.bincount(lab.ravel())
+    edge = np.unique(np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]]))
+    small = sizes <= max_hole_cells
+    small[0] = False
+    small[edge] = False
+    fill = small[lab]
+    if not fill.any():
+        return out
+    iterations = iterations or int(math.ceil(math.sqrt(max_hole_cells))) + 2
+    kernel = np.ones((3, 3), dtype=np.float64)
+    for _ in range(iterations):
+        valid = np.isfinite(out)
+        vals = np.where(valid, out, 0.0).astype(np.float64)
+        s = ndimage.convolve(vals, kernel, mode="constant")
+        k = ndimage.convolve(valid.astype(np.float64), kernel, mode="constant")
+        todo = fill & ~valid & (k > 0)
+        if not todo.any():
+            break
+        out[todo] = (s[todo] / k[todo]).astype(out.dtype)
+    return out
+
+
+def remove_speckles(dsm: np.ndarray, max_cells: int = 4) -> np.ndarray:
+    """Drop isolated groups of at most ``max_cells`` valid cells (lone matches far from the surface
+    are usually wrong); they become holes that fill_small_holes may fill."""
+    from scipy import ndimage
+
+    valid = np.isfinite(dsm)
+    lab, n = ndimage.label(valid, structure=np.ones((3, 3)))
+    if n == 0:
+        return dsm
+    sizes = np.bincount(lab.ravel())
+    small = sizes <= max_cells
+    small[0] = False
+    out = dsm.copy()
+    out[small[lab]] = np.nan
+    return out
+
+
+def rasterize_points(files: Sequence[PointFile], grid: Grid, offset: Sequence[float], cluster_tol: float,
+                     progress: Optional[Progress] = None, tile: int = TILE) -> Tuple[np.ndarray, np.ndarray]:
+    """Rasterise point files (local frame; world = local + offset) onto ``grid``: (heights float32 with NaN
+    for no data, point counts int32).  Tile by tile: memory ~ the points of one tile."""
+    progress = progress or NullProgress()
+    off = np.asarray(offset, dtype=np.float64)
+    dsm = np.full((grid.height, grid.width), np.nan, dtype=np.float32)
+    counts = np.zeros((grid.height, grid.width), dtype=np.int32)
+    tiles = [(r, c) for r in range(0, grid.height, tile) for c in range(0, grid.width, tile)]
+    res = grid.resolution
+    for k, (r0, c0) in enumerate(tiles):
+        check_cancel(progress)
+        h = min(tile, grid.height - r0)
+        w = min(tile, grid.width - c0)
+        # tile bounds in the local frame
+        txmin = grid.x0 + c0 * res - off[0]
+        txmax = txmin + w * res
+        tymax = grid.y0 - r0 * res - off[1]
+        tymin = tymax - h * res
+        cells_parts, z_parts = [], []
+        for pf in files:
+            bx0, by0, bx1, by1 = pf.bbox
+            if bx1 < txmin or bx0 > txmax or by1 < tymin or by0 > tymax:
+                continue
+            xyz, _ = pf.load()
+            ix = np.floor((xyz[:, 0].astype(np.float64) - txmin) / res).astype(np.int64)
+            iy = np.floor((tymax - xyz[:, 1].astype(np.float64)) / res).astype(np.int64)
+            m = (ix >= 0) & (ix < w) & (iy >= 0) & (iy < h) & np.isfinite(xyz[:, 2])
+            if m.any():
+                cells_parts.append(iy[m] * w + ix[m])
+                z_parts.append(xyz[m, 2].astype(np.float64) + off[2])
+        if cells_parts:
+            cells = np.concatenate(cells_parts)
+            z = np.concatenate(z_parts)
+            del cells_parts, z_parts
+            val, cnt = cell_statistic(cells, z, w * h, cluster_tol)
+            dsm[r0:r0 + h, c0:c0 + w] = val.reshape(h, w)
+            counts[r0:r0 + h, c0:c0 + w] = cnt.reshape(h, w)
+        progress.report((k + 1) / len(tiles), f"DSM tile {k + 1}/{len(tiles)}")
+    return dsm, counts
+
+
+def polygon_mask(grid: Grid, polygon_xy: np.ndarray) -> np.ndarray:
+    """Boolean mask of the cells whose centres lie inside a polygon (world coordinates)."""
+    from matplotlib.path import Path
+
+    xs, ys = grid.cell_centres()
+    mask = np.zeros((grid.height, grid.width), dtype=bool)
+    if len(polygon_xy) < 3:
+        return mask
+    path = Path(np.asarray(polygon_xy, dtype=float))
+    gx, gy = np.meshgrid(xs, ys)
+    mask[:] = path.contains_points(np.column_stack([gx.ravel(), gy.ravel()])).reshape(mask.shape)
+    return mask
+
+
+def convex_hull_xy(points_xy: np.ndarray) -> np.ndarray:
+    """Convex hull (counter-clockwise vertices) of 2-D points; fewer than 3 distinct points -> as given."""
+    pts = np.unique(np.asarray(points_xy, dtype=float), axis=0)
+    if len(pts) < 3:
+        return pts
+    try:
+        from scipy.spatial import ConvexHull
+
+        hull = ConvexHull(pts)
+    except Exception:  # collinear points (one strip)  # noqa: BLE001
+        return pts
+    return pts[hull.vertices]
+
+
+# ---------------------------------------------------------------------------
+# writing
+# ---------------------------------------------------------------------------
+
+def write_cog(path: str, array: np.ndarray, geotransform: Sequence[float], crs: Optional[str],
+              nodata: float = NODATA, progress: Optional[Progress] = None,
+              description: str = "DSM", metadata: Optional[dict] = None) -> str:
+    """Write a single-band float32 Cloud-Optimized GeoTIFF (DEFLATE, overviews) atomically.
+
+    NaN cells become ``nodata``.  ``crs`` None writes no CRS (local frame).  A cancel or crash
+    leaves no file at ``path`` (a previous complete file stays until the new one is complete)."""
+    gdal, _ = _gdal()
+    progress = progress or NullProgress()
+    data = np.where(np.isfinite(array), array, nodata).astype(np.float32)
+    wkt = crs_to_wkt(crs)
+    with atomic_output(path) as tmp:
+        mem = gdal.GetDriverByName("MEM").Create("", data.shape[1], data.shape[0], 1, gdal.GDT_Float32)
+        mem.SetGeoTransform(tuple(float(v) for v in geotransform))
+        if wkt:
+            mem.SetProjection(wkt)
+        band = mem.GetRasterBand(1)
+        band.SetNoDataValue(float(nodata))
+        band.SetDescription(description)
+        band.WriteArray(data)
+        if metadata:
+            mem.SetMetadata({str(k): str(v) for k, v in metadata.items()})
+        check_cancel(progress)
+
+        def cb(fraction, _msg, _data):
+            progress.report(fraction, "writing Cloud-Optimized GeoTIFF")
+            return 0 if progress.is_cancelled() else 1
+
+        opts = gdal.TranslateOptions(format="COG", creationOptions=[
+            "COMPRESS=DEFLATE", "PREDICTOR=YES", "BLOCKSIZE=512", "OVERVIEWS=IGNORE_EXISTING",
+            "OVERVIEW_RESAMPLING=AVERAGE", "BIGTIFF=IF_SAFER"], callback=cb)
+        try:
+            out = gdal.Translate(tmp, mem, options=opts)
+        except RuntimeError as e:
+            check_cancel(progress)  # GDAL reports a user interrupt as an error
+            raise DsmError(f"cannot write {path}: {e}") from e
+        if out is None:
+            check_cancel(progress)
+            raise DsmError(f"cannot write {path}")
+        out.FlushCache()
+        out = None
+        mem = None
+        check_cancel(progress)
+    return path
+
+
+# ---------------------------------------------------------------------------
+# reading (our DSM or an external one, e.g. ALS)
+# ---------------------------------------------------------------------------
+
+@dataclass
+class DsmInfo:
+    path: str
+    width: int
+    height: int
+    geotransform: Tuple[float, ...]
+    crs_wkt: str
+    nodata: Optional[float]
+    bounds: Tuple[float, float, float, float]  # xmin, ymin, xmax, ymax
+    resolution: Tuple[float, float]
+    metadata: dict = field(default_factory=dict)
+
+
+def open_dsm(path: str) -> DsmInfo:
+    """Check and describe a DSM raster (ours or external).  Raises DsmError with a clear message."""
+    gdal, _ = _gdal()
+    if not os.path.isfile(path):
+        raise DsmError(f"DSM {path} does not exist")
+    try:
+        ds = gdal.Open(path)
+    except RuntimeError as e:
+        raise DsmError(f"{path} is not a raster GDAL can read: {e}") from e
+    if ds.RasterCount < 1:
+        raise DsmError(f"{path} has no raster band")
+    gt = ds.GetGeoTransform(can_return_null=True)
+    if gt is None:
+        raise DsmError(f"{path} has no georeferencing (geotransform)")
+    if gt[2] != 0 or gt[4] != 0:
+        raise DsmError(f"{path} is rotated (geotransform {gt}); warp it north-up first")
+    w, h = ds.RasterXSize, ds.RasterYSize
+    xs = (gt[0], gt[0] + w * gt[1])
+    ys = (gt[3], gt[3] + h * gt[5])
+    band = ds.GetRasterBand(1)
+    return DsmInfo(path=path, width=w, height=h, geotransform=tuple(gt), crs_wkt=ds.GetProjection() or "",
+                   nodata=band.GetNoDataValue(), bounds=(min(xs), min(ys), max(xs), max(ys)),
+                   resolution=(abs(gt[1]), abs(gt[5])), metadata=ds.GetMetadata() or {})
+
+
+class DsmReader:
+    """Reads heights from a DSM, optionally reprojected into ``target_crs`` on the fly (a GDAL warped
+    VRT, so an ALS DSM in another CRS works without a copy).  Heights are float64 with NaN for nodata.
+
+    with DsmReader(path, target_crs="EPSG:32617") as dsm:
+        z = dsm.sample(x, y)                 # bilinear, world coordinates of target_crs
+        arr, gt = dsm.read_window(xmin, ymin, xmax, ymax)
+    """
+
+    def __init__(self, path: str, target_crs: Optional[str] = None, resampling: str = "bilinear"):
+        gdal, osr = _gdal()
+        self.info = open_dsm(path)
+        self._ds = gdal.Open(path)
+        if target_crs and self.info.crs_wkt:
+            src = osr.SpatialReference(wkt=self.info.crs_wkt)
+            dst = osr.SpatialReference()
+            dst.SetFromUserInput(target_crs)
+            if not src.IsSame(dst):
+                self._ds = gdal.AutoCreateWarpedVRT(self._ds, self.info.crs_wkt, dst.ExportToWkt(),
+                                                    getattr(gdal, f"GRA_{resampling.capitalize()}", gdal.GRA_Bilinear))
+        gt = self._ds.GetGeoTransform()
+        self.geotransform = gt
+        self.width, self.height = self._ds.RasterXSize, self._ds.RasterYSize
+        self.nodata = self._ds.GetRasterBand(1).GetNoDataValue()
+        self.crs_wkt = self._ds.GetProjection()
+        self._cache: Optional[np.ndarray] = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def close(self):
+        self._ds = None
+        self._cache = None
+
+    def _clean(self, arr: np.ndarray) -> np.ndarray:
+        arr = arr.astype(np.float64)
+        if self.nodata is not None:
+            arr[arr == self.nodata] = np.nan
+        arr[~np.isfinite(arr)] = np.nan
+        return arr
+
+    def read_window(self, xmin: float, ymin: float, xmax: float, ymax: float) -> Tuple[np.ndarray, Tuple[float, ...]]:
+        """Heights of the cells covering a box (clipped to the raster) and the window's geotransform."""
+        gt = self.geotransform
+        c0 = max(0, int(math.floor((xmin - gt[0]) / gt[1])))
+        c1 = min(self.width, int(math.ceil((xmax - gt[0]) / gt[1])))
+        r0 = max(0, int(math.floor((ymax - gt[3]) / gt[5])))
+        r1 = min(self.height, int(math.ceil((ymin - gt[3]) / gt[5])))
+        if c1 <= c0 or r1 <= r0:
+            return np.full((0, 0), np.nan), gt
+        arr = self._ds.GetRasterBand(1).ReadAsArray(c0, r0, c1 - c0, r1 - r0)
+        wgt = (gt[0] + c0 * gt[1], gt[1], 0.0, gt[3] + r0 * gt[5], 0.0, gt[5])
+        return self._clean(arr), wgt
+
+    def read_all(self) -> np.ndarray:
+        if self._cache is None:
+            self._cache = self._clean(self._ds.GetRasterBand(1).ReadAsArray())
+        return self._cache
+
+    def sample(self, x, y) -> np.ndarray:
+        """Bilinear heights at world points (NaN outside or where a neighbour cell is nodata)."""
+        x = np.asarray(x, dtype=np.float64)
+        y = np.asarray(y, dtype=np.float64)
+        if x.size == 0:
+            return np.zeros(x.shape)
+        gt = self.geotransform
+        fc = (x - gt[0]) / gt[1] - 0.5
+        fr = (y - gt[3]) / gt[5] - 0.5
+        finite = np.isfinite(fc) & np.isfinite(fr)
+        if not finite.any():
+            return np.full(x.shape, np.nan)
+        c0 = int(max(0, math.floor(np.nanmin(fc[finite])) - 1))
+        c1 = int(min(self.width, math.ceil(np.nanmax(fc[finite])) + 2))
+        r0 = int(max(0, math.floor(np.nanmin(fr[finite])) - 1))
+        r1 = int(min(self.height, math.ceil(np.nanmax(fr[finite])) + 2))
+        out = np.full(x.shape, np.nan)
+        if c1 <= c0 or r1 <= r0:
+            return out
+        if self._cache is not None:
+            arr = self._cache[r0:r1, c0:c1]
+        else:
+            arr = self._clean(self._ds.GetRasterBand(1).ReadAsArray(c0, r0, c1 - c0, r1 - r0))
+        return bilinear(arr, fc - c0, fr - r0)
+
+
+def bilinear(arr: np.ndarray, fc: np.ndarray, fr: np.ndarray) -> np.ndarray:
+    """Bilinear interpolation of ``arr`` at fractional (column, row) positions of cell centres;
+    NaN outside or where any of the four cells is NaN."""
+    h, w = arr.shape
+    out = np.full(np.shape(fc), np.nan)
+    c = np.floor(fc)
+    r = np.floor(fr)
+    # points on the outer half cell clamp to the edge cell
+    c = np.where((fc >= -0.5) & (fc < 0), 0, np.where((fc >= w - 1) & (fc <= w - 0.5), w - 2, c))
+    r = np.where((fr >= -0.5) & (fr < 0), 0, np.where((fr >= h - 1) & (fr <= h - 0.5), h - 2, r))
+    ok = np.isfinite(c) & np.isfinite(r) & (c >= 0) & (r >= 0) & (c <= w - 2) & (r <= h - 2)
+    if w == 1 or h == 1:
+        ci = np.clip(np.round(fc), 0, w - 1)
+        ri = np.clip(np.round(fr), 0, h - 1)
+        ok1 = np.isfinite(ci) & np.isfinite(ri) & (fc > -0.5) & (fc < w - 0.5) & (fr > -0.5) & (fr < h - 0.5)
+        out[ok1] = arr[ri[ok1].astype(int), ci[ok1].astype(int)]
+        return out
+    ci = c[ok].astype(np.int64)
+    ri = r[ok].astype(np.int64)
+    tx = np.clip(fc[ok] - ci, 0.0, 1.0)
+    ty = np.clip(fr[ok] - ri, 0.0, 1.0)
+    v = ((1 - tx) * (1 - ty) * arr[ri, ci] + tx * (1 - ty) * arr[ri, ci + 1]
+         + (1 - tx) * ty * arr[ri + 1, ci] + tx * ty * arr[ri + 1, ci + 1])
+    out[ok] = v
+    return out
+
+
+def read_dsm(path: str, target_crs: Optional[str] = None) -> Tuple[np.ndarray, Tuple[float, ...], str]:
+    """The whole DSM as (heights float64 with NaN, geotransform, CRS WKT); for small rasters and tests."""
+    with DsmReader(path, target_crs) as r:
+        return r.read_all().copy(), r.geotransform, r.crs_wkt
+
+
+# ---------------------------------------------------------------------------
+# LAS point clouds (own writer: LAS 1.2, point format 2 = XYZ + RGB)
+# ---------------------------------------------------------------------------
+
+LAS_SCALE = 0.001
+
+
+def _geokey_vlr(epsg: int, geographic: bool) -> bytes:
+    # GeoKeyDirectoryTag: header (1, 1, 0, n) then keys (id, location 0, count 1, value)
+    keys = [(1024, 0, 1, 2 if geographic else 1)]  # GTModelTypeGeoKey
+    keys.append((2048 if geographic else 3072, 0, 1, epsg))  # Geographic/ProjectedCSTypeGeoKey
+    if not geographic:
+        keys.append((3076, 0, 1, 9001))  # ProjLinearUnitsGeoKey: metre
+    data = struct.pack("<4H", 1, 1, 0, len(keys)) + b"".join(struct.pack("<4H", *k) for k in keys)
+    return _vlr(b"LASF_Projection", 34735, data, b"GeoKeyDirectoryTag")
+
+
+def _wkt_vlr(wkt: str) -> bytes:
+    return _vlr(b"LASF_Projection", 2112, wkt.encode("utf-8") + b"\0", b"OGC WKT")
+
+
+def _vlr(user_id: bytes, record_id: int, data: bytes, description: bytes) -> bytes:
+    return (struct.pack("<H", 0) + user_id.ljust(16, b"\0")[:16] + struct.pack("<HH", record_id, len(data))
+            + description.ljust(32, b"\0")[:32] + data)
+
+
+def write_las(path: str, chunks: Iterable[Tuple[np.ndarray, np.ndarray]], offset: Sequence[float],
+              crs: Optional[str], progress: Optional[Progress] = None, total: int = 0,
+              system_id: str = "ArchaeoOrtho dense") -> int:
+    """Write a LAS 1.2 file (point data format 2: XYZ + RGB) from (xyz local float, rgb uint8) chunks.
+
+    World = local + ``offset``; coordinates are stored as int32 at 1 mm with the LAS offset at the
+    rounded workspace offset.  The CRS goes in a GeoKeyDirectory VLR (EPSG) and/or an OGC WKT VLR.
+    Written atomically; returns the number of points."""
+    progress = progress or NullProgress()
+    off = np.round(np.asarray(offset, dtype=np.float64), 0)
+    local_shift = np.asarray(offset, dtype=np.float64) - off
+    vlrs = b""
+    n_vlr = 0
+    if crs:
+        epsg, geographic = crs_epsg(crs)
+        if epsg:
+            vlrs += _geokey_vlr(epsg, geographic)
+            n_vlr += 1
+        vlrs += _wkt_vlr(crs_to_wkt(crs))
+        n_vlr += 1
+    header_size = 227
+    offset_to_points = header_size + len(vlrs)
+    n = 0
+    mins = np.full(3, np.inf)
+    maxs = np.full(3, -np.inf)
+    returns = 0
+    dt = np.dtype([("x", "<i4"), ("y", "<i4"), ("z", "<i4"), ("intensity", "<u2"), ("flags", "u1"),
+                   ("cls", "u1"), ("angle", "i1"), ("user", "u1"), ("src", "<u2"),
+                   ("r", "<u2"), ("g", "<u2"), ("b", "<u2")])
+    assert dt.itemsize == 26
+    with atomic_output(path) as tmp:
+        with open(tmp, "wb") as f:
+            f.write(b"\0" * header_size)
+            f.write(vlrs)
+            for xyz, rgb in chunks:
+                check_cancel(progress)
+                if len(xyz) == 0:
+                    continue
+                w = xyz.astype(np.float64) + local_shift
+                rec = np.zeros(len(w), dtype=dt)
+                q = np.round(w / LAS_SCALE)
+                rec["x"], rec["y"], rec["z"] = q[:, 0], q[:, 1], q[:, 2]
+                rec["flags"] = 0b00001001  # return 1 of 1
+                rec["cls"] = 1  # unclassified
+                rgb16 = rgb.astype(np.uint16) * 257
+                rec["r"], rec["g"], rec["b"] = rgb16[:, 0], rgb16[:, 1], rgb16[:, 2]
+                rec["intensity"] = (rgb.astype(np.uint32).sum(axis=1) * 257 // 3).astype(np.uint16)
+                f.write(rec.tobytes())
+                mins = np.minimum(mins, q.min(axis=0) * LAS_SCALE + off)
+                maxs = np.maximum(maxs, q.max(axis=0) * LAS_SCALE + off)
+                n += len(w)
+                returns += len(w)
+                if total:
+                    progress.report(min(1.0, n / total), f"point cloud: {n} points")
+            if n == 0:
+                mins = maxs = off.copy()
+            import datetime
+
+            today = datetime.date.today()
+            hdr = bytearray(header_size)
+            struct.pack_into("<4sHH", hdr, 0, b"LASF", 0, 0)  # file source id, global encoding
+            # GUID (16 bytes) zero, version 1.2
+            struct.pack_into("<BB", hdr, 24, 1, 2)
+            struct.pack_into("<32s32s", hdr, 26, system_id.encode()[:32], b"ArchaeoOrtho QGIS plugin")
+            struct.pack_into("<HHHIIBHI", hdr, 90, today.timetuple().tm_yday, today.year, header_size,
+                             offset_to_points, n_vlr, 2, dt.itemsize, min(n, 2 ** 32 - 1))
+            struct.pack_into("<5I", hdr, 111, min(returns, 2 ** 32 - 1), 0, 0, 0, 0)
+            struct.pack_into("<3d3d", hdr, 131, LAS_SCALE, LAS_SCALE, LAS_SCALE, *off)
+            struct.pack_into("<6d", hdr, 179, maxs[0], mins[0], maxs[1], mins[1], maxs[2], mins[2])
+            f.seek(0)
+            f.write(bytes(hdr))
+            f.flush()
+            os.fsync(f.fileno())
+    return n
+
+
+def read_las(path: str) -> Tuple[np.ndarray, np.ndarray, dict]:
+    """Read a LAS 1.2 format-2 file written by :func:`write_las`: (xyz world float64, rgb uint16, header)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:4] != b"LASF":
+        raise DsmError(f"{path} is not a LAS file")
+    major, minor = struct.unpack_from("<BB", data, 24)
+    header_size, offset_to_points, n_vlr, fmt, rec_len, n = struct.unpack_from("<HIIBHI", data, 94)
+    scale = struct.unpack_from("<3d", data, 131)
+    off = struct.unpack_from("<3d", data, 155)
+    bounds = struct.unpack_from("<6d", data, 179)
+    vlrs = []
+    pos = header_size
+    for _ in range(n_vlr):
+        user = data[pos + 2:pos + 18].rstrip(b"\0").decode()
+        rid, length = struct.unpack_from("<HH", data, pos + 18)
+        vlrs.append((user, rid, data[pos + 54:pos + 54 + length]))
+        pos += 54 + length
+    raw = np.frombuffer(data, dtype=np.uint8, count=n * rec_len, offset=offset_to_points).reshape(n, rec_len)
+    ints = raw[:, :12].copy().view("<i4").reshape(n, 3)
+    xyz = ints * np.asarray(scale) + np.asarray(off)
+    rgb = raw[:, 20:26].copy().view("<u2").reshape(n, 3) if fmt in (2, 3) else np.zeros((n, 3), np.uint16)
+    header = {"version": f"{major}.{minor}", "point_format": fmt, "record_length": rec_len, "count": n,
+              "scale": scale, "offset": off, "max_min": bounds, "vlrs": vlrs}
+    return xyz, rgb, header
+
+
+def stream_point_files(files: Sequence[PointFile]) -> Iterable[Tuple[np.ndarray, np.ndarray]]:
+    for pf in files:
+        yield pf.load()
+
+
+def footprint_valid_fraction(dsm: np.ndarray, mask: np.ndarray) -> Optional[float]:
+    n = int(mask.sum())
+    if n == 0:
+        return None
+    return float(np.isfinite(dsm[mask]).sum() / n)
+
+
+Loader = Callable[[], Tuple[np.ndarray, np.ndarray]]
+
+__all__ = ["Grid", "PointFile", "rasterize_points", "fill_small_holes", "remove_speckles", "write_cog", "open_dsm",
+           "DsmReader", "read_dsm", "write_las", "read_las", "DsmError", "NODATA", "convex_hull_xy",
+           "polygon_mask", "footprint_valid_fraction", "cell_statistic", "bilinear"]

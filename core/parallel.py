@@ -1,0 +1,288 @@
+"""Run independent units of work (stereo pairs, images, tiles) on an executor.
+
+One interface, several back-ends (DESIGN.md §6):
+
+- ``serial``: in this process, one unit at a time (workers=1; tests, debugging);
+- ``process``: a local :class:`concurrent.futures.ProcessPoolExecutor` (the default
+  for more than one worker).  Processes are *spawned*, never forked: forking a
+  running QGIS (Qt threads, GDAL caches) is unsafe.  Inside QGIS or qgis_process
+  ``sys.executable`` is the QGIS binary, so the pool is told which Python to start;
+- ``thread``: a thread pool (OpenCV and NumPy release the GIL in the heavy parts);
+- a Dask ``distributed.Client`` when a scheduler address is given (``dask`` must be
+  installed; it is optional).  Its ``submit``/future API is the same as
+  ``concurrent.futures``, so :func:`run_units` drives every back-end alike.
+
+A unit is a module-level function ``fn(unit, cancel_path)`` that returns a small,
+picklable result and writes anything large to disk itself, so memory is bounded
+by the units in flight, not by the block.  ``cancel_path`` names a file that
+appears when the user cancels: a unit may poll :func:`cancel_requested` between
+its steps and raise :class:`~.progress.Cancelled` (cancel *within* a unit).
+"""
+from __future__ import annotations
+
+import concurrent.futures as cf
+import contextlib
+import os
+import shutil
+import sys
+import tempfile
+import threading
+from typing import Any, Callable, Iterator, List, Optional, Sequence, Tuple
+
+from .progress import Cancelled, NullProgress, Progress
+
+KINDS = ("auto", "serial", "process", "thread")
+
+
+class ParallelError(RuntimeError):
+    """The executor could not be created; the message says why."""
+
+
+def cpu_count() -> int:
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):  # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def available_memory() -> Optional[int]:
+    """Bytes of memory available to new work (Linux /proc/meminfo), or None."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
+def auto_workers(unit_memory: int = 0, max_workers: int = 0) -> int:
+    """Workers for this machine: one per core, fewer when ``unit_memory`` bytes per unit would not fit
+    in half of the available memory."""
+    n = cpu_count()
+    mem = available_memory()
+    if unit_memory > 0 and mem:
+        n = min(n, max(1, int(0.5 * mem // unit_memory)))
+    if max_workers > 0:
+        n = min(n, max_workers)
+    return max(1, n)
+
+
+def python_executable() -> Optional[str]:
+    """A Python interpreter that can run pool workers (inside QGIS sys.executable is QGIS itself)."""
+    exe = sys.executable or ""
+    if os.path.basename(exe).lower().startswith("python") and os.path.isfile(exe):
+        return exe
+    ver = f"{sys.version_info.major}.{sys.version_info.minor}"
+    candidates = [os.path.join(sys.exec_prefix, "bin", f"python{ver}"), os.path.join(sys.exec_prefix, "bin", "python3"),
+                  shutil.which(f"python{ver}"), shutil.which("python3")]
+    if os.name == "nt":  # pragma: no cover - QGIS on Windows ships python.exe beside qgis-bin.exe
+        candidates.insert(0, os.path.join(sys.exec_prefix, "python.exe"))
+    for c in candidates:
+        if c and os.path.isfile(c):
+            return c
+    return None
+
+
+class SerialExecutor(cf.Executor):
+    """Runs each unit at submit time in this process: no pickling, no start-up."""
+
+    def submit(self, fn, /, *args, **kwargs):
+        fut: cf.Future = cf.Future()
+        try:
+            fut.set_result(fn(*args, **kwargs))
+        except BaseException as e:  # noqa: B036 - stored on the future, re-raised by result()
+            fut.set_exception(e)
+        return fut
+
+
+def make_executor(workers: int = 0, kind: str = "auto", scheduler: Optional[str] = None,
+                  unit_memory: int = 0):
+    """An executor for units of work.
+
+    ``workers`` 0 = one per core (bounded by ``unit_memory``); ``kind`` auto = serial for one worker,
+    else processes; ``scheduler`` = a Dask scheduler address (tcp://host:8786) to use a cluster.
+    The caller shuts it down (``with make_executor(...) as ex:``)."""
+    if scheduler:
+        try:
+            from dask.distributed import Client  # optional dependency
+        except ImportError as e:
+            raise ParallelError(f"a Dask scheduler ({scheduler}) was given but dask.distributed is not installed "
+                                "in the Python that runs ArchaeoOrtho") from e
+        try:
+            return _DaskExecutor(Client(scheduler, timeout=30))
+        except OSError as e:
+            raise ParallelError(f"cannot reach the Dask scheduler {scheduler}: {e}") from e
+    if kind not in KINDS:
+        raise ParallelError(f"unknown executor kind {kind!r}; choose one of {', '.join(KINDS)}")
+    n = workers if workers and workers > 0 else auto_workers(unit_memory)
+    if kind == "serial" or (kind == "auto" and n <= 1):
+        return SerialExecutor()
+    if kind == "thread":
+        return cf.ThreadPoolExecutor(max_workers=n)
+    import multiprocessing
+
+    ctx = multiprocessing.get_context("spawn")
+    exe = python_executable()
+    if exe is None:  # no interpreter to spawn: threads still use the cores for OpenCV work
+        return cf.ThreadPoolExecutor(max_workers=n)
+    if exe != sys.executable:
+        ctx.set_executable(exe)
+    return cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx)
+
+
+class _DaskExecutor:
+    """The concurrent.futures subset run_units needs, on a dask.distributed Client."""
+
+    def __init__(self, client):
+        self.client = client
+        self._max_workers = max(1, sum(client.nthreads().values()))
+
+    def submit(self, fn, *args, **kwargs):
+        return _DaskFuture(self.client.submit(fn, *args, pure=False, **kwargs))
+
+    def shutdown(self, wait=True, cancel_futures=False):
+        self.client.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.shutdown()
+        return False
+
+
+class _DaskFuture:
+    def __init__(self, fut):
+        self.fut = fut
+
+    def done(self):
+        return self.fut.done()
+
+    def result(self, timeout=None):
+        return self.fut.result(timeout=timeout)
+
+    def cancel(self):
+        self.fut.cancel()
+        return True
+
+
+def max_in_flight(executor) -> int:
+    n = getattr(executor, "_max_workers", 1) or 1
+    return 1 if isinstance(executor, SerialExecutor) else 2 * n
+
+
+def cancel_requested(cancel_path: Optional[str]) -> bool:
+    return bool(cancel_path) and os.path.exists(cancel_path)
+
+
+def check_unit_cancel(cancel_path: Optional[str]) -> None:
+    """For units: raise Cancelled when the cancel file exists."""
+    if cancel_requested(cancel_path):
+        raise Cancelled("cancelled by the user")
+
+
+class _CancelFile:
+    """Creates ``cancel_path`` when ``progress.is_cancelled()`` turns true (polled by a thread)."""
+
+    def __init__(self, progress: Progress, folder: Optional[str] = None):
+        self.progress = progress
+        self.dir = tempfile.mkdtemp(prefix=".cancel-", dir=folder)
+        self.path = os.path.join(self.dir, "cancel")
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+
+    def _run(self):
+        while not self._stop.wait(0.2):
+            if self.progress.is_cancelled():
+                self.set()
+                return
+
+    def set(self):
+        with contextlib.suppress(OSError):
+            open(self.path, "w").close()
+
+    def __enter__(self):
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self._stop.set()
+        self._thread.join(timeout=1)
+        shutil.rmtree(self.dir, ignore_errors=True)
+        return False
+
+
+def run_units(executor, fn: Callable[[Any, Optional[str]], Any], units: Sequence[Any],
+              progress: Optional[Progress] = None, label: str = "unit",
+              describe: Optional[Callable[[Any], str]] = None,
+              cancel_dir: Optional[str] = None) -> Iterator[Tuple[int, Any]]:
+    """Run ``fn(unit, cancel_path)`` for every unit; yield (index, result) as each one finishes.
+
+    Reports progress per finished unit, hears a cancel within ~0.2 s (pending units are dropped,
+    running ones see the cancel file), then raises Cancelled.  The first failing unit's
+    exception is re-raised after the others are cancelled."""
+    progress = progress or NullProgress()
+    total = len(units)
+    if total == 0:
+        return
+    limit = max_in_flight(executor)
+    done_count = 0
+    with _CancelFile(progress, cancel_dir) as cancel:
+        pending: dict = {}
+        next_i = 0
+
+        def fill():
+            nonlocal next_i
+            while next_i < total and len(pending) < limit:
+                if progress.is_cancelled():
+                    return
+                pending[executor.submit(fn, units[next_i], cancel.path)] = next_i
+                next_i += 1
+
+        try:
+            fill()
+            while pending:
+                if progress.is_cancelled():
+                    cancel.set()
+                    raise Cancelled("cancelled by the user")
+                finished = [f for f in pending if f.done()]
+                if not finished:
+                    _wait_any(list(pending), 0.2)
+                    continue
+                for f in finished:
+                    i = pending.pop(f)
+                    result = f.result()  # re-raises the unit's exception
+                    done_count += 1
+                    what = describe(units[i]) if describe else f"{label} {i + 1}"
+                    progress.report(done_count / total, f"{label} {done_count}/{total}: {what}")
+                    yield i, result
+                fill()
+            if progress.is_cancelled():
+                raise Cancelled("cancelled by the user")
+        except BaseException:
+            cancel.set()
+            for f in pending:
+                f.cancel()
+            _wait_all(list(pending), 30.0)
+            raise
+
+
+def _wait_any(futures: List[Any], timeout: float) -> None:
+    cf_futs = [f for f in futures if isinstance(f, cf.Future)]
+    if len(cf_futs) == len(futures):
+        cf.wait(cf_futs, timeout=timeout, return_when=cf.FIRST_COMPLETED)
+    else:  # Dask futures: poll
+        threading.Event().wait(timeout)
+
+
+def _wait_all(futures: List[Any], timeout: float) -> None:
+    """Let running units see the cancel file and stop (they must not write after we return)."""
+    cf_futs = [f for f in futures if isinstance(f, cf.Future)]
+    if cf_futs:
+        cf.wait(cf_futs, timeout=timeout)
+
+
+__all__ = ["make_executor", "run_units", "check_unit_cancel", "cancel_requested", "auto_workers", "cpu_count",
+           "ParallelError", "SerialExecutor", "python_executable"]
