@@ -337,7 +337,7 @@ class Scene:
             inside = b.contains(xx, yy)
             u, _ = b.local_uv(xx[inside], yy[inside])
             sub = tex[win]
-            sub[inside] = 0.5 * sub[inside] + 0.9 * np.sin(2 * np.pi * u / 0.9).astype(np.float32) + 0.6
+            sub[inside] = 0.8 * sub[inside] + 0.35 * np.sin(2 * np.pi * u / 0.9).astype(np.float32) + 0.6
         (x0, y0), (x1, y1), hw, _ = self.ditch
         win = self._window(min(x0, x1) - hw, min(y0, y1) - hw, max(x0, x1) + hw, max(y0, y1) + hw,
                            self.texture_res)
@@ -594,14 +594,16 @@ class SyntheticBlock:
 
     # ---- ground control
     def add_gcps(self, n_ground_x: int = 4, n_ground_y: int = 3, roofs: int = 2, min_views: int = 3,
-                 inset: float = 0.1) -> List[TruePoint]:
+                 inset: float = 0.05) -> List[TruePoint]:
         """Ground points on a jittered grid over the covered area (away from buildings and the ditch),
         plus points on ``roofs`` building roofs; each kept only where it is seen in >= ``min_views`` images."""
         rng = np.random.default_rng(self.seed + 7)
         cover = np.array([s.centre[:2] for s in self.shots if s.kind == "vertical"])
-        half = 0.25 * np.array([self.camera.width / self.camera.fx, self.camera.height / self.camera.fy]) * self.altitude
-        x0, y0 = cover.min(axis=0) - half
-        x1, y1 = cover.max(axis=0) + half
+        x0, y0 = cover.min(axis=0)
+        x1, y1 = cover.max(axis=0)
+        across = self.camera.height / self.camera.fy * self.altitude
+        if y1 - y0 < 0.5 * across:  # a single strip: spread across its footprint
+            y0, y1 = y0 - 0.3 * across, y1 + 0.3 * across
         wx, wy = x1 - x0, y1 - y0
         pts: List[TruePoint] = []
         for j in range(n_ground_y):
@@ -623,13 +625,17 @@ class SyntheticBlock:
                 p = TruePoint(f"G{len(pts) + 1:02d}", xyz[best], "ground")
                 self._observe(p, min_views)
                 pts.append(p)
-        for b in sorted(self.scene.buildings, key=lambda b: -(b.half_w * b.half_l))[:roofs]:
+        n_roof = 0
+        for b in sorted(self.scene.buildings, key=lambda b: -(b.half_w * b.half_l)):
+            if n_roof >= roofs:
+                break
             u, v = rng.uniform(-0.4, 0.4, 2) * [b.half_w, b.half_l]
             c, s = math.cos(b.angle), math.sin(b.angle)
             x, y = b.cx + c * u - s * v, b.cy + s * u + c * v
-            p = TruePoint(f"R{len([q for q in pts if q.kind == 'roof']) + 1:02d}", np.array([x, y, b.roof]), "roof")
+            p = TruePoint(f"R{n_roof + 1:02d}", np.array([x, y, b.roof]), "roof")
             if self._observe(p, min_views):
                 pts.append(p)
+                n_roof += 1
         self.gcps = pts
         return pts
 
@@ -832,8 +838,8 @@ DEFAULT_CAMERA = CameraModel(800, 600, 650.0, 650.0, 403.7, 296.2, k1=-0.08, k2=
 
 
 def vertical_block(seed: int = 1, camera: CameraModel = DEFAULT_CAMERA, altitude: float = 50.0,
-                   n_strips: int = 3, per_strip: int = 5, forward_overlap: float = 0.7,
-                   side_overlap: float = 0.3, attitude_sigma_deg: float = 1.0, position_jitter: float = 0.5,
+                   n_strips: int = 3, per_strip: int = 6, forward_overlap: float = 0.75,
+                   side_overlap: float = 0.35, attitude_sigma_deg: float = 1.0, position_jitter: float = 0.5,
                    orbit: int = 0, orbit_tilt_deg: float = 30.0, n_buildings: int = 5,
                    gcp_grid: Tuple[int, int] = (4, 3), roofs: int = 2) -> SyntheticBlock:
     """Parallel strips along local x (serpentine: every other strip flown the other way), image x along

@@ -1,0 +1,286 @@
+"""Georeferencing against synthetic ground truth (tests/synthetic.py): issue 3's acceptance tests.
+
+Two kinds of model:
+- a sparse model built directly from the truth (exact poses, projected tie points with pixel noise, an
+  arbitrary model frame, optionally a controlled deformation or a wrong camera): fast, isolates
+  core.georef;
+- the rendered vertical block aligned by core.sfm.align (real pycolmap): end to end, rendered and aligned
+  once per session.
+
+Figures are printed (pytest -s) so that runs can be compared.
+"""
+import math
+import os
+import shutil
+import time
+
+import numpy as np
+import pytest
+
+from core import georef, sfm
+from core.gcp import CHECK, CONTROL, read_gcps, write_odm_gcp_list
+from tests import synthetic as syn
+
+GCP_NOISE_PX = 0.4
+POSITION_SIGMA = 0.5  # m
+
+
+def _fmt(r):
+    if not r or r.get("n", 0) == 0:
+        return "n=0"
+    return f"n={r['n']} xy={r['xy']:.4f} z={r['z']:.4f} m"
+
+
+def _report(label, result, gsd):
+    chk, hel = result.rmse(CHECK), result.rmse(CHECK, helmert=True)
+    ctl = result.rmse(CONTROL)
+    print(f"\n[{label}] GSD {gsd:.4f} m | control {_fmt(ctl)} | check {_fmt(chk)} "
+          f"({chk['xy'] / gsd:.2f} / {chk['z'] / gsd:.2f} GSD) | check Helmert-only {_fmt(hel)} | "
+          f"tie reprojection {result.mean_reprojection_error:.3f} px, GCP {result.gcp_reprojection_error:.3f} px"
+          if chk["n"] else f"\n[{label}] control {_fmt(ctl)}")
+
+
+# ----------------------------------------------------------------------------------------------
+# the generator itself: conventions that everything else relies on
+# ----------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def block():
+    return syn.vertical_block(seed=1)
+
+
+def test_camera_model_is_pycolmaps_opencv_model(block):
+    cam = block.camera
+    pc = cam.pycolmap_camera()
+    rng = np.random.default_rng(0)
+    xc = np.column_stack([rng.uniform(-0.7, 0.7, 500), rng.uniform(-0.5, 0.5, 500), np.ones(500)])
+    ours = cam.image_from_camera(xc)
+    theirs = np.asarray(pc.img_from_cam(xc))
+    assert np.abs(ours - theirs).max() < 1e-9
+    # undistortion inverts distortion, and agrees with pycolmap's
+    back = cam.undistort(cam.normalized_from_pixel(ours))
+    assert np.abs(back - xc[:, :2]).max() < 1e-12
+    assert np.abs(np.asarray(pc.cam_from_img(ours)) - xc[:, :2]).max() < 1e-6
+    # noticeable distortion: more than 10 px at the image corner
+    corner = np.array([[0.0, 0.0]])
+    assert np.linalg.norm(cam.undistort(cam.normalized_from_pixel(corner)) * cam.fx
+                          - cam.normalized_from_pixel(corner) * cam.fx) > 10.0
+
+
+def test_gcp_observations_are_exact_projections_with_visibility(block):
+    rec = block.truth_reconstruction(noise_px=0.0, model_from_local=None, n_points=200)
+    ims = {im.name: im for im in rec.images.values()}
+    assert len(block.gcps) >= 10
+    assert any(p.kind == "roof" for p in block.gcps)
+    for p in block.gcps:
+        assert len(p.observations) >= 3, p.name
+        assert abs(p.xyz[2] - float(block.scene.height_at(p.xyz[0], p.xyz[1]))) < 1e-9
+        for name, px in p.observations.items():
+            im = ims[name]
+            proj = np.asarray(rec.cameras[im.camera_id].img_from_cam(im.cam_from_world() * p.xyz))
+            assert np.abs(proj - px).max() < 1e-6
+            assert 0 <= px[0] <= block.camera.width and 0 <= px[1] <= block.camera.height
+    # a point hidden by a building is not visible: the foot of a wall seen from across the roof
+    b = max(block.scene.buildings, key=lambda b: b.roof - float(block.scene.ground_at(b.cx, b.cy)))
+    c, s = math.cos(b.angle), math.sin(b.angle)
+    foot = np.array([b.cx + c * (b.half_w + 0.05), b.cy + s * (b.half_w + 0.05)])
+    foot = np.array([foot[0], foot[1], float(block.scene.ground_at(*foot))])
+    far = np.array([b.cx - c * 60.0, b.cy - s * 60.0, b.roof + 20.0])  # across the roof, low
+    shot = syn.Shot("x", syn.look_at(far, foot, np.array([0.0, 0.0, 1.0])), far)
+    ok, _ = block.visible(shot, foot[None], margin=0)
+    assert not ok[0]
+    near = foot + np.array([c * 30.0, s * 30.0, 40.0])  # on the open side
+    shot = syn.Shot("y", syn.look_at(near, foot, np.array([0.0, 0.0, 1.0])), near)
+    ok, _ = block.visible(shot, foot[None], margin=0)
+    assert ok[0]
+
+
+def test_rendered_image_puts_ground_points_where_the_camera_model_says(block, tmp_path):
+    """Render a textured patch check: the image around a GCP's projected pixel matches the orthoimage
+    resampled through the true camera (sub-pixel), so rendering and truth share one pixel convention."""
+    import cv2
+
+    shot = block.shots[len(block.shots) // 2]
+    img = syn.render_image(block.scene, block.camera, shot, noise=0.0).astype(np.float32)
+    # predict the same image by projecting a dense ground grid (no occlusion near a ground GCP)
+    p = next(q for q in block.gcps if q.kind == "ground" and shot.name in q.observations)
+    px = p.observations[shot.name]
+    gsd = block.gsd
+    g = np.arange(-25, 26) * gsd * 0.5
+    xx, yy = np.meshgrid(p.xyz[0] + g, p.xyz[1] + g)
+    zz = block.scene.height_at(xx, yy)
+    pix, _ = block.project(shot, np.column_stack([xx.ravel(), yy.ravel(), zz.ravel()]))
+    tex = block.scene.texture_raster()
+    mx, my = block.scene.raster_coords(xx.ravel(), yy.ravel(), block.scene.texture_res)
+    val = cv2.remap(tex, mx.reshape(1, -1), my.reshape(1, -1), cv2.INTER_LINEAR).ravel()
+    # the rendered image sampled at the projected pixels (COLMAP convention: centre of pixel (0,0) is 0.5)
+    sampled = cv2.remap(img, (pix[:, 0] - 0.5).astype(np.float32).reshape(1, -1),
+                        (pix[:, 1] - 0.5).astype(np.float32).reshape(1, -1), cv2.INTER_LINEAR).ravel()
+    corr = np.corrcoef(val, sampled)[0, 1]
+    # the same with a 1-pixel shift must correlate clearly worse
+    shifted = cv2.remap(img, (pix[:, 0] + 0.5).astype(np.float32).reshape(1, -1),
+                        (pix[:, 1] - 0.5).astype(np.float32).reshape(1, -1), cv2.INTER_LINEAR).ravel()
+    corr_shift = np.corrcoef(val, shifted)[0, 1]
+    print(f"\nrender check at {p.name} in {shot.name} ({px[0]:.1f}, {px[1]:.1f}): corr {corr:.3f}, "
+          f"1 px off {corr_shift:.3f}")
+    assert corr > 0.85
+    assert corr - corr_shift > 0.05
+
+
+# ----------------------------------------------------------------------------------------------
+# core.georef on models built from the truth
+# ----------------------------------------------------------------------------------------------
+
+
+def test_truth_model_georeferenced_with_five_control_points(block):
+    rec = block.truth_reconstruction()
+    control = block.spread_control(5)
+    gcps = block.gcp_set(control, noise_px=GCP_NOISE_PX)
+    result = georef.georeference(rec, gcps)
+    _report("truth model, 5 control", result, block.gsd)
+    chk = result.rmse(CHECK)
+    assert chk["n"] >= 5
+    assert chk["xy"] <= 0.5 * block.gsd and chk["z"] <= 1.0 * block.gsd
+    assert not result.outliers
+    # the adjusted cameras are where the truth says (world = local + offset)
+    ims = {im.name: im for im in result.reconstruction.images.values()}
+    err = [np.linalg.norm(result.to_world(ims[s.name].projection_center()) - (s.centre + syn.ORIGIN))
+           for s in block.shots]
+    assert max(err) < 0.1
+
+
+@pytest.fixture(scope="module")
+def strip():
+    return syn.single_strip(seed=3, n=12)
+
+
+def test_constrained_adjustment_removes_the_bending_of_a_long_strip(strip):
+    """A long single strip whose sparse model sags (1.5 m dome over the strip): a 7-parameter transform
+    cannot remove that, the GCP-constrained adjustment (tie points + GCPs) must."""
+    xs = np.array([s.centre[0] for s in strip.shots])
+    half = 0.5 * (xs.max() - xs.min()) + 10.0
+    bend = syn.dome(1.5, (float(xs.mean()), 0.0), half)
+    rec = strip.truth_reconstruction(deform=bend)
+    ground = sorted((p for p in strip.gcps if p.kind == "ground"), key=lambda p: p.xyz[0])
+    # control at both ends and in the middle, on both sides of the strip; the rest are check points
+    control = [ground[0].name, ground[1].name, ground[-1].name, ground[-2].name,
+               ground[len(ground) // 2].name]
+    gcps = strip.gcp_set(control, noise_px=GCP_NOISE_PX)
+    result = georef.georeference(rec, gcps)
+    _report("bent strip", result, strip.gsd)
+    chk, hel = result.rmse(CHECK), result.rmse(CHECK, helmert=True)
+    assert chk["n"] >= 3
+    assert hel["xyz"] > 0.3  # the deformation is there after the Helmert step
+    assert chk["xyz"] < hel["xyz"] / 4  # ...and the adjustment removes it
+    assert chk["xy"] <= 1.0 * strip.gsd and chk["z"] <= 1.5 * strip.gsd
+
+
+def test_camera_positions_only_land_within_their_noise(block):
+    """No GCPs: camera positions with sigma 0.5 m.  The datum (shift, rotation, scale) is then known to
+    about sigma / sqrt(n): check points must sit within a few times that, well inside sigma itself."""
+    rec = block.truth_reconstruction()
+    positions, noise = block.camera_positions(sigma=POSITION_SIGMA, seed=13)
+    gcps = block.gcp_set([], noise_px=GCP_NOISE_PX)  # every ground point is a check point
+    result = georef.georeference(rec, gcps, positions)
+    assert result.source == "camera positions"
+    rows = [r for r in result.points if r.status == georef.CHECKED]
+    assert len(rows) == len(block.gcps)
+    d = np.array([[r.dx, r.dy, r.dz] for r in rows if r.dx is not None])
+    n = len(block.shots)
+    rmse_xy = float(np.sqrt(np.mean(d[:, 0] ** 2 + d[:, 1] ** 2)))
+    rmse_z = float(np.sqrt(np.mean(d[:, 2] ** 2)))
+    mean_noise = np.mean(np.array(list(noise.values())), axis=0)
+    print(f"\n[positions only] n={n} sigma={POSITION_SIGMA} m: check RMSE xy {rmse_xy:.3f} z {rmse_z:.3f} m; "
+          f"mean position noise {np.round(mean_noise, 3)}; mean check error {np.round(d.mean(axis=0), 3)}")
+    # translation ~ sigma/sqrt(n) per axis, rotation/scale errors add about as much again over the block
+    bound = 3.0 * POSITION_SIGMA * math.sqrt(2.0 / n)
+    assert rmse_xy <= 2 * bound  # horizontal: two axes
+    assert rmse_z <= bound
+    assert rmse_xy < POSITION_SIGMA and rmse_z < POSITION_SIGMA
+    # the mean error is what the mean of the position noise predicts (the datum follows the positions)
+    assert np.all(np.abs(d.mean(axis=0) - mean_noise) < 2.0 * POSITION_SIGMA / math.sqrt(n))
+    # and the camera residuals reported are consistent with the noise
+    cams = [c for c in result.cameras if c.used]
+    assert len(cams) == n
+    res = np.sqrt(np.mean([c.dx ** 2 + c.dy ** 2 + c.dz ** 2 for c in cams]))
+    assert 0.5 * POSITION_SIGMA * math.sqrt(3) < res < 1.5 * POSITION_SIGMA * math.sqrt(3)
+
+
+def test_gcp_with_a_100_m_typo_is_flagged_by_name_and_spares_the_check_points(block):
+    rec = block.truth_reconstruction()
+    control = block.spread_control(6)
+    gcps = block.gcp_set(control, noise_px=GCP_NOISE_PX)
+    bad = gcps.by_name(control[2])
+    bad.x += 100.0  # a typo in the easting
+    result = georef.georeference(rec, gcps)
+    _report("100 m typo", result, block.gsd)
+    flagged = [o for o in result.outliers if o.name == bad.name]
+    assert flagged, [o.to_dict() for o in result.outliers]
+    assert all(o.name == bad.name for o in result.outliers if o.kind == "control point")
+    assert any(bad.name in w for w in result.warnings)
+    row = next(r for r in result.points if r.name == bad.name)
+    assert row.status == georef.REJECTED
+    assert abs(abs(row.dx) - 100.0) < 0.5  # its residual shows the typo
+    chk = result.rmse(CHECK)
+    assert chk["xy"] <= 0.5 * block.gsd and chk["z"] <= 1.0 * block.gsd
+
+
+def test_observation_outside_the_image_is_named_and_ignored(block, tmp_path):
+    gcps = block.gcp_set(block.spread_control(5), noise_px=GCP_NOISE_PX)
+    p = gcps.by_name(block.spread_control(5)[1])
+    img = p.observations[0].image
+    p.observations[0].x = block.camera.width + 250.0  # off the right edge
+    path = str(tmp_path / "gcp_list.txt")
+    write_odm_gcp_list(gcps, path)
+    sizes = {s.name: (block.camera.width, block.camera.height) for s in block.shots}
+    read = read_gcps(path, image_names=list(sizes), image_sizes=sizes)
+    msg = [w for w in read.warnings if p.name in w and img in w and "outside" in w]
+    assert msg, read.warnings
+    assert img not in read.by_name(p.name).images()
+    result = georef.georeference(block.truth_reconstruction(), read)
+    assert any(p.name in w and img in w for w in result.warnings)
+    assert not result.outliers
+    chk = result.rmse(CHECK)
+    assert chk["xy"] <= 0.5 * block.gsd and chk["z"] <= 1.0 * block.gsd
+
+
+# ----------------------------------------------------------------------------------------------
+# end to end: rendered images -> core.sfm.align (pycolmap) -> core.georef
+# ----------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="session")
+def aligned_block(tmp_path_factory):
+    root = tmp_path_factory.mktemp("synthetic block")
+    blk = syn.vertical_block(seed=1)
+    t0 = time.time()
+    blk.render(str(root / "images"))
+    t_render = time.time() - t0
+    t0 = time.time()
+    res = sfm.align(str(root / "images"), str(root / "ws"),
+                    sfm.AlignOptions(pairing="exhaustive", num_threads=2, max_features=4000))
+    t_align = time.time() - t0
+    print(f"\n[synthetic block] {len(blk.shots)} images {blk.camera.width}x{blk.camera.height}, GSD "
+          f"{blk.gsd:.4f} m: render {t_render:.1f} s, align {t_align:.1f} s, registered {res.registered}, "
+          f"{res.num_points3d} points, reprojection {res.mean_reprojection_error:.3f} px")
+    return blk, str(root / "ws"), res
+
+
+@pytest.mark.slow
+def test_end_to_end_five_control_points_reach_one_gsd(aligned_block):
+    blk, ws, res = aligned_block
+    assert res.registered == len(blk.shots)
+    rec = sfm.load_model(ws)
+    control = blk.spread_control(5)
+    gcps = blk.gcp_set(control, noise_px=GCP_NOISE_PX)
+    result = georef.georeference(rec, gcps)
+    _report("end to end, 5 control", result, blk.gsd)
+    for r in result.points:
+        if r.status == georef.CHECKED:
+            print(f"  {r.name}: dx {r.dx:+.3f} dy {r.dy:+.3f} dz {r.dz:+.3f} m ({r.n_obs} obs)")
+    chk = result.rmse(CHECK)
+    assert chk["n"] >= 5
+    assert chk["xy"] <= 1.0 * blk.gsd
+    assert chk["z"] <= 1.5 * blk.gsd
+    assert not [o for o in result.outliers if o.kind == "control point"]
