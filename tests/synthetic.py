@@ -477,7 +477,7 @@ def _surface_value(scene: Scene, xyz: np.ndarray) -> np.ndarray:
     tex = scene.texture_raster()
     x, y, z = xyz[..., 0], xyz[..., 1], xyz[..., 2]
     mx, my = scene.raster_coords(x, y, scene.texture_res)
-    val = cv2.remap(tex, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT101)
+    val = _sample(tex, mx, my)
     for b in scene.buildings:
         u, v = b.local_uv(x, y)
         on_wall = ((np.abs(np.abs(u) - b.half_w) < 0.08) & (np.abs(v) <= b.half_l + 0.08)
@@ -486,7 +486,7 @@ def _surface_value(scene: Scene, xyz: np.ndarray) -> np.ndarray:
             along = np.where(np.abs(np.abs(u) - b.half_w) < 0.08, v, u)
             wx, wy = scene.raster_coords(b.cx + along[on_wall] * 0.7, b.cy + (z[on_wall] - b.roof) * 0.7,
                                          scene.texture_res)
-            wall = cv2.remap(tex, wx, wy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT101)
+            wall = _sample(tex, wx, wy)
             val[on_wall] = (0.55 * wall.ravel() + 0.1 * ((np.floor(z[on_wall] * 2.0) % 2) - 0.5)).ravel()
     return val
 
