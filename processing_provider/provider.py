@@ -21,7 +21,8 @@ class ArchaeoOrthoProvider(QgsProcessingProvider):
 
     def loadAlgorithms(self):  # noqa: N802 (QGIS API name)
         from .align_images import AlignImagesAlgorithm
+        from .build_dsm import BuildDsmAlgorithm
         from .georeference import GeoreferenceAlgorithm
 
-        for alg in (AlignImagesAlgorithm(), GeoreferenceAlgorithm()):
+        for alg in (AlignImagesAlgorithm(), GeoreferenceAlgorithm(), BuildDsmAlgorithm()):
             self.addAlgorithm(alg)

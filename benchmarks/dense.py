@@ -1,0 +1,231 @@
+"""Dense matching + DSM on real data: Toledo (57 images, georeferenced with EXIF GPS).
+
+Aligns and georeferences the block first when the workspace is not ready (or reuses
+--workspace), clears the pair cache (unless --resume), then runs the DSM stage in a
+child process while sampling the memory of the whole process tree (the child and its
+pool workers).  Prints seconds per stereo pair and per megapixel, total seconds, peak
+RSS, VALID_FRACTION inside the convex hull of the image centres, the heights of raised
+objects above a local ground estimate, and writes a hillshade PNG of the DSM.
+
+    python benchmarks/dense.py [--workspace DIR] [--quality half] [--workers 0] [--resume]
+                               [--png PATH] [--point-cloud]
+"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, ROOT)
+DATA = os.path.join(os.path.dirname(ROOT), "shared", "data")
+
+
+def ensure_georeferenced(images, ws, crs):
+    from core import pipeline, sfm
+    from core.progress import PrintProgress
+    from core.workspace import Workspace
+
+    try:
+        w = Workspace.open(ws)
+        if w.stage_done("georeference"):
+            return
+        aligned = w.stage_done("align")
+    except Exception:  # noqa: BLE001 - no workspace yet
+        aligned = False
+    if not aligned:
+        t0 = time.time()
+        r = sfm.align(images, ws, sfm.AlignOptions(), PrintProgress("  align "))
+        print(f"aligned {r.registered}/{r.images_given} in {time.time() - t0:.0f} s")
+    r = pipeline.georeference_workspace(ws, use_exif_gps=True, crs=crs, progress=PrintProgress("  georef "))
+    print(f"georeferenced with EXIF GPS: camera RMSE {r.figures['CAMERA_RMSE_XYZ']:.2f} m")
+
+
+def _tree_rss(root_pid):
+    """Sum of RSS (bytes) of a process and all its descendants (Linux /proc)."""
+    parents = {}
+    rss = {}
+    page = os.sysconf("SC_PAGE_SIZE")
+    for d in os.listdir("/proc"):
+        if not d.isdigit():
+            continue
+        try:
+            with open(f"/proc/{d}/stat") as f:
+                st = f.read()
+            fields = st[st.rfind(")") + 2:].split()
+            parents[int(d)] = int(fields[1])
+            rss[int(d)] = int(fields[21]) * page
+        except (OSError, IndexError, ValueError):
+            continue
+    tree = {root_pid}
+    changed = True
+    while changed:
+        changed = False
+        for pid, ppid in parents.items():
+            if ppid in tree and pid not in tree:
+                tree.add(pid)
+                changed = True
+    return sum(rss.get(p, 0) for p in tree), len(tree)
+
+
+def run_child(args):
+    """Run the DSM stage in a child process; sample the tree's memory every 0.2 s."""
+    out_json = os.path.join(os.path.dirname(os.path.abspath(args.workspace)), "bench-dense-result.json")
+    cmd = [sys.executable, os.path.abspath(__file__), "--child", "--workspace", args.workspace,
+           "--quality", args.quality, "--workers", str(args.workers), "--result", out_json]
+    if args.point_cloud:
+        cmd.append("--point-cloud")
+    peak = {"sum": 0, "procs": 0}
+    proc = subprocess.Popen(cmd)
+    stop = threading.Event()
+
+    def sample():
+        while not stop.wait(0.2):
+            s, n = _tree_rss(proc.pid)
+            if s > peak["sum"]:
+                peak["sum"], peak["procs"] = s, n
+
+    th = threading.Thread(target=sample, daemon=True)
+    th.start()
+    _, status, usage = os.wait4(proc.pid, 0)
+    stop.set()
+    th.join()
+    code = os.waitstatus_to_exitcode(status)
+    if code != 0:
+        raise SystemExit(f"DSM stage failed (exit {code})")
+    with open(out_json) as f:
+        result = json.load(f)
+    result["peak_rss_tree_mib"] = peak["sum"] / 2 ** 20
+    result["peak_rss_single_mib"] = usage.ru_maxrss / 1024.0
+    result["processes_at_peak"] = peak["procs"]
+    return result
+
+
+def child(args):
+    from core import dense
+    from core.progress import PrintProgress
+
+    pc = os.path.join(args.workspace, "dense", "points.las") if args.point_cloud else None
+    t0 = time.time()
+    r = dense.build_dsm_workspace(args.workspace, quality=args.quality, output_point_cloud=pc,
+                                  options=dense.DenseOptions(workers=args.workers), progress=PrintProgress("  "))
+    wall = time.time() - t0
+    # per-pair figures from the cache summaries
+    from glob import glob
+
+    pairs = []
+    for p in glob(os.path.join(args.workspace, "dense", "pairs-*", "*.npz")):
+        s = dense.read_pair_summary(p)
+        if not s.get("skipped"):
+            pairs.append(s)
+    with open(args.result, "w") as f:
+        json.dump({"wall": wall, "dsm": r.dsm_path, "point_cloud": r.point_cloud_path, "pairs": r.pairs,
+                   "pairs_reused": r.pairs_reused, "points": r.points, "valid_fraction": r.valid_fraction,
+                   "resolution": r.resolution, "timings": r.timings, "log": r.log_lines,
+                   "pair_seconds": [s["seconds"] for s in pairs], "pair_megapixels": [s["megapixels"] for s in pairs],
+                   "pair_valid_fraction": [s.get("valid_fraction", 0.0) for s in pairs]}, f)
+
+
+def hillshade(z, res, azimuth=315.0, altitude=45.0):
+    zf = np.where(np.isfinite(z), z, np.nanmedian(z))
+    gy, gx = np.gradient(zf, res)
+    slope = np.arctan(np.hypot(gx, gy))
+    aspect = np.arctan2(-gx, gy)
+    az, alt = np.radians(360.0 - azimuth + 90.0), np.radians(altitude)
+    hs = np.sin(alt) * np.cos(slope) + np.cos(alt) * np.sin(slope) * np.cos(az - aspect)
+    return np.clip(hs, 0, 1)
+
+
+def figures_png(dsm_path, png):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from scipy import ndimage
+
+    from core import dsm
+
+    z, gt, _ = dsm.read_dsm(dsm_path)
+    res = gt[1]
+    hs = hillshade(z, res)
+    hs[~np.isfinite(z)] = np.nan
+    # normalised DSM: height above a local ground estimate (grey opening, 31 m window)
+    zf = np.where(np.isfinite(z), z, np.nanmax(z))
+    size = max(3, int(round(31.0 / res)) | 1)
+    ground = ndimage.grey_opening(zf, size=(size, size))
+    ground = ndimage.uniform_filter(ground, size=max(3, size // 3))
+    ndsm = np.where(np.isfinite(z), z - ground, np.nan)
+    fig, ax = plt.subplots(1, 2, figsize=(16, 7))
+    ax[0].imshow(hs, cmap="gray", interpolation="nearest")
+    ax[0].set_title(f"hillshade, {res:g} m cells")
+    im = ax[1].imshow(ndsm, cmap="viridis", vmin=-1, vmax=12, interpolation="nearest")
+    ax[1].set_title("height above local ground (m)")
+    fig.colorbar(im, ax=ax[1], shrink=0.8)
+    for a in ax:
+        a.set_xticks([])
+        a.set_yticks([])
+    fig.tight_layout()
+    fig.savefig(png, dpi=90)
+    plt.close(fig)
+    raised = ndsm[np.isfinite(ndsm) & (ndsm > 2.5)]
+    return raised
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--workspace", default=os.path.join(ROOT, "build", "bench-dense", "toledo-ws"))
+    ap.add_argument("--images", default=os.path.join(DATA, "toledo", "images"))
+    ap.add_argument("--crs", default="EPSG:32617")
+    ap.add_argument("--quality", default="half")
+    ap.add_argument("--workers", type=int, default=0)
+    ap.add_argument("--resume", action="store_true", help="keep the pair cache (measures a resumed run)")
+    ap.add_argument("--point-cloud", action="store_true", help="also write dense/points.las")
+    ap.add_argument("--png", default=None, help="hillshade PNG (default beside the workspace)")
+    ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--result", default=None, help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.child:
+        child(args)
+        return
+    if not os.path.isdir(args.images):
+        raise SystemExit(f"no images at {args.images}")
+    ensure_georeferenced(args.images, args.workspace, args.crs)
+    if not args.resume:
+        for name in os.listdir(os.path.join(args.workspace, "dense")) if os.path.isdir(
+                os.path.join(args.workspace, "dense")) else []:
+            shutil.rmtree(os.path.join(args.workspace, "dense", name), ignore_errors=True)
+    r = run_child(args)
+    secs = np.array(r["pair_seconds"])
+    mp = np.array(r["pair_megapixels"])
+    png = args.png or os.path.join(os.path.dirname(os.path.abspath(args.workspace)), "toledo_dsm_hillshade.png")
+    raised = figures_png(r["dsm"], png)
+    print("\n== dense matching + DSM, Toledo ==")
+    for line in r["log"]:
+        print("  " + line)
+    print(f"  quality {args.quality}: {r['pairs']} pairs ({r['pairs_reused']} reused), {r['points']} points, "
+          f"DSM {r['resolution']:g} m")
+    if len(secs):
+        print(f"  seconds per pair: mean {secs.mean():.2f}, median {np.median(secs):.2f}, max {secs.max():.2f} "
+              "(one worker's time for one pair)")
+        print(f"  seconds per megapixel (both images of a pair at the matching scale): {secs.sum() / mp.sum():.2f}")
+        print(f"  matched share of the rectified left image per pair: median {np.median(r['pair_valid_fraction']):.2f}")
+    print("  stage seconds: " + ", ".join(f"{k} {v:.1f}" for k, v in r["timings"].items()))
+    print(f"  total seconds (wall, child process): {r['wall']:.1f}")
+    print(f"  peak RSS: {r['peak_rss_tree_mib']:.0f} MiB for the whole process tree ({r['processes_at_peak']} processes), "
+          f"{r['peak_rss_single_mib']:.0f} MiB for the largest single process (limit 4096 MiB)")
+    print(f"  VALID_FRACTION inside the convex hull of the image centres: {r['valid_fraction']:.3f}")
+    if len(raised):
+        print(f"  raised objects (> 2.5 m above local ground): {len(raised)} cells, "
+              f"height percentiles 50/90/99: {np.percentile(raised, 50):.1f} / {np.percentile(raised, 90):.1f} / "
+              f"{np.percentile(raised, 99):.1f} m")
+    print(f"  hillshade: {png}")
+
+
+if __name__ == "__main__":
+    main()

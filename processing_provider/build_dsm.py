@@ -1,0 +1,101 @@
+"""Build DSM: thin adapter over core.dense.build_dsm_workspace."""
+from qgis.core import (
+    QgsProcessingOutputFolder,
+    QgsProcessingOutputNumber,
+    QgsProcessingParameterDefinition,
+    QgsProcessingParameterEnum,
+    QgsProcessingParameterFile,
+    QgsProcessingParameterFileDestination,
+    QgsProcessingParameterNumber,
+    QgsProcessingParameterRasterDestination,
+    QgsProcessingParameterString,
+)
+
+from .base import AlgorithmBase, FeedbackProgress
+
+
+class BuildDsmAlgorithm(AlgorithmBase):
+    NAME = "builddsm"
+    DISPLAY = "Build DSM"
+    WORKSPACE = "WORKSPACE"
+    RESOLUTION = "RESOLUTION"
+    QUALITY = "QUALITY"
+    ENGINE = "ENGINE"
+    WORKERS = "WORKERS"
+    SCHEDULER = "SCHEDULER"
+    OUTPUT_DSM = "OUTPUT_DSM"
+    OUTPUT_POINT_CLOUD = "OUTPUT_POINT_CLOUD"
+    OUT_WORKSPACE = "WORKSPACE"  # the same name as the input: models chain stages through it
+    VALID_FRACTION = "VALID_FRACTION"
+    PAIRS = "PAIRS"
+    POINTS = "POINTS"
+    QUALITIES = ("full", "half", "quarter")
+    ENGINES = ("cpu", "cuda")
+    HELP = (
+        "Dense matching of the georeferenced block and a digital surface model (DSM).\n\n"
+        "Stereo pairs are chosen from the sparse model (shared tie points, baseline-to-depth ratio, viewing "
+        "angle); each pair is undistorted and rectified from the known poses and matched with semi-global "
+        "matching (OpenCV SGBM) with a left-right check; a pixel is kept where at least two independent pairs "
+        "agree. The fused points are rasterised (median of the highest height cluster per cell), small holes "
+        "are filled and large ones left nodata.\n\n"
+        "WORKSPACE: a georeferenced workspace (run 'Georeference' first: a DSM needs a metric scale and a "
+        "vertical direction, so a workspace that is only aligned is refused).\n"
+        "RESOLUTION: DSM cell size in metres; 0 = about twice the median ground sample distance.\n"
+        "QUALITY: image scale for matching (full, half, quarter): half is four times faster than full.\n"
+        "ENGINE: cpu (default); cuda runs COLMAP patch-match stereo where pycolmap was built with CUDA.\n"
+        "OUTPUT_DSM: Cloud-Optimized GeoTIFF, float32 with nodata (default: <workspace>/dsm.tif).\n"
+        "OUTPUT_POINT_CLOUD: optional LAS file (XYZ + RGB, workspace CRS).\n\n"
+        "Re-running after a cancel resumes: pairs already matched are reused from <workspace>/dense/."
+    )
+
+    def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
+        self.addParameter(QgsProcessingParameterFile(
+            self.WORKSPACE, self.tr("Workspace folder (georeferenced)"), behavior=QgsProcessingParameterFile.Folder))
+        self.addParameter(QgsProcessingParameterNumber(
+            self.RESOLUTION, self.tr("DSM resolution in metres (0 = automatic)"),
+            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
+        self.addParameter(QgsProcessingParameterEnum(
+            self.QUALITY, self.tr("Matching quality (image scale)"), options=list(self.QUALITIES), defaultValue=1))
+        self.addParameter(QgsProcessingParameterEnum(
+            self.ENGINE, self.tr("Engine"), options=list(self.ENGINES), defaultValue=0))
+        workers = QgsProcessingParameterNumber(
+            self.WORKERS, self.tr("Parallel workers (0 = one per core)"), type=QgsProcessingParameterNumber.Integer,
+            defaultValue=0, minValue=0)
+        scheduler = QgsProcessingParameterString(
+            self.SCHEDULER, self.tr("Dask scheduler address (empty = this computer)"), defaultValue="", optional=True)
+        for p in (workers, scheduler):
+            p.setFlags(p.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
+            self.addParameter(p)
+        self.addParameter(QgsProcessingParameterRasterDestination(
+            self.OUTPUT_DSM, self.tr("DSM (default: <workspace>/dsm.tif)"), optional=True, createByDefault=False))
+        self.addParameter(QgsProcessingParameterFileDestination(
+            self.OUTPUT_POINT_CLOUD, self.tr("Point cloud (LAS)"), fileFilter="LAS point cloud (*.las)",
+            optional=True, createByDefault=False))
+        self.addOutput(QgsProcessingOutputFolder(self.OUT_WORKSPACE, self.tr("Workspace")))
+        self.addOutput(QgsProcessingOutputNumber(self.VALID_FRACTION, self.tr(
+            "Share of DSM cells with data inside the camera centres' convex hull")))
+        self.addOutput(QgsProcessingOutputNumber(self.PAIRS, self.tr("Stereo pairs matched")))
+        self.addOutput(QgsProcessingOutputNumber(self.POINTS, self.tr("Fused points")))
+
+    def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
+        from ..core import dense
+
+        workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
+        output_dsm = self.parameterAsOutputLayer(parameters, self.OUTPUT_DSM, context) or None
+        output_pc = self.parameterAsFileOutput(parameters, self.OUTPUT_POINT_CLOUD, context) or None
+        options = dense.DenseOptions(
+            workers=self.parameterAsInt(parameters, self.WORKERS, context),
+            scheduler=self.parameterAsString(parameters, self.SCHEDULER, context).strip() or None)
+        result = self.run_core(
+            dense.build_dsm_workspace, workspace,
+            resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context),
+            quality=self.QUALITIES[self.parameterAsEnum(parameters, self.QUALITY, context)],
+            engine=self.ENGINES[self.parameterAsEnum(parameters, self.ENGINE, context)],
+            output_dsm=output_dsm, output_point_cloud=output_pc, options=options,
+            progress=FeedbackProgress(feedback))
+        feedback.pushInfo(self.tr("DSM {} ({} m cells), valid fraction {}").format(
+            result.dsm_path, result.resolution,
+            "n/a" if result.valid_fraction is None else f"{result.valid_fraction:.3f}"))
+        return {self.OUT_WORKSPACE: result.workspace, self.OUTPUT_DSM: result.dsm_path,
+                self.OUTPUT_POINT_CLOUD: result.point_cloud_path, self.VALID_FRACTION: result.valid_fraction,
+                self.PAIRS: result.pairs, self.POINTS: result.points}
