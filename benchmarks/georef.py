@@ -47,8 +47,43 @@ def table(rows, title):
               f"{np.hypot(p['dx'], p['dy']):8.3f}  {p['n_obs']}")
 
 
-def copr(ws):
+def consistency(ws):
+    """Every target (control and check) against the block: which agree with each other?"""
+    import pycolmap
+
+    from core import gcp as gcpmod
+    from core import georef
+
+    rec = pycolmap.Reconstruction()
+    rec.read_binary(os.path.join(ws, "sfm", "model"))
+    g = gcpmod.read_gcps(os.path.join(DATA, "copr", "gcp_list.txt"))
+    m, w, n = [], [], []
+    print("\ntargets triangulated in the unadjusted block (px: residual per observation):")
+    for p in g.points:
+        t = georef.triangulate_observations(rec, p.observations)
+        px = " ".join(f"{ob.image}:{v:.2f}" for ob, v in zip(p.observations, t.residuals_px))
+        print(f"  {p.name}: {'not triangulated' if t.xyz is None else f'angle {t.angle_deg:4.1f} deg'}  {px}")
+        if t.xyz is not None:
+            m.append(t.xyz)
+            w.append([p.x, p.y, p.z])
+            n.append(p.name)
+    c = georef.control_consistency(np.array(m), np.array(w), n, 0.06, xy_only=True)
+    print(f"largest set of targets that one similarity fits within 0.06 m (XY; Z is a placeholder): "
+          f"{', '.join(c.consistent)} at {c.rms:.3f} m RMS")
+    for name in n:
+        print(f"  {name}: {c.residuals[name]:.3f} m from that fit" + ("" if name in c.consistent else "  <- suspect"))
+
+
+def copr(ws, variants=True):
     ensure_aligned(os.path.join(DATA, "copr", "images"), ws)
+    consistency(ws)
+    if variants:
+        for refine in ("all", True):
+            r = pipeline.georeference_workspace(ws, gcp_path=os.path.join(DATA, "copr", "gcp_list.txt"),
+                                                check_points=["gcp03", "gcp06", "gcp09"], refine_intrinsics=refine)
+            f = r.figures
+            print(f"variant REFINE_INTRINSICS={refine}: control RMSE XY {f['GCP_RMSE_XY']:.3f} m, check RMSE XY "
+                  f"{f['CHECK_RMSE_XY']:.3f} m, tie points {f['MEAN_REPROJECTION_ERROR']:.3f} px")
     t0 = time.time()
     r = pipeline.georeference_workspace(ws, gcp_path=os.path.join(DATA, "copr", "gcp_list.txt"),
                                         check_points=["gcp03", "gcp06", "gcp09"], progress=PrintProgress("  "))

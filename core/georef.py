@@ -257,6 +257,102 @@ def helmert_ransac(src, dst, threshold: float, max_iterations: int = 2000, seed:
     return HelmertResult(tr, inliers.copy(), np.linalg.norm(vec, axis=1), vec)
 
 
+@dataclass
+class Consistency:
+    """Which control points agree with each other through the (rigid) model."""
+
+    consistent: List[str]  # the largest subset whose similarity fit has RMS <= tolerance
+    rms: float  # RMS residual of that subset (m)
+    tolerance: float
+    residuals: Dict[str, float]  # every point's distance (m; XY when xy_only) from that subset's fit
+    xy_only: bool
+
+    @property
+    def suspects(self) -> List[str]:
+        return sorted((n for n in self.residuals if n not in self.consistent), key=lambda n: -self.residuals[n])
+
+    def to_dict(self) -> Dict[str, Any]:
+        return {"consistent": self.consistent, "rms_m": self.rms, "tolerance_m": self.tolerance,
+                "residuals_m": self.residuals, "xy_only": self.xy_only, "suspects": self.suspects}
+
+
+def _fit_similarity(src: np.ndarray, dst: np.ndarray, xy_only: bool) -> Tuple[Similarity, np.ndarray]:
+    """Similarity and per-point residual distances; ``xy_only`` ignores the target Z (unknown heights)."""
+    tr = helmert_fit(src, dst)
+    if not xy_only:
+        return tr, np.linalg.norm(dst - tr.apply(src), axis=1)
+    from scipy.optimize import least_squares
+
+    mu = src.mean(axis=0)
+    sc = src - mu
+    t0 = tr.apply(mu)
+
+    def parts(v):
+        r = _rodrigues(v[1:4])[0] @ tr.rotation
+        return math.exp(v[0]), r, np.array([v[4], v[5], t0[2]])
+
+    def res(v):
+        s_, r, t = parts(v)
+        return (s_ * sc @ r.T + t)[:, :2].ravel() - dst[:, :2].ravel()
+
+    v0 = np.r_[math.log(tr.scale), 0.0, 0.0, 0.0, t0[:2]]
+    sol = least_squares(res, v0, method="trf")
+    s_, r, t = parts(sol.x)
+    tr2 = Similarity(s_, r, t - s_ * r @ mu)
+    return tr2, np.linalg.norm(tr2.apply(src)[:, :2] - dst[:, :2], axis=1)
+
+
+def control_consistency(model_xyz, world_xyz, names: Sequence[str], tolerance: float,
+                        xy_only: bool = False, max_exhaustive: int = 10) -> Optional[Consistency]:
+    """The largest set of control points that one similarity maps onto their coordinates within
+    ``tolerance`` RMS, found by trying subsets (all of them for up to ``max_exhaustive`` points,
+    else by dropping the worst point repeatedly).  A correct block cannot move one surveyed point
+    by metres against the others: points outside that set have wrong coordinates, wrong labels or
+    observations on the wrong mark.  None when fewer than 4 points."""
+    src = np.asarray(model_xyz, dtype=float).reshape(-1, 3)
+    dst = np.asarray(world_xyz, dtype=float).reshape(-1, 3)
+    n = len(src)
+    if n < 4:
+        return None
+    dst = dst - dst.mean(axis=0)
+    best: Optional[Tuple[float, Tuple[int, ...]]] = None
+    if n <= max_exhaustive:
+        for k in range(n, 3, -1):
+            found = []
+            for idx in itertools.combinations(range(n), k):
+                sel = list(idx)
+                try:
+                    _, r = _fit_similarity(src[sel], dst[sel], xy_only)
+                except ValueError:
+                    continue
+                rms = float(np.sqrt(np.mean(r ** 2)))
+                if rms <= tolerance:
+                    found.append((rms, idx))
+            if found:
+                best = min(found)
+                break
+    else:
+        idx = list(range(n))
+        while len(idx) >= 4:
+            _, r = _fit_similarity(src[idx], dst[idx], xy_only)
+            rms = float(np.sqrt(np.mean(r ** 2)))
+            if rms <= tolerance:
+                best = (rms, tuple(idx))
+                break
+            idx.pop(int(np.argmax(r)))
+    if best is None:  # nothing agrees: report against the fit of all
+        tr, r = _fit_similarity(src, dst, xy_only)
+        return Consistency([], float(np.sqrt(np.mean(r ** 2))), tolerance,
+                           {names[i]: float(r[i]) for i in range(n)}, xy_only)
+    sel = list(best[1])
+    tr, _ = _fit_similarity(src[sel], dst[sel], xy_only)
+    p = tr.apply(src)
+    d = (p[:, :2] - dst[:, :2]) if xy_only else (p - dst)
+    r_all = np.linalg.norm(d, axis=1)
+    return Consistency([names[i] for i in sel], best[0], tolerance, {names[i]: float(r_all[i]) for i in range(n)},
+                       xy_only)
+
+
 # ----------------------------------------------------------------------------
 # small geometry helpers
 # ----------------------------------------------------------------------------
@@ -1319,6 +1415,20 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
     if source == "camera positions":
         bad = {objs[k].image for k in np.flatnonzero(~hel.inliers)}
         cam_pos = [(cp, im) for cp, im in cam_pos if cp.image not in bad]
+    consistency = None
+    if source == "control points" and len(usable) >= 4:
+        tol = max(3.0 * float(np.median([p.sigma_xy for p in usable])), 0.05)
+        consistency = control_consistency(model, world_local, [p.name for p in usable], tol,
+                                          xy_only=placeholder_z is not None)
+        if consistency is not None and consistency.suspects and len(consistency.consistent) >= 3:
+            _warn(progress, warnings,
+                  f"control points {', '.join(consistency.consistent)} agree with the block within "
+                  f"{consistency.rms:.3f} m RMS, but " + ", ".join(
+                      f"{n} ({consistency.residuals[n]:.2f} m)" for n in consistency.suspects) +
+                  " do not: their coordinates, labels or image marks are suspect")
+        elif consistency is not None and not consistency.consistent:
+            _warn(progress, warnings, f"no 4 control points agree with the block within {tol:.3f} m: either the "
+                                      "block is deformed or several coordinates are wrong")
     timings["helmert"] = time.time() - t_start
     _progress_call(progress, 0.08, f"Helmert from {int(hel.inliers.sum())} {source}")
 
@@ -1332,7 +1442,8 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
     result = GeorefResult(rec, model_to_local, offset, crs, source, helmert_points=helmert_rows,
                           warnings=warnings, outliers=outliers, adjusted=False)
     stats: Dict[str, Any] = {"helmert_threshold_m": thr, "helmert_inliers": int(hel.inliers.sum()),
-                             "helmert_scale": model_to_local.scale, "placeholder_z": placeholder_z}
+                             "helmert_scale": model_to_local.scale, "placeholder_z": placeholder_z,
+                             "control_consistency": consistency.to_dict() if consistency else None}
     if not adjust:
         result.points = helmert_rows
         result.cameras = _camera_rows(rec, cam_pos, offset, lookup)

@@ -256,3 +256,21 @@ def test_gcps_in_degrees_labelled_as_metres_are_refused(block):
         p.x, p.y = 12.5 + p.x * 1e-6, 41.5 + p.y * 1e-6
     with pytest.raises(ValueError, match="(?i)degree"):
         gcpmod.check_units(gcps, "EPSG:32633")
+
+
+def test_control_points_that_disagree_with_the_block_by_metres_are_named(block):
+    """COPR's pattern: most targets agree with the block to centimetres, some are metres off."""
+    rec, _ = block
+    xy = dict(SPREAD, f=(40.0, 8.0), g=(20.0, 50.0))
+    gcps = _gcps(rec, MODEL_FROM_WORLD, xy, noise_px=0.2)
+    for p in gcps.points:
+        if p.name == "b":
+            p.x += 1.5
+        if p.name == "g":
+            p.y -= 2.0
+    r = georef.georeference(rec, gcps)
+    cons = r.statistics["control_consistency"]
+    assert cons["suspects"] == ["g", "b"]
+    assert cons["rms_m"] < 0.05
+    assert cons["residuals_m"]["g"] == pytest.approx(2.0, abs=0.2)
+    assert any("b (" in w and "g (" in w and "suspect" in w for w in r.warnings)
