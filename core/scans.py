@@ -356,30 +356,55 @@ def _rotation_deg(points: Dict[str, Tuple[float, float]]) -> float:
     return math.degrees(math.atan2(np.mean(np.sin(angles)), np.mean(np.cos(angles))))
 
 
-def refine_symmetric(grey: np.ndarray, x: float, y: float, size: float, iterations: int = 8) -> Tuple[float, float, bool]:
+def refine_symmetric(grey: np.ndarray, x: float, y: float, size: float, iterations: int = 12) -> Tuple[float, float, bool]:
     """Centre of point symmetry of a mark near (x, y) (OpenCV pixel-centre coordinates of ``grey``).
 
-    The patch around the estimate is phase-correlated with its 180-degree
-    rotation: their shift is twice the distance to the true centre.  Returns
-    (x, y, converged).
+    Gauss-Newton on sum w(u) (I(c + u) - I(c - u))^2 over a patch of about 1.5
+    mark sizes (Gaussian weights, bicubic sampling): at the true centre a
+    point-symmetric mark (cross, dot, ring) equals its 180-degree rotation.
+    Returns (x, y, converged).
     """
     import cv2
 
+    g = np.ascontiguousarray(grey, dtype=np.float32)
+    gx = cv2.Sobel(g, cv2.CV_32F, 1, 0, ksize=3, scale=0.125)
+    gy = cv2.Sobel(g, cv2.CV_32F, 0, 1, ksize=3, scale=0.125)
     n = int(math.ceil(1.5 * size + 4))
     n += 1 - n % 2
     n = max(n, 15)
-    win = cv2.createHanningWindow((n, n), cv2.CV_32F)
-    g = np.ascontiguousarray(grey, dtype=np.float32)
+    half = (n - 1) / 2.0
+    u = np.arange(n, dtype=np.float32) - np.float32(half)
+    uu, vv = np.meshgrid(u, u)
+    w = np.exp(-(uu ** 2 + vv ** 2) / (2 * (0.45 * n) ** 2)).astype(np.float32)
     converged = False
+    track = []
     for _ in range(iterations):
-        p = cv2.getRectSubPix(g, (n, n), (float(x), float(y)))
-        q = np.ascontiguousarray(p[::-1, ::-1])
-        (sx, sy), _resp = cv2.phaseCorrelate(p.astype(np.float64), q.astype(np.float64), win.astype(np.float64))
-        dx, dy = -0.5 * sx, -0.5 * sy
-        x, y = x + dx, y + dy
-        if math.hypot(dx, dy) < 0.002:
+        mx, my = (uu + np.float32(x)), (vv + np.float32(y))
+        p = cv2.remap(g, mx, my, cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE)
+        px = cv2.remap(gx, mx, my, cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE)
+        py = cv2.remap(gy, mx, my, cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE)
+        r = p - p[::-1, ::-1]
+        jx = px - px[::-1, ::-1]
+        jy = py - py[::-1, ::-1]
+        h = np.array([[float((w * jx * jx).sum()), float((w * jx * jy).sum())],
+                      [float((w * jx * jy).sum()), float((w * jy * jy).sum())]])
+        b = np.array([float((w * jx * r).sum()), float((w * jy * r).sum())])
+        if np.linalg.cond(h) > 1e8:
+            return x, y, False
+        dx, dy = -np.linalg.solve(h, b)
+        step = math.hypot(dx, dy)
+        if step > 0.25 * size:  # diverging: keep the previous estimate
+            return x, y, False
+        x, y = x + float(dx), y + float(dy)
+        track.append((x, y, step))
+        if step < 0.005:
             converged = True
             break
+    if not converged and len(track) >= 4:
+        # grain makes the last steps wander by a few hundredths of a pixel: take their mean
+        last = np.array([t[:2] for t in track[-4:]])
+        x, y = float(last[:, 0].mean()), float(last[:, 1].mean())
+        converged = float(np.hypot(*(last - last.mean(0)).T).max()) < 0.1
     return x, y, converged
 
 
@@ -394,10 +419,13 @@ def _quadratic_peak(r: np.ndarray, i: int, j: int) -> Tuple[float, float]:
 
 
 def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
-                     template: Optional[np.ndarray] = None) -> Tuple[List[Fiducial], List[str]]:
+                     template: Optional[np.ndarray] = None,
+                     hints: Optional[Dict[str, str]] = None) -> Tuple[List[Fiducial], List[str]]:
     """Find the fiducial marks of one scan.  Returns (marks with a score >= min_score, warnings).
 
     Positions are sub-pixel, in full-resolution pixels of the scan (corner convention).
+    ``hints`` (slot -> mark kind, from an earlier scan of the set) narrows the
+    search to that kind; a slot where it fails is searched with every kind.
     """
     import cv2
 
@@ -424,22 +452,43 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
     coarse = {}
     if template is not None:
         base = 0.5 * (kx + ky)
-        cands = []
+        groups = {"template": []}
         for f in (0.8, 0.9, 1.0, 1.1, 1.25):
             th = max(5, int(round(template.shape[0] / base * f)))
             tw = max(5, int(round(template.shape[1] / base * f)))
-            cands.append(("template", max(tw, th), cv2.resize(template, (tw, th), interpolation=cv2.INTER_AREA)))
+            groups["template"].append((max(tw, th), cv2.resize(template, (tw, th), interpolation=cv2.INTER_AREA)))
     else:
-        cands = []
-        for kind in kinds:
-            for s in _sizes(min(h, w)):
-                cands.append((kind, s, render_mark(kind, s)))
+        groups = {kind: [(s, render_mark(kind, s)) for s in _sizes(min(h, w))] for kind in kinds}
+    hints = hints or {}
+
+    def z_of(sc, tpl):
+        # a large template that correlates well is stronger evidence than a small one (a dot of
+        # five pixels also fits every full stop of a data strip): rank by atanh(r) * sqrt(side)
+        return math.atanh(min(max(sc, 0.0), 0.999)) * math.sqrt(max(tpl.shape))
+
+    def search(slot, win, kinds_here):
+        best, best_z = (-1.0,), -np.inf
+        for kind in kinds_here:
+            cands = groups[kind]
+            tried = [(_best_match(g, win, tpl), s, tpl) for s, tpl in cands]
+            if kind != "template":
+                # thin rings and bars are sensitive to scale: refine the size around the two best
+                for (_m, s0, _t) in sorted(tried, key=lambda t: -t[0][0])[:2]:
+                    for f in (0.88, 0.94, 1.06, 1.12):
+                        tpl = render_mark(kind, s0 * f)
+                        tried.append((_best_match(g, win, tpl), s0 * f, tpl))
+            for (sc, cx, cy, pol), s, tpl in tried:
+                z = z_of(sc, tpl)
+                if sc >= options.min_score and z > best_z:
+                    best, best_z = (sc, cx, cy, pol, kind, s), z
+        return best
+
     for slot, win in windows.items():
         best = (-1.0,)
-        for kind, s, tpl in cands:
-            sc, cx, cy, pol = _best_match(g, win, tpl)
-            if sc > best[0]:
-                best = (sc, cx, cy, pol, kind, s)
+        if hints.get(slot) in groups:
+            best = search(slot, win, [hints[slot]])
+        if best[0] < options.min_score:
+            best = search(slot, win, list(groups))
         if best[0] >= options.min_score:
             coarse[slot] = best
     warnings: List[str] = []
@@ -782,7 +831,13 @@ def _np_dtype(gdal_type):
 
 
 def _image_area_edges(grey: np.ndarray, valid: np.ndarray) -> Optional[Tuple[float, float, float, float]]:
-    """Edges (x0, y0, x1, y1, in pixels of ``grey``) of the textured picture area inside a uniform film border."""
+    """Edges (x0, y0, x1, y1, in pixels of ``grey``) of the picture area inside a uniform film border.
+
+    The border is what looks like the outer ring of the image: the same grey
+    level and no texture beyond grain.  From the centre outwards, the first
+    columns (rows) that are mostly border end the picture; a data strip or the
+    film edge further out does not matter.
+    """
     import cv2
 
     g = grey.astype(np.float32)
@@ -794,14 +849,15 @@ def _image_area_edges(grey: np.ndarray, valid: np.ndarray) -> Optional[Tuple[flo
     centre = np.zeros_like(v)
     centre[int(0.3 * h):int(0.7 * h), int(0.3 * w):int(0.7 * w)] = True
     ring = np.ones_like(v)
-    ring[int(0.1 * h):int(0.9 * h), int(0.1 * w):int(0.9 * w)] = False
+    ring[int(0.06 * h):int(0.94 * h), int(0.06 * w):int(0.94 * w)] = False
     if not (centre & v).any() or not (ring & v).any():
         return None
-    c_med = float(np.median(sd[centre & v]))
-    b_med = float(np.median(sd[ring & v]))
-    if c_med < 2.5 * max(b_med, 1e-4):
+    level = float(np.median(mu[ring & v]))
+    noise = float(np.median(sd[ring & v]))
+    border = (np.abs(mu - level) < max(5.0 * noise, 0.03)) & (sd < max(3.0 * noise, 0.01))
+    if border[ring & v].mean() < 0.4 or border[centre & v].mean() > 0.5:
         return None  # no uniform border around the picture
-    content = (sd > math.sqrt(c_med * max(b_med, 1e-4))) & v
+    content = ~border & v
     rows = slice(int(0.3 * h), int(0.7 * h))
     cols = slice(int(0.3 * w), int(0.7 * w))
     fx = content[rows, :].mean(axis=0)
@@ -883,9 +939,12 @@ def prepare_scans(paths: Sequence[str], out_dir: str, masks_dir: str, options: O
     sizes: Dict[str, Tuple[int, int]] = {}
     res_mm: Dict[str, Optional[float]] = {}
     sp = SubProgress(progress, 0.0, 0.35)
+    hints: Dict[str, str] = {}
     for i, (p, n) in enumerate(zip(paths, names)):
         check_cancel(progress)
-        fids, w = detect_fiducials(p, options, template)
+        fids, w = detect_fiducials(p, options, template, hints)
+        for f in fids:
+            hints.setdefault(f.slot, f.kind)
         warnings.extend(w)
         if calib is not None:
             fids = [f for f in fids if f.slot in calib.points]
