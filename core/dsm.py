@@ -306,7 +306,7 @@ def write_cog(path: str, array: np.ndarray, geotransform: Sequence[float], crs: 
             return 0 if progress.is_cancelled() else 1
 
         opts = gdal.TranslateOptions(format="COG", creationOptions=[
-            "COMPRESS=DEFLATE", "PREDICTOR=YES", "BLOCKSIZE=512", "OVERVIEWS=IGNORE_EXISTING",
+            "COMPRESS=DEFLATE", "PREDICTOR=YES", "BLOCKSIZE=256", "OVERVIEWS=IGNORE_EXISTING",
             "OVERVIEW_RESAMPLING=AVERAGE", "BIGTIFF=IF_SAFER"], callback=cb)
         try:
             out = gdal.Translate(tmp, mem, options=opts)

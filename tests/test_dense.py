@@ -1,0 +1,390 @@
+"""Dense matching and the DSM stage: geometry units, a synthetic block with exact truth, cancel/resume,
+bad input, the point cloud, and the Processing algorithm on the sample strip."""
+import json
+import os
+import shutil
+import time
+
+import numpy as np
+import pytest
+
+from core import dense, dsm, parallel
+from core.progress import Cancelled, NullProgress
+from core.workspace import DONE, Workspace
+from tests import synthetic as syn
+from tests.conftest import SAMPLE, TOLEDO_STRIP, copy_images
+
+# a small camera keeps rendering and matching fast; the block: 2 strips of 6, 80 % / 50 % overlap (seed 8 puts
+# two buildings where at least four photos see their roofs)
+CAMERA = syn.CameraModel(400, 300, 325.0, 325.0, 201.9, 148.1, k1=-0.08, k2=0.02, p1=0.0006, p2=-0.0004)
+
+
+def make_workspace(root, block, names=None, georeferenced=True, images_dir=None):
+    """A workspace holding the true (local-frame) model of a synthetic block, as if aligned + georeferenced."""
+    rec = block.truth_reconstruction(model_from_local=None, noise_px=0.2, n_points=1500, images=names)
+    ws = Workspace.create_or_open(root)
+    ws.data["images_dir"] = images_dir
+    ws.data["images"] = [{"name": n, "width": block.camera.width, "height": block.camera.height}
+                         for n in (names or block.names)]
+    ws.data["stages"]["align"] = {"status": DONE}
+    folder = "georef" if georeferenced else "sfm"
+    os.makedirs(ws.path(folder, "model"), exist_ok=True)
+    rec.write_binary(ws.path(folder, "model"))
+    if georeferenced:
+        ws.crs = syn.CRS
+        with open(ws.path("georef", "transform.json"), "w") as f:
+            json.dump({"crs": syn.CRS, "offset": [float(v) for v in syn.ORIGIN]}, f)
+        ws.data["stages"]["georeference"] = {"status": DONE}
+    ws.save()
+    return ws.root
+
+
+@pytest.fixture(scope="module")
+def block_dir(tmp_path_factory):
+    root = tmp_path_factory.mktemp("dense synthetic")
+    block = syn.vertical_block(seed=8, camera=CAMERA, altitude=40.0, n_strips=2, per_strip=6, forward_overlap=0.8,
+                               side_overlap=0.5, gcp_grid=(2, 2), roofs=0)
+    block.render(str(root / "images"))
+    return block, str(root)
+
+
+@pytest.fixture(scope="module")
+def built(block_dir):
+    """The DSM stage on the synthetic block at full quality (the images are small), with a point cloud."""
+    block, root = block_dir
+    ws = make_workspace(os.path.join(root, "ws"), block, images_dir=os.path.join(root, "images"))
+    result = dense.build_dsm_workspace(ws, quality="full", output_point_cloud=os.path.join(root, "ws", "points.las"),
+                                       options=dense.DenseOptions(workers=1))
+    return block, result
+
+
+def _copy_ws(root, tmp_path):
+    """A fresh copy of the synthetic workspace without dense results."""
+    dst = str(tmp_path / "ws")
+    shutil.copytree(os.path.join(root, "ws"), dst, ignore=shutil.ignore_patterns("dense", "dsm.tif", "*.las"))
+    return dst
+
+
+def _truth_grid(block, path):
+    z, gt, wkt = dsm.read_dsm(path)
+    h, w = z.shape
+    xs = gt[0] + (np.arange(w) + 0.5) * gt[1] - syn.ORIGIN[0]
+    ys = gt[3] + (np.arange(h) + 0.5) * gt[5] - syn.ORIGIN[1]
+    x, y = np.meshgrid(xs, ys)
+    return z, gt, wkt, x, y, block.scene.height_at(x, y)
+
+
+# ---------------------------------------------------------------------------
+# units
+# ---------------------------------------------------------------------------
+
+def _view(name, rot, centre, cam):
+    return dense.View(0, name, "", cam.width, cam.height, "OPENCV", tuple(cam.params), rot, -rot @ centre)
+
+
+def test_rectification_maps_follow_the_camera_model():
+    """A ground point lands on one row in both rectified images, and the maps lead back to its true
+    (distorted, COLMAP-convention) pixels in both photos."""
+    rng = np.random.default_rng(0)
+    down = syn.look_at(np.array([0.0, 0, 50]), np.array([0.0, 0, 0]), np.array([0.0, 1, 0]))
+    ri = syn.small_rotation(rng, 2.0) @ down
+    rj = syn.small_rotation(rng, 2.0) @ down
+    ci, cj = np.array([0.0, 0, 50]), np.array([12.0, 3, 51])
+    vi, vj = _view("a", ri, ci, CAMERA), _view("b", rj, cj, CAMERA)
+    ki, di = dense.camera_matrix("OPENCV", CAMERA.params, 1.0, 1.0)
+    kj, dj = dense.camera_matrix("OPENCV", CAMERA.params, 1.0, 1.0)
+    rect = dense.rectify_pair(vi, vj, ki, di, kj, dj, (CAMERA.width, CAMERA.height), (CAMERA.width, CAMERA.height))
+    pts = np.column_stack([rng.uniform(-3, 15, 40), rng.uniform(-8, 8, 40), rng.uniform(-2, 6, 40)])
+    pi = dense.rect_project(pts, ci, rect, rect.cx_i)
+    pj = dense.rect_project(pts, cj, rect, rect.cx_j)
+    assert np.allclose(pi[:, 1], pj[:, 1], atol=1e-6)  # same row
+    assert (pi[:, 0] - pj[:, 0] - rect.cx_i + rect.cx_j > 0).all()  # positive disparity
+    for p, shot_r, c, maps in ((pi, ri, ci, rect.maps_i), (pj, rj, cj, rect.maps_j)):
+        truth = CAMERA.image_from_camera((pts - c) @ shot_r.T) - 0.5  # COLMAP corner -> OpenCV centre convention
+        inside = (p[:, 0] > 1) & (p[:, 0] < rect.width - 2) & (p[:, 1] > 1) & (p[:, 1] < rect.height - 2)
+        assert inside.sum() > 20
+        for k in np.flatnonzero(inside):
+            x, y = p[k, 0], p[k, 1]
+            x0, y0 = int(x), int(y)
+            tx, ty = x - x0, y - y0
+            got = [(1 - tx) * (1 - ty) * m[y0, x0] + tx * (1 - ty) * m[y0, x0 + 1] + (1 - tx) * ty * m[y0 + 1, x0]
+                   + tx * ty * m[y0 + 1, x0 + 1] for m in maps]
+            assert np.allclose(got, truth[k], atol=0.02)
+
+
+def test_fusion_keeps_what_two_pairs_confirm():
+    z = np.full((4, 4), 50.0, dtype=np.float32)
+    maps = np.stack([z, z * 1.001, z.copy(), z.copy()])
+    maps[2, 0, 0] = 60.0  # one pair disagrees here: the other two still confirm 50
+    maps[3, 0, 0] = np.nan
+    maps[1, 1, 1] = 70.0  # only one pair left that says 50 -> dropped
+    maps[2, 1, 1] = np.nan
+    maps[3, 1, 1] = np.nan
+    maps[:, 2, 2] = [50.0, 55.0, 60.0, 65.0]  # nobody agrees
+    fused, n = dense.fuse_depth_maps(maps, np.full(4, 0.005), 2)
+    assert fused[0, 0] == pytest.approx(50.025, abs=1e-3)
+    assert np.isnan(fused[1, 1]) and np.isnan(fused[2, 2])
+    assert fused[3, 3] == pytest.approx(50.0125, abs=1e-3) and n[3, 3] == 4
+
+
+def test_cell_statistic_takes_the_highest_cluster():
+    cells = np.array([0, 0, 0, 0, 0, 1, 1, 1, 2])
+    z = np.array([10.0, 10.1, 15.0, 15.1, 15.2, 3.0, 3.1, 2.9, 7.0])
+    val, cnt = dsm.cell_statistic(cells, z, 4, cluster_tol=0.5)
+    assert val[0] == pytest.approx(15.1, abs=0.06)  # the roof, not the mean of roof and ground
+    assert val[1] == pytest.approx(3.0, abs=0.06)
+    assert val[2] == pytest.approx(7.0) and np.isnan(val[3])
+    assert list(cnt) == [5, 3, 1, 0]
+
+
+def test_small_holes_filled_large_ones_kept():
+    a = np.full((40, 40), 5.0, dtype=np.float32)
+    a[5:7, 5:7] = np.nan  # 4 cells
+    a[20:32, 20:32] = np.nan  # 144 cells
+    out = dsm.fill_small_holes(a, max_hole_cells=16)
+    assert np.isfinite(out[5:7, 5:7]).all() and np.allclose(out[5:7, 5:7], 5.0)
+    assert np.isnan(out[20:32, 20:32]).all()
+
+
+def _square(x, cancel_path=None):
+    return x * x
+
+
+def _slow(x, cancel_path=None):
+    for _ in range(100):
+        parallel.check_unit_cancel(cancel_path)
+        time.sleep(0.05)
+    return x
+
+
+class _CancelAfter(NullProgress):
+    def __init__(self, n=None, when=None):
+        self.n, self.when, self.reports, self.cancelled = n, when, 0, False
+
+    def report(self, fraction, message=""):
+        if message.startswith("pair "):
+            self.reports += 1
+        if (self.n is not None and self.reports >= self.n) or (self.when and self.when in message):
+            self.cancelled = True
+
+    def is_cancelled(self):
+        return self.cancelled
+
+
+def test_process_pool_runs_units():
+    with parallel.make_executor(workers=2, kind="process") as ex:
+        assert isinstance(ex, parallel.cf.ProcessPoolExecutor)
+        assert sorted(r for _, r in parallel.run_units(ex, _square, list(range(6)))) == [0, 1, 4, 9, 16, 25]
+    with parallel.make_executor(workers=1) as ex:
+        assert isinstance(ex, parallel.SerialExecutor)
+
+
+def test_process_pool_cancel_within_a_unit():
+    prog = _CancelAfter()
+    with parallel.make_executor(workers=2, kind="thread") as ex:
+        t0 = time.time()
+        it = parallel.run_units(ex, _slow, [1, 2], prog)
+        prog.cancelled = True
+        with pytest.raises(Cancelled):
+            list(it)
+    assert time.time() - t0 < 3.0  # running units saw the cancel file and stopped (5 s otherwise)
+
+
+# ---------------------------------------------------------------------------
+# the synthetic block
+# ---------------------------------------------------------------------------
+
+def test_synthetic_dsm_accuracy(built):
+    block, r = built
+    gsd = block.gsd
+    z, gt, wkt, x, y, truth = _truth_grid(block, r.dsm_path)
+    res = gt[1]
+    assert res == pytest.approx(r.resolution) and res < 2.5 * gsd
+    covered = np.isfinite(z)
+    walls = np.zeros_like(covered)
+    for b in block.scene.buildings:  # a band of 2 cells either side of every wall
+        walls |= b.contains(x, y, 2 * res) & ~b.contains(x, y, -2 * res)
+    judged = covered & ~walls
+    assert judged.sum() >= 0.9 * covered.sum()
+    err = z - truth
+    rmse = float(np.sqrt(np.mean(err[judged] ** 2)))
+    assert rmse <= 1.5 * gsd, f"RMSE {rmse:.3f} m > 1.5 GSD ({1.5 * gsd:.3f} m)"
+    assert np.mean(np.abs(err[judged]) > 5 * gsd) < 0.005  # hardly any blunders
+    assert r.valid_fraction >= 0.85
+    assert r.pairs >= 15 and r.points > 100000
+
+
+def test_synthetic_building_walls_are_sharp(built):
+    from scipy import ndimage
+
+    block, r = built
+    z, gt, _, x, y, truth = _truth_grid(block, r.dsm_path)
+    covered = np.isfinite(z)
+    checked = 0
+    for b in block.scene.buildings:
+        inside = b.contains(x, y)
+        if inside.sum() == 0 or (inside & covered).sum() < 0.9 * inside.sum():
+            continue  # not (fully) seen by the block
+        near = b.contains(x, y, 6.0)
+        ground = float(np.median(truth[near & ~b.contains(x, y, 1.0)]))
+        mid = 0.5 * (b.roof + ground)
+        high = truth > mid  # this roof (and a neighbour's, if one is this close)
+        wrong = near & covered & ((z > mid) != high)
+        # distance of each wrongly classified cell from the true outline, in cells
+        outline = high ^ ndimage.binary_erosion(high)
+        dist = ndimage.distance_transform_edt(~outline)
+        assert wrong.sum() == 0 or dist[wrong].max() <= 2.0, (
+            f"building at ({b.cx:.0f}, {b.cy:.0f}): edge cells up to {dist[wrong].max():.1f} cells off")
+        checked += 1
+    assert checked >= 2
+
+
+def test_dsm_file_is_a_cog_with_crs_and_nodata(built):
+    from osgeo import gdal
+
+    block, r = built
+    ds = gdal.Open(r.dsm_path)
+    band = ds.GetRasterBand(1)
+    assert band.DataType == gdal.GDT_Float32
+    assert band.GetNoDataValue() == dsm.NODATA
+    assert band.GetOverviewCount() >= 1
+    assert ds.GetMetadataItem("LAYOUT", "IMAGE_STRUCTURE") == "COG"
+    assert "32633" in ds.GetProjection()
+    info = dsm.open_dsm(r.dsm_path)
+    assert syn.ORIGIN[0] - 200 < info.bounds[0] < syn.ORIGIN[0] + 200
+    # the reader samples heights in world coordinates, and reprojects on the fly (ALS in another CRS)
+    x0, y0 = syn.ORIGIN[0] + 1.0, syn.ORIGIN[1] + 1.0
+    with dsm.DsmReader(r.dsm_path) as rd:
+        h = rd.sample(np.array([x0]), np.array([y0]))[0]
+    assert h == pytest.approx(float(block.scene.height_at(1.0, 1.0)), abs=0.5)
+    with dsm.DsmReader(r.dsm_path, target_crs="EPSG:3857") as rd:
+        assert rd.width > 0 and "3857" in rd.crs_wkt or "Pseudo" in rd.crs_wkt
+    ws = Workspace.open(r.workspace)
+    st = ws.stage("dsm")
+    assert st["status"] == "done" and st["outputs"]["dsm"] == "dsm.tif"
+    assert st["results"]["VALID_FRACTION"] == pytest.approx(r.valid_fraction)
+    assert {"matching", "fusion", "dsm", "total"} <= set(st["timings"])
+
+
+def test_point_cloud_las_in_world_coordinates(built):
+    block, r = built
+    xyz, rgb, header = dsm.read_las(r.point_cloud_path)
+    assert header["version"] == "1.2" and header["point_format"] == 2 and header["count"] == r.points
+    assert any(rid == 34735 for _, rid, _ in header["vlrs"])  # GeoKeyDirectory (EPSG:32633)
+    geokeys = next(d for _, rid, d in header["vlrs"] if rid == 34735)
+    assert 32633 in np.frombuffer(geokeys, dtype="<u2")
+    assert abs(np.median(xyz[:, 0]) - syn.ORIGIN[0]) < 200
+    sample = xyz[:: max(1, len(xyz) // 5000)]
+    err = sample[:, 2] - block.scene.height_at(sample[:, 0] - syn.ORIGIN[0], sample[:, 1] - syn.ORIGIN[1])
+    assert np.median(np.abs(err)) < block.gsd
+    assert rgb.max() > 0 and (rgb[:, 0] == rgb[:, 1]).all()  # grey images: grey points
+    mx, mn = header["max_min"][0], header["max_min"][1]
+    assert mn <= xyz[:, 0].min() + 1e-3 and mx >= xyz[:, 0].max() - 1e-3
+
+
+def test_cancel_leaves_no_dsm_and_resume_skips_finished_pairs(block_dir, tmp_path):
+    block, root = block_dir
+    ws = _copy_ws(root, tmp_path)
+    prog = _CancelAfter(n=4)
+    with pytest.raises(Cancelled):
+        dense.build_dsm_workspace(ws, quality="full", options=dense.DenseOptions(workers=1), progress=prog)
+    assert not os.path.exists(os.path.join(ws, "dsm.tif"))
+    assert Workspace.open(ws).stage("dsm")["status"] == "cancelled"
+
+    def pair_files():
+        return sorted(os.path.join(dp, f) for dp, _, fs in os.walk(os.path.join(ws, "dense")) for f in fs
+                      if f.endswith(".npz") and "-" in f and "partial" not in f)
+
+    first = pair_files()
+    assert 4 <= len(first) < 20
+    mtimes = {p: os.stat(p).st_mtime_ns for p in first}
+
+    # resume on a process pool of two; cancel while the GeoTIFF is written: no dsm.tif, no partial file
+    prog = _CancelAfter(when="writing Cloud-Optimized GeoTIFF")
+    with pytest.raises(Cancelled):
+        dense.build_dsm_workspace(ws, quality="full", options=dense.DenseOptions(workers=2, executor="process"),
+                                  progress=prog)
+    assert not [f for f in os.listdir(ws) if "dsm" in f and f.endswith(".tif")]
+    assert Workspace.open(ws).stage("dsm")["status"] == "cancelled"
+    everything = pair_files()
+    assert len(everything) > len(first)
+    for p, m in mtimes.items():
+        assert os.stat(p).st_mtime_ns == m  # the finished pairs were not matched again
+
+    # the third run reuses every pair
+    r = dense.build_dsm_workspace(ws, quality="full", options=dense.DenseOptions(workers=1))
+    assert r.pairs_reused == len(everything) == r.pairs
+    assert os.path.isfile(r.dsm_path) and r.valid_fraction > 0.8
+    assert any(f"{len(everything)} reused" in line for line in r.log_lines)
+
+
+def test_no_stereo_pair_is_a_clear_error(block_dir, tmp_path):
+    block, root = block_dir
+    # the two photos farthest apart (opposite corners of the block): they share no ground
+    c = np.array([s.centre for s in block.shots])
+    i, j = np.unravel_index(np.argmax(np.linalg.norm(c[:, None] - c[None], axis=2)), (len(c), len(c)))
+    names = [block.names[i], block.names[j]]
+    ws = make_workspace(str(tmp_path / "ws"), block, names=names, images_dir=os.path.join(root, "images"))
+    with pytest.raises(dense.DenseError, match="no stereo pair passed the selection"):
+        dense.build_dsm_workspace(ws)
+    assert Workspace.open(ws).stage("dsm")["status"] == "pending"  # refused before the stage began
+
+
+def test_not_georeferenced_is_refused(block_dir, tmp_path):
+    block, root = block_dir
+    ws = make_workspace(str(tmp_path / "ws"), block, georeferenced=False, images_dir=os.path.join(root, "images"))
+    with pytest.raises(dense.DenseError, match="not georeferenced.*Georeference"):
+        dense.build_dsm_workspace(ws)
+
+
+def test_bad_parameters_are_clear(block_dir, tmp_path):
+    import pycolmap
+
+    block, root = block_dir
+    ws = _copy_ws(root, tmp_path)
+    with pytest.raises(dense.DenseError, match="QUALITY"):
+        dense.build_dsm_workspace(ws, quality="ultra")
+    with pytest.raises(dense.DenseError, match="RESOLUTION"):
+        dense.build_dsm_workspace(ws, resolution=-1)
+    if not pycolmap.has_cuda:
+        with pytest.raises(dense.DenseError, match="CUDA"):
+            dense.build_dsm_workspace(ws, engine="cuda")
+
+
+# ---------------------------------------------------------------------------
+# Processing, on the sample strip (aligned + georeferenced with EXIF GPS)
+# ---------------------------------------------------------------------------
+
+@pytest.mark.slow
+def test_processing_build_dsm_on_the_sample_strip(qgis_processing, qgis_iface, tmp_path):
+    import archaeoortho
+    from qgis import processing
+    from qgis.core import QgsApplication, QgsProcessingException, QgsRasterLayer
+
+    plugin = archaeoortho.classFactory(qgis_iface)
+    plugin.initProcessing()
+    try:
+        alg = QgsApplication.processingRegistry().algorithmById("archaeoortho:builddsm")
+        assert alg is not None and alg.shortHelpString()
+        assert {"WORKSPACE", "RESOLUTION", "QUALITY", "ENGINE", "OUTPUT_DSM", "OUTPUT_POINT_CLOUD"} <= {
+            p.name() for p in alg.parameterDefinitions()}
+        assert {"VALID_FRACTION", "OUTPUT_DSM", "WORKSPACE"} <= {o.name() for o in alg.outputDefinitions()}
+        images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:5], str(tmp_path / "img"))
+        ws = processing.run("archaeoortho:alignimages", {
+            "IMAGES": images, "WORKSPACE": str(tmp_path / "ws"), "MAX_IMAGE_SIZE": 800, "MAX_FEATURES": 2048,
+        })["WORKSPACE"]
+        with pytest.raises(QgsProcessingException, match="not georeferenced"):
+            processing.run("archaeoortho:builddsm", {"WORKSPACE": ws})
+        processing.run("archaeoortho:georeference", {"WORKSPACE": ws, "USE_EXIF_GPS": True, "CRS": "EPSG:32617"})
+        res = processing.run("archaeoortho:builddsm", {
+            "WORKSPACE": ws, "QUALITY": 2, "OUTPUT_POINT_CLOUD": str(tmp_path / "points.las")})
+        assert res["WORKSPACE"] == ws
+        assert os.path.samefile(res["OUTPUT_DSM"], os.path.join(ws, "dsm.tif"))
+        assert res["PAIRS"] >= 3 and res["POINTS"] > 1000
+        assert 0.3 < res["VALID_FRACTION"] <= 1.0
+        layer = QgsRasterLayer(res["OUTPUT_DSM"], "dsm")
+        assert layer.isValid() and layer.crs().authid() == "EPSG:32617"
+        assert 274700 < layer.extent().center().x() < 275200
+        assert os.path.getsize(res["OUTPUT_POINT_CLOUD"]) > 227 + 26 * 1000
+    finally:
+        plugin.unload()
