@@ -1,0 +1,173 @@
+"""Image quality screening (core.screening) on the Toledo sample: blurriest first, exposure flags, decisions."""
+import json
+import os
+import shutil
+
+import numpy as np
+import pytest
+
+from tests.conftest import SAMPLE
+
+cv2 = pytest.importorskip("cv2")
+
+BLURS = {"blur_s3.0.JPG": 3.0, "blur_s1.5.JPG": 1.5, "blur_s0.8.JPG": 0.8}  # Gaussian sigma, pixels
+SOURCE = "1JI_0066.JPG"  # the least sharp original of the sample: the hardest case
+
+
+@pytest.fixture(scope="module")
+def toledo_with_bad_copies(tmp_path_factory):
+    """The 18 sample images + three blurred copies (known sigma) + one over-exposed copy."""
+    d = tmp_path_factory.mktemp("screening") / "images ü"
+    shutil.copytree(os.path.join(SAMPLE, "images"), d)
+    img = cv2.imread(os.path.join(SAMPLE, "images", SOURCE))
+    for name, sigma in BLURS.items():
+        cv2.imwrite(str(d / name), cv2.GaussianBlur(img, (0, 0), sigma), [cv2.IMWRITE_JPEG_QUALITY, 95])
+    over = cv2.convertScaleAbs(img, alpha=1.8, beta=60)  # a stop and a half over: highlights clip
+    cv2.imwrite(str(d / "overexposed.JPG"), over, [cv2.IMWRITE_JPEG_QUALITY, 95])
+    return str(d)
+
+
+@pytest.fixture(scope="module")
+def screened(toledo_with_bad_copies):
+    from core.screening import screen_folder
+
+    return screen_folder(toledo_with_bad_copies)
+
+
+def test_blurriest_images_rank_first(screened):
+    quality = screened
+    ranked = sorted(quality, key=lambda q: q.blur_rank)
+    print("\nblur scores (variance of the Laplacian, 90th percentile of tiles, 1024 px):")
+    for q in ranked[:6]:
+        print(f"  {q.blur_rank:2d} {q.name:18s} {q.blur_score:8.1f}  {100 * q.blur_relative:5.1f} % of median  {q.flags}")
+    originals = [q.blur_score for q in quality if q.name in os.listdir(os.path.join(SAMPLE, "images"))]
+    print(f"  originals: min {min(originals):.1f}, median {np.median(originals):.1f}, max {max(originals):.1f}")
+    # the three blurred copies are the three lowest, strongest blur first
+    assert [q.name for q in ranked[:3]] == sorted(BLURS, key=lambda n: -BLURS[n])
+    for q in ranked[:3]:
+        assert "blurry" in q.flags
+    # no sharp original is flagged blurry
+    assert not [q.name for q in quality if q.name in os.listdir(os.path.join(SAMPLE, "images")) and q.flags]
+
+
+def test_overexposed_copy_is_flagged(screened):
+    by_name = {q.name: q for q in screened}
+    over = by_name["overexposed.JPG"]
+    assert "overexposed" in over.flags
+    assert over.highlights_clipped > 0.05
+    assert over.exposure_rank == 1
+    assert by_name[SOURCE].exposure_score > 0.8 and "overexposed" not in by_name[SOURCE].flags
+
+
+def test_scores_do_not_depend_on_image_size(tmp_path):
+    """The same photo at 1200 px and at 2400 px (upsampled) scores alike: analysis at a fixed size."""
+    from core.screening import measure_image
+
+    img = cv2.imread(os.path.join(SAMPLE, "images", SOURCE))
+    cv2.imwrite(str(tmp_path / "big.png"), cv2.resize(img, None, fx=2, fy=2, interpolation=cv2.INTER_CUBIC))
+    cv2.imwrite(str(tmp_path / "small.png"), img)
+    a, b = measure_image(str(tmp_path / "small.png")), measure_image(str(tmp_path / "big.png"))
+    assert b.blur_score == pytest.approx(a.blur_score, rel=0.35)
+    assert b.dynamic_range == pytest.approx(a.dynamic_range, abs=0.02)
+
+
+def test_sky_does_not_make_a_sharp_photo_blurry():
+    """Half the frame uniform (sky, water): the textured tiles decide."""
+    from core.screening import blur_score, to_grey
+
+    img = cv2.imread(os.path.join(SAMPLE, "images", SOURCE))[:, :, ::-1]
+    g = to_grey(img)
+    sky = g.copy()
+    sky[: g.shape[0] // 2] = 0.8
+    assert blur_score(sky) > 0.8 * blur_score(g)
+    assert blur_score(sky) > 5 * blur_score(to_grey(cv2.GaussianBlur(img, (0, 0), 1.5)))
+
+
+def test_sixteen_bit_and_grey_images(tmp_path):
+    from core.screening import full_scale, measure_image
+
+    g = cv2.imread(os.path.join(SAMPLE, "images", SOURCE), cv2.IMREAD_GRAYSCALE)
+    cv2.imwrite(str(tmp_path / "g16.tif"), (g.astype(np.uint16) * 16))  # 12-bit data in 16-bit
+    cv2.imwrite(str(tmp_path / "g8.tif"), g)
+    a, b = measure_image(str(tmp_path / "g8.tif")), measure_image(str(tmp_path / "g16.tif"))
+    assert full_scale(np.array([4095], np.uint16)) == 4095
+    assert b.brightness == pytest.approx(a.brightness, abs=0.01)
+    assert b.blur_score == pytest.approx(a.blur_score, rel=0.05)
+
+
+def test_prepare_stage_records_decisions_and_excludes(toledo_with_bad_copies, tmp_path):
+    from core.screening import PrepareOptions, ScreeningOptions, load_screening, prepare_images_workspace
+
+    ws = str(tmp_path / "ws")
+    out = str(tmp_path / "prepared")
+    opts = PrepareOptions(screening=ScreeningOptions(exclude_flagged=True))
+    res = prepare_images_workspace(toledo_with_bad_copies, ws, out, opts)
+    flagged = {q.name for q in res.images if q.flags}
+    assert set(BLURS) | {"overexposed.JPG"} <= flagged
+    assert res.excluded == len(flagged) and res.kept == 22 - len(flagged)
+    kept = sorted(n for n in os.listdir(out) if not n.startswith("."))
+    assert len(kept) == res.kept and not set(kept) & flagged
+    doc = load_screening(ws)
+    assert doc["blurriest_first"][:3] == sorted(BLURS, key=lambda n: -BLURS[n])
+    rows = {r["name"]: r for r in doc["images"]}
+    assert rows["blur_s3.0.JPG"]["decision"] == "exclude" and rows["blur_s3.0.JPG"]["reasons"]
+    assert rows[SOURCE]["decision"] == "keep"
+    manifest = json.load(open(os.path.join(ws, "workspace.json")))
+    rec = manifest["stages"]["prepare"]
+    assert rec["status"] == "done" and rec["results"]["excluded"] == res.excluded
+    assert rec["results"]["decisions"]["overexposed.JPG"]["decision"] == "exclude"
+    assert rec["outputs"]["prepared_images"] == os.path.abspath(out)
+
+    # a re-run without exclusion replaces the prepared folder as a whole
+    res2 = prepare_images_workspace(toledo_with_bad_copies, ws, out, PrepareOptions())
+    assert res2.excluded == 0 and len([n for n in os.listdir(out) if not n.startswith(".")]) == 22
+
+
+def test_output_folder_with_foreign_files_is_refused(tmp_path):
+    from core.screening import ScreeningError, prepare_images_workspace
+
+    images = tmp_path / "img"
+    shutil.copytree(os.path.join(SAMPLE, "images"), images, ignore=lambda d, names: names[3:])
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "thesis.docx").write_text("precious")
+    with pytest.raises(ScreeningError, match="did not write"):
+        prepare_images_workspace(str(images), str(tmp_path / "ws"), str(out))
+    assert (out / "thesis.docx").exists()
+    with pytest.raises(ScreeningError, match="must not be the image folder"):
+        prepare_images_workspace(str(images), str(tmp_path / "ws"), str(images))
+
+
+def test_corrupt_file_is_named(tmp_path):
+    from core.images import ImageError
+    from core.screening import prepare_images_workspace
+
+    images = tmp_path / "img"
+    shutil.copytree(os.path.join(SAMPLE, "images"), images, ignore=lambda d, names: names[3:])
+    data = open(os.path.join(SAMPLE, "images", SOURCE), "rb").read()
+    (images / "broken.JPG").write_bytes(data[: len(data) // 3])  # a truncated download
+    with pytest.raises(ImageError, match="broken.JPG"):
+        prepare_images_workspace(str(images), str(tmp_path / "ws"), str(tmp_path / "out"))
+    assert not os.path.exists(tmp_path / "out")
+
+
+def test_cancel_leaves_no_complete_looking_output(tmp_path):
+    from core.progress import Cancelled, NullProgress
+    from core.screening import prepare_images_workspace
+
+    class CancelAfter(NullProgress):
+        def __init__(self, n):
+            self.n = n
+
+        def is_cancelled(self):
+            self.n -= 1
+            return self.n < 0
+
+    images = tmp_path / "img"
+    shutil.copytree(os.path.join(SAMPLE, "images"), images, ignore=lambda d, names: names[6:])
+    with pytest.raises(Cancelled):
+        prepare_images_workspace(str(images), str(tmp_path / "ws"), str(tmp_path / "out"), progress=CancelAfter(3))
+    assert not os.path.exists(tmp_path / "out")
+    assert not os.path.exists(tmp_path / "ws" / "screening.json")
+    manifest = json.load(open(tmp_path / "ws" / "workspace.json"))
+    assert manifest["stages"]["prepare"]["status"] == "cancelled"
