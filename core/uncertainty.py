@@ -1,0 +1,618 @@
+"""Precision of a bundle-adjusted block: covariance from the Jacobian of the adjustment.
+
+For the report (``core.report``) and its GeoPackage layers.  The model is linearised at the adjusted
+solution (the georeferenced model ``georef/model`` in the local frame, or the aligned model) with the
+same observations and weights the georeferencing adjustment used (``core.georef``):
+
+- tie-point observations, sigma ``tie_sigma_px`` (1 px), Huber weights beyond ``huber_px`` (2 px);
+- control-point observations, sigma ``gcp_sigma_px`` (1 px), and the control coordinates as priors with
+  their sigma XY / Z (raised to 1 m in Z for placeholder heights, as ``core.georef`` does);
+- camera projection-centre priors with their sigmas (EXIF GPS: 3 m / 5 m; a positions file: its sigmas).
+
+Unknowns: per image a rotation increment (camera axes) and its projection centre; per camera (group) the
+refined intrinsic parameters; per point its position.  The normal matrix is reduced to the camera
+parameters by a Schur complement on the 3x3 point blocks, inverted densely, and the point covariances are
+recovered from it (``Q_pp = N_pp^-1 + N_pp^-1 N_pc Q_cc N_cp N_pp^-1``).  Everything is scaled by the a
+posteriori variance factor sigma0^2 (weighted residual sum of squares / redundancy).
+
+Datum: with control points or camera positions the datum is the control's (absolute precision in the
+CRS).  Without them (an aligned block only) the 7-parameter datum defect is removed by a generalised
+inverse (the eigenvectors of the 7 smallest eigenvalues of the scaled reduced system are dropped): the
+intrinsic parameters' standard deviations are then datum-free, positions are in the arbitrary model
+frame and units ("free network").
+
+Why not ``pycolmap.estimate_ba_covariance``: it needs a Ceres problem built by pycolmap's own bundle
+adjusters, which have no prior on a 3-D point (GCPs), so it cannot give the precision of a
+GCP-controlled block.  The derivatives here are analytic for the rigid part and central differences
+through pycolmap's camera model (``Camera.img_from_cam``), so every COLMAP camera model works.
+
+Simplifications, stated in the result's ``notes``: each image has its own pose (rigs are treated as
+independent cameras), the intrinsics' covariance is that of the parameters marked free, and beyond
+``max_observations`` tie-point observations only the best-observed points enter (every image covered):
+the precision is then slightly pessimistic and the points left out get no covariance.
+"""
+from __future__ import annotations
+
+import copy
+import json
+import math
+import os
+import time
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from .progress import NullProgress, Progress, check_cancel
+
+DATUM_CONTROL = "control"
+DATUM_FREE = "free network"
+FREE_DATUM_DEFECT = 7
+EXIF_SIGMA_XY = 3.0  # the same a priori sigmas as core.pipeline's EXIF GPS positions
+EXIF_SIGMA_Z = 5.0
+PLACEHOLDER_SIGMA_Z = 1.0  # core.georef's placeholder_sigma_z default
+
+
+class UncertaintyError(RuntimeError):
+    """The covariance cannot be computed; the message says why."""
+
+
+@dataclass
+class ControlInput:
+    """A control point in the adjustment: adjusted position (local frame), sigma XYZ and observations."""
+
+    name: str
+    xyz: np.ndarray
+    sigma: np.ndarray  # (3,)
+    given: np.ndarray  # given coordinates (local frame), for the prior residual
+    observations: List[Tuple[str, float, float]]  # (image name, x px, y px)
+
+
+@dataclass
+class CameraPrior:
+    image: str
+    xyz: np.ndarray  # given projection centre (local frame); NaN z = XY only
+    sigma: np.ndarray  # (3,)
+
+
+@dataclass
+class Observations:
+    """Every tie-point observation of a reconstruction with its reprojection residual."""
+
+    image_ids: np.ndarray  # (I,) registered image ids, sorted
+    image_names: List[str]
+    img: np.ndarray  # (O,) index into image_ids
+    pt: np.ndarray  # (O,) index into point_ids
+    xy: np.ndarray  # (O, 2) observed pixel
+    residual: np.ndarray  # (O, 2) projected - observed, pixels (NaN behind the camera)
+    point_ids: np.ndarray  # (P,) point3D ids
+    xyz: np.ndarray  # (P, 3)
+    track_length: np.ndarray  # (P,)
+
+    @property
+    def error(self) -> np.ndarray:
+        return np.linalg.norm(self.residual, axis=1)
+
+
+@dataclass
+class UncertaintyResult:
+    datum: str
+    sigma0: float  # a posteriori standard deviation of unit weight
+    redundancy: int
+    n_observations: int  # image observations (tie + control) used
+    n_points: int
+    cameras: List[Dict[str, Any]]  # image, camera_id, x, y, z, sx, sy, sz (m), s_rx, s_ry, s_rz (deg)
+    intrinsics: Dict[int, Dict[str, Any]]  # camera_id -> model, names, values, std (None = held fixed)
+    point_ids: np.ndarray
+    point_xyz: np.ndarray  # (P, 3) local frame (or model frame)
+    point_std: np.ndarray  # (P, 3)
+    control: List[Dict[str, Any]]  # name, sx, sy, sz
+    offset: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    notes: List[str] = field(default_factory=list)
+    seconds: float = 0.0
+
+    def summary(self) -> Dict[str, Any]:
+        cs = np.array([[c["sx"], c["sy"], c["sz"]] for c in self.cameras], dtype=float).reshape(-1, 3)
+        ps = self.point_std
+        h = np.hypot(ps[:, 0], ps[:, 1]) if len(ps) else np.zeros(0)
+        return {
+            "datum": self.datum, "sigma0": self.sigma0, "redundancy": self.redundancy,
+            "camera_std_xy_median": float(np.median(np.hypot(cs[:, 0], cs[:, 1]))) if len(cs) else None,
+            "camera_std_z_median": float(np.median(cs[:, 2])) if len(cs) else None,
+            "point_std_xy_median": float(np.median(h)) if len(h) else None,
+            "point_std_z_median": float(np.median(ps[:, 2])) if len(ps) else None,
+            "point_std_xy_p95": float(np.percentile(h, 95)) if len(h) else None,
+            "point_std_z_p95": float(np.percentile(ps[:, 2], 95)) if len(ps) else None,
+            "points": int(len(ps)), "seconds": self.seconds,
+        }
+
+
+# --------------------------------------------------------------------------------------------------
+# observations and residuals
+# --------------------------------------------------------------------------------------------------
+
+def _project(camera, xc: np.ndarray) -> np.ndarray:
+    if len(xc) == 0:
+        return np.zeros((0, 2))
+    return np.asarray(camera.img_from_cam(np.ascontiguousarray(xc, dtype=float), check_cheirality=False))
+
+
+def collect_observations(rec) -> Observations:
+    """Tie-point observations of every registered image of a pycolmap.Reconstruction, with residuals."""
+    image_ids = np.array(sorted(int(i) for i in rec.reg_image_ids()), dtype=np.int64)
+    names = [rec.image(int(i)).name for i in image_ids]
+    pids, xyz, tl = [], [], []
+    for pid, p in rec.points3D.items():
+        pids.append(int(pid))
+        xyz.append(np.asarray(p.xyz, dtype=float))
+        tl.append(int(p.track.length()))
+    index = {pid: k for k, pid in enumerate(pids)}
+    o_img, o_pt, o_xy, o_res = [], [], [], []
+    xyz_a = np.asarray(xyz, dtype=float).reshape(-1, 3)
+    for k, iid in enumerate(image_ids):
+        im = rec.image(int(iid))
+        obs = im.get_observation_points2D()
+        if not len(obs):
+            continue
+        pt = np.array([index[int(p2.point3D_id)] for p2 in obs], dtype=np.int64)
+        xy = np.array([p2.xy for p2 in obs], dtype=float).reshape(-1, 2)
+        m = np.asarray(im.cam_from_world().matrix())
+        xc = xyz_a[pt] @ m[:, :3].T + m[:, 3]
+        uv = _project(rec.cameras[im.camera_id], xc)
+        res = uv - xy
+        res[xc[:, 2] <= 0] = np.nan
+        o_img.append(np.full(len(pt), k, dtype=np.int64))
+        o_pt.append(pt)
+        o_xy.append(xy)
+        o_res.append(res)
+
+    def cat(parts, shape):
+        return np.concatenate(parts) if parts else np.zeros(shape)
+
+    return Observations(image_ids, names, cat(o_img, (0,)).astype(np.int64), cat(o_pt, (0,)).astype(np.int64),
+                        cat(o_xy, (0, 2)), cat(o_res, (0, 2)), np.asarray(pids, dtype=np.int64), xyz_a,
+                        np.asarray(tl, dtype=np.int64))
+
+
+# --------------------------------------------------------------------------------------------------
+# the covariance
+# --------------------------------------------------------------------------------------------------
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    z = np.zeros(len(v))
+    return np.stack([np.stack([z, -v[:, 2], v[:, 1]], -1),
+                     np.stack([v[:, 2], z, -v[:, 0]], -1),
+                     np.stack([-v[:, 1], v[:, 0], z], -1)], axis=1)
+
+
+def _inv3(m: np.ndarray) -> np.ndarray:
+    """Inverse of a stack of 3x3 matrices by the adjugate (fast on busy cores, unlike batched LAPACK)."""
+    a, b, c = m[:, 0, 0], m[:, 0, 1], m[:, 0, 2]
+    d, e, f = m[:, 1, 0], m[:, 1, 1], m[:, 1, 2]
+    g, h, i = m[:, 2, 0], m[:, 2, 1], m[:, 2, 2]
+    co = np.empty_like(m)
+    co[:, 0, 0] = e * i - f * h
+    co[:, 0, 1] = c * h - b * i
+    co[:, 0, 2] = b * f - c * e
+    co[:, 1, 0] = f * g - d * i
+    co[:, 1, 1] = a * i - c * g
+    co[:, 1, 2] = c * d - a * f
+    co[:, 2, 0] = d * h - e * g
+    co[:, 2, 1] = b * g - a * h
+    co[:, 2, 2] = a * e - b * d
+    det = a * co[:, 0, 0] + b * co[:, 1, 0] + c * co[:, 2, 0]
+    det = np.where(np.abs(det) > 1e-300, det, np.nan)
+    return co / det[:, None, None]
+
+
+def _proj_jacobian(camera, xc: np.ndarray) -> np.ndarray:
+    h = 1e-6 * np.maximum(np.abs(xc[:, 2]), 1e-9)
+    jac = np.empty((len(xc), 2, 3))
+    for k in range(3):
+        d = np.zeros_like(xc)
+        d[:, k] = h
+        jac[:, :, k] = (_project(camera, xc + d) - _project(camera, xc - d)) / (2 * h)[:, None]
+    return jac
+
+
+def _intrinsics_jacobian(camera, xc: np.ndarray, free: Sequence[int]) -> np.ndarray:
+    out = np.empty((len(xc), 2, len(free)))
+    base = np.array(camera.params, dtype=float)
+    cam = copy.copy(camera)
+    for j, k in enumerate(free):
+        h = 1e-6 * max(1.0, abs(base[k]))
+        p = base.copy()
+        p[k] += h
+        cam.params = p
+        up = _project(cam, xc)
+        p[k] -= 2 * h
+        cam.params = p
+        dn = _project(cam, xc)
+        out[:, :, j] = (up - dn) / (2 * h)
+    return out
+
+
+def default_free_intrinsics(rec, principal_point: bool = False) -> Dict[int, List[int]]:
+    """Focal length(s) and distortion of every camera; the principal point too when it was refined."""
+    out = {}
+    for cid, cam in rec.cameras.items():
+        idx = list(cam.focal_length_idxs()) + list(cam.extra_params_idxs())
+        if principal_point:
+            idx += list(cam.principal_point_idxs())
+        out[int(cid)] = sorted(set(int(i) for i in idx))
+    return out
+
+
+def _select_points(obs: Observations, ok: np.ndarray, max_observations: int) -> np.ndarray:
+    """Mask of points kept: all when few enough observations, else longest tracks first, every image kept."""
+    n_obs_pt = np.bincount(obs.pt[ok], minlength=len(obs.point_ids))
+    keep = n_obs_pt >= 2
+    if int(n_obs_pt[keep].sum()) <= max_observations:
+        return keep
+    order = np.argsort(-n_obs_pt, kind="stable")
+    chosen = np.zeros(len(keep), dtype=bool)
+    total = 0
+    for k in order:
+        if n_obs_pt[k] < 2 or total + n_obs_pt[k] > max_observations:
+            continue
+        chosen[k] = True
+        total += int(n_obs_pt[k])
+    return chosen
+
+
+def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[CameraPrior] = (),
+             free_intrinsics: Optional[Dict[int, List[int]]] = None, tie_sigma_px: float = 1.0,
+             gcp_sigma_px: float = 1.0, huber_px: float = 2.0, max_observations: int = 300_000,
+             max_unknowns: int = 6000, offset=None, progress: Optional[Progress] = None,
+             observations: Optional[Observations] = None) -> UncertaintyResult:
+    """Covariance of the cameras, intrinsics and points of an adjusted block (see the module docstring)."""
+    import scipy.sparse as sp
+
+    t0 = time.time()
+    progress = progress or NullProgress()
+    notes: List[str] = []
+    obs = observations if observations is not None else collect_observations(rec)
+    n_img = len(obs.image_ids)
+    if n_img < 2:
+        raise UncertaintyError("the model has fewer than 2 registered images")
+    img_index = {name: k for k, name in enumerate(obs.image_names)}
+    images = [rec.image(int(i)) for i in obs.image_ids]
+    cam_ids = sorted({int(im.camera_id) for im in images})
+    free = free_intrinsics if free_intrinsics is not None else default_free_intrinsics(rec)
+    free = {cid: list(free.get(cid, [])) for cid in cam_ids}
+    intr_off = {}
+    nc = 6 * n_img
+    for cid in cam_ids:
+        intr_off[cid] = nc
+        nc += len(free[cid])
+    if nc > max_unknowns:
+        raise UncertaintyError(f"{nc} camera unknowns: more than the dense covariance handles here ({max_unknowns})")
+
+    # tie observations (finite residuals), point selection
+    err = obs.error
+    ok = np.isfinite(err)
+    keep_pt = _select_points(obs, ok, max_observations)
+    if not keep_pt.all():
+        notes.append(f"{int(keep_pt.sum())} of {len(keep_pt)} tie points (the best observed) entered the "
+                     "covariance; the others have no standard deviation")
+    sel = ok & keep_pt[obs.pt]
+    pt_new = np.full(len(obs.point_ids), -1, dtype=np.int64)
+    pt_new[keep_pt] = np.arange(int(keep_pt.sum()))
+    o_img = obs.img[sel]
+    o_pt = pt_new[obs.pt[sel]]
+    o_res = obs.residual[sel]
+    o_sig = np.full(len(o_img), float(tie_sigma_px))
+    o_rob = np.ones(len(o_img), dtype=bool)
+    X = obs.xyz[keep_pt].copy()
+    n_tie = len(X)
+
+    # control points: extra points with priors and their own observations
+    prior_idx, prior_xyz, prior_sig = [], [], []
+    c_img, c_pt, c_res = [], [], []
+    ctl_rows = []
+    for c in control:
+        k = len(X)
+        rows = []
+        for name, x, y in c.observations:
+            j = img_index.get(name)
+            if j is None:
+                continue
+            im = images[j]
+            m = np.asarray(im.cam_from_world().matrix())
+            xc = m[:, :3] @ c.xyz + m[:, 3]
+            if xc[2] <= 0:
+                continue
+            uv = _project(rec.cameras[im.camera_id], xc[None])[0]
+            rows.append((j, uv - np.array([x, y])))
+        if not rows:  # not connected to the block
+            continue
+        X = np.vstack([X, np.asarray(c.xyz, dtype=float)[None]])
+        for j, r in rows:
+            c_img.append(j)
+            c_pt.append(k)
+            c_res.append(r)
+        prior_idx.append(k)
+        prior_xyz.append(np.asarray(c.given, dtype=float))
+        prior_sig.append(np.asarray(c.sigma, dtype=float))
+        ctl_rows.append((c.name, k))
+    if c_img:
+        o_img = np.concatenate([o_img, np.asarray(c_img, dtype=np.int64)])
+        o_pt = np.concatenate([o_pt, np.asarray(c_pt, dtype=np.int64)])
+        o_res = np.vstack([o_res, np.asarray(c_res, dtype=float)])
+        o_sig = np.concatenate([o_sig, np.full(len(c_img), float(gcp_sigma_px))])
+        o_rob = np.concatenate([o_rob, np.zeros(len(c_img), dtype=bool)])
+    n_pts = len(X)
+    n_o = len(o_img)
+
+    # weights (Huber on tie points, as in the adjustment)
+    s = np.linalg.norm(o_res, axis=1) / o_sig
+    w = np.ones(n_o)
+    big = o_rob & (s > huber_px)
+    w[big] = huber_px / s[big]
+    sw = np.sqrt(w) / o_sig  # sqrt of the weight of each residual component
+
+    # Jacobians, per image
+    progress.report(0.05, "covariance: Jacobian")
+    q_max = max((len(v) for v in free.values()), default=0)
+    jc = np.zeros((n_o, 2, 6 + q_max))
+    jp = np.zeros((n_o, 2, 3))
+    cam_cols = np.zeros((n_o, 6 + q_max), dtype=np.int64)
+    n_cols = np.zeros(n_o, dtype=np.int64)
+    order = np.argsort(o_img, kind="stable")
+    bounds = np.searchsorted(o_img[order], np.arange(n_img + 1))
+    for j in range(n_img):
+        rows = order[bounds[j]:bounds[j + 1]]
+        if not len(rows):
+            continue
+        check_cancel(progress)
+        im = images[j]
+        cam = rec.cameras[im.camera_id]
+        m = np.asarray(im.cam_from_world().matrix())
+        r = m[:, :3]
+        xc = X[o_pt[rows]] @ r.T + m[:, 3]
+        jpi = _proj_jacobian(cam, xc)
+        jc[rows, :, 0:3] = np.einsum("nij,njk->nik", jpi, -_skew(xc))
+        jc[rows, :, 3:6] = jpi @ (-r)
+        jp[rows] = jpi @ r
+        fr = free[int(im.camera_id)]
+        cols = list(range(6 * j, 6 * j + 6))
+        if fr:
+            jc[rows, :, 6:6 + len(fr)] = _intrinsics_jacobian(cam, xc, fr)
+            cols += list(range(intr_off[int(im.camera_id)], intr_off[int(im.camera_id)] + len(fr)))
+        cam_cols[rows, :len(cols)] = cols
+        n_cols[rows] = len(cols)
+    jc *= sw[:, None, None]
+    jp *= sw[:, None, None]
+
+    # normal equations
+    progress.report(0.4, "covariance: normal equations")
+    width = 6 + q_max
+    valid = np.arange(width)[None, :] < n_cols[:, None]  # (O, width)
+    row_id = (2 * np.arange(n_o))[:, None, None] + np.arange(2)[None, :, None]
+    rr = np.broadcast_to(row_id, (n_o, 2, width))
+    cc = np.broadcast_to(cam_cols[:, None, :], (n_o, 2, width))
+    vm = np.broadcast_to(valid[:, None, :], (n_o, 2, width))
+    jc_s = sp.csr_matrix((jc[vm], (rr[vm], cc[vm])), shape=(2 * n_o, nc))
+    pr = np.broadcast_to(row_id, (n_o, 2, 3))
+    pc = np.broadcast_to((3 * o_pt)[:, None, None] + np.arange(3)[None, None, :], (n_o, 2, 3))
+    jp_s = sp.csr_matrix((jp.ravel(), (pr.ravel(), pc.ravel())), shape=(2 * n_o, 3 * n_pts))
+    ncc = (jc_s.T @ jc_s).toarray()
+    ncp = (jc_s.T @ jp_s).tocsr()
+    npp = np.zeros((n_pts, 3, 3))
+    np.add.at(npp, o_pt, np.einsum("nki,nkj->nij", jp, jp))
+    prior_res = []
+    if prior_idx:
+        pi = np.asarray(prior_idx)
+        ps = np.asarray(prior_sig)
+        npp[pi] += np.einsum("ni,ij->nij", 1.0 / ps ** 2, np.eye(3))
+        prior_res.append(((X[pi] - np.asarray(prior_xyz)) / ps).ravel())
+    n_cam_prior_comp = 0
+    centres = np.array([np.asarray(im.projection_center(), dtype=float) for im in images])
+    for cp in camera_priors:
+        j = img_index.get(cp.image)
+        if j is None:
+            continue
+        for a in range(3):
+            if math.isfinite(float(cp.xyz[a])) and math.isfinite(float(cp.sigma[a])) and cp.sigma[a] > 0:
+                ncc[6 * j + 3 + a, 6 * j + 3 + a] += 1.0 / cp.sigma[a] ** 2
+                prior_res.append(np.array([(centres[j, a] - cp.xyz[a]) / cp.sigma[a]]))
+                n_cam_prior_comp += 1
+    # points seen only once and without a prior cannot be estimated: drop them
+    npp_inv = _inv3(npp)
+    bad = ~np.all(np.isfinite(npp_inv.reshape(n_pts, -1)), axis=1)
+    if np.any(bad):
+        npp_inv[bad] = 0.0
+    bi = (3 * np.arange(n_pts))[:, None, None] + np.arange(3)[None, :, None] + np.zeros((1, 1, 3), dtype=np.int64)
+    nppi_s = sp.csr_matrix((npp_inv.ravel(), (bi.ravel(), np.swapaxes(bi, 1, 2).ravel())),
+                           shape=(3 * n_pts, 3 * n_pts))
+    s_mat = ncc - (ncp @ nppi_s @ ncp.T).toarray()
+    s_mat = 0.5 * (s_mat + s_mat.T)
+
+    # datum
+    n_ctl = len(prior_idx)
+    has_datum = n_ctl >= 3 or n_cam_prior_comp >= 7 or (n_ctl >= 1 and n_ctl * 3 + n_cam_prior_comp >= 7)
+    progress.report(0.6, "covariance: inverting the reduced system")
+    d = np.sqrt(np.maximum(np.diag(s_mat), 1e-300))
+    s_scaled = s_mat / d[:, None] / d[None, :]
+    datum = DATUM_CONTROL
+    defect = 0
+    q_cc = None
+    if has_datum:
+        try:
+            from scipy.linalg import cho_factor, cho_solve
+
+            f = cho_factor(s_scaled, lower=True)
+            q_cc = cho_solve(f, np.eye(nc))
+        except np.linalg.LinAlgError:
+            notes.append("the reduced normal matrix is singular with the control given: free-network inverse")
+    if q_cc is None:
+        evals, evecs = np.linalg.eigh(s_scaled)
+        defect = FREE_DATUM_DEFECT if not has_datum else int(np.sum(evals < 1e-10 * evals[-1]))
+        keep = np.arange(nc) >= defect
+        q_cc = (evecs[:, keep] / evals[keep]) @ evecs[:, keep].T
+        datum = DATUM_FREE
+        if not has_datum:
+            notes.append("no control points or camera positions: free-network precision (datum defect 7 removed "
+                         "by a generalised inverse); positions are in the model frame")
+    q_cc = q_cc / d[:, None] / d[None, :]
+
+    # variance factor
+    wrss = float(np.sum(w * (np.linalg.norm(o_res, axis=1) / o_sig) ** 2))
+    if prior_res:
+        wrss += float(np.sum(np.concatenate(prior_res) ** 2))
+    n_eq = 2 * n_o + 3 * n_ctl + n_cam_prior_comp
+    redundancy = int(n_eq - (nc + 3 * n_pts - 3 * int(bad.sum())) + defect)
+    sigma0 = math.sqrt(wrss / redundancy) if redundancy > 0 else float("nan")
+    var0 = sigma0 ** 2 if math.isfinite(sigma0) else 1.0
+    if not math.isfinite(sigma0):
+        notes.append("no redundancy: a priori precision (sigma0 = 1)")
+
+    # cameras
+    cameras = []
+    for j, im in enumerate(images):
+        blk = q_cc[6 * j:6 * j + 6, 6 * j:6 * j + 6] * var0
+        sd = np.sqrt(np.maximum(np.diag(blk), 0.0))
+        c = centres[j]
+        cameras.append({"image": im.name, "camera_id": int(im.camera_id), "x": float(c[0]), "y": float(c[1]),
+                        "z": float(c[2]), "sx": float(sd[3]), "sy": float(sd[4]), "sz": float(sd[5]),
+                        "s_rx": math.degrees(sd[0]), "s_ry": math.degrees(sd[1]), "s_rz": math.degrees(sd[2])})
+    intr = {}
+    for cid in cam_ids:
+        cam = rec.cameras[cid]
+        names = [n.strip() for n in str(cam.params_info).split(",")]
+        std: List[Optional[float]] = [None] * len(cam.params)
+        o = intr_off[cid]
+        for k, pidx in enumerate(free[cid]):
+            std[pidx] = float(math.sqrt(max(q_cc[o + k, o + k] * var0, 0.0)))
+        intr[cid] = {"model": cam.model.name, "width": int(cam.width), "height": int(cam.height),
+                     "names": names, "values": [float(v) for v in cam.params], "std": std,
+                     "images": sum(1 for im in images if int(im.camera_id) == cid)}
+
+    # points: Q_pp = N^-1 + N^-1 T^T Q_cc T N^-1 with T = N_cp columns of the point
+    progress.report(0.75, "covariance: points")
+    pstd = np.full((n_pts, 3), np.nan)
+    chunk = max(50, int(3e6 // max(nc, 1)) // 3)
+    ncp_csc = ncp.tocsc()
+    for a in range(0, n_pts, chunk):
+        check_cancel(progress)
+        b = min(n_pts, a + chunk)
+        t = ncp_csc[:, 3 * a:3 * b].toarray()  # (nc, 3m)
+        g = q_cc @ t
+        m_ = b - a
+        core = np.einsum("kmi,kmj->mij", t.reshape(nc, m_, 3), g.reshape(nc, m_, 3))
+        ni = npp_inv[a:b]
+        q = ni + ni @ core @ ni
+        pstd[a:b] = np.sqrt(np.maximum(np.einsum("nii->ni", q), 0.0) * var0)
+    pstd[bad] = np.nan
+    control_rows = [{"name": name, "sx": float(pstd[k, 0]), "sy": float(pstd[k, 1]), "sz": float(pstd[k, 2])}
+                    for name, k in ctl_rows]
+    if any(len(free[c]) for c in cam_ids):
+        notes.append("intrinsic parameters free: " + "; ".join(
+            f"camera {c}: {', '.join(intr[c]['names'][i] for i in free[c]) or 'none'}" for c in cam_ids))
+    if any(r.num_sensors() > 1 for r in rec.rigs.values()):
+        notes.append("multi-camera rigs are treated as independent cameras")
+    progress.report(1.0, "covariance done")
+    return UncertaintyResult(
+        datum=datum, sigma0=sigma0, redundancy=redundancy, n_observations=n_o, n_points=n_tie,
+        cameras=cameras, intrinsics=intr, point_ids=obs.point_ids[keep_pt], point_xyz=X[:n_tie],
+        point_std=pstd[:n_tie], control=control_rows,
+        offset=np.zeros(3) if offset is None else np.asarray(offset, dtype=float), notes=notes,
+        seconds=round(time.time() - t0, 3))
+
+
+# --------------------------------------------------------------------------------------------------
+# workspaces
+# --------------------------------------------------------------------------------------------------
+
+def _read_json(path: str) -> Optional[Dict[str, Any]]:
+    if not os.path.isfile(path):
+        return None
+    with open(path, encoding="utf-8") as f:
+        return json.load(f)
+
+
+def workspace_inputs(ws, rec) -> Tuple[List[ControlInput], List[CameraPrior], Dict[int, List[int]], np.ndarray]:
+    """Control, camera priors, free intrinsics and the local->world offset of a workspace's newest model.
+
+    The georeferenced model when the georeference stage is done (priors from georef/residuals.json,
+    control sigmas from georef/control.json), else the aligned model without priors."""
+    pp = bool((_read_json(ws.path("sfm", "alignment.json")) or {}).get("principal_point_refined"))
+    geo = ws.stage("georeference")
+    if geo.get("status") != "done" or not os.path.isdir(ws.path("georef", "model")):
+        return [], [], default_free_intrinsics(rec, pp), np.zeros(3)
+    params = geo.get("parameters", {}) or {}
+    refine = params.get("refine_intrinsics")
+    transform = _read_json(ws.path("georef", "transform.json")) or {}
+    offset = np.asarray(transform.get("offset", [0.0, 0.0, 0.0]), dtype=float)
+    residuals = _read_json(ws.path("georef", "residuals.json")) or {}
+    control_doc = _read_json(ws.path("georef", "control.json")) or {}
+    sigmas = {p["name"]: (float(p.get("sigma_xy", 0.02)), float(p.get("sigma_z", 0.05)))
+              for p in control_doc.get("points", [])}
+    placeholder = (residuals.get("statistics") or {}).get("placeholder_z") is not None
+    control = []
+    for p in residuals.get("points", []):
+        if p.get("status") != "used" or p.get("dx") is None:
+            continue
+        sxy, sz = sigmas.get(p["name"], (0.02, 0.05))
+        if placeholder:
+            sz = max(sz, PLACEHOLDER_SIGMA_Z)
+        given = np.array([p["x"], p["y"], p["z"]], dtype=float) - offset
+        adj = given + np.array([p["dx"], p["dy"], p["dz"]], dtype=float)
+        obs = [(o["image"], float(o["x"]), float(o["y"])) for o in p.get("observations", [])
+               if o.get("px") is not None]
+        control.append(ControlInput(p["name"], adj, np.array([sxy, sxy, sz]), given, obs))
+    priors = []
+    cams = [c for c in residuals.get("cameras", []) if c.get("used", True)]
+    if cams:
+        sig: Dict[str, Tuple[float, float]] = {}
+        if params.get("camera_positions"):
+            try:
+                from .gcp import read_camera_positions
+
+                _, cps = read_camera_positions(params["camera_positions"])
+                sig = {c.image: (c.sigma_xy, c.sigma_z) for c in cps}
+            except (OSError, ValueError):
+                sig = {}
+            default = (5.0, 10.0)
+        else:
+            default = (EXIF_SIGMA_XY, EXIF_SIGMA_Z)
+        for c in cams:
+            z = c.get("z")
+            sxy, sz = sig.get(c["image"], default)
+            xyz = np.array([c["x"], c["y"], np.nan if z is None else z], dtype=float) - offset
+            priors.append(CameraPrior(c["image"], xyz, np.array([sxy, sxy, sz], dtype=float)))
+    if refine == "all" or (isinstance(refine, (list, tuple)) and "principal_point" in refine):
+        pp = True
+    # intrinsics that stayed at their alignment values still get their precision in this block
+    free = default_free_intrinsics(rec, pp)
+    return control, priors, free, offset
+
+
+def write_layers(result: UncertaintyResult, folder: str, crs: Optional[str]) -> Dict[str, str]:
+    """cameras.gpkg and points.gpkg (standard deviations in metres / degrees) in ``folder``."""
+    from .vector import write_points_gpkg
+
+    os.makedirs(folder, exist_ok=True)
+    off = result.offset
+    cam_rows = [dict(c, x=c["x"] + off[0], y=c["y"] + off[1], z=c["z"] + off[2]) for c in result.cameras]
+    for r in cam_rows:
+        r["sxy"] = float(math.hypot(r["sx"], r["sy"]))
+    cam_fields = [("image", "str"), ("camera_id", "int"), ("sx", "float"), ("sy", "float"), ("sz", "float"),
+                  ("sxy", "float"), ("s_rx", "float"), ("s_ry", "float"), ("s_rz", "float")]
+    paths = {"cameras": write_points_gpkg(os.path.join(folder, "cameras.gpkg"), "camera_precision", cam_rows,
+                                          cam_fields, crs)}
+    xyz = result.point_xyz + off
+    std = result.point_std
+    ok = np.all(np.isfinite(std), axis=1)
+    rows = [{"point_id": int(pid), "x": float(p[0]), "y": float(p[1]), "z": float(p[2]), "sx": float(s[0]),
+             "sy": float(s[1]), "sz": float(s[2]), "sxy": float(math.hypot(s[0], s[1]))}
+            for pid, p, s in zip(result.point_ids[ok], xyz[ok], std[ok])]
+    pt_fields = [("point_id", "int"), ("sx", "float"), ("sy", "float"), ("sz", "float"), ("sxy", "float")]
+    paths["points"] = write_points_gpkg(os.path.join(folder, "points.gpkg"), "point_precision", rows, pt_fields,
+                                        crs)
+    return paths
+
+
+__all__ = ["CameraPrior", "ControlInput", "DATUM_CONTROL", "DATUM_FREE", "Observations", "UncertaintyError",
+           "UncertaintyResult", "collect_observations", "default_free_intrinsics", "estimate", "workspace_inputs",
+           "write_layers"]
