@@ -437,14 +437,14 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
     if options.fiducial_type not in FIDUCIAL_TYPES:
         raise ScanError(f"unknown fiducial type {options.fiducial_type!r}; choose one of {', '.join(FIDUCIAL_TYPES)}")
     ds = _open(path)
-    W, H = ds.RasterXSize, ds.RasterYSize
+    full_w, full_h = ds.RasterXSize, ds.RasterYSize
     try:
         small = read_image(path, max_size=options.detect_size)
     except RuntimeError as e:
         raise ImageError(f"{path}: image data cannot be read ({str(e).strip()})") from e
     g = to_grey(small)
     h, w = g.shape
-    kx, ky = W / w, H / h
+    kx, ky = full_w / w, full_h / h
     windows = _windows(h, w, LAYOUTS[options.layout])
     kinds = MARK_KINDS if options.fiducial_type == "auto" else (options.fiducial_type,)
 
@@ -514,7 +514,7 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
         search = 2.0 * max(kx, ky) + 3.0 * red
         half = int(math.ceil(0.8 * size_full + search + 0.8 * max(tpl_full.shape) * red + 8))
         x0, y0 = max(0, int(fx) - half), max(0, int(fy) - half)
-        x1, y1 = min(W, int(fx) + half + 1), min(H, int(fy) + half + 1)
+        x1, y1 = min(full_w, int(fx) + half + 1), min(full_h, int(fy) + half + 1)
         if x1 - x0 < 8 or y1 - y0 < 8:
             continue
         gw = _grey_window(ds, x0, y0, x1 - x0, y1 - y0)

@@ -23,6 +23,7 @@ class ArchaeoOrthoProvider(QgsProcessingProvider):
         from .align_images import AlignImagesAlgorithm
         from .build_dsm import BuildDsmAlgorithm
         from .georeference import GeoreferenceAlgorithm
+        from .prepare_images import PrepareImagesAlgorithm
 
-        for alg in (AlignImagesAlgorithm(), GeoreferenceAlgorithm(), BuildDsmAlgorithm()):
+        for alg in (AlignImagesAlgorithm(), GeoreferenceAlgorithm(), BuildDsmAlgorithm(), PrepareImagesAlgorithm()):
             self.addAlgorithm(alg)

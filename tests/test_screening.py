@@ -171,3 +171,52 @@ def test_cancel_leaves_no_complete_looking_output(tmp_path):
     assert not os.path.exists(tmp_path / "ws" / "screening.json")
     manifest = json.load(open(tmp_path / "ws" / "workspace.json"))
     assert manifest["stages"]["prepare"]["status"] == "cancelled"
+
+
+# ---------------------------------------------------------------------------
+# the Processing algorithm, as QGIS runs it (pytest-qgis)
+# ---------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def plugin(qgis_iface, qgis_processing):
+    import archaeoortho
+
+    p = archaeoortho.classFactory(qgis_iface)
+    p.initProcessing()
+    yield p
+    p.unload()
+
+
+def test_processing_prepare_images(plugin, toledo_with_bad_copies, tmp_path):
+    from qgis import processing
+    from qgis.core import QgsApplication, QgsProcessingFeedback
+
+    alg = QgsApplication.processingRegistry().algorithmById("archaeoortho:prepareimages")
+    assert alg is not None and alg.shortHelpString()
+    names = {p.name() for p in alg.parameterDefinitions()}
+    assert {"IMAGES", "WORKSPACE", "BLUR_THRESHOLD", "EXCLUDE_FLAGGED", "SCANNED_FILM", "FIDUCIAL_COORDINATES",
+            "FOCAL_LENGTH_MM", "OUTPUT"} <= names
+    assert {"WORKSPACE", "PREPARED_IMAGES", "FLAGGED"} <= {o.name() for o in alg.outputDefinitions()}
+
+    feedback = QgsProcessingFeedback()
+    progress = []
+    feedback.progressChanged.connect(progress.append)
+    res = processing.run("archaeoortho:prepareimages", {
+        "IMAGES": toledo_with_bad_copies, "WORKSPACE": str(tmp_path / "ws"), "EXCLUDE_FLAGGED": True,
+        "OUTPUT": str(tmp_path / "prepared"),
+    }, feedback=feedback)
+    assert res["FLAGGED"] == 4 and res["EXCLUDED"] == 4
+    assert res["PREPARED_IMAGES"] == str(tmp_path / "prepared")
+    kept = [n for n in os.listdir(res["PREPARED_IMAGES"]) if not n.startswith(".")]
+    assert len(kept) == 18 and not any(n.startswith(("blur_", "overexposed")) for n in kept)
+    assert os.path.isfile(os.path.join(res["WORKSPACE"], "screening.json"))
+    assert progress and max(progress) == pytest.approx(100.0)
+
+    # bad input is a clear QgsProcessingException naming the problem
+    from qgis.core import QgsProcessingException
+
+    with pytest.raises(QgsProcessingException, match="did not write"):
+        (tmp_path / "busy").mkdir()
+        (tmp_path / "busy" / "notes.txt").write_text("mine")
+        processing.run("archaeoortho:prepareimages", {
+            "IMAGES": toledo_with_bad_copies, "WORKSPACE": str(tmp_path / "ws"), "OUTPUT": str(tmp_path / "busy")})

@@ -1,0 +1,153 @@
+"""Prepare images: thin adapter over core.screening.prepare_images_workspace (and core.scans)."""
+from qgis.core import (
+    QgsProcessingOutputFile,
+    QgsProcessingOutputFolder,
+    QgsProcessingOutputNumber,
+    QgsProcessingParameterBoolean,
+    QgsProcessingParameterDefinition,
+    QgsProcessingParameterEnum,
+    QgsProcessingParameterFile,
+    QgsProcessingParameterFolderDestination,
+    QgsProcessingParameterNumber,
+    QgsProcessingParameterString,
+)
+
+from .base import AlgorithmBase, FeedbackProgress
+
+FIDUCIAL_TYPES = ["auto", "cross", "dot", "ring_dot", "cross_ring"]
+FIDUCIAL_LAYOUTS = ["auto", "corners", "sides", "eight"]
+
+
+class PrepareImagesAlgorithm(AlgorithmBase):
+    NAME = "prepareimages"
+    DISPLAY = "Prepare images"
+    IMAGES = "IMAGES"
+    WORKSPACE = "WORKSPACE"
+    OUTPUT = "OUTPUT"
+    BLUR_THRESHOLD = "BLUR_THRESHOLD"
+    BLUR_RELATIVE = "BLUR_RELATIVE"
+    EXCLUDE_FLAGGED = "EXCLUDE_FLAGGED"
+    SCANNED_FILM = "SCANNED_FILM"
+    FIDUCIAL_COORDINATES = "FIDUCIAL_COORDINATES"
+    FOCAL_LENGTH_MM = "FOCAL_LENGTH_MM"
+    FIDUCIAL_TYPE = "FIDUCIAL_TYPE"
+    FIDUCIAL_LAYOUT = "FIDUCIAL_LAYOUT"
+    FIDUCIAL_TEMPLATE = "FIDUCIAL_TEMPLATE"
+    SCAN_DPI = "SCAN_DPI"
+    PREPARED_IMAGES = "PREPARED_IMAGES"
+    FLAGGED = "FLAGGED"
+    EXCLUDED = "EXCLUDED"
+    SCREENING = "SCREENING"
+    HELP = (
+        "Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the "
+        "fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared "
+        "images for 'Align images', and the WORKSPACE, which records a decision per image (screening.json) "
+        "for the accuracy report.\n\n"
+        "Blur score: variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of "
+        "tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is "
+        "flagged 'blurry' below BLUR_RELATIVE x the median of the set, or below BLUR_THRESHOLD when that is "
+        "set (absolute scores depend on the scene: sand scores far lower than roofs).\n"
+        "Exposure: images with more than 5 % clipped highlights or shadows, a mean brightness far from the "
+        "set's, or a very small dynamic range are flagged. EXCLUDE_FLAGGED leaves flagged images out of the "
+        "prepared folder; otherwise they are kept and only reported.\n\n"
+        "SCANNED_FILM: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side "
+        "middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is "
+        "resampled by an affine transform into the common fiducial frame, all with the same size and the "
+        "principal point at the centre, and masks (workspace/masks) hide the film border, data strips and "
+        "the marks from matching. FIDUCIAL_COORDINATES: the calibration certificate's fiducial coordinates "
+        "in mm, as a file or pasted text, one 'id x y' line per mark (x right, y up), optionally 'PP x y' "
+        "(principal point) and 'focal f'. Without them the mean layout of the set is used, centred on the "
+        "fiducial centre. With FOCAL_LENGTH_MM (or 'focal' in the certificate) the prepared images carry "
+        "the focal length in pixels for the alignment."
+    )
+
+    def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
+        self.addParameter(QgsProcessingParameterFile(
+            self.IMAGES, self.tr("Folder of images"), behavior=QgsProcessingParameterFile.Folder))
+        self.addParameter(QgsProcessingParameterFolderDestination(self.WORKSPACE, self.tr("Workspace folder")))
+        self.addParameter(QgsProcessingParameterNumber(
+            self.BLUR_THRESHOLD, self.tr("Smallest blur score (0 = only relative to the set)"),
+            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
+        self.addParameter(QgsProcessingParameterBoolean(
+            self.EXCLUDE_FLAGGED, self.tr("Leave flagged images out of the prepared folder"), defaultValue=False))
+        self.addParameter(QgsProcessingParameterBoolean(
+            self.SCANNED_FILM, self.tr("Scanned film: fiducial marks, common frame, masks"), defaultValue=False))
+        self.addParameter(QgsProcessingParameterString(
+            self.FIDUCIAL_COORDINATES, self.tr("Calibrated fiducial coordinates in mm (file path or text)"),
+            multiLine=True, optional=True))
+        self.addParameter(QgsProcessingParameterNumber(
+            self.FOCAL_LENGTH_MM, self.tr("Calibrated focal length in mm (0 = unknown)"),
+            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
+        advanced = [
+            QgsProcessingParameterNumber(
+                self.BLUR_RELATIVE, self.tr("Flag images below this fraction of the set's median blur score"),
+                type=QgsProcessingParameterNumber.Double, defaultValue=0.4, minValue=0.0, maxValue=1.0),
+            QgsProcessingParameterEnum(
+                self.FIDUCIAL_TYPE, self.tr("Fiducial mark type"), options=FIDUCIAL_TYPES, defaultValue=0),
+            QgsProcessingParameterEnum(
+                self.FIDUCIAL_LAYOUT, self.tr("Fiducial positions"), options=FIDUCIAL_LAYOUTS, defaultValue=0),
+            QgsProcessingParameterFile(
+                self.FIDUCIAL_TEMPLATE, self.tr("Template image of one fiducial mark"), optional=True),
+            QgsProcessingParameterNumber(
+                self.SCAN_DPI, self.tr("Scan resolution in dpi when not in the files (0 = from the files)"),
+                type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0),
+        ]
+        for p in advanced:
+            p.setFlags(p.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
+            self.addParameter(p)
+        self.addParameter(QgsProcessingParameterFolderDestination(self.OUTPUT, self.tr("Prepared images")))
+        self.addOutput(QgsProcessingOutputFolder(self.PREPARED_IMAGES, self.tr("Folder of prepared images")))
+        self.addOutput(QgsProcessingOutputNumber(self.FLAGGED, self.tr("Flagged images")))
+        self.addOutput(QgsProcessingOutputNumber(self.EXCLUDED, self.tr("Excluded images")))
+        self.addOutput(QgsProcessingOutputFile(self.SCREENING, self.tr("Screening record (JSON)")))
+
+    def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
+        from ..core import screening
+        from ..core.scans import ScanOptions
+
+        images = self.parameterAsFile(parameters, self.IMAGES, context)
+        workspace = self.parameterAsString(parameters, self.WORKSPACE, context)
+        output = self.parameterAsString(parameters, self.OUTPUT, context)
+        dpi = self.parameterAsDouble(parameters, self.SCAN_DPI, context)
+        scanned = self.parameterAsBoolean(parameters, self.SCANNED_FILM, context)
+        options = screening.PrepareOptions(
+            screening=screening.ScreeningOptions(
+                blur_threshold=self.parameterAsDouble(parameters, self.BLUR_THRESHOLD, context),
+                blur_relative=self.parameterAsDouble(parameters, self.BLUR_RELATIVE, context),
+                exclude_flagged=self.parameterAsBoolean(parameters, self.EXCLUDE_FLAGGED, context),
+            ),
+            scanned_film=scanned,
+            scan=ScanOptions(
+                fiducial_type=FIDUCIAL_TYPES[self.parameterAsEnum(parameters, self.FIDUCIAL_TYPE, context)],
+                layout=FIDUCIAL_LAYOUTS[self.parameterAsEnum(parameters, self.FIDUCIAL_LAYOUT, context)],
+                template_path=self.parameterAsFile(parameters, self.FIDUCIAL_TEMPLATE, context) or None,
+                fiducial_coordinates=(self.parameterAsString(parameters, self.FIDUCIAL_COORDINATES, context)
+                                      or "").strip() or None,
+                focal_length_mm=self.parameterAsDouble(parameters, self.FOCAL_LENGTH_MM, context) or None,
+                scan_pixel_size_mm=(25.4 / dpi) if dpi > 0 else None,
+            ) if scanned else None,
+        )
+        result = self.run_core(screening.prepare_images_workspace, images, workspace, output or None, options,
+                               FeedbackProgress(feedback))
+        for w in result.warnings:
+            feedback.pushWarning(w)
+        feedback.pushInfo(self.tr("{} images: {} flagged, {} excluded, {} in the prepared folder").format(
+            len(result.images), result.flagged, result.excluded, result.kept))
+        feedback.pushInfo(self.tr("Blurriest first (blur score, % of the set's median):"))
+        for q in sorted(result.images, key=lambda q: q.blur_rank)[:10]:
+            flags = ", ".join(q.flags) if q.flags else "ok"
+            feedback.pushInfo(f"  {q.blur_rank:3d}. {q.name}: {q.blur_score:.1f} ({100 * q.blur_relative:.0f} %) "
+                              f"{flags} -> {q.decision}")
+        io = result.interior_orientation
+        if io:
+            focal = f", focal {io['focal_px']:.2f} px" if io.get("focal_px") else ""
+            feedback.pushInfo(self.tr("Prepared scans: {} x {} px, pixel size {:.6g} {}{}").format(
+                io["width"], io["height"], io["pixel_size"], io["frame_units"], focal))
+        return {
+            self.WORKSPACE: result.workspace,
+            self.OUTPUT: result.prepared_dir,
+            self.PREPARED_IMAGES: result.prepared_dir,
+            self.FLAGGED: result.flagged,
+            self.EXCLUDED: result.excluded,
+            self.SCREENING: result.screening_path,
+        }
