@@ -30,6 +30,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass, field, replace
+from functools import lru_cache
 from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import cv2
@@ -412,64 +413,74 @@ def _sample(raster: np.ndarray, mx: np.ndarray, my: np.ndarray, interpolation=cv
 
 
 def _ray_cast(scene: Scene, centre: np.ndarray, dirs: np.ndarray, step: float = 0.4,
-              bisections: int = 9) -> np.ndarray:
+              bisections: int = 6) -> np.ndarray:
     """First intersection (..., 3) of rays centre + t * dirs (pointing down) with the surface.
 
     Each ray starts at a safe height (the highest surface within its horizontal travel, from a
     max-pooled coarse raster), marches down in ``step`` metres until it is below the surface (only the
-    rays still above it are evaluated), then bisects (``step`` / 2^bisections)."""
+    rays still above it are evaluated), bisects the last step and ends with a secant step."""
     hr = scene.height_raster()
     zmax, zmin = float(hr.max()) + 0.01, float(hr.min()) - 0.01
     shape = dirs.shape[:-1]
-    d = dirs.reshape(-1, 3).astype(np.float64)
-    if np.any(d[:, 2] >= -1e-6):
+    d = np.asarray(dirs, dtype=np.float64)
+    if np.any(d[..., 2] >= -1e-6):
         raise ValueError("a ray points upward: the camera sees the horizon")
-    sx = (d[:, 0] / d[:, 2]).astype(np.float32)  # dx/dz, dy/dz
-    sy = (d[:, 1] / d[:, 2]).astype(np.float32)
-    cx, cy, cz = (float(v) for v in centre)
     res = scene.height_res
+    xmin, _, _, ymax = scene.bounds
+    cx, cy, cz = (float(v) for v in centre)
+    # raster coordinates along a ray: col = ax + dz * bx, row = ay - dz * by with dz = z - cz
+    bx = (d[..., 0] / d[..., 2] / res).astype(np.float32)
+    by = (d[..., 1] / d[..., 2] / res).astype(np.float32)
+    ax = np.float32((cx - xmin) / res - 0.5)
+    ay = np.float32((ymax - cy) / res - 0.5)
 
-    def surface(z, idx):
-        x = cx + (z - cz) * sx[idx]
-        y = cy + (z - cz) * sy[idx]
-        xmin, _, _, ymax = scene.bounds
-        return _sample(hr, (x - xmin) / res - 0.5, (ymax - y) / res - 0.5)
+    def gap(dz, bx_, by_):  # ray height minus surface height (> 0: above the surface)
+        if dz.ndim == 2:
+            h = cv2.remap(hr, ax + dz * bx_, ay - dz * by_, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+        else:
+            h = _sample(hr, ax + dz * bx_, ay - dz * by_)
+        return dz + np.float32(cz) - h
 
     # safe start: max of the surface within the ray's horizontal travel over [zmin, zmax]
-    travel = (zmax - zmin) * float(np.max(np.hypot(sx, sy))) + 1.0
-    cell = 1.0
-    k = max(1, int(round(cell / res)))
+    travel = (zmax - zmin) * float(np.max(np.hypot(bx, by))) * res + 1.0
+    k = max(1, int(round(1.0 / res)))  # 1 m cells
     ny, nx = hr.shape[0] // k * k, hr.shape[1] // k * k
     coarse = hr[:ny, :nx].reshape(ny // k, k, nx // k, k).max(axis=(1, 3))
     coarse = np.pad(coarse, ((0, 1), (0, 1)), mode="edge")
     r = int(math.ceil(travel / (k * res))) + 1
     pooled = cv2.dilate(coarse, np.ones((2 * r + 1, 2 * r + 1), np.uint8), borderType=cv2.BORDER_REPLICATE)
-    zmid = 0.5 * (zmax + zmin)
-    xmin, _, _, ymax = scene.bounds
-    xm = cx + (zmid - cz) * sx
-    ym = cy + (zmid - cz) * sy
-    start = _sample(pooled, (xm - xmin) / (k * res) - 0.5, (ymax - ym) / (k * res) - 0.5, cv2.INTER_NEAREST)
-    hi = np.minimum(start.astype(np.float64) + 0.01, zmax)
-    lo = np.full(hi.shape, zmin)
-    active = np.arange(len(hi))
-    z = hi.copy()
-    while len(active):
-        zn = np.maximum(z[active] - step, zmin)
-        below = zn <= surface(zn, active)
-        done = below | (zn <= zmin)
-        idx = active[done]
-        lo[idx] = zn[done]
-        hi[idx] = z[idx]
-        z[active] = zn
-        active = active[~done]
+    dzmid = np.float32(0.5 * (zmax + zmin) - cz)
+    start = cv2.remap(pooled, (ax + dzmid * bx + 0.5) / k - 0.5, (ay - dzmid * by + 0.5) / k - 0.5,
+                      cv2.INTER_NEAREST, borderMode=cv2.BORDER_REPLICATE)
+    dz_top, dz_bottom = np.float32(zmax - cz), np.float32(zmin - cz)
+    hi = np.minimum(start.reshape(-1) - np.float32(cz) + np.float32(0.01), dz_top)  # dz above the surface
+    lo = np.full(hi.shape, dz_bottom, dtype=np.float32)
+    f_hi = np.full(hi.shape, 1.0, dtype=np.float32)
+    f_lo = np.full(hi.shape, -1.0, dtype=np.float32)
+    bxf, byf = bx.reshape(-1), by.reshape(-1)
+    idx = np.arange(hi.size)
+    z, fz, bxa, bya = hi.copy(), f_hi.copy(), bxf, byf
+    while idx.size:
+        zn = np.maximum(z - np.float32(step), dz_bottom)
+        fn = gap(zn, bxa, bya)
+        done = (fn <= 0) | (zn <= dz_bottom)
+        di = idx[done]
+        lo[di], f_lo[di] = zn[done], fn[done]
+        hi[di], f_hi[di] = z[done], fz[done]
+        keep = ~done
+        idx, z, fz, bxa, bya = idx[keep], zn[keep], fn[keep], bxa[keep], bya[keep]
+    lo, hi, f_lo, f_hi = (a.reshape(shape) for a in (lo, hi, f_lo, f_hi))
     for _ in range(bisections):
         mid = 0.5 * (lo + hi)
-        a = mid > surface(mid, slice(None))
-        hi = np.where(a, mid, hi)
-        lo = np.where(a, lo, mid)
-    zf = 0.5 * (lo + hi)
-    out = np.stack([cx + (zf - cz) * sx, cy + (zf - cz) * sy, zf], axis=-1)
-    return out.reshape(shape + (3,))
+        fm = gap(mid, bx, by)
+        above = fm > 0
+        hi, f_hi = np.where(above, mid, hi), np.where(above, fm, f_hi)
+        lo, f_lo = np.where(above, lo, mid), np.where(above, f_lo, fm)
+    denom = f_hi - f_lo
+    w = np.where(denom > 1e-6, -f_lo / np.maximum(denom, 1e-6), 0.5)
+    dz = (lo + np.clip(w, 0.0, 1.0) * (hi - lo)).astype(np.float64)
+    t = dz / d[..., 2]
+    return np.stack([cx + t * d[..., 0], cy + t * d[..., 1], cz + dz], axis=-1)
 
 
 def _surface_value(scene: Scene, xyz: np.ndarray) -> np.ndarray:
@@ -479,24 +490,29 @@ def _surface_value(scene: Scene, xyz: np.ndarray) -> np.ndarray:
     mx, my = scene.raster_coords(x, y, scene.texture_res)
     val = _sample(tex, mx, my)
     for b in scene.buildings:
-        u, v = b.local_uv(x, y)
-        on_wall = ((np.abs(np.abs(u) - b.half_w) < 0.08) & (np.abs(v) <= b.half_l + 0.08)
-                   | (np.abs(np.abs(v) - b.half_l) < 0.08) & (np.abs(u) <= b.half_w + 0.08)) & (z < b.roof - 0.03)
+        rad = math.hypot(b.half_w, b.half_l) + 0.1
+        near = (np.abs(x - b.cx) < rad) & (np.abs(y - b.cy) < rad) & (z < b.roof - 0.03)
+        if not np.any(near):
+            continue
+        xs, ys, zs = x[near], y[near], z[near]
+        u, v = b.local_uv(xs, ys)
+        on_u = np.abs(np.abs(u) - b.half_w) < 0.08
+        on_wall = ((on_u & (np.abs(v) <= b.half_l + 0.08))
+                   | ((np.abs(np.abs(v) - b.half_l) < 0.08) & (np.abs(u) <= b.half_w + 0.08)))
         if np.any(on_wall):
-            along = np.where(np.abs(np.abs(u) - b.half_w) < 0.08, v, u)
-            wx, wy = scene.raster_coords(b.cx + along[on_wall] * 0.7, b.cy + (z[on_wall] - b.roof) * 0.7,
-                                         scene.texture_res)
-            wall = _sample(tex, wx, wy)
-            val[on_wall] = (0.55 * wall.ravel() + 0.1 * ((np.floor(z[on_wall] * 2.0) % 2) - 0.5)).ravel()
+            along = np.where(on_u, v, u)[on_wall]
+            zw = zs[on_wall]
+            wx, wy = scene.raster_coords(b.cx + along * 0.7, b.cy + (zw - b.roof) * 0.7, scene.texture_res)
+            sub = val[near]
+            sub[on_wall] = 0.55 * _sample(tex, wx, wy) + 0.1 * ((np.floor(zw * 2.0) % 2) - 0.5)
+            val[near] = sub
     return val
 
 
-def render_image(scene: Scene, camera: CameraModel, shot: Shot, supersample: int = 2, noise: float = 1.5,
-                 seed: int = 0) -> np.ndarray:
-    """Grey uint8 image (height, width) of ``shot``: ray-cast undistorted canvas, then distortion by remap."""
+@lru_cache(maxsize=4)
+def _canvas_geometry(camera: CameraModel, s: int):
+    """Per camera model: rays of the undistorted canvas and the remap from it to the distorted image."""
     w, h = camera.width, camera.height
-    s = int(supersample)
-    # distorted output pixel centres -> undistorted normalised coordinates
     jj, ii = np.meshgrid(np.arange(w, dtype=float) + 0.5, np.arange(h, dtype=float) + 0.5)
     xu = camera.undistort(camera.normalized_from_pixel(np.stack([jj, ii], axis=-1)))
     pad = 3.0 / (camera.fx * s)
@@ -505,19 +521,29 @@ def render_image(scene: Scene, camera: CameraModel, shot: Shot, supersample: int
     du, dv = 1.0 / (camera.fx * s), 1.0 / (camera.fy * s)  # canvas pixel size in normalised units
     cw, ch = int(math.ceil((ux1 - ux0) / du)), int(math.ceil((uy1 - uy0) / dv))
     cu, cv_ = np.meshgrid(ux0 + (np.arange(cw) + 0.5) * du, uy0 + (np.arange(ch) + 0.5) * dv)
-    dirs = shot.rays(np.stack([cu, cv_], axis=-1))
-    del cu, cv_
-    xyz = _ray_cast(scene, shot.centre, dirs)
-    canvas = _surface_value(scene, xyz).astype(np.float32)
-    del xyz, dirs
-    canvas = cv2.GaussianBlur(canvas, (0, 0), 0.45 * s)  # optics + anti-aliasing before resampling
+    canvas_xn = np.stack([cu, cv_], axis=-1)
     map_x = ((xu[..., 0] - ux0) / du - 0.5).astype(np.float32)
     map_y = ((xu[..., 1] - uy0) / dv - 0.5).astype(np.float32)
-    img = cv2.remap(canvas, map_x, map_y, cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE)
-    # a little vignetting and sensor noise
     r2 = ((jj - w / 2) ** 2 + (ii - h / 2) ** 2) / (0.25 * (w * w + h * h))
-    img = img * (1.0 - 0.12 * r2) * 255.0
-    img += np.random.default_rng(seed).normal(0.0, noise, img.shape)
+    vignetting = (1.0 - 0.12 * r2).astype(np.float32)
+    return canvas_xn, map_x, map_y, vignetting
+
+
+def render_image(scene: Scene, camera: CameraModel, shot: Shot, supersample: int = 2, noise: float = 1.5,
+                 seed: int = 0) -> np.ndarray:
+    """Grey uint8 image (height, width) of ``shot``: the undistorted canvas (``supersample`` x the pixel
+    density) is ray-cast into the height field, blurred a little (optics, anti-aliasing), and the lens
+    distortion is applied with cv2.remap: each distorted pixel takes the canvas value at its undistorted
+    position.  Vignetting and sensor noise added."""
+    s = int(supersample)
+    canvas_xn, map_x, map_y, vignetting = _canvas_geometry(camera, s)
+    xyz = _ray_cast(scene, shot.centre, shot.rays(canvas_xn))
+    canvas = _surface_value(scene, xyz).astype(np.float32)
+    del xyz
+    canvas = cv2.GaussianBlur(canvas, (0, 0), 0.45 * s)
+    img = cv2.remap(canvas, map_x, map_y, cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE)
+    img = img * vignetting * 255.0
+    img += np.random.default_rng(seed).normal(0.0, noise, img.shape).astype(np.float32)
     return np.clip(np.round(img), 0, 255).astype(np.uint8)
 
 
@@ -828,6 +854,19 @@ def dome(amplitude: float, centre_xy: Sequence[float], radius: float) -> Callabl
         return xyz
 
     return f
+
+
+def similarity_fit(src: np.ndarray, dst: np.ndarray) -> Tuple[float, np.ndarray, np.ndarray]:
+    """Least-squares similarity dst ~ s * R @ src + t (Umeyama), independent of core.georef."""
+    src = np.asarray(src, dtype=float)
+    dst = np.asarray(dst, dtype=float)
+    ms, md = src.mean(axis=0), dst.mean(axis=0)
+    a, b = src - ms, dst - md
+    u, sv, vt = np.linalg.svd(b.T @ a / len(src))
+    d = np.diag([1.0, 1.0, np.sign(np.linalg.det(u @ vt))])
+    r = u @ d @ vt
+    sc = float(np.trace(np.diag(sv) @ d) / np.mean(np.sum(a * a, axis=1)))
+    return sc, r, md - sc * r @ ms
 
 
 # --------------------------------------------------------------------------------------------------
