@@ -8,7 +8,14 @@ PLUGIN_DIR = os.path.dirname(__file__)
 
 
 def _locale() -> str:
-    value = QSettings().value("locale/userLocale", "") or QLocale.system().name()
+    """The two-letter language QGIS runs in: its override setting, else the system's."""
+    value = ""
+    try:
+        value = QgsApplication.locale()
+    except Exception:  # noqa: BLE001 - no QgsApplication yet
+        value = ""
+    if not value:
+        value = QSettings().value("locale/userLocale", "") or QLocale.system().name()
     return str(value)[:2]
 
 
@@ -19,7 +26,12 @@ class ArchaeoOrthoPlugin:
         self.iface = iface
         self.provider = None
         self.translator = None
+        self.action = None
+        self.dock = None
         self._install_translator()
+
+    def tr(self, text):
+        return QCoreApplication.translate("ArchaeoOrthoPlugin", text)
 
     def _install_translator(self):
         qm = os.path.join(PLUGIN_DIR, "i18n", f"archaeoortho_{_locale()}.qm")
@@ -27,6 +39,8 @@ class ArchaeoOrthoPlugin:
             self.translator = QTranslator()
             if self.translator.load(qm):
                 QCoreApplication.installTranslator(self.translator)
+            else:
+                self.translator = None
 
     def initProcessing(self):  # noqa: N802 (QGIS API name)
         if self.provider is not None:
@@ -38,8 +52,61 @@ class ArchaeoOrthoPlugin:
 
     def initGui(self):  # noqa: N802 (QGIS API name)
         self.initProcessing()
+        if self.iface is None:
+            return
+        from qgis.PyQt.QtGui import QIcon
+        from qgis.PyQt.QtWidgets import QAction
+
+        self.action = QAction(QIcon(os.path.join(PLUGIN_DIR, "icon.svg")), self.tr("Ground control (GCP dock)"),
+                              self.iface.mainWindow())
+        self.action.setObjectName("ArchaeoOrthoGcpAction")
+        self.action.setCheckable(True)
+        self.action.setToolTip(self.tr("ArchaeoOrtho: pick ground control points on the map and in the photos"))
+        self.action.toggled.connect(self.show_dock)
+        self.iface.addPluginToRasterMenu(self.tr("&ArchaeoOrtho"), self.action)
+        self.iface.addRasterToolBarIcon(self.action)
+
+    def show_dock(self, visible=True):
+        """Create the GCP dock (and its photo dock) on first use and show or hide both."""
+        if self.iface is None:
+            return None
+        if self.dock is None:
+            if not visible:
+                return None
+            from qgis.PyQt.QtCore import Qt
+
+            from .ui.gcp_dock import GcpDock
+
+            self.dock = GcpDock(self.iface, parent=self.iface.mainWindow())
+            self.iface.addDockWidget(Qt.RightDockWidgetArea, self.dock)
+            self.iface.addDockWidget(Qt.BottomDockWidgetArea, self.dock.photo_dock)
+            self.dock.visibilityChanged.connect(self._dock_visibility)
+        self.dock.setUserVisible(visible)
+        self.dock.photo_dock.setUserVisible(visible)
+        if self.action is not None and self.action.isChecked() != visible:
+            self.action.setChecked(visible)
+        return self.dock
+
+    def _dock_visibility(self, visible):
+        if self.action is not None and not visible and self.dock is not None and not self.dock.isUserVisible():
+            self.action.blockSignals(True)
+            self.action.setChecked(False)
+            self.action.blockSignals(False)
 
     def unload(self):
+        if self.dock is not None:
+            self.dock.cleanup()
+            if self.iface is not None:
+                self.iface.removeDockWidget(self.dock)
+                self.iface.removeDockWidget(self.dock.photo_dock)
+            self.dock.photo_dock.deleteLater()
+            self.dock.deleteLater()
+            self.dock = None
+        if self.action is not None and self.iface is not None:
+            self.iface.removePluginRasterMenu(self.tr("&ArchaeoOrtho"), self.action)
+            self.iface.removeRasterToolBarIcon(self.action)
+            self.action.deleteLater()
+            self.action = None
         if self.provider is not None:
             QgsApplication.processingRegistry().removeProvider(self.provider)
             self.provider = None

@@ -50,7 +50,8 @@ def table(rows, title):
 def copr_second_alignment(ws):
     """An independent alignment (SIMPLE_RADIAL camera, 2048 features, principal point fixed): if the
     block were bent by metres, the two blocks would disagree; the targets' misfits would change."""
-    if not Workspace.open(ws).stage_done("align") if os.path.exists(os.path.join(ws, "workspace.json")) else True:
+    done = os.path.exists(os.path.join(ws, "workspace.json")) and Workspace.open(ws).stage_done("align")
+    if not done:
         sfm.align(os.path.join(DATA, "copr", "images"), ws,
                   sfm.AlignOptions(camera_model="SIMPLE_RADIAL", max_features=2048, refine_principal_point=False))
     print("\nsecond, independent alignment (SIMPLE_RADIAL, 2048 features):")

@@ -524,12 +524,15 @@ class _Report:
         err = o.error
         fin = err[np.isfinite(err)]
         mean_img, n_img = d.per_image_error()
-        mre = float(np.mean(fin)) if len(fin) else None
+        d.rec.update_point_3d_errors()
+        mre = _num(d.rec.compute_mean_reprojection_error()) if len(fin) else None
         self.figures["MEAN_REPROJECTION_ERROR"] = mre
         parts = [_kv([
-            ("Reprojection error: mean / median / RMS",
-             f'<span data-key="reproj.mean">{_f(mre, 3)}</span> / {_f(np.median(fin) if len(fin) else None, 3)} / '
-             f'{_f(accuracy.rmse(fin), 3)} px'),
+            ("Mean reprojection error (mean over tie points of their mean error, as COLMAP reports it)",
+             f'<span data-key="reproj.mean">{_f(mre, 3)}</span> px'),
+            ("Reprojection error of the observations: mean / median / RMS",
+             f'<span data-key="reproj.obs_mean">{_f(np.mean(fin) if len(fin) else None, 3)}</span> / '
+             f'{_f(np.median(fin) if len(fin) else None, 3)} / {_f(accuracy.rmse(fin), 3)} px'),
             ("Largest reprojection error", f"{_f(fin.max() if len(fin) else None, 2)} px"),
             ("Track length: mean / median / max",
              f"{_f(np.mean(o.track_length), 2)} / {_f(np.median(o.track_length), 0)} / {int(o.track_length.max())}"
@@ -1017,8 +1020,9 @@ class _Report:
         if ok.any():
             h = np.hypot(ps[ok, 0], ps[ok, 1])
             z = ps[ok, 2]
-            fig = _figure(10.0, 4.2)
-            ax = fig.add_subplot(131)
+            fig = _figure(11.0, 4.2)
+            gs = fig.add_gridspec(1, 3, wspace=0.45)
+            ax = fig.add_subplot(gs[0, 0])
             hi = float(np.percentile(np.concatenate([h, z]), 99))
             ax.hist(np.clip(h, 0, hi), bins=40, alpha=0.7, label="σXY", color="#4477aa")
             ax.hist(np.clip(z, 0, hi), bins=40, alpha=0.6, label="σZ", color="#e69f00")
@@ -1026,7 +1030,7 @@ class _Report:
             ax.set_ylabel("tie points", fontsize=8)
             ax.legend(fontsize=7)
             ax.tick_params(labelsize=7)
-            ax2 = fig.add_subplot(1, 3, (2, 3))
+            ax2 = fig.add_subplot(gs[0, 1:])
             xyz = u.point_xyz[ok] + u.offset
             order = np.argsort(z)
             vmax = float(np.percentile(z, 95))
@@ -1197,8 +1201,7 @@ h3{font-size:15px;margin:22px 0 6px;color:#234}
 nav{font-size:13px;margin:8px 0 14px}nav a{margin-right:14px;color:#2a5d9f;text-decoration:none}
 .cards{display:grid;grid-template-columns:repeat(auto-fill,minmax(165px,1fr));gap:10px;margin:12px 0}
 .card{border:1px solid #d6dde6;border-radius:6px;padding:8px 10px;background:#f8fafc}
-.card .v{font-size:20px;font-weight:600;color:#1d3b5e}.card .l{font-size:11px;color:#555;text-transform:uppercase;
-letter-spacing:.03em}
+.card .v{font-size:20px;font-weight:600;color:#1d3b5e}.card .l{font-size:12px;color:#555}
 ul.glance{list-style:none;padding:0;margin:8px 0}ul.glance li{margin:3px 0;font-size:14px}
 .dot{display:inline-block;width:10px;height:10px;border-radius:50%;margin-right:8px;background:#999}
 li.ok .dot{background:#2e9e44}li.warn .dot{background:#e69f00}li.bad .dot{background:#c0392b}

@@ -408,6 +408,25 @@ def refine_symmetric(grey: np.ndarray, x: float, y: float, size: float, iteratio
     return x, y, converged
 
 
+def is_point_symmetric(img: np.ndarray, min_corr: float = 0.85) -> bool:
+    """True when an image (a mark's template) looks the same turned by 180 degrees about its centre."""
+    a = np.asarray(img, np.float64) - float(np.mean(img))
+    b = a[::-1, ::-1]
+    den = math.sqrt(float((a * a).sum()) * float((b * b).sum()))
+    return den > 0 and float((a * b).sum()) / den >= min_corr
+
+
+def _mark_fraction(template: np.ndarray) -> float:
+    """Extent of the mark in a template image as a fraction of the template's longer side."""
+    t = np.asarray(template, np.float32)
+    edge = np.concatenate([t[0], t[-1], t[:, 0], t[:, -1]])
+    dev = np.abs(t - float(np.median(edge)))
+    ys, xs = np.nonzero(dev > 0.5 * float(dev.max()))
+    if len(xs) == 0:
+        return 1.0
+    return float(min(1.0, (max(np.ptp(xs), np.ptp(ys)) + 1) / max(t.shape)))
+
+
 def _quadratic_peak(r: np.ndarray, i: int, j: int) -> Tuple[float, float]:
     """Sub-pixel offset of a correlation peak at (i, j) by separable parabola fits."""
     def off(a, b, c):
@@ -495,6 +514,8 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
     if not coarse:
         return [], warnings
     angle = _rotation_deg({k: (v[1], v[2]) for k, v in coarse.items()})
+    symmetric_template = template is not None and is_point_symmetric(template)
+    mark_frac = _mark_fraction(template) if template is not None else 1.0
 
     # fine: full-resolution correlation, then the centre of symmetry
     out: List[Fiducial] = []
@@ -503,16 +524,17 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
         size_full = s * 0.5 * (kx + ky)
         red = max(1.0, size_full / 96.0)  # correlate at most ~96 px marks; refine at full resolution
         if template is not None:
-            tpl_full = template
+            f = size_full / max(template.shape) / red  # the user's template at this scan's scale
+            t = cv2.resize(template, (max(5, int(round(template.shape[1] * f))), max(5, int(round(template.shape[0] * f)))),
+                           interpolation=cv2.INTER_AREA if f < 1 else cv2.INTER_CUBIC)
+            if abs(angle) > 0.3:
+                c = ((t.shape[1] - 1) / 2.0, (t.shape[0] - 1) / 2.0)
+                t = cv2.warpAffine(t, cv2.getRotationMatrix2D(c, -angle, 1.0), (t.shape[1], t.shape[0]),
+                                   borderMode=cv2.BORDER_REPLICATE)
         else:
-            tpl_full = render_mark(kind, size_full / red, angle)
-        if template is not None and abs(angle) > 0.3:
-            c = ((template.shape[1] - 1) / 2.0, (template.shape[0] - 1) / 2.0)
-            rot = cv2.getRotationMatrix2D(c, -angle, 1.0)
-            tpl_full = cv2.warpAffine(template, rot, (template.shape[1], template.shape[0]),
-                                      borderMode=cv2.BORDER_REPLICATE)
+            t = render_mark(kind, size_full / red, angle)
         search = 2.0 * max(kx, ky) + 3.0 * red
-        half = int(math.ceil(0.8 * size_full + search + 0.8 * max(tpl_full.shape) * red + 8))
+        half = int(math.ceil(0.8 * size_full + search + 0.8 * max(t.shape) * red + 8))
         x0, y0 = max(0, int(fx) - half), max(0, int(fy) - half)
         x1, y1 = min(full_w, int(fx) + half + 1), min(full_h, int(fy) + half + 1)
         if x1 - x0 < 8 or y1 - y0 < 8:
@@ -522,9 +544,6 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
                                                     max(8, int(round(gw.shape[0] / red)))),
                                               interpolation=cv2.INTER_AREA)
         sx_, sy_ = gw.shape[1] / gs.shape[1], gw.shape[0] / gs.shape[0]
-        t = tpl_full if template is None else (tpl_full if red == 1.0 else cv2.resize(
-            tpl_full, (max(5, int(round(tpl_full.shape[1] / red))), max(5, int(round(tpl_full.shape[0] / red)))),
-            interpolation=cv2.INTER_AREA))
         if gs.shape[0] <= t.shape[0] or gs.shape[1] <= t.shape[1]:
             continue
         r = cv2.matchTemplate(gs, t, cv2.TM_CCOEFF_NORMED) * pol
@@ -538,7 +557,9 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
         ox, oy = _quadratic_peak(r, i, j)
         px = ((j + ox + (t.shape[1] - 1) / 2.0) + 0.5) * sx_ - 0.5  # window pixel-centre coordinates
         py = ((i + oy + (t.shape[0] - 1) / 2.0) + 0.5) * sy_ - 0.5
-        if template is None:
+        if template is not None:
+            size_full *= mark_frac  # the mark itself, without the template's margin
+        if template is None or symmetric_template:
             qx, qy, ok = refine_symmetric(gw, px, py, size_full)
             if ok and math.hypot(qx - px, qy - py) <= max(2.0 * red, 0.25 * size_full):
                 px, py = qx, qy

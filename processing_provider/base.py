@@ -1,6 +1,36 @@
-"""Small in-house base class for the algorithms, and the QgsFeedback <-> Progress adapter."""
-from qgis.core import QgsProcessingAlgorithm, QgsProcessingException
+"""Small in-house base class for the algorithms, and the QgsFeedback <-> Progress adapter.
+
+Every algorithm's outputs are offered to the project as styled layers when the run loads layers (the
+toolbox dialog, processing.runAndLoadResults): see ``AlgorithmBase.register_styled_outputs``.  Under
+qgis_process (and QGIS Server) nothing of that runs.
+"""
+import functools
+
+from qgis.core import QgsApplication, QgsProcessingAlgorithm, QgsProcessingException
 from qgis.PyQt.QtCore import QCoreApplication
+
+HEADLESS_PLATFORMS = ("qgis_process", "server")
+
+
+def styling_enabled():
+    """True where loaded outputs get our styles: QGIS desktop and Python scripts, not qgis_process."""
+    try:
+        return QgsApplication.platform() not in HEADLESS_PLATFORMS
+    except Exception:  # noqa: BLE001 - no application object: nothing to load into
+        return False
+
+
+def _with_styled_outputs(process):
+    """Wrap a subclass's processAlgorithm: after it returns, register its layer outputs for styling."""
+
+    @functools.wraps(process)
+    def wrapper(self, parameters, context, feedback):
+        results = process(self, parameters, context, feedback)
+        self.register_styled_outputs(results, context, feedback)
+        return results
+
+    wrapper._archaeoortho_styled = True
+    return wrapper
 
 
 class FeedbackProgress:
@@ -45,6 +75,28 @@ class AlgorithmBase(QgsProcessingAlgorithm):
     HELP = ""
     GROUP_ID = "photogrammetry"
     GROUP = "Photogrammetry"
+    STYLE_OUTPUTS = True  # a subclass sets False to leave its outputs as QGIS loads them
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        process = cls.__dict__.get("processAlgorithm")
+        if process is not None and not getattr(process, "_archaeoortho_styled", False):
+            cls.processAlgorithm = _with_styled_outputs(process)
+
+    def register_styled_outputs(self, results, context, feedback=None):
+        """Post-processing hook: outputs that are ours (DSM, orthomosaic, cameras, residuals, point cloud)
+        are loaded on completion with their styles (ui/layers.py: qgis.core only).  Never under
+        qgis_process; a problem here is a warning, never a failed run."""
+        if not self.STYLE_OUTPUTS or not styling_enabled():
+            return 0
+        try:
+            from ..ui.layers import register_outputs
+
+            return register_outputs(self, results, context)
+        except Exception as e:  # noqa: BLE001 - styling must never fail an algorithm that worked
+            if feedback is not None:
+                feedback.pushInfo(QCoreApplication.translate("AlgorithmBase", "Outputs not styled: {}").format(e))
+            return 0
 
     def tr(self, text):
         return QCoreApplication.translate(type(self).__name__, text)

@@ -27,3 +27,6 @@ class ArchaeoOrthoProvider(QgsProcessingProvider):
 
         for alg in (AlignImagesAlgorithm(), GeoreferenceAlgorithm(), BuildDsmAlgorithm(), PrepareImagesAlgorithm()):
             self.addAlgorithm(alg)
+        from .accuracy_report import AccuracyReportAlgorithm
+
+        self.addAlgorithm(AccuracyReportAlgorithm())

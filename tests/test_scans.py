@@ -358,3 +358,20 @@ def test_too_few_marks_is_a_clear_error(tmp_path):
     img = os.path.join(SAMPLE, "images", TOLEDO_STRIP[0])  # a photo without any fiducial mark
     with pytest.raises(ScanError, match=TOLEDO_STRIP[0]):
         prepare_scans([img], str(tmp_path), str(tmp_path), ScanOptions(fiducial_type="ring_dot", min_score=0.8))
+
+
+def test_user_template_of_one_mark(synthetic_scans, tmp_path):
+    """A crop of one mark from one scan finds the marks of the others (other resolutions and rotations)."""
+    from core.scans import ScanOptions, detect_fiducials, load_template
+
+    folder, truth = synthetic_scans
+    img = cv2.imread(os.path.join(folder, "frame_001.tif"), cv2.IMREAD_GRAYSCALE)
+    x, y = (int(v) for v in truth["frame_001.tif"]["TL"])
+    cv2.imwrite(str(tmp_path / "mark.png"), img[y - 22:y + 23, x - 22:x + 23])
+    opts = ScanOptions(layout="corners", template_path=str(tmp_path / "mark.png"))
+    for name in ("frame_002.tif", "frame_003.tif"):
+        fids, _ = detect_fiducials(os.path.join(folder, name), opts, load_template(opts.template_path))
+        assert {f.slot for f in fids} == {"TL", "TR", "BR", "BL"}
+        for f in fids:
+            t = truth[name][f.slot]
+            assert math.hypot(f.x - t[0], f.y - t[1]) <= 0.5, (name, f.slot)
