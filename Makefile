@@ -9,7 +9,8 @@ PLUGINS := $(BUILD)/qgis-plugins
 QGIS_CONFIG := $(BUILD)/qgis-profile
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 APT_PACKAGES := qgis python3-qgis qgis-providers python3-gdal python3-numpy python3-scipy \
-                python3-matplotlib python3-venv python3-pip qttools5-dev-tools pyqt5-dev-tools xvfb xauth zip
+                python3-matplotlib python3-venv python3-pip qttools5-dev-tools pyqt5-dev-tools xvfb xauth zip \
+                chromium
 QGIS_PROCESS := $(shell command -v qgis_process.bin || command -v qgis_process || echo /usr/bin/qgis_process.bin)
 PYTEST_ARGS ?=
 ARGS ?=
@@ -26,7 +27,7 @@ help:
 	@echo "make setup | demo | test [PYTEST_ARGS=...] | process ARGS='...' | package | lint | transup | transcompile | bench"
 
 apt: $(BUILD)/.apt-stamp
-$(BUILD)/.apt-stamp:
+$(BUILD)/.apt-stamp: Makefile
 	@mkdir -p $(BUILD)
 	@if ! dpkg -s $(APT_PACKAGES) >/dev/null 2>&1; then \
 	  echo "Installing Debian packages: $(APT_PACKAGES)" >&2; \
