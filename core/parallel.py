@@ -70,17 +70,25 @@ def auto_workers(unit_memory: int = 0, max_workers: int = 0) -> int:
 
 
 def python_executable() -> Optional[str]:
-    """A Python interpreter that can run pool workers (inside QGIS sys.executable is QGIS itself)."""
+    """The Python interpreter of *this* installation, to start pool workers with.
+
+    Inside QGIS or qgis_process Python is embedded: ``sys.executable`` is then whatever ``python3`` comes
+    first on PATH (a pyenv shim, say), another interpreter with another standard library, so it is used
+    only when it lives under this interpreter's prefix; otherwise ``<exec_prefix>/bin/pythonX.Y``."""
     exe = sys.executable or ""
-    if os.path.basename(exe).lower().startswith("python") and os.path.isfile(exe):
-        return exe
+    prefixes = {os.path.realpath(p) + os.sep for p in (sys.prefix, sys.exec_prefix, sys.base_exec_prefix) if p}
+    if exe and os.path.isfile(exe) and os.path.basename(exe).lower().startswith("python"):
+        if any(exe.startswith(p) or os.path.realpath(exe).startswith(p) for p in
+               prefixes | {os.path.abspath(sys.prefix) + os.sep}):
+            return exe
     ver = f"{sys.version_info.major}.{sys.version_info.minor}"
-    candidates = [os.path.join(sys.exec_prefix, "bin", f"python{ver}"), os.path.join(sys.exec_prefix, "bin", "python3"),
-                  shutil.which(f"python{ver}"), shutil.which("python3")]
-    if os.name == "nt":  # pragma: no cover - QGIS on Windows ships python.exe beside qgis-bin.exe
-        candidates.insert(0, os.path.join(sys.exec_prefix, "python.exe"))
+    candidates = []
+    for root in dict.fromkeys((sys.exec_prefix, sys.base_exec_prefix)):
+        if os.name == "nt":  # pragma: no cover - QGIS on Windows ships python.exe in its apps folder
+            candidates.append(os.path.join(root, "python.exe"))
+        candidates += [os.path.join(root, "bin", f"python{ver}"), os.path.join(root, "bin", "python3")]
     for c in candidates:
-        if c and os.path.isfile(c):
+        if os.path.isfile(c):
             return c
     return None
 
