@@ -388,3 +388,38 @@ def test_processing_build_dsm_on_the_sample_strip(qgis_processing, qgis_iface, t
         assert os.path.getsize(res["OUTPUT_POINT_CLOUD"]) > 227 + 26 * 1000
     finally:
         plugin.unload()
+
+
+def test_pool_python_is_this_installation(monkeypatch):
+    """Embedded in QGIS, sys.executable is whatever python3 is first on PATH: never spawn that one."""
+    import sys
+
+    monkeypatch.setattr(sys, "executable", "/nonexistent/shims/python3")
+    exe = parallel.python_executable()
+    assert exe and (exe.startswith(sys.exec_prefix) or exe.startswith(sys.base_exec_prefix))
+    assert "shims" not in exe
+
+
+@pytest.mark.slow
+def test_qgis_process_builds_a_dsm_with_a_process_pool(built, tmp_path):
+    """Headless, as a user runs it: qgis_process (embedded Python) spawning pool workers."""
+    import subprocess
+    import sysconfig
+
+    from tests.conftest import PLUGINS, ROOT
+
+    exe = os.environ.get("QGIS_PROCESS") or "/usr/bin/qgis_process.bin"
+    if not os.path.exists(exe) or not os.path.islink(os.path.join(PLUGINS, "archaeoortho")):
+        pytest.skip("qgis_process or the plugin link missing: run 'make setup'")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([sysconfig.get_paths()["purelib"], os.environ.get("PYTHONPATH", "")]),
+               QGIS_PLUGINPATH=PLUGINS, QT_QPA_PLATFORM="offscreen")
+    env.setdefault("QGIS_CUSTOM_CONFIG_PATH", os.path.join(ROOT, "build", "qgis-profile"))
+    block, r = built
+    ws = _copy_ws(os.path.dirname(r.workspace), tmp_path)
+    out = subprocess.run([exe, "--json", "run", "archaeoortho:builddsm", "--", f"WORKSPACE={ws}", "QUALITY=1",
+                          "WORKERS=2"], env=env, capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-3000:]
+    res = json.loads(out.stdout)["results"]
+    assert os.path.samefile(res["OUTPUT_DSM"], os.path.join(ws, "dsm.tif"))
+    assert res["PAIRS"] >= 10 and res["VALID_FRACTION"] > 0.8
+    assert "2 worker(s)" in out.stdout
