@@ -78,7 +78,7 @@ class ArchaeoOrthoPlugin:
             from .ui.gcp_dock import GcpDock
 
             self.dock = GcpDock(self.iface, parent=self.iface.mainWindow())
-            self.iface.addDockWidget(Qt.RightDockWidgetArea, self.dock)
+            self.iface.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, self.dock)
             self.iface.addDockWidget(Qt.BottomDockWidgetArea, self.dock.photo_dock)
             self.dock.visibilityChanged.connect(self._dock_visibility)
         self.dock.setUserVisible(visible)

@@ -1,0 +1,316 @@
+"""Guided GCP placement: where a ground point probably falls in each photo of a block.
+
+Pure functions over a pycolmap reconstruction (no qgis / Qt), used by the GCP dock (ui/).
+
+Three sources of a predicted position, best first:
+
+``rays``
+    the point has observations in at least two registered photos: it is triangulated in the block
+    (``georef.triangulate_observations``, full camera model) and projected into every other photo.
+    This needs no world coordinates at all and agrees with the photos to the precision of the clicks.
+``georef``
+    the block is georeferenced (adjusted model in the local frame, ``world = local + offset``): the
+    point's world coordinates minus the offset are projected.
+``helmert``
+    the block is only aligned, but at least three non-collinear points with world coordinates are
+    triangulated: a 7-parameter similarity world -> model is fitted to them (Umeyama) and the
+    point's world coordinates are projected through it.
+
+A projection counts only where the point is in front of the camera, lands inside the image (with a
+margin) and the lens model is trusted there: the pixel is undistorted back and must give the same
+ray, which rejects the wrap-around of distortion polynomials far outside the frame.
+
+Pixel convention: COLMAP's, origin at the upper-left corner of the upper-left pixel (DESIGN.md §4).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Dict, List, Mapping, Optional, Sequence, Tuple
+
+import numpy as np
+
+from .gcp import GCPSet, GroundPoint, Observation
+
+RAYS = "rays"
+GEOREF = "georef"
+HELMERT = "helmert"
+
+
+@dataclass
+class Prediction:
+    name: str  # ground point
+    image: str
+    x: float  # pixel, COLMAP convention
+    y: float
+    source: str  # RAYS, GEOREF or HELMERT
+    centrality: float  # 0 at the image centre, 1 at a corner: smaller is a better view
+
+    @property
+    def xy(self) -> Tuple[float, float]:
+        return (self.x, self.y)
+
+
+def _registered(rec) -> Dict[str, object]:
+    out = {}
+    for iid in rec.reg_image_ids():
+        im = rec.image(iid)
+        out[im.name] = im
+    return out
+
+
+def project_point(rec, xyz, images: Optional[Sequence[str]] = None, margin: float = 0.0,
+                  _lookup: Optional[Dict[str, object]] = None) -> Dict[str, Tuple[float, float, float]]:
+    """Project one point (in the reconstruction's frame) into the registered images.
+
+    Returns {image: (x, y, centrality)} for the images where the point lies in front of the camera,
+    at least ``margin`` pixels inside the frame, and where the camera model round-trips (see module
+    docstring).  ``images`` restricts the images considered.
+    """
+    xyz = np.asarray(xyz, dtype=float).reshape(3)
+    lookup = _registered(rec) if _lookup is None else _lookup
+    names = lookup.keys() if images is None else [n for n in images if n in lookup]
+    out: Dict[str, Tuple[float, float, float]] = {}
+    for name in names:
+        im = lookup[name]
+        m = np.asarray(im.cam_from_world().matrix())
+        xc = m[:, :3] @ xyz + m[:, 3]
+        if not xc[2] > 1e-9:
+            continue
+        cam = rec.cameras[im.camera_id]
+        px = np.asarray(cam.img_from_cam(xc.reshape(1, 3), check_cheirality=False), dtype=float).reshape(2)
+        if not np.all(np.isfinite(px)):
+            continue
+        w, h = float(cam.width), float(cam.height)
+        if not (margin <= px[0] <= w - margin and margin <= px[1] <= h - margin):
+            continue
+        back = np.asarray(cam.cam_from_img(px.reshape(1, 2)), dtype=float).reshape(2)
+        ray = xc[:2] / xc[2]
+        if not np.all(np.isfinite(back)) or np.linalg.norm(back - ray) > 1e-4 * (1.0 + np.linalg.norm(ray)):
+            continue  # outside the domain where the distortion model is one-to-one
+        half_diag = 0.5 * math.hypot(w, h)
+        centrality = math.hypot(px[0] - 0.5 * w, px[1] - 0.5 * h) / half_diag
+        out[name] = (float(px[0]), float(px[1]), float(centrality))
+    return out
+
+
+def _similarity_fit(src: np.ndarray, dst: np.ndarray):
+    from .georef import helmert_fit
+
+    return helmert_fit(src, dst)
+
+
+class Predictor:
+    """Predicted GCP positions in the photos of one block.
+
+    ``rec``: a pycolmap.Reconstruction; ``offset``: for a georeferenced model in the local frame,
+    the (3,) vector with world = local + offset; None for a model that is only aligned (arbitrary
+    frame).  ``max_ray_error_px``: observations further than this from the other rays are left out
+    of the triangulation (a wrong click must not drag the predictions along).
+    """
+
+    def __init__(self, rec, offset: Optional[Sequence[float]] = None, max_ray_error_px: float = 4.0):
+        self.rec = rec
+        self.offset = None if offset is None else np.asarray(offset, dtype=float).reshape(3)
+        self.max_ray_error_px = float(max_ray_error_px)
+        self._lookup = _registered(rec)
+        self._all = {im.name for im in rec.images.values()}
+        self._world_to_model = None  # (scale, R, t) of a Helmert fit, aligned blocks only
+        self.helmert_points: List[str] = []
+        self.helmert_rms: Optional[float] = None  # metres (world units), on the fitted points
+
+    @property
+    def georeferenced(self) -> bool:
+        return self.offset is not None
+
+    @property
+    def image_names(self) -> List[str]:
+        return sorted(self._lookup)
+
+    def triangulate(self, observations: Sequence[Observation]):
+        """Triangulation in the model frame (``georef.Triangulation``) or None with fewer than 2 usable views."""
+        from .georef import triangulate_observations
+
+        obs = [o for o in observations if o.image in self._lookup]
+        if len(obs) < 2:
+            return None
+        tri = triangulate_observations(self.rec, obs, max_error_px=self.max_ray_error_px,
+                                       _lookup=self._lookup, _all_names=self._all)
+        return tri if tri.xyz is not None else None
+
+    def fit(self, gcps: GCPSet) -> None:
+        """Prepare the world -> model similarity of an aligned block from the points already placed."""
+        self._world_to_model = None
+        self.helmert_points = []
+        self.helmert_rms = None
+        if self.georeferenced:
+            return
+        src, dst, names = [], [], []
+        for p in gcps.points:
+            if not all(math.isfinite(v) for v in (p.x, p.y, p.z)):
+                continue
+            tri = self.triangulate(p.observations)
+            if tri is None:
+                continue
+            src.append([p.x, p.y, p.z])
+            dst.append(tri.xyz)
+            names.append(p.name)
+        if len(src) < 3:
+            return
+        src_a, dst_a = np.asarray(src, dtype=float), np.asarray(dst, dtype=float)
+        centre = src_a.mean(axis=0)  # keep UTM-size numbers out of the fit
+        try:
+            sim = _similarity_fit(src_a - centre, dst_a)
+        except ValueError:  # collinear or coincident points
+            return
+        self._world_to_model = (sim, centre)
+        self.helmert_points = names
+        res = sim.apply(src_a - centre) - dst_a
+        self.helmert_rms = float(np.sqrt(np.mean(np.sum(res ** 2, axis=1)))) / sim.scale
+
+    def model_point(self, point: GroundPoint) -> Tuple[Optional[np.ndarray], Optional[str]]:
+        """(xyz in the model frame, source) of a point, or (None, None) when it cannot be located yet."""
+        tri = self.triangulate(point.observations)
+        if tri is not None:
+            return np.asarray(tri.xyz, dtype=float), RAYS
+        if not all(math.isfinite(v) for v in (point.x, point.y, point.z)):
+            return None, None
+        world = np.array([point.x, point.y, point.z], dtype=float)
+        if self.georeferenced:
+            return world - self.offset, GEOREF
+        if self._world_to_model is not None:
+            sim, centre = self._world_to_model
+            return sim.apply((world - centre)[None])[0], HELMERT
+        return None, None
+
+    def predict_point(self, point: GroundPoint, images: Optional[Sequence[str]] = None,
+                      margin: float = 0.0) -> Dict[str, Prediction]:
+        """{image: Prediction} for every registered image (or ``images``) that probably sees the point,
+        observed images included (their prediction shows how far the click is from the other rays)."""
+        xyz, source = self.model_point(point)
+        if xyz is None:
+            return {}
+        proj = project_point(self.rec, xyz, images, margin, _lookup=self._lookup)
+        return {name: Prediction(point.name, name, x, y, source, c) for name, (x, y, c) in proj.items()}
+
+    def predict(self, gcps: GCPSet, names: Optional[Sequence[str]] = None,
+                margin: float = 0.0) -> Dict[str, Dict[str, Prediction]]:
+        """{point name: {image: Prediction}}; fits the world -> model similarity first when needed."""
+        self.fit(gcps)
+        out = {}
+        for p in gcps.points:
+            if names is not None and p.name not in names:
+                continue
+            out[p.name] = self.predict_point(p, margin=margin)
+        return out
+
+
+def images_seeing(predictions: Mapping[str, Prediction], observed: Sequence[str] = ()) -> List[str]:
+    """Image names ordered for the thumbnail strip: observed images first (in their order), then the
+    predicted ones from the most central view outwards."""
+    first = [n for n in observed]
+    rest = sorted((p for n, p in predictions.items() if n not in first), key=lambda p: (p.centrality, p.image))
+    return first + [p.image for p in rest]
+
+
+def ground_sample_distance(rec, scale: float = 1.0) -> Optional[float]:
+    """Median ground sample distance of the block (model units per pixel, times ``scale``): for each
+    image the median depth of its tie points over the focal length."""
+    values = []
+    pts = rec.points3D
+    for name, im in _registered(rec).items():
+        del name
+        cam = rec.cameras[im.camera_id]
+        m = np.asarray(im.cam_from_world().matrix())
+        ids = [p.point3D_id for p in im.points2D if p.has_point3D()]
+        if not ids:
+            continue
+        if len(ids) > 400:
+            ids = ids[:: len(ids) // 400]
+        xyz = np.array([pts[i].xyz for i in ids], dtype=float)
+        depth = xyz @ m[:, :3].T[:, 2] + m[2, 3]
+        depth = depth[depth > 0]
+        if len(depth):
+            values.append(float(np.median(depth)) / float(cam.mean_focal_length()))
+    return float(np.median(values)) * scale if values else None
+
+
+def image_footprints(rec, ground_z: float, samples_per_side: int = 4,
+                     max_range: Optional[float] = None) -> Dict[str, List[Tuple[float, float]]]:
+    """Ground footprint of each registered image on the horizontal plane z = ``ground_z`` (model /
+    local frame): the image border (``samples_per_side`` points per side, lens model included) cast
+    onto the plane.  Rays that miss the plane or reach beyond ``max_range`` (default: 20 times the
+    camera height above the plane) are clipped at that range, so oblique views stay bounded."""
+    out = {}
+    for name, im in _registered(rec).items():
+        cam = rec.cameras[im.camera_id]
+        w, h = float(cam.width), float(cam.height)
+        n = max(1, int(samples_per_side))
+        t = np.linspace(0.0, 1.0, n, endpoint=False)
+        border = np.concatenate([
+            np.column_stack([t * w, np.zeros(n)]), np.column_stack([np.full(n, w), t * h]),
+            np.column_stack([w - t * w, np.full(n, h)]), np.column_stack([np.zeros(n), h - t * h])])
+        m = np.asarray(im.cam_from_world().matrix())
+        rot, tr = m[:, :3], m[:, 3]
+        centre = -rot.T @ tr
+        height = centre[2] - ground_z
+        if height <= 0:
+            continue
+        reach = max_range if max_range is not None else 20.0 * height
+        rays_cam = np.column_stack([np.asarray(cam.cam_from_img(border), dtype=float), np.ones(len(border))])
+        rays = rays_cam @ rot  # world directions (rows): R^T d
+        poly = []
+        for d in rays:
+            d = d / np.linalg.norm(d)
+            s = -height / d[2] if d[2] < -1e-9 else math.inf
+            if not math.isfinite(s) or s * math.hypot(d[0], d[1]) > reach:
+                horiz = np.array([d[0], d[1]])
+                norm = np.linalg.norm(horiz)
+                if norm < 1e-12:
+                    continue
+                p = centre[:2] + reach * horiz / norm
+            else:
+                p = centre[:2] + s * d[:2]
+            poly.append((float(p[0]), float(p[1])))
+        if len(poly) >= 3:
+            out[name] = poly
+    return out
+
+
+def write_footprints_gpkg(path: str, footprints: Mapping[str, Sequence[Tuple[float, float]]],
+                          offset: Sequence[float] = (0.0, 0.0, 0.0), crs: Optional[str] = None) -> str:
+    """Footprint polygons (local frame + ``offset``) to a GeoPackage layer ``footprints`` (field ``image``),
+    written atomically."""
+    from osgeo import ogr, osr
+
+    from .workspace import atomic_output
+
+    ogr.UseExceptions()
+    srs = None
+    if crs:
+        srs = osr.SpatialReference()
+        srs.SetFromUserInput(crs)
+        srs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+    ox, oy = float(offset[0]), float(offset[1])
+    with atomic_output(path) as tmp:
+        ds = ogr.GetDriverByName("GPKG").CreateDataSource(tmp)
+        lyr = ds.CreateLayer("footprints", srs, ogr.wkbPolygon)
+        lyr.CreateField(ogr.FieldDefn("image", ogr.OFTString))
+        defn = lyr.GetLayerDefn()
+        for name in sorted(footprints):
+            ring = ogr.Geometry(ogr.wkbLinearRing)
+            pts = list(footprints[name])
+            for x, y in pts + pts[:1]:
+                ring.AddPoint_2D(x + ox, y + oy)
+            poly = ogr.Geometry(ogr.wkbPolygon)
+            poly.AddGeometry(ring)
+            f = ogr.Feature(defn)
+            f.SetField("image", name)
+            f.SetGeometry(poly)
+            lyr.CreateFeature(f)
+        ds = None
+    return path
+
+
+__all__ = ["GEOREF", "HELMERT", "RAYS", "Prediction", "Predictor", "ground_sample_distance", "image_footprints",
+           "images_seeing", "project_point", "write_footprints_gpkg"]

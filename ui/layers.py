@@ -1,0 +1,548 @@
+"""Result layers with sensible styles: DSM (pseudocolour + hillshade), orthomosaic (RGB, nodata
+transparent), cameras (labelled points + footprints), GCP residuals (exaggerated vectors).
+
+qgis.core only (no qgis.gui): used by the Processing post-processing hook (processing_provider/base.py)
+and by the GCP dock.  Never called under qgis_process.
+"""
+import math
+import os
+
+from qgis.core import (
+    QgsArrowSymbolLayer,
+    QgsCategorizedSymbolRenderer,
+    QgsColorRampShader,
+    QgsCoordinateReferenceSystem,
+    QgsFillSymbol,
+    QgsGeometryGeneratorSymbolLayer,
+    QgsGradientColorRamp,
+    QgsHillshadeRenderer,
+    QgsLineSymbol,
+    QgsMarkerSymbol,
+    QgsMultiBandColorRenderer,
+    QgsPainting,
+    QgsPalLayerSettings,
+    QgsProcessingLayerPostProcessorInterface,
+    QgsProject,
+    QgsProviderRegistry,
+    QgsRasterBandStats,
+    QgsRasterLayer,
+    QgsRasterShader,
+    QgsRendererCategory,
+    QgsSingleBandPseudoColorRenderer,
+    QgsStyle,
+    QgsSymbol,
+    QgsTextBufferSettings,
+    QgsTextFormat,
+    QgsVectorLayer,
+    QgsVectorLayerSimpleLabeling,
+)
+from qgis.PyQt.QtCore import QCoreApplication
+from qgis.PyQt.QtGui import QColor, QFont
+
+KIND_PROPERTY = "archaeoortho/kind"
+PATH_PROPERTY = "archaeoortho/path"
+
+DSM = "dsm"
+HILLSHADE = "hillshade"
+ORTHO = "ortho"
+CAMERAS = "cameras"
+FOOTPRINTS = "footprints"
+RESIDUALS = "residuals"
+POINT_CLOUD = "pointcloud"
+
+# residual point status (core.georef) -> colour
+STATUS_COLOURS = {"used": "#1a9641", "check": "#2b83ba", "rejected": "#d7191c", "not triangulated": "#888888"}
+
+
+def qgs_crs(text):
+    """QgsCoordinateReferenceSystem from what core.gcp accepts: EPSG:xxxx, a proj string or WKT."""
+    text = (text or "").strip()
+    if not text:
+        return QgsCoordinateReferenceSystem()
+    crs = QgsCoordinateReferenceSystem(text)
+    if not crs.isValid() and text.startswith("+"):
+        crs = QgsCoordinateReferenceSystem.fromProj(text)
+    if not crs.isValid():
+        crs = QgsCoordinateReferenceSystem.fromWkt(text)
+    return crs
+
+
+def crs_text(crs):
+    """The string core.gcp stores for a QGIS CRS: the authority id where there is one, else WKT."""
+    if not crs.isValid():
+        return ""
+    return crs.authid() or crs.toWkt()
+
+
+# --------------------------------------------------------------------------------------------------
+# rasters
+# --------------------------------------------------------------------------------------------------
+
+
+def _band_range(layer, band=1):
+    provider = layer.dataProvider()
+    try:
+        lo, hi = provider.cumulativeCut(band, 0.02, 0.98, layer.extent(), 250000)
+    except Exception:  # noqa: BLE001 - fall back to plain statistics
+        lo = hi = float("nan")
+    if not (math.isfinite(lo) and math.isfinite(hi)) or hi <= lo:
+        stats = provider.bandStatistics(band, QgsRasterBandStats.Min | QgsRasterBandStats.Max, layer.extent(), 250000)
+        lo, hi = stats.minimumValue, stats.maximumValue
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        lo, hi = 0.0, 1.0
+    if hi <= lo:
+        hi = lo + 1.0
+    return float(lo), float(hi)
+
+
+def _elevation_ramp():
+    ramp = QgsStyle.defaultStyle().colorRamp("Spectral") if QgsStyle.defaultStyle() else None
+    if ramp is not None:
+        ramp.invert()  # low = blue, high = red
+        return ramp
+    return QgsGradientColorRamp(QColor("#2b83ba"), QColor("#d7191c"))
+
+
+def style_dsm(layer):
+    """Pseudocolour (Spectral, 2-98 % stretch) for a DSM layer; nodata stays transparent."""
+    lo, hi = _band_range(layer)
+    ramp = _elevation_ramp()
+    shader = QgsColorRampShader(lo, hi, ramp, QgsColorRampShader.Interpolated, QgsColorRampShader.Continuous)
+    shader.classifyColorRamp(5, -1, layer.extent(), layer.dataProvider())
+    raster_shader = QgsRasterShader(lo, hi)
+    raster_shader.setRasterShaderFunction(shader)
+    renderer = QgsSingleBandPseudoColorRenderer(layer.dataProvider(), 1, raster_shader)
+    renderer.setClassificationMin(lo)
+    renderer.setClassificationMax(hi)
+    layer.setRenderer(renderer)
+    _mark(layer, DSM)
+    layer.triggerRepaint()
+    return layer
+
+
+def style_hillshade(layer):
+    """Multidirectional hillshade drawn with 'multiply' over the pseudocolour DSM."""
+    renderer = QgsHillshadeRenderer(layer.dataProvider(), 1, 315.0, 45.0)
+    renderer.setMultiDirectional(True)
+    renderer.setZFactor(1.0)
+    layer.setRenderer(renderer)
+    layer.setBlendMode(QgsPainting.getCompositionMode(QgsPainting.BlendMultiply))
+    layer.setOpacity(0.6)
+    _mark(layer, HILLSHADE)
+    layer.triggerRepaint()
+    return layer
+
+
+def style_orthomosaic(layer):
+    """RGB from bands 1-3, the alpha band (4) or nodata transparent."""
+    provider = layer.dataProvider()
+    n = layer.bandCount()
+    if n >= 3:
+        renderer = QgsMultiBandColorRenderer(provider, 1, 2, 3)
+        if n >= 4:
+            renderer.setAlphaBand(4)
+        layer.setRenderer(renderer)
+    for band in range(1, n + 1):
+        if provider.sourceHasNoDataValue(band):
+            provider.setUseSourceNoDataValue(band, True)
+    _mark(layer, ORTHO)
+    layer.triggerRepaint()
+    return layer
+
+
+# --------------------------------------------------------------------------------------------------
+# vectors
+# --------------------------------------------------------------------------------------------------
+
+
+def _labels(layer, expression, size=8.0, colour="#202020", is_expression=True, offset=2.0):
+    fmt = QgsTextFormat()
+    font = QFont()
+    font.setPointSizeF(size)
+    fmt.setFont(font)
+    fmt.setSize(size)
+    fmt.setColor(QColor(colour))
+    buf = QgsTextBufferSettings()
+    buf.setEnabled(True)
+    buf.setSize(0.8)
+    buf.setColor(QColor("white"))
+    fmt.setBuffer(buf)
+    settings = QgsPalLayerSettings()
+    settings.fieldName = expression
+    settings.isExpression = is_expression
+    settings.setFormat(fmt)
+    settings.dist = offset
+    settings.placement = QgsPalLayerSettings.OverPoint if layer.geometryType() == 0 else settings.placement
+    if layer.geometryType() == 0:
+        settings.quadOffset = QgsPalLayerSettings.QuadrantAboveRight
+    layer.setLabeling(QgsVectorLayerSimpleLabeling(settings))
+    layer.setLabelsEnabled(True)
+
+
+def style_cameras(layer):
+    """Camera centres: dark triangles labelled with the image name."""
+    symbol = QgsMarkerSymbol.createSimple({"name": "triangle", "color": "#303030", "outline_color": "white",
+                                           "size": "3.2", "outline_width": "0.3"})
+    layer.renderer().setSymbol(symbol)
+    _labels(layer, '"image"', size=7.5)
+    _mark(layer, CAMERAS)
+    layer.triggerRepaint()
+    return layer
+
+
+def style_footprints(layer):
+    symbol = QgsFillSymbol.createSimple({"color": "0,0,0,0", "outline_color": "#e66101", "outline_width": "0.35",
+                                         "outline_style": "solid"})
+    layer.renderer().setSymbol(symbol)
+    layer.setOpacity(0.8)
+    _mark(layer, FOOTPRINTS)
+    layer.triggerRepaint()
+    return layer
+
+
+def _nice(value):
+    """The 1-2-5 number nearest below ``value`` (> 0)."""
+    if not value > 0 or not math.isfinite(value):
+        return 1.0
+    e = math.floor(math.log10(value))
+    base = value / 10 ** e
+    step = 5.0 if base >= 5 else 2.0 if base >= 2 else 1.0
+    return step * 10 ** e
+
+
+def residual_exaggeration(layer, share=0.15):
+    """A 1-2-5 factor that draws the largest horizontal residual at ``share`` of the layer's extent."""
+    largest = 0.0
+    for f in layer.getFeatures():
+        dx, dy = f["dx"], f["dy"]
+        try:
+            largest = max(largest, math.hypot(float(dx), float(dy)))
+        except (TypeError, ValueError):
+            continue
+    ext = layer.extent()
+    size = max(ext.width(), ext.height())
+    if not size > 0:
+        size = 100.0 * largest if largest > 0 else 10.0
+    if largest <= 0:
+        return 1.0
+    return max(1.0, _nice(share * size / largest))
+
+
+def style_residuals(layer, factor=None):
+    """GCP residuals: points coloured by status, the horizontal residual drawn as an arrow exaggerated by
+    ``factor`` (default: see residual_exaggeration), labelled with name and residual."""
+    factor = residual_exaggeration(layer) if factor is None else float(factor)
+    categories = []
+    arrows = True
+    labels = {"used": QCoreApplication.translate("ResultLayers", "control (used)"),
+              "check": QCoreApplication.translate("ResultLayers", "check point"),
+              "rejected": QCoreApplication.translate("ResultLayers", "rejected (outlier)"),
+              "not triangulated": QCoreApplication.translate("ResultLayers", "not triangulated")}
+    for status, colour in STATUS_COLOURS.items():
+        symbol = QgsMarkerSymbol.createSimple({"name": "square" if status == "check" else "circle",
+                                               "color": colour, "outline_color": "white", "size": "3.0"})
+        gen = QgsGeometryGeneratorSymbolLayer.create({
+            "geometryModifier": (f'make_line($geometry, make_point($x + coalesce("dx", 0) * {factor:g}, '
+                                 f'$y + coalesce("dy", 0) * {factor:g}))')})
+        gen.setSymbolType(QgsSymbol.Line)
+        arrow = QgsArrowSymbolLayer()
+        arrow.setIsCurved(False)
+        arrow.setIsRepeated(False)
+        arrow.setArrowWidth(0.5)
+        arrow.setArrowStartWidth(0.5)
+        arrow.setHeadLength(2.0)
+        arrow.setHeadThickness(1.4)
+        arrow_fill = QgsFillSymbol.createSimple({"color": colour, "outline_style": "no"})
+        arrow.setSubSymbol(arrow_fill)
+        line = QgsLineSymbol()
+        if not line.changeSymbolLayer(0, arrow):
+            line = QgsLineSymbol.createSimple({"color": colour, "width": "0.5"})
+        gen.setSubSymbol(line)
+        arrows = symbol.appendSymbolLayer(gen) and arrows  # without the arrow the point is still drawn
+        categories.append(QgsRendererCategory(status, symbol, labels[status]))
+    layer.setRenderer(QgsCategorizedSymbolRenderer("status", categories))
+    _labels(layer, """"name" || coalesce('  ' || format_number("dxy", 3) || ' m', '')""", size=8.0)
+    layer.setCustomProperty("archaeoortho/exaggeration", factor if arrows else 0)
+    _mark(layer, RESIDUALS)
+    layer.triggerRepaint()
+    return layer
+
+
+def _mark(layer, kind):
+    layer.setCustomProperty(KIND_PROPERTY, kind)
+
+
+# --------------------------------------------------------------------------------------------------
+# adding to a project
+# --------------------------------------------------------------------------------------------------
+
+
+def _norm(path):
+    return os.path.normcase(os.path.realpath(path)) if path else ""
+
+
+def remove_loaded(project, path, kinds=None):
+    """Remove layers earlier loaded from ``path`` (a re-run replaces its products)."""
+    target = _norm(path)
+    drop = []
+    for layer in project.mapLayers().values():
+        if _norm(layer.customProperty(PATH_PROPERTY, "")) == target and (
+                kinds is None or layer.customProperty(KIND_PROPERTY, "") in kinds):
+            drop.append(layer.id())
+    if drop:
+        project.removeMapLayers(drop)
+
+
+def _group(project, name):
+    if not name:
+        return None
+    root = project.layerTreeRoot()
+    group = root.findGroup(name)
+    if group is None:
+        group = root.insertGroup(0, name)
+    return group
+
+
+def add_layer(project, layer, group=None, path=None):
+    """Add ``layer`` to ``project`` (at the top of ``group`` when given) and remember its source."""
+    layer.setCustomProperty(PATH_PROPERTY, path or layer.source().split("|")[0])
+    node = _group(project, group)
+    if project.addMapLayer(layer, node is None) is None:
+        return None
+    if node is not None:
+        node.insertLayer(0, layer)
+    return layer
+
+
+def load_dsm(path, project=None, group=None, name=None):
+    """DSM as two layers: the pseudocolour and a multiplied hillshade above it."""
+    project = project or QgsProject.instance()
+    remove_loaded(project, path, (DSM, HILLSHADE))
+    dsm = QgsRasterLayer(path, name or QCoreApplication.translate("ResultLayers", "DSM"))
+    if not dsm.isValid():
+        return []
+    style_dsm(dsm)
+    shade = QgsRasterLayer(path, QCoreApplication.translate("ResultLayers", "DSM hillshade"))
+    style_hillshade(shade)
+    return [lyr for lyr in (add_layer(project, dsm, group, path), add_layer(project, shade, group, path))
+            if lyr is not None]
+
+
+def load_orthomosaic(path, project=None, group=None, name=None):
+    project = project or QgsProject.instance()
+    remove_loaded(project, path, (ORTHO,))
+    layer = QgsRasterLayer(path, name or QCoreApplication.translate("ResultLayers", "Orthomosaic"))
+    if not layer.isValid():
+        return []
+    style_orthomosaic(layer)
+    return [layer] if add_layer(project, layer, group, path) is not None else []
+
+
+def load_cameras(path, project=None, group=None, name=None, workspace=None):
+    """Camera centres (only when they carry a CRS: an aligned block is in an arbitrary frame) and, for a
+    georeferenced workspace, the image footprints on the mean ground height."""
+    project = project or QgsProject.instance()
+    layer = QgsVectorLayer(path, name or QCoreApplication.translate("ResultLayers", "Cameras"), "ogr")
+    if not layer.isValid() or not layer.crs().isValid():
+        return []
+    remove_loaded(project, path, (CAMERAS,))
+    out = []
+    foot = footprints_path(workspace) if workspace else None
+    if foot:
+        remove_loaded(project, foot, (FOOTPRINTS,))
+        fl = QgsVectorLayer(foot, QCoreApplication.translate("ResultLayers", "Camera footprints"), "ogr")
+        if fl.isValid():
+            style_footprints(fl)
+            out.append(add_layer(project, fl, group, foot))
+    style_cameras(layer)
+    out.append(add_layer(project, layer, group, path))
+    return [lyr for lyr in out if lyr is not None]
+
+
+def footprints_path(workspace):
+    """Write <workspace>/georef/footprints.gpkg for a georeferenced workspace; None when not possible."""
+    try:
+        import numpy as np
+
+        from ..core import guided
+        from ..core.pipeline import load_georef_model
+    except ImportError:
+        return None
+    try:
+        rec, transform = load_georef_model(workspace)
+    except Exception:  # noqa: BLE001 - not georeferenced or no pycolmap: no footprints
+        return None
+    z = [p.xyz[2] for p in rec.points3D.values()]
+    if not z:
+        return None
+    prints = guided.image_footprints(rec, float(np.median(z)))
+    path = os.path.join(workspace, "georef", "footprints.gpkg")
+    try:
+        return guided.write_footprints_gpkg(path, prints, transform.get("offset", (0, 0, 0)), transform.get("crs"))
+    except Exception:  # noqa: BLE001 - a missing GPKG driver must not stop the loading of the rest
+        return None
+
+
+def load_residuals(path, project=None, group=None, name=None):
+    project = project or QgsProject.instance()
+    layer = QgsVectorLayer(path, "residuals", "ogr")
+    if not layer.isValid():
+        return []
+    remove_loaded(project, path, (RESIDUALS,))
+    style_residuals(layer)
+    factor = layer.customProperty("archaeoortho/exaggeration", 1.0)
+    layer.setName(name or QCoreApplication.translate("ResultLayers", "GCP residuals (vectors x{})").format(
+        f"{float(factor):g}"))
+    return [layer] if add_layer(project, layer, group, path) is not None else []
+
+
+def load_point_cloud(path, project=None, group=None, name=None):
+    """A LAS/LAZ point cloud where this QGIS build has the PDAL provider; [] otherwise."""
+    if "pdal" not in QgsProviderRegistry.instance().providerList():
+        return []
+    from qgis.core import QgsPointCloudLayer
+
+    project = project or QgsProject.instance()
+    remove_loaded(project, path, (POINT_CLOUD,))
+    layer = QgsPointCloudLayer(path, name or QCoreApplication.translate("ResultLayers", "Point cloud"), "pdal")
+    if not layer.isValid():
+        return []
+    _mark(layer, POINT_CLOUD)
+    return [layer] if add_layer(project, layer, group, path) is not None else []
+
+
+def load_workspace_results(workspace, project=None, group=None):
+    """Every product a workspace holds, styled: DSM, orthomosaic, cameras + footprints, residuals."""
+    project = project or QgsProject.instance()
+    group = group or QCoreApplication.translate("ResultLayers", "ArchaeoOrtho: {}").format(
+        os.path.basename(os.path.normpath(workspace)))
+    loaded = []
+    candidates = [
+        (os.path.join(workspace, "dsm.tif"), load_dsm, {}),
+        (os.path.join(workspace, "orthomosaic.tif"), load_orthomosaic, {}),
+        (os.path.join(workspace, "cameras.gpkg"), load_cameras, {"workspace": workspace}),
+        (os.path.join(workspace, "georef", "residuals.gpkg"), load_residuals, {}),
+    ]
+    for path, fn, kw in candidates:
+        if os.path.exists(path):
+            loaded += fn(path, project, group, **kw)
+    return loaded
+
+
+# --------------------------------------------------------------------------------------------------
+# Processing: style outputs when the run loads them into a project
+# --------------------------------------------------------------------------------------------------
+
+
+def output_kind(output_name, path):
+    """Which style an algorithm output gets, from its name and file; None for none of ours."""
+    n = (output_name or "").upper()
+    ext = os.path.splitext(str(path))[1].lower()
+    if "RESIDUAL" in n:
+        return RESIDUALS
+    if "CAMERA" in n:
+        return CAMERAS
+    if ext in (".las", ".laz", ".copc") or "POINT_CLOUD" in n:
+        return POINT_CLOUD
+    if "ORTHO" in n:
+        return ORTHO
+    if "DSM" in n or "DTM" in n or "DEM" in n:
+        return DSM
+    return None
+
+
+_KEEP = []  # the post-processors must outlive the run (QGIS keeps only a raw pointer)
+
+
+class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
+    """Styles a loaded output layer; for a DSM adds the hillshade, for cameras the footprints."""
+
+    def __init__(self, kind, workspace=None):
+        super().__init__()
+        self.kind = kind
+        self.workspace = workspace
+        _KEEP.append(self)
+        del _KEEP[:-100]
+
+    def postProcessLayer(self, layer, context, feedback):  # noqa: N802 (QGIS API name)
+        project = context.project() or QgsProject.instance()
+        path = layer.source().split("|")[0]
+        layer.setCustomProperty(PATH_PROPERTY, path)
+        if self.kind == DSM:
+            style_dsm(layer)
+            shade = QgsRasterLayer(path, QCoreApplication.translate("ResultLayers", "DSM hillshade"))
+            if shade.isValid():
+                style_hillshade(shade)
+                add_layer(project, shade, None, path)
+        elif self.kind == ORTHO:
+            style_orthomosaic(layer)
+        elif self.kind == CAMERAS:
+            style_cameras(layer)
+            foot = footprints_path(self.workspace) if self.workspace else None
+            if foot:
+                remove_loaded(project, foot, (FOOTPRINTS,))
+                fl = QgsVectorLayer(foot, QCoreApplication.translate("ResultLayers", "Camera footprints"), "ogr")
+                if fl.isValid():
+                    style_footprints(fl)
+                    add_layer(project, fl, None, foot)
+        elif self.kind == RESIDUALS:
+            style_residuals(layer)
+            factor = layer.customProperty("archaeoortho/exaggeration", 1.0)
+            layer.setName(QCoreApplication.translate("ResultLayers", "GCP residuals (vectors x{})").format(
+                f"{float(factor):g}"))
+        elif self.kind == POINT_CLOUD:
+            _mark(layer, POINT_CLOUD)
+
+
+def register_outputs(alg, results, context):
+    """Ask the run to load ``alg``'s layer outputs in ``results`` with our styles (see base.py).
+
+    Layers the dialog already loads (destination parameters the user ticked) get the post-processor;
+    plain outputs (QgsProcessingOutputVectorLayer / RasterLayer) and our raster destinations are added.
+    Aligned blocks have no CRS: their camera layers are not loaded.
+    """
+    from qgis.core import QgsProcessingContext, QgsProcessingUtils
+
+    project = context.project()
+    if project is None or not isinstance(results, dict):
+        return 0
+    workspace = results.get("WORKSPACE") if isinstance(results.get("WORKSPACE"), str) else None
+    count = 0
+    loading = context.layersToLoadOnCompletion()
+    for name, value in results.items():
+        if not isinstance(value, str) or not value or not os.path.exists(value.split("|")[0]):
+            continue
+        kind = output_kind(name, value)
+        if kind is None:
+            continue
+        out_def = alg.outputDefinition(name)
+        if out_def is None:
+            continue
+        if kind == CAMERAS and not _has_crs(value):
+            continue
+        if kind == POINT_CLOUD and "pdal" not in QgsProviderRegistry.instance().providerList():
+            continue
+        pp = StylePostProcessor(kind, workspace)
+        if value in loading:
+            details = context.layerToLoadOnCompletionDetails(value)
+            details.setPostProcessor(pp)
+        else:
+            hint = QgsProcessingUtils.LayerHint.Raster if kind in (DSM, ORTHO) else (
+                QgsProcessingUtils.LayerHint.Vector if kind in (CAMERAS, RESIDUALS) else
+                QgsProcessingUtils.LayerHint.UnknownType)
+            details = QgsProcessingContext.LayerDetails(out_def.description() or name, project, name, hint)
+            details.setPostProcessor(pp)
+            context.addLayerToLoadOnCompletion(value, details)
+        count += 1
+    return count
+
+
+def _has_crs(path):
+    try:
+        from osgeo import ogr
+    except ImportError:
+        return True
+    ds = ogr.Open(path.split("|")[0])
+    if ds is None or ds.GetLayerCount() == 0:
+        return False
+    return ds.GetLayer(0).GetSpatialRef() is not None

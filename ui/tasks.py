@@ -1,0 +1,79 @@
+"""Core stages as QgsTasks: progress in the task manager and the dock, cancel within seconds, the UI
+stays responsive.  The result (or the error) is handed to callbacks in the main thread."""
+from qgis.core import Qgis, QgsApplication, QgsMessageLog, QgsTask
+from qgis.PyQt.QtCore import pyqtSignal
+
+
+class TaskProgress:
+    """The core Progress protocol on top of a QgsTask."""
+
+    def __init__(self, task):
+        self.task = task
+        self.messages = []
+
+    def report(self, fraction, message=""):
+        self.task.setProgress(100.0 * min(max(float(fraction), 0.0), 1.0))
+        if message:
+            self.task.message.emit(message)
+
+    def is_cancelled(self):
+        return self.task.isCanceled()
+
+    def info(self, message):
+        self.messages.append(("info", message))
+        QgsMessageLog.logMessage(message, "ArchaeoOrtho", Qgis.Info)
+
+    def warning(self, message):
+        self.messages.append(("warning", message))
+        QgsMessageLog.logMessage(message, "ArchaeoOrtho", Qgis.Warning)
+
+
+class CoreTask(QgsTask):
+    """Runs ``fn(*args, progress=..., **kwargs)`` in a worker thread.
+
+    ``on_done(result)`` / ``on_error(message, cancelled)`` run in the main thread when it ends.
+    """
+
+    message = pyqtSignal(str)
+
+    def __init__(self, description, fn, args=(), kwargs=None, on_done=None, on_error=None):
+        super().__init__(description, QgsTask.CanCancel)
+        self.fn = fn
+        self.args = tuple(args)
+        self.kwargs = dict(kwargs or {})
+        self.on_done = on_done
+        self.on_error = on_error
+        self.result = None
+        self.error = None
+        self.was_cancelled = False
+        self.progress_adapter = TaskProgress(self)
+
+    def run(self):
+        from ..core.progress import Cancelled
+
+        try:
+            self.result = self.fn(*self.args, progress=self.progress_adapter, **self.kwargs)
+            return True
+        except Cancelled as e:
+            self.was_cancelled = True
+            self.error = str(e) or "cancelled"
+        except Exception as e:  # noqa: BLE001 - every failure is reported to the user, not raised in a thread
+            self.error = f"{type(e).__name__}: {e}" if not str(e) else str(e)
+            self.was_cancelled = self.isCanceled()
+        return False
+
+    def finished(self, ok):
+        if ok:
+            if self.on_done is not None:
+                self.on_done(self.result)
+        else:
+            if self.isCanceled():
+                self.was_cancelled = True
+            if self.on_error is not None:
+                self.on_error(self.error or "cancelled", self.was_cancelled)
+
+
+def start(task):
+    """Hand a task to QGIS's task manager; returns it (keep a reference until it finishes)."""
+    QgsApplication.taskManager().addTask(task)
+    return task
