@@ -31,7 +31,7 @@ import math
 import os
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
-from typing import Callable, Dict, List, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import cv2
 import numpy as np
@@ -771,7 +771,7 @@ class SyntheticBlock:
     def truth_reconstruction(self, *, n_points: int = 2000, noise_px: float = 0.3, seed: int = 5,
                              camera: Optional[CameraModel] = None,
                              deform: Optional[Callable[[np.ndarray], np.ndarray]] = None,
-                             model_from_local: Optional[Tuple[float, np.ndarray, np.ndarray]] = "random",
+                             model_from_local: Union[str, Tuple[float, np.ndarray, np.ndarray], None] = "random",
                              images: Optional[Sequence[str]] = None):
         """A pycolmap.Reconstruction from the truth, like an alignment would give.
 
