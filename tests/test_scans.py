@@ -375,3 +375,33 @@ def test_user_template_of_one_mark(synthetic_scans, tmp_path):
         for f in fids:
             t = truth[name][f.slot]
             assert math.hypot(f.x - t[0], f.y - t[1]) <= 0.5, (name, f.slot)
+
+
+def test_processing_prepare_scanned_film(synthetic_scans, qgis_processing, qgis_iface, tmp_path):
+    """archaeoortho:prepareimages with SCANNED_FILM, the certificate pasted as text, as QGIS runs it."""
+    import shutil
+
+    import archaeoortho
+    from qgis import processing
+
+    folder, _ = synthetic_scans
+    images = tmp_path / "three scans"
+    images.mkdir()
+    for n in ("frame_001.tif", "frame_002.tif", "frame_003.tif"):
+        shutil.copyfile(os.path.join(folder, n), images / n)
+    plugin = archaeoortho.classFactory(qgis_iface)
+    plugin.initProcessing()
+    try:
+        res = processing.run("archaeoortho:prepareimages", {
+            "IMAGES": str(images), "WORKSPACE": str(tmp_path / "ws"), "SCANNED_FILM": True,
+            "FIDUCIAL_COORDINATES": calibration_text(), "FIDUCIAL_TYPE": 0, "OUTPUT": str(tmp_path / "out"),
+        })
+    finally:
+        plugin.unload()
+    assert res["FLAGGED"] == 0
+    assert sorted(n for n in os.listdir(res["PREPARED_IMAGES"]) if not n.startswith(".")) == \
+        ["frame_001.tif", "frame_002.tif", "frame_003.tif"]
+    assert sorted(os.listdir(os.path.join(res["WORKSPACE"], "masks"))) == \
+        ["frame_001.tif.png", "frame_002.tif.png", "frame_003.tif.png"]
+    doc = json.load(open(os.path.join(res["WORKSPACE"], "scans.json")))
+    assert doc["calibrated"] and doc["interior_orientation"]["focal_length_mm"] == pytest.approx(FOCAL_MM, abs=1e-3)
