@@ -225,12 +225,29 @@ def read_for_analysis(path: str, size: int = ANALYSIS_SIZE) -> np.ndarray:
 
 
 def measure_image(path: str, name: Optional[str] = None, mask_path: Optional[str] = None,
-                  analysis_size: int = ANALYSIS_SIZE) -> ImageQuality:
-    """Blur and exposure figures of one image file (optionally only where its mask is white)."""
+                  analysis_size: int = ANALYSIS_SIZE, check: bool = True) -> ImageQuality:
+    """Blur and exposure figures of one image file (optionally only where its mask is white).
+
+    ``check`` first decodes the file's last rows (core.images.read_image_info), so
+    that a truncated file fails with a clear ImageError naming it; callers that
+    have just checked the file pass False.
+    """
     import cv2
 
     name = name or os.path.basename(path)
-    info = read_image_info(path, name)  # clear ImageError for empty, corrupt or truncated files
+    if check:
+        info = read_image_info(path, name)  # clear ImageError for empty, corrupt or truncated files
+        size = (info.width, info.height)
+    else:
+        from osgeo import gdal
+
+        gdal.UseExceptions()
+        try:
+            ds = gdal.Open(path)
+            size = (ds.RasterXSize, ds.RasterYSize)
+            ds = None
+        except RuntimeError as e:
+            raise ImageError(f"{path}: not a readable image ({str(e).strip()})") from e
     arr = read_for_analysis(path, analysis_size)
     scale = full_scale(arr)
     mask = None
@@ -241,7 +258,7 @@ def measure_image(path: str, name: Optional[str] = None, mask_path: Optional[str
         mask = cv2.resize(m, (arr.shape[1], arr.shape[0]), interpolation=cv2.INTER_NEAREST) > 127
     grey = to_grey(arr, scale)
     exp = exposure_figures(arr, mask, scale)
-    return ImageQuality(name=name, blur_score=blur_score(grey, mask), width=info.width, height=info.height, **exp)
+    return ImageQuality(name=name, blur_score=blur_score(grey, mask), width=size[0], height=size[1], **exp)
 
 
 # ---------------------------------------------------------------------------
@@ -295,7 +312,7 @@ def screen(measured: Sequence[ImageQuality], options: Optional[ScreeningOptions]
 
 def screen_folder(images_dir: str, options: Optional[ScreeningOptions] = None,
                   progress: Optional[Progress] = None, names: Optional[Sequence[str]] = None,
-                  masks: Optional[Dict[str, str]] = None) -> List[ImageQuality]:
+                  masks: Optional[Dict[str, str]] = None, check: bool = True) -> List[ImageQuality]:
     """Measure and screen every image of a folder; raises ImageError naming a corrupt file."""
     options = options or ScreeningOptions()
     progress = progress or NullProgress()
@@ -303,7 +320,8 @@ def screen_folder(images_dir: str, options: Optional[ScreeningOptions] = None,
     measured = []
     for i, n in enumerate(names):
         check_cancel(progress)
-        measured.append(measure_image(os.path.join(images_dir, n), n, (masks or {}).get(n), options.analysis_size))
+        measured.append(measure_image(os.path.join(images_dir, n), n, (masks or {}).get(n), options.analysis_size,
+                                      check))
         progress.report((i + 1) / max(1, len(names)), f"screening: {i + 1}/{len(names)} images ({n})")
     return screen(measured, options)
 
@@ -426,7 +444,7 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
                 screen_dir, screen_names = images_dir, names
                 sp = SubProgress(progress, 0.03, 0.90)
             t0 = time.time()
-            quality = screen_folder(screen_dir, sopt, sp, screen_names, mask_files)
+            quality = screen_folder(screen_dir, sopt, sp, screen_names, mask_files, check=False)
             timings["screening"] = time.time() - t0
             ws.record_timing(STAGE, "screening", timings["screening"])
             # screening measured prepared scans: report under the original names
