@@ -489,7 +489,7 @@ def _zbuffer(shape: Tuple[int, int], px: np.ndarray, py: np.ndarray, depth: np.n
     r = np.round(py).astype(np.int64)
     ok = (c >= 0) & (c < shape[1]) & (r >= 0) & (r < shape[0]) & (depth > 0)
     c, r, d = c[ok], r[ok], depth[ok]
-    order = np.argsort(-d, kind="stable")  # nearest written last: it wins
+    order = np.argsort(-d.astype(np.float32))  # nearest written last: it wins
     out[r[order], c[order]] = d[order]
     return out
 
@@ -574,14 +574,23 @@ def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
     return summary
 
 
-def _save_pair(path: str, map_i, map_j, rel_err: float, summary: dict) -> None:
-    """Save atomically (a cancelled or killed unit leaves no file that looks finished)."""
+def _save_npz(path: str, **arrays) -> None:
+    """np.savez with fast deflate (level 1: depth maps with holes shrink ~3x at a fraction of savez_compressed's
+    time), written to a temporary name and renamed: a cancelled or killed unit leaves no file that looks done."""
+    import zipfile
+
     tmp = path + ".partial.npz"
-    empty = np.zeros((0, 0), np.float32)
-    np.savez_compressed(tmp, depth_i=map_i if map_i is not None else empty,
-                        depth_j=map_j if map_j is not None else empty, rel_err=np.float64(rel_err),
-                        summary=np.array(json.dumps(summary)))
+    with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=1) as zf:
+        for name, arr in arrays.items():
+            with zf.open(name + ".npy", "w", force_zip64=True) as f:
+                np.lib.format.write_array(f, np.asanyarray(arr), allow_pickle=False)
     os.replace(tmp, path)
+
+
+def _save_pair(path: str, map_i, map_j, rel_err: float, summary: dict) -> None:
+    empty = np.zeros((0, 0), np.float32)
+    _save_npz(path, depth_i=map_i if map_i is not None else empty, depth_j=map_j if map_j is not None else empty,
+              rel_err=np.float64(rel_err), summary=np.array(json.dumps(summary)))
 
 
 def read_pair_summary(path: str) -> dict:
