@@ -231,6 +231,7 @@ class _Data:
         self.transform = _read_json(ws.path("georef", "transform.json")) if self.georeferenced else None
         self.offset = np.asarray((self.transform or {}).get("offset", [0.0, 0.0, 0.0]), dtype=float)
         self.crs = ws.crs if self.georeferenced else None
+        self.crs_label = crs_label(self.crs) if self.crs else None
         self.screening = _read_json(ws.path("screening.json"))
         self.rec = None
         self.obs = None
@@ -417,7 +418,7 @@ class _Report:
         else:
             self.figures.update(IMAGES=len(images) or None, REGISTERED_IMAGES=None)
             rows.append(("Images given", str(len(images))))
-        rows.append(("Coordinate reference system", _esc(d.crs or "none (local model frame)")))
+        rows.append(("Coordinate reference system", _esc(f"{d.crs_label}: {d.crs}" if d.crs else "none (local model frame)")))
         parts.append(_kv(rows))
 
         # not aligned, with why
@@ -599,8 +600,9 @@ class _Report:
         c = d.shared_points()
         n = len(c)
         centres = d.centres()
-        fig = _figure(10.0, 4.6)
-        ax = fig.add_subplot(121)
+        fig = _figure(10.5, 4.6)
+        gs = fig.add_gridspec(1, 2, wspace=0.35)
+        ax = fig.add_subplot(gs[0, 0])
         from matplotlib.colors import LogNorm
 
         im = ax.imshow(np.where(c > 0, c, np.nan), cmap="viridis", norm=LogNorm(vmin=1, vmax=max(2, c.max())),
@@ -614,7 +616,7 @@ class _Report:
         else:
             ax.tick_params(labelsize=6)
         ax.set_title("image × image", fontsize=9)
-        ax2 = fig.add_subplot(122)
+        ax2 = fig.add_subplot(gs[0, 1])
         iu = np.argwhere(np.triu(c) > 0)
         if len(iu):
             w = c[iu[:, 0], iu[:, 1]]
@@ -666,8 +668,8 @@ class _Report:
             q = ax.quiver(xy[:, 0], xy[:, 1], dxy[:, 0] * k, dxy[:, 1] * k, angles="xy", scale_units="xy", scale=1,
                           color="#c0392b", width=0.004, zorder=4)
             ref = _nice(lmax)
-            ax.quiverkey(q, 0.85, 1.03, ref * k, f"{ref:g} m", labelpos="E", coordinates="axes", fontproperties={
-                "size": 7})
+            ax.quiverkey(q, 0.82, 0.96, ref * k, f"{ref:g} m", labelpos="E", coordinates="axes",
+                         fontproperties={"size": 7})
             excl = [r for r in cams["rows"] if not r.get("used", True)]
             for r in excl:
                 ax.annotate("excluded " + r["image"], (r["x"], r["y"]), fontsize=6, color="#c0392b")
@@ -679,7 +681,7 @@ class _Report:
             fig.colorbar(sc, ax=ax, shrink=0.7, label="mean reprojection error (px)")
             caption += "; colour: mean reprojection error per image (no camera positions were given)."
         _equal_xy(ax)
-        ax.set_title(f"camera positions ({_esc(d.crs) if d.crs else d.unit})", fontsize=9)
+        ax.set_title(f"camera positions ({d.crs_label or d.unit})", fontsize=9)
         return "<h3>Camera positions</h3>" + _img(fig, "camera positions", caption)
 
     # ---- georeferencing --------------------------------------------------------------------------
@@ -695,15 +697,16 @@ class _Report:
         ortho_res = self._ortho_resolution()
         acc = accuracy_figures(res, ortho_res or self.gsd)
         self.acc = acc
-        sets, stats = acc["sets"], acc["stats"]
+        stats = acc["stats"]
         tf = d.transform or {}
         parts = [_kv([
-            ("CRS", _esc(res.get("crs") or d.crs)),
+            ("CRS", _esc(crs_label(res.get("crs") or d.crs))),
             ("Source of the datum", _esc(tf.get("source", "–"))),
             ("Local frame offset (world = local + offset)", _esc(", ".join(f"{v:.1f}" for v in d.offset))),
             ("Tie-point reprojection error after the adjustment",
              f"{_f(res.get('mean_reprojection_error_px'), 3)} px"),
-            ("GCP observation reprojection error (mean)", f"{_f(res.get('gcp_reprojection_error_px'), 3)} px"),
+            ("GCP observation reprojection error in the adjustment (mean; control held at its coordinates "
+             "within its sigmas)", f"{_f(res.get('gcp_reprojection_error_px'), 3)} px"),
         ])]
         if acc["placeholder_z"]:
             parts.append('<p class="warn">Every control point has the same height (a placeholder, not a surveyed '
@@ -867,7 +870,7 @@ class _Report:
         q = ax.quiver(xy[:, 0], xy[:, 1], dxy[:, 0] * k, dxy[:, 1] * k, angles="xy", scale_units="xy", scale=1,
                       color="#222222", width=0.004, zorder=5)
         ref = _nice(lmax)
-        ax.quiverkey(q, 0.85, 1.03, ref * k, f"{ref:g} m", labelpos="E", coordinates="axes",
+        ax.quiverkey(q, 0.82, 0.96, ref * k, f"{ref:g} m", labelpos="E", coordinates="axes",
                      fontproperties={"size": 7})
         for p in pts:
             ax.annotate(p["name"], (p["x"], p["y"]), xytext=(4, 4), textcoords="offset points", fontsize=7)
@@ -875,7 +878,7 @@ class _Report:
             fig.colorbar(sc, ax=ax, shrink=0.7, label="dZ (m)")
         ax.legend(fontsize=7, loc="lower left")
         _equal_xy(ax)
-        ax.set_title(f"ground point residuals ({_esc(d.crs or '')})", fontsize=9)
+        ax.set_title(f"ground point residuals ({d.crs_label})", fontsize=9)
         return "<h3>Residual vectors over the footprint</h3>" + _img(
             fig, "residual vectors", f"Horizontal residual of each control (triangle) and check point (circle), "
             f"exaggerated ×{k:.3g} (key: {ref:g} m); colour: vertical residual. Systematic patterns (all arrows one "
@@ -948,6 +951,14 @@ class _Report:
             self.glance.append(_badge("warn", "no check points: accuracy not tested (control residuals only)"))
         if acc["placeholder_z"]:
             self.glance.append(_badge("warn", "control heights are placeholders: no vertical accuracy"))
+        if acc["tested"] and self.unc is not None:
+            sxy = self.unc.summary()["point_std_xy_median"]
+            rr = _num(st["check"]["rmse_r"])
+            if sxy and rr and rr > 5 * max(sxy, self.gsd or 0.0):
+                self.glance.append(_badge("bad", _esc(
+                    f"check-point RMSE XY is {rr / sxy:.0f} × the precision the adjustment predicts for tie points "
+                    f"({sxy:.3f} m): the errors are systematic (control coordinates, their marking, or a deformed "
+                    "block), not noise")))
         if acc["sets"]["rejected"]:
             self.glance.append(_badge("bad", "rejected control points: " + _esc(
                 ", ".join(p["name"] for p in acc["sets"]["rejected"]))))
@@ -999,7 +1010,7 @@ class _Report:
         self.figures.update(SIGMA0=_num(u.sigma0), POINT_STD_XY_MEDIAN=s["point_std_xy_median"],
                             POINT_STD_Z_MEDIAN=s["point_std_z_median"])
         parts = [_kv([
-            ("Datum", _esc(u.datum + (" (control points and/or camera positions)" if u.datum == "control" else ""))),
+            ("Datum", _esc(u.datum_text())),
             ("Sigma0 (a posteriori, unit weight = 1 px)", f'<span data-key="sigma0">{_f(u.sigma0, 3)}</span>'),
             ("Redundancy", f"{u.redundancy:,}"),
             ("Observations / points", f"{u.n_observations:,} / {u.n_points:,}"),
@@ -1036,7 +1047,7 @@ class _Report:
             vmax = float(np.percentile(z, 95))
             sc = ax2.scatter(xyz[order, 0], xyz[order, 1], c=z[order], s=1.5, cmap="magma_r", vmin=0, vmax=vmax,
                              lw=0)
-            fig.colorbar(sc, ax=ax2, shrink=0.8, label=f"σZ ({unit}), clipped at the 95th percentile")
+            fig.colorbar(sc, ax=ax2, shrink=0.8, label=f"σZ ({unit})")
             cxy = np.array([[c["x"], c["y"]] for c in u.cameras]) + u.offset[:2]
             ax2.scatter(cxy[:, 0], cxy[:, 1], s=12, marker="s", c="#4477aa", label="cameras")
             if u.control:
@@ -1048,8 +1059,9 @@ class _Report:
             ax2.legend(fontsize=7, loc="lower left")
             _equal_xy(ax2)
             parts.append(_img(fig, "point standard deviations",
-                              "Left: distribution of the tie points' standard deviations. Right: σZ over the block "
-                              "(precision degrades where few images overlap and away from control)."))
+                              "Left: distribution of the tie points' standard deviations. Right: σZ over the block, "
+                              "colours clipped at the 95th percentile (precision degrades where few images overlap "
+                              "and away from control)."))
         rows = [[_td(c["image"]), _td(c["camera_id"]), _cell(c["sx"], 3), _cell(c["sy"], 3), _cell(c["sz"], 3),
                  _cell(c["s_rx"], 4), _cell(c["s_ry"], 4), _cell(c["s_rz"], 4)] for c in u.cameras]
         parts.append("<details><summary>Per camera: standard deviations</summary>" + _table(
@@ -1153,6 +1165,19 @@ class _Report:
             " with hillshade (sun from the north-west, 45°)." if dem else "."))
 
 
+def _precision_badge(unc, gsd: Optional[float]) -> str:
+    """Green when the tie points' median sigma XY is within 3 GSD, amber (with the likely reason) beyond."""
+    s = unc.summary()
+    sxy, sz = s["point_std_xy_median"], s["point_std_z_median"]
+    txt = f"precision from the adjustment: tie points σXY {_f(sxy, 3)} m, σZ {_f(sz, 3)} m (median)"
+    if sxy is None or gsd is None or sxy <= 3 * gsd:
+        return _badge("ok", _esc(txt))
+    why = (" — the datum is weak: positions of limited accuracy (e.g. EXIF GPS) leave the block free to shift and "
+           "tilt; add ground control points" if not unc.n_control else
+           " — the control does not hold the block well (too few or badly spread control points)")
+    return _badge("warn", _esc(txt + f", more than 3 × the GSD ({gsd:.3f} m)" + why))
+
+
 def _nice(v: float) -> float:
     """A round number near v (1, 2, 5 × 10^k) for plot keys."""
     if not v or not math.isfinite(v) or v <= 0:
@@ -1162,6 +1187,28 @@ def _nice(v: float) -> float:
         if m * 10 ** e <= v:
             return float(m * 10 ** e)
     return float(10 ** e)
+
+
+def crs_label(crs: Optional[str]) -> str:
+    """A short name for a CRS given as EPSG code, WKT or proj string, e.g. "EPSG:32611 (WGS 84 / UTM zone 11N)";
+    a proj string that matches an EPSG definition is named by it ("~" marks the match)."""
+    if not crs:
+        return "local model frame"
+    try:
+        from osgeo import osr
+
+        srs = osr.SpatialReference()
+        if srs.SetFromUserInput(str(crs)) != 0:
+            return str(crs)
+        code = srs.GetAuthorityCode(None)
+        if code:
+            return f"{srs.GetAuthorityName(None)}:{code} ({srs.GetName()})"
+        for m, conf in srs.FindMatches() or []:
+            if conf >= 70 and m.GetAuthorityCode(None):
+                return f"~{m.GetAuthorityName(None)}:{m.GetAuthorityCode(None)} ({m.GetName()})"
+        return srs.GetName() or str(crs)
+    except Exception:  # noqa: BLE001 - GDAL raises or returns codes depending on UseExceptions
+        return str(crs)
 
 
 def _crs_name(ds) -> str:
@@ -1330,9 +1377,7 @@ def build_report(workspace_dir: str, output_html: Optional[str] = None, *, uncer
         else:
             rep.glance.insert(0, _badge("bad", "no aligned model: run 'Align images'"))
         if rep.unc is not None and georef:
-            s = rep.unc.summary()
-            rep.glance.append(_badge("ok", f"precision from the adjustment: tie points σXY {_f(s['point_std_xy_median'], 3)}"
-                                           f" m, σZ {_f(s['point_std_z_median'], 3)} m (median)"))
+            rep.glance.append(_precision_badge(rep.unc, rep.gsd))
         if status.get("products") != "ok":
             rep.glance.append(_badge("note", "no DSM / orthomosaic yet"))
         now = _dt.datetime.now().astimezone().isoformat(timespec="seconds")

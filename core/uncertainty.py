@@ -23,7 +23,8 @@ frame and units ("free network").
 
 Why not ``pycolmap.estimate_ba_covariance``: it needs a Ceres problem built by pycolmap's own bundle
 adjusters, which have no prior on a 3-D point (GCPs), so it cannot give the precision of a
-GCP-controlled block.  The derivatives here are analytic for the rigid part and central differences
+GCP-controlled block.  Without control the two agree (tests/test_report.py compares the intrinsics'
+standard deviations with ``estimate_ba_covariance`` to 0.1 %).  The derivatives here are analytic for the rigid part and central differences
 through pycolmap's camera model (``Camera.img_from_cam``), so every COLMAP camera model works.
 
 Simplifications, stated in the result's ``notes``: each image has its own pose (rigs are treated as
@@ -110,6 +111,18 @@ class UncertaintyResult:
     offset: np.ndarray = field(default_factory=lambda: np.zeros(3))
     notes: List[str] = field(default_factory=list)
     seconds: float = 0.0
+    n_control: int = 0  # control points that entered as priors
+    n_camera_priors: int = 0  # cameras with a position prior
+
+    def datum_text(self) -> str:
+        if self.datum == DATUM_FREE and not (self.n_control or self.n_camera_priors):
+            return "free network (no control): positions in the arbitrary model frame"
+        src = []
+        if self.n_control:
+            src.append(f"{self.n_control} control point(s)")
+        if self.n_camera_priors:
+            src.append(f"{self.n_camera_priors} camera position(s)")
+        return " and ".join(src) + (" (singular: generalised inverse)" if self.datum == DATUM_FREE else "")
 
     def summary(self) -> Dict[str, Any]:
         cs = np.array([[c["sx"], c["sy"], c["sz"]] for c in self.cameras], dtype=float).reshape(-1, 3)
@@ -303,15 +316,15 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
     o_res = obs.residual[sel]
     o_sig = np.full(len(o_img), float(tie_sigma_px))
     o_rob = np.ones(len(o_img), dtype=bool)
-    X = obs.xyz[keep_pt].copy()
-    n_tie = len(X)
+    xyz_all = obs.xyz[keep_pt].copy()
+    n_tie = len(xyz_all)
 
     # control points: extra points with priors and their own observations
     prior_idx, prior_xyz, prior_sig = [], [], []
     c_img, c_pt, c_res = [], [], []
     ctl_rows = []
     for c in control:
-        k = len(X)
+        k = len(xyz_all)
         rows = []
         for name, x, y in c.observations:
             j = img_index.get(name)
@@ -326,7 +339,7 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
             rows.append((j, uv - np.array([x, y])))
         if not rows:  # not connected to the block
             continue
-        X = np.vstack([X, np.asarray(c.xyz, dtype=float)[None]])
+        xyz_all = np.vstack([xyz_all, np.asarray(c.xyz, dtype=float)[None]])
         for j, r in rows:
             c_img.append(j)
             c_pt.append(k)
@@ -341,7 +354,7 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
         o_res = np.vstack([o_res, np.asarray(c_res, dtype=float)])
         o_sig = np.concatenate([o_sig, np.full(len(c_img), float(gcp_sigma_px))])
         o_rob = np.concatenate([o_rob, np.zeros(len(c_img), dtype=bool)])
-    n_pts = len(X)
+    n_pts = len(xyz_all)
     n_o = len(o_img)
 
     # weights (Huber on tie points, as in the adjustment)
@@ -369,7 +382,7 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
         cam = rec.cameras[im.camera_id]
         m = np.asarray(im.cam_from_world().matrix())
         r = m[:, :3]
-        xc = X[o_pt[rows]] @ r.T + m[:, 3]
+        xc = xyz_all[o_pt[rows]] @ r.T + m[:, 3]
         jpi = _proj_jacobian(cam, xc)
         jc[rows, :, 0:3] = np.einsum("nij,njk->nik", jpi, -_skew(xc))
         jc[rows, :, 3:6] = jpi @ (-r)
@@ -405,8 +418,9 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
         pi = np.asarray(prior_idx)
         ps = np.asarray(prior_sig)
         npp[pi] += np.einsum("ni,ij->nij", 1.0 / ps ** 2, np.eye(3))
-        prior_res.append(((X[pi] - np.asarray(prior_xyz)) / ps).ravel())
+        prior_res.append(((xyz_all[pi] - np.asarray(prior_xyz)) / ps).ravel())
     n_cam_prior_comp = 0
+    cams_with_prior = set()
     centres = np.array([np.asarray(im.projection_center(), dtype=float) for im in images])
     for cp in camera_priors:
         j = img_index.get(cp.image)
@@ -417,6 +431,7 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
                 ncc[6 * j + 3 + a, 6 * j + 3 + a] += 1.0 / cp.sigma[a] ** 2
                 prior_res.append(np.array([(centres[j, a] - cp.xyz[a]) / cp.sigma[a]]))
                 n_cam_prior_comp += 1
+                cams_with_prior.add(j)
     # points seen only once and without a prior cannot be estimated: drop them
     npp_inv = _inv3(npp)
     bad = ~np.all(np.isfinite(npp_inv.reshape(n_pts, -1)), axis=1)
@@ -514,10 +529,10 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
     progress.report(1.0, "covariance done")
     return UncertaintyResult(
         datum=datum, sigma0=sigma0, redundancy=redundancy, n_observations=n_o, n_points=n_tie,
-        cameras=cameras, intrinsics=intr, point_ids=obs.point_ids[keep_pt], point_xyz=X[:n_tie],
+        cameras=cameras, intrinsics=intr, point_ids=obs.point_ids[keep_pt], point_xyz=xyz_all[:n_tie],
         point_std=pstd[:n_tie], control=control_rows,
         offset=np.zeros(3) if offset is None else np.asarray(offset, dtype=float), notes=notes,
-        seconds=round(time.time() - t0, 3))
+        seconds=round(time.time() - t0, 3), n_control=n_ctl, n_camera_priors=len(cams_with_prior))
 
 
 # --------------------------------------------------------------------------------------------------
