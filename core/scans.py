@@ -566,9 +566,47 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
             else:
                 warnings.append(f"{os.path.basename(path)}: fiducial {slot}: centre of symmetry not found, "
                                 "correlation peak used")
-        out.append(Fiducial(slot=slot, x=x0 + px + 0.5, y=y0 + py + 0.5, score=min(sc, fine_score) if fine_score > 0 else sc,
-                            kind=kind, size_px=size_full, polarity=int(pol)))
+        cx_full, cy_full = x0 + px + 0.5, y0 + py + 0.5
+        extent = _mark_extent(ds, cx_full, cy_full, size_full)
+        out.append(Fiducial(slot=slot, x=cx_full, y=cy_full, score=min(sc, fine_score) if fine_score > 0 else sc,
+                            kind=kind, size_px=max(size_full, extent), polarity=int(pol)))
     return out, warnings
+
+
+def _mark_extent(ds, x: float, y: float, size: float) -> float:
+    """Diameter (scan pixels) of the mark at (x, y): out to where its contrast with the ground ends.
+
+    Guards the masks against a mark classified by its inner part only (the
+    dot of a dot-in-circle).  Stops at the first gap, so a data strip or the
+    picture beyond the ground does not count.
+    """
+    r = int(min(max(3.0 * size, 12.0), 400.0))
+    xi, yi = int(x), int(y)
+    x0, y0 = max(0, xi - r), max(0, yi - r)
+    x1, y1 = min(ds.RasterXSize, xi + r + 1), min(ds.RasterYSize, yi + r + 1)
+    g = _grey_window(ds, x0, y0, x1 - x0, y1 - y0)
+    yy, xx = np.mgrid[y0:y1, x0:x1]
+    d = np.hypot(xx + 0.5 - x, yy + 0.5 - y)
+    core = d <= 0.5 * size
+    ring = (d > 0.75 * size) & (d <= 1.0 * size)
+    if not ring.any() or not core.any():
+        return size
+    ground = float(np.median(g[ring]))
+    dev = np.abs(g - ground)
+    noise = 1.4826 * float(np.median(np.abs(g[ring] - ground))) + 1e-6
+    thr = max(5.0 * noise, 0.25 * float(np.percentile(dev[core], 99)))
+    radius, gap = 0.0, 0
+    for k in range(int(r)):
+        ann = (d >= k) & (d < k + 1)
+        if not ann.any():
+            break
+        if float(np.percentile(dev[ann], 95)) > thr:
+            radius, gap = k + 1.0, 0
+        else:
+            gap += 1
+            if gap >= 3 and k > 0.25 * size:
+                break
+    return 2.0 * radius
 
 
 # ---------------------------------------------------------------------------
