@@ -1,0 +1,1663 @@
+"""True orthophotos per image, the orthomosaic, and single-image orthorectification on an existing DSM.
+
+Pure Python + numpy + OpenCV + GDAL: no qgis, no Qt (DESIGN.md §1).
+
+How a cell of an orthophoto gets its value
+------------------------------------------
+Every output cell (a north-up grid in the working CRS) takes its height from the DSM (bilinear), goes
+through the full camera model (pose, intrinsics, lens distortion: :class:`core.resection.Intrinsics`) into
+the image, and is sampled there (bilinear by default, cubic or nearest on request; 8/16-bit, float, any
+number of bands, kept as they are).  A cell is *nodata* (alpha 0) when it falls outside the image, in a
+masked area (``<workspace>/masks/<image>.png``, white = use), where the DSM has no height, or when it is
+hidden from that camera by higher surface.
+
+Occlusion: radial sweep from the nadir point
+--------------------------------------------
+Seen from a camera at height H over the nadir point N, a surface point at horizontal distance r and height z
+has the "tangent" t = r / (H - z).  Along every radial line from N, a point is visible exactly when its t is
+not below the largest t of the surface closer to N (Habib et al. 2007, angle-based true orthophotos).  Per
+image the DSM is resampled on a polar grid around N (bins of half a DSM cell), the running maximum of t is
+taken along each ray (``np.maximum.accumulate``), and a cell is hidden when its height lies more than a small
+tolerance below the sight line over that maximum.  The polar table is built once per image from the DSM of
+its footprint and cached on disk, so a tile needs only table look-ups: no z-buffer splatting artefacts, no
+per-cell ray marching, and memory per image independent of the output area.
+
+Orthomosaic
+-----------
+1. A *planning grid* (a few GSD per cell, its size fixed in ground units, independent of the output
+   resolution) holds for every image its validity and a cost (squared distance from the principal point +
+   squared tangent of the viewing angle: "closest to nadir"); each planning cell takes the cheapest valid
+   image.
+2. Seamlines avoid relief: objects standing above their surroundings (buildings, trees: a morphological
+   top-hat of the DSM) are given whole to one image that sees all of them, so no seam cuts a roof or a crown
+   (where a seam would show any DSM error as a step).
+3. Exposure: one gain per image from the mean brightness of the overlaps (least squares, as OpenCV's gain
+   compensator).
+4. Tiles (512 cells, memory bounded by one tile and the caches): each image's label region is feathered
+   (a linear ramp across the seam), or blended with a Laplacian pyramid (multi-band), or cut hard; cells whose
+   image is occluded there at full resolution are filled from the best image that sees them.
+5. Tiles stream into a tiled GeoTIFF that becomes a Cloud-Optimized GeoTIFF with overviews; optional per-image
+   true orthophotos (COG) and a GeoPackage layer of which image each part of the mosaic comes from.
+
+Outputs are written to a temporary name and renamed when complete (``core.workspace.atomic_output``).
+"""
+from __future__ import annotations
+
+import contextlib
+import fnmatch
+import json
+import math
+import os
+import shutil
+import tempfile
+import time
+from collections import OrderedDict
+from dataclasses import asdict, dataclass, field
+from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from . import dsm as dsmmod
+from .progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
+from .resection import Intrinsics, Pose
+from .workspace import CANCELLED, DONE, FAILED, STAGE_ORDER, Workspace, atomic_output, file_fingerprint, fingerprint
+
+STAGE = "orthophoto"
+BLENDINGS = ("feather", "multiband", "none")
+INTERPOLATIONS = ("bilinear", "cubic", "nearest")
+PLANNING_GSD = 4.0  # planning cell = 4 x GSD
+MAX_PLANNING_CELLS = 4096 * 4096
+MAX_POLAR_CELLS = 12_000_000
+
+
+class OrthoError(RuntimeError):
+    """Orthophoto production cannot run with this input; the message says why."""
+
+
+@dataclass
+class OrthoOptions:
+    """Options of the orthophoto stage (one dataclass, as OpenSfM's config)."""
+
+    resolution: float = 0.0  # output cell size in CRS units; 0 = the images' median ground sample distance
+    blending: str = "feather"  # feather / multiband / none
+    interpolation: str = "bilinear"  # bilinear / cubic / nearest
+    tile: int = 512  # output cells per tile side
+    feather_gsd: float = 16.0  # width of the feathering ramp across a seam, in GSD
+    occlusion: bool = True  # leave cells hidden from a camera nodata (true orthophoto)
+    height_tolerance: float = 0.0  # m below the sight line still counted visible; 0 = max(0.1, DSM cell)
+    exposure: bool = True  # per-image gain compensation in the mosaic
+    avoid_relief: bool = True  # keep seamlines off buildings and trees
+    relief_height: float = 1.5  # m above the surroundings that makes an object seams go around
+    compress: str = "DEFLATE"
+    cache_mb: int = 384  # decoded images + visibility tables kept in memory
+    workers: int = 1  # tile workers (core.parallel); 0 = one per core
+    scheduler: Optional[str] = None  # Dask scheduler address
+
+    def check(self) -> None:
+        if self.blending not in BLENDINGS:
+            raise OrthoError(f"unknown BLENDING {self.blending!r}; choose one of {', '.join(BLENDINGS)}")
+        if self.interpolation not in INTERPOLATIONS:
+            raise OrthoError(f"unknown interpolation {self.interpolation!r}; choose one of {', '.join(INTERPOLATIONS)}")
+        if self.resolution is None or not math.isfinite(self.resolution) or self.resolution < 0:
+            raise OrthoError(f"RESOLUTION must be 0 (the ground sample distance) or a positive number of metres, "
+                             f"got {self.resolution}")
+        if self.tile < 64:
+            raise OrthoError(f"tile size must be at least 64 cells, got {self.tile}")
+
+
+# ---------------------------------------------------------------------------
+# cameras
+# ---------------------------------------------------------------------------
+
+@dataclass
+class OrthoCamera:
+    """One image with its orientation in the local frame (world = local + offset)."""
+
+    name: str
+    path: str
+    camera: Intrinsics
+    pose: Pose
+    camera_id: int = 0
+    mask_path: Optional[str] = None
+
+    @property
+    def centre(self) -> np.ndarray:
+        return self.pose.centre
+
+    def project(self, xyz_local: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(pixels (N, 2), depth (N,), ok (N,): in front, trusted by the lens model and inside the image)."""
+        xc = self.pose.to_camera(xyz_local)
+        px, ok = self.camera.project(xc)
+        ok &= self.camera.inside(px) & np.all(np.isfinite(px), axis=-1)
+        return px, xc[..., 2], ok
+
+
+def find_mask(masks_dir: Optional[str], name: str) -> Optional[str]:
+    """``masks/<image>.png`` (as core.scans writes them) or ``masks/<stem>.png``; None if there is none."""
+    if not masks_dir or not os.path.isdir(masks_dir):
+        return None
+    for cand in (name + ".png", os.path.splitext(name)[0] + ".png"):
+        p = os.path.join(masks_dir, cand)
+        if os.path.isfile(p):
+            return p
+    return None
+
+
+def cameras_from_reconstruction(rec, images_dir: str, masks_dir: Optional[str] = None) -> List[OrthoCamera]:
+    """OrthoCameras of the registered images of a pycolmap.Reconstruction (its frame = the local frame)."""
+    out = []
+    for im in sorted(rec.images.values(), key=lambda i: i.name):
+        if not im.has_pose:
+            continue
+        cam = rec.cameras[im.camera_id]
+        p = im.cam_from_world()
+        pose = Pose(np.asarray(p.rotation.matrix(), dtype=float), np.asarray(p.translation, dtype=float))
+        out.append(OrthoCamera(im.name, os.path.join(images_dir or "", im.name), Intrinsics.from_pycolmap(cam), pose,
+                               int(im.camera_id), find_mask(masks_dir, im.name)))
+    return out
+
+
+def select_cameras(cameras: Sequence[OrthoCamera], images_filter: Optional[str],
+                   camera_groups: Sequence[dict] = ()) -> List[OrthoCamera]:
+    """The cameras an IMAGES_FILTER names.
+
+    The filter is a list separated by commas, semicolons or new lines; each item is an image name, a wildcard
+    (``DJI_00*.JPG``, case-insensitive), or ``group:<n>`` / ``group:<text>`` for a camera group by id or by a
+    part of its make, model or key (``group:2``, ``group:FC300X``, ``group:NIR``).  An item starting with ``!``
+    removes what it matches.  Empty: all."""
+    if not images_filter or not images_filter.strip():
+        return list(cameras)
+    items = [s.strip() for s in images_filter.replace(";", ",").replace("\n", ",").split(",") if s.strip()]
+    chosen: "OrderedDict[str, OrthoCamera]" = OrderedDict()
+    positive = [i for i in items if not i.startswith("!")]
+    negative = [i[1:].strip() for i in items if i.startswith("!")]
+    unmatched = []
+
+    def matches(item: str) -> List[OrthoCamera]:
+        if item.lower().startswith("group:"):
+            key = item.split(":", 1)[1].strip().lower()
+            ids = set()
+            for g in camera_groups:
+                gid = str(g.get("camera_id", ""))
+                text = " ".join(str(g.get(k, "")) for k in ("key", "make", "model")).lower()
+                if key == gid or (key and key in text):
+                    ids.add(int(g.get("camera_id")))
+            names = {n for g in camera_groups if int(g.get("camera_id", -1)) in ids for n in g.get("images", [])}
+            return [c for c in cameras if c.camera_id in ids or c.name in names]
+        pat = item.lower()
+        return [c for c in cameras if fnmatch.fnmatchcase(c.name.lower(), pat)
+                or fnmatch.fnmatchcase(os.path.basename(c.name).lower(), pat)]
+
+    for item in positive or ["*"]:
+        found = matches(item)
+        if not found:
+            unmatched.append(item)
+        for c in found:
+            chosen[c.name] = c
+    for item in negative:
+        for c in matches(item):
+            chosen.pop(c.name, None)
+    if not chosen:
+        examples = ", ".join(c.name for c in list(cameras)[:5])
+        groups = ", ".join(f"{g.get('camera_id')}: {g.get('model') or g.get('key')}" for g in camera_groups)
+        raise OrthoError(f"IMAGES_FILTER {images_filter!r} matches none of the {len(cameras)} oriented images "
+                         f"(for example {examples}{'; camera groups ' + groups if groups else ''})")
+    return list(chosen.values())
+
+
+# ---------------------------------------------------------------------------
+# DSM access (through core.dsm.DsmReader, reprojected into the working CRS on the fly)
+# ---------------------------------------------------------------------------
+
+class _Dsm:
+    """Heights from a DSM in the working CRS, in world coordinates (NaN = no height)."""
+
+    def __init__(self, path: str, crs: Optional[str]):
+        try:
+            self.info = dsmmod.open_dsm(path)
+        except dsmmod.DsmError as e:
+            raise OrthoError(str(e)) from e
+        if crs and not self.info.crs_wkt:
+            raise OrthoError(f"DSM {path} has no CRS: it cannot be placed in {crs}; assign its CRS first")
+        self.path = path
+        self.crs = crs
+        self.reader = dsmmod.DsmReader(path, target_crs=crs)
+        gt = self.reader.geotransform
+        self.geotransform = gt
+        self.res = float(min(abs(gt[1]), abs(gt[5])))
+        xs = (gt[0], gt[0] + self.reader.width * gt[1])
+        ys = (gt[3], gt[3] + self.reader.height * gt[5])
+        self.bounds = (min(xs), min(ys), max(xs), max(ys))
+        self.reprojected = bool(crs and self.info.crs_wkt and not _same_crs(self.info.crs_wkt, crs))
+
+    def close(self):
+        self.reader.close()
+
+    def sample(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        return self.reader.sample(x, y)
+
+    def window(self, box: Tuple[float, float, float, float]) -> Tuple[np.ndarray, Tuple[float, ...]]:
+        """Heights of the cells covering ``box`` (full resolution), with their geotransform; (0, 0) if outside."""
+        return self.reader.read_window(*box)
+
+    def window_sampler(self, box: Tuple[float, float, float, float], margin_cells: int = 2):
+        """A bilinear sampler over one window read once: f(x, y) -> z (NaN outside)."""
+        g = self.geotransform
+        m = margin_cells * self.res
+        arr, wgt = self.window((box[0] - m, box[1] - m, box[2] + m, box[3] + m))
+
+        arr32 = arr.astype(np.float32) if arr.size else arr
+
+        def f(x, y):
+            x = np.asarray(x, dtype=np.float64)
+            if arr.size == 0:
+                return np.full(x.shape, np.nan)
+            fc = (x - wgt[0]) / g[1] - 0.5
+            fr = (np.asarray(y, dtype=np.float64) - wgt[3]) / g[5] - 0.5
+            if arr.shape[0] < 2 or arr.shape[1] < 2 or max(arr.shape) >= 32767:
+                return dsmmod.bilinear(arr, fc, fr)
+            # cv2.remap: bilinear, NaN where a neighbour is NaN (like dsm.bilinear), far faster
+            out = _remap(arr32[:, :, None], fc.ravel(), fr.ravel(), "bilinear", border_nan=True)[:, 0]
+            return out.reshape(x.shape).astype(np.float64)
+        return f
+
+    def coarse(self, box: Tuple[float, float, float, float], max_cells: int = 1_000_000
+               ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Heights on a coarse grid over ``box`` (at most ``max_cells`` samples): (z, x, y) 2-D arrays."""
+        x0, y0, x1, y1 = box
+        x0, y0 = max(x0, self.bounds[0]), max(y0, self.bounds[1])
+        x1, y1 = min(x1, self.bounds[2]), min(y1, self.bounds[3])
+        if x1 <= x0 or y1 <= y0:
+            return np.zeros((0, 0)), np.zeros((0, 0)), np.zeros((0, 0))
+        step = max(self.res, math.sqrt((x1 - x0) * (y1 - y0) / max_cells))
+        xs = np.arange(x0 + step / 2, x1, step)
+        ys = np.arange(y1 - step / 2, y0, -step)
+        out = np.full((len(ys), len(xs)), np.nan)
+        rows = max(1, int(4_000_000 * self.res * self.res / max(1e-12, (x1 - x0) * step)))  # bound window reads
+        for r0 in range(0, len(ys), rows):
+            yy = ys[r0:r0 + rows]
+            gx, gy = np.meshgrid(xs, yy)
+            out[r0:r0 + len(yy)] = self.sample(gx, gy)
+        gx, gy = np.meshgrid(xs, ys)
+        return out, gx, gy
+
+
+def _same_crs(wkt: str, crs: str) -> bool:
+    from osgeo import osr
+
+    a = osr.SpatialReference(wkt=wkt)
+    b = osr.SpatialReference()
+    try:
+        b.SetFromUserInput(crs)
+    except RuntimeError:
+        return False
+    return bool(a.IsSame(b))
+
+
+# ---------------------------------------------------------------------------
+# footprints and visibility
+# ---------------------------------------------------------------------------
+
+@dataclass
+class Footprint:
+    polygon: np.ndarray  # (K, 2) world XY, convex, counter-clockwise
+    bbox: Tuple[float, float, float, float]
+    gsd: float  # ground sample distance at the nadir-most view, metres per pixel
+    z_ref: float
+
+
+def camera_footprint(cam: OrthoCamera, offset: np.ndarray, z_lo: float, z_hi: float,
+                     max_range_factor: float = 15.0) -> Optional[Footprint]:
+    """Ground area the image can see between heights z_lo and z_hi (world): the image border's rays
+    intersected with both planes (rays near the horizon clipped at ``max_range_factor`` x the height)."""
+    w, h = cam.camera.width, cam.camera.height
+    t = np.linspace(0.0, 1.0, 17)
+    border = np.concatenate([np.column_stack([t * w, np.zeros_like(t)]), np.column_stack([np.full_like(t, w), t * h]),
+                             np.column_stack([(1 - t) * w, np.full_like(t, h)]), np.column_stack([np.zeros_like(t), (1 - t) * h])])
+    xn = cam.camera.unproject(border)
+    d = np.column_stack([xn, np.ones(len(xn))]) @ cam.pose.rotation  # world directions (R^T d)
+    c = cam.centre + offset
+    pts = []
+    for z in (z_lo, z_hi):
+        height = c[2] - z
+        if height <= 0:
+            continue
+        max_h = max_range_factor * height
+        for di in d:
+            horiz = math.hypot(di[0], di[1])
+            if di[2] < -1e-9:
+                s = (z - c[2]) / di[2]
+                if s * horiz > max_h:
+                    s = max_h / max(horiz, 1e-12)
+            elif horiz > 1e-12:
+                s = max_h / horiz
+            else:
+                continue
+            pts.append((c[0] + s * di[0], c[1] + s * di[1]))
+    if len(pts) < 3:
+        return None
+    poly = dsmmod.convex_hull_xy(np.array(pts))
+    if len(poly) < 3:
+        return None
+    xmin, ymin = poly.min(axis=0)
+    xmax, ymax = poly.max(axis=0)
+    z_ref = 0.5 * (z_lo + z_hi)
+    gsd = max(c[2] - z_ref, 1e-6) / cam.camera.focal
+    return Footprint(poly, (float(xmin), float(ymin), float(xmax), float(ymax)), float(gsd), float(z_ref))
+
+
+def _point_in_polygon(poly: np.ndarray, x: float, y: float) -> bool:
+    from matplotlib.path import Path
+
+    return bool(Path(poly).contains_point((x, y)))
+
+
+@dataclass
+class Visibility:
+    """Polar occlusion table of one camera (see the module docstring).  ``table`` holds, per angle row and
+    radius bin k, the largest t = r / (H - z) of the surface in bins < k."""
+
+    nadir: Tuple[float, float]
+    height: float  # camera Z (world)
+    dr: float
+    phi0: float
+    dphi: float
+    n_phi: int
+    n_r: int
+    full_circle: bool
+    tolerance: float
+    path: str = ""
+    table: Optional[np.ndarray] = field(default=None, repr=False)
+
+    def nbytes(self) -> int:
+        return self.n_phi * self.n_r * 4
+
+    def load(self) -> np.ndarray:
+        if self.table is None:
+            self.table = np.load(self.path)
+        return self.table
+
+    def visible(self, x: np.ndarray, y: np.ndarray, z: np.ndarray, table: Optional[np.ndarray] = None) -> np.ndarray:
+        tab = self.load() if table is None else table
+        dx = x - self.nadir[0]
+        dy = y - self.nadir[1]
+        r = np.hypot(dx, dy)
+        a = np.arctan2(dy, dx) - self.phi0
+        a = np.mod(a, 2 * np.pi)
+        j = np.rint(a / self.dphi).astype(np.int64)
+        if self.full_circle:
+            j %= self.n_phi
+            inside = np.ones(j.shape, dtype=bool)
+        else:
+            inside = (j >= 0) & (j < self.n_phi)
+            j = np.clip(j, 0, self.n_phi - 1)
+        k = np.clip(np.floor(r / self.dr).astype(np.int64) - 1, 0, self.n_r - 1)
+        m = tab[j, k]
+        vis = (self.height - z - self.tolerance) * m <= r
+        return vis | ~inside
+
+
+def build_visibility(cam: OrthoCamera, offset: np.ndarray, fp: Footprint, dsm: _Dsm, tolerance: float,
+                     path: str = "") -> Visibility:
+    """The polar occlusion table of ``cam`` over its footprint (saved to ``path`` when given)."""
+    c = cam.centre + offset
+    nx, ny, hz = float(c[0]), float(c[1]), float(c[2])
+    poly = fp.polygon
+    rel = poly - [nx, ny]
+    r_max = float(np.max(np.hypot(rel[:, 0], rel[:, 1])))
+    dr = max(0.5 * dsm.res, 0.5 * fp.gsd, 1e-3)  # finer than the DSM or the image resolves is wasted
+    full = _point_in_polygon(poly, nx, ny) or r_max < 4 * dr
+    if full:
+        phi0, span = -math.pi, 2 * math.pi
+    else:
+        ang = np.arctan2(rel[:, 1], rel[:, 0])
+        centre_dir = math.atan2(float(np.mean(rel[:, 1])), float(np.mean(rel[:, 0])))
+        da = np.mod(ang - centre_dir + np.pi, 2 * np.pi) - np.pi
+        lo, hi = float(da.min()), float(da.max())
+        pad = 0.02
+        phi0, span = centre_dir + lo - pad, (hi - lo) + 2 * pad
+        if span >= 2 * math.pi - 1e-6:
+            full, phi0, span = True, -math.pi, 2 * math.pi
+    r_max += 2 * dr
+    n_r = int(math.ceil(r_max / dr)) + 1
+    n_phi = max(8, int(math.ceil(span * r_max / dr)))
+    while n_r * n_phi > MAX_POLAR_CELLS:
+        dr *= 1.25
+        n_r = int(math.ceil(r_max / dr)) + 1
+        n_phi = max(8, int(math.ceil(span * r_max / dr)))
+    dphi = span / n_phi
+    sampler = dsm.window_sampler((nx - r_max, ny - r_max, nx + r_max, ny + r_max) if full else
+                                 (min(nx, poly[:, 0].min()), min(ny, poly[:, 1].min()),
+                                  max(nx, poly[:, 0].max()), max(ny, poly[:, 1].max())))
+    table = np.empty((n_phi, n_r), dtype=np.float32)
+    radii = (np.arange(n_r) + 0.5) * dr
+    rows = max(1, 2_000_000 // n_r)
+    for j0 in range(0, n_phi, rows):
+        phis = phi0 + np.arange(j0, min(n_phi, j0 + rows)) * dphi
+        xx = nx + np.cos(phis)[:, None] * radii[None, :]
+        yy = ny + np.sin(phis)[:, None] * radii[None, :]
+        z = sampler(xx, yy)
+        depth = hz - z
+        t = np.where(np.isfinite(z), np.where(depth > 1e-6, radii[None, :] / np.maximum(depth, 1e-6), np.inf), 0.0)
+        cm = np.maximum.accumulate(t, axis=1)
+        table[j0:j0 + len(phis), 0] = 0.0
+        table[j0:j0 + len(phis), 1:] = cm[:, :-1]
+    vis = Visibility((nx, ny), hz, dr, phi0, dphi, n_phi, n_r, full, tolerance, path)
+    if path:
+        np.save(path, table)
+    else:
+        vis.table = table
+    return vis
+
+
+# ---------------------------------------------------------------------------
+# image access and sampling
+# ---------------------------------------------------------------------------
+
+class _LRU:
+    """A byte-bounded least-recently-used cache."""
+
+    def __init__(self, max_bytes: int):
+        self.max_bytes = max_bytes
+        self.items: "OrderedDict[Any, Tuple[Any, int]]" = OrderedDict()
+        self.size = 0
+
+    def get(self, key, make):
+        if key in self.items:
+            self.items.move_to_end(key)
+            return self.items[key][0]
+        value, nbytes = make()
+        self.items[key] = (value, nbytes)
+        self.size += nbytes
+        while self.size > self.max_bytes and len(self.items) > 1:
+            _, (_, nb) = self.items.popitem(last=False)
+            self.size -= nb
+        return value
+
+    def clear(self):
+        self.items.clear()
+        self.size = 0
+
+
+_CACHE = _LRU(384 << 20)
+_WHOLE_IMAGE_MAX = 96 << 20  # images up to this size are decoded whole and cached; larger ones read by window
+
+
+def _gdal():
+    from osgeo import gdal
+
+    gdal.UseExceptions()
+    return gdal
+
+
+@dataclass
+class ImageMeta:
+    width: int
+    height: int
+    bands: int
+    dtype: str  # numpy dtype name
+
+
+def image_meta(path: str) -> ImageMeta:
+    gdal = _gdal()
+    from osgeo import gdal_array
+
+    try:
+        ds = gdal.Open(path)
+    except RuntimeError as e:
+        raise OrthoError(f"image {path} cannot be read: {e}") from e
+    if ds is None or ds.RasterCount == 0:
+        raise OrthoError(f"image {path} cannot be read")
+    dt = np.dtype(gdal_array.GDALTypeCodeToNumericTypeCode(ds.GetRasterBand(1).DataType)).name
+    return ImageMeta(ds.RasterXSize, ds.RasterYSize, ds.RasterCount, dt)
+
+
+def _read_window(path: str, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
+    gdal = _gdal()
+    ds = gdal.Open(path)
+    arr = ds.ReadAsArray(x0, y0, x1 - x0, y1 - y0)
+    if arr.ndim == 2:
+        arr = arr[:, :, None]
+    else:
+        arr = np.moveaxis(arr, 0, -1)
+    return np.ascontiguousarray(arr)
+
+
+def _image_window(path: str, meta: ImageMeta, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
+    nbytes = meta.width * meta.height * meta.bands * np.dtype(meta.dtype).itemsize
+    if nbytes <= _WHOLE_IMAGE_MAX:
+        whole = _CACHE.get(("img", path), lambda: (_read_window(path, 0, 0, meta.width, meta.height), nbytes))
+        return whole[y0:y1, x0:x1]
+    return _read_window(path, x0, y0, x1, y1)
+
+
+def _mask(path: Optional[str]) -> Optional[np.ndarray]:
+    if not path:
+        return None
+
+    def make():
+        import cv2
+
+        m = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
+        if m is None:
+            raise OrthoError(f"mask {path} cannot be read")
+        return m, m.nbytes
+    return _CACHE.get(("mask", path), make)
+
+
+def _table(vis: Visibility) -> np.ndarray:
+    if vis.table is not None:
+        return vis.table
+    return _CACHE.get(("vis", vis.path), lambda: (np.load(vis.path), vis.nbytes()))
+
+
+_CV_TYPES = ("uint8", "uint16", "int16", "float32")
+
+
+def _remap(src: np.ndarray, mx: np.ndarray, my: np.ndarray, interpolation: str, border_nan: bool = False
+           ) -> np.ndarray:
+    """cv2.remap of 1-D coordinate arrays (rows of 1024, as remap wants short sides) -> (N, bands) float32."""
+    import cv2
+
+    flag = {"bilinear": cv2.INTER_LINEAR, "cubic": cv2.INTER_CUBIC, "nearest": cv2.INTER_NEAREST}[interpolation]
+    n = mx.size
+    cols = 1024
+    rows = max(1, -(-n // cols))
+    pad = rows * cols - n
+    fx = np.pad(mx.astype(np.float32), (0, pad), constant_values=-10).reshape(rows, cols)
+    fy = np.pad(my.astype(np.float32), (0, pad), constant_values=-10).reshape(rows, cols)
+    if src.dtype.name not in _CV_TYPES:
+        src = src.astype(np.float32)
+    bands = src.shape[2]
+    out = np.empty((n, bands), dtype=np.float32)
+    border = cv2.BORDER_REPLICATE
+    kw = {}
+    if border_nan:
+        border, kw = cv2.BORDER_CONSTANT, {"borderValue": float("nan")}
+    for b0 in range(0, bands, 4):
+        part = np.ascontiguousarray(src[:, :, b0:b0 + 4])
+        if part.shape[2] == 1:
+            part = part[:, :, 0]
+        elif part.shape[2] == 2:  # remap takes 1, 3 or 4 channels
+            for k in range(2):
+                r = cv2.remap(np.ascontiguousarray(part[:, :, k]), fx, fy, flag, borderMode=border, **kw)
+                out[:, b0 + k] = r.reshape(-1)[:n]
+            continue
+        r = cv2.remap(part, fx, fy, flag, borderMode=border, **kw)
+        r = r.reshape(rows * cols, -1)[:n]
+        out[:, b0:b0 + r.shape[1]] = r
+    return out
+
+
+@dataclass
+class Sampled:
+    values: np.ndarray  # (N, bands) float32 (only rows where valid are meaningful)
+    valid: np.ndarray  # (N,) bool
+    cost: np.ndarray  # (N,) float32, inf where not valid
+
+
+def sample_camera(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.ndarray, y: np.ndarray,
+                  z: np.ndarray, vis: Optional[Visibility], interpolation: str = "bilinear",
+                  want_values: bool = True) -> Sampled:
+    """Values of ground points (world, 1-D arrays) in one image, with validity and the view cost."""
+    n = x.size
+    finite = np.isfinite(z)
+    xyz = np.column_stack([x - offset[0], y - offset[1], np.where(finite, z, 0.0) - offset[2]])
+    px, _depth, ok = cam.project(xyz)
+    ok &= finite
+    if vis is not None and ok.any():
+        idx = np.flatnonzero(ok)
+        ok[idx] = vis.visible(x[idx], y[idx], z[idx], _table(vis))
+    mask = _mask(cam.mask_path)
+    if mask is not None and ok.any():
+        idx = np.flatnonzero(ok)
+        mc = np.clip(px[idx, 0].astype(np.int64), 0, mask.shape[1] - 1)
+        mr = np.clip(px[idx, 1].astype(np.int64), 0, mask.shape[0] - 1)
+        ok[idx] = mask[mr, mc] >= 128
+    cost = np.full(n, np.inf, dtype=np.float32)
+    values = np.zeros((n, meta.bands), dtype=np.float32)
+    if not ok.any():
+        return Sampled(values, ok, cost)
+    idx = np.flatnonzero(ok)
+    c = cam.centre
+    dxy = np.hypot(xyz[idx, 0] - c[0], xyz[idx, 1] - c[1])
+    dz = np.maximum(c[2] - xyz[idx, 2], 1e-6)
+    half_diag = 0.5 * math.hypot(cam.camera.width, cam.camera.height)
+    rho = np.hypot(px[idx, 0] - cam.camera.cx, px[idx, 1] - cam.camera.cy) / half_diag
+    cost[idx] = (rho * rho + (dxy / dz) ** 2).astype(np.float32)
+    if want_values:
+        u = px[idx, 0] - 0.5
+        v = px[idx, 1] - 0.5
+        pad = 3
+        x0 = max(0, int(math.floor(u.min())) - pad)
+        y0 = max(0, int(math.floor(v.min())) - pad)
+        x1 = min(meta.width, int(math.ceil(u.max())) + pad + 1)
+        y1 = min(meta.height, int(math.ceil(v.max())) + pad + 1)
+        win = _image_window(cam.path, meta, x0, y0, x1, y1)
+        values[idx] = _remap(win, u - x0, v - y0, interpolation)
+    return Sampled(values, ok, cost)
+
+
+# ---------------------------------------------------------------------------
+# output rasters
+# ---------------------------------------------------------------------------
+
+def _alpha_value(dtype: str) -> Optional[float]:
+    dt = np.dtype(dtype)
+    if dt.kind in "ui":
+        return float(np.iinfo(dt).max)
+    return None  # float images: nodata NaN instead of an alpha band
+
+
+class _RasterWriter:
+    """A tiled GeoTIFF that tiles are written into, then translated to a COG (atomically)."""
+
+    def __init__(self, path: str, width: int, height: int, bands: int, dtype: str, geotransform, crs: Optional[str]):
+        gdal = _gdal()
+        from osgeo import gdal_array
+
+        self.path = path
+        self.dtype = np.dtype(dtype)
+        self.bands = bands
+        self.alpha = _alpha_value(dtype)
+        n = bands + (1 if self.alpha is not None else 0)
+        gtype = gdal_array.NumericTypeCodeToGDALTypeCode(self.dtype)
+        drv = gdal.GetDriverByName("GTiff")
+        self.ds = drv.Create(path, width, height, n, gtype, options=[
+            "TILED=YES", "BLOCKXSIZE=256", "BLOCKYSIZE=256", "COMPRESS=ZSTD" if _has_zstd() else "COMPRESS=LZW",
+            "BIGTIFF=IF_SAFER", "SPARSE_OK=TRUE"] + (["PHOTOMETRIC=RGB"] if bands == 3 and self.dtype == np.uint8
+                                                      else []) + (["ALPHA=YES"] if self.alpha is not None else []))
+        self.ds.SetGeoTransform(tuple(float(v) for v in geotransform))
+        wkt = dsmmod.crs_to_wkt(crs) if crs else ""
+        if wkt:
+            self.ds.SetProjection(wkt)
+        if self.alpha is not None:
+            self.ds.GetRasterBand(n).SetColorInterpretation(gdal.GCI_AlphaBand)
+        else:
+            for b in range(1, bands + 1):
+                self.ds.GetRasterBand(b).SetNoDataValue(float("nan"))
+
+    def write(self, r0: int, c0: int, values: np.ndarray, valid: np.ndarray) -> None:
+        """values (h, w, bands) float32, valid (h, w) bool."""
+        dt = self.dtype
+        if dt.kind in "ui":
+            info = np.iinfo(dt)
+            v = np.clip(np.rint(values), info.min, info.max).astype(dt)
+        else:
+            v = values.astype(dt)
+            v[~valid] = np.nan
+        if dt.kind in "ui":
+            v[~valid] = 0
+        for b in range(self.bands):
+            self.ds.GetRasterBand(b + 1).WriteArray(v[:, :, b], int(c0), int(r0))
+        if self.alpha is not None:
+            a = np.where(valid, self.alpha, 0).astype(dt)
+            self.ds.GetRasterBand(self.bands + 1).WriteArray(a, int(c0), int(r0))
+
+    def finish(self, out_path: str, compress: str, progress: Optional[Progress], metadata: Optional[dict] = None
+               ) -> None:
+        """Translate to a Cloud-Optimized GeoTIFF at ``out_path`` (atomic) and delete the work file."""
+        gdal = _gdal()
+        progress = progress or NullProgress()
+        if metadata:
+            self.ds.SetMetadata({str(k): str(v) for k, v in metadata.items()})
+        self.ds.FlushCache()
+        self.ds = None
+
+        def cb(fraction, _msg, _data):
+            progress.report(fraction, "writing Cloud-Optimized GeoTIFF")
+            return 0 if progress.is_cancelled() else 1
+
+        opts = ["COMPRESS=" + compress, "BLOCKSIZE=256", "OVERVIEWS=IGNORE_EXISTING", "OVERVIEW_RESAMPLING=AVERAGE",
+                "BIGTIFF=IF_SAFER", "NUM_THREADS=1"]
+        if compress.upper() in ("DEFLATE", "LZW", "ZSTD"):
+            opts.append("PREDICTOR=YES")
+        try:
+            with atomic_output(out_path) as tmp:
+                try:
+                    out = gdal.Translate(tmp, self.path, options=gdal.TranslateOptions(
+                        format="COG", creationOptions=opts, callback=cb))
+                except RuntimeError as e:
+                    check_cancel(progress)
+                    raise OrthoError(f"cannot write {out_path}: {e}") from e
+                if out is None:
+                    check_cancel(progress)
+                    raise OrthoError(f"cannot write {out_path}")
+                out.FlushCache()
+                out = None
+                check_cancel(progress)
+        finally:
+            with contextlib.suppress(OSError):
+                os.unlink(self.path)
+
+    def abort(self):
+        self.ds = None
+        with contextlib.suppress(OSError):
+            os.unlink(self.path)
+
+
+_ZSTD: Optional[bool] = None
+
+
+def _has_zstd() -> bool:
+    global _ZSTD
+    if _ZSTD is None:
+        md = _gdal().GetDriverByName("GTiff").GetMetadataItem("DMD_CREATIONOPTIONLIST") or ""
+        _ZSTD = "ZSTD" in md
+    return _ZSTD
+
+
+@contextlib.contextmanager
+def _gdal_cache(mb: int):
+    gdal = _gdal()
+    old = gdal.GetCacheMax()
+    gdal.SetCacheMax(int(mb) << 20)
+    try:
+        yield
+    finally:
+        gdal.SetCacheMax(old)
+
+
+# ---------------------------------------------------------------------------
+# grids and tiles
+# ---------------------------------------------------------------------------
+
+def _tiles(width: int, height: int, tile: int) -> List[Tuple[int, int, int, int]]:
+    return [(r, c, min(tile, height - r), min(tile, width - c)) for r in range(0, height, tile)
+            for c in range(0, width, tile)]
+
+
+def _cell_centres(grid: dsmmod.Grid, r0: int, c0: int, h: int, w: int) -> Tuple[np.ndarray, np.ndarray]:
+    xs = grid.x0 + (c0 + np.arange(w) + 0.5) * grid.resolution
+    ys = grid.y0 - (r0 + np.arange(h) + 0.5) * grid.resolution
+    gx, gy = np.meshgrid(xs, ys)
+    return gx.ravel(), gy.ravel()
+
+
+def _subgrid(grid: dsmmod.Grid, bbox: Tuple[float, float, float, float]) -> Optional[Tuple[int, int, int, int]]:
+    """(row0, col0, height, width) of the cells of ``grid`` covering ``bbox``, clipped; None if disjoint."""
+    res = grid.resolution
+    c0 = max(0, int(math.floor((bbox[0] - grid.x0) / res)))
+    c1 = min(grid.width, int(math.ceil((bbox[2] - grid.x0) / res)))
+    r0 = max(0, int(math.floor((grid.y0 - bbox[3]) / res)))
+    r1 = min(grid.height, int(math.ceil((grid.y0 - bbox[1]) / res)))
+    if c1 <= c0 or r1 <= r0:
+        return None
+    return r0, c0, r1 - r0, c1 - c0
+
+
+def _box_intersects(a, b) -> bool:
+    return not (a[2] <= b[0] or a[0] >= b[2] or a[3] <= b[1] or a[1] >= b[3])
+
+
+# ---------------------------------------------------------------------------
+# the block set-up shared by the mosaic and per-image orthophotos
+# ---------------------------------------------------------------------------
+
+@dataclass
+class _Prepared:
+    cameras: List[OrthoCamera]
+    metas: List[ImageMeta]
+    footprints: List[Footprint]
+    visibility: List[Optional[Visibility]]
+    grid: dsmmod.Grid
+    gsd: float
+    z_range: Tuple[float, float]
+    warnings: List[str]
+
+
+def prepare_block(cameras: Sequence[OrthoCamera], dsm: _Dsm, offset: np.ndarray, resolution: float,
+                  workdir: str, occlusion: bool = True, height_tolerance: float = 0.0,
+                  progress: Optional[Progress] = None) -> _Prepared:
+    """Footprints, the output grid and per-image visibility tables; checks the DSM against the images."""
+    progress = progress or NullProgress()
+    warnings: List[str] = []
+    offset = np.asarray(offset, dtype=float)
+    if not cameras:
+        raise OrthoError("no image to orthorectify")
+    centres = np.array([c.centre + offset for c in cameras])
+    # a first look at the DSM around the cameras (coarse): the ground under them, then its height range
+    z_nadir = dsm.sample(centres[:, 0], centres[:, 1])
+    if np.isfinite(z_nadir).any():
+        above = centres[:, 2] - float(np.nanmedian(z_nadir))
+        span = float(np.clip(1.5 * np.max(above), 20.0, 5000.0))
+    else:
+        span = 1000.0
+    box0 = (float(centres[:, 0].min() - span), float(centres[:, 1].min() - span),
+            float(centres[:, 0].max() + span), float(centres[:, 1].max() + span))
+    z0, _, _ = dsm.coarse(box0, 400_000)
+    if z0.size == 0:
+        raise OrthoError(
+            f"the DSM {dsm.path} does not cover the images: its extent {_fmt_box(dsm.bounds)} and the cameras' area "
+            f"{_fmt_box(box0)} (in {dsm.crs or 'the DSM CRS'}) do not overlap. Use a DSM of this area"
+            + (" (or check the CRS: the DSM was reprojected)" if dsm.reprojected else ""))
+    zf = z0[np.isfinite(z0)]
+    if zf.size == 0:
+        raise OrthoError(f"the DSM {dsm.path} has no valid height (all nodata) where the images are "
+                         f"({_fmt_box(box0)}): it cannot orthorectify them")
+    z_lo, z_hi = float(np.percentile(zf, 0.5)), float(np.percentile(zf, 99.9))
+    below = [c.name for c, p in zip(cameras, centres) if p[2] <= z_hi]
+    if below and len(below) == len(cameras):
+        raise OrthoError(f"every camera is below the DSM's surface (highest {z_hi:.1f}, cameras at "
+                         f"{centres[:, 2].min():.1f}..{centres[:, 2].max():.1f}): heights of the DSM and the block "
+                         "disagree (vertical datum, units or CRS?)")
+    footprints: List[Optional[Footprint]] = []
+    for c in cameras:
+        footprints.append(camera_footprint(c, offset, z_lo, z_hi))
+    keep = [i for i, f in enumerate(footprints) if f is not None]
+    dropped = [cameras[i].name for i, f in enumerate(footprints) if f is None]
+    if dropped:
+        warnings.append(f"{len(dropped)} image(s) see no ground below the DSM's heights and are left out: "
+                        f"{', '.join(dropped[:8])}")
+    cams = [cameras[i] for i in keep]
+    fps = [footprints[i] for i in keep]
+    if not cams:
+        raise OrthoError("no image sees the ground of the DSM (cameras below the surface or looking up)")
+    # DSM coverage per image
+    covered = []
+    for c, f in zip(cams, fps):
+        zc, _, _ = dsm.coarse(f.bbox, 4000)
+        frac = float(np.isfinite(zc).mean()) if zc.size else 0.0
+        covered.append(frac)
+    if max(covered) == 0.0:
+        raise OrthoError(
+            f"the DSM {dsm.path} does not cover the images: no valid height under any of the {len(cams)} images' "
+            f"footprints (DSM extent {_fmt_box(dsm.bounds)}, images {_fmt_box(_union(f.bbox for f in fps))})")
+    poor = [c.name for c, f in zip(cams, covered) if f < 0.5]
+    if poor:
+        warnings.append(f"the DSM covers less than half of the footprint of {len(poor)} image(s) "
+                        f"({', '.join(poor[:6])}{' ...' if len(poor) > 6 else ''}): their uncovered parts stay nodata")
+    # metadata of the images
+    metas = []
+    for c in cams:
+        if not os.path.isfile(c.path):
+            raise OrthoError(f"image {c.name} is missing: {c.path}")
+        m = image_meta(c.path)
+        if (m.width, m.height) != (c.camera.width, c.camera.height):
+            raise OrthoError(f"image {c.path} is {m.width} x {m.height} pixels but its camera model is "
+                             f"{c.camera.width} x {c.camera.height}: the file is not the one that was oriented")
+        metas.append(m)
+    # grid
+    gsd = float(np.median([f.gsd for f in fps]))
+    res = float(resolution) if resolution and resolution > 0 else _nice(gsd)
+    box = _union(f.bbox for f in fps)
+    zc, gx, gy = dsm.coarse(box, 1_000_000)
+    ok = np.isfinite(zc)
+    if not ok.any():
+        raise OrthoError(f"the DSM {dsm.path} has no valid height under the images (all nodata there)")
+    step = abs(gx[0, 1] - gx[0, 0]) if gx.shape[1] > 1 else dsm.res
+    vbox = (float(gx[ok].min() - step), float(gy[ok].min() - step), float(gx[ok].max() + step),
+            float(gy[ok].max() + step))
+    box = (max(box[0], vbox[0]), max(box[1], vbox[1]), min(box[2], vbox[2]), min(box[3], vbox[3]))
+    if box[2] <= box[0] or box[3] <= box[1]:
+        raise OrthoError("the DSM's valid heights and the images' footprints do not overlap")
+    grid = dsmmod.Grid.covering(*box, res)
+    if grid.width * grid.height > 400_000_000:
+        raise OrthoError(f"a {grid.width} x {grid.height} orthophoto at {res:g} is too large: choose a coarser "
+                         "RESOLUTION or fewer images")
+    # visibility tables
+    tol = height_tolerance if height_tolerance and height_tolerance > 0 else max(0.1, dsm.res)
+    vis: List[Optional[Visibility]] = []
+    for i, (c, f) in enumerate(zip(cams, fps)):
+        check_cancel(progress)
+        if occlusion:
+            vis.append(build_visibility(c, offset, f, dsm, tol, os.path.join(workdir, f"vis_{i:05d}.npy")))
+        else:
+            vis.append(None)
+        progress.report((i + 1) / len(cams), f"visibility {i + 1}/{len(cams)}: {c.name}")
+    return _Prepared(cams, metas, fps, vis, grid, gsd, (z_lo, z_hi), warnings)
+
+
+def _nice(gsd: float) -> float:
+    """GSD rounded to 2 significant digits."""
+    if gsd <= 0 or not math.isfinite(gsd):
+        raise OrthoError(f"cannot derive a resolution from a ground sample distance of {gsd}")
+    e = math.floor(math.log10(gsd)) - 1
+    return round(gsd / 10 ** e) * 10 ** e
+
+
+def _union(boxes: Iterable[Tuple[float, float, float, float]]) -> Tuple[float, float, float, float]:
+    b = np.array(list(boxes), dtype=float)
+    return float(b[:, 0].min()), float(b[:, 1].min()), float(b[:, 2].max()), float(b[:, 3].max())
+
+
+def _fmt_box(b) -> str:
+    return f"[{b[0]:.1f}, {b[1]:.1f}] - [{b[2]:.1f}, {b[3]:.1f}]"
+
+
+def _check_kind(metas: Sequence[ImageMeta], cams: Sequence[OrthoCamera]) -> Tuple[int, str]:
+    kinds = {}
+    for m, c in zip(metas, cams):
+        kinds.setdefault((m.bands, m.dtype), []).append(c.name)
+    if len(kinds) > 1:
+        desc = "; ".join(f"{b} band(s) {d}: {', '.join(n[:3])}{' ...' if len(n) > 3 else ''}"
+                         for (b, d), n in kinds.items())
+        raise OrthoError(f"the images differ in bands or data type ({desc}): one mosaic needs one kind; choose a "
+                         "subset with IMAGES_FILTER (e.g. group:<camera> for the NIR camera only)")
+    (bands, dtype), = kinds.keys()
+    return bands, dtype
+
+
+# ---------------------------------------------------------------------------
+# per-image true orthophoto
+# ---------------------------------------------------------------------------
+
+def write_camera_ortho(cam: OrthoCamera, meta: ImageMeta, vis: Optional[Visibility], fp: Footprint, dsm: _Dsm,
+                       offset: np.ndarray, grid: dsmmod.Grid, crs: Optional[str], out_path: str,
+                       options: OrthoOptions, progress: Optional[Progress] = None) -> Optional[Dict[str, Any]]:
+    """One image's true orthophoto on the cells of ``grid`` under its footprint, as a COG.  Returns the
+    sub-grid and valid fraction, or None when the image covers no cell."""
+    progress = progress or NullProgress()
+    sub = _subgrid(grid, fp.bbox)
+    if sub is None:
+        return None
+    r0, c0, h, w = sub
+    g = dsmmod.Grid(grid.x0 + c0 * grid.resolution, grid.y0 - r0 * grid.resolution, grid.resolution, w, h)
+    work = os.path.join(os.path.dirname(os.path.abspath(out_path)), ".work-" + os.path.basename(out_path))
+    writer = _RasterWriter(work, w, h, meta.bands, meta.dtype, g.geotransform, crs)
+    n_valid = 0
+    try:
+        tiles = _tiles(w, h, options.tile)
+        for k, (tr, tc, th, tw) in enumerate(tiles):
+            check_cancel(progress)
+            x, y = _cell_centres(g, tr, tc, th, tw)
+            z = dsm.sample(x, y)
+            s = sample_camera(cam, meta, offset, x, y, z, vis, options.interpolation)
+            writer.write(tr, tc, s.values.reshape(th, tw, -1), s.valid.reshape(th, tw))
+            n_valid += int(s.valid.sum())
+            progress.report(0.9 * (k + 1) / len(tiles), f"{cam.name}: tile {k + 1}/{len(tiles)}")
+        writer.finish(out_path, options.compress, SubProgress(progress, 0.9, 1.0),
+                      metadata={"ARCHAEOORTHO_STAGE": "orthophoto", "IMAGE": cam.name})
+    except BaseException:
+        writer.abort()
+        raise
+    return {"path": out_path, "grid": asdict(g), "valid_fraction": n_valid / float(w * h)}
+
+
+# ---------------------------------------------------------------------------
+# mosaic planning: labels, relief-aware seams, exposure
+# ---------------------------------------------------------------------------
+
+@dataclass
+class _Plan:
+    k: int  # planning cell = k output cells
+    width: int
+    height: int
+    labels_path: str  # int32 (height, width), -1 = no image
+    gains: List[float]
+    windows: List[Optional[Tuple[int, int, int, int]]]  # per camera: (r0, c0, h, w) in planning cells
+    feather_cells: int
+    relief_blobs: int
+    relief_reassigned: int
+
+
+def _plan_mosaic(prep: _Prepared, dsm: _Dsm, offset: np.ndarray, options: OrthoOptions, workdir: str,
+                 progress: Progress) -> _Plan:
+    import cv2
+
+    grid = prep.grid
+    k = max(1, int(round(PLANNING_GSD * prep.gsd / grid.resolution)))
+    while math.ceil(grid.width / k) * math.ceil(grid.height / k) > MAX_PLANNING_CELLS:
+        k += 1
+    pw, ph = int(math.ceil(grid.width / k)), int(math.ceil(grid.height / k))
+    p = k * grid.resolution
+    pgrid = dsmmod.Grid(grid.x0, grid.y0, p, pw, ph)
+    # DSM at planning cells
+    zp = np.full((ph, pw), np.nan, dtype=np.float32)
+    rows = max(1, 1_000_000 // pw)
+    for r0 in range(0, ph, rows):
+        h = min(rows, ph - r0)
+        x, y = _cell_centres(pgrid, r0, 0, h, pw)
+        zp[r0:r0 + h] = dsm.sample(x, y).reshape(h, pw)
+    best = np.full((ph, pw), np.inf, dtype=np.float32)
+    labels = np.full((ph, pw), -1, dtype=np.int32)
+    windows: List[Optional[Tuple[int, int, int, int]]] = []
+    costs: List[Optional[np.ndarray]] = []
+    greys: List[Optional[np.ndarray]] = []
+    n = len(prep.cameras)
+    for i, (cam, meta, fp, vis) in enumerate(zip(prep.cameras, prep.metas, prep.footprints, prep.visibility)):
+        check_cancel(progress)
+        sub = _subgrid(pgrid, fp.bbox)
+        windows.append(sub)
+        if sub is None:
+            costs.append(None)
+            greys.append(None)
+            continue
+        r0, c0, h, w = sub
+        x, y = _cell_centres(pgrid, r0, c0, h, w)
+        z = zp[r0:r0 + h, c0:c0 + w].ravel().astype(np.float64)
+        s = sample_camera(cam, meta, offset, x, y, z, vis, "bilinear", want_values=options.exposure)
+        cost = s.cost.reshape(h, w)
+        costs.append(cost)
+        greys.append(s.values.mean(axis=1).reshape(h, w).astype(np.float32) if options.exposure else None)
+        win_best = best[r0:r0 + h, c0:c0 + w]
+        better = cost < win_best
+        win_best[better] = cost[better]
+        labels[r0:r0 + h, c0:c0 + w][better] = i
+        progress.report(0.7 * (i + 1) / n, f"planning the mosaic: {i + 1}/{n}")
+
+    # relief: objects above their surroundings go whole to one image
+    blobs = reassigned = 0
+    if options.avoid_relief and np.isfinite(zp).any():
+        zf = np.where(np.isfinite(zp), zp, np.nanmin(zp)).astype(np.float32)
+        radius = max(1, int(math.ceil(12.0 / p)))  # objects up to ~24 m across
+        ker = cv2.getStructuringElement(cv2.MORPH_RECT, (2 * radius + 1, 2 * radius + 1))
+        opened = cv2.dilate(cv2.erode(zf, ker), ker)
+        core = (zf - opened) > options.relief_height
+        margin = max(1, int(math.ceil(1.0 / p)))
+        tall = cv2.dilate(core.astype(np.uint8), cv2.getStructuringElement(
+            cv2.MORPH_ELLIPSE, (2 * margin + 1, 2 * margin + 1))) > 0
+        from scipy import ndimage
+
+        lab, nb = ndimage.label(tall)
+        blobs = int(nb)
+        if nb:
+            slices = ndimage.find_objects(lab)
+            for b, sl in enumerate(slices, start=1):
+                if sl is None:
+                    continue
+                region = lab[sl] == b
+                region_core = core[sl][region]
+                current = labels[sl][region]
+                present = np.unique(current[current >= 0])
+                if len(present) <= 1:
+                    continue
+                br0, bc0 = sl[0].start, sl[1].start
+                choice, choice_key = None, None
+                for cid in present:
+                    win = windows[cid]
+                    if win is None:
+                        continue
+                    wr0, wc0, wh, ww = win
+                    rr, cc = np.nonzero(region)
+                    rr = rr + br0 - wr0
+                    cc = cc + bc0 - wc0
+                    inwin = (rr >= 0) & (rr < wh) & (cc >= 0) & (cc < ww)
+                    vals = np.full(len(rr), np.inf, dtype=np.float32)
+                    vals[inwin] = costs[cid][rr[inwin], cc[inwin]]
+                    frac = float(np.isfinite(vals[region_core]).mean()) if region_core.any() else 0.0
+                    key = (frac >= 0.97, -float(np.mean(vals[np.isfinite(vals)])) if np.isfinite(vals).any() else -1e9)
+                    if choice_key is None or key > choice_key:
+                        choice, choice_key, choice_vals = cid, key, vals
+                if choice is None or not choice_key[0]:
+                    continue
+                sub_labels = labels[sl]
+                put = region.copy()
+                put[region] = np.isfinite(choice_vals)
+                sub_labels[put] = choice
+                reassigned += 1
+    np.save(os.path.join(workdir, "labels.npy"), labels)
+
+    # exposure gains (OpenCV's gain compensator: overlaps' mean intensities)
+    gains = [1.0] * n
+    if options.exposure:
+        gains = _exposure_gains(windows, costs, greys, prep.metas[0].dtype)
+    progress.report(1.0, "mosaic planned")
+    feather = max(1, int(round(options.feather_gsd * prep.gsd / (2 * p)))) if options.blending == "feather" else 0
+    return _Plan(k, pw, ph, os.path.join(workdir, "labels.npy"), gains, windows, feather, blobs, reassigned)
+
+
+def _exposure_gains(windows, costs, greys, dtype: str) -> List[float]:
+    n = len(windows)
+    scale = float(np.iinfo(np.dtype(dtype)).max) if np.dtype(dtype).kind in "ui" else 1.0
+    sigma_n, sigma_g = 10.0 / 255.0, 0.1
+    a = np.zeros((n, n))
+    b = np.zeros(n)
+    for i in range(n):
+        wi = windows[i]
+        if wi is None or greys[i] is None:
+            continue
+        for j in range(i + 1, n):
+            wj = windows[j]
+            if wj is None or greys[j] is None:
+                continue
+            r0, c0 = max(wi[0], wj[0]), max(wi[1], wj[1])
+            r1, c1 = min(wi[0] + wi[2], wj[0] + wj[2]), min(wi[1] + wi[3], wj[1] + wj[3])
+            if r1 <= r0 or c1 <= c0:
+                continue
+            si = (slice(r0 - wi[0], r1 - wi[0]), slice(c0 - wi[1], c1 - wi[1]))
+            sj = (slice(r0 - wj[0], r1 - wj[0]), slice(c0 - wj[1], c1 - wj[1]))
+            both = np.isfinite(costs[i][si]) & np.isfinite(costs[j][sj])
+            nij = int(both.sum())
+            if nij < 16:
+                continue
+            iij = float(greys[i][si][both].mean()) / scale
+            iji = float(greys[j][sj][both].mean()) / scale
+            for p, q, ip, iq in ((i, j, iij, iji), (j, i, iji, iij)):
+                a[p, p] += nij * (ip * ip / sigma_n ** 2 + 1.0 / sigma_g ** 2)
+                a[p, q] -= nij * ip * iq / sigma_n ** 2
+                b[p] += nij / sigma_g ** 2
+    gains = np.ones(n)
+    used = np.flatnonzero(np.diag(a) > 0)
+    if len(used):
+        try:
+            g = np.linalg.solve(a[np.ix_(used, used)], b[used])
+            gains[used] = np.clip(g, 0.5, 2.0)
+        except np.linalg.LinAlgError:
+            pass
+    return [float(v) for v in gains]
+
+
+# ---------------------------------------------------------------------------
+# mosaic tiles
+# ---------------------------------------------------------------------------
+
+@dataclass
+class _TileUnit:
+    """Everything one mosaic tile needs (picklable: runs in a pool worker or on a Dask cluster)."""
+
+    index: int
+    r0: int  # tile rows/cols in output cells (without halo)
+    c0: int
+    h: int
+    w: int
+    halo: int
+    grid: Dict[str, Any]
+    dsm_path: str
+    crs: Optional[str]
+    offset: List[float]
+    cameras: List[OrthoCamera]
+    metas: List[ImageMeta]
+    visibility: List[Optional[Visibility]]
+    primary: List[int]  # indices into cameras (labels present near the tile)
+    secondary: List[int]  # other images over the tile, best first (fill occlusions)
+    gains: List[float]
+    labels_path: str
+    k: int
+    plan_shape: Tuple[int, int]
+    feather_cells: int
+    blending: str
+    interpolation: str
+    cache_mb: int
+
+
+_DSM_CACHE: Dict[Tuple[str, Optional[str]], _Dsm] = {}
+
+
+def _dsm_for(path: str, crs: Optional[str]) -> _Dsm:
+    key = (path, crs)
+    if key not in _DSM_CACHE:
+        _DSM_CACHE.clear()
+        _DSM_CACHE[key] = _Dsm(path, crs)
+    return _DSM_CACHE[key]
+
+
+def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str, Any]:
+    """Blend one mosaic tile: returns values (h, w, bands) float32, valid (h, w) and which-image counts."""
+    import cv2
+
+    _CACHE.max_bytes = unit.cache_mb << 20
+    grid = dsmmod.Grid(**unit.grid)
+    dsm = _dsm_for(unit.dsm_path, unit.crs)
+    off = np.asarray(unit.offset, dtype=float)
+    halo = unit.halo
+    # rows/cols with halo, clipped to the grid
+    R0, C0 = max(0, unit.r0 - halo), max(0, unit.c0 - halo)
+    R1, C1 = min(grid.height, unit.r0 + unit.h + halo), min(grid.width, unit.c0 + unit.w + halo)
+    H, W = R1 - R0, C1 - C0
+    x, y = _cell_centres(grid, R0, C0, H, W)
+    z = dsm.sample(x, y)
+    bands = unit.metas[0].bands
+    labels_all = np.load(unit.labels_path, mmap_mode="r")
+    k = unit.k
+    ph, pw = unit.plan_shape
+    # planning window around the tile (margin for the feathering blur)
+    m = unit.feather_cells + 1
+    pr0, pc0 = max(0, R0 // k - m), max(0, C0 // k - m)
+    pr1, pc1 = min(ph, (R1 - 1) // k + 1 + m), min(pw, (C1 - 1) // k + 1 + m)
+    lab = np.asarray(labels_all[pr0:pr1, pc0:pc1])
+    rows = np.arange(R0, R1)
+    cols = np.arange(C0, C1)
+    # planning coordinates of the output cells (for soft weights), nearest planning cell (for hard labels)
+    fr = ((rows + 0.5) / k - 0.5 - pr0).astype(np.float32)
+    fc = ((cols + 0.5) / k - 0.5 - pc0).astype(np.float32)
+    map_x, map_y = np.meshgrid(fc, fr)
+    hard = lab[(rows // k - pr0)[:, None], (cols // k - pc0)[None, :]]
+
+    acc = np.zeros((H * W, bands), dtype=np.float64) if unit.blending != "multiband" else None
+    wsum = np.zeros(H * W, dtype=np.float64)
+    any_valid = np.zeros(H * W, dtype=bool)
+    best_cost = np.full(H * W, np.inf, dtype=np.float32)
+    layers = []  # multiband: (values, weight)
+    counts: Dict[int, int] = {}
+    for ci in unit.primary:
+        if cancel_path and os.path.exists(cancel_path):
+            raise Cancelled("cancelled by the user")
+        cam = unit.cameras[ci]
+        s = sample_camera(cam, unit.metas[ci], off, x, y, z, unit.visibility[ci], unit.interpolation)
+        if not s.valid.any():
+            continue
+        vals = s.values * np.float32(unit.gains[ci])
+        if unit.blending == "feather" and unit.feather_cells > 0:
+            onehot = (lab == ci).astype(np.float32)
+            ksz = 2 * unit.feather_cells + 1
+            soft = cv2.blur(onehot, (ksz, ksz), borderType=cv2.BORDER_REPLICATE)
+            wgt = cv2.remap(soft, map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE).ravel()
+        else:
+            wgt = (hard == ci).astype(np.float32).ravel()
+        wgt = np.where(s.valid, wgt, 0.0)
+        any_valid |= s.valid
+        better = s.cost < best_cost
+        best_cost[better] = s.cost[better]
+        if unit.blending == "multiband":
+            layers.append((vals, s.valid, wgt))
+        else:
+            acc += vals * wgt[:, None]
+        wsum += wgt
+    # cells whose planned image cannot see them: the best image that does (primary first, then the others)
+    need = wsum <= 1e-6
+    fill_vals = np.zeros((H * W, bands), dtype=np.float32)
+    fill_cost = np.full(H * W, np.inf, dtype=np.float32)
+    if need.any():
+        order = list(unit.primary) + list(unit.secondary)
+        idx = np.flatnonzero(need)
+        for ci in order:
+            if not len(idx):
+                break
+            s = sample_camera(unit.cameras[ci], unit.metas[ci], off, x[idx], y[idx], z[idx], unit.visibility[ci],
+                              unit.interpolation)
+            better = s.valid & (s.cost < fill_cost[idx])
+            if better.any():
+                sel = idx[better]
+                fill_vals[sel] = s.values[better] * np.float32(unit.gains[ci])
+                fill_cost[sel] = s.cost[better]
+                counts[ci] = counts.get(ci, 0) + int(better.sum())
+        filled = need & np.isfinite(fill_cost)
+    else:
+        filled = need
+    valid = (wsum > 1e-6) | filled
+    if unit.blending == "multiband":
+        out = _multiband(layers, fill_vals, filled, H, W, bands)
+    else:
+        out = np.zeros((H * W, bands), dtype=np.float32)
+        ok = wsum > 1e-6
+        out[ok] = (acc[ok] / wsum[ok, None]).astype(np.float32)
+        out[filled] = fill_vals[filled]
+    # crop the halo
+    rr0, cc0 = unit.r0 - R0, unit.c0 - C0
+    out = out.reshape(H, W, bands)[rr0:rr0 + unit.h, cc0:cc0 + unit.w]
+    valid = valid.reshape(H, W)[rr0:rr0 + unit.h, cc0:cc0 + unit.w]
+    return {"index": unit.index, "r0": unit.r0, "c0": unit.c0, "values": out, "valid": valid,
+            "fill_cells": int(filled.reshape(H, W)[rr0:rr0 + unit.h, cc0:cc0 + unit.w].sum())}
+
+
+def _multiband(layers, fill_vals: np.ndarray, filled: np.ndarray, h: int, w: int, bands: int) -> np.ndarray:
+    """Laplacian-pyramid blending of the layers (values, valid, weight) plus the hard fill."""
+    import cv2
+
+    levels = max(1, min(5, int(math.log2(max(2, min(h, w)))) - 3))
+    items = list(layers)
+    if filled.any():
+        items.append((fill_vals, filled, filled.astype(np.float32)))
+    if not items:
+        return np.zeros((h * w, bands), dtype=np.float32)
+    num = None
+    den = None
+    for vals, valid, wgt in items:
+        img = _push_pull(vals.reshape(h, w, bands), valid.reshape(h, w), levels + 1)
+        lap = _laplacian(img, levels)
+        gw = [wgt.reshape(h, w).astype(np.float32)]
+        for _ in range(levels):
+            gw.append(cv2.pyrDown(gw[-1]))
+        if num is None:
+            num = [np.zeros_like(li) for li in lap]
+            den = [np.zeros(g.shape, dtype=np.float32) for g in gw]
+        for lv in range(levels + 1):
+            num[lv] += lap[lv] * gw[lv][:, :, None]
+            den[lv] += gw[lv]
+    blended = [n_ / np.maximum(d_, 1e-6)[:, :, None] for n_, d_ in zip(num, den)]
+    out = blended[-1]
+    for lv in range(levels - 1, -1, -1):
+        sz = (blended[lv].shape[1], blended[lv].shape[0])
+        out = _pyr_up(out, sz) + blended[lv]
+    return out.reshape(h * w, bands)
+
+
+def _pyr_up(a: np.ndarray, size) -> np.ndarray:
+    import cv2
+
+    up = cv2.pyrUp(a, dstsize=size)
+    return up if up.ndim == 3 else up[:, :, None]
+
+
+def _pyr_down(a: np.ndarray) -> np.ndarray:
+    import cv2
+
+    d = cv2.pyrDown(a)
+    return d if d.ndim == 3 else d[:, :, None]
+
+
+def _laplacian(img: np.ndarray, levels: int) -> List[np.ndarray]:
+    gp = [img]
+    for _ in range(levels):
+        gp.append(_pyr_down(gp[-1]))
+    lp = []
+    for lv in range(levels):
+        size = (gp[lv].shape[1], gp[lv].shape[0])
+        lp.append(gp[lv] - _pyr_up(gp[lv + 1], size))
+    lp.append(gp[-1])
+    return lp
+
+
+def _push_pull(img: np.ndarray, valid: np.ndarray, levels: int) -> np.ndarray:
+    """Fill invalid cells from valid neighbours at coarser scales (so pyramids see no dark holes)."""
+    if valid.all():
+        return img.astype(np.float32)
+    wv = valid.astype(np.float32)
+    pyr_v = [img.astype(np.float32) * wv[:, :, None]]
+    pyr_w = [wv]
+    for _ in range(levels + 4):
+        if min(pyr_w[-1].shape) <= 2:
+            break
+        pyr_v.append(_pyr_down(pyr_v[-1]))
+        pyr_w.append(_pyr_down(pyr_w[-1][:, :, None])[:, :, 0])
+    est = pyr_v[-1] / np.maximum(pyr_w[-1], 1e-6)[:, :, None]
+    for lv in range(len(pyr_v) - 2, -1, -1):
+        size = (pyr_v[lv].shape[1], pyr_v[lv].shape[0])
+        up = _pyr_up(est, size)
+        wl = pyr_w[lv]
+        here = pyr_v[lv] / np.maximum(wl, 1e-6)[:, :, None]
+        a = np.clip(wl, 0.0, 1.0)[:, :, None]
+        est = a * here + (1 - a) * up
+    out = img.astype(np.float32).copy()
+    out[~valid] = est[~valid]
+    return out
+
+
+# ---------------------------------------------------------------------------
+# the mosaic
+# ---------------------------------------------------------------------------
+
+@dataclass
+class MosaicResult:
+    path: str
+    crs: Optional[str]
+    resolution: float
+    gsd: float
+    width: int
+    height: int
+    images: List[str]
+    valid_fraction: float
+    per_image: Dict[str, str] = field(default_factory=dict)
+    seamlines_path: Optional[str] = None
+    gains: Dict[str, float] = field(default_factory=dict)
+    timings: Dict[str, float] = field(default_factory=dict)
+    warnings: List[str] = field(default_factory=list)
+    log_lines: List[str] = field(default_factory=list)
+
+
+def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Optional[str], offset: Sequence[float],
+                      output: str, options: Optional[OrthoOptions] = None, per_image_folder: Optional[str] = None,
+                      seamlines_path: Optional[str] = None, progress: Optional[Progress] = None) -> MosaicResult:
+    """The orthomosaic of ``cameras`` (poses in the local frame, world = local + ``offset``) on a DSM.
+
+    Writes a COG at ``output`` (atomically), optionally one true orthophoto per image into
+    ``per_image_folder`` and the which-image polygons into the GeoPackage ``seamlines_path``."""
+    options = options or OrthoOptions()
+    options.check()
+    progress = progress or NullProgress()
+    offset = np.asarray(offset, dtype=float)
+    t_start = time.time()
+    timings: Dict[str, float] = {}
+    log: List[str] = []
+    out_dir = os.path.dirname(os.path.abspath(output))
+    os.makedirs(out_dir, exist_ok=True)
+    workdir = tempfile.mkdtemp(prefix=".ortho-work-", dir=out_dir)
+    _CACHE.max_bytes = options.cache_mb << 20
+    dsm = _Dsm(dsm_path, crs)
+    try:
+        with _gdal_cache(64):
+            t0 = time.time()
+            prep = prepare_block(cameras, dsm, offset, options.resolution, workdir, options.occlusion,
+                                 options.height_tolerance, SubProgress(progress, 0.0, 0.12))
+            for w_ in prep.warnings:
+                progress.warning(w_)
+            if dsm.reprojected:
+                log.append(f"DSM {dsm_path} reprojected on the fly into {crs}")
+            bands, dtype = _check_kind(prep.metas, prep.cameras)
+            grid = prep.grid
+            timings["visibility"] = time.time() - t0
+            log.append(f"{len(prep.cameras)} images, GSD {prep.gsd:.3f}, mosaic {grid.width} x {grid.height} cells "
+                       f"at {grid.resolution:g} ({bands} band(s) {dtype}), blending {options.blending}")
+            progress.info(log[-1])
+            t0 = time.time()
+            plan = _plan_mosaic(prep, dsm, offset, options, workdir, SubProgress(progress, 0.12, 0.2))
+            timings["planning"] = time.time() - t0
+            log.append(f"seamlines: {plan.relief_blobs} raised objects, {plan.relief_reassigned} given whole to one "
+                       f"image; exposure gains {min(plan.gains):.3f}..{max(plan.gains):.3f}")
+            progress.info(log[-1])
+            t0 = time.time()
+            n_valid, fill_cells = _run_tiles(prep, plan, dsm_path, crs, offset, output, options, bands, dtype,
+                                             SubProgress(progress, 0.2, 0.85 if per_image_folder else 0.97))
+            timings["mosaic"] = time.time() - t0
+            valid_fraction = n_valid / float(grid.width * grid.height)
+            labels = np.load(plan.labels_path)
+            if seamlines_path:
+                _write_sources_gpkg(seamlines_path, labels, prep, plan, crs)
+            del labels
+            per_image: Dict[str, str] = {}
+            if per_image_folder:
+                t0 = time.time()
+                os.makedirs(per_image_folder, exist_ok=True)
+                sp = SubProgress(progress, 0.85, 1.0)
+                for i, (cam, meta, fp, vis) in enumerate(zip(prep.cameras, prep.metas, prep.footprints,
+                                                             prep.visibility)):
+                    path = os.path.join(per_image_folder, os.path.splitext(os.path.basename(cam.name))[0] + ".tif")
+                    info = write_camera_ortho(cam, meta, vis, fp, dsm, offset, grid, crs, path, options,
+                                              SubProgress(sp, i / len(prep.cameras), (i + 1) / len(prep.cameras)))
+                    if info:
+                        per_image[cam.name] = path
+                timings["per_image"] = time.time() - t0
+            timings["total"] = time.time() - t_start
+            log.append(f"mosaic {output}: {100 * valid_fraction:.1f} % of the cells have data, {fill_cells} cells "
+                       "filled from another image where the planned one is occluded")
+            progress.report(1.0, "orthomosaic done")
+            return MosaicResult(path=output, crs=crs, resolution=grid.resolution, gsd=prep.gsd, width=grid.width,
+                                height=grid.height, images=[c.name for c in prep.cameras],
+                                valid_fraction=valid_fraction, per_image=per_image, seamlines_path=seamlines_path,
+                                gains={c.name: g for c, g in zip(prep.cameras, plan.gains)},
+                                timings={k: round(v, 3) for k, v in timings.items()}, warnings=prep.warnings,
+                                log_lines=log)
+    finally:
+        dsm.close()
+        _DSM_CACHE.clear()
+        _CACHE.clear()
+        shutil.rmtree(workdir, ignore_errors=True)
+
+
+def _run_tiles(prep: _Prepared, plan: _Plan, dsm_path: str, crs, offset, output: str, options: OrthoOptions,
+               bands: int, dtype: str, progress: Progress) -> Tuple[int, int]:
+    from . import parallel
+
+    grid = prep.grid
+    work = os.path.join(os.path.dirname(os.path.abspath(output)), ".work-" + os.path.basename(output))
+    writer = _RasterWriter(work, grid.width, grid.height, bands, dtype, grid.geotransform, crs)
+    halo = 0
+    if options.blending == "multiband":
+        halo = 64
+    labels = np.load(plan.labels_path, mmap_mode="r")
+    units = []
+    k = plan.k
+    for i, (r0, c0, h, w) in enumerate(_tiles(grid.width, grid.height, options.tile)):
+        m = plan.feather_cells + 1 + (halo // k + 1)
+        pr0, pc0 = max(0, r0 // k - m), max(0, c0 // k - m)
+        pr1, pc1 = min(plan.height, (r0 + h - 1) // k + 1 + m), min(plan.width, (c0 + w - 1) // k + 1 + m)
+        present = [int(v) for v in np.unique(labels[pr0:pr1, pc0:pc1]) if v >= 0]
+        tb = (grid.x0 + c0 * grid.resolution, grid.y0 - (r0 + h) * grid.resolution,
+              grid.x0 + (c0 + w) * grid.resolution, grid.y0 - r0 * grid.resolution)
+        cx, cy = 0.5 * (tb[0] + tb[2]), 0.5 * (tb[1] + tb[3])
+        others = [j for j, fp in enumerate(prep.footprints) if j not in present and _box_intersects(fp.bbox, tb)]
+        others.sort(key=lambda j: math.hypot(prep.cameras[j].centre[0] + offset[0] - cx,
+                                             prep.cameras[j].centre[1] + offset[1] - cy))
+        if not present and not others:
+            continue
+        units.append(_TileUnit(i, r0, c0, h, w, halo, asdict(grid), dsm_path, crs, [float(v) for v in offset],
+                               prep.cameras, prep.metas, prep.visibility, present, others, plan.gains,
+                               plan.labels_path, k, (plan.height, plan.width), plan.feather_cells, options.blending,
+                               options.interpolation, options.cache_mb))
+    del labels
+    n_valid = 0
+    fill = 0
+    try:
+        workers = options.workers if options.workers and options.workers > 0 else 0
+        with parallel.make_executor(workers, "auto", options.scheduler) as ex:
+            for _i, res in parallel.run_units(ex, _render_tile, units, progress, label="tile"):
+                writer.write(res["r0"], res["c0"], res["values"], res["valid"])
+                n_valid += int(res["valid"].sum())
+                fill += res["fill_cells"]
+        writer.finish(output, options.compress, None,
+                      metadata={"ARCHAEOORTHO_STAGE": "orthophoto", "BLENDING": options.blending,
+                                "IMAGES": len(prep.cameras), "RESOLUTION": grid.resolution})
+    except BaseException:
+        writer.abort()
+        raise
+    return n_valid, fill
+
+
+def _write_sources_gpkg(path: str, labels: np.ndarray, prep: _Prepared, plan: _Plan, crs: Optional[str]) -> str:
+    """Polygons of the image each part of the mosaic comes from (the seamlines are their borders)."""
+    gdal = _gdal()
+    from osgeo import ogr, osr
+
+    ogr.UseExceptions()
+    grid = prep.grid
+    p = plan.k * grid.resolution
+    mem = gdal.GetDriverByName("MEM").Create("", plan.width, plan.height, 1, gdal.GDT_Int32)
+    mem.SetGeoTransform((grid.x0, p, 0.0, grid.y0, 0.0, -p))
+    band = mem.GetRasterBand(1)
+    band.WriteArray(labels.astype(np.int32))
+    band.SetNoDataValue(-1)
+    srs = None
+    if crs:
+        srs = osr.SpatialReference()
+        srs.SetFromUserInput(crs)
+        srs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+    with atomic_output(path) as tmp:
+        ds = ogr.GetDriverByName("GPKG").CreateDataSource(tmp)
+        lyr = ds.CreateLayer("mosaic_sources", srs, ogr.wkbPolygon)
+        lyr.CreateField(ogr.FieldDefn("label", ogr.OFTInteger))
+        gdal.Polygonize(band, band.GetMaskBand(), lyr, 0, [], callback=None)
+        lyr.CreateField(ogr.FieldDefn("image", ogr.OFTString))
+        lyr.CreateField(ogr.FieldDefn("camera_id", ogr.OFTInteger))
+        lyr.CreateField(ogr.FieldDefn("gain", ogr.OFTReal))
+        lyr.StartTransaction()
+        for f in lyr:
+            i = f.GetField("label")
+            if i is not None and 0 <= i < len(prep.cameras):
+                f.SetField("image", prep.cameras[i].name)
+                f.SetField("camera_id", prep.cameras[i].camera_id)
+                f.SetField("gain", plan.gains[i])
+                lyr.SetFeature(f)
+        lyr.CommitTransaction()
+        ds = None
+    return path
+
+
+# ---------------------------------------------------------------------------
+# the workspace stage
+# ---------------------------------------------------------------------------
+
+@dataclass
+class OrthoStageResult:
+    workspace: str
+    orthomosaic: str
+    crs: Optional[str]
+    resolution: float
+    images: List[str]
+    valid_fraction: float
+    per_image_folder: Optional[str]
+    seamlines: Optional[str]
+    timings: Dict[str, float]
+    warnings: List[str]
+    log_lines: List[str]
+
+
+def workspace_dsm(ws: Workspace) -> Optional[str]:
+    """The workspace's DSM: the DSM stage's output if recorded, else <workspace>/dsm.tif; None if absent."""
+    rec = ws.stage("dsm")
+    out = (rec.get("outputs") or {}).get("dsm")
+    if out:
+        p = out if os.path.isabs(out) else ws.path(out)
+        if os.path.isfile(p):
+            return p
+    p = ws.path("dsm.tif")
+    return p if os.path.isfile(p) else None
+
+
+def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = None, images_filter: Optional[str] = None,
+                               resolution: float = 0.0, blending: str = "feather", output: Optional[str] = None,
+                               per_image_folder: Optional[str] = None, seamlines: Optional[str] = None,
+                               options: Optional[OrthoOptions] = None,
+                               progress: Optional[Progress] = None) -> OrthoStageResult:
+    """The orthophoto stage of a georeferenced workspace: orthomosaic (default <workspace>/orthomosaic.tif),
+    optional per-image true orthophotos and the which-image layer.  Records the stage in workspace.json.
+
+    Raises OrthoError (bad input), WorkspaceError, Cancelled."""
+    import pycolmap
+
+    progress = progress or NullProgress()
+    options = options or OrthoOptions()
+    options.resolution = float(resolution or 0.0)
+    options.blending = (blending or options.blending).lower()
+    options.check()
+    ws = Workspace.open(workspace_dir)
+    if not ws.stage_done("georeference") or not os.path.isdir(ws.path("georef", "model")):
+        state = ws.stage("georeference").get("status", "pending")
+        raise OrthoError(f"workspace {ws.root} is not georeferenced (georeference stage: {state}): run "
+                         "'Georeference' first; an orthophoto needs the images in a map CRS")
+    dsm_path = os.path.abspath(dsm_path) if dsm_path else workspace_dsm(ws)
+    if not dsm_path:
+        raise OrthoError(f"workspace {ws.root} has no DSM: run 'Build DSM' first or give a DSM raster")
+    if not os.path.isfile(dsm_path):
+        raise OrthoError(f"DSM {dsm_path} does not exist")
+    rec = pycolmap.Reconstruction()
+    rec.read_binary(ws.path("georef", "model"))
+    with open(ws.path("georef", "transform.json"), encoding="utf-8") as f:
+        transform = json.load(f)
+    offset = np.asarray(transform.get("offset", [0.0, 0.0, 0.0]), dtype=float)
+    crs = transform.get("crs") or ws.crs
+    images_dir = ws.data.get("images_dir") or ""
+    cams = cameras_from_reconstruction(rec, images_dir, ws.path("masks"))
+    if not cams:
+        raise OrthoError(f"the model of {ws.root} has no oriented image")
+    cams = select_cameras(cams, images_filter, ws.data.get("camera_groups", []))
+    output = os.path.abspath(output) if output else ws.path("orthomosaic.tif")
+    per_image_folder = os.path.abspath(per_image_folder) if per_image_folder else None
+    seamlines = os.path.abspath(seamlines) if seamlines else None
+    params = {"dsm": dsm_path, "images_filter": images_filter or "", "resolution": options.resolution,
+              "blending": options.blending, "output": output, "per_image_folder": per_image_folder,
+              "seamlines": seamlines, "options": {k: v for k, v in asdict(options).items()
+                                                  if k not in ("workers", "scheduler", "cache_mb")}}
+    inputs = {"dsm": file_fingerprint(dsm_path), "images": fingerprint(sorted(c.name for c in cams))}
+    model_dir = ws.path("georef", "model")
+    for n in sorted(os.listdir(model_dir)):
+        if n.endswith(".bin"):
+            inputs["model/" + n] = file_fingerprint(os.path.join(model_dir, n))
+    ws.begin_stage(STAGE, params, inputs)
+    try:
+        result = build_orthomosaic(cams, dsm_path, crs, offset, output, options, per_image_folder, seamlines, progress)
+        for k_, v in result.timings.items():
+            if k_ != "total":
+                ws.record_timing(STAGE, k_, v)
+        outputs = {"orthomosaic": _rel(ws, output)}
+        if per_image_folder:
+            outputs["per_image_folder"] = _rel(ws, per_image_folder)
+        if seamlines:
+            outputs["seamlines"] = _rel(ws, seamlines)
+        ws.end_stage(STAGE, DONE, outputs=outputs, results={
+            "resolution": result.resolution, "gsd": result.gsd, "width": result.width, "height": result.height,
+            "images": len(result.images), "valid_fraction": result.valid_fraction, "warnings": result.warnings})
+        ws.invalidate_after(STAGE, STAGE_ORDER)
+        return OrthoStageResult(ws.root, output, crs, result.resolution, result.images, result.valid_fraction,
+                                per_image_folder, seamlines, result.timings, result.warnings, result.log_lines)
+    except Cancelled:
+        ws.end_stage(STAGE, CANCELLED, error="cancelled by the user")
+        raise
+    except Exception as e:
+        ws.end_stage(STAGE, FAILED, error=str(e))
+        raise
+
+
+def _rel(ws: Workspace, path: str) -> str:
+    rel = os.path.relpath(path, ws.root)
+    return path if rel.startswith("..") else rel
