@@ -224,6 +224,29 @@ def test_refined_intrinsics_repair_a_block_aligned_without_distortion(block):
     assert abs(params[0] - block.camera.fx) < 0.01 * block.camera.fx
 
 
+@pytest.mark.xfail(reason="core.georef rejects control points for good at the Helmert step: on a strongly deformed "
+                          "strip a correct control point lies metres off the 7-parameter fit of the others and never "
+                          "enters the adjustment that would have removed the deformation", strict=False)
+def test_deformed_strip_keeps_its_good_control_points(strip):
+    """A single strip aligned with a distortion-free camera bends by metres.  All five control points are
+    correct: the constrained adjustment with refined intrinsics must keep them all and reach the goal
+    (it does, 0.02 / 0.05 m, when the Helmert threshold is raised by hand)."""
+    import pycolmap
+
+    rec = strip.truth_reconstruction(camera=strip.camera.with_params(k1=0.0, k2=0.0, p1=0.0, p2=0.0))
+    ba = pycolmap.BundleAdjustmentOptions()
+    ba.refine_focal_length = ba.refine_principal_point = ba.refine_extra_params = False
+    ba.print_summary = False
+    pycolmap.bundle_adjustment(rec, ba)
+    ground = sorted((p for p in strip.gcps if p.kind == "ground"), key=lambda p: p.xyz[0])
+    control = [ground[0].name, ground[1].name, ground[-1].name, ground[-2].name, ground[len(ground) // 2].name]
+    result = georef.georeference(rec, strip.gcp_set(control, noise_px=GCP_NOISE_PX), refine_intrinsics=True)
+    _report("strip aligned without distortion", result, strip.gsd)
+    assert not [o.name for o in result.outliers if o.kind == "control point"]
+    chk = result.rmse(CHECK)
+    assert chk["xy"] <= 1.0 * strip.gsd and chk["z"] <= 1.5 * strip.gsd
+
+
 def _positions_only(block, rec, label):
     """Georeference ``rec`` with noisy camera positions only; every GCP is a check point.  Returns the
     check errors (N,3), the errors that least squares predicts for this noise realisation, and n."""
@@ -320,6 +343,25 @@ def test_observation_outside_the_image_is_named_and_ignored(block, tmp_path):
     assert not result.outliers
     chk = result.rmse(CHECK)
     assert chk["xy"] <= 0.5 * block.gsd and chk["z"] <= 1.0 * block.gsd
+
+
+@pytest.mark.xfail(reason="core.georef.georeference does not check observations against the image size: an "
+                          "observation off the image is used (and here a good observation of the same point is "
+                          "dropped instead, then the point is rejected at the Helmert step); only the file "
+                          "readers drop it, when given image sizes", strict=False)
+def test_observation_outside_the_image_given_directly_is_named_and_ignored(block):
+    """The same through the API, as with GCPs picked in QGIS and passed as a GCPSet (no file reader)."""
+    control = block.spread_control(5)
+    gcps = block.gcp_set(control, noise_px=GCP_NOISE_PX)
+    p = gcps.by_name(control[1])
+    img = p.observations[0].image
+    p.observations[0].x = block.camera.width + 250.0
+    result = georef.georeference(block.truth_reconstruction(), gcps)
+    assert any(p.name in w and img in w and "outside" in w for w in result.warnings), result.warnings
+    assert not [o for o in result.outliers if o.kind == "control point"], result.outliers
+    row = next(r for r in result.points if r.name == p.name)
+    assert row.status == georef.USED
+    assert next(o for o in row.observations if o["image"] == img)["px"] is None
 
 
 # ----------------------------------------------------------------------------------------------
