@@ -469,7 +469,7 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
             check_cancel(progress)
             progress.report(0.96, "writing the screening record")
             # last step inside the atomic block: nothing below can be cancelled
-            masks_dir = ws.subdir("masks")
+            masks_dir = ws.path("masks")
             for rel in previous_masks:  # masks this stage wrote last time
                 p = ws.path(rel)
                 if os.path.isfile(p) and os.path.dirname(os.path.abspath(p)) == masks_dir:
@@ -478,6 +478,7 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
             for q in quality:
                 src = mask_files.get(q.prepared_name)
                 if q.decision == KEEP and src and os.path.isfile(src):
+                    os.makedirs(masks_dir, exist_ok=True)
                     dst = os.path.join(masks_dir, os.path.basename(src))
                     os.replace(src, dst)
                     written_masks.append(os.path.relpath(dst, ws.root))

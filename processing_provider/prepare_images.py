@@ -58,7 +58,9 @@ class PrepareImagesAlgorithm(AlgorithmBase):
         "in mm, as a file or pasted text, one 'id x y' line per mark (x right, y up), optionally 'PP x y' "
         "(principal point) and 'focal f'. Without them the mean layout of the set is used, centred on the "
         "fiducial centre. With FOCAL_LENGTH_MM (or 'focal' in the certificate) the prepared images carry "
-        "the focal length in pixels for the alignment."
+        "the focal length in pixels for the alignment.\n\n"
+        "OUTPUT: the folder of prepared images (replaced as a whole; it must be new, empty or written by an "
+        "earlier run); when skipped, <workspace>/prepared."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
@@ -95,7 +97,9 @@ class PrepareImagesAlgorithm(AlgorithmBase):
         for p in advanced:
             p.setFlags(p.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
             self.addParameter(p)
-        self.addParameter(QgsProcessingParameterFolderDestination(self.OUTPUT, self.tr("Prepared images")))
+        self.addParameter(QgsProcessingParameterFolderDestination(
+            self.OUTPUT, self.tr("Prepared images (skipped: <workspace>/prepared)"), optional=True,
+            createByDefault=False))
         self.addOutput(QgsProcessingOutputFolder(self.PREPARED_IMAGES, self.tr("Folder of prepared images")))
         self.addOutput(QgsProcessingOutputNumber(self.FLAGGED, self.tr("Flagged images")))
         self.addOutput(QgsProcessingOutputNumber(self.EXCLUDED, self.tr("Excluded images")))
