@@ -260,13 +260,16 @@ class _Data:
         if self.rec is None or not len(self.obs.img):
             return None
         vals = []
-        for k, iid in enumerate(self.obs.image_ids):
-            im = self.rec.image(int(iid))
-            m = self.obs.img == k
-            if not np.any(m):
+        o = self.obs
+        order = np.argsort(o.img, kind="stable")
+        bounds = np.searchsorted(o.img[order], np.arange(len(o.image_ids) + 1))
+        for k, iid in enumerate(o.image_ids):
+            rows = order[bounds[k]:bounds[k + 1]]
+            if not len(rows):
                 continue
+            im = self.rec.image(int(iid))
             mat = np.asarray(im.cam_from_world().matrix())
-            depth = self.obs.xyz[self.obs.pt[m]] @ mat[2, :3] + mat[2, 3]
+            depth = o.xyz[o.pt[rows]] @ mat[2, :3] + mat[2, 3]
             depth = depth[depth > 0]
             cam = self.rec.cameras[im.camera_id]
             f = float(np.mean([cam.params[i] for i in cam.focal_length_idxs()]))
@@ -418,7 +421,9 @@ class _Report:
         else:
             self.figures.update(IMAGES=len(images) or None, REGISTERED_IMAGES=None)
             rows.append(("Images given", str(len(images))))
-        rows.append(("Coordinate reference system", _esc(f"{d.crs_label}: {d.crs}" if d.crs else "none (local model frame)")))
+        crs_txt = ("none (local model frame)" if not d.crs else d.crs_label if str(d.crs) in d.crs_label
+                   else f"{d.crs_label}: {d.crs}")
+        rows.append(("Coordinate reference system", _esc(crs_txt)))
         parts.append(_kv(rows))
 
         # not aligned, with why
@@ -1156,11 +1161,17 @@ class _Report:
             lo, hi = np.percentile(arr[alpha], [0.5, 99.5]) if alpha.any() else (0.0, 255.0)
             rgb = np.clip((arr - lo) / max(hi - lo, 1e-9), 0, 1)
             ax.imshow(np.dstack([rgb, alpha.astype(float)]), extent=extent, interpolation="nearest")
-        info.append(("Valid fraction", f'<span data-key="{title.lower()}.valid">{frac:.3f}</span>'
-                                       + (f" (estimated on a 1:{step} overview)" if step > 1 else "")))
+        info.append(("Valid fraction (cells with data)", f'<span data-key="{title.lower()}.valid">{frac:.3f}</span>'
+                                                          + (f" (estimated on a 1:{step} overview)" if step > 1 else "")))
+        stage_vf = _num(((self.d.manifest.get("stages", {}).get("dsm" if dem else "orthophoto") or {}).get("results")
+                         or {}).get("VALID_FRACTION"))
+        if stage_vf is not None:
+            info.append(("Valid fraction inside the camera centres' convex hull (as the stage reports it)",
+                         f"{stage_vf:.3f}"))
         self.figures[f"{'DSM' if dem else 'ORTHO'}_VALID_FRACTION"] = frac
         self.figures[f"{'DSM' if dem else 'ORTHO'}_RESOLUTION"] = abs(gt[1])
         _equal_xy(ax)
+        ax.grid(False)
         return f"<h3>{title}</h3>" + _kv(info) + _img(fig, f"{title} preview", f"{title} preview" + (
             " with hillshade (sun from the north-west, 45°)." if dem else "."))
 
