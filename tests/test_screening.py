@@ -53,6 +53,8 @@ def test_blurriest_images_rank_first(screened):
 def test_overexposed_copy_is_flagged(screened):
     by_name = {q.name: q for q in screened}
     over = by_name["overexposed.JPG"]
+    print(f"\noverexposed copy: {100 * over.highlights_clipped:.1f} % clipped, exposure score "
+          f"{over.exposure_score:.2f}, flags {over.flags}; source {by_name[SOURCE].exposure_score:.2f}")
     assert "overexposed" in over.flags
     assert over.highlights_clipped > 0.05
     assert over.exposure_rank == 1
@@ -117,6 +119,7 @@ def test_prepare_stage_records_decisions_and_excludes(toledo_with_bad_copies, tm
     assert rec["status"] == "done" and rec["results"]["excluded"] == res.excluded
     assert rec["results"]["decisions"]["overexposed.JPG"]["decision"] == "exclude"
     assert rec["outputs"]["prepared_images"] == os.path.abspath(out)
+    assert not os.path.exists(os.path.join(ws, "masks"))  # no scans, no masks (COLMAP wants all or none)
 
     # a re-run without exclusion replaces the prepared folder as a whole
     res2 = prepare_images_workspace(toledo_with_bad_copies, ws, out, PrepareOptions())
