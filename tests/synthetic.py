@@ -595,11 +595,25 @@ class SyntheticBlock:
         xyz = np.atleast_2d(np.asarray(xyz_local, dtype=float))
         px, depth = self.project(shot, xyz)
         ok = (depth > 0) & self.camera.inside(px, margin)
-        # the distorted model is only trusted inside the image: reproject through undistort
-        ok &= np.all(np.isfinite(px), axis=1)
+        # a distortion polynomial can fold far-off points back into the image: keep only points whose
+        # undistorted radius is within that of the image corners
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r_u = np.hypot(*(self.to_camera_xy(shot, xyz).T))
+        ok &= np.isfinite(r_u) & (r_u <= 1.001 * self._corner_radius())
         if np.any(ok):
             ok[ok] &= ~self._occluded(shot.centre, xyz[ok])
         return ok, px
+
+    @staticmethod
+    def to_camera_xy(shot: Shot, xyz: np.ndarray) -> np.ndarray:
+        """Undistorted normalised image coordinates (N,2) of local points."""
+        xc = shot.to_camera(xyz)
+        return xc[:, :2] / xc[:, 2:3]
+
+    def _corner_radius(self) -> float:
+        c = self.camera
+        corners = np.array([[0.0, 0.0], [c.width, 0.0], [0.0, c.height], [c.width, c.height]])
+        return float(np.max(np.hypot(*c.undistort(c.normalized_from_pixel(corners)).T)))
 
     def _occluded(self, centre: np.ndarray, xyz: np.ndarray, step: float = 0.2) -> np.ndarray:
         zmax = self.scene.max_height()
