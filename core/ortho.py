@@ -855,7 +855,7 @@ def prepare_block(cameras: Sequence[OrthoCamera], dsm: _Dsm, offset: np.ndarray,
         raise OrthoError("no image sees the ground of the DSM (cameras below the surface or looking up)")
     # DSM coverage per image
     covered = []
-    for c, f in zip(cams, fps):
+    for f in fps:
         zc, _, _ = dsm.coarse(f.bbox, 4000)
         frac = float(np.isfinite(zc).mean()) if zc.size else 0.0
         covered.append(frac)
@@ -1192,10 +1192,10 @@ def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str
     off = np.asarray(unit.offset, dtype=float)
     halo = unit.halo
     # rows/cols with halo, clipped to the grid
-    R0, C0 = max(0, unit.r0 - halo), max(0, unit.c0 - halo)
-    R1, C1 = min(grid.height, unit.r0 + unit.h + halo), min(grid.width, unit.c0 + unit.w + halo)
-    H, W = R1 - R0, C1 - C0
-    x, y = _cell_centres(grid, R0, C0, H, W)
+    ar0, ac0 = max(0, unit.r0 - halo), max(0, unit.c0 - halo)
+    ar1, ac1 = min(grid.height, unit.r0 + unit.h + halo), min(grid.width, unit.c0 + unit.w + halo)
+    hh, ww = ar1 - ar0, ac1 - ac0
+    x, y = _cell_centres(grid, ar0, ac0, hh, ww)
     z = dsm.sample(x, y)
     bands = unit.metas[0].bands
     labels_all = np.load(unit.labels_path, mmap_mode="r")
@@ -1203,21 +1203,21 @@ def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str
     ph, pw = unit.plan_shape
     # planning window around the tile (margin for the feathering blur)
     m = unit.feather_cells + 1
-    pr0, pc0 = max(0, R0 // k - m), max(0, C0 // k - m)
-    pr1, pc1 = min(ph, (R1 - 1) // k + 1 + m), min(pw, (C1 - 1) // k + 1 + m)
+    pr0, pc0 = max(0, ar0 // k - m), max(0, ac0 // k - m)
+    pr1, pc1 = min(ph, (ar1 - 1) // k + 1 + m), min(pw, (ac1 - 1) // k + 1 + m)
     lab = np.asarray(labels_all[pr0:pr1, pc0:pc1])
-    rows = np.arange(R0, R1)
-    cols = np.arange(C0, C1)
+    rows = np.arange(ar0, ar1)
+    cols = np.arange(ac0, ac1)
     # planning coordinates of the output cells (for soft weights), nearest planning cell (for hard labels)
     fr = ((rows + 0.5) / k - 0.5 - pr0).astype(np.float32)
     fc = ((cols + 0.5) / k - 0.5 - pc0).astype(np.float32)
     map_x, map_y = np.meshgrid(fc, fr)
     hard = lab[(rows // k - pr0)[:, None], (cols // k - pc0)[None, :]]
 
-    acc = np.zeros((H * W, bands), dtype=np.float64) if unit.blending != "multiband" else None
-    wsum = np.zeros(H * W, dtype=np.float64)
-    any_valid = np.zeros(H * W, dtype=bool)
-    best_cost = np.full(H * W, np.inf, dtype=np.float32)
+    acc = np.zeros((hh * ww, bands), dtype=np.float64) if unit.blending != "multiband" else None
+    wsum = np.zeros(hh * ww, dtype=np.float64)
+    any_valid = np.zeros(hh * ww, dtype=bool)
+    best_cost = np.full(hh * ww, np.inf, dtype=np.float32)
     layers = []  # multiband: (values, weight)
     counts: Dict[int, int] = {}
     for ci in unit.primary:
@@ -1246,8 +1246,8 @@ def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str
         wsum += wgt
     # cells whose planned image cannot see them: the best image that does (primary first, then the others)
     need = wsum <= 1e-6
-    fill_vals = np.zeros((H * W, bands), dtype=np.float32)
-    fill_cost = np.full(H * W, np.inf, dtype=np.float32)
+    fill_vals = np.zeros((hh * ww, bands), dtype=np.float32)
+    fill_cost = np.full(hh * ww, np.inf, dtype=np.float32)
     if need.any():
         order = list(unit.primary) + list(unit.secondary)
         idx = np.flatnonzero(need)
@@ -1267,18 +1267,18 @@ def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str
         filled = need
     valid = (wsum > 1e-6) | filled
     if unit.blending == "multiband":
-        out = _multiband(layers, fill_vals, filled, H, W, bands)
+        out = _multiband(layers, fill_vals, filled, hh, ww, bands)
     else:
-        out = np.zeros((H * W, bands), dtype=np.float32)
+        out = np.zeros((hh * ww, bands), dtype=np.float32)
         ok = wsum > 1e-6
         out[ok] = (acc[ok] / wsum[ok, None]).astype(np.float32)
         out[filled] = fill_vals[filled]
     # crop the halo
-    rr0, cc0 = unit.r0 - R0, unit.c0 - C0
-    out = out.reshape(H, W, bands)[rr0:rr0 + unit.h, cc0:cc0 + unit.w]
-    valid = valid.reshape(H, W)[rr0:rr0 + unit.h, cc0:cc0 + unit.w]
+    rr0, cc0 = unit.r0 - ar0, unit.c0 - ac0
+    out = out.reshape(hh, ww, bands)[rr0:rr0 + unit.h, cc0:cc0 + unit.w]
+    valid = valid.reshape(hh, ww)[rr0:rr0 + unit.h, cc0:cc0 + unit.w]
     return {"index": unit.index, "r0": unit.r0, "c0": unit.c0, "values": out, "valid": valid,
-            "fill_cells": int(filled.reshape(H, W)[rr0:rr0 + unit.h, cc0:cc0 + unit.w].sum())}
+            "fill_cells": int(filled.reshape(hh, ww)[rr0:rr0 + unit.h, cc0:cc0 + unit.w].sum())}
 
 
 def _multiband(layers, fill_vals: np.ndarray, filled: np.ndarray, h: int, w: int, bands: int) -> np.ndarray:
@@ -1661,3 +1661,536 @@ def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = Non
 def _rel(ws: Workspace, path: str) -> str:
     rel = os.path.relpath(path, ws.root)
     return path if rel.startswith("..") else rel
+
+
+# ---------------------------------------------------------------------------
+# one image on an existing DSM: space resection or known orientation; true ortho or planar rectification
+# ---------------------------------------------------------------------------
+
+MODES = ("ortho", "planar")
+_ORIENTATION_KEYS = {
+    "x": ("x", "easting", "e", "lon", "x_m"), "y": ("y", "northing", "n", "lat", "y_m"),
+    "z": ("z", "height", "h", "alt", "altitude", "elevation", "z_m"),
+    "omega": ("omega", "o", "omega_deg"), "phi": ("phi", "p", "phi_deg"), "kappa": ("kappa", "k", "kappa_deg"),
+    "image": ("image", "imagename", "name", "image_name", "file", "filename", "photo"),
+    "focal_mm": ("focal_mm", "focal", "f_mm", "focallength"), "sensor_width_mm": ("sensor_width_mm", "sensor_mm",
+                                                                                 "sensorwidth"),
+    "focal_px": ("focal_px", "f_px"), "cx": ("cx", "ppx", "cx_px"), "cy": ("cy", "ppy", "cy_px"),
+    "k1": ("k1",), "k2": ("k2",), "p1": ("p1",), "p2": ("p2",), "crs": ("crs", "epsg", "srs"),
+}
+
+
+def _orientation_key(name: str) -> Optional[str]:
+    n = name.strip().lower().replace(" ", "").replace("-", "_")
+    for key, aliases in _ORIENTATION_KEYS.items():
+        if n in aliases:
+            return key
+    return None
+
+
+def _normalise_orientation(d: Dict[str, Any], source: str) -> Dict[str, Any]:
+    out: Dict[str, Any] = {}
+    for k, v in d.items():
+        key = _orientation_key(str(k))
+        if key is None or v is None or v == "":
+            continue
+        if key in ("image", "crs"):
+            out[key] = str(v).strip()
+        else:
+            try:
+                out[key] = float(v)
+            except (TypeError, ValueError) as e:
+                raise OrthoError(f"{source}: {k} = {v!r} is not a number") from e
+    missing = [k for k in ("x", "y", "z", "omega", "phi", "kappa") if k not in out]
+    if missing:
+        raise OrthoError(f"{source}: the orientation lacks {', '.join(missing)} (needs x, y, z, omega, phi, kappa "
+                         "in degrees; optional focal_mm, sensor_width_mm, focal_px, cx, cy, k1, k2, p1, p2, crs)")
+    return out
+
+
+def read_orientation(path: str, image_name: Optional[str] = None) -> Dict[str, Any]:
+    """Exterior (and optionally interior) orientation of one image from a file.
+
+    JSON: ``{"x": .., "y": .., "z": .., "omega": .., "phi": .., "kappa": .., "crs": "EPSG:..", "focal_mm": ..}``
+    (or ``{"images": {name: {...}}}``).  Text: an optional CRS line (``EPSG:xxxx`` or ``# crs: ...``), a header
+    row naming the columns (``imageName X Y Z Omega Phi Kappa`` as Pix4D writes it, comma or white space
+    separated, more columns allowed), then one row per image; the row of ``image_name`` (case-insensitive, with
+    or without extension) is taken, or the only row.  A file without header holds ``x y z omega phi kappa``
+    or ``image x y z omega phi kappa``.  Angles in degrees, photogrammetric convention (see core.resection)."""
+    if not os.path.isfile(path):
+        raise OrthoError(f"orientation file {path} does not exist")
+    with open(path, encoding="utf-8-sig") as f:
+        text = f.read()
+    want = (image_name or "").lower()
+
+    def name_ok(n: str) -> bool:
+        n = os.path.basename(n.replace("\\", "/")).lower()
+        return bool(want) and (n == want or os.path.splitext(n)[0] == os.path.splitext(want)[0])
+
+    if text.lstrip().startswith("{"):
+        try:
+            d = json.loads(text)
+        except json.JSONDecodeError as e:
+            raise OrthoError(f"{path}: not valid JSON ({e})") from e
+        if isinstance(d.get("images"), dict):
+            rows = d["images"]
+            hit = [v for k, v in rows.items() if name_ok(k)]
+            if not hit and len(rows) == 1:
+                hit = list(rows.values())
+            if not hit:
+                raise OrthoError(f"{path} holds no orientation for {image_name} (images: {', '.join(list(rows)[:6])})")
+            merged = {k: v for k, v in d.items() if k != "images"}
+            merged.update(hit[0])
+            return _normalise_orientation(merged, path)
+        return _normalise_orientation(d, path)
+    crs = None
+    header: Optional[List[str]] = None
+    rows: List[List[str]] = []
+    for raw in text.splitlines():
+        line = raw.strip()
+        if not line:
+            continue
+        low = line.lower()
+        if line.startswith("#"):
+            body = line.lstrip("#").strip()
+            if body.lower().startswith("crs:") or body.lower().startswith("crs="):
+                crs = body[4:].strip()
+            continue
+        if low.startswith("epsg:") or low.startswith("+proj") or low.startswith("wgs84 utm"):
+            crs = line
+            continue
+        cells = [c.strip() for c in (line.split(",") if "," in line else line.split("\t") if "\t" in line
+                                     else line.split())]
+        if header is None and not rows and any(_orientation_key(c) in ("x", "omega") for c in cells):
+            header = cells
+            continue
+        rows.append(cells)
+    if not rows:
+        raise OrthoError(f"{path} holds no orientation row")
+    parsed = []
+    for cells in rows:
+        if header:
+            d = dict(zip(header, cells))
+        elif len(cells) == 6:
+            d = dict(zip(("x", "y", "z", "omega", "phi", "kappa"), cells))
+        elif len(cells) >= 7:
+            d = dict(zip(("image", "x", "y", "z", "omega", "phi", "kappa"), cells))
+        else:
+            raise OrthoError(f"{path}: a row needs x y z omega phi kappa (optionally the image name first); got "
+                             f"{' '.join(cells)!r}")
+        parsed.append(d)
+    hit = [d for d in parsed if name_ok(str(next((v for k, v in d.items() if _orientation_key(k) == "image"), "")))]
+    if not hit and len(parsed) == 1:
+        hit = parsed
+    if not hit:
+        raise OrthoError(f"{path} holds {len(parsed)} orientations but none for {image_name}")
+    d = dict(hit[0])
+    if crs and "crs" not in {_orientation_key(k) for k in d}:
+        d["crs"] = crs
+    return _normalise_orientation(d, path)
+
+
+@dataclass
+class SingleImageResult:
+    output: str
+    mode: str
+    crs: Optional[str]
+    resolution: float
+    valid_fraction: float
+    orientation: Dict[str, float]  # x, y, z (world), omega, phi, kappa (degrees), focal_px, k1
+    source: str  # "resection" or "orientation"
+    rmse_px: Optional[float] = None
+    residuals: List[Dict[str, Any]] = field(default_factory=list)
+    outliers: List[str] = field(default_factory=list)
+    estimated_intrinsics: bool = False
+    planar_rmse_m: Optional[float] = None
+    planar_error: Optional[Dict[str, float]] = None  # how far planar rectification is off given the DSM
+    residuals_path: Optional[str] = None
+    warnings: List[str] = field(default_factory=list)
+    log_lines: List[str] = field(default_factory=list)
+
+
+def _image_observations(gcps, name: str) -> List[Tuple[Any, Any]]:
+    """(point, observation) pairs of the GCP set observed in image ``name`` (by name, base name, stem)."""
+    base = os.path.basename(name).lower()
+    stem = os.path.splitext(base)[0]
+    out = []
+    for p in gcps.points:
+        for o in p.observations:
+            ob = os.path.basename(o.image.replace("\\", "/")).lower()
+            if ob == base or os.path.splitext(ob)[0] == stem:
+                out.append((p, o))
+                break
+    return out
+
+
+def _focal(meta: ImageMeta, image_path: str, focal_px, focal_mm, sensor_width_mm, orient: Optional[dict]
+           ) -> Tuple[Optional[float], str]:
+    long_side = max(meta.width, meta.height)
+    if focal_px:
+        return float(focal_px), "FOCAL_PX"
+    if focal_mm and sensor_width_mm:
+        return float(focal_mm) / float(sensor_width_mm) * long_side, "FOCAL_MM / SENSOR_WIDTH_MM"
+    if focal_mm or sensor_width_mm:
+        raise OrthoError("give both FOCAL_MM and SENSOR_WIDTH_MM (the sensor's long side in mm), or neither")
+    if orient:
+        if orient.get("focal_px"):
+            return float(orient["focal_px"]), "orientation file"
+        if orient.get("focal_mm") and orient.get("sensor_width_mm"):
+            return float(orient["focal_mm"]) / float(orient["sensor_width_mm"]) * long_side, "orientation file"
+    from .images import ImageError, read_image_info
+
+    try:
+        info = read_image_info(image_path)
+    except ImageError:
+        return None, "none"
+    if info.focal_source != "default" and info.focal_px:
+        return float(info.focal_px), f"EXIF ({info.focal_source})"
+    return None, "none"
+
+
+def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = None, gcps=None,
+                       orientation=None, focal_mm: Optional[float] = None, sensor_width_mm: Optional[float] = None,
+                       focal_px: Optional[float] = None, mode: str = "ortho", crs: Optional[str] = None,
+                       resolution: float = 0.0, residuals_path: Optional[str] = None,
+                       estimate_intrinsics="auto", mask_path: Optional[str] = None,
+                       options: Optional[OrthoOptions] = None, progress: Optional[Progress] = None
+                       ) -> SingleImageResult:
+    """Orthorectify one image (even one outside any block) on an existing DSM.
+
+    Orientation from ``gcps`` (a GCP file path or a core.gcp.GCPSet with observations in this image: space
+    resection, >= 4 control points, >= 6 to also estimate focal length and k1) or from ``orientation`` (a file
+    for :func:`read_orientation` or a dict with x, y, z, omega, phi, kappa).  ``mode`` "ortho": true orthophoto
+    on the DSM (required; reprojected on the fly when in another CRS); "planar": projective rectification
+    through the control points onto a plane, and, when a DSM is given, how far that is off.  Writes a COG at
+    ``output`` and optionally the GCP residuals to the GeoPackage ``residuals_path``."""
+    from . import gcp as gcpmod
+    from . import resection as rs
+
+    progress = progress or NullProgress()
+    options = options or OrthoOptions()
+    options.resolution = float(resolution or 0.0)
+    options.check()
+    mode = (mode or "ortho").lower()
+    if mode not in MODES:
+        raise OrthoError(f"unknown MODE {mode!r}; choose one of {', '.join(MODES)}")
+    if not image_path or not os.path.isfile(image_path):
+        raise OrthoError(f"image {image_path} does not exist")
+    if gcps is None and orientation is None:
+        raise OrthoError("give ground control points observed in the image (GCPS) or its orientation (ORIENTATION)")
+    if mode == "ortho" and not dsm_path:
+        raise OrthoError("a true orthophoto needs a DSM; give DSM, or choose MODE planar for flat ground")
+    if mode == "planar" and gcps is None:
+        raise OrthoError("planar rectification needs at least 4 ground control points observed in the image (GCPS)")
+    name = os.path.basename(image_path)
+    meta = image_meta(image_path)
+    warnings: List[str] = []
+    log: List[str] = []
+
+    def warn(msg: str) -> None:
+        warnings.append(msg)
+        progress.warning(msg)
+
+    orient = None
+    if orientation is not None:
+        orient = (read_orientation(orientation, name) if isinstance(orientation, str)
+                  else _normalise_orientation(dict(orientation), "ORIENTATION"))
+    if isinstance(gcps, str):
+        try:
+            gcps = gcpmod.read_gcps(gcps)
+        except gcpmod.GCPError as e:
+            raise OrthoError(str(e)) from e
+    # working CRS
+    dsm_info = dsmmod.open_dsm(dsm_path) if dsm_path else None
+    work_crs = crs or (gcps.crs if gcps is not None and gcps.crs else None) or (orient or {}).get("crs")
+    if not work_crs and dsm_info is not None and dsm_info.crs_wkt:
+        work_crs = dsm_info.crs_wkt
+    if not work_crs:
+        warn("no CRS given: coordinates are taken as they are (no CRS written)")
+    # ground control observed in this image
+    pairs = []
+    if gcps is not None:
+        for w_ in getattr(gcps, "warnings", []):
+            warn(w_)
+        pairs = _image_observations(gcps, name)
+        if gcps.crs and work_crs and not _crs_equal(gcps.crs, work_crs):
+            xyz = gcpmod.transform_points(np.array([[p.x, p.y, p.z] for p, _ in pairs], dtype=float).reshape(-1, 3),
+                                          gcps.crs, work_crs)
+        else:
+            xyz = np.array([[p.x, p.y, p.z] for p, _ in pairs], dtype=float).reshape(-1, 3)
+        control = [i for i, (p, _) in enumerate(pairs) if p.role == gcpmod.CONTROL]
+        checks = [i for i, (p, _) in enumerate(pairs) if p.role != gcpmod.CONTROL]
+        need = rs.MIN_RESECTION_POINTS if orient is None else 0
+        if len(control) < need:
+            images = ", ".join(gcps.image_names()[:6]) if hasattr(gcps, "image_names") else ""
+            raise OrthoError(
+                f"space resection needs at least {rs.MIN_RESECTION_POINTS} ground control points observed in {name} "
+                f"({rs.MIN_INTRINSICS_POINTS} to also estimate the focal length and k1); found {len(control)}"
+                + (f" (and {len(checks)} check points, which are not used)" if checks else "")
+                + (f". The control file names the images {images}" if not pairs and images else ""))
+        px_all = np.array([[o.x, o.y] for _, o in pairs], dtype=float).reshape(-1, 2)
+        outside = [pairs[i][0].name for i in range(len(pairs))
+                   if not (0 <= px_all[i, 0] <= meta.width and 0 <= px_all[i, 1] <= meta.height)]
+        if outside:
+            warn(f"GCP observation(s) outside the {meta.width} x {meta.height} image {name}: {', '.join(outside)}")
+    # local frame
+    if orient is not None:
+        c_world = np.array([orient["x"], orient["y"], orient["z"]], dtype=float)
+        ocrs = orient.get("crs")
+        if ocrs and work_crs and not _crs_equal(ocrs, work_crs):
+            c_world = gcpmod.transform_points(c_world[None], ocrs, work_crs)[0]
+        offset = np.array([round(c_world[0]), round(c_world[1]), 0.0])
+    else:
+        offset = np.array([round(float(np.mean(xyz[control, 0]))), round(float(np.mean(xyz[control, 1]))), 0.0])
+    # interior orientation
+    f_px, f_source = _focal(meta, image_path, focal_px, focal_mm, sensor_width_mm, orient)
+    n_control = len(control) if gcps is not None else 0
+    if f_px is None:
+        if orient is None and n_control >= rs.MIN_INTRINSICS_POINTS:
+            f_px = 1.2 * max(meta.width, meta.height)
+            estimate_intrinsics = True
+            warn(f"the focal length of {name} is unknown (no EXIF, none given): it is estimated from the "
+                 f"{n_control} control points")
+        else:
+            raise OrthoError(
+                f"the focal length of {name} is unknown (no EXIF focal length): give FOCAL_MM and SENSOR_WIDTH_MM "
+                f"(or a focal length in the orientation file), or at least {rs.MIN_INTRINSICS_POINTS} GCPs to "
+                "estimate it")
+    o = orient or {}
+    cam0 = rs.Intrinsics.simple(meta.width, meta.height, f_px, o.get("cx"), o.get("cy"), o.get("k1", 0.0),
+                                o.get("k2", 0.0), o.get("p1", 0.0), o.get("p2", 0.0))
+    log.append(f"{name}: {meta.width} x {meta.height} px, {meta.bands} band(s) {meta.dtype}, focal {f_px:.1f} px "
+               f"({f_source})")
+    # exterior orientation
+    residuals: List[Dict[str, Any]] = []
+    rmse = None
+    outliers: List[str] = []
+    estimated = False
+    if orient is not None:
+        rot = rs.rotation_from_opk(orient["omega"], orient["phi"], orient["kappa"])
+        pose = rs.Pose.from_centre(rot, c_world - offset)
+        cam = cam0
+        source = "orientation"
+        if pairs:
+            proj, ok = rs.project_points(pose, cam, xyz - offset)
+            for i, (p, ob) in enumerate(pairs):
+                residuals.append(_residual_row(p, ob, name, xyz[i], proj[i], True, "check (orientation given)"))
+            r = np.array([row["res_px"] for row in residuals])
+            rmse = float(np.sqrt(np.mean(r ** 2)))
+    else:
+        try:
+            res = rs.space_resection(xyz[control] - offset, px_all[control], cam0,
+                                     names=[pairs[i][0].name for i in control],
+                                     estimate_intrinsics=estimate_intrinsics, image=name)
+        except rs.ResectionError as e:
+            raise OrthoError(str(e)) from e
+        pose, cam, estimated, rmse = res.pose, res.camera, res.estimated_intrinsics, res.rmse_px
+        outliers = res.outliers
+        for w_ in res.warnings:
+            warn(w_)
+        source = "resection"
+        proj, ok = rs.project_points(pose, cam, xyz - offset)
+        used = {r.name: r.used for r in res.residuals}
+        for i, (p, ob) in enumerate(pairs):
+            role = "control" if i in control else "check"
+            residuals.append(_residual_row(p, ob, name, xyz[i], proj[i], used.get(p.name, False) if i in control
+                                           else False, role if used.get(p.name, True) else "outlier"))
+        chk = [row["res_px"] for row in residuals if row["role"] == "check"]
+        log.append(f"space resection from {res.n_used} of {len(control)} control points: RMSE {rmse:.2f} px"
+                   + (f", check points RMSE {float(np.sqrt(np.mean(np.square(chk)))):.2f} px ({len(chk)})" if chk else "")
+                   + (f"; estimated {' and '.join(res.estimated_params)}: focal length {cam.focal:.1f} px, k1 "
+                      f"{cam.dist[0]:+.4f}" if estimated else "")
+                   + (f"; left out: {', '.join(outliers)}" if outliers else ""))
+        progress.info(log[-1])
+    centre_w = pose.centre + offset
+    om, ph, ka = rs.opk_from_rotation(pose.rotation)
+    orientation_out = {"x": float(centre_w[0]), "y": float(centre_w[1]), "z": float(centre_w[2]), "omega": om,
+                       "phi": ph, "kappa": ka, "focal_px": float(cam.focal), "k1": float(cam.dist[0])}
+    log.append(f"camera at X {centre_w[0]:.2f} Y {centre_w[1]:.2f} Z {centre_w[2]:.2f}, omega {om:.3f} phi {ph:.3f} "
+               f"kappa {ka:.3f} deg")
+    progress.info(log[-1])
+    progress.report(0.1, "oriented")
+    ocam = OrthoCamera(name, os.path.abspath(image_path), cam, pose, 0, mask_path)
+    out_dir = os.path.dirname(os.path.abspath(output))
+    os.makedirs(out_dir, exist_ok=True)
+    workdir = tempfile.mkdtemp(prefix=".ortho-work-", dir=out_dir)
+    _CACHE.max_bytes = options.cache_mb << 20
+    dsm = _Dsm(dsm_path, work_crs) if dsm_path else None
+    result = SingleImageResult(output, mode, work_crs, 0.0, 0.0, orientation_out, source, rmse, residuals, outliers,
+                               estimated, warnings=warnings, log_lines=log)
+    try:
+        with _gdal_cache(64):
+            if dsm is not None and dsm.reprojected:
+                log.append(f"DSM {dsm_path} reprojected on the fly into the working CRS")
+                progress.info(log[-1])
+            if mode == "ortho":
+                prep = prepare_block([ocam], dsm, offset, options.resolution, workdir, options.occlusion,
+                                     options.height_tolerance, SubProgress(progress, 0.1, 0.3))
+                for w_ in prep.warnings:
+                    warn(w_)
+                info = write_camera_ortho(ocam, prep.metas[0], prep.visibility[0], prep.footprints[0], dsm, offset,
+                                          prep.grid, work_crs, output, options, SubProgress(progress, 0.3, 1.0))
+                if info is None:
+                    raise OrthoError(f"the DSM does not cover the ground seen by {name}")
+                result.resolution = prep.grid.resolution
+                result.valid_fraction = info["valid_fraction"]
+                if info["valid_fraction"] == 0.0:
+                    raise OrthoError(f"no cell of the orthophoto of {name} has data: the DSM has no valid height "
+                                     "where the image looks")
+            else:
+                _planar(result, ocam, meta, pairs, control, xyz, px_all, offset, dsm, options, output, warn,
+                        SubProgress(progress, 0.1, 1.0))
+        log.append(f"{mode} orthophoto {output}: {result.resolution:g} per cell, "
+                   f"{100 * result.valid_fraction:.1f} % of its cells with data")
+        progress.info(log[-1])
+        if residuals_path and residuals:
+            from .vector import write_points_gpkg
+
+            fields = [("name", "str"), ("role", "str"), ("image", "str"), ("px", "float"), ("py", "float"),
+                      ("dx_px", "float"), ("dy_px", "float"), ("res_px", "float"), ("used", "int"),
+                      ("dx_m", "float"), ("dy_m", "float"), ("res_m", "float")]
+            write_points_gpkg(residuals_path, "gcp_residuals", residuals, fields, work_crs)
+            result.residuals_path = residuals_path
+        progress.report(1.0, "done")
+        return result
+    finally:
+        if dsm is not None:
+            dsm.close()
+        _CACHE.clear()
+        shutil.rmtree(workdir, ignore_errors=True)
+
+
+def _crs_equal(a: str, b: str) -> bool:
+    from osgeo import osr
+
+    sa, sb = osr.SpatialReference(), osr.SpatialReference()
+    try:
+        sa.SetFromUserInput(a)
+        sb.SetFromUserInput(b)
+    except RuntimeError:
+        return a == b
+    return bool(sa.IsSame(sb))
+
+
+def _residual_row(p, ob, image: str, xyz_w, proj, used: bool, role: str) -> Dict[str, Any]:
+    dx, dy = float(proj[0] - ob.x), float(proj[1] - ob.y)
+    return {"name": p.name, "role": role, "image": image, "px": float(ob.x), "py": float(ob.y), "dx_px": dx,
+            "dy_px": dy, "res_px": math.hypot(dx, dy), "used": int(bool(used)), "x": float(xyz_w[0]),
+            "y": float(xyz_w[1]), "z": float(xyz_w[2])}
+
+
+def _planar(result: SingleImageResult, ocam: OrthoCamera, meta: ImageMeta, pairs, control, xyz, px_all,
+            offset: np.ndarray, dsm: Optional[_Dsm], options: OrthoOptions, output: str, warn, progress: Progress
+            ) -> None:
+    """Projective rectification through the control points; with a DSM, how far it is off from the truth."""
+    from . import resection as rs
+
+    cam = ocam.camera
+    name = ocam.name
+
+    def undist_px(px):
+        xn = cam.unproject(px)
+        return np.stack([cam.fx * xn[..., 0] + cam.cx, cam.fy * xn[..., 1] + cam.cy], axis=-1)
+
+    try:
+        hom = rs.fit_homography(undist_px(px_all[control]), (xyz[control, :2] - offset[:2]),
+                                [pairs[i][0].name for i in control], image=name)
+    except rs.ResectionError as e:
+        raise OrthoError(str(e)) from e
+    for w_ in hom.warnings:
+        warn(w_)
+    result.planar_rmse_m = hom.rmse_m
+    by_name = {r.name: r for r in hom.residuals}
+    for row in result.residuals:
+        r = by_name.get(row["name"])
+        if r is not None:
+            row["dx_m"], row["dy_m"], row["res_m"] = r.dx, r.dy, r.residual
+    # which side of the horizon the image is on: the sign of w at the image centre
+    hmat = hom.matrix
+    w_c = (hmat @ np.array([cam.cx, cam.cy, 1.0]))[2]
+    t = np.linspace(0.0, 1.0, 33)
+    border = np.concatenate([np.column_stack([t * cam.width, np.zeros_like(t)]),
+                             np.column_stack([np.full_like(t, cam.width), t * cam.height]),
+                             np.column_stack([(1 - t) * cam.width, np.full_like(t, cam.height)]),
+                             np.column_stack([np.zeros_like(t), (1 - t) * cam.height])])
+    ub = undist_px(border)
+    wb = np.column_stack([ub, np.ones(len(ub))]) @ hmat.T
+    if np.any(wb[:, 2] * w_c <= 0):
+        raise OrthoError(f"the plane through the control points reaches the horizon in {name}: planar "
+                         "rectification of an oblique view this steep has no bounded result; use MODE ortho")
+    corners = wb[:, :2] / wb[:, 2:3] + offset[:2]
+    jac_d = 1.0
+    c0 = hom.world_from_pixel(np.array([[cam.cx, cam.cy], [cam.cx + jac_d, cam.cy], [cam.cx, cam.cy + jac_d]]))
+    gsd = math.sqrt(abs(np.cross(c0[1] - c0[0], c0[2] - c0[0])))
+    res = options.resolution if options.resolution > 0 else _nice(gsd)
+    grid = dsmmod.Grid.covering(float(corners[:, 0].min()), float(corners[:, 1].min()), float(corners[:, 0].max()),
+                                float(corners[:, 1].max()), res)
+    if grid.width * grid.height > 400_000_000:
+        raise OrthoError(f"a {grid.width} x {grid.height} planar rectification at {res:g} is too large")
+    work = os.path.join(os.path.dirname(os.path.abspath(output)), ".work-" + os.path.basename(output))
+    writer = _RasterWriter(work, grid.width, grid.height, meta.bands, meta.dtype, grid.geotransform, result.crs)
+    n_valid = 0
+    try:
+        tiles = _tiles(grid.width, grid.height, options.tile)
+        for k, (r0, c0_, h, w) in enumerate(tiles):
+            check_cancel(progress)
+            x, y = _cell_centres(grid, r0, c0_, h, w)
+            pu = hom.pixel_from_world(np.column_stack([x - offset[0], y - offset[1]]))
+            xn = np.column_stack([(pu[:, 0] - cam.cx) / cam.fx, (pu[:, 1] - cam.cy) / cam.fy])
+            ok = cam.valid_normalized(xn)
+            xd = cam.distort(xn)
+            px = np.column_stack([cam.fx * xd[:, 0] + cam.cx, cam.fy * xd[:, 1] + cam.cy])
+            ok &= cam.inside(px) & np.all(np.isfinite(px), axis=1)
+            vals = np.zeros((len(x), meta.bands), dtype=np.float32)
+            if ok.any():
+                idx = np.flatnonzero(ok)
+                u, v = px[idx, 0] - 0.5, px[idx, 1] - 0.5
+                xa, ya = max(0, int(u.min()) - 3), max(0, int(v.min()) - 3)
+                xb, yb = min(meta.width, int(u.max()) + 4), min(meta.height, int(v.max()) + 4)
+                win = _image_window(ocam.path, meta, xa, ya, xb, yb)
+                vals[idx] = _remap(win, u - xa, v - ya, options.interpolation)
+                mask = _mask(ocam.mask_path)
+                if mask is not None:
+                    ok[idx] &= mask[np.clip(px[idx, 1].astype(int), 0, mask.shape[0] - 1),
+                                    np.clip(px[idx, 0].astype(int), 0, mask.shape[1] - 1)] >= 128
+            writer.write(r0, c0_, vals.reshape(h, w, -1), ok.reshape(h, w))
+            n_valid += int(ok.sum())
+            progress.report(0.8 * (k + 1) / len(tiles), f"planar rectification: tile {k + 1}/{len(tiles)}")
+        writer.finish(output, options.compress, SubProgress(progress, 0.8, 0.95),
+                      metadata={"ARCHAEOORTHO_STAGE": "planar rectification", "IMAGE": name})
+    except BaseException:
+        writer.abort()
+        raise
+    result.resolution = res
+    result.valid_fraction = n_valid / float(grid.width * grid.height)
+    log = result.log_lines
+    log.append(f"planar rectification through {sum(r.used for r in hom.residuals)} control points: RMSE "
+               f"{hom.rmse_m:.3f} m on the plane")
+    if dsm is None:
+        warn("no DSM given: how far planar rectification is off because of relief cannot be measured")
+        return
+    # displacement of planar rectification against the true geometry: ground (X, Y, DSM) -> image (pose) ->
+    # plane (homography); the difference is where the plane puts what truly lies at (X, Y)
+    n = 200
+    xs = np.linspace(grid.x0, grid.x0 + grid.width * res, n)
+    ys = np.linspace(grid.y0, grid.y0 - grid.height * res, n)
+    gx, gy = np.meshgrid(xs, ys)
+    gx, gy = gx.ravel(), gy.ravel()
+    gz = dsm.sample(gx, gy)
+    fin = np.isfinite(gz)
+    xyz_l = np.column_stack([gx - offset[0], gy - offset[1], np.where(fin, gz, 0.0) - offset[2]])
+    px, _d, ok = ocam.project(xyz_l)
+    ok &= fin
+    if not ok.any():
+        warn("the DSM does not cover the image's ground: planar displacement not measured")
+        return
+    planar = hom.world_from_pixel(undist_px(px[ok]))
+    d = np.hypot(planar[:, 0] - xyz_l[ok, 0], planar[:, 1] - xyz_l[ok, 1])
+    relief = float(np.nanpercentile(gz[ok], 99) - np.nanpercentile(gz[ok], 1))
+    result.planar_error = {"mean_m": float(d.mean()), "p95_m": float(np.percentile(d, 95)), "max_m": float(d.max()),
+                           "mean_px": float(d.mean() / res), "p95_px": float(np.percentile(d, 95) / res),
+                           "max_px": float(d.max() / res), "relief_m": relief, "samples": int(ok.sum())}
+    pe = result.planar_error
+    log.append(f"planar rectification is off by {pe['mean_m']:.2f} m on average, {pe['p95_m']:.2f} m at the 95th "
+               f"percentile and {pe['max_m']:.2f} m at most ({pe['p95_px']:.1f} cells at 95 %) over "
+               f"{pe['relief_m']:.1f} m of relief in the DSM")

@@ -325,6 +325,7 @@ class ResectionResult:
     estimated_intrinsics: bool
     focal_sigma_px: Optional[float] = None
     warnings: List[str] = field(default_factory=list)
+    estimated_params: List[str] = field(default_factory=list)  # "focal", "k1"
 
     @property
     def outliers(self) -> List[str]:
@@ -372,9 +373,10 @@ def _pnp(xyz: np.ndarray, xn: np.ndarray) -> List[Pose]:
     return out
 
 
-def _refine(xyz: np.ndarray, px: np.ndarray, pose: Pose, cam: Intrinsics, free_intrinsics: bool
-            ) -> Tuple[Pose, Intrinsics, Optional[float]]:
-    """Least-squares (Levenberg-Marquardt) refinement of the pose, optionally focal length and k1."""
+def _refine(xyz: np.ndarray, px: np.ndarray, pose: Pose, cam: Intrinsics, free: str = ""
+            ) -> Tuple[Pose, Intrinsics, Optional[float], Optional[float]]:
+    """Least-squares (Levenberg-Marquardt) refinement of the pose and, with ``free`` "fk1", the focal length and
+    k1, with "k1" k1 alone.  Returns (pose, camera, sigma of the focal length px, sigma of k1)."""
     from scipy.optimize import least_squares
 
     base = cam.as_opencv()
@@ -382,16 +384,19 @@ def _refine(xyz: np.ndarray, px: np.ndarray, pose: Pose, cam: Intrinsics, free_i
     p0 = list(base.params)
     i_fx, i_fy, i_k1 = names.index("fx"), names.index("fy"), names.index("k1")
     f0 = base.focal
+    ratio = base.fy / base.fx
 
     def unpack(v):
         pose_ = Pose(_rmat(v[:3]), v[3:6])
-        if not free_intrinsics:
+        if not free:
             return pose_, base
         p = list(p0)
-        ratio = base.fy / base.fx
-        p[i_fx] = v[6] * f0
-        p[i_fy] = v[6] * f0 * ratio
-        p[i_k1] = v[7]
+        if free == "fk1":
+            p[i_fx] = v[6] * f0
+            p[i_fy] = v[6] * f0 * ratio
+            p[i_k1] = v[7]
+        else:
+            p[i_k1] = v[6]
         return pose_, Intrinsics(base.model, base.width, base.height, tuple(p))
 
     def fun(v):
@@ -403,20 +408,26 @@ def _refine(xyz: np.ndarray, px: np.ndarray, pose: Pose, cam: Intrinsics, free_i
         return (proj - px).ravel()
 
     v0 = np.concatenate([_rvec(pose.rotation), pose.translation])
-    if free_intrinsics:
+    if free == "fk1":
         v0 = np.concatenate([v0, [1.0, p0[i_k1]]])
+    elif free == "k1":
+        v0 = np.concatenate([v0, [p0[i_k1]]])
     res = least_squares(fun, v0, method="lm", x_scale="jac", max_nfev=2000)
     pose_, cam_ = unpack(res.x)
-    sigma_f = None
-    if free_intrinsics:
+    sigma_f = sigma_k = None
+    if free:
         dof = max(1, res.fun.size - res.x.size)
         s0 = float(res.fun @ res.fun) / dof
         try:
             cov = np.linalg.inv(res.jac.T @ res.jac) * max(s0, 0.25)  # at least 0.5 px a priori
-            sigma_f = float(math.sqrt(max(cov[6, 6], 0.0))) * f0
+            d = np.sqrt(np.maximum(np.diag(cov), 0.0))
         except np.linalg.LinAlgError:
-            sigma_f = float("inf")
-    return pose_, cam_, sigma_f
+            d = np.full(res.x.size, np.inf)
+        if free == "fk1":
+            sigma_f, sigma_k = float(d[6]) * f0, float(d[7])
+        else:
+            sigma_k = float(d[6])
+    return pose_, cam_, sigma_f, sigma_k
 
 
 def space_resection(xyz: np.ndarray, pixels: np.ndarray, camera: Intrinsics, names: Optional[Sequence[str]] = None,
@@ -472,31 +483,41 @@ def space_resection(xyz: np.ndarray, pixels: np.ndarray, camera: Intrinsics, nam
         used = np.ones(n, dtype=bool)  # nothing agrees well: use all and report
     cam = camera
     for _ in range(3):
-        pose, cam, _sf = _refine(xyz[used], pixels[used], pose, camera, False)
+        pose, cam, _sf, _sk = _refine(xyz[used], pixels[used], pose, camera)
         new_used = _errors(pose, cam, xyz, pixels) < thr
         if new_used.sum() < MIN_RESECTION_POINTS or np.array_equal(new_used, used):
             break
         used = new_used
 
     estimated = False
+    est_params: List[str] = []
     sigma_f = None
-    want = estimate_intrinsics is True or (estimate_intrinsics == "auto" and used.sum() >= MIN_INTRINSICS_POINTS)
-    if want and used.sum() >= MIN_INTRINSICS_POINTS:
-        p2, c2, sf = _refine(xyz[used], pixels[used], pose, camera, True)
+    n_used = int(used.sum())
+    want = estimate_intrinsics is True or (estimate_intrinsics == "auto" and n_used >= MIN_INTRINSICS_POINTS)
+    if want and n_used >= MIN_INTRINSICS_POINTS:
+        p2, c2, sf, sk = _refine(xyz[used], pixels[used], pose, camera, "fk1")
         rel = sf / c2.focal if sf is not None and c2.focal > 0 else float("inf")
         sane = 0.5 < c2.focal / camera.focal < 2.0 and abs(c2.dist[0]) < 1.0
         if sane and (estimate_intrinsics is True or rel < 0.02):
             pose, cam, estimated, sigma_f = p2, c2, True, sf
+            est_params = ["focal", "k1"]
             if rel >= 0.02:
                 warnings.append(f"the focal length of {image} is poorly determined by these points "
                                 f"(sigma {100 * rel:.1f} %): spread GCPs over more relief or give the focal length")
         else:
             sigma_f = sf
-            warnings.append(f"focal length and k1 of {image} were not estimated: the {int(used.sum())} points do not "
-                            f"determine them (sigma {100 * rel:.0f} % of the focal length; flat or clustered GCPs); "
-                            "the given focal length was kept")
-    elif estimate_intrinsics == "auto" and n >= MIN_INTRINSICS_POINTS and used.sum() < MIN_INTRINSICS_POINTS:
-        warnings.append(f"focal length and k1 of {image} were not estimated: only {int(used.sum())} points agree "
+            # flat control fixes k1 (a radial pattern) even where the focal length trades off against the height
+            p3, c3, _sf3, sk3 = _refine(xyz[used], pixels[used], pose, camera, "k1")
+            k1_ok = sk3 is not None and sk3 < 0.02 and abs(c3.dist[0]) < 1.0
+            if k1_ok:
+                pose, cam = p3, c3
+                est_params = ["k1"]
+            warnings.append(f"the focal length of {image} was not estimated: the {n_used} points do not determine "
+                            f"it (sigma {100 * rel:.0f} %; flat or clustered GCPs); the given focal length was kept"
+                            + (f", k1 estimated alone ({c3.dist[0]:+.4f})" if k1_ok else ", and k1 too"))
+            estimated = k1_ok
+    elif estimate_intrinsics == "auto" and n >= MIN_INTRINSICS_POINTS and n_used < MIN_INTRINSICS_POINTS:
+        warnings.append(f"focal length and k1 of {image} were not estimated: only {n_used} points agree "
                         f"({MIN_INTRINSICS_POINTS} needed)")
 
     proj, ok = project_points(pose, cam, xyz)
@@ -513,7 +534,7 @@ def space_resection(xyz: np.ndarray, pixels: np.ndarray, camera: Intrinsics, nam
         warnings.append(f"with only {n} GCPs a wrong one cannot be told apart; RMSE {rmse:.1f} px: add GCPs")
     if not camera.dist.any() and not estimated and rmse > 3.0:
         warnings.append(f"residuals of {rmse:.1f} px: lens distortion may be unmodelled (6 or more GCPs estimate k1)")
-    return ResectionResult(pose, cam, residuals, rmse, estimated, sigma_f, warnings)
+    return ResectionResult(pose, cam, residuals, rmse, estimated, sigma_f, warnings, est_params)
 
 
 # ---------------------------------------------------------------------------
