@@ -128,7 +128,7 @@ def child(args):
         json.dump({"wall": wall, "dsm": r.dsm_path, "point_cloud": r.point_cloud_path, "pairs": r.pairs,
                    "pairs_reused": r.pairs_reused, "points": r.points, "valid_fraction": r.valid_fraction,
                    "resolution": r.resolution, "timings": r.timings, "log": r.log_lines,
-                   "pair_seconds": [s["seconds"] for s in pairs], "pair_megapixels": [s["megapixels"] for s in pairs],
+                   "pair_seconds": [s["seconds"] for s in pairs], "pair_cpu": [s.get("cpu_seconds", 0.0) for s in pairs], "pair_megapixels": [s["megapixels"] for s in pairs],
                    "pair_valid_fraction": [s.get("valid_fraction", 0.0) for s in pairs]}, f)
 
 
@@ -214,9 +214,13 @@ def main():
         print(f"  seconds per pair: mean {secs.mean():.2f}, median {np.median(secs):.2f}, max {secs.max():.2f} "
               "(one worker's time for one pair)")
         print(f"  seconds per megapixel (both images of a pair at the matching scale): {secs.sum() / mp.sum():.2f}")
+        cpu = np.array(r["pair_cpu"])
+        print(f"  CPU seconds per pair (all threads of the worker; unaffected by other load): mean {cpu.mean():.2f}, "
+              f"per megapixel {cpu.sum() / mp.sum():.2f}")
         print(f"  matched share of the rectified left image per pair: median {np.median(r['pair_valid_fraction']):.2f}")
     print("  stage seconds: " + ", ".join(f"{k} {v:.1f}" for k, v in r["timings"].items()))
-    print(f"  total seconds (wall, child process): {r['wall']:.1f}")
+    print(f"  total seconds (wall, child process): {r['wall']:.1f}; machine load average now "
+          f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print(f"  peak RSS: {r['peak_rss_tree_mib']:.0f} MiB for the whole process tree ({r['processes_at_peak']} processes), "
           f"{r['peak_rss_single_mib']:.0f} MiB for the largest single process (limit 4096 MiB)")
     print(f"  VALID_FRACTION inside the convex hull of the image centres: {r['valid_fraction']:.3f}")

@@ -498,7 +498,7 @@ def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
     """The unit of work: one stereo pair -> depth maps of both images, saved to ``unit.out_path``."""
     import cv2
 
-    t0 = time.time()
+    t0, c0 = time.time(), time.process_time()
     cv2.setNumThreads(max(1, unit.threads))
     check_unit_cancel(cancel_path)
     img_i, sxi, syi = load_scaled(unit.vi, unit.scale)
@@ -568,7 +568,7 @@ def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
     rel_err = zmed / (rect.f * rect.baseline) if len(z) else 0.0
     summary.update(valid=int(len(z)), valid_fraction=float(len(z) / max(1, int(mi.sum()))),
                    megapixels=(wi_ * hi_ + wj_ * hj_) / 1e6, rectified=[w, h], disparities=[dmin, num],
-                   rel_err=rel_err, seconds=time.time() - t0)
+                   rel_err=rel_err, seconds=time.time() - t0, cpu_seconds=time.process_time() - c0)
     check_unit_cancel(cancel_path)
     _save_pair(unit.out_path, map_i, map_j, rel_err, summary)
     return summary
@@ -990,6 +990,10 @@ def _cuda_points(ws: Workspace, rec, views, scale: float, dense_dir: str, progre
     from .sfm import _CancelWatcher
 
     mvs = os.path.join(dense_dir, "mvs")
+    key = fingerprint({"model": _model_fingerprint(ws), "scale": scale})
+    key_file = os.path.join(mvs, "archaeoortho-key.txt")
+    if os.path.isdir(mvs) and (not os.path.isfile(key_file) or open(key_file).read().strip() != key):
+        shutil.rmtree(mvs, ignore_errors=True)  # built from another model or scale
     fused_dir = os.path.join(dense_dir, "fused")
     shutil.rmtree(fused_dir, ignore_errors=True)
     os.makedirs(fused_dir)
@@ -1002,6 +1006,7 @@ def _cuda_points(ws: Workspace, rec, views, scale: float, dense_dir: str, progre
             uo = pycolmap.UndistortCameraOptions()
             uo.max_image_size = max_size
             pycolmap.undistort_images(mvs, model_dir, images_dir, undistort_options=uo, cancellation_token=token)
+            atomic_write_text(key_file, key)
         progress.report(0.1, "patch-match stereo (COLMAP, CUDA)")
         pm = pycolmap.PatchMatchOptions()
         pm.max_image_size = max_size

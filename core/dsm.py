@@ -246,17 +246,18 @@ def rasterize_points(files: Sequence[PointFile], grid: Grid, offset: Sequence[fl
 
 
 def polygon_mask(grid: Grid, polygon_xy: np.ndarray) -> np.ndarray:
-    """Boolean mask of the cells whose centres lie inside a polygon (world coordinates)."""
-    from matplotlib.path import Path
+    """Boolean mask of the cells (centres) inside a polygon given in world coordinates."""
+    import cv2
 
-    xs, ys = grid.cell_centres()
-    mask = np.zeros((grid.height, grid.width), dtype=bool)
+    mask = np.zeros((grid.height, grid.width), dtype=np.uint8)
     if len(polygon_xy) < 3:
-        return mask
-    path = Path(np.asarray(polygon_xy, dtype=float))
-    gx, gy = np.meshgrid(xs, ys)
-    mask[:] = path.contains_points(np.column_stack([gx.ravel(), gy.ravel()])).reshape(mask.shape)
-    return mask
+        return mask.astype(bool)
+    p = np.asarray(polygon_xy, dtype=np.float64)
+    cols = (p[:, 0] - grid.x0) / grid.resolution - 0.5
+    rows = (grid.y0 - p[:, 1]) / grid.resolution - 0.5
+    pts = np.round(np.column_stack([cols, rows]) * 16).astype(np.int32)  # 4 fractional bits
+    cv2.fillPoly(mask, [pts.reshape(-1, 1, 2)], 1, lineType=cv2.LINE_8, shift=4)
+    return mask.astype(bool)
 
 
 def convex_hull_xy(points_xy: np.ndarray) -> np.ndarray:
