@@ -209,6 +209,11 @@ class GcpTableModel(QAbstractTableModel):
         self.beginResetModel()
         self.endResetModel()
 
+    def repaint_all(self):
+        """Values changed, rows did not: keeps the selection."""
+        if self.rowCount():
+            self.dataChanged.emit(self.index(0, 0), self.index(self.rowCount() - 1, self.columnCount() - 1))
+
 
 class RoleDelegate(QStyledItemDelegate):
     def createEditor(self, parent, option, index):  # noqa: N802 (Qt API)
@@ -310,11 +315,19 @@ class GcpDock(QgsDockWidget):
             b.setMenu(menu)
             b.setPopupMode(QToolButton.InstantPopup)
             self.toolbar.addWidget(b)
-        self.act_undo = self.store.undo_stack.createUndoAction(w, self.tr("Undo"))
-        self.act_redo = self.store.undo_stack.createRedoAction(w, self.tr("Redo"))
-        self.act_undo.setShortcut(QKeySequence.Undo)
-        self.act_redo.setShortcut(QKeySequence.Redo)
+        stack = self.store.undo_stack
+        self.act_undo = QAction(self.tr("Undo"), w)
+        self.act_redo = QAction(self.tr("Redo"), w)
+        self.act_undo.setShortcut(QKeySequence.StandardKey.Undo)
+        self.act_redo.setShortcut(QKeySequence.StandardKey.Redo)
+        self.act_undo.triggered.connect(stack.undo)
+        self.act_redo.triggered.connect(stack.redo)
+        stack.canUndoChanged.connect(self.act_undo.setEnabled)
+        stack.canRedoChanged.connect(self.act_redo.setEnabled)
+        stack.undoTextChanged.connect(lambda t: self.act_undo.setToolTip(self.tr("Undo: {}").format(t) if t else ""))
+        stack.redoTextChanged.connect(lambda t: self.act_redo.setToolTip(self.tr("Redo: {}").format(t) if t else ""))
         for a in (self.act_undo, self.act_redo):
+            a.setEnabled(False)
             a.setShortcutContext(Qt.WidgetWithChildrenShortcut)
             self.toolbar.addAction(a)
         self.act_results = self.toolbar.addAction(self.tr("Load results"))
@@ -556,12 +569,12 @@ class GcpDock(QgsDockWidget):
         self._update_summary()
 
     def _residuals_changed(self):
-        self.model.refresh()
+        self.model.repaint_all()
         self._update_summary()
 
     def _tolerance_changed(self, value):
         self.store.save_settings(tolerance=value)
-        self.model.refresh()
+        self.model.repaint_all()
 
     def _dsm_changed(self, layer):
         self.store.save_settings(dsm_layer=layer.id() if layer is not None else None)
@@ -637,9 +650,6 @@ class GcpDock(QgsDockWidget):
         dsm = self.dsm_combo.currentLayer()
         if dsm is not None:
             z = sample_height(dsm, QgsPointXY(point), canvas_crs)
-            if z is None:
-                self.message(self.tr("No height at this place in {}: Z left as it was").format(dsm.name()),
-                             Qgis.Warning)
         name = self.current_name()
         if name is None:
             name = self.add_point(x=p.x(), y=p.y(), z=z if z is not None else math.nan)
@@ -651,6 +661,9 @@ class GcpDock(QgsDockWidget):
         if z is not None:
             self.message(self.tr("{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})").format(
                 name, p.x(), p.y(), z, dsm.name()))
+        elif dsm is not None:
+            self.message(self.tr("{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was").format(
+                name, p.x(), p.y(), dsm.name()), Qgis.Warning)
         else:
             self.message(self.tr("{}: X {:.3f}, Y {:.3f}").format(name, p.x(), p.y()))
         return name
@@ -726,6 +739,7 @@ class GcpDock(QgsDockWidget):
         image = panel.image
         if point is None or image is None:
             panel.set_markers(None)
+            panel.set_next_available(False)
             panel.title.setText(f"<b>{image or ''}</b>")
             panel.hint.setText(self.tr("Select or add a ground point in the table, then click on it in the photo.")
                                if self.store.workspace is not None else "")
@@ -737,13 +751,14 @@ class GcpDock(QgsDockWidget):
                   "helmert": self.tr("from the points already placed (similarity fit)")}.get(
             pred.source if pred else "", "")
         panel.set_markers(point.name, (obs.x, obs.y) if obs else None, (pred.x, pred.y) if pred else None, source)
+        panel.set_next_available(self.next_photo() is not None)
         panel.title.setText(f"<b>{point.name}</b> \u2014 {image}")
         if obs is not None:
             panel.hint.setText(self.tr("Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete "
                                        "to remove it.").format(obs.x, obs.y))
         elif pred is not None:
-            panel.hint.setText(self.tr("Predicted {}. Press Enter (or 'Confirm') to accept it, drag it, or click "
-                                       "where the point really is.").format(source))
+            panel.hint.setText(self.tr("Predicted {}. Press Enter to accept it and go on (Space: accept), drag "
+                                       "it, or click where the point really is.").format(source))
         else:
             panel.hint.setText(self.tr("Click where {} is in this photo.").format(point.name))
         if zoom:
@@ -788,6 +803,7 @@ class GcpDock(QgsDockWidget):
         return None
 
     def confirm_and_next(self):
+        """Accept the prediction in the photo shown (if any) and show the next photo still to place."""
         self.confirm_prediction()
         nxt = self.next_photo()
         if nxt is not None:
@@ -927,8 +943,8 @@ class GcpDock(QgsDockWidget):
         gs = self.store.usable_gcps()
         crs = layers.qgs_crs(gs.crs)
         fields = "&".join(f"field={n}:{t}" for n, t in (
-            ("name", "string"), ("image", "string"), ("px", "double"), ("py", "double"), ("z", "double"),
-            ("sx", "double"), ("sy", "double"), ("sz", "double"), ("role", "string")))
+            ("name", "string"), ("image", "string"), ("px", "double(0,0)"), ("py", "double(0,0)"), ("z", "double(0,0)"),
+            ("sx", "double(0,0)"), ("sy", "double(0,0)"), ("sz", "double(0,0)"), ("role", "string")))
         mem = QgsVectorLayer(f"PointZ?{fields}", "gcp_observations", "memory")
         if crs.isValid():
             mem.setCrs(crs)
@@ -1086,5 +1102,3 @@ def _short_crs(text):
         return crs.authid() or crs.description() or text[:40]
     return text[:40]
 
-
-_ = QAction  # re-exported for the plugin's toolbar action

@@ -10,8 +10,8 @@ inside the exposed area: smooth on 20-megapixel photos.
 
 Mouse and keys: wheel zooms about the cursor; a left click places the observation of the selected GCP
 (a second click moves it); dragging a marker moves it; dragging the background, or the middle / right
-button, pans; Delete / Backspace removes the observation; Enter / Space confirms the prediction; F fits
-the photo, Z zooms to the GCP.
+button, pans; Delete / Backspace removes the observation; Space confirms the prediction, Enter confirms it and
+shows the next photo to place; F fits the photo, Z zooms to the GCP.
 """
 import math
 from collections import OrderedDict
@@ -229,6 +229,7 @@ class PhotoView(QGraphicsView):
     clicked = pyqtSignal(QPointF)
     deleteRequested = pyqtSignal()  # noqa: N815 (Qt signal naming)
     confirmRequested = pyqtSignal()  # noqa: N815
+    nextRequested = pyqtSignal()  # noqa: N815
     zoomToPointRequested = pyqtSignal()  # noqa: N815
 
     MIN_SCALE = 1.0 / 64
@@ -353,7 +354,9 @@ class PhotoView(QGraphicsView):
         key = event.key()
         if key in (Qt.Key_Delete, Qt.Key_Backspace):
             self.deleteRequested.emit()
-        elif key in (Qt.Key_Return, Qt.Key_Enter, Qt.Key_Space):
+        elif key in (Qt.Key_Return, Qt.Key_Enter):
+            self.nextRequested.emit()
+        elif key == Qt.Key_Space:
             self.confirmRequested.emit()
         elif key in (Qt.Key_Plus, Qt.Key_Equal):
             self._fit_mode = False
@@ -422,10 +425,11 @@ class PhotoPanel(QWidget):
         self.btn_fit = self._button(self.tr("Fit"), self.tr("Show the whole photo (F)"), self.view.fit)
         self.btn_zoom = self._button(self.tr("Zoom to point"), self.tr("Zoom to the observation or prediction (Z)"),
                                      self.zoom_to_point)
-        self.btn_confirm = self._button(self.tr("Confirm"), self.tr("Accept the predicted position (Enter)"),
+        self.btn_confirm = self._button(self.tr("Confirm"), self.tr("Accept the predicted position (Space)"),
                                         self._confirm)
         self.btn_next = self._button(self.tr("Confirm && next"),
-                                     self.tr("Accept the prediction and show the next photo"), self.nextRequested)
+                                     self.tr("Accept the prediction and show the next photo to place (Enter)"),
+                                     self.nextRequested)
         self.btn_remove = self._button(self.tr("Remove"), self.tr("Remove the observation in this photo (Delete)"),
                                        self._remove)
 
@@ -449,6 +453,7 @@ class PhotoPanel(QWidget):
         self.view.clicked.connect(self._clicked)
         self.view.deleteRequested.connect(self._remove)
         self.view.confirmRequested.connect(self._confirm)
+        self.view.nextRequested.connect(self._next)
         self.view.zoomToPointRequested.connect(self.zoom_to_point)
         self._update_buttons()
 
@@ -600,7 +605,7 @@ class PhotoPanel(QWidget):
 
     def _update_buttons(self):
         self.btn_confirm.setEnabled(self.prediction is not None)
-        self.btn_next.setEnabled(self.prediction is not None)
+        self.btn_next.setEnabled(self.prediction is not None or getattr(self, "_has_next", False))
         self.btn_remove.setEnabled(self.observation is not None)
         self.btn_zoom.setEnabled(self.observation is not None or self.prediction is not None)
 
@@ -628,3 +633,12 @@ class PhotoPanel(QWidget):
     def _confirm(self):
         if self.image and self.prediction is not None:
             self.confirmRequested.emit(self.image)
+
+    def _next(self):
+        if self.btn_next.isEnabled():
+            self.nextRequested.emit()
+
+    def set_next_available(self, available):
+        """Whether 'Confirm & next' has somewhere to go (the dock knows the photos still to place)."""
+        self._has_next = bool(available)
+        self._update_buttons()
