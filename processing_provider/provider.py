@@ -30,3 +30,8 @@ class ArchaeoOrthoProvider(QgsProcessingProvider):
         from .accuracy_report import AccuracyReportAlgorithm
 
         self.addAlgorithm(AccuracyReportAlgorithm())
+        from .build_orthophoto import BuildOrthophotoAlgorithm
+        from .orthorectify_image import OrthorectifyImageAlgorithm
+
+        for alg in (BuildOrthophotoAlgorithm(), OrthorectifyImageAlgorithm()):
+            self.addAlgorithm(alg)

@@ -1,0 +1,126 @@
+"""Build orthophoto: thin adapter over core.ortho.build_orthophoto_workspace."""
+from qgis.core import (
+    QgsProcessingException,
+    QgsProcessingOutputFolder,
+    QgsProcessingOutputNumber,
+    QgsProcessingParameterDefinition,
+    QgsProcessingParameterEnum,
+    QgsProcessingParameterFile,
+    QgsProcessingParameterFolderDestination,
+    QgsProcessingParameterNumber,
+    QgsProcessingParameterRasterDestination,
+    QgsProcessingParameterRasterLayer,
+    QgsProcessingParameterString,
+    QgsProcessingParameterVectorDestination,
+)
+
+from .base import AlgorithmBase, FeedbackProgress
+
+
+class BuildOrthophotoAlgorithm(AlgorithmBase):
+    NAME = "buildorthophoto"
+    DISPLAY = "Build orthophoto"
+    WORKSPACE = "WORKSPACE"
+    DSM = "DSM"
+    IMAGES_FILTER = "IMAGES_FILTER"
+    RESOLUTION = "RESOLUTION"
+    BLENDING = "BLENDING"
+    INTERPOLATION = "INTERPOLATION"
+    WORKERS = "WORKERS"
+    OUTPUT = "OUTPUT"
+    PER_IMAGE_FOLDER = "PER_IMAGE_FOLDER"
+    SEAMLINES = "SEAMLINES"
+    OUT_WORKSPACE = "WORKSPACE"  # the same name as the input: models chain stages through it
+    VALID_FRACTION = "VALID_FRACTION"
+    RESOLUTION_USED = "RESOLUTION_USED"
+    IMAGES_USED = "IMAGES_USED"
+    BLENDINGS = ("feather", "multiband", "none")
+    INTERPOLATIONS = ("bilinear", "cubic", "nearest")
+    HELP = (
+        "True orthophotos and the orthomosaic of a georeferenced workspace.\n\n"
+        "Every cell takes its height from the DSM and is projected through the full camera model (pose, focal "
+        "length, principal point, lens distortion) into the images. A cell hidden from an image by higher surface "
+        "(a wall, a tree, a hill) is left out of that image, so buildings do not lean and nothing appears twice; "
+        "the mosaic fills it from an image that sees it. Each part of the mosaic comes from the image that looks "
+        "at it most vertically and closest to its centre; seamlines go around buildings and trees; brightness "
+        "differences between images are evened out and seams blended.\n\n"
+        "WORKSPACE: a georeferenced workspace with a DSM (run 'Build DSM' first), or give DSM.\n"
+        "DSM: optional raster (e.g. an ALS DSM, in any CRS: reprojected on the fly); default the workspace DSM.\n"
+        "IMAGES_FILTER: a subset, e.g. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' or 'group:NIR' "
+        "(a camera group by id or by make/model), '!name' to leave one out. Empty: all images.\n"
+        "RESOLUTION: cell size in CRS units; 0 = the images' ground sample distance.\n"
+        "BLENDING: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness "
+        "and no ghosting), none (hard cut).\n"
+        "OUTPUT: Cloud-Optimized GeoTIFF with overviews, the images' bands and data type (8/16 bit kept) plus "
+        "an alpha band (default <workspace>/orthomosaic.tif).\n"
+        "PER_IMAGE_FOLDER: optional folder for one true orthophoto per image (COG).\n"
+        "SEAMLINES: optional GeoPackage of polygons naming the image each part of the mosaic comes from."
+    )
+
+    def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
+        self.addParameter(QgsProcessingParameterFile(
+            self.WORKSPACE, self.tr("Workspace folder (georeferenced, with a DSM)"),
+            behavior=QgsProcessingParameterFile.Folder))
+        self.addParameter(QgsProcessingParameterRasterLayer(
+            self.DSM, self.tr("DSM (default: the workspace DSM)"), optional=True))
+        self.addParameter(QgsProcessingParameterString(
+            self.IMAGES_FILTER, self.tr("Images (names, wildcards or group:<camera>; empty = all)"),
+            defaultValue="", optional=True))
+        self.addParameter(QgsProcessingParameterNumber(
+            self.RESOLUTION, self.tr("Resolution in CRS units (0 = ground sample distance)"),
+            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
+        self.addParameter(QgsProcessingParameterEnum(
+            self.BLENDING, self.tr("Blending across seamlines"), options=list(self.BLENDINGS), defaultValue=0))
+        interp = QgsProcessingParameterEnum(
+            self.INTERPOLATION, self.tr("Resampling of the images"), options=list(self.INTERPOLATIONS), defaultValue=0)
+        workers = QgsProcessingParameterNumber(
+            self.WORKERS, self.tr("Parallel tile workers (0 = one per core)"),
+            type=QgsProcessingParameterNumber.Integer, defaultValue=1, minValue=0)
+        for p in (interp, workers):
+            p.setFlags(p.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
+            self.addParameter(p)
+        self.addParameter(QgsProcessingParameterRasterDestination(
+            self.OUTPUT, self.tr("Orthomosaic (default: <workspace>/orthomosaic.tif)"), optional=True,
+            createByDefault=False))
+        self.addParameter(QgsProcessingParameterFolderDestination(
+            self.PER_IMAGE_FOLDER, self.tr("Folder for per-image true orthophotos"), optional=True,
+            createByDefault=False))
+        self.addParameter(QgsProcessingParameterVectorDestination(
+            self.SEAMLINES, self.tr("Seamlines (which image, GeoPackage)"), optional=True, createByDefault=False))
+        self.addOutput(QgsProcessingOutputFolder(self.OUT_WORKSPACE, self.tr("Workspace")))
+        self.addOutput(QgsProcessingOutputNumber(self.VALID_FRACTION, self.tr("Share of mosaic cells with data")))
+        self.addOutput(QgsProcessingOutputNumber(self.RESOLUTION_USED, self.tr("Resolution used")))
+        self.addOutput(QgsProcessingOutputNumber(self.IMAGES_USED, self.tr("Images in the mosaic")))
+
+    def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
+        from ..core import ortho
+
+        workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
+        dsm_layer = self.parameterAsRasterLayer(parameters, self.DSM, context)
+        dsm_path = dsm_layer.source() if dsm_layer is not None else None
+        output = self.parameterAsOutputLayer(parameters, self.OUTPUT, context) or None
+        per_image = None
+        if parameters.get(self.PER_IMAGE_FOLDER):
+            per_image = self.parameterAsFileOutput(parameters, self.PER_IMAGE_FOLDER, context) or None
+        seamlines = self.parameterAsOutputLayer(parameters, self.SEAMLINES, context) or None
+        if seamlines and not seamlines.lower().endswith(".gpkg"):
+            raise QgsProcessingException(self.tr("SEAMLINES must be a GeoPackage (.gpkg) file, got {}").format(
+                seamlines))
+        options = ortho.OrthoOptions(
+            interpolation=self.INTERPOLATIONS[self.parameterAsEnum(parameters, self.INTERPOLATION, context)],
+            workers=self.parameterAsInt(parameters, self.WORKERS, context))
+        result = self.run_core(
+            ortho.build_orthophoto_workspace, workspace, dsm_path=dsm_path,
+            images_filter=self.parameterAsString(parameters, self.IMAGES_FILTER, context).strip() or None,
+            resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context),
+            blending=self.BLENDINGS[self.parameterAsEnum(parameters, self.BLENDING, context)],
+            output=output, per_image_folder=per_image, seamlines=seamlines, options=options,
+            progress=FeedbackProgress(feedback))
+        for w in result.warnings:
+            feedback.pushWarning(w)
+        for line in result.log_lines:
+            feedback.pushInfo(line)
+        return {self.OUT_WORKSPACE: result.workspace, self.OUTPUT: result.orthomosaic,
+                self.PER_IMAGE_FOLDER: result.per_image_folder, self.SEAMLINES: result.seamlines,
+                self.VALID_FRACTION: result.valid_fraction, self.RESOLUTION_USED: result.resolution,
+                self.IMAGES_USED: len(result.images)}

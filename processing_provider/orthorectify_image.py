@@ -1,0 +1,151 @@
+"""Orthorectify image: thin adapter over core.ortho.orthorectify_image."""
+from qgis.core import (
+    QgsProcessing,
+    QgsProcessingException,
+    QgsProcessingOutputNumber,
+    QgsProcessingParameterCrs,
+    QgsProcessingParameterEnum,
+    QgsProcessingParameterFeatureSource,
+    QgsProcessingParameterFile,
+    QgsProcessingParameterNumber,
+    QgsProcessingParameterRasterDestination,
+    QgsProcessingParameterRasterLayer,
+    QgsProcessingParameterVectorDestination,
+)
+
+from .base import AlgorithmBase, FeedbackProgress
+
+
+class OrthorectifyImageAlgorithm(AlgorithmBase):
+    NAME = "orthorectifyimage"
+    DISPLAY = "Orthorectify image"
+    IMAGE = "IMAGE"
+    DSM = "DSM"
+    GCPS = "GCPS"
+    GCP_LAYER = "GCP_LAYER"
+    ORIENTATION = "ORIENTATION"
+    FOCAL_MM = "FOCAL_MM"
+    SENSOR_WIDTH_MM = "SENSOR_WIDTH_MM"
+    MODE = "MODE"
+    RESOLUTION = "RESOLUTION"
+    CRS = "CRS"
+    OUTPUT = "OUTPUT"
+    RESIDUALS = "RESIDUALS"
+    RMSE_PX = "RMSE_PX"
+    PLANAR_OFFSET_P95 = "PLANAR_OFFSET_P95"
+    MODES = ("ortho", "planar")
+    MODE_LABELS = ("True orthophoto on the DSM", "Planar rectification (projective, flat ground)")
+    HELP = (
+        "Orthorectifies one photograph — also one that is not part of any block, such as a single oblique or an "
+        "old print — on an existing DSM, for example an airborne laser scanning (ALS) DSM in any CRS (it is "
+        "reprojected on the fly).\n\n"
+        "The camera's position and attitude come from ground control points observed in the photo (space "
+        "resection: at least 4 points; one wrong point among 5 or more is found and left out; with 6 or more the "
+        "focal length and the radial distortion k1 are estimated too where the points determine them), or from a "
+        "known orientation.\n\n"
+        "IMAGE: the photo. DSM: height raster (needed for a true orthophoto).\n"
+        "GCPS: an OpenDroneMap gcp_list.txt or CSV points file with observations in this image; or GCP_LAYER: a "
+        "point layer with one feature per observation and fields name, image, px, py (optional z, role; pixel "
+        "origin at the upper-left corner, y down).\n"
+        "ORIENTATION: instead of GCPs, a file with x y z omega phi kappa (degrees, photogrammetric convention; "
+        "a header row as Pix4D writes it, or JSON), optionally focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 "
+        "and a CRS line.\n"
+        "FOCAL_MM and SENSOR_WIDTH_MM: interior orientation (the sensor's long side); default the EXIF focal "
+        "length.\n"
+        "MODE: a true orthophoto on the DSM, or a planar (projective) rectification through the GCPs for "
+        "comparison on flat ground; with a DSM the log and PLANAR_OFFSET_P95 say how far the planar result is "
+        "off because of relief.\n"
+        "RESIDUALS: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane)."
+    )
+
+    def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
+        self.addParameter(QgsProcessingParameterFile(
+            self.IMAGE, self.tr("Image"), fileFilter="Images (*.jpg *.jpeg *.tif *.tiff *.png);;All files (*)"))
+        self.addParameter(QgsProcessingParameterRasterLayer(self.DSM, self.tr("DSM"), optional=True))
+        self.addParameter(QgsProcessingParameterFile(
+            self.GCPS, self.tr("Ground control file (gcp_list.txt or CSV)"), optional=True,
+            fileFilter="GCP files (*.txt *.csv);;All files (*)"))
+        self.addParameter(QgsProcessingParameterFeatureSource(
+            self.GCP_LAYER, self.tr("Ground control point layer (one feature per observation)"),
+            [QgsProcessing.TypeVectorPoint], optional=True))
+        self.addParameter(QgsProcessingParameterFile(
+            self.ORIENTATION, self.tr("Known orientation (x y z omega phi kappa)"), optional=True,
+            fileFilter="Orientation (*.txt *.csv *.json);;All files (*)"))
+        self.addParameter(QgsProcessingParameterNumber(
+            self.FOCAL_MM, self.tr("Focal length in mm (0 = from EXIF)"), type=QgsProcessingParameterNumber.Double,
+            defaultValue=0.0, minValue=0.0, optional=True))
+        self.addParameter(QgsProcessingParameterNumber(
+            self.SENSOR_WIDTH_MM, self.tr("Sensor width (long side) in mm"), type=QgsProcessingParameterNumber.Double,
+            defaultValue=0.0, minValue=0.0, optional=True))
+        self.addParameter(QgsProcessingParameterEnum(
+            self.MODE, self.tr("Mode"), options=list(self.MODE_LABELS), defaultValue=0))
+        self.addParameter(QgsProcessingParameterNumber(
+            self.RESOLUTION, self.tr("Resolution in CRS units (0 = ground sample distance)"),
+            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
+        self.addParameter(QgsProcessingParameterCrs(
+            self.CRS, self.tr("Output CRS (default: the GCPs' or orientation's CRS)"), optional=True))
+        self.addParameter(QgsProcessingParameterRasterDestination(self.OUTPUT, self.tr("Orthophoto")))
+        self.addParameter(QgsProcessingParameterVectorDestination(
+            self.RESIDUALS, self.tr("GCP residuals"), optional=True, createByDefault=False))
+        self.addOutput(QgsProcessingOutputNumber(self.RMSE_PX, self.tr("GCP residual RMSE (pixels)")))
+        self.addOutput(QgsProcessingOutputNumber(self.PLANAR_OFFSET_P95, self.tr(
+            "Planar rectification: 95th percentile of its offset from the true position (CRS units)")))
+
+    def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
+        from ..core import gcp as gcpmod
+        from ..core import ortho
+
+        image = self.parameterAsFile(parameters, self.IMAGE, context)
+        dsm_layer = self.parameterAsRasterLayer(parameters, self.DSM, context)
+        dsm_path = dsm_layer.source() if dsm_layer is not None else None
+        gcps = self.parameterAsFile(parameters, self.GCPS, context) or None
+        source = self.parameterAsSource(parameters, self.GCP_LAYER, context)
+        if source is not None:
+            gcps = self._gcps_from_layer(source, gcpmod)
+        orientation = self.parameterAsFile(parameters, self.ORIENTATION, context) or None
+        if gcps is None and orientation is None:
+            raise QgsProcessingException(self.tr(
+                "Give ground control points observed in the image (GCPS or GCP_LAYER) or its orientation "
+                "(ORIENTATION)"))
+        crs = self.parameterAsCrs(parameters, self.CRS, context)
+        crs_text = (crs.authid() or crs.toWkt()) if crs.isValid() else None
+        residuals = self.parameterAsOutputLayer(parameters, self.RESIDUALS, context) or None
+        if residuals and not residuals.lower().endswith(".gpkg"):
+            raise QgsProcessingException(self.tr("RESIDUALS must be a GeoPackage (.gpkg) file, got {}").format(
+                residuals))
+        result = self.run_core(
+            ortho.orthorectify_image, image, self.parameterAsOutputLayer(parameters, self.OUTPUT, context),
+            dsm_path=dsm_path, gcps=gcps, orientation=orientation,
+            focal_mm=self.parameterAsDouble(parameters, self.FOCAL_MM, context) or None,
+            sensor_width_mm=self.parameterAsDouble(parameters, self.SENSOR_WIDTH_MM, context) or None,
+            mode=self.MODES[self.parameterAsEnum(parameters, self.MODE, context)], crs=crs_text,
+            resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context), residuals_path=residuals,
+            progress=FeedbackProgress(feedback))
+        for w in result.warnings:
+            feedback.pushWarning(w)
+        for line in result.log_lines:
+            feedback.pushInfo(line)
+        for r in result.residuals:
+            feedback.pushInfo(self.tr("{} ({}): {:.2f} px").format(r["name"], r["role"], r["res_px"]))
+        return {self.OUTPUT: result.output, self.RESIDUALS: result.residuals_path, self.RMSE_PX: result.rmse_px,
+                self.PLANAR_OFFSET_P95: (result.planar_error or {}).get("p95_m")}
+
+    def _gcps_from_layer(self, source, gcpmod):
+        fields = [f.name().lower() for f in source.fields()]
+        for need in ("name", "image", "px", "py"):
+            if need not in fields:
+                raise QgsProcessingException(self.tr(
+                    "GCP layer {} lacks the field '{}' (needs name, image, px, py)").format(source.sourceName(), need))
+        rows = []
+        for feat in source.getFeatures():
+            attrs = {k.lower(): feat[k] for k in source.fields().names()}
+            pt = feat.geometry().constGet()
+            z = attrs.get("z")
+            if z in (None, "") and pt is not None and pt.is3D():
+                z = pt.z()
+            rows.append(dict(attrs, x=pt.x(), y=pt.y(), z=z or 0.0))
+        crs = source.sourceCrs().authid() or source.sourceCrs().toWkt()
+        try:
+            return gcpmod.gcps_from_rows(rows, crs, source_name=source.sourceName())
+        except gcpmod.GCPError as e:
+            raise QgsProcessingException(str(e)) from e
