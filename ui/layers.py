@@ -67,6 +67,12 @@ def qgs_crs(text):
     return crs
 
 
+def has_real_crs(crs):
+    """A CRS that places data on the earth: GeoPackages written without one report "Undefined geographic
+    SRS" (GDAL's srs_id 0), which QGIS takes as valid."""
+    return crs.isValid() and not crs.description().lower().startswith("undefined")
+
+
 def crs_text(crs):
     """The string core.gcp stores for a QGIS CRS: the authority id where there is one, else WKT."""
     if not crs.isValid():
@@ -103,8 +109,22 @@ def _elevation_ramp():
     return QgsGradientColorRamp(QColor("#2b83ba"), QColor("#d7191c"))
 
 
+def _smooth_resampling(layer):
+    """Bilinear resampling in the provider, before the renderer: no stair steps in a hillshade or a colour
+    ramp when zoomed in beyond the DSM's cells."""
+    try:
+        from qgis.core import QgsRasterDataProvider, QgsRasterPipe
+
+        layer.setResamplingStage(QgsRasterPipe.ResamplingStage.Provider)
+        layer.dataProvider().setZoomedInResamplingMethod(QgsRasterDataProvider.ResamplingMethod.Bilinear)
+        layer.dataProvider().setZoomedOutResamplingMethod(QgsRasterDataProvider.ResamplingMethod.Bilinear)
+    except (AttributeError, ImportError):  # pragma: no cover - older QGIS
+        pass
+
+
 def style_dsm(layer):
     """Pseudocolour (Spectral, 2-98 % stretch) for a DSM layer; nodata stays transparent."""
+    _smooth_resampling(layer)
     lo, hi = _band_range(layer)
     ramp = _elevation_ramp()
     shader = QgsColorRampShader(lo, hi, ramp, QgsColorRampShader.Interpolated, QgsColorRampShader.Continuous)
@@ -122,6 +142,7 @@ def style_dsm(layer):
 
 def style_hillshade(layer):
     """Multidirectional hillshade drawn with 'multiply' over the pseudocolour DSM."""
+    _smooth_resampling(layer)
     renderer = QgsHillshadeRenderer(layer.dataProvider(), 1, 315.0, 45.0)
     renderer.setMultiDirectional(True)
     renderer.setZFactor(1.0)
@@ -343,7 +364,7 @@ def load_cameras(path, project=None, group=None, name=None, workspace=None):
     georeferenced workspace, the image footprints on the mean ground height."""
     project = project or QgsProject.instance()
     layer = QgsVectorLayer(path, name or QCoreApplication.translate("ResultLayers", "Cameras"), "ogr")
-    if not layer.isValid() or not layer.crs().isValid():
+    if not layer.isValid() or not has_real_crs(layer.crs()):
         return []
     remove_loaded(project, path, (CAMERAS,))
     out = []
@@ -545,4 +566,5 @@ def _has_crs(path):
     ds = ogr.Open(path.split("|")[0])
     if ds is None or ds.GetLayerCount() == 0:
         return False
-    return ds.GetLayer(0).GetSpatialRef() is not None
+    srs = ds.GetLayer(0).GetSpatialRef()
+    return srs is not None and not (srs.GetName() or "").lower().startswith("undefined")

@@ -1,0 +1,210 @@
+"""Results as styled layers: the Processing post-processing hook (toolbox runs load outputs styled), the
+style functions (DSM pseudocolour + hillshade, orthomosaic, cameras + footprints, residual vectors), and
+nothing of it under qgis_process."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from tests.conftest import PLUGINS
+from tests.test_ui_dock import SCREENSHOTS, make_workspace, quick_photos
+
+pytestmark = pytest.mark.usefixtures("qgis_processing")
+
+
+@pytest.fixture(scope="module")
+def plugin(qgis_iface, qgis_processing):
+    import archaeoortho
+
+    p = archaeoortho.classFactory(qgis_iface)
+    p.initProcessing()
+    p.initGui()
+    yield p
+    p.unload()
+
+
+@pytest.fixture(scope="module")
+def block():
+    from tests import synthetic as syn
+
+    return syn.vertical_block(seed=1)
+
+
+@pytest.fixture(scope="module")
+def photos(block, tmp_path_factory):
+    return quick_photos(block, str(tmp_path_factory.mktemp("layers") / "photos"))
+
+
+@pytest.fixture
+def aligned(block, photos, tmp_path):
+    from archaeoortho.core.gcp import write_odm_gcp_list
+
+    root = tmp_path
+    ws = make_workspace(str(root), block, photos)
+    gcp_file = str(root / "gcp_list.txt")
+    write_odm_gcp_list(block.gcp_set(block.spread_control(5), noise_px=0.4), gcp_file)
+    return ws, gcp_file
+
+
+def _raster(path, bands, nodata=None, alpha=False):
+    from osgeo import gdal, osr
+
+    n = 64
+    ds = gdal.GetDriverByName("GTiff").Create(path, n, n, bands, gdal.GDT_Float32 if bands == 1 else gdal.GDT_Byte)
+    ds.SetGeoTransform((500000.0, 0.5, 0, 4600000.0, 0, -0.5))
+    srs = osr.SpatialReference()
+    srs.ImportFromEPSG(32633)
+    ds.SetProjection(srs.ExportToWkt())
+    yy, xx = np.mgrid[0:n, 0:n]
+    for b in range(1, bands + 1):
+        if bands == 1:
+            data = 150 + 5 * np.sin(xx / 9.0) * np.cos(yy / 7.0)
+            data[:4, :4] = -9999
+        else:
+            data = (40 * b + 2 * xx) % 255
+            if alpha and b == bands:
+                data = np.where(xx < 8, 0, 255)
+        ds.GetRasterBand(b).WriteArray(data)
+        if nodata is not None:
+            ds.GetRasterBand(b).SetNoDataValue(nodata)
+    if alpha:
+        ds.GetRasterBand(bands).SetColorInterpretation(gdal.GCI_AlphaBand)
+    ds = None
+    return path
+
+
+def test_georeference_from_the_toolbox_loads_styled_layers(plugin, aligned, qgis_new_project):
+    """processing.runAndLoadResults runs the same loading as the toolbox dialog: residuals and cameras come
+    in styled, with the camera footprints."""
+    from processing import runAndLoadResults
+    from qgis.core import QgsCategorizedSymbolRenderer, QgsProject
+
+    ws, gcp_file = aligned
+    res = runAndLoadResults("archaeoortho:georeference", {"WORKSPACE": ws, "GCPS": gcp_file})
+    assert res and os.path.isfile(res["RESIDUALS"])
+    layers = {lyr.customProperty("archaeoortho/kind"): lyr for lyr in QgsProject.instance().mapLayers().values()}
+    assert {"residuals", "cameras", "footprints"} <= set(layers)
+    residuals = layers["residuals"]
+    assert isinstance(residuals.renderer(), QgsCategorizedSymbolRenderer)
+    assert residuals.renderer().classAttribute() == "status"
+    assert residuals.labelsEnabled()
+    assert float(residuals.customProperty("archaeoortho/exaggeration")) >= 1.0
+    assert "x" in residuals.name()
+    cams = layers["cameras"]
+    assert cams.labelsEnabled() and cams.labeling().settings().fieldName == '"image"'
+    assert layers["footprints"].featureCount() == cams.featureCount()
+    _render(QgsProject.instance(), [residuals, cams, layers["footprints"]], "toolbox-georeference-layers.png")
+
+
+def test_hook_registers_only_our_outputs(plugin, aligned):
+    from qgis.core import QgsApplication, QgsProcessingContext, QgsProcessingFeedback, QgsProject
+
+    ws, _ = aligned
+    alg = QgsApplication.processingRegistry().algorithmById("archaeoortho:georeference")
+    ctx = QgsProcessingContext()
+    ctx.setProject(QgsProject.instance())
+    n = alg.register_styled_outputs({"WORKSPACE": ws, "CAMERAS": os.path.join(ws, "cameras.gpkg"),
+                                     "GCP_RMSE_XY": 0.1}, ctx, QgsProcessingFeedback())
+    # the aligned workspace's cameras have no CRS (model frame): not loaded onto a map
+    assert n == 0 and not ctx.layersToLoadOnCompletion()
+    ctx.setProject(None)
+    assert alg.register_styled_outputs({"CAMERAS": os.path.join(ws, "cameras.gpkg")}, ctx) == 0
+
+
+def test_dsm_pseudocolour_and_hillshade(tmp_path, qgis_new_project):
+    from qgis.core import QgsProject
+
+    from archaeoortho.ui import layers
+
+    path = _raster(str(tmp_path / "dsm.tif"), 1, nodata=-9999)
+    loaded = layers.load_dsm(path, QgsProject.instance(), "DSM group")
+    assert [lyr.renderer().type() for lyr in loaded] == ["singlebandpseudocolor", "hillshade"]
+    lo, hi = loaded[0].renderer().classificationMin(), loaded[0].renderer().classificationMax()
+    assert 144 < lo < hi < 156  # stretched on the data, nodata left out
+    assert loaded[1].blendMode() != 0
+    # loading again replaces instead of stacking duplicates
+    loaded = layers.load_dsm(path, QgsProject.instance(), "DSM group")
+    assert len(QgsProject.instance().mapLayers()) == 2
+    assert layers.output_kind("OUTPUT_DSM", path) == layers.DSM
+    _render(QgsProject.instance(), list(reversed(loaded)), "dsm-styled.png")
+
+
+def test_orthomosaic_rgb_with_transparent_alpha_or_nodata(tmp_path, qgis_new_project):
+    from qgis.core import QgsProject
+
+    from archaeoortho.ui import layers
+
+    with_alpha = layers.load_orthomosaic(_raster(str(tmp_path / "a.tif"), 4, alpha=True), QgsProject.instance())[0]
+    assert with_alpha.renderer().type() == "multibandcolor"
+    assert with_alpha.renderer().alphaBand() == 4
+    rgb = layers.load_orthomosaic(_raster(str(tmp_path / "b.tif"), 3, nodata=0), QgsProject.instance())[0]
+    assert rgb.renderer().type() == "multibandcolor"
+    assert rgb.dataProvider().useSourceNoDataValue(1)
+    assert layers.output_kind("ORTHOMOSAIC", "x.tif") == layers.ORTHO
+    assert layers.output_kind("OUTPUT_POINT_CLOUD", "x.las") == layers.POINT_CLOUD
+    assert layers.output_kind("VALID_FRACTION", "") is None
+
+
+def test_nothing_styled_under_qgis_process_platform():
+    """With QGIS's platform reported as qgis_process the hook does nothing and imports no ui module."""
+    code = (
+        f"import sys; sys.path.insert(0, {PLUGINS!r});"
+        "from qgis.core import QgsApplication; app = QgsApplication([], False); app.initQgis();"
+        "QgsApplication.platform = staticmethod(lambda: 'qgis_process');"
+        "import archaeoortho.processing_provider.georeference as g;"
+        "from qgis.core import QgsProcessingContext, QgsProject;"
+        "ctx = QgsProcessingContext(); ctx.setProject(QgsProject.instance());"
+        "n = g.GeoreferenceAlgorithm().register_styled_outputs({'RESIDUALS': sys.executable}, ctx);"
+        "bad = [m for m in sys.modules if m.startswith('archaeoortho.ui')];"
+        "print(n, bad); import os; os._exit(1 if (n or bad) else 0)"
+    )
+    env = dict(os.environ, QT_QPA_PLATFORM="offscreen")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, env=env)
+    assert out.returncode == 0, out.stdout + out.stderr
+
+
+@pytest.mark.slow
+def test_qgis_process_runs_headless_with_the_dock_code_present(aligned, tmp_path):
+    """qgis_process (no iface, platform qgis_process) runs Georeference; the hook stays out of the way."""
+    import json
+
+    from tests.test_qgis_plugin import _qgis_process, _qgis_process_env
+
+    exe, env = _qgis_process(), _qgis_process_env()
+    if not os.path.islink(os.path.join(PLUGINS, "archaeoortho")):
+        pytest.skip("plugin link missing: run 'make setup'")
+    ws, gcp_file = aligned
+    out = subprocess.run([exe, "--json", "run", "archaeoortho:georeference", "--", f"WORKSPACE={ws}",
+                          f"GCPS={gcp_file}"], env=env, capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-3000:]
+    result = json.loads(out.stdout)["results"]
+    assert result["CHECK_RMSE_XY"] < 0.2
+    assert "Outputs not styled" not in out.stdout + out.stderr
+
+
+def _render(project, layer_list, name):
+    """Render layers to build/screenshots/ui/<name> (to look at) and check something was drawn."""
+    from qgis.core import QgsMapRendererSequentialJob, QgsMapSettings, QgsRectangle
+    from qgis.PyQt.QtCore import QSize
+    from qgis.PyQt.QtGui import QColor
+
+    settings = QgsMapSettings()
+    settings.setLayers(layer_list)
+    ext = QgsRectangle(layer_list[0].extent())
+    for lyr in layer_list[1:]:
+        ext.combineExtentWith(lyr.extent())
+    ext.scale(1.15)
+    settings.setExtent(ext)
+    settings.setDestinationCrs(layer_list[0].crs())
+    settings.setOutputSize(QSize(900, 700))
+    settings.setBackgroundColor(QColor("white"))
+    job = QgsMapRendererSequentialJob(settings)
+    job.start()
+    job.waitForFinished()
+    image = job.renderedImage()
+    os.makedirs(SCREENSHOTS, exist_ok=True)
+    image.save(os.path.join(SCREENSHOTS, name))
+    colours = {image.pixel(x, y) for x in range(0, 900, 7) for y in range(0, 700, 7)}
+    assert len(colours) > 5
