@@ -2,11 +2,91 @@
 <!DOCTYPE TS>
 <TS version="2.1">
 <context>
+    <name>AccuracyReportAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="71"/>
+        <source>Workspace folder</source>
+        <translation>Arbeitsbereich-Ordner</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="73"/>
+        <source>Compute the bundle adjustment covariance (uncertainty section and layers)</source>
+        <translation>Kovarianz der Bündelblockausgleichung berechnen (Abschnitt und Layer zur Unsicherheit)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="76"/>
+        <source>Report (default: &lt;workspace&gt;/report.html)</source>
+        <translation>Bericht (Vorgabe: &lt;workspace&gt;/report.html)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="79"/>
+        <source>Workspace</source>
+        <translation>Arbeitsbereich</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="80"/>
+        <source>Camera precision (GeoPackage)</source>
+        <translation>Genauigkeit der Kameras (GeoPackage)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="81"/>
+        <source>Tie point precision (GeoPackage)</source>
+        <translation>Genauigkeit der Verknüpfungspunkte (GeoPackage)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="82"/>
+        <source>Sections skipped</source>
+        <translation>Ausgelassene Abschnitte</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="99"/>
+        <source>section {} skipped: {}</source>
+        <translation>Abschnitt {} ausgelassen: {}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="101"/>
+        <source>report written: {} ({} s)</source>
+        <translation>Bericht geschrieben: {} ({} s)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Accuracy report</source>
+        <translation>Genauigkeitsbericht</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Writes one self-contained HTML report of a workspace (plots embedded, readable offline) and returns its key figures.
+
+Summary: images given / aligned / not aligned and why, image screening, cameras with their calibrated parameters and standard deviations, GSD, area, CRS, processing times and parameters. Orientation quality: reprojection errors, tie-point track lengths, image connectivity, camera positions with residuals. Georeferencing: control and check points with dX dY dZ and image residuals, residual vectors, RMSE per set, NSSDA (FGDC-STD-007.3-1998) accuracy statements at 95 % confidence, ASPRS 2014 and 2023 accuracy classes, camera-position residuals, outliers. Uncertainty: standard deviations of cameras and tie points from the bundle adjustment covariance. Products: DSM and orthomosaic previews, resolution, valid fraction. Sections whose stage has not run are skipped with a note.
+
+WORKSPACE: a workspace folder (at least aligned).
+UNCERTAINTY: compute the covariance (seconds for hundreds of images) and write &lt;workspace&gt;/uncertainty/cameras.gpkg and points.gpkg.
+OUTPUT_HTML: the report file (default: &lt;workspace&gt;/report.html). It is written under a temporary name and renamed when complete.</source>
+        <translation>Schreibt einen eigenständigen HTML-Bericht über einen Arbeitsbereich (Diagramme eingebettet, offline lesbar) und gibt seine Kennzahlen zurück.
+
+Übersicht: gegebene / orientierte / nicht orientierte Bilder und warum, Bildprüfung, Kameras mit ihren kalibrierten Parametern und Standardabweichungen, GSD, Fläche, KBS, Rechenzeiten und Parameter. Orientierungsqualität: Rückprojektionsfehler, Längen der Verknüpfungspunkt-Spuren, Bildverbindungen, Kamerapositionen mit Residuen. Georeferenzierung: Pass- und Kontrollpunkte mit dX dY dZ und Bildresiduen, Residuenvektoren, RMSE je Gruppe, Genauigkeitsangaben nach NSSDA (FGDC-STD-007.3-1998) mit 95 % Konfidenz, ASPRS-Genauigkeitsklassen 2014 und 2023, Residuen der Kamerapositionen, Ausreißer. Unsicherheit: Standardabweichungen der Kameras und Verknüpfungspunkte aus der Kovarianz der Bündelblockausgleichung. Produkte: Vorschauen von DOM und Orthomosaik, Auflösung, Anteil gültiger Zellen. Abschnitte, deren Schritt nicht gelaufen ist, werden mit einem Hinweis ausgelassen.
+
+WORKSPACE: ein Arbeitsbereich-Ordner (mindestens orientiert).
+UNCERTAINTY: die Kovarianz berechnen (Sekunden für Hunderte von Bildern) und &lt;workspace&gt;/uncertainty/cameras.gpkg und points.gpkg schreiben.
+OUTPUT_HTML: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird unter einem vorläufigen Namen geschrieben und erst umbenannt, wenn sie vollständig ist.</translation>
+    </message>
+</context>
+<context>
     <name>AlgorithmBase</name>
     <message>
-        <location filename="../processing_provider/base.py" line="78"/>
+        <location filename="../processing_provider/base.py" line="130"/>
         <source>Cancelled: {}</source>
-        <translation type="unfinished"></translation>
+        <translation>Abgebrochen: {}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/base.py" line="98"/>
+        <source>Outputs not styled: {}</source>
+        <translation>Ausgaben nicht gestaltet: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Photogrammetry</source>
+        <translation>Photogrammetrie</translation>
     </message>
 </context>
 <context>
@@ -14,82 +94,118 @@
     <message>
         <location filename="../processing_provider/align_images.py" line="48"/>
         <source>Folder of images</source>
-        <translation type="unfinished"></translation>
+        <translation>Bilderordner</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Workspace folder</source>
-        <translation type="unfinished"></translation>
+        <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="51"/>
         <source>Pair selection</source>
-        <translation type="unfinished"></translation>
+        <translation>Paarauswahl</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="53"/>
         <source>Camera model</source>
-        <translation type="unfinished"></translation>
+        <translation>Kameramodell</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="55"/>
         <source>Largest image side for matching (0 = full size)</source>
-        <translation type="unfinished"></translation>
+        <translation>Größte Bildseite für die Zuordnung (0 = volle Größe)</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="58"/>
         <source>Largest number of features per image (0 = auto, ~4000 per megapixel)</source>
-        <translation type="unfinished"></translation>
+        <translation>Höchstzahl der Merkmale je Bild (0 = automatisch, ~4000 je Megapixel)</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="61"/>
         <source>Affine-invariant features (oblique views; slower)</source>
-        <translation type="unfinished"></translation>
+        <translation>Affin-invariante Merkmale (Schrägaufnahmen; langsamer)</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="63"/>
         <source>Focal length in mm when EXIF is missing (0 = from EXIF)</source>
-        <translation type="unfinished"></translation>
+        <translation>Brennweite in mm, wenn EXIF fehlt (0 = aus EXIF)</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Sensor (frame) width in mm, long side (0 = unknown)</source>
-        <translation type="unfinished"></translation>
+        <translation>Breite des Sensors (Bildformats) in mm, lange Seite (0 = unbekannt)</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="69"/>
         <source>One camera for all images</source>
-        <translation type="unfinished"></translation>
+        <translation>Eine Kamera für alle Bilder</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="71"/>
         <source>Camera centres</source>
-        <translation type="unfinished"></translation>
+        <translation>Projektionszentren</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="72"/>
         <source>Registered images</source>
-        <translation type="unfinished"></translation>
+        <translation>Orientierte Bilder</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="73"/>
         <source>Mean reprojection error (px)</source>
-        <translation type="unfinished"></translation>
+        <translation>Mittlerer Rückprojektionsfehler (px)</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="95"/>
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
-        <translation type="unfinished"></translation>
+        <translation>{} von {} Bildern orientiert, mittlerer Rückprojektionsfehler {:.3f} px, {} Punkte</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="98"/>
         <source>Images not registered:</source>
-        <translation type="unfinished"></translation>
+        <translation>Nicht orientierte Bilder:</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="101"/>
         <source>Seconds per step: {}</source>
-        <translation type="unfinished"></translation>
+        <translation>Sekunden je Schritt: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Align images</source>
+        <translation>Bilder ausrichten</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Structure from motion: SIFT features, pair selection, robust matching (RANSAC), incremental mapping with self-calibration (focal length, principal point, lens distortion) and a final bundle adjustment. The result is stored in the WORKSPACE folder, which the following stages (Georeference, Build DSM, Build orthophoto) take as input. A re-run resumes: features and matches already computed are reused.
+
+PAIRING: &apos;auto&apos; uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
+CAMERA_MODEL: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
+FOCAL_MM and SENSOR_WIDTH_MM: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres.</source>
+        <translation>Structure from Motion: SIFT-Merkmale, Paarauswahl, robuste Zuordnung (RANSAC), inkrementelle Rekonstruktion mit Selbstkalibrierung (Brennweite, Bildhauptpunkt, Objektivverzeichnung) und eine abschließende Bündelblockausgleichung. Das Ergebnis wird im Ordner WORKSPACE gespeichert, den die folgenden Schritte (Georeferenzieren, DOM erzeugen, Orthophoto erzeugen) als Eingabe nehmen. Ein erneuter Lauf setzt fort: bereits berechnete Merkmale und Zuordnungen werden wiederverwendet.
+
+PAIRING: &apos;auto&apos; nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
+CAMERA_MODEL: &apos;AUTO&apos; schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
+FOCAL_MM und SENSOR_WIDTH_MM: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern.</translation>
+    </message>
+</context>
+<context>
+    <name>ArchaeoOrthoPlugin</name>
+    <message>
+        <location filename="../plugin.py" line="60"/>
+        <source>Ground control (GCP dock)</source>
+        <translation>Passpunkte (GCP-Fenster)</translation>
+    </message>
+    <message>
+        <location filename="../plugin.py" line="64"/>
+        <source>ArchaeoOrtho: pick ground control points on the map and in the photos</source>
+        <translation>ArchaeoOrtho: Passpunkte auf der Karte und in den Fotos messen</translation>
+    </message>
+    <message>
+        <location filename="../plugin.py" line="106"/>
+        <source>&amp;ArchaeoOrtho</source>
+        <translation>&amp;ArchaeoOrtho</translation>
     </message>
 </context>
 <context>
@@ -97,7 +213,1353 @@
     <message>
         <location filename="../processing_provider/provider.py" line="17"/>
         <source>ArchaeoOrtho photogrammetry</source>
-        <translation type="unfinished"></translation>
+        <translation>ArchaeoOrtho Photogrammetrie</translation>
+    </message>
+</context>
+<context>
+    <name>BuildDsmAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="52"/>
+        <source>Workspace folder (georeferenced)</source>
+        <translation>Arbeitsbereich-Ordner (georeferenziert)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="54"/>
+        <source>DSM resolution in metres (0 = automatic)</source>
+        <translation>DOM-Auflösung in Metern (0 = automatisch)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="57"/>
+        <source>Matching quality (image scale)</source>
+        <translation>Zuordnungsqualität (Bildmaßstab)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="59"/>
+        <source>Engine</source>
+        <translation>Rechenwerk</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="61"/>
+        <source>Parallel workers (0 = one per core)</source>
+        <translation>Parallele Prozesse (0 = einer je Kern)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="64"/>
+        <source>Dask scheduler address (empty = this computer)</source>
+        <translation>Adresse des Dask-Schedulers (leer = dieser Rechner)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="69"/>
+        <source>DSM (default: &lt;workspace&gt;/dsm.tif)</source>
+        <translation>DOM (Vorgabe: &lt;workspace&gt;/dsm.tif)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="71"/>
+        <source>Point cloud (LAS)</source>
+        <translation>Punktwolke (LAS)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="74"/>
+        <source>Workspace</source>
+        <translation>Arbeitsbereich</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="75"/>
+        <source>Share of DSM cells with data inside the camera centres&apos; convex hull</source>
+        <translation>Anteil der DOM-Zellen mit Daten innerhalb der konvexen Hülle der Projektionszentren</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="77"/>
+        <source>Stereo pairs matched</source>
+        <translation>Zugeordnete Stereopaare</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="78"/>
+        <source>Fused points</source>
+        <translation>Verschmolzene Punkte</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="96"/>
+        <source>DSM {} ({} m cells), valid fraction {}</source>
+        <translation>DOM {} ({} m Zellen), Anteil gültiger Zellen {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Build DSM</source>
+        <translation>DOM erzeugen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Dense matching of the georeferenced block and a digital surface model (DSM).
+
+Stereo pairs are chosen from the sparse model (shared tie points, baseline-to-depth ratio, viewing angle); each pair is undistorted and rectified from the known poses and matched with semi-global matching (OpenCV SGBM) with a left-right check; a pixel is kept where at least two independent pairs agree. The fused points are rasterised (median of the highest height cluster per cell), small holes are filled and large ones left nodata.
+
+WORKSPACE: a georeferenced workspace (run &apos;Georeference&apos; first: a DSM needs a metric scale and a vertical direction, so a workspace that is only aligned is refused).
+RESOLUTION: DSM cell size in metres; 0 = about twice the median ground sample distance.
+QUALITY: image scale for matching (full, half, quarter): half is four times faster than full.
+ENGINE: cpu (default); cuda runs COLMAP patch-match stereo where pycolmap was built with CUDA.
+OUTPUT_DSM: Cloud-Optimized GeoTIFF, float32 with nodata (default: &lt;workspace&gt;/dsm.tif).
+OUTPUT_POINT_CLOUD: optional LAS file (XYZ + RGB, workspace CRS).
+
+Re-running after a cancel resumes: pairs already matched are reused from &lt;workspace&gt;/dense/.</source>
+        <translation>Dichte Bildzuordnung des georeferenzierten Blocks und ein digitales Oberflächenmodell (DOM).
+
+Stereopaare werden aus dem dünnen Modell gewählt (gemeinsame Verknüpfungspunkte, Basis-Höhen-Verhältnis, Blickwinkel); jedes Paar wird aus den bekannten Orientierungen entzerrt und normalisiert und mit Semi-Global Matching (OpenCV SGBM) mit Links-Rechts-Prüfung zugeordnet; ein Pixel bleibt, wo mindestens zwei unabhängige Paare übereinstimmen. Die verschmolzenen Punkte werden gerastert (Median der höchsten Höhengruppe je Zelle), kleine Lücken gefüllt und große als NoData belassen.
+
+WORKSPACE: ein georeferenzierter Arbeitsbereich (zuerst &apos;Georeferenzieren&apos; ausführen: ein DOM braucht einen metrischen Maßstab und eine Lotrichtung, ein nur orientierter Arbeitsbereich wird abgelehnt).
+RESOLUTION: DOM-Zellgröße in Metern; 0 = etwa die doppelte mittlere Bodenauflösung (GSD).
+QUALITY: Bildmaßstab für die Zuordnung (voll, halb, viertel): halb ist viermal schneller als voll.
+ENGINE: cpu (Vorgabe); cuda führt COLMAPs Patch-Match-Stereo aus, wo pycolmap mit CUDA gebaut wurde.
+OUTPUT_DSM: Cloud-Optimized GeoTIFF, float32 mit NoData (Vorgabe: &lt;workspace&gt;/dsm.tif).
+OUTPUT_POINT_CLOUD: optionale LAS-Datei (XYZ + RGB, KBS des Arbeitsbereichs).
+
+Ein erneuter Lauf nach einem Abbruch setzt fort: bereits zugeordnete Paare werden aus &lt;workspace&gt;/dense/ wiederverwendet.</translation>
+    </message>
+</context>
+<context>
+    <name>BuildOrthophotoAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="61"/>
+        <source>Workspace folder (georeferenced, with a DSM)</source>
+        <translation>Arbeitsbereich-Ordner (georeferenziert, mit DOM)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="64"/>
+        <source>DSM (default: the workspace DSM)</source>
+        <translation>DOM (Vorgabe: das DOM des Arbeitsbereichs)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <source>Images (names, wildcards or group:&lt;camera&gt;; empty = all)</source>
+        <translation>Bilder (Namen, Platzhalter oder group:&lt;Kamera&gt;; leer = alle)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="69"/>
+        <source>Resolution in CRS units (0 = ground sample distance)</source>
+        <translation>Auflösung in KBS-Einheiten (0 = Bodenauflösung)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="72"/>
+        <source>Blending across seamlines</source>
+        <translation>Überblendung an den Nahtlinien</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="74"/>
+        <source>Resampling of the images</source>
+        <translation>Resampling der Bilder</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="76"/>
+        <source>Parallel tile workers (0 = one per core)</source>
+        <translation>Parallele Kachel-Prozesse (0 = einer je Kern)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="82"/>
+        <source>Orthomosaic (default: &lt;workspace&gt;/orthomosaic.tif)</source>
+        <translation>Orthomosaik (Vorgabe: &lt;workspace&gt;/orthomosaic.tif)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="85"/>
+        <source>Folder for per-image true orthophotos</source>
+        <translation>Ordner für wahre Orthophotos je Bild</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="88"/>
+        <source>Seamlines (which image, GeoPackage)</source>
+        <translation>Nahtlinien (welches Bild, GeoPackage)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="90"/>
+        <source>Workspace</source>
+        <translation>Arbeitsbereich</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="91"/>
+        <source>Share of mosaic cells with data</source>
+        <translation>Anteil der Mosaikzellen mit Daten</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="92"/>
+        <source>Resolution used</source>
+        <translation>Verwendete Auflösung</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="93"/>
+        <source>Images in the mosaic</source>
+        <translation>Bilder im Mosaik</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="107"/>
+        <source>SEAMLINES must be a GeoPackage (.gpkg) file, got {}</source>
+        <translation>SEAMLINES muss eine GeoPackage-Datei (.gpkg) sein, erhalten: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Build orthophoto</source>
+        <translation>Orthophoto erzeugen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>True orthophotos and the orthomosaic of a georeferenced workspace.
+
+Every cell takes its height from the DSM and is projected through the full camera model (pose, focal length, principal point, lens distortion) into the images. A cell hidden from an image by higher surface (a wall, a tree, a hill) is left out of that image, so buildings do not lean and nothing appears twice; the mosaic fills it from an image that sees it. Each part of the mosaic comes from the image that looks at it most vertically and closest to its centre; seamlines go around buildings and trees; brightness differences between images are evened out and seams blended.
+
+WORKSPACE: a georeferenced workspace with a DSM (run &apos;Build DSM&apos; first), or give DSM.
+DSM: optional raster (e.g. an ALS DSM, in any CRS: reprojected on the fly); default the workspace DSM.
+IMAGES_FILTER: a subset, e.g. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; or &apos;group:NIR&apos; (a camera group by id or by make/model), &apos;!name&apos; to leave one out. Empty: all images.
+RESOLUTION: cell size in CRS units; 0 = the images&apos; ground sample distance.
+BLENDING: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness and no ghosting), none (hard cut).
+OUTPUT: Cloud-Optimized GeoTIFF with overviews, the images&apos; bands and data type (8/16 bit kept) plus an alpha band (default &lt;workspace&gt;/orthomosaic.tif).
+PER_IMAGE_FOLDER: optional folder for one true orthophoto per image (COG).
+SEAMLINES: optional GeoPackage of polygons naming the image each part of the mosaic comes from.</source>
+        <translation>Wahre Orthophotos und das Orthomosaik eines georeferenzierten Arbeitsbereichs.
+
+Jede Zelle nimmt ihre Höhe aus dem DOM und wird über das vollständige Kameramodell (Orientierung, Brennweite, Bildhauptpunkt, Objektivverzeichnung) in die Bilder projiziert. Eine Zelle, die in einem Bild von höherer Oberfläche verdeckt ist (eine Mauer, ein Baum, ein Hügel), bleibt aus diesem Bild weg, so dass Gebäude nicht kippen und nichts doppelt erscheint; das Mosaik füllt sie aus einem Bild, das sie sieht. Jeder Teil des Mosaiks stammt aus dem Bild, das am senkrechtesten und am nächsten zu seiner Mitte darauf blickt; Nahtlinien laufen um Gebäude und Bäume; Helligkeitsunterschiede zwischen den Bildern werden ausgeglichen und Nähte überblendet.
+
+WORKSPACE: ein georeferenzierter Arbeitsbereich mit DOM (zuerst &apos;DOM erzeugen&apos; ausführen) oder DSM angeben.
+DSM: optionales Raster (z. B. ein ALS-DOM, in beliebigem KBS: wird im Lauf umprojiziert); Vorgabe ist das DOM des Arbeitsbereichs.
+IMAGES_FILTER: eine Auswahl, z. B. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; oder &apos;group:NIR&apos; (eine Kameragruppe nach Nummer oder Hersteller/Modell), &apos;!name&apos; lässt eines weg. Leer: alle Bilder.
+RESOLUTION: Zellgröße in KBS-Einheiten; 0 = die Bodenauflösung der Bilder.
+BLENDING: feather (Rampe über die Nähte), multiband (Laplace-Pyramide: keine sichtbare Naht in der Helligkeit und keine Geisterbilder), none (harter Schnitt).
+OUTPUT: Cloud-Optimized GeoTIFF mit Übersichten, den Kanälen und dem Datentyp der Bilder (8/16 Bit bleiben) und einem Alphakanal (Vorgabe &lt;workspace&gt;/orthomosaic.tif).
+PER_IMAGE_FOLDER: optionaler Ordner für ein wahres Orthophoto je Bild (COG).
+SEAMLINES: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem jeder Teil des Mosaiks stammt.</translation>
+    </message>
+</context>
+<context>
+    <name>GcpDock</name>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="241"/>
+        <source>ArchaeoOrtho ground control</source>
+        <translation>ArchaeoOrtho Passpunkte</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="254"/>
+        <source>ArchaeoOrtho photos</source>
+        <translation>ArchaeoOrtho Fotos</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="270"/>
+        <source>Workspace:</source>
+        <translation>Arbeitsbereich:</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="447"/>
+        <source>none open</source>
+        <translation>keiner geöffnet</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="275"/>
+        <source>Openu2026</source>
+        <translation>Öffnen…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="276"/>
+        <source>Open a workspace folder (made by Align images)</source>
+        <translation>Einen Arbeitsbereich-Ordner öffnen (von &apos;Bilder ausrichten&apos; angelegt)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="277"/>
+        <source>New from photosu2026</source>
+        <translation>Neu aus Fotos…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="278"/>
+        <source>Choose a folder of photos and a workspace folder, and align the photos</source>
+        <translation>Einen Fotoordner und einen Arbeitsbereich-Ordner wählen und die Fotos ausrichten</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="284"/>
+        <source>Heights (Z) from:</source>
+        <translation>Höhen (Z) aus:</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="289"/>
+        <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
+        <translation>Ein DOM- oder DGM-Rasterlayer (z. B. ein ALS-DOM): ein auf der Karte gemessener Punkt erhält seine Höhe daraus (bilinear). Leer: Z von Hand eingeben.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="829"/>
+        <source>Add</source>
+        <translation>Hinzufügen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="299"/>
+        <source>Add a ground point</source>
+        <translation>Einen Passpunkt hinzufügen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="300"/>
+        <source>Remove</source>
+        <translation>Entfernen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="301"/>
+        <source>Remove the selected ground point and its observations</source>
+        <translation>Den gewählten Passpunkt mit seinen Messungen entfernen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="302"/>
+        <source>Pick on map</source>
+        <translation>Auf der Karte messen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="304"/>
+        <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
+        <translation>In die Kartenansicht klicken, um X und Y des gewählten Punkts zu setzen (Z aus dem Höhenlayer)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="307"/>
+        <source>From file (gcp_list.txt, CSV)u2026</source>
+        <translation>Aus Datei (gcp_list.txt, CSV)…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="308"/>
+        <source>From a point layeru2026</source>
+        <translation>Aus einem Punktlayer…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="310"/>
+        <source>To file (gcp_list.txt, CSV)u2026</source>
+        <translation>In Datei (gcp_list.txt, CSV)…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="311"/>
+        <source>To a GeoPackage layeru2026</source>
+        <translation>In einen GeoPackage-Layer…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="312"/>
+        <source>Import</source>
+        <translation>Importieren</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="312"/>
+        <source>Export</source>
+        <translation>Exportieren</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="319"/>
+        <source>Undo</source>
+        <translation>Rückgängig</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="320"/>
+        <source>Redo</source>
+        <translation>Wiederholen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="327"/>
+        <source>Undo: {}</source>
+        <translation>Rückgängig: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="328"/>
+        <source>Redo: {}</source>
+        <translation>Wiederholen: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="333"/>
+        <source>Load results</source>
+        <translation>Ergebnisse laden</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="334"/>
+        <source>Add the workspace&apos;s products to the map as styled layers</source>
+        <translation>Die Produkte des Arbeitsbereichs als gestaltete Layer zur Karte hinzufügen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="351"/>
+        <source>Residual tolerance:</source>
+        <translation>Residuen-Toleranz:</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="357"/>
+        <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
+        <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="359"/>
+        <source>Refine camera calibration</source>
+        <translation>Kamerakalibrierung verfeinern</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="360"/>
+        <source>Let the adjustment refine focal length, principal point and distortion</source>
+        <translation>Die Ausgleichung Brennweite, Bildhauptpunkt und Verzeichnung verfeinern lassen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="366"/>
+        <source>Georeference</source>
+        <translation>Georeferenzieren</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="367"/>
+        <source>Run the adjustment with these points (in the background)</source>
+        <translation>Die Ausgleichung mit diesen Punkten ausführen (im Hintergrund)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="368"/>
+        <source>Cancel</source>
+        <translation>Abbrechen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="424"/>
+        <source>ArchaeoOrtho</source>
+        <translation>ArchaeoOrtho</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="431"/>
+        <source>Open an ArchaeoOrtho workspace</source>
+        <translation>Einen ArchaeoOrtho-Arbeitsbereich öffnen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="468"/>
+        <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
+        <translation>{} Fotos; der Block ist noch nicht ausgerichtet: &apos;Bilder ausrichten&apos; (oder &apos;Neu aus Fotos&apos;) ausführen, um vorhergesagte Positionen zu erhalten</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="471"/>
+        <source>{} photos, {} ground points. {}</source>
+        <translation>{} Fotos, {} Passpunkte. {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="702"/>
+        <source>no predicted positions: {}</source>
+        <translation>keine vorhergesagten Positionen: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="504"/>
+        <source>Predicted positions from the georeferenced block.</source>
+        <translation>Vorhergesagte Positionen aus dem georeferenzierten Block.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="504"/>
+        <source>Predicted positions once a point is placed in 2 photos, and for every point once 3 points are placed.</source>
+        <translation>Vorhergesagte Positionen, sobald ein Punkt in 2 Fotos gemessen ist, und für alle Punkte, sobald 3 Punkte gemessen sind.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="510"/>
+        <source>Folder of photos</source>
+        <translation>Fotoordner</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="513"/>
+        <source>Workspace folder (new or existing)</source>
+        <translation>Arbeitsbereich-Ordner (neu oder vorhanden)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="525"/>
+        <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
+        <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="529"/>
+        <source>ArchaeoOrtho: align photos</source>
+        <translation>ArchaeoOrtho: Fotos ausrichten</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="596"/>
+        <source>CRS: {}</source>
+        <translation>KBS: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="623"/>
+        <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
+        <translation>Auf der Karte an die Position des gewählten Punkts klicken (Esc beendet)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="662"/>
+        <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
+        <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (aus {})</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="665"/>
+        <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
+        <translation>{}: X {:.3f}, Y {:.3f}. Keine Höhe an dieser Stelle in {}: Z bleibt unverändert</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="668"/>
+        <source>{}: X {:.3f}, Y {:.3f}</source>
+        <translation>{}: X {:.3f}, Y {:.3f}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="725"/>
+        <source>{:.1f} px</source>
+        <translation>{:.1f} px</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="729"/>
+        <source>predicted</source>
+        <translation>vorhergesagt</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="744"/>
+        <source>Select or add a ground point in the table, then click on it in the photo.</source>
+        <translation>Einen Passpunkt in der Tabelle wählen oder hinzufügen, dann im Foto darauf klicken.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="749"/>
+        <source>from the point&apos;s other observations</source>
+        <translation>aus den übrigen Messungen des Punkts</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="750"/>
+        <source>from the georeferenced block</source>
+        <translation>aus dem georeferenzierten Block</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="751"/>
+        <source>from the points already placed (similarity fit)</source>
+        <translation>aus den bereits gemessenen Punkten (Ähnlichkeitstransformation)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="757"/>
+        <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
+        <translation>Gemessen bei x {:.2f}, y {:.2f}. Klicken zum Versetzen, ziehen oder Entf zum Entfernen.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="760"/>
+        <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
+        <translation>Vorhergesagt {}. Eingabetaste übernimmt und geht weiter (Leertaste: übernehmen), ziehen oder dorthin klicken, wo der Punkt wirklich ist.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="763"/>
+        <source>Click where {} is in this photo.</source>
+        <translation>Dorthin klicken, wo {} in diesem Foto ist.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="773"/>
+        <source>Select or add a ground point first</source>
+        <translation>Zuerst einen Passpunkt wählen oder hinzufügen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="812"/>
+        <source>{}: every photo predicted to see it has an observation</source>
+        <translation>{}: jedes Foto, das ihn voraussichtlich zeigt, hat eine Messung</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="869"/>
+        <source>Import ground control</source>
+        <translation>Passpunkte importieren</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="817"/>
+        <source>Ground control (*.txt *.csv);;All files (*)</source>
+        <translation>Passpunkte (*.txt *.csv);;Alle Dateien (*)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="825"/>
+        <source>Replace the current points, or add the imported ones to them (same names are updated)?</source>
+        <translation>Die vorhandenen Punkte ersetzen oder die importierten hinzufügen (gleichnamige werden aktualisiert)?</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="828"/>
+        <source>Replace</source>
+        <translation>Ersetzen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="851"/>
+        <source>import {}</source>
+        <translation>{} importieren</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="853"/>
+        <source>warnings</source>
+        <translation>Warnungen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="854"/>
+        <source>Imported {} points and {} observations from {}</source>
+        <translation>{} Punkte und {} Messungen aus {} importiert</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="866"/>
+        <source>No point layer in the project</source>
+        <translation>Kein Punktlayer im Projekt</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="869"/>
+        <source>Point layer (one feature per observation: name, image, px, py)</source>
+        <translation>Punktlayer (ein Objekt je Messung: name, image, px, py)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="882"/>
+        <source>Layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
+        <translation>Dem Layer {} fehlt das Feld &apos;{}&apos; (benötigt name, image, px, py)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="908"/>
+        <source>OpenDroneMap gcp_list (*.txt)</source>
+        <translation>OpenDroneMap gcp_list (*.txt)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="908"/>
+        <source>CSV points + observations (*.csv)</source>
+        <translation>CSV-Punkte + Messungen (*.csv)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="909"/>
+        <source>Export ground control</source>
+        <translation>Passpunkte exportieren</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="920"/>
+        <source>The points have no CRS yet: pick one on the map or import a file first</source>
+        <translation>Die Punkte haben noch kein KBS: zuerst einen auf der Karte messen oder eine Datei importieren</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="929"/>
+        <source>Exported {} points to {}</source>
+        <translation>{} Punkte nach {} exportiert</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="929"/>
+        <source> ({} without coordinates left out)</source>
+        <translation> ({} ohne Koordinaten ausgelassen)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="934"/>
+        <source>Export ground control as a layer</source>
+        <translation>Passpunkte als Layer exportieren</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="934"/>
+        <source>GeoPackage (*.gpkg)</source>
+        <translation>GeoPackage (*.gpkg)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="965"/>
+        <source>Cannot write {}: {}</source>
+        <translation>{} kann nicht geschrieben werden: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="968"/>
+        <source>Exported {} observations to {}</source>
+        <translation>{} Messungen nach {} exportiert</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="968"/>
+        <source> (points without observations left out: {})</source>
+        <translation> (Punkte ohne Messungen ausgelassen: {})</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="972"/>
+        <source>GCP observations</source>
+        <translation>Passpunktmessungen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="974"/>
+        <source>Cannot add {} to the project</source>
+        <translation>{} kann nicht zum Projekt hinzugefügt werden</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="980"/>
+        <source>A task of this dock is still running</source>
+        <translation>Eine Aufgabe dieses Fensters läuft noch</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1003"/>
+        <source>Cancelled</source>
+        <translation>Abgebrochen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1011"/>
+        <source>Cancellingu2026</source>
+        <translation>Wird abgebrochen…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1020"/>
+        <source>The block is not aligned yet: run Align images first</source>
+        <translation>Der Block ist noch nicht ausgerichtet: zuerst &apos;Bilder ausrichten&apos; ausführen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1025"/>
+        <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
+        <translation>Die Ausgleichung braucht mindestens 3 Passpunkte mit Koordinaten und Messungen; vorhanden sind {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1040"/>
+        <source>Outliers left out: {}</source>
+        <translation>Ausreißer ausgelassen: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1041"/>
+        <source>Georeferenced in {}.</source>
+        <translation>Georeferenziert in {}.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1044"/>
+        <source>ArchaeoOrtho: georeference</source>
+        <translation>ArchaeoOrtho: georeferenzieren</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1047"/>
+        <source>Georeferencing with {} control pointsu2026</source>
+        <translation>Georeferenzierung mit {} Passpunkten…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1053"/>
+        <source>Not georeferenced yet.</source>
+        <translation>Noch nicht georeferenziert.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1055"/>
+        <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
+        <translation>Passpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1058"/>
+        <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
+        <translation>Kontrollpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1061"/>
+        <source>heights are placeholders: no vertical accuracy</source>
+        <translation>Höhen sind Platzhalter: keine Höhengenauigkeit</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1063"/>
+        <source>tie points {} px</source>
+        <translation>Verknüpfungspunkte {} px</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1065"/>
+        <source>edited since: re-run to update</source>
+        <translation>seither bearbeitet: erneut ausführen zum Aktualisieren</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1075"/>
+        <source>ArchaeoOrtho: {}</source>
+        <translation>ArchaeoOrtho: {}</translation>
+    </message>
+</context>
+<context>
+    <name>GcpStore</name>
+    <message>
+        <location filename="../ui/store.py" line="194"/>
+        <source>a point named {} exists already</source>
+        <translation>ein Punkt namens {} existiert bereits</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="182"/>
+        <source>add point {}</source>
+        <translation>Punkt {} hinzufügen</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="189"/>
+        <source>remove point {}</source>
+        <translation>Punkt {} entfernen</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="205"/>
+        <source>set {} of {}</source>
+        <translation>{} von {} setzen</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="218"/>
+        <source>place {} in {}</source>
+        <translation>{} in {} messen</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="226"/>
+        <source>remove {} from {}</source>
+        <translation>{} aus {} entfernen</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="251"/>
+        <source>set CRS</source>
+        <translation>KBS setzen</translation>
+    </message>
+</context>
+<context>
+    <name>GcpTableModel</name>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="81"/>
+        <source>Name</source>
+        <translation>Name</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="81"/>
+        <source>X</source>
+        <translation>X</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="81"/>
+        <source>Y</source>
+        <translation>Y</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="81"/>
+        <source>Z</source>
+        <translation>Z</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="81"/>
+        <source>u03c3 XY</source>
+        <translation>σ XY</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="81"/>
+        <source>u03c3 Z</source>
+        <translation>σ Z</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="82"/>
+        <source>Role</source>
+        <translation>Rolle</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="82"/>
+        <source>Obs.</source>
+        <translation>Mess.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="82"/>
+        <source>dXY (m)</source>
+        <translation>dXY (m)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="82"/>
+        <source>dZ (m)</source>
+        <translation>dZ (m)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="82"/>
+        <source>px</source>
+        <translation>px</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="85"/>
+        <source>check</source>
+        <translation>Kontrolle</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="85"/>
+        <source>control</source>
+        <translation>Passpunkt</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="97"/>
+        <source>Horizontal residual after the adjustment (estimated from the photos minus given)</source>
+        <translation>Lageresiduum nach der Ausgleichung (aus den Fotos geschätzt minus gegeben)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="98"/>
+        <source>Vertical residual after the adjustment</source>
+        <translation>Höhenresiduum nach der Ausgleichung</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="99"/>
+        <source>Mean reprojection error of the point&apos;s observations (pixels)</source>
+        <translation>Mittlerer Rückprojektionsfehler der Messungen des Punkts (Pixel)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="100"/>
+        <source>Number of photos the point is placed in</source>
+        <translation>Anzahl der Fotos, in denen der Punkt gemessen ist</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="113"/>
+        <source>rejected as an outlier</source>
+        <translation>als Ausreißer verworfen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="115"/>
+        <source>not triangulated (fewer than 2 usable observations)</source>
+        <translation>nicht trianguliert (weniger als 2 brauchbare Messungen)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="121"/>
+        <source>within the tolerance</source>
+        <translation>innerhalb der Toleranz</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="123"/>
+        <source>up to 3 times the tolerance</source>
+        <translation>bis zum Dreifachen der Toleranz</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="124"/>
+        <source>more than 3 times the tolerance</source>
+        <translation>mehr als das Dreifache der Toleranz</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="166"/>
+        <source>edited since the last adjustment: run Georeference to update</source>
+        <translation>seit der letzten Ausgleichung bearbeitet: &apos;Georeferenzieren&apos; ausführen zum Aktualisieren</translation>
+    </message>
+</context>
+<context>
+    <name>GeoreferenceAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="49"/>
+        <source>Workspace folder (aligned)</source>
+        <translation>Arbeitsbereich-Ordner (ausgerichtet)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="51"/>
+        <source>Ground control file (gcp_list.txt or CSV)</source>
+        <translation>Passpunktdatei (gcp_list.txt oder CSV)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="54"/>
+        <source>Ground control point layer (one feature per observation)</source>
+        <translation>Passpunktlayer (ein Objekt je Messung)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="57"/>
+        <source>Check points (comma-separated names)</source>
+        <translation>Kontrollpunkte (Namen, durch Kommas getrennt)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="59"/>
+        <source>Camera positions (CSV)</source>
+        <translation>Kamerapositionen (CSV)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="62"/>
+        <source>Use EXIF GPS camera positions</source>
+        <translation>EXIF-GPS-Kamerapositionen verwenden</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="64"/>
+        <source>Target CRS (default: the GCP file&apos;s)</source>
+        <translation>Ziel-KBS (Vorgabe: das der Passpunktdatei)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="66"/>
+        <source>Refine camera calibration in the adjustment</source>
+        <translation>Kamerakalibrierung in der Ausgleichung verfeinern</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="68"/>
+        <source>Workspace</source>
+        <translation>Arbeitsbereich</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="69"/>
+        <source>GCP residuals</source>
+        <translation>Passpunkt-Residuen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="70"/>
+        <source>Camera centres (world)</source>
+        <translation>Projektionszentren (Welt)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="91"/>
+        <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS)</source>
+        <translation>Passpunkte (GCPS oder GCP_LAYER) und/oder Kamerapositionen (CAMERA_POSITIONS oder USE_EXIF_GPS) angeben</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="102"/>
+        <source>outlier left out: {}</source>
+        <translation>Ausreißer ausgelassen: {}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="106"/>
+        <source>CRS {}; control RMSE XY {} m, Z {} m; check RMSE XY {} m, Z {} m</source>
+        <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="119"/>
+        <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
+        <translation>Dem Passpunktlayer {} fehlt das Feld &apos;{}&apos; (benötigt name, image, px, py)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Georeference</source>
+        <translation>Georeferenzieren</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Fixes the aligned block in a real coordinate reference system with ground control points (GCPs) and/or camera positions, used inside the bundle adjustment so that they also remove the block&apos;s drift and bending, which a 7-parameter (Helmert) transform cannot. Check points take no part in the adjustment: they are triangulated afterwards and compared with their surveyed coordinates.
+
+GCPS: an OpenDroneMap gcp_list.txt (CRS line, then &apos;x y z px py image [name]&apos;) or a CSV points file with a matching &apos;&lt;name&gt;_observations.csv&apos;. GCP_LAYER: alternatively a point layer with one feature per observation and fields name, image, px, py (optional z, sx, sy, sz, role).
+CHECK_POINTS: comma-separated names that become check points.
+CAMERA_POSITIONS: CSV &apos;image,x,y,z[,sigma]&apos; (optional CRS line). USE_EXIF_GPS: use the photos&apos; GPS.
+Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.</source>
+        <translation>Legt den ausgerichteten Block mit Passpunkten (GCPs) und/oder Kamerapositionen in einem echten Koordinatenbezugssystem fest. Sie wirken in der Bündelblockausgleichung, so dass sie auch Drift und Verbiegung des Blocks beseitigen, was eine 7-Parameter-Transformation (Helmert) nicht kann. Kontrollpunkte nehmen an der Ausgleichung nicht teil: sie werden danach trianguliert und mit ihren vermessenen Koordinaten verglichen.
+
+GCPS: eine OpenDroneMap gcp_list.txt (KBS-Zeile, dann &apos;x y z px py image [name]&apos;) oder eine CSV-Punktdatei mit passender &apos;&lt;name&gt;_observations.csv&apos;. GCP_LAYER: alternativ ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, sx, sy, sz, role).
+CHECK_POINTS: durch Kommas getrennte Namen, die zu Kontrollpunkten werden.
+CAMERA_POSITIONS: CSV &apos;image,x,y,z[,sigma]&apos; (optionale KBS-Zeile). USE_EXIF_GPS: das GPS der Fotos verwenden.
+Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erkannt, im Protokoll genannt und ausgelassen.</translation>
+    </message>
+</context>
+<context>
+    <name>OrthorectifyImageAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
+        <source>Image</source>
+        <translation>Bild</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>DSM</source>
+        <translation>DOM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="65"/>
+        <source>Ground control file (gcp_list.txt or CSV)</source>
+        <translation>Passpunktdatei (gcp_list.txt oder CSV)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="68"/>
+        <source>Ground control point layer (one feature per observation)</source>
+        <translation>Passpunktlayer (ein Objekt je Messung)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="71"/>
+        <source>Known orientation (x y z omega phi kappa)</source>
+        <translation>Bekannte Orientierung (x y z omega phi kappa)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="74"/>
+        <source>Focal length in mm (0 = from EXIF)</source>
+        <translation>Brennweite in mm (0 = aus EXIF)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="77"/>
+        <source>Sensor width (long side) in mm</source>
+        <translation>Sensorbreite (lange Seite) in mm</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="80"/>
+        <source>Mode</source>
+        <translation>Modus</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="82"/>
+        <source>Resolution in CRS units (0 = ground sample distance)</source>
+        <translation>Auflösung in KBS-Einheiten (0 = Bodenauflösung)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="85"/>
+        <source>Output CRS (default: the GCPs&apos; or orientation&apos;s CRS)</source>
+        <translation>Ausgabe-KBS (Vorgabe: das der Passpunkte oder der Orientierung)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="87"/>
+        <source>Orthophoto</source>
+        <translation>Orthophoto</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="88"/>
+        <source>GCP residuals</source>
+        <translation>Passpunkt-Residuen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="90"/>
+        <source>GCP residual RMSE (pixels)</source>
+        <translation>RMSE der Passpunktresiduen (Pixel)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="91"/>
+        <source>Planar rectification: 95th percentile of its offset from the true position (CRS units)</source>
+        <translation>Ebene Entzerrung: 95. Perzentil ihres Versatzes gegen die wahre Lage (KBS-Einheiten)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="107"/>
+        <source>Give ground control points observed in the image (GCPS or GCP_LAYER) or its orientation (ORIENTATION)</source>
+        <translation>Im Bild gemessene Passpunkte (GCPS oder GCP_LAYER) oder seine Orientierung (ORIENTATION) angeben</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="114"/>
+        <source>RESIDUALS must be a GeoPackage (.gpkg) file, got {}</source>
+        <translation>RESIDUALS muss eine GeoPackage-Datei (.gpkg) sein, erhalten: {}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="129"/>
+        <source>{} ({}): {:.2f} px</source>
+        <translation>{} ({}): {:.2f} px</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="137"/>
+        <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
+        <translation>Dem Passpunktlayer {} fehlt das Feld &apos;{}&apos; (benötigt name, image, px, py)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Orthorectify image</source>
+        <translation>Bild orthorektifizieren</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Orthorectifies one photograph — also one that is not part of any block, such as a single oblique or an old print — on an existing DSM, for example an airborne laser scanning (ALS) DSM in any CRS (it is reprojected on the fly).
+
+The camera's position and attitude come from ground control points observed in the photo (space resection: at least 4 points; one wrong point among 5 or more is found and left out; with 6 or more the focal length and the radial distortion k1 are estimated too where the points determine them), or from a known orientation.
+
+IMAGE: the photo. DSM: height raster (needed for a true orthophoto).
+GCPS: an OpenDroneMap gcp_list.txt or CSV points file with observations in this image; or GCP_LAYER: a point layer with one feature per observation and fields name, image, px, py (optional z, role; pixel origin at the upper-left corner, y down).
+ORIENTATION: instead of GCPs, a file with x y z omega phi kappa (degrees, photogrammetric convention; a header row as Pix4D writes it, or JSON), optionally focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 and a CRS line.
+FOCAL_MM and SENSOR_WIDTH_MM: interior orientation (the sensor's long side); default the EXIF focal length.
+MODE: a true orthophoto on the DSM, or a planar (projective) rectification through the GCPs for comparison on flat ground; with a DSM the log and PLANAR_OFFSET_P95 say how far the planar result is off because of relief.
+RESIDUALS: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
+        <translation>Orthorektifiziert ein Foto — auch eines, das zu keinem Block gehört, etwa eine einzelne Schrägaufnahme oder ein alter Abzug — auf einem vorhandenen DOM, zum Beispiel einem DOM aus Airborne Laserscanning (ALS) in beliebigem KBS (es wird im Lauf umprojiziert).
+
+Position und Lage der Kamera ergeben sich aus im Foto gemessenen Passpunkten (räumlicher Rückwärtsschnitt: mindestens 4 Punkte; ein falscher Punkt unter 5 oder mehr wird gefunden und ausgelassen; ab 6 Punkten werden auch Brennweite und radiale Verzeichnung k1 geschätzt, wo die Punkte sie bestimmen) oder aus einer bekannten Orientierung.
+
+IMAGE: das Foto. DSM: Höhenraster (für ein wahres Orthophoto nötig).
+GCPS: eine OpenDroneMap gcp_list.txt oder CSV-Punktdatei mit Messungen in diesem Bild; oder GCP_LAYER: ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, role; Pixelursprung in der linken oberen Ecke, y nach unten).
+ORIENTATION: statt Passpunkten eine Datei mit x y z omega phi kappa (Grad, photogrammetrische Konvention; eine Kopfzeile wie von Pix4D geschrieben, oder JSON), optional focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 und eine KBS-Zeile.
+FOCAL_MM und SENSOR_WIDTH_MM: innere Orientierung (die lange Seite des Sensors); Vorgabe ist die EXIF-Brennweite.
+MODE: ein wahres Orthophoto auf dem DOM oder eine ebene (projektive) Entzerrung über die Passpunkte zum Vergleich auf flachem Gelände; mit DOM sagen das Protokoll und PLANAR_OFFSET_P95, wie weit das ebene Ergebnis wegen des Reliefs abweicht.
+RESIDUALS: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in der Ebene).</translation>
+    </message>
+</context>
+<context>
+    <name>PhotoPanel</name>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="422"/>
+        <source>Only photos that probably see the point</source>
+        <translation>Nur Fotos, die den Punkt voraussichtlich zeigen</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="425"/>
+        <source>Fit</source>
+        <translation>Einpassen</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="425"/>
+        <source>Show the whole photo (F)</source>
+        <translation>Das ganze Foto zeigen (F)</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="426"/>
+        <source>Zoom to point</source>
+        <translation>Auf Punkt zoomen</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="426"/>
+        <source>Zoom to the observation or prediction (Z)</source>
+        <translation>Auf die Messung oder Vorhersage zoomen (Z)</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="428"/>
+        <source>Confirm</source>
+        <translation>Übernehmen</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="428"/>
+        <source>Accept the predicted position (Space)</source>
+        <translation>Die vorhergesagte Position übernehmen (Leertaste)</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="430"/>
+        <source>Confirm &amp;&amp; next</source>
+        <translation>Übernehmen &amp;&amp; weiter</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="430"/>
+        <source>Accept the prediction and show the next photo to place (Enter)</source>
+        <translation>Die Vorhersage übernehmen und das nächste zu messende Foto zeigen (Eingabetaste)</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="433"/>
+        <source>Remove</source>
+        <translation>Entfernen</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="433"/>
+        <source>Remove the observation in this photo (Delete)</source>
+        <translation>Die Messung in diesem Foto entfernen (Entf)</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="596"/>
+        <source>{} (predicted)</source>
+        <translation>{} (vorhergesagt)</translation>
+    </message>
+</context>
+<context>
+    <name>PrepareImagesAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="67"/>
+        <source>Folder of images</source>
+        <translation>Bilderordner</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="69"/>
+        <source>Workspace folder</source>
+        <translation>Arbeitsbereich-Ordner</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="70"/>
+        <source>Smallest blur score (0 = only relative to the set)</source>
+        <translation>Kleinster Schärfewert (0 = nur relativ zum Satz)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="73"/>
+        <source>Leave flagged images out of the prepared folder</source>
+        <translation>Markierte Bilder aus dem vorbereiteten Ordner weglassen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="75"/>
+        <source>Scanned film: fiducial marks, common frame, masks</source>
+        <translation>Gescannter Film: Rahmenmarken, gemeinsamer Rahmen, Masken</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="77"/>
+        <source>Calibrated fiducial coordinates in mm (file path or text)</source>
+        <translation>Kalibrierte Rahmenmarken-Koordinaten in mm (Dateipfad oder Text)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="80"/>
+        <source>Calibrated focal length in mm (0 = unknown)</source>
+        <translation>Kalibrierte Brennweite in mm (0 = unbekannt)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="84"/>
+        <source>Flag images below this fraction of the set&apos;s median blur score</source>
+        <translation>Bilder unter diesem Bruchteil des mittleren Schärfewerts des Satzes markieren</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="87"/>
+        <source>Fiducial mark type</source>
+        <translation>Art der Rahmenmarken</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="89"/>
+        <source>Fiducial positions</source>
+        <translation>Lage der Rahmenmarken</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="91"/>
+        <source>Template image of one fiducial mark</source>
+        <translation>Vorlagenbild einer Rahmenmarke</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <source>Scan resolution in dpi when not in the files (0 = from the files)</source>
+        <translation>Scanauflösung in dpi, wenn nicht in den Dateien (0 = aus den Dateien)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
+        <source>Prepared images (skipped: &lt;workspace&gt;/prepared)</source>
+        <translation>Vorbereitete Bilder (ausgelassen: &lt;workspace&gt;/prepared)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="103"/>
+        <source>Folder of prepared images</source>
+        <translation>Ordner der vorbereiteten Bilder</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="104"/>
+        <source>Flagged images</source>
+        <translation>Markierte Bilder</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="105"/>
+        <source>Excluded images</source>
+        <translation>Ausgeschlossene Bilder</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="106"/>
+        <source>Screening record (JSON)</source>
+        <translation>Prüfprotokoll (JSON)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="138"/>
+        <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
+        <translation>{} Bilder: {} markiert, {} ausgeschlossen, {} im vorbereiteten Ordner</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="140"/>
+        <source>Blurriest first (blur score, % of the set&apos;s median):</source>
+        <translation>Unschärfste zuerst (Schärfewert, % des Medians des Satzes):</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="148"/>
+        <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
+        <translation>Vorbereitete Scans: {} x {} px, Pixelgröße {:.6g} {}{}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Prepare images</source>
+        <translation>Bilder vorbereiten</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for &apos;Align images&apos;, and the WORKSPACE, which records a decision per image (screening.json) for the accuracy report.
+
+Blur score: variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged &apos;blurry&apos; below BLUR_RELATIVE x the median of the set, or below BLUR_THRESHOLD when that is set (absolute scores depend on the scene: sand scores far lower than roofs).
+Exposure: images with more than 5 % clipped highlights or shadows, a mean brightness far from the set&apos;s, or a very small dynamic range are flagged. EXCLUDE_FLAGGED leaves flagged images out of the prepared folder; otherwise they are kept and only reported.
+
+SCANNED_FILM: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. FIDUCIAL_COORDINATES: the calibration certificate&apos;s fiducial coordinates in mm, as a file or pasted text, one &apos;id x y&apos; line per mark (x right, y up), optionally &apos;PP x y&apos; (principal point) and &apos;focal f&apos;. Without them the mean layout of the set is used, centred on the fiducial centre. With FOCAL_LENGTH_MM (or &apos;focal&apos; in the certificate) the prepared images carry the focal length in pixels for the alignment.
+
+OUTPUT: the folder of prepared images (replaced as a whole; it must be new, empty or written by an earlier run); when skipped, &lt;workspace&gt;/prepared.</source>
+        <translation>Prüft einen Ordner mit Fotos auf Unschärfe und Belichtung und findet bei gescanntem historischem Film die Rahmenmarken und rechnet jeden Scan in einen gemeinsamen Kamerarahmen um. Das Ergebnis ist ein Ordner vorbereiteter Bilder für &apos;Bilder ausrichten&apos; und der WORKSPACE, der je Bild eine Entscheidung festhält (screening.json) für den Genauigkeitsbericht.
+
+Schärfewert: Varianz des Laplace-Operators auf einer grauen Kopie von 1024 px Breite, 90. Perzentil eines Rasters von 8 x 6 Kacheln (Himmel oder Wasser in einem Teil des Bildes zählt nicht dagegen). Höher ist schärfer. Ein Bild wird als &apos;unscharf&apos; markiert unter BLUR_RELATIVE x dem Median des Satzes oder unter BLUR_THRESHOLD, wenn gesetzt (absolute Werte hängen von der Szene ab: Sand erreicht weit weniger als Dächer).
+Belichtung: Bilder mit mehr als 5 % beschnittenen Lichtern oder Schatten, einer mittleren Helligkeit weit weg von der des Satzes oder einem sehr kleinen Dynamikumfang werden markiert. EXCLUDE_FLAGGED lässt markierte Bilder aus dem vorbereiteten Ordner weg; sonst bleiben sie und werden nur gemeldet.
+
+SCANNED_FILM: Rahmenmarken (Kreuze, Punkte, Punkte in Kreisen; in den Ecken und/oder Seitenmitten, oder wie ein Vorlagenbild einer Marke) werden auf Bruchteile eines Pixels gefunden, jeder Scan wird durch eine affine Transformation in den gemeinsamen Rahmenmarken-Rahmen umgerechnet, alle gleich groß und mit dem Bildhauptpunkt in der Mitte, und Masken (workspace/masks) verbergen Filmrand, Datenstreifen und die Marken vor der Zuordnung. FIDUCIAL_COORDINATES: die Rahmenmarken-Koordinaten des Kalibrierzertifikats in mm, als Datei oder eingefügter Text, eine Zeile &apos;id x y&apos; je Marke (x nach rechts, y nach oben), optional &apos;PP x y&apos; (Bildhauptpunkt) und &apos;focal f&apos;. Ohne sie wird die mittlere Anordnung des Satzes verwendet, zentriert auf die Rahmenmitte. Mit FOCAL_LENGTH_MM (oder &apos;focal&apos; im Zertifikat) tragen die vorbereiteten Bilder die Brennweite in Pixeln für die Ausrichtung.
+
+OUTPUT: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetzt; er muss neu, leer oder von einem früheren Lauf geschrieben sein); wenn ausgelassen, &lt;workspace&gt;/prepared.</translation>
+    </message>
+</context>
+<context>
+    <name>ResultLayers</name>
+    <message>
+        <location filename="../ui/layers.py" line="258"/>
+        <source>control (used)</source>
+        <translation>Passpunkt (verwendet)</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="259"/>
+        <source>check point</source>
+        <translation>Kontrollpunkt</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="260"/>
+        <source>rejected (outlier)</source>
+        <translation>verworfen (Ausreißer)</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="261"/>
+        <source>not triangulated</source>
+        <translation>nicht trianguliert</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="342"/>
+        <source>DSM</source>
+        <translation>DOM</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="494"/>
+        <source>DSM hillshade</source>
+        <translation>DOM-Schummerung</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="355"/>
+        <source>Orthomosaic</source>
+        <translation>Orthomosaik</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="366"/>
+        <source>Cameras</source>
+        <translation>Kameras</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="505"/>
+        <source>Camera footprints</source>
+        <translation>Bildfußabdrücke</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="512"/>
+        <source>GCP residuals (vectors x{})</source>
+        <translation>Passpunkt-Residuen (Vektoren x{})</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="428"/>
+        <source>Point cloud</source>
+        <translation>Punktwolke</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="438"/>
+        <source>ArchaeoOrtho: {}</source>
+        <translation>ArchaeoOrtho: {}</translation>
     </message>
 </context>
 </TS>

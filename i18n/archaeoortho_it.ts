@@ -2,11 +2,91 @@
 <!DOCTYPE TS>
 <TS version="2.1">
 <context>
+    <name>AccuracyReportAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="71"/>
+        <source>Workspace folder</source>
+        <translation>Cartella dell&apos;area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="73"/>
+        <source>Compute the bundle adjustment covariance (uncertainty section and layers)</source>
+        <translation>Calcola la covarianza della compensazione a stelle proiettive (sezione e layer dell&apos;incertezza)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="76"/>
+        <source>Report (default: &lt;workspace&gt;/report.html)</source>
+        <translation>Rapporto (predefinito: &lt;workspace&gt;/report.html)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="79"/>
+        <source>Workspace</source>
+        <translation>Area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="80"/>
+        <source>Camera precision (GeoPackage)</source>
+        <translation>Precisione delle camere (GeoPackage)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="81"/>
+        <source>Tie point precision (GeoPackage)</source>
+        <translation>Precisione dei punti di legame (GeoPackage)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="82"/>
+        <source>Sections skipped</source>
+        <translation>Sezioni saltate</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="99"/>
+        <source>section {} skipped: {}</source>
+        <translation>sezione {} saltata: {}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="101"/>
+        <source>report written: {} ({} s)</source>
+        <translation>rapporto scritto: {} ({} s)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Accuracy report</source>
+        <translation>Rapporto di accuratezza</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Writes one self-contained HTML report of a workspace (plots embedded, readable offline) and returns its key figures.
+
+Summary: images given / aligned / not aligned and why, image screening, cameras with their calibrated parameters and standard deviations, GSD, area, CRS, processing times and parameters. Orientation quality: reprojection errors, tie-point track lengths, image connectivity, camera positions with residuals. Georeferencing: control and check points with dX dY dZ and image residuals, residual vectors, RMSE per set, NSSDA (FGDC-STD-007.3-1998) accuracy statements at 95 % confidence, ASPRS 2014 and 2023 accuracy classes, camera-position residuals, outliers. Uncertainty: standard deviations of cameras and tie points from the bundle adjustment covariance. Products: DSM and orthomosaic previews, resolution, valid fraction. Sections whose stage has not run are skipped with a note.
+
+WORKSPACE: a workspace folder (at least aligned).
+UNCERTAINTY: compute the covariance (seconds for hundreds of images) and write &lt;workspace&gt;/uncertainty/cameras.gpkg and points.gpkg.
+OUTPUT_HTML: the report file (default: &lt;workspace&gt;/report.html). It is written under a temporary name and renamed when complete.</source>
+        <translation>Scrive un rapporto HTML autonomo di un&apos;area di lavoro (grafici incorporati, leggibile offline) e ne restituisce le cifre principali.
+
+Sintesi: immagini fornite / orientate / non orientate e perché, controllo delle immagini, camere con i parametri calibrati e le deviazioni standard, GSD, area, SR, tempi e parametri di elaborazione. Qualità dell&apos;orientamento: errori di riproiezione, lunghezze delle tracce dei punti di legame, connessioni tra immagini, posizioni delle camere con residui. Georeferenziazione: punti d&apos;appoggio e di controllo con dX dY dZ e residui in immagine, vettori dei residui, RMSE per gruppo, accuratezza NSSDA (FGDC-STD-007.3-1998) al 95 % di confidenza, classi di accuratezza ASPRS 2014 e 2023, residui delle posizioni delle camere, valori anomali. Incertezza: deviazioni standard delle camere e dei punti di legame dalla covarianza della compensazione. Prodotti: anteprime di DSM e ortomosaico, risoluzione, frazione valida. Le sezioni la cui fase non è stata eseguita vengono saltate con una nota.
+
+WORKSPACE: una cartella dell&apos;area di lavoro (almeno orientata).
+UNCERTAINTY: calcola la covarianza (secondi per centinaia di immagini) e scrive &lt;workspace&gt;/uncertainty/cameras.gpkg e points.gpkg.
+OUTPUT_HTML: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Viene scritto con un nome provvisorio e rinominato quando è completo.</translation>
+    </message>
+</context>
+<context>
     <name>AlgorithmBase</name>
     <message>
-        <location filename="../processing_provider/base.py" line="78"/>
+        <location filename="../processing_provider/base.py" line="130"/>
         <source>Cancelled: {}</source>
-        <translation type="unfinished"></translation>
+        <translation>Annullato: {}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/base.py" line="98"/>
+        <source>Outputs not styled: {}</source>
+        <translation>Output senza stile: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Photogrammetry</source>
+        <translation>Fotogrammetria</translation>
     </message>
 </context>
 <context>
@@ -14,82 +94,118 @@
     <message>
         <location filename="../processing_provider/align_images.py" line="48"/>
         <source>Folder of images</source>
-        <translation type="unfinished"></translation>
+        <translation>Cartella delle immagini</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Workspace folder</source>
-        <translation type="unfinished"></translation>
+        <translation>Cartella dell&apos;area di lavoro</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="51"/>
         <source>Pair selection</source>
-        <translation type="unfinished"></translation>
+        <translation>Selezione delle coppie</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="53"/>
         <source>Camera model</source>
-        <translation type="unfinished"></translation>
+        <translation>Modello di camera</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="55"/>
         <source>Largest image side for matching (0 = full size)</source>
-        <translation type="unfinished"></translation>
+        <translation>Lato maggiore dell&apos;immagine per la corrispondenza (0 = dimensione piena)</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="58"/>
         <source>Largest number of features per image (0 = auto, ~4000 per megapixel)</source>
-        <translation type="unfinished"></translation>
+        <translation>Numero massimo di feature per immagine (0 = automatico, ~4000 per megapixel)</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="61"/>
         <source>Affine-invariant features (oblique views; slower)</source>
-        <translation type="unfinished"></translation>
+        <translation>Feature invarianti affini (prese oblique; più lento)</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="63"/>
         <source>Focal length in mm when EXIF is missing (0 = from EXIF)</source>
-        <translation type="unfinished"></translation>
+        <translation>Focale in mm se manca l&apos;EXIF (0 = dall&apos;EXIF)</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Sensor (frame) width in mm, long side (0 = unknown)</source>
-        <translation type="unfinished"></translation>
+        <translation>Larghezza del sensore (fotogramma) in mm, lato lungo (0 = sconosciuta)</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="69"/>
         <source>One camera for all images</source>
-        <translation type="unfinished"></translation>
+        <translation>Una sola camera per tutte le immagini</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="71"/>
         <source>Camera centres</source>
-        <translation type="unfinished"></translation>
+        <translation>Centri di presa</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="72"/>
         <source>Registered images</source>
-        <translation type="unfinished"></translation>
+        <translation>Immagini orientate</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="73"/>
         <source>Mean reprojection error (px)</source>
-        <translation type="unfinished"></translation>
+        <translation>Errore medio di riproiezione (px)</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="95"/>
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
-        <translation type="unfinished"></translation>
+        <translation>Orientate {} di {} immagini, errore medio di riproiezione {:.3f} px, {} punti</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="98"/>
         <source>Images not registered:</source>
-        <translation type="unfinished"></translation>
+        <translation>Immagini non orientate:</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="101"/>
         <source>Seconds per step: {}</source>
-        <translation type="unfinished"></translation>
+        <translation>Secondi per fase: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Align images</source>
+        <translation>Allinea immagini</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Structure from motion: SIFT features, pair selection, robust matching (RANSAC), incremental mapping with self-calibration (focal length, principal point, lens distortion) and a final bundle adjustment. The result is stored in the WORKSPACE folder, which the following stages (Georeference, Build DSM, Build orthophoto) take as input. A re-run resumes: features and matches already computed are reused.
+
+PAIRING: &apos;auto&apos; uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
+CAMERA_MODEL: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
+FOCAL_MM and SENSOR_WIDTH_MM: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres.</source>
+        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell&apos;obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella WORKSPACE, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
+
+PAIRING: &apos;auto&apos; usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
+CAMERA_MODEL: &apos;AUTO&apos; stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
+FOCAL_MM e SENSOR_WIDTH_MM: orientamento interno quando manca l&apos;EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri.</translation>
+    </message>
+</context>
+<context>
+    <name>ArchaeoOrthoPlugin</name>
+    <message>
+        <location filename="../plugin.py" line="60"/>
+        <source>Ground control (GCP dock)</source>
+        <translation>Punti d&apos;appoggio (pannello GCP)</translation>
+    </message>
+    <message>
+        <location filename="../plugin.py" line="64"/>
+        <source>ArchaeoOrtho: pick ground control points on the map and in the photos</source>
+        <translation>ArchaeoOrtho: misura i punti d&apos;appoggio sulla mappa e nelle foto</translation>
+    </message>
+    <message>
+        <location filename="../plugin.py" line="106"/>
+        <source>&amp;ArchaeoOrtho</source>
+        <translation>&amp;ArchaeoOrtho</translation>
     </message>
 </context>
 <context>
@@ -97,7 +213,1353 @@
     <message>
         <location filename="../processing_provider/provider.py" line="17"/>
         <source>ArchaeoOrtho photogrammetry</source>
-        <translation type="unfinished"></translation>
+        <translation>ArchaeoOrtho fotogrammetria</translation>
+    </message>
+</context>
+<context>
+    <name>BuildDsmAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="52"/>
+        <source>Workspace folder (georeferenced)</source>
+        <translation>Cartella dell&apos;area di lavoro (georeferenziata)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="54"/>
+        <source>DSM resolution in metres (0 = automatic)</source>
+        <translation>Risoluzione del DSM in metri (0 = automatica)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="57"/>
+        <source>Matching quality (image scale)</source>
+        <translation>Qualità della corrispondenza (scala dell&apos;immagine)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="59"/>
+        <source>Engine</source>
+        <translation>Motore di calcolo</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="61"/>
+        <source>Parallel workers (0 = one per core)</source>
+        <translation>Processi paralleli (0 = uno per core)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="64"/>
+        <source>Dask scheduler address (empty = this computer)</source>
+        <translation>Indirizzo dello scheduler Dask (vuoto = questo computer)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="69"/>
+        <source>DSM (default: &lt;workspace&gt;/dsm.tif)</source>
+        <translation>DSM (predefinito: &lt;workspace&gt;/dsm.tif)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="71"/>
+        <source>Point cloud (LAS)</source>
+        <translation>Nuvola di punti (LAS)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="74"/>
+        <source>Workspace</source>
+        <translation>Area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="75"/>
+        <source>Share of DSM cells with data inside the camera centres&apos; convex hull</source>
+        <translation>Frazione delle celle del DSM con dati entro l&apos;inviluppo convesso dei centri di presa</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="77"/>
+        <source>Stereo pairs matched</source>
+        <translation>Coppie stereo elaborate</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="78"/>
+        <source>Fused points</source>
+        <translation>Punti fusi</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="96"/>
+        <source>DSM {} ({} m cells), valid fraction {}</source>
+        <translation>DSM {} (celle di {} m), frazione valida {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Build DSM</source>
+        <translation>Genera DSM</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Dense matching of the georeferenced block and a digital surface model (DSM).
+
+Stereo pairs are chosen from the sparse model (shared tie points, baseline-to-depth ratio, viewing angle); each pair is undistorted and rectified from the known poses and matched with semi-global matching (OpenCV SGBM) with a left-right check; a pixel is kept where at least two independent pairs agree. The fused points are rasterised (median of the highest height cluster per cell), small holes are filled and large ones left nodata.
+
+WORKSPACE: a georeferenced workspace (run &apos;Georeference&apos; first: a DSM needs a metric scale and a vertical direction, so a workspace that is only aligned is refused).
+RESOLUTION: DSM cell size in metres; 0 = about twice the median ground sample distance.
+QUALITY: image scale for matching (full, half, quarter): half is four times faster than full.
+ENGINE: cpu (default); cuda runs COLMAP patch-match stereo where pycolmap was built with CUDA.
+OUTPUT_DSM: Cloud-Optimized GeoTIFF, float32 with nodata (default: &lt;workspace&gt;/dsm.tif).
+OUTPUT_POINT_CLOUD: optional LAS file (XYZ + RGB, workspace CRS).
+
+Re-running after a cancel resumes: pairs already matched are reused from &lt;workspace&gt;/dense/.</source>
+        <translation>Corrispondenza densa del blocco georeferenziato e un modello digitale della superficie (DSM).
+
+Le coppie stereo sono scelte dal modello sparso (punti di legame comuni, rapporto base/distanza, angolo di vista); ogni coppia è corretta dalla distorsione e rettificata dagli orientamenti noti e abbinata con semi-global matching (OpenCV SGBM) con controllo sinistra-destra; un pixel è tenuto dove almeno due coppie indipendenti concordano. I punti fusi sono rasterizzati (mediana del gruppo di quote più alto per cella), i piccoli vuoti riempiti e quelli grandi lasciati nodata.
+
+WORKSPACE: un&apos;area di lavoro georeferenziata (eseguire prima &apos;Georeferenzia&apos;: un DSM richiede una scala metrica e una verticale, quindi un&apos;area di lavoro solo orientata viene rifiutata).
+RESOLUTION: dimensione della cella del DSM in metri; 0 = circa il doppio del GSD mediano.
+QUALITY: scala dell&apos;immagine per la corrispondenza (piena, metà, quarto): metà è quattro volte più veloce di piena.
+ENGINE: cpu (predefinito); cuda esegue lo stereo patch-match di COLMAP dove pycolmap è compilato con CUDA.
+OUTPUT_DSM: Cloud-Optimized GeoTIFF, float32 con nodata (predefinito: &lt;workspace&gt;/dsm.tif).
+OUTPUT_POINT_CLOUD: file LAS facoltativo (XYZ + RGB, SR dell&apos;area di lavoro).
+
+Una nuova esecuzione dopo un annullamento riprende: le coppie già elaborate sono riutilizzate da &lt;workspace&gt;/dense/.</translation>
+    </message>
+</context>
+<context>
+    <name>BuildOrthophotoAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="61"/>
+        <source>Workspace folder (georeferenced, with a DSM)</source>
+        <translation>Cartella dell&apos;area di lavoro (georeferenziata, con DSM)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="64"/>
+        <source>DSM (default: the workspace DSM)</source>
+        <translation>DSM (predefinito: il DSM dell&apos;area di lavoro)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <source>Images (names, wildcards or group:&lt;camera&gt;; empty = all)</source>
+        <translation>Immagini (nomi, caratteri jolly o group:&lt;camera&gt;; vuoto = tutte)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="69"/>
+        <source>Resolution in CRS units (0 = ground sample distance)</source>
+        <translation>Risoluzione in unità del SR (0 = GSD)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="72"/>
+        <source>Blending across seamlines</source>
+        <translation>Sfumatura lungo le linee di giunzione</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="74"/>
+        <source>Resampling of the images</source>
+        <translation>Ricampionamento delle immagini</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="76"/>
+        <source>Parallel tile workers (0 = one per core)</source>
+        <translation>Processi paralleli per tassello (0 = uno per core)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="82"/>
+        <source>Orthomosaic (default: &lt;workspace&gt;/orthomosaic.tif)</source>
+        <translation>Ortomosaico (predefinito: &lt;workspace&gt;/orthomosaic.tif)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="85"/>
+        <source>Folder for per-image true orthophotos</source>
+        <translation>Cartella per le ortofoto vere di ciascuna immagine</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="88"/>
+        <source>Seamlines (which image, GeoPackage)</source>
+        <translation>Linee di giunzione (quale immagine, GeoPackage)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="90"/>
+        <source>Workspace</source>
+        <translation>Area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="91"/>
+        <source>Share of mosaic cells with data</source>
+        <translation>Frazione delle celle del mosaico con dati</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="92"/>
+        <source>Resolution used</source>
+        <translation>Risoluzione usata</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="93"/>
+        <source>Images in the mosaic</source>
+        <translation>Immagini nel mosaico</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="107"/>
+        <source>SEAMLINES must be a GeoPackage (.gpkg) file, got {}</source>
+        <translation>SEAMLINES deve essere un file GeoPackage (.gpkg), ricevuto {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Build orthophoto</source>
+        <translation>Genera ortofoto</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>True orthophotos and the orthomosaic of a georeferenced workspace.
+
+Every cell takes its height from the DSM and is projected through the full camera model (pose, focal length, principal point, lens distortion) into the images. A cell hidden from an image by higher surface (a wall, a tree, a hill) is left out of that image, so buildings do not lean and nothing appears twice; the mosaic fills it from an image that sees it. Each part of the mosaic comes from the image that looks at it most vertically and closest to its centre; seamlines go around buildings and trees; brightness differences between images are evened out and seams blended.
+
+WORKSPACE: a georeferenced workspace with a DSM (run &apos;Build DSM&apos; first), or give DSM.
+DSM: optional raster (e.g. an ALS DSM, in any CRS: reprojected on the fly); default the workspace DSM.
+IMAGES_FILTER: a subset, e.g. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; or &apos;group:NIR&apos; (a camera group by id or by make/model), &apos;!name&apos; to leave one out. Empty: all images.
+RESOLUTION: cell size in CRS units; 0 = the images&apos; ground sample distance.
+BLENDING: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness and no ghosting), none (hard cut).
+OUTPUT: Cloud-Optimized GeoTIFF with overviews, the images&apos; bands and data type (8/16 bit kept) plus an alpha band (default &lt;workspace&gt;/orthomosaic.tif).
+PER_IMAGE_FOLDER: optional folder for one true orthophoto per image (COG).
+SEAMLINES: optional GeoPackage of polygons naming the image each part of the mosaic comes from.</source>
+        <translation>Ortofoto vere e l&apos;ortomosaico di un&apos;area di lavoro georeferenziata.
+
+Ogni cella prende la quota dal DSM ed è proiettata nelle immagini con il modello completo della camera (orientamento, focale, punto principale, distorsione dell&apos;obiettivo). Una cella nascosta in un&apos;immagine da una superficie più alta (un muro, un albero, una collina) viene esclusa da quell&apos;immagine, così gli edifici non pendono e nulla compare due volte; il mosaico la riempie da un&apos;immagine che la vede. Ogni parte del mosaico proviene dall&apos;immagine che la guarda nel modo più verticale e più vicino al suo centro; le linee di giunzione girano attorno a edifici e alberi; le differenze di luminosità tra le immagini sono compensate e le giunzioni sfumate.
+
+WORKSPACE: un&apos;area di lavoro georeferenziata con DSM (eseguire prima &apos;Genera DSM&apos;), oppure indicare DSM.
+DSM: raster facoltativo (ad es. un DSM ALS, in qualsiasi SR: riproiettato al volo); predefinito il DSM dell&apos;area di lavoro.
+IMAGES_FILTER: un sottoinsieme, ad es. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; o &apos;group:NIR&apos; (un gruppo di camere per numero o per marca/modello), &apos;!nome&apos; per escluderne una. Vuoto: tutte le immagini.
+RESOLUTION: dimensione della cella in unità del SR; 0 = il GSD delle immagini.
+BLENDING: feather (rampa attraverso le giunzioni), multiband (piramide laplaciana: nessuna giunzione visibile nella luminosità e nessun effetto fantasma), none (taglio netto).
+OUTPUT: Cloud-Optimized GeoTIFF con panoramiche, le bande e il tipo di dato delle immagini (8/16 bit conservati) più una banda alfa (predefinito &lt;workspace&gt;/orthomosaic.tif).
+PER_IMAGE_FOLDER: cartella facoltativa per un&apos;ortofoto vera per immagine (COG).
+SEAMLINES: GeoPackage facoltativo di poligoni che indicano l&apos;immagine da cui proviene ogni parte del mosaico.</translation>
+    </message>
+</context>
+<context>
+    <name>GcpDock</name>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="241"/>
+        <source>ArchaeoOrtho ground control</source>
+        <translation>ArchaeoOrtho punti d&apos;appoggio</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="254"/>
+        <source>ArchaeoOrtho photos</source>
+        <translation>ArchaeoOrtho foto</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="270"/>
+        <source>Workspace:</source>
+        <translation>Area di lavoro:</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="447"/>
+        <source>none open</source>
+        <translation>nessuna aperta</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="275"/>
+        <source>Openu2026</source>
+        <translation>Apri…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="276"/>
+        <source>Open a workspace folder (made by Align images)</source>
+        <translation>Apri una cartella dell&apos;area di lavoro (creata da &apos;Allinea immagini&apos;)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="277"/>
+        <source>New from photosu2026</source>
+        <translation>Nuova dalle foto…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="278"/>
+        <source>Choose a folder of photos and a workspace folder, and align the photos</source>
+        <translation>Scegli una cartella di foto e una cartella dell&apos;area di lavoro e allinea le foto</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="284"/>
+        <source>Heights (Z) from:</source>
+        <translation>Quote (Z) da:</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="289"/>
+        <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
+        <translation>Un layer raster DSM o DTM (ad es. un DSM ALS): un punto misurato sulla mappa ne prende la quota (bilineare). Vuoto: inserire Z a mano.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="829"/>
+        <source>Add</source>
+        <translation>Aggiungi</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="299"/>
+        <source>Add a ground point</source>
+        <translation>Aggiungi un punto d&apos;appoggio</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="300"/>
+        <source>Remove</source>
+        <translation>Rimuovi</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="301"/>
+        <source>Remove the selected ground point and its observations</source>
+        <translation>Rimuovi il punto d&apos;appoggio selezionato e le sue misure</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="302"/>
+        <source>Pick on map</source>
+        <translation>Misura sulla mappa</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="304"/>
+        <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
+        <translation>Fai clic sulla mappa per impostare X e Y del punto selezionato (Z dal layer delle quote)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="307"/>
+        <source>From file (gcp_list.txt, CSV)u2026</source>
+        <translation>Da file (gcp_list.txt, CSV)…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="308"/>
+        <source>From a point layeru2026</source>
+        <translation>Da un layer di punti…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="310"/>
+        <source>To file (gcp_list.txt, CSV)u2026</source>
+        <translation>Su file (gcp_list.txt, CSV)…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="311"/>
+        <source>To a GeoPackage layeru2026</source>
+        <translation>Su un layer GeoPackage…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="312"/>
+        <source>Import</source>
+        <translation>Importa</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="312"/>
+        <source>Export</source>
+        <translation>Esporta</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="319"/>
+        <source>Undo</source>
+        <translation>Annulla</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="320"/>
+        <source>Redo</source>
+        <translation>Ripeti</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="327"/>
+        <source>Undo: {}</source>
+        <translation>Annulla: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="328"/>
+        <source>Redo: {}</source>
+        <translation>Ripeti: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="333"/>
+        <source>Load results</source>
+        <translation>Carica risultati</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="334"/>
+        <source>Add the workspace&apos;s products to the map as styled layers</source>
+        <translation>Aggiungi i prodotti dell&apos;area di lavoro alla mappa come layer con stile</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="351"/>
+        <source>Residual tolerance:</source>
+        <translation>Tolleranza dei residui:</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="357"/>
+        <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
+        <translation>Residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="359"/>
+        <source>Refine camera calibration</source>
+        <translation>Affina la calibrazione della camera</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="360"/>
+        <source>Let the adjustment refine focal length, principal point and distortion</source>
+        <translation>Lascia che la compensazione affini focale, punto principale e distorsione</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="366"/>
+        <source>Georeference</source>
+        <translation>Georeferenzia</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="367"/>
+        <source>Run the adjustment with these points (in the background)</source>
+        <translation>Esegui la compensazione con questi punti (in background)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="368"/>
+        <source>Cancel</source>
+        <translation>Interrompi</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="424"/>
+        <source>ArchaeoOrtho</source>
+        <translation>ArchaeoOrtho</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="431"/>
+        <source>Open an ArchaeoOrtho workspace</source>
+        <translation>Apri un&apos;area di lavoro ArchaeoOrtho</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="468"/>
+        <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
+        <translation>{} foto; il blocco non è ancora allineato: esegui &apos;Allinea immagini&apos; (o &apos;Nuova dalle foto&apos;) per avere le posizioni previste</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="471"/>
+        <source>{} photos, {} ground points. {}</source>
+        <translation>{} foto, {} punti d&apos;appoggio. {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="702"/>
+        <source>no predicted positions: {}</source>
+        <translation>nessuna posizione prevista: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="504"/>
+        <source>Predicted positions from the georeferenced block.</source>
+        <translation>Posizioni previste dal blocco georeferenziato.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="504"/>
+        <source>Predicted positions once a point is placed in 2 photos, and for every point once 3 points are placed.</source>
+        <translation>Posizioni previste quando un punto è misurato in 2 foto, e per tutti i punti quando ne sono misurati 3.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="510"/>
+        <source>Folder of photos</source>
+        <translation>Cartella delle foto</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="513"/>
+        <source>Workspace folder (new or existing)</source>
+        <translation>Cartella dell&apos;area di lavoro (nuova o esistente)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="525"/>
+        <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
+        <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="529"/>
+        <source>ArchaeoOrtho: align photos</source>
+        <translation>ArchaeoOrtho: allinea le foto</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="596"/>
+        <source>CRS: {}</source>
+        <translation>SR: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="623"/>
+        <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
+        <translation>Fai clic sulla mappa nella posizione del punto selezionato (Esc per terminare)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="662"/>
+        <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
+        <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (da {})</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="665"/>
+        <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
+        <translation>{}: X {:.3f}, Y {:.3f}. Nessuna quota in questo punto in {}: Z invariata</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="668"/>
+        <source>{}: X {:.3f}, Y {:.3f}</source>
+        <translation>{}: X {:.3f}, Y {:.3f}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="725"/>
+        <source>{:.1f} px</source>
+        <translation>{:.1f} px</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="729"/>
+        <source>predicted</source>
+        <translation>prevista</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="744"/>
+        <source>Select or add a ground point in the table, then click on it in the photo.</source>
+        <translation>Seleziona o aggiungi un punto d&apos;appoggio nella tabella, poi fai clic su di esso nella foto.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="749"/>
+        <source>from the point&apos;s other observations</source>
+        <translation>dalle altre misure del punto</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="750"/>
+        <source>from the georeferenced block</source>
+        <translation>dal blocco georeferenziato</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="751"/>
+        <source>from the points already placed (similarity fit)</source>
+        <translation>dai punti già misurati (trasformazione di similitudine)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="757"/>
+        <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
+        <translation>Misurato in x {:.2f}, y {:.2f}. Fai clic per spostarlo, trascinalo o premi Canc per rimuoverlo.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="760"/>
+        <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
+        <translation>Previsto {}. Premi Invio per accettarlo e proseguire (Spazio: accetta), trascinalo o fai clic dove si trova davvero il punto.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="763"/>
+        <source>Click where {} is in this photo.</source>
+        <translation>Fai clic dove si trova {} in questa foto.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="773"/>
+        <source>Select or add a ground point first</source>
+        <translation>Seleziona o aggiungi prima un punto d&apos;appoggio</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="812"/>
+        <source>{}: every photo predicted to see it has an observation</source>
+        <translation>{}: ogni foto in cui è previsto ha una misura</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="869"/>
+        <source>Import ground control</source>
+        <translation>Importa punti d&apos;appoggio</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="817"/>
+        <source>Ground control (*.txt *.csv);;All files (*)</source>
+        <translation>Punti d&apos;appoggio (*.txt *.csv);;Tutti i file (*)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="825"/>
+        <source>Replace the current points, or add the imported ones to them (same names are updated)?</source>
+        <translation>Sostituire i punti attuali o aggiungere quelli importati (quelli con lo stesso nome vengono aggiornati)?</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="828"/>
+        <source>Replace</source>
+        <translation>Sostituisci</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="851"/>
+        <source>import {}</source>
+        <translation>importa {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="853"/>
+        <source>warnings</source>
+        <translation>avvisi</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="854"/>
+        <source>Imported {} points and {} observations from {}</source>
+        <translation>Importati {} punti e {} misure da {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="866"/>
+        <source>No point layer in the project</source>
+        <translation>Nessun layer di punti nel progetto</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="869"/>
+        <source>Point layer (one feature per observation: name, image, px, py)</source>
+        <translation>Layer di punti (un elemento per misura: name, image, px, py)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="882"/>
+        <source>Layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
+        <translation>Al layer {} manca il campo &apos;{}&apos; (servono name, image, px, py)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="908"/>
+        <source>OpenDroneMap gcp_list (*.txt)</source>
+        <translation>OpenDroneMap gcp_list (*.txt)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="908"/>
+        <source>CSV points + observations (*.csv)</source>
+        <translation>Punti CSV + misure (*.csv)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="909"/>
+        <source>Export ground control</source>
+        <translation>Esporta punti d&apos;appoggio</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="920"/>
+        <source>The points have no CRS yet: pick one on the map or import a file first</source>
+        <translation>I punti non hanno ancora un SR: misurane uno sulla mappa o importa prima un file</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="929"/>
+        <source>Exported {} points to {}</source>
+        <translation>Esportati {} punti in {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="929"/>
+        <source> ({} without coordinates left out)</source>
+        <translation> ({} senza coordinate esclusi)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="934"/>
+        <source>Export ground control as a layer</source>
+        <translation>Esporta i punti d&apos;appoggio come layer</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="934"/>
+        <source>GeoPackage (*.gpkg)</source>
+        <translation>GeoPackage (*.gpkg)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="965"/>
+        <source>Cannot write {}: {}</source>
+        <translation>Impossibile scrivere {}: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="968"/>
+        <source>Exported {} observations to {}</source>
+        <translation>Esportate {} misure in {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="968"/>
+        <source> (points without observations left out: {})</source>
+        <translation> (punti senza misure esclusi: {})</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="972"/>
+        <source>GCP observations</source>
+        <translation>Misure dei punti d&apos;appoggio</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="974"/>
+        <source>Cannot add {} to the project</source>
+        <translation>Impossibile aggiungere {} al progetto</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="980"/>
+        <source>A task of this dock is still running</source>
+        <translation>Un&apos;operazione di questo pannello è ancora in corso</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1003"/>
+        <source>Cancelled</source>
+        <translation>Interrotto</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1011"/>
+        <source>Cancellingu2026</source>
+        <translation>Interruzione…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1020"/>
+        <source>The block is not aligned yet: run Align images first</source>
+        <translation>Il blocco non è ancora allineato: esegui prima &apos;Allinea immagini&apos;</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1025"/>
+        <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
+        <translation>La compensazione richiede almeno 3 punti d&apos;appoggio con coordinate e misure; ce ne sono {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1040"/>
+        <source>Outliers left out: {}</source>
+        <translation>Valori anomali esclusi: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1041"/>
+        <source>Georeferenced in {}.</source>
+        <translation>Georeferenziato in {}.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1044"/>
+        <source>ArchaeoOrtho: georeference</source>
+        <translation>ArchaeoOrtho: georeferenzia</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1047"/>
+        <source>Georeferencing with {} control pointsu2026</source>
+        <translation>Georeferenziazione con {} punti d&apos;appoggio…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1053"/>
+        <source>Not georeferenced yet.</source>
+        <translation>Non ancora georeferenziato.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1055"/>
+        <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
+        <translation>Appoggio: RMSE XY {} m, Z {} m (n = {})</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1058"/>
+        <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
+        <translation>Controllo: RMSE XY {} m, Z {} m (n = {})</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1061"/>
+        <source>heights are placeholders: no vertical accuracy</source>
+        <translation>le quote sono segnaposto: nessuna accuratezza verticale</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1063"/>
+        <source>tie points {} px</source>
+        <translation>punti di legame {} px</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1065"/>
+        <source>edited since: re-run to update</source>
+        <translation>modificato da allora: riesegui per aggiornare</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="1075"/>
+        <source>ArchaeoOrtho: {}</source>
+        <translation>ArchaeoOrtho: {}</translation>
+    </message>
+</context>
+<context>
+    <name>GcpStore</name>
+    <message>
+        <location filename="../ui/store.py" line="194"/>
+        <source>a point named {} exists already</source>
+        <translation>esiste già un punto chiamato {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="182"/>
+        <source>add point {}</source>
+        <translation>aggiungi il punto {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="189"/>
+        <source>remove point {}</source>
+        <translation>rimuovi il punto {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="205"/>
+        <source>set {} of {}</source>
+        <translation>imposta {} di {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="218"/>
+        <source>place {} in {}</source>
+        <translation>misura {} in {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="226"/>
+        <source>remove {} from {}</source>
+        <translation>rimuovi {} da {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="251"/>
+        <source>set CRS</source>
+        <translation>imposta il SR</translation>
+    </message>
+</context>
+<context>
+    <name>GcpTableModel</name>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="81"/>
+        <source>Name</source>
+        <translation>Nome</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="81"/>
+        <source>X</source>
+        <translation>X</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="81"/>
+        <source>Y</source>
+        <translation>Y</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="81"/>
+        <source>Z</source>
+        <translation>Z</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="81"/>
+        <source>u03c3 XY</source>
+        <translation>σ XY</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="81"/>
+        <source>u03c3 Z</source>
+        <translation>σ Z</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="82"/>
+        <source>Role</source>
+        <translation>Ruolo</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="82"/>
+        <source>Obs.</source>
+        <translation>Mis.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="82"/>
+        <source>dXY (m)</source>
+        <translation>dXY (m)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="82"/>
+        <source>dZ (m)</source>
+        <translation>dZ (m)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="82"/>
+        <source>px</source>
+        <translation>px</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="85"/>
+        <source>check</source>
+        <translation>controllo</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="85"/>
+        <source>control</source>
+        <translation>appoggio</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="97"/>
+        <source>Horizontal residual after the adjustment (estimated from the photos minus given)</source>
+        <translation>Residuo planimetrico dopo la compensazione (stimato dalle foto meno dato)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="98"/>
+        <source>Vertical residual after the adjustment</source>
+        <translation>Residuo altimetrico dopo la compensazione</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="99"/>
+        <source>Mean reprojection error of the point&apos;s observations (pixels)</source>
+        <translation>Errore medio di riproiezione delle misure del punto (pixel)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="100"/>
+        <source>Number of photos the point is placed in</source>
+        <translation>Numero di foto in cui il punto è misurato</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="113"/>
+        <source>rejected as an outlier</source>
+        <translation>scartato come valore anomalo</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="115"/>
+        <source>not triangulated (fewer than 2 usable observations)</source>
+        <translation>non triangolato (meno di 2 misure utilizzabili)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="121"/>
+        <source>within the tolerance</source>
+        <translation>entro la tolleranza</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="123"/>
+        <source>up to 3 times the tolerance</source>
+        <translation>fino al triplo della tolleranza</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="124"/>
+        <source>more than 3 times the tolerance</source>
+        <translation>oltre il triplo della tolleranza</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="166"/>
+        <source>edited since the last adjustment: run Georeference to update</source>
+        <translation>modificato dopo l&apos;ultima compensazione: esegui &apos;Georeferenzia&apos; per aggiornare</translation>
+    </message>
+</context>
+<context>
+    <name>GeoreferenceAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="49"/>
+        <source>Workspace folder (aligned)</source>
+        <translation>Cartella dell&apos;area di lavoro (allineata)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="51"/>
+        <source>Ground control file (gcp_list.txt or CSV)</source>
+        <translation>File dei punti d&apos;appoggio (gcp_list.txt o CSV)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="54"/>
+        <source>Ground control point layer (one feature per observation)</source>
+        <translation>Layer dei punti d&apos;appoggio (un elemento per misura)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="57"/>
+        <source>Check points (comma-separated names)</source>
+        <translation>Punti di controllo (nomi separati da virgole)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="59"/>
+        <source>Camera positions (CSV)</source>
+        <translation>Posizioni delle camere (CSV)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="62"/>
+        <source>Use EXIF GPS camera positions</source>
+        <translation>Usa le posizioni GPS EXIF delle camere</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="64"/>
+        <source>Target CRS (default: the GCP file&apos;s)</source>
+        <translation>SR di destinazione (predefinito: quello del file dei punti d&apos;appoggio)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="66"/>
+        <source>Refine camera calibration in the adjustment</source>
+        <translation>Affina la calibrazione della camera nella compensazione</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="68"/>
+        <source>Workspace</source>
+        <translation>Area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="69"/>
+        <source>GCP residuals</source>
+        <translation>Residui dei punti d&apos;appoggio</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="70"/>
+        <source>Camera centres (world)</source>
+        <translation>Centri di presa (mondo)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="91"/>
+        <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS)</source>
+        <translation>Indica i punti d&apos;appoggio (GCPS o GCP_LAYER) e/o le posizioni delle camere (CAMERA_POSITIONS o USE_EXIF_GPS)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="102"/>
+        <source>outlier left out: {}</source>
+        <translation>valore anomalo escluso: {}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="106"/>
+        <source>CRS {}; control RMSE XY {} m, Z {} m; check RMSE XY {} m, Z {} m</source>
+        <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="119"/>
+        <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
+        <translation>Al layer dei punti d&apos;appoggio {} manca il campo &apos;{}&apos; (servono name, image, px, py)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Georeference</source>
+        <translation>Georeferenzia</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Fixes the aligned block in a real coordinate reference system with ground control points (GCPs) and/or camera positions, used inside the bundle adjustment so that they also remove the block&apos;s drift and bending, which a 7-parameter (Helmert) transform cannot. Check points take no part in the adjustment: they are triangulated afterwards and compared with their surveyed coordinates.
+
+GCPS: an OpenDroneMap gcp_list.txt (CRS line, then &apos;x y z px py image [name]&apos;) or a CSV points file with a matching &apos;&lt;name&gt;_observations.csv&apos;. GCP_LAYER: alternatively a point layer with one feature per observation and fields name, image, px, py (optional z, sx, sy, sz, role).
+CHECK_POINTS: comma-separated names that become check points.
+CAMERA_POSITIONS: CSV &apos;image,x,y,z[,sigma]&apos; (optional CRS line). USE_EXIF_GPS: use the photos&apos; GPS.
+Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.</source>
+        <translation>Fissa il blocco allineato in un sistema di riferimento reale con punti d&apos;appoggio (GCP) e/o posizioni delle camere, usati all&apos;interno della compensazione a stelle proiettive in modo che eliminino anche la deriva e la flessione del blocco, cosa che una trasformazione a 7 parametri (Helmert) non può fare. I punti di controllo non partecipano alla compensazione: vengono triangolati in seguito e confrontati con le loro coordinate rilevate.
+
+GCPS: un gcp_list.txt di OpenDroneMap (riga del SR, poi &apos;x y z px py image [name]&apos;) o un file CSV di punti con il corrispondente &apos;&lt;name&gt;_observations.csv&apos;. GCP_LAYER: in alternativa un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, sx, sy, sz, role).
+CHECK_POINTS: nomi separati da virgole che diventano punti di controllo.
+CAMERA_POSITIONS: CSV &apos;image,x,y,z[,sigma]&apos; (riga del SR facoltativa). USE_EXIF_GPS: usa il GPS delle foto.
+I valori anomali (una misura errata, un errore di battitura in una coordinata) sono individuati, nominati nel registro ed esclusi.</translation>
+    </message>
+</context>
+<context>
+    <name>OrthorectifyImageAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
+        <source>Image</source>
+        <translation>Immagine</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>DSM</source>
+        <translation>DSM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="65"/>
+        <source>Ground control file (gcp_list.txt or CSV)</source>
+        <translation>File dei punti d&apos;appoggio (gcp_list.txt o CSV)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="68"/>
+        <source>Ground control point layer (one feature per observation)</source>
+        <translation>Layer dei punti d&apos;appoggio (un elemento per misura)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="71"/>
+        <source>Known orientation (x y z omega phi kappa)</source>
+        <translation>Orientamento noto (x y z omega phi kappa)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="74"/>
+        <source>Focal length in mm (0 = from EXIF)</source>
+        <translation>Focale in mm (0 = dall&apos;EXIF)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="77"/>
+        <source>Sensor width (long side) in mm</source>
+        <translation>Larghezza del sensore (lato lungo) in mm</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="80"/>
+        <source>Mode</source>
+        <translation>Modalità</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="82"/>
+        <source>Resolution in CRS units (0 = ground sample distance)</source>
+        <translation>Risoluzione in unità del SR (0 = GSD)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="85"/>
+        <source>Output CRS (default: the GCPs&apos; or orientation&apos;s CRS)</source>
+        <translation>SR di output (predefinito: quello dei punti d&apos;appoggio o dell&apos;orientamento)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="87"/>
+        <source>Orthophoto</source>
+        <translation>Ortofoto</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="88"/>
+        <source>GCP residuals</source>
+        <translation>Residui dei punti d&apos;appoggio</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="90"/>
+        <source>GCP residual RMSE (pixels)</source>
+        <translation>RMSE dei residui dei punti d&apos;appoggio (pixel)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="91"/>
+        <source>Planar rectification: 95th percentile of its offset from the true position (CRS units)</source>
+        <translation>Raddrizzamento piano: 95° percentile del suo scostamento dalla posizione vera (unità del SR)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="107"/>
+        <source>Give ground control points observed in the image (GCPS or GCP_LAYER) or its orientation (ORIENTATION)</source>
+        <translation>Indica i punti d&apos;appoggio misurati nell&apos;immagine (GCPS o GCP_LAYER) o il suo orientamento (ORIENTATION)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="114"/>
+        <source>RESIDUALS must be a GeoPackage (.gpkg) file, got {}</source>
+        <translation>RESIDUALS deve essere un file GeoPackage (.gpkg), ricevuto {}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="129"/>
+        <source>{} ({}): {:.2f} px</source>
+        <translation>{} ({}): {:.2f} px</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="137"/>
+        <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
+        <translation>Al layer dei punti d&apos;appoggio {} manca il campo &apos;{}&apos; (servono name, image, px, py)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Orthorectify image</source>
+        <translation>Ortorettifica immagine</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Orthorectifies one photograph — also one that is not part of any block, such as a single oblique or an old print — on an existing DSM, for example an airborne laser scanning (ALS) DSM in any CRS (it is reprojected on the fly).
+
+The camera's position and attitude come from ground control points observed in the photo (space resection: at least 4 points; one wrong point among 5 or more is found and left out; with 6 or more the focal length and the radial distortion k1 are estimated too where the points determine them), or from a known orientation.
+
+IMAGE: the photo. DSM: height raster (needed for a true orthophoto).
+GCPS: an OpenDroneMap gcp_list.txt or CSV points file with observations in this image; or GCP_LAYER: a point layer with one feature per observation and fields name, image, px, py (optional z, role; pixel origin at the upper-left corner, y down).
+ORIENTATION: instead of GCPs, a file with x y z omega phi kappa (degrees, photogrammetric convention; a header row as Pix4D writes it, or JSON), optionally focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 and a CRS line.
+FOCAL_MM and SENSOR_WIDTH_MM: interior orientation (the sensor's long side); default the EXIF focal length.
+MODE: a true orthophoto on the DSM, or a planar (projective) rectification through the GCPs for comparison on flat ground; with a DSM the log and PLANAR_OFFSET_P95 say how far the planar result is off because of relief.
+RESIDUALS: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
+        <translation>Ortorettifica una fotografia — anche una che non fa parte di alcun blocco, come una singola obliqua o una vecchia stampa — su un DSM esistente, ad esempio un DSM da laser scanning aereo (ALS) in qualsiasi SR (riproiettato al volo).
+
+Posizione e assetto della camera derivano dai punti d&apos;appoggio misurati nella foto (resezione spaziale: almeno 4 punti; un punto errato su 5 o più viene individuato ed escluso; con 6 o più si stimano anche la focale e la distorsione radiale k1 dove i punti le determinano), oppure da un orientamento noto.
+
+IMAGE: la foto. DSM: raster delle quote (necessario per un&apos;ortofoto vera).
+GCPS: un gcp_list.txt di OpenDroneMap o un file CSV di punti con misure in questa immagine; oppure GCP_LAYER: un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, role; origine dei pixel nell&apos;angolo in alto a sinistra, y verso il basso).
+ORIENTATION: al posto dei punti d&apos;appoggio, un file con x y z omega phi kappa (gradi, convenzione fotogrammetrica; una riga di intestazione come la scrive Pix4D, o JSON), facoltativamente focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 e una riga del SR.
+FOCAL_MM e SENSOR_WIDTH_MM: orientamento interno (il lato lungo del sensore); predefinita la focale EXIF.
+MODE: un&apos;ortofoto vera sul DSM, o un raddrizzamento piano (proiettivo) tramite i punti d&apos;appoggio per confronto su terreno piatto; con un DSM il registro e PLANAR_OFFSET_P95 dicono di quanto il risultato piano si discosta a causa del rilievo.
+RESIDUALS: GeoPackage dei punti d&apos;appoggio con i loro residui in pixel (e in metri sul piano).</translation>
+    </message>
+</context>
+<context>
+    <name>PhotoPanel</name>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="422"/>
+        <source>Only photos that probably see the point</source>
+        <translation>Solo le foto che probabilmente vedono il punto</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="425"/>
+        <source>Fit</source>
+        <translation>Adatta</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="425"/>
+        <source>Show the whole photo (F)</source>
+        <translation>Mostra l&apos;intera foto (F)</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="426"/>
+        <source>Zoom to point</source>
+        <translation>Zoom sul punto</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="426"/>
+        <source>Zoom to the observation or prediction (Z)</source>
+        <translation>Zoom sulla misura o sulla previsione (Z)</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="428"/>
+        <source>Confirm</source>
+        <translation>Conferma</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="428"/>
+        <source>Accept the predicted position (Space)</source>
+        <translation>Accetta la posizione prevista (Spazio)</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="430"/>
+        <source>Confirm &amp;&amp; next</source>
+        <translation>Conferma &amp;&amp; avanti</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="430"/>
+        <source>Accept the prediction and show the next photo to place (Enter)</source>
+        <translation>Accetta la previsione e mostra la prossima foto da misurare (Invio)</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="433"/>
+        <source>Remove</source>
+        <translation>Rimuovi</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="433"/>
+        <source>Remove the observation in this photo (Delete)</source>
+        <translation>Rimuovi la misura in questa foto (Canc)</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="596"/>
+        <source>{} (predicted)</source>
+        <translation>{} (previsto)</translation>
+    </message>
+</context>
+<context>
+    <name>PrepareImagesAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="67"/>
+        <source>Folder of images</source>
+        <translation>Cartella delle immagini</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="69"/>
+        <source>Workspace folder</source>
+        <translation>Cartella dell&apos;area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="70"/>
+        <source>Smallest blur score (0 = only relative to the set)</source>
+        <translation>Punteggio di nitidezza minimo (0 = solo relativo all&apos;insieme)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="73"/>
+        <source>Leave flagged images out of the prepared folder</source>
+        <translation>Escludi le immagini segnalate dalla cartella preparata</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="75"/>
+        <source>Scanned film: fiducial marks, common frame, masks</source>
+        <translation>Pellicola scansionata: marche fiduciali, fotogramma comune, maschere</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="77"/>
+        <source>Calibrated fiducial coordinates in mm (file path or text)</source>
+        <translation>Coordinate calibrate delle marche fiduciali in mm (percorso di file o testo)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="80"/>
+        <source>Calibrated focal length in mm (0 = unknown)</source>
+        <translation>Focale calibrata in mm (0 = sconosciuta)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="84"/>
+        <source>Flag images below this fraction of the set&apos;s median blur score</source>
+        <translation>Segnala le immagini sotto questa frazione del punteggio di nitidezza mediano dell&apos;insieme</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="87"/>
+        <source>Fiducial mark type</source>
+        <translation>Tipo di marca fiduciale</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="89"/>
+        <source>Fiducial positions</source>
+        <translation>Posizioni delle marche fiduciali</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="91"/>
+        <source>Template image of one fiducial mark</source>
+        <translation>Immagine modello di una marca fiduciale</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <source>Scan resolution in dpi when not in the files (0 = from the files)</source>
+        <translation>Risoluzione di scansione in dpi se non nei file (0 = dai file)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
+        <source>Prepared images (skipped: &lt;workspace&gt;/prepared)</source>
+        <translation>Immagini preparate (se omesso: &lt;workspace&gt;/prepared)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="103"/>
+        <source>Folder of prepared images</source>
+        <translation>Cartella delle immagini preparate</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="104"/>
+        <source>Flagged images</source>
+        <translation>Immagini segnalate</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="105"/>
+        <source>Excluded images</source>
+        <translation>Immagini escluse</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="106"/>
+        <source>Screening record (JSON)</source>
+        <translation>Registro del controllo (JSON)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="138"/>
+        <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
+        <translation>{} immagini: {} segnalate, {} escluse, {} nella cartella preparata</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="140"/>
+        <source>Blurriest first (blur score, % of the set&apos;s median):</source>
+        <translation>Le più sfocate per prime (punteggio di nitidezza, % della mediana dell&apos;insieme):</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="148"/>
+        <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
+        <translation>Scansioni preparate: {} x {} px, dimensione del pixel {:.6g} {}{}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Prepare images</source>
+        <translation>Prepara immagini</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for &apos;Align images&apos;, and the WORKSPACE, which records a decision per image (screening.json) for the accuracy report.
+
+Blur score: variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged &apos;blurry&apos; below BLUR_RELATIVE x the median of the set, or below BLUR_THRESHOLD when that is set (absolute scores depend on the scene: sand scores far lower than roofs).
+Exposure: images with more than 5 % clipped highlights or shadows, a mean brightness far from the set&apos;s, or a very small dynamic range are flagged. EXCLUDE_FLAGGED leaves flagged images out of the prepared folder; otherwise they are kept and only reported.
+
+SCANNED_FILM: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. FIDUCIAL_COORDINATES: the calibration certificate&apos;s fiducial coordinates in mm, as a file or pasted text, one &apos;id x y&apos; line per mark (x right, y up), optionally &apos;PP x y&apos; (principal point) and &apos;focal f&apos;. Without them the mean layout of the set is used, centred on the fiducial centre. With FOCAL_LENGTH_MM (or &apos;focal&apos; in the certificate) the prepared images carry the focal length in pixels for the alignment.
+
+OUTPUT: the folder of prepared images (replaced as a whole; it must be new, empty or written by an earlier run); when skipped, &lt;workspace&gt;/prepared.</source>
+        <translation>Controlla una cartella di fotografie per sfocatura ed esposizione e, per le pellicole storiche scansionate, trova le marche fiduciali e ricampiona ogni scansione in un unico fotogramma della camera. Il risultato è una cartella di immagini preparate per &apos;Allinea immagini&apos; e il WORKSPACE, che registra una decisione per immagine (screening.json) per il rapporto di accuratezza.
+
+Punteggio di nitidezza: varianza del laplaciano su una copia in grigio larga 1024 px, 90° percentile di una griglia di 8 x 6 tasselli (cielo o acqua in una parte del fotogramma non vanno a suo sfavore). Più alto è più nitido. Un&apos;immagine è segnalata come &apos;sfocata&apos; sotto BLUR_RELATIVE x la mediana dell&apos;insieme, o sotto BLUR_THRESHOLD se impostato (i punteggi assoluti dipendono dalla scena: la sabbia ottiene molto meno dei tetti).
+Esposizione: vengono segnalate le immagini con più del 5 % di luci o ombre tagliate, una luminosità media lontana da quella dell&apos;insieme o una gamma dinamica molto ridotta. EXCLUDE_FLAGGED esclude le immagini segnalate dalla cartella preparata; altrimenti vengono mantenute e solo riportate.
+
+SCANNED_FILM: le marche fiduciali (croci, punti, punti in cerchi; negli angoli e/o a metà dei lati, o come un&apos;immagine modello di una marca) sono trovate con precisione sub-pixel, ogni scansione è ricampionata con una trasformazione affine nel fotogramma fiduciale comune, tutte della stessa dimensione e con il punto principale al centro, e delle maschere (workspace/masks) nascondono alla corrispondenza il bordo della pellicola, le strisce di dati e le marche. FIDUCIAL_COORDINATES: le coordinate delle marche fiduciali del certificato di calibrazione in mm, come file o testo incollato, una riga &apos;id x y&apos; per marca (x a destra, y in alto), facoltativamente &apos;PP x y&apos; (punto principale) e &apos;focal f&apos;. Senza di esse si usa la disposizione media dell&apos;insieme, centrata sul centro fiduciale. Con FOCAL_LENGTH_MM (o &apos;focal&apos; nel certificato) le immagini preparate riportano la focale in pixel per l&apos;allineamento.
+
+OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere nuova, vuota o scritta da un&apos;esecuzione precedente); se omessa, &lt;workspace&gt;/prepared.</translation>
+    </message>
+</context>
+<context>
+    <name>ResultLayers</name>
+    <message>
+        <location filename="../ui/layers.py" line="258"/>
+        <source>control (used)</source>
+        <translation>appoggio (usato)</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="259"/>
+        <source>check point</source>
+        <translation>punto di controllo</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="260"/>
+        <source>rejected (outlier)</source>
+        <translation>scartato (valore anomalo)</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="261"/>
+        <source>not triangulated</source>
+        <translation>non triangolato</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="342"/>
+        <source>DSM</source>
+        <translation>DSM</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="494"/>
+        <source>DSM hillshade</source>
+        <translation>Ombreggiatura del DSM</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="355"/>
+        <source>Orthomosaic</source>
+        <translation>Ortomosaico</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="366"/>
+        <source>Cameras</source>
+        <translation>Camere</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="505"/>
+        <source>Camera footprints</source>
+        <translation>Impronte delle immagini</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="512"/>
+        <source>GCP residuals (vectors x{})</source>
+        <translation>Residui dei punti d&apos;appoggio (vettori x{})</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="428"/>
+        <source>Point cloud</source>
+        <translation>Nuvola di punti</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="438"/>
+        <source>ArchaeoOrtho: {}</source>
+        <translation>ArchaeoOrtho: {}</translation>
     </message>
 </context>
 </TS>

@@ -114,9 +114,8 @@ def test_hook_registers_only_our_outputs(plugin, aligned):
 
 
 def test_dsm_pseudocolour_and_hillshade(tmp_path, qgis_new_project):
-    from qgis.core import QgsProject
-
     from archaeoortho.ui import layers
+    from qgis.core import QgsProject
 
     path = _raster(str(tmp_path / "dsm.tif"), 1, nodata=-9999)
     loaded = layers.load_dsm(path, QgsProject.instance(), "DSM group")
@@ -132,9 +131,8 @@ def test_dsm_pseudocolour_and_hillshade(tmp_path, qgis_new_project):
 
 
 def test_orthomosaic_rgb_with_transparent_alpha_or_nodata(tmp_path, qgis_new_project):
-    from qgis.core import QgsProject
-
     from archaeoortho.ui import layers
+    from qgis.core import QgsProject
 
     with_alpha = layers.load_orthomosaic(_raster(str(tmp_path / "a.tif"), 4, alpha=True), QgsProject.instance())[0]
     assert with_alpha.renderer().type() == "multibandcolor"

@@ -115,9 +115,10 @@ def _smooth_resampling(layer):
     try:
         from qgis.core import QgsRasterDataProvider, QgsRasterPipe
 
-        layer.setResamplingStage(QgsRasterPipe.ResamplingStage.Provider)
-        layer.dataProvider().setZoomedInResamplingMethod(QgsRasterDataProvider.ResamplingMethod.Bilinear)
-        layer.dataProvider().setZoomedOutResamplingMethod(QgsRasterDataProvider.ResamplingMethod.Bilinear)
+        provider = layer.dataProvider()
+        bilinear = QgsRasterDataProvider.ResamplingMethod.Bilinear
+        if provider.setZoomedInResamplingMethod(bilinear) and provider.setZoomedOutResamplingMethod(bilinear):
+            layer.setResamplingStage(QgsRasterPipe.ResamplingStage.Provider)
     except (AttributeError, ImportError):  # pragma: no cover - older QGIS
         pass
 
