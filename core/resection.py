@@ -471,7 +471,7 @@ def space_resection(xyz: np.ndarray, pixels: np.ndarray, camera: Intrinsics, nam
         for pose in _pnp(xyz[idx], xn[idx]):
             err = _errors(pose, camera, xyz, pixels)
             inl = err < thr
-            key = (int(inl.sum()), -float(np.sqrt(np.mean(np.minimum(err, 1e6) ** 2))))
+            key = (int(inl.sum()), -float(np.sqrt(np.mean(err[inl] ** 2))) if inl.any() else -1e9)
             if best is None or key > best[0]:
                 best = (key, pose)
     if best is None:
@@ -594,7 +594,7 @@ def fit_homography(pixels: np.ndarray, world_xy: np.ndarray, names: Optional[Seq
         hom = Homography(h, [], 0.0)
         err = np.hypot(*(hom.world_from_pixel(pixels) - world_xy).T)
         inl = err < max_residual_m
-        key = (int(inl.sum()), -float(np.sqrt(np.mean(np.minimum(err, 1e9) ** 2))))
+        key = (int(inl.sum()), -float(np.sqrt(np.mean(err[inl] ** 2))) if inl.any() else -1e9)
         if best is None or key > best[0]:
             best = (key, inl)
     if best is None:
