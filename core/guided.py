@@ -16,6 +16,11 @@ Three sources of a predicted position, best first:
     triangulated: a 7-parameter similarity world -> model is fitted to them (Umeyama) and the
     point's world coordinates are projected through it.
 
+Placeholder heights (every point given the same Z, as in OpenDroneMap files whose heights were never
+surveyed: COPR's 0, Toledo's 400) would put a point metres above or below the ground it marks, tens of
+pixels off in an oblique ray.  Then the height comes from the block itself: the median height of the
+tie points nearest to the point's X, Y; and the similarity of an aligned block is fitted to X and Y only.
+
 A projection counts only where the point is in front of the camera, lands inside the image (with a
 margin) and the lens model is trusted there: the pixel is undistorted back and must give the same
 ray, which rejects the wrap-around of distortion polynomials far outside the frame.
@@ -109,15 +114,21 @@ class Predictor:
     of the triangulation (a wrong click must not drag the predictions along).
     """
 
-    def __init__(self, rec, offset: Optional[Sequence[float]] = None, max_ray_error_px: float = 4.0):
+    def __init__(self, rec, offset: Optional[Sequence[float]] = None, max_ray_error_px: float = 4.0,
+                 surface_neighbours: int = 12):
         self.rec = rec
         self.offset = None if offset is None else np.asarray(offset, dtype=float).reshape(3)
         self.max_ray_error_px = float(max_ray_error_px)
+        self.surface_neighbours = int(surface_neighbours)
         self._lookup = _registered(rec)
         self._all = {im.name for im in rec.images.values()}
-        self._world_to_model = None  # (scale, R, t) of a Helmert fit, aligned blocks only
+        self._world_to_model = None  # (Similarity world - centre -> model, centre), aligned blocks only
         self.helmert_points: List[str] = []
         self.helmert_rms: Optional[float] = None  # metres (world units), on the fitted points
+        self.placeholder_z: Optional[float] = None  # the common Z of the points when heights are placeholders
+        self._tie = np.array([p.xyz for p in rec.points3D.values()], dtype=float).reshape(-1, 3)
+        self._tree = None  # KD-tree over the tie points' horizontal coordinates (world-aligned frame)
+        self._tree_xyz = None
 
     @property
     def georeferenced(self) -> bool:
@@ -139,11 +150,15 @@ class Predictor:
         return tri if tri.xyz is not None else None
 
     def fit(self, gcps: GCPSet) -> None:
-        """Prepare the world -> model similarity of an aligned block from the points already placed."""
+        """Prepare the world -> model similarity of an aligned block from the points already placed, and
+        notice placeholder heights."""
         self._world_to_model = None
         self.helmert_points = []
         self.helmert_rms = None
+        zs = [p.z for p in gcps.points if all(math.isfinite(v) for v in (p.x, p.y, p.z))]
+        self.placeholder_z = zs[0] if len(zs) >= 2 and max(zs) - min(zs) < 1e-6 else None
         if self.georeferenced:
+            self._set_surface(self._tie)
             return
         src, dst, names = [], [], []
         for p in gcps.points:
@@ -160,13 +175,41 @@ class Predictor:
         src_a, dst_a = np.asarray(src, dtype=float), np.asarray(dst, dtype=float)
         centre = src_a.mean(axis=0)  # keep UTM-size numbers out of the fit
         try:
-            sim = _similarity_fit(src_a - centre, dst_a)
-        except ValueError:  # collinear or coincident points
+            if self.placeholder_z is None:
+                sim = _similarity_fit(src_a - centre, dst_a)
+                res = sim.apply(src_a - centre) - dst_a
+                rms = float(np.sqrt(np.mean(np.sum(res ** 2, axis=1)))) / sim.scale
+            else:  # heights unknown: model -> world on X and Y only, then inverted
+                from .georef import _fit_similarity
+
+                m2w, r = _fit_similarity(dst_a, src_a - centre, xy_only=True)
+                sim = m2w.inverse()
+                rms = float(np.sqrt(np.mean(r ** 2)))
+        except (ValueError, np.linalg.LinAlgError):  # collinear or coincident points
             return
         self._world_to_model = (sim, centre)
         self.helmert_points = names
-        res = sim.apply(src_a - centre) - dst_a
-        self.helmert_rms = float(np.sqrt(np.mean(np.sum(res ** 2, axis=1)))) / sim.scale
+        self.helmert_rms = rms
+        if self.placeholder_z is not None:
+            self._set_surface(sim.inverse().apply(self._tie))
+
+    def _set_surface(self, xyz_world_aligned: np.ndarray) -> None:
+        self._tree_xyz = xyz_world_aligned
+        self._tree = None
+        if len(xyz_world_aligned) >= 1:
+            from scipy.spatial import cKDTree
+
+            self._tree = cKDTree(xyz_world_aligned[:, :2])
+
+    def surface_height(self, x: float, y: float) -> Optional[float]:
+        """Median height of the tie points nearest to (x, y), in the frame of ``_set_surface`` (local
+        for a georeferenced block, world minus the fit's centre for an aligned one)."""
+        if self._tree is None:
+            return None
+        k = min(self.surface_neighbours, len(self._tree_xyz))
+        _, idx = self._tree.query([x, y], k=k)
+        idx = np.atleast_1d(idx)
+        return float(np.median(self._tree_xyz[idx, 2]))
 
     def model_point(self, point: GroundPoint) -> Tuple[Optional[np.ndarray], Optional[str]]:
         """(xyz in the model frame, source) of a point, or (None, None) when it cannot be located yet."""
@@ -177,16 +220,25 @@ class Predictor:
             return None, None
         world = np.array([point.x, point.y, point.z], dtype=float)
         if self.georeferenced:
-            return world - self.offset, GEOREF
+            local = world - self.offset
+            if self.placeholder_z is not None:
+                z = self.surface_height(local[0], local[1])
+                local[2] = local[2] if z is None else z
+            return local, GEOREF
         if self._world_to_model is not None:
             sim, centre = self._world_to_model
-            return sim.apply((world - centre)[None])[0], HELMERT
+            w = world - centre
+            if self.placeholder_z is not None:
+                z = self.surface_height(w[0], w[1])
+                w[2] = w[2] if z is None else z
+            return sim.apply(w[None])[0], HELMERT
         return None, None
 
     def predict_point(self, point: GroundPoint, images: Optional[Sequence[str]] = None,
                       margin: float = 0.0) -> Dict[str, Prediction]:
         """{image: Prediction} for every registered image (or ``images``) that probably sees the point,
-        observed images included (their prediction shows how far the click is from the other rays)."""
+        observed images included (their prediction shows how far the click is from the other rays).
+        Call ``fit`` first (``predict`` does) so that the similarity and placeholder heights are known."""
         xyz, source = self.model_point(point)
         if xyz is None:
             return {}
@@ -312,5 +364,133 @@ def write_footprints_gpkg(path: str, footprints: Mapping[str, Sequence[Tuple[flo
     return path
 
 
-__all__ = ["GEOREF", "HELMERT", "RAYS", "Prediction", "Predictor", "ground_sample_distance", "image_footprints",
-           "images_seeing", "project_point", "write_footprints_gpkg"]
+
+
+# --------------------------------------------------------------------------------------------------
+# refinement by image matching
+# --------------------------------------------------------------------------------------------------
+
+
+@dataclass
+class Match:
+    x: float  # refined pixel in the target photo
+    y: float
+    score: float  # normalised cross-correlation of the best match, -1..1
+    margin: float  # best score minus the best score away from that peak (ambiguity: small is bad)
+    shift: float  # distance from the prediction (pixels)
+
+
+def read_gray(path: str) -> np.ndarray:
+    """A photo as an 8-bit grey array, pixels as stored (EXIF orientation not applied, as in COLMAP)."""
+    import cv2
+
+    img = cv2.imread(path, cv2.IMREAD_GRAYSCALE | cv2.IMREAD_IGNORE_ORIENTATION)
+    if img is None:
+        raise OSError(f"cannot read {path}")
+    return img
+
+
+def _camera_geometry(rec, name: str):
+    im = next(i for i in rec.images.values() if i.name == name)
+    cam = rec.cameras[im.camera_id]
+    m = np.asarray(im.cam_from_world().matrix())
+    return cam, m[:, :3], m[:, 3]
+
+
+def refine_by_matching(rec, ref_image: str, ref_xy: Sequence[float], ref_gray: np.ndarray,
+                       tgt_image: str, tgt_xy: Sequence[float], tgt_gray: np.ndarray, xyz_model: Sequence[float],
+                       radius: float = 250.0, half: int = 20, min_score: float = 0.6,
+                       min_margin: float = 0.08) -> Optional[Match]:
+    """Look for the point observed at ``ref_xy`` in ``ref_image`` around its predicted position ``tgt_xy``
+    in ``tgt_image``: the reference photo's neighbourhood of the point is re-projected into the target
+    photo's geometry through the plane that faces the reference camera at the point's depth (``xyz_model``
+    gives the depth), then searched by normalised cross-correlation within ``radius`` pixels.
+
+    Returns the sub-pixel match, or None when it is weak (score < ``min_score``), ambiguous (another peak
+    within ``min_margin`` of the best), at the edge of the search window, or out of the image.
+    ``*_gray``: the photos as 2-D uint8 / float arrays (pixel centres at +0.5, as everywhere)."""
+    import cv2
+
+    cam_r, rot_r, t_r = _camera_geometry(rec, ref_image)
+    cam_t, rot_t, t_t = _camera_geometry(rec, tgt_image)
+    c_r = -rot_r.T @ t_r
+    c_t = -rot_t.T @ t_t
+    xyz = np.asarray(xyz_model, dtype=float)
+    depth = float((rot_r @ xyz + t_r)[2])
+    if not depth > 0:
+        return None
+    ray = np.r_[np.asarray(cam_r.cam_from_img(np.asarray(ref_xy, dtype=float).reshape(1, 2))).reshape(2), 1.0]
+    x0 = c_r + depth * (rot_r.T @ ray)  # the observed point at the predicted depth
+    normal = rot_r.T @ np.array([0.0, 0.0, 1.0])  # plane facing the reference camera
+    p0 = project_point(rec, x0, [tgt_image], margin=-1e9)  # no frame test: the window is checked below
+    if tgt_image not in p0:
+        return None
+    p0 = np.array(p0[tgt_image][:2])
+    shift0 = np.asarray(tgt_xy, dtype=float) - p0  # search around the prediction, template centred on p0
+    r = int(math.ceil(radius + np.linalg.norm(shift0)))
+    ref = np.asarray(ref_gray, dtype=np.float32)
+    tgt = np.asarray(tgt_gray, dtype=np.float32)
+    # template: target pixels p0 + (du, dv) -> ray -> plane -> reference pixel; smaller near the frame's edge
+    for h in (half, (3 * half) // 4, half // 2):
+        if h < 6:
+            return None
+        du = np.arange(-h, h + 1, dtype=float)
+        uu, vv = np.meshgrid(du, du)
+        pix = np.column_stack([(p0[0] + uu).ravel(), (p0[1] + vv).ravel()])
+        rays = np.column_stack([np.asarray(cam_t.cam_from_img(pix), dtype=float), np.ones(len(pix))]) @ rot_t
+        denom = rays @ normal
+        if np.any(np.abs(denom) < 1e-9):
+            return None
+        s = ((x0 - c_t) @ normal) / denom
+        pts = c_t + s[:, None] * rays
+        xc = (pts @ rot_r.T) + t_r
+        if np.any(xc[:, 2] <= 0):
+            return None
+        ref_px = np.asarray(cam_r.img_from_cam(xc, check_cheirality=False), dtype=float)
+        mx = (ref_px[:, 0] - 0.5).reshape(uu.shape).astype(np.float32)
+        my = (ref_px[:, 1] - 0.5).reshape(uu.shape).astype(np.float32)
+        if mx.min() >= 0 and my.min() >= 0 and mx.max() <= ref.shape[1] - 1 and my.max() <= ref.shape[0] - 1:
+            half = h
+            break
+    else:
+        return None
+    templ = cv2.remap(ref, mx, my, cv2.INTER_LINEAR)
+    if float(templ.std()) < 2.0:
+        return None  # no texture to match
+    # search window in the target (integer pixel grid; pixel k has its centre at k + 0.5)
+    cx, cy = int(round(p0[0] - 0.5)), int(round(p0[1] - 0.5))
+    x_lo, x_hi = max(0, cx - r - half), min(tgt.shape[1], cx + r + half + 1)
+    y_lo, y_hi = max(0, cy - r - half), min(tgt.shape[0], cy + r + half + 1)
+    if x_hi - x_lo < 2 * half + 3 or y_hi - y_lo < 2 * half + 3:
+        return None
+    window = tgt[y_lo:y_hi, x_lo:x_hi]
+    ncc = cv2.matchTemplate(window, templ, cv2.TM_CCOEFF_NORMED)
+    _, best, _, (bx, by) = cv2.minMaxLoc(ncc)
+    if best < min_score:
+        return None
+    if not (0 < bx < ncc.shape[1] - 1 and 0 < by < ncc.shape[0] - 1):
+        return None  # on the edge of the window: the true peak may lie outside
+    masked = ncc.copy()
+    masked[max(0, by - half):by + half + 1, max(0, bx - half):bx + half + 1] = -1.0
+    second = float(masked.max()) if masked.size else -1.0
+    if best - second < min_margin:
+        return None
+    # sub-pixel: parabola through the peak and its neighbours
+    def vertex(a, b, c):
+        d = a - 2 * b + c
+        return 0.0 if abs(d) < 1e-12 else float(np.clip(0.5 * (a - c) / d, -0.5, 0.5))
+
+    sx = vertex(ncc[by, bx - 1], ncc[by, bx], ncc[by, bx + 1])
+    sy = vertex(ncc[by - 1, bx], ncc[by, bx], ncc[by + 1, bx])
+    # the template was sampled at p0 + (i - half, j - half); matched at window offset (bx, by), its centre
+    # sample (the point) sits on the centre of target pixel (x_lo + bx + half, y_lo + by + half)
+    x = x_lo + bx + half + 0.5 + sx
+    y = y_lo + by + half + 0.5 + sy
+    if not (0 <= x <= tgt.shape[1] and 0 <= y <= tgt.shape[0]):
+        return None
+    return Match(float(x), float(y), float(best), float(best - second),
+                 float(np.hypot(x - tgt_xy[0], y - tgt_xy[1])))
+
+
+__all__ = ["GEOREF", "HELMERT", "RAYS", "Match", "Prediction", "Predictor", "ground_sample_distance", "image_footprints",
+           "images_seeing", "project_point", "read_gray", "refine_by_matching", "write_footprints_gpkg"]

@@ -175,3 +175,38 @@ def test_empty_block_and_set():
     pred = guided.Predictor(pycolmap.Reconstruction())
     assert pred.predict(GCPSet("EPSG:32633")) == {}
     assert guided.ground_sample_distance(pycolmap.Reconstruction()) is None
+
+
+def test_matching_refines_a_prediction_that_is_tens_of_pixels_off(block, georeferenced, tmp_path):
+    """A point placed in one photo is found in another by correlation around a prediction 47 px off."""
+    from tests.test_ui_dock import quick_photos
+
+    result, _ = georeferenced
+    photos = quick_photos(block, str(tmp_path / "photos"))
+    gray = {n: guided.read_gray(p) for n, p in photos.items()}
+    rec = result.reconstruction
+    pred = guided.Predictor(rec, result.offset)
+    errs, found, tried = [], 0, 0
+    for p in block.gcps:
+        names = sorted(p.observations)
+        if len(names) < 2:
+            continue
+        ref, tgt = names[0], names[1]
+        xyz = p.xyz - (result.offset - syn.ORIGIN)  # the point in the adjusted local frame
+        truth = p.observations[tgt]
+        off = truth + np.array([40.0, -25.0])
+        tried += 1
+        m = guided.refine_by_matching(rec, ref, p.observations[ref], gray[ref], tgt, off, gray[tgt], xyz,
+                                      radius=120)
+        if m is None:
+            continue
+        found += 1
+        errs.append(float(np.hypot(m.x - truth[0], m.y - truth[1])))
+    errs = np.array(errs)
+    print(f"\n[matching] {found}/{tried} found, max {errs.max():.3f} px, mean {errs.mean():.3f} px")
+    assert found >= 0.8 * tried
+    assert errs.max() < 1.0
+    # nothing to find in a blank photo
+    blank = np.full_like(gray[ref], 128)
+    assert guided.refine_by_matching(rec, ref, p.observations[ref], gray[ref], tgt, truth, blank, xyz) is None
+    del pred

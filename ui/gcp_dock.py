@@ -8,6 +8,7 @@ core.pipeline adjusts); this module only translates clicks and keys into those c
 import math
 import os
 
+import numpy as np
 from qgis.core import (
     Qgis,
     QgsCoordinateTransform,
@@ -243,6 +244,9 @@ class GcpDock(QgsDockWidget):
         self.predictor = None
         self.predictor_note = ""
         self.predictions = {}  # image -> core.guided.Prediction for the selected point
+        self._last_point = None
+        self.matches = {}  # (point, image, observations) -> core.guided.Match or None: refined predictions
+        self._gray = {}  # image name -> grey array for matching (a few, most recent last)
         self.task = None
         self.last_task_error = None
         self.prev_tool = None
@@ -553,6 +557,18 @@ class GcpDock(QgsDockWidget):
     def _selection_changed(self):
         self._update_predictions()
         self._update_thumbnails()
+        name = self.current_name()
+        if name != getattr(self, "_last_point", None):
+            # another point: show the photo where it is to be placed next (or its first photo)
+            self._last_point = name
+            target = self.next_photo() if name else None
+            strip = self.photo_panel.thumbnail_names()
+            target = target or (strip[0] if name and strip and self.predictions else None)
+            if target and target != self.photo_panel.image and self.photo_panel.show_photo(target):
+                self._update_photo(zoom=True)
+                self._update_markers()
+                self._update_enabled()
+                return
         self._update_photo()
         self._update_markers()
         self._update_enabled()
@@ -697,10 +713,72 @@ class GcpDock(QgsDockWidget):
             return
         try:
             self.predictor.fit(self.store.gcps)
-            self.predictions = self.predictor.predict_point(point)
+            preds = self.predictor.predict_point(point)
+            if any(p.source != "rays" for p in preds.values()):
+                # positions from world coordinates can be off by the block's misfit to the control: offer
+                # the photos where the point lands near the frame too (matching may find it inside)
+                slack = -0.15 * max(self.predictor.rec.cameras[c].width for c in self.predictor.rec.cameras)
+                preds = self.predictor.predict_point(point, margin=slack)
+            self.predictions = preds
         except Exception as e:  # noqa: BLE001 - degenerate geometry: no predictions, say why
             self.message(self.tr("no predicted positions: {}").format(e), Qgis.Warning)
             self.predictions = {}
+
+    def _gray_image(self, name):
+        from ..core.guided import read_gray
+
+        if name not in self._gray:
+            path = next((im["path"] for im in self.store.images() if im["name"] == name), None)
+            if path is None:
+                return None
+            self._gray[name] = read_gray(path)
+            while len(self._gray) > 6:
+                self._gray.pop(next(iter(self._gray)))
+        return self._gray[name]
+
+    def refined_prediction(self, image):
+        """The prediction in ``image``, refined by matching the point's look in a photo where it is placed
+        (core.guided.refine_by_matching); the geometric prediction when matching finds nothing sure."""
+        from ..core import guided
+
+        pred = self.predictions.get(image)
+        point = self.current_point()
+        if pred is None or point is None or pred.source == guided.RAYS or not point.observations \
+                or self.predictor is None:
+            return pred, None
+        key = (point.name, image, tuple((o.image, round(o.x, 3), round(o.y, 3)) for o in point.observations),
+               round(pred.x, 2), round(pred.y, 2))
+        if key not in self.matches:
+            match = None
+            try:
+                xyz, _ = self.predictor.model_point(point)
+                cam = self.predictor.rec.cameras
+                size = max(max(c.width, c.height) for c in cam.values())
+                tgt = self._gray_image(image)
+                refs = sorted(point.observations, key=lambda o: self._baseline(o.image, image))
+                for ref in refs[:2]:
+                    match = guided.refine_by_matching(
+                        self.predictor.rec, ref.image, (ref.x, ref.y), self._gray_image(ref.image), image,
+                        pred.xy, tgt, xyz, radius=min(600.0, 0.3 * size))
+                    if match is not None:
+                        break
+            except Exception:  # noqa: BLE001 - matching is a help, never an obstacle
+                match = None
+            self.matches[key] = match
+        match = self.matches[key]
+        if match is None:
+            return pred, None
+        return guided.Prediction(pred.name, image, match.x, match.y, "matched", pred.centrality), match
+
+    def _baseline(self, a, b):
+        """Distance between two photos' projection centres (nearer photos look more alike)."""
+        try:
+            lookup = self.predictor._lookup
+            ca = np.asarray(lookup[a].projection_center())
+            cb = np.asarray(lookup[b].projection_center())
+            return float(np.linalg.norm(ca - cb))
+        except (KeyError, AttributeError):
+            return float("inf")
 
     def visible_photos(self):
         """Photos for the strip: all, or (filter on) the observed ones and those predicted to see the point."""
@@ -745,11 +823,14 @@ class GcpDock(QgsDockWidget):
                                if self.store.workspace is not None else "")
             return
         obs = next((o for o in point.observations if o.image == image), None)
-        pred = self.predictions.get(image)
+        pred, match = self.refined_prediction(image) if obs is None else (self.predictions.get(image), None)
         source = {"rays": self.tr("from the point's other observations"),
                   "georef": self.tr("from the georeferenced block"),
-                  "helmert": self.tr("from the points already placed (similarity fit)")}.get(
-            pred.source if pred else "", "")
+                  "helmert": self.tr("from the points already placed (similarity fit)"),
+                  "matched": self.tr("by matching its look in another photo")}.get(pred.source if pred else "", "")
+        if match is not None:
+            source += " " + self.tr("(correlation {:.2f}, {:.0f} px from the geometric prediction)").format(
+                match.score, match.shift)
         panel.set_markers(point.name, (obs.x, obs.y) if obs else None, (pred.x, pred.y) if pred else None, source)
         panel.set_next_available(self.next_photo() is not None)
         panel.title.setText(f"<b>{point.name}</b> \u2014 {image}")
@@ -781,7 +862,7 @@ class GcpDock(QgsDockWidget):
 
     def confirm_prediction(self, image=None):
         image = image or self.photo_panel.image
-        pred = self.predictions.get(image)
+        pred, _ = self.refined_prediction(image)
         name = self.current_name()
         if pred is None or name is None:
             return False
