@@ -63,14 +63,15 @@ class CoreTask(QgsTask):
         return False
 
     def finished(self, ok):
-        if ok:
-            if self.on_done is not None:
+        if not ok and self.isCanceled():
+            self.was_cancelled = True
+        try:
+            if ok and self.on_done is not None:
                 self.on_done(self.result)
-        else:
-            if self.isCanceled():
-                self.was_cancelled = True
-            if self.on_error is not None:
+            elif not ok and self.on_error is not None:
                 self.on_error(self.error or "cancelled", self.was_cancelled)
+        except RuntimeError as e:  # the dock was closed (plugin unloaded) while the task ran
+            QgsMessageLog.logMessage(f"{self.description()}: {e}", "ArchaeoOrtho", Qgis.Warning)
 
 
 def start(task):
