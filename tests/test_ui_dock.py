@@ -558,3 +558,53 @@ def test_screenshots_of_the_dock_and_the_photo_viewer(dock, georef_ws, block):
     for f in ("dock.png", "photo-viewer-prediction.png", "photo-viewer-zoomed.png"):
         assert os.path.getsize(os.path.join(SCREENSHOTS, f)) > 10000
     shutil.copy(os.path.join(georef_ws, "georef", "control.json"), os.path.join(SCREENSHOTS, "control.json"))
+
+
+def test_twenty_megapixel_photo_is_drawn_from_pyramid_tiles(tmp_path):
+    """A 5472 x 3648 photo: decoded once, drawn from the pyramid level that fits the zoom and only the
+    tiles in view; figures printed (pytest -s), no timing asserted."""
+    import cv2
+    from archaeoortho.ui.photo_viewer import TILE, PhotoPanel
+    from qgis.PyQt.QtCore import QPointF
+
+    rng = np.random.default_rng(3)
+    small = rng.integers(0, 255, (456, 684, 3), dtype=np.uint8)
+    img = cv2.resize(small, (5472, 3648), interpolation=cv2.INTER_CUBIC)
+    path = str(tmp_path / "big.jpg")
+    cv2.imwrite(path, img, [cv2.IMWRITE_JPEG_QUALITY, 90])
+    panel = PhotoPanel()
+    panel.resize(1000, 700)
+    panel.show()
+    process(100)
+    panel.set_photos({"big.jpg": path})
+    t0 = time.time()
+    assert panel.show_photo("big.jpg")
+    t_open = time.time() - t0
+    pyr = panel.pyramid("big.jpg")
+    assert (pyr.width, pyr.height) == (5472, 3648)
+    assert len(pyr.levels) >= 4
+    view = panel.view
+    process(100)
+    view.fit()
+    t0 = time.time()
+    view.viewport().repaint()
+    t_fit = time.time() - t0
+    level_fit = view.pyramid_item.last_level
+    tiles_fit = pyr.tiles_made
+    assert level_fit >= 2  # a coarse level for the whole photo
+    view.set_zoom(1.0, QPointF(2736.0, 1824.0))
+    t0 = time.time()
+    view.viewport().repaint()
+    t_full = time.time() - t0
+    assert view.pyramid_item.last_level == 0
+    visible = math.ceil(view.viewport().width() / TILE + 1) * math.ceil(view.viewport().height() / TILE + 1)
+    assert pyr.tiles_made - tiles_fit <= visible  # only the tiles in view, never the whole level
+    t0 = time.time()
+    for dx in range(10):  # panning: tiles come from the cache
+        view.horizontalScrollBar().setValue(view.horizontalScrollBar().value() + 40)
+        view.viewport().grab()
+    t_pan = (time.time() - t0) / 10
+    print(f"\n[20 MP photo] open (decode + pyramid) {t_open:.2f} s; repaint at fit {1000 * t_fit:.0f} ms "
+          f"(level {level_fit}); at 1:1 {1000 * t_full:.0f} ms; pan step {1000 * t_pan:.0f} ms; "
+          f"tiles made {pyr.tiles_made}")
+    panel.close()
