@@ -185,8 +185,8 @@ CAMERA_MODEL: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, 
 FOCAL_MM and SENSOR_WIDTH_MM: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres.</source>
         <translation>Structure from Motion: SIFT-Merkmale, Paarauswahl, robuste Zuordnung (RANSAC), inkrementelle Rekonstruktion mit Selbstkalibrierung (Brennweite, Bildhauptpunkt, Objektivverzeichnung) und eine abschließende Bündelblockausgleichung. Das Ergebnis wird im Ordner WORKSPACE gespeichert, den die folgenden Schritte (Georeferenzieren, DOM erzeugen, Orthophoto erzeugen) als Eingabe nehmen. Ein erneuter Lauf setzt fort: bereits berechnete Merkmale und Zuordnungen werden wiederverwendet.
 
-PAIRING: &apos;auto&apos; nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
-CAMERA_MODEL: &apos;AUTO&apos; schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
+PAIRING: 'auto' nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
+CAMERA_MODEL: 'AUTO' schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
 FOCAL_MM und SENSOR_WIDTH_MM: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern.</translation>
     </message>
 </context>
@@ -306,7 +306,7 @@ Re-running after a cancel resumes: pairs already matched are reused from &lt;wor
 
 Stereopaare werden aus dem dünnen Modell gewählt (gemeinsame Verknüpfungspunkte, Basis-Höhen-Verhältnis, Blickwinkel); jedes Paar wird aus den bekannten Orientierungen entzerrt und normalisiert und mit Semi-Global Matching (OpenCV SGBM) mit Links-Rechts-Prüfung zugeordnet; ein Pixel bleibt, wo mindestens zwei unabhängige Paare übereinstimmen. Die verschmolzenen Punkte werden gerastert (Median der höchsten Höhengruppe je Zelle), kleine Lücken gefüllt und große als NoData belassen.
 
-WORKSPACE: ein georeferenzierter Arbeitsbereich (zuerst &apos;Georeferenzieren&apos; ausführen: ein DOM braucht einen metrischen Maßstab und eine Lotrichtung, ein nur orientierter Arbeitsbereich wird abgelehnt).
+WORKSPACE: ein georeferenzierter Arbeitsbereich (zuerst 'Georeferenzieren' ausführen: ein DOM braucht einen metrischen Maßstab und eine Lotrichtung, ein nur orientierter Arbeitsbereich wird abgelehnt).
 RESOLUTION: DOM-Zellgröße in Metern; 0 = etwa die doppelte mittlere Bodenauflösung (GSD).
 QUALITY: Bildmaßstab für die Zuordnung (voll, halb, viertel): halb ist viermal schneller als voll.
 ENGINE: cpu (Vorgabe); cuda führt COLMAPs Patch-Match-Stereo aus, wo pycolmap mit CUDA gebaut wurde.
@@ -416,9 +416,9 @@ SEAMLINES: optional GeoPackage of polygons naming the image each part of the mos
 
 Jede Zelle nimmt ihre Höhe aus dem DOM und wird über das vollständige Kameramodell (Orientierung, Brennweite, Bildhauptpunkt, Objektivverzeichnung) in die Bilder projiziert. Eine Zelle, die in einem Bild von höherer Oberfläche verdeckt ist (eine Mauer, ein Baum, ein Hügel), bleibt aus diesem Bild weg, so dass Gebäude nicht kippen und nichts doppelt erscheint; das Mosaik füllt sie aus einem Bild, das sie sieht. Jeder Teil des Mosaiks stammt aus dem Bild, das am senkrechtesten und am nächsten zu seiner Mitte darauf blickt; Nahtlinien laufen um Gebäude und Bäume; Helligkeitsunterschiede zwischen den Bildern werden ausgeglichen und Nähte überblendet.
 
-WORKSPACE: ein georeferenzierter Arbeitsbereich mit DOM (zuerst &apos;DOM erzeugen&apos; ausführen) oder DSM angeben.
+WORKSPACE: ein georeferenzierter Arbeitsbereich mit DOM (zuerst 'DOM erzeugen' ausführen) oder DSM angeben.
 DSM: optionales Raster (z. B. ein ALS-DOM, in beliebigem KBS: wird im Lauf umprojiziert); Vorgabe ist das DOM des Arbeitsbereichs.
-IMAGES_FILTER: eine Auswahl, z. B. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; oder &apos;group:NIR&apos; (eine Kameragruppe nach Nummer oder Hersteller/Modell), &apos;!name&apos; lässt eines weg. Leer: alle Bilder.
+IMAGES_FILTER: eine Auswahl, z. B. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' oder 'group:NIR' (eine Kameragruppe nach Nummer oder Hersteller/Modell), '!name' lässt eines weg. Leer: alle Bilder.
 RESOLUTION: Zellgröße in KBS-Einheiten; 0 = die Bodenauflösung der Bilder.
 BLENDING: feather (Rampe über die Nähte), multiband (Laplace-Pyramide: keine sichtbare Naht in der Helligkeit und keine Geisterbilder), none (harter Schnitt).
 OUTPUT: Cloud-Optimized GeoTIFF mit Übersichten, den Kanälen und dem Datentyp der Bilder (8/16 Bit bleiben) und einem Alphakanal (Vorgabe &lt;workspace&gt;/orthomosaic.tif).
@@ -429,509 +429,519 @@ SEAMLINES: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem jed
 <context>
     <name>GcpDock</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="241"/>
+        <location filename="../ui/gcp_dock.py" line="242"/>
         <source>ArchaeoOrtho ground control</source>
         <translation>ArchaeoOrtho Passpunkte</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="254"/>
+        <location filename="../ui/gcp_dock.py" line="258"/>
         <source>ArchaeoOrtho photos</source>
         <translation>ArchaeoOrtho Fotos</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="270"/>
+        <location filename="../ui/gcp_dock.py" line="274"/>
         <source>Workspace:</source>
         <translation>Arbeitsbereich:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="447"/>
+        <location filename="../ui/gcp_dock.py" line="451"/>
         <source>none open</source>
         <translation>keiner geöffnet</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="275"/>
+        <location filename="../ui/gcp_dock.py" line="279"/>
         <source>Openu2026</source>
         <translation>Öffnen…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="276"/>
+        <location filename="../ui/gcp_dock.py" line="280"/>
         <source>Open a workspace folder (made by Align images)</source>
-        <translation>Einen Arbeitsbereich-Ordner öffnen (von &apos;Bilder ausrichten&apos; angelegt)</translation>
+        <translation>Einen Arbeitsbereich-Ordner öffnen (von 'Bilder ausrichten' angelegt)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="277"/>
+        <location filename="../ui/gcp_dock.py" line="281"/>
         <source>New from photosu2026</source>
         <translation>Neu aus Fotos…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="278"/>
+        <location filename="../ui/gcp_dock.py" line="282"/>
         <source>Choose a folder of photos and a workspace folder, and align the photos</source>
         <translation>Einen Fotoordner und einen Arbeitsbereich-Ordner wählen und die Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="284"/>
+        <location filename="../ui/gcp_dock.py" line="288"/>
         <source>Heights (Z) from:</source>
         <translation>Höhen (Z) aus:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="289"/>
+        <location filename="../ui/gcp_dock.py" line="293"/>
         <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
         <translation>Ein DOM- oder DGM-Rasterlayer (z. B. ein ALS-DOM): ein auf der Karte gemessener Punkt erhält seine Höhe daraus (bilinear). Leer: Z von Hand eingeben.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="829"/>
+        <location filename="../ui/gcp_dock.py" line="910"/>
         <source>Add</source>
         <translation>Hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="299"/>
+        <location filename="../ui/gcp_dock.py" line="303"/>
         <source>Add a ground point</source>
         <translation>Einen Passpunkt hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="300"/>
+        <location filename="../ui/gcp_dock.py" line="304"/>
         <source>Remove</source>
         <translation>Entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="301"/>
+        <location filename="../ui/gcp_dock.py" line="305"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Den gewählten Passpunkt mit seinen Messungen entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="302"/>
+        <location filename="../ui/gcp_dock.py" line="306"/>
         <source>Pick on map</source>
         <translation>Auf der Karte messen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="304"/>
+        <location filename="../ui/gcp_dock.py" line="308"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>In die Kartenansicht klicken, um X und Y des gewählten Punkts zu setzen (Z aus dem Höhenlayer)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="307"/>
+        <location filename="../ui/gcp_dock.py" line="311"/>
         <source>From file (gcp_list.txt, CSV)u2026</source>
         <translation>Aus Datei (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="308"/>
+        <location filename="../ui/gcp_dock.py" line="312"/>
         <source>From a point layeru2026</source>
         <translation>Aus einem Punktlayer…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="310"/>
+        <location filename="../ui/gcp_dock.py" line="314"/>
         <source>To file (gcp_list.txt, CSV)u2026</source>
         <translation>In Datei (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="311"/>
+        <location filename="../ui/gcp_dock.py" line="315"/>
         <source>To a GeoPackage layeru2026</source>
         <translation>In einen GeoPackage-Layer…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="312"/>
+        <location filename="../ui/gcp_dock.py" line="316"/>
         <source>Import</source>
         <translation>Importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="312"/>
+        <location filename="../ui/gcp_dock.py" line="316"/>
         <source>Export</source>
         <translation>Exportieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="319"/>
+        <location filename="../ui/gcp_dock.py" line="323"/>
         <source>Undo</source>
         <translation>Rückgängig</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="320"/>
+        <location filename="../ui/gcp_dock.py" line="324"/>
         <source>Redo</source>
         <translation>Wiederholen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="327"/>
+        <location filename="../ui/gcp_dock.py" line="331"/>
         <source>Undo: {}</source>
         <translation>Rückgängig: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="328"/>
+        <location filename="../ui/gcp_dock.py" line="332"/>
         <source>Redo: {}</source>
         <translation>Wiederholen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="333"/>
+        <location filename="../ui/gcp_dock.py" line="337"/>
         <source>Load results</source>
         <translation>Ergebnisse laden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="334"/>
+        <location filename="../ui/gcp_dock.py" line="338"/>
         <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Die Produkte des Arbeitsbereichs als gestaltete Layer zur Karte hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="351"/>
+        <location filename="../ui/gcp_dock.py" line="355"/>
         <source>Residual tolerance:</source>
         <translation>Residuen-Toleranz:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="357"/>
+        <location filename="../ui/gcp_dock.py" line="361"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="359"/>
+        <location filename="../ui/gcp_dock.py" line="363"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="360"/>
+        <location filename="../ui/gcp_dock.py" line="364"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Die Ausgleichung Brennweite, Bildhauptpunkt und Verzeichnung verfeinern lassen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="366"/>
+        <location filename="../ui/gcp_dock.py" line="370"/>
         <source>Georeference</source>
         <translation>Georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="367"/>
+        <location filename="../ui/gcp_dock.py" line="371"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Die Ausgleichung mit diesen Punkten ausführen (im Hintergrund)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="368"/>
+        <location filename="../ui/gcp_dock.py" line="372"/>
         <source>Cancel</source>
         <translation>Abbrechen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="424"/>
+        <location filename="../ui/gcp_dock.py" line="428"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="431"/>
+        <location filename="../ui/gcp_dock.py" line="435"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Einen ArchaeoOrtho-Arbeitsbereich öffnen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="468"/>
+        <location filename="../ui/gcp_dock.py" line="472"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
-        <translation>{} Fotos; der Block ist noch nicht ausgerichtet: &apos;Bilder ausrichten&apos; (oder &apos;Neu aus Fotos&apos;) ausführen, um vorhergesagte Positionen zu erhalten</translation>
+        <translation>{} Fotos; der Block ist noch nicht ausgerichtet: 'Bilder ausrichten' (oder 'Neu aus Fotos') ausführen, um vorhergesagte Positionen zu erhalten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="471"/>
+        <location filename="../ui/gcp_dock.py" line="475"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} Fotos, {} Passpunkte. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="702"/>
+        <location filename="../ui/gcp_dock.py" line="724"/>
         <source>no predicted positions: {}</source>
         <translation>keine vorhergesagten Positionen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="504"/>
+        <location filename="../ui/gcp_dock.py" line="508"/>
         <source>Predicted positions from the georeferenced block.</source>
         <translation>Vorhergesagte Positionen aus dem georeferenzierten Block.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="504"/>
+        <location filename="../ui/gcp_dock.py" line="508"/>
         <source>Predicted positions once a point is placed in 2 photos, and for every point once 3 points are placed.</source>
         <translation>Vorhergesagte Positionen, sobald ein Punkt in 2 Fotos gemessen ist, und für alle Punkte, sobald 3 Punkte gemessen sind.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="510"/>
+        <location filename="../ui/gcp_dock.py" line="514"/>
         <source>Folder of photos</source>
         <translation>Fotoordner</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="513"/>
+        <location filename="../ui/gcp_dock.py" line="517"/>
         <source>Workspace folder (new or existing)</source>
         <translation>Arbeitsbereich-Ordner (neu oder vorhanden)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="525"/>
+        <location filename="../ui/gcp_dock.py" line="529"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
         <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="529"/>
+        <location filename="../ui/gcp_dock.py" line="533"/>
         <source>ArchaeoOrtho: align photos</source>
         <translation>ArchaeoOrtho: Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="596"/>
+        <location filename="../ui/gcp_dock.py" line="612"/>
         <source>CRS: {}</source>
         <translation>KBS: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="623"/>
+        <location filename="../ui/gcp_dock.py" line="639"/>
         <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Auf der Karte an die Position des gewählten Punkts klicken (Esc beendet)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="662"/>
+        <location filename="../ui/gcp_dock.py" line="678"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (aus {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="665"/>
+        <location filename="../ui/gcp_dock.py" line="681"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Keine Höhe an dieser Stelle in {}: Z bleibt unverändert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="668"/>
+        <location filename="../ui/gcp_dock.py" line="684"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="725"/>
+        <location filename="../ui/gcp_dock.py" line="803"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="729"/>
+        <location filename="../ui/gcp_dock.py" line="807"/>
         <source>predicted</source>
         <translation>vorhergesagt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="744"/>
+        <location filename="../ui/gcp_dock.py" line="822"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Einen Passpunkt in der Tabelle wählen oder hinzufügen, dann im Foto darauf klicken.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="749"/>
+        <location filename="../ui/gcp_dock.py" line="827"/>
         <source>from the point&apos;s other observations</source>
         <translation>aus den übrigen Messungen des Punkts</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="750"/>
+        <location filename="../ui/gcp_dock.py" line="828"/>
         <source>from the georeferenced block</source>
         <translation>aus dem georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="751"/>
+        <location filename="../ui/gcp_dock.py" line="829"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>aus den bereits gemessenen Punkten (Ähnlichkeitstransformation)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="757"/>
+        <location filename="../ui/gcp_dock.py" line="838"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Gemessen bei x {:.2f}, y {:.2f}. Klicken zum Versetzen, ziehen oder Entf zum Entfernen.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="760"/>
+        <location filename="../ui/gcp_dock.py" line="841"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Vorhergesagt {}. Eingabetaste übernimmt und geht weiter (Leertaste: übernehmen), ziehen oder dorthin klicken, wo der Punkt wirklich ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="763"/>
+        <location filename="../ui/gcp_dock.py" line="844"/>
         <source>Click where {} is in this photo.</source>
         <translation>Dorthin klicken, wo {} in diesem Foto ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="773"/>
+        <location filename="../ui/gcp_dock.py" line="854"/>
         <source>Select or add a ground point first</source>
         <translation>Zuerst einen Passpunkt wählen oder hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="812"/>
+        <location filename="../ui/gcp_dock.py" line="893"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: jedes Foto, das ihn voraussichtlich zeigt, hat eine Messung</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="869"/>
+        <location filename="../ui/gcp_dock.py" line="950"/>
         <source>Import ground control</source>
         <translation>Passpunkte importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="817"/>
+        <location filename="../ui/gcp_dock.py" line="898"/>
         <source>Ground control (*.txt *.csv);;All files (*)</source>
         <translation>Passpunkte (*.txt *.csv);;Alle Dateien (*)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="825"/>
+        <location filename="../ui/gcp_dock.py" line="906"/>
         <source>Replace the current points, or add the imported ones to them (same names are updated)?</source>
         <translation>Die vorhandenen Punkte ersetzen oder die importierten hinzufügen (gleichnamige werden aktualisiert)?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="828"/>
+        <location filename="../ui/gcp_dock.py" line="909"/>
         <source>Replace</source>
         <translation>Ersetzen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="851"/>
+        <location filename="../ui/gcp_dock.py" line="932"/>
         <source>import {}</source>
         <translation>{} importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="853"/>
+        <location filename="../ui/gcp_dock.py" line="934"/>
         <source>warnings</source>
         <translation>Warnungen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="854"/>
+        <location filename="../ui/gcp_dock.py" line="935"/>
         <source>Imported {} points and {} observations from {}</source>
         <translation>{} Punkte und {} Messungen aus {} importiert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="866"/>
+        <location filename="../ui/gcp_dock.py" line="947"/>
         <source>No point layer in the project</source>
         <translation>Kein Punktlayer im Projekt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="869"/>
+        <location filename="../ui/gcp_dock.py" line="950"/>
         <source>Point layer (one feature per observation: name, image, px, py)</source>
         <translation>Punktlayer (ein Objekt je Messung: name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="882"/>
+        <location filename="../ui/gcp_dock.py" line="963"/>
         <source>Layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
-        <translation>Dem Layer {} fehlt das Feld &apos;{}&apos; (benötigt name, image, px, py)</translation>
+        <translation>Dem Layer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="908"/>
+        <location filename="../ui/gcp_dock.py" line="989"/>
         <source>OpenDroneMap gcp_list (*.txt)</source>
         <translation>OpenDroneMap gcp_list (*.txt)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="908"/>
+        <location filename="../ui/gcp_dock.py" line="989"/>
         <source>CSV points + observations (*.csv)</source>
         <translation>CSV-Punkte + Messungen (*.csv)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="909"/>
+        <location filename="../ui/gcp_dock.py" line="990"/>
         <source>Export ground control</source>
         <translation>Passpunkte exportieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="920"/>
+        <location filename="../ui/gcp_dock.py" line="1001"/>
         <source>The points have no CRS yet: pick one on the map or import a file first</source>
         <translation>Die Punkte haben noch kein KBS: zuerst einen auf der Karte messen oder eine Datei importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="929"/>
+        <location filename="../ui/gcp_dock.py" line="1010"/>
         <source>Exported {} points to {}</source>
         <translation>{} Punkte nach {} exportiert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="929"/>
+        <location filename="../ui/gcp_dock.py" line="1010"/>
         <source> ({} without coordinates left out)</source>
         <translation> ({} ohne Koordinaten ausgelassen)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="934"/>
+        <location filename="../ui/gcp_dock.py" line="1015"/>
         <source>Export ground control as a layer</source>
         <translation>Passpunkte als Layer exportieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="934"/>
+        <location filename="../ui/gcp_dock.py" line="1015"/>
         <source>GeoPackage (*.gpkg)</source>
         <translation>GeoPackage (*.gpkg)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="965"/>
+        <location filename="../ui/gcp_dock.py" line="1046"/>
         <source>Cannot write {}: {}</source>
         <translation>{} kann nicht geschrieben werden: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="968"/>
+        <location filename="../ui/gcp_dock.py" line="1049"/>
         <source>Exported {} observations to {}</source>
         <translation>{} Messungen nach {} exportiert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="968"/>
+        <location filename="../ui/gcp_dock.py" line="1049"/>
         <source> (points without observations left out: {})</source>
         <translation> (Punkte ohne Messungen ausgelassen: {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="972"/>
+        <location filename="../ui/gcp_dock.py" line="1053"/>
         <source>GCP observations</source>
         <translation>Passpunktmessungen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="974"/>
+        <location filename="../ui/gcp_dock.py" line="1055"/>
         <source>Cannot add {} to the project</source>
         <translation>{} kann nicht zum Projekt hinzugefügt werden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="980"/>
+        <location filename="../ui/gcp_dock.py" line="1061"/>
         <source>A task of this dock is still running</source>
         <translation>Eine Aufgabe dieses Fensters läuft noch</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1003"/>
+        <location filename="../ui/gcp_dock.py" line="1084"/>
         <source>Cancelled</source>
         <translation>Abgebrochen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1011"/>
+        <location filename="../ui/gcp_dock.py" line="1092"/>
         <source>Cancellingu2026</source>
         <translation>Wird abgebrochen…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1020"/>
+        <location filename="../ui/gcp_dock.py" line="1101"/>
         <source>The block is not aligned yet: run Align images first</source>
-        <translation>Der Block ist noch nicht ausgerichtet: zuerst &apos;Bilder ausrichten&apos; ausführen</translation>
+        <translation>Der Block ist noch nicht ausgerichtet: zuerst 'Bilder ausrichten' ausführen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1025"/>
+        <location filename="../ui/gcp_dock.py" line="1106"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>Die Ausgleichung braucht mindestens 3 Passpunkte mit Koordinaten und Messungen; vorhanden sind {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1040"/>
+        <location filename="../ui/gcp_dock.py" line="1121"/>
         <source>Outliers left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1041"/>
+        <location filename="../ui/gcp_dock.py" line="1122"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziert in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1044"/>
+        <location filename="../ui/gcp_dock.py" line="1125"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1047"/>
+        <location filename="../ui/gcp_dock.py" line="1128"/>
         <source>Georeferencing with {} control pointsu2026</source>
         <translation>Georeferenzierung mit {} Passpunkten…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1053"/>
+        <location filename="../ui/gcp_dock.py" line="1134"/>
         <source>Not georeferenced yet.</source>
         <translation>Noch nicht georeferenziert.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1055"/>
+        <location filename="../ui/gcp_dock.py" line="1136"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Passpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1058"/>
+        <location filename="../ui/gcp_dock.py" line="1139"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Kontrollpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1061"/>
+        <location filename="../ui/gcp_dock.py" line="1142"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>Höhen sind Platzhalter: keine Höhengenauigkeit</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1063"/>
+        <location filename="../ui/gcp_dock.py" line="1144"/>
         <source>tie points {} px</source>
         <translation>Verknüpfungspunkte {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1065"/>
+        <location filename="../ui/gcp_dock.py" line="1146"/>
         <source>edited since: re-run to update</source>
         <translation>seither bearbeitet: erneut ausführen zum Aktualisieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1075"/>
+        <location filename="../ui/gcp_dock.py" line="1156"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="830"/>
+        <source>by matching its look in another photo</source>
+        <translation>durch Abgleich mit seinem Aussehen in einem anderen Foto</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="832"/>
+        <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
+        <translation>(Korrelation {:.2f}, {:.0f} px von der geometrischen Vorhersage)</translation>
     </message>
 </context>
 <context>
@@ -975,119 +985,119 @@ SEAMLINES: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem jed
 <context>
     <name>GcpTableModel</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="82"/>
         <source>Name</source>
         <translation>Name</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="82"/>
         <source>X</source>
         <translation>X</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="82"/>
         <source>Y</source>
         <translation>Y</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="82"/>
         <source>Z</source>
         <translation>Z</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="82"/>
         <source>u03c3 XY</source>
         <translation>σ XY</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="82"/>
         <source>u03c3 Z</source>
         <translation>σ Z</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82"/>
+        <location filename="../ui/gcp_dock.py" line="83"/>
         <source>Role</source>
         <translation>Rolle</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82"/>
+        <location filename="../ui/gcp_dock.py" line="83"/>
         <source>Obs.</source>
         <translation>Mess.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82"/>
+        <location filename="../ui/gcp_dock.py" line="83"/>
         <source>dXY (m)</source>
         <translation>dXY (m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82"/>
+        <location filename="../ui/gcp_dock.py" line="83"/>
         <source>dZ (m)</source>
         <translation>dZ (m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82"/>
+        <location filename="../ui/gcp_dock.py" line="83"/>
         <source>px</source>
         <translation>px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="85"/>
+        <location filename="../ui/gcp_dock.py" line="86"/>
         <source>check</source>
         <translation>Kontrolle</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="85"/>
+        <location filename="../ui/gcp_dock.py" line="86"/>
         <source>control</source>
         <translation>Passpunkt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="97"/>
+        <location filename="../ui/gcp_dock.py" line="98"/>
         <source>Horizontal residual after the adjustment (estimated from the photos minus given)</source>
         <translation>Lageresiduum nach der Ausgleichung (aus den Fotos geschätzt minus gegeben)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="98"/>
+        <location filename="../ui/gcp_dock.py" line="99"/>
         <source>Vertical residual after the adjustment</source>
         <translation>Höhenresiduum nach der Ausgleichung</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="99"/>
+        <location filename="../ui/gcp_dock.py" line="100"/>
         <source>Mean reprojection error of the point&apos;s observations (pixels)</source>
         <translation>Mittlerer Rückprojektionsfehler der Messungen des Punkts (Pixel)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="100"/>
+        <location filename="../ui/gcp_dock.py" line="101"/>
         <source>Number of photos the point is placed in</source>
         <translation>Anzahl der Fotos, in denen der Punkt gemessen ist</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="113"/>
+        <location filename="../ui/gcp_dock.py" line="114"/>
         <source>rejected as an outlier</source>
         <translation>als Ausreißer verworfen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="115"/>
+        <location filename="../ui/gcp_dock.py" line="116"/>
         <source>not triangulated (fewer than 2 usable observations)</source>
         <translation>nicht trianguliert (weniger als 2 brauchbare Messungen)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="121"/>
+        <location filename="../ui/gcp_dock.py" line="122"/>
         <source>within the tolerance</source>
         <translation>innerhalb der Toleranz</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="123"/>
+        <location filename="../ui/gcp_dock.py" line="124"/>
         <source>up to 3 times the tolerance</source>
         <translation>bis zum Dreifachen der Toleranz</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="124"/>
+        <location filename="../ui/gcp_dock.py" line="125"/>
         <source>more than 3 times the tolerance</source>
         <translation>mehr als das Dreifache der Toleranz</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="166"/>
+        <location filename="../ui/gcp_dock.py" line="167"/>
         <source>edited since the last adjustment: run Georeference to update</source>
-        <translation>seit der letzten Ausgleichung bearbeitet: &apos;Georeferenzieren&apos; ausführen zum Aktualisieren</translation>
+        <translation>seit der letzten Ausgleichung bearbeitet: 'Georeferenzieren' ausführen zum Aktualisieren</translation>
     </message>
 </context>
 <context>
@@ -1165,7 +1175,7 @@ SEAMLINES: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem jed
     <message>
         <location filename="../processing_provider/georeference.py" line="119"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
-        <translation>Dem Passpunktlayer {} fehlt das Feld &apos;{}&apos; (benötigt name, image, px, py)</translation>
+        <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1182,9 +1192,9 @@ CAMERA_POSITIONS: CSV &apos;image,x,y,z[,sigma]&apos; (optional CRS line). USE_E
 Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.</source>
         <translation>Legt den ausgerichteten Block mit Passpunkten (GCPs) und/oder Kamerapositionen in einem echten Koordinatenbezugssystem fest. Sie wirken in der Bündelblockausgleichung, so dass sie auch Drift und Verbiegung des Blocks beseitigen, was eine 7-Parameter-Transformation (Helmert) nicht kann. Kontrollpunkte nehmen an der Ausgleichung nicht teil: sie werden danach trianguliert und mit ihren vermessenen Koordinaten verglichen.
 
-GCPS: eine OpenDroneMap gcp_list.txt (KBS-Zeile, dann &apos;x y z px py image [name]&apos;) oder eine CSV-Punktdatei mit passender &apos;&lt;name&gt;_observations.csv&apos;. GCP_LAYER: alternativ ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, sx, sy, sz, role).
+GCPS: eine OpenDroneMap gcp_list.txt (KBS-Zeile, dann 'x y z px py image [name]') oder eine CSV-Punktdatei mit passender '&lt;name&gt;_observations.csv'. GCP_LAYER: alternativ ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, sx, sy, sz, role).
 CHECK_POINTS: durch Kommas getrennte Namen, die zu Kontrollpunkten werden.
-CAMERA_POSITIONS: CSV &apos;image,x,y,z[,sigma]&apos; (optionale KBS-Zeile). USE_EXIF_GPS: das GPS der Fotos verwenden.
+CAMERA_POSITIONS: CSV 'image,x,y,z[,sigma]' (optionale KBS-Zeile). USE_EXIF_GPS: das GPS der Fotos verwenden.
 Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erkannt, im Protokoll genannt und ausgelassen.</translation>
     </message>
 </context>
@@ -1278,7 +1288,7 @@ Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erk
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="137"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
-        <translation>Dem Passpunktlayer {} fehlt das Feld &apos;{}&apos; (benötigt name, image, px, py)</translation>
+        <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1489,12 +1499,12 @@ Exposure: images with more than 5 % clipped highlights or shadows, a mean bright
 SCANNED_FILM: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. FIDUCIAL_COORDINATES: the calibration certificate&apos;s fiducial coordinates in mm, as a file or pasted text, one &apos;id x y&apos; line per mark (x right, y up), optionally &apos;PP x y&apos; (principal point) and &apos;focal f&apos;. Without them the mean layout of the set is used, centred on the fiducial centre. With FOCAL_LENGTH_MM (or &apos;focal&apos; in the certificate) the prepared images carry the focal length in pixels for the alignment.
 
 OUTPUT: the folder of prepared images (replaced as a whole; it must be new, empty or written by an earlier run); when skipped, &lt;workspace&gt;/prepared.</source>
-        <translation>Prüft einen Ordner mit Fotos auf Unschärfe und Belichtung und findet bei gescanntem historischem Film die Rahmenmarken und rechnet jeden Scan in einen gemeinsamen Kamerarahmen um. Das Ergebnis ist ein Ordner vorbereiteter Bilder für &apos;Bilder ausrichten&apos; und der WORKSPACE, der je Bild eine Entscheidung festhält (screening.json) für den Genauigkeitsbericht.
+        <translation>Prüft einen Ordner mit Fotos auf Unschärfe und Belichtung und findet bei gescanntem historischem Film die Rahmenmarken und rechnet jeden Scan in einen gemeinsamen Kamerarahmen um. Das Ergebnis ist ein Ordner vorbereiteter Bilder für 'Bilder ausrichten' und der WORKSPACE, der je Bild eine Entscheidung festhält (screening.json) für den Genauigkeitsbericht.
 
-Schärfewert: Varianz des Laplace-Operators auf einer grauen Kopie von 1024 px Breite, 90. Perzentil eines Rasters von 8 x 6 Kacheln (Himmel oder Wasser in einem Teil des Bildes zählt nicht dagegen). Höher ist schärfer. Ein Bild wird als &apos;unscharf&apos; markiert unter BLUR_RELATIVE x dem Median des Satzes oder unter BLUR_THRESHOLD, wenn gesetzt (absolute Werte hängen von der Szene ab: Sand erreicht weit weniger als Dächer).
+Schärfewert: Varianz des Laplace-Operators auf einer grauen Kopie von 1024 px Breite, 90. Perzentil eines Rasters von 8 x 6 Kacheln (Himmel oder Wasser in einem Teil des Bildes zählt nicht dagegen). Höher ist schärfer. Ein Bild wird als 'unscharf' markiert unter BLUR_RELATIVE x dem Median des Satzes oder unter BLUR_THRESHOLD, wenn gesetzt (absolute Werte hängen von der Szene ab: Sand erreicht weit weniger als Dächer).
 Belichtung: Bilder mit mehr als 5 % beschnittenen Lichtern oder Schatten, einer mittleren Helligkeit weit weg von der des Satzes oder einem sehr kleinen Dynamikumfang werden markiert. EXCLUDE_FLAGGED lässt markierte Bilder aus dem vorbereiteten Ordner weg; sonst bleiben sie und werden nur gemeldet.
 
-SCANNED_FILM: Rahmenmarken (Kreuze, Punkte, Punkte in Kreisen; in den Ecken und/oder Seitenmitten, oder wie ein Vorlagenbild einer Marke) werden auf Bruchteile eines Pixels gefunden, jeder Scan wird durch eine affine Transformation in den gemeinsamen Rahmenmarken-Rahmen umgerechnet, alle gleich groß und mit dem Bildhauptpunkt in der Mitte, und Masken (workspace/masks) verbergen Filmrand, Datenstreifen und die Marken vor der Zuordnung. FIDUCIAL_COORDINATES: die Rahmenmarken-Koordinaten des Kalibrierzertifikats in mm, als Datei oder eingefügter Text, eine Zeile &apos;id x y&apos; je Marke (x nach rechts, y nach oben), optional &apos;PP x y&apos; (Bildhauptpunkt) und &apos;focal f&apos;. Ohne sie wird die mittlere Anordnung des Satzes verwendet, zentriert auf die Rahmenmitte. Mit FOCAL_LENGTH_MM (oder &apos;focal&apos; im Zertifikat) tragen die vorbereiteten Bilder die Brennweite in Pixeln für die Ausrichtung.
+SCANNED_FILM: Rahmenmarken (Kreuze, Punkte, Punkte in Kreisen; in den Ecken und/oder Seitenmitten, oder wie ein Vorlagenbild einer Marke) werden auf Bruchteile eines Pixels gefunden, jeder Scan wird durch eine affine Transformation in den gemeinsamen Rahmenmarken-Rahmen umgerechnet, alle gleich groß und mit dem Bildhauptpunkt in der Mitte, und Masken (workspace/masks) verbergen Filmrand, Datenstreifen und die Marken vor der Zuordnung. FIDUCIAL_COORDINATES: die Rahmenmarken-Koordinaten des Kalibrierzertifikats in mm, als Datei oder eingefügter Text, eine Zeile 'id x y' je Marke (x nach rechts, y nach oben), optional 'PP x y' (Bildhauptpunkt) und 'focal f'. Ohne sie wird die mittlere Anordnung des Satzes verwendet, zentriert auf die Rahmenmitte. Mit FOCAL_LENGTH_MM (oder 'focal' im Zertifikat) tragen die vorbereiteten Bilder die Brennweite in Pixeln für die Ausrichtung.
 
 OUTPUT: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetzt; er muss neu, leer oder von einem früheren Lauf geschrieben sein); wenn ausgelassen, &lt;workspace&gt;/prepared.</translation>
     </message>
@@ -1502,62 +1512,62 @@ OUTPUT: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetzt; er muss ne
 <context>
     <name>ResultLayers</name>
     <message>
-        <location filename="../ui/layers.py" line="258"/>
+        <location filename="../ui/layers.py" line="259"/>
         <source>control (used)</source>
         <translation>Passpunkt (verwendet)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="259"/>
+        <location filename="../ui/layers.py" line="260"/>
         <source>check point</source>
         <translation>Kontrollpunkt</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="260"/>
+        <location filename="../ui/layers.py" line="261"/>
         <source>rejected (outlier)</source>
         <translation>verworfen (Ausreißer)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="261"/>
+        <location filename="../ui/layers.py" line="262"/>
         <source>not triangulated</source>
         <translation>nicht trianguliert</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="342"/>
+        <location filename="../ui/layers.py" line="343"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="494"/>
+        <location filename="../ui/layers.py" line="495"/>
         <source>DSM hillshade</source>
         <translation>DOM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="355"/>
+        <location filename="../ui/layers.py" line="356"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="366"/>
+        <location filename="../ui/layers.py" line="367"/>
         <source>Cameras</source>
         <translation>Kameras</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="505"/>
+        <location filename="../ui/layers.py" line="506"/>
         <source>Camera footprints</source>
         <translation>Bildfußabdrücke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="512"/>
+        <location filename="../ui/layers.py" line="513"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Passpunkt-Residuen (Vektoren x{})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="428"/>
+        <location filename="../ui/layers.py" line="429"/>
         <source>Point cloud</source>
         <translation>Punktwolke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="438"/>
+        <location filename="../ui/layers.py" line="439"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>

@@ -6,12 +6,12 @@
     <message>
         <location filename="../processing_provider/accuracy_report.py" line="71"/>
         <source>Workspace folder</source>
-        <translation>Cartella dell&apos;area di lavoro</translation>
+        <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
         <location filename="../processing_provider/accuracy_report.py" line="73"/>
         <source>Compute the bundle adjustment covariance (uncertainty section and layers)</source>
-        <translation>Calcola la covarianza della compensazione a stelle proiettive (sezione e layer dell&apos;incertezza)</translation>
+        <translation>Calcola la covarianza della compensazione a stelle proiettive (sezione e layer dell'incertezza)</translation>
     </message>
     <message>
         <location filename="../processing_provider/accuracy_report.py" line="76"/>
@@ -62,11 +62,11 @@ Summary: images given / aligned / not aligned and why, image screening, cameras 
 WORKSPACE: a workspace folder (at least aligned).
 UNCERTAINTY: compute the covariance (seconds for hundreds of images) and write &lt;workspace&gt;/uncertainty/cameras.gpkg and points.gpkg.
 OUTPUT_HTML: the report file (default: &lt;workspace&gt;/report.html). It is written under a temporary name and renamed when complete.</source>
-        <translation>Scrive un rapporto HTML autonomo di un&apos;area di lavoro (grafici incorporati, leggibile offline) e ne restituisce le cifre principali.
+        <translation>Scrive un rapporto HTML autonomo di un'area di lavoro (grafici incorporati, leggibile offline) e ne restituisce le cifre principali.
 
-Sintesi: immagini fornite / orientate / non orientate e perché, controllo delle immagini, camere con i parametri calibrati e le deviazioni standard, GSD, area, SR, tempi e parametri di elaborazione. Qualità dell&apos;orientamento: errori di riproiezione, lunghezze delle tracce dei punti di legame, connessioni tra immagini, posizioni delle camere con residui. Georeferenziazione: punti d&apos;appoggio e di controllo con dX dY dZ e residui in immagine, vettori dei residui, RMSE per gruppo, accuratezza NSSDA (FGDC-STD-007.3-1998) al 95 % di confidenza, classi di accuratezza ASPRS 2014 e 2023, residui delle posizioni delle camere, valori anomali. Incertezza: deviazioni standard delle camere e dei punti di legame dalla covarianza della compensazione. Prodotti: anteprime di DSM e ortomosaico, risoluzione, frazione valida. Le sezioni la cui fase non è stata eseguita vengono saltate con una nota.
+Sintesi: immagini fornite / orientate / non orientate e perché, controllo delle immagini, camere con i parametri calibrati e le deviazioni standard, GSD, area, SR, tempi e parametri di elaborazione. Qualità dell'orientamento: errori di riproiezione, lunghezze delle tracce dei punti di legame, connessioni tra immagini, posizioni delle camere con residui. Georeferenziazione: punti d'appoggio e di controllo con dX dY dZ e residui in immagine, vettori dei residui, RMSE per gruppo, accuratezza NSSDA (FGDC-STD-007.3-1998) al 95 % di confidenza, classi di accuratezza ASPRS 2014 e 2023, residui delle posizioni delle camere, valori anomali. Incertezza: deviazioni standard delle camere e dei punti di legame dalla covarianza della compensazione. Prodotti: anteprime di DSM e ortomosaico, risoluzione, frazione valida. Le sezioni la cui fase non è stata eseguita vengono saltate con una nota.
 
-WORKSPACE: una cartella dell&apos;area di lavoro (almeno orientata).
+WORKSPACE: una cartella dell'area di lavoro (almeno orientata).
 UNCERTAINTY: calcola la covarianza (secondi per centinaia di immagini) e scrive &lt;workspace&gt;/uncertainty/cameras.gpkg e points.gpkg.
 OUTPUT_HTML: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Viene scritto con un nome provvisorio e rinominato quando è completo.</translation>
     </message>
@@ -99,7 +99,7 @@ OUTPUT_HTML: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). 
     <message>
         <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Workspace folder</source>
-        <translation>Cartella dell&apos;area di lavoro</translation>
+        <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="51"/>
@@ -114,7 +114,7 @@ OUTPUT_HTML: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). 
     <message>
         <location filename="../processing_provider/align_images.py" line="55"/>
         <source>Largest image side for matching (0 = full size)</source>
-        <translation>Lato maggiore dell&apos;immagine per la corrispondenza (0 = dimensione piena)</translation>
+        <translation>Lato maggiore dell'immagine per la corrispondenza (0 = dimensione piena)</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="58"/>
@@ -129,7 +129,7 @@ OUTPUT_HTML: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). 
     <message>
         <location filename="../processing_provider/align_images.py" line="63"/>
         <source>Focal length in mm when EXIF is missing (0 = from EXIF)</source>
-        <translation>Focale in mm se manca l&apos;EXIF (0 = dall&apos;EXIF)</translation>
+        <translation>Focale in mm se manca l'EXIF (0 = dall'EXIF)</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="66"/>
@@ -183,11 +183,11 @@ OUTPUT_HTML: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). 
 PAIRING: &apos;auto&apos; uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
 CAMERA_MODEL: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
 FOCAL_MM and SENSOR_WIDTH_MM: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres.</source>
-        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell&apos;obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella WORKSPACE, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
+        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell'obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella WORKSPACE, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
 
-PAIRING: &apos;auto&apos; usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
-CAMERA_MODEL: &apos;AUTO&apos; stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
-FOCAL_MM e SENSOR_WIDTH_MM: orientamento interno quando manca l&apos;EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri.</translation>
+PAIRING: 'auto' usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
+CAMERA_MODEL: 'AUTO' stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
+FOCAL_MM e SENSOR_WIDTH_MM: orientamento interno quando manca l'EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri.</translation>
     </message>
 </context>
 <context>
@@ -195,12 +195,12 @@ FOCAL_MM e SENSOR_WIDTH_MM: orientamento interno quando manca l&apos;EXIF (pelli
     <message>
         <location filename="../plugin.py" line="60"/>
         <source>Ground control (GCP dock)</source>
-        <translation>Punti d&apos;appoggio (pannello GCP)</translation>
+        <translation>Punti d'appoggio (pannello GCP)</translation>
     </message>
     <message>
         <location filename="../plugin.py" line="64"/>
         <source>ArchaeoOrtho: pick ground control points on the map and in the photos</source>
-        <translation>ArchaeoOrtho: misura i punti d&apos;appoggio sulla mappa e nelle foto</translation>
+        <translation>ArchaeoOrtho: misura i punti d'appoggio sulla mappa e nelle foto</translation>
     </message>
     <message>
         <location filename="../plugin.py" line="106"/>
@@ -221,7 +221,7 @@ FOCAL_MM e SENSOR_WIDTH_MM: orientamento interno quando manca l&apos;EXIF (pelli
     <message>
         <location filename="../processing_provider/build_dsm.py" line="52"/>
         <source>Workspace folder (georeferenced)</source>
-        <translation>Cartella dell&apos;area di lavoro (georeferenziata)</translation>
+        <translation>Cartella dell'area di lavoro (georeferenziata)</translation>
     </message>
     <message>
         <location filename="../processing_provider/build_dsm.py" line="54"/>
@@ -231,7 +231,7 @@ FOCAL_MM e SENSOR_WIDTH_MM: orientamento interno quando manca l&apos;EXIF (pelli
     <message>
         <location filename="../processing_provider/build_dsm.py" line="57"/>
         <source>Matching quality (image scale)</source>
-        <translation>Qualità della corrispondenza (scala dell&apos;immagine)</translation>
+        <translation>Qualità della corrispondenza (scala dell'immagine)</translation>
     </message>
     <message>
         <location filename="../processing_provider/build_dsm.py" line="59"/>
@@ -266,7 +266,7 @@ FOCAL_MM e SENSOR_WIDTH_MM: orientamento interno quando manca l&apos;EXIF (pelli
     <message>
         <location filename="../processing_provider/build_dsm.py" line="75"/>
         <source>Share of DSM cells with data inside the camera centres&apos; convex hull</source>
-        <translation>Frazione delle celle del DSM con dati entro l&apos;inviluppo convesso dei centri di presa</translation>
+        <translation>Frazione delle celle del DSM con dati entro l'inviluppo convesso dei centri di presa</translation>
     </message>
     <message>
         <location filename="../processing_provider/build_dsm.py" line="77"/>
@@ -306,12 +306,12 @@ Re-running after a cancel resumes: pairs already matched are reused from &lt;wor
 
 Le coppie stereo sono scelte dal modello sparso (punti di legame comuni, rapporto base/distanza, angolo di vista); ogni coppia è corretta dalla distorsione e rettificata dagli orientamenti noti e abbinata con semi-global matching (OpenCV SGBM) con controllo sinistra-destra; un pixel è tenuto dove almeno due coppie indipendenti concordano. I punti fusi sono rasterizzati (mediana del gruppo di quote più alto per cella), i piccoli vuoti riempiti e quelli grandi lasciati nodata.
 
-WORKSPACE: un&apos;area di lavoro georeferenziata (eseguire prima &apos;Georeferenzia&apos;: un DSM richiede una scala metrica e una verticale, quindi un&apos;area di lavoro solo orientata viene rifiutata).
+WORKSPACE: un'area di lavoro georeferenziata (eseguire prima 'Georeferenzia': un DSM richiede una scala metrica e una verticale, quindi un'area di lavoro solo orientata viene rifiutata).
 RESOLUTION: dimensione della cella del DSM in metri; 0 = circa il doppio del GSD mediano.
-QUALITY: scala dell&apos;immagine per la corrispondenza (piena, metà, quarto): metà è quattro volte più veloce di piena.
+QUALITY: scala dell'immagine per la corrispondenza (piena, metà, quarto): metà è quattro volte più veloce di piena.
 ENGINE: cpu (predefinito); cuda esegue lo stereo patch-match di COLMAP dove pycolmap è compilato con CUDA.
 OUTPUT_DSM: Cloud-Optimized GeoTIFF, float32 con nodata (predefinito: &lt;workspace&gt;/dsm.tif).
-OUTPUT_POINT_CLOUD: file LAS facoltativo (XYZ + RGB, SR dell&apos;area di lavoro).
+OUTPUT_POINT_CLOUD: file LAS facoltativo (XYZ + RGB, SR dell'area di lavoro).
 
 Una nuova esecuzione dopo un annullamento riprende: le coppie già elaborate sono riutilizzate da &lt;workspace&gt;/dense/.</translation>
     </message>
@@ -321,12 +321,12 @@ Una nuova esecuzione dopo un annullamento riprende: le coppie già elaborate son
     <message>
         <location filename="../processing_provider/build_orthophoto.py" line="61"/>
         <source>Workspace folder (georeferenced, with a DSM)</source>
-        <translation>Cartella dell&apos;area di lavoro (georeferenziata, con DSM)</translation>
+        <translation>Cartella dell'area di lavoro (georeferenziata, con DSM)</translation>
     </message>
     <message>
         <location filename="../processing_provider/build_orthophoto.py" line="64"/>
         <source>DSM (default: the workspace DSM)</source>
-        <translation>DSM (predefinito: il DSM dell&apos;area di lavoro)</translation>
+        <translation>DSM (predefinito: il DSM dell'area di lavoro)</translation>
     </message>
     <message>
         <location filename="../processing_provider/build_orthophoto.py" line="66"/>
@@ -412,526 +412,536 @@ BLENDING: feather (a ramp across seams), multiband (Laplacian pyramid: no visibl
 OUTPUT: Cloud-Optimized GeoTIFF with overviews, the images&apos; bands and data type (8/16 bit kept) plus an alpha band (default &lt;workspace&gt;/orthomosaic.tif).
 PER_IMAGE_FOLDER: optional folder for one true orthophoto per image (COG).
 SEAMLINES: optional GeoPackage of polygons naming the image each part of the mosaic comes from.</source>
-        <translation>Ortofoto vere e l&apos;ortomosaico di un&apos;area di lavoro georeferenziata.
+        <translation>Ortofoto vere e l'ortomosaico di un'area di lavoro georeferenziata.
 
-Ogni cella prende la quota dal DSM ed è proiettata nelle immagini con il modello completo della camera (orientamento, focale, punto principale, distorsione dell&apos;obiettivo). Una cella nascosta in un&apos;immagine da una superficie più alta (un muro, un albero, una collina) viene esclusa da quell&apos;immagine, così gli edifici non pendono e nulla compare due volte; il mosaico la riempie da un&apos;immagine che la vede. Ogni parte del mosaico proviene dall&apos;immagine che la guarda nel modo più verticale e più vicino al suo centro; le linee di giunzione girano attorno a edifici e alberi; le differenze di luminosità tra le immagini sono compensate e le giunzioni sfumate.
+Ogni cella prende la quota dal DSM ed è proiettata nelle immagini con il modello completo della camera (orientamento, focale, punto principale, distorsione dell'obiettivo). Una cella nascosta in un'immagine da una superficie più alta (un muro, un albero, una collina) viene esclusa da quell'immagine, così gli edifici non pendono e nulla compare due volte; il mosaico la riempie da un'immagine che la vede. Ogni parte del mosaico proviene dall'immagine che la guarda nel modo più verticale e più vicino al suo centro; le linee di giunzione girano attorno a edifici e alberi; le differenze di luminosità tra le immagini sono compensate e le giunzioni sfumate.
 
-WORKSPACE: un&apos;area di lavoro georeferenziata con DSM (eseguire prima &apos;Genera DSM&apos;), oppure indicare DSM.
-DSM: raster facoltativo (ad es. un DSM ALS, in qualsiasi SR: riproiettato al volo); predefinito il DSM dell&apos;area di lavoro.
-IMAGES_FILTER: un sottoinsieme, ad es. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; o &apos;group:NIR&apos; (un gruppo di camere per numero o per marca/modello), &apos;!nome&apos; per escluderne una. Vuoto: tutte le immagini.
+WORKSPACE: un'area di lavoro georeferenziata con DSM (eseguire prima 'Genera DSM'), oppure indicare DSM.
+DSM: raster facoltativo (ad es. un DSM ALS, in qualsiasi SR: riproiettato al volo); predefinito il DSM dell'area di lavoro.
+IMAGES_FILTER: un sottoinsieme, ad es. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' o 'group:NIR' (un gruppo di camere per numero o per marca/modello), '!nome' per escluderne una. Vuoto: tutte le immagini.
 RESOLUTION: dimensione della cella in unità del SR; 0 = il GSD delle immagini.
 BLENDING: feather (rampa attraverso le giunzioni), multiband (piramide laplaciana: nessuna giunzione visibile nella luminosità e nessun effetto fantasma), none (taglio netto).
 OUTPUT: Cloud-Optimized GeoTIFF con panoramiche, le bande e il tipo di dato delle immagini (8/16 bit conservati) più una banda alfa (predefinito &lt;workspace&gt;/orthomosaic.tif).
-PER_IMAGE_FOLDER: cartella facoltativa per un&apos;ortofoto vera per immagine (COG).
-SEAMLINES: GeoPackage facoltativo di poligoni che indicano l&apos;immagine da cui proviene ogni parte del mosaico.</translation>
+PER_IMAGE_FOLDER: cartella facoltativa per un'ortofoto vera per immagine (COG).
+SEAMLINES: GeoPackage facoltativo di poligoni che indicano l'immagine da cui proviene ogni parte del mosaico.</translation>
     </message>
 </context>
 <context>
     <name>GcpDock</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="241"/>
+        <location filename="../ui/gcp_dock.py" line="242"/>
         <source>ArchaeoOrtho ground control</source>
-        <translation>ArchaeoOrtho punti d&apos;appoggio</translation>
+        <translation>ArchaeoOrtho punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="254"/>
+        <location filename="../ui/gcp_dock.py" line="258"/>
         <source>ArchaeoOrtho photos</source>
         <translation>ArchaeoOrtho foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="270"/>
+        <location filename="../ui/gcp_dock.py" line="274"/>
         <source>Workspace:</source>
         <translation>Area di lavoro:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="447"/>
+        <location filename="../ui/gcp_dock.py" line="451"/>
         <source>none open</source>
         <translation>nessuna aperta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="275"/>
+        <location filename="../ui/gcp_dock.py" line="279"/>
         <source>Openu2026</source>
         <translation>Apri…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="276"/>
+        <location filename="../ui/gcp_dock.py" line="280"/>
         <source>Open a workspace folder (made by Align images)</source>
-        <translation>Apri una cartella dell&apos;area di lavoro (creata da &apos;Allinea immagini&apos;)</translation>
+        <translation>Apri una cartella dell'area di lavoro (creata da 'Allinea immagini')</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="277"/>
+        <location filename="../ui/gcp_dock.py" line="281"/>
         <source>New from photosu2026</source>
         <translation>Nuova dalle foto…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="278"/>
+        <location filename="../ui/gcp_dock.py" line="282"/>
         <source>Choose a folder of photos and a workspace folder, and align the photos</source>
-        <translation>Scegli una cartella di foto e una cartella dell&apos;area di lavoro e allinea le foto</translation>
+        <translation>Scegli una cartella di foto e una cartella dell'area di lavoro e allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="284"/>
+        <location filename="../ui/gcp_dock.py" line="288"/>
         <source>Heights (Z) from:</source>
         <translation>Quote (Z) da:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="289"/>
+        <location filename="../ui/gcp_dock.py" line="293"/>
         <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
         <translation>Un layer raster DSM o DTM (ad es. un DSM ALS): un punto misurato sulla mappa ne prende la quota (bilineare). Vuoto: inserire Z a mano.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="829"/>
+        <location filename="../ui/gcp_dock.py" line="910"/>
         <source>Add</source>
         <translation>Aggiungi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="299"/>
+        <location filename="../ui/gcp_dock.py" line="303"/>
         <source>Add a ground point</source>
-        <translation>Aggiungi un punto d&apos;appoggio</translation>
+        <translation>Aggiungi un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="300"/>
+        <location filename="../ui/gcp_dock.py" line="304"/>
         <source>Remove</source>
         <translation>Rimuovi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="301"/>
+        <location filename="../ui/gcp_dock.py" line="305"/>
         <source>Remove the selected ground point and its observations</source>
-        <translation>Rimuovi il punto d&apos;appoggio selezionato e le sue misure</translation>
+        <translation>Rimuovi il punto d'appoggio selezionato e le sue misure</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="302"/>
+        <location filename="../ui/gcp_dock.py" line="306"/>
         <source>Pick on map</source>
         <translation>Misura sulla mappa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="304"/>
+        <location filename="../ui/gcp_dock.py" line="308"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>Fai clic sulla mappa per impostare X e Y del punto selezionato (Z dal layer delle quote)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="307"/>
+        <location filename="../ui/gcp_dock.py" line="311"/>
         <source>From file (gcp_list.txt, CSV)u2026</source>
         <translation>Da file (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="308"/>
+        <location filename="../ui/gcp_dock.py" line="312"/>
         <source>From a point layeru2026</source>
         <translation>Da un layer di punti…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="310"/>
+        <location filename="../ui/gcp_dock.py" line="314"/>
         <source>To file (gcp_list.txt, CSV)u2026</source>
         <translation>Su file (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="311"/>
+        <location filename="../ui/gcp_dock.py" line="315"/>
         <source>To a GeoPackage layeru2026</source>
         <translation>Su un layer GeoPackage…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="312"/>
+        <location filename="../ui/gcp_dock.py" line="316"/>
         <source>Import</source>
         <translation>Importa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="312"/>
+        <location filename="../ui/gcp_dock.py" line="316"/>
         <source>Export</source>
         <translation>Esporta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="319"/>
+        <location filename="../ui/gcp_dock.py" line="323"/>
         <source>Undo</source>
         <translation>Annulla</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="320"/>
+        <location filename="../ui/gcp_dock.py" line="324"/>
         <source>Redo</source>
         <translation>Ripeti</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="327"/>
+        <location filename="../ui/gcp_dock.py" line="331"/>
         <source>Undo: {}</source>
         <translation>Annulla: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="328"/>
+        <location filename="../ui/gcp_dock.py" line="332"/>
         <source>Redo: {}</source>
         <translation>Ripeti: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="333"/>
+        <location filename="../ui/gcp_dock.py" line="337"/>
         <source>Load results</source>
         <translation>Carica risultati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="334"/>
+        <location filename="../ui/gcp_dock.py" line="338"/>
         <source>Add the workspace&apos;s products to the map as styled layers</source>
-        <translation>Aggiungi i prodotti dell&apos;area di lavoro alla mappa come layer con stile</translation>
+        <translation>Aggiungi i prodotti dell'area di lavoro alla mappa come layer con stile</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="351"/>
+        <location filename="../ui/gcp_dock.py" line="355"/>
         <source>Residual tolerance:</source>
         <translation>Tolleranza dei residui:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="357"/>
+        <location filename="../ui/gcp_dock.py" line="361"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="359"/>
+        <location filename="../ui/gcp_dock.py" line="363"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="360"/>
+        <location filename="../ui/gcp_dock.py" line="364"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Lascia che la compensazione affini focale, punto principale e distorsione</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="366"/>
+        <location filename="../ui/gcp_dock.py" line="370"/>
         <source>Georeference</source>
         <translation>Georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="367"/>
+        <location filename="../ui/gcp_dock.py" line="371"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Esegui la compensazione con questi punti (in background)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="368"/>
+        <location filename="../ui/gcp_dock.py" line="372"/>
         <source>Cancel</source>
         <translation>Interrompi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="424"/>
+        <location filename="../ui/gcp_dock.py" line="428"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="431"/>
+        <location filename="../ui/gcp_dock.py" line="435"/>
         <source>Open an ArchaeoOrtho workspace</source>
-        <translation>Apri un&apos;area di lavoro ArchaeoOrtho</translation>
+        <translation>Apri un'area di lavoro ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="468"/>
+        <location filename="../ui/gcp_dock.py" line="472"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
-        <translation>{} foto; il blocco non è ancora allineato: esegui &apos;Allinea immagini&apos; (o &apos;Nuova dalle foto&apos;) per avere le posizioni previste</translation>
+        <translation>{} foto; il blocco non è ancora allineato: esegui 'Allinea immagini' (o 'Nuova dalle foto') per avere le posizioni previste</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="471"/>
+        <location filename="../ui/gcp_dock.py" line="475"/>
         <source>{} photos, {} ground points. {}</source>
-        <translation>{} foto, {} punti d&apos;appoggio. {}</translation>
+        <translation>{} foto, {} punti d'appoggio. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="702"/>
+        <location filename="../ui/gcp_dock.py" line="724"/>
         <source>no predicted positions: {}</source>
         <translation>nessuna posizione prevista: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="504"/>
+        <location filename="../ui/gcp_dock.py" line="508"/>
         <source>Predicted positions from the georeferenced block.</source>
         <translation>Posizioni previste dal blocco georeferenziato.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="504"/>
+        <location filename="../ui/gcp_dock.py" line="508"/>
         <source>Predicted positions once a point is placed in 2 photos, and for every point once 3 points are placed.</source>
         <translation>Posizioni previste quando un punto è misurato in 2 foto, e per tutti i punti quando ne sono misurati 3.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="510"/>
+        <location filename="../ui/gcp_dock.py" line="514"/>
         <source>Folder of photos</source>
         <translation>Cartella delle foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="513"/>
+        <location filename="../ui/gcp_dock.py" line="517"/>
         <source>Workspace folder (new or existing)</source>
-        <translation>Cartella dell&apos;area di lavoro (nuova o esistente)</translation>
+        <translation>Cartella dell'area di lavoro (nuova o esistente)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="525"/>
+        <location filename="../ui/gcp_dock.py" line="529"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
         <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="529"/>
+        <location filename="../ui/gcp_dock.py" line="533"/>
         <source>ArchaeoOrtho: align photos</source>
         <translation>ArchaeoOrtho: allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="596"/>
+        <location filename="../ui/gcp_dock.py" line="612"/>
         <source>CRS: {}</source>
         <translation>SR: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="623"/>
+        <location filename="../ui/gcp_dock.py" line="639"/>
         <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Fai clic sulla mappa nella posizione del punto selezionato (Esc per terminare)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="662"/>
+        <location filename="../ui/gcp_dock.py" line="678"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (da {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="665"/>
+        <location filename="../ui/gcp_dock.py" line="681"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Nessuna quota in questo punto in {}: Z invariata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="668"/>
+        <location filename="../ui/gcp_dock.py" line="684"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="725"/>
+        <location filename="../ui/gcp_dock.py" line="803"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="729"/>
+        <location filename="../ui/gcp_dock.py" line="807"/>
         <source>predicted</source>
         <translation>prevista</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="744"/>
+        <location filename="../ui/gcp_dock.py" line="822"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
-        <translation>Seleziona o aggiungi un punto d&apos;appoggio nella tabella, poi fai clic su di esso nella foto.</translation>
+        <translation>Seleziona o aggiungi un punto d'appoggio nella tabella, poi fai clic su di esso nella foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="749"/>
+        <location filename="../ui/gcp_dock.py" line="827"/>
         <source>from the point&apos;s other observations</source>
         <translation>dalle altre misure del punto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="750"/>
+        <location filename="../ui/gcp_dock.py" line="828"/>
         <source>from the georeferenced block</source>
         <translation>dal blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="751"/>
+        <location filename="../ui/gcp_dock.py" line="829"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>dai punti già misurati (trasformazione di similitudine)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="757"/>
+        <location filename="../ui/gcp_dock.py" line="838"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Misurato in x {:.2f}, y {:.2f}. Fai clic per spostarlo, trascinalo o premi Canc per rimuoverlo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="760"/>
+        <location filename="../ui/gcp_dock.py" line="841"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Previsto {}. Premi Invio per accettarlo e proseguire (Spazio: accetta), trascinalo o fai clic dove si trova davvero il punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="763"/>
+        <location filename="../ui/gcp_dock.py" line="844"/>
         <source>Click where {} is in this photo.</source>
         <translation>Fai clic dove si trova {} in questa foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="773"/>
+        <location filename="../ui/gcp_dock.py" line="854"/>
         <source>Select or add a ground point first</source>
-        <translation>Seleziona o aggiungi prima un punto d&apos;appoggio</translation>
+        <translation>Seleziona o aggiungi prima un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="812"/>
+        <location filename="../ui/gcp_dock.py" line="893"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: ogni foto in cui è previsto ha una misura</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="869"/>
+        <location filename="../ui/gcp_dock.py" line="950"/>
         <source>Import ground control</source>
-        <translation>Importa punti d&apos;appoggio</translation>
+        <translation>Importa punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="817"/>
+        <location filename="../ui/gcp_dock.py" line="898"/>
         <source>Ground control (*.txt *.csv);;All files (*)</source>
-        <translation>Punti d&apos;appoggio (*.txt *.csv);;Tutti i file (*)</translation>
+        <translation>Punti d'appoggio (*.txt *.csv);;Tutti i file (*)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="825"/>
+        <location filename="../ui/gcp_dock.py" line="906"/>
         <source>Replace the current points, or add the imported ones to them (same names are updated)?</source>
         <translation>Sostituire i punti attuali o aggiungere quelli importati (quelli con lo stesso nome vengono aggiornati)?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="828"/>
+        <location filename="../ui/gcp_dock.py" line="909"/>
         <source>Replace</source>
         <translation>Sostituisci</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="851"/>
+        <location filename="../ui/gcp_dock.py" line="932"/>
         <source>import {}</source>
         <translation>importa {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="853"/>
+        <location filename="../ui/gcp_dock.py" line="934"/>
         <source>warnings</source>
         <translation>avvisi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="854"/>
+        <location filename="../ui/gcp_dock.py" line="935"/>
         <source>Imported {} points and {} observations from {}</source>
         <translation>Importati {} punti e {} misure da {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="866"/>
+        <location filename="../ui/gcp_dock.py" line="947"/>
         <source>No point layer in the project</source>
         <translation>Nessun layer di punti nel progetto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="869"/>
+        <location filename="../ui/gcp_dock.py" line="950"/>
         <source>Point layer (one feature per observation: name, image, px, py)</source>
         <translation>Layer di punti (un elemento per misura: name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="882"/>
+        <location filename="../ui/gcp_dock.py" line="963"/>
         <source>Layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
-        <translation>Al layer {} manca il campo &apos;{}&apos; (servono name, image, px, py)</translation>
+        <translation>Al layer {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="908"/>
+        <location filename="../ui/gcp_dock.py" line="989"/>
         <source>OpenDroneMap gcp_list (*.txt)</source>
         <translation>OpenDroneMap gcp_list (*.txt)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="908"/>
+        <location filename="../ui/gcp_dock.py" line="989"/>
         <source>CSV points + observations (*.csv)</source>
         <translation>Punti CSV + misure (*.csv)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="909"/>
+        <location filename="../ui/gcp_dock.py" line="990"/>
         <source>Export ground control</source>
-        <translation>Esporta punti d&apos;appoggio</translation>
+        <translation>Esporta punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="920"/>
+        <location filename="../ui/gcp_dock.py" line="1001"/>
         <source>The points have no CRS yet: pick one on the map or import a file first</source>
         <translation>I punti non hanno ancora un SR: misurane uno sulla mappa o importa prima un file</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="929"/>
+        <location filename="../ui/gcp_dock.py" line="1010"/>
         <source>Exported {} points to {}</source>
         <translation>Esportati {} punti in {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="929"/>
+        <location filename="../ui/gcp_dock.py" line="1010"/>
         <source> ({} without coordinates left out)</source>
         <translation> ({} senza coordinate esclusi)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="934"/>
+        <location filename="../ui/gcp_dock.py" line="1015"/>
         <source>Export ground control as a layer</source>
-        <translation>Esporta i punti d&apos;appoggio come layer</translation>
+        <translation>Esporta i punti d'appoggio come layer</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="934"/>
+        <location filename="../ui/gcp_dock.py" line="1015"/>
         <source>GeoPackage (*.gpkg)</source>
         <translation>GeoPackage (*.gpkg)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="965"/>
+        <location filename="../ui/gcp_dock.py" line="1046"/>
         <source>Cannot write {}: {}</source>
         <translation>Impossibile scrivere {}: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="968"/>
+        <location filename="../ui/gcp_dock.py" line="1049"/>
         <source>Exported {} observations to {}</source>
         <translation>Esportate {} misure in {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="968"/>
+        <location filename="../ui/gcp_dock.py" line="1049"/>
         <source> (points without observations left out: {})</source>
         <translation> (punti senza misure esclusi: {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="972"/>
+        <location filename="../ui/gcp_dock.py" line="1053"/>
         <source>GCP observations</source>
-        <translation>Misure dei punti d&apos;appoggio</translation>
+        <translation>Misure dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="974"/>
+        <location filename="../ui/gcp_dock.py" line="1055"/>
         <source>Cannot add {} to the project</source>
         <translation>Impossibile aggiungere {} al progetto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="980"/>
+        <location filename="../ui/gcp_dock.py" line="1061"/>
         <source>A task of this dock is still running</source>
-        <translation>Un&apos;operazione di questo pannello è ancora in corso</translation>
+        <translation>Un'operazione di questo pannello è ancora in corso</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1003"/>
+        <location filename="../ui/gcp_dock.py" line="1084"/>
         <source>Cancelled</source>
         <translation>Interrotto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1011"/>
+        <location filename="../ui/gcp_dock.py" line="1092"/>
         <source>Cancellingu2026</source>
         <translation>Interruzione…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1020"/>
+        <location filename="../ui/gcp_dock.py" line="1101"/>
         <source>The block is not aligned yet: run Align images first</source>
-        <translation>Il blocco non è ancora allineato: esegui prima &apos;Allinea immagini&apos;</translation>
+        <translation>Il blocco non è ancora allineato: esegui prima 'Allinea immagini'</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1025"/>
+        <location filename="../ui/gcp_dock.py" line="1106"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
-        <translation>La compensazione richiede almeno 3 punti d&apos;appoggio con coordinate e misure; ce ne sono {}</translation>
+        <translation>La compensazione richiede almeno 3 punti d'appoggio con coordinate e misure; ce ne sono {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1040"/>
+        <location filename="../ui/gcp_dock.py" line="1121"/>
         <source>Outliers left out: {}</source>
         <translation>Valori anomali esclusi: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1041"/>
+        <location filename="../ui/gcp_dock.py" line="1122"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziato in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1044"/>
+        <location filename="../ui/gcp_dock.py" line="1125"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1047"/>
+        <location filename="../ui/gcp_dock.py" line="1128"/>
         <source>Georeferencing with {} control pointsu2026</source>
-        <translation>Georeferenziazione con {} punti d&apos;appoggio…</translation>
+        <translation>Georeferenziazione con {} punti d'appoggio…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1053"/>
+        <location filename="../ui/gcp_dock.py" line="1134"/>
         <source>Not georeferenced yet.</source>
         <translation>Non ancora georeferenziato.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1055"/>
+        <location filename="../ui/gcp_dock.py" line="1136"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Appoggio: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1058"/>
+        <location filename="../ui/gcp_dock.py" line="1139"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Controllo: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1061"/>
+        <location filename="../ui/gcp_dock.py" line="1142"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>le quote sono segnaposto: nessuna accuratezza verticale</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1063"/>
+        <location filename="../ui/gcp_dock.py" line="1144"/>
         <source>tie points {} px</source>
         <translation>punti di legame {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1065"/>
+        <location filename="../ui/gcp_dock.py" line="1146"/>
         <source>edited since: re-run to update</source>
         <translation>modificato da allora: riesegui per aggiornare</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1075"/>
+        <location filename="../ui/gcp_dock.py" line="1156"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="830"/>
+        <source>by matching its look in another photo</source>
+        <translation>confrontandone l&apos;aspetto in un&apos;altra foto</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="832"/>
+        <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
+        <translation>(correlazione {:.2f}, {:.0f} px dalla previsione geometrica)</translation>
     </message>
 </context>
 <context>
@@ -975,119 +985,119 @@ SEAMLINES: GeoPackage facoltativo di poligoni che indicano l&apos;immagine da cu
 <context>
     <name>GcpTableModel</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="82"/>
         <source>Name</source>
         <translation>Nome</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="82"/>
         <source>X</source>
         <translation>X</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="82"/>
         <source>Y</source>
         <translation>Y</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="82"/>
         <source>Z</source>
         <translation>Z</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="82"/>
         <source>u03c3 XY</source>
         <translation>σ XY</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="82"/>
         <source>u03c3 Z</source>
         <translation>σ Z</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82"/>
+        <location filename="../ui/gcp_dock.py" line="83"/>
         <source>Role</source>
         <translation>Ruolo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82"/>
+        <location filename="../ui/gcp_dock.py" line="83"/>
         <source>Obs.</source>
         <translation>Mis.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82"/>
+        <location filename="../ui/gcp_dock.py" line="83"/>
         <source>dXY (m)</source>
         <translation>dXY (m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82"/>
+        <location filename="../ui/gcp_dock.py" line="83"/>
         <source>dZ (m)</source>
         <translation>dZ (m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82"/>
+        <location filename="../ui/gcp_dock.py" line="83"/>
         <source>px</source>
         <translation>px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="85"/>
+        <location filename="../ui/gcp_dock.py" line="86"/>
         <source>check</source>
         <translation>controllo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="85"/>
+        <location filename="../ui/gcp_dock.py" line="86"/>
         <source>control</source>
         <translation>appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="97"/>
+        <location filename="../ui/gcp_dock.py" line="98"/>
         <source>Horizontal residual after the adjustment (estimated from the photos minus given)</source>
         <translation>Residuo planimetrico dopo la compensazione (stimato dalle foto meno dato)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="98"/>
+        <location filename="../ui/gcp_dock.py" line="99"/>
         <source>Vertical residual after the adjustment</source>
         <translation>Residuo altimetrico dopo la compensazione</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="99"/>
+        <location filename="../ui/gcp_dock.py" line="100"/>
         <source>Mean reprojection error of the point&apos;s observations (pixels)</source>
         <translation>Errore medio di riproiezione delle misure del punto (pixel)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="100"/>
+        <location filename="../ui/gcp_dock.py" line="101"/>
         <source>Number of photos the point is placed in</source>
         <translation>Numero di foto in cui il punto è misurato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="113"/>
+        <location filename="../ui/gcp_dock.py" line="114"/>
         <source>rejected as an outlier</source>
         <translation>scartato come valore anomalo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="115"/>
+        <location filename="../ui/gcp_dock.py" line="116"/>
         <source>not triangulated (fewer than 2 usable observations)</source>
         <translation>non triangolato (meno di 2 misure utilizzabili)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="121"/>
+        <location filename="../ui/gcp_dock.py" line="122"/>
         <source>within the tolerance</source>
         <translation>entro la tolleranza</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="123"/>
+        <location filename="../ui/gcp_dock.py" line="124"/>
         <source>up to 3 times the tolerance</source>
         <translation>fino al triplo della tolleranza</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="124"/>
+        <location filename="../ui/gcp_dock.py" line="125"/>
         <source>more than 3 times the tolerance</source>
         <translation>oltre il triplo della tolleranza</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="166"/>
+        <location filename="../ui/gcp_dock.py" line="167"/>
         <source>edited since the last adjustment: run Georeference to update</source>
-        <translation>modificato dopo l&apos;ultima compensazione: esegui &apos;Georeferenzia&apos; per aggiornare</translation>
+        <translation>modificato dopo l'ultima compensazione: esegui 'Georeferenzia' per aggiornare</translation>
     </message>
 </context>
 <context>
@@ -1095,17 +1105,17 @@ SEAMLINES: GeoPackage facoltativo di poligoni che indicano l&apos;immagine da cu
     <message>
         <location filename="../processing_provider/georeference.py" line="49"/>
         <source>Workspace folder (aligned)</source>
-        <translation>Cartella dell&apos;area di lavoro (allineata)</translation>
+        <translation>Cartella dell'area di lavoro (allineata)</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="51"/>
         <source>Ground control file (gcp_list.txt or CSV)</source>
-        <translation>File dei punti d&apos;appoggio (gcp_list.txt o CSV)</translation>
+        <translation>File dei punti d'appoggio (gcp_list.txt o CSV)</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="54"/>
         <source>Ground control point layer (one feature per observation)</source>
-        <translation>Layer dei punti d&apos;appoggio (un elemento per misura)</translation>
+        <translation>Layer dei punti d'appoggio (un elemento per misura)</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="57"/>
@@ -1125,7 +1135,7 @@ SEAMLINES: GeoPackage facoltativo di poligoni che indicano l&apos;immagine da cu
     <message>
         <location filename="../processing_provider/georeference.py" line="64"/>
         <source>Target CRS (default: the GCP file&apos;s)</source>
-        <translation>SR di destinazione (predefinito: quello del file dei punti d&apos;appoggio)</translation>
+        <translation>SR di destinazione (predefinito: quello del file dei punti d'appoggio)</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="66"/>
@@ -1140,7 +1150,7 @@ SEAMLINES: GeoPackage facoltativo di poligoni che indicano l&apos;immagine da cu
     <message>
         <location filename="../processing_provider/georeference.py" line="69"/>
         <source>GCP residuals</source>
-        <translation>Residui dei punti d&apos;appoggio</translation>
+        <translation>Residui dei punti d'appoggio</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="70"/>
@@ -1150,7 +1160,7 @@ SEAMLINES: GeoPackage facoltativo di poligoni che indicano l&apos;immagine da cu
     <message>
         <location filename="../processing_provider/georeference.py" line="91"/>
         <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS)</source>
-        <translation>Indica i punti d&apos;appoggio (GCPS o GCP_LAYER) e/o le posizioni delle camere (CAMERA_POSITIONS o USE_EXIF_GPS)</translation>
+        <translation>Indica i punti d'appoggio (GCPS o GCP_LAYER) e/o le posizioni delle camere (CAMERA_POSITIONS o USE_EXIF_GPS)</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="102"/>
@@ -1165,7 +1175,7 @@ SEAMLINES: GeoPackage facoltativo di poligoni che indicano l&apos;immagine da cu
     <message>
         <location filename="../processing_provider/georeference.py" line="119"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
-        <translation>Al layer dei punti d&apos;appoggio {} manca il campo &apos;{}&apos; (servono name, image, px, py)</translation>
+        <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1180,11 +1190,11 @@ GCPS: an OpenDroneMap gcp_list.txt (CRS line, then &apos;x y z px py image [name
 CHECK_POINTS: comma-separated names that become check points.
 CAMERA_POSITIONS: CSV &apos;image,x,y,z[,sigma]&apos; (optional CRS line). USE_EXIF_GPS: use the photos&apos; GPS.
 Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.</source>
-        <translation>Fissa il blocco allineato in un sistema di riferimento reale con punti d&apos;appoggio (GCP) e/o posizioni delle camere, usati all&apos;interno della compensazione a stelle proiettive in modo che eliminino anche la deriva e la flessione del blocco, cosa che una trasformazione a 7 parametri (Helmert) non può fare. I punti di controllo non partecipano alla compensazione: vengono triangolati in seguito e confrontati con le loro coordinate rilevate.
+        <translation>Fissa il blocco allineato in un sistema di riferimento reale con punti d'appoggio (GCP) e/o posizioni delle camere, usati all'interno della compensazione a stelle proiettive in modo che eliminino anche la deriva e la flessione del blocco, cosa che una trasformazione a 7 parametri (Helmert) non può fare. I punti di controllo non partecipano alla compensazione: vengono triangolati in seguito e confrontati con le loro coordinate rilevate.
 
-GCPS: un gcp_list.txt di OpenDroneMap (riga del SR, poi &apos;x y z px py image [name]&apos;) o un file CSV di punti con il corrispondente &apos;&lt;name&gt;_observations.csv&apos;. GCP_LAYER: in alternativa un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, sx, sy, sz, role).
+GCPS: un gcp_list.txt di OpenDroneMap (riga del SR, poi 'x y z px py image [name]') o un file CSV di punti con il corrispondente '&lt;name&gt;_observations.csv'. GCP_LAYER: in alternativa un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, sx, sy, sz, role).
 CHECK_POINTS: nomi separati da virgole che diventano punti di controllo.
-CAMERA_POSITIONS: CSV &apos;image,x,y,z[,sigma]&apos; (riga del SR facoltativa). USE_EXIF_GPS: usa il GPS delle foto.
+CAMERA_POSITIONS: CSV 'image,x,y,z[,sigma]' (riga del SR facoltativa). USE_EXIF_GPS: usa il GPS delle foto.
 I valori anomali (una misura errata, un errore di battitura in una coordinata) sono individuati, nominati nel registro ed esclusi.</translation>
     </message>
 </context>
@@ -1203,12 +1213,12 @@ I valori anomali (una misura errata, un errore di battitura in una coordinata) s
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="65"/>
         <source>Ground control file (gcp_list.txt or CSV)</source>
-        <translation>File dei punti d&apos;appoggio (gcp_list.txt o CSV)</translation>
+        <translation>File dei punti d'appoggio (gcp_list.txt o CSV)</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="68"/>
         <source>Ground control point layer (one feature per observation)</source>
-        <translation>Layer dei punti d&apos;appoggio (un elemento per misura)</translation>
+        <translation>Layer dei punti d'appoggio (un elemento per misura)</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="71"/>
@@ -1218,7 +1228,7 @@ I valori anomali (una misura errata, un errore di battitura in una coordinata) s
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="74"/>
         <source>Focal length in mm (0 = from EXIF)</source>
-        <translation>Focale in mm (0 = dall&apos;EXIF)</translation>
+        <translation>Focale in mm (0 = dall'EXIF)</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="77"/>
@@ -1238,7 +1248,7 @@ I valori anomali (una misura errata, un errore di battitura in una coordinata) s
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="85"/>
         <source>Output CRS (default: the GCPs&apos; or orientation&apos;s CRS)</source>
-        <translation>SR di output (predefinito: quello dei punti d&apos;appoggio o dell&apos;orientamento)</translation>
+        <translation>SR di output (predefinito: quello dei punti d'appoggio o dell'orientamento)</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="87"/>
@@ -1248,12 +1258,12 @@ I valori anomali (una misura errata, un errore di battitura in una coordinata) s
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="88"/>
         <source>GCP residuals</source>
-        <translation>Residui dei punti d&apos;appoggio</translation>
+        <translation>Residui dei punti d'appoggio</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="90"/>
         <source>GCP residual RMSE (pixels)</source>
-        <translation>RMSE dei residui dei punti d&apos;appoggio (pixel)</translation>
+        <translation>RMSE dei residui dei punti d'appoggio (pixel)</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="91"/>
@@ -1263,7 +1273,7 @@ I valori anomali (una misura errata, un errore di battitura in una coordinata) s
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="107"/>
         <source>Give ground control points observed in the image (GCPS or GCP_LAYER) or its orientation (ORIENTATION)</source>
-        <translation>Indica i punti d&apos;appoggio misurati nell&apos;immagine (GCPS o GCP_LAYER) o il suo orientamento (ORIENTATION)</translation>
+        <translation>Indica i punti d'appoggio misurati nell'immagine (GCPS o GCP_LAYER) o il suo orientamento (ORIENTATION)</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="114"/>
@@ -1278,7 +1288,7 @@ I valori anomali (una misura errata, un errore di battitura in una coordinata) s
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="137"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
-        <translation>Al layer dei punti d&apos;appoggio {} manca il campo &apos;{}&apos; (servono name, image, px, py)</translation>
+        <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1299,14 +1309,14 @@ MODE: a true orthophoto on the DSM, or a planar (projective) rectification throu
 RESIDUALS: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
         <translation>Ortorettifica una fotografia — anche una che non fa parte di alcun blocco, come una singola obliqua o una vecchia stampa — su un DSM esistente, ad esempio un DSM da laser scanning aereo (ALS) in qualsiasi SR (riproiettato al volo).
 
-Posizione e assetto della camera derivano dai punti d&apos;appoggio misurati nella foto (resezione spaziale: almeno 4 punti; un punto errato su 5 o più viene individuato ed escluso; con 6 o più si stimano anche la focale e la distorsione radiale k1 dove i punti le determinano), oppure da un orientamento noto.
+Posizione e assetto della camera derivano dai punti d'appoggio misurati nella foto (resezione spaziale: almeno 4 punti; un punto errato su 5 o più viene individuato ed escluso; con 6 o più si stimano anche la focale e la distorsione radiale k1 dove i punti le determinano), oppure da un orientamento noto.
 
-IMAGE: la foto. DSM: raster delle quote (necessario per un&apos;ortofoto vera).
-GCPS: un gcp_list.txt di OpenDroneMap o un file CSV di punti con misure in questa immagine; oppure GCP_LAYER: un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, role; origine dei pixel nell&apos;angolo in alto a sinistra, y verso il basso).
-ORIENTATION: al posto dei punti d&apos;appoggio, un file con x y z omega phi kappa (gradi, convenzione fotogrammetrica; una riga di intestazione come la scrive Pix4D, o JSON), facoltativamente focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 e una riga del SR.
+IMAGE: la foto. DSM: raster delle quote (necessario per un'ortofoto vera).
+GCPS: un gcp_list.txt di OpenDroneMap o un file CSV di punti con misure in questa immagine; oppure GCP_LAYER: un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, role; origine dei pixel nell'angolo in alto a sinistra, y verso il basso).
+ORIENTATION: al posto dei punti d'appoggio, un file con x y z omega phi kappa (gradi, convenzione fotogrammetrica; una riga di intestazione come la scrive Pix4D, o JSON), facoltativamente focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 e una riga del SR.
 FOCAL_MM e SENSOR_WIDTH_MM: orientamento interno (il lato lungo del sensore); predefinita la focale EXIF.
-MODE: un&apos;ortofoto vera sul DSM, o un raddrizzamento piano (proiettivo) tramite i punti d&apos;appoggio per confronto su terreno piatto; con un DSM il registro e PLANAR_OFFSET_P95 dicono di quanto il risultato piano si discosta a causa del rilievo.
-RESIDUALS: GeoPackage dei punti d&apos;appoggio con i loro residui in pixel (e in metri sul piano).</translation>
+MODE: un'ortofoto vera sul DSM, o un raddrizzamento piano (proiettivo) tramite i punti d'appoggio per confronto su terreno piatto; con un DSM il registro e PLANAR_OFFSET_P95 dicono di quanto il risultato piano si discosta a causa del rilievo.
+RESIDUALS: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in metri sul piano).</translation>
     </message>
 </context>
 <context>
@@ -1324,7 +1334,7 @@ RESIDUALS: GeoPackage dei punti d&apos;appoggio con i loro residui in pixel (e i
     <message>
         <location filename="../ui/photo_viewer.py" line="425"/>
         <source>Show the whole photo (F)</source>
-        <translation>Mostra l&apos;intera foto (F)</translation>
+        <translation>Mostra l'intera foto (F)</translation>
     </message>
     <message>
         <location filename="../ui/photo_viewer.py" line="426"/>
@@ -1382,12 +1392,12 @@ RESIDUALS: GeoPackage dei punti d&apos;appoggio con i loro residui in pixel (e i
     <message>
         <location filename="../processing_provider/prepare_images.py" line="69"/>
         <source>Workspace folder</source>
-        <translation>Cartella dell&apos;area di lavoro</translation>
+        <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
         <location filename="../processing_provider/prepare_images.py" line="70"/>
         <source>Smallest blur score (0 = only relative to the set)</source>
-        <translation>Punteggio di nitidezza minimo (0 = solo relativo all&apos;insieme)</translation>
+        <translation>Punteggio di nitidezza minimo (0 = solo relativo all'insieme)</translation>
     </message>
     <message>
         <location filename="../processing_provider/prepare_images.py" line="73"/>
@@ -1412,7 +1422,7 @@ RESIDUALS: GeoPackage dei punti d&apos;appoggio con i loro residui in pixel (e i
     <message>
         <location filename="../processing_provider/prepare_images.py" line="84"/>
         <source>Flag images below this fraction of the set&apos;s median blur score</source>
-        <translation>Segnala le immagini sotto questa frazione del punteggio di nitidezza mediano dell&apos;insieme</translation>
+        <translation>Segnala le immagini sotto questa frazione del punteggio di nitidezza mediano dell'insieme</translation>
     </message>
     <message>
         <location filename="../processing_provider/prepare_images.py" line="87"/>
@@ -1467,7 +1477,7 @@ RESIDUALS: GeoPackage dei punti d&apos;appoggio con i loro residui in pixel (e i
     <message>
         <location filename="../processing_provider/prepare_images.py" line="140"/>
         <source>Blurriest first (blur score, % of the set&apos;s median):</source>
-        <translation>Le più sfocate per prime (punteggio di nitidezza, % della mediana dell&apos;insieme):</translation>
+        <translation>Le più sfocate per prime (punteggio di nitidezza, % della mediana dell'insieme):</translation>
     </message>
     <message>
         <location filename="../processing_provider/prepare_images.py" line="148"/>
@@ -1489,75 +1499,75 @@ Exposure: images with more than 5 % clipped highlights or shadows, a mean bright
 SCANNED_FILM: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. FIDUCIAL_COORDINATES: the calibration certificate&apos;s fiducial coordinates in mm, as a file or pasted text, one &apos;id x y&apos; line per mark (x right, y up), optionally &apos;PP x y&apos; (principal point) and &apos;focal f&apos;. Without them the mean layout of the set is used, centred on the fiducial centre. With FOCAL_LENGTH_MM (or &apos;focal&apos; in the certificate) the prepared images carry the focal length in pixels for the alignment.
 
 OUTPUT: the folder of prepared images (replaced as a whole; it must be new, empty or written by an earlier run); when skipped, &lt;workspace&gt;/prepared.</source>
-        <translation>Controlla una cartella di fotografie per sfocatura ed esposizione e, per le pellicole storiche scansionate, trova le marche fiduciali e ricampiona ogni scansione in un unico fotogramma della camera. Il risultato è una cartella di immagini preparate per &apos;Allinea immagini&apos; e il WORKSPACE, che registra una decisione per immagine (screening.json) per il rapporto di accuratezza.
+        <translation>Controlla una cartella di fotografie per sfocatura ed esposizione e, per le pellicole storiche scansionate, trova le marche fiduciali e ricampiona ogni scansione in un unico fotogramma della camera. Il risultato è una cartella di immagini preparate per 'Allinea immagini' e il WORKSPACE, che registra una decisione per immagine (screening.json) per il rapporto di accuratezza.
 
-Punteggio di nitidezza: varianza del laplaciano su una copia in grigio larga 1024 px, 90° percentile di una griglia di 8 x 6 tasselli (cielo o acqua in una parte del fotogramma non vanno a suo sfavore). Più alto è più nitido. Un&apos;immagine è segnalata come &apos;sfocata&apos; sotto BLUR_RELATIVE x la mediana dell&apos;insieme, o sotto BLUR_THRESHOLD se impostato (i punteggi assoluti dipendono dalla scena: la sabbia ottiene molto meno dei tetti).
-Esposizione: vengono segnalate le immagini con più del 5 % di luci o ombre tagliate, una luminosità media lontana da quella dell&apos;insieme o una gamma dinamica molto ridotta. EXCLUDE_FLAGGED esclude le immagini segnalate dalla cartella preparata; altrimenti vengono mantenute e solo riportate.
+Punteggio di nitidezza: varianza del laplaciano su una copia in grigio larga 1024 px, 90° percentile di una griglia di 8 x 6 tasselli (cielo o acqua in una parte del fotogramma non vanno a suo sfavore). Più alto è più nitido. Un'immagine è segnalata come 'sfocata' sotto BLUR_RELATIVE x la mediana dell'insieme, o sotto BLUR_THRESHOLD se impostato (i punteggi assoluti dipendono dalla scena: la sabbia ottiene molto meno dei tetti).
+Esposizione: vengono segnalate le immagini con più del 5 % di luci o ombre tagliate, una luminosità media lontana da quella dell'insieme o una gamma dinamica molto ridotta. EXCLUDE_FLAGGED esclude le immagini segnalate dalla cartella preparata; altrimenti vengono mantenute e solo riportate.
 
-SCANNED_FILM: le marche fiduciali (croci, punti, punti in cerchi; negli angoli e/o a metà dei lati, o come un&apos;immagine modello di una marca) sono trovate con precisione sub-pixel, ogni scansione è ricampionata con una trasformazione affine nel fotogramma fiduciale comune, tutte della stessa dimensione e con il punto principale al centro, e delle maschere (workspace/masks) nascondono alla corrispondenza il bordo della pellicola, le strisce di dati e le marche. FIDUCIAL_COORDINATES: le coordinate delle marche fiduciali del certificato di calibrazione in mm, come file o testo incollato, una riga &apos;id x y&apos; per marca (x a destra, y in alto), facoltativamente &apos;PP x y&apos; (punto principale) e &apos;focal f&apos;. Senza di esse si usa la disposizione media dell&apos;insieme, centrata sul centro fiduciale. Con FOCAL_LENGTH_MM (o &apos;focal&apos; nel certificato) le immagini preparate riportano la focale in pixel per l&apos;allineamento.
+SCANNED_FILM: le marche fiduciali (croci, punti, punti in cerchi; negli angoli e/o a metà dei lati, o come un'immagine modello di una marca) sono trovate con precisione sub-pixel, ogni scansione è ricampionata con una trasformazione affine nel fotogramma fiduciale comune, tutte della stessa dimensione e con il punto principale al centro, e delle maschere (workspace/masks) nascondono alla corrispondenza il bordo della pellicola, le strisce di dati e le marche. FIDUCIAL_COORDINATES: le coordinate delle marche fiduciali del certificato di calibrazione in mm, come file o testo incollato, una riga 'id x y' per marca (x a destra, y in alto), facoltativamente 'PP x y' (punto principale) e 'focal f'. Senza di esse si usa la disposizione media dell'insieme, centrata sul centro fiduciale. Con FOCAL_LENGTH_MM (o 'focal' nel certificato) le immagini preparate riportano la focale in pixel per l'allineamento.
 
-OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere nuova, vuota o scritta da un&apos;esecuzione precedente); se omessa, &lt;workspace&gt;/prepared.</translation>
+OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere nuova, vuota o scritta da un'esecuzione precedente); se omessa, &lt;workspace&gt;/prepared.</translation>
     </message>
 </context>
 <context>
     <name>ResultLayers</name>
     <message>
-        <location filename="../ui/layers.py" line="258"/>
+        <location filename="../ui/layers.py" line="259"/>
         <source>control (used)</source>
         <translation>appoggio (usato)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="259"/>
+        <location filename="../ui/layers.py" line="260"/>
         <source>check point</source>
         <translation>punto di controllo</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="260"/>
+        <location filename="../ui/layers.py" line="261"/>
         <source>rejected (outlier)</source>
         <translation>scartato (valore anomalo)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="261"/>
+        <location filename="../ui/layers.py" line="262"/>
         <source>not triangulated</source>
         <translation>non triangolato</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="342"/>
+        <location filename="../ui/layers.py" line="343"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="494"/>
+        <location filename="../ui/layers.py" line="495"/>
         <source>DSM hillshade</source>
         <translation>Ombreggiatura del DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="355"/>
+        <location filename="../ui/layers.py" line="356"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="366"/>
+        <location filename="../ui/layers.py" line="367"/>
         <source>Cameras</source>
         <translation>Camere</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="505"/>
+        <location filename="../ui/layers.py" line="506"/>
         <source>Camera footprints</source>
         <translation>Impronte delle immagini</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="512"/>
+        <location filename="../ui/layers.py" line="513"/>
         <source>GCP residuals (vectors x{})</source>
-        <translation>Residui dei punti d&apos;appoggio (vettori x{})</translation>
+        <translation>Residui dei punti d'appoggio (vettori x{})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="428"/>
+        <location filename="../ui/layers.py" line="429"/>
         <source>Point cloud</source>
         <translation>Nuvola di punti</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="438"/>
+        <location filename="../ui/layers.py" line="439"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
