@@ -929,8 +929,11 @@ class GcpDock(QgsDockWidget):
             for p, q in zip(gs.points, out):
                 p.x, p.y = float(q[0]), float(q[1])
             gs.crs = self.store.crs
-        self.store.replace_all(gs, self.tr("import {}").format(source), merge=merge)
         n_obs = gs.n_observations()
+        if n_obs == 0:  # coordinates only (a surveyor's list): that the points have no observations is the point
+            gs.warnings = [w for w in gs.warnings
+                           if "no usable observation" not in w and "no observations file" not in w]
+        self.store.replace_all(gs, self.tr("import {}").format(source), merge=merge)
         warn = f" ({len(gs.warnings)} " + self.tr("warnings") + ")" if gs.warnings else ""
         self.message(self.tr("Imported {} points and {} observations from {}").format(
             len(gs.points), n_obs, source) + warn, Qgis.Warning if gs.warnings else Qgis.Info)
