@@ -245,6 +245,22 @@ class Predictor:
         proj = project_point(self.rec, xyz, images, margin, _lookup=self._lookup)
         return {name: Prediction(point.name, name, x, y, source, c) for name, (x, y, c) in proj.items()}
 
+    def leave_one_out(self, point: GroundPoint) -> Dict[str, float]:
+        """{image: pixels between the observation and where the point's other observations put it}, for
+        points placed in at least 3 registered photos: a wrong click stands out."""
+        obs = [o for o in point.observations if o.image in self._lookup]
+        out: Dict[str, float] = {}
+        if len(obs) < 3:
+            return out
+        for k, o in enumerate(obs):
+            tri = self.triangulate(obs[:k] + obs[k + 1:])
+            if tri is None:
+                continue
+            proj = project_point(self.rec, tri.xyz, [o.image], margin=-1e9, _lookup=self._lookup)
+            if o.image in proj:
+                out[o.image] = float(math.hypot(proj[o.image][0] - o.x, proj[o.image][1] - o.y))
+        return out
+
     def predict(self, gcps: GCPSet, names: Optional[Sequence[str]] = None,
                 margin: float = 0.0) -> Dict[str, Dict[str, Prediction]]:
         """{point name: {image: Prediction}}; fits the world -> model similarity first when needed."""

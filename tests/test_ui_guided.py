@@ -210,3 +210,18 @@ def test_matching_refines_a_prediction_that_is_tens_of_pixels_off(block, georefe
     blank = np.full_like(gray[ref], 128)
     assert guided.refine_by_matching(rec, ref, p.observations[ref], gray[ref], tgt, truth, blank, xyz) is None
     del pred
+
+
+def test_leave_one_out_names_a_wrong_click(block, georeferenced):
+    result, _ = georeferenced
+    pred = guided.Predictor(result.reconstruction, result.offset)
+    p = max(block.gcps, key=lambda q: len(q.observations))
+    gs = block.gcp_set([p.name], noise_px=0.2, only=[p.name])
+    pt = gs.points[0]
+    assert len(pt.observations) >= 4
+    good = pred.leave_one_out(pt)
+    assert len(good) == len(pt.observations) and max(good.values()) < 2.0
+    pt.observations[1].x += 25.0  # a click on the wrong spot
+    bad = pred.leave_one_out(pt)
+    worst = max(bad, key=bad.get)
+    assert worst == pt.observations[1].image and bad[worst] > 15.0

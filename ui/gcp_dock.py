@@ -797,12 +797,11 @@ class GcpDock(QgsDockWidget):
         point = self.current_point()
         marks = {}
         if point is not None:
+            # placed photos: how far the click is from where the point's other photos put it
+            loo = self.predictor.leave_one_out(point) if self.predictor is not None else {}
             for o in point.observations:
-                pr = self.predictions.get(o.image)
-                if pr is not None and len(point.observations) >= 2:
-                    marks[o.image] = "\u2713 " + self.tr("{:.1f} px").format(math.hypot(pr.x - o.x, pr.y - o.y))
-                else:
-                    marks[o.image] = "\u2713"
+                d = loo.get(o.image)
+                marks[o.image] = "\u2713" + (" " + self.tr("{:.1f} px").format(d) if d is not None else "")
             for n in self.predictions:
                 marks.setdefault(n, self.tr("predicted"))
         self.photo_panel.set_thumbnails(self.visible_photos(), marks)
