@@ -89,7 +89,7 @@ class OrthoOptions:
     avoid_relief: bool = True  # keep seamlines off buildings and trees
     relief_height: float = 1.5  # m above the surroundings that makes an object seams go around
     compress: str = "DEFLATE"
-    cache_mb: int = 384  # decoded images + visibility tables kept in memory
+    cache_mb: int = 256  # decoded images + visibility tables kept in memory
     workers: int = 1  # tile workers (core.parallel); 0 = one per core
     scheduler: Optional[str] = None  # Dask scheduler address
 
@@ -479,7 +479,7 @@ class _LRU:
         self.size = 0
 
 
-_CACHE = _LRU(384 << 20)
+_CACHE = _LRU(256 << 20)
 _WHOLE_IMAGE_MAX = 96 << 20  # images up to this size are decoded whole and cached; larger ones read by window
 
 
@@ -1505,6 +1505,8 @@ def _run_tiles(prep: _Prepared, plan: _Plan, dsm_path: str, crs, offset, output:
                 writer.write(res["r0"], res["c0"], res["values"], res["valid"])
                 n_valid += int(res["valid"].sum())
                 fill += res["fill_cells"]
+                del res
+                _trim_heap()
         writer.finish(output, options.compress, None,
                       metadata={"ARCHAEOORTHO_STAGE": "orthophoto", "BLENDING": options.blending,
                                 "IMAGES": len(prep.cameras), "RESOLUTION": grid.resolution})
@@ -1512,6 +1514,25 @@ def _run_tiles(prep: _Prepared, plan: _Plan, dsm_path: str, crs, offset, output:
         writer.abort()
         raise
     return n_valid, fill
+
+
+_LIBC: Any = None
+
+
+def _trim_heap() -> None:
+    """Give freed heap memory back to the system between tiles (glibc keeps it otherwise, and the peak memory
+    would creep up with the number of tiles instead of staying at one tile's worth)."""
+    global _LIBC
+    if _LIBC is None:
+        try:
+            import ctypes
+
+            _LIBC = ctypes.CDLL("libc.so.6")
+            _LIBC.malloc_trim.argtypes = [ctypes.c_size_t]
+        except (OSError, AttributeError):
+            _LIBC = False
+    if _LIBC:
+        _LIBC.malloc_trim(0)
 
 
 def _write_sources_gpkg(path: str, labels: np.ndarray, prep: _Prepared, plan: _Plan, crs: Optional[str]) -> str:
@@ -1688,7 +1709,7 @@ def _orientation_key(name: str) -> Optional[str]:
     return None
 
 
-def _normalise_orientation(d: Dict[str, Any], source: str) -> Dict[str, Any]:
+def _normalise_orientation(d: Dict[str, Any], source: str, exterior: bool = True) -> Dict[str, Any]:
     out: Dict[str, Any] = {}
     for k, v in d.items():
         key = _orientation_key(str(k))
@@ -1702,13 +1723,15 @@ def _normalise_orientation(d: Dict[str, Any], source: str) -> Dict[str, Any]:
             except (TypeError, ValueError) as e:
                 raise OrthoError(f"{source}: {k} = {v!r} is not a number") from e
     missing = [k for k in ("x", "y", "z", "omega", "phi", "kappa") if k not in out]
+    if missing and not exterior and len(missing) == 6 and ("focal_px" in out or "focal_mm" in out):
+        return out  # interior orientation only (with GCPs: space resection with a calibrated camera)
     if missing:
         raise OrthoError(f"{source}: the orientation lacks {', '.join(missing)} (needs x, y, z, omega, phi, kappa "
                          "in degrees; optional focal_mm, sensor_width_mm, focal_px, cx, cy, k1, k2, p1, p2, crs)")
     return out
 
 
-def read_orientation(path: str, image_name: Optional[str] = None) -> Dict[str, Any]:
+def read_orientation(path: str, image_name: Optional[str] = None, exterior: bool = True) -> Dict[str, Any]:
     """Exterior (and optionally interior) orientation of one image from a file.
 
     JSON: ``{"x": .., "y": .., "z": .., "omega": .., "phi": .., "kappa": .., "crs": "EPSG:..", "focal_mm": ..}``
@@ -1741,8 +1764,8 @@ def read_orientation(path: str, image_name: Optional[str] = None) -> Dict[str, A
                 raise OrthoError(f"{path} holds no orientation for {image_name} (images: {', '.join(list(rows)[:6])})")
             merged = {k: v for k, v in d.items() if k != "images"}
             merged.update(hit[0])
-            return _normalise_orientation(merged, path)
-        return _normalise_orientation(d, path)
+            return _normalise_orientation(merged, path, exterior)
+        return _normalise_orientation(d, path, exterior)
     crs = None
     header: Optional[List[str]] = None
     rows: List[List[str]] = []
@@ -1787,7 +1810,7 @@ def read_orientation(path: str, image_name: Optional[str] = None) -> Dict[str, A
     d = dict(hit[0])
     if crs and "crs" not in {_orientation_key(k) for k in d}:
         d["crs"] = crs
-    return _normalise_orientation(d, path)
+    return _normalise_orientation(d, path, exterior)
 
 
 @dataclass
@@ -1854,6 +1877,7 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
                        focal_px: Optional[float] = None, mode: str = "ortho", crs: Optional[str] = None,
                        resolution: float = 0.0, residuals_path: Optional[str] = None,
                        estimate_intrinsics="auto", mask_path: Optional[str] = None,
+                       camera: Optional[Intrinsics] = None,
                        options: Optional[OrthoOptions] = None, progress: Optional[Progress] = None
                        ) -> SingleImageResult:
     """Orthorectify one image (even one outside any block) on an existing DSM.
@@ -1862,7 +1886,9 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
     resection, >= 4 control points, >= 6 to also estimate focal length and k1) or from ``orientation`` (a file
     for :func:`read_orientation` or a dict with x, y, z, omega, phi, kappa).  ``mode`` "ortho": true orthophoto
     on the DSM (required; reprojected on the fly when in another CRS); "planar": projective rectification
-    through the control points onto a plane, and, when a DSM is given, how far that is off.  Writes a COG at
+    through the control points onto a plane, and, when a DSM is given, how far that is off.  ``camera``: a
+    calibrated interior orientation (e.g. the block's camera), kept as it is unless ``estimate_intrinsics`` is
+    True; an orientation file without x..kappa is taken as interior orientation too.  Writes a COG at
     ``output`` and optionally the GCP residuals to the GeoPackage ``residuals_path``."""
     from . import gcp as gcpmod
     from . import resection as rs
@@ -1893,8 +1919,16 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
 
     orient = None
     if orientation is not None:
-        orient = (read_orientation(orientation, name) if isinstance(orientation, str)
-                  else _normalise_orientation(dict(orientation), "ORIENTATION"))
+        orient = (read_orientation(orientation, name, exterior=gcps is None) if isinstance(orientation, str)
+                  else _normalise_orientation(dict(orientation), "ORIENTATION", exterior=gcps is None))
+        if "omega" not in orient:  # interior orientation only
+            interior = orient
+            orient = None
+            if camera is None:
+                f_i, _src = _focal(meta, image_path, None, None, None, interior)
+                camera = Intrinsics.simple(meta.width, meta.height, f_i, interior.get("cx"), interior.get("cy"),
+                                           interior.get("k1", 0.0), interior.get("k2", 0.0), interior.get("p1", 0.0),
+                                           interior.get("p2", 0.0))
     if isinstance(gcps, str):
         try:
             gcps = gcpmod.read_gcps(gcps)
@@ -1943,7 +1977,15 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
     else:
         offset = np.array([round(float(np.mean(xyz[control, 0]))), round(float(np.mean(xyz[control, 1]))), 0.0])
     # interior orientation
-    f_px, f_source = _focal(meta, image_path, focal_px, focal_mm, sensor_width_mm, orient)
+    if camera is not None:
+        if (camera.width, camera.height) != (meta.width, meta.height):
+            raise OrthoError(f"the camera model is {camera.width} x {camera.height} pixels but {name} is "
+                             f"{meta.width} x {meta.height}")
+        f_px, f_source = camera.focal, "calibrated camera"
+        if estimate_intrinsics == "auto":
+            estimate_intrinsics = False
+    else:
+        f_px, f_source = _focal(meta, image_path, focal_px, focal_mm, sensor_width_mm, orient)
     n_control = len(control) if gcps is not None else 0
     if f_px is None:
         if orient is None and n_control >= rs.MIN_INTRINSICS_POINTS:
@@ -1957,8 +1999,9 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
                 f"(or a focal length in the orientation file), or at least {rs.MIN_INTRINSICS_POINTS} GCPs to "
                 "estimate it")
     o = orient or {}
-    cam0 = rs.Intrinsics.simple(meta.width, meta.height, f_px, o.get("cx"), o.get("cy"), o.get("k1", 0.0),
-                                o.get("k2", 0.0), o.get("p1", 0.0), o.get("p2", 0.0))
+    cam0 = camera.as_opencv() if camera is not None else rs.Intrinsics.simple(
+        meta.width, meta.height, f_px, o.get("cx"), o.get("cy"), o.get("k1", 0.0), o.get("k2", 0.0),
+        o.get("p1", 0.0), o.get("p2", 0.0))
     log.append(f"{name}: {meta.width} x {meta.height} px, {meta.bands} band(s) {meta.dtype}, focal {f_px:.1f} px "
                f"({f_source})")
     # exterior orientation

@@ -26,6 +26,7 @@ import numpy as np
 
 MIN_RESECTION_POINTS = 4
 MIN_INTRINSICS_POINTS = 6  # focal length + k1 on top of the pose
+MIN_K2_POINTS = 10  # k2 as well
 MIN_PLANAR_POINTS = 4
 
 # COLMAP camera models this module projects natively: name -> parameter names
@@ -395,6 +396,8 @@ def _refine(xyz: np.ndarray, px: np.ndarray, pose: Pose, cam: Intrinsics, free: 
             p[i_fx] = v[6] * f0
             p[i_fy] = v[6] * f0 * ratio
             p[i_k1] = v[7]
+        elif free == "k1k2":
+            p[i_k1], p[i_k1 + 1] = v[6], v[7]
         else:
             p[i_k1] = v[6]
         return pose_, Intrinsics(base.model, base.width, base.height, tuple(p))
@@ -412,6 +415,8 @@ def _refine(xyz: np.ndarray, px: np.ndarray, pose: Pose, cam: Intrinsics, free: 
         v0 = np.concatenate([v0, [1.0, p0[i_k1]]])
     elif free == "k1":
         v0 = np.concatenate([v0, [p0[i_k1]]])
+    elif free == "k1k2":
+        v0 = np.concatenate([v0, [p0[i_k1], p0[i_k1 + 1]]])
     res = least_squares(fun, v0, method="lm", x_scale="jac", max_nfev=2000)
     pose_, cam_ = unpack(res.x)
     sigma_f = sigma_k = None
@@ -426,7 +431,7 @@ def _refine(xyz: np.ndarray, px: np.ndarray, pose: Pose, cam: Intrinsics, free: 
         if free == "fk1":
             sigma_f, sigma_k = float(d[6]) * f0, float(d[7])
         else:
-            sigma_k = float(d[6])
+            sigma_k = float(d[6])  # k1 (with k1k2: k1's)
     return pose_, cam_, sigma_f, sigma_k
 
 
@@ -512,9 +517,17 @@ def space_resection(xyz: np.ndarray, pixels: np.ndarray, camera: Intrinsics, nam
             if k1_ok:
                 pose, cam = p3, c3
                 est_params = ["k1"]
+                if n_used >= MIN_K2_POINTS:  # many points: k2 too, where it lowers the residuals clearly
+                    p4, c4, _sf4, _sk4 = _refine(xyz[used], pixels[used], p3, c3, "k1k2")
+                    e3 = _errors(p3, c3, xyz[used], pixels[used])
+                    e4 = _errors(p4, c4, xyz[used], pixels[used])
+                    if np.sqrt(np.mean(e4 ** 2)) < 0.8 * np.sqrt(np.mean(e3 ** 2)) and abs(c4.dist[1]) < 1.0:
+                        pose, cam = p4, c4
+                        est_params = ["k1", "k2"]
             warnings.append(f"the focal length of {image} was not estimated: the {n_used} points do not determine "
                             f"it (sigma {100 * rel:.0f} %; flat or clustered GCPs); the given focal length was kept"
-                            + (f", k1 estimated alone ({c3.dist[0]:+.4f})" if k1_ok else ", and k1 too"))
+                            + (f", {' and '.join(est_params)} estimated ({', '.join(f'{v:+.4f}' for v in cam.dist[:len(est_params)])})"
+                               if k1_ok else ", and k1 too"))
             estimated = k1_ok
     elif estimate_intrinsics == "auto" and n >= MIN_INTRINSICS_POINTS and n_used < MIN_INTRINSICS_POINTS:
         warnings.append(f"focal length and k1 of {image} were not estimated: only {n_used} points agree "
