@@ -1114,6 +1114,7 @@ class GcpDock(QgsDockWidget):
             self._task_ended()
             self.progress.setValue(100)
             self.store.reload_workspace()
+            self.store.save()  # the stage wrote the points it used to control.json: keep all of the dock's
             self.store.load_residuals()
             self.load_predictor()
             self._selection_changed()
