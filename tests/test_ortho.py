@@ -289,6 +289,31 @@ def test_hidden_cells_are_nodata_in_the_per_image_orthophoto(scene, mosaic):
     assert (~ortho_ok & seen).sum() / seen.sum() < 0.03  # visible cells lost: < 3 %
 
 
+def test_masked_pixels_stay_nodata(scene, tmp_path):
+    """<workspace>/masks/<image>.png (white = use, as core.scans writes them): masked pixels give no data."""
+    block, _root, images, dsm, _ws = scene
+    ws = make_workspace(str(tmp_path / "ws"), block, images, names=["S2_02.jpg", "S2_03.jpg"])
+    os.makedirs(os.path.join(ws, "masks"))
+    mask = np.full((CAMERA.height, CAMERA.width), 255, np.uint8)
+    mask[:, : CAMERA.width // 2] = 0
+    cv2.imwrite(os.path.join(ws, "masks", "S2_02.jpg.png"), mask)
+    res = ortho.build_orthophoto_workspace(ws, dsm_path=dsm, resolution=0.2, images_filter="S2_02.jpg",
+                                           per_image_folder=str(tmp_path / "per"))
+    a, gt = _read(os.path.join(str(tmp_path / "per"), "S2_02.tif"))
+    h, w = a.shape[1:]
+    cols, rows = np.meshgrid(np.arange(w), np.arange(h))
+    x = gt[0] + (cols + 0.5) * gt[1] - syn.ORIGIN[0]
+    y = gt[3] + (rows + 0.5) * gt[5] - syn.ORIGIN[1]
+    xyz = np.column_stack([x.ravel(), y.ravel(), block.scene.height_at(x.ravel(), y.ravel())])
+    px, depth = block.project(block.shot("S2_02.jpg"), xyz)
+    valid = a[-1].ravel() > 0
+    left = CAMERA.inside(px, 2.0) & (px[:, 0] < CAMERA.width / 2 - 2)
+    right = CAMERA.inside(px, 2.0) & (px[:, 0] > CAMERA.width / 2 + 2)
+    assert left.sum() > 1000 and not valid[left].any()
+    assert valid[right].mean() > 0.9
+    assert 0.2 < res.valid_fraction < 0.7
+
+
 def test_which_image_layer_names_images(scene, mosaic):
     ds = gdal.OpenEx(mosaic.seamlines)
     lyr = ds.GetLayer(0)
