@@ -87,7 +87,7 @@ class OrthoOptions:
     height_tolerance: float = 0.0  # m below the sight line still counted visible; 0 = max(0.1, DSM cell)
     exposure: bool = True  # per-image gain compensation in the mosaic
     avoid_relief: bool = True  # keep seamlines off buildings and trees
-    seam_iterations: int = 10  # moves of the seamlines towards where the images agree (0 = off)
+    seam_iterations: int = 2  # passes moving the seamlines towards where the images agree (0 = off)
     seam_alpha: float = 5.0  # weight of the view cost against the seam cost in those moves
     relief_height: float = 1.5  # m above the surroundings that makes an object seams go around
     compress: str = "DEFLATE"
@@ -1164,14 +1164,15 @@ def _seam_disagreement(labels: np.ndarray, windows, greys, scale: float) -> floa
     return tot / n / scale if n else 0.0
 
 
-def _refine_seams(labels: np.ndarray, windows, costs, greys, scale: float, iterations: int,
-                  alpha: float = 5.0, tol: float = 0.05) -> np.ndarray:
-    """Move seamlines (a few planning cells) to where the two images agree and the scene has no edges.
-
-    Iterated conditional modes on the seam cells (checkerboard halves): a cell takes the label (its own or a
-    neighbour's, valid there) that minimises alpha * view cost + sum over its 4 neighbours of a different label of
-    1 + |grey_a - grey_b| / tol + (gradient_a + gradient_b) / (2 tol)  (brightness as a fraction of full scale)."""
+def _refine_seams(labels: np.ndarray, windows, costs, greys, scale: float, iterations: int = 1,
+                  alpha: float = 5.0, tol: float = 0.05, band: int = 8) -> np.ndarray:
+    """Move the seamline between every two adjacent images within a band of ``band`` planning cells to where the
+    two images agree and the scene has no edges: a minimum cut (scipy max-flow) of the band with the cost
+    alpha * view cost per cell and, per seam edge, 1 + |grey_a - grey_b| / tol + mean gradient / tol
+    (brightness as a fraction of full scale).  Cells outside the band, or seen by only one of the two, stay."""
     import cv2
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import breadth_first_order, maximum_flow
 
     grads = []
     for g in greys:
@@ -1185,39 +1186,86 @@ def _refine_seams(labels: np.ndarray, windows, costs, greys, scale: float, itera
     norm = [None if g is None else g / scale for g in greys]
     labels = labels.copy()
     h, w = labels.shape
-    for _ in range(iterations):
+    kernel = np.ones((2 * band + 1, 2 * band + 1), np.uint8)
+    for _ in range(max(1, iterations)):
+        pairs = set()
+        for a_, b_ in ((labels[:, 1:], labels[:, :-1]), (labels[1:], labels[:-1])):
+            m = (a_ != b_) & (a_ >= 0) & (b_ >= 0)
+            for u, v in zip(a_[m].tolist(), b_[m].tolist()):
+                pairs.add((min(u, v), max(u, v)))
         changed = 0
-        for parity in (0, 1):
-            rr, cc = _seam_cells(labels, parity)
-            if not len(rr):
+        for la, lb in sorted(pairs):
+            in_a, in_b = labels == la, labels == lb
+            seam = np.zeros_like(in_a)
+            seam[:, 1:] |= (in_a[:, 1:] & in_b[:, :-1]) | (in_b[:, 1:] & in_a[:, :-1])
+            seam[:, :-1] |= (in_a[:, :-1] & in_b[:, 1:]) | (in_b[:, :-1] & in_a[:, 1:])
+            seam[1:] |= (in_a[1:] & in_b[:-1]) | (in_b[1:] & in_a[:-1])
+            seam[:-1] |= (in_a[:-1] & in_b[1:]) | (in_b[:-1] & in_a[1:])
+            if not seam.any():
                 continue
-            own = labels[rr, cc]
-            neigh = []
-            for dr, dc in _NEIGHBOURS:
+            rows, cols = np.nonzero(seam)
+            r0, r1 = max(0, rows.min() - band - 1), min(h, rows.max() + band + 2)
+            c0, c1 = max(0, cols.min() - band - 1), min(w, cols.max() + band + 2)
+            sub = labels[r0:r1, c0:c1]
+            near = cv2.dilate(seam[r0:r1, c0:c1].astype(np.uint8), kernel) > 0
+            cand = near & ((sub == la) | (sub == lb))
+            rr, cc = np.nonzero(cand)
+            gr, gc = rr + r0, cc + c0
+            ca = _gather(costs, windows, np.full(len(rr), la), gr, gc)
+            cb = _gather(costs, windows, np.full(len(rr), lb), gr, gc)
+            ok = np.isfinite(ca) & np.isfinite(cb)
+            if ok.sum() < 4:
+                continue
+            rr, cc, gr, gc, ca, cb = rr[ok], cc[ok], gr[ok], gc[ok], ca[ok], cb[ok]
+            n = len(rr)
+            index = np.full(sub.shape, -1, dtype=np.int64)
+            index[rr, cc] = np.arange(n)
+            ga = _gather(norm, windows, np.full(n, la), gr, gc, np.nan)
+            gb = _gather(norm, windows, np.full(n, lb), gr, gc, np.nan)
+            diff = np.nan_to_num(np.abs(ga - gb), nan=0.2)
+            edge = (_gather(grads, windows, np.full(n, la), gr, gc, 0.0)
+                    + _gather(grads, windows, np.full(n, lb), gr, gc, 0.0)) / 2.0
+            unit = diff / tol + edge / tol  # per cell; an edge costs 1 + the mean of its two cells
+            d_a = alpha * ca.astype(np.float64)  # cost of giving the cell to la
+            d_b = alpha * cb.astype(np.float64)
+            src, dst, cap = [], [], []
+            for dr, dc in ((0, 1), (1, 0), (0, -1), (-1, 0)):
                 qr, qc = rr + dr, cc + dc
-                inside = (qr >= 0) & (qr < h) & (qc >= 0) & (qc < w)
-                lab = np.full(len(rr), -1, dtype=labels.dtype)
-                lab[inside] = labels[qr[inside], qc[inside]]
-                neigh.append(lab)
-            cands = [own] + neigh
-            g_n = [_gather(norm, windows, m, rr, cc, np.nan) for m in neigh]
-            d_n = [_gather(grads, windows, m, rr, cc, 0.0) for m in neigh]
-            best_e = np.full(len(rr), np.inf, dtype=np.float32)
-            best_l = own.copy()
-            for cand in cands:
-                e = alpha * _gather(costs, windows, cand, rr, cc, np.inf)
-                e[cand < 0] = np.inf
-                g_c = _gather(norm, windows, cand, rr, cc, np.nan)
-                d_c = _gather(grads, windows, cand, rr, cc, 0.0)
-                for m, g_m, d_m in zip(neigh, g_n, d_n):
-                    diff = (m >= 0) & (m != cand)
-                    pen = 1.0 + np.nan_to_num(np.abs(g_c - g_m), nan=0.2) / tol + (d_c + d_m) / (2 * tol)
-                    e = e + np.where(diff, pen, 0.0)
-                better = e < best_e - 1e-6
-                best_e[better] = e[better]
-                best_l[better] = cand[better]
-            moved = best_l != own
-            labels[rr[moved], cc[moved]] = best_l[moved]
+                inside = (qr >= 0) & (qr < sub.shape[0]) & (qc >= 0) & (qc < sub.shape[1])
+                q = np.full(n, -1, dtype=np.int64)
+                q[inside] = index[qr[inside], qc[inside]]
+                lq = np.full(n, -1, dtype=labels.dtype)
+                lq[inside] = sub[qr[inside], qc[inside]]
+                fixed = inside & (q < 0) & (lq >= 0)  # a neighbour that keeps its label
+                wgt = 1.0 + unit
+                d_a += np.where(fixed & (lq != la), wgt, 0.0)
+                d_b += np.where(fixed & (lq != lb), wgt, 0.0)
+                if dr >= 0 and dc >= 0:  # each free-free edge once, both directions
+                    both = q >= 0
+                    if both.any():
+                        wq = 1.0 + 0.5 * (unit[both] + unit[q[both]])
+                        src += [np.arange(n)[both], q[both]]
+                        dst += [q[both], np.arange(n)[both]]
+                        cap += [wq, wq]
+            s_node, t_node = n, n + 1
+            lo = np.minimum(d_a, d_b)
+            src += [np.full(n, s_node), np.arange(n)]
+            dst += [np.arange(n), np.full(n, t_node)]
+            cap += [d_b - lo, d_a - lo]  # cutting s->p puts p on lb's side (pays d_b), p->t on la's side
+            cap_i = np.maximum(0, np.rint(np.concatenate(cap) * 100.0)).astype(np.int32)
+            si, di = np.concatenate(src), np.concatenate(dst)
+            keep = cap_i > 0
+            graph = coo_matrix((cap_i[keep], (si[keep], di[keep])), shape=(n + 2, n + 2)).tocsr()
+            flow = maximum_flow(graph, s_node, t_node).flow
+            residual = (graph - flow).tocsr()
+            residual.data = (residual.data > 0).astype(np.int8)
+            residual.eliminate_zeros()
+            reach = breadth_first_order(residual, s_node, directed=True, return_predecessors=False)
+            side_a = np.zeros(n + 2, dtype=bool)
+            side_a[reach] = True
+            new = np.where(side_a[:n], la, lb)
+            moved = new != sub[rr, cc]
+            sub[rr[moved], cc[moved]] = new[moved]
             changed += int(moved.sum())
         if changed == 0:
             break

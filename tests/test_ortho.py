@@ -351,6 +351,26 @@ def test_select_cameras_by_name_wildcard_and_group():
         names("zzz*")
 
 
+def test_seamlines_move_to_where_the_images_agree():
+    """Two images, equal view cost at column 20, but they disagree (a moving object) on columns 17-23: the seam
+    leaves that band."""
+    h, w = 20, 40
+    x = np.arange(w, dtype=np.float32)[None, :].repeat(h, 0)
+    costs = [0.005 * x, 0.005 * (w - x)]
+    rng = np.random.default_rng(0)
+    base = (100 + 20 * rng.random((h, w))).astype(np.float32)
+    other = base.copy()
+    other[:, 17:24] += 80.0
+    labels = np.where(x < 20, 0, 1).astype(np.int32)
+    windows = [(0, 0, h, w), (0, 0, h, w)]
+    before = ortho._seam_disagreement(labels, windows, [base, other], 255.0)
+    moved = ortho._refine_seams(labels, windows, costs, [base, other], 255.0, 10)
+    after = ortho._seam_disagreement(moved, windows, [base, other], 255.0)
+    cols = [int(np.flatnonzero(row == 1)[0]) for row in moved]
+    assert all(c <= 17 or c >= 24 for c in cols), cols
+    assert after < 0.2 * before
+
+
 # ---------------------------------------------------------------------------
 # bad input
 # ---------------------------------------------------------------------------
