@@ -52,7 +52,9 @@ $(PLUGINS)/archaeoortho:
 	@ln -sfn $(ROOT) $@
 
 setup: apt venv plugin-link transcompile
-	@$(PROCESS_ENV) $(QGIS_PROCESS) plugins enable archaeoortho >/dev/null 2>&1 || true
+	@$(PROCESS_ENV) $(QGIS_PROCESS) plugins enable archaeoortho >$(BUILD)/plugins-enable.log 2>&1 \
+	  || grep -q "already enabled" $(BUILD)/plugins-enable.log \
+	  || echo "warning: 'qgis_process plugins enable archaeoortho' failed, see $(BUILD)/plugins-enable.log" >&2
 	@echo "setup done: $(PY), plugin linked at $(PLUGINS)/archaeoortho, qgis_process = $(QGIS_PROCESS)" >&2
 
 process: setup

@@ -35,6 +35,38 @@ def copy_images(src_dir, names, dst_dir):
 TOLEDO_STRIP = ["1JI_0064.JPG", "1JI_0065.JPG", "1JI_0066.JPG", "1JI_0067.JPG", "1JI_0068.JPG", "1JI_0076.JPG"]
 
 
+_ENABLED = {}
+
+
+def qgis_process():
+    """(qgis_process executable, environment) exactly as a user runs it headless: the venv's packages on
+    PYTHONPATH, the plugin folder, the private profile, and the plugin enabled in that profile (checked once a
+    session: a profile that QGIS rewrote, or one made fresh, must not hide the provider).  Skips without
+    qgis_process or the plugin link ('make setup' makes both)."""
+    import subprocess
+    import sysconfig
+
+    exe = os.environ.get("QGIS_PROCESS") or "/usr/bin/qgis_process.bin"
+    if not os.path.exists(exe):
+        pytest.skip("qgis_process not installed")
+    if not os.path.islink(os.path.join(PLUGINS, "archaeoortho")):
+        pytest.skip("plugin link missing: run 'make setup'")
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([sysconfig.get_paths()["purelib"], env.get("PYTHONPATH", "")])
+    env["QGIS_PLUGINPATH"] = PLUGINS
+    env["QT_QPA_PLATFORM"] = "offscreen"
+    env.setdefault("QGIS_CUSTOM_CONFIG_PATH", os.path.join(ROOT, "build", "qgis-profile"))
+    key = env["QGIS_CUSTOM_CONFIG_PATH"]
+    if key not in _ENABLED:
+        out = subprocess.run([exe, "plugins", "enable", "archaeoortho"], env=env, capture_output=True, text=True,
+                             timeout=300)
+        listing = subprocess.run([exe, "plugins"], env=env, capture_output=True, text=True, timeout=300)
+        assert "* archaeoortho" in listing.stdout, (
+            f"qgis_process did not enable the plugin: {out.stdout[-1500:]} {out.stderr[-1500:]} {listing.stdout}")
+        _ENABLED[key] = True
+    return exe, env
+
+
 @pytest.fixture(scope="session")
 def toledo_strip(tmp_path_factory):
     d = tmp_path_factory.mktemp("toledo strip")

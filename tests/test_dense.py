@@ -404,16 +404,10 @@ def test_pool_python_is_this_installation(monkeypatch):
 def test_qgis_process_builds_a_dsm_with_a_process_pool(built, tmp_path):
     """Headless, as a user runs it: qgis_process (embedded Python) spawning pool workers."""
     import subprocess
-    import sysconfig
 
-    from tests.conftest import PLUGINS, ROOT
+    from tests.conftest import qgis_process
 
-    exe = os.environ.get("QGIS_PROCESS") or "/usr/bin/qgis_process.bin"
-    if not os.path.exists(exe) or not os.path.islink(os.path.join(PLUGINS, "archaeoortho")):
-        pytest.skip("qgis_process or the plugin link missing: run 'make setup'")
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([sysconfig.get_paths()["purelib"], os.environ.get("PYTHONPATH", "")]),
-               QGIS_PLUGINPATH=PLUGINS, QT_QPA_PLATFORM="offscreen")
-    env.setdefault("QGIS_CUSTOM_CONFIG_PATH", os.path.join(ROOT, "build", "qgis-profile"))
+    exe, env = qgis_process()
     block, r = built
     ws = _copy_ws(os.path.dirname(r.workspace), tmp_path)
     out = subprocess.run([exe, "--json", "run", "archaeoortho:builddsm", "--", f"WORKSPACE={ws}", "QUALITY=1",

@@ -6,7 +6,7 @@ import sys
 
 import pytest
 
-from tests.conftest import PLUGINS, ROOT, SAMPLE, TOLEDO_STRIP, copy_images
+from tests.conftest import PLUGINS, SAMPLE, TOLEDO_STRIP, copy_images, qgis_process
 
 pytestmark = pytest.mark.usefixtures("qgis_processing")
 
@@ -90,31 +90,10 @@ def test_cancel_button_stops_the_stage(plugin, tmp_path):
     assert not os.path.exists(tmp_path / "ws" / "sfm" / "model")
 
 
-def _qgis_process_env():
-    import sysconfig
-
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([sysconfig.get_paths()["purelib"], env.get("PYTHONPATH", "")])
-    env["QGIS_PLUGINPATH"] = PLUGINS
-    env["QT_QPA_PLATFORM"] = "offscreen"
-    env.setdefault("QGIS_CUSTOM_CONFIG_PATH", os.path.join(ROOT, "build", "qgis-profile"))
-    return env
-
-
-def _qgis_process():
-    exe = os.environ.get("QGIS_PROCESS") or "/usr/bin/qgis_process.bin"
-    if not os.path.exists(exe):
-        pytest.skip("qgis_process not installed")
-    return exe
-
-
 @pytest.mark.slow
 def test_qgis_process_cli_end_to_end(tmp_path):
     """Exactly as a user runs it headless: qgis_process --json run archaeoortho:alignimages."""
-    exe, env = _qgis_process(), _qgis_process_env()
-    if not os.path.islink(os.path.join(PLUGINS, "archaeoortho")):
-        pytest.skip("plugin link missing: run 'make setup'")
-    subprocess.run([exe, "plugins", "enable", "archaeoortho"], env=env, capture_output=True, timeout=120)
+    exe, env = qgis_process()
     images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:4], str(tmp_path / "my photos ä"))
     ws = str(tmp_path / "work space")
     out = subprocess.run([exe, "--json", "run", "archaeoortho:alignimages", "--", f"IMAGES={images}",

@@ -168,11 +168,9 @@ def test_qgis_process_runs_headless_with_the_dock_code_present(aligned, tmp_path
     """qgis_process (no iface, platform qgis_process) runs Georeference; the hook stays out of the way."""
     import json
 
-    from tests.test_qgis_plugin import _qgis_process, _qgis_process_env
+    from tests.conftest import qgis_process
 
-    exe, env = _qgis_process(), _qgis_process_env()
-    if not os.path.islink(os.path.join(PLUGINS, "archaeoortho")):
-        pytest.skip("plugin link missing: run 'make setup'")
+    exe, env = qgis_process()
     ws, gcp_file = aligned
     out = subprocess.run([exe, "--json", "run", "archaeoortho:georeference", "--", f"WORKSPACE={ws}",
                           f"GCPS={gcp_file}"], env=env, capture_output=True, text=True, timeout=600)
