@@ -24,6 +24,9 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, ROOT)
+sys.path.insert(0, HERE)
+from _util import tree_rss  # noqa: E402
+
 DATA = os.path.join(os.path.dirname(ROOT), "shared", "data")
 
 
@@ -47,33 +50,6 @@ def ensure_georeferenced(images, ws, crs):
     print(f"georeferenced with EXIF GPS: camera RMSE {r.figures['CAMERA_RMSE_XYZ']:.2f} m")
 
 
-def _tree_rss(root_pid):
-    """Sum of RSS (bytes) of a process and all its descendants (Linux /proc)."""
-    parents = {}
-    rss = {}
-    page = os.sysconf("SC_PAGE_SIZE")
-    for d in os.listdir("/proc"):
-        if not d.isdigit():
-            continue
-        try:
-            with open(f"/proc/{d}/stat") as f:
-                st = f.read()
-            fields = st[st.rfind(")") + 2:].split()
-            parents[int(d)] = int(fields[1])
-            rss[int(d)] = int(fields[21]) * page
-        except (OSError, IndexError, ValueError):
-            continue
-    tree = {root_pid}
-    changed = True
-    while changed:
-        changed = False
-        for pid, ppid in parents.items():
-            if ppid in tree and pid not in tree:
-                tree.add(pid)
-                changed = True
-    return sum(rss.get(p, 0) for p in tree), len(tree)
-
-
 def run_child(args):
     """Run the DSM stage in a child process; sample the tree's memory every 0.2 s."""
     out_json = os.path.join(os.path.dirname(os.path.abspath(args.workspace)), "bench-dense-result.json")
@@ -87,7 +63,7 @@ def run_child(args):
 
     def sample():
         while not stop.wait(0.2):
-            s, n = _tree_rss(proc.pid)
+            s, n = tree_rss(proc.pid)
             if s > peak["sum"]:
                 peak["sum"], peak["procs"] = s, n
 

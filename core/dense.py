@@ -51,7 +51,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from . import dsm as dsmmod
-from .parallel import check_unit_cancel, cpu_count, make_executor, run_units
+from .parallel import check_unit_cancel, cpu_count, describe_executor, make_executor, run_units
 from .progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
 from .workspace import (
     CANCELLED,
@@ -907,6 +907,7 @@ def _cpu_points(views, pairs: List[PairInfo], xyz, scale, options: DenseOptions,
     unit_mem = _unit_memory(views, scale)
     executor = make_executor(options.workers, options.executor, options.scheduler, unit_memory=unit_mem)
     workers = getattr(executor, "_max_workers", 1) or 1
+    where = describe_executor(executor)
     threads = _threads_per_unit(workers)
 
     # 2. matching, pair by pair
@@ -948,7 +949,7 @@ def _cpu_points(views, pairs: List[PairInfo], xyz, scale, options: DenseOptions,
     mp = sum(s.get("megapixels", 0.0) for s in matched)
     log.append(f"matching: {len(matched)} pairs ({n_reused} reused from a previous run), "
                f"{np.mean(secs) if secs else 0:.2f} s per pair, {sum(secs) / max(mp, 1e-9):.2f} s per megapixel, "
-               f"{workers} worker(s)")
+               f"{where}")
     progress.info(log[-1])
 
     # 3. fusion, image by image

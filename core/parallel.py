@@ -32,6 +32,8 @@ from typing import Any, Callable, Iterator, List, Optional, Sequence, Tuple
 from .progress import Cancelled, NullProgress, Progress
 
 KINDS = ("auto", "serial", "process", "thread")
+# batch use: a Dask scheduler address in this environment variable sends every stage's units to that cluster
+SCHEDULER_ENV = "ARCHAEOORTHO_DASK_SCHEDULER"
 
 
 class ParallelError(RuntimeError):
@@ -105,22 +107,31 @@ class SerialExecutor(cf.Executor):
         return fut
 
 
+def resolve_scheduler(scheduler: Optional[str] = None) -> Optional[str]:
+    """The Dask scheduler address to use: the one given, else ``$ARCHAEOORTHO_DASK_SCHEDULER``, else None."""
+    address = (scheduler or "").strip() or os.environ.get(SCHEDULER_ENV, "").strip()
+    return address or None
+
+
 def make_executor(workers: int = 0, kind: str = "auto", scheduler: Optional[str] = None,
-                  unit_memory: int = 0):
+                  unit_memory: int = 0, connect_timeout: float = 30.0):
     """An executor for units of work.
 
     ``workers`` 0 = one per core (bounded by ``unit_memory``); ``kind`` auto = serial for one worker,
-    else processes; ``scheduler`` = a Dask scheduler address (tcp://host:8786) to use a cluster.
-    The caller shuts it down (``with make_executor(...) as ex:``)."""
+    else processes; ``scheduler`` = a Dask scheduler address (tcp://host:8786; default
+    ``$ARCHAEOORTHO_DASK_SCHEDULER``) to use a cluster, whose workers must see the same paths (a shared
+    file system) and have this plugin's ``core`` importable.  The caller shuts it down
+    (``with make_executor(...) as ex:``)."""
+    scheduler = resolve_scheduler(scheduler)
     if scheduler:
         try:
             from dask.distributed import Client  # optional dependency
         except ImportError as e:
             raise ParallelError(f"a Dask scheduler ({scheduler}) was given but dask.distributed is not installed "
-                                "in the Python that runs ArchaeoOrtho") from e
+                                "in the Python that runs ArchaeoOrtho (pip install 'dask[distributed]')") from e
         try:
-            return _DaskExecutor(Client(scheduler, timeout=30))
-        except OSError as e:
+            return _DaskExecutor(Client(scheduler, timeout=connect_timeout, set_as_default=False))
+        except (OSError, TimeoutError) as e:
             raise ParallelError(f"cannot reach the Dask scheduler {scheduler}: {e}") from e
     if kind not in KINDS:
         raise ParallelError(f"unknown executor kind {kind!r}; choose one of {', '.join(KINDS)}")
@@ -140,11 +151,29 @@ def make_executor(workers: int = 0, kind: str = "auto", scheduler: Optional[str]
     return cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx)
 
 
+def executor_kind(executor) -> str:
+    """'dask', 'serial', 'thread' or 'process': for the log."""
+    if isinstance(executor, _DaskExecutor):
+        return "dask"
+    if isinstance(executor, SerialExecutor):
+        return "serial"
+    return "thread" if isinstance(executor, cf.ThreadPoolExecutor) else "process"
+
+
+def describe_executor(executor) -> str:
+    """'2 worker(s)' locally, 'Dask cluster tcp://...: 8 worker thread(s)' on a cluster."""
+    n = getattr(executor, "_max_workers", 1) or 1
+    if isinstance(executor, _DaskExecutor):
+        return f"Dask cluster {executor.address}: {n} worker thread(s)"
+    return f"{n} worker(s)"
+
+
 class _DaskExecutor:
     """The concurrent.futures subset run_units needs, on a dask.distributed Client."""
 
     def __init__(self, client):
         self.client = client
+        self.address = client.scheduler.address
         self._max_workers = max(1, sum(client.nthreads().values()))
 
     def submit(self, fn, *args, **kwargs):
@@ -292,5 +321,5 @@ def _wait_all(futures: List[Any], timeout: float) -> None:
         cf.wait(cf_futs, timeout=timeout)
 
 
-__all__ = ["make_executor", "run_units", "check_unit_cancel", "cancel_requested", "auto_workers", "cpu_count",
+__all__ = ["make_executor", "resolve_scheduler", "executor_kind", "describe_executor", "SCHEDULER_ENV", "run_units", "check_unit_cancel", "cancel_requested", "auto_workers", "cpu_count",
            "ParallelError", "SerialExecutor", "python_executable"]

@@ -249,4 +249,71 @@ def _write_residual_layer(ws: Workspace, result, crs: str) -> str:
     return write_points_gpkg(ws.path("georef", "residuals.gpkg"), "residuals", rows, fields, crs)
 
 
-__all__ = ["georeference_workspace", "load_georef_model", "model_path", "StageError", "WorkspaceError"]
+@dataclass
+class PipelineResult:
+    """What ``run_pipeline`` did: each stage's own result object (None where the stage did not run)."""
+    workspace: str
+    align: object
+    georef: Optional[GeorefStageResult]
+    dsm: object = None
+    ortho: object = None
+    report: object = None
+    seconds: Dict[str, float] = field(default_factory=dict)
+    warnings: List[str] = field(default_factory=list)
+
+
+def run_pipeline(images_dir: str, workspace_dir: str, *, align_options=None, gcp_path: Optional[str] = None,
+                 gcps: Optional[gcpmod.GCPSet] = None, check_points: Sequence[str] = (),
+                 camera_positions_path: Optional[str] = None, use_exif_gps: bool = False, crs: Optional[str] = None,
+                 refine_intrinsics: bool = False, dsm_resolution: float = 0.0, dsm_quality: str = "half",
+                 dense_options=None, ortho_resolution: float = 0.0, blending: str = "feather",
+                 images_filter: Optional[str] = None, ortho_options=None, report: bool = True,
+                 uncertainty: bool = True, progress: Optional[Progress] = None) -> PipelineResult:
+    """The whole chain in one call: align -> georeference -> DSM -> orthomosaic -> report.
+
+    The same stage functions the single Processing algorithms call, in order, on one workspace; every
+    stage records itself in workspace.json as when run alone, so a re-run resumes (features, matches and
+    dense pairs already computed are reused).  Without ground control or camera positions the chain stops
+    after the alignment: a DSM and an orthophoto need a metric scale and a vertical direction, so that is a
+    StageError naming what to give."""
+    from . import dense, ortho, sfm
+    from . import report as reportmod
+
+    progress = progress or NullProgress()
+    if gcp_path is None and gcps is None and not camera_positions_path and not use_exif_gps:
+        raise StageError("the pipeline needs ground control (GCPS) and/or camera positions (CAMERA_POSITIONS or "
+                         "USE_EXIF_GPS) to georeference the block before the DSM and orthophoto; to align only, "
+                         "run 'Align images'")
+    seconds: Dict[str, float] = {}
+    spans = (("align", 0.0, 0.40), ("georeference", 0.40, 0.45), ("dsm", 0.45, 0.75),
+             ("orthophoto", 0.75, 0.93), ("report", 0.93, 1.0))
+
+    def run(name, fn, *args, **kwargs):
+        lo, hi = next((a, b) for n, a, b in spans if n == name)
+        progress.info(f"--- stage {name} ---")
+        t0 = time.time()
+        out = fn(*args, progress=SubProgress(progress, lo, hi), **kwargs)
+        seconds[name] = round(time.time() - t0, 2)
+        return out
+
+    res = PipelineResult(workspace=os.path.abspath(workspace_dir), align=None, georef=None, seconds=seconds)
+    res.align = run("align", sfm.align, images_dir, workspace_dir, align_options)
+    res.georef = run("georeference", georeference_workspace, workspace_dir, gcp_path=gcp_path, gcps=gcps,
+                     check_points=check_points, camera_positions_path=camera_positions_path,
+                     use_exif_gps=use_exif_gps, crs=crs, refine_intrinsics=refine_intrinsics)
+    res.warnings += res.georef.warnings
+    res.dsm = run("dsm", dense.build_dsm_workspace, workspace_dir, resolution=dsm_resolution, quality=dsm_quality,
+                  options=dense_options)
+    res.warnings += res.dsm.warnings
+    res.ortho = run("orthophoto", ortho.build_orthophoto_workspace, workspace_dir, images_filter=images_filter,
+                    resolution=ortho_resolution, blending=blending, options=ortho_options)
+    res.warnings += res.ortho.warnings
+    if report:
+        res.report = run("report", reportmod.build_report, workspace_dir, uncertainty=uncertainty)
+        res.warnings += res.report.warnings
+    progress.report(1.0, "pipeline done")
+    return res
+
+
+__all__ = ["georeference_workspace", "load_georef_model", "model_path", "run_pipeline", "PipelineResult",
+           "StageError", "WorkspaceError"]

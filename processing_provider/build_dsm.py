@@ -22,7 +22,7 @@ class BuildDsmAlgorithm(AlgorithmBase):
     QUALITY = "QUALITY"
     ENGINE = "ENGINE"
     WORKERS = "WORKERS"
-    SCHEDULER = "SCHEDULER"
+    SCHEDULER = "DASK_SCHEDULER"
     OUTPUT_DSM = "OUTPUT_DSM"
     OUTPUT_POINT_CLOUD = "OUTPUT_POINT_CLOUD"
     OUT_WORKSPACE = "WORKSPACE"  # the same name as the input: models chain stages through it
@@ -44,7 +44,9 @@ class BuildDsmAlgorithm(AlgorithmBase):
         "QUALITY: image scale for matching (full, half, quarter): half is four times faster than full.\n"
         "ENGINE: cpu (default); cuda runs COLMAP patch-match stereo where pycolmap was built with CUDA.\n"
         "OUTPUT_DSM: Cloud-Optimized GeoTIFF, float32 with nodata (default: <workspace>/dsm.tif).\n"
-        "OUTPUT_POINT_CLOUD: optional LAS file (XYZ + RGB, workspace CRS).\n\n"
+        "OUTPUT_POINT_CLOUD: optional LAS file (XYZ + RGB, workspace CRS).\n"
+        "DASK_SCHEDULER: run the stereo pairs on a Dask cluster (tcp://host:8786) whose workers see the workspace "
+        "path; empty = this computer (or the ARCHAEOORTHO_DASK_SCHEDULER environment variable).\n\n"
         "Re-running after a cancel resumes: pairs already matched are reused from <workspace>/dense/."
     )
 
@@ -62,7 +64,7 @@ class BuildDsmAlgorithm(AlgorithmBase):
             self.WORKERS, self.tr("Parallel workers (0 = one per core)"), type=QgsProcessingParameterNumber.Integer,
             defaultValue=0, minValue=0)
         scheduler = QgsProcessingParameterString(
-            self.SCHEDULER, self.tr("Dask scheduler address (empty = this computer)"), defaultValue="", optional=True)
+            self.SCHEDULER, self.tr("Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)"), defaultValue="", optional=True)
         for p in (workers, scheduler):
             p.setFlags(p.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
             self.addParameter(p)

@@ -27,6 +27,7 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
     BLENDING = "BLENDING"
     INTERPOLATION = "INTERPOLATION"
     WORKERS = "WORKERS"
+    SCHEDULER = "DASK_SCHEDULER"
     OUTPUT = "OUTPUT"
     PER_IMAGE_FOLDER = "PER_IMAGE_FOLDER"
     SEAMLINES = "SEAMLINES"
@@ -54,7 +55,8 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
         "OUTPUT: Cloud-Optimized GeoTIFF with overviews, the images' bands and data type (8/16 bit kept) plus "
         "an alpha band (default <workspace>/orthomosaic.tif).\n"
         "PER_IMAGE_FOLDER: optional folder for one true orthophoto per image (COG).\n"
-        "SEAMLINES: optional GeoPackage of polygons naming the image each part of the mosaic comes from."
+        "SEAMLINES: optional GeoPackage of polygons naming the image each part of the mosaic comes from.\n"
+        "DASK_SCHEDULER: render the tiles on a Dask cluster (tcp://host:8786) whose workers see the workspace path."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
@@ -76,7 +78,10 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
         workers = QgsProcessingParameterNumber(
             self.WORKERS, self.tr("Parallel tile workers (0 = one per core)"),
             type=QgsProcessingParameterNumber.Integer, defaultValue=1, minValue=0)
-        for p in (interp, workers):
+        scheduler = QgsProcessingParameterString(
+            self.SCHEDULER, self.tr("Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)"),
+            defaultValue="", optional=True)
+        for p in (interp, workers, scheduler):
             p.setFlags(p.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
             self.addParameter(p)
         self.addParameter(QgsProcessingParameterRasterDestination(
@@ -108,7 +113,8 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
                 seamlines))
         options = ortho.OrthoOptions(
             interpolation=self.INTERPOLATIONS[self.parameterAsEnum(parameters, self.INTERPOLATION, context)],
-            workers=self.parameterAsInt(parameters, self.WORKERS, context))
+            workers=self.parameterAsInt(parameters, self.WORKERS, context),
+            scheduler=self.parameterAsString(parameters, self.SCHEDULER, context).strip() or None)
         result = self.run_core(
             ortho.build_orthophoto_workspace, workspace, dsm_path=dsm_path,
             images_filter=self.parameterAsString(parameters, self.IMAGES_FILTER, context).strip() or None,

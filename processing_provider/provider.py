@@ -35,3 +35,6 @@ class ArchaeoOrthoProvider(QgsProcessingProvider):
 
         for alg in (BuildOrthophotoAlgorithm(), OrthorectifyImageAlgorithm()):
             self.addAlgorithm(alg)
+        from .run_pipeline import RunPipelineAlgorithm
+
+        self.addAlgorithm(RunPipelineAlgorithm())

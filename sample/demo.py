@@ -1,4 +1,4 @@
-"""make demo: run the pipeline, as far as it exists, on the bundled sample through qgis_process.
+"""make demo: run the whole pipeline on the bundled sample through qgis_process (archaeoortho:runpipeline).
 
 Prints where the products are and the key figures.  Usage:
     python sample/demo.py [--qgis-process PATH] [--build DIR] [--workspace DIR]
@@ -49,16 +49,27 @@ def main():
     subprocess.run([a.qgis_process, "plugins", "enable", "archaeoortho"], env=env, capture_output=True)
     images = os.path.join(HERE, "toledo", "images")
     t_all = time.time()
-    res, secs = run_alg(a.qgis_process, env, "archaeoortho:alignimages", IMAGES=images, WORKSPACE=ws)
+    # the whole chain in one call (the same functions as the single stages): align, georeference with the
+    # photos' EXIF GPS, DSM, orthomosaic, accuracy report
+    res, secs = run_alg(a.qgis_process, env, "archaeoortho:runpipeline", IMAGES=images, WORKSPACE=ws,
+                        USE_EXIF_GPS="true")
     n = len([f for f in os.listdir(images) if f.lower().endswith(".jpg")])
-    print("\n=== ArchaeoOrtho demo: Toledo sample ===")
-    print(f"images aligned:             {res['REGISTERED_IMAGES']} of {n}")
-    print(f"mean reprojection error:    {res['MEAN_REPROJECTION_ERROR']:.3f} px")
-    print(f"alignment time:             {secs:.1f} s")
-    print(f"workspace:                  {res['WORKSPACE']}")
-    print(f"sparse model (COLMAP):      {os.path.join(res['WORKSPACE'], 'sfm', 'model')}")
-    print(f"camera centres (GeoPackage): {res['CAMERAS']}")
-    print(f"total time:                 {time.time() - t_all:.1f} s")
+
+    def fmt(v, unit=""):
+        return "n/a" if v is None else f"{v:.3f}{unit}"
+
+    print("\n=== ArchaeoOrtho demo: Toledo sample (18 photos, georeferenced by their EXIF GPS) ===")
+    print(f"images aligned:              {res['REGISTERED_IMAGES']} of {n}")
+    print(f"mean reprojection error:     {fmt(res['MEAN_REPROJECTION_ERROR'], ' px')}")
+    print(f"camera position RMSE XYZ:    {fmt(res['CAMERA_RMSE_XYZ'], ' m')} (against the EXIF GPS)")
+    print(f"DSM valid fraction:          {fmt(res['DSM_VALID_FRACTION'])}")
+    print(f"orthomosaic valid fraction:  {fmt(res['ORTHO_VALID_FRACTION'])}")
+    print(f"workspace:                   {res['WORKSPACE']}")
+    print(f"sparse model (COLMAP):       {os.path.join(res['WORKSPACE'], 'georef', 'model')}")
+    print(f"DSM (COG):                   {res['DSM']}")
+    print(f"orthomosaic (COG):           {res['ORTHOMOSAIC']}")
+    print(f"accuracy report (HTML):      {res['REPORT']}")
+    print(f"total time:                  {time.time() - t_all:.1f} s (pipeline {secs:.1f} s)")
 
 
 if __name__ == "__main__":

@@ -1,0 +1,113 @@
+"""The whole chain to orthomosaic (core.pipeline.run_pipeline: align, EXIF-GPS georeference, DSM, orthomosaic,
+report), timed per stage, with the peak memory of the whole process tree (pool workers included).
+
+With --counts the chain runs on the first N images of the set for each N, and prints how time and memory grow
+with the number of images (a power-law exponent fitted over the runs: 1 = linear).
+
+    python benchmarks/chain.py [--images DIR] [--counts 25,50,75] [--workdir DIR] [--no-report]
+
+Defaults: Toledo (../shared/data/toledo/images, all 57 images).  Growth, as the issue asks:
+    python benchmarks/chain.py --images ../shared/data/caliterra/images --counts 25,50,75
+"""
+import argparse
+import json
+import math
+import os
+import shutil
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+sys.path.insert(0, ROOT)
+from _util import run_tree_measured  # noqa: E402
+
+DATA = os.path.join(os.path.dirname(ROOT), "shared", "data")
+EXT = (".jpg", ".jpeg", ".tif", ".tiff")
+
+
+def child(images, ws, result, report):
+    from core import pipeline
+    from core.progress import PrintProgress
+
+    r = pipeline.run_pipeline(images, ws, use_exif_gps=True, report=report, progress=PrintProgress("  "))
+    with open(result, "w") as f:
+        json.dump({"registered": r.align.registered, "images": r.align.images_given,
+                   "mre": r.align.mean_reprojection_error, "align_timings": r.align.timings,
+                   "seconds": r.seconds, "camera_rmse": r.georef.figures.get("CAMERA_RMSE_XYZ"),
+                   "dsm_valid": r.dsm.valid_fraction, "pairs": r.dsm.pairs, "points": r.dsm.points,
+                   "ortho_valid": r.ortho.valid_fraction, "ortho_resolution": r.ortho.resolution,
+                   "dsm_resolution": r.dsm.resolution}, f)
+
+
+def one_run(images, names, workdir, report):
+    n = len(names)
+    d = os.path.join(workdir, f"n{n}")
+    shutil.rmtree(d, ignore_errors=True)
+    sub = os.path.join(d, "images")
+    os.makedirs(sub)
+    for name in names:
+        os.symlink(os.path.join(images, name), os.path.join(sub, name))
+    result = os.path.join(d, "result.json")
+    cmd = [sys.executable, os.path.abspath(__file__), "--child", sub, os.path.join(d, "ws"), result]
+    if not report:
+        cmd.append("--no-report")
+    log = os.path.join(d, "chain.log")
+    rc, wall, rss = run_tree_measured(cmd, log_path=log)
+    if rc != 0:
+        raise SystemExit(f"the chain failed on {n} images (exit {rc}), see {log}")
+    with open(result) as f:
+        r = json.load(f)
+    r.update(wall=wall, peak_rss_mib=rss, n=n)
+    return r
+
+
+def fit_exponent(xs, ys):
+    """Least-squares slope of log(y) over log(x)."""
+    lx = [math.log(x) for x in xs]
+    ly = [math.log(max(y, 1e-9)) for y in ys]
+    mx, my = sum(lx) / len(lx), sum(ly) / len(ly)
+    den = sum((a - mx) ** 2 for a in lx)
+    return sum((a - mx) * (b - my) for a, b in zip(lx, ly)) / den if den else float("nan")
+
+
+def main():
+    if len(sys.argv) > 1 and sys.argv[1] == "--child":
+        child(sys.argv[2], sys.argv[3], sys.argv[4], "--no-report" not in sys.argv)
+        return
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--images", default=os.path.join(DATA, "toledo", "images"))
+    ap.add_argument("--counts", default="", help="comma-separated image counts (first N images); empty = all")
+    ap.add_argument("--workdir", default=os.path.join(ROOT, "build", "bench-chain"))
+    ap.add_argument("--no-report", action="store_true")
+    a = ap.parse_args()
+    images = os.path.abspath(a.images)
+    names = sorted(n for n in os.listdir(images) if n.lower().endswith(EXT))
+    counts = [int(c) for c in a.counts.split(",") if c.strip()] or [len(names)]
+    workdir = os.path.join(a.workdir, os.path.basename(os.path.dirname(images)) or "set")
+    print(f"images: {images} ({len(names)}); cores: {os.cpu_count()}; runs: {counts}", flush=True)
+    runs = []
+    for n in counts:
+        r = one_run(images, names[:n], workdir, not a.no_report)
+        runs.append(r)
+        stages = ", ".join(f"{k} {v:.0f}" for k, v in r["seconds"].items())
+        print(f"\n{n} images: wall {r['wall']:.0f} s ({stages}); peak RSS (process tree) {r['peak_rss_mib']:.0f} MiB",
+              flush=True)
+        al = ", ".join(f"{k} {v:.0f}" for k, v in r["align_timings"].items())
+        print(f"  align: {r['registered']}/{r['images']} registered, {r['mre']:.3f} px ({al} s)")
+        cam = "n/a" if r["camera_rmse"] is None else f"{r['camera_rmse']:.2f} m"
+        print(f"  georeference (EXIF GPS): camera RMSE XYZ {cam}")
+        print(f"  DSM: {r['pairs']} pairs, {r['points']} points, {r['dsm_resolution']:.3f} m cells, valid "
+              f"{r['dsm_valid']:.3f}; orthomosaic {r['ortho_resolution']:.3f} m cells, valid {r['ortho_valid']:.3f}")
+        print(f"  per image: {r['wall'] / n:.1f} s", flush=True)
+    if len(runs) > 1:
+        xs = [r["n"] for r in runs]
+        print("\ngrowth with the number of images (exponent of a power law fitted over the runs; 1 = linear):")
+        print(f"  whole chain time   {fit_exponent(xs, [r['wall'] for r in runs]):.2f}")
+        for stage in runs[0]["seconds"]:
+            print(f"  {stage:<18} {fit_exponent(xs, [r['seconds'].get(stage, 0.0) for r in runs]):.2f}")
+        print(f"  peak RSS           {fit_exponent(xs, [r['peak_rss_mib'] for r in runs]):.2f}")
+
+
+if __name__ == "__main__":
+    main()

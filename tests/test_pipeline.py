@@ -1,0 +1,112 @@
+"""The whole chain: the shipped Processing model (.model3) and archaeoortho:runpipeline, run by qgis_process as a
+user runs them, on a strip of the bundled Toledo sample georeferenced with its EXIF GPS."""
+import json
+import os
+import re
+import subprocess
+
+import numpy as np
+import pytest
+
+from tests.conftest import ROOT, SAMPLE, TOLEDO_STRIP, copy_images, qgis_process
+
+MODEL = os.path.join(ROOT, "processing_provider", "models", "orthophoto_chain.model3")
+
+
+def _raster(path):
+    from osgeo import gdal
+
+    ds = gdal.Open(path)
+    assert ds is not None, path
+    band = ds.GetRasterBand(1)
+    return ds, band.ReadAsArray().astype(float), band.GetNoDataValue()
+
+
+def _check_products(dsm, mosaic, report):
+    from osgeo import osr
+
+    ds, z, nodata = _raster(dsm)
+    srs = osr.SpatialReference(wkt=ds.GetProjection())
+    assert srs.GetAuthorityCode(None) == "32617"  # the UTM zone of the photos' GPS
+    valid = z != nodata
+    assert valid.mean() > 0.8
+    # houses and trees stand above the ground: a real surface, not a plane
+    lo, hi = np.percentile(z[valid], [5, 95])
+    assert 3.0 < hi - lo < 60.0, (lo, hi)
+    ms, band1, _ = _raster(mosaic)
+    assert ms.RasterCount == 4  # RGB + alpha
+    alpha = ms.GetRasterBand(4).ReadAsArray()
+    assert (alpha > 0).mean() > 0.6
+    gt_d, gt_m = ds.GetGeoTransform(), ms.GetGeoTransform()
+    # the mosaic lies over the DSM (same place on the ground, within a DSM cell)
+    assert abs(gt_d[0] - gt_m[0]) < 5 * gt_d[1] and abs(gt_d[3] - gt_m[3]) < 5 * gt_d[1]
+    html = open(report, encoding="utf-8").read()
+    assert "data:image/png;base64" in html and "EPSG:32617" in html
+
+
+@pytest.fixture(scope="module")
+def strip(tmp_path_factory):
+    d = tmp_path_factory.mktemp("chain")
+    return copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP, str(d / "photos"))
+
+
+@pytest.mark.slow
+def test_shipped_model_chains_the_stages_through_the_workspace(strip, tmp_path):
+    """qgis_process run <model file>: Align -> Georeference -> Build DSM -> Build orthophoto -> Accuracy report."""
+    exe, env = qgis_process()
+    ws = str(tmp_path / "model ws")
+    out = subprocess.run([exe, "--json", "run", MODEL, "--", f"IMAGES={strip}", "USE_EXIF_GPS=true", "QUALITY=2",
+                          f"align:Workspace={ws}"], env=env, capture_output=True, text=True, timeout=900)
+    assert out.returncode == 0, out.stdout[-2000:] + out.stderr[-3000:]
+    res = json.loads(out.stdout)["results"]
+    assert os.path.samefile(res["align:Workspace"], ws)
+    assert os.path.samefile(res["dsm:DSM"], os.path.join(ws, "dsm.tif"))
+    _check_products(res["dsm:DSM"], res["ortho:Orthomosaic"], res["report:Report"])
+    stages = json.load(open(os.path.join(ws, "workspace.json")))["stages"]
+    for s in ("align", "georeference", "dsm", "orthophoto", "report"):
+        assert stages[s]["status"] == "done", (s, stages[s].get("status"))
+
+
+@pytest.mark.slow
+def test_runpipeline_from_qgis_process_and_resume(strip, tmp_path):
+    exe, env = qgis_process()
+    ws = str(tmp_path / "pipe ws")
+    args = [exe, "--json", "run", "archaeoortho:runpipeline", "--", f"IMAGES={strip}", f"WORKSPACE={ws}",
+            "USE_EXIF_GPS=true", "QUALITY=2", "MAX_IMAGE_SIZE=800"]
+    out = subprocess.run(args, env=env, capture_output=True, text=True, timeout=900)
+    assert out.returncode == 0, out.stdout[-2000:] + out.stderr[-3000:]
+    doc = json.loads(out.stdout)
+    res = doc["results"]
+    assert res["REGISTERED_IMAGES"] == len(TOLEDO_STRIP)
+    assert res["MEAN_REPROJECTION_ERROR"] < 1.0
+    assert res["CAMERA_RMSE_XYZ"] is not None and res["CAMERA_RMSE_XYZ"] < 10.0  # consumer GPS
+    assert res["DSM_VALID_FRACTION"] > 0.8 and res["ORTHO_VALID_FRACTION"] > 0.6
+    _check_products(res["DSM"], res["ORTHOMOSAIC"], res["REPORT"])
+    assert any("Seconds per stage" in line for line in doc["log"]["info"])
+    # a second run resumes: features and matches are reused, the products are rewritten whole
+    before = os.path.getmtime(res["DSM"])
+    out2 = subprocess.run(args, env=env, capture_output=True, text=True, timeout=900)
+    assert out2.returncode == 0, out2.stderr[-3000:]
+    log2 = "\n".join(json.loads(out2.stdout)["log"]["info"])
+    assert re.search(r"features: \d+ images already extracted, reused", log2), log2
+    assert re.search(r"matching: (\d+) of \1 pairs already matched, reused", log2), log2
+    assert os.path.getmtime(res["DSM"]) >= before
+
+
+@pytest.mark.slow
+def test_runpipeline_without_control_refuses_before_any_work(strip, tmp_path):
+    exe, env = qgis_process()
+    ws = tmp_path / "no control"
+    out = subprocess.run([exe, "run", "archaeoortho:runpipeline", "--", f"IMAGES={strip}", f"WORKSPACE={ws}"],
+                         env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode != 0
+    assert "camera positions" in out.stdout + out.stderr
+    assert not (ws / "workspace.json").exists()
+
+
+def test_core_run_pipeline_refuses_without_control(tmp_path):
+    from core.pipeline import StageError, run_pipeline
+
+    with pytest.raises(StageError, match="ground control"):
+        run_pipeline(str(tmp_path / "photos"), str(tmp_path / "ws"))
+    assert not (tmp_path / "ws").exists()
