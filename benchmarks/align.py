@@ -6,9 +6,12 @@ ratio.  "Same work" means the same images, the same camera model (OPENCV, one ca
 camera type), the same number of features and the same pairs: with GPS, COLMAP's
 spatial_matcher with the same neighbour count; without, its exhaustive_matcher.
 ``--colmap-defaults`` runs COLMAP with its own defaults instead (exhaustive matching,
-8192 features), the reference the issues quote.
+8192 features), the reference the issues quote.  ``--pycolmap-defaults`` also runs pycolmap's own
+default pipeline (``extract_features`` + ``match_exhaustive`` + ``incremental_mapping``, default
+options) on the same images, the second reference; ratios are printed against each reference run.
 
     python benchmarks/align.py [--images DIR] [--workdir DIR] [--skip-colmap] [--colmap-defaults]
+                               [--pycolmap-defaults]
 """
 import argparse
 import json
@@ -38,6 +41,34 @@ def ours(images, work, threads):
     rc, wall, rss = run_measured([sys.executable, "-c", code], log_path=log)
     if rc != 0:
         raise SystemExit(f"our alignment failed, see {log}")
+    result = [json.loads(line[7:]) for line in open(log) if line.startswith("RESULT ")][0]
+    return result, wall, rss
+
+
+PYCOLMAP_DEFAULTS = r"""
+import json, os, sys, time
+import pycolmap
+images, d = sys.argv[1], sys.argv[2]
+db = os.path.join(d, "database.db")
+t = {}
+t0 = time.time(); pycolmap.extract_features(db, images, device=pycolmap.Device.cpu); t["features"] = time.time() - t0
+t0 = time.time(); pycolmap.match_exhaustive(db, device=pycolmap.Device.cpu); t["matching"] = time.time() - t0
+t0 = time.time(); recs = pycolmap.incremental_mapping(db, images, os.path.join(d, "sparse")); t["mapping"] = time.time() - t0
+best = max(recs.values(), key=lambda r: r.num_reg_images()) if recs else None
+print("RESULT", json.dumps({"timings": t, "registered": best.num_reg_images() if best else 0,
+                            "mre": best.compute_mean_reprojection_error() if best else None}))
+"""
+
+
+def pycolmap_defaults(images, work):
+    """pycolmap's own default pipeline on the same images, in a child process (wall time, peak RSS)."""
+    d = os.path.join(work, "pycolmap-defaults")
+    shutil.rmtree(d, ignore_errors=True)
+    os.makedirs(os.path.join(d, "sparse"))
+    log = os.path.join(d, "run.log")
+    rc, wall, rss = run_measured([sys.executable, "-c", PYCOLMAP_DEFAULTS, images, d], log_path=log)
+    if rc != 0:
+        raise SystemExit(f"pycolmap defaults failed, see {log}")
     result = [json.loads(line[7:]) for line in open(log) if line.startswith("RESULT ")][0]
     return result, wall, rss
 
@@ -114,6 +145,7 @@ def main():
     ap.add_argument("--threads", type=int, default=os.cpu_count())
     ap.add_argument("--skip-colmap", action="store_true")
     ap.add_argument("--colmap-defaults", action="store_true")
+    ap.add_argument("--pycolmap-defaults", action="store_true", help="also run pycolmap's default pipeline")
     a = ap.parse_args()
     os.makedirs(a.workdir, exist_ok=True)
     n = len([f for f in os.listdir(a.images) if f.lower().endswith((".jpg", ".jpeg", ".tif", ".tiff"))])
@@ -125,6 +157,15 @@ def main():
     print(f"  {'wall':<18} {wall:8.1f} s   peak RSS {rss:7.0f} MiB")
     print(f"  registered {r['registered']}/{r['images']}, mean reprojection error {r['mre']:.3f} px, "
           f"{r['points']} points, pairing {r['pairing']} ({r['pairs']} pairs)", flush=True)
+    if a.pycolmap_defaults:
+        p, pwall, prss = pycolmap_defaults(a.images, a.workdir)
+        print("\npycolmap default pipeline (extract_features + match_exhaustive + incremental_mapping)")
+        for k, v in p["timings"].items():
+            print(f"  {k:<18} {v:8.1f} s")
+        print(f"  {'wall':<18} {pwall:8.1f} s   peak RSS {prss:7.0f} MiB")
+        mre = "n/a" if p["mre"] is None else f"{p['mre']:.3f}"
+        print(f"  registered {p['registered']}/{n}, mean reprojection error {mre} px")
+        print(f"\nratio ArchaeoOrtho / pycolmap defaults wall time: {wall / pwall:.2f}", flush=True)
     if a.skip_colmap:
         return
     from core.images import read_image_info

@@ -85,9 +85,77 @@ def consistency(ws):
         print(f"  {name}: {c.residuals[name]:.3f} m from that fit" + ("" if name in c.consistent else "  <- suspect"))
 
 
+def _tarp_side_px(img, x, y, r=50):
+    """Side (px) of the black square of the cross target at (x, y): the convex hull of its four dark quadrants."""
+    import cv2
+
+    xi, yi = int(round(x)), int(round(y))
+    x0, y0 = max(0, xi - r), max(0, yi - r)
+    win = cv2.cvtColor(img[y0:yi + r, x0:xi + r], cv2.COLOR_BGR2GRAY)
+    _, m = cv2.threshold(win, 0, 255, cv2.THRESH_BINARY_INV + cv2.THRESH_OTSU)
+    m = cv2.morphologyEx(m, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+    n, lab, st, cen = cv2.connectedComponentsWithStats(m)
+    c = np.array([x - x0, y - y0])
+    quads = [i for i in range(1, n) if np.linalg.norm(cen[i] - c) < 30 and st[i, cv2.CC_STAT_AREA] > 20]
+    quads = sorted(quads, key=lambda i: -st[i, cv2.CC_STAT_AREA])[:4]
+    if len(quads) < 4:
+        return None
+    pts = np.vstack([np.argwhere(lab == i)[:, ::-1] for i in quads]).astype(np.float32)
+    return float(np.sqrt(cv2.contourArea(cv2.convexHull(pts))))
+
+
+def tarp_ruler(ws):
+    """An independent test of the block, needing no coordinates: the COPR targets are identical tarps, so at each
+    observation (depth in the model x tarp side in px / focal length) is the model's length of one tarp side
+    there.  If the block were deformed by the metres the coordinates ask for, that length would vary by tens of
+    per cent across the block; its spread is the block's local scale error."""
+    import cv2
+    import pycolmap
+
+    from core import gcp as gcpmod
+    from core import georef
+
+    rec = pycolmap.Reconstruction()
+    rec.read_binary(os.path.join(ws, "sfm", "model"))
+    images = {im.name: im for im in rec.images.values() if im.has_pose}
+    g = gcpmod.read_gcps(os.path.join(DATA, "copr", "gcp_list.txt"))
+    scales, xyz = [], {}
+    for p in g.points:
+        t = georef.triangulate_observations(rec, p.observations)
+        if t.xyz is None:
+            continue
+        xyz[p.name] = np.asarray(t.xyz)
+        for ob, res in zip(p.observations, t.residuals_px):
+            im = images.get(ob.image)
+            if im is None or not np.isfinite(res):
+                continue
+            side = _tarp_side_px(cv2.imread(os.path.join(DATA, "copr", "images", ob.image)), ob.x, ob.y)
+            if side:
+                depth = (im.cam_from_world() * t.xyz)[2]
+                scales.append((p.name, ob.image, depth * side / rec.cameras[im.camera_id].params[0]))
+    k = np.array([s[2] for s in scales])
+    med = float(np.median(k))
+    print("\nthe tarps as a ruler (no coordinates used): model length of one tarp side at each observation, "
+          "relative to the median")
+    print("  " + ", ".join(f"{n}/{i[4:8]} {v / med:.3f}" for n, i, v in scales))
+    print(f"  spread {100 * k.std() / med:.1f} % (std) over {len(k)} observations, largest "
+          f"{100 * np.abs(k / med - 1).max():.1f} %: the block's local scale is uniform to a few per cent")
+    # what the coordinates say for two targets in the same photos, against what the photos say
+    w = {p.name: np.array([p.x, p.y]) for p in g.points}
+    for a, b, img in (("gcp03", "gcp04", "46, 52"), ("gcp07", "gcp08", "82")):
+        if a in xyz and b in xyz:
+            tarps = np.linalg.norm(xyz[a] - xyz[b]) / med
+            print(f"  {a}-{b} (both in IMG_{img}): {tarps:.2f} tarp sides apart in the photos; the coordinates "
+                  f"say {np.linalg.norm(w[a] - w[b]):.2f} m, i.e. a tarp of "
+                  f"{100 * np.linalg.norm(w[a] - w[b]) / tarps:.1f} cm")
+    print("  one tarp cannot have two sizes: coordinates that imply different sizes for the same tarps disagree "
+          "with the photos, not with a deformed block")
+
+
 def copr(ws, variants=True):
     ensure_aligned(os.path.join(DATA, "copr", "images"), ws)
     consistency(ws)
+    tarp_ruler(ws)
     if variants:
         for refine in ("all", True):
             r = pipeline.georeference_workspace(ws, gcp_path=os.path.join(DATA, "copr", "gcp_list.txt"),

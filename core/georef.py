@@ -16,8 +16,10 @@ Frames (DESIGN.md section 2):
    (full camera model, robust to one wrong observation);
 2. fit a similarity model -> local frame by RANSAC over minimal 3-point sets
    (control points, or camera projection centres when there are fewer than 3
-   usable control points) with a least-squares refit on the inliers; points far
-   off that fit (a typo of 100 m) are rejected by name;
+   usable control points) with a least-squares refit on the inliers; control
+   points far off that fit are left out of the first adjustment (step 4) only:
+   a deformed block (a long strip, a wrong calibration) can put a correct point
+   metres off a similarity of the others;
 3. move the reconstruction into the local frame (``Reconstruction.transform``);
 4. constrained bundle adjustment (own sparse Levenberg-Marquardt with a Schur
    complement on the points, see ``_BundleProblem``): tie-point reprojection
@@ -25,7 +27,13 @@ Frames (DESIGN.md section 2):
    by sigma_xy / sigma_z + camera projection-centre priors weighted by their sigma,
    optionally intrinsics; check points take no part.  After each run, the worst
    GCP observation or GCP / camera position far off its residual threshold is
-   removed by name and the adjustment is re-run;
+   removed by name and the adjustment is re-run.  Then each control point left
+   out at step 2 is re-tested against the adjusted block, held fixed: placed
+   where its image observations and its coordinates agree best (weighted by
+   their sigmas), it must pass the adjustment's own thresholds (normalised
+   coordinate residual, pixel residuals).  Those that pass are re-admitted and
+   the adjustment is run again (repeated while points come back); the others (a
+   typo of 100 m) are named with their residuals and stay out;
 5. check points (and rejected control points) are triangulated in the adjusted
    model and compared with their given coordinates.
 
@@ -494,6 +502,16 @@ def _image_names(reconstruction) -> set:
     return {im.name for im in reconstruction.images.values()}
 
 
+def _outside_image(camera, ob: Observation) -> bool:
+    """The observation lies off the image: the pixel origin is the upper-left corner of the upper-left
+    pixel, x right, y down, so valid is 0 <= x <= width and 0 <= y <= height (NaN is outside).  A camera
+    without a size (0) is not checked."""
+    w, h = float(camera.width), float(camera.height)
+    if w <= 0 or h <= 0:
+        return False
+    return not (0.0 <= float(ob.x) <= w and 0.0 <= float(ob.y) <= h)
+
+
 def _collect_views(reconstruction, observations: Sequence[Observation], lookup: Dict[str, Any],
                    all_names: Optional[set] = None) -> Tuple[List[_View], List[str]]:
     views, notes = [], []
@@ -506,6 +524,10 @@ def _collect_views(reconstruction, observations: Sequence[Observation], lookup: 
                 notes.append(f"image {ob.image} is not in the model: observation skipped")
             continue
         cam = reconstruction.cameras[im.camera_id]
+        if _outside_image(cam, ob):
+            notes.append(f"observation in {ob.image} at ({ob.x:g}, {ob.y:g}) lies outside the image "
+                         f"({cam.width} x {cam.height} px): skipped")
+            continue
         views.append(_View(i, ob.image, cam, np.asarray(im.cam_from_world().matrix()),
                            np.array([ob.x, ob.y], dtype=float)))
     return views, notes
@@ -1275,7 +1297,10 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
     ``max_observations``: tie-point observations in the adjustment; beyond it the
     best-observed tie points are kept (every image covered) and the others are
     re-triangulated with the adjusted cameras afterwards.
-    ``adjust=False`` stops after the Helmert step.
+    ``adjust=False`` stops after the Helmert step (its outliers are then final; with the adjustment,
+    control points off the Helmert fit are re-tested against the adjusted block, see the module notes).
+    GCP observations outside their image (valid: 0 <= x <= width, 0 <= y <= height, COLMAP's pixel
+    convention) are named in a warning and ignored (their ``px`` in the residual rows is None).
     Camera positions with a non-finite ``z`` constrain X and Y only.  When every control
     point has the same Z (a placeholder such as 0), their sigma Z is raised to
     ``placeholder_sigma_z`` and a warning says so (``statistics["placeholder_z"]``).
@@ -1306,6 +1331,17 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
         if p.role not in (CONTROL, CHECK):
             raise GeorefError(f"ground point {p.name}: unknown role {p.role!r} (use {CONTROL!r} or {CHECK!r})")
     control = [p for p in points if p.role == CONTROL]
+    # observations off their image (GCPs picked in QGIS come here directly, without the file readers'
+    # check): named and ignored, in the triangulation, the adjustment and the evaluation alike
+    by_name = {im.name: im for im in rec.images.values()}
+    for p in points:
+        for ob in p.observations:
+            im = by_name.get(ob.image)
+            if im is not None and _outside_image(rec.cameras[im.camera_id], ob):
+                cam = rec.cameras[im.camera_id]
+                _warn(progress, warnings, f"{'control' if p.role == CONTROL else 'check'} point {p.name}: observation "
+                                          f"at ({ob.x:g}, {ob.y:g}) lies outside image {ob.image} ({cam.width} x "
+                                          f"{cam.height} px); ignored")
     _progress_call(progress, 0.0, "triangulating control points")
 
     # 1. triangulate control points in the model frame
@@ -1402,6 +1438,11 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
     except ValueError as e:
         raise GeorefError(f"no consistent similarity between the model and the {source}: {e}") from e
     rejected_ctrl: set = set()
+    # control points off the Helmert fit are only provisional outliers when the adjustment follows: on a
+    # deformed block (a long strip, a wrong calibration) a correct point can lie metres off the similarity
+    # of the others.  They are re-tested against the adjusted block (_retest_provisional) and re-admitted
+    # when consistent with it; those that are not (a typo) are named in a warning then.
+    provisional: Dict[str, Outlier] = {}
     for k in np.flatnonzero(~hel.inliers):
         o = objs[k]
         nm = o.name if source == "control points" else o.image
@@ -1409,9 +1450,15 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
                                 float(hel.residuals[k]), "m", "helmert",
                                 message=f"{source[:-1]} {nm} is {hel.residuals[k]:.2f} m off the Helmert fit of "
                                         f"the others (threshold {thr:.2f} m): excluded; check its coordinates"))
-        _warn(progress, warnings, outliers[-1].message)
         if source == "control points":
             rejected_ctrl.add(nm)
+        if source == "control points" and adjust:
+            provisional[nm] = outliers[-1]
+            _info(progress, f"control point {nm} is {hel.residuals[k]:.2f} m off the Helmert fit of the others "
+                            f"(threshold {thr:.2f} m): left out of the first adjustment, then re-tested against "
+                            "the adjusted block")
+        else:
+            _warn(progress, warnings, outliers[-1].message)
     if source == "camera positions":
         bad = {objs[k].image for k in np.flatnonzero(~hel.inliers)}
         cam_pos = [(cp, im) for cp, im in cam_pos if cp.image not in bad]
@@ -1456,35 +1503,83 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
     # 4. constrained bundle adjustment
     _check_cancel(progress)
     t0 = time.time()
-    ba_points = [p for p in usable if p.name not in rejected_ctrl]
+    # the provisional outliers are part of the problem from the start, switched off until re-admitted
+    ba_points = [p for p in usable if p.name not in rejected_ctrl or p.name in provisional]
     prob, tie_ids, gcp_index, gcp_obs_rows, sel_info = _build_problem(
         rec, lookup, ba_points, tri, cam_pos, offset, model_to_local, groups, gcp_pixel_sigma,
         tie_pixel_sigma, huber_px, max_observations, min_intrinsics_images, warnings, progress)
+    removed_points: set = set()
+    for nm in provisional:
+        _set_point_active(prob, gcp_index[nm], gcp_obs_rows[nm], False)
+        removed_points.add(nm)
     stats.update(sel_info)
     timings["build"] = time.time() - t0
     t0 = time.time()
-    removed_points: set = set()
     total_iterations = 0
-    rounds = 0
-    for rounds in range(1, max_outlier_rounds + 2):
-        _check_cancel(progress)
-        sub = _SubProgress(progress, 0.12 + 0.7 * (1 - 0.5 ** (rounds - 1)), 0.12 + 0.7 * (1 - 0.5 ** rounds))
-        info = prob.solve(max_iterations=max_iterations, progress=sub)
-        total_iterations += info["iterations"]
-        if rounds > max_outlier_rounds:
+    rounds = 0  # rounds over all passes (the progress fractions keep growing)
+    readmitted: List[str] = []
+    retests: Dict[str, Dict[str, Any]] = {}
+    while True:
+        for pass_round in range(1, max_outlier_rounds + 2):
+            rounds += 1
+            _check_cancel(progress)
+            sub = _SubProgress(progress, 0.12 + 0.7 * (1 - 0.5 ** (rounds - 1)), 0.12 + 0.7 * (1 - 0.5 ** rounds))
+            info = prob.solve(max_iterations=max_iterations, progress=sub)
+            total_iterations += info["iterations"]
+            if pass_round > max_outlier_rounds:
+                break
+            min_left = 0 if cam_pos else 3
+            found = _find_outlier(prob, ba_points, gcp_index, gcp_obs_rows, removed_points, outlier_threshold,
+                                  outlier_sigma, len(ba_points) - len(removed_points), min_left)
+            if found is None:
+                break
+            outliers.append(found)
+            _warn(progress, warnings, found.message)
+            if found.kind == "control point":
+                rejected_ctrl.add(found.name)
+                removed_points.add(found.name)
+        # re-test the provisional outliers against the adjusted block; re-admit the consistent ones and adjust
+        # again (a point re-admitted can make another one consistent: repeat until none comes back)
+        back = []
+        if provisional:
+            thr_px, thr_z = _control_thresholds(prob, ba_points, gcp_index, gcp_obs_rows, removed_points,
+                                                outlier_threshold, outlier_sigma)
+            for nm in provisional:
+                t = _retest_provisional(prob, gcp_index[nm], gcp_obs_rows[nm])
+                t.update({"threshold_px": thr_px, "threshold_sigma": thr_z})
+                retests[nm] = t
+                if t["sigma"] <= thr_z and t["px"] <= thr_px:
+                    back.append(nm)
+        if not back:
             break
-        min_left = 0 if cam_pos else 3
-        found = _find_outlier(prob, ba_points, gcp_index, gcp_obs_rows, removed_points, outlier_threshold,
-                              outlier_sigma, len(ba_points) - len(removed_points), min_left)
-        if found is None:
-            break
-        outliers.append(found)
-        _warn(progress, warnings, found.message)
-        if found.kind == "control point":
-            rejected_ctrl.add(found.name)
-            removed_points.add(found.name)
+        for nm in back:
+            out = provisional.pop(nm)
+            outliers.remove(out)
+            rejected_ctrl.discard(nm)
+            removed_points.discard(nm)
+            k = gcp_index[nm]
+            prob.X[k] = retests[nm]["xyz"]
+            _set_point_active(prob, k, gcp_obs_rows[nm], True)
+            readmitted.append(nm)
+            t = retests[nm]
+            _info(progress, f"control point {nm}: {out.residual:.2f} m off the Helmert fit of the others, but "
+                            f"consistent with the adjusted block ({t['sigma']:.1f} sigma, image residuals up to "
+                            f"{t['px']:.1f} px): re-admitted; the block was deformed")
+    for nm, out in provisional.items():  # still off the adjusted block: outliers for good
+        t = retests.get(nm)
+        if t is not None and np.isfinite(t["sigma"]):
+            rays = (f"its rays meet {t['free_distance_m']:.2f} m from its coordinates in the adjusted block; "
+                    if t.get("free_distance_m") is not None else "")
+            out.message = (f"control point {nm} is {out.residual:.2f} m off the Helmert fit of the others; {rays}"
+                           f"held to its coordinates it stays {t['sigma']:.1f} sigma off with image residuals up to "
+                           f"{t['px']:.1f} px (thresholds {t['threshold_sigma']:.1f} sigma, {t['threshold_px']:.1f} "
+                           "px): excluded; check its coordinates")
+        _warn(progress, warnings, out.message)
     timings["adjustment"] = time.time() - t0
-    stats.update({"adjustment_iterations": total_iterations, "outlier_rounds": rounds})
+    stats.update({"adjustment_iterations": total_iterations, "outlier_rounds": rounds,
+                  "control_points_adjusted": len(ba_points) - len(provisional),
+                  "readmitted_control_points": readmitted,
+                  "helmert_retests": {nm: {k: v for k, v in t.items() if k != "xyz"} for nm, t in retests.items()}})
 
     # 5. write back, re-triangulate the tie points left out, evaluate
     t0 = time.time()
@@ -1634,7 +1729,7 @@ def _build_problem(rec, lookup, ba_points, tri, cam_pos, offset, model_to_local,
         t = tri[p.name]
         for j, ob in enumerate(p.observations):
             im = lookup.get(ob.image)
-            if im is None or j in t.rejected:
+            if im is None or j in t.rejected or _outside_image(rec.cameras[im.camera_id], ob):
                 continue
             rows.append((len(o_img), ob.image))
             o_img.append(img_index[im.image_id])
@@ -1670,12 +1765,19 @@ def _build_problem(rec, lookup, ba_points, tri, cam_pos, offset, model_to_local,
     return prob, tie_ids, gcp_index, gcp_obs_rows, info
 
 
-def _find_outlier(prob: _BundleProblem, ba_points, gcp_index, gcp_obs_rows, removed_points,
-                  px_threshold, sigma_threshold, n_control_left: int, min_left: int) -> Optional[Outlier]:
-    """The single worst GCP observation, control point or camera position beyond its threshold, removed."""
+def _set_point_active(prob: _BundleProblem, k: int, rows, active: bool) -> None:
+    """Switch a GCP (its position prior and its observations) on or off in the adjustment."""
+    prob.has_pp[k] = active and bool(np.all(np.isfinite(prob.pp[k])))
+    for r, _ in rows:
+        prob.obs.active[r] = active
+
+
+def _gcp_residuals(prob: _BundleProblem, ba_points, gcp_index, gcp_obs_rows, removed_points,
+                   px_threshold, sigma_threshold):
+    """Residuals of the GCPs in the adjustment and the thresholds of the outlier tests: the pixel
+    residuals of their active observations (thr_px = max(px_threshold, 5 x median)) and the largest
+    normalised coordinate residual of each point (thr_z = max(sigma_threshold, 5 x median))."""
     obs = prob.obs
-    cands: List[Tuple[float, Outlier, Any]] = []
-    # GCP observations
     all_rows, owner = [], []
     for p in ba_points:
         if p.name in removed_points:
@@ -1706,6 +1808,72 @@ def _find_outlier(prob: _BundleProblem, ba_points, gcp_index, gcp_obs_rows, remo
         z.append(float(np.max(np.abs(d))))
     z = np.asarray(z)
     thr_z = max(sigma_threshold, 5.0 * float(np.median(z))) if len(z) else sigma_threshold
+    return all_rows, owner, px, thr_px, bad_obs_per_point, n_obs_per_point, names, z, thr_z
+
+
+def _control_thresholds(prob: _BundleProblem, ba_points, gcp_index, gcp_obs_rows, removed_points,
+                        px_threshold, sigma_threshold) -> Tuple[float, float]:
+    """(thr_px, thr_z) of the adjustment's outlier tests for the current state (see _gcp_residuals)."""
+    res = _gcp_residuals(prob, ba_points, gcp_index, gcp_obs_rows, removed_points, px_threshold, sigma_threshold)
+    return res[3], res[8]
+
+
+def _retest_provisional(prob: _BundleProblem, k: int, rows) -> Dict[str, Any]:
+    """A control point left out of the adjustment, against the adjusted block held fixed: the position
+    that best agrees with both its image observations (pixel sigma) and its given coordinates (sigma),
+    i.e. the point's own part of the adjustment.  Returns that position (``xyz``), its largest normalised
+    coordinate residual (``sigma``) and distance (``distance_m``) from the given coordinates, and its
+    largest image residual (``px``).  Conservative: admitted, the point could also bend the block its way.
+    A point that cannot be placed (fewer than 2 observations, behind the cameras) gets infinite figures."""
+    from scipy.optimize import least_squares
+
+    inf = {"xyz": None, "sigma": float("inf"), "distance_m": float("inf"), "px": float("inf"), "n_obs": 0}
+    o = prob.obs
+    views = []
+    for r, img in rows:
+        i = o.img[r]
+        f = prob.img_frame[i]
+        rot = prob.Rs[i] @ prob.R[f]
+        m = np.column_stack([rot, prob.ts[i] - rot @ prob.C[f]])
+        views.append((_View(int(r), img, prob.cameras[prob.img_cam[i]], m, o.xy[r].copy()), float(o.sigma[r])))
+    if len(views) < 2 or not np.all(np.isfinite(prob.pp[k])):
+        return inf
+    prior, ps = prob.pp[k], prob.pps[k]
+    x_free = _triangulate_views([v for v, _ in views])
+    if x_free is not None and not np.all(np.isfinite(x_free)):
+        x_free = None
+    x0 = x_free if x_free is not None else prior.copy()
+    vs = [v for v, _ in views]
+    sig = np.array([s for _, s in views])
+
+    def res(x):
+        r, depth = _view_residuals(vs, x)
+        r = r / sig[:, None]
+        r = np.where(np.isfinite(r) & (depth[:, None] > 0), r, 1e6)
+        return np.concatenate([r.ravel(), (x - prior) / ps])
+
+    try:
+        sol = least_squares(res, x0, method="lm", x_scale=np.maximum(ps, 1e-6))
+    except (ValueError, np.linalg.LinAlgError):
+        return inf
+    x = sol.x
+    r, depth = _view_residuals(vs, x)
+    px = np.linalg.norm(r, axis=1)
+    if not (np.all(depth > 0) and np.all(np.isfinite(px))):
+        return inf
+    d = x - prior
+    return {"xyz": x, "sigma": float(np.max(np.abs(d / ps))), "distance_m": float(np.linalg.norm(d)),
+            "px": float(px.max()), "n_obs": len(vs),
+            "free_distance_m": float(np.linalg.norm(x_free - prior)) if x_free is not None else None}
+
+
+def _find_outlier(prob: _BundleProblem, ba_points, gcp_index, gcp_obs_rows, removed_points,
+                  px_threshold, sigma_threshold, n_control_left: int, min_left: int) -> Optional[Outlier]:
+    """The single worst GCP observation, control point or camera position beyond its threshold, removed."""
+    obs = prob.obs
+    cands: List[Tuple[float, Outlier, Any]] = []
+    all_rows, owner, px, thr_px, bad_obs_per_point, n_obs_per_point, names, z, thr_z = _gcp_residuals(
+        prob, ba_points, gcp_index, gcp_obs_rows, removed_points, px_threshold, sigma_threshold)
     for (p, d), zz in zip(names, z):
         nb, nt = bad_obs_per_point.get(p.name, 0), n_obs_per_point.get(p.name, 0)
         if zz > thr_z and (nb == 0 or 2 * nb >= nt) and n_control_left > min_left:

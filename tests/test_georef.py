@@ -198,6 +198,44 @@ def test_a_100_m_typo_is_named_and_left_out(block):
     assert r.rmse("check")["xy"] < 0.05
 
 
+def test_a_typo_stays_out_after_the_retest_against_the_adjusted_block(block):
+    """Control points off the Helmert fit are re-tested against the adjusted block: a 100 m typo fails
+    that test by far (named in a warning with its residuals); without the adjustment the Helmert
+    verdict is final."""
+    rec, _ = block
+    xy = dict(SPREAD, f=(40.0, 8.0), g=(20.0, 50.0))
+    gcps = _gcps(rec, MODEL_FROM_WORLD, xy, noise_px=0.3)
+    gcpmod.apply_check_points(gcps, ["e"])
+    next(p for p in gcps.points if p.name == "d").x += 100.0
+    r = georef.georeference(rec, gcps)
+    assert r.statistics["readmitted_control_points"] == []
+    t = r.statistics["helmert_retests"]["d"]
+    assert t["sigma"] > 100 * t["threshold_sigma"] and t["free_distance_m"] == pytest.approx(100.0, rel=0.01)
+    assert any("d is" in w and "adjusted block" in w and "excluded" in w for w in r.warnings)
+    h = georef.georeference(rec, gcps, adjust=False)
+    assert [o.name for o in h.outliers if o.kind == "control point"] == ["d"]
+    assert any("d is" in w and "Helmert fit" in w for w in h.warnings)
+    assert next(p for p in h.points if p.name == "d").status == georef.REJECTED
+
+
+def test_observation_outside_the_image_is_skipped_in_the_triangulation(block):
+    rec, _ = block
+    gcps = _gcps(rec, MODEL_FROM_WORLD, {"e": SPREAD["e"]})
+    obs = list(gcps.points[0].observations)
+    seen = {o.image for o in obs}
+    other = next(rec.image(i).name for i in rec.reg_image_ids() if rec.image(i).name not in seen)
+    obs.insert(0, gcpmod.Observation(other, W + 0.5, 100.0))  # just off the right edge
+    t = georef.triangulate_observations(rec, obs)
+    assert not t.used[0] and np.isnan(t.residuals_px[0]) and t.n_used == len(obs) - 1
+    assert any("outside" in n and other in n for n in t.notes)
+    # pixel convention: the image spans [0, width] x [0, height], edges included
+    cam = rec.cameras[1]
+    inside = [(0.0, 0.0), (W, H), (W / 2, H / 2)]
+    outside = [(-0.01, 10.0), (10.0, H + 0.01), (W + 0.01, 10.0), (float("nan"), 10.0)]
+    assert not any(georef._outside_image(cam, gcpmod.Observation("x", x, y)) for x, y in inside)
+    assert all(georef._outside_image(cam, gcpmod.Observation("x", x, y)) for x, y in outside)
+
+
 def test_camera_positions_without_heights_constrain_xy_only(block):
     rec, centres = block
     gcps = _gcps(rec, MODEL_FROM_WORLD, SPREAD)
