@@ -1168,7 +1168,9 @@ class _Report:
         if stage_vf is not None:
             info.append(("Valid fraction inside the camera centres' convex hull (as the stage reports it)",
                          f"{stage_vf:.3f}"))
-        self.figures[f"{'DSM' if dem else 'ORTHO'}_VALID_FRACTION"] = frac
+        # the key figure is the stage's own (the Processing output VALID_FRACTION): inside the camera centres'
+        # convex hull; the whole raster's share is shown beside it above
+        self.figures[f"{'DSM' if dem else 'ORTHO'}_VALID_FRACTION"] = stage_vf if stage_vf is not None else frac
         self.figures[f"{'DSM' if dem else 'ORTHO'}_RESOLUTION"] = abs(gt[1])
         _equal_xy(ax)
         ax.grid(False)

@@ -253,6 +253,14 @@ def test_products_previews_with_resolution_and_valid_fraction(georeferenced, tmp
     assert result.sections["uncertainty"] != "ok"  # not requested: skipped with its reason
     hs = report.hillshade(z.astype(float), 0.25, 0.25)
     assert hs.shape == z.shape and 0.0 <= hs.min() and hs.max() <= 1.0
+    # with the DSM stage's own figure (inside the camera centres' hull) the key figure is that one, the same
+    # number as the Processing output VALID_FRACTION; the whole raster's share stays in the products section
+    manifest = json.load(open(os.path.join(ws, "workspace.json")))
+    manifest["stages"]["dsm"] = {"status": "done", "results": {"VALID_FRACTION": 0.93}}
+    json.dump(manifest, open(os.path.join(ws, "workspace.json"), "w"))
+    result = report.build_report(ws, uncertainty=False)
+    assert result.figures["DSM_VALID_FRACTION"] == pytest.approx(0.93)
+    assert '<span data-key="dsm.valid">0.750</span>' in open(result.path, encoding="utf-8").read()
 
 
 class _CancelAt(NullProgress):
