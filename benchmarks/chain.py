@@ -2,9 +2,11 @@
 report), timed per stage, with the peak memory of the whole process tree (pool workers included).
 
 With --counts the chain runs on the first N images of the set for each N, and prints how time and memory grow
-with the number of images (a power-law exponent fitted over the runs: 1 = linear).
+with the number of images (a power-law exponent fitted over the runs: 1 = linear).  --synthetic N renders the
+synthetic vertical block of tests/synthetic.py with about N images (800 x 600, strips of 20) and runs the chain
+on it, georeferenced by its camera positions (sigma 0.5 m) instead of EXIF GPS.
 
-    python benchmarks/chain.py [--images DIR] [--counts 25,50,75] [--workdir DIR] [--no-report]
+    python benchmarks/chain.py [--images DIR] [--counts 25,50,75] [--synthetic N] [--workdir DIR] [--no-report]
 
 Defaults: Toledo (../shared/data/toledo/images, all 57 images).  Growth, as the issue asks:
     python benchmarks/chain.py --images ../shared/data/caliterra/images --counts 25,50,75
@@ -30,7 +32,9 @@ def child(images, ws, result, report):
     from core import pipeline
     from core.progress import PrintProgress
 
-    r = pipeline.run_pipeline(images, ws, use_exif_gps=True, report=report, progress=PrintProgress("  "))
+    positions = os.path.join(os.path.dirname(images), "camera_positions.csv")
+    control = dict(camera_positions_path=positions) if os.path.isfile(positions) else dict(use_exif_gps=True)
+    r = pipeline.run_pipeline(images, ws, report=report, progress=PrintProgress("  "), **control)
     with open(result, "w") as f:
         json.dump({"registered": r.align.registered, "images": r.align.images_given,
                    "mre": r.align.mean_reprojection_error, "align_timings": r.align.timings,
@@ -48,6 +52,9 @@ def one_run(images, names, workdir, report):
     os.makedirs(sub)
     for name in names:
         os.symlink(os.path.join(images, name), os.path.join(sub, name))
+    positions = os.path.join(os.path.dirname(images), "camera_positions.csv")
+    if os.path.isfile(positions):
+        shutil.copyfile(positions, os.path.join(d, "camera_positions.csv"))
     result = os.path.join(d, "result.json")
     cmd = [sys.executable, os.path.abspath(__file__), "--child", sub, os.path.join(d, "ws"), result]
     if not report:
@@ -60,6 +67,27 @@ def one_run(images, names, workdir, report):
         r = json.load(f)
     r.update(wall=wall, peak_rss_mib=rss, n=n)
     return r
+
+
+def synthetic_set(n, workdir):
+    """Render the synthetic vertical block with ~n images; write its camera positions beside the images."""
+    from tests import synthetic as syn
+
+    per_strip = 20
+    strips = max(1, round(n / per_strip))
+    d = os.path.join(workdir, f"synthetic{strips * per_strip}")
+    images = os.path.join(d, "images")
+    if not os.path.isdir(images) or len(os.listdir(images)) != strips * per_strip:
+        shutil.rmtree(d, ignore_errors=True)
+        block = syn.vertical_block(seed=3, n_strips=strips, per_strip=per_strip, forward_overlap=0.75,
+                                   side_overlap=0.35, n_buildings=max(5, strips * 3))
+        block.render(images)
+        positions, _ = block.camera_positions(sigma=0.5)
+        with open(os.path.join(d, "camera_positions.csv"), "w") as f:
+            f.write(f"{syn.CRS}\nimage,x,y,z,sigma\n")
+            for p in positions:
+                f.write(f"{p.image},{p.x:.3f},{p.y:.3f},{p.z:.3f},0.5\n")
+    return images
 
 
 def fit_exponent(xs, ys):
@@ -80,8 +108,9 @@ def main():
     ap.add_argument("--counts", default="", help="comma-separated image counts (first N images); empty = all")
     ap.add_argument("--workdir", default=os.path.join(ROOT, "build", "bench-chain"))
     ap.add_argument("--no-report", action="store_true")
+    ap.add_argument("--synthetic", type=int, default=0, help="render a synthetic block of about N images")
     a = ap.parse_args()
-    images = os.path.abspath(a.images)
+    images = os.path.abspath(synthetic_set(a.synthetic, a.workdir) if a.synthetic else a.images)
     names = sorted(n for n in os.listdir(images) if n.lower().endswith(EXT))
     counts = [int(c) for c in a.counts.split(",") if c.strip()] or [len(names)]
     workdir = os.path.join(a.workdir, os.path.basename(os.path.dirname(images)) or "set")
@@ -96,7 +125,7 @@ def main():
         al = ", ".join(f"{k} {v:.0f}" for k, v in r["align_timings"].items())
         print(f"  align: {r['registered']}/{r['images']} registered, {r['mre']:.3f} px ({al} s)")
         cam = "n/a" if r["camera_rmse"] is None else f"{r['camera_rmse']:.2f} m"
-        print(f"  georeference (EXIF GPS): camera RMSE XYZ {cam}")
+        print(f"  georeference ({'camera positions' if a.synthetic else 'EXIF GPS'}): camera RMSE XYZ {cam}")
         print(f"  DSM: {r['pairs']} pairs, {r['points']} points, {r['dsm_resolution']:.3f} m cells, valid "
               f"{r['dsm_valid']:.3f}; orthomosaic {r['ortho_resolution']:.3f} m cells, valid {r['ortho_valid']:.3f}")
         print(f"  per image: {r['wall'] / n:.1f} s", flush=True)

@@ -119,9 +119,11 @@ def georeference_workspace(workspace_dir: str, gcp_path: Optional[str] = None,
         gcps = gcpmod.read_gcps(gcp_path, image_names=list(sizes), image_sizes=sizes)
     if gcps is not None and check_points:
         gcpmod.apply_check_points(gcps, list(check_points))
-    target = crs or (gcps.crs if gcps is not None else None) or ws.crs or _default_crs(ws)
+    positions_crs = gcpmod.read_camera_positions(camera_positions_path)[0] if camera_positions_path else None
+    target = (crs or (gcps.crs if gcps is not None else None) or ws.crs or positions_crs or _default_crs(ws))
     if not target:
-        raise StageError("no target CRS: give CRS, or GCPs with a CRS line, or images with EXIF GPS")
+        raise StageError("no target CRS: give CRS, or GCPs or camera positions with a CRS line, or images with "
+                         "EXIF GPS")
     if gcps is not None:
         gcpmod.check_units(gcps, target)
         if gcps.crs and crs and gcps.crs != crs:

@@ -59,6 +59,30 @@ def test_exif_gps_georeferencing_lines_up_with_surveyed_positions(aligned):
     assert transform["offset"][0] > 200000
 
 
+def test_camera_positions_file_gives_the_crs(aligned, tmp_path):
+    """Camera positions alone (no GCPs, no CRS parameter, EXIF GPS not used): the file's CRS line is the target,
+    here Web Mercator so that it differs from the UTM zone the photos' GPS would suggest."""
+    import shutil
+
+    from core import gcp as gcpmod
+
+    ws_dir = str(tmp_path / "ws")
+    shutil.copytree(aligned, ws_dir)
+    ws = Workspace.open(ws_dir)
+    ws.crs = None
+    ws.save()
+    ref = _reference_positions()
+    names = sorted(set(ref) & set(TOLEDO_STRIP))
+    utm = np.array([[ref[n][0], ref[n][1], 0.0] for n in names])
+    merc = gcpmod.transform_points(utm, "EPSG:32617", "EPSG:3857")
+    csv = tmp_path / "positions.csv"
+    csv.write_text("EPSG:3857\n" + "".join(f"{n},{x:.3f},{y:.3f},{z}\n" for n, (x, y, _), z in
+                                            zip(names, merc, [250.0] * len(names))))
+    result = pipeline.georeference_workspace(ws_dir, camera_positions_path=str(csv))
+    assert result.crs == "EPSG:3857"
+    assert result.figures["CAMERA_RMSE_XY"] is not None and result.figures["CAMERA_RMSE_XY"] < 5.0
+
+
 def test_too_few_control_points_is_a_clear_error(aligned):
     gcps = GCPSet(crs="EPSG:32617", points=[
         GroundPoint("A", 274900.0, 4603270.0, 180.0, observations=[Observation("1JI_0064.JPG", 500, 400),
