@@ -85,6 +85,7 @@ class OrthoOptions:
     feather_gsd: float = 16.0  # width of the feathering ramp across a seam, in GSD
     occlusion: bool = True  # leave cells hidden from a camera nodata (true orthophoto)
     height_tolerance: float = 0.0  # m below the sight line still counted visible; 0 = max(0.1, DSM cell)
+    fill_dsm_gaps_m: float = 25.0  # DSM gaps inside the data's hull, up to this far from a height, interpolated
     exposure: bool = True  # per-image gain compensation in the mosaic
     avoid_relief: bool = True  # keep seamlines off buildings and trees
     seam_iterations: int = 2  # passes moving the seamlines towards where the images agree (0 = off)
@@ -1579,7 +1580,19 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
     os.makedirs(out_dir, exist_ok=True)
     workdir = tempfile.mkdtemp(prefix=".ortho-work-", dir=out_dir)
     _CACHE.max_bytes = options.cache_mb << 20
-    dsm = _Dsm(dsm_path, crs)
+    source_dsm = dsm_path
+    try:
+        dsm_path, filled = fill_dsm_gaps(dsm_path, os.path.join(workdir, "dsm-gaps-filled.tif"),
+                                         options.fill_dsm_gaps_m)
+        dsm = _Dsm(dsm_path, crs)
+    except BaseException:
+        shutil.rmtree(workdir, ignore_errors=True)
+        raise
+    if filled:
+        log.append(f"DSM gaps: {filled} cells without a height, inside the hull of the measured ones and at most "
+                   f"{options.fill_dsm_gaps_m:g} m from one, took interpolated heights for the orthophoto (the DSM "
+                   "file is unchanged)")
+        progress.info(log[-1])
     try:
         with _gdal_cache(64):
             t0 = time.time()
@@ -1588,7 +1601,7 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
             for w_ in prep.warnings:
                 progress.warning(w_)
             if dsm.reprojected:
-                log.append(f"DSM {dsm_path} reprojected on the fly into {crs}")
+                log.append(f"DSM {source_dsm} reprojected on the fly into {crs}")
             bands, dtype = _check_kind(prep.metas, prep.cameras)
             grid = prep.grid
             timings["visibility"] = time.time() - t0
@@ -1640,6 +1653,61 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
         _DSM_CACHE.clear()
         _CACHE.clear()
         shutil.rmtree(workdir, ignore_errors=True)
+
+
+FILL_MAX_CELLS = 120_000_000  # larger DSMs are used as they are (the fill works on the whole raster in memory)
+
+
+def fill_dsm_gaps(dsm_path: str, out_path: str, max_distance: float) -> Tuple[str, int]:
+    """Fill the gaps of a DSM for orthorectification: cells without a height that lie inside the convex hull of
+    the measured cells and within ``max_distance`` (CRS units) of one get a height interpolated (inverse distance,
+    GDAL FillNodata) from their surroundings, so that a tree crown the dense matching missed does not leave a hole
+    in the orthophoto.  Beyond the measured area (a DSM that covers part of the block) nothing is invented.
+
+    Returns (path of the DSM to use, cells filled): ``out_path`` when something was filled, else ``dsm_path``."""
+    import cv2
+    from osgeo import gdal
+
+    if not max_distance or max_distance <= 0:
+        return dsm_path, 0
+    ds = gdal.Open(dsm_path)
+    if ds is None or ds.RasterXSize * ds.RasterYSize > FILL_MAX_CELLS:
+        return dsm_path, 0
+    band = ds.GetRasterBand(1)
+    z = band.ReadAsArray().astype(np.float32)
+    nodata = band.GetNoDataValue()
+    valid = np.isfinite(z)
+    if nodata is not None and np.isfinite(nodata):
+        valid &= z != nodata
+    if valid.all() or not valid.any():
+        return dsm_path, 0
+    rows, cols = np.nonzero(valid)
+    hull = cv2.convexHull(np.column_stack([cols, rows]).astype(np.int32))
+    inside = np.zeros(z.shape, np.uint8)
+    cv2.fillConvexPoly(inside, hull, 1)
+    gaps = (~valid) & inside.astype(bool)
+    if not gaps.any():
+        return dsm_path, 0
+    gt = ds.GetGeoTransform()
+    max_cells = max(1.0, max_distance / max(abs(gt[1]), abs(gt[5])))
+    fill_value = -9999.0
+    mem = gdal.GetDriverByName("MEM").Create("", ds.RasterXSize, ds.RasterYSize, 1, gdal.GDT_Float32)
+    mem.SetGeoTransform(gt)
+    mem.SetProjection(ds.GetProjection())
+    mb = mem.GetRasterBand(1)
+    mb.SetNoDataValue(fill_value)
+    mb.WriteArray(np.where(valid, z, fill_value).astype(np.float32))
+    gdal.FillNodata(mb, None, maxSearchDist=float(max_cells), smoothingIterations=0)
+    out = mb.ReadAsArray()
+    take = gaps & (out != fill_value)
+    result = np.where(valid, z, np.nan).astype(np.float32)
+    result[take] = out[take]
+    n = int(take.sum())
+    if n == 0:
+        return dsm_path, 0
+    srs = ds.GetSpatialRef()
+    dsmmod.write_cog(out_path, result, gt, srs.ExportToWkt() if srs is not None else None)
+    return out_path, n
 
 
 def _run_tiles(prep: _Prepared, plan: _Plan, dsm_path: str, crs, offset, output: str, options: OrthoOptions,

@@ -410,6 +410,40 @@ def test_partial_dsm_warns_and_leaves_nodata(scene, tmp_path):
     assert 0.05 < res.valid_fraction < 0.9
 
 
+def test_dsm_gaps_inside_the_data_are_filled_for_the_orthophoto(scene, tmp_path):
+    """A hole in the DSM (a tree crown the dense matching missed) takes interpolated heights, so the mosaic has
+    no hole there; with the fill switched off the hole stays nodata.  The DSM file is not changed."""
+    from osgeo import gdal
+
+    block, _root, _images, dsm, _ws = scene
+    z, gt, _ = dsmmod.read_dsm(dsm)
+    h, w = z.shape
+    yy, xx = np.mgrid[0:h, 0:w]
+    hole = (yy - h / 2) ** 2 + (xx - w / 2) ** 2 < (min(h, w) / 8) ** 2
+    z[hole] = np.nan
+    holed = dsmmod.write_cog(str(tmp_path / "holed.tif"), z, gt, syn.CRS)
+    before = open(holed, "rb").read()
+    ws2 = make_workspace(str(tmp_path / "ws"), block, scene[2], names=["S2_01.jpg", "S2_02.jpg", "S2_05.jpg"])
+    centre_x, centre_y = gt[0] + (w / 2) * gt[1], gt[3] + (h / 2) * gt[5]
+
+    def alpha_at_centre(path):
+        ds = gdal.Open(path)
+        g = ds.GetGeoTransform()
+        c, r = int((centre_x - g[0]) / g[1]), int((centre_y - g[3]) / g[5])
+        return ds.GetRasterBand(ds.RasterCount).ReadAsArray(c - 2, r - 2, 5, 5)
+
+    res = ortho.build_orthophoto_workspace(ws2, dsm_path=holed, resolution=0.3, output=str(tmp_path / "filled.tif"))
+    assert any("DSM gaps" in line and "interpolated" in line for line in res.log_lines), res.log_lines
+    assert (alpha_at_centre(res.orthomosaic) > 0).all()
+    off = ortho.build_orthophoto_workspace(ws2, dsm_path=holed, resolution=0.3, output=str(tmp_path / "off.tif"),
+                                           options=ortho.OrthoOptions(fill_dsm_gaps_m=0.0))
+    assert (alpha_at_centre(off.orthomosaic) == 0).all()
+    assert open(holed, "rb").read() == before
+    # the hull rule: a DSM covering half of the area is not extended (test_partial_dsm_warns_and_leaves_nodata)
+    path, n = ortho.fill_dsm_gaps(holed, str(tmp_path / "f.tif"), 25.0)
+    assert n == int(hole.sum()) and path != holed
+
+
 def test_workspace_without_georeference_or_dsm_is_refused(scene, tmp_path):
     block = scene[0]
     ws = make_workspace(str(tmp_path / "ws"), block, scene[2], names=["S2_01.jpg", "S2_02.jpg"])
