@@ -58,6 +58,7 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple
 import numpy as np
 
 from . import dsm as dsmmod
+from .masks import find_mask
 from .progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
 from .resection import Intrinsics, Pose
 from .workspace import CANCELLED, DONE, FAILED, STAGE_ORDER, Workspace, atomic_output, file_fingerprint, fingerprint
@@ -133,17 +134,6 @@ class OrthoCamera:
         px, ok = self.camera.project(xc)
         ok &= self.camera.inside(px) & np.all(np.isfinite(px), axis=-1)
         return px, xc[..., 2], ok
-
-
-def find_mask(masks_dir: Optional[str], name: str) -> Optional[str]:
-    """``masks/<image>.png`` (as core.scans writes them) or ``masks/<stem>.png``; None if there is none."""
-    if not masks_dir or not os.path.isdir(masks_dir):
-        return None
-    for cand in (name + ".png", os.path.splitext(name)[0] + ".png"):
-        p = os.path.join(masks_dir, cand)
-        if os.path.isfile(p):
-            return p
-    return None
 
 
 def cameras_from_reconstruction(rec, images_dir: str, masks_dir: Optional[str] = None) -> List[OrthoCamera]:

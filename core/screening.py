@@ -29,7 +29,15 @@ in ``<workspace>/screening.json`` and in the workspace's ``prepare`` stage.
 
 The stage :func:`prepare_images_workspace` also runs the scanned-film
 restitution of :mod:`core.scans` (fiducials, affine resampling, masks) when
-asked, and writes the folder of prepared images that "Align images" takes.
+asked, rasterises the user's "ignore" polygons into the per-image masks
+(:mod:`core.masks`), and writes the folder of prepared images that "Align
+images" takes.  Blur and exposure are measured inside each image's mask only.
+
+Masks live in ``<workspace>/masks/<prepared image name>.png``.  The stage
+rewrites the masks it wrote last time; a mask it did not write (put there by
+hand) is merged into the new mask of its image and kept aside in
+``masks/.originals/`` so that the next run merges it again instead of the
+previous result.
 """
 from __future__ import annotations
 
@@ -335,6 +343,11 @@ class PrepareOptions:
     screening: ScreeningOptions = field(default_factory=ScreeningOptions)
     scanned_film: bool = False
     scan: Optional[object] = None  # core.scans.ScanOptions when scanned_film
+    # user masks: "ignore" polygons, (image name or None for every image, [exterior, hole, ...][, label])
+    # with rings of (x, y) image pixel coordinates (core.masks); for scanned film in the prepared images' frame
+    mask_polygons: Optional[Sequence] = None
+    mask_source: str = "mask polygons"  # names the polygons' origin (a layer, a file) in messages
+    mask_y_axis: str = "auto"  # auto / down / up (y = -row, the QGIS georeferencer)
 
 
 @dataclass
@@ -351,6 +364,7 @@ class PrepareResult:
     interior_orientation: Optional[dict]
     warnings: List[str]
     timings: Dict[str, float]
+    user_masked: Dict[str, int] = field(default_factory=dict)  # image -> user polygons applied
 
 
 def _link_or_copy(src: str, dst: str) -> None:
@@ -378,6 +392,34 @@ def _check_output_dir(output_dir: str, images_dir: str, ws_root: str) -> None:
 
 def _json(obj) -> str:
     return json.dumps(obj, indent=2, default=str)
+
+
+ORIGINALS = ".originals"  # masks/<this>/: masks this stage did not write, kept aside while it replaces them
+
+
+def _foreign_mask(ws: Workspace, name: str, ours: Sequence[str]) -> Optional[str]:
+    """A mask of ``name`` that this stage did not write (by hand, another tool), or None."""
+    from .masks import mask_file_name
+
+    kept = ws.path("masks", ORIGINALS, mask_file_name(name))
+    if os.path.isfile(kept):
+        return kept
+    ours = {os.path.normpath(r) for r in ours}
+    for cand in (mask_file_name(name), os.path.splitext(name)[0] + ".png"):
+        p = ws.path("masks", cand)
+        if os.path.isfile(p) and os.path.normpath(os.path.relpath(p, ws.root)) not in ours:
+            return p
+    return None
+
+
+def _polygon_record(polygons: Sequence, source: str) -> dict:
+    """JSON-able digest of the user polygons for the stage parameters; raises MaskError for a malformed one."""
+    from .masks import to_polygons
+    from .workspace import fingerprint
+
+    polys = to_polygons(polygons, source)
+    return {"count": len(polys), "images": sorted({p.image or "*" for p in polys}),
+            "fingerprint": fingerprint([(p.image, [np.round(r, 3).tolist() for r in p.rings]) for p in polys])}
 
 
 def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Optional[str] = None,
@@ -408,13 +450,19 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
 
     # header check of every file first: a corrupt file stops the stage before any work, by name
     t0 = time.time()
+    sizes: Dict[str, Tuple[int, int]] = {}
     for i, n in enumerate(names):
-        read_image_info(os.path.join(images_dir, n), n)
+        info = read_image_info(os.path.join(images_dir, n), n)
+        sizes[n] = (info.width, info.height)
         progress.report(0.03 * (i + 1) / len(names), f"checking {n}")
     timings["check"] = time.time() - t0
+    polygons = list(options.mask_polygons or [])
     params = {"screening": asdict(sopt), "scanned_film": options.scanned_film,
               "scan": asdict(options.scan) if options.scanned_film and options.scan is not None else None,
               "output_dir": output_dir}
+    if polygons:  # a malformed polygon fails here, before the stage starts, by name
+        params["mask_polygons"] = dict(_polygon_record(polygons, options.mask_source), source=options.mask_source,
+                                       y_axis=options.mask_y_axis)
     ws.begin_stage(STAGE, params, {
         "images": _fingerprint_files(images_dir, names)})
     previous_masks = list((ws.data["stages"][STAGE].get("outputs") or {}).get("masks") or [])
@@ -439,12 +487,39 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
                 screen_dir = tmp
                 screen_names = [s.prepared_name for s in scan_set.scans]
                 mask_files = {s.prepared_name: os.path.join(masks_staging, s.mask_name) for s in scan_set.scans}
+                screen_sizes = {s.prepared_name: (scan_set.width, scan_set.height) for s in scan_set.scans}
+                aliases = {s.name: s.prepared_name for s in scan_set.scans}
                 sp = SubProgress(progress, 0.75, 0.95)
             else:
                 screen_dir, screen_names = images_dir, names
+                screen_sizes, aliases = sizes, {}
                 sp = SubProgress(progress, 0.03, 0.90)
+            # masks: the scans', the user's polygons and masks put in <workspace>/masks by hand, merged
+            foreign = {n: p for n in screen_names for p in [_foreign_mask(ws, n, previous_masks)] if p}
+            user_masked: Dict[str, int] = {}
+            if polygons or (mask_files and foreign):
+                from . import masks as masksmod
+
+                t0 = time.time()
+                by_image, axis = masksmod.polygons_by_image(polygons, screen_names, aliases, options.mask_source,
+                                                            options.mask_y_axis)
+                bases = {n: [p for p in (mask_files.get(n), foreign.get(n)) if p]
+                         for n in screen_names if n in mask_files or n in by_image}
+                os.makedirs(masks_staging, exist_ok=True)
+                mres = masksmod.build_masks(by_image, screen_sizes, masks_staging, bases, options.mask_source)
+                mask_files.update(mres.masks)
+                warnings.extend(mres.warnings)
+                user_masked = {n: c for n, c in mres.polygons.items() if c}
+                if polygons:
+                    progress.info(f"masks: {len(polygons)} polygons ({options.mask_source}, y "
+                                  f"{'= -row' if axis == 'up' else 'down'}) hide parts of {len(user_masked)} "
+                                  f"of {len(screen_names)} images")
+                timings["masks"] = time.time() - t0
+                ws.record_timing(STAGE, "masks", timings["masks"])
+            screen_masks = dict(foreign)
+            screen_masks.update(mask_files)
             t0 = time.time()
-            quality = screen_folder(screen_dir, sopt, sp, screen_names, mask_files, check=False)
+            quality = screen_folder(screen_dir, sopt, sp, screen_names, screen_masks, check=False)
             timings["screening"] = time.time() - t0
             ws.record_timing(STAGE, "screening", timings["screening"])
             # screening measured prepared scans: report under the original names
@@ -474,12 +549,24 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
                 p = ws.path(rel)
                 if os.path.isfile(p) and os.path.dirname(os.path.abspath(p)) == masks_dir:
                     os.unlink(p)
+            originals = os.path.join(masks_dir, ORIGINALS)
+            if os.path.isdir(originals):  # masks set aside last time go back to their place
+                for f in os.listdir(originals):
+                    src, dst = os.path.join(originals, f), os.path.join(masks_dir, f)
+                    if os.path.exists(dst):
+                        os.unlink(src)  # replaced by hand since: the newer one stays
+                    else:
+                        os.replace(src, dst)
+                shutil.rmtree(originals, ignore_errors=True)
             written_masks = []
             for q in quality:
                 src = mask_files.get(q.prepared_name)
                 if q.decision == KEEP and src and os.path.isfile(src):
                     os.makedirs(masks_dir, exist_ok=True)
                     dst = os.path.join(masks_dir, os.path.basename(src))
+                    if os.path.isfile(dst):  # not ours: merged into the new mask, kept aside for the next run
+                        os.makedirs(originals, exist_ok=True)
+                        os.replace(dst, os.path.join(originals, os.path.basename(dst)))
                     os.replace(src, dst)
                     written_masks.append(os.path.relpath(dst, ws.root))
             shutil.rmtree(masks_staging, ignore_errors=True)
@@ -506,7 +593,9 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
             "images": len(quality), "flagged": summary["flagged"], "excluded": summary["excluded"],
             "kept": summary["kept"], "median_blur_score": summary["median"]["blur_score"],
             "decisions": {q.name: {"decision": q.decision, "flags": q.flags} for q in quality},
-            "interior_orientation": io, "total_seconds": round(time.time() - t_start, 2)})
+            "interior_orientation": io, "masks": len(written_masks),
+            "user_masked_images": {n: user_masked[n] for n in sorted(user_masked)},
+            "total_seconds": round(time.time() - t_start, 2)})
         ws.invalidate_after(STAGE, STAGE_ORDER)
         progress.report(1.0, f"screened {len(quality)} images: {summary['flagged']} flagged, "
                              f"{summary['excluded']} excluded")
@@ -514,7 +603,7 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
             workspace=ws.root, prepared_dir=output_dir, screening_path=screening_path, images=quality,
             flagged=summary["flagged"], excluded=summary["excluded"], kept=summary["kept"],
             scans_path=scans_path, masks=[ws.path(m) for m in written_masks], interior_orientation=io,
-            warnings=warnings, timings=timings)
+            warnings=warnings, timings=timings, user_masked=user_masked)
     except Cancelled:
         shutil.rmtree(ws.path(".partial-masks-prepare"), ignore_errors=True)
         ws.end_stage(STAGE, CANCELLED, error="cancelled by the user")

@@ -8,6 +8,15 @@ The stage reads images from a folder and writes, in the workspace:
   local model frame;
 - ``sfm/alignment.json``: figures and the list of images not registered, with why.
 
+Masks: feature extraction ignores the black pixels of ``<workspace>/masks/<image
+name>.png`` (core.masks: COLMAP's own convention, as core.scans writes them
+for scanned film and Prepare images for user polygons); an image without a
+mask uses every pixel (it is extracted without ``mask_path``: COLMAP would
+skip it).  Masks found only as ``masks/<stem>.png`` (also
+accepted by the orthophoto stage) are linked under COLMAP's names into
+``sfm/masks/``.  The masks are part of the database key: a change of masks
+extracts the features afresh.
+
 Pair selection (``pairing``):
 
 - ``exhaustive``: every pair (n(n-1)/2);
@@ -22,6 +31,7 @@ Pair selection (``pairing``):
 """
 from __future__ import annotations
 
+import hashlib
 import math
 import os
 import shutil
@@ -87,6 +97,7 @@ class AlignResult:
     num_pairs: int
     timings: Dict[str, float]
     cameras: List[dict]
+    masked_images: int = 0
 
 
 # ---------------------------------------------------------------------------
@@ -219,14 +230,17 @@ def select_pairs(images: Sequence[ImageInfo], pairing: str,
 # ---------------------------------------------------------------------------
 
 def _setup_database(pycolmap, db_path: str, groups: List[CameraGroup], options: AlignOptions,
-                    images_dir: str, state: dict) -> Dict[str, int]:
+                    images_dir: str, state: dict, masks_key: Optional[str] = None) -> Dict[str, int]:
     """Create (or check) the database's cameras; returns camera_id per group key."""
-    key = fingerprint({
+    what = {
         "groups": [(g.key, g.width, g.height, round(g.focal_px, 3), sorted(g.images)) for g in groups],
         "model": options.camera_model, "max_image_size": options.max_image_size,
         "max_features": options.max_features, "affine": options.affine_features,
         "images_dir": os.path.abspath(images_dir),
-    })
+    }
+    if masks_key:  # only with masks: the key of a workspace without masks stays as it was
+        what["masks"] = masks_key
+    key = fingerprint(what)
     if os.path.exists(db_path) and state.get("database_key") != key:
         os.unlink(db_path)  # different images or extraction settings: start afresh
     state["database_key"] = key
@@ -254,7 +268,54 @@ def auto_max_features(width: int, height: int, max_image_size: int = 0) -> int:
     return int(min(8192, max(2048, round(4000 * mp, -2))))
 
 
-def _extract(pycolmap, db_path, images_dir, groups, camera_ids, options, progress: Progress):
+def _file_hash(path: str) -> str:
+    h = hashlib.sha1()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()[:16]
+
+
+def _masks_for_colmap(masks_dir: str, infos: Sequence[ImageInfo], sfm_dir: str) -> Tuple[Optional[str], Dict[str, str]]:
+    """The folder to give COLMAP as ``mask_path`` (None without masks) and image -> mask file.
+
+    Every mask must have its image's size (COLMAP drops every feature outside
+    a smaller mask).  When all masks carry COLMAP's names the workspace's
+    masks folder is used as it is; otherwise ``sfm/masks`` gets links (or
+    copies) under COLMAP's names.
+    """
+    from .masks import MaskError, find_mask, mask_file_name, png_size
+
+    found: Dict[str, str] = {}
+    for im in infos:
+        p = find_mask(masks_dir, im.name)
+        if not p:
+            continue
+        try:
+            w, h = png_size(p)
+        except MaskError as e:
+            raise AlignError(str(e)) from e
+        if (w, h) != (im.width, im.height):
+            raise AlignError(f"mask {p} is {w} x {h} px but image {im.name} is {im.width} x {im.height} px: "
+                             "a mask must have its image's size (run 'Prepare images' again or remove the mask)")
+        found[im.name] = p
+    linked = os.path.join(sfm_dir, "masks")
+    if all(os.path.basename(p) == mask_file_name(n) for n, p in found.items()):
+        shutil.rmtree(linked, ignore_errors=True)
+        return (masks_dir if found else None), found
+    with atomic_output(linked) as tmp:
+        os.makedirs(tmp)
+        for n, p in found.items():
+            dst = os.path.join(tmp, mask_file_name(n))
+            try:
+                os.link(p, dst)
+            except OSError:
+                shutil.copyfile(p, dst)
+    return linked, found
+
+
+def _extract(pycolmap, db_path, images_dir, groups, camera_ids, options, progress: Progress,
+             mask_path: Optional[str] = None, masked: Optional[Sequence[str]] = None):
     eo = pycolmap.FeatureExtractionOptions()
     g0 = max(groups, key=lambda g: g.width * g.height)
     eo.sift.max_num_features = int(options.max_features or auto_max_features(g0.width, g0.height,
@@ -270,11 +331,20 @@ def _extract(pycolmap, db_path, images_dir, groups, camera_ids, options, progres
         done = {im.name for im in db.read_all_images() if db.exists_keypoints(im.image_id)}
     finally:
         db.close()
+    masked = set(masked or ())
     todo: List[Tuple[CameraGroup, List[str]]] = []
     for g in groups:
         rest = [n for n in g.images if n not in done]
-        for i in range(0, len(rest), EXTRACT_BLOCK):
-            todo.append((g, rest[i:i + EXTRACT_BLOCK]))
+        # COLMAP skips an image whose mask is missing when mask_path is set: masked and unmasked images go
+        # in separate blocks (in file order), only the masked ones with mask_path
+        block: List[str] = []
+        for n in rest:
+            if block and (len(block) >= EXTRACT_BLOCK or (n in masked) != (block[0] in masked)):
+                todo.append((g, block))
+                block = []
+            block.append(n)
+        if block:
+            todo.append((g, block))
     total = sum(len(b) for _, b in todo)
     if done:
         progress.info(f"features: {len(done)} images already extracted, reused")
@@ -283,6 +353,8 @@ def _extract(pycolmap, db_path, images_dir, groups, camera_ids, options, progres
         check_cancel(progress)
         ro = pycolmap.ImageReaderOptions()
         ro.existing_camera_id = camera_ids[g.key]
+        if mask_path and block[0] in masked:
+            ro.mask_path = mask_path  # <mask_path>/<image name>.png, black = no features
         with _CancelWatcher(progress) as token:
             pycolmap.extract_features(db_path, images_dir, image_names=block,
                                       camera_mode=pycolmap.CameraMode.SINGLE, reader_options=ro,
@@ -448,12 +520,19 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
     sfm_dir = ws.subdir("sfm")
     db_path = os.path.join(sfm_dir, "database.db")
     try:
-        camera_ids = _setup_database(pycolmap, db_path, groups, options, images_dir, rec_state)
+        mask_path, masks = _masks_for_colmap(ws.path("masks"), infos, sfm_dir)
+        masks_key = fingerprint(sorted((n, _file_hash(p)) for n, p in masks.items())) if masks else None
+        if masks:
+            rec_state["inputs"]["masks"] = masks_key
+            progress.info(f"masks: {len(masks)} of {len(infos)} images have a mask ({ws.path('masks')}): "
+                          "no features where they are black")
+        camera_ids = _setup_database(pycolmap, db_path, groups, options, images_dir, rec_state, masks_key)
         ws.save()
 
         # 2. features
         t0 = time.time()
-        _extract(pycolmap, db_path, images_dir, groups, camera_ids, options, SubProgress(progress, 0.02, 0.35))
+        _extract(pycolmap, db_path, images_dir, groups, camera_ids, options, SubProgress(progress, 0.02, 0.35),
+                 mask_path, list(masks))
         timings["features"] = time.time() - t0
         ws.record_timing(STAGE, "features", timings["features"])
 
@@ -531,6 +610,7 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
             mean_reprojection_error=mre, num_points3d=int(rec.num_points3D()), unregistered=unregistered,
             other_components=others, skipped_files=skipped, pairing_used=pairing_used, num_pairs=len(pairs),
             timings={k: round(v, 3) for k, v in timings.items()}, cameras=camera_summary(rec),
+            masked_images=len(masks),
         )
         figures = {k: v for k, v in asdict(result).items() if k not in ("workspace", "model_dir", "cameras_path")}
         figures["principal_point_refined"] = pp
@@ -539,7 +619,7 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
                                             "cameras": os.path.relpath(cameras_path, ws.root)},
                      results={"registered": result.registered, "images": len(infos),
                               "mean_reprojection_error": mre, "points3d": result.num_points3d,
-                              "pairing": pairing_used, "pairs": len(pairs),
+                              "pairing": pairing_used, "pairs": len(pairs), "masked_images": len(masks),
                               "total_seconds": round(time.time() - t_start, 2)})
         # later stages were built on the previous model
         ws.invalidate_after(STAGE, ["align", "georeference", "dsm", "orthophoto", "report"])

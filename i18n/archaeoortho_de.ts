@@ -1394,102 +1394,102 @@ RESIDUALS: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in
 <context>
     <name>PrepareImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="67" />
+        <location filename="../processing_provider/prepare_images.py" line="82" />
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="69" />
+        <location filename="../processing_provider/prepare_images.py" line="84" />
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="70" />
+        <location filename="../processing_provider/prepare_images.py" line="85" />
         <source>Smallest blur score (0 = only relative to the set)</source>
         <translation>Kleinster Schärfewert (0 = nur relativ zum Satz)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="73" />
+        <location filename="../processing_provider/prepare_images.py" line="88" />
         <source>Leave flagged images out of the prepared folder</source>
         <translation>Markierte Bilder aus dem vorbereiteten Ordner weglassen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="75" />
+        <location filename="../processing_provider/prepare_images.py" line="93" />
         <source>Scanned film: fiducial marks, common frame, masks</source>
         <translation>Gescannter Film: Rahmenmarken, gemeinsamer Rahmen, Masken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="77" />
+        <location filename="../processing_provider/prepare_images.py" line="95" />
         <source>Calibrated fiducial coordinates in mm (file path or text)</source>
         <translation>Kalibrierte Rahmenmarken-Koordinaten in mm (Dateipfad oder Text)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="80" />
+        <location filename="../processing_provider/prepare_images.py" line="98" />
         <source>Calibrated focal length in mm (0 = unknown)</source>
         <translation>Kalibrierte Brennweite in mm (0 = unbekannt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="84" />
+        <location filename="../processing_provider/prepare_images.py" line="102" />
         <source>Flag images below this fraction of the set's median blur score</source>
         <translation>Bilder unter diesem Bruchteil des mittleren Schärfewerts des Satzes markieren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="87" />
+        <location filename="../processing_provider/prepare_images.py" line="105" />
         <source>Fiducial mark type</source>
         <translation>Art der Rahmenmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="89" />
+        <location filename="../processing_provider/prepare_images.py" line="107" />
         <source>Fiducial positions</source>
         <translation>Lage der Rahmenmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="91" />
+        <location filename="../processing_provider/prepare_images.py" line="109" />
         <source>Template image of one fiducial mark</source>
         <translation>Vorlagenbild einer Rahmenmarke</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93" />
+        <location filename="../processing_provider/prepare_images.py" line="111" />
         <source>Scan resolution in dpi when not in the files (0 = from the files)</source>
         <translation>Scanauflösung in dpi, wenn nicht in den Dateien (0 = aus den Dateien)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="100" />
+        <location filename="../processing_provider/prepare_images.py" line="118" />
         <source>Prepared images (skipped: &lt;workspace&gt;/prepared)</source>
         <translation>Vorbereitete Bilder (ausgelassen: &lt;workspace&gt;/prepared)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="103" />
+        <location filename="../processing_provider/prepare_images.py" line="121" />
         <source>Folder of prepared images</source>
         <translation>Ordner der vorbereiteten Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="104" />
+        <location filename="../processing_provider/prepare_images.py" line="122" />
         <source>Flagged images</source>
         <translation>Markierte Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="105" />
+        <location filename="../processing_provider/prepare_images.py" line="123" />
         <source>Excluded images</source>
         <translation>Ausgeschlossene Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="106" />
+        <location filename="../processing_provider/prepare_images.py" line="124" />
         <source>Screening record (JSON)</source>
         <translation>Prüfprotokoll (JSON)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="138" />
+        <location filename="../processing_provider/prepare_images.py" line="160" />
         <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
         <translation>{} Bilder: {} markiert, {} ausgeschlossen, {} im vorbereiteten Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="140" />
+        <location filename="../processing_provider/prepare_images.py" line="162" />
         <source>Blurriest first (blur score, % of the set's median):</source>
         <translation>Unschärfste zuerst (Schärfewert, % des Medians des Satzes):</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="148" />
+        <location filename="../processing_provider/prepare_images.py" line="170" />
         <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
         <translation>Vorbereitete Scans: {} x {} px, Pixelgröße {:.6g} {}{}</translation>
     </message>
@@ -1499,11 +1499,38 @@ RESIDUALS: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in
         <translation>Bilder vorbereiten</translation>
     </message>
     <message>
+        <location filename="../processing_provider/prepare_images.py" line="90" />
+        <source>Mask polygons: areas to ignore, in pixel coordinates (optional text field 'image')</source>
+        <translation>Maskenpolygone: zu ignorierende Bereiche in Pixelkoordinaten (optionales Textfeld 'image')</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="155" />
+        <source>MASKS layer '{}'</source>
+        <translation>MASKS-Layer '{}'</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="190" />
+        <source>feature {}</source>
+        <translation>Objekt {}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="194" />
+        <source>MASKS layer '{}': {} has no geometry: skipped</source>
+        <translation>MASKS-Layer '{}': {} hat keine Geometrie: übersprungen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="197" />
+        <source>MASKS layer '{}': {} is a {} geometry, not a polygon</source>
+        <translation>MASKS-Layer '{}': {} ist eine {}-Geometrie, kein Polygon</translation>
+    </message>
+    <message>
         <location filename="../ui/catalog.py" line="7" />
         <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for 'Align images', and the WORKSPACE, which records a decision per image (screening.json) for the accuracy report.
 
 Blur score: variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged 'blurry' below BLUR_RELATIVE x the median of the set, or below BLUR_THRESHOLD when that is set (absolute scores depend on the scene: sand scores far lower than roofs).
 Exposure: images with more than 5 % clipped highlights or shadows, a mean brightness far from the set's, or a very small dynamic range are flagged. EXCLUDE_FLAGGED leaves flagged images out of the prepared folder; otherwise they are kept and only reported.
+
+MASKS: optional polygon layer of areas to ignore (a boom, the drone's shadow, a date stamp, a frame border), in the image's pixel coordinates: origin at the upper-left corner of the image, x right, y down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is &lt;= 0). A text field 'image' names the image a polygon belongs to; empty (or no such field) applies it to every image. The polygons are written into the per-image masks (workspace/masks/&lt;image&gt;.png, merged with any mask already there): 'Align images' finds no features under them, the orthophoto does not use those pixels, and blur and exposure are measured outside them. For scanned film the coordinates are those of the prepared images (the common fiducial frame, so one polygon fits every frame).
 
 SCANNED_FILM: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. FIDUCIAL_COORDINATES: the calibration certificate's fiducial coordinates in mm, as a file or pasted text, one 'id x y' line per mark (x right, y up), optionally 'PP x y' (principal point) and 'focal f'. Without them the mean layout of the set is used, centred on the fiducial centre. With FOCAL_LENGTH_MM (or 'focal' in the certificate) the prepared images carry the focal length in pixels for the alignment.
 
@@ -1512,6 +1539,8 @@ OUTPUT: the folder of prepared images (replaced as a whole; it must be new, empt
 
 Schärfewert: Varianz des Laplace-Operators auf einer grauen Kopie von 1024 px Breite, 90. Perzentil eines Rasters von 8 x 6 Kacheln (Himmel oder Wasser in einem Teil des Bildes zählt nicht dagegen). Höher ist schärfer. Ein Bild wird als 'unscharf' markiert unter BLUR_RELATIVE x dem Median des Satzes oder unter BLUR_THRESHOLD, wenn gesetzt (absolute Werte hängen von der Szene ab: Sand erreicht weit weniger als Dächer).
 Belichtung: Bilder mit mehr als 5 % beschnittenen Lichtern oder Schatten, einer mittleren Helligkeit weit weg von der des Satzes oder einem sehr kleinen Dynamikumfang werden markiert. EXCLUDE_FLAGGED lässt markierte Bilder aus dem vorbereiteten Ordner weg; sonst bleiben sie und werden nur gemeldet.
+
+MASKS: optionaler Polygon-Layer mit zu ignorierenden Bereichen (ein Ausleger, der Schatten der Drohne, ein Datumsstempel, ein Bildrand) in den Pixelkoordinaten des Bildes: Ursprung in der oberen linken Ecke, x nach rechts, y nach unten, oder y = -Zeile, wie der QGIS-Georeferenzierer ein Foto zeigt (erkannt, wenn jedes y &lt;= 0 ist). Ein Textfeld 'image' nennt das Bild, zu dem ein Polygon gehört; leer (oder ohne dieses Feld) gilt es für jedes Bild. Die Polygone werden in die Masken je Bild geschrieben (workspace/masks/&lt;Bild&gt;.png, mit einer vorhandenen Maske vereinigt): 'Bilder ausrichten' findet darunter keine Merkmale, das Orthophoto verwendet diese Pixel nicht, und Schärfe und Belichtung werden außerhalb gemessen. Bei gescanntem Film sind es die Koordinaten der vorbereiteten Bilder (der gemeinsame Rahmenmarken-Rahmen, so passt ein Polygon zu jedem Bild).
 
 SCANNED_FILM: Rahmenmarken (Kreuze, Punkte, Punkte in Kreisen; in den Ecken und/oder Seitenmitten, oder wie ein Vorlagenbild einer Marke) werden auf Bruchteile eines Pixels gefunden, jeder Scan wird durch eine affine Transformation in den gemeinsamen Rahmenmarken-Rahmen umgerechnet, alle gleich groß und mit dem Bildhauptpunkt in der Mitte, und Masken (workspace/masks) verbergen Filmrand, Datenstreifen und die Marken vor der Zuordnung. FIDUCIAL_COORDINATES: die Rahmenmarken-Koordinaten des Kalibrierzertifikats in mm, als Datei oder eingefügter Text, eine Zeile 'id x y' je Marke (x nach rechts, y nach oben), optional 'PP x y' (Bildhauptpunkt) und 'focal f'. Ohne sie wird die mittlere Anordnung des Satzes verwendet, zentriert auf die Rahmenmitte. Mit FOCAL_LENGTH_MM (oder 'focal' im Zertifikat) tragen die vorbereiteten Bilder die Brennweite in Pixeln für die Ausrichtung.
 

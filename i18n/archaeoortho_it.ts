@@ -1394,102 +1394,102 @@ RESIDUALS: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in met
 <context>
     <name>PrepareImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="67" />
+        <location filename="../processing_provider/prepare_images.py" line="82" />
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="69" />
+        <location filename="../processing_provider/prepare_images.py" line="84" />
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="70" />
+        <location filename="../processing_provider/prepare_images.py" line="85" />
         <source>Smallest blur score (0 = only relative to the set)</source>
         <translation>Punteggio di nitidezza minimo (0 = solo relativo all'insieme)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="73" />
+        <location filename="../processing_provider/prepare_images.py" line="88" />
         <source>Leave flagged images out of the prepared folder</source>
         <translation>Escludi le immagini segnalate dalla cartella preparata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="75" />
+        <location filename="../processing_provider/prepare_images.py" line="93" />
         <source>Scanned film: fiducial marks, common frame, masks</source>
         <translation>Pellicola scansionata: marche fiduciali, fotogramma comune, maschere</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="77" />
+        <location filename="../processing_provider/prepare_images.py" line="95" />
         <source>Calibrated fiducial coordinates in mm (file path or text)</source>
         <translation>Coordinate calibrate delle marche fiduciali in mm (percorso di file o testo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="80" />
+        <location filename="../processing_provider/prepare_images.py" line="98" />
         <source>Calibrated focal length in mm (0 = unknown)</source>
         <translation>Focale calibrata in mm (0 = sconosciuta)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="84" />
+        <location filename="../processing_provider/prepare_images.py" line="102" />
         <source>Flag images below this fraction of the set's median blur score</source>
         <translation>Segnala le immagini sotto questa frazione del punteggio di nitidezza mediano dell'insieme</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="87" />
+        <location filename="../processing_provider/prepare_images.py" line="105" />
         <source>Fiducial mark type</source>
         <translation>Tipo di marca fiduciale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="89" />
+        <location filename="../processing_provider/prepare_images.py" line="107" />
         <source>Fiducial positions</source>
         <translation>Posizioni delle marche fiduciali</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="91" />
+        <location filename="../processing_provider/prepare_images.py" line="109" />
         <source>Template image of one fiducial mark</source>
         <translation>Immagine modello di una marca fiduciale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93" />
+        <location filename="../processing_provider/prepare_images.py" line="111" />
         <source>Scan resolution in dpi when not in the files (0 = from the files)</source>
         <translation>Risoluzione di scansione in dpi se non nei file (0 = dai file)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="100" />
+        <location filename="../processing_provider/prepare_images.py" line="118" />
         <source>Prepared images (skipped: &lt;workspace&gt;/prepared)</source>
         <translation>Immagini preparate (se omesso: &lt;workspace&gt;/prepared)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="103" />
+        <location filename="../processing_provider/prepare_images.py" line="121" />
         <source>Folder of prepared images</source>
         <translation>Cartella delle immagini preparate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="104" />
+        <location filename="../processing_provider/prepare_images.py" line="122" />
         <source>Flagged images</source>
         <translation>Immagini segnalate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="105" />
+        <location filename="../processing_provider/prepare_images.py" line="123" />
         <source>Excluded images</source>
         <translation>Immagini escluse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="106" />
+        <location filename="../processing_provider/prepare_images.py" line="124" />
         <source>Screening record (JSON)</source>
         <translation>Registro del controllo (JSON)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="138" />
+        <location filename="../processing_provider/prepare_images.py" line="160" />
         <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
         <translation>{} immagini: {} segnalate, {} escluse, {} nella cartella preparata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="140" />
+        <location filename="../processing_provider/prepare_images.py" line="162" />
         <source>Blurriest first (blur score, % of the set's median):</source>
         <translation>Le più sfocate per prime (punteggio di nitidezza, % della mediana dell'insieme):</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="148" />
+        <location filename="../processing_provider/prepare_images.py" line="170" />
         <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
         <translation>Scansioni preparate: {} x {} px, dimensione del pixel {:.6g} {}{}</translation>
     </message>
@@ -1499,11 +1499,38 @@ RESIDUALS: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in met
         <translation>Prepara immagini</translation>
     </message>
     <message>
+        <location filename="../processing_provider/prepare_images.py" line="90" />
+        <source>Mask polygons: areas to ignore, in pixel coordinates (optional text field 'image')</source>
+        <translation>Poligoni di maschera: aree da ignorare, in coordinate pixel (campo di testo opzionale 'image')</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="155" />
+        <source>MASKS layer '{}'</source>
+        <translation>layer MASKS '{}'</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="190" />
+        <source>feature {}</source>
+        <translation>elemento {}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="194" />
+        <source>MASKS layer '{}': {} has no geometry: skipped</source>
+        <translation>layer MASKS '{}': {} non ha geometria: saltato</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="197" />
+        <source>MASKS layer '{}': {} is a {} geometry, not a polygon</source>
+        <translation>layer MASKS '{}': {} è una geometria {}, non un poligono</translation>
+    </message>
+    <message>
         <location filename="../ui/catalog.py" line="7" />
         <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for 'Align images', and the WORKSPACE, which records a decision per image (screening.json) for the accuracy report.
 
 Blur score: variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged 'blurry' below BLUR_RELATIVE x the median of the set, or below BLUR_THRESHOLD when that is set (absolute scores depend on the scene: sand scores far lower than roofs).
 Exposure: images with more than 5 % clipped highlights or shadows, a mean brightness far from the set's, or a very small dynamic range are flagged. EXCLUDE_FLAGGED leaves flagged images out of the prepared folder; otherwise they are kept and only reported.
+
+MASKS: optional polygon layer of areas to ignore (a boom, the drone's shadow, a date stamp, a frame border), in the image's pixel coordinates: origin at the upper-left corner of the image, x right, y down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is &lt;= 0). A text field 'image' names the image a polygon belongs to; empty (or no such field) applies it to every image. The polygons are written into the per-image masks (workspace/masks/&lt;image&gt;.png, merged with any mask already there): 'Align images' finds no features under them, the orthophoto does not use those pixels, and blur and exposure are measured outside them. For scanned film the coordinates are those of the prepared images (the common fiducial frame, so one polygon fits every frame).
 
 SCANNED_FILM: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. FIDUCIAL_COORDINATES: the calibration certificate's fiducial coordinates in mm, as a file or pasted text, one 'id x y' line per mark (x right, y up), optionally 'PP x y' (principal point) and 'focal f'. Without them the mean layout of the set is used, centred on the fiducial centre. With FOCAL_LENGTH_MM (or 'focal' in the certificate) the prepared images carry the focal length in pixels for the alignment.
 
@@ -1512,6 +1539,8 @@ OUTPUT: the folder of prepared images (replaced as a whole; it must be new, empt
 
 Punteggio di nitidezza: varianza del laplaciano su una copia in grigio larga 1024 px, 90° percentile di una griglia di 8 x 6 tasselli (cielo o acqua in una parte del fotogramma non vanno a suo sfavore). Più alto è più nitido. Un'immagine è segnalata come 'sfocata' sotto BLUR_RELATIVE x la mediana dell'insieme, o sotto BLUR_THRESHOLD se impostato (i punteggi assoluti dipendono dalla scena: la sabbia ottiene molto meno dei tetti).
 Esposizione: vengono segnalate le immagini con più del 5 % di luci o ombre tagliate, una luminosità media lontana da quella dell'insieme o una gamma dinamica molto ridotta. EXCLUDE_FLAGGED esclude le immagini segnalate dalla cartella preparata; altrimenti vengono mantenute e solo riportate.
+
+MASKS: layer poligonale opzionale delle aree da ignorare (un braccio, l'ombra del drone, un timbro con la data, un bordo del fotogramma), nelle coordinate pixel dell'immagine: origine nell'angolo superiore sinistro, x verso destra, y verso il basso, oppure y = -riga come il georeferenziatore di QGIS mostra una foto (riconosciuto quando ogni y è &lt;= 0). Un campo di testo 'image' indica l'immagine a cui appartiene un poligono; vuoto (o senza tale campo) vale per ogni immagine. I poligoni vengono scritti nelle maschere per immagine (workspace/masks/&lt;immagine&gt;.png, unite a una maschera già presente): 'Allinea immagini' non trova caratteristiche sotto di essi, l'ortofoto non usa quei pixel, e nitidezza ed esposizione vengono misurate al di fuori. Per la pellicola scansionata valgono le coordinate delle immagini preparate (il riferimento comune delle marche fiduciali, così un poligono vale per ogni fotogramma).
 
 SCANNED_FILM: le marche fiduciali (croci, punti, punti in cerchi; negli angoli e/o a metà dei lati, o come un'immagine modello di una marca) sono trovate con precisione sub-pixel, ogni scansione è ricampionata con una trasformazione affine nel fotogramma fiduciale comune, tutte della stessa dimensione e con il punto principale al centro, e delle maschere (workspace/masks) nascondono alla corrispondenza il bordo della pellicola, le strisce di dati e le marche. FIDUCIAL_COORDINATES: le coordinate delle marche fiduciali del certificato di calibrazione in mm, come file o testo incollato, una riga 'id x y' per marca (x a destra, y in alto), facoltativamente 'PP x y' (punto principale) e 'focal f'. Senza di esse si usa la disposizione media dell'insieme, centrata sul centro fiduciale. Con FOCAL_LENGTH_MM (o 'focal' nel certificato) le immagini preparate riportano la focale in pixel per l'allineamento.
 

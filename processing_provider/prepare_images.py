@@ -1,15 +1,21 @@
 """Prepare images: thin adapter over core.screening.prepare_images_workspace (and core.scans)."""
 from qgis.core import (
+    NULL,
+    QgsGeometry,
+    QgsProcessing,
+    QgsProcessingException,
     QgsProcessingOutputFile,
     QgsProcessingOutputFolder,
     QgsProcessingOutputNumber,
     QgsProcessingParameterBoolean,
     QgsProcessingParameterDefinition,
     QgsProcessingParameterEnum,
+    QgsProcessingParameterFeatureSource,
     QgsProcessingParameterFile,
     QgsProcessingParameterFolderDestination,
     QgsProcessingParameterNumber,
     QgsProcessingParameterString,
+    QgsWkbTypes,
 )
 
 from .base import AlgorithmBase, FeedbackProgress
@@ -27,6 +33,7 @@ class PrepareImagesAlgorithm(AlgorithmBase):
     BLUR_THRESHOLD = "BLUR_THRESHOLD"
     BLUR_RELATIVE = "BLUR_RELATIVE"
     EXCLUDE_FLAGGED = "EXCLUDE_FLAGGED"
+    MASKS = "MASKS"
     SCANNED_FILM = "SCANNED_FILM"
     FIDUCIAL_COORDINATES = "FIDUCIAL_COORDINATES"
     FOCAL_LENGTH_MM = "FOCAL_LENGTH_MM"
@@ -50,6 +57,14 @@ class PrepareImagesAlgorithm(AlgorithmBase):
         "Exposure: images with more than 5 % clipped highlights or shadows, a mean brightness far from the "
         "set's, or a very small dynamic range are flagged. EXCLUDE_FLAGGED leaves flagged images out of the "
         "prepared folder; otherwise they are kept and only reported.\n\n"
+        "MASKS: optional polygon layer of areas to ignore (a boom, the drone's shadow, a date stamp, a frame "
+        "border), in the image's pixel coordinates: origin at the upper-left corner of the image, x right, y "
+        "down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is <= 0). A text field "
+        "'image' names the image a polygon belongs to; empty (or no such field) applies it to every image. "
+        "The polygons are written into the per-image masks (workspace/masks/<image>.png, merged with any mask "
+        "already there): 'Align images' finds no features under them, the orthophoto does not use those pixels, "
+        "and blur and exposure are measured outside them. For scanned film the coordinates are those of the "
+        "prepared images (the common fiducial frame, so one polygon fits every frame).\n\n"
         "SCANNED_FILM: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side "
         "middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is "
         "resampled by an affine transform into the common fiducial frame, all with the same size and the "
@@ -72,6 +87,9 @@ class PrepareImagesAlgorithm(AlgorithmBase):
             type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
         self.addParameter(QgsProcessingParameterBoolean(
             self.EXCLUDE_FLAGGED, self.tr("Leave flagged images out of the prepared folder"), defaultValue=False))
+        self.addParameter(QgsProcessingParameterFeatureSource(
+            self.MASKS, self.tr("Mask polygons: areas to ignore, in pixel coordinates (optional text field 'image')"),
+            [QgsProcessing.TypeVectorPolygon], optional=True))
         self.addParameter(QgsProcessingParameterBoolean(
             self.SCANNED_FILM, self.tr("Scanned film: fiducial marks, common frame, masks"), defaultValue=False))
         self.addParameter(QgsProcessingParameterString(
@@ -131,6 +149,10 @@ class PrepareImagesAlgorithm(AlgorithmBase):
                 scan_pixel_size_mm=(25.4 / dpi) if dpi > 0 else None,
             ) if scanned else None,
         )
+        source = self.parameterAsSource(parameters, self.MASKS, context)
+        if source is not None:
+            options.mask_polygons = self.mask_polygons(source, feedback)
+            options.mask_source = self.tr("MASKS layer '{}'").format(source.sourceName())
         result = self.run_core(screening.prepare_images_workspace, images, workspace, output or None, options,
                                FeedbackProgress(feedback))
         for w in result.warnings:
@@ -155,3 +177,34 @@ class PrepareImagesAlgorithm(AlgorithmBase):
             self.EXCLUDED: result.excluded,
             self.SCREENING: result.screening_path,
         }
+
+    def mask_polygons(self, source, feedback=None):
+        """The features of a polygon source as plain (image or None, [exterior, hole, ...], label) items."""
+        fields = source.fields()
+        image_field = next((i for i in range(fields.count()) if fields.at(i).name().lower() == "image"), -1)
+        layer = source.sourceName()
+        out = []
+        for feature in source.getFeatures():
+            if feedback is not None and feedback.isCanceled():
+                break
+            label = self.tr("feature {}").format(feature.id())
+            geom = feature.geometry()
+            if geom is None or geom.isNull() or geom.isEmpty():
+                if feedback is not None:
+                    feedback.pushWarning(self.tr("MASKS layer '{}': {} has no geometry: skipped").format(layer, label))
+                continue
+            if geom.type() != QgsWkbTypes.PolygonGeometry:
+                raise QgsProcessingException(self.tr("MASKS layer '{}': {} is a {} geometry, not a polygon").format(
+                    layer, label, QgsWkbTypes.displayString(geom.wkbType())))
+            if QgsWkbTypes.isCurvedType(geom.wkbType()):
+                geom = QgsGeometry(geom.constGet().segmentize())
+            image = None
+            if image_field >= 0:
+                value = feature.attribute(image_field)
+                image = None if value is None or value == NULL else (str(value).strip() or None)
+            parts = geom.asMultiPolygon() if geom.isMultipart() else [geom.asPolygon()]
+            for part in parts:
+                rings = [[(p.x(), p.y()) for p in ring] for ring in part]
+                if rings:
+                    out.append((image, rings, label))
+        return out
