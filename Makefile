@@ -83,7 +83,7 @@ transcompile: apt
 
 package: transcompile
 	@rm -rf $(BUILD)/package && mkdir -p $(BUILD)/package/archaeoortho dist
-	@git ls-files -co --exclude-standard | grep -vE '^(tests/|benchmarks/|sample/|\.ci/|\.git|\.flake8|Makefile|requirements-dev|pytest\.ini|ruff\.toml|setup\.cfg)' \
+	@git ls-files -co --exclude-standard | grep -vE '^(tests/|benchmarks/|sample/|docs/|\.ci/|\.git|\.flake8|Makefile|requirements-dev|pytest\.ini|ruff\.toml|setup\.cfg)' \
 	  | while read f; do [ -f "$$f" ] && install -D -m 644 "$$f" "$(BUILD)/package/archaeoortho/$$f"; done
 	@cp i18n/*.qm $(BUILD)/package/archaeoortho/i18n/ 2>/dev/null || true
 	@cd $(BUILD)/package && rm -f $(ROOT)/dist/archaeoortho.zip && zip -qr $(ROOT)/dist/archaeoortho.zip archaeoortho

@@ -22,7 +22,9 @@ Pair selection (``pairing``):
 - ``exhaustive``: every pair (n(n-1)/2);
 - ``sequential``: each image with the next ``SEQUENTIAL_OVERLAP`` images in file
   order (flight order), plus vocabulary-free loop pairs: every image with
-  every ``LOOP_STRIDE``-th image, which closes loops between strips;
+  every ``LOOP_STRIDE``-th image, which closes loops between strips (at most
+  ``MAX_LOOP_ANCHORS`` such anchor images: the stride grows with the set, so the
+  pair count grows linearly, not quadratically, with the number of images);
 - ``spatial``: each image with its ``SPATIAL_NEIGHBOURS`` nearest neighbours by
   EXIF GPS (horizontal distance), plus a sequential overlap of 3 as a safety
   net; falls back to exhaustive with a warning when images lack GPS;
@@ -53,6 +55,7 @@ CAMERA_MODELS = ("AUTO", "SIMPLE_RADIAL", "RADIAL", "OPENCV", "FULL_OPENCV")
 SPATIAL_NEIGHBOURS = 12
 SEQUENTIAL_OVERLAP = 12
 LOOP_STRIDE = 10
+MAX_LOOP_ANCHORS = 30
 AUTO_EXHAUSTIVE_MAX = 100
 MATCH_BLOCK = 24  # pairs per matching call: the unit of progress and cancel
 EXTRACT_BLOCK = 2  # images per extraction call: the unit of progress and cancel
@@ -206,11 +209,12 @@ def select_pairs(images: Sequence[ImageInfo], pairing: str,
             for j in range(i + 1, n):
                 add(i, j)
     elif pairing == "sequential":
+        stride = max(LOOP_STRIDE, -(-n // MAX_LOOP_ANCHORS))
         for i in range(n):
             for k in range(1, SEQUENTIAL_OVERLAP + 1):
                 if i + k < n:
                     add(i, i + k)
-            for j in range(0, n, LOOP_STRIDE):
+            for j in range(0, n, stride):
                 add(i, j)
     else:  # spatial
         xy = gps_to_local_xy([im.gps for im in images])

@@ -56,12 +56,27 @@ def test_pair_selection_spatial_and_fallback():
 
 
 def test_pair_selection_sequential_has_loop_pairs():
+    from collections import Counter
+
     imgs = [_info(f"{i:03d}.jpg") for i in range(150)]
     pairs, used, _ = sfm.select_pairs(imgs, "auto")
     assert used == "sequential"
     assert ("000.jpg", "001.jpg") in pairs and ("000.jpg", "012.jpg") in pairs
     assert ("005.jpg", "140.jpg") in pairs  # loop pair to every 10th image
     assert len(pairs) < 150 * 149 // 4
+    # a large set: the loop anchors are bounded, so the pairs grow linearly with the images
+    counts = {}
+    for n in (1000, 2000):
+        pairs, used, _ = sfm.select_pairs([_info(f"{i:04d}.jpg") for i in range(n)], "sequential")
+        counts[n] = len(pairs)
+        far = Counter()
+        for a, b in pairs:
+            if int(b[:4]) - int(a[:4]) > sfm.SEQUENTIAL_OVERLAP:
+                far[a] += 1
+                far[b] += 1
+        anchors = [k for k, v in far.items() if v > n // 4]  # paired with a large share of the set
+        assert 0 < len(anchors) <= sfm.MAX_LOOP_ANCHORS
+    assert counts[2000] < 2.1 * counts[1000]
 
 
 def test_camera_model_choice():
