@@ -29,14 +29,14 @@ from _util import run_measured  # noqa: E402
 DEFAULT_IMAGES = os.path.join(os.path.dirname(ROOT), "shared", "data", "toledo", "images")
 
 
-def ours(images, work, threads):
+def ours(images, work, threads, mapper="incremental"):
     ws = os.path.join(work, "archaeoortho-ws")
     shutil.rmtree(ws, ignore_errors=True)
     code = ("import sys, json; sys.path.insert(0, %r); from core.sfm import align, AlignOptions;"
-            "r = align(%r, %r, AlignOptions(num_threads=%d));"
+            "r = align(%r, %r, AlignOptions(num_threads=%d, mapper=%r));"
             "print('RESULT', json.dumps({'registered': r.registered, 'images': r.images_given,"
             "'mre': r.mean_reprojection_error, 'timings': r.timings, 'pairs': r.num_pairs,"
-            "'pairing': r.pairing_used, 'points': r.num_points3d}))") % (ROOT, images, ws, threads)
+            "'pairing': r.pairing_used, 'points': r.num_points3d}))") % (ROOT, images, ws, threads, mapper)
     log = os.path.join(work, "archaeoortho.log")
     rc, wall, rss = run_measured([sys.executable, "-c", code], log_path=log)
     if rc != 0:
@@ -146,12 +146,13 @@ def main():
     ap.add_argument("--skip-colmap", action="store_true")
     ap.add_argument("--colmap-defaults", action="store_true")
     ap.add_argument("--pycolmap-defaults", action="store_true", help="also run pycolmap's default pipeline")
+    ap.add_argument("--mapper", default="incremental", choices=["incremental", "global"], help="our mapper")
     a = ap.parse_args()
     os.makedirs(a.workdir, exist_ok=True)
     n = len([f for f in os.listdir(a.images) if f.lower().endswith((".jpg", ".jpeg", ".tif", ".tiff"))])
     print(f"images: {a.images} ({n}); cores: {os.cpu_count()}; threads: {a.threads}", flush=True)
-    r, wall, rss = ours(a.images, a.workdir, a.threads)
-    print("\nArchaeoOrtho align")
+    r, wall, rss = ours(a.images, a.workdir, a.threads, a.mapper)
+    print(f"\nArchaeoOrtho align (mapper {a.mapper})")
     for k, v in r["timings"].items():
         print(f"  {k:<18} {v:8.1f} s")
     print(f"  {'wall':<18} {wall:8.1f} s   peak RSS {rss:7.0f} MiB")

@@ -81,6 +81,7 @@ class AlignOptions:
     num_threads: int = -1
     refine_principal_point: bool = True  # in the final global BA, when the camera has enough images
     min_images_opencv: int = 10  # AUTO picks OPENCV from this many images per camera, RADIAL below
+    mapper: str = "incremental"  # incremental (COLMAP) or global (GLOMAP: rotation averaging + global positioning)
     seed: int = 1
 
 
@@ -418,7 +419,12 @@ def _verified_partners(pycolmap, db_path, min_inliers: int) -> Dict[str, int]:
         db.close()
 
 
+MAPPERS = ("incremental", "global")
+
+
 def _map(pycolmap, db_path, images_dir, out_dir, n_images, options, progress: Progress):
+    if options.mapper == "global":
+        return _map_global(pycolmap, db_path, images_dir, out_dir, options, progress)
     opts = pycolmap.IncrementalPipelineOptions()
     opts.num_threads = options.num_threads
     opts.random_seed = options.seed
@@ -436,6 +442,21 @@ def _map(pycolmap, db_path, images_dir, out_dir, n_images, options, progress: Pr
         recs = pycolmap.incremental_mapping(db_path, images_dir, out_dir, options=opts,
                                             next_image_callback=on_next, cancellation_token=token)
     check_cancel(progress)
+    return recs
+
+
+def _map_global(pycolmap, db_path, images_dir, out_dir, options, progress: Progress):
+    """GLOMAP's global pipeline (rotation averaging, global positioning, bundle adjustment).  pycolmap 4.2
+    gives it no cancellation token and no progress callback: a cancel takes effect when it returns."""
+    opts = pycolmap.GlobalPipelineOptions()
+    opts.num_threads = options.num_threads
+    opts.random_seed = options.seed
+    opts.min_model_size = 3
+    progress.report(0.0, "mapping: global SfM (rotation averaging, global positioning, bundle adjustment)")
+    check_cancel(progress)
+    recs = pycolmap.global_mapping(db_path, images_dir, out_dir, options=opts)
+    check_cancel(progress)
+    progress.report(1.0, "mapping: global SfM done")
     return recs
 
 
@@ -484,6 +505,8 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
     """Run the alignment stage.  Raises AlignError / ImageError / WorkspaceError / Cancelled."""
     options = options or AlignOptions()
     progress = progress or NullProgress()
+    if options.mapper not in MAPPERS:
+        raise AlignError(f"unknown mapper {options.mapper!r}; choose one of {', '.join(MAPPERS)}")
     pycolmap = _pycolmap()
     t_start = time.time()
     images_dir = os.path.abspath(images_dir)

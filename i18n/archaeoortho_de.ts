@@ -92,82 +92,82 @@ OUTPUT_HTML: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wir
 <context>
     <name>AlignImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/align_images.py" line="48" />
+        <location filename="../processing_provider/align_images.py" line="53" />
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50" />
+        <location filename="../processing_provider/align_images.py" line="55" />
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="51" />
+        <location filename="../processing_provider/align_images.py" line="56" />
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="53" />
+        <location filename="../processing_provider/align_images.py" line="58" />
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="55" />
+        <location filename="../processing_provider/align_images.py" line="60" />
         <source>Largest image side for matching (0 = full size)</source>
         <translation>Größte Bildseite für die Zuordnung (0 = volle Größe)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="58" />
+        <location filename="../processing_provider/align_images.py" line="63" />
         <source>Largest number of features per image (0 = auto, ~4000 per megapixel)</source>
         <translation>Höchstzahl der Merkmale je Bild (0 = automatisch, ~4000 je Megapixel)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="61" />
+        <location filename="../processing_provider/align_images.py" line="66" />
         <source>Affine-invariant features (oblique views; slower)</source>
         <translation>Affin-invariante Merkmale (Schrägaufnahmen; langsamer)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="63" />
+        <location filename="../processing_provider/align_images.py" line="68" />
         <source>Focal length in mm when EXIF is missing (0 = from EXIF)</source>
         <translation>Brennweite in mm, wenn EXIF fehlt (0 = aus EXIF)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66" />
+        <location filename="../processing_provider/align_images.py" line="71" />
         <source>Sensor (frame) width in mm, long side (0 = unknown)</source>
         <translation>Breite des Sensors (Bildformats) in mm, lange Seite (0 = unbekannt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="69" />
+        <location filename="../processing_provider/align_images.py" line="74" />
         <source>One camera for all images</source>
         <translation>Eine Kamera für alle Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="71" />
+        <location filename="../processing_provider/align_images.py" line="79" />
         <source>Camera centres</source>
         <translation>Projektionszentren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="72" />
+        <location filename="../processing_provider/align_images.py" line="80" />
         <source>Registered images</source>
         <translation>Orientierte Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="73" />
+        <location filename="../processing_provider/align_images.py" line="81" />
         <source>Mean reprojection error (px)</source>
         <translation>Mittlerer Rückprojektionsfehler (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="95" />
+        <location filename="../processing_provider/align_images.py" line="104" />
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
         <translation>{} von {} Bildern orientiert, mittlerer Rückprojektionsfehler {:.3f} px, {} Punkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="98" />
+        <location filename="../processing_provider/align_images.py" line="107" />
         <source>Images not registered:</source>
         <translation>Nicht orientierte Bilder:</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="101" />
+        <location filename="../processing_provider/align_images.py" line="110" />
         <source>Seconds per step: {}</source>
         <translation>Sekunden je Schritt: {}</translation>
     </message>
@@ -177,17 +177,24 @@ OUTPUT_HTML: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wir
         <translation>Bilder ausrichten</translation>
     </message>
     <message>
+        <location filename="../processing_provider/align_images.py" line="76" />
+        <source>Mapper</source>
+        <translation>Rekonstruktionsverfahren</translation>
+    </message>
+    <message>
         <location filename="../ui/catalog.py" line="7" />
         <source>Structure from motion: SIFT features, pair selection, robust matching (RANSAC), incremental mapping with self-calibration (focal length, principal point, lens distortion) and a final bundle adjustment. The result is stored in the WORKSPACE folder, which the following stages (Georeference, Build DSM, Build orthophoto) take as input. A re-run resumes: features and matches already computed are reused.
 
 PAIRING: 'auto' uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
 CAMERA_MODEL: 'AUTO' estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
-FOCAL_MM and SENSOR_WIDTH_MM: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres.</source>
+FOCAL_MM and SENSOR_WIDTH_MM: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres.
+MAPPER (advanced): 'incremental' (COLMAP, the default) or 'global' (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).</source>
         <translation>Structure from Motion: SIFT-Merkmale, Paarauswahl, robuste Zuordnung (RANSAC), inkrementelle Rekonstruktion mit Selbstkalibrierung (Brennweite, Bildhauptpunkt, Objektivverzeichnung) und eine abschließende Bündelblockausgleichung. Das Ergebnis wird im Ordner WORKSPACE gespeichert, den die folgenden Schritte (Georeferenzieren, DOM erzeugen, Orthophoto erzeugen) als Eingabe nehmen. Ein erneuter Lauf setzt fort: bereits berechnete Merkmale und Zuordnungen werden wiederverwendet.
 
 PAIRING: 'auto' nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
 CAMERA_MODEL: 'AUTO' schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
-FOCAL_MM und SENSOR_WIDTH_MM: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern.</translation>
+FOCAL_MM und SENSOR_WIDTH_MM: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern.
+MAPPER (erweitert): 'incremental' (COLMAP, Standard) oder 'global' (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).</translation>
     </message>
 </context>
 <context>

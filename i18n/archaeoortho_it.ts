@@ -92,82 +92,82 @@ OUTPUT_HTML: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). 
 <context>
     <name>AlignImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/align_images.py" line="48" />
+        <location filename="../processing_provider/align_images.py" line="53" />
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50" />
+        <location filename="../processing_provider/align_images.py" line="55" />
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="51" />
+        <location filename="../processing_provider/align_images.py" line="56" />
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="53" />
+        <location filename="../processing_provider/align_images.py" line="58" />
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="55" />
+        <location filename="../processing_provider/align_images.py" line="60" />
         <source>Largest image side for matching (0 = full size)</source>
         <translation>Lato maggiore dell'immagine per la corrispondenza (0 = dimensione piena)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="58" />
+        <location filename="../processing_provider/align_images.py" line="63" />
         <source>Largest number of features per image (0 = auto, ~4000 per megapixel)</source>
         <translation>Numero massimo di feature per immagine (0 = automatico, ~4000 per megapixel)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="61" />
+        <location filename="../processing_provider/align_images.py" line="66" />
         <source>Affine-invariant features (oblique views; slower)</source>
         <translation>Feature invarianti affini (prese oblique; più lento)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="63" />
+        <location filename="../processing_provider/align_images.py" line="68" />
         <source>Focal length in mm when EXIF is missing (0 = from EXIF)</source>
         <translation>Focale in mm se manca l'EXIF (0 = dall'EXIF)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66" />
+        <location filename="../processing_provider/align_images.py" line="71" />
         <source>Sensor (frame) width in mm, long side (0 = unknown)</source>
         <translation>Larghezza del sensore (fotogramma) in mm, lato lungo (0 = sconosciuta)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="69" />
+        <location filename="../processing_provider/align_images.py" line="74" />
         <source>One camera for all images</source>
         <translation>Una sola camera per tutte le immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="71" />
+        <location filename="../processing_provider/align_images.py" line="79" />
         <source>Camera centres</source>
         <translation>Centri di presa</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="72" />
+        <location filename="../processing_provider/align_images.py" line="80" />
         <source>Registered images</source>
         <translation>Immagini orientate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="73" />
+        <location filename="../processing_provider/align_images.py" line="81" />
         <source>Mean reprojection error (px)</source>
         <translation>Errore medio di riproiezione (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="95" />
+        <location filename="../processing_provider/align_images.py" line="104" />
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
         <translation>Orientate {} di {} immagini, errore medio di riproiezione {:.3f} px, {} punti</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="98" />
+        <location filename="../processing_provider/align_images.py" line="107" />
         <source>Images not registered:</source>
         <translation>Immagini non orientate:</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="101" />
+        <location filename="../processing_provider/align_images.py" line="110" />
         <source>Seconds per step: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -177,17 +177,24 @@ OUTPUT_HTML: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). 
         <translation>Allinea immagini</translation>
     </message>
     <message>
+        <location filename="../processing_provider/align_images.py" line="76" />
+        <source>Mapper</source>
+        <translation>Metodo di ricostruzione</translation>
+    </message>
+    <message>
         <location filename="../ui/catalog.py" line="7" />
         <source>Structure from motion: SIFT features, pair selection, robust matching (RANSAC), incremental mapping with self-calibration (focal length, principal point, lens distortion) and a final bundle adjustment. The result is stored in the WORKSPACE folder, which the following stages (Georeference, Build DSM, Build orthophoto) take as input. A re-run resumes: features and matches already computed are reused.
 
 PAIRING: 'auto' uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
 CAMERA_MODEL: 'AUTO' estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
-FOCAL_MM and SENSOR_WIDTH_MM: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres.</source>
+FOCAL_MM and SENSOR_WIDTH_MM: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres.
+MAPPER (advanced): 'incremental' (COLMAP, the default) or 'global' (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).</source>
         <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell'obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella WORKSPACE, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
 
 PAIRING: 'auto' usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
 CAMERA_MODEL: 'AUTO' stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
-FOCAL_MM e SENSOR_WIDTH_MM: orientamento interno quando manca l'EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri.</translation>
+FOCAL_MM e SENSOR_WIDTH_MM: orientamento interno quando manca l'EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri.
+MAPPER (avanzato): 'incremental' (COLMAP, predefinito) o 'global' (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).</translation>
     </message>
 </context>
 <context>

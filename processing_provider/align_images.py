@@ -3,6 +3,7 @@ from qgis.core import (
     QgsProcessingOutputNumber,
     QgsProcessingOutputVectorLayer,
     QgsProcessingParameterBoolean,
+    QgsProcessingParameterDefinition,
     QgsProcessingParameterEnum,
     QgsProcessingParameterFile,
     QgsProcessingParameterFolderDestination,
@@ -13,6 +14,7 @@ from .base import AlgorithmBase, FeedbackProgress
 
 PAIRINGS = ["auto", "exhaustive", "sequential", "spatial"]
 CAMERA_MODELS = ["AUTO", "SIMPLE_RADIAL", "RADIAL", "OPENCV", "FULL_OPENCV"]
+MAPPERS = ["incremental", "global"]
 
 
 class AlignImagesAlgorithm(AlgorithmBase):
@@ -28,6 +30,7 @@ class AlignImagesAlgorithm(AlgorithmBase):
     FOCAL_MM = "FOCAL_MM"
     SENSOR_WIDTH_MM = "SENSOR_WIDTH_MM"
     SINGLE_CAMERA = "SINGLE_CAMERA"
+    MAPPER = "MAPPER"
     CAMERAS = "CAMERAS"
     REGISTERED_IMAGES = "REGISTERED_IMAGES"
     MEAN_REPROJECTION_ERROR = "MEAN_REPROJECTION_ERROR"
@@ -41,7 +44,9 @@ class AlignImagesAlgorithm(AlgorithmBase):
         "CAMERA_MODEL: 'AUTO' estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with "
         "10 or more images, and a simpler radial model below.\n"
         "FOCAL_MM and SENSOR_WIDTH_MM: interior orientation when EXIF is missing (scanned film): the focal "
-        "length and the width of the long side of the frame, in millimetres."
+        "length and the width of the long side of the frame, in millimetres.\n"
+        "MAPPER (advanced): 'incremental' (COLMAP, the default) or 'global' (GLOMAP: rotation averaging and "
+        "global positioning, often faster on large blocks; a Cancel takes effect only when it has finished)."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
@@ -68,6 +73,9 @@ class AlignImagesAlgorithm(AlgorithmBase):
             type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
         self.addParameter(QgsProcessingParameterBoolean(
             self.SINGLE_CAMERA, self.tr("One camera for all images"), defaultValue=False))
+        mapper = QgsProcessingParameterEnum(self.MAPPER, self.tr("Mapper"), options=MAPPERS, defaultValue=0)
+        mapper.setFlags(mapper.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
+        self.addParameter(mapper)
         self.addOutput(QgsProcessingOutputVectorLayer(self.CAMERAS, self.tr("Camera centres")))
         self.addOutput(QgsProcessingOutputNumber(self.REGISTERED_IMAGES, self.tr("Registered images")))
         self.addOutput(QgsProcessingOutputNumber(
@@ -90,6 +98,7 @@ class AlignImagesAlgorithm(AlgorithmBase):
             grouping=GROUP_SINGLE if self.parameterAsBoolean(parameters, self.SINGLE_CAMERA, context) else GROUP_AUTO,
             focal_mm=focal_mm or None,
             sensor_width_mm=sensor_mm or None,
+            mapper=MAPPERS[self.parameterAsEnum(parameters, self.MAPPER, context)],
         )
         result = self.run_core(sfm.align, images, workspace, options, FeedbackProgress(feedback))
         feedback.pushInfo(self.tr("Registered {} of {} images, mean reprojection error {:.3f} px, {} points").format(

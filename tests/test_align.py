@@ -187,3 +187,19 @@ def test_foreign_images_are_reported_not_registered(tmp_path):
     assert result.registered == 5
     assert "IMG_0037.jpg" in result.unregistered
     assert any("IMG_0037.jpg" in w for w in rec.warnings)
+
+
+@pytest.mark.slow
+def test_global_mapper_aligns_the_strip(toledo_strip, tmp_path):
+    """MAPPER=global (GLOMAP through pycolmap) on the sample strip: every image registered, sub-pixel."""
+    r = sfm.align(toledo_strip, str(tmp_path / "ws"),
+                  sfm.AlignOptions(mapper="global", max_image_size=800, max_features=2048))
+    assert r.registered == len(TOLEDO_STRIP)
+    assert r.mean_reprojection_error < 1.0
+    assert json.load(open(tmp_path / "ws" / "workspace.json"))["stages"]["align"]["parameters"]["mapper"] == "global"
+
+
+def test_unknown_mapper_is_a_clear_error(toledo_strip, tmp_path):
+    with pytest.raises(sfm.AlignError, match="unknown mapper 'magic'"):
+        sfm.align(toledo_strip, str(tmp_path / "ws"), sfm.AlignOptions(mapper="magic"))
+    assert not (tmp_path / "ws").exists()
