@@ -57,6 +57,7 @@ SEQUENTIAL_OVERLAP = 12
 LOOP_STRIDE = 10
 MAX_LOOP_ANCHORS = 30
 AUTO_EXHAUSTIVE_MAX = 100
+UPSAMPLE_BELOW = 1000  # long side (px, at the matching scale) below which SIFT starts on a 2x upsampled image
 MATCH_BLOCK = 24  # pairs per matching call: the unit of progress and cancel
 EXTRACT_BLOCK = 2  # images per extraction call: the unit of progress and cancel
 STAGE = "align"
@@ -82,6 +83,7 @@ class AlignOptions:
     refine_principal_point: bool = True  # in the final global BA, when the camera has enough images
     min_images_opencv: int = 10  # AUTO picks OPENCV from this many images per camera, RADIAL below
     mapper: str = "incremental"  # incremental (COLMAP) or global (GLOMAP: rotation averaging + global positioning)
+    first_octave: Optional[int] = None  # SIFT's first octave; None = auto (-1, upsampled, below UPSAMPLE_BELOW px)
     seed: int = 1
 
 
@@ -245,6 +247,10 @@ def _setup_database(pycolmap, db_path: str, groups: List[CameraGroup], options: 
     }
     if masks_key:  # only with masks: the key of a workspace without masks stays as it was
         what["masks"] = masks_key
+    g0 = max(groups, key=lambda g: g.width * g.height)
+    octave = sift_first_octave(options, g0.width, g0.height)
+    if octave != -1:  # COLMAP's default (-1) keeps the key of earlier workspaces
+        what["first_octave"] = octave
     key = fingerprint(what)
     if os.path.exists(db_path) and state.get("database_key") != key:
         os.unlink(db_path)  # different images or extraction settings: start afresh
@@ -319,6 +325,18 @@ def _masks_for_colmap(masks_dir: str, infos: Sequence[ImageInfo], sfm_dir: str) 
     return linked, found
 
 
+def sift_first_octave(options: AlignOptions, width: int, height: int) -> int:
+    """SIFT's first octave: -1 (the image upsampled 2x: more small-scale features, 4x the work) for small
+    images, 0 from ``UPSAMPLE_BELOW`` px on the long side at the matching scale, where the image itself has
+    features enough; ``options.first_octave`` overrides."""
+    if options.first_octave is not None:
+        return int(options.first_octave)
+    side = max(width, height)
+    if options.max_image_size and options.max_image_size > 0:
+        side = min(side, options.max_image_size)
+    return -1 if side < UPSAMPLE_BELOW else 0
+
+
 def _extract(pycolmap, db_path, images_dir, groups, camera_ids, options, progress: Progress,
              mask_path: Optional[str] = None, masked: Optional[Sequence[str]] = None):
     eo = pycolmap.FeatureExtractionOptions()
@@ -327,6 +345,7 @@ def _extract(pycolmap, db_path, images_dir, groups, camera_ids, options, progres
                                                                               options.max_image_size))
     if options.max_image_size and options.max_image_size > 0:
         eo.max_image_size = int(options.max_image_size)
+    eo.sift.first_octave = sift_first_octave(options, g0.width, g0.height)
     eo.num_threads = options.num_threads
     if options.affine_features:
         eo.sift.estimate_affine_shape = True

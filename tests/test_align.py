@@ -203,3 +203,11 @@ def test_unknown_mapper_is_a_clear_error(toledo_strip, tmp_path):
     with pytest.raises(sfm.AlignError, match="unknown mapper 'magic'"):
         sfm.align(toledo_strip, str(tmp_path / "ws"), sfm.AlignOptions(mapper="magic"))
     assert not (tmp_path / "ws").exists()
+
+
+def test_sift_first_octave_upsamples_only_small_images():
+    o = sfm.AlignOptions()
+    assert sfm.sift_first_octave(o, 800, 600) == -1  # small: upsampled for enough small-scale features
+    assert sfm.sift_first_octave(o, 1200, 900) == 0  # the image itself has features enough
+    assert sfm.sift_first_octave(sfm.AlignOptions(max_image_size=800), 4000, 3000) == -1  # matched at 800 px
+    assert sfm.sift_first_octave(sfm.AlignOptions(first_octave=-1), 4000, 3000) == -1  # the user's choice
