@@ -11,7 +11,7 @@ default pipeline (``extract_features`` + ``match_exhaustive`` + ``incremental_ma
 options) on the same images, the second reference; ratios are printed against each reference run.
 
     python benchmarks/align.py [--images DIR] [--workdir DIR] [--skip-colmap] [--colmap-defaults]
-                               [--pycolmap-defaults]
+                               [--pycolmap-defaults] [--mapper incremental|global] [--chain]
 """
 import argparse
 import json
@@ -147,6 +147,8 @@ def main():
     ap.add_argument("--colmap-defaults", action="store_true")
     ap.add_argument("--pycolmap-defaults", action="store_true", help="also run pycolmap's default pipeline")
     ap.add_argument("--mapper", default="incremental", choices=["incremental", "global"], help="our mapper")
+    ap.add_argument("--chain", action="store_true",
+                    help="also run our whole chain to orthomosaic on the same images (benchmarks/chain.py)")
     a = ap.parse_args()
     os.makedirs(a.workdir, exist_ok=True)
     n = len([f for f in os.listdir(a.images) if f.lower().endswith((".jpg", ".jpeg", ".tif", ".tiff"))])
@@ -167,6 +169,20 @@ def main():
         mre = "n/a" if p["mre"] is None else f"{p['mre']:.3f}"
         print(f"  registered {p['registered']}/{n}, mean reprojection error {mre} px")
         print(f"\nratio ArchaeoOrtho / pycolmap defaults wall time: {wall / pwall:.2f}", flush=True)
+    chain_wall = None
+    if a.chain:
+        import chain
+
+        names = sorted(f for f in os.listdir(a.images) if f.lower().endswith((".jpg", ".jpeg", ".tif", ".tiff")))
+        c = chain.one_run(os.path.abspath(a.images), names, os.path.join(a.workdir, "chain"), True)
+        stages = ", ".join(f"{k} {v:.1f}" for k, v in c["seconds"].items())
+        print("\nArchaeoOrtho whole chain to orthomosaic (align, EXIF-GPS georeference, DSM, orthomosaic, report)")
+        print(f"  wall {c['wall']:.1f} s ({stages}); peak RSS (process tree) {c['peak_rss_mib']:.0f} MiB")
+        print(f"  {c['registered']}/{c['images']} registered, DSM valid {c['dsm_valid']:.3f}, orthomosaic valid "
+              f"{c['ortho_valid']:.3f}", flush=True)
+        chain_wall = c["wall"]
+        if a.pycolmap_defaults:
+            print(f"  whole chain / pycolmap defaults' alignment alone: {c['wall'] / pwall:.2f}")
     if a.skip_colmap:
         return
     from core.images import read_image_info
@@ -184,6 +200,8 @@ def main():
     print(f"  {'wall':<18} {total:8.1f} s   peak RSS {peak:7.0f} MiB")
     print(f"  registered {reg}, mean reprojection error {mre} px")
     print(f"\nratio ArchaeoOrtho / COLMAP wall time: {wall / total:.2f}")
+    if chain_wall is not None:
+        print(f"ratio ArchaeoOrtho whole chain / COLMAP alignment alone: {chain_wall / total:.2f}")
 
 
 if __name__ == "__main__":
