@@ -45,18 +45,23 @@ def tree_rss(root_pid):
     return sum(rss.get(p, 0) for p in tree), len(tree)
 
 
-def run_tree_measured(cmd, env=None, log_path=None, interval=0.2):
+def run_tree_measured(cmd, env=None, log_path=None, interval=0.2, peak_at=None):
     """Run ``cmd``; return (exit code, wall seconds, peak summed RSS in MiB of the child and all its
-    descendants (pool workers), sampled every ``interval`` s)."""
+    descendants (pool workers), sampled every ``interval`` s).  ``peak_at``: a list that receives the
+    seconds after the start at which the peak was seen."""
     out = open(log_path, "w") if log_path else subprocess.DEVNULL
     t0 = time.time()
     proc = subprocess.Popen(cmd, env=env, stdout=out, stderr=subprocess.STDOUT)
     peak = [0]
     stop = threading.Event()
 
+    when = [0.0]
+
     def sample():
         while not stop.wait(interval):
-            peak[0] = max(peak[0], tree_rss(proc.pid)[0])
+            rss = tree_rss(proc.pid)[0]
+            if rss > peak[0]:
+                peak[0], when[0] = rss, time.time() - t0
 
     th = threading.Thread(target=sample, daemon=True)
     th.start()
@@ -65,4 +70,6 @@ def run_tree_measured(cmd, env=None, log_path=None, interval=0.2):
     th.join()
     if log_path:
         out.close()
+    if peak_at is not None:
+        peak_at.append(when[0])
     return os.waitstatus_to_exitcode(status), time.time() - t0, max(peak[0] / 2 ** 20, usage.ru_maxrss / 1024.0)

@@ -60,13 +60,24 @@ def one_run(images, names, workdir, report):
     if not report:
         cmd.append("--no-report")
     log = os.path.join(d, "chain.log")
-    rc, wall, rss = run_tree_measured(cmd, log_path=log)
+    when = []
+    rc, wall, rss = run_tree_measured(cmd, log_path=log, peak_at=when)
     if rc != 0:
         raise SystemExit(f"the chain failed on {n} images (exit {rc}), see {log}")
     with open(result) as f:
         r = json.load(f)
-    r.update(wall=wall, peak_rss_mib=rss, n=n)
+    r.update(wall=wall, peak_rss_mib=rss, n=n, peak_stage=_stage_at(r["seconds"], when[0] if when else 0.0))
     return r
+
+
+def _stage_at(seconds, t):
+    """The stage running ``t`` seconds after the start (stages run in order; start-up counts to the first)."""
+    elapsed = 0.0
+    for stage, secs in seconds.items():
+        elapsed += secs
+        if t <= elapsed:
+            return stage
+    return "after the last stage"
 
 
 def synthetic_set(n, workdir):
@@ -120,7 +131,8 @@ def main():
         r = one_run(images, names[:n], workdir, not a.no_report)
         runs.append(r)
         stages = ", ".join(f"{k} {v:.0f}" for k, v in r["seconds"].items())
-        print(f"\n{n} images: wall {r['wall']:.0f} s ({stages}); peak RSS (process tree) {r['peak_rss_mib']:.0f} MiB",
+        print(f"\n{n} images: wall {r['wall']:.0f} s ({stages}); peak RSS (process tree) {r['peak_rss_mib']:.0f} MiB "
+              f"(during {r['peak_stage']})",
               flush=True)
         al = ", ".join(f"{k} {v:.0f}" for k, v in r["align_timings"].items())
         print(f"  align: {r['registered']}/{r['images']} registered, {r['mre']:.3f} px ({al} s)")
