@@ -151,15 +151,6 @@ def make_executor(workers: int = 0, kind: str = "auto", scheduler: Optional[str]
     return cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx)
 
 
-def executor_kind(executor) -> str:
-    """'dask', 'serial', 'thread' or 'process': for the log."""
-    if isinstance(executor, _DaskExecutor):
-        return "dask"
-    if isinstance(executor, SerialExecutor):
-        return "serial"
-    return "thread" if isinstance(executor, cf.ThreadPoolExecutor) else "process"
-
-
 def describe_executor(executor) -> str:
     """'2 worker(s)' locally, 'Dask cluster tcp://...: 8 worker thread(s)' on a cluster."""
     n = getattr(executor, "_max_workers", 1) or 1
@@ -321,5 +312,5 @@ def _wait_all(futures: List[Any], timeout: float) -> None:
         cf.wait(cf_futs, timeout=timeout)
 
 
-__all__ = ["make_executor", "resolve_scheduler", "executor_kind", "describe_executor", "SCHEDULER_ENV", "run_units", "check_unit_cancel", "cancel_requested", "auto_workers", "cpu_count",
+__all__ = ["make_executor", "resolve_scheduler", "describe_executor", "SCHEDULER_ENV", "run_units", "check_unit_cancel", "cancel_requested", "auto_workers", "cpu_count",
            "ParallelError", "SerialExecutor", "python_executable"]

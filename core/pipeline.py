@@ -287,11 +287,11 @@ def run_pipeline(images_dir: str, workspace_dir: str, *, align_options=None, gcp
                          "USE_EXIF_GPS) to georeference the block before the DSM and orthophoto; to align only, "
                          "run 'Align images'")
     seconds: Dict[str, float] = {}
-    spans = (("align", 0.0, 0.40), ("georeference", 0.40, 0.45), ("dsm", 0.45, 0.75),
-             ("orthophoto", 0.75, 0.93), ("report", 0.93, 1.0))
+    spans = {"align": (0.0, 0.40), "georeference": (0.40, 0.45), "dsm": (0.45, 0.75),
+             "orthophoto": (0.75, 0.93), "report": (0.93, 1.0)}
 
     def run(name, fn, *args, **kwargs):
-        lo, hi = next((a, b) for n, a, b in spans if n == name)
+        lo, hi = spans[name]
         progress.info(f"--- stage {name} ---")
         t0 = time.time()
         out = fn(*args, progress=SubProgress(progress, lo, hi), **kwargs)

@@ -70,11 +70,11 @@ def test_dask_products_are_identical_to_the_local_run(block_root, cluster):
 def test_scheduler_from_the_environment(monkeypatch, cluster):
     monkeypatch.setenv(parallel.SCHEDULER_ENV, cluster.scheduler_address)
     with parallel.make_executor(workers=1) as ex:
-        assert parallel.executor_kind(ex) == "dask"
+        assert parallel.describe_executor(ex) == f"Dask cluster {cluster.scheduler_address}: 2 worker thread(s)"
         assert ex.submit(pow, 3, 4).result() == 81
     monkeypatch.setenv(parallel.SCHEDULER_ENV, "")
     with parallel.make_executor(workers=1) as ex:
-        assert parallel.executor_kind(ex) == "serial"
+        assert isinstance(ex, parallel.SerialExecutor)
 
 
 def test_unreachable_scheduler_is_a_clear_error():
