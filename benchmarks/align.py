@@ -132,7 +132,7 @@ def _grab(text, key):
 
 
 def _has_gps(images):
-    from core.images import read_image_info
+    from core.io.images import read_image_info
 
     names = [n for n in os.listdir(images) if n.lower().endswith((".jpg", ".jpeg", ".tif", ".tiff"))]
     return all(read_image_info(os.path.join(images, n)).gps for n in names[:5])
@@ -185,8 +185,8 @@ def main():
             print(f"  whole chain / pycolmap defaults' alignment alone: {c['wall'] / pwall:.2f}")
     if a.skip_colmap:
         return
-    from core.images import read_image_info
-    from core.sfm import auto_max_features
+    from core.align.sfm import auto_max_features
+    from core.io.images import read_image_info
 
     first = sorted(f for f in os.listdir(a.images) if f.lower().endswith((".jpg", ".jpeg", ".tif", ".tiff")))[0]
     info = read_image_info(os.path.join(a.images, first))

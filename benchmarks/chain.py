@@ -30,7 +30,7 @@ EXT = (".jpg", ".jpeg", ".tif", ".tiff")
 
 def child(images, ws, result, report):
     from core import pipeline
-    from core.progress import PrintProgress
+    from core.common.progress import PrintProgress
 
     positions = os.path.join(os.path.dirname(images), "camera_positions.csv")
     control = dict(camera_positions_path=positions) if os.path.isfile(positions) else dict(use_exif_gps=True)

@@ -31,9 +31,10 @@ DATA = os.path.join(os.path.dirname(ROOT), "shared", "data")
 
 
 def ensure_georeferenced(images, ws, crs):
-    from core import pipeline, sfm
-    from core.progress import PrintProgress
-    from core.workspace import Workspace
+    from core import pipeline
+    from core.align import sfm
+    from core.common.progress import PrintProgress
+    from core.project.workspace import Workspace
 
     try:
         w = Workspace.open(ws)
@@ -84,8 +85,8 @@ def run_child(args):
 
 
 def child(args):
-    from core import dense
-    from core.progress import PrintProgress
+    from core.common.progress import PrintProgress
+    from core.dense import matching as dense
 
     pc = os.path.join(args.workspace, "dense", "points.las") if args.point_cloud else None
     t0 = time.time()
@@ -125,7 +126,7 @@ def figures_png(dsm_path, png):
     import matplotlib.pyplot as plt
     from scipy import ndimage
 
-    from core import dsm
+    from core.io import raster as dsm
 
     z, gt, _ = dsm.read_dsm(dsm_path)
     res = gt[1]

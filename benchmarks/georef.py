@@ -20,9 +20,10 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, ROOT)
 DATA = os.path.join(os.path.dirname(ROOT), "shared", "data")
 
-from core import pipeline, sfm  # noqa: E402
-from core.progress import PrintProgress  # noqa: E402
-from core.workspace import Workspace  # noqa: E402
+from core import pipeline  # noqa: E402
+from core.align import sfm  # noqa: E402
+from core.common.progress import PrintProgress  # noqa: E402
+from core.project.workspace import Workspace  # noqa: E402
 
 
 def ensure_aligned(images, ws):
@@ -62,8 +63,8 @@ def consistency(ws):
     """Every target (control and check) against the block: which agree with each other?"""
     import pycolmap
 
-    from core import gcp as gcpmod
-    from core import georef
+    from core.georef import adjust as georef
+    from core.io import gcp as gcpmod
 
     rec = pycolmap.Reconstruction()
     rec.read_binary(os.path.join(ws, "sfm", "model"))
@@ -112,8 +113,8 @@ def tarp_ruler(ws):
     import cv2
     import pycolmap
 
-    from core import gcp as gcpmod
-    from core import georef
+    from core.georef import adjust as georef
+    from core.io import gcp as gcpmod
 
     rec = pycolmap.Reconstruction()
     rec.read_binary(os.path.join(ws, "sfm", "model"))

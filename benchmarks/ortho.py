@@ -157,7 +157,7 @@ def sparse_dsm(ws_dir, path, res=0.5):
     """A DSM from the sparse points (linear interpolation), for a workspace without a dense DSM."""
     from scipy.interpolate import griddata
 
-    from core import dsm as dsmmod
+    from core.io import raster as dsmmod
     from core.pipeline import load_georef_model
 
     rec, transform = load_georef_model(ws_dir)
@@ -174,8 +174,10 @@ def sparse_dsm(ws_dir, path, res=0.5):
 
 
 def build_workspace(ws_dir):
-    from core import dense, pipeline, sfm
-    from core.progress import PrintProgress
+    from core import pipeline
+    from core.align import sfm
+    from core.common.progress import PrintProgress
+    from core.dense import matching as dense
 
     sfm.align(os.path.join(TOLEDO, "images"), ws_dir, progress=PrintProgress("align "))
     pipeline.georeference_workspace(ws_dir, use_exif_gps=True, crs="EPSG:32617", progress=PrintProgress("georef "))
@@ -184,7 +186,7 @@ def build_workspace(ws_dir):
 
 def mosaic_only(args):
     """Child process of the RSS measurement: one orthomosaic, prints JSON."""
-    from core import ortho
+    from core.ortho import mosaic as ortho
 
     t0 = time.time()
     res = ortho.build_orthophoto_workspace(args.workspace, dsm_path=args.dsm, resolution=args.resolution,
@@ -210,7 +212,7 @@ def _run_child(args, resolution, output, extra=()):
 
 def transferred_gcps(ws_dir, name, n=10):
     """GCPs for one image from the block: well-spread sparse points (track >= 4) seen in it (world coords)."""
-    from core import gcp as gcpmod
+    from core.io import gcp as gcpmod
     from core.pipeline import load_georef_model
 
     rec, transform = load_georef_model(ws_dir)
@@ -269,8 +271,8 @@ def main():
     if args.mosaic_only:
         return mosaic_only(args)
 
-    from core import ortho
-    from core.workspace import Workspace
+    from core.ortho import mosaic as ortho
+    from core.project.workspace import Workspace
 
     os.makedirs(args.out, exist_ok=True)
     if not args.workspace:
@@ -328,7 +330,7 @@ def main():
 
     # 3. one image alone on the block's DSM
     if not args.skip_single:
-        from core import resection as rs
+        from core.geometry import resection as rs
 
         name = args.single
         mos = os.path.join(args.out, "mosaic_without_single.tif")

@@ -25,7 +25,7 @@ sys.path.insert(0, ROOT)
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
-from core.screening import screen_folder  # noqa: E402
+from core.prepare.screening import screen_folder  # noqa: E402
 
 DATA = os.path.join(os.path.dirname(ROOT), "shared", "data")
 
@@ -71,7 +71,7 @@ def real_sets():
 
 
 def scans(n, res, work):
-    from core.scans import ScanOptions, prepare_scans
+    from core.prepare.scans import ScanOptions, prepare_scans
     from tests.conftest import SAMPLE, TOLEDO_STRIP
     from tests.test_scans import SCAN_SETUP, calibration_text, make_scan
 

@@ -20,8 +20,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, ROOT)
 
-from core import georef, sfm  # noqa: E402
-from core.gcp import CHECK, CONTROL  # noqa: E402
+from core.align import sfm  # noqa: E402
+from core.georef import adjust as georef  # noqa: E402
+from core.io.gcp import CHECK, CONTROL  # noqa: E402
 from tests import synthetic as syn  # noqa: E402
 
 

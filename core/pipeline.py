@@ -14,10 +14,18 @@ from typing import Dict, List, Optional, Sequence
 
 import numpy as np
 
-from . import gcp as gcpmod
-from .progress import Cancelled, NullProgress, Progress, SubProgress
-from .vector import write_points_gpkg
-from .workspace import CANCELLED, DONE, FAILED, Workspace, WorkspaceError, atomic_output, file_fingerprint
+from .common.progress import Cancelled, NullProgress, Progress, SubProgress
+from .io import gcp as gcpmod
+from .io.vector import write_points_gpkg
+from .project.workspace import (
+    CANCELLED,
+    DONE,
+    FAILED,
+    Workspace,
+    WorkspaceError,
+    atomic_output,
+    file_fingerprint,
+)
 
 GEOREF = "georeference"
 EXIF_SIGMA_XY = 3.0  # m: consumer GNSS in EXIF
@@ -102,9 +110,10 @@ def georeference_workspace(workspace_dir: str, gcp_path: Optional[str] = None,
     """Georeference an aligned workspace with GCPs and/or camera positions (see core.georef)."""
     import pycolmap
 
-    from . import accuracy, georef
-    from .sfm import STAGE as ALIGN
-    from .sfm import camera_rows
+    from .align.sfm import STAGE as ALIGN
+    from .align.sfm import camera_rows
+    from .georef import accuracy
+    from .georef import adjust as georef
 
     progress = progress or NullProgress()
     ws = Workspace.open(workspace_dir)
@@ -171,7 +180,7 @@ def georeference_workspace(workspace_dir: str, gcp_path: Optional[str] = None,
             r["x"] += offset[0]
             r["y"] += offset[1]
             r["z"] += offset[2]
-        from .vector import write_cameras_gpkg
+        from .io.vector import write_cameras_gpkg
 
         cameras_path = write_cameras_gpkg(ws.root, rows, crs=target)
         figures = _figures(result, accuracy)
@@ -278,8 +287,10 @@ def run_pipeline(images_dir: str, workspace_dir: str, *, align_options=None, gcp
     dense pairs already computed are reused).  Without ground control or camera positions the chain stops
     after the alignment: a DSM and an orthophoto need a metric scale and a vertical direction, so that is a
     StageError naming what to give."""
-    from . import dense, ortho, sfm
-    from . import report as reportmod
+    from .align import sfm
+    from .dense import matching as dense
+    from .ortho import mosaic as ortho
+    from .report import html as reportmod
 
     progress = progress or NullProgress()
     if gcp_path is None and gcps is None and not camera_positions_path and not use_exif_gps:

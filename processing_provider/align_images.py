@@ -82,8 +82,8 @@ class AlignImagesAlgorithm(AlgorithmBase):
             self.MEAN_REPROJECTION_ERROR, self.tr("Mean reprojection error (px)")))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core import sfm
-        from ..core.images import GROUP_AUTO, GROUP_SINGLE
+        from ..core.align import sfm
+        from ..core.io.images import GROUP_AUTO, GROUP_SINGLE
 
         images = self.parameterAsFile(parameters, self.IMAGES, context)
         workspace = self.parameterAsString(parameters, self.WORKSPACE, context)

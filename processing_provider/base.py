@@ -122,7 +122,7 @@ class AlgorithmBase(QgsProcessingAlgorithm):
     @staticmethod
     def run_core(func, *args, **kwargs):
         """Call a core function; turn its clear errors into QgsProcessingException."""
-        from ..core.progress import Cancelled
+        from ..core.common.progress import Cancelled
 
         try:
             return func(*args, **kwargs)

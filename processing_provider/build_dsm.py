@@ -80,7 +80,7 @@ class BuildDsmAlgorithm(AlgorithmBase):
         self.addOutput(QgsProcessingOutputNumber(self.POINTS, self.tr("Fused points")))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core import dense
+        from ..core.dense import matching as dense
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         output_dsm = self.parameterAsOutputLayer(parameters, self.OUTPUT_DSM, context) or None

@@ -72,8 +72,8 @@ class GeoreferenceAlgorithm(AlgorithmBase):
             self.addOutput(QgsProcessingOutputNumber(n, n))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core import gcp as gcpmod
         from ..core import pipeline
+        from ..core.io import gcp as gcpmod
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         gcp_path = self.parameterAsFile(parameters, self.GCPS, context) or None

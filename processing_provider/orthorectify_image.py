@@ -92,8 +92,8 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
             "Planar rectification: 95th percentile of its offset from the true position (CRS units)")))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core import gcp as gcpmod
-        from ..core import ortho
+        from ..core.io import gcp as gcpmod
+        from ..core.ortho import mosaic as ortho
 
         image = self.parameterAsFile(parameters, self.IMAGE, context)
         dsm_layer = self.parameterAsRasterLayer(parameters, self.DSM, context)

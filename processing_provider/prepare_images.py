@@ -124,8 +124,8 @@ class PrepareImagesAlgorithm(AlgorithmBase):
         self.addOutput(QgsProcessingOutputFile(self.SCREENING, self.tr("Screening record (JSON)")))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core import screening
-        from ..core.scans import ScanOptions
+        from ..core.prepare import screening
+        from ..core.prepare.scans import ScanOptions
 
         images = self.parameterAsFile(parameters, self.IMAGES, context)
         workspace = self.parameterAsString(parameters, self.WORKSPACE, context)

@@ -121,8 +121,11 @@ class RunPipelineAlgorithm(AlgorithmBase):
             self.addOutput(QgsProcessingOutputNumber(name, self.tr(label)))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core import dense, ortho, pipeline, sfm
-        from ..core import gcp as gcpmod
+        from ..core import pipeline
+        from ..core.align import sfm
+        from ..core.dense import matching as dense
+        from ..core.io import gcp as gcpmod
+        from ..core.ortho import mosaic as ortho
 
         p = parameters
         gcps = None

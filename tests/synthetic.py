@@ -717,7 +717,7 @@ class SyntheticBlock:
                 images: Optional[Sequence[str]] = None):
         """core.gcp.GCPSet in world coordinates (EPSG:32633): ``control`` names are CONTROL, the others
         CHECK; observations are the exact pixels plus N(0, noise_px) noise."""
-        from core.gcp import CHECK, CONTROL, GCPSet, GroundPoint, Observation
+        from core.io.gcp import CHECK, CONTROL, GCPSet, GroundPoint, Observation
 
         rng = np.random.default_rng(seed)
         pts = []
@@ -738,7 +738,7 @@ class SyntheticBlock:
 
     def camera_positions(self, sigma: float = 0.5, seed: int = 13, images: Optional[Sequence[str]] = None):
         """core.gcp.CameraPosition list (world) with N(0, sigma) noise on X, Y and Z; the noise is returned too."""
-        from core.gcp import CameraPosition
+        from core.io.gcp import CameraPosition
 
         rng = np.random.default_rng(seed)
         out, noise = [], {}

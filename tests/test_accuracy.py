@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from core.accuracy import (
+from core.georef.accuracy import (
     NSSDA_TEMPLATES,
     asprs_horizontal_class,
     asprs_horizontal_class_limits,

@@ -6,10 +6,10 @@ import shutil
 
 import pytest
 
-from core import sfm
-from core.images import ImageInfo
-from core.progress import Cancelled, NullProgress
-from core.workspace import Workspace, WorkspaceError
+from core.align import sfm
+from core.common.progress import Cancelled, NullProgress
+from core.io.images import ImageInfo
+from core.project.workspace import Workspace, WorkspaceError
 from tests.conftest import SAMPLE, TOLEDO_STRIP, copy_images, shared
 
 FAST = dict(max_image_size=800, max_features=2048)

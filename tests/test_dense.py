@@ -8,9 +8,11 @@ import time
 import numpy as np
 import pytest
 
-from core import dense, dsm, parallel
-from core.progress import Cancelled, NullProgress
-from core.workspace import DONE, Workspace
+from core.common import parallel
+from core.common.progress import Cancelled, NullProgress
+from core.dense import matching as dense
+from core.io import raster as dsm
+from core.project.workspace import DONE, Workspace
 from tests import synthetic as syn
 from tests.conftest import SAMPLE, TOLEDO_STRIP, copy_images
 

@@ -6,8 +6,8 @@ import warnings
 import numpy as np
 import pytest
 
-from core import gcp
-from core.gcp import (
+from core.io import gcp
+from core.io.gcp import (
     CHECK,
     CONTROL,
     GCPError,

@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from core import gcp as gcpmod
-from core import georef
+from core.georef import adjust as georef
+from core.io import gcp as gcpmod
 
 
 def _rot(ax, ay, az):

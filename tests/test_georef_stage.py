@@ -4,9 +4,10 @@ import os
 import numpy as np
 import pytest
 
-from core import pipeline, sfm
-from core.gcp import GCPSet, GroundPoint, Observation
-from core.workspace import Workspace
+from core import pipeline
+from core.align import sfm
+from core.io.gcp import GCPSet, GroundPoint, Observation
+from core.project.workspace import Workspace
 from tests.conftest import SAMPLE, TOLEDO_STRIP, copy_images
 
 pytestmark = pytest.mark.slow
@@ -64,7 +65,7 @@ def test_camera_positions_file_gives_the_crs(aligned, tmp_path):
     here Web Mercator so that it differs from the UTM zone the photos' GPS would suggest."""
     import shutil
 
-    from core import gcp as gcpmod
+    from core.io import gcp as gcpmod
 
     ws_dir = str(tmp_path / "ws")
     shutil.copytree(aligned, ws_dir)

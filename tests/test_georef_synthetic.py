@@ -16,8 +16,9 @@ import time
 import numpy as np
 import pytest
 
-from core import georef, sfm
-from core.gcp import CHECK, CONTROL, read_gcps, write_odm_gcp_list
+from core.align import sfm
+from core.georef import adjust as georef
+from core.io.gcp import CHECK, CONTROL, read_gcps, write_odm_gcp_list
 from tests import synthetic as syn
 
 GCP_NOISE_PX = 0.4

@@ -4,7 +4,7 @@ import os
 import numpy as np
 import pytest
 
-from core.images import (
+from core.io.images import (
     GROUP_PER_IMAGE,
     GROUP_SINGLE,
     ImageError,

@@ -33,7 +33,7 @@ def _expected(*boxes, base=None):
 # ---------------------------------------------------------------------------
 
 def test_square_polygon_y_down_for_one_image(tmp_path):
-    from core.masks import write_user_masks
+    from core.prepare.masks import write_user_masks
 
     res = write_user_masks([("a.JPG", [SQUARE])], {"a.JPG": (W, H), "b.JPG": (W, H)}, str(tmp_path))
     assert res.y_axis == "down" and set(res.masks) == {"a.JPG"}
@@ -45,7 +45,7 @@ def test_square_polygon_y_down_for_one_image(tmp_path):
 
 
 def test_y_negative_georeferencer_form_gives_the_same_mask(tmp_path):
-    from core.masks import write_user_masks
+    from core.prepare.masks import write_user_masks
 
     closed = [(x, -y) for x, y in SQUARE] + [(SQUARE[0][0], -SQUARE[0][1])]  # y = -row, ring closed
     res = write_user_masks([("a.JPG", [closed])], {"a.JPG": (W, H)}, str(tmp_path))
@@ -54,7 +54,7 @@ def test_y_negative_georeferencer_form_gives_the_same_mask(tmp_path):
 
 
 def test_polygon_for_every_image_and_holes(tmp_path):
-    from core.masks import write_user_masks
+    from core.prepare.masks import write_user_masks
 
     outer = [(0, 0), (8, 0), (8, 8), (0, 8)]
     hole = [(2, 2), (6, 2), (6, 6), (2, 6)]
@@ -69,7 +69,7 @@ def test_polygon_for_every_image_and_holes(tmp_path):
 
 def test_merge_with_an_existing_mask(tmp_path):
     """Logical AND of the areas to use: the scan's (or a hand-made) mask stays, the polygon is added."""
-    from core.masks import find_mask, write_user_masks
+    from core.prepare.masks import find_mask, write_user_masks
 
     base = _expected((0, 0, 5, H))  # left border black
     cv2.imwrite(str(tmp_path / "a.JPG.png"), base)
@@ -85,7 +85,7 @@ def test_merge_with_an_existing_mask(tmp_path):
 
 
 def test_existing_mask_of_another_size_is_refused(tmp_path):
-    from core.masks import MaskError, write_user_masks
+    from core.prepare.masks import MaskError, write_user_masks
 
     cv2.imwrite(str(tmp_path / "a.JPG.png"), np.full((10, 10), 255, np.uint8))
     with pytest.raises(MaskError, match=r"a\.JPG\.png is 10 x 10 px but its image is 40 x 30"):
@@ -94,7 +94,7 @@ def test_existing_mask_of_another_size_is_refused(tmp_path):
 
 def test_rasterisation_is_the_pixel_centre_rule():
     """Against a brute-force point-in-polygon test of every pixel centre (random concave polygons)."""
-    from core.masks import polygons_by_image, rasterise
+    from core.prepare.masks import polygons_by_image, rasterise
 
     def inside(x, y, poly):
         c = False
@@ -114,7 +114,7 @@ def test_rasterisation_is_the_pixel_centre_rule():
 
 
 def test_errors_name_the_polygon_and_the_problem(tmp_path):
-    from core.masks import MaskError, write_user_masks
+    from core.prepare.masks import MaskError, write_user_masks
 
     sizes = {"a.JPG": (W, H), "b.JPG": (W, H)}
     with pytest.raises(MaskError, match=r"masks\.gpkg: feature 7: unknown image 'c\.JPG'.*a\.JPG, b\.JPG"):
@@ -146,7 +146,7 @@ RIGHT_HALF = [(IMG_W / 2, 0), (IMG_W, 0), (IMG_W, IMG_H), (IMG_W / 2, IMG_H)]
 
 
 def test_prepare_stage_writes_merges_and_rewrites_user_masks(tmp_path):
-    from core.screening import PrepareOptions, measure_image, prepare_images_workspace
+    from core.prepare.screening import PrepareOptions, measure_image, prepare_images_workspace
 
     names = TOLEDO_STRIP[:2]
     images = copy_images(os.path.join(SAMPLE, "images"), names, str(tmp_path / "images"))
@@ -188,8 +188,8 @@ def test_prepare_stage_writes_merges_and_rewrites_user_masks(tmp_path):
 
 
 def test_prepare_stage_refuses_an_unknown_image_name(tmp_path):
-    from core.masks import MaskError
-    from core.screening import PrepareOptions, prepare_images_workspace
+    from core.prepare.masks import MaskError
+    from core.prepare.screening import PrepareOptions, prepare_images_workspace
 
     images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:2], str(tmp_path / "images"))
     with pytest.raises(MaskError, match="my layer: feature 4: unknown image 'IMG_9999.JPG'"):
@@ -203,8 +203,8 @@ def test_prepare_stage_refuses_an_unknown_image_name(tmp_path):
 def test_prepare_scanned_film_merges_polygons_with_the_scan_masks(tmp_path):
     """Scanned film: a polygon named by the original scan (frame_002.tiff, prepared as frame_002.tif), in the
     prepared frame, ANDed with the scan's mask."""
-    from core.scans import ScanOptions
-    from core.screening import PrepareOptions, prepare_images_workspace
+    from core.prepare.scans import ScanOptions
+    from core.prepare.screening import PrepareOptions, prepare_images_workspace
     from tests.test_scans import SCAN_SETUP, calibration_text, make_scan
 
     folder = tmp_path / "scans"
@@ -223,7 +223,7 @@ def test_prepare_scanned_film_merges_polygons_with_the_scan_masks(tmp_path):
     masks = os.path.join(r.workspace, "masks")
     assert sorted(os.listdir(masks)) == ["frame_001.tif.png", "frame_002.tif.png", "frame_003.tif.png"]
     m = _read(os.path.join(masks, "frame_002.tif.png"))
-    from core.masks import polygons_by_image, rasterise
+    from core.prepare.masks import polygons_by_image, rasterise
 
     by_image, _ = polygons_by_image([(None, [box])], ["x"])
     expected = np.where((scan_mask >= 128) & ~rasterise(by_image["x"], w, h), 255, 0)
@@ -248,8 +248,8 @@ def _keypoints(db_path):
 
 def test_align_extracts_no_keypoints_under_the_masks(tmp_path):
     pytest.importorskip("pycolmap")
-    from core import sfm
-    from core.masks import image_sizes, write_user_masks
+    from core.align import sfm
+    from core.prepare.masks import image_sizes, write_user_masks
     from tests.test_align import FAST, Recorder
 
     names = TOLEDO_STRIP[:3]

@@ -13,12 +13,12 @@ import numpy as np
 import pytest
 from osgeo import gdal
 
-from core import dsm as dsmmod
-from core import gcp as gcpmod
-from core import ortho
-from core import resection as rs
-from core.progress import Cancelled, NullProgress
-from core.workspace import DONE, Workspace
+from core.common.progress import Cancelled, NullProgress
+from core.geometry import resection as rs
+from core.io import gcp as gcpmod
+from core.io import raster as dsmmod
+from core.ortho import mosaic as ortho
+from core.project.workspace import DONE, Workspace
 from tests import synthetic as syn
 
 # a small camera keeps rendering fast; 3 strips of 5 images, 70 % / 40 % overlap, 40 m above ground

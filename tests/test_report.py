@@ -14,9 +14,11 @@ import subprocess
 import numpy as np
 import pytest
 
-from core import accuracy, pipeline, report, uncertainty
-from core.progress import Cancelled, NullProgress
-from core.workspace import DONE, Workspace
+from core import pipeline
+from core.common.progress import Cancelled, NullProgress
+from core.georef import accuracy, uncertainty
+from core.project.workspace import DONE, Workspace
+from core.report import html as report
 from tests import synthetic as syn
 
 IMG_RE = re.compile(r'<img alt="([^"]*)" src="data:image/png;base64,([A-Za-z0-9+/=]+)">')

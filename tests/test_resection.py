@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from core import resection as rs
+from core.geometry import resection as rs
 from tests import synthetic as syn
 
 CAM = syn.DEFAULT_CAMERA

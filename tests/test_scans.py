@@ -48,7 +48,7 @@ def calibration_text(pp=PP, slots=tuple(MARKS)):
 
 def _film(photo_path, frame_no, slots):
     """The film raster (float32 0..1, y down) and the mapping mm -> raster pixel (OpenCV centres)."""
-    from core.scans import mark_coverage
+    from core.prepare.scans import mark_coverage
 
     w, h = int(round(FILM_W * RASTER)), int(round(FILM_H * RASTER))
     rng = np.random.default_rng(frame_no)
@@ -150,7 +150,7 @@ def synthetic_scans(tmp_path_factory):
 # ---------------------------------------------------------------------------
 
 def test_parse_fiducial_coordinates_assigns_slots_and_pp(tmp_path):
-    from core.scans import ScanError, parse_fiducial_coordinates
+    from core.prepare.scans import ScanError, parse_fiducial_coordinates
 
     cal = parse_fiducial_coordinates(calibration_text())
     assert set(cal.points) == set(MARKS)
@@ -167,7 +167,7 @@ def test_parse_fiducial_coordinates_assigns_slots_and_pp(tmp_path):
 
 
 def test_symmetric_refinement_is_sub_pixel():
-    from core.scans import refine_symmetric, render_mark
+    from core.prepare.scans import refine_symmetric, render_mark
 
     rng = np.random.default_rng(3)
     for kind in ("cross", "ring_dot", "dot"):
@@ -186,8 +186,8 @@ def test_symmetric_refinement_is_sub_pixel():
 @pytest.fixture(scope="module")
 def prepared(synthetic_scans, tmp_path_factory):
     """The whole "prepare" stage on the five scans, with the calibration certificate."""
-    from core.scans import ScanOptions
-    from core.screening import PrepareOptions, prepare_images_workspace
+    from core.prepare.scans import ScanOptions
+    from core.prepare.screening import PrepareOptions, prepare_images_workspace
 
     folder, truth = synthetic_scans
     root = tmp_path_factory.mktemp("prepared")
@@ -215,8 +215,8 @@ def test_recovered_fiducials_within_half_a_pixel(prepared):
 
 def test_prepared_scans_share_one_frame_centred_on_the_principal_point(prepared):
     """Identical sizes; a mark re-found in a prepared image sits where the calibrated frame puts it."""
-    from core.images import read_image_info
-    from core.scans import ScanOptions, detect_fiducials
+    from core.io.images import read_image_info
+    from core.prepare.scans import ScanOptions, detect_fiducials
 
     result, _ = prepared
     io = result.interior_orientation
@@ -310,7 +310,7 @@ def test_colmap_honours_the_masks(prepared, tmp_path):
 @pytest.mark.slow
 def test_prepared_scans_align(prepared, tmp_path):
     """The prepared set aligns: core.sfm.align registers all five scans in one block."""
-    from core import sfm
+    from core.align import sfm
 
     result, _ = prepared
     r = sfm.align(result.prepared_dir, str(tmp_path / "ws"), sfm.AlignOptions(max_features=2048))
@@ -324,7 +324,7 @@ def test_prepared_scans_align(prepared, tmp_path):
 
 def test_uncalibrated_corner_marks_mean_frame(tmp_path):
     """Four corner crosses, no certificate: the mean frame of the set, in pixels, PP at the fiducial centre."""
-    from core.scans import ScanOptions, prepare_scans
+    from core.prepare.scans import ScanOptions, prepare_scans
 
     folder = tmp_path / "scans"
     folder.mkdir()
@@ -353,7 +353,7 @@ def test_uncalibrated_corner_marks_mean_frame(tmp_path):
 
 
 def test_too_few_marks_is_a_clear_error(tmp_path):
-    from core.scans import ScanError, ScanOptions, prepare_scans
+    from core.prepare.scans import ScanError, ScanOptions, prepare_scans
 
     img = os.path.join(SAMPLE, "images", TOLEDO_STRIP[0])  # a photo without any fiducial mark
     with pytest.raises(ScanError, match=TOLEDO_STRIP[0]):
@@ -362,7 +362,7 @@ def test_too_few_marks_is_a_clear_error(tmp_path):
 
 def test_user_template_of_one_mark(synthetic_scans, tmp_path):
     """A crop of one mark from one scan finds the marks of the others (other resolutions and rotations)."""
-    from core.scans import ScanOptions, detect_fiducials, load_template
+    from core.prepare.scans import ScanOptions, detect_fiducials, load_template
 
     folder, truth = synthetic_scans
     img = cv2.imread(os.path.join(folder, "frame_001.tif"), cv2.IMREAD_GRAYSCALE)

@@ -29,7 +29,7 @@ def toledo_with_bad_copies(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def screened(toledo_with_bad_copies):
-    from core.screening import screen_folder
+    from core.prepare.screening import screen_folder
 
     return screen_folder(toledo_with_bad_copies)
 
@@ -63,7 +63,7 @@ def test_overexposed_copy_is_flagged(screened):
 
 def test_scores_do_not_depend_on_image_size(tmp_path):
     """The same photo at 1200 px and at 2400 px (upsampled) scores alike: analysis at a fixed size."""
-    from core.screening import measure_image
+    from core.prepare.screening import measure_image
 
     img = cv2.imread(os.path.join(SAMPLE, "images", SOURCE))
     cv2.imwrite(str(tmp_path / "big.png"), cv2.resize(img, None, fx=2, fy=2, interpolation=cv2.INTER_CUBIC))
@@ -75,7 +75,7 @@ def test_scores_do_not_depend_on_image_size(tmp_path):
 
 def test_sky_does_not_make_a_sharp_photo_blurry():
     """Half the frame uniform (sky, water): the textured tiles decide."""
-    from core.screening import blur_score, to_grey
+    from core.prepare.screening import blur_score, to_grey
 
     img = cv2.imread(os.path.join(SAMPLE, "images", SOURCE))[:, :, ::-1]
     g = to_grey(img)
@@ -86,7 +86,7 @@ def test_sky_does_not_make_a_sharp_photo_blurry():
 
 
 def test_sixteen_bit_and_grey_images(tmp_path):
-    from core.screening import full_scale, measure_image
+    from core.prepare.screening import full_scale, measure_image
 
     g = cv2.imread(os.path.join(SAMPLE, "images", SOURCE), cv2.IMREAD_GRAYSCALE)
     cv2.imwrite(str(tmp_path / "g16.tif"), (g.astype(np.uint16) * 16))  # 12-bit data in 16-bit
@@ -98,7 +98,12 @@ def test_sixteen_bit_and_grey_images(tmp_path):
 
 
 def test_prepare_stage_records_decisions_and_excludes(toledo_with_bad_copies, tmp_path):
-    from core.screening import PrepareOptions, ScreeningOptions, load_screening, prepare_images_workspace
+    from core.prepare.screening import (
+        PrepareOptions,
+        ScreeningOptions,
+        load_screening,
+        prepare_images_workspace,
+    )
 
     ws = str(tmp_path / "ws")
     out = str(tmp_path / "prepared")
@@ -127,7 +132,7 @@ def test_prepare_stage_records_decisions_and_excludes(toledo_with_bad_copies, tm
 
 
 def test_output_folder_with_foreign_files_is_refused(tmp_path):
-    from core.screening import ScreeningError, prepare_images_workspace
+    from core.prepare.screening import ScreeningError, prepare_images_workspace
 
     images = tmp_path / "img"
     shutil.copytree(os.path.join(SAMPLE, "images"), images, ignore=lambda d, names: names[3:])
@@ -142,8 +147,8 @@ def test_output_folder_with_foreign_files_is_refused(tmp_path):
 
 
 def test_corrupt_file_is_named(tmp_path):
-    from core.images import ImageError
-    from core.screening import prepare_images_workspace
+    from core.io.images import ImageError
+    from core.prepare.screening import prepare_images_workspace
 
     images = tmp_path / "img"
     shutil.copytree(os.path.join(SAMPLE, "images"), images, ignore=lambda d, names: names[3:])
@@ -155,8 +160,8 @@ def test_corrupt_file_is_named(tmp_path):
 
 
 def test_cancel_leaves_no_complete_looking_output(tmp_path):
-    from core.progress import Cancelled, NullProgress
-    from core.screening import prepare_images_workspace
+    from core.common.progress import Cancelled, NullProgress
+    from core.prepare.screening import prepare_images_workspace
 
     class CancelAfter(NullProgress):
         def __init__(self, n):

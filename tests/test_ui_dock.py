@@ -87,9 +87,9 @@ def make_workspace(root, blk, photos, georeference_with=None, name="ws"):
     """An aligned workspace from the block's truth (model in an arbitrary frame); georeferenced with the
     GCPSet ``georeference_with`` when given.  Returns the workspace path."""
     from archaeoortho.core import pipeline
-    from archaeoortho.core.sfm import camera_rows
-    from archaeoortho.core.vector import write_cameras_gpkg
-    from archaeoortho.core.workspace import DONE, Workspace
+    from archaeoortho.core.align.sfm import camera_rows
+    from archaeoortho.core.io.vector import write_cameras_gpkg
+    from archaeoortho.core.project.workspace import DONE, Workspace
 
     ws = Workspace.create_or_open(os.path.join(root, name))
     ws.data["images_dir"] = os.path.dirname(next(iter(photos.values())))
@@ -448,7 +448,7 @@ def test_import_export_round_trips(dock, aligned_ws, block, tmp_path):
     """ODM gcp_list.txt, CSV pair and a GeoPackage point layer: export, import into a fresh workspace, compare."""
     import copy
 
-    from archaeoortho.core import gcp as gcpmod
+    from archaeoortho.core.io import gcp as gcpmod
     from qgis.core import QgsProject, QgsVectorLayer
 
     assert dock.open_workspace(aligned_ws)

@@ -6,8 +6,9 @@ within 2 px of the true (noise-free) projections.
 import numpy as np
 import pytest
 
-from core import georef, guided
-from core.gcp import GCPSet
+from core.georef import adjust as georef
+from core.georef import guided
+from core.io.gcp import GCPSet
 from tests import synthetic as syn
 
 TOL_PX = 2.0

@@ -39,7 +39,7 @@ def photos(block, tmp_path_factory):
 
 @pytest.fixture
 def aligned(block, photos, tmp_path):
-    from archaeoortho.core.gcp import write_odm_gcp_list
+    from archaeoortho.core.io.gcp import write_odm_gcp_list
 
     root = tmp_path
     ws = make_workspace(str(root), block, photos)

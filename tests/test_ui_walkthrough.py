@@ -42,7 +42,7 @@ def test_copr_georeferencing_in_qgis_desktop(tmp_path):
     copr = os.path.join(SHARED_DATA, "copr")
     if not os.path.isfile(os.path.join(copr, "gcp_list.txt")):
         pytest.skip("COPR data not available")
-    from core import gcp as gcpmod
+    from core.io import gcp as gcpmod
 
     ref = gcpmod.read_gcps(os.path.join(copr, "gcp_list.txt"))
     points_csv = str(tmp_path / "copr_targets.csv")
@@ -194,7 +194,7 @@ def _thumb_click(op, dock, name):
 
 
 def _walk(op):
-    from archaeoortho.core import gcp as gcpmod
+    from archaeoortho.core.io import gcp as gcpmod
     from qgis.core import QgsProject
     from qgis.PyQt.QtCore import QPoint, QPointF, Qt
     from qgis.utils import iface, plugins

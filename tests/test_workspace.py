@@ -4,8 +4,9 @@ import stat
 
 import pytest
 
-from core import workspace as wsmod
-from core.workspace import Workspace, WorkspaceError, atomic_output
+from core.project import workspace as wsmod
+from core.project.stages import STAGE_ORDER
+from core.project.workspace import Workspace, WorkspaceError, atomic_output
 
 
 def test_create_reopen_and_stage_records(tmp_path):
@@ -29,7 +30,7 @@ def test_invalidate_later_stages(tmp_path):
     for s in ("align", "georeference", "dsm"):
         ws.begin_stage(s, {})
         ws.end_stage(s, wsmod.DONE)
-    ws.invalidate_after("align", wsmod.STAGE_ORDER)
+    ws.invalidate_after("align", STAGE_ORDER)
     assert ws.stage("align")["status"] == "done"
     assert ws.stage("georeference")["status"] == "stale"
     assert ws.stage("dsm")["status"] == "stale"

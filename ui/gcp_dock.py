@@ -48,7 +48,7 @@ from qgis.PyQt.QtWidgets import (
     QWidget,
 )
 
-from ..core import gcp as gcpmod
+from ..core.io import gcp as gcpmod
 from . import layers
 from .map_tool import GcpMapTool, GcpMarkers
 from .photo_viewer import PhotoPanel
@@ -437,7 +437,7 @@ class GcpDock(QgsDockWidget):
             self.open_workspace(folder)
 
     def open_workspace(self, folder):
-        from ..core.workspace import WorkspaceError
+        from ..core.project.workspace import WorkspaceError
 
         try:
             self.store.open(folder)
@@ -483,7 +483,8 @@ class GcpDock(QgsDockWidget):
         if self.store.workspace is None or not self.store.stage_done("align"):
             return
         try:
-            from ..core import guided, sfm
+            from ..core.align import sfm
+            from ..core.georef import guided
             from ..core.pipeline import load_georef_model
         except ImportError as e:
             self.predictor_note = self.tr("no predicted positions: {}").format(e)
@@ -519,7 +520,7 @@ class GcpDock(QgsDockWidget):
             self.start_alignment(images, ws)
 
     def start_alignment(self, images_dir, workspace_dir, options=None):
-        from ..core import sfm
+        from ..core.align import sfm
 
         if self._busy():
             return None
@@ -725,7 +726,7 @@ class GcpDock(QgsDockWidget):
             self.predictions = {}
 
     def _gray_image(self, name):
-        from ..core.guided import read_gray
+        from ..core.georef.guided import read_gray
 
         if name not in self._gray:
             path = next((im["path"] for im in self.store.images() if im["name"] == name), None)
@@ -739,7 +740,7 @@ class GcpDock(QgsDockWidget):
     def refined_prediction(self, image):
         """The prediction in ``image``, refined by matching the point's look in a photo where it is placed
         (core.guided.refine_by_matching); the geometric prediction when matching finds nothing sure."""
-        from ..core import guided
+        from ..core.georef import guided
 
         pred = self.predictions.get(image)
         point = self.current_point()
@@ -782,7 +783,7 @@ class GcpDock(QgsDockWidget):
 
     def visible_photos(self):
         """Photos for the strip: all, or (filter on) the observed ones and those predicted to see the point."""
-        from ..core.guided import images_seeing
+        from ..core.georef.guided import images_seeing
 
         names = [im["name"] for im in self.store.images()]
         point = self.current_point()

@@ -386,7 +386,7 @@ def footprints_path(workspace):
     try:
         import numpy as np
 
-        from ..core import guided
+        from ..core.georef import guided
         from ..core.pipeline import load_georef_model
     except ImportError:
         return None

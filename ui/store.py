@@ -8,8 +8,8 @@ import os
 from qgis.PyQt.QtCore import QCoreApplication, QObject, pyqtSignal
 from qgis.PyQt.QtWidgets import QUndoCommand, QUndoStack
 
-from ..core import gcp as gcpmod
-from ..core.workspace import Workspace, atomic_write_text
+from ..core.io import gcp as gcpmod
+from ..core.project.workspace import Workspace, atomic_write_text
 
 CONTROL_FILE = ("georef", "control.json")
 EDITOR_FILE = ("georef", "gcp_editor.json")  # dock settings of this workspace (DSM layer, tolerance)

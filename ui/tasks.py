@@ -49,7 +49,7 @@ class CoreTask(QgsTask):
         self.progress_adapter = TaskProgress(self)
 
     def run(self):
-        from ..core.progress import Cancelled
+        from ..core.common.progress import Cancelled
 
         try:
             self.result = self.fn(*self.args, progress=self.progress_adapter, **self.kwargs)

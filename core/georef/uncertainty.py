@@ -44,7 +44,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .progress import NullProgress, Progress, check_cancel
+from ..common.progress import NullProgress, Progress, check_cancel
 
 DATUM_CONTROL = "control"
 DATUM_FREE = "free network"
@@ -582,7 +582,7 @@ def workspace_inputs(ws, rec) -> Tuple[List[ControlInput], List[CameraPrior], Di
         sig: Dict[str, Tuple[float, float]] = {}
         if params.get("camera_positions"):
             try:
-                from .gcp import read_camera_positions
+                from ..io.gcp import read_camera_positions
 
                 _, cps = read_camera_positions(params["camera_positions"])
                 sig = {c.image: (c.sigma_xy, c.sigma_z) for c in cps}
@@ -605,7 +605,7 @@ def workspace_inputs(ws, rec) -> Tuple[List[ControlInput], List[CameraPrior], Di
 
 def write_layers(result: UncertaintyResult, folder: str, crs: Optional[str]) -> Dict[str, str]:
     """cameras.gpkg and points.gpkg (standard deviations in metres / degrees) in ``folder``."""
-    from .vector import write_points_gpkg
+    from ..io.vector import write_points_gpkg
 
     os.makedirs(folder, exist_ok=True)
     off = result.offset

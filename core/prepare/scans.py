@@ -51,8 +51,8 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .images import ImageError
-from .progress import NullProgress, Progress, SubProgress, check_cancel
+from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
+from ..io.images import ImageError
 from .screening import to_grey
 
 SCANS_JSON = "scans.json"
@@ -218,7 +218,7 @@ def render_mark(kind: str, size: float, angle_deg: float = 0.0, canvas: Optional
 
 def load_template(path: str) -> np.ndarray:
     """A user's template image (one mark, any polarity) as grey in [0, 1]."""
-    from .images import read_image
+    from ..io.images import read_image
 
     try:
         arr = read_image(path)
@@ -448,7 +448,7 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
     """
     import cv2
 
-    from .images import read_image
+    from ..io.images import read_image
 
     options = options or ScanOptions()
     if options.layout not in LAYOUTS:
@@ -1121,7 +1121,7 @@ def _median(values):
 
 def _set_image_area(paths, out_to_scans, scan_sizes, width, height, warnings, size=640):
     """The picture area common to the set: median of the per-scan edges found from texture."""
-    from .images import read_image
+    from ..io.images import read_image
 
     edges = []
     for path, m, (sw, sh) in zip(paths, out_to_scans, scan_sizes):

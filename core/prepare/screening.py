@@ -50,13 +50,12 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .images import ImageError, list_images, read_image_info
-from .progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
-from .workspace import (
+from ..common.progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
+from ..io.images import ImageError, list_images, read_image_info
+from ..project.workspace import (
     CANCELLED,
     DONE,
     FAILED,
-    STAGE_ORDER,
     Workspace,
     WorkspaceError,
     atomic_output,
@@ -221,7 +220,7 @@ def exposure_figures(pixels: np.ndarray, mask: Optional[np.ndarray] = None,
 
 def read_for_analysis(path: str, size: int = ANALYSIS_SIZE) -> np.ndarray:
     """Pixels at ``size`` on the long side (GDAL average); raises ImageError naming the file."""
-    from .images import read_image
+    from ..io.images import read_image
 
     try:
         arr = read_image(path, max_size=size)
@@ -414,8 +413,8 @@ def _foreign_mask(ws: Workspace, name: str, ours: Sequence[str]) -> Optional[str
 
 def _polygon_record(polygons: Sequence, source: str) -> dict:
     """JSON-able digest of the user polygons for the stage parameters; raises MaskError for a malformed one."""
+    from ..project.workspace import fingerprint
     from .masks import to_polygons
-    from .workspace import fingerprint
 
     polys = to_polygons(polygons, source)
     return {"count": len(polys), "images": sorted({p.image or "*" for p in polys}),
@@ -596,7 +595,7 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
             "interior_orientation": io, "masks": len(written_masks),
             "user_masked_images": {n: user_masked[n] for n in sorted(user_masked)},
             "total_seconds": round(time.time() - t_start, 2)})
-        ws.invalidate_after(STAGE, STAGE_ORDER)
+        ws.invalidate_after(STAGE)
         progress.report(1.0, f"screened {len(quality)} images: {summary['flagged']} flagged, "
                              f"{summary['excluded']} excluded")
         return PrepareResult(
@@ -615,7 +614,7 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
 
 
 def _fingerprint_files(folder: str, names: Sequence[str]) -> str:
-    from .workspace import fingerprint
+    from ..project.workspace import fingerprint
 
     return fingerprint([(n, file_fingerprint(os.path.join(folder, n))) for n in names])
 

@@ -57,11 +57,19 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from . import dsm as dsmmod
-from .masks import find_mask
-from .progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
-from .resection import Intrinsics, Pose
-from .workspace import CANCELLED, DONE, FAILED, STAGE_ORDER, Workspace, atomic_output, file_fingerprint, fingerprint
+from ..common.progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
+from ..geometry.resection import Intrinsics, Pose
+from ..io import raster as dsmmod
+from ..prepare.masks import find_mask
+from ..project.workspace import (
+    CANCELLED,
+    DONE,
+    FAILED,
+    Workspace,
+    atomic_output,
+    file_fingerprint,
+    fingerprint,
+)
 
 STAGE = "orthophoto"
 BLENDINGS = ("feather", "multiband", "none")
@@ -1702,7 +1710,7 @@ def fill_dsm_gaps(dsm_path: str, out_path: str, max_distance: float) -> Tuple[st
 
 def _run_tiles(prep: _Prepared, plan: _Plan, dsm_path: str, crs, offset, output: str, options: OrthoOptions,
                bands: int, dtype: str, progress: Progress) -> Tuple[int, int]:
-    from . import parallel
+    from ..common import parallel
 
     grid = prep.grid
     work = os.path.join(os.path.dirname(os.path.abspath(output)), ".work-" + os.path.basename(output))
@@ -1903,7 +1911,7 @@ def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = Non
         ws.end_stage(STAGE, DONE, outputs=outputs, results={
             "resolution": result.resolution, "gsd": result.gsd, "width": result.width, "height": result.height,
             "images": len(result.images), "valid_fraction": result.valid_fraction, "warnings": result.warnings})
-        ws.invalidate_after(STAGE, STAGE_ORDER)
+        ws.invalidate_after(STAGE)
         return OrthoStageResult(ws.root, output, crs, result.resolution, result.images, result.valid_fraction,
                                 per_image_folder, seamlines, result.timings, result.warnings, result.log_lines)
     except Cancelled:
@@ -2096,7 +2104,7 @@ def _focal(meta: ImageMeta, image_path: str, focal_px, focal_mm, sensor_width_mm
             return float(orient["focal_px"]), "orientation file"
         if orient.get("focal_mm") and orient.get("sensor_width_mm"):
             return float(orient["focal_mm"]) / float(orient["sensor_width_mm"]) * long_side, "orientation file"
-    from .images import ImageError, read_image_info
+    from ..io.images import ImageError, read_image_info
 
     try:
         info = read_image_info(image_path)
@@ -2125,8 +2133,8 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
     calibrated interior orientation (e.g. the block's camera), kept as it is unless ``estimate_intrinsics`` is
     True; an orientation file without x..kappa is taken as interior orientation too.  Writes a COG at
     ``output`` and optionally the GCP residuals to the GeoPackage ``residuals_path``."""
-    from . import gcp as gcpmod
-    from . import resection as rs
+    from ..geometry import resection as rs
+    from ..io import gcp as gcpmod
 
     progress = progress or NullProgress()
     options = options or OrthoOptions()
@@ -2322,7 +2330,7 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
                    f"{100 * result.valid_fraction:.1f} % of its cells with data")
         progress.info(log[-1])
         if residuals_path and residuals:
-            from .vector import write_points_gpkg
+            from ..io.vector import write_points_gpkg
 
             fields = [("name", "str"), ("role", "str"), ("image", "str"), ("px", "float"), ("py", "float"),
                       ("dx_px", "float"), ("dy_px", "float"), ("res_px", "float"), ("used", "int"),
@@ -2361,7 +2369,7 @@ def _planar(result: SingleImageResult, ocam: OrthoCamera, meta: ImageMeta, pairs
             offset: np.ndarray, dsm: Optional[_Dsm], options: OrthoOptions, output: str, warn, progress: Progress
             ) -> None:
     """Projective rectification through the control points; with a DSM, how far it is off from the truth."""
-    from . import resection as rs
+    from ..geometry import resection as rs
 
     cam = ocam.camera
     name = ocam.name

@@ -35,7 +35,7 @@ from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .gcp import GCPSet, GroundPoint, Observation
+from ..io.gcp import GCPSet, GroundPoint, Observation
 
 RAYS = "rays"
 GEOREF = "georef"
@@ -100,7 +100,7 @@ def project_point(rec, xyz, images: Optional[Sequence[str]] = None, margin: floa
 
 
 def _similarity_fit(src: np.ndarray, dst: np.ndarray):
-    from .georef import helmert_fit
+    from .adjust import helmert_fit
 
     return helmert_fit(src, dst)
 
@@ -140,7 +140,7 @@ class Predictor:
 
     def triangulate(self, observations: Sequence[Observation]):
         """Triangulation in the model frame (``georef.Triangulation``) or None with fewer than 2 usable views."""
-        from .georef import triangulate_observations
+        from .adjust import triangulate_observations
 
         obs = [o for o in observations if o.image in self._lookup]
         if len(obs) < 2:
@@ -180,7 +180,7 @@ class Predictor:
                 res = sim.apply(src_a - centre) - dst_a
                 rms = float(np.sqrt(np.mean(np.sum(res ** 2, axis=1)))) / sim.scale
             else:  # heights unknown: model -> world on X and Y only, then inverted
-                from .georef import _fit_similarity
+                from .adjust import _fit_similarity
 
                 m2w, r = _fit_similarity(dst_a, src_a - centre, xy_only=True)
                 sim = m2w.inverse()
@@ -351,7 +351,7 @@ def write_footprints_gpkg(path: str, footprints: Mapping[str, Sequence[Tuple[flo
     written atomically."""
     from osgeo import ogr, osr
 
-    from .workspace import atomic_output
+    from ..project.workspace import atomic_output
 
     ogr.UseExceptions()
     srs = None

@@ -44,10 +44,18 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .images import GROUP_AUTO, CameraGroup, ImageError, ImageInfo, group_cameras, scan_images
-from .progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
-from .vector import write_cameras_gpkg
-from .workspace import CANCELLED, DONE, FAILED, Workspace, atomic_output, atomic_write_text, fingerprint
+from ..common.progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
+from ..io.images import GROUP_AUTO, CameraGroup, ImageError, ImageInfo, group_cameras, scan_images
+from ..io.vector import write_cameras_gpkg
+from ..project.workspace import (
+    CANCELLED,
+    DONE,
+    FAILED,
+    Workspace,
+    atomic_output,
+    atomic_write_text,
+    fingerprint,
+)
 
 PAIRINGS = ("auto", "exhaustive", "sequential", "spatial")
 CAMERA_MODELS = ("AUTO", "SIMPLE_RADIAL", "RADIAL", "OPENCV", "FULL_OPENCV")
@@ -295,7 +303,7 @@ def _masks_for_colmap(masks_dir: str, infos: Sequence[ImageInfo], sfm_dir: str) 
     masks folder is used as it is; otherwise ``sfm/masks`` gets links (or
     copies) under COLMAP's names.
     """
-    from .masks import MaskError, find_mask, mask_file_name, png_size
+    from ..prepare.masks import MaskError, find_mask, mask_file_name, png_size
 
     found: Dict[str, str] = {}
     for im in infos:

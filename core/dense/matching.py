@@ -50,14 +50,13 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from . import dsm as dsmmod
-from .parallel import check_unit_cancel, cpu_count, describe_executor, make_executor, run_units
-from .progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
-from .workspace import (
+from ..common.parallel import check_unit_cancel, cpu_count, describe_executor, make_executor, run_units
+from ..common.progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
+from ..io import raster as dsmmod
+from ..project.workspace import (
     CANCELLED,
     DONE,
     FAILED,
-    STAGE_ORDER,
     Workspace,
     atomic_write_text,
     file_fingerprint,
@@ -354,7 +353,7 @@ def _to_rgb8(img: np.ndarray) -> np.ndarray:
 
 def load_scaled(view: View, scale: float) -> Tuple[np.ndarray, float, float]:
     """Image pixels at ``scale`` and the exact (sx, sy) factors of the array obtained."""
-    from .images import read_image
+    from ..io.images import read_image
 
     if not os.path.isfile(view.path):
         raise DenseError(f"image {view.path} is missing (moved since alignment?)")
@@ -861,7 +860,7 @@ def build_dsm_workspace(workspace_dir: str, resolution: float = 0.0, quality: st
                      results={"VALID_FRACTION": valid_fraction, "pairs": n_pairs, "pairs_reused": n_reused,
                               "points": n_points, "resolution": res, "gsd": gsd, "width": grid.width,
                               "height": grid.height, "warnings": warnings})
-        ws.invalidate_after(STAGE, STAGE_ORDER)
+        ws.invalidate_after(STAGE)
         progress.report(1.0, f"DSM: {grid.width} x {grid.height} cells at {res:g} m")
         return DsmStageResult(workspace=ws.root, dsm_path=dsm_path, point_cloud_path=pc_path, crs=crs or "",
                               resolution=res, valid_fraction=valid_fraction, pairs=n_pairs, pairs_reused=n_reused,
@@ -988,7 +987,7 @@ def _cuda_points(ws: Workspace, rec, views, scale: float, dense_dir: str, progre
     """COLMAP patch-match stereo + fusion (CUDA builds of pycolmap only); points as one point file."""
     import pycolmap
 
-    from .sfm import _CancelWatcher
+    from ..align.sfm import _CancelWatcher
 
     mvs = os.path.join(dense_dir, "mvs")
     key = fingerprint({"model": _model_fingerprint(ws), "scale": scale})

@@ -31,7 +31,7 @@ from typing import Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Uni
 
 import numpy as np
 
-from .workspace import atomic_output
+from ..project.workspace import atomic_output
 
 MASKS_DIR = "masks"
 Y_AXES = ("auto", "down", "up")
@@ -102,7 +102,7 @@ def image_sizes(images_dir: str, names: Optional[Iterable[str]] = None) -> Dict[
     """(width, height) of the images of a folder (headers only)."""
     from osgeo import gdal
 
-    from .images import ImageError, list_images
+    from ..io.images import ImageError, list_images
 
     gdal.UseExceptions()
     out = {}

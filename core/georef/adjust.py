@@ -63,10 +63,10 @@ from typing import Any, Dict, Iterable, Iterator, List, Optional, Sequence, Tupl
 
 import numpy as np
 
-from .gcp import CHECK, CONTROL, CameraPosition, GCPSet, GroundPoint, Observation
+from ..io.gcp import CHECK, CONTROL, CameraPosition, GCPSet, GroundPoint, Observation
 
 try:  # the lead's Progress protocol; Cancelled must be the shared class
-    from .progress import Cancelled
+    from ..common.progress import Cancelled
 except ImportError:  # pragma: no cover - fallback while core/progress.py is missing
 
     class Cancelled(Exception):  # type: ignore[no-redef]
@@ -1174,7 +1174,7 @@ def _jsonable(obj):
 
 def _atomic_write(path: str, text: str) -> None:
     try:
-        from .workspace import atomic_write_text
+        from ..project.workspace import atomic_write_text
     except ImportError:  # pragma: no cover
         tmp = path + ".tmp"
         with open(tmp, "w", encoding="utf-8") as f:

@@ -237,8 +237,12 @@ class Workspace:
         rec["error"] = error
         self.save()
 
-    def invalidate_after(self, name: str, order: List[str]) -> None:
-        """Mark the stages after ``name`` in ``order`` as stale (inputs changed)."""
+    def invalidate_after(self, name: str, order: Optional[List[str]] = None) -> None:
+        """Mark the stages after ``name`` in ``order`` (default: the stage order) as stale (inputs changed)."""
+        if order is None:
+            from .stages import STAGE_ORDER
+
+            order = STAGE_ORDER
         if name not in order:
             return
         for later in order[order.index(name) + 1:]:
@@ -256,8 +260,6 @@ class Workspace:
     def crs(self, value: Optional[str]) -> None:
         self.data["crs"] = value
 
-
-STAGE_ORDER = ["prepare", "align", "georeference", "dsm", "orthophoto", "report"]
 
 
 def check_writable(folder: str) -> None:

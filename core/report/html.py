@@ -38,9 +38,9 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from . import accuracy
-from .progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
-from .workspace import CANCELLED, DONE, FAILED, Workspace, WorkspaceError, atomic_output
+from ..common.progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
+from ..georef import accuracy
+from ..project.workspace import CANCELLED, DONE, FAILED, Workspace, WorkspaceError, atomic_output
 
 STAGE = "report"
 REPORT_FILE = "report.html"
@@ -221,7 +221,7 @@ class _Data:
     """Everything the sections read, loaded once."""
 
     def __init__(self, ws: Workspace, progress: Progress):
-        from .uncertainty import collect_observations
+        from ..georef.uncertainty import collect_observations
 
         self.ws = ws
         self.manifest = json.loads(json.dumps(ws.data, default=str))  # as it was before the report stage
@@ -982,7 +982,7 @@ class _Report:
 
     # ---- uncertainty -----------------------------------------------------------------------------
     def compute_uncertainty(self) -> None:
-        from . import uncertainty as unc
+        from ..georef import uncertainty as unc
 
         d = self.d
         if not self.do_uncertainty:

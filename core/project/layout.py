@@ -1,0 +1,248 @@
+"""Where every product of a workspace lives, and typed loading and saving of the shared ones.
+
+This module alone spells out product paths.  Stages, the report and the dock ask it for a path or a loaded
+product instead of joining folder names themselves::
+
+    lay = Layout(ws)
+    rec, transform = lay.load_georef_model()
+    dsm = lay.dsm()
+
+Paths are absolute.  ``rel()`` turns a path into what the manifest records (relative inside the workspace,
+absolute outside it).
+"""
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Dict, Optional, Tuple
+
+from ..common.errors import ArchaeoOrthoError, require
+from .stages import ALIGN, DSM, GEOREFERENCE
+from .workspace import Workspace, atomic_write_text
+
+# folder and file names inside a workspace (the workspace format: changing one breaks old workspaces)
+MANIFEST = "workspace.json"
+PREPARED_DIR = "prepared"
+SCREENING_JSON = "screening.json"
+SCANS_JSON = "scans.json"
+MASKS_DIR = "masks"
+SFM_DIR = "sfm"
+DATABASE = "database.db"
+MODEL_DIR = "model"
+ALIGNMENT_JSON = "alignment.json"
+CAMERAS_GPKG = "cameras.gpkg"
+GEOREF_DIR = "georef"
+TRANSFORM_JSON = "transform.json"
+RESIDUALS_JSON = "residuals.json"
+RESIDUALS_GPKG = "residuals.gpkg"
+CONTROL_JSON = "control.json"
+EDITOR_JSON = "gcp_editor.json"
+ADJUSTMENT_INPUTS_JSON = "adjustment_inputs.json"
+DENSE_DIR = "dense"
+DSM_TIF = "dsm.tif"
+ORTHOMOSAIC_TIF = "orthomosaic.tif"
+REPORT_HTML = "report.html"
+UNCERTAINTY_DIR = "uncertainty"
+
+
+class LayoutError(ArchaeoOrthoError, RuntimeError):
+    """A product a stage needs is missing: the message names the stage to run."""
+
+
+def read_json(path: str) -> Optional[Any]:
+    """A JSON product, or None when it does not exist or cannot be read."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None
+
+
+def write_json(path: str, obj: Any) -> str:
+    """Write a JSON product atomically; returns the path."""
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    atomic_write_text(path, json.dumps(obj, indent=2, default=str))
+    return path
+
+
+class Layout:
+    """The products of one workspace."""
+
+    def __init__(self, ws: Workspace):
+        self.ws = ws
+        self.root = ws.root
+
+    def path(self, *parts: str) -> str:
+        return os.path.join(self.root, *parts)
+
+    def rel(self, path: str) -> str:
+        """``path`` as the manifest records it: relative inside the workspace, absolute outside."""
+        rel = os.path.relpath(os.path.abspath(path), self.root)
+        return path if rel.startswith("..") else rel
+
+    def resolve(self, recorded: str) -> str:
+        """A path recorded in the manifest as an absolute path."""
+        return recorded if os.path.isabs(recorded) else self.path(recorded)
+
+    # --- prepare ---------------------------------------------------------
+    @property
+    def manifest(self) -> str:
+        return self.path(MANIFEST)
+
+    @property
+    def prepared_dir(self) -> str:
+        return self.path(PREPARED_DIR)
+
+    @property
+    def screening_json(self) -> str:
+        return self.path(SCREENING_JSON)
+
+    @property
+    def scans_json(self) -> str:
+        return self.path(SCANS_JSON)
+
+    @property
+    def masks_dir(self) -> str:
+        return self.path(MASKS_DIR)
+
+    # --- align -----------------------------------------------------------
+    @property
+    def sfm_dir(self) -> str:
+        return self.path(SFM_DIR)
+
+    @property
+    def database(self) -> str:
+        return self.path(SFM_DIR, DATABASE)
+
+    @property
+    def aligned_model_dir(self) -> str:
+        return self.path(SFM_DIR, MODEL_DIR)
+
+    @property
+    def alignment_json(self) -> str:
+        return self.path(SFM_DIR, ALIGNMENT_JSON)
+
+    @property
+    def cameras_gpkg(self) -> str:
+        return self.path(CAMERAS_GPKG)
+
+    def has_aligned_model(self) -> bool:
+        return self.ws.stage_done(ALIGN) and os.path.isdir(self.aligned_model_dir)
+
+    def load_aligned_model(self):
+        """The aligned model (pycolmap.Reconstruction, model frame); LayoutError if the workspace has none."""
+        if not self.has_aligned_model():
+            raise LayoutError(f"workspace {self.root} has no aligned model: run 'Align images' first")
+        return self._read_model(self.aligned_model_dir)
+
+    def alignment(self) -> Dict[str, Any]:
+        """sfm/alignment.json (figures of the alignment), {} if absent."""
+        return read_json(self.alignment_json) or {}
+
+    # --- georeference ----------------------------------------------------
+    @property
+    def georef_dir(self) -> str:
+        return self.path(GEOREF_DIR)
+
+    @property
+    def georef_model_dir(self) -> str:
+        return self.path(GEOREF_DIR, MODEL_DIR)
+
+    @property
+    def transform_json(self) -> str:
+        return self.path(GEOREF_DIR, TRANSFORM_JSON)
+
+    @property
+    def residuals_json(self) -> str:
+        return self.path(GEOREF_DIR, RESIDUALS_JSON)
+
+    @property
+    def residuals_gpkg(self) -> str:
+        return self.path(GEOREF_DIR, RESIDUALS_GPKG)
+
+    @property
+    def control_json(self) -> str:
+        return self.path(GEOREF_DIR, CONTROL_JSON)
+
+    @property
+    def editor_json(self) -> str:
+        return self.path(GEOREF_DIR, EDITOR_JSON)
+
+    @property
+    def adjustment_inputs_json(self) -> str:
+        return self.path(GEOREF_DIR, ADJUSTMENT_INPUTS_JSON)
+
+    def is_georeferenced(self) -> bool:
+        return self.ws.stage_done(GEOREFERENCE) and os.path.isdir(self.georef_model_dir)
+
+    def require_georeferenced(self, why: str = "") -> None:
+        if not self.is_georeferenced():
+            state = self.ws.stage(GEOREFERENCE).get("status", "pending")
+            raise LayoutError(f"workspace {self.root} is not georeferenced (georeference stage: {state}): run "
+                              f"'Georeference' first{'; ' + why if why else ''}")
+
+    def load_transform(self) -> Dict[str, Any]:
+        """georef/transform.json: the local frame's 'offset' and the 'crs' (and the similarity)."""
+        t = read_json(self.transform_json)
+        if t is None:
+            raise LayoutError(f"{self.transform_json} is missing or damaged: run 'Georeference' again")
+        return t
+
+    def load_georef_model(self) -> Tuple[Any, Dict[str, Any]]:
+        """(pycolmap.Reconstruction in the local frame, transform dict) of a georeferenced workspace."""
+        self.require_georeferenced()
+        return self._read_model(self.georef_model_dir), self.load_transform()
+
+    def newest_model_dir(self) -> str:
+        """The georeferenced model if there is one, else the aligned model."""
+        return self.georef_model_dir if self.is_georeferenced() else self.aligned_model_dir
+
+    def residuals(self) -> Optional[Dict[str, Any]]:
+        return read_json(self.residuals_json)
+
+    # --- dense -----------------------------------------------------------
+    @property
+    def dense_dir(self) -> str:
+        return self.path(DENSE_DIR)
+
+    @property
+    def default_dsm(self) -> str:
+        return self.path(DSM_TIF)
+
+    def dsm(self) -> Optional[str]:
+        """The workspace's DSM: the DSM stage's recorded output, else <workspace>/dsm.tif; None if absent."""
+        out = (self.ws.stage(DSM).get("outputs") or {}).get("dsm")
+        if out:
+            p = self.resolve(out)
+            if os.path.isfile(p):
+                return p
+        return self.default_dsm if os.path.isfile(self.default_dsm) else None
+
+    # --- ortho / report --------------------------------------------------
+    @property
+    def default_orthomosaic(self) -> str:
+        return self.path(ORTHOMOSAIC_TIF)
+
+    @property
+    def default_report(self) -> str:
+        return self.path(REPORT_HTML)
+
+    @property
+    def uncertainty_dir(self) -> str:
+        return self.path(UNCERTAINTY_DIR)
+
+    # --- helpers ---------------------------------------------------------
+    def model_fingerprints(self, model_dir: Optional[str] = None) -> Dict[str, str]:
+        """Fingerprints of a model's .bin files (what a stage built on it records as inputs)."""
+        from .workspace import file_fingerprint
+
+        model_dir = model_dir or self.georef_model_dir
+        return {"model/" + n: file_fingerprint(os.path.join(model_dir, n))
+                for n in sorted(os.listdir(model_dir)) if n.endswith(".bin")}
+
+    @staticmethod
+    def _read_model(folder: str):
+        pycolmap = require("pycolmap", "reading the sparse model")
+        rec = pycolmap.Reconstruction()
+        rec.read_binary(folder)
+        return rec

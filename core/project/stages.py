@@ -1,0 +1,91 @@
+"""The stages, their order, and the one epilogue every stage shares.
+
+``run_stage()`` is the only place that records a stage's begin / timings / done / cancelled / failed in the
+manifest and marks the later stages stale when a stage produced new results::
+
+    with run_stage(ws, ALIGN, parameters, inputs) as run:
+        with run.step("features"):
+            ...
+        run.finish(outputs={...}, results={...})
+
+A stage body that raises :class:`~core.common.progress.Cancelled` is recorded ``cancelled``; any other
+exception ``failed`` with its message, and is re-raised unchanged.  Leaving the block without calling
+``finish()`` is recorded ``done`` with no outputs.
+"""
+from __future__ import annotations
+
+import contextlib
+import time
+from typing import Any, Dict, Iterator, List, Optional
+
+from ..common.progress import Cancelled
+from .workspace import CANCELLED, DONE, FAILED, Workspace
+
+PREPARE = "prepare"
+ALIGN = "align"
+GEOREFERENCE = "georeference"
+DSM = "dsm"
+ORTHOPHOTO = "orthophoto"
+REPORT = "report"
+
+# the order data flows in; a stage that finishes marks the done stages after it stale
+STAGE_ORDER: List[str] = [PREPARE, ALIGN, GEOREFERENCE, DSM, ORTHOPHOTO, REPORT]
+
+
+def later_stages(name: str) -> List[str]:
+    """The stages after ``name`` in the flow (nothing for an unknown name)."""
+    return STAGE_ORDER[STAGE_ORDER.index(name) + 1:] if name in STAGE_ORDER else []
+
+
+class StageRun:
+    """What a stage body records while it runs (see :func:`run_stage`)."""
+
+    def __init__(self, ws: Workspace, name: str):
+        self.ws = ws
+        self.name = name
+        self.timings: Dict[str, float] = {}
+        self.outputs: Optional[Dict[str, Any]] = None
+        self.results: Optional[Dict[str, Any]] = None
+        self.t_start = time.time()
+
+    @property
+    def record(self) -> Dict[str, Any]:
+        """The stage's manifest record (for stage-specific keys)."""
+        return self.ws.data["stages"][self.name]
+
+    @contextlib.contextmanager
+    def step(self, step: str, save: bool = True) -> Iterator[None]:
+        """Time a step; the seconds go into the manifest's timings for this stage."""
+        t0 = time.time()
+        yield
+        self.timings[step] = time.time() - t0
+        self.ws.record_timing(self.name, step, self.timings[step])
+        if save:
+            self.ws.save()
+
+    def elapsed(self) -> float:
+        return time.time() - self.t_start
+
+    def finish(self, outputs: Optional[Dict[str, Any]] = None, results: Optional[Dict[str, Any]] = None) -> None:
+        """The outputs (paths relative to the workspace) and key results to record when the stage ends."""
+        self.outputs = outputs
+        self.results = results
+
+
+@contextlib.contextmanager
+def run_stage(ws: Workspace, name: str, parameters: Dict[str, Any], inputs: Optional[Dict[str, str]] = None,
+              invalidate: bool = True) -> Iterator[StageRun]:
+    """Run a stage body and record its outcome in the workspace manifest (see the module docstring)."""
+    ws.begin_stage(name, parameters, inputs)
+    run = StageRun(ws, name)
+    try:
+        yield run
+    except Cancelled:
+        ws.end_stage(name, CANCELLED, error="cancelled by the user")
+        raise
+    except BaseException as e:
+        ws.end_stage(name, FAILED, error=str(e) or type(e).__name__)
+        raise
+    ws.end_stage(name, DONE, outputs=run.outputs, results=run.results)
+    if invalidate:
+        ws.invalidate_after(name, STAGE_ORDER)
