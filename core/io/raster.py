@@ -27,7 +27,7 @@ from typing import Callable, Iterable, Optional, Sequence, Tuple
 import numpy as np
 
 from ..common.progress import NullProgress, Progress, check_cancel
-from ..project.workspace import atomic_output
+from ..common.files import atomic_output
 
 NODATA = -9999.0
 TILE = 1024  # cells per tile side for rasterisation

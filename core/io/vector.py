@@ -4,7 +4,7 @@ from __future__ import annotations
 import os
 from typing import Dict, List, Optional, Sequence
 
-from ..project.workspace import atomic_output
+from ..common.files import atomic_output
 
 
 def write_points_gpkg(path: str, layer: str, rows: Sequence[Dict], fields: Sequence[tuple],

@@ -19,7 +19,14 @@ import time
 from typing import Any, Dict, Iterator, List, Optional
 
 from ..common.progress import Cancelled
-from .workspace import CANCELLED, DONE, FAILED, Workspace
+
+# stage status values (the manifest's "status" of a stage)
+PENDING = "pending"
+RUNNING = "running"
+DONE = "done"
+FAILED = "failed"
+CANCELLED = "cancelled"
+STALE = "stale"
 
 PREPARE = "prepare"
 ALIGN = "align"
@@ -40,7 +47,7 @@ def later_stages(name: str) -> List[str]:
 class StageRun:
     """What a stage body records while it runs (see :func:`run_stage`)."""
 
-    def __init__(self, ws: Workspace, name: str):
+    def __init__(self, ws: "Workspace", name: str):  # noqa: F821 (project.workspace.Workspace)
         self.ws = ws
         self.name = name
         self.timings: Dict[str, float] = {}
@@ -73,7 +80,8 @@ class StageRun:
 
 
 @contextlib.contextmanager
-def run_stage(ws: Workspace, name: str, parameters: Dict[str, Any], inputs: Optional[Dict[str, str]] = None,
+def run_stage(ws: "Workspace",  # noqa: F821 (project.workspace.Workspace)
+              name: str, parameters: Dict[str, Any], inputs: Optional[Dict[str, str]] = None,
               invalidate: bool = True) -> Iterator[StageRun]:
     """Run a stage body and record its outcome in the workspace manifest (see the module docstring)."""
     ws.begin_stage(name, parameters, inputs)

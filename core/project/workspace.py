@@ -11,25 +11,21 @@ overwritten: opening it raises :class:`WorkspaceError`.
 """
 from __future__ import annotations
 
-import contextlib
 import datetime as _dt
-import hashlib
 import json
 import os
-import shutil
 import tempfile
 import time
-from typing import Any, Dict, Iterator, List, Optional
+from typing import Any, Dict, List, Optional
+
+# the atomic file helpers live in common.files, the status values and stage order in project.stages;
+# both are re-exported here for the stages that import them with the Workspace
+from ..common.files import atomic_output, atomic_write_text, file_fingerprint, fingerprint  # noqa: F401
+from .stages import CANCELLED, DONE, FAILED, PENDING, RUNNING, STAGE_ORDER, STALE  # noqa: F401
 
 FORMAT_VERSION = 1
 MANIFEST = "workspace.json"
 
-# stage status values
-PENDING = "pending"
-RUNNING = "running"
-DONE = "done"
-FAILED = "failed"
-CANCELLED = "cancelled"
 
 
 class WorkspaceError(RuntimeError):
@@ -38,73 +34,6 @@ class WorkspaceError(RuntimeError):
 
 def _now() -> str:
     return _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
-
-
-def atomic_write_text(path: str, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file in the same folder."""
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix="-" + os.path.basename(path), dir=folder)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-
-
-@contextlib.contextmanager
-def atomic_output(path: str) -> Iterator[str]:
-    """Yield a temporary path beside ``path``; rename it to ``path`` only on success.
-
-    Works for files and folders.  A crash or cancel leaves nothing at ``path``
-    that looks complete (a previous complete product stays as it was until the
-    new one is ready).
-    """
-    folder = os.path.dirname(os.path.abspath(path))
-    os.makedirs(folder, exist_ok=True)
-    tmp = os.path.join(folder, ".partial-" + os.path.basename(path))
-    _remove(tmp)
-    try:
-        yield tmp
-        if os.path.isdir(tmp) and os.path.isdir(path):
-            old = os.path.join(folder, ".old-" + os.path.basename(path))
-            _remove(old)
-            os.replace(path, old)
-            os.replace(tmp, path)
-            _remove(old)
-        else:
-            if os.path.isdir(path):
-                _remove(path)
-            os.replace(tmp, path)
-    except BaseException:
-        _remove(tmp)
-        raise
-
-
-def _remove(path: str) -> None:
-    if os.path.isdir(path) and not os.path.islink(path):
-        shutil.rmtree(path, ignore_errors=True)
-    elif os.path.lexists(path):
-        with contextlib.suppress(OSError):
-            os.unlink(path)
-
-
-def file_fingerprint(path: str) -> str:
-    """Cheap fingerprint of a file: size, mtime and a hash of its first 64 KiB."""
-    st = os.stat(path)
-    h = hashlib.sha1()
-    with open(path, "rb") as f:
-        h.update(f.read(65536))
-    return f"{st.st_size}:{int(st.st_mtime)}:{h.hexdigest()[:16]}"
-
-
-def fingerprint(obj: Any) -> str:
-    """Stable hash of a JSON-serialisable object (stage parameters, image lists)."""
-    return hashlib.sha1(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
 class Workspace:
@@ -240,15 +169,13 @@ class Workspace:
     def invalidate_after(self, name: str, order: Optional[List[str]] = None) -> None:
         """Mark the stages after ``name`` in ``order`` (default: the stage order) as stale (inputs changed)."""
         if order is None:
-            from .stages import STAGE_ORDER
-
             order = STAGE_ORDER
         if name not in order:
             return
         for later in order[order.index(name) + 1:]:
             rec = self.data["stages"].get(later)
             if rec and rec.get("status") == DONE:
-                rec["status"] = "stale"
+                rec["status"] = STALE
         self.save()
 
     # --- convenience ---------------------------------------------------
