@@ -35,6 +35,7 @@ GEOREF_DIR = "georef"
 TRANSFORM_JSON = "transform.json"
 RESIDUALS_JSON = "residuals.json"
 RESIDUALS_GPKG = "residuals.gpkg"
+FOOTPRINTS_GPKG = "footprints.gpkg"  # written by the dock (ui/layers.py)
 CONTROL_JSON = "control.json"
 EDITOR_JSON = "gcp_editor.json"
 ADJUSTMENT_INPUTS_JSON = "adjustment_inputs.json"
@@ -159,6 +160,10 @@ class Layout:
     @property
     def residuals_gpkg(self) -> str:
         return self.path(GEOREF_DIR, RESIDUALS_GPKG)
+
+    @property
+    def footprints_gpkg(self) -> str:
+        return self.path(GEOREF_DIR, FOOTPRINTS_GPKG)
 
     @property
     def control_json(self) -> str:
