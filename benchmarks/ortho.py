@@ -330,7 +330,7 @@ def main():
 
     # 3. one image alone on the block's DSM
     if not args.skip_single:
-        from core.geometry import resection as rs
+        from core.geometry import camera as gcam
 
         name = args.single
         mos = os.path.join(args.out, "mosaic_without_single.tif")
@@ -339,7 +339,7 @@ def main():
         img = os.path.join(ws.data["images_dir"], name)
         print(f"single image {name}, against the mosaic of the other {len(res.images)} images (128 x 128 windows):")
         _gcps, rec, im, off = transferred_gcps(args.workspace, name, 4)
-        block_cam = rs.Intrinsics.from_pycolmap(rec.cameras[im.camera_id]).as_opencv()
+        block_cam = gcam.Intrinsics.from_pycolmap(rec.cameras[im.camera_id]).as_opencv()
         cases = [("resection, 6 GCPs, the block's calibrated camera", 6, {"camera": block_cam}),
                  ("resection, 20 GCPs, EXIF focal length only (a lone photo)", 20, {}),
                  ("resection, 8 GCPs, EXIF focal length only (a lone photo)", 8, {})]
@@ -356,9 +356,9 @@ def main():
             _dist(d, "    shift")
         # known orientation from the block
         p = im.cam_from_world()
-        pose = rs.Pose(np.asarray(p.rotation.matrix()), np.asarray(p.translation))
+        pose = gcam.Pose(np.asarray(p.rotation.matrix()), np.asarray(p.translation))
         c = pose.centre + off
-        om, ph, ka = rs.opk_from_rotation(pose.rotation)
+        om, ph, ka = gcam.opk_from_rotation(pose.rotation)
         k = dict(zip(("k1", "k2", "p1", "p2"), block_cam.dist[:4]))
         orientation = {"x": c[0], "y": c[1], "z": c[2], "omega": om, "phi": ph, "kappa": ka,
                        "focal_px": block_cam.focal, "cx": block_cam.cx, "cy": block_cam.cy, "crs": "EPSG:32617", **k}

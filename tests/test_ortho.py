@@ -14,7 +14,7 @@ import pytest
 from osgeo import gdal
 
 from core.common.progress import Cancelled, NullProgress
-from core.geometry import resection as rs
+from core.geometry import camera as gcam
 from core.io import gcp as gcpmod
 from core.io import raster as dsmmod
 from core.ortho import mosaic as ortho
@@ -337,7 +337,7 @@ def test_subset_multiband_and_options(scene, tmp_path):
 
 
 def test_select_cameras_by_name_wildcard_and_group():
-    cams = [ortho.OrthoCamera(n, n, rs.Intrinsics.simple(10, 10, 10), rs.Pose(np.eye(3), np.zeros(3)), cid)
+    cams = [ortho.OrthoCamera(n, n, gcam.Intrinsics.simple(10, 10, 10), gcam.Pose(np.eye(3), np.zeros(3)), cid)
             for n, cid in (("a1.jpg", 1), ("a2.jpg", 1), ("n1.tif", 2), ("n2.tif", 2))]
     groups = [{"camera_id": 1, "model": "FC300X", "images": ["a1.jpg", "a2.jpg"]},
               {"camera_id": 2, "model": "Sequoia NIR", "images": ["n1.tif", "n2.tif"]}]
@@ -554,7 +554,7 @@ def test_single_image_with_known_orientation_and_a_dsm_in_another_crs(scene, tmp
     on the fly; the 16-bit single-band image stays 16-bit single-band."""
     block, _root, images, dsm, _ws = scene
     shot = block.shot(SINGLE)
-    om, ph, ka = rs.opk_from_rotation(shot.rotation)
+    om, ph, ka = gcam.opk_from_rotation(shot.rotation)
     c = shot.centre + syn.ORIGIN
     orient = tmp_path / "opk.txt"
     orient.write_text("# crs: EPSG:32633\nimageName X Y Z Omega Phi Kappa focal_px cx cy k1 k2 p1 p2\n"

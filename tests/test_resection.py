@@ -1,10 +1,12 @@
-"""core.resection: the camera model against pycolmap and the synthetic renderer's, omega-phi-kappa, space
-resection (exact, noisy, one wrong point, too few points, focal length + k1), planar homography."""
+"""core.geometry.camera and core.geometry.resection: the camera model against pycolmap and the synthetic
+renderer's, omega-phi-kappa, space resection (exact, noisy, one wrong point, too few points, focal length + k1),
+planar homography."""
 import math
 
 import numpy as np
 import pytest
 
+from core.geometry import camera as cm
 from core.geometry import resection as rs
 from tests import synthetic as syn
 
@@ -12,7 +14,7 @@ CAM = syn.DEFAULT_CAMERA
 
 
 def _intrinsics(cam=CAM):
-    return rs.Intrinsics("OPENCV", cam.width, cam.height, cam.params)
+    return cm.Intrinsics("OPENCV", cam.width, cam.height, cam.params)
 
 
 @pytest.mark.parametrize("model,params", [
@@ -27,7 +29,7 @@ def test_projection_matches_pycolmap(model, params):
 
     pc = pycolmap.Camera.create_from_model_name(1, model, 650.0, 800, 600)
     pc.params = np.array(params)
-    cam = rs.Intrinsics.from_pycolmap(pc)
+    cam = cm.Intrinsics.from_pycolmap(pc)
     rng = np.random.default_rng(0)
     xc = np.column_stack([rng.uniform(-0.55, 0.55, (200, 2)), rng.uniform(1.0, 30.0, 200)])
     xc[:, :2] *= xc[:, 2:3]
@@ -44,7 +46,7 @@ def test_projection_matches_the_synthetic_camera_and_rejects_fold_back():
     px, ok = cam.project(xc)
     np.testing.assert_allclose(px, CAM.image_from_camera(xc), atol=1e-9)
     # a strong barrel distortion turns back beyond the image: far-off points must not land inside it
-    strong = rs.Intrinsics("OPENCV", 800, 600, (400.0, 400.0, 400.0, 300.0, -0.35, 0.0, 0.0, 0.0))
+    strong = cm.Intrinsics("OPENCV", 800, 600, (400.0, 400.0, 400.0, 300.0, -0.35, 0.0, 0.0, 0.0))
     far = np.array([[3.0, 0.0, 1.0], [0.0, 2.5, 1.0], [0.2, 0.1, 1.0], [0.0, 0.0, -1.0]])
     px, ok = strong.project(far)
     assert list(ok) == [False, False, True, False]
@@ -53,19 +55,19 @@ def test_projection_matches_the_synthetic_camera_and_rejects_fold_back():
 
 def test_omega_phi_kappa_convention():
     # zero angles: looking straight down, image x to the east, image y (down) to the south
-    r = rs.rotation_from_opk(0, 0, 0)
+    r = cm.rotation_from_opk(0, 0, 0)
     np.testing.assert_allclose(r @ [0, 0, -1], [0, 0, 1])  # down is the viewing direction
     np.testing.assert_allclose(r @ [1, 0, 0], [1, 0, 0])
     np.testing.assert_allclose(r @ [0, 1, 0], [0, -1, 0])
     # kappa 90: image x points north
-    np.testing.assert_allclose(rs.rotation_from_opk(0, 0, 90) @ [0, 1, 0], [1, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(cm.rotation_from_opk(0, 0, 90) @ [0, 1, 0], [1, 0, 0], atol=1e-12)
     # omega tilts about the X (east) axis: positive omega looks towards +Y (north) in this convention
-    d = rs.rotation_from_opk(10, 0, 0).T @ [0, 0, 1]  # viewing direction in the world
+    d = cm.rotation_from_opk(10, 0, 0).T @ [0, 0, 1]  # viewing direction in the world
     assert d[1] > 0.17 and abs(d[0]) < 1e-12
     for angles in [(3.0, -2.0, 47.0), (-20.0, 15.0, -170.0), (0.5, 0.2, 179.9)]:
-        np.testing.assert_allclose(rs.opk_from_rotation(rs.rotation_from_opk(*angles)), angles, atol=1e-9)
+        np.testing.assert_allclose(cm.opk_from_rotation(cm.rotation_from_opk(*angles)), angles, atol=1e-9)
     # the matrix is the classic photogrammetric M (Wolf & Dewitt): m31 = sin(phi), m32 = -sin(omega) cos(phi)
-    m = rs.opk_matrix(12.0, -7.0, 33.0)
+    m = cm.opk_matrix(12.0, -7.0, 33.0)
     w, p = math.radians(12.0), math.radians(-7.0)
     assert m[2, 0] == pytest.approx(math.sin(p)) and m[2, 1] == pytest.approx(-math.sin(w) * math.cos(p))
 
@@ -73,17 +75,17 @@ def test_omega_phi_kappa_convention():
 def _scene(n, seed=0, relief=0.0, noise=0.0):
     """n ground points under a camera 50 m up, tilted a little; returns (xyz, pixels, pose)."""
     rng = np.random.default_rng(seed)
-    rot = rs.rotation_from_opk(2.0, -3.0, 30.0)
-    pose = rs.Pose.from_centre(rot, [3.0, -2.0, 50.0])
+    rot = cm.rotation_from_opk(2.0, -3.0, 30.0)
+    pose = cm.Pose.from_centre(rot, [3.0, -2.0, 50.0])
     cam = _intrinsics()
     xyz = []
     while len(xyz) < n:
         p = np.array([rng.uniform(-30, 30), rng.uniform(-22, 22), rng.uniform(0, relief)])
-        px, ok = rs.project_points(pose, cam, p[None])
+        px, ok = cm.project_points(pose, cam, p[None])
         if ok[0] and cam.inside(px[0], 20):
             xyz.append(p)
     xyz = np.array(xyz)
-    px, _ = rs.project_points(pose, cam, xyz)
+    px, _ = cm.project_points(pose, cam, xyz)
     return xyz, px + rng.normal(0, noise, px.shape), pose
 
 
@@ -120,20 +122,20 @@ def test_too_few_points_name_the_number_needed():
 
 
 def test_focal_length_and_k1_are_estimated_from_six_points_with_relief():
-    true = rs.Intrinsics("OPENCV", 800, 600, (650.0, 650.0, 400.0, 300.0, -0.08, 0.0, 0.0, 0.0))
+    true = cm.Intrinsics("OPENCV", 800, 600, (650.0, 650.0, 400.0, 300.0, -0.08, 0.0, 0.0, 0.0))
     rng = np.random.default_rng(5)
-    rot = rs.rotation_from_opk(8.0, -6.0, 30.0)
-    pose = rs.Pose.from_centre(rot, [3.0, -2.0, 50.0])
+    rot = cm.rotation_from_opk(8.0, -6.0, 30.0)
+    pose = cm.Pose.from_centre(rot, [3.0, -2.0, 50.0])
     xyz = []
     while len(xyz) < 10:
         p = np.array([rng.uniform(-35, 35), rng.uniform(-30, 30), rng.uniform(0, 25)])
-        px, ok = rs.project_points(pose, true, p[None])
+        px, ok = cm.project_points(pose, true, p[None])
         if ok[0] and true.inside(px[0], 10):
             xyz.append(p)
     xyz = np.array(xyz)
-    px, _ = rs.project_points(pose, true, xyz)
+    px, _ = cm.project_points(pose, true, xyz)
     px += rng.normal(0, 0.2, px.shape)
-    prior = rs.Intrinsics.simple(800, 600, 650.0 * 1.06)
+    prior = cm.Intrinsics.simple(800, 600, 650.0 * 1.06)
     r = rs.space_resection(xyz, px, prior)
     assert r.estimated_intrinsics and r.estimated_params == ["focal", "k1"]
     assert r.camera.focal == pytest.approx(650.0, rel=0.01)
@@ -143,7 +145,7 @@ def test_focal_length_and_k1_are_estimated_from_six_points_with_relief():
 
 def test_flat_control_keeps_the_focal_length_and_says_so():
     xyz, px, _ = _scene(8, seed=7, noise=0.3)
-    r = rs.space_resection(xyz, px, rs.Intrinsics.simple(800, 600, 660.0))
+    r = rs.space_resection(xyz, px, cm.Intrinsics.simple(800, 600, 660.0))
     assert "focal" not in r.estimated_params
     assert r.camera.focal == pytest.approx(660.0)
     assert any("focal length" in w and "not estimated" in w for w in r.warnings)

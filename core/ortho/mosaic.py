@@ -58,7 +58,7 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..common.progress import Cancelled, NullProgress, Progress, SubProgress, check_cancel
-from ..geometry.resection import Intrinsics, Pose
+from ..geometry.camera import Intrinsics, Pose, opk_from_rotation, rotation_from_opk
 from ..io import raster as dsmmod
 from ..prepare.masks import find_mask
 from ..project.workspace import (
@@ -2253,7 +2253,7 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
     outliers: List[str] = []
     estimated = False
     if orient is not None:
-        rot = rs.rotation_from_opk(orient["omega"], orient["phi"], orient["kappa"])
+        rot = rotation_from_opk(orient["omega"], orient["phi"], orient["kappa"])
         pose = rs.Pose.from_centre(rot, c_world - offset)
         cam = cam0
         source = "orientation"
@@ -2289,7 +2289,7 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
                    + (f"; left out: {', '.join(outliers)}" if outliers else ""))
         progress.info(log[-1])
     centre_w = pose.centre + offset
-    om, ph, ka = rs.opk_from_rotation(pose.rotation)
+    om, ph, ka = opk_from_rotation(pose.rotation)
     orientation_out = {"x": float(centre_w[0]), "y": float(centre_w[1]), "z": float(centre_w[2]), "omega": om,
                        "phi": ph, "kappa": ka, "focal_px": float(cam.focal), "k1": float(cam.dist[0])}
     log.append(f"camera at X {centre_w[0]:.2f} Y {centre_w[1]:.2f} Z {centre_w[2]:.2f}, omega {om:.3f} phi {ph:.3f} "
