@@ -6,7 +6,7 @@ Three sources of a predicted position, best first:
 
 ``rays``
     the point has observations in at least two registered photos: it is triangulated in the block
-    (``georef.triangulate_observations``, full camera model) and projected into every other photo.
+    (``core.georef.triangulate.triangulate_observations``, full camera model) and projected into every other photo.
     This needs no world coordinates at all and agrees with the photos to the precision of the clicks.
 ``georef``
     the block is georeferenced (adjusted model in the local frame, ``world = local + offset``): the
@@ -35,7 +35,11 @@ from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
+from ..common.errors import require
+from ..geometry.similarity import fit_similarity, helmert_fit
 from ..io.gcp import GCPSet, GroundPoint, Observation
+from ..project.workspace import atomic_output
+from .triangulate import triangulate_observations
 
 RAYS = "rays"
 GEOREF = "georef"
@@ -99,12 +103,6 @@ def project_point(rec, xyz, images: Optional[Sequence[str]] = None, margin: floa
     return out
 
 
-def _similarity_fit(src: np.ndarray, dst: np.ndarray):
-    from .adjust import helmert_fit
-
-    return helmert_fit(src, dst)
-
-
 class Predictor:
     """Predicted GCP positions in the photos of one block.
 
@@ -140,8 +138,6 @@ class Predictor:
 
     def triangulate(self, observations: Sequence[Observation]):
         """Triangulation in the model frame (``georef.Triangulation``) or None with fewer than 2 usable views."""
-        from .adjust import triangulate_observations
-
         obs = [o for o in observations if o.image in self._lookup]
         if len(obs) < 2:
             return None
@@ -176,13 +172,11 @@ class Predictor:
         centre = src_a.mean(axis=0)  # keep UTM-size numbers out of the fit
         try:
             if self.placeholder_z is None:
-                sim = _similarity_fit(src_a - centre, dst_a)
+                sim = helmert_fit(src_a - centre, dst_a)
                 res = sim.apply(src_a - centre) - dst_a
                 rms = float(np.sqrt(np.mean(np.sum(res ** 2, axis=1)))) / sim.scale
             else:  # heights unknown: model -> world on X and Y only, then inverted
-                from .adjust import _fit_similarity
-
-                m2w, r = _fit_similarity(dst_a, src_a - centre, xy_only=True)
+                m2w, r = fit_similarity(dst_a, src_a - centre, xy_only=True)
                 sim = m2w.inverse()
                 rms = float(np.sqrt(np.mean(r ** 2)))
         except (ValueError, np.linalg.LinAlgError):  # collinear or coincident points
@@ -351,8 +345,6 @@ def write_footprints_gpkg(path: str, footprints: Mapping[str, Sequence[Tuple[flo
     written atomically."""
     from osgeo import ogr, osr
 
-    from ..project.workspace import atomic_output
-
     ogr.UseExceptions()
     srs = None
     if crs:
@@ -398,8 +390,7 @@ class Match:
 
 def read_gray(path: str) -> np.ndarray:
     """A photo as an 8-bit grey array, pixels as stored (EXIF orientation not applied, as in COLMAP)."""
-    import cv2
-
+    cv2 = require("cv2", "reading the photos for guided placement")
     img = cv2.imread(path, cv2.IMREAD_GRAYSCALE | cv2.IMREAD_IGNORE_ORIENTATION)
     if img is None:
         raise OSError(f"cannot read {path}")
@@ -425,8 +416,7 @@ def refine_by_matching(rec, ref_image: str, ref_xy: Sequence[float], ref_gray: n
     Returns the sub-pixel match, or None when it is weak (score < ``min_score``), ambiguous (another peak
     within ``min_margin`` of the best), at the edge of the search window, or out of the image.
     ``*_gray``: the photos as 2-D uint8 / float arrays (pixel centres at +0.5, as everywhere)."""
-    import cv2
-
+    cv2 = require("cv2", "matching the GCP marks between photos")
     cam_r, rot_r, t_r = _camera_geometry(rec, ref_image)
     cam_t, rot_t, t_t = _camera_geometry(rec, tgt_image)
     c_r = -rot_r.T @ t_r

@@ -1,0 +1,69 @@
+"""The options of the georeferencing (``core.georef.adjust.georeference``) and of its stage: defaults in one place."""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any, Optional, Tuple
+
+INTRINSIC_GROUPS = ("focal", "principal_point", "extra")
+
+EXIF_SIGMA_XY = 3.0  # m: consumer GNSS in EXIF, the a priori sigmas of EXIF GPS camera positions
+EXIF_SIGMA_Z = 5.0
+FILE_POSITION_SIGMAS = (5.0, 10.0)  # m: a positions file's sigmas when the workspace did not save them
+PLACEHOLDER_SIGMA_Z = 1.0  # m: sigma Z of control points whose heights are all the same placeholder
+
+
+@dataclass
+class GeorefOptions:
+    """How ``georeference`` adjusts a block (see its docstring for each option's meaning).
+
+    ``refine_intrinsics``: False; True (focal + distortion); "all" (also the principal point); or a subset of
+    ("focal", "principal_point", "extra").  ``outlier_threshold``: pixels; ``outlier_sigma``: normalised
+    coordinate residual; ``helmert_threshold``: metres (None: from the point spread and sigmas)."""
+
+    refine_intrinsics: Any = False
+    outlier_threshold: float = 5.0
+    outlier_sigma: float = 5.0
+    helmert_threshold: Optional[float] = None
+    gcp_pixel_sigma: float = 1.0
+    tie_pixel_sigma: float = 1.0
+    huber_px: float = 2.0
+    max_observations: int = 200_000
+    max_iterations: int = 50
+    max_outlier_rounds: int = 10
+    min_intrinsics_images: int = 3
+    adjust: bool = True
+    crs: Optional[str] = None
+    copy_model: bool = True
+    placeholder_sigma_z: float = PLACEHOLDER_SIGMA_Z
+
+    @classmethod
+    def of(cls, options: Optional["GeorefOptions"] = None, **kwargs: Any) -> "GeorefOptions":
+        """``options`` (or the defaults) with the keyword options given one by one replacing its fields;
+        TypeError for a keyword that is not an option."""
+        base = options if options is not None else cls()
+        names = {f.name for f in dataclasses.fields(cls)}
+        bad = sorted(k for k in kwargs if k not in names)
+        if bad:
+            raise TypeError(f"georeference() got unexpected keyword argument(s): {', '.join(bad)}")
+        return dataclasses.replace(base, **kwargs) if kwargs else base
+
+    def intrinsic_groups(self) -> Tuple[str, ...]:
+        """The groups of intrinsic parameters to refine (ValueError for an unknown group)."""
+        refine = self.refine_intrinsics
+        if not refine:
+            return ()
+        if refine is True:
+            return ("focal", "extra")
+        if isinstance(refine, str):
+            refine = ("focal", "principal_point", "extra") if refine == "all" else (refine,)
+        groups = tuple(refine)
+        bad = [g for g in groups if g not in INTRINSIC_GROUPS]
+        if bad:
+            raise ValueError(f"refine_intrinsics: unknown group(s) {bad}; use True, 'all' or a subset of "
+                             f"{INTRINSIC_GROUPS}")
+        return groups
+
+
+__all__ = ["EXIF_SIGMA_XY", "EXIF_SIGMA_Z", "FILE_POSITION_SIGMAS", "GeorefOptions", "INTRINSIC_GROUPS",
+           "PLACEHOLDER_SIGMA_Z"]
