@@ -124,7 +124,7 @@ class PrepareImagesAlgorithm(AlgorithmBase):
         self.addOutput(QgsProcessingOutputFile(self.SCREENING, self.tr("Screening record (JSON)")))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core.prepare import screening
+        from ..core.prepare import stage as screening
         from ..core.prepare.scans import ScanOptions
 
         images = self.parameterAsFile(parameters, self.IMAGES, context)

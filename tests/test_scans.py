@@ -187,7 +187,7 @@ def test_symmetric_refinement_is_sub_pixel():
 def prepared(synthetic_scans, tmp_path_factory):
     """The whole "prepare" stage on the five scans, with the calibration certificate."""
     from core.prepare.scans import ScanOptions
-    from core.prepare.screening import PrepareOptions, prepare_images_workspace
+    from core.prepare.stage import PrepareOptions, prepare_images_workspace
 
     folder, truth = synthetic_scans
     root = tmp_path_factory.mktemp("prepared")

@@ -98,7 +98,7 @@ def test_sixteen_bit_and_grey_images(tmp_path):
 
 
 def test_prepare_stage_records_decisions_and_excludes(toledo_with_bad_copies, tmp_path):
-    from core.prepare.screening import (
+    from core.prepare.stage import (
         PrepareOptions,
         ScreeningOptions,
         load_screening,
@@ -132,7 +132,7 @@ def test_prepare_stage_records_decisions_and_excludes(toledo_with_bad_copies, tm
 
 
 def test_output_folder_with_foreign_files_is_refused(tmp_path):
-    from core.prepare.screening import ScreeningError, prepare_images_workspace
+    from core.prepare.stage import ScreeningError, prepare_images_workspace
 
     images = tmp_path / "img"
     shutil.copytree(os.path.join(SAMPLE, "images"), images, ignore=lambda d, names: names[3:])
@@ -148,7 +148,7 @@ def test_output_folder_with_foreign_files_is_refused(tmp_path):
 
 def test_corrupt_file_is_named(tmp_path):
     from core.io.images import ImageError
-    from core.prepare.screening import prepare_images_workspace
+    from core.prepare.stage import prepare_images_workspace
 
     images = tmp_path / "img"
     shutil.copytree(os.path.join(SAMPLE, "images"), images, ignore=lambda d, names: names[3:])
@@ -161,7 +161,7 @@ def test_corrupt_file_is_named(tmp_path):
 
 def test_cancel_leaves_no_complete_looking_output(tmp_path):
     from core.common.progress import Cancelled, NullProgress
-    from core.prepare.screening import prepare_images_workspace
+    from core.prepare.stage import prepare_images_workspace
 
     class CancelAfter(NullProgress):
         def __init__(self, n):

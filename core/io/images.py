@@ -1,4 +1,4 @@
-"""Image reading, EXIF camera priors and GPS, camera groups.
+"""Image reading, grey conversion, EXIF camera priors and GPS, camera groups.
 
 Images are read through GDAL (JPEG, TIFF 8/16-bit, RGB, single-band NIR or
 grey).  Everything here is plain Python + GDAL + numpy: no qgis, no Qt.
@@ -13,6 +13,8 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from ..common.errors import ArchaeoOrthoError
+
 IMAGE_EXTENSIONS = (".jpg", ".jpeg", ".tif", ".tiff", ".png")
 
 # one camera per distinct (make, model, focal, size) / one for all / one per image
@@ -24,7 +26,7 @@ FULL_FRAME_DIAGONAL_MM = math.hypot(36.0, 24.0)
 DEFAULT_FOCAL_FACTOR = 1.2  # focal = 1.2 x long side when nothing is known (COLMAP's guess)
 
 
-class ImageError(ValueError):
+class ImageError(ArchaeoOrthoError, ValueError):
     """An image that cannot be used; the message names the file and the problem."""
 
 
@@ -245,3 +247,35 @@ def read_image(path: str, max_size: Optional[int] = None) -> np.ndarray:
     else:
         arr = np.moveaxis(arr, 0, -1)
     return arr
+
+
+def full_scale(arr: np.ndarray) -> float:
+    """The value that means "white" for this array: 255 for 8-bit, 2^k - 1 for 16-bit, 1 for floats <= 1."""
+    if arr.dtype == np.uint8:
+        return 255.0
+    mx = float(np.nanmax(arr)) if arr.size else 1.0
+    if np.issubdtype(arr.dtype, np.integer):
+        bits = max(8, int(np.ceil(np.log2(mx + 1.0)))) if mx > 0 else 8
+        for b in (8, 10, 12, 14, 16):  # camera and scanner bit depths
+            if bits <= b:
+                return float(2 ** b - 1)
+        return float(2 ** bits - 1)
+    return 1.0 if mx <= 1.0 else mx
+
+
+def to_grey(arr: np.ndarray, scale: Optional[float] = None) -> np.ndarray:
+    """(rows, cols[, bands]) pixels -> float32 grey in [0, 1].
+
+    Three or more bands are read as R, G, B (GDAL band order) with Rec. 601
+    weights; one or two bands use the first band (grey, NIR).
+    """
+    a = np.asarray(arr)
+    scale = float(scale or full_scale(a))
+    if a.ndim == 3 and a.shape[2] >= 3:
+        g = (0.299 * a[:, :, 0].astype(np.float32) + 0.587 * a[:, :, 1].astype(np.float32)
+             + 0.114 * a[:, :, 2].astype(np.float32))
+    elif a.ndim == 3:
+        g = a[:, :, 0].astype(np.float32)
+    else:
+        g = a.astype(np.float32)
+    return g / np.float32(scale)

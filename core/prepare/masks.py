@@ -31,6 +31,8 @@ from typing import Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Uni
 
 import numpy as np
 
+from ..common.errors import ArchaeoOrthoError, require
+from ..io.images import ImageError, list_images
 from ..project.workspace import atomic_output
 
 MASKS_DIR = "masks"
@@ -39,7 +41,7 @@ Y_AXES = ("auto", "down", "up")
 Ring = Sequence[Tuple[float, float]]
 
 
-class MaskError(ValueError):
+class MaskError(ArchaeoOrthoError, ValueError):
     """Masks cannot be made; the message names the polygon (or file) and the problem."""
 
 
@@ -79,7 +81,7 @@ def png_size(path: str) -> Tuple[int, int]:
 
 def read_keep(path: str, width: int, height: int) -> np.ndarray:
     """A mask file as a boolean array, True = use (grey >= 128); its size must be the image's."""
-    import cv2
+    cv2 = require("cv2", "image masks")
 
     m = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
     if m is None:
@@ -91,7 +93,7 @@ def read_keep(path: str, width: int, height: int) -> np.ndarray:
 
 def write_keep(path: str, keep: np.ndarray) -> None:
     """Write a keep-area (True = use) as a 0/255 PNG, atomically (temporary name, then rename)."""
-    import cv2
+    cv2 = require("cv2", "image masks")
 
     with atomic_output(path) as tmp:
         if not cv2.imwrite(tmp, np.where(keep, 255, 0).astype(np.uint8)):
@@ -101,8 +103,6 @@ def write_keep(path: str, keep: np.ndarray) -> None:
 def image_sizes(images_dir: str, names: Optional[Iterable[str]] = None) -> Dict[str, Tuple[int, int]]:
     """(width, height) of the images of a folder (headers only)."""
     from osgeo import gdal
-
-    from ..io.images import ImageError, list_images
 
     gdal.UseExceptions()
     out = {}

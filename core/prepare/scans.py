@@ -51,9 +51,10 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from ..common.errors import ArchaeoOrthoError, require
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
-from ..io.images import ImageError
-from .screening import to_grey
+from ..io.images import ImageError, read_image, to_grey
+from .options import ScanOptions
 
 SCANS_JSON = "scans.json"
 
@@ -70,25 +71,8 @@ FIDUCIAL_TYPES = ("auto",) + MARK_KINDS
 OPPOSITE = {"TL": "BR", "TR": "BL", "T": "B", "L": "R"}
 
 
-class ScanError(ValueError):
+class ScanError(ArchaeoOrthoError, ValueError):
     """Scanned film cannot be prepared; the message names the file and the problem."""
-
-
-@dataclass
-class ScanOptions:
-    fiducial_type: str = "auto"  # auto / cross / dot / ring_dot / cross_ring
-    layout: str = "auto"  # auto / corners / sides / eight
-    template_path: Optional[str] = None  # an image of one fiducial mark, at the scans' resolution
-    fiducial_coordinates: Optional[str] = None  # file path or text: "id x y" lines in mm, optional "PP x y"
-    focal_length_mm: Optional[float] = None
-    scan_pixel_size_mm: Optional[float] = None  # scan resolution when not in the file (25.4 / dpi)
-    output_pixel_size: Optional[float] = None  # in frame units (mm or px); default: the median scan's
-    margin: Optional[float] = None  # frame units beyond the outermost fiducial centres; default 1 mark size
-    detect_size: int = 1200  # long side of the reduced scan used for the coarse search
-    min_score: float = 0.6  # smallest correlation accepted for a mark
-    max_residual_px: float = 3.0  # a mark further than this from the affine fit is dropped (>= 5 marks)
-    mask_border: bool = True  # mask the film border and data strips outside the picture area
-    mask_margin_px: float = 4.0  # extra inward margin of the masks, output pixels
 
 
 @dataclass
@@ -218,8 +202,6 @@ def render_mark(kind: str, size: float, angle_deg: float = 0.0, canvas: Optional
 
 def load_template(path: str) -> np.ndarray:
     """A user's template image (one mark, any polarity) as grey in [0, 1]."""
-    from ..io.images import read_image
-
     try:
         arr = read_image(path)
     except (RuntimeError, AttributeError) as e:
@@ -297,7 +279,7 @@ def _windows(h: int, w: int, slots: Sequence[str]) -> Dict[str, Tuple[int, int, 
 
 def _best_match(img: np.ndarray, win: Tuple[int, int, int, int], tpl: np.ndarray, polarities=(1, -1)):
     """Best normalised correlation of ``tpl`` whose centre lies in ``win``: (score, cx, cy, polarity)."""
-    import cv2
+    cv2 = require("cv2", "scanned film")
 
     th, tw = tpl.shape
     h, w = img.shape
@@ -364,7 +346,7 @@ def refine_symmetric(grey: np.ndarray, x: float, y: float, size: float, iteratio
     point-symmetric mark (cross, dot, ring) equals its 180-degree rotation.
     Returns (x, y, converged).
     """
-    import cv2
+    cv2 = require("cv2", "scanned film")
 
     g = np.ascontiguousarray(grey, dtype=np.float32)
     gx = cv2.Sobel(g, cv2.CV_32F, 1, 0, ksize=3, scale=0.125)
@@ -446,10 +428,6 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
     ``hints`` (slot -> mark kind, from an earlier scan of the set) narrows the
     search to that kind; a slot where it fails is searched with every kind.
     """
-    import cv2
-
-    from ..io.images import read_image
-
     options = options or ScanOptions()
     if options.layout not in LAYOUTS:
         raise ScanError(f"unknown fiducial layout {options.layout!r}; choose one of {', '.join(LAYOUTS)}")
@@ -466,26 +444,48 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
     kx, ky = full_w / w, full_h / h
     windows = _windows(h, w, LAYOUTS[options.layout])
     kinds = MARK_KINDS if options.fiducial_type == "auto" else (options.fiducial_type,)
+    groups = _coarse_templates(template, kinds, min(h, w), 0.5 * (kx + ky))
+    coarse = _coarse_search(g, windows, groups, hints or {}, options.min_score)
+    warnings: List[str] = []
+    if not coarse:
+        return [], warnings
+    angle = _rotation_deg({k: (v[1], v[2]) for k, v in coarse.items()})
+    symmetric_template = template is not None and is_point_symmetric(template)
+    mark_frac = _mark_fraction(template) if template is not None else 1.0
+    out: List[Fiducial] = []
+    for slot, hit in coarse.items():
+        f = _refine_mark(ds, path, slot, hit, template, angle, (kx, ky), symmetric_template, mark_frac, warnings)
+        if f is not None:
+            out.append(f)
+    return out, warnings
 
-    # coarse: best (score, x, y, polarity, kind, size) per window
-    coarse = {}
-    if template is not None:
-        base = 0.5 * (kx + ky)
-        groups = {"template": []}
-        for f in (0.8, 0.9, 1.0, 1.1, 1.25):
-            th = max(5, int(round(template.shape[0] / base * f)))
-            tw = max(5, int(round(template.shape[1] / base * f)))
-            groups["template"].append((max(tw, th), cv2.resize(template, (tw, th), interpolation=cv2.INTER_AREA)))
-    else:
-        groups = {kind: [(s, render_mark(kind, s)) for s in _sizes(min(h, w))] for kind in kinds}
-    hints = hints or {}
 
+def _coarse_templates(template: Optional[np.ndarray], kinds: Sequence[str], short_side: int,
+                      base: float) -> Dict[str, List[Tuple[float, np.ndarray]]]:
+    """kind -> [(size, template)] searched on the reduced scan: the user's template at five scales, or the
+    built-in marks at a range of sizes.  ``base``: scan pixels per reduced pixel."""
+    cv2 = require("cv2", "scanned film")
+
+    if template is None:
+        return {kind: [(s, render_mark(kind, s)) for s in _sizes(short_side)] for kind in kinds}
+    scaled = []
+    for f in (0.8, 0.9, 1.0, 1.1, 1.25):
+        th = max(5, int(round(template.shape[0] / base * f)))
+        tw = max(5, int(round(template.shape[1] / base * f)))
+        scaled.append((max(tw, th), cv2.resize(template, (tw, th), interpolation=cv2.INTER_AREA)))
+    return {"template": scaled}
+
+
+def _coarse_search(g: np.ndarray, windows: Dict[str, Tuple[int, int, int, int]],
+                   groups: Dict[str, List[Tuple[float, np.ndarray]]], hints: Dict[str, str],
+                   min_score: float) -> Dict[str, tuple]:
+    """Best (score, x, y, polarity, kind, size) per window on the reduced scan, for the windows with a mark."""
     def z_of(sc, tpl):
         # a large template that correlates well is stronger evidence than a small one (a dot of
         # five pixels also fits every full stop of a data strip): rank by atanh(r) * sqrt(side)
         return math.atanh(min(max(sc, 0.0), 0.999)) * math.sqrt(max(tpl.shape))
 
-    def search(slot, win, kinds_here):
+    def search(win, kinds_here):
         best, best_z = (-1.0,), -np.inf
         for kind in kinds_here:
             cands = groups[kind]
@@ -498,79 +498,81 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
                         tried.append((_best_match(g, win, tpl), s0 * f, tpl))
             for (sc, cx, cy, pol), s, tpl in tried:
                 z = z_of(sc, tpl)
-                if sc >= options.min_score and z > best_z:
+                if sc >= min_score and z > best_z:
                     best, best_z = (sc, cx, cy, pol, kind, s), z
         return best
 
+    coarse = {}
     for slot, win in windows.items():
         best = (-1.0,)
         if hints.get(slot) in groups:
-            best = search(slot, win, [hints[slot]])
-        if best[0] < options.min_score:
-            best = search(slot, win, list(groups))
-        if best[0] >= options.min_score:
+            best = search(win, [hints[slot]])
+        if best[0] < min_score:
+            best = search(win, list(groups))
+        if best[0] >= min_score:
             coarse[slot] = best
-    warnings: List[str] = []
-    if not coarse:
-        return [], warnings
-    angle = _rotation_deg({k: (v[1], v[2]) for k, v in coarse.items()})
-    symmetric_template = template is not None and is_point_symmetric(template)
-    mark_frac = _mark_fraction(template) if template is not None else 1.0
+    return coarse
 
-    # fine: full-resolution correlation, then the centre of symmetry
-    out: List[Fiducial] = []
-    for slot, (sc, cx, cy, pol, kind, s) in coarse.items():
-        fx, fy = (cx + 0.5) * kx - 0.5, (cy + 0.5) * ky - 0.5  # full-res pixel-centre coordinates
-        size_full = s * 0.5 * (kx + ky)
-        red = max(1.0, size_full / 96.0)  # correlate at most ~96 px marks; refine at full resolution
-        if template is not None:
-            f = size_full / max(template.shape) / red  # the user's template at this scan's scale
-            t = cv2.resize(template, (max(5, int(round(template.shape[1] * f))), max(5, int(round(template.shape[0] * f)))),
-                           interpolation=cv2.INTER_AREA if f < 1 else cv2.INTER_CUBIC)
-            if abs(angle) > 0.3:
-                c = ((t.shape[1] - 1) / 2.0, (t.shape[0] - 1) / 2.0)
-                t = cv2.warpAffine(t, cv2.getRotationMatrix2D(c, -angle, 1.0), (t.shape[1], t.shape[0]),
-                                   borderMode=cv2.BORDER_REPLICATE)
+
+def _refine_mark(ds, path: str, slot: str, hit: tuple, template: Optional[np.ndarray], angle: float,
+                 k: Tuple[float, float], symmetric_template: bool, mark_frac: float,
+                 warnings: List[str]) -> Optional[Fiducial]:
+    """A coarse hit refined in the full-resolution scan: correlation peak, then the centre of symmetry."""
+    cv2 = require("cv2", "scanned film")
+
+    sc, cx, cy, pol, kind, s = hit
+    kx, ky = k
+    full_w, full_h = ds.RasterXSize, ds.RasterYSize
+    fx, fy = (cx + 0.5) * kx - 0.5, (cy + 0.5) * ky - 0.5  # full-res pixel-centre coordinates
+    size_full = s * 0.5 * (kx + ky)
+    red = max(1.0, size_full / 96.0)  # correlate at most ~96 px marks; refine at full resolution
+    if template is not None:
+        f = size_full / max(template.shape) / red  # the user's template at this scan's scale
+        t = cv2.resize(template, (max(5, int(round(template.shape[1] * f))), max(5, int(round(template.shape[0] * f)))),
+                       interpolation=cv2.INTER_AREA if f < 1 else cv2.INTER_CUBIC)
+        if abs(angle) > 0.3:
+            c = ((t.shape[1] - 1) / 2.0, (t.shape[0] - 1) / 2.0)
+            t = cv2.warpAffine(t, cv2.getRotationMatrix2D(c, -angle, 1.0), (t.shape[1], t.shape[0]),
+                               borderMode=cv2.BORDER_REPLICATE)
+    else:
+        t = render_mark(kind, size_full / red, angle)
+    search = 2.0 * max(kx, ky) + 3.0 * red
+    half = int(math.ceil(0.8 * size_full + search + 0.8 * max(t.shape) * red + 8))
+    x0, y0 = max(0, int(fx) - half), max(0, int(fy) - half)
+    x1, y1 = min(full_w, int(fx) + half + 1), min(full_h, int(fy) + half + 1)
+    if x1 - x0 < 8 or y1 - y0 < 8:
+        return None
+    gw = _grey_window(ds, x0, y0, x1 - x0, y1 - y0)
+    gs = gw if red == 1.0 else cv2.resize(gw, (max(8, int(round(gw.shape[1] / red))),
+                                                max(8, int(round(gw.shape[0] / red)))),
+                                          interpolation=cv2.INTER_AREA)
+    sx_, sy_ = gw.shape[1] / gs.shape[1], gw.shape[0] / gs.shape[0]
+    if gs.shape[0] <= t.shape[0] or gs.shape[1] <= t.shape[1]:
+        return None
+    r = cv2.matchTemplate(gs, t, cv2.TM_CCOEFF_NORMED) * pol
+    r[~np.isfinite(r)] = -1
+    # keep the peak near the coarse position
+    ex, ey = (fx - x0 + 0.5) / sx_ - 0.5 - (t.shape[1] - 1) / 2.0, (fy - y0 + 0.5) / sy_ - 0.5 - (t.shape[0] - 1) / 2.0
+    yy, xx = np.mgrid[0:r.shape[0], 0:r.shape[1]]
+    r[np.hypot(xx - ex, yy - ey) > search / red + 1] = -1
+    i, j = divmod(int(np.argmax(r)), r.shape[1])
+    fine_score = float(r[i, j])
+    ox, oy = _quadratic_peak(r, i, j)
+    px = ((j + ox + (t.shape[1] - 1) / 2.0) + 0.5) * sx_ - 0.5  # window pixel-centre coordinates
+    py = ((i + oy + (t.shape[0] - 1) / 2.0) + 0.5) * sy_ - 0.5
+    if template is not None:
+        size_full *= mark_frac  # the mark itself, without the template's margin
+    if template is None or symmetric_template:
+        qx, qy, ok = refine_symmetric(gw, px, py, size_full)
+        if ok and math.hypot(qx - px, qy - py) <= max(2.0 * red, 0.25 * size_full):
+            px, py = qx, qy
         else:
-            t = render_mark(kind, size_full / red, angle)
-        search = 2.0 * max(kx, ky) + 3.0 * red
-        half = int(math.ceil(0.8 * size_full + search + 0.8 * max(t.shape) * red + 8))
-        x0, y0 = max(0, int(fx) - half), max(0, int(fy) - half)
-        x1, y1 = min(full_w, int(fx) + half + 1), min(full_h, int(fy) + half + 1)
-        if x1 - x0 < 8 or y1 - y0 < 8:
-            continue
-        gw = _grey_window(ds, x0, y0, x1 - x0, y1 - y0)
-        gs = gw if red == 1.0 else cv2.resize(gw, (max(8, int(round(gw.shape[1] / red))),
-                                                    max(8, int(round(gw.shape[0] / red)))),
-                                              interpolation=cv2.INTER_AREA)
-        sx_, sy_ = gw.shape[1] / gs.shape[1], gw.shape[0] / gs.shape[0]
-        if gs.shape[0] <= t.shape[0] or gs.shape[1] <= t.shape[1]:
-            continue
-        r = cv2.matchTemplate(gs, t, cv2.TM_CCOEFF_NORMED) * pol
-        r[~np.isfinite(r)] = -1
-        # keep the peak near the coarse position
-        ex, ey = (fx - x0 + 0.5) / sx_ - 0.5 - (t.shape[1] - 1) / 2.0, (fy - y0 + 0.5) / sy_ - 0.5 - (t.shape[0] - 1) / 2.0
-        yy, xx = np.mgrid[0:r.shape[0], 0:r.shape[1]]
-        r[np.hypot(xx - ex, yy - ey) > search / red + 1] = -1
-        i, j = divmod(int(np.argmax(r)), r.shape[1])
-        fine_score = float(r[i, j])
-        ox, oy = _quadratic_peak(r, i, j)
-        px = ((j + ox + (t.shape[1] - 1) / 2.0) + 0.5) * sx_ - 0.5  # window pixel-centre coordinates
-        py = ((i + oy + (t.shape[0] - 1) / 2.0) + 0.5) * sy_ - 0.5
-        if template is not None:
-            size_full *= mark_frac  # the mark itself, without the template's margin
-        if template is None or symmetric_template:
-            qx, qy, ok = refine_symmetric(gw, px, py, size_full)
-            if ok and math.hypot(qx - px, qy - py) <= max(2.0 * red, 0.25 * size_full):
-                px, py = qx, qy
-            else:
-                warnings.append(f"{os.path.basename(path)}: fiducial {slot}: centre of symmetry not found, "
-                                "correlation peak used")
-        cx_full, cy_full = x0 + px + 0.5, y0 + py + 0.5
-        extent = _mark_extent(ds, cx_full, cy_full, size_full)
-        out.append(Fiducial(slot=slot, x=cx_full, y=cy_full, score=min(sc, fine_score) if fine_score > 0 else sc,
-                            kind=kind, size_px=max(size_full, extent), polarity=int(pol)))
-    return out, warnings
+            warnings.append(f"{os.path.basename(path)}: fiducial {slot}: centre of symmetry not found, "
+                            "correlation peak used")
+    cx_full, cy_full = x0 + px + 0.5, y0 + py + 0.5
+    extent = _mark_extent(ds, cx_full, cy_full, size_full)
+    return Fiducial(slot=slot, x=cx_full, y=cy_full, score=min(sc, fine_score) if fine_score > 0 else sc,
+                    kind=kind, size_px=max(size_full, extent), polarity=int(pol))
 
 
 def _mark_extent(ds, x: float, y: float, size: float) -> float:
@@ -825,7 +827,7 @@ def restitute(path: str, out_to_scan: np.ndarray, width: int, height: int, out_p
     ``out_to_scan``: 2 x 3, output pixel (corner convention) -> scan pixel.  Writes
     a tiled, DEFLATE-compressed TIFF of the scan's bands and data type.
     """
-    import cv2
+    cv2 = require("cv2", "scanned film")
 
     gdal = _gdal()
     progress = progress or NullProgress()
@@ -897,7 +899,7 @@ def _image_area_edges(grey: np.ndarray, valid: np.ndarray) -> Optional[Tuple[flo
     columns (rows) that are mostly border end the picture; a data strip or the
     film edge further out does not matter.
     """
-    import cv2
+    cv2 = require("cv2", "scanned film")
 
     g = grey.astype(np.float32)
     k = (5, 5)
@@ -941,7 +943,7 @@ def write_mask(path: str, width: int, height: int, scan_to_out: np.ndarray, scan
                image_area: Optional[Tuple[float, float, float, float]], fiducials: Sequence[Tuple[float, float, float]],
                margin: float) -> None:
     """Mask PNG, white = use, black = ignore: outside the scan, outside the picture area, over the marks."""
-    import cv2
+    cv2 = require("cv2", "scanned film")
 
     m = np.zeros((height, width), np.uint8)
     inset = margin + 2.0
@@ -988,55 +990,15 @@ def prepare_scans(paths: Sequence[str], out_dir: str, masks_dir: str, options: O
     if not paths:
         raise ScanError("no scans given")
     calib = parse_fiducial_coordinates(options.fiducial_coordinates) if options.fiducial_coordinates else None
-    template = load_template(options.template_path) if options.template_path else None
     focal_mm = options.focal_length_mm or (calib.focal_length_mm if calib else None)
     warnings: List[str] = []
     names = [os.path.basename(p) for p in paths]
 
     # 1. detection
-    dets: Dict[str, List[Fiducial]] = {}
-    sizes: Dict[str, Tuple[int, int]] = {}
-    res_mm: Dict[str, Optional[float]] = {}
-    sp = SubProgress(progress, 0.0, 0.35)
-    hints: Dict[str, str] = {}
-    for i, (p, n) in enumerate(zip(paths, names)):
-        check_cancel(progress)
-        fids, w = detect_fiducials(p, options, template, hints)
-        for f in fids:
-            hints.setdefault(f.slot, f.kind)
-        warnings.extend(w)
-        if calib is not None:
-            fids = [f for f in fids if f.slot in calib.points]
-        if len(fids) < 3:
-            raise ScanError(f"{p}: only {len(fids)} fiducial mark(s) found "
-                            f"({', '.join(f.slot for f in fids) or 'none'}; best correlation must reach "
-                            f"{options.min_score:g}); at least 3 are needed. Check the fiducial type and layout, "
-                            "or give a template image of one mark")
-        dets[n] = fids
-        ds = _open(p)
-        sizes[n] = (ds.RasterXSize, ds.RasterYSize)
-        res_mm[n] = scan_resolution_mm(ds)
-        ds = None
-        sp.report((i + 1) / len(paths), f"fiducials: {i + 1}/{len(paths)} scans ({n}: {len(fids)} marks)")
-
+    dets, sizes, res_mm = _detect_set(paths, names, options, calib, SubProgress(progress, 0.0, 0.35), progress,
+                                      warnings)
     # 2. the frame
-    if calib is not None:
-        frame = dict(calib.points)
-        units, calibrated = "mm", True
-    else:
-        slots, w = _consistent_slots(dets)
-        warnings.extend(w)
-        if len(slots) < 3:
-            raise ScanError("fewer than 3 fiducial positions were found consistently across the scans "
-                            f"({', '.join(slots) or 'none'}); check the fiducial type and layout")
-        frame_px = mean_frame([{f.slot: (f.x, f.y) for f in fids if f.slot in slots} for fids in dets.values()])
-        px_mm = options.scan_pixel_size_mm or _median([r for r in res_mm.values() if r])
-        if px_mm:
-            frame = {k: (v[0] * px_mm, v[1] * px_mm) for k, v in frame_px.items()}
-            units = "mm"
-        else:
-            frame, units = frame_px, "px"
-        calibrated = False
+    frame, units, calibrated = _set_frame(dets, res_mm, calib, options, warnings)
 
     # 3. per-scan affine
     fits: Dict[str, Tuple[np.ndarray, List[Fiducial], List[str], List[str]]] = {}
@@ -1052,28 +1014,7 @@ def prepare_scans(paths: Sequence[str], out_dir: str, masks_dir: str, options: O
     width, height = 2 * int(math.ceil(hx / p)), 2 * int(math.ceil(hy / p))
     # output pixel (corner convention) -> frame: x = (qx - W/2) p, y = (H/2 - qy) p
     out_to_frame = np.array([[p, 0.0, -0.5 * width * p], [0.0, -p, 0.5 * height * p], [0.0, 0.0, 1.0]])
-
-    pixel_size_mm = p if units == "mm" else None
-    io = {
-        "frame_units": units, "calibrated_fiducials": calibrated, "pixel_size": p,
-        "pixel_size_mm": pixel_size_mm, "width": width, "height": height,
-        "principal_point_px": [width / 2.0, height / 2.0],
-        "principal_point_from": "calibrated fiducial coordinates" if calibrated else "fiducial centre",
-        "focal_length_mm": focal_mm,
-        "focal_px": (focal_mm / pixel_size_mm) if (focal_mm and pixel_size_mm) else None,
-    }
-    if focal_mm and not pixel_size_mm:
-        warnings.append("the focal length in mm cannot be turned into pixels: give calibrated fiducial "
-                        "coordinates (mm) or the scan resolution")
-    metadata = {"ARCHAEOORTHO_FRAME": units, "ARCHAEOORTHO_PIXEL_SIZE": f"{p:.9g}"}
-    if io["focal_px"]:
-        px_per_cm = 10.0 / pixel_size_mm
-        metadata.update({
-            "EXIF_FocalLength": f"({focal_mm:.6g})", "EXIF_FocalPlaneXResolution": f"({px_per_cm:.9g})",
-            "EXIF_FocalPlaneYResolution": f"({px_per_cm:.9g})", "EXIF_FocalPlaneResolutionUnit": "3",
-            "EXIF_PixelXDimension": str(width), "EXIF_PixelYDimension": str(height),
-            "EXIF_Model": "scanned film",
-        })
+    io, metadata = _interior_orientation(units, calibrated, p, width, height, focal_mm, warnings)
 
     # 4. resampling
     prepared = _prepared_names(paths)
@@ -1096,17 +1037,17 @@ def prepare_scans(paths: Sequence[str], out_dir: str, masks_dir: str, options: O
 
     # 5. masks
     check_cancel(progress)
+    out_to_scans = {s.name: fits[s.name][0] @ out_to_frame for s in scans}
     image_area = None
     if options.mask_border:
         image_area = _set_image_area([os.path.join(out_dir, s.prepared_name) for s in scans],
-                                     [fits[s.name][0] @ out_to_frame for s in scans],
+                                     [out_to_scans[s.name] for s in scans],
                                      [sizes[s.name] for s in scans], width, height, warnings)
     marks_out = [((v[0] / p) + width / 2.0, height / 2.0 - v[1] / p, 0.75 * mark_size / p + 2.0)
                  for v in frame.values()]
     for i, s in enumerate(scans):
         check_cancel(progress)
-        out_to_scan = fits[s.name][0] @ out_to_frame
-        scan_to_out = np.linalg.inv(np.vstack([out_to_scan, [0, 0, 1]]))[:2]
+        scan_to_out = np.linalg.inv(np.vstack([out_to_scans[s.name], [0, 0, 1]]))[:2]
         write_mask(os.path.join(masks_dir, s.mask_name), width, height, scan_to_out, s.scan_width,
                    s.scan_height, image_area, marks_out, options.mask_margin_px)
         progress.report(0.9 + 0.1 * (i + 1) / len(scans), f"masks: {i + 1}/{len(scans)}")
@@ -1115,14 +1056,86 @@ def prepare_scans(paths: Sequence[str], out_dir: str, masks_dir: str, options: O
                    interior_orientation=io, warnings=warnings)
 
 
+def _detect_set(paths: Sequence[str], names: Sequence[str], options: ScanOptions,
+                calib: Optional[CalibratedFiducials], sp: Progress, progress: Progress, warnings: List[str]):
+    """Fiducials, size and resolution (mm, from the file) of every scan; ScanError when one has fewer than 3."""
+    template = load_template(options.template_path) if options.template_path else None
+    dets: Dict[str, List[Fiducial]] = {}
+    sizes: Dict[str, Tuple[int, int]] = {}
+    res_mm: Dict[str, Optional[float]] = {}
+    hints: Dict[str, str] = {}
+    for i, (p, n) in enumerate(zip(paths, names)):
+        check_cancel(progress)
+        fids, w = detect_fiducials(p, options, template, hints)
+        for f in fids:
+            hints.setdefault(f.slot, f.kind)
+        warnings.extend(w)
+        if calib is not None:
+            fids = [f for f in fids if f.slot in calib.points]
+        if len(fids) < 3:
+            raise ScanError(f"{p}: only {len(fids)} fiducial mark(s) found "
+                            f"({', '.join(f.slot for f in fids) or 'none'}; best correlation must reach "
+                            f"{options.min_score:g}); at least 3 are needed. Check the fiducial type and layout, "
+                            "or give a template image of one mark")
+        dets[n] = fids
+        ds = _open(p)
+        sizes[n] = (ds.RasterXSize, ds.RasterYSize)
+        res_mm[n] = scan_resolution_mm(ds)
+        ds = None
+        sp.report((i + 1) / len(paths), f"fiducials: {i + 1}/{len(paths)} scans ({n}: {len(fids)} marks)")
+    return dets, sizes, res_mm
+
+
+def _set_frame(dets: Dict[str, List[Fiducial]], res_mm: Dict[str, Optional[float]],
+               calib: Optional[CalibratedFiducials], options: ScanOptions, warnings: List[str]):
+    """(frame: slot -> coordinates, units "mm" or "px", calibrated): the certificate's, or the set's mean."""
+    if calib is not None:
+        return dict(calib.points), "mm", True
+    slots, w = _consistent_slots(dets)
+    warnings.extend(w)
+    if len(slots) < 3:
+        raise ScanError("fewer than 3 fiducial positions were found consistently across the scans "
+                        f"({', '.join(slots) or 'none'}); check the fiducial type and layout")
+    frame_px = mean_frame([{f.slot: (f.x, f.y) for f in fids if f.slot in slots} for fids in dets.values()])
+    px_mm = options.scan_pixel_size_mm or _median([r for r in res_mm.values() if r])
+    if px_mm:
+        return {k: (v[0] * px_mm, v[1] * px_mm) for k, v in frame_px.items()}, "mm", False
+    return frame_px, "px", False
+
+
+def _interior_orientation(units: str, calibrated: bool, p: float, width: int, height: int,
+                          focal_mm: Optional[float], warnings: List[str]) -> Tuple[dict, Dict[str, str]]:
+    """The prepared images' interior orientation and the TIFF metadata that carries it to core.io.images."""
+    pixel_size_mm = p if units == "mm" else None
+    io = {
+        "frame_units": units, "calibrated_fiducials": calibrated, "pixel_size": p,
+        "pixel_size_mm": pixel_size_mm, "width": width, "height": height,
+        "principal_point_px": [width / 2.0, height / 2.0],
+        "principal_point_from": "calibrated fiducial coordinates" if calibrated else "fiducial centre",
+        "focal_length_mm": focal_mm,
+        "focal_px": (focal_mm / pixel_size_mm) if (focal_mm and pixel_size_mm) else None,
+    }
+    if focal_mm and not pixel_size_mm:
+        warnings.append("the focal length in mm cannot be turned into pixels: give calibrated fiducial "
+                        "coordinates (mm) or the scan resolution")
+    metadata = {"ARCHAEOORTHO_FRAME": units, "ARCHAEOORTHO_PIXEL_SIZE": f"{p:.9g}"}
+    if io["focal_px"]:
+        px_per_cm = 10.0 / pixel_size_mm
+        metadata.update({
+            "EXIF_FocalLength": f"({focal_mm:.6g})", "EXIF_FocalPlaneXResolution": f"({px_per_cm:.9g})",
+            "EXIF_FocalPlaneYResolution": f"({px_per_cm:.9g})", "EXIF_FocalPlaneResolutionUnit": "3",
+            "EXIF_PixelXDimension": str(width), "EXIF_PixelYDimension": str(height),
+            "EXIF_Model": "scanned film",
+        })
+    return io, metadata
+
+
 def _median(values):
     return float(np.median(values)) if values else None
 
 
 def _set_image_area(paths, out_to_scans, scan_sizes, width, height, warnings, size=640):
     """The picture area common to the set: median of the per-scan edges found from texture."""
-    from ..io.images import read_image
-
     edges = []
     for path, m, (sw, sh) in zip(paths, out_to_scans, scan_sizes):
         arr = read_image(path, max_size=size)
