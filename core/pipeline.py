@@ -290,7 +290,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, *, align_options=None, gcp
     from .align import sfm
     from .dense import matching as dense
     from .ortho import mosaic as ortho
-    from .report import html as reportmod
+    from .report import stage as reportmod
 
     progress = progress or NullProgress()
     if gcp_path is None and gcps is None and not camera_positions_path and not use_exif_gps:

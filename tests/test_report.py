@@ -18,7 +18,8 @@ from core import pipeline
 from core.common.progress import Cancelled, NullProgress
 from core.georef import accuracy, uncertainty
 from core.project.workspace import DONE, Workspace
-from core.report import html as report
+from core.report import stage as report
+from core.report.html import esc
 from tests import synthetic as syn
 
 IMG_RE = re.compile(r'<img alt="([^"]*)" src="data:image/png;base64,([A-Za-z0-9+/=]+)">')
@@ -132,7 +133,7 @@ def test_report_numbers_are_core_accuracy_figures(built, georeferenced):
     for ed in (2014, 2023):
         a = accuracy.asprs_horizontal_class(st["rmse_x"], st["rmse_y"], result.figures["GSD"], edition=ed)
         assert float(keyed[f"asprs.{ed}.h"][1]) == a["class_cm"]
-        assert report._esc(a["statement"]) in text
+        assert esc(a["statement"]) in text
         vz = accuracy.asprs_vertical_class(st["rmse_z"], edition=ed)
         assert float(keyed[f"asprs.{ed}.v"][1]) == vz["class_cm"]
     # per-point residuals, and the camera-position residuals

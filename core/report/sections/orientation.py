@@ -1,0 +1,184 @@
+"""The orientation quality section: reprojection errors, track lengths, image connectivity, camera
+positions."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ...common.progress import check_cancel
+from ...georef import accuracy
+from ..context import ReportContext, Skip
+from ..figures import embed, equal_xy, new_figure, nice
+from ..html import badge, cell, esc, fmt, kv, num, table, td
+from ..residuals import camera_position_figures
+
+
+def section(ctx: ReportContext) -> str:
+    d = ctx.d
+    if d.rec is None:
+        raise Skip("the workspace is not aligned: run 'Align images'.")
+    o = d.obs
+    err = o.error
+    fin = err[np.isfinite(err)]
+    mean_img, n_img = d.per_image_error()
+    d.rec.update_point_3d_errors()
+    mre = num(d.rec.compute_mean_reprojection_error()) if len(fin) else None
+    ctx.figures["MEAN_REPROJECTION_ERROR"] = mre
+    parts = [kv([
+        ("Mean reprojection error (mean over tie points of their mean error, as COLMAP reports it)",
+         f'<span data-key="reproj.mean">{fmt(mre, 3)}</span> px'),
+        ("Reprojection error of the observations: mean / median / RMS",
+         f'<span data-key="reproj.obs_mean">{fmt(np.mean(fin) if len(fin) else None, 3)}</span> / '
+         f'{fmt(np.median(fin) if len(fin) else None, 3)} / {fmt(accuracy.rmse(fin), 3)} px'),
+        ("Largest reprojection error", f"{fmt(fin.max() if len(fin) else None, 2)} px"),
+        ("Track length: mean / median / max",
+         f"{fmt(np.mean(o.track_length), 2)} / {fmt(np.median(o.track_length), 0)} / {int(o.track_length.max())}"
+         if len(o.track_length) else "–"),
+        ("Model", esc(os.path.relpath(d.model_dir, d.ws.root))),
+    ])]
+    # histogram + track lengths
+    fig = new_figure(9.0, 3.0)
+    ax = fig.add_subplot(121)
+    if len(fin):
+        hi = max(float(np.percentile(fin, 99.5)), 1e-3)
+        ax.hist(np.clip(fin, 0, hi), bins=50, color="#4477aa")
+        ax.axvline(np.mean(fin), color="#c0392b", lw=1, label=f"mean {np.mean(fin):.2f} px")
+        ax.axvline(np.median(fin), color="k", lw=1, ls="--", label=f"median {np.median(fin):.2f} px")
+        ax.legend(fontsize=7)
+    ax.set_xlabel("reprojection error (px)", fontsize=8)
+    ax.set_ylabel("observations", fontsize=8)
+    ax.tick_params(labelsize=7)
+    ax2 = fig.add_subplot(122)
+    if len(o.track_length):
+        tl = o.track_length
+        top = int(min(tl.max(), np.percentile(tl, 99.5) + 1))
+        ax2.hist(np.clip(tl, 2, top), bins=np.arange(1.5, top + 1.5), color="#228833")
+    ax2.set_xlabel("track length (images per tie point)", fontsize=8)
+    ax2.set_ylabel("tie points", fontsize=8)
+    ax2.tick_params(labelsize=7)
+    parts.append(embed(fig, "reprojection error and track length histograms",
+                      "Left: reprojection error of every tie-point observation (clipped at the 99.5th "
+                      "percentile). Right: number of images per tie point."))
+    # per image
+    names = d.obs.image_names
+    n = len(names)
+    fig = new_figure(max(7.0, min(16.0, 0.18 * n + 2)), 3.6)
+    ax = fig.add_subplot(211)
+    med = np.nanmedian(mean_img) if n else 0.0
+    colours = ["#c0392b" if v > 2 * med else "#4477aa" for v in np.nan_to_num(mean_img)]
+    ax.bar(range(n), np.nan_to_num(mean_img), color=colours)
+    ax.set_ylabel("mean error (px)", fontsize=8)
+    ax.set_xticks([])
+    ax.tick_params(labelsize=7)
+    ax2 = fig.add_subplot(212)
+    ax2.bar(range(n), n_img, color="#228833")
+    ax2.set_ylabel("observations", fontsize=8)
+    ax2.set_xticks(range(n))
+    ax2.set_xticklabels(names if n <= 80 else [""] * n, rotation=90, fontsize=6)
+    ax2.tick_params(axis="y", labelsize=7)
+    parts.append(embed(fig, "reprojection error per image",
+                      "Mean reprojection error (red: more than twice the median) and tie-point observations "
+                      "per image."))
+    rows = [[td(nm), cell(mean_img[k], 3), td(int(n_img[k]))] for k, nm in enumerate(names)]
+    parts.append("<details><summary>Per-image table</summary>"
+                 + table(["image", "mean reprojection error (px)", "observations"], rows) + "</details>")
+    bad = [names[k] for k in range(n) if np.isfinite(mean_img[k]) and mean_img[k] > 2 * med]
+    if bad:
+        ctx.glance.append(badge("warn", f"{len(bad)} image(s) with more than twice the median reprojection "
+                                          f"error: {esc(', '.join(bad[:6]))}{' …' if len(bad) > 6 else ''}"))
+    check_cancel(ctx.progress)
+    parts.append(_connectivity(ctx))
+    parts.append(_camera_plot(ctx))
+    return "".join(parts)
+
+
+def _connectivity(ctx: ReportContext) -> str:
+    d = ctx.d
+    c = d.shared_points()
+    n = len(c)
+    centres = d.centres()
+    fig = new_figure(10.5, 4.6)
+    gs = fig.add_gridspec(1, 2, wspace=0.35)
+    ax = fig.add_subplot(gs[0, 0])
+    from matplotlib.colors import LogNorm
+
+    im = ax.imshow(np.where(c > 0, c, np.nan), cmap="viridis", norm=LogNorm(vmin=1, vmax=max(2, c.max())),
+                   interpolation="nearest")
+    fig.colorbar(im, ax=ax, shrink=0.8, label="shared tie points")
+    if n <= 40:
+        ax.set_xticks(range(n))
+        ax.set_yticks(range(n))
+        ax.set_xticklabels(d.obs.image_names, rotation=90, fontsize=5)
+        ax.set_yticklabels(d.obs.image_names, fontsize=5)
+    else:
+        ax.tick_params(labelsize=6)
+    ax.set_title("image × image", fontsize=9)
+    ax2 = fig.add_subplot(gs[0, 1])
+    iu = np.argwhere(np.triu(c) > 0)
+    if len(iu):
+        w = c[iu[:, 0], iu[:, 1]]
+        order = np.argsort(w)
+        from matplotlib.collections import LineCollection
+
+        segs = np.stack([centres[iu[order, 0], :2], centres[iu[order, 1], :2]], axis=1)
+        lc = LineCollection(segs, array=np.log10(w[order]), cmap="viridis",
+                            linewidths=0.4 + 2.0 * w[order] / w.max())
+        ax2.add_collection(lc)
+    ax2.scatter(centres[:, 0], centres[:, 1], s=10, c="#c0392b", zorder=3)
+    weak = [k for k in range(n) if (c[k] > 0).sum() <= 1]
+    for k in weak:
+        ax2.annotate(d.obs.image_names[k], centres[k, :2], fontsize=6, color="#c0392b")
+    equal_xy(ax2)
+    ax2.autoscale()
+    ax2.set_title(f"camera centres ({d.unit}); line width ∝ shared points", fontsize=9)
+    n_pairs = int((np.triu(c) > 0).sum())
+    return ("<h3>Image connectivity</h3>" + embed(
+        fig, "image connectivity", f"Which photos share tie points and how many: {n_pairs} connected image pairs. "
+        "Images linked to at most one other image are named on the map.")
+        + (f'<p class="warn">Weakly connected images: {esc(", ".join(d.obs.image_names[k] for k in weak))}</p>'
+           if weak else ""))
+
+
+def _camera_plot(ctx: ReportContext) -> str:
+    d = ctx.d
+    centres = d.centres()
+    tie = d.tie_xyz()
+    mean_img, _ = d.per_image_error()
+    cams = camera_position_figures(d.residuals) if d.residuals else None
+    fig = new_figure(7.5, 6.0)
+    ax = fig.add_subplot(111)
+    if len(tie):
+        sub = tie[:: max(1, len(tie) // 20000)]
+        ax.scatter(sub[:, 0], sub[:, 1], s=0.3, c="#bbbbbb", lw=0, label="tie points")
+    caption = "Camera projection centres over the tie points"
+    if cams:
+        rows = [r for r in cams["rows"] if r.get("dx") is not None]
+        xy = np.array([[r["x"], r["y"]] for r in rows], dtype=float)
+        dxy = np.array([[r["dx"], r["dy"]] for r in rows], dtype=float)
+        dz = np.array([np.nan if r.get("dz") is None else r["dz"] for r in rows], dtype=float)
+        ext = float(np.ptp(centres[:, :2], axis=0).max()) if len(centres) > 1 else 1.0
+        lmax = float(np.hypot(dxy[:, 0], dxy[:, 1]).max()) if len(dxy) else 0.0
+        k = 0.15 * ext / lmax if lmax > 0 else 1.0
+        lim = float(np.nanmax(np.abs(dz))) if np.any(np.isfinite(dz)) else 1.0
+        sc = ax.scatter(xy[:, 0], xy[:, 1], c=np.nan_to_num(dz), cmap="RdBu_r", vmin=-lim, vmax=lim, s=28,
+                        edgecolors="k", linewidths=0.4, zorder=3)
+        fig.colorbar(sc, ax=ax, shrink=0.7, label="dZ (m): adjusted − given")
+        q = ax.quiver(xy[:, 0], xy[:, 1], dxy[:, 0] * k, dxy[:, 1] * k, angles="xy", scale_units="xy", scale=1,
+                      color="#c0392b", width=0.004, zorder=4)
+        ref = nice(lmax)
+        ax.quiverkey(q, 0.82, 0.96, ref * k, f"{ref:g} m", labelpos="E", coordinates="axes",
+                     fontproperties={"size": 7})
+        excl = [r for r in cams["rows"] if not r.get("used", True)]
+        for r in excl:
+            ax.annotate("excluded " + r["image"], (r["x"], r["y"]), fontsize=6, color="#c0392b")
+        caption += (f"; arrows: horizontal camera-position residual (adjusted − given), exaggerated ×{k:.3g}; "
+                    "colour: vertical residual.")
+    else:
+        sc = ax.scatter(centres[:, 0], centres[:, 1], c=np.nan_to_num(mean_img), cmap="viridis", s=28,
+                        edgecolors="k", linewidths=0.4, zorder=3)
+        fig.colorbar(sc, ax=ax, shrink=0.7, label="mean reprojection error (px)")
+        caption += "; colour: mean reprojection error per image (no camera positions were given)."
+    equal_xy(ax)
+    ax.set_title(f"camera positions ({d.crs_label or d.unit})", fontsize=9)
+    return "<h3>Camera positions</h3>" + embed(fig, "camera positions", caption)

@@ -1,0 +1,95 @@
+"""The products section: DSM and orthomosaic previews (hillshade), resolution, valid fraction."""
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from ..context import ReportContext, Skip
+from ..figures import draw_dem, draw_image, embed, equal_xy, new_figure
+from ..html import esc, kv, num, raster_crs_name
+
+
+def section(ctx: ReportContext) -> str:
+    dsm = ctx.d.dsm_path()
+    ortho = ctx.d.orthomosaic_path()
+    if not dsm and not ortho:
+        raise Skip("no DSM or orthomosaic yet: run 'Build DSM' and 'Build orthophoto'.")
+    parts = []
+    if dsm:
+        parts.append(_raster(ctx, dsm, "DSM", dem=True))
+    else:
+        parts.append('<p class="skip">No DSM yet.</p>')
+    if ortho:
+        parts.append(_raster(ctx, ortho, "Orthomosaic", dem=False))
+    else:
+        parts.append('<p class="skip">No orthomosaic yet.</p>')
+    return "".join(parts)
+
+
+def _raster(ctx: ReportContext, path: str, title: str, dem: bool) -> str:
+    from osgeo import gdal
+
+    gdal.UseExceptions()
+    try:
+        ds = gdal.Open(path)
+    except RuntimeError as e:
+        return f'<h3>{title}</h3><p class="warn">{esc(path)} cannot be read: {esc(e)}</p>'
+    w, h = ds.RasterXSize, ds.RasterYSize
+    gt = ds.GetGeoTransform()
+    step = max(1, int(math.ceil(max(w, h) / 900)))
+    bw, bh = max(1, w // step), max(1, h // step)
+    b1 = ds.GetRasterBand(1)
+    nodata = b1.GetNoDataValue()
+    info = [("File", esc(os.path.relpath(path, ctx.d.ws.root))), ("Size", f"{w} × {h} cells, {ds.RasterCount} "
+                                                                          "band(s)"),
+            ("Resolution", f"{abs(gt[1]):.4g} × {abs(gt[5]):.4g} m"),
+            ("CRS", esc(raster_crs_name(ds)))]
+    fig = new_figure(7.5, 6.0)
+    ax = fig.add_subplot(111)
+    extent = (gt[0], gt[0] + gt[1] * w, gt[3] + gt[5] * h, gt[3])
+    if dem:
+        z = b1.ReadAsArray(buf_xsize=bw, buf_ysize=bh).astype(float)
+        valid = np.isfinite(z) & ((z != nodata) if nodata is not None else True)
+        frac = float(valid.mean())
+        zz = np.where(valid, z, np.nan)
+        shown = draw_dem(fig, ax, zz, valid, abs(gt[1]) * w / bw, abs(gt[5]) * h / bh, extent)
+        if shown is not None:
+            info.append(("Height range (1st–99th percentile)", f"{shown[0]:.2f} – {shown[1]:.2f} m"))
+    else:
+        arr, alpha = _read_image(ds, bw, bh)
+        frac = float(alpha.mean())
+        draw_image(ax, arr, alpha, extent)
+    info.append(("Valid fraction (cells with data)", f'<span data-key="{title.lower()}.valid">{frac:.3f}</span>'
+                                                      + (f" (estimated on a 1:{step} overview)" if step > 1 else "")))
+    stage_vf = num(((ctx.d.manifest.get("stages", {}).get("dsm" if dem else "orthophoto") or {}).get("results")
+                     or {}).get("VALID_FRACTION"))
+    if stage_vf is not None:
+        info.append(("Valid fraction inside the camera centres' convex hull (as the stage reports it)",
+                     f"{stage_vf:.3f}"))
+    # the key figure is the stage's own (the Processing output VALID_FRACTION): inside the camera centres'
+    # convex hull; the whole raster's share is shown beside it above
+    ctx.figures[f"{'DSM' if dem else 'ORTHO'}_VALID_FRACTION"] = stage_vf if stage_vf is not None else frac
+    ctx.figures[f"{'DSM' if dem else 'ORTHO'}_RESOLUTION"] = abs(gt[1])
+    equal_xy(ax)
+    ax.grid(False)
+    return f"<h3>{title}</h3>" + kv(info) + embed(fig, f"{title} preview", f"{title} preview" + (
+        " with hillshade (sun from the north-west, 45°)." if dem else "."))
+
+
+def _read_image(ds, bw: int, bh: int):
+    """The first three bands at (bw, bh) cells, and where they hold data (the alpha band, else the mask)."""
+    from osgeo import gdal
+
+    bands = [ds.GetRasterBand(i + 1) for i in range(min(3, ds.RasterCount))]
+    arr = np.dstack([b.ReadAsArray(buf_xsize=bw, buf_ysize=bh).astype(float) for b in bands])
+    alpha = None
+    for i in range(ds.RasterCount):
+        b = ds.GetRasterBand(i + 1)
+        if b.GetColorInterpretation() == gdal.GCI_AlphaBand:
+            alpha = b.ReadAsArray(buf_xsize=bw, buf_ysize=bh) > 0
+    if alpha is None:
+        mb = ds.GetRasterBand(1).GetMaskBand().ReadAsArray(buf_xsize=bw, buf_ysize=bh)
+        alpha = mb > 0
+    return arr, alpha

@@ -1,0 +1,60 @@
+"""The one way tests build a workspace from a synthetic block's truth, as if the earlier stages had run.
+
+Every product goes where ``core.project.layout.Layout`` says and every stage record through
+``core.project.stages.run_stage`` (the same epilogue the real stages use), so a test workspace cannot drift from
+the real format.
+"""
+import os
+
+from core.io.vector import write_cameras_gpkg
+from core.project.layout import Layout, write_json
+from core.project.stages import ALIGN, GEOREFERENCE, run_stage
+from core.project.workspace import Workspace
+
+
+def synthetic_workspace(root, block, rec, *, names=None, images_dir=None, photos=None, camera_groups=None,
+                        georeferenced=False, crs=None, offset=None, align_parameters=None, alignment=None,
+                        align_timings=None, align_results=None, cameras_gpkg=False):
+    """A workspace at ``root`` holding ``rec`` (a pycolmap.Reconstruction, usually
+    ``block.truth_reconstruction(...)``) and returning its path.
+
+    - aligned only (default): ``rec`` is the aligned model in ``sfm/model``;
+    - ``georeferenced=True``: ``rec`` is the georeferenced model (local frame) in ``georef/model`` with a
+      transform of ``crs`` and ``offset`` (the local frame's origin), and both stages are done;
+    - ``photos``: {name: path} of rendered photos (the image list then records their paths, as the aligner does),
+      else the image list is ``names`` (default: all of the block's) at the block camera's size;
+    - ``alignment``: the figures written to ``sfm/alignment.json``; ``align_timings`` {step: seconds} and
+      ``align_results`` go into the align stage's record; ``cameras_gpkg`` writes ``cameras.gpkg``.
+    """
+    ws = Workspace.create_or_open(str(root))
+    lay = Layout(ws)
+    if photos is not None:
+        ws.data["images_dir"] = os.path.dirname(next(iter(photos.values())))
+        ws.data["images"] = [{"name": n, "path": p, "width": block.camera.width, "height": block.camera.height,
+                              "gps": None} for n, p in photos.items()]
+    else:
+        ws.data["images_dir"] = images_dir
+        ws.data["images"] = [{"name": n, "width": block.camera.width, "height": block.camera.height}
+                             for n in (names or block.names)]
+    if camera_groups is not None:
+        ws.data["camera_groups"] = camera_groups
+    outputs = {"model": "sfm/model"}
+    with run_stage(ws, ALIGN, align_parameters or {"synthetic": True}) as run:
+        folder = lay.georef_model_dir if georeferenced else lay.aligned_model_dir
+        os.makedirs(folder, exist_ok=True)
+        rec.write_binary(folder)
+        if alignment is not None:
+            write_json(lay.alignment_json, alignment)
+        for step, seconds in (align_timings or {}).items():
+            ws.record_timing(ALIGN, step, seconds)
+        if cameras_gpkg:
+            from core.align.sfm import camera_rows
+
+            outputs["cameras"] = lay.rel(write_cameras_gpkg(ws.root, camera_rows(rec), crs=None))
+        run.finish(outputs=outputs, results=align_results)
+    if georeferenced:
+        ws.crs = crs
+        with run_stage(ws, GEOREFERENCE, {"synthetic": True}) as run:
+            write_json(lay.transform_json, {"crs": crs, "offset": [float(v) for v in offset]})
+            run.finish(outputs={"model": lay.rel(lay.georef_model_dir), "transform": lay.rel(lay.transform_json)})
+    return ws.root
