@@ -4,11 +4,10 @@ from qgis.core import (
     QgsProcessingOutputFolder,
     QgsProcessingOutputNumber,
     QgsProcessingOutputString,
-    QgsProcessingParameterBoolean,
-    QgsProcessingParameterFile,
     QgsProcessingParameterFileDestination,
 )
 
+from . import params
 from .base import AlgorithmBase, FeedbackProgress
 
 
@@ -68,11 +67,12 @@ class AccuracyReportAlgorithm(AlgorithmBase):
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
-        self.addParameter(QgsProcessingParameterFile(
-            self.WORKSPACE, self.tr("Workspace folder"), behavior=QgsProcessingParameterFile.Folder))
-        self.addParameter(QgsProcessingParameterBoolean(
-            self.UNCERTAINTY, self.tr("Compute the bundle adjustment covariance (uncertainty section and layers)"),
-            defaultValue=True))
+        params.add(
+            self,
+            params.folder(self.WORKSPACE, self.tr("Workspace folder")),
+            params.flag(self.UNCERTAINTY, self.tr(
+                "Compute the bundle adjustment covariance (uncertainty section and layers)"), default=True),
+        )
         self.addParameter(QgsProcessingParameterFileDestination(
             self.OUTPUT_HTML, self.tr("Report (default: <workspace>/report.html)"), fileFilter="HTML files (*.html)",
             optional=True, createByDefault=False))
@@ -84,7 +84,7 @@ class AccuracyReportAlgorithm(AlgorithmBase):
             self.addOutput(QgsProcessingOutputNumber(name, self.tr(label)))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core.report import stage as report
+        from ..core.report import html as report
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         output = self.parameterAsFileOutput(parameters, self.OUTPUT_HTML, context) or None

@@ -1,20 +1,9 @@
 """Align images: thin adapter over core.sfm.align."""
-from qgis.core import (
-    QgsProcessingOutputNumber,
-    QgsProcessingOutputVectorLayer,
-    QgsProcessingParameterBoolean,
-    QgsProcessingParameterDefinition,
-    QgsProcessingParameterEnum,
-    QgsProcessingParameterFile,
-    QgsProcessingParameterFolderDestination,
-    QgsProcessingParameterNumber,
-)
+from qgis.core import QgsProcessingOutputNumber, QgsProcessingOutputVectorLayer
 
+from . import params
 from .base import AlgorithmBase, FeedbackProgress
-
-PAIRINGS = ["auto", "exhaustive", "sequential", "spatial"]
-CAMERA_MODELS = ["AUTO", "SIMPLE_RADIAL", "RADIAL", "OPENCV", "FULL_OPENCV"]
-MAPPERS = ["incremental", "global"]
+from .params import CAMERA_MODELS, MAPPERS, PAIRINGS
 
 
 class AlignImagesAlgorithm(AlgorithmBase):
@@ -50,32 +39,21 @@ class AlignImagesAlgorithm(AlgorithmBase):
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
-        self.addParameter(QgsProcessingParameterFile(
-            self.IMAGES, self.tr("Folder of images"), behavior=QgsProcessingParameterFile.Folder))
-        self.addParameter(QgsProcessingParameterFolderDestination(self.WORKSPACE, self.tr("Workspace folder")))
-        self.addParameter(QgsProcessingParameterEnum(
-            self.PAIRING, self.tr("Pair selection"), options=PAIRINGS, defaultValue=0))
-        self.addParameter(QgsProcessingParameterEnum(
-            self.CAMERA_MODEL, self.tr("Camera model"), options=CAMERA_MODELS, defaultValue=0))
-        self.addParameter(QgsProcessingParameterNumber(
-            self.MAX_IMAGE_SIZE, self.tr("Largest image side for matching (0 = full size)"),
-            type=QgsProcessingParameterNumber.Integer, defaultValue=0, minValue=0))
-        self.addParameter(QgsProcessingParameterNumber(
-            self.MAX_FEATURES, self.tr("Largest number of features per image (0 = auto, ~4000 per megapixel)"),
-            type=QgsProcessingParameterNumber.Integer, defaultValue=0, minValue=0))
-        self.addParameter(QgsProcessingParameterBoolean(
-            self.AFFINE_FEATURES, self.tr("Affine-invariant features (oblique views; slower)"), defaultValue=False))
-        self.addParameter(QgsProcessingParameterNumber(
-            self.FOCAL_MM, self.tr("Focal length in mm when EXIF is missing (0 = from EXIF)"),
-            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
-        self.addParameter(QgsProcessingParameterNumber(
-            self.SENSOR_WIDTH_MM, self.tr("Sensor (frame) width in mm, long side (0 = unknown)"),
-            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
-        self.addParameter(QgsProcessingParameterBoolean(
-            self.SINGLE_CAMERA, self.tr("One camera for all images"), defaultValue=False))
-        mapper = QgsProcessingParameterEnum(self.MAPPER, self.tr("Mapper"), options=MAPPERS, defaultValue=0)
-        mapper.setFlags(mapper.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
-        self.addParameter(mapper)
+        params.add(
+            self,
+            params.folder(self.IMAGES, self.tr("Folder of images")),
+            params.workspace_destination(self.WORKSPACE, self.tr("Workspace folder")),
+            params.pairing(self.PAIRING, self.tr("Pair selection")),
+            params.camera_model(self.CAMERA_MODEL, self.tr("Camera model")),
+            params.max_image_size(self.MAX_IMAGE_SIZE, self.tr("Largest image side for matching (0 = full size)")),
+            params.integer(self.MAX_FEATURES, self.tr(
+                "Largest number of features per image (0 = auto, ~4000 per megapixel)")),
+            params.flag(self.AFFINE_FEATURES, self.tr("Affine-invariant features (oblique views; slower)")),
+            params.number(self.FOCAL_MM, self.tr("Focal length in mm when EXIF is missing (0 = from EXIF)")),
+            params.number(self.SENSOR_WIDTH_MM, self.tr("Sensor (frame) width in mm, long side (0 = unknown)")),
+            params.flag(self.SINGLE_CAMERA, self.tr("One camera for all images")),
+            *params.advanced(params.choice(self.MAPPER, self.tr("Mapper"), MAPPERS)),
+        )
         self.addOutput(QgsProcessingOutputVectorLayer(self.CAMERAS, self.tr("Camera centres")))
         self.addOutput(QgsProcessingOutputNumber(self.REGISTERED_IMAGES, self.tr("Registered images")))
         self.addOutput(QgsProcessingOutputNumber(
@@ -90,15 +68,15 @@ class AlignImagesAlgorithm(AlgorithmBase):
         focal_mm = self.parameterAsDouble(parameters, self.FOCAL_MM, context)
         sensor_mm = self.parameterAsDouble(parameters, self.SENSOR_WIDTH_MM, context)
         options = sfm.AlignOptions(
-            pairing=PAIRINGS[self.parameterAsEnum(parameters, self.PAIRING, context)],
-            camera_model=CAMERA_MODELS[self.parameterAsEnum(parameters, self.CAMERA_MODEL, context)],
+            pairing=params.read_choice(self, parameters, self.PAIRING, context, PAIRINGS),
+            camera_model=params.read_choice(self, parameters, self.CAMERA_MODEL, context, CAMERA_MODELS),
             max_image_size=self.parameterAsInt(parameters, self.MAX_IMAGE_SIZE, context),
             max_features=self.parameterAsInt(parameters, self.MAX_FEATURES, context),
             affine_features=self.parameterAsBoolean(parameters, self.AFFINE_FEATURES, context),
             grouping=GROUP_SINGLE if self.parameterAsBoolean(parameters, self.SINGLE_CAMERA, context) else GROUP_AUTO,
             focal_mm=focal_mm or None,
             sensor_width_mm=sensor_mm or None,
-            mapper=MAPPERS[self.parameterAsEnum(parameters, self.MAPPER, context)],
+            mapper=params.read_choice(self, parameters, self.MAPPER, context, MAPPERS),
         )
         result = self.run_core(sfm.align, images, workspace, options, FeedbackProgress(feedback))
         feedback.pushInfo(self.tr("Registered {} of {} images, mean reprojection error {:.3f} px, {} points").format(

@@ -5,8 +5,9 @@ toolbox dialog, processing.runAndLoadResults): see ``AlgorithmBase.register_styl
 qgis_process (and QGIS Server) nothing of that runs.
 """
 import functools
+import traceback
 
-from qgis.core import QgsApplication, QgsProcessingAlgorithm, QgsProcessingException
+from qgis.core import Qgis, QgsApplication, QgsMessageLog, QgsProcessingAlgorithm, QgsProcessingException
 from qgis.PyQt.QtCore import QCoreApplication
 
 HEADLESS_PLATFORMS = ("qgis_process", "server")
@@ -121,13 +122,49 @@ class AlgorithmBase(QgsProcessingAlgorithm):
 
     @staticmethod
     def run_core(func, *args, **kwargs):
-        """Call a core function; turn its clear errors into QgsProcessingException."""
-        from ..core.common.progress import Cancelled
+        """Call a core function; turn its errors into QgsProcessingException.
 
-        try:
-            return func(*args, **kwargs)
-        except Cancelled as e:
-            raise QgsProcessingException(
-                QCoreApplication.translate("AlgorithmBase", "Cancelled: {}").format(e)) from e
-        except (ValueError, RuntimeError, OSError) as e:
+        A user-facing error (core.common.errors.ArchaeoOrthoError, a missing package) becomes its message;
+        anything else is a bug: its traceback goes to the log first, then it fails the run (never QGIS)."""
+        return call_core(func, *args, **kwargs)
+
+
+def call_core(func, *args, **kwargs):
+    """Call ``func(*args, **kwargs)``: Cancelled, user errors and bugs all end as QgsProcessingException.
+
+    The Processing log of a bug's traceback is the feedback of the FeedbackProgress passed to ``func``."""
+    from ..core.common.errors import user_message
+    from ..core.common.progress import Cancelled
+
+    try:
+        return func(*args, **kwargs)
+    except QgsProcessingException:
+        raise
+    except Cancelled as e:
+        raise QgsProcessingException(
+            QCoreApplication.translate("AlgorithmBase", "Cancelled: {}").format(e)) from e
+    except Exception as e:  # noqa: BLE001 - every failure becomes a failed run, never an abort of QGIS
+        message = user_message(e)
+        if message is not None:
+            raise QgsProcessingException(message) from e
+        if isinstance(e, (ValueError, RuntimeError, OSError)):
+            # fallback while the core's error classes move to ArchaeoOrthoError: shown as before
             raise QgsProcessingException(str(e)) from e
+        report_bug(e, _feedback_of(args, kwargs))
+        raise QgsProcessingException(f"{type(e).__name__}: {e}") from e
+
+
+def _feedback_of(args, kwargs):
+    for value in list(args) + list(kwargs.values()):
+        if isinstance(value, FeedbackProgress):
+            return value.feedback
+    return None
+
+
+def report_bug(error, feedback=None):
+    """Put the traceback of an unexpected exception in the Processing log (or QGIS's message log)."""
+    text = "".join(traceback.format_exception(type(error), error, error.__traceback__))
+    if feedback is not None:
+        feedback.reportError(text, False)
+    else:
+        QgsMessageLog.logMessage(text, "ArchaeoOrtho", Qgis.Critical)

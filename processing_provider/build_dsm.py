@@ -2,15 +2,11 @@
 from qgis.core import (
     QgsProcessingOutputFolder,
     QgsProcessingOutputNumber,
-    QgsProcessingParameterDefinition,
-    QgsProcessingParameterEnum,
-    QgsProcessingParameterFile,
     QgsProcessingParameterFileDestination,
-    QgsProcessingParameterNumber,
     QgsProcessingParameterRasterDestination,
-    QgsProcessingParameterString,
 )
 
+from . import params
 from .base import AlgorithmBase, FeedbackProgress
 
 
@@ -29,8 +25,8 @@ class BuildDsmAlgorithm(AlgorithmBase):
     VALID_FRACTION = "VALID_FRACTION"
     PAIRS = "PAIRS"
     POINTS = "POINTS"
-    QUALITIES = ("full", "half", "quarter")
-    ENGINES = ("cpu", "cuda")
+    QUALITIES = params.QUALITIES
+    ENGINES = params.ENGINES
     HELP = (
         "Dense matching of the georeferenced block and a digital surface model (DSM).\n\n"
         "Stereo pairs are chosen from the sparse model (shared tie points, baseline-to-depth ratio, viewing "
@@ -51,23 +47,17 @@ class BuildDsmAlgorithm(AlgorithmBase):
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
-        self.addParameter(QgsProcessingParameterFile(
-            self.WORKSPACE, self.tr("Workspace folder (georeferenced)"), behavior=QgsProcessingParameterFile.Folder))
-        self.addParameter(QgsProcessingParameterNumber(
-            self.RESOLUTION, self.tr("DSM resolution in metres (0 = automatic)"),
-            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
-        self.addParameter(QgsProcessingParameterEnum(
-            self.QUALITY, self.tr("Matching quality (image scale)"), options=list(self.QUALITIES), defaultValue=1))
-        self.addParameter(QgsProcessingParameterEnum(
-            self.ENGINE, self.tr("Engine"), options=list(self.ENGINES), defaultValue=0))
-        workers = QgsProcessingParameterNumber(
-            self.WORKERS, self.tr("Parallel workers (0 = one per core)"), type=QgsProcessingParameterNumber.Integer,
-            defaultValue=0, minValue=0)
-        scheduler = QgsProcessingParameterString(
-            self.SCHEDULER, self.tr("Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)"), defaultValue="", optional=True)
-        for p in (workers, scheduler):
-            p.setFlags(p.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
-            self.addParameter(p)
+        params.add(
+            self,
+            params.folder(self.WORKSPACE, self.tr("Workspace folder (georeferenced)")),
+            params.dsm_resolution(self.RESOLUTION, self.tr("DSM resolution in metres (0 = automatic)")),
+            params.quality(self.QUALITY, self.tr("Matching quality (image scale)")),
+            params.choice(self.ENGINE, self.tr("Engine"), self.ENGINES),
+            *params.advanced(
+                params.workers(self.WORKERS, self.tr("Parallel workers (0 = one per core)")),
+                params.scheduler(self.SCHEDULER, self.tr(
+                    "Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)"))),
+        )
         self.addParameter(QgsProcessingParameterRasterDestination(
             self.OUTPUT_DSM, self.tr("DSM (default: <workspace>/dsm.tif)"), optional=True, createByDefault=False))
         self.addParameter(QgsProcessingParameterFileDestination(
@@ -87,12 +77,12 @@ class BuildDsmAlgorithm(AlgorithmBase):
         output_pc = self.parameterAsFileOutput(parameters, self.OUTPUT_POINT_CLOUD, context) or None
         options = dense.DenseOptions(
             workers=self.parameterAsInt(parameters, self.WORKERS, context),
-            scheduler=self.parameterAsString(parameters, self.SCHEDULER, context).strip() or None)
+            scheduler=params.read_scheduler(self, parameters, self.SCHEDULER, context))
         result = self.run_core(
             dense.build_dsm_workspace, workspace,
             resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context),
-            quality=self.QUALITIES[self.parameterAsEnum(parameters, self.QUALITY, context)],
-            engine=self.ENGINES[self.parameterAsEnum(parameters, self.ENGINE, context)],
+            quality=params.read_choice(self, parameters, self.QUALITY, context, self.QUALITIES),
+            engine=params.read_choice(self, parameters, self.ENGINE, context, self.ENGINES),
             output_dsm=output_dsm, output_point_cloud=output_pc, options=options,
             progress=FeedbackProgress(feedback))
         feedback.pushInfo(self.tr("DSM {} ({} m cells), valid fraction {}").format(

@@ -3,17 +3,14 @@ from qgis.core import (
     QgsProcessingException,
     QgsProcessingOutputFolder,
     QgsProcessingOutputNumber,
-    QgsProcessingParameterDefinition,
-    QgsProcessingParameterEnum,
-    QgsProcessingParameterFile,
     QgsProcessingParameterFolderDestination,
-    QgsProcessingParameterNumber,
     QgsProcessingParameterRasterDestination,
     QgsProcessingParameterRasterLayer,
     QgsProcessingParameterString,
     QgsProcessingParameterVectorDestination,
 )
 
+from . import params
 from .base import AlgorithmBase, FeedbackProgress
 
 
@@ -35,8 +32,8 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
     VALID_FRACTION = "VALID_FRACTION"
     RESOLUTION_USED = "RESOLUTION_USED"
     IMAGES_USED = "IMAGES_USED"
-    BLENDINGS = ("feather", "multiband", "none")
-    INTERPOLATIONS = ("bilinear", "cubic", "nearest")
+    BLENDINGS = params.BLENDINGS
+    INTERPOLATIONS = params.INTERPOLATIONS
     HELP = (
         "True orthophotos and the orthomosaic of a georeferenced workspace.\n\n"
         "Every cell takes its height from the DSM and is projected through the full camera model (pose, focal "
@@ -60,30 +57,21 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
-        self.addParameter(QgsProcessingParameterFile(
-            self.WORKSPACE, self.tr("Workspace folder (georeferenced, with a DSM)"),
-            behavior=QgsProcessingParameterFile.Folder))
-        self.addParameter(QgsProcessingParameterRasterLayer(
-            self.DSM, self.tr("DSM (default: the workspace DSM)"), optional=True))
-        self.addParameter(QgsProcessingParameterString(
-            self.IMAGES_FILTER, self.tr("Images (names, wildcards or group:<camera>; empty = all)"),
-            defaultValue="", optional=True))
-        self.addParameter(QgsProcessingParameterNumber(
-            self.RESOLUTION, self.tr("Resolution in CRS units (0 = ground sample distance)"),
-            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
-        self.addParameter(QgsProcessingParameterEnum(
-            self.BLENDING, self.tr("Blending across seamlines"), options=list(self.BLENDINGS), defaultValue=0))
-        interp = QgsProcessingParameterEnum(
-            self.INTERPOLATION, self.tr("Resampling of the images"), options=list(self.INTERPOLATIONS), defaultValue=0)
-        workers = QgsProcessingParameterNumber(
-            self.WORKERS, self.tr("Parallel tile workers (0 = one per core)"),
-            type=QgsProcessingParameterNumber.Integer, defaultValue=1, minValue=0)
-        scheduler = QgsProcessingParameterString(
-            self.SCHEDULER, self.tr("Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)"),
-            defaultValue="", optional=True)
-        for p in (interp, workers, scheduler):
-            p.setFlags(p.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
-            self.addParameter(p)
+        params.add(
+            self,
+            params.folder(self.WORKSPACE, self.tr("Workspace folder (georeferenced, with a DSM)")),
+            QgsProcessingParameterRasterLayer(self.DSM, self.tr("DSM (default: the workspace DSM)"), optional=True),
+            QgsProcessingParameterString(
+                self.IMAGES_FILTER, self.tr("Images (names, wildcards or group:<camera>; empty = all)"),
+                defaultValue="", optional=True),
+            params.number(self.RESOLUTION, self.tr("Resolution in CRS units (0 = ground sample distance)")),
+            params.blending(self.BLENDING, self.tr("Blending across seamlines")),
+            *params.advanced(
+                params.choice(self.INTERPOLATION, self.tr("Resampling of the images"), self.INTERPOLATIONS),
+                params.workers(self.WORKERS, self.tr("Parallel tile workers (0 = one per core)"), default=1),
+                params.scheduler(self.SCHEDULER, self.tr(
+                    "Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)"))),
+        )
         self.addParameter(QgsProcessingParameterRasterDestination(
             self.OUTPUT, self.tr("Orthomosaic (default: <workspace>/orthomosaic.tif)"), optional=True,
             createByDefault=False))
@@ -112,14 +100,14 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
             raise QgsProcessingException(self.tr("SEAMLINES must be a GeoPackage (.gpkg) file, got {}").format(
                 seamlines))
         options = ortho.OrthoOptions(
-            interpolation=self.INTERPOLATIONS[self.parameterAsEnum(parameters, self.INTERPOLATION, context)],
+            interpolation=params.read_choice(self, parameters, self.INTERPOLATION, context, self.INTERPOLATIONS),
             workers=self.parameterAsInt(parameters, self.WORKERS, context),
-            scheduler=self.parameterAsString(parameters, self.SCHEDULER, context).strip() or None)
+            scheduler=params.read_scheduler(self, parameters, self.SCHEDULER, context))
         result = self.run_core(
             ortho.build_orthophoto_workspace, workspace, dsm_path=dsm_path,
             images_filter=self.parameterAsString(parameters, self.IMAGES_FILTER, context).strip() or None,
             resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context),
-            blending=self.BLENDINGS[self.parameterAsEnum(parameters, self.BLENDING, context)],
+            blending=params.read_choice(self, parameters, self.BLENDING, context, self.BLENDINGS),
             output=output, per_image_folder=per_image, seamlines=seamlines, options=options,
             progress=FeedbackProgress(feedback))
         for w in result.warnings:

@@ -1,18 +1,14 @@
 """Orthorectify image: thin adapter over core.ortho.orthorectify_image."""
 from qgis.core import (
-    QgsProcessing,
     QgsProcessingException,
     QgsProcessingOutputNumber,
-    QgsProcessingParameterCrs,
-    QgsProcessingParameterEnum,
-    QgsProcessingParameterFeatureSource,
     QgsProcessingParameterFile,
-    QgsProcessingParameterNumber,
     QgsProcessingParameterRasterDestination,
     QgsProcessingParameterRasterLayer,
     QgsProcessingParameterVectorDestination,
 )
 
+from . import params
 from .base import AlgorithmBase, FeedbackProgress
 
 
@@ -61,29 +57,20 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
         self.addParameter(QgsProcessingParameterFile(
             self.IMAGE, self.tr("Image"), fileFilter="Images (*.jpg *.jpeg *.tif *.tiff *.png);;All files (*)"))
-        self.addParameter(QgsProcessingParameterRasterLayer(self.DSM, self.tr("DSM"), optional=True))
-        self.addParameter(QgsProcessingParameterFile(
-            self.GCPS, self.tr("Ground control file (gcp_list.txt or CSV)"), optional=True,
-            fileFilter="GCP files (*.txt *.csv);;All files (*)"))
-        self.addParameter(QgsProcessingParameterFeatureSource(
-            self.GCP_LAYER, self.tr("Ground control point layer (one feature per observation)"),
-            [QgsProcessing.TypeVectorPoint], optional=True))
-        self.addParameter(QgsProcessingParameterFile(
-            self.ORIENTATION, self.tr("Known orientation (x y z omega phi kappa)"), optional=True,
-            fileFilter="Orientation (*.txt *.csv *.json);;All files (*)"))
-        self.addParameter(QgsProcessingParameterNumber(
-            self.FOCAL_MM, self.tr("Focal length in mm (0 = from EXIF)"), type=QgsProcessingParameterNumber.Double,
-            defaultValue=0.0, minValue=0.0, optional=True))
-        self.addParameter(QgsProcessingParameterNumber(
-            self.SENSOR_WIDTH_MM, self.tr("Sensor width (long side) in mm"), type=QgsProcessingParameterNumber.Double,
-            defaultValue=0.0, minValue=0.0, optional=True))
-        self.addParameter(QgsProcessingParameterEnum(
-            self.MODE, self.tr("Mode"), options=list(self.MODE_LABELS), defaultValue=0))
-        self.addParameter(QgsProcessingParameterNumber(
-            self.RESOLUTION, self.tr("Resolution in CRS units (0 = ground sample distance)"),
-            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
-        self.addParameter(QgsProcessingParameterCrs(
-            self.CRS, self.tr("Output CRS (default: the GCPs' or orientation's CRS)"), optional=True))
+        params.add(
+            self,
+            QgsProcessingParameterRasterLayer(self.DSM, self.tr("DSM"), optional=True),
+            params.gcp_file(self.GCPS, self.tr("Ground control file (gcp_list.txt or CSV)")),
+            params.gcp_layer(self.GCP_LAYER, self.tr("Ground control point layer (one feature per observation)")),
+            QgsProcessingParameterFile(
+                self.ORIENTATION, self.tr("Known orientation (x y z omega phi kappa)"), optional=True,
+                fileFilter="Orientation (*.txt *.csv *.json);;All files (*)"),
+            params.number(self.FOCAL_MM, self.tr("Focal length in mm (0 = from EXIF)"), optional=True),
+            params.number(self.SENSOR_WIDTH_MM, self.tr("Sensor width (long side) in mm"), optional=True),
+            params.choice(self.MODE, self.tr("Mode"), self.MODE_LABELS),
+            params.number(self.RESOLUTION, self.tr("Resolution in CRS units (0 = ground sample distance)")),
+            params.target_crs(self.CRS, self.tr("Output CRS (default: the GCPs' or orientation's CRS)")),
+        )
         self.addParameter(QgsProcessingParameterRasterDestination(self.OUTPUT, self.tr("Orthophoto")))
         self.addParameter(QgsProcessingParameterVectorDestination(
             self.RESIDUALS, self.tr("GCP residuals"), optional=True, createByDefault=False))
@@ -92,23 +79,22 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
             "Planar rectification: 95th percentile of its offset from the true position (CRS units)")))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core.io import gcp as gcpmod
         from ..core.ortho import mosaic as ortho
 
         image = self.parameterAsFile(parameters, self.IMAGE, context)
         dsm_layer = self.parameterAsRasterLayer(parameters, self.DSM, context)
         dsm_path = dsm_layer.source() if dsm_layer is not None else None
-        gcps = self.parameterAsFile(parameters, self.GCPS, context) or None
-        source = self.parameterAsSource(parameters, self.GCP_LAYER, context)
-        if source is not None:
-            gcps = self._gcps_from_layer(source, gcpmod)
-        orientation = self.parameterAsFile(parameters, self.ORIENTATION, context) or None
+        gcps = params.read_optional_file(self, parameters, self.GCPS, context)
+        layer_gcps = params.read_gcp_layer(self, parameters, self.GCP_LAYER, context, self.tr(
+            "GCP layer {} lacks the field '{}' (needs name, image, px, py)"))
+        if layer_gcps is not None:
+            gcps = layer_gcps
+        orientation = params.read_optional_file(self, parameters, self.ORIENTATION, context)
         if gcps is None and orientation is None:
             raise QgsProcessingException(self.tr(
                 "Give ground control points observed in the image (GCPS or GCP_LAYER) or its orientation "
                 "(ORIENTATION)"))
-        crs = self.parameterAsCrs(parameters, self.CRS, context)
-        crs_text = (crs.authid() or crs.toWkt()) if crs.isValid() else None
+        crs_text = params.read_crs(self, parameters, self.CRS, context)
         residuals = self.parameterAsOutputLayer(parameters, self.RESIDUALS, context) or None
         if residuals and not residuals.lower().endswith(".gpkg"):
             raise QgsProcessingException(self.tr("RESIDUALS must be a GeoPackage (.gpkg) file, got {}").format(
@@ -118,7 +104,7 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
             dsm_path=dsm_path, gcps=gcps, orientation=orientation,
             focal_mm=self.parameterAsDouble(parameters, self.FOCAL_MM, context) or None,
             sensor_width_mm=self.parameterAsDouble(parameters, self.SENSOR_WIDTH_MM, context) or None,
-            mode=self.MODES[self.parameterAsEnum(parameters, self.MODE, context)], crs=crs_text,
+            mode=params.read_choice(self, parameters, self.MODE, context, self.MODES), crs=crs_text,
             resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context), residuals_path=residuals,
             progress=FeedbackProgress(feedback))
         for w in result.warnings:
@@ -129,23 +115,3 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
             feedback.pushInfo(self.tr("{} ({}): {:.2f} px").format(r["name"], r["role"], r["res_px"]))
         return {self.OUTPUT: result.output, self.RESIDUALS: result.residuals_path, self.RMSE_PX: result.rmse_px,
                 self.PLANAR_OFFSET_P95: (result.planar_error or {}).get("p95_m")}
-
-    def _gcps_from_layer(self, source, gcpmod):
-        fields = [f.name().lower() for f in source.fields()]
-        for need in ("name", "image", "px", "py"):
-            if need not in fields:
-                raise QgsProcessingException(self.tr(
-                    "GCP layer {} lacks the field '{}' (needs name, image, px, py)").format(source.sourceName(), need))
-        rows = []
-        for feat in source.getFeatures():
-            attrs = {k.lower(): feat[k] for k in source.fields().names()}
-            pt = feat.geometry().constGet()
-            z = attrs.get("z")
-            if z in (None, "") and pt is not None and pt.is3D():
-                z = pt.z()
-            rows.append(dict(attrs, x=pt.x(), y=pt.y(), z=z or 0.0))
-        crs = source.sourceCrs().authid() or source.sourceCrs().toWkt()
-        try:
-            return gcpmod.gcps_from_rows(rows, crs, source_name=source.sourceName())
-        except gcpmod.GCPError as e:
-            raise QgsProcessingException(str(e)) from e

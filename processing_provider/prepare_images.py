@@ -7,17 +7,14 @@ from qgis.core import (
     QgsProcessingOutputFile,
     QgsProcessingOutputFolder,
     QgsProcessingOutputNumber,
-    QgsProcessingParameterBoolean,
-    QgsProcessingParameterDefinition,
-    QgsProcessingParameterEnum,
     QgsProcessingParameterFeatureSource,
     QgsProcessingParameterFile,
     QgsProcessingParameterFolderDestination,
-    QgsProcessingParameterNumber,
     QgsProcessingParameterString,
     QgsWkbTypes,
 )
 
+from . import params
 from .base import AlgorithmBase, FeedbackProgress
 
 FIDUCIAL_TYPES = ["auto", "cross", "dot", "ring_dot", "cross_ring"]
@@ -79,42 +76,33 @@ class PrepareImagesAlgorithm(AlgorithmBase):
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
-        self.addParameter(QgsProcessingParameterFile(
-            self.IMAGES, self.tr("Folder of images"), behavior=QgsProcessingParameterFile.Folder))
-        self.addParameter(QgsProcessingParameterFolderDestination(self.WORKSPACE, self.tr("Workspace folder")))
-        self.addParameter(QgsProcessingParameterNumber(
-            self.BLUR_THRESHOLD, self.tr("Smallest blur score (0 = only relative to the set)"),
-            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
-        self.addParameter(QgsProcessingParameterBoolean(
-            self.EXCLUDE_FLAGGED, self.tr("Leave flagged images out of the prepared folder"), defaultValue=False))
+        params.add(
+            self,
+            params.folder(self.IMAGES, self.tr("Folder of images")),
+            params.workspace_destination(self.WORKSPACE, self.tr("Workspace folder")),
+            params.number(self.BLUR_THRESHOLD, self.tr("Smallest blur score (0 = only relative to the set)")),
+            params.flag(self.EXCLUDE_FLAGGED, self.tr("Leave flagged images out of the prepared folder")),
+        )
         self.addParameter(QgsProcessingParameterFeatureSource(
             self.MASKS, self.tr("Mask polygons: areas to ignore, in pixel coordinates (optional text field 'image')"),
             [QgsProcessing.TypeVectorPolygon], optional=True))
-        self.addParameter(QgsProcessingParameterBoolean(
-            self.SCANNED_FILM, self.tr("Scanned film: fiducial marks, common frame, masks"), defaultValue=False))
+        self.addParameter(params.flag(self.SCANNED_FILM, self.tr("Scanned film: fiducial marks, common frame, masks")))
         self.addParameter(QgsProcessingParameterString(
             self.FIDUCIAL_COORDINATES, self.tr("Calibrated fiducial coordinates in mm (file path or text)"),
             multiLine=True, optional=True))
-        self.addParameter(QgsProcessingParameterNumber(
-            self.FOCAL_LENGTH_MM, self.tr("Calibrated focal length in mm (0 = unknown)"),
-            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
-        advanced = [
-            QgsProcessingParameterNumber(
-                self.BLUR_RELATIVE, self.tr("Flag images below this fraction of the set's median blur score"),
-                type=QgsProcessingParameterNumber.Double, defaultValue=0.4, minValue=0.0, maxValue=1.0),
-            QgsProcessingParameterEnum(
-                self.FIDUCIAL_TYPE, self.tr("Fiducial mark type"), options=FIDUCIAL_TYPES, defaultValue=0),
-            QgsProcessingParameterEnum(
-                self.FIDUCIAL_LAYOUT, self.tr("Fiducial positions"), options=FIDUCIAL_LAYOUTS, defaultValue=0),
-            QgsProcessingParameterFile(
-                self.FIDUCIAL_TEMPLATE, self.tr("Template image of one fiducial mark"), optional=True),
-            QgsProcessingParameterNumber(
-                self.SCAN_DPI, self.tr("Scan resolution in dpi when not in the files (0 = from the files)"),
-                type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0),
-        ]
-        for p in advanced:
-            p.setFlags(p.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
-            self.addParameter(p)
+        params.add(
+            self,
+            params.number(self.FOCAL_LENGTH_MM, self.tr("Calibrated focal length in mm (0 = unknown)")),
+            *params.advanced(
+                params.number(self.BLUR_RELATIVE, self.tr(
+                    "Flag images below this fraction of the set's median blur score"), default=0.4, maxValue=1.0),
+                params.choice(self.FIDUCIAL_TYPE, self.tr("Fiducial mark type"), FIDUCIAL_TYPES),
+                params.choice(self.FIDUCIAL_LAYOUT, self.tr("Fiducial positions"), FIDUCIAL_LAYOUTS),
+                QgsProcessingParameterFile(
+                    self.FIDUCIAL_TEMPLATE, self.tr("Template image of one fiducial mark"), optional=True),
+                params.number(self.SCAN_DPI, self.tr(
+                    "Scan resolution in dpi when not in the files (0 = from the files)"))),
+        )
         self.addParameter(QgsProcessingParameterFolderDestination(
             self.OUTPUT, self.tr("Prepared images (skipped: <workspace>/prepared)"), optional=True,
             createByDefault=False))
@@ -140,8 +128,8 @@ class PrepareImagesAlgorithm(AlgorithmBase):
             ),
             scanned_film=scanned,
             scan=ScanOptions(
-                fiducial_type=FIDUCIAL_TYPES[self.parameterAsEnum(parameters, self.FIDUCIAL_TYPE, context)],
-                layout=FIDUCIAL_LAYOUTS[self.parameterAsEnum(parameters, self.FIDUCIAL_LAYOUT, context)],
+                fiducial_type=params.read_choice(self, parameters, self.FIDUCIAL_TYPE, context, FIDUCIAL_TYPES),
+                layout=params.read_choice(self, parameters, self.FIDUCIAL_LAYOUT, context, FIDUCIAL_LAYOUTS),
                 template_path=self.parameterAsFile(parameters, self.FIDUCIAL_TEMPLATE, context) or None,
                 fiducial_coordinates=(self.parameterAsString(parameters, self.FIDUCIAL_COORDINATES, context)
                                       or "").strip() or None,

@@ -20,21 +20,21 @@ class ArchaeoOrthoProvider(QgsProcessingProvider):
         return QIcon(os.path.join(os.path.dirname(os.path.dirname(__file__)), "icon.svg"))
 
     def loadAlgorithms(self):  # noqa: N802 (QGIS API name)
-        from .align_images import AlignImagesAlgorithm
-        from .build_dsm import BuildDsmAlgorithm
-        from .georeference import GeoreferenceAlgorithm
-        from .prepare_images import PrepareImagesAlgorithm
-
-        for alg in (AlignImagesAlgorithm(), GeoreferenceAlgorithm(), BuildDsmAlgorithm(), PrepareImagesAlgorithm()):
+        for alg in algorithms():
             self.addAlgorithm(alg)
-        from .accuracy_report import AccuracyReportAlgorithm
 
-        self.addAlgorithm(AccuracyReportAlgorithm())
-        from .build_orthophoto import BuildOrthophotoAlgorithm
-        from .orthorectify_image import OrthorectifyImageAlgorithm
 
-        for alg in (BuildOrthophotoAlgorithm(), OrthorectifyImageAlgorithm()):
-            self.addAlgorithm(alg)
-        from .run_pipeline import RunPipelineAlgorithm
+def algorithms():
+    """One instance of every algorithm, in toolbox order: the one list of them."""
+    from .accuracy_report import AccuracyReportAlgorithm
+    from .align_images import AlignImagesAlgorithm
+    from .build_dsm import BuildDsmAlgorithm
+    from .build_orthophoto import BuildOrthophotoAlgorithm
+    from .georeference import GeoreferenceAlgorithm
+    from .orthorectify_image import OrthorectifyImageAlgorithm
+    from .prepare_images import PrepareImagesAlgorithm
+    from .run_pipeline import RunPipelineAlgorithm
 
-        self.addAlgorithm(RunPipelineAlgorithm())
+    return [AlignImagesAlgorithm(), GeoreferenceAlgorithm(), BuildDsmAlgorithm(), PrepareImagesAlgorithm(),
+            AccuracyReportAlgorithm(), BuildOrthophotoAlgorithm(), OrthorectifyImageAlgorithm(),
+            RunPipelineAlgorithm()]

@@ -381,6 +381,14 @@ def load_cameras(path, project=None, group=None, name=None, workspace=None):
     return [lyr for lyr in out if lyr is not None]
 
 
+def workspace_layout(workspace):
+    """core.project.layout.Layout of a workspace folder: its product paths (no manifest needed for them)."""
+    from ..core.project.layout import Layout
+    from ..core.project.workspace import Workspace
+
+    return Layout(Workspace(workspace, {}))
+
+
 def footprints_path(workspace):
     """Write <workspace>/georef/footprints.gpkg for a georeferenced workspace; None when not possible."""
     try:
@@ -398,7 +406,7 @@ def footprints_path(workspace):
     if not z:
         return None
     prints = guided.image_footprints(rec, float(np.median(z)))
-    path = os.path.join(workspace, "georef", "footprints.gpkg")
+    path = workspace_layout(workspace).footprints_gpkg
     try:
         return guided.write_footprints_gpkg(path, prints, transform.get("offset", (0, 0, 0)), transform.get("crs"))
     except Exception:  # noqa: BLE001 - a missing GPKG driver must not stop the loading of the rest
@@ -439,11 +447,12 @@ def load_workspace_results(workspace, project=None, group=None):
     group = group or QCoreApplication.translate("ResultLayers", "ArchaeoOrtho: {}").format(
         os.path.basename(os.path.normpath(workspace)))
     loaded = []
+    lay = workspace_layout(workspace)
     candidates = [
-        (os.path.join(workspace, "dsm.tif"), load_dsm, {}),
-        (os.path.join(workspace, "orthomosaic.tif"), load_orthomosaic, {}),
-        (os.path.join(workspace, "cameras.gpkg"), load_cameras, {"workspace": workspace}),
-        (os.path.join(workspace, "georef", "residuals.gpkg"), load_residuals, {}),
+        (lay.default_dsm, load_dsm, {}),
+        (lay.default_orthomosaic, load_orthomosaic, {}),
+        (lay.cameras_gpkg, load_cameras, {"workspace": workspace}),
+        (lay.residuals_gpkg, load_residuals, {}),
     ]
     for path, fn, kw in candidates:
         if os.path.exists(path):

@@ -9,10 +9,9 @@ from qgis.PyQt.QtCore import QCoreApplication, QObject, pyqtSignal
 from qgis.PyQt.QtWidgets import QUndoCommand, QUndoStack
 
 from ..core.io import gcp as gcpmod
+from ..core.project.layout import Layout
+from ..core.project.stages import GEOREFERENCE
 from ..core.project.workspace import Workspace, atomic_write_text
-
-CONTROL_FILE = ("georef", "control.json")
-EDITOR_FILE = ("georef", "gcp_editor.json")  # dock settings of this workspace (DSM layer, tolerance)
 
 
 class _Snapshot(QUndoCommand):
@@ -58,12 +57,17 @@ class GcpStore(QObject):
     def root(self):
         return self.workspace.root if self.workspace is not None else None
 
+    @property
+    def layout(self):
+        """Where the workspace's products live (core.project.layout.Layout), None without a workspace."""
+        return Layout(self.workspace) if self.workspace is not None else None
+
     def open(self, path):
         """Open a workspace folder (raises core.workspace.WorkspaceError)."""
         ws = Workspace.open(path)
         self.workspace = ws
         self.gcps = self._load_control(ws)
-        self.settings = self._load_json(ws.path(*EDITOR_FILE)) or {}
+        self.settings = self._load_json(Layout(ws).editor_json) or {}
         self.undo_stack.clear()
         self.stale = set()
         self.load_residuals()
@@ -86,7 +90,7 @@ class GcpStore(QObject):
             return None
 
     def _load_control(self, ws):
-        data = self._load_json(ws.path(*CONTROL_FILE))
+        data = self._load_json(Layout(ws).control_json)
         if data:
             gs = gcpmod.GCPSet.from_dict(data)
         else:
@@ -120,25 +124,27 @@ class GcpStore(QObject):
     def save(self):
         if self.workspace is None:
             return
-        self.workspace.subdir("georef")
+        lay = self.layout
+        os.makedirs(lay.georef_dir, exist_ok=True)
         data = self.gcps.to_dict()
         data["warnings"] = []
-        atomic_write_text(self.workspace.path(*CONTROL_FILE), json.dumps(data, indent=1))
+        atomic_write_text(lay.control_json, json.dumps(data, indent=1))
 
     def save_settings(self, **values):
         self.settings.update(values)
         if self.workspace is None:
             return
-        self.workspace.subdir("georef")
-        atomic_write_text(self.workspace.path(*EDITOR_FILE), json.dumps(self.settings, indent=1))
+        lay = self.layout
+        os.makedirs(lay.georef_dir, exist_ok=True)
+        atomic_write_text(lay.editor_json, json.dumps(self.settings, indent=1))
 
     # --- residuals of the last adjustment
     def load_residuals(self):
         self.residuals, self.figures = {}, {}
-        if self.workspace is not None and self.workspace.stage_done("georeference"):
-            data = self._load_json(self.workspace.path("georef", "residuals.json")) or {}
+        if self.workspace is not None and self.workspace.stage_done(GEOREFERENCE):
+            data = self._load_json(self.layout.residuals_json) or {}
             self.residuals = {p["name"]: p for p in data.get("points", [])}
-            self.figures = dict(self.workspace.stage("georeference").get("results") or {})
+            self.figures = dict(self.workspace.stage(GEOREFERENCE).get("results") or {})
         self.stale = set()
         self.residualsChanged.emit()
 

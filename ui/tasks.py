@@ -1,5 +1,7 @@
 """Core stages as QgsTasks: progress in the task manager and the dock, cancel within seconds, the UI
 stays responsive.  The result (or the error) is handed to callbacks in the main thread."""
+import traceback
+
 from qgis.core import Qgis, QgsApplication, QgsMessageLog, QgsTask
 from qgis.PyQt.QtCore import pyqtSignal
 
@@ -49,6 +51,7 @@ class CoreTask(QgsTask):
         self.progress_adapter = TaskProgress(self)
 
     def run(self):
+        from ..core.common.errors import user_message
         from ..core.common.progress import Cancelled
 
         try:
@@ -58,7 +61,11 @@ class CoreTask(QgsTask):
             self.was_cancelled = True
             self.error = str(e) or "cancelled"
         except Exception as e:  # noqa: BLE001 - every failure is reported to the user, not raised in a thread
-            self.error = f"{type(e).__name__}: {e}" if not str(e) else str(e)
+            message = user_message(e)
+            if message is None:  # a bug: the traceback goes to the log, the user sees the exception
+                log_traceback(self.description(), e)
+                message = f"{type(e).__name__}: {e}" if not str(e) else str(e)
+            self.error = message
             self.was_cancelled = self.isCanceled()
         return False
 
@@ -72,6 +79,26 @@ class CoreTask(QgsTask):
                 self.on_error(self.error or "cancelled", self.was_cancelled)
         except RuntimeError as e:  # the dock was closed (plugin unloaded) while the task ran
             QgsMessageLog.logMessage(f"{self.description()}: {e}", "ArchaeoOrtho", Qgis.Warning)
+        except Exception as e:  # noqa: BLE001 - an exception escaping a C++ virtual would abort QGIS
+            log_traceback(self.description(), e)
+            _tell_user(self.description(), e)
+
+
+def log_traceback(what, error):
+    """The full traceback of an unexpected exception in QGIS's message log (tab ArchaeoOrtho)."""
+    text = "".join(traceback.format_exception(type(error), error, error.__traceback__))
+    QgsMessageLog.logMessage(f"{what}: {text}", "ArchaeoOrtho", Qgis.Critical)
+
+
+def _tell_user(what, error):
+    """A message bar entry where QGIS has an interface (the log has the details)."""
+    try:
+        from qgis.utils import iface
+
+        if iface is not None and iface.messageBar() is not None:
+            iface.messageBar().pushCritical("ArchaeoOrtho", f"{what}: {type(error).__name__}: {error}")
+    except Exception:  # noqa: BLE001 - telling the user must not fail in turn
+        pass
 
 
 def start(task):
