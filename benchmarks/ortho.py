@@ -186,7 +186,7 @@ def build_workspace(ws_dir):
 
 def mosaic_only(args):
     """Child process of the RSS measurement: one orthomosaic, prints JSON."""
-    from core.ortho import mosaic as ortho
+    from core import ortho
 
     t0 = time.time()
     res = ortho.build_orthophoto_workspace(args.workspace, dsm_path=args.dsm, resolution=args.resolution,
@@ -271,7 +271,7 @@ def main():
     if args.mosaic_only:
         return mosaic_only(args)
 
-    from core.ortho import mosaic as ortho
+    from core import ortho
     from core.project.workspace import Workspace
 
     os.makedirs(args.out, exist_ok=True)

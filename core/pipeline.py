@@ -289,7 +289,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, *, align_options=None, gcp
     StageError naming what to give."""
     from .align import sfm
     from .dense import matching as dense
-    from .ortho import mosaic as ortho
+    from .ortho import stage as ortho
     from .report import stage as reportmod
 
     progress = progress or NullProgress()

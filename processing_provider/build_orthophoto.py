@@ -86,7 +86,7 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
         self.addOutput(QgsProcessingOutputNumber(self.IMAGES_USED, self.tr("Images in the mosaic")))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core.ortho import mosaic as ortho
+        from ..core import ortho
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         dsm_layer = self.parameterAsRasterLayer(parameters, self.DSM, context)

@@ -79,7 +79,7 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
             "Planar rectification: 95th percentile of its offset from the true position (CRS units)")))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core.ortho import mosaic as ortho
+        from ..core.ortho import single as ortho
 
         image = self.parameterAsFile(parameters, self.IMAGE, context)
         dsm_layer = self.parameterAsRasterLayer(parameters, self.DSM, context)

@@ -125,7 +125,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
         from ..core.align import sfm
         from ..core.dense import matching as dense
         from ..core.io import gcp as gcpmod
-        from ..core.ortho import mosaic as ortho
+        from ..core.ortho import options as ortho
 
         p = parameters
         gcps = None

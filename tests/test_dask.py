@@ -6,10 +6,10 @@ import shutil
 import numpy as np
 import pytest
 
+from core import ortho
 from core.common import parallel
 from core.dense import matching as dense
 from core.io import raster as dsm
-from core.ortho import mosaic as ortho
 from tests import synthetic as syn
 from tests.test_dense import CAMERA, make_workspace
 

@@ -17,7 +17,13 @@ from core.common.progress import Cancelled, NullProgress
 from core.geometry import camera as gcam
 from core.io import gcp as gcpmod
 from core.io import raster as dsmmod
-from core.ortho import mosaic as ortho
+from core.ortho import seams
+from core.ortho.cameras import OrthoCamera, select_cameras
+from core.ortho.options import OrthoError, OrthoOptions
+from core.ortho.orientation import read_orientation
+from core.ortho.single import orthorectify_image
+from core.ortho.stage import build_orthophoto_workspace
+from core.ortho.surface import fill_dsm_gaps
 from core.project.workspace import DONE, Workspace
 from tests import synthetic as syn
 
@@ -69,7 +75,7 @@ def scene(tmp_path_factory):
 @pytest.fixture(scope="module")
 def mosaic(scene):
     block, root, _images, dsm, ws = scene
-    res = ortho.build_orthophoto_workspace(ws, dsm_path=dsm, blending="feather",
+    res = build_orthophoto_workspace(ws, dsm_path=dsm, blending="feather",
                                            per_image_folder=os.path.join(ws, "ortho"),
                                            seamlines=os.path.join(ws, "seamlines.gpkg"))
     return res
@@ -297,7 +303,7 @@ def test_masked_pixels_stay_nodata(scene, tmp_path):
     mask = np.full((CAMERA.height, CAMERA.width), 255, np.uint8)
     mask[:, : CAMERA.width // 2] = 0
     cv2.imwrite(os.path.join(ws, "masks", "S2_02.jpg.png"), mask)
-    res = ortho.build_orthophoto_workspace(ws, dsm_path=dsm, resolution=0.2, images_filter="S2_02.jpg",
+    res = build_orthophoto_workspace(ws, dsm_path=dsm, resolution=0.2, images_filter="S2_02.jpg",
                                            per_image_folder=str(tmp_path / "per"))
     a, gt = _read(os.path.join(str(tmp_path / "per"), "S2_02.tif"))
     h, w = a.shape[1:]
@@ -326,28 +332,28 @@ def test_subset_multiband_and_options(scene, tmp_path):
     """A subset by wildcard, multi-band blending, coarser resolution; all-images filter errors are clear."""
     block, _root, _images, dsm, ws = scene
     out = str(tmp_path / "strip2.tif")
-    res = ortho.build_orthophoto_workspace(ws, dsm_path=dsm, images_filter="S2_*, !S2_05.jpg", resolution=0.25,
+    res = build_orthophoto_workspace(ws, dsm_path=dsm, images_filter="S2_*, !S2_05.jpg", resolution=0.25,
                                            blending="multiband", output=out)
     assert sorted(res.images) == [f"S2_0{i}.jpg" for i in range(1, 5)]
     assert res.resolution == 0.25
     ground, cell = _ground_shifts(block, out, count=40, n=16)
     assert len(ground) >= 20 and _rmse(ground) * cell <= block.gsd
-    with pytest.raises(ortho.OrthoError, match="matches none"):
-        ortho.build_orthophoto_workspace(ws, dsm_path=dsm, images_filter="NIR_*", output=str(tmp_path / "x.tif"))
+    with pytest.raises(OrthoError, match="matches none"):
+        build_orthophoto_workspace(ws, dsm_path=dsm, images_filter="NIR_*", output=str(tmp_path / "x.tif"))
 
 
 def test_select_cameras_by_name_wildcard_and_group():
-    cams = [ortho.OrthoCamera(n, n, gcam.Intrinsics.simple(10, 10, 10), gcam.Pose(np.eye(3), np.zeros(3)), cid)
+    cams = [OrthoCamera(n, n, gcam.Intrinsics.simple(10, 10, 10), gcam.Pose(np.eye(3), np.zeros(3)), cid)
             for n, cid in (("a1.jpg", 1), ("a2.jpg", 1), ("n1.tif", 2), ("n2.tif", 2))]
     groups = [{"camera_id": 1, "model": "FC300X", "images": ["a1.jpg", "a2.jpg"]},
               {"camera_id": 2, "model": "Sequoia NIR", "images": ["n1.tif", "n2.tif"]}]
-    names = lambda f: [c.name for c in ortho.select_cameras(cams, f, groups)]  # noqa: E731
+    names = lambda f: [c.name for c in select_cameras(cams, f, groups)]  # noqa: E731
     assert names("") == ["a1.jpg", "a2.jpg", "n1.tif", "n2.tif"]
     assert names("A*.JPG") == ["a1.jpg", "a2.jpg"]
     assert names("group:nir") == ["n1.tif", "n2.tif"]
     assert names("group:1; n2.tif") == ["a1.jpg", "a2.jpg", "n2.tif"]
     assert names("*, !a2.jpg") == ["a1.jpg", "n1.tif", "n2.tif"]
-    with pytest.raises(ortho.OrthoError, match="matches none"):
+    with pytest.raises(OrthoError, match="matches none"):
         names("zzz*")
 
 
@@ -363,9 +369,9 @@ def test_seamlines_move_to_where_the_images_agree():
     other[:, 17:24] += 80.0
     labels = np.where(x < 20, 0, 1).astype(np.int32)
     windows = [(0, 0, h, w), (0, 0, h, w)]
-    before = ortho._seam_disagreement(labels, windows, [base, other], 255.0)
-    moved = ortho._refine_seams(labels, windows, costs, [base, other], 255.0, 10)
-    after = ortho._seam_disagreement(moved, windows, [base, other], 255.0)
+    before = seams._seam_disagreement(labels, windows, [base, other], 255.0)
+    moved = seams._refine_seams(labels, windows, costs, [base, other], 255.0, 10)
+    after = seams._seam_disagreement(moved, windows, [base, other], 255.0)
     cols = [int(np.flatnonzero(row == 1)[0]) for row in moved]
     assert all(c <= 17 or c >= 24 for c in cols), cols
     assert after < 0.2 * before
@@ -386,8 +392,8 @@ def _shifted_dsm(src, dst, dx=0.0, fill=None, crs=None):
 def test_dsm_that_does_not_cover_the_images_is_refused(scene, tmp_path):
     _block, _root, _images, dsm, ws = scene
     far = _shifted_dsm(dsm, str(tmp_path / "far.tif"), dx=20000.0)
-    with pytest.raises(ortho.OrthoError, match="does not cover"):
-        ortho.build_orthophoto_workspace(ws, dsm_path=far, output=str(tmp_path / "m.tif"))
+    with pytest.raises(OrthoError, match="does not cover"):
+        build_orthophoto_workspace(ws, dsm_path=far, output=str(tmp_path / "m.tif"))
     assert Workspace.open(ws).stage("orthophoto")["status"] == "failed"
     assert not os.path.exists(tmp_path / "m.tif")
 
@@ -395,8 +401,8 @@ def test_dsm_that_does_not_cover_the_images_is_refused(scene, tmp_path):
 def test_all_nodata_dsm_is_refused(scene, tmp_path):
     _block, _root, _images, dsm, ws = scene
     empty = _shifted_dsm(dsm, str(tmp_path / "empty.tif"), fill=np.nan)
-    with pytest.raises(ortho.OrthoError, match="no valid height"):
-        ortho.build_orthophoto_workspace(ws, dsm_path=empty, output=str(tmp_path / "m.tif"))
+    with pytest.raises(OrthoError, match="no valid height"):
+        build_orthophoto_workspace(ws, dsm_path=empty, output=str(tmp_path / "m.tif"))
 
 
 def test_partial_dsm_warns_and_leaves_nodata(scene, tmp_path):
@@ -405,7 +411,7 @@ def test_partial_dsm_warns_and_leaves_nodata(scene, tmp_path):
     z[:, : z.shape[1] // 2] = np.nan  # the western half has no height
     half = dsmmod.write_cog(str(tmp_path / "half.tif"), z, gt, syn.CRS)
     ws2 = make_workspace(str(tmp_path / "ws"), block, scene[2], names=["S2_01.jpg", "S2_02.jpg", "S2_05.jpg"])
-    res = ortho.build_orthophoto_workspace(ws2, dsm_path=half, resolution=0.3)
+    res = build_orthophoto_workspace(ws2, dsm_path=half, resolution=0.3)
     assert any("less than half" in w for w in res.warnings)
     assert 0.05 < res.valid_fraction < 0.9
 
@@ -432,28 +438,28 @@ def test_dsm_gaps_inside_the_data_are_filled_for_the_orthophoto(scene, tmp_path)
         c, r = int((centre_x - g[0]) / g[1]), int((centre_y - g[3]) / g[5])
         return ds.GetRasterBand(ds.RasterCount).ReadAsArray(c - 2, r - 2, 5, 5)
 
-    res = ortho.build_orthophoto_workspace(ws2, dsm_path=holed, resolution=0.3, output=str(tmp_path / "filled.tif"))
+    res = build_orthophoto_workspace(ws2, dsm_path=holed, resolution=0.3, output=str(tmp_path / "filled.tif"))
     assert any("DSM gaps" in line and "interpolated" in line for line in res.log_lines), res.log_lines
     assert (alpha_at_centre(res.orthomosaic) > 0).all()
-    off = ortho.build_orthophoto_workspace(ws2, dsm_path=holed, resolution=0.3, output=str(tmp_path / "off.tif"),
-                                           options=ortho.OrthoOptions(fill_dsm_gaps_m=0.0))
+    off = build_orthophoto_workspace(ws2, dsm_path=holed, resolution=0.3, output=str(tmp_path / "off.tif"),
+                                           options=OrthoOptions(fill_dsm_gaps_m=0.0))
     assert (alpha_at_centre(off.orthomosaic) == 0).all()
     assert open(holed, "rb").read() == before
     # the hull rule: a DSM covering half of the area is not extended (test_partial_dsm_warns_and_leaves_nodata)
-    path, n = ortho.fill_dsm_gaps(holed, str(tmp_path / "f.tif"), 25.0)
+    path, n = fill_dsm_gaps(holed, str(tmp_path / "f.tif"), 25.0)
     assert n == int(hole.sum()) and path != holed
 
 
 def test_workspace_without_georeference_or_dsm_is_refused(scene, tmp_path):
     block = scene[0]
     ws = make_workspace(str(tmp_path / "ws"), block, scene[2], names=["S2_01.jpg", "S2_02.jpg"])
-    with pytest.raises(ortho.OrthoError, match="no DSM"):
-        ortho.build_orthophoto_workspace(ws)
+    with pytest.raises(OrthoError, match="no DSM"):
+        build_orthophoto_workspace(ws)
     w = Workspace.open(ws)
     w.data["stages"]["georeference"] = {"status": "pending"}
     w.save()
-    with pytest.raises(ortho.OrthoError, match="not georeferenced"):
-        ortho.build_orthophoto_workspace(ws, dsm_path=scene[3])
+    with pytest.raises(OrthoError, match="not georeferenced"):
+        build_orthophoto_workspace(ws, dsm_path=scene[3])
 
 
 class _CancelAfter(NullProgress):
@@ -473,8 +479,8 @@ def test_cancel_leaves_no_mosaic(scene, tmp_path):
     block, _root, images, dsm, _ws = scene
     ws = make_workspace(str(tmp_path / "ws"), block, images, names=["S2_02.jpg", "S2_03.jpg", "S2_04.jpg"])
     with pytest.raises(Cancelled):
-        ortho.build_orthophoto_workspace(ws, dsm_path=dsm, resolution=0.2,
-                                         options=ortho.OrthoOptions(tile=64), progress=_CancelAfter(2))
+        build_orthophoto_workspace(ws, dsm_path=dsm, resolution=0.2,
+                                         options=OrthoOptions(tile=64), progress=_CancelAfter(2))
     assert Workspace.open(ws).stage("orthophoto")["status"] == "cancelled"
     assert not [n for n in os.listdir(ws) if n.endswith(".tif") or n.startswith(".")]
 
@@ -514,7 +520,7 @@ def test_single_image_by_resection_registers_to_the_truth_and_the_mosaic(scene, 
     block, _root, images, dsm, _ws = scene
     gcps = _image_gcps(block, SINGLE, 12, bad=4)
     out = str(tmp_path / "single.tif")
-    r = ortho.orthorectify_image(os.path.join(images, SINGLE), out, dsm, gcps=gcps, focal_px=331.0,
+    r = orthorectify_image(os.path.join(images, SINGLE), out, dsm, gcps=gcps, focal_px=331.0,
                                  residuals_path=str(tmp_path / "res.gpkg"))
     assert r.source == "resection" and r.outliers == ["T5"]
     assert r.rmse_px < 0.8
@@ -567,7 +573,7 @@ def test_single_image_with_known_orientation_and_a_dsm_in_another_crs(scene, tmp
     dsm3035 = str(tmp_path / "dsm_3035.tif")
     gdal.Warp(dsm3035, dsm, dstSRS="EPSG:3035", resampleAlg="bilinear")
     out = str(tmp_path / "single16.tif")
-    r = ortho.orthorectify_image(img16, out, dsm3035, orientation=str(orient))
+    r = orthorectify_image(img16, out, dsm3035, orientation=str(orient))
     assert r.source == "orientation" and any("reprojected" in line for line in r.log_lines)
     ds = gdal.Open(out)
     assert ds.RasterCount == 2 and ds.GetRasterBand(1).DataType == gdal.GDT_UInt16
@@ -582,7 +588,7 @@ def test_single_image_with_known_orientation_and_a_dsm_in_another_crs(scene, tmp
 def test_planar_rectification_and_how_far_it_is_off(scene, tmp_path):
     block, _root, images, dsm, _ws = scene
     gcps = _image_gcps(block, SINGLE, 8)
-    r = ortho.orthorectify_image(os.path.join(images, SINGLE), str(tmp_path / "planar.tif"), dsm, gcps=gcps,
+    r = orthorectify_image(os.path.join(images, SINGLE), str(tmp_path / "planar.tif"), dsm, gcps=gcps,
                                  focal_px=325.0, mode="planar", residuals_path=str(tmp_path / "res.gpkg"))
     assert r.mode == "planar" and r.planar_rmse_m < 0.5
     pe = r.planar_error
@@ -596,14 +602,14 @@ def test_planar_rectification_and_how_far_it_is_off(scene, tmp_path):
 def test_too_few_gcps_name_how_many_are_needed(scene, tmp_path):
     _block, _root, images, dsm, _ws = scene
     gcps = _image_gcps(scene[0], SINGLE, 3)
-    with pytest.raises(ortho.OrthoError, match=r"at least 4 ground control points .* found 3"):
-        ortho.orthorectify_image(os.path.join(images, SINGLE), str(tmp_path / "o.tif"), dsm, gcps=gcps,
+    with pytest.raises(OrthoError, match=r"at least 4 ground control points .* found 3"):
+        orthorectify_image(os.path.join(images, SINGLE), str(tmp_path / "o.tif"), dsm, gcps=gcps,
                                  focal_px=325.0)
-    with pytest.raises(ortho.OrthoError, match="needs a DSM"):
-        ortho.orthorectify_image(os.path.join(images, SINGLE), str(tmp_path / "o.tif"), None, gcps=gcps)
+    with pytest.raises(OrthoError, match="needs a DSM"):
+        orthorectify_image(os.path.join(images, SINGLE), str(tmp_path / "o.tif"), None, gcps=gcps)
     gcps.points[0].observations[0].image = "another.jpg"
-    with pytest.raises(ortho.OrthoError, match="found 2"):
-        ortho.orthorectify_image(os.path.join(images, SINGLE), str(tmp_path / "o.tif"), dsm, gcps=gcps,
+    with pytest.raises(OrthoError, match="found 2"):
+        orthorectify_image(os.path.join(images, SINGLE), str(tmp_path / "o.tif"), dsm, gcps=gcps,
                                  focal_px=325.0, mode="planar")
     assert not os.path.exists(tmp_path / "o.tif")
 
@@ -612,15 +618,15 @@ def test_orientation_files_are_read(tmp_path):
     p = tmp_path / "o.json"
     p.write_text(json.dumps({"images": {"A.JPG": {"X": 1, "Y": 2, "Z": 3, "omega": 0.5, "phi": 1, "kappa": 90}},
                              "crs": "EPSG:32617", "focal_mm": 8.8, "sensor_width_mm": 13.2}))
-    o = ortho.read_orientation(str(p), "a.jpg")
+    o = read_orientation(str(p), "a.jpg")
     assert o["x"] == 1 and o["kappa"] == 90 and o["crs"] == "EPSG:32617" and o["focal_mm"] == 8.8
     q = tmp_path / "o.txt"
     q.write_text("EPSG:32617\n500000, 4600000, 150, 1, 2, 3\n")
-    o = ortho.read_orientation(str(q), "whatever.jpg")
+    o = read_orientation(str(q), "whatever.jpg")
     assert o["z"] == 150 and o["phi"] == 2 and o["crs"] == "EPSG:32617"
     q.write_text("x y z omega\n1 2 3 4\n")
-    with pytest.raises(ortho.OrthoError, match="lacks phi, kappa"):
-        ortho.read_orientation(str(q), "a.jpg")
+    with pytest.raises(OrthoError, match="lacks phi, kappa"):
+        read_orientation(str(q), "a.jpg")
 
 
 # ---------------------------------------------------------------------------

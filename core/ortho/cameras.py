@@ -1,0 +1,99 @@
+"""The images to orthorectify: their orientation in the local frame, from a model, chosen by IMAGES_FILTER."""
+from __future__ import annotations
+
+import fnmatch
+import os
+from collections import OrderedDict
+from dataclasses import dataclass
+from typing import List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from ..geometry.camera import Intrinsics, Pose
+from ..prepare.masks import find_mask
+from .options import OrthoError
+
+
+@dataclass
+class OrthoCamera:
+    """One image with its orientation in the local frame (world = local + offset)."""
+
+    name: str
+    path: str
+    camera: Intrinsics
+    pose: Pose
+    camera_id: int = 0
+    mask_path: Optional[str] = None
+
+    @property
+    def centre(self) -> np.ndarray:
+        return self.pose.centre
+
+    def project(self, xyz_local: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(pixels (N, 2), depth (N,), ok (N,): in front, trusted by the lens model and inside the image)."""
+        xc = self.pose.to_camera(xyz_local)
+        px, ok = self.camera.project(xc)
+        ok &= self.camera.inside(px) & np.all(np.isfinite(px), axis=-1)
+        return px, xc[..., 2], ok
+
+
+def cameras_from_reconstruction(rec, images_dir: str, masks_dir: Optional[str] = None) -> List[OrthoCamera]:
+    """OrthoCameras of the registered images of a pycolmap.Reconstruction (its frame = the local frame)."""
+    out = []
+    for im in sorted(rec.images.values(), key=lambda i: i.name):
+        if not im.has_pose:
+            continue
+        cam = rec.cameras[im.camera_id]
+        p = im.cam_from_world()
+        pose = Pose(np.asarray(p.rotation.matrix(), dtype=float), np.asarray(p.translation, dtype=float))
+        out.append(OrthoCamera(im.name, os.path.join(images_dir or "", im.name), Intrinsics.from_pycolmap(cam), pose,
+                               int(im.camera_id), find_mask(masks_dir, im.name)))
+    return out
+
+
+def select_cameras(cameras: Sequence[OrthoCamera], images_filter: Optional[str],
+                   camera_groups: Sequence[dict] = ()) -> List[OrthoCamera]:
+    """The cameras an IMAGES_FILTER names.
+
+    The filter is a list separated by commas, semicolons or new lines; each item is an image name, a wildcard
+    (``DJI_00*.JPG``, case-insensitive), or ``group:<n>`` / ``group:<text>`` for a camera group by id or by a
+    part of its make, model or key (``group:2``, ``group:FC300X``, ``group:NIR``).  An item starting with ``!``
+    removes what it matches.  Empty: all."""
+    if not images_filter or not images_filter.strip():
+        return list(cameras)
+    items = [s.strip() for s in images_filter.replace(";", ",").replace("\n", ",").split(",") if s.strip()]
+    chosen: "OrderedDict[str, OrthoCamera]" = OrderedDict()
+    positive = [i for i in items if not i.startswith("!")]
+    negative = [i[1:].strip() for i in items if i.startswith("!")]
+    unmatched = []
+
+    def matches(item: str) -> List[OrthoCamera]:
+        if item.lower().startswith("group:"):
+            key = item.split(":", 1)[1].strip().lower()
+            ids = set()
+            for g in camera_groups:
+                gid = str(g.get("camera_id", ""))
+                text = " ".join(str(g.get(k, "")) for k in ("key", "make", "model")).lower()
+                if key == gid or (key and key in text):
+                    ids.add(int(g.get("camera_id")))
+            names = {n for g in camera_groups if int(g.get("camera_id", -1)) in ids for n in g.get("images", [])}
+            return [c for c in cameras if c.camera_id in ids or c.name in names]
+        pat = item.lower()
+        return [c for c in cameras if fnmatch.fnmatchcase(c.name.lower(), pat)
+                or fnmatch.fnmatchcase(os.path.basename(c.name).lower(), pat)]
+
+    for item in positive or ["*"]:
+        found = matches(item)
+        if not found:
+            unmatched.append(item)
+        for c in found:
+            chosen[c.name] = c
+    for item in negative:
+        for c in matches(item):
+            chosen.pop(c.name, None)
+    if not chosen:
+        examples = ", ".join(c.name for c in list(cameras)[:5])
+        groups = ", ".join(f"{g.get('camera_id')}: {g.get('model') or g.get('key')}" for g in camera_groups)
+        raise OrthoError(f"IMAGES_FILTER {images_filter!r} matches none of the {len(cameras)} oriented images "
+                         f"(for example {examples}{'; camera groups ' + groups if groups else ''})")
+    return list(chosen.values())

@@ -1,0 +1,74 @@
+"""The options of the orthophoto stage and of single-image orthorectification (defaults in one place),
+and the error they raise."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Optional
+
+from ..common.errors import ArchaeoOrthoError
+from ..geometry.camera import Intrinsics
+
+
+class OrthoError(ArchaeoOrthoError, RuntimeError):
+    """Orthophoto production cannot run with this input; the message says why."""
+
+
+BLENDINGS = ("feather", "multiband", "none")
+INTERPOLATIONS = ("bilinear", "cubic", "nearest")
+MODES = ("ortho", "planar")
+
+
+@dataclass
+class OrthoOptions:
+    """Options of the orthophoto stage (one dataclass, as OpenSfM's config)."""
+
+    resolution: float = 0.0  # output cell size in CRS units; 0 = the images' median ground sample distance
+    blending: str = "feather"  # feather / multiband / none
+    interpolation: str = "bilinear"  # bilinear / cubic / nearest
+    tile: int = 512  # output cells per tile side
+    feather_gsd: float = 16.0  # width of the feathering ramp across a seam, in GSD
+    occlusion: bool = True  # leave cells hidden from a camera nodata (true orthophoto)
+    height_tolerance: float = 0.0  # m below the sight line still counted visible; 0 = max(0.1, DSM cell)
+    fill_dsm_gaps_m: float = 25.0  # DSM gaps inside the data's hull, up to this far from a height, interpolated
+    exposure: bool = True  # per-image gain compensation in the mosaic
+    avoid_relief: bool = True  # keep seamlines off buildings and trees
+    seam_iterations: int = 2  # passes moving the seamlines towards where the images agree (0 = off)
+    seam_alpha: float = 5.0  # weight of the view cost against the seam cost in those moves
+    relief_height: float = 1.5  # m above the surroundings that makes an object seams go around
+    compress: str = "DEFLATE"
+    cache_mb: int = 256  # decoded images + visibility tables kept in memory
+    workers: int = 1  # tile workers (core.parallel); 0 = one per core
+    scheduler: Optional[str] = None  # Dask scheduler address
+
+    def check(self) -> None:
+        if self.blending not in BLENDINGS:
+            raise OrthoError(f"unknown BLENDING {self.blending!r}; choose one of {', '.join(BLENDINGS)}")
+        if self.interpolation not in INTERPOLATIONS:
+            raise OrthoError(f"unknown interpolation {self.interpolation!r}; choose one of {', '.join(INTERPOLATIONS)}")
+        if self.resolution is None or not math.isfinite(self.resolution) or self.resolution < 0:
+            raise OrthoError(f"RESOLUTION must be 0 (the ground sample distance) or a positive number of metres, "
+                             f"got {self.resolution}")
+        if self.tile < 64:
+            raise OrthoError(f"tile size must be at least 64 cells, got {self.tile}")
+
+
+@dataclass
+class SingleImageOptions:
+    """How one image is oriented and rectified by :func:`core.ortho.single.orthorectify_image` (its keywords of the
+    same names; OrthoOptions holds the rest: resolution, interpolation, occlusion, compression ...)."""
+
+    mode: str = "ortho"  # ortho: true orthophoto on the DSM / planar: projective, through the control points
+    crs: Optional[str] = None  # working CRS; None = the GCPs', else the orientation's, else the DSM's
+    focal_mm: Optional[float] = None  # with sensor_width_mm (the sensor's long side): the focal length
+    sensor_width_mm: Optional[float] = None
+    focal_px: Optional[float] = None
+    estimate_intrinsics: Any = "auto"  # True / False / "auto" (not with a calibrated camera)
+    mask_path: Optional[str] = None  # white = use
+    camera: Optional[Intrinsics] = None  # a calibrated interior orientation, kept unless estimate_intrinsics
+    residuals_path: Optional[str] = None  # GeoPackage of the GCP residuals
+
+    def check(self) -> None:
+        self.mode = (self.mode or "ortho").lower()
+        if self.mode not in MODES:
+            raise OrthoError(f"unknown MODE {self.mode!r}; choose one of {', '.join(MODES)}")

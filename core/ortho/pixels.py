@@ -1,0 +1,141 @@
+"""Pixels of the source images: metadata, windows, masks, the byte-bounded cache that holds them, and
+cv2.remap of scattered coordinates (bilinear / cubic / nearest)."""
+from __future__ import annotations
+
+from collections import OrderedDict
+from dataclasses import dataclass
+from typing import Any, Optional, Tuple
+
+import numpy as np
+
+from ..common.errors import require
+from .options import OrthoError
+
+
+class _LRU:
+    """A byte-bounded least-recently-used cache."""
+
+    def __init__(self, max_bytes: int):
+        self.max_bytes = max_bytes
+        self.items: "OrderedDict[Any, Tuple[Any, int]]" = OrderedDict()
+        self.size = 0
+
+    def get(self, key, make):
+        if key in self.items:
+            self.items.move_to_end(key)
+            return self.items[key][0]
+        value, nbytes = make()
+        self.items[key] = (value, nbytes)
+        self.size += nbytes
+        while self.size > self.max_bytes and len(self.items) > 1:
+            _, (_, nb) = self.items.popitem(last=False)
+            self.size -= nb
+        return value
+
+    def clear(self):
+        self.items.clear()
+        self.size = 0
+
+
+_CACHE = _LRU(256 << 20)
+_WHOLE_IMAGE_MAX = 96 << 20  # images up to this size are decoded whole and cached; larger ones read by window
+
+
+def _gdal():
+    from osgeo import gdal
+
+    gdal.UseExceptions()
+    return gdal
+
+
+@dataclass
+class ImageMeta:
+    width: int
+    height: int
+    bands: int
+    dtype: str  # numpy dtype name
+
+
+def image_meta(path: str) -> ImageMeta:
+    gdal = _gdal()
+    from osgeo import gdal_array
+
+    try:
+        ds = gdal.Open(path)
+    except RuntimeError as e:
+        raise OrthoError(f"image {path} cannot be read: {e}") from e
+    if ds is None or ds.RasterCount == 0:
+        raise OrthoError(f"image {path} cannot be read")
+    dt = np.dtype(gdal_array.GDALTypeCodeToNumericTypeCode(ds.GetRasterBand(1).DataType)).name
+    return ImageMeta(ds.RasterXSize, ds.RasterYSize, ds.RasterCount, dt)
+
+
+def _read_window(path: str, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
+    gdal = _gdal()
+    ds = gdal.Open(path)
+    arr = ds.ReadAsArray(x0, y0, x1 - x0, y1 - y0)
+    if arr.ndim == 2:
+        arr = arr[:, :, None]
+    else:
+        arr = np.moveaxis(arr, 0, -1)
+    return np.ascontiguousarray(arr)
+
+
+def _image_window(path: str, meta: ImageMeta, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
+    nbytes = meta.width * meta.height * meta.bands * np.dtype(meta.dtype).itemsize
+    if nbytes <= _WHOLE_IMAGE_MAX:
+        whole = _CACHE.get(("img", path), lambda: (_read_window(path, 0, 0, meta.width, meta.height), nbytes))
+        return whole[y0:y1, x0:x1]
+    return _read_window(path, x0, y0, x1, y1)
+
+
+def _mask(path: Optional[str]) -> Optional[np.ndarray]:
+    if not path:
+        return None
+
+    def make():
+        cv2 = require("cv2", "orthophotos")
+
+        m = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
+        if m is None:
+            raise OrthoError(f"mask {path} cannot be read")
+        return m, m.nbytes
+    return _CACHE.get(("mask", path), make)
+
+
+_CV_TYPES = ("uint8", "uint16", "int16", "float32")
+
+
+def _remap(src: np.ndarray, mx: np.ndarray, my: np.ndarray, interpolation: str, border_nan: bool = False
+           ) -> np.ndarray:
+    """cv2.remap of 1-D coordinate arrays (rows of 1024, as remap wants short sides) -> (N, bands) float32."""
+    cv2 = require("cv2", "orthophotos")
+
+    flag = {"bilinear": cv2.INTER_LINEAR, "cubic": cv2.INTER_CUBIC, "nearest": cv2.INTER_NEAREST}[interpolation]
+    n = mx.size
+    cols = 1024
+    rows = max(1, -(-n // cols))
+    pad = rows * cols - n
+    fx = np.pad(mx.astype(np.float32), (0, pad), constant_values=-10).reshape(rows, cols)
+    fy = np.pad(my.astype(np.float32), (0, pad), constant_values=-10).reshape(rows, cols)
+    if src.dtype.name not in _CV_TYPES:
+        src = src.astype(np.float32)
+    bands = src.shape[2]
+    out = np.empty((n, bands), dtype=np.float32)
+    border = cv2.BORDER_REPLICATE
+    kw = {}
+    if border_nan:
+        border, kw = cv2.BORDER_CONSTANT, {"borderValue": float("nan")}
+    for b0 in range(0, bands, 4):
+        part = np.ascontiguousarray(src[:, :, b0:b0 + 4])
+        if part.shape[2] == 1:
+            part = part[:, :, 0]
+        elif part.shape[2] == 2:  # remap takes 1, 3 or 4 channels
+            for k in range(2):
+                r = cv2.remap(np.ascontiguousarray(part[:, :, k]), fx, fy, flag, borderMode=border, **kw)
+                out[:, b0 + k] = r.reshape(-1)[:n]
+            continue
+        r = cv2.remap(part, fx, fy, flag, borderMode=border, **kw)
+        r = r.reshape(rows * cols, -1)[:n]
+        out[:, b0:b0 + r.shape[1]] = r
+    return out

@@ -1,0 +1,62 @@
+"""Values of ground points in one image: projection through the camera model, occlusion, mask, view cost and
+interpolation."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from .cameras import OrthoCamera
+from .pixels import ImageMeta, _image_window, _mask, _remap
+from .visibility import Visibility, _table
+
+
+@dataclass
+class Sampled:
+    values: np.ndarray  # (N, bands) float32 (only rows where valid are meaningful)
+    valid: np.ndarray  # (N,) bool
+    cost: np.ndarray  # (N,) float32, inf where not valid
+
+
+def sample_camera(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.ndarray, y: np.ndarray,
+                  z: np.ndarray, vis: Optional[Visibility], interpolation: str = "bilinear",
+                  want_values: bool = True) -> Sampled:
+    """Values of ground points (world, 1-D arrays) in one image, with validity and the view cost."""
+    n = x.size
+    finite = np.isfinite(z)
+    xyz = np.column_stack([x - offset[0], y - offset[1], np.where(finite, z, 0.0) - offset[2]])
+    px, _depth, ok = cam.project(xyz)
+    ok &= finite
+    if vis is not None and ok.any():
+        idx = np.flatnonzero(ok)
+        ok[idx] = vis.visible(x[idx], y[idx], z[idx], _table(vis))
+    mask = _mask(cam.mask_path)
+    if mask is not None and ok.any():
+        idx = np.flatnonzero(ok)
+        mc = np.clip(px[idx, 0].astype(np.int64), 0, mask.shape[1] - 1)
+        mr = np.clip(px[idx, 1].astype(np.int64), 0, mask.shape[0] - 1)
+        ok[idx] = mask[mr, mc] >= 128
+    cost = np.full(n, np.inf, dtype=np.float32)
+    values = np.zeros((n, meta.bands), dtype=np.float32)
+    if not ok.any():
+        return Sampled(values, ok, cost)
+    idx = np.flatnonzero(ok)
+    c = cam.centre
+    dxy = np.hypot(xyz[idx, 0] - c[0], xyz[idx, 1] - c[1])
+    dz = np.maximum(c[2] - xyz[idx, 2], 1e-6)
+    half_diag = 0.5 * math.hypot(cam.camera.width, cam.camera.height)
+    rho = np.hypot(px[idx, 0] - cam.camera.cx, px[idx, 1] - cam.camera.cy) / half_diag
+    cost[idx] = (rho * rho + (dxy / dz) ** 2).astype(np.float32)
+    if want_values:
+        u = px[idx, 0] - 0.5
+        v = px[idx, 1] - 0.5
+        pad = 3
+        x0 = max(0, int(math.floor(u.min())) - pad)
+        y0 = max(0, int(math.floor(v.min())) - pad)
+        x1 = min(meta.width, int(math.ceil(u.max())) + pad + 1)
+        y1 = min(meta.height, int(math.ceil(v.max())) + pad + 1)
+        win = _image_window(cam.path, meta, x0, y0, x1, y1)
+        values[idx] = _remap(win, u - x0, v - y0, interpolation)
+    return Sampled(values, ok, cost)

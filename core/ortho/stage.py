@@ -1,0 +1,105 @@
+"""The orthophoto stage of a workspace: reads the georeferenced model and the DSM through the layout, runs the
+mosaic inside run_stage() and records its outputs."""
+from __future__ import annotations
+
+import os
+from dataclasses import asdict, dataclass, replace
+from typing import Dict, List, Optional, Tuple
+
+import numpy as np
+
+from ..common.progress import NullProgress, Progress
+from ..project.layout import Layout, LayoutError
+from ..project.stages import ORTHOPHOTO, run_stage
+from ..project.workspace import Workspace, file_fingerprint, fingerprint
+from .cameras import OrthoCamera, cameras_from_reconstruction, select_cameras
+from .mosaic import build_orthomosaic
+from .options import OrthoError, OrthoOptions
+
+STAGE = ORTHOPHOTO
+
+
+@dataclass
+class OrthoStageResult:
+    workspace: str
+    orthomosaic: str
+    crs: Optional[str]
+    resolution: float
+    images: List[str]
+    valid_fraction: float
+    per_image_folder: Optional[str]
+    seamlines: Optional[str]
+    timings: Dict[str, float]
+    warnings: List[str]
+    log_lines: List[str]
+
+
+def workspace_dsm(ws: Workspace) -> Optional[str]:
+    """The workspace's DSM: the DSM stage's output if recorded, else <workspace>/dsm.tif; None if absent."""
+    return Layout(ws).dsm()
+
+
+def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = None, images_filter: Optional[str] = None,
+                               resolution: float = 0.0, blending: str = "feather", output: Optional[str] = None,
+                               per_image_folder: Optional[str] = None, seamlines: Optional[str] = None,
+                               options: Optional[OrthoOptions] = None,
+                               progress: Optional[Progress] = None) -> OrthoStageResult:
+    """The orthophoto stage of a georeferenced workspace: orthomosaic (default <workspace>/orthomosaic.tif),
+    optional per-image true orthophotos and the which-image layer.  Records the stage in workspace.json.
+
+    ``options`` is not modified (RESOLUTION and BLENDING go into a copy).
+    Raises OrthoError (bad input), WorkspaceError, Cancelled."""
+    progress = progress or NullProgress()
+    options = options or OrthoOptions()
+    options = replace(options, resolution=float(resolution or 0.0), blending=(blending or options.blending).lower())
+    options.check()
+    lay = Layout(Workspace.open(workspace_dir))
+    dsm_path, crs, offset, cams = _inputs(lay, dsm_path, images_filter)
+    output = os.path.abspath(output) if output else lay.default_orthomosaic
+    per_image_folder = os.path.abspath(per_image_folder) if per_image_folder else None
+    seamlines = os.path.abspath(seamlines) if seamlines else None
+    params = {"dsm": dsm_path, "images_filter": images_filter or "", "resolution": options.resolution,
+              "blending": options.blending, "output": output, "per_image_folder": per_image_folder,
+              "seamlines": seamlines, "options": {k: v for k, v in asdict(options).items()
+                                                  if k not in ("workers", "scheduler", "cache_mb")}}
+    inputs = {"dsm": file_fingerprint(dsm_path), "images": fingerprint(sorted(c.name for c in cams)),
+              **lay.model_fingerprints()}
+    with run_stage(lay.ws, STAGE, params, inputs) as run:
+        result = build_orthomosaic(cams, dsm_path, crs, offset, output, options, per_image_folder, seamlines, progress)
+        for k_, v in result.timings.items():
+            if k_ != "total":
+                lay.ws.record_timing(STAGE, k_, v)
+        outputs = {"orthomosaic": lay.rel(output)}
+        if per_image_folder:
+            outputs["per_image_folder"] = lay.rel(per_image_folder)
+        if seamlines:
+            outputs["seamlines"] = lay.rel(seamlines)
+        run.finish(outputs=outputs, results={
+            "resolution": result.resolution, "gsd": result.gsd, "width": result.width, "height": result.height,
+            "images": len(result.images), "valid_fraction": result.valid_fraction, "warnings": result.warnings})
+    return OrthoStageResult(lay.root, output, crs, result.resolution, result.images, result.valid_fraction,
+                            per_image_folder, seamlines, result.timings, result.warnings, result.log_lines)
+
+
+def _inputs(lay: Layout, dsm_path: Optional[str], images_filter: Optional[str]
+            ) -> Tuple[str, Optional[str], np.ndarray, List[OrthoCamera]]:
+    """(DSM path, CRS, local frame offset, the chosen cameras) of a georeferenced workspace; OrthoError if unusable."""
+    ws = lay.ws
+    try:
+        lay.require_georeferenced("an orthophoto needs the images in a map CRS")
+    except LayoutError as e:
+        raise OrthoError(str(e)) from e
+    dsm_path = os.path.abspath(dsm_path) if dsm_path else lay.dsm()
+    if not dsm_path:
+        raise OrthoError(f"workspace {ws.root} has no DSM: run 'Build DSM' first or give a DSM raster")
+    if not os.path.isfile(dsm_path):
+        raise OrthoError(f"DSM {dsm_path} does not exist")
+    rec, transform = lay.load_georef_model()
+    offset = np.asarray(transform.get("offset", [0.0, 0.0, 0.0]), dtype=float)
+    crs = transform.get("crs") or ws.crs
+    cams = cameras_from_reconstruction(rec, ws.data.get("images_dir") or "", lay.masks_dir)
+    if not cams:
+        raise OrthoError(f"the model of {ws.root} has no oriented image")
+    cams = select_cameras(cams, images_filter, ws.data.get("camera_groups", []))
+    return dsm_path, crs, offset, cams
+

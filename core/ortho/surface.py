@@ -1,0 +1,153 @@
+"""The surface: heights from a DSM in the working CRS (reprojected on the fly), and its gaps filled for
+orthorectification."""
+from __future__ import annotations
+
+import math
+from typing import Optional, Tuple
+
+import numpy as np
+
+from ..common.errors import require
+from ..io import raster as dsmmod
+from .options import OrthoError
+from .pixels import _remap
+
+
+class _Dsm:
+    """Heights from a DSM in the working CRS, in world coordinates (NaN = no height)."""
+
+    def __init__(self, path: str, crs: Optional[str]):
+        try:
+            self.info = dsmmod.open_dsm(path)
+        except dsmmod.DsmError as e:
+            raise OrthoError(str(e)) from e
+        if crs and not self.info.crs_wkt:
+            raise OrthoError(f"DSM {path} has no CRS: it cannot be placed in {crs}; assign its CRS first")
+        self.path = path
+        self.crs = crs
+        self.reader = dsmmod.DsmReader(path, target_crs=crs)
+        gt = self.reader.geotransform
+        self.geotransform = gt
+        self.res = float(min(abs(gt[1]), abs(gt[5])))
+        xs = (gt[0], gt[0] + self.reader.width * gt[1])
+        ys = (gt[3], gt[3] + self.reader.height * gt[5])
+        self.bounds = (min(xs), min(ys), max(xs), max(ys))
+        self.reprojected = bool(crs and self.info.crs_wkt and not _same_crs(self.info.crs_wkt, crs))
+
+    def close(self):
+        self.reader.close()
+
+    def sample(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        return self.reader.sample(x, y)
+
+    def window(self, box: Tuple[float, float, float, float]) -> Tuple[np.ndarray, Tuple[float, ...]]:
+        """Heights of the cells covering ``box`` (full resolution), with their geotransform; (0, 0) if outside."""
+        return self.reader.read_window(*box)
+
+    def window_sampler(self, box: Tuple[float, float, float, float], margin_cells: int = 2):
+        """A bilinear sampler over one window read once: f(x, y) -> z (NaN outside)."""
+        g = self.geotransform
+        m = margin_cells * self.res
+        arr, wgt = self.window((box[0] - m, box[1] - m, box[2] + m, box[3] + m))
+
+        arr32 = arr.astype(np.float32) if arr.size else arr
+
+        def f(x, y):
+            x = np.asarray(x, dtype=np.float64)
+            if arr.size == 0:
+                return np.full(x.shape, np.nan)
+            fc = (x - wgt[0]) / g[1] - 0.5
+            fr = (np.asarray(y, dtype=np.float64) - wgt[3]) / g[5] - 0.5
+            if arr.shape[0] < 2 or arr.shape[1] < 2 or max(arr.shape) >= 32767:
+                return dsmmod.bilinear(arr, fc, fr)
+            # cv2.remap: bilinear, NaN where a neighbour is NaN (like dsm.bilinear), far faster
+            out = _remap(arr32[:, :, None], fc.ravel(), fr.ravel(), "bilinear", border_nan=True)[:, 0]
+            return out.reshape(x.shape).astype(np.float64)
+        return f
+
+    def coarse(self, box: Tuple[float, float, float, float], max_cells: int = 1_000_000
+               ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Heights on a coarse grid over ``box`` (at most ``max_cells`` samples): (z, x, y) 2-D arrays."""
+        x0, y0, x1, y1 = box
+        x0, y0 = max(x0, self.bounds[0]), max(y0, self.bounds[1])
+        x1, y1 = min(x1, self.bounds[2]), min(y1, self.bounds[3])
+        if x1 <= x0 or y1 <= y0:
+            return np.zeros((0, 0)), np.zeros((0, 0)), np.zeros((0, 0))
+        step = max(self.res, math.sqrt((x1 - x0) * (y1 - y0) / max_cells))
+        xs = np.arange(x0 + step / 2, x1, step)
+        ys = np.arange(y1 - step / 2, y0, -step)
+        out = np.full((len(ys), len(xs)), np.nan)
+        rows = max(1, int(4_000_000 * self.res * self.res / max(1e-12, (x1 - x0) * step)))  # bound window reads
+        for r0 in range(0, len(ys), rows):
+            yy = ys[r0:r0 + rows]
+            gx, gy = np.meshgrid(xs, yy)
+            out[r0:r0 + len(yy)] = self.sample(gx, gy)
+        gx, gy = np.meshgrid(xs, ys)
+        return out, gx, gy
+
+
+def _same_crs(wkt: str, crs: str) -> bool:
+    from osgeo import osr
+
+    a = osr.SpatialReference(wkt=wkt)
+    b = osr.SpatialReference()
+    try:
+        b.SetFromUserInput(crs)
+    except RuntimeError:
+        return False
+    return bool(a.IsSame(b))
+
+
+FILL_MAX_CELLS = 120_000_000  # larger DSMs are used as they are (the fill works on the whole raster in memory)
+
+
+def fill_dsm_gaps(dsm_path: str, out_path: str, max_distance: float) -> Tuple[str, int]:
+    """Fill the gaps of a DSM for orthorectification: cells without a height that lie inside the convex hull of
+    the measured cells and within ``max_distance`` (CRS units) of one get a height interpolated (inverse distance,
+    GDAL FillNodata) from their surroundings, so that a tree crown the dense matching missed does not leave a hole
+    in the orthophoto.  Beyond the measured area (a DSM that covers part of the block) nothing is invented.
+
+    Returns (path of the DSM to use, cells filled): ``out_path`` when something was filled, else ``dsm_path``."""
+    cv2 = require("cv2", "orthophotos")
+    from osgeo import gdal
+
+    if not max_distance or max_distance <= 0:
+        return dsm_path, 0
+    ds = gdal.Open(dsm_path)
+    if ds is None or ds.RasterXSize * ds.RasterYSize > FILL_MAX_CELLS:
+        return dsm_path, 0
+    band = ds.GetRasterBand(1)
+    z = band.ReadAsArray().astype(np.float32)
+    nodata = band.GetNoDataValue()
+    valid = np.isfinite(z)
+    if nodata is not None and np.isfinite(nodata):
+        valid &= z != nodata
+    if valid.all() or not valid.any():
+        return dsm_path, 0
+    rows, cols = np.nonzero(valid)
+    hull = cv2.convexHull(np.column_stack([cols, rows]).astype(np.int32))
+    inside = np.zeros(z.shape, np.uint8)
+    cv2.fillConvexPoly(inside, hull, 1)
+    gaps = (~valid) & inside.astype(bool)
+    if not gaps.any():
+        return dsm_path, 0
+    gt = ds.GetGeoTransform()
+    max_cells = max(1.0, max_distance / max(abs(gt[1]), abs(gt[5])))
+    fill_value = -9999.0
+    mem = gdal.GetDriverByName("MEM").Create("", ds.RasterXSize, ds.RasterYSize, 1, gdal.GDT_Float32)
+    mem.SetGeoTransform(gt)
+    mem.SetProjection(ds.GetProjection())
+    mb = mem.GetRasterBand(1)
+    mb.SetNoDataValue(fill_value)
+    mb.WriteArray(np.where(valid, z, fill_value).astype(np.float32))
+    gdal.FillNodata(mb, None, maxSearchDist=float(max_cells), smoothingIterations=0)
+    out = mb.ReadAsArray()
+    take = gaps & (out != fill_value)
+    result = np.where(valid, z, np.nan).astype(np.float32)
+    result[take] = out[take]
+    n = int(take.sum())
+    if n == 0:
+        return dsm_path, 0
+    srs = ds.GetSpatialRef()
+    dsmmod.write_cog(out_path, result, gt, srs.ExportToWkt() if srs is not None else None)
+    return out_path, n

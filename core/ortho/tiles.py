@@ -1,0 +1,158 @@
+"""One mosaic tile: the picklable unit a worker (process pool or Dask) renders, and its blending."""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import Any, Dict, List, Optional, Tuple
+
+import numpy as np
+
+from ..common.errors import require
+from ..common.progress import Cancelled
+from ..io import raster as dsmmod
+from .blend import _multiband
+from .cameras import OrthoCamera
+from .grid import _cell_centres
+from .pixels import _CACHE, ImageMeta
+from .sampling import sample_camera
+from .surface import _Dsm
+from .visibility import Visibility
+
+
+@dataclass
+class _TileUnit:
+    """Everything one mosaic tile needs (picklable: runs in a pool worker or on a Dask cluster)."""
+
+    index: int
+    r0: int  # tile rows/cols in output cells (without halo)
+    c0: int
+    h: int
+    w: int
+    halo: int
+    grid: Dict[str, Any]
+    dsm_path: str
+    crs: Optional[str]
+    offset: List[float]
+    cameras: List[OrthoCamera]
+    metas: List[ImageMeta]
+    visibility: List[Optional[Visibility]]
+    primary: List[int]  # indices into cameras (labels present near the tile)
+    secondary: List[int]  # other images over the tile, best first (fill occlusions)
+    gains: List[float]
+    labels_path: str
+    k: int
+    plan_shape: Tuple[int, int]
+    feather_cells: int
+    blending: str
+    interpolation: str
+    cache_mb: int
+
+
+_DSM_CACHE: Dict[Tuple[str, Optional[str]], _Dsm] = {}
+
+
+def _dsm_for(path: str, crs: Optional[str]) -> _Dsm:
+    key = (path, crs)
+    if key not in _DSM_CACHE:
+        _DSM_CACHE.clear()
+        _DSM_CACHE[key] = _Dsm(path, crs)
+    return _DSM_CACHE[key]
+
+
+def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str, Any]:
+    """Blend one mosaic tile: returns values (h, w, bands) float32, valid (h, w) and which-image counts."""
+    cv2 = require("cv2", "orthophotos")
+
+    _CACHE.max_bytes = unit.cache_mb << 20
+    grid = dsmmod.Grid(**unit.grid)
+    dsm = _dsm_for(unit.dsm_path, unit.crs)
+    off = np.asarray(unit.offset, dtype=float)
+    halo = unit.halo
+    # rows/cols with halo, clipped to the grid
+    ar0, ac0 = max(0, unit.r0 - halo), max(0, unit.c0 - halo)
+    ar1, ac1 = min(grid.height, unit.r0 + unit.h + halo), min(grid.width, unit.c0 + unit.w + halo)
+    hh, ww = ar1 - ar0, ac1 - ac0
+    x, y = _cell_centres(grid, ar0, ac0, hh, ww)
+    z = dsm.sample(x, y)
+    bands = unit.metas[0].bands
+    labels_all = np.load(unit.labels_path, mmap_mode="r")
+    k = unit.k
+    ph, pw = unit.plan_shape
+    # planning window around the tile (margin for the feathering blur)
+    m = unit.feather_cells + 1
+    pr0, pc0 = max(0, ar0 // k - m), max(0, ac0 // k - m)
+    pr1, pc1 = min(ph, (ar1 - 1) // k + 1 + m), min(pw, (ac1 - 1) // k + 1 + m)
+    lab = np.asarray(labels_all[pr0:pr1, pc0:pc1])
+    rows = np.arange(ar0, ar1)
+    cols = np.arange(ac0, ac1)
+    # planning coordinates of the output cells (for soft weights), nearest planning cell (for hard labels)
+    fr = ((rows + 0.5) / k - 0.5 - pr0).astype(np.float32)
+    fc = ((cols + 0.5) / k - 0.5 - pc0).astype(np.float32)
+    map_x, map_y = np.meshgrid(fc, fr)
+    hard = lab[(rows // k - pr0)[:, None], (cols // k - pc0)[None, :]]
+
+    acc = np.zeros((hh * ww, bands), dtype=np.float64) if unit.blending != "multiband" else None
+    wsum = np.zeros(hh * ww, dtype=np.float64)
+    any_valid = np.zeros(hh * ww, dtype=bool)
+    best_cost = np.full(hh * ww, np.inf, dtype=np.float32)
+    layers = []  # multiband: (values, weight)
+    counts: Dict[int, int] = {}
+    for ci in unit.primary:
+        if cancel_path and os.path.exists(cancel_path):
+            raise Cancelled("cancelled by the user")
+        cam = unit.cameras[ci]
+        s = sample_camera(cam, unit.metas[ci], off, x, y, z, unit.visibility[ci], unit.interpolation)
+        if not s.valid.any():
+            continue
+        vals = s.values * np.float32(unit.gains[ci])
+        if unit.blending == "feather" and unit.feather_cells > 0:
+            onehot = (lab == ci).astype(np.float32)
+            ksz = 2 * unit.feather_cells + 1
+            soft = cv2.blur(onehot, (ksz, ksz), borderType=cv2.BORDER_REPLICATE)
+            wgt = cv2.remap(soft, map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE).ravel()
+        else:
+            wgt = (hard == ci).astype(np.float32).ravel()
+        wgt = np.where(s.valid, wgt, 0.0)
+        any_valid |= s.valid
+        better = s.cost < best_cost
+        best_cost[better] = s.cost[better]
+        if unit.blending == "multiband":
+            layers.append((vals, s.valid, wgt))
+        else:
+            acc += vals * wgt[:, None]
+        wsum += wgt
+    # cells whose planned image cannot see them: the best image that does (primary first, then the others)
+    need = wsum <= 1e-6
+    fill_vals = np.zeros((hh * ww, bands), dtype=np.float32)
+    fill_cost = np.full(hh * ww, np.inf, dtype=np.float32)
+    if need.any():
+        order = list(unit.primary) + list(unit.secondary)
+        idx = np.flatnonzero(need)
+        for ci in order:
+            if not len(idx):
+                break
+            s = sample_camera(unit.cameras[ci], unit.metas[ci], off, x[idx], y[idx], z[idx], unit.visibility[ci],
+                              unit.interpolation)
+            better = s.valid & (s.cost < fill_cost[idx])
+            if better.any():
+                sel = idx[better]
+                fill_vals[sel] = s.values[better] * np.float32(unit.gains[ci])
+                fill_cost[sel] = s.cost[better]
+                counts[ci] = counts.get(ci, 0) + int(better.sum())
+        filled = need & np.isfinite(fill_cost)
+    else:
+        filled = need
+    valid = (wsum > 1e-6) | filled
+    if unit.blending == "multiband":
+        out = _multiband(layers, fill_vals, filled, hh, ww, bands)
+    else:
+        out = np.zeros((hh * ww, bands), dtype=np.float32)
+        ok = wsum > 1e-6
+        out[ok] = (acc[ok] / wsum[ok, None]).astype(np.float32)
+        out[filled] = fill_vals[filled]
+    # crop the halo
+    rr0, cc0 = unit.r0 - ar0, unit.c0 - ac0
+    out = out.reshape(hh, ww, bands)[rr0:rr0 + unit.h, cc0:cc0 + unit.w]
+    valid = valid.reshape(hh, ww)[rr0:rr0 + unit.h, cc0:cc0 + unit.w]
+    return {"index": unit.index, "r0": unit.r0, "c0": unit.c0, "values": out, "valid": valid,
+            "fill_cells": int(filled.reshape(hh, ww)[rr0:rr0 + unit.h, cc0:cc0 + unit.w].sum())}

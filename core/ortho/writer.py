@@ -1,0 +1,131 @@
+"""Output rasters: a tiled GeoTIFF that tiles stream into, translated to a Cloud-Optimized GeoTIFF (atomically);
+the GDAL block cache bound while writing."""
+from __future__ import annotations
+
+import contextlib
+import os
+from typing import Optional
+
+import numpy as np
+
+from ..common.progress import NullProgress, Progress, check_cancel
+from ..io import raster as dsmmod
+from ..project.workspace import atomic_output
+from .options import OrthoError
+from .pixels import _gdal
+
+
+def _alpha_value(dtype: str) -> Optional[float]:
+    dt = np.dtype(dtype)
+    if dt.kind in "ui":
+        return float(np.iinfo(dt).max)
+    return None  # float images: nodata NaN instead of an alpha band
+
+
+class _RasterWriter:
+    """A tiled GeoTIFF that tiles are written into, then translated to a COG (atomically)."""
+
+    def __init__(self, path: str, width: int, height: int, bands: int, dtype: str, geotransform, crs: Optional[str]):
+        gdal = _gdal()
+        from osgeo import gdal_array
+
+        self.path = path
+        self.dtype = np.dtype(dtype)
+        self.bands = bands
+        self.alpha = _alpha_value(dtype)
+        n = bands + (1 if self.alpha is not None else 0)
+        gtype = gdal_array.NumericTypeCodeToGDALTypeCode(self.dtype)
+        drv = gdal.GetDriverByName("GTiff")
+        self.ds = drv.Create(path, width, height, n, gtype, options=[
+            "TILED=YES", "BLOCKXSIZE=256", "BLOCKYSIZE=256", "COMPRESS=ZSTD" if _has_zstd() else "COMPRESS=LZW",
+            "BIGTIFF=IF_SAFER", "SPARSE_OK=TRUE"] + (["PHOTOMETRIC=RGB"] if bands == 3 and self.dtype == np.uint8
+                                                      else []) + (["ALPHA=YES"] if self.alpha is not None else []))
+        self.ds.SetGeoTransform(tuple(float(v) for v in geotransform))
+        wkt = dsmmod.crs_to_wkt(crs) if crs else ""
+        if wkt:
+            self.ds.SetProjection(wkt)
+        if self.alpha is not None:
+            self.ds.GetRasterBand(n).SetColorInterpretation(gdal.GCI_AlphaBand)
+        else:
+            for b in range(1, bands + 1):
+                self.ds.GetRasterBand(b).SetNoDataValue(float("nan"))
+
+    def write(self, r0: int, c0: int, values: np.ndarray, valid: np.ndarray) -> None:
+        """values (h, w, bands) float32, valid (h, w) bool."""
+        dt = self.dtype
+        if dt.kind in "ui":
+            info = np.iinfo(dt)
+            v = np.clip(np.rint(values), info.min, info.max).astype(dt)
+        else:
+            v = values.astype(dt)
+            v[~valid] = np.nan
+        if dt.kind in "ui":
+            v[~valid] = 0
+        for b in range(self.bands):
+            self.ds.GetRasterBand(b + 1).WriteArray(v[:, :, b], int(c0), int(r0))
+        if self.alpha is not None:
+            a = np.where(valid, self.alpha, 0).astype(dt)
+            self.ds.GetRasterBand(self.bands + 1).WriteArray(a, int(c0), int(r0))
+
+    def finish(self, out_path: str, compress: str, progress: Optional[Progress], metadata: Optional[dict] = None
+               ) -> None:
+        """Translate to a Cloud-Optimized GeoTIFF at ``out_path`` (atomic) and delete the work file."""
+        gdal = _gdal()
+        progress = progress or NullProgress()
+        if metadata:
+            self.ds.SetMetadata({str(k): str(v) for k, v in metadata.items()})
+        self.ds.FlushCache()
+        self.ds = None
+
+        def cb(fraction, _msg, _data):
+            progress.report(fraction, "writing Cloud-Optimized GeoTIFF")
+            return 0 if progress.is_cancelled() else 1
+
+        opts = ["COMPRESS=" + compress, "BLOCKSIZE=256", "OVERVIEWS=IGNORE_EXISTING", "OVERVIEW_RESAMPLING=AVERAGE",
+                "BIGTIFF=IF_SAFER", "NUM_THREADS=1"]
+        if compress.upper() in ("DEFLATE", "LZW", "ZSTD"):
+            opts.append("PREDICTOR=YES")
+        try:
+            with atomic_output(out_path) as tmp:
+                try:
+                    out = gdal.Translate(tmp, self.path, options=gdal.TranslateOptions(
+                        format="COG", creationOptions=opts, callback=cb))
+                except RuntimeError as e:
+                    check_cancel(progress)
+                    raise OrthoError(f"cannot write {out_path}: {e}") from e
+                if out is None:
+                    check_cancel(progress)
+                    raise OrthoError(f"cannot write {out_path}")
+                out.FlushCache()
+                out = None
+                check_cancel(progress)
+        finally:
+            with contextlib.suppress(OSError):
+                os.unlink(self.path)
+
+    def abort(self):
+        self.ds = None
+        with contextlib.suppress(OSError):
+            os.unlink(self.path)
+
+
+_ZSTD: Optional[bool] = None
+
+
+def _has_zstd() -> bool:
+    global _ZSTD
+    if _ZSTD is None:
+        md = _gdal().GetDriverByName("GTiff").GetMetadataItem("DMD_CREATIONOPTIONLIST") or ""
+        _ZSTD = "ZSTD" in md
+    return _ZSTD
+
+
+@contextlib.contextmanager
+def _gdal_cache(mb: int):
+    gdal = _gdal()
+    old = gdal.GetCacheMax()
+    gdal.SetCacheMax(int(mb) << 20)
+    try:
+        yield
+    finally:
+        gdal.SetCacheMax(old)
