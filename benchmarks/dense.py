@@ -86,7 +86,8 @@ def run_child(args):
 
 def child(args):
     from core.common.progress import PrintProgress
-    from core.dense import matching as dense
+    from core.dense import stage as dense
+    from core.dense.stereo import read_pair_summary
 
     pc = os.path.join(args.workspace, "dense", "points.las") if args.point_cloud else None
     t0 = time.time()
@@ -98,7 +99,7 @@ def child(args):
 
     pairs = []
     for p in glob(os.path.join(args.workspace, "dense", "pairs-*", "*.npz")):
-        s = dense.read_pair_summary(p)
+        s = read_pair_summary(p)
         if not s.get("skipped"):
             pairs.append(s)
     with open(args.result, "w") as f:

@@ -177,7 +177,7 @@ def build_workspace(ws_dir):
     from core import pipeline
     from core.align import sfm
     from core.common.progress import PrintProgress
-    from core.dense import matching as dense
+    from core.dense import stage as dense
 
     sfm.align(os.path.join(TOLEDO, "images"), ws_dir, progress=PrintProgress("align "))
     pipeline.georeference_workspace(ws_dir, use_exif_gps=True, crs="EPSG:32617", progress=PrintProgress("georef "))

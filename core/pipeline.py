@@ -288,7 +288,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, *, align_options=None, gcp
     after the alignment: a DSM and an orthophoto need a metric scale and a vertical direction, so that is a
     StageError naming what to give."""
     from .align import sfm
-    from .dense import matching as dense
+    from .dense import stage as dense
     from .ortho import stage as ortho
     from .report import stage as reportmod
 

@@ -1,4 +1,4 @@
-"""Build DSM: thin adapter over core.dense.build_dsm_workspace."""
+"""Build DSM: thin adapter over core.dense.stage.build_dsm_workspace."""
 from qgis.core import (
     QgsProcessingOutputFolder,
     QgsProcessingOutputNumber,
@@ -70,7 +70,7 @@ class BuildDsmAlgorithm(AlgorithmBase):
         self.addOutput(QgsProcessingOutputNumber(self.POINTS, self.tr("Fused points")))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core.dense import matching as dense
+        from ..core.dense import stage as dense
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         output_dsm = self.parameterAsOutputLayer(parameters, self.OUTPUT_DSM, context) or None

@@ -123,7 +123,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
         from ..core import pipeline
         from ..core.align import sfm
-        from ..core.dense import matching as dense
+        from ..core.dense import stage as dense
         from ..core.io import gcp as gcpmod
         from ..core.ortho import options as ortho
 

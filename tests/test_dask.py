@@ -8,7 +8,7 @@ import pytest
 
 from core import ortho
 from core.common import parallel
-from core.dense import matching as dense
+from core.dense import stage as dense
 from core.io import raster as dsm
 from tests import synthetic as syn
 from tests.test_dense import CAMERA, make_workspace

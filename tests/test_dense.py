@@ -10,7 +10,10 @@ import pytest
 
 from core.common import parallel
 from core.common.progress import Cancelled, NullProgress
-from core.dense import matching as dense
+from core.dense import fusion, stereo
+from core.dense import grid as gridding
+from core.dense import stage as dense
+from core.dense.pairs import View
 from core.io import raster as dsm
 from core.project.workspace import DONE, Workspace
 from tests import synthetic as syn
@@ -81,7 +84,7 @@ def _truth_grid(block, path):
 # ---------------------------------------------------------------------------
 
 def _view(name, rot, centre, cam):
-    return dense.View(0, name, "", cam.width, cam.height, "OPENCV", tuple(cam.params), rot, -rot @ centre)
+    return View(0, name, "", cam.width, cam.height, "OPENCV", tuple(cam.params), rot, -rot @ centre)
 
 
 def test_rectification_maps_follow_the_camera_model():
@@ -93,12 +96,12 @@ def test_rectification_maps_follow_the_camera_model():
     rj = syn.small_rotation(rng, 2.0) @ down
     ci, cj = np.array([0.0, 0, 50]), np.array([12.0, 3, 51])
     vi, vj = _view("a", ri, ci, CAMERA), _view("b", rj, cj, CAMERA)
-    ki, di = dense.camera_matrix("OPENCV", CAMERA.params, 1.0, 1.0)
-    kj, dj = dense.camera_matrix("OPENCV", CAMERA.params, 1.0, 1.0)
-    rect = dense.rectify_pair(vi, vj, ki, di, kj, dj, (CAMERA.width, CAMERA.height), (CAMERA.width, CAMERA.height))
+    ki, di = vi.camera_matrix(1.0, 1.0)
+    kj, dj = vj.camera_matrix(1.0, 1.0)
+    rect = stereo.rectify_pair(vi, vj, ki, di, kj, dj, (CAMERA.width, CAMERA.height), (CAMERA.width, CAMERA.height))
     pts = np.column_stack([rng.uniform(-3, 15, 40), rng.uniform(-8, 8, 40), rng.uniform(-2, 6, 40)])
-    pi = dense.rect_project(pts, ci, rect, rect.cx_i)
-    pj = dense.rect_project(pts, cj, rect, rect.cx_j)
+    pi = stereo.rect_project(pts, ci, rect, rect.cx_i)
+    pj = stereo.rect_project(pts, cj, rect, rect.cx_j)
     assert np.allclose(pi[:, 1], pj[:, 1], atol=1e-6)  # same row
     assert (pi[:, 0] - pj[:, 0] - rect.cx_i + rect.cx_j > 0).all()  # positive disparity
     for p, shot_r, c, maps in ((pi, ri, ci, rect.maps_i), (pj, rj, cj, rect.maps_j)):
@@ -123,7 +126,7 @@ def test_fusion_keeps_what_two_pairs_confirm():
     maps[2, 1, 1] = np.nan
     maps[3, 1, 1] = np.nan
     maps[:, 2, 2] = [50.0, 55.0, 60.0, 65.0]  # nobody agrees
-    fused, n = dense.fuse_depth_maps(maps, np.full(4, 0.005), 2)
+    fused, n = fusion.fuse_depth_maps(maps, np.full(4, 0.005), 2)
     assert fused[0, 0] == pytest.approx(50.025, abs=1e-3)
     assert np.isnan(fused[1, 1]) and np.isnan(fused[2, 2])
     assert fused[3, 3] == pytest.approx(50.0125, abs=1e-3) and n[3, 3] == 4
@@ -132,7 +135,7 @@ def test_fusion_keeps_what_two_pairs_confirm():
 def test_cell_statistic_takes_the_highest_cluster():
     cells = np.array([0, 0, 0, 0, 0, 1, 1, 1, 2])
     z = np.array([10.0, 10.1, 15.0, 15.1, 15.2, 3.0, 3.1, 2.9, 7.0])
-    val, cnt = dsm.cell_statistic(cells, z, 4, cluster_tol=0.5)
+    val, cnt = gridding.cell_statistic(cells, z, 4, cluster_tol=0.5)
     assert val[0] == pytest.approx(15.1, abs=0.06)  # the roof, not the mean of roof and ground
     assert val[1] == pytest.approx(3.0, abs=0.06)
     assert val[2] == pytest.approx(7.0) and np.isnan(val[3])
@@ -143,7 +146,7 @@ def test_small_holes_filled_large_ones_kept():
     a = np.full((40, 40), 5.0, dtype=np.float32)
     a[5:7, 5:7] = np.nan  # 4 cells
     a[20:32, 20:32] = np.nan  # 144 cells
-    out = dsm.fill_small_holes(a, max_hole_cells=16)
+    out = gridding.fill_small_holes(a, max_hole_cells=16)
     assert np.isfinite(out[5:7, 5:7]).all() and np.allclose(out[5:7, 5:7], 5.0)
     assert np.isnan(out[20:32, 20:32]).all()
 

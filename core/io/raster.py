@@ -1,20 +1,14 @@
-"""Digital surface models: points -> raster, Cloud-Optimized GeoTIFF, reading, LAS point clouds.
+"""Rasters and point clouds on disk: the DSM's Cloud-Optimized GeoTIFF, the DSM reader, LAS point clouds.
 
 This is the one module that writes and reads DSMs, so the orthophoto stage reads
 ours and an external one (an ALS DSM the user has) through the same helpers:
 :func:`open_dsm`, :class:`DsmReader` (window reads, bilinear sampling, optional
-reprojection into the workspace CRS).
-
-Rasterisation (:func:`rasterize_points`) works tile by tile over point files, so
-memory is bounded by the points of one tile.  Per cell it takes the median of
-the *highest cluster* of heights (the points within ``cluster_tol`` of the
-cell's 90th percentile), so a cell on a roof edge shows the roof, not a mean of
-roof and ground, and a lone low point under a crown does not pull it down.
-Small holes (at most ``max_hole_cells`` cells) are filled from their borders;
-larger ones stay nodata.
+reprojection into the workspace CRS).  :class:`Grid` is the north-up raster grid
+both stages write on; turning points into heights on it is
+:mod:`core.dense.grid`.
 
 Outputs are written to a temporary name and renamed when complete
-(:func:`core.workspace.atomic_output`).
+(:func:`core.project.workspace.atomic_output`).
 """
 from __future__ import annotations
 
@@ -22,18 +16,18 @@ import math
 import os
 import struct
 from dataclasses import dataclass, field
-from typing import Callable, Iterable, Optional, Sequence, Tuple
+from typing import Iterable, Optional, Sequence, Tuple
 
 import numpy as np
 
-from ..common.progress import NullProgress, Progress, check_cancel
+from ..common.errors import ArchaeoOrthoError
 from ..common.files import atomic_output
+from ..common.progress import NullProgress, Progress, check_cancel
 
 NODATA = -9999.0
-TILE = 1024  # cells per tile side for rasterisation
 
 
-class DsmError(RuntimeError):
+class DsmError(ArchaeoOrthoError, RuntimeError):
     """A DSM cannot be written or read; the message says why."""
 
 
@@ -71,7 +65,7 @@ def crs_epsg(crs: Optional[str]) -> Tuple[Optional[int], bool]:
 
 
 # ---------------------------------------------------------------------------
-# grid and rasterisation
+# grid
 # ---------------------------------------------------------------------------
 
 @dataclass
@@ -105,173 +99,6 @@ class Grid:
         xs = self.x0 + (np.arange(self.width) + 0.5) * self.resolution
         ys = self.y0 - (np.arange(self.height) + 0.5) * self.resolution
         return xs, ys
-
-
-@dataclass
-class PointFile:
-    """Points of one source (one image's fused depth map) on disk, with their bounding box
-    in the local frame; ``load`` returns (xyz float32 local, rgb uint8)."""
-
-    path: str
-    bbox: Tuple[float, float, float, float]  # xmin, ymin, xmax, ymax (local frame)
-    count: int
-
-    def load(self) -> Tuple[np.ndarray, np.ndarray]:
-        with np.load(self.path) as d:
-            return d["xyz"], d["rgb"]
-
-
-def cell_statistic(cells: np.ndarray, z: np.ndarray, n_cells: int, cluster_tol: float,
-                   upper_quantile: float = 0.9) -> Tuple[np.ndarray, np.ndarray]:
-    """Per cell: (value, count), value = median of the points within ``cluster_tol`` below the
-    cell's ``upper_quantile`` height (the highest cluster).  NaN where a cell has no point."""
-    value = np.full(n_cells, np.nan, dtype=np.float32)
-    count = np.zeros(n_cells, dtype=np.int32)
-    if len(z) == 0:
-        return value, count
-    order = np.lexsort((z, cells))
-    c = cells[order]
-    zs = z[order].astype(np.float64)
-    starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
-    ends = np.r_[starts[1:], len(c)]
-    n = ends - starts
-    ucell = c[starts]
-    q_idx = starts + np.floor((n - 1) * upper_quantile).astype(np.int64)
-    q = zs[q_idx]
-    # first index in each cell with z >= q - tol: search on a key that is sorted by (cell, z)
-    zmin = zs.min()
-    span = zs.max() - zmin + 2 * cluster_tol + 1.0
-    key = (np.arange(len(starts)).repeat(n) * span) + (zs - zmin)
-    first = np.searchsorted(key, np.arange(len(starts)) * span + (q - cluster_tol - zmin), side="left")
-    first = np.clip(first, starts, q_idx)
-    last = np.maximum(q_idx, first)  # include up to the quantile point (higher ones are outlier candidates)
-    mid_lo = (first + last) // 2
-    mid_hi = (first + last + 1) // 2
-    value[ucell] = (0.5 * (zs[mid_lo] + zs[mid_hi])).astype(np.float32)
-    count[ucell] = n
-    return value, count
-
-
-def fill_small_holes(dsm: np.ndarray, max_hole_cells: int = 16, iterations: int = 0) -> np.ndarray:
-    """Fill nodata holes (NaN) of at most ``max_hole_cells`` cells by averaging their valid
-    neighbours inwards; holes that touch the raster edge or are larger stay NaN."""
-    from scipy import ndimage
-
-    out = dsm.copy()
-    holes = ~np.isfinite(out)
-    if not holes.any() or max_hole_cells <= 0:
-        return out
-    lab, n = ndimage.label(holes)
-    if n == 0:
-        return out
-    sizes = np.bincount(lab.ravel())
-    edge = np.unique(np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]]))
-    small = sizes <= max_hole_cells
-    small[0] = False
-    small[edge] = False
-    fill = small[lab]
-    if not fill.any():
-        return out
-    iterations = iterations or int(math.ceil(math.sqrt(max_hole_cells))) + 2
-    kernel = np.ones((3, 3), dtype=np.float64)
-    for _ in range(iterations):
-        valid = np.isfinite(out)
-        vals = np.where(valid, out, 0.0).astype(np.float64)
-        s = ndimage.convolve(vals, kernel, mode="constant")
-        k = ndimage.convolve(valid.astype(np.float64), kernel, mode="constant")
-        todo = fill & ~valid & (k > 0)
-        if not todo.any():
-            break
-        out[todo] = (s[todo] / k[todo]).astype(out.dtype)
-    return out
-
-
-def remove_speckles(dsm: np.ndarray, max_cells: int = 4) -> np.ndarray:
-    """Drop isolated groups of at most ``max_cells`` valid cells (lone matches far from the surface
-    are usually wrong); they become holes that fill_small_holes may fill."""
-    from scipy import ndimage
-
-    valid = np.isfinite(dsm)
-    lab, n = ndimage.label(valid, structure=np.ones((3, 3)))
-    if n == 0:
-        return dsm
-    sizes = np.bincount(lab.ravel())
-    small = sizes <= max_cells
-    small[0] = False
-    out = dsm.copy()
-    out[small[lab]] = np.nan
-    return out
-
-
-def rasterize_points(files: Sequence[PointFile], grid: Grid, offset: Sequence[float], cluster_tol: float,
-                     progress: Optional[Progress] = None, tile: int = TILE) -> Tuple[np.ndarray, np.ndarray]:
-    """Rasterise point files (local frame; world = local + offset) onto ``grid``: (heights float32 with NaN
-    for no data, point counts int32).  Tile by tile: memory ~ the points of one tile."""
-    progress = progress or NullProgress()
-    off = np.asarray(offset, dtype=np.float64)
-    dsm = np.full((grid.height, grid.width), np.nan, dtype=np.float32)
-    counts = np.zeros((grid.height, grid.width), dtype=np.int32)
-    tiles = [(r, c) for r in range(0, grid.height, tile) for c in range(0, grid.width, tile)]
-    res = grid.resolution
-    for k, (r0, c0) in enumerate(tiles):
-        check_cancel(progress)
-        h = min(tile, grid.height - r0)
-        w = min(tile, grid.width - c0)
-        # tile bounds in the local frame
-        txmin = grid.x0 + c0 * res - off[0]
-        txmax = txmin + w * res
-        tymax = grid.y0 - r0 * res - off[1]
-        tymin = tymax - h * res
-        cells_parts, z_parts = [], []
-        for pf in files:
-            bx0, by0, bx1, by1 = pf.bbox
-            if bx1 < txmin or bx0 > txmax or by1 < tymin or by0 > tymax:
-                continue
-            xyz, _ = pf.load()
-            ix = np.floor((xyz[:, 0].astype(np.float64) - txmin) / res).astype(np.int64)
-            iy = np.floor((tymax - xyz[:, 1].astype(np.float64)) / res).astype(np.int64)
-            m = (ix >= 0) & (ix < w) & (iy >= 0) & (iy < h) & np.isfinite(xyz[:, 2])
-            if m.any():
-                cells_parts.append(iy[m] * w + ix[m])
-                z_parts.append(xyz[m, 2].astype(np.float64) + off[2])
-        if cells_parts:
-            cells = np.concatenate(cells_parts)
-            z = np.concatenate(z_parts)
-            del cells_parts, z_parts
-            val, cnt = cell_statistic(cells, z, w * h, cluster_tol)
-            dsm[r0:r0 + h, c0:c0 + w] = val.reshape(h, w)
-            counts[r0:r0 + h, c0:c0 + w] = cnt.reshape(h, w)
-        progress.report((k + 1) / len(tiles), f"DSM tile {k + 1}/{len(tiles)}")
-    return dsm, counts
-
-
-def polygon_mask(grid: Grid, polygon_xy: np.ndarray) -> np.ndarray:
-    """Boolean mask of the cells (centres) inside a polygon given in world coordinates."""
-    import cv2
-
-    mask = np.zeros((grid.height, grid.width), dtype=np.uint8)
-    if len(polygon_xy) < 3:
-        return mask.astype(bool)
-    p = np.asarray(polygon_xy, dtype=np.float64)
-    cols = (p[:, 0] - grid.x0) / grid.resolution - 0.5
-    rows = (grid.y0 - p[:, 1]) / grid.resolution - 0.5
-    pts = np.round(np.column_stack([cols, rows]) * 16).astype(np.int32)  # 4 fractional bits
-    cv2.fillPoly(mask, [pts.reshape(-1, 1, 2)], 1, lineType=cv2.LINE_8, shift=4)
-    return mask.astype(bool)
-
-
-def convex_hull_xy(points_xy: np.ndarray) -> np.ndarray:
-    """Convex hull (counter-clockwise vertices) of 2-D points; fewer than 3 distinct points -> as given."""
-    pts = np.unique(np.asarray(points_xy, dtype=float), axis=0)
-    if len(pts) < 3:
-        return pts
-    try:
-        from scipy.spatial import ConvexHull
-
-        hull = ConvexHull(pts)
-    except Exception:  # collinear points (one strip)  # noqa: BLE001
-        return pts
-    return pts[hull.vertices]
 
 
 # ---------------------------------------------------------------------------
@@ -617,20 +444,5 @@ def read_las(path: str) -> Tuple[np.ndarray, np.ndarray, dict]:
     return xyz, rgb, header
 
 
-def stream_point_files(files: Sequence[PointFile]) -> Iterable[Tuple[np.ndarray, np.ndarray]]:
-    for pf in files:
-        yield pf.load()
-
-
-def footprint_valid_fraction(dsm: np.ndarray, mask: np.ndarray) -> Optional[float]:
-    n = int(mask.sum())
-    if n == 0:
-        return None
-    return float(np.isfinite(dsm[mask]).sum() / n)
-
-
-Loader = Callable[[], Tuple[np.ndarray, np.ndarray]]
-
-__all__ = ["Grid", "PointFile", "rasterize_points", "fill_small_holes", "remove_speckles", "write_cog", "open_dsm",
-           "DsmReader", "read_dsm", "write_las", "read_las", "DsmError", "NODATA", "convex_hull_xy",
-           "polygon_mask", "footprint_valid_fraction", "cell_statistic", "bilinear"]
+__all__ = ["Grid", "write_cog", "open_dsm", "DsmReader", "DsmInfo", "read_dsm", "write_las", "read_las", "DsmError",
+           "NODATA", "bilinear", "crs_to_wkt", "crs_epsg"]

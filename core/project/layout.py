@@ -237,12 +237,13 @@ class Layout:
         return self.path(UNCERTAINTY_DIR)
 
     # --- helpers ---------------------------------------------------------
-    def model_fingerprints(self, model_dir: Optional[str] = None) -> Dict[str, str]:
-        """Fingerprints of a model's .bin files (what a stage built on it records as inputs)."""
+    def model_fingerprints(self, model_dir: Optional[str] = None, prefix: str = "model/") -> Dict[str, str]:
+        """Fingerprints of a model's .bin files (what a stage built on it records as inputs), keyed
+        ``prefix`` + file name (the DSM stage records bare names: prefix "")."""
         from .workspace import file_fingerprint
 
         model_dir = model_dir or self.georef_model_dir
-        return {"model/" + n: file_fingerprint(os.path.join(model_dir, n))
+        return {prefix + n: file_fingerprint(os.path.join(model_dir, n))
                 for n in sorted(os.listdir(model_dir)) if n.endswith(".bin")}
 
     @staticmethod

@@ -1,0 +1,120 @@
+"""Fusion per image, the unit of work after matching: the depth maps an image received from its pairs ->
+coloured points.
+
+The depth maps are compared pixel by pixel; a pixel is kept where at least ``min_consistent`` independent
+pairs agree within a tolerance (about one disparity pixel of the weakest pair, relative to depth), its depth is
+the mean of the agreeing ones, and it is back-projected with the camera model and coloured from the image.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import List, Optional, Tuple
+
+import numpy as np
+
+from ..common.errors import require
+from ..common.parallel import check_unit_cancel
+from .options import DenseError
+from .pairs import View, load_scaled
+
+
+@dataclass
+class FuseUnit:
+    view: View
+    scale: float
+    maps: List[Tuple[str, str, float]]  # (pair file, role 'i' or 'j', relative depth error per px)
+    tolerance_px: float
+    min_consistent: int
+    out_path: str
+    threads: int
+
+
+def fuse_depth_maps(maps: np.ndarray, rel_tol: np.ndarray, min_consistent: int) -> Tuple[np.ndarray, np.ndarray]:
+    """Fuse k depth maps (k, h, w) of one image: per pixel the candidate most others agree with
+    (|d_l - d_m| <= rel_tol * d_m); kept where at least ``min_consistent`` maps agree; value = their mean.
+    Returns (depth with NaN, number of agreeing maps)."""
+    k = maps.shape[0]
+    best_n = np.zeros(maps.shape[1:], dtype=np.int16)
+    best_v = np.full(maps.shape[1:], np.nan, dtype=np.float32)
+    for m in range(k):
+        ref = maps[m]
+        tol = rel_tol[m] * ref
+        agree = np.zeros(maps.shape[1:], dtype=np.int16)
+        total = np.zeros(maps.shape[1:], dtype=np.float64)
+        for ll in range(k):
+            with np.errstate(invalid="ignore"):
+                a = np.abs(maps[ll] - ref) <= np.maximum(tol, rel_tol[ll] * ref)
+            agree += a
+            total += np.where(a, maps[ll], 0.0)
+        better = agree > best_n
+        best_n = np.where(better, agree, best_n)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            best_v = np.where(better, (total / np.maximum(agree, 1)).astype(np.float32), best_v)
+    keep = best_n >= max(1, min_consistent)
+    return np.where(keep, best_v, np.nan).astype(np.float32), best_n
+
+
+def backproject(view: View, k: np.ndarray, dist: np.ndarray, depth: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    """Local-frame points of the valid pixels of a depth map (z along the optical axis) and their (rows, cols)."""
+    cv2 = require("cv2", "depth fusion")
+    rows, cols = np.nonzero(np.isfinite(depth))
+    if len(rows) == 0:
+        return np.zeros((0, 3)), (rows, cols)
+    pix = np.column_stack([cols, rows]).astype(np.float64).reshape(-1, 1, 2)
+    und = cv2.undistortPoints(pix, k, dist).reshape(-1, 2)
+    z = depth[rows, cols].astype(np.float64)
+    pc = np.column_stack([und[:, 0] * z, und[:, 1] * z, z])
+    return pc @ view.R + view.centre, (rows, cols)
+
+
+def fuse_image(unit: FuseUnit, cancel_path: Optional[str] = None) -> dict:
+    """The unit of fusion: one image's depth maps -> coloured points (local frame) in ``unit.out_path``."""
+    cv2 = require("cv2", "depth fusion")
+    cv2.setNumThreads(max(1, unit.threads))
+    check_unit_cancel(cancel_path)
+    maps, errs = [], []
+    for path, role, rel_err in unit.maps:
+        with np.load(path) as d:
+            m = d["depth_" + role]
+        if m.size:
+            maps.append(m)
+            errs.append(rel_err)
+    out = {"image": unit.view.name, "points": 0, "path": unit.out_path, "bbox": None}
+    if len(maps) < unit.min_consistent:
+        out["note"] = f"{len(maps)} usable pair(s), {unit.min_consistent} needed"
+        return out
+    shapes = {m.shape for m in maps}
+    if len(shapes) != 1:
+        raise DenseError(f"depth maps of {unit.view.name} differ in size: {shapes}")
+    stack = np.stack(maps)
+    rel_tol = np.clip(unit.tolerance_px * np.asarray(errs, dtype=np.float64), 0.002, 0.05)
+    fused, _n = fuse_depth_maps(stack, rel_tol, unit.min_consistent)
+    del stack, maps
+    check_unit_cancel(cancel_path)
+    img, sx, sy = load_scaled(unit.view, unit.scale)
+    k, dist = unit.view.camera_matrix(sx, sy)
+    xyz, (rows, cols) = backproject(unit.view, k, dist, fused)
+    rgb = _to_rgb8(img)[rows, cols]
+    if len(xyz):
+        lo = np.percentile(xyz[:, :2], 0.5, axis=0)
+        hi = np.percentile(xyz[:, :2], 99.5, axis=0)
+        out["bbox"] = [float(v) for v in (*xyz[:, 0:2].min(axis=0), *xyz[:, 0:2].max(axis=0))]
+        out["robust_bbox"] = [float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])]
+    tmp = unit.out_path + ".partial.npz"
+    np.savez(tmp, xyz=xyz.astype(np.float32), rgb=rgb.astype(np.uint8))
+    os.replace(tmp, unit.out_path)
+    out["points"] = int(len(xyz))
+    return out
+
+
+def _to_rgb8(img: np.ndarray) -> np.ndarray:
+    if img.shape[2] >= 3:
+        rgb = img[:, :, :3]
+    else:
+        rgb = np.repeat(img[:, :, :1], 3, axis=2)
+    if rgb.dtype != np.uint8:
+        rgb = rgb.astype(np.float32)
+        lo, hi = np.percentile(rgb, [0.5, 99.5])
+        rgb = np.clip((rgb - lo) * (255.0 / max(hi - lo, 1e-6)), 0, 255).astype(np.uint8)
+    return np.ascontiguousarray(rgb)

@@ -1,0 +1,48 @@
+"""The options of the DSM stage (defaults in this one place), its qualities and engines, and its error."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+from ..common.errors import ArchaeoOrthoError
+
+QUALITIES = {"full": 1.0, "half": 0.5, "quarter": 0.25}  # QUALITY -> image downscale for matching
+ENGINES = ("cpu", "cuda")
+CACHE_VERSION = 1  # of the per-pair depth map cache (dense/pairs-<key>/)
+
+# options that say where the work runs, not what it computes (not recorded among the stage's parameters)
+EXECUTION_OPTIONS = ("workers", "executor", "scheduler")
+
+
+class DenseError(ArchaeoOrthoError, RuntimeError):
+    """Dense matching cannot run with these inputs; the message says why."""
+
+
+@dataclass
+class DenseOptions:
+    quality: str = "half"
+    partners: int = 5  # at most this many pairs chosen per image (greedy two-fold cover of its tie points)
+    min_shared_points: int = 15
+    min_baseline_ratio: float = 0.03
+    max_baseline_ratio: float = 1.2
+    ideal_baseline_ratio: float = 0.3
+    max_view_angle: float = 40.0  # degrees between the optical axes
+    block_size: int = 0  # SGBM block; 0 = auto (5 at full/half, 3 at quarter)
+    uniqueness: int = 10
+    lr_tolerance: float = 1.0  # px
+    min_consistent: int = 2  # pairs that must agree on a pixel
+    depth_tolerance_px: float = 1.0  # agreement tolerance, in disparity pixels of the weakest pair
+    max_hole_cells: int = 16
+    workers: int = 0  # 0 = one per core (bounded by memory)
+    executor: str = "auto"  # auto / serial / process / thread
+    scheduler: Optional[str] = None  # Dask scheduler address
+
+    @property
+    def scale(self) -> float:
+        """The image downscale of ``quality``."""
+        return QUALITIES[self.quality]
+
+    def sgbm_block(self) -> int:
+        """The SGBM block size: ``block_size``, or 3 at quarter quality and 5 above; always odd."""
+        block = self.block_size or (3 if self.scale <= 0.25 else 5)
+        return block + 1 if block % 2 == 0 else block

@@ -1,0 +1,225 @@
+"""The two drivers that turn the chosen pairs into fused point files (local frame).
+
+Engine ``cpu`` (the default and the tested one): every pair is a unit of work (:func:`stereo.match_pair`, run
+through :mod:`core.common.parallel`, cached in ``dense/pairs-<key>/`` so a re-run skips finished pairs), then
+every image is one (:func:`fusion.fuse_image`).  Engine ``cuda`` runs COLMAP's patch-match stereo and fusion
+instead (only where pycolmap was built with CUDA).  Both return :class:`grid.PointFile` s for the DSM.
+"""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import time
+from typing import Callable, Dict, List, Tuple
+
+import numpy as np
+
+from ..common.cancel import CancelWatcher, load_pycolmap
+from ..common.files import atomic_write_text, fingerprint
+from ..common.parallel import cpu_count, describe_executor, make_executor, run_units
+from ..common.progress import Progress, SubProgress
+from .fusion import FuseUnit, fuse_image
+from .grid import PointFile
+from .options import CACHE_VERSION, DenseError, DenseOptions
+from .pairs import PairInfo, View
+from .stereo import PairUnit, match_pair, read_pair_summary
+
+Say = Callable[[str], None]
+
+
+def unit_memory(views: Dict[int, View], scale: float) -> int:
+    """Bytes one matching unit needs at most (bounds the number of local workers)."""
+    px = max(v.width * v.height for v in views.values()) * scale * scale
+    return int(px * 160)  # both images, rectified copies, maps, SGBM buffers, disparities, depth maps
+
+
+def threads_per_unit(workers: int) -> int:
+    return max(1, cpu_count() // max(1, workers))
+
+
+# ---------------------------------------------------------------------------
+# cpu: pairs -> depth maps -> fused points per image
+# ---------------------------------------------------------------------------
+
+def cpu_points(views: Dict[int, View], pairs: List[PairInfo], xyz: np.ndarray, options: DenseOptions,
+               dense_dir: str, model_fp: Dict[str, str], progress: Progress, warn: Say,
+               log: List[str]) -> Tuple[List[PointFile], int, int, Dict[str, float]]:
+    """(point files, pairs matched, pairs reused from the cache, timings) of the OpenCV engine."""
+    timings: Dict[str, float] = {}
+    scale = options.scale
+    block = options.sgbm_block()
+    pair_dir = _pair_cache(dense_dir, model_fp, scale, block, options)
+    unit_mem = unit_memory(views, scale)
+    executor = make_executor(options.workers, options.executor, options.scheduler, unit_memory=unit_mem)
+    workers = getattr(executor, "_max_workers", 1) or 1
+    where = describe_executor(executor)
+    threads = threads_per_unit(workers)
+
+    # 2. matching, pair by pair
+    t0 = time.time()
+
+    def unit(p: PairInfo, out: str) -> PairUnit:
+        return PairUnit(f"{p.i}-{p.j}", out, views[p.i], views[p.j], scale, xyz[p.point_idx], block,
+                        options.uniqueness, options.lr_tolerance, threads)
+
+    units, summaries, n_reused = _cached_pairs(pairs, pair_dir, unit, progress)
+    sub = SubProgress(progress, 0.02 + 0.73 * (n_reused / len(pairs)), 0.75)
+    with executor:
+        for _i, summary in run_units(executor, match_pair, units, sub, label="pair",
+                                     describe=lambda u: f"{u.vi.name} + {u.vj.name}", cancel_dir=dense_dir):
+            summaries.append(summary)
+    timings["matching"] = time.time() - t0
+    matched = _matched(summaries, warn)
+    secs = [s["seconds"] for s in matched if "seconds" in s]
+    mp = sum(s.get("megapixels", 0.0) for s in matched)
+    log.append(f"matching: {len(matched)} pairs ({n_reused} reused from a previous run), "
+               f"{np.mean(secs) if secs else 0:.2f} s per pair, {sum(secs) / max(mp, 1e-9):.2f} s per megapixel, "
+               f"{where}")
+    progress.info(log[-1])
+
+    # 3. fusion, image by image
+    t0 = time.time()
+    files = _fuse(views, pairs, summaries, pair_dir, options, dense_dir, unit_mem, threads, progress)
+    timings["fusion"] = time.time() - t0
+    return files, len(matched), n_reused, timings
+
+
+def _pair_cache(dense_dir: str, model_fp: Dict[str, str], scale: float, block: int, options: DenseOptions) -> str:
+    """The folder of this model's and these settings' depth maps (caches of others removed, partial files too)."""
+    key = fingerprint({"v": CACHE_VERSION, "model": model_fp, "scale": scale, "block": block,
+                       "uniq": options.uniqueness, "lr": options.lr_tolerance})
+    pair_dir = os.path.join(dense_dir, f"pairs-{key}")
+    for name in os.listdir(dense_dir):  # caches of other models / settings
+        if name.startswith("pairs-") and name != f"pairs-{key}":
+            shutil.rmtree(os.path.join(dense_dir, name), ignore_errors=True)
+    os.makedirs(pair_dir, exist_ok=True)
+    for name in os.listdir(pair_dir):
+        if ".partial" in name:
+            os.unlink(os.path.join(pair_dir, name))
+    atomic_write_text(os.path.join(pair_dir, "cache.json"),
+                      json.dumps({"model": model_fp, "scale": scale, "block": block}, indent=1))
+    return pair_dir
+
+
+def _cached_pairs(pairs: List[PairInfo], pair_dir: str, unit: Callable[[PairInfo, str], PairUnit],
+                  progress: Progress) -> Tuple[List[PairUnit], List[dict], int]:
+    """(units still to match, summaries of the pairs a previous run matched, how many were reused)."""
+    units, done_pairs = [], []
+    for p in pairs:
+        out = os.path.join(pair_dir, f"{p.i}-{p.j}.npz")
+        if os.path.isfile(out):
+            done_pairs.append((p, out))
+            continue
+        units.append(unit(p, out))
+    n_reused = len(done_pairs)
+    if n_reused:
+        progress.info(f"resuming: {n_reused} of {len(pairs)} pairs already matched")
+    summaries = []
+    for p, out in done_pairs:
+        try:
+            summaries.append(read_pair_summary(out))
+        except (OSError, ValueError, KeyError):  # damaged cache file: match again
+            os.unlink(out)
+            units.append(unit(p, out))
+            n_reused -= 1
+    return units, summaries, n_reused
+
+
+def _matched(summaries: List[dict], warn: Say) -> List[dict]:
+    """The summaries of the pairs that matched; a warning for each skipped one; DenseError if none matched."""
+    skipped = [s for s in summaries if s.get("skipped")]
+    for s in skipped:
+        warn(f"pair {s['i']} + {s['j']} skipped: {s['skipped']}")
+    matched = [s for s in summaries if not s.get("skipped")]
+    if not matched:
+        raise DenseError("no stereo pair could be rectified and matched: " + "; ".join(
+            s["skipped"] for s in skipped[:5]))
+    return matched
+
+
+def _fuse(views: Dict[int, View], pairs: List[PairInfo], summaries: List[dict], pair_dir: str,
+          options: DenseOptions, dense_dir: str, unit_mem: int, threads: int, progress: Progress) -> List[PointFile]:
+    """Fuse the depth maps of every image in ``min_consistent`` or more matched pairs -> point files."""
+    by_key = {s["key"]: s for s in summaries}
+    per_image: Dict[int, List[Tuple[str, str, float]]] = {}
+    for p in pairs:
+        s = by_key.get(f"{p.i}-{p.j}")
+        if s is None or s.get("skipped"):
+            continue
+        path = os.path.join(pair_dir, f"{p.i}-{p.j}.npz")
+        per_image.setdefault(p.i, []).append((path, "i", float(s.get("rel_err", 0.01))))
+        per_image.setdefault(p.j, []).append((path, "j", float(s.get("rel_err", 0.01))))
+    fused_dir = _fresh_fused_dir(dense_dir)
+    lonely = [views[i].name for i, m in per_image.items() if len(m) < options.min_consistent]
+    if lonely:
+        progress.info(f"{len(lonely)} image(s) are in fewer than {options.min_consistent} matched pairs and add no "
+                      f"points of their own: {', '.join(lonely[:6])}{' ...' if len(lonely) > 6 else ''}")
+    funits = [FuseUnit(views[i], options.scale, maps, options.depth_tolerance_px, options.min_consistent,
+                       os.path.join(fused_dir, f"{i}.npz"), threads)
+              for i, maps in sorted(per_image.items()) if len(maps) >= options.min_consistent]
+    files: List[PointFile] = []
+    executor = make_executor(options.workers, options.executor, options.scheduler, unit_memory=unit_mem)
+    with executor:
+        for _i, r in run_units(executor, fuse_image, funits, SubProgress(progress, 0.75, 0.88), label="fusion",
+                               describe=lambda u: u.view.name, cancel_dir=dense_dir):
+            if r["points"] > 0:
+                files.append(PointFile(r["path"], tuple(r["bbox"]), r["points"], tuple(r["robust_bbox"])))
+    return files
+
+
+def _fresh_fused_dir(dense_dir: str) -> str:
+    fused_dir = os.path.join(dense_dir, "fused")
+    shutil.rmtree(fused_dir, ignore_errors=True)
+    os.makedirs(fused_dir)
+    return fused_dir
+
+
+# ---------------------------------------------------------------------------
+# cuda: COLMAP patch-match stereo + fusion
+# ---------------------------------------------------------------------------
+
+def cuda_points(views: Dict[int, View], scale: float, dense_dir: str, model_dir: str, images_dir: str,
+                model_fp: Dict[str, str], progress: Progress) -> Tuple[List[PointFile], int]:
+    """COLMAP patch-match stereo + fusion (CUDA builds of pycolmap only): (points as one point file, 0 reused)."""
+    pycolmap = load_pycolmap("dense matching on CUDA")
+    mvs = os.path.join(dense_dir, "mvs")
+    key = fingerprint({"model": model_fp, "scale": scale})
+    key_file = os.path.join(mvs, "archaeoortho-key.txt")
+    if os.path.isdir(mvs) and (not os.path.isfile(key_file) or _read_text(key_file).strip() != key):
+        shutil.rmtree(mvs, ignore_errors=True)  # built from another model or scale
+    fused_dir = _fresh_fused_dir(dense_dir)
+    max_size = int(max(max(v.width, v.height) for v in views.values()) * scale)
+    with CancelWatcher(progress) as token:
+        progress.report(0.0, "undistorting images (COLMAP)")
+        if not os.path.isdir(os.path.join(mvs, "stereo")):
+            uo = pycolmap.UndistortCameraOptions()
+            uo.max_image_size = max_size
+            pycolmap.undistort_images(mvs, model_dir, images_dir, undistort_options=uo, cancellation_token=token)
+            atomic_write_text(key_file, key)
+        progress.report(0.1, "patch-match stereo (COLMAP, CUDA)")
+        pm = pycolmap.PatchMatchOptions()
+        pm.max_image_size = max_size
+        pm.geom_consistency = True
+        pycolmap.patch_match_stereo(mvs, options=pm, cancellation_token=token)
+        progress.report(0.8, "stereo fusion (COLMAP)")
+        fo = pycolmap.StereoFusionOptions()
+        fo.max_image_size = max_size
+        fused = pycolmap.stereo_fusion(os.path.join(mvs, "fused.ply"), mvs, options=fo, output_type="PLY",
+                                       cancellation_token=token)
+    pts = [(np.asarray(p.xyz), np.asarray(p.color)) for p in fused.points3D.values()]
+    xyz = np.array([p[0] for p in pts], dtype=np.float32).reshape(-1, 3)
+    rgb = np.array([p[1] for p in pts], dtype=np.uint8).reshape(-1, 3)
+    path = os.path.join(fused_dir, "cuda.npz")
+    np.savez(path, xyz=xyz, rgb=rgb)
+    if len(xyz) == 0:
+        return [], 0
+    lo = np.percentile(xyz[:, :2], 0.5, axis=0)
+    hi = np.percentile(xyz[:, :2], 99.5, axis=0)
+    bbox = (*xyz[:, :2].min(axis=0), *xyz[:, :2].max(axis=0))
+    return [PointFile(path, tuple(float(v) for v in bbox), len(xyz), (lo[0], lo[1], hi[0], hi[1]))], 0
+
+
+def _read_text(path: str) -> str:
+    with open(path, encoding="utf-8") as f:
+        return f.read()
