@@ -6,7 +6,8 @@ import warnings
 import numpy as np
 import pytest
 
-from core.io import gcp
+from core.geometry import crs as crsmod
+from core.geometry.crs import check_coordinates_match_crs, crs_is_geographic, transform_points, utm_epsg_for_lonlat
 from core.io.gcp import (
     CHECK,
     CONTROL,
@@ -15,15 +16,11 @@ from core.io.gcp import (
     GroundPoint,
     Observation,
     apply_check_points,
-    check_coordinates_match_crs,
     check_units,
-    crs_is_geographic,
     gcps_from_rows,
     read_camera_positions,
     read_csv_gcps,
     read_gcps,
-    transform_points,
-    utm_epsg_for_lonlat,
     write_csv_gcps,
     write_gcps,
     write_odm_gcp_list,
@@ -156,8 +153,8 @@ def test_unknown_crs_is_an_error(tmp_path, header):
 
 
 def test_crs_not_validated_without_a_crs_library(tmp_path, monkeypatch):
-    monkeypatch.setattr(gcp, "_osr", lambda: None)
-    monkeypatch.setattr(gcp, "_pyproj", lambda: None)
+    monkeypatch.setattr(crsmod, "_osr", lambda: None)
+    monkeypatch.setattr(crsmod, "_pyproj", lambda: None)
     p = write(tmp_path, "g.txt", "EPSG:999999\n1 2 3 10 20 a.jpg P1\n1 2 3 11 21 b.jpg P1\n")
     gs = read_gcps(p)
     assert gs.crs == "EPSG:999999"
