@@ -29,6 +29,7 @@ import tempfile
 import threading
 from typing import Any, Callable, Iterator, List, Optional, Sequence, Tuple
 
+from .errors import ArchaeoOrthoError
 from .progress import Cancelled, NullProgress, Progress
 
 KINDS = ("auto", "serial", "process", "thread")
@@ -36,7 +37,7 @@ KINDS = ("auto", "serial", "process", "thread")
 SCHEDULER_ENV = "ARCHAEOORTHO_DASK_SCHEDULER"
 
 
-class ParallelError(RuntimeError):
+class ParallelError(ArchaeoOrthoError, RuntimeError):
     """The executor could not be created; the message says why."""
 
 
