@@ -1,18 +1,13 @@
 """Georeference: thin adapter over core.pipeline.georeference_workspace."""
 from qgis.core import (
     QgsCoordinateReferenceSystem,
-    QgsProcessing,
     QgsProcessingException,
     QgsProcessingOutputFolder,
     QgsProcessingOutputNumber,
     QgsProcessingOutputVectorLayer,
-    QgsProcessingParameterBoolean,
-    QgsProcessingParameterCrs,
-    QgsProcessingParameterFeatureSource,
-    QgsProcessingParameterFile,
-    QgsProcessingParameterString,
 )
 
+from . import params
 from .base import AlgorithmBase, FeedbackProgress
 
 
@@ -46,25 +41,17 @@ class GeoreferenceAlgorithm(AlgorithmBase):
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
-        self.addParameter(QgsProcessingParameterFile(
-            self.WORKSPACE, self.tr("Workspace folder (aligned)"), behavior=QgsProcessingParameterFile.Folder))
-        self.addParameter(QgsProcessingParameterFile(
-            self.GCPS, self.tr("Ground control file (gcp_list.txt or CSV)"), optional=True,
-            fileFilter="GCP files (*.txt *.csv);;All files (*)"))
-        self.addParameter(QgsProcessingParameterFeatureSource(
-            self.GCP_LAYER, self.tr("Ground control point layer (one feature per observation)"),
-            [QgsProcessing.TypeVectorPoint], optional=True))
-        self.addParameter(QgsProcessingParameterString(
-            self.CHECK_POINTS, self.tr("Check points (comma-separated names)"), defaultValue="", optional=True))
-        self.addParameter(QgsProcessingParameterFile(
-            self.CAMERA_POSITIONS, self.tr("Camera positions (CSV)"), optional=True,
-            fileFilter="CSV/text (*.csv *.txt);;All files (*)"))
-        self.addParameter(QgsProcessingParameterBoolean(
-            self.USE_EXIF_GPS, self.tr("Use EXIF GPS camera positions"), defaultValue=False))
-        self.addParameter(QgsProcessingParameterCrs(
-            self.CRS, self.tr("Target CRS (default: the GCP file's)"), optional=True))
-        self.addParameter(QgsProcessingParameterBoolean(
-            self.REFINE_INTRINSICS, self.tr("Refine camera calibration in the adjustment"), defaultValue=False))
+        params.add(
+            self,
+            params.folder(self.WORKSPACE, self.tr("Workspace folder (aligned)")),
+            params.gcp_file(self.GCPS, self.tr("Ground control file (gcp_list.txt or CSV)")),
+            params.gcp_layer(self.GCP_LAYER, self.tr("Ground control point layer (one feature per observation)")),
+            params.check_points(self.CHECK_POINTS, self.tr("Check points (comma-separated names)")),
+            params.camera_positions(self.CAMERA_POSITIONS, self.tr("Camera positions (CSV)")),
+            params.flag(self.USE_EXIF_GPS, self.tr("Use EXIF GPS camera positions")),
+            params.target_crs(self.CRS, self.tr("Target CRS (default: the GCP file's)")),
+            params.flag(self.REFINE_INTRINSICS, self.tr("Refine camera calibration in the adjustment")),
+        )
         self.addOutput(QgsProcessingOutputFolder(self.OUT_WORKSPACE, self.tr("Workspace")))
         self.addOutput(QgsProcessingOutputVectorLayer(self.RESIDUALS, self.tr("GCP residuals")))
         self.addOutput(QgsProcessingOutputVectorLayer(self.CAMERAS, self.tr("Camera centres (world)")))
@@ -73,21 +60,16 @@ class GeoreferenceAlgorithm(AlgorithmBase):
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
         from ..core import pipeline
-        from ..core.io import gcp as gcpmod
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
-        gcp_path = self.parameterAsFile(parameters, self.GCPS, context) or None
-        checks = [s.strip() for s in self.parameterAsString(parameters, self.CHECK_POINTS, context).split(",")
-                  if s.strip()]
-        positions = self.parameterAsFile(parameters, self.CAMERA_POSITIONS, context) or None
-        crs = self.parameterAsCrs(parameters, self.CRS, context)
-        crs_text = crs.authid() or crs.toWkt() if crs.isValid() else None
-        gcps = None
-        source = self.parameterAsSource(parameters, self.GCP_LAYER, context)
-        if source is not None:
-            gcps = self._gcps_from_layer(source, gcpmod)
-        if gcp_path is None and gcps is None and not positions and not self.parameterAsBoolean(
-                parameters, self.USE_EXIF_GPS, context):
+        gcp_path = params.read_optional_file(self, parameters, self.GCPS, context)
+        checks = params.read_names(self, parameters, self.CHECK_POINTS, context)
+        positions = params.read_optional_file(self, parameters, self.CAMERA_POSITIONS, context)
+        crs_text = params.read_crs(self, parameters, self.CRS, context)
+        gcps = params.read_gcp_layer(self, parameters, self.GCP_LAYER, context, self.tr(
+            "GCP layer {} lacks the field '{}' (needs name, image, px, py)"))
+        if not params.has_control(gcp_path, gcps, positions, self.parameterAsBoolean(
+                parameters, self.USE_EXIF_GPS, context)):
             raise QgsProcessingException(self.tr(
                 "Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS)"))
         result = self.run_core(
@@ -111,23 +93,6 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         for n in self.NUMBERS:
             out[n] = f.get(n)
         return out
-
-    def _gcps_from_layer(self, source, gcpmod):
-        fields = [f.name().lower() for f in source.fields()]
-        for need in ("name", "image", "px", "py"):
-            if need not in fields:
-                raise QgsProcessingException(self.tr(
-                    "GCP layer {} lacks the field '{}' (needs name, image, px, py)").format(source.sourceName(), need))
-        rows = []
-        for feat in source.getFeatures():
-            attrs = {k.lower(): feat[k] for k in source.fields().names()}
-            pt = feat.geometry().constGet()
-            z = attrs.get("z")
-            if z in (None, "") and pt is not None and pt.is3D():
-                z = pt.z()
-            rows.append(dict(attrs, x=pt.x(), y=pt.y(), z=z or 0.0))
-        crs = source.sourceCrs().authid() or source.sourceCrs().toWkt()
-        return gcpmod.gcps_from_rows(rows, crs, source_name=source.sourceName())
 
 
 def _fmt(v):

@@ -1,26 +1,15 @@
 """Run pipeline: thin adapter over core.pipeline.run_pipeline (align -> georeference -> DSM -> orthomosaic -> report)."""
 from qgis.core import (
-    QgsProcessing,
     QgsProcessingException,
     QgsProcessingOutputFile,
     QgsProcessingOutputNumber,
     QgsProcessingOutputRasterLayer,
-    QgsProcessingParameterBoolean,
-    QgsProcessingParameterCrs,
-    QgsProcessingParameterDefinition,
-    QgsProcessingParameterEnum,
-    QgsProcessingParameterFeatureSource,
-    QgsProcessingParameterFile,
-    QgsProcessingParameterFolderDestination,
-    QgsProcessingParameterNumber,
-    QgsProcessingParameterString,
 )
+from qgis.PyQt.QtCore import QCoreApplication
 
-from .align_images import CAMERA_MODELS, PAIRINGS
+from . import params
 from .base import AlgorithmBase, FeedbackProgress
-from .build_dsm import BuildDsmAlgorithm
-from .build_orthophoto import BuildOrthophotoAlgorithm
-from .georeference import GeoreferenceAlgorithm
+from .params import BLENDINGS, CAMERA_MODELS, PAIRINGS, QUALITIES
 
 
 class RunPipelineAlgorithm(AlgorithmBase):
@@ -65,55 +54,30 @@ class RunPipelineAlgorithm(AlgorithmBase):
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
-        self.addParameter(QgsProcessingParameterFile(
-            self.IMAGES, self.tr("Folder of images"), behavior=QgsProcessingParameterFile.Folder))
-        self.addParameter(QgsProcessingParameterFolderDestination(self.WORKSPACE, self.tr("Workspace folder")))
-        self.addParameter(QgsProcessingParameterFile(
-            self.GCPS, self.tr("Ground control file (gcp_list.txt or CSV)"), optional=True,
-            fileFilter="GCP files (*.txt *.csv);;All files (*)"))
-        self.addParameter(QgsProcessingParameterFeatureSource(
-            self.GCP_LAYER, self.tr("Ground control point layer (one feature per observation)"),
-            [QgsProcessing.TypeVectorPoint], optional=True))
-        self.addParameter(QgsProcessingParameterString(
-            self.CHECK_POINTS, self.tr("Check points (comma-separated names)"), defaultValue="", optional=True))
-        self.addParameter(QgsProcessingParameterBoolean(
-            self.USE_EXIF_GPS, self.tr("Use EXIF GPS camera positions"), defaultValue=False))
-        self.addParameter(QgsProcessingParameterFile(
-            self.CAMERA_POSITIONS, self.tr("Camera positions (CSV)"), optional=True,
-            fileFilter="CSV/text (*.csv *.txt);;All files (*)"))
-        self.addParameter(QgsProcessingParameterCrs(
-            self.CRS, self.tr("Target CRS (default: the GCP file's, or the UTM zone of the GPS)"), optional=True))
-        self.addParameter(QgsProcessingParameterEnum(
-            self.PAIRING, self.tr("Pair selection"), options=PAIRINGS, defaultValue=0))
-        self.addParameter(QgsProcessingParameterEnum(
-            self.CAMERA_MODEL, self.tr("Camera model"), options=CAMERA_MODELS, defaultValue=0))
-        self.addParameter(QgsProcessingParameterNumber(
-            self.MAX_IMAGE_SIZE, self.tr("Largest image side for matching (0 = full size)"),
-            type=QgsProcessingParameterNumber.Integer, defaultValue=0, minValue=0))
-        self.addParameter(QgsProcessingParameterBoolean(
-            self.REFINE_INTRINSICS, self.tr("Refine camera calibration in the adjustment"), defaultValue=False))
-        self.addParameter(QgsProcessingParameterNumber(
-            self.DSM_RESOLUTION, self.tr("DSM resolution in metres (0 = automatic)"),
-            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
-        self.addParameter(QgsProcessingParameterEnum(
-            self.QUALITY, self.tr("Matching quality (image scale)"), options=list(BuildDsmAlgorithm.QUALITIES),
-            defaultValue=1))
-        self.addParameter(QgsProcessingParameterNumber(
-            self.ORTHO_RESOLUTION, self.tr("Orthomosaic resolution (0 = ground sample distance)"),
-            type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
-        self.addParameter(QgsProcessingParameterEnum(
-            self.BLENDING, self.tr("Blending across seamlines"), options=list(BuildOrthophotoAlgorithm.BLENDINGS),
-            defaultValue=0))
-        self.addParameter(QgsProcessingParameterBoolean(
-            self.REPORT_ENABLED, self.tr("Write the accuracy report"), defaultValue=True))
-        workers = QgsProcessingParameterNumber(
-            self.WORKERS, self.tr("Parallel workers for dense matching and tiles (0 = one per core)"),
-            type=QgsProcessingParameterNumber.Integer, defaultValue=0, minValue=0)
-        scheduler = QgsProcessingParameterString(
-            self.SCHEDULER, self.tr("Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)"), defaultValue="", optional=True)
-        for p in (workers, scheduler):
-            p.setFlags(p.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
-            self.addParameter(p)
+        params.add(
+            self,
+            params.folder(self.IMAGES, self.tr("Folder of images")),
+            params.workspace_destination(self.WORKSPACE, self.tr("Workspace folder")),
+            params.gcp_file(self.GCPS, self.tr("Ground control file (gcp_list.txt or CSV)")),
+            params.gcp_layer(self.GCP_LAYER, self.tr("Ground control point layer (one feature per observation)")),
+            params.check_points(self.CHECK_POINTS, self.tr("Check points (comma-separated names)")),
+            params.flag(self.USE_EXIF_GPS, self.tr("Use EXIF GPS camera positions")),
+            params.camera_positions(self.CAMERA_POSITIONS, self.tr("Camera positions (CSV)")),
+            params.target_crs(self.CRS, self.tr("Target CRS (default: the GCP file's, or the UTM zone of the GPS)")),
+            params.pairing(self.PAIRING, self.tr("Pair selection")),
+            params.camera_model(self.CAMERA_MODEL, self.tr("Camera model")),
+            params.max_image_size(self.MAX_IMAGE_SIZE, self.tr("Largest image side for matching (0 = full size)")),
+            params.flag(self.REFINE_INTRINSICS, self.tr("Refine camera calibration in the adjustment")),
+            params.dsm_resolution(self.DSM_RESOLUTION, self.tr("DSM resolution in metres (0 = automatic)")),
+            params.quality(self.QUALITY, self.tr("Matching quality (image scale)")),
+            params.number(self.ORTHO_RESOLUTION, self.tr("Orthomosaic resolution (0 = ground sample distance)")),
+            params.blending(self.BLENDING, self.tr("Blending across seamlines")),
+            params.flag(self.REPORT_ENABLED, self.tr("Write the accuracy report"), default=True),
+            *params.advanced(
+                params.workers(self.WORKERS, self.tr("Parallel workers for dense matching and tiles (0 = one per core)")),
+                params.scheduler(self.SCHEDULER, self.tr(
+                    "Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)"))),
+        )
         self.addOutput(QgsProcessingOutputRasterLayer(self.DSM, self.tr("DSM")))
         self.addOutput(QgsProcessingOutputRasterLayer(self.ORTHOMOSAIC, self.tr("Orthomosaic")))
         self.addOutput(QgsProcessingOutputFile(self.REPORT, self.tr("Accuracy report (HTML)")))
@@ -124,42 +88,39 @@ class RunPipelineAlgorithm(AlgorithmBase):
         from ..core import pipeline
         from ..core.align import sfm
         from ..core.dense import stage as dense
-        from ..core.io import gcp as gcpmod
         from ..core.ortho import options as ortho
 
         p = parameters
-        gcps = None
-        source = self.parameterAsSource(p, self.GCP_LAYER, context)
-        if source is not None:
-            gcps = GeoreferenceAlgorithm()._gcps_from_layer(source, gcpmod)
-        gcp_path = self.parameterAsFile(p, self.GCPS, context) or None
-        positions = self.parameterAsFile(p, self.CAMERA_POSITIONS, context) or None
+        gcps = params.read_gcp_layer(self, p, self.GCP_LAYER, context, QCoreApplication.translate(
+            "GeoreferenceAlgorithm", "GCP layer {} lacks the field '{}' (needs name, image, px, py)"))
+        gcp_path = params.read_optional_file(self, p, self.GCPS, context)
+        positions = params.read_optional_file(self, p, self.CAMERA_POSITIONS, context)
         use_gps = self.parameterAsBoolean(p, self.USE_EXIF_GPS, context)
-        if gcp_path is None and gcps is None and not positions and not use_gps:
+        if not params.has_control(gcp_path, gcps, positions, use_gps):
             raise QgsProcessingException(self.tr(
                 "Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS): "
                 "the DSM and orthophoto need a georeferenced block"))
-        crs = self.parameterAsCrs(p, self.CRS, context)
+        crs_text = params.read_crs(self, p, self.CRS, context)
+        checks = params.read_names(self, p, self.CHECK_POINTS, context)
         workers = self.parameterAsInt(p, self.WORKERS, context)
-        scheduler = self.parameterAsString(p, self.SCHEDULER, context).strip() or None
+        scheduler = params.read_scheduler(self, p, self.SCHEDULER, context)
         result = self.run_core(
             pipeline.run_pipeline,
             self.parameterAsFile(p, self.IMAGES, context), self.parameterAsString(p, self.WORKSPACE, context),
             align_options=sfm.AlignOptions(
-                pairing=PAIRINGS[self.parameterAsEnum(p, self.PAIRING, context)],
-                camera_model=CAMERA_MODELS[self.parameterAsEnum(p, self.CAMERA_MODEL, context)],
+                pairing=params.read_choice(self, p, self.PAIRING, context, PAIRINGS),
+                camera_model=params.read_choice(self, p, self.CAMERA_MODEL, context, CAMERA_MODELS),
                 max_image_size=self.parameterAsInt(p, self.MAX_IMAGE_SIZE, context)),
             gcp_path=gcp_path, gcps=gcps,
-            check_points=[s.strip() for s in self.parameterAsString(p, self.CHECK_POINTS, context).split(",")
-                          if s.strip()],
+            check_points=checks,
             camera_positions_path=positions, use_exif_gps=use_gps,
-            crs=(crs.authid() or crs.toWkt()) if crs.isValid() else None,
+            crs=crs_text,
             refine_intrinsics=self.parameterAsBoolean(p, self.REFINE_INTRINSICS, context),
             dsm_resolution=self.parameterAsDouble(p, self.DSM_RESOLUTION, context),
-            dsm_quality=BuildDsmAlgorithm.QUALITIES[self.parameterAsEnum(p, self.QUALITY, context)],
+            dsm_quality=params.read_choice(self, p, self.QUALITY, context, QUALITIES),
             dense_options=dense.DenseOptions(workers=workers, scheduler=scheduler),
             ortho_resolution=self.parameterAsDouble(p, self.ORTHO_RESOLUTION, context),
-            blending=BuildOrthophotoAlgorithm.BLENDINGS[self.parameterAsEnum(p, self.BLENDING, context)],
+            blending=params.read_choice(self, p, self.BLENDING, context, BLENDINGS),
             ortho_options=ortho.OrthoOptions(workers=workers, scheduler=scheduler),
             report=self.parameterAsBoolean(p, self.REPORT_ENABLED, context),
             progress=FeedbackProgress(feedback))
