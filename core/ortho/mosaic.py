@@ -14,8 +14,8 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..common import parallel
+from ..common.files import atomic_output
 from ..common.progress import NullProgress, Progress, SubProgress
-from ..project.workspace import atomic_output
 from .block import _check_kind, _Prepared, prepare_block, write_camera_ortho
 from .cameras import OrthoCamera
 from .grid import _box_intersects, _tiles

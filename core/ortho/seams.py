@@ -39,8 +39,6 @@ class _Plan:
 
 def _plan_mosaic(prep: _Prepared, dsm: _Dsm, offset: np.ndarray, options: OrthoOptions, workdir: str,
                  progress: Progress) -> _Plan:
-    cv2 = require("cv2", "orthophotos")
-
     grid = prep.grid
     k = max(1, int(round(PLANNING_GSD * prep.gsd / grid.resolution)))
     while math.ceil(grid.width / k) * math.ceil(grid.height / k) > MAX_PLANNING_CELLS:
@@ -98,58 +96,69 @@ def _plan_mosaic(prep: _Prepared, dsm: _Dsm, offset: np.ndarray, options: OrthoO
     # relief: objects above their surroundings go whole to one image
     blobs = reassigned = 0
     if options.avoid_relief and np.isfinite(zp).any():
-        zf = np.where(np.isfinite(zp), zp, np.nanmin(zp)).astype(np.float32)
-        radius = max(1, int(math.ceil(12.0 / p)))  # objects up to ~24 m across
-        ker = cv2.getStructuringElement(cv2.MORPH_RECT, (2 * radius + 1, 2 * radius + 1))
-        opened = cv2.dilate(cv2.erode(zf, ker), ker)
-        core = (zf - opened) > options.relief_height
-        margin = max(1, int(math.ceil(1.0 / p)))
-        tall = cv2.dilate(core.astype(np.uint8), cv2.getStructuringElement(
-            cv2.MORPH_ELLIPSE, (2 * margin + 1, 2 * margin + 1))) > 0
-        from scipy import ndimage
-
-        lab, nb = ndimage.label(tall)
-        blobs = int(nb)
-        if nb:
-            slices = ndimage.find_objects(lab)
-            for b, sl in enumerate(slices, start=1):
-                if sl is None:
-                    continue
-                region = lab[sl] == b
-                region_core = core[sl][region]
-                current = labels[sl][region]
-                present = np.unique(current[current >= 0])
-                if len(present) <= 1:
-                    continue
-                br0, bc0 = sl[0].start, sl[1].start
-                choice, choice_key = None, None
-                for cid in present:
-                    win = windows[cid]
-                    if win is None:
-                        continue
-                    wr0, wc0, wh, ww = win
-                    rr, cc = np.nonzero(region)
-                    rr = rr + br0 - wr0
-                    cc = cc + bc0 - wc0
-                    inwin = (rr >= 0) & (rr < wh) & (cc >= 0) & (cc < ww)
-                    vals = np.full(len(rr), np.inf, dtype=np.float32)
-                    vals[inwin] = costs[cid][rr[inwin], cc[inwin]]
-                    frac = float(np.isfinite(vals[region_core]).mean()) if region_core.any() else 0.0
-                    key = (frac >= 0.97, -float(np.mean(vals[np.isfinite(vals)])) if np.isfinite(vals).any() else -1e9)
-                    if choice_key is None or key > choice_key:
-                        choice, choice_key, choice_vals = cid, key, vals
-                if choice is None or not choice_key[0]:
-                    continue
-                sub_labels = labels[sl]
-                put = region.copy()
-                put[region] = np.isfinite(choice_vals)
-                sub_labels[put] = choice
-                reassigned += 1
+        blobs, reassigned = _avoid_relief(labels, zp, p, windows, costs, options.relief_height)
     np.save(os.path.join(workdir, "labels.npy"), labels)
     progress.report(1.0, "mosaic planned")
     feather = max(1, int(round(options.feather_gsd * prep.gsd / (2 * p)))) if options.blending == "feather" else 0
     return _Plan(k, pw, ph, os.path.join(workdir, "labels.npy"), gains, windows, feather, blobs, reassigned,
                  seam_before, seam_after)
+
+
+def _avoid_relief(labels: np.ndarray, zp: np.ndarray, p: float, windows, costs, relief_height: float
+                  ) -> Tuple[int, int]:
+    """Give each object standing more than ``relief_height`` above its surroundings (a morphological top-hat of
+    the planning DSM ``zp``, cells of ``p`` metres) whole to one image that sees all of it, so no seam cuts a
+    roof or a crown.  Changes ``labels`` in place; returns (raised objects, objects reassigned)."""
+    cv2 = require("cv2", "orthophotos")
+    reassigned = 0
+    zf = np.where(np.isfinite(zp), zp, np.nanmin(zp)).astype(np.float32)
+    radius = max(1, int(math.ceil(12.0 / p)))  # objects up to ~24 m across
+    ker = cv2.getStructuringElement(cv2.MORPH_RECT, (2 * radius + 1, 2 * radius + 1))
+    opened = cv2.dilate(cv2.erode(zf, ker), ker)
+    core = (zf - opened) > relief_height
+    margin = max(1, int(math.ceil(1.0 / p)))
+    tall = cv2.dilate(core.astype(np.uint8), cv2.getStructuringElement(
+        cv2.MORPH_ELLIPSE, (2 * margin + 1, 2 * margin + 1))) > 0
+    from scipy import ndimage
+
+    lab, nb = ndimage.label(tall)
+    blobs = int(nb)
+    if nb:
+        slices = ndimage.find_objects(lab)
+        for b, sl in enumerate(slices, start=1):
+            if sl is None:
+                continue
+            region = lab[sl] == b
+            region_core = core[sl][region]
+            current = labels[sl][region]
+            present = np.unique(current[current >= 0])
+            if len(present) <= 1:
+                continue
+            br0, bc0 = sl[0].start, sl[1].start
+            choice, choice_key = None, None
+            for cid in present:
+                win = windows[cid]
+                if win is None:
+                    continue
+                wr0, wc0, wh, ww = win
+                rr, cc = np.nonzero(region)
+                rr = rr + br0 - wr0
+                cc = cc + bc0 - wc0
+                inwin = (rr >= 0) & (rr < wh) & (cc >= 0) & (cc < ww)
+                vals = np.full(len(rr), np.inf, dtype=np.float32)
+                vals[inwin] = costs[cid][rr[inwin], cc[inwin]]
+                frac = float(np.isfinite(vals[region_core]).mean()) if region_core.any() else 0.0
+                key = (frac >= 0.97, -float(np.mean(vals[np.isfinite(vals)])) if np.isfinite(vals).any() else -1e9)
+                if choice_key is None or key > choice_key:
+                    choice, choice_key, choice_vals = cid, key, vals
+            if choice is None or not choice_key[0]:
+                continue
+            sub_labels = labels[sl]
+            put = region.copy()
+            put[region] = np.isfinite(choice_vals)
+            sub_labels[put] = choice
+            reassigned += 1
+    return blobs, reassigned
 
 
 def _gather(arrays: Sequence[Optional[np.ndarray]], windows, lab: np.ndarray, rr: np.ndarray, cc: np.ndarray,

@@ -8,10 +8,11 @@ from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
+from ..common.files import file_fingerprint, fingerprint
 from ..common.progress import NullProgress, Progress
 from ..project.layout import Layout, LayoutError
 from ..project.stages import ORTHOPHOTO, run_stage
-from ..project.workspace import Workspace, file_fingerprint, fingerprint
+from ..project.workspace import Workspace
 from .cameras import OrthoCamera, cameras_from_reconstruction, select_cameras
 from .mosaic import build_orthomosaic
 from .options import OrthoError, OrthoOptions

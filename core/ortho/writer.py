@@ -8,9 +8,9 @@ from typing import Optional
 
 import numpy as np
 
+from ..common.files import atomic_output
 from ..common.progress import NullProgress, Progress, check_cancel
 from ..io import raster as dsmmod
-from ..project.workspace import atomic_output
 from .options import OrthoError
 from .pixels import _gdal
 
