@@ -14,6 +14,7 @@ import json
 import math
 import os
 import time
+import zipfile
 from dataclasses import dataclass
 from typing import Optional, Tuple
 
@@ -262,8 +263,6 @@ def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
 def _save_npz(path: str, **arrays) -> None:
     """np.savez with fast deflate (level 1: depth maps with holes shrink ~3x at a fraction of savez_compressed's
     time), written to a temporary name and renamed: a cancelled or killed unit leaves no file that looks done."""
-    import zipfile
-
     tmp = path + ".partial.npz"
     with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=1) as zf:
         for name, arr in arrays.items():

@@ -12,6 +12,7 @@ Outputs are written to a temporary name and renamed when complete
 """
 from __future__ import annotations
 
+import datetime
 import math
 import os
 import struct
@@ -397,8 +398,6 @@ def write_las(path: str, chunks: Iterable[Tuple[np.ndarray, np.ndarray]], offset
                     progress.report(min(1.0, n / total), f"point cloud: {n} points")
             if n == 0:
                 mins = maxs = off.copy()
-            import datetime
-
             today = datetime.date.today()
             hdr = bytearray(header_size)
             struct.pack_into("<4sHH", hdr, 0, b"LASF", 0, 0)  # file source id, global encoding
