@@ -140,3 +140,71 @@ def test_processing_align_then_georeference_with_exif_gps(plugin, tmp_path):
     assert cams.crs().authid() == "EPSG:32617"
     x = [f.geometry().asPoint().x() for f in cams.getFeatures()]
     assert all(274800 < v < 275100 for v in x)
+
+
+def test_run_core_turns_errors_into_processing_exceptions():
+    """User errors show their message, a missing package names itself and how to install it, and a bug keeps
+    its traceback in the log before it fails the run (never escaping as a raw exception)."""
+    from archaeoortho.core.common.errors import ArchaeoOrthoError, MissingDependencyError
+    from archaeoortho.core.common.progress import Cancelled
+    from archaeoortho.processing_provider.base import AlgorithmBase, FeedbackProgress
+    from qgis.core import QgsProcessingException, QgsProcessingFeedback
+
+    class Log(QgsProcessingFeedback):
+        def __init__(self):
+            super().__init__()
+            self.errors = []
+
+        def reportError(self, error, fatalError=False):
+            self.errors.append(error)
+
+    def fail(error, progress=None):
+        raise error
+
+    feedback = Log()
+    progress = FeedbackProgress(feedback)
+    with pytest.raises(QgsProcessingException, match="^the workspace is broken$"):
+        AlgorithmBase.run_core(fail, ArchaeoOrthoError("the workspace is broken"), progress=progress)
+    with pytest.raises(QgsProcessingException, match="pycolmap.*pip install"):
+        AlgorithmBase.run_core(fail, MissingDependencyError("pycolmap", "alignment"), progress=progress)
+    with pytest.raises(QgsProcessingException, match="opencv-python-headless.*pip install"):
+        AlgorithmBase.run_core(fail, ModuleNotFoundError("No module named 'cv2'", name="cv2"), progress=progress)
+    with pytest.raises(QgsProcessingException, match="Cancelled"):
+        AlgorithmBase.run_core(fail, Cancelled("stop"), progress=progress)
+    assert feedback.errors == []
+    with pytest.raises(QgsProcessingException, match="KeyError"):
+        AlgorithmBase.run_core(fail, KeyError("focal"), progress=progress)
+    assert len(feedback.errors) == 1 and "Traceback" in feedback.errors[0] and "KeyError" in feedback.errors[0]
+
+
+def test_core_task_reports_user_errors_and_survives_failing_callbacks(qgis_app):
+    """CoreTask: a user error's message goes to on_error; an exception raised by a callback is logged with
+    its traceback instead of escaping into QGIS's C++ (which would abort it)."""
+    from archaeoortho.core.common.errors import ArchaeoOrthoError
+    from archaeoortho.ui.tasks import CoreTask
+    from qgis.core import QgsApplication
+
+    logged = []
+    log = QgsApplication.messageLog()
+
+    def keep(message, tag, level):
+        logged.append(message)
+    log.messageReceived.connect(keep)
+    errors = []
+
+    def user_error(progress=None):
+        raise ArchaeoOrthoError("no control points")
+
+    task = CoreTask("t", user_error, on_error=lambda message, cancelled: errors.append((message, cancelled)))
+    assert task.run() is False
+    task.finished(False)
+    assert errors == [("no control points", False)]
+
+    def broken_callback(result):
+        raise TypeError("a bug in the dock")
+
+    task = CoreTask("t2", lambda progress=None: 42, on_done=broken_callback)
+    assert task.run() is True
+    task.finished(True)  # must not raise
+    log.messageReceived.disconnect(keep)
+    assert any("TypeError: a bug in the dock" in m and "Traceback" in m for m in logged), logged
