@@ -33,8 +33,10 @@ def child(images, ws, result, report):
     from core.common.progress import PrintProgress
 
     positions = os.path.join(os.path.dirname(images), "camera_positions.csv")
-    control = dict(camera_positions_path=positions) if os.path.isfile(positions) else dict(use_exif_gps=True)
-    r = pipeline.run_pipeline(images, ws, report=report, progress=PrintProgress("  "), **control)
+    control = (pipeline.Control(camera_positions_path=positions) if os.path.isfile(positions)
+               else pipeline.Control(use_exif_gps=True))
+    r = pipeline.run_pipeline(images, ws, pipeline.PipelineOptions(make_report=report), control,
+                              progress=PrintProgress("  "))
     with open(result, "w") as f:
         json.dump({"registered": r.align.registered, "images": r.align.images_given,
                    "mre": r.align.mean_reprojection_error, "align_timings": r.align.timings,

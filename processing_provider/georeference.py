@@ -1,4 +1,4 @@
-"""Georeference: thin adapter over core.pipeline.georeference_workspace."""
+"""Georeference: thin adapter over core.georef.stage.georeference_workspace."""
 from qgis.core import (
     QgsCoordinateReferenceSystem,
     QgsProcessingException,
@@ -59,7 +59,7 @@ class GeoreferenceAlgorithm(AlgorithmBase):
             self.addOutput(QgsProcessingOutputNumber(n, n))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core import pipeline
+        from ..core.georef.stage import georeference_workspace
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         gcp_path = params.read_optional_file(self, parameters, self.GCPS, context)
@@ -73,7 +73,7 @@ class GeoreferenceAlgorithm(AlgorithmBase):
             raise QgsProcessingException(self.tr(
                 "Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS)"))
         result = self.run_core(
-            pipeline.georeference_workspace, workspace, gcp_path=gcp_path, gcps=gcps, check_points=checks,
+            georeference_workspace, workspace, gcp_path=gcp_path, gcps=gcps, check_points=checks,
             camera_positions_path=positions,
             use_exif_gps=self.parameterAsBoolean(parameters, self.USE_EXIF_GPS, context),
             crs=crs_text, refine_intrinsics=self.parameterAsBoolean(parameters, self.REFINE_INTRINSICS, context),

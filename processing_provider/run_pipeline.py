@@ -88,6 +88,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
         from ..core import pipeline
         from ..core.align import sfm
         from ..core.dense import stage as dense
+        from ..core.georef.options import GeorefOptions
         from ..core.ortho import options as ortho
 
         p = parameters
@@ -107,22 +108,21 @@ class RunPipelineAlgorithm(AlgorithmBase):
         result = self.run_core(
             pipeline.run_pipeline,
             self.parameterAsFile(p, self.IMAGES, context), self.parameterAsString(p, self.WORKSPACE, context),
-            align_options=sfm.AlignOptions(
-                pairing=params.read_choice(self, p, self.PAIRING, context, PAIRINGS),
-                camera_model=params.read_choice(self, p, self.CAMERA_MODEL, context, CAMERA_MODELS),
-                max_image_size=self.parameterAsInt(p, self.MAX_IMAGE_SIZE, context)),
-            gcp_path=gcp_path, gcps=gcps,
-            check_points=checks,
-            camera_positions_path=positions, use_exif_gps=use_gps,
-            crs=crs_text,
-            refine_intrinsics=self.parameterAsBoolean(p, self.REFINE_INTRINSICS, context),
-            dsm_resolution=self.parameterAsDouble(p, self.DSM_RESOLUTION, context),
-            dsm_quality=params.read_choice(self, p, self.QUALITY, context, QUALITIES),
-            dense_options=dense.DenseOptions(workers=workers, scheduler=scheduler),
-            ortho_resolution=self.parameterAsDouble(p, self.ORTHO_RESOLUTION, context),
-            blending=params.read_choice(self, p, self.BLENDING, context, BLENDINGS),
-            ortho_options=ortho.OrthoOptions(workers=workers, scheduler=scheduler),
-            report=self.parameterAsBoolean(p, self.REPORT_ENABLED, context),
+            options=pipeline.PipelineOptions(
+                align=sfm.AlignOptions(
+                    pairing=params.read_choice(self, p, self.PAIRING, context, PAIRINGS),
+                    camera_model=params.read_choice(self, p, self.CAMERA_MODEL, context, CAMERA_MODELS),
+                    max_image_size=self.parameterAsInt(p, self.MAX_IMAGE_SIZE, context)),
+                georef=GeorefOptions(refine_intrinsics=self.parameterAsBoolean(p, self.REFINE_INTRINSICS, context)),
+                dsm_resolution=self.parameterAsDouble(p, self.DSM_RESOLUTION, context),
+                dsm_quality=params.read_choice(self, p, self.QUALITY, context, QUALITIES),
+                dense=dense.DenseOptions(workers=workers, scheduler=scheduler),
+                ortho_resolution=self.parameterAsDouble(p, self.ORTHO_RESOLUTION, context),
+                blending=params.read_choice(self, p, self.BLENDING, context, BLENDINGS),
+                ortho=ortho.OrthoOptions(workers=workers, scheduler=scheduler),
+                make_report=self.parameterAsBoolean(p, self.REPORT_ENABLED, context)),
+            control=pipeline.Control(gcp_path=gcp_path, gcps=gcps, check_points=checks,
+                                     camera_positions_path=positions, use_exif_gps=use_gps, crs=crs_text),
             progress=FeedbackProgress(feedback))
         for w in result.warnings:
             feedback.pushWarning(w)

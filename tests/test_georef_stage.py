@@ -4,8 +4,8 @@ import os
 import numpy as np
 import pytest
 
-from core import pipeline
 from core.align import sfm
+from core.georef import stage as georef_stage
 from core.io.gcp import GCPSet, GroundPoint, Observation
 from core.project.workspace import Workspace
 from tests.conftest import SAMPLE, TOLEDO_STRIP, copy_images
@@ -33,7 +33,7 @@ def _reference_positions():
 
 
 def test_exif_gps_georeferencing_lines_up_with_surveyed_positions(aligned):
-    result = pipeline.georeference_workspace(aligned, use_exif_gps=True, crs="EPSG:32617")
+    result = georef_stage.georeference_workspace(aligned, use_exif_gps=True, crs="EPSG:32617")
     assert result.crs == "EPSG:32617"
     assert result.figures["CAMERA_RMSE_XYZ"] is not None and result.figures["CAMERA_RMSE_XYZ"] < 5.0
     from osgeo import ogr
@@ -52,7 +52,7 @@ def test_exif_gps_georeferencing_lines_up_with_surveyed_positions(aligned):
     assert ws.stage("georeference")["status"] == "done"
     assert ws.crs == "EPSG:32617"
     assert os.path.isfile(os.path.join(aligned, "georef", "transform.json"))
-    rec, transform = pipeline.load_georef_model(aligned)
+    rec, transform = georef_stage.load_georef_model(aligned)
     assert rec.num_reg_images() == len(TOLEDO_STRIP)
     # the adjusted model stays near the origin: world = local + offset
     centres = np.array([im.projection_center() for im in rec.images.values()])
@@ -79,7 +79,7 @@ def test_camera_positions_file_gives_the_crs(aligned, tmp_path):
     csv = tmp_path / "positions.csv"
     csv.write_text("EPSG:3857\n" + "".join(f"{n},{x:.3f},{y:.3f},{z}\n" for n, (x, y, _), z in
                                             zip(names, merc, [250.0] * len(names))))
-    result = pipeline.georeference_workspace(ws_dir, camera_positions_path=str(csv))
+    result = georef_stage.georeference_workspace(ws_dir, camera_positions_path=str(csv))
     assert result.crs == "EPSG:3857"
     assert result.figures["CAMERA_RMSE_XY"] is not None and result.figures["CAMERA_RMSE_XY"] < 5.0
 
@@ -91,11 +91,11 @@ def test_too_few_control_points_is_a_clear_error(aligned):
         GroundPoint("B", 274905.0, 4603290.0, 180.0, observations=[Observation("1JI_0066.JPG", 600, 400),
                                                                   Observation("1JI_0067.JPG", 600, 300)]),
     ])
-    with pytest.raises(pipeline.StageError, match="at least 3 control points.*found 2"):
-        pipeline.georeference_workspace(aligned, gcps=gcps)
+    with pytest.raises(georef_stage.StageError, match="at least 3 control points.*found 2"):
+        georef_stage.georeference_workspace(aligned, gcps=gcps)
 
 
 def test_unaligned_workspace_is_refused(tmp_path):
     Workspace.create_or_open(str(tmp_path / "ws"))
-    with pytest.raises(pipeline.StageError, match="run 'Align images' first"):
-        pipeline.georeference_workspace(str(tmp_path / "ws"), use_exif_gps=True)
+    with pytest.raises(georef_stage.StageError, match="run 'Align images' first"):
+        georef_stage.georeference_workspace(str(tmp_path / "ws"), use_exif_gps=True)

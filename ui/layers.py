@@ -395,7 +395,7 @@ def footprints_path(workspace):
         import numpy as np
 
         from ..core.georef import guided
-        from ..core.pipeline import load_georef_model
+        from ..core.georef.stage import load_georef_model
     except ImportError:
         return None
     try:

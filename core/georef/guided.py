@@ -36,9 +36,9 @@ from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 import numpy as np
 
 from ..common.errors import require
+from ..common.files import atomic_output
 from ..geometry.similarity import fit_similarity, helmert_fit
 from ..io.gcp import GCPSet, GroundPoint, Observation
-from ..project.workspace import atomic_output
 from .triangulate import triangulate_observations
 
 RAYS = "rays"

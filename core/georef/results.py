@@ -14,9 +14,9 @@ from typing import Any, Dict, List, Optional, Sequence
 
 import numpy as np
 
+from ..common.files import atomic_write_text
 from ..geometry.similarity import Similarity
 from ..io.gcp import CHECK, CONTROL
-from ..project.workspace import atomic_write_text
 
 TRANSFORM_FILE = "transform.json"
 RESIDUALS_FILE = "residuals.json"

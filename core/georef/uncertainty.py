@@ -34,8 +34,6 @@ the precision is then slightly pessimistic and the points left out get no covari
 """
 from __future__ import annotations
 
-import copy
-import json
 import math
 import os
 import time
@@ -44,17 +42,21 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from ..common.errors import ArchaeoOrthoError
 from ..common.progress import NullProgress, Progress, check_cancel
+from ..io.gcp import read_camera_positions
+from ..io.vector import write_points_gpkg
+from ..project.layout import Layout, read_json
+from ..project.stages import GEOREFERENCE
+from .bundle import intrinsics_jacobian, inv3, pose_point_jacobians, project, project_jacobian
+from .options import EXIF_SIGMA_XY, EXIF_SIGMA_Z, FILE_POSITION_SIGMAS, PLACEHOLDER_SIGMA_Z
 
 DATUM_CONTROL = "control"
 DATUM_FREE = "free network"
 FREE_DATUM_DEFECT = 7
-EXIF_SIGMA_XY = 3.0  # the same a priori sigmas as core.pipeline's EXIF GPS positions
-EXIF_SIGMA_Z = 5.0
-PLACEHOLDER_SIGMA_Z = 1.0  # core.georef's placeholder_sigma_z default
 
 
-class UncertaintyError(RuntimeError):
+class UncertaintyError(ArchaeoOrthoError, RuntimeError):
     """The covariance cannot be computed; the message says why."""
 
 
@@ -144,12 +146,6 @@ class UncertaintyResult:
 # observations and residuals
 # --------------------------------------------------------------------------------------------------
 
-def _project(camera, xc: np.ndarray) -> np.ndarray:
-    if len(xc) == 0:
-        return np.zeros((0, 2))
-    return np.asarray(camera.img_from_cam(np.ascontiguousarray(xc, dtype=float), check_cheirality=False))
-
-
 def collect_observations(rec) -> Observations:
     """Tie-point observations of every registered image of a pycolmap.Reconstruction, with residuals."""
     image_ids = np.array(sorted(int(i) for i in rec.reg_image_ids()), dtype=np.int64)
@@ -171,7 +167,7 @@ def collect_observations(rec) -> Observations:
         xy = np.array([p2.xy for p2 in obs], dtype=float).reshape(-1, 2)
         m = np.asarray(im.cam_from_world().matrix())
         xc = xyz_a[pt] @ m[:, :3].T + m[:, 3]
-        uv = _project(rec.cameras[im.camera_id], xc)
+        uv = project(rec.cameras[im.camera_id], xc)
         res = uv - xy
         res[xc[:, 2] <= 0] = np.nan
         o_img.append(np.full(len(pt), k, dtype=np.int64))
@@ -190,60 +186,6 @@ def collect_observations(rec) -> Observations:
 # --------------------------------------------------------------------------------------------------
 # the covariance
 # --------------------------------------------------------------------------------------------------
-
-def _skew(v: np.ndarray) -> np.ndarray:
-    z = np.zeros(len(v))
-    return np.stack([np.stack([z, -v[:, 2], v[:, 1]], -1),
-                     np.stack([v[:, 2], z, -v[:, 0]], -1),
-                     np.stack([-v[:, 1], v[:, 0], z], -1)], axis=1)
-
-
-def _inv3(m: np.ndarray) -> np.ndarray:
-    """Inverse of a stack of 3x3 matrices by the adjugate (fast on busy cores, unlike batched LAPACK)."""
-    a, b, c = m[:, 0, 0], m[:, 0, 1], m[:, 0, 2]
-    d, e, f = m[:, 1, 0], m[:, 1, 1], m[:, 1, 2]
-    g, h, i = m[:, 2, 0], m[:, 2, 1], m[:, 2, 2]
-    co = np.empty_like(m)
-    co[:, 0, 0] = e * i - f * h
-    co[:, 0, 1] = c * h - b * i
-    co[:, 0, 2] = b * f - c * e
-    co[:, 1, 0] = f * g - d * i
-    co[:, 1, 1] = a * i - c * g
-    co[:, 1, 2] = c * d - a * f
-    co[:, 2, 0] = d * h - e * g
-    co[:, 2, 1] = b * g - a * h
-    co[:, 2, 2] = a * e - b * d
-    det = a * co[:, 0, 0] + b * co[:, 1, 0] + c * co[:, 2, 0]
-    det = np.where(np.abs(det) > 1e-300, det, np.nan)
-    return co / det[:, None, None]
-
-
-def _proj_jacobian(camera, xc: np.ndarray) -> np.ndarray:
-    h = 1e-6 * np.maximum(np.abs(xc[:, 2]), 1e-9)
-    jac = np.empty((len(xc), 2, 3))
-    for k in range(3):
-        d = np.zeros_like(xc)
-        d[:, k] = h
-        jac[:, :, k] = (_project(camera, xc + d) - _project(camera, xc - d)) / (2 * h)[:, None]
-    return jac
-
-
-def _intrinsics_jacobian(camera, xc: np.ndarray, free: Sequence[int]) -> np.ndarray:
-    out = np.empty((len(xc), 2, len(free)))
-    base = np.array(camera.params, dtype=float)
-    cam = copy.copy(camera)
-    for j, k in enumerate(free):
-        h = 1e-6 * max(1.0, abs(base[k]))
-        p = base.copy()
-        p[k] += h
-        cam.params = p
-        up = _project(cam, xc)
-        p[k] -= 2 * h
-        cam.params = p
-        dn = _project(cam, xc)
-        out[:, :, j] = (up - dn) / (2 * h)
-    return out
-
 
 def default_free_intrinsics(rec, principal_point: bool = False) -> Dict[int, List[int]]:
     """Focal length(s) and distortion of every camera; the principal point too when it was refined."""
@@ -273,37 +215,27 @@ def _select_points(obs: Observations, ok: np.ndarray, max_observations: int) -> 
     return chosen
 
 
-def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[CameraPrior] = (),
-             free_intrinsics: Optional[Dict[int, List[int]]] = None, tie_sigma_px: float = 1.0,
-             gcp_sigma_px: float = 1.0, huber_px: float = 2.0, max_observations: int = 300_000,
-             max_unknowns: int = 6000, offset=None, progress: Optional[Progress] = None,
-             observations: Optional[Observations] = None) -> UncertaintyResult:
-    """Covariance of the cameras, intrinsics and points of an adjusted block (see the module docstring)."""
-    import scipy.sparse as sp
+@dataclass
+class _Rows:
+    """The observations that enter the covariance: tie points (selected) and control points with priors."""
 
-    t0 = time.time()
-    progress = progress or NullProgress()
-    notes: List[str] = []
-    obs = observations if observations is not None else collect_observations(rec)
-    n_img = len(obs.image_ids)
-    if n_img < 2:
-        raise UncertaintyError("the model has fewer than 2 registered images")
-    img_index = {name: k for k, name in enumerate(obs.image_names)}
-    images = [rec.image(int(i)) for i in obs.image_ids]
-    cam_ids = sorted({int(im.camera_id) for im in images})
-    free = free_intrinsics if free_intrinsics is not None else default_free_intrinsics(rec)
-    free = {cid: list(free.get(cid, [])) for cid in cam_ids}
-    intr_off = {}
-    nc = 6 * n_img
-    for cid in cam_ids:
-        intr_off[cid] = nc
-        nc += len(free[cid])
-    if nc > max_unknowns:
-        raise UncertaintyError(f"{nc} camera unknowns: more than the dense covariance handles here ({max_unknowns})")
+    img: np.ndarray  # (O,) index into the images
+    pt: np.ndarray  # (O,) index into xyz
+    res: np.ndarray  # (O, 2) pixel residuals
+    sigma: np.ndarray  # (O,)
+    robust: np.ndarray  # (O,) Huber (tie points)
+    xyz: np.ndarray  # (P, 3): the tie points, then the control points
+    n_tie: int
+    keep_pt: np.ndarray  # mask of the tie points of the Observations that entered
+    prior_idx: List[int] = field(default_factory=list)
+    prior_xyz: List[np.ndarray] = field(default_factory=list)
+    prior_sig: List[np.ndarray] = field(default_factory=list)
+    control_rows: List[Tuple[str, int]] = field(default_factory=list)  # (name, row in xyz)
 
-    # tie observations (finite residuals), point selection
-    err = obs.error
-    ok = np.isfinite(err)
+
+def _tie_rows(obs: Observations, max_observations: int, tie_sigma_px: float, notes: List[str]) -> _Rows:
+    """Tie observations with finite residuals, of the points selected (all, or the best observed)."""
+    ok = np.isfinite(obs.error)
     keep_pt = _select_points(obs, ok, max_observations)
     if not keep_pt.all():
         notes.append(f"{int(keep_pt.sum())} of {len(keep_pt)} tie points (the best observed) entered the "
@@ -312,20 +244,18 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
     pt_new = np.full(len(obs.point_ids), -1, dtype=np.int64)
     pt_new[keep_pt] = np.arange(int(keep_pt.sum()))
     o_img = obs.img[sel]
-    o_pt = pt_new[obs.pt[sel]]
-    o_res = obs.residual[sel]
-    o_sig = np.full(len(o_img), float(tie_sigma_px))
-    o_rob = np.ones(len(o_img), dtype=bool)
-    xyz_all = obs.xyz[keep_pt].copy()
-    n_tie = len(xyz_all)
+    xyz = obs.xyz[keep_pt].copy()
+    return _Rows(o_img, pt_new[obs.pt[sel]], obs.residual[sel], np.full(len(o_img), float(tie_sigma_px)),
+                 np.ones(len(o_img), dtype=bool), xyz, len(xyz), keep_pt)
 
-    # control points: extra points with priors and their own observations
-    prior_idx, prior_xyz, prior_sig = [], [], []
+
+def _add_control(rec, rows: _Rows, control: Sequence[ControlInput], images, img_index: Dict[str, int],
+                 gcp_sigma_px: float) -> None:
+    """Control points: extra points with priors and their own observations (those not connected: left out)."""
     c_img, c_pt, c_res = [], [], []
-    ctl_rows = []
     for c in control:
-        k = len(xyz_all)
-        rows = []
+        k = len(rows.xyz)
+        own = []
         for name, x, y in c.observations:
             j = img_index.get(name)
             if j is None:
@@ -335,71 +265,96 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
             xc = m[:, :3] @ c.xyz + m[:, 3]
             if xc[2] <= 0:
                 continue
-            uv = _project(rec.cameras[im.camera_id], xc[None])[0]
-            rows.append((j, uv - np.array([x, y])))
-        if not rows:  # not connected to the block
+            uv = project(rec.cameras[im.camera_id], xc[None])[0]
+            own.append((j, uv - np.array([x, y])))
+        if not own:  # not connected to the block
             continue
-        xyz_all = np.vstack([xyz_all, np.asarray(c.xyz, dtype=float)[None]])
-        for j, r in rows:
+        rows.xyz = np.vstack([rows.xyz, np.asarray(c.xyz, dtype=float)[None]])
+        for j, r in own:
             c_img.append(j)
             c_pt.append(k)
             c_res.append(r)
-        prior_idx.append(k)
-        prior_xyz.append(np.asarray(c.given, dtype=float))
-        prior_sig.append(np.asarray(c.sigma, dtype=float))
-        ctl_rows.append((c.name, k))
+        rows.prior_idx.append(k)
+        rows.prior_xyz.append(np.asarray(c.given, dtype=float))
+        rows.prior_sig.append(np.asarray(c.sigma, dtype=float))
+        rows.control_rows.append((c.name, k))
     if c_img:
-        o_img = np.concatenate([o_img, np.asarray(c_img, dtype=np.int64)])
-        o_pt = np.concatenate([o_pt, np.asarray(c_pt, dtype=np.int64)])
-        o_res = np.vstack([o_res, np.asarray(c_res, dtype=float)])
-        o_sig = np.concatenate([o_sig, np.full(len(c_img), float(gcp_sigma_px))])
-        o_rob = np.concatenate([o_rob, np.zeros(len(c_img), dtype=bool)])
-    n_pts = len(xyz_all)
-    n_o = len(o_img)
+        rows.img = np.concatenate([rows.img, np.asarray(c_img, dtype=np.int64)])
+        rows.pt = np.concatenate([rows.pt, np.asarray(c_pt, dtype=np.int64)])
+        rows.res = np.vstack([rows.res, np.asarray(c_res, dtype=float)])
+        rows.sigma = np.concatenate([rows.sigma, np.full(len(c_img), float(gcp_sigma_px))])
+        rows.robust = np.concatenate([rows.robust, np.zeros(len(c_img), dtype=bool)])
 
-    # weights (Huber on tie points, as in the adjustment)
-    s = np.linalg.norm(o_res, axis=1) / o_sig
-    w = np.ones(n_o)
-    big = o_rob & (s > huber_px)
+
+def _weights(rows: _Rows, huber_px: float) -> Tuple[np.ndarray, np.ndarray]:
+    """(Huber weight, sqrt of the weight of each residual component) per observation, as in the adjustment."""
+    s = np.linalg.norm(rows.res, axis=1) / rows.sigma
+    w = np.ones(len(rows.img))
+    big = rows.robust & (s > huber_px)
     w[big] = huber_px / s[big]
-    sw = np.sqrt(w) / o_sig  # sqrt of the weight of each residual component
+    return w, np.sqrt(w) / rows.sigma
 
-    # Jacobians, per image
-    progress.report(0.05, "covariance: Jacobian")
+
+def _jacobians(rec, images, rows: _Rows, free: Dict[int, List[int]], intr_off: Dict[int, int], sw: np.ndarray,
+               progress: Progress):
+    """Weighted Jacobian blocks per observation (the bundle problem's, core.georef.bundle): camera
+    (pose + intrinsics, with their columns) and point."""
+    n_o, n_img = len(rows.img), len(images)
     q_max = max((len(v) for v in free.values()), default=0)
     jc = np.zeros((n_o, 2, 6 + q_max))
     jp = np.zeros((n_o, 2, 3))
     cam_cols = np.zeros((n_o, 6 + q_max), dtype=np.int64)
     n_cols = np.zeros(n_o, dtype=np.int64)
-    order = np.argsort(o_img, kind="stable")
-    bounds = np.searchsorted(o_img[order], np.arange(n_img + 1))
+    order = np.argsort(rows.img, kind="stable")
+    bounds = np.searchsorted(rows.img[order], np.arange(n_img + 1))
     for j in range(n_img):
-        rows = order[bounds[j]:bounds[j + 1]]
-        if not len(rows):
+        sel = order[bounds[j]:bounds[j + 1]]
+        if not len(sel):
             continue
         check_cancel(progress)
         im = images[j]
         cam = rec.cameras[im.camera_id]
         m = np.asarray(im.cam_from_world().matrix())
         r = m[:, :3]
-        xc = xyz_all[o_pt[rows]] @ r.T + m[:, 3]
-        jpi = _proj_jacobian(cam, xc)
-        jc[rows, :, 0:3] = np.einsum("nij,njk->nik", jpi, -_skew(xc))
-        jc[rows, :, 3:6] = jpi @ (-r)
-        jp[rows] = jpi @ r
+        xc = rows.xyz[rows.pt[sel]] @ r.T + m[:, 3]
+        jpi = project_jacobian(cam, xc)
+        # each image its own pose (sensor = rig): the camera-frame point is the rig-frame point
+        n = len(sel)
+        j_rot, j_c, j_pt = pose_point_jacobians(jpi, np.broadcast_to(np.eye(3), (n, 3, 3)),
+                                                np.broadcast_to(r, (n, 3, 3)), xc)
+        jc[sel, :, 0:3] = j_rot
+        jc[sel, :, 3:6] = j_c
+        jp[sel] = j_pt
         fr = free[int(im.camera_id)]
         cols = list(range(6 * j, 6 * j + 6))
         if fr:
-            jc[rows, :, 6:6 + len(fr)] = _intrinsics_jacobian(cam, xc, fr)
+            jc[sel, :, 6:6 + len(fr)] = intrinsics_jacobian(cam, xc, fr)
             cols += list(range(intr_off[int(im.camera_id)], intr_off[int(im.camera_id)] + len(fr)))
-        cam_cols[rows, :len(cols)] = cols
-        n_cols[rows] = len(cols)
+        cam_cols[sel, :len(cols)] = cols
+        n_cols[sel] = len(cols)
     jc *= sw[:, None, None]
     jp *= sw[:, None, None]
+    return jc, jp, cam_cols, n_cols
 
-    # normal equations
-    progress.report(0.4, "covariance: normal equations")
-    width = 6 + q_max
+
+@dataclass
+class _Normals:
+    ncc: np.ndarray  # (nc, nc) dense
+    ncp: Any  # (nc, 3P) sparse
+    npp: np.ndarray  # (P, 3, 3)
+    prior_res: List[np.ndarray]
+    n_cam_prior_comp: int
+    cams_with_prior: set
+    centres: np.ndarray  # (I, 3) projection centres
+
+
+def _normals(rows: _Rows, images, img_index, jc, jp, cam_cols, n_cols, nc: int,
+             camera_priors: Sequence[CameraPrior]) -> _Normals:
+    """The normal equations, with the control-point and camera-position priors."""
+    import scipy.sparse as sp
+
+    n_o, n_pts = len(rows.img), len(rows.xyz)
+    width = jc.shape[2]
     valid = np.arange(width)[None, :] < n_cols[:, None]  # (O, width)
     row_id = (2 * np.arange(n_o))[:, None, None] + np.arange(2)[None, :, None]
     rr = np.broadcast_to(row_id, (n_o, 2, width))
@@ -407,18 +362,18 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
     vm = np.broadcast_to(valid[:, None, :], (n_o, 2, width))
     jc_s = sp.csr_matrix((jc[vm], (rr[vm], cc[vm])), shape=(2 * n_o, nc))
     pr = np.broadcast_to(row_id, (n_o, 2, 3))
-    pc = np.broadcast_to((3 * o_pt)[:, None, None] + np.arange(3)[None, None, :], (n_o, 2, 3))
+    pc = np.broadcast_to((3 * rows.pt)[:, None, None] + np.arange(3)[None, None, :], (n_o, 2, 3))
     jp_s = sp.csr_matrix((jp.ravel(), (pr.ravel(), pc.ravel())), shape=(2 * n_o, 3 * n_pts))
     ncc = (jc_s.T @ jc_s).toarray()
     ncp = (jc_s.T @ jp_s).tocsr()
     npp = np.zeros((n_pts, 3, 3))
-    np.add.at(npp, o_pt, np.einsum("nki,nkj->nij", jp, jp))
+    np.add.at(npp, rows.pt, np.einsum("nki,nkj->nij", jp, jp))
     prior_res = []
-    if prior_idx:
-        pi = np.asarray(prior_idx)
-        ps = np.asarray(prior_sig)
+    if rows.prior_idx:
+        pi = np.asarray(rows.prior_idx)
+        ps = np.asarray(rows.prior_sig)
         npp[pi] += np.einsum("ni,ij->nij", 1.0 / ps ** 2, np.eye(3))
-        prior_res.append(((xyz_all[pi] - np.asarray(prior_xyz)) / ps).ravel())
+        prior_res.append(((rows.xyz[pi] - np.asarray(rows.prior_xyz)) / ps).ravel())
     n_cam_prior_comp = 0
     cams_with_prior = set()
     centres = np.array([np.asarray(im.projection_center(), dtype=float) for im in images])
@@ -432,21 +387,29 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
                 prior_res.append(np.array([(centres[j, a] - cp.xyz[a]) / cp.sigma[a]]))
                 n_cam_prior_comp += 1
                 cams_with_prior.add(j)
-    # points seen only once and without a prior cannot be estimated: drop them
-    npp_inv = _inv3(npp)
+    return _Normals(ncc, ncp, npp, prior_res, n_cam_prior_comp, cams_with_prior, centres)
+
+
+def _reduce(nrm: _Normals):
+    """Schur complement on the 3x3 point blocks: (reduced camera system, N_pp^-1, points that cannot be
+    estimated: seen only once and without a prior)."""
+    import scipy.sparse as sp
+
+    n_pts = len(nrm.npp)
+    npp_inv = inv3(nrm.npp)
     bad = ~np.all(np.isfinite(npp_inv.reshape(n_pts, -1)), axis=1)
     if np.any(bad):
         npp_inv[bad] = 0.0
     bi = (3 * np.arange(n_pts))[:, None, None] + np.arange(3)[None, :, None] + np.zeros((1, 1, 3), dtype=np.int64)
     nppi_s = sp.csr_matrix((npp_inv.ravel(), (bi.ravel(), np.swapaxes(bi, 1, 2).ravel())),
                            shape=(3 * n_pts, 3 * n_pts))
-    s_mat = ncc - (ncp @ nppi_s @ ncp.T).toarray()
-    s_mat = 0.5 * (s_mat + s_mat.T)
+    s_mat = nrm.ncc - (nrm.ncp @ nppi_s @ nrm.ncp.T).toarray()
+    return 0.5 * (s_mat + s_mat.T), npp_inv, bad
 
-    # datum
-    n_ctl = len(prior_idx)
-    has_datum = n_ctl >= 3 or n_cam_prior_comp >= 7 or (n_ctl >= 1 and n_ctl * 3 + n_cam_prior_comp >= 7)
-    progress.report(0.6, "covariance: inverting the reduced system")
+
+def _invert(s_mat: np.ndarray, has_datum: bool, notes: List[str]) -> Tuple[np.ndarray, str, int]:
+    """(Q_cc, datum, datum defect): Cholesky with the control's datum, else a generalised inverse."""
+    nc = len(s_mat)
     d = np.sqrt(np.maximum(np.diag(s_mat), 1e-300))
     s_scaled = s_mat / d[:, None] / d[None, :]
     datum = DATUM_CONTROL
@@ -469,20 +432,10 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
         if not has_datum:
             notes.append("no control points or camera positions: free-network precision (datum defect 7 removed "
                          "by a generalised inverse); positions are in the model frame")
-    q_cc = q_cc / d[:, None] / d[None, :]
+    return q_cc / d[:, None] / d[None, :], datum, defect
 
-    # variance factor
-    wrss = float(np.sum(w * (np.linalg.norm(o_res, axis=1) / o_sig) ** 2))
-    if prior_res:
-        wrss += float(np.sum(np.concatenate(prior_res) ** 2))
-    n_eq = 2 * n_o + 3 * n_ctl + n_cam_prior_comp
-    redundancy = int(n_eq - (nc + 3 * n_pts - 3 * int(bad.sum())) + defect)
-    sigma0 = math.sqrt(wrss / redundancy) if redundancy > 0 else float("nan")
-    var0 = sigma0 ** 2 if math.isfinite(sigma0) else 1.0
-    if not math.isfinite(sigma0):
-        notes.append("no redundancy: a priori precision (sigma0 = 1)")
 
-    # cameras
+def _camera_rows(images, centres: np.ndarray, q_cc: np.ndarray, var0: float) -> List[Dict[str, Any]]:
     cameras = []
     for j, im in enumerate(images):
         blk = q_cc[6 * j:6 * j + 6, 6 * j:6 * j + 6] * var0
@@ -491,6 +444,10 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
         cameras.append({"image": im.name, "camera_id": int(im.camera_id), "x": float(c[0]), "y": float(c[1]),
                         "z": float(c[2]), "sx": float(sd[3]), "sy": float(sd[4]), "sz": float(sd[5]),
                         "s_rx": math.degrees(sd[0]), "s_ry": math.degrees(sd[1]), "s_rz": math.degrees(sd[2])})
+    return cameras
+
+
+def _intrinsic_rows(rec, images, cam_ids, free, intr_off, q_cc: np.ndarray, var0: float) -> Dict[int, Dict[str, Any]]:
     intr = {}
     for cid in cam_ids:
         cam = rec.cameras[cid]
@@ -502,12 +459,16 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
         intr[cid] = {"model": cam.model.name, "width": int(cam.width), "height": int(cam.height),
                      "names": names, "values": [float(v) for v in cam.params], "std": std,
                      "images": sum(1 for im in images if int(im.camera_id) == cid)}
+    return intr
 
-    # points: Q_pp = N^-1 + N^-1 T^T Q_cc T N^-1 with T = N_cp columns of the point
-    progress.report(0.75, "covariance: points")
+
+def _point_std(nrm: _Normals, npp_inv: np.ndarray, bad: np.ndarray, q_cc: np.ndarray, var0: float,
+               progress: Progress) -> np.ndarray:
+    """Q_pp = N^-1 + N^-1 T^T Q_cc T N^-1 with T = N_cp columns of the point, in chunks."""
+    n_pts, nc = len(npp_inv), len(q_cc)
     pstd = np.full((n_pts, 3), np.nan)
     chunk = max(50, int(3e6 // max(nc, 1)) // 3)
-    ncp_csc = ncp.tocsc()
+    ncp_csc = nrm.ncp.tocsc()
     for a in range(0, n_pts, chunk):
         check_cancel(progress)
         b = min(n_pts, a + chunk)
@@ -519,50 +480,144 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
         q = ni + ni @ core @ ni
         pstd[a:b] = np.sqrt(np.maximum(np.einsum("nii->ni", q), 0.0) * var0)
     pstd[bad] = np.nan
+    return pstd
+
+
+def _camera_unknowns(cam_ids, free: Dict[int, List[int]], n_img: int) -> Tuple[int, Dict[int, int]]:
+    """Number of camera unknowns (6 per image, then the free intrinsics per camera) and each camera's column."""
+    intr_off = {}
+    nc = 6 * n_img
+    for cid in cam_ids:
+        intr_off[cid] = nc
+        nc += len(free[cid])
+    return nc, intr_off
+
+
+def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[CameraPrior] = (),
+             free_intrinsics: Optional[Dict[int, List[int]]] = None, tie_sigma_px: float = 1.0,
+             gcp_sigma_px: float = 1.0, huber_px: float = 2.0, max_observations: int = 300_000,
+             max_unknowns: int = 6000, offset=None, progress: Optional[Progress] = None,
+             observations: Optional[Observations] = None) -> UncertaintyResult:
+    """Covariance of the cameras, intrinsics and points of an adjusted block (see the module docstring)."""
+    t0 = time.time()
+    progress = progress or NullProgress()
+    notes: List[str] = []
+    obs = observations if observations is not None else collect_observations(rec)
+    n_img = len(obs.image_ids)
+    if n_img < 2:
+        raise UncertaintyError("the model has fewer than 2 registered images")
+    img_index = {name: k for k, name in enumerate(obs.image_names)}
+    images = [rec.image(int(i)) for i in obs.image_ids]
+    cam_ids = sorted({int(im.camera_id) for im in images})
+    free = free_intrinsics if free_intrinsics is not None else default_free_intrinsics(rec)
+    free = {cid: list(free.get(cid, [])) for cid in cam_ids}
+    nc, intr_off = _camera_unknowns(cam_ids, free, n_img)
+    if nc > max_unknowns:
+        raise UncertaintyError(f"{nc} camera unknowns: more than the dense covariance handles here ({max_unknowns})")
+    rows = _tie_rows(obs, max_observations, tie_sigma_px, notes)
+    _add_control(rec, rows, control, images, img_index, gcp_sigma_px)
+    n_pts, n_o = len(rows.xyz), len(rows.img)
+    w, sw = _weights(rows, huber_px)
+    progress.report(0.05, "covariance: Jacobian")
+    jc, jp, cam_cols, n_cols = _jacobians(rec, images, rows, free, intr_off, sw, progress)
+    progress.report(0.4, "covariance: normal equations")
+    nrm = _normals(rows, images, img_index, jc, jp, cam_cols, n_cols, nc, camera_priors)
+    s_mat, npp_inv, bad = _reduce(nrm)
+    n_ctl = len(rows.prior_idx)
+    ncp_comp = nrm.n_cam_prior_comp
+    has_datum = n_ctl >= 3 or ncp_comp >= 7 or (n_ctl >= 1 and n_ctl * 3 + ncp_comp >= 7)
+    progress.report(0.6, "covariance: inverting the reduced system")
+    q_cc, datum, defect = _invert(s_mat, has_datum, notes)
+
+    # variance factor
+    wrss = float(np.sum(w * (np.linalg.norm(rows.res, axis=1) / rows.sigma) ** 2))
+    if nrm.prior_res:
+        wrss += float(np.sum(np.concatenate(nrm.prior_res) ** 2))
+    n_eq = 2 * n_o + 3 * n_ctl + ncp_comp
+    redundancy = int(n_eq - (nc + 3 * n_pts - 3 * int(bad.sum())) + defect)
+    sigma0 = math.sqrt(wrss / redundancy) if redundancy > 0 else float("nan")
+    var0 = sigma0 ** 2 if math.isfinite(sigma0) else 1.0
+    if not math.isfinite(sigma0):
+        notes.append("no redundancy: a priori precision (sigma0 = 1)")
+
+    cameras = _camera_rows(images, nrm.centres, q_cc, var0)
+    intr = _intrinsic_rows(rec, images, cam_ids, free, intr_off, q_cc, var0)
+    progress.report(0.75, "covariance: points")
+    pstd = _point_std(nrm, npp_inv, bad, q_cc, var0, progress)
     control_rows = [{"name": name, "sx": float(pstd[k, 0]), "sy": float(pstd[k, 1]), "sz": float(pstd[k, 2])}
-                    for name, k in ctl_rows]
+                    for name, k in rows.control_rows]
     if any(len(free[c]) for c in cam_ids):
         notes.append("intrinsic parameters free: " + "; ".join(
             f"camera {c}: {', '.join(intr[c]['names'][i] for i in free[c]) or 'none'}" for c in cam_ids))
     if any(r.num_sensors() > 1 for r in rec.rigs.values()):
         notes.append("multi-camera rigs are treated as independent cameras")
     progress.report(1.0, "covariance done")
+    n_tie = rows.n_tie
     return UncertaintyResult(
         datum=datum, sigma0=sigma0, redundancy=redundancy, n_observations=n_o, n_points=n_tie,
-        cameras=cameras, intrinsics=intr, point_ids=obs.point_ids[keep_pt], point_xyz=xyz_all[:n_tie],
+        cameras=cameras, intrinsics=intr, point_ids=obs.point_ids[rows.keep_pt], point_xyz=rows.xyz[:n_tie],
         point_std=pstd[:n_tie], control=control_rows,
         offset=np.zeros(3) if offset is None else np.asarray(offset, dtype=float), notes=notes,
-        seconds=round(time.time() - t0, 3), n_control=n_ctl, n_camera_priors=len(cams_with_prior))
+        seconds=round(time.time() - t0, 3), n_control=n_ctl, n_camera_priors=len(nrm.cams_with_prior))
 
 
 # --------------------------------------------------------------------------------------------------
 # workspaces
 # --------------------------------------------------------------------------------------------------
 
-def _read_json(path: str) -> Optional[Dict[str, Any]]:
-    if not os.path.isfile(path):
-        return None
-    with open(path, encoding="utf-8") as f:
-        return json.load(f)
-
-
 def workspace_inputs(ws, rec) -> Tuple[List[ControlInput], List[CameraPrior], Dict[int, List[int]], np.ndarray]:
     """Control, camera priors, free intrinsics and the local->world offset of a workspace's newest model.
 
-    The georeferenced model when the georeference stage is done (priors from georef/residuals.json,
-    control sigmas from georef/control.json), else the aligned model without priors."""
-    pp = bool((_read_json(ws.path("sfm", "alignment.json")) or {}).get("principal_point_refined"))
-    geo = ws.stage("georeference")
-    if geo.get("status") != "done" or not os.path.isdir(ws.path("georef", "model")):
+    The georeferenced model when the georeference stage is done (priors from georef/residuals.json, their
+    sigmas from the adjustment inputs the stage saved, georef/adjustment_inputs.json; a workspace from before
+    that file: georef/control.json and the camera-positions file), else the aligned model without priors."""
+    lay = Layout(ws)
+    pp = bool(lay.alignment().get("principal_point_refined"))
+    if not lay.is_georeferenced():
         return [], [], default_free_intrinsics(rec, pp), np.zeros(3)
-    params = geo.get("parameters", {}) or {}
+    params = ws.stage(GEOREFERENCE).get("parameters", {}) or {}
     refine = params.get("refine_intrinsics")
-    transform = _read_json(ws.path("georef", "transform.json")) or {}
+    transform = read_json(lay.transform_json) or {}
     offset = np.asarray(transform.get("offset", [0.0, 0.0, 0.0]), dtype=float)
-    residuals = _read_json(ws.path("georef", "residuals.json")) or {}
-    control_doc = _read_json(ws.path("georef", "control.json")) or {}
-    sigmas = {p["name"]: (float(p.get("sigma_xy", 0.02)), float(p.get("sigma_z", 0.05)))
-              for p in control_doc.get("points", [])}
+    residuals = lay.residuals() or {}
+    inputs = read_json(lay.adjustment_inputs_json)
+    control = _control_inputs(residuals, _control_sigmas(lay, inputs), offset)
+    priors = _camera_priors(residuals, _camera_sigmas(inputs, params), offset)
+    if refine == "all" or (isinstance(refine, (list, tuple)) and "principal_point" in refine):
+        pp = True
+    # intrinsics that stayed at their alignment values still get their precision in this block
+    free = default_free_intrinsics(rec, pp)
+    return control, priors, free, offset
+
+
+def _control_sigmas(lay: Layout, inputs: Optional[Dict[str, Any]]) -> Dict[str, Tuple[float, float]]:
+    """name -> (sigma XY, sigma Z) of the ground control the adjustment used."""
+    if inputs is not None:
+        doc = inputs.get("gcps") or {}
+    else:  # a workspace from before adjustment_inputs.json
+        doc = read_json(lay.control_json) or {}
+    return {p["name"]: (float(p.get("sigma_xy", 0.02)), float(p.get("sigma_z", 0.05)))
+            for p in doc.get("points", [])}
+
+
+def _camera_sigmas(inputs: Optional[Dict[str, Any]], params: Dict[str, Any]):
+    """(image -> (sigma XY, sigma Z), default) of the camera positions the adjustment used."""
+    default = FILE_POSITION_SIGMAS if params.get("camera_positions") else (EXIF_SIGMA_XY, EXIF_SIGMA_Z)
+    if inputs is not None:
+        return {c["image"]: (float(c["sigma_xy"]), float(c["sigma_z"]))
+                for c in inputs.get("camera_positions") or []}, default
+    sig: Dict[str, Tuple[float, float]] = {}
+    if params.get("camera_positions"):  # a workspace from before adjustment_inputs.json: the user's file
+        try:
+            _, cps = read_camera_positions(params["camera_positions"])
+            sig = {c.image: (c.sigma_xy, c.sigma_z) for c in cps}
+        except (OSError, ValueError):
+            sig = {}
+    return sig, default
+
+
+def _control_inputs(residuals: Dict[str, Any], sigmas: Dict[str, Tuple[float, float]],
+                    offset: np.ndarray) -> List[ControlInput]:
     placeholder = (residuals.get("statistics") or {}).get("placeholder_z") is not None
     control = []
     for p in residuals.get("points", []):
@@ -576,37 +631,24 @@ def workspace_inputs(ws, rec) -> Tuple[List[ControlInput], List[CameraPrior], Di
         obs = [(o["image"], float(o["x"]), float(o["y"])) for o in p.get("observations", [])
                if o.get("px") is not None]
         control.append(ControlInput(p["name"], adj, np.array([sxy, sxy, sz]), given, obs))
-    priors = []
-    cams = [c for c in residuals.get("cameras", []) if c.get("used", True)]
-    if cams:
-        sig: Dict[str, Tuple[float, float]] = {}
-        if params.get("camera_positions"):
-            try:
-                from ..io.gcp import read_camera_positions
+    return control
 
-                _, cps = read_camera_positions(params["camera_positions"])
-                sig = {c.image: (c.sigma_xy, c.sigma_z) for c in cps}
-            except (OSError, ValueError):
-                sig = {}
-            default = (5.0, 10.0)
-        else:
-            default = (EXIF_SIGMA_XY, EXIF_SIGMA_Z)
-        for c in cams:
-            z = c.get("z")
-            sxy, sz = sig.get(c["image"], default)
-            xyz = np.array([c["x"], c["y"], np.nan if z is None else z], dtype=float) - offset
-            priors.append(CameraPrior(c["image"], xyz, np.array([sxy, sxy, sz], dtype=float)))
-    if refine == "all" or (isinstance(refine, (list, tuple)) and "principal_point" in refine):
-        pp = True
-    # intrinsics that stayed at their alignment values still get their precision in this block
-    free = default_free_intrinsics(rec, pp)
-    return control, priors, free, offset
+
+def _camera_priors(residuals: Dict[str, Any], sigmas, offset: np.ndarray) -> List[CameraPrior]:
+    sig, default = sigmas
+    priors = []
+    for c in residuals.get("cameras", []):
+        if not c.get("used", True):
+            continue
+        z = c.get("z")
+        sxy, sz = sig.get(c["image"], default)
+        xyz = np.array([c["x"], c["y"], np.nan if z is None else z], dtype=float) - offset
+        priors.append(CameraPrior(c["image"], xyz, np.array([sxy, sxy, sz], dtype=float)))
+    return priors
 
 
 def write_layers(result: UncertaintyResult, folder: str, crs: Optional[str]) -> Dict[str, str]:
     """cameras.gpkg and points.gpkg (standard deviations in metres / degrees) in ``folder``."""
-    from ..io.vector import write_points_gpkg
-
     os.makedirs(folder, exist_ok=True)
     off = result.offset
     cam_rows = [dict(c, x=c["x"] + off[0], y=c["y"] + off[1], z=c["z"] + off[2]) for c in result.cameras]
