@@ -32,7 +32,7 @@ DEFAULT_IMAGES = os.path.join(os.path.dirname(ROOT), "shared", "data", "toledo",
 def ours(images, work, threads, mapper="incremental"):
     ws = os.path.join(work, "archaeoortho-ws")
     shutil.rmtree(ws, ignore_errors=True)
-    code = ("import sys, json; sys.path.insert(0, %r); from core.sfm import align, AlignOptions;"
+    code = ("import sys, json; sys.path.insert(0, %r); from core.align.stage import align, AlignOptions;"
             "r = align(%r, %r, AlignOptions(num_threads=%d, mapper=%r));"
             "print('RESULT', json.dumps({'registered': r.registered, 'images': r.images_given,"
             "'mre': r.mean_reprojection_error, 'timings': r.timings, 'pairs': r.num_pairs,"

@@ -1,0 +1,221 @@
+"""Features and matches in the COLMAP database: cameras, masks for COLMAP, SIFT extraction, pair matching.
+
+Masks: feature extraction ignores the black pixels of ``<workspace>/masks/<image
+name>.png`` (core.prepare.masks: COLMAP's own convention, as core.prepare.scans writes
+them for scanned film and Prepare images for user polygons); an image without a
+mask uses every pixel (it is extracted without ``mask_path``: COLMAP would
+skip it).  Masks found only as ``masks/<stem>.png`` (also accepted by the
+orthophoto stage) are linked under COLMAP's names into ``sfm/masks/``.  The
+masks are part of the database key: a change of masks extracts the features
+afresh.
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+from typing import Dict, List, Optional, Sequence, Tuple
+
+from ..common.cancel import CancelWatcher
+from ..common.progress import Progress, check_cancel
+from ..io.images import CameraGroup, ImageInfo
+from ..prepare.masks import MaskError, find_mask, mask_file_name, png_size
+from ..project.workspace import atomic_output, atomic_write_text, fingerprint
+from .options import CAMERA_MODELS, EXTRACT_BLOCK, MATCH_BLOCK, UPSAMPLE_BELOW, AlignError, AlignOptions
+
+
+def choose_camera_model(requested: str, n_images: int, min_images_opencv: int = 10) -> str:
+    requested = (requested or "AUTO").upper()
+    if requested not in CAMERA_MODELS:
+        raise AlignError(f"unknown camera model {requested!r}; choose one of {', '.join(CAMERA_MODELS)}")
+    if requested != "AUTO":
+        return requested
+    if n_images >= min_images_opencv:
+        return "OPENCV"
+    if n_images >= 3:
+        return "RADIAL"
+    return "SIMPLE_RADIAL"
+
+
+def setup_database(pycolmap, db_path: str, groups: List[CameraGroup], options: AlignOptions,
+                    images_dir: str, state: dict, masks_key: Optional[str] = None) -> Dict[str, int]:
+    """Create (or check) the database's cameras; returns camera_id per group key."""
+    what = {
+        "groups": [(g.key, g.width, g.height, round(g.focal_px, 3), sorted(g.images)) for g in groups],
+        "model": options.camera_model, "max_image_size": options.max_image_size,
+        "max_features": options.max_features, "affine": options.affine_features,
+        "images_dir": os.path.abspath(images_dir),
+    }
+    if masks_key:  # only with masks: the key of a workspace without masks stays as it was
+        what["masks"] = masks_key
+    g0 = max(groups, key=lambda g: g.width * g.height)
+    octave = sift_first_octave(options, g0.width, g0.height)
+    if octave != -1:  # COLMAP's default (-1) keeps the key of earlier workspaces
+        what["first_octave"] = octave
+    key = fingerprint(what)
+    if os.path.exists(db_path) and state.get("database_key") != key:
+        os.unlink(db_path)  # different images or extraction settings: start afresh
+    state["database_key"] = key
+    db = pycolmap.Database.open(db_path)
+    try:
+        ids = {}
+        existing = {c.camera_id: c for c in db.read_all_cameras()}
+        for g in groups:
+            model = choose_camera_model(options.camera_model, len(g.images), options.min_images_opencv)
+            if g.camera_id in existing:
+                ids[g.key] = g.camera_id
+                continue
+            cam = pycolmap.Camera.create_from_model_name(g.camera_id, model, g.focal_px, g.width, g.height)
+            cam.has_prior_focal_length = g.focal_source != "default"
+            ids[g.key] = db.write_camera(cam, use_camera_id=True)
+        return ids
+    finally:
+        db.close()
+
+
+def auto_max_features(width: int, height: int, max_image_size: int = 0) -> int:
+    """Features per image when the user leaves it at 0: ~4000 per megapixel matched, 2048..8192."""
+    scale = min(1.0, max_image_size / max(width, height)) if max_image_size else 1.0
+    mp = width * height * scale * scale / 1e6
+    return int(min(8192, max(2048, round(4000 * mp, -2))))
+
+
+def file_hash(path: str) -> str:
+    h = hashlib.sha1()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()[:16]
+
+
+def masks_for_colmap(masks_dir: str, infos: Sequence[ImageInfo], sfm_dir: str) -> Tuple[Optional[str], Dict[str, str]]:
+    """The folder to give COLMAP as ``mask_path`` (None without masks) and image -> mask file.
+
+    Every mask must have its image's size (COLMAP drops every feature outside
+    a smaller mask).  When all masks carry COLMAP's names the workspace's
+    masks folder is used as it is; otherwise ``sfm/masks`` gets links (or
+    copies) under COLMAP's names.
+    """
+    found: Dict[str, str] = {}
+    for im in infos:
+        p = find_mask(masks_dir, im.name)
+        if not p:
+            continue
+        try:
+            w, h = png_size(p)
+        except MaskError as e:
+            raise AlignError(str(e)) from e
+        if (w, h) != (im.width, im.height):
+            raise AlignError(f"mask {p} is {w} x {h} px but image {im.name} is {im.width} x {im.height} px: "
+                             "a mask must have its image's size (run 'Prepare images' again or remove the mask)")
+        found[im.name] = p
+    linked = os.path.join(sfm_dir, "masks")
+    if all(os.path.basename(p) == mask_file_name(n) for n, p in found.items()):
+        shutil.rmtree(linked, ignore_errors=True)
+        return (masks_dir if found else None), found
+    with atomic_output(linked) as tmp:
+        os.makedirs(tmp)
+        for n, p in found.items():
+            dst = os.path.join(tmp, mask_file_name(n))
+            try:
+                os.link(p, dst)
+            except OSError:
+                shutil.copyfile(p, dst)
+    return linked, found
+
+
+def sift_first_octave(options: AlignOptions, width: int, height: int) -> int:
+    """SIFT's first octave: -1 (the image upsampled 2x: more small-scale features, 4x the work) for small
+    images, 0 from ``UPSAMPLE_BELOW`` px on the long side at the matching scale, where the image itself has
+    features enough; ``options.first_octave`` overrides."""
+    if options.first_octave is not None:
+        return int(options.first_octave)
+    side = max(width, height)
+    if options.max_image_size and options.max_image_size > 0:
+        side = min(side, options.max_image_size)
+    return -1 if side < UPSAMPLE_BELOW else 0
+
+
+def extract_features(pycolmap, db_path, images_dir, groups, camera_ids, options, progress: Progress,
+             mask_path: Optional[str] = None, masked: Optional[Sequence[str]] = None):
+    eo = pycolmap.FeatureExtractionOptions()
+    g0 = max(groups, key=lambda g: g.width * g.height)
+    eo.sift.max_num_features = int(options.max_features or auto_max_features(g0.width, g0.height,
+                                                                              options.max_image_size))
+    if options.max_image_size and options.max_image_size > 0:
+        eo.max_image_size = int(options.max_image_size)
+    eo.sift.first_octave = sift_first_octave(options, g0.width, g0.height)
+    eo.num_threads = options.num_threads
+    if options.affine_features:
+        eo.sift.estimate_affine_shape = True
+        eo.sift.domain_size_pooling = True
+    db = pycolmap.Database.open(db_path)
+    try:
+        done = {im.name for im in db.read_all_images() if db.exists_keypoints(im.image_id)}
+    finally:
+        db.close()
+    masked = set(masked or ())
+    todo: List[Tuple[CameraGroup, List[str]]] = []
+    for g in groups:
+        rest = [n for n in g.images if n not in done]
+        # COLMAP skips an image whose mask is missing when mask_path is set: masked and unmasked images go
+        # in separate blocks (in file order), only the masked ones with mask_path
+        block: List[str] = []
+        for n in rest:
+            if block and (len(block) >= EXTRACT_BLOCK or (n in masked) != (block[0] in masked)):
+                todo.append((g, block))
+                block = []
+            block.append(n)
+        if block:
+            todo.append((g, block))
+    total = sum(len(b) for _, b in todo)
+    if done:
+        progress.info(f"features: {len(done)} images already extracted, reused")
+    count = 0
+    for g, block in todo:
+        check_cancel(progress)
+        ro = pycolmap.ImageReaderOptions()
+        ro.existing_camera_id = camera_ids[g.key]
+        if mask_path and block[0] in masked:
+            ro.mask_path = mask_path  # <mask_path>/<image name>.png, black = no features
+        with CancelWatcher(progress) as token:
+            pycolmap.extract_features(db_path, images_dir, image_names=block,
+                                      camera_mode=pycolmap.CameraMode.SINGLE, reader_options=ro,
+                                      extraction_options=eo, device=pycolmap.Device.cpu,
+                                      cancellation_token=token)
+        check_cancel(progress)
+        count += len(block)
+        progress.report(count / max(1, total), f"features: {count}/{total} images ({block[-1]})")
+
+
+def match_pairs(pycolmap, db_path, pairs, work_dir, options, progress: Progress):
+    db = pycolmap.Database.open(db_path)
+    try:
+        id_by_name = {im.name: im.image_id for im in db.read_all_images()}
+        todo = []
+        for a, b in pairs:
+            if a not in id_by_name or b not in id_by_name:
+                continue
+            if not db.exists_two_view_geometry(id_by_name[a], id_by_name[b]):
+                todo.append((a, b))
+    finally:
+        db.close()
+    if len(todo) < len(pairs):
+        progress.info(f"matching: {len(pairs) - len(todo)} of {len(pairs)} pairs already matched, reused")
+    mo = pycolmap.FeatureMatchingOptions()
+    mo.num_threads = options.num_threads
+    vo = pycolmap.TwoViewGeometryOptions()
+    list_path = os.path.join(work_dir, "pairs-block.txt")
+    for start in range(0, len(todo), MATCH_BLOCK):
+        check_cancel(progress)
+        block = todo[start:start + MATCH_BLOCK]
+        atomic_write_text(list_path, "".join(f"{a} {b}\n" for a, b in block))
+        po = pycolmap.ImportedPairingOptions()
+        po.match_list_path = list_path
+        with CancelWatcher(progress) as token:
+            pycolmap.match_image_pairs(db_path, matching_options=mo, pairing_options=po,
+                                       verification_options=vo, device=pycolmap.Device.cpu,
+                                       cancellation_token=token)
+        check_cancel(progress)
+        done = min(len(todo), start + MATCH_BLOCK)
+        progress.report(done / max(1, len(todo)), f"matching: {done}/{len(todo)} pairs")
