@@ -35,8 +35,6 @@ from .options import (
 from .pairs import gps_to_local_xy, select_pairs
 from .stage import STAGE, AlignResult, align, diagnose_unregistered, load_model
 
-_CancelWatcher = CancelWatcher  # the old name (core.dense imported it from here)
-
 __all__ = [
     "AUTO_EXHAUSTIVE_MAX", "CAMERA_MODELS", "EXTRACT_BLOCK", "LOOP_STRIDE", "MAPPERS", "MATCH_BLOCK",
     "MAX_LOOP_ANCHORS", "PAIRINGS", "SEQUENTIAL_OVERLAP", "SPATIAL_NEIGHBOURS", "STAGE", "UPSAMPLE_BELOW",
