@@ -84,6 +84,33 @@ def test_camera_positions_file_gives_the_crs(aligned, tmp_path):
     assert result.figures["CAMERA_RMSE_XY"] is not None and result.figures["CAMERA_RMSE_XY"] < 5.0
 
 
+
+def test_the_stage_saves_its_adjustment_inputs_and_the_covariance_reads_them(aligned, tmp_path):
+    """georef/adjustment_inputs.json holds the camera positions with their sigmas and the target CRS; the
+    covariance's priors come from it, not from the user's file (deleted here)."""
+    import json
+    import shutil
+
+    from core.georef import uncertainty
+
+    ws_dir = str(tmp_path / "ws")
+    shutil.copytree(aligned, ws_dir)
+    ref = _reference_positions()
+    names = sorted(set(ref) & set(TOLEDO_STRIP))
+    csv = tmp_path / "positions.csv"
+    csv.write_text("EPSG:32617\n" + "".join(f"{n} {ref[n][0]:.3f} {ref[n][1]:.3f} 250.0 2.5 7.5\n" for n in names))
+    georef_stage.georeference_workspace(ws_dir, camera_positions_path=str(csv))
+    with open(os.path.join(ws_dir, "georef", "adjustment_inputs.json"), encoding="utf-8") as f:
+        inputs = json.load(f)
+    assert inputs["crs"] == "EPSG:32617"
+    assert inputs["camera_positions_source"] == "file"
+    assert {c["image"] for c in inputs["camera_positions"]} == set(names)
+    assert all((c["sigma_xy"], c["sigma_z"]) == (2.5, 7.5) for c in inputs["camera_positions"])
+    os.remove(csv)
+    rec, _ = georef_stage.load_georef_model(ws_dir)
+    _, priors, _, _ = uncertainty.workspace_inputs(Workspace.open(ws_dir), rec)
+    assert priors and all(np.allclose(p.sigma, [2.5, 2.5, 7.5]) for p in priors)
+
 def test_too_few_control_points_is_a_clear_error(aligned):
     gcps = GCPSet(crs="EPSG:32617", points=[
         GroundPoint("A", 274900.0, 4603270.0, 180.0, observations=[Observation("1JI_0064.JPG", 500, 400),

@@ -452,7 +452,8 @@ def _outlier_rounds(run: _Run, adj: _Adjustment) -> None:
     for pass_round in range(1, opt.max_outlier_rounds + 2):
         adj.rounds += 1
         check_cancel(run.progress)
-        sub = SubProgress(run.progress, 0.12 + 0.7 * (1 - 0.5 ** (adj.rounds - 1)), 0.12 + 0.7 * (1 - 0.5 ** adj.rounds))
+        lo, hi = 0.12 + 0.7 * (1 - 0.5 ** (adj.rounds - 1)), 0.12 + 0.7 * (1 - 0.5 ** adj.rounds)
+        sub = SubProgress(run.progress, lo, hi)
         info = adj.prob.solve(max_iterations=opt.max_iterations, progress=sub)
         adj.iterations += info["iterations"]
         if pass_round > opt.max_outlier_rounds:

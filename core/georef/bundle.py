@@ -78,6 +78,15 @@ def pose_point_jacobians(jpi: np.ndarray, sensor_rotation: np.ndarray, rotation:
     return j_rot, -j_pt, j_pt
 
 
+def huber_weights(s: np.ndarray, robust: np.ndarray, huber: float) -> np.ndarray:
+    """Iteratively-reweighted Huber weights of normalised residuals ``s``: 1, or huber / s beyond ``huber``
+    where ``robust`` (tie points; GCP observations are not robust)."""
+    w = np.ones_like(s)
+    big = robust & (s > huber)
+    w[big] = huber / s[big]
+    return w
+
+
 def inv3(m: np.ndarray) -> np.ndarray:
     """Inverse of a stack of 3x3 matrices by the adjugate (numpy's batched inv calls LAPACK per
     matrix, through BLAS threads: 100x slower on busy cores)."""
@@ -222,10 +231,7 @@ class BundleProblem:
         return (self.camera_centres()[self.cp_img[idx]] - self.cp_xyz[idx]) / self.cp_sigma[idx]
 
     def _huber_weights(self, s: np.ndarray, robust: np.ndarray) -> np.ndarray:
-        w = np.ones_like(s)
-        big = robust & (s > self.huber)
-        w[big] = self.huber / s[big]
-        return w
+        return huber_weights(s, robust, self.huber)
 
     def cost(self) -> float:
         o = self.obs
@@ -641,6 +647,6 @@ def write_back(rec, prob: BundleProblem, tie_ids, frame_ids, camera_ids) -> None
 
 
 
-__all__ = ["BundleProblem", "Observations", "build_problem", "intrinsics_jacobian", "inv3", "outside_image",
-           "pose_point_jacobians", "project", "project_jacobian", "select_tie_points", "set_point_active",
-           "write_back"]
+__all__ = ["BundleProblem", "Observations", "build_problem", "huber_weights", "intrinsics_jacobian", "inv3",
+           "outside_image", "pose_point_jacobians", "project", "project_jacobian", "select_tie_points",
+           "set_point_active", "write_back"]

@@ -498,5 +498,6 @@ def refine_by_matching(rec, ref_image: str, ref_xy: Sequence[float], ref_gray: n
                  float(np.hypot(x - tgt_xy[0], y - tgt_xy[1])))
 
 
-__all__ = ["GEOREF", "HELMERT", "RAYS", "Match", "Prediction", "Predictor", "ground_sample_distance", "image_footprints",
-           "images_seeing", "project_point", "read_gray", "refine_by_matching", "write_footprints_gpkg"]
+__all__ = ["GEOREF", "HELMERT", "RAYS", "Match", "Prediction", "Predictor", "ground_sample_distance",
+           "image_footprints", "images_seeing", "project_point", "read_gray", "refine_by_matching",
+           "write_footprints_gpkg"]

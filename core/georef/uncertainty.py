@@ -24,8 +24,9 @@ frame and units ("free network").
 Why not ``pycolmap.estimate_ba_covariance``: it needs a Ceres problem built by pycolmap's own bundle
 adjusters, which have no prior on a 3-D point (GCPs), so it cannot give the precision of a
 GCP-controlled block.  Without control the two agree (tests/test_report.py compares the intrinsics'
-standard deviations with ``estimate_ba_covariance`` to 0.1 %).  The derivatives here are analytic for the rigid part and central differences
-through pycolmap's camera model (``Camera.img_from_cam``), so every COLMAP camera model works.
+standard deviations with ``estimate_ba_covariance`` to 0.1 %).  The projection, its derivatives (analytic for
+the rigid part, central differences through pycolmap's camera model, ``Camera.img_from_cam``, so every COLMAP
+camera model works) and the Huber weights are the adjustment's own (``core.georef.bundle``).
 
 Simplifications, stated in the result's ``notes``: each image has its own pose (rigs are treated as
 independent cameras), the intrinsics' covariance is that of the parameters marked free, and beyond
@@ -48,7 +49,7 @@ from ..io.gcp import read_camera_positions
 from ..io.vector import write_points_gpkg
 from ..project.layout import Layout, read_json
 from ..project.stages import GEOREFERENCE
-from .bundle import intrinsics_jacobian, inv3, pose_point_jacobians, project, project_jacobian
+from .bundle import huber_weights, intrinsics_jacobian, inv3, pose_point_jacobians, project, project_jacobian
 from .options import EXIF_SIGMA_XY, EXIF_SIGMA_Z, FILE_POSITION_SIGMAS, PLACEHOLDER_SIGMA_Z
 
 DATUM_CONTROL = "control"
@@ -289,9 +290,7 @@ def _add_control(rec, rows: _Rows, control: Sequence[ControlInput], images, img_
 def _weights(rows: _Rows, huber_px: float) -> Tuple[np.ndarray, np.ndarray]:
     """(Huber weight, sqrt of the weight of each residual component) per observation, as in the adjustment."""
     s = np.linalg.norm(rows.res, axis=1) / rows.sigma
-    w = np.ones(len(rows.img))
-    big = rows.robust & (s > huber_px)
-    w[big] = huber_px / s[big]
+    w = huber_weights(s, rows.robust, huber_px)
     return w, np.sqrt(w) / rows.sigma
 
 
