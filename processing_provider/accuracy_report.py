@@ -84,7 +84,7 @@ class AccuracyReportAlgorithm(AlgorithmBase):
             self.addOutput(QgsProcessingOutputNumber(name, self.tr(label)))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core.report import html as report
+        from ..core.report import stage as report
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         output = self.parameterAsFileOutput(parameters, self.OUTPUT_HTML, context) or None

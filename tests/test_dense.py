@@ -15,9 +15,10 @@ from core.dense import grid as gridding
 from core.dense import stage as dense
 from core.dense.pairs import View
 from core.io import raster as dsm
-from core.project.workspace import DONE, Workspace
+from core.project.workspace import Workspace
 from tests import synthetic as syn
 from tests.conftest import SAMPLE, TOLEDO_STRIP, copy_images
+from tests.workspaces import synthetic_workspace
 
 # a small camera keeps rendering and matching fast; the block: 2 strips of 6, 80 % / 50 % overlap (seed 8 puts
 # two buildings where at least four photos see their roofs)
@@ -27,22 +28,8 @@ CAMERA = syn.CameraModel(400, 300, 325.0, 325.0, 201.9, 148.1, k1=-0.08, k2=0.02
 def make_workspace(root, block, names=None, georeferenced=True, images_dir=None):
     """A workspace holding the true (local-frame) model of a synthetic block, as if aligned + georeferenced."""
     rec = block.truth_reconstruction(model_from_local=None, noise_px=0.2, n_points=1500, images=names)
-    ws = Workspace.create_or_open(root)
-    ws.data["images_dir"] = images_dir
-    ws.data["images"] = [{"name": n, "width": block.camera.width, "height": block.camera.height}
-                         for n in (names or block.names)]
-    ws.data["stages"]["align"] = {"status": DONE}
-    folder = "georef" if georeferenced else "sfm"
-    os.makedirs(ws.path(folder, "model"), exist_ok=True)
-    rec.write_binary(ws.path(folder, "model"))
-    if georeferenced:
-        ws.crs = syn.CRS
-        with open(ws.path("georef", "transform.json"), "w") as f:
-            json.dump({"crs": syn.CRS, "offset": [float(v) for v in syn.ORIGIN]}, f)
-        ws.data["stages"]["georeference"] = {"status": DONE}
-    ws.save()
-    return ws.root
-
+    return synthetic_workspace(root, block, rec, names=names, images_dir=images_dir, georeferenced=georeferenced,
+                               crs=syn.CRS, offset=syn.ORIGIN)
 
 @pytest.fixture(scope="module")
 def block_dir(tmp_path_factory):

@@ -26,6 +26,7 @@ from core.ortho.stage import build_orthophoto_workspace
 from core.ortho.surface import fill_dsm_gaps
 from core.project.workspace import DONE, Workspace
 from tests import synthetic as syn
+from tests.workspaces import synthetic_workspace
 
 # a small camera keeps rendering fast; 3 strips of 5 images, 70 % / 40 % overlap, 40 m above ground
 CAMERA = syn.CameraModel(400, 300, 325.0, 325.0, 201.9, 148.1, k1=-0.08, k2=0.02, p1=0.0006, p2=-0.0004)
@@ -35,22 +36,10 @@ SINGLE = "S2_02.jpg"
 def make_workspace(root, block, images_dir, names=None):
     """A workspace holding the true (local-frame) model of a synthetic block, as if aligned + georeferenced."""
     rec = block.truth_reconstruction(model_from_local=None, noise_px=0.2, n_points=400, images=names)
-    ws = Workspace.create_or_open(root)
-    ws.data["images_dir"] = images_dir
-    ws.data["images"] = [{"name": n, "width": block.camera.width, "height": block.camera.height}
-                         for n in (names or block.names)]
-    ws.data["camera_groups"] = [{"camera_id": 1, "key": "synthetic|400x300", "make": "synthetic", "model": "NIR-less",
-                                 "images": list(names or block.names)}]
-    ws.data["stages"]["align"] = {"status": DONE}
-    os.makedirs(ws.path("georef", "model"), exist_ok=True)
-    rec.write_binary(ws.path("georef", "model"))
-    ws.crs = syn.CRS
-    with open(ws.path("georef", "transform.json"), "w") as f:
-        json.dump({"crs": syn.CRS, "offset": [float(v) for v in syn.ORIGIN]}, f)
-    ws.data["stages"]["georeference"] = {"status": DONE}
-    ws.save()
-    return ws.root
-
+    groups = [{"camera_id": 1, "key": "synthetic|400x300", "make": "synthetic", "model": "NIR-less",
+               "images": list(names or block.names)}]
+    return synthetic_workspace(root, block, rec, names=names, images_dir=images_dir, camera_groups=groups,
+                               georeferenced=True, crs=syn.CRS, offset=syn.ORIGIN)
 
 def truth_dsm(block, path):
     """The renderer's own height raster (bilinear between cell centres) as a DSM in world coordinates."""

@@ -17,10 +17,11 @@ import pytest
 from core import pipeline
 from core.common.progress import Cancelled, NullProgress
 from core.georef import accuracy, uncertainty
-from core.project.workspace import DONE, Workspace
+from core.project.workspace import Workspace
 from core.report import stage as report
 from core.report.html import esc
 from tests import synthetic as syn
+from tests.workspaces import synthetic_workspace
 
 IMG_RE = re.compile(r'<img alt="([^"]*)" src="data:image/png;base64,([A-Za-z0-9+/=]+)">')
 
@@ -30,23 +31,13 @@ IMG_RE = re.compile(r'<img alt="([^"]*)" src="data:image/png;base64,([A-Za-z0-9+
 # --------------------------------------------------------------------------------------------------
 
 def _aligned_workspace(path, block, rec, unregistered=None):
-    ws = Workspace.create_or_open(str(path))
-    ws.data["images"] = [{"name": s.name, "width": block.camera.width, "height": block.camera.height}
-                         for s in block.shots]
-    ws.data["images_dir"] = "/synthetic/images"
-    ws.begin_stage("align", {"pairing": "synthetic"})
-    os.makedirs(ws.path("sfm", "model"), exist_ok=True)
-    rec.write_binary(ws.path("sfm", "model"))
     n = len(block.shots)
     alignment = {"images_given": n + len(unregistered or {}), "registered": n,
                  "unregistered": unregistered or {}, "skipped_files": [], "other_components": [],
                  "principal_point_refined": False}
-    with open(ws.path("sfm", "alignment.json"), "w", encoding="utf-8") as f:
-        json.dump(alignment, f)
-    ws.record_timing("align", "features", 1.5)
-    ws.end_stage("align", DONE, outputs={"model": "sfm/model"}, results={"registered": n})
-    return ws.root
-
+    return synthetic_workspace(path, block, rec, names=[s.name for s in block.shots], images_dir="/synthetic/images",
+                               align_parameters={"pairing": "synthetic"}, alignment=alignment,
+                               align_timings={"features": 1.5}, align_results={"registered": n})
 
 @pytest.fixture(scope="module")
 def block():

@@ -18,6 +18,7 @@ import pytest
 
 from tests import synthetic as syn
 from tests.conftest import ROOT
+from tests.workspaces import synthetic_workspace
 
 pytestmark = pytest.mark.usefixtures("qgis_app")
 
@@ -87,24 +88,12 @@ def make_workspace(root, blk, photos, georeference_with=None, name="ws"):
     """An aligned workspace from the block's truth (model in an arbitrary frame); georeferenced with the
     GCPSet ``georeference_with`` when given.  Returns the workspace path."""
     from archaeoortho.core import pipeline
-    from archaeoortho.core.align.sfm import camera_rows
-    from archaeoortho.core.io.vector import write_cameras_gpkg
-    from archaeoortho.core.project.workspace import DONE, Workspace
 
-    ws = Workspace.create_or_open(os.path.join(root, name))
-    ws.data["images_dir"] = os.path.dirname(next(iter(photos.values())))
-    ws.data["images"] = [{"name": n, "path": p, "width": blk.camera.width, "height": blk.camera.height,
-                          "gps": None} for n, p in photos.items()]
-    ws.begin_stage("align", {"synthetic": True})
     rec = blk.truth_reconstruction(n_points=800, noise_px=0.3)
-    model = ws.subdir("sfm", "model")
-    rec.write_binary(model)
-    cams = write_cameras_gpkg(ws.root, camera_rows(rec), crs=None)
-    ws.end_stage("align", DONE, outputs={"model": "sfm/model", "cameras": os.path.relpath(cams, ws.root)})
+    ws = synthetic_workspace(os.path.join(root, name), blk, rec, photos=photos, cameras_gpkg=True)
     if georeference_with is not None:
-        pipeline.georeference_workspace(ws.root, gcps=georeference_with)
-    return ws.root
-
+        pipeline.georeference_workspace(ws, gcps=georeference_with)
+    return ws
 
 @pytest.fixture(scope="module")
 def block():

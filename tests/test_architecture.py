@@ -1,0 +1,159 @@
+"""The structure of core/ (docs/architecture.md): one-way imports, short functions, one error base.
+
+Static checks over the source (ast), no imports of the plugin: they fail with the offending module, line or
+cycle named."""
+import ast
+import os
+
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+CORE = os.path.join(ROOT, "core")
+MAX_FUNCTION_LINES = 120
+MAX_CLASS_LINES = 400
+# the rooms in the order data flows; a room may import only rooms before it (and itself)
+LAYERS = [["common"], ["geometry", "project"], ["io"], ["prepare"], ["align"], ["georef"], ["dense"], ["ortho"],
+          ["report"], ["pipeline"]]
+
+
+def _modules():
+    for folder, _, files in os.walk(CORE):
+        for f in sorted(files):
+            if f.endswith(".py"):
+                path = os.path.join(folder, f)
+                rel = os.path.relpath(path, ROOT)[:-3].replace(os.sep, ".")
+                name = rel[: -len(".__init__")] if rel.endswith(".__init__") else rel
+                with open(path, encoding="utf-8") as fh:
+                    yield name, path, ast.parse(fh.read(), path), f == "__init__.py"
+
+
+def _imports(name, tree, is_pkg):
+    """(line, imported core module) for every import in the module, in functions too."""
+    package = name if is_pkg else name.rsplit(".", 1)[0]
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[: len(base) - (node.level - 1)]
+                mod = ".".join(base + ([node.module] if node.module else []))
+            else:
+                mod = node.module or ""
+                if mod.startswith("archaeoortho."):
+                    mod = mod[len("archaeoortho."):]
+            if mod == "core" or mod.startswith("core."):
+                if node.module is None or mod == "core":  # from . import x / from core import x
+                    for a in node.names:
+                        yield node.lineno, f"{mod}.{a.name}"
+                else:
+                    yield node.lineno, mod
+        elif isinstance(node, ast.Import):
+            for a in node.names:
+                if a.name.startswith("core."):
+                    yield node.lineno, a.name
+
+
+def _graph():
+    mods = {name: (path, tree, is_pkg) for name, path, tree, is_pkg in _modules()}
+    graph = {}
+    for name, (path, tree, is_pkg) in mods.items():
+        deps = set()
+        for line, mod in _imports(name, tree, is_pkg):
+            while mod not in mods and "." in mod:  # 'from .x import name' where name is not a module
+                mod = mod.rsplit(".", 1)[0]
+            if mod in mods and mod != name:
+                deps.add((mod, line))
+        graph[name] = deps
+    return mods, graph
+
+
+def _room(module):
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else ""
+
+
+def test_core_imports_no_qgis_or_qt():
+    bad = []
+    for name, path, tree, _ in _modules():
+        for node in ast.walk(tree):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else (
+                [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
+            bad += [f"{path}:{node.lineno} imports {n}" for n in names
+                    if n.split(".")[0] in ("qgis", "PyQt5", "PyQt6", "PySide6", "sip")]
+    assert not bad, "\n".join(bad)
+
+
+def test_no_import_cycle_in_core():
+    _, graph = _graph()
+    colour, stack, cycles = {}, [], []
+
+    def visit(n):
+        colour[n] = 1
+        stack.append(n)
+        for m, _ in sorted(graph[n]):
+            if colour.get(m) == 1:
+                cycles.append(" -> ".join(stack[stack.index(m):] + [m]))
+            elif not colour.get(m):
+                visit(m)
+        stack.pop()
+        colour[n] = 2
+
+    for n in sorted(graph):
+        if not colour.get(n):
+            visit(n)
+    assert not cycles, "import cycles in core/:\n" + "\n".join(cycles)
+
+
+def test_rooms_import_only_upstream():
+    rank = {room: i for i, layer in enumerate(LAYERS) for room in layer}
+    mods, graph = _graph()
+    bad = []
+    for name, deps in graph.items():
+        r = _room(name)
+        if r not in rank:
+            continue
+        for dep, line in deps:
+            d = _room(dep)
+            if d in rank and d != r and rank[d] >= rank[r]:
+                bad.append(f"{mods[name][0]}:{line}: {name} ({r}) imports {dep} ({d})")
+    assert not bad, "imports against the flow:\n" + "\n".join(sorted(bad))
+
+
+def test_no_long_function_or_class_in_core():
+    long = []
+    for _, path, tree, _ in _modules():
+        for node in ast.walk(tree):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                n = node.end_lineno - node.lineno + 1
+                limit = MAX_CLASS_LINES if isinstance(node, ast.ClassDef) else MAX_FUNCTION_LINES
+                if n > limit:
+                    long.append(f"{os.path.relpath(path, ROOT)}:{node.lineno} {node.name}: {n} lines (> {limit})")
+    assert not long, "\n".join(long)
+
+
+def test_every_core_error_derives_from_the_one_base():
+    """Every class named *Error in core/ has ArchaeoOrthoError among its bases (directly or through another
+    core error), so the faces catch one base."""
+    classes = {}
+    for _, path, tree, _ in _modules():
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ClassDef):
+                bases = [b.id if isinstance(b, ast.Name) else b.attr if isinstance(b, ast.Attribute) else ""
+                         for b in node.bases]
+                classes.setdefault(node.name, (path, node.lineno, bases))
+
+    def derives(name, seen=()):
+        if name == "ArchaeoOrthoError":
+            return True
+        if name not in classes or name in seen:
+            return False
+        return any(derives(b, seen + (name,)) for b in classes[name][2])
+
+    bad = [f"{os.path.relpath(p, ROOT)}:{line} {n}({', '.join(b)})" for n, (p, line, b) in classes.items()
+           if n.endswith("Error") and n != "ArchaeoOrthoError" and not derives(n)]
+    assert not bad, "errors outside the ArchaeoOrthoError family:\n" + "\n".join(bad)
+
+
+@pytest.mark.parametrize("room", ["prepare", "align", "georef", "dense", "ortho", "report"])
+def test_each_stage_room_has_options_and_stage(room):
+    for f in ("options.py", "stage.py"):
+        assert os.path.isfile(os.path.join(CORE, room, f)), f"core/{room}/{f} missing"
