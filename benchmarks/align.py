@@ -185,7 +185,7 @@ def main():
             print(f"  whole chain / pycolmap defaults' alignment alone: {c['wall'] / pwall:.2f}")
     if a.skip_colmap:
         return
-    from core.align.sfm import auto_max_features
+    from core.align.features import auto_max_features
     from core.io.images import read_image_info
 
     first = sorted(f for f in os.listdir(a.images) if f.lower().endswith((".jpg", ".jpeg", ".tif", ".tiff")))[0]

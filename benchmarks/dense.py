@@ -32,7 +32,8 @@ DATA = os.path.join(os.path.dirname(ROOT), "shared", "data")
 
 def ensure_georeferenced(images, ws, crs):
     from core import pipeline
-    from core.align import sfm
+    from core.align.options import AlignOptions
+    from core.align.stage import align
     from core.common.progress import PrintProgress
     from core.project.workspace import Workspace
 
@@ -45,7 +46,7 @@ def ensure_georeferenced(images, ws, crs):
         aligned = False
     if not aligned:
         t0 = time.time()
-        r = sfm.align(images, ws, sfm.AlignOptions(), PrintProgress("  align "))
+        r = align(images, ws, AlignOptions(), PrintProgress("  align "))
         print(f"aligned {r.registered}/{r.images_given} in {time.time() - t0:.0f} s")
     r = pipeline.georeference_workspace(ws, use_exif_gps=True, crs=crs, progress=PrintProgress("  georef "))
     print(f"georeferenced with EXIF GPS: camera RMSE {r.figures['CAMERA_RMSE_XYZ']:.2f} m")

@@ -20,7 +20,8 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, ROOT)
 DATA = os.path.join(os.path.dirname(ROOT), "shared", "data")
 
-from core.align import sfm  # noqa: E402
+from core.align.options import AlignOptions  # noqa: E402
+from core.align.stage import align  # noqa: E402
 from core.common.progress import PrintProgress  # noqa: E402
 from core.georef import stage as georef_stage  # noqa: E402
 from core.project.workspace import Workspace  # noqa: E402
@@ -33,7 +34,7 @@ def ensure_aligned(images, ws):
     except Exception:
         pass
     t0 = time.time()
-    r = sfm.align(images, ws, sfm.AlignOptions(), PrintProgress("  align "))
+    r = align(images, ws, AlignOptions(), PrintProgress("  align "))
     print(f"aligned {r.registered}/{r.images_given} in {time.time() - t0:.0f} s, {r.mean_reprojection_error:.3f} px")
 
 
@@ -53,8 +54,8 @@ def copr_second_alignment(ws):
     block were bent by metres, the two blocks would disagree; the targets' misfits would change."""
     done = os.path.exists(os.path.join(ws, "workspace.json")) and Workspace.open(ws).stage_done("align")
     if not done:
-        sfm.align(os.path.join(DATA, "copr", "images"), ws,
-                  sfm.AlignOptions(camera_model="SIMPLE_RADIAL", max_features=2048, refine_principal_point=False))
+        align(os.path.join(DATA, "copr", "images"), ws,
+                  AlignOptions(camera_model="SIMPLE_RADIAL", max_features=2048, refine_principal_point=False))
     print("\nsecond, independent alignment (SIMPLE_RADIAL, 2048 features):")
     consistency(ws)
 

@@ -175,11 +175,11 @@ def sparse_dsm(ws_dir, path, res=0.5):
 
 def build_workspace(ws_dir):
     from core import pipeline
-    from core.align import sfm
+    from core.align.stage import align
     from core.common.progress import PrintProgress
     from core.dense import stage as dense
 
-    sfm.align(os.path.join(TOLEDO, "images"), ws_dir, progress=PrintProgress("align "))
+    align(os.path.join(TOLEDO, "images"), ws_dir, progress=PrintProgress("align "))
     pipeline.georeference_workspace(ws_dir, use_exif_gps=True, crs="EPSG:32617", progress=PrintProgress("georef "))
     dense.build_dsm_workspace(ws_dir, progress=PrintProgress("dsm "))
 

@@ -1,7 +1,7 @@
 """Georeferencing against synthetic ground truth: render -> align (pycolmap) -> georeference.
 
 For each seed, renders the synthetic vertical block of tests/synthetic.py (optionally with an oblique
-orbit), aligns it with core.sfm.align and georeferences it with core.georef: 5 well-spread control
+orbit), aligns it with core.align.stage.align and georeferences it with core.georef: 5 well-spread control
 points (the rest check points), Helmert only, camera positions only (sigma 0.5 m), and the truth-built
 model for comparison.  Prints the GSD, check-point RMSE in metres and in GSD, per-stage seconds.
 
@@ -20,7 +20,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, ROOT)
 
-from core.align import sfm  # noqa: E402
+from core.align.options import AlignOptions  # noqa: E402
+from core.align.stage import align, load_model  # noqa: E402
 from core.georef import adjust as georef  # noqa: E402
 from core.io.gcp import CHECK, CONTROL  # noqa: E402
 from tests import synthetic as syn  # noqa: E402
@@ -44,14 +45,14 @@ def run(seed, args, work):
     block.render(images)
     t_render = time.time() - t0
     t0 = time.time()
-    res = sfm.align(images, ws, sfm.AlignOptions(pairing="exhaustive", num_threads=args.threads,
+    res = align(images, ws, AlignOptions(pairing="exhaustive", num_threads=args.threads,
                                                  max_features=args.features))
     t_align = time.time() - t0
     gsd = block.gsd
     print(f"seed {seed}: {len(block.shots)} images {block.camera.width}x{block.camera.height}, GSD {gsd:.4f} m, "
           f"{len(block.gcps)} GCPs; scene {t_scene:.1f} s, render {t_render:.1f} s, align {t_align:.1f} s "
           f"({res.timings}), registered {res.registered}, reprojection {res.mean_reprojection_error:.3f} px")
-    rec = sfm.load_model(ws)
+    rec = load_model(ws)
     control = block.spread_control(5)
     gcps = block.gcp_set(control, noise_px=args.noise)
     t0 = time.time()

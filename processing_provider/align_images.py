@@ -1,4 +1,4 @@
-"""Align images: thin adapter over core.sfm.align."""
+"""Align images: thin adapter over core.align.stage.align."""
 from qgis.core import QgsProcessingOutputNumber, QgsProcessingOutputVectorLayer
 
 from . import params
@@ -60,14 +60,15 @@ class AlignImagesAlgorithm(AlgorithmBase):
             self.MEAN_REPROJECTION_ERROR, self.tr("Mean reprojection error (px)")))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core.align import sfm
+        from ..core.align.options import AlignOptions
+        from ..core.align.stage import align
         from ..core.io.images import GROUP_AUTO, GROUP_SINGLE
 
         images = self.parameterAsFile(parameters, self.IMAGES, context)
         workspace = self.parameterAsString(parameters, self.WORKSPACE, context)
         focal_mm = self.parameterAsDouble(parameters, self.FOCAL_MM, context)
         sensor_mm = self.parameterAsDouble(parameters, self.SENSOR_WIDTH_MM, context)
-        options = sfm.AlignOptions(
+        options = AlignOptions(
             pairing=params.read_choice(self, parameters, self.PAIRING, context, PAIRINGS),
             camera_model=params.read_choice(self, parameters, self.CAMERA_MODEL, context, CAMERA_MODELS),
             max_image_size=self.parameterAsInt(parameters, self.MAX_IMAGE_SIZE, context),
@@ -78,7 +79,7 @@ class AlignImagesAlgorithm(AlgorithmBase):
             sensor_width_mm=sensor_mm or None,
             mapper=params.read_choice(self, parameters, self.MAPPER, context, MAPPERS),
         )
-        result = self.run_core(sfm.align, images, workspace, options, FeedbackProgress(feedback))
+        result = self.run_core(align, images, workspace, options, FeedbackProgress(feedback))
         feedback.pushInfo(self.tr("Registered {} of {} images, mean reprojection error {:.3f} px, {} points").format(
             result.registered, result.images_given, result.mean_reprojection_error, result.num_points3d))
         if result.unregistered:

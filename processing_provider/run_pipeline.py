@@ -86,7 +86,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
         from ..core import pipeline
-        from ..core.align import sfm
+        from ..core.align.options import AlignOptions
         from ..core.dense import stage as dense
         from ..core.georef.options import GeorefOptions
         from ..core.ortho import options as ortho
@@ -109,7 +109,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
             pipeline.run_pipeline,
             self.parameterAsFile(p, self.IMAGES, context), self.parameterAsString(p, self.WORKSPACE, context),
             options=pipeline.PipelineOptions(
-                align=sfm.AlignOptions(
+                align=AlignOptions(
                     pairing=params.read_choice(self, p, self.PAIRING, context, PAIRINGS),
                     camera_model=params.read_choice(self, p, self.CAMERA_MODEL, context, CAMERA_MODELS),
                     max_image_size=self.parameterAsInt(p, self.MAX_IMAGE_SIZE, context)),

@@ -6,7 +6,10 @@ import shutil
 
 import pytest
 
-from core.align import sfm
+from core.align.features import choose_camera_model, sift_first_octave
+from core.align.options import MAX_LOOP_ANCHORS, SEQUENTIAL_OVERLAP, AlignError, AlignOptions
+from core.align.pairs import select_pairs
+from core.align.stage import align, load_model
 from core.common.progress import Cancelled, NullProgress
 from core.io.images import ImageInfo
 from core.project.workspace import Workspace, WorkspaceError
@@ -44,13 +47,13 @@ def _info(name, gps=None):
 def test_pair_selection_spatial_and_fallback():
     # a 2 x 10 grid of GPS positions ~20 m apart
     imgs = [_info(f"i{r}{c:02d}.jpg", (10 + c * 0.00025, 50 + r * 0.00018, 100)) for r in range(2) for c in range(10)]
-    pairs, used, warnings = sfm.select_pairs(imgs, "auto", spatial_neighbours=4)
+    pairs, used, warnings = select_pairs(imgs, "auto", spatial_neighbours=4)
     assert used == "spatial" and not warnings
     assert ("i000.jpg", "i001.jpg") in pairs
     assert ("i000.jpg", "i009.jpg") not in pairs  # far apart: not paired
     assert len(pairs) < 20 * 19 // 2
     imgs[3].gps = None
-    pairs, used, warnings = sfm.select_pairs(imgs, "spatial", spatial_neighbours=4)
+    pairs, used, warnings = select_pairs(imgs, "spatial", spatial_neighbours=4)
     assert used == "exhaustive" and "falling back to exhaustive" in warnings[0]
     assert len(pairs) == 190
 
@@ -59,7 +62,7 @@ def test_pair_selection_sequential_has_loop_pairs():
     from collections import Counter
 
     imgs = [_info(f"{i:03d}.jpg") for i in range(150)]
-    pairs, used, _ = sfm.select_pairs(imgs, "auto")
+    pairs, used, _ = select_pairs(imgs, "auto")
     assert used == "sequential"
     assert ("000.jpg", "001.jpg") in pairs and ("000.jpg", "012.jpg") in pairs
     assert ("005.jpg", "140.jpg") in pairs  # loop pair to every 10th image
@@ -67,24 +70,24 @@ def test_pair_selection_sequential_has_loop_pairs():
     # a large set: the loop anchors are bounded, so the pairs grow linearly with the images
     counts = {}
     for n in (1000, 2000):
-        pairs, used, _ = sfm.select_pairs([_info(f"{i:04d}.jpg") for i in range(n)], "sequential")
+        pairs, used, _ = select_pairs([_info(f"{i:04d}.jpg") for i in range(n)], "sequential")
         counts[n] = len(pairs)
         far = Counter()
         for a, b in pairs:
-            if int(b[:4]) - int(a[:4]) > sfm.SEQUENTIAL_OVERLAP:
+            if int(b[:4]) - int(a[:4]) > SEQUENTIAL_OVERLAP:
                 far[a] += 1
                 far[b] += 1
         anchors = [k for k, v in far.items() if v > n // 4]  # paired with a large share of the set
-        assert 0 < len(anchors) <= sfm.MAX_LOOP_ANCHORS
+        assert 0 < len(anchors) <= MAX_LOOP_ANCHORS
     assert counts[2000] < 2.1 * counts[1000]
 
 
 def test_camera_model_choice():
-    assert sfm.choose_camera_model("AUTO", 20) == "OPENCV"
-    assert sfm.choose_camera_model("AUTO", 5) == "RADIAL"
-    assert sfm.choose_camera_model("full_opencv", 2) == "FULL_OPENCV"
-    with pytest.raises(sfm.AlignError, match="unknown camera model"):
-        sfm.choose_camera_model("FISHEYE9", 5)
+    assert choose_camera_model("AUTO", 20) == "OPENCV"
+    assert choose_camera_model("AUTO", 5) == "RADIAL"
+    assert choose_camera_model("full_opencv", 2) == "FULL_OPENCV"
+    with pytest.raises(AlignError, match="unknown camera model"):
+        choose_camera_model("FISHEYE9", 5)
 
 
 @pytest.mark.slow
@@ -98,7 +101,7 @@ def test_align_skips_bad_files_in_unicode_path(tmp_path):
         f.write("flight notes")
     rec = Recorder()
     ws_dir = str(tmp_path / "work space ø")
-    result = sfm.align(images, ws_dir, sfm.AlignOptions(**FAST), rec)
+    result = align(images, ws_dir, AlignOptions(**FAST), rec)
     assert result.registered == len(TOLEDO_STRIP)
     assert result.mean_reprojection_error < 1.0
     warned = "\n".join(rec.warnings)
@@ -110,7 +113,7 @@ def test_align_skips_bad_files_in_unicode_path(tmp_path):
     assert set(ws.stage("align")["timings"]) >= {"features", "matching", "mapping", "total"}
     figures = json.load(open(os.path.join(ws_dir, "sfm", "alignment.json")))
     assert figures["registered"] == len(TOLEDO_STRIP)
-    model = sfm.load_model(ws_dir)
+    model = load_model(ws_dir)
     assert model.num_reg_images() == len(TOLEDO_STRIP)
     from osgeo import ogr
 
@@ -129,13 +132,13 @@ def test_cancel_leaves_no_model_and_rerun_resumes(tmp_path):
     ws_dir = str(tmp_path / "ws")
     rec = Recorder(cancel_on="mapping")
     with pytest.raises(Cancelled):
-        sfm.align(images, ws_dir, sfm.AlignOptions(**FAST), rec)
+        align(images, ws_dir, AlignOptions(**FAST), rec)
     ws = Workspace.open(ws_dir)
     assert ws.stage("align")["status"] == "cancelled"
     assert not os.path.exists(os.path.join(ws_dir, "sfm", "model"))
     assert os.path.exists(os.path.join(ws_dir, "sfm", "database.db"))
     rec2 = Recorder()
-    result = sfm.align(images, ws_dir, sfm.AlignOptions(**FAST), rec2)
+    result = align(images, ws_dir, AlignOptions(**FAST), rec2)
     assert result.registered == 5
     assert any("already extracted, reused" in m for m in rec2.messages)
     assert any("already matched, reused" in m for m in rec2.messages)
@@ -145,11 +148,11 @@ def test_cancel_leaves_no_model_and_rerun_resumes(tmp_path):
 def test_one_image_or_empty_folder_is_a_clear_error(tmp_path):
     empty = tmp_path / "empty"
     empty.mkdir()
-    with pytest.raises(sfm.AlignError, match="no readable images"):
-        sfm.align(str(empty), str(tmp_path / "ws1"))
+    with pytest.raises(AlignError, match="no readable images"):
+        align(str(empty), str(tmp_path / "ws1"))
     one = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:1], str(tmp_path / "one"))
-    with pytest.raises(sfm.AlignError, match="only one readable image.*1JI_0064.JPG"):
-        sfm.align(one, str(tmp_path / "ws2"))
+    with pytest.raises(AlignError, match="only one readable image.*1JI_0064.JPG"):
+        align(one, str(tmp_path / "ws2"))
 
 
 def test_unwritable_workspace_fails_before_work(tmp_path):
@@ -157,9 +160,9 @@ def test_unwritable_workspace_fails_before_work(tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("x")
     with pytest.raises(WorkspaceError, match="not a folder"):
-        sfm.align(images, str(blocker))
+        align(images, str(blocker))
     with pytest.raises(WorkspaceError, match="cannot create workspace folder"):
-        sfm.align(images, "/proc/archaeoortho-workspace")
+        align(images, "/proc/archaeoortho-workspace")
 
 
 @pytest.mark.slow
@@ -172,8 +175,8 @@ def test_images_without_overlap_are_named(tmp_path):
     images.mkdir()
     for k in range(3):
         cv2.imwrite(str(images / f"crop{k}.jpg"), photo[:, k * 400:(k + 1) * 400])
-    with pytest.raises(sfm.AlignError, match="do not overlap") as err:
-        sfm.align(str(images), str(tmp_path / "ws"), sfm.AlignOptions(**FAST))
+    with pytest.raises(AlignError, match="do not overlap") as err:
+        align(str(images), str(tmp_path / "ws"), AlignOptions(**FAST))
     assert "crop0.jpg" in str(err.value) and "crop2.jpg" in str(err.value)
 
 
@@ -183,7 +186,7 @@ def test_foreign_images_are_reported_not_registered(tmp_path):
     images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:5], str(tmp_path / "img"))
     shutil.copyfile(os.path.join(copr, "IMG_0037.jpg"), os.path.join(images, "IMG_0037.jpg"))
     rec = Recorder()
-    result = sfm.align(images, str(tmp_path / "ws"), sfm.AlignOptions(**FAST), rec)
+    result = align(images, str(tmp_path / "ws"), AlignOptions(**FAST), rec)
     assert result.registered == 5
     assert "IMG_0037.jpg" in result.unregistered
     assert any("IMG_0037.jpg" in w for w in rec.warnings)
@@ -192,22 +195,22 @@ def test_foreign_images_are_reported_not_registered(tmp_path):
 @pytest.mark.slow
 def test_global_mapper_aligns_the_strip(toledo_strip, tmp_path):
     """MAPPER=global (GLOMAP through pycolmap) on the sample strip: every image registered, sub-pixel."""
-    r = sfm.align(toledo_strip, str(tmp_path / "ws"),
-                  sfm.AlignOptions(mapper="global", max_image_size=800, max_features=2048))
+    r = align(toledo_strip, str(tmp_path / "ws"),
+                  AlignOptions(mapper="global", max_image_size=800, max_features=2048))
     assert r.registered == len(TOLEDO_STRIP)
     assert r.mean_reprojection_error < 1.0
     assert json.load(open(tmp_path / "ws" / "workspace.json"))["stages"]["align"]["parameters"]["mapper"] == "global"
 
 
 def test_unknown_mapper_is_a_clear_error(toledo_strip, tmp_path):
-    with pytest.raises(sfm.AlignError, match="unknown mapper 'magic'"):
-        sfm.align(toledo_strip, str(tmp_path / "ws"), sfm.AlignOptions(mapper="magic"))
+    with pytest.raises(AlignError, match="unknown mapper 'magic'"):
+        align(toledo_strip, str(tmp_path / "ws"), AlignOptions(mapper="magic"))
     assert not (tmp_path / "ws").exists()
 
 
 def test_sift_first_octave_upsamples_only_small_images():
-    o = sfm.AlignOptions()
-    assert sfm.sift_first_octave(o, 800, 600) == -1  # small: upsampled for enough small-scale features
-    assert sfm.sift_first_octave(o, 1200, 900) == 0  # the image itself has features enough
-    assert sfm.sift_first_octave(sfm.AlignOptions(max_image_size=800), 4000, 3000) == -1  # matched at 800 px
-    assert sfm.sift_first_octave(sfm.AlignOptions(first_octave=-1), 4000, 3000) == -1  # the user's choice
+    o = AlignOptions()
+    assert sift_first_octave(o, 800, 600) == -1  # small: upsampled for enough small-scale features
+    assert sift_first_octave(o, 1200, 900) == 0  # the image itself has features enough
+    assert sift_first_octave(AlignOptions(max_image_size=800), 4000, 3000) == -1  # matched at 800 px
+    assert sift_first_octave(AlignOptions(first_octave=-1), 4000, 3000) == -1  # the user's choice

@@ -4,7 +4,8 @@ import os
 import numpy as np
 import pytest
 
-from core.align import sfm
+from core.align.options import AlignOptions
+from core.align.stage import align
 from core.georef import stage as georef_stage
 from core.io.gcp import GCPSet, GroundPoint, Observation
 from core.project.workspace import Workspace
@@ -18,7 +19,7 @@ def aligned(tmp_path_factory):
     d = tmp_path_factory.mktemp("georef")
     images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP, str(d / "img"))
     ws = str(d / "ws")
-    sfm.align(images, ws, sfm.AlignOptions(max_image_size=800, max_features=2048))
+    align(images, ws, AlignOptions(max_image_size=800, max_features=2048))
     return ws
 
 

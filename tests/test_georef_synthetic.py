@@ -4,7 +4,7 @@ Two kinds of model:
 - a sparse model built directly from the truth (exact poses, projected tie points with pixel noise, an
   arbitrary model frame, optionally a controlled deformation or a wrong camera): fast, isolates
   core.georef;
-- the rendered vertical block aligned by core.sfm.align (real pycolmap): end to end, rendered and aligned
+- the rendered vertical block aligned by core.align.stage.align (real pycolmap): end to end, rendered and aligned
   once per session.
 
 Figures are printed (pytest -s) so that runs can be compared.
@@ -16,7 +16,8 @@ import time
 import numpy as np
 import pytest
 
-from core.align import sfm
+from core.align.options import AlignOptions
+from core.align.stage import align, load_model
 from core.georef import adjust as georef
 from core.io.gcp import CHECK, CONTROL, read_gcps, write_odm_gcp_list
 from tests import synthetic as syn
@@ -360,7 +361,7 @@ def test_observation_outside_the_image_given_directly_is_named_and_ignored(block
 
 
 # ----------------------------------------------------------------------------------------------
-# end to end: rendered images -> core.sfm.align (pycolmap) -> core.georef
+# end to end: rendered images -> core.align.stage.align (pycolmap) -> core.georef
 # ----------------------------------------------------------------------------------------------
 
 
@@ -372,8 +373,8 @@ def aligned_block(tmp_path_factory, block):
     blk.render(str(root / "images"))
     t_render = time.time() - t0
     t0 = time.time()
-    res = sfm.align(str(root / "images"), str(root / "ws"),
-                    sfm.AlignOptions(pairing="exhaustive", num_threads=2, max_features=2000))
+    res = align(str(root / "images"), str(root / "ws"),
+                    AlignOptions(pairing="exhaustive", num_threads=2, max_features=2000))
     t_align = time.time() - t0
     print(f"\n[synthetic block] {len(blk.shots)} images {blk.camera.width}x{blk.camera.height}, GSD "
           f"{blk.gsd:.4f} m: render {t_render:.1f} s, align {t_align:.1f} s, registered {res.registered}, "
@@ -385,7 +386,7 @@ def aligned_block(tmp_path_factory, block):
 def test_end_to_end_five_control_points_reach_one_gsd(aligned_block):
     blk, ws, res = aligned_block
     assert res.registered == len(blk.shots)
-    rec = sfm.load_model(ws)
+    rec = load_model(ws)
     control = blk.spread_control(5)
     gcps = blk.gcp_set(control, noise_px=GCP_NOISE_PX)
     result = georef.georeference(rec, gcps)
@@ -403,7 +404,7 @@ def test_end_to_end_five_control_points_reach_one_gsd(aligned_block):
 @pytest.mark.slow
 def test_end_to_end_camera_positions_only(aligned_block):
     blk, ws, res = aligned_block
-    rec = sfm.load_model(ws)
+    rec = load_model(ws)
     result, d, predicted, n = _positions_only(blk, rec, "end to end, positions only")
     (cam,) = rec.cameras.values()
     _assert_within_position_noise(blk, result, d, predicted, n, focal=float(np.sqrt(cam.params[0] * cam.params[1])))

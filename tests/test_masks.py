@@ -249,7 +249,8 @@ def _keypoints(db_path):
 
 def test_align_extracts_no_keypoints_under_the_masks(tmp_path):
     pytest.importorskip("pycolmap")
-    from core.align import sfm
+    from core.align.options import AlignOptions
+    from core.align.stage import align
     from core.prepare.masks import image_sizes, write_user_masks
     from tests.test_align import FAST, Recorder
 
@@ -261,7 +262,7 @@ def test_align_extracts_no_keypoints_under_the_masks(tmp_path):
     write_user_masks([(n, [LEFT_HALF]) for n in names[:2]], sizes, masks)
 
     rec = Recorder()
-    r = sfm.align(images, str(ws), sfm.AlignOptions(**FAST), rec)
+    r = align(images, str(ws), AlignOptions(**FAST), rec)
     assert r.masked_images == 2
     assert any(m.startswith("masks: 2 of 3 images have a mask") for m in rec.messages)
     kp = _keypoints(str(ws / "sfm" / "database.db"))
@@ -279,7 +280,7 @@ def test_align_extracts_no_keypoints_under_the_masks(tmp_path):
     stem = os.path.splitext(names[1])[0] + ".png"
     os.replace(os.path.join(masks, names[1] + ".png"), os.path.join(masks, stem))
     rec2 = Recorder()
-    r2 = sfm.align(images, str(ws), sfm.AlignOptions(**FAST), rec2)
+    r2 = align(images, str(ws), AlignOptions(**FAST), rec2)
     assert r2.masked_images == 2
     assert not any("already extracted" in m for m in rec2.messages)
     assert json.load(open(ws / "workspace.json"))["stages"]["align"]["database_key"] != key1

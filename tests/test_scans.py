@@ -309,11 +309,12 @@ def test_colmap_honours_the_masks(prepared, tmp_path):
 
 @pytest.mark.slow
 def test_prepared_scans_align(prepared, tmp_path):
-    """The prepared set aligns: core.sfm.align registers all five scans in one block."""
-    from core.align import sfm
+    """The prepared set aligns: core.align.stage.align registers all five scans in one block."""
+    from core.align.options import AlignOptions
+    from core.align.stage import align
 
     result, _ = prepared
-    r = sfm.align(result.prepared_dir, str(tmp_path / "ws"), sfm.AlignOptions(max_features=2048))
+    r = align(result.prepared_dir, str(tmp_path / "ws"), AlignOptions(max_features=2048))
     print(f"\naligned {r.registered}/{r.images_given}, {r.mean_reprojection_error:.3f} px, {r.timings}")
     assert r.registered == 5 and not r.unregistered
     assert r.mean_reprojection_error < 1.0

@@ -48,7 +48,7 @@ def synthetic_workspace(root, block, rec, *, names=None, images_dir=None, photos
         for step, seconds in (align_timings or {}).items():
             ws.record_timing(ALIGN, step, seconds)
         if cameras_gpkg:
-            from core.align.sfm import camera_rows
+            from core.align.mapping import camera_rows
 
             outputs["cameras"] = lay.rel(write_cameras_gpkg(ws.root, camera_rows(rec), crs=None))
         run.finish(outputs=outputs, results=align_results)

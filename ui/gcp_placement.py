@@ -29,7 +29,7 @@ class GcpPlacement:
         if self.store.workspace is None or not self.store.stage_done(ALIGN):
             return
         try:
-            from ..core.align import sfm
+            from ..core.align import stage as sfm
             from ..core.georef import guided
             from ..core.pipeline import load_georef_model
         except ImportError as e:

@@ -29,7 +29,7 @@ class GcpTasks:
             self.start_alignment(images, ws)
 
     def start_alignment(self, images_dir, workspace_dir, options=None):
-        from ..core.align import sfm
+        from ..core.align import stage as sfm
 
         if self._busy():
             return None
