@@ -157,8 +157,8 @@ def sparse_dsm(ws_dir, path, res=0.5):
     """A DSM from the sparse points (linear interpolation), for a workspace without a dense DSM."""
     from scipy.interpolate import griddata
 
+    from core.georef.stage import load_georef_model
     from core.io import raster as dsmmod
-    from core.pipeline import load_georef_model
 
     rec, transform = load_georef_model(ws_dir)
     off = np.asarray(transform["offset"], dtype=float)
@@ -174,13 +174,13 @@ def sparse_dsm(ws_dir, path, res=0.5):
 
 
 def build_workspace(ws_dir):
-    from core import pipeline
     from core.align.stage import align
     from core.common.progress import PrintProgress
     from core.dense import stage as dense
+    from core.georef.stage import georeference_workspace
 
     align(os.path.join(TOLEDO, "images"), ws_dir, progress=PrintProgress("align "))
-    pipeline.georeference_workspace(ws_dir, use_exif_gps=True, crs="EPSG:32617", progress=PrintProgress("georef "))
+    georeference_workspace(ws_dir, use_exif_gps=True, crs="EPSG:32617", progress=PrintProgress("georef "))
     dense.build_dsm_workspace(ws_dir, progress=PrintProgress("dsm "))
 
 
@@ -212,8 +212,8 @@ def _run_child(args, resolution, output, extra=()):
 
 def transferred_gcps(ws_dir, name, n=10):
     """GCPs for one image from the block: well-spread sparse points (track >= 4) seen in it (world coords)."""
+    from core.georef.stage import load_georef_model
     from core.io import gcp as gcpmod
-    from core.pipeline import load_georef_model
 
     rec, transform = load_georef_model(ws_dir)
     off = np.asarray(transform["offset"], dtype=float)

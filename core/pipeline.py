@@ -5,9 +5,6 @@
 ``core.ortho.stage.build_orthophoto_workspace``, ``core.report.stage.build_report``).  Its options are a
 :class:`PipelineOptions` (each stage's option object and the few chain settings) and a :class:`Control`
 (the ground control and camera positions).
-
-The georeference stage itself lives in ``core.georef.stage``; its names are re-exported here for the callers
-that import them from ``core.pipeline``.
 """
 from __future__ import annotations
 
@@ -22,12 +19,11 @@ from .common.progress import NullProgress, Progress, SubProgress
 from .dense.options import DenseOptions
 from .dense.stage import build_dsm_workspace
 from .georef.options import GeorefOptions
-from .georef.stage import GeorefStageResult, StageError, georeference_workspace, load_georef_model, model_path
+from .georef.stage import GeorefStageResult, georeference_workspace
 from .io.gcp import GCPSet
 from .ortho.options import OrthoOptions
 from .ortho.stage import build_orthophoto_workspace
-from .project.stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, REPORT
-from .project.workspace import WorkspaceError
+from .project.stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, REPORT, StageError
 from .report.options import ReportOptions
 from .report.stage import build_report
 
@@ -131,5 +127,4 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
     return res
 
 
-__all__ = ["Control", "GeorefStageResult", "PipelineOptions", "PipelineResult", "StageError", "WorkspaceError",
-           "georeference_workspace", "load_georef_model", "model_path", "run_pipeline"]
+__all__ = ["Control", "PipelineOptions", "PipelineResult", "run_pipeline"]

@@ -8,6 +8,7 @@ from core.align.options import AlignOptions
 from core.align.stage import align
 from core.georef import stage as georef_stage
 from core.io.gcp import GCPSet, GroundPoint, Observation
+from core.project.stages import StageError
 from core.project.workspace import Workspace
 from tests.conftest import SAMPLE, TOLEDO_STRIP, copy_images
 
@@ -119,11 +120,11 @@ def test_too_few_control_points_is_a_clear_error(aligned):
         GroundPoint("B", 274905.0, 4603290.0, 180.0, observations=[Observation("1JI_0066.JPG", 600, 400),
                                                                   Observation("1JI_0067.JPG", 600, 300)]),
     ])
-    with pytest.raises(georef_stage.StageError, match="at least 3 control points.*found 2"):
+    with pytest.raises(StageError, match="at least 3 control points.*found 2"):
         georef_stage.georeference_workspace(aligned, gcps=gcps)
 
 
 def test_unaligned_workspace_is_refused(tmp_path):
     Workspace.create_or_open(str(tmp_path / "ws"))
-    with pytest.raises(georef_stage.StageError, match="run 'Align images' first"):
+    with pytest.raises(StageError, match="run 'Align images' first"):
         georef_stage.georeference_workspace(str(tmp_path / "ws"), use_exif_gps=True)

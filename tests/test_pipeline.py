@@ -105,7 +105,8 @@ def test_runpipeline_without_control_refuses_before_any_work(strip, tmp_path):
 
 
 def test_core_run_pipeline_refuses_without_control(tmp_path):
-    from core.pipeline import StageError, run_pipeline
+    from core.pipeline import run_pipeline
+    from core.project.stages import StageError
 
     with pytest.raises(StageError, match="ground control"):
         run_pipeline(str(tmp_path / "photos"), str(tmp_path / "ws"))

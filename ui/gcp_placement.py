@@ -31,7 +31,7 @@ class GcpPlacement:
         try:
             from ..core.align import stage as sfm
             from ..core.georef import guided
-            from ..core.pipeline import load_georef_model
+            from ..core.georef.stage import load_georef_model
         except ImportError as e:
             self.predictor_note = translate("GcpDock", "no predicted positions: {}").format(e)
             return

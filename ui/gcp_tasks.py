@@ -82,7 +82,7 @@ class GcpTasks:
 
     def run_georeference(self):
         """Adjust the block with the current points in a background task; residuals update when it ends."""
-        from ..core import pipeline
+        from ..core.georef import stage as pipeline
 
         if self.store.workspace is None or self._busy():
             return None

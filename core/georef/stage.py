@@ -18,13 +18,12 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..align.mapping import camera_rows
-from ..common.errors import ArchaeoOrthoError
 from ..common.files import atomic_output, atomic_write_text, file_fingerprint
 from ..common.progress import NullProgress, Progress, SubProgress
 from ..io import gcp as gcpmod
 from ..io.vector import write_cameras_gpkg, write_points_gpkg
 from ..project.layout import Layout, write_json
-from ..project.stages import GEOREFERENCE, run_stage
+from ..project.stages import GEOREFERENCE, StageError, run_stage
 from ..project.workspace import Workspace
 from . import accuracy
 from .adjust import georeference
@@ -33,10 +32,6 @@ from .results import GeorefResult
 
 GEOREF = GEOREFERENCE
 ADJUSTMENT_INPUTS_FORMAT = "archaeoortho-adjustment-inputs"
-
-
-class StageError(ArchaeoOrthoError, RuntimeError):
-    """A stage cannot run with these inputs; the message says why."""
 
 
 @dataclass
@@ -265,5 +260,5 @@ def _write_residual_layer(lay: Layout, result: GeorefResult, crs: str) -> str:
     return write_points_gpkg(lay.residuals_gpkg, "residuals", rows, fields, crs)
 
 
-__all__ = ["GeorefStageResult", "StageError", "adjustment_inputs", "georeference_workspace", "load_georef_model",
+__all__ = ["GeorefStageResult", "adjustment_inputs", "georeference_workspace", "load_georef_model",
            "model_path"]

@@ -18,6 +18,7 @@ import contextlib
 import time
 from typing import Any, Dict, Iterator, List, Optional
 
+from ..common.errors import ArchaeoOrthoError
 from ..common.progress import Cancelled
 
 # stage status values (the manifest's "status" of a stage)
@@ -37,6 +38,11 @@ REPORT = "report"
 
 # the order data flows in; a stage that finishes marks the done stages after it stale
 STAGE_ORDER: List[str] = [PREPARE, ALIGN, GEOREFERENCE, DSM, ORTHOPHOTO, REPORT]
+
+
+class StageError(ArchaeoOrthoError, RuntimeError):
+    """A stage cannot run yet with these inputs (a product of an earlier stage missing, no ground control
+    given, ...); the message says why and what to run or give."""
 
 
 def later_stages(name: str) -> List[str]:
