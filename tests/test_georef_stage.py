@@ -67,7 +67,7 @@ def test_camera_positions_file_gives_the_crs(aligned, tmp_path):
     here Web Mercator so that it differs from the UTM zone the photos' GPS would suggest."""
     import shutil
 
-    from core.io import gcp as gcpmod
+    from core.geometry.crs import transform_points
 
     ws_dir = str(tmp_path / "ws")
     shutil.copytree(aligned, ws_dir)
@@ -77,7 +77,7 @@ def test_camera_positions_file_gives_the_crs(aligned, tmp_path):
     ref = _reference_positions()
     names = sorted(set(ref) & set(TOLEDO_STRIP))
     utm = np.array([[ref[n][0], ref[n][1], 0.0] for n in names])
-    merc = gcpmod.transform_points(utm, "EPSG:32617", "EPSG:3857")
+    merc = transform_points(utm, "EPSG:32617", "EPSG:3857")
     csv = tmp_path / "positions.csv"
     csv.write_text("EPSG:3857\n" + "".join(f"{n},{x:.3f},{y:.3f},{z}\n" for n, (x, y, _), z in
                                             zip(names, merc, [250.0] * len(names))))

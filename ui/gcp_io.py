@@ -16,6 +16,7 @@ from qgis.core import (
 from qgis.PyQt.QtCore import QCoreApplication, QVariant
 from qgis.PyQt.QtWidgets import QFileDialog, QInputDialog, QMessageBox
 
+from ..core.geometry.crs import transform_points
 from ..core.io import gcp as gcpmod
 from . import layers
 
@@ -57,7 +58,7 @@ class GcpImportExport:
         if self.store.crs and gs.crs and layers.qgs_crs(gs.crs) != layers.qgs_crs(self.store.crs) \
                 and self.store.gcps.points:
             xyz = [(p.x, p.y, p.z) for p in gs.points]
-            out = gcpmod.transform_points(xyz, gs.crs, self.store.crs) if xyz else []
+            out = transform_points(xyz, gs.crs, self.store.crs) if xyz else []
             for p, q in zip(gs.points, out):
                 p.x, p.y = float(q[0]), float(q[1])
             gs.crs = self.store.crs

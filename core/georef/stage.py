@@ -20,6 +20,7 @@ import numpy as np
 from ..align.mapping import camera_rows
 from ..common.files import atomic_output, atomic_write_text, file_fingerprint
 from ..common.progress import NullProgress, Progress, SubProgress
+from ..geometry.crs import transform_points, utm_epsg_for_lonlat
 from ..io import gcp as gcpmod
 from ..io.vector import write_cameras_gpkg, write_points_gpkg
 from ..project.layout import Layout, write_json
@@ -65,7 +66,7 @@ def _exif_positions(ws: Workspace, crs: str) -> List[gcpmod.CameraPosition]:
     if not rows:
         return []
     lonlat = np.array([[g[0], g[1], 0.0] for _, g in rows], dtype=float)
-    xy = gcpmod.transform_points(lonlat, "EPSG:4326", crs)
+    xy = transform_points(lonlat, "EPSG:4326", crs)
     # EXIF altitude is kept as it is (normally above mean sea level): only X and Y are transformed
     return [gcpmod.CameraPosition(image=n, x=float(p[0]), y=float(p[1]), z=float(g[2]),
                                   sigma_xy=EXIF_SIGMA_XY, sigma_z=EXIF_SIGMA_Z)
@@ -76,7 +77,7 @@ def _file_positions(path: str, crs: str) -> List[gcpmod.CameraPosition]:
     src_crs, cams = gcpmod.read_camera_positions(path)
     if src_crs and crs and src_crs != crs:
         xyz = np.array([[c.x, c.y, 0.0] for c in cams], dtype=float)
-        out = gcpmod.transform_points(xyz, src_crs, crs)
+        out = transform_points(xyz, src_crs, crs)
         for c, p in zip(cams, out):
             c.x, c.y = float(p[0]), float(p[1])
     return cams
@@ -88,7 +89,7 @@ def _default_crs(ws: Workspace) -> Optional[str]:
         return None
     lon = float(np.mean([g[0] for g in gps]))
     lat = float(np.mean([g[1] for g in gps]))
-    return f"EPSG:{gcpmod.utm_epsg_for_lonlat(lon, lat)}"
+    return f"EPSG:{utm_epsg_for_lonlat(lon, lat)}"
 
 
 def _read_control(ws: Workspace, gcp_path: Optional[str], gcps: Optional[gcpmod.GCPSet], check_points: Sequence[str],
@@ -110,7 +111,7 @@ def _read_control(ws: Workspace, gcp_path: Optional[str], gcps: Optional[gcpmod.
         gcpmod.check_units(gcps, target)
         if gcps.crs and crs and gcps.crs != crs:
             xyz = np.array([[p.x, p.y, p.z] for p in gcps.points], dtype=float)
-            out = gcpmod.transform_points(xyz, gcps.crs, crs)
+            out = transform_points(xyz, gcps.crs, crs)
             for p, q in zip(gcps.points, out):
                 p.x, p.y = float(q[0]), float(q[1])
             gcps.crs = crs

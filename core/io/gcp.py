@@ -52,18 +52,7 @@ import warnings as _warnings
 from dataclasses import dataclass, field
 from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
 
-from ..geometry.crs import (
-    WKT_START,
-    CRSError,
-    check_coordinates_match_crs,
-    crs_is_geographic,
-    crs_status,
-    looks_like_crs,
-    normalize_crs,
-    transform_points,
-    utm_epsg_for_lonlat,
-    validate_crs,
-)
+from ..geometry.crs import WKT_START, CRSError, check_coordinates_match_crs, crs_status, looks_like_crs, normalize_crs
 
 CONTROL = "control"
 CHECK = "check"
@@ -924,12 +913,8 @@ def read_camera_positions(path: PathLike, default_sigma_xy: float = 5.0, default
     return use_crs, out
 
 
-# the CRS helpers live in core.geometry.crs; they are re-exported here for the callers that use gcp.*
 __all__ = [
-    "CHECK", "CONTROL", "CRSError", "CameraPosition", "GCPError", "GCPSet", "GroundPoint", "Observation",
-    "apply_check_points", "check_coordinates_match_crs", "check_units", "crs_is_geographic",
-    "default_observations_path", "gcps_from_rows",
-    "detect_gcp_format", "looks_like_crs", "normalize_crs", "read_camera_positions", "read_csv_gcps",
-    "read_gcps", "read_odm_gcp_list", "transform_points", "utm_epsg_for_lonlat", "validate_crs",
-    "write_csv_gcps", "write_gcps", "write_odm_gcp_list",
+    "CHECK", "CONTROL", "CameraPosition", "GCPError", "GCPSet", "GroundPoint", "Observation", "apply_check_points",
+    "check_units", "default_observations_path", "detect_gcp_format", "gcps_from_rows", "read_camera_positions",
+    "read_csv_gcps", "read_gcps", "read_odm_gcp_list", "write_csv_gcps", "write_gcps", "write_odm_gcp_list",
 ]

@@ -13,6 +13,7 @@ import numpy as np
 from ..common.progress import NullProgress, Progress, SubProgress
 from ..geometry import resection as rs
 from ..geometry.camera import Intrinsics, Pose, opk_from_rotation, project_points, rotation_from_opk
+from ..geometry.crs import transform_points
 from ..io import gcp as gcpmod
 from ..io import raster as dsmmod
 from ..io.images import ImageError, read_image_info
@@ -228,7 +229,7 @@ def _ground_control(gcps, orient: Optional[dict], work_crs: Optional[str], run: 
     pairs = _image_observations(gcps, name)
     xyz = np.array([[p.x, p.y, p.z] for p, _ in pairs], dtype=float).reshape(-1, 3)
     if gcps.crs and work_crs and not _crs_equal(gcps.crs, work_crs):
-        xyz = gcpmod.transform_points(xyz, gcps.crs, work_crs)
+        xyz = transform_points(xyz, gcps.crs, work_crs)
     control = [i for i, (p, _) in enumerate(pairs) if p.role == gcpmod.CONTROL]
     checks = [i for i, (p, _) in enumerate(pairs) if p.role != gcpmod.CONTROL]
     need = rs.MIN_RESECTION_POINTS if orient is None else 0
@@ -256,7 +257,7 @@ def _local_frame(orient: Optional[dict], ctl: _Control, work_crs: Optional[str]
     c_world = np.array([orient["x"], orient["y"], orient["z"]], dtype=float)
     ocrs = orient.get("crs")
     if ocrs and work_crs and not _crs_equal(ocrs, work_crs):
-        c_world = gcpmod.transform_points(c_world[None], ocrs, work_crs)[0]
+        c_world = transform_points(c_world[None], ocrs, work_crs)[0]
     return np.array([round(c_world[0]), round(c_world[1]), 0.0]), c_world
 
 
