@@ -439,6 +439,36 @@ def test_dsm_gaps_inside_the_data_are_filled_for_the_orthophoto(scene, tmp_path)
     assert n == int(hole.sum()) and path != holed
 
 
+def test_gap_fill_writes_nothing_into_the_current_directory(tmp_path, monkeypatch):
+    """GDAL FillNodata's work rasters stay in memory: run from a read-only current directory (root ignores the
+    mode, so it must also stay empty) and from one that no longer exists (where any relative write fails, even
+    for root), the gaps are filled all the same."""
+    h = w = 200
+    yy, xx = np.mgrid[0:h, 0:w]
+    z = (10.0 + 0.01 * xx + 0.02 * yy).astype(np.float32)
+    hole = (yy - 100) ** 2 + (xx - 100) ** 2 < 20 ** 2
+    z[hole] = np.nan
+    gt = (500000.0, 0.5, 0.0, 4000000.0, 0.0, -0.5)
+    holed = dsmmod.write_cog(str(tmp_path / "holed.tif"), z, gt, syn.CRS)
+    truth = (10.0 + 0.01 * xx + 0.02 * yy)[hole]
+    readonly = tmp_path / "readonly"
+    readonly.mkdir()
+    readonly.chmod(0o555)
+    monkeypatch.chdir(readonly)
+    path, n = fill_dsm_gaps(holed, str(tmp_path / "filled.tif"), 25.0)
+    assert n == int(hole.sum()) and path == str(tmp_path / "filled.tif")
+    assert os.listdir(readonly) == []
+    filled, _, _ = dsmmod.read_dsm(path)
+    assert np.abs(filled[hole] - truth).max() < 0.5  # a plane: inverse-distance heights stay near it
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    path, n = fill_dsm_gaps(holed, str(tmp_path / "filled2.tif"), 25.0)
+    assert n == int(hole.sum())
+    readonly.chmod(0o755)
+
+
 def test_workspace_without_georeference_or_dsm_is_refused(scene, tmp_path):
     block = scene[0]
     ws = make_workspace(str(tmp_path / "ws"), block, scene[2], names=["S2_01.jpg", "S2_02.jpg"])

@@ -140,7 +140,10 @@ def fill_dsm_gaps(dsm_path: str, out_path: str, max_distance: float) -> Tuple[st
     mb = mem.GetRasterBand(1)
     mb.SetNoDataValue(fill_value)
     mb.WriteArray(np.where(valid, z, fill_value).astype(np.float32))
-    gdal.FillNodata(mb, None, maxSearchDist=float(max_cells), smoothingIterations=0)
+    # the work rasters (distance, value, mask) in memory too: with the default GTiff driver GDAL writes
+    # _<pid>_1fill_*_work.tif files into the current directory while it runs
+    gdal.FillNodata(mb, None, maxSearchDist=float(max_cells), smoothingIterations=0,
+                    options=["TEMP_FILE_DRIVER=MEM"])
     out = mb.ReadAsArray()
     take = gaps & (out != fill_value)
     result = np.where(valid, z, np.nan).astype(np.float32)
