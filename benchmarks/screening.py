@@ -71,7 +71,8 @@ def real_sets():
 
 
 def scans(n, res, work):
-    from core.prepare.scans import ScanOptions, prepare_scans
+    from core.prepare.options import ScanOptions
+    from core.prepare.scans import prepare_scans
     from tests.conftest import SAMPLE, TOLEDO_STRIP
     from tests.test_scans import SCAN_SETUP, calibration_text, make_scan
 

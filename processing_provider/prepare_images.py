@@ -1,4 +1,4 @@
-"""Prepare images: thin adapter over core.screening.prepare_images_workspace (and core.scans)."""
+"""Prepare images: thin adapter over core.prepare.stage.prepare_images_workspace (screening, scans, masks)."""
 from qgis.core import (
     NULL,
     QgsGeometry,
@@ -112,16 +112,16 @@ class PrepareImagesAlgorithm(AlgorithmBase):
         self.addOutput(QgsProcessingOutputFile(self.SCREENING, self.tr("Screening record (JSON)")))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core.prepare import stage as screening
-        from ..core.prepare.scans import ScanOptions
+        from ..core.prepare.options import PrepareOptions, ScanOptions, ScreeningOptions
+        from ..core.prepare.stage import prepare_images_workspace
 
         images = self.parameterAsFile(parameters, self.IMAGES, context)
         workspace = self.parameterAsString(parameters, self.WORKSPACE, context)
         output = self.parameterAsString(parameters, self.OUTPUT, context)
         dpi = self.parameterAsDouble(parameters, self.SCAN_DPI, context)
         scanned = self.parameterAsBoolean(parameters, self.SCANNED_FILM, context)
-        options = screening.PrepareOptions(
-            screening=screening.ScreeningOptions(
+        options = PrepareOptions(
+            screening=ScreeningOptions(
                 blur_threshold=self.parameterAsDouble(parameters, self.BLUR_THRESHOLD, context),
                 blur_relative=self.parameterAsDouble(parameters, self.BLUR_RELATIVE, context),
                 exclude_flagged=self.parameterAsBoolean(parameters, self.EXCLUDE_FLAGGED, context),
@@ -141,7 +141,7 @@ class PrepareImagesAlgorithm(AlgorithmBase):
         if source is not None:
             options.mask_polygons = self.mask_polygons(source, feedback)
             options.mask_source = self.tr("MASKS layer '{}'").format(source.sourceName())
-        result = self.run_core(screening.prepare_images_workspace, images, workspace, output or None, options,
+        result = self.run_core(prepare_images_workspace, images, workspace, output or None, options,
                                FeedbackProgress(feedback))
         for w in result.warnings:
             feedback.pushWarning(w)

@@ -146,8 +146,9 @@ RIGHT_HALF = [(IMG_W / 2, 0), (IMG_W, 0), (IMG_W, IMG_H), (IMG_W / 2, IMG_H)]
 
 
 def test_prepare_stage_writes_merges_and_rewrites_user_masks(tmp_path):
+    from core.prepare.options import PrepareOptions
     from core.prepare.screening import measure_image
-    from core.prepare.stage import PrepareOptions, prepare_images_workspace
+    from core.prepare.stage import prepare_images_workspace
 
     names = TOLEDO_STRIP[:2]
     images = copy_images(os.path.join(SAMPLE, "images"), names, str(tmp_path / "images"))
@@ -190,7 +191,8 @@ def test_prepare_stage_writes_merges_and_rewrites_user_masks(tmp_path):
 
 def test_prepare_stage_refuses_an_unknown_image_name(tmp_path):
     from core.prepare.masks import MaskError
-    from core.prepare.stage import PrepareOptions, prepare_images_workspace
+    from core.prepare.options import PrepareOptions
+    from core.prepare.stage import prepare_images_workspace
 
     images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:2], str(tmp_path / "images"))
     with pytest.raises(MaskError, match="my layer: feature 4: unknown image 'IMG_9999.JPG'"):
@@ -204,8 +206,8 @@ def test_prepare_stage_refuses_an_unknown_image_name(tmp_path):
 def test_prepare_scanned_film_merges_polygons_with_the_scan_masks(tmp_path):
     """Scanned film: a polygon named by the original scan (frame_002.tiff, prepared as frame_002.tif), in the
     prepared frame, ANDed with the scan's mask."""
-    from core.prepare.scans import ScanOptions
-    from core.prepare.stage import PrepareOptions, prepare_images_workspace
+    from core.prepare.options import PrepareOptions, ScanOptions
+    from core.prepare.stage import prepare_images_workspace
     from tests.test_scans import SCAN_SETUP, calibration_text, make_scan
 
     folder = tmp_path / "scans"

@@ -186,8 +186,8 @@ def test_symmetric_refinement_is_sub_pixel():
 @pytest.fixture(scope="module")
 def prepared(synthetic_scans, tmp_path_factory):
     """The whole "prepare" stage on the five scans, with the calibration certificate."""
-    from core.prepare.scans import ScanOptions
-    from core.prepare.stage import PrepareOptions, prepare_images_workspace
+    from core.prepare.options import PrepareOptions, ScanOptions
+    from core.prepare.stage import prepare_images_workspace
 
     folder, truth = synthetic_scans
     root = tmp_path_factory.mktemp("prepared")
@@ -216,7 +216,8 @@ def test_recovered_fiducials_within_half_a_pixel(prepared):
 def test_prepared_scans_share_one_frame_centred_on_the_principal_point(prepared):
     """Identical sizes; a mark re-found in a prepared image sits where the calibrated frame puts it."""
     from core.io.images import read_image_info
-    from core.prepare.scans import ScanOptions, detect_fiducials
+    from core.prepare.options import ScanOptions
+    from core.prepare.scans import detect_fiducials
 
     result, _ = prepared
     io = result.interior_orientation
@@ -325,7 +326,8 @@ def test_prepared_scans_align(prepared, tmp_path):
 
 def test_uncalibrated_corner_marks_mean_frame(tmp_path):
     """Four corner crosses, no certificate: the mean frame of the set, in pixels, PP at the fiducial centre."""
-    from core.prepare.scans import ScanOptions, prepare_scans
+    from core.prepare.options import ScanOptions
+    from core.prepare.scans import prepare_scans
 
     folder = tmp_path / "scans"
     folder.mkdir()
@@ -354,7 +356,8 @@ def test_uncalibrated_corner_marks_mean_frame(tmp_path):
 
 
 def test_too_few_marks_is_a_clear_error(tmp_path):
-    from core.prepare.scans import ScanError, ScanOptions, prepare_scans
+    from core.prepare.options import ScanOptions
+    from core.prepare.scans import ScanError, prepare_scans
 
     img = os.path.join(SAMPLE, "images", TOLEDO_STRIP[0])  # a photo without any fiducial mark
     with pytest.raises(ScanError, match=TOLEDO_STRIP[0]):
@@ -363,7 +366,8 @@ def test_too_few_marks_is_a_clear_error(tmp_path):
 
 def test_user_template_of_one_mark(synthetic_scans, tmp_path):
     """A crop of one mark from one scan finds the marks of the others (other resolutions and rotations)."""
-    from core.prepare.scans import ScanOptions, detect_fiducials, load_template
+    from core.prepare.options import ScanOptions
+    from core.prepare.scans import detect_fiducials, load_template
 
     folder, truth = synthetic_scans
     img = cv2.imread(os.path.join(folder, "frame_001.tif"), cv2.IMREAD_GRAYSCALE)

@@ -75,7 +75,8 @@ def test_scores_do_not_depend_on_image_size(tmp_path):
 
 def test_sky_does_not_make_a_sharp_photo_blurry():
     """Half the frame uniform (sky, water): the textured tiles decide."""
-    from core.prepare.screening import blur_score, to_grey
+    from core.io.images import to_grey
+    from core.prepare.screening import blur_score
 
     img = cv2.imread(os.path.join(SAMPLE, "images", SOURCE))[:, :, ::-1]
     g = to_grey(img)
@@ -86,7 +87,8 @@ def test_sky_does_not_make_a_sharp_photo_blurry():
 
 
 def test_sixteen_bit_and_grey_images(tmp_path):
-    from core.prepare.screening import full_scale, measure_image
+    from core.io.images import full_scale
+    from core.prepare.screening import measure_image
 
     g = cv2.imread(os.path.join(SAMPLE, "images", SOURCE), cv2.IMREAD_GRAYSCALE)
     cv2.imwrite(str(tmp_path / "g16.tif"), (g.astype(np.uint16) * 16))  # 12-bit data in 16-bit
@@ -98,12 +100,8 @@ def test_sixteen_bit_and_grey_images(tmp_path):
 
 
 def test_prepare_stage_records_decisions_and_excludes(toledo_with_bad_copies, tmp_path):
-    from core.prepare.stage import (
-        PrepareOptions,
-        ScreeningOptions,
-        load_screening,
-        prepare_images_workspace,
-    )
+    from core.prepare.options import PrepareOptions, ScreeningOptions
+    from core.prepare.stage import load_screening, prepare_images_workspace
 
     ws = str(tmp_path / "ws")
     out = str(tmp_path / "prepared")
@@ -132,7 +130,8 @@ def test_prepare_stage_records_decisions_and_excludes(toledo_with_bad_copies, tm
 
 
 def test_output_folder_with_foreign_files_is_refused(tmp_path):
-    from core.prepare.stage import ScreeningError, prepare_images_workspace
+    from core.prepare.screening import ScreeningError
+    from core.prepare.stage import prepare_images_workspace
 
     images = tmp_path / "img"
     shutil.copytree(os.path.join(SAMPLE, "images"), images, ignore=lambda d, names: names[3:])

@@ -44,9 +44,8 @@ from ..common.progress import NullProgress, Progress, check_cancel
 from ..io.images import ImageError, full_scale, list_images, read_image, read_image_info, to_grey
 from .options import ANALYSIS_SIZE, ScreeningOptions
 
-__all__ = ["ANALYSIS_SIZE", "EXCLUDE", "KEEP", "ImageQuality", "ScreeningError", "ScreeningOptions", "blur_score",
-           "exposure_figures", "full_scale", "measure_image", "read_for_analysis", "screen", "screen_folder",
-           "to_grey"]
+__all__ = ["EXCLUDE", "KEEP", "ImageQuality", "ScreeningError", "blur_score", "exposure_figures", "measure_image",
+           "read_for_analysis", "screen", "screen_folder"]
 
 TILES = (8, 6)  # columns x rows of the blur grid (long side x short side)
 TILE_PERCENTILE = 90.0

@@ -34,11 +34,10 @@ from ..project.workspace import (
 )
 from . import masks as masksmod
 from . import scans
-from .options import PrepareOptions, ScanOptions, ScreeningOptions
+from .options import PrepareOptions, ScanOptions
 from .screening import EXCLUDE, KEEP, ImageQuality, ScreeningError, screen_folder
 
-__all__ = ["OUTPUT_MARKER", "PrepareOptions", "PrepareResult", "ScanOptions", "ScreeningOptions", "STAGE",
-           "load_screening", "prepare_images_workspace"]
+__all__ = ["OUTPUT_MARKER", "PrepareResult", "STAGE", "load_screening", "prepare_images_workspace"]
 
 STAGE = PREPARE
 OUTPUT_MARKER = ".archaeoortho-prepared"
