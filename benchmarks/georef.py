@@ -64,7 +64,8 @@ def consistency(ws):
     """Every target (control and check) against the block: which agree with each other?"""
     import pycolmap
 
-    from core.georef import adjust as georef
+    from core.georef.outliers import control_consistency
+    from core.georef.triangulate import triangulate_observations
     from core.io import gcp as gcpmod
 
     rec = pycolmap.Reconstruction()
@@ -73,14 +74,14 @@ def consistency(ws):
     m, w, n = [], [], []
     print("\ntargets triangulated in the unadjusted block (px: residual per observation):")
     for p in g.points:
-        t = georef.triangulate_observations(rec, p.observations)
+        t = triangulate_observations(rec, p.observations)
         px = " ".join(f"{ob.image}:{v:.2f}" for ob, v in zip(p.observations, t.residuals_px))
         print(f"  {p.name}: {'not triangulated' if t.xyz is None else f'angle {t.angle_deg:4.1f} deg'}  {px}")
         if t.xyz is not None:
             m.append(t.xyz)
             w.append([p.x, p.y, p.z])
             n.append(p.name)
-    c = georef.control_consistency(np.array(m), np.array(w), n, 0.06, xy_only=True)
+    c = control_consistency(np.array(m), np.array(w), n, 0.06, xy_only=True)
     print(f"largest set of targets that one similarity fits within 0.06 m (XY; Z is a placeholder): "
           f"{', '.join(c.consistent)} at {c.rms:.3f} m RMS")
     for name in n:
@@ -114,7 +115,7 @@ def tarp_ruler(ws):
     import cv2
     import pycolmap
 
-    from core.georef import adjust as georef
+    from core.georef.triangulate import triangulate_observations
     from core.io import gcp as gcpmod
 
     rec = pycolmap.Reconstruction()
@@ -123,7 +124,7 @@ def tarp_ruler(ws):
     g = gcpmod.read_gcps(os.path.join(DATA, "copr", "gcp_list.txt"))
     scales, xyz = [], {}
     for p in g.points:
-        t = georef.triangulate_observations(rec, p.observations)
+        t = triangulate_observations(rec, p.observations)
         if t.xyz is None:
             continue
         xyz[p.name] = np.asarray(t.xyz)

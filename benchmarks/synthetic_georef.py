@@ -22,7 +22,8 @@ sys.path.insert(0, ROOT)
 
 from core.align.options import AlignOptions  # noqa: E402
 from core.align.stage import align, load_model  # noqa: E402
-from core.georef import adjust as georef  # noqa: E402
+from core.georef.adjust import georeference  # noqa: E402
+from core.georef.results import CHECKED  # noqa: E402
 from core.io.gcp import CHECK, CONTROL  # noqa: E402
 from tests import synthetic as syn  # noqa: E402
 
@@ -56,7 +57,7 @@ def run(seed, args, work):
     control = block.spread_control(5)
     gcps = block.gcp_set(control, noise_px=args.noise)
     t0 = time.time()
-    result = georef.georeference(rec, gcps)
+    result = georeference(rec, gcps)
     t_geo = time.time() - t0
     print(f"  control: {', '.join(control)}; georeference {t_geo:.1f} s; outliers: "
           f"{[o.name for o in result.outliers] or 'none'}")
@@ -64,12 +65,12 @@ def run(seed, args, work):
     print(_line("check, constrained adjustment", result.rmse(CHECK), gsd))
     print(_line("check, Helmert only", result.rmse(CHECK, helmert=True), gsd))
     for r in result.points:
-        if r.status == georef.CHECKED:
+        if r.status == CHECKED:
             print(f"    {r.name}: dx {r.dx:+.3f} dy {r.dy:+.3f} dz {r.dz:+.3f} m, {r.n_obs} obs")
-    truth = georef.georeference(block.truth_reconstruction(), gcps)
+    truth = georeference(block.truth_reconstruction(), gcps)
     print(_line("check, truth-built model", truth.rmse(CHECK), gsd))
     positions, _ = block.camera_positions(sigma=0.5, seed=13)
-    pos = georef.georeference(rec, block.gcp_set([], noise_px=args.noise), positions)
+    pos = georeference(rec, block.gcp_set([], noise_px=args.noise), positions)
     print(_line("check, positions only (0.5 m)", pos.rmse(CHECK), gsd)
           + f"   (sigma/sqrt(n) = {0.5 / math.sqrt(len(positions)):.3f} m)")
     return result.rmse(CHECK), gsd

@@ -1,4 +1,4 @@
-"""Unit tests of core/georef.py that need no rendering and no SfM: Helmert fit and RANSAC,
+"""Unit tests of core/georef/ that need no rendering and no SfM: Helmert fit and RANSAC,
 Similarity algebra, and the adjustment on a small exact model built directly in pycolmap
 (camera positions without heights, placeholder heights, a typo in a control point)."""
 import math
@@ -6,7 +6,12 @@ import math
 import numpy as np
 import pytest
 
-from core.georef import adjust as georef
+from core.geometry.similarity import Similarity, helmert_fit, helmert_ransac
+from core.georef.adjust import georeference
+from core.georef.bundle import outside_image
+from core.georef.errors import GeorefError
+from core.georef.results import REJECTED
+from core.georef.triangulate import triangulate_observations
 from core.io import gcp as gcpmod
 
 
@@ -18,7 +23,7 @@ def _rot(ax, ay, az):
     return rz @ ry @ rx
 
 
-TRUE = georef.Similarity(37.5, _rot(0.1, -0.2, 2.5), [500123.4, 4600456.7, 312.0])
+TRUE = Similarity(37.5, _rot(0.1, -0.2, 2.5), [500123.4, 4600456.7, 312.0])
 
 
 def _points(n=8, seed=1):
@@ -28,37 +33,37 @@ def _points(n=8, seed=1):
 
 def test_helmert_fit_recovers_a_known_similarity():
     src = _points()
-    tr = georef.helmert_fit(src, TRUE.apply(src))
+    tr = helmert_fit(src, TRUE.apply(src))
     assert tr.scale == pytest.approx(TRUE.scale, rel=1e-10)
     np.testing.assert_allclose(tr.rotation, TRUE.rotation, atol=1e-10)
     np.testing.assert_allclose(tr.translation, TRUE.translation, atol=1e-6)
     # inverse and composition are consistent
     ident = tr.inverse().compose(tr)
     np.testing.assert_allclose(ident.apply(src), src, atol=1e-9)
-    back = georef.Similarity.from_dict(tr.to_dict())
+    back = Similarity.from_dict(tr.to_dict())
     np.testing.assert_allclose(back.matrix(), tr.matrix(), atol=1e-9)
 
 
 def test_helmert_fit_never_returns_a_reflection():
     src = _points()
     mirrored = TRUE.apply(src) * np.array([1, 1, -1])
-    tr = georef.helmert_fit(src, mirrored)
+    tr = helmert_fit(src, mirrored)
     assert np.linalg.det(tr.rotation) == pytest.approx(1.0)
 
 
 def test_helmert_fit_rejects_collinear_and_too_few_points():
     line = np.outer(np.arange(5.0), [1, 2, 3])
     with pytest.raises(ValueError, match="collinear"):
-        georef.helmert_fit(line, line * 2)
+        helmert_fit(line, line * 2)
     with pytest.raises(ValueError, match="at least 3"):
-        georef.helmert_fit(line[:2], line[:2])
+        helmert_fit(line[:2], line[:2])
 
 
 def test_helmert_ransac_finds_the_one_bad_point_and_its_residual():
     src = _points(8)
     dst = TRUE.apply(src) + np.random.default_rng(2).normal(0, 0.02, (8, 3))
     dst[5] += [100.0, 0.0, 0.0]  # a typo of 100 m in X
-    res = georef.helmert_ransac(src, dst, threshold=0.5)
+    res = helmert_ransac(src, dst, threshold=0.5)
     assert list(np.flatnonzero(~res.inliers)) == [5]
     assert res.residuals[5] == pytest.approx(100.0, abs=1.0)
     assert np.all(res.residuals[res.inliers] < 0.1)
@@ -77,7 +82,7 @@ def _ground(x, y):
     return 2.0 * np.sin(x / 15.0) * np.cos(y / 20.0)
 
 
-def _block(model_from_world: georef.Similarity, seed=0, n_tie=1500):
+def _block(model_from_world: Similarity, seed=0, n_tie=1500):
     """A 3 x 4 vertical block 60 m above wavy ground, exact observations, returned in the model
     frame given by ``model_from_world`` (world = local + OFFSET); also the true world centres."""
     import pycolmap
@@ -163,7 +168,7 @@ def _gcps(rec, model_from_world, names_xy, z_given=None, noise_px=0.0, seed=3):
     return gcpmod.GCPSet(points=pts, crs="EPSG:32633")
 
 
-MODEL_FROM_WORLD = georef.Similarity(0.05, _rot(0.3, 0.1, 1.0), [1.0, -2.0, 3.0])
+MODEL_FROM_WORLD = Similarity(0.05, _rot(0.3, 0.1, 1.0), [1.0, -2.0, 3.0])
 SPREAD = {"a": (2.0, 3.0), "b": (73.0, 5.0), "c": (5.0, 58.0), "d": (72.0, 57.0), "e": (38.0, 30.0)}
 
 
@@ -176,7 +181,7 @@ def test_exact_block_with_gcps_lands_on_the_truth(block):
     rec, _ = block
     gcps = _gcps(rec, MODEL_FROM_WORLD, SPREAD)
     gcpmod.apply_check_points(gcps, ["e"])
-    r = georef.georeference(rec, gcps)
+    r = georeference(rec, gcps)
     chk = r.rmse("check")
     assert chk["n"] == 1
     assert chk["xy"] < 0.01 and chk["z"] < 0.01
@@ -190,7 +195,7 @@ def test_a_100_m_typo_is_named_and_left_out(block):
     gcpmod.apply_check_points(gcps, ["e"])
     typo = next(p for p in gcps.points if p.name == "d")
     typo.x += 100.0
-    r = georef.georeference(rec, gcps)
+    r = georeference(rec, gcps)
     named = [o for o in r.outliers if o.name == "d"]
     assert named, r.outliers
     assert named[0].residual == pytest.approx(100.0, rel=0.1)
@@ -207,15 +212,15 @@ def test_a_typo_stays_out_after_the_retest_against_the_adjusted_block(block):
     gcps = _gcps(rec, MODEL_FROM_WORLD, xy, noise_px=0.3)
     gcpmod.apply_check_points(gcps, ["e"])
     next(p for p in gcps.points if p.name == "d").x += 100.0
-    r = georef.georeference(rec, gcps)
+    r = georeference(rec, gcps)
     assert r.statistics["readmitted_control_points"] == []
     t = r.statistics["helmert_retests"]["d"]
     assert t["sigma"] > 100 * t["threshold_sigma"] and t["free_distance_m"] == pytest.approx(100.0, rel=0.01)
     assert any("d is" in w and "adjusted block" in w and "excluded" in w for w in r.warnings)
-    h = georef.georeference(rec, gcps, adjust=False)
+    h = georeference(rec, gcps, adjust=False)
     assert [o.name for o in h.outliers if o.kind == "control point"] == ["d"]
     assert any("d is" in w and "Helmert fit" in w for w in h.warnings)
-    assert next(p for p in h.points if p.name == "d").status == georef.REJECTED
+    assert next(p for p in h.points if p.name == "d").status == REJECTED
 
 
 def test_observation_outside_the_image_is_skipped_in_the_triangulation(block):
@@ -225,15 +230,15 @@ def test_observation_outside_the_image_is_skipped_in_the_triangulation(block):
     seen = {o.image for o in obs}
     other = next(rec.image(i).name for i in rec.reg_image_ids() if rec.image(i).name not in seen)
     obs.insert(0, gcpmod.Observation(other, W + 0.5, 100.0))  # just off the right edge
-    t = georef.triangulate_observations(rec, obs)
+    t = triangulate_observations(rec, obs)
     assert not t.used[0] and np.isnan(t.residuals_px[0]) and t.n_used == len(obs) - 1
     assert any("outside" in n and other in n for n in t.notes)
     # pixel convention: the image spans [0, width] x [0, height], edges included
     cam = rec.cameras[1]
     inside = [(0.0, 0.0), (W, H), (W / 2, H / 2)]
     outside = [(-0.01, 10.0), (10.0, H + 0.01), (W + 0.01, 10.0), (float("nan"), 10.0)]
-    assert not any(georef._outside_image(cam, gcpmod.Observation("x", x, y)) for x, y in inside)
-    assert all(georef._outside_image(cam, gcpmod.Observation("x", x, y)) for x, y in outside)
+    assert not any(outside_image(cam, gcpmod.Observation("x", x, y)) for x, y in inside)
+    assert all(outside_image(cam, gcpmod.Observation("x", x, y)) for x, y in outside)
 
 
 def test_camera_positions_without_heights_constrain_xy_only(block):
@@ -242,7 +247,7 @@ def test_camera_positions_without_heights_constrain_xy_only(block):
     gcpmod.apply_check_points(gcps, ["e", "d"])  # 3 control points fix the datum
     cams = [gcpmod.CameraPosition(image=f"img{k + 1:02d}.jpg", x=c[0] + OFFSET[0], y=c[1] + OFFSET[1],
                                   z=float("nan"), sigma_xy=0.05, sigma_z=1.0) for k, c in enumerate(centres)]
-    r = georef.georeference(rec, gcps, cams)
+    r = georeference(rec, gcps, cams)
     assert any("without a height" in w for w in r.warnings)
     assert r.rmse("check")["xy"] < 0.01
     dxy = [math.hypot(c.dx, c.dy) for c in r.cameras]
@@ -254,8 +259,8 @@ def test_camera_positions_without_heights_alone_are_refused(block):
     rec, centres = block
     cams = [gcpmod.CameraPosition(image=f"img{k + 1:02d}.jpg", x=c[0] + OFFSET[0], y=c[1] + OFFSET[1],
                                   z=float("nan")) for k, c in enumerate(centres)]
-    with pytest.raises(georef.GeorefError, match="without a height"):
-        georef.georeference(rec, None, cams, crs="EPSG:32633")
+    with pytest.raises(GeorefError, match="without a height"):
+        georeference(rec, None, cams, crs="EPSG:32633")
 
 
 def test_camera_positions_only_land_within_their_noise(block):
@@ -267,7 +272,7 @@ def test_camera_positions_only_land_within_their_noise(block):
                                   z=c[2] + OFFSET[2], sigma_xy=sigma, sigma_z=sigma) for k, c in enumerate(noisy)]
     gcps = _gcps(rec, MODEL_FROM_WORLD, SPREAD)
     gcpmod.apply_check_points(gcps, list(SPREAD))
-    r = georef.georeference(rec, gcps, cams)
+    r = georeference(rec, gcps, cams)
     assert r.source == "camera positions"
     chk = r.rmse("check")
     # 12 positions with sigma 0.5 m fix the datum to about sigma / sqrt(12) = 0.14 m per axis
@@ -280,7 +285,7 @@ def test_placeholder_heights_are_detected_and_not_taken_as_surveyed(block):
     rec, _ = block
     gcps = _gcps(rec, MODEL_FROM_WORLD, SPREAD, z_given=0.0)
     gcpmod.apply_check_points(gcps, ["e"])
-    r = georef.georeference(rec, gcps)
+    r = georeference(rec, gcps)
     assert r.statistics["placeholder_z"] == pytest.approx(OFFSET[2])
     assert any("placeholder" in w for w in r.warnings)
     # the check point's XY stays good: the wavy ground (+-2 m) was not forced flat at 5 cm
@@ -306,7 +311,7 @@ def test_control_points_that_disagree_with_the_block_by_metres_are_named(block):
             p.x += 1.5
         if p.name == "g":
             p.y -= 2.0
-    r = georef.georeference(rec, gcps)
+    r = georeference(rec, gcps)
     cons = r.statistics["control_consistency"]
     assert cons["suspects"] == ["g", "b"]
     assert cons["rms_m"] < 0.05

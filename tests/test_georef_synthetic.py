@@ -18,7 +18,8 @@ import pytest
 
 from core.align.options import AlignOptions
 from core.align.stage import align, load_model
-from core.georef import adjust as georef
+from core.georef.adjust import georeference
+from core.georef.results import CHECKED, REJECTED, USED
 from core.io.gcp import CHECK, CONTROL, read_gcps, write_odm_gcp_list
 from tests import synthetic as syn
 
@@ -162,7 +163,7 @@ def test_truth_model_georeferenced_with_five_control_points(block):
     rec = block.truth_reconstruction()
     control = block.spread_control(5)
     gcps = block.gcp_set(control, noise_px=GCP_NOISE_PX)
-    result = georef.georeference(rec, gcps)
+    result = georeference(rec, gcps)
     _report("truth model, 5 control", result, block.gsd)
     chk = result.rmse(CHECK)
     assert chk["n"] >= 5
@@ -192,7 +193,7 @@ def test_constrained_adjustment_removes_the_bending_of_a_long_strip(strip):
     control = [ground[0].name, ground[1].name, ground[-1].name, ground[-2].name,
                ground[len(ground) // 2].name]
     gcps = strip.gcp_set(control, noise_px=GCP_NOISE_PX)
-    result = georef.georeference(rec, gcps)
+    result = georeference(rec, gcps)
     _report("bent strip", result, strip.gsd)
     chk, hel = result.rmse(CHECK), result.rmse(CHECK, helmert=True)
     assert chk["n"] >= 3
@@ -215,7 +216,7 @@ def test_refined_intrinsics_repair_a_block_aligned_without_distortion(block):
     ba.print_summary = False
     pycolmap.bundle_adjustment(rec, ba)  # the block settles into its deformed shape
     gcps = block.gcp_set(block.spread_control(5), noise_px=GCP_NOISE_PX)
-    result = georef.georeference(rec, gcps, refine_intrinsics=True)
+    result = georeference(rec, gcps, refine_intrinsics=True)
     _report("aligned without distortion, refine intrinsics", result, block.gsd)
     chk, hel = result.rmse(CHECK), result.rmse(CHECK, helmert=True)
     assert hel["xyz"] > 0.5  # the deformation is real...
@@ -240,7 +241,7 @@ def test_deformed_strip_keeps_its_good_control_points(strip):
     pycolmap.bundle_adjustment(rec, ba)
     ground = sorted((p for p in strip.gcps if p.kind == "ground"), key=lambda p: p.xyz[0])
     control = [ground[0].name, ground[1].name, ground[-1].name, ground[-2].name, ground[len(ground) // 2].name]
-    result = georef.georeference(rec, strip.gcp_set(control, noise_px=GCP_NOISE_PX), refine_intrinsics=True)
+    result = georeference(rec, strip.gcp_set(control, noise_px=GCP_NOISE_PX), refine_intrinsics=True)
     _report("strip aligned without distortion", result, strip.gsd)
     assert not [o.name for o in result.outliers if o.kind == "control point"]
     chk = result.rmse(CHECK)
@@ -252,9 +253,9 @@ def _positions_only(block, rec, label):
     check errors (N,3), the errors that least squares predicts for this noise realisation, and n."""
     positions, _ = block.camera_positions(sigma=POSITION_SIGMA, seed=13)
     gcps = block.gcp_set([], noise_px=GCP_NOISE_PX)  # no control: every ground point is a check point
-    result = georef.georeference(rec, gcps, positions)
+    result = georeference(rec, gcps, positions)
     assert result.source == "camera positions"
-    rows = [r for r in result.points if r.status == georef.CHECKED]
+    rows = [r for r in result.points if r.status == CHECKED]
     assert len(rows) == len(block.gcps)
     d = np.array([[r.dx, r.dy, r.dz] for r in rows])
     # the best any estimator can do: the similarity that carries the true centres onto the noisy positions
@@ -313,14 +314,14 @@ def test_gcp_with_a_100_m_typo_is_flagged_by_name_and_spares_the_check_points(bl
     gcps = block.gcp_set(control + [extra], noise_px=GCP_NOISE_PX)
     bad = gcps.by_name(extra)
     bad.x += 100.0  # a typo in the easting
-    result = georef.georeference(rec, gcps)
+    result = georeference(rec, gcps)
     _report("100 m typo", result, block.gsd)
     flagged = [o for o in result.outliers if o.name == bad.name]
     assert flagged, [o.to_dict() for o in result.outliers]
     assert all(o.name == bad.name for o in result.outliers if o.kind == "control point")
     assert any(bad.name in w for w in result.warnings)
     row = next(r for r in result.points if r.name == bad.name)
-    assert row.status == georef.REJECTED
+    assert row.status == REJECTED
     assert abs(abs(row.dx) - 100.0) < 0.5  # its residual shows the typo
     chk = result.rmse(CHECK)
     assert chk["xy"] <= 0.5 * block.gsd and chk["z"] <= 1.0 * block.gsd
@@ -338,7 +339,7 @@ def test_observation_outside_the_image_is_named_and_ignored(block, tmp_path):
     msg = [w for w in read.warnings if p.name in w and img in w and "outside" in w]
     assert msg, read.warnings
     assert img not in read.by_name(p.name).images()
-    result = georef.georeference(block.truth_reconstruction(), read)
+    result = georeference(block.truth_reconstruction(), read)
     assert any(p.name in w and img in w for w in result.warnings)
     assert not result.outliers
     chk = result.rmse(CHECK)
@@ -352,11 +353,11 @@ def test_observation_outside_the_image_given_directly_is_named_and_ignored(block
     p = gcps.by_name(control[1])
     img = p.observations[0].image
     p.observations[0].x = block.camera.width + 250.0
-    result = georef.georeference(block.truth_reconstruction(), gcps)
+    result = georeference(block.truth_reconstruction(), gcps)
     assert any(p.name in w and img in w and "outside" in w for w in result.warnings), result.warnings
     assert not [o for o in result.outliers if o.kind == "control point"], result.outliers
     row = next(r for r in result.points if r.name == p.name)
-    assert row.status == georef.USED
+    assert row.status == USED
     assert next(o for o in row.observations if o["image"] == img)["px"] is None
 
 
@@ -389,10 +390,10 @@ def test_end_to_end_five_control_points_reach_one_gsd(aligned_block):
     rec = load_model(ws)
     control = blk.spread_control(5)
     gcps = blk.gcp_set(control, noise_px=GCP_NOISE_PX)
-    result = georef.georeference(rec, gcps)
+    result = georeference(rec, gcps)
     _report("end to end, 5 control", result, blk.gsd)
     for r in result.points:
-        if r.status == georef.CHECKED:
+        if r.status == CHECKED:
             print(f"  {r.name}: dx {r.dx:+.3f} dy {r.dy:+.3f} dz {r.dz:+.3f} m ({r.n_obs} obs)")
     chk = result.rmse(CHECK)
     assert chk["n"] >= 5

@@ -6,8 +6,8 @@ within 2 px of the true (noise-free) projections.
 import numpy as np
 import pytest
 
-from core.georef import adjust as georef
 from core.georef import guided
+from core.georef.adjust import georeference
 from core.io.gcp import GCPSet
 from tests import synthetic as syn
 
@@ -23,7 +23,7 @@ def block():
 def georeferenced(block):
     rec = block.truth_reconstruction(n_points=800, noise_px=0.3)
     control = block.spread_control(5)
-    result = georef.georeference(rec, block.gcp_set(control, noise_px=0.4))
+    result = georeference(rec, block.gcp_set(control, noise_px=0.4))
     return result, control
 
 

@@ -68,11 +68,11 @@ import numpy as np
 
 from ..common.errors import require
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
-from ..geometry.similarity import HelmertResult, Similarity, fit_similarity, helmert_fit, helmert_ransac
+from ..geometry.similarity import HelmertResult, helmert_ransac
 from ..io.gcp import CHECK, CONTROL, CameraPosition, GCPSet, GroundPoint
 from .bundle import BundleProblem, build_problem, outside_image, set_point_active, write_back
 from .errors import GeorefError
-from .options import INTRINSIC_GROUPS, GeorefOptions
+from .options import GeorefOptions
 from .outliers import (
     Consistency,
     control_consistency,
@@ -83,21 +83,15 @@ from .outliers import (
 )
 from .results import (
     CHECKED,
-    FORMAT_VERSION,
     NOT_TRIANGULATED,
     REJECTED,
-    RESIDUALS_FILE,
-    TRANSFORM_FILE,
     USED,
     CameraResidual,
     GeorefResult,
     Outlier,
     PointResidual,
-    load_transform,
 )
 from .triangulate import Triangulation, image_names, refine_tie_points, registered_images, triangulate_observations
-
-_outside_image = outside_image  # the name the tests use
 
 
 @dataclass
@@ -630,9 +624,4 @@ def _camera_rows(rec, cam_pos, offset, lookup, used: Optional[set] = None) -> Li
     return rows
 
 
-
-__all__ = ["CHECKED", "CameraResidual", "Consistency", "FORMAT_VERSION", "GeorefError", "GeorefOptions",
-           "GeorefResult", "INTRINSIC_GROUPS", "NOT_TRIANGULATED", "Outlier", "PointResidual", "REJECTED",
-           "RESIDUALS_FILE", "Similarity", "TRANSFORM_FILE", "Triangulation", "USED", "control_consistency",
-           "fit_similarity", "georeference", "helmert_fit", "helmert_ransac", "load_transform",
-           "triangulate_observations"]
+__all__ = ["georeference"]

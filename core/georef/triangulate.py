@@ -308,6 +308,6 @@ def refine_tie_points(rec, huber_px: float, progress, iterations: int = 10) -> N
 
 
 
-__all__ = ["Triangulation", "View", "collect_views", "image_names", "intersection_angle", "outside_image",
+__all__ = ["Triangulation", "View", "collect_views", "image_names", "intersection_angle",
            "refine_point", "refine_tie_points", "registered_images", "triangulate_observations",
            "triangulate_views", "view_residuals"]
