@@ -17,9 +17,11 @@ import pytest
 from core.common.progress import Cancelled, NullProgress
 from core.georef import accuracy, uncertainty
 from core.georef.stage import georeference_workspace
-from core.project.workspace import Workspace
+from core.project.workspace import Workspace, WorkspaceError
 from core.report import stage as report
+from core.report.figures import hillshade
 from core.report.html import esc
+from core.report.page import read_report_data
 from tests import synthetic as syn
 from tests.workspaces import synthetic_workspace
 
@@ -137,7 +139,7 @@ def test_report_numbers_are_core_accuracy_figures(built, georeferenced):
     assert keyed["images.given"][0] == "11" and keyed["images.aligned"][0] == "10"
     assert "ghost.jpg" in text and "no verified matches with any other image" in text
     # the embedded machine-readable copy agrees
-    data = report.read_report_data(result.path)
+    data = read_report_data(result.path)
     assert data["figures"]["NSSDA_H"] == pytest.approx(h, rel=1e-12)
     assert data["sections"]["georeferencing"] == "ok"
 
@@ -245,7 +247,7 @@ def test_products_previews_with_resolution_and_valid_fraction(georeferenced, tmp
     alts = [a for a, _ in IMG_RE.findall(text)]
     assert "DSM preview" in alts and "Orthomosaic preview" in alts
     assert result.sections["uncertainty"] != "ok"  # not requested: skipped with its reason
-    hs = report.hillshade(z.astype(float), 0.25, 0.25)
+    hs = hillshade(z.astype(float), 0.25, 0.25)
     assert hs.shape == z.shape and 0.0 <= hs.min() and hs.max() <= 1.0
     # with the DSM stage's own figure (inside the camera centres' hull) the key figure is that one, the same
     # number as the Processing output VALID_FRACTION; the whole raster's share stays in the products section
@@ -291,7 +293,7 @@ def test_cancel_never_leaves_a_report_that_looks_complete(georeferenced, tmp_pat
 
 
 def test_not_a_workspace_is_a_clear_error(tmp_path):
-    with pytest.raises(report.WorkspaceError, match="not an ArchaeoOrtho workspace"):
+    with pytest.raises(WorkspaceError, match="not an ArchaeoOrtho workspace"):
         report.build_report(str(tmp_path))
 
 

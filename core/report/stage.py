@@ -34,15 +34,13 @@ from typing import Any, Dict, List, Optional, Tuple
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..project.layout import REPORT_HTML, Layout
 from ..project.stages import REPORT, run_stage
-from ..project.workspace import Workspace, WorkspaceError, atomic_output
+from ..project.workspace import Workspace, atomic_output
 from .context import ReportContext, Skip
 from .data import ReportData
 from .errors import ReportError
-from .figures import hillshade
-from .html import crs_label, esc
+from .html import esc
 from .options import ReportOptions
-from .page import SECTIONS, glance_lines, page, read_report_data
-from .residuals import accuracy_figures, camera_position_figures
+from .page import SECTIONS, glance_lines, page
 from .sections import georeferencing, orientation, products, summary
 from .sections import uncertainty as uncertainty_section
 
@@ -138,5 +136,4 @@ def build_report(workspace_dir: str, output_html: Optional[str] = None, *, uncer
     return ReportResult(out, ws.root, figures, status, ctx.layers, ctx.warnings, seconds)
 
 
-__all__ = ["REPORT_FILE", "ReportError", "ReportOptions", "ReportResult", "WorkspaceError", "accuracy_figures",
-           "build_report", "camera_position_figures", "crs_label", "hillshade", "read_report_data"]
+__all__ = ["REPORT_FILE", "ReportResult", "build_report"]
