@@ -14,7 +14,6 @@ from qgis.PyQt.QtCore import QCoreApplication, Qt
 from qgis.PyQt.QtGui import QKeySequence
 from qgis.PyQt.QtWidgets import (
     QAbstractItemView,
-    QAction,
     QCheckBox,
     QDoubleSpinBox,
     QFileDialog,
@@ -30,6 +29,11 @@ from qgis.PyQt.QtWidgets import (
     QVBoxLayout,
     QWidget,
 )
+
+try:  # Qt6 moved QAction to QtGui
+    from qgis.PyQt.QtGui import QAction
+except ImportError:
+    from qgis.PyQt.QtWidgets import QAction
 
 from ..core.project.stages import ALIGN
 from .gcp_io import GcpImportExport
@@ -116,7 +120,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         row = QHBoxLayout()
         row.addWidget(QLabel(self.tr("Workspace:")))
         self.ws_label = QLabel(self.tr("none open"))
-        self.ws_label.setTextInteractionFlags(Qt.TextSelectableByMouse)
+        self.ws_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         self.ws_label.setMinimumWidth(60)
         row.addWidget(self.ws_label, 1)
         self.btn_open = QPushButton(self.tr("Open\u2026"))
@@ -131,7 +135,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         row = QHBoxLayout()
         row.addWidget(QLabel(self.tr("Heights (Z) from:")))
         self.dsm_combo = QgsMapLayerComboBox()
-        self.dsm_combo.setFilters(QgsMapLayerProxyModel.RasterLayer)
+        self.dsm_combo.setFilters(QgsMapLayerProxyModel.Filter.RasterLayer)
         self.dsm_combo.setAllowEmptyLayer(True)
         self.dsm_combo.setLayer(None)
         self.dsm_combo.setToolTip(self.tr("A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map "
@@ -143,7 +147,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
 
     def _build_toolbar(self, w):
         self.toolbar = QToolBar(w)
-        self.toolbar.setToolButtonStyle(Qt.ToolButtonTextOnly)
+        self.toolbar.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
         self.act_add = self.toolbar.addAction(self.tr("Add"))
         self.act_add.setToolTip(self.tr("Add a ground point"))
         self.act_remove = self.toolbar.addAction(self.tr("Remove"))
@@ -162,7 +166,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
             b = QToolButton(w)
             b.setText(text)
             b.setMenu(menu)
-            b.setPopupMode(QToolButton.InstantPopup)
+            b.setPopupMode(QToolButton.ToolButtonPopupMode.InstantPopup)
             self.toolbar.addWidget(b)
         self._build_undo_actions(w)
         self.act_results = self.toolbar.addAction(self.tr("Load results"))
@@ -183,7 +187,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         stack.redoTextChanged.connect(lambda t: self.act_redo.setToolTip(self.tr("Redo: {}").format(t) if t else ""))
         for a in (self.act_undo, self.act_redo):
             a.setEnabled(False)
-            a.setShortcutContext(Qt.WidgetWithChildrenShortcut)
+            a.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
             self.toolbar.addAction(a)
 
     def _build_table(self, w):
@@ -194,10 +198,10 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         self.table.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
         self.table.setItemDelegateForColumn(ROLE, RoleDelegate(self.table))
         self.table.verticalHeader().setVisible(False)
-        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeToContents)
+        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
         self.table.horizontalHeader().setStretchLastSection(True)
-        self.table.setEditTriggers(QAbstractItemView.DoubleClicked | QAbstractItemView.EditKeyPressed
-                                   | QAbstractItemView.AnyKeyPressed)
+        triggers = QAbstractItemView.EditTrigger
+        self.table.setEditTriggers(triggers.DoubleClicked | triggers.EditKeyPressed | triggers.AnyKeyPressed)
         return self.table
 
     def _build_tolerance_row(self):
@@ -264,9 +268,9 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         p.filterChanged.connect(lambda _on: self._update_thumbnails())
 
     # ------------------------------------------------------------------ messages
-    def message(self, text, level=Qgis.Info):
+    def message(self, text, level=Qgis.MessageLevel.Info):
         self.status.setText(text)
-        if self.iface is not None and level != Qgis.Info:
+        if self.iface is not None and level != Qgis.MessageLevel.Info:
             self.iface.messageBar().pushMessage(self.tr("ArchaeoOrtho"), text, level, 8)
 
     def tolerance(self):
@@ -284,7 +288,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         try:
             self.store.open(folder)
         except WorkspaceError as e:
-            self.message(str(e), Qgis.Critical)
+            self.message(str(e), Qgis.MessageLevel.Critical)
             return False
         return True
 
@@ -401,7 +405,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         try:
             name = self.store.add_point(name, x, y, z)
         except ValueError as e:
-            self.message(str(e), Qgis.Warning)
+            self.message(str(e), Qgis.MessageLevel.Warning)
             return None
         self.select_point(name)
         return name

@@ -39,8 +39,8 @@ class GcpImportExport:
         box = QMessageBox(QMessageBox.Icon.Question, translate("GcpDock", "Import ground control"),
                           translate("GcpDock", "Replace the current points, or add the imported ones to them (same names are "
                                   "updated)?"), parent=self)
-        replace = box.addButton(translate("GcpDock", "Replace"), QMessageBox.AcceptRole)
-        box.addButton(translate("GcpDock", "Add"), QMessageBox.AcceptRole)
+        replace = box.addButton(translate("GcpDock", "Replace"), QMessageBox.ButtonRole.AcceptRole)
+        box.addButton(translate("GcpDock", "Add"), QMessageBox.ButtonRole.AcceptRole)
         box.exec()
         return box.clickedButton() is not replace
 
@@ -50,7 +50,7 @@ class GcpImportExport:
             gs = gcpmod.read_gcps(path, image_names=[im["name"] for im in self.store.images()] or None,
                                   image_sizes=self.store.image_sizes() or None, unknown_images="warn")
         except (gcpmod.GCPError, OSError, ValueError) as e:
-            self.message(str(e), Qgis.Critical)
+            self.message(str(e), Qgis.MessageLevel.Critical)
             return None
         return self._import(gs, os.path.basename(path), merge)
 
@@ -69,7 +69,7 @@ class GcpImportExport:
         self.store.replace_all(gs, translate("GcpDock", "import {}").format(source), merge=merge)
         warn = f" ({len(gs.warnings)} " + translate("GcpDock", "warnings") + ")" if gs.warnings else ""
         self.message(translate("GcpDock", "Imported {} points and {} observations from {}").format(
-            len(gs.points), n_obs, source) + warn, Qgis.Warning if gs.warnings else Qgis.Info)
+            len(gs.points), n_obs, source) + warn, Qgis.MessageLevel.Warning if gs.warnings else Qgis.MessageLevel.Info)
         if gs.warnings:
             self.status.setToolTip("\n".join(gs.warnings))
         self.load_predictor()
@@ -78,9 +78,10 @@ class GcpImportExport:
 
     def choose_import_layer(self):
         candidates = [lyr for lyr in QgsProject.instance().mapLayers().values()
-                      if isinstance(lyr, QgsVectorLayer) and lyr.geometryType() == QgsWkbTypes.PointGeometry]
+                      if isinstance(lyr, QgsVectorLayer)
+                      and lyr.geometryType() == QgsWkbTypes.GeometryType.PointGeometry]
         if not candidates:
-            self.message(translate("GcpDock", "No point layer in the project"), Qgis.Warning)
+            self.message(translate("GcpDock", "No point layer in the project"), Qgis.MessageLevel.Warning)
             return
         names = [lyr.name() for lyr in candidates]
         name, ok = QInputDialog.getItem(self, translate("GcpDock", "Import ground control"),
@@ -97,7 +98,7 @@ class GcpImportExport:
         for need in ("name", "image", "px", "py"):
             if need not in lower:
                 self.message(translate("GcpDock", "Layer {} lacks the field '{}' (needs name, image, px, py)").format(
-                    layer.name(), need), Qgis.Critical)
+                    layer.name(), need), Qgis.MessageLevel.Critical)
                 return None
         rows = []
         for feat in layer.getFeatures():
@@ -117,7 +118,7 @@ class GcpImportExport:
                                        image_names=[im["name"] for im in self.store.images()] or None,
                                        image_sizes=self.store.image_sizes() or None, unknown_images="warn")
         except (gcpmod.GCPError, ValueError) as e:
-            self.message(str(e), Qgis.Critical)
+            self.message(str(e), Qgis.MessageLevel.Critical)
             return None
         return self._import(gs, layer.name(), merge)
 
@@ -135,12 +136,12 @@ class GcpImportExport:
         gs = self.store.usable_gcps()
         if not gs.crs:
             self.message(translate("GcpDock", "The points have no CRS yet: pick one on the map or import a file first"),
-                         Qgis.Warning)
+                         Qgis.MessageLevel.Warning)
             return None
         try:
             gcpmod.write_gcps(gs, path)
         except (gcpmod.GCPError, OSError) as e:
-            self.message(str(e), Qgis.Critical)
+            self.message(str(e), Qgis.MessageLevel.Critical)
             return None
         left = len(self.store.gcps.points) - len(gs.points)
         self.message(translate("GcpDock", "Exported {} points to {}").format(len(gs.points), path)
@@ -178,8 +179,8 @@ class GcpImportExport:
         opts.driverName = "GPKG"
         opts.layerName = "gcp_observations"
         res = QgsVectorFileWriter.writeAsVectorFormatV2(mem, path, QgsProject.instance().transformContext(), opts)
-        if res[0] != QgsVectorFileWriter.NoError:
-            self.message(translate("GcpDock", "Cannot write {}: {}").format(path, res[1]), Qgis.Critical)
+        if res[0] != QgsVectorFileWriter.WriterError.NoError:
+            self.message(translate("GcpDock", "Cannot write {}: {}").format(path, res[1]), Qgis.MessageLevel.Critical)
             return None
         skipped = [p.name for p in gs.points if not p.observations]
         self.message(translate("GcpDock", "Exported {} observations to {}").format(len(feats), path)
@@ -188,5 +189,6 @@ class GcpImportExport:
         if add_to_project:
             added = QgsProject.instance().addMapLayer(QgsVectorLayer(path, translate("GcpDock", "GCP observations"), "ogr"))
             if added is None:
-                self.message(translate("GcpDock", "Cannot add {} to the project").format(path), Qgis.Warning)
+                self.message(translate("GcpDock", "Cannot add {} to the project").format(path),
+                             Qgis.MessageLevel.Warning)
         return path

@@ -108,7 +108,7 @@ class GcpPlacement:
                 name, p.x(), p.y(), z, dsm.name()))
         elif dsm is not None:
             self.message(translate("GcpDock", "{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was").format(
-                name, p.x(), p.y(), dsm.name()), Qgis.Warning)
+                name, p.x(), p.y(), dsm.name()), Qgis.MessageLevel.Warning)
         else:
             self.message(translate("GcpDock", "{}: X {:.3f}, Y {:.3f}").format(name, p.x(), p.y()))
         return name
@@ -150,7 +150,7 @@ class GcpPlacement:
                 preds = self.predictor.predict_point(point, margin=slack)
             self.predictions = preds
         except Exception as e:  # noqa: BLE001 - degenerate geometry: no predictions, say why
-            self.message(translate("GcpDock", "no predicted positions: {}").format(e), Qgis.Warning)
+            self.message(translate("GcpDock", "no predicted positions: {}").format(e), Qgis.MessageLevel.Warning)
             self.predictions = {}
 
     def _gray_image(self, name):
@@ -279,7 +279,7 @@ class GcpPlacement:
     def place_observation(self, image, x, y):
         name = self.current_name()
         if name is None:
-            self.message(translate("GcpDock", "Select or add a ground point first"), Qgis.Warning)
+            self.message(translate("GcpDock", "Select or add a ground point first"), Qgis.MessageLevel.Warning)
             return
         self.store.set_observation(name, image, x, y)
 

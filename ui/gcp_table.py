@@ -109,7 +109,7 @@ class GcpTableModel(QAbstractTableModel):
             if col == PX:
                 px = [o.get("px") for o in r.get("observations", []) if o.get("px") is not None]
                 return fmt(sum(px) / len(px), 2) if px else "\u2014"
-        if role == Qt.BackgroundRole and col in (NAME, DXY, DZ, PX):
+        if role == Qt.ItemDataRole.BackgroundRole and col in (NAME, DXY, DZ, PX):
             colour, _ = self.quality(p.name)
             return colour
         if role == Qt.ItemDataRole.ToolTipRole:
@@ -124,16 +124,16 @@ class GcpTableModel(QAbstractTableModel):
             f = QFont()
             f.setItalic(True)
             return f
-        if role == Qt.ForegroundRole and p.name in self.store.stale and col in (DXY, DZ, PX):
+        if role == Qt.ItemDataRole.ForegroundRole and p.name in self.store.stale and col in (DXY, DZ, PX):
             return QColor("#777777")
         if role == Qt.ItemDataRole.TextAlignmentRole and col not in (NAME, ROLE):
-            return int(Qt.AlignRight | Qt.AlignVCenter)
+            return int(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
         return None
 
     def flags(self, index):
         f = super().flags(index)
         if index.isValid() and index.column() in EDITABLE:
-            f |= Qt.ItemIsEditable
+            f |= Qt.ItemFlag.ItemIsEditable
         return f
 
     def setData(self, index, value, role=Qt.ItemDataRole.EditRole):  # noqa: N802 (Qt API)
@@ -156,7 +156,7 @@ class GcpTableModel(QAbstractTableModel):
             elif col == ROLE:
                 self.store.set_point(p.name, role=gcpmod.CHECK if value == gcpmod.CHECK else gcpmod.CONTROL)
         except ValueError as e:
-            self.dock.message(str(e), Qgis.Warning)
+            self.dock.message(str(e), Qgis.MessageLevel.Warning)
             return False
         return True
 

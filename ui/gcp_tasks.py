@@ -47,7 +47,7 @@ class GcpTasks:
     # ------------------------------------------------------------------ adjustment
     def _busy(self):
         if self.task is not None:
-            self.message(translate("GcpDock", "A task of this dock is still running"), Qgis.Warning)
+            self.message(translate("GcpDock", "A task of this dock is still running"), Qgis.MessageLevel.Warning)
             return True
         return False
 
@@ -70,9 +70,9 @@ class GcpTasks:
         self.last_task_error = message
         self.progress.setValue(0)
         if cancelled:
-            self.message(translate("GcpDock", "Cancelled"), Qgis.Info)
+            self.message(translate("GcpDock", "Cancelled"), Qgis.MessageLevel.Info)
         else:
-            self.message(message, Qgis.Critical)
+            self.message(message, Qgis.MessageLevel.Critical)
         self.store.reload_workspace()
 
     def cancel_task(self):
@@ -87,13 +87,14 @@ class GcpTasks:
         if self.store.workspace is None or self._busy():
             return None
         if not self.store.stage_done(ALIGN):
-            self.message(translate("GcpDock", "The block is not aligned yet: run Align images first"), Qgis.Warning)
+            self.message(translate("GcpDock", "The block is not aligned yet: run Align images first"),
+                         Qgis.MessageLevel.Warning)
             return None
         gs = self.store.usable_gcps()
         n_control = sum(1 for p in gs.points if p.role == gcpmod.CONTROL and len(p.observations) >= 1)
         if n_control < 3:
             self.message(translate("GcpDock", "The adjustment needs at least 3 control points with coordinates and "
-                                 "observations; there are {}").format(n_control), Qgis.Warning)
+                                 "observations; there are {}").format(n_control), Qgis.MessageLevel.Warning)
             return None
         root = self.store.root
 
@@ -110,7 +111,7 @@ class GcpTasks:
             if result.outliers:
                 extra = " " + translate("GcpDock", "Outliers left out: {}").format("; ".join(result.outliers))
             self.message(translate("GcpDock", "Georeferenced in {}.").format(short_crs(result.crs)) + extra,
-                         Qgis.Warning if result.outliers else Qgis.Success)
+                         Qgis.MessageLevel.Warning if result.outliers else Qgis.MessageLevel.Success)
 
         task = CoreTask(translate("GcpDock", "ArchaeoOrtho: georeference"), pipeline.georeference_workspace, (root,),
                         {"gcps": gs, "refine_intrinsics": self.refine_box.isChecked()},

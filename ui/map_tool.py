@@ -14,7 +14,7 @@ class GcpMapTool(QgsMapToolEmitPoint):
 
     def __init__(self, canvas):
         super().__init__(canvas)
-        self.setCursor(Qt.CrossCursor)
+        self.setCursor(Qt.CursorShape.CrossCursor)
 
     def canvasReleaseEvent(self, event):  # noqa: N802 (Qt API name)
         if event.button() != Qt.MouseButton.LeftButton:
@@ -23,7 +23,7 @@ class GcpMapTool(QgsMapToolEmitPoint):
         self.picked.emit(QgsPointXY(point))
 
     def keyPressEvent(self, event):  # noqa: N802 (Qt API name)
-        if event.key() == Qt.Key_Escape:
+        if event.key() == Qt.Key.Key_Escape:
             self.escaped.emit()
             event.accept()
             return
@@ -48,7 +48,8 @@ class GcpMarkers:
         for name, p in points.items():
             m = QgsVertexMarker(self.canvas)
             m.setCenter(p)
-            m.setIconType(QgsVertexMarker.ICON_CROSS if name != selected else QgsVertexMarker.ICON_CIRCLE)
+            icons = QgsVertexMarker.IconType
+            m.setIconType(icons.ICON_CROSS if name != selected else icons.ICON_CIRCLE)
             m.setColor(QColor("#d7191c") if name == selected else QColor("#2b83ba"))
             m.setIconSize(16 if name == selected else 10)
             m.setPenWidth(3 if name == selected else 2)

@@ -48,15 +48,17 @@ class ImagePyramid:
         image = reader.read()
         if image.isNull():
             raise OSError(f"cannot read {path}: {reader.errorString()}")
-        if image.format() not in (QImage.Format_RGB32, QImage.Format_ARGB32, QImage.Format_ARGB32_Premultiplied):
-            image = image.convertToFormat(QImage.Format_RGB32)
+        if image.format() not in (QImage.Format.Format_RGB32, QImage.Format.Format_ARGB32,
+                                  QImage.Format.Format_ARGB32_Premultiplied):
+            image = image.convertToFormat(QImage.Format.Format_RGB32)
         self.path = path
         self.width, self.height = image.width(), image.height()
         self.levels = [image]
         while max(self.levels[-1].width(), self.levels[-1].height()) > TILE:
             prev = self.levels[-1]
             self.levels.append(prev.scaled(max(1, prev.width() // 2), max(1, prev.height() // 2),
-                                           Qt.AspectRatioMode.IgnoreAspectRatio, Qt.SmoothTransformation))
+                                           Qt.AspectRatioMode.IgnoreAspectRatio,
+                                           Qt.TransformationMode.SmoothTransformation))
         self._tiles = OrderedDict()
         self._max = max_cached_tiles
         self.tiles_made = 0
@@ -89,7 +91,8 @@ class ImagePyramid:
         return pm
 
     def thumbnail(self, size=THUMB):
-        return QPixmap.fromImage(self.levels[-1].scaled(size, Qt.AspectRatioMode.KeepAspectRatio, Qt.SmoothTransformation))
+        return QPixmap.fromImage(self.levels[-1].scaled(size, Qt.AspectRatioMode.KeepAspectRatio,
+                                                        Qt.TransformationMode.SmoothTransformation))
 
 
 def read_thumbnail(path, size=THUMB):
@@ -110,7 +113,7 @@ def read_thumbnail(path, size=THUMB):
 class ThumbStrip(QListWidget):
     """A one-row strip of thumbnails that only ever scrolls sideways."""
 
-    def scrollTo(self, index, hint=QListWidget.EnsureVisible):  # noqa: N802 (Qt API name)
+    def scrollTo(self, index, hint=QListWidget.ScrollHint.EnsureVisible):  # noqa: N802 (Qt API name)
         super().scrollTo(index, hint)
         self.verticalScrollBar().setValue(0)
 
@@ -125,7 +128,7 @@ class PyramidItem(QGraphicsItem):
     def __init__(self, pyramid):
         super().__init__()
         self.pyramid = pyramid
-        self.setFlag(QGraphicsItem.ItemUsesExtendedStyleOption, True)
+        self.setFlag(QGraphicsItem.GraphicsItemFlag.ItemUsesExtendedStyleOption, True)
         self.setZValue(-1)
         self.last_level = None
 
@@ -141,7 +144,7 @@ class PyramidItem(QGraphicsItem):
         exposed = option.exposedRect.intersected(self.boundingRect())
         if exposed.isEmpty():
             return
-        painter.setRenderHint(QPainter.SmoothPixmapTransform, lod < 1.0)
+        painter.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform, lod < 1.0)
         x0 = max(int(exposed.left() / sx) // TILE, 0)
         y0 = max(int(exposed.top() / sy) // TILE, 0)
         x1 = min(int(math.ceil(exposed.right() / sx)) // TILE, (im.width() - 1) // TILE)
@@ -164,10 +167,10 @@ class MarkerItem(QGraphicsObject):
         self.label = label
         self.predicted = predicted
         self.colour = QColor(colour)
-        self.setFlag(QGraphicsItem.ItemIgnoresTransformations, True)
-        self.setFlag(QGraphicsItem.ItemIsMovable, True)
-        self.setFlag(QGraphicsItem.ItemSendsGeometryChanges, True)
-        self.setCursor(Qt.SizeAllCursor)
+        self.setFlag(QGraphicsItem.GraphicsItemFlag.ItemIgnoresTransformations, True)
+        self.setFlag(QGraphicsItem.GraphicsItemFlag.ItemIsMovable, True)
+        self.setFlag(QGraphicsItem.GraphicsItemFlag.ItemSendsGeometryChanges, True)
+        self.setCursor(Qt.CursorShape.SizeAllCursor)
         self.setZValue(10)
         self._press = None
 
@@ -182,12 +185,12 @@ class MarkerItem(QGraphicsObject):
         return path
 
     def paint(self, painter, option, widget=None):
-        painter.setRenderHint(QPainter.Antialiasing, True)
+        painter.setRenderHint(QPainter.RenderHint.Antialiasing, True)
         halo = QPen(QColor(255, 255, 255, 200), 4)
-        pen = QPen(self.colour, 2, Qt.DashLine if self.predicted else Qt.SolidLine)
+        pen = QPen(self.colour, 2, Qt.PenStyle.DashLine if self.predicted else Qt.PenStyle.SolidLine)
         for p in (halo, pen):
             painter.setPen(p)
-            painter.setBrush(Qt.NoBrush)
+            painter.setBrush(Qt.BrushStyle.NoBrush)
             painter.drawEllipse(QRectF(-10, -10, 20, 20))
             if not self.predicted:
                 painter.drawLine(QPointF(-14, 0), QPointF(-3, 0))
@@ -238,9 +241,9 @@ class PhotoView(QGraphicsView):
     def __init__(self, parent=None):
         super().__init__(parent)
         self.setScene(QGraphicsScene(self))
-        self.setTransformationAnchor(QGraphicsView.AnchorUnderMouse)
-        self.setResizeAnchor(QGraphicsView.AnchorViewCenter)
-        self.setViewportUpdateMode(QGraphicsView.SmartViewportUpdate)
+        self.setTransformationAnchor(QGraphicsView.ViewportAnchor.AnchorUnderMouse)
+        self.setResizeAnchor(QGraphicsView.ViewportAnchor.AnchorViewCenter)
+        self.setViewportUpdateMode(QGraphicsView.ViewportUpdateMode.SmartViewportUpdate)
         self.setBackgroundBrush(QBrush(QColor("#2b2b2b")))
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self.setMouseTracking(True)
@@ -309,7 +312,7 @@ class PhotoView(QGraphicsView):
 
     def mousePressEvent(self, event):  # noqa: N802 (Qt API name)
         self.setFocus()
-        if event.button() in (Qt.MiddleButton, Qt.MouseButton.RightButton):
+        if event.button() in (Qt.MouseButton.MiddleButton, Qt.MouseButton.RightButton):
             self._pan_from = event.pos()
             self._panning = True
             event.accept()
@@ -352,21 +355,21 @@ class PhotoView(QGraphicsView):
 
     def keyPressEvent(self, event):  # noqa: N802 (Qt API name)
         key = event.key()
-        if key in (Qt.Key_Delete, Qt.Key_Backspace):
+        if key in (Qt.Key.Key_Delete, Qt.Key.Key_Backspace):
             self.deleteRequested.emit()
-        elif key in (Qt.Key_Return, Qt.Key_Enter):
+        elif key in (Qt.Key.Key_Return, Qt.Key.Key_Enter):
             self.nextRequested.emit()
-        elif key == Qt.Key_Space:
+        elif key == Qt.Key.Key_Space:
             self.confirmRequested.emit()
-        elif key in (Qt.Key_Plus, Qt.Key_Equal):
+        elif key in (Qt.Key.Key_Plus, Qt.Key.Key_Equal):
             self._fit_mode = False
             self.scale(1.25, 1.25)
-        elif key == Qt.Key_Minus:
+        elif key == Qt.Key.Key_Minus:
             self._fit_mode = False
             self.scale(0.8, 0.8)
-        elif key == Qt.Key_F:
+        elif key == Qt.Key.Key_F:
             self.fit()
-        elif key == Qt.Key_Z:
+        elif key == Qt.Key.Key_Z:
             self.zoomToPointRequested.emit()
         else:
             super().keyPressEvent(event)
@@ -405,10 +408,10 @@ class PhotoPanel(QWidget):
         self.hint.setWordWrap(True)
         self.view = PhotoView(self)
         self.thumbs = ThumbStrip(self)
-        self.thumbs.setViewMode(QListView.IconMode)
-        self.thumbs.setFlow(QListView.LeftToRight)
+        self.thumbs.setViewMode(QListView.ViewMode.IconMode)
+        self.thumbs.setFlow(QListView.Flow.LeftToRight)
         self.thumbs.setWrapping(False)
-        self.thumbs.setMovement(QListView.Static)
+        self.thumbs.setMovement(QListView.Movement.Static)
         self.thumbs.setIconSize(THUMB)
         self.thumbs.setGridSize(QSize(THUMB.width() + 20, THUMB.height() + 42))
         self.thumbs.setUniformItemSizes(True)
@@ -519,9 +522,9 @@ class PhotoPanel(QWidget):
         self._thumb_queue = []
         for n in names:
             item = QListWidgetItem(n + (f"\n{marks[n]}" if marks.get(n) else ""))
-            item.setData(Qt.UserRole, n)
+            item.setData(Qt.ItemDataRole.UserRole, n)
             item.setToolTip(n)
-            item.setTextAlignment(Qt.AlignHCenter)
+            item.setTextAlignment(Qt.AlignmentFlag.AlignHCenter)
             if n in self._thumbs:
                 item.setIcon(self._thumbs[n])
             else:
@@ -541,7 +544,7 @@ class PhotoPanel(QWidget):
         return self._blank
 
     def thumbnail_names(self):
-        return [self.thumbs.item(i).data(Qt.UserRole) for i in range(self.thumbs.count())]
+        return [self.thumbs.item(i).data(Qt.ItemDataRole.UserRole) for i in range(self.thumbs.count())]
 
     def _load_some_thumbs(self, count=4):
         for _ in range(count):
@@ -555,7 +558,7 @@ class PhotoPanel(QWidget):
             self._thumbs[n] = icon
             for i in range(self.thumbs.count()):
                 it = self.thumbs.item(i)
-                if it.data(Qt.UserRole) == n:
+                if it.data(Qt.ItemDataRole.UserRole) == n:
                     it.setIcon(icon)
 
     def load_all_thumbnails(self):
@@ -565,7 +568,7 @@ class PhotoPanel(QWidget):
     def _select_thumb(self, name):
         self.thumbs.blockSignals(True)
         for i in range(self.thumbs.count()):
-            if self.thumbs.item(i).data(Qt.UserRole) == name:
+            if self.thumbs.item(i).data(Qt.ItemDataRole.UserRole) == name:
                 self.thumbs.setCurrentRow(i)
                 self.thumbs.scrollToItem(self.thumbs.item(i))
                 break
@@ -576,7 +579,7 @@ class PhotoPanel(QWidget):
     def _thumb_changed(self, current, previous):
         del previous
         if current is not None:
-            self.photoSelected.emit(current.data(Qt.UserRole))
+            self.photoSelected.emit(current.data(Qt.ItemDataRole.UserRole))
 
     # --- markers
     def set_markers(self, point_name, observation=None, prediction=None, prediction_source=""):

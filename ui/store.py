@@ -6,7 +6,11 @@ import math
 import os
 
 from qgis.PyQt.QtCore import QCoreApplication, QObject, pyqtSignal
-from qgis.PyQt.QtWidgets import QUndoCommand, QUndoStack
+
+try:  # Qt6 moved the undo framework to QtGui
+    from qgis.PyQt.QtGui import QUndoCommand, QUndoStack
+except ImportError:
+    from qgis.PyQt.QtWidgets import QUndoCommand, QUndoStack
 
 from ..core.io import gcp as gcpmod
 from ..core.project.layout import Layout

@@ -23,11 +23,11 @@ class TaskProgress:
 
     def info(self, message):
         self.messages.append(("info", message))
-        QgsMessageLog.logMessage(message, "ArchaeoOrtho", Qgis.Info)
+        QgsMessageLog.logMessage(message, "ArchaeoOrtho", Qgis.MessageLevel.Info)
 
     def warning(self, message):
         self.messages.append(("warning", message))
-        QgsMessageLog.logMessage(message, "ArchaeoOrtho", Qgis.Warning)
+        QgsMessageLog.logMessage(message, "ArchaeoOrtho", Qgis.MessageLevel.Warning)
 
 
 class CoreTask(QgsTask):
@@ -39,7 +39,7 @@ class CoreTask(QgsTask):
     message = pyqtSignal(str)
 
     def __init__(self, description, fn, args=(), kwargs=None, on_done=None, on_error=None):
-        super().__init__(description, QgsTask.CanCancel)
+        super().__init__(description, QgsTask.Flag.CanCancel)
         self.fn = fn
         self.args = tuple(args)
         self.kwargs = dict(kwargs or {})
@@ -78,7 +78,7 @@ class CoreTask(QgsTask):
             elif not ok and self.on_error is not None:
                 self.on_error(self.error or "cancelled", self.was_cancelled)
         except RuntimeError as e:  # the dock was closed (plugin unloaded) while the task ran
-            QgsMessageLog.logMessage(f"{self.description()}: {e}", "ArchaeoOrtho", Qgis.Warning)
+            QgsMessageLog.logMessage(f"{self.description()}: {e}", "ArchaeoOrtho", Qgis.MessageLevel.Warning)
         except Exception as e:  # noqa: BLE001 - an exception escaping a C++ virtual would abort QGIS
             log_traceback(self.description(), e)
             _tell_user(self.description(), e)
@@ -87,7 +87,7 @@ class CoreTask(QgsTask):
 def log_traceback(what, error):
     """The full traceback of an unexpected exception in QGIS's message log (tab ArchaeoOrtho)."""
     text = "".join(traceback.format_exception(type(error), error, error.__traceback__))
-    QgsMessageLog.logMessage(f"{what}: {text}", "ArchaeoOrtho", Qgis.Critical)
+    QgsMessageLog.logMessage(f"{what}: {text}", "ArchaeoOrtho", Qgis.MessageLevel.Critical)
 
 
 def _tell_user(what, error):
