@@ -21,10 +21,10 @@ export QGIS_PLUGINPATH := $(PLUGINS)
 PROCESS_ENV = PYTHONPATH="$$($(PY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])'):$$PYTHONPATH" \
               QGIS_CUSTOM_CONFIG_PATH=$(QGIS_CONFIG) QGIS_PLUGINPATH=$(PLUGINS) QT_QPA_PLATFORM=offscreen
 
-.PHONY: help setup apt venv plugin-link demo test process package lint transup transcompile bench clean
+.PHONY: help setup apt venv plugin-link demo test test-qgis340 process package lint transup transcompile bench clean FORCE
 
 help:
-	@echo "make setup | demo | test [PYTEST_ARGS=...] | process ARGS='...' | package | lint | transup | transcompile | bench"
+	@echo "make setup | demo | test [PYTEST_ARGS=...] | test-qgis340 [PYTEST_ARGS=...] | process ARGS='...' | package | lint | transup | transcompile | bench"
 
 apt: $(BUILD)/.apt-stamp
 $(BUILD)/.apt-stamp: Makefile
@@ -36,14 +36,22 @@ $(BUILD)/.apt-stamp: Makefile
 	fi
 	@touch $@
 
+# The venv keeps the system NumPy, whatever its major version (1.24 on Debian 12, 2.x on Debian 13): the system
+# GDAL/QGIS bindings are built against it.  Every pip install gets this constraints file, so nothing replaces it.
+CONSTRAINTS := $(BUILD)/constraints.txt
+$(CONSTRAINTS): $(BUILD)/.apt-stamp FORCE
+	@$(SYSPY) -c "import numpy; print('numpy==' + numpy.__version__)" >$@.new
+	@cmp -s $@.new $@ && rm -f $@.new || mv -f $@.new $@
+
 venv: $(VENV)/.stamp
-$(VENV)/.stamp: requirements.txt requirements-dev.txt $(BUILD)/.apt-stamp
+$(VENV)/.stamp: requirements.txt requirements-dev.txt $(CONSTRAINTS)
 	@test -x $(PY) || $(SYSPY) -m venv --system-site-packages $(VENV)
-	@echo "Installing Python packages into $(VENV)" >&2
-	@$(PY) -m pip install -q --disable-pip-version-check -r requirements-dev.txt >&2
+	@echo "Installing Python packages into $(VENV) ($$(cat $(CONSTRAINTS)))" >&2
+	@$(PY) -m pip install -q --disable-pip-version-check -c $(CONSTRAINTS) -r requirements-dev.txt >&2
 	@$(PY) -c "import numpy, pycolmap, cv2; from osgeo import gdal_array; import qgis.core; \
-	  assert numpy.__version__.startswith('1.'), numpy.__version__; \
-	  print('venv ok: numpy', numpy.__version__, 'pycolmap', pycolmap.__version__, 'cv2', cv2.__version__)" >&2
+	  assert 'numpy==' + numpy.__version__ == '$$(cat $(CONSTRAINTS))', numpy.__file__; \
+	  print('venv ok: numpy', numpy.__version__, 'pycolmap', pycolmap.__version__, 'cv2', cv2.__version__, \
+	        'qgis', qgis.core.Qgis.QGIS_VERSION)" >&2
 	@touch $@
 
 plugin-link: $(PLUGINS)/archaeoortho
@@ -62,6 +70,10 @@ process: setup
 
 test: setup
 	QGIS_PROCESS=$(QGIS_PROCESS) QGIS_CUSTOM_CONFIG_PATH=$(QGIS_CONFIG) $(PY) -m pytest $(PYTEST_ARGS)
+
+# The same `make test` on QGIS 3.40 / Python 3.13 / NumPy 2 in a cached Debian 13 chroot (root or sudo; see the script)
+test-qgis340:
+	APT_PACKAGES="$(APT_PACKAGES)" PYTEST_ARGS="$(PYTEST_ARGS)" ci/qgis340.sh
 
 demo: setup
 	$(PY) sample/demo.py --qgis-process "$(QGIS_PROCESS)" --build $(BUILD)
@@ -83,7 +95,7 @@ transcompile: apt
 
 package: transcompile
 	@rm -rf $(BUILD)/package && mkdir -p $(BUILD)/package/archaeoortho dist
-	@git ls-files -co --exclude-standard | grep -vE '^(tests/|benchmarks/|sample/|docs/|\.ci/|\.git|\.flake8|Makefile|requirements-dev|pytest\.ini|ruff\.toml|setup\.cfg)' \
+	@git ls-files -co --exclude-standard | grep -vE '^(tests/|benchmarks/|sample/|docs/|ci/|\.ci/|\.git|\.flake8|Makefile|requirements-dev|pytest\.ini|ruff\.toml|setup\.cfg)' \
 	  | while read f; do [ -f "$$f" ] && install -D -m 644 "$$f" "$(BUILD)/package/archaeoortho/$$f"; done
 	@cp i18n/*.qm $(BUILD)/package/archaeoortho/i18n/ 2>/dev/null || true
 	@cd $(BUILD)/package && rm -f $(ROOT)/dist/archaeoortho.zip && zip -qr $(ROOT)/dist/archaeoortho.zip archaeoortho

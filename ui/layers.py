@@ -8,6 +8,7 @@ import math
 import os
 
 from qgis.core import (
+    Qgis,
     QgsArrowSymbolLayer,
     QgsCategorizedSymbolRenderer,
     QgsColorRampShader,
@@ -177,6 +178,12 @@ def style_orthomosaic(layer):
 # --------------------------------------------------------------------------------------------------
 
 
+# QGIS >= 3.26: the placement is Qgis.LabelPlacement (QgsPalLayerSettings.OverPoint then names a
+# LabelPredefinedPointPosition, which the placement setter refuses); 3.22 has only QgsPalLayerSettings.OverPoint.
+_OVER_POINT = (Qgis.LabelPlacement.OverPoint if hasattr(Qgis, "LabelPlacement")
+               else QgsPalLayerSettings.OverPoint)
+
+
 def _labels(layer, expression, size=8.0, colour="#202020", is_expression=True, offset=2.0):
     fmt = QgsTextFormat()
     font = QFont()
@@ -194,7 +201,7 @@ def _labels(layer, expression, size=8.0, colour="#202020", is_expression=True, o
     settings.isExpression = is_expression
     settings.setFormat(fmt)
     settings.dist = offset
-    settings.placement = QgsPalLayerSettings.OverPoint if layer.geometryType() == 0 else settings.placement
+    settings.placement = _OVER_POINT if layer.geometryType() == 0 else settings.placement
     if layer.geometryType() == 0:
         settings.quadOffset = QgsPalLayerSettings.QuadrantAboveRight
     layer.setLabeling(QgsVectorLayerSimpleLabeling(settings))

@@ -1,0 +1,150 @@
+#!/usr/bin/env bash
+# The QGIS 3.40 test leg: runs this repository's `make test` inside a Debian 13 (trixie) chroot, which has
+# QGIS 3.40, Python 3.13 and NumPy 2.x (the host leg is Debian 12: QGIS 3.22, Python 3.11, NumPy 1.24).
+#
+#   make test-qgis340 [PYTEST_ARGS=...]          (or: APT_PACKAGES="..." ci/qgis340.sh)
+#
+# The chroot is cached OUTSIDE the repository (CI clones afresh every run) at $QGIS340_CHROOT
+# (default /var/cache/archaeoortho/trixie) and rebuilt when missing or when its package list changed
+# (debootstrap + apt-get: about 6 minutes).  Each run bind-mounts the repository at /ao/repo and ../shared
+# read-only at /ao/shared (the tests look for ../shared/data), plus /proc /dev /sys, and unmounts them on exit,
+# also on failure.  Inside, `make test` keeps its venv and QGIS profile under build/qgis340/, apart from the
+# host's .venv and build/.
+set -euo pipefail
+
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+CHROOT=${QGIS340_CHROOT:-/var/cache/archaeoortho/trixie}
+SUITE=${QGIS340_SUITE:-trixie}
+MIRROR=${DEBIAN_MIRROR:-http://deb.debian.org/debian}
+SHARED=$(dirname "$ROOT")/shared
+PYTEST_ARGS=${PYTEST_ARGS:-}
+: "${APT_PACKAGES:?set APT_PACKAGES to the apt list of the Makefile, as make test-qgis340 does}"
+
+if [ "$(id -u)" != 0 ]; then
+  exec sudo APT_PACKAGES="$APT_PACKAGES" PYTEST_ARGS="$PYTEST_ARGS" QGIS340_CHROOT="$CHROOT" \
+    QGIS340_SUITE="$SUITE" DEBIAN_MIRROR="$MIRROR" "${BASH_SOURCE[0]}" "$@"
+fi
+
+log() { echo "qgis340: $*" >&2; }
+
+# Every mount point at or below $1, deepest first (read from /proc/self/mounts; octal escapes kept as is).
+mounts_under() {
+  awk -v d="$1" '$2 == d || index($2, d "/") == 1 { print $2 }' /proc/self/mounts | sort -r
+}
+
+unmount_all() {
+  local m
+  for m in $(mounts_under "$1"); do
+    umount "$m" 2>/dev/null || umount -l "$m" || true
+  done
+  if [ -n "$(mounts_under "$1")" ]; then
+    log "still mounted under $1:"; mounts_under "$1" >&2
+    return 1
+  fi
+}
+
+# Remove a chroot directory, but never while anything (the repository!) is still mounted inside it.
+remove_tree() {
+  [ -e "$1" ] || return 0
+  unmount_all "$1" || { log "refusing to remove $1"; exit 1; }
+  rm -rf --one-file-system "$1"
+}
+
+mount_system() {  # /proc /dev /sys into chroot $1
+  mkdir -p "$1/proc" "$1/dev" "$1/sys"
+  mount -t proc proc "$1/proc"
+  mount --rbind /dev "$1/dev" && mount --make-rslave "$1/dev"
+  mount --rbind /sys "$1/sys" && mount --make-rslave "$1/sys"
+}
+
+# The host's network settings and certificate authorities (a TLS-inspecting proxy's CA among them),
+# so that apt and pip inside reach what they reach outside.
+host_config() {  # into chroot $1
+  cp -L /etc/resolv.conf "$1/etc/resolv.conf" 2>/dev/null || true
+  mkdir -p "$1/usr/local/share/ca-certificates"
+  if [ -d /usr/local/share/ca-certificates ]; then
+    cp -rL /usr/local/share/ca-certificates/. "$1/usr/local/share/ca-certificates/"
+  fi
+  if [ -x "$1/usr/sbin/update-ca-certificates" ]; then
+    chroot "$1" update-ca-certificates >/dev/null 2>&1 || log "warning: update-ca-certificates failed"
+  fi
+}
+
+in_chroot() {  # chroot $1, command...: a clean environment plus the proxy/pip/TLS settings of this one
+  local dir=$1; shift
+  local pass=() v
+  for v in http_proxy https_proxy no_proxy HTTP_PROXY HTTPS_PROXY NO_PROXY PIP_INDEX_URL PIP_EXTRA_INDEX_URL \
+           PIP_DEFAULT_TIMEOUT PIP_DISABLE_PIP_VERSION_CHECK; do
+    [ -n "${!v:-}" ] && pass+=("$v=${!v}")
+  done
+  chroot "$dir" /usr/bin/env -i HOME=/root LANG=C.UTF-8 TERM=dumb DEBIAN_FRONTEND=noninteractive \
+    PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
+    SSL_CERT_FILE=/etc/ssl/certs/ca-certificates.crt REQUESTS_CA_BUNDLE=/etc/ssl/certs/ca-certificates.crt \
+    PIP_CERT=/etc/ssl/certs/ca-certificates.crt "${pass[@]}" "$@"
+}
+
+# What the chroot must hold: the Makefile's apt list plus what running make in it needs.
+WANT=$(printf '%s\n' $APT_PACKAGES make git ca-certificates | sort -u)
+STAMP=.archaeoortho-packages
+
+build_chroot() {
+  local new=$CHROOT.new
+  command -v debootstrap >/dev/null || { apt-get update -q && apt-get install -y -q debootstrap; } >&2
+  remove_tree "$new"
+  mkdir -p "$(dirname "$CHROOT")"
+  log "debootstrap $SUITE into $new ($MIRROR)"
+  debootstrap --variant=minbase "$SUITE" "$new" "$MIRROR" >"$CHROOT.debootstrap.log" 2>&1 \
+    || { tail -20 "$CHROOT.debootstrap.log" >&2; remove_tree "$new"; exit 1; }
+  host_config "$new"
+  mount_system "$new"
+  log "apt-get install: $(echo $WANT)"
+  if ! { in_chroot "$new" apt-get update -q && \
+         in_chroot "$new" apt-get install -y -q --no-install-recommends $WANT && \
+         in_chroot "$new" apt-get clean; } >"$CHROOT.apt.log" 2>&1; then
+    tail -30 "$CHROOT.apt.log" >&2; remove_tree "$new"; exit 1
+  fi
+  unmount_all "$new"
+  host_config "$new"
+  echo "$WANT" >"$new/$STAMP"
+  remove_tree "$CHROOT"
+  mv "$new" "$CHROOT"
+}
+
+mkdir -p "$(dirname "$CHROOT")"
+exec 9>"$CHROOT.lock"
+flock 9  # one leg at a time per chroot
+
+cleanup() { unmount_all "$CHROOT" || true; unmount_all "$CHROOT.new" 2>/dev/null || true; }
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+
+start=$SECONDS
+unmount_all "$CHROOT" 2>/dev/null || true  # left over from a killed run
+if [ ! -f "$CHROOT/$STAMP" ] || [ "$(cat "$CHROOT/$STAMP")" != "$WANT" ]; then
+  [ -d "$CHROOT" ] && log "package list changed (or chroot incomplete): rebuilding $CHROOT"
+  build_chroot
+  log "chroot built in $(( (SECONDS - start) / 60 )) min $(( (SECONDS - start) % 60 )) s"
+else
+  log "reusing $CHROOT"
+fi
+
+host_config "$CHROOT"
+mount_system "$CHROOT"
+mkdir -p "$CHROOT/ao/repo" "$CHROOT/ao/shared"
+mount --bind "$ROOT" "$CHROOT/ao/repo"
+if [ -d "$SHARED" ]; then
+  mount --bind "$SHARED" "$CHROOT/ao/shared"
+  mount -o remount,bind,ro "$CHROOT/ao/shared"
+else
+  log "no $SHARED: the tests that need it are skipped"
+fi
+
+log "$(in_chroot "$CHROOT" sh -c 'echo QGIS $(dpkg-query -W -f "\${Version}" qgis), $(python3 -V), NumPy \
+$(python3 -c "import numpy; print(numpy.__version__)")')"
+test_start=$SECONDS
+rc=0
+in_chroot "$CHROOT" make -C /ao/repo test VENV=/ao/repo/build/qgis340/venv BUILD=/ao/repo/build/qgis340 \
+  PYTEST_ARGS="$PYTEST_ARGS" || rc=$?
+log "make test (QGIS 3.40) exited $rc after $(( (SECONDS - test_start) / 60 )) min $(( (SECONDS - test_start) % 60 )) s;" \
+  "whole leg $(( (SECONDS - start) / 60 )) min $(( (SECONDS - start) % 60 )) s"
+exit $rc
