@@ -55,7 +55,11 @@ class ArchaeoOrthoPlugin:
         if self.iface is None:
             return
         from qgis.PyQt.QtGui import QIcon
-        from qgis.PyQt.QtWidgets import QAction
+
+        try:  # Qt6 moved QAction to QtGui
+            from qgis.PyQt.QtGui import QAction
+        except ImportError:
+            from qgis.PyQt.QtWidgets import QAction
 
         self.action = QAction(QIcon(os.path.join(PLUGIN_DIR, "icon.svg")), self.tr("Ground control (GCP dock)"),
                               self.iface.mainWindow())
@@ -79,7 +83,7 @@ class ArchaeoOrthoPlugin:
 
             self.dock = GcpDock(self.iface, parent=self.iface.mainWindow())
             self.iface.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, self.dock)
-            self.iface.addDockWidget(Qt.BottomDockWidgetArea, self.dock.photo_dock)
+            self.iface.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.dock.photo_dock)
             self.dock.visibilityChanged.connect(self._dock_visibility)
         self.dock.setUserVisible(visible)
         self.dock.photo_dock.setUserVisible(visible)

@@ -167,4 +167,4 @@ def report_bug(error, feedback=None):
     if feedback is not None:
         feedback.reportError(text, False)
     else:
-        QgsMessageLog.logMessage(text, "ArchaeoOrtho", Qgis.Critical)
+        QgsMessageLog.logMessage(text, "ArchaeoOrtho", Qgis.MessageLevel.Critical)

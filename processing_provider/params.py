@@ -43,14 +43,14 @@ def add(alg, *params):
 def advanced(*params):
     """The parameters, flagged advanced (folded away in the dialog); returns them as a list."""
     for p in params:
-        p.setFlags(p.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
+        p.setFlags(p.flags() | QgsProcessingParameterDefinition.Flag.FlagAdvanced)
     return list(params)
 
 
 # --- folders ---------------------------------------------------------------------------------------
 def folder(name, label):
     """An existing folder (the images, a workspace made by an earlier stage)."""
-    return QgsProcessingParameterFile(name, label, behavior=QgsProcessingParameterFile.Folder)
+    return QgsProcessingParameterFile(name, label, behavior=QgsProcessingParameterFile.Behavior.Folder)
 
 
 def workspace_destination(name, label):
@@ -60,12 +60,12 @@ def workspace_destination(name, label):
 
 # --- numbers and flags -------------------------------------------------------------------------------
 def integer(name, label, default=0, minimum=0):
-    return QgsProcessingParameterNumber(name, label, type=QgsProcessingParameterNumber.Integer,
+    return QgsProcessingParameterNumber(name, label, type=QgsProcessingParameterNumber.Type.Integer,
                                         defaultValue=default, minValue=minimum)
 
 
 def number(name, label, default=0.0, minimum=0.0, **kwargs):
-    return QgsProcessingParameterNumber(name, label, type=QgsProcessingParameterNumber.Double,
+    return QgsProcessingParameterNumber(name, label, type=QgsProcessingParameterNumber.Type.Double,
                                         defaultValue=default, minValue=minimum, **kwargs)
 
 
@@ -101,7 +101,7 @@ def gcp_file(name, label):
 
 
 def gcp_layer(name, label):
-    return QgsProcessingParameterFeatureSource(name, label, [QgsProcessing.TypeVectorPoint], optional=True)
+    return QgsProcessingParameterFeatureSource(name, label, [QgsProcessing.SourceType.TypeVectorPoint], optional=True)
 
 
 def check_points(name, label):

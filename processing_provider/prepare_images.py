@@ -85,7 +85,7 @@ class PrepareImagesAlgorithm(AlgorithmBase):
         )
         self.addParameter(QgsProcessingParameterFeatureSource(
             self.MASKS, self.tr("Mask polygons: areas to ignore, in pixel coordinates (optional text field 'image')"),
-            [QgsProcessing.TypeVectorPolygon], optional=True))
+            [QgsProcessing.SourceType.TypeVectorPolygon], optional=True))
         self.addParameter(params.flag(self.SCANNED_FILM, self.tr("Scanned film: fiducial marks, common frame, masks")))
         self.addParameter(QgsProcessingParameterString(
             self.FIDUCIAL_COORDINATES, self.tr("Calibrated fiducial coordinates in mm (file path or text)"),
@@ -181,7 +181,7 @@ class PrepareImagesAlgorithm(AlgorithmBase):
                 if feedback is not None:
                     feedback.pushWarning(self.tr("MASKS layer '{}': {} has no geometry: skipped").format(layer, label))
                 continue
-            if geom.type() != QgsWkbTypes.PolygonGeometry:
+            if geom.type() != QgsWkbTypes.GeometryType.PolygonGeometry:
                 raise QgsProcessingException(self.tr("MASKS layer '{}': {} is a {} geometry, not a polygon").format(
                     layer, label, QgsWkbTypes.displayString(geom.wkbType())))
             if QgsWkbTypes.isCurvedType(geom.wkbType()):

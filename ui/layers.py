@@ -93,7 +93,7 @@ def _band_range(layer, band=1):
     except Exception:  # noqa: BLE001 - fall back to plain statistics
         lo = hi = float("nan")
     if not (math.isfinite(lo) and math.isfinite(hi)) or hi <= lo:
-        stats = provider.bandStatistics(band, QgsRasterBandStats.Min | QgsRasterBandStats.Max, layer.extent(), 250000)
+        stats = provider.bandStatistics(band, QgsRasterBandStats.Stats.Min | QgsRasterBandStats.Stats.Max, layer.extent(), 250000)
         lo, hi = stats.minimumValue, stats.maximumValue
     if not (math.isfinite(lo) and math.isfinite(hi)):
         lo, hi = 0.0, 1.0
@@ -129,7 +129,7 @@ def style_dsm(layer):
     _smooth_resampling(layer)
     lo, hi = _band_range(layer)
     ramp = _elevation_ramp()
-    shader = QgsColorRampShader(lo, hi, ramp, QgsColorRampShader.Interpolated, QgsColorRampShader.Continuous)
+    shader = QgsColorRampShader(lo, hi, ramp, QgsColorRampShader.Type.Interpolated, QgsColorRampShader.ClassificationMode.Continuous)
     shader.classifyColorRamp(5, -1, layer.extent(), layer.dataProvider())
     raster_shader = QgsRasterShader(lo, hi)
     raster_shader.setRasterShaderFunction(shader)
@@ -149,7 +149,7 @@ def style_hillshade(layer):
     renderer.setMultiDirectional(True)
     renderer.setZFactor(1.0)
     layer.setRenderer(renderer)
-    layer.setBlendMode(QgsPainting.getCompositionMode(QgsPainting.BlendMultiply))
+    layer.setBlendMode(QgsPainting.getCompositionMode(QgsPainting.BlendMode.BlendMultiply))
     layer.setOpacity(0.6)
     _mark(layer, HILLSHADE)
     layer.triggerRepaint()
@@ -181,7 +181,7 @@ def style_orthomosaic(layer):
 # QGIS >= 3.26: the placement is Qgis.LabelPlacement (QgsPalLayerSettings.OverPoint then names a
 # LabelPredefinedPointPosition, which the placement setter refuses); 3.22 has only QgsPalLayerSettings.OverPoint.
 _OVER_POINT = (Qgis.LabelPlacement.OverPoint if hasattr(Qgis, "LabelPlacement")
-               else QgsPalLayerSettings.OverPoint)
+               else QgsPalLayerSettings.Placement.OverPoint)
 
 
 def _labels(layer, expression, size=8.0, colour="#202020", is_expression=True, offset=2.0):
@@ -203,7 +203,7 @@ def _labels(layer, expression, size=8.0, colour="#202020", is_expression=True, o
     settings.dist = offset
     settings.placement = _OVER_POINT if layer.geometryType() == 0 else settings.placement
     if layer.geometryType() == 0:
-        settings.quadOffset = QgsPalLayerSettings.QuadrantAboveRight
+        settings.quadOffset = QgsPalLayerSettings.QuadrantPosition.QuadrantAboveRight
     layer.setLabeling(QgsVectorLayerSimpleLabeling(settings))
     layer.setLabelsEnabled(True)
 
@@ -273,7 +273,7 @@ def style_residuals(layer, factor=None):
         gen = QgsGeometryGeneratorSymbolLayer.create({
             "geometryModifier": (f'make_line($geometry, make_point($x + coalesce("dx", 0) * {factor:g}, '
                                  f'$y + coalesce("dy", 0) * {factor:g}))')})
-        gen.setSymbolType(QgsSymbol.Line)
+        gen.setSymbolType(QgsSymbol.SymbolType.Line)
         arrow = QgsArrowSymbolLayer()
         arrow.setIsCurved(False)
         arrow.setIsRepeated(False)
