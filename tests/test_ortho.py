@@ -24,7 +24,8 @@ from core.ortho.orientation import read_orientation
 from core.ortho.single import orthorectify_image
 from core.ortho.stage import build_orthophoto_workspace
 from core.ortho.surface import fill_dsm_gaps
-from core.project.workspace import DONE, Workspace
+from core.project.stages import DONE
+from core.project.workspace import Workspace
 from tests import synthetic as syn
 from tests.workspaces import synthetic_workspace
 

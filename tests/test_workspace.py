@@ -4,16 +4,17 @@ import stat
 
 import pytest
 
+from core.common.files import atomic_output
 from core.project import workspace as wsmod
-from core.project.stages import STAGE_ORDER
-from core.project.workspace import Workspace, WorkspaceError, atomic_output
+from core.project.stages import DONE, STAGE_ORDER
+from core.project.workspace import Workspace, WorkspaceError
 
 
 def test_create_reopen_and_stage_records(tmp_path):
     ws = Workspace.create_or_open(str(tmp_path / "ws"))
     ws.begin_stage("align", {"pairing": "auto"}, {"images": "abc"})
     ws.record_timing("align", "features", 1.25)
-    ws.end_stage("align", wsmod.DONE, outputs={"model": "sfm/model"}, results={"registered": 5})
+    ws.end_stage("align", DONE, outputs={"model": "sfm/model"}, results={"registered": 5})
     again = Workspace.open(str(tmp_path / "ws"))
     rec = again.stage("align")
     assert rec["status"] == "done"
@@ -29,7 +30,7 @@ def test_invalidate_later_stages(tmp_path):
     ws = Workspace.create_or_open(str(tmp_path))
     for s in ("align", "georeference", "dsm"):
         ws.begin_stage(s, {})
-        ws.end_stage(s, wsmod.DONE)
+        ws.end_stage(s, DONE)
     ws.invalidate_after("align", STAGE_ORDER)
     assert ws.stage("align")["status"] == "done"
     assert ws.stage("georeference")["status"] == "stale"

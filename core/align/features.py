@@ -17,10 +17,10 @@ import shutil
 from typing import Dict, List, Optional, Sequence, Tuple
 
 from ..common.cancel import CancelWatcher
+from ..common.files import atomic_output, atomic_write_text, fingerprint
 from ..common.progress import Progress, check_cancel
 from ..io.images import CameraGroup, ImageInfo
 from ..prepare.masks import MaskError, find_mask, mask_file_name, png_size
-from ..project.workspace import atomic_output, atomic_write_text, fingerprint
 from .options import CAMERA_MODELS, EXTRACT_BLOCK, MATCH_BLOCK, UPSAMPLE_BELOW, AlignError, AlignOptions
 
 

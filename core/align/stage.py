@@ -23,12 +23,13 @@ from dataclasses import asdict, dataclass
 from typing import Dict, List, Optional, Sequence, Set, Tuple
 
 from ..common.cancel import load_pycolmap
+from ..common.files import atomic_output, atomic_write_text, fingerprint
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..io.images import CameraGroup, ImageError, ImageInfo, group_cameras, scan_images
 from ..io.vector import write_cameras_gpkg
 from ..project.layout import Layout
 from ..project.stages import ALIGN, run_stage
-from ..project.workspace import Workspace, atomic_output, atomic_write_text, fingerprint
+from ..project.workspace import Workspace
 from .features import extract_features, file_hash, masks_for_colmap, match_pairs, setup_database
 from .mapping import camera_rows, camera_summary, final_bundle_adjustment, run_mapping, verified_partners
 from .options import MAPPERS, MIN_VERIFIED_INLIERS, AlignError, AlignOptions

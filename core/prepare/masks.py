@@ -32,8 +32,8 @@ from typing import Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Uni
 import numpy as np
 
 from ..common.errors import ArchaeoOrthoError, require
+from ..common.files import atomic_output
 from ..io.images import ImageError, list_images
-from ..project.workspace import atomic_output
 
 MASKS_DIR = "masks"
 Y_AXES = ("auto", "down", "up")

@@ -20,18 +20,12 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from ..common.files import atomic_output, atomic_write_text, file_fingerprint, fingerprint
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..io.images import list_images, read_image_info
 from ..project.layout import SCREENING_JSON, Layout
 from ..project.stages import PREPARE, run_stage
-from ..project.workspace import (
-    Workspace,
-    WorkspaceError,
-    atomic_output,
-    atomic_write_text,
-    file_fingerprint,
-    fingerprint,
-)
+from ..project.workspace import Workspace, WorkspaceError
 from . import masks as masksmod
 from . import scans
 from .options import PrepareOptions, ScanOptions

@@ -17,8 +17,9 @@ import os
 from typing import Any, Dict, Optional, Tuple
 
 from ..common.errors import ArchaeoOrthoError, require
+from ..common.files import atomic_write_text
 from .stages import ALIGN, DSM, GEOREFERENCE
-from .workspace import Workspace, atomic_write_text
+from .workspace import Workspace
 
 # folder and file names inside a workspace (the workspace format: changing one breaks old workspaces)
 MANIFEST = "workspace.json"
@@ -240,7 +241,7 @@ class Layout:
     def model_fingerprints(self, model_dir: Optional[str] = None, prefix: str = "model/") -> Dict[str, str]:
         """Fingerprints of a model's .bin files (what a stage built on it records as inputs), keyed
         ``prefix`` + file name (the DSM stage records bare names: prefix "")."""
-        from .workspace import file_fingerprint
+        from ..common.files import file_fingerprint
 
         model_dir = model_dir or self.georef_model_dir
         return {prefix + n: file_fingerprint(os.path.join(model_dir, n))

@@ -18,11 +18,9 @@ import tempfile
 import time
 from typing import Any, Dict, List, Optional
 
-# the atomic file helpers live in common.files, the status values and stage order in project.stages;
-# both are re-exported here for the stages that import them with the Workspace
 from ..common.errors import ArchaeoOrthoError
-from ..common.files import atomic_output, atomic_write_text, file_fingerprint, fingerprint  # noqa: F401
-from .stages import CANCELLED, DONE, FAILED, PENDING, RUNNING, STAGE_ORDER, STALE  # noqa: F401
+from ..common.files import atomic_write_text
+from .stages import DONE, PENDING, RUNNING, STAGE_ORDER, STALE
 
 FORMAT_VERSION = 1
 MANIFEST = "workspace.json"

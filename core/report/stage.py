@@ -31,10 +31,11 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
 
+from ..common.files import atomic_output
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..project.layout import REPORT_HTML, Layout
 from ..project.stages import REPORT, run_stage
-from ..project.workspace import Workspace, atomic_output
+from ..project.workspace import Workspace
 from .context import ReportContext, Skip
 from .data import ReportData
 from .errors import ReportError
