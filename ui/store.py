@@ -12,10 +12,11 @@ try:  # Qt6 moved the undo framework to QtGui
 except ImportError:
     from qgis.PyQt.QtWidgets import QUndoCommand, QUndoStack
 
+from ..core.common.files import atomic_write_text
 from ..core.io import gcp as gcpmod
 from ..core.project.layout import Layout
 from ..core.project.stages import GEOREFERENCE
-from ..core.project.workspace import Workspace, atomic_write_text
+from ..core.project.workspace import Workspace
 
 
 class _Snapshot(QUndoCommand):
