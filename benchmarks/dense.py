@@ -88,12 +88,13 @@ def run_child(args):
 def child(args):
     from core.common.progress import PrintProgress
     from core.dense import stage as dense
+    from core.dense.options import DenseOptions
     from core.dense.stereo import read_pair_summary
 
     pc = os.path.join(args.workspace, "dense", "points.las") if args.point_cloud else None
     t0 = time.time()
     r = dense.build_dsm_workspace(args.workspace, quality=args.quality, output_point_cloud=pc,
-                                  options=dense.DenseOptions(workers=args.workers), progress=PrintProgress("  "))
+                                  options=DenseOptions(workers=args.workers), progress=PrintProgress("  "))
     wall = time.time() - t0
     # per-pair figures from the cache summaries
     from glob import glob

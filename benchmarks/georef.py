@@ -55,7 +55,7 @@ def copr_second_alignment(ws):
     done = os.path.exists(os.path.join(ws, "workspace.json")) and Workspace.open(ws).stage_done("align")
     if not done:
         align(os.path.join(DATA, "copr", "images"), ws,
-                  AlignOptions(camera_model="SIMPLE_RADIAL", max_features=2048, refine_principal_point=False))
+              AlignOptions(camera_model="SIMPLE_RADIAL", max_features=2048, refine_principal_point=False))
     print("\nsecond, independent alignment (SIMPLE_RADIAL, 2048 features):")
     consistency(ws)
 

@@ -186,11 +186,11 @@ def build_workspace(ws_dir):
 
 def mosaic_only(args):
     """Child process of the RSS measurement: one orthomosaic, prints JSON."""
-    from core import ortho
+    from core.ortho.stage import build_orthophoto_workspace
 
     t0 = time.time()
-    res = ortho.build_orthophoto_workspace(args.workspace, dsm_path=args.dsm, resolution=args.resolution,
-                                           images_filter=args.filter, output=args.output)
+    res = build_orthophoto_workspace(args.workspace, dsm_path=args.dsm, resolution=args.resolution,
+                                     images_filter=args.filter, output=args.output)
     print(json.dumps({"seconds": time.time() - t0, "width": res.resolution and None, "resolution": res.resolution,
                       "timings": res.timings, "rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
 
@@ -271,7 +271,8 @@ def main():
     if args.mosaic_only:
         return mosaic_only(args)
 
-    from core import ortho
+    from core.ortho.single import orthorectify_image
+    from core.ortho.stage import build_orthophoto_workspace, workspace_dsm
     from core.project.workspace import Workspace
 
     os.makedirs(args.out, exist_ok=True)
@@ -282,20 +283,20 @@ def main():
                 raise SystemExit("give --workspace (georeferenced Toledo workspace, with a DSM) or --build")
             build_workspace(args.workspace)
     ws = Workspace.open(args.workspace)
-    if not args.dsm and not ortho.workspace_dsm(ws):
+    if not args.dsm and not workspace_dsm(ws):
         args.dsm = sparse_dsm(args.workspace, os.path.join(args.out, "sparse_dsm.tif"))
         print(f"NOTE: the workspace has no DSM; using one interpolated from the sparse points: {args.dsm}")
-    dsm_used = args.dsm or ortho.workspace_dsm(ws)
+    dsm_used = args.dsm or workspace_dsm(ws)
     print(f"workspace {args.workspace}, DSM {dsm_used}, {len(ws.data.get('images', []))} images")
 
     # 1. per-image orthophotos and their agreement
     if not args.skip_pairs:
         folder = os.path.join(args.out, "per_image")
         t0 = time.time()
-        res = ortho.build_orthophoto_workspace(args.workspace, dsm_path=args.dsm,
-                                               output=os.path.join(args.out, "mosaic_all.tif"),
-                                               per_image_folder=folder,
-                                               seamlines=os.path.join(args.out, "seamlines.gpkg"))
+        res = build_orthophoto_workspace(args.workspace, dsm_path=args.dsm,
+                                         output=os.path.join(args.out, "mosaic_all.tif"),
+                                         per_image_folder=folder,
+                                         seamlines=os.path.join(args.out, "seamlines.gpkg"))
         print(f"mosaic + {len(res.images)} per-image orthophotos at {res.resolution:g} m: {time.time() - t0:.1f} s "
               f"({', '.join(f'{k} {v:.1f}' for k, v in res.timings.items())})")
         for line in res.log_lines:
@@ -334,8 +335,8 @@ def main():
 
         name = args.single
         mos = os.path.join(args.out, "mosaic_without_single.tif")
-        res = ortho.build_orthophoto_workspace(args.workspace, dsm_path=args.dsm, images_filter=f"!{name}",
-                                               output=mos)
+        res = build_orthophoto_workspace(args.workspace, dsm_path=args.dsm, images_filter=f"!{name}",
+                                         output=mos)
         img = os.path.join(ws.data["images_dir"], name)
         print(f"single image {name}, against the mosaic of the other {len(res.images)} images (128 x 128 windows):")
         _gcps, rec, im, off = transferred_gcps(args.workspace, name, 4)
@@ -347,7 +348,7 @@ def main():
             gcps, *_ = transferred_gcps(args.workspace, name, n)
             out = os.path.join(args.out, f"single_{n}.tif")
             t0 = time.time()
-            r = ortho.orthorectify_image(img, out, dsm_used, gcps=gcps, resolution=res.resolution, **kw)
+            r = orthorectify_image(img, out, dsm_used, gcps=gcps, resolution=res.resolution, **kw)
             s = shifts_against(out, mos)
             d = np.hypot(s[:, 0], s[:, 1]) if len(s) else np.zeros(0)
             print(f"  {label} ({time.time() - t0:.1f} s): GCP RMSE {r.rmse_px:.2f} px, left out "
@@ -363,7 +364,7 @@ def main():
         orientation = {"x": c[0], "y": c[1], "z": c[2], "omega": om, "phi": ph, "kappa": ka,
                        "focal_px": block_cam.focal, "cx": block_cam.cx, "cy": block_cam.cy, "crs": "EPSG:32617", **k}
         out2 = os.path.join(args.out, "single_orientation.tif")
-        ortho.orthorectify_image(img, out2, dsm_used, orientation=orientation, resolution=res.resolution)
+        orthorectify_image(img, out2, dsm_used, orientation=orientation, resolution=res.resolution)
         s = shifts_against(out2, mos)
         d = np.hypot(s[:, 0], s[:, 1])
         print(f"  known orientation (x y z omega phi kappa + interior from the block): mean shift "

@@ -71,11 +71,12 @@ class BuildDsmAlgorithm(AlgorithmBase):
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
         from ..core.dense import stage as dense
+        from ..core.dense.options import DenseOptions
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         output_dsm = self.parameterAsOutputLayer(parameters, self.OUTPUT_DSM, context) or None
         output_pc = self.parameterAsFileOutput(parameters, self.OUTPUT_POINT_CLOUD, context) or None
-        options = dense.DenseOptions(
+        options = DenseOptions(
             workers=self.parameterAsInt(parameters, self.WORKERS, context),
             scheduler=params.read_scheduler(self, parameters, self.SCHEDULER, context))
         result = self.run_core(

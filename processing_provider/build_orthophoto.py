@@ -1,4 +1,4 @@
-"""Build orthophoto: thin adapter over core.ortho.build_orthophoto_workspace."""
+"""Build orthophoto: thin adapter over core.ortho.stage.build_orthophoto_workspace."""
 from qgis.core import (
     QgsProcessingException,
     QgsProcessingOutputFolder,
@@ -86,7 +86,8 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
         self.addOutput(QgsProcessingOutputNumber(self.IMAGES_USED, self.tr("Images in the mosaic")))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core import ortho
+        from ..core.ortho.options import OrthoOptions
+        from ..core.ortho.stage import build_orthophoto_workspace
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         dsm_layer = self.parameterAsRasterLayer(parameters, self.DSM, context)
@@ -99,12 +100,12 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
         if seamlines and not seamlines.lower().endswith(".gpkg"):
             raise QgsProcessingException(self.tr("SEAMLINES must be a GeoPackage (.gpkg) file, got {}").format(
                 seamlines))
-        options = ortho.OrthoOptions(
+        options = OrthoOptions(
             interpolation=params.read_choice(self, parameters, self.INTERPOLATION, context, self.INTERPOLATIONS),
             workers=self.parameterAsInt(parameters, self.WORKERS, context),
             scheduler=params.read_scheduler(self, parameters, self.SCHEDULER, context))
         result = self.run_core(
-            ortho.build_orthophoto_workspace, workspace, dsm_path=dsm_path,
+            build_orthophoto_workspace, workspace, dsm_path=dsm_path,
             images_filter=self.parameterAsString(parameters, self.IMAGES_FILTER, context).strip() or None,
             resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context),
             blending=params.read_choice(self, parameters, self.BLENDING, context, self.BLENDINGS),

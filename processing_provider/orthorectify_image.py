@@ -1,4 +1,4 @@
-"""Orthorectify image: thin adapter over core.ortho.orthorectify_image."""
+"""Orthorectify image: thin adapter over core.ortho.single.orthorectify_image."""
 from qgis.core import (
     QgsProcessingException,
     QgsProcessingOutputNumber,

@@ -87,9 +87,9 @@ class RunPipelineAlgorithm(AlgorithmBase):
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
         from ..core import pipeline
         from ..core.align.options import AlignOptions
-        from ..core.dense import stage as dense
+        from ..core.dense.options import DenseOptions
         from ..core.georef.options import GeorefOptions
-        from ..core.ortho import options as ortho
+        from ..core.ortho.options import OrthoOptions
 
         p = parameters
         gcps = params.read_gcp_layer(self, p, self.GCP_LAYER, context, QCoreApplication.translate(
@@ -116,10 +116,10 @@ class RunPipelineAlgorithm(AlgorithmBase):
                 georef=GeorefOptions(refine_intrinsics=self.parameterAsBoolean(p, self.REFINE_INTRINSICS, context)),
                 dsm_resolution=self.parameterAsDouble(p, self.DSM_RESOLUTION, context),
                 dsm_quality=params.read_choice(self, p, self.QUALITY, context, QUALITIES),
-                dense=dense.DenseOptions(workers=workers, scheduler=scheduler),
+                dense=DenseOptions(workers=workers, scheduler=scheduler),
                 ortho_resolution=self.parameterAsDouble(p, self.ORTHO_RESOLUTION, context),
                 blending=params.read_choice(self, p, self.BLENDING, context, BLENDINGS),
-                ortho=ortho.OrthoOptions(workers=workers, scheduler=scheduler),
+                ortho=OrthoOptions(workers=workers, scheduler=scheduler),
                 make_report=self.parameterAsBoolean(p, self.REPORT_ENABLED, context)),
             control=pipeline.Control(gcp_path=gcp_path, gcps=gcps, check_points=checks,
                                      camera_positions_path=positions, use_exif_gps=use_gps, crs=crs_text),

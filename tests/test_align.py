@@ -196,7 +196,7 @@ def test_foreign_images_are_reported_not_registered(tmp_path):
 def test_global_mapper_aligns_the_strip(toledo_strip, tmp_path):
     """MAPPER=global (GLOMAP through pycolmap) on the sample strip: every image registered, sub-pixel."""
     r = align(toledo_strip, str(tmp_path / "ws"),
-                  AlignOptions(mapper="global", max_image_size=800, max_features=2048))
+              AlignOptions(mapper="global", max_image_size=800, max_features=2048))
     assert r.registered == len(TOLEDO_STRIP)
     assert r.mean_reprojection_error < 1.0
     assert json.load(open(tmp_path / "ws" / "workspace.json"))["stages"]["align"]["parameters"]["mapper"] == "global"

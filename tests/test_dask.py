@@ -6,10 +6,12 @@ import shutil
 import numpy as np
 import pytest
 
-from core import ortho
 from core.common import parallel
 from core.dense import stage as dense
+from core.dense.options import DenseOptions
 from core.io import raster as dsm
+from core.ortho.options import OrthoOptions
+from core.ortho.stage import build_orthophoto_workspace
 from tests import synthetic as syn
 from tests.test_dense import CAMERA, make_workspace
 
@@ -49,9 +51,9 @@ def _raster(path):
 def test_dask_products_are_identical_to_the_local_run(block_root, cluster):
     local = _workspace(block_root, "local")
     remote = _workspace(block_root, "dask")
-    r_local = dense.build_dsm_workspace(local, quality="full", options=dense.DenseOptions(workers=1))
+    r_local = dense.build_dsm_workspace(local, quality="full", options=DenseOptions(workers=1))
     r_dask = dense.build_dsm_workspace(remote, quality="full",
-                                       options=dense.DenseOptions(scheduler=cluster.scheduler_address))
+                                       options=DenseOptions(scheduler=cluster.scheduler_address))
     assert r_local.pairs == r_dask.pairs >= 4
     assert any("Dask" in line for line in r_dask.log_lines), r_dask.log_lines
     z_l, gt_l, _ = dsm.read_dsm(r_local.dsm_path)
@@ -60,9 +62,9 @@ def test_dask_products_are_identical_to_the_local_run(block_root, cluster):
     assert np.isfinite(z_l).mean() > 0.5
     np.testing.assert_array_equal(z_l, z_d)
 
-    o_local = ortho.build_orthophoto_workspace(local, options=ortho.OrthoOptions(workers=1, tile=128))
-    o_dask = ortho.build_orthophoto_workspace(
-        remote, options=ortho.OrthoOptions(tile=128, scheduler=cluster.scheduler_address))
+    o_local = build_orthophoto_workspace(local, options=OrthoOptions(workers=1, tile=128))
+    o_dask = build_orthophoto_workspace(
+        remote, options=OrthoOptions(tile=128, scheduler=cluster.scheduler_address))
     a_l, g_l, p_l = _raster(o_local.orthomosaic)
     a_d, g_d, p_d = _raster(o_dask.orthomosaic)
     assert g_l == g_d and p_l == p_d

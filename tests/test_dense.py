@@ -13,6 +13,7 @@ from core.common.progress import Cancelled, NullProgress
 from core.dense import fusion, stereo
 from core.dense import grid as gridding
 from core.dense import stage as dense
+from core.dense.options import DenseError, DenseOptions
 from core.dense.pairs import View
 from core.io import raster as dsm
 from core.project.workspace import Workspace
@@ -46,7 +47,7 @@ def built(block_dir):
     block, root = block_dir
     ws = make_workspace(os.path.join(root, "ws"), block, images_dir=os.path.join(root, "images"))
     result = dense.build_dsm_workspace(ws, quality="full", output_point_cloud=os.path.join(root, "ws", "points.las"),
-                                       options=dense.DenseOptions(workers=1))
+                                       options=DenseOptions(workers=1))
     return block, result
 
 
@@ -279,7 +280,7 @@ def test_cancel_leaves_no_dsm_and_resume_skips_finished_pairs(block_dir, tmp_pat
     ws = _copy_ws(root, tmp_path)
     prog = _CancelAfter(n=4)
     with pytest.raises(Cancelled):
-        dense.build_dsm_workspace(ws, quality="full", options=dense.DenseOptions(workers=1), progress=prog)
+        dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=1), progress=prog)
     assert not os.path.exists(os.path.join(ws, "dsm.tif"))
     assert Workspace.open(ws).stage("dsm")["status"] == "cancelled"
 
@@ -294,7 +295,7 @@ def test_cancel_leaves_no_dsm_and_resume_skips_finished_pairs(block_dir, tmp_pat
     # resume on a process pool of two; cancel while the GeoTIFF is written: no dsm.tif, no partial file
     prog = _CancelAfter(when="writing Cloud-Optimized GeoTIFF")
     with pytest.raises(Cancelled):
-        dense.build_dsm_workspace(ws, quality="full", options=dense.DenseOptions(workers=2, executor="process"),
+        dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=2, executor="process"),
                                   progress=prog)
     assert not [f for f in os.listdir(ws) if "dsm" in f and f.endswith(".tif")]
     assert Workspace.open(ws).stage("dsm")["status"] == "cancelled"
@@ -304,7 +305,7 @@ def test_cancel_leaves_no_dsm_and_resume_skips_finished_pairs(block_dir, tmp_pat
         assert os.stat(p).st_mtime_ns == m  # the finished pairs were not matched again
 
     # the third run reuses every pair
-    r = dense.build_dsm_workspace(ws, quality="full", options=dense.DenseOptions(workers=1))
+    r = dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=1))
     assert r.pairs_reused == len(everything) == r.pairs
     assert os.path.isfile(r.dsm_path) and r.valid_fraction > 0.8
     assert any(f"{len(everything)} reused" in line for line in r.log_lines)
@@ -317,7 +318,7 @@ def test_no_stereo_pair_is_a_clear_error(block_dir, tmp_path):
     i, j = np.unravel_index(np.argmax(np.linalg.norm(c[:, None] - c[None], axis=2)), (len(c), len(c)))
     names = [block.names[i], block.names[j]]
     ws = make_workspace(str(tmp_path / "ws"), block, names=names, images_dir=os.path.join(root, "images"))
-    with pytest.raises(dense.DenseError, match="no stereo pair passed the selection"):
+    with pytest.raises(DenseError, match="no stereo pair passed the selection"):
         dense.build_dsm_workspace(ws)
     assert Workspace.open(ws).stage("dsm")["status"] == "pending"  # refused before the stage began
 
@@ -325,7 +326,7 @@ def test_no_stereo_pair_is_a_clear_error(block_dir, tmp_path):
 def test_not_georeferenced_is_refused(block_dir, tmp_path):
     block, root = block_dir
     ws = make_workspace(str(tmp_path / "ws"), block, georeferenced=False, images_dir=os.path.join(root, "images"))
-    with pytest.raises(dense.DenseError, match="not georeferenced.*Georeference"):
+    with pytest.raises(DenseError, match="not georeferenced.*Georeference"):
         dense.build_dsm_workspace(ws)
 
 
@@ -334,12 +335,12 @@ def test_bad_parameters_are_clear(block_dir, tmp_path):
 
     block, root = block_dir
     ws = _copy_ws(root, tmp_path)
-    with pytest.raises(dense.DenseError, match="QUALITY"):
+    with pytest.raises(DenseError, match="QUALITY"):
         dense.build_dsm_workspace(ws, quality="ultra")
-    with pytest.raises(dense.DenseError, match="RESOLUTION"):
+    with pytest.raises(DenseError, match="RESOLUTION"):
         dense.build_dsm_workspace(ws, resolution=-1)
     if not pycolmap.has_cuda:
-        with pytest.raises(dense.DenseError, match="CUDA"):
+        with pytest.raises(DenseError, match="CUDA"):
             dense.build_dsm_workspace(ws, engine="cuda")
 
 

@@ -375,7 +375,7 @@ def aligned_block(tmp_path_factory, block):
     t_render = time.time() - t0
     t0 = time.time()
     res = align(str(root / "images"), str(root / "ws"),
-                    AlignOptions(pairing="exhaustive", num_threads=2, max_features=2000))
+                AlignOptions(pairing="exhaustive", num_threads=2, max_features=2000))
     t_align = time.time() - t0
     print(f"\n[synthetic block] {len(blk.shots)} images {blk.camera.width}x{blk.camera.height}, GSD "
           f"{blk.gsd:.4f} m: render {t_render:.1f} s, align {t_align:.1f} s, registered {res.registered}, "

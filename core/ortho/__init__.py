@@ -42,8 +42,8 @@ Orthomosaic
 
 Outputs are written to a temporary name and renamed when complete (``core.common.files.atomic_output``).
 
-Modules (each one concern; the stage entry points and their options are re-exported here)
---------------------------------------------------------------------------------------------
+Modules (each one concern; import a name from the module that defines it)
+--------------------------------------------------------------------------
 options (OrthoOptions, SingleImageOptions, OrthoError), cameras (OrthoCamera, IMAGES_FILTER), surface (the DSM
 in the working CRS, gap filling), visibility (footprints, polar occlusion tables), pixels (image windows,
 masks, the cache, remap), sampling (a camera's values at ground points), grid (tiles and cells), writer (the
@@ -52,17 +52,3 @@ seamlines, exposure), blend (multi-band pyramids), tiles (one mosaic tile), mosa
 stage (the workspace stage), orientation (orientation files), planar (planar rectification), single
 (orthorectify_image).
 """
-
-from .cameras import OrthoCamera, cameras_from_reconstruction, select_cameras
-from .mosaic import MosaicResult, build_orthomosaic
-from .options import OrthoError, OrthoOptions, SingleImageOptions
-from .orientation import read_orientation
-from .single import SingleImageResult, orthorectify_image
-from .stage import OrthoStageResult, build_orthophoto_workspace, workspace_dsm
-from .surface import fill_dsm_gaps
-
-__all__ = [
-    "MosaicResult", "OrthoCamera", "OrthoError", "OrthoOptions", "OrthoStageResult", "SingleImageOptions",
-    "SingleImageResult", "build_orthomosaic", "build_orthophoto_workspace", "cameras_from_reconstruction",
-    "fill_dsm_gaps", "orthorectify_image", "read_orientation", "select_cameras", "workspace_dsm",
-]

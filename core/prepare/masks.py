@@ -4,7 +4,7 @@ A mask is ``<workspace>/masks/<image name>.png`` (the image's full file name,
 extension included, plus ``.png``: ``IMG_0012.JPG`` -> ``IMG_0012.JPG.png``),
 8-bit grey at the image's size, white (255) = use, black (0) = ignore.  That
 is COLMAP's convention (``ImageReaderOptions.mask_path``: pixels of value 0
-are ignored by feature extraction) and the one :mod:`core.scans` writes for
+are ignored by feature extraction) and the one :mod:`core.prepare.scans` writes for
 scanned film; :func:`find_mask` also accepts ``masks/<stem>.png`` and is the
 lookup the alignment, the screening and the orthophoto stage share.
 
@@ -55,7 +55,7 @@ def mask_file_name(image_name: str) -> str:
 
 
 def find_mask(masks_dir: Optional[str], name: str) -> Optional[str]:
-    """``masks/<image>.png`` (COLMAP's name, as core.scans writes them) or ``masks/<stem>.png``; None if there is
+    """``masks/<image>.png`` (COLMAP's name, as core.prepare.scans writes them) or ``masks/<stem>.png``; None if there is
     none.  The one lookup the alignment, the screening and the orthophotos share."""
     if not masks_dir or not os.path.isdir(masks_dir):
         return None
