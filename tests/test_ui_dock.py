@@ -162,7 +162,7 @@ def test_dock_opens_with_a_workspace(dock, georef_ws, block):
     assert dock.predictor is not None and dock.predictor.georeferenced
     assert dock.current_name() == names[0]
     # residuals of the adjustment are shown, with a colour
-    from archaeoortho.ui.gcp_dock import DXY, NAME
+    from archaeoortho.ui.gcp_table import DXY, NAME
     from qgis.PyQt.QtCore import Qt
 
     assert dock.model.index(0, DXY).data() not in ("", None)
@@ -247,7 +247,7 @@ def test_canvas_click_sets_xy_and_samples_z_from_a_dsm(dock, aligned_ws, tmp_pat
     assert p.z == z_before
     assert "No height" in dock.status.text()
     # Z by hand, and undo twice restores the first click
-    from archaeoortho.ui.gcp_dock import Z
+    from archaeoortho.ui.gcp_table import Z
 
     dock.model.setData(dock.model.index(dock.store.gcps.points.index(p), Z), "123.5")
     assert dock.current_point().z == 123.5

@@ -232,7 +232,7 @@ def _walk(op):
     op.clicks += 2 + 2
     dock.import_file(os.environ["AO_POINTS"])
     # check points: double-click the role cell, open the list, choose 'check'
-    from archaeoortho.ui.gcp_dock import ROLE
+    from archaeoortho.ui.gcp_table import ROLE
 
     for name in CHECK:
         row = [p.name for p in dock.store.gcps.points].index(name)

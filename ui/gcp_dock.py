@@ -38,20 +38,11 @@ except ImportError:
 from ..core.project.stages import ALIGN
 from .gcp_io import GcpImportExport
 from .gcp_placement import GcpPlacement
-from .gcp_table import (  # noqa: F401 - the column numbers are part of this module's interface (tests)
-    DXY,
-    DZ,
+from .gcp_table import (
     NAME,
-    OBS,
-    PX,
     ROLE,
-    SXY,
-    SZ,
     GcpTableModel,
     RoleDelegate,
-    X,
-    Y,
-    Z,
     short_crs,
 )
 from .gcp_tasks import GcpTasks
