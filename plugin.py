@@ -28,7 +28,10 @@ class ArchaeoOrthoPlugin:
         self.translator = None
         self.action = None
         self.dock = None
+        self.dependencies_dir = None
+        self.dependencies_message = None
         self._install_translator()
+        self._activate_dependencies()
 
     def tr(self, text):
         return QCoreApplication.translate("ArchaeoOrthoPlugin", text)
@@ -41,6 +44,29 @@ class ArchaeoOrthoPlugin:
                 QCoreApplication.installTranslator(self.translator)
             else:
                 self.translator = None
+
+    def _activate_dependencies(self):
+        """pycolmap / OpenCV installed by the plugin live in its folder in the QGIS profile: on sys.path now."""
+        from .core.common import dependencies
+
+        try:
+            self.dependencies_dir = dependencies.activate(QgsApplication.qgisSettingsDirPath())
+        except Exception as e:  # noqa: BLE001 - never fail the plugin's load over this
+            from qgis.core import Qgis, QgsMessageLog
+
+            QgsMessageLog.logMessage(f"ArchaeoOrtho: dependency folder not added: {e}", "ArchaeoOrtho",
+                                     Qgis.MessageLevel.Warning)
+
+    def _offer_dependencies(self):
+        """ONE message bar item (with an Install button) when pycolmap / OpenCV are missing or unusable."""
+        from .core.common import dependencies
+
+        bad = dependencies.problems(dependencies.check())
+        if bad:
+            from .ui.dependencies import push_missing_message
+
+            self.dependencies_message = push_missing_message(self.iface, bad,
+                                                             QgsApplication.qgisSettingsDirPath())
 
     def initProcessing(self):  # noqa: N802 (QGIS API name)
         if self.provider is not None:
@@ -69,6 +95,7 @@ class ArchaeoOrthoPlugin:
         self.action.toggled.connect(self.show_dock)
         self.iface.addPluginToRasterMenu(self.tr("&ArchaeoOrtho"), self.action)
         self.iface.addRasterToolBarIcon(self.action)
+        self._offer_dependencies()
 
     def show_dock(self, visible=True):
         """Create the GCP dock (and its photo dock) on first use and show or hide both."""

@@ -26,12 +26,29 @@ def _with_styled_outputs(process):
 
     @functools.wraps(process)
     def wrapper(self, parameters, context, feedback):
+        check_dependencies(self.REQUIRES, self.displayName())
         results = process(self, parameters, context, feedback)
         self.register_styled_outputs(results, context, feedback)
         return results
 
     wrapper._archaeoortho_styled = True
     return wrapper
+
+
+def check_dependencies(modules, purpose=""):
+    """Fail fast (before any work) when pycolmap / OpenCV are missing or of a version that does not work:
+    the message names the exact pip command for this machine (core.common.dependencies)."""
+    from ..core.common import dependencies
+    from ..core.common.errors import MissingDependencyError
+
+    bad = dependencies.problems(dependencies.check([r for r in dependencies.REQUIREMENTS if r.module in modules]))
+    if not bad:
+        return
+    message = str(MissingDependencyError(bad[0].requirement.dist, purpose))
+    found = [f.describe() for f in bad if f.state != "missing"]
+    if found:
+        message += ". Found: " + "; ".join(found)
+    raise QgsProcessingException(message)
 
 
 class FeedbackProgress:
@@ -77,6 +94,7 @@ class AlgorithmBase(QgsProcessingAlgorithm):
     GROUP_ID = "photogrammetry"
     GROUP = "Photogrammetry"
     STYLE_OUTPUTS = True  # a subclass sets False to leave its outputs as QGIS loads them
+    REQUIRES = ("pycolmap", "cv2")  # import names checked before processAlgorithm runs (fail fast, headless too)
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -145,11 +163,13 @@ def call_core(func, *args, **kwargs):
             QCoreApplication.translate("AlgorithmBase", "Cancelled: {}").format(e)) from e
     except Exception as e:  # noqa: BLE001 - every failure becomes a failed run, never an abort of QGIS
         message = user_message(e)
+        if message is None and isinstance(e, OSError) and e.filename:
+            # a file the user named cannot be read or written (missing, no permission, disk full): its message
+            # names the file, shown without a traceback.  An OSError without a filename, a ValueError or a
+            # RuntimeError is a bug (every core error meant for the user derives from ArchaeoOrthoError).
+            message = str(e)
         if message is not None:
             raise QgsProcessingException(message) from e
-        if isinstance(e, (ValueError, RuntimeError, OSError)):
-            # fallback while the core's error classes move to ArchaeoOrthoError: shown as before
-            raise QgsProcessingException(str(e)) from e
         report_bug(e, _feedback_of(args, kwargs))
         raise QgsProcessingException(f"{type(e).__name__}: {e}") from e
 

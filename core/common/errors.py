@@ -12,6 +12,8 @@ from __future__ import annotations
 import importlib
 from typing import Any, Optional
 
+from .dependencies import REQUIREMENTS, install_command
+
 
 class ArchaeoOrthoError(Exception):
     """Base of every error whose message is meant for the user (names the file and the problem)."""
@@ -28,20 +30,20 @@ class MissingDependencyError(ArchaeoOrthoError, ImportError):
 
     def _message(self) -> str:
         what = f" (needed for {self.purpose})" if self.purpose else ""
-        pin = PINNED.get(self.package, self.package)
-        msg = (f"the Python package '{self.package}' is missing{what}. Install it into the Python that QGIS "
-               f"uses: python3 -m pip install \"{pin}\" (in the OSGeo4W Shell on Windows), "
-               "or run 'make setup' in the plugin folder")
+        command = install_command([self.package])
+        msg = f"the Python package '{self.package}' is missing{what}. "
+        if self.package in PINNED:
+            msg += ("Install it with the 'Install' button that ArchaeoOrtho shows in the QGIS message bar, or "
+                    f"run (in the OSGeo4W Shell on Windows): {command}")
+        else:
+            msg += f"Install it into the Python that QGIS uses: {command}"
         if self.detail:
             msg += f". Import error: {self.detail}"
         return msg
 
 
 # the versions requirements.txt pins (the messages name them so a user installs the tested build)
-PINNED = {
-    "pycolmap": "pycolmap==4.2.1",
-    "opencv-python-headless": "opencv-python-headless==4.10.0.84",
-}
+PINNED = {r.dist: r.pin for r in REQUIREMENTS}
 
 # import name -> PyPI name
 _PYPI = {"cv2": "opencv-python-headless", "pycolmap": "pycolmap"}
