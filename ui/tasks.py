@@ -62,6 +62,11 @@ class CoreTask(QgsTask):
             self.error = str(e) or "cancelled"
         except Exception as e:  # noqa: BLE001 - every failure is reported to the user, not raised in a thread
             message = user_message(e)
+            if message is None and isinstance(e, OSError) and e.filename:
+                # a file the user named cannot be read or written: its message names the file, no traceback.
+                # An OSError without a filename, a ValueError or a RuntimeError is a bug (every core error meant
+                # for the user derives from ArchaeoOrthoError).
+                message = str(e)
             if message is None:  # a bug: the traceback goes to the log, the user sees the exception
                 log_traceback(self.description(), e)
                 message = f"{type(e).__name__}: {e}" if not str(e) else str(e)

@@ -39,6 +39,7 @@ from ..common.errors import require
 from ..common.files import atomic_output
 from ..geometry.similarity import fit_similarity, helmert_fit
 from ..io.gcp import GCPSet, GroundPoint, Observation
+from .errors import GeorefError
 from .triangulate import triangulate_observations
 
 RAYS = "rays"
@@ -393,7 +394,7 @@ def read_gray(path: str) -> np.ndarray:
     cv2 = require("cv2", "reading the photos for guided placement")
     img = cv2.imread(path, cv2.IMREAD_GRAYSCALE | cv2.IMREAD_IGNORE_ORIENTATION)
     if img is None:
-        raise OSError(f"cannot read {path}")
+        raise GeorefError(f"cannot read {path}: missing, or not an image OpenCV reads")
     return img
 
 

@@ -1,0 +1,83 @@
+"""The faces' error policy (processing_provider/base.py call_core, ui/tasks.py CoreTask.run): an
+ArchaeoOrthoError, and an OSError that names a file, are shown as their message; a ValueError, a RuntimeError
+or an OSError without a filename is a bug: its traceback goes to the log."""
+import errno
+import os
+
+import pytest
+
+pytestmark = pytest.mark.usefixtures("qgis_app")
+
+
+def fail(error, progress=None):
+    raise error
+
+
+def _processing_log():
+    from qgis.core import QgsProcessingFeedback
+
+    class Log(QgsProcessingFeedback):
+        def __init__(self):
+            super().__init__()
+            self.errors = []
+
+        def reportError(self, error, fatalError=False):  # noqa: N802, N803 (QGIS API names)
+            self.errors.append(error)
+
+    return Log()
+
+
+def test_call_core_shows_a_named_file_and_logs_bare_value_and_runtime_errors(tmp_path):
+    from archaeoortho.processing_provider.base import AlgorithmBase, FeedbackProgress
+    from qgis.core import QgsProcessingException
+
+    missing = str(tmp_path / "dsm.tif")
+    feedback = _processing_log()
+    progress = FeedbackProgress(feedback)
+    with pytest.raises(QgsProcessingException) as e:
+        AlgorithmBase.run_core(fail, OSError(errno.ENOENT, os.strerror(errno.ENOENT), missing), progress=progress)
+    assert missing in str(e.value) and "OSError" not in str(e.value)
+    assert feedback.errors == []
+
+    for error in (ValueError("bad shape"), RuntimeError("solver diverged"), OSError("no space left")):
+        feedback.errors.clear()
+        with pytest.raises(QgsProcessingException, match=f"^{type(error).__name__}: {error}$"):
+            AlgorithmBase.run_core(fail, error, progress=progress)
+        assert len(feedback.errors) == 1 and "Traceback" in feedback.errors[0], type(error)
+
+
+def test_core_task_shows_a_named_file_and_logs_a_bare_value_error(tmp_path):
+    from archaeoortho.ui.tasks import CoreTask
+    from qgis.core import QgsApplication
+
+    logged, errors = [], []
+    log = QgsApplication.messageLog()
+
+    def keep(message, tag, level):
+        logged.append(message)
+
+    log.messageReceived.connect(keep)
+    try:
+        missing = str(tmp_path / "photo.jpg")
+        task = CoreTask("t", fail, (FileNotFoundError(errno.ENOENT, "No such file or directory", missing),),
+                        on_error=lambda message, cancelled: errors.append(message))
+        assert task.run() is False
+        task.finished(False)
+        task = CoreTask("t2", fail, (ValueError("bad shape"),), on_error=lambda message, cancelled: errors.append(message))
+        assert task.run() is False
+        task.finished(False)
+    finally:
+        log.messageReceived.disconnect(keep)
+    assert len(errors) == 2 and missing in errors[0] and errors[1] == "bad shape"
+    assert not any(missing in m for m in logged), logged
+    assert any("Traceback" in m and "ValueError: bad shape" in m for m in logged), logged
+
+
+def test_guided_read_gray_names_the_unreadable_photo(tmp_path):
+    from core.common.errors import ArchaeoOrthoError
+    from core.georef.guided import read_gray
+
+    bad = tmp_path / "not_a_photo.jpg"
+    bad.write_text("text, not JPEG")
+    with pytest.raises(ArchaeoOrthoError, match="not_a_photo.jpg"):
+        read_gray(str(bad))
