@@ -1,6 +1,5 @@
 """Georeference: thin adapter over core.georef.stage.georeference_workspace."""
 from qgis.core import (
-    QgsCoordinateReferenceSystem,
     QgsProcessingException,
     QgsProcessingOutputFolder,
     QgsProcessingOutputNumber,
@@ -97,6 +96,3 @@ class GeoreferenceAlgorithm(AlgorithmBase):
 
 def _fmt(v):
     return "n/a" if v is None else f"{v:.3f}"
-
-
-_ = QgsCoordinateReferenceSystem  # re-exported for models that build CRS values
