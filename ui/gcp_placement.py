@@ -29,7 +29,7 @@ class GcpPlacement:
         if self.store.workspace is None or not self.store.stage_done(ALIGN):
             return
         try:
-            from ..core.align import stage as sfm
+            from ..core.align import stage as align_stage
             from ..core.georef import guided
             from ..core.georef.stage import load_georef_model
         except ImportError as e:
@@ -42,7 +42,7 @@ class GcpPlacement:
                 same = layers.qgs_crs(transform.get("crs", "")) == layers.qgs_crs(self.store.crs)
                 self.predictor = guided.Predictor(rec, transform.get("offset") if same else None)
             else:
-                self.predictor = guided.Predictor(sfm.load_model(ws))
+                self.predictor = guided.Predictor(align_stage.load_model(ws))
             gsd = guided.ground_sample_distance(self.predictor.rec)
             if gsd and self.predictor.georeferenced and not self.store.settings.get("tolerance"):
                 self.tol_spin.blockSignals(True)  # a default, not the user's choice: not saved

@@ -29,7 +29,7 @@ class GcpTasks:
             self.start_alignment(images, ws)
 
     def start_alignment(self, images_dir, workspace_dir, options=None):
-        from ..core.align import stage as sfm
+        from ..core.align import stage as align_stage
 
         if self._busy():
             return None
@@ -40,7 +40,7 @@ class GcpTasks:
                 result.registered, result.images_given, result.mean_reprojection_error))
             self.open_workspace(workspace_dir)
 
-        task = CoreTask(translate("GcpDock", "ArchaeoOrtho: align photos"), sfm.align, (images_dir, workspace_dir),
+        task = CoreTask(translate("GcpDock", "ArchaeoOrtho: align photos"), align_stage.align, (images_dir, workspace_dir),
                         {"options": options}, on_done=done, on_error=self._task_failed)
         return self._start_task(task)
 
@@ -82,7 +82,7 @@ class GcpTasks:
 
     def run_georeference(self):
         """Adjust the block with the current points in a background task; residuals update when it ends."""
-        from ..core.georef import stage as pipeline
+        from ..core.georef import stage as georef_stage
 
         if self.store.workspace is None or self._busy():
             return None
@@ -113,7 +113,7 @@ class GcpTasks:
             self.message(translate("GcpDock", "Georeferenced in {}.").format(short_crs(result.crs)) + extra,
                          Qgis.MessageLevel.Warning if result.outliers else Qgis.MessageLevel.Success)
 
-        task = CoreTask(translate("GcpDock", "ArchaeoOrtho: georeference"), pipeline.georeference_workspace, (root,),
+        task = CoreTask(translate("GcpDock", "ArchaeoOrtho: georeference"), georef_stage.georeference_workspace, (root,),
                         {"gcps": gs, "refine_intrinsics": self.refine_box.isChecked()},
                         on_done=done, on_error=self._task_failed)
         self.message(translate("GcpDock", "Georeferencing with {} control points\u2026").format(n_control))
