@@ -56,6 +56,7 @@ class ResectionResult:
     focal_sigma_px: Optional[float] = None
     warnings: List[str] = field(default_factory=list)
     estimated_params: List[str] = field(default_factory=list)  # "focal", "k1"
+    geometry: Optional["PoseGeometry"] = None  # how well the points determine the pose
 
     @property
     def outliers(self) -> List[str]:
@@ -161,6 +162,116 @@ def _refine(xyz: np.ndarray, px: np.ndarray, pose: Pose, cam: Intrinsics, free: 
     return pose_, cam_, sigma_f, sigma_k
 
 
+# thresholds of the pose's strength (1-sigma, from the least-squares covariance)
+WEAK_ANGLE_DEG = 2.0  # warn
+BAD_ANGLE_DEG = 5.0  # refuse
+WEAK_CENTRE_FRACTION = 0.04  # of the distance to the ground points: warn
+BAD_CENTRE_FRACTION = 0.10  # refuse
+NEAR_LINE_RATIO = 0.05  # below: "nearly on one line"
+COLLINEAR_RATIO = 1e-6  # second over first singular value of the centred ground points
+WEAK_COVERAGE = 0.10  # convex hull of the points over the image's area: warn below
+
+
+@dataclass
+class PoseGeometry:
+    """How well the control points determine a resected pose."""
+
+    sigma_centre_m: float  # 1-sigma of the projection centre (largest axis), metres
+    sigma_angle_deg: float  # 1-sigma of the rotation (largest axis), degrees
+    condition: float  # of the normal matrix, angle-scaled (centre columns times the distance)
+    image_coverage: float  # convex hull of the points / image area
+    spread_3d: Tuple[float, float, float]  # singular values of the centred ground points / sqrt(n), metres
+    distance_m: float  # median camera-to-point distance
+
+
+def _hull_area(p: np.ndarray) -> float:
+    if len(p) < 3:
+        return 0.0
+    try:
+        from scipy.spatial import ConvexHull, QhullError
+    except ImportError:  # scipy < 1.8
+        from scipy.spatial import ConvexHull
+        from scipy.spatial.qhull import QhullError
+    try:
+        return float(ConvexHull(p).volume)
+    except (QhullError, ValueError):
+        return 0.0
+
+
+def pose_geometry(xyz: np.ndarray, pixels: np.ndarray, pose: Pose, cam: Intrinsics,
+                  sigma_px: float = 0.5) -> PoseGeometry:
+    """Covariance of the 6 pose parameters, (J^T J)^-1 sigma^2 with sigma the residuals' (at least ``sigma_px``),
+    with J the pixels' derivatives by a small rotation and the centre; the points' spread in the image and in 3-D."""
+    xyz = np.asarray(xyz, dtype=float).reshape(-1, 3)
+    pixels = np.asarray(pixels, dtype=float).reshape(-1, 2)
+    centred = xyz - xyz.mean(axis=0)
+    sv = np.linalg.svd(centred, compute_uv=False) / math.sqrt(max(1, len(xyz)))
+    sv = np.concatenate([sv, np.zeros(3 - len(sv))])
+    c0, r0 = pose.centre, pose.rotation
+    dist = float(np.median(np.linalg.norm(xyz - c0, axis=1))) or 1.0
+
+    def fun(v):
+        p = Pose.from_centre(_rmat(v[:3]) @ r0, c0 + v[3:] * dist)
+        proj, _ = project_points(p, cam, xyz)
+        return (proj - pixels).ravel()
+
+    f0 = fun(np.zeros(6))
+    jac = np.empty((f0.size, 6))
+    h = 1e-6
+    for k in range(6):
+        dv = np.zeros(6)
+        dv[k] = h
+        jac[:, k] = (fun(dv) - fun(-dv)) / (2 * h)
+    dof = max(1, f0.size - 6)
+    s2 = max(float(f0 @ f0) / dof, sigma_px ** 2)
+    n = jac.T @ jac
+    ev = np.linalg.eigvalsh(n)
+    cond = float(ev[-1] / ev[0]) if ev[0] > ev[-1] * 1e-15 and ev[0] > 0 else float("inf")
+    if math.isfinite(cond):
+        d = np.sqrt(np.maximum(np.diag(np.linalg.inv(n) * s2), 0.0))
+        sig_a, sig_c = math.degrees(float(d[:3].max())), float(d[3:].max()) * dist
+    else:
+        sig_a = sig_c = float("inf")
+    cover = _hull_area(pixels) / float(cam.width * cam.height)
+    return PoseGeometry(sig_c, sig_a, cond, cover, (float(sv[0]), float(sv[1]), float(sv[2])), dist)
+
+
+def _collinear_message(xyz: np.ndarray, image: str, names: Sequence[str]) -> Optional[str]:
+    """The message when the ground points lie exactly on one line (or on one point), else None."""
+    sv = np.linalg.svd(xyz - xyz.mean(axis=0), compute_uv=False)
+    if sv[0] <= 1e-9 * max(1.0, float(np.abs(xyz).max())):
+        return (f"space resection of {image} is impossible: the {len(xyz)} ground control points "
+                f"({', '.join(names)}) all have the same coordinates")
+    if len(sv) > 1 and sv[1] > COLLINEAR_RATIO * sv[0]:
+        return None
+    return (f"space resection of {image} is impossible: the {len(xyz)} ground control points ({', '.join(names)}) "
+            "are collinear (they lie on one straight line in 3-D, so the camera may turn freely about that line). "
+            "Add control points off the line, spread across the image")
+
+
+def _geometry_verdict(g: PoseGeometry, n: int, image: str, warnings: List[str]) -> None:
+    """Refuse (ResectionError) an undetermined pose, warn about a weak one; both with the numbers."""
+    along, across, depth = g.spread_3d
+    near_line = across < NEAR_LINE_RATIO * along
+    numbers = (f"pose uncertainty (1 sigma) {g.sigma_centre_m:.2f} m in the camera position and {g.sigma_angle_deg:.2f}"
+               f" deg in its angles at {g.distance_m:.0f} m from the points, condition number {g.condition:.3g}; the "
+               f"points cover {100 * g.image_coverage:.1f} % of the image and spread {along:.2f} / {across:.2f} / "
+               f"{depth:.2f} m (RMS along their three axes)")
+    why = (f"the {n} control points lie nearly on one line (nearly collinear: {across:.2f} m across it, {along:.2f} m"
+           " along it)" if near_line else f"the {n} control points are too few or too clustered")
+    bad = (g.sigma_angle_deg > BAD_ANGLE_DEG or g.sigma_centre_m > BAD_CENTRE_FRACTION * g.distance_m
+           or not math.isfinite(g.condition))
+    if bad:
+        raise ResectionError(f"space resection of {image} is undetermined: {why} to fix the camera's pose ({numbers})."
+                             " Add control points away from the others, spread across the image")
+    if g.sigma_angle_deg > WEAK_ANGLE_DEG or g.sigma_centre_m > WEAK_CENTRE_FRACTION * g.distance_m:
+        warnings.append(f"the pose of {image} is weakly determined: {why} ({numbers}); "
+                        "check the orthophoto away from the GCPs, or add GCPs spread across the image")
+    elif g.image_coverage < WEAK_COVERAGE:
+        warnings.append(f"the control points cover only {100 * g.image_coverage:.1f} % of {image}: the orthophoto "
+                        "far from them is extrapolated; spread GCPs across the image")
+
+
 def space_resection(xyz: np.ndarray, pixels: np.ndarray, camera: Intrinsics, names: Optional[Sequence[str]] = None,
                     estimate_intrinsics: Union[bool, str] = "auto", max_residual_px: Optional[float] = None,
                     image: str = "the image") -> ResectionResult:
@@ -186,6 +297,9 @@ def space_resection(xyz: np.ndarray, pixels: np.ndarray, camera: Intrinsics, nam
             f"{image}; found {n}. Give the focal length (FOCAL_MM and SENSOR_WIDTH_MM) and leave the estimate off")
     if not np.all(np.isfinite(xyz)) or not np.all(np.isfinite(pixels)):
         raise ResectionError(f"ground control for {image} holds non-finite coordinates")
+    collinear = _collinear_message(xyz, image, names)
+    if collinear:
+        raise ResectionError(collinear)
     diag = math.hypot(camera.width, camera.height)
     thr = float(max_residual_px) if max_residual_px else max(4.0, 0.003 * diag)
     warnings: List[str] = []
@@ -259,6 +373,8 @@ def space_resection(xyz: np.ndarray, pixels: np.ndarray, camera: Intrinsics, nam
         warnings.append(f"focal length and k1 of {image} were not estimated: only {n_used} points agree "
                         f"({MIN_INTRINSICS_POINTS} needed)")
 
+    geometry = pose_geometry(xyz[used], pixels[used], pose, cam)
+    _geometry_verdict(geometry, n_used, image, warnings)
     proj, ok = project_points(pose, cam, xyz)
     residuals = [PointResidual(nm, float(p[0]), float(p[1]), float(q[0] - p[0]), float(q[1] - p[1]), bool(u))
                  for nm, p, q, u in zip(names, pixels, proj, used)]
@@ -273,7 +389,7 @@ def space_resection(xyz: np.ndarray, pixels: np.ndarray, camera: Intrinsics, nam
         warnings.append(f"with only {n} GCPs a wrong one cannot be told apart; RMSE {rmse:.1f} px: add GCPs")
     if not camera.dist.any() and not estimated and rmse > 3.0:
         warnings.append(f"residuals of {rmse:.1f} px: lens distortion may be unmodelled (6 or more GCPs estimate k1)")
-    return ResectionResult(pose, cam, residuals, rmse, estimated, sigma_f, warnings, est_params)
+    return ResectionResult(pose, cam, residuals, rmse, estimated, sigma_f, warnings, est_params, geometry)
 
 
 # ---------------------------------------------------------------------------

@@ -1,0 +1,76 @@
+"""Issue 17: bad inputs that used to give a silent wrong product or a misleading message - weak resection
+geometry (item 3), a DASK_SCHEDULER that is no Dask scheduler (4), gap filling of a DSM in degrees (8), GCP reader
+warnings in every outcome (11), messages that name the right thing (12), the CRS parameter of a CSV GCP file (13)."""
+import math
+
+import numpy as np
+import pytest
+
+from core.geometry import camera as cm
+from core.geometry import resection as rs
+from tests import synthetic as syn
+
+CAM = syn.DEFAULT_CAMERA
+
+
+def _intrinsics():
+    return cm.Intrinsics("OPENCV", CAM.width, CAM.height, CAM.params)
+
+
+# ---------------------------------------------------------------------------
+# item 3: space resection from (nearly) collinear control
+# ---------------------------------------------------------------------------
+
+def _road(across=0.0, z_spread=0.1, noise=0.3, seed=0, n=6):
+    """n GCPs along a straight road under a camera 50 m up (omega -1.3 deg); returns (xyz, pixels, pose)."""
+    rng = np.random.default_rng(seed)
+    pose = cm.Pose.from_centre(cm.rotation_from_opk(-1.3, 2.0, 30.0), [3.0, -2.0, 50.0])
+    t = np.linspace(-25, 25, n)
+    xyz = np.column_stack([t, 0.3 * t + rng.uniform(-across / 2, across / 2, n), rng.uniform(0, z_spread, n)])
+    px, ok = cm.project_points(pose, _intrinsics(), xyz)
+    assert ok.all()
+    return xyz, px + rng.normal(0, noise, px.shape), pose
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_nearly_collinear_gcps_are_refused_with_the_numbers(seed):
+    xyz, px, _ = _road(seed=seed)
+    with pytest.raises(rs.ResectionError) as e:
+        rs.space_resection(xyz, px, _intrinsics(), names=list("ABCDEF"), estimate_intrinsics=False,
+                           image="IMG_7.JPG")
+    msg = str(e.value)
+    assert "IMG_7.JPG" in msg and "undetermined" in msg and "collinear" in msg
+    # the numbers: the position's and the angles' uncertainty, the condition number, the image coverage
+    sig_m = float(msg.split(" m in the camera position")[0].rsplit(" ", 1)[1])
+    sig_deg = float(msg.split(" deg in its angles")[0].rsplit(" ", 1)[1])
+    assert sig_m > 5.0 and sig_deg > 5.0 and "condition number" in msg and "% of the image" in msg
+
+
+def test_exactly_collinear_gcps_say_collinear():
+    xyz, px, _ = _road(z_spread=0.0, noise=0.0)
+    with pytest.raises(rs.ResectionError, match="are collinear") as e:
+        rs.space_resection(xyz, px, _intrinsics(), estimate_intrinsics=False, image="IMG_7.JPG")
+    assert "vertical datum" not in str(e.value) and "IMG_7.JPG" in str(e.value)
+
+
+def test_well_spread_gcps_give_a_tight_pose_and_no_geometry_warning():
+    rng = np.random.default_rng(4)
+    pose = cm.Pose.from_centre(cm.rotation_from_opk(-1.3, 2.0, 30.0), [3.0, -2.0, 50.0])
+    xyz = np.column_stack([rng.uniform(-30, 30, 12), rng.uniform(-20, 20, 12), rng.uniform(0, 0.1, 12)])
+    px, ok = cm.project_points(pose, _intrinsics(), xyz)
+    xyz, px = xyz[ok & _intrinsics().inside(px, 20)], px[ok & _intrinsics().inside(px, 20)]
+    assert len(xyz) >= 8
+    r = rs.space_resection(xyz, px + rng.normal(0, 0.3, px.shape), _intrinsics(), estimate_intrinsics=False)
+    g = r.geometry
+    assert g is not None and g.sigma_angle_deg < rs.WEAK_ANGLE_DEG and g.image_coverage > 0.1
+    assert np.linalg.norm(r.pose.centre - pose.centre) < 3 * g.sigma_centre_m + 0.05
+    assert not [w for w in r.warnings if "weakly" in w or "cover only" in w]
+
+
+def test_a_road_a_few_metres_wide_warns_about_the_weak_pose():
+    xyz, px, _ = _road(across=3.0, seed=1)
+    r = rs.space_resection(xyz, px, _intrinsics(), estimate_intrinsics=False, image="IMG_7.JPG")
+    weak = [w for w in r.warnings if "weakly determined" in w]
+    assert weak and "IMG_7.JPG" in weak[0] and "deg in its angles" in weak[0]
+    assert rs.WEAK_ANGLE_DEG < r.geometry.sigma_angle_deg < rs.BAD_ANGLE_DEG
+    assert math.isfinite(r.geometry.condition)
