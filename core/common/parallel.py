@@ -114,6 +114,61 @@ def resolve_scheduler(scheduler: Optional[str] = None) -> Optional[str]:
     return address or None
 
 
+# the whole Dask connection (connect, handshake, the first request) must be done within this many seconds
+# (the connect_timeout argument; this environment variable overrides it, for batch use)
+DASK_TIMEOUT_ENV = "ARCHAEOORTHO_DASK_TIMEOUT"
+
+
+def _dask_deadline(connect_timeout: float) -> float:
+    raw = os.environ.get(DASK_TIMEOUT_ENV, "").strip()
+    try:
+        value = float(raw) if raw else float(connect_timeout)
+    except ValueError:
+        raise ParallelError(f"${DASK_TIMEOUT_ENV} must be a number of seconds; it is {raw!r}") from None
+    return value if value > 0 else 30.0
+
+
+def _connect_dask(client_class, address: str, connect_timeout: float) -> _DaskExecutor:
+    """Connect to the Dask scheduler at ``address`` in a thread with a hard deadline for the whole handshake: a
+    service that accepts the connection but never answers like a scheduler (a web server) cannot hang the stage,
+    and whatever goes wrong (refused, timed out, a garbage reply that makes the protocol decoder raise
+    ValueError or MemoryError) is one ParallelError naming the address."""
+    deadline = _dask_deadline(connect_timeout)
+    lock, box, done = threading.Lock(), {}, threading.Event()
+
+    def connect() -> None:
+        try:
+            client = client_class(address, timeout=deadline, set_as_default=False)
+            executor = _DaskExecutor(client)
+        except BaseException as e:  # noqa: B036 - reported as text; the exception (and its client) stay here
+            box["error"] = f"{type(e).__name__}: {e}" if str(e) else type(e).__name__
+            box["kind"] = "network" if isinstance(e, (OSError, TimeoutError)) else "protocol"
+        else:
+            with lock:
+                late = box.get("abandoned", False)
+                box["executor"] = executor
+            if late:  # the caller gave up: do not leave a client connected
+                with contextlib.suppress(Exception):
+                    client.close()
+        finally:
+            done.set()
+
+    threading.Thread(target=connect, name="archaeoortho-dask-connect", daemon=True).start()
+    finished = done.wait(deadline + 1.0)
+    with lock:
+        if not finished:
+            box["abandoned"] = True
+    if not finished:
+        raise ParallelError(f"cannot reach a Dask scheduler at {address}: no Dask handshake within {deadline:g} s "
+                            "(the address answers, but not as a Dask scheduler: check the host and the port, 8786 by "
+                            f"default; ${DASK_TIMEOUT_ENV} sets the time allowed)")
+    if "error" in box:
+        hint = ("" if box["kind"] == "network" else
+                " (the reply is not Dask's protocol: is this the scheduler's port, 8786 by default?)")
+        raise ParallelError(f"cannot reach a Dask scheduler at {address}: {box['error']}{hint}")
+    return box["executor"]
+
+
 def make_executor(workers: int = 0, kind: str = "auto", scheduler: Optional[str] = None,
                   unit_memory: int = 0, connect_timeout: float = 30.0):
     """An executor for units of work.
@@ -130,10 +185,7 @@ def make_executor(workers: int = 0, kind: str = "auto", scheduler: Optional[str]
         except ImportError as e:
             raise ParallelError(f"a Dask scheduler ({scheduler}) was given but dask.distributed is not installed "
                                 "in the Python that runs ArchaeoOrtho (pip install 'dask[distributed]')") from e
-        try:
-            return _DaskExecutor(Client(scheduler, timeout=connect_timeout, set_as_default=False))
-        except (OSError, TimeoutError) as e:
-            raise ParallelError(f"cannot reach the Dask scheduler {scheduler}: {e}") from e
+        return _connect_dask(Client, scheduler, connect_timeout)
     if kind not in KINDS:
         raise ParallelError(f"unknown executor kind {kind!r}; choose one of {', '.join(KINDS)}")
     n = workers if workers and workers > 0 else auto_workers(unit_memory)
