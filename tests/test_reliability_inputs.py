@@ -74,3 +74,110 @@ def test_a_road_a_few_metres_wide_warns_about_the_weak_pose():
     assert weak and "IMG_7.JPG" in weak[0] and "deg in its angles" in weak[0]
     assert rs.WEAK_ANGLE_DEG < r.geometry.sigma_angle_deg < rs.BAD_ANGLE_DEG
     assert math.isfinite(r.geometry.condition)
+
+
+# ---------------------------------------------------------------------------
+# item 4: a DASK_SCHEDULER that is not a Dask scheduler (loopback only)
+# ---------------------------------------------------------------------------
+
+def _free_port():
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _connect_error(address, connect_timeout, ceiling=90.0):
+    """make_executor(scheduler=address) in a thread; the ParallelError it raises (fails if it is still running after
+    ``ceiling`` s: a generous bound, far above the deadline, not a speed test)."""
+    import threading
+
+    from core.common import parallel
+
+    out = {}
+
+    def go():
+        try:
+            out["executor"] = parallel.make_executor(scheduler=address, connect_timeout=connect_timeout)
+        except BaseException as e:  # noqa: B036 - inspected by the test
+            out["error"] = e
+
+    t = threading.Thread(target=go, daemon=True)
+    t.start()
+    t.join(ceiling)
+    assert not t.is_alive(), f"make_executor({address}) still hangs after {ceiling} s"
+    assert "executor" not in out
+    return out["error"]
+
+
+def test_a_web_server_as_dask_scheduler_fails_within_the_deadline_naming_the_address():
+    pytest.importorskip("distributed")
+    import subprocess
+    import sys
+    import time
+
+    from core.common import parallel
+
+    port = _free_port()
+    srv = subprocess.Popen([sys.executable, "-m", "http.server", str(port), "--bind", "127.0.0.1"],
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        for _ in range(100):  # wait until it listens
+            try:
+                import socket
+
+                socket.create_connection(("127.0.0.1", port), timeout=1).close()
+                break
+            except OSError:
+                time.sleep(0.1)
+        err = _connect_error(f"tcp://127.0.0.1:{port}", connect_timeout=3)
+    finally:
+        srv.terminate()
+        srv.wait(10)
+    assert isinstance(err, parallel.ParallelError), repr(err)
+    assert f"cannot reach a Dask scheduler at tcp://127.0.0.1:{port}" in str(err)
+    assert "handshake" in str(err)
+
+
+@pytest.mark.parametrize("garbage", [b"\xff" * 16 + b"garbage" * 100,  # a length no decoder accepts
+                                     (1 << 40).to_bytes(8, "little") * 3])  # a 1 TB frame: MemoryError
+def test_a_service_that_answers_garbage_is_one_clear_error(garbage):
+    pytest.importorskip("distributed")
+    import socket
+    import threading
+
+    from core.common import parallel
+
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(8)
+    port = server.getsockname()[1]
+    stop = threading.Event()
+
+    def serve():
+        server.settimeout(0.2)
+        conns = []
+        while not stop.is_set():
+            try:
+                c, _ = server.accept()
+            except OSError:
+                continue
+            try:
+                c.sendall(garbage)
+            except OSError:
+                pass
+            conns.append(c)
+        for c in conns:
+            c.close()
+
+    t = threading.Thread(target=serve, daemon=True)
+    t.start()
+    try:
+        err = _connect_error(f"tcp://127.0.0.1:{port}", connect_timeout=5)
+    finally:
+        stop.set()
+        t.join(5)
+        server.close()
+    assert isinstance(err, parallel.ParallelError), repr(err)
+    assert f"cannot reach a Dask scheduler at tcp://127.0.0.1:{port}" in str(err)
