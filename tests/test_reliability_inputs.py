@@ -181,3 +181,78 @@ def test_a_service_that_answers_garbage_is_one_clear_error(garbage):
         server.close()
     assert isinstance(err, parallel.ParallelError), repr(err)
     assert f"cannot reach a Dask scheduler at tcp://127.0.0.1:{port}" in str(err)
+
+
+# ---------------------------------------------------------------------------
+# item 8: gap filling of a DSM in a geographic CRS (the distance is metres, not degrees)
+# ---------------------------------------------------------------------------
+
+def _gappy_dsm(path, crs, cell, origin):
+    """A 240 x 240 tilted-plane DSM with a big gap (100 x 100 cells) and a small one (4 x 4 cells)."""
+    from core.io import raster
+
+    rr, cc = np.mgrid[0:240, 0:240]
+    z = (100.0 + 0.05 * rr + 0.02 * cc).astype(np.float32)
+    z[70:170, 70:170] = np.nan  # big: its centre is 50 cells from a height
+    z[20:24, 20:24] = np.nan  # small
+    gt = (origin[0], cell[0], 0.0, origin[1], 0.0, -cell[1])
+    raster.write_cog(str(path), z, gt, crs)
+    return z
+
+
+def _filled(path, tmp_path, distance):
+    from osgeo import gdal
+
+    from core.ortho.surface import fill_dsm_gaps
+
+    out, n = fill_dsm_gaps(str(path), str(tmp_path / "filled.tif"), distance)
+    ds = gdal.Open(out)
+    band = ds.GetRasterBand(1)
+    z = band.ReadAsArray().astype(float)
+    nd = band.GetNoDataValue()
+    if nd is not None:
+        z[z == nd] = np.nan
+    return z, n
+
+
+def test_gap_filling_of_a_dsm_in_degrees_uses_metres(tmp_path):
+    # 1e-5 deg cells at 48 N: 0.74 m east-west, 1.11 m north-south; the big gap is 74 m x 111 m wide
+    lat = 48.0
+    _gappy_dsm(tmp_path / "dsm4326.tif", "EPSG:4326", (1e-5, 1e-5), (11.0, lat))
+    z, n = _filled(tmp_path / "dsm4326.tif", tmp_path, 25.0)
+    assert np.isfinite(z[20:24, 20:24]).all()  # the small gap (4 m) is filled
+    assert np.isnan(z[120, 120])  # the centre of the big one (> 37 m from a height) stays a gap
+    # cells within 25 m of a height are filled, those beyond stay empty (25 m = 22 cells at 1.11 m, 33 at 0.74 m)
+    assert np.isfinite(z[70:170, 70:170][:, :15]).all()
+    assert np.isnan(z[70:170, 70:170][40:60, 40:60]).all()
+    assert 0 < n < 100 * 100 + 16
+
+
+def test_gap_filling_of_a_projected_dsm_in_feet_uses_metres(tmp_path):
+    # EPSG:2249 (NAD83 / Massachusetts Mainland, US survey feet): 1 ft cells; 25 m = 82 ft
+    _gappy_dsm(tmp_path / "dsmft.tif", "EPSG:2249", (1.0, 1.0), (700000.0, 3000000.0))
+    z, _ = _filled(tmp_path / "dsmft.tif", tmp_path, 25.0)
+    assert np.isfinite(z[20:24, 20:24]).all()
+    assert np.isfinite(z[120, 120])  # 50 ft = 15 m from a height: within 25 m
+    _gappy_dsm(tmp_path / "dsmm.tif", "EPSG:32632", (1.0, 1.0), (700000.0, 5300000.0))
+    z, _ = _filled(tmp_path / "dsmm.tif", tmp_path, 25.0)
+    assert np.isnan(z[120, 120])  # 50 m from a height: beyond 25 m
+
+
+# ---------------------------------------------------------------------------
+# item 12: messages name the user's files, not internal ones
+# ---------------------------------------------------------------------------
+
+def test_a_dsm_beside_the_images_is_named_not_its_gap_filled_work_copy(tmp_path):
+    from core.ortho.cameras import OrthoCamera
+    from core.ortho.mosaic import build_orthomosaic
+    from core.ortho.options import OrthoError
+
+    dsm = tmp_path / "my dsm.tif"
+    _gappy_dsm(dsm, "EPSG:32632", (1.0, 1.0), (700000.0, 5300000.0))  # has gaps: a filled work copy is made
+    cam = OrthoCamera("IMG_1.JPG", str(tmp_path / "IMG_1.JPG"), cm.Intrinsics.simple(800, 600, 650.0),
+                      cm.Pose.from_centre(cm.rotation_from_opk(0, 0, 0), [0.0, 0.0, 50.0]))
+    with pytest.raises(OrthoError, match="does not cover the images") as e:
+        build_orthomosaic([cam], str(dsm), "EPSG:32632", [0.0, 0.0, 0.0], str(tmp_path / "out" / "mosaic.tif"))
+    assert str(dsm) in str(e.value)
+    assert ".ortho-work-" not in str(e.value) and "gaps-filled" not in str(e.value)

@@ -16,14 +16,17 @@ from .pixels import _remap
 class _Dsm:
     """Heights from a DSM in the working CRS, in world coordinates (NaN = no height)."""
 
-    def __init__(self, path: str, crs: Optional[str]):
+    def __init__(self, path: str, crs: Optional[str], name: Optional[str] = None):
+        """``name``: the DSM the messages name (the user's, where ``path`` is a work copy, its gaps filled)."""
+        name = name or path
         try:
             self.info = dsmmod.open_dsm(path)
         except dsmmod.DsmError as e:
-            raise OrthoError(str(e)) from e
+            raise OrthoError(str(e).replace(path, name)) from e
         if crs and not self.info.crs_wkt:
-            raise OrthoError(f"DSM {path} has no CRS: it cannot be placed in {crs}; assign its CRS first")
-        self.path = path
+            raise OrthoError(f"DSM {name} has no CRS: it cannot be placed in {crs}; assign its CRS first")
+        self.path = name  # for messages
+        self.file = path  # the raster read
         self.crs = crs
         self.reader = dsmmod.DsmReader(path, target_crs=crs)
         gt = self.reader.geotransform
@@ -101,9 +104,25 @@ def _same_crs(wkt: str, crs: str) -> bool:
 FILL_MAX_CELLS = 120_000_000  # larger DSMs are used as they are (the fill works on the whole raster in memory)
 
 
+def _cell_size_m(ds, rows: np.ndarray, cols: np.ndarray) -> float:
+    """The larger side of a DSM cell in metres: the CRS's linear unit, or degrees at the latitude of the measured
+    cells (the middle of ``rows``); CRS units taken as metres without a CRS."""
+    gt = ds.GetGeoTransform()
+    dx, dy = abs(gt[1]), abs(gt[5])
+    srs = ds.GetSpatialRef()
+    if srs is None:
+        return max(dx, dy)
+    if srs.IsGeographic():
+        lat = gt[3] + (float(np.median(rows)) + 0.5) * gt[5] + (float(np.median(cols)) + 0.5) * gt[4]
+        axis_m = math.radians(1.0) * srs.GetSemiMajor()  # metres per degree along a meridian (sphere)
+        return max(dx * axis_m * max(math.cos(math.radians(min(89.9, abs(lat)))), 1e-6), dy * axis_m)
+    return max(dx, dy) * (srs.GetLinearUnits() or 1.0)
+
+
 def fill_dsm_gaps(dsm_path: str, out_path: str, max_distance: float) -> Tuple[str, int]:
     """Fill the gaps of a DSM for orthorectification: cells without a height that lie inside the convex hull of
-    the measured cells and within ``max_distance`` (CRS units) of one get a height interpolated (inverse distance,
+    the measured cells and within ``max_distance`` metres of one (converted with the DSM CRS's units: degrees at the
+    DSM's latitude for a geographic CRS, feet for a CRS in feet) get a height interpolated (inverse distance,
     GDAL FillNodata) from their surroundings, so that a tree crown the dense matching missed does not leave a hole
     in the orthophoto.  Beyond the measured area (a DSM that covers part of the block) nothing is invented.
 
@@ -132,7 +151,7 @@ def fill_dsm_gaps(dsm_path: str, out_path: str, max_distance: float) -> Tuple[st
     if not gaps.any():
         return dsm_path, 0
     gt = ds.GetGeoTransform()
-    max_cells = max(1.0, max_distance / max(abs(gt[1]), abs(gt[5])))
+    max_cells = max(1.0, max_distance / _cell_size_m(ds, rows, cols))
     fill_value = -9999.0
     mem = gdal.GetDriverByName("MEM").Create("", ds.RasterXSize, ds.RasterYSize, 1, gdal.GDT_Float32)
     mem.SetGeoTransform(gt)
