@@ -67,7 +67,7 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
     try:
         dsm_path, filled = fill_dsm_gaps(dsm_path, os.path.join(workdir, "dsm-gaps-filled.tif"),
                                          options.fill_dsm_gaps_m)
-        dsm = _Dsm(dsm_path, crs)
+        dsm = _Dsm(dsm_path, crs, name=source_dsm)
     except BaseException:
         shutil.rmtree(workdir, ignore_errors=True)
         raise
