@@ -256,3 +256,94 @@ def test_a_dsm_beside_the_images_is_named_not_its_gap_filled_work_copy(tmp_path)
         build_orthomosaic([cam], str(dsm), "EPSG:32632", [0.0, 0.0, 0.0], str(tmp_path / "out" / "mosaic.tif"))
     assert str(dsm) in str(e.value)
     assert ".ortho-work-" not in str(e.value) and "gaps-filled" not in str(e.value)
+
+
+# ---------------------------------------------------------------------------
+# items 11 and 13: the GCP reader's warnings in every outcome; a CSV file's CRS from the CRS parameter
+# ---------------------------------------------------------------------------
+
+class _Recorder:
+    def __init__(self):
+        self.warnings, self.infos = [], []
+
+    def report(self, fraction, message=""):
+        pass
+
+    def is_cancelled(self):
+        return False
+
+    def info(self, message):
+        self.infos.append(message)
+
+    def warning(self, message):
+        self.warnings.append(message)
+
+
+def _workspace_with_images(tmp_path, n=3, size=(4000, 3000)):
+    from core.project.workspace import Workspace
+
+    ws = Workspace.create_or_open(str(tmp_path / "ws"))
+    ws.data["images"] = [{"name": f"IMG_{i}.JPG", "width": size[0], "height": size[1]} for i in range(1, n + 1)]
+    ws.save()
+    return ws
+
+
+def _csv_gcps(tmp_path, crs_line, rows, obs):
+    pts = tmp_path / "gcps.csv"
+    pts.write_text((crs_line + "\n" if crs_line else "") + "name,x,y,z\n" + "".join(f"{r}\n" for r in rows))
+    (tmp_path / "gcps_observations.csv").write_text("name,image,px,py\n" + "".join(f"{o}\n" for o in obs))
+    return str(pts)
+
+
+_UTM_ROWS = ["A,500000,4000000,100", "B,500100,4000000,101", "C,500000,4000100,102", "D,500100,4000100,103"]
+
+
+def test_gcp_warnings_reach_the_user_when_georeferencing_fails_and_counts_are_honest(tmp_path):
+    from core.georef import stage as georef_stage
+    from core.project.stages import StageError
+
+    ws = _workspace_with_images(tmp_path)
+    # px and py swapped for A, B and C (py beyond the 3000 px height): their lines are dropped
+    obs = [f"{p},IMG_{i}.JPG,{2000 + 10 * i},{3500 + 10 * i}" for p in "ABC" for i in (1, 2)] + \
+          [f"D,IMG_{i}.JPG,{1000 + 10 * i},{800 + 10 * i}" for i in (1, 2)]
+    path = _csv_gcps(tmp_path, "# crs: EPSG:32617", _UTM_ROWS, obs)
+    with pytest.raises(StageError) as e:
+        georef_stage._read_control(ws, path, None, (), None, False, None, _Recorder())
+    msg = str(e.value)
+    assert "A (control, 2 observations, both dropped: outside the image)" in msg
+    assert "D (control, 2 observations)" in msg
+    assert "lies outside image IMG_1" in msg and "dropped" in msg  # the reader's warnings, with the lines
+    assert "gcps_observations.csv:2" in msg
+
+
+def test_gcp_warnings_are_kept_when_the_reader_itself_fails(tmp_path):
+    from core.io import gcp
+
+    obs = ["A,IMG_1.JPG,100,5000", "A,IMG_2.JPG,100,200", "A,IMG_9.JPG,1,1"]
+    path = _csv_gcps(tmp_path, "# crs: EPSG:32617", _UTM_ROWS[:1], obs)
+    sizes = {f"IMG_{i}.JPG": (4000, 3000) for i in (1, 2)}
+    with pytest.raises(gcp.GCPError, match="not in the block") as e:
+        gcp.read_gcps(path, image_names=list(sizes), image_sizes=sizes)
+    assert "lies outside image IMG_1.JPG" in str(e.value)
+
+
+def test_a_csv_gcp_file_without_crs_takes_the_crs_parameter(tmp_path):
+    from core.georef import stage as georef_stage
+
+    ws = _workspace_with_images(tmp_path)
+    obs = [f"{p},IMG_{i}.JPG,{1000 + 100 * k},{800 + 50 * i}" for k, p in enumerate("ABCD") for i in (1, 2)]
+    path = _csv_gcps(tmp_path, None, _UTM_ROWS, obs)
+    gcps, _, target = georef_stage._read_control(ws, path, None, (), None, False, "EPSG:32617", _Recorder())
+    assert gcps.crs == "EPSG:32617" and target == "EPSG:32617"
+    assert [p.x for p in gcps.points] == [500000, 500100, 500000, 500100]
+    # a file that names its CRS keeps it; the CRS parameter is then the target it is transformed into
+    lonlat = ["A,-81.0,36.14,100", "B,-80.999,36.14,101", "C,-81.0,36.141,102", "D,-80.999,36.141,103"]
+    path = _csv_gcps(tmp_path, "# crs: EPSG:4326", lonlat, obs)
+    gcps, _, target = georef_stage._read_control(ws, path, None, (), None, False, "EPSG:32617", _Recorder())
+    assert target == "EPSG:32617" and 499000 < gcps.points[0].x < 501000 and 3.99e6 < gcps.points[0].y < 4.01e6
+    # neither: the message says where the CRS can come from
+    from core.io import gcp
+
+    path = _csv_gcps(tmp_path, None, _UTM_ROWS, obs)
+    with pytest.raises(gcp.GCPError, match="CRS parameter"):
+        georef_stage._read_control(ws, path, None, (), None, False, None, _Recorder())

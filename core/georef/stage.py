@@ -18,6 +18,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..align.mapping import camera_rows
+from ..common.errors import ArchaeoOrthoError
 from ..common.files import atomic_output, atomic_write_text, file_fingerprint
 from ..common.progress import NullProgress, Progress, SubProgress
 from ..geometry.crs import transform_points, utm_epsg_for_lonlat
@@ -99,7 +100,8 @@ def _read_control(ws: Workspace, gcp_path: Optional[str], gcps: Optional[gcpmod.
     not enough to georeference."""
     sizes = {im["name"]: (im["width"], im["height"]) for im in ws.data.get("images", [])}
     if gcp_path:
-        gcps = gcpmod.read_gcps(gcp_path, image_names=list(sizes), image_sizes=sizes)
+        # a CSV points file without a CRS line takes the CRS parameter
+        gcps = gcpmod.read_gcps(gcp_path, image_names=list(sizes), image_sizes=sizes, default_crs=crs)
     if gcps is not None and check_points:
         gcpmod.apply_check_points(gcps, list(check_points))
     positions_crs = gcpmod.read_camera_positions(camera_positions_path)[0] if camera_positions_path else None
@@ -122,12 +124,13 @@ def _read_control(ws: Workspace, gcp_path: Optional[str], gcps: Optional[gcpmod.
         cams = _exif_positions(ws, target)
         if not cams:
             progress.warning("USE_EXIF_GPS is set but no image carries EXIF GPS")
-    n_control = sum(1 for p in gcps.points if p.role == gcpmod.CONTROL) if gcps else 0
+    # a control point whose observations were all dropped (outside the image, unknown image) controls nothing
+    n_control = sum(1 for p in gcps.points if p.role == gcpmod.CONTROL and p.observations) if gcps else 0
     if n_control < 3 and len(cams) < 3:
-        found = ", ".join(f"{p.name} ({p.role}, {len(p.observations)} obs.)" for p in gcps.points) if gcps else "none"
-        raise StageError(
+        found = "; ".join(f"{p.name} ({p.role}, {p.describe_observations()})" for p in gcps.points) if gcps else "none"
+        raise StageError(gcpmod.with_warnings(
             f"georeferencing needs at least 3 control points (or 3 camera positions); found {n_control} control "
-            f"point(s) and {len(cams)} camera position(s). Points: {found}")
+            f"point(s) with observations and {len(cams)} camera position(s). Points: {found}", gcps.warnings if gcps else []))
     return gcps, cams, target
 
 
@@ -155,7 +158,12 @@ def georeference_workspace(workspace_dir: str, gcp_path: Optional[str] = None,
     opt = GeorefOptions.of(options, refine_intrinsics=refine_intrinsics, crs=target)
     with run_stage(ws, GEOREF, params, inputs) as run:
         with run.step("adjustment", save=False):
-            result = georeference(rec, gcps, cams or None, progress=SubProgress(progress, 0.0, 0.9), options=opt)
+            try:
+                result = georeference(rec, gcps, cams or None, progress=SubProgress(progress, 0.0, 0.9), options=opt)
+            except ArchaeoOrthoError:  # the GCP file's warnings reach the user in this outcome too
+                for w in gcps.warnings if gcps is not None else []:
+                    progress.warning(w)
+                raise
         source = "file" if camera_positions_path else ("exif" if cams else None)
         outputs, residuals_path, cameras_path = _save_products(lay, result, gcps, cams, source, target, opt)
         figures = _figures(result)

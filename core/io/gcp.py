@@ -49,6 +49,7 @@ import math
 import os
 import re
 import warnings as _warnings
+from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -79,10 +80,24 @@ class GroundPoint:
     sigma_z: float = 0.05
     role: str = CONTROL  # CONTROL or CHECK
     observations: List[Observation] = field(default_factory=list)
+    dropped: List[str] = field(default_factory=list)  # why the reader dropped observations, one entry each
 
     def images(self) -> List[str]:
         """Names of the images this point is observed in, in order, without repeats."""
         return list(dict.fromkeys(o.image for o in self.observations))
+
+    def describe_observations(self) -> str:
+        """'2 observations', or with the ones the reader dropped: '2 observations, both dropped: outside the
+        image', '3 observations, 1 dropped: duplicate'."""
+        kept, lost = len(self.observations), len(self.dropped)
+        total = kept + lost
+        text = f"{total} observation{'s' if total != 1 else ''}"
+        if lost:
+            reasons = ", ".join(f"{r} x{c}" if c > 1 and len(set(self.dropped)) > 1 else r
+                                for r, c in Counter(self.dropped).items())
+            which = ("both" if lost == 2 else "all" if lost > 2 else "it") if not kept else str(lost)
+            text += f", {which} dropped: {reasons}"
+        return text
 
 
 @dataclass
@@ -253,12 +268,14 @@ def _finish(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike,
                 else:
                     gs.warnings.append(f"{at}: image {o.image!r} (point {p.name}) is not in the block; "
                                        "observation ignored")
+                    p.dropped.append("image not in the block")
                 continue
             o = Observation(img, o.x, o.y)
             if img in seen:
                 first = f"{unit} {seen[img]}" if seen[img] else f"an earlier {unit}"
                 gs.warnings.append(f"{at}: duplicate observation of point {p.name} in image {img} "
                                    f"(first on {first}); keeping the first")
+                p.dropped.append("duplicate")
                 continue
             if sizes_lookup is not None:
                 key = sizes_lookup.find(img)
@@ -268,6 +285,7 @@ def _finish(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike,
                         gs.warnings.append(
                             f"{at}: observation of point {p.name} at ({o.x:g}, {o.y:g}) lies outside image "
                             f"{img} ({w} x {h} px); dropped")
+                        p.dropped.append("outside the image")
                         continue
             seen[img] = ln
             kept.append(o)
@@ -284,7 +302,7 @@ def _finish(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike,
         first = next(iter(obs_lines.get(id(p)) or []), 0)
         at = (point_where or {}).get(id(p)) or loc(first)
         if n == 0:
-            gs.warnings.append(f"{at}: point {p.name} has no usable observation")
+            gs.warnings.append(f"{at}: point {p.name} has no usable observation ({p.describe_observations()})")
         elif n == 1:
             gs.warnings.append(f"{at}: point {p.name} is observed in only 1 image "
                                f"({p.observations[0].image}): usable only for single-image work (space "
@@ -295,6 +313,28 @@ def _finish(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike,
 def _check_units(gs: GCPSet, path: PathLike) -> None:
     if gs.points:
         check_coordinates_match_crs(gs.crs, [(p.x, p.y) for p in gs.points], "GCP coordinates", str(path))
+
+
+def with_warnings(error: Exception, warnings: Sequence[str]) -> str:
+    """The message of ``error`` followed by the reader's warnings (that led to it, often: dropped lines)."""
+    if not warnings:
+        return str(error)
+    shown = list(warnings[:20]) + ([f"... ({len(warnings)} in all)"] if len(warnings) > 20 else [])
+    return f"{error}\nwarnings while reading the ground control:\n  " + "\n  ".join(shown)
+
+
+def _finish_checked(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike, units_path: PathLike,
+                    image_names: Optional[Iterable[str]], image_sizes: Optional[ImageSizes], unknown_images: str,
+                    point_where: Optional[Dict[int, str]] = None) -> GCPSet:
+    """_finish and _check_units; a GCPError they raise carries the warnings collected before it."""
+    try:
+        _finish(gs, obs_lines, path, image_names, image_sizes, unknown_images, point_where)
+        _check_units(gs, units_path)
+    except GCPError as e:
+        if not gs.warnings:
+            raise
+        raise GCPError(with_warnings(e, gs.warnings)) from e
+    return gs
 
 
 # --------------------------------------------------------------------------------------------------
@@ -411,9 +451,7 @@ def read_odm_gcp_list(path: PathLike, image_names: Optional[Iterable[str]] = Non
     gs.points = order
     if not order:
         gs.warnings.append(f"{path}: no observations")
-    _finish(gs, obs_lines, path, image_names, image_sizes, unknown_images)
-    _check_units(gs, path)
-    return gs
+    return _finish_checked(gs, obs_lines, path, path, image_names, image_sizes, unknown_images)
 
 
 def _fmt(v: float) -> str:
@@ -556,20 +594,23 @@ def default_observations_path(points_path: PathLike) -> str:
 
 def read_csv_gcps(points_path: PathLike, observations_path: Optional[PathLike] = None, *,
                   crs: Optional[str] = None, image_names: Optional[Iterable[str]] = None,
-                  image_sizes: Optional[ImageSizes] = None, unknown_images: str = "error") -> GCPSet:
+                  image_sizes: Optional[ImageSizes] = None, unknown_images: str = "error",
+                  default_crs: Optional[str] = None) -> GCPSet:
     """Read GCPs from a points CSV and an observations CSV (format in the module docstring).
 
-    ``crs`` overrides a CRS found in the points file; one of the two is required.  Without
+    ``crs`` overrides a CRS found in the points file; ``default_crs`` (an algorithm's CRS parameter) is the CRS
+    of a points file that names none; one of the three is required.  Without
     ``observations_path`` the file ``default_observations_path(points_path)`` is read if it exists.
     Validation as for ``read_odm_gcp_list``.
     """
     file_crs, crs_line, cols, rows = _csv_table(points_path, _POINT_COLS, ("name", "x", "y", "z"), "points")
-    use_crs = normalize_crs(crs) if crs else file_crs
+    given = crs or (default_crs if not file_crs else None)
+    use_crs = normalize_crs(given) if given else file_crs
     if not use_crs:
-        raise GCPError(f"{points_path}: no CRS: give it as the crs argument or as a line '# crs: EPSG:xxxx' "
-                       "before the header")
+        raise GCPError(f"{points_path}: no CRS: give it as the crs argument (the algorithm's CRS parameter) or as "
+                       "a line '# crs: EPSG:xxxx' before the header")
     gs = GCPSet(crs=use_crs, source=str(points_path))
-    _check_crs_for_file(use_crs, points_path, crs_line if not crs else None, gs.warnings)
+    _check_crs_for_file(use_crs, points_path, crs_line if not given else None, gs.warnings)
     defaults = GroundPoint("", 0.0, 0.0, 0.0)
     first_line: Dict[str, int] = {}
     for lineno, cells in rows:
@@ -624,9 +665,7 @@ def read_csv_gcps(points_path: PathLike, observations_path: Optional[PathLike] =
             p.observations.append(Observation(img, px, py))
             obs_lines.setdefault(id(p), []).append(lineno)
     where = {id(p): f"{points_path}:{first_line[p.name]}" for p in gs.points}
-    _finish(gs, obs_lines, obs_path, image_names, image_sizes, unknown_images, where)
-    _check_units(gs, points_path)
-    return gs
+    return _finish_checked(gs, obs_lines, obs_path, points_path, image_names, image_sizes, unknown_images, where)
 
 
 def _csv_text(rows: Iterable[Sequence[Any]]) -> str:
@@ -681,15 +720,16 @@ def detect_gcp_format(path: PathLike) -> str:
 
 def read_gcps(path: PathLike, image_names: Optional[Iterable[str]] = None,
               image_sizes: Optional[ImageSizes] = None, *, observations_path: Optional[PathLike] = None,
-              crs: Optional[str] = None, unknown_images: str = "error") -> GCPSet:
+              crs: Optional[str] = None, unknown_images: str = "error", default_crs: Optional[str] = None) -> GCPSet:
     """Read ground control from an OpenDroneMap gcp_list.txt or a CSV points file (+ observations file).
 
-    ``crs`` and ``observations_path`` apply to the CSV form only.  See ``read_odm_gcp_list`` for
+    ``crs``, ``default_crs`` (the CRS of a file that names none) and ``observations_path`` apply to the CSV form
+    only (a gcp_list.txt always names its CRS).  See ``read_odm_gcp_list`` for
     ``image_names``, ``image_sizes`` and ``unknown_images``.
     """
     if detect_gcp_format(path) == "csv":
         return read_csv_gcps(path, observations_path, crs=crs, image_names=image_names,
-                             image_sizes=image_sizes, unknown_images=unknown_images)
+                             image_sizes=image_sizes, unknown_images=unknown_images, default_crs=default_crs)
     return read_odm_gcp_list(path, image_names, image_sizes, unknown_images=unknown_images)
 
 
