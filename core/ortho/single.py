@@ -116,7 +116,7 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
     orient, single.camera = _orientation_input(orientation, gcps is None, run, image_path, single.camera)
     if isinstance(gcps, str):
         try:
-            gcps = gcpmod.read_gcps(gcps)
+            gcps = gcpmod.read_gcps(gcps, default_crs=single.crs)  # a CSV without a CRS line: the CRS parameter
         except gcpmod.GCPError as e:
             raise OrthoError(str(e)) from e
     work_crs = _working_crs(single.crs, dsm_path, gcps, orient, run)
