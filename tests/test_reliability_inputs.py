@@ -347,3 +347,38 @@ def test_a_csv_gcp_file_without_crs_takes_the_crs_parameter(tmp_path):
     path = _csv_gcps(tmp_path, None, _UTM_ROWS, obs)
     with pytest.raises(gcp.GCPError, match="CRS parameter"):
         georef_stage._read_control(ws, path, None, (), None, False, None, _Recorder())
+
+
+def _damaged_geotiff(path):
+    """A tiled, DEFLATE-compressed RGB GeoTIFF whose tiles' bytes are overwritten with garbage."""
+    from osgeo import gdal, osr
+
+    drv = gdal.GetDriverByName("GTiff")
+    ds = drv.Create(str(path), 512, 512, 3, gdal.GDT_Byte, ["TILED=YES", "COMPRESS=DEFLATE", "BLOCKXSIZE=256",
+                                                            "BLOCKYSIZE=256"])
+    ds.SetGeoTransform((500000.0, 0.1, 0.0, 4000000.0, 0.0, -0.1))
+    srs = osr.SpatialReference()
+    srs.ImportFromEPSG(32617)
+    ds.SetProjection(srs.ExportToWkt())
+    rng = np.random.default_rng(0)
+    for b in range(3):
+        ds.GetRasterBand(b + 1).WriteArray(rng.integers(0, 255, (512, 512), dtype=np.uint8))
+    ds = None
+    size = path.stat().st_size
+    with open(path, "r+b") as f:  # the header stays, the compressed tiles become garbage
+        f.seek(size // 3)
+        f.write(b"\x00\xff" * (size // 6))
+
+
+def test_a_damaged_orthomosaic_in_the_report_is_a_report_error_naming_the_file(tmp_path):
+    from types import SimpleNamespace
+
+    from core.report.errors import ReportError
+    from core.report.sections import products
+
+    path = tmp_path / "orthomosaic.tif"
+    _damaged_geotiff(path)
+    ctx = SimpleNamespace(d=SimpleNamespace(ws=SimpleNamespace(root=str(tmp_path)), manifest={}), figures={})
+    with pytest.raises(ReportError) as e:
+        products._raster(ctx, str(path), "Orthomosaic", dem=False)
+    assert str(path) in str(e.value) and "damaged" in str(e.value)

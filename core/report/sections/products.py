@@ -7,6 +7,7 @@ import os
 import numpy as np
 
 from ..context import ReportContext, Skip
+from ..errors import ReportError
 from ..figures import draw_dem, draw_image, embed, equal_xy, new_figure
 from ..html import esc, kv, num, raster_crs_name
 
@@ -49,8 +50,15 @@ def _raster(ctx: ReportContext, path: str, title: str, dem: bool) -> str:
     fig = new_figure(7.5, 6.0)
     ax = fig.add_subplot(111)
     extent = (gt[0], gt[0] + gt[1] * w, gt[3] + gt[5] * h, gt[3])
+    try:
+        if dem:
+            z = b1.ReadAsArray(buf_xsize=bw, buf_ysize=bh).astype(float)
+        else:
+            arr, alpha = _read_image(ds, bw, bh)
+    except RuntimeError as e:  # a damaged tile: GDAL's "IReadBlock failed ... TIFFReadEncodedTile() failed"
+        raise ReportError(f"the {title.lower()} {path} is damaged: GDAL cannot read its cells ({e}). Run the stage "
+                          f"that writes it again ('{'Build DSM' if dem else 'Build orthophoto'}')") from e
     if dem:
-        z = b1.ReadAsArray(buf_xsize=bw, buf_ysize=bh).astype(float)
         valid = np.isfinite(z) & ((z != nodata) if nodata is not None else True)
         frac = float(valid.mean())
         zz = np.where(valid, z, np.nan)
@@ -58,7 +66,6 @@ def _raster(ctx: ReportContext, path: str, title: str, dem: bool) -> str:
         if shown is not None:
             info.append(("Height range (1st–99th percentile)", f"{shown[0]:.2f} – {shown[1]:.2f} m"))
     else:
-        arr, alpha = _read_image(ds, bw, bh)
         frac = float(alpha.mean())
         draw_image(ax, arr, alpha, extent)
     info.append(("Valid fraction (cells with data)", f'<span data-key="{title.lower()}.valid">{frac:.3f}</span>'
