@@ -382,3 +382,17 @@ def test_a_damaged_orthomosaic_in_the_report_is_a_report_error_naming_the_file(t
     with pytest.raises(ReportError) as e:
         products._raster(ctx, str(path), "Orthomosaic", dem=False)
     assert str(path) in str(e.value) and "damaged" in str(e.value)
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-le", "utf-16-be"])  # with a byte-order mark, without
+def test_a_utf16_gcp_file_names_the_encoding_instead_of_printing_garbage_as_a_crs(tmp_path, encoding):
+    from core.io import gcp
+
+    text = "EPSG:32617\n500000 4000000 100 1000 800 IMG_1.JPG A\n500000 4000000 100 1010 810 IMG_2.JPG A\n"
+    for name in ("gcp_list.txt", "gcps.csv"):
+        path = tmp_path / name
+        path.write_bytes(text.encode(encoding))
+        with pytest.raises(gcp.GCPError) as e:
+            gcp.read_gcps(str(path))
+        assert f"file {path} is UTF-16" in str(e.value) and "save it as UTF-8" in str(e.value)
+        assert "\x00" not in str(e.value) and "ÿþ" not in str(e.value)

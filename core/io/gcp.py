@@ -169,12 +169,28 @@ ImageSizes = Mapping[str, Tuple[int, int]]
 # reading helpers
 # --------------------------------------------------------------------------------------------------
 
+def _utf16_or_32(raw: bytes) -> Optional[str]:
+    """'UTF-16' / 'UTF-32' when the bytes are such text (a byte-order mark, or NUL bytes between ASCII ones:
+    Windows Notepad's "Unicode"), else None."""
+    if raw.startswith((b"\xff\xfe\x00\x00", b"\x00\x00\xfe\xff")):
+        return "UTF-32"
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        return "UTF-16"
+    head = raw[:4096]
+    if len(head) >= 8 and head.count(b"\x00") > len(head) // 4:
+        return "UTF-32" if head.count(b"\x00") > len(head) // 2 else "UTF-16"
+    return None
+
+
 def _read_lines(path: PathLike) -> List[str]:
     try:
         with open(path, "rb") as f:
             raw = f.read()
     except OSError as e:
         raise GCPError(f"{path}: cannot read: {e.strerror or e}") from e
+    wide = _utf16_or_32(raw)
+    if wide:
+        raise GCPError(f"file {path} is {wide} text; save it as UTF-8 (or plain ASCII) and read it again")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError:
