@@ -8,6 +8,7 @@
 """
 from __future__ import annotations
 
+import copy
 import os
 import time
 from dataclasses import dataclass, field
@@ -18,9 +19,11 @@ from .align.stage import align
 from .common.progress import NullProgress, Progress, SubProgress
 from .dense.options import DenseOptions
 from .dense.stage import build_dsm_workspace
+from .geometry.crs import validate_crs
 from .georef.options import GeorefOptions
 from .georef.stage import GeorefStageResult, georeference_workspace
-from .io.gcp import GCPSet
+from .io.gcp import GCPSet, apply_check_points, read_camera_positions, read_gcps
+from .io.images import check_image_folder, list_images
 from .ortho.options import OrthoOptions
 from .ortho.stage import build_orthophoto_workspace
 from .project.stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, REPORT, StageError
@@ -80,6 +83,24 @@ SPANS = {ALIGN: (0.0, 0.40), GEOREFERENCE: (0.40, 0.45), DSM: (0.45, 0.75), ORTH
          REPORT: (0.93, 1.0)}
 
 
+def check_inputs(images_dir: str, control: Control) -> None:
+    """Read and check what the later stages take before the alignment starts (minutes of work that an unknown
+    EPSG code or a bad GCP file would throw away): the image folder, the CRS, the GCP file (its CRS line, its
+    rows, the images it names, the check points) and the camera positions file.  Raises the readers' errors
+    (ImageError, CRSError, GCPError: each names the file or value and the problem)."""
+    check_image_folder(images_dir, "IMAGES folder")
+    if control.crs:
+        validate_crs(control.crs)
+    if control.gcp_path:
+        gcps = read_gcps(control.gcp_path, image_names=list_images(images_dir), crs=control.crs)
+        if control.check_points:
+            apply_check_points(gcps, list(control.check_points))
+    elif control.gcps is not None and control.check_points:
+        apply_check_points(copy.deepcopy(control.gcps), list(control.check_points))
+    if control.camera_positions_path:
+        read_camera_positions(control.camera_positions_path)
+
+
 def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[PipelineOptions] = None,
                  control: Optional[Control] = None, progress: Optional[Progress] = None) -> PipelineResult:
     """The whole chain in one call: align -> georeference -> DSM -> orthomosaic -> report.
@@ -96,6 +117,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
         raise StageError("the pipeline needs ground control (GCPS) and/or camera positions (CAMERA_POSITIONS or "
                          "USE_EXIF_GPS) to georeference the block before the DSM and orthophoto; to align only, "
                          "run 'Align images'")
+    check_inputs(images_dir, ctl)
     seconds: Dict[str, float] = {}
 
     def run(name, fn, *args, **kwargs):
@@ -127,4 +149,4 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
     return res
 
 
-__all__ = ["Control", "PipelineOptions", "PipelineResult", "run_pipeline"]
+__all__ = ["Control", "PipelineOptions", "PipelineResult", "check_inputs", "run_pipeline"]

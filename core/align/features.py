@@ -37,9 +37,10 @@ def choose_camera_model(requested: str, n_images: int, min_images_opencv: int = 
     return "SIMPLE_RADIAL"
 
 
-def setup_database(pycolmap, db_path: str, groups: List[CameraGroup], options: AlignOptions,
-                    images_dir: str, state: dict, masks_key: Optional[str] = None) -> Dict[str, int]:
-    """Create (or check) the database's cameras; returns camera_id per group key."""
+def database_key(groups: List[CameraGroup], options: AlignOptions, images_dir: str, masks_key: Optional[str] = None,
+                 photos_key: Optional[str] = None) -> str:
+    """The key of what a database's features were extracted from: images (names, sizes, content), folder,
+    camera settings and masks; a database of another key is not reused."""
     what = {
         "groups": [(g.key, g.width, g.height, round(g.focal_px, 3), sorted(g.images)) for g in groups],
         "model": options.camera_model, "max_image_size": options.max_image_size,
@@ -52,10 +53,17 @@ def setup_database(pycolmap, db_path: str, groups: List[CameraGroup], options: A
     octave = sift_first_octave(options, g0.width, g0.height)
     if octave != -1:  # COLMAP's default (-1) keeps the key of earlier workspaces
         what["first_octave"] = octave
-    key = fingerprint(what)
-    if os.path.exists(db_path) and state.get("database_key") != key:
+    if photos_key:  # the photos' content: another photo under the same name is extracted afresh
+        what["photos"] = photos_key
+    return fingerprint(what)
+
+
+def setup_database(pycolmap, db_path: str, groups: List[CameraGroup], options: AlignOptions, key: str,
+                   known_key: Optional[str]) -> Dict[str, int]:
+    """Create (or check) the database's cameras; returns camera_id per group key.  A database at ``db_path``
+    made for ``known_key`` is removed first when the ``key`` of this run differs."""
+    if os.path.exists(db_path) and known_key != key:
         os.unlink(db_path)  # different images or extraction settings: start afresh
-    state["database_key"] = key
     db = pycolmap.Database.open(db_path)
     try:
         ids = {}

@@ -27,16 +27,31 @@ def verified_partners(pycolmap, db_path, min_inliers: int) -> Dict[str, int]:
         db.close()
 
 
+def verified_pairs(pycolmap, db_path, min_inliers: int) -> int:
+    """How many image pairs of the database have at least ``min_inliers`` verified inliers."""
+    db = pycolmap.Database.open(db_path)
+    try:
+        _pair_ids, counts = db.read_two_view_geometry_num_inliers()
+        return int(sum(1 for c in counts if c >= min_inliers))
+    finally:
+        db.close()
+
+
 def run_mapping(pycolmap, db_path, images_dir, out_dir, n_images, options, progress: Progress):
-    if options.mapper == "global":
-        return _map_global(pycolmap, db_path, images_dir, out_dir, options, progress)
+    if options.mapper == "global" and n_images <= 2:
+        progress.info("mapping: two images, mapped with the incremental mapper (the global mapper needs tracks of "
+                      "three or more views)")
+    elif options.mapper == "global":
+        return _map_global(pycolmap, db_path, images_dir, out_dir, n_images, options, progress)
     opts = pycolmap.IncrementalPipelineOptions()
     opts.num_threads = options.num_threads
     opts.random_seed = options.seed
     opts.mapper.random_seed = options.seed
     opts.triangulation.random_seed = options.seed
     opts.ba_refine_principal_point = False
-    opts.min_model_size = 3  # keep small separate components so they can be reported by name
+    opts.min_model_size = min_model_size(n_images)
+    if n_images <= 2:  # every track of a stereo pair has two views: COLMAP skips those by default
+        opts.triangulation.ignore_two_view_tracks = False
     state = {"n": 0}
 
     def on_next():
@@ -50,13 +65,19 @@ def run_mapping(pycolmap, db_path, images_dir, out_dir, n_images, options, progr
     return recs
 
 
-def _map_global(pycolmap, db_path, images_dir, out_dir, options, progress: Progress):
+def min_model_size(n_images: int) -> int:
+    """The smallest model the mapper keeps: 3 images (small separate components are kept so they can be
+    reported by name), 2 when only two images are given (a stereo pair is a valid block)."""
+    return 2 if n_images <= 2 else 3
+
+
+def _map_global(pycolmap, db_path, images_dir, out_dir, n_images, options, progress: Progress):
     """GLOMAP's global pipeline (rotation averaging, global positioning, bundle adjustment).  pycolmap 4.2
     gives it no cancellation token and no progress callback: a cancel takes effect when it returns."""
     opts = pycolmap.GlobalPipelineOptions()
     opts.num_threads = options.num_threads
     opts.random_seed = options.seed
-    opts.min_model_size = 3
+    opts.min_model_size = min_model_size(n_images)
     progress.report(0.0, "mapping: global SfM (rotation averaging, global positioning, bundle adjustment)")
     check_cancel(progress)
     recs = pycolmap.global_mapping(db_path, images_dir, out_dir, options=opts)

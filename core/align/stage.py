@@ -15,6 +15,7 @@ selection), :mod:`.mapping` (incremental or global mapping, bundle adjustment); 
 """
 from __future__ import annotations
 
+import copy
 import json
 import os
 import shutil
@@ -25,17 +26,26 @@ from typing import Dict, List, Optional, Sequence, Set, Tuple
 from ..common.cancel import load_pycolmap
 from ..common.files import atomic_output, atomic_write_text, fingerprint
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
-from ..io.images import CameraGroup, ImageError, ImageInfo, group_cameras, scan_images
+from ..io.images import CameraGroup, ImageError, ImageInfo, check_image_folder, group_cameras, scan_images
 from ..io.vector import write_cameras_gpkg
 from ..project.layout import Layout
 from ..project.stages import ALIGN, run_stage
 from ..project.workspace import Workspace
-from .features import extract_features, file_hash, masks_for_colmap, match_pairs, setup_database
-from .mapping import camera_rows, camera_summary, final_bundle_adjustment, run_mapping, verified_partners
+from .features import database_key, extract_features, file_hash, masks_for_colmap, match_pairs, setup_database
+from .mapping import (
+    camera_rows,
+    camera_summary,
+    final_bundle_adjustment,
+    run_mapping,
+    verified_pairs,
+    verified_partners,
+)
 from .options import MAPPERS, MIN_VERIFIED_INLIERS, AlignError, AlignOptions
 from .pairs import select_pairs
+from .photos import PHOTO_FINGERPRINTS, fingerprint_photos
 
 STAGE = ALIGN
+STAGED_KEY = "staged_database_key"  # the align record's key of sfm/database.staged.db (a re-run in progress)
 
 
 @dataclass
@@ -111,41 +121,104 @@ def _report_unregistered(progress: Progress, unregistered: Dict[str, str], other
         )
 
 
-def _no_reconstruction(partners: Dict[str, int], n_images: int) -> AlignError:
+def _no_reconstruction(partners: Dict[str, int], n_images: int, n_pairs: int) -> AlignError:
     isolated = [n for n, c in partners.items() if c == 0]
+    if isolated:
+        return AlignError(
+            "no reconstruction could be built: the images do not overlap enough. "
+            f"{len(isolated)} of {n_images} images share no verified matches with any other image"
+            f" ({', '.join(isolated[:10])}{' ...' if len(isolated) > 10 else ''})")
     return AlignError(
-        "no reconstruction could be built: the images do not overlap enough. "
-        f"{len(isolated)} of {n_images} images share no verified matches with any other image"
-        + (f" ({', '.join(isolated[:10])})" if isolated else "")
-    )
+        f"no reconstruction could be built: every one of the {n_images} images shares verified matches "
+        f"({n_pairs} image pair(s) with {MIN_VERIFIED_INLIERS} or more inliers), but the mapper found no initial "
+        "pair it could triangulate (baseline too short for the distance, e.g. photos taken from one spot, or "
+        "matches on a repeated pattern); add photos taken from other positions")
 
 
-def _mapping(pycolmap, lay: Layout, images_dir: str, n_images: int, options: AlignOptions, progress: Progress):
+def _mapping(pycolmap, lay: Layout, db_path: str, images_dir: str, n_images: int, options: AlignOptions,
+             progress: Progress):
     """The reconstructions, largest first; mapping works in a scratch folder removed afterwards."""
     map_tmp = os.path.join(lay.sfm_dir, ".mapping")
     shutil.rmtree(map_tmp, ignore_errors=True)
     os.makedirs(map_tmp)
-    recs = run_mapping(pycolmap, lay.database, images_dir, map_tmp, n_images, options, progress)
+    recs = run_mapping(pycolmap, db_path, images_dir, map_tmp, n_images, options, progress)
     shutil.rmtree(map_tmp, ignore_errors=True)
     return sorted(recs.values(), key=lambda r: r.num_reg_images(), reverse=True) if recs else []
 
 
-def _setup(pycolmap, lay: Layout, infos, groups, options: AlignOptions, images_dir: str, record: dict,
+@dataclass
+class _Photos:
+    """What the alignment reads from the image folder before any work."""
+
+    images_dir: str
+    infos: List[ImageInfo]
+    skipped: List[str]
+    groups: List[CameraGroup]
+    fingerprints: Dict[str, str]  # image name -> content fingerprint (core.align.photos)
+    seconds: float
+
+
+def _database_path(lay: Layout, record: dict, key: str, keep_previous: bool) -> Tuple[str, Optional[str]]:
+    """(the database this run works in, the key it was made for).  The workspace's database when it was made for
+    the same images and settings (a re-run after a cancel reuses its features and matches) or when there is no
+    previous alignment to keep; otherwise a staged database beside it (``sfm/database.staged.db``), swapped in
+    only when the new alignment succeeds, so a failed re-run leaves the previous alignment's database as it was."""
+    if not keep_previous or record.get("database_key") == key or not os.path.exists(lay.database):
+        record.pop(STAGED_KEY, None)
+        if os.path.exists(lay.staged_database):
+            os.unlink(lay.staged_database)
+        known, record["database_key"] = record.get("database_key"), key
+        return lay.database, known
+    known, record[STAGED_KEY] = record.get(STAGED_KEY), key
+    return lay.staged_database, known
+
+
+def _setup(pycolmap, lay: Layout, photos: _Photos, options: AlignOptions, record: dict, keep_previous: bool,
            progress: Progress):
-    """Masks for COLMAP and the database's cameras: (mask_path, image -> mask, camera ids)."""
+    """Masks for COLMAP and the database's cameras: (database path, mask_path, image -> mask, camera ids)."""
+    infos, groups = photos.infos, photos.groups
     mask_path, masks = masks_for_colmap(lay.masks_dir, infos, lay.sfm_dir)
     masks_key = fingerprint(sorted((n, file_hash(p)) for n, p in masks.items())) if masks else None
     if masks:
         record["inputs"]["masks"] = masks_key
         progress.info(f"masks: {len(masks)} of {len(infos)} images have a mask ({lay.masks_dir}): "
                       "no features where they are black")
-    camera_ids = setup_database(pycolmap, lay.database, groups, options, images_dir, record, masks_key)
-    return mask_path, masks, camera_ids
+    key = database_key(groups, options, photos.images_dir, masks_key, fingerprint(photos.fingerprints))
+    db_path, known_key = _database_path(lay, record, key, keep_previous)
+    camera_ids = setup_database(pycolmap, db_path, groups, options, key, known_key)
+    return db_path, mask_path, masks, camera_ids
+
+
+def _read_folder(images_dir: str, options: AlignOptions, progress: Progress) -> _Photos:
+    """The usable photos of ``images_dir`` and their fingerprints; AlignError with fewer than two."""
+    t0 = time.time()
+    infos, skipped, groups = _read_images(images_dir, options, progress)
+    return _Photos(images_dir, infos, skipped, groups, fingerprint_photos(infos), time.time() - t0)
+
+
+def _previous_alignment(ws: Workspace, lay: Layout) -> Optional[dict]:
+    """A copy of the align stage's record when the workspace holds a complete alignment (else None)."""
+    return copy.deepcopy(ws.data["stages"][STAGE]) if lay.has_aligned_model() else None
+
+
+def _keep_previous(ws: Workspace, previous: dict) -> None:
+    """After a failed or cancelled re-run: the previous alignment stays the workspace's (its record, image list,
+    database and model were not replaced); the attempt is recorded under ``last_attempt``."""
+    failed = ws.data["stages"].get(STAGE, {})
+    record = copy.deepcopy(previous)
+    record["last_attempt"] = {k: failed.get(k) for k in ("status", "started", "finished", "error", "parameters")}
+    if failed.get(STAGED_KEY):
+        record[STAGED_KEY] = failed[STAGED_KEY]  # a re-run of the same attempt resumes in the staged database
+    ws.data["stages"][STAGE] = record
+    ws.save()
 
 
 def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] = None,
           progress: Optional[Progress] = None) -> AlignResult:
-    """Run the alignment stage.  Raises AlignError / ImageError / WorkspaceError / Cancelled."""
+    """Run the alignment stage.  Raises AlignError / ImageError / WorkspaceError / Cancelled.
+
+    A re-run that fails or is cancelled leaves a previous complete alignment as it was: the image list, the
+    database, the model and the later stages' records are replaced only when the new alignment succeeds."""
     options = options or AlignOptions()
     progress = progress or NullProgress()
     if options.mapper not in MAPPERS:
@@ -153,34 +226,39 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
     pycolmap = load_pycolmap("the alignment")
     t_start = time.time()
     images_dir = os.path.abspath(images_dir)
-    if not os.path.isdir(images_dir):
-        raise AlignError(f"image folder {images_dir} does not exist")
+    try:
+        check_image_folder(images_dir)  # does not exist / is a file / cannot be read: before the workspace
+    except ImageError as e:
+        raise AlignError(str(e)) from e
     ws = Workspace.create_or_open(workspace_dir)  # checks writability before any work
     lay = Layout(ws)
+    photos = _read_folder(images_dir, options, progress)
+    previous = _previous_alignment(ws, lay)
+    try:
+        return _run(pycolmap, ws, lay, photos, options, previous is not None, t_start, progress)
+    except BaseException:
+        if previous is not None:
+            _keep_previous(ws, previous)
+        raise
 
-    # 1. images
-    t0 = time.time()
-    infos, skipped, groups = _read_images(images_dir, options, progress)
-    images_seconds = time.time() - t0
-    ws.data["images_dir"] = images_dir
-    ws.data["images"] = [im.to_dict() for im in infos]
-    ws.data["camera_groups"] = [asdict(g) for g in groups]
-    database_key = ws.data["stages"].get(STAGE, {}).get("database_key")
+
+def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOptions, keep_previous: bool,
+         t_start: float, progress: Progress) -> AlignResult:
+    """The stage body inside run_stage(): features, matches, mapping, bundle adjustment, products."""
+    infos, groups, images_dir = photos.infos, photos.groups, photos.images_dir
     inputs = {"images": fingerprint([(im.name, im.width, im.height) for im in infos])}
     with run_stage(ws, STAGE, asdict(options), inputs) as run:
-        if database_key:
-            run.record["database_key"] = database_key
         for g in groups:
             progress.info(f"camera {g.camera_id}: {g.make} {g.model} {g.width}x{g.height}, focal prior "
                           f"{g.focal_px:.1f} px ({g.focal_source}), {len(g.images)} images")
         os.makedirs(lay.sfm_dir, exist_ok=True)
-        mask_path, masks, camera_ids = _setup(pycolmap, lay, infos, groups, options, images_dir, run.record,
-                                              progress)
+        db_path, mask_path, masks, camera_ids = _setup(pycolmap, lay, photos, options, run.record, keep_previous,
+                                                       progress)
         ws.save()
 
         # 2. features
         with run.step("features", save=False):
-            extract_features(pycolmap, lay.database, images_dir, groups, camera_ids, options,
+            extract_features(pycolmap, db_path, images_dir, groups, camera_ids, options,
                              SubProgress(progress, 0.02, 0.35), mask_path, list(masks))
         # 3. pairs + matching
         with run.step("matching", save=False):
@@ -188,13 +266,14 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
             for w in pw:
                 progress.warning(w)
             progress.info(f"pair selection: {pairing_used}, {len(pairs)} pairs for {len(infos)} images")
-            match_pairs(pycolmap, lay.database, pairs, lay.sfm_dir, options, SubProgress(progress, 0.35, 0.65))
+            match_pairs(pycolmap, db_path, pairs, lay.sfm_dir, options, SubProgress(progress, 0.35, 0.65))
         # 4. mapping
         with run.step("mapping", save=False):
-            ordered = _mapping(pycolmap, lay, images_dir, len(infos), options, SubProgress(progress, 0.65, 0.93))
-        partners = verified_partners(pycolmap, lay.database, MIN_VERIFIED_INLIERS)
+            ordered = _mapping(pycolmap, lay, db_path, images_dir, len(infos), options,
+                               SubProgress(progress, 0.65, 0.93))
+        partners = verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS)
         if not ordered:
-            raise _no_reconstruction(partners, len(infos))
+            raise _no_reconstruction(partners, len(infos), verified_pairs(pycolmap, db_path, MIN_VERIFIED_INLIERS))
         rec = ordered[0]
         others = [sorted(rec2.images[i].name for i in rec2.reg_image_ids()) for rec2 in ordered[1:]]
         # 5. final global bundle adjustment
@@ -206,18 +285,19 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
         _report_unregistered(progress, unregistered, others, len(registered))
         check_cancel(progress)
 
-        # 6. write the model atomically
+        # 6. write the model atomically; the new image list and database become the workspace's
         with atomic_output(lay.aligned_model_dir) as tmp:
             os.makedirs(tmp)
             rec.write_binary(tmp)
+        _commit(ws, lay, run.record, photos, db_path)
         cameras_path = write_cameras_gpkg(ws.root, camera_rows(rec), crs=None)
         mre = float(rec.compute_mean_reprojection_error())
-        timings = dict(images=images_seconds, **run.timings)
+        timings = dict(images=photos.seconds, **run.timings)
         result = AlignResult(
             workspace=ws.root, model_dir=lay.aligned_model_dir, cameras_path=cameras_path, images_given=len(infos),
             registered=len(registered), mean_reprojection_error=mre, num_points3d=int(rec.num_points3D()),
-            unregistered=unregistered, other_components=others, skipped_files=skipped, pairing_used=pairing_used,
-            num_pairs=len(pairs), timings={k: round(v, 3) for k, v in timings.items()},
+            unregistered=unregistered, other_components=others, skipped_files=photos.skipped,
+            pairing_used=pairing_used, num_pairs=len(pairs), timings={k: round(v, 3) for k, v in timings.items()},
             cameras=camera_summary(rec), masked_images=len(masks),
         )
         figures = {k: v for k, v in asdict(result).items() if k not in ("workspace", "model_dir", "cameras_path")}
@@ -231,6 +311,19 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
     # later stages were built on the previous model: run_stage marked them stale
     progress.report(1.0, f"aligned {result.registered}/{len(infos)} images, {mre:.3f} px")
     return result
+
+
+def _commit(ws: Workspace, lay: Layout, record: dict, photos: _Photos, db_path: str) -> None:
+    """The new alignment succeeded: its image list, camera groups, photo fingerprints and database become the
+    workspace's (the manifest is saved when run_stage records the stage done)."""
+    if db_path != lay.database:
+        os.replace(db_path, lay.database)
+        record["database_key"] = record.pop(STAGED_KEY)
+    record.pop("last_attempt", None)
+    record[PHOTO_FINGERPRINTS] = photos.fingerprints
+    ws.data["images_dir"] = photos.images_dir
+    ws.data["images"] = [im.to_dict() for im in photos.infos]
+    ws.data["camera_groups"] = [asdict(g) for g in photos.groups]
 
 
 def load_model(workspace_dir: str):

@@ -28,9 +28,11 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from ..align.photos import check_photos
 from ..common.cancel import load_pycolmap
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..io import raster
+from ..io.images import ImageError
 from ..project.layout import Layout
 from ..project.stages import DSM, GEOREFERENCE, run_stage
 from ..project.workspace import Workspace
@@ -100,6 +102,8 @@ def build_dsm_workspace(workspace_dir: str, resolution: float = 0.0, quality: st
     crs = transform.get("crs") or ws.crs
     images_dir = ws.data.get("images_dir") or ""
     views = _views(ws, rec, images_dir)
+    for note in _check_photos(ws, views):
+        job.info(note)
 
     # 1. pairs
     t_pairs = time.time()
@@ -107,6 +111,7 @@ def build_dsm_workspace(workspace_dir: str, resolution: float = 0.0, quality: st
     pairs, stats = _pairs(views, xyz, tracks, options)
     gsd = median_gsd(views, xyz, tracks)
     res = float(resolution) if resolution and resolution > 0 else auto_resolution(gsd, options.scale)
+    _check_resolution(resolution, gsd, xyz, auto_resolution(gsd, options.scale))
     job.timings["pair_selection"] = time.time() - t_pairs
     job.info(f"pairs: {len(pairs)} selected from {stats['candidates']} overlapping image pairs "
              f"({len(views)} images, quality {options.quality}, median GSD {gsd:.3f} m, DSM resolution {res:g} m)")
@@ -207,6 +212,40 @@ def _views(ws: Workspace, rec, images_dir: str) -> Dict[int, View]:
         raise DenseError(f"{len(missing)} image(s) of the model are missing from {images_dir}: "
                          f"{', '.join(missing[:8])}{' ...' if len(missing) > 8 else ''}")
     return views
+
+
+def _check_photos(ws: Workspace, views: Dict[int, View]) -> List[str]:
+    """The photos about to be matched against the alignment's (core.align.photos); DenseError naming the missing,
+    unreadable or changed ones, notes for the log of an older workspace."""
+    try:
+        return check_photos(ws, {v.name: v.path for v in views.values()})
+    except ImageError as e:
+        raise DenseError(str(e)) from e
+
+
+MAX_DSM_CELLS = 50_000 * 50_000  # a RESOLUTION giving more cells over the block is refused before matching
+
+
+def _check_resolution(resolution: float, gsd: float, xyz: np.ndarray, auto: float) -> None:
+    """DenseError, before any matching, for a RESOLUTION that cannot make a sensible DSM of this block: finer
+    than a tenth of the ground sample distance, over MAX_DSM_CELLS cells, or under 2 cells across the block
+    (its extent: the 1st to 99th percentile of the tie points)."""
+    if not resolution or resolution <= 0 or len(xyz) == 0:
+        return  # automatic
+    res = float(resolution)
+    hint = f"give 0 (automatic: {auto:.3g} m here)"
+    if math.isfinite(gsd) and gsd > 0 and res < gsd / 10:
+        raise DenseError(f"RESOLUTION {res:g} m is finer than a tenth of the images' ground sample distance "
+                         f"({gsd:.3g} m): the photos hold no detail at that scale; {hint} or {gsd / 10:.3g} m or more")
+    lo, hi = np.percentile(xyz[:, :2], [1, 99], axis=0)
+    width, height = (float(v) for v in hi - lo)
+    cols, rows = math.ceil(width / res) + 1, math.ceil(height / res) + 1
+    if cols * rows > MAX_DSM_CELLS:
+        raise DenseError(f"RESOLUTION {res:g} m would make a DSM of {cols:,} x {rows:,} cells over the block's "
+                         f"{width:.0f} x {height:.0f} m (more than 50,000 x 50,000); {hint} or a coarser one")
+    if res > max(width, height) / 2:
+        raise DenseError(f"RESOLUTION {res:g} m is coarser than half the block's extent ({width:.0f} x {height:.0f} "
+                         f"m): the DSM would have fewer than 2 cells across; {hint} or a finer one")
 
 
 def _pairs(views: Dict[int, View], xyz: np.ndarray, tracks: Sequence[np.ndarray],

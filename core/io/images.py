@@ -5,6 +5,7 @@ grey).  Everything here is plain Python + GDAL + numpy: no qgis, no Qt.
 """
 from __future__ import annotations
 
+import hashlib
 import math
 import os
 import re
@@ -95,10 +96,19 @@ def _dms(value: str, ref: str) -> Optional[float]:
     return deg
 
 
+def check_image_folder(folder: str, what: str = "image folder") -> None:
+    """ImageError unless ``folder`` is a readable folder; the message says which of the three it is not."""
+    if not folder or not os.path.exists(folder):
+        raise ImageError(f"{what} {folder} does not exist")
+    if not os.path.isdir(folder):
+        raise ImageError(f"{what} {folder} is a file, not a folder: give the folder that holds the photos")
+    if not os.access(folder, os.R_OK | os.X_OK):
+        raise ImageError(f"{what} {folder} cannot be read (permission denied)")
+
+
 def list_images(folder: str) -> List[str]:
     """Names (relative to ``folder``) of files with an image extension, sorted; no recursion."""
-    if not os.path.isdir(folder):
-        raise ImageError(f"image folder {folder} does not exist or is not a folder")
+    check_image_folder(folder)
     return sorted(
         n for n in os.listdir(folder)
         if n.lower().endswith(IMAGE_EXTENSIONS) and os.path.isfile(os.path.join(folder, n))
@@ -108,30 +118,12 @@ def list_images(folder: str) -> List[str]:
 def read_image_info(path: str, name: Optional[str] = None, manual_focal_mm: Optional[float] = None,
                     manual_sensor_width_mm: Optional[float] = None,
                     manual_focal_px: Optional[float] = None) -> ImageInfo:
-    """Open the image header, check that its pixels decode, read EXIF.  Raises ImageError."""
+    """Open the image header, check that its pixels decode (:func:`check_image`), read EXIF.  Raises ImageError."""
     gdal = _gdal()
     name = name or os.path.basename(path)
-    if os.path.getsize(path) == 0:
-        raise ImageError(f"{path}: empty file (0 bytes)")
-    try:
-        ds = gdal.Open(path)
-    except RuntimeError as e:
-        raise ImageError(f"{path}: not a readable image ({str(e).strip()})") from e
-    if ds is None or ds.RasterCount == 0:
-        raise ImageError(f"{path}: not a readable image")
+    ds = _checked_dataset(path)
     w, h, nb = ds.RasterXSize, ds.RasterYSize, ds.RasterCount
-    # decode a strip at the bottom: truncated JPEGs fail there (libjpeg only warns unless told)
-    old = gdal.GetConfigOption("GDAL_ERROR_ON_LIBJPEG_WARNING")
-    gdal.SetConfigOption("GDAL_ERROR_ON_LIBJPEG_WARNING", "TRUE")
-    try:
-        band = ds.GetRasterBand(1)
-        arr = band.ReadAsArray(0, max(0, h - 8), w, min(8, h))
-        if arr is None:
-            raise RuntimeError("no pixels")
-    except RuntimeError as e:
-        raise ImageError(f"{path}: image data is corrupt or truncated ({str(e).strip()})") from e
-    finally:
-        gdal.SetConfigOption("GDAL_ERROR_ON_LIBJPEG_WARNING", old)
+    band = ds.GetRasterBand(1)
     dtype = gdal.GetDataTypeName(band.DataType)
     md = ds.GetMetadata() or {}
     info = ImageInfo(name=name, path=os.path.abspath(path), width=w, height=h, bands=nb, dtype=dtype)
@@ -151,6 +143,64 @@ def read_image_info(path: str, name: Optional[str] = None, manual_focal_mm: Opti
             alt = -alt
         info.gps = (lon, lat, alt)
     return info
+
+
+def _checked_dataset(path: str):
+    """The opened GDAL dataset of a photo whose pixels decode to the last row; ImageError naming the file and
+    the problem otherwise (see :func:`check_image`)."""
+    gdal = _gdal()
+    if not os.path.exists(path):
+        raise ImageError(f"{path}: the photo does not exist")
+    if os.path.isdir(path):
+        raise ImageError(f"{path}: a folder, not an image file")
+    if os.path.getsize(path) == 0:
+        raise ImageError(f"{path}: empty file (0 bytes)")
+    try:
+        ds = gdal.Open(path)
+    except RuntimeError as e:
+        raise ImageError(f"{path}: not a readable image ({str(e).strip()})") from e
+    if ds is None or ds.RasterCount == 0:
+        raise ImageError(f"{path}: not a readable image")
+    w, h = ds.RasterXSize, ds.RasterYSize
+    # decode a strip at the bottom: a JPEG decodes sequentially, so this decodes the whole scan and a truncated
+    # JPEG fails there (libjpeg only warns unless told); a truncated TIFF fails on its last strip or tile
+    old = gdal.GetConfigOption("GDAL_ERROR_ON_LIBJPEG_WARNING")
+    gdal.SetConfigOption("GDAL_ERROR_ON_LIBJPEG_WARNING", "TRUE")
+    try:
+        for b in range(1, ds.RasterCount + 1):
+            arr = ds.GetRasterBand(b).ReadAsArray(0, max(0, h - 8), w, min(8, h))
+            if arr is None:
+                raise RuntimeError(f"no pixels in band {b}")
+    except RuntimeError as e:
+        raise ImageError(f"{path}: image data is corrupt or truncated ({str(e).strip()})") from e
+    finally:
+        gdal.SetConfigOption("GDAL_ERROR_ON_LIBJPEG_WARNING", old)
+    return ds
+
+
+def check_image(path: str) -> None:
+    """The one check of a photo before its pixels are used (alignment, DSM, orthophoto, Orthorectify image):
+    the file exists, is not empty, GDAL opens it and its pixels decode to the last row (a truncated or corrupt
+    JPEG or TIFF fails).  Raises ImageError naming the file and the problem."""
+    _checked_dataset(path)
+
+
+PHOTO_BLOCK = 65536  # bytes hashed at the start, the middle and the end of a photo
+
+
+def photo_fingerprint(path: str) -> str:
+    """The content fingerprint of a photo: its size and a hash of three 64 KiB blocks (start, middle, end).
+
+    Another photo under the same name differs in its EXIF block (time, exposure) and in its compressed
+    pixels; the modification time is left out, so a copy of the folder (``cp -p`` or not, another disk)
+    keeps the fingerprints.  OSError when the file cannot be read."""
+    size = os.path.getsize(path)
+    h = hashlib.sha1()
+    with open(path, "rb") as f:
+        for start in sorted({0, max(0, size // 2 - PHOTO_BLOCK // 2), max(0, size - PHOTO_BLOCK)}):
+            f.seek(start)
+            h.update(f.read(PHOTO_BLOCK))
+    return f"{size}:{h.hexdigest()[:20]}"
 
 
 def _focal_prior(info: ImageInfo, md: dict, manual_focal_mm, manual_sensor_width_mm, manual_focal_px):
@@ -185,8 +235,7 @@ def scan_images(folder: str, manual_focal_mm: Optional[float] = None,
                 manual_focal_px: Optional[float] = None,
                 progress=None) -> Tuple[List[ImageInfo], List[str]]:
     """Read every image in ``folder``.  Returns (usable images, warnings naming skipped files)."""
-    if not os.path.isdir(folder):
-        raise ImageError(f"image folder {folder} does not exist or is not a folder")
+    check_image_folder(folder)
     names = sorted(n for n in os.listdir(folder) if os.path.isfile(os.path.join(folder, n)))
     good: List[ImageInfo] = []
     warnings: List[str] = []

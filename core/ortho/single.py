@@ -16,7 +16,7 @@ from ..geometry.camera import Intrinsics, Pose, opk_from_rotation, project_point
 from ..geometry.crs import transform_points
 from ..io import gcp as gcpmod
 from ..io import raster as dsmmod
-from ..io.images import ImageError, read_image_info
+from ..io.images import ImageError, check_image, read_image_info
 from ..io.vector import write_points_gpkg
 from .block import prepare_block, write_camera_ortho
 from .cameras import OrthoCamera
@@ -112,6 +112,10 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
                                 camera=camera, residuals_path=residuals_path)
     single.check()
     _check_inputs(image_path, dsm_path, gcps, orientation, single.mode)
+    try:
+        check_image(image_path)  # the alignment's check: a truncated or corrupt photo is refused, named
+    except ImageError as e:
+        raise OrthoError(str(e)) from e
     run = _Run(os.path.basename(image_path), image_meta(image_path), progress)
     orient, single.camera = _orientation_input(orientation, gcps is None, run, image_path, single.camera)
     if isinstance(gcps, str):

@@ -8,8 +8,10 @@ from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
+from ..align.photos import check_photos
 from ..common.files import file_fingerprint, fingerprint
 from ..common.progress import NullProgress, Progress
+from ..io.images import ImageError
 from ..project.layout import Layout, LayoutError
 from ..project.stages import ORTHOPHOTO, run_stage
 from ..project.workspace import Workspace
@@ -56,6 +58,8 @@ def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = Non
     options.check()
     lay = Layout(Workspace.open(workspace_dir))
     dsm_path, crs, offset, cams = _inputs(lay, dsm_path, images_filter)
+    for note in _check_photos(lay.ws, cams):
+        progress.info(note)
     output = os.path.abspath(output) if output else lay.default_orthomosaic
     per_image_folder = os.path.abspath(per_image_folder) if per_image_folder else None
     seamlines = os.path.abspath(seamlines) if seamlines else None
@@ -80,6 +84,15 @@ def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = Non
             "images": len(result.images), "valid_fraction": result.valid_fraction, "warnings": result.warnings})
     return OrthoStageResult(lay.root, output, crs, result.resolution, result.images, result.valid_fraction,
                             per_image_folder, seamlines, result.timings, result.warnings, result.log_lines)
+
+
+def _check_photos(ws: Workspace, cams: List[OrthoCamera]) -> List[str]:
+    """The photos of the mosaic against the alignment's (core.align.photos); OrthoError naming the missing,
+    unreadable or changed ones, notes for the log of an older workspace."""
+    try:
+        return check_photos(ws, {c.name: c.path for c in cams})
+    except ImageError as e:
+        raise OrthoError(str(e)) from e
 
 
 def _inputs(lay: Layout, dsm_path: Optional[str], images_filter: Optional[str]

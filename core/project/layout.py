@@ -117,6 +117,11 @@ class Layout:
         return self.path(SFM_DIR, DATABASE)
 
     @property
+    def staged_database(self) -> str:
+        """The database of an alignment re-run in progress: it replaces ``database`` only when the run succeeds."""
+        return self.path(SFM_DIR, "database.staged.db")
+
+    @property
     def aligned_model_dir(self) -> str:
         return self.path(SFM_DIR, MODEL_DIR)
 

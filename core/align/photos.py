@@ -1,0 +1,72 @@
+"""The photos an alignment was made from, and the check every later stage that reads photos makes.
+
+The align stage records a content fingerprint of every photo it aligned (:func:`core.io.images.photo_fingerprint`:
+size + a hash of three blocks) in its manifest record under ``photo_fingerprints``.  The DSM and orthophoto
+stages read the photos again (pixels for matching and for the mosaic) and call :func:`check_photos` first: a
+photo that is missing, unreadable or other than the one aligned (another photo under the same name, an edited
+one) is refused with an :class:`~core.io.images.ImageError` that names the photos and says to re-run Align.
+Refusing, not marking the stages stale: the model's poses belong to the aligned photos, so a product from
+another photo is wrong however often it is rebuilt; only a new alignment (or the original photos) mends it.
+
+A workspace aligned before the fingerprints were recorded has none: its photos are checked for readability
+(:func:`core.io.images.check_image`) and the stage notes in the log that they cannot be compared.
+"""
+from __future__ import annotations
+
+import os
+from typing import Dict, List, Mapping, Sequence
+
+from ..io.images import ImageError, ImageInfo, check_image, photo_fingerprint
+from ..project.stages import ALIGN
+from ..project.workspace import Workspace
+
+PHOTO_FINGERPRINTS = "photo_fingerprints"  # key of the align stage's record: {image name: fingerprint}
+
+
+def fingerprint_photos(infos: Sequence[ImageInfo]) -> Dict[str, str]:
+    """{image name: content fingerprint} of the photos being aligned (ImageError naming an unreadable one)."""
+    out: Dict[str, str] = {}
+    for im in infos:
+        try:
+            out[im.name] = photo_fingerprint(im.path)
+        except OSError as e:
+            raise ImageError(f"{im.path}: cannot be read ({e.strerror or e})") from e
+    return out
+
+
+def _list(names: Sequence[str], limit: int = 8) -> str:
+    return ", ".join(names[:limit]) + (f" and {len(names) - limit} more" if len(names) > limit else "")
+
+
+def check_photos(ws: Workspace, photos: Mapping[str, str]) -> List[str]:
+    """Check the photos {image name: path} a stage is about to read against the alignment's fingerprints.
+
+    Returns notes for the log (an old workspace without fingerprints); raises ImageError naming the missing,
+    unreadable or changed photos."""
+    recorded = ws.stage(ALIGN).get(PHOTO_FINGERPRINTS)
+    missing = sorted(n for n, p in photos.items() if not os.path.isfile(p))
+    if missing:
+        folder = os.path.dirname(photos[missing[0]]) or "."
+        raise ImageError(f"{len(missing)} photo(s) of the aligned model are missing from {folder}: {_list(missing)}; "
+                         "put them back or re-run 'Align images' on the photos as they are now")
+    if not isinstance(recorded, dict):
+        for n in sorted(photos):
+            check_image(photos[n])
+        return [f"the alignment of {ws.root} recorded no photo fingerprints (an older workspace): the {len(photos)} "
+                "photos were checked for readability but cannot be compared with the photos aligned; re-run "
+                "'Align images' to record them"]
+    changed = []
+    for n in sorted(photos):
+        try:
+            fp = photo_fingerprint(photos[n])
+        except OSError as e:
+            raise ImageError(f"{photos[n]}: cannot be read ({e.strerror or e})") from e
+        if n in recorded and recorded[n] != fp:
+            changed.append(n)
+    if changed:
+        folder = os.path.dirname(photos[changed[0]]) or "."
+        raise ImageError(
+            f"{len(changed)} photo(s) in {folder} changed since the alignment (other content under the same name): "
+            f"{_list(changed)}. The model's camera poses belong to the photos that were aligned, so products from "
+            "these would be wrong: re-run 'Align images' (and 'Georeference') or put the original photos back")
+    return []
