@@ -396,3 +396,25 @@ def test_a_utf16_gcp_file_names_the_encoding_instead_of_printing_garbage_as_a_cr
             gcp.read_gcps(str(path))
         assert f"file {path} is UTF-16" in str(e.value) and "save it as UTF-8" in str(e.value)
         assert "\x00" not in str(e.value) and "ÿþ" not in str(e.value)
+
+
+def test_a_too_fine_orthophoto_grid_names_the_orthophoto_not_a_dsm(tmp_path):
+    import cv2
+
+    from core.common.errors import ArchaeoOrthoError
+    from core.ortho.cameras import OrthoCamera
+    from core.ortho.mosaic import build_orthomosaic
+    from core.ortho.options import OrthoOptions
+
+    dsm = tmp_path / "dsm.tif"
+    _gappy_dsm(dsm, "EPSG:32632", (1.0, 1.0), (700000.0, 5300000.0))
+    img = tmp_path / "IMG_1.png"
+    cv2.imwrite(str(img), np.random.default_rng(0).integers(0, 255, (600, 800, 3), dtype=np.uint8))
+    cam = OrthoCamera("IMG_1.png", str(img), cm.Intrinsics.simple(800, 600, 650.0),
+                      cm.Pose.from_centre(cm.rotation_from_opk(0, 0, 0), [0.0, 0.0, 150.0]))
+    with pytest.raises(ArchaeoOrthoError) as e:
+        build_orthomosaic([cam], str(dsm), "EPSG:32632", [700120.0, 5299880.0, 0.0], str(tmp_path / "o" / "m.tif"),
+                          OrthoOptions(resolution=1e-4))
+    msg = str(e.value)
+    assert "orthophoto" in msg and "DSM" not in msg.split("too large")[0], msg
+    assert "RESOLUTION" in msg

@@ -84,8 +84,10 @@ class Grid:
         return (self.x0, self.resolution, 0.0, self.y0, 0.0, -self.resolution)
 
     @classmethod
-    def covering(cls, xmin: float, ymin: float, xmax: float, ymax: float, resolution: float) -> Grid:
-        """The grid with cell edges on multiples of ``resolution`` that covers the box."""
+    def covering(cls, xmin: float, ymin: float, xmax: float, ymax: float, resolution: float,
+                 what: str = "DSM") -> Grid:
+        """The grid with cell edges on multiples of ``resolution`` that covers the box; ``what`` it is for (the
+        messages name it: "DSM", "orthophoto")."""
         if not (resolution > 0 and math.isfinite(resolution)):
             raise DsmError(f"resolution must be positive, got {resolution}")
         x0 = math.floor(xmin / resolution) * resolution
@@ -93,7 +95,8 @@ class Grid:
         w = max(1, int(math.ceil((xmax - x0) / resolution)))
         h = max(1, int(math.ceil((y0 - ymin) / resolution)))
         if w * h > 2_000_000_000:
-            raise DsmError(f"a {w} x {h} DSM at {resolution} m is too large: choose a coarser RESOLUTION")
+            raise DsmError(f"a {w} x {h} {what} at {resolution:g} per cell ({w * h / 1e9:.3g} billion cells) is too "
+                           f"large: choose a coarser RESOLUTION for the {what}")
         return cls(x0, y0, resolution, w, h)
 
     def cell_centres(self) -> Tuple[np.ndarray, np.ndarray]:

@@ -117,7 +117,10 @@ def prepare_block(cameras: Sequence[OrthoCamera], dsm: _Dsm, offset: np.ndarray,
     box = (max(box[0], vbox[0]), max(box[1], vbox[1]), min(box[2], vbox[2]), min(box[3], vbox[3]))
     if box[2] <= box[0] or box[3] <= box[1]:
         raise OrthoError("the DSM's valid heights and the images' footprints do not overlap")
-    grid = dsmmod.Grid.covering(*box, res)
+    try:
+        grid = dsmmod.Grid.covering(*box, res, what="orthophoto")
+    except dsmmod.DsmError as e:
+        raise OrthoError(f"{e} (or fewer images)") from e
     if grid.width * grid.height > 400_000_000:
         raise OrthoError(f"a {grid.width} x {grid.height} orthophoto at {res:g} is too large: choose a coarser "
                          "RESOLUTION or fewer images")

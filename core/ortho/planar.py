@@ -92,7 +92,7 @@ def _planar_grid(hom, cam: Intrinsics, name: str, offset: np.ndarray, resolution
     gsd = math.sqrt(abs(np.cross(c0[1] - c0[0], c0[2] - c0[0])))
     res = resolution if resolution > 0 else _nice(gsd)
     grid = dsmmod.Grid.covering(float(corners[:, 0].min()), float(corners[:, 1].min()), float(corners[:, 0].max()),
-                                float(corners[:, 1].max()), res)
+                                float(corners[:, 1].max()), res, what="planar rectification")
     if grid.width * grid.height > 400_000_000:
         raise OrthoError(f"a {grid.width} x {grid.height} planar rectification at {res:g} is too large")
     return grid
