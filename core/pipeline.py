@@ -92,7 +92,7 @@ def check_inputs(images_dir: str, control: Control) -> None:
     if control.crs:
         validate_crs(control.crs)
     if control.gcp_path:
-        gcps = read_gcps(control.gcp_path, image_names=list_images(images_dir), crs=control.crs)
+        gcps = read_gcps(control.gcp_path, image_names=list_images(images_dir), default_crs=control.crs)
         if control.check_points:
             apply_check_points(gcps, list(control.check_points))
     elif control.gcps is not None and control.check_points:

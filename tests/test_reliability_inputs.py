@@ -2,6 +2,7 @@
 geometry (item 3), a DASK_SCHEDULER that is no Dask scheduler (4), gap filling of a DSM in degrees (8), GCP reader
 warnings in every outcome (11), messages that name the right thing (12), the CRS parameter of a CSV GCP file (13)."""
 import math
+import os
 
 import numpy as np
 import pytest
@@ -418,3 +419,20 @@ def test_a_too_fine_orthophoto_grid_names_the_orthophoto_not_a_dsm(tmp_path):
     msg = str(e.value)
     assert "orthophoto" in msg and "DSM" not in msg.split("too large")[0], msg
     assert "RESOLUTION" in msg
+
+
+def test_run_pipeline_checks_a_csv_gcp_file_with_the_crs_parameter_as_its_default(tmp_path):
+    """Run pipeline's up-front check reads the CSV as the Georeference stage does: the CRS parameter is the CRS of
+    a file without a CRS line, and the target of one with (a lon/lat file and a UTM target are fine)."""
+    from core.io import gcp
+    from core.pipeline import Control, check_inputs
+    from tests.conftest import SAMPLE, TOLEDO_STRIP, copy_images
+
+    images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:2], str(tmp_path / "img"))
+    names = sorted(os.listdir(images))
+    obs = [f"{p},{n},{100 + 10 * k},{200 + 10 * k}" for k, p in enumerate("ABCD") for n in names]
+    lonlat = ["A,-81.0,36.14,100", "B,-80.999,36.14,101", "C,-81.0,36.141,102", "D,-80.999,36.141,103"]
+    check_inputs(images, Control(gcp_path=_csv_gcps(tmp_path, "# crs: EPSG:4326", lonlat, obs), crs="EPSG:32617"))
+    check_inputs(images, Control(gcp_path=_csv_gcps(tmp_path, None, _UTM_ROWS, obs), crs="EPSG:32617"))
+    with pytest.raises(gcp.GCPError, match="CRS parameter"):
+        check_inputs(images, Control(gcp_path=_csv_gcps(tmp_path, None, _UTM_ROWS, obs)))
