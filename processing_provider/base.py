@@ -5,6 +5,10 @@ toolbox dialog, processing.runAndLoadResults): see ``AlgorithmBase.register_styl
 qgis_process (and QGIS Server) nothing of that runs.
 """
 import functools
+import os
+import signal
+import sys
+import threading
 import traceback
 
 from qgis.core import Qgis, QgsApplication, QgsMessageLog, QgsProcessingAlgorithm, QgsProcessingException
@@ -59,6 +63,7 @@ class FeedbackProgress:
         self.start = start
         self.end = end
         self._last_message = None
+        self._pushed = set()  # (kind, message) already in the log: a result's lines are not pushed twice
 
     def report(self, fraction, message=""):
         if self.feedback is None:
@@ -70,13 +75,25 @@ class FeedbackProgress:
             self.feedback.setProgressText(message)
 
     def is_cancelled(self):
-        return bool(self.feedback is not None and self.feedback.isCanceled())
+        return SIGNALLED.is_set() or bool(self.feedback is not None and self.feedback.isCanceled())
 
     def info(self, message):
+        self._pushed.add(("info", message))
         if self.feedback is not None:
             self.feedback.pushInfo(message)
 
+    def push_result(self, warnings=(), lines=()):
+        """After the core call: its result's warnings and log lines that the core did not push while it ran
+        (the core pushes most of them through :meth:`info` / :meth:`warning` already; each appears once)."""
+        for w in warnings:
+            if ("warning", w) not in self._pushed:
+                self.warning(w)
+        for line in lines:
+            if ("info", line) not in self._pushed:
+                self.info(line)
+
     def warning(self, message):
+        self._pushed.add(("warning", message))
         if self.feedback is None:
             return
         if hasattr(self.feedback, "pushWarning"):
@@ -155,7 +172,8 @@ def call_core(func, *args, **kwargs):
     from ..core.common.progress import Cancelled
 
     try:
-        return func(*args, **kwargs)
+        with SignalCancel(_feedbacks_of(args, kwargs)):
+            return func(*args, **kwargs)
     except QgsProcessingException:
         raise
     except Cancelled as e:
@@ -172,6 +190,125 @@ def call_core(func, *args, **kwargs):
             raise QgsProcessingException(message) from e
         report_bug(e, _feedback_of(args, kwargs))
         raise QgsProcessingException(f"{type(e).__name__}: {e}") from e
+
+
+# set while a SIGINT / SIGTERM asks the running core call to stop (FeedbackProgress.is_cancelled reads it)
+SIGNALLED = threading.Event()
+
+
+class SignalCancel:
+    """SIGINT and SIGTERM as a cancel while a core call runs in the main thread of a headless process
+    (qgis_process, a standalone script): the same path as the GUI's Cancel (the stage is recorded cancelled by
+    run_stage, pool workers see the cancel file, nothing half-written stays).  A second signal gets what the
+    signal did before (qgis_process's or glog's handler, else the default action: stop at once).  The previous
+    handlers, C ones included (saved with sigaction where libc has it), are back when the call returns."""
+
+    SIGNALS = ("SIGINT", "SIGTERM")
+
+    def __init__(self, feedbacks=()):
+        self.feedbacks = list(feedbacks)
+        self.previous = {}  # signal -> (Python handler or None for a C one, saved C sigaction or None)
+
+    def __enter__(self):
+        if threading.current_thread() is not threading.main_thread() or not headless():
+            return self
+        SIGNALLED.clear()
+        _import_pycolmap_first()
+        for name in self.SIGNALS:
+            sig = getattr(signal, name, None)
+            if sig is None:
+                continue
+            saved = _save_sigaction(sig)
+            try:
+                previous = signal.getsignal(sig)
+                signal.signal(sig, self._handle)
+            except (ValueError, OSError, TypeError):  # not the main interpreter, or a signal it cannot catch
+                continue
+            self.previous[sig] = (previous, saved)
+        return self
+
+    def _handle(self, signum, frame):
+        if SIGNALLED.is_set():  # asked twice: what the signal did before
+            previous = self.previous.get(signum, (signal.SIG_DFL, None))[0]
+            self._restore()
+            if callable(previous):
+                previous(signum, frame)
+            else:
+                os.kill(os.getpid(), signum)
+            return
+        SIGNALLED.set()
+        for feedback in self.feedbacks:
+            try:
+                feedback.pushWarning(f"{signal.Signals(signum).name}: cancelling (send it again to stop at once)")
+                feedback.cancel()
+            except Exception:  # noqa: BLE001,S110 - the flag alone cancels the core call
+                pass
+
+    def _restore(self):
+        for sig, (handler, saved) in self.previous.items():
+            try:
+                signal.signal(sig, signal.SIG_DFL if handler is None else handler)
+            except (ValueError, OSError, TypeError):
+                pass
+            if saved is not None:
+                _restore_sigaction(sig, saved)
+        self.previous = {}
+
+    def __exit__(self, *exc):
+        self._restore()
+        SIGNALLED.clear()
+        return False
+
+
+def _libc():
+    import ctypes
+
+    return ctypes.CDLL(None, use_errno=True)
+
+
+def _save_sigaction(sig):
+    """The C-level action of ``sig`` (an opaque struct sigaction), or None where libc has no sigaction."""
+    if os.name == "nt":
+        return None
+    try:
+        import ctypes
+
+        buf = ctypes.create_string_buffer(512)  # larger than struct sigaction on every libc
+        return buf if _libc().sigaction(int(sig), None, buf) == 0 else None
+    except (OSError, AttributeError):
+        return None
+
+
+def _restore_sigaction(sig, saved):
+    try:
+        _libc().sigaction(int(sig), saved, None)
+    except (OSError, AttributeError):
+        pass
+
+
+def _import_pycolmap_first():
+    """pycolmap's import installs glog's failure handler for SIGTERM (a stack trace, then death): import it
+    before our handlers go in, so that they are the ones that hear the signal."""
+    import importlib.util
+
+    try:
+        if "pycolmap" not in sys.modules and importlib.util.find_spec("pycolmap") is not None:
+            importlib.import_module("pycolmap")
+    except Exception:  # noqa: BLE001,S110 - a broken pycolmap is reported by the core call itself
+        pass
+
+
+def headless():
+    """True without a QGIS desktop GUI (qgis_process, QGIS Server, a standalone script)."""
+    try:
+        return QgsApplication.platform() != "desktop"
+    except Exception:  # noqa: BLE001 - no application object
+        return True
+
+
+def _feedbacks_of(args, kwargs):
+    return [v.feedback for v in list(args) + list(kwargs.values())
+            if isinstance(v, FeedbackProgress) and v.feedback is not None]
 
 
 def _feedback_of(args, kwargs):

@@ -104,17 +104,15 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
             interpolation=params.read_choice(self, parameters, self.INTERPOLATION, context, self.INTERPOLATIONS),
             workers=self.parameterAsInt(parameters, self.WORKERS, context),
             scheduler=params.read_scheduler(self, parameters, self.SCHEDULER, context))
+        progress = FeedbackProgress(feedback)
         result = self.run_core(
             build_orthophoto_workspace, workspace, dsm_path=dsm_path,
             images_filter=self.parameterAsString(parameters, self.IMAGES_FILTER, context).strip() or None,
             resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context),
             blending=params.read_choice(self, parameters, self.BLENDING, context, self.BLENDINGS),
             output=output, per_image_folder=per_image, seamlines=seamlines, options=options,
-            progress=FeedbackProgress(feedback))
-        for w in result.warnings:
-            feedback.pushWarning(w)
-        for line in result.log_lines:
-            feedback.pushInfo(line)
+            progress=progress)
+        progress.push_result(result.warnings, result.log_lines)
         return {self.OUT_WORKSPACE: result.workspace, self.OUTPUT: result.orthomosaic,
                 self.PER_IMAGE_FOLDER: result.per_image_folder, self.SEAMLINES: result.seamlines,
                 self.VALID_FRACTION: result.valid_fraction, self.RESOLUTION_USED: result.resolution,

@@ -71,14 +71,14 @@ class GeoreferenceAlgorithm(AlgorithmBase):
                 parameters, self.USE_EXIF_GPS, context)):
             raise QgsProcessingException(self.tr(
                 "Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS)"))
+        progress = FeedbackProgress(feedback)
         result = self.run_core(
             georeference_workspace, workspace, gcp_path=gcp_path, gcps=gcps, check_points=checks,
             camera_positions_path=positions,
             use_exif_gps=self.parameterAsBoolean(parameters, self.USE_EXIF_GPS, context),
             crs=crs_text, refine_intrinsics=self.parameterAsBoolean(parameters, self.REFINE_INTRINSICS, context),
-            progress=FeedbackProgress(feedback))
-        for w in result.warnings:
-            feedback.pushWarning(w)
+            progress=progress)
+        progress.push_result(result.warnings)
         for o in result.outliers:
             feedback.pushWarning(self.tr("outlier left out: {}").format(o))
         for line in result.report_lines:

@@ -99,6 +99,7 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
         if residuals and not residuals.lower().endswith(".gpkg"):
             raise QgsProcessingException(self.tr("RESIDUALS must be a GeoPackage (.gpkg) file, got {}").format(
                 residuals))
+        progress = FeedbackProgress(feedback)
         result = self.run_core(
             ortho.orthorectify_image, image, self.parameterAsOutputLayer(parameters, self.OUTPUT, context),
             dsm_path=dsm_path, gcps=gcps, orientation=orientation,
@@ -106,11 +107,8 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
             sensor_width_mm=self.parameterAsDouble(parameters, self.SENSOR_WIDTH_MM, context) or None,
             mode=params.read_choice(self, parameters, self.MODE, context, self.MODES), crs=crs_text,
             resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context), residuals_path=residuals,
-            progress=FeedbackProgress(feedback))
-        for w in result.warnings:
-            feedback.pushWarning(w)
-        for line in result.log_lines:
-            feedback.pushInfo(line)
+            progress=progress)
+        progress.push_result(result.warnings, result.log_lines)
         for r in result.residuals:
             feedback.pushInfo(self.tr("{} ({}): {:.2f} px").format(r["name"], r["role"], r["res_px"]))
         return {self.OUTPUT: result.output, self.RESIDUALS: result.residuals_path, self.RMSE_PX: result.rmse_px,

@@ -30,11 +30,14 @@ import threading
 from typing import Any, Callable, Iterator, List, Optional, Sequence, Tuple
 
 from .errors import ArchaeoOrthoError
+from .files import owned_tempdir
 from .progress import Cancelled, NullProgress, Progress
 
 KINDS = ("auto", "serial", "process", "thread")
 # batch use: a Dask scheduler address in this environment variable sends every stage's units to that cluster
 SCHEDULER_ENV = "ARCHAEOORTHO_DASK_SCHEDULER"
+# the cancel folders run_units makes in its cancel_dir (a killed run's are removed by the next: files.clean_debris)
+CANCEL_PREFIX = ".cancel-"
 
 
 class ParallelError(ArchaeoOrthoError, RuntimeError):
@@ -201,7 +204,35 @@ def make_executor(workers: int = 0, kind: str = "auto", scheduler: Optional[str]
         return cf.ThreadPoolExecutor(max_workers=n)
     if exe != sys.executable:
         ctx.set_executable(exe)
-    return cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx)
+    return cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=worker_init, initargs=(os.getpid(),))
+
+
+PR_SET_PDEATHSIG = 1
+
+
+def worker_init(parent_pid: int) -> None:
+    """Pool worker start-up: the worker dies with the process that started the pool (kill -9 of qgis_process must
+    not orphan workers that keep ~100 MB each for ever).  Linux: the kernel sends SIGTERM when the parent dies
+    (prctl PR_SET_PDEATHSIG); everywhere: a watchdog thread exits when the parent is gone (the parent pid
+    changes: re-parented to init)."""
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(OSError, AttributeError):
+            import ctypes
+            import signal
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0)
+    if os.getppid() != parent_pid:  # the parent died before prctl took effect
+        os._exit(1)
+    threading.Thread(target=_watch_parent, args=(parent_pid,), name="archaeoortho-parent-watchdog",
+                     daemon=True).start()
+
+
+def _watch_parent(parent_pid: int, interval: float = 1.0) -> None:
+    while True:
+        threading.Event().wait(interval)
+        if os.getppid() != parent_pid:
+            os._exit(1)
 
 
 def describe_executor(executor) -> str:
@@ -269,7 +300,7 @@ class _CancelFile:
 
     def __init__(self, progress: Progress, folder: Optional[str] = None):
         self.progress = progress
-        self.dir = tempfile.mkdtemp(prefix=".cancel-", dir=folder)
+        self.dir = owned_tempdir(CANCEL_PREFIX, folder) if folder else tempfile.mkdtemp(prefix=CANCEL_PREFIX)
         self.path = os.path.join(self.dir, "cancel")
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, daemon=True)
@@ -366,4 +397,4 @@ def _wait_all(futures: List[Any], timeout: float) -> None:
 
 
 __all__ = ["make_executor", "resolve_scheduler", "describe_executor", "SCHEDULER_ENV", "run_units", "check_unit_cancel", "cancel_requested", "auto_workers", "cpu_count",
-           "ParallelError", "SerialExecutor", "python_executable"]
+           "ParallelError", "SerialExecutor", "python_executable", "worker_init", "CANCEL_PREFIX"]

@@ -7,13 +7,13 @@ the mean of the agreeing ones, and it is back-projected with the camera model an
 """
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from typing import List, Optional, Tuple
 
 import numpy as np
 
 from ..common.errors import require
+from ..common.files import save_npz
 from ..common.parallel import check_unit_cancel
 from .options import DenseError
 from .pairs import View, load_scaled
@@ -101,9 +101,7 @@ def fuse_image(unit: FuseUnit, cancel_path: Optional[str] = None) -> dict:
         hi = np.percentile(xyz[:, :2], 99.5, axis=0)
         out["bbox"] = [float(v) for v in (*xyz[:, 0:2].min(axis=0), *xyz[:, 0:2].max(axis=0))]
         out["robust_bbox"] = [float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])]
-    tmp = unit.out_path + ".partial.npz"
-    np.savez(tmp, xyz=xyz.astype(np.float32), rgb=rgb.astype(np.uint8))
-    os.replace(tmp, unit.out_path)
+    save_npz(unit.out_path, xyz=xyz.astype(np.float32), rgb=rgb.astype(np.uint8))
     out["points"] = int(len(xyz))
     return out
 

@@ -16,7 +16,7 @@ from typing import Callable, Dict, List, Tuple
 import numpy as np
 
 from ..common.cancel import CancelWatcher, load_pycolmap
-from ..common.files import atomic_write_text, fingerprint
+from ..common.files import atomic_write_text, fingerprint, save_npz
 from ..common.parallel import cpu_count, describe_executor, make_executor, run_units
 from ..common.progress import Progress, SubProgress
 from .fusion import FuseUnit, fuse_image
@@ -211,7 +211,7 @@ def cuda_points(views: Dict[int, View], scale: float, dense_dir: str, model_dir:
     xyz = np.array([p[0] for p in pts], dtype=np.float32).reshape(-1, 3)
     rgb = np.array([p[1] for p in pts], dtype=np.uint8).reshape(-1, 3)
     path = os.path.join(fused_dir, "cuda.npz")
-    np.savez(path, xyz=xyz, rgb=rgb)
+    save_npz(path, xyz=xyz, rgb=rgb)
     if len(xyz) == 0:
         return [], 0
     lo = np.percentile(xyz[:, :2], 0.5, axis=0)

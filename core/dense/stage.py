@@ -30,6 +30,8 @@ import numpy as np
 
 from ..align.photos import check_photos
 from ..common.cancel import load_pycolmap
+from ..common.files import clean_debris
+from ..common.parallel import CANCEL_PREFIX
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..io import raster
 from ..io.images import ImageError
@@ -124,6 +126,8 @@ def build_dsm_workspace(workspace_dir: str, resolution: float = 0.0, quality: st
                                                          if k not in EXECUTION_OPTIONS}}
     with run_stage(ws, DSM, params, model_fp) as run:
         os.makedirs(lay.dense_dir, exist_ok=True)
+        for debris in clean_debris(lay.dense_dir, CANCEL_PREFIX):
+            job.info(f"removed {debris}, left by a killed run")
         if engine == "cuda":
             point_files, n_reused = cuda_points(views, options.scale, lay.dense_dir, lay.georef_model_dir,
                                                 images_dir, model_fp, SubProgress(progress, 0.02, 0.88))

@@ -12,15 +12,14 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import time
-import zipfile
 from dataclasses import dataclass
 from typing import Optional, Tuple
 
 import numpy as np
 
 from ..common.errors import require
+from ..common.files import save_npz
 from ..common.parallel import check_unit_cancel
 from .options import DenseError
 from .pairs import View, load_scaled
@@ -263,12 +262,7 @@ def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
 def _save_npz(path: str, **arrays) -> None:
     """np.savez with fast deflate (level 1: depth maps with holes shrink ~3x at a fraction of savez_compressed's
     time), written to a temporary name and renamed: a cancelled or killed unit leaves no file that looks done."""
-    tmp = path + ".partial.npz"
-    with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=1) as zf:
-        for name, arr in arrays.items():
-            with zf.open(name + ".npy", "w", force_zip64=True) as f:
-                np.lib.format.write_array(f, np.asanyarray(arr), allow_pickle=False)
-    os.replace(tmp, path)
+    save_npz(path, compresslevel=1, **arrays)
 
 
 def _save_pair(path: str, map_i, map_j, rel_err: float, summary: dict) -> None:

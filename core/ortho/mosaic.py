@@ -6,7 +6,6 @@ import ctypes
 import math
 import os
 import shutil
-import tempfile
 import time
 from dataclasses import asdict, dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple
@@ -14,7 +13,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..common import parallel
-from ..common.files import atomic_output
+from ..common.files import atomic_output, owned_tempdir
 from ..common.progress import NullProgress, Progress, SubProgress
 from .block import _check_kind, _Prepared, prepare_block, write_camera_ortho
 from .cameras import OrthoCamera
@@ -25,6 +24,9 @@ from .seams import _Plan, _plan_mosaic
 from .surface import _Dsm, fill_dsm_gaps
 from .tiles import _DSM_CACHE, _render_tile, _TileUnit
 from .writer import _gdal_cache, _RasterWriter
+
+# the work folders of a run, beside its output (a killed run's are removed by the next: files.clean_debris)
+WORK_PREFIX = ".ortho-work-"
 
 
 @dataclass
@@ -61,7 +63,7 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
     log: List[str] = []
     out_dir = os.path.dirname(os.path.abspath(output))
     os.makedirs(out_dir, exist_ok=True)
-    workdir = tempfile.mkdtemp(prefix=".ortho-work-", dir=out_dir)
+    workdir = owned_tempdir(WORK_PREFIX, out_dir)
     _CACHE.max_bytes = options.cache_mb << 20
     source_dsm = dsm_path
     try:

@@ -4,12 +4,12 @@ from __future__ import annotations
 import math
 import os
 import shutil
-import tempfile
 from dataclasses import dataclass, field, replace
 from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 
+from ..common.files import clean_debris, owned_tempdir
 from ..common.progress import NullProgress, Progress, SubProgress
 from ..geometry import resection as rs
 from ..geometry.camera import Intrinsics, Pose, opk_from_rotation, project_points, rotation_from_opk
@@ -20,6 +20,7 @@ from ..io.images import ImageError, check_image, read_image_info
 from ..io.vector import write_points_gpkg
 from .block import prepare_block, write_camera_ortho
 from .cameras import OrthoCamera
+from .mosaic import WORK_PREFIX
 from .options import OrthoError, OrthoOptions, SingleImageOptions
 from .orientation import _normalise_orientation, read_orientation
 from .pixels import _CACHE, ImageMeta, image_meta
@@ -345,7 +346,8 @@ def _rectify(result: SingleImageResult, ocam: OrthoCamera, run: _Run, ctl: _Cont
     progress, name, mode, work_crs = run.progress, run.name, result.mode, result.crs
     out_dir = os.path.dirname(os.path.abspath(result.output))
     os.makedirs(out_dir, exist_ok=True)
-    workdir = tempfile.mkdtemp(prefix=".ortho-work-", dir=out_dir)
+    clean_debris(out_dir, WORK_PREFIX)
+    workdir = owned_tempdir(WORK_PREFIX, out_dir)
     _CACHE.max_bytes = options.cache_mb << 20
     dsm = _Dsm(dsm_path, work_crs) if dsm_path else None
     try:

@@ -9,14 +9,14 @@ from typing import Dict, List, Optional, Tuple
 import numpy as np
 
 from ..align.photos import check_photos
-from ..common.files import file_fingerprint, fingerprint
+from ..common.files import clean_debris, file_fingerprint, fingerprint
 from ..common.progress import NullProgress, Progress
 from ..io.images import ImageError
 from ..project.layout import Layout, LayoutError
 from ..project.stages import ORTHOPHOTO, run_stage
 from ..project.workspace import Workspace
 from .cameras import OrthoCamera, cameras_from_reconstruction, select_cameras
-from .mosaic import build_orthomosaic
+from .mosaic import WORK_PREFIX, build_orthomosaic
 from .options import OrthoError, OrthoOptions
 
 STAGE = ORTHOPHOTO
@@ -70,6 +70,8 @@ def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = Non
     inputs = {"dsm": file_fingerprint(dsm_path), "images": fingerprint(sorted(c.name for c in cams)),
               **lay.model_fingerprints()}
     with run_stage(lay.ws, STAGE, params, inputs) as run:
+        for debris in clean_debris(os.path.dirname(output), WORK_PREFIX):
+            progress.info(f"removed {debris}, left by a killed run")
         result = build_orthomosaic(cams, dsm_path, crs, offset, output, options, per_image_folder, seamlines, progress)
         for k_, v in result.timings.items():
             if k_ != "total":

@@ -15,11 +15,14 @@ exception ``failed`` with its message, and is re-raised unchanged.  Leaving the 
 from __future__ import annotations
 
 import contextlib
+import logging
 import time
 from typing import Any, Dict, Iterator, List, Optional
 
 from ..common.errors import ArchaeoOrthoError
 from ..common.progress import Cancelled
+
+log = logging.getLogger("archaeoortho")
 
 # stage status values (the manifest's "status" of a stage)
 PENDING = "pending"
@@ -28,6 +31,8 @@ DONE = "done"
 FAILED = "failed"
 CANCELLED = "cancelled"
 STALE = "stale"
+INTERRUPTED = "interrupted"  # found running whose process is gone (killed, crashed, power cut)
+STATUSES = (PENDING, RUNNING, DONE, FAILED, CANCELLED, STALE, INTERRUPTED)
 
 PREPARE = "prepare"
 ALIGN = "align"
@@ -85,6 +90,19 @@ class StageRun:
         self.results = results
 
 
+def _record_end(ws, name: str, status: str, error: BaseException, message: str) -> None:
+    """Record a stage's cancel or failure; when that cannot be written either (the disk that made the stage fail
+    is full), the stage's own error stays the one raised: the recording failure becomes a note on it and a log
+    line, and the record is left running, read as interrupted on the next open (its process is gone then)."""
+    try:
+        ws.end_stage(name, status, error=message)
+    except Exception as record_error:  # noqa: BLE001 - never hide the stage's own error behind this one
+        note = f"(the stage could not be recorded {status} in the workspace either: {record_error})"
+        log.warning("%s: %s %s", name, message, note)
+        if hasattr(error, "add_note"):
+            error.add_note(note)
+
+
 @contextlib.contextmanager
 def run_stage(ws: "Workspace",  # noqa: F821 (project.workspace.Workspace)
               name: str, parameters: Dict[str, Any], inputs: Optional[Dict[str, str]] = None,
@@ -94,11 +112,11 @@ def run_stage(ws: "Workspace",  # noqa: F821 (project.workspace.Workspace)
     run = StageRun(ws, name)
     try:
         yield run
-    except Cancelled:
-        ws.end_stage(name, CANCELLED, error="cancelled by the user")
+    except Cancelled as e:
+        _record_end(ws, name, CANCELLED, e, "cancelled by the user")
         raise
     except BaseException as e:
-        ws.end_stage(name, FAILED, error=str(e) or type(e).__name__)
+        _record_end(ws, name, FAILED, e, str(e) or type(e).__name__)
         raise
     ws.end_stage(name, DONE, outputs=run.outputs, results=run.results)
     if invalidate:

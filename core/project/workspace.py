@@ -19,13 +19,15 @@ import time
 from typing import Any, Dict, List, Optional
 
 from ..common.errors import ArchaeoOrthoError
-from ..common.files import atomic_write_text
-from .stages import DONE, PENDING, RUNNING, STAGE_ORDER, STALE
+from ..common.files import atomic_write_text, clean_partials, owner_alive, process_owner
+from .stages import DONE, INTERRUPTED, PENDING, RUNNING, STAGE_ORDER, STALE, STATUSES
 
 FORMAT_VERSION = 1
 MANIFEST = "workspace.json"
 
-
+# (workspace root, stage) of the stages this process runs now: a "running" record of this process that is not
+# here ended without recording its outcome (the manifest could not be written: disk full)
+_ACTIVE: set = set()
 
 class WorkspaceError(ArchaeoOrthoError, RuntimeError):
     """A workspace that cannot be opened or written; the message says why."""
@@ -65,10 +67,31 @@ class Workspace:
                 f"{path} was written by a newer ArchaeoOrtho (format {version}, this version reads up to "
                 f"{FORMAT_VERSION}); update the plugin. The workspace was left untouched."
             )
+        check_shape(path, data)
         data.setdefault("stages", {})
         data.setdefault("images", [])
         data.setdefault("camera_groups", [])
-        return cls(root, data)
+        ws = cls(root, data)
+        ws._mark_interrupted()
+        return ws
+
+    def _mark_interrupted(self) -> None:
+        """A stage recorded running whose process is gone (kill -9, crash, a failure that could not be recorded)
+        reads as interrupted; the manifest is written with it at the next save."""
+        for name, rec in self.data["stages"].items():
+            if rec.get("status") != RUNNING:
+                continue
+            owner = rec.get("owner")
+            alive = owner_alive(owner)
+            if alive is None:
+                continue  # cannot tell: another host, or no owner recorded (an older version)
+            ours = owner.get("pid") == os.getpid()
+            if alive and (not ours or (self.root, name) in _ACTIVE):
+                continue  # running now, in another process or in this one
+            rec["status"] = INTERRUPTED
+            rec["error"] = (f"interrupted: the process that ran it (pid {owner.get('pid')} on {owner.get('host')}, "
+                            f"started {rec.get('started')}) ended without recording the outcome (killed, crashed "
+                            "or the workspace could not be written); run the stage again")
 
     @classmethod
     def create_or_open(cls, root: str) -> Workspace:
@@ -125,7 +148,12 @@ class Workspace:
         return self.stage(name).get("status") == DONE
 
     def begin_stage(self, name: str, parameters: Dict[str, Any], inputs: Optional[Dict[str, str]] = None) -> None:
+        """Record ``name`` running in this process (its owner: host, pid, process start).  Refuses while another
+        live process runs the same stage; otherwise the partial files of killed runs go first."""
         rec = self.data["stages"].setdefault(name, {})
+        self._refuse_if_running_elsewhere(name, rec)
+        if not self._running_elsewhere():
+            clean_partials(self.root)
         rec.update(
             {
                 "status": RUNNING,
@@ -134,11 +162,29 @@ class Workspace:
                 "started": _now(),
                 "finished": None,
                 "error": None,
+                "owner": process_owner(),
             }
         )
         rec.setdefault("timings", {})
         self._t0[name] = time.time()
         self.save()
+        _ACTIVE.add((self.root, name))
+
+    def _refuse_if_running_elsewhere(self, name: str, rec: Dict[str, Any]) -> None:
+        owner = rec.get("owner")
+        if rec.get("status") == RUNNING and owner_alive(owner) and owner.get("pid") != os.getpid():
+            raise WorkspaceError(
+                f"stage {name} of {self.root} is running in another process (pid {owner.get('pid')} on "
+                f"{owner.get('host')}, since {rec.get('started')}); wait for it to end or stop it first")
+
+    def _running_elsewhere(self) -> bool:
+        """Whether another live process runs a stage of this workspace now (its partial files must stay)."""
+        for rec in self.data["stages"].values():
+            owner = rec.get("owner")
+            if rec.get("status") == RUNNING and owner_alive(owner) is not False and (
+                    not isinstance(owner, dict) or owner.get("pid") != os.getpid()):
+                return True
+        return False
 
     def record_timing(self, name: str, step: str, seconds: float) -> None:
         rec = self.data["stages"].setdefault(name, {})
@@ -154,6 +200,7 @@ class Workspace:
     ) -> None:
         rec = self.data["stages"].setdefault(name, {})
         t0 = self._t0.pop(name, None)
+        _ACTIVE.discard((self.root, name))
         rec["status"] = status
         rec["finished"] = _now()
         if t0 is not None:
@@ -186,6 +233,41 @@ class Workspace:
     def crs(self, value: Optional[str]) -> None:
         self.data["crs"] = value
 
+
+def _shape_problem(data: Dict[str, Any]) -> Optional[str]:
+    """What is wrong with the structure of a manifest, or None (a hand-written schema of what the code reads)."""
+    for key, kind, what in (("stages", dict, "an object of stage records"), ("images", list, "a list of images"),
+                            ("camera_groups", list, "a list"), ("crs", (str, type(None)), "a CRS text or null"),
+                            ("images_dir", (str, type(None)), "a folder or null")):
+        if key in data and not isinstance(data[key], kind):
+            return f'"{key}" is {type(data[key]).__name__}, not {what}'
+    for name, rec in data.get("stages", {}).items():
+        if not isinstance(rec, dict):
+            return f'"stages" -> "{name}" is {json.dumps(rec)[:40]}, not a stage record (an object with "status")'
+        status = rec.get("status", PENDING)
+        if status not in STATUSES:
+            return f'"stages" -> "{name}" -> "status" is {json.dumps(status)[:40]}, not one of {", ".join(STATUSES)}'
+        for key in ("parameters", "inputs", "timings", "outputs", "results", "owner"):
+            if rec.get(key) is not None and not isinstance(rec[key], dict):
+                return f'"stages" -> "{name}" -> "{key}" is {type(rec[key]).__name__}, not an object'
+        if rec.get("error") is not None and not isinstance(rec["error"], str):
+            return f'"stages" -> "{name}" -> "error" is {type(rec["error"]).__name__}, not a text'
+    for i, image in enumerate(data.get("images", [])):
+        if not isinstance(image, dict) or not isinstance(image.get("name"), str):
+            return f'"images" [{i}] is {json.dumps(image, default=str)[:40]}, not an image (an object with "name")'
+    for i, group in enumerate(data.get("camera_groups", [])):
+        if not isinstance(group, dict):
+            return f'"camera_groups" [{i}] is {type(group).__name__}, not an object'
+    return None
+
+
+def check_shape(path: str, data: Dict[str, Any]) -> None:
+    """WorkspaceError naming the file and the bad key when a manifest that is valid JSON has the wrong structure
+    (it is refused like a damaged one and never rewritten)."""
+    problem = _shape_problem(data)
+    if problem:
+        raise WorkspaceError(f"{path} is damaged: {problem}; it was left untouched. "
+                             "Repair it or choose another workspace folder.")
 
 
 def check_writable(folder: str) -> None:
