@@ -10,7 +10,12 @@ manifest and marks the later stages stale when a stage produced new results::
 
 A stage body that raises :class:`~core.common.progress.Cancelled` is recorded ``cancelled``; any other
 exception ``failed`` with its message, and is re-raised unchanged.  Leaving the block without calling
-``finish()`` is recorded ``done`` with no outputs.
+``finish()`` is recorded ``done`` with no outputs.  When the outcome cannot be written (the disk that made the stage
+fail is full) the stage's own error is still the one raised, with the recording failure as a note.
+
+The record names its owner (host, pid, process start); a stage found ``running`` whose owner is gone (killed,
+crashed, or its outcome could not be written) reads ``interrupted`` on the next open, and a stage running in
+another live process is not started twice (``Workspace.begin_stage``).
 """
 from __future__ import annotations
 
