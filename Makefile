@@ -8,9 +8,10 @@ BUILD := $(ROOT)/build
 PLUGINS := $(BUILD)/qgis-plugins
 QGIS_CONFIG := $(BUILD)/qgis-profile
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+# proj-bin: in a venv Debian's pyproj finds its PROJ data through the `proj` executable (sys.prefix is the venv)
 APT_PACKAGES := qgis python3-qgis qgis-providers python3-gdal python3-numpy python3-scipy \
                 python3-matplotlib python3-venv python3-pip qttools5-dev-tools pyqt5-dev-tools xvfb xauth zip \
-                chromium
+                chromium proj-bin
 QGIS_PROCESS := $(shell command -v qgis_process.bin || command -v qgis_process || echo /usr/bin/qgis_process.bin)
 PYTEST_ARGS ?=
 ARGS ?=

@@ -6,10 +6,10 @@
 #
 # The chroot is cached OUTSIDE the repository (CI clones afresh every run) at $QGIS340_CHROOT
 # (default /var/cache/archaeoortho/trixie) and rebuilt when missing or when its package list changed
-# (debootstrap + apt-get: about 6 minutes).  Each run bind-mounts the repository at /ao/repo and ../shared
-# read-only at /ao/shared (the tests look for ../shared/data), plus /proc /dev /sys, and unmounts them on exit,
-# also on failure.  Inside, `make test` keeps its venv and QGIS profile under build/qgis340/, apart from the
-# host's .venv and build/.
+# (debootstrap + apt-get: about 4-6 minutes).  Each run bind-mounts the repository and ../shared (read-only;
+# the tests look for ../shared/data) at their own paths, plus /proc /dev /sys, and unmounts them on exit, also
+# on failure.  Inside, `make test` keeps its venv, apt stamp and QGIS profile under build/qgis340/, apart from
+# the host's .venv and build/; the plugin link build/qgis-plugins/archaeoortho is shared (same target).
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -130,11 +130,13 @@ fi
 
 host_config "$CHROOT"
 mount_system "$CHROOT"
-mkdir -p "$CHROOT/ao/repo" "$CHROOT/ao/shared"
-mount --bind "$ROOT" "$CHROOT/ao/repo"
+# The repository and ../shared at the same paths as outside: absolute paths (the plugin link
+# build/qgis-plugins/archaeoortho, which the tests use) mean the same thing on both legs.
+mkdir -p "$CHROOT$ROOT" "$CHROOT$SHARED"
+mount --bind "$ROOT" "$CHROOT$ROOT"
 if [ -d "$SHARED" ]; then
-  mount --bind "$SHARED" "$CHROOT/ao/shared"
-  mount -o remount,bind,ro "$CHROOT/ao/shared"
+  mount --bind "$SHARED" "$CHROOT$SHARED"
+  mount -o remount,bind,ro "$CHROOT$SHARED"
 else
   log "no $SHARED: the tests that need it are skipped"
 fi
@@ -143,8 +145,8 @@ log "$(in_chroot "$CHROOT" sh -c 'echo QGIS $(dpkg-query -W -f "\${Version}" qgi
 $(python3 -c "import numpy; print(numpy.__version__)")')"
 test_start=$SECONDS
 rc=0
-in_chroot "$CHROOT" make -C /ao/repo test VENV=/ao/repo/build/qgis340/venv BUILD=/ao/repo/build/qgis340 \
-  PYTEST_ARGS="$PYTEST_ARGS" || rc=$?
+in_chroot "$CHROOT" make -C "$ROOT" test VENV="$ROOT/build/qgis340/venv" BUILD="$ROOT/build/qgis340" \
+  PLUGINS="$ROOT/build/qgis-plugins" PYTEST_ARGS="$PYTEST_ARGS" || rc=$?
 log "make test (QGIS 3.40) exited $rc after $(( (SECONDS - test_start) / 60 )) min $(( (SECONDS - test_start) % 60 )) s;" \
   "whole leg $(( (SECONDS - start) / 60 )) min $(( (SECONDS - start) % 60 )) s"
 exit $rc

@@ -143,8 +143,10 @@ def wheels():
     os.makedirs(WHEELS, exist_ok=True)
     want = {"pycolmap-4.2.1-", "opencv_python_headless-4.10.0.84-"}
 
+    tag = f"-cp{sys.version_info[0]}{sys.version_info[1]}-"  # build/wheels may hold another Python's wheels too
+
     def have():
-        return all(any(n.startswith(w) for n in os.listdir(WHEELS)) for w in want)
+        return all(any(n.startswith(w) and (tag in n or "-abi3-" in n) for n in os.listdir(WHEELS)) for w in want)
 
     if not have():
         out = subprocess.run([sys.executable, "-m", "pip", "download", "--no-deps", "--only-binary=:all:", "-d",

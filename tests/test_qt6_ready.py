@@ -90,7 +90,10 @@ def unscoped_enums(source, filename="<source>"):
             value = getattr(cls, node.attr, None)
             if value is None or not _enum_value(value) or type(value).__name__ == qual:
                 continue
-            found.append((node.lineno, f"{qual}.{node.attr}", f"{qual}.{type(value).__name__}.{node.attr}"))
+            # the name ``qual`` gives the enum (QGIS >= 3.36: QgsProcessing.SourceType is Qgis.ProcessingSourceType)
+            scope = [n for n in dir(cls) if getattr(cls, n, None) is type(value)]
+            scope = type(value).__name__ if not scope or type(value).__name__ in scope else scope[0]
+            found.append((node.lineno, f"{qual}.{node.attr}", f"{qual}.{scope}.{node.attr}"))
     return sorted(found)
 
 
