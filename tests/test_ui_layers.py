@@ -94,6 +94,15 @@ def test_georeference_from_the_toolbox_loads_styled_layers(plugin, aligned, qgis
     assert "x" in residuals.name()
     cams = layers["cameras"]
     assert cams.labelsEnabled() and cams.labeling().settings().fieldName == '"image"'
+    # labels sit over the points on every QGIS version (3.26+ take Qgis.LabelPlacement: the old
+    # QgsPalLayerSettings.OverPoint there is another enum and raised TypeError, leaving the layers unstyled)
+    from qgis.core import Qgis, QgsPalLayerSettings
+
+    over_point = getattr(getattr(Qgis, "LabelPlacement", None), "OverPoint", None)
+    if over_point is None:
+        over_point = QgsPalLayerSettings.OverPoint
+    for layer in (cams, residuals):
+        assert layer.labeling().settings().placement == over_point, layer.name()
     assert layers["footprints"].featureCount() == cams.featureCount()
     _render(QgsProject.instance(), [residuals, cams, layers["footprints"]], "toolbox-georeference-layers.png")
 
