@@ -139,6 +139,49 @@ def test_dsm_pseudocolour_and_hillshade(tmp_path, qgis_new_project):
     _render(QgsProject.instance(), list(reversed(loaded)), "dsm-styled.png")
 
 
+def test_a_failing_style_step_is_logged_and_reported_not_raised(tmp_path, qgis_new_project, monkeypatch):
+    """QGIS calls postProcessLayer from C++: an exception escaping it would abort QGIS.  A styling bug is
+    caught, logged with its traceback and reported to the run's feedback; the layer stays loaded."""
+    from archaeoortho.ui import layers
+    from qgis.core import QgsApplication, QgsProcessingContext, QgsProcessingFeedback, QgsProject, QgsRasterLayer
+
+    path = _raster(str(tmp_path / "o.tif"), 3, nodata=0)
+    layer = QgsRasterLayer(path, "orthomosaic")
+    assert layer.isValid()
+    QgsProject.instance().addMapLayer(layer)
+
+    def broken(_layer):
+        raise ZeroDivisionError("a bug in a style function")
+
+    monkeypatch.setattr(layers, "style_orthomosaic", broken)
+    logged = []
+
+    def on_message(message, tag, level):
+        logged.append((tag, message))
+
+    QgsApplication.messageLog().messageReceived.connect(on_message)
+
+    class Feedback(QgsProcessingFeedback):
+        def __init__(self):
+            super().__init__()
+            self.errors = []
+
+        def reportError(self, error, fatal=False):  # noqa: N802 (QGIS API name)
+            self.errors.append(error)
+
+    feedback = Feedback()
+    ctx = QgsProcessingContext()
+    ctx.setProject(QgsProject.instance())
+    try:
+        layers.StylePostProcessor(layers.ORTHO).postProcessLayer(layer, ctx, feedback)  # must not raise
+    finally:
+        QgsApplication.messageLog().messageReceived.disconnect(on_message)
+    assert feedback.errors and "a bug in a style function" in feedback.errors[0]
+    assert "orthomosaic" in feedback.errors[0]
+    assert any(tag == "ArchaeoOrtho" and "Traceback" in m and "ZeroDivisionError" in m for tag, m in logged)
+    assert layer.id() in QgsProject.instance().mapLayers()
+
+
 def test_orthomosaic_rgb_with_transparent_alpha_or_nodata(tmp_path, qgis_new_project):
     from archaeoortho.ui import layers
     from qgis.core import QgsProject

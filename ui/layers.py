@@ -19,6 +19,7 @@ from qgis.core import (
     QgsHillshadeRenderer,
     QgsLineSymbol,
     QgsMarkerSymbol,
+    QgsMessageLog,
     QgsMultiBandColorRenderer,
     QgsPainting,
     QgsPalLayerSettings,
@@ -503,6 +504,20 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
         del _KEEP[:-100]
 
     def postProcessLayer(self, layer, context, feedback):  # noqa: N802 (QGIS API name)
+        """QGIS calls this from C++: an exception escaping it would abort QGIS, so every failure is logged
+        with its traceback and reported to the run's feedback; the layer stays loaded, unstyled."""
+        try:
+            self._style(layer, context)
+        except Exception:  # noqa: BLE001 - a styling bug must never abort QGIS; it is logged, not hidden
+            import traceback
+
+            text = traceback.format_exc()
+            message = f"ArchaeoOrtho could not style the layer {layer.name()}: {text.strip().splitlines()[-1]}"
+            QgsMessageLog.logMessage(f"{message}\n{text}", "ArchaeoOrtho", Qgis.MessageLevel.Critical)
+            if feedback is not None:
+                feedback.reportError(message, False)
+
+    def _style(self, layer, context):
         project = context.project() or QgsProject.instance()
         path = layer.source().split("|")[0]
         layer.setCustomProperty(PATH_PROPERTY, path)
