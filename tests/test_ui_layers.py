@@ -148,7 +148,7 @@ def test_a_failing_style_step_is_logged_and_reported_not_raised(tmp_path, qgis_n
     path = _raster(str(tmp_path / "o.tif"), 3, nodata=0)
     layer = QgsRasterLayer(path, "orthomosaic")
     assert layer.isValid()
-    QgsProject.instance().addMapLayer(layer)
+    assert QgsProject.instance().addMapLayer(layer) is not None
 
     def broken(_layer):
         raise ZeroDivisionError("a bug in a style function")
