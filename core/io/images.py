@@ -155,12 +155,7 @@ def _checked_dataset(path: str):
         raise ImageError(f"{path}: a folder, not an image file")
     if os.path.getsize(path) == 0:
         raise ImageError(f"{path}: empty file (0 bytes)")
-    try:
-        ds = gdal.Open(path)
-    except RuntimeError as e:
-        raise ImageError(f"{path}: not a readable image ({str(e).strip()})") from e
-    if ds is None or ds.RasterCount == 0:
-        raise ImageError(f"{path}: not a readable image")
+    ds = open_image(path)
     w, h = ds.RasterXSize, ds.RasterYSize
     # decode a strip at the bottom: a JPEG decodes sequentially, so this decodes the whole scan and a truncated
     # JPEG fails there (libjpeg only warns unless told); a truncated TIFF fails on its last strip or tile
@@ -175,6 +170,18 @@ def _checked_dataset(path: str):
         raise ImageError(f"{path}: image data is corrupt or truncated ({str(e).strip()})") from e
     finally:
         gdal.SetConfigOption("GDAL_ERROR_ON_LIBJPEG_WARNING", old)
+    return ds
+
+
+def open_image(path: str):
+    """The GDAL dataset of an image file; ImageError naming the file when GDAL cannot read it."""
+    gdal = _gdal()
+    try:
+        ds = gdal.Open(path)
+    except RuntimeError as e:
+        raise ImageError(f"{path}: not a readable image ({str(e).strip()})") from e
+    if ds is None or ds.RasterCount == 0:
+        raise ImageError(f"{path}: not a readable image")
     return ds
 
 

@@ -53,7 +53,7 @@ import numpy as np
 
 from ..common.errors import ArchaeoOrthoError, require
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
-from ..io.images import ImageError, read_image, to_grey
+from ..io.images import ImageError, open_image, read_image, to_grey
 from .options import ScanOptions
 
 SCANS_JSON = "scans.json"
@@ -221,17 +221,6 @@ def _gdal():
 
     gdal.UseExceptions()
     return gdal
-
-
-def _open(path: str):
-    gdal = _gdal()
-    try:
-        ds = gdal.Open(path)
-    except RuntimeError as e:
-        raise ImageError(f"{path}: not a readable image ({str(e).strip()})") from e
-    if ds is None or ds.RasterCount == 0:
-        raise ImageError(f"{path}: not a readable image")
-    return ds
 
 
 def _read_window(ds, x0: int, y0: int, w: int, h: int) -> np.ndarray:
@@ -433,7 +422,7 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
         raise ScanError(f"unknown fiducial layout {options.layout!r}; choose one of {', '.join(LAYOUTS)}")
     if options.fiducial_type not in FIDUCIAL_TYPES:
         raise ScanError(f"unknown fiducial type {options.fiducial_type!r}; choose one of {', '.join(FIDUCIAL_TYPES)}")
-    ds = _open(path)
+    ds = open_image(path)
     full_w, full_h = ds.RasterXSize, ds.RasterYSize
     try:
         small = read_image(path, max_size=options.detect_size)
@@ -831,7 +820,7 @@ def restitute(path: str, out_to_scan: np.ndarray, width: int, height: int, out_p
 
     gdal = _gdal()
     progress = progress or NullProgress()
-    ds = _open(path)
+    ds = open_image(path)
     sw, sh, nb = ds.RasterXSize, ds.RasterYSize, ds.RasterCount
     dtype = ds.GetRasterBand(1).DataType
     shrink = math.sqrt(abs(np.linalg.det(out_to_scan[:, :2])))  # scan pixels per output pixel
@@ -1078,7 +1067,7 @@ def _detect_set(paths: Sequence[str], names: Sequence[str], options: ScanOptions
                             f"{options.min_score:g}); at least 3 are needed. Check the fiducial type and layout, "
                             "or give a template image of one mark")
         dets[n] = fids
-        ds = _open(p)
+        ds = open_image(p)
         sizes[n] = (ds.RasterXSize, ds.RasterYSize)
         res_mm[n] = scan_resolution_mm(ds)
         ds = None
