@@ -184,7 +184,7 @@ def test_bad_lines_name_file_and_line(tmp_path, line, what):
 def test_unknown_image(tmp_path):
     p = write(tmp_path, "g.txt", "EPSG:32617\n1000 2000 3 10 20 a.jpg P1\n1000 2000 3 11 21 zz.jpg P1\n")
     with pytest.raises(GCPError) as e:
-        read_gcps(p, image_names=["a.jpg", "b.jpg"])
+        read_gcps(p, image_names=["a.jpg", "b.jpg"], unknown_images="error")
     assert "line 3: zz.jpg" in str(e.value) and str(p) in str(e.value)
     # the lenient mode drops it with a warning instead
     gs = read_gcps(p, image_names=["a.jpg", "b.jpg"], unknown_images="warn")
@@ -377,7 +377,7 @@ def test_gcps_from_rows():
         gcps_from_rows([dict(rows[0], px="ten")], "EPSG:32617", source_name="gcps layer")
     with pytest.raises(GCPError, match=r"gcps layer: .*row 2: zz\.jpg"):
         gcps_from_rows([rows[0], dict(rows[1], image="zz.jpg")], "EPSG:32617", source_name="gcps layer",
-                       image_names=["a.jpg", "b.jpg"])
+                       image_names=["a.jpg", "b.jpg"], unknown_images="error")
 
 
 @needs_crs_lib

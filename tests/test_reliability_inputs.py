@@ -324,7 +324,7 @@ def test_gcp_warnings_are_kept_when_the_reader_itself_fails(tmp_path):
     path = _csv_gcps(tmp_path, "# crs: EPSG:32617", _UTM_ROWS[:1], obs)
     sizes = {f"IMG_{i}.JPG": (4000, 3000) for i in (1, 2)}
     with pytest.raises(gcp.GCPError, match="not in the block") as e:
-        gcp.read_gcps(path, image_names=list(sizes), image_sizes=sizes)
+        gcp.read_gcps(path, image_names=list(sizes), image_sizes=sizes, unknown_images="error")
     assert "lies outside image IMG_1.JPG" in str(e.value)
 
 

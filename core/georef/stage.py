@@ -9,6 +9,7 @@ which ``core.georef.uncertainty`` reads back).
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 import json
 import os
@@ -23,6 +24,7 @@ from ..common.files import atomic_output, atomic_write_text, file_fingerprint
 from ..common.progress import NullProgress, Progress, SubProgress
 from ..geometry.crs import transform_points, utm_epsg_for_lonlat
 from ..io import gcp as gcpmod
+from ..io.images import exif_orientation
 from ..io.vector import write_cameras_gpkg, write_points_gpkg
 from ..project.layout import Layout, write_json
 from ..project.stages import GEOREFERENCE, StageError, run_stage
@@ -93,15 +95,39 @@ def _default_crs(ws: Workspace) -> Optional[str]:
     return f"EPSG:{utm_epsg_for_lonlat(lon, lat)}"
 
 
+def photo_orientations(ws: Workspace) -> Dict[str, int]:
+    """{image: EXIF orientation} of the workspace's photos that a photo viewer shows turned (not 1): as the
+    alignment recorded it, else read from the photo's header."""
+    out: Dict[str, int] = {}
+    for im in ws.data.get("images", []):
+        o = im.get("orientation")
+        if o is None:
+            path = im.get("path") or os.path.join(ws.data.get("images_dir") or "", im["name"])
+            o = exif_orientation(path) if os.path.isfile(path) else 1
+        if int(o) != 1:
+            out[im["name"]] = int(o)
+    return out
+
+
 def _read_control(ws: Workspace, gcp_path: Optional[str], gcps: Optional[gcpmod.GCPSet], check_points: Sequence[str],
                   camera_positions_path: Optional[str], use_exif_gps: bool, crs: Optional[str],
-                  progress: Progress) -> Tuple[Optional[gcpmod.GCPSet], List[gcpmod.CameraPosition], str]:
+                  progress: Progress, gcps_upright: bool = False
+                  ) -> Tuple[Optional[gcpmod.GCPSet], List[gcpmod.CameraPosition], str]:
     """The ground control in the target CRS: (GCPs, camera positions, target CRS); StageError when it is
-    not enough to georeference."""
+    not enough to georeference.  Observations in photos that are not in the workspace are left out with a
+    warning (an error when none is in one of its photos); ``gcps_upright``: the pixel coordinates were measured
+    on upright photos (EXIF orientation applied) and are converted to the stored grid."""
     sizes = {im["name"]: (im["width"], im["height"]) for im in ws.data.get("images", [])}
+    upright = photo_orientations(ws) if gcps_upright else None
+    if gcps_upright and not upright:
+        progress.info("GCP coordinates measured on upright photos: no photo of the block is stored turned (EXIF "
+                      "orientation 1 or none), nothing to convert")
     if gcp_path:
         # a CSV points file without a CRS line takes the CRS parameter
-        gcps = gcpmod.read_gcps(gcp_path, image_names=list(sizes), image_sizes=sizes, default_crs=crs)
+        gcps = gcpmod.read_gcps(gcp_path, image_names=list(sizes), image_sizes=sizes, default_crs=crs,
+                                upright_orientations=upright)
+    elif gcps is not None and upright:
+        gcps = gcpmod.observations_to_stored(copy.deepcopy(gcps), sizes, upright)
     if gcps is not None and check_points:
         gcpmod.apply_check_points(gcps, list(check_points))
     positions_crs = gcpmod.read_camera_positions(camera_positions_path)[0] if camera_positions_path else None
@@ -139,8 +165,12 @@ def georeference_workspace(workspace_dir: str, gcp_path: Optional[str] = None,
                            camera_positions_path: Optional[str] = None, use_exif_gps: bool = False,
                            crs: Optional[str] = None, refine_intrinsics: bool = False,
                            progress: Optional[Progress] = None,
-                           options: Optional[GeorefOptions] = None) -> GeorefStageResult:
+                           options: Optional[GeorefOptions] = None, gcps_upright: bool = False) -> GeorefStageResult:
     """Georeference an aligned workspace with GCPs and/or camera positions (see core.georef.adjust).
+
+    GCP pixel coordinates are in the stored pixel grid (COLMAP's, EXIF orientation not applied), unless
+    ``gcps_upright``: then they were measured on the photos shown upright (a browser, most photo viewers) and
+    are converted to the stored grid with each photo's EXIF orientation.
 
     ``options``: further :class:`~core.georef.options.GeorefOptions` of the adjustment (``refine_intrinsics``
     and the target CRS come from the keywords)."""
@@ -151,9 +181,11 @@ def georeference_workspace(workspace_dir: str, gcp_path: Optional[str] = None,
         raise StageError(f"workspace {ws.root} has no aligned model: run 'Align images' first")
     rec = lay.load_aligned_model()
     gcps, cams, target = _read_control(ws, gcp_path, gcps, check_points, camera_positions_path, use_exif_gps, crs,
-                                       progress)
+                                       progress, gcps_upright=gcps_upright)
     params = {"gcps": gcp_path, "check_points": list(check_points), "camera_positions": camera_positions_path,
               "use_exif_gps": use_exif_gps, "crs": target, "refine_intrinsics": refine_intrinsics}
+    if gcps_upright:
+        params["gcps_upright"] = True
     inputs = {k: file_fingerprint(v) for k, v in (("gcps", gcp_path), ("positions", camera_positions_path)) if v}
     opt = GeorefOptions.of(options, refine_intrinsics=refine_intrinsics, crs=target)
     with run_stage(ws, GEOREF, params, inputs) as run:

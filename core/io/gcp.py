@@ -45,6 +45,8 @@ form.
 from __future__ import annotations
 
 import csv
+import difflib
+import functools
 import math
 import os
 import re
@@ -249,15 +251,98 @@ class _ImageLookup:
         return None
 
 
+def _closest_names(image: str, names: Sequence[str], n: int = 3) -> List[str]:
+    """The block's photo names closest to ``image`` (difflib on lower-case base names), best first."""
+    base = {}
+    for name in names:
+        base.setdefault(os.path.basename(name.replace("\\", "/")).lower(), name)
+    key = os.path.basename(image.replace("\\", "/")).lower()
+    return [base[b] for b in difflib.get_close_matches(key, list(base), n=n, cutoff=0.5)]
+
+
+def _line_list(lines: Sequence[int], unit: str) -> str:
+    shown = [str(n) for n in lines if n][:12]
+    if not shown:
+        return ""
+    more = f", ... ({len(lines)} in all)" if len(lines) > 12 else ""
+    return f"{unit}{'s' if len(lines) > 1 else ''} {', '.join(shown)}{more}"
+
+
+def _unknown_images(gs: GCPSet, unknown: Dict[str, List[Tuple[int, str]]], matched: int, known: Sequence[str],
+                    path: PathLike, unit: str, mode: str, loc) -> None:
+    """The policy for observations in photos that are not in the block (``unknown``: {image: [(line, point)]}):
+    with ``mode="warn"`` they are ignored with one warning per photo naming its lines and points, unless no
+    observation at all matches a photo of the block: then (and always with ``mode="error"``) GCPError, naming
+    the closest photo names of the block so that a naming mistake shows."""
+    n_unknown = sum(len(v) for v in unknown.values())
+    if mode == "warn" and matched:
+        gs.warnings.append(
+            f"{path}: {n_unknown} observation(s) in {len(unknown)} photo(s) that are not in the block "
+            f"({len(known)} photos) ignored: {', '.join(list(unknown)[:10])}{' ...' if len(unknown) > 10 else ''}; "
+            f"{matched} observation(s) match the block's photos and are used")
+        for image, rows in unknown.items():
+            points = ", ".join(dict.fromkeys(pt for _, pt in rows))
+            lines = _line_list([ln for ln, _ in rows], unit)
+            gs.warnings.append(f"{loc(rows[0][0])}: image {image!r} is not in the block: {len(rows)} observation(s) "
+                               f"ignored ({lines + '; ' if lines else ''}point(s) {points})")
+        return
+
+    def hint(image: str) -> str:
+        close = _closest_names(image, known)
+        return f"closest in the block: {', '.join(close)}" if close else "no similar name in the block"
+
+    details = "; ".join(f"{image!r} ({_line_list([ln for ln, _ in rows], unit) + ', ' if rows[0][0] else ''}"
+                        f"{hint(image)})" for image, rows in list(unknown.items())[:12])
+    more = f"; ... ({len(unknown)} photos in all)" if len(unknown) > 12 else ""
+    sample = ", ".join(list(known)[:5]) + (", ..." if len(known) > 5 else "")
+    if mode == "warn":
+        raise GCPError(f"{path}: none of its {n_unknown} observation(s) is in a photo of the block ({len(known)} "
+                       f"photos, e.g. {sample}): the image names do not match: {details}{more}")
+    shown = "; ".join(f"{unit} {ln}: {image}" if ln else image for image, rows in unknown.items()
+                      for ln, _ in rows)
+    raise GCPError(f"{path}: observation(s) in image(s) that are not in the block ({len(known)} images): "
+                   f"{shown[:2000]}. Per photo: {details}{more}")
+
+
+def _upright_table(upright: Optional[Mapping[str, int]], image_sizes: Optional[ImageSizes],
+                   path: PathLike) -> Dict[str, Any]:
+    """{image: (x, y) -> stored (x, y)} for the photos of ``upright`` whose orientation turns the grid."""
+    from .images import upright_to_stored
+
+    out: Dict[str, Any] = {}
+    for image, orientation in (upright or {}).items():
+        if int(orientation) == 1:
+            continue
+        size = (image_sizes or {}).get(image)
+        if size is None:
+            raise GCPError(f"{path}: cannot convert the upright pixel coordinates of image {image}: its stored size "
+                           "is not known")
+        out[image] = functools.partial(upright_to_stored, orientation=int(orientation), width=size[0], height=size[1])
+    return out
+
+
+def observations_to_stored(gcpset: GCPSet, image_sizes: ImageSizes, orientations: Mapping[str, int]) -> GCPSet:
+    """Convert observations measured on upright photos to the stored pixel grid, in place (for a GCPSet made
+    elsewhere, e.g. from a point layer; the readers take ``upright_orientations`` instead).  ``image_sizes``:
+    stored sizes; ``orientations``: {image: EXIF orientation}; other images are left as they are."""
+    table = _upright_table(orientations, image_sizes, gcpset.source or "ground control")
+    for p in gcpset.points:
+        p.observations = [Observation(o.image, *table[o.image](o.x, o.y)) if o.image in table else o
+                          for o in p.observations]
+    return gcpset
+
+
 def _finish(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike,
             image_names: Optional[Iterable[str]], image_sizes: Optional[ImageSizes],
-            unknown_images: str = "error", point_where: Optional[Dict[int, str]] = None,
-            unit: str = "line") -> GCPSet:
+            unknown_images: str = "warn", point_where: Optional[Dict[int, str]] = None,
+            unit: str = "line", upright: Optional[Mapping[str, int]] = None) -> GCPSet:
     """Shared validation: unknown images, duplicate observations, bounds, points seen in < 2 images.
 
     ``obs_lines[id(point)]`` holds the source line (in ``path``) of each observation of that point;
     ``point_where[id(point)]`` where the point itself is defined, when that is elsewhere ("file:line").
-    ``unit``: "line" (file:line) or "row" (source: row n) in messages.
+    ``unit``: "line" (file:line) or "row" (source: row n) in messages.  ``upright``: {image: EXIF orientation}
+    of photos whose observations were measured on the upright photo; they are converted to the stored grid
+    (``image_sizes`` gives the stored sizes) before the bounds check.
     """
 
     def loc(n: int) -> str:
@@ -269,7 +354,9 @@ def _finish(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike,
         raise ValueError("unknown_images must be 'error' or 'warn'")
     names = _ImageLookup(image_names)
     sizes_lookup = _ImageLookup(image_sizes.keys()) if image_sizes is not None else None
-    unknown: List[str] = []
+    rotations = _upright_table(upright, image_sizes, path)
+    unknown: Dict[str, List[Tuple[int, str]]] = {}
+    matched = 0
     for p in gs.points:
         lines = obs_lines.get(id(p), [0] * len(p.observations))
         kept: List[Observation] = []
@@ -279,13 +366,10 @@ def _finish(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike,
             at = loc(ln)
             img = names.find(o.image)
             if img is None:
-                if unknown_images == "error":
-                    unknown.append(f"{unit} {ln}: {o.image}" if ln else o.image)
-                else:
-                    gs.warnings.append(f"{at}: image {o.image!r} (point {p.name}) is not in the block; "
-                                       "observation ignored")
-                    p.dropped.append("image not in the block")
+                unknown.setdefault(o.image, []).append((ln, p.name))
+                p.dropped.append("image not in the block")
                 continue
+            matched += 1
             o = Observation(img, o.x, o.y)
             if img in seen:
                 first = f"{unit} {seen[img]}" if seen[img] else f"an earlier {unit}"
@@ -293,6 +377,8 @@ def _finish(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike,
                                    f"(first on {first}); keeping the first")
                 p.dropped.append("duplicate")
                 continue
+            if img in rotations:
+                o = Observation(img, *rotations[img](o.x, o.y))
             if sizes_lookup is not None:
                 key = sizes_lookup.find(img)
                 if key is not None and key in image_sizes:
@@ -300,7 +386,7 @@ def _finish(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike,
                     if not (0.0 <= o.x <= float(w) and 0.0 <= o.y <= float(h)):
                         gs.warnings.append(
                             f"{at}: observation of point {p.name} at ({o.x:g}, {o.y:g}) lies outside image "
-                            f"{img} ({w} x {h} px); dropped")
+                            f"{img} ({w} x {h} px){' (stored grid)' if img in rotations else ''}; dropped")
                         p.dropped.append("outside the image")
                         continue
             seen[img] = ln
@@ -309,10 +395,7 @@ def _finish(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike,
         p.observations = kept
         obs_lines[id(p)] = kept_lines
     if unknown:
-        shown = "; ".join(unknown[:20]) + (f"; ... ({len(unknown)} in all)" if len(unknown) > 20 else "")
-        known = names.names or []
-        raise GCPError(f"{path}: observation(s) in image(s) that are not in the block ({len(known)} images): "
-                       f"{shown}")
+        _unknown_images(gs, unknown, matched, names.names or [], path, unit, unknown_images, loc)
     for p in gs.points:
         n = len(p.images())
         first = next(iter(obs_lines.get(id(p)) or []), 0)
@@ -341,10 +424,11 @@ def with_warnings(error: Exception, warnings: Sequence[str]) -> str:
 
 def _finish_checked(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike, units_path: PathLike,
                     image_names: Optional[Iterable[str]], image_sizes: Optional[ImageSizes], unknown_images: str,
-                    point_where: Optional[Dict[int, str]] = None) -> GCPSet:
+                    point_where: Optional[Dict[int, str]] = None,
+                    upright: Optional[Mapping[str, int]] = None) -> GCPSet:
     """_finish and _check_units; a GCPError they raise carries the warnings collected before it."""
     try:
-        _finish(gs, obs_lines, path, image_names, image_sizes, unknown_images, point_where)
+        _finish(gs, obs_lines, path, image_names, image_sizes, unknown_images, point_where, upright=upright)
         _check_units(gs, units_path)
     except GCPError as e:
         if not gs.warnings:
@@ -358,13 +442,20 @@ def _finish_checked(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike,
 # --------------------------------------------------------------------------------------------------
 
 def read_odm_gcp_list(path: PathLike, image_names: Optional[Iterable[str]] = None,
-                      image_sizes: Optional[ImageSizes] = None, *, unknown_images: str = "error") -> GCPSet:
+                      image_sizes: Optional[ImageSizes] = None, *, unknown_images: str = "warn",
+                      upright_orientations: Optional[Mapping[str, int]] = None) -> GCPSet:
     """Read an OpenDroneMap ``gcp_list.txt`` (format in the module docstring).
 
-    ``image_names``: the block's images; an observation in any other image raises GCPError (or, with
-    ``unknown_images="warn"``, is dropped with a warning).  Names match exactly, else by base name, else by
-    base name ignoring case; the block's spelling is kept.  ``image_sizes``: {image: (width, height)};
-    observations outside [0, w] x [0, h] are dropped with a warning.
+    ``image_names``: the block's images.  An observation in any other image is dropped with a warning that
+    names its lines, photo and points (``unknown_images="warn"``, the default: a file that also lists photos
+    left out of the block, or not registered, is used for what matches); GCPError only when no observation at
+    all is in a photo of the block, naming the block's closest photo names so that a naming mistake shows.
+    ``unknown_images="error"``: any observation in another image is a GCPError.  Names match exactly, else by
+    base name, else by base name ignoring case; the block's spelling is kept.  ``image_sizes``: {image:
+    (width, height)} of the stored pixel grid; observations outside [0, w] x [0, h] are dropped with a warning.
+    ``upright_orientations``: {image: EXIF orientation} when the pixel coordinates were measured on photos
+    shown upright (a browser, most photo viewers): they are converted to the stored grid (needs
+    ``image_sizes``; see core.io.images.upright_to_stored).
     """
     lines = _read_lines(path)
     i = 0
@@ -467,7 +558,8 @@ def read_odm_gcp_list(path: PathLike, image_names: Optional[Iterable[str]] = Non
     gs.points = order
     if not order:
         gs.warnings.append(f"{path}: no observations")
-    return _finish_checked(gs, obs_lines, path, path, image_names, image_sizes, unknown_images)
+    return _finish_checked(gs, obs_lines, path, path, image_names, image_sizes, unknown_images,
+                           upright=upright_orientations)
 
 
 def _fmt(v: float) -> str:
@@ -610,8 +702,9 @@ def default_observations_path(points_path: PathLike) -> str:
 
 def read_csv_gcps(points_path: PathLike, observations_path: Optional[PathLike] = None, *,
                   crs: Optional[str] = None, image_names: Optional[Iterable[str]] = None,
-                  image_sizes: Optional[ImageSizes] = None, unknown_images: str = "error",
-                  default_crs: Optional[str] = None) -> GCPSet:
+                  image_sizes: Optional[ImageSizes] = None, unknown_images: str = "warn",
+                  default_crs: Optional[str] = None,
+                  upright_orientations: Optional[Mapping[str, int]] = None) -> GCPSet:
     """Read GCPs from a points CSV and an observations CSV (format in the module docstring).
 
     ``crs`` overrides a CRS found in the points file; ``default_crs`` (an algorithm's CRS parameter) is the CRS
@@ -681,7 +774,8 @@ def read_csv_gcps(points_path: PathLike, observations_path: Optional[PathLike] =
             p.observations.append(Observation(img, px, py))
             obs_lines.setdefault(id(p), []).append(lineno)
     where = {id(p): f"{points_path}:{first_line[p.name]}" for p in gs.points}
-    return _finish_checked(gs, obs_lines, obs_path, points_path, image_names, image_sizes, unknown_images, where)
+    return _finish_checked(gs, obs_lines, obs_path, points_path, image_names, image_sizes, unknown_images, where,
+                           upright=upright_orientations)
 
 
 def _csv_text(rows: Iterable[Sequence[Any]]) -> str:
@@ -736,17 +830,20 @@ def detect_gcp_format(path: PathLike) -> str:
 
 def read_gcps(path: PathLike, image_names: Optional[Iterable[str]] = None,
               image_sizes: Optional[ImageSizes] = None, *, observations_path: Optional[PathLike] = None,
-              crs: Optional[str] = None, unknown_images: str = "error", default_crs: Optional[str] = None) -> GCPSet:
+              crs: Optional[str] = None, unknown_images: str = "warn", default_crs: Optional[str] = None,
+              upright_orientations: Optional[Mapping[str, int]] = None) -> GCPSet:
     """Read ground control from an OpenDroneMap gcp_list.txt or a CSV points file (+ observations file).
 
     ``crs``, ``default_crs`` (the CRS of a file that names none) and ``observations_path`` apply to the CSV form
     only (a gcp_list.txt always names its CRS).  See ``read_odm_gcp_list`` for
-    ``image_names``, ``image_sizes`` and ``unknown_images``.
+    ``image_names``, ``image_sizes``, ``unknown_images`` and ``upright_orientations``.
     """
     if detect_gcp_format(path) == "csv":
         return read_csv_gcps(path, observations_path, crs=crs, image_names=image_names,
-                             image_sizes=image_sizes, unknown_images=unknown_images, default_crs=default_crs)
-    return read_odm_gcp_list(path, image_names, image_sizes, unknown_images=unknown_images)
+                             image_sizes=image_sizes, unknown_images=unknown_images, default_crs=default_crs,
+                             upright_orientations=upright_orientations)
+    return read_odm_gcp_list(path, image_names, image_sizes, unknown_images=unknown_images,
+                             upright_orientations=upright_orientations)
 
 
 def write_gcps(gcpset: GCPSet, path: PathLike, observations_path: Optional[PathLike] = None) -> None:
@@ -759,7 +856,7 @@ def write_gcps(gcpset: GCPSet, path: PathLike, observations_path: Optional[PathL
 
 def gcps_from_rows(rows: Iterable[Mapping[str, Any]], crs: str, *, source_name: str = "layer",
                    image_names: Optional[Iterable[str]] = None, image_sizes: Optional[ImageSizes] = None,
-                   unknown_images: str = "error") -> GCPSet:
+                   unknown_images: str = "warn", upright_orientations: Optional[Mapping[str, int]] = None) -> GCPSet:
     """Ground control from table rows, one row per observation (e.g. the features of a QGIS point layer).
 
     Each row is a mapping with keys (case-insensitive) ``name``, ``x``, ``y``, ``z``, ``image``, ``px``,
@@ -811,7 +908,8 @@ def gcps_from_rows(rows: Iterable[Mapping[str, Any]], crs: str, *, source_name: 
         obs_lines.setdefault(id(p), []).append(k)
     if not gs.points:
         gs.warnings.append(f"{source_name}: no ground control rows")
-    _finish(gs, obs_lines, source_name, image_names, image_sizes, unknown_images, unit="row")
+    _finish(gs, obs_lines, source_name, image_names, image_sizes, unknown_images, unit="row",
+            upright=upright_orientations)
     _check_units(gs, source_name)
     return gs
 
@@ -971,6 +1069,7 @@ def read_camera_positions(path: PathLike, default_sigma_xy: float = 5.0, default
 
 __all__ = [
     "CHECK", "CONTROL", "CameraPosition", "GCPError", "GCPSet", "GroundPoint", "Observation", "apply_check_points",
-    "check_units", "default_observations_path", "detect_gcp_format", "gcps_from_rows", "read_camera_positions",
+    "check_units", "default_observations_path", "detect_gcp_format", "gcps_from_rows", "observations_to_stored",
+    "read_camera_positions",
     "read_csv_gcps", "read_gcps", "read_odm_gcp_list", "write_csv_gcps", "write_gcps", "write_odm_gcp_list",
 ]

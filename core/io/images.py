@@ -46,6 +46,7 @@ class ImageInfo:
     focal_px: Optional[float] = None  # best prior for the focal length in pixels
     focal_source: str = "default"  # exif35 / exif_plane / manual / default
     gps: Optional[Tuple[float, float, float]] = None  # lon, lat, ellipsoidal(ish) alt (WGS84)
+    orientation: int = 1  # EXIF orientation (1-8): how a photo viewer turns the stored grid; see ORIENTATION_STEPS
 
     def to_dict(self) -> dict:
         d = asdict(self)
@@ -133,6 +134,7 @@ def read_image_info(path: str, name: Optional[str] = None, manual_focal_mm: Opti
     info.focal_mm = fmm[0] if fmm and fmm[0] > 0 else None
     f35 = _rational(md.get("EXIF_FocalLengthIn35mmFilm", ""))
     info.focal_35mm = f35[0] if f35 and f35[0] > 0 else None
+    info.orientation = _orientation_value(md.get("EXIF_Orientation"))
     info.focal_px, info.focal_source = _focal_prior(info, md, manual_focal_mm, manual_sensor_width_mm, manual_focal_px)
     lat = _dms(md.get("EXIF_GPSLatitude", ""), md.get("EXIF_GPSLatitudeRef", "N"))
     lon = _dms(md.get("EXIF_GPSLongitude", ""), md.get("EXIF_GPSLongitudeRef", "E"))
@@ -143,6 +145,103 @@ def read_image_info(path: str, name: Optional[str] = None, manual_focal_mm: Opti
             alt = -alt
         info.gps = (lon, lat, alt)
     return info
+
+
+# --------------------------------------------------------------------------------------------------
+# EXIF orientation
+#
+# The one convention: every pixel coordinate the plugin stores (GCP observations, COLMAP's keypoints,
+# georef/control.json) is in the STORED pixel grid, the raster as written in the file (COLMAP's grid, EXIF
+# orientation not applied).  A photo viewer (a browser, the GCP dock) shows the photo UPRIGHT: the stored grid
+# turned by the EXIF orientation tag.  The functions below convert between the two; both use the pixel
+# convention of core.io.gcp (origin at the upper-left corner of the upper-left pixel, x right, y down), and
+# ``width``, ``height`` are always the STORED size.
+# --------------------------------------------------------------------------------------------------
+
+# EXIF orientation -> (degrees clockwise, then mirror left-right, then mirror top-bottom) that turn the stored
+# grid upright (the EXIF 2.3 definitions: 6 = "the 0th row is the visual right-hand side", shown by a 90 degree
+# clockwise turn, as cameras held in portrait write it; 8 = 270 degrees clockwise)
+ORIENTATION_STEPS: Dict[int, Tuple[int, bool, bool]] = {
+    1: (0, False, False), 2: (0, True, False), 3: (180, False, False), 4: (0, False, True),
+    5: (90, True, False), 6: (90, False, False), 7: (90, False, True), 8: (270, False, False)}
+
+
+def _orientation_value(text: Optional[str]) -> int:
+    try:
+        value = int(str(text).strip().strip("\x00")) if text is not None else 1
+    except ValueError:
+        return 1
+    return value if value in ORIENTATION_STEPS else 1
+
+
+def exif_orientation(path: str) -> int:
+    """The EXIF orientation (1-8) of a photo, 1 when it has none or an invalid one; reads the header only.
+    ImageError naming the file when it cannot be opened."""
+    return _orientation_value(open_image(path).GetMetadataItem("EXIF_Orientation"))
+
+
+def _check_orientation(orientation: int) -> int:
+    o = int(orientation)
+    if o not in ORIENTATION_STEPS:
+        raise ValueError(f"EXIF orientation must be 1-8, got {orientation!r}")
+    return o
+
+
+def upright_size(orientation: int, width: int, height: int) -> Tuple[int, int]:
+    """(width, height) of the upright photo whose stored grid is ``width`` x ``height``."""
+    turn = ORIENTATION_STEPS[_check_orientation(orientation)][0]
+    return (height, width) if turn in (90, 270) else (width, height)
+
+
+def orientation_matrix(orientation: int, width: int, height: int) -> np.ndarray:
+    """3 x 3 matrix taking stored pixel coordinates (x, y, 1) to upright ones (exact: a signed permutation plus
+    a shift)."""
+    turn, mirror_lr, mirror_tb = ORIENTATION_STEPS[_check_orientation(orientation)]
+    w, h = float(width), float(height)
+    m = np.eye(3)
+    if turn == 90:  # (x, y) -> (h - y, x)
+        m = np.array([[0.0, -1.0, h], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    elif turn == 180:
+        m = np.array([[-1.0, 0.0, w], [0.0, -1.0, h], [0.0, 0.0, 1.0]])
+    elif turn == 270:  # (x, y) -> (y, w - x)
+        m = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, w], [0.0, 0.0, 1.0]])
+    uw, uh = upright_size(orientation, width, height)
+    if mirror_lr:
+        m = np.array([[-1.0, 0.0, float(uw)], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]) @ m
+    if mirror_tb:
+        m = np.array([[1.0, 0.0, 0.0], [0.0, -1.0, float(uh)], [0.0, 0.0, 1.0]]) @ m
+    return m
+
+
+def _apply(m: np.ndarray, x, y):
+    xa, ya = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    u = m[0, 0] * xa + m[0, 1] * ya + m[0, 2]
+    v = m[1, 0] * xa + m[1, 1] * ya + m[1, 2]
+    if u.ndim == 0:
+        return float(u), float(v)
+    return u, v
+
+
+def stored_to_upright(x, y, orientation: int, width: int, height: int):
+    """Upright pixel coordinates of stored ones (floats or arrays) in a photo stored ``width`` x ``height``."""
+    return _apply(orientation_matrix(orientation, width, height), x, y)
+
+
+def upright_to_stored(x, y, orientation: int, width: int, height: int):
+    """Stored pixel coordinates of upright ones (as measured on the photo a viewer shows); ``width``, ``height``:
+    the STORED size."""
+    return _apply(np.linalg.inv(orientation_matrix(orientation, width, height)), x, y)
+
+
+def to_upright(arr: np.ndarray, orientation: int) -> np.ndarray:
+    """The stored raster ``arr`` (rows, cols[, bands]) turned upright, as a photo viewer shows it."""
+    turn, mirror_lr, mirror_tb = ORIENTATION_STEPS[_check_orientation(orientation)]
+    out = np.rot90(arr, k=-(turn // 90), axes=(0, 1)) if turn else arr
+    if mirror_lr:
+        out = out[:, ::-1]
+    if mirror_tb:
+        out = out[::-1]
+    return np.ascontiguousarray(out)
 
 
 def _checked_dataset(path: str):
