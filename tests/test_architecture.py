@@ -12,7 +12,7 @@ CORE = os.path.join(ROOT, "core")
 MAX_FUNCTION_LINES = 120
 MAX_CLASS_LINES = 400
 # the rooms in the order data flows; a room may import only rooms before it (and itself)
-LAYERS = [["common"], ["geometry", "project"], ["io"], ["prepare"], ["align"], ["georef"], ["dense"], ["ortho"],
+LAYERS = [["common"], ["geometry", "project"], ["io"], ["prepare"], ["align"], ["georef"], ["dense"], ["ortho", "terrain"],
           ["report"], ["pipeline"]]
 
 
@@ -153,7 +153,7 @@ def test_every_core_error_derives_from_the_one_base():
     assert not bad, "errors outside the ArchaeoOrthoError family:\n" + "\n".join(bad)
 
 
-@pytest.mark.parametrize("room", ["prepare", "align", "georef", "dense", "ortho", "report"])
+@pytest.mark.parametrize("room", ["prepare", "align", "georef", "dense", "ortho", "terrain", "report"])
 def test_each_stage_room_has_options_and_stage(room):
     for f in ("options.py", "stage.py"):
         assert os.path.isfile(os.path.join(CORE, room, f)), f"core/{room}/{f} missing"

@@ -18,7 +18,7 @@ from typing import Any, Dict, Optional, Tuple
 
 from ..common.errors import ArchaeoOrthoError, require
 from ..common.files import atomic_write_text
-from .stages import ALIGN, DSM, GEOREFERENCE
+from .stages import ALIGN, DSM, GEOREFERENCE, TERRAIN
 from .workspace import Workspace
 
 # folder and file names inside a workspace (the workspace format: changing one breaks old workspaces)
@@ -45,6 +45,12 @@ DSM_TIF = "dsm.tif"
 ORTHOMOSAIC_TIF = "orthomosaic.tif"
 REPORT_HTML = "report.html"
 UNCERTAINTY_DIR = "uncertainty"
+DTM_TIF = "dtm.tif"
+TERRAIN_DIR = "terrain"
+DTM_SOURCE_TIF = "dtm-source.tif"  # 1 measured ground, 2 interpolated under objects / in holes
+RELIEF_DIR = "relief"
+CONTOURS_GPKG = "contours.gpkg"
+CLASSIFIED_LAS = "points-classified.las"
 
 
 class LayoutError(ArchaeoOrthoError, RuntimeError):
@@ -241,6 +247,47 @@ class Layout:
     @property
     def uncertainty_dir(self) -> str:
         return self.path(UNCERTAINTY_DIR)
+
+    # --- terrain ---------------------------------------------------------
+    @property
+    def default_dtm(self) -> str:
+        return self.path(DTM_TIF)
+
+    @property
+    def terrain_dir(self) -> str:
+        return self.path(TERRAIN_DIR)
+
+    @property
+    def dtm_source(self) -> str:
+        """Beside the DTM: which cells are measured ground (1) and which interpolated (2)."""
+        return self.path(TERRAIN_DIR, DTM_SOURCE_TIF)
+
+    @property
+    def contours_gpkg(self) -> str:
+        return self.path(TERRAIN_DIR, CONTOURS_GPKG)
+
+    @property
+    def classified_point_cloud(self) -> str:
+        return self.path(TERRAIN_DIR, CLASSIFIED_LAS)
+
+    def relief(self, key: str, source: str = "dtm") -> str:
+        """A relief visualisation (core.terrain.options.VISUALISATIONS) of the DTM or DSM."""
+        return self.path(TERRAIN_DIR, RELIEF_DIR, f"{source}-{key}.tif")
+
+    def dtm(self) -> Optional[str]:
+        """The workspace's DTM: the terrain stage's recorded output, else <workspace>/dtm.tif; None if absent."""
+        out = (self.ws.stage(TERRAIN).get("outputs") or {}).get("dtm")
+        if out:
+            p = self.resolve(out)
+            if os.path.isfile(p):
+                return p
+        return self.default_dtm if os.path.isfile(self.default_dtm) else None
+
+    def point_cloud(self) -> Optional[str]:
+        """The DSM stage's point cloud (LAS), None if it wrote none."""
+        out = (self.ws.stage(DSM).get("outputs") or {}).get("point_cloud")
+        p = self.resolve(out) if out else None
+        return p if p and os.path.isfile(p) else None
 
     # --- helpers ---------------------------------------------------------
     def model_fingerprints(self, model_dir: Optional[str] = None, prefix: str = "model/") -> Dict[str, str]:

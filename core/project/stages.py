@@ -45,9 +45,11 @@ GEOREFERENCE = "georeference"
 DSM = "dsm"
 ORTHOPHOTO = "orthophoto"
 REPORT = "report"
+TERRAIN = "terrain"  # DTM (+ contours) from the DSM
+RELIEF = "relief"  # relief visualisations of the DTM or DSM
 
 # the order data flows in; a stage that finishes marks the done stages after it stale
-STAGE_ORDER: List[str] = [PREPARE, ALIGN, GEOREFERENCE, DSM, ORTHOPHOTO, REPORT]
+STAGE_ORDER: List[str] = [PREPARE, ALIGN, GEOREFERENCE, DSM, ORTHOPHOTO, TERRAIN, RELIEF, REPORT]
 
 
 class StageError(ArchaeoOrthoError, RuntimeError):

@@ -1,0 +1,79 @@
+"""The options of the terrain stage (DTM, relief visualisations, contours): defaults in this one place, and its
+error."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Tuple
+
+from ..common.errors import ArchaeoOrthoError
+
+# the relief visualisations (Processing enum order; file name = key)
+VISUALISATIONS: Tuple[Tuple[str, str], ...] = (
+    ("svf", "Sky-view factor"),
+    ("openness_pos", "Openness (positive)"),
+    ("openness_neg", "Openness (negative)"),
+    ("slrm", "Simple local relief model"),
+    ("msrm", "Multi-scale relief model"),
+    ("mhs", "Multi-direction hillshade"),
+    ("ld", "Local dominance"),
+    ("vat", "VAT (visualisation for archaeological topography, blend)"),
+)
+VISUALISATION_KEYS = tuple(k for k, _ in VISUALISATIONS)
+
+# measured ground / interpolated: the values of the DTM's source raster (terrain/dtm-source.tif)
+SOURCE_MEASURED = 1
+SOURCE_INTERPOLATED = 2
+
+
+class TerrainError(ArchaeoOrthoError, RuntimeError):
+    """The DTM, a relief visualisation or contours cannot be made from this raster; the message names the file
+    and the problem."""
+
+
+@dataclass
+class GroundOptions:
+    """The ground filter: SMRF (Pingel, Clarke & McBride 2013, the algorithm of PDAL's filters.smrf) on the DSM grid.
+
+    Defaults are PDAL's filters.smrf defaults (slope 0.15, window 18 m, threshold 0.5 m, scalar 1.25); the
+    filter grid is the DSM's, coarsened to ``filter_cell`` for the morphological opening only."""
+
+    slope: float = 0.15  # rise over run: a terrain steeper than this between two window sizes is an object
+    window: float = 18.0  # m, the largest opening radius (the half-size of the largest building to remove)
+    threshold: float = 0.5  # m above the provisional ground surface: object
+    scalar: float = 1.25  # threshold grows by scalar x the local slope of the provisional surface
+    filter_cell: float = 0.5  # m, the grid of the morphological opening (finer DSMs are reduced to it)
+    dilate: float = 0.0  # m, objects grown by this much (0 = one DSM cell: the blurred foot of a wall)
+
+
+@dataclass
+class ReliefOptions:
+    """RVT's default parameters (rvt.default.DefaultValues, given in cells of a 1 m DEM), converted to metres
+    and back to cells of the actual DEM: a radius of 10 cells at 1 m is 10 m, i.e. 100 cells at 0.1 m; capped at
+    ``max_radius_cells`` (the run time grows with the radius)."""
+
+    reference_cell: float = 1.0  # m: the cell size RVT's defaults are given for
+    svf_directions: int = 16
+    svf_radius: float = 10.0  # reference cells
+    svf_noise: int = 0
+    slrm_radius: float = 20.0
+    msrm_feature_min: float = 0.0  # m (RVT: 0 .. 20 m, scaling factor 2)
+    msrm_feature_max: float = 20.0
+    msrm_scaling: int = 2
+    hs_sun_elevation: float = 35.0
+    mhs_directions: int = 16
+    ld_min_radius: float = 10.0
+    ld_max_radius: float = 20.0
+    ld_observer_height: float = 1.7  # m
+    max_radius_cells: int = 120
+    vertical_exaggeration: float = 1.0
+
+
+@dataclass
+class TerrainOptions:
+    ground: GroundOptions = None  # type: ignore[assignment]
+    contour_interval: float = 0.0  # m; 0 = no contours
+    classify_point_cloud: bool = True
+
+    def __post_init__(self):
+        if self.ground is None:
+            self.ground = GroundOptions()

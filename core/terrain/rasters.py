@@ -1,0 +1,101 @@
+"""Reading an elevation raster for the terrain products (checked: projected CRS, data, size) and writing them."""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import Optional, Tuple
+
+import numpy as np
+
+from ..io import raster
+from .options import TerrainError
+
+MIN_CELLS = 16  # the smallest raster side the filters work on
+
+
+@dataclass
+class Elevation:
+    path: str
+    z: np.ndarray  # float64, NaN = nodata, in metres
+    geotransform: Tuple[float, ...]
+    crs_wkt: str
+    cell: float  # metres
+    unit: float  # metres per CRS unit (the heights are scaled by it, and back on writing)
+
+    @property
+    def shape(self) -> Tuple[int, int]:
+        return self.z.shape
+
+
+def read_elevation(path: str, what: str = "DSM") -> Elevation:
+    """The whole raster ``path`` (band 1) as metres; TerrainError naming the file for a raster that cannot be a
+    terrain model: unreadable, geographic CRS (degrees), rotated or non-square cells, too small, no data."""
+    from osgeo import gdal, osr
+
+    gdal.UseExceptions()
+    if not os.path.isfile(path):
+        raise TerrainError(f"the {what} {path} does not exist")
+    try:
+        ds = gdal.Open(path)
+    except RuntimeError as e:
+        raise TerrainError(f"cannot read the {what} {path}: {e}") from e
+    gt = ds.GetGeoTransform()
+    wkt = ds.GetProjection() or ""
+    unit = 1.0
+    if wkt:
+        srs = osr.SpatialReference(wkt=wkt)
+        if srs.IsGeographic():
+            raise TerrainError(f"the {what} {path} is in a geographic CRS ({srs.GetName()}, cells in degrees): a "
+                               "terrain model needs metres; reproject it to a projected CRS (e.g. its UTM zone) "
+                               "with Raster > Projections > Warp first")
+        unit = float(srs.GetLinearUnits() or 1.0)
+    if gt[2] or gt[4]:
+        raise TerrainError(f"the {what} {path} is rotated (geotransform {gt}): warp it to a north-up grid first")
+    if abs(abs(gt[1]) - abs(gt[5])) > 1e-6 * abs(gt[1]):
+        raise TerrainError(f"the {what} {path} has non-square cells ({gt[1]:g} x {abs(gt[5]):g}): resample it to "
+                           "square cells first")
+    w, h = ds.RasterXSize, ds.RasterYSize
+    if w < MIN_CELLS or h < MIN_CELLS:
+        raise TerrainError(f"the {what} {path} is {w} x {h} cells: too small for a terrain model (at least "
+                           f"{MIN_CELLS} x {MIN_CELLS} cells)")
+    band = ds.GetRasterBand(1)
+    z = band.ReadAsArray().astype(np.float64)
+    nd = band.GetNoDataValue()
+    if nd is not None:
+        z[z == nd] = np.nan
+    z[~np.isfinite(z)] = np.nan
+    ds = None
+    n_valid = int(np.isfinite(z).sum())
+    if n_valid == 0:
+        raise TerrainError(f"the {what} {path} has no data: every one of its {w} x {h} cells is nodata")
+    if n_valid < MIN_CELLS * MIN_CELLS:
+        raise TerrainError(f"the {what} {path} has only {n_valid} cells with data: too few for a terrain model "
+                           f"(at least {MIN_CELLS * MIN_CELLS})")
+    return Elevation(path, z * unit, tuple(gt), wkt, abs(gt[1]) * unit, unit)
+
+
+def write_float(path: str, array: np.ndarray, elev: Elevation, description: str, metadata: dict,
+                heights: bool = True, progress=None) -> str:
+    """A float32 COG on the grid of ``elev`` (heights converted back to the CRS's units when ``heights``)."""
+    out = array / elev.unit if heights else array
+    return raster.write_cog(path, out, elev.geotransform, elev.crs_wkt or None, progress=progress,
+                            description=description, metadata=metadata)
+
+
+def write_classes(path: str, array: np.ndarray, elev: Elevation, description: str, metadata: dict) -> str:
+    """A class raster (small integers, 0 = nodata) as a COG on the grid of ``elev``."""
+    data = np.where(array > 0, array.astype(np.float32), np.nan)
+    return raster.write_cog(path, data, elev.geotransform, elev.crs_wkt or None, nodata=0.0,
+                            description=description, metadata=metadata)
+
+
+def same_grid(a: str, b: str) -> Optional[str]:
+    """None when rasters ``a`` and ``b`` share size and geotransform, else what differs."""
+    from osgeo import gdal
+
+    da, db = gdal.Open(a), gdal.Open(b)
+    if (da.RasterXSize, da.RasterYSize) != (db.RasterXSize, db.RasterYSize):
+        return f"size {da.RasterXSize} x {da.RasterYSize} vs {db.RasterXSize} x {db.RasterYSize}"
+    if not np.allclose(da.GetGeoTransform(), db.GetGeoTransform()):
+        return f"geotransform {da.GetGeoTransform()} vs {db.GetGeoTransform()}"
+    return None
