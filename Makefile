@@ -89,7 +89,7 @@ lint: venv
 
 I18N_SOURCES := $(shell ls *.py processing_provider/*.py ui/*.py 2>/dev/null)
 transup: apt
-	pylupdate5 -noobsolete $(I18N_SOURCES) -ts i18n/archaeoortho_de.ts i18n/archaeoortho_it.ts
+	python3 i18n/make_catalog.py && python3 i18n/update_ts.py -noobsolete
 
 transcompile: apt
 	@for ts in i18n/*.ts; do [ -e "$$ts" ] && lrelease -silent "$$ts" -qm "$${ts%.ts}.qm" || true; done

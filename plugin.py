@@ -8,15 +8,27 @@ PLUGIN_DIR = os.path.dirname(__file__)
 
 
 def _locale() -> str:
-    """The two-letter language QGIS runs in: its override setting, else the system's."""
-    value = ""
-    try:
-        value = QgsApplication.locale()
-    except Exception:  # noqa: BLE001 - no QgsApplication yet
-        value = ""
+    """The two-letter language QGIS runs in, read the way QGIS applies it (call it when the plugin is set up,
+    not at import): the override of Options > General (``locale/overrideFlag`` + ``locale/userLocale``), else
+    the translation QGIS installed at start (``qgis --lang de`` sets it, QgsApplication.translation()), else
+    ``locale/userLocale`` (QGIS writes it at every start, from --lang or the system), else the system's."""
+    settings = QSettings()
+    override = str(settings.value("locale/overrideFlag", False)).lower() in ("true", "1")
+    value = str(settings.value("locale/userLocale", "") or "") if override else ""
     if not value:
-        value = QSettings().value("locale/userLocale", "") or QLocale.system().name()
-    return str(value)[:2]
+        try:
+            app = QgsApplication.instance()
+            value = app.translation() if isinstance(app, QgsApplication) else ""
+        except Exception:  # noqa: BLE001 - no QgsApplication yet
+            value = ""
+    if not value:
+        value = str(settings.value("locale/userLocale", "") or "")
+    if not value:
+        try:
+            value = QgsApplication.locale()
+        except Exception:  # noqa: BLE001 - no QgsApplication yet
+            value = ""
+    return str(value or QLocale.system().name())[:2]
 
 
 class ArchaeoOrthoPlugin:
@@ -26,6 +38,7 @@ class ArchaeoOrthoPlugin:
         self.iface = iface
         self.provider = None
         self.translator = None
+        self._language = None
         self.action = None
         self.dock = None
         self.dependencies_dir = None
@@ -37,7 +50,17 @@ class ArchaeoOrthoPlugin:
         return QCoreApplication.translate("ArchaeoOrthoPlugin", text)
 
     def _install_translator(self):
-        qm = os.path.join(PLUGIN_DIR, "i18n", f"archaeoortho_{_locale()}.qm")
+        """The translation of the language QGIS runs in; called again by initProcessing / initGui (QGIS has
+        applied ``--lang`` and the Options override by then): a changed language swaps the translator."""
+        lang = _locale()
+        if lang == self._language:
+            return
+        if self.translator is not None:
+            QCoreApplication.removeTranslator(self.translator)
+            self.translator = None
+        self._language = None
+        self._language = lang
+        qm = os.path.join(PLUGIN_DIR, "i18n", f"archaeoortho_{lang}.qm")
         if os.path.exists(qm):
             self.translator = QTranslator()
             if self.translator.load(qm):
@@ -71,12 +94,14 @@ class ArchaeoOrthoPlugin:
     def initProcessing(self):  # noqa: N802 (QGIS API name)
         if self.provider is not None:
             return
+        self._install_translator()  # before the algorithms' labels are made
         from .processing_provider.provider import ArchaeoOrthoProvider
 
         self.provider = ArchaeoOrthoProvider()
         QgsApplication.processingRegistry().addProvider(self.provider)
 
     def initGui(self):  # noqa: N802 (QGIS API name)
+        self._install_translator()
         self.initProcessing()
         if self.iface is None:
             return
@@ -94,7 +119,8 @@ class ArchaeoOrthoPlugin:
         self.action.setToolTip(self.tr("ArchaeoOrtho: pick ground control points on the map and in the photos"))
         self.action.toggled.connect(self.show_dock)
         self.iface.addPluginToRasterMenu(self.tr("&ArchaeoOrtho"), self.action)
-        self.iface.addRasterToolBarIcon(self.action)
+        # the Plugins toolbar is shown by default (the Raster toolbar is not)
+        self.iface.addToolBarIcon(self.action)
         self._offer_dependencies()
 
     def show_dock(self, visible=True):
@@ -135,7 +161,7 @@ class ArchaeoOrthoPlugin:
             self.dock = None
         if self.action is not None and self.iface is not None:
             self.iface.removePluginRasterMenu(self.tr("&ArchaeoOrtho"), self.action)
-            self.iface.removeRasterToolBarIcon(self.action)
+            self.iface.removeToolBarIcon(self.action)
             self.action.deleteLater()
             self.action = None
         if self.provider is not None:
@@ -144,3 +170,4 @@ class ArchaeoOrthoPlugin:
         if self.translator is not None:
             QCoreApplication.removeTranslator(self.translator)
             self.translator = None
+        self._language = None

@@ -1,60 +1,60 @@
-<?xml version='1.0' encoding='utf-8'?>
+<?xml version="1.0" encoding="utf-8"?>
 <!DOCTYPE TS>
 <TS version="2.1">
 <context>
     <name>AccuracyReportAlgorithm</name>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="71" />
+        <location filename="../processing_provider/accuracy_report.py" line="70"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="73" />
+        <location filename="../processing_provider/accuracy_report.py" line="70"/>
         <source>Compute the bundle adjustment covariance (uncertainty section and layers)</source>
         <translation>Kovarianz der Bündelblockausgleichung berechnen (Abschnitt und Layer zur Unsicherheit)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="76" />
+        <location filename="../processing_provider/accuracy_report.py" line="76"/>
         <source>Report (default: &lt;workspace&gt;/report.html)</source>
         <translation>Bericht (Vorgabe: &lt;workspace&gt;/report.html)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="79" />
+        <location filename="../processing_provider/accuracy_report.py" line="79"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="80" />
+        <location filename="../processing_provider/accuracy_report.py" line="80"/>
         <source>Camera precision (GeoPackage)</source>
         <translation>Genauigkeit der Kameras (GeoPackage)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="81" />
+        <location filename="../processing_provider/accuracy_report.py" line="81"/>
         <source>Tie point precision (GeoPackage)</source>
         <translation>Genauigkeit der Verknüpfungspunkte (GeoPackage)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="82" />
+        <location filename="../processing_provider/accuracy_report.py" line="82"/>
         <source>Sections skipped</source>
         <translation>Ausgelassene Abschnitte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="99" />
+        <location filename="../processing_provider/accuracy_report.py" line="99"/>
         <source>section {} skipped: {}</source>
         <translation>Abschnitt {} ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="101" />
+        <location filename="../processing_provider/accuracy_report.py" line="101"/>
         <source>report written: {} ({} s)</source>
         <translation>Bericht geschrieben: {} ({} s)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Accuracy report</source>
         <translation>Genauigkeitsbericht</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Writes one self-contained HTML report of a workspace (plots embedded, readable offline) and returns its key figures.
 
 Summary: images given / aligned / not aligned and why, image screening, cameras with their calibrated parameters and standard deviations, GSD, area, CRS, processing times and parameters. Orientation quality: reprojection errors, tie-point track lengths, image connectivity, camera positions with residuals. Georeferencing: control and check points with dX dY dZ and image residuals, residual vectors, RMSE per set, NSSDA (FGDC-STD-007.3-1998) accuracy statements at 95 % confidence, ASPRS 2014 and 2023 accuracy classes, camera-position residuals, outliers. Uncertainty: standard deviations of cameras and tie points from the bundle adjustment covariance. Products: DSM and orthomosaic previews, resolution, valid fraction. Sections whose stage has not run are skipped with a note.
@@ -74,17 +74,17 @@ OUTPUT_HTML: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wir
 <context>
     <name>AlgorithmBase</name>
     <message>
-        <location filename="../processing_provider/base.py" line="130" />
+        <location filename="../processing_provider/base.py" line="226"/>
         <source>Cancelled: {}</source>
         <translation>Abgebrochen: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/base.py" line="98" />
+        <location filename="../processing_provider/base.py" line="135"/>
         <source>Outputs not styled: {}</source>
         <translation>Ausgaben nicht gestaltet: {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Photogrammetry</source>
         <translation>Photogrammetrie</translation>
     </message>
@@ -92,125 +92,127 @@ OUTPUT_HTML: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wir
 <context>
     <name>AlignImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/align_images.py" line="53" />
+        <location filename="../processing_provider/align_images.py" line="45"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="55" />
+        <location filename="../processing_provider/align_images.py" line="45"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="56" />
+        <location filename="../processing_provider/align_images.py" line="45"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="58" />
+        <location filename="../processing_provider/align_images.py" line="45"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="60" />
-        <source>Largest image side for matching (0 = full size)</source>
-        <translation>Größte Bildseite für die Zuordnung (0 = volle Größe)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="63" />
-        <source>Largest number of features per image (0 = auto, ~4000 per megapixel)</source>
-        <translation>Höchstzahl der Merkmale je Bild (0 = automatisch, ~4000 je Megapixel)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="66" />
-        <source>Affine-invariant features (oblique views; slower)</source>
-        <translation>Affin-invariante Merkmale (Schrägaufnahmen; langsamer)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="68" />
-        <source>Focal length in mm when EXIF is missing (0 = from EXIF)</source>
-        <translation>Brennweite in mm, wenn EXIF fehlt (0 = aus EXIF)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="71" />
-        <source>Sensor (frame) width in mm, long side (0 = unknown)</source>
-        <translation>Breite des Sensors (Bildformats) in mm, lange Seite (0 = unbekannt)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="74" />
+        <location filename="../processing_provider/align_images.py" line="45"/>
         <source>One camera for all images</source>
         <translation>Eine Kamera für alle Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="79" />
+        <location filename="../processing_provider/align_images.py" line="59"/>
         <source>Camera centres</source>
         <translation>Projektionszentren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="80" />
+        <location filename="../processing_provider/align_images.py" line="60"/>
         <source>Registered images</source>
         <translation>Orientierte Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="81" />
+        <location filename="../processing_provider/align_images.py" line="61"/>
         <source>Mean reprojection error (px)</source>
         <translation>Mittlerer Rückprojektionsfehler (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="104" />
+        <location filename="../processing_provider/align_images.py" line="85"/>
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
         <translation>{} von {} Bildern orientiert, mittlerer Rückprojektionsfehler {:.3f} px, {} Punkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="107" />
+        <location filename="../processing_provider/align_images.py" line="88"/>
         <source>Images not registered:</source>
         <translation>Nicht orientierte Bilder:</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="110" />
+        <location filename="../processing_provider/align_images.py" line="91"/>
         <source>Seconds per step: {}</source>
         <translation>Sekunden je Schritt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Align images</source>
         <translation>Bilder ausrichten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="76" />
+        <location filename="../processing_provider/align_images.py" line="45"/>
         <source>Mapper</source>
         <translation>Rekonstruktionsverfahren</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
-        <source>Structure from motion: SIFT features, pair selection, robust matching (RANSAC), incremental mapping with self-calibration (focal length, principal point, lens distortion) and a final bundle adjustment. The result is stored in the WORKSPACE folder, which the following stages (Georeference, Build DSM, Build orthophoto) take as input. A re-run resumes: features and matches already computed are reused.
+        <location filename="../processing_provider/align_images.py" line="45"/>
+        <source>Matching image size (px)</source>
+        <translation>Bildgröße für die Zuordnung (px)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="45"/>
+        <source>Features per image</source>
+        <translation>Merkmale je Bild</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="45"/>
+        <source>Affine-invariant features</source>
+        <translation>Affin-invariante Merkmale</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="45"/>
+        <source>Focal length (mm)</source>
+        <translation>Brennweite (mm)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="45"/>
+        <source>Sensor width (mm)</source>
+        <translation>Sensorbreite (mm)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Structure from motion: SIFT features, pair selection, robust matching (RANSAC), incremental mapping with self-calibration (focal length, principal point, lens distortion) and a final bundle adjustment. The result is stored in the workspace folder, which the following stages (Georeference, Build DSM, Build orthophoto) take as input. A re-run resumes: features and matches already computed are reused.
 
-PAIRING: 'auto' uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
-CAMERA_MODEL: 'AUTO' estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
-FOCAL_MM and SENSOR_WIDTH_MM: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres.
-MAPPER (advanced): 'incremental' (COLMAP, the default) or 'global' (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).</source>
-        <translation>Structure from Motion: SIFT-Merkmale, Paarauswahl, robuste Zuordnung (RANSAC), inkrementelle Rekonstruktion mit Selbstkalibrierung (Brennweite, Bildhauptpunkt, Objektivverzeichnung) und eine abschließende Bündelblockausgleichung. Das Ergebnis wird im Ordner WORKSPACE gespeichert, den die folgenden Schritte (Georeferenzieren, DOM erzeugen, Orthophoto erzeugen) als Eingabe nehmen. Ein erneuter Lauf setzt fort: bereits berechnete Merkmale und Zuordnungen werden wiederverwendet.
+Pair selection: &apos;auto&apos; uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
+Camera model: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
+Matching image size: the longest side the images are scaled to for matching (0 = full size). Features per image: 0 = automatic (about 4000 per megapixel). Affine-invariant features help with oblique views and are slower.
+Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).
+Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).</source>
+        <translation>Structure from Motion: SIFT-Merkmale, Paarauswahl, robuste Zuordnung (RANSAC), inkrementelle Rekonstruktion mit Selbstkalibrierung (Brennweite, Bildhauptpunkt, Objektivverzeichnung) und eine abschließende Bündelblockausgleichung. Das Ergebnis wird im Arbeitsbereich-Ordner gespeichert, den die folgenden Schritte (Georeferenzieren, DOM erzeugen, Orthophoto erzeugen) als Eingabe nehmen. Ein erneuter Lauf setzt fort: bereits berechnete Merkmale und Zuordnungen werden wiederverwendet.
 
-PAIRING: 'auto' nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
-CAMERA_MODEL: 'AUTO' schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
-FOCAL_MM und SENSOR_WIDTH_MM: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern.
-MAPPER (erweitert): 'incremental' (COLMAP, Standard) oder 'global' (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).</translation>
+Paarauswahl: 'auto' nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
+Kameramodell: 'AUTO' schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
+Bildgröße für die Zuordnung: die längste Seite, auf die die Bilder für die Zuordnung verkleinert werden (0 = volle Größe). Merkmale je Bild: 0 = automatisch (etwa 4000 je Megapixel). Affin-invariante Merkmale helfen bei Schrägaufnahmen und sind langsamer.
+Brennweite und Sensorbreite: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern (0 = aus EXIF / unbekannt).
+Rekonstruktionsverfahren (erweitert): 'incremental' (COLMAP, Standard) oder 'global' (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).</translation>
     </message>
 </context>
 <context>
     <name>ArchaeoOrthoPlugin</name>
     <message>
-        <location filename="../plugin.py" line="60" />
+        <location filename="../plugin.py" line="114"/>
         <source>Ground control (GCP dock)</source>
         <translation>Passpunkte (GCP-Fenster)</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="64" />
+        <location filename="../plugin.py" line="118"/>
         <source>ArchaeoOrtho: pick ground control points on the map and in the photos</source>
         <translation>ArchaeoOrtho: Passpunkte auf der Karte und in den Fotos messen</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="106" />
+        <location filename="../plugin.py" line="162"/>
         <source>&amp;ArchaeoOrtho</source>
         <translation>&amp;ArchaeoOrtho</translation>
     </message>
@@ -218,7 +220,7 @@ MAPPER (erweitert): 'incremental' (COLMAP, Standard) oder 'global' (GLOMAP: Rota
 <context>
     <name>ArchaeoOrthoProvider</name>
     <message>
-        <location filename="../processing_provider/provider.py" line="17" />
+        <location filename="../processing_provider/provider.py" line="17"/>
         <source>ArchaeoOrtho photogrammetry</source>
         <translation>ArchaeoOrtho Photogrammetrie</translation>
     </message>
@@ -226,82 +228,82 @@ MAPPER (erweitert): 'incremental' (COLMAP, Standard) oder 'global' (GLOMAP: Rota
 <context>
     <name>BuildDsmAlgorithm</name>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="54" />
+        <location filename="../processing_provider/build_dsm.py" line="50"/>
         <source>Workspace folder (georeferenced)</source>
         <translation>Arbeitsbereich-Ordner (georeferenziert)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="56" />
+        <location filename="../processing_provider/build_dsm.py" line="50"/>
         <source>DSM resolution in metres (0 = automatic)</source>
         <translation>DOM-Auflösung in Metern (0 = automatisch)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="59" />
+        <location filename="../processing_provider/build_dsm.py" line="50"/>
         <source>Matching quality (image scale)</source>
         <translation>Zuordnungsqualität (Bildmaßstab)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="61" />
+        <location filename="../processing_provider/build_dsm.py" line="50"/>
         <source>Engine</source>
         <translation>Rechenwerk</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="63" />
+        <location filename="../processing_provider/build_dsm.py" line="50"/>
         <source>Parallel workers (0 = one per core)</source>
         <translation>Parallele Prozesse (0 = einer je Kern)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="71" />
+        <location filename="../processing_provider/build_dsm.py" line="61"/>
         <source>DSM (default: &lt;workspace&gt;/dsm.tif)</source>
         <translation>DOM (Vorgabe: &lt;workspace&gt;/dsm.tif)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="73" />
+        <location filename="../processing_provider/build_dsm.py" line="63"/>
         <source>Point cloud (LAS)</source>
         <translation>Punktwolke (LAS)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="76" />
+        <location filename="../processing_provider/build_dsm.py" line="66"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="77" />
-        <source>Share of DSM cells with data inside the camera centres' convex hull</source>
+        <location filename="../processing_provider/build_dsm.py" line="67"/>
+        <source>Share of DSM cells with data inside the camera centres&apos; convex hull</source>
         <translation>Anteil der DOM-Zellen mit Daten innerhalb der konvexen Hülle der Projektionszentren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="79" />
+        <location filename="../processing_provider/build_dsm.py" line="69"/>
         <source>Stereo pairs matched</source>
         <translation>Zugeordnete Stereopaare</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="80" />
+        <location filename="../processing_provider/build_dsm.py" line="70"/>
         <source>Fused points</source>
         <translation>Verschmolzene Punkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="98" />
+        <location filename="../processing_provider/build_dsm.py" line="89"/>
         <source>DSM {} ({} m cells), valid fraction {}</source>
         <translation>DOM {} ({} m Zellen), Anteil gültiger Zellen {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Build DSM</source>
         <translation>DOM erzeugen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="66" />
+        <location filename="../processing_provider/build_dsm.py" line="50"/>
         <source>Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)</source>
         <translation>Adresse des Dask-Schedulers (leer = dieser Rechner, oder $ARCHAEOORTHO_DASK_SCHEDULER)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Dense matching of the georeferenced block and a digital surface model (DSM).
 
 Stereo pairs are chosen from the sparse model (shared tie points, baseline-to-depth ratio, viewing angle); each pair is undistorted and rectified from the known poses and matched with semi-global matching (OpenCV SGBM) with a left-right check; a pixel is kept where at least two independent pairs agree. The fused points are rasterised (median of the highest height cluster per cell), small holes are filled and large ones left nodata.
 
-WORKSPACE: a georeferenced workspace (run 'Georeference' first: a DSM needs a metric scale and a vertical direction, so a workspace that is only aligned is refused).
+WORKSPACE: a georeferenced workspace (run &apos;Georeference&apos; first: a DSM needs a metric scale and a vertical direction, so a workspace that is only aligned is refused).
 RESOLUTION: DSM cell size in metres; 0 = about twice the median ground sample distance.
 QUALITY: image scale for matching (full, half, quarter): half is four times faster than full.
 ENGINE: cpu (default); cuda runs COLMAP patch-match stereo where pycolmap was built with CUDA.
@@ -328,991 +330,1128 @@ Ein erneuter Lauf nach einem Abbruch setzt fort: bereits zugeordnete Paare werde
 <context>
     <name>BuildOrthophotoAlgorithm</name>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63" />
-        <source>Workspace folder (georeferenced, with a DSM)</source>
-        <translation>Arbeitsbereich-Ordner (georeferenziert, mit DOM)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66" />
-        <source>DSM (default: the workspace DSM)</source>
-        <translation>DOM (Vorgabe: das DOM des Arbeitsbereichs)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="68" />
-        <source>Images (names, wildcards or group:&lt;camera&gt;; empty = all)</source>
-        <translation>Bilder (Namen, Platzhalter oder group:&lt;Kamera&gt;; leer = alle)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="71" />
-        <source>Resolution in CRS units (0 = ground sample distance)</source>
-        <translation>Auflösung in KBS-Einheiten (0 = Bodenauflösung)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="74" />
-        <source>Blending across seamlines</source>
-        <translation>Überblendung an den Nahtlinien</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="76" />
-        <source>Resampling of the images</source>
-        <translation>Resampling der Bilder</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="78" />
-        <source>Parallel tile workers (0 = one per core)</source>
-        <translation>Parallele Kachel-Prozesse (0 = einer je Kern)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="87" />
-        <source>Orthomosaic (default: &lt;workspace&gt;/orthomosaic.tif)</source>
-        <translation>Orthomosaik (Vorgabe: &lt;workspace&gt;/orthomosaic.tif)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="90" />
-        <source>Folder for per-image true orthophotos</source>
-        <translation>Ordner für wahre Orthophotos je Bild</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="93" />
-        <source>Seamlines (which image, GeoPackage)</source>
-        <translation>Nahtlinien (welches Bild, GeoPackage)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="95" />
+        <location filename="../processing_provider/build_orthophoto.py" line="84"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="96" />
+        <location filename="../processing_provider/build_orthophoto.py" line="85"/>
         <source>Share of mosaic cells with data</source>
         <translation>Anteil der Mosaikzellen mit Daten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="97" />
+        <location filename="../processing_provider/build_orthophoto.py" line="86"/>
         <source>Resolution used</source>
         <translation>Verwendete Auflösung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="98" />
+        <location filename="../processing_provider/build_orthophoto.py" line="87"/>
         <source>Images in the mosaic</source>
         <translation>Bilder im Mosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="112" />
-        <source>SEAMLINES must be a GeoPackage (.gpkg) file, got {}</source>
-        <translation>SEAMLINES muss eine GeoPackage-Datei (.gpkg) sein, erhalten: {}</translation>
-    </message>
-    <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Build orthophoto</source>
         <translation>Orthophoto erzeugen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="81" />
-        <source>Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)</source>
-        <translation>Adresse des Dask-Schedulers (leer = dieser Rechner, oder $ARCHAEOORTHO_DASK_SCHEDULER)</translation>
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>Georeferenced workspace</source>
+        <translation>Georeferenzierter Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>DSM</source>
+        <translation>DOM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>Images</source>
+        <translation>Bilder</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>Resolution</source>
+        <translation>Auflösung</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>Seam blending</source>
+        <translation>Überblendung der Nähte</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>Resampling</source>
+        <translation>Resampling</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>Parallel tile workers</source>
+        <translation>Parallele Kachel-Prozesse</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>Dask scheduler</source>
+        <translation>Dask-Scheduler</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="76"/>
+        <source>Orthomosaic</source>
+        <translation>Orthomosaik</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
+        <source>Per-image orthophotos folder</source>
+        <translation>Ordner für Einzelbild-Orthophotos</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="82"/>
+        <source>Seamlines</source>
+        <translation>Nahtlinien</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="102"/>
+        <source>Seamlines must be a GeoPackage (.gpkg) file, got {}</source>
+        <translation>Nahtlinien müssen eine GeoPackage-Datei (.gpkg) sein, erhalten: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
         <source>True orthophotos and the orthomosaic of a georeferenced workspace.
 
 Every cell takes its height from the DSM and is projected through the full camera model (pose, focal length, principal point, lens distortion) into the images. A cell hidden from an image by higher surface (a wall, a tree, a hill) is left out of that image, so buildings do not lean and nothing appears twice; the mosaic fills it from an image that sees it. Each part of the mosaic comes from the image that looks at it most vertically and closest to its centre; seamlines go around buildings and trees; brightness differences between images are evened out and seams blended.
 
-WORKSPACE: a georeferenced workspace with a DSM (run 'Build DSM' first), or give DSM.
+Georeferenced workspace: a workspace with a DSM (run &apos;Build DSM&apos; first), or give a DSM.
 DSM: optional raster (e.g. an ALS DSM, in any CRS: reprojected on the fly); default the workspace DSM.
-IMAGES_FILTER: a subset, e.g. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' or 'group:NIR' (a camera group by id or by make/model), '!name' to leave one out. Empty: all images.
-RESOLUTION: cell size in CRS units; 0 = the images' ground sample distance.
-BLENDING: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness and no ghosting), none (hard cut).
-OUTPUT: Cloud-Optimized GeoTIFF with overviews, the images' bands and data type (8/16 bit kept) plus an alpha band (default &lt;workspace&gt;/orthomosaic.tif).
-PER_IMAGE_FOLDER: optional folder for one true orthophoto per image (COG).
-SEAMLINES: optional GeoPackage of polygons naming the image each part of the mosaic comes from.
-DASK_SCHEDULER: render the tiles on a Dask cluster (tcp://host:8786) whose workers see the workspace path.</source>
+Images: a subset, e.g. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; or &apos;group:NIR&apos; (a camera group by id or by make/model), &apos;!name&apos; to leave one out. Empty: all images.
+Resolution: cell size in CRS units; 0 = the images&apos; ground sample distance.
+Seam blending: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness and no ghosting), none (hard cut).
+Orthomosaic: Cloud-Optimized GeoTIFF with overviews, the images&apos; bands and data type (8/16 bit kept) plus an alpha band (default &lt;workspace&gt;/orthomosaic.tif).
+Per-image orthophotos folder: optional folder for one true orthophoto per image (COG).
+Seamlines: optional GeoPackage of polygons naming the image each part of the mosaic comes from.
+Dask scheduler (advanced): render the tiles on a Dask cluster (tcp://host:8786) whose workers see the workspace path; empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER.</source>
         <translation>Wahre Orthophotos und das Orthomosaik eines georeferenzierten Arbeitsbereichs.
 
 Jede Zelle nimmt ihre Höhe aus dem DOM und wird über das vollständige Kameramodell (Orientierung, Brennweite, Bildhauptpunkt, Objektivverzeichnung) in die Bilder projiziert. Eine Zelle, die in einem Bild von höherer Oberfläche verdeckt ist (eine Mauer, ein Baum, ein Hügel), bleibt aus diesem Bild weg, so dass Gebäude nicht kippen und nichts doppelt erscheint; das Mosaik füllt sie aus einem Bild, das sie sieht. Jeder Teil des Mosaiks stammt aus dem Bild, das am senkrechtesten und am nächsten zu seiner Mitte darauf blickt; Nahtlinien laufen um Gebäude und Bäume; Helligkeitsunterschiede zwischen den Bildern werden ausgeglichen und Nähte überblendet.
 
-WORKSPACE: ein georeferenzierter Arbeitsbereich mit DOM (zuerst 'DOM erzeugen' ausführen) oder DSM angeben.
-DSM: optionales Raster (z. B. ein ALS-DOM, in beliebigem KBS: wird im Lauf umprojiziert); Vorgabe ist das DOM des Arbeitsbereichs.
-IMAGES_FILTER: eine Auswahl, z. B. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' oder 'group:NIR' (eine Kameragruppe nach Nummer oder Hersteller/Modell), '!name' lässt eines weg. Leer: alle Bilder.
-RESOLUTION: Zellgröße in KBS-Einheiten; 0 = die Bodenauflösung der Bilder.
-BLENDING: feather (Rampe über die Nähte), multiband (Laplace-Pyramide: keine sichtbare Naht in der Helligkeit und keine Geisterbilder), none (harter Schnitt).
-OUTPUT: Cloud-Optimized GeoTIFF mit Übersichten, den Kanälen und dem Datentyp der Bilder (8/16 Bit bleiben) und einem Alphakanal (Vorgabe &lt;workspace&gt;/orthomosaic.tif).
-PER_IMAGE_FOLDER: optionaler Ordner für ein wahres Orthophoto je Bild (COG).
-SEAMLINES: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem jeder Teil des Mosaiks stammt.
-DASK_SCHEDULER: die Kacheln auf einem Dask-Cluster (tcp://host:8786) rechnen, dessen Worker den Pfad des Arbeitsbereichs sehen.</translation>
+Georeferenzierter Arbeitsbereich: ein Arbeitsbereich mit DOM (zuerst 'DOM erzeugen' ausführen) oder ein DOM angeben.
+DOM: optionales Raster (z. B. ein ALS-DOM, in beliebigem KBS: wird im Lauf umprojiziert); Vorgabe ist das DOM des Arbeitsbereichs.
+Bilder: eine Auswahl, z. B. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' oder 'group:NIR' (eine Kameragruppe nach Nummer oder Hersteller/Modell), '!name' lässt eines weg. Leer: alle Bilder.
+Auflösung: Zellgröße in KBS-Einheiten; 0 = die Bodenauflösung der Bilder.
+Überblendung der Nähte: feather (Rampe über die Nähte), multiband (Laplace-Pyramide: keine sichtbare Naht in der Helligkeit und keine Geisterbilder), none (harter Schnitt).
+Orthomosaik: Cloud-Optimized GeoTIFF mit Übersichten, den Kanälen und dem Datentyp der Bilder (8/16 Bit bleiben) und einem Alphakanal (Vorgabe &lt;workspace&gt;/orthomosaic.tif).
+Ordner für Einzelbild-Orthophotos: optionaler Ordner für ein wahres Orthophoto je Bild (COG).
+Nahtlinien: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem jeder Teil des Mosaiks stammt.
+Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786) rechnen, dessen Worker den Pfad des Arbeitsbereichs sehen; leer = dieser Rechner, oder $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
     </message>
 </context>
 <context>
     <name>GcpDock</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="242" />
+        <location filename="../ui/gcp_dock.py" line="65"/>
         <source>ArchaeoOrtho ground control</source>
         <translation>ArchaeoOrtho Passpunkte</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="258" />
+        <location filename="../ui/gcp_dock.py" line="81"/>
         <source>ArchaeoOrtho photos</source>
         <translation>ArchaeoOrtho Fotos</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="274" />
+        <location filename="../ui/gcp_dock.py" line="117"/>
         <source>Workspace:</source>
         <translation>Arbeitsbereich:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="451" />
+        <location filename="../ui/gcp_dock.py" line="298"/>
         <source>none open</source>
         <translation>keiner geöffnet</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="279" />
-        <source>Openu2026</source>
-        <translation>Öffnen…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="280" />
+        <location filename="../ui/gcp_dock.py" line="123"/>
         <source>Open a workspace folder (made by Align images)</source>
         <translation>Einen Arbeitsbereich-Ordner öffnen (von 'Bilder ausrichten' angelegt)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="281" />
-        <source>New from photosu2026</source>
-        <translation>Neu aus Fotos…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="282" />
+        <location filename="../ui/gcp_dock.py" line="125"/>
         <source>Choose a folder of photos and a workspace folder, and align the photos</source>
         <translation>Einen Fotoordner und einen Arbeitsbereich-Ordner wählen und die Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="288" />
+        <location filename="../ui/gcp_dock.py" line="132"/>
         <source>Heights (Z) from:</source>
         <translation>Höhen (Z) aus:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="293" />
+        <location filename="../ui/gcp_dock.py" line="137"/>
         <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
         <translation>Ein DOM- oder DGM-Rasterlayer (z. B. ein ALS-DOM): ein auf der Karte gemessener Punkt erhält seine Höhe daraus (bilinear). Leer: Z von Hand eingeben.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="909" />
+        <location filename="../ui/gcp_io.py" line="64"/>
         <source>Add</source>
         <translation>Hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="303" />
+        <location filename="../ui/gcp_dock.py" line="148"/>
         <source>Add a ground point</source>
         <translation>Einen Passpunkt hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="304" />
+        <location filename="../ui/gcp_dock.py" line="149"/>
         <source>Remove</source>
         <translation>Entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="305" />
+        <location filename="../ui/gcp_dock.py" line="150"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Den gewählten Passpunkt mit seinen Messungen entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="306" />
+        <location filename="../ui/gcp_dock.py" line="151"/>
         <source>Pick on map</source>
         <translation>Auf der Karte messen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="308" />
+        <location filename="../ui/gcp_dock.py" line="153"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>In die Kartenansicht klicken, um X und Y des gewählten Punkts zu setzen (Z aus dem Höhenlayer)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="311" />
-        <source>From file (gcp_list.txt, CSV)u2026</source>
-        <translation>Aus Datei (gcp_list.txt, CSV)…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="312" />
-        <source>From a point layeru2026</source>
-        <translation>Aus einem Punktlayer…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="314" />
-        <source>To file (gcp_list.txt, CSV)u2026</source>
-        <translation>In Datei (gcp_list.txt, CSV)…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="315" />
-        <source>To a GeoPackage layeru2026</source>
-        <translation>In einen GeoPackage-Layer…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="316" />
+        <location filename="../ui/gcp_io.py" line="61"/>
         <source>Import</source>
         <translation>Importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="316" />
+        <location filename="../ui/gcp_dock.py" line="161"/>
         <source>Export</source>
         <translation>Exportieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="323" />
+        <location filename="../ui/gcp_dock.py" line="174"/>
         <source>Undo</source>
         <translation>Rückgängig</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="324" />
+        <location filename="../ui/gcp_dock.py" line="175"/>
         <source>Redo</source>
         <translation>Wiederholen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="331" />
+        <location filename="../ui/gcp_dock.py" line="182"/>
         <source>Undo: {}</source>
         <translation>Rückgängig: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="332" />
+        <location filename="../ui/gcp_dock.py" line="183"/>
         <source>Redo: {}</source>
         <translation>Wiederholen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="337" />
+        <location filename="../ui/gcp_dock.py" line="168"/>
         <source>Load results</source>
         <translation>Ergebnisse laden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="338" />
-        <source>Add the workspace's products to the map as styled layers</source>
+        <location filename="../ui/gcp_dock.py" line="169"/>
+        <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Die Produkte des Arbeitsbereichs als gestaltete Layer zur Karte hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="355" />
+        <location filename="../ui/gcp_dock.py" line="205"/>
         <source>Residual tolerance:</source>
         <translation>Residuen-Toleranz:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="361" />
+        <location filename="../ui/gcp_dock.py" line="211"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="363" />
+        <location filename="../ui/gcp_dock.py" line="215"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="364" />
+        <location filename="../ui/gcp_dock.py" line="216"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Die Ausgleichung Brennweite, Bildhauptpunkt und Verzeichnung verfeinern lassen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="370" />
+        <location filename="../ui/gcp_dock.py" line="223"/>
         <source>Georeference</source>
         <translation>Georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="371" />
+        <location filename="../ui/gcp_dock.py" line="224"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Die Ausgleichung mit diesen Punkten ausführen (im Hintergrund)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="372" />
+        <location filename="../ui/gcp_dock.py" line="225"/>
         <source>Cancel</source>
         <translation>Abbrechen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="428" />
+        <location filename="../ui/gcp_dock.py" line="275"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="435" />
+        <location filename="../ui/gcp_dock.py" line="282"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Einen ArchaeoOrtho-Arbeitsbereich öffnen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="472" />
-        <source>{} photos; the block is not aligned yet: run Align images (or 'New from photos') to get predicted positions</source>
+        <location filename="../ui/gcp_dock.py" line="319"/>
+        <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} Fotos; der Block ist noch nicht ausgerichtet: 'Bilder ausrichten' (oder 'Neu aus Fotos') ausführen, um vorhergesagte Positionen zu erhalten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="475" />
+        <location filename="../ui/gcp_dock.py" line="322"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} Fotos, {} Passpunkte. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="724" />
+        <location filename="../ui/gcp_placement.py" line="221"/>
         <source>no predicted positions: {}</source>
         <translation>keine vorhergesagten Positionen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="508" />
+        <location filename="../ui/gcp_placement.py" line="61"/>
         <source>Predicted positions from the georeferenced block.</source>
         <translation>Vorhergesagte Positionen aus dem georeferenzierten Block.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="508" />
+        <location filename="../ui/gcp_placement.py" line="61"/>
         <source>Predicted positions once a point is placed in 2 photos, and for every point once 3 points are placed.</source>
         <translation>Vorhergesagte Positionen, sobald ein Punkt in 2 Fotos gemessen ist, und für alle Punkte, sobald 3 Punkte gemessen sind.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="514" />
+        <location filename="../ui/gcp_tasks.py" line="24"/>
         <source>Folder of photos</source>
         <translation>Fotoordner</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="517" />
+        <location filename="../ui/gcp_tasks.py" line="27"/>
         <source>Workspace folder (new or existing)</source>
         <translation>Arbeitsbereich-Ordner (neu oder vorhanden)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="529" />
+        <location filename="../ui/gcp_tasks.py" line="39"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
         <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="533" />
+        <location filename="../ui/gcp_tasks.py" line="43"/>
         <source>ArchaeoOrtho: align photos</source>
         <translation>ArchaeoOrtho: Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="612" />
+        <location filename="../ui/gcp_dock.py" line="400"/>
         <source>CRS: {}</source>
         <translation>KBS: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="639" />
-        <source>Click on the map at the selected point's position (Esc to stop)</source>
+        <location filename="../ui/gcp_placement.py" line="107"/>
+        <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Auf der Karte an die Position des gewählten Punkts klicken (Esc beendet)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="678" />
+        <location filename="../ui/gcp_placement.py" line="153"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (aus {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="681" />
+        <location filename="../ui/gcp_placement.py" line="156"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Keine Höhe an dieser Stelle in {}: Z bleibt unverändert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="684" />
+        <location filename="../ui/gcp_placement.py" line="159"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="804" />
+        <location filename="../ui/gcp_placement.py" line="331"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="806" />
+        <location filename="../ui/gcp_placement.py" line="333"/>
         <source>predicted</source>
         <translation>vorhergesagt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="821" />
+        <location filename="../ui/gcp_placement.py" line="356"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Einen Passpunkt in der Tabelle wählen oder hinzufügen, dann im Foto darauf klicken.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="826" />
-        <source>from the point's other observations</source>
+        <location filename="../ui/gcp_placement.py" line="363"/>
+        <source>from the point&apos;s other observations</source>
         <translation>aus den übrigen Messungen des Punkts</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="827" />
+        <location filename="../ui/gcp_placement.py" line="364"/>
         <source>from the georeferenced block</source>
         <translation>aus dem georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="828" />
+        <location filename="../ui/gcp_placement.py" line="365"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>aus den bereits gemessenen Punkten (Ähnlichkeitstransformation)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="837" />
+        <location filename="../ui/gcp_placement.py" line="374"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Gemessen bei x {:.2f}, y {:.2f}. Klicken zum Versetzen, ziehen oder Entf zum Entfernen.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="840" />
+        <location filename="../ui/gcp_placement.py" line="377"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Vorhergesagt {}. Eingabetaste übernimmt und geht weiter (Leertaste: übernehmen), ziehen oder dorthin klicken, wo der Punkt wirklich ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="843" />
+        <location filename="../ui/gcp_placement.py" line="389"/>
         <source>Click where {} is in this photo.</source>
         <translation>Dorthin klicken, wo {} in diesem Foto ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="853" />
+        <location filename="../ui/gcp_placement.py" line="409"/>
         <source>Select or add a ground point first</source>
         <translation>Zuerst einen Passpunkt wählen oder hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="892" />
+        <location filename="../ui/gcp_placement.py" line="456"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: jedes Foto, das ihn voraussichtlich zeigt, hat eine Messung</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="952" />
+        <location filename="../ui/gcp_io.py" line="127"/>
         <source>Import ground control</source>
         <translation>Passpunkte importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="897" />
+        <location filename="../ui/gcp_io.py" line="32"/>
         <source>Ground control (*.txt *.csv);;All files (*)</source>
         <translation>Passpunkte (*.txt *.csv);;Alle Dateien (*)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="905" />
+        <location filename="../ui/gcp_io.py" line="57"/>
         <source>Replace the current points, or add the imported ones to them (same names are updated)?</source>
         <translation>Die vorhandenen Punkte ersetzen oder die importierten hinzufügen (gleichnamige werden aktualisiert)?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="908" />
+        <location filename="../ui/gcp_io.py" line="61"/>
         <source>Replace</source>
         <translation>Ersetzen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="935" />
+        <location filename="../ui/gcp_io.py" line="103"/>
         <source>import {}</source>
         <translation>{} importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="936" />
+        <location filename="../ui/gcp_io.py" line="104"/>
         <source>warnings</source>
         <translation>Warnungen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="937" />
+        <location filename="../ui/gcp_io.py" line="111"/>
         <source>Imported {} points and {} observations from {}</source>
         <translation>{} Punkte und {} Messungen aus {} importiert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="949" />
+        <location filename="../ui/gcp_io.py" line="124"/>
         <source>No point layer in the project</source>
         <translation>Kein Punktlayer im Projekt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="952" />
+        <location filename="../ui/gcp_io.py" line="127"/>
         <source>Point layer (one feature per observation: name, image, px, py)</source>
         <translation>Punktlayer (ein Objekt je Messung: name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="965" />
-        <source>Layer {} lacks the field '{}' (needs name, image, px, py)</source>
+        <location filename="../ui/gcp_io.py" line="142"/>
+        <source>Layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Layer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="991" />
+        <location filename="../ui/gcp_io.py" line="169"/>
         <source>OpenDroneMap gcp_list (*.txt)</source>
         <translation>OpenDroneMap gcp_list (*.txt)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="991" />
+        <location filename="../ui/gcp_io.py" line="169"/>
         <source>CSV points + observations (*.csv)</source>
         <translation>CSV-Punkte + Messungen (*.csv)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="992" />
+        <location filename="../ui/gcp_io.py" line="170"/>
         <source>Export ground control</source>
         <translation>Passpunkte exportieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1003" />
+        <location filename="../ui/gcp_io.py" line="181"/>
         <source>The points have no CRS yet: pick one on the map or import a file first</source>
         <translation>Die Punkte haben noch kein KBS: zuerst einen auf der Karte messen oder eine Datei importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1012" />
+        <location filename="../ui/gcp_io.py" line="190"/>
         <source>Exported {} points to {}</source>
         <translation>{} Punkte nach {} exportiert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1012" />
+        <location filename="../ui/gcp_io.py" line="190"/>
         <source> ({} without coordinates left out)</source>
         <translation> ({} ohne Koordinaten ausgelassen)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1017" />
+        <location filename="../ui/gcp_io.py" line="195"/>
         <source>Export ground control as a layer</source>
         <translation>Passpunkte als Layer exportieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1017" />
+        <location filename="../ui/gcp_io.py" line="195"/>
         <source>GeoPackage (*.gpkg)</source>
         <translation>GeoPackage (*.gpkg)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1048" />
+        <location filename="../ui/gcp_io.py" line="226"/>
         <source>Cannot write {}: {}</source>
         <translation>{} kann nicht geschrieben werden: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1051" />
+        <location filename="../ui/gcp_io.py" line="229"/>
         <source>Exported {} observations to {}</source>
         <translation>{} Messungen nach {} exportiert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1051" />
+        <location filename="../ui/gcp_io.py" line="229"/>
         <source> (points without observations left out: {})</source>
         <translation> (Punkte ohne Messungen ausgelassen: {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1055" />
+        <location filename="../ui/gcp_io.py" line="233"/>
         <source>GCP observations</source>
         <translation>Passpunktmessungen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1057" />
+        <location filename="../ui/gcp_io.py" line="235"/>
         <source>Cannot add {} to the project</source>
         <translation>{} kann nicht zum Projekt hinzugefügt werden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1063" />
+        <location filename="../ui/gcp_tasks.py" line="50"/>
         <source>A task of this dock is still running</source>
         <translation>Eine Aufgabe dieses Fensters läuft noch</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1086" />
+        <location filename="../ui/gcp_tasks.py" line="73"/>
         <source>Cancelled</source>
         <translation>Abgebrochen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1094" />
-        <source>Cancellingu2026</source>
-        <translation>Wird abgebrochen…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="1103" />
+        <location filename="../ui/gcp_tasks.py" line="90"/>
         <source>The block is not aligned yet: run Align images first</source>
         <translation>Der Block ist noch nicht ausgerichtet: zuerst 'Bilder ausrichten' ausführen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1108" />
+        <location filename="../ui/gcp_tasks.py" line="96"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>Die Ausgleichung braucht mindestens 3 Passpunkte mit Koordinaten und Messungen; vorhanden sind {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1124" />
+        <location filename="../ui/gcp_tasks.py" line="112"/>
         <source>Outliers left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1125" />
+        <location filename="../ui/gcp_tasks.py" line="113"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziert in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1128" />
+        <location filename="../ui/gcp_tasks.py" line="116"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1131" />
-        <source>Georeferencing with {} control pointsu2026</source>
-        <translation>Georeferenzierung mit {} Passpunkten…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="1137" />
+        <location filename="../ui/gcp_tasks.py" line="125"/>
         <source>Not georeferenced yet.</source>
         <translation>Noch nicht georeferenziert.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1139" />
+        <location filename="../ui/gcp_tasks.py" line="127"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Passpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1142" />
+        <location filename="../ui/gcp_tasks.py" line="130"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Kontrollpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1145" />
+        <location filename="../ui/gcp_tasks.py" line="133"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>Höhen sind Platzhalter: keine Höhengenauigkeit</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1147" />
+        <location filename="../ui/gcp_tasks.py" line="135"/>
         <source>tie points {} px</source>
         <translation>Verknüpfungspunkte {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1149" />
+        <location filename="../ui/gcp_tasks.py" line="137"/>
         <source>edited since: re-run to update</source>
         <translation>seither bearbeitet: erneut ausführen zum Aktualisieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1159" />
-        <source>ArchaeoOrtho: {}</source>
-        <translation>ArchaeoOrtho: {}</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="829" />
+        <location filename="../ui/gcp_placement.py" line="366"/>
         <source>by matching its look in another photo</source>
         <translation>durch Abgleich mit seinem Aussehen in einem anderen Foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="831" />
+        <location filename="../ui/gcp_placement.py" line="368"/>
         <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
         <translation>(Korrelation {:.2f}, {:.0f} px von der geometrischen Vorhersage)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="122"/>
+        <source>Open…</source>
+        <translation>Öffnen…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="124"/>
+        <source>New from photos…</source>
+        <translation>Neu aus Fotos…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="156"/>
+        <source>From file (gcp_list.txt, CSV)…</source>
+        <translation>Aus Datei (gcp_list.txt, CSV)…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="157"/>
+        <source>From a point layer…</source>
+        <translation>Aus einem Punktlayer…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="159"/>
+        <source>To file (gcp_list.txt, CSV)…</source>
+        <translation>In Datei (gcp_list.txt, CSV)…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="160"/>
+        <source>To a GeoPackage layer…</source>
+        <translation>In einen GeoPackage-Layer…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="81"/>
+        <source>Cancelling…</source>
+        <translation>Wird abgebrochen…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="119"/>
+        <source>Georeferencing with {} control points…</source>
+        <translation>Georeferenzierung mit {} Passpunkten…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_io.py" line="57"/>
+        <source>How were the pixel coordinates measured?</source>
+        <translation>Wie wurden die Pixelkoordinaten gemessen?</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_io.py" line="68"/>
+        <source>Coordinates measured on upright photos ({} photos are stored turned: EXIF orientation); leave unticked for the stored pixel grid (COLMAP&apos;s, OpenDroneMap&apos;s)</source>
+        <translation>Koordinaten auf aufrecht gedrehten Fotos gemessen ({} Fotos sind gedreht gespeichert: EXIF-Ausrichtung); nicht ankreuzen für das gespeicherte Pixelraster (das von COLMAP und OpenDroneMap)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="70"/>
+        <source>your setting</source>
+        <translation>Ihre Einstellung</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="73"/>
+        <source>default: 3 × GSD of the georeferenced block (GSD {:.3f} m)</source>
+        <translation>Vorgabe: 3 × Bodenauflösung des georeferenzierten Blocks (GSD {:.3f} m)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="74"/>
+        <source>default</source>
+        <translation>Vorgabe</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="81"/>
+        <source>Residuals up to this are green, up to 3 times yellow, beyond red. Now: {}</source>
+        <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot. Jetzt: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="89"/>
+        <source>Diagnosis of the adjustment:</source>
+        <translation>Diagnose der Ausgleichung:</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="144"/>
+        <source>Moved {:.2f} m (Undo: Ctrl+Z).</source>
+        <translation>Um {:.2f} m verschoben (Rückgängig: Strg+Z).</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="333"/>
+        <source>near the edge</source>
+        <translation>nahe am Rand</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="380"/>
+        <source>{} is predicted where it cannot be placed: {}. Click where the point is if you see it, or press Enter for the next photo.</source>
+        <translation>{} wird dort vorhergesagt, wo er nicht gesetzt werden kann: {}. Klicken Sie auf den Punkt, wenn Sie ihn sehen, oder drücken Sie die Eingabetaste für das nächste Foto.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="386"/>
+        <source>Click where {} is in this photo, or use Pick on map (or type X, Y, Z in the table) to have it predicted in the photos.</source>
+        <translation>Klicken Sie in diesem Foto auf {}, oder nutzen Sie „Auf der Karte messen“ (oder geben Sie X, Y, Z in der Tabelle ein), damit er in den Fotos vorhergesagt wird.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="399"/>
+        <source>{}: the workspace has no photos to place it in.</source>
+        <translation>{}: der Arbeitsbereich hat keine Fotos, in denen er gesetzt werden kann.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="401"/>
+        <source>{} is selected: use Pick on map or type X, Y, Z in the table, or choose a photo in the strip below and click on the point.</source>
+        <translation>{} ist ausgewählt: nutzen Sie „Auf der Karte messen“ oder geben Sie X, Y, Z in der Tabelle ein, oder wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="403"/>
+        <source>{} is selected: choose a photo in the strip below and click on the point.</source>
+        <translation>{} ist ausgewählt: wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
     </message>
 </context>
 <context>
     <name>GcpStore</name>
     <message>
-        <location filename="../ui/store.py" line="194" />
+        <location filename="../ui/store.py" line="252"/>
         <source>a point named {} exists already</source>
         <translation>ein Punkt namens {} existiert bereits</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="182" />
+        <location filename="../ui/store.py" line="240"/>
         <source>add point {}</source>
         <translation>Punkt {} hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="189" />
+        <location filename="../ui/store.py" line="247"/>
         <source>remove point {}</source>
         <translation>Punkt {} entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="205" />
+        <location filename="../ui/store.py" line="263"/>
         <source>set {} of {}</source>
         <translation>{} von {} setzen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="218" />
+        <location filename="../ui/store.py" line="321"/>
         <source>place {} in {}</source>
         <translation>{} in {} messen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="226" />
+        <location filename="../ui/store.py" line="329"/>
         <source>remove {} from {}</source>
         <translation>{} aus {} entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="251" />
+        <location filename="../ui/store.py" line="407"/>
         <source>set CRS</source>
         <translation>KBS setzen</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="291"/>
+        <source>no position</source>
+        <translation>keine Position</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="294"/>
+        <source>({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)</source>
+        <translation>({:.0f}, {:.0f}) liegt außerhalb des Fotos {} ({} × {} px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="301"/>
+        <source>({:.0f}, {:.0f}) is inside the mask of {}</source>
+        <translation>({:.0f}, {:.0f}) liegt in der Maske von {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="309"/>
+        <source>{} not placed: {}</source>
+        <translation>{} nicht gesetzt: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="353"/>
+        <source>{} points replaced by {} from the file</source>
+        <translation>{} Punkte durch {} aus der Datei ersetzt</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="387"/>
+        <source>added {} points: {}</source>
+        <translation>{} Punkte hinzugefügt: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="389"/>
+        <source>coordinates updated from the file: {}</source>
+        <translation>Koordinaten aus der Datei aktualisiert: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="391"/>
+        <source>role set by the file: {}</source>
+        <translation>Rolle von der Datei gesetzt: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="393"/>
+        <source>role kept (the file gives none): {}</source>
+        <translation>Rolle beibehalten (die Datei nennt keine): {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="395"/>
+        <source>σ set by the file: {}</source>
+        <translation>σ von der Datei gesetzt: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="397"/>
+        <source>{} observations added</source>
+        <translation>{} Messungen hinzugefügt</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="399"/>
+        <source>placed observations kept (the file has others): {}</source>
+        <translation>gesetzte Messungen beibehalten (die Datei hat andere): {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="400"/>
+        <source>nothing changed</source>
+        <translation>nichts geändert</translation>
     </message>
 </context>
 <context>
     <name>GcpTableModel</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82" />
+        <location filename="../ui/gcp_table.py" line="36"/>
         <source>Name</source>
         <translation>Name</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82" />
+        <location filename="../ui/gcp_table.py" line="36"/>
         <source>X</source>
         <translation>X</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82" />
+        <location filename="../ui/gcp_table.py" line="36"/>
         <source>Y</source>
         <translation>Y</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82" />
+        <location filename="../ui/gcp_table.py" line="36"/>
         <source>Z</source>
         <translation>Z</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82" />
-        <source>u03c3 XY</source>
-        <translation>σ XY</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="82" />
-        <source>u03c3 Z</source>
-        <translation>σ Z</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="83" />
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>Role</source>
         <translation>Rolle</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="83" />
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>Obs.</source>
         <translation>Mess.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="83" />
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>dXY (m)</source>
         <translation>dXY (m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="83" />
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>dZ (m)</source>
         <translation>dZ (m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="83" />
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>px</source>
         <translation>px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="86" />
+        <location filename="../ui/gcp_table.py" line="40"/>
         <source>check</source>
         <translation>Kontrolle</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="86" />
+        <location filename="../ui/gcp_table.py" line="40"/>
         <source>control</source>
         <translation>Passpunkt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="98" />
+        <location filename="../ui/gcp_table.py" line="52"/>
         <source>Horizontal residual after the adjustment (estimated from the photos minus given)</source>
         <translation>Lageresiduum nach der Ausgleichung (aus den Fotos geschätzt minus gegeben)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="99" />
+        <location filename="../ui/gcp_table.py" line="53"/>
         <source>Vertical residual after the adjustment</source>
         <translation>Höhenresiduum nach der Ausgleichung</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="100" />
-        <source>Mean reprojection error of the point's observations (pixels)</source>
+        <location filename="../ui/gcp_table.py" line="54"/>
+        <source>Mean reprojection error of the point&apos;s observations (pixels)</source>
         <translation>Mittlerer Rückprojektionsfehler der Messungen des Punkts (Pixel)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="101" />
+        <location filename="../ui/gcp_table.py" line="55"/>
         <source>Number of photos the point is placed in</source>
         <translation>Anzahl der Fotos, in denen der Punkt gemessen ist</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="114" />
+        <location filename="../ui/gcp_table.py" line="68"/>
         <source>rejected as an outlier</source>
         <translation>als Ausreißer verworfen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="116" />
+        <location filename="../ui/gcp_table.py" line="70"/>
         <source>not triangulated (fewer than 2 usable observations)</source>
         <translation>nicht trianguliert (weniger als 2 brauchbare Messungen)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="122" />
+        <location filename="../ui/gcp_table.py" line="76"/>
         <source>within the tolerance</source>
         <translation>innerhalb der Toleranz</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="124" />
+        <location filename="../ui/gcp_table.py" line="78"/>
         <source>up to 3 times the tolerance</source>
         <translation>bis zum Dreifachen der Toleranz</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="125" />
+        <location filename="../ui/gcp_table.py" line="79"/>
         <source>more than 3 times the tolerance</source>
         <translation>mehr als das Dreifache der Toleranz</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="167" />
+        <location filename="../ui/gcp_table.py" line="121"/>
         <source>edited since the last adjustment: run Georeference to update</source>
         <translation>seit der letzten Ausgleichung bearbeitet: 'Georeferenzieren' ausführen zum Aktualisieren</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_table.py" line="36"/>
+        <source>σ XY</source>
+        <translation>σ XY</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_table.py" line="36"/>
+        <source>σ Z</source>
+        <translation>σ Z</translation>
     </message>
 </context>
 <context>
     <name>GeoreferenceAlgorithm</name>
     <message>
-        <location filename="../processing_provider/georeference.py" line="49" />
-        <source>Workspace folder (aligned)</source>
-        <translation>Arbeitsbereich-Ordner (ausgerichtet)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="51" />
-        <source>Ground control file (gcp_list.txt or CSV)</source>
-        <translation>Passpunktdatei (gcp_list.txt oder CSV)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="54" />
-        <source>Ground control point layer (one feature per observation)</source>
-        <translation>Passpunktlayer (ein Objekt je Messung)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="57" />
-        <source>Check points (comma-separated names)</source>
-        <translation>Kontrollpunkte (Namen, durch Kommas getrennt)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="59" />
+        <location filename="../processing_provider/georeference.py" line="47"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="62" />
-        <source>Use EXIF GPS camera positions</source>
-        <translation>EXIF-GPS-Kamerapositionen verwenden</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="64" />
-        <source>Target CRS (default: the GCP file's)</source>
-        <translation>Ziel-KBS (Vorgabe: das der Passpunktdatei)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="66" />
-        <source>Refine camera calibration in the adjustment</source>
-        <translation>Kamerakalibrierung in der Ausgleichung verfeinern</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="68" />
+        <location filename="../processing_provider/georeference.py" line="59"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="69" />
+        <location filename="../processing_provider/georeference.py" line="60"/>
         <source>GCP residuals</source>
         <translation>Passpunkt-Residuen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="70" />
+        <location filename="../processing_provider/georeference.py" line="61"/>
         <source>Camera centres (world)</source>
         <translation>Projektionszentren (Welt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="91" />
+        <location filename="../processing_provider/georeference.py" line="77"/>
         <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS)</source>
         <translation>Passpunkte (GCPS oder GCP_LAYER) und/oder Kamerapositionen (CAMERA_POSITIONS oder USE_EXIF_GPS) angeben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="102" />
+        <location filename="../processing_provider/georeference.py" line="88"/>
         <source>outlier left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="106" />
+        <location filename="../processing_provider/georeference.py" line="92"/>
         <source>CRS {}; control RMSE XY {} m, Z {} m; check RMSE XY {} m, Z {} m</source>
         <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="119" />
-        <source>GCP layer {} lacks the field '{}' (needs name, image, px, py)</source>
+        <location filename="../processing_provider/run_pipeline.py" line="95"/>
+        <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Georeference</source>
         <translation>Georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
-        <source>Fixes the aligned block in a real coordinate reference system with ground control points (GCPs) and/or camera positions, used inside the bundle adjustment so that they also remove the block's drift and bending, which a 7-parameter (Helmert) transform cannot. Check points take no part in the adjustment: they are triangulated afterwards and compared with their surveyed coordinates.
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>Aligned workspace</source>
+        <translation>Ausgerichteter Arbeitsbereich</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>Ground control file</source>
+        <translation>Passpunktdatei</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>Ground control layer</source>
+        <translation>Passpunktlayer</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>Check points</source>
+        <translation>Kontrollpunkte</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>Use EXIF GPS positions</source>
+        <translation>EXIF-GPS-Positionen verwenden</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>Target CRS</source>
+        <translation>Ziel-KBS</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>Refine camera calibration</source>
+        <translation>Kamerakalibrierung verfeinern</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Fixes the aligned block in a real coordinate reference system with ground control points (GCPs) and/or camera positions, used inside the bundle adjustment so that they also remove the block&apos;s drift and bending, which a 7-parameter (Helmert) transform cannot. Check points take no part in the adjustment: they are triangulated afterwards and compared with their surveyed coordinates.
 
-GCPS: an OpenDroneMap gcp_list.txt (CRS line, then 'x y z px py image [name]') or a CSV points file with a matching '&lt;name&gt;_observations.csv'. GCP_LAYER: alternatively a point layer with one feature per observation and fields name, image, px, py (optional z, sx, sy, sz, role).
-CHECK_POINTS: comma-separated names that become check points.
-CAMERA_POSITIONS: CSV 'image,x,y,z[,sigma]' (optional CRS line). USE_EXIF_GPS: use the photos' GPS.
+Ground control file: an OpenDroneMap gcp_list.txt (CRS line, then &apos;x y z px py image [name]&apos;) or a CSV points file with a matching &apos;&lt;name&gt;_observations.csv&apos;. Ground control layer: alternatively a point layer with one feature per observation and fields name, image, px, py (optional z, sx, sy, sz, role).
+Check points: comma-separated names that become check points.
+Camera positions: CSV &apos;image,x,y,z[,sigma]&apos; (optional CRS line). Use EXIF GPS positions: use the photos&apos; GPS.
+Target CRS: default the ground control file&apos;s. Refine camera calibration: let the adjustment refine focal length, principal point and distortion.
 Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.</source>
         <translation>Legt den ausgerichteten Block mit Passpunkten (GCPs) und/oder Kamerapositionen in einem echten Koordinatenbezugssystem fest. Sie wirken in der Bündelblockausgleichung, so dass sie auch Drift und Verbiegung des Blocks beseitigen, was eine 7-Parameter-Transformation (Helmert) nicht kann. Kontrollpunkte nehmen an der Ausgleichung nicht teil: sie werden danach trianguliert und mit ihren vermessenen Koordinaten verglichen.
 
-GCPS: eine OpenDroneMap gcp_list.txt (KBS-Zeile, dann 'x y z px py image [name]') oder eine CSV-Punktdatei mit passender '&lt;name&gt;_observations.csv'. GCP_LAYER: alternativ ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, sx, sy, sz, role).
-CHECK_POINTS: durch Kommas getrennte Namen, die zu Kontrollpunkten werden.
-CAMERA_POSITIONS: CSV 'image,x,y,z[,sigma]' (optionale KBS-Zeile). USE_EXIF_GPS: das GPS der Fotos verwenden.
+Passpunktdatei: eine OpenDroneMap gcp_list.txt (KBS-Zeile, dann 'x y z px py image [name]') oder eine CSV-Punktdatei mit passender '&lt;name&gt;_observations.csv'. Passpunktlayer: alternativ ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, sx, sy, sz, role).
+Kontrollpunkte: durch Kommas getrennte Namen, die zu Kontrollpunkten werden.
+Kamerapositionen: CSV 'image,x,y,z[,sigma]' (optionale KBS-Zeile). EXIF-GPS-Positionen verwenden: das GPS der Fotos verwenden.
+Ziel-KBS: Vorgabe ist das KBS der Passpunktdatei. Kamerakalibrierung verfeinern: die Ausgleichung verfeinert Brennweite, Bildhauptpunkt und Verzeichnung.
 Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erkannt, im Protokoll genannt und ausgelassen.</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>GCP pixels measured on upright photos</source>
+        <translation>GCP-Pixel auf aufrechten Fotos gemessen</translation>
     </message>
 </context>
 <context>
     <name>OrthorectifyImageAlgorithm</name>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62" />
+        <location filename="../processing_provider/orthorectify_image.py" line="58"/>
         <source>Image</source>
         <translation>Bild</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="65" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Ground control file (gcp_list.txt or CSV)</source>
         <translation>Passpunktdatei (gcp_list.txt oder CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="68" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Ground control point layer (one feature per observation)</source>
         <translation>Passpunktlayer (ein Objekt je Messung)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="71" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Known orientation (x y z omega phi kappa)</source>
         <translation>Bekannte Orientierung (x y z omega phi kappa)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="74" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Focal length in mm (0 = from EXIF)</source>
         <translation>Brennweite in mm (0 = aus EXIF)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="77" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Sensor width (long side) in mm</source>
         <translation>Sensorbreite (lange Seite) in mm</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="80" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Mode</source>
         <translation>Modus</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="82" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Resolution in CRS units (0 = ground sample distance)</source>
         <translation>Auflösung in KBS-Einheiten (0 = Bodenauflösung)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="85" />
-        <source>Output CRS (default: the GCPs' or orientation's CRS)</source>
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <source>Output CRS (default: the GCPs&apos; or orientation&apos;s CRS)</source>
         <translation>Ausgabe-KBS (Vorgabe: das der Passpunkte oder der Orientierung)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="87" />
+        <location filename="../processing_provider/orthorectify_image.py" line="74"/>
         <source>Orthophoto</source>
         <translation>Orthophoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="88" />
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>GCP residuals</source>
         <translation>Passpunkt-Residuen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="90" />
+        <location filename="../processing_provider/orthorectify_image.py" line="77"/>
         <source>GCP residual RMSE (pixels)</source>
         <translation>RMSE der Passpunktresiduen (Pixel)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="91" />
+        <location filename="../processing_provider/orthorectify_image.py" line="78"/>
         <source>Planar rectification: 95th percentile of its offset from the true position (CRS units)</source>
         <translation>Ebene Entzerrung: 95. Perzentil ihres Versatzes gegen die wahre Lage (KBS-Einheiten)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="107" />
+        <location filename="../processing_provider/orthorectify_image.py" line="94"/>
         <source>Give ground control points observed in the image (GCPS or GCP_LAYER) or its orientation (ORIENTATION)</source>
         <translation>Im Bild gemessene Passpunkte (GCPS oder GCP_LAYER) oder seine Orientierung (ORIENTATION) angeben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="114" />
+        <location filename="../processing_provider/orthorectify_image.py" line="100"/>
         <source>RESIDUALS must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>RESIDUALS muss eine GeoPackage-Datei (.gpkg) sein, erhalten: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="129" />
+        <location filename="../processing_provider/orthorectify_image.py" line="113"/>
         <source>{} ({}): {:.2f} px</source>
         <translation>{} ({}): {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="137" />
-        <source>GCP layer {} lacks the field '{}' (needs name, image, px, py)</source>
+        <location filename="../processing_provider/orthorectify_image.py" line="88"/>
+        <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Orthorectify image</source>
         <translation>Bild orthorektifizieren</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Orthorectifies one photograph — also one that is not part of any block, such as a single oblique or an old print — on an existing DSM, for example an airborne laser scanning (ALS) DSM in any CRS (it is reprojected on the fly).
 
 The camera's position and attitude come from ground control points observed in the photo (space resection: at least 4 points; one wrong point among 5 or more is found and left out; with 6 or more the focal length and the radial distortion k1 are estimated too where the points determine them), or from a known orientation.
@@ -1338,62 +1477,62 @@ RESIDUALS: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in
 <context>
     <name>PhotoPanel</name>
     <message>
-        <location filename="../ui/photo_viewer.py" line="422" />
+        <location filename="../ui/photo_viewer.py" line="425"/>
         <source>Only photos that probably see the point</source>
         <translation>Nur Fotos, die den Punkt voraussichtlich zeigen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="425" />
+        <location filename="../ui/photo_viewer.py" line="428"/>
         <source>Fit</source>
         <translation>Einpassen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="425" />
+        <location filename="../ui/photo_viewer.py" line="428"/>
         <source>Show the whole photo (F)</source>
         <translation>Das ganze Foto zeigen (F)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="426" />
+        <location filename="../ui/photo_viewer.py" line="429"/>
         <source>Zoom to point</source>
         <translation>Auf Punkt zoomen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="426" />
+        <location filename="../ui/photo_viewer.py" line="429"/>
         <source>Zoom to the observation or prediction (Z)</source>
         <translation>Auf die Messung oder Vorhersage zoomen (Z)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="428" />
+        <location filename="../ui/photo_viewer.py" line="431"/>
         <source>Confirm</source>
         <translation>Übernehmen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="428" />
+        <location filename="../ui/photo_viewer.py" line="431"/>
         <source>Accept the predicted position (Space)</source>
         <translation>Die vorhergesagte Position übernehmen (Leertaste)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="430" />
+        <location filename="../ui/photo_viewer.py" line="433"/>
         <source>Confirm &amp;&amp; next</source>
         <translation>Übernehmen &amp;&amp; weiter</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="430" />
+        <location filename="../ui/photo_viewer.py" line="433"/>
         <source>Accept the prediction and show the next photo to place (Enter)</source>
         <translation>Die Vorhersage übernehmen und das nächste zu messende Foto zeigen (Eingabetaste)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="433" />
+        <location filename="../ui/photo_viewer.py" line="436"/>
         <source>Remove</source>
         <translation>Entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="433" />
+        <location filename="../ui/photo_viewer.py" line="436"/>
         <source>Remove the observation in this photo (Delete)</source>
         <translation>Die Messung in diesem Foto entfernen (Entf)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="596" />
+        <location filename="../ui/photo_viewer.py" line="599"/>
         <source>{} (predicted)</source>
         <translation>{} (vorhergesagt)</translation>
     </message>
@@ -1401,145 +1540,145 @@ RESIDUALS: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in
 <context>
     <name>PrepareImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="82" />
+        <location filename="../processing_provider/prepare_images.py" line="79"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="84" />
+        <location filename="../processing_provider/prepare_images.py" line="79"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="85" />
+        <location filename="../processing_provider/prepare_images.py" line="79"/>
         <source>Smallest blur score (0 = only relative to the set)</source>
         <translation>Kleinster Schärfewert (0 = nur relativ zum Satz)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="88" />
+        <location filename="../processing_provider/prepare_images.py" line="79"/>
         <source>Leave flagged images out of the prepared folder</source>
         <translation>Markierte Bilder aus dem vorbereiteten Ordner weglassen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93" />
+        <location filename="../processing_provider/prepare_images.py" line="89"/>
         <source>Scanned film: fiducial marks, common frame, masks</source>
         <translation>Gescannter Film: Rahmenmarken, gemeinsamer Rahmen, Masken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="95" />
+        <location filename="../processing_provider/prepare_images.py" line="90"/>
         <source>Calibrated fiducial coordinates in mm (file path or text)</source>
         <translation>Kalibrierte Rahmenmarken-Koordinaten in mm (Dateipfad oder Text)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="98" />
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
         <source>Calibrated focal length in mm (0 = unknown)</source>
         <translation>Kalibrierte Brennweite in mm (0 = unbekannt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="102" />
-        <source>Flag images below this fraction of the set's median blur score</source>
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <source>Flag images below this fraction of the set&apos;s median blur score</source>
         <translation>Bilder unter diesem Bruchteil des mittleren Schärfewerts des Satzes markieren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="105" />
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
         <source>Fiducial mark type</source>
         <translation>Art der Rahmenmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="107" />
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
         <source>Fiducial positions</source>
         <translation>Lage der Rahmenmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="109" />
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
         <source>Template image of one fiducial mark</source>
         <translation>Vorlagenbild einer Rahmenmarke</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="111" />
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
         <source>Scan resolution in dpi when not in the files (0 = from the files)</source>
         <translation>Scanauflösung in dpi, wenn nicht in den Dateien (0 = aus den Dateien)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="118" />
+        <location filename="../processing_provider/prepare_images.py" line="106"/>
         <source>Prepared images (skipped: &lt;workspace&gt;/prepared)</source>
         <translation>Vorbereitete Bilder (ausgelassen: &lt;workspace&gt;/prepared)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="121" />
+        <location filename="../processing_provider/prepare_images.py" line="109"/>
         <source>Folder of prepared images</source>
         <translation>Ordner der vorbereiteten Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="122" />
+        <location filename="../processing_provider/prepare_images.py" line="110"/>
         <source>Flagged images</source>
         <translation>Markierte Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="123" />
+        <location filename="../processing_provider/prepare_images.py" line="111"/>
         <source>Excluded images</source>
         <translation>Ausgeschlossene Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="124" />
+        <location filename="../processing_provider/prepare_images.py" line="112"/>
         <source>Screening record (JSON)</source>
         <translation>Prüfprotokoll (JSON)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="160" />
+        <location filename="../processing_provider/prepare_images.py" line="148"/>
         <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
         <translation>{} Bilder: {} markiert, {} ausgeschlossen, {} im vorbereiteten Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="162" />
-        <source>Blurriest first (blur score, % of the set's median):</source>
+        <location filename="../processing_provider/prepare_images.py" line="150"/>
+        <source>Blurriest first (blur score, % of the set&apos;s median):</source>
         <translation>Unschärfste zuerst (Schärfewert, % des Medians des Satzes):</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="170" />
+        <location filename="../processing_provider/prepare_images.py" line="158"/>
         <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
         <translation>Vorbereitete Scans: {} x {} px, Pixelgröße {:.6g} {}{}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Prepare images</source>
         <translation>Bilder vorbereiten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="90" />
-        <source>Mask polygons: areas to ignore, in pixel coordinates (optional text field 'image')</source>
+        <location filename="../processing_provider/prepare_images.py" line="86"/>
+        <source>Mask polygons: areas to ignore, in pixel coordinates (optional text field &apos;image&apos;)</source>
         <translation>Maskenpolygone: zu ignorierende Bereiche in Pixelkoordinaten (optionales Textfeld 'image')</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="155" />
-        <source>MASKS layer '{}'</source>
+        <location filename="../processing_provider/prepare_images.py" line="143"/>
+        <source>MASKS layer &apos;{}&apos;</source>
         <translation>MASKS-Layer '{}'</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="190" />
+        <location filename="../processing_provider/prepare_images.py" line="178"/>
         <source>feature {}</source>
         <translation>Objekt {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="194" />
-        <source>MASKS layer '{}': {} has no geometry: skipped</source>
+        <location filename="../processing_provider/prepare_images.py" line="182"/>
+        <source>MASKS layer &apos;{}&apos;: {} has no geometry: skipped</source>
         <translation>MASKS-Layer '{}': {} hat keine Geometrie: übersprungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="197" />
-        <source>MASKS layer '{}': {} is a {} geometry, not a polygon</source>
+        <location filename="../processing_provider/prepare_images.py" line="185"/>
+        <source>MASKS layer &apos;{}&apos;: {} is a {} geometry, not a polygon</source>
         <translation>MASKS-Layer '{}': {} ist eine {}-Geometrie, kein Polygon</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
-        <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for 'Align images', and the WORKSPACE, which records a decision per image (screening.json) for the accuracy report.
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for &apos;Align images&apos;, and the WORKSPACE, which records a decision per image (screening.json) for the accuracy report.
 
-Blur score: variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged 'blurry' below BLUR_RELATIVE x the median of the set, or below BLUR_THRESHOLD when that is set (absolute scores depend on the scene: sand scores far lower than roofs).
-Exposure: images with more than 5 % clipped highlights or shadows, a mean brightness far from the set's, or a very small dynamic range are flagged. EXCLUDE_FLAGGED leaves flagged images out of the prepared folder; otherwise they are kept and only reported.
+Blur score: variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged &apos;blurry&apos; below BLUR_RELATIVE x the median of the set, or below BLUR_THRESHOLD when that is set (absolute scores depend on the scene: sand scores far lower than roofs).
+Exposure: images with more than 5 % clipped highlights or shadows, a mean brightness far from the set&apos;s, or a very small dynamic range are flagged. EXCLUDE_FLAGGED leaves flagged images out of the prepared folder; otherwise they are kept and only reported.
 
-MASKS: optional polygon layer of areas to ignore (a boom, the drone's shadow, a date stamp, a frame border), in the image's pixel coordinates: origin at the upper-left corner of the image, x right, y down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is &lt;= 0). A text field 'image' names the image a polygon belongs to; empty (or no such field) applies it to every image. The polygons are written into the per-image masks (workspace/masks/&lt;image&gt;.png, merged with any mask already there): 'Align images' finds no features under them, the orthophoto does not use those pixels, and blur and exposure are measured outside them. For scanned film the coordinates are those of the prepared images (the common fiducial frame, so one polygon fits every frame).
+MASKS: optional polygon layer of areas to ignore (a boom, the drone&apos;s shadow, a date stamp, a frame border), in the image&apos;s pixel coordinates: origin at the upper-left corner of the image, x right, y down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is &lt;= 0). A text field &apos;image&apos; names the image a polygon belongs to; empty (or no such field) applies it to every image. The polygons are written into the per-image masks (workspace/masks/&lt;image&gt;.png, merged with any mask already there): &apos;Align images&apos; finds no features under them, the orthophoto does not use those pixels, and blur and exposure are measured outside them. For scanned film the coordinates are those of the prepared images (the common fiducial frame, so one polygon fits every frame).
 
-SCANNED_FILM: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. FIDUCIAL_COORDINATES: the calibration certificate's fiducial coordinates in mm, as a file or pasted text, one 'id x y' line per mark (x right, y up), optionally 'PP x y' (principal point) and 'focal f'. Without them the mean layout of the set is used, centred on the fiducial centre. With FOCAL_LENGTH_MM (or 'focal' in the certificate) the prepared images carry the focal length in pixels for the alignment.
+SCANNED_FILM: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. FIDUCIAL_COORDINATES: the calibration certificate&apos;s fiducial coordinates in mm, as a file or pasted text, one &apos;id x y&apos; line per mark (x right, y up), optionally &apos;PP x y&apos; (principal point) and &apos;focal f&apos;. Without them the mean layout of the set is used, centred on the fiducial centre. With FOCAL_LENGTH_MM (or &apos;focal&apos; in the certificate) the prepared images carry the focal length in pixels for the alignment.
 
 OUTPUT: the folder of prepared images (replaced as a whole; it must be new, empty or written by an earlier run); when skipped, &lt;workspace&gt;/prepared.</source>
         <translation>Prüft einen Ordner mit Fotos auf Unschärfe und Belichtung und findet bei gescanntem historischem Film die Rahmenmarken und rechnet jeden Scan in einen gemeinsamen Kamerarahmen um. Das Ergebnis ist ein Ordner vorbereiteter Bilder für 'Bilder ausrichten' und der WORKSPACE, der je Bild eine Entscheidung festhält (screening.json) für den Genauigkeitsbericht.
@@ -1557,62 +1696,62 @@ OUTPUT: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetzt; er muss ne
 <context>
     <name>ResultLayers</name>
     <message>
-        <location filename="../ui/layers.py" line="259" />
+        <location filename="../ui/layers.py" line="267"/>
         <source>control (used)</source>
         <translation>Passpunkt (verwendet)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="260" />
+        <location filename="../ui/layers.py" line="268"/>
         <source>check point</source>
         <translation>Kontrollpunkt</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="261" />
+        <location filename="../ui/layers.py" line="269"/>
         <source>rejected (outlier)</source>
         <translation>verworfen (Ausreißer)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="262" />
+        <location filename="../ui/layers.py" line="270"/>
         <source>not triangulated</source>
         <translation>nicht trianguliert</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="343" />
+        <location filename="../ui/layers.py" line="559"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="495" />
+        <location filename="../ui/layers.py" line="534"/>
         <source>DSM hillshade</source>
         <translation>DOM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="356" />
+        <location filename="../ui/layers.py" line="560"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="367" />
+        <location filename="../ui/layers.py" line="561"/>
         <source>Cameras</source>
         <translation>Kameras</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="506" />
+        <location filename="../ui/layers.py" line="545"/>
         <source>Camera footprints</source>
         <translation>Bildfußabdrücke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="513" />
+        <location filename="../ui/layers.py" line="552"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Passpunkt-Residuen (Vektoren x{})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="429" />
+        <location filename="../ui/layers.py" line="562"/>
         <source>Point cloud</source>
         <translation>Punktwolke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="439" />
+        <location filename="../ui/layers.py" line="568"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
@@ -1620,144 +1759,144 @@ OUTPUT: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetzt; er muss ne
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="68" />
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="70" />
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71" />
-        <source>Ground control file (gcp_list.txt or CSV)</source>
-        <translation>Passpunktdatei (gcp_list.txt oder CSV)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="74" />
-        <source>Ground control point layer (one feature per observation)</source>
-        <translation>Passpunktlayer (ein Objekt je Messung)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="77" />
-        <source>Check points (comma-separated names)</source>
-        <translation>Kontrollpunkte (Namen, durch Kommas getrennt)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="79" />
-        <source>Use EXIF GPS camera positions</source>
-        <translation>EXIF-GPS-Kamerapositionen verwenden</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="81" />
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="84" />
-        <source>Target CRS (default: the GCP file's, or the UTM zone of the GPS)</source>
-        <translation>Ziel-KBS (Standard: das der GCP-Datei oder die UTM-Zone des GPS)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="86" />
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="88" />
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="90" />
-        <source>Largest image side for matching (0 = full size)</source>
-        <translation>Größte Bildseite für die Zuordnung (0 = volle Größe)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="93" />
-        <source>Refine camera calibration in the adjustment</source>
-        <translation>Kamerakalibrierung in der Ausgleichung verfeinern</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="95" />
-        <source>DSM resolution in metres (0 = automatic)</source>
-        <translation>DOM-Auflösung in Metern (0 = automatisch)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="98" />
-        <source>Matching quality (image scale)</source>
-        <translation>Zuordnungsqualität (Bildmaßstab)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="101" />
-        <source>Orthomosaic resolution (0 = ground sample distance)</source>
-        <translation>Auflösung des Orthomosaiks (0 = Bodenauflösung)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="104" />
-        <source>Blending across seamlines</source>
-        <translation>Überblendung an den Nahtlinien</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107" />
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
         <source>Write the accuracy report</source>
         <translation>Genauigkeitsbericht schreiben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="109" />
-        <source>Parallel workers for dense matching and tiles (0 = one per core)</source>
-        <translation>Parallele Prozesse für dichte Zuordnung und Kacheln (0 = einer pro Kern)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="112" />
-        <source>Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)</source>
-        <translation>Adresse des Dask-Schedulers (leer = dieser Rechner, oder $ARCHAEOORTHO_DASK_SCHEDULER)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="117" />
+        <location filename="../processing_provider/run_pipeline.py" line="81"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="118" />
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="119" />
+        <location filename="../processing_provider/run_pipeline.py" line="83"/>
         <source>Accuracy report (HTML)</source>
         <translation>Genauigkeitsbericht (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="136" />
+        <location filename="../processing_provider/run_pipeline.py" line="101"/>
         <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Geben Sie Passpunkte (GCPS oder GCP_LAYER) und/oder Kamerapositionen (CAMERA_POSITIONS oder USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="165" />
+        <location filename="../processing_provider/run_pipeline.py" line="129"/>
         <source>Seconds per stage: {}</source>
         <translation>Sekunden pro Stufe: {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Run pipeline</source>
         <translation>Gesamte Verarbeitung ausführen</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Ground control file</source>
+        <translation>Passpunktdatei</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Ground control layer</source>
+        <translation>Passpunktlayer</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Check points</source>
+        <translation>Kontrollpunkte</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Use EXIF GPS positions</source>
+        <translation>EXIF-GPS-Positionen verwenden</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Target CRS</source>
+        <translation>Ziel-KBS</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Matching image size (px)</source>
+        <translation>Bildgröße für die Zuordnung (px)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Refine camera calibration</source>
+        <translation>Kamerakalibrierung verfeinern</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>DSM resolution (m)</source>
+        <translation>DOM-Auflösung (m)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Matching quality</source>
+        <translation>Zuordnungsqualität</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Orthomosaic resolution</source>
+        <translation>Auflösung des Orthomosaiks</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Seam blending</source>
+        <translation>Überblendung der Nähte</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Parallel workers</source>
+        <translation>Parallele Prozesse</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Dask scheduler</source>
+        <translation>Dask-Scheduler</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
         <source>The whole chain in one call, for batch use: Align images, Georeference, Build DSM, Build orthophoto and Accuracy report on one workspace. It calls the same functions as the single algorithms, and a re-run resumes (features, matches and dense pairs already computed are reused).
 
-IMAGES: folder of photos. WORKSPACE: the workspace folder.
-Georeferencing needs ground control (GCPS file or GCP_LAYER, CHECK_POINTS held out) and/or camera positions (CAMERA_POSITIONS CSV or USE_EXIF_GPS): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction.
+Folder of images: the photos. Workspace folder: where every product is written.
+Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction.
 The other parameters are those of the single stages (see their help); 0 means automatic.
-Outputs: DSM, ORTHOMOSAIC and REPORT (HTML), plus the key figures.</source>
+Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures.</source>
         <translation>Die gesamte Verarbeitung in einem Aufruf, für die Stapelverarbeitung: Bilder ausrichten, Georeferenzieren, DOM erzeugen, Orthophoto erzeugen und Genauigkeitsbericht in einem Arbeitsbereich. Es werden dieselben Funktionen wie in den einzelnen Algorithmen aufgerufen; ein erneuter Lauf setzt fort (bereits berechnete Merkmale, Zuordnungen und Stereopaare werden wiederverwendet).
 
-IMAGES: Ordner mit Fotos. WORKSPACE: der Arbeitsbereich.
-Die Georeferenzierung braucht Passpunkte (GCPS-Datei oder GCP_LAYER, CHECK_POINTS werden zurückgehalten) und/oder Kamerapositionen (CAMERA_POSITIONS-CSV oder USE_EXIF_GPS): ohne sie wird die Verarbeitung abgelehnt, da ein DOM einen metrischen Maßstab und eine Lotrichtung braucht.
+Bilderordner: die Fotos. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben werden.
+Die Georeferenzierung braucht Passpunkte (eine Passpunktdatei oder ein Passpunktlayer, Kontrollpunkte werden zurückgehalten) und/oder Kamerapositionen (eine CSV-Datei der Kamerapositionen oder EXIF-GPS-Positionen verwenden): ohne sie wird die Verarbeitung abgelehnt, da ein DOM einen metrischen Maßstab und eine Lotrichtung braucht.
 Die übrigen Parameter sind die der einzelnen Stufen (siehe deren Hilfe); 0 bedeutet automatisch.
-Ausgaben: DSM, ORTHOMOSAIC und REPORT (HTML) sowie die wichtigsten Kennzahlen.</translation>
+Ausgaben: das DOM, das Orthomosaik und der Genauigkeitsbericht (HTML) sowie die wichtigsten Kennzahlen.</translation>
     </message>
 </context>
 </TS>

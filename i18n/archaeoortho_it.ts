@@ -1,60 +1,60 @@
-<?xml version='1.0' encoding='utf-8'?>
+<?xml version="1.0" encoding="utf-8"?>
 <!DOCTYPE TS>
 <TS version="2.1">
 <context>
     <name>AccuracyReportAlgorithm</name>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="71" />
+        <location filename="../processing_provider/accuracy_report.py" line="70"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="73" />
+        <location filename="../processing_provider/accuracy_report.py" line="70"/>
         <source>Compute the bundle adjustment covariance (uncertainty section and layers)</source>
         <translation>Calcola la covarianza della compensazione a stelle proiettive (sezione e layer dell'incertezza)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="76" />
+        <location filename="../processing_provider/accuracy_report.py" line="76"/>
         <source>Report (default: &lt;workspace&gt;/report.html)</source>
         <translation>Rapporto (predefinito: &lt;workspace&gt;/report.html)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="79" />
+        <location filename="../processing_provider/accuracy_report.py" line="79"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="80" />
+        <location filename="../processing_provider/accuracy_report.py" line="80"/>
         <source>Camera precision (GeoPackage)</source>
         <translation>Precisione delle camere (GeoPackage)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="81" />
+        <location filename="../processing_provider/accuracy_report.py" line="81"/>
         <source>Tie point precision (GeoPackage)</source>
         <translation>Precisione dei punti di legame (GeoPackage)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="82" />
+        <location filename="../processing_provider/accuracy_report.py" line="82"/>
         <source>Sections skipped</source>
         <translation>Sezioni saltate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="99" />
+        <location filename="../processing_provider/accuracy_report.py" line="99"/>
         <source>section {} skipped: {}</source>
         <translation>sezione {} saltata: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="101" />
+        <location filename="../processing_provider/accuracy_report.py" line="101"/>
         <source>report written: {} ({} s)</source>
         <translation>rapporto scritto: {} ({} s)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Accuracy report</source>
         <translation>Rapporto di accuratezza</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Writes one self-contained HTML report of a workspace (plots embedded, readable offline) and returns its key figures.
 
 Summary: images given / aligned / not aligned and why, image screening, cameras with their calibrated parameters and standard deviations, GSD, area, CRS, processing times and parameters. Orientation quality: reprojection errors, tie-point track lengths, image connectivity, camera positions with residuals. Georeferencing: control and check points with dX dY dZ and image residuals, residual vectors, RMSE per set, NSSDA (FGDC-STD-007.3-1998) accuracy statements at 95 % confidence, ASPRS 2014 and 2023 accuracy classes, camera-position residuals, outliers. Uncertainty: standard deviations of cameras and tie points from the bundle adjustment covariance. Products: DSM and orthomosaic previews, resolution, valid fraction. Sections whose stage has not run are skipped with a note.
@@ -74,17 +74,17 @@ OUTPUT_HTML: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). 
 <context>
     <name>AlgorithmBase</name>
     <message>
-        <location filename="../processing_provider/base.py" line="130" />
+        <location filename="../processing_provider/base.py" line="226"/>
         <source>Cancelled: {}</source>
         <translation>Annullato: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/base.py" line="98" />
+        <location filename="../processing_provider/base.py" line="135"/>
         <source>Outputs not styled: {}</source>
         <translation>Output senza stile: {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Photogrammetry</source>
         <translation>Fotogrammetria</translation>
     </message>
@@ -92,125 +92,127 @@ OUTPUT_HTML: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). 
 <context>
     <name>AlignImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/align_images.py" line="53" />
+        <location filename="../processing_provider/align_images.py" line="45"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="55" />
+        <location filename="../processing_provider/align_images.py" line="45"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="56" />
+        <location filename="../processing_provider/align_images.py" line="45"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="58" />
+        <location filename="../processing_provider/align_images.py" line="45"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="60" />
-        <source>Largest image side for matching (0 = full size)</source>
-        <translation>Lato maggiore dell'immagine per la corrispondenza (0 = dimensione piena)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="63" />
-        <source>Largest number of features per image (0 = auto, ~4000 per megapixel)</source>
-        <translation>Numero massimo di feature per immagine (0 = automatico, ~4000 per megapixel)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="66" />
-        <source>Affine-invariant features (oblique views; slower)</source>
-        <translation>Feature invarianti affini (prese oblique; più lento)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="68" />
-        <source>Focal length in mm when EXIF is missing (0 = from EXIF)</source>
-        <translation>Focale in mm se manca l'EXIF (0 = dall'EXIF)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="71" />
-        <source>Sensor (frame) width in mm, long side (0 = unknown)</source>
-        <translation>Larghezza del sensore (fotogramma) in mm, lato lungo (0 = sconosciuta)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="74" />
+        <location filename="../processing_provider/align_images.py" line="45"/>
         <source>One camera for all images</source>
         <translation>Una sola camera per tutte le immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="79" />
+        <location filename="../processing_provider/align_images.py" line="59"/>
         <source>Camera centres</source>
         <translation>Centri di presa</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="80" />
+        <location filename="../processing_provider/align_images.py" line="60"/>
         <source>Registered images</source>
         <translation>Immagini orientate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="81" />
+        <location filename="../processing_provider/align_images.py" line="61"/>
         <source>Mean reprojection error (px)</source>
         <translation>Errore medio di riproiezione (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="104" />
+        <location filename="../processing_provider/align_images.py" line="85"/>
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
         <translation>Orientate {} di {} immagini, errore medio di riproiezione {:.3f} px, {} punti</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="107" />
+        <location filename="../processing_provider/align_images.py" line="88"/>
         <source>Images not registered:</source>
         <translation>Immagini non orientate:</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="110" />
+        <location filename="../processing_provider/align_images.py" line="91"/>
         <source>Seconds per step: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Align images</source>
         <translation>Allinea immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="76" />
+        <location filename="../processing_provider/align_images.py" line="45"/>
         <source>Mapper</source>
         <translation>Metodo di ricostruzione</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
-        <source>Structure from motion: SIFT features, pair selection, robust matching (RANSAC), incremental mapping with self-calibration (focal length, principal point, lens distortion) and a final bundle adjustment. The result is stored in the WORKSPACE folder, which the following stages (Georeference, Build DSM, Build orthophoto) take as input. A re-run resumes: features and matches already computed are reused.
+        <location filename="../processing_provider/align_images.py" line="45"/>
+        <source>Matching image size (px)</source>
+        <translation>Dimensione per la corrispondenza (px)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="45"/>
+        <source>Features per image</source>
+        <translation>Feature per immagine</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="45"/>
+        <source>Affine-invariant features</source>
+        <translation>Feature invarianti affini</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="45"/>
+        <source>Focal length (mm)</source>
+        <translation>Focale (mm)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="45"/>
+        <source>Sensor width (mm)</source>
+        <translation>Larghezza del sensore (mm)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Structure from motion: SIFT features, pair selection, robust matching (RANSAC), incremental mapping with self-calibration (focal length, principal point, lens distortion) and a final bundle adjustment. The result is stored in the workspace folder, which the following stages (Georeference, Build DSM, Build orthophoto) take as input. A re-run resumes: features and matches already computed are reused.
 
-PAIRING: 'auto' uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
-CAMERA_MODEL: 'AUTO' estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
-FOCAL_MM and SENSOR_WIDTH_MM: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres.
-MAPPER (advanced): 'incremental' (COLMAP, the default) or 'global' (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).</source>
-        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell'obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella WORKSPACE, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
+Pair selection: &apos;auto&apos; uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
+Camera model: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
+Matching image size: the longest side the images are scaled to for matching (0 = full size). Features per image: 0 = automatic (about 4000 per megapixel). Affine-invariant features help with oblique views and are slower.
+Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).
+Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).</source>
+        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell'obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella dell'area di lavoro, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
 
-PAIRING: 'auto' usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
-CAMERA_MODEL: 'AUTO' stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
-FOCAL_MM e SENSOR_WIDTH_MM: orientamento interno quando manca l'EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri.
-MAPPER (avanzato): 'incremental' (COLMAP, predefinito) o 'global' (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).</translation>
+Selezione delle coppie: 'auto' usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
+Modello di camera: 'AUTO' stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
+Dimensione per la corrispondenza: il lato maggiore a cui le immagini sono ridotte per la corrispondenza (0 = dimensione piena). Feature per immagine: 0 = automatico (circa 4000 per megapixel). Le feature invarianti affini aiutano con le prese oblique e sono più lente.
+Focale e Larghezza del sensore: orientamento interno quando manca l'EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri (0 = dall'EXIF / sconosciuta).
+Metodo di ricostruzione (avanzato): 'incremental' (COLMAP, predefinito) o 'global' (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).</translation>
     </message>
 </context>
 <context>
     <name>ArchaeoOrthoPlugin</name>
     <message>
-        <location filename="../plugin.py" line="60" />
+        <location filename="../plugin.py" line="114"/>
         <source>Ground control (GCP dock)</source>
         <translation>Punti d'appoggio (pannello GCP)</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="64" />
+        <location filename="../plugin.py" line="118"/>
         <source>ArchaeoOrtho: pick ground control points on the map and in the photos</source>
         <translation>ArchaeoOrtho: misura i punti d'appoggio sulla mappa e nelle foto</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="106" />
+        <location filename="../plugin.py" line="162"/>
         <source>&amp;ArchaeoOrtho</source>
         <translation>&amp;ArchaeoOrtho</translation>
     </message>
@@ -218,7 +220,7 @@ MAPPER (avanzato): 'incremental' (COLMAP, predefinito) o 'global' (GLOMAP: media
 <context>
     <name>ArchaeoOrthoProvider</name>
     <message>
-        <location filename="../processing_provider/provider.py" line="17" />
+        <location filename="../processing_provider/provider.py" line="17"/>
         <source>ArchaeoOrtho photogrammetry</source>
         <translation>ArchaeoOrtho fotogrammetria</translation>
     </message>
@@ -226,82 +228,82 @@ MAPPER (avanzato): 'incremental' (COLMAP, predefinito) o 'global' (GLOMAP: media
 <context>
     <name>BuildDsmAlgorithm</name>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="54" />
+        <location filename="../processing_provider/build_dsm.py" line="50"/>
         <source>Workspace folder (georeferenced)</source>
         <translation>Cartella dell'area di lavoro (georeferenziata)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="56" />
+        <location filename="../processing_provider/build_dsm.py" line="50"/>
         <source>DSM resolution in metres (0 = automatic)</source>
         <translation>Risoluzione del DSM in metri (0 = automatica)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="59" />
+        <location filename="../processing_provider/build_dsm.py" line="50"/>
         <source>Matching quality (image scale)</source>
         <translation>Qualità della corrispondenza (scala dell'immagine)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="61" />
+        <location filename="../processing_provider/build_dsm.py" line="50"/>
         <source>Engine</source>
         <translation>Motore di calcolo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="63" />
+        <location filename="../processing_provider/build_dsm.py" line="50"/>
         <source>Parallel workers (0 = one per core)</source>
         <translation>Processi paralleli (0 = uno per core)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="71" />
+        <location filename="../processing_provider/build_dsm.py" line="61"/>
         <source>DSM (default: &lt;workspace&gt;/dsm.tif)</source>
         <translation>DSM (predefinito: &lt;workspace&gt;/dsm.tif)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="73" />
+        <location filename="../processing_provider/build_dsm.py" line="63"/>
         <source>Point cloud (LAS)</source>
         <translation>Nuvola di punti (LAS)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="76" />
+        <location filename="../processing_provider/build_dsm.py" line="66"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="77" />
-        <source>Share of DSM cells with data inside the camera centres' convex hull</source>
+        <location filename="../processing_provider/build_dsm.py" line="67"/>
+        <source>Share of DSM cells with data inside the camera centres&apos; convex hull</source>
         <translation>Frazione delle celle del DSM con dati entro l'inviluppo convesso dei centri di presa</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="79" />
+        <location filename="../processing_provider/build_dsm.py" line="69"/>
         <source>Stereo pairs matched</source>
         <translation>Coppie stereo elaborate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="80" />
+        <location filename="../processing_provider/build_dsm.py" line="70"/>
         <source>Fused points</source>
         <translation>Punti fusi</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="98" />
+        <location filename="../processing_provider/build_dsm.py" line="89"/>
         <source>DSM {} ({} m cells), valid fraction {}</source>
         <translation>DSM {} (celle di {} m), frazione valida {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Build DSM</source>
         <translation>Genera DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="66" />
+        <location filename="../processing_provider/build_dsm.py" line="50"/>
         <source>Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)</source>
         <translation>Indirizzo dello scheduler Dask (vuoto = questo computer, oppure $ARCHAEOORTHO_DASK_SCHEDULER)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Dense matching of the georeferenced block and a digital surface model (DSM).
 
 Stereo pairs are chosen from the sparse model (shared tie points, baseline-to-depth ratio, viewing angle); each pair is undistorted and rectified from the known poses and matched with semi-global matching (OpenCV SGBM) with a left-right check; a pixel is kept where at least two independent pairs agree. The fused points are rasterised (median of the highest height cluster per cell), small holes are filled and large ones left nodata.
 
-WORKSPACE: a georeferenced workspace (run 'Georeference' first: a DSM needs a metric scale and a vertical direction, so a workspace that is only aligned is refused).
+WORKSPACE: a georeferenced workspace (run &apos;Georeference&apos; first: a DSM needs a metric scale and a vertical direction, so a workspace that is only aligned is refused).
 RESOLUTION: DSM cell size in metres; 0 = about twice the median ground sample distance.
 QUALITY: image scale for matching (full, half, quarter): half is four times faster than full.
 ENGINE: cpu (default); cuda runs COLMAP patch-match stereo where pycolmap was built with CUDA.
@@ -328,991 +330,1128 @@ Una nuova esecuzione dopo un annullamento riprende: le coppie già elaborate son
 <context>
     <name>BuildOrthophotoAlgorithm</name>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63" />
-        <source>Workspace folder (georeferenced, with a DSM)</source>
-        <translation>Cartella dell'area di lavoro (georeferenziata, con DSM)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66" />
-        <source>DSM (default: the workspace DSM)</source>
-        <translation>DSM (predefinito: il DSM dell'area di lavoro)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="68" />
-        <source>Images (names, wildcards or group:&lt;camera&gt;; empty = all)</source>
-        <translation>Immagini (nomi, caratteri jolly o group:&lt;camera&gt;; vuoto = tutte)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="71" />
-        <source>Resolution in CRS units (0 = ground sample distance)</source>
-        <translation>Risoluzione in unità del SR (0 = GSD)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="74" />
-        <source>Blending across seamlines</source>
-        <translation>Sfumatura lungo le linee di giunzione</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="76" />
-        <source>Resampling of the images</source>
-        <translation>Ricampionamento delle immagini</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="78" />
-        <source>Parallel tile workers (0 = one per core)</source>
-        <translation>Processi paralleli per tassello (0 = uno per core)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="87" />
-        <source>Orthomosaic (default: &lt;workspace&gt;/orthomosaic.tif)</source>
-        <translation>Ortomosaico (predefinito: &lt;workspace&gt;/orthomosaic.tif)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="90" />
-        <source>Folder for per-image true orthophotos</source>
-        <translation>Cartella per le ortofoto vere di ciascuna immagine</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="93" />
-        <source>Seamlines (which image, GeoPackage)</source>
-        <translation>Linee di giunzione (quale immagine, GeoPackage)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="95" />
+        <location filename="../processing_provider/build_orthophoto.py" line="84"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="96" />
+        <location filename="../processing_provider/build_orthophoto.py" line="85"/>
         <source>Share of mosaic cells with data</source>
         <translation>Frazione delle celle del mosaico con dati</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="97" />
+        <location filename="../processing_provider/build_orthophoto.py" line="86"/>
         <source>Resolution used</source>
         <translation>Risoluzione usata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="98" />
+        <location filename="../processing_provider/build_orthophoto.py" line="87"/>
         <source>Images in the mosaic</source>
         <translation>Immagini nel mosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="112" />
-        <source>SEAMLINES must be a GeoPackage (.gpkg) file, got {}</source>
-        <translation>SEAMLINES deve essere un file GeoPackage (.gpkg), ricevuto {}</translation>
-    </message>
-    <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Build orthophoto</source>
         <translation>Genera ortofoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="81" />
-        <source>Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)</source>
-        <translation>Indirizzo dello scheduler Dask (vuoto = questo computer, oppure $ARCHAEOORTHO_DASK_SCHEDULER)</translation>
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>Georeferenced workspace</source>
+        <translation>Area di lavoro georeferenziata</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>DSM</source>
+        <translation>DSM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>Images</source>
+        <translation>Immagini</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>Resolution</source>
+        <translation>Risoluzione</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>Seam blending</source>
+        <translation>Sfumatura delle giunzioni</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>Resampling</source>
+        <translation>Ricampionamento</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>Parallel tile workers</source>
+        <translation>Processi paralleli per tessera</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <source>Dask scheduler</source>
+        <translation>Scheduler Dask</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="76"/>
+        <source>Orthomosaic</source>
+        <translation>Ortomosaico</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
+        <source>Per-image orthophotos folder</source>
+        <translation>Cartella delle ortofoto per immagine</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="82"/>
+        <source>Seamlines</source>
+        <translation>Linee di giunzione</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="102"/>
+        <source>Seamlines must be a GeoPackage (.gpkg) file, got {}</source>
+        <translation>Le linee di giunzione devono essere un file GeoPackage (.gpkg), ricevuto {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
         <source>True orthophotos and the orthomosaic of a georeferenced workspace.
 
 Every cell takes its height from the DSM and is projected through the full camera model (pose, focal length, principal point, lens distortion) into the images. A cell hidden from an image by higher surface (a wall, a tree, a hill) is left out of that image, so buildings do not lean and nothing appears twice; the mosaic fills it from an image that sees it. Each part of the mosaic comes from the image that looks at it most vertically and closest to its centre; seamlines go around buildings and trees; brightness differences between images are evened out and seams blended.
 
-WORKSPACE: a georeferenced workspace with a DSM (run 'Build DSM' first), or give DSM.
+Georeferenced workspace: a workspace with a DSM (run &apos;Build DSM&apos; first), or give a DSM.
 DSM: optional raster (e.g. an ALS DSM, in any CRS: reprojected on the fly); default the workspace DSM.
-IMAGES_FILTER: a subset, e.g. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' or 'group:NIR' (a camera group by id or by make/model), '!name' to leave one out. Empty: all images.
-RESOLUTION: cell size in CRS units; 0 = the images' ground sample distance.
-BLENDING: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness and no ghosting), none (hard cut).
-OUTPUT: Cloud-Optimized GeoTIFF with overviews, the images' bands and data type (8/16 bit kept) plus an alpha band (default &lt;workspace&gt;/orthomosaic.tif).
-PER_IMAGE_FOLDER: optional folder for one true orthophoto per image (COG).
-SEAMLINES: optional GeoPackage of polygons naming the image each part of the mosaic comes from.
-DASK_SCHEDULER: render the tiles on a Dask cluster (tcp://host:8786) whose workers see the workspace path.</source>
+Images: a subset, e.g. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; or &apos;group:NIR&apos; (a camera group by id or by make/model), &apos;!name&apos; to leave one out. Empty: all images.
+Resolution: cell size in CRS units; 0 = the images&apos; ground sample distance.
+Seam blending: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness and no ghosting), none (hard cut).
+Orthomosaic: Cloud-Optimized GeoTIFF with overviews, the images&apos; bands and data type (8/16 bit kept) plus an alpha band (default &lt;workspace&gt;/orthomosaic.tif).
+Per-image orthophotos folder: optional folder for one true orthophoto per image (COG).
+Seamlines: optional GeoPackage of polygons naming the image each part of the mosaic comes from.
+Dask scheduler (advanced): render the tiles on a Dask cluster (tcp://host:8786) whose workers see the workspace path; empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER.</source>
         <translation>Ortofoto vere e l'ortomosaico di un'area di lavoro georeferenziata.
 
 Ogni cella prende la quota dal DSM ed è proiettata nelle immagini con il modello completo della camera (orientamento, focale, punto principale, distorsione dell'obiettivo). Una cella nascosta in un'immagine da una superficie più alta (un muro, un albero, una collina) viene esclusa da quell'immagine, così gli edifici non pendono e nulla compare due volte; il mosaico la riempie da un'immagine che la vede. Ogni parte del mosaico proviene dall'immagine che la guarda nel modo più verticale e più vicino al suo centro; le linee di giunzione girano attorno a edifici e alberi; le differenze di luminosità tra le immagini sono compensate e le giunzioni sfumate.
 
-WORKSPACE: un'area di lavoro georeferenziata con DSM (eseguire prima 'Genera DSM'), oppure indicare DSM.
+Area di lavoro georeferenziata: un'area di lavoro con DSM (eseguire prima 'Genera DSM'), oppure indicare un DSM.
 DSM: raster facoltativo (ad es. un DSM ALS, in qualsiasi SR: riproiettato al volo); predefinito il DSM dell'area di lavoro.
-IMAGES_FILTER: un sottoinsieme, ad es. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' o 'group:NIR' (un gruppo di camere per numero o per marca/modello), '!nome' per escluderne una. Vuoto: tutte le immagini.
-RESOLUTION: dimensione della cella in unità del SR; 0 = il GSD delle immagini.
-BLENDING: feather (rampa attraverso le giunzioni), multiband (piramide laplaciana: nessuna giunzione visibile nella luminosità e nessun effetto fantasma), none (taglio netto).
-OUTPUT: Cloud-Optimized GeoTIFF con panoramiche, le bande e il tipo di dato delle immagini (8/16 bit conservati) più una banda alfa (predefinito &lt;workspace&gt;/orthomosaic.tif).
-PER_IMAGE_FOLDER: cartella facoltativa per un'ortofoto vera per immagine (COG).
-SEAMLINES: GeoPackage facoltativo di poligoni che indicano l'immagine da cui proviene ogni parte del mosaico.
-DASK_SCHEDULER: calcola le tessere su un cluster Dask (tcp://host:8786) i cui worker vedono il percorso dello spazio di lavoro.</translation>
+Immagini: un sottoinsieme, ad es. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' o 'group:NIR' (un gruppo di camere per numero o per marca/modello), '!nome' per escluderne una. Vuoto: tutte le immagini.
+Risoluzione: dimensione della cella in unità del SR; 0 = il GSD delle immagini.
+Sfumatura delle giunzioni: feather (rampa attraverso le giunzioni), multiband (piramide laplaciana: nessuna giunzione visibile nella luminosità e nessun effetto fantasma), none (taglio netto).
+Ortomosaico: Cloud-Optimized GeoTIFF con panoramiche, le bande e il tipo di dato delle immagini (8/16 bit conservati) più una banda alfa (predefinito &lt;workspace&gt;/orthomosaic.tif).
+Cartella delle ortofoto per immagine: cartella facoltativa per un'ortofoto vera per immagine (COG).
+Linee di giunzione: GeoPackage facoltativo di poligoni che indicano l'immagine da cui proviene ogni parte del mosaico.
+Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:8786) i cui worker vedono il percorso dell'area di lavoro; vuoto = questo computer, oppure $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
     </message>
 </context>
 <context>
     <name>GcpDock</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="242" />
+        <location filename="../ui/gcp_dock.py" line="65"/>
         <source>ArchaeoOrtho ground control</source>
         <translation>ArchaeoOrtho punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="258" />
+        <location filename="../ui/gcp_dock.py" line="81"/>
         <source>ArchaeoOrtho photos</source>
         <translation>ArchaeoOrtho foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="274" />
+        <location filename="../ui/gcp_dock.py" line="117"/>
         <source>Workspace:</source>
         <translation>Area di lavoro:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="451" />
+        <location filename="../ui/gcp_dock.py" line="298"/>
         <source>none open</source>
         <translation>nessuna aperta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="279" />
-        <source>Openu2026</source>
-        <translation>Apri…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="280" />
+        <location filename="../ui/gcp_dock.py" line="123"/>
         <source>Open a workspace folder (made by Align images)</source>
         <translation>Apri una cartella dell'area di lavoro (creata da 'Allinea immagini')</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="281" />
-        <source>New from photosu2026</source>
-        <translation>Nuova dalle foto…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="282" />
+        <location filename="../ui/gcp_dock.py" line="125"/>
         <source>Choose a folder of photos and a workspace folder, and align the photos</source>
         <translation>Scegli una cartella di foto e una cartella dell'area di lavoro e allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="288" />
+        <location filename="../ui/gcp_dock.py" line="132"/>
         <source>Heights (Z) from:</source>
         <translation>Quote (Z) da:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="293" />
+        <location filename="../ui/gcp_dock.py" line="137"/>
         <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
         <translation>Un layer raster DSM o DTM (ad es. un DSM ALS): un punto misurato sulla mappa ne prende la quota (bilineare). Vuoto: inserire Z a mano.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="909" />
+        <location filename="../ui/gcp_io.py" line="64"/>
         <source>Add</source>
         <translation>Aggiungi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="303" />
+        <location filename="../ui/gcp_dock.py" line="148"/>
         <source>Add a ground point</source>
         <translation>Aggiungi un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="304" />
+        <location filename="../ui/gcp_dock.py" line="149"/>
         <source>Remove</source>
         <translation>Rimuovi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="305" />
+        <location filename="../ui/gcp_dock.py" line="150"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Rimuovi il punto d'appoggio selezionato e le sue misure</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="306" />
+        <location filename="../ui/gcp_dock.py" line="151"/>
         <source>Pick on map</source>
         <translation>Misura sulla mappa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="308" />
+        <location filename="../ui/gcp_dock.py" line="153"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>Fai clic sulla mappa per impostare X e Y del punto selezionato (Z dal layer delle quote)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="311" />
-        <source>From file (gcp_list.txt, CSV)u2026</source>
-        <translation>Da file (gcp_list.txt, CSV)…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="312" />
-        <source>From a point layeru2026</source>
-        <translation>Da un layer di punti…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="314" />
-        <source>To file (gcp_list.txt, CSV)u2026</source>
-        <translation>Su file (gcp_list.txt, CSV)…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="315" />
-        <source>To a GeoPackage layeru2026</source>
-        <translation>Su un layer GeoPackage…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="316" />
+        <location filename="../ui/gcp_io.py" line="61"/>
         <source>Import</source>
         <translation>Importa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="316" />
+        <location filename="../ui/gcp_dock.py" line="161"/>
         <source>Export</source>
         <translation>Esporta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="323" />
+        <location filename="../ui/gcp_dock.py" line="174"/>
         <source>Undo</source>
         <translation>Annulla</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="324" />
+        <location filename="../ui/gcp_dock.py" line="175"/>
         <source>Redo</source>
         <translation>Ripeti</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="331" />
+        <location filename="../ui/gcp_dock.py" line="182"/>
         <source>Undo: {}</source>
         <translation>Annulla: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="332" />
+        <location filename="../ui/gcp_dock.py" line="183"/>
         <source>Redo: {}</source>
         <translation>Ripeti: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="337" />
+        <location filename="../ui/gcp_dock.py" line="168"/>
         <source>Load results</source>
         <translation>Carica risultati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="338" />
-        <source>Add the workspace's products to the map as styled layers</source>
+        <location filename="../ui/gcp_dock.py" line="169"/>
+        <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Aggiungi i prodotti dell'area di lavoro alla mappa come layer con stile</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="355" />
+        <location filename="../ui/gcp_dock.py" line="205"/>
         <source>Residual tolerance:</source>
         <translation>Tolleranza dei residui:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="361" />
+        <location filename="../ui/gcp_dock.py" line="211"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="363" />
+        <location filename="../ui/gcp_dock.py" line="215"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="364" />
+        <location filename="../ui/gcp_dock.py" line="216"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Lascia che la compensazione affini focale, punto principale e distorsione</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="370" />
+        <location filename="../ui/gcp_dock.py" line="223"/>
         <source>Georeference</source>
         <translation>Georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="371" />
+        <location filename="../ui/gcp_dock.py" line="224"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Esegui la compensazione con questi punti (in background)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="372" />
+        <location filename="../ui/gcp_dock.py" line="225"/>
         <source>Cancel</source>
         <translation>Interrompi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="428" />
+        <location filename="../ui/gcp_dock.py" line="275"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="435" />
+        <location filename="../ui/gcp_dock.py" line="282"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Apri un'area di lavoro ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="472" />
-        <source>{} photos; the block is not aligned yet: run Align images (or 'New from photos') to get predicted positions</source>
+        <location filename="../ui/gcp_dock.py" line="319"/>
+        <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} foto; il blocco non è ancora allineato: esegui 'Allinea immagini' (o 'Nuova dalle foto') per avere le posizioni previste</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="475" />
+        <location filename="../ui/gcp_dock.py" line="322"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} foto, {} punti d'appoggio. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="724" />
+        <location filename="../ui/gcp_placement.py" line="221"/>
         <source>no predicted positions: {}</source>
         <translation>nessuna posizione prevista: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="508" />
+        <location filename="../ui/gcp_placement.py" line="61"/>
         <source>Predicted positions from the georeferenced block.</source>
         <translation>Posizioni previste dal blocco georeferenziato.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="508" />
+        <location filename="../ui/gcp_placement.py" line="61"/>
         <source>Predicted positions once a point is placed in 2 photos, and for every point once 3 points are placed.</source>
         <translation>Posizioni previste quando un punto è misurato in 2 foto, e per tutti i punti quando ne sono misurati 3.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="514" />
+        <location filename="../ui/gcp_tasks.py" line="24"/>
         <source>Folder of photos</source>
         <translation>Cartella delle foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="517" />
+        <location filename="../ui/gcp_tasks.py" line="27"/>
         <source>Workspace folder (new or existing)</source>
         <translation>Cartella dell'area di lavoro (nuova o esistente)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="529" />
+        <location filename="../ui/gcp_tasks.py" line="39"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
         <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="533" />
+        <location filename="../ui/gcp_tasks.py" line="43"/>
         <source>ArchaeoOrtho: align photos</source>
         <translation>ArchaeoOrtho: allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="612" />
+        <location filename="../ui/gcp_dock.py" line="400"/>
         <source>CRS: {}</source>
         <translation>SR: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="639" />
-        <source>Click on the map at the selected point's position (Esc to stop)</source>
+        <location filename="../ui/gcp_placement.py" line="107"/>
+        <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Fai clic sulla mappa nella posizione del punto selezionato (Esc per terminare)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="678" />
+        <location filename="../ui/gcp_placement.py" line="153"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (da {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="681" />
+        <location filename="../ui/gcp_placement.py" line="156"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Nessuna quota in questo punto in {}: Z invariata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="684" />
+        <location filename="../ui/gcp_placement.py" line="159"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="804" />
+        <location filename="../ui/gcp_placement.py" line="331"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="806" />
+        <location filename="../ui/gcp_placement.py" line="333"/>
         <source>predicted</source>
         <translation>prevista</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="821" />
+        <location filename="../ui/gcp_placement.py" line="356"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Seleziona o aggiungi un punto d'appoggio nella tabella, poi fai clic su di esso nella foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="826" />
-        <source>from the point's other observations</source>
+        <location filename="../ui/gcp_placement.py" line="363"/>
+        <source>from the point&apos;s other observations</source>
         <translation>dalle altre misure del punto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="827" />
+        <location filename="../ui/gcp_placement.py" line="364"/>
         <source>from the georeferenced block</source>
         <translation>dal blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="828" />
+        <location filename="../ui/gcp_placement.py" line="365"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>dai punti già misurati (trasformazione di similitudine)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="837" />
+        <location filename="../ui/gcp_placement.py" line="374"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Misurato in x {:.2f}, y {:.2f}. Fai clic per spostarlo, trascinalo o premi Canc per rimuoverlo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="840" />
+        <location filename="../ui/gcp_placement.py" line="377"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Previsto {}. Premi Invio per accettarlo e proseguire (Spazio: accetta), trascinalo o fai clic dove si trova davvero il punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="843" />
+        <location filename="../ui/gcp_placement.py" line="389"/>
         <source>Click where {} is in this photo.</source>
         <translation>Fai clic dove si trova {} in questa foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="853" />
+        <location filename="../ui/gcp_placement.py" line="409"/>
         <source>Select or add a ground point first</source>
         <translation>Seleziona o aggiungi prima un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="892" />
+        <location filename="../ui/gcp_placement.py" line="456"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: ogni foto in cui è previsto ha una misura</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="952" />
+        <location filename="../ui/gcp_io.py" line="127"/>
         <source>Import ground control</source>
         <translation>Importa punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="897" />
+        <location filename="../ui/gcp_io.py" line="32"/>
         <source>Ground control (*.txt *.csv);;All files (*)</source>
         <translation>Punti d'appoggio (*.txt *.csv);;Tutti i file (*)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="905" />
+        <location filename="../ui/gcp_io.py" line="57"/>
         <source>Replace the current points, or add the imported ones to them (same names are updated)?</source>
         <translation>Sostituire i punti attuali o aggiungere quelli importati (quelli con lo stesso nome vengono aggiornati)?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="908" />
+        <location filename="../ui/gcp_io.py" line="61"/>
         <source>Replace</source>
         <translation>Sostituisci</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="935" />
+        <location filename="../ui/gcp_io.py" line="103"/>
         <source>import {}</source>
         <translation>importa {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="936" />
+        <location filename="../ui/gcp_io.py" line="104"/>
         <source>warnings</source>
         <translation>avvisi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="937" />
+        <location filename="../ui/gcp_io.py" line="111"/>
         <source>Imported {} points and {} observations from {}</source>
         <translation>Importati {} punti e {} misure da {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="949" />
+        <location filename="../ui/gcp_io.py" line="124"/>
         <source>No point layer in the project</source>
         <translation>Nessun layer di punti nel progetto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="952" />
+        <location filename="../ui/gcp_io.py" line="127"/>
         <source>Point layer (one feature per observation: name, image, px, py)</source>
         <translation>Layer di punti (un elemento per misura: name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="965" />
-        <source>Layer {} lacks the field '{}' (needs name, image, px, py)</source>
+        <location filename="../ui/gcp_io.py" line="142"/>
+        <source>Layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="991" />
+        <location filename="../ui/gcp_io.py" line="169"/>
         <source>OpenDroneMap gcp_list (*.txt)</source>
         <translation>OpenDroneMap gcp_list (*.txt)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="991" />
+        <location filename="../ui/gcp_io.py" line="169"/>
         <source>CSV points + observations (*.csv)</source>
         <translation>Punti CSV + misure (*.csv)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="992" />
+        <location filename="../ui/gcp_io.py" line="170"/>
         <source>Export ground control</source>
         <translation>Esporta punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1003" />
+        <location filename="../ui/gcp_io.py" line="181"/>
         <source>The points have no CRS yet: pick one on the map or import a file first</source>
         <translation>I punti non hanno ancora un SR: misurane uno sulla mappa o importa prima un file</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1012" />
+        <location filename="../ui/gcp_io.py" line="190"/>
         <source>Exported {} points to {}</source>
         <translation>Esportati {} punti in {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1012" />
+        <location filename="../ui/gcp_io.py" line="190"/>
         <source> ({} without coordinates left out)</source>
         <translation> ({} senza coordinate esclusi)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1017" />
+        <location filename="../ui/gcp_io.py" line="195"/>
         <source>Export ground control as a layer</source>
         <translation>Esporta i punti d'appoggio come layer</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1017" />
+        <location filename="../ui/gcp_io.py" line="195"/>
         <source>GeoPackage (*.gpkg)</source>
         <translation>GeoPackage (*.gpkg)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1048" />
+        <location filename="../ui/gcp_io.py" line="226"/>
         <source>Cannot write {}: {}</source>
         <translation>Impossibile scrivere {}: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1051" />
+        <location filename="../ui/gcp_io.py" line="229"/>
         <source>Exported {} observations to {}</source>
         <translation>Esportate {} misure in {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1051" />
+        <location filename="../ui/gcp_io.py" line="229"/>
         <source> (points without observations left out: {})</source>
         <translation> (punti senza misure esclusi: {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1055" />
+        <location filename="../ui/gcp_io.py" line="233"/>
         <source>GCP observations</source>
         <translation>Misure dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1057" />
+        <location filename="../ui/gcp_io.py" line="235"/>
         <source>Cannot add {} to the project</source>
         <translation>Impossibile aggiungere {} al progetto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1063" />
+        <location filename="../ui/gcp_tasks.py" line="50"/>
         <source>A task of this dock is still running</source>
         <translation>Un'operazione di questo pannello è ancora in corso</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1086" />
+        <location filename="../ui/gcp_tasks.py" line="73"/>
         <source>Cancelled</source>
         <translation>Interrotto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1094" />
-        <source>Cancellingu2026</source>
-        <translation>Interruzione…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="1103" />
+        <location filename="../ui/gcp_tasks.py" line="90"/>
         <source>The block is not aligned yet: run Align images first</source>
         <translation>Il blocco non è ancora allineato: esegui prima 'Allinea immagini'</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1108" />
+        <location filename="../ui/gcp_tasks.py" line="96"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>La compensazione richiede almeno 3 punti d'appoggio con coordinate e misure; ce ne sono {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1124" />
+        <location filename="../ui/gcp_tasks.py" line="112"/>
         <source>Outliers left out: {}</source>
         <translation>Valori anomali esclusi: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1125" />
+        <location filename="../ui/gcp_tasks.py" line="113"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziato in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1128" />
+        <location filename="../ui/gcp_tasks.py" line="116"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1131" />
-        <source>Georeferencing with {} control pointsu2026</source>
-        <translation>Georeferenziazione con {} punti d'appoggio…</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="1137" />
+        <location filename="../ui/gcp_tasks.py" line="125"/>
         <source>Not georeferenced yet.</source>
         <translation>Non ancora georeferenziato.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1139" />
+        <location filename="../ui/gcp_tasks.py" line="127"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Appoggio: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1142" />
+        <location filename="../ui/gcp_tasks.py" line="130"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Controllo: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1145" />
+        <location filename="../ui/gcp_tasks.py" line="133"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>le quote sono segnaposto: nessuna accuratezza verticale</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1147" />
+        <location filename="../ui/gcp_tasks.py" line="135"/>
         <source>tie points {} px</source>
         <translation>punti di legame {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1149" />
+        <location filename="../ui/gcp_tasks.py" line="137"/>
         <source>edited since: re-run to update</source>
         <translation>modificato da allora: riesegui per aggiornare</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="1159" />
-        <source>ArchaeoOrtho: {}</source>
-        <translation>ArchaeoOrtho: {}</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="829" />
+        <location filename="../ui/gcp_placement.py" line="366"/>
         <source>by matching its look in another photo</source>
         <translation>confrontandone l'aspetto in un'altra foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="831" />
+        <location filename="../ui/gcp_placement.py" line="368"/>
         <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
         <translation>(correlazione {:.2f}, {:.0f} px dalla previsione geometrica)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="122"/>
+        <source>Open…</source>
+        <translation>Apri…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="124"/>
+        <source>New from photos…</source>
+        <translation>Nuova dalle foto…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="156"/>
+        <source>From file (gcp_list.txt, CSV)…</source>
+        <translation>Da file (gcp_list.txt, CSV)…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="157"/>
+        <source>From a point layer…</source>
+        <translation>Da un layer di punti…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="159"/>
+        <source>To file (gcp_list.txt, CSV)…</source>
+        <translation>Su file (gcp_list.txt, CSV)…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="160"/>
+        <source>To a GeoPackage layer…</source>
+        <translation>Su un layer GeoPackage…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="81"/>
+        <source>Cancelling…</source>
+        <translation>Interruzione…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="119"/>
+        <source>Georeferencing with {} control points…</source>
+        <translation>Georeferenziazione con {} punti d'appoggio…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_io.py" line="57"/>
+        <source>How were the pixel coordinates measured?</source>
+        <translation>Come sono state misurate le coordinate pixel?</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_io.py" line="68"/>
+        <source>Coordinates measured on upright photos ({} photos are stored turned: EXIF orientation); leave unticked for the stored pixel grid (COLMAP&apos;s, OpenDroneMap&apos;s)</source>
+        <translation>Coordinate misurate sulle foto raddrizzate ({} foto sono salvate ruotate: orientamento EXIF); lasciare deselezionato per la griglia di pixel salvata (quella di COLMAP e OpenDroneMap)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="70"/>
+        <source>your setting</source>
+        <translation>la tua impostazione</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="73"/>
+        <source>default: 3 × GSD of the georeferenced block (GSD {:.3f} m)</source>
+        <translation>predefinito: 3 × GSD del blocco georeferenziato (GSD {:.3f} m)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="74"/>
+        <source>default</source>
+        <translation>predefinito</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="81"/>
+        <source>Residuals up to this are green, up to 3 times yellow, beyond red. Now: {}</source>
+        <translation>I residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi. Ora: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="89"/>
+        <source>Diagnosis of the adjustment:</source>
+        <translation>Diagnosi della compensazione:</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="144"/>
+        <source>Moved {:.2f} m (Undo: Ctrl+Z).</source>
+        <translation>Spostato di {:.2f} m (Annulla: Ctrl+Z).</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="333"/>
+        <source>near the edge</source>
+        <translation>vicino al bordo</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="380"/>
+        <source>{} is predicted where it cannot be placed: {}. Click where the point is if you see it, or press Enter for the next photo.</source>
+        <translation>{} è previsto dove non può essere posizionato: {}. Fai clic sul punto se lo vedi, o premi Invio per la foto successiva.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="386"/>
+        <source>Click where {} is in this photo, or use Pick on map (or type X, Y, Z in the table) to have it predicted in the photos.</source>
+        <translation>Fai clic su {} in questa foto, oppure usa Misura sulla mappa (o scrivi X, Y, Z nella tabella) per farlo prevedere nelle foto.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="399"/>
+        <source>{}: the workspace has no photos to place it in.</source>
+        <translation>{}: l&apos;area di lavoro non ha foto in cui posizionarlo.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="401"/>
+        <source>{} is selected: use Pick on map or type X, Y, Z in the table, or choose a photo in the strip below and click on the point.</source>
+        <translation>{} è selezionato: usa Misura sulla mappa o scrivi X, Y, Z nella tabella, oppure scegli una foto nella striscia sotto e fai clic sul punto.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="403"/>
+        <source>{} is selected: choose a photo in the strip below and click on the point.</source>
+        <translation>{} è selezionato: scegli una foto nella striscia sotto e fai clic sul punto.</translation>
     </message>
 </context>
 <context>
     <name>GcpStore</name>
     <message>
-        <location filename="../ui/store.py" line="194" />
+        <location filename="../ui/store.py" line="252"/>
         <source>a point named {} exists already</source>
         <translation>esiste già un punto chiamato {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="182" />
+        <location filename="../ui/store.py" line="240"/>
         <source>add point {}</source>
         <translation>aggiungi il punto {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="189" />
+        <location filename="../ui/store.py" line="247"/>
         <source>remove point {}</source>
         <translation>rimuovi il punto {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="205" />
+        <location filename="../ui/store.py" line="263"/>
         <source>set {} of {}</source>
         <translation>imposta {} di {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="218" />
+        <location filename="../ui/store.py" line="321"/>
         <source>place {} in {}</source>
         <translation>misura {} in {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="226" />
+        <location filename="../ui/store.py" line="329"/>
         <source>remove {} from {}</source>
         <translation>rimuovi {} da {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="251" />
+        <location filename="../ui/store.py" line="407"/>
         <source>set CRS</source>
         <translation>imposta il SR</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="291"/>
+        <source>no position</source>
+        <translation>nessuna posizione</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="294"/>
+        <source>({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)</source>
+        <translation>({:.0f}, {:.0f}) è fuori dalla foto {} ({} × {} px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="301"/>
+        <source>({:.0f}, {:.0f}) is inside the mask of {}</source>
+        <translation>({:.0f}, {:.0f}) è dentro la maschera di {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="309"/>
+        <source>{} not placed: {}</source>
+        <translation>{} non posizionato: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="353"/>
+        <source>{} points replaced by {} from the file</source>
+        <translation>{} punti sostituiti da {} dal file</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="387"/>
+        <source>added {} points: {}</source>
+        <translation>aggiunti {} punti: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="389"/>
+        <source>coordinates updated from the file: {}</source>
+        <translation>coordinate aggiornate dal file: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="391"/>
+        <source>role set by the file: {}</source>
+        <translation>ruolo impostato dal file: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="393"/>
+        <source>role kept (the file gives none): {}</source>
+        <translation>ruolo mantenuto (il file non ne indica): {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="395"/>
+        <source>σ set by the file: {}</source>
+        <translation>σ impostata dal file: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="397"/>
+        <source>{} observations added</source>
+        <translation>{} misure aggiunte</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="399"/>
+        <source>placed observations kept (the file has others): {}</source>
+        <translation>misure posizionate mantenute (il file ne ha altre): {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="400"/>
+        <source>nothing changed</source>
+        <translation>nulla è cambiato</translation>
     </message>
 </context>
 <context>
     <name>GcpTableModel</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82" />
+        <location filename="../ui/gcp_table.py" line="36"/>
         <source>Name</source>
         <translation>Nome</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82" />
+        <location filename="../ui/gcp_table.py" line="36"/>
         <source>X</source>
         <translation>X</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82" />
+        <location filename="../ui/gcp_table.py" line="36"/>
         <source>Y</source>
         <translation>Y</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82" />
+        <location filename="../ui/gcp_table.py" line="36"/>
         <source>Z</source>
         <translation>Z</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="82" />
-        <source>u03c3 XY</source>
-        <translation>σ XY</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="82" />
-        <source>u03c3 Z</source>
-        <translation>σ Z</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_dock.py" line="83" />
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>Role</source>
         <translation>Ruolo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="83" />
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>Obs.</source>
         <translation>Mis.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="83" />
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>dXY (m)</source>
         <translation>dXY (m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="83" />
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>dZ (m)</source>
         <translation>dZ (m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="83" />
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>px</source>
         <translation>px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="86" />
+        <location filename="../ui/gcp_table.py" line="40"/>
         <source>check</source>
         <translation>controllo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="86" />
+        <location filename="../ui/gcp_table.py" line="40"/>
         <source>control</source>
         <translation>appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="98" />
+        <location filename="../ui/gcp_table.py" line="52"/>
         <source>Horizontal residual after the adjustment (estimated from the photos minus given)</source>
         <translation>Residuo planimetrico dopo la compensazione (stimato dalle foto meno dato)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="99" />
+        <location filename="../ui/gcp_table.py" line="53"/>
         <source>Vertical residual after the adjustment</source>
         <translation>Residuo altimetrico dopo la compensazione</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="100" />
-        <source>Mean reprojection error of the point's observations (pixels)</source>
+        <location filename="../ui/gcp_table.py" line="54"/>
+        <source>Mean reprojection error of the point&apos;s observations (pixels)</source>
         <translation>Errore medio di riproiezione delle misure del punto (pixel)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="101" />
+        <location filename="../ui/gcp_table.py" line="55"/>
         <source>Number of photos the point is placed in</source>
         <translation>Numero di foto in cui il punto è misurato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="114" />
+        <location filename="../ui/gcp_table.py" line="68"/>
         <source>rejected as an outlier</source>
         <translation>scartato come valore anomalo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="116" />
+        <location filename="../ui/gcp_table.py" line="70"/>
         <source>not triangulated (fewer than 2 usable observations)</source>
         <translation>non triangolato (meno di 2 misure utilizzabili)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="122" />
+        <location filename="../ui/gcp_table.py" line="76"/>
         <source>within the tolerance</source>
         <translation>entro la tolleranza</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="124" />
+        <location filename="../ui/gcp_table.py" line="78"/>
         <source>up to 3 times the tolerance</source>
         <translation>fino al triplo della tolleranza</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="125" />
+        <location filename="../ui/gcp_table.py" line="79"/>
         <source>more than 3 times the tolerance</source>
         <translation>oltre il triplo della tolleranza</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="167" />
+        <location filename="../ui/gcp_table.py" line="121"/>
         <source>edited since the last adjustment: run Georeference to update</source>
         <translation>modificato dopo l'ultima compensazione: esegui 'Georeferenzia' per aggiornare</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_table.py" line="36"/>
+        <source>σ XY</source>
+        <translation>σ XY</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_table.py" line="36"/>
+        <source>σ Z</source>
+        <translation>σ Z</translation>
     </message>
 </context>
 <context>
     <name>GeoreferenceAlgorithm</name>
     <message>
-        <location filename="../processing_provider/georeference.py" line="49" />
-        <source>Workspace folder (aligned)</source>
-        <translation>Cartella dell'area di lavoro (allineata)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="51" />
-        <source>Ground control file (gcp_list.txt or CSV)</source>
-        <translation>File dei punti d'appoggio (gcp_list.txt o CSV)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="54" />
-        <source>Ground control point layer (one feature per observation)</source>
-        <translation>Layer dei punti d'appoggio (un elemento per misura)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="57" />
-        <source>Check points (comma-separated names)</source>
-        <translation>Punti di controllo (nomi separati da virgole)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="59" />
+        <location filename="../processing_provider/georeference.py" line="47"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="62" />
-        <source>Use EXIF GPS camera positions</source>
-        <translation>Usa le posizioni GPS EXIF delle camere</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="64" />
-        <source>Target CRS (default: the GCP file's)</source>
-        <translation>SR di destinazione (predefinito: quello del file dei punti d'appoggio)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="66" />
-        <source>Refine camera calibration in the adjustment</source>
-        <translation>Affina la calibrazione della camera nella compensazione</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="68" />
+        <location filename="../processing_provider/georeference.py" line="59"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="69" />
+        <location filename="../processing_provider/georeference.py" line="60"/>
         <source>GCP residuals</source>
         <translation>Residui dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="70" />
+        <location filename="../processing_provider/georeference.py" line="61"/>
         <source>Camera centres (world)</source>
         <translation>Centri di presa (mondo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="91" />
+        <location filename="../processing_provider/georeference.py" line="77"/>
         <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS)</source>
         <translation>Indica i punti d'appoggio (GCPS o GCP_LAYER) e/o le posizioni delle camere (CAMERA_POSITIONS o USE_EXIF_GPS)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="102" />
+        <location filename="../processing_provider/georeference.py" line="88"/>
         <source>outlier left out: {}</source>
         <translation>valore anomalo escluso: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="106" />
+        <location filename="../processing_provider/georeference.py" line="92"/>
         <source>CRS {}; control RMSE XY {} m, Z {} m; check RMSE XY {} m, Z {} m</source>
         <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="119" />
-        <source>GCP layer {} lacks the field '{}' (needs name, image, px, py)</source>
+        <location filename="../processing_provider/run_pipeline.py" line="95"/>
+        <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Georeference</source>
         <translation>Georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
-        <source>Fixes the aligned block in a real coordinate reference system with ground control points (GCPs) and/or camera positions, used inside the bundle adjustment so that they also remove the block's drift and bending, which a 7-parameter (Helmert) transform cannot. Check points take no part in the adjustment: they are triangulated afterwards and compared with their surveyed coordinates.
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>Aligned workspace</source>
+        <translation>Area di lavoro allineata</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>Ground control file</source>
+        <translation>File dei punti d'appoggio</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>Ground control layer</source>
+        <translation>Layer dei punti d'appoggio</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>Check points</source>
+        <translation>Punti di controllo</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>Use EXIF GPS positions</source>
+        <translation>Usa le posizioni GPS EXIF</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>Target CRS</source>
+        <translation>SR di destinazione</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>Refine camera calibration</source>
+        <translation>Affina la calibrazione della camera</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Fixes the aligned block in a real coordinate reference system with ground control points (GCPs) and/or camera positions, used inside the bundle adjustment so that they also remove the block&apos;s drift and bending, which a 7-parameter (Helmert) transform cannot. Check points take no part in the adjustment: they are triangulated afterwards and compared with their surveyed coordinates.
 
-GCPS: an OpenDroneMap gcp_list.txt (CRS line, then 'x y z px py image [name]') or a CSV points file with a matching '&lt;name&gt;_observations.csv'. GCP_LAYER: alternatively a point layer with one feature per observation and fields name, image, px, py (optional z, sx, sy, sz, role).
-CHECK_POINTS: comma-separated names that become check points.
-CAMERA_POSITIONS: CSV 'image,x,y,z[,sigma]' (optional CRS line). USE_EXIF_GPS: use the photos' GPS.
+Ground control file: an OpenDroneMap gcp_list.txt (CRS line, then &apos;x y z px py image [name]&apos;) or a CSV points file with a matching &apos;&lt;name&gt;_observations.csv&apos;. Ground control layer: alternatively a point layer with one feature per observation and fields name, image, px, py (optional z, sx, sy, sz, role).
+Check points: comma-separated names that become check points.
+Camera positions: CSV &apos;image,x,y,z[,sigma]&apos; (optional CRS line). Use EXIF GPS positions: use the photos&apos; GPS.
+Target CRS: default the ground control file&apos;s. Refine camera calibration: let the adjustment refine focal length, principal point and distortion.
 Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.</source>
         <translation>Fissa il blocco allineato in un sistema di riferimento reale con punti d'appoggio (GCP) e/o posizioni delle camere, usati all'interno della compensazione a stelle proiettive in modo che eliminino anche la deriva e la flessione del blocco, cosa che una trasformazione a 7 parametri (Helmert) non può fare. I punti di controllo non partecipano alla compensazione: vengono triangolati in seguito e confrontati con le loro coordinate rilevate.
 
-GCPS: un gcp_list.txt di OpenDroneMap (riga del SR, poi 'x y z px py image [name]') o un file CSV di punti con il corrispondente '&lt;name&gt;_observations.csv'. GCP_LAYER: in alternativa un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, sx, sy, sz, role).
-CHECK_POINTS: nomi separati da virgole che diventano punti di controllo.
-CAMERA_POSITIONS: CSV 'image,x,y,z[,sigma]' (riga del SR facoltativa). USE_EXIF_GPS: usa il GPS delle foto.
+File dei punti d'appoggio: un gcp_list.txt di OpenDroneMap (riga del SR, poi 'x y z px py image [name]') o un file CSV di punti con il corrispondente '&lt;name&gt;_observations.csv'. Layer dei punti d'appoggio: in alternativa un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, sx, sy, sz, role).
+Punti di controllo: nomi separati da virgole che diventano punti di controllo.
+Posizioni delle camere: CSV 'image,x,y,z[,sigma]' (riga del SR facoltativa). Usa le posizioni GPS EXIF: usa il GPS delle foto.
+SR di destinazione: predefinito quello del file dei punti d'appoggio. Affina la calibrazione della camera: la compensazione affina focale, punto principale e distorsione.
 I valori anomali (una misura errata, un errore di battitura in una coordinata) sono individuati, nominati nel registro ed esclusi.</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="47"/>
+        <source>GCP pixels measured on upright photos</source>
+        <translation>Pixel dei GCP misurati sulle foto raddrizzate</translation>
     </message>
 </context>
 <context>
     <name>OrthorectifyImageAlgorithm</name>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62" />
+        <location filename="../processing_provider/orthorectify_image.py" line="58"/>
         <source>Image</source>
         <translation>Immagine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="65" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Ground control file (gcp_list.txt or CSV)</source>
         <translation>File dei punti d'appoggio (gcp_list.txt o CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="68" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Ground control point layer (one feature per observation)</source>
         <translation>Layer dei punti d'appoggio (un elemento per misura)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="71" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Known orientation (x y z omega phi kappa)</source>
         <translation>Orientamento noto (x y z omega phi kappa)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="74" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Focal length in mm (0 = from EXIF)</source>
         <translation>Focale in mm (0 = dall'EXIF)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="77" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Sensor width (long side) in mm</source>
         <translation>Larghezza del sensore (lato lungo) in mm</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="80" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Mode</source>
         <translation>Modalità</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="82" />
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Resolution in CRS units (0 = ground sample distance)</source>
         <translation>Risoluzione in unità del SR (0 = GSD)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="85" />
-        <source>Output CRS (default: the GCPs' or orientation's CRS)</source>
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <source>Output CRS (default: the GCPs&apos; or orientation&apos;s CRS)</source>
         <translation>SR di output (predefinito: quello dei punti d'appoggio o dell'orientamento)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="87" />
+        <location filename="../processing_provider/orthorectify_image.py" line="74"/>
         <source>Orthophoto</source>
         <translation>Ortofoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="88" />
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>GCP residuals</source>
         <translation>Residui dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="90" />
+        <location filename="../processing_provider/orthorectify_image.py" line="77"/>
         <source>GCP residual RMSE (pixels)</source>
         <translation>RMSE dei residui dei punti d'appoggio (pixel)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="91" />
+        <location filename="../processing_provider/orthorectify_image.py" line="78"/>
         <source>Planar rectification: 95th percentile of its offset from the true position (CRS units)</source>
         <translation>Raddrizzamento piano: 95° percentile del suo scostamento dalla posizione vera (unità del SR)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="107" />
+        <location filename="../processing_provider/orthorectify_image.py" line="94"/>
         <source>Give ground control points observed in the image (GCPS or GCP_LAYER) or its orientation (ORIENTATION)</source>
         <translation>Indica i punti d'appoggio misurati nell'immagine (GCPS o GCP_LAYER) o il suo orientamento (ORIENTATION)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="114" />
+        <location filename="../processing_provider/orthorectify_image.py" line="100"/>
         <source>RESIDUALS must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>RESIDUALS deve essere un file GeoPackage (.gpkg), ricevuto {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="129" />
+        <location filename="../processing_provider/orthorectify_image.py" line="113"/>
         <source>{} ({}): {:.2f} px</source>
         <translation>{} ({}): {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="137" />
-        <source>GCP layer {} lacks the field '{}' (needs name, image, px, py)</source>
+        <location filename="../processing_provider/orthorectify_image.py" line="88"/>
+        <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Orthorectify image</source>
         <translation>Ortorettifica immagine</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Orthorectifies one photograph — also one that is not part of any block, such as a single oblique or an old print — on an existing DSM, for example an airborne laser scanning (ALS) DSM in any CRS (it is reprojected on the fly).
 
 The camera's position and attitude come from ground control points observed in the photo (space resection: at least 4 points; one wrong point among 5 or more is found and left out; with 6 or more the focal length and the radial distortion k1 are estimated too where the points determine them), or from a known orientation.
@@ -1338,62 +1477,62 @@ RESIDUALS: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in met
 <context>
     <name>PhotoPanel</name>
     <message>
-        <location filename="../ui/photo_viewer.py" line="422" />
+        <location filename="../ui/photo_viewer.py" line="425"/>
         <source>Only photos that probably see the point</source>
         <translation>Solo le foto che probabilmente vedono il punto</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="425" />
+        <location filename="../ui/photo_viewer.py" line="428"/>
         <source>Fit</source>
         <translation>Adatta</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="425" />
+        <location filename="../ui/photo_viewer.py" line="428"/>
         <source>Show the whole photo (F)</source>
         <translation>Mostra l'intera foto (F)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="426" />
+        <location filename="../ui/photo_viewer.py" line="429"/>
         <source>Zoom to point</source>
         <translation>Zoom sul punto</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="426" />
+        <location filename="../ui/photo_viewer.py" line="429"/>
         <source>Zoom to the observation or prediction (Z)</source>
         <translation>Zoom sulla misura o sulla previsione (Z)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="428" />
+        <location filename="../ui/photo_viewer.py" line="431"/>
         <source>Confirm</source>
         <translation>Conferma</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="428" />
+        <location filename="../ui/photo_viewer.py" line="431"/>
         <source>Accept the predicted position (Space)</source>
         <translation>Accetta la posizione prevista (Spazio)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="430" />
+        <location filename="../ui/photo_viewer.py" line="433"/>
         <source>Confirm &amp;&amp; next</source>
         <translation>Conferma &amp;&amp; avanti</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="430" />
+        <location filename="../ui/photo_viewer.py" line="433"/>
         <source>Accept the prediction and show the next photo to place (Enter)</source>
         <translation>Accetta la previsione e mostra la prossima foto da misurare (Invio)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="433" />
+        <location filename="../ui/photo_viewer.py" line="436"/>
         <source>Remove</source>
         <translation>Rimuovi</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="433" />
+        <location filename="../ui/photo_viewer.py" line="436"/>
         <source>Remove the observation in this photo (Delete)</source>
         <translation>Rimuovi la misura in questa foto (Canc)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="596" />
+        <location filename="../ui/photo_viewer.py" line="599"/>
         <source>{} (predicted)</source>
         <translation>{} (previsto)</translation>
     </message>
@@ -1401,145 +1540,145 @@ RESIDUALS: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in met
 <context>
     <name>PrepareImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="82" />
+        <location filename="../processing_provider/prepare_images.py" line="79"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="84" />
+        <location filename="../processing_provider/prepare_images.py" line="79"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="85" />
+        <location filename="../processing_provider/prepare_images.py" line="79"/>
         <source>Smallest blur score (0 = only relative to the set)</source>
         <translation>Punteggio di nitidezza minimo (0 = solo relativo all'insieme)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="88" />
+        <location filename="../processing_provider/prepare_images.py" line="79"/>
         <source>Leave flagged images out of the prepared folder</source>
         <translation>Escludi le immagini segnalate dalla cartella preparata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93" />
+        <location filename="../processing_provider/prepare_images.py" line="89"/>
         <source>Scanned film: fiducial marks, common frame, masks</source>
         <translation>Pellicola scansionata: marche fiduciali, fotogramma comune, maschere</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="95" />
+        <location filename="../processing_provider/prepare_images.py" line="90"/>
         <source>Calibrated fiducial coordinates in mm (file path or text)</source>
         <translation>Coordinate calibrate delle marche fiduciali in mm (percorso di file o testo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="98" />
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
         <source>Calibrated focal length in mm (0 = unknown)</source>
         <translation>Focale calibrata in mm (0 = sconosciuta)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="102" />
-        <source>Flag images below this fraction of the set's median blur score</source>
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <source>Flag images below this fraction of the set&apos;s median blur score</source>
         <translation>Segnala le immagini sotto questa frazione del punteggio di nitidezza mediano dell'insieme</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="105" />
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
         <source>Fiducial mark type</source>
         <translation>Tipo di marca fiduciale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="107" />
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
         <source>Fiducial positions</source>
         <translation>Posizioni delle marche fiduciali</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="109" />
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
         <source>Template image of one fiducial mark</source>
         <translation>Immagine modello di una marca fiduciale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="111" />
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
         <source>Scan resolution in dpi when not in the files (0 = from the files)</source>
         <translation>Risoluzione di scansione in dpi se non nei file (0 = dai file)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="118" />
+        <location filename="../processing_provider/prepare_images.py" line="106"/>
         <source>Prepared images (skipped: &lt;workspace&gt;/prepared)</source>
         <translation>Immagini preparate (se omesso: &lt;workspace&gt;/prepared)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="121" />
+        <location filename="../processing_provider/prepare_images.py" line="109"/>
         <source>Folder of prepared images</source>
         <translation>Cartella delle immagini preparate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="122" />
+        <location filename="../processing_provider/prepare_images.py" line="110"/>
         <source>Flagged images</source>
         <translation>Immagini segnalate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="123" />
+        <location filename="../processing_provider/prepare_images.py" line="111"/>
         <source>Excluded images</source>
         <translation>Immagini escluse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="124" />
+        <location filename="../processing_provider/prepare_images.py" line="112"/>
         <source>Screening record (JSON)</source>
         <translation>Registro del controllo (JSON)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="160" />
+        <location filename="../processing_provider/prepare_images.py" line="148"/>
         <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
         <translation>{} immagini: {} segnalate, {} escluse, {} nella cartella preparata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="162" />
-        <source>Blurriest first (blur score, % of the set's median):</source>
+        <location filename="../processing_provider/prepare_images.py" line="150"/>
+        <source>Blurriest first (blur score, % of the set&apos;s median):</source>
         <translation>Le più sfocate per prime (punteggio di nitidezza, % della mediana dell'insieme):</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="170" />
+        <location filename="../processing_provider/prepare_images.py" line="158"/>
         <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
         <translation>Scansioni preparate: {} x {} px, dimensione del pixel {:.6g} {}{}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Prepare images</source>
         <translation>Prepara immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="90" />
-        <source>Mask polygons: areas to ignore, in pixel coordinates (optional text field 'image')</source>
+        <location filename="../processing_provider/prepare_images.py" line="86"/>
+        <source>Mask polygons: areas to ignore, in pixel coordinates (optional text field &apos;image&apos;)</source>
         <translation>Poligoni di maschera: aree da ignorare, in coordinate pixel (campo di testo opzionale 'image')</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="155" />
-        <source>MASKS layer '{}'</source>
+        <location filename="../processing_provider/prepare_images.py" line="143"/>
+        <source>MASKS layer &apos;{}&apos;</source>
         <translation>layer MASKS '{}'</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="190" />
+        <location filename="../processing_provider/prepare_images.py" line="178"/>
         <source>feature {}</source>
         <translation>elemento {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="194" />
-        <source>MASKS layer '{}': {} has no geometry: skipped</source>
+        <location filename="../processing_provider/prepare_images.py" line="182"/>
+        <source>MASKS layer &apos;{}&apos;: {} has no geometry: skipped</source>
         <translation>layer MASKS '{}': {} non ha geometria: saltato</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="197" />
-        <source>MASKS layer '{}': {} is a {} geometry, not a polygon</source>
+        <location filename="../processing_provider/prepare_images.py" line="185"/>
+        <source>MASKS layer &apos;{}&apos;: {} is a {} geometry, not a polygon</source>
         <translation>layer MASKS '{}': {} è una geometria {}, non un poligono</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
-        <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for 'Align images', and the WORKSPACE, which records a decision per image (screening.json) for the accuracy report.
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for &apos;Align images&apos;, and the WORKSPACE, which records a decision per image (screening.json) for the accuracy report.
 
-Blur score: variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged 'blurry' below BLUR_RELATIVE x the median of the set, or below BLUR_THRESHOLD when that is set (absolute scores depend on the scene: sand scores far lower than roofs).
-Exposure: images with more than 5 % clipped highlights or shadows, a mean brightness far from the set's, or a very small dynamic range are flagged. EXCLUDE_FLAGGED leaves flagged images out of the prepared folder; otherwise they are kept and only reported.
+Blur score: variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged &apos;blurry&apos; below BLUR_RELATIVE x the median of the set, or below BLUR_THRESHOLD when that is set (absolute scores depend on the scene: sand scores far lower than roofs).
+Exposure: images with more than 5 % clipped highlights or shadows, a mean brightness far from the set&apos;s, or a very small dynamic range are flagged. EXCLUDE_FLAGGED leaves flagged images out of the prepared folder; otherwise they are kept and only reported.
 
-MASKS: optional polygon layer of areas to ignore (a boom, the drone's shadow, a date stamp, a frame border), in the image's pixel coordinates: origin at the upper-left corner of the image, x right, y down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is &lt;= 0). A text field 'image' names the image a polygon belongs to; empty (or no such field) applies it to every image. The polygons are written into the per-image masks (workspace/masks/&lt;image&gt;.png, merged with any mask already there): 'Align images' finds no features under them, the orthophoto does not use those pixels, and blur and exposure are measured outside them. For scanned film the coordinates are those of the prepared images (the common fiducial frame, so one polygon fits every frame).
+MASKS: optional polygon layer of areas to ignore (a boom, the drone&apos;s shadow, a date stamp, a frame border), in the image&apos;s pixel coordinates: origin at the upper-left corner of the image, x right, y down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is &lt;= 0). A text field &apos;image&apos; names the image a polygon belongs to; empty (or no such field) applies it to every image. The polygons are written into the per-image masks (workspace/masks/&lt;image&gt;.png, merged with any mask already there): &apos;Align images&apos; finds no features under them, the orthophoto does not use those pixels, and blur and exposure are measured outside them. For scanned film the coordinates are those of the prepared images (the common fiducial frame, so one polygon fits every frame).
 
-SCANNED_FILM: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. FIDUCIAL_COORDINATES: the calibration certificate's fiducial coordinates in mm, as a file or pasted text, one 'id x y' line per mark (x right, y up), optionally 'PP x y' (principal point) and 'focal f'. Without them the mean layout of the set is used, centred on the fiducial centre. With FOCAL_LENGTH_MM (or 'focal' in the certificate) the prepared images carry the focal length in pixels for the alignment.
+SCANNED_FILM: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. FIDUCIAL_COORDINATES: the calibration certificate&apos;s fiducial coordinates in mm, as a file or pasted text, one &apos;id x y&apos; line per mark (x right, y up), optionally &apos;PP x y&apos; (principal point) and &apos;focal f&apos;. Without them the mean layout of the set is used, centred on the fiducial centre. With FOCAL_LENGTH_MM (or &apos;focal&apos; in the certificate) the prepared images carry the focal length in pixels for the alignment.
 
 OUTPUT: the folder of prepared images (replaced as a whole; it must be new, empty or written by an earlier run); when skipped, &lt;workspace&gt;/prepared.</source>
         <translation>Controlla una cartella di fotografie per sfocatura ed esposizione e, per le pellicole storiche scansionate, trova le marche fiduciali e ricampiona ogni scansione in un unico fotogramma della camera. Il risultato è una cartella di immagini preparate per 'Allinea immagini' e il WORKSPACE, che registra una decisione per immagine (screening.json) per il rapporto di accuratezza.
@@ -1557,62 +1696,62 @@ OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere
 <context>
     <name>ResultLayers</name>
     <message>
-        <location filename="../ui/layers.py" line="259" />
+        <location filename="../ui/layers.py" line="267"/>
         <source>control (used)</source>
         <translation>appoggio (usato)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="260" />
+        <location filename="../ui/layers.py" line="268"/>
         <source>check point</source>
         <translation>punto di controllo</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="261" />
+        <location filename="../ui/layers.py" line="269"/>
         <source>rejected (outlier)</source>
         <translation>scartato (valore anomalo)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="262" />
+        <location filename="../ui/layers.py" line="270"/>
         <source>not triangulated</source>
         <translation>non triangolato</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="343" />
+        <location filename="../ui/layers.py" line="559"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="495" />
+        <location filename="../ui/layers.py" line="534"/>
         <source>DSM hillshade</source>
         <translation>Ombreggiatura del DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="356" />
+        <location filename="../ui/layers.py" line="560"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="367" />
+        <location filename="../ui/layers.py" line="561"/>
         <source>Cameras</source>
         <translation>Camere</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="506" />
+        <location filename="../ui/layers.py" line="545"/>
         <source>Camera footprints</source>
         <translation>Impronte delle immagini</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="513" />
+        <location filename="../ui/layers.py" line="552"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Residui dei punti d'appoggio (vettori x{})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="429" />
+        <location filename="../ui/layers.py" line="562"/>
         <source>Point cloud</source>
         <translation>Nuvola di punti</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="439" />
+        <location filename="../ui/layers.py" line="568"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
@@ -1620,144 +1759,144 @@ OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="68" />
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="70" />
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71" />
-        <source>Ground control file (gcp_list.txt or CSV)</source>
-        <translation>File dei punti d'appoggio (gcp_list.txt o CSV)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="74" />
-        <source>Ground control point layer (one feature per observation)</source>
-        <translation>Layer dei punti d'appoggio (un elemento per misura)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="77" />
-        <source>Check points (comma-separated names)</source>
-        <translation>Punti di controllo (nomi separati da virgole)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="79" />
-        <source>Use EXIF GPS camera positions</source>
-        <translation>Usa le posizioni GPS EXIF delle camere</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="81" />
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="84" />
-        <source>Target CRS (default: the GCP file's, or the UTM zone of the GPS)</source>
-        <translation>SR di destinazione (predefinito: quello del file GCP o la zona UTM del GPS)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="86" />
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="88" />
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="90" />
-        <source>Largest image side for matching (0 = full size)</source>
-        <translation>Lato maggiore dell'immagine per la corrispondenza (0 = dimensione piena)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="93" />
-        <source>Refine camera calibration in the adjustment</source>
-        <translation>Affina la calibrazione della camera nella compensazione</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="95" />
-        <source>DSM resolution in metres (0 = automatic)</source>
-        <translation>Risoluzione del DSM in metri (0 = automatica)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="98" />
-        <source>Matching quality (image scale)</source>
-        <translation>Qualità della corrispondenza (scala dell'immagine)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="101" />
-        <source>Orthomosaic resolution (0 = ground sample distance)</source>
-        <translation>Risoluzione dell'ortomosaico (0 = GSD)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="104" />
-        <source>Blending across seamlines</source>
-        <translation>Sfumatura lungo le linee di giunzione</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107" />
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
         <source>Write the accuracy report</source>
         <translation>Scrivi il rapporto di accuratezza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="109" />
-        <source>Parallel workers for dense matching and tiles (0 = one per core)</source>
-        <translation>Processi paralleli per la correlazione densa e le tessere (0 = uno per core)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="112" />
-        <source>Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)</source>
-        <translation>Indirizzo dello scheduler Dask (vuoto = questo computer, oppure $ARCHAEOORTHO_DASK_SCHEDULER)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="117" />
+        <location filename="../processing_provider/run_pipeline.py" line="81"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="118" />
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="119" />
+        <location filename="../processing_provider/run_pipeline.py" line="83"/>
         <source>Accuracy report (HTML)</source>
         <translation>Rapporto di accuratezza (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="136" />
+        <location filename="../processing_provider/run_pipeline.py" line="101"/>
         <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Indicare punti di appoggio (GCPS o GCP_LAYER) e/o posizioni delle camere (CAMERA_POSITIONS o USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="165" />
+        <location filename="../processing_provider/run_pipeline.py" line="129"/>
         <source>Seconds per stage: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../ui/catalog.py" line="7"/>
         <source>Run pipeline</source>
         <translation>Esegui l'intera elaborazione</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7" />
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Ground control file</source>
+        <translation>File dei punti d'appoggio</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Ground control layer</source>
+        <translation>Layer dei punti d'appoggio</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Check points</source>
+        <translation>Punti di controllo</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Use EXIF GPS positions</source>
+        <translation>Usa le posizioni GPS EXIF</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Target CRS</source>
+        <translation>SR di destinazione</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Matching image size (px)</source>
+        <translation>Dimensione per la corrispondenza (px)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Refine camera calibration</source>
+        <translation>Affina la calibrazione della camera</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>DSM resolution (m)</source>
+        <translation>Risoluzione del DSM (m)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Matching quality</source>
+        <translation>Qualità della corrispondenza</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Orthomosaic resolution</source>
+        <translation>Risoluzione dell'ortomosaico</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Seam blending</source>
+        <translation>Sfumatura delle giunzioni</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Parallel workers</source>
+        <translation>Processi paralleli</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <source>Dask scheduler</source>
+        <translation>Scheduler Dask</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
         <source>The whole chain in one call, for batch use: Align images, Georeference, Build DSM, Build orthophoto and Accuracy report on one workspace. It calls the same functions as the single algorithms, and a re-run resumes (features, matches and dense pairs already computed are reused).
 
-IMAGES: folder of photos. WORKSPACE: the workspace folder.
-Georeferencing needs ground control (GCPS file or GCP_LAYER, CHECK_POINTS held out) and/or camera positions (CAMERA_POSITIONS CSV or USE_EXIF_GPS): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction.
+Folder of images: the photos. Workspace folder: where every product is written.
+Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction.
 The other parameters are those of the single stages (see their help); 0 means automatic.
-Outputs: DSM, ORTHOMOSAIC and REPORT (HTML), plus the key figures.</source>
+Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures.</source>
         <translation>L'intera elaborazione in una sola chiamata, per l'uso in batch: Allinea immagini, Georeferenzia, Crea DSM, Crea ortofoto e Rapporto di accuratezza su un solo spazio di lavoro. Chiama le stesse funzioni dei singoli algoritmi, e una nuova esecuzione riprende (caratteristiche, corrispondenze e coppie dense già calcolate vengono riutilizzate).
 
-IMAGES: cartella di foto. WORKSPACE: lo spazio di lavoro.
-La georeferenziazione richiede punti di appoggio (file GCPS o GCP_LAYER, CHECK_POINTS esclusi) e/o posizioni delle camere (CSV CAMERA_POSITIONS o USE_EXIF_GPS): senza di essi l'elaborazione viene rifiutata, perché un DSM richiede una scala metrica e una direzione verticale.
+Cartella delle immagini: le foto. Cartella dell'area di lavoro: dove sono scritti tutti i prodotti.
+La georeferenziazione richiede punti di appoggio (un file o un layer dei punti d'appoggio, punti di controllo esclusi) e/o posizioni delle camere (un CSV delle posizioni delle camere o Usa le posizioni GPS EXIF): senza di essi l'elaborazione viene rifiutata, perché un DSM richiede una scala metrica e una direzione verticale.
 Gli altri parametri sono quelli delle singole fasi (vedi il loro aiuto); 0 significa automatico.
-Risultati: DSM, ORTHOMOSAIC e REPORT (HTML), più le cifre principali.</translation>
+Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali.</translation>
     </message>
 </context>
 </TS>

@@ -26,15 +26,18 @@ class AlignImagesAlgorithm(AlgorithmBase):
     HELP = (
         "Structure from motion: SIFT features, pair selection, robust matching (RANSAC), incremental mapping "
         "with self-calibration (focal length, principal point, lens distortion) and a final bundle adjustment. "
-        "The result is stored in the WORKSPACE folder, which the following stages (Georeference, Build DSM, "
+        "The result is stored in the workspace folder, which the following stages (Georeference, Build DSM, "
         "Build orthophoto) take as input. A re-run resumes: features and matches already computed are reused.\n\n"
-        "PAIRING: 'auto' uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images "
+        "Pair selection: 'auto' uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images "
         "otherwise, and sequential pairs with loop pairs for larger sets without GPS.\n"
-        "CAMERA_MODEL: 'AUTO' estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with "
+        "Camera model: 'AUTO' estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with "
         "10 or more images, and a simpler radial model below.\n"
-        "FOCAL_MM and SENSOR_WIDTH_MM: interior orientation when EXIF is missing (scanned film): the focal "
-        "length and the width of the long side of the frame, in millimetres.\n"
-        "MAPPER (advanced): 'incremental' (COLMAP, the default) or 'global' (GLOMAP: rotation averaging and "
+        "Matching image size: the longest side the images are scaled to for matching (0 = full size). Features "
+        "per image: 0 = automatic (about 4000 per megapixel). Affine-invariant features help with oblique views "
+        "and are slower.\n"
+        "Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal "
+        "length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).\n"
+        "Mapper (advanced): 'incremental' (COLMAP, the default) or 'global' (GLOMAP: rotation averaging and "
         "global positioning, often faster on large blocks; a Cancel takes effect only when it has finished)."
     )
 
@@ -45,12 +48,11 @@ class AlignImagesAlgorithm(AlgorithmBase):
             params.workspace_destination(self.WORKSPACE, self.tr("Workspace folder")),
             params.pairing(self.PAIRING, self.tr("Pair selection")),
             params.camera_model(self.CAMERA_MODEL, self.tr("Camera model")),
-            params.max_image_size(self.MAX_IMAGE_SIZE, self.tr("Largest image side for matching (0 = full size)")),
-            params.integer(self.MAX_FEATURES, self.tr(
-                "Largest number of features per image (0 = auto, ~4000 per megapixel)")),
-            params.flag(self.AFFINE_FEATURES, self.tr("Affine-invariant features (oblique views; slower)")),
-            params.number(self.FOCAL_MM, self.tr("Focal length in mm when EXIF is missing (0 = from EXIF)")),
-            params.number(self.SENSOR_WIDTH_MM, self.tr("Sensor (frame) width in mm, long side (0 = unknown)")),
+            params.max_image_size(self.MAX_IMAGE_SIZE, self.tr("Matching image size (px)")),
+            params.integer(self.MAX_FEATURES, self.tr("Features per image")),
+            params.flag(self.AFFINE_FEATURES, self.tr("Affine-invariant features")),
+            params.number(self.FOCAL_MM, self.tr("Focal length (mm)")),
+            params.number(self.SENSOR_WIDTH_MM, self.tr("Sensor width (mm)")),
             params.flag(self.SINGLE_CAMERA, self.tr("One camera for all images")),
             *params.advanced(params.choice(self.MAPPER, self.tr("Mapper"), MAPPERS)),
         )

@@ -112,6 +112,7 @@ class AlgorithmBase(QgsProcessingAlgorithm):
     GROUP = "Photogrammetry"
     STYLE_OUTPUTS = True  # a subclass sets False to leave its outputs as QGIS loads them
     REQUIRES = ("pycolmap", "cv2")  # import names checked before processAlgorithm runs (fail fast, headless too)
+    HELP_SECTION = ""  # the README heading of the algorithm's section; default: the one naming `archaeoortho:NAME`
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -152,6 +153,10 @@ class AlgorithmBase(QgsProcessingAlgorithm):
     def shortHelpString(self):  # noqa: N802 (QGIS API name)
         return self.tr(self.HELP)
 
+    def helpUrl(self):  # noqa: N802 (QGIS API name)
+        """The README section of this algorithm on the project page (the dialog's Help button)."""
+        return help_url(self.NAME, self.HELP_SECTION)
+
     def createInstance(self):  # noqa: N802 (QGIS API name)
         return type(self)()
 
@@ -162,6 +167,47 @@ class AlgorithmBase(QgsProcessingAlgorithm):
         A user-facing error (core.common.errors.ArchaeoOrthoError, a missing package) becomes its message;
         anything else is a bug: its traceback goes to the log first, then it fails the run (never QGIS)."""
         return call_core(func, *args, **kwargs)
+
+
+PLUGIN_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DEFAULT_HOMEPAGE = "https://github.com/archaeoortho/archaeoortho"
+
+
+def _homepage():
+    import configparser
+
+    parser = configparser.ConfigParser(interpolation=None)
+    try:
+        parser.read(os.path.join(PLUGIN_DIR, "metadata.txt"), encoding="utf-8")
+        return parser.get("general", "homepage", fallback=DEFAULT_HOMEPAGE).rstrip("/")
+    except (OSError, configparser.Error):
+        return DEFAULT_HOMEPAGE
+
+
+def heading_anchor(heading):
+    """The anchor GitHub gives a Markdown heading: lower case, punctuation dropped, spaces as hyphens."""
+    import re
+
+    text = re.sub(r"[^\w\- ]", "", heading.strip().lower())
+    return text.replace(" ", "-")
+
+
+def readme_headings():
+    try:
+        with open(os.path.join(PLUGIN_DIR, "README.md"), encoding="utf-8") as f:
+            return [line.lstrip("#").strip() for line in f if line.startswith("## ")]
+    except OSError:
+        return []
+
+
+def help_url(name, section=""):
+    """``<homepage>#<anchor>`` of the README section ``section`` (default: the heading naming
+    `archaeoortho:<name>`); the README's top when there is none."""
+    headings = readme_headings()
+    heading = section if section in headings else next(
+        (h for h in headings if f"`archaeoortho:{name}`" in h), "")
+    base = _homepage()
+    return f"{base}#{heading_anchor(heading)}" if heading else f"{base}#readme"
 
 
 def call_core(func, *args, **kwargs):

@@ -33,6 +33,7 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
     RESOLUTION_USED = "RESOLUTION_USED"
     IMAGES_USED = "IMAGES_USED"
     BLENDINGS = params.BLENDINGS
+    OUTPUT_KINDS = {OUTPUT: "ortho"}  # the output's style and layer name (ui/layers.py): its id does not say
     INTERPOLATIONS = params.INTERPOLATIONS
     HELP = (
         "True orthophotos and the orthomosaic of a georeferenced workspace.\n\n"
@@ -42,44 +43,44 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
         "the mosaic fills it from an image that sees it. Each part of the mosaic comes from the image that looks "
         "at it most vertically and closest to its centre; seamlines go around buildings and trees; brightness "
         "differences between images are evened out and seams blended.\n\n"
-        "WORKSPACE: a georeferenced workspace with a DSM (run 'Build DSM' first), or give DSM.\n"
+        "Georeferenced workspace: a workspace with a DSM (run 'Build DSM' first), or give a DSM.\n"
         "DSM: optional raster (e.g. an ALS DSM, in any CRS: reprojected on the fly); default the workspace DSM.\n"
-        "IMAGES_FILTER: a subset, e.g. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' or 'group:NIR' "
+        "Images: a subset, e.g. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' or 'group:NIR' "
         "(a camera group by id or by make/model), '!name' to leave one out. Empty: all images.\n"
-        "RESOLUTION: cell size in CRS units; 0 = the images' ground sample distance.\n"
-        "BLENDING: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness "
+        "Resolution: cell size in CRS units; 0 = the images' ground sample distance.\n"
+        "Seam blending: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness "
         "and no ghosting), none (hard cut).\n"
-        "OUTPUT: Cloud-Optimized GeoTIFF with overviews, the images' bands and data type (8/16 bit kept) plus "
+        "Orthomosaic: Cloud-Optimized GeoTIFF with overviews, the images' bands and data type (8/16 bit kept) plus "
         "an alpha band (default <workspace>/orthomosaic.tif).\n"
-        "PER_IMAGE_FOLDER: optional folder for one true orthophoto per image (COG).\n"
-        "SEAMLINES: optional GeoPackage of polygons naming the image each part of the mosaic comes from.\n"
-        "DASK_SCHEDULER: render the tiles on a Dask cluster (tcp://host:8786) whose workers see the workspace path."
+        "Per-image orthophotos folder: optional folder for one true orthophoto per image (COG).\n"
+        "Seamlines: optional GeoPackage of polygons naming the image each part of the mosaic comes from.\n"
+        "Dask scheduler (advanced): render the tiles on a Dask cluster (tcp://host:8786) whose workers see the "
+        "workspace path; empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
         params.add(
             self,
-            params.folder(self.WORKSPACE, self.tr("Workspace folder (georeferenced, with a DSM)")),
-            QgsProcessingParameterRasterLayer(self.DSM, self.tr("DSM (default: the workspace DSM)"), optional=True),
+            params.folder(self.WORKSPACE, self.tr("Georeferenced workspace")),
+            QgsProcessingParameterRasterLayer(self.DSM, self.tr("DSM"), optional=True),
             QgsProcessingParameterString(
-                self.IMAGES_FILTER, self.tr("Images (names, wildcards or group:<camera>; empty = all)"),
+                self.IMAGES_FILTER, self.tr("Images"),
                 defaultValue="", optional=True),
-            params.number(self.RESOLUTION, self.tr("Resolution in CRS units (0 = ground sample distance)")),
-            params.blending(self.BLENDING, self.tr("Blending across seamlines")),
+            params.number(self.RESOLUTION, self.tr("Resolution")),
+            params.blending(self.BLENDING, self.tr("Seam blending")),
             *params.advanced(
-                params.choice(self.INTERPOLATION, self.tr("Resampling of the images"), self.INTERPOLATIONS),
-                params.workers(self.WORKERS, self.tr("Parallel tile workers (0 = one per core)"), default=1),
-                params.scheduler(self.SCHEDULER, self.tr(
-                    "Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)"))),
+                params.choice(self.INTERPOLATION, self.tr("Resampling"), self.INTERPOLATIONS),
+                params.workers(self.WORKERS, self.tr("Parallel tile workers"), default=1),
+                params.scheduler(self.SCHEDULER, self.tr("Dask scheduler"))),
         )
         self.addParameter(QgsProcessingParameterRasterDestination(
-            self.OUTPUT, self.tr("Orthomosaic (default: <workspace>/orthomosaic.tif)"), optional=True,
+            self.OUTPUT, self.tr("Orthomosaic"), optional=True,
             createByDefault=False))
         self.addParameter(QgsProcessingParameterFolderDestination(
-            self.PER_IMAGE_FOLDER, self.tr("Folder for per-image true orthophotos"), optional=True,
+            self.PER_IMAGE_FOLDER, self.tr("Per-image orthophotos folder"), optional=True,
             createByDefault=False))
         self.addParameter(QgsProcessingParameterVectorDestination(
-            self.SEAMLINES, self.tr("Seamlines (which image, GeoPackage)"), optional=True, createByDefault=False))
+            self.SEAMLINES, self.tr("Seamlines"), optional=True, createByDefault=False))
         self.addOutput(QgsProcessingOutputFolder(self.OUT_WORKSPACE, self.tr("Workspace")))
         self.addOutput(QgsProcessingOutputNumber(self.VALID_FRACTION, self.tr("Share of mosaic cells with data")))
         self.addOutput(QgsProcessingOutputNumber(self.RESOLUTION_USED, self.tr("Resolution used")))
@@ -98,7 +99,7 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
             per_image = self.parameterAsFileOutput(parameters, self.PER_IMAGE_FOLDER, context) or None
         seamlines = self.parameterAsOutputLayer(parameters, self.SEAMLINES, context) or None
         if seamlines and not seamlines.lower().endswith(".gpkg"):
-            raise QgsProcessingException(self.tr("SEAMLINES must be a GeoPackage (.gpkg) file, got {}").format(
+            raise QgsProcessingException(self.tr("Seamlines must be a GeoPackage (.gpkg) file, got {}").format(
                 seamlines))
         options = OrthoOptions(
             interpolation=params.read_choice(self, parameters, self.INTERPOLATION, context, self.INTERPOLATIONS),

@@ -31,25 +31,28 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         "and/or camera positions, used inside the bundle adjustment so that they also remove the block's "
         "drift and bending, which a 7-parameter (Helmert) transform cannot. Check points take no part in the "
         "adjustment: they are triangulated afterwards and compared with their surveyed coordinates.\n\n"
-        "GCPS: an OpenDroneMap gcp_list.txt (CRS line, then 'x y z px py image [name]') or a CSV points file "
-        "with a matching '<name>_observations.csv'. GCP_LAYER: alternatively a point layer with one feature per "
+        "Ground control file: an OpenDroneMap gcp_list.txt (CRS line, then 'x y z px py image [name]') or a CSV points file "
+        "with a matching '<name>_observations.csv'. Ground control layer: alternatively a point layer with one feature per "
         "observation and fields name, image, px, py (optional z, sx, sy, sz, role).\n"
-        "CHECK_POINTS: comma-separated names that become check points.\n"
-        "CAMERA_POSITIONS: CSV 'image,x,y,z[,sigma]' (optional CRS line). USE_EXIF_GPS: use the photos' GPS.\n"
+        "Check points: comma-separated names that become check points.\n"
+        "Camera positions: CSV 'image,x,y,z[,sigma]' (optional CRS line). Use EXIF GPS positions: use the photos' "
+        "GPS.\n"
+        "Target CRS: default the ground control file's. Refine camera calibration: let the adjustment refine "
+        "focal length, principal point and distortion.\n"
         "Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
         params.add(
             self,
-            params.folder(self.WORKSPACE, self.tr("Workspace folder (aligned)")),
-            params.gcp_file(self.GCPS, self.tr("Ground control file (gcp_list.txt or CSV)")),
-            params.gcp_layer(self.GCP_LAYER, self.tr("Ground control point layer (one feature per observation)")),
-            params.check_points(self.CHECK_POINTS, self.tr("Check points (comma-separated names)")),
+            params.folder(self.WORKSPACE, self.tr("Aligned workspace")),
+            params.gcp_file(self.GCPS, self.tr("Ground control file")),
+            params.gcp_layer(self.GCP_LAYER, self.tr("Ground control layer")),
+            params.check_points(self.CHECK_POINTS, self.tr("Check points")),
             params.camera_positions(self.CAMERA_POSITIONS, self.tr("Camera positions (CSV)")),
-            params.flag(self.USE_EXIF_GPS, self.tr("Use EXIF GPS camera positions")),
-            params.target_crs(self.CRS, self.tr("Target CRS (default: the GCP file's)")),
-            params.flag(self.REFINE_INTRINSICS, self.tr("Refine camera calibration in the adjustment")),
+            params.flag(self.USE_EXIF_GPS, self.tr("Use EXIF GPS positions")),
+            params.target_crs(self.CRS, self.tr("Target CRS")),
+            params.flag(self.REFINE_INTRINSICS, self.tr("Refine camera calibration")),
         )
         self.addOutput(QgsProcessingOutputFolder(self.OUT_WORKSPACE, self.tr("Workspace")))
         self.addOutput(QgsProcessingOutputVectorLayer(self.RESIDUALS, self.tr("GCP residuals")))

@@ -15,6 +15,7 @@ from .params import BLENDINGS, CAMERA_MODELS, PAIRINGS, QUALITIES
 class RunPipelineAlgorithm(AlgorithmBase):
     NAME = "runpipeline"
     DISPLAY = "Run pipeline"
+    HELP_SECTION = "The whole chain: Run pipeline and the shipped model"
     IMAGES = "IMAGES"
     WORKSPACE = "WORKSPACE"
     GCPS = "GCPS"
@@ -45,12 +46,12 @@ class RunPipelineAlgorithm(AlgorithmBase):
         "The whole chain in one call, for batch use: Align images, Georeference, Build DSM, Build orthophoto "
         "and Accuracy report on one workspace. It calls the same functions as the single algorithms, and a "
         "re-run resumes (features, matches and dense pairs already computed are reused).\n\n"
-        "IMAGES: folder of photos. WORKSPACE: the workspace folder.\n"
-        "Georeferencing needs ground control (GCPS file or GCP_LAYER, CHECK_POINTS held out) and/or camera "
-        "positions (CAMERA_POSITIONS CSV or USE_EXIF_GPS): without them the pipeline refuses, since a DSM needs a "
-        "metric scale and a vertical direction.\n"
+        "Folder of images: the photos. Workspace folder: where every product is written.\n"
+        "Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera "
+        "positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a "
+        "DSM needs a metric scale and a vertical direction.\n"
         "The other parameters are those of the single stages (see their help); 0 means automatic.\n"
-        "Outputs: DSM, ORTHOMOSAIC and REPORT (HTML), plus the key figures."
+        "Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
@@ -58,25 +59,24 @@ class RunPipelineAlgorithm(AlgorithmBase):
             self,
             params.folder(self.IMAGES, self.tr("Folder of images")),
             params.workspace_destination(self.WORKSPACE, self.tr("Workspace folder")),
-            params.gcp_file(self.GCPS, self.tr("Ground control file (gcp_list.txt or CSV)")),
-            params.gcp_layer(self.GCP_LAYER, self.tr("Ground control point layer (one feature per observation)")),
-            params.check_points(self.CHECK_POINTS, self.tr("Check points (comma-separated names)")),
-            params.flag(self.USE_EXIF_GPS, self.tr("Use EXIF GPS camera positions")),
+            params.gcp_file(self.GCPS, self.tr("Ground control file")),
+            params.gcp_layer(self.GCP_LAYER, self.tr("Ground control layer")),
+            params.check_points(self.CHECK_POINTS, self.tr("Check points")),
+            params.flag(self.USE_EXIF_GPS, self.tr("Use EXIF GPS positions")),
             params.camera_positions(self.CAMERA_POSITIONS, self.tr("Camera positions (CSV)")),
-            params.target_crs(self.CRS, self.tr("Target CRS (default: the GCP file's, or the UTM zone of the GPS)")),
+            params.target_crs(self.CRS, self.tr("Target CRS")),
             params.pairing(self.PAIRING, self.tr("Pair selection")),
             params.camera_model(self.CAMERA_MODEL, self.tr("Camera model")),
-            params.max_image_size(self.MAX_IMAGE_SIZE, self.tr("Largest image side for matching (0 = full size)")),
-            params.flag(self.REFINE_INTRINSICS, self.tr("Refine camera calibration in the adjustment")),
-            params.dsm_resolution(self.DSM_RESOLUTION, self.tr("DSM resolution in metres (0 = automatic)")),
-            params.quality(self.QUALITY, self.tr("Matching quality (image scale)")),
-            params.number(self.ORTHO_RESOLUTION, self.tr("Orthomosaic resolution (0 = ground sample distance)")),
-            params.blending(self.BLENDING, self.tr("Blending across seamlines")),
+            params.max_image_size(self.MAX_IMAGE_SIZE, self.tr("Matching image size (px)")),
+            params.flag(self.REFINE_INTRINSICS, self.tr("Refine camera calibration")),
+            params.dsm_resolution(self.DSM_RESOLUTION, self.tr("DSM resolution (m)")),
+            params.quality(self.QUALITY, self.tr("Matching quality")),
+            params.number(self.ORTHO_RESOLUTION, self.tr("Orthomosaic resolution")),
+            params.blending(self.BLENDING, self.tr("Seam blending")),
             params.flag(self.REPORT_ENABLED, self.tr("Write the accuracy report"), default=True),
             *params.advanced(
-                params.workers(self.WORKERS, self.tr("Parallel workers for dense matching and tiles (0 = one per core)")),
-                params.scheduler(self.SCHEDULER, self.tr(
-                    "Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)"))),
+                params.workers(self.WORKERS, self.tr("Parallel workers")),
+                params.scheduler(self.SCHEDULER, self.tr("Dask scheduler"))),
         )
         self.addOutput(QgsProcessingOutputRasterLayer(self.DSM, self.tr("DSM")))
         self.addOutput(QgsProcessingOutputRasterLayer(self.ORTHOMOSAIC, self.tr("Orthomosaic")))

@@ -145,7 +145,7 @@ class GcpTasks:
             return []
         root = self.store.root
         lay = self.store.layout
-        group = translate("GcpDock", "ArchaeoOrtho: {}").format(os.path.basename(os.path.normpath(root)))
+        group = layers.workspace_group_name(root)
         project = QgsProject.instance()
         out = []
         kinds = kinds or ("dsm", "ortho", "cameras", "residuals")

@@ -452,8 +452,7 @@ def load_point_cloud(path, project=None, group=None, name=None):
 def load_workspace_results(workspace, project=None, group=None):
     """Every product a workspace holds, styled: DSM, orthomosaic, cameras + footprints, residuals."""
     project = project or QgsProject.instance()
-    group = group or QCoreApplication.translate("ResultLayers", "ArchaeoOrtho: {}").format(
-        os.path.basename(os.path.normpath(workspace)))
+    group = group or workspace_group_name(workspace)
     loaded = []
     lay = workspace_layout(workspace)
     candidates = [
@@ -521,12 +520,18 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
         project = context.project() or QgsProject.instance()
         path = layer.source().split("|")[0]
         layer.setCustomProperty(PATH_PROPERTY, path)
+        group = workspace_group_name(self.workspace) if self.workspace else None
+        if group:  # with the workspace's other layers (the dock's Load results puts them there too); first, so
+            # that a hillshade or footprints added below go on top of it
+            _replace_older(project, layer, path, self.kind)
+            move_to_group(project, layer, group)
         if self.kind == DSM:
             style_dsm(layer)
+            remove_loaded(project, path, (HILLSHADE,))
             shade = QgsRasterLayer(path, QCoreApplication.translate("ResultLayers", "DSM hillshade"))
             if shade.isValid():
                 style_hillshade(shade)
-                add_layer(project, shade, None, path)
+                add_layer(project, shade, group, path)
         elif self.kind == ORTHO:
             style_orthomosaic(layer)
         elif self.kind == CAMERAS:
@@ -537,7 +542,7 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
                 fl = QgsVectorLayer(foot, QCoreApplication.translate("ResultLayers", "Camera footprints"), "ogr")
                 if fl.isValid():
                     style_footprints(fl)
-                    add_layer(project, fl, None, foot)
+                    add_layer(project, fl, group, foot)
         elif self.kind == RESIDUALS:
             style_residuals(layer)
             factor = layer.customProperty("archaeoortho/exaggeration", 1.0)
@@ -545,6 +550,45 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
                 f"{float(factor):g}"))
         elif self.kind == POINT_CLOUD:
             _mark(layer, POINT_CLOUD)
+        name = _output_layer_name(self.kind)
+        if name:  # not the parameter's label ("Orthomosaic (default: <workspace>/orthomosaic.tif)")
+            layer.setName(name)
+
+
+def _output_layer_name(kind):
+    names = {DSM: QCoreApplication.translate("ResultLayers", "DSM"),
+             ORTHO: QCoreApplication.translate("ResultLayers", "Orthomosaic"),
+             CAMERAS: QCoreApplication.translate("ResultLayers", "Cameras"),
+             POINT_CLOUD: QCoreApplication.translate("ResultLayers", "Point cloud")}
+    return names.get(kind)
+
+
+def workspace_group_name(workspace):
+    """The layer-tree group of a workspace's layers: 'ArchaeoOrtho: <folder name>'."""
+    return QCoreApplication.translate("ResultLayers", "ArchaeoOrtho: {}").format(
+        os.path.basename(os.path.normpath(workspace)))
+
+
+def _replace_older(project, layer, path, kind):
+    """A re-run's product replaces the layer an earlier run (or Load results) loaded from the same file."""
+    target = _norm(path)
+    drop = [other.id() for other in project.mapLayers().values()
+            if other.id() != layer.id() and _norm(other.customProperty(PATH_PROPERTY, "")) == target
+            and other.customProperty(KIND_PROPERTY, "") == kind]
+    if drop:
+        project.removeMapLayers(drop)
+
+
+def move_to_group(project, layer, group_name):
+    """Move ``layer``'s node to the top of the group ``group_name`` (made when missing)."""
+    root = project.layerTreeRoot()
+    node = root.findLayer(layer.id())
+    group = _group(project, group_name)
+    if node is None or group is None or node.parent() is group:
+        return
+    parent = node.parent()
+    group.insertChildNode(0, node.clone())
+    parent.removeChildNode(node)
 
 
 def register_outputs(alg, results, context):
@@ -565,7 +609,7 @@ def register_outputs(alg, results, context):
     for name, value in results.items():
         if not isinstance(value, str) or not value or not os.path.exists(value.split("|")[0]):
             continue
-        kind = output_kind(name, value)
+        kind = getattr(alg, "OUTPUT_KINDS", {}).get(name) or output_kind(name, value)
         if kind is None:
             continue
         out_def = alg.outputDefinition(name)

@@ -1,0 +1,226 @@
+"""Processing dialogs as a new user meets them: every '…' browse button and label is visible at the dialog's
+default size (English and German), the help names parameters by the labels the form shows, and the help
+link opens the README section of the algorithm."""
+import os
+import re
+
+import pytest
+
+from tests.conftest import ROOT
+
+pytestmark = pytest.mark.usefixtures("qgis_processing")
+
+_KEEP = []
+DIALOG_ALGORITHMS = ("alignimages", "georeference", "runpipeline", "buildorthophoto")
+
+
+@pytest.fixture(scope="module")
+def plugin(qgis_iface, qgis_processing):
+    import archaeoortho
+
+    p = archaeoortho.classFactory(qgis_iface)
+    p.initProcessing()
+    yield p
+    p.unload()
+
+
+def _dialog(alg_id):
+    from processing.gui import ParametersPanel
+    from processing.gui.AlgorithmDialog import AlgorithmDialog
+    from qgis.core import QgsApplication
+    from qgis.gui import QgsBrowserGuiModel
+
+    if ParametersPanel.iface is not None:  # pytest-qgis's interface has no browser model: a real one
+        model = QgsBrowserGuiModel()
+        model.initialize()
+        _KEEP.append(model)
+        ParametersPanel.iface.browserModel = lambda: model
+
+    alg = QgsApplication.processingRegistry().algorithmById(alg_id)
+    assert alg is not None, alg_id
+    return AlgorithmDialog(alg.create(), False, None)
+
+
+def _process(ms=100):
+    import time
+
+    from qgis.PyQt.QtCore import QCoreApplication
+
+    end = time.time() + ms / 1000.0
+    while time.time() < end:
+        QCoreApplication.processEvents()
+
+
+def hidden_in_dialog(alg_id):
+    """[(what, how far past the right edge in px)] for the browse buttons and labels of the dialog's
+    parameters panel at its default size."""
+    from qgis.gui import QgsFileWidget
+    from qgis.PyQt.QtWidgets import QLabel, QScrollArea, QToolButton
+
+    dlg = _dialog(alg_id)
+    try:
+        dlg.show()
+        _process(200)
+        area = max(dlg.findChildren(QScrollArea), key=lambda a: a.width() * a.height())
+        viewport = area.viewport()
+        right = viewport.width()
+        out = []
+        for fw in dlg.findChildren(QgsFileWidget):
+            for b in fw.findChildren(QToolButton):
+                if not b.isVisibleTo(dlg):
+                    continue
+                x = b.mapTo(viewport, b.rect().topRight()).x()
+                if x > right:
+                    out.append((f"browse button of {fw.parent().objectName() or fw.objectName()}", x - right))
+        for label in area.widget().findChildren(QLabel):
+            if not label.isVisibleTo(dlg) or not label.text():
+                continue
+            x = label.mapTo(viewport, label.rect().topRight()).x()
+            if x > right + 1 and not label.wordWrap():
+                out.append((f"label {label.text()!r}", x - right))
+        return out, (dlg.width(), dlg.height(), right)
+    finally:
+        dlg.close()
+        dlg.deleteLater()
+
+
+@pytest.mark.parametrize("alg", DIALOG_ALGORITHMS)
+def test_browse_buttons_and_labels_visible_at_default_size(plugin, alg):
+    hidden, size = hidden_in_dialog("archaeoortho:" + alg)
+    print(f"\n[{alg}] dialog {size[0]} x {size[1]}, panel {size[2]} px wide; hidden: {hidden}")
+    assert hidden == []
+
+
+@pytest.fixture
+def german():
+    """The German translation installed (as the plugin does for a German QGIS); the algorithms' labels are
+    made when an instance is created, so a dialog opened now is German."""
+    from qgis.PyQt.QtCore import QCoreApplication, QTranslator
+
+    qm = os.path.join(ROOT, "i18n", "archaeoortho_de.qm")
+    if not os.path.exists(qm):
+        pytest.skip("no compiled German translation (make transcompile)")
+    t = QTranslator()
+    assert t.load(qm)
+    QCoreApplication.installTranslator(t)
+    yield t
+    QCoreApplication.removeTranslator(t)
+
+
+@pytest.mark.parametrize("alg", DIALOG_ALGORITHMS)
+def test_browse_buttons_and_labels_visible_in_german(plugin, german, alg):
+    from qgis.core import QgsApplication
+
+    a = QgsApplication.processingRegistry().algorithmById("archaeoortho:" + alg).create()
+    assert a.parameterDefinition("WORKSPACE").description() != "Workspace folder"  # German
+    hidden, size = hidden_in_dialog("archaeoortho:" + alg)
+    print(f"\n[{alg}, de] dialog {size[0]} x {size[1]}, panel {size[2]} px wide; hidden: {hidden}")
+    assert hidden == []
+
+
+def _ids_in(text, alg):
+    """Parameter and output ids (PAIRING, CAMERA_MODEL) written in ``text``; DSM and CRS are words too."""
+    names = {p.name() for p in alg.parameterDefinitions()} | {o.name() for o in alg.outputDefinitions()}
+    names -= {"DSM", "CRS"}
+    return sorted(n for n in names if re.search(rf"\b{re.escape(n)}\b", text))
+
+
+@pytest.mark.parametrize("alg", DIALOG_ALGORITHMS)
+def test_help_names_parameters_by_their_labels(plugin, alg):
+    """The form shows labels, never ids: the help text must not speak of PAIRING or CAMERA_MODEL, and the
+    labels it names are the form's."""
+    from qgis.core import QgsApplication
+
+    a = QgsApplication.processingRegistry().algorithmById("archaeoortho:" + alg).create()
+    text = a.shortHelpString()
+    assert _ids_in(text, a) == []
+    labels = {p.description() for p in a.parameterDefinitions()}
+    named = [line.split(":")[0].replace(" (advanced)", "") for line in text.split("\n")
+             if ":" in line and len(line.split(":")[0]) < 40 and line[:1].isupper()]
+    unknown = [n for n in named if not any(n in lab or lab in n for lab in labels)
+               and n not in ("Structure from motion", "Outputs")]
+    assert not [u for u in unknown if " and " not in u], (alg, unknown)
+
+
+@pytest.mark.parametrize("alg", DIALOG_ALGORITHMS)
+def test_help_in_german_uses_the_german_labels(plugin, german, alg):
+    from qgis.core import QgsApplication
+
+    a = QgsApplication.processingRegistry().algorithmById("archaeoortho:" + alg).create()
+    assert a.shortHelpString() != a.HELP  # translated
+    assert _ids_in(a.shortHelpString(), a) == []
+
+
+def test_help_url_opens_the_readme_section(plugin):
+    from archaeoortho.processing_provider.base import heading_anchor, readme_headings
+    from qgis.core import QgsApplication
+
+    headings = {heading_anchor(h): h for h in readme_headings()}
+    assert heading_anchor("Align images (`archaeoortho:alignimages`)") == "align-images-archaeoorthoalignimages"
+    provider = QgsApplication.processingRegistry().providerById("archaeoortho")
+    for a in provider.algorithms():
+        url = a.helpUrl()
+        assert url.startswith("https://github.com/archaeoortho/archaeoortho#"), (a.id(), url)
+        anchor = url.split("#", 1)[1]
+        if a.name() in DIALOG_ALGORITHMS or f"`archaeoortho:{a.name()}`" in "".join(headings.values()):
+            assert anchor in headings, (a.id(), url)
+    by_id = {a.name(): a.helpUrl().split("#", 1)[1] for a in provider.algorithms()}
+    assert headings[by_id["runpipeline"]].startswith("The whole chain")
+    assert "archaeoortho:buildorthophoto" in headings[by_id["buildorthophoto"]]
+
+
+def test_build_orthophoto_output_is_named_orthomosaic_in_the_workspace_group(plugin, tmp_path, qgis_new_project):
+    """As the toolbox dialog loads a ticked destination: the layer is 'Orthomosaic' (not the parameter's label
+    'Orthomosaic (default: <workspace>/orthomosaic.tif)') and sits in the workspace's group with its other
+    layers; a re-run replaces it."""
+    from archaeoortho.ui import layers
+    from processing.gui.Postprocessing import handleAlgorithmResults
+    from qgis.core import (
+        QgsApplication,
+        QgsProcessingContext,
+        QgsProcessingFeedback,
+        QgsProject,
+        QgsRasterLayer,
+    )
+
+    from tests.test_ui_layers import _raster
+
+    ws = tmp_path / "Site 7"
+    ws.mkdir()
+    path = _raster(str(ws / "orthomosaic.tif"), 4, alpha=True)
+    project = QgsProject.instance()
+    # the workspace's group exists already (the dock's Load results made it) with an older orthomosaic
+    older = layers.load_orthomosaic(path, project, layers.workspace_group_name(str(ws)))
+    assert len(older) == 1
+    alg = QgsApplication.processingRegistry().algorithmById("archaeoortho:buildorthophoto")
+
+    class Feedback(QgsProcessingFeedback):
+        def __init__(self):
+            super().__init__()
+            self.infos = []
+
+        def pushInfo(self, info):  # noqa: N802 (QGIS API name)
+            self.infos.append(info)
+
+    def run_dialog_loading():
+        ctx = QgsProcessingContext()
+        ctx.setProject(project)
+        out = alg.outputDefinition("OUTPUT")
+        details = QgsProcessingContext.LayerDetails(out.description(), project, "OUTPUT")
+        ctx.addLayerToLoadOnCompletion(path, details)  # the dialog's "Open output file after running"
+        results = {"WORKSPACE": str(ws), "OUTPUT": path, "VALID_FRACTION": 1.0}
+        feedback = Feedback()
+        assert alg.register_styled_outputs(results, ctx, feedback) == 1, feedback.infos
+        assert handleAlgorithmResults(alg, ctx, QgsProcessingFeedback(), parameters={"OUTPUT": path})
+
+    run_dialog_loading()
+    run_dialog_loading()  # a re-run
+    loaded = [lyr for lyr in project.mapLayers().values() if isinstance(lyr, QgsRasterLayer)]
+    assert [lyr.name() for lyr in loaded] == ["Orthomosaic"]
+    root = project.layerTreeRoot()
+    group = root.findGroup("ArchaeoOrtho: Site 7")
+    assert group is not None
+    node = root.findLayer(loaded[0].id())
+    assert node.parent() is group
+    assert loaded[0].renderer().type() == "multibandcolor"
+    assert [n.name() for n in root.children()] == ["ArchaeoOrtho: Site 7"]
