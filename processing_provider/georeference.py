@@ -21,6 +21,7 @@ class GeoreferenceAlgorithm(AlgorithmBase):
     USE_EXIF_GPS = "USE_EXIF_GPS"
     CRS = "CRS"
     REFINE_INTRINSICS = "REFINE_INTRINSICS"
+    GCPS_UPRIGHT = "GCPS_UPRIGHT"
     OUT_WORKSPACE = "WORKSPACE"  # the same name as the input: models chain stages through it
     RESIDUALS = "RESIDUALS"
     CAMERAS = "CAMERAS"
@@ -53,6 +54,7 @@ class GeoreferenceAlgorithm(AlgorithmBase):
             params.flag(self.USE_EXIF_GPS, self.tr("Use EXIF GPS positions")),
             params.target_crs(self.CRS, self.tr("Target CRS")),
             params.flag(self.REFINE_INTRINSICS, self.tr("Refine camera calibration")),
+            params.flag(self.GCPS_UPRIGHT, self.tr("GCP pixels measured on upright photos")),
         )
         self.addOutput(QgsProcessingOutputFolder(self.OUT_WORKSPACE, self.tr("Workspace")))
         self.addOutput(QgsProcessingOutputVectorLayer(self.RESIDUALS, self.tr("GCP residuals")))
@@ -80,7 +82,7 @@ class GeoreferenceAlgorithm(AlgorithmBase):
             camera_positions_path=positions,
             use_exif_gps=self.parameterAsBoolean(parameters, self.USE_EXIF_GPS, context),
             crs=crs_text, refine_intrinsics=self.parameterAsBoolean(parameters, self.REFINE_INTRINSICS, context),
-            progress=progress)
+            progress=progress, gcps_upright=self.parameterAsBoolean(parameters, self.GCPS_UPRIGHT, context))
         progress.push_result(result.warnings)
         for o in result.outliers:
             feedback.pushWarning(self.tr("outlier left out: {}").format(o))

@@ -216,3 +216,166 @@ def test_upright_conversion_of_a_gcp_set_and_its_errors(copr_rotated):
     # orientation 1 photos are left as they are
     same = gcpmod.read_gcps(gcp_file, image_sizes={ROTATED: (1200, 800)}, upright_orientations={ROTATED: 1})
     assert [(o.x, o.y) for p in same.points for o in p.observations] == [(x, y) for _, x, y in obs]
+
+
+# --------------------------------------------------------------------------------------------------
+# the GCP dock: an orientation-6 photo shown upright, clicks and imports mapped to the stored grid
+# --------------------------------------------------------------------------------------------------
+
+OCHOTA_PHOTO = "img_3006.jpg"
+# a white object in the middle of the fenced field, in the upright 1/4-scale copy (864 x 1152 upright)
+OCHOTA_TARGET = (481.0, 545.0)
+
+
+@pytest.fixture(scope="module")
+def ochota_quarter(tmp_path_factory):
+    """A 1/4-scale copy of an ochota_kap photo (the JPEG's own 1/4 decode: 1152 x 864 stored) that keeps its
+    EXIF orientation 6."""
+    from osgeo import gdal
+
+    src = os.path.join(shared("ochota_kap", "images"), OCHOTA_PHOTO)
+    ds = gdal.Open(src)
+    assert ds.GetMetadataItem("EXIF_Orientation") == "6"
+    ov = [ds.GetRasterBand(b + 1).GetOverview(1) for b in range(3)]
+    d = tmp_path_factory.mktemp("ochota quarter")
+    os.makedirs(d / "images")
+    mem = gdal.GetDriverByName("MEM").Create("", ov[0].XSize, ov[0].YSize, 3, gdal.GDT_Byte)
+    for b in range(3):
+        mem.GetRasterBand(b + 1).WriteArray(ov[b].ReadAsArray())
+    mem.SetMetadataItem("EXIF_Orientation", "6")
+    path = str(d / "images" / OCHOTA_PHOTO)
+    gdal.GetDriverByName("JPEG").CreateCopy(path, mem, options=["QUALITY=95"])
+    return path
+
+
+def _ochota_workspace(root, path):
+    """A workspace listing the copy (not aligned: the dock only shows photos here)."""
+    from core.project.workspace import Workspace
+
+    ws = Workspace.create_or_open(str(root))
+    ws.data["images_dir"] = os.path.dirname(path)
+    ws.data["images"] = [{"name": OCHOTA_PHOTO, "path": path, "width": 1152, "height": 864, "orientation": 6}]
+    ws.data["crs"] = "EPSG:2180"
+    ws.save()
+    return ws.root
+
+
+@pytest.fixture
+def dock(qgis_canvas, qgis_new_project):
+    from archaeoortho.ui.gcp_dock import GcpDock
+
+    d = GcpDock(None, qgis_canvas)
+    d.resize(700, 600)
+    d.photo_dock.resize(760, 900)
+    d.show()
+    d.photo_dock.show()
+    yield d
+    d.cleanup()
+    d.photo_dock.close()
+    d.close()
+
+
+def _qimage_grey_patch(image, x, y, r=6):
+    from qgis.PyQt.QtGui import QColor
+
+    c, rr = int(np.floor(x)), int(np.floor(y))
+    def grey(i, j):
+        q = QColor(image.pixel(i, j))
+        return (q.red() + q.green() + q.blue()) / 3.0
+
+    return np.array([[grey(i, j) for i in range(c - r, c + r + 1)] for j in range(rr - r, rr + r + 1)])
+
+
+def _near_brightest(arr, x, y, r=10):
+    grey = arr.astype(float).mean(axis=2)
+    c, rr = int(x), int(y)
+    win = grey[rr - r:rr + r + 1, c - r:c + r + 1]
+    j, i = np.unravel_index(np.argmax(win), win.shape)
+    return c - r + i + 0.5, rr - r + j + 0.5
+
+
+def test_the_dock_shows_an_orientation_6_photo_upright_and_maps_a_click_to_the_stored_grid(
+        dock, ochota_quarter, tmp_path, qgis_app):
+    from qgis.PyQt.QtCore import QPointF
+
+    from tests.test_ui_dock import SCREENSHOTS, _click, process
+
+    path = ochota_quarter
+    ws = _ochota_workspace(tmp_path / "ws", path)
+
+    assert dock.open_workspace(ws)
+    name = dock.add_point("W1", 630500.0, 485200.0, 100.0)
+    dock.show_photo(OCHOTA_PHOTO)
+    panel = dock.photo_panel
+    assert panel.image == OCHOTA_PHOTO
+    pyr = panel.pyramid(OCHOTA_PHOTO)
+    assert (pyr.stored_width, pyr.stored_height, pyr.orientation) == (1152, 864, 6)
+    assert (pyr.width, pyr.height) == (864, 1152)  # upright, portrait, as a photo viewer shows it
+    assert panel.orientation_note.isVisibleTo(panel) and "EXIF orientation 6" in panel.orientation_note.text()
+    stored = _read_rgb(path)
+    # what the dock draws is the stored raster turned as core.io.images turns it (Qt and GDAL decode alike)
+    upright = to_upright(stored, 6)
+    target = _near_brightest(upright, *OCHOTA_TARGET)
+    shown = _qimage_grey_patch(pyr.levels[0], *target)
+    want = _patch(upright, *target, r=6)
+    assert np.abs(shown - want).mean() < 3.0
+    assert _correlation(shown, want) > 0.95
+    # a click on the target: the scene position is upright, the observation is stored
+    view = panel.view
+    view.set_zoom(4.0, QPointF(*target))
+    process(50)
+    expected = _click(view, target)
+    obs = dock.store.gcps.by_name(name).observations
+    assert len(obs) == 1 and obs[0].image == OCHOTA_PHOTO
+    sx, sy = upright_to_stored(expected.x(), expected.y(), 6, 1152, 864)
+    assert (obs[0].x, obs[0].y) == (pytest.approx(sx, abs=1e-9), pytest.approx(sy, abs=1e-9))
+    assert (obs[0].x, obs[0].y) == pytest.approx((expected.y(), 864.0 - expected.x()), abs=1e-9)
+    assert abs(expected.x() - target[0]) <= 0.25 and abs(expected.y() - target[1]) <= 0.25
+    # the stored pixels at the stored observation are the target the user clicked on
+    assert _correlation(np.rot90(_patch(stored, obs[0].x, obs[0].y, r=6), k=-1), want) > 0.95
+    # and the marker is drawn where it was clicked (stored -> upright)
+    marker = panel.observation
+    assert marker is not None
+    assert (marker.pos().x(), marker.pos().y()) == pytest.approx((expected.x(), expected.y()), abs=1e-9)
+    # the thumbnail is upright too (portrait)
+    from archaeoortho.ui.photo_viewer import read_thumbnail
+
+    thumb = read_thumbnail(path)
+    assert thumb.height() > thumb.width()
+    view.fit()
+    process(150)
+    os.makedirs(SCREENSHOTS, exist_ok=True)
+    shot = os.path.join(SCREENSHOTS, "photo-viewer-orientation-6.png")
+    dock.photo_dock.grab().save(shot)
+    dock.grab().save(os.path.join(SCREENSHOTS, "dock-orientation-6.png"))
+    assert os.path.getsize(shot) > 10000
+
+
+def test_the_dock_imports_gcp_coordinates_measured_on_the_upright_photo(dock, ochota_quarter, tmp_path, qgis_app):
+    ws = _ochota_workspace(tmp_path / "ws", ochota_quarter)
+    u, v = OCHOTA_TARGET
+    path = tmp_path / "gcp_list.txt"
+    path.write_text(f"EPSG:2180\n630500.0 485200.0 100.0 {u} {v} {OCHOTA_PHOTO} W1\n"
+                    f"630510.0 485210.0 100.0 5.0 6.0 not_in_the_workspace.jpg W2\n")
+    assert dock.open_workspace(ws)
+    assert dock.photo_orientations() == {OCHOTA_PHOTO: 6}
+    gs = dock.import_file(str(path), upright=True)
+    assert gs is not None
+    o = dock.store.gcps.by_name("W1").observations
+    assert len(o) == 1 and (o[0].x, o[0].y) == pytest.approx(upright_to_stored(u, v, 6, 1152, 864))
+    assert any("not_in_the_workspace.jpg" in w for w in gs.warnings)  # the photo outside the block is named
+    assert "not_in_the_workspace.jpg" in dock.status.text()  # in the dock's message too
+    dock.select_point("W1")
+    dock.show_photo(OCHOTA_PHOTO)
+    marker = dock.photo_panel.observation
+    assert marker is not None and (marker.pos().x(), marker.pos().y()) == pytest.approx((u, v))
+    # the same file taken as stored coordinates: (481, 545) fits the stored 1152 x 864 grid but is elsewhere
+    gs = dock.import_file(str(path), upright=False)
+    o = dock.store.gcps.by_name("W1").observations
+    assert (o[0].x, o[0].y) == (u, v)
+    # a file whose photos are all outside the workspace: an error naming the closest photo names
+    bad = tmp_path / "bad.txt"
+    bad.write_text("EPSG:2180\n630500.0 485200.0 100.0 10 20 img_306.jpg W1\n")
+    assert dock.import_file(str(bad)) is None
+    assert "none of its 1 observation(s)" in dock.status.text()
+    assert f"'img_306.jpg' (line 2, closest in the block: {OCHOTA_PHOTO})" in dock.status.text()

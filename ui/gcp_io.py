@@ -14,10 +14,11 @@ from qgis.core import (
     QgsWkbTypes,
 )
 from qgis.PyQt.QtCore import QCoreApplication, QVariant
-from qgis.PyQt.QtWidgets import QFileDialog, QInputDialog, QMessageBox
+from qgis.PyQt.QtWidgets import QCheckBox, QFileDialog, QInputDialog, QMessageBox
 
 from ..core.geometry.crs import transform_points
 from ..core.io import gcp as gcpmod
+from ..core.io.images import ImageError, exif_orientation
 from . import layers
 
 translate = QCoreApplication.translate
@@ -31,24 +32,57 @@ class GcpImportExport:
         path, _ = QFileDialog.getOpenFileName(self, translate("GcpDock", "Import ground control"), self.store.root or "",
                                               translate("GcpDock", "Ground control (*.txt *.csv);;All files (*)"))
         if path:
-            self.import_file(path, merge=self._ask_merge())
+            merge, upright = self._ask_import_options()
+            if merge is not None:
+                self.import_file(path, merge=merge, upright=upright)
 
-    def _ask_merge(self):
-        if not self.store.gcps.points:
-            return False
+    def photo_orientations(self):
+        """{image: EXIF orientation} of the workspace's photos that a photo viewer shows turned (not 1)."""
+        out = {}
+        for im in self.store.images():
+            try:
+                o = exif_orientation(im["path"]) if im.get("path") and os.path.exists(im["path"]) else 1
+            except ImageError:
+                o = 1
+            if o != 1:
+                out[im["name"]] = o
+        return out
+
+    def _ask_import_options(self):
+        """(merge, upright) for an import; merge None when the user cancelled.  The merge question only when
+        points exist, the upright option only when some photo has an EXIF orientation that turns it."""
+        turned = self.photo_orientations()
+        if not self.store.gcps.points and not turned:
+            return False, False
         box = QMessageBox(QMessageBox.Icon.Question, translate("GcpDock", "Import ground control"),
                           translate("GcpDock", "Replace the current points, or add the imported ones to them (same names are "
-                                  "updated)?"), parent=self)
-        replace = box.addButton(translate("GcpDock", "Replace"), QMessageBox.ButtonRole.AcceptRole)
-        box.addButton(translate("GcpDock", "Add"), QMessageBox.ButtonRole.AcceptRole)
+                                  "updated)?") if self.store.gcps.points else
+                          translate("GcpDock", "How were the pixel coordinates measured?"), parent=self)
+        replace = box.addButton(translate("GcpDock", "Replace") if self.store.gcps.points else translate("GcpDock", "Import"),
+                                QMessageBox.ButtonRole.AcceptRole)
+        if self.store.gcps.points:
+            box.addButton(translate("GcpDock", "Add"), QMessageBox.ButtonRole.AcceptRole)
+        cancel = box.addButton(QMessageBox.StandardButton.Cancel)
+        upright = None
+        if turned:
+            upright = QCheckBox(translate("GcpDock", "Coordinates measured on upright photos ({} photos are stored turned: "
+                                          "EXIF orientation); leave unticked for the stored pixel grid (COLMAP's, "
+                                          "OpenDroneMap's)").format(len(turned)))
+            box.setCheckBox(upright)
         box.exec()
-        return box.clickedButton() is not replace
+        if box.clickedButton() is cancel:
+            return None, False
+        return box.clickedButton() is not replace, bool(upright is not None and upright.isChecked())
 
-    def import_file(self, path, merge=False):
-        """Read an ODM gcp_list.txt or a CSV points file (+ observations) into the workspace's control."""
+    def import_file(self, path, merge=False, upright=False):
+        """Read an ODM gcp_list.txt or a CSV points file (+ observations) into the workspace's control.
+        Observations in photos that are not in the workspace are left out with a warning; an error only when
+        none is in one of its photos.  ``upright``: the pixel coordinates were measured on the photos shown
+        upright (EXIF orientation applied, as browsers show them): converted to the stored grid."""
         try:
             gs = gcpmod.read_gcps(path, image_names=[im["name"] for im in self.store.images()] or None,
-                                  image_sizes=self.store.image_sizes() or None, unknown_images="warn")
+                                  image_sizes=self.store.image_sizes() or None, unknown_images="warn",
+                                  upright_orientations=self.photo_orientations() if upright else None)
         except (gcpmod.GCPError, OSError, ValueError) as e:
             self.message(str(e), Qgis.MessageLevel.Critical)
             return None
@@ -66,8 +100,14 @@ class GcpImportExport:
         if n_obs == 0:  # coordinates only (a surveyor's list): that the points have no observations is the point
             gs.warnings = [w for w in gs.warnings
                            if "no usable observation" not in w and "no observations file" not in w]
-        self.store.replace_all(gs, translate("GcpDock", "import {}").format(source), merge=merge)
+        changed = self.store.replace_all(gs, translate("GcpDock", "import {}").format(source), merge=merge)
         warn = f" ({len(gs.warnings)} " + translate("GcpDock", "warnings") + ")" if gs.warnings else ""
+        if merge and changed:  # what the merge changed (roles and sigmas the user set are kept)
+            warn += ". " + "; ".join(changed)
+        # observations left out because their photos are not in the workspace: say which, not just how many
+        left_out = next((w for w in gs.warnings if "that are not in the block" in w), None)
+        if left_out:
+            warn += ": " + left_out.split(": ", 1)[-1]
         self.message(translate("GcpDock", "Imported {} points and {} observations from {}").format(
             len(gs.points), n_obs, source) + warn, Qgis.MessageLevel.Warning if gs.warnings else Qgis.MessageLevel.Info)
         if gs.warnings:
@@ -88,11 +128,13 @@ class GcpImportExport:
                                         translate("GcpDock", "Point layer (one feature per observation: name, image, px, py)"),
                                         names, 0, False)
         if ok:
-            self.import_layer(candidates[names.index(name)], merge=self._ask_merge())
+            merge, upright = self._ask_import_options()
+            if merge is not None:
+                self.import_layer(candidates[names.index(name)], merge=merge, upright=upright)
 
-    def import_layer(self, layer, merge=False):
+    def import_layer(self, layer, merge=False, upright=False):
         """A point layer with one feature per observation (fields name, image, px, py; z, sx, sy, sz, role
-        optional), as the Georeference algorithm's GCP_LAYER."""
+        optional), as the Georeference algorithm's GCP_LAYER; ``upright`` as for import_file."""
         fields = [f.name() for f in layer.fields()]
         lower = [f.lower() for f in fields]
         for need in ("name", "image", "px", "py"):
@@ -116,7 +158,8 @@ class GcpImportExport:
         try:
             gs = gcpmod.gcps_from_rows(rows, crs, source_name=layer.name(),
                                        image_names=[im["name"] for im in self.store.images()] or None,
-                                       image_sizes=self.store.image_sizes() or None, unknown_images="warn")
+                                       image_sizes=self.store.image_sizes() or None, unknown_images="warn",
+                                       upright_orientations=self.photo_orientations() if upright else None)
         except (gcpmod.GCPError, ValueError) as e:
             self.message(str(e), Qgis.MessageLevel.Critical)
             return None

@@ -1,8 +1,10 @@
 """Photo viewer of the GCP dock: a zoomable, pannable photo on an image pyramid cut into tiles.
 
-Scene coordinates are pixel coordinates in the convention of core.gcp (origin at the upper-left corner
-of the upper-left pixel, x right, y down), so a click maps to an observation without any conversion,
-with the precision of one screen pixel at the current zoom (sub-pixel when zoomed in).
+Scene coordinates are pixel coordinates of the photo shown UPRIGHT, as photo viewers and browsers show it
+(turned by its EXIF orientation; core.io.images), in the convention of core.gcp (origin at the upper-left corner
+of the upper-left pixel, x right, y down).  Observations are stored in the stored pixel grid (COLMAP's): the
+panel draws them at their upright positions and maps a click back to the stored grid (exact: a quarter turn
+or a mirror), with the precision of one screen pixel at the current zoom (sub-pixel when zoomed in).
 
 The photo is decoded once per visit; its pyramid levels (1, 1/2, 1/4, ...) are built from that decode
 and cut into tiles on first use, and a repaint draws only the tiles of the level that matches the zoom
@@ -17,7 +19,7 @@ import math
 from collections import OrderedDict
 
 from qgis.PyQt.QtCore import QPointF, QRectF, QSize, Qt, QTimer, pyqtSignal
-from qgis.PyQt.QtGui import QBrush, QColor, QFont, QIcon, QImage, QImageReader, QPainter, QPen, QPixmap
+from qgis.PyQt.QtGui import QBrush, QColor, QFont, QIcon, QImage, QImageReader, QPainter, QPen, QPixmap, QTransform
 from qgis.PyQt.QtWidgets import (
     QCheckBox,
     QGraphicsItem,
@@ -35,16 +37,37 @@ from qgis.PyQt.QtWidgets import (
     QWidget,
 )
 
+from ..core.io.images import ORIENTATION_STEPS, ImageError, exif_orientation, stored_to_upright, upright_to_stored
+
 TILE = 512
 THUMB = QSize(120, 80)
+
+
+def photo_orientation(path):
+    """The EXIF orientation of a photo (1 when it has none or cannot be read)."""
+    try:
+        return exif_orientation(path)
+    except ImageError:
+        return 1
+
+
+def upright_qimage(image, orientation):
+    """The stored QImage turned upright, as a photo viewer shows it: the steps of
+    core.io.images.ORIENTATION_STEPS (a clockwise turn, then mirrors), so that display and coordinates agree."""
+    turn, mirror_lr, mirror_tb = ORIENTATION_STEPS.get(orientation, (0, False, False))
+    if turn:
+        image = image.transformed(QTransform().rotate(turn))
+    if mirror_lr or mirror_tb:
+        image = image.mirrored(mirror_lr, mirror_tb)
+    return image
 
 
 class ImagePyramid:
     """Levels 0 (full size), 1 (half), ... of one photo, cut into TILE x TILE pixmaps on demand."""
 
-    def __init__(self, path, max_cached_tiles=256):
+    def __init__(self, path, max_cached_tiles=256, orientation=None):
         reader = QImageReader(path)
-        reader.setAutoTransform(False)  # pixel coordinates are those of the stored raster, as in COLMAP
+        reader.setAutoTransform(False)  # the stored raster (COLMAP's grid), turned upright below by our own rule
         image = reader.read()
         if image.isNull():
             raise OSError(f"cannot read {path}: {reader.errorString()}")
@@ -52,7 +75,10 @@ class ImagePyramid:
                                   QImage.Format.Format_ARGB32_Premultiplied):
             image = image.convertToFormat(QImage.Format.Format_RGB32)
         self.path = path
-        self.width, self.height = image.width(), image.height()
+        self.stored_width, self.stored_height = image.width(), image.height()
+        self.orientation = photo_orientation(path) if orientation is None else int(orientation)
+        image = upright_qimage(image, self.orientation)
+        self.width, self.height = image.width(), image.height()  # upright: the scene's size
         self.levels = [image]
         while max(self.levels[-1].width(), self.levels[-1].height()) > TILE:
             prev = self.levels[-1]
@@ -62,6 +88,14 @@ class ImagePyramid:
         self._tiles = OrderedDict()
         self._max = max_cached_tiles
         self.tiles_made = 0
+
+    def to_scene(self, x, y):
+        """Scene (upright) coordinates of stored pixel coordinates."""
+        return stored_to_upright(x, y, self.orientation, self.stored_width, self.stored_height)
+
+    def to_stored(self, x, y):
+        """Stored pixel coordinates of scene (upright) ones."""
+        return upright_to_stored(x, y, self.orientation, self.stored_width, self.stored_height)
 
     def level_for(self, lod):
         """The coarsest level that still has at least one image pixel per screen pixel at ``lod``."""
@@ -96,18 +130,22 @@ class ImagePyramid:
 
 
 def read_thumbnail(path, size=THUMB):
-    """A small pixmap of a photo, decoded at reduced size where the format allows (JPEG)."""
+    """A small pixmap of a photo, upright, decoded at reduced size where the format allows (JPEG)."""
     reader = QImageReader(path)
     reader.setAutoTransform(False)
+    orientation = photo_orientation(path)
+    turned = ORIENTATION_STEPS.get(orientation, (0,))[0] in (90, 270)
     full = reader.size()
     if full.isValid():
-        reader.setScaledSize(full.scaled(size, Qt.AspectRatioMode.KeepAspectRatio))
+        upright = full.transposed() if turned else full
+        small = upright.scaled(size, Qt.AspectRatioMode.KeepAspectRatio)
+        reader.setScaledSize(small.transposed() if turned else small)
     image = reader.read()
     if image.isNull():
         pm = QPixmap(size)
         pm.fill(QColor("#606060"))
         return pm
-    return QPixmap.fromImage(image)
+    return QPixmap.fromImage(upright_qimage(image, orientation))
 
 
 class ThumbStrip(QListWidget):
@@ -405,6 +443,9 @@ class PhotoPanel(QWidget):
         self.title = QLabel()
         self.title.setTextFormat(Qt.TextFormat.RichText)
         self.hint = QLabel()
+        self.orientation_note = QLabel()  # says when the photo is shown turned from its stored grid
+        self.orientation_note.setWordWrap(True)
+        self.orientation_note.setVisible(False)
         self.hint.setWordWrap(True)
         self.view = PhotoView(self)
         self.thumbs = ThumbStrip(self)
@@ -447,6 +488,7 @@ class PhotoPanel(QWidget):
         tl.addWidget(self.title)
         tl.addLayout(bar)
         tl.addWidget(self.view, 1)
+        tl.addWidget(self.orientation_note)
         tl.addWidget(self.hint)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(2, 2, 2, 2)
@@ -511,8 +553,18 @@ class PhotoPanel(QWidget):
         self.view.set_pyramid(pyr)
         if old is None:
             self.view.fit()
+        self._show_orientation(pyr)
         self._select_thumb(name)
         return True
+
+    def _show_orientation(self, pyr):
+        turned = pyr.orientation != 1
+        if turned:
+            self.orientation_note.setText(self.tr(
+                "Shown upright (EXIF orientation {}: stored {} x {} px); pixel coordinates are those of the stored "
+                "grid, as COLMAP and gcp_list.txt use them").format(pyr.orientation, pyr.stored_width,
+                                                                     pyr.stored_height))
+        self.orientation_note.setVisible(turned)
 
     def set_thumbnails(self, names, marks=None):
         """Show ``names`` in the strip; ``marks``: {name: text} shown under the picture (e.g. a tick)."""
@@ -592,13 +644,13 @@ class PhotoPanel(QWidget):
         self.point_name = point_name or ""
         if point_name and observation is not None:
             self.observation = MarkerItem(point_name, predicted=False, colour="#ff2a2a")
-            self.observation.setPos(QPointF(*observation))
+            self.observation.setPos(self._scene_point(observation))
             self.observation.moved.connect(self._marker_moved)
             scene.addItem(self.observation)
         if point_name and prediction is not None and observation is None:
             label = self.tr("{} (predicted)").format(point_name)
             self.prediction = MarkerItem(label, predicted=True, colour="#ffb000")
-            self.prediction.setPos(QPointF(*prediction))
+            self.prediction.setPos(self._scene_point(prediction))
             self.prediction.moved.connect(self._marker_moved)
             self.prediction.activated.connect(self._confirm)
             if prediction_source:
@@ -620,14 +672,24 @@ class PhotoPanel(QWidget):
             scale = max(self.view.zoom(), 2.0)
         self.view.set_zoom(scale, item.pos())
 
-    # --- user actions -> signals
+    def _scene_point(self, xy):
+        """The scene (upright) position of stored pixel coordinates in the photo shown."""
+        item = self.view.pyramid_item
+        return QPointF(*(item.pyramid.to_scene(*xy) if item is not None else xy))
+
+    def _stored(self, pos):
+        """Stored pixel coordinates (x, y) of a scene position in the photo shown."""
+        item = self.view.pyramid_item
+        return item.pyramid.to_stored(pos.x(), pos.y()) if item is not None else (pos.x(), pos.y())
+
+    # --- user actions -> signals (in stored pixel coordinates)
     def _clicked(self, pos):
         if self.image and self.point_name:
-            self.placed.emit(self.image, pos.x(), pos.y())
+            self.placed.emit(self.image, *self._stored(pos))
 
     def _marker_moved(self, pos):
         if self.image and self.point_name:
-            self.placed.emit(self.image, pos.x(), pos.y())
+            self.placed.emit(self.image, *self._stored(pos))
 
     def _remove(self):
         if self.image and self.observation is not None:
