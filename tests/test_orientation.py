@@ -218,6 +218,46 @@ def test_upright_conversion_of_a_gcp_set_and_its_errors(copr_rotated):
     assert [(o.x, o.y) for p in same.points for o in p.observations] == [(x, y) for _, x, y in obs]
 
 
+
+def test_the_georef_stage_reads_upright_gcps_of_a_turned_photo_into_the_stored_grid(copr_rotated, tmp_path):
+    """The workspace lists the turned copy (its orientation read from the photo, as for a workspace aligned
+    before orientations were recorded) and the original photo: with ``gcps_upright`` only the turned photo's
+    observations move; without it nothing moves."""
+    from core.common.progress import NullProgress
+    from core.georef import stage as georef_stage
+    from core.project.workspace import Workspace
+
+    _, path, obs, gcp_file = copr_rotated
+    original = os.path.join(shared("copr", "images"), COPR_PHOTO)
+    ws = Workspace.create_or_open(str(tmp_path / "ws"))
+    ws.data["images"] = [{"name": ROTATED, "path": path, "width": 800, "height": 1200},
+                         {"name": COPR_PHOTO, "path": original, "width": 1200, "height": 800, "orientation": 1}]
+    ws.save()
+    assert georef_stage.photo_orientations(ws) == {ROTATED: 6}
+    both = tmp_path / "both.txt"
+    text = open(gcp_file).read()
+    both.write_text(text + "".join(f"{line.replace(ROTATED, COPR_PHOTO)}\n" for line in text.splitlines()[1:]))
+    for upright in (True, False):
+        gcps = georef_stage._read_control(ws, str(both), None, (), None, False, None, NullProgress(),
+                                          gcps_upright=upright)[0]
+        for name, ox, oy in obs:
+            p = gcps.by_name(name)
+            at = {o.image: (o.x, o.y) for o in p.observations}
+            assert at[COPR_PHOTO] == (ox, oy)
+            if upright:
+                assert at[ROTATED] == pytest.approx(upright_to_stored(ox, oy, 6, 800, 1200))
+            else:
+                assert at.get(ROTATED, (ox, oy)) == (ox, oy)  # taken as stored (or dropped outside the photo)
+
+
+def test_the_georeference_algorithm_has_the_upright_parameter(qgis_app):
+    from archaeoortho.processing_provider.georeference import GeoreferenceAlgorithm
+
+    alg = GeoreferenceAlgorithm()
+    alg.initAlgorithm()
+    p = alg.parameterDefinition("GCPS_UPRIGHT")
+    assert p is not None and p.type() == "boolean" and p.defaultValue() is False
+
 # --------------------------------------------------------------------------------------------------
 # the GCP dock: an orientation-6 photo shown upright, clicks and imports mapped to the stored grid
 # --------------------------------------------------------------------------------------------------
