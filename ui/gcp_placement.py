@@ -2,6 +2,7 @@
 with guided placement (core.georef.guided predicts where a point is in each photo and refines that by
 matching its look in a photo where it is placed).  A mixin of ui.gcp_dock.GcpDock: it works on the dock's
 store, table and photo panel; its strings are translated in the dock's context."""
+import html
 import math
 import os
 
@@ -44,18 +45,56 @@ class GcpPlacement:
             else:
                 self.predictor = guided.Predictor(align_stage.load_model(ws))
             gsd = guided.ground_sample_distance(self.predictor.rec)
+            self._gsd_tolerance = None
             if gsd and self.predictor.georeferenced and not self.store.settings.get("tolerance"):
-                self.tol_spin.blockSignals(True)  # a default, not the user's choice: not saved
-                self.tol_spin.setValue(max(0.001, round(3.0 * gsd, 3)))
+                self._gsd_tolerance = (max(0.001, round(3.0 * gsd, 3)), gsd)
+                self.tol_spin.blockSignals(True)  # a default, not the user's choice: not saved (but shown)
+                self.tol_spin.setValue(self._gsd_tolerance[0])
                 self.tol_spin.blockSignals(False)
+                self.model.repaint_all()
         except Exception as e:  # noqa: BLE001 - a broken model must not break the dock
             self.predictor = None
             self.predictor_note = translate("GcpDock", "no predicted positions: {}").format(e)
+            self.show_tolerance_source()
             return
+        self.show_tolerance_source()
         self.predictor_note = (translate("GcpDock", "Predicted positions from the georeferenced block.")
                                if self.predictor.georeferenced else
                                translate("GcpDock", "Predicted positions once a point is placed in 2 photos, and for every "
                                        "point once 3 points are placed."))
+
+    # ------------------------------------------------------------------ tolerance and diagnosis
+    def tolerance_source(self):
+        """Where the residual tolerance comes from, as the dock shows it next to the value."""
+        if self.store.settings.get("tolerance"):
+            return translate("GcpDock", "your setting")
+        gsd = getattr(self, "_gsd_tolerance", None)
+        if gsd is not None and abs(self.tol_spin.value() - gsd[0]) < 5e-4:
+            return translate("GcpDock", "default: 3 × GSD of the georeferenced block (GSD {:.3f} m)").format(gsd[1])
+        return translate("GcpDock", "default")
+
+    def show_tolerance_source(self):
+        text = self.tolerance_source()
+        label = getattr(self, "tol_source", None)
+        if label is not None:
+            label.setText("(" + text + ")")
+        self.tol_spin.setToolTip(translate("GcpDock", "Residuals up to this are green, up to 3 times yellow, beyond "
+                                           "red. Now: {}").format(text))
+
+    def diagnosis_text(self):
+        """The last adjustment's diagnosis (its warnings and outliers, georef/residuals.json) as rich text."""
+        lines = self.store.diagnosis
+        if not lines:
+            return ""
+        return "<b>" + translate("GcpDock", "Diagnosis of the adjustment:") + "</b><br>" + "<br>".join(
+            "\u2022 " + html.escape(t) for t in lines)
+
+    def show_diagnosis(self):
+        label = getattr(self, "diagnosis", None)
+        if label is not None:
+            text = self.diagnosis_text()
+            label.setText(text)
+            label.setVisible(bool(text))
 
     # ------------------------------------------------------------------ map tool
     def set_picking(self, on):
@@ -96,22 +135,51 @@ class GcpPlacement:
         if dsm is not None:
             z = sample_height(dsm, QgsPointXY(point), canvas_crs)
         name = self.current_name()
+        moved = ""
         if name is None:
             name = self.add_point(x=p.x(), y=p.y(), z=z if z is not None else math.nan)
         else:
+            old = self.store.gcps.by_name(name)
+            if math.isfinite(old.x) and math.isfinite(old.y):
+                moved = " " + translate("GcpDock", "Moved {:.2f} m (Undo: Ctrl+Z).").format(
+                    math.hypot(p.x() - old.x, p.y() - old.y))
             fields = {"x": p.x(), "y": p.y()}
             if z is not None:
                 fields["z"] = z
             self.store.set_point(name, **fields)
+        # one pick per 'Pick on map': a later click on the map must not move the point
+        self.set_picking(False)
         if z is not None:
             self.message(translate("GcpDock", "{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})").format(
-                name, p.x(), p.y(), z, dsm.name()))
+                name, p.x(), p.y(), z, dsm.name()) + moved)
         elif dsm is not None:
             self.message(translate("GcpDock", "{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was").format(
-                name, p.x(), p.y(), dsm.name()), Qgis.MessageLevel.Warning)
+                name, p.x(), p.y(), dsm.name()) + moved, Qgis.MessageLevel.Warning)
         else:
-            self.message(translate("GcpDock", "{}: X {:.3f}, Y {:.3f}").format(name, p.x(), p.y()))
+            self.message(translate("GcpDock", "{}: X {:.3f}, Y {:.3f}").format(name, p.x(), p.y()) + moved)
+        self.show_best_photo()
         return name
+
+    def best_photo(self):
+        """The photo where the selected point is predicted most centrally and not yet placed (None if none)."""
+        point = self.current_point()
+        if point is None:
+            return None
+        observed = set(point.images())
+        shown = set(self.photo_panel.paths)
+        cands = [n for n in self.predictions if n not in observed and n in shown and self._may_offer(n)]
+        return min(cands, key=lambda n: self.predictions[n].centrality) if cands else None
+
+    def show_best_photo(self):
+        """Show the best predicted photo of the selected point, zoomed to the prediction."""
+        best = self.best_photo()
+        if best is None:
+            return False
+        if best == self.photo_panel.image:
+            self._update_photo(zoom=True)
+        else:
+            self.show_photo(best)
+        return True
 
     def _update_markers(self):
         if self.markers is None:
@@ -166,6 +234,37 @@ class GcpPlacement:
         return self._gray[name]
 
     def refined_prediction(self, image):
+        """The prediction offered in ``image``: the refined one (``_refined_prediction``) when its position is in
+        the photo and outside its mask, else (None, None) and ``refused[image]`` says why."""
+        refused = self.__dict__.setdefault("refused", {})
+        refused.pop(image, None)
+        pred, match = self._refined_prediction(image)
+        if pred is None:
+            return None, None
+        problem = self.store.position_problem(image, pred.x, pred.y)
+        if problem is not None:
+            refused[image] = problem
+            return None, None
+        return pred, match
+
+    @staticmethod
+    def _match_key(point, image, pred):
+        return (point.name, image, tuple((o.image, round(o.x, 3), round(o.y, 3)) for o in point.observations),
+                round(pred.x, 2), round(pred.y, 2))
+
+    def _may_offer(self, image, masks=True):
+        """Whether the prediction in ``image`` can be offered: its geometric position (or its refinement, when
+        already matched) lies in the photo (and, with ``masks``, outside its mask)."""
+        pred = self.predictions.get(image)
+        point = self.current_point()
+        if pred is None or point is None:
+            return False
+        if self.store.position_problem(image, pred.x, pred.y, masks=masks) is None:
+            return True
+        match = self.matches.get(self._match_key(point, image, pred))
+        return match is not None and self.store.position_problem(image, match.x, match.y, masks=masks) is None
+
+    def _refined_prediction(self, image):
         """The prediction in ``image``, refined by matching the point's look in a photo where it is placed
         (core.guided.refine_by_matching); the geometric prediction when matching finds nothing sure."""
         from ..core.georef import guided
@@ -175,8 +274,7 @@ class GcpPlacement:
         if pred is None or point is None or pred.source == guided.RAYS or not point.observations \
                 or self.predictor is None:
             return pred, None
-        key = (point.name, image, tuple((o.image, round(o.x, 3), round(o.y, 3)) for o in point.observations),
-               round(pred.x, 2), round(pred.y, 2))
+        key = self._match_key(point, image, pred)
         if key not in self.matches:
             match = None
             try:
@@ -232,7 +330,8 @@ class GcpPlacement:
                 d = loo.get(o.image)
                 marks[o.image] = "\u2713" + (" " + translate("GcpDock", "{:.1f} px").format(d) if d is not None else "")
             for n in self.predictions:
-                marks.setdefault(n, translate("GcpDock", "predicted"))
+                marks.setdefault(n, translate("GcpDock", "predicted") if self._may_offer(n, masks=False)
+                                 else translate("GcpDock", "near the edge"))
         self.photo_panel.set_thumbnails(self.visible_photos(), marks)
 
     def show_photo(self, name):
@@ -243,12 +342,21 @@ class GcpPlacement:
         panel = self.photo_panel
         point = self.current_point()
         image = panel.image
+        if point is not None and image is None:  # a point and no photo yet: show the first one of the strip
+            strip = panel.thumbnail_names()
+            if strip and panel.show_photo(strip[0]):
+                image, zoom = panel.image, True
         if point is None or image is None:
             panel.set_markers(None)
             panel.set_next_available(False)
-            panel.title.setText(f"<b>{image or ''}</b>")
-            panel.hint.setText(translate("GcpDock", "Select or add a ground point in the table, then click on it in the photo.")
-                               if self.store.workspace is not None else "")
+            panel.title.setText(f"<b>{point.name if point is not None else image or ''}</b>")
+            if self.store.workspace is None:
+                panel.hint.setText("")
+            elif point is None:
+                panel.hint.setText(translate("GcpDock", "Select or add a ground point in the table, then click on it "
+                                             "in the photo."))
+            else:
+                panel.hint.setText(self._no_photo_hint(point))
             return
         obs = next((o for o in point.observations if o.image == image), None)
         pred, match = self.refined_prediction(image) if obs is None else (self.predictions.get(image), None)
@@ -268,6 +376,15 @@ class GcpPlacement:
         elif pred is not None:
             panel.hint.setText(translate("GcpDock", "Predicted {}. Press Enter to accept it and go on (Space: accept), drag "
                                        "it, or click where the point really is.").format(source))
+        elif image in getattr(self, "refused", {}):
+            panel.hint.setText(translate("GcpDock", "{} is predicted where it cannot be placed: {}. Click where the "
+                                         "point is if you see it, or press Enter for the next photo.").format(
+                point.name, self.refused[image]))
+        elif not point.observations and not self.predictions and not (
+                math.isfinite(point.x) and math.isfinite(point.y)) and self.predictor is not None \
+                and self.predictor.georeferenced:
+            panel.hint.setText(translate("GcpDock", "Click where {} is in this photo, or use Pick on map (or type X, "
+                                         "Y, Z in the table) to have it predicted in the photos.").format(point.name))
         else:
             panel.hint.setText(translate("GcpDock", "Click where {} is in this photo.").format(point.name))
         if zoom:
@@ -276,12 +393,26 @@ class GcpPlacement:
             else:
                 panel.view.fit()
 
+    def _no_photo_hint(self, point):
+        """The viewer's hint for a selected point when no photo is shown: what to do next."""
+        if not self.photo_panel.paths:
+            return translate("GcpDock", "{}: the workspace has no photos to place it in.").format(point.name)
+        if not (math.isfinite(point.x) and math.isfinite(point.y)):
+            return translate("GcpDock", "{} is selected: use Pick on map or type X, Y, Z in the table, or choose a "
+                             "photo in the strip below and click on the point.").format(point.name)
+        return translate("GcpDock", "{} is selected: choose a photo in the strip below and click on the point.").format(
+            point.name)
+
     def place_observation(self, image, x, y):
         name = self.current_name()
         if name is None:
             self.message(translate("GcpDock", "Select or add a ground point first"), Qgis.MessageLevel.Warning)
             return
-        self.store.set_observation(name, image, x, y)
+        try:
+            self.store.set_observation(name, image, x, y)
+        except ValueError as e:  # outside the photo or in its mask: not stored, the marker goes back
+            self.message(str(e), Qgis.MessageLevel.Warning)
+            self._update_photo()
 
     def remove_observation(self, image):
         name = self.current_name()
@@ -294,7 +425,11 @@ class GcpPlacement:
         name = self.current_name()
         if pred is None or name is None:
             return False
-        self.store.set_observation(name, image, pred.x, pred.y)
+        try:
+            self.store.set_observation(name, image, pred.x, pred.y)
+        except ValueError as e:
+            self.message(str(e), Qgis.MessageLevel.Warning)
+            return False
         return True
 
     def next_photo(self):
@@ -307,7 +442,7 @@ class GcpPlacement:
         cur = self.photo_panel.image
         start = names.index(cur) + 1 if cur in names else 0
         for n in names[start:] + names[:start]:
-            if n not in observed and n in self.predictions:
+            if n not in observed and n in self.predictions and self._may_offer(n):
                 return n
         return None
 

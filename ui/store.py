@@ -5,7 +5,8 @@ import json
 import math
 import os
 
-from qgis.PyQt.QtCore import QCoreApplication, QObject, pyqtSignal
+from qgis.PyQt.QtCore import QCoreApplication, QEvent, QObject, pyqtSignal
+from qgis.PyQt.QtGui import QKeySequence
 
 try:  # Qt6 moved the undo framework to QtGui
     from qgis.PyQt.QtGui import QUndoCommand, QUndoStack
@@ -37,6 +38,40 @@ class _Snapshot(QUndoCommand):
         self.store._set_state(self.before)
 
 
+class UndoKeys(QObject):
+    """Ctrl+Z / Ctrl+Shift+Z (QKeySequence.Undo / Redo) on a widget (the photo view, the table) undo and redo the
+    store's edits.  The widget claims the keys in the ShortcutOverride phase, so that no other action with the
+    same shortcut (QGIS's own Undo in its main window) makes the shortcut ambiguous and nothing happens."""
+
+    def __init__(self, stack, parent=None):
+        super().__init__(parent)
+        self.stack = stack
+
+    def _which(self, event):
+        if event.matches(QKeySequence.StandardKey.Undo):
+            return self.stack.undo
+        if event.matches(QKeySequence.StandardKey.Redo):
+            return self.stack.redo
+        return None
+
+    def eventFilter(self, obj, event):  # noqa: N802 (Qt API)
+        kind = event.type()
+        if kind == QEvent.Type.ShortcutOverride and self._which(event) is not None:
+            event.accept()
+            return True
+        if kind == QEvent.Type.KeyPress:
+            act = self._which(event)
+            if act is not None:
+                act()
+                event.accept()
+                return True
+        return super().eventFilter(obj, event)
+
+
+def _differs(a, b):
+    return not (a == b or (isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b)))
+
+
 class GcpStore(QObject):
     """Ground control of one workspace with undo; emits ``changed`` after every edit."""
 
@@ -53,6 +88,15 @@ class GcpStore(QObject):
         self.stale = set()  # points edited since the last adjustment
         self.undo_stack = QUndoStack(self)
         self.settings = {}
+        self.diagnosis = []  # the last adjustment's warnings and outlier messages (georef/residuals.json)
+        self._masks = {}  # image name -> (mask path, mtime, keep array or None)
+        self._undo_keys = UndoKeys(self.undo_stack, self)
+        self.last_import_report = []  # what the last import changed (GcpStore.replace_all)
+
+    def install_undo_keys(self, *widgets):
+        """Ctrl+Z / Ctrl+Shift+Z undo / redo when one of ``widgets`` has the focus."""
+        for w in widgets:
+            w.installEventFilter(self._undo_keys)
 
     def tr(self, text):
         return QCoreApplication.translate("GcpStore", text)
@@ -145,11 +189,14 @@ class GcpStore(QObject):
 
     # --- residuals of the last adjustment
     def load_residuals(self):
-        self.residuals, self.figures = {}, {}
+        self.residuals, self.figures, self.diagnosis = {}, {}, []
         if self.workspace is not None and self.workspace.stage_done(GEOREFERENCE):
             data = self._load_json(self.layout.residuals_json) or {}
             self.residuals = {p["name"]: p for p in data.get("points", [])}
             self.figures = dict(self.workspace.stage(GEOREFERENCE).get("results") or {})
+            lines = [str(w) for w in data.get("warnings", []) if w]
+            lines += [str(o["message"]) for o in data.get("outliers", []) if o.get("message")]
+            self.diagnosis = list(dict.fromkeys(lines))
         self.stale = set()
         self.residualsChanged.emit()
 
@@ -215,7 +262,52 @@ class GcpStore(QObject):
         what = ", ".join(sorted(fields))
         return self.edit(self.tr("set {} of {}").format(what, name), fn)
 
+    def _mask_keep(self, image):
+        """The keep-area (True = use) of ``image``'s mask (core.prepare.masks.find_mask), None without a mask."""
+        from ..core.prepare import masks as masksmod
+
+        path = masksmod.find_mask(self.layout.masks_dir, image) if self.workspace is not None else None
+        if path is None:
+            self._masks.pop(image, None)
+            return None
+        mtime = os.path.getmtime(path)
+        hit = self._masks.get(image)
+        if hit is not None and hit[0] == path and hit[1] == mtime:
+            return hit[2]
+        try:
+            w, h = masksmod.png_size(path)
+            keep = masksmod.read_keep(path, w, h)
+        except (masksmod.MaskError, ImportError, OSError):
+            keep = None
+        self._masks[image] = (path, mtime, keep)
+        while len(self._masks) > 6:
+            self._masks.pop(next(iter(self._masks)))
+        return keep
+
+    def position_problem(self, image, x, y, masks=True):
+        """Why (x, y) cannot be an observation in ``image`` (outside the photo, with ``masks`` inside its mask),
+        None if it can."""
+        if not (math.isfinite(x) and math.isfinite(y)):
+            return self.tr("no position")
+        size = self.image_sizes().get(image)
+        if size is not None and not (0.0 <= x <= size[0] and 0.0 <= y <= size[1]):
+            return self.tr("({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)").format(
+                x, y, image, size[0], size[1])
+        keep = self._mask_keep(image) if masks else None
+        if keep is not None:
+            col = min(max(int(math.floor(x)), 0), keep.shape[1] - 1)
+            row = min(max(int(math.floor(y)), 0), keep.shape[0] - 1)
+            if not keep[row, col]:
+                return self.tr("({:.0f}, {:.0f}) is inside the mask of {}").format(x, y, image)
+        return None
+
     def set_observation(self, name, image, x, y):
+        """Place (or move) point ``name`` in ``image``; raises ValueError (naming why) for a position outside the
+        photo or inside its mask."""
+        problem = self.position_problem(image, float(x), float(y))
+        if problem is not None:
+            raise ValueError(self.tr("{} not placed: {}").format(name, problem))
+
         def fn(gs):
             p = gs.by_name(name)
             if p is None:
@@ -236,27 +328,80 @@ class GcpStore(QObject):
         self.stale.add(name)
         return self.edit(self.tr("remove {} from {}").format(name, image), fn)
 
-    def replace_all(self, gcpset, text, merge=False):
-        """Import: replace the ground control (or, with ``merge``, add points and observations by name)."""
+    def replace_all(self, gcpset, text, merge=False, given=None):
+        """Import: replace the ground control (or, with ``merge``, add points and observations by name).
+
+        Merging keeps what the user set unless the file says otherwise: a point's role and sigmas change only
+        when the file gives them (``given``: {name: {"role", "sigma_xy", "sigma_z"}} as the reader saw them;
+        without it, a file gives a role when it marks the point as a check point, and a sigma that is not the
+        default); observations already placed stay.  Returns the list of what changed, one line per kind."""
+        defaults = gcpmod.GroundPoint("", 0.0, 0.0, 0.0)
+
+        def says(p, field):
+            if given is not None:
+                return field in given.get(p.name, ())
+            if field == "role":
+                return p.role == gcpmod.CHECK
+            return _differs(getattr(p, field), getattr(defaults, field))
+
         def fn(gs):
             new = copy.deepcopy(gcpset)
             if not merge:
                 gs.crs = new.crs or gs.crs
+                n_old = len(gs.points)
                 gs.points = new.points
-                return
+                return [self.tr("{} points replaced by {} from the file").format(n_old, len(new.points))]
             if not gs.crs:
                 gs.crs = new.crs
+            added, moved, roles, kept_roles, sigmas, kept_obs = [], [], [], [], [], []
+            n_obs = 0
             for p in new.points:
                 old = gs.by_name(p.name)
                 if old is None:
                     gs.points.append(p)
+                    added.append(p.name)
+                    n_obs += len(p.observations)
                     continue
+                if any(_differs(a, b) for a, b in ((old.x, p.x), (old.y, p.y), (old.z, p.z))):
+                    moved.append(p.name)
                 old.x, old.y, old.z = p.x, p.y, p.z
-                old.sigma_xy, old.sigma_z, old.role = p.sigma_xy, p.sigma_z, p.role
-                have = {o.image for o in old.observations}
-                old.observations += [o for o in p.observations if o.image not in have]
+                if says(p, "role") and p.role != old.role:
+                    roles.append(f"{p.name} → {p.role}")
+                    old.role = p.role
+                elif p.role != old.role:
+                    kept_roles.append(f"{p.name} ({old.role})")
+                for field in ("sigma_xy", "sigma_z"):
+                    if says(p, field) and _differs(getattr(old, field), getattr(p, field)):
+                        sigmas.append(p.name)
+                        setattr(old, field, getattr(p, field))
+                have = {o.image: o for o in old.observations}
+                for o in p.observations:
+                    mine = have.get(o.image)
+                    if mine is None:
+                        old.observations.append(o)
+                        n_obs += 1
+                    elif _differs(mine.x, o.x) or _differs(mine.y, o.y):
+                        kept_obs.append(f"{p.name} in {o.image}")
+            out = []
+            if added:
+                out.append(self.tr("added {} points: {}").format(len(added), ", ".join(added)))
+            if moved:
+                out.append(self.tr("coordinates updated from the file: {}").format(", ".join(dict.fromkeys(moved))))
+            if roles:
+                out.append(self.tr("role set by the file: {}").format(", ".join(roles)))
+            if kept_roles:
+                out.append(self.tr("role kept (the file gives none): {}").format(", ".join(kept_roles)))
+            if sigmas:
+                out.append(self.tr("σ set by the file: {}").format(", ".join(dict.fromkeys(sigmas))))
+            if n_obs:
+                out.append(self.tr("{} observations added").format(n_obs))
+            if kept_obs:
+                out.append(self.tr("placed observations kept (the file has others): {}").format(", ".join(kept_obs)))
+            return out or [self.tr("nothing changed")]
         self.stale.update(p.name for p in gcpset.points)
-        return self.edit(text, fn)
+        report = self.edit(text, fn)
+        self.last_import_report = report
+        return report
 
     def set_crs(self, crs):
         return self.edit(self.tr("set CRS"), lambda gs: setattr(gs, "crs", crs))
