@@ -3,7 +3,8 @@
 The filter is the Simple Morphological Filter (Pingel, Clarke & McBride 2013, ISPRS J. 77: 21-30), the
 algorithm behind PDAL's ``filters.smrf``, here on the DSM raster (NumPy/SciPy, no extra package):
 
-1. the DSM's lowest value per ``filter_cell`` (0.5 m) block, nodata filled (push-pull);
+1. the DSM's median per ``filter_cell`` (0.5 m) block, pits (1 m below their neighbours) and nodata filled
+   (push-pull);
 2. a progressive opening (square windows of radius 1 .. ``window`` m): a cell whose opened height drops by more
    than ``slope`` x the window radius from one window to the next is an object (a building, a tree);
 3. the provisional ground surface: the non-object blocks, the objects filled in between, back on the DSM grid;
@@ -101,18 +102,29 @@ def resample_to(coarse: np.ndarray, factor: int, h: int, w: int) -> np.ndarray:
 
 # ---------------------------------------------------------------- SMRF
 
-def _block_min(dsm: np.ndarray, factor: int) -> np.ndarray:
+def _block_surface(dsm: np.ndarray, factor: int) -> np.ndarray:
+    """The DSM on the filter grid: the median of each block (SMRF takes the minimum of lidar returns; a
+    photogrammetric DSM has one surface, whose lowest cells are matching noise)."""
+    import warnings
+
     h, w = dsm.shape
     hp, wp = -(-h // factor) * factor, -(-w // factor) * factor
     pad = np.full((hp, wp), np.nan)
     pad[:h, :w] = dsm
-    blocks = pad.reshape(hp // factor, factor, wp // factor, factor)
-    with np.errstate(all="ignore"):
-        import warnings
+    blocks = pad.reshape(hp // factor, factor, wp // factor, factor).transpose(0, 2, 1, 3).reshape(
+        hp // factor, wp // factor, factor * factor)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN blocks
+        return np.nanmedian(blocks, axis=2)
 
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN blocks
-            return np.nanmin(blocks, axis=(1, 3))
+
+def low_outliers(z: np.ndarray, known: np.ndarray, depth: float) -> np.ndarray:
+    """Cells more than ``depth`` below the median of their 3 x 3 neighbourhood (matching pits: a pit pulls the
+    opening down and the ground around it becomes 'object').  A ditch wider than two cells is no outlier."""
+    from scipy import ndimage
+
+    med = ndimage.median_filter(z, size=3, mode="nearest")
+    return known & (z < med - depth)
 
 
 def smrf_objects(zmin: np.ndarray, cell: float, options: GroundOptions, progress: Progress) -> np.ndarray:
@@ -143,11 +155,16 @@ def filter_ground(dsm: np.ndarray, cell: float, options: GroundOptions,
     h, w = dsm.shape
     factor = max(1, int(round(options.filter_cell / cell)))
     coarse_cell = cell * factor
-    zmin = _block_min(dsm, factor)
+    zmin = _block_surface(dsm, factor)
     coarse_valid = np.isfinite(zmin)
+    coarse_valid &= ~low_outliers(push_pull(np.nan_to_num(zmin), coarse_valid), coarse_valid, 2 * options.threshold)
     zfill = push_pull(np.nan_to_num(zmin), coarse_valid)
     objects = smrf_objects(zfill, coarse_cell, options, progress) | ~coarse_valid
-    provisional_c = push_pull(zfill, ~objects) if (~objects).any() else zfill
+    # the provisional surface is drawn under the objects and their skirts: a DSM blurs a wall into a slope
+    # that an opening keeps (it keeps every ramp), and the skirt would then pass for ground
+    skirt = int(np.ceil(options.skirt / coarse_cell))
+    grown = ndimage.binary_dilation(objects, iterations=skirt) if skirt else objects
+    provisional_c = push_pull(zfill, ~grown) if (~grown).any() else zfill
     provisional = resample_to(provisional_c, factor, h, w)
     gy, gx = np.gradient(provisional, cell)
     slope = np.hypot(gx, gy)
@@ -223,4 +240,4 @@ def _spline_fill(dsm, ground, lab, label, sl, ring, fill) -> np.ndarray:
         out = np.concatenate([rbf(q[i:i + 200_000]) for i in range(0, len(q), 200_000)])
     except (np.linalg.LinAlgError, ValueError):
         return fill[r0:r1, c0:c1][comp]
-    return out
+    return np.clip(out, vals.min(), vals.max())  # a spline may overshoot between noisy ring points: never above

@@ -43,6 +43,7 @@ class GroundOptions:
     scalar: float = 1.25  # threshold grows by scalar x the local slope of the provisional surface
     filter_cell: float = 0.5  # m, the grid of the morphological opening (finer DSMs are reduced to it)
     dilate: float = 0.0  # m, objects grown by this much (0 = one DSM cell: the blurred foot of a wall)
+    skirt: float = 2.0  # m around the objects where the provisional surface is interpolated (blurred walls)
 
 
 @dataclass
