@@ -45,10 +45,12 @@ $(CONSTRAINTS): $(BUILD)/.apt-stamp FORCE
 	@cmp -s $@.new $@ && rm -f $@.new || mv -f $@.new $@
 
 venv: $(VENV)/.stamp
-$(VENV)/.stamp: requirements.txt requirements-dev.txt $(CONSTRAINTS)
+$(VENV)/.stamp: requirements.txt requirements-dev.txt requirements-optional.txt $(CONSTRAINTS)
 	@test -x $(PY) || $(SYSPY) -m venv --system-site-packages $(VENV)
 	@echo "Installing Python packages into $(VENV) ($$(cat $(CONSTRAINTS)))" >&2
 	@$(PY) -m pip install -q --disable-pip-version-check -c $(CONSTRAINTS) -r requirements-dev.txt >&2
+	@$(PY) -m pip install -q --disable-pip-version-check --no-deps --ignore-requires-python -c $(CONSTRAINTS) \
+	  -r requirements-optional.txt >&2
 	@$(PY) -c "import numpy, pycolmap, cv2; from osgeo import gdal_array; import qgis.core; \
 	  assert 'numpy==' + numpy.__version__ == '$$(cat $(CONSTRAINTS))', numpy.__file__; \
 	  print('venv ok: numpy', numpy.__version__, 'pycolmap', pycolmap.__version__, 'cv2', cv2.__version__, \

@@ -29,12 +29,15 @@ def algorithms():
     from .accuracy_report import AccuracyReportAlgorithm
     from .align_images import AlignImagesAlgorithm
     from .build_dsm import BuildDsmAlgorithm
+    from .build_dtm import BuildDtmAlgorithm
     from .build_orthophoto import BuildOrthophotoAlgorithm
+    from .contours import ContoursAlgorithm
     from .georeference import GeoreferenceAlgorithm
     from .orthorectify_image import OrthorectifyImageAlgorithm
     from .prepare_images import PrepareImagesAlgorithm
+    from .relief_visualisation import ReliefVisualisationAlgorithm
     from .run_pipeline import RunPipelineAlgorithm
 
     return [AlignImagesAlgorithm(), GeoreferenceAlgorithm(), BuildDsmAlgorithm(), PrepareImagesAlgorithm(),
             AccuracyReportAlgorithm(), BuildOrthophotoAlgorithm(), OrthorectifyImageAlgorithm(),
-            RunPipelineAlgorithm()]
+            RunPipelineAlgorithm(), BuildDtmAlgorithm(), ReliefVisualisationAlgorithm(), ContoursAlgorithm()]

@@ -54,6 +54,15 @@ REQUIREMENTS: Tuple[Requirement, ...] = (
     Requirement("cv2", "opencv-python-headless", "4.10.0.84", "OpenCV (image processing)", "4.5", "5"),
 )
 
+# optional packages: the plugin loads and runs without them; the one feature that needs one names it and the pip
+# command when used.  rvt-py (relief visualisations, core/terrain/relief.py) is one pure-Python wheel whose
+# metadata asks for Python < 3.12 and for jupyter, geopandas, rasterio, ... that rvt.vis never imports (it needs
+# NumPy and SciPy only): it is installed with --no-deps --ignore-requires-python (tested on Python 3.11 and 3.13)
+OPTIONAL: Tuple[Requirement, ...] = (
+    Requirement("rvt.vis", "rvt-py", "2.2.3", "rvt-py (relief visualisations)", "2.2", "3"),
+)
+OPTIONAL_PIP_FLAGS = ("--no-deps", "--ignore-requires-python")
+
 # what `pip download --only-binary=:all: --platform <tag> --python-version <v> pycolmap==4.2.1` finds
 # (checked for win_amd64, macosx_14_0_arm64, macosx_10_15_x86_64, macosx_13_0_x86_64, manylinux2014_x86_64,
 # manylinux_2_28_x86_64/aarch64 and Python 3.10-3.14); OpenCV 4.10.0.84 has wheels everywhere pycolmap has
@@ -317,6 +326,9 @@ def command_line(program: str, args: Sequence[str], platform: str = sys.platform
 def install_command(packages: Optional[Iterable[str]] = None) -> str:
     """The command a user runs for a missing package: the plugin folder's pip command for the pinned
     packages once configure() knows the profile, else the plain pip command."""
+    optional = [r for r in OPTIONAL if packages is not None and (r.dist in packages or r.module in packages)]
+    if optional:
+        return command_line("python3", ["-m", "pip", "install", *OPTIONAL_PIP_FLAGS, *[r.pin for r in optional]])
     wanted = [r for r in REQUIREMENTS if packages is None or r.dist in packages or r.module in packages]
     known = {r.dist for r in REQUIREMENTS} | {r.module for r in REQUIREMENTS}
     others = [p for p in (packages or []) if p not in known]

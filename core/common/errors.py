@@ -46,7 +46,7 @@ class MissingDependencyError(ArchaeoOrthoError, ImportError):
 PINNED = {r.dist: r.pin for r in REQUIREMENTS}
 
 # import name -> PyPI name
-_PYPI = {"cv2": "opencv-python-headless", "pycolmap": "pycolmap"}
+_PYPI = {"cv2": "opencv-python-headless", "pycolmap": "pycolmap", "rvt": "rvt-py", "rvt.vis": "rvt-py"}
 
 
 def require(module: str, purpose: str = "") -> Any:

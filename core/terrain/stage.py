@@ -156,8 +156,9 @@ def build_dtm_workspace(workspace_dir: str, dsm: Optional[str] = None, output_dt
 
 def relief(dem_path: str, keys: Sequence[str], output_dir: str, prefix: str = "dtm",
            options: Optional[ReliefOptions] = None, progress: Optional[Progress] = None,
-           what: str = "DTM") -> ReliefResult:
-    """The visualisations ``keys`` of the elevation raster ``dem_path`` as ``<output_dir>/<prefix>-<key>.tif``."""
+           what: str = "DTM", outputs: Optional[Dict[str, str]] = None) -> ReliefResult:
+    """The visualisations ``keys`` of the elevation raster ``dem_path`` as ``<output_dir>/<prefix>-<key>.tif``
+    (or at ``outputs[key]``)."""
     progress = progress or NullProgress()
     options = options or ReliefOptions()
     bad = [k for k in keys if k not in VISUALISATION_KEYS]
@@ -170,7 +171,7 @@ def relief(dem_path: str, keys: Sequence[str], output_dir: str, prefix: str = "d
         sub = SubProgress(progress, i / len(keys), (i + 1) / len(keys))
         sub.report(0.0, f"relief visualisation: {key}")
         image = rv.compute(key, elev.z, elev.cell, options, sub)
-        path = os.path.join(output_dir, f"{prefix}-{key}.tif")
+        path = (outputs or {}).get(key) or os.path.join(output_dir, f"{prefix}-{key}.tif")
         lo, hi = rv.DISPLAY_RANGE[key]
         write_float(path, image, elev, f"{key} ({rv.UNITS[key]})",
                     {"ARCHAEOORTHO_STAGE": "relief", "ARCHAEOORTHO_PRODUCT": f"relief-{key}", "RELIEF": key,
