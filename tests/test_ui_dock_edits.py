@@ -516,6 +516,45 @@ def test_new_point_hint_and_the_viewer_jumps_to_the_best_predicted_photo(dock, g
     assert math.hypot(px.x() - t[0], px.y() - t[1]) < 15.0
 
 
+def test_a_pick_without_a_heights_layer_is_predicted_at_the_height_of_the_block(dock, georef_ws, block,  # noqa: F811
+                                                                                 qgis_canvas):
+    """No heights layer, no Z typed: on a georeferenced block the point stands at the height of the tie points
+    around it, is predicted, and the viewer shows its best photo."""
+    assert dock.open_workspace(georef_ws)
+    assert dock.dsm_combo.currentLayer() is None
+    utm_canvas(qgis_canvas, block)
+    truth, xyz = _new_point_xyz(block, [p.name for p in dock.store.gcps.points])
+    c = Counter()
+    c.click(tool_button(dock, dock.act_add))
+    name = dock.current_name()
+    c.click(tool_button(dock, dock.act_pick))
+    c.click(qgis_canvas.viewport(), canvas_pixel(qgis_canvas, xyz[0], xyz[1]))
+    point = dock.store.gcps.by_name(name)
+    assert math.isnan(point.z)  # nothing invented in the table
+    preds = dock.predictions
+    assert preds, "no predictions for a picked point without Z"
+    best = min(preds, key=lambda n: preds[n].centrality)
+    assert dock.photo_panel.image == best and dock.photo_panel.prediction is not None
+    assert "tie points" in dock.photo_panel.hint.text()
+    t = truth.observations[best]
+    q = preds[best]
+    assert math.hypot(q.x - t[0], q.y - t[1]) < 25.0  # the pick (0.27 m a canvas pixel) and the height's error
+
+
+def test_a_pick_that_sets_the_crs_is_one_undo_step(dock, aligned_ws, block, qgis_canvas):  # noqa: F811
+    QTest, Qt, _, _ = _qt()
+    assert dock.open_workspace(aligned_ws)
+    assert dock.store.crs == "" and dock.store.gcps.points == []
+    utm_canvas(qgis_canvas, block)
+    c = Counter()
+    c.click(tool_button(dock, dock.act_pick))
+    c.click(qgis_canvas.viewport(), canvas_pixel(qgis_canvas, syn.ORIGIN[0], syn.ORIGIN[1]))
+    assert len(dock.store.gcps.points) == 1 and dock.store.crs
+    dock.table.setFocus()
+    c.key(dock.table, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
+    assert dock.store.gcps.points == [] and dock.store.gcps.crs == ""
+
+
 # --------------------------------------------------------------------------------------------------
 # 18.12: the tolerance shows its source; the diagnosis shows in the dock
 # --------------------------------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 with guided placement (core.georef.guided predicts where a point is in each photo and refines that by
 matching its look in a photo where it is placed).  A mixin of ui.gcp_dock.GcpDock: it works on the dock's
 store, table and photo panel; its strings are translated in the dock's context."""
+import dataclasses
 import html
 import math
 import os
@@ -123,6 +124,16 @@ class GcpPlacement:
         selected) in the GCP CRS, Z from the heights layer."""
         if self.store.workspace is None:
             return
+        if self.store.crs:
+            return self._map_picked(point)
+        stack = self.store.undo_stack
+        stack.beginMacro(translate("GcpDock", "pick on map"))  # the CRS it sets and the point: one undo step
+        try:
+            return self._map_picked(point)
+        finally:
+            stack.endMacro()
+
+    def _map_picked(self, point):
         canvas_crs = self._project_crs()
         if not self.store.crs:
             self.store.set_crs(layers.crs_text(canvas_crs))
@@ -203,6 +214,23 @@ class GcpPlacement:
         self.markers.update(pts, self.current_name())
 
     # ------------------------------------------------------------------ photos and predictions
+    def _predictable(self, point):
+        """The point as the predictor is to see it: a point with X and Y but no Z (no heights layer, none typed)
+        on a georeferenced block stands at the height of the block's tie points around it."""
+        self._z_from_block = False
+        if point is None or self.predictor is None or not self.predictor.georeferenced \
+                or not (math.isfinite(point.x) and math.isfinite(point.y)) or math.isfinite(point.z):
+            return point
+        off = self.predictor.offset
+        try:
+            z = self.predictor.surface_height(point.x - off[0], point.y - off[1])
+        except Exception:  # noqa: BLE001 - no surface: no prediction from the world coordinates
+            z = None
+        if z is None or not math.isfinite(z):
+            return point
+        self._z_from_block = True
+        return dataclasses.replace(point, z=float(z + off[2]))
+
     def _update_predictions(self):
         self.predictions = {}
         point = self.current_point()
@@ -210,6 +238,7 @@ class GcpPlacement:
             return
         try:
             self.predictor.fit(self.store.gcps)
+            point = self._predictable(point)
             preds = self.predictor.predict_point(point)
             if any(p.source != "rays" for p in preds.values()):
                 # positions from world coordinates can be off by the block's misfit to the control: offer
@@ -278,7 +307,7 @@ class GcpPlacement:
         if key not in self.matches:
             match = None
             try:
-                xyz, _ = self.predictor.model_point(point)
+                xyz, _ = self.predictor.model_point(self._predictable(point))
                 cam = self.predictor.rec.cameras
                 size = max(max(c.width, c.height) for c in cam.values())
                 tgt = self._gray_image(image)
@@ -364,6 +393,8 @@ class GcpPlacement:
                   "georef": translate("GcpDock", "from the georeferenced block"),
                   "helmert": translate("GcpDock", "from the points already placed (similarity fit)"),
                   "matched": translate("GcpDock", "by matching its look in another photo")}.get(pred.source if pred else "", "")
+        if pred is not None and pred.source != "rays" and getattr(self, "_z_from_block", False):
+            source += " " + translate("GcpDock", "(no Z yet: at the height of the block's tie points)")
         if match is not None:
             source += " " + translate("GcpDock", "(correlation {:.2f}, {:.0f} px from the geometric prediction)").format(
                 match.score, match.shift)
