@@ -138,11 +138,28 @@ class ArchaeoOrthoPlugin:
             self.iface.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, self.dock)
             self.iface.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.dock.photo_dock)
             self.dock.visibilityChanged.connect(self._dock_visibility)
+            self.dock.setUserVisible(visible)
+            self.dock.photo_dock.setUserVisible(visible)
+            self._default_dock_sizes()
         self.dock.setUserVisible(visible)
         self.dock.photo_dock.setUserVisible(visible)
         if self.action is not None and self.action.isChecked() != visible:
             self.action.setChecked(visible)
         return self.dock
+
+    def _default_dock_sizes(self):
+        """First shown: the GCP dock at its default width (the key columns visible), the photo dock at a height
+        where a photo can be worked in (QGIS would give it the height of its smallest content)."""
+        from qgis.PyQt.QtCore import Qt
+
+        from .ui.gcp_dock import PHOTO_DOCK_HEIGHT
+
+        main = self.iface.mainWindow()
+        if not hasattr(main, "resizeDocks"):
+            return
+        height = min(PHOTO_DOCK_HEIGHT, max(300, int(main.height() * 0.62)))
+        main.resizeDocks([self.dock.photo_dock], [height], Qt.Orientation.Vertical)
+        main.resizeDocks([self.dock], [self.dock.sizeHint().width()], Qt.Orientation.Horizontal)
 
     def _dock_visibility(self, visible):
         if self.action is not None and not visible and self.dock is not None and not self.dock.isUserVisible():

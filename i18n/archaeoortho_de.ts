@@ -202,17 +202,17 @@ Rekonstruktionsverfahren (erweitert): 'incremental' (COLMAP, Standard) oder 'glo
 <context>
     <name>ArchaeoOrthoPlugin</name>
     <message>
-        <location filename="../plugin.py" line="114"/>
+        <location filename="../plugin.py" line="115"/>
         <source>Ground control (GCP dock)</source>
         <translation>Passpunkte (GCP-Fenster)</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="118"/>
+        <location filename="../plugin.py" line="119"/>
         <source>ArchaeoOrtho: pick ground control points on the map and in the photos</source>
         <translation>ArchaeoOrtho: Passpunkte auf der Karte und in den Fotos messen</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="162"/>
+        <location filename="../plugin.py" line="180"/>
         <source>&amp;ArchaeoOrtho</source>
         <translation>&amp;ArchaeoOrtho</translation>
     </message>
@@ -325,6 +325,110 @@ OUTPUT_POINT_CLOUD: optionale LAS-Datei (XYZ + RGB, KBS des Arbeitsbereichs).
 DASK_SCHEDULER: die Stereopaare auf einem Dask-Cluster (tcp://host:8786) rechnen, dessen Worker den Pfad des Arbeitsbereichs sehen; leer = dieser Rechner (oder die Umgebungsvariable ARCHAEOORTHO_DASK_SCHEDULER).
 
 Ein erneuter Lauf nach einem Abbruch setzt fort: bereits zugeordnete Paare werden aus &lt;workspace&gt;/dense/ wiederverwendet.</translation>
+    </message>
+</context>
+<context>
+    <name>BuildDtmAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="53"/>
+        <source>Workspace folder</source>
+        <translation>Arbeitsbereich-Ordner</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <source>DSM file (default: the workspace&apos;s)</source>
+        <translation>DOM-Datei (Vorgabe: das des Arbeitsbereichs)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <source>Contour interval in metres (0 = none)</source>
+        <translation>Höhenlinienabstand in Metern (0 = keine)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <source>Ground filter slope (rise over run)</source>
+        <translation>Neigung des Bodenfilters (Steigung)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <source>Largest object radius in metres</source>
+        <translation>Größter Objektradius in Metern</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <source>Height above ground of an object in metres</source>
+        <translation>Höhe eines Objekts über dem Boden in Metern</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="65"/>
+        <source>DTM (default: &lt;workspace&gt;/dtm.tif)</source>
+        <translation>DGM (Vorgabe: &lt;workspace&gt;/dtm.tif)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="67"/>
+        <source>Contours (default: &lt;workspace&gt;/terrain/contours.gpkg)</source>
+        <translation>Höhenlinien (Vorgabe: &lt;workspace&gt;/terrain/contours.gpkg)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="70"/>
+        <source>Workspace</source>
+        <translation>Arbeitsbereich</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="71"/>
+        <source>DTM source</source>
+        <translation>DGM-Herkunft</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="72"/>
+        <source>Classified point cloud</source>
+        <translation>Klassifizierte Punktwolke</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="73"/>
+        <source>Contour lines</source>
+        <translation>Höhenlinien</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="74"/>
+        <source>Share of DSM cells on the ground</source>
+        <translation>Anteil der DOM-Zellen am Boden</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="75"/>
+        <source>Share of DTM cells interpolated</source>
+        <translation>Anteil der interpolierten DGM-Zellen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="102"/>
+        <source>Give a workspace folder, or a DSM file and where to write the DTM</source>
+        <translation>Geben Sie einen Arbeitsbereich-Ordner an, oder eine DOM-Datei und wohin das DGM geschrieben wird</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Build DTM</source>
+        <translation>DGM erzeugen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>A digital terrain model (bare earth) from the DSM: buildings, trees and crops removed, the ground interpolated under them.
+
+The ground filter is SMRF (Pingel et al. 2013, the algorithm of PDAL&apos;s filters.smrf) on the DSM&apos;s grid; under each removed object the ground is a thin-plate spline through the ground around it. The DTM is a Cloud-Optimized GeoTIFF on the DSM&apos;s exact grid; beside it terrain/dtm-source.tif says which cells are measured ground (1) and which interpolated (2). The DSM stage&apos;s point cloud, if it wrote one, is copied with ASPRS classes 2 (ground) and 1 (unclassified) to terrain/points-classified.las.
+
+Workspace folder: a workspace with a DSM (optional when a DSM file is given).
+DSM file: any DSM in a projected CRS (metres); default: the workspace&apos;s.
+Contour interval: contour lines every this many metres into a GeoPackage (0 = none).
+Slope, largest object radius and height threshold (advanced): SMRF&apos;s parameters (PDAL&apos;s defaults).
+DTM: where to write it (default: &lt;workspace&gt;/dtm.tif).</source>
+        <translation>Ein digitales Geländemodell (nackte Erde) aus dem DOM: Gebäude, Bäume und Feldfrüchte entfernt, der Boden darunter interpoliert.
+
+Der Bodenfilter ist SMRF (Pingel et al. 2013, der Algorithmus von PDALs filters.smrf) auf dem Raster des DOM; unter jedem entfernten Objekt ist der Boden ein Thin-Plate-Spline durch den Boden ringsum. Das DGM ist ein Cloud-Optimized GeoTIFF auf genau dem Raster des DOM; daneben sagt terrain/dtm-source.tif, welche Zellen gemessener Boden (1) und welche interpoliert (2) sind. Die Punktwolke der DOM-Stufe wird, falls sie eine geschrieben hat, mit den ASPRS-Klassen 2 (Boden) und 1 (nicht klassifiziert) nach terrain/points-classified.las kopiert.
+
+Arbeitsbereich-Ordner: ein Arbeitsbereich mit DOM (optional, wenn eine DOM-Datei angegeben ist).
+DOM-Datei: ein beliebiges DOM in einem projizierten KBS (Meter); Vorgabe: das des Arbeitsbereichs.
+Höhenlinienabstand: Höhenlinien alle so viele Meter in ein GeoPackage (0 = keine).
+Neigung, größter Objektradius und Höhenschwelle (erweitert): die Parameter von SMRF (die Vorgaben von PDAL).
+DGM: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/dtm.tif).</translation>
     </message>
 </context>
 <context>
@@ -445,44 +549,80 @@ Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786)
     </message>
 </context>
 <context>
+    <name>ContoursAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/contours.py" line="30"/>
+        <source>Elevation raster</source>
+        <translation>Höhenraster</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/contours.py" line="30"/>
+        <source>Interval in metres</source>
+        <translation>Abstand in Metern</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Contours</source>
+        <translation>Höhenlinien</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/contours.py" line="37"/>
+        <source>Contour lines</source>
+        <translation>Höhenlinien</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Contour lines of a DTM or DSM at a chosen interval (GDAL&apos;s contour generator) into a GeoPackage layer &apos;contours&apos; whose &apos;elevation&apos; field labels them.
+
+Elevation raster: a DTM or DSM in a projected CRS (metres).
+Interval: metres between two contour lines (e.g. 0.5).
+Contours: the GeoPackage to write.</source>
+        <translation>Höhenlinien eines DGM oder DOM in einem gewählten Abstand (GDALs Höhenliniengenerator) in einen GeoPackage-Layer &apos;contours&apos;, dessen Feld &apos;elevation&apos; sie beschriftet.
+
+Höhenraster: ein DGM oder DOM in einem projizierten KBS (Meter).
+Abstand: Meter zwischen zwei Höhenlinien (z. B. 0.5).
+Höhenlinien: das zu schreibende GeoPackage.</translation>
+    </message>
+</context>
+<context>
     <name>GcpDock</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="65"/>
+        <location filename="../ui/gcp_dock.py" line="74"/>
         <source>ArchaeoOrtho ground control</source>
         <translation>ArchaeoOrtho Passpunkte</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="92"/>
         <source>ArchaeoOrtho photos</source>
         <translation>ArchaeoOrtho Fotos</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="117"/>
+        <location filename="../ui/gcp_dock.py" line="141"/>
         <source>Workspace:</source>
         <translation>Arbeitsbereich:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="298"/>
+        <location filename="../ui/gcp_dock.py" line="348"/>
         <source>none open</source>
         <translation>keiner geöffnet</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="123"/>
+        <location filename="../ui/gcp_dock.py" line="148"/>
         <source>Open a workspace folder (made by Align images)</source>
         <translation>Einen Arbeitsbereich-Ordner öffnen (von 'Bilder ausrichten' angelegt)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="125"/>
+        <location filename="../ui/gcp_dock.py" line="150"/>
         <source>Choose a folder of photos and a workspace folder, and align the photos</source>
         <translation>Einen Fotoordner und einen Arbeitsbereich-Ordner wählen und die Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="132"/>
+        <location filename="../ui/gcp_dock.py" line="157"/>
         <source>Heights (Z) from:</source>
         <translation>Höhen (Z) aus:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="137"/>
+        <location filename="../ui/gcp_dock.py" line="162"/>
         <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
         <translation>Ein DOM- oder DGM-Rasterlayer (z. B. ein ALS-DOM): ein auf der Karte gemessener Punkt erhält seine Höhe daraus (bilinear). Leer: Z von Hand eingeben.</translation>
     </message>
@@ -492,27 +632,27 @@ Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786)
         <translation>Hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="148"/>
+        <location filename="../ui/gcp_dock.py" line="177"/>
         <source>Add a ground point</source>
         <translation>Einen Passpunkt hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="149"/>
+        <location filename="../ui/gcp_dock.py" line="178"/>
         <source>Remove</source>
         <translation>Entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="150"/>
+        <location filename="../ui/gcp_dock.py" line="179"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Den gewählten Passpunkt mit seinen Messungen entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="151"/>
+        <location filename="../ui/gcp_placement.py" line="185"/>
         <source>Pick on map</source>
         <translation>Auf der Karte messen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="153"/>
+        <location filename="../ui/gcp_dock.py" line="182"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>In die Kartenansicht klicken, um X und Y des gewählten Punkts zu setzen (Z aus dem Höhenlayer)</translation>
     </message>
@@ -522,107 +662,107 @@ Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786)
         <translation>Importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="161"/>
+        <location filename="../ui/gcp_dock.py" line="190"/>
         <source>Export</source>
         <translation>Exportieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="174"/>
+        <location filename="../ui/gcp_dock.py" line="205"/>
         <source>Undo</source>
         <translation>Rückgängig</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="175"/>
+        <location filename="../ui/gcp_dock.py" line="206"/>
         <source>Redo</source>
         <translation>Wiederholen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="182"/>
+        <location filename="../ui/gcp_dock.py" line="216"/>
         <source>Undo: {}</source>
         <translation>Rückgängig: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="183"/>
+        <location filename="../ui/gcp_dock.py" line="218"/>
         <source>Redo: {}</source>
         <translation>Wiederholen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="168"/>
+        <location filename="../ui/gcp_dock.py" line="197"/>
         <source>Load results</source>
         <translation>Ergebnisse laden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="169"/>
+        <location filename="../ui/gcp_dock.py" line="198"/>
         <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Die Produkte des Arbeitsbereichs als gestaltete Layer zur Karte hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="205"/>
+        <location filename="../ui/gcp_dock.py" line="250"/>
         <source>Residual tolerance:</source>
         <translation>Residuen-Toleranz:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="211"/>
+        <location filename="../ui/gcp_dock.py" line="256"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="215"/>
+        <location filename="../ui/gcp_dock.py" line="265"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="216"/>
+        <location filename="../ui/gcp_dock.py" line="266"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Die Ausgleichung Brennweite, Bildhauptpunkt und Verzeichnung verfeinern lassen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="223"/>
+        <location filename="../ui/gcp_dock.py" line="273"/>
         <source>Georeference</source>
         <translation>Georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="224"/>
+        <location filename="../ui/gcp_dock.py" line="274"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Die Ausgleichung mit diesen Punkten ausführen (im Hintergrund)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="225"/>
+        <location filename="../ui/gcp_dock.py" line="275"/>
         <source>Cancel</source>
         <translation>Abbrechen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="275"/>
+        <location filename="../ui/gcp_dock.py" line="325"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="282"/>
+        <location filename="../ui/gcp_dock.py" line="332"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Einen ArchaeoOrtho-Arbeitsbereich öffnen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="319"/>
+        <location filename="../ui/gcp_dock.py" line="370"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} Fotos; der Block ist noch nicht ausgerichtet: 'Bilder ausrichten' (oder 'Neu aus Fotos') ausführen, um vorhergesagte Positionen zu erhalten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="322"/>
+        <location filename="../ui/gcp_dock.py" line="373"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} Fotos, {} Passpunkte. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="221"/>
+        <location filename="../ui/gcp_placement.py" line="273"/>
         <source>no predicted positions: {}</source>
         <translation>keine vorhergesagten Positionen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="61"/>
+        <location filename="../ui/gcp_placement.py" line="63"/>
         <source>Predicted positions from the georeferenced block.</source>
         <translation>Vorhergesagte Positionen aus dem georeferenzierten Block.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="61"/>
+        <location filename="../ui/gcp_placement.py" line="63"/>
         <source>Predicted positions once a point is placed in 2 photos, and for every point once 3 points are placed.</source>
         <translation>Vorhergesagte Positionen, sobald ein Punkt in 2 Fotos gemessen ist, und für alle Punkte, sobald 3 Punkte gemessen sind.</translation>
     </message>
@@ -637,92 +777,92 @@ Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786)
         <translation>Arbeitsbereich-Ordner (neu oder vorhanden)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="39"/>
+        <location filename="../ui/gcp_tasks.py" line="40"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
         <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="43"/>
+        <location filename="../ui/gcp_tasks.py" line="47"/>
         <source>ArchaeoOrtho: align photos</source>
         <translation>ArchaeoOrtho: Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="400"/>
+        <location filename="../ui/gcp_dock.py" line="495"/>
         <source>CRS: {}</source>
         <translation>KBS: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="107"/>
+        <location filename="../ui/gcp_placement.py" line="109"/>
         <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Auf der Karte an die Position des gewählten Punkts klicken (Esc beendet)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="153"/>
+        <location filename="../ui/gcp_placement.py" line="173"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (aus {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="156"/>
+        <location filename="../ui/gcp_placement.py" line="176"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Keine Höhe an dieser Stelle in {}: Z bleibt unverändert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="159"/>
+        <location filename="../ui/gcp_placement.py" line="179"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="331"/>
+        <location filename="../ui/gcp_placement.py" line="383"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="333"/>
+        <location filename="../ui/gcp_placement.py" line="385"/>
         <source>predicted</source>
         <translation>vorhergesagt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="356"/>
+        <location filename="../ui/gcp_placement.py" line="408"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Einen Passpunkt in der Tabelle wählen oder hinzufügen, dann im Foto darauf klicken.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="363"/>
+        <location filename="../ui/gcp_placement.py" line="415"/>
         <source>from the point&apos;s other observations</source>
         <translation>aus den übrigen Messungen des Punkts</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="364"/>
+        <location filename="../ui/gcp_placement.py" line="416"/>
         <source>from the georeferenced block</source>
         <translation>aus dem georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="365"/>
+        <location filename="../ui/gcp_placement.py" line="417"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>aus den bereits gemessenen Punkten (Ähnlichkeitstransformation)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="374"/>
+        <location filename="../ui/gcp_placement.py" line="428"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Gemessen bei x {:.2f}, y {:.2f}. Klicken zum Versetzen, ziehen oder Entf zum Entfernen.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="377"/>
+        <location filename="../ui/gcp_placement.py" line="431"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Vorhergesagt {}. Eingabetaste übernimmt und geht weiter (Leertaste: übernehmen), ziehen oder dorthin klicken, wo der Punkt wirklich ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="389"/>
+        <location filename="../ui/gcp_placement.py" line="443"/>
         <source>Click where {} is in this photo.</source>
         <translation>Dorthin klicken, wo {} in diesem Foto ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="409"/>
+        <location filename="../ui/gcp_placement.py" line="463"/>
         <source>Select or add a ground point first</source>
         <translation>Zuerst einen Passpunkt wählen oder hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="456"/>
+        <location filename="../ui/gcp_placement.py" line="510"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: jedes Foto, das ihn voraussichtlich zeigt, hat eine Messung</translation>
     </message>
@@ -842,117 +982,117 @@ Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786)
         <translation>{} kann nicht zum Projekt hinzugefügt werden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="50"/>
+        <location filename="../ui/gcp_tasks.py" line="54"/>
         <source>A task of this dock is still running</source>
         <translation>Eine Aufgabe dieses Fensters läuft noch</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="73"/>
+        <location filename="../ui/gcp_tasks.py" line="77"/>
         <source>Cancelled</source>
         <translation>Abgebrochen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="90"/>
+        <location filename="../ui/gcp_tasks.py" line="94"/>
         <source>The block is not aligned yet: run Align images first</source>
         <translation>Der Block ist noch nicht ausgerichtet: zuerst 'Bilder ausrichten' ausführen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="96"/>
+        <location filename="../ui/gcp_tasks.py" line="100"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>Die Ausgleichung braucht mindestens 3 Passpunkte mit Koordinaten und Messungen; vorhanden sind {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="112"/>
+        <location filename="../ui/gcp_tasks.py" line="116"/>
         <source>Outliers left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="113"/>
+        <location filename="../ui/gcp_tasks.py" line="117"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziert in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="116"/>
+        <location filename="../ui/gcp_tasks.py" line="120"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="125"/>
+        <location filename="../ui/gcp_tasks.py" line="129"/>
         <source>Not georeferenced yet.</source>
         <translation>Noch nicht georeferenziert.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="127"/>
+        <location filename="../ui/gcp_tasks.py" line="131"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Passpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="130"/>
+        <location filename="../ui/gcp_tasks.py" line="134"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Kontrollpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="133"/>
+        <location filename="../ui/gcp_tasks.py" line="137"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>Höhen sind Platzhalter: keine Höhengenauigkeit</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="135"/>
+        <location filename="../ui/gcp_tasks.py" line="139"/>
         <source>tie points {} px</source>
         <translation>Verknüpfungspunkte {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="137"/>
+        <location filename="../ui/gcp_tasks.py" line="141"/>
         <source>edited since: re-run to update</source>
         <translation>seither bearbeitet: erneut ausführen zum Aktualisieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="366"/>
+        <location filename="../ui/gcp_placement.py" line="418"/>
         <source>by matching its look in another photo</source>
         <translation>durch Abgleich mit seinem Aussehen in einem anderen Foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="368"/>
+        <location filename="../ui/gcp_placement.py" line="422"/>
         <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
         <translation>(Korrelation {:.2f}, {:.0f} px von der geometrischen Vorhersage)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="122"/>
+        <location filename="../ui/gcp_dock.py" line="147"/>
         <source>Open…</source>
         <translation>Öffnen…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="124"/>
+        <location filename="../ui/gcp_dock.py" line="149"/>
         <source>New from photos…</source>
         <translation>Neu aus Fotos…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="156"/>
+        <location filename="../ui/gcp_dock.py" line="185"/>
         <source>From file (gcp_list.txt, CSV)…</source>
         <translation>Aus Datei (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="157"/>
+        <location filename="../ui/gcp_dock.py" line="186"/>
         <source>From a point layer…</source>
         <translation>Aus einem Punktlayer…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="159"/>
+        <location filename="../ui/gcp_dock.py" line="188"/>
         <source>To file (gcp_list.txt, CSV)…</source>
         <translation>In Datei (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="160"/>
+        <location filename="../ui/gcp_dock.py" line="189"/>
         <source>To a GeoPackage layer…</source>
         <translation>In einen GeoPackage-Layer…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="81"/>
+        <location filename="../ui/gcp_tasks.py" line="85"/>
         <source>Cancelling…</source>
         <translation>Wird abgebrochen…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="119"/>
+        <location filename="../ui/gcp_tasks.py" line="123"/>
         <source>Georeferencing with {} control points…</source>
         <translation>Georeferenzierung mit {} Passpunkten…</translation>
     </message>
@@ -967,64 +1107,134 @@ Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786)
         <translation>Koordinaten auf aufrecht gedrehten Fotos gemessen ({} Fotos sind gedreht gespeichert: EXIF-Ausrichtung); nicht ankreuzen für das gespeicherte Pixelraster (das von COLMAP und OpenDroneMap)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="70"/>
+        <location filename="../ui/gcp_placement.py" line="72"/>
         <source>your setting</source>
         <translation>Ihre Einstellung</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="73"/>
+        <location filename="../ui/gcp_placement.py" line="75"/>
         <source>default: 3 × GSD of the georeferenced block (GSD {:.3f} m)</source>
         <translation>Vorgabe: 3 × Bodenauflösung des georeferenzierten Blocks (GSD {:.3f} m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="74"/>
+        <location filename="../ui/gcp_placement.py" line="76"/>
         <source>default</source>
         <translation>Vorgabe</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="81"/>
+        <location filename="../ui/gcp_placement.py" line="83"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red. Now: {}</source>
         <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot. Jetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="89"/>
+        <location filename="../ui/gcp_placement.py" line="91"/>
         <source>Diagnosis of the adjustment:</source>
         <translation>Diagnose der Ausgleichung:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="144"/>
+        <location filename="../ui/gcp_placement.py" line="164"/>
         <source>Moved {:.2f} m (Undo: Ctrl+Z).</source>
         <translation>Um {:.2f} m verschoben (Rückgängig: Strg+Z).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="333"/>
+        <location filename="../ui/gcp_placement.py" line="385"/>
         <source>near the edge</source>
         <translation>nahe am Rand</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="380"/>
+        <location filename="../ui/gcp_placement.py" line="434"/>
         <source>{} is predicted where it cannot be placed: {}. Click where the point is if you see it, or press Enter for the next photo.</source>
         <translation>{} wird dort vorhergesagt, wo er nicht gesetzt werden kann: {}. Klicken Sie auf den Punkt, wenn Sie ihn sehen, oder drücken Sie die Eingabetaste für das nächste Foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="386"/>
+        <location filename="../ui/gcp_placement.py" line="440"/>
         <source>Click where {} is in this photo, or use Pick on map (or type X, Y, Z in the table) to have it predicted in the photos.</source>
         <translation>Klicken Sie in diesem Foto auf {}, oder nutzen Sie „Auf der Karte messen“ (oder geben Sie X, Y, Z in der Tabelle ein), damit er in den Fotos vorhergesagt wird.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="399"/>
+        <location filename="../ui/gcp_placement.py" line="453"/>
         <source>{}: the workspace has no photos to place it in.</source>
         <translation>{}: der Arbeitsbereich hat keine Fotos, in denen er gesetzt werden kann.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="401"/>
+        <location filename="../ui/gcp_placement.py" line="455"/>
         <source>{} is selected: use Pick on map or type X, Y, Z in the table, or choose a photo in the strip below and click on the point.</source>
         <translation>{} ist ausgewählt: nutzen Sie „Auf der Karte messen“ oder geben Sie X, Y, Z in der Tabelle ein, oder wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="403"/>
+        <location filename="../ui/gcp_placement.py" line="457"/>
         <source>{} is selected: choose a photo in the strip below and click on the point.</source>
         <translation>{} ist ausgewählt: wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="213"/>
+        <source>Undo (Ctrl+Z)</source>
+        <translation>Rückgängig (Strg+Z)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="213"/>
+        <source>Redo (Ctrl+Shift+Z)</source>
+        <translation>Wiederholen (Strg+Umschalt+Z)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="391"/>
+        <source>Aligned {} of {} photos, mean reprojection error {:.2f} px.</source>
+        <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="396"/>
+        <source>Not aligned ({}): {}</source>
+        <translation>Nicht ausgerichtet ({}): {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="397"/>
+        <source>(marked in the photo strip; hover for the reason)</source>
+        <translation>(in der Fotoleiste markiert; der Grund steht im Tooltip)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="416"/>
+        <source>✗ not aligned</source>
+        <translation>✗ nicht ausgerichtet</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="417"/>
+        <source>{}: not aligned: {}</source>
+        <translation>{}: nicht ausgerichtet: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="43"/>
+        <source>Not aligned: {}</source>
+        <translation>Nicht ausgerichtet: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="131"/>
+        <source>pick on map</source>
+        <translation>auf der Karte messen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="420"/>
+        <source>(no Z yet: at the height of the block&apos;s tie points)</source>
+        <translation>(noch kein Z: auf der Höhe der Verknüpfungspunkte des Blocks)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="156"/>
+        <source>{} not moved</source>
+        <translation>{} nicht verschoben</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="185"/>
+        <source>{} is placed in {} photos. Move it {:.2f} m to the picked position, or add a new point there?</source>
+        <translation>{} ist in {} Fotos gesetzt. Um {:.2f} m an die gemessene Position verschieben, oder dort einen neuen Punkt anlegen?</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="189"/>
+        <source>Move {}</source>
+        <translation>{} verschieben</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="190"/>
+        <source>New point</source>
+        <translation>Neuer Punkt</translation>
     </message>
 </context>
 <context>
@@ -1286,7 +1496,7 @@ Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786)
         <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="95"/>
+        <location filename="../processing_provider/run_pipeline.py" line="103"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
@@ -1477,64 +1687,69 @@ RESIDUALS: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in
 <context>
     <name>PhotoPanel</name>
     <message>
-        <location filename="../ui/photo_viewer.py" line="425"/>
+        <location filename="../ui/photo_viewer.py" line="466"/>
         <source>Only photos that probably see the point</source>
         <translation>Nur Fotos, die den Punkt voraussichtlich zeigen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="428"/>
+        <location filename="../ui/photo_viewer.py" line="469"/>
         <source>Fit</source>
         <translation>Einpassen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="428"/>
+        <location filename="../ui/photo_viewer.py" line="469"/>
         <source>Show the whole photo (F)</source>
         <translation>Das ganze Foto zeigen (F)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="429"/>
+        <location filename="../ui/photo_viewer.py" line="470"/>
         <source>Zoom to point</source>
         <translation>Auf Punkt zoomen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="429"/>
+        <location filename="../ui/photo_viewer.py" line="470"/>
         <source>Zoom to the observation or prediction (Z)</source>
         <translation>Auf die Messung oder Vorhersage zoomen (Z)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="431"/>
+        <location filename="../ui/photo_viewer.py" line="472"/>
         <source>Confirm</source>
         <translation>Übernehmen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="431"/>
+        <location filename="../ui/photo_viewer.py" line="472"/>
         <source>Accept the predicted position (Space)</source>
         <translation>Die vorhergesagte Position übernehmen (Leertaste)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="433"/>
+        <location filename="../ui/photo_viewer.py" line="474"/>
         <source>Confirm &amp;&amp; next</source>
         <translation>Übernehmen &amp;&amp; weiter</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="433"/>
+        <location filename="../ui/photo_viewer.py" line="474"/>
         <source>Accept the prediction and show the next photo to place (Enter)</source>
         <translation>Die Vorhersage übernehmen und das nächste zu messende Foto zeigen (Eingabetaste)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="436"/>
+        <location filename="../ui/photo_viewer.py" line="477"/>
         <source>Remove</source>
         <translation>Entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="436"/>
+        <location filename="../ui/photo_viewer.py" line="477"/>
         <source>Remove the observation in this photo (Delete)</source>
         <translation>Die Messung in diesem Foto entfernen (Entf)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="599"/>
+        <location filename="../ui/photo_viewer.py" line="651"/>
         <source>{} (predicted)</source>
         <translation>{} (vorhergesagt)</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="563"/>
+        <source>Shown upright (EXIF orientation {}: stored {} x {} px); pixel coordinates are those of the stored grid, as COLMAP and gcp_list.txt use them</source>
+        <translation>Aufrecht gezeigt (EXIF-Ausrichtung {}: gespeichert {} x {} px); die Pixelkoordinaten sind die des gespeicherten Rasters, wie COLMAP und gcp_list.txt sie verwenden</translation>
     </message>
 </context>
 <context>
@@ -1694,6 +1909,76 @@ OUTPUT: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetzt; er muss ne
     </message>
 </context>
 <context>
+    <name>ReliefVisualisationAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="41"/>
+        <source>Workspace folder</source>
+        <translation>Arbeitsbereich-Ordner</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <source>Elevation raster (instead of the workspace&apos;s)</source>
+        <translation>Höhenraster (statt dem des Arbeitsbereichs)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <source>Surface</source>
+        <translation>Oberfläche</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <source>DTM</source>
+        <translation>DGM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <source>DSM</source>
+        <translation>DOM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <source>Visualisation</source>
+        <translation>Visualisierung</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="50"/>
+        <source>Visualisation (default: in &lt;workspace&gt;/terrain/relief)</source>
+        <translation>Visualisierung (Vorgabe: in &lt;workspace&gt;/terrain/relief)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="53"/>
+        <source>Workspace</source>
+        <translation>Arbeitsbereich</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="78"/>
+        <source>Give a workspace folder, or an elevation raster and where to write the visualisation</source>
+        <translation>Geben Sie einen Arbeitsbereich-Ordner an, oder ein Höhenraster und wohin die Visualisierung geschrieben wird</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Relief visualisation</source>
+        <translation>Reliefvisualisierung</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Relief visualisations for reading earthworks, hollow ways, ridge and furrow and field boundaries, computed with rvt-py (the Relief Visualization Toolbox&apos;s library) with RVT&apos;s default parameters, converted from the 1 m DEMs RVT was made for to this raster&apos;s cell size.
+
+Workspace folder: a workspace with a DTM (Build DTM) or DSM.
+Elevation raster: any DTM/DSM in a projected CRS instead (optional).
+Surface: the workspace&apos;s DTM (bare earth, default) or DSM.
+Visualisation: sky-view factor, openness (positive, negative), simple local relief model, multi-scale relief model, multi-direction hillshade, local dominance, or the VAT blend.
+Output: where to write it (default: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</source>
+        <translation>Reliefvisualisierungen zum Lesen von Erdwerken, Hohlwegen, Wölbäckern und Flurgrenzen, berechnet mit rvt-py (der Bibliothek der Relief Visualization Toolbox) mit den Standardparametern von RVT, umgerechnet von den 1-m-Geländemodellen, für die RVT gemacht ist, auf die Zellgröße dieses Rasters.
+
+Arbeitsbereich-Ordner: ein Arbeitsbereich mit DGM (DGM erzeugen) oder DOM.
+Höhenraster: stattdessen ein beliebiges DGM/DOM in einem projizierten KBS (optional).
+Oberfläche: das DGM des Arbeitsbereichs (nackte Erde, Vorgabe) oder sein DOM.
+Visualisierung: Sky-View-Faktor, Offenheit (positiv, negativ), einfaches lokales Reliefmodell, mehrskaliges Reliefmodell, Schummerung aus mehreren Richtungen, lokale Dominanz oder die VAT-Mischung.
+Ausgabe: wohin sie geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</translation>
+    </message>
+</context>
+<context>
     <name>ResultLayers</name>
     <message>
         <location filename="../ui/layers.py" line="267"/>
@@ -1721,7 +2006,7 @@ OUTPUT: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetzt; er muss ne
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="534"/>
+        <location filename="../ui/layers.py" line="531"/>
         <source>DSM hillshade</source>
         <translation>DOM-Schummerung</translation>
     </message>
@@ -1736,12 +2021,12 @@ OUTPUT: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetzt; er muss ne
         <translation>Kameras</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="545"/>
+        <location filename="../ui/layers.py" line="542"/>
         <source>Camera footprints</source>
         <translation>Bildfußabdrücke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="552"/>
+        <location filename="../ui/layers.py" line="549"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Passpunkt-Residuen (Vektoren x{})</translation>
     </message>
@@ -1759,57 +2044,57 @@ OUTPUT: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetzt; er muss ne
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Write the accuracy report</source>
         <translation>Genauigkeitsbericht schreiben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="81"/>
+        <location filename="../processing_provider/run_pipeline.py" line="89"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="90"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="83"/>
+        <location filename="../processing_provider/run_pipeline.py" line="91"/>
         <source>Accuracy report (HTML)</source>
         <translation>Genauigkeitsbericht (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="101"/>
+        <location filename="../processing_provider/run_pipeline.py" line="109"/>
         <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Geben Sie Passpunkte (GCPS oder GCP_LAYER) und/oder Kamerapositionen (CAMERA_POSITIONS oder USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="129"/>
+        <location filename="../processing_provider/run_pipeline.py" line="140"/>
         <source>Seconds per stage: {}</source>
         <translation>Sekunden pro Stufe: {}</translation>
     </message>
@@ -1819,67 +2104,67 @@ OUTPUT: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetzt; er muss ne
         <translation>Gesamte Verarbeitung ausführen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Ground control layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Check points</source>
         <translation>Kontrollpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Use EXIF GPS positions</source>
         <translation>EXIF-GPS-Positionen verwenden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Target CRS</source>
         <translation>Ziel-KBS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Matching image size (px)</source>
         <translation>Bildgröße für die Zuordnung (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>DSM resolution (m)</source>
         <translation>DOM-Auflösung (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Matching quality</source>
         <translation>Zuordnungsqualität</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Orthomosaic resolution</source>
         <translation>Auflösung des Orthomosaiks</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Seam blending</source>
         <translation>Überblendung der Nähte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Parallel workers</source>
         <translation>Parallele Prozesse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Dask scheduler</source>
         <translation>Dask-Scheduler</translation>
     </message>
@@ -1897,6 +2182,26 @@ Bilderordner: die Fotos. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben 
 Die Georeferenzierung braucht Passpunkte (eine Passpunktdatei oder ein Passpunktlayer, Kontrollpunkte werden zurückgehalten) und/oder Kamerapositionen (eine CSV-Datei der Kamerapositionen oder EXIF-GPS-Positionen verwenden): ohne sie wird die Verarbeitung abgelehnt, da ein DOM einen metrischen Maßstab und eine Lotrichtung braucht.
 Die übrigen Parameter sind die der einzelnen Stufen (siehe deren Hilfe); 0 bedeutet automatisch.
 Ausgaben: das DOM, das Orthomosaik und der Genauigkeitsbericht (HTML) sowie die wichtigsten Kennzahlen.</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <source>Build the DTM</source>
+        <translation>Das DGM erzeugen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <source>Contour interval (m, 0 = none)</source>
+        <translation>Höhenlinienabstand (m, 0 = keine)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <source>Relief visualisations</source>
+        <translation>Reliefvisualisierungen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="88"/>
+        <source>DTM</source>
+        <translation>DGM</translation>
     </message>
 </context>
 </TS>

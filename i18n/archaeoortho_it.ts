@@ -6,7 +6,7 @@
     <message>
         <location filename="../processing_provider/accuracy_report.py" line="70"/>
         <source>Workspace folder</source>
-        <translation>Cartella dell'area di lavoro</translation>
+        <translation>Cartella dell&apos;area di lavoro</translation>
     </message>
     <message>
         <location filename="../processing_provider/accuracy_report.py" line="70"/>
@@ -99,7 +99,7 @@ OUTPUT_HTML: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). 
     <message>
         <location filename="../processing_provider/align_images.py" line="45"/>
         <source>Workspace folder</source>
-        <translation>Cartella dell'area di lavoro</translation>
+        <translation>Cartella dell&apos;area di lavoro</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="45"/>
@@ -202,17 +202,17 @@ Metodo di ricostruzione (avanzato): 'incremental' (COLMAP, predefinito) o 'globa
 <context>
     <name>ArchaeoOrthoPlugin</name>
     <message>
-        <location filename="../plugin.py" line="114"/>
+        <location filename="../plugin.py" line="115"/>
         <source>Ground control (GCP dock)</source>
         <translation>Punti d'appoggio (pannello GCP)</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="118"/>
+        <location filename="../plugin.py" line="119"/>
         <source>ArchaeoOrtho: pick ground control points on the map and in the photos</source>
         <translation>ArchaeoOrtho: misura i punti d'appoggio sulla mappa e nelle foto</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="162"/>
+        <location filename="../plugin.py" line="180"/>
         <source>&amp;ArchaeoOrtho</source>
         <translation>&amp;ArchaeoOrtho</translation>
     </message>
@@ -325,6 +325,110 @@ OUTPUT_POINT_CLOUD: file LAS facoltativo (XYZ + RGB, SR dell'area di lavoro).
 DASK_SCHEDULER: calcola le coppie stereo su un cluster Dask (tcp://host:8786) i cui worker vedono il percorso dello spazio di lavoro; vuoto = questo computer (o la variabile d'ambiente ARCHAEOORTHO_DASK_SCHEDULER).
 
 Una nuova esecuzione dopo un annullamento riprende: le coppie già elaborate sono riutilizzate da &lt;workspace&gt;/dense/.</translation>
+    </message>
+</context>
+<context>
+    <name>BuildDtmAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="53"/>
+        <source>Workspace folder</source>
+        <translation>Cartella dell&apos;area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <source>DSM file (default: the workspace&apos;s)</source>
+        <translation>File DSM (predefinito: quello dell&apos;area di lavoro)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <source>Contour interval in metres (0 = none)</source>
+        <translation>Equidistanza delle curve di livello in metri (0 = nessuna)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <source>Ground filter slope (rise over run)</source>
+        <translation>Pendenza del filtro del terreno (dislivello su distanza)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <source>Largest object radius in metres</source>
+        <translation>Raggio massimo degli oggetti in metri</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <source>Height above ground of an object in metres</source>
+        <translation>Altezza di un oggetto sul terreno in metri</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="65"/>
+        <source>DTM (default: &lt;workspace&gt;/dtm.tif)</source>
+        <translation>DTM (predefinito: &lt;workspace&gt;/dtm.tif)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="67"/>
+        <source>Contours (default: &lt;workspace&gt;/terrain/contours.gpkg)</source>
+        <translation>Curve di livello (predefinito: &lt;workspace&gt;/terrain/contours.gpkg)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="70"/>
+        <source>Workspace</source>
+        <translation>Area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="71"/>
+        <source>DTM source</source>
+        <translation>Origine del DTM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="72"/>
+        <source>Classified point cloud</source>
+        <translation>Nuvola di punti classificata</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="73"/>
+        <source>Contour lines</source>
+        <translation>Curve di livello</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="74"/>
+        <source>Share of DSM cells on the ground</source>
+        <translation>Frazione delle celle del DSM sul terreno</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="75"/>
+        <source>Share of DTM cells interpolated</source>
+        <translation>Frazione delle celle del DTM interpolate</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="102"/>
+        <source>Give a workspace folder, or a DSM file and where to write the DTM</source>
+        <translation>Indica una cartella dell&apos;area di lavoro, oppure un file DSM e dove scrivere il DTM</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Build DTM</source>
+        <translation>Genera DTM</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>A digital terrain model (bare earth) from the DSM: buildings, trees and crops removed, the ground interpolated under them.
+
+The ground filter is SMRF (Pingel et al. 2013, the algorithm of PDAL&apos;s filters.smrf) on the DSM&apos;s grid; under each removed object the ground is a thin-plate spline through the ground around it. The DTM is a Cloud-Optimized GeoTIFF on the DSM&apos;s exact grid; beside it terrain/dtm-source.tif says which cells are measured ground (1) and which interpolated (2). The DSM stage&apos;s point cloud, if it wrote one, is copied with ASPRS classes 2 (ground) and 1 (unclassified) to terrain/points-classified.las.
+
+Workspace folder: a workspace with a DSM (optional when a DSM file is given).
+DSM file: any DSM in a projected CRS (metres); default: the workspace&apos;s.
+Contour interval: contour lines every this many metres into a GeoPackage (0 = none).
+Slope, largest object radius and height threshold (advanced): SMRF&apos;s parameters (PDAL&apos;s defaults).
+DTM: where to write it (default: &lt;workspace&gt;/dtm.tif).</source>
+        <translation>Un modello digitale del terreno (suolo nudo) dal DSM: edifici, alberi e colture rimossi, il terreno interpolato sotto di essi.
+
+Il filtro del terreno è SMRF (Pingel et al. 2013, l&apos;algoritmo di filters.smrf di PDAL) sulla griglia del DSM; sotto ogni oggetto rimosso il terreno è una thin-plate spline attraverso il terreno intorno. Il DTM è un Cloud-Optimized GeoTIFF esattamente sulla griglia del DSM; accanto, terrain/dtm-source.tif indica quali celle sono terreno misurato (1) e quali interpolate (2). La nuvola di punti della fase DSM, se ne ha scritta una, è copiata con le classi ASPRS 2 (terreno) e 1 (non classificato) in terrain/points-classified.las.
+
+Cartella dell&apos;area di lavoro: un&apos;area di lavoro con DSM (facoltativa se è indicato un file DSM).
+File DSM: qualsiasi DSM in un SR proiettato (metri); predefinito: quello dell&apos;area di lavoro.
+Equidistanza: curve di livello ogni tanti metri in un GeoPackage (0 = nessuna).
+Pendenza, raggio massimo degli oggetti e soglia di altezza (avanzati): i parametri di SMRF (i valori predefiniti di PDAL).
+DTM: dove scriverlo (predefinito: &lt;workspace&gt;/dtm.tif).</translation>
     </message>
 </context>
 <context>
@@ -445,44 +549,80 @@ Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:878
     </message>
 </context>
 <context>
+    <name>ContoursAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/contours.py" line="30"/>
+        <source>Elevation raster</source>
+        <translation>Raster delle quote</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/contours.py" line="30"/>
+        <source>Interval in metres</source>
+        <translation>Equidistanza in metri</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Contours</source>
+        <translation>Curve di livello</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/contours.py" line="37"/>
+        <source>Contour lines</source>
+        <translation>Curve di livello</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Contour lines of a DTM or DSM at a chosen interval (GDAL&apos;s contour generator) into a GeoPackage layer &apos;contours&apos; whose &apos;elevation&apos; field labels them.
+
+Elevation raster: a DTM or DSM in a projected CRS (metres).
+Interval: metres between two contour lines (e.g. 0.5).
+Contours: the GeoPackage to write.</source>
+        <translation>Curve di livello di un DTM o DSM a un&apos;equidistanza scelta (il generatore di curve di livello di GDAL) in un layer GeoPackage &apos;contours&apos; il cui campo &apos;elevation&apos; le etichetta.
+
+Raster delle quote: un DTM o DSM in un SR proiettato (metri).
+Equidistanza: metri tra due curve di livello (ad es. 0.5).
+Curve di livello: il GeoPackage da scrivere.</translation>
+    </message>
+</context>
+<context>
     <name>GcpDock</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="65"/>
+        <location filename="../ui/gcp_dock.py" line="74"/>
         <source>ArchaeoOrtho ground control</source>
         <translation>ArchaeoOrtho punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="92"/>
         <source>ArchaeoOrtho photos</source>
         <translation>ArchaeoOrtho foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="117"/>
+        <location filename="../ui/gcp_dock.py" line="141"/>
         <source>Workspace:</source>
         <translation>Area di lavoro:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="298"/>
+        <location filename="../ui/gcp_dock.py" line="348"/>
         <source>none open</source>
         <translation>nessuna aperta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="123"/>
+        <location filename="../ui/gcp_dock.py" line="148"/>
         <source>Open a workspace folder (made by Align images)</source>
         <translation>Apri una cartella dell'area di lavoro (creata da 'Allinea immagini')</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="125"/>
+        <location filename="../ui/gcp_dock.py" line="150"/>
         <source>Choose a folder of photos and a workspace folder, and align the photos</source>
         <translation>Scegli una cartella di foto e una cartella dell'area di lavoro e allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="132"/>
+        <location filename="../ui/gcp_dock.py" line="157"/>
         <source>Heights (Z) from:</source>
         <translation>Quote (Z) da:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="137"/>
+        <location filename="../ui/gcp_dock.py" line="162"/>
         <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
         <translation>Un layer raster DSM o DTM (ad es. un DSM ALS): un punto misurato sulla mappa ne prende la quota (bilineare). Vuoto: inserire Z a mano.</translation>
     </message>
@@ -492,27 +632,27 @@ Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:878
         <translation>Aggiungi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="148"/>
+        <location filename="../ui/gcp_dock.py" line="177"/>
         <source>Add a ground point</source>
         <translation>Aggiungi un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="149"/>
+        <location filename="../ui/gcp_dock.py" line="178"/>
         <source>Remove</source>
         <translation>Rimuovi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="150"/>
+        <location filename="../ui/gcp_dock.py" line="179"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Rimuovi il punto d'appoggio selezionato e le sue misure</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="151"/>
+        <location filename="../ui/gcp_placement.py" line="185"/>
         <source>Pick on map</source>
         <translation>Misura sulla mappa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="153"/>
+        <location filename="../ui/gcp_dock.py" line="182"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>Fai clic sulla mappa per impostare X e Y del punto selezionato (Z dal layer delle quote)</translation>
     </message>
@@ -522,107 +662,107 @@ Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:878
         <translation>Importa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="161"/>
+        <location filename="../ui/gcp_dock.py" line="190"/>
         <source>Export</source>
         <translation>Esporta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="174"/>
+        <location filename="../ui/gcp_dock.py" line="205"/>
         <source>Undo</source>
         <translation>Annulla</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="175"/>
+        <location filename="../ui/gcp_dock.py" line="206"/>
         <source>Redo</source>
         <translation>Ripeti</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="182"/>
+        <location filename="../ui/gcp_dock.py" line="216"/>
         <source>Undo: {}</source>
         <translation>Annulla: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="183"/>
+        <location filename="../ui/gcp_dock.py" line="218"/>
         <source>Redo: {}</source>
         <translation>Ripeti: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="168"/>
+        <location filename="../ui/gcp_dock.py" line="197"/>
         <source>Load results</source>
         <translation>Carica risultati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="169"/>
+        <location filename="../ui/gcp_dock.py" line="198"/>
         <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Aggiungi i prodotti dell'area di lavoro alla mappa come layer con stile</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="205"/>
+        <location filename="../ui/gcp_dock.py" line="250"/>
         <source>Residual tolerance:</source>
         <translation>Tolleranza dei residui:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="211"/>
+        <location filename="../ui/gcp_dock.py" line="256"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="215"/>
+        <location filename="../ui/gcp_dock.py" line="265"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="216"/>
+        <location filename="../ui/gcp_dock.py" line="266"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Lascia che la compensazione affini focale, punto principale e distorsione</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="223"/>
+        <location filename="../ui/gcp_dock.py" line="273"/>
         <source>Georeference</source>
         <translation>Georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="224"/>
+        <location filename="../ui/gcp_dock.py" line="274"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Esegui la compensazione con questi punti (in background)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="225"/>
+        <location filename="../ui/gcp_dock.py" line="275"/>
         <source>Cancel</source>
         <translation>Interrompi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="275"/>
+        <location filename="../ui/gcp_dock.py" line="325"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="282"/>
+        <location filename="../ui/gcp_dock.py" line="332"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Apri un'area di lavoro ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="319"/>
+        <location filename="../ui/gcp_dock.py" line="370"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} foto; il blocco non è ancora allineato: esegui 'Allinea immagini' (o 'Nuova dalle foto') per avere le posizioni previste</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="322"/>
+        <location filename="../ui/gcp_dock.py" line="373"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} foto, {} punti d'appoggio. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="221"/>
+        <location filename="../ui/gcp_placement.py" line="273"/>
         <source>no predicted positions: {}</source>
         <translation>nessuna posizione prevista: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="61"/>
+        <location filename="../ui/gcp_placement.py" line="63"/>
         <source>Predicted positions from the georeferenced block.</source>
         <translation>Posizioni previste dal blocco georeferenziato.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="61"/>
+        <location filename="../ui/gcp_placement.py" line="63"/>
         <source>Predicted positions once a point is placed in 2 photos, and for every point once 3 points are placed.</source>
         <translation>Posizioni previste quando un punto è misurato in 2 foto, e per tutti i punti quando ne sono misurati 3.</translation>
     </message>
@@ -637,92 +777,92 @@ Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:878
         <translation>Cartella dell'area di lavoro (nuova o esistente)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="39"/>
+        <location filename="../ui/gcp_tasks.py" line="40"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
         <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="43"/>
+        <location filename="../ui/gcp_tasks.py" line="47"/>
         <source>ArchaeoOrtho: align photos</source>
         <translation>ArchaeoOrtho: allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="400"/>
+        <location filename="../ui/gcp_dock.py" line="495"/>
         <source>CRS: {}</source>
         <translation>SR: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="107"/>
+        <location filename="../ui/gcp_placement.py" line="109"/>
         <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Fai clic sulla mappa nella posizione del punto selezionato (Esc per terminare)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="153"/>
+        <location filename="../ui/gcp_placement.py" line="173"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (da {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="156"/>
+        <location filename="../ui/gcp_placement.py" line="176"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Nessuna quota in questo punto in {}: Z invariata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="159"/>
+        <location filename="../ui/gcp_placement.py" line="179"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="331"/>
+        <location filename="../ui/gcp_placement.py" line="383"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="333"/>
+        <location filename="../ui/gcp_placement.py" line="385"/>
         <source>predicted</source>
         <translation>prevista</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="356"/>
+        <location filename="../ui/gcp_placement.py" line="408"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Seleziona o aggiungi un punto d'appoggio nella tabella, poi fai clic su di esso nella foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="363"/>
+        <location filename="../ui/gcp_placement.py" line="415"/>
         <source>from the point&apos;s other observations</source>
         <translation>dalle altre misure del punto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="364"/>
+        <location filename="../ui/gcp_placement.py" line="416"/>
         <source>from the georeferenced block</source>
         <translation>dal blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="365"/>
+        <location filename="../ui/gcp_placement.py" line="417"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>dai punti già misurati (trasformazione di similitudine)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="374"/>
+        <location filename="../ui/gcp_placement.py" line="428"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Misurato in x {:.2f}, y {:.2f}. Fai clic per spostarlo, trascinalo o premi Canc per rimuoverlo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="377"/>
+        <location filename="../ui/gcp_placement.py" line="431"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Previsto {}. Premi Invio per accettarlo e proseguire (Spazio: accetta), trascinalo o fai clic dove si trova davvero il punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="389"/>
+        <location filename="../ui/gcp_placement.py" line="443"/>
         <source>Click where {} is in this photo.</source>
         <translation>Fai clic dove si trova {} in questa foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="409"/>
+        <location filename="../ui/gcp_placement.py" line="463"/>
         <source>Select or add a ground point first</source>
         <translation>Seleziona o aggiungi prima un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="456"/>
+        <location filename="../ui/gcp_placement.py" line="510"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: ogni foto in cui è previsto ha una misura</translation>
     </message>
@@ -842,117 +982,117 @@ Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:878
         <translation>Impossibile aggiungere {} al progetto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="50"/>
+        <location filename="../ui/gcp_tasks.py" line="54"/>
         <source>A task of this dock is still running</source>
         <translation>Un'operazione di questo pannello è ancora in corso</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="73"/>
+        <location filename="../ui/gcp_tasks.py" line="77"/>
         <source>Cancelled</source>
         <translation>Interrotto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="90"/>
+        <location filename="../ui/gcp_tasks.py" line="94"/>
         <source>The block is not aligned yet: run Align images first</source>
         <translation>Il blocco non è ancora allineato: esegui prima 'Allinea immagini'</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="96"/>
+        <location filename="../ui/gcp_tasks.py" line="100"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>La compensazione richiede almeno 3 punti d'appoggio con coordinate e misure; ce ne sono {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="112"/>
+        <location filename="../ui/gcp_tasks.py" line="116"/>
         <source>Outliers left out: {}</source>
         <translation>Valori anomali esclusi: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="113"/>
+        <location filename="../ui/gcp_tasks.py" line="117"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziato in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="116"/>
+        <location filename="../ui/gcp_tasks.py" line="120"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="125"/>
+        <location filename="../ui/gcp_tasks.py" line="129"/>
         <source>Not georeferenced yet.</source>
         <translation>Non ancora georeferenziato.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="127"/>
+        <location filename="../ui/gcp_tasks.py" line="131"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Appoggio: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="130"/>
+        <location filename="../ui/gcp_tasks.py" line="134"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Controllo: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="133"/>
+        <location filename="../ui/gcp_tasks.py" line="137"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>le quote sono segnaposto: nessuna accuratezza verticale</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="135"/>
+        <location filename="../ui/gcp_tasks.py" line="139"/>
         <source>tie points {} px</source>
         <translation>punti di legame {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="137"/>
+        <location filename="../ui/gcp_tasks.py" line="141"/>
         <source>edited since: re-run to update</source>
         <translation>modificato da allora: riesegui per aggiornare</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="366"/>
+        <location filename="../ui/gcp_placement.py" line="418"/>
         <source>by matching its look in another photo</source>
         <translation>confrontandone l'aspetto in un'altra foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="368"/>
+        <location filename="../ui/gcp_placement.py" line="422"/>
         <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
         <translation>(correlazione {:.2f}, {:.0f} px dalla previsione geometrica)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="122"/>
+        <location filename="../ui/gcp_dock.py" line="147"/>
         <source>Open…</source>
         <translation>Apri…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="124"/>
+        <location filename="../ui/gcp_dock.py" line="149"/>
         <source>New from photos…</source>
         <translation>Nuova dalle foto…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="156"/>
+        <location filename="../ui/gcp_dock.py" line="185"/>
         <source>From file (gcp_list.txt, CSV)…</source>
         <translation>Da file (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="157"/>
+        <location filename="../ui/gcp_dock.py" line="186"/>
         <source>From a point layer…</source>
         <translation>Da un layer di punti…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="159"/>
+        <location filename="../ui/gcp_dock.py" line="188"/>
         <source>To file (gcp_list.txt, CSV)…</source>
         <translation>Su file (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="160"/>
+        <location filename="../ui/gcp_dock.py" line="189"/>
         <source>To a GeoPackage layer…</source>
         <translation>Su un layer GeoPackage…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="81"/>
+        <location filename="../ui/gcp_tasks.py" line="85"/>
         <source>Cancelling…</source>
         <translation>Interruzione…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="119"/>
+        <location filename="../ui/gcp_tasks.py" line="123"/>
         <source>Georeferencing with {} control points…</source>
         <translation>Georeferenziazione con {} punti d'appoggio…</translation>
     </message>
@@ -967,64 +1107,134 @@ Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:878
         <translation>Coordinate misurate sulle foto raddrizzate ({} foto sono salvate ruotate: orientamento EXIF); lasciare deselezionato per la griglia di pixel salvata (quella di COLMAP e OpenDroneMap)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="70"/>
+        <location filename="../ui/gcp_placement.py" line="72"/>
         <source>your setting</source>
         <translation>la tua impostazione</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="73"/>
+        <location filename="../ui/gcp_placement.py" line="75"/>
         <source>default: 3 × GSD of the georeferenced block (GSD {:.3f} m)</source>
         <translation>predefinito: 3 × GSD del blocco georeferenziato (GSD {:.3f} m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="74"/>
+        <location filename="../ui/gcp_placement.py" line="76"/>
         <source>default</source>
         <translation>predefinito</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="81"/>
+        <location filename="../ui/gcp_placement.py" line="83"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red. Now: {}</source>
         <translation>I residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi. Ora: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="89"/>
+        <location filename="../ui/gcp_placement.py" line="91"/>
         <source>Diagnosis of the adjustment:</source>
         <translation>Diagnosi della compensazione:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="144"/>
+        <location filename="../ui/gcp_placement.py" line="164"/>
         <source>Moved {:.2f} m (Undo: Ctrl+Z).</source>
         <translation>Spostato di {:.2f} m (Annulla: Ctrl+Z).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="333"/>
+        <location filename="../ui/gcp_placement.py" line="385"/>
         <source>near the edge</source>
         <translation>vicino al bordo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="380"/>
+        <location filename="../ui/gcp_placement.py" line="434"/>
         <source>{} is predicted where it cannot be placed: {}. Click where the point is if you see it, or press Enter for the next photo.</source>
         <translation>{} è previsto dove non può essere posizionato: {}. Fai clic sul punto se lo vedi, o premi Invio per la foto successiva.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="386"/>
+        <location filename="../ui/gcp_placement.py" line="440"/>
         <source>Click where {} is in this photo, or use Pick on map (or type X, Y, Z in the table) to have it predicted in the photos.</source>
         <translation>Fai clic su {} in questa foto, oppure usa Misura sulla mappa (o scrivi X, Y, Z nella tabella) per farlo prevedere nelle foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="399"/>
+        <location filename="../ui/gcp_placement.py" line="453"/>
         <source>{}: the workspace has no photos to place it in.</source>
-        <translation>{}: l&apos;area di lavoro non ha foto in cui posizionarlo.</translation>
+        <translation>{}: l'area di lavoro non ha foto in cui posizionarlo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="401"/>
+        <location filename="../ui/gcp_placement.py" line="455"/>
         <source>{} is selected: use Pick on map or type X, Y, Z in the table, or choose a photo in the strip below and click on the point.</source>
         <translation>{} è selezionato: usa Misura sulla mappa o scrivi X, Y, Z nella tabella, oppure scegli una foto nella striscia sotto e fai clic sul punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="403"/>
+        <location filename="../ui/gcp_placement.py" line="457"/>
         <source>{} is selected: choose a photo in the strip below and click on the point.</source>
         <translation>{} è selezionato: scegli una foto nella striscia sotto e fai clic sul punto.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="213"/>
+        <source>Undo (Ctrl+Z)</source>
+        <translation>Annulla (Ctrl+Z)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="213"/>
+        <source>Redo (Ctrl+Shift+Z)</source>
+        <translation>Ripeti (Ctrl+Maiusc+Z)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="391"/>
+        <source>Aligned {} of {} photos, mean reprojection error {:.2f} px.</source>
+        <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="396"/>
+        <source>Not aligned ({}): {}</source>
+        <translation>Non allineate ({}): {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="397"/>
+        <source>(marked in the photo strip; hover for the reason)</source>
+        <translation>(segnate nella striscia delle foto; il motivo è nel suggerimento)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="416"/>
+        <source>✗ not aligned</source>
+        <translation>✗ non allineata</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_dock.py" line="417"/>
+        <source>{}: not aligned: {}</source>
+        <translation>{}: non allineata: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="43"/>
+        <source>Not aligned: {}</source>
+        <translation>Non allineate: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="131"/>
+        <source>pick on map</source>
+        <translation>misura sulla mappa</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="420"/>
+        <source>(no Z yet: at the height of the block&apos;s tie points)</source>
+        <translation>(ancora nessuna Z: all'altezza dei punti di legame del blocco)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="156"/>
+        <source>{} not moved</source>
+        <translation>{} non spostato</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="185"/>
+        <source>{} is placed in {} photos. Move it {:.2f} m to the picked position, or add a new point there?</source>
+        <translation>{} è posizionato in {} foto. Spostarlo di {:.2f} m nella posizione misurata, o aggiungere lì un nuovo punto?</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="189"/>
+        <source>Move {}</source>
+        <translation>Sposta {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_placement.py" line="190"/>
+        <source>New point</source>
+        <translation>Nuovo punto</translation>
     </message>
 </context>
 <context>
@@ -1286,7 +1496,7 @@ Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:878
         <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="95"/>
+        <location filename="../processing_provider/run_pipeline.py" line="103"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
@@ -1477,64 +1687,69 @@ RESIDUALS: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in met
 <context>
     <name>PhotoPanel</name>
     <message>
-        <location filename="../ui/photo_viewer.py" line="425"/>
+        <location filename="../ui/photo_viewer.py" line="466"/>
         <source>Only photos that probably see the point</source>
         <translation>Solo le foto che probabilmente vedono il punto</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="428"/>
+        <location filename="../ui/photo_viewer.py" line="469"/>
         <source>Fit</source>
         <translation>Adatta</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="428"/>
+        <location filename="../ui/photo_viewer.py" line="469"/>
         <source>Show the whole photo (F)</source>
         <translation>Mostra l'intera foto (F)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="429"/>
+        <location filename="../ui/photo_viewer.py" line="470"/>
         <source>Zoom to point</source>
         <translation>Zoom sul punto</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="429"/>
+        <location filename="../ui/photo_viewer.py" line="470"/>
         <source>Zoom to the observation or prediction (Z)</source>
         <translation>Zoom sulla misura o sulla previsione (Z)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="431"/>
+        <location filename="../ui/photo_viewer.py" line="472"/>
         <source>Confirm</source>
         <translation>Conferma</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="431"/>
+        <location filename="../ui/photo_viewer.py" line="472"/>
         <source>Accept the predicted position (Space)</source>
         <translation>Accetta la posizione prevista (Spazio)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="433"/>
+        <location filename="../ui/photo_viewer.py" line="474"/>
         <source>Confirm &amp;&amp; next</source>
         <translation>Conferma &amp;&amp; avanti</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="433"/>
+        <location filename="../ui/photo_viewer.py" line="474"/>
         <source>Accept the prediction and show the next photo to place (Enter)</source>
         <translation>Accetta la previsione e mostra la prossima foto da misurare (Invio)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="436"/>
+        <location filename="../ui/photo_viewer.py" line="477"/>
         <source>Remove</source>
         <translation>Rimuovi</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="436"/>
+        <location filename="../ui/photo_viewer.py" line="477"/>
         <source>Remove the observation in this photo (Delete)</source>
         <translation>Rimuovi la misura in questa foto (Canc)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="599"/>
+        <location filename="../ui/photo_viewer.py" line="651"/>
         <source>{} (predicted)</source>
         <translation>{} (previsto)</translation>
+    </message>
+    <message>
+        <location filename="../ui/photo_viewer.py" line="563"/>
+        <source>Shown upright (EXIF orientation {}: stored {} x {} px); pixel coordinates are those of the stored grid, as COLMAP and gcp_list.txt use them</source>
+        <translation>Mostrata raddrizzata (orientamento EXIF {}: salvata {} x {} px); le coordinate pixel sono quelle della griglia salvata, come le usano COLMAP e gcp_list.txt</translation>
     </message>
 </context>
 <context>
@@ -1547,7 +1762,7 @@ RESIDUALS: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in met
     <message>
         <location filename="../processing_provider/prepare_images.py" line="79"/>
         <source>Workspace folder</source>
-        <translation>Cartella dell'area di lavoro</translation>
+        <translation>Cartella dell&apos;area di lavoro</translation>
     </message>
     <message>
         <location filename="../processing_provider/prepare_images.py" line="79"/>
@@ -1694,6 +1909,76 @@ OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere
     </message>
 </context>
 <context>
+    <name>ReliefVisualisationAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="41"/>
+        <source>Workspace folder</source>
+        <translation>Cartella dell&apos;area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <source>Elevation raster (instead of the workspace&apos;s)</source>
+        <translation>Raster delle quote (invece di quello dell&apos;area di lavoro)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <source>Surface</source>
+        <translation>Superficie</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <source>DTM</source>
+        <translation>DTM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <source>DSM</source>
+        <translation>DSM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <source>Visualisation</source>
+        <translation>Visualizzazione</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="50"/>
+        <source>Visualisation (default: in &lt;workspace&gt;/terrain/relief)</source>
+        <translation>Visualizzazione (predefinito: in &lt;workspace&gt;/terrain/relief)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="53"/>
+        <source>Workspace</source>
+        <translation>Area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="78"/>
+        <source>Give a workspace folder, or an elevation raster and where to write the visualisation</source>
+        <translation>Indica una cartella dell&apos;area di lavoro, oppure un raster delle quote e dove scrivere la visualizzazione</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Relief visualisation</source>
+        <translation>Visualizzazione del rilievo</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Relief visualisations for reading earthworks, hollow ways, ridge and furrow and field boundaries, computed with rvt-py (the Relief Visualization Toolbox&apos;s library) with RVT&apos;s default parameters, converted from the 1 m DEMs RVT was made for to this raster&apos;s cell size.
+
+Workspace folder: a workspace with a DTM (Build DTM) or DSM.
+Elevation raster: any DTM/DSM in a projected CRS instead (optional).
+Surface: the workspace&apos;s DTM (bare earth, default) or DSM.
+Visualisation: sky-view factor, openness (positive, negative), simple local relief model, multi-scale relief model, multi-direction hillshade, local dominance, or the VAT blend.
+Output: where to write it (default: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</source>
+        <translation>Visualizzazioni del rilievo per leggere terrapieni, strade incassate, campi baulati e confini di campi, calcolate con rvt-py (la libreria del Relief Visualization Toolbox) con i parametri predefiniti di RVT, convertiti dai DEM a 1 m per cui RVT è fatto alla dimensione di cella di questo raster.
+
+Cartella dell&apos;area di lavoro: un&apos;area di lavoro con DTM (Genera DTM) o DSM.
+Raster delle quote: in alternativa qualsiasi DTM/DSM in un SR proiettato (facoltativo).
+Superficie: il DTM dell&apos;area di lavoro (suolo nudo, predefinito) o il DSM.
+Visualizzazione: fattore di vista del cielo, apertura (positiva, negativa), modello semplice del rilievo locale, modello del rilievo a più scale, ombreggiatura da più direzioni, dominanza locale o la miscela VAT.
+Risultato: dove scriverla (predefinito: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</translation>
+    </message>
+</context>
+<context>
     <name>ResultLayers</name>
     <message>
         <location filename="../ui/layers.py" line="267"/>
@@ -1721,7 +2006,7 @@ OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="534"/>
+        <location filename="../ui/layers.py" line="531"/>
         <source>DSM hillshade</source>
         <translation>Ombreggiatura del DSM</translation>
     </message>
@@ -1736,12 +2021,12 @@ OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere
         <translation>Camere</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="545"/>
+        <location filename="../ui/layers.py" line="542"/>
         <source>Camera footprints</source>
         <translation>Impronte delle immagini</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="552"/>
+        <location filename="../ui/layers.py" line="549"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Residui dei punti d'appoggio (vettori x{})</translation>
     </message>
@@ -1759,57 +2044,57 @@ OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Workspace folder</source>
-        <translation>Cartella dell'area di lavoro</translation>
+        <translation>Cartella dell&apos;area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Write the accuracy report</source>
         <translation>Scrivi il rapporto di accuratezza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="81"/>
+        <location filename="../processing_provider/run_pipeline.py" line="89"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="90"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="83"/>
+        <location filename="../processing_provider/run_pipeline.py" line="91"/>
         <source>Accuracy report (HTML)</source>
         <translation>Rapporto di accuratezza (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="101"/>
+        <location filename="../processing_provider/run_pipeline.py" line="109"/>
         <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Indicare punti di appoggio (GCPS o GCP_LAYER) e/o posizioni delle camere (CAMERA_POSITIONS o USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="129"/>
+        <location filename="../processing_provider/run_pipeline.py" line="140"/>
         <source>Seconds per stage: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -1819,67 +2104,67 @@ OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere
         <translation>Esegui l'intera elaborazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Ground control layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Check points</source>
         <translation>Punti di controllo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Use EXIF GPS positions</source>
         <translation>Usa le posizioni GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Target CRS</source>
         <translation>SR di destinazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Matching image size (px)</source>
         <translation>Dimensione per la corrispondenza (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>DSM resolution (m)</source>
         <translation>Risoluzione del DSM (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Matching quality</source>
         <translation>Qualità della corrispondenza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Orthomosaic resolution</source>
         <translation>Risoluzione dell'ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Seam blending</source>
         <translation>Sfumatura delle giunzioni</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Parallel workers</source>
         <translation>Processi paralleli</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="58"/>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Dask scheduler</source>
         <translation>Scheduler Dask</translation>
     </message>
@@ -1897,6 +2182,26 @@ Cartella delle immagini: le foto. Cartella dell'area di lavoro: dove sono scritt
 La georeferenziazione richiede punti di appoggio (un file o un layer dei punti d'appoggio, punti di controllo esclusi) e/o posizioni delle camere (un CSV delle posizioni delle camere o Usa le posizioni GPS EXIF): senza di essi l'elaborazione viene rifiutata, perché un DSM richiede una scala metrica e una direzione verticale.
 Gli altri parametri sono quelli delle singole fasi (vedi il loro aiuto); 0 significa automatico.
 Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali.</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <source>Build the DTM</source>
+        <translation>Genera il DTM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <source>Contour interval (m, 0 = none)</source>
+        <translation>Equidistanza (m, 0 = nessuna)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <source>Relief visualisations</source>
+        <translation>Visualizzazioni del rilievo</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="88"/>
+        <source>DTM</source>
+        <translation>DTM</translation>
     </message>
 </context>
 </TS>

@@ -7,6 +7,7 @@ This script copies the sources to a temporary tree with every ``\\uXXXX``, ``\\U
 copies of the .ts files (same relative paths, so the <location> lines stay the same) and copies them back.
 
     python3 i18n/update_ts.py [pylupdate5 options]    # e.g. -noobsolete
+    python3 i18n/update_ts.py --tracked -noobsolete   # only the files git tracks (leave others' new files out)
 """
 import io
 import os
@@ -62,12 +63,17 @@ def decode_escapes(text):
     return "".join(out)
 
 
-def sources(root=ROOT):
+def sources(root=ROOT, tracked=False):
+    known = None
+    if tracked:
+        out = subprocess.run(["git", "ls-files"], cwd=root, capture_output=True, text=True, check=True)
+        known = set(out.stdout.split())
     for folder in SOURCE_GLOBS:
         base = os.path.join(root, folder)
         for name in sorted(os.listdir(base)):
-            if name.endswith(".py"):
-                yield os.path.join(folder, name) if folder else name
+            path = os.path.join(folder, name) if folder else name
+            if name.endswith(".py") and (known is None or path in known):
+                yield path
 
 
 def main(argv):
@@ -75,8 +81,10 @@ def main(argv):
     if pylupdate is None:
         print("pylupdate5 not found (Debian: pyqt5-dev-tools)", file=sys.stderr)
         return 1
+    tracked = "--tracked" in argv
+    argv = [a for a in argv if a != "--tracked"]
     with tempfile.TemporaryDirectory(prefix="archaeoortho-ts-") as tmp:
-        rel = list(sources())
+        rel = list(sources(tracked=tracked))
         for path in rel:
             dst = os.path.join(tmp, path)
             os.makedirs(os.path.dirname(dst), exist_ok=True)

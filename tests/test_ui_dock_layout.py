@@ -10,7 +10,9 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
+from tests import synthetic as syn
 from tests.conftest import ROOT
+from tests.test_ui_dock import make_workspace, process, quick_photos, wait_task
 
 pytestmark = pytest.mark.usefixtures("qgis_processing")
 
@@ -79,10 +81,16 @@ def test_toolbar_icon_goes_to_the_plugins_toolbar(qgis_iface, qgis_language):
 def _translated_literals():
     """{(context, text)} of every tr() / translate() call with literal arguments in the plugin's sources, as
     Python reads them (escapes decoded)."""
+    import subprocess
+
     out = set()
     files = [os.path.join(ROOT, f) for f in os.listdir(ROOT) if f.endswith(".py")]
     for folder in ("ui", "processing_provider"):
         files += [os.path.join(ROOT, folder, f) for f in os.listdir(os.path.join(ROOT, folder)) if f.endswith(".py")]
+    listed = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True)
+    if listed.returncode == 0 and listed.stdout:  # a checkout: the files in the repository (not a new one in work)
+        tracked = {os.path.join(ROOT, p) for p in listed.stdout.split()}
+        files = [f for f in files if f in tracked]
     for path in files:
         tree = ast.parse(open(path, encoding="utf-8").read())
         for node in ast.walk(tree):
@@ -190,3 +198,263 @@ def test_override_in_the_options_wins(qgis_iface, qgis_language):
     assert plugin_module._locale() == "de"
     p = archaeoortho.classFactory(qgis_iface)
     p.unload()
+
+
+# --------------------------------------------------------------------------------------------------
+# the dock at its default size
+# --------------------------------------------------------------------------------------------------
+
+SHOTS = os.path.join(ROOT, "docs", "screenshots")
+
+
+@pytest.fixture(scope="module")
+def block():
+    return syn.vertical_block(seed=1)
+
+
+@pytest.fixture(scope="module")
+def photos(block, tmp_path_factory):
+    return quick_photos(block, str(tmp_path_factory.mktemp("layout photos")))
+
+
+@pytest.fixture(scope="module")
+def georef_ws(block, photos, tmp_path_factory):
+    return make_workspace(str(tmp_path_factory.mktemp("layout georef")), block, photos,
+                          block.gcp_set(block.spread_control(5)))
+
+
+@pytest.fixture
+def default_dock(qgis_canvas, qgis_new_project):
+    """The dock and the photo dock as QGIS first shows them: the dock at its size hint in a main window's right
+    area, the photo dock at the bottom (plugin.show_dock's default sizes)."""
+    from archaeoortho.ui.gcp_dock import GcpDock
+    from qgis.PyQt.QtCore import Qt
+    from qgis.PyQt.QtWidgets import QMainWindow
+
+    win = QMainWindow()
+    win.setCentralWidget(qgis_canvas)
+    _qgis_like(win)
+    win.resize(1366, 768)
+    d = GcpDock(None, qgis_canvas, parent=win)
+    win.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, d)
+    win.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, d.photo_dock)
+    win.show()
+    process(100)
+    _default_sizes(win, d)
+    process(100)
+    yield d
+    d.cleanup()
+    qgis_canvas.setParent(None)
+    win.close()
+
+
+def _qgis_like(win):
+    """QGIS's main window gives the side dock areas the bottom corners (QgisApp: setCorner)."""
+    from qgis.PyQt.QtCore import Qt
+
+    win.setCorner(Qt.Corner.BottomLeftCorner, Qt.DockWidgetArea.LeftDockWidgetArea)
+    win.setCorner(Qt.Corner.BottomRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
+
+
+def _default_sizes(win, d):
+    """What ArchaeoOrthoPlugin.show_dock does the first time (its _default_dock_sizes)."""
+    from archaeoortho.plugin import ArchaeoOrthoPlugin
+
+    class _Iface:
+        def mainWindow(self):  # noqa: N802 (QGIS API name)
+            return win
+
+    p = ArchaeoOrthoPlugin.__new__(ArchaeoOrthoPlugin)
+    p.iface, p.dock = _Iface(), d
+    p._default_dock_sizes()
+
+
+def overflowing_actions(dock):
+    """Texts of the toolbar actions that are not shown (in a >> overflow or cut off) at the dock's size."""
+    from qgis.PyQt.QtWidgets import QToolBar, QToolButton
+
+    out = []
+    for bar in dock.findChildren(QToolBar):
+        ext = bar.findChild(QToolButton, "qt_toolbar_ext_button")
+        if ext is not None and ext.isVisible():
+            out.append(f"{bar.objectName() or 'toolbar'}: >> overflow")
+        for a in bar.actions():
+            w = bar.widgetForAction(a)
+            if w is None or a.isSeparator():
+                continue
+            if not w.isVisible() or w.geometry().right() > bar.width():
+                out.append(a.text() or (w.text() if hasattr(w, "text") else "?"))
+    return out
+
+
+def hidden_key_columns(dock):
+    from archaeoortho.ui.gcp_dock import KEY_COLUMNS
+
+    header = dock.table.horizontalHeader()
+    width = dock.table.viewport().width()
+    out = []
+    for col in KEY_COLUMNS:
+        left = header.sectionViewportPosition(col)
+        if header.isSectionHidden(col) or left < 0 or left + header.sectionSize(col) > width:
+            out.append(dock.model.headerData(col, 1))
+    return out
+
+
+def test_layout_at_the_default_size(default_dock, georef_ws):
+    """Nothing in the toolbar's >> overflow (Load results and Redo were), the table's Name, Obs., dXY, dZ and px
+    columns visible without scrolling, and a photo viewer that is more than a strip."""
+    dock = default_dock
+    assert dock.open_workspace(georef_ws)
+    process(100)
+    print(f"\n[layout] dock {dock.width()} x {dock.height()}, photo dock {dock.photo_dock.width()} x "
+          f"{dock.photo_dock.height()}, photo view {dock.photo_panel.view.height()} px high")
+    assert dock.width() <= 480  # the default width, not a test's generous one
+    assert overflowing_actions(dock) == []
+    assert dock.act_results.isEnabled() and dock.act_redo in dock.toolbar.actions()
+    assert hidden_key_columns(dock) == []
+    assert dock.table.horizontalScrollBar().value() == 0
+    assert dock.photo_panel.view.height() >= 200
+    assert dock.photo_dock.height() >= 400
+
+
+def test_layout_in_german_at_the_default_size(qgis_canvas, qgis_new_project, georef_ws):
+    """German labels are longer (Rückgängig, Exportieren, Ergebnisse laden): still nothing in an overflow."""
+    from archaeoortho.ui.gcp_dock import GcpDock
+    from qgis.PyQt.QtCore import QCoreApplication, Qt, QTranslator
+    from qgis.PyQt.QtWidgets import QMainWindow
+
+    t = QTranslator()
+    assert t.load(os.path.join(I18N, "archaeoortho_de.qm"))
+    QCoreApplication.installTranslator(t)
+    win = QMainWindow()
+    try:
+        win.setCentralWidget(qgis_canvas)
+        _qgis_like(win)
+        win.resize(1366, 768)
+        d = GcpDock(None, qgis_canvas, parent=win)
+        win.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, d)
+        win.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, d.photo_dock)
+        win.show()
+        process(100)
+        _default_sizes(win, d)
+        process(100)
+        assert d.btn_georef.text() == "Georeferenzieren"
+        assert d.open_workspace(georef_ws)
+        process(100)
+        assert overflowing_actions(d) == []
+        assert hidden_key_columns(d) == []
+        assert d.width() <= 520
+        os.makedirs(SHOTS, exist_ok=True)
+        _screenshot(win, d, os.path.join(SHOTS, "gcp-dock-de.png"))
+        d.cleanup()
+    finally:
+        QCoreApplication.removeTranslator(t)
+        qgis_canvas.setParent(None)
+        win.close()
+
+
+def _screenshot(win, dock, path):
+    """The main window's docks as they are (GCP dock right, photo dock below), one picture."""
+    from qgis.PyQt.QtCore import QPoint
+    from qgis.PyQt.QtGui import QPainter, QPixmap
+
+    process(200)
+    a, b = dock.grab(), dock.photo_dock.grab()
+    out = QPixmap(max(a.width(), 1) + b.width() + 8, max(a.height(), b.height()))
+    out.fill()
+    painter = QPainter(out)
+    painter.drawPixmap(QPoint(0, 0), b)
+    painter.drawPixmap(QPoint(b.width() + 8, 0), a)
+    painter.end()
+    assert out.save(path)
+    assert os.path.getsize(path) > 10000
+
+
+def test_screenshot_english_default_size(default_dock, georef_ws, block):
+    dock = default_dock
+    assert dock.open_workspace(georef_ws)
+    dock.select_point(block.spread_control(5)[2])
+    process(200)
+    os.makedirs(SHOTS, exist_ok=True)
+    _screenshot(dock.parent(), dock, os.path.join(SHOTS, "gcp-dock-en.png"))
+
+
+# --------------------------------------------------------------------------------------------------
+# item 3: the alignment result
+# --------------------------------------------------------------------------------------------------
+
+
+@pytest.fixture
+def partly_aligned_ws(block, photos, tmp_path):
+    """An aligned workspace with two more photos, first in its image list, that did not align (in the image list,
+    not in the model, named with the reason in sfm/alignment.json)."""
+    import shutil
+
+    from tests.workspaces import synthetic_workspace
+
+    rec = block.truth_reconstruction(n_points=800, noise_px=0.3)
+    first = next(iter(photos.values()))
+    lost = {"AAA_blurred.jpg": "no verified matches with any other image (no overlap, blur or too little texture)",
+            "AAB_sky.jpg": "matched 2 image(s) but could not be registered (too few matches in a good geometry)"}
+    folder = tmp_path / "photos"
+    folder.mkdir()
+    all_photos = {}
+    for name in list(lost) + list(photos):
+        all_photos[name] = str(folder / name)
+        shutil.copyfile(photos.get(name, first), all_photos[name])
+    figures = {"registered": len(photos), "images_given": len(all_photos), "mean_reprojection_error": 0.61,
+               "unregistered": lost}
+    ws = synthetic_workspace(str(tmp_path / "partly"), block, rec, photos=all_photos, cameras_gpkg=True,
+                             alignment=figures)
+    return ws, lost
+
+
+def test_alignment_result_stays_and_unaligned_photos_are_marked(default_dock, partly_aligned_ws, block,
+                                                               monkeypatch):
+    """'New from photos…' ends with the result on screen (it was overwritten 0.1 s later), kept while the user
+    works; the photos that did not align are at the end of the strip, marked, with the reason."""
+    from archaeoortho.core.align import stage as align_stage
+    from qgis.PyQt.QtCore import Qt
+    from qgis.PyQt.QtTest import QTest
+
+    ws, lost = partly_aligned_ws
+    dock = default_dock
+
+    class Result:  # what core.align.stage.align returns, for this workspace
+        registered, images_given, mean_reprojection_error = len(block.shots), len(block.shots) + 2, 0.61
+        unregistered = lost
+
+    def fake_align(images_dir, workspace_dir, progress=None, options=None):
+        progress.report(0.5, "matching")
+        return Result()
+
+    monkeypatch.setattr(align_stage, "align", fake_align)
+    assert dock.start_alignment("photos", ws) is not None
+    wait_task(dock)
+    process(500)
+    n = len(block.shots) + 2
+    status = dock.status.text()
+    assert f"Aligned {n - 2} of {n} photos" in status, status
+    assert all(name in status for name in lost)
+    assert dock.align_label.isVisible()
+    assert f"Aligned {n - 2} of {n} photos" in dock.align_label.text()
+    # the user works on: adding a point writes the status line, the result stays
+    QTest.mouseClick(dock.toolbar.widgetForAction(dock.act_add), Qt.MouseButton.LeftButton)
+    process(100)
+    assert f"Aligned {n - 2} of {n} photos" in dock.align_label.text()
+    assert all(name in dock.align_label.text() for name in lost)
+    # the strip, all photos: the unaligned ones last, marked, the reason in the tooltip
+    if dock.photo_panel.filter_box.isChecked():
+        QTest.mouseClick(dock.photo_panel.filter_box, Qt.MouseButton.LeftButton)
+        process(50)
+    assert not dock.photo_panel.filter_box.isChecked()
+    strip = dock.photo_panel.thumbnail_names()
+    assert set(strip[-2:]) == set(lost)
+    thumbs = dock.photo_panel.thumbs
+    for i in range(thumbs.count()):
+        item = thumbs.item(i)
+        name = item.data(Qt.ItemDataRole.UserRole)
+        if name in lost:
+            assert "not aligned" in item.text() and lost[name] in item.toolTip()
+        else:
+            assert "not aligned" not in item.text()

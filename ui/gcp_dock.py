@@ -8,10 +8,10 @@ core.pipeline adjusts); this module only translates clicks and keys into those c
 import math
 import os
 
-from qgis.core import Qgis, QgsMapLayerProxyModel, QgsProject
+from qgis.core import Qgis, QgsApplication, QgsMapLayerProxyModel, QgsProject
 from qgis.gui import QgsDockWidget, QgsMapLayerComboBox
-from qgis.PyQt.QtCore import QCoreApplication, Qt
-from qgis.PyQt.QtGui import QKeySequence
+from qgis.PyQt.QtCore import QCoreApplication, QSize, Qt
+from qgis.PyQt.QtGui import QColor, QKeySequence
 from qgis.PyQt.QtWidgets import (
     QAbstractItemView,
     QCheckBox,
@@ -23,6 +23,7 @@ from qgis.PyQt.QtWidgets import (
     QMenu,
     QProgressBar,
     QPushButton,
+    QSizePolicy,
     QTableView,
     QToolBar,
     QToolButton,
@@ -39,7 +40,11 @@ from ..core.project.stages import ALIGN
 from .gcp_io import GcpImportExport
 from .gcp_placement import GcpPlacement
 from .gcp_table import (
+    DXY,
+    DZ,
     NAME,
+    OBS,
+    PX,
     ROLE,
     GcpTableModel,
     RoleDelegate,
@@ -49,6 +54,10 @@ from .gcp_tasks import GcpTasks
 from .map_tool import GcpMapTool, GcpMarkers
 from .photo_viewer import PhotoPanel
 from .store import GcpStore
+
+KEY_COLUMNS = (NAME, OBS, DXY, DZ, PX)  # visible at the dock's default width (tests/test_ui_dock_layout.py)
+DEFAULT_WIDTH = 440  # the dock's width when QGIS first shows it (its size hint)
+PHOTO_DOCK_HEIGHT = 540  # the photo dock's height when first shown (plugin.show_dock), at most 62 % of the window
 
 
 class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
@@ -67,6 +76,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         self.predictor = None
         self.predictor_note = ""
         self.predictions = {}  # image -> core.guided.Prediction for the selected point
+        self.unaligned = {}  # image -> why it did not align (sfm/alignment.json)
         self._last_point = None
         self.matches = {}  # (point, image, observations) -> core.guided.Match or None: refined predictions
         self._gray = {}  # image name -> grey array for matching (a few, most recent last)
@@ -76,6 +86,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         self.map_tool = GcpMapTool(self.canvas) if self.canvas is not None else None
         self.markers = GcpMarkers(self.canvas) if self.canvas is not None else None
         self.photo_panel = PhotoPanel()
+        self.photo_panel.view.setMinimumHeight(160)  # never a sliver of a photo
         self.photo_dock = QgsDockWidget(parent)
         self.photo_dock.setObjectName("ArchaeoOrthoPhotoDock")
         self.photo_dock.setWindowTitle(self.tr("ArchaeoOrtho photos"))
@@ -87,16 +98,29 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
     def tr(self, text):
         return QCoreApplication.translate("GcpDock", text)
 
+    def sizeHint(self):  # noqa: N802 (Qt API name)
+        """The width QGIS gives the dock when it first shows it: the key columns and both toolbar rows fit."""
+        hint = super().sizeHint()
+        return QSize(max(DEFAULT_WIDTH, self.minimumSizeHint().width()), max(hint.height(), 600))
+
     # ------------------------------------------------------------------ layout
     def _build(self):
         w = QWidget(self)
         lay = QVBoxLayout(w)
         lay.setContentsMargins(4, 4, 4, 4)
         lay.addLayout(self._build_workspace_row())
+        self.align_label = QLabel()  # the alignment's result, kept on screen (not the status line's next message)
+        self.align_label.setWordWrap(True)
+        self.align_label.setTextFormat(Qt.TextFormat.RichText)
+        self.align_label.setVisible(False)
+        lay.addWidget(self.align_label)
         lay.addLayout(self._build_heights_row())
-        lay.addWidget(self._build_toolbar(w))
+        for bar in self._build_toolbar(w):
+            lay.addWidget(bar)
         lay.addWidget(self._build_table(w), 1)
         lay.addLayout(self._build_tolerance_row())
+        lay.addWidget(self.tol_source)
+        lay.addLayout(self._build_refine_row())
         lay.addLayout(self._build_adjustment_row())
         self.summary = QLabel()
         self.summary.setWordWrap(True)
@@ -118,6 +142,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         self.ws_label = QLabel(self.tr("none open"))
         self.ws_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         self.ws_label.setMinimumWidth(60)
+        self.ws_label.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)  # a long name: cut
         row.addWidget(self.ws_label, 1)
         self.btn_open = QPushButton(self.tr("Open\u2026"))
         self.btn_open.setToolTip(self.tr("Open a workspace folder (made by Align images)"))
@@ -142,8 +167,12 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         return row
 
     def _build_toolbar(self, w):
+        """Two rows, each at least as wide as its buttons (the dock cannot be made narrower): nothing ends up in a
+        toolbar's >> overflow, in any language.  Row 1: the point and undo; row 2: import, export, results."""
         self.toolbar = QToolBar(w)
         self.toolbar.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
+        self.toolbar2 = QToolBar(w)
+        self.toolbar2.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
         self.act_add = self.toolbar.addAction(self.tr("Add"))
         self.act_add.setToolTip(self.tr("Add a ground point"))
         self.act_remove = self.toolbar.addAction(self.tr("Remove"))
@@ -163,11 +192,13 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
             b.setText(text)
             b.setMenu(menu)
             b.setPopupMode(QToolButton.ToolButtonPopupMode.InstantPopup)
-            self.toolbar.addWidget(b)
+            self.toolbar2.addWidget(b)
         self._build_undo_actions(w)
-        self.act_results = self.toolbar.addAction(self.tr("Load results"))
+        self.act_results = self.toolbar2.addAction(self.tr("Load results"))
         self.act_results.setToolTip(self.tr("Add the workspace's products to the map as styled layers"))
-        return self.toolbar
+        for bar in (self.toolbar, self.toolbar2):
+            bar.setMinimumWidth(bar.sizeHint().width())
+        return self.toolbar, self.toolbar2
 
     def _build_undo_actions(self, w):
         stack = self.store.undo_stack
@@ -179,12 +210,21 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         self.act_redo.triggered.connect(stack.redo)
         stack.canUndoChanged.connect(self.act_undo.setEnabled)
         stack.canRedoChanged.connect(self.act_redo.setEnabled)
-        stack.undoTextChanged.connect(lambda t: self.act_undo.setToolTip(self.tr("Undo: {}").format(t) if t else ""))
-        stack.redoTextChanged.connect(lambda t: self.act_redo.setToolTip(self.tr("Redo: {}").format(t) if t else ""))
-        for a in (self.act_undo, self.act_redo):
+        undo_tip, redo_tip = self.tr("Undo (Ctrl+Z)"), self.tr("Redo (Ctrl+Shift+Z)")
+        self.act_undo.setToolTip(undo_tip)
+        self.act_redo.setToolTip(redo_tip)
+        stack.undoTextChanged.connect(
+            lambda t: self.act_undo.setToolTip(self.tr("Undo: {}").format(t) if t else undo_tip))
+        stack.redoTextChanged.connect(
+            lambda t: self.act_redo.setToolTip(self.tr("Redo: {}").format(t) if t else redo_tip))
+        for a, icon in ((self.act_undo, "mActionUndo.svg"), (self.act_redo, "mActionRedo.svg")):
             a.setEnabled(False)
             a.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+            a.setIcon(QgsApplication.getThemeIcon(icon))
             self.toolbar.addAction(a)
+            button = self.toolbar.widgetForAction(a)
+            if button is not None and not a.icon().isNull():  # the usual arrows: narrow in every language
+                button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonIconOnly)
 
     def _build_table(self, w):
         self.model = GcpTableModel(self)
@@ -194,8 +234,13 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         self.table.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
         self.table.setItemDelegateForColumn(ROLE, RoleDelegate(self.table))
         self.table.verticalHeader().setVisible(False)
-        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
-        self.table.horizontalHeader().setStretchLastSection(True)
+        header = self.table.horizontalHeader()
+        header.setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        header.setStretchLastSection(True)
+        # compact: the name and what tells whether a point is good (photos, residuals) first, the coordinates
+        # after them; the model's column numbers stay (only the view's order changes)
+        for visual, column in enumerate(KEY_COLUMNS):
+            header.moveSection(header.visualIndex(column), visual)
         triggers = QAbstractItemView.EditTrigger
         self.table.setEditTriggers(triggers.DoubleClicked | triggers.EditKeyPressed | triggers.AnyKeyPressed)
         return self.table
@@ -211,7 +256,12 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         self.tol_spin.setToolTip(self.tr("Residuals up to this are green, up to 3 times yellow, beyond red"))
         row.addWidget(self.tol_spin)
         self.tol_source = QLabel()  # where the tolerance comes from (GcpPlacement.show_tolerance_source)
-        row.addWidget(self.tol_source)
+        self.tol_source.setWordWrap(True)  # its own line under the row (_build): wraps instead of widening the dock
+        row.addStretch(1)
+        return row
+
+    def _build_refine_row(self):
+        row = QHBoxLayout()  # its own row: beside the tolerance it made the dock too wide for its default width
         self.refine_box = QCheckBox(self.tr("Refine camera calibration"))
         self.refine_box.setToolTip(self.tr("Let the adjustment refine focal length, principal point and distortion"))
         row.addWidget(self.refine_box)
@@ -297,6 +347,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         root = self.store.root or ""
         self.ws_label.setText(os.path.basename(os.path.normpath(root)) if root else self.tr("none open"))
         self.ws_label.setToolTip(root)
+        self._show_alignment()
         photos = {im["name"]: im["path"] for im in self.store.images()}
         self.photo_panel.set_photos(photos)
         tol = self.store.settings.get("tolerance")
@@ -321,6 +372,50 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         else:
             self.message(self.tr("{} photos, {} ground points. {}").format(
                 n_img, len(self.store.gcps.points), self.predictor_note))
+
+    # ------------------------------------------------------------------ alignment result
+    def _show_alignment(self):
+        """'Aligned 38 of 41 photos' and which did not align, why: from the workspace's sfm/alignment.json, on
+        screen for as long as the workspace is open."""
+        figures = {}
+        if self.store.workspace is not None and self.store.stage_done(ALIGN):
+            try:
+                figures = self.store.layout.alignment()
+            except (OSError, ValueError):
+                figures = {}
+        self.unaligned = {str(k): str(v) for k, v in (figures.get("unregistered") or {}).items()}
+        if not figures:
+            self.align_label.setVisible(False)
+            self.align_label.setText("")
+            return
+        text = self.tr("Aligned {} of {} photos, mean reprojection error {:.2f} px.").format(
+            figures.get("registered", 0), figures.get("images_given", 0),
+            float(figures.get("mean_reprojection_error") or 0.0))
+        if self.unaligned:
+            names = ", ".join(sorted(self.unaligned))
+            text += " <b>" + self.tr("Not aligned ({}): {}").format(len(self.unaligned), names) + "</b> " + \
+                self.tr("(marked in the photo strip; hover for the reason)")
+        self.align_label.setText(text)
+        self.align_label.setToolTip("\n".join(f"{n}: {why}" for n, why in sorted(self.unaligned.items())))
+        self.align_label.setVisible(True)
+
+    def visible_photos(self):
+        """The strip's photos: the aligned ones first, those that did not align after them (GcpPlacement)."""
+        names = super().visible_photos()
+        return [n for n in names if n not in self.unaligned] + [n for n in names if n in self.unaligned]
+
+    def _update_thumbnails(self):
+        super()._update_thumbnails()
+        if not self.unaligned:
+            return
+        strip = self.photo_panel.thumbs
+        for i in range(strip.count()):
+            item = strip.item(i)
+            name = item.data(Qt.ItemDataRole.UserRole)
+            if name in self.unaligned:
+                item.setText(name + "\n" + self.tr("\u2717 not aligned"))
+                item.setToolTip(self.tr("{}: not aligned: {}").format(name, self.unaligned[name]))
+                item.setForeground(QColor("#b00000"))
 
     # ------------------------------------------------------------------ selection
     def current_name(self):

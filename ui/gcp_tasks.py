@@ -36,9 +36,13 @@ class GcpTasks:
 
         def done(result):
             self._task_ended()
-            self.message(translate("GcpDock", "Aligned {} of {} photos, mean reprojection error {:.2f} px").format(
-                result.registered, result.images_given, result.mean_reprojection_error))
-            self.open_workspace(workspace_dir)
+            self.open_workspace(workspace_dir)  # first: its own message must not replace the result
+            text = translate("GcpDock", "Aligned {} of {} photos, mean reprojection error {:.2f} px").format(
+                result.registered, result.images_given, result.mean_reprojection_error)
+            if result.unregistered:
+                text += ". " + translate("GcpDock", "Not aligned: {}").format(
+                    "; ".join(f"{n} ({why})" for n, why in sorted(result.unregistered.items())))
+            self.message(text, Qgis.MessageLevel.Warning if result.unregistered else Qgis.MessageLevel.Success)
 
         task = CoreTask(translate("GcpDock", "ArchaeoOrtho: align photos"), align_stage.align, (images_dir, workspace_dir),
                         {"options": options}, on_done=done, on_error=self._task_failed)
