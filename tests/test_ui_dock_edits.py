@@ -449,7 +449,8 @@ def test_ctrl_z_and_ctrl_shift_z_undo_and_redo_every_edit_in_the_table_and_the_p
 # --------------------------------------------------------------------------------------------------
 
 
-def test_pick_on_map_ends_after_one_pick(dock, georef_ws, block, qgis_canvas):  # noqa: F811
+def test_pick_on_map_ends_after_one_pick_and_asks_before_moving_a_placed_point(dock, georef_ws, block,  # noqa: F811
+                                                                                qgis_canvas):
     QTest, Qt, _, _ = _qt()
     assert dock.open_workspace(georef_ws)
     utm_canvas(qgis_canvas, block)
@@ -460,7 +461,9 @@ def test_pick_on_map_ends_after_one_pick(dock, georef_ws, block, qgis_canvas):  
     c.click(tool_button(dock, dock.act_pick))
     assert qgis_canvas.mapTool() is dock.map_tool
     target = (p0.x + 3.0, p0.y - 2.0)
+    asked = press_later(f"Move {name}")
     c.click(qgis_canvas.viewport(), canvas_pixel(qgis_canvas, *target))
+    assert asked == [f"Move {name}"], "no question before moving a point placed in photos"
     p1 = dock.store.gcps.by_name(name)
     assert math.hypot(p1.x - target[0], p1.y - target[1]) < 0.5  # one canvas pixel
     assert "Moved" in dock.status.text()
@@ -469,6 +472,27 @@ def test_pick_on_map_ends_after_one_pick(dock, georef_ws, block, qgis_canvas):  
     c.click(qgis_canvas.viewport(), canvas_pixel(qgis_canvas, p0.x - 16.0, p0.y + 5.0))
     p2 = dock.store.gcps.by_name(name)
     assert (p2.x, p2.y) == (p1.x, p1.y), "a later map click moved the point"
+    # "New point": the placed point stays, a new one is made at the pick
+    n = len(dock.store.gcps.points)
+    c.click(tool_button(dock, dock.act_pick))
+    elsewhere = (p0.x - 16.0, p0.y + 5.0)
+    asked = press_later("New point")
+    c.click(qgis_canvas.viewport(), canvas_pixel(qgis_canvas, *elsewhere))
+    assert asked == ["New point"]
+    assert len(dock.store.gcps.points) == n + 1
+    new = dock.store.gcps.points[-1]
+    assert dock.current_name() == new.name and math.hypot(new.x - elsewhere[0], new.y - elsewhere[1]) < 0.5
+    p3 = dock.store.gcps.by_name(name)
+    assert (p3.x, p3.y) == (p1.x, p1.y)
+    # Cancel: nothing changes, the tool ends
+    dock.select_point(name)
+    before = dock.store.gcps.to_dict()
+    c.click(tool_button(dock, dock.act_pick))
+    asked = press_later("Cancel")
+    c.click(qgis_canvas.viewport(), canvas_pixel(qgis_canvas, *elsewhere))
+    assert asked == ["Cancel"]
+    assert dock.store.gcps.to_dict() == before
+    assert qgis_canvas.mapTool() is not dock.map_tool and not dock.act_pick.isChecked()
 
 
 # --------------------------------------------------------------------------------------------------

@@ -10,6 +10,7 @@ import os
 import numpy as np
 from qgis.core import Qgis, QgsCoordinateTransform, QgsPointXY, QgsProject
 from qgis.PyQt.QtCore import QCoreApplication
+from qgis.PyQt.QtWidgets import QMessageBox
 
 from ..core.project.stages import ALIGN, GEOREFERENCE
 from . import layers
@@ -147,10 +148,18 @@ class GcpPlacement:
             z = sample_height(dsm, QgsPointXY(point), canvas_crs)
         name = self.current_name()
         moved = ""
+        old = self.store.gcps.by_name(name) if name is not None else None
+        if old is not None and old.observations and math.isfinite(old.x) and math.isfinite(old.y):
+            choice = self._ask_move(old, math.hypot(p.x() - old.x, p.y() - old.y))
+            if choice is None:
+                self.set_picking(False)
+                self.message(translate("GcpDock", "{} not moved").format(name))
+                return None
+            if choice == "new":
+                name = old = None
         if name is None:
             name = self.add_point(x=p.x(), y=p.y(), z=z if z is not None else math.nan)
         else:
-            old = self.store.gcps.by_name(name)
             if math.isfinite(old.x) and math.isfinite(old.y):
                 moved = " " + translate("GcpDock", "Moved {:.2f} m (Undo: Ctrl+Z).").format(
                     math.hypot(p.x() - old.x, p.y() - old.y))
@@ -170,6 +179,20 @@ class GcpPlacement:
             self.message(translate("GcpDock", "{}: X {:.3f}, Y {:.3f}").format(name, p.x(), p.y()) + moved)
         self.show_best_photo()
         return name
+
+    def _ask_move(self, point, distance):
+        """A map pick for a point already placed in photos: "move", "new" (a new point there) or None (cancel)."""
+        box = QMessageBox(QMessageBox.Icon.Question, translate("GcpDock", "Pick on map"),
+                          translate("GcpDock", "{} is placed in {} photos. Move it {:.2f} m to the picked position, or "
+                                    "add a new point there?").format(point.name, len(point.observations), distance),
+                          parent=self)
+        move = box.addButton(translate("GcpDock", "Move {}").format(point.name), QMessageBox.ButtonRole.AcceptRole)
+        new = box.addButton(translate("GcpDock", "New point"), QMessageBox.ButtonRole.AcceptRole)
+        box.addButton(QMessageBox.StandardButton.Cancel)
+        box.setDefaultButton(new)
+        box.exec()
+        clicked = box.clickedButton()
+        return "move" if clicked is move else "new" if clicked is new else None
 
     def best_photo(self):
         """The photo where the selected point is predicted most centrally and not yet placed (None if none)."""
