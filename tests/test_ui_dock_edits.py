@@ -365,6 +365,29 @@ def test_no_prediction_outside_the_photo_or_in_its_mask_is_offered_or_stored(doc
         os.remove(mask_path)
 
 
+def test_a_marker_dragged_out_of_the_photo_is_not_stored(dock, aligned_ws, block):  # noqa: F811
+    from tests.test_ui_dock import drag
+
+    assert dock.open_workspace(aligned_ws)
+    name = dock.add_point("T1", 500000.0, 4600000.0, 150.0)
+    image = block.shots[3].name
+    c = Counter()
+    thumb_click(c, dock, image)
+    view = dock.photo_panel.view
+    view_click(c, view, (30.0, 40.0))
+    obs = dock.store.gcps.by_name(name).observations
+    assert len(obs) == 1
+    x0, y0 = obs[0].x, obs[0].y
+    marker = dock.photo_panel.observation
+    start = view.mapFromScene(marker.pos())
+    drag(view.viewport(), start, start - type(start)(120, 120))
+    process(50)
+    o = dock.store.gcps.by_name(name).observations[0]
+    assert (o.x, o.y) == (x0, y0), f"a drag out of the photo stored ({o.x:.1f}, {o.y:.1f})"
+    assert "outside the photo" in dock.status.text()
+    assert dock.photo_panel.observation.pos().x() == x0  # the marker is back where the point is
+
+
 # --------------------------------------------------------------------------------------------------
 # 18.4: Ctrl+Z / Ctrl+Shift+Z in the table and the photo view, every edit undoable
 # --------------------------------------------------------------------------------------------------
