@@ -1,4 +1,4 @@
-"""The whole chain in one call: align -> georeference -> DSM -> orthomosaic -> report.
+"""The whole chain in one call: align -> georeference -> DSM -> orthomosaic -> DTM (+ relief) -> report.
 
 ``run_pipeline`` calls each room's stage entry point in order on one workspace (``core.align.stage.align``,
 ``core.georef.stage.georeference_workspace``, ``core.dense.stage.build_dsm_workspace``,
@@ -26,9 +26,10 @@ from .io.gcp import GCPSet, apply_check_points, read_camera_positions, read_gcps
 from .io.images import check_image_folder, list_images
 from .ortho.options import OrthoOptions
 from .ortho.stage import build_orthophoto_workspace
-from .project.stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, REPORT, StageError
+from .project.stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, RELIEF, REPORT, TERRAIN, StageError
 from .report.options import ReportOptions
 from .report.stage import build_report
+from .terrain.stage import build_dtm_workspace, relief_workspace
 
 
 @dataclass
@@ -62,7 +63,10 @@ class PipelineOptions:
     ortho_resolution: float = 0.0
     blending: str = "feather"
     images_filter: Optional[str] = None
-    make_report: bool = True  # False: the chain stops after the orthomosaic
+    make_report: bool = True  # False: the chain stops after the orthomosaic (and the terrain products)
+    make_dtm: bool = True  # the DTM (seconds for a DSM of a few million cells)
+    contour_interval: float = 0.0  # m; 0 = no contours
+    relief: Sequence[str] = ()  # relief visualisations of the DTM (core.terrain.options.VISUALISATIONS); slow
 
 
 @dataclass
@@ -74,13 +78,15 @@ class PipelineResult:
     dsm: object = None
     ortho: object = None
     report: object = None
+    dtm: object = None
+    relief: object = None
     seconds: Dict[str, float] = field(default_factory=dict)
     warnings: List[str] = field(default_factory=list)
 
 
 # the share of the progress bar of each stage
-SPANS = {ALIGN: (0.0, 0.40), GEOREFERENCE: (0.40, 0.45), DSM: (0.45, 0.75), ORTHOPHOTO: (0.75, 0.93),
-         REPORT: (0.93, 1.0)}
+SPANS = {ALIGN: (0.0, 0.40), GEOREFERENCE: (0.40, 0.45), DSM: (0.45, 0.75), ORTHOPHOTO: (0.75, 0.9),
+         TERRAIN: (0.9, 0.92), RELIEF: (0.92, 0.95), REPORT: (0.95, 1.0)}
 
 
 def check_inputs(images_dir: str, control: Control) -> None:
@@ -141,6 +147,10 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
     res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, images_filter=opt.images_filter,
                     resolution=opt.ortho_resolution, blending=opt.blending, options=opt.ortho)
     res.warnings += res.ortho.warnings
+    if opt.make_dtm:
+        res.dtm = run(TERRAIN, build_dtm_workspace, workspace_dir, contour_interval=opt.contour_interval)
+        if opt.relief:
+            res.relief = run(RELIEF, relief_workspace, workspace_dir, list(opt.relief), source="dtm")
     if opt.make_report:
         res.report = run(REPORT, build_report, workspace_dir, uncertainty=opt.report.uncertainty,
                          write_layers=opt.report.write_layers)

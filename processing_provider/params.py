@@ -189,3 +189,19 @@ def scheduler(name, label):
 def read_scheduler(alg, parameters, name, context):
     """A Dask scheduler address, None for this computer."""
     return alg.parameterAsString(parameters, name, context).strip() or None
+
+
+# --- terrain -----------------------------------------------------------------------------------------
+def relief_choice(name, label):
+    """Relief visualisations to make (several may be chosen; none by default: they take minutes)."""
+    from ..core.terrain.options import VISUALISATIONS
+
+    return QgsProcessingParameterEnum(name, label, options=[lab for _, lab in VISUALISATIONS], allowMultiple=True,
+                                      optional=True, defaultValue=[])
+
+
+def read_relief(alg, parameters, name, context):
+    """The core keys of the chosen relief visualisations."""
+    from ..core.terrain.options import VISUALISATION_KEYS
+
+    return [VISUALISATION_KEYS[i] for i in alg.parameterAsEnums(parameters, name, context)]

@@ -33,6 +33,10 @@ class RunPipelineAlgorithm(AlgorithmBase):
     ORTHO_RESOLUTION = "ORTHO_RESOLUTION"
     BLENDING = "BLENDING"
     REPORT_ENABLED = "MAKE_REPORT"
+    DTM_ENABLED = "MAKE_DTM"
+    CONTOUR_INTERVAL = "CONTOUR_INTERVAL"
+    RELIEF = "RELIEF"
+    DTM = "DTM"
     WORKERS = "WORKERS"
     SCHEDULER = "DASK_SCHEDULER"
     DSM = "DSM"
@@ -74,10 +78,14 @@ class RunPipelineAlgorithm(AlgorithmBase):
             params.number(self.ORTHO_RESOLUTION, self.tr("Orthomosaic resolution")),
             params.blending(self.BLENDING, self.tr("Seam blending")),
             params.flag(self.REPORT_ENABLED, self.tr("Write the accuracy report"), default=True),
+            params.flag(self.DTM_ENABLED, self.tr("Build the DTM"), default=True),
             *params.advanced(
                 params.workers(self.WORKERS, self.tr("Parallel workers")),
-                params.scheduler(self.SCHEDULER, self.tr("Dask scheduler"))),
+                params.scheduler(self.SCHEDULER, self.tr("Dask scheduler")),
+                params.number(self.CONTOUR_INTERVAL, self.tr("Contour interval (m, 0 = none)")),
+                params.relief_choice(self.RELIEF, self.tr("Relief visualisations"))),
         )
+        self.addOutput(QgsProcessingOutputRasterLayer(self.DTM, self.tr("DTM")))
         self.addOutput(QgsProcessingOutputRasterLayer(self.DSM, self.tr("DSM")))
         self.addOutput(QgsProcessingOutputRasterLayer(self.ORTHOMOSAIC, self.tr("Orthomosaic")))
         self.addOutput(QgsProcessingOutputFile(self.REPORT, self.tr("Accuracy report (HTML)")))
@@ -120,7 +128,10 @@ class RunPipelineAlgorithm(AlgorithmBase):
                 ortho_resolution=self.parameterAsDouble(p, self.ORTHO_RESOLUTION, context),
                 blending=params.read_choice(self, p, self.BLENDING, context, BLENDINGS),
                 ortho=OrthoOptions(workers=workers, scheduler=scheduler),
-                make_report=self.parameterAsBoolean(p, self.REPORT_ENABLED, context)),
+                make_report=self.parameterAsBoolean(p, self.REPORT_ENABLED, context),
+                make_dtm=self.parameterAsBoolean(p, self.DTM_ENABLED, context),
+                contour_interval=self.parameterAsDouble(p, self.CONTOUR_INTERVAL, context),
+                relief=params.read_relief(self, p, self.RELIEF, context)),
             control=pipeline.Control(gcp_path=gcp_path, gcps=gcps, check_points=checks,
                                      camera_positions_path=positions, use_exif_gps=use_gps, crs=crs_text),
             progress=FeedbackProgress(feedback))
@@ -136,4 +147,5 @@ class RunPipelineAlgorithm(AlgorithmBase):
                    "DSM_VALID_FRACTION": result.dsm.valid_fraction,
                    "ORTHO_VALID_FRACTION": result.ortho.valid_fraction}
         return dict(numbers, WORKSPACE=result.workspace, DSM=result.dsm.dsm_path,
-                    ORTHOMOSAIC=result.ortho.orthomosaic, REPORT=result.report.path if result.report else None)
+                    ORTHOMOSAIC=result.ortho.orthomosaic, REPORT=result.report.path if result.report else None,
+                    DTM=result.dtm.dtm_path if result.dtm else None)

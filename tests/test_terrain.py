@@ -269,6 +269,19 @@ def test_workspace_stage_classifies_the_point_cloud(scene_dsm, tmp_path):
     rec = Workspace.open(root).stage(RELIEF)
     assert rec["status"] == "done" and {"dtm-slrm", "dsm-slrm"} <= set(rec["outputs"])
 
+    # the report lists and previews them
+    from core.report.stage import build_report
+
+    rep = build_report(root, uncertainty=False)
+    with open(rep.path, encoding="utf-8") as f:
+        html = f.read()
+    assert rep.sections["products"] == "ok"
+    for text in ("Terrain (DTM)", "dtm.tif", "points-classified.las", "contours.gpkg",
+                 "Simple local relief model (DTM)", "Simple local relief model (DSM)", 'alt="DTM preview"',
+                 'alt="Relief visualisations"'):
+        assert text in html, text
+    assert rep.figures["DTM_GROUND_FRACTION"] == pytest.approx(r.ground_fraction)
+
 
 def test_workspace_without_dsm_says_what_to_run(tmp_path):
     ws = Workspace.create_or_open(str(tmp_path / "ws"))

@@ -1,4 +1,5 @@
-"""The products section: DSM and orthomosaic previews (hillshade), resolution, valid fraction."""
+"""The products section: DSM and orthomosaic previews (hillshade), resolution, valid fraction; then the terrain
+products (:mod:`.terrain`)."""
 from __future__ import annotations
 
 import math
@@ -10,6 +11,7 @@ from ..context import ReportContext, Skip
 from ..errors import ReportError
 from ..figures import draw_dem, draw_image, embed, equal_xy, new_figure
 from ..html import esc, kv, num, raster_crs_name
+from . import terrain
 
 
 def section(ctx: ReportContext) -> str:
@@ -26,6 +28,7 @@ def section(ctx: ReportContext) -> str:
         parts.append(_raster(ctx, ortho, "Orthomosaic", dem=False))
     else:
         parts.append('<p class="skip">No orthomosaic yet.</p>')
+    parts.append(terrain.subsection(ctx))  # DTM, contours, relief visualisations ('' without them)
     return "".join(parts)
 
 
