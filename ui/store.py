@@ -289,7 +289,9 @@ class GcpStore(QObject):
         None if it can."""
         if not (math.isfinite(x) and math.isfinite(y)):
             return self.tr("no position")
-        size = self.image_sizes().get(image)
+        if getattr(self, "_sizes", None) is None or self._sizes[0] is not self.workspace:
+            self._sizes = (self.workspace, self.image_sizes())  # per workspace record (reload_workspace: a new one)
+        size = self._sizes[1].get(image)
         if size is not None and not (0.0 <= x <= size[0] and 0.0 <= y <= size[1]):
             return self.tr("({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)").format(
                 x, y, image, size[0], size[1])
