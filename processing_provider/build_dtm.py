@@ -5,7 +5,6 @@ from qgis.core import (
     QgsProcessingOutputFolder,
     QgsProcessingOutputNumber,
     QgsProcessingOutputRasterLayer,
-    QgsProcessingOutputVectorLayer,
     QgsProcessingParameterFile,
     QgsProcessingParameterFileDestination,
     QgsProcessingParameterRasterDestination,
@@ -70,7 +69,6 @@ class BuildDtmAlgorithm(AlgorithmBase):
         self.addOutput(QgsProcessingOutputFolder(self.OUT_WORKSPACE, self.tr("Workspace")))
         self.addOutput(QgsProcessingOutputRasterLayer(self.OUTPUT_SOURCE, self.tr("DTM source")))
         self.addOutput(QgsProcessingOutputFile(self.OUTPUT_POINT_CLOUD, self.tr("Classified point cloud")))
-        self.addOutput(QgsProcessingOutputVectorLayer(self.OUTPUT_CONTOURS + "_LAYER", self.tr("Contour lines")))
         self.addOutput(QgsProcessingOutputNumber(self.GROUND_FRACTION, self.tr("Share of DSM cells on the ground")))
         self.addOutput(QgsProcessingOutputNumber(self.INTERPOLATED_FRACTION, self.tr(
             "Share of DTM cells interpolated")))
@@ -105,6 +103,6 @@ class BuildDtmAlgorithm(AlgorithmBase):
                                    contours_path=contours, progress=progress)
         return {self.OUT_WORKSPACE: result.workspace, self.OUTPUT_DTM: result.dtm_path,
                 self.OUTPUT_SOURCE: result.source_path, self.OUTPUT_POINT_CLOUD: result.point_cloud_path,
-                self.OUTPUT_CONTOURS: result.contours_path, self.OUTPUT_CONTOURS + "_LAYER": result.contours_path,
+                self.OUTPUT_CONTOURS: result.contours_path,
                 self.GROUND_FRACTION: result.ground_fraction,
                 self.INTERPOLATED_FRACTION: result.interpolated_fraction}

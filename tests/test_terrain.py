@@ -368,3 +368,34 @@ def test_qgis_process_runs_the_terrain_algorithms(scene_dsm, tmp_path):
         text = out.stdout + out.stderr
         assert out.returncode != 0 and "geographic CRS" in text and bad in text, text[-2000:]
         assert "Traceback" not in text, text[-2000:]
+
+
+@pytest.mark.usefixtures("qgis_processing")
+def test_products_load_styled_in_qgis(scene_dsm, tmp_path, qgis_new_project):
+    pytest.importorskip("rvt.vis")
+    from archaeoortho.ui import layers
+    from qgis.core import QgsProject, QgsSingleBandGrayRenderer
+
+    scene, x, y, path, buildings, trees = scene_dsm
+    root, _ = _workspace_with_dsm(tmp_path / "ws", path, scene)
+    build_dtm_workspace(root, contour_interval=1.0)
+    relief_workspace(root, ["svf", "openness_neg"])
+    loaded = layers.load_workspace_results(root, QgsProject.instance())
+    by_kind = {lyr.customProperty(layers.KIND_PROPERTY): lyr for lyr in loaded}
+    assert by_kind["dtm"].renderer().type() == "singlebandpseudocolor"
+    assert by_kind["dtmhillshade"].renderer().type() == "hillshade"
+    assert by_kind["contours"].labelsEnabled() and by_kind["contours"].featureCount() > 10
+    reliefs = [lyr for lyr in loaded if lyr.customProperty(layers.KIND_PROPERTY) == "relief"]
+    names = sorted(lyr.name() for lyr in reliefs)
+    assert names == ["Openness (negative) (DTM)", "Sky-view factor (DTM)"], names
+    for lyr in reliefs:
+        r = lyr.renderer()
+        assert r.type() == "singlebandgray"
+        ce = r.contrastEnhancement()
+        if "Sky-view" in lyr.name():  # RVT's display range of the sky-view factor
+            assert (ce.minimumValue(), ce.maximumValue()) == pytest.approx((0.6375, 1.0))
+            assert r.gradient() == QgsSingleBandGrayRenderer.Gradient.BlackToWhite
+        else:
+            assert r.gradient() == QgsSingleBandGrayRenderer.Gradient.WhiteToBlack
+    assert layers.output_kind("OUTPUT_DTM", "x/dtm.tif") == layers.DTM
+    assert layers.output_kind("OUTPUT_CONTOURS", "x/c.gpkg") == layers.CONTOURS

@@ -51,6 +51,10 @@ CAMERAS = "cameras"
 FOOTPRINTS = "footprints"
 RESIDUALS = "residuals"
 POINT_CLOUD = "pointcloud"
+DTM = "dtm"
+DTM_HILLSHADE = "dtmhillshade"
+RELIEF = "relief"
+CONTOURS = "contours"
 
 # residual point status (core.georef) -> colour
 STATUS_COLOURS = {"used": "#1a9641", "check": "#2b83ba", "rejected": "#d7191c", "not triangulated": "#888888"}
@@ -303,6 +307,123 @@ def _mark(layer, kind):
 
 
 # --------------------------------------------------------------------------------------------------
+# terrain products: DTM, relief visualisations, contours
+# --------------------------------------------------------------------------------------------------
+
+_CURVED = (Qgis.LabelPlacement.Curved if hasattr(Qgis, "LabelPlacement") else QgsPalLayerSettings.Placement.Curved)
+
+
+def _file_metadata(path):
+    try:
+        from osgeo import gdal
+
+        ds = gdal.Open(path)
+        return (ds.GetMetadata() or {}) if ds is not None else {}
+    except (ImportError, RuntimeError):
+        return {}
+
+
+def style_dtm(layer):
+    """A DTM as a DSM: pseudocolour (Spectral, 2-98 %); its hillshade is a second layer."""
+    style_dsm(layer)
+    _mark(layer, DTM)
+    return layer
+
+
+def style_relief(layer):
+    """A relief visualisation in grey, stretched over RVT's display range of it (the file's DISPLAY_MIN /
+    DISPLAY_MAX: sky-view factor 0.64-1, openness 60-95 deg, local relief -2..2 m, ...); negative openness
+    inverted (valleys light, as RVT shows it)."""
+    from qgis.core import QgsContrastEnhancement, QgsSingleBandGrayRenderer
+
+    _smooth_resampling(layer)
+    path = layer.source().split("|")[0]
+    meta = _file_metadata(path)
+    try:
+        lo, hi = float(meta["DISPLAY_MIN"]), float(meta["DISPLAY_MAX"])
+    except (KeyError, ValueError):
+        lo, hi = _band_range(layer)
+    renderer = QgsSingleBandGrayRenderer(layer.dataProvider(), 1)
+    ce = QgsContrastEnhancement(layer.dataProvider().dataType(1))
+    ce.setContrastEnhancementAlgorithm(QgsContrastEnhancement.ContrastEnhancementAlgorithm.StretchToMinimumMaximum)
+    ce.setMinimumValue(lo)
+    ce.setMaximumValue(hi)
+    renderer.setContrastEnhancement(ce)
+    if meta.get("RELIEF") == "openness_neg":
+        renderer.setGradient(QgsSingleBandGrayRenderer.Gradient.WhiteToBlack)
+    layer.setRenderer(renderer)
+    _mark(layer, RELIEF)
+    layer.triggerRepaint()
+    return layer
+
+
+def style_contours(layer):
+    """Contour lines: thin brown, labelled with their elevation along the line."""
+    symbol = QgsLineSymbol.createSimple({"color": "#8c510a", "width": "0.25"})
+    layer.renderer().setSymbol(symbol)
+    _labels(layer, 'format_number("elevation", 1)', size=7.0, colour="#5a3206")
+    labeling = layer.labeling()
+    if labeling is not None:
+        settings = labeling.settings()
+        settings.placement = _CURVED
+        layer.setLabeling(QgsVectorLayerSimpleLabeling(settings))
+    _mark(layer, CONTOURS)
+    layer.triggerRepaint()
+    return layer
+
+
+def relief_name(path):
+    """The layer name of a relief visualisation file: its visualisation and surface ('Sky-view factor (DTM)')."""
+    meta = _file_metadata(path)
+    key = meta.get("RELIEF") or os.path.splitext(os.path.basename(path))[0].split("-", 1)[-1]
+    try:
+        from ..core.terrain.options import VISUALISATIONS
+
+        label = dict(VISUALISATIONS).get(key, key)
+    except ImportError:  # pragma: no cover
+        label = key
+    surface = os.path.basename(path).split("-", 1)[0].upper()
+    return QCoreApplication.translate("ResultLayers", "{} ({})").format(label, surface if surface in ("DTM", "DSM")
+                                                                        else "DTM")
+
+
+def load_dtm(path, project=None, group=None, name=None):
+    """DTM as two layers: the pseudocolour and a multiplied hillshade above it."""
+    project = project or QgsProject.instance()
+    remove_loaded(project, path, (DTM, DTM_HILLSHADE))
+    dtm = QgsRasterLayer(path, name or QCoreApplication.translate("ResultLayers", "DTM"))
+    if not dtm.isValid():
+        return []
+    style_dtm(dtm)
+    shade = QgsRasterLayer(path, QCoreApplication.translate("ResultLayers", "DTM hillshade"))
+    style_hillshade(shade)
+    _mark(shade, DTM_HILLSHADE)
+    return [lyr for lyr in (add_layer(project, dtm, group, path), add_layer(project, shade, group, path))
+            if lyr is not None]
+
+
+def load_relief(path, project=None, group=None, name=None):
+    project = project or QgsProject.instance()
+    remove_loaded(project, path, (RELIEF,))
+    layer = QgsRasterLayer(path, name or relief_name(path))
+    if not layer.isValid():
+        return []
+    style_relief(layer)
+    return [layer] if add_layer(project, layer, group, path) is not None else []
+
+
+def load_contours(path, project=None, group=None, name=None):
+    project = project or QgsProject.instance()
+    remove_loaded(project, path, (CONTOURS,))
+    layer = QgsVectorLayer(f"{path}|layername=contours", name or QCoreApplication.translate(
+        "ResultLayers", "Contours"), "ogr")
+    if not layer.isValid():
+        return []
+    style_contours(layer)
+    return [layer] if add_layer(project, layer, group, path) is not None else []
+
+
+# --------------------------------------------------------------------------------------------------
 # adding to a project
 # --------------------------------------------------------------------------------------------------
 
@@ -460,7 +581,13 @@ def load_workspace_results(workspace, project=None, group=None):
         (lay.default_orthomosaic, load_orthomosaic, {}),
         (lay.cameras_gpkg, load_cameras, {"workspace": workspace}),
         (lay.residuals_gpkg, load_residuals, {}),
+        (lay.default_dtm, load_dtm, {}),
+        (lay.contours_gpkg, load_contours, {}),
     ]
+    relief_dir = os.path.dirname(lay.relief("x"))
+    if os.path.isdir(relief_dir):
+        candidates += [(os.path.join(relief_dir, n), load_relief, {}) for n in sorted(os.listdir(relief_dir))
+                       if n.endswith(".tif")]
     for path, fn, kw in candidates:
         if os.path.exists(path):
             loaded += fn(path, project, group, **kw)
@@ -484,7 +611,11 @@ def output_kind(output_name, path):
         return POINT_CLOUD
     if "ORTHO" in n:
         return ORTHO
-    if "DSM" in n or "DTM" in n or "DEM" in n:
+    if "CONTOUR" in n and ext == ".gpkg":
+        return CONTOURS
+    if "DTM" in n and "SOURCE" not in n:
+        return DTM
+    if "DSM" in n or "DEM" in n:
         return DSM
     return None
 
@@ -550,6 +681,19 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
                 f"{float(factor):g}"))
         elif self.kind == POINT_CLOUD:
             _mark(layer, POINT_CLOUD)
+        elif self.kind == DTM:
+            style_dtm(layer)
+            remove_loaded(project, path, (DTM_HILLSHADE,))
+            shade = QgsRasterLayer(path, QCoreApplication.translate("ResultLayers", "DTM hillshade"))
+            if shade.isValid():
+                style_hillshade(shade)
+                _mark(shade, DTM_HILLSHADE)
+                add_layer(project, shade, group, path)
+        elif self.kind == RELIEF:
+            style_relief(layer)
+            layer.setName(relief_name(path))
+        elif self.kind == CONTOURS:
+            style_contours(layer)
         name = _output_layer_name(self.kind)
         if name:  # not the parameter's label ("Orthomosaic (default: <workspace>/orthomosaic.tif)")
             layer.setName(name)
@@ -559,7 +703,9 @@ def _output_layer_name(kind):
     names = {DSM: QCoreApplication.translate("ResultLayers", "DSM"),
              ORTHO: QCoreApplication.translate("ResultLayers", "Orthomosaic"),
              CAMERAS: QCoreApplication.translate("ResultLayers", "Cameras"),
-             POINT_CLOUD: QCoreApplication.translate("ResultLayers", "Point cloud")}
+             POINT_CLOUD: QCoreApplication.translate("ResultLayers", "Point cloud"),
+             DTM: QCoreApplication.translate("ResultLayers", "DTM"),
+             CONTOURS: QCoreApplication.translate("ResultLayers", "Contours")}
     return names.get(kind)
 
 
@@ -624,8 +770,8 @@ def register_outputs(alg, results, context):
             details = context.layerToLoadOnCompletionDetails(value)
             details.setPostProcessor(pp)
         else:
-            hint = QgsProcessingUtils.LayerHint.Raster if kind in (DSM, ORTHO) else (
-                QgsProcessingUtils.LayerHint.Vector if kind in (CAMERAS, RESIDUALS) else
+            hint = QgsProcessingUtils.LayerHint.Raster if kind in (DSM, ORTHO, DTM, RELIEF) else (
+                QgsProcessingUtils.LayerHint.Vector if kind in (CAMERAS, RESIDUALS, CONTOURS) else
                 QgsProcessingUtils.LayerHint.UnknownType)
             details = QgsProcessingContext.LayerDetails(out_def.description() or name, project, name, hint)
             details.setPostProcessor(pp)
