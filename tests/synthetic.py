@@ -938,3 +938,221 @@ def single_strip(seed: int = 3, camera: CameraModel = DEFAULT_CAMERA, altitude: 
     """One long strip (the classic case where a block bends)."""
     return vertical_block(seed, camera, altitude, n_strips=1, per_strip=n, forward_overlap=forward_overlap,
                           gcp_grid=kw.pop("gcp_grid", (6, 2)), **kw)
+
+
+# --------------------------------------------------------------------------------------------------
+# high obliques: an orbit around the site with the far field, the horizon and the sky in view (issue 13)
+# --------------------------------------------------------------------------------------------------
+
+# a small wide-angle frame (vertical half angle ~31 deg): at 65 deg off nadir the top rows look above the horizon
+ORBIT_CAMERA = CameraModel(480, 360, 300.0, 300.0, 241.3, 178.6, k1=-0.05, k2=0.01, p1=0.0004, p2=-0.0003)
+GROUND_TINT = np.array([1.06, 1.0, 0.74], dtype=np.float32)  # RGB factors of the grey ground (brownish fields)
+SKY_ZENITH = np.array([0.52, 0.66, 0.92], dtype=np.float32)  # RGB of the sky well above the horizon
+HAZE = np.array([0.80, 0.82, 0.86], dtype=np.float32)  # RGB of the haze the far field fades into
+HAZE_DISTANCE = 1500.0  # m: the ground keeps exp(-distance / this) of its contrast
+FAR_PERIOD = 512.0  # m: the far-field texture repeats with this period (the ground goes on to the horizon)
+FAR_RES = 0.5  # m per far-field texture cell
+
+
+@lru_cache(maxsize=2)
+def _far_texture(seed: int) -> np.ndarray:
+    """Periodic grey texture (FAR_PERIOD square at FAR_RES) of the ground beyond the scene: band-limited noise
+    (FFT, so it wraps) and soft-edged fields."""
+    n = int(round(FAR_PERIOD / FAR_RES))
+    rng = np.random.default_rng(seed + 202)
+    f = np.fft.fftfreq(n, d=FAR_RES)
+    fr = np.hypot(f[None, :], f[:, None])
+    tex = np.zeros((n, n))
+    for wavelength, weight in ((1.5, 0.8), (4.0, 1.0), (12.0, 0.9), (40.0, 0.7)):
+        band = np.exp(-0.5 * ((fr - 1.0 / wavelength) / (0.35 / wavelength)) ** 2)
+        noise = np.real(np.fft.ifft2(np.fft.fft2(rng.normal(0.0, 1.0, (n, n))) * band))
+        tex += weight * noise / max(noise.std(), 1e-9)
+    fields = np.real(np.fft.ifft2(np.fft.fft2(rng.normal(0.0, 1.0, (n, n))) * np.exp(-0.5 * (fr * 60.0) ** 2)))
+    tex = tex / 3.0 + 1.2 * np.tanh(fields / max(fields.std(), 1e-9) * 3.0)
+    return np.clip(0.5 + 0.12 * tex, 0.05, 0.95).astype(np.float32)
+
+
+def _far_hit(scene: Scene, centre: np.ndarray, d: np.ndarray, iterations: int = 8) -> np.ndarray:
+    """Intersections (N,3) of downward rays with the smooth analytic ground (no buildings; ramp and hills as
+    ``scene.ground_at``), by Newton's method from the plane z = base_z."""
+    t = (scene.base_z - centre[2]) / d[:, 2]
+    h = 0.05
+    for _ in range(iterations):
+        p = centre[None, :] + t[:, None] * d
+        f = p[:, 2] - scene.ground_at(p[:, 0], p[:, 1])
+        q = p + h * d
+        fq = q[:, 2] - scene.ground_at(q[:, 0], q[:, 1])
+        slope = (fq - f) / h
+        t = np.maximum(t - f / np.where(slope < -1e-6, slope, d[:, 2]), 1e-3)
+    return centre[None, :] + t[:, None] * d
+
+
+def _enters_scene(scene: Scene, centre: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """True for rays whose part between the scene's highest and lowest surface crosses its bounds (Liang-Barsky)."""
+    zmax, zmin = scene.max_height(), scene.min_height()
+    t0 = np.maximum((zmax - centre[2]) / d[:, 2], 0.0)
+    t1 = (zmin - centre[2]) / d[:, 2]
+    xmin, ymin, xmax, ymax = scene.bounds
+    lo, hi = t0.copy(), t1.copy()
+    for k, (a, b) in enumerate(((xmin, xmax), (ymin, ymax))):
+        dk = d[:, k]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ta = (a - centre[k]) / dk
+            tb = (b - centre[k]) / dk
+        still = np.abs(dk) < 1e-12
+        inside = (centre[k] >= a) & (centre[k] <= b)
+        lo = np.where(still, np.where(inside, lo, np.inf), np.maximum(lo, np.minimum(ta, tb)))
+        hi = np.where(still, np.where(inside, hi, -np.inf), np.minimum(hi, np.maximum(ta, tb)))
+    return lo <= hi
+
+
+def render_oblique_image(scene: Scene, camera: CameraModel, shot: Shot, supersample: int = 2, noise: float = 1.5,
+                         seed: int = 0) -> np.ndarray:
+    """RGB uint8 image (height, width, 3) of a shot that may see beyond the scene and above the horizon.
+
+    Rays that cross the scene are cast into its height field as in :func:`render_image`; rays that miss it meet
+    the smooth analytic ground beyond (a periodic far-field texture, so the ground goes on to the horizon); rays
+    at or above the horizontal are sky (blue, paler towards the horizon).  Everything fades into haze with
+    distance (``HAZE_DISTANCE``).  Ground grey values are tinted brownish (``GROUND_TINT``)."""
+    s = int(supersample)
+    canvas_xn, map_x, map_y, vignetting = _canvas_geometry(camera, s)
+    d = shot.rays(canvas_xn).reshape(-1, 3)
+    d = d / np.linalg.norm(d, axis=1, keepdims=True)
+    sky = d[:, 2] > -1e-4
+    ground = ~sky
+    xyz = np.zeros((len(d), 3))
+    near = ground & _enters_scene(scene, shot.centre, np.where(ground[:, None], d, [[0.0, 0.0, -1.0]]))
+    if near.any():
+        dn = d[near]
+        pad = -len(dn) % 1024  # _ray_cast remaps 2-D arrays: rows of 1024 rays (padded with nadir rays)
+        dn = np.concatenate([dn, np.tile([[0.0, 0.0, -1.0]], (pad, 1))]).reshape(-1, 1024, 3)
+        xyz[near] = _ray_cast(scene, shot.centre, dn, step=0.25).reshape(-1, 3)[:len(d[near].reshape(-1, 3))]
+    xmin, ymin, xmax, ymax = scene.bounds
+    inset = 2 * scene.height_res
+    far = ground & ~(near & (xyz[:, 0] > xmin + inset) & (xyz[:, 0] < xmax - inset)
+                     & (xyz[:, 1] > ymin + inset) & (xyz[:, 1] < ymax - inset))
+    if far.any():
+        xyz[far] = _far_hit(scene, shot.centre, d[far])
+    grey = np.zeros(len(d), dtype=np.float32)
+    inner = ground & ~far
+    if inner.any():
+        grey[inner] = _surface_value(scene, xyz[inner])
+    if far.any():
+        tex = _far_texture(scene.seed)
+        n = tex.shape[0]
+        mx, my = np.mod(xyz[far, 0] / FAR_RES, n), np.mod(-xyz[far, 1] / FAR_RES, n)
+        c0, r0 = np.floor(mx).astype(np.int64), np.floor(my).astype(np.int64)
+        fx_, fy_ = (mx - c0).astype(np.float32), (my - r0).astype(np.float32)
+        c0, r0, c1, r1 = c0 % n, r0 % n, (c0 + 1) % n, (r0 + 1) % n  # bilinear, wrapping around
+        grey[far] = ((1 - fy_) * ((1 - fx_) * tex[r0, c0] + fx_ * tex[r0, c1])
+                     + fy_ * ((1 - fx_) * tex[r1, c0] + fx_ * tex[r1, c1]))
+    rgb = np.clip(grey[:, None] * GROUND_TINT[None, :], 0.0, 1.0)
+    dist = np.linalg.norm(xyz - shot.centre[None, :], axis=1)
+    keep = np.exp(-dist / HAZE_DISTANCE).astype(np.float32)[:, None]
+    rgb = rgb * keep + HAZE[None, :] * (1.0 - keep)
+    elev = np.clip(d[sky, 2], 0.0, 1.0)
+    w = np.exp(-elev / 0.12)[:, None].astype(np.float32)
+    rgb[sky] = SKY_ZENITH[None, :] * (1.0 - w) + HAZE[None, :] * w
+    canvas = rgb.reshape(canvas_xn.shape[:2] + (3,)).astype(np.float32)
+    canvas = cv2.GaussianBlur(canvas, (0, 0), 0.45 * s)
+    img = cv2.remap(canvas, map_x, map_y, cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE)
+    img = img * vignetting[:, :, None] * 255.0
+    img += np.random.default_rng(seed).normal(0.0, noise, img.shape).astype(np.float32)
+    return np.clip(np.round(img), 0, 255).astype(np.uint8)
+
+
+@dataclass
+class ObliqueBlock(SyntheticBlock):
+    """A block of high obliques: rendered in colour with the far field, the horizon and the sky
+    (:func:`render_oblique_image`); ``sky_mask`` is the truth of which pixels see the sky."""
+
+    tilts: Dict[str, float] = field(default_factory=dict)  # image -> degrees off nadir
+
+    def render(self, folder: str, supersample: int = 2, ext: str = ".jpg", quality: int = 95) -> List[str]:
+        os.makedirs(folder, exist_ok=True)
+        paths = []
+        for k, s in enumerate(self.shots):
+            img = render_oblique_image(self.scene, self.camera, s, supersample, seed=self.seed * 1000 + k)
+            path = os.path.join(folder, s.name if s.name.lower().endswith(ext) else s.name + ext)
+            params = [cv2.IMWRITE_JPEG_QUALITY, quality] if ext.lower() in (".jpg", ".jpeg") else []
+            if not cv2.imwrite(path, cv2.cvtColor(img, cv2.COLOR_RGB2BGR), params):
+                raise OSError(f"cannot write {path}")
+            paths.append(path)
+        return paths
+
+    def sky_mask(self, shot: Union[Shot, str], margin_deg: float = 0.0) -> np.ndarray:
+        """(height, width) bool: True where the pixel's ray (through the true distorted camera) points at or above
+        the horizontal, i.e. at the sky (``margin_deg`` > 0 counts that much below the horizon too)."""
+        shot = self.shot(shot) if isinstance(shot, str) else shot
+        c = self.camera
+        jj, ii = np.meshgrid(np.arange(c.width, dtype=float) + 0.5, np.arange(c.height, dtype=float) + 0.5)
+        xu = c.undistort(c.normalized_from_pixel(np.stack([jj, ii], axis=-1)))
+        d = shot.rays(xu)
+        elev = np.degrees(np.arcsin(d[..., 2] / np.linalg.norm(d, axis=-1)))
+        return elev >= -margin_deg
+
+    def in_sky(self, shot: Union[Shot, str], px: np.ndarray, margin_deg: float = 0.0) -> np.ndarray:
+        """For pixels (N,2) of ``shot`` (COLMAP convention): True where they see the sky (as ``sky_mask``)."""
+        shot = self.shot(shot) if isinstance(shot, str) else shot
+        c = self.camera
+        xu = c.undistort(c.normalized_from_pixel(np.atleast_2d(np.asarray(px, dtype=float))))
+        d = shot.rays(xu)
+        return np.degrees(np.arcsin(d[:, 2] / np.linalg.norm(d, axis=1))) >= -margin_deg
+
+    def add_site_gcps(self, half: float, n: int = 4, roofs: int = 2, min_views: int = 3) -> List[TruePoint]:
+        """Ground points on a jittered n x n grid over the square of ``half`` metres around the site's centre
+        (away from buildings and the ditch), plus points on ``roofs`` roofs; kept where seen in >= ``min_views``."""
+        rng = np.random.default_rng(self.seed + 7)
+        pts: List[TruePoint] = []
+        for j in range(n):
+            for i in range(n):
+                fx_, fy_ = -1.0 + 2.0 * i / max(1, n - 1), -1.0 + 2.0 * j / max(1, n - 1)
+                cand = np.column_stack([fx_ * half + rng.normal(0, 0.06 * half, 40),
+                                        fy_ * half + rng.normal(0, 0.06 * half, 40)])
+                cand = cand[~self.scene.near_feature(cand[:, 0], cand[:, 1], 3.0)]
+                for xy in cand[:8]:
+                    p = TruePoint(f"G{len(pts) + 1:02d}", np.array([xy[0], xy[1], float(self.scene.ground_at(*xy))]),
+                                  "ground")
+                    if self._observe(p, min_views):
+                        pts.append(p)
+                        break
+        n_roof = 0
+        for b in sorted(self.scene.buildings, key=lambda b: -(b.half_w * b.half_l)):
+            if n_roof >= roofs:
+                break
+            p = TruePoint(f"R{n_roof + 1:02d}", np.array([b.cx, b.cy, b.roof]), "roof")
+            if self._observe(p, min_views):
+                pts.append(p)
+                n_roof += 1
+        self.gcps = pts
+        return pts
+
+
+def orbit_block(seed: int = 21, camera: CameraModel = ORBIT_CAMERA, altitude: float = 40.0,
+                tilts: Sequence[float] = (45.0, 65.0), per_ring: int = 8, half_size: float = 65.0,
+                attitude_sigma_deg: float = 1.0, position_jitter: float = 0.5, target_jitter: float = 3.0,
+                n_buildings: int = 5, gcp_half: float = 22.0, ring_offset: float = 0.5) -> ObliqueBlock:
+    """Cameras circling the site, ``per_ring`` per tilt (degrees off nadir), all ``altitude`` above the base and
+    looking at (near) the centre, image up = world up (the horizon at the top of the steep ones; at 65 deg with
+    ORBIT_CAMERA the top ~40 rows are sky).  The rings are offset by ``ring_offset`` of a step in azimuth.  The scene is
+    ``half_size`` m either side of the centre (no ramp, so the ground beyond it continues smoothly)."""
+    rng = np.random.default_rng(seed)
+    scene = make_scene(seed, (-half_size, -half_size, half_size, half_size), n_buildings=n_buildings)
+    scene.ramp = (0.0, 0.0)
+    scene._rasters.clear()
+    shots: List[Shot] = []
+    tilt_of: Dict[str, float] = {}
+    for ri, tilt in enumerate(tilts):
+        dist = altitude * math.tan(math.radians(tilt))
+        for k in range(per_ring):
+            a = 2 * math.pi * (k + ring_offset * ri) / per_ring
+            target = np.array([*rng.normal(0.0, target_jitter, 2), scene.base_z])
+            c = np.array([dist * math.cos(a), dist * math.sin(a), scene.base_z + altitude])
+            c = c + rng.normal(0.0, position_jitter, 3)
+            r = small_rotation(rng, attitude_sigma_deg) @ look_at(c, target, np.array([0.0, 0.0, 1.0]))
+            name = f"T{int(round(tilt))}_{k + 1:02d}.jpg"
+            shots.append(Shot(name, r, c, "oblique", ri + 1))
+            tilt_of[name] = float(tilt)
+    block = ObliqueBlock(scene, camera, shots, altitude, seed=seed, tilts=tilt_of)
+    block.add_site_gcps(gcp_half)
+    return block

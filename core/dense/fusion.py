@@ -15,6 +15,8 @@ import numpy as np
 from ..common.errors import require
 from ..common.files import save_npz
 from ..common.parallel import check_unit_cancel
+from ..prepare.masks import read_keep
+from ..prepare.sky import horizon_keep
 from .options import DenseError
 from .pairs import View, load_scaled
 
@@ -28,6 +30,22 @@ class FuseUnit:
     min_consistent: int
     out_path: str
     threads: int
+    sky_margin_deg: Optional[float] = None  # drop pixels less than this far below the horizon (None: keep)
+
+
+def sky_free(view: View, depth: np.ndarray, sky_margin_deg: Optional[float]) -> np.ndarray:
+    """``depth`` (an image's map at any scale) without the pixels of the sky: those less than ``sky_margin_deg``
+    below the horizon of the pose (the georeferenced frame's z is up; core.prepare.sky.horizon_keep) and the black
+    pixels of the image's mask."""
+    cv2 = require("cv2", "depth fusion")
+    out = depth.copy()
+    if sky_margin_deg is not None:
+        out[~horizon_keep(view.camera, view.R, (0.0, 0.0, 1.0), sky_margin_deg, shape=depth.shape)] = np.nan
+    if view.mask_path:
+        keep = read_keep(view.mask_path, view.width, view.height).astype(np.uint8)
+        keep = cv2.resize(keep, (depth.shape[1], depth.shape[0]), interpolation=cv2.INTER_NEAREST) > 0
+        out[~keep] = np.nan
+    return out
 
 
 def fuse_depth_maps(maps: np.ndarray, rel_tol: np.ndarray, min_consistent: int) -> Tuple[np.ndarray, np.ndarray]:
@@ -91,6 +109,8 @@ def fuse_image(unit: FuseUnit, cancel_path: Optional[str] = None) -> dict:
     rel_tol = np.clip(unit.tolerance_px * np.asarray(errs, dtype=np.float64), 0.002, 0.05)
     fused, _n = fuse_depth_maps(stack, rel_tol, unit.min_consistent)
     del stack, maps
+    if unit.sky_margin_deg is not None or unit.view.mask_path:
+        fused = sky_free(unit.view, fused, unit.sky_margin_deg)
     check_unit_cancel(cancel_path)
     img, sx, sy = load_scaled(unit.view, unit.scale)
     k, dist = unit.view.camera_matrix(sx, sy)

@@ -33,6 +33,10 @@ class DenseOptions:
     min_consistent: int = 2  # pairs that must agree on a pixel
     depth_tolerance_px: float = 1.0  # agreement tolerance, in disparity pixels of the weakest pair
     max_hole_cells: int = 16
+    # no dense point from the sky: pixels whose ray points less than this many degrees below the horizontal (the
+    # horizon of the georeferenced pose, core.prepare.sky.horizon_keep) are dropped, as are the black pixels of
+    # the images' masks; None = keep everything above the horizon (terrain rising above the cameras)
+    sky_margin_deg: Optional[float] = 1.0
     workers: int = 0  # 0 = one per core (bounded by memory)
     executor: str = "auto"  # auto / serial / process / thread
     scheduler: Optional[str] = None  # Dask scheduler address

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass, field
-from typing import Dict, List, Sequence, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -32,6 +32,7 @@ class View:
     params: Tuple[float, ...]
     R: np.ndarray
     t: np.ndarray
+    mask_path: Optional[str] = None  # masks/<image>.png (white = use): no dense point from its black pixels
 
     @property
     def centre(self) -> np.ndarray:

@@ -156,7 +156,7 @@ def _fuse(views: Dict[int, View], pairs: List[PairInfo], summaries: List[dict], 
         progress.info(f"{len(lonely)} image(s) are in fewer than {options.min_consistent} matched pairs and add no "
                       f"points of their own: {', '.join(lonely[:6])}{' ...' if len(lonely) > 6 else ''}")
     funits = [FuseUnit(views[i], options.scale, maps, options.depth_tolerance_px, options.min_consistent,
-                       os.path.join(fused_dir, f"{i}.npz"), threads)
+                       os.path.join(fused_dir, f"{i}.npz"), threads, sky_margin_deg=options.sky_margin_deg)
               for i, maps in sorted(per_image.items()) if len(maps) >= options.min_consistent]
     files: List[PointFile] = []
     executor = make_executor(options.workers, options.executor, options.scheduler, unit_memory=unit_mem)

@@ -35,6 +35,7 @@ from ..common.parallel import CANCEL_PREFIX
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..io import raster
 from ..io.images import ImageError
+from ..prepare.masks import find_mask
 from ..project.layout import Layout
 from ..project.stages import DSM, GEOREFERENCE, run_stage
 from ..project.workspace import Workspace
@@ -211,6 +212,9 @@ def _views(ws: Workspace, rec, images_dir: str) -> Dict[int, View]:
     views = views_from_reconstruction(rec, images_dir)
     if len(views) < 2:
         raise DenseError(f"the model of {ws.root} has {len(views)} registered image(s): dense matching needs 2 or more")
+    masks_dir = Layout(ws).masks_dir
+    for v in views.values():  # the sky masks (and any other): no dense point from their black pixels
+        v.mask_path = find_mask(masks_dir, v.name)
     missing = [v.name for v in views.values() if not os.path.isfile(v.path)]
     if missing:
         raise DenseError(f"{len(missing)} image(s) of the model are missing from {images_dir}: "

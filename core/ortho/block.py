@@ -3,7 +3,7 @@ images, the output grid, visibility tables), and one image's true orthophoto."""
 from __future__ import annotations
 
 import os
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
@@ -16,7 +16,7 @@ from .options import OrthoError, OrthoOptions
 from .pixels import ImageMeta, image_meta
 from .sampling import sample_camera
 from .surface import _Dsm
-from .visibility import Footprint, Visibility, build_visibility, camera_footprint
+from .visibility import Footprint, Visibility, build_visibility, camera_footprint, resolution_limited
 from .writer import _RasterWriter
 
 
@@ -34,8 +34,10 @@ class _Prepared:
 
 def prepare_block(cameras: Sequence[OrthoCamera], dsm: _Dsm, offset: np.ndarray, resolution: float,
                   workdir: str, occlusion: bool = True, height_tolerance: float = 0.0,
-                  progress: Optional[Progress] = None) -> _Prepared:
-    """Footprints, the output grid and per-image visibility tables; checks the DSM against the images."""
+                  progress: Optional[Progress] = None, gsd_factor: float = 0.0) -> _Prepared:
+    """Footprints, the output grid and per-image visibility tables; checks the DSM against the images.
+    ``gsd_factor`` > 0: each image is used only where its ground resolution is within that factor of its best
+    (its footprint trimmed, OrthoCamera.max_gsd set on a copy)."""
     progress = progress or NullProgress()
     warnings: List[str] = []
     offset = np.asarray(offset, dtype=float)
@@ -77,6 +79,8 @@ def prepare_block(cameras: Sequence[OrthoCamera], dsm: _Dsm, offset: np.ndarray,
                         f"{', '.join(dropped[:8])}")
     cams = [cameras[i] for i in keep]
     fps = [footprints[i] for i in keep]
+    if gsd_factor and gsd_factor > 0:
+        cams, fps = _limit_resolution(cams, fps, offset, z_lo, z_hi, gsd_factor)
     if not cams:
         raise OrthoError("no image sees the ground of the DSM (cameras below the surface or looking up)")
     # DSM coverage per image
@@ -135,6 +139,18 @@ def prepare_block(cameras: Sequence[OrthoCamera], dsm: _Dsm, offset: np.ndarray,
             vis.append(None)
         progress.report((i + 1) / len(cams), f"visibility {i + 1}/{len(cams)}: {c.name}")
     return _Prepared(cams, metas, fps, vis, grid, gsd, (z_lo, z_hi), warnings)
+
+
+def _limit_resolution(cams: Sequence[OrthoCamera], fps: Sequence[Footprint], offset: np.ndarray, z_lo: float,
+                      z_hi: float, factor: float) -> Tuple[List[OrthoCamera], List[Footprint]]:
+    """Copies of the cameras with ``max_gsd`` = factor x their best ground resolution, and their trimmed
+    footprints (core.ortho.visibility.resolution_limited)."""
+    out_c, out_f = [], []
+    for c, f in zip(cams, fps):
+        f2, best = resolution_limited(c, offset, f, z_lo, z_hi, factor)
+        out_c.append(replace(c, max_gsd=factor * best) if np.isfinite(best) else c)
+        out_f.append(f2)
+    return out_c, out_f
 
 
 def _check_kind(metas: Sequence[ImageMeta], cams: Sequence[OrthoCamera]) -> Tuple[int, str]:

@@ -24,6 +24,26 @@ class OrthoCamera:
     pose: Pose
     camera_id: int = 0
     mask_path: Optional[str] = None
+    max_gsd: Optional[float] = None  # ground points this image resolves coarser than this (m/px) are not used
+
+    def ground_resolution(self, xyz_local: np.ndarray) -> np.ndarray:
+        """Ground sample distance (N,) of this image at local points (N, 3): metres of level ground per pixel in
+        the worst direction (1 / the smallest singular value of d pixel / d (x, y)), by finite differences through
+        the full camera model; inf where a point does not project."""
+        xyz = np.atleast_2d(np.asarray(xyz_local, dtype=float))
+        depth = np.maximum(self.pose.to_camera(xyz)[..., 2], 1e-6)
+        h = (depth / max(self.camera.focal, 1e-9))[:, None]  # about one pixel on the ground
+        p0, _, ok0 = self.project(xyz)
+        px, _, okx = self.project(xyz + h * np.array([1.0, 0.0, 0.0]))
+        py, _, oky = self.project(xyz + h * np.array([0.0, 1.0, 0.0]))
+        a, c = (px - p0).T / h[:, 0]
+        b, d = (py - p0).T / h[:, 0]
+        t = a * a + b * b + c * c + d * d
+        det = np.abs(a * d - b * c)
+        s_min2 = 0.5 * (t - np.sqrt(np.maximum(t * t - 4.0 * det * det, 0.0)))
+        with np.errstate(divide="ignore"):
+            g = 1.0 / np.sqrt(np.maximum(s_min2, 0.0))
+        return np.where(ok0 & okx & oky, g, np.inf)
 
     @property
     def centre(self) -> np.ndarray:

@@ -82,7 +82,8 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
         with _gdal_cache(64):
             t0 = time.time()
             prep = prepare_block(cameras, dsm, offset, options.resolution, workdir, options.occlusion,
-                                 options.height_tolerance, SubProgress(progress, 0.0, 0.12))
+                                 options.height_tolerance, SubProgress(progress, 0.0, 0.12),
+                                 gsd_factor=options.gsd_factor)
             for w_ in prep.warnings:
                 progress.warning(w_)
             if dsm.reprojected:

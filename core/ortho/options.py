@@ -36,6 +36,9 @@ class OrthoOptions:
     seam_iterations: int = 2  # passes moving the seamlines towards where the images agree (0 = off)
     seam_alpha: float = 5.0  # weight of the view cost against the seam cost in those moves
     relief_height: float = 1.5  # m above the surroundings that makes an object seams go around
+    # each image only where it resolves the ground within this factor of its best ground resolution (the far field
+    # of a high oblique stays out of the mosaic and of its own orthophoto); 0 = no limit
+    gsd_factor: float = 3.0
     compress: str = "DEFLATE"
     cache_mb: int = 256  # decoded images + visibility tables kept in memory
     workers: int = 1  # tile workers (core.parallel); 0 = one per core
@@ -49,6 +52,10 @@ class OrthoOptions:
         if self.resolution is None or not math.isfinite(self.resolution) or self.resolution < 0:
             raise OrthoError(f"RESOLUTION must be 0 (the ground sample distance) or a positive number of metres, "
                              f"got {self.resolution}")
+        if self.gsd_factor is None or not math.isfinite(self.gsd_factor) or \
+                (self.gsd_factor != 0 and self.gsd_factor < 1.0):
+            raise OrthoError(f"GSD_FACTOR must be 0 (no limit) or at least 1 (each image only where its ground "
+                             f"resolution is within that factor of its best), got {self.gsd_factor}")
         if self.tile < 64:
             raise OrthoError(f"tile size must be at least 64 cells, got {self.tile}")
 

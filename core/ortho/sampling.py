@@ -32,6 +32,9 @@ def sample_camera(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.n
     if vis is not None and ok.any():
         idx = np.flatnonzero(ok)
         ok[idx] = vis.visible(x[idx], y[idx], z[idx], _table(vis))
+    if cam.max_gsd and ok.any():  # the stretched far field of an oblique: left to the images that see it nearer
+        idx = np.flatnonzero(ok)
+        ok[idx] = cam.ground_resolution(xyz[idx]) <= cam.max_gsd
     mask = _mask(cam.mask_path)
     if mask is not None and ok.any():
         idx = np.flatnonzero(ok)

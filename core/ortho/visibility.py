@@ -64,6 +64,47 @@ def camera_footprint(cam: OrthoCamera, offset: np.ndarray, z_lo: float, z_hi: fl
     return Footprint(poly, (float(xmin), float(ymin), float(xmax), float(ymax)), float(gsd), float(z_ref))
 
 
+GSD_SAMPLES = (41, 31)  # image points (across, down) at which an image's ground resolution is sampled
+GSD_MARGIN = 1.3  # the trimmed footprint reaches this much beyond the limit (the exact test is per cell)
+
+
+def resolution_limited(cam: OrthoCamera, offset: np.ndarray, fp: Footprint, z_lo: float, z_hi: float,
+                       factor: float) -> Tuple[Footprint, float]:
+    """(the footprint trimmed to where the image resolves the ground within ``factor`` x its best, its best ground
+    resolution): the image sampled on a GSD_SAMPLES grid (border included), the rays met with the planes z_lo and
+    z_hi, the ground resolution there (OrthoCamera.ground_resolution); the convex hull of the points within
+    GSD_MARGIN x the limit.  ``fp`` and nan when nothing is sampled."""
+    w, h = cam.camera.width, cam.camera.height
+    gx, gy = np.meshgrid(np.linspace(0.0, w, GSD_SAMPLES[0]), np.linspace(0.0, h, GSD_SAMPLES[1]))
+    xn = cam.camera.unproject(np.column_stack([gx.ravel(), gy.ravel()]))
+    d = np.column_stack([xn, np.ones(len(xn))]) @ cam.pose.rotation
+    d = d[np.isfinite(d).all(axis=1) & (d[:, 2] < -1e-9)]
+    c = cam.centre
+    pts, gsd = [], []
+    for z in (z_lo, z_hi):
+        s = (z - offset[2] - c[2]) / d[:, 2]
+        p = c[None, :] + s[s > 0, None] * d[s > 0]
+        pts.append(p[:, :2])
+        gsd.append(cam.ground_resolution(p))
+    pts_a, gsd_a = np.concatenate(pts), np.concatenate(gsd)
+    fin = np.isfinite(gsd_a)
+    if not fin.any():
+        return fp, float("nan")
+    best = float(gsd_a[fin].min())
+    sel = fin & (gsd_a <= GSD_MARGIN * factor * best)
+    if sel.sum() < 3:
+        return fp, best
+    poly = convex_hull_xy(pts_a[sel] + offset[:2])
+    if len(poly) < 3:
+        return fp, best
+    xmin, ymin = np.maximum(poly.min(axis=0), fp.bbox[:2])
+    xmax, ymax = np.minimum(poly.max(axis=0), fp.bbox[2:])
+    if xmax <= xmin or ymax <= ymin:
+        return fp, best
+    gsd_fp = best if best > 1.05 * fp.gsd else fp.gsd  # an oblique's best view, not the nadir it does not see
+    return Footprint(poly, (float(xmin), float(ymin), float(xmax), float(ymax)), float(gsd_fp), fp.z_ref), best
+
+
 def _point_in_polygon(poly: np.ndarray, x: float, y: float) -> bool:
     from matplotlib.path import Path
 

@@ -46,3 +46,21 @@ class PrepareOptions:
     mask_polygons: Optional[Sequence] = None
     mask_source: str = "mask polygons"  # names the polygons' origin (a layer, a file) in messages
     mask_y_axis: str = "auto"  # auto / down / up (y = -row, the QGIS georeferencer)
+    # sky masks (core.prepare.sky): high obliques showing the horizon; the sky is hidden from the alignment
+    sky_masks: bool = False
+    sky: Optional["SkyOptions"] = None  # when sky_masks (None = SkyOptions())
+
+
+@dataclass
+class SkyOptions:
+    """The sky detector of core.prepare.sky (before alignment): smooth, bright, bluish or pale regions connected
+    to the upper edge of the upright photo."""
+
+    analysis_size: int = 640  # long side (px) at which the sky is searched
+    max_texture: float = 4.0  # largest local standard deviation (grey levels of 255, 7 x 7 window) of the sky
+    min_brightness: float = 0.45  # smallest mean brightness of the sky (fraction of full scale)
+    min_blueness: float = 0.03  # blue minus red (fraction of full scale) of a blue sky...
+    max_pale_saturation: float = 0.12  # ...or at most this spread between the channels (haze, overcast white)
+    min_fraction: float = 0.005  # a smaller region at the upper edge is no sky
+    min_top_cover: float = 0.25  # the sky spans at least this share of the upper edge (and never reaches the lower)
+    margin: float = 0.015  # the mask reaches this fraction of the image height beyond the sky (the horizon's haze)

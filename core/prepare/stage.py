@@ -28,7 +28,8 @@ from ..project.stages import PREPARE, run_stage
 from ..project.workspace import Workspace, WorkspaceError
 from . import masks as masksmod
 from . import scans
-from .options import PrepareOptions, ScanOptions
+from . import sky as skymod
+from .options import PrepareOptions, ScanOptions, SkyOptions
 from .screening import EXCLUDE, KEEP, ImageQuality, ScreeningError, screen_folder
 
 __all__ = ["OUTPUT_MARKER", "PrepareResult", "STAGE", "load_screening", "prepare_images_workspace"]
@@ -142,6 +143,8 @@ def _parameters(options: PrepareOptions, output_dir: str, polygons: Sequence) ->
     params = {"screening": asdict(options.screening), "scanned_film": options.scanned_film,
               "scan": asdict(options.scan) if options.scanned_film and options.scan is not None else None,
               "output_dir": output_dir}
+    if options.sky_masks:
+        params["sky"] = asdict(options.sky or SkyOptions())
     if polygons:  # a malformed polygon fails here, before the stage starts, by name
         params["mask_polygons"] = dict(_polygon_record(polygons, options.mask_source), source=options.mask_source,
                                        y_axis=options.mask_y_axis)
@@ -180,6 +183,19 @@ def _merge_user_masks(sc: _Screened, polygons: Sequence, foreign: Dict[str, str]
                       f"{'= -row' if axis == 'up' else 'down'}) hide parts of {len(user_masked)} "
                       f"of {len(sc.names)} images")
     return user_masked
+
+
+def _add_sky_masks(sc: _Screened, foreign: Dict[str, str], staging: str, options: PrepareOptions,
+                   progress: Progress, warnings: List[str]) -> Dict[str, float]:
+    """The sky detector (core.prepare.sky) on every image; its masks merged into the staged ones (or the masks put
+    in <workspace>/masks by hand); returns image -> share hidden as sky."""
+    bases = {n: sc.mask_files.get(n) or foreign.get(n) for n in sc.names}
+    res = skymod.write_sky_masks(sc.folder, sc.names, staging, options.sky or SkyOptions(), bases,
+                                 SubProgress(progress, 0.03, 0.2))
+    sc.mask_files.update(res.masks)
+    warnings.extend(res.warnings)
+    progress.info(f"sky: {len(res.masks)} of {len(sc.names)} images show sky, hidden from the alignment")
+    return dict(res.sky_fraction)
 
 
 def _fill_prepared(tmp: str, images_dir: str, quality: Sequence[ImageQuality], scanned_film: bool) -> None:
@@ -289,6 +305,10 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
                     with run.step("masks", save=False):
                         user_masked = _merge_user_masks(sc, polygons, foreign, staging, options, progress,
                                                         warnings)
+                sky_masked: Dict[str, float] = {}
+                if options.sky_masks:
+                    with run.step("sky", save=False):
+                        sky_masked = _add_sky_masks(sc, foreign, staging, options, progress, warnings)
                 screen_masks = dict(foreign)
                 screen_masks.update(sc.mask_files)
                 with run.step("screening", save=False):
@@ -322,6 +342,7 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
                 "decisions": {q.name: {"decision": q.decision, "flags": q.flags} for q in quality},
                 "interior_orientation": io, "masks": len(written_masks),
                 "user_masked_images": {n: user_masked[n] for n in sorted(user_masked)},
+                **({"sky_masked_images": {n: sky_masked[n] for n in sorted(sky_masked)}} if options.sky_masks else {}),
                 "total_seconds": round(time.time() - t_start, 2)})
     finally:
         shutil.rmtree(staging, ignore_errors=True)

@@ -1,0 +1,326 @@
+"""High obliques (issue 13, item 4): sky masks before and after alignment, no tie point and no dense point from the
+sky, per-image orthophotos limited to where their ground resolution is within a factor of their best, and a
+synthetic orbit (tests/synthetic.py: cameras circling the site at 45 and 65 degrees off nadir, the horizon and
+the sky in view at 65) aligned, georeferenced, matched and mosaicked end to end against its truth.
+
+Fast tests first (one or two rendered images, analytic cameras); the orbit end to end is marked slow."""
+import math
+import os
+
+import cv2
+import numpy as np
+import pytest
+from osgeo import gdal
+
+from core.geometry.camera import Intrinsics, Pose
+from core.io import raster as rastermod
+from core.ortho.cameras import OrthoCamera
+from core.ortho.mosaic import build_orthomosaic
+from core.ortho.options import OrthoError, OrthoOptions
+from core.prepare import sky
+from core.prepare.masks import find_mask, read_keep
+from core.prepare.options import PrepareOptions, SkyOptions
+from tests import synthetic as syn
+
+ORBIT = dict(seed=21, per_ring=8)
+CAM = syn.ORBIT_CAMERA
+
+
+def _intrinsics(c=CAM):
+    return Intrinsics("OPENCV", c.width, c.height, tuple(c.params))
+
+
+@pytest.fixture(scope="module")
+def orbit():
+    return syn.orbit_block(**ORBIT)
+
+
+@pytest.fixture(scope="module")
+def two_renders(orbit, tmp_path_factory):
+    """One 65 degree and one 45 degree image of the orbit, rendered (about 4 s)."""
+    root = tmp_path_factory.mktemp("two obliques")
+    steep = next(s for s in orbit.shots if orbit.tilts[s.name] == 65.0)
+    mild = next(s for s in orbit.shots if orbit.tilts[s.name] == 45.0)
+    paths = {}
+    for k, s in enumerate((steep, mild)):
+        img = syn.render_oblique_image(orbit.scene, orbit.camera, s, seed=k)
+        paths[s.name] = str(root / s.name)
+        cv2.imwrite(paths[s.name], cv2.cvtColor(img, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, 95])
+    return steep, mild, paths
+
+
+# ---------------------------------------------------------------------------
+# the synthetic orbit itself
+# ---------------------------------------------------------------------------
+
+def test_orbit_has_sky_in_the_steep_views_only(orbit):
+    assert len(orbit.shots) == 16
+    for s in orbit.shots:
+        frac = orbit.sky_mask(s).mean()
+        if orbit.tilts[s.name] == 65.0:
+            assert 0.02 < frac < 0.25, (s.name, frac)
+        else:
+            assert frac == 0.0, s.name
+    assert sum(p.kind == "ground" for p in orbit.gcps) >= 10
+    assert all(len(p.observations) >= 3 for p in orbit.gcps)
+
+
+def test_render_shows_sky_where_the_truth_says(orbit, two_renders):
+    steep, mild, paths = two_renders
+    img = cv2.cvtColor(cv2.imread(paths[steep.name]), cv2.COLOR_BGR2RGB).astype(float)
+    truth = orbit.sky_mask(steep, margin_deg=-1.0)  # 1 degree above the horizon: clear sky
+    ground = ~orbit.sky_mask(steep, margin_deg=8.0)  # 8 degrees below it: the scene
+    assert truth.any() and ground.any()
+    assert img[truth][:, 2].mean() > img[truth][:, 0].mean() + 25  # blue sky
+    assert img[ground][:, 2].mean() < img[ground][:, 0].mean()  # brownish ground
+    assert img[truth].std(axis=0).max() < 25 and img[ground].std(axis=0).min() > 15
+
+
+# ---------------------------------------------------------------------------
+# the sky detector (before alignment) and the pose's horizon (after)
+# ---------------------------------------------------------------------------
+
+def test_sky_detector_masks_the_sky_and_keeps_the_ground(orbit, two_renders, tmp_path):
+    steep, mild, paths = two_renders
+    keep = sky.detect_sky(paths[steep.name])
+    truth = orbit.sky_mask(steep)
+    assert keep.shape == truth.shape
+    assert not (truth & keep).any(), "a sky pixel is left for the features"
+    masked_ground = ~keep & ~truth
+    print(f"\nsky {truth.mean():.3f} of the image, masked {1 - keep.mean():.3f}, ground masked "
+          f"{masked_ground.mean():.3f}")
+    # what is hidden beyond the sky is the hazy band along the horizon: within 3 degrees below it
+    assert not (masked_ground & ~orbit.sky_mask(steep, margin_deg=3.0)).any()
+    assert masked_ground.mean() < 0.04
+    # the 45 degree view shows no sky: no mask
+    assert sky.detect_sky(paths[mild.name]).all()
+    # written through the mask machinery, merged with a mask the image already has
+    images = os.path.dirname(paths[steep.name])
+    masks = str(tmp_path / "masks")
+    os.makedirs(masks)
+    prior = np.ones(truth.shape, bool)
+    prior[-20:, :] = False  # e.g. a date stamp at the bottom
+    cv2.imwrite(os.path.join(masks, steep.name + ".png"), np.where(prior, 255, 0).astype(np.uint8))
+    res = sky.write_sky_masks(images, [steep.name, mild.name], masks)
+    assert set(res.masks) == {steep.name}
+    written = read_keep(find_mask(masks, steep.name), CAM.width, CAM.height)
+    assert np.array_equal(written, keep & prior)
+    assert find_mask(masks, mild.name) is None
+    assert abs(res.sky_fraction[steep.name] - (1 - written.mean())) < 1e-3
+
+
+def test_sky_detector_follows_the_exif_orientation(orbit, two_renders):
+    """A portrait-held camera (EXIF 6: shown turned 90 degrees clockwise): the sky is at the upright top, i.e. the
+    stored grid's left edge."""
+    steep, _, paths = two_renders
+    img = cv2.cvtColor(cv2.imread(paths[steep.name]), cv2.COLOR_BGR2RGB)
+    stored = np.ascontiguousarray(np.rot90(img, k=1))  # what a camera held in portrait stores (orientation 6)
+    keep6 = sky.sky_keep(stored, orientation=6)
+    keep1 = sky.sky_keep(img)
+    assert np.array_equal(keep6, np.rot90(keep1, k=1))
+    assert not keep6[:, :5].any() and keep6[:, -5:].all()  # the sky along the stored grid's left edge
+
+
+def test_sky_detector_finds_no_sky_in_vertical_photos():
+    """Real vertical photos (the Toledo strip: bright roads and roofs at the upper edge) and a rendered vertical."""
+    from tests.conftest import SAMPLE, TOLEDO_STRIP
+
+    for name in TOLEDO_STRIP[:3]:
+        keep = sky.detect_sky(os.path.join(SAMPLE, "images", name))
+        assert keep.all(), (name, 1 - keep.mean())
+    blk = syn.vertical_block(seed=2, camera=syn.CameraModel(400, 300, 325.0, 325.0, 200.0, 150.0), n_strips=1,
+                             per_strip=2, gcp_grid=(2, 2), roofs=0)
+    grey = syn.render_image(blk.scene, blk.camera, blk.shots[0])
+    assert sky.sky_keep(grey).all()
+
+
+def test_horizon_of_the_pose_is_the_true_horizon(orbit):
+    cam = _intrinsics()
+    for s in orbit.shots[7:10]:
+        keep = sky.horizon_keep(cam, s.rotation, margin_deg=0.0)
+        truth = orbit.sky_mask(s)
+        # the same pixels but for the interpolated band along the line (a row or so)
+        differ = keep != ~truth
+        assert differ.sum() <= 2 * CAM.width, (s.name, differ.sum())
+        band = orbit.sky_mask(s, margin_deg=0.3) & ~orbit.sky_mask(s, margin_deg=-0.3)  # within 0.3 degrees
+        assert not (differ & ~band).any()
+        # a margin hides that much below the horizon as well
+        keep2 = sky.horizon_keep(cam, s.rotation, margin_deg=2.0)
+        assert not (keep2 & orbit.sky_mask(s, margin_deg=1.8)).any()
+        assert (~keep2).sum() >= (~keep).sum()
+    # at reduced size (a dense-matching scale)
+    s = orbit.shots[8]
+    half = sky.horizon_keep(cam, s.rotation, margin_deg=0.0, shape=(CAM.height // 2, CAM.width // 2))
+    assert abs(half.mean() - (~orbit.sky_mask(s)).mean()) < 0.01
+
+
+def test_up_of_an_aligned_model_from_its_tie_points(orbit):
+    rec = orbit.truth_reconstruction(n_points=800, model_from_local="random", seed=3)
+    im = next(iter(rec.images.values()))
+    r_model = np.asarray(im.cam_from_world().rotation.matrix())
+    r_true = orbit.shot(im.name).rotation
+    model_from_local = r_model.T @ r_true  # rotation part of the random similarity
+    up = sky.estimate_up(rec)
+    expected = model_from_local @ np.array([0.0, 0.0, 1.0])
+    angle = math.degrees(math.acos(np.clip(up @ expected, -1, 1)))
+    print(f"\nup estimated within {angle:.2f} degrees")
+    assert angle < 3.0  # hills of a few metres over 130 m: the best plane is nearly level
+
+
+def test_horizon_masks_after_alignment(orbit, tmp_path):
+    rec = orbit.truth_reconstruction(n_points=800, model_from_local="random", seed=3)
+    res = sky.write_horizon_masks(rec, str(tmp_path / "masks"), margin_deg=1.0)
+    steep = {n for n, t in orbit.tilts.items() if t == 65.0}
+    assert set(res.masks) == steep
+    for n in steep:
+        keep = read_keep(res.masks[n], CAM.width, CAM.height)
+        assert not (keep & orbit.sky_mask(n)).any(), n
+
+
+def test_prepare_stage_writes_sky_masks(two_renders, tmp_path):
+    from core.prepare.stage import prepare_images_workspace
+    from core.project.workspace import Workspace
+
+    steep, mild, paths = two_renders
+    images = os.path.dirname(paths[steep.name])
+    ws = str(tmp_path / "ws")
+    res = prepare_images_workspace(images, ws, options=PrepareOptions(sky_masks=True, sky=SkyOptions()))
+    assert [os.path.basename(m) for m in res.masks] == [steep.name + ".png"]
+    rec = Workspace.open(ws).stage("prepare")
+    assert set(rec["results"]["sky_masked_images"]) == {steep.name}
+    assert rec["parameters"]["sky"]["max_texture"] == SkyOptions().max_texture
+    # off by default: no mask
+    res2 = prepare_images_workspace(images, str(tmp_path / "ws2"))
+    assert not res2.masks
+
+
+# ---------------------------------------------------------------------------
+# dense matching: nothing from the sky
+# ---------------------------------------------------------------------------
+
+def test_fusion_drops_the_sky_of_the_pose_and_the_masked_pixels(orbit, tmp_path):
+    from core.dense.fusion import sky_free
+    from core.dense.pairs import View
+
+    s = next(s for s in orbit.shots if orbit.tilts[s.name] == 65.0)
+    v = View(1, s.name, "", CAM.width, CAM.height, "OPENCV", tuple(CAM.params), s.rotation, -s.rotation @ s.centre)
+    depth = np.full((CAM.height // 2, CAM.width // 2), 50.0, np.float32)
+    out = sky_free(v, depth, 1.0)
+
+    def small(m):
+        return cv2.resize(m.astype(np.uint8), depth.shape[::-1], interpolation=cv2.INTER_NEAREST) > 0
+
+    assert np.isnan(out[small(orbit.sky_mask(s, margin_deg=0.8))]).all()  # the sky and 1 degree below the horizon
+    assert np.isfinite(out[~small(orbit.sky_mask(s, margin_deg=1.2))]).all()  # the rest
+    mask = np.full((CAM.height, CAM.width), 255, np.uint8)
+    mask[:, :40] = 0
+    cv2.imwrite(str(tmp_path / "m.png"), mask)
+    v.mask_path = str(tmp_path / "m.png")
+    out = sky_free(v, depth, None)
+    assert np.isnan(out[:, :20]).all() and np.isfinite(out[:, 20:]).all()
+
+
+# ---------------------------------------------------------------------------
+# orthophotos: each image only within GSD_FACTOR of its best ground resolution
+# ---------------------------------------------------------------------------
+
+def _pinhole(w=400, h=300, f=300.0):
+    return Intrinsics("PINHOLE", w, h, (f, f, w / 2, h / 2))
+
+
+def test_ground_resolution_of_nadir_and_oblique_views():
+    cam = _pinhole()
+    nadir = OrthoCamera("n", "", cam, Pose.from_centre(syn.look_at([0, 0, 50.0], [0, 0, 0.0], [0, 1.0, 0]),
+                                                         [0, 0, 50.0]))
+    assert abs(nadir.ground_resolution(np.array([[0.0, 0.0, 0.0]]))[0] - 50.0 / 300.0) < 1e-3
+    for tilt in (30.0, 45.0, 65.0):
+        d = 50.0 * math.tan(math.radians(tilt))
+        c = [-d, 0.0, 50.0]
+        ob = OrthoCamera("o", "", cam, Pose.from_centre(syn.look_at(c, [0, 0, 0.0], [0, 0, 1.0]), c))
+        # on the optical axis: the along-range footprint of a pixel, H / (f cos^2 tilt)
+        expected = 50.0 / (300.0 * math.cos(math.radians(tilt)) ** 2)
+        got = ob.ground_resolution(np.array([[0.0, 0.0, 0.0]]))[0]
+        assert abs(got / expected - 1) < 0.01, (tilt, got, expected)
+        assert not np.isfinite(ob.ground_resolution(np.array([[-2 * d, 0.0, 0.0]]))[0])  # behind it
+
+
+def test_gsd_factor_is_checked():
+    for bad in (0.5, -1.0, float("nan")):
+        with pytest.raises(OrthoError, match="GSD_FACTOR"):
+            OrthoOptions(gsd_factor=bad).check()
+    OrthoOptions(gsd_factor=0).check()
+    OrthoOptions(gsd_factor=1.0).check()
+
+
+def _flat_pair(root):
+    """A flat DSM (z = 100) and two uniformly grey images: A (value 60), a 65 degree oblique from the west looking
+    east, whose far field reaches over B (value 200), a vertical 160 m east of it."""
+    crs = syn.CRS
+    offset = np.array(syn.ORIGIN)
+    res = 1.0
+    xs0, ys0 = -150.0, 150.0
+    dsm = np.full((300, 400), 100.0, np.float32)
+    gt = (xs0 + offset[0], res, 0.0, ys0 + offset[1], 0.0, -res)
+    dsm_path = rastermod.write_cog(os.path.join(root, "dsm.tif"), dsm, gt, crs)
+    cam = _pinhole()
+    ca = np.array([-100.0, 0.0, 150.0])
+    ta = ca + np.array([math.sin(math.radians(65.0)), 0.0, -math.cos(math.radians(65.0))])
+    cb = np.array([60.0, 0.0, 150.0])
+    cams = []
+    for name, c, target, up, value in (("A.tif", ca, ta, [0, 0, 1.0], 60), ("B.tif", cb, cb - [0, 0, 1.0], [0, 1.0, 0], 200)):
+        path = os.path.join(root, name)
+        cv2.imwrite(path, np.full((cam.height, cam.width, 3), value, np.uint8))
+        cams.append(OrthoCamera(name, path, cam, Pose.from_centre(syn.look_at(c, target, np.array(up)), c)))
+    return cams, dsm_path, crs, offset
+
+
+def _values_along_x(path, offset):
+    ds = gdal.Open(path)
+    a = ds.ReadAsArray().astype(float)
+    gt = ds.GetGeoTransform()
+    row = int(round((offset[1] - gt[3]) / gt[5]))  # the line y = 0 (local)
+    xs = gt[0] + (np.arange(a.shape[2]) + 0.5) * gt[1] - offset[0]
+    return xs, a[0, row], a[-1, row] > 0
+
+
+def test_far_field_of_an_oblique_is_left_to_the_near_view(tmp_path):
+    """Along the line between the two cameras: A's near field, A's far field (coarser than 3 x A's best), B's
+    footprint.  With GSD_FACTOR 3 the far field stays out of A's own orthophoto and out of the mosaic, B fills its
+    footprint; without a limit A's far field is in both."""
+    cams, dsm, crs, offset = _flat_pair(str(tmp_path))
+    a = cams[0]
+    # A's best ground resolution: over its whole image (pixels met with the ground plane), at a lower corner
+    gx, gy = np.meshgrid(np.linspace(0, 400, 81), np.linspace(0, 300, 61))
+    rays = np.column_stack([a.camera.unproject(np.column_stack([gx.ravel(), gy.ravel()])), np.ones(gx.size)])
+    rays = rays @ a.pose.rotation
+    rays = rays[rays[:, 2] < 0]
+    ground = a.centre + ((100.0 - a.centre[2]) / rays[:, 2])[:, None] * rays
+    best = float(np.min(a.ground_resolution(ground)))
+    assert 0.2 < best < 0.23  # 50 m / 300 px, stretched 38 degrees off nadir, shrunk off the optical axis
+    xs_line = np.linspace(-100, 150, 2501)
+    g = a.ground_resolution(np.column_stack([xs_line, np.zeros_like(xs_line), np.full_like(xs_line, 100.0)]))
+    first = np.flatnonzero(np.isfinite(g))[0]  # the image's lower edge
+    x_limit = float(xs_line[first + np.flatnonzero(g[first:] > 3 * best)[0]])
+    assert -20 < x_limit < 20  # the far field starts about where A's optical axis meets the ground
+    results = {}
+    for factor in (3.0, 0.0):
+        out = str(tmp_path / f"mosaic_{factor:g}.tif")
+        per = str(tmp_path / f"per_{factor:g}")
+        build_orthomosaic(cams, dsm, crs, offset, out, OrthoOptions(gsd_factor=factor, blending="none",
+                                                                    exposure=False, resolution=0.5),
+                          per_image_folder=per)
+        results[factor] = (_values_along_x(out, offset), _values_along_x(os.path.join(per, "A.tif"), offset))
+    (xs, val, ok), (xa, _va, oka) = results[3.0]
+    b_lo, b_hi = 60 - 50.0 * 200 / 300.0, 60 + 50.0 * 200 / 300.0  # B's footprint on the line
+    in_b = (xs > b_lo + 1) & (xs < b_hi - 1)
+    assert ok[in_b].all() and np.all(np.abs(val[in_b] - 200) < 1)  # B there, not A's far field
+    a_only = (xs > x_limit + 2) & (xs < b_lo - 1)
+    assert a_only.any() and not ok[a_only].any()  # A's far field and nothing nearer: nodata
+    near_a = (xs > -55) & (xs < x_limit - 2)
+    assert ok[near_a].all() and np.all(np.abs(val[near_a] - 60) < 1)
+    # A's own orthophoto ends where its resolution passes 3 x its best (within a cell or two)
+    assert abs(float(xa[oka].max()) - x_limit) < 1.5
+    (xs0, val0, ok0), (xa0, _, oka0) = results[0.0]
+    far = (xs0 > x_limit + 2) & (xs0 < b_lo - 1)
+    assert ok0[far].all() and np.all(np.abs(val0[far] - 60) < 1)  # without a limit A's far field is used
+    assert float(xa0[oka0].max()) > b_hi  # ... and reaches past B in its own orthophoto
