@@ -399,3 +399,27 @@ def test_products_load_styled_in_qgis(scene_dsm, tmp_path, qgis_new_project):
             assert r.gradient() == QgsSingleBandGrayRenderer.Gradient.WhiteToBlack
     assert layers.output_kind("OUTPUT_DTM", "x/dtm.tif") == layers.DTM
     assert layers.output_kind("OUTPUT_CONTOURS", "x/c.gpkg") == layers.CONTOURS
+
+
+def test_without_rvt_the_message_names_the_pip_command(dtm, tmp_path, monkeypatch):
+    import sys
+
+    from core.common.errors import MissingDependencyError
+
+    result, _, _ = dtm
+    monkeypatch.setitem(sys.modules, "rvt.vis", None)  # as if rvt-py were not installed
+    with pytest.raises(MissingDependencyError, match=r"rvt-py.*relief visualisations.*pip install --no-deps "
+                                                     r"--ignore-requires-python rvt-py==2\.2\.3"):
+        relief(result.dtm_path, ["svf"], str(tmp_path))
+    # the DTM and contours do not need it
+    build_dtm(result.dsm_path, str(tmp_path / "dtm.tif"), contour_interval=2.0)
+
+
+def test_dependency_dialog_lists_rvt_as_optional(qgis_app, monkeypatch):
+    from archaeoortho.core.common import dependencies
+    from archaeoortho.ui.dependencies import optional_packages_html
+
+    html = optional_packages_html()
+    assert "Optional" in html and "rvt-py (relief visualisations)" in html
+    monkeypatch.setattr(dependencies, "check", lambda reqs: [dependencies.Found(r) for r in reqs])  # missing
+    assert "--ignore-requires-python rvt-py==2.2.3" in optional_packages_html()

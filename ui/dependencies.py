@@ -65,6 +65,20 @@ def push_missing_message(iface, bad, profile_dir):
     return item
 
 
+def optional_packages_html():
+    """The optional packages (core.common.dependencies.OPTIONAL): what this Python has of each, and the command
+    that installs a missing one; the features that need them say so when used, the plugin loads without them."""
+    rows = []
+    for f in dependencies.check(dependencies.OPTIONAL):
+        colour = "green" if f.usable else "#777"
+        how = "" if f.usable else " " + _tr("install with: {}").format(
+            f"<code>{dependencies.install_command([f.requirement.dist])}</code>")
+        rows.append(f"<li><span style='color:{colour}'>[{_tr(_STATE_TEXT[f.state])}]</span> {f.describe()}{how}</li>")
+    if not rows:
+        return ""
+    return _tr("Optional (only the feature named needs it):") + f"<ul>{''.join(rows)}</ul>"
+
+
 class DependenciesDialog(QDialog):
     """Lists what is missing, installs it with pip (QProcess, log, busy bar, Cancel, Retry), verifies it.
 
@@ -155,7 +169,7 @@ class DependenciesDialog(QDialog):
             rows.append(f"<li><span style='color:{colour}'>[{_tr(_STATE_TEXT[f.state])}]</span> "
                         f"{f.describe()}</li>")
         heading = _tr("ArchaeoOrtho needs these Python packages:")
-        self.packages_label.setText(f"{heading}<ul>{''.join(rows)}</ul>")
+        self.packages_label.setText(f"{heading}<ul>{''.join(rows)}</ul>{optional_packages_html()}")
         running = self.state in ("running", "verifying")
         self.install_button.setEnabled(not running)
         self.install_button.setText({"failed": _tr("Retry"), "cancelled": _tr("Retry"),

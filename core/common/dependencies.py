@@ -59,7 +59,7 @@ REQUIREMENTS: Tuple[Requirement, ...] = (
 # metadata asks for Python < 3.12 and for jupyter, geopandas, rasterio, ... that rvt.vis never imports (it needs
 # NumPy and SciPy only): it is installed with --no-deps --ignore-requires-python (tested on Python 3.11 and 3.13)
 OPTIONAL: Tuple[Requirement, ...] = (
-    Requirement("rvt.vis", "rvt-py", "2.2.3", "rvt-py (relief visualisations)", "2.2", "3"),
+    Requirement("rvt", "rvt-py", "2.2.3", "rvt-py (relief visualisations)", "2.2", "3"),
 )
 OPTIONAL_PIP_FLAGS = ("--no-deps", "--ignore-requires-python")
 
