@@ -79,7 +79,7 @@ class GcpPlacement:
         text = self.tolerance_source()
         label = getattr(self, "tol_source", None)
         if label is not None:
-            label.setText("(" + text + ")")
+            label.setText(text if "(" in text else "(" + text + ")")
         self.tol_spin.setToolTip(translate("GcpDock", "Residuals up to this are green, up to 3 times yellow, beyond "
                                            "red. Now: {}").format(text))
 
