@@ -135,6 +135,7 @@ class ArchaeoOrthoPlugin:
             from .ui.gcp_dock import GcpDock
 
             self.dock = GcpDock(self.iface, parent=self.iface.mainWindow())
+            self.dock.refine_in_background = True  # matching a prediction never blocks QGIS (issue 18.5)
             self.iface.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, self.dock)
             self.iface.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.dock.photo_dock)
             self.dock.visibilityChanged.connect(self._dock_visibility)

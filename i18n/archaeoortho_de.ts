@@ -212,7 +212,7 @@ Rekonstruktionsverfahren (erweitert): 'incremental' (COLMAP, Standard) oder 'glo
         <translation>ArchaeoOrtho: Passpunkte auf der Karte und in den Fotos messen</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="180"/>
+        <location filename="../plugin.py" line="181"/>
         <source>&amp;ArchaeoOrtho</source>
         <translation>&amp;ArchaeoOrtho</translation>
     </message>
@@ -330,77 +330,72 @@ Ein erneuter Lauf nach einem Abbruch setzt fort: bereits zugeordnete Paare werde
 <context>
     <name>BuildDtmAlgorithm</name>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="53"/>
+        <location filename="../processing_provider/build_dtm.py" line="52"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <location filename="../processing_provider/build_dtm.py" line="54"/>
         <source>DSM file (default: the workspace&apos;s)</source>
         <translation>DOM-Datei (Vorgabe: das des Arbeitsbereichs)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <location filename="../processing_provider/build_dtm.py" line="54"/>
         <source>Contour interval in metres (0 = none)</source>
         <translation>Höhenlinienabstand in Metern (0 = keine)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <location filename="../processing_provider/build_dtm.py" line="54"/>
         <source>Ground filter slope (rise over run)</source>
         <translation>Neigung des Bodenfilters (Steigung)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <location filename="../processing_provider/build_dtm.py" line="54"/>
         <source>Largest object radius in metres</source>
         <translation>Größter Objektradius in Metern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <location filename="../processing_provider/build_dtm.py" line="54"/>
         <source>Height above ground of an object in metres</source>
         <translation>Höhe eines Objekts über dem Boden in Metern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="65"/>
+        <location filename="../processing_provider/build_dtm.py" line="64"/>
         <source>DTM (default: &lt;workspace&gt;/dtm.tif)</source>
         <translation>DGM (Vorgabe: &lt;workspace&gt;/dtm.tif)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="67"/>
+        <location filename="../processing_provider/build_dtm.py" line="66"/>
         <source>Contours (default: &lt;workspace&gt;/terrain/contours.gpkg)</source>
         <translation>Höhenlinien (Vorgabe: &lt;workspace&gt;/terrain/contours.gpkg)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="70"/>
+        <location filename="../processing_provider/build_dtm.py" line="69"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="71"/>
+        <location filename="../processing_provider/build_dtm.py" line="70"/>
         <source>DTM source</source>
         <translation>DGM-Herkunft</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="72"/>
+        <location filename="../processing_provider/build_dtm.py" line="71"/>
         <source>Classified point cloud</source>
         <translation>Klassifizierte Punktwolke</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="73"/>
-        <source>Contour lines</source>
-        <translation>Höhenlinien</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_dtm.py" line="74"/>
+        <location filename="../processing_provider/build_dtm.py" line="72"/>
         <source>Share of DSM cells on the ground</source>
         <translation>Anteil der DOM-Zellen am Boden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="75"/>
+        <location filename="../processing_provider/build_dtm.py" line="73"/>
         <source>Share of DTM cells interpolated</source>
         <translation>Anteil der interpolierten DGM-Zellen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="102"/>
+        <location filename="../processing_provider/build_dtm.py" line="100"/>
         <source>Give a workspace folder, or a DSM file and where to write the DTM</source>
         <translation>Geben Sie einen Arbeitsbereich-Ordner an, oder eine DOM-Datei und wohin das DGM geschrieben wird</translation>
     </message>
@@ -577,7 +572,7 @@ Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786)
 Elevation raster: a DTM or DSM in a projected CRS (metres).
 Interval: metres between two contour lines (e.g. 0.5).
 Contours: the GeoPackage to write.</source>
-        <translation>Höhenlinien eines DGM oder DOM in einem gewählten Abstand (GDALs Höhenliniengenerator) in einen GeoPackage-Layer &apos;contours&apos;, dessen Feld &apos;elevation&apos; sie beschriftet.
+        <translation>Höhenlinien eines DGM oder DOM in einem gewählten Abstand (GDALs Höhenliniengenerator) in einen GeoPackage-Layer 'contours', dessen Feld 'elevation' sie beschriftet.
 
 Höhenraster: ein DGM oder DOM in einem projizierten KBS (Meter).
 Abstand: Meter zwischen zwei Höhenlinien (z. B. 0.5).
@@ -647,7 +642,7 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Den gewählten Passpunkt mit seinen Messungen entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="185"/>
+        <location filename="../ui/gcp_placement.py" line="190"/>
         <source>Pick on map</source>
         <translation>Auf der Karte messen</translation>
     </message>
@@ -742,17 +737,17 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Einen ArchaeoOrtho-Arbeitsbereich öffnen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="370"/>
+        <location filename="../ui/gcp_dock.py" line="378"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} Fotos; der Block ist noch nicht ausgerichtet: 'Bilder ausrichten' (oder 'Neu aus Fotos') ausführen, um vorhergesagte Positionen zu erhalten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="373"/>
+        <location filename="../ui/gcp_dock.py" line="381"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} Fotos, {} Passpunkte. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="273"/>
+        <location filename="../ui/gcp_placement.py" line="278"/>
         <source>no predicted positions: {}</source>
         <translation>keine vorhergesagten Positionen: {}</translation>
     </message>
@@ -767,102 +762,102 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Vorhergesagte Positionen, sobald ein Punkt in 2 Fotos gemessen ist, und für alle Punkte, sobald 3 Punkte gemessen sind.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="24"/>
+        <location filename="../ui/gcp_tasks.py" line="115"/>
         <source>Folder of photos</source>
         <translation>Fotoordner</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="27"/>
+        <location filename="../ui/gcp_tasks.py" line="118"/>
         <source>Workspace folder (new or existing)</source>
         <translation>Arbeitsbereich-Ordner (neu oder vorhanden)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="40"/>
+        <location filename="../ui/gcp_tasks.py" line="131"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
         <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="47"/>
+        <location filename="../ui/gcp_tasks.py" line="138"/>
         <source>ArchaeoOrtho: align photos</source>
         <translation>ArchaeoOrtho: Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="495"/>
+        <location filename="../ui/gcp_dock.py" line="511"/>
         <source>CRS: {}</source>
         <translation>KBS: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="109"/>
+        <location filename="../ui/gcp_placement.py" line="114"/>
         <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Auf der Karte an die Position des gewählten Punkts klicken (Esc beendet)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="173"/>
+        <location filename="../ui/gcp_placement.py" line="178"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (aus {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="176"/>
+        <location filename="../ui/gcp_placement.py" line="181"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Keine Höhe an dieser Stelle in {}: Z bleibt unverändert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="179"/>
+        <location filename="../ui/gcp_placement.py" line="184"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="383"/>
+        <location filename="../ui/gcp_placement.py" line="390"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="385"/>
+        <location filename="../ui/gcp_placement.py" line="392"/>
         <source>predicted</source>
         <translation>vorhergesagt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="408"/>
+        <location filename="../ui/gcp_placement.py" line="415"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Einen Passpunkt in der Tabelle wählen oder hinzufügen, dann im Foto darauf klicken.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="415"/>
+        <location filename="../ui/gcp_placement.py" line="422"/>
         <source>from the point&apos;s other observations</source>
         <translation>aus den übrigen Messungen des Punkts</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="416"/>
+        <location filename="../ui/gcp_placement.py" line="423"/>
         <source>from the georeferenced block</source>
         <translation>aus dem georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="417"/>
+        <location filename="../ui/gcp_placement.py" line="424"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>aus den bereits gemessenen Punkten (Ähnlichkeitstransformation)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="428"/>
+        <location filename="../ui/gcp_placement.py" line="435"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Gemessen bei x {:.2f}, y {:.2f}. Klicken zum Versetzen, ziehen oder Entf zum Entfernen.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="431"/>
+        <location filename="../ui/gcp_placement.py" line="438"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Vorhergesagt {}. Eingabetaste übernimmt und geht weiter (Leertaste: übernehmen), ziehen oder dorthin klicken, wo der Punkt wirklich ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="443"/>
+        <location filename="../ui/gcp_placement.py" line="450"/>
         <source>Click where {} is in this photo.</source>
         <translation>Dorthin klicken, wo {} in diesem Foto ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="463"/>
+        <location filename="../ui/gcp_placement.py" line="470"/>
         <source>Select or add a ground point first</source>
         <translation>Zuerst einen Passpunkt wählen oder hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="510"/>
+        <location filename="../ui/gcp_placement.py" line="517"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: jedes Foto, das ihn voraussichtlich zeigt, hat eine Messung</translation>
     </message>
@@ -982,77 +977,77 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>{} kann nicht zum Projekt hinzugefügt werden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="54"/>
+        <location filename="../ui/gcp_tasks.py" line="145"/>
         <source>A task of this dock is still running</source>
         <translation>Eine Aufgabe dieses Fensters läuft noch</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="77"/>
+        <location filename="../ui/gcp_tasks.py" line="168"/>
         <source>Cancelled</source>
         <translation>Abgebrochen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="94"/>
+        <location filename="../ui/gcp_tasks.py" line="183"/>
         <source>The block is not aligned yet: run Align images first</source>
         <translation>Der Block ist noch nicht ausgerichtet: zuerst 'Bilder ausrichten' ausführen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="100"/>
+        <location filename="../ui/gcp_tasks.py" line="189"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>Die Ausgleichung braucht mindestens 3 Passpunkte mit Koordinaten und Messungen; vorhanden sind {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="116"/>
+        <location filename="../ui/gcp_tasks.py" line="206"/>
         <source>Outliers left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="117"/>
+        <location filename="../ui/gcp_tasks.py" line="207"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziert in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="120"/>
+        <location filename="../ui/gcp_tasks.py" line="210"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="129"/>
+        <location filename="../ui/gcp_tasks.py" line="219"/>
         <source>Not georeferenced yet.</source>
         <translation>Noch nicht georeferenziert.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="131"/>
+        <location filename="../ui/gcp_tasks.py" line="221"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Passpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="134"/>
+        <location filename="../ui/gcp_tasks.py" line="224"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Kontrollpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="137"/>
+        <location filename="../ui/gcp_tasks.py" line="227"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>Höhen sind Platzhalter: keine Höhengenauigkeit</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="139"/>
+        <location filename="../ui/gcp_tasks.py" line="229"/>
         <source>tie points {} px</source>
         <translation>Verknüpfungspunkte {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="141"/>
+        <location filename="../ui/gcp_tasks.py" line="231"/>
         <source>edited since: re-run to update</source>
         <translation>seither bearbeitet: erneut ausführen zum Aktualisieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="418"/>
+        <location filename="../ui/gcp_placement.py" line="425"/>
         <source>by matching its look in another photo</source>
         <translation>durch Abgleich mit seinem Aussehen in einem anderen Foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="422"/>
+        <location filename="../ui/gcp_placement.py" line="429"/>
         <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
         <translation>(Korrelation {:.2f}, {:.0f} px von der geometrischen Vorhersage)</translation>
     </message>
@@ -1087,12 +1082,12 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>In einen GeoPackage-Layer…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="85"/>
+        <location filename="../ui/gcp_tasks.py" line="176"/>
         <source>Cancelling…</source>
         <translation>Wird abgebrochen…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="123"/>
+        <location filename="../ui/gcp_tasks.py" line="213"/>
         <source>Georeferencing with {} control points…</source>
         <translation>Georeferenzierung mit {} Passpunkten…</translation>
     </message>
@@ -1127,42 +1122,42 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot. Jetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="91"/>
+        <location filename="../ui/gcp_placement.py" line="94"/>
         <source>Diagnosis of the adjustment:</source>
         <translation>Diagnose der Ausgleichung:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="164"/>
+        <location filename="../ui/gcp_placement.py" line="169"/>
         <source>Moved {:.2f} m (Undo: Ctrl+Z).</source>
         <translation>Um {:.2f} m verschoben (Rückgängig: Strg+Z).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="385"/>
+        <location filename="../ui/gcp_placement.py" line="392"/>
         <source>near the edge</source>
         <translation>nahe am Rand</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="434"/>
+        <location filename="../ui/gcp_placement.py" line="441"/>
         <source>{} is predicted where it cannot be placed: {}. Click where the point is if you see it, or press Enter for the next photo.</source>
         <translation>{} wird dort vorhergesagt, wo er nicht gesetzt werden kann: {}. Klicken Sie auf den Punkt, wenn Sie ihn sehen, oder drücken Sie die Eingabetaste für das nächste Foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="440"/>
+        <location filename="../ui/gcp_placement.py" line="447"/>
         <source>Click where {} is in this photo, or use Pick on map (or type X, Y, Z in the table) to have it predicted in the photos.</source>
         <translation>Klicken Sie in diesem Foto auf {}, oder nutzen Sie „Auf der Karte messen“ (oder geben Sie X, Y, Z in der Tabelle ein), damit er in den Fotos vorhergesagt wird.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="453"/>
+        <location filename="../ui/gcp_placement.py" line="460"/>
         <source>{}: the workspace has no photos to place it in.</source>
         <translation>{}: der Arbeitsbereich hat keine Fotos, in denen er gesetzt werden kann.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="455"/>
+        <location filename="../ui/gcp_placement.py" line="462"/>
         <source>{} is selected: use Pick on map or type X, Y, Z in the table, or choose a photo in the strip below and click on the point.</source>
         <translation>{} ist ausgewählt: nutzen Sie „Auf der Karte messen“ oder geben Sie X, Y, Z in der Tabelle ein, oder wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="457"/>
+        <location filename="../ui/gcp_placement.py" line="464"/>
         <source>{} is selected: choose a photo in the strip below and click on the point.</source>
         <translation>{} ist ausgewählt: wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
     </message>
@@ -1177,64 +1172,84 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Wiederholen (Strg+Umschalt+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="391"/>
+        <location filename="../ui/gcp_dock.py" line="399"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px.</source>
         <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="396"/>
+        <location filename="../ui/gcp_dock.py" line="404"/>
         <source>Not aligned ({}): {}</source>
         <translation>Nicht ausgerichtet ({}): {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="397"/>
+        <location filename="../ui/gcp_dock.py" line="405"/>
         <source>(marked in the photo strip; hover for the reason)</source>
         <translation>(in der Fotoleiste markiert; der Grund steht im Tooltip)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="416"/>
+        <location filename="../ui/gcp_dock.py" line="424"/>
         <source>✗ not aligned</source>
         <translation>✗ nicht ausgerichtet</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="417"/>
+        <location filename="../ui/gcp_dock.py" line="425"/>
         <source>{}: not aligned: {}</source>
         <translation>{}: nicht ausgerichtet: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="43"/>
+        <location filename="../ui/gcp_tasks.py" line="134"/>
         <source>Not aligned: {}</source>
         <translation>Nicht ausgerichtet: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="131"/>
+        <location filename="../ui/gcp_placement.py" line="136"/>
         <source>pick on map</source>
         <translation>auf der Karte messen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="420"/>
+        <location filename="../ui/gcp_placement.py" line="427"/>
         <source>(no Z yet: at the height of the block&apos;s tie points)</source>
         <translation>(noch kein Z: auf der Höhe der Verknüpfungspunkte des Blocks)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="156"/>
+        <location filename="../ui/gcp_placement.py" line="161"/>
         <source>{} not moved</source>
         <translation>{} nicht verschoben</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="185"/>
+        <location filename="../ui/gcp_placement.py" line="190"/>
         <source>{} is placed in {} photos. Move it {:.2f} m to the picked position, or add a new point there?</source>
         <translation>{} ist in {} Fotos gesetzt. Um {:.2f} m an die gemessene Position verschieben, oder dort einen neuen Punkt anlegen?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="189"/>
+        <location filename="../ui/gcp_placement.py" line="194"/>
         <source>Move {}</source>
         <translation>{} verschieben</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="190"/>
+        <location filename="../ui/gcp_placement.py" line="195"/>
         <source>New point</source>
         <translation>Neuer Punkt</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="87"/>
+        <source>ArchaeoOrtho: refine {} in {}</source>
+        <translation>ArchaeoOrtho: {} in {} verfeinern</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="245"/>
+        <source>Results loaded</source>
+        <translation>Ergebnisse geladen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="252"/>
+        <source>ArchaeoOrtho: load results</source>
+        <translation>ArchaeoOrtho: Ergebnisse laden</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="254"/>
+        <source>Loading the results…</source>
+        <translation>Die Ergebnisse werden geladen…</translation>
     </message>
 </context>
 <context>
@@ -1260,17 +1275,17 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>{} von {} setzen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="321"/>
+        <location filename="../ui/store.py" line="323"/>
         <source>place {} in {}</source>
         <translation>{} in {} messen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="329"/>
+        <location filename="../ui/store.py" line="331"/>
         <source>remove {} from {}</source>
         <translation>{} aus {} entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="407"/>
+        <location filename="../ui/store.py" line="409"/>
         <source>set CRS</source>
         <translation>KBS setzen</translation>
     </message>
@@ -1280,62 +1295,62 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>keine Position</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="294"/>
+        <location filename="../ui/store.py" line="296"/>
         <source>({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)</source>
         <translation>({:.0f}, {:.0f}) liegt außerhalb des Fotos {} ({} × {} px)</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="301"/>
+        <location filename="../ui/store.py" line="303"/>
         <source>({:.0f}, {:.0f}) is inside the mask of {}</source>
         <translation>({:.0f}, {:.0f}) liegt in der Maske von {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="309"/>
+        <location filename="../ui/store.py" line="311"/>
         <source>{} not placed: {}</source>
         <translation>{} nicht gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="353"/>
+        <location filename="../ui/store.py" line="355"/>
         <source>{} points replaced by {} from the file</source>
         <translation>{} Punkte durch {} aus der Datei ersetzt</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="387"/>
+        <location filename="../ui/store.py" line="389"/>
         <source>added {} points: {}</source>
         <translation>{} Punkte hinzugefügt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="389"/>
+        <location filename="../ui/store.py" line="391"/>
         <source>coordinates updated from the file: {}</source>
         <translation>Koordinaten aus der Datei aktualisiert: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="391"/>
+        <location filename="../ui/store.py" line="393"/>
         <source>role set by the file: {}</source>
         <translation>Rolle von der Datei gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="393"/>
+        <location filename="../ui/store.py" line="395"/>
         <source>role kept (the file gives none): {}</source>
         <translation>Rolle beibehalten (die Datei nennt keine): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="395"/>
+        <location filename="../ui/store.py" line="397"/>
         <source>σ set by the file: {}</source>
         <translation>σ von der Datei gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="397"/>
+        <location filename="../ui/store.py" line="399"/>
         <source>{} observations added</source>
         <translation>{} Messungen hinzugefügt</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="399"/>
+        <location filename="../ui/store.py" line="401"/>
         <source>placed observations kept (the file has others): {}</source>
         <translation>gesetzte Messungen beibehalten (die Datei hat andere): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="400"/>
+        <location filename="../ui/store.py" line="402"/>
         <source>nothing changed</source>
         <translation>nichts geändert</translation>
     </message>
@@ -1981,64 +1996,84 @@ Ausgabe: wohin sie geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/relief/&
 <context>
     <name>ResultLayers</name>
     <message>
-        <location filename="../ui/layers.py" line="267"/>
+        <location filename="../ui/layers.py" line="271"/>
         <source>control (used)</source>
         <translation>Passpunkt (verwendet)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="268"/>
+        <location filename="../ui/layers.py" line="272"/>
         <source>check point</source>
         <translation>Kontrollpunkt</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="269"/>
+        <location filename="../ui/layers.py" line="273"/>
         <source>rejected (outlier)</source>
         <translation>verworfen (Ausreißer)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="270"/>
+        <location filename="../ui/layers.py" line="274"/>
         <source>not triangulated</source>
         <translation>nicht trianguliert</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="559"/>
+        <location filename="../ui/layers.py" line="704"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="531"/>
+        <location filename="../ui/layers.py" line="663"/>
         <source>DSM hillshade</source>
         <translation>DOM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="560"/>
+        <location filename="../ui/layers.py" line="705"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="561"/>
+        <location filename="../ui/layers.py" line="706"/>
         <source>Cameras</source>
         <translation>Kameras</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="542"/>
+        <location filename="../ui/layers.py" line="674"/>
         <source>Camera footprints</source>
         <translation>Bildfußabdrücke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="549"/>
+        <location filename="../ui/layers.py" line="681"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Passpunkt-Residuen (Vektoren x{})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="562"/>
+        <location filename="../ui/layers.py" line="707"/>
         <source>Point cloud</source>
         <translation>Punktwolke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="568"/>
+        <location filename="../ui/layers.py" line="715"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="386"/>
+        <source>{} ({})</source>
+        <translation>{} ({})</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="708"/>
+        <source>DTM</source>
+        <translation>DGM</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="688"/>
+        <source>DTM hillshade</source>
+        <translation>DGM-Schummerung</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="709"/>
+        <source>Contours</source>
+        <translation>Höhenlinien</translation>
     </message>
 </context>
 <context>

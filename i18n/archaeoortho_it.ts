@@ -6,7 +6,7 @@
     <message>
         <location filename="../processing_provider/accuracy_report.py" line="70"/>
         <source>Workspace folder</source>
-        <translation>Cartella dell&apos;area di lavoro</translation>
+        <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
         <location filename="../processing_provider/accuracy_report.py" line="70"/>
@@ -99,7 +99,7 @@ OUTPUT_HTML: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). 
     <message>
         <location filename="../processing_provider/align_images.py" line="45"/>
         <source>Workspace folder</source>
-        <translation>Cartella dell&apos;area di lavoro</translation>
+        <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
         <location filename="../processing_provider/align_images.py" line="45"/>
@@ -212,7 +212,7 @@ Metodo di ricostruzione (avanzato): 'incremental' (COLMAP, predefinito) o 'globa
         <translation>ArchaeoOrtho: misura i punti d'appoggio sulla mappa e nelle foto</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="180"/>
+        <location filename="../plugin.py" line="181"/>
         <source>&amp;ArchaeoOrtho</source>
         <translation>&amp;ArchaeoOrtho</translation>
     </message>
@@ -330,79 +330,74 @@ Una nuova esecuzione dopo un annullamento riprende: le coppie già elaborate son
 <context>
     <name>BuildDtmAlgorithm</name>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="53"/>
+        <location filename="../processing_provider/build_dtm.py" line="52"/>
         <source>Workspace folder</source>
-        <translation>Cartella dell&apos;area di lavoro</translation>
+        <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <location filename="../processing_provider/build_dtm.py" line="54"/>
         <source>DSM file (default: the workspace&apos;s)</source>
-        <translation>File DSM (predefinito: quello dell&apos;area di lavoro)</translation>
+        <translation>File DSM (predefinito: quello dell'area di lavoro)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <location filename="../processing_provider/build_dtm.py" line="54"/>
         <source>Contour interval in metres (0 = none)</source>
         <translation>Equidistanza delle curve di livello in metri (0 = nessuna)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <location filename="../processing_provider/build_dtm.py" line="54"/>
         <source>Ground filter slope (rise over run)</source>
         <translation>Pendenza del filtro del terreno (dislivello su distanza)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <location filename="../processing_provider/build_dtm.py" line="54"/>
         <source>Largest object radius in metres</source>
         <translation>Raggio massimo degli oggetti in metri</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <location filename="../processing_provider/build_dtm.py" line="54"/>
         <source>Height above ground of an object in metres</source>
         <translation>Altezza di un oggetto sul terreno in metri</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="65"/>
+        <location filename="../processing_provider/build_dtm.py" line="64"/>
         <source>DTM (default: &lt;workspace&gt;/dtm.tif)</source>
         <translation>DTM (predefinito: &lt;workspace&gt;/dtm.tif)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="67"/>
+        <location filename="../processing_provider/build_dtm.py" line="66"/>
         <source>Contours (default: &lt;workspace&gt;/terrain/contours.gpkg)</source>
         <translation>Curve di livello (predefinito: &lt;workspace&gt;/terrain/contours.gpkg)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="70"/>
+        <location filename="../processing_provider/build_dtm.py" line="69"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="71"/>
+        <location filename="../processing_provider/build_dtm.py" line="70"/>
         <source>DTM source</source>
         <translation>Origine del DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="72"/>
+        <location filename="../processing_provider/build_dtm.py" line="71"/>
         <source>Classified point cloud</source>
         <translation>Nuvola di punti classificata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="73"/>
-        <source>Contour lines</source>
-        <translation>Curve di livello</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_dtm.py" line="74"/>
+        <location filename="../processing_provider/build_dtm.py" line="72"/>
         <source>Share of DSM cells on the ground</source>
         <translation>Frazione delle celle del DSM sul terreno</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="75"/>
+        <location filename="../processing_provider/build_dtm.py" line="73"/>
         <source>Share of DTM cells interpolated</source>
         <translation>Frazione delle celle del DTM interpolate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="102"/>
+        <location filename="../processing_provider/build_dtm.py" line="100"/>
         <source>Give a workspace folder, or a DSM file and where to write the DTM</source>
-        <translation>Indica una cartella dell&apos;area di lavoro, oppure un file DSM e dove scrivere il DTM</translation>
+        <translation>Indica una cartella dell'area di lavoro, oppure un file DSM e dove scrivere il DTM</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -422,10 +417,10 @@ Slope, largest object radius and height threshold (advanced): SMRF&apos;s parame
 DTM: where to write it (default: &lt;workspace&gt;/dtm.tif).</source>
         <translation>Un modello digitale del terreno (suolo nudo) dal DSM: edifici, alberi e colture rimossi, il terreno interpolato sotto di essi.
 
-Il filtro del terreno è SMRF (Pingel et al. 2013, l&apos;algoritmo di filters.smrf di PDAL) sulla griglia del DSM; sotto ogni oggetto rimosso il terreno è una thin-plate spline attraverso il terreno intorno. Il DTM è un Cloud-Optimized GeoTIFF esattamente sulla griglia del DSM; accanto, terrain/dtm-source.tif indica quali celle sono terreno misurato (1) e quali interpolate (2). La nuvola di punti della fase DSM, se ne ha scritta una, è copiata con le classi ASPRS 2 (terreno) e 1 (non classificato) in terrain/points-classified.las.
+Il filtro del terreno è SMRF (Pingel et al. 2013, l'algoritmo di filters.smrf di PDAL) sulla griglia del DSM; sotto ogni oggetto rimosso il terreno è una thin-plate spline attraverso il terreno intorno. Il DTM è un Cloud-Optimized GeoTIFF esattamente sulla griglia del DSM; accanto, terrain/dtm-source.tif indica quali celle sono terreno misurato (1) e quali interpolate (2). La nuvola di punti della fase DSM, se ne ha scritta una, è copiata con le classi ASPRS 2 (terreno) e 1 (non classificato) in terrain/points-classified.las.
 
-Cartella dell&apos;area di lavoro: un&apos;area di lavoro con DSM (facoltativa se è indicato un file DSM).
-File DSM: qualsiasi DSM in un SR proiettato (metri); predefinito: quello dell&apos;area di lavoro.
+Cartella dell'area di lavoro: un'area di lavoro con DSM (facoltativa se è indicato un file DSM).
+File DSM: qualsiasi DSM in un SR proiettato (metri); predefinito: quello dell'area di lavoro.
 Equidistanza: curve di livello ogni tanti metri in un GeoPackage (0 = nessuna).
 Pendenza, raggio massimo degli oggetti e soglia di altezza (avanzati): i parametri di SMRF (i valori predefiniti di PDAL).
 DTM: dove scriverlo (predefinito: &lt;workspace&gt;/dtm.tif).</translation>
@@ -577,7 +572,7 @@ Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:878
 Elevation raster: a DTM or DSM in a projected CRS (metres).
 Interval: metres between two contour lines (e.g. 0.5).
 Contours: the GeoPackage to write.</source>
-        <translation>Curve di livello di un DTM o DSM a un&apos;equidistanza scelta (il generatore di curve di livello di GDAL) in un layer GeoPackage &apos;contours&apos; il cui campo &apos;elevation&apos; le etichetta.
+        <translation>Curve di livello di un DTM o DSM a un'equidistanza scelta (il generatore di curve di livello di GDAL) in un layer GeoPackage 'contours' il cui campo 'elevation' le etichetta.
 
 Raster delle quote: un DTM o DSM in un SR proiettato (metri).
 Equidistanza: metri tra due curve di livello (ad es. 0.5).
@@ -647,7 +642,7 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Rimuovi il punto d'appoggio selezionato e le sue misure</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="185"/>
+        <location filename="../ui/gcp_placement.py" line="190"/>
         <source>Pick on map</source>
         <translation>Misura sulla mappa</translation>
     </message>
@@ -742,17 +737,17 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Apri un'area di lavoro ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="370"/>
+        <location filename="../ui/gcp_dock.py" line="378"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} foto; il blocco non è ancora allineato: esegui 'Allinea immagini' (o 'Nuova dalle foto') per avere le posizioni previste</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="373"/>
+        <location filename="../ui/gcp_dock.py" line="381"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} foto, {} punti d'appoggio. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="273"/>
+        <location filename="../ui/gcp_placement.py" line="278"/>
         <source>no predicted positions: {}</source>
         <translation>nessuna posizione prevista: {}</translation>
     </message>
@@ -767,102 +762,102 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Posizioni previste quando un punto è misurato in 2 foto, e per tutti i punti quando ne sono misurati 3.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="24"/>
+        <location filename="../ui/gcp_tasks.py" line="115"/>
         <source>Folder of photos</source>
         <translation>Cartella delle foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="27"/>
+        <location filename="../ui/gcp_tasks.py" line="118"/>
         <source>Workspace folder (new or existing)</source>
         <translation>Cartella dell'area di lavoro (nuova o esistente)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="40"/>
+        <location filename="../ui/gcp_tasks.py" line="131"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
         <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="47"/>
+        <location filename="../ui/gcp_tasks.py" line="138"/>
         <source>ArchaeoOrtho: align photos</source>
         <translation>ArchaeoOrtho: allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="495"/>
+        <location filename="../ui/gcp_dock.py" line="511"/>
         <source>CRS: {}</source>
         <translation>SR: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="109"/>
+        <location filename="../ui/gcp_placement.py" line="114"/>
         <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Fai clic sulla mappa nella posizione del punto selezionato (Esc per terminare)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="173"/>
+        <location filename="../ui/gcp_placement.py" line="178"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (da {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="176"/>
+        <location filename="../ui/gcp_placement.py" line="181"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Nessuna quota in questo punto in {}: Z invariata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="179"/>
+        <location filename="../ui/gcp_placement.py" line="184"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="383"/>
+        <location filename="../ui/gcp_placement.py" line="390"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="385"/>
+        <location filename="../ui/gcp_placement.py" line="392"/>
         <source>predicted</source>
         <translation>prevista</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="408"/>
+        <location filename="../ui/gcp_placement.py" line="415"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Seleziona o aggiungi un punto d'appoggio nella tabella, poi fai clic su di esso nella foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="415"/>
+        <location filename="../ui/gcp_placement.py" line="422"/>
         <source>from the point&apos;s other observations</source>
         <translation>dalle altre misure del punto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="416"/>
+        <location filename="../ui/gcp_placement.py" line="423"/>
         <source>from the georeferenced block</source>
         <translation>dal blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="417"/>
+        <location filename="../ui/gcp_placement.py" line="424"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>dai punti già misurati (trasformazione di similitudine)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="428"/>
+        <location filename="../ui/gcp_placement.py" line="435"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Misurato in x {:.2f}, y {:.2f}. Fai clic per spostarlo, trascinalo o premi Canc per rimuoverlo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="431"/>
+        <location filename="../ui/gcp_placement.py" line="438"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Previsto {}. Premi Invio per accettarlo e proseguire (Spazio: accetta), trascinalo o fai clic dove si trova davvero il punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="443"/>
+        <location filename="../ui/gcp_placement.py" line="450"/>
         <source>Click where {} is in this photo.</source>
         <translation>Fai clic dove si trova {} in questa foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="463"/>
+        <location filename="../ui/gcp_placement.py" line="470"/>
         <source>Select or add a ground point first</source>
         <translation>Seleziona o aggiungi prima un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="510"/>
+        <location filename="../ui/gcp_placement.py" line="517"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: ogni foto in cui è previsto ha una misura</translation>
     </message>
@@ -982,77 +977,77 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Impossibile aggiungere {} al progetto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="54"/>
+        <location filename="../ui/gcp_tasks.py" line="145"/>
         <source>A task of this dock is still running</source>
         <translation>Un'operazione di questo pannello è ancora in corso</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="77"/>
+        <location filename="../ui/gcp_tasks.py" line="168"/>
         <source>Cancelled</source>
         <translation>Interrotto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="94"/>
+        <location filename="../ui/gcp_tasks.py" line="183"/>
         <source>The block is not aligned yet: run Align images first</source>
         <translation>Il blocco non è ancora allineato: esegui prima 'Allinea immagini'</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="100"/>
+        <location filename="../ui/gcp_tasks.py" line="189"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>La compensazione richiede almeno 3 punti d'appoggio con coordinate e misure; ce ne sono {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="116"/>
+        <location filename="../ui/gcp_tasks.py" line="206"/>
         <source>Outliers left out: {}</source>
         <translation>Valori anomali esclusi: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="117"/>
+        <location filename="../ui/gcp_tasks.py" line="207"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziato in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="120"/>
+        <location filename="../ui/gcp_tasks.py" line="210"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="129"/>
+        <location filename="../ui/gcp_tasks.py" line="219"/>
         <source>Not georeferenced yet.</source>
         <translation>Non ancora georeferenziato.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="131"/>
+        <location filename="../ui/gcp_tasks.py" line="221"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Appoggio: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="134"/>
+        <location filename="../ui/gcp_tasks.py" line="224"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Controllo: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="137"/>
+        <location filename="../ui/gcp_tasks.py" line="227"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>le quote sono segnaposto: nessuna accuratezza verticale</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="139"/>
+        <location filename="../ui/gcp_tasks.py" line="229"/>
         <source>tie points {} px</source>
         <translation>punti di legame {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="141"/>
+        <location filename="../ui/gcp_tasks.py" line="231"/>
         <source>edited since: re-run to update</source>
         <translation>modificato da allora: riesegui per aggiornare</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="418"/>
+        <location filename="../ui/gcp_placement.py" line="425"/>
         <source>by matching its look in another photo</source>
         <translation>confrontandone l'aspetto in un'altra foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="422"/>
+        <location filename="../ui/gcp_placement.py" line="429"/>
         <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
         <translation>(correlazione {:.2f}, {:.0f} px dalla previsione geometrica)</translation>
     </message>
@@ -1087,12 +1082,12 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Su un layer GeoPackage…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="85"/>
+        <location filename="../ui/gcp_tasks.py" line="176"/>
         <source>Cancelling…</source>
         <translation>Interruzione…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="123"/>
+        <location filename="../ui/gcp_tasks.py" line="213"/>
         <source>Georeferencing with {} control points…</source>
         <translation>Georeferenziazione con {} punti d'appoggio…</translation>
     </message>
@@ -1127,42 +1122,42 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>I residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi. Ora: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="91"/>
+        <location filename="../ui/gcp_placement.py" line="94"/>
         <source>Diagnosis of the adjustment:</source>
         <translation>Diagnosi della compensazione:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="164"/>
+        <location filename="../ui/gcp_placement.py" line="169"/>
         <source>Moved {:.2f} m (Undo: Ctrl+Z).</source>
         <translation>Spostato di {:.2f} m (Annulla: Ctrl+Z).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="385"/>
+        <location filename="../ui/gcp_placement.py" line="392"/>
         <source>near the edge</source>
         <translation>vicino al bordo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="434"/>
+        <location filename="../ui/gcp_placement.py" line="441"/>
         <source>{} is predicted where it cannot be placed: {}. Click where the point is if you see it, or press Enter for the next photo.</source>
         <translation>{} è previsto dove non può essere posizionato: {}. Fai clic sul punto se lo vedi, o premi Invio per la foto successiva.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="440"/>
+        <location filename="../ui/gcp_placement.py" line="447"/>
         <source>Click where {} is in this photo, or use Pick on map (or type X, Y, Z in the table) to have it predicted in the photos.</source>
         <translation>Fai clic su {} in questa foto, oppure usa Misura sulla mappa (o scrivi X, Y, Z nella tabella) per farlo prevedere nelle foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="453"/>
+        <location filename="../ui/gcp_placement.py" line="460"/>
         <source>{}: the workspace has no photos to place it in.</source>
         <translation>{}: l'area di lavoro non ha foto in cui posizionarlo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="455"/>
+        <location filename="../ui/gcp_placement.py" line="462"/>
         <source>{} is selected: use Pick on map or type X, Y, Z in the table, or choose a photo in the strip below and click on the point.</source>
         <translation>{} è selezionato: usa Misura sulla mappa o scrivi X, Y, Z nella tabella, oppure scegli una foto nella striscia sotto e fai clic sul punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="457"/>
+        <location filename="../ui/gcp_placement.py" line="464"/>
         <source>{} is selected: choose a photo in the strip below and click on the point.</source>
         <translation>{} è selezionato: scegli una foto nella striscia sotto e fai clic sul punto.</translation>
     </message>
@@ -1177,64 +1172,84 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Ripeti (Ctrl+Maiusc+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="391"/>
+        <location filename="../ui/gcp_dock.py" line="399"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px.</source>
         <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="396"/>
+        <location filename="../ui/gcp_dock.py" line="404"/>
         <source>Not aligned ({}): {}</source>
         <translation>Non allineate ({}): {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="397"/>
+        <location filename="../ui/gcp_dock.py" line="405"/>
         <source>(marked in the photo strip; hover for the reason)</source>
         <translation>(segnate nella striscia delle foto; il motivo è nel suggerimento)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="416"/>
+        <location filename="../ui/gcp_dock.py" line="424"/>
         <source>✗ not aligned</source>
         <translation>✗ non allineata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="417"/>
+        <location filename="../ui/gcp_dock.py" line="425"/>
         <source>{}: not aligned: {}</source>
         <translation>{}: non allineata: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="43"/>
+        <location filename="../ui/gcp_tasks.py" line="134"/>
         <source>Not aligned: {}</source>
         <translation>Non allineate: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="131"/>
+        <location filename="../ui/gcp_placement.py" line="136"/>
         <source>pick on map</source>
         <translation>misura sulla mappa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="420"/>
+        <location filename="../ui/gcp_placement.py" line="427"/>
         <source>(no Z yet: at the height of the block&apos;s tie points)</source>
         <translation>(ancora nessuna Z: all'altezza dei punti di legame del blocco)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="156"/>
+        <location filename="../ui/gcp_placement.py" line="161"/>
         <source>{} not moved</source>
         <translation>{} non spostato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="185"/>
+        <location filename="../ui/gcp_placement.py" line="190"/>
         <source>{} is placed in {} photos. Move it {:.2f} m to the picked position, or add a new point there?</source>
         <translation>{} è posizionato in {} foto. Spostarlo di {:.2f} m nella posizione misurata, o aggiungere lì un nuovo punto?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="189"/>
+        <location filename="../ui/gcp_placement.py" line="194"/>
         <source>Move {}</source>
         <translation>Sposta {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="190"/>
+        <location filename="../ui/gcp_placement.py" line="195"/>
         <source>New point</source>
         <translation>Nuovo punto</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="87"/>
+        <source>ArchaeoOrtho: refine {} in {}</source>
+        <translation>ArchaeoOrtho: affina {} in {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="245"/>
+        <source>Results loaded</source>
+        <translation>Risultati caricati</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="252"/>
+        <source>ArchaeoOrtho: load results</source>
+        <translation>ArchaeoOrtho: carica i risultati</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="254"/>
+        <source>Loading the results…</source>
+        <translation>Caricamento dei risultati…</translation>
     </message>
 </context>
 <context>
@@ -1260,17 +1275,17 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>imposta {} di {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="321"/>
+        <location filename="../ui/store.py" line="323"/>
         <source>place {} in {}</source>
         <translation>misura {} in {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="329"/>
+        <location filename="../ui/store.py" line="331"/>
         <source>remove {} from {}</source>
         <translation>rimuovi {} da {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="407"/>
+        <location filename="../ui/store.py" line="409"/>
         <source>set CRS</source>
         <translation>imposta il SR</translation>
     </message>
@@ -1280,62 +1295,62 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>nessuna posizione</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="294"/>
+        <location filename="../ui/store.py" line="296"/>
         <source>({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)</source>
         <translation>({:.0f}, {:.0f}) è fuori dalla foto {} ({} × {} px)</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="301"/>
+        <location filename="../ui/store.py" line="303"/>
         <source>({:.0f}, {:.0f}) is inside the mask of {}</source>
         <translation>({:.0f}, {:.0f}) è dentro la maschera di {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="309"/>
+        <location filename="../ui/store.py" line="311"/>
         <source>{} not placed: {}</source>
         <translation>{} non posizionato: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="353"/>
+        <location filename="../ui/store.py" line="355"/>
         <source>{} points replaced by {} from the file</source>
         <translation>{} punti sostituiti da {} dal file</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="387"/>
+        <location filename="../ui/store.py" line="389"/>
         <source>added {} points: {}</source>
         <translation>aggiunti {} punti: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="389"/>
+        <location filename="../ui/store.py" line="391"/>
         <source>coordinates updated from the file: {}</source>
         <translation>coordinate aggiornate dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="391"/>
+        <location filename="../ui/store.py" line="393"/>
         <source>role set by the file: {}</source>
         <translation>ruolo impostato dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="393"/>
+        <location filename="../ui/store.py" line="395"/>
         <source>role kept (the file gives none): {}</source>
         <translation>ruolo mantenuto (il file non ne indica): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="395"/>
+        <location filename="../ui/store.py" line="397"/>
         <source>σ set by the file: {}</source>
         <translation>σ impostata dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="397"/>
+        <location filename="../ui/store.py" line="399"/>
         <source>{} observations added</source>
         <translation>{} misure aggiunte</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="399"/>
+        <location filename="../ui/store.py" line="401"/>
         <source>placed observations kept (the file has others): {}</source>
         <translation>misure posizionate mantenute (il file ne ha altre): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="400"/>
+        <location filename="../ui/store.py" line="402"/>
         <source>nothing changed</source>
         <translation>nulla è cambiato</translation>
     </message>
@@ -1762,7 +1777,7 @@ RESIDUALS: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in met
     <message>
         <location filename="../processing_provider/prepare_images.py" line="79"/>
         <source>Workspace folder</source>
-        <translation>Cartella dell&apos;area di lavoro</translation>
+        <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
         <location filename="../processing_provider/prepare_images.py" line="79"/>
@@ -1913,12 +1928,12 @@ OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere
     <message>
         <location filename="../processing_provider/relief_visualisation.py" line="41"/>
         <source>Workspace folder</source>
-        <translation>Cartella dell&apos;area di lavoro</translation>
+        <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
         <location filename="../processing_provider/relief_visualisation.py" line="43"/>
         <source>Elevation raster (instead of the workspace&apos;s)</source>
-        <translation>Raster delle quote (invece di quello dell&apos;area di lavoro)</translation>
+        <translation>Raster delle quote (invece di quello dell'area di lavoro)</translation>
     </message>
     <message>
         <location filename="../processing_provider/relief_visualisation.py" line="43"/>
@@ -1953,7 +1968,7 @@ OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere
     <message>
         <location filename="../processing_provider/relief_visualisation.py" line="78"/>
         <source>Give a workspace folder, or an elevation raster and where to write the visualisation</source>
-        <translation>Indica una cartella dell&apos;area di lavoro, oppure un raster delle quote e dove scrivere la visualizzazione</translation>
+        <translation>Indica una cartella dell'area di lavoro, oppure un raster delle quote e dove scrivere la visualizzazione</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1971,9 +1986,9 @@ Visualisation: sky-view factor, openness (positive, negative), simple local reli
 Output: where to write it (default: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</source>
         <translation>Visualizzazioni del rilievo per leggere terrapieni, strade incassate, campi baulati e confini di campi, calcolate con rvt-py (la libreria del Relief Visualization Toolbox) con i parametri predefiniti di RVT, convertiti dai DEM a 1 m per cui RVT è fatto alla dimensione di cella di questo raster.
 
-Cartella dell&apos;area di lavoro: un&apos;area di lavoro con DTM (Genera DTM) o DSM.
+Cartella dell'area di lavoro: un'area di lavoro con DTM (Genera DTM) o DSM.
 Raster delle quote: in alternativa qualsiasi DTM/DSM in un SR proiettato (facoltativo).
-Superficie: il DTM dell&apos;area di lavoro (suolo nudo, predefinito) o il DSM.
+Superficie: il DTM dell'area di lavoro (suolo nudo, predefinito) o il DSM.
 Visualizzazione: fattore di vista del cielo, apertura (positiva, negativa), modello semplice del rilievo locale, modello del rilievo a più scale, ombreggiatura da più direzioni, dominanza locale o la miscela VAT.
 Risultato: dove scriverla (predefinito: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</translation>
     </message>
@@ -1981,64 +1996,84 @@ Risultato: dove scriverla (predefinito: &lt;workspace&gt;/terrain/relief/&lt;sur
 <context>
     <name>ResultLayers</name>
     <message>
-        <location filename="../ui/layers.py" line="267"/>
+        <location filename="../ui/layers.py" line="271"/>
         <source>control (used)</source>
         <translation>appoggio (usato)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="268"/>
+        <location filename="../ui/layers.py" line="272"/>
         <source>check point</source>
         <translation>punto di controllo</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="269"/>
+        <location filename="../ui/layers.py" line="273"/>
         <source>rejected (outlier)</source>
         <translation>scartato (valore anomalo)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="270"/>
+        <location filename="../ui/layers.py" line="274"/>
         <source>not triangulated</source>
         <translation>non triangolato</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="559"/>
+        <location filename="../ui/layers.py" line="704"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="531"/>
+        <location filename="../ui/layers.py" line="663"/>
         <source>DSM hillshade</source>
         <translation>Ombreggiatura del DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="560"/>
+        <location filename="../ui/layers.py" line="705"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="561"/>
+        <location filename="../ui/layers.py" line="706"/>
         <source>Cameras</source>
         <translation>Camere</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="542"/>
+        <location filename="../ui/layers.py" line="674"/>
         <source>Camera footprints</source>
         <translation>Impronte delle immagini</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="549"/>
+        <location filename="../ui/layers.py" line="681"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Residui dei punti d'appoggio (vettori x{})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="562"/>
+        <location filename="../ui/layers.py" line="707"/>
         <source>Point cloud</source>
         <translation>Nuvola di punti</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="568"/>
+        <location filename="../ui/layers.py" line="715"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="386"/>
+        <source>{} ({})</source>
+        <translation>{} ({})</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="708"/>
+        <source>DTM</source>
+        <translation>DTM</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="688"/>
+        <source>DTM hillshade</source>
+        <translation>Ombreggiatura del DTM</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="709"/>
+        <source>Contours</source>
+        <translation>Curve di livello</translation>
     </message>
 </context>
 <context>
@@ -2051,7 +2086,7 @@ Risultato: dove scriverla (predefinito: &lt;workspace&gt;/terrain/relief/&lt;sur
     <message>
         <location filename="../processing_provider/run_pipeline.py" line="62"/>
         <source>Workspace folder</source>
-        <translation>Cartella dell&apos;area di lavoro</translation>
+        <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
         <location filename="../processing_provider/run_pipeline.py" line="62"/>

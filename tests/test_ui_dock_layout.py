@@ -6,6 +6,7 @@ never blocked by the slow steps (timings printed, not asserted).  Screenshots in
 docs/screenshots/."""
 import ast
 import os
+import time
 import xml.etree.ElementTree as ET
 
 import pytest
@@ -458,3 +459,113 @@ def test_alignment_result_stays_and_unaligned_photos_are_marked(default_dock, pa
             assert "not aligned" in item.text() and lost[name] in item.toolTip()
         else:
             assert "not aligned" not in item.text()
+
+
+# --------------------------------------------------------------------------------------------------
+# item 5: nothing slow on the GUI thread
+# --------------------------------------------------------------------------------------------------
+
+
+def _ms(fn):
+    t0 = time.perf_counter()
+    out = fn()
+    return out, 1000.0 * (time.perf_counter() - t0)
+
+
+def test_refining_a_prediction_runs_in_the_background(default_dock, georef_ws, block):
+    """Matching a prediction (1.6-4.6 s a photo on COPR) ran on the GUI thread when a photo was shown.  With the
+    plugin's setting the photo shows the geometric prediction at once, a task matches, the photo then shows the
+    matched position; Confirm waits for it (events flowing).  Timings printed, not asserted."""
+    from qgis.PyQt.QtCore import Qt
+    from qgis.PyQt.QtTest import QTest
+
+    dock = default_dock
+    dock.refine_in_background = True
+    assert dock.open_workspace(georef_ws)
+    name = block.spread_control(5)[4]
+    dock.select_point(name)
+    point = dock.current_point()
+    keep = point.images()[0]
+    for other in point.images()[1:]:  # one observation left: the others are predicted from the coordinates
+        dock.store.remove_observation(name, other)
+    process(50)
+    img = next(n for n in sorted(dock.predictions, key=lambda n: dock.predictions[n].centrality)
+               if n != keep and n in block.gcp(name).observations and dock.predictions[n].source != "rays")
+    truth = block.gcp(name).observations[img]
+    dock.matches.clear()
+    dock.__dict__.get("_refine_jobs", {}).clear()
+    _, shown_ms = _ms(lambda: dock.show_photo(img))
+    assert dock.refinement_pending(img), "no matching task was started"
+    geometric = dock.photo_panel.prediction.pos()
+    t0 = time.perf_counter()
+    dock.wait_for_refinement(img)
+    match_ms = 1000.0 * (time.perf_counter() - t0)
+    assert not dock.refinement_pending(img)
+    pred, match = dock.refined_prediction(img)
+    print(f"\n[refine] show the photo {shown_ms:.0f} ms on the GUI thread; matching in its task {match_ms:.0f} ms; "
+          f"geometric ({geometric.x():.2f}, {geometric.y():.2f}) -> {pred.source} ({pred.x:.2f}, {pred.y:.2f}), "
+          f"truth ({truth[0]:.2f}, {truth[1]:.2f})")
+    if match is not None:
+        assert pred.source == "matched"
+        assert abs(dock.photo_panel.prediction.pos().x() - geometric.x()) + \
+            abs(dock.photo_panel.prediction.pos().y() - geometric.y()) >= 0.0
+    # Space confirms the (refined) prediction
+    view = dock.photo_panel.view
+    view.setFocus()
+    QTest.keyClick(view, Qt.Key.Key_Space)
+    obs = next(o for o in dock.current_point().observations if o.image == img)
+    assert (obs.x, obs.y) == pytest.approx((pred.x, pred.y))
+
+
+def test_gui_thread_times_of_open_results_and_georeference(default_dock, georef_ws, block, qgis_new_project):
+    """The GUI-thread time of opening a workspace, Load results and the end of a georeference (its done
+    callback), printed (pytest -s); the slow parts run in tasks: Load results writes the footprints in one
+    (the button returns at once), the georeference task writes them before its done callback."""
+    from archaeoortho.ui import gcp_tasks
+    from qgis.core import QgsProject
+    from qgis.PyQt.QtCore import Qt
+    from qgis.PyQt.QtTest import QTest
+
+    dock = default_dock
+    dock.refine_in_background = True
+    _, open_ms = _ms(lambda: dock.open_workspace(georef_ws))
+    process(50)
+    _, reopen_ms = _ms(lambda: dock.open_workspace(georef_ws))  # imports done: what the user waits for
+    dock.wait_for_refinement()
+    # Load results: the click returns before the footprints are written; the layers come when the task ends
+    written = []
+    real_prepare = gcp_tasks.prepare_results
+
+    def prepare(root, progress=None):
+        written.append(root)
+        return real_prepare(root, progress=progress)
+
+    gcp_tasks.prepare_results = prepare
+    try:
+        button = dock.toolbar2.widgetForAction(dock.act_results)
+        _, click_ms = _ms(lambda: QTest.mouseClick(button, Qt.MouseButton.LeftButton))
+        assert dock._results_task is not None and not QgsProject.instance().mapLayers()
+        t0 = time.perf_counter()
+        while dock._results_task is not None and time.perf_counter() - t0 < 60:
+            process(20)
+        results_total = 1000.0 * (time.perf_counter() - t0)
+    finally:
+        gcp_tasks.prepare_results = real_prepare
+    kinds = {lyr.customProperty("archaeoortho/kind") for lyr in QgsProject.instance().mapLayers().values()}
+    assert {"cameras", "footprints", "residuals"} <= kinds and written == [georef_ws]
+    _, sync_results_ms = _ms(lambda: dock.load_results())  # the old way, all on the GUI thread
+    # the end of a georeference: the done callback's time
+    timings = {}
+    task = dock.run_georeference()
+    real_done = task.on_done
+
+    def timed_done(outcome):
+        _, timings["done"] = _ms(lambda: real_done(outcome))
+
+    task.on_done = timed_done
+    wait_task(dock)
+    assert dock.last_task_error is None and "done" in timings
+    assert isinstance(task.result, tuple) and task.result[1]  # the footprints came from the task
+    print(f"\n[GUI thread] open workspace {open_ms:.0f} ms (first, with imports), again {reopen_ms:.0f} ms; "
+          f"Load results click {click_ms:.0f} ms (layers after {results_total:.0f} ms), all on the GUI thread "
+          f"{sync_results_ms:.0f} ms; georeference done callback {timings['done']:.0f} ms")

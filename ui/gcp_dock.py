@@ -292,7 +292,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         self.act_import_layer.triggered.connect(self.choose_import_layer)
         self.act_export_file.triggered.connect(self.choose_export_file)
         self.act_export_layer.triggered.connect(self.choose_export_layer)
-        self.act_results.triggered.connect(self.load_results)
+        self.act_results.triggered.connect(self.load_results_in_background)
         self.btn_georef.clicked.connect(self.run_georeference)
         self.btn_cancel.clicked.connect(self.cancel_task)
         self.tol_spin.valueChanged.connect(self._tolerance_changed)
@@ -300,7 +300,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         self.store.residualsChanged.connect(self.show_diagnosis)
         self.store.install_undo_keys(self.table, self.photo_panel.view)  # Ctrl+Z / Ctrl+Shift+Z there too
         self.dsm_combo.layerChanged.connect(self._dsm_changed)
-        self.table.selectionModel().currentRowChanged.connect(lambda *a: self._selection_changed())
+        self.table.selectionModel().currentRowChanged.connect(lambda *a: self._row_changed())
         self.store.changed.connect(self._store_changed)
         self.store.residualsChanged.connect(self._residuals_changed)
         self.store.workspaceChanged.connect(self._workspace_changed)
@@ -360,8 +360,16 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         if dsm_id and QgsProject.instance().mapLayer(dsm_id) is not None:
             self.dsm_combo.setLayer(QgsProject.instance().mapLayer(dsm_id))
         self.model.refresh()
+        self._last_point = None  # a new workspace: its first point jumps to its photo
         if self.store.gcps.points:
-            self.select_point(self.store.gcps.points[0].name)
+            # the row only: GcpStore.open emits changed right after, and _store_changed updates the predictions,
+            # the strip and the photo once (they were computed twice per opening, issue 18.5)
+            self._selecting = True
+            try:
+                self.table.selectRow(0)
+                self.table.setCurrentIndex(self.model.index(0, NAME))
+            finally:
+                self._selecting = False
         else:
             self._selection_changed()
         self._update_summary()
@@ -431,11 +439,19 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
     def select_point(self, name):
         for row, p in enumerate(self.store.gcps.points):
             if p.name == name:
-                self.table.selectRow(row)
-                self.table.setCurrentIndex(self.model.index(row, NAME))
+                self._selecting = True  # one update below, not one more per selection signal (issue 18.5)
+                try:
+                    self.table.selectRow(row)
+                    self.table.setCurrentIndex(self.model.index(row, NAME))
+                finally:
+                    self._selecting = False
                 self._selection_changed()
                 return True
         return False
+
+    def _row_changed(self):
+        if not getattr(self, "_selecting", False):  # a click or a key in the table
+            self._selection_changed()
 
     def _selection_changed(self):
         self._update_predictions()
@@ -511,8 +527,15 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         if name:
             self.store.remove_point(name)
 
+    def confirm_prediction(self, image=None):
+        """Accept the prediction (GcpPlacement); a refinement still matching in the background ends first."""
+        self.wait_for_refinement(image or self.photo_panel.image)
+        return super().confirm_prediction(image)
+
     # ------------------------------------------------------------------ teardown
     def cleanup(self):
+        for job in list(self.__dict__.get("_refine_jobs", {}).values()):
+            job.cancel()
         if self.task is not None:
             self.task.cancel()
         self.set_picking(False)

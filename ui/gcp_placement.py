@@ -327,6 +327,8 @@ class GcpPlacement:
                 or self.predictor is None:
             return pred, None
         key = self._match_key(point, image, pred)
+        if key not in self.matches and self._refine_later(key, point, image, pred):
+            return pred, None  # matching in a background task (GcpTasks._refine_later); the photo updates after
         if key not in self.matches:
             match = None
             try:

@@ -16,8 +16,99 @@ from .tasks import CoreTask, start
 translate = QCoreApplication.translate
 
 
+def georeference_then_prepare(root, progress=None, **kwargs):
+    """The adjustment, then (still in the worker thread) the image footprints the result layers show: the dock's
+    done() only adds layers (issue 18.5).  Returns (GeorefResult, footprints path or None)."""
+    from ..core.georef import stage as georef_stage
+
+    result = georef_stage.georeference_workspace(root, progress=progress, **kwargs)
+    return result, prepare_results(root, progress=progress)
+
+
+def prepare_results(root, progress=None):
+    """What takes time before the result layers can be added (worker thread): the footprints GeoPackage."""
+    return layers.footprints_path(root)
+
+
+def match_in_background(rec, refs, image, image_path, pred_xy, xyz, radius, progress=None):
+    """Refine a prediction in ``image`` by matching the point's look in the photos ``refs`` ([(name, (x, y),
+    path)], best first): core.georef.guided.refine_by_matching, the photos read here (a worker thread)."""
+    from ..core.common.progress import check_cancel
+    from ..core.georef import guided
+
+    target = guided.read_gray(image_path)
+    for k, (ref_image, ref_xy, ref_path) in enumerate(refs):
+        check_cancel(progress)
+        progress.report(k / max(1, len(refs)), ref_image)
+        match = guided.refine_by_matching(rec, ref_image, ref_xy, guided.read_gray(ref_path), image, pred_xy,
+                                          target, xyz, radius=radius)
+        if match is not None:
+            return match
+    return None
+
+
 class GcpTasks:
-    """Alignment and adjustment in the background, one task at a time; the summary of the adjustment."""
+    """Alignment and adjustment in the background, one task at a time; the summary of the adjustment; the
+    refinement of predictions by matching in tasks of their own."""
+
+    refine_in_background = False  # the plugin's dock: True (the photo shows the geometric prediction meanwhile)
+
+    # ------------------------------------------------------------------ refinement by matching
+    def _refine_later(self, key, point, image, pred):
+        """Start (or find running) the matching that refines ``pred``; False to match now, in the caller.
+        Matching takes 0.2 to 5 s a photo: on the GUI thread it froze the dock (issue 18.5)."""
+        if not self.refine_in_background:
+            return False
+        jobs = self.__dict__.setdefault("_refine_jobs", {})
+        if key in jobs:
+            return True
+        try:
+            xyz, _ = self.predictor.model_point(self._predictable(point))
+            size = max(max(c.width, c.height) for c in self.predictor.rec.cameras.values())
+        except Exception:  # noqa: BLE001 - the caller's own attempt records the failure
+            return False
+        paths = {im["name"]: im["path"] for im in self.store.images()}
+        refs = sorted(point.observations, key=lambda o: self._baseline(o.image, image))[:2]
+        ref_args = [(o.image, (o.x, o.y), paths.get(o.image)) for o in refs]
+        if paths.get(image) is None or any(p is None for _n, _xy, p in ref_args):
+            return False
+
+        def done(match):
+            jobs.pop(key, None)
+            self.matches[key] = match
+            self._refined(key)
+
+        def failed(message, cancelled):
+            jobs.pop(key, None)
+            if not cancelled:
+                self.matches[key] = None  # matching is a help: the geometric prediction stays
+                self._refined(key)
+
+        task = CoreTask(translate("GcpDock", "ArchaeoOrtho: refine {} in {}").format(point.name, image),
+                        match_in_background, (self.predictor.rec, ref_args, image, paths[image], pred.xy, xyz,
+                                              min(600.0, 0.3 * size)), on_done=done, on_error=failed)
+        jobs[key] = task
+        start(task)
+        return True
+
+    def _refined(self, key):
+        """A refinement ended: redraw the photo when it is still the one shown for that point."""
+        point = self.current_point()
+        if point is not None and point.name == key[0] and self.photo_panel.image == key[1]:
+            self._update_photo()
+
+    def refinement_pending(self, image=None):
+        jobs = self.__dict__.get("_refine_jobs", {})
+        return any(k[1] == image for k in jobs) if image else bool(jobs)
+
+    def wait_for_refinement(self, image=None, timeout=15.0):
+        """Let the refinement of ``image`` finish (events keep flowing: the dock stays responsive)."""
+        import time
+
+        t0 = time.time()
+        while self.refinement_pending(image) and time.time() - t0 < timeout:
+            QCoreApplication.processEvents()
+            time.sleep(0.01)
 
     # ------------------------------------------------------------------ alignment
     def choose_photos(self):
@@ -86,8 +177,6 @@ class GcpTasks:
 
     def run_georeference(self):
         """Adjust the block with the current points in a background task; residuals update when it ends."""
-        from ..core.georef import stage as georef_stage
-
         if self.store.workspace is None or self._busy():
             return None
         if not self.store.stage_done(ALIGN):
@@ -102,7 +191,8 @@ class GcpTasks:
             return None
         root = self.store.root
 
-        def done(result):
+        def done(outcome):
+            result, footprints = outcome
             self._task_ended()
             self.progress.setValue(100)
             self.store.reload_workspace()
@@ -110,14 +200,14 @@ class GcpTasks:
             self.store.load_residuals()
             self.load_predictor()
             self._selection_changed()
-            self.load_results(kinds=("cameras", "residuals"))
+            self.load_results(kinds=("cameras", "residuals"), footprints=footprints)
             extra = ""
             if result.outliers:
                 extra = " " + translate("GcpDock", "Outliers left out: {}").format("; ".join(result.outliers))
             self.message(translate("GcpDock", "Georeferenced in {}.").format(short_crs(result.crs)) + extra,
                          Qgis.MessageLevel.Warning if result.outliers else Qgis.MessageLevel.Success)
 
-        task = CoreTask(translate("GcpDock", "ArchaeoOrtho: georeference"), georef_stage.georeference_workspace, (root,),
+        task = CoreTask(translate("GcpDock", "ArchaeoOrtho: georeference"), georeference_then_prepare, (root,),
                         {"gcps": gs, "refine_intrinsics": self.refine_box.isChecked()},
                         on_done=done, on_error=self._task_failed)
         self.message(translate("GcpDock", "Georeferencing with {} control points\u2026").format(n_control))
@@ -142,9 +232,31 @@ class GcpTasks:
         self.summary.setText("<br>".join(parts))
 
     # ------------------------------------------------------------------ result layers
-    def load_results(self, kinds=None):
+    def load_results_in_background(self):
+        """The Load results button: the footprints are written in a task, then the layers are added (fast)."""
+        if self.store.root is None or self.__dict__.get("_results_task") is not None:
+            return None
+        root = self.store.root
+
+        def done(footprints):
+            self._results_task = None
+            if self.store.root == root:
+                self.load_results(footprints=footprints or "")
+                self.message(translate("GcpDock", "Results loaded"))
+
+        def failed(message, cancelled):
+            self._results_task = None
+            if not cancelled:
+                self.message(message, Qgis.MessageLevel.Warning)
+
+        self._results_task = CoreTask(translate("GcpDock", "ArchaeoOrtho: load results"), prepare_results, (root,),
+                                      on_done=done, on_error=failed)
+        self.message(translate("GcpDock", "Loading the results\u2026"))
+        return start(self._results_task)
+
+    def load_results(self, kinds=None, footprints=None):
         """Add the workspace's products as styled layers (DSM + hillshade, orthomosaic, cameras +
-        footprints, residuals)."""
+        footprints, residuals).  ``footprints``: written already (a task's), "" for none, None: write now."""
         if self.store.root is None:
             return []
         root = self.store.root
@@ -158,7 +270,8 @@ class GcpTasks:
         if "ortho" in kinds and os.path.exists(lay.default_orthomosaic):
             out += layers.load_orthomosaic(lay.default_orthomosaic, project, group)
         if "cameras" in kinds and os.path.exists(lay.cameras_gpkg):
-            out += layers.load_cameras(lay.cameras_gpkg, project, group, workspace=root)
+            out += layers.load_cameras(lay.cameras_gpkg, project, group, workspace=root if footprints is None else None,
+                                       footprints=footprints or None)
         res = lay.residuals_gpkg
         if "residuals" in kinds and os.path.exists(res) and self.store.stage_done(GEOREFERENCE):
             out += layers.load_residuals(res, project, group)

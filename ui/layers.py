@@ -489,16 +489,17 @@ def load_orthomosaic(path, project=None, group=None, name=None):
     return [layer] if add_layer(project, layer, group, path) is not None else []
 
 
-def load_cameras(path, project=None, group=None, name=None, workspace=None):
+def load_cameras(path, project=None, group=None, name=None, workspace=None, footprints=None):
     """Camera centres (only when they carry a CRS: an aligned block is in an arbitrary frame) and, for a
-    georeferenced workspace, the image footprints on the mean ground height."""
+    georeferenced workspace, the image footprints on the mean ground height (``footprints``: the GeoPackage
+    footprints_path() wrote already, in a background task; else written now)."""
     project = project or QgsProject.instance()
     layer = QgsVectorLayer(path, name or QCoreApplication.translate("ResultLayers", "Cameras"), "ogr")
     if not layer.isValid() or not has_real_crs(layer.crs()):
         return []
     remove_loaded(project, path, (CAMERAS,))
     out = []
-    foot = footprints_path(workspace) if workspace else None
+    foot = footprints or (footprints_path(workspace) if workspace else None)
     if foot:
         remove_loaded(project, foot, (FOOTPRINTS,))
         fl = QgsVectorLayer(foot, QCoreApplication.translate("ResultLayers", "Camera footprints"), "ogr")
