@@ -645,8 +645,16 @@ def test_diagnosis_of_large_residuals_is_shown_in_the_dock(dock, block, photos, 
     assert dock.store.diagnosis, "the adjustment wrote no diagnosis"
     label = dock.diagnosis
     assert not label.isHidden()
-    assert wrong.name in label.text()
     assert any(wrong.name in line for line in dock.store.diagnosis)
+    assert wrong.name in label.text() or wrong.name in label.toolTip()
+    # the first message shown (two lines at most), every message in the tooltip; the table keeps its room
+    for line in dock.store.diagnosis:
+        assert line.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;") in label.toolTip()
+    if len(dock.store.diagnosis) > 1:
+        assert f"+{len(dock.store.diagnosis) - 1}" in label.text()
+    dock.resize(dock.sizeHint())
+    process(50)
+    assert label.height() <= 3.5 * label.fontMetrics().lineSpacing(), "the diagnosis takes more than 3 lines"
     # a workspace without an adjustment: no diagnosis shown
     ws2 = make_workspace(str(tmp_path), block, photos, name="ws2")
     assert dock.open_workspace(ws2)

@@ -83,19 +83,28 @@ class GcpPlacement:
         self.tol_spin.setToolTip(translate("GcpDock", "Residuals up to this are green, up to 3 times yellow, beyond "
                                            "red. Now: {}").format(text))
 
-    def diagnosis_text(self):
-        """The last adjustment's diagnosis (its warnings and outliers, georef/residuals.json) as rich text."""
+    def diagnosis_text(self, shown=1):
+        """The last adjustment's diagnosis (its warnings and outliers, georef/residuals.json) as rich text: the
+        first ``shown`` messages (the dock keeps room for the table), then how many more; None: all of them."""
         lines = self.store.diagnosis
         if not lines:
             return ""
-        return "<b>" + translate("GcpDock", "Diagnosis of the adjustment:") + "</b><br>" + "<br>".join(
-            "\u2022 " + html.escape(t) for t in lines)
+        title = "<b>" + translate("GcpDock", "Diagnosis of the adjustment:") + "</b>"
+        if shown is None:
+            return title + "<br>" + "<br>".join("\u2022 " + html.escape(t) for t in lines)
+        text = " ".join(lines[:shown])
+        if len(text) > 100:  # about three lines of the dock at its default width: the table keeps its room
+            text = text[:100].rsplit(" ", 1)[0] + " \u2026"
+        more = len(lines) - min(shown, len(lines))
+        return title + " " + html.escape(text) + (f" <i>(+{more})</i>" if more else "")
 
     def show_diagnosis(self):
+        """The diagnosis under the summary: its first message, all of them in the tooltip."""
         label = getattr(self, "diagnosis", None)
         if label is not None:
             text = self.diagnosis_text()
             label.setText(text)
+            label.setToolTip(self.diagnosis_text(shown=None))
             label.setVisible(bool(text))
 
     # ------------------------------------------------------------------ map tool
