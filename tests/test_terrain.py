@@ -392,11 +392,10 @@ def test_products_load_styled_in_qgis(scene_dsm, tmp_path, qgis_new_project):
         r = lyr.renderer()
         assert r.type() == "singlebandgray"
         ce = r.contrastEnhancement()
-        if "Sky-view" in lyr.name():  # RVT's display range of the sky-view factor
-            assert (ce.minimumValue(), ce.maximumValue()) == pytest.approx((0.6375, 1.0))
-            assert r.gradient() == QgsSingleBandGrayRenderer.Gradient.BlackToWhite
-        else:
-            assert r.gradient() == QgsSingleBandGrayRenderer.Gradient.WhiteToBlack
+        assert r.gradient() == QgsSingleBandGrayRenderer.Gradient.BlackToWhite
+        # RVT's display ranges (rvt.default: svf_bytscl, neg_opns_bytscl)
+        expected = (0.6375, 1.0) if "Sky-view" in lyr.name() else (60.0, 95.0)
+        assert (ce.minimumValue(), ce.maximumValue()) == pytest.approx(expected)
     assert layers.output_kind("OUTPUT_DTM", "x/dtm.tif") == layers.DTM
     assert layers.output_kind("OUTPUT_CONTOURS", "x/c.gpkg") == layers.CONTOURS
 

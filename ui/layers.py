@@ -332,8 +332,7 @@ def style_dtm(layer):
 
 def style_relief(layer):
     """A relief visualisation in grey, stretched over RVT's display range of it (the file's DISPLAY_MIN /
-    DISPLAY_MAX: sky-view factor 0.64-1, openness 60-95 deg, local relief -2..2 m, ...); negative openness
-    inverted (valleys light, as RVT shows it)."""
+    DISPLAY_MAX: sky-view factor 0.64-1, openness 60-95 deg, local relief -2..2 m, ...), as RVT's 8-bit files."""
     from qgis.core import QgsContrastEnhancement, QgsSingleBandGrayRenderer
 
     _smooth_resampling(layer)
@@ -349,8 +348,6 @@ def style_relief(layer):
     ce.setMinimumValue(lo)
     ce.setMaximumValue(hi)
     renderer.setContrastEnhancement(ce)
-    if meta.get("RELIEF") == "openness_neg":
-        renderer.setGradient(QgsSingleBandGrayRenderer.Gradient.WhiteToBlack)
     layer.setRenderer(renderer)
     _mark(layer, RELIEF)
     layer.triggerRepaint()

@@ -111,8 +111,7 @@ def _relief(items: List[Tuple[str, str]]) -> str:
         lo, hi = num(meta.get("DISPLAY_MIN")), num(meta.get("DISPLAY_MAX"))
         if lo is None or hi is None or hi <= lo:
             lo, hi = np.nanpercentile(z, [2, 98]) if np.isfinite(z).any() else (0.0, 1.0)
-        cmap = "gray_r" if vis == "openness_neg" else "gray"
-        ax.imshow(z, extent=extent, cmap=cmap, vmin=lo, vmax=hi, interpolation="nearest")
+        ax.imshow(z, extent=extent, cmap="gray", vmin=lo, vmax=hi, interpolation="nearest")
         ax.set_title(title, fontsize=8)
         ax.set_xticks([])
         ax.set_yticks([])
