@@ -262,6 +262,16 @@ def test_workspace_stage_classifies_the_point_cloud(scene_dsm, tmp_path):
     assert np.mean(classes[on_object] == 1) >= 0.95
     assert np.mean(classes[~on_object] == 2) > 0.8  # trees are among the others
     assert r.points == n and 0 < r.ground_points < n
+    # patched in chunks: the same file whatever the chunk size
+    from core.terrain.classify import classify_las
+    from core.terrain.rasters import read_elevation
+
+    src, _, _ = raster.read_dsm(lay.dtm_source)
+    again = str(tmp_path / "again.las")
+    classify_las(lay.point_cloud(), again, read_elevation(lay.dtm(), "DTM"), np.nan_to_num(src).astype(np.uint8),
+                 0.5, chunk=1000)
+    with open(again, "rb") as f:
+        assert f.read() == data
 
     rr = relief_workspace(root, ["slrm"], source="dtm")
     assert os.path.samefile(rr.paths["slrm"], lay.relief("slrm", "dtm"))
