@@ -12,6 +12,14 @@ options) on the same images, the second reference; ratios are printed against ea
 
     python benchmarks/align.py [--images DIR] [--workdir DIR] [--skip-colmap] [--colmap-defaults]
                                [--pycolmap-defaults] [--mapper incremental|global] [--chain]
+    python benchmarks/align.py --table [--sets small,toledo,...] [--only ours|pycolmap]
+
+``--table`` runs ours (default options: the fast path, escalation where it fails) and pycolmap's default
+pipeline on every shared set and the synthetic small frames, and prints one table: registered images, mean
+reprojection error, wall seconds, what was escalated.  Each run's result is kept under
+``<workdir>/table/<set>/`` and reused by the next ``--table`` (delete it to measure again); ``--only`` runs one
+side.  ``ochota_kap`` (16 MP) is measured on half-size copies (2304 x 1728, EXIF kept): on 2 cores its full
+frames take too long for one run of the table.
 """
 import argparse
 import json
@@ -29,14 +37,15 @@ from _util import run_measured  # noqa: E402
 DEFAULT_IMAGES = os.path.join(os.path.dirname(ROOT), "shared", "data", "toledo", "images")
 
 
-def ours(images, work, threads, mapper="incremental"):
+def ours(images, work, threads, mapper="incremental", extra=None):
     ws = os.path.join(work, "archaeoortho-ws")
     shutil.rmtree(ws, ignore_errors=True)
     code = ("import sys, json; sys.path.insert(0, %r); from core.align.stage import align, AlignOptions;"
-            "r = align(%r, %r, AlignOptions(num_threads=%d, mapper=%r));"
+            "r = align(%r, %r, AlignOptions(num_threads=%d, mapper=%r, **%r));"
             "print('RESULT', json.dumps({'registered': r.registered, 'images': r.images_given,"
             "'mre': r.mean_reprojection_error, 'timings': r.timings, 'pairs': r.num_pairs,"
-            "'pairing': r.pairing_used, 'points': r.num_points3d}))") % (ROOT, images, ws, threads, mapper)
+            "'pairing': r.pairing_used, 'points': r.num_points3d, 'others': r.other_components,"
+            "'escalation': r.escalation}))") % (ROOT, images, ws, threads, mapper, dict(extra or {}))
     log = os.path.join(work, "archaeoortho.log")
     rc, wall, rss = run_measured([sys.executable, "-c", code], log_path=log)
     if rc != 0:
@@ -138,6 +147,104 @@ def _has_gps(images):
     return all(read_image_info(os.path.join(images, n)).gps for n in names[:5])
 
 
+SHARED = os.path.join(os.path.dirname(ROOT), "shared", "data")
+TABLE_SETS = ("small", "toledo", "copr", "caliterra", "ochota_kap", "toledo_2400")
+
+
+def _half_size_copies(src, dst):
+    """Half-size JPEG copies of ``src``'s photos with their EXIF (focal length, orientation) kept."""
+    from PIL import Image
+
+    os.makedirs(dst, exist_ok=True)
+    for n in sorted(os.listdir(src)):
+        if not n.lower().endswith((".jpg", ".jpeg")) or os.path.exists(os.path.join(dst, n)):
+            continue
+        with Image.open(os.path.join(src, n)) as im:
+            exif = im.info.get("exif", b"")
+            im.resize((im.width // 2, im.height // 2), Image.LANCZOS).save(os.path.join(dst, n), quality=95,
+                                                                          exif=exif)
+    return dst
+
+
+def table_set(name, work):
+    """(images folder, our extra options, note) of a table row; the small frames and the ochota copies are
+    made under ``work`` once."""
+    if name == "small":
+        from tests.test_align_escalation import FOCAL_MM, SENSOR_WIDTH_MM, SMALL_FRAMES, small_frames
+
+        d = os.path.join(work, "small-frames")
+        if not os.path.isdir(d):
+            small_frames(os.path.join(ROOT, "sample", "toledo", "images"), SMALL_FRAMES, d)
+        return d, {"focal_mm": FOCAL_MM, "sensor_width_mm": SENSOR_WIDTH_MM}, \
+            "5 Toledo frames at 1152 x 640, contrast 12 %, no EXIF (tests/test_align_escalation.py)"
+    if name == "ochota_kap":
+        return _half_size_copies(os.path.join(SHARED, name, "images"), os.path.join(work, "ochota-half")), {}, \
+            "half size (2304 x 1728), EXIF kept"
+    return os.path.join(SHARED, name, "images"), {}, ""
+
+
+def _cached(path, run, *args, **kw):
+    """The run's {result, wall, rss} kept at ``path``; run only when it is not there."""
+    if os.path.exists(path):
+        return json.load(open(path))
+    out = dict(zip(("result", "wall", "rss"), run(*args, **kw)))
+    with open(path, "w") as f:
+        json.dump(out, f, indent=1)
+    return out
+
+
+def table(a):
+    """One table across every set: ours vs pycolmap's default pipeline."""
+    rows = []
+    for name in a.sets.split(","):
+        d = os.path.join(a.workdir, "table", name)
+        os.makedirs(d, exist_ok=True)
+        images, extra, note = table_set(name, os.path.join(a.workdir, "table"))
+        n = len([f for f in os.listdir(images) if f.lower().endswith((".jpg", ".jpeg", ".tif", ".tiff", ".png"))])
+        print(f"{name}: {images} ({n} images)", flush=True)
+        mine = theirs = None
+        if a.only in (None, "ours"):
+            mine = _cached(os.path.join(d, "ours.json"), ours, images, d, a.threads, extra=extra)
+        elif os.path.exists(os.path.join(d, "ours.json")):
+            mine = json.load(open(os.path.join(d, "ours.json")))
+        if a.only in (None, "pycolmap"):
+            theirs = _cached(os.path.join(d, "pycolmap.json"), pycolmap_defaults, images, d)
+        elif os.path.exists(os.path.join(d, "pycolmap.json")):
+            theirs = json.load(open(os.path.join(d, "pycolmap.json")))
+        rows.append((name, n, note, mine, theirs))
+        print(_table_text(rows[-1:]), flush=True)
+    print("\n" + _table_text(rows))
+
+
+def _table_text(rows):
+    out = ["| set | images | ours: registered | ours: reprojection | ours: wall | escalated | "
+           "pycolmap defaults: registered | reprojection | wall | ours / pycolmap |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
+    for name, n, note, mine, theirs in rows:
+        cells = [name + (f" ({note})" if note else ""), str(n)]
+        if mine:
+            r = mine["result"]
+            esc = r.get("escalation")
+            what = "no"
+            if esc:
+                what = "; ".join(f"round {x['round']}: {len(x['left_out'])} left out, {len(x['re_extracted'])} "
+                                 f"re-extracted, {x['registered_before']} -> {x['registered_after']}"
+                                 for x in esc["rounds"])
+            split = f" + {len(r['others'])} other component(s)" if r.get("others") else ""
+            cells += [f"{r['registered']}/{n}{split}", f"{r['mre']:.3f} px", f"{mine['wall']:.1f} s", what]
+        else:
+            cells += ["", "", "", ""]
+        if theirs:
+            p = theirs["result"]
+            cells += [f"{p['registered']}/{n}", "n/a" if p["mre"] is None else f"{p['mre']:.3f} px",
+                      f"{theirs['wall']:.1f} s"]
+        else:
+            cells += ["", "", ""]
+        cells.append(f"{mine['wall'] / theirs['wall']:.2f}" if mine and theirs else "")
+        out.append("| " + " | ".join(cells) + " |")
+    return "\n".join(out)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--images", default=DEFAULT_IMAGES)
@@ -149,8 +256,13 @@ def main():
     ap.add_argument("--mapper", default="incremental", choices=["incremental", "global"], help="our mapper")
     ap.add_argument("--chain", action="store_true",
                     help="also run our whole chain to orthomosaic on the same images (benchmarks/chain.py)")
+    ap.add_argument("--table", action="store_true", help="one table across every shared set, ours vs pycolmap")
+    ap.add_argument("--sets", default=",".join(TABLE_SETS), help="the table's sets (comma-separated)")
+    ap.add_argument("--only", choices=["ours", "pycolmap"], help="the table: run one side only")
     a = ap.parse_args()
     os.makedirs(a.workdir, exist_ok=True)
+    if a.table:
+        return table(a)
     n = len([f for f in os.listdir(a.images) if f.lower().endswith((".jpg", ".jpeg", ".tif", ".tiff"))])
     print(f"images: {a.images} ({n}); cores: {os.cpu_count()}; threads: {a.threads}", flush=True)
     r, wall, rss = ours(a.images, a.workdir, a.threads, a.mapper)

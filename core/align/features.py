@@ -145,7 +145,10 @@ def sift_first_octave(options: AlignOptions, width: int, height: int) -> int:
 
 
 def extract_features(pycolmap, db_path, images_dir, groups, camera_ids, options, progress: Progress,
-             mask_path: Optional[str] = None, masked: Optional[Sequence[str]] = None):
+                     mask_path: Optional[str] = None, masked: Optional[Sequence[str]] = None,
+                     sift: Optional[Dict[str, object]] = None):
+    """SIFT features of every image of ``groups`` the database has none for; ``sift`` overrides the SIFT
+    options (the escalation's upsampled, richer settings: core.align.escalation)."""
     eo = pycolmap.FeatureExtractionOptions()
     g0 = max(groups, key=lambda g: g.width * g.height)
     eo.sift.max_num_features = int(options.max_features or auto_max_features(g0.width, g0.height,
@@ -157,6 +160,8 @@ def extract_features(pycolmap, db_path, images_dir, groups, camera_ids, options,
     if options.affine_features:
         eo.sift.estimate_affine_shape = True
         eo.sift.domain_size_pooling = True
+    for k, v in (sift or {}).items():
+        setattr(eo.sift, k, v)
     db = pycolmap.Database.open(db_path)
     try:
         done = {im.name for im in db.read_all_images() if db.exists_keypoints(im.image_id)}

@@ -44,3 +44,4 @@ class AlignOptions:
     mapper: str = "incremental"  # incremental (COLMAP) or global (GLOMAP: rotation averaging + global positioning)
     first_octave: Optional[int] = None  # SIFT's first octave; None = auto (-1, upsampled, below UPSAMPLE_BELOW px)
     seed: int = 1
+    escalate: bool = True  # retry images left out / a split block with richer features and pairs (escalation.py)

@@ -31,6 +31,7 @@ from ..io.vector import write_cameras_gpkg
 from ..project.layout import Layout
 from ..project.stages import ALIGN, run_stage
 from ..project.workspace import Workspace
+from .escalation import EscalationContext, block_state, escalate
 from .features import database_key, extract_features, file_hash, masks_for_colmap, match_pairs, setup_database
 from .mapping import (
     camera_rows,
@@ -65,6 +66,7 @@ class AlignResult:
     timings: Dict[str, float]
     cameras: List[dict]
     masked_images: int = 0
+    escalation: Optional[dict] = None  # what was escalated and why (core.align.escalation), None when not needed
 
 
 def _json(obj) -> str:
@@ -267,15 +269,23 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
                 progress.warning(w)
             progress.info(f"pair selection: {pairing_used}, {len(pairs)} pairs for {len(infos)} images")
             match_pairs(pycolmap, db_path, pairs, lay.sfm_dir, options, SubProgress(progress, 0.35, 0.65))
-        # 4. mapping
+        # 4. mapping, then escalation where the fast path left images out or split the block
         with run.step("mapping", save=False):
             ordered = _mapping(pycolmap, lay, db_path, images_dir, len(infos), options,
-                               SubProgress(progress, 0.65, 0.93))
+                               SubProgress(progress, 0.65, 0.90))
+        ctx = EscalationContext(pycolmap, db_path, lay.sfm_dir, images_dir, [im.name for im in infos], groups,
+                                camera_ids, options, pairs, mask_path, list(masks),
+                                lambda p: _mapping(pycolmap, lay, db_path, images_dir, len(infos), options, p),
+                                lambda reg, oth: diagnose_unregistered(
+                                    infos, reg, oth, verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS)),
+                                lambda: verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS))
+        with run.step("escalation", save=False):
+            ordered, escalation = escalate(ctx, ordered, SubProgress(progress, 0.90, 0.93))
         partners = verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS)
         if not ordered:
             raise _no_reconstruction(partners, len(infos), verified_pairs(pycolmap, db_path, MIN_VERIFIED_INLIERS))
         rec = ordered[0]
-        others = [sorted(rec2.images[i].name for i in rec2.reg_image_ids()) for rec2 in ordered[1:]]
+        _registered, others = block_state(ordered)
         # 5. final global bundle adjustment
         with run.step("bundle_adjustment", save=False):
             progress.report(0.94, "final bundle adjustment")
@@ -299,6 +309,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
             unregistered=unregistered, other_components=others, skipped_files=photos.skipped,
             pairing_used=pairing_used, num_pairs=len(pairs), timings={k: round(v, 3) for k, v in timings.items()},
             cameras=camera_summary(rec), masked_images=len(masks),
+            escalation=escalation.to_dict() if escalation else None,
         )
         figures = {k: v for k, v in asdict(result).items() if k not in ("workspace", "model_dir", "cameras_path")}
         figures["principal_point_refined"] = pp
@@ -307,6 +318,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
                    results={"registered": result.registered, "images": len(infos),
                             "mean_reprojection_error": mre, "points3d": result.num_points3d,
                             "pairing": pairing_used, "pairs": len(pairs), "masked_images": len(masks),
+                            "escalation_rounds": len(escalation.rounds) if escalation else 0,
                             "total_seconds": round(time.time() - t_start, 2)})
     # later stages were built on the previous model: run_stage marked them stale
     progress.report(1.0, f"aligned {result.registered}/{len(infos)} images, {mre:.3f} px")

@@ -1,0 +1,339 @@
+"""Escalation: the fast path's features and pairs retried, richer, only where the fast path failed.
+
+The fast path (``features`` + ``pairs``) is tuned for speed on typical drone frames: SIFT starts at octave 0
+from ``UPSAMPLE_BELOW`` px, about 4000 features per megapixel, spatial or sequential pairs.  On other frames
+(small scans, low texture, low overlap) it can leave images unregistered or split the block into components
+where pycolmap's default pipeline (upsampled SIFT, 8192 features, exhaustive pairs) does not.  After the first
+mapping, :func:`escalate` retries *only the images left out of the main block and their neighbours*, the
+cheaper retry first:
+
+1. **round 1** -- the left-out images, plus the registered images they matched best (from the database's raw
+   matches) and the cameras next to those in the model ("guided by what did register"), are extracted again
+   with upsampled SIFT (``first_octave = -1``), twice the features (at least 8192) and a third of SIFT's peak
+   threshold (faint, low-contrast features); their old matches are removed; they are matched again on the
+   original pairs plus new pairs: every pair among the left-out images and each left-out image with every
+   neighbour;
+2. **round 2** (only when round 1 still leaves images out or the block split) -- the same with affine-shape
+   estimation and domain-size pooling (features that survive strong perspective and scale change; slower),
+   on every image with exhaustive pairs in a block of up to ``ESCALATE_ALL_MAX`` images; in a larger block on
+   the left-out images and their neighbours (chosen again), each left-out image paired with every registered
+   image: the cost stays that of the images that failed, not of the block.
+
+After each round the mapping runs again on the enlarged database (one merged reconstruction); a round's result
+is kept only when it registers more images in the main block (or as many in fewer components).  What was
+escalated, for which image and why, goes to the log and to ``sfm/alignment.json`` (``escalation``).
+"""
+from __future__ import annotations
+
+import sqlite3
+import time
+from dataclasses import asdict, dataclass, field
+from typing import Callable, Dict, List, Optional, Sequence, Set, Tuple
+
+import numpy as np
+
+from ..common.progress import Progress, SubProgress, check_cancel
+from .features import auto_max_features, extract_features, match_pairs
+from .options import AlignOptions
+
+ESCALATION_MIN_FEATURES = 8192  # pycolmap's default SIFT budget: the escalated budget is never below it
+ESCALATION_PEAK_THRESHOLD = 0.02 / 3 / 3  # a third of SIFT's default (0.02 / octave_resolution): faint features
+ANCHORS_PER_IMAGE = 6  # registered images a left-out image matched best
+MODEL_NEIGHBOURS = 3  # registered cameras next to each anchor in the model
+ESCALATE_ALL_MAX = 20  # round 2 re-extracts and matches every image exhaustively in a block this small
+PAIR_ID_BASE = 2147483647  # COLMAP: pair_id = image_id1 * 2147483647 + image_id2 (image_id1 < image_id2)
+
+
+@dataclass
+class EscalationRound:
+    """What one escalation round did (a row of ``escalation.rounds`` in sfm/alignment.json)."""
+
+    round: int
+    reason: str
+    left_out: Dict[str, str]  # image -> why it was outside the main block before this round
+    re_extracted: List[str]
+    neighbours: List[str]  # registered images re-extracted with the left-out ones
+    sift: Dict[str, object]
+    pairs_matched: int
+    registered_before: int
+    components_before: int
+    registered_after: int = 0
+    components_after: int = 0
+    kept: bool = False
+    seconds: float = 0.0
+    timings: Dict[str, float] = field(default_factory=dict)
+
+
+@dataclass
+class Escalation:
+    """The escalation record: why it ran, its rounds, and per image what was done and the outcome."""
+
+    reason: str
+    rounds: List[EscalationRound] = field(default_factory=list)
+    images: Dict[str, Dict[str, object]] = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        return {"reason": self.reason, "rounds": [asdict(r) for r in self.rounds], "images": self.images}
+
+
+def block_state(ordered) -> Tuple[Set[str], List[List[str]]]:
+    """(names registered in the largest reconstruction, the other components' images outside it).
+
+    COLMAP may register an image in more than one model: a component whose images are all in the main block
+    is no split, and the images of another component that the main block holds are not counted twice."""
+    if not ordered:
+        return set(), []
+    main = {ordered[0].images[i].name for i in ordered[0].reg_image_ids()}
+    others = []
+    for rec in ordered[1:]:
+        rest = sorted({rec.images[i].name for i in rec.reg_image_ids()} - main)
+        if rest:
+            others.append(rest)
+    return main, others
+
+
+def escalation_reason(n_images: int, registered: Set[str], others: Sequence[Sequence[str]]) -> Optional[str]:
+    """Why the fast path's result needs escalation, or None when every image is in one block."""
+    parts = []
+    if len(registered) < n_images:
+        parts.append(f"{n_images - len(registered)} of {n_images} images not in the main block")
+    if others:
+        parts.append(f"the block split into {len(others) + 1} components")
+    return "; ".join(parts) or None
+
+
+def escalated_sift(options: AlignOptions, width: int, height: int, round_: int = 1) -> Dict[str, object]:
+    """The SIFT settings of escalation round ``round_``: upsampled, more and fainter features; from round 2 also
+    affine shape + domain-size pooling."""
+    base = int(options.max_features or auto_max_features(width, height, options.max_image_size))
+    out: Dict[str, object] = {"first_octave": -1, "max_num_features": max(ESCALATION_MIN_FEATURES, 2 * base),
+                              "peak_threshold": ESCALATION_PEAK_THRESHOLD}
+    if round_ >= 2:
+        out.update(estimate_affine_shape=True, domain_size_pooling=True)
+    return out
+
+
+def _pair_counts(db_path: str) -> Tuple[Dict[int, str], Dict[Tuple[str, str], int]]:
+    """(image_id -> name, (name, name) -> raw matches) read from the COLMAP database (SQLite)."""
+    con = sqlite3.connect(db_path)
+    try:
+        names = {int(i): n for i, n in con.execute("SELECT image_id, name FROM images")}
+        counts: Dict[Tuple[str, str], int] = {}
+        for pid, rows in con.execute("SELECT pair_id, rows FROM matches"):
+            a, b = names.get(int(pid) // PAIR_ID_BASE), names.get(int(pid) % PAIR_ID_BASE)
+            if a and b:
+                counts[(a, b)] = counts[(b, a)] = int(rows)
+        return names, counts
+    finally:
+        con.close()
+
+
+def forget_features(db_path: str, names: Sequence[str]) -> None:
+    """Remove the keypoints, descriptors, matches and two-view geometries of ``names`` from the database, so
+    that the next extraction and matching compute them afresh (COLMAP skips images that have features)."""
+    con = sqlite3.connect(db_path)
+    try:
+        wanted = set(names)
+        ids = [int(i) for i, n in con.execute("SELECT image_id, name FROM images") if n in wanted]
+        idset = set(ids)
+        with con:
+            for table in ("keypoints", "descriptors"):
+                con.executemany(f"DELETE FROM {table} WHERE image_id = ?", [(i,) for i in ids])
+            for table in ("matches", "two_view_geometries"):
+                pids = [int(p) for (p,) in con.execute(f"SELECT pair_id FROM {table}")
+                        if int(p) // PAIR_ID_BASE in idset or int(p) % PAIR_ID_BASE in idset]
+                con.executemany(f"DELETE FROM {table} WHERE pair_id = ?", [(p,) for p in pids])
+    finally:
+        con.close()
+
+
+def _model_neighbours(rec, names: Sequence[str], k: int) -> Dict[str, List[str]]:
+    """For each registered image of ``names``: the ``k`` registered images nearest to it in the model."""
+    centres = {rec.images[i].name: np.asarray(rec.images[i].projection_center(), dtype=float)
+               for i in rec.reg_image_ids()}
+    keys = sorted(centres)
+    if not keys:
+        return {}
+    xyz = np.array([centres[n] for n in keys])
+    out = {}
+    for n in names:
+        if n in centres:
+            d = np.linalg.norm(xyz - centres[n], axis=1)
+            out[n] = [keys[j] for j in np.argsort(d)[1:k + 1]]
+    return out
+
+
+def choose_neighbours(db_path: str, order: Sequence[str], registered: Set[str], left_out: Sequence[str],
+                      rec) -> List[str]:
+    """The registered images re-extracted and matched with the left-out ones: for each left-out image the
+    registered images it has most raw matches with (or, with none, its neighbours in file order), plus the
+    cameras next to those in the model."""
+    _ids, counts = _pair_counts(db_path)
+    index = {n: k for k, n in enumerate(order)}
+    anchors: Set[str] = set()
+    for w in left_out:
+        ranked = sorted(((c, r) for r in registered if (c := counts.get((w, r), 0)) > 0), reverse=True)
+        mine = [r for _c, r in ranked[:ANCHORS_PER_IMAGE]]
+        if len(mine) < 2:  # nothing matched: the images taken just before and after it
+            near = sorted(registered, key=lambda r: abs(index.get(r, 0) - index.get(w, 0)))
+            mine += [r for r in near[:2] if r not in mine]
+        anchors.update(mine)
+    out = set(anchors)
+    if rec is not None:
+        for near in _model_neighbours(rec, sorted(anchors), MODEL_NEIGHBOURS).values():
+            out.update(near)
+    return sorted(out)
+
+
+def round_pairs(original: Sequence[Tuple[str, str]], left_out: Sequence[str], neighbours: Sequence[str],
+                all_names: Sequence[str], exhaustive: bool) -> List[Tuple[str, str]]:
+    """The pairs an escalation round matches: the original pairs touching a re-extracted image (their old
+    matches are gone), every pair among the left-out images, each left-out image with every neighbour; with
+    ``exhaustive`` every pair of ``all_names``."""
+    pairs: Set[Tuple[str, str]] = set()
+    if exhaustive:
+        for i, a in enumerate(all_names):
+            for b in all_names[i + 1:]:
+                pairs.add((min(a, b), max(a, b)))
+        return sorted(pairs)
+    touched = set(left_out) | set(neighbours)
+    for a, b in original:
+        if a in touched or b in touched:
+            pairs.add((min(a, b), max(a, b)))
+    group = list(left_out)
+    for i, a in enumerate(group):
+        for b in group[i + 1:] + list(neighbours):
+            if a != b:
+                pairs.add((min(a, b), max(a, b)))
+    return sorted(pairs)
+
+
+@dataclass
+class EscalationContext:
+    """What :func:`escalate` needs from the stage: the database, the photos and the stage's steps."""
+
+    pycolmap: object
+    db_path: str
+    work_dir: str
+    images_dir: str
+    order: List[str]  # every image name, in file order
+    groups: list
+    camera_ids: Dict[str, int]
+    options: AlignOptions
+    pairs: List[Tuple[str, str]]
+    mask_path: Optional[str]
+    masked: List[str]
+    mapping: Callable[[Progress], list]  # runs the mapping on the database: reconstructions, largest first
+    diagnose: Callable[[Set[str], List[List[str]]], Dict[str, str]]  # (registered, others) -> image -> why
+    partners: Callable[[], Dict[str, int]]  # image -> how many images it shares a verified pair with
+
+
+def _better(new, old) -> bool:
+    """Does the reconstruction list ``new`` beat ``old``: more images in the main block, or as many in fewer
+    components."""
+    (rn, on), (ro, oo) = block_state(new), block_state(old)
+    return (len(rn), -len(on)) > (len(ro), -len(oo))
+
+
+def _round_images(ctx: EscalationContext, k: int, registered: Set[str], left: List[str], ordered):
+    """(neighbours, exhaustive) of round ``k``: round 2 takes every image (exhaustive pairs) in a block of up
+    to ESCALATE_ALL_MAX images."""
+    if k >= 2 and len(ctx.order) <= ESCALATE_ALL_MAX:
+        return [n for n in ctx.order if n in registered], True
+    neighbours = choose_neighbours(ctx.db_path, ctx.order, registered, left, ordered[0] if ordered else None)
+    return neighbours, False
+
+
+def _run_round(ctx: EscalationContext, k: int, reason: str, ordered, left: List[str],
+               progress: Progress) -> Tuple[EscalationRound, list]:
+    """Round ``k``: re-extract the ``left`` out images and their neighbours, match them again, map again."""
+    t0 = time.time()
+    registered, others = block_state(ordered)
+    why = ctx.diagnose(registered, others)
+    neighbours, exhaustive = _round_images(ctx, k, registered, left, ordered)
+    redo = [n for n in ctx.order if n in set(left) | set(neighbours)]
+    g0 = max(ctx.groups, key=lambda g: g.width * g.height)
+    sift = escalated_sift(ctx.options, g0.width, g0.height, k)
+    extra = ", affine shape + DSP" if sift.get("domain_size_pooling") else ""
+    progress.info(f"escalation round {k} ({reason}): {len(left)} image(s) left out, re-extracting {len(redo)} "
+                  f"with upsampled SIFT (first octave -1), {sift['max_num_features']} features, peak threshold "
+                  f"{sift['peak_threshold']:.4f}{extra}")
+    for n in left:
+        progress.info(f"escalation round {k}: {n}: {why.get(n, 'not in the main block')}")
+    forget_features(ctx.db_path, redo)
+    extract_features(ctx.pycolmap, ctx.db_path, ctx.images_dir, ctx.groups, ctx.camera_ids, ctx.options,
+                     SubProgress(progress, 0.0, 0.4), ctx.mask_path, ctx.masked, sift=sift)
+    t_features = time.time() - t0
+    pairs = round_pairs(ctx.pairs, left, neighbours, ctx.order, exhaustive)
+    if k >= 2 and not exhaustive:  # a larger block: each left-out image with every registered one
+        pairs = sorted(set(pairs) | {(min(a, b), max(a, b)) for a in left for b in registered})
+    progress.info(f"escalation round {k}: matching {len(pairs)} pairs")
+    match_pairs(ctx.pycolmap, ctx.db_path, pairs, ctx.work_dir, ctx.options, SubProgress(progress, 0.4, 0.7))
+    t_matching = time.time() - t0 - t_features
+    check_cancel(progress)
+    new = ctx.mapping(SubProgress(progress, 0.7, 1.0))
+    reg_new, others_new = block_state(new)
+    row = EscalationRound(k, reason, {n: why.get(n, "") for n in left}, redo, [n for n in neighbours if n in redo],
+                          sift, len(pairs), len(registered), (len(others) + 1) if ordered else 0, len(reg_new),
+                          (len(others_new) + 1) if new else 0, kept=_better(new, ordered),
+                          seconds=round(time.time() - t0, 2),
+                          timings={"features": round(t_features, 2), "matching": round(t_matching, 2),
+                                   "mapping": round(time.time() - t0 - t_features - t_matching, 2)})
+    return row, new
+
+
+def _hopeful(ctx: EscalationContext, registered: Set[str], others: List[List[str]], progress: Progress) -> List[str]:
+    """The images round 2 (affine shape + DSP, the slow features) is worth running for: those still outside the
+    main block that, after round 1's richer features, share a verified pair with some image or sit in another
+    component.  An image without any verified pair after round 1 shares no ground with the block (a foreign
+    photo, sky, water): round 2 would not change that and is not run for it."""
+    partners = ctx.partners()
+    in_other = {n for comp in others for n in comp}
+    left = [n for n in ctx.order if n not in registered]
+    hopeful = [n for n in left if n in in_other or partners.get(n, 0) > 0]
+    if len(hopeful) < len(left):
+        rest = [n for n in left if n not in hopeful]
+        progress.info(f"escalation: {len(rest)} image(s) without any verified pair after round 1, not escalated "
+                      f"further (no ground shared with the block): {', '.join(rest[:10])}")
+    return hopeful
+
+
+def escalate(ctx: EscalationContext, ordered, progress: Progress):
+    """Escalate where the fast path failed; returns (reconstructions, largest first, Escalation or None)."""
+    if not ctx.options.escalate:
+        return ordered, None
+    registered, others = block_state(ordered)
+    reason = escalation_reason(len(ctx.order), registered, others)
+    if reason is None:
+        return ordered, None
+    record = Escalation(reason)
+    progress.warning(f"fast path: {reason}; escalating for the images left out")
+    first_left = [n for n in ctx.order if n not in registered]
+    left = first_left
+    for k in (1, 2):
+        if k == 2:
+            registered, others = block_state(ordered)
+            reason = escalation_reason(len(ctx.order), registered, others)
+            if reason is None:
+                break
+            left = _hopeful(ctx, registered, others, progress)
+            if not left:
+                break
+        row, new = _run_round(ctx, k, reason, ordered, left, SubProgress(progress, (k - 1) / 2.0, k / 2.0))
+        record.rounds.append(row)
+        if row.kept:
+            ordered = new
+        progress.info(f"escalation round {k}: main block {row.registered_before} -> {row.registered_after} images, "
+                      f"{row.components_before} -> {row.components_after} component(s), {row.seconds:.1f} s"
+                      + ("" if row.kept else "; not better, the previous result kept"))
+    final, _ = block_state(ordered)
+    for n in first_left:
+        done = [r.round for r in record.rounds if n in r.left_out]
+        record.images[n] = {"why": record.rounds[0].left_out.get(n, ""), "rounds": done,
+                            "registered": n in final,
+                            "escalated": [("upsampled SIFT (first octave -1), more and fainter features"
+                                           + (", affine shape + DSP" if r.round >= 2 else "")
+                                           + f", {r.pairs_matched} pairs matched again") for r in record.rounds
+                                          if n in r.left_out]}
+    return ordered, record
+

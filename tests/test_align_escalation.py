@@ -1,0 +1,179 @@
+"""Alignment escalation (issue 13 item 1) and mixed-camera blocks (item 5), on real Toledo frames.
+
+The small-frame failure: five Toledo frames (sample/toledo) cropped and downsampled to 1152 x 640 px, contrast
+lowered to 12 % (a flat, hazy scan: no EXIF, the interior orientation given as FOCAL_MM / SENSOR_WIDTH_MM).
+At 1152 px the fast path starts SIFT at octave 0 and finds too few features: the block does not build.
+Escalation (upsampled SIFT, more features, affine shape + DSP, more pairs) registers every frame in one block.
+"""
+import json
+import os
+import sqlite3
+
+import cv2
+import numpy as np
+import pytest
+
+from core.align.escalation import (
+    ESCALATION_MIN_FEATURES,
+    block_state,
+    escalated_sift,
+    escalation_reason,
+    forget_features,
+    round_pairs,
+)
+from core.align.options import AlignError, AlignOptions
+from core.align.stage import align
+from tests.conftest import SAMPLE
+
+SMALL_FRAMES = ["1JI_0064.JPG", "1JI_0065.JPG", "1JI_0066.JPG", "1JI_0067.JPG", "1JI_0068.JPG"]
+SMALL_SIZE = (1152, 640)
+SMALL_CONTRAST = 0.12
+# the DJI FC300X's lens, 3.61 mm on a 6.17 mm wide sensor: what a user types as FOCAL_MM / SENSOR_WIDTH_MM
+FOCAL_MM, SENSOR_WIDTH_MM = 3.61, 6.17
+# Toledo's two cameras over the same ground (sample/toledo): FC300X (1JI_*) and FC350 (DJI_*)
+MIXED_FC300X = ["1JI_0066.JPG", "1JI_0067.JPG", "1JI_0077.JPG", "1JI_0078.JPG"]
+MIXED_FC350 = ["DJI_0089.JPG", "DJI_0090.JPG", "DJI_0092.JPG", "DJI_0093.JPG"]
+
+
+def small_frames(src_dir, names, dst_dir, size=SMALL_SIZE, contrast=SMALL_CONTRAST):
+    """Frames cropped to the aspect of ``size``, downsampled to it (INTER_AREA) and their contrast scaled by
+    ``contrast`` around the mean, written as PNG (no EXIF)."""
+    os.makedirs(dst_dir, exist_ok=True)
+    w, h = size
+    for n in names:
+        im = cv2.imread(os.path.join(src_dir, n))
+        rows = int(round(im.shape[1] * h / w))
+        if rows <= im.shape[0]:
+            y0 = (im.shape[0] - rows) // 2
+            im = im[y0:y0 + rows]
+        im = cv2.resize(im, (w, h), interpolation=cv2.INTER_AREA).astype(np.float32)
+        im = np.clip(128.0 + contrast * (im - im.mean()), 0, 255).astype(np.uint8)
+        assert cv2.imwrite(os.path.join(dst_dir, os.path.splitext(n)[0] + ".png"), im)
+    return dst_dir
+
+
+@pytest.fixture(scope="module")
+def small_block(tmp_path_factory):
+    d = tmp_path_factory.mktemp("small frames")
+    return small_frames(os.path.join(SAMPLE, "images"), SMALL_FRAMES, str(d / "img"))
+
+
+def _options(**kw):
+    return AlignOptions(focal_mm=FOCAL_MM, sensor_width_mm=SENSOR_WIDTH_MM, **kw)
+
+
+class _Image:
+    def __init__(self, name):
+        self.name = name
+
+
+class _Rec:
+    """The two things block_state reads of a pycolmap.Reconstruction."""
+
+    def __init__(self, names):
+        self.images = {k: _Image(n) for k, n in enumerate(names)}
+
+    def reg_image_ids(self):
+        return list(self.images)
+
+
+def test_block_state_ignores_components_inside_the_main_block():
+    main, others = block_state([_Rec(["a", "b", "c", "d"]), _Rec(["b", "c"]), _Rec(["c", "e", "f"])])
+    assert main == {"a", "b", "c", "d"}
+    assert others == [["e", "f"]]  # the component of b, c is no split; c is not counted twice
+    assert block_state([]) == (set(), [])
+
+
+def test_escalation_reason_and_settings():
+    assert escalation_reason(4, {"a", "b", "c", "d"}, []) is None
+    assert escalation_reason(4, {"a", "b"}, [["c", "d"]]) == ("2 of 4 images not in the main block; "
+                                                              "the block split into 2 components")
+    s = escalated_sift(AlignOptions(), 1152, 640)  # the fast path: ~2900 features, octave 0
+    assert s["first_octave"] == -1 and s["peak_threshold"] < 0.0066 and "domain_size_pooling" not in s
+    assert s["max_num_features"] == ESCALATION_MIN_FEATURES
+    assert escalated_sift(AlignOptions(max_features=6000), 4000, 3000)["max_num_features"] == 12000
+    s2 = escalated_sift(AlignOptions(), 1152, 640, 2)  # round 2 adds affine shape + domain-size pooling
+    assert s2["estimate_affine_shape"] and s2["domain_size_pooling"] and s2["first_octave"] == -1
+
+
+def test_round_pairs_rematch_what_changed_and_add_pairs_for_the_left_out():
+    original = [("a", "b"), ("b", "c"), ("c", "d"), ("d", "e"), ("e", "f")]
+    pairs = round_pairs(original, ["e", "f"], ["c"], list("abcdef"), exhaustive=False)
+    # original pairs touching a re-extracted image, e-f, and each left-out image with each neighbour
+    assert pairs == [("b", "c"), ("c", "d"), ("c", "e"), ("c", "f"), ("d", "e"), ("e", "f")]
+    assert len(round_pairs(original, ["e"], [], list("abcdef"), exhaustive=True)) == 15
+
+
+@pytest.fixture(scope="module")
+def fast_path(small_block, tmp_path_factory):
+    """The fast path alone on the small frames: (workspace, AlignResult or the AlignError)."""
+    ws = tmp_path_factory.mktemp("fast path") / "ws"
+    try:
+        return ws, align(small_block, str(ws), _options(escalate=False))
+    except AlignError as e:
+        return ws, e
+
+
+@pytest.mark.slow
+def test_fast_path_fails_on_small_low_contrast_frames_and_escalation_fixes_it(small_block, fast_path, tmp_path):
+    # the fast path alone (octave 0 at 1152 px, ~2900 features, SIFT's default peak threshold): no block, or
+    # not every frame in one block
+    _ws, fast = fast_path
+    if isinstance(fast, AlignError):
+        assert "no reconstruction" in str(fast)
+    else:
+        assert fast.registered < len(SMALL_FRAMES) or fast.other_components
+    ws = tmp_path / "ws"
+    r = align(small_block, str(ws), _options())
+    assert r.registered == len(SMALL_FRAMES) and r.other_components == [] and not r.unregistered
+    assert r.mean_reprojection_error < 1.0 and r.num_points3d > 300
+    record = json.load(open(ws / "sfm" / "alignment.json"))["escalation"]
+    assert record["reason"].startswith("5 of 5 images not in the main block")
+    first = record["rounds"][0]
+    assert first["sift"]["first_octave"] == -1 and first["kept"] and first["registered_after"] == 5
+    assert sorted(first["re_extracted"]) == sorted(n.replace(".JPG", ".png") for n in SMALL_FRAMES)
+    for n in SMALL_FRAMES:  # per image: why it was escalated, what was done and the outcome
+        one = record["images"][n.replace(".JPG", ".png")]
+        assert one["why"] and one["registered"] is True and one["rounds"] and one["escalated"]
+    assert json.load(open(ws / "workspace.json"))["stages"]["align"]["results"]["escalation_rounds"] >= 1
+
+
+@pytest.mark.slow
+def test_forget_features_empties_only_the_named_images(fast_path):
+    """The fast path's database (features of all five frames, matches): two frames forgotten."""
+    ws, _ = fast_path
+    db = str(ws / "sfm" / "database.db")
+    con = sqlite3.connect(db)
+    names = dict(con.execute("SELECT image_id, name FROM images"))
+    con.close()
+    gone = ["1JI_0064.png", "1JI_0066.png"]
+    forget_features(db, gone)
+    con = sqlite3.connect(db)
+    with_kp = {names[i] for (i,) in con.execute("SELECT image_id FROM keypoints")}
+    with_desc = {names[i] for (i,) in con.execute("SELECT image_id FROM descriptors")}
+    paired = set()
+    for table in ("matches", "two_view_geometries"):
+        for (pid,) in con.execute(f"SELECT pair_id FROM {table}"):
+            paired.update((names[pid // 2147483647], names[pid % 2147483647]))
+    con.close()
+    assert len(names) == 5 and with_kp == with_desc == set(names.values()) - set(gone)
+    assert paired and not paired & set(gone)  # the other frames' pairs are kept
+
+
+@pytest.mark.slow
+def test_mixed_cameras_register_in_one_block(tmp_path):
+    """Issue 13 item 5: Toledo's FC300X and FC350 frames over the same ground, each camera its own intrinsics
+    group, register together into one component."""
+    from tests.conftest import copy_images
+
+    images = copy_images(os.path.join(SAMPLE, "images"), MIXED_FC300X + MIXED_FC350, str(tmp_path / "img"))
+    r = align(images, str(tmp_path / "ws"), AlignOptions(max_image_size=640, max_features=1536))
+    assert r.registered == len(MIXED_FC300X) + len(MIXED_FC350)
+    assert r.other_components == [] and not r.unregistered
+    assert r.mean_reprojection_error < 1.0
+    assert len(r.cameras) == 2  # two intrinsics groups, one per camera
+    ws = json.load(open(tmp_path / "ws" / "workspace.json"))
+    groups = {g["model"]: set(g["images"]) for g in ws["camera_groups"]}
+    assert groups["FC300X"] == set(MIXED_FC300X) and groups["FC350"] == set(MIXED_FC350)
+    model = {c["camera_id"]: c for c in r.cameras}
+    assert {m["width"] for m in model.values()} == {1200}  # the matching scale does not change the camera
