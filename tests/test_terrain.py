@@ -373,7 +373,8 @@ def test_qgis_process_runs_the_terrain_algorithms(scene_dsm, tmp_path):
     # bad input: a clear message, no traceback
     bad = next(p for p, what in _bad_rasters(tmp_path).items() if what == "geographic CRS")
     for alg, args in (("builddtm", [f"DSM={bad}", f"OUTPUT_DTM={tmp_path / 'x.tif'}"]),
-                      ("contours", [f"INPUT={bad}", "INTERVAL=1", f"OUTPUT={tmp_path / 'x.gpkg'}"])):
+                      ("contours", [f"INPUT={bad}", "INTERVAL=1", f"OUTPUT={tmp_path / 'x.gpkg'}"]),
+                      ("reliefvisualisation", [f"INPUT={bad}", f"OUTPUT={tmp_path / 'r.tif'}"])):
         out = run(alg, *args)
         text = out.stdout + out.stderr
         assert out.returncode != 0 and "geographic CRS" in text and bad in text, text[-2000:]
