@@ -324,3 +324,179 @@ def test_far_field_of_an_oblique_is_left_to_the_near_view(tmp_path):
     far = (xs0 > x_limit + 2) & (xs0 < b_lo - 1)
     assert ok0[far].all() and np.all(np.abs(val0[far] - 60) < 1)  # without a limit A's far field is used
     assert float(xa0[oka0].max()) > b_hi  # ... and reaches past B in its own orthophoto
+
+
+# ---------------------------------------------------------------------------
+# the orbit end to end: prepare (sky masks) -> align -> georeference -> DSM -> orthomosaic, against the truth
+# ---------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def orbit_run(orbit, tmp_path_factory):
+    """The 16 orbit images rendered, sky-masked by 'Prepare images', aligned (affine-shape SIFT, the option for
+    oblique sets), georeferenced with 5 control points, matched (full quality) and mosaicked; a few minutes."""
+    import time
+
+    from core.align.options import AlignOptions
+    from core.align.stage import align
+    from core.dense.stage import build_dsm_workspace
+    from core.georef.stage import georeference_workspace
+    from core.ortho.stage import build_orthophoto_workspace
+    from core.prepare.stage import prepare_images_workspace
+
+    root = tmp_path_factory.mktemp("orbit")
+    ws = str(root / "ws")
+    t = {}
+    t0 = time.time()
+    orbit.render(str(root / "photos"))
+    t["render"] = time.time() - t0
+    t0 = time.time()
+    prep = prepare_images_workspace(str(root / "photos"), ws, options=PrepareOptions(sky_masks=True))
+    t["prepare"] = time.time() - t0
+    t0 = time.time()
+    aligned = align(prep.prepared_dir, ws, AlignOptions(pairing="exhaustive", num_threads=2, affine_features=True))
+    t["align"] = time.time() - t0
+    control = orbit.spread_control(5)
+    t0 = time.time()
+    geo = georeference_workspace(ws, gcps=orbit.gcp_set(control, noise_px=0.4))
+    t["georef"] = time.time() - t0
+    t0 = time.time()
+    dsm = build_dsm_workspace(ws, quality="full")
+    t["dsm"] = time.time() - t0
+    t0 = time.time()
+    ortho = build_orthophoto_workspace(ws)
+    t["ortho"] = time.time() - t0
+    print("\n[orbit] " + ", ".join(f"{k} {v:.0f} s" for k, v in t.items())
+          + f"; registered {aligned.registered}/{len(orbit.shots)}, {aligned.num_points3d} points, reprojection "
+          f"{aligned.mean_reprojection_error:.3f} px; sky masks {len(prep.masks)}; DSM {dsm.points} points; "
+          f"mosaic at {ortho.resolution:g} m")
+    return dict(ws=ws, prep=prep, aligned=aligned, geo=geo, dsm=dsm, ortho=ortho, control=control)
+
+
+@pytest.mark.slow
+def test_orbit_sky_masks_before_alignment(orbit, orbit_run):
+    prep = orbit_run["prep"]
+    steep = sorted(n for n, t in orbit.tilts.items() if t == 65.0)
+    assert sorted(os.path.basename(m)[:-4] for m in prep.masks) == steep
+    for m in prep.masks:
+        name = os.path.basename(m)[:-4]
+        assert not (read_keep(m, CAM.width, CAM.height) & orbit.sky_mask(name)).any(), name
+
+
+@pytest.mark.slow
+def test_orbit_every_camera_registered_and_no_sky_tie_point(orbit, orbit_run):
+    from core.align.stage import load_model
+
+    assert orbit_run["aligned"].registered == len(orbit.shots)
+    rec = load_model(orbit_run["ws"])
+    n_kp = n_tie = 0
+    for im in rec.images.values():
+        xy = np.array([p.xy for p in im.points2D])
+        tie = np.array([p.has_point3D() for p in im.points2D])
+        n_kp += len(xy)
+        n_tie += int(tie.sum())
+        in_sky = orbit.in_sky(im.name, xy)
+        assert not in_sky.any(), f"{im.name}: {int(in_sky.sum())} keypoints in the sky"
+        steep = orbit.tilts[im.name] == 65.0
+        if steep:  # the steep views keep tie points on the ground, up to the hazy band below the horizon
+            assert tie.sum() >= 50, im.name
+    print(f"\n{n_kp} keypoints, {n_tie} observations of tie points, none in the sky")
+
+
+@pytest.mark.slow
+def test_orbit_poses_within_the_nadir_tolerances(orbit, orbit_run):
+    """As the vertical block's end-to-end test (tests/test_georef_synthetic.py): 5 control points, check points
+    within 1 GSD (xy) and 1.5 GSD (z), GSD the nominal 40 m / 300 px (the finest these obliques see); the camera
+    centres and attitudes against the truth as well."""
+    from core.project.layout import Layout
+    from core.project.workspace import Workspace
+
+    geo = orbit_run["geo"]
+    gsd = orbit.gsd
+    f = geo.figures
+    print(f"\ncheck points: n={f['CHECK_N']} xy {f['CHECK_RMSE_XY']:.3f} m ({f['CHECK_RMSE_XY'] / gsd:.2f} GSD), "
+          f"z {f['CHECK_RMSE_Z']:.3f} m ({f['CHECK_RMSE_Z'] / gsd:.2f} GSD)")
+    assert f["CHECK_N"] >= 5
+    assert f["CHECK_RMSE_XY"] <= 1.0 * gsd and f["CHECK_RMSE_Z"] <= 1.5 * gsd
+    rec, transform = Layout(Workspace.open(orbit_run["ws"])).load_georef_model()
+    offset = np.asarray(transform["offset"], dtype=float)
+    err = np.array([np.asarray(im.projection_center()) + offset - syn.ORIGIN - orbit.shot(im.name).centre
+                    for im in rec.images.values()])
+    rmse = np.sqrt(np.mean(err ** 2, axis=0))
+    rot = [math.degrees(math.acos(np.clip((np.trace(np.asarray(im.cam_from_world().rotation.matrix())
+                                                    @ orbit.shot(im.name).rotation.T) - 1) / 2, -1, 1)))
+           for im in rec.images.values()]
+    print(f"camera centres: RMSE x {rmse[0]:.3f} y {rmse[1]:.3f} z {rmse[2]:.3f} m; attitude max {max(rot):.3f} deg")
+    # the true ground marks through the adjusted cameras (pose and the intrinsics refined with it: an attitude
+    # off by a few tenths of a degree comes with a principal point that makes up for it) land on their pixels
+    res_px = []
+    for im in rec.images.values():
+        cam = Intrinsics.from_pycolmap(rec.cameras[im.camera_id])
+        m = np.asarray(im.cam_from_world().matrix())
+        for p in orbit.gcps:
+            if im.name in p.observations:
+                px, _ = cam.project((m[:, :3] @ (p.world - offset) + m[:, 3])[None])
+                res_px.append(np.linalg.norm(px[0] - p.observations[im.name]))
+    res_px = np.array(res_px)
+    print(f"true marks reprojected: {len(res_px)} observations, RMS {np.sqrt(np.mean(res_px ** 2)):.3f} px, "
+          f"max {res_px.max():.3f} px")
+    # the centres lie 57-95 m from the site and their height trades off against the focal length: 4 GSD (0.53 m)
+    # is 0.6-0.9 % of that distance
+    assert np.hypot(rmse[0], rmse[1]) <= 2.0 * gsd and float(np.linalg.norm(rmse)) <= 4.0 * gsd
+    assert np.sqrt(np.mean(res_px ** 2)) <= 1.0 and res_px.max() <= 3.0
+
+
+@pytest.mark.slow
+def test_orbit_no_dense_point_from_the_sky(orbit, orbit_run):
+    from core.project.layout import Layout
+    from core.project.workspace import Workspace
+
+    lay = Layout(Workspace.open(orbit_run["ws"]))
+    rec, transform = lay.load_georef_model()
+    shift = np.asarray(transform["offset"], dtype=float) - syn.ORIGIN  # georef local -> synthetic local
+    fused = os.path.join(lay.dense_dir, "fused")
+    total, near = 0, []
+    for f in os.listdir(fused):
+        image_id = int(os.path.splitext(f)[0])
+        with np.load(os.path.join(fused, f)) as d:
+            xyz = d["xyz"].astype(float) + shift
+        shot = orbit.shot(rec.images[image_id].name)
+        ray = xyz - shot.centre
+        elev = np.degrees(np.arcsin(ray[:, 2] / np.linalg.norm(ray, axis=1)))
+        assert elev.max() < -0.5, f"{shot.name}: a dense point {elev.max():.2f} degrees from the horizon"
+        total += len(xyz)
+        near.append(np.abs(xyz[:, 2] - orbit.scene.height_at(xyz[:, 0], xyz[:, 1])))
+    dz = np.concatenate(near)
+    print(f"\n{total} dense points, none from the sky; |dz| median {np.median(dz):.3f} m, 95 % {np.percentile(dz, 95):.3f} m")
+    assert total > 20000
+    assert np.median(dz) < orbit.gsd
+
+
+def _mark_shift(orbit, arr, gt, xw, yw, n=32):
+    """(dx, dy, response) in cells of the mosaic at world (xw, yw) against the scene's true orthoimage (phase
+    correlation of n x n cells, as tests/test_ortho.py measures them); None near nodata."""
+    c, r = int((xw - gt[0]) / gt[1]), int((yw - gt[3]) / gt[5])
+    r0, c0 = r - n // 2, c - n // 2
+    if r0 < 0 or c0 < 0 or r0 + n > arr.shape[1] or c0 + n > arr.shape[2] or (arr[-1, r0:r0 + n, c0:c0 + n] == 0).mean() > 0.05:
+        return None
+    xs = gt[0] + (c0 + np.arange(n) + 0.5) * gt[1] - syn.ORIGIN[0]
+    ys = gt[3] + (r0 + np.arange(n) + 0.5) * gt[5] - syn.ORIGIN[1]
+    x, y = np.meshgrid(xs, ys)
+    truth = syn._sample(orbit.scene.texture_raster(), *orbit.scene.raster_coords(x, y, orbit.scene.texture_res))
+    grey = arr[:3, r0:r0 + n, c0:c0 + n].mean(axis=0)
+    win = cv2.createHanningWindow((n, n), cv2.CV_64F)
+    (dx, dy), resp = cv2.phaseCorrelate(truth.astype(np.float64), grey.astype(np.float64), win)
+    return dx, dy, resp
+
+
+@pytest.mark.slow
+def test_orbit_mosaic_ground_marks_within_one_and_a_half_gsd(orbit, orbit_run):
+    ortho = orbit_run["ortho"]
+    ds = gdal.Open(ortho.orthomosaic)
+    arr = ds.ReadAsArray().astype(np.float32)
+    gt = ds.GetGeoTransform()
+    marks = [_mark_shift(orbit, arr, gt, *p.world[:2]) for p in orbit.gcps if p.kind == "ground"]
+    marks = np.array([m for m in marks if m and m[2] > 0.2])
+    assert len(marks) >= 8, marks
+    rmse = float(np.sqrt(np.mean(marks[:, 0] ** 2 + marks[:, 1] ** 2))) * gt[1]
+    print(f"\nground marks: {len(marks)}, RMSE {rmse:.3f} m = {rmse / orbit.gsd:.2f} GSD (cells of {gt[1]:g} m)")
+    assert rmse <= 1.5 * orbit.gsd
