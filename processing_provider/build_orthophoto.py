@@ -23,6 +23,7 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
     RESOLUTION = "RESOLUTION"
     BLENDING = "BLENDING"
     INTERPOLATION = "INTERPOLATION"
+    GSD_FACTOR = "GSD_FACTOR"
     WORKERS = "WORKERS"
     SCHEDULER = "DASK_SCHEDULER"
     OUTPUT = "OUTPUT"
@@ -70,6 +71,9 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
             params.blending(self.BLENDING, self.tr("Seam blending")),
             *params.advanced(
                 params.choice(self.INTERPOLATION, self.tr("Resampling"), self.INTERPOLATIONS),
+                params.number(self.GSD_FACTOR, self.tr(
+                    "Use each image only where its ground resolution is within this factor of its best "
+                    "(0 = no limit)"), default=3.0),
                 params.workers(self.WORKERS, self.tr("Parallel tile workers"), default=1),
                 params.scheduler(self.SCHEDULER, self.tr("Dask scheduler"))),
         )
@@ -103,6 +107,7 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
                 seamlines))
         options = OrthoOptions(
             interpolation=params.read_choice(self, parameters, self.INTERPOLATION, context, self.INTERPOLATIONS),
+            gsd_factor=self.parameterAsDouble(parameters, self.GSD_FACTOR, context),
             workers=self.parameterAsInt(parameters, self.WORKERS, context),
             scheduler=params.read_scheduler(self, parameters, self.SCHEDULER, context))
         progress = FeedbackProgress(feedback)

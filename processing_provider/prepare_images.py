@@ -30,6 +30,7 @@ class PrepareImagesAlgorithm(AlgorithmBase):
     BLUR_THRESHOLD = "BLUR_THRESHOLD"
     BLUR_RELATIVE = "BLUR_RELATIVE"
     EXCLUDE_FLAGGED = "EXCLUDE_FLAGGED"
+    SKY_MASKS = "SKY_MASKS"
     MASKS = "MASKS"
     SCANNED_FILM = "SCANNED_FILM"
     FIDUCIAL_COORDINATES = "FIDUCIAL_COORDINATES"
@@ -86,6 +87,8 @@ class PrepareImagesAlgorithm(AlgorithmBase):
         self.addParameter(QgsProcessingParameterFeatureSource(
             self.MASKS, self.tr("Mask polygons: areas to ignore, in pixel coordinates (optional text field 'image')"),
             [QgsProcessing.SourceType.TypeVectorPolygon], optional=True))
+        self.addParameter(params.flag(self.SKY_MASKS, self.tr(
+            "Sky masks: hide the sky and the horizon of oblique photos from the alignment")))
         self.addParameter(params.flag(self.SCANNED_FILM, self.tr("Scanned film: fiducial marks, common frame, masks")))
         self.addParameter(QgsProcessingParameterString(
             self.FIDUCIAL_COORDINATES, self.tr("Calibrated fiducial coordinates in mm (file path or text)"),
@@ -127,6 +130,7 @@ class PrepareImagesAlgorithm(AlgorithmBase):
                 exclude_flagged=self.parameterAsBoolean(parameters, self.EXCLUDE_FLAGGED, context),
             ),
             scanned_film=scanned,
+            sky_masks=self.parameterAsBoolean(parameters, self.SKY_MASKS, context),
             scan=ScanOptions(
                 fiducial_type=params.read_choice(self, parameters, self.FIDUCIAL_TYPE, context, FIDUCIAL_TYPES),
                 layout=params.read_choice(self, parameters, self.FIDUCIAL_LAYOUT, context, FIDUCIAL_LAYOUTS),

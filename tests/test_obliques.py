@@ -194,6 +194,32 @@ def test_prepare_stage_writes_sky_masks(two_renders, tmp_path):
     assert not res2.masks
 
 
+@pytest.fixture(scope="module")
+def plugin(qgis_iface, qgis_processing):
+    import archaeoortho
+
+    p = archaeoortho.classFactory(qgis_iface)
+    p.initProcessing()
+    yield p
+    p.unload()
+
+
+def test_processing_exposes_sky_masks_and_the_gsd_factor(plugin, two_renders, tmp_path):
+    from qgis import processing
+    from qgis.core import QgsApplication
+
+    ortho = QgsApplication.processingRegistry().algorithmById("archaeoortho:buildorthophoto")
+    assert ortho.parameterDefinition("GSD_FACTOR").defaultValue() == OrthoOptions().gsd_factor == 3.0
+    steep, mild, paths = two_renders
+    images = str(tmp_path / "images")
+    os.makedirs(images)
+    for p in paths.values():
+        os.link(p, os.path.join(images, os.path.basename(p)))
+    res = processing.run("archaeoortho:prepareimages", {"IMAGES": images, "WORKSPACE": str(tmp_path / "ws"),
+                                                         "SKY_MASKS": True})
+    assert os.listdir(os.path.join(res["WORKSPACE"], "masks")) == [steep.name + ".png"]
+
+
 # ---------------------------------------------------------------------------
 # dense matching: nothing from the sky
 # ---------------------------------------------------------------------------
