@@ -10,8 +10,9 @@ PLUGIN_DIR = os.path.dirname(__file__)
 def _locale() -> str:
     """The two-letter language QGIS runs in, read the way QGIS applies it (call it when the plugin is set up,
     not at import): the override of Options > General (``locale/overrideFlag`` + ``locale/userLocale``), else
-    the translation QGIS installed at start (``qgis --lang de`` sets it, QgsApplication.translation()), else
-    ``locale/userLocale`` (QGIS writes it at every start, from --lang or the system), else the system's."""
+    the translation QGIS installed at start (``qgis --lang de`` sets it, QgsApplication.translation()), else (no
+    QGIS desktop: qgis_process, a script) QgsApplication.locale(), the system's language.  A ``locale/userLocale``
+    that ``qgis --lang`` left in the profile does not switch later headless runs."""
     settings = QSettings()
     override = str(settings.value("locale/overrideFlag", False)).lower() in ("true", "1")
     value = str(settings.value("locale/userLocale", "") or "") if override else ""
@@ -21,8 +22,6 @@ def _locale() -> str:
             value = app.translation() if isinstance(app, QgsApplication) else ""
         except Exception:  # noqa: BLE001 - no QgsApplication yet
             value = ""
-    if not value:
-        value = str(settings.value("locale/userLocale", "") or "")
     if not value:
         try:
             value = QgsApplication.locale()

@@ -202,17 +202,17 @@ Rekonstruktionsverfahren (erweitert): 'incremental' (COLMAP, Standard) oder 'glo
 <context>
     <name>ArchaeoOrthoPlugin</name>
     <message>
-        <location filename="../plugin.py" line="115"/>
+        <location filename="../plugin.py" line="114"/>
         <source>Ground control (GCP dock)</source>
         <translation>Passpunkte (GCP-Fenster)</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="119"/>
+        <location filename="../plugin.py" line="118"/>
         <source>ArchaeoOrtho: pick ground control points on the map and in the photos</source>
         <translation>ArchaeoOrtho: Passpunkte auf der Karte und in den Fotos messen</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="181"/>
+        <location filename="../plugin.py" line="180"/>
         <source>&amp;ArchaeoOrtho</source>
         <translation>&amp;ArchaeoOrtho</translation>
     </message>
@@ -429,22 +429,22 @@ DGM: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/dtm.tif).</translatio
 <context>
     <name>BuildOrthophotoAlgorithm</name>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="84"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="88"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="85"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="89"/>
         <source>Share of mosaic cells with data</source>
         <translation>Anteil der Mosaikzellen mit Daten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="86"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="90"/>
         <source>Resolution used</source>
         <translation>Verwendete Auflösung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="87"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="91"/>
         <source>Images in the mosaic</source>
         <translation>Bilder im Mosaik</translation>
     </message>
@@ -454,62 +454,62 @@ DGM: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/dtm.tif).</translatio
         <translation>Orthophoto erzeugen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>Georeferenced workspace</source>
         <translation>Georeferenzierter Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>Images</source>
         <translation>Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>Resolution</source>
         <translation>Auflösung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>Seam blending</source>
         <translation>Überblendung der Nähte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>Resampling</source>
         <translation>Resampling</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>Parallel tile workers</source>
         <translation>Parallele Kachel-Prozesse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>Dask scheduler</source>
         <translation>Dask-Scheduler</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="76"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="80"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="83"/>
         <source>Per-image orthophotos folder</source>
         <translation>Ordner für Einzelbild-Orthophotos</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="82"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="86"/>
         <source>Seamlines</source>
         <translation>Nahtlinien</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="102"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="106"/>
         <source>Seamlines must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>Nahtlinien müssen eine GeoPackage-Datei (.gpkg) sein, erhalten: {}</translation>
     </message>
@@ -541,6 +541,11 @@ Orthomosaik: Cloud-Optimized GeoTIFF mit Übersichten, den Kanälen und dem Date
 Ordner für Einzelbild-Orthophotos: optionaler Ordner für ein wahres Orthophoto je Bild (COG).
 Nahtlinien: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem jeder Teil des Mosaiks stammt.
 Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786) rechnen, dessen Worker den Pfad des Arbeitsbereichs sehen; leer = dieser Rechner, oder $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <source>Use each image only where its ground resolution is within this factor of its best (0 = no limit)</source>
+        <translation>Jedes Bild nur dort verwenden, wo seine Bodenauflösung höchstens dieses Vielfache seiner besten ist (0 = keine Grenze)</translation>
     </message>
 </context>
 <context>
@@ -587,37 +592,37 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>ArchaeoOrtho Passpunkte</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="92"/>
+        <location filename="../ui/gcp_dock.py" line="91"/>
         <source>ArchaeoOrtho photos</source>
         <translation>ArchaeoOrtho Fotos</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="141"/>
+        <location filename="../ui/gcp_dock.py" line="140"/>
         <source>Workspace:</source>
         <translation>Arbeitsbereich:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="348"/>
+        <location filename="../ui/gcp_dock.py" line="347"/>
         <source>none open</source>
         <translation>keiner geöffnet</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="148"/>
+        <location filename="../ui/gcp_dock.py" line="147"/>
         <source>Open a workspace folder (made by Align images)</source>
         <translation>Einen Arbeitsbereich-Ordner öffnen (von 'Bilder ausrichten' angelegt)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="150"/>
+        <location filename="../ui/gcp_dock.py" line="149"/>
         <source>Choose a folder of photos and a workspace folder, and align the photos</source>
         <translation>Einen Fotoordner und einen Arbeitsbereich-Ordner wählen und die Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="157"/>
+        <location filename="../ui/gcp_dock.py" line="156"/>
         <source>Heights (Z) from:</source>
         <translation>Höhen (Z) aus:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="162"/>
+        <location filename="../ui/gcp_dock.py" line="161"/>
         <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
         <translation>Ein DOM- oder DGM-Rasterlayer (z. B. ein ALS-DOM): ein auf der Karte gemessener Punkt erhält seine Höhe daraus (bilinear). Leer: Z von Hand eingeben.</translation>
     </message>
@@ -627,27 +632,27 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="177"/>
+        <location filename="../ui/gcp_dock.py" line="176"/>
         <source>Add a ground point</source>
         <translation>Einen Passpunkt hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="178"/>
+        <location filename="../ui/gcp_dock.py" line="177"/>
         <source>Remove</source>
         <translation>Entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="179"/>
+        <location filename="../ui/gcp_dock.py" line="178"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Den gewählten Passpunkt mit seinen Messungen entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="190"/>
+        <location filename="../ui/gcp_placement.py" line="194"/>
         <source>Pick on map</source>
         <translation>Auf der Karte messen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="182"/>
+        <location filename="../ui/gcp_dock.py" line="181"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>In die Kartenansicht klicken, um X und Y des gewählten Punkts zu setzen (Z aus dem Höhenlayer)</translation>
     </message>
@@ -657,97 +662,97 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="190"/>
+        <location filename="../ui/gcp_dock.py" line="189"/>
         <source>Export</source>
         <translation>Exportieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="205"/>
+        <location filename="../ui/gcp_dock.py" line="204"/>
         <source>Undo</source>
         <translation>Rückgängig</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="206"/>
+        <location filename="../ui/gcp_dock.py" line="205"/>
         <source>Redo</source>
         <translation>Wiederholen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="216"/>
+        <location filename="../ui/gcp_dock.py" line="215"/>
         <source>Undo: {}</source>
         <translation>Rückgängig: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="218"/>
+        <location filename="../ui/gcp_dock.py" line="217"/>
         <source>Redo: {}</source>
         <translation>Wiederholen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="197"/>
+        <location filename="../ui/gcp_dock.py" line="196"/>
         <source>Load results</source>
         <translation>Ergebnisse laden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="198"/>
+        <location filename="../ui/gcp_dock.py" line="197"/>
         <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Die Produkte des Arbeitsbereichs als gestaltete Layer zur Karte hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="250"/>
+        <location filename="../ui/gcp_dock.py" line="249"/>
         <source>Residual tolerance:</source>
         <translation>Residuen-Toleranz:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="256"/>
+        <location filename="../ui/gcp_dock.py" line="255"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="265"/>
+        <location filename="../ui/gcp_dock.py" line="264"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="266"/>
+        <location filename="../ui/gcp_dock.py" line="265"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Die Ausgleichung Brennweite, Bildhauptpunkt und Verzeichnung verfeinern lassen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="273"/>
+        <location filename="../ui/gcp_dock.py" line="272"/>
         <source>Georeference</source>
         <translation>Georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="274"/>
+        <location filename="../ui/gcp_dock.py" line="273"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Die Ausgleichung mit diesen Punkten ausführen (im Hintergrund)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="275"/>
+        <location filename="../ui/gcp_dock.py" line="274"/>
         <source>Cancel</source>
         <translation>Abbrechen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="325"/>
+        <location filename="../ui/gcp_dock.py" line="324"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="332"/>
+        <location filename="../ui/gcp_dock.py" line="331"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Einen ArchaeoOrtho-Arbeitsbereich öffnen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="378"/>
+        <location filename="../ui/gcp_dock.py" line="377"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} Fotos; der Block ist noch nicht ausgerichtet: 'Bilder ausrichten' (oder 'Neu aus Fotos') ausführen, um vorhergesagte Positionen zu erhalten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="381"/>
+        <location filename="../ui/gcp_dock.py" line="380"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} Fotos, {} Passpunkte. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="278"/>
+        <location filename="../ui/gcp_placement.py" line="282"/>
         <source>no predicted positions: {}</source>
         <translation>keine vorhergesagten Positionen: {}</translation>
     </message>
@@ -782,82 +787,82 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>ArchaeoOrtho: Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="511"/>
+        <location filename="../ui/gcp_dock.py" line="518"/>
         <source>CRS: {}</source>
         <translation>KBS: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="114"/>
+        <location filename="../ui/gcp_placement.py" line="118"/>
         <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Auf der Karte an die Position des gewählten Punkts klicken (Esc beendet)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="178"/>
+        <location filename="../ui/gcp_placement.py" line="182"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (aus {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="181"/>
+        <location filename="../ui/gcp_placement.py" line="185"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Keine Höhe an dieser Stelle in {}: Z bleibt unverändert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="184"/>
+        <location filename="../ui/gcp_placement.py" line="188"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="390"/>
+        <location filename="../ui/gcp_placement.py" line="394"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="392"/>
+        <location filename="../ui/gcp_placement.py" line="396"/>
         <source>predicted</source>
         <translation>vorhergesagt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="415"/>
+        <location filename="../ui/gcp_placement.py" line="419"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Einen Passpunkt in der Tabelle wählen oder hinzufügen, dann im Foto darauf klicken.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="422"/>
+        <location filename="../ui/gcp_placement.py" line="426"/>
         <source>from the point&apos;s other observations</source>
         <translation>aus den übrigen Messungen des Punkts</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="423"/>
+        <location filename="../ui/gcp_placement.py" line="427"/>
         <source>from the georeferenced block</source>
         <translation>aus dem georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="424"/>
+        <location filename="../ui/gcp_placement.py" line="428"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>aus den bereits gemessenen Punkten (Ähnlichkeitstransformation)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="435"/>
+        <location filename="../ui/gcp_placement.py" line="439"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Gemessen bei x {:.2f}, y {:.2f}. Klicken zum Versetzen, ziehen oder Entf zum Entfernen.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="438"/>
+        <location filename="../ui/gcp_placement.py" line="442"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Vorhergesagt {}. Eingabetaste übernimmt und geht weiter (Leertaste: übernehmen), ziehen oder dorthin klicken, wo der Punkt wirklich ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="450"/>
+        <location filename="../ui/gcp_placement.py" line="454"/>
         <source>Click where {} is in this photo.</source>
         <translation>Dorthin klicken, wo {} in diesem Foto ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="470"/>
+        <location filename="../ui/gcp_placement.py" line="474"/>
         <source>Select or add a ground point first</source>
         <translation>Zuerst einen Passpunkt wählen oder hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="517"/>
+        <location filename="../ui/gcp_placement.py" line="521"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: jedes Foto, das ihn voraussichtlich zeigt, hat eine Messung</translation>
     </message>
@@ -1042,42 +1047,42 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>seither bearbeitet: erneut ausführen zum Aktualisieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="425"/>
+        <location filename="../ui/gcp_placement.py" line="429"/>
         <source>by matching its look in another photo</source>
         <translation>durch Abgleich mit seinem Aussehen in einem anderen Foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="429"/>
+        <location filename="../ui/gcp_placement.py" line="433"/>
         <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
         <translation>(Korrelation {:.2f}, {:.0f} px von der geometrischen Vorhersage)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="147"/>
+        <location filename="../ui/gcp_dock.py" line="146"/>
         <source>Open…</source>
         <translation>Öffnen…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="149"/>
+        <location filename="../ui/gcp_dock.py" line="148"/>
         <source>New from photos…</source>
         <translation>Neu aus Fotos…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="185"/>
+        <location filename="../ui/gcp_dock.py" line="184"/>
         <source>From file (gcp_list.txt, CSV)…</source>
         <translation>Aus Datei (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="186"/>
+        <location filename="../ui/gcp_dock.py" line="185"/>
         <source>From a point layer…</source>
         <translation>Aus einem Punktlayer…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="188"/>
+        <location filename="../ui/gcp_dock.py" line="187"/>
         <source>To file (gcp_list.txt, CSV)…</source>
         <translation>In Datei (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="189"/>
+        <location filename="../ui/gcp_dock.py" line="188"/>
         <source>To a GeoPackage layer…</source>
         <translation>In einen GeoPackage-Layer…</translation>
     </message>
@@ -1122,77 +1127,77 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot. Jetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="94"/>
+        <location filename="../ui/gcp_placement.py" line="92"/>
         <source>Diagnosis of the adjustment:</source>
         <translation>Diagnose der Ausgleichung:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="169"/>
+        <location filename="../ui/gcp_placement.py" line="173"/>
         <source>Moved {:.2f} m (Undo: Ctrl+Z).</source>
         <translation>Um {:.2f} m verschoben (Rückgängig: Strg+Z).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="392"/>
+        <location filename="../ui/gcp_placement.py" line="396"/>
         <source>near the edge</source>
         <translation>nahe am Rand</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="441"/>
+        <location filename="../ui/gcp_placement.py" line="445"/>
         <source>{} is predicted where it cannot be placed: {}. Click where the point is if you see it, or press Enter for the next photo.</source>
         <translation>{} wird dort vorhergesagt, wo er nicht gesetzt werden kann: {}. Klicken Sie auf den Punkt, wenn Sie ihn sehen, oder drücken Sie die Eingabetaste für das nächste Foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="447"/>
+        <location filename="../ui/gcp_placement.py" line="451"/>
         <source>Click where {} is in this photo, or use Pick on map (or type X, Y, Z in the table) to have it predicted in the photos.</source>
         <translation>Klicken Sie in diesem Foto auf {}, oder nutzen Sie „Auf der Karte messen“ (oder geben Sie X, Y, Z in der Tabelle ein), damit er in den Fotos vorhergesagt wird.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="460"/>
+        <location filename="../ui/gcp_placement.py" line="464"/>
         <source>{}: the workspace has no photos to place it in.</source>
         <translation>{}: der Arbeitsbereich hat keine Fotos, in denen er gesetzt werden kann.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="462"/>
+        <location filename="../ui/gcp_placement.py" line="466"/>
         <source>{} is selected: use Pick on map or type X, Y, Z in the table, or choose a photo in the strip below and click on the point.</source>
         <translation>{} ist ausgewählt: nutzen Sie „Auf der Karte messen“ oder geben Sie X, Y, Z in der Tabelle ein, oder wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="464"/>
+        <location filename="../ui/gcp_placement.py" line="468"/>
         <source>{} is selected: choose a photo in the strip below and click on the point.</source>
         <translation>{} ist ausgewählt: wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="213"/>
+        <location filename="../ui/gcp_dock.py" line="212"/>
         <source>Undo (Ctrl+Z)</source>
         <translation>Rückgängig (Strg+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="213"/>
+        <location filename="../ui/gcp_dock.py" line="212"/>
         <source>Redo (Ctrl+Shift+Z)</source>
         <translation>Wiederholen (Strg+Umschalt+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="399"/>
+        <location filename="../ui/gcp_dock.py" line="398"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px.</source>
         <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="404"/>
+        <location filename="../ui/gcp_dock.py" line="403"/>
         <source>Not aligned ({}): {}</source>
         <translation>Nicht ausgerichtet ({}): {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="405"/>
+        <location filename="../ui/gcp_dock.py" line="404"/>
         <source>(marked in the photo strip; hover for the reason)</source>
         <translation>(in der Fotoleiste markiert; der Grund steht im Tooltip)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="424"/>
+        <location filename="../ui/gcp_dock.py" line="423"/>
         <source>✗ not aligned</source>
         <translation>✗ nicht ausgerichtet</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="425"/>
+        <location filename="../ui/gcp_dock.py" line="424"/>
         <source>{}: not aligned: {}</source>
         <translation>{}: nicht ausgerichtet: {}</translation>
     </message>
@@ -1202,32 +1207,32 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Nicht ausgerichtet: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="136"/>
+        <location filename="../ui/gcp_placement.py" line="140"/>
         <source>pick on map</source>
         <translation>auf der Karte messen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="427"/>
+        <location filename="../ui/gcp_placement.py" line="431"/>
         <source>(no Z yet: at the height of the block&apos;s tie points)</source>
         <translation>(noch kein Z: auf der Höhe der Verknüpfungspunkte des Blocks)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="161"/>
+        <location filename="../ui/gcp_placement.py" line="165"/>
         <source>{} not moved</source>
         <translation>{} nicht verschoben</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="190"/>
+        <location filename="../ui/gcp_placement.py" line="194"/>
         <source>{} is placed in {} photos. Move it {:.2f} m to the picked position, or add a new point there?</source>
         <translation>{} ist in {} Fotos gesetzt. Um {:.2f} m an die gemessene Position verschieben, oder dort einen neuen Punkt anlegen?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="194"/>
+        <location filename="../ui/gcp_placement.py" line="198"/>
         <source>Move {}</source>
         <translation>{} verschieben</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="195"/>
+        <location filename="../ui/gcp_placement.py" line="199"/>
         <source>New point</source>
         <translation>Neuer Punkt</translation>
     </message>
@@ -1757,12 +1762,12 @@ RESIDUALS: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in
         <translation>Die Messung in diesem Foto entfernen (Entf)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="651"/>
+        <location filename="../ui/photo_viewer.py" line="653"/>
         <source>{} (predicted)</source>
         <translation>{} (vorhergesagt)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="563"/>
+        <location filename="../ui/photo_viewer.py" line="565"/>
         <source>Shown upright (EXIF orientation {}: stored {} x {} px); pixel coordinates are those of the stored grid, as COLMAP and gcp_list.txt use them</source>
         <translation>Aufrecht gezeigt (EXIF-Ausrichtung {}: gespeichert {} x {} px); die Pixelkoordinaten sind die des gespeicherten Rasters, wie COLMAP und gcp_list.txt sie verwenden</translation>
     </message>
@@ -1770,102 +1775,102 @@ RESIDUALS: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in
 <context>
     <name>PrepareImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="79"/>
+        <location filename="../processing_provider/prepare_images.py" line="80"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="79"/>
+        <location filename="../processing_provider/prepare_images.py" line="80"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="79"/>
+        <location filename="../processing_provider/prepare_images.py" line="80"/>
         <source>Smallest blur score (0 = only relative to the set)</source>
         <translation>Kleinster Schärfewert (0 = nur relativ zum Satz)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="79"/>
+        <location filename="../processing_provider/prepare_images.py" line="80"/>
         <source>Leave flagged images out of the prepared folder</source>
         <translation>Markierte Bilder aus dem vorbereiteten Ordner weglassen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="89"/>
+        <location filename="../processing_provider/prepare_images.py" line="92"/>
         <source>Scanned film: fiducial marks, common frame, masks</source>
         <translation>Gescannter Film: Rahmenmarken, gemeinsamer Rahmen, Masken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="90"/>
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
         <source>Calibrated fiducial coordinates in mm (file path or text)</source>
         <translation>Kalibrierte Rahmenmarken-Koordinaten in mm (Dateipfad oder Text)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Calibrated focal length in mm (0 = unknown)</source>
         <translation>Kalibrierte Brennweite in mm (0 = unbekannt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Flag images below this fraction of the set&apos;s median blur score</source>
         <translation>Bilder unter diesem Bruchteil des mittleren Schärfewerts des Satzes markieren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Fiducial mark type</source>
         <translation>Art der Rahmenmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Fiducial positions</source>
         <translation>Lage der Rahmenmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Template image of one fiducial mark</source>
         <translation>Vorlagenbild einer Rahmenmarke</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Scan resolution in dpi when not in the files (0 = from the files)</source>
         <translation>Scanauflösung in dpi, wenn nicht in den Dateien (0 = aus den Dateien)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="106"/>
+        <location filename="../processing_provider/prepare_images.py" line="109"/>
         <source>Prepared images (skipped: &lt;workspace&gt;/prepared)</source>
         <translation>Vorbereitete Bilder (ausgelassen: &lt;workspace&gt;/prepared)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="109"/>
+        <location filename="../processing_provider/prepare_images.py" line="112"/>
         <source>Folder of prepared images</source>
         <translation>Ordner der vorbereiteten Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="110"/>
+        <location filename="../processing_provider/prepare_images.py" line="113"/>
         <source>Flagged images</source>
         <translation>Markierte Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="111"/>
+        <location filename="../processing_provider/prepare_images.py" line="114"/>
         <source>Excluded images</source>
         <translation>Ausgeschlossene Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="112"/>
+        <location filename="../processing_provider/prepare_images.py" line="115"/>
         <source>Screening record (JSON)</source>
         <translation>Prüfprotokoll (JSON)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="148"/>
+        <location filename="../processing_provider/prepare_images.py" line="152"/>
         <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
         <translation>{} Bilder: {} markiert, {} ausgeschlossen, {} im vorbereiteten Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="150"/>
+        <location filename="../processing_provider/prepare_images.py" line="154"/>
         <source>Blurriest first (blur score, % of the set&apos;s median):</source>
         <translation>Unschärfste zuerst (Schärfewert, % des Medians des Satzes):</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="158"/>
+        <location filename="../processing_provider/prepare_images.py" line="162"/>
         <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
         <translation>Vorbereitete Scans: {} x {} px, Pixelgröße {:.6g} {}{}</translation>
     </message>
@@ -1875,27 +1880,27 @@ RESIDUALS: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in
         <translation>Bilder vorbereiten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="86"/>
+        <location filename="../processing_provider/prepare_images.py" line="87"/>
         <source>Mask polygons: areas to ignore, in pixel coordinates (optional text field &apos;image&apos;)</source>
         <translation>Maskenpolygone: zu ignorierende Bereiche in Pixelkoordinaten (optionales Textfeld 'image')</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="143"/>
+        <location filename="../processing_provider/prepare_images.py" line="147"/>
         <source>MASKS layer &apos;{}&apos;</source>
         <translation>MASKS-Layer '{}'</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="178"/>
+        <location filename="../processing_provider/prepare_images.py" line="182"/>
         <source>feature {}</source>
         <translation>Objekt {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="182"/>
+        <location filename="../processing_provider/prepare_images.py" line="186"/>
         <source>MASKS layer &apos;{}&apos;: {} has no geometry: skipped</source>
         <translation>MASKS-Layer '{}': {} hat keine Geometrie: übersprungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="185"/>
+        <location filename="../processing_provider/prepare_images.py" line="189"/>
         <source>MASKS layer &apos;{}&apos;: {} is a {} geometry, not a polygon</source>
         <translation>MASKS-Layer '{}': {} ist eine {}-Geometrie, kein Polygon</translation>
     </message>
@@ -1921,6 +1926,11 @@ MASKS: optionaler Polygon-Layer mit zu ignorierenden Bereichen (ein Ausleger, de
 SCANNED_FILM: Rahmenmarken (Kreuze, Punkte, Punkte in Kreisen; in den Ecken und/oder Seitenmitten, oder wie ein Vorlagenbild einer Marke) werden auf Bruchteile eines Pixels gefunden, jeder Scan wird durch eine affine Transformation in den gemeinsamen Rahmenmarken-Rahmen umgerechnet, alle gleich groß und mit dem Bildhauptpunkt in der Mitte, und Masken (workspace/masks) verbergen Filmrand, Datenstreifen und die Marken vor der Zuordnung. FIDUCIAL_COORDINATES: die Rahmenmarken-Koordinaten des Kalibrierzertifikats in mm, als Datei oder eingefügter Text, eine Zeile 'id x y' je Marke (x nach rechts, y nach oben), optional 'PP x y' (Bildhauptpunkt) und 'focal f'. Ohne sie wird die mittlere Anordnung des Satzes verwendet, zentriert auf die Rahmenmitte. Mit FOCAL_LENGTH_MM (oder 'focal' im Zertifikat) tragen die vorbereiteten Bilder die Brennweite in Pixeln für die Ausrichtung.
 
 OUTPUT: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetzt; er muss neu, leer oder von einem früheren Lauf geschrieben sein); wenn ausgelassen, &lt;workspace&gt;/prepared.</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="90"/>
+        <source>Sky masks: hide the sky and the horizon of oblique photos from the alignment</source>
+        <translation>Himmelsmasken: Himmel und Horizont von Schrägaufnahmen vor der Ausrichtung verbergen</translation>
     </message>
 </context>
 <context>
@@ -2016,62 +2026,62 @@ Ausgabe: wohin sie geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/relief/&
         <translation>nicht trianguliert</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="704"/>
+        <location filename="../ui/layers.py" line="701"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="663"/>
+        <location filename="../ui/layers.py" line="660"/>
         <source>DSM hillshade</source>
         <translation>DOM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="705"/>
+        <location filename="../ui/layers.py" line="702"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="706"/>
+        <location filename="../ui/layers.py" line="703"/>
         <source>Cameras</source>
         <translation>Kameras</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="674"/>
+        <location filename="../ui/layers.py" line="671"/>
         <source>Camera footprints</source>
         <translation>Bildfußabdrücke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="681"/>
+        <location filename="../ui/layers.py" line="678"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Passpunkt-Residuen (Vektoren x{})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="707"/>
+        <location filename="../ui/layers.py" line="704"/>
         <source>Point cloud</source>
         <translation>Punktwolke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="715"/>
+        <location filename="../ui/layers.py" line="712"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="386"/>
+        <location filename="../ui/layers.py" line="383"/>
         <source>{} ({})</source>
         <translation>{} ({})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="708"/>
+        <location filename="../ui/layers.py" line="705"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="688"/>
+        <location filename="../ui/layers.py" line="685"/>
         <source>DTM hillshade</source>
         <translation>DGM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="709"/>
+        <location filename="../ui/layers.py" line="706"/>
         <source>Contours</source>
         <translation>Höhenlinien</translation>
     </message>

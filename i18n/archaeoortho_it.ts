@@ -202,17 +202,17 @@ Metodo di ricostruzione (avanzato): 'incremental' (COLMAP, predefinito) o 'globa
 <context>
     <name>ArchaeoOrthoPlugin</name>
     <message>
-        <location filename="../plugin.py" line="115"/>
+        <location filename="../plugin.py" line="114"/>
         <source>Ground control (GCP dock)</source>
         <translation>Punti d'appoggio (pannello GCP)</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="119"/>
+        <location filename="../plugin.py" line="118"/>
         <source>ArchaeoOrtho: pick ground control points on the map and in the photos</source>
         <translation>ArchaeoOrtho: misura i punti d'appoggio sulla mappa e nelle foto</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="181"/>
+        <location filename="../plugin.py" line="180"/>
         <source>&amp;ArchaeoOrtho</source>
         <translation>&amp;ArchaeoOrtho</translation>
     </message>
@@ -429,22 +429,22 @@ DTM: dove scriverlo (predefinito: &lt;workspace&gt;/dtm.tif).</translation>
 <context>
     <name>BuildOrthophotoAlgorithm</name>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="84"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="88"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="85"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="89"/>
         <source>Share of mosaic cells with data</source>
         <translation>Frazione delle celle del mosaico con dati</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="86"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="90"/>
         <source>Resolution used</source>
         <translation>Risoluzione usata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="87"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="91"/>
         <source>Images in the mosaic</source>
         <translation>Immagini nel mosaico</translation>
     </message>
@@ -454,62 +454,62 @@ DTM: dove scriverlo (predefinito: &lt;workspace&gt;/dtm.tif).</translation>
         <translation>Genera ortofoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>Georeferenced workspace</source>
         <translation>Area di lavoro georeferenziata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>Images</source>
         <translation>Immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>Resolution</source>
         <translation>Risoluzione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>Seam blending</source>
         <translation>Sfumatura delle giunzioni</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>Resampling</source>
         <translation>Ricampionamento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>Parallel tile workers</source>
         <translation>Processi paralleli per tessera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="62"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
         <source>Dask scheduler</source>
         <translation>Scheduler Dask</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="76"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="80"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="83"/>
         <source>Per-image orthophotos folder</source>
         <translation>Cartella delle ortofoto per immagine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="82"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="86"/>
         <source>Seamlines</source>
         <translation>Linee di giunzione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="102"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="106"/>
         <source>Seamlines must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>Le linee di giunzione devono essere un file GeoPackage (.gpkg), ricevuto {}</translation>
     </message>
@@ -541,6 +541,11 @@ Ortomosaico: Cloud-Optimized GeoTIFF con panoramiche, le bande e il tipo di dato
 Cartella delle ortofoto per immagine: cartella facoltativa per un'ortofoto vera per immagine (COG).
 Linee di giunzione: GeoPackage facoltativo di poligoni che indicano l'immagine da cui proviene ogni parte del mosaico.
 Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:8786) i cui worker vedono il percorso dell'area di lavoro; vuoto = questo computer, oppure $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <source>Use each image only where its ground resolution is within this factor of its best (0 = no limit)</source>
+        <translation>Usa ogni immagine solo dove la sua risoluzione al suolo è entro questo fattore della migliore (0 = nessun limite)</translation>
     </message>
 </context>
 <context>
@@ -587,37 +592,37 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>ArchaeoOrtho punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="92"/>
+        <location filename="../ui/gcp_dock.py" line="91"/>
         <source>ArchaeoOrtho photos</source>
         <translation>ArchaeoOrtho foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="141"/>
+        <location filename="../ui/gcp_dock.py" line="140"/>
         <source>Workspace:</source>
         <translation>Area di lavoro:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="348"/>
+        <location filename="../ui/gcp_dock.py" line="347"/>
         <source>none open</source>
         <translation>nessuna aperta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="148"/>
+        <location filename="../ui/gcp_dock.py" line="147"/>
         <source>Open a workspace folder (made by Align images)</source>
         <translation>Apri una cartella dell'area di lavoro (creata da 'Allinea immagini')</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="150"/>
+        <location filename="../ui/gcp_dock.py" line="149"/>
         <source>Choose a folder of photos and a workspace folder, and align the photos</source>
         <translation>Scegli una cartella di foto e una cartella dell'area di lavoro e allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="157"/>
+        <location filename="../ui/gcp_dock.py" line="156"/>
         <source>Heights (Z) from:</source>
         <translation>Quote (Z) da:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="162"/>
+        <location filename="../ui/gcp_dock.py" line="161"/>
         <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
         <translation>Un layer raster DSM o DTM (ad es. un DSM ALS): un punto misurato sulla mappa ne prende la quota (bilineare). Vuoto: inserire Z a mano.</translation>
     </message>
@@ -627,27 +632,27 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Aggiungi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="177"/>
+        <location filename="../ui/gcp_dock.py" line="176"/>
         <source>Add a ground point</source>
         <translation>Aggiungi un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="178"/>
+        <location filename="../ui/gcp_dock.py" line="177"/>
         <source>Remove</source>
         <translation>Rimuovi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="179"/>
+        <location filename="../ui/gcp_dock.py" line="178"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Rimuovi il punto d'appoggio selezionato e le sue misure</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="190"/>
+        <location filename="../ui/gcp_placement.py" line="194"/>
         <source>Pick on map</source>
         <translation>Misura sulla mappa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="182"/>
+        <location filename="../ui/gcp_dock.py" line="181"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>Fai clic sulla mappa per impostare X e Y del punto selezionato (Z dal layer delle quote)</translation>
     </message>
@@ -657,97 +662,97 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Importa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="190"/>
+        <location filename="../ui/gcp_dock.py" line="189"/>
         <source>Export</source>
         <translation>Esporta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="205"/>
+        <location filename="../ui/gcp_dock.py" line="204"/>
         <source>Undo</source>
         <translation>Annulla</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="206"/>
+        <location filename="../ui/gcp_dock.py" line="205"/>
         <source>Redo</source>
         <translation>Ripeti</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="216"/>
+        <location filename="../ui/gcp_dock.py" line="215"/>
         <source>Undo: {}</source>
         <translation>Annulla: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="218"/>
+        <location filename="../ui/gcp_dock.py" line="217"/>
         <source>Redo: {}</source>
         <translation>Ripeti: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="197"/>
+        <location filename="../ui/gcp_dock.py" line="196"/>
         <source>Load results</source>
         <translation>Carica risultati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="198"/>
+        <location filename="../ui/gcp_dock.py" line="197"/>
         <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Aggiungi i prodotti dell'area di lavoro alla mappa come layer con stile</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="250"/>
+        <location filename="../ui/gcp_dock.py" line="249"/>
         <source>Residual tolerance:</source>
         <translation>Tolleranza dei residui:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="256"/>
+        <location filename="../ui/gcp_dock.py" line="255"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="265"/>
+        <location filename="../ui/gcp_dock.py" line="264"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="266"/>
+        <location filename="../ui/gcp_dock.py" line="265"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Lascia che la compensazione affini focale, punto principale e distorsione</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="273"/>
+        <location filename="../ui/gcp_dock.py" line="272"/>
         <source>Georeference</source>
         <translation>Georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="274"/>
+        <location filename="../ui/gcp_dock.py" line="273"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Esegui la compensazione con questi punti (in background)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="275"/>
+        <location filename="../ui/gcp_dock.py" line="274"/>
         <source>Cancel</source>
         <translation>Interrompi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="325"/>
+        <location filename="../ui/gcp_dock.py" line="324"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="332"/>
+        <location filename="../ui/gcp_dock.py" line="331"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Apri un'area di lavoro ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="378"/>
+        <location filename="../ui/gcp_dock.py" line="377"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} foto; il blocco non è ancora allineato: esegui 'Allinea immagini' (o 'Nuova dalle foto') per avere le posizioni previste</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="381"/>
+        <location filename="../ui/gcp_dock.py" line="380"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} foto, {} punti d'appoggio. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="278"/>
+        <location filename="../ui/gcp_placement.py" line="282"/>
         <source>no predicted positions: {}</source>
         <translation>nessuna posizione prevista: {}</translation>
     </message>
@@ -782,82 +787,82 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>ArchaeoOrtho: allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="511"/>
+        <location filename="../ui/gcp_dock.py" line="518"/>
         <source>CRS: {}</source>
         <translation>SR: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="114"/>
+        <location filename="../ui/gcp_placement.py" line="118"/>
         <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Fai clic sulla mappa nella posizione del punto selezionato (Esc per terminare)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="178"/>
+        <location filename="../ui/gcp_placement.py" line="182"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (da {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="181"/>
+        <location filename="../ui/gcp_placement.py" line="185"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Nessuna quota in questo punto in {}: Z invariata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="184"/>
+        <location filename="../ui/gcp_placement.py" line="188"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="390"/>
+        <location filename="../ui/gcp_placement.py" line="394"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="392"/>
+        <location filename="../ui/gcp_placement.py" line="396"/>
         <source>predicted</source>
         <translation>prevista</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="415"/>
+        <location filename="../ui/gcp_placement.py" line="419"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Seleziona o aggiungi un punto d'appoggio nella tabella, poi fai clic su di esso nella foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="422"/>
+        <location filename="../ui/gcp_placement.py" line="426"/>
         <source>from the point&apos;s other observations</source>
         <translation>dalle altre misure del punto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="423"/>
+        <location filename="../ui/gcp_placement.py" line="427"/>
         <source>from the georeferenced block</source>
         <translation>dal blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="424"/>
+        <location filename="../ui/gcp_placement.py" line="428"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>dai punti già misurati (trasformazione di similitudine)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="435"/>
+        <location filename="../ui/gcp_placement.py" line="439"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Misurato in x {:.2f}, y {:.2f}. Fai clic per spostarlo, trascinalo o premi Canc per rimuoverlo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="438"/>
+        <location filename="../ui/gcp_placement.py" line="442"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Previsto {}. Premi Invio per accettarlo e proseguire (Spazio: accetta), trascinalo o fai clic dove si trova davvero il punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="450"/>
+        <location filename="../ui/gcp_placement.py" line="454"/>
         <source>Click where {} is in this photo.</source>
         <translation>Fai clic dove si trova {} in questa foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="470"/>
+        <location filename="../ui/gcp_placement.py" line="474"/>
         <source>Select or add a ground point first</source>
         <translation>Seleziona o aggiungi prima un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="517"/>
+        <location filename="../ui/gcp_placement.py" line="521"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: ogni foto in cui è previsto ha una misura</translation>
     </message>
@@ -1042,42 +1047,42 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>modificato da allora: riesegui per aggiornare</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="425"/>
+        <location filename="../ui/gcp_placement.py" line="429"/>
         <source>by matching its look in another photo</source>
         <translation>confrontandone l'aspetto in un'altra foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="429"/>
+        <location filename="../ui/gcp_placement.py" line="433"/>
         <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
         <translation>(correlazione {:.2f}, {:.0f} px dalla previsione geometrica)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="147"/>
+        <location filename="../ui/gcp_dock.py" line="146"/>
         <source>Open…</source>
         <translation>Apri…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="149"/>
+        <location filename="../ui/gcp_dock.py" line="148"/>
         <source>New from photos…</source>
         <translation>Nuova dalle foto…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="185"/>
+        <location filename="../ui/gcp_dock.py" line="184"/>
         <source>From file (gcp_list.txt, CSV)…</source>
         <translation>Da file (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="186"/>
+        <location filename="../ui/gcp_dock.py" line="185"/>
         <source>From a point layer…</source>
         <translation>Da un layer di punti…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="188"/>
+        <location filename="../ui/gcp_dock.py" line="187"/>
         <source>To file (gcp_list.txt, CSV)…</source>
         <translation>Su file (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="189"/>
+        <location filename="../ui/gcp_dock.py" line="188"/>
         <source>To a GeoPackage layer…</source>
         <translation>Su un layer GeoPackage…</translation>
     </message>
@@ -1122,77 +1127,77 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>I residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi. Ora: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="94"/>
+        <location filename="../ui/gcp_placement.py" line="92"/>
         <source>Diagnosis of the adjustment:</source>
         <translation>Diagnosi della compensazione:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="169"/>
+        <location filename="../ui/gcp_placement.py" line="173"/>
         <source>Moved {:.2f} m (Undo: Ctrl+Z).</source>
         <translation>Spostato di {:.2f} m (Annulla: Ctrl+Z).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="392"/>
+        <location filename="../ui/gcp_placement.py" line="396"/>
         <source>near the edge</source>
         <translation>vicino al bordo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="441"/>
+        <location filename="../ui/gcp_placement.py" line="445"/>
         <source>{} is predicted where it cannot be placed: {}. Click where the point is if you see it, or press Enter for the next photo.</source>
         <translation>{} è previsto dove non può essere posizionato: {}. Fai clic sul punto se lo vedi, o premi Invio per la foto successiva.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="447"/>
+        <location filename="../ui/gcp_placement.py" line="451"/>
         <source>Click where {} is in this photo, or use Pick on map (or type X, Y, Z in the table) to have it predicted in the photos.</source>
         <translation>Fai clic su {} in questa foto, oppure usa Misura sulla mappa (o scrivi X, Y, Z nella tabella) per farlo prevedere nelle foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="460"/>
+        <location filename="../ui/gcp_placement.py" line="464"/>
         <source>{}: the workspace has no photos to place it in.</source>
         <translation>{}: l'area di lavoro non ha foto in cui posizionarlo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="462"/>
+        <location filename="../ui/gcp_placement.py" line="466"/>
         <source>{} is selected: use Pick on map or type X, Y, Z in the table, or choose a photo in the strip below and click on the point.</source>
         <translation>{} è selezionato: usa Misura sulla mappa o scrivi X, Y, Z nella tabella, oppure scegli una foto nella striscia sotto e fai clic sul punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="464"/>
+        <location filename="../ui/gcp_placement.py" line="468"/>
         <source>{} is selected: choose a photo in the strip below and click on the point.</source>
         <translation>{} è selezionato: scegli una foto nella striscia sotto e fai clic sul punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="213"/>
+        <location filename="../ui/gcp_dock.py" line="212"/>
         <source>Undo (Ctrl+Z)</source>
         <translation>Annulla (Ctrl+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="213"/>
+        <location filename="../ui/gcp_dock.py" line="212"/>
         <source>Redo (Ctrl+Shift+Z)</source>
         <translation>Ripeti (Ctrl+Maiusc+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="399"/>
+        <location filename="../ui/gcp_dock.py" line="398"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px.</source>
         <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="404"/>
+        <location filename="../ui/gcp_dock.py" line="403"/>
         <source>Not aligned ({}): {}</source>
         <translation>Non allineate ({}): {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="405"/>
+        <location filename="../ui/gcp_dock.py" line="404"/>
         <source>(marked in the photo strip; hover for the reason)</source>
         <translation>(segnate nella striscia delle foto; il motivo è nel suggerimento)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="424"/>
+        <location filename="../ui/gcp_dock.py" line="423"/>
         <source>✗ not aligned</source>
         <translation>✗ non allineata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="425"/>
+        <location filename="../ui/gcp_dock.py" line="424"/>
         <source>{}: not aligned: {}</source>
         <translation>{}: non allineata: {}</translation>
     </message>
@@ -1202,32 +1207,32 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Non allineate: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="136"/>
+        <location filename="../ui/gcp_placement.py" line="140"/>
         <source>pick on map</source>
         <translation>misura sulla mappa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="427"/>
+        <location filename="../ui/gcp_placement.py" line="431"/>
         <source>(no Z yet: at the height of the block&apos;s tie points)</source>
         <translation>(ancora nessuna Z: all'altezza dei punti di legame del blocco)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="161"/>
+        <location filename="../ui/gcp_placement.py" line="165"/>
         <source>{} not moved</source>
         <translation>{} non spostato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="190"/>
+        <location filename="../ui/gcp_placement.py" line="194"/>
         <source>{} is placed in {} photos. Move it {:.2f} m to the picked position, or add a new point there?</source>
         <translation>{} è posizionato in {} foto. Spostarlo di {:.2f} m nella posizione misurata, o aggiungere lì un nuovo punto?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="194"/>
+        <location filename="../ui/gcp_placement.py" line="198"/>
         <source>Move {}</source>
         <translation>Sposta {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="195"/>
+        <location filename="../ui/gcp_placement.py" line="199"/>
         <source>New point</source>
         <translation>Nuovo punto</translation>
     </message>
@@ -1757,12 +1762,12 @@ RESIDUALS: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in met
         <translation>Rimuovi la misura in questa foto (Canc)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="651"/>
+        <location filename="../ui/photo_viewer.py" line="653"/>
         <source>{} (predicted)</source>
         <translation>{} (previsto)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="563"/>
+        <location filename="../ui/photo_viewer.py" line="565"/>
         <source>Shown upright (EXIF orientation {}: stored {} x {} px); pixel coordinates are those of the stored grid, as COLMAP and gcp_list.txt use them</source>
         <translation>Mostrata raddrizzata (orientamento EXIF {}: salvata {} x {} px); le coordinate pixel sono quelle della griglia salvata, come le usano COLMAP e gcp_list.txt</translation>
     </message>
@@ -1770,102 +1775,102 @@ RESIDUALS: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in met
 <context>
     <name>PrepareImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="79"/>
+        <location filename="../processing_provider/prepare_images.py" line="80"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="79"/>
+        <location filename="../processing_provider/prepare_images.py" line="80"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="79"/>
+        <location filename="../processing_provider/prepare_images.py" line="80"/>
         <source>Smallest blur score (0 = only relative to the set)</source>
         <translation>Punteggio di nitidezza minimo (0 = solo relativo all'insieme)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="79"/>
+        <location filename="../processing_provider/prepare_images.py" line="80"/>
         <source>Leave flagged images out of the prepared folder</source>
         <translation>Escludi le immagini segnalate dalla cartella preparata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="89"/>
+        <location filename="../processing_provider/prepare_images.py" line="92"/>
         <source>Scanned film: fiducial marks, common frame, masks</source>
         <translation>Pellicola scansionata: marche fiduciali, fotogramma comune, maschere</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="90"/>
+        <location filename="../processing_provider/prepare_images.py" line="93"/>
         <source>Calibrated fiducial coordinates in mm (file path or text)</source>
         <translation>Coordinate calibrate delle marche fiduciali in mm (percorso di file o testo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Calibrated focal length in mm (0 = unknown)</source>
         <translation>Focale calibrata in mm (0 = sconosciuta)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Flag images below this fraction of the set&apos;s median blur score</source>
         <translation>Segnala le immagini sotto questa frazione del punteggio di nitidezza mediano dell'insieme</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Fiducial mark type</source>
         <translation>Tipo di marca fiduciale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Fiducial positions</source>
         <translation>Posizioni delle marche fiduciali</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Template image of one fiducial mark</source>
         <translation>Immagine modello di una marca fiduciale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Scan resolution in dpi when not in the files (0 = from the files)</source>
         <translation>Risoluzione di scansione in dpi se non nei file (0 = dai file)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="106"/>
+        <location filename="../processing_provider/prepare_images.py" line="109"/>
         <source>Prepared images (skipped: &lt;workspace&gt;/prepared)</source>
         <translation>Immagini preparate (se omesso: &lt;workspace&gt;/prepared)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="109"/>
+        <location filename="../processing_provider/prepare_images.py" line="112"/>
         <source>Folder of prepared images</source>
         <translation>Cartella delle immagini preparate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="110"/>
+        <location filename="../processing_provider/prepare_images.py" line="113"/>
         <source>Flagged images</source>
         <translation>Immagini segnalate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="111"/>
+        <location filename="../processing_provider/prepare_images.py" line="114"/>
         <source>Excluded images</source>
         <translation>Immagini escluse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="112"/>
+        <location filename="../processing_provider/prepare_images.py" line="115"/>
         <source>Screening record (JSON)</source>
         <translation>Registro del controllo (JSON)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="148"/>
+        <location filename="../processing_provider/prepare_images.py" line="152"/>
         <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
         <translation>{} immagini: {} segnalate, {} escluse, {} nella cartella preparata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="150"/>
+        <location filename="../processing_provider/prepare_images.py" line="154"/>
         <source>Blurriest first (blur score, % of the set&apos;s median):</source>
         <translation>Le più sfocate per prime (punteggio di nitidezza, % della mediana dell'insieme):</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="158"/>
+        <location filename="../processing_provider/prepare_images.py" line="162"/>
         <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
         <translation>Scansioni preparate: {} x {} px, dimensione del pixel {:.6g} {}{}</translation>
     </message>
@@ -1875,27 +1880,27 @@ RESIDUALS: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in met
         <translation>Prepara immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="86"/>
+        <location filename="../processing_provider/prepare_images.py" line="87"/>
         <source>Mask polygons: areas to ignore, in pixel coordinates (optional text field &apos;image&apos;)</source>
         <translation>Poligoni di maschera: aree da ignorare, in coordinate pixel (campo di testo opzionale 'image')</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="143"/>
+        <location filename="../processing_provider/prepare_images.py" line="147"/>
         <source>MASKS layer &apos;{}&apos;</source>
         <translation>layer MASKS '{}'</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="178"/>
+        <location filename="../processing_provider/prepare_images.py" line="182"/>
         <source>feature {}</source>
         <translation>elemento {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="182"/>
+        <location filename="../processing_provider/prepare_images.py" line="186"/>
         <source>MASKS layer &apos;{}&apos;: {} has no geometry: skipped</source>
         <translation>layer MASKS '{}': {} non ha geometria: saltato</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="185"/>
+        <location filename="../processing_provider/prepare_images.py" line="189"/>
         <source>MASKS layer &apos;{}&apos;: {} is a {} geometry, not a polygon</source>
         <translation>layer MASKS '{}': {} è una geometria {}, non un poligono</translation>
     </message>
@@ -1921,6 +1926,11 @@ MASKS: layer poligonale opzionale delle aree da ignorare (un braccio, l'ombra de
 SCANNED_FILM: le marche fiduciali (croci, punti, punti in cerchi; negli angoli e/o a metà dei lati, o come un'immagine modello di una marca) sono trovate con precisione sub-pixel, ogni scansione è ricampionata con una trasformazione affine nel fotogramma fiduciale comune, tutte della stessa dimensione e con il punto principale al centro, e delle maschere (workspace/masks) nascondono alla corrispondenza il bordo della pellicola, le strisce di dati e le marche. FIDUCIAL_COORDINATES: le coordinate delle marche fiduciali del certificato di calibrazione in mm, come file o testo incollato, una riga 'id x y' per marca (x a destra, y in alto), facoltativamente 'PP x y' (punto principale) e 'focal f'. Senza di esse si usa la disposizione media dell'insieme, centrata sul centro fiduciale. Con FOCAL_LENGTH_MM (o 'focal' nel certificato) le immagini preparate riportano la focale in pixel per l'allineamento.
 
 OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere nuova, vuota o scritta da un'esecuzione precedente); se omessa, &lt;workspace&gt;/prepared.</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="90"/>
+        <source>Sky masks: hide the sky and the horizon of oblique photos from the alignment</source>
+        <translation>Maschere del cielo: nascondi il cielo e l&apos;orizzonte delle foto oblique all&apos;allineamento</translation>
     </message>
 </context>
 <context>
@@ -2016,62 +2026,62 @@ Risultato: dove scriverla (predefinito: &lt;workspace&gt;/terrain/relief/&lt;sur
         <translation>non triangolato</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="704"/>
+        <location filename="../ui/layers.py" line="701"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="663"/>
+        <location filename="../ui/layers.py" line="660"/>
         <source>DSM hillshade</source>
         <translation>Ombreggiatura del DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="705"/>
+        <location filename="../ui/layers.py" line="702"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="706"/>
+        <location filename="../ui/layers.py" line="703"/>
         <source>Cameras</source>
         <translation>Camere</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="674"/>
+        <location filename="../ui/layers.py" line="671"/>
         <source>Camera footprints</source>
         <translation>Impronte delle immagini</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="681"/>
+        <location filename="../ui/layers.py" line="678"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Residui dei punti d'appoggio (vettori x{})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="707"/>
+        <location filename="../ui/layers.py" line="704"/>
         <source>Point cloud</source>
         <translation>Nuvola di punti</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="715"/>
+        <location filename="../ui/layers.py" line="712"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="386"/>
+        <location filename="../ui/layers.py" line="383"/>
         <source>{} ({})</source>
         <translation>{} ({})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="708"/>
+        <location filename="../ui/layers.py" line="705"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="688"/>
+        <location filename="../ui/layers.py" line="685"/>
         <source>DTM hillshade</source>
         <translation>Ombreggiatura del DTM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="709"/>
+        <location filename="../ui/layers.py" line="706"/>
         <source>Contours</source>
         <translation>Curve di livello</translation>
     </message>

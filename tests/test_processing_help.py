@@ -53,7 +53,7 @@ def _process(ms=100):
 
 def hidden_in_dialog(alg_id):
     """[(what, how far past the right edge in px)] for the browse buttons and labels of the dialog's
-    parameters panel at its default size."""
+    parameters panel at its default size (the Advanced parameters folded, as the dialog opens)."""
     from qgis.gui import QgsFileWidget
     from qgis.PyQt.QtWidgets import QLabel, QScrollArea, QToolButton
 

@@ -569,3 +569,45 @@ def test_gui_thread_times_of_open_results_and_georeference(default_dock, georef_
     print(f"\n[GUI thread] open workspace {open_ms:.0f} ms (first, with imports), again {reopen_ms:.0f} ms; "
           f"Load results click {click_ms:.0f} ms (layers after {results_total:.0f} ms), all on the GUI thread "
           f"{sync_results_ms:.0f} ms; georeference done callback {timings['done']:.0f} ms")
+
+
+@pytest.mark.slow
+def test_qgis_desktop_lang_de(georef_ws, tmp_path):
+    """`qgis --lang de` under Xvfb, a copy of the test profile (QGIS writes the language into it): the plugin
+    speaks German, its icon is on the (visible) Plugins toolbar, and a click on it opens the docks at their
+    default sizes with nothing hidden.  The screenshot goes to docs/screenshots/qgis-desktop-de.png."""
+    import json
+    import shutil
+    import subprocess
+    import sysconfig
+
+    from tests.conftest import PLUGINS
+
+    if not (shutil.which("qgis") and shutil.which("xvfb-run")):
+        pytest.skip("needs qgis and xvfb-run")
+    if not os.path.islink(os.path.join(PLUGINS, "archaeoortho")):
+        pytest.skip("plugin link missing: run 'make setup'")
+    out = tmp_path / "out"
+    out.mkdir()
+    profile = tmp_path / "profile"
+    shutil.copytree(os.path.join(ROOT, "build", "qgis-profile"), profile, symlinks=True)
+    env = dict(os.environ)
+    env.pop("QT_QPA_PLATFORM", None)
+    env.update(AO_OUT=str(out), AO_WORKSPACE=georef_ws, QGIS_PLUGINPATH=PLUGINS, QGIS_CUSTOM_CONFIG_PATH=str(profile),
+               PYTHONPATH=os.pathsep.join([sysconfig.get_paths()["purelib"], env.get("PYTHONPATH", "")]))
+    script = os.path.join(ROOT, "tests", "desktop_lang_script.py")
+    subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1366x768x24", "qgis", "--lang", "de", "--nologo",
+                    "--noversioncheck", "--code", script], env=env, capture_output=True, timeout=300)
+    log = json.load(open(out / "log.json"))
+    print(f"\n[qgis --lang de] {json.dumps(log, ensure_ascii=False)}")
+    assert "error" not in log, log.get("error")
+    assert "archaeoortho" in log["plugins"] and log["translator"]
+    assert log["icon_on_plugins_toolbar"] and log["plugins_toolbar_visible"] and log["icon_shown"]
+    assert log["texts"]["open"] == "Öffnen…" and log["texts"]["new"] == "Neu aus Fotos…"
+    assert log["texts"]["import"] == ["Aus Datei (gcp_list.txt, CSV)…", "Aus einem Punktlayer…"]
+    assert log["texts"]["georef"] == "Georeferenzieren"
+    assert log["toolbar_hidden"] == [] and log["key_columns_hidden"] == []
+    assert log["photo_view_height"] >= 180
+    assert log["window"][0] <= 1366 and log["window"][1] <= 768  # the docks' minimum sizes fit the screen
+    os.makedirs(SHOTS, exist_ok=True)
+    shutil.copyfile(out / "screen.png", os.path.join(SHOTS, "qgis-desktop-de.png"))

@@ -10,7 +10,7 @@ import os
 
 from qgis.core import Qgis, QgsApplication, QgsMapLayerProxyModel, QgsProject
 from qgis.gui import QgsDockWidget, QgsMapLayerComboBox
-from qgis.PyQt.QtCore import QCoreApplication, QSize, Qt
+from qgis.PyQt.QtCore import QCoreApplication, QSize, Qt, QTimer
 from qgis.PyQt.QtGui import QColor, QKeySequence
 from qgis.PyQt.QtWidgets import (
     QAbstractItemView,
@@ -86,7 +86,6 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         self.map_tool = GcpMapTool(self.canvas) if self.canvas is not None else None
         self.markers = GcpMarkers(self.canvas) if self.canvas is not None else None
         self.photo_panel = PhotoPanel()
-        self.photo_panel.view.setMinimumHeight(160)  # never a sliver of a photo
         self.photo_dock = QgsDockWidget(parent)
         self.photo_dock.setObjectName("ArchaeoOrthoPhotoDock")
         self.photo_dock.setWindowTitle(self.tr("ArchaeoOrtho photos"))
@@ -446,8 +445,16 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
                 finally:
                     self._selecting = False
                 self._selection_changed()
+                self.table.scrollTo(self.model.index(row, NAME))  # after the update: it may resize the rows
+                QTimer.singleShot(0, self._scroll_to_current)
                 return True
         return False
+
+    def _scroll_to_current(self):
+        try:
+            self.table.scrollTo(self.table.currentIndex())
+        except RuntimeError:  # the dock was closed meanwhile
+            pass
 
     def _row_changed(self):
         if not getattr(self, "_selecting", False):  # a click or a key in the table

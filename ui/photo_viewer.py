@@ -481,11 +481,13 @@ class PhotoPanel(QWidget):
         for w in (self.btn_fit, self.btn_zoom, self.btn_confirm, self.btn_next, self.btn_remove):
             bar.addWidget(w)
         bar.addStretch(1)
-        bar.addWidget(self.filter_box)
+        heading = QHBoxLayout()  # the filter beside the title, not after the buttons: the dock fits a 1366 px screen
+        heading.addWidget(self.title, 1)
+        heading.addWidget(self.filter_box)
         top = QWidget()
         tl = QVBoxLayout(top)
         tl.setContentsMargins(0, 0, 0, 0)
-        tl.addWidget(self.title)
+        tl.addLayout(heading)
         tl.addLayout(bar)
         tl.addWidget(self.view, 1)
         tl.addWidget(self.orientation_note)
