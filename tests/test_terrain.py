@@ -54,10 +54,9 @@ def add_trees(scene, x, y, dsm, n=25, seed=1):
     return dsm, crowns
 
 
-@pytest.fixture(scope="module")
-def scene_dsm(tmp_path_factory):
-    """(scene, x, y local cell centres, DSM path, building mask, tree mask)."""
-    root = tmp_path_factory.mktemp("terrain")
+def synthetic_dsm():
+    """(scene, x, y local cell centres, DSM array, geotransform, building mask, tree mask): the scene as the DSM
+    stage sees it (also used by benchmarks/terrain.py --compare-csf)."""
     scene = syn.make_scene(3, BOUNDS)
     x, y = _grid()
     dsm, trees = add_trees(scene, x, y, scene.height_at(x, y))
@@ -71,6 +70,14 @@ def scene_dsm(tmp_path_factory):
     for b in scene.buildings:
         buildings |= b.contains(x, y)
     gt = (BOUNDS[0] + syn.ORIGIN[0], CELL, 0.0, BOUNDS[3] + syn.ORIGIN[1], 0.0, -CELL)
+    return scene, x, y, dsm, gt, buildings, trees
+
+
+@pytest.fixture(scope="module")
+def scene_dsm(tmp_path_factory):
+    """(scene, x, y local cell centres, DSM path, building mask, tree mask)."""
+    root = tmp_path_factory.mktemp("terrain")
+    scene, x, y, dsm, gt, buildings, trees = synthetic_dsm()
     path = str(root / "dsm.tif")
     raster.write_cog(path, dsm, gt, syn.CRS)
     return scene, x, y, path, buildings, trees
