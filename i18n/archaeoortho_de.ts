@@ -647,7 +647,7 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Den gewählten Passpunkt mit seinen Messungen entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="194"/>
+        <location filename="../ui/gcp_placement.py" line="196"/>
         <source>Pick on map</source>
         <translation>Auf der Karte messen</translation>
     </message>
@@ -752,37 +752,37 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>{} Fotos, {} Passpunkte. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="282"/>
+        <location filename="../ui/gcp_placement.py" line="284"/>
         <source>no predicted positions: {}</source>
         <translation>keine vorhergesagten Positionen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="63"/>
+        <location filename="../ui/gcp_placement.py" line="65"/>
         <source>Predicted positions from the georeferenced block.</source>
         <translation>Vorhergesagte Positionen aus dem georeferenzierten Block.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="63"/>
+        <location filename="../ui/gcp_placement.py" line="65"/>
         <source>Predicted positions once a point is placed in 2 photos, and for every point once 3 points are placed.</source>
         <translation>Vorhergesagte Positionen, sobald ein Punkt in 2 Fotos gemessen ist, und für alle Punkte, sobald 3 Punkte gemessen sind.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="115"/>
+        <location filename="../ui/gcp_tasks.py" line="173"/>
         <source>Folder of photos</source>
         <translation>Fotoordner</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="118"/>
+        <location filename="../ui/gcp_tasks.py" line="176"/>
         <source>Workspace folder (new or existing)</source>
         <translation>Arbeitsbereich-Ordner (neu oder vorhanden)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="131"/>
+        <location filename="../ui/gcp_tasks.py" line="189"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
         <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="138"/>
+        <location filename="../ui/gcp_tasks.py" line="196"/>
         <source>ArchaeoOrtho: align photos</source>
         <translation>ArchaeoOrtho: Fotos ausrichten</translation>
     </message>
@@ -792,77 +792,77 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>KBS: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="118"/>
+        <location filename="../ui/gcp_placement.py" line="120"/>
         <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Auf der Karte an die Position des gewählten Punkts klicken (Esc beendet)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="182"/>
+        <location filename="../ui/gcp_placement.py" line="184"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (aus {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="185"/>
+        <location filename="../ui/gcp_placement.py" line="187"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Keine Höhe an dieser Stelle in {}: Z bleibt unverändert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="188"/>
+        <location filename="../ui/gcp_placement.py" line="190"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="394"/>
+        <location filename="../ui/gcp_placement.py" line="396"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="396"/>
+        <location filename="../ui/gcp_placement.py" line="398"/>
         <source>predicted</source>
         <translation>vorhergesagt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="419"/>
+        <location filename="../ui/gcp_placement.py" line="421"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Einen Passpunkt in der Tabelle wählen oder hinzufügen, dann im Foto darauf klicken.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="426"/>
+        <location filename="../ui/gcp_placement.py" line="428"/>
         <source>from the point&apos;s other observations</source>
         <translation>aus den übrigen Messungen des Punkts</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="427"/>
+        <location filename="../ui/gcp_placement.py" line="429"/>
         <source>from the georeferenced block</source>
         <translation>aus dem georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="428"/>
+        <location filename="../ui/gcp_placement.py" line="430"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>aus den bereits gemessenen Punkten (Ähnlichkeitstransformation)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="439"/>
+        <location filename="../ui/gcp_placement.py" line="441"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Gemessen bei x {:.2f}, y {:.2f}. Klicken zum Versetzen, ziehen oder Entf zum Entfernen.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="442"/>
+        <location filename="../ui/gcp_placement.py" line="444"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Vorhergesagt {}. Eingabetaste übernimmt und geht weiter (Leertaste: übernehmen), ziehen oder dorthin klicken, wo der Punkt wirklich ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="454"/>
+        <location filename="../ui/gcp_placement.py" line="456"/>
         <source>Click where {} is in this photo.</source>
         <translation>Dorthin klicken, wo {} in diesem Foto ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="474"/>
+        <location filename="../ui/gcp_placement.py" line="476"/>
         <source>Select or add a ground point first</source>
         <translation>Zuerst einen Passpunkt wählen oder hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="521"/>
+        <location filename="../ui/gcp_placement.py" line="523"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: jedes Foto, das ihn voraussichtlich zeigt, hat eine Messung</translation>
     </message>
@@ -982,77 +982,77 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>{} kann nicht zum Projekt hinzugefügt werden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="145"/>
+        <location filename="../ui/gcp_tasks.py" line="203"/>
         <source>A task of this dock is still running</source>
         <translation>Eine Aufgabe dieses Fensters läuft noch</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="168"/>
+        <location filename="../ui/gcp_tasks.py" line="226"/>
         <source>Cancelled</source>
         <translation>Abgebrochen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="183"/>
+        <location filename="../ui/gcp_tasks.py" line="241"/>
         <source>The block is not aligned yet: run Align images first</source>
         <translation>Der Block ist noch nicht ausgerichtet: zuerst 'Bilder ausrichten' ausführen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="189"/>
+        <location filename="../ui/gcp_tasks.py" line="247"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>Die Ausgleichung braucht mindestens 3 Passpunkte mit Koordinaten und Messungen; vorhanden sind {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="206"/>
+        <location filename="../ui/gcp_tasks.py" line="265"/>
         <source>Outliers left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="207"/>
+        <location filename="../ui/gcp_tasks.py" line="266"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziert in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="210"/>
+        <location filename="../ui/gcp_tasks.py" line="269"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="219"/>
+        <location filename="../ui/gcp_tasks.py" line="278"/>
         <source>Not georeferenced yet.</source>
         <translation>Noch nicht georeferenziert.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="221"/>
+        <location filename="../ui/gcp_tasks.py" line="280"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Passpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="224"/>
+        <location filename="../ui/gcp_tasks.py" line="283"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Kontrollpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="227"/>
+        <location filename="../ui/gcp_tasks.py" line="286"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>Höhen sind Platzhalter: keine Höhengenauigkeit</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="229"/>
+        <location filename="../ui/gcp_tasks.py" line="288"/>
         <source>tie points {} px</source>
         <translation>Verknüpfungspunkte {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="231"/>
+        <location filename="../ui/gcp_tasks.py" line="290"/>
         <source>edited since: re-run to update</source>
         <translation>seither bearbeitet: erneut ausführen zum Aktualisieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="429"/>
+        <location filename="../ui/gcp_placement.py" line="431"/>
         <source>by matching its look in another photo</source>
         <translation>durch Abgleich mit seinem Aussehen in einem anderen Foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="433"/>
+        <location filename="../ui/gcp_placement.py" line="435"/>
         <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
         <translation>(Korrelation {:.2f}, {:.0f} px von der geometrischen Vorhersage)</translation>
     </message>
@@ -1087,12 +1087,12 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>In einen GeoPackage-Layer…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="176"/>
+        <location filename="../ui/gcp_tasks.py" line="234"/>
         <source>Cancelling…</source>
         <translation>Wird abgebrochen…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="213"/>
+        <location filename="../ui/gcp_tasks.py" line="272"/>
         <source>Georeferencing with {} control points…</source>
         <translation>Georeferenzierung mit {} Passpunkten…</translation>
     </message>
@@ -1107,62 +1107,62 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Koordinaten auf aufrecht gedrehten Fotos gemessen ({} Fotos sind gedreht gespeichert: EXIF-Ausrichtung); nicht ankreuzen für das gespeicherte Pixelraster (das von COLMAP und OpenDroneMap)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="72"/>
+        <location filename="../ui/gcp_placement.py" line="74"/>
         <source>your setting</source>
         <translation>Ihre Einstellung</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="75"/>
+        <location filename="../ui/gcp_placement.py" line="77"/>
         <source>default: 3 × GSD of the georeferenced block (GSD {:.3f} m)</source>
         <translation>Vorgabe: 3 × Bodenauflösung des georeferenzierten Blocks (GSD {:.3f} m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="76"/>
+        <location filename="../ui/gcp_placement.py" line="78"/>
         <source>default</source>
         <translation>Vorgabe</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="83"/>
+        <location filename="../ui/gcp_placement.py" line="85"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red. Now: {}</source>
         <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot. Jetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="92"/>
+        <location filename="../ui/gcp_placement.py" line="94"/>
         <source>Diagnosis of the adjustment:</source>
         <translation>Diagnose der Ausgleichung:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="173"/>
+        <location filename="../ui/gcp_placement.py" line="175"/>
         <source>Moved {:.2f} m (Undo: Ctrl+Z).</source>
         <translation>Um {:.2f} m verschoben (Rückgängig: Strg+Z).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="396"/>
+        <location filename="../ui/gcp_placement.py" line="398"/>
         <source>near the edge</source>
         <translation>nahe am Rand</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="445"/>
+        <location filename="../ui/gcp_placement.py" line="447"/>
         <source>{} is predicted where it cannot be placed: {}. Click where the point is if you see it, or press Enter for the next photo.</source>
         <translation>{} wird dort vorhergesagt, wo er nicht gesetzt werden kann: {}. Klicken Sie auf den Punkt, wenn Sie ihn sehen, oder drücken Sie die Eingabetaste für das nächste Foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="451"/>
+        <location filename="../ui/gcp_placement.py" line="453"/>
         <source>Click where {} is in this photo, or use Pick on map (or type X, Y, Z in the table) to have it predicted in the photos.</source>
         <translation>Klicken Sie in diesem Foto auf {}, oder nutzen Sie „Auf der Karte messen“ (oder geben Sie X, Y, Z in der Tabelle ein), damit er in den Fotos vorhergesagt wird.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="464"/>
+        <location filename="../ui/gcp_placement.py" line="466"/>
         <source>{}: the workspace has no photos to place it in.</source>
         <translation>{}: der Arbeitsbereich hat keine Fotos, in denen er gesetzt werden kann.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="466"/>
+        <location filename="../ui/gcp_placement.py" line="468"/>
         <source>{} is selected: use Pick on map or type X, Y, Z in the table, or choose a photo in the strip below and click on the point.</source>
         <translation>{} ist ausgewählt: nutzen Sie „Auf der Karte messen“ oder geben Sie X, Y, Z in der Tabelle ein, oder wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="468"/>
+        <location filename="../ui/gcp_placement.py" line="470"/>
         <source>{} is selected: choose a photo in the strip below and click on the point.</source>
         <translation>{} ist ausgewählt: wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
     </message>
@@ -1202,59 +1202,69 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>{}: nicht ausgerichtet: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="134"/>
+        <location filename="../ui/gcp_tasks.py" line="192"/>
         <source>Not aligned: {}</source>
         <translation>Nicht ausgerichtet: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="140"/>
+        <location filename="../ui/gcp_placement.py" line="142"/>
         <source>pick on map</source>
         <translation>auf der Karte messen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="431"/>
+        <location filename="../ui/gcp_placement.py" line="433"/>
         <source>(no Z yet: at the height of the block&apos;s tie points)</source>
         <translation>(noch kein Z: auf der Höhe der Verknüpfungspunkte des Blocks)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="165"/>
+        <location filename="../ui/gcp_placement.py" line="167"/>
         <source>{} not moved</source>
         <translation>{} nicht verschoben</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="194"/>
+        <location filename="../ui/gcp_placement.py" line="196"/>
         <source>{} is placed in {} photos. Move it {:.2f} m to the picked position, or add a new point there?</source>
         <translation>{} ist in {} Fotos gesetzt. Um {:.2f} m an die gemessene Position verschieben, oder dort einen neuen Punkt anlegen?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="198"/>
+        <location filename="../ui/gcp_placement.py" line="200"/>
         <source>Move {}</source>
         <translation>{} verschieben</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="199"/>
+        <location filename="../ui/gcp_placement.py" line="201"/>
         <source>New point</source>
         <translation>Neuer Punkt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="87"/>
+        <location filename="../ui/gcp_tasks.py" line="145"/>
         <source>ArchaeoOrtho: refine {} in {}</source>
         <translation>ArchaeoOrtho: {} in {} verfeinern</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="245"/>
+        <location filename="../ui/gcp_tasks.py" line="304"/>
         <source>Results loaded</source>
         <translation>Ergebnisse geladen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="252"/>
+        <location filename="../ui/gcp_tasks.py" line="311"/>
         <source>ArchaeoOrtho: load results</source>
         <translation>ArchaeoOrtho: Ergebnisse laden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="254"/>
+        <location filename="../ui/gcp_tasks.py" line="313"/>
         <source>Loading the results…</source>
         <translation>Die Ergebnisse werden geladen…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="109"/>
+        <source>ArchaeoOrtho: open workspace</source>
+        <translation>ArchaeoOrtho: Arbeitsbereich öffnen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="111"/>
+        <source>Opening {}…</source>
+        <translation>{} wird geöffnet…</translation>
     </message>
 </context>
 <context>

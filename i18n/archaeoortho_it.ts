@@ -647,7 +647,7 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Rimuovi il punto d'appoggio selezionato e le sue misure</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="194"/>
+        <location filename="../ui/gcp_placement.py" line="196"/>
         <source>Pick on map</source>
         <translation>Misura sulla mappa</translation>
     </message>
@@ -752,37 +752,37 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>{} foto, {} punti d'appoggio. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="282"/>
+        <location filename="../ui/gcp_placement.py" line="284"/>
         <source>no predicted positions: {}</source>
         <translation>nessuna posizione prevista: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="63"/>
+        <location filename="../ui/gcp_placement.py" line="65"/>
         <source>Predicted positions from the georeferenced block.</source>
         <translation>Posizioni previste dal blocco georeferenziato.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="63"/>
+        <location filename="../ui/gcp_placement.py" line="65"/>
         <source>Predicted positions once a point is placed in 2 photos, and for every point once 3 points are placed.</source>
         <translation>Posizioni previste quando un punto è misurato in 2 foto, e per tutti i punti quando ne sono misurati 3.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="115"/>
+        <location filename="../ui/gcp_tasks.py" line="173"/>
         <source>Folder of photos</source>
         <translation>Cartella delle foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="118"/>
+        <location filename="../ui/gcp_tasks.py" line="176"/>
         <source>Workspace folder (new or existing)</source>
         <translation>Cartella dell'area di lavoro (nuova o esistente)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="131"/>
+        <location filename="../ui/gcp_tasks.py" line="189"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
         <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="138"/>
+        <location filename="../ui/gcp_tasks.py" line="196"/>
         <source>ArchaeoOrtho: align photos</source>
         <translation>ArchaeoOrtho: allinea le foto</translation>
     </message>
@@ -792,77 +792,77 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>SR: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="118"/>
+        <location filename="../ui/gcp_placement.py" line="120"/>
         <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Fai clic sulla mappa nella posizione del punto selezionato (Esc per terminare)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="182"/>
+        <location filename="../ui/gcp_placement.py" line="184"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (da {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="185"/>
+        <location filename="../ui/gcp_placement.py" line="187"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Nessuna quota in questo punto in {}: Z invariata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="188"/>
+        <location filename="../ui/gcp_placement.py" line="190"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="394"/>
+        <location filename="../ui/gcp_placement.py" line="396"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="396"/>
+        <location filename="../ui/gcp_placement.py" line="398"/>
         <source>predicted</source>
         <translation>prevista</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="419"/>
+        <location filename="../ui/gcp_placement.py" line="421"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Seleziona o aggiungi un punto d'appoggio nella tabella, poi fai clic su di esso nella foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="426"/>
+        <location filename="../ui/gcp_placement.py" line="428"/>
         <source>from the point&apos;s other observations</source>
         <translation>dalle altre misure del punto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="427"/>
+        <location filename="../ui/gcp_placement.py" line="429"/>
         <source>from the georeferenced block</source>
         <translation>dal blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="428"/>
+        <location filename="../ui/gcp_placement.py" line="430"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>dai punti già misurati (trasformazione di similitudine)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="439"/>
+        <location filename="../ui/gcp_placement.py" line="441"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Misurato in x {:.2f}, y {:.2f}. Fai clic per spostarlo, trascinalo o premi Canc per rimuoverlo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="442"/>
+        <location filename="../ui/gcp_placement.py" line="444"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Previsto {}. Premi Invio per accettarlo e proseguire (Spazio: accetta), trascinalo o fai clic dove si trova davvero il punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="454"/>
+        <location filename="../ui/gcp_placement.py" line="456"/>
         <source>Click where {} is in this photo.</source>
         <translation>Fai clic dove si trova {} in questa foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="474"/>
+        <location filename="../ui/gcp_placement.py" line="476"/>
         <source>Select or add a ground point first</source>
         <translation>Seleziona o aggiungi prima un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="521"/>
+        <location filename="../ui/gcp_placement.py" line="523"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: ogni foto in cui è previsto ha una misura</translation>
     </message>
@@ -982,77 +982,77 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Impossibile aggiungere {} al progetto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="145"/>
+        <location filename="../ui/gcp_tasks.py" line="203"/>
         <source>A task of this dock is still running</source>
         <translation>Un'operazione di questo pannello è ancora in corso</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="168"/>
+        <location filename="../ui/gcp_tasks.py" line="226"/>
         <source>Cancelled</source>
         <translation>Interrotto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="183"/>
+        <location filename="../ui/gcp_tasks.py" line="241"/>
         <source>The block is not aligned yet: run Align images first</source>
         <translation>Il blocco non è ancora allineato: esegui prima 'Allinea immagini'</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="189"/>
+        <location filename="../ui/gcp_tasks.py" line="247"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>La compensazione richiede almeno 3 punti d'appoggio con coordinate e misure; ce ne sono {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="206"/>
+        <location filename="../ui/gcp_tasks.py" line="265"/>
         <source>Outliers left out: {}</source>
         <translation>Valori anomali esclusi: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="207"/>
+        <location filename="../ui/gcp_tasks.py" line="266"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziato in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="210"/>
+        <location filename="../ui/gcp_tasks.py" line="269"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="219"/>
+        <location filename="../ui/gcp_tasks.py" line="278"/>
         <source>Not georeferenced yet.</source>
         <translation>Non ancora georeferenziato.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="221"/>
+        <location filename="../ui/gcp_tasks.py" line="280"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Appoggio: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="224"/>
+        <location filename="../ui/gcp_tasks.py" line="283"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Controllo: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="227"/>
+        <location filename="../ui/gcp_tasks.py" line="286"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>le quote sono segnaposto: nessuna accuratezza verticale</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="229"/>
+        <location filename="../ui/gcp_tasks.py" line="288"/>
         <source>tie points {} px</source>
         <translation>punti di legame {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="231"/>
+        <location filename="../ui/gcp_tasks.py" line="290"/>
         <source>edited since: re-run to update</source>
         <translation>modificato da allora: riesegui per aggiornare</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="429"/>
+        <location filename="../ui/gcp_placement.py" line="431"/>
         <source>by matching its look in another photo</source>
         <translation>confrontandone l'aspetto in un'altra foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="433"/>
+        <location filename="../ui/gcp_placement.py" line="435"/>
         <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
         <translation>(correlazione {:.2f}, {:.0f} px dalla previsione geometrica)</translation>
     </message>
@@ -1087,12 +1087,12 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Su un layer GeoPackage…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="176"/>
+        <location filename="../ui/gcp_tasks.py" line="234"/>
         <source>Cancelling…</source>
         <translation>Interruzione…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="213"/>
+        <location filename="../ui/gcp_tasks.py" line="272"/>
         <source>Georeferencing with {} control points…</source>
         <translation>Georeferenziazione con {} punti d'appoggio…</translation>
     </message>
@@ -1107,62 +1107,62 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Coordinate misurate sulle foto raddrizzate ({} foto sono salvate ruotate: orientamento EXIF); lasciare deselezionato per la griglia di pixel salvata (quella di COLMAP e OpenDroneMap)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="72"/>
+        <location filename="../ui/gcp_placement.py" line="74"/>
         <source>your setting</source>
         <translation>la tua impostazione</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="75"/>
+        <location filename="../ui/gcp_placement.py" line="77"/>
         <source>default: 3 × GSD of the georeferenced block (GSD {:.3f} m)</source>
         <translation>predefinito: 3 × GSD del blocco georeferenziato (GSD {:.3f} m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="76"/>
+        <location filename="../ui/gcp_placement.py" line="78"/>
         <source>default</source>
         <translation>predefinito</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="83"/>
+        <location filename="../ui/gcp_placement.py" line="85"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red. Now: {}</source>
         <translation>I residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi. Ora: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="92"/>
+        <location filename="../ui/gcp_placement.py" line="94"/>
         <source>Diagnosis of the adjustment:</source>
         <translation>Diagnosi della compensazione:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="173"/>
+        <location filename="../ui/gcp_placement.py" line="175"/>
         <source>Moved {:.2f} m (Undo: Ctrl+Z).</source>
         <translation>Spostato di {:.2f} m (Annulla: Ctrl+Z).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="396"/>
+        <location filename="../ui/gcp_placement.py" line="398"/>
         <source>near the edge</source>
         <translation>vicino al bordo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="445"/>
+        <location filename="../ui/gcp_placement.py" line="447"/>
         <source>{} is predicted where it cannot be placed: {}. Click where the point is if you see it, or press Enter for the next photo.</source>
         <translation>{} è previsto dove non può essere posizionato: {}. Fai clic sul punto se lo vedi, o premi Invio per la foto successiva.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="451"/>
+        <location filename="../ui/gcp_placement.py" line="453"/>
         <source>Click where {} is in this photo, or use Pick on map (or type X, Y, Z in the table) to have it predicted in the photos.</source>
         <translation>Fai clic su {} in questa foto, oppure usa Misura sulla mappa (o scrivi X, Y, Z nella tabella) per farlo prevedere nelle foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="464"/>
+        <location filename="../ui/gcp_placement.py" line="466"/>
         <source>{}: the workspace has no photos to place it in.</source>
         <translation>{}: l'area di lavoro non ha foto in cui posizionarlo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="466"/>
+        <location filename="../ui/gcp_placement.py" line="468"/>
         <source>{} is selected: use Pick on map or type X, Y, Z in the table, or choose a photo in the strip below and click on the point.</source>
         <translation>{} è selezionato: usa Misura sulla mappa o scrivi X, Y, Z nella tabella, oppure scegli una foto nella striscia sotto e fai clic sul punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="468"/>
+        <location filename="../ui/gcp_placement.py" line="470"/>
         <source>{} is selected: choose a photo in the strip below and click on the point.</source>
         <translation>{} è selezionato: scegli una foto nella striscia sotto e fai clic sul punto.</translation>
     </message>
@@ -1202,59 +1202,69 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>{}: non allineata: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="134"/>
+        <location filename="../ui/gcp_tasks.py" line="192"/>
         <source>Not aligned: {}</source>
         <translation>Non allineate: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="140"/>
+        <location filename="../ui/gcp_placement.py" line="142"/>
         <source>pick on map</source>
         <translation>misura sulla mappa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="431"/>
+        <location filename="../ui/gcp_placement.py" line="433"/>
         <source>(no Z yet: at the height of the block&apos;s tie points)</source>
         <translation>(ancora nessuna Z: all'altezza dei punti di legame del blocco)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="165"/>
+        <location filename="../ui/gcp_placement.py" line="167"/>
         <source>{} not moved</source>
         <translation>{} non spostato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="194"/>
+        <location filename="../ui/gcp_placement.py" line="196"/>
         <source>{} is placed in {} photos. Move it {:.2f} m to the picked position, or add a new point there?</source>
         <translation>{} è posizionato in {} foto. Spostarlo di {:.2f} m nella posizione misurata, o aggiungere lì un nuovo punto?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="198"/>
+        <location filename="../ui/gcp_placement.py" line="200"/>
         <source>Move {}</source>
         <translation>Sposta {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="199"/>
+        <location filename="../ui/gcp_placement.py" line="201"/>
         <source>New point</source>
         <translation>Nuovo punto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="87"/>
+        <location filename="../ui/gcp_tasks.py" line="145"/>
         <source>ArchaeoOrtho: refine {} in {}</source>
         <translation>ArchaeoOrtho: affina {} in {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="245"/>
+        <location filename="../ui/gcp_tasks.py" line="304"/>
         <source>Results loaded</source>
         <translation>Risultati caricati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="252"/>
+        <location filename="../ui/gcp_tasks.py" line="311"/>
         <source>ArchaeoOrtho: load results</source>
         <translation>ArchaeoOrtho: carica i risultati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="254"/>
+        <location filename="../ui/gcp_tasks.py" line="313"/>
         <source>Loading the results…</source>
         <translation>Caricamento dei risultati…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="109"/>
+        <source>ArchaeoOrtho: open workspace</source>
+        <translation>ArchaeoOrtho: apri l&apos;area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="111"/>
+        <source>Opening {}…</source>
+        <translation>Apertura di {}…</translation>
     </message>
 </context>
 <context>
@@ -1930,7 +1940,7 @@ OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere
     <message>
         <location filename="../processing_provider/prepare_images.py" line="90"/>
         <source>Sky masks: hide the sky and the horizon of oblique photos from the alignment</source>
-        <translation>Maschere del cielo: nascondi il cielo e l&apos;orizzonte delle foto oblique all&apos;allineamento</translation>
+        <translation>Maschere del cielo: nascondi il cielo e l'orizzonte delle foto oblique all'allineamento</translation>
     </message>
 </context>
 <context>

@@ -566,6 +566,7 @@ def test_gui_thread_times_of_open_results_and_georeference(default_dock, georef_
     wait_task(dock)
     assert dock.last_task_error is None and "done" in timings
     assert isinstance(task.result, tuple) and task.result[1]  # the footprints came from the task
+    assert task.result[2] is not None and dock.__dict__.get("_prebuilt_model") is None  # so did the model
     print(f"\n[GUI thread] open workspace {open_ms:.0f} ms (first, with imports), again {reopen_ms:.0f} ms; "
           f"Load results click {click_ms:.0f} ms (layers after {results_total:.0f} ms), all on the GUI thread "
           f"{sync_results_ms:.0f} ms; georeference done callback {timings['done']:.0f} ms")
@@ -611,3 +612,36 @@ def test_qgis_desktop_lang_de(georef_ws, tmp_path):
     assert log["window"][0] <= 1366 and log["window"][1] <= 768  # the docks' minimum sizes fit the screen
     os.makedirs(SHOTS, exist_ok=True)
     shutil.copyfile(out / "screen.png", os.path.join(SHOTS, "qgis-desktop-de.png"))
+
+
+def test_open_button_reads_the_block_model_in_a_task(default_dock, georef_ws, monkeypatch):
+    """Open…: the folder is chosen, the block model (the slow part of opening) is read in a task, then the
+    workspace opens with it; the click itself returns at once.  Timings printed."""
+    from qgis.PyQt.QtCore import Qt
+    from qgis.PyQt.QtTest import QTest
+    from qgis.PyQt.QtWidgets import QFileDialog
+
+    dock = default_dock
+    dock.refine_in_background = True
+    monkeypatch.setattr(QFileDialog, "getExistingDirectory", staticmethod(lambda *a, **k: georef_ws))
+    read = []
+    from archaeoortho.ui import gcp_tasks
+
+    real = gcp_tasks.read_block_model
+
+    def reading(root, progress=None):
+        read.append(root)
+        return real(root, progress=progress)
+
+    monkeypatch.setattr(gcp_tasks, "read_block_model", reading)
+    _, click_ms = _ms(lambda: QTest.mouseClick(dock.btn_open, Qt.MouseButton.LeftButton))
+    assert dock._open_task is not None and dock.store.root is None  # not opened on the GUI thread
+    t0 = time.perf_counter()
+    while dock._open_task is not None and time.perf_counter() - t0 < 60:
+        process(20)
+    total_ms = 1000.0 * (time.perf_counter() - t0)
+    assert read == [georef_ws] and dock.store.root == georef_ws
+    assert dock.predictor is not None and dock.predictor.georeferenced
+    assert dock.__dict__.get("_prebuilt_model") is None  # used by load_predictor, not read again
+    assert dock.current_name() is not None and dock.predictions
+    print(f"\n[open button] click {click_ms:.0f} ms on the GUI thread; workspace open after {total_ms:.0f} ms")

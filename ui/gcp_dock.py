@@ -330,7 +330,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
     def choose_workspace(self):
         folder = QFileDialog.getExistingDirectory(self, self.tr("Open an ArchaeoOrtho workspace"))
         if folder:
-            self.open_workspace(folder)
+            self.open_workspace_in_background(folder)  # the block model is read in a task (issue 18.5)
 
     def open_workspace(self, folder):
         from ..core.project.workspace import WorkspaceError

@@ -41,12 +41,14 @@ class GcpPlacement:
         ws = self.store.root
         try:
             if self.store.stage_done(GEOREFERENCE) and os.path.isdir(self.store.layout.georef_model_dir):
-                rec, transform = load_georef_model(ws)
+                prebuilt = self._take_prebuilt_model(ws, True)  # read and measured in a task (GcpTasks), or None
+                rec, transform = prebuilt[:2] if prebuilt else load_georef_model(ws)
                 same = layers.qgs_crs(transform.get("crs", "")) == layers.qgs_crs(self.store.crs)
                 self.predictor = guided.Predictor(rec, transform.get("offset") if same else None)
             else:
-                self.predictor = guided.Predictor(align_stage.load_model(ws))
-            gsd = guided.ground_sample_distance(self.predictor.rec)
+                prebuilt = self._take_prebuilt_model(ws, False)
+                self.predictor = guided.Predictor(prebuilt[0] if prebuilt else align_stage.load_model(ws))
+            gsd = prebuilt[2] if prebuilt else guided.ground_sample_distance(self.predictor.rec)
             self._gsd_tolerance = None
             if gsd and self.predictor.georeferenced and not self.store.settings.get("tolerance"):
                 self._gsd_tolerance = (max(0.001, round(3.0 * gsd, 3)), gsd)

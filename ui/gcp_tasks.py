@@ -22,7 +22,28 @@ def georeference_then_prepare(root, progress=None, **kwargs):
     from ..core.georef import stage as georef_stage
 
     result = georef_stage.georeference_workspace(root, progress=progress, **kwargs)
-    return result, prepare_results(root, progress=progress)
+    try:
+        model = read_block_model(root)
+    except Exception:  # noqa: BLE001 - the dock's load_predictor reads it again and reports the problem
+        model = None
+    return result, prepare_results(root, progress=progress), model
+
+
+def read_block_model(root, progress=None):
+    """(model, transform or None, ground sample distance) of a workspace, read in a worker thread for
+    GcpPlacement.load_predictor: the georeferenced model when there is one, else the aligned one."""
+    from ..core.align import stage as align_stage
+    from ..core.georef import guided
+    from ..core.georef.stage import load_georef_model
+    from ..core.project.layout import Layout
+    from ..core.project.workspace import Workspace
+
+    ws = Workspace.open(root)
+    if ws.stage_done(GEOREFERENCE) and os.path.isdir(Layout(ws).georef_model_dir):
+        rec, transform = load_georef_model(root)
+    else:
+        rec, transform = align_stage.load_model(root), None
+    return rec, transform, guided.ground_sample_distance(rec)
 
 
 def prepare_results(root, progress=None):
@@ -52,6 +73,43 @@ class GcpTasks:
     refinement of predictions by matching in tasks of their own."""
 
     refine_in_background = False  # the plugin's dock: True (the photo shows the geometric prediction meanwhile)
+
+    # ------------------------------------------------------------------ the block model, read in a task
+    def _take_prebuilt_model(self, root, georeferenced):
+        """(model, transform, gsd) a task read for ``root`` (once; the georeferenced model when
+        ``georeferenced``), else None: GcpPlacement.load_predictor reads it itself then."""
+        prebuilt = self.__dict__.pop("_prebuilt_model", None)
+        if prebuilt is None or os.path.normpath(prebuilt[0]) != os.path.normpath(root):
+            return None
+        model = prebuilt[1]
+        return model if (model[1] is not None) == bool(georeferenced) else None
+
+    def open_workspace_in_background(self, folder):
+        """The Open button: the block model is read in a task, then the workspace opens (fast)."""
+        from ..core.project.workspace import Workspace, WorkspaceError
+
+        try:
+            Workspace.open(folder)  # a folder that is no workspace is told at once
+        except WorkspaceError as e:
+            self.message(str(e), Qgis.MessageLevel.Critical)
+            return None
+        if self.__dict__.get("_open_task") is not None:
+            return None
+
+        def done(model):
+            self._open_task = None
+            self._prebuilt_model = (folder, model)
+            self.open_workspace(folder)
+
+        def failed(message, cancelled):
+            self._open_task = None
+            self._prebuilt_model = None
+            self.open_workspace(folder)  # without a model: the dock says why there are no predictions
+
+        self._open_task = CoreTask(translate("GcpDock", "ArchaeoOrtho: open workspace"), read_block_model,
+                                   (folder,), on_done=done, on_error=failed)
+        self.message(translate("GcpDock", "Opening {}\u2026").format(os.path.basename(os.path.normpath(folder))))
+        return start(self._open_task)
 
     # ------------------------------------------------------------------ refinement by matching
     def _refine_later(self, key, point, image, pred):
@@ -192,10 +250,11 @@ class GcpTasks:
         root = self.store.root
 
         def done(outcome):
-            result, footprints = outcome
+            result, footprints, model = outcome
             self._task_ended()
             self.progress.setValue(100)
             self.store.reload_workspace()
+            self._prebuilt_model = (root, model) if model is not None else None
             self.store.save()  # the stage wrote the points it used to control.json: keep all of the dock's
             self.store.load_residuals()
             self.load_predictor()
