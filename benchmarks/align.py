@@ -148,7 +148,45 @@ def _has_gps(images):
 
 
 SHARED = os.path.join(os.path.dirname(ROOT), "shared", "data")
-TABLE_SETS = ("small", "toledo", "copr", "caliterra", "ochota_kap", "toledo_2400")
+TABLE_SETS = ("small", "toledo", "copr", "caliterra", "ochota_kap", "toledo_2400", "synthetic_mixed")
+
+
+def _write_jpeg_with_exif(path, pixels, cam, make, model):
+    """A JPEG with Make, Model and FocalLengthIn35mmFilm (the focal prior and the camera grouping read them)."""
+    import math
+
+    from PIL import Image
+
+    from core.io.images import FULL_FRAME_DIAGONAL_MM
+
+    ex = Image.Exif()
+    ex[0x010F], ex[0x0110] = make, model
+    ex.get_ifd(0x8769)[0xA405] = int(round(cam.fx / math.hypot(cam.width, cam.height) * FULL_FRAME_DIAGONAL_MM))
+    Image.fromarray(pixels).save(path, quality=95, exif=ex)
+
+
+def synthetic_mixed(dst):
+    """Issue 13 item 5's synthetic block: the tests' orbit (tests/synthetic.py orbit_block, 6 views at 45 and 6
+    at 65 degrees off nadir, horizon in the 65 degree views, 480 x 360 camera) plus 6 verticals over the site
+    from another camera (640 x 480, its own focal length and distortion)."""
+    import numpy as np
+
+    import tests.synthetic as syn
+
+    os.makedirs(dst, exist_ok=True)
+    orbit = syn.orbit_block(seed=21, per_ring=6)
+    for k, s in enumerate(orbit.shots):
+        _write_jpeg_with_exif(os.path.join(dst, s.name), syn.render_oblique_image(orbit.scene, orbit.camera, s, seed=k),
+                              orbit.camera, "Synth", "Orbit480")
+    vcam = syn.CameraModel(640, 480, 560.0, 560.0, 322.1, 238.4, k1=-0.03, k2=0.005)
+    z = orbit.scene.base_z + orbit.altitude
+    for k, (x, y) in enumerate([(-12, -8), (0, -8), (12, -8), (-12, 8), (0, 8), (12, 8)]):
+        c = np.array([x, y, z])
+        shot = syn.Shot(f"V_{k + 1:02d}.jpg", syn.look_at(c, c - np.array([0, 0, 1.0]), np.array([0.0, 1.0, 0.0])),
+                        c, "vertical", 9)
+        _write_jpeg_with_exif(os.path.join(dst, shot.name), syn.render_oblique_image(orbit.scene, vcam, shot, seed=100 + k),
+                              vcam, "Synth", "Nadir640")
+    return dst
 
 
 def _half_size_copies(src, dst):
@@ -177,6 +215,11 @@ def table_set(name, work):
             small_frames(os.path.join(ROOT, "sample", "toledo", "images"), SMALL_FRAMES, d)
         return d, {"focal_mm": FOCAL_MM, "sensor_width_mm": SENSOR_WIDTH_MM}, \
             "5 Toledo frames at 1152 x 640, contrast 12 %, no EXIF (tests/test_align_escalation.py)"
+    if name == "synthetic_mixed":
+        d = os.path.join(work, "synthetic-mixed")
+        if not os.path.isdir(d):
+            synthetic_mixed(d)
+        return d, {}, "orbit 6 x 45 deg + 6 x 65 deg (480 x 360) + 6 verticals (640 x 480, another camera)"
     if name == "ochota_kap":
         return _half_size_copies(os.path.join(SHARED, name, "images"), os.path.join(work, "ochota-half")), {}, \
             "half size (2304 x 1728), EXIF kept"
