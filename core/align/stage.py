@@ -11,7 +11,9 @@
 - ``cameras.gpkg``: the camera positions (model frame).
 
 The algorithm modules: :mod:`.features` (cameras, masks, extraction, matching), :mod:`.pairs` (pair
-selection), :mod:`.mapping` (incremental or global mapping, bundle adjustment); the options in :mod:`.options`.
+selection), :mod:`.mapping` (incremental or global mapping, bundle adjustment), :mod:`.escalation` (richer
+features and more pairs for the images the fast path left out, or a split block; ``escalation`` in
+``sfm/alignment.json`` says what was done per image and why); the options in :mod:`.options`.
 """
 from __future__ import annotations
 
