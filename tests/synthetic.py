@@ -972,6 +972,36 @@ def _far_texture(seed: int) -> np.ndarray:
     return np.clip(0.5 + 0.12 * tex, 0.05, 0.95).astype(np.float32)
 
 
+CLOUD_CELL = (360.0 / 512, 0.5)  # degrees of azimuth and of elevation per cloud texture cell (clouds far away)
+
+
+@lru_cache(maxsize=2)
+def _cloud_texture(seed: int) -> Tuple[np.ndarray, np.ndarray]:
+    """(density 0..1, shading 0.8..1) periodic tiles of the clouds: band-limited noise, thresholded."""
+    n = 512
+    rng = np.random.default_rng(seed + 303)
+    f = np.fft.fftfreq(n)
+    fr = np.hypot(f[None, :], f[:, None])
+    out = []
+    for wavelength in (20.0, 5.0):  # cells
+        band = np.exp(-0.5 * (fr * wavelength / 2.0) ** 2) - np.exp(-0.5 * (fr * wavelength) ** 2)
+        noise = np.real(np.fft.ifft2(np.fft.fft2(rng.normal(0.0, 1.0, (n, n))) * band))
+        out.append(noise / max(noise.std(), 1e-9))
+    density = np.clip((out[0] + 0.3 * out[1] - 0.2) * 3.0, 0.0, 1.0).astype(np.float32)
+    shading = (0.92 + 0.03 * np.tanh(out[1])).astype(np.float32)
+    return density, shading
+
+
+def _wrap_bilinear(tex: np.ndarray, mx: np.ndarray, my: np.ndarray) -> np.ndarray:
+    """Bilinear samples of a periodic tile at cell coordinates (any size, wrapping around)."""
+    n0, n1 = tex.shape
+    c0, r0 = np.floor(mx).astype(np.int64), np.floor(my).astype(np.int64)
+    fx_, fy_ = (mx - c0).astype(np.float32), (my - r0).astype(np.float32)
+    c0, r0, c1, r1 = c0 % n1, r0 % n0, (c0 + 1) % n1, (r0 + 1) % n0
+    return ((1 - fy_) * ((1 - fx_) * tex[r0, c0] + fx_ * tex[r0, c1])
+            + fy_ * ((1 - fx_) * tex[r1, c0] + fx_ * tex[r1, c1]))
+
+
 def _far_hit(scene: Scene, centre: np.ndarray, d: np.ndarray, iterations: int = 8) -> np.ndarray:
     """Intersections (N,3) of downward rays with the smooth analytic ground (no buildings; ramp and hills as
     ``scene.ground_at``), by Newton's method from the plane z = base_z."""
@@ -1007,13 +1037,17 @@ def _enters_scene(scene: Scene, centre: np.ndarray, d: np.ndarray) -> np.ndarray
 
 
 def render_oblique_image(scene: Scene, camera: CameraModel, shot: Shot, supersample: int = 2, noise: float = 1.5,
-                         seed: int = 0) -> np.ndarray:
+                         seed: int = 0, clouds: float = 0.0,
+                         cloud_drift: Tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
     """RGB uint8 image (height, width, 3) of a shot that may see beyond the scene and above the horizon.
 
     Rays that cross the scene are cast into its height field as in :func:`render_image`; rays that miss it meet
     the smooth analytic ground beyond (a periodic far-field texture, so the ground goes on to the horizon); rays
     at or above the horizontal are sky (blue, paler towards the horizon).  Everything fades into haze with
-    distance (``HAZE_DISTANCE``).  Ground grey values are tinted brownish (``GROUND_TINT``)."""
+    distance (``HAZE_DISTANCE``).  Ground grey values are tinted brownish (``GROUND_TINT``).  ``clouds`` > 0: white
+    clouds of that opacity far away (a pattern of azimuth and elevation), more than 2-4 degrees above the horizon,
+    moved by ``cloud_drift`` (degrees of azimuth and elevation: they drift between exposures, so matching them
+    would be wrong)."""
     s = int(supersample)
     canvas_xn, map_x, map_y, vignetting = _canvas_geometry(camera, s)
     d = shot.rays(canvas_xn).reshape(-1, 3)
@@ -1040,12 +1074,7 @@ def render_oblique_image(scene: Scene, camera: CameraModel, shot: Shot, supersam
     if far.any():
         tex = _far_texture(scene.seed)
         n = tex.shape[0]
-        mx, my = np.mod(xyz[far, 0] / FAR_RES, n), np.mod(-xyz[far, 1] / FAR_RES, n)
-        c0, r0 = np.floor(mx).astype(np.int64), np.floor(my).astype(np.int64)
-        fx_, fy_ = (mx - c0).astype(np.float32), (my - r0).astype(np.float32)
-        c0, r0, c1, r1 = c0 % n, r0 % n, (c0 + 1) % n, (r0 + 1) % n  # bilinear, wrapping around
-        grey[far] = ((1 - fy_) * ((1 - fx_) * tex[r0, c0] + fx_ * tex[r0, c1])
-                     + fy_ * ((1 - fx_) * tex[r1, c0] + fx_ * tex[r1, c1]))
+        grey[far] = _wrap_bilinear(tex, np.mod(xyz[far, 0] / FAR_RES, n), np.mod(-xyz[far, 1] / FAR_RES, n))
     rgb = np.clip(grey[:, None] * GROUND_TINT[None, :], 0.0, 1.0)
     dist = np.linalg.norm(xyz - shot.centre[None, :], axis=1)
     keep = np.exp(-dist / HAZE_DISTANCE).astype(np.float32)[:, None]
@@ -1053,6 +1082,16 @@ def render_oblique_image(scene: Scene, camera: CameraModel, shot: Shot, supersam
     elev = np.clip(d[sky, 2], 0.0, 1.0)
     w = np.exp(-elev / 0.12)[:, None].astype(np.float32)
     rgb[sky] = SKY_ZENITH[None, :] * (1.0 - w) + HAZE[None, :] * w
+    if clouds > 0 and sky.any():
+        ds = d[sky]
+        elev_deg = np.degrees(np.arcsin(np.clip(ds[:, 2], -1.0, 1.0)))
+        cx = (np.degrees(np.arctan2(ds[:, 1], ds[:, 0])) + cloud_drift[0]) / CLOUD_CELL[0]
+        cy = (elev_deg + cloud_drift[1]) / CLOUD_CELL[1]
+        density_t, shading_t = _cloud_texture(scene.seed)
+        fade = np.clip((elev_deg - 2.0) / 2.0, 0.0, 1.0).astype(np.float32)
+        a = (clouds * fade * _wrap_bilinear(density_t, cx, cy))[:, None]
+        white = _wrap_bilinear(shading_t, cx, cy)[:, None] * np.array([0.97, 0.97, 0.98], np.float32)[None, :]
+        rgb[sky] = rgb[sky] * (1.0 - a) + white * a
     canvas = rgb.reshape(canvas_xn.shape[:2] + (3,)).astype(np.float32)
     canvas = cv2.GaussianBlur(canvas, (0, 0), 0.45 * s)
     img = cv2.remap(canvas, map_x, map_y, cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE)
@@ -1067,12 +1106,16 @@ class ObliqueBlock(SyntheticBlock):
     (:func:`render_oblique_image`); ``sky_mask`` is the truth of which pixels see the sky."""
 
     tilts: Dict[str, float] = field(default_factory=dict)  # image -> degrees off nadir
+    clouds: float = 0.0  # opacity of the clouds (render_oblique_image)
+    cloud_drift: Tuple[float, float] = (2.0, 0.1)  # degrees (azimuth, elevation) the clouds move per exposure
 
     def render(self, folder: str, supersample: int = 2, ext: str = ".jpg", quality: int = 95) -> List[str]:
         os.makedirs(folder, exist_ok=True)
         paths = []
         for k, s in enumerate(self.shots):
-            img = render_oblique_image(self.scene, self.camera, s, supersample, seed=self.seed * 1000 + k)
+            img = render_oblique_image(self.scene, self.camera, s, supersample, seed=self.seed * 1000 + k,
+                                       clouds=self.clouds,
+                                       cloud_drift=(k * self.cloud_drift[0], k * self.cloud_drift[1]))
             path = os.path.join(folder, s.name if s.name.lower().endswith(ext) else s.name + ext)
             params = [cv2.IMWRITE_JPEG_QUALITY, quality] if ext.lower() in (".jpg", ".jpeg") else []
             if not cv2.imwrite(path, cv2.cvtColor(img, cv2.COLOR_RGB2BGR), params):
@@ -1131,11 +1174,13 @@ class ObliqueBlock(SyntheticBlock):
 def orbit_block(seed: int = 21, camera: CameraModel = ORBIT_CAMERA, altitude: float = 40.0,
                 tilts: Sequence[float] = (45.0, 65.0), per_ring: int = 8, half_size: float = 65.0,
                 attitude_sigma_deg: float = 1.0, position_jitter: float = 0.5, target_jitter: float = 3.0,
-                n_buildings: int = 5, gcp_half: float = 22.0, ring_offset: float = 0.5) -> ObliqueBlock:
+                n_buildings: int = 5, gcp_half: float = 22.0, ring_offset: float = 0.5,
+                clouds: float = 0.8) -> ObliqueBlock:
     """Cameras circling the site, ``per_ring`` per tilt (degrees off nadir), all ``altitude`` above the base and
     looking at (near) the centre, image up = world up (the horizon at the top of the steep ones; at 65 deg with
     ORBIT_CAMERA the top ~40 rows are sky).  The rings are offset by ``ring_offset`` of a step in azimuth.  The scene is
-    ``half_size`` m either side of the centre (no ramp, so the ground beyond it continues smoothly)."""
+    ``half_size`` m either side of the centre (no ramp, so the ground beyond it continues smoothly); ``clouds``: their
+    opacity in the sky (drifting between exposures), 0 for a clear sky."""
     rng = np.random.default_rng(seed)
     scene = make_scene(seed, (-half_size, -half_size, half_size, half_size), n_buildings=n_buildings)
     scene.ramp = (0.0, 0.0)
@@ -1153,6 +1198,6 @@ def orbit_block(seed: int = 21, camera: CameraModel = ORBIT_CAMERA, altitude: fl
             name = f"T{int(round(tilt))}_{k + 1:02d}.jpg"
             shots.append(Shot(name, r, c, "oblique", ri + 1))
             tilt_of[name] = float(tilt)
-    block = ObliqueBlock(scene, camera, shots, altitude, seed=seed, tilts=tilt_of)
+    block = ObliqueBlock(scene, camera, shots, altitude, seed=seed, tilts=tilt_of, clouds=clouds)
     block.add_site_gcps(gcp_half)
     return block

@@ -8,8 +8,9 @@ noise) and the haze along the horizon matches anything.
   pale grey-white, connected to the upper edge of the upright photo (its EXIF orientation is applied first).
   The detector marks the pixels of low local texture (standard deviation in a 7 x 7 window, at an analysis size
   of ``SkyOptions.analysis_size``) that are bright and bluish or pale, keeps the connected regions of them that
-  span at least ``min_top_cover`` of the upper edge and do not reach the lower one (a smooth field or road running
-  across a vertical photo does), fills their holes (a bird, a cloud's edge), and widens the result by
+  touch the upper edge and do not reach the lower one (a smooth field or road running across a vertical photo
+  does) and together span at least ``min_top_cover`` of it, fills their holes (clouds, a bird: what the lower
+  edge cannot reach without crossing the sky), and widens the result by
   ``SkyOptions.margin`` of the image height downwards to take the horizon's mixed pixels.  A region under
   ``min_fraction`` of the image is no sky (a pale roof at the upper edge of a vertical photo).
 - :func:`write_sky_masks` writes those masks through the mask machinery of :mod:`core.prepare.masks`
@@ -89,6 +90,22 @@ def _candidates(img: np.ndarray, options: SkyOptions) -> np.ndarray:
     return smooth & bright & (bluish | pale)
 
 
+def _down_to_the_ground(cand: np.ndarray, columns: np.ndarray) -> np.ndarray:
+    """In the ``columns`` that have sky at the top: every row above the first run of non-sky pixels longer than 4 %
+    of the height (the ground; a cloud's edge or a bird is shorter), unless no such run reaches down (no ground)."""
+    h = cand.shape[0]
+    need = max(3, int(round(0.04 * h)))
+    run = np.zeros(cand.shape, np.int32)
+    acc = np.zeros(cand.shape[1], np.int32)
+    for r in range(h - 1, -1, -1):
+        acc = np.where(cand[r], 0, acc + 1)
+        run[r] = acc
+    hit = run >= need
+    first = np.where(hit.any(axis=0), hit.argmax(axis=0), h)
+    ok = columns & (first < h)
+    return (np.arange(h)[:, None] < first[None, :]) & ok[None, :]
+
+
 def sky_keep(img: np.ndarray, options: Optional[SkyOptions] = None, orientation: int = 1) -> np.ndarray:
     """(height, width) bool of an image array (rows, cols[, bands]): True = use, False = sky.
 
@@ -108,16 +125,20 @@ def sky_keep(img: np.ndarray, options: Optional[SkyOptions] = None, orientation:
     n, labels = cv2.connectedComponents(cand, connectivity=4)
     # the sky: regions spanning a good part of the upper edge (min_top_cover) that do not reach the lower one (a
     # smooth field or road running across a vertical photo does)
-    top_ids, top_counts = np.unique(labels[0][cand[0] > 0], return_counts=True)
+    # (clouds may split it: the regions touching the upper edge count together, over the top 5 % of the rows)
     bottom = set(np.unique(labels[-1]).tolist())
-    ids = [i for i, c in zip(top_ids, top_counts) if c >= options.min_top_cover * cand.shape[1] and i not in bottom]
+    ids = [i for i in np.unique(labels[0][cand[0] > 0]) if i not in bottom]
     sky = np.isin(labels, ids) if n > 1 and ids else np.zeros(cand.shape, bool)
+    band = max(1, int(round(0.05 * sky.shape[0])))
+    if sky[:band].any(axis=0).mean() < options.min_top_cover:
+        sky[:] = False
+    sky |= _down_to_the_ground(cand > 0, sky[:band].any(axis=0))
     if sky.mean() < options.min_fraction:
         return np.ones((height, width), bool)
-    # holes: what the bottom and side edges cannot reach without crossing the sky is sky too
+    # holes (clouds, a bird): what the lower edge cannot reach without crossing the sky is sky too
     ground = (~sky).astype(np.uint8)
     n, labels = cv2.connectedComponents(ground, connectivity=4)
-    edge = np.unique(np.concatenate([labels[-1], labels[:, 0], labels[:, -1]]))
+    edge = np.unique(labels[-1])
     sky = ~np.isin(labels, edge[edge > 0])
     m = max(1, int(round(options.margin * sky.shape[0])))
     sky = cv2.dilate(sky.astype(np.uint8), cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * m + 1, 2 * m + 1))) > 0
