@@ -136,6 +136,7 @@ def test_fast_path_fails_on_small_low_contrast_frames_and_escalation_fixes_it(sm
         one = record["images"][n.replace(".JPG", ".png")]
         assert one["why"] and one["registered"] is True and one["rounds"] and one["escalated"]
     assert json.load(open(ws / "workspace.json"))["stages"]["align"]["results"]["escalation_rounds"] >= 1
+    assert not (ws / "sfm" / "database.db.before-escalation").exists()  # the round's backup is removed
 
 
 @pytest.mark.slow

@@ -20,11 +20,15 @@ cheaper retry first:
    image: the cost stays that of the images that failed, not of the block.
 
 After each round the mapping runs again on the enlarged database (one merged reconstruction); a round's result
-is kept only when it registers more images in the main block (or as many in fewer components).  What was
-escalated, for which image and why, goes to the log and to ``sfm/alignment.json`` (``escalation``).
+is kept only when it registers more images in the main block (or as many in fewer components); otherwise the
+database goes back to its state before the round (a copy taken before it), so that it always holds the
+features and matches of the result kept.  What was escalated, for which image and why, goes to the log and to
+``sfm/alignment.json`` (``escalation``).
 """
 from __future__ import annotations
 
+import os
+import shutil
 import sqlite3
 import time
 from dataclasses import asdict, dataclass, field
@@ -282,6 +286,21 @@ def _run_round(ctx: EscalationContext, k: int, reason: str, ordered, left: List[
     return row, new
 
 
+def _backup_database(db_path: str) -> str:
+    """A copy of the (closed) database beside it, taken before a round: restored when the round is not kept."""
+    backup = db_path + ".before-escalation"
+    for suffix in ("-wal", "-shm"):  # every connection is closed: a leftover journal is checkpointed first
+        if os.path.exists(db_path + suffix):
+            con = sqlite3.connect(db_path)
+            try:
+                con.execute("PRAGMA wal_checkpoint(TRUNCATE)")
+            finally:
+                con.close()
+            break
+    shutil.copyfile(db_path, backup)
+    return backup
+
+
 def _hopeful(ctx: EscalationContext, registered: Set[str], others: List[List[str]], progress: Progress) -> List[str]:
     """The images round 2 (affine shape + DSP, the slow features) is worth running for: those still outside the
     main block that, after round 1's richer features, share a verified pair with some image or sit in another
@@ -319,10 +338,17 @@ def escalate(ctx: EscalationContext, ordered, progress: Progress):
             left = _hopeful(ctx, registered, others, progress)
             if not left:
                 break
-        row, new = _run_round(ctx, k, reason, ordered, left, SubProgress(progress, (k - 1) / 2.0, k / 2.0))
-        record.rounds.append(row)
-        if row.kept:
-            ordered = new
+        backup = _backup_database(ctx.db_path)
+        try:
+            row, new = _run_round(ctx, k, reason, ordered, left, SubProgress(progress, (k - 1) / 2.0, k / 2.0))
+            record.rounds.append(row)
+            if row.kept:
+                ordered = new
+            else:  # the database goes back to the features and matches of the result kept (a re-run reuses them)
+                os.replace(backup, ctx.db_path)
+        finally:
+            if os.path.exists(backup):
+                os.unlink(backup)
         progress.info(f"escalation round {k}: main block {row.registered_before} -> {row.registered_after} images, "
                       f"{row.components_before} -> {row.components_after} component(s), {row.seconds:.1f} s"
                       + ("" if row.kept else "; not better, the previous result kept"))
