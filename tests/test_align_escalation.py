@@ -178,3 +178,35 @@ def test_mixed_cameras_register_in_one_block(tmp_path):
     assert groups["FC300X"] == set(MIXED_FC300X) and groups["FC350"] == set(MIXED_FC350)
     model = {c["camera_id"]: c for c in r.cameras}
     assert {m["width"] for m in model.values()} == {1200}  # the matching scale does not change the camera
+
+
+def test_a_round_not_kept_puts_the_database_back(tmp_path, monkeypatch):
+    """A round whose mapping is worse than the result before it: the result and the database stay as they were."""
+    import core.align.escalation as esc
+    from core.common.progress import NullProgress
+
+    db = tmp_path / "database.db"
+    con = sqlite3.connect(db)
+    con.execute("CREATE TABLE keypoints (image_id INTEGER, rows INTEGER)")
+    con.execute("INSERT INTO keypoints VALUES (1, 10)")
+    con.commit()
+    con.close()
+
+    def worse_round(ctx, k, reason, ordered, left, progress):
+        c = sqlite3.connect(ctx.db_path)
+        c.execute("DELETE FROM keypoints")  # the round's new features...
+        c.commit()
+        c.close()
+        return esc.EscalationRound(k, reason, {n: "?" for n in left}, list(left), [], {}, 1, 2, 1, 1, 1), []
+
+    monkeypatch.setattr(esc, "_run_round", worse_round)
+    ctx = esc.EscalationContext(None, str(db), str(tmp_path), str(tmp_path), ["a", "b", "c"], [], {}, AlignOptions(),
+                                [], None, [], lambda p: [], lambda reg, oth: {}, lambda: {"c": 1})
+    before = [_Rec(["a", "b"])]
+    out, record = esc.escalate(ctx, before, NullProgress())
+    assert out is before and [r.round for r in record.rounds] == [1, 2]  # c has a verified pair: round 2 ran
+    assert record.images["c"]["registered"] is False and record.images["c"]["rounds"] == [1, 2]
+    con = sqlite3.connect(db)
+    assert con.execute("SELECT COUNT(*) FROM keypoints").fetchone()[0] == 1  # ...are gone again
+    con.close()
+    assert not os.path.exists(str(db) + ".before-escalation")
