@@ -1259,7 +1259,7 @@ Curve di livello: il GeoPackage da scrivere.</translation>
     <message>
         <location filename="../ui/gcp_tasks.py" line="109"/>
         <source>ArchaeoOrtho: open workspace</source>
-        <translation>ArchaeoOrtho: apri l&apos;area di lavoro</translation>
+        <translation>ArchaeoOrtho: apri l'area di lavoro</translation>
     </message>
     <message>
         <location filename="../ui/gcp_tasks.py" line="111"/>
