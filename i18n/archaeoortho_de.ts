@@ -57,18 +57,18 @@
         <location filename="../ui/catalog.py" line="7"/>
         <source>Writes one self-contained HTML report of a workspace (plots embedded, readable offline) and returns its key figures.
 
-Summary: images given / aligned / not aligned and why, image screening, cameras with their calibrated parameters and standard deviations, GSD, area, CRS, processing times and parameters. Orientation quality: reprojection errors, tie-point track lengths, image connectivity, camera positions with residuals. Georeferencing: control and check points with dX dY dZ and image residuals, residual vectors, RMSE per set, NSSDA (FGDC-STD-007.3-1998) accuracy statements at 95 % confidence, ASPRS 2014 and 2023 accuracy classes, camera-position residuals, outliers. Uncertainty: standard deviations of cameras and tie points from the bundle adjustment covariance. Products: DSM and orthomosaic previews, resolution, valid fraction. Sections whose stage has not run are skipped with a note.
+Sections of the report. Summary — images given / aligned / not aligned and why, image screening, cameras with their calibrated parameters and standard deviations, GSD, area, CRS, processing times and parameters. Orientation quality: reprojection errors, tie-point track lengths, image connectivity, camera positions with residuals. Georeferencing: control and check points with dX dY dZ and image residuals, residual vectors, RMSE per set, NSSDA (FGDC-STD-007.3-1998) accuracy statements at 95 % confidence, ASPRS 2014 and 2023 accuracy classes, camera-position residuals, outliers. Uncertainty: standard deviations of cameras and tie points from the bundle adjustment covariance. Products: DSM and orthomosaic previews, resolution, valid fraction. Sections whose stage has not run are skipped with a note.
 
-WORKSPACE: a workspace folder (at least aligned).
-UNCERTAINTY: compute the covariance (seconds for hundreds of images) and write &lt;workspace&gt;/uncertainty/cameras.gpkg and points.gpkg.
-OUTPUT_HTML: the report file (default: &lt;workspace&gt;/report.html). It is written under a temporary name and renamed when complete.</source>
+Workspace folder: a workspace folder (at least aligned).
+Compute the bundle adjustment covariance: computes it (seconds for hundreds of images) and writes &lt;workspace&gt;/uncertainty/cameras.gpkg and points.gpkg.
+Report: the report file (default: &lt;workspace&gt;/report.html). It is written under a temporary name and renamed when complete.</source>
         <translation>Schreibt einen eigenständigen HTML-Bericht über einen Arbeitsbereich (Diagramme eingebettet, offline lesbar) und gibt seine Kennzahlen zurück.
 
-Übersicht: gegebene / orientierte / nicht orientierte Bilder und warum, Bildprüfung, Kameras mit ihren kalibrierten Parametern und Standardabweichungen, GSD, Fläche, KBS, Rechenzeiten und Parameter. Orientierungsqualität: Rückprojektionsfehler, Längen der Verknüpfungspunkt-Spuren, Bildverbindungen, Kamerapositionen mit Residuen. Georeferenzierung: Pass- und Kontrollpunkte mit dX dY dZ und Bildresiduen, Residuenvektoren, RMSE je Gruppe, Genauigkeitsangaben nach NSSDA (FGDC-STD-007.3-1998) mit 95 % Konfidenz, ASPRS-Genauigkeitsklassen 2014 und 2023, Residuen der Kamerapositionen, Ausreißer. Unsicherheit: Standardabweichungen der Kameras und Verknüpfungspunkte aus der Kovarianz der Bündelblockausgleichung. Produkte: Vorschauen von DOM und Orthomosaik, Auflösung, Anteil gültiger Zellen. Abschnitte, deren Schritt nicht gelaufen ist, werden mit einem Hinweis ausgelassen.
+Abschnitte des Berichts. Übersicht — gegebene / orientierte / nicht orientierte Bilder und warum, Bildprüfung, Kameras mit ihren kalibrierten Parametern und Standardabweichungen, GSD, Fläche, KBS, Rechenzeiten und Parameter. Orientierungsqualität: Rückprojektionsfehler, Längen der Verknüpfungspunkt-Spuren, Bildverbindungen, Kamerapositionen mit Residuen. Georeferenzierung: Pass- und Kontrollpunkte mit dX dY dZ und Bildresiduen, Residuenvektoren, RMSE je Gruppe, Genauigkeitsangaben nach NSSDA (FGDC-STD-007.3-1998) mit 95 % Konfidenz, ASPRS-Genauigkeitsklassen 2014 und 2023, Residuen der Kamerapositionen, Ausreißer. Unsicherheit: Standardabweichungen der Kameras und Verknüpfungspunkte aus der Kovarianz der Bündelblockausgleichung. Produkte: Vorschauen von DOM und Orthomosaik, Auflösung, Anteil gültiger Zellen. Abschnitte, deren Schritt nicht gelaufen ist, werden mit einem Hinweis ausgelassen.
 
-WORKSPACE: ein Arbeitsbereich-Ordner (mindestens orientiert).
-UNCERTAINTY: die Kovarianz berechnen (Sekunden für Hunderte von Bildern) und &lt;workspace&gt;/uncertainty/cameras.gpkg und points.gpkg schreiben.
-OUTPUT_HTML: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird unter einem vorläufigen Namen geschrieben und erst umbenannt, wenn sie vollständig ist.</translation>
+Arbeitsbereich-Ordner: ein Arbeitsbereich-Ordner (mindestens orientiert).
+Kovarianz der Bündelblockausgleichung berechnen: berechnet sie (Sekunden für Hunderte von Bildern) und schreibt &lt;workspace&gt;/uncertainty/cameras.gpkg und points.gpkg.
+Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird unter einem vorläufigen Namen geschrieben und erst umbenannt, wenn sie vollständig ist.</translation>
     </message>
 </context>
 <context>
@@ -303,28 +303,28 @@ Rekonstruktionsverfahren (erweitert): 'incremental' (COLMAP, Standard) oder 'glo
 
 Stereo pairs are chosen from the sparse model (shared tie points, baseline-to-depth ratio, viewing angle); each pair is undistorted and rectified from the known poses and matched with semi-global matching (OpenCV SGBM) with a left-right check; a pixel is kept where at least two independent pairs agree. The fused points are rasterised (median of the highest height cluster per cell), small holes are filled and large ones left nodata.
 
-WORKSPACE: a georeferenced workspace (run &apos;Georeference&apos; first: a DSM needs a metric scale and a vertical direction, so a workspace that is only aligned is refused).
-RESOLUTION: DSM cell size in metres; 0 = about twice the median ground sample distance.
-QUALITY: image scale for matching (full, half, quarter): half is four times faster than full.
-ENGINE: cpu (default); cuda runs COLMAP patch-match stereo where pycolmap was built with CUDA.
-OUTPUT_DSM: Cloud-Optimized GeoTIFF, float32 with nodata (default: &lt;workspace&gt;/dsm.tif).
-OUTPUT_POINT_CLOUD: optional LAS file (XYZ + RGB, workspace CRS).
-DASK_SCHEDULER: run the stereo pairs on a Dask cluster (tcp://host:8786) whose workers see the workspace path; empty = this computer (or the ARCHAEOORTHO_DASK_SCHEDULER environment variable).
+Workspace folder: a georeferenced workspace (run &apos;Georeference&apos; first: a DSM needs a metric scale and a vertical direction, so a workspace that is only aligned is refused).
+DSM resolution: DSM cell size in metres; 0 = about twice the median ground sample distance.
+Matching quality: image scale for matching (full, half, quarter): half is four times faster than full.
+Engine: cpu (default); cuda runs COLMAP patch-match stereo where pycolmap was built with CUDA.
+DSM: Cloud-Optimized GeoTIFF, float32 with nodata (default: &lt;workspace&gt;/dsm.tif).
+Point cloud: optional LAS file (XYZ + RGB, workspace CRS).
+Dask scheduler (advanced): run the stereo pairs on a Dask cluster (tcp://host:8786) whose workers see the workspace path; empty = this computer (or the ARCHAEOORTHO_DASK_SCHEDULER environment variable).
 
-Re-running after a cancel resumes: pairs already matched are reused from &lt;workspace&gt;/dense/.</source>
+A re-run after a cancel resumes, reusing the pairs already matched in &lt;workspace&gt;/dense/.</source>
         <translation>Dichte Bildzuordnung des georeferenzierten Blocks und ein digitales Oberflächenmodell (DOM).
 
 Stereopaare werden aus dem dünnen Modell gewählt (gemeinsame Verknüpfungspunkte, Basis-Höhen-Verhältnis, Blickwinkel); jedes Paar wird aus den bekannten Orientierungen entzerrt und normalisiert und mit Semi-Global Matching (OpenCV SGBM) mit Links-Rechts-Prüfung zugeordnet; ein Pixel bleibt, wo mindestens zwei unabhängige Paare übereinstimmen. Die verschmolzenen Punkte werden gerastert (Median der höchsten Höhengruppe je Zelle), kleine Lücken gefüllt und große als NoData belassen.
 
-WORKSPACE: ein georeferenzierter Arbeitsbereich (zuerst 'Georeferenzieren' ausführen: ein DOM braucht einen metrischen Maßstab und eine Lotrichtung, ein nur orientierter Arbeitsbereich wird abgelehnt).
-RESOLUTION: DOM-Zellgröße in Metern; 0 = etwa die doppelte mittlere Bodenauflösung (GSD).
-QUALITY: Bildmaßstab für die Zuordnung (voll, halb, viertel): halb ist viermal schneller als voll.
-ENGINE: cpu (Vorgabe); cuda führt COLMAPs Patch-Match-Stereo aus, wo pycolmap mit CUDA gebaut wurde.
-OUTPUT_DSM: Cloud-Optimized GeoTIFF, float32 mit NoData (Vorgabe: &lt;workspace&gt;/dsm.tif).
-OUTPUT_POINT_CLOUD: optionale LAS-Datei (XYZ + RGB, KBS des Arbeitsbereichs).
-DASK_SCHEDULER: die Stereopaare auf einem Dask-Cluster (tcp://host:8786) rechnen, dessen Worker den Pfad des Arbeitsbereichs sehen; leer = dieser Rechner (oder die Umgebungsvariable ARCHAEOORTHO_DASK_SCHEDULER).
+Arbeitsbereich-Ordner: ein georeferenzierter Arbeitsbereich (zuerst 'Georeferenzieren' ausführen: ein DOM braucht einen metrischen Maßstab und eine Lotrichtung, ein nur orientierter Arbeitsbereich wird abgelehnt).
+DOM-Auflösung: DOM-Zellgröße in Metern; 0 = etwa die doppelte mittlere Bodenauflösung (GSD).
+Zuordnungsqualität: Bildmaßstab für die Zuordnung (voll, halb, viertel): halb ist viermal schneller als voll.
+Rechenwerk: cpu (Vorgabe); cuda führt COLMAPs Patch-Match-Stereo aus, wo pycolmap mit CUDA gebaut wurde.
+DOM: Cloud-Optimized GeoTIFF, float32 mit NoData (Vorgabe: &lt;workspace&gt;/dsm.tif).
+Punktwolke: optionale LAS-Datei (XYZ + RGB, KBS des Arbeitsbereichs).
+Dask-Scheduler (erweitert): die Stereopaare auf einem Dask-Cluster (tcp://host:8786) rechnen, dessen Worker den Pfad des Arbeitsbereichs sehen; leer = dieser Rechner (oder die Umgebungsvariable ARCHAEOORTHO_DASK_SCHEDULER).
 
-Ein erneuter Lauf nach einem Abbruch setzt fort: bereits zugeordnete Paare werden aus &lt;workspace&gt;/dense/ wiederverwendet.</translation>
+Ein erneuter Lauf nach einem Abbruch setzt fort und verwendet die bereits zugeordneten Paare in &lt;workspace&gt;/dense/ wieder.</translation>
     </message>
 </context>
 <context>
@@ -429,22 +429,22 @@ DGM: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/dtm.tif).</translatio
 <context>
     <name>BuildOrthophotoAlgorithm</name>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="88"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="90"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="89"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="91"/>
         <source>Share of mosaic cells with data</source>
         <translation>Anteil der Mosaikzellen mit Daten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="90"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="92"/>
         <source>Resolution used</source>
         <translation>Verwendete Auflösung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="91"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="93"/>
         <source>Images in the mosaic</source>
         <translation>Bilder im Mosaik</translation>
     </message>
@@ -454,64 +454,69 @@ DGM: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/dtm.tif).</translatio
         <translation>Orthophoto erzeugen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>Georeferenced workspace</source>
         <translation>Georeferenzierter Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>Images</source>
         <translation>Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>Resolution</source>
         <translation>Auflösung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>Seam blending</source>
         <translation>Überblendung der Nähte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>Resampling</source>
         <translation>Resampling</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>Parallel tile workers</source>
         <translation>Parallele Kachel-Prozesse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>Dask scheduler</source>
         <translation>Dask-Scheduler</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="80"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="82"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="83"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="85"/>
         <source>Per-image orthophotos folder</source>
         <translation>Ordner für Einzelbild-Orthophotos</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="86"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="88"/>
         <source>Seamlines</source>
         <translation>Nahtlinien</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="106"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="108"/>
         <source>Seamlines must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>Nahtlinien müssen eine GeoPackage-Datei (.gpkg) sein, erhalten: {}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <source>Far-field limit (× best ground resolution, 0 = off)</source>
+        <translation>Fernfeld-Grenze (× beste Bodenauflösung, 0 = aus)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -524,6 +529,7 @@ DSM: optional raster (e.g. an ALS DSM, in any CRS: reprojected on the fly); defa
 Images: a subset, e.g. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; or &apos;group:NIR&apos; (a camera group by id or by make/model), &apos;!name&apos; to leave one out. Empty: all images.
 Resolution: cell size in CRS units; 0 = the images&apos; ground sample distance.
 Seam blending: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness and no ghosting), none (hard cut).
+Far-field limit (advanced): each image is used only where its ground resolution is within this factor of its best, so the stretched far field of an oblique (towards the horizon) is left out and the mosaic takes those cells from a nearer view; cells no image sees finely enough stay empty. 0 = off (default 3).
 Orthomosaic: Cloud-Optimized GeoTIFF with overviews, the images&apos; bands and data type (8/16 bit kept) plus an alpha band (default &lt;workspace&gt;/orthomosaic.tif).
 Per-image orthophotos folder: optional folder for one true orthophoto per image (COG).
 Seamlines: optional GeoPackage of polygons naming the image each part of the mosaic comes from.
@@ -537,15 +543,11 @@ DOM: optionales Raster (z. B. ein ALS-DOM, in beliebigem KBS: wird im Lauf umpro
 Bilder: eine Auswahl, z. B. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' oder 'group:NIR' (eine Kameragruppe nach Nummer oder Hersteller/Modell), '!name' lässt eines weg. Leer: alle Bilder.
 Auflösung: Zellgröße in KBS-Einheiten; 0 = die Bodenauflösung der Bilder.
 Überblendung der Nähte: feather (Rampe über die Nähte), multiband (Laplace-Pyramide: keine sichtbare Naht in der Helligkeit und keine Geisterbilder), none (harter Schnitt).
+Fernfeld-Grenze (erweitert): jedes Bild wird nur dort verwendet, wo seine Bodenauflösung innerhalb dieses Faktors seiner besten liegt; so bleibt das gedehnte Fernfeld einer Schrägaufnahme (zum Horizont hin) weg, und das Mosaik nimmt diese Zellen aus einer näheren Ansicht; Zellen, die kein Bild fein genug sieht, bleiben leer. 0 = aus (Vorgabe 3).
 Orthomosaik: Cloud-Optimized GeoTIFF mit Übersichten, den Kanälen und dem Datentyp der Bilder (8/16 Bit bleiben) und einem Alphakanal (Vorgabe &lt;workspace&gt;/orthomosaic.tif).
 Ordner für Einzelbild-Orthophotos: optionaler Ordner für ein wahres Orthophoto je Bild (COG).
 Nahtlinien: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem jeder Teil des Mosaiks stammt.
 Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786) rechnen, dessen Worker den Pfad des Arbeitsbereichs sehen; leer = dieser Rechner, oder $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
-        <source>Use each image only where its ground resolution is within this factor of its best (0 = no limit)</source>
-        <translation>Jedes Bild nur dort verwenden, wo seine Bodenauflösung höchstens dieses Vielfache seiner besten ist (0 = keine Grenze)</translation>
     </message>
 </context>
 <context>
@@ -1491,42 +1493,42 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
 <context>
     <name>GeoreferenceAlgorithm</name>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="59"/>
+        <location filename="../processing_provider/georeference.py" line="62"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="60"/>
+        <location filename="../processing_provider/georeference.py" line="63"/>
         <source>GCP residuals</source>
         <translation>Passpunkt-Residuen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="61"/>
+        <location filename="../processing_provider/georeference.py" line="64"/>
         <source>Camera centres (world)</source>
         <translation>Projektionszentren (Welt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="77"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS)</source>
         <translation>Passpunkte (GCPS oder GCP_LAYER) und/oder Kamerapositionen (CAMERA_POSITIONS oder USE_EXIF_GPS) angeben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="88"/>
+        <location filename="../processing_provider/georeference.py" line="91"/>
         <source>outlier left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="92"/>
+        <location filename="../processing_provider/georeference.py" line="95"/>
         <source>CRS {}; control RMSE XY {} m, Z {} m; check RMSE XY {} m, Z {} m</source>
         <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="103"/>
+        <location filename="../processing_provider/run_pipeline.py" line="106"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
@@ -1536,39 +1538,44 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Aligned workspace</source>
         <translation>Ausgerichteter Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Ground control layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Check points</source>
         <translation>Kontrollpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Use EXIF GPS positions</source>
         <translation>EXIF-GPS-Positionen verwenden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Target CRS</source>
         <translation>Ziel-KBS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="50"/>
+        <source>GCP pixels measured on upright photos</source>
+        <translation>GCP-Pixel auf aufrechten Fotos gemessen</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1578,6 +1585,7 @@ Ground control file: an OpenDroneMap gcp_list.txt (CRS line, then &apos;x y z px
 Check points: comma-separated names that become check points.
 Camera positions: CSV &apos;image,x,y,z[,sigma]&apos; (optional CRS line). Use EXIF GPS positions: use the photos&apos; GPS.
 Target CRS: default the ground control file&apos;s. Refine camera calibration: let the adjustment refine focal length, principal point and distortion.
+GCP pixels measured on upright photos: tick when the pixel coordinates were measured on the photos shown upright by their EXIF orientation, as web browsers and photo viewers show them; they are turned into the stored pixel grid of each photo (photos stored without a turn are unchanged).
 Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.</source>
         <translation>Legt den ausgerichteten Block mit Passpunkten (GCPs) und/oder Kamerapositionen in einem echten Koordinatenbezugssystem fest. Sie wirken in der Bündelblockausgleichung, so dass sie auch Drift und Verbiegung des Blocks beseitigen, was eine 7-Parameter-Transformation (Helmert) nicht kann. Kontrollpunkte nehmen an der Ausgleichung nicht teil: sie werden danach trianguliert und mit ihren vermessenen Koordinaten verglichen.
 
@@ -1585,103 +1593,99 @@ Passpunktdatei: eine OpenDroneMap gcp_list.txt (KBS-Zeile, dann 'x y z px py ima
 Kontrollpunkte: durch Kommas getrennte Namen, die zu Kontrollpunkten werden.
 Kamerapositionen: CSV 'image,x,y,z[,sigma]' (optionale KBS-Zeile). EXIF-GPS-Positionen verwenden: das GPS der Fotos verwenden.
 Ziel-KBS: Vorgabe ist das KBS der Passpunktdatei. Kamerakalibrierung verfeinern: die Ausgleichung verfeinert Brennweite, Bildhauptpunkt und Verzeichnung.
+GCP-Pixel auf aufrechten Fotos gemessen: ankreuzen, wenn die Pixelkoordinaten auf den Fotos gemessen wurden, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden (wie in Webbrowsern und Bildbetrachtern); sie werden in das gespeicherte Pixelraster jedes Fotos umgerechnet (ungedreht gespeicherte Fotos bleiben unverändert).
 Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erkannt, im Protokoll genannt und ausgelassen.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
-        <source>GCP pixels measured on upright photos</source>
-        <translation>GCP-Pixel auf aufrechten Fotos gemessen</translation>
     </message>
 </context>
 <context>
     <name>OrthorectifyImageAlgorithm</name>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="58"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Image</source>
         <translation>Bild</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Ground control file (gcp_list.txt or CSV)</source>
         <translation>Passpunktdatei (gcp_list.txt oder CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Ground control point layer (one feature per observation)</source>
         <translation>Passpunktlayer (ein Objekt je Messung)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Known orientation (x y z omega phi kappa)</source>
         <translation>Bekannte Orientierung (x y z omega phi kappa)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Focal length in mm (0 = from EXIF)</source>
         <translation>Brennweite in mm (0 = aus EXIF)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Sensor width (long side) in mm</source>
         <translation>Sensorbreite (lange Seite) in mm</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Mode</source>
         <translation>Modus</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Resolution in CRS units (0 = ground sample distance)</source>
         <translation>Auflösung in KBS-Einheiten (0 = Bodenauflösung)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Output CRS (default: the GCPs&apos; or orientation&apos;s CRS)</source>
         <translation>Ausgabe-KBS (Vorgabe: das der Passpunkte oder der Orientierung)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="74"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="76"/>
         <source>Orthophoto</source>
         <translation>Orthophoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="77"/>
         <source>GCP residuals</source>
         <translation>Passpunkt-Residuen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="77"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="79"/>
         <source>GCP residual RMSE (pixels)</source>
         <translation>RMSE der Passpunktresiduen (Pixel)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="78"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="80"/>
         <source>Planar rectification: 95th percentile of its offset from the true position (CRS units)</source>
         <translation>Ebene Entzerrung: 95. Perzentil ihres Versatzes gegen die wahre Lage (KBS-Einheiten)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="94"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="96"/>
         <source>Give ground control points observed in the image (GCPS or GCP_LAYER) or its orientation (ORIENTATION)</source>
         <translation>Im Bild gemessene Passpunkte (GCPS oder GCP_LAYER) oder seine Orientierung (ORIENTATION) angeben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="100"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="102"/>
         <source>RESIDUALS must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>RESIDUALS muss eine GeoPackage-Datei (.gpkg) sein, erhalten: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="113"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="115"/>
         <source>{} ({}): {:.2f} px</source>
         <translation>{} ({}): {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="88"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="90"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
@@ -1696,22 +1700,22 @@ Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erk
 
 The camera's position and attitude come from ground control points observed in the photo (space resection: at least 4 points; one wrong point among 5 or more is found and left out; with 6 or more the focal length and the radial distortion k1 are estimated too where the points determine them), or from a known orientation.
 
-IMAGE: the photo. DSM: height raster (needed for a true orthophoto).
-GCPS: an OpenDroneMap gcp_list.txt or CSV points file with observations in this image; or GCP_LAYER: a point layer with one feature per observation and fields name, image, px, py (optional z, role; pixel origin at the upper-left corner, y down).
-ORIENTATION: instead of GCPs, a file with x y z omega phi kappa (degrees, photogrammetric convention; a header row as Pix4D writes it, or JSON), optionally focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 and a CRS line.
-FOCAL_MM and SENSOR_WIDTH_MM: interior orientation (the sensor's long side); default the EXIF focal length.
-MODE: a true orthophoto on the DSM, or a planar (projective) rectification through the GCPs for comparison on flat ground; with a DSM the log and PLANAR_OFFSET_P95 say how far the planar result is off because of relief.
-RESIDUALS: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
+Image: the photo. DSM: height raster (needed for a true orthophoto).
+Ground control file: an OpenDroneMap gcp_list.txt or CSV points file with observations in this image; or Ground control point layer: a point layer with one feature per observation and fields name, image, px, py (optional z, role; pixel origin at the upper-left corner, y down).
+Known orientation: instead of GCPs, a file with x y z omega phi kappa (degrees, photogrammetric convention; a header row as Pix4D writes it, or JSON), optionally focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 and a CRS line.
+Focal length and Sensor width: interior orientation (the sensor's long side); default the EXIF focal length.
+Mode: a true orthophoto on the DSM, or a planar (projective) rectification through the GCPs for comparison on flat ground; with a DSM the log and the output 'Planar rectification: 95th percentile of its offset' say how far the planar result is off because of relief.
+GCP residuals: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
         <translation>Orthorektifiziert ein Foto — auch eines, das zu keinem Block gehört, etwa eine einzelne Schrägaufnahme oder ein alter Abzug — auf einem vorhandenen DOM, zum Beispiel einem DOM aus Airborne Laserscanning (ALS) in beliebigem KBS (es wird im Lauf umprojiziert).
 
 Position und Lage der Kamera ergeben sich aus im Foto gemessenen Passpunkten (räumlicher Rückwärtsschnitt: mindestens 4 Punkte; ein falscher Punkt unter 5 oder mehr wird gefunden und ausgelassen; ab 6 Punkten werden auch Brennweite und radiale Verzeichnung k1 geschätzt, wo die Punkte sie bestimmen) oder aus einer bekannten Orientierung.
 
-IMAGE: das Foto. DSM: Höhenraster (für ein wahres Orthophoto nötig).
-GCPS: eine OpenDroneMap gcp_list.txt oder CSV-Punktdatei mit Messungen in diesem Bild; oder GCP_LAYER: ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, role; Pixelursprung in der linken oberen Ecke, y nach unten).
-ORIENTATION: statt Passpunkten eine Datei mit x y z omega phi kappa (Grad, photogrammetrische Konvention; eine Kopfzeile wie von Pix4D geschrieben, oder JSON), optional focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 und eine KBS-Zeile.
-FOCAL_MM und SENSOR_WIDTH_MM: innere Orientierung (die lange Seite des Sensors); Vorgabe ist die EXIF-Brennweite.
-MODE: ein wahres Orthophoto auf dem DOM oder eine ebene (projektive) Entzerrung über die Passpunkte zum Vergleich auf flachem Gelände; mit DOM sagen das Protokoll und PLANAR_OFFSET_P95, wie weit das ebene Ergebnis wegen des Reliefs abweicht.
-RESIDUALS: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in der Ebene).</translation>
+Bild: das Foto. DSM: Höhenraster (für ein wahres Orthophoto nötig).
+Passpunktdatei: eine OpenDroneMap gcp_list.txt oder CSV-Punktdatei mit Messungen in diesem Bild; oder Passpunktlayer: ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, role; Pixelursprung in der linken oberen Ecke, y nach unten).
+Bekannte Orientierung: statt Passpunkten eine Datei mit x y z omega phi kappa (Grad, photogrammetrische Konvention; eine Kopfzeile wie von Pix4D geschrieben, oder JSON), optional focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 und eine KBS-Zeile.
+Brennweite und Sensorbreite: innere Orientierung (die lange Seite des Sensors); Vorgabe ist die EXIF-Brennweite.
+Modus: ein wahres Orthophoto auf dem DOM oder eine ebene (projektive) Entzerrung über die Passpunkte zum Vergleich auf flachem Gelände; mit DOM sagen das Protokoll und die Ausgabe 'Ebene Entzerrung: 95. Perzentil ihres Versatzes', wie weit das ebene Ergebnis wegen des Reliefs abweicht.
+Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in der Ebene).</translation>
     </message>
 </context>
 <context>
@@ -1785,102 +1789,102 @@ RESIDUALS: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in
 <context>
     <name>PrepareImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="80"/>
+        <location filename="../processing_provider/prepare_images.py" line="84"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="80"/>
+        <location filename="../processing_provider/prepare_images.py" line="84"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="80"/>
+        <location filename="../processing_provider/prepare_images.py" line="84"/>
         <source>Smallest blur score (0 = only relative to the set)</source>
         <translation>Kleinster Schärfewert (0 = nur relativ zum Satz)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="80"/>
+        <location filename="../processing_provider/prepare_images.py" line="84"/>
         <source>Leave flagged images out of the prepared folder</source>
         <translation>Markierte Bilder aus dem vorbereiteten Ordner weglassen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="92"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Scanned film: fiducial marks, common frame, masks</source>
         <translation>Gescannter Film: Rahmenmarken, gemeinsamer Rahmen, Masken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <location filename="../processing_provider/prepare_images.py" line="97"/>
         <source>Calibrated fiducial coordinates in mm (file path or text)</source>
         <translation>Kalibrierte Rahmenmarken-Koordinaten in mm (Dateipfad oder Text)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Calibrated focal length in mm (0 = unknown)</source>
         <translation>Kalibrierte Brennweite in mm (0 = unbekannt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Flag images below this fraction of the set&apos;s median blur score</source>
         <translation>Bilder unter diesem Bruchteil des mittleren Schärfewerts des Satzes markieren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Fiducial mark type</source>
         <translation>Art der Rahmenmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Fiducial positions</source>
         <translation>Lage der Rahmenmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Template image of one fiducial mark</source>
         <translation>Vorlagenbild einer Rahmenmarke</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Scan resolution in dpi when not in the files (0 = from the files)</source>
         <translation>Scanauflösung in dpi, wenn nicht in den Dateien (0 = aus den Dateien)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="109"/>
+        <location filename="../processing_provider/prepare_images.py" line="113"/>
         <source>Prepared images (skipped: &lt;workspace&gt;/prepared)</source>
         <translation>Vorbereitete Bilder (ausgelassen: &lt;workspace&gt;/prepared)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="112"/>
+        <location filename="../processing_provider/prepare_images.py" line="116"/>
         <source>Folder of prepared images</source>
         <translation>Ordner der vorbereiteten Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="113"/>
+        <location filename="../processing_provider/prepare_images.py" line="117"/>
         <source>Flagged images</source>
         <translation>Markierte Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="114"/>
+        <location filename="../processing_provider/prepare_images.py" line="118"/>
         <source>Excluded images</source>
         <translation>Ausgeschlossene Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="115"/>
+        <location filename="../processing_provider/prepare_images.py" line="119"/>
         <source>Screening record (JSON)</source>
         <translation>Prüfprotokoll (JSON)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="152"/>
+        <location filename="../processing_provider/prepare_images.py" line="156"/>
         <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
         <translation>{} Bilder: {} markiert, {} ausgeschlossen, {} im vorbereiteten Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="154"/>
+        <location filename="../processing_provider/prepare_images.py" line="158"/>
         <source>Blurriest first (blur score, % of the set&apos;s median):</source>
         <translation>Unschärfste zuerst (Schärfewert, % des Medians des Satzes):</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="162"/>
+        <location filename="../processing_provider/prepare_images.py" line="166"/>
         <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
         <translation>Vorbereitete Scans: {} x {} px, Pixelgröße {:.6g} {}{}</translation>
     </message>
@@ -1890,57 +1894,59 @@ RESIDUALS: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in
         <translation>Bilder vorbereiten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="87"/>
+        <location filename="../processing_provider/prepare_images.py" line="91"/>
         <source>Mask polygons: areas to ignore, in pixel coordinates (optional text field &apos;image&apos;)</source>
         <translation>Maskenpolygone: zu ignorierende Bereiche in Pixelkoordinaten (optionales Textfeld 'image')</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="147"/>
+        <location filename="../processing_provider/prepare_images.py" line="151"/>
         <source>MASKS layer &apos;{}&apos;</source>
         <translation>MASKS-Layer '{}'</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="182"/>
+        <location filename="../processing_provider/prepare_images.py" line="186"/>
         <source>feature {}</source>
         <translation>Objekt {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="186"/>
+        <location filename="../processing_provider/prepare_images.py" line="190"/>
         <source>MASKS layer &apos;{}&apos;: {} has no geometry: skipped</source>
         <translation>MASKS-Layer '{}': {} hat keine Geometrie: übersprungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="189"/>
+        <location filename="../processing_provider/prepare_images.py" line="193"/>
         <source>MASKS layer &apos;{}&apos;: {} is a {} geometry, not a polygon</source>
         <translation>MASKS-Layer '{}': {} ist eine {}-Geometrie, kein Polygon</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
-        <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for &apos;Align images&apos;, and the WORKSPACE, which records a decision per image (screening.json) for the accuracy report.
-
-Blur score: variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged &apos;blurry&apos; below BLUR_RELATIVE x the median of the set, or below BLUR_THRESHOLD when that is set (absolute scores depend on the scene: sand scores far lower than roofs).
-Exposure: images with more than 5 % clipped highlights or shadows, a mean brightness far from the set&apos;s, or a very small dynamic range are flagged. EXCLUDE_FLAGGED leaves flagged images out of the prepared folder; otherwise they are kept and only reported.
-
-MASKS: optional polygon layer of areas to ignore (a boom, the drone&apos;s shadow, a date stamp, a frame border), in the image&apos;s pixel coordinates: origin at the upper-left corner of the image, x right, y down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is &lt;= 0). A text field &apos;image&apos; names the image a polygon belongs to; empty (or no such field) applies it to every image. The polygons are written into the per-image masks (workspace/masks/&lt;image&gt;.png, merged with any mask already there): &apos;Align images&apos; finds no features under them, the orthophoto does not use those pixels, and blur and exposure are measured outside them. For scanned film the coordinates are those of the prepared images (the common fiducial frame, so one polygon fits every frame).
-
-SCANNED_FILM: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. FIDUCIAL_COORDINATES: the calibration certificate&apos;s fiducial coordinates in mm, as a file or pasted text, one &apos;id x y&apos; line per mark (x right, y up), optionally &apos;PP x y&apos; (principal point) and &apos;focal f&apos;. Without them the mean layout of the set is used, centred on the fiducial centre. With FOCAL_LENGTH_MM (or &apos;focal&apos; in the certificate) the prepared images carry the focal length in pixels for the alignment.
-
-OUTPUT: the folder of prepared images (replaced as a whole; it must be new, empty or written by an earlier run); when skipped, &lt;workspace&gt;/prepared.</source>
-        <translation>Prüft einen Ordner mit Fotos auf Unschärfe und Belichtung und findet bei gescanntem historischem Film die Rahmenmarken und rechnet jeden Scan in einen gemeinsamen Kamerarahmen um. Das Ergebnis ist ein Ordner vorbereiteter Bilder für 'Bilder ausrichten' und der WORKSPACE, der je Bild eine Entscheidung festhält (screening.json) für den Genauigkeitsbericht.
-
-Schärfewert: Varianz des Laplace-Operators auf einer grauen Kopie von 1024 px Breite, 90. Perzentil eines Rasters von 8 x 6 Kacheln (Himmel oder Wasser in einem Teil des Bildes zählt nicht dagegen). Höher ist schärfer. Ein Bild wird als 'unscharf' markiert unter BLUR_RELATIVE x dem Median des Satzes oder unter BLUR_THRESHOLD, wenn gesetzt (absolute Werte hängen von der Szene ab: Sand erreicht weit weniger als Dächer).
-Belichtung: Bilder mit mehr als 5 % beschnittenen Lichtern oder Schatten, einer mittleren Helligkeit weit weg von der des Satzes oder einem sehr kleinen Dynamikumfang werden markiert. EXCLUDE_FLAGGED lässt markierte Bilder aus dem vorbereiteten Ordner weg; sonst bleiben sie und werden nur gemeldet.
-
-MASKS: optionaler Polygon-Layer mit zu ignorierenden Bereichen (ein Ausleger, der Schatten der Drohne, ein Datumsstempel, ein Bildrand) in den Pixelkoordinaten des Bildes: Ursprung in der oberen linken Ecke, x nach rechts, y nach unten, oder y = -Zeile, wie der QGIS-Georeferenzierer ein Foto zeigt (erkannt, wenn jedes y &lt;= 0 ist). Ein Textfeld 'image' nennt das Bild, zu dem ein Polygon gehört; leer (oder ohne dieses Feld) gilt es für jedes Bild. Die Polygone werden in die Masken je Bild geschrieben (workspace/masks/&lt;Bild&gt;.png, mit einer vorhandenen Maske vereinigt): 'Bilder ausrichten' findet darunter keine Merkmale, das Orthophoto verwendet diese Pixel nicht, und Schärfe und Belichtung werden außerhalb gemessen. Bei gescanntem Film sind es die Koordinaten der vorbereiteten Bilder (der gemeinsame Rahmenmarken-Rahmen, so passt ein Polygon zu jedem Bild).
-
-SCANNED_FILM: Rahmenmarken (Kreuze, Punkte, Punkte in Kreisen; in den Ecken und/oder Seitenmitten, oder wie ein Vorlagenbild einer Marke) werden auf Bruchteile eines Pixels gefunden, jeder Scan wird durch eine affine Transformation in den gemeinsamen Rahmenmarken-Rahmen umgerechnet, alle gleich groß und mit dem Bildhauptpunkt in der Mitte, und Masken (workspace/masks) verbergen Filmrand, Datenstreifen und die Marken vor der Zuordnung. FIDUCIAL_COORDINATES: die Rahmenmarken-Koordinaten des Kalibrierzertifikats in mm, als Datei oder eingefügter Text, eine Zeile 'id x y' je Marke (x nach rechts, y nach oben), optional 'PP x y' (Bildhauptpunkt) und 'focal f'. Ohne sie wird die mittlere Anordnung des Satzes verwendet, zentriert auf die Rahmenmitte. Mit FOCAL_LENGTH_MM (oder 'focal' im Zertifikat) tragen die vorbereiteten Bilder die Brennweite in Pixeln für die Ausrichtung.
-
-OUTPUT: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetzt; er muss neu, leer oder von einem früheren Lauf geschrieben sein); wenn ausgelassen, &lt;workspace&gt;/prepared.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="90"/>
+        <location filename="../processing_provider/prepare_images.py" line="94"/>
         <source>Sky masks: hide the sky and the horizon of oblique photos from the alignment</source>
         <translation>Himmelsmasken: Himmel und Horizont von Schrägaufnahmen vor der Ausrichtung verbergen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for &apos;Align images&apos;, and the Workspace folder, which records a decision per image (screening.json) for the accuracy report.
+
+The blur score is the variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged &apos;blurry&apos; below a fraction of the median of the set (Flag images below this fraction of the set&apos;s median blur score, advanced), or below the Smallest blur score when that is set (absolute scores depend on the scene: sand scores far lower than roofs).
+Images with more than 5 % clipped highlights or shadows, a mean brightness far from the set&apos;s, or a very small dynamic range are flagged for their exposure. With &apos;Leave flagged images out of the prepared folder&apos; ticked they are left out; otherwise they are kept and only reported.
+
+Mask polygons: optional polygon layer of areas to ignore (a boom, the drone&apos;s shadow, a date stamp, a frame border), in the image&apos;s pixel coordinates: origin at the upper-left corner of the image, x right, y down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is &lt;= 0). A text field &apos;image&apos; names the image a polygon belongs to; empty (or no such field) applies it to every image. The polygons are written into the per-image masks (workspace/masks/&lt;image&gt;.png, merged with any mask already there): &apos;Align images&apos; finds no features under them, the orthophoto does not use those pixels, and blur and exposure are measured outside them. For scanned film the coordinates are those of the prepared images (the common fiducial frame, so one polygon fits every frame).
+Sky masks: for oblique photos the sky (clouds included) and the haze along the horizon are found automatically and written into the per-image masks, so that &apos;Align images&apos; takes no tie points from clouds that move between shots; a photo without sky (looking straight down) gets no sky mask.
+
+Scanned film: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. Calibrated fiducial coordinates: the calibration certificate&apos;s fiducial coordinates in mm, as a file or pasted text, one &apos;id x y&apos; line per mark (x right, y up), optionally &apos;PP x y&apos; (principal point) and &apos;focal f&apos;. Without them the mean layout of the set is used, centred on the fiducial centre. With the Calibrated focal length (or &apos;focal&apos; in the certificate) the prepared images carry the focal length in pixels for the alignment.
+
+Prepared images: the folder of prepared images (replaced as a whole; it must be new, empty or written by an earlier run); when skipped, &lt;workspace&gt;/prepared.</source>
+        <translation>Prüft einen Ordner mit Fotos auf Unschärfe und Belichtung und findet bei gescanntem historischem Film die Rahmenmarken und rechnet jeden Scan in einen gemeinsamen Kamerarahmen um. Das Ergebnis ist ein Ordner vorbereiteter Bilder für 'Bilder ausrichten' und der Arbeitsbereich-Ordner, der je Bild eine Entscheidung festhält (screening.json) für den Genauigkeitsbericht.
+
+Der Schärfewert ist die Varianz des Laplace-Operators auf einer grauen Kopie von 1024 px Breite, 90. Perzentil eines Rasters von 8 x 6 Kacheln (Himmel oder Wasser in einem Teil des Bildes zählt nicht dagegen). Höher ist schärfer. Ein Bild wird als 'unscharf' markiert unter einem Bruchteil des Medians des Satzes (Bilder unter diesem Bruchteil des mittleren Schärfewerts des Satzes markieren, erweitert) oder unter dem Kleinsten Schärfewert, wenn gesetzt (absolute Werte hängen von der Szene ab: Sand erreicht weit weniger als Dächer).
+Bilder mit mehr als 5 % beschnittenen Lichtern oder Schatten, einer mittleren Helligkeit weit weg von der des Satzes oder einem sehr kleinen Dynamikumfang werden wegen ihrer Belichtung markiert. Mit 'Markierte Bilder aus dem vorbereiteten Ordner weglassen' werden sie weggelassen; sonst bleiben sie und werden nur gemeldet.
+
+Maskenpolygone: optionaler Polygon-Layer mit zu ignorierenden Bereichen (ein Ausleger, der Schatten der Drohne, ein Datumsstempel, ein Bildrand) in den Pixelkoordinaten des Bildes: Ursprung in der oberen linken Ecke, x nach rechts, y nach unten, oder y = -Zeile, wie der QGIS-Georeferenzierer ein Foto zeigt (erkannt, wenn jedes y &lt;= 0 ist). Ein Textfeld 'image' nennt das Bild, zu dem ein Polygon gehört; leer (oder ohne dieses Feld) gilt es für jedes Bild. Die Polygone werden in die Masken je Bild geschrieben (workspace/masks/&lt;Bild&gt;.png, mit einer vorhandenen Maske vereinigt): 'Bilder ausrichten' findet darunter keine Merkmale, das Orthophoto verwendet diese Pixel nicht, und Schärfe und Belichtung werden außerhalb gemessen. Bei gescanntem Film sind es die Koordinaten der vorbereiteten Bilder (der gemeinsame Rahmenmarken-Rahmen, so passt ein Polygon zu jedem Bild).
+Himmelsmasken: bei Schrägaufnahmen werden der Himmel (samt Wolken) und der Dunst am Horizont automatisch gefunden und in die Masken je Bild geschrieben, damit 'Bilder ausrichten' keine Verknüpfungspunkte aus Wolken nimmt, die zwischen den Aufnahmen ziehen; ein Foto ohne Himmel (senkrecht nach unten) erhält keine Himmelsmaske.
+
+Gescannter Film: Rahmenmarken (Kreuze, Punkte, Punkte in Kreisen; in den Ecken und/oder Seitenmitten, oder wie ein Vorlagenbild einer Marke) werden auf Bruchteile eines Pixels gefunden, jeder Scan wird durch eine affine Transformation in den gemeinsamen Rahmenmarken-Rahmen umgerechnet, alle gleich groß und mit dem Bildhauptpunkt in der Mitte, und Masken (workspace/masks) verbergen Filmrand, Datenstreifen und die Marken vor der Zuordnung. Kalibrierte Rahmenmarken-Koordinaten: die Rahmenmarken-Koordinaten des Kalibrierzertifikats in mm, als Datei oder eingefügter Text, eine Zeile 'id x y' je Marke (x nach rechts, y nach oben), optional 'PP x y' (Bildhauptpunkt) und 'focal f'. Ohne sie wird die mittlere Anordnung des Satzes verwendet, zentriert auf die Rahmenmitte. Mit der Kalibrierten Brennweite (oder 'focal' im Zertifikat) tragen die vorbereiteten Bilder die Brennweite in Pixeln für die Ausrichtung.
+
+Vorbereitete Bilder: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetzt; er muss neu, leer oder von einem früheren Lauf geschrieben sein); wenn ausgelassen, &lt;workspace&gt;/prepared.</translation>
     </message>
 </context>
 <context>
@@ -2003,14 +2009,14 @@ Workspace folder: a workspace with a DTM (Build DTM) or DSM.
 Elevation raster: any DTM/DSM in a projected CRS instead (optional).
 Surface: the workspace&apos;s DTM (bare earth, default) or DSM.
 Visualisation: sky-view factor, openness (positive, negative), simple local relief model, multi-scale relief model, multi-direction hillshade, local dominance, or the VAT blend.
-Output: where to write it (default: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</source>
+The output &apos;Visualisation&apos;: where to write it (default: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</source>
         <translation>Reliefvisualisierungen zum Lesen von Erdwerken, Hohlwegen, Wölbäckern und Flurgrenzen, berechnet mit rvt-py (der Bibliothek der Relief Visualization Toolbox) mit den Standardparametern von RVT, umgerechnet von den 1-m-Geländemodellen, für die RVT gemacht ist, auf die Zellgröße dieses Rasters.
 
 Arbeitsbereich-Ordner: ein Arbeitsbereich mit DGM (DGM erzeugen) oder DOM.
 Höhenraster: stattdessen ein beliebiges DGM/DOM in einem projizierten KBS (optional).
 Oberfläche: das DGM des Arbeitsbereichs (nackte Erde, Vorgabe) oder sein DOM.
 Visualisierung: Sky-View-Faktor, Offenheit (positiv, negativ), einfaches lokales Reliefmodell, mehrskaliges Reliefmodell, Schummerung aus mehreren Richtungen, lokale Dominanz oder die VAT-Mischung.
-Ausgabe: wohin sie geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</translation>
+Die Ausgabe 'Visualisierung': wohin sie geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</translation>
     </message>
 </context>
 <context>
@@ -2099,57 +2105,57 @@ Ausgabe: wohin sie geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/relief/&
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Write the accuracy report</source>
         <translation>Genauigkeitsbericht schreiben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="89"/>
+        <location filename="../processing_provider/run_pipeline.py" line="92"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="90"/>
+        <location filename="../processing_provider/run_pipeline.py" line="93"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="91"/>
+        <location filename="../processing_provider/run_pipeline.py" line="94"/>
         <source>Accuracy report (HTML)</source>
         <translation>Genauigkeitsbericht (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="109"/>
+        <location filename="../processing_provider/run_pipeline.py" line="112"/>
         <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Geben Sie Passpunkte (GCPS oder GCP_LAYER) und/oder Kamerapositionen (CAMERA_POSITIONS oder USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="140"/>
+        <location filename="../processing_provider/run_pipeline.py" line="143"/>
         <source>Seconds per stage: {}</source>
         <translation>Sekunden pro Stufe: {}</translation>
     </message>
@@ -2159,69 +2165,89 @@ Ausgabe: wohin sie geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/relief/&
         <translation>Gesamte Verarbeitung ausführen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Ground control layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Check points</source>
         <translation>Kontrollpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Use EXIF GPS positions</source>
         <translation>EXIF-GPS-Positionen verwenden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Target CRS</source>
         <translation>Ziel-KBS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Matching image size (px)</source>
         <translation>Bildgröße für die Zuordnung (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>DSM resolution (m)</source>
         <translation>DOM-Auflösung (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Matching quality</source>
         <translation>Zuordnungsqualität</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Orthomosaic resolution</source>
         <translation>Auflösung des Orthomosaiks</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Seam blending</source>
         <translation>Überblendung der Nähte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Parallel workers</source>
         <translation>Parallele Prozesse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Dask scheduler</source>
         <translation>Dask-Scheduler</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
+        <source>Build the DTM</source>
+        <translation>Das DGM erzeugen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
+        <source>Contour interval (m, 0 = none)</source>
+        <translation>Höhenlinienabstand (m, 0 = keine)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
+        <source>Relief visualisations</source>
+        <translation>Reliefvisualisierungen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="91"/>
+        <source>DTM</source>
+        <translation>DGM</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -2229,34 +2255,16 @@ Ausgabe: wohin sie geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/relief/&
 
 Folder of images: the photos. Workspace folder: where every product is written.
 Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction.
+Build the DTM: after the DSM, a bare-earth DTM (as &apos;Build DTM&apos;). Contour interval (advanced): contour lines of the DTM at this interval (as &apos;Contours&apos;; 0 = none). Relief visualisations (advanced): those chosen are computed from the DTM (as &apos;Relief visualisation&apos;). Both need the DTM.
 The other parameters are those of the single stages (see their help); 0 means automatic.
 Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures.</source>
         <translation>Die gesamte Verarbeitung in einem Aufruf, für die Stapelverarbeitung: Bilder ausrichten, Georeferenzieren, DOM erzeugen, Orthophoto erzeugen und Genauigkeitsbericht in einem Arbeitsbereich. Es werden dieselben Funktionen wie in den einzelnen Algorithmen aufgerufen; ein erneuter Lauf setzt fort (bereits berechnete Merkmale, Zuordnungen und Stereopaare werden wiederverwendet).
 
 Bilderordner: die Fotos. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben werden.
 Die Georeferenzierung braucht Passpunkte (eine Passpunktdatei oder ein Passpunktlayer, Kontrollpunkte werden zurückgehalten) und/oder Kamerapositionen (eine CSV-Datei der Kamerapositionen oder EXIF-GPS-Positionen verwenden): ohne sie wird die Verarbeitung abgelehnt, da ein DOM einen metrischen Maßstab und eine Lotrichtung braucht.
+Das DGM erzeugen: nach dem DOM ein DGM der nackten Erde (wie 'DGM erzeugen'). Höhenlinienabstand (erweitert): Höhenlinien des DGM in diesem Abstand (wie 'Höhenlinien'; 0 = keine). Reliefvisualisierungen (erweitert): die gewählten werden aus dem DGM berechnet (wie 'Reliefvisualisierung'). Beide brauchen das DGM.
 Die übrigen Parameter sind die der einzelnen Stufen (siehe deren Hilfe); 0 bedeutet automatisch.
 Ausgaben: das DOM, das Orthomosaik und der Genauigkeitsbericht (HTML) sowie die wichtigsten Kennzahlen.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
-        <source>Build the DTM</source>
-        <translation>Das DGM erzeugen</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
-        <source>Contour interval (m, 0 = none)</source>
-        <translation>Höhenlinienabstand (m, 0 = keine)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
-        <source>Relief visualisations</source>
-        <translation>Reliefvisualisierungen</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="88"/>
-        <source>DTM</source>
-        <translation>DGM</translation>
     </message>
 </context>
 </TS>

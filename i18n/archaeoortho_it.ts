@@ -57,18 +57,18 @@
         <location filename="../ui/catalog.py" line="7"/>
         <source>Writes one self-contained HTML report of a workspace (plots embedded, readable offline) and returns its key figures.
 
-Summary: images given / aligned / not aligned and why, image screening, cameras with their calibrated parameters and standard deviations, GSD, area, CRS, processing times and parameters. Orientation quality: reprojection errors, tie-point track lengths, image connectivity, camera positions with residuals. Georeferencing: control and check points with dX dY dZ and image residuals, residual vectors, RMSE per set, NSSDA (FGDC-STD-007.3-1998) accuracy statements at 95 % confidence, ASPRS 2014 and 2023 accuracy classes, camera-position residuals, outliers. Uncertainty: standard deviations of cameras and tie points from the bundle adjustment covariance. Products: DSM and orthomosaic previews, resolution, valid fraction. Sections whose stage has not run are skipped with a note.
+Sections of the report. Summary — images given / aligned / not aligned and why, image screening, cameras with their calibrated parameters and standard deviations, GSD, area, CRS, processing times and parameters. Orientation quality: reprojection errors, tie-point track lengths, image connectivity, camera positions with residuals. Georeferencing: control and check points with dX dY dZ and image residuals, residual vectors, RMSE per set, NSSDA (FGDC-STD-007.3-1998) accuracy statements at 95 % confidence, ASPRS 2014 and 2023 accuracy classes, camera-position residuals, outliers. Uncertainty: standard deviations of cameras and tie points from the bundle adjustment covariance. Products: DSM and orthomosaic previews, resolution, valid fraction. Sections whose stage has not run are skipped with a note.
 
-WORKSPACE: a workspace folder (at least aligned).
-UNCERTAINTY: compute the covariance (seconds for hundreds of images) and write &lt;workspace&gt;/uncertainty/cameras.gpkg and points.gpkg.
-OUTPUT_HTML: the report file (default: &lt;workspace&gt;/report.html). It is written under a temporary name and renamed when complete.</source>
+Workspace folder: a workspace folder (at least aligned).
+Compute the bundle adjustment covariance: computes it (seconds for hundreds of images) and writes &lt;workspace&gt;/uncertainty/cameras.gpkg and points.gpkg.
+Report: the report file (default: &lt;workspace&gt;/report.html). It is written under a temporary name and renamed when complete.</source>
         <translation>Scrive un rapporto HTML autonomo di un'area di lavoro (grafici incorporati, leggibile offline) e ne restituisce le cifre principali.
 
-Sintesi: immagini fornite / orientate / non orientate e perché, controllo delle immagini, camere con i parametri calibrati e le deviazioni standard, GSD, area, SR, tempi e parametri di elaborazione. Qualità dell'orientamento: errori di riproiezione, lunghezze delle tracce dei punti di legame, connessioni tra immagini, posizioni delle camere con residui. Georeferenziazione: punti d'appoggio e di controllo con dX dY dZ e residui in immagine, vettori dei residui, RMSE per gruppo, accuratezza NSSDA (FGDC-STD-007.3-1998) al 95 % di confidenza, classi di accuratezza ASPRS 2014 e 2023, residui delle posizioni delle camere, valori anomali. Incertezza: deviazioni standard delle camere e dei punti di legame dalla covarianza della compensazione. Prodotti: anteprime di DSM e ortomosaico, risoluzione, frazione valida. Le sezioni la cui fase non è stata eseguita vengono saltate con una nota.
+Sezioni del rapporto. Sintesi — immagini fornite / orientate / non orientate e perché, controllo delle immagini, camere con i parametri calibrati e le deviazioni standard, GSD, area, SR, tempi e parametri di elaborazione. Qualità dell'orientamento: errori di riproiezione, lunghezze delle tracce dei punti di legame, connessioni tra immagini, posizioni delle camere con residui. Georeferenziazione: punti d'appoggio e di controllo con dX dY dZ e residui in immagine, vettori dei residui, RMSE per gruppo, accuratezza NSSDA (FGDC-STD-007.3-1998) al 95 % di confidenza, classi di accuratezza ASPRS 2014 e 2023, residui delle posizioni delle camere, valori anomali. Incertezza: deviazioni standard delle camere e dei punti di legame dalla covarianza della compensazione. Prodotti: anteprime di DSM e ortomosaico, risoluzione, frazione valida. Le sezioni la cui fase non è stata eseguita vengono saltate con una nota.
 
-WORKSPACE: una cartella dell'area di lavoro (almeno orientata).
-UNCERTAINTY: calcola la covarianza (secondi per centinaia di immagini) e scrive &lt;workspace&gt;/uncertainty/cameras.gpkg e points.gpkg.
-OUTPUT_HTML: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Viene scritto con un nome provvisorio e rinominato quando è completo.</translation>
+Cartella dell'area di lavoro: una cartella dell'area di lavoro (almeno orientata).
+Calcola la covarianza della compensazione a stelle proiettive: calcola la covarianza (secondi per centinaia di immagini) e scrive &lt;workspace&gt;/uncertainty/cameras.gpkg e points.gpkg.
+Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Viene scritto con un nome provvisorio e rinominato quando è completo.</translation>
     </message>
 </context>
 <context>
@@ -303,26 +303,26 @@ Metodo di ricostruzione (avanzato): 'incremental' (COLMAP, predefinito) o 'globa
 
 Stereo pairs are chosen from the sparse model (shared tie points, baseline-to-depth ratio, viewing angle); each pair is undistorted and rectified from the known poses and matched with semi-global matching (OpenCV SGBM) with a left-right check; a pixel is kept where at least two independent pairs agree. The fused points are rasterised (median of the highest height cluster per cell), small holes are filled and large ones left nodata.
 
-WORKSPACE: a georeferenced workspace (run &apos;Georeference&apos; first: a DSM needs a metric scale and a vertical direction, so a workspace that is only aligned is refused).
-RESOLUTION: DSM cell size in metres; 0 = about twice the median ground sample distance.
-QUALITY: image scale for matching (full, half, quarter): half is four times faster than full.
-ENGINE: cpu (default); cuda runs COLMAP patch-match stereo where pycolmap was built with CUDA.
-OUTPUT_DSM: Cloud-Optimized GeoTIFF, float32 with nodata (default: &lt;workspace&gt;/dsm.tif).
-OUTPUT_POINT_CLOUD: optional LAS file (XYZ + RGB, workspace CRS).
-DASK_SCHEDULER: run the stereo pairs on a Dask cluster (tcp://host:8786) whose workers see the workspace path; empty = this computer (or the ARCHAEOORTHO_DASK_SCHEDULER environment variable).
+Workspace folder: a georeferenced workspace (run &apos;Georeference&apos; first: a DSM needs a metric scale and a vertical direction, so a workspace that is only aligned is refused).
+DSM resolution: DSM cell size in metres; 0 = about twice the median ground sample distance.
+Matching quality: image scale for matching (full, half, quarter): half is four times faster than full.
+Engine: cpu (default); cuda runs COLMAP patch-match stereo where pycolmap was built with CUDA.
+DSM: Cloud-Optimized GeoTIFF, float32 with nodata (default: &lt;workspace&gt;/dsm.tif).
+Point cloud: optional LAS file (XYZ + RGB, workspace CRS).
+Dask scheduler (advanced): run the stereo pairs on a Dask cluster (tcp://host:8786) whose workers see the workspace path; empty = this computer (or the ARCHAEOORTHO_DASK_SCHEDULER environment variable).
 
-Re-running after a cancel resumes: pairs already matched are reused from &lt;workspace&gt;/dense/.</source>
+A re-run after a cancel resumes, reusing the pairs already matched in &lt;workspace&gt;/dense/.</source>
         <translation>Corrispondenza densa del blocco georeferenziato e un modello digitale della superficie (DSM).
 
 Le coppie stereo sono scelte dal modello sparso (punti di legame comuni, rapporto base/distanza, angolo di vista); ogni coppia è corretta dalla distorsione e rettificata dagli orientamenti noti e abbinata con semi-global matching (OpenCV SGBM) con controllo sinistra-destra; un pixel è tenuto dove almeno due coppie indipendenti concordano. I punti fusi sono rasterizzati (mediana del gruppo di quote più alto per cella), i piccoli vuoti riempiti e quelli grandi lasciati nodata.
 
-WORKSPACE: un'area di lavoro georeferenziata (eseguire prima 'Georeferenzia': un DSM richiede una scala metrica e una verticale, quindi un'area di lavoro solo orientata viene rifiutata).
-RESOLUTION: dimensione della cella del DSM in metri; 0 = circa il doppio del GSD mediano.
-QUALITY: scala dell'immagine per la corrispondenza (piena, metà, quarto): metà è quattro volte più veloce di piena.
-ENGINE: cpu (predefinito); cuda esegue lo stereo patch-match di COLMAP dove pycolmap è compilato con CUDA.
-OUTPUT_DSM: Cloud-Optimized GeoTIFF, float32 con nodata (predefinito: &lt;workspace&gt;/dsm.tif).
-OUTPUT_POINT_CLOUD: file LAS facoltativo (XYZ + RGB, SR dell'area di lavoro).
-DASK_SCHEDULER: calcola le coppie stereo su un cluster Dask (tcp://host:8786) i cui worker vedono il percorso dello spazio di lavoro; vuoto = questo computer (o la variabile d'ambiente ARCHAEOORTHO_DASK_SCHEDULER).
+Cartella dell'area di lavoro: un'area di lavoro georeferenziata (eseguire prima 'Georeferenzia': un DSM richiede una scala metrica e una verticale, quindi un'area di lavoro solo orientata viene rifiutata).
+Risoluzione del DSM: dimensione della cella del DSM in metri; 0 = circa il doppio del GSD mediano.
+Qualità della corrispondenza: scala dell'immagine per la corrispondenza (piena, metà, quarto): metà è quattro volte più veloce di piena.
+Motore di calcolo: cpu (predefinito); cuda esegue lo stereo patch-match di COLMAP dove pycolmap è compilato con CUDA.
+DSM: Cloud-Optimized GeoTIFF, float32 con nodata (predefinito: &lt;workspace&gt;/dsm.tif).
+Nuvola di punti: file LAS facoltativo (XYZ + RGB, SR dell'area di lavoro).
+Scheduler Dask (avanzato): calcola le coppie stereo su un cluster Dask (tcp://host:8786) i cui worker vedono il percorso dello spazio di lavoro; vuoto = questo computer (o la variabile d'ambiente ARCHAEOORTHO_DASK_SCHEDULER).
 
 Una nuova esecuzione dopo un annullamento riprende: le coppie già elaborate sono riutilizzate da &lt;workspace&gt;/dense/.</translation>
     </message>
@@ -429,22 +429,22 @@ DTM: dove scriverlo (predefinito: &lt;workspace&gt;/dtm.tif).</translation>
 <context>
     <name>BuildOrthophotoAlgorithm</name>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="88"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="90"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="89"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="91"/>
         <source>Share of mosaic cells with data</source>
         <translation>Frazione delle celle del mosaico con dati</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="90"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="92"/>
         <source>Resolution used</source>
         <translation>Risoluzione usata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="91"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="93"/>
         <source>Images in the mosaic</source>
         <translation>Immagini nel mosaico</translation>
     </message>
@@ -454,64 +454,69 @@ DTM: dove scriverlo (predefinito: &lt;workspace&gt;/dtm.tif).</translation>
         <translation>Genera ortofoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>Georeferenced workspace</source>
         <translation>Area di lavoro georeferenziata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>Images</source>
         <translation>Immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>Resolution</source>
         <translation>Risoluzione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>Seam blending</source>
         <translation>Sfumatura delle giunzioni</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>Resampling</source>
         <translation>Ricampionamento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>Parallel tile workers</source>
         <translation>Processi paralleli per tessera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
         <source>Dask scheduler</source>
         <translation>Scheduler Dask</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="80"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="82"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="83"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="85"/>
         <source>Per-image orthophotos folder</source>
         <translation>Cartella delle ortofoto per immagine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="86"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="88"/>
         <source>Seamlines</source>
         <translation>Linee di giunzione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="106"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="108"/>
         <source>Seamlines must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>Le linee di giunzione devono essere un file GeoPackage (.gpkg), ricevuto {}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <source>Far-field limit (× best ground resolution, 0 = off)</source>
+        <translation>Limite del campo lontano (× miglior risoluzione al suolo, 0 = spento)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -524,6 +529,7 @@ DSM: optional raster (e.g. an ALS DSM, in any CRS: reprojected on the fly); defa
 Images: a subset, e.g. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; or &apos;group:NIR&apos; (a camera group by id or by make/model), &apos;!name&apos; to leave one out. Empty: all images.
 Resolution: cell size in CRS units; 0 = the images&apos; ground sample distance.
 Seam blending: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness and no ghosting), none (hard cut).
+Far-field limit (advanced): each image is used only where its ground resolution is within this factor of its best, so the stretched far field of an oblique (towards the horizon) is left out and the mosaic takes those cells from a nearer view; cells no image sees finely enough stay empty. 0 = off (default 3).
 Orthomosaic: Cloud-Optimized GeoTIFF with overviews, the images&apos; bands and data type (8/16 bit kept) plus an alpha band (default &lt;workspace&gt;/orthomosaic.tif).
 Per-image orthophotos folder: optional folder for one true orthophoto per image (COG).
 Seamlines: optional GeoPackage of polygons naming the image each part of the mosaic comes from.
@@ -537,15 +543,11 @@ DSM: raster facoltativo (ad es. un DSM ALS, in qualsiasi SR: riproiettato al vol
 Immagini: un sottoinsieme, ad es. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' o 'group:NIR' (un gruppo di camere per numero o per marca/modello), '!nome' per escluderne una. Vuoto: tutte le immagini.
 Risoluzione: dimensione della cella in unità del SR; 0 = il GSD delle immagini.
 Sfumatura delle giunzioni: feather (rampa attraverso le giunzioni), multiband (piramide laplaciana: nessuna giunzione visibile nella luminosità e nessun effetto fantasma), none (taglio netto).
+Limite del campo lontano (avanzato): ogni immagine è usata solo dove la sua risoluzione al suolo è entro questo fattore della sua migliore, così il campo lontano allungato di una foto obliqua (verso l'orizzonte) è escluso e il mosaico prende quelle celle da una vista più vicina; le celle che nessuna immagine vede abbastanza finemente restano vuote. 0 = spento (predefinito 3).
 Ortomosaico: Cloud-Optimized GeoTIFF con panoramiche, le bande e il tipo di dato delle immagini (8/16 bit conservati) più una banda alfa (predefinito &lt;workspace&gt;/orthomosaic.tif).
 Cartella delle ortofoto per immagine: cartella facoltativa per un'ortofoto vera per immagine (COG).
 Linee di giunzione: GeoPackage facoltativo di poligoni che indicano l'immagine da cui proviene ogni parte del mosaico.
 Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:8786) i cui worker vedono il percorso dell'area di lavoro; vuoto = questo computer, oppure $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="63"/>
-        <source>Use each image only where its ground resolution is within this factor of its best (0 = no limit)</source>
-        <translation>Usa ogni immagine solo dove la sua risoluzione al suolo è entro questo fattore della migliore (0 = nessun limite)</translation>
     </message>
 </context>
 <context>
@@ -1491,42 +1493,42 @@ Curve di livello: il GeoPackage da scrivere.</translation>
 <context>
     <name>GeoreferenceAlgorithm</name>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="59"/>
+        <location filename="../processing_provider/georeference.py" line="62"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="60"/>
+        <location filename="../processing_provider/georeference.py" line="63"/>
         <source>GCP residuals</source>
         <translation>Residui dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="61"/>
+        <location filename="../processing_provider/georeference.py" line="64"/>
         <source>Camera centres (world)</source>
         <translation>Centri di presa (mondo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="77"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS)</source>
         <translation>Indica i punti d'appoggio (GCPS o GCP_LAYER) e/o le posizioni delle camere (CAMERA_POSITIONS o USE_EXIF_GPS)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="88"/>
+        <location filename="../processing_provider/georeference.py" line="91"/>
         <source>outlier left out: {}</source>
         <translation>valore anomalo escluso: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="92"/>
+        <location filename="../processing_provider/georeference.py" line="95"/>
         <source>CRS {}; control RMSE XY {} m, Z {} m; check RMSE XY {} m, Z {} m</source>
         <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="103"/>
+        <location filename="../processing_provider/run_pipeline.py" line="106"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
@@ -1536,39 +1538,44 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Georeferenzia</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Aligned workspace</source>
         <translation>Area di lavoro allineata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Ground control layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Check points</source>
         <translation>Punti di controllo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Use EXIF GPS positions</source>
         <translation>Usa le posizioni GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Target CRS</source>
         <translation>SR di destinazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
+        <location filename="../processing_provider/georeference.py" line="50"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="50"/>
+        <source>GCP pixels measured on upright photos</source>
+        <translation>Pixel dei GCP misurati sulle foto raddrizzate</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1578,6 +1585,7 @@ Ground control file: an OpenDroneMap gcp_list.txt (CRS line, then &apos;x y z px
 Check points: comma-separated names that become check points.
 Camera positions: CSV &apos;image,x,y,z[,sigma]&apos; (optional CRS line). Use EXIF GPS positions: use the photos&apos; GPS.
 Target CRS: default the ground control file&apos;s. Refine camera calibration: let the adjustment refine focal length, principal point and distortion.
+GCP pixels measured on upright photos: tick when the pixel coordinates were measured on the photos shown upright by their EXIF orientation, as web browsers and photo viewers show them; they are turned into the stored pixel grid of each photo (photos stored without a turn are unchanged).
 Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.</source>
         <translation>Fissa il blocco allineato in un sistema di riferimento reale con punti d'appoggio (GCP) e/o posizioni delle camere, usati all'interno della compensazione a stelle proiettive in modo che eliminino anche la deriva e la flessione del blocco, cosa che una trasformazione a 7 parametri (Helmert) non può fare. I punti di controllo non partecipano alla compensazione: vengono triangolati in seguito e confrontati con le loro coordinate rilevate.
 
@@ -1585,103 +1593,99 @@ File dei punti d'appoggio: un gcp_list.txt di OpenDroneMap (riga del SR, poi 'x 
 Punti di controllo: nomi separati da virgole che diventano punti di controllo.
 Posizioni delle camere: CSV 'image,x,y,z[,sigma]' (riga del SR facoltativa). Usa le posizioni GPS EXIF: usa il GPS delle foto.
 SR di destinazione: predefinito quello del file dei punti d'appoggio. Affina la calibrazione della camera: la compensazione affina focale, punto principale e distorsione.
+Pixel dei GCP misurati sulle foto raddrizzate: da spuntare quando le coordinate pixel sono state misurate sulle foto mostrate diritte secondo il loro orientamento EXIF, come le mostrano i browser e i visualizzatori di foto; sono convertite nella griglia di pixel memorizzata di ogni foto (le foto memorizzate senza rotazione restano invariate).
 I valori anomali (una misura errata, un errore di battitura in una coordinata) sono individuati, nominati nel registro ed esclusi.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="47"/>
-        <source>GCP pixels measured on upright photos</source>
-        <translation>Pixel dei GCP misurati sulle foto raddrizzate</translation>
     </message>
 </context>
 <context>
     <name>OrthorectifyImageAlgorithm</name>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="58"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
         <source>Image</source>
         <translation>Immagine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Ground control file (gcp_list.txt or CSV)</source>
         <translation>File dei punti d'appoggio (gcp_list.txt o CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Ground control point layer (one feature per observation)</source>
         <translation>Layer dei punti d'appoggio (un elemento per misura)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Known orientation (x y z omega phi kappa)</source>
         <translation>Orientamento noto (x y z omega phi kappa)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Focal length in mm (0 = from EXIF)</source>
         <translation>Focale in mm (0 = dall'EXIF)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Sensor width (long side) in mm</source>
         <translation>Larghezza del sensore (lato lungo) in mm</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Mode</source>
         <translation>Modalità</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Resolution in CRS units (0 = ground sample distance)</source>
         <translation>Risoluzione in unità del SR (0 = GSD)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Output CRS (default: the GCPs&apos; or orientation&apos;s CRS)</source>
         <translation>SR di output (predefinito: quello dei punti d'appoggio o dell'orientamento)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="74"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="76"/>
         <source>Orthophoto</source>
         <translation>Ortofoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="77"/>
         <source>GCP residuals</source>
         <translation>Residui dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="77"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="79"/>
         <source>GCP residual RMSE (pixels)</source>
         <translation>RMSE dei residui dei punti d'appoggio (pixel)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="78"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="80"/>
         <source>Planar rectification: 95th percentile of its offset from the true position (CRS units)</source>
         <translation>Raddrizzamento piano: 95° percentile del suo scostamento dalla posizione vera (unità del SR)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="94"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="96"/>
         <source>Give ground control points observed in the image (GCPS or GCP_LAYER) or its orientation (ORIENTATION)</source>
         <translation>Indica i punti d'appoggio misurati nell'immagine (GCPS o GCP_LAYER) o il suo orientamento (ORIENTATION)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="100"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="102"/>
         <source>RESIDUALS must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>RESIDUALS deve essere un file GeoPackage (.gpkg), ricevuto {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="113"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="115"/>
         <source>{} ({}): {:.2f} px</source>
         <translation>{} ({}): {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="88"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="90"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
@@ -1696,22 +1700,22 @@ I valori anomali (una misura errata, un errore di battitura in una coordinata) s
 
 The camera's position and attitude come from ground control points observed in the photo (space resection: at least 4 points; one wrong point among 5 or more is found and left out; with 6 or more the focal length and the radial distortion k1 are estimated too where the points determine them), or from a known orientation.
 
-IMAGE: the photo. DSM: height raster (needed for a true orthophoto).
-GCPS: an OpenDroneMap gcp_list.txt or CSV points file with observations in this image; or GCP_LAYER: a point layer with one feature per observation and fields name, image, px, py (optional z, role; pixel origin at the upper-left corner, y down).
-ORIENTATION: instead of GCPs, a file with x y z omega phi kappa (degrees, photogrammetric convention; a header row as Pix4D writes it, or JSON), optionally focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 and a CRS line.
-FOCAL_MM and SENSOR_WIDTH_MM: interior orientation (the sensor's long side); default the EXIF focal length.
-MODE: a true orthophoto on the DSM, or a planar (projective) rectification through the GCPs for comparison on flat ground; with a DSM the log and PLANAR_OFFSET_P95 say how far the planar result is off because of relief.
-RESIDUALS: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
+Image: the photo. DSM: height raster (needed for a true orthophoto).
+Ground control file: an OpenDroneMap gcp_list.txt or CSV points file with observations in this image; or Ground control point layer: a point layer with one feature per observation and fields name, image, px, py (optional z, role; pixel origin at the upper-left corner, y down).
+Known orientation: instead of GCPs, a file with x y z omega phi kappa (degrees, photogrammetric convention; a header row as Pix4D writes it, or JSON), optionally focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 and a CRS line.
+Focal length and Sensor width: interior orientation (the sensor's long side); default the EXIF focal length.
+Mode: a true orthophoto on the DSM, or a planar (projective) rectification through the GCPs for comparison on flat ground; with a DSM the log and the output 'Planar rectification: 95th percentile of its offset' say how far the planar result is off because of relief.
+GCP residuals: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
         <translation>Ortorettifica una fotografia — anche una che non fa parte di alcun blocco, come una singola obliqua o una vecchia stampa — su un DSM esistente, ad esempio un DSM da laser scanning aereo (ALS) in qualsiasi SR (riproiettato al volo).
 
 Posizione e assetto della camera derivano dai punti d'appoggio misurati nella foto (resezione spaziale: almeno 4 punti; un punto errato su 5 o più viene individuato ed escluso; con 6 o più si stimano anche la focale e la distorsione radiale k1 dove i punti le determinano), oppure da un orientamento noto.
 
-IMAGE: la foto. DSM: raster delle quote (necessario per un'ortofoto vera).
-GCPS: un gcp_list.txt di OpenDroneMap o un file CSV di punti con misure in questa immagine; oppure GCP_LAYER: un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, role; origine dei pixel nell'angolo in alto a sinistra, y verso il basso).
-ORIENTATION: al posto dei punti d'appoggio, un file con x y z omega phi kappa (gradi, convenzione fotogrammetrica; una riga di intestazione come la scrive Pix4D, o JSON), facoltativamente focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 e una riga del SR.
-FOCAL_MM e SENSOR_WIDTH_MM: orientamento interno (il lato lungo del sensore); predefinita la focale EXIF.
-MODE: un'ortofoto vera sul DSM, o un raddrizzamento piano (proiettivo) tramite i punti d'appoggio per confronto su terreno piatto; con un DSM il registro e PLANAR_OFFSET_P95 dicono di quanto il risultato piano si discosta a causa del rilievo.
-RESIDUALS: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in metri sul piano).</translation>
+Immagine: la foto. DSM: raster delle quote (necessario per un'ortofoto vera).
+File dei punti d'appoggio: un gcp_list.txt di OpenDroneMap o un file CSV di punti con misure in questa immagine; oppure Layer dei punti d'appoggio: un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, role; origine dei pixel nell'angolo in alto a sinistra, y verso il basso).
+Orientamento noto: al posto dei punti d'appoggio, un file con x y z omega phi kappa (gradi, convenzione fotogrammetrica; una riga di intestazione come la scrive Pix4D, o JSON), facoltativamente focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 e una riga del SR.
+Focale e Larghezza del sensore: orientamento interno (il lato lungo del sensore); predefinita la focale EXIF.
+Modalità: un'ortofoto vera sul DSM, o un raddrizzamento piano (proiettivo) tramite i punti d'appoggio per confronto su terreno piatto; con un DSM il registro e il risultato 'Raddrizzamento piano: 95° percentile del suo scostamento' dicono di quanto il risultato piano si discosta a causa del rilievo.
+Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in metri sul piano).</translation>
     </message>
 </context>
 <context>
@@ -1785,102 +1789,102 @@ RESIDUALS: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in met
 <context>
     <name>PrepareImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="80"/>
+        <location filename="../processing_provider/prepare_images.py" line="84"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="80"/>
+        <location filename="../processing_provider/prepare_images.py" line="84"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="80"/>
+        <location filename="../processing_provider/prepare_images.py" line="84"/>
         <source>Smallest blur score (0 = only relative to the set)</source>
         <translation>Punteggio di nitidezza minimo (0 = solo relativo all'insieme)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="80"/>
+        <location filename="../processing_provider/prepare_images.py" line="84"/>
         <source>Leave flagged images out of the prepared folder</source>
         <translation>Escludi le immagini segnalate dalla cartella preparata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="92"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Scanned film: fiducial marks, common frame, masks</source>
         <translation>Pellicola scansionata: marche fiduciali, fotogramma comune, maschere</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="93"/>
+        <location filename="../processing_provider/prepare_images.py" line="97"/>
         <source>Calibrated fiducial coordinates in mm (file path or text)</source>
         <translation>Coordinate calibrate delle marche fiduciali in mm (percorso di file o testo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Calibrated focal length in mm (0 = unknown)</source>
         <translation>Focale calibrata in mm (0 = sconosciuta)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Flag images below this fraction of the set&apos;s median blur score</source>
         <translation>Segnala le immagini sotto questa frazione del punteggio di nitidezza mediano dell'insieme</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Fiducial mark type</source>
         <translation>Tipo di marca fiduciale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Fiducial positions</source>
         <translation>Posizioni delle marche fiduciali</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Template image of one fiducial mark</source>
         <translation>Immagine modello di una marca fiduciale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Scan resolution in dpi when not in the files (0 = from the files)</source>
         <translation>Risoluzione di scansione in dpi se non nei file (0 = dai file)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="109"/>
+        <location filename="../processing_provider/prepare_images.py" line="113"/>
         <source>Prepared images (skipped: &lt;workspace&gt;/prepared)</source>
         <translation>Immagini preparate (se omesso: &lt;workspace&gt;/prepared)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="112"/>
+        <location filename="../processing_provider/prepare_images.py" line="116"/>
         <source>Folder of prepared images</source>
         <translation>Cartella delle immagini preparate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="113"/>
+        <location filename="../processing_provider/prepare_images.py" line="117"/>
         <source>Flagged images</source>
         <translation>Immagini segnalate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="114"/>
+        <location filename="../processing_provider/prepare_images.py" line="118"/>
         <source>Excluded images</source>
         <translation>Immagini escluse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="115"/>
+        <location filename="../processing_provider/prepare_images.py" line="119"/>
         <source>Screening record (JSON)</source>
         <translation>Registro del controllo (JSON)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="152"/>
+        <location filename="../processing_provider/prepare_images.py" line="156"/>
         <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
         <translation>{} immagini: {} segnalate, {} escluse, {} nella cartella preparata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="154"/>
+        <location filename="../processing_provider/prepare_images.py" line="158"/>
         <source>Blurriest first (blur score, % of the set&apos;s median):</source>
         <translation>Le più sfocate per prime (punteggio di nitidezza, % della mediana dell'insieme):</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="162"/>
+        <location filename="../processing_provider/prepare_images.py" line="166"/>
         <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
         <translation>Scansioni preparate: {} x {} px, dimensione del pixel {:.6g} {}{}</translation>
     </message>
@@ -1890,57 +1894,59 @@ RESIDUALS: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in met
         <translation>Prepara immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="87"/>
+        <location filename="../processing_provider/prepare_images.py" line="91"/>
         <source>Mask polygons: areas to ignore, in pixel coordinates (optional text field &apos;image&apos;)</source>
         <translation>Poligoni di maschera: aree da ignorare, in coordinate pixel (campo di testo opzionale 'image')</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="147"/>
+        <location filename="../processing_provider/prepare_images.py" line="151"/>
         <source>MASKS layer &apos;{}&apos;</source>
         <translation>layer MASKS '{}'</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="182"/>
+        <location filename="../processing_provider/prepare_images.py" line="186"/>
         <source>feature {}</source>
         <translation>elemento {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="186"/>
+        <location filename="../processing_provider/prepare_images.py" line="190"/>
         <source>MASKS layer &apos;{}&apos;: {} has no geometry: skipped</source>
         <translation>layer MASKS '{}': {} non ha geometria: saltato</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="189"/>
+        <location filename="../processing_provider/prepare_images.py" line="193"/>
         <source>MASKS layer &apos;{}&apos;: {} is a {} geometry, not a polygon</source>
         <translation>layer MASKS '{}': {} è una geometria {}, non un poligono</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
-        <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for &apos;Align images&apos;, and the WORKSPACE, which records a decision per image (screening.json) for the accuracy report.
-
-Blur score: variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged &apos;blurry&apos; below BLUR_RELATIVE x the median of the set, or below BLUR_THRESHOLD when that is set (absolute scores depend on the scene: sand scores far lower than roofs).
-Exposure: images with more than 5 % clipped highlights or shadows, a mean brightness far from the set&apos;s, or a very small dynamic range are flagged. EXCLUDE_FLAGGED leaves flagged images out of the prepared folder; otherwise they are kept and only reported.
-
-MASKS: optional polygon layer of areas to ignore (a boom, the drone&apos;s shadow, a date stamp, a frame border), in the image&apos;s pixel coordinates: origin at the upper-left corner of the image, x right, y down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is &lt;= 0). A text field &apos;image&apos; names the image a polygon belongs to; empty (or no such field) applies it to every image. The polygons are written into the per-image masks (workspace/masks/&lt;image&gt;.png, merged with any mask already there): &apos;Align images&apos; finds no features under them, the orthophoto does not use those pixels, and blur and exposure are measured outside them. For scanned film the coordinates are those of the prepared images (the common fiducial frame, so one polygon fits every frame).
-
-SCANNED_FILM: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. FIDUCIAL_COORDINATES: the calibration certificate&apos;s fiducial coordinates in mm, as a file or pasted text, one &apos;id x y&apos; line per mark (x right, y up), optionally &apos;PP x y&apos; (principal point) and &apos;focal f&apos;. Without them the mean layout of the set is used, centred on the fiducial centre. With FOCAL_LENGTH_MM (or &apos;focal&apos; in the certificate) the prepared images carry the focal length in pixels for the alignment.
-
-OUTPUT: the folder of prepared images (replaced as a whole; it must be new, empty or written by an earlier run); when skipped, &lt;workspace&gt;/prepared.</source>
-        <translation>Controlla una cartella di fotografie per sfocatura ed esposizione e, per le pellicole storiche scansionate, trova le marche fiduciali e ricampiona ogni scansione in un unico fotogramma della camera. Il risultato è una cartella di immagini preparate per 'Allinea immagini' e il WORKSPACE, che registra una decisione per immagine (screening.json) per il rapporto di accuratezza.
-
-Punteggio di nitidezza: varianza del laplaciano su una copia in grigio larga 1024 px, 90° percentile di una griglia di 8 x 6 tasselli (cielo o acqua in una parte del fotogramma non vanno a suo sfavore). Più alto è più nitido. Un'immagine è segnalata come 'sfocata' sotto BLUR_RELATIVE x la mediana dell'insieme, o sotto BLUR_THRESHOLD se impostato (i punteggi assoluti dipendono dalla scena: la sabbia ottiene molto meno dei tetti).
-Esposizione: vengono segnalate le immagini con più del 5 % di luci o ombre tagliate, una luminosità media lontana da quella dell'insieme o una gamma dinamica molto ridotta. EXCLUDE_FLAGGED esclude le immagini segnalate dalla cartella preparata; altrimenti vengono mantenute e solo riportate.
-
-MASKS: layer poligonale opzionale delle aree da ignorare (un braccio, l'ombra del drone, un timbro con la data, un bordo del fotogramma), nelle coordinate pixel dell'immagine: origine nell'angolo superiore sinistro, x verso destra, y verso il basso, oppure y = -riga come il georeferenziatore di QGIS mostra una foto (riconosciuto quando ogni y è &lt;= 0). Un campo di testo 'image' indica l'immagine a cui appartiene un poligono; vuoto (o senza tale campo) vale per ogni immagine. I poligoni vengono scritti nelle maschere per immagine (workspace/masks/&lt;immagine&gt;.png, unite a una maschera già presente): 'Allinea immagini' non trova caratteristiche sotto di essi, l'ortofoto non usa quei pixel, e nitidezza ed esposizione vengono misurate al di fuori. Per la pellicola scansionata valgono le coordinate delle immagini preparate (il riferimento comune delle marche fiduciali, così un poligono vale per ogni fotogramma).
-
-SCANNED_FILM: le marche fiduciali (croci, punti, punti in cerchi; negli angoli e/o a metà dei lati, o come un'immagine modello di una marca) sono trovate con precisione sub-pixel, ogni scansione è ricampionata con una trasformazione affine nel fotogramma fiduciale comune, tutte della stessa dimensione e con il punto principale al centro, e delle maschere (workspace/masks) nascondono alla corrispondenza il bordo della pellicola, le strisce di dati e le marche. FIDUCIAL_COORDINATES: le coordinate delle marche fiduciali del certificato di calibrazione in mm, come file o testo incollato, una riga 'id x y' per marca (x a destra, y in alto), facoltativamente 'PP x y' (punto principale) e 'focal f'. Senza di esse si usa la disposizione media dell'insieme, centrata sul centro fiduciale. Con FOCAL_LENGTH_MM (o 'focal' nel certificato) le immagini preparate riportano la focale in pixel per l'allineamento.
-
-OUTPUT: la cartella delle immagini preparate (sostituita per intero; deve essere nuova, vuota o scritta da un'esecuzione precedente); se omessa, &lt;workspace&gt;/prepared.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="90"/>
+        <location filename="../processing_provider/prepare_images.py" line="94"/>
         <source>Sky masks: hide the sky and the horizon of oblique photos from the alignment</source>
         <translation>Maschere del cielo: nascondi il cielo e l'orizzonte delle foto oblique all'allineamento</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for &apos;Align images&apos;, and the Workspace folder, which records a decision per image (screening.json) for the accuracy report.
+
+The blur score is the variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged &apos;blurry&apos; below a fraction of the median of the set (Flag images below this fraction of the set&apos;s median blur score, advanced), or below the Smallest blur score when that is set (absolute scores depend on the scene: sand scores far lower than roofs).
+Images with more than 5 % clipped highlights or shadows, a mean brightness far from the set&apos;s, or a very small dynamic range are flagged for their exposure. With &apos;Leave flagged images out of the prepared folder&apos; ticked they are left out; otherwise they are kept and only reported.
+
+Mask polygons: optional polygon layer of areas to ignore (a boom, the drone&apos;s shadow, a date stamp, a frame border), in the image&apos;s pixel coordinates: origin at the upper-left corner of the image, x right, y down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is &lt;= 0). A text field &apos;image&apos; names the image a polygon belongs to; empty (or no such field) applies it to every image. The polygons are written into the per-image masks (workspace/masks/&lt;image&gt;.png, merged with any mask already there): &apos;Align images&apos; finds no features under them, the orthophoto does not use those pixels, and blur and exposure are measured outside them. For scanned film the coordinates are those of the prepared images (the common fiducial frame, so one polygon fits every frame).
+Sky masks: for oblique photos the sky (clouds included) and the haze along the horizon are found automatically and written into the per-image masks, so that &apos;Align images&apos; takes no tie points from clouds that move between shots; a photo without sky (looking straight down) gets no sky mask.
+
+Scanned film: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. Calibrated fiducial coordinates: the calibration certificate&apos;s fiducial coordinates in mm, as a file or pasted text, one &apos;id x y&apos; line per mark (x right, y up), optionally &apos;PP x y&apos; (principal point) and &apos;focal f&apos;. Without them the mean layout of the set is used, centred on the fiducial centre. With the Calibrated focal length (or &apos;focal&apos; in the certificate) the prepared images carry the focal length in pixels for the alignment.
+
+Prepared images: the folder of prepared images (replaced as a whole; it must be new, empty or written by an earlier run); when skipped, &lt;workspace&gt;/prepared.</source>
+        <translation>Controlla una cartella di fotografie per sfocatura ed esposizione e, per le pellicole storiche scansionate, trova le marche fiduciali e ricampiona ogni scansione in un unico fotogramma della camera. Il risultato è una cartella di immagini preparate per 'Allinea immagini' e la Cartella dell'area di lavoro, che registra una decisione per immagine (screening.json) per il rapporto di accuratezza.
+
+Il punteggio di nitidezza è la varianza del laplaciano su una copia in grigio larga 1024 px, 90° percentile di una griglia di 8 x 6 tasselli (cielo o acqua in una parte del fotogramma non vanno a suo sfavore). Più alto è più nitido. Un'immagine è segnalata come 'sfocata' sotto una frazione della mediana dell'insieme (Segnala le immagini sotto questa frazione del punteggio di nitidezza mediano dell'insieme, avanzato), o sotto il Punteggio di nitidezza minimo se impostato (i punteggi assoluti dipendono dalla scena: la sabbia ottiene molto meno dei tetti).
+Vengono segnalate per l'esposizione le immagini con più del 5 % di luci o ombre tagliate, una luminosità media lontana da quella dell'insieme o una gamma dinamica molto ridotta. Con 'Escludi le immagini segnalate dalla cartella preparata' attivo sono escluse; altrimenti vengono mantenute e solo riportate.
+
+Poligoni di maschera: layer poligonale opzionale delle aree da ignorare (un braccio, l'ombra del drone, un timbro con la data, un bordo del fotogramma), nelle coordinate pixel dell'immagine: origine nell'angolo superiore sinistro, x verso destra, y verso il basso, oppure y = -riga come il georeferenziatore di QGIS mostra una foto (riconosciuto quando ogni y è &lt;= 0). Un campo di testo 'image' indica l'immagine a cui appartiene un poligono; vuoto (o senza tale campo) vale per ogni immagine. I poligoni vengono scritti nelle maschere per immagine (workspace/masks/&lt;immagine&gt;.png, unite a una maschera già presente): 'Allinea immagini' non trova caratteristiche sotto di essi, l'ortofoto non usa quei pixel, e nitidezza ed esposizione vengono misurate al di fuori. Per la pellicola scansionata valgono le coordinate delle immagini preparate (il riferimento comune delle marche fiduciali, così un poligono vale per ogni fotogramma).
+Maschere del cielo: nelle foto oblique il cielo (nuvole comprese) e la foschia lungo l'orizzonte sono trovati automaticamente e scritti nelle maschere per immagine, così 'Allinea immagini' non prende punti di legame dalle nuvole che si spostano tra uno scatto e l'altro; una foto senza cielo (rivolta verso il basso) non riceve una maschera del cielo.
+
+Pellicola scansionata: le marche fiduciali (croci, punti, punti in cerchi; negli angoli e/o a metà dei lati, o come un'immagine modello di una marca) sono trovate con precisione sub-pixel, ogni scansione è ricampionata con una trasformazione affine nel fotogramma fiduciale comune, tutte della stessa dimensione e con il punto principale al centro, e delle maschere (workspace/masks) nascondono alla corrispondenza il bordo della pellicola, le strisce di dati e le marche. Coordinate calibrate delle marche fiduciali: le coordinate delle marche fiduciali del certificato di calibrazione in mm, come file o testo incollato, una riga 'id x y' per marca (x a destra, y in alto), facoltativamente 'PP x y' (punto principale) e 'focal f'. Senza di esse si usa la disposizione media dell'insieme, centrata sul centro fiduciale. Con la Focale calibrata (o 'focal' nel certificato) le immagini preparate riportano la focale in pixel per l'allineamento.
+
+Immagini preparate: la cartella delle immagini preparate (sostituita per intero; deve essere nuova, vuota o scritta da un'esecuzione precedente); se omessa, &lt;workspace&gt;/prepared.</translation>
     </message>
 </context>
 <context>
@@ -2003,14 +2009,14 @@ Workspace folder: a workspace with a DTM (Build DTM) or DSM.
 Elevation raster: any DTM/DSM in a projected CRS instead (optional).
 Surface: the workspace&apos;s DTM (bare earth, default) or DSM.
 Visualisation: sky-view factor, openness (positive, negative), simple local relief model, multi-scale relief model, multi-direction hillshade, local dominance, or the VAT blend.
-Output: where to write it (default: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</source>
+The output &apos;Visualisation&apos;: where to write it (default: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</source>
         <translation>Visualizzazioni del rilievo per leggere terrapieni, strade incassate, campi baulati e confini di campi, calcolate con rvt-py (la libreria del Relief Visualization Toolbox) con i parametri predefiniti di RVT, convertiti dai DEM a 1 m per cui RVT è fatto alla dimensione di cella di questo raster.
 
 Cartella dell'area di lavoro: un'area di lavoro con DTM (Genera DTM) o DSM.
 Raster delle quote: in alternativa qualsiasi DTM/DSM in un SR proiettato (facoltativo).
 Superficie: il DTM dell'area di lavoro (suolo nudo, predefinito) o il DSM.
 Visualizzazione: fattore di vista del cielo, apertura (positiva, negativa), modello semplice del rilievo locale, modello del rilievo a più scale, ombreggiatura da più direzioni, dominanza locale o la miscela VAT.
-Risultato: dove scriverla (predefinito: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</translation>
+Il risultato 'Visualizzazione': dove scriverla (predefinito: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</translation>
     </message>
 </context>
 <context>
@@ -2099,57 +2105,57 @@ Risultato: dove scriverla (predefinito: &lt;workspace&gt;/terrain/relief/&lt;sur
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Write the accuracy report</source>
         <translation>Scrivi il rapporto di accuratezza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="89"/>
+        <location filename="../processing_provider/run_pipeline.py" line="92"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="90"/>
+        <location filename="../processing_provider/run_pipeline.py" line="93"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="91"/>
+        <location filename="../processing_provider/run_pipeline.py" line="94"/>
         <source>Accuracy report (HTML)</source>
         <translation>Rapporto di accuratezza (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="109"/>
+        <location filename="../processing_provider/run_pipeline.py" line="112"/>
         <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Indicare punti di appoggio (GCPS o GCP_LAYER) e/o posizioni delle camere (CAMERA_POSITIONS o USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="140"/>
+        <location filename="../processing_provider/run_pipeline.py" line="143"/>
         <source>Seconds per stage: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -2159,69 +2165,89 @@ Risultato: dove scriverla (predefinito: &lt;workspace&gt;/terrain/relief/&lt;sur
         <translation>Esegui l'intera elaborazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Ground control layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Check points</source>
         <translation>Punti di controllo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Use EXIF GPS positions</source>
         <translation>Usa le posizioni GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Target CRS</source>
         <translation>SR di destinazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Matching image size (px)</source>
         <translation>Dimensione per la corrispondenza (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>DSM resolution (m)</source>
         <translation>Risoluzione del DSM (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Matching quality</source>
         <translation>Qualità della corrispondenza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Orthomosaic resolution</source>
         <translation>Risoluzione dell'ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Seam blending</source>
         <translation>Sfumatura delle giunzioni</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Parallel workers</source>
         <translation>Processi paralleli</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
         <source>Dask scheduler</source>
         <translation>Scheduler Dask</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
+        <source>Build the DTM</source>
+        <translation>Genera il DTM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
+        <source>Contour interval (m, 0 = none)</source>
+        <translation>Equidistanza (m, 0 = nessuna)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="65"/>
+        <source>Relief visualisations</source>
+        <translation>Visualizzazioni del rilievo</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="91"/>
+        <source>DTM</source>
+        <translation>DTM</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -2229,34 +2255,16 @@ Risultato: dove scriverla (predefinito: &lt;workspace&gt;/terrain/relief/&lt;sur
 
 Folder of images: the photos. Workspace folder: where every product is written.
 Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction.
+Build the DTM: after the DSM, a bare-earth DTM (as &apos;Build DTM&apos;). Contour interval (advanced): contour lines of the DTM at this interval (as &apos;Contours&apos;; 0 = none). Relief visualisations (advanced): those chosen are computed from the DTM (as &apos;Relief visualisation&apos;). Both need the DTM.
 The other parameters are those of the single stages (see their help); 0 means automatic.
 Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures.</source>
         <translation>L'intera elaborazione in una sola chiamata, per l'uso in batch: Allinea immagini, Georeferenzia, Crea DSM, Crea ortofoto e Rapporto di accuratezza su un solo spazio di lavoro. Chiama le stesse funzioni dei singoli algoritmi, e una nuova esecuzione riprende (caratteristiche, corrispondenze e coppie dense già calcolate vengono riutilizzate).
 
 Cartella delle immagini: le foto. Cartella dell'area di lavoro: dove sono scritti tutti i prodotti.
 La georeferenziazione richiede punti di appoggio (un file o un layer dei punti d'appoggio, punti di controllo esclusi) e/o posizioni delle camere (un CSV delle posizioni delle camere o Usa le posizioni GPS EXIF): senza di essi l'elaborazione viene rifiutata, perché un DSM richiede una scala metrica e una direzione verticale.
+Genera il DTM: dopo il DSM, un DTM del suolo nudo (come 'Genera DTM'). Equidistanza (avanzato): curve di livello del DTM con questa equidistanza (come 'Curve di livello'; 0 = nessuna). Visualizzazioni del rilievo (avanzato): quelle scelte sono calcolate dal DTM (come 'Visualizzazione del rilievo'). Entrambe richiedono il DTM.
 Gli altri parametri sono quelli delle singole fasi (vedi il loro aiuto); 0 significa automatico.
 Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
-        <source>Build the DTM</source>
-        <translation>Genera il DTM</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
-        <source>Contour interval (m, 0 = none)</source>
-        <translation>Equidistanza (m, 0 = nessuna)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="62"/>
-        <source>Relief visualisations</source>
-        <translation>Visualizzazioni del rilievo</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="88"/>
-        <source>DTM</source>
-        <translation>DTM</translation>
     </message>
 </context>
 </TS>

@@ -51,7 +51,7 @@ class AccuracyReportAlgorithm(AlgorithmBase):
     HELP = (
         "Writes one self-contained HTML report of a workspace (plots embedded, readable offline) and returns its "
         "key figures.\n\n"
-        "Summary: images given / aligned / not aligned and why, image screening, cameras with their calibrated "
+        "Sections of the report. Summary — images given / aligned / not aligned and why, image screening, cameras with their calibrated "
         "parameters and standard deviations, GSD, area, CRS, processing times and parameters. Orientation quality: "
         "reprojection errors, tie-point track lengths, image connectivity, camera positions with residuals. "
         "Georeferencing: control and check points with dX dY dZ and image residuals, residual vectors, RMSE per "
@@ -59,10 +59,10 @@ class AccuracyReportAlgorithm(AlgorithmBase):
         "classes, camera-position residuals, outliers. Uncertainty: standard deviations of cameras and tie points "
         "from the bundle adjustment covariance. Products: DSM and orthomosaic previews, resolution, valid "
         "fraction. Sections whose stage has not run are skipped with a note.\n\n"
-        "WORKSPACE: a workspace folder (at least aligned).\n"
-        "UNCERTAINTY: compute the covariance (seconds for hundreds of images) and write "
+        "Workspace folder: a workspace folder (at least aligned).\n"
+        "Compute the bundle adjustment covariance: computes it (seconds for hundreds of images) and writes "
         "<workspace>/uncertainty/cameras.gpkg and points.gpkg.\n"
-        "OUTPUT_HTML: the report file (default: <workspace>/report.html). It is written under a temporary name and "
+        "Report: the report file (default: <workspace>/report.html). It is written under a temporary name and "
         "renamed when complete."
     )
 

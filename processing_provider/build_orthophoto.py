@@ -51,6 +51,9 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
         "Resolution: cell size in CRS units; 0 = the images' ground sample distance.\n"
         "Seam blending: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness "
         "and no ghosting), none (hard cut).\n"
+        "Far-field limit (advanced): each image is used only where its ground resolution is within this factor of "
+        "its best, so the stretched far field of an oblique (towards the horizon) is left out and the mosaic takes "
+        "those cells from a nearer view; cells no image sees finely enough stay empty. 0 = off (default 3).\n"
         "Orthomosaic: Cloud-Optimized GeoTIFF with overviews, the images' bands and data type (8/16 bit kept) plus "
         "an alpha band (default <workspace>/orthomosaic.tif).\n"
         "Per-image orthophotos folder: optional folder for one true orthophoto per image (COG).\n"
@@ -72,8 +75,7 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
             *params.advanced(
                 params.choice(self.INTERPOLATION, self.tr("Resampling"), self.INTERPOLATIONS),
                 params.number(self.GSD_FACTOR, self.tr(
-                    "Use each image only where its ground resolution is within this factor of its best "
-                    "(0 = no limit)"), default=3.0),
+                    "Far-field limit (× best ground resolution, 0 = off)"), default=3.0),
                 params.workers(self.WORKERS, self.tr("Parallel tile workers"), default=1),
                 params.scheduler(self.SCHEDULER, self.tr("Dask scheduler"))),
         )

@@ -40,6 +40,9 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         "GPS.\n"
         "Target CRS: default the ground control file's. Refine camera calibration: let the adjustment refine "
         "focal length, principal point and distortion.\n"
+        "GCP pixels measured on upright photos: tick when the pixel coordinates were measured on the photos shown "
+        "upright by their EXIF orientation, as web browsers and photo viewers show them; they are turned into the "
+        "stored pixel grid of each photo (photos stored without a turn are unchanged).\n"
         "Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out."
     )
 

@@ -32,7 +32,7 @@ class ReliefVisualisationAlgorithm(AlgorithmBase):
         "Surface: the workspace's DTM (bare earth, default) or DSM.\n"
         "Visualisation: sky-view factor, openness (positive, negative), simple local relief model, multi-scale "
         "relief model, multi-direction hillshade, local dominance, or the VAT blend.\n"
-        "Output: where to write it (default: <workspace>/terrain/relief/<surface>-<visualisation>.tif)."
+        "The output 'Visualisation': where to write it (default: <workspace>/terrain/relief/<surface>-<visualisation>.tif)."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)

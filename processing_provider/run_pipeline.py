@@ -54,6 +54,9 @@ class RunPipelineAlgorithm(AlgorithmBase):
         "Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera "
         "positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a "
         "DSM needs a metric scale and a vertical direction.\n"
+        "Build the DTM: after the DSM, a bare-earth DTM (as 'Build DTM'). Contour interval (advanced): contour lines "
+        "of the DTM at this interval (as 'Contours'; 0 = none). Relief visualisations (advanced): those chosen "
+        "are computed from the DTM (as 'Relief visualisation'). Both need the DTM.\n"
         "The other parameters are those of the single stages (see their help); 0 means automatic.\n"
         "Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures."
     )

@@ -12,6 +12,9 @@ pytestmark = pytest.mark.usefixtures("qgis_processing")
 
 _KEEP = []
 DIALOG_ALGORITHMS = ("alignimages", "georeference", "runpipeline", "buildorthophoto")
+# every algorithm of the provider: the help of each names its parameters by the form's labels
+ALL_ALGORITHMS = ("prepareimages", "alignimages", "georeference", "builddsm", "buildorthophoto", "accuracyreport",
+                  "orthorectifyimage", "builddtm", "reliefvisualisation", "contours", "runpipeline")
 
 
 @pytest.fixture(scope="module")
@@ -119,13 +122,14 @@ def test_browse_buttons_and_labels_visible_in_german(plugin, german, alg):
 
 
 def _ids_in(text, alg):
-    """Parameter and output ids (PAIRING, CAMERA_MODEL) written in ``text``; DSM and CRS are words too."""
+    """Parameter and output ids (PAIRING, CAMERA_MODEL) written in ``text``; DSM, DTM, CRS and GSD are words
+    too."""
     names = {p.name() for p in alg.parameterDefinitions()} | {o.name() for o in alg.outputDefinitions()}
-    names -= {"DSM", "CRS"}
+    names -= {"DSM", "DTM", "CRS", "GSD"}
     return sorted(n for n in names if re.search(rf"\b{re.escape(n)}\b", text))
 
 
-@pytest.mark.parametrize("alg", DIALOG_ALGORITHMS)
+@pytest.mark.parametrize("alg", ALL_ALGORITHMS)
 def test_help_names_parameters_by_their_labels(plugin, alg):
     """The form shows labels, never ids: the help text must not speak of PAIRING or CAMERA_MODEL, and the
     labels it names are the form's."""
@@ -142,7 +146,7 @@ def test_help_names_parameters_by_their_labels(plugin, alg):
     assert not [u for u in unknown if " and " not in u], (alg, unknown)
 
 
-@pytest.mark.parametrize("alg", DIALOG_ALGORITHMS)
+@pytest.mark.parametrize("alg", ALL_ALGORITHMS)
 def test_help_in_german_uses_the_german_labels(plugin, german, alg):
     from qgis.core import QgsApplication
 
