@@ -43,6 +43,7 @@ class Control:
     camera_positions_path: Optional[str] = None
     use_exif_gps: bool = False
     crs: Optional[str] = None
+    gcps_upright: bool = False  # the GCPs' pixel coordinates were measured on upright photos (EXIF orientation)
 
     def given(self) -> bool:
         return not (self.gcp_path is None and self.gcps is None and not self.camera_positions_path
@@ -139,7 +140,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
     res.georef = run(GEOREFERENCE, georeference_workspace, workspace_dir, gcp_path=ctl.gcp_path, gcps=ctl.gcps,
                      check_points=ctl.check_points, camera_positions_path=ctl.camera_positions_path,
                      use_exif_gps=ctl.use_exif_gps, crs=ctl.crs, refine_intrinsics=opt.georef.refine_intrinsics,
-                     options=opt.georef)
+                     options=opt.georef, gcps_upright=ctl.gcps_upright)
     res.warnings += res.georef.warnings
     res.dsm = run(DSM, build_dsm_workspace, workspace_dir, resolution=opt.dsm_resolution, quality=opt.dsm_quality,
                   options=opt.dense)

@@ -36,6 +36,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
     DTM_ENABLED = "MAKE_DTM"
     CONTOUR_INTERVAL = "CONTOUR_INTERVAL"
     RELIEF = "RELIEF"
+    GCPS_UPRIGHT = "GCPS_UPRIGHT"
     DTM = "DTM"
     WORKERS = "WORKERS"
     SCHEDULER = "DASK_SCHEDULER"
@@ -53,7 +54,8 @@ class RunPipelineAlgorithm(AlgorithmBase):
         "Folder of images: the photos. Workspace folder: where every product is written.\n"
         "Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera "
         "positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a "
-        "DSM needs a metric scale and a vertical direction.\n"
+        "DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in "
+        "'Georeference' (the pixel coordinates measured on the photos shown upright by their EXIF orientation).\n"
         "Build the DTM: after the DSM, a bare-earth DTM (as 'Build DTM'). Contour interval (advanced): contour lines "
         "of the DTM at this interval (as 'Contours'; 0 = none). Relief visualisations (advanced): those chosen "
         "are computed from the DTM (as 'Relief visualisation'). Both need the DTM.\n"
@@ -69,6 +71,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
             params.gcp_file(self.GCPS, self.tr("Ground control file")),
             params.gcp_layer(self.GCP_LAYER, self.tr("Ground control layer")),
             params.check_points(self.CHECK_POINTS, self.tr("Check points")),
+            params.flag(self.GCPS_UPRIGHT, self.tr("GCP pixels measured on upright photos")),
             params.flag(self.USE_EXIF_GPS, self.tr("Use EXIF GPS positions")),
             params.camera_positions(self.CAMERA_POSITIONS, self.tr("Camera positions (CSV)")),
             params.target_crs(self.CRS, self.tr("Target CRS")),
@@ -136,7 +139,8 @@ class RunPipelineAlgorithm(AlgorithmBase):
                 contour_interval=self.parameterAsDouble(p, self.CONTOUR_INTERVAL, context),
                 relief=params.read_relief(self, p, self.RELIEF, context)),
             control=pipeline.Control(gcp_path=gcp_path, gcps=gcps, check_points=checks,
-                                     camera_positions_path=positions, use_exif_gps=use_gps, crs=crs_text),
+                                     camera_positions_path=positions, use_exif_gps=use_gps, crs=crs_text,
+                                     gcps_upright=self.parameterAsBoolean(p, self.GCPS_UPRIGHT, context)),
             progress=FeedbackProgress(feedback))
         for w in result.warnings:
             feedback.pushWarning(w)

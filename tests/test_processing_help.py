@@ -228,3 +228,56 @@ def test_build_orthophoto_output_is_named_orthomosaic_in_the_workspace_group(plu
     assert node.parent() is group
     assert loaded[0].renderer().type() == "multibandcolor"
     assert [n.name() for n in root.children()] == ["ArchaeoOrtho: Site 7"]
+
+
+def test_run_pipeline_passes_gcps_upright_on_to_the_georeferencing(plugin, tmp_path, monkeypatch):
+    """'GCP pixels measured on upright photos' of Run pipeline reaches the pipeline's Control, and the pipeline
+    hands it to the georeferencing stage (no stage runs: they are replaced by recorders)."""
+    from archaeoortho.core import pipeline
+    from qgis.core import QgsApplication, QgsProcessingContext, QgsProcessingException, QgsProcessingFeedback
+
+    alg = QgsApplication.processingRegistry().algorithmById("archaeoortho:runpipeline").create()
+    flag = alg.parameterDefinition("GCPS_UPRIGHT")
+    assert flag is not None and flag.description() == "GCP pixels measured on upright photos"
+    assert flag.defaultValue() in (False, None)
+
+    class Stop(Exception):
+        pass
+
+    seen = {}
+
+    def fake_run_pipeline(images, workspace, options=None, control=None, progress=None):
+        seen["control"] = control
+        raise Stop()
+
+    gcp = tmp_path / "gcp_list.txt"
+    gcp.write_text("EPSG:32633\n500000 5000000 100 10 20 a.jpg p1\n")
+    images = tmp_path / "images"
+    images.mkdir()
+    monkeypatch.setattr(pipeline, "run_pipeline", fake_run_pipeline)
+    for value in (True, False):
+        seen.clear()
+        parameters = {"IMAGES": str(images), "WORKSPACE": str(tmp_path / "ws"), "GCPS": str(gcp),
+                      "GCPS_UPRIGHT": value}
+        with pytest.raises(QgsProcessingException, match="Stop"):  # run_core turns it into this
+            alg.processAlgorithm(parameters, QgsProcessingContext(), QgsProcessingFeedback())
+        assert seen["control"].gcps_upright is value
+        assert seen["control"].gcp_path == str(gcp)
+    monkeypatch.undo()
+
+    # the pipeline itself: Control.gcps_upright -> georeference_workspace(gcps_upright=...)
+    got = {}
+
+    def fake_georeference(workspace_dir, progress=None, **kwargs):
+        got.update(kwargs)
+        raise Stop()
+
+    monkeypatch.setattr(pipeline, "check_inputs", lambda images_dir, control: None)
+    monkeypatch.setattr(pipeline, "align", lambda *a, progress=None, **k: None)
+    monkeypatch.setattr(pipeline, "georeference_workspace", fake_georeference)
+    for value in (True, False):
+        got.clear()
+        with pytest.raises(Stop):
+            pipeline.run_pipeline(str(images), str(tmp_path / "ws"),
+                                  control=pipeline.Control(gcp_path=str(gcp), gcps_upright=value))
+        assert got["gcps_upright"] is value
