@@ -4,19 +4,9 @@
 <context>
     <name>AccuracyReportAlgorithm</name>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="70"/>
+        <location filename="../processing_provider/accuracy_report.py" line="71"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/accuracy_report.py" line="70"/>
-        <source>Compute the bundle adjustment covariance (uncertainty section and layers)</source>
-        <translation>Kovarianz der Bündelblockausgleichung berechnen (Abschnitt und Layer zur Unsicherheit)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/accuracy_report.py" line="76"/>
-        <source>Report (default: &lt;workspace&gt;/report.html)</source>
-        <translation>Bericht (Vorgabe: &lt;workspace&gt;/report.html)</translation>
     </message>
     <message>
         <location filename="../processing_provider/accuracy_report.py" line="79"/>
@@ -54,20 +44,30 @@
         <translation>Genauigkeitsbericht</translation>
     </message>
     <message>
+        <location filename="../processing_provider/accuracy_report.py" line="71"/>
+        <source>Compute uncertainty</source>
+        <translation>Unsicherheit berechnen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="76"/>
+        <source>Report</source>
+        <translation>Bericht</translation>
+    </message>
+    <message>
         <location filename="../ui/catalog.py" line="7"/>
         <source>Writes one self-contained HTML report of a workspace (plots embedded, readable offline) and returns its key figures.
 
 Sections of the report. Summary — images given / aligned / not aligned and why, image screening, cameras with their calibrated parameters and standard deviations, GSD, area, CRS, processing times and parameters. Orientation quality: reprojection errors, tie-point track lengths, image connectivity, camera positions with residuals. Georeferencing: control and check points with dX dY dZ and image residuals, residual vectors, RMSE per set, NSSDA (FGDC-STD-007.3-1998) accuracy statements at 95 % confidence, ASPRS 2014 and 2023 accuracy classes, camera-position residuals, outliers. Uncertainty: standard deviations of cameras and tie points from the bundle adjustment covariance. Products: DSM and orthomosaic previews, resolution, valid fraction. Sections whose stage has not run are skipped with a note.
 
 Workspace folder: a workspace folder (at least aligned).
-Compute the bundle adjustment covariance: computes it (seconds for hundreds of images) and writes &lt;workspace&gt;/uncertainty/cameras.gpkg and points.gpkg.
+Compute uncertainty: computes the bundle adjustment covariance (seconds for hundreds of images) for the uncertainty section and writes &lt;workspace&gt;/uncertainty/cameras.gpkg and points.gpkg.
 Report: the report file (default: &lt;workspace&gt;/report.html). It is written under a temporary name and renamed when complete.</source>
         <translation>Schreibt einen eigenständigen HTML-Bericht über einen Arbeitsbereich (Diagramme eingebettet, offline lesbar) und gibt seine Kennzahlen zurück.
 
 Abschnitte des Berichts. Übersicht — gegebene / orientierte / nicht orientierte Bilder und warum, Bildprüfung, Kameras mit ihren kalibrierten Parametern und Standardabweichungen, GSD, Fläche, KBS, Rechenzeiten und Parameter. Orientierungsqualität: Rückprojektionsfehler, Längen der Verknüpfungspunkt-Spuren, Bildverbindungen, Kamerapositionen mit Residuen. Georeferenzierung: Pass- und Kontrollpunkte mit dX dY dZ und Bildresiduen, Residuenvektoren, RMSE je Gruppe, Genauigkeitsangaben nach NSSDA (FGDC-STD-007.3-1998) mit 95 % Konfidenz, ASPRS-Genauigkeitsklassen 2014 und 2023, Residuen der Kamerapositionen, Ausreißer. Unsicherheit: Standardabweichungen der Kameras und Verknüpfungspunkte aus der Kovarianz der Bündelblockausgleichung. Produkte: Vorschauen von DOM und Orthomosaik, Auflösung, Anteil gültiger Zellen. Abschnitte, deren Schritt nicht gelaufen ist, werden mit einem Hinweis ausgelassen.
 
 Arbeitsbereich-Ordner: ein Arbeitsbereich-Ordner (mindestens orientiert).
-Kovarianz der Bündelblockausgleichung berechnen: berechnet sie (Sekunden für Hunderte von Bildern) und schreibt &lt;workspace&gt;/uncertainty/cameras.gpkg und points.gpkg.
+Unsicherheit berechnen: berechnet die Kovarianz der Bündelblockausgleichung (Sekunden für Hunderte von Bildern) für den Abschnitt zur Unsicherheit und schreibt &lt;workspace&gt;/uncertainty/cameras.gpkg und points.gpkg.
 Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird unter einem vorläufigen Namen geschrieben und erst umbenannt, wenn sie vollständig ist.</translation>
     </message>
 </context>
@@ -253,11 +253,6 @@ Rekonstruktionsverfahren (erweitert): 'incremental' (COLMAP, Standard) oder 'glo
         <translation>Parallele Prozesse (0 = einer je Kern)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="61"/>
-        <source>DSM (default: &lt;workspace&gt;/dsm.tif)</source>
-        <translation>DOM (Vorgabe: &lt;workspace&gt;/dsm.tif)</translation>
-    </message>
-    <message>
         <location filename="../processing_provider/build_dsm.py" line="63"/>
         <source>Point cloud (LAS)</source>
         <translation>Punktwolke (LAS)</translation>
@@ -326,76 +321,66 @@ Dask-Scheduler (erweitert): die Stereopaare auf einem Dask-Cluster (tcp://host:8
 
 Ein erneuter Lauf nach einem Abbruch setzt fort und verwendet die bereits zugeordneten Paare in &lt;workspace&gt;/dense/ wieder.</translation>
     </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="61"/>
+        <source>DSM</source>
+        <translation>DOM</translation>
+    </message>
 </context>
 <context>
     <name>BuildDtmAlgorithm</name>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="52"/>
+        <location filename="../processing_provider/build_dtm.py" line="53"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="54"/>
-        <source>DSM file (default: the workspace&apos;s)</source>
-        <translation>DOM-Datei (Vorgabe: das des Arbeitsbereichs)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_dtm.py" line="54"/>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
         <source>Contour interval in metres (0 = none)</source>
         <translation>Höhenlinienabstand in Metern (0 = keine)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="54"/>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
         <source>Ground filter slope (rise over run)</source>
         <translation>Neigung des Bodenfilters (Steigung)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="54"/>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
         <source>Largest object radius in metres</source>
         <translation>Größter Objektradius in Metern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="54"/>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
         <source>Height above ground of an object in metres</source>
         <translation>Höhe eines Objekts über dem Boden in Metern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="64"/>
-        <source>DTM (default: &lt;workspace&gt;/dtm.tif)</source>
-        <translation>DGM (Vorgabe: &lt;workspace&gt;/dtm.tif)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_dtm.py" line="66"/>
-        <source>Contours (default: &lt;workspace&gt;/terrain/contours.gpkg)</source>
-        <translation>Höhenlinien (Vorgabe: &lt;workspace&gt;/terrain/contours.gpkg)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_dtm.py" line="69"/>
+        <location filename="../processing_provider/build_dtm.py" line="70"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="70"/>
+        <location filename="../processing_provider/build_dtm.py" line="71"/>
         <source>DTM source</source>
         <translation>DGM-Herkunft</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="71"/>
+        <location filename="../processing_provider/build_dtm.py" line="72"/>
         <source>Classified point cloud</source>
         <translation>Klassifizierte Punktwolke</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="72"/>
+        <location filename="../processing_provider/build_dtm.py" line="73"/>
         <source>Share of DSM cells on the ground</source>
         <translation>Anteil der DOM-Zellen am Boden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="73"/>
+        <location filename="../processing_provider/build_dtm.py" line="74"/>
         <source>Share of DTM cells interpolated</source>
         <translation>Anteil der interpolierten DGM-Zellen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="100"/>
+        <location filename="../processing_provider/build_dtm.py" line="101"/>
         <source>Give a workspace folder, or a DSM file and where to write the DTM</source>
         <translation>Geben Sie einen Arbeitsbereich-Ordner an, oder eine DOM-Datei und wohin das DGM geschrieben wird</translation>
     </message>
@@ -403,6 +388,21 @@ Ein erneuter Lauf nach einem Abbruch setzt fort und verwendet die bereits zugeor
         <location filename="../ui/catalog.py" line="7"/>
         <source>Build DTM</source>
         <translation>DGM erzeugen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <source>DSM file</source>
+        <translation>DOM-Datei</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="65"/>
+        <source>DTM</source>
+        <translation>DGM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="67"/>
+        <source>Contours</source>
+        <translation>Höhenlinien</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -414,7 +414,8 @@ Workspace folder: a workspace with a DSM (optional when a DSM file is given).
 DSM file: any DSM in a projected CRS (metres); default: the workspace&apos;s.
 Contour interval: contour lines every this many metres into a GeoPackage (0 = none).
 Slope, largest object radius and height threshold (advanced): SMRF&apos;s parameters (PDAL&apos;s defaults).
-DTM: where to write it (default: &lt;workspace&gt;/dtm.tif).</source>
+DTM: where to write it (default: &lt;workspace&gt;/dtm.tif).
+Contours: where to write the contour lines (default: &lt;workspace&gt;/terrain/contours.gpkg).</source>
         <translation>Ein digitales Geländemodell (nackte Erde) aus dem DOM: Gebäude, Bäume und Feldfrüchte entfernt, der Boden darunter interpoliert.
 
 Der Bodenfilter ist SMRF (Pingel et al. 2013, der Algorithmus von PDALs filters.smrf) auf dem Raster des DOM; unter jedem entfernten Objekt ist der Boden ein Thin-Plate-Spline durch den Boden ringsum. Das DGM ist ein Cloud-Optimized GeoTIFF auf genau dem Raster des DOM; daneben sagt terrain/dtm-source.tif, welche Zellen gemessener Boden (1) und welche interpoliert (2) sind. Die Punktwolke der DOM-Stufe wird, falls sie eine geschrieben hat, mit den ASPRS-Klassen 2 (Boden) und 1 (nicht klassifiziert) nach terrain/points-classified.las kopiert.
@@ -423,7 +424,8 @@ Arbeitsbereich-Ordner: ein Arbeitsbereich mit DOM (optional, wenn eine DOM-Datei
 DOM-Datei: ein beliebiges DOM in einem projizierten KBS (Meter); Vorgabe: das des Arbeitsbereichs.
 Höhenlinienabstand: Höhenlinien alle so viele Meter in ein GeoPackage (0 = keine).
 Neigung, größter Objektradius und Höhenschwelle (erweitert): die Parameter von SMRF (die Vorgaben von PDAL).
-DGM: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/dtm.tif).</translation>
+DGM: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/dtm.tif).
+Höhenlinien: wohin die Höhenlinien geschrieben werden (Vorgabe: &lt;workspace&gt;/terrain/contours.gpkg).</translation>
     </message>
 </context>
 <context>
@@ -1600,92 +1602,57 @@ Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erk
 <context>
     <name>OrthorectifyImageAlgorithm</name>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Image</source>
         <translation>Bild</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
-        <source>Ground control file (gcp_list.txt or CSV)</source>
-        <translation>Passpunktdatei (gcp_list.txt oder CSV)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
-        <source>Ground control point layer (one feature per observation)</source>
-        <translation>Passpunktlayer (ein Objekt je Messung)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
-        <source>Known orientation (x y z omega phi kappa)</source>
-        <translation>Bekannte Orientierung (x y z omega phi kappa)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
-        <source>Focal length in mm (0 = from EXIF)</source>
-        <translation>Brennweite in mm (0 = aus EXIF)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
-        <source>Sensor width (long side) in mm</source>
-        <translation>Sensorbreite (lange Seite) in mm</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
         <source>Mode</source>
         <translation>Modus</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
-        <source>Resolution in CRS units (0 = ground sample distance)</source>
-        <translation>Auflösung in KBS-Einheiten (0 = Bodenauflösung)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
-        <source>Output CRS (default: the GCPs&apos; or orientation&apos;s CRS)</source>
-        <translation>Ausgabe-KBS (Vorgabe: das der Passpunkte oder der Orientierung)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="76"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="78"/>
         <source>Orthophoto</source>
         <translation>Orthophoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="77"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="79"/>
         <source>GCP residuals</source>
         <translation>Passpunkt-Residuen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="79"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="81"/>
         <source>GCP residual RMSE (pixels)</source>
         <translation>RMSE der Passpunktresiduen (Pixel)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="80"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="82"/>
         <source>Planar rectification: 95th percentile of its offset from the true position (CRS units)</source>
         <translation>Ebene Entzerrung: 95. Perzentil ihres Versatzes gegen die wahre Lage (KBS-Einheiten)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="96"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="98"/>
         <source>Give ground control points observed in the image (GCPS or GCP_LAYER) or its orientation (ORIENTATION)</source>
         <translation>Im Bild gemessene Passpunkte (GCPS oder GCP_LAYER) oder seine Orientierung (ORIENTATION) angeben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="102"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="104"/>
         <source>RESIDUALS must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>RESIDUALS muss eine GeoPackage-Datei (.gpkg) sein, erhalten: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="115"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="117"/>
         <source>{} ({}): {:.2f} px</source>
         <translation>{} ({}): {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="90"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="92"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
@@ -1693,6 +1660,41 @@ Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erk
         <location filename="../ui/catalog.py" line="7"/>
         <source>Orthorectify image</source>
         <translation>Bild orthorektifizieren</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>Ground control file</source>
+        <translation>Passpunktdatei</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>Ground control point layer</source>
+        <translation>Passpunktlayer</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>Known orientation</source>
+        <translation>Bekannte Orientierung</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>Focal length (mm)</source>
+        <translation>Brennweite (mm)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>Sensor width (mm)</source>
+        <translation>Sensorbreite (mm)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>Resolution (0 = automatic)</source>
+        <translation>Auflösung (0 = automatisch)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>Output CRS</source>
+        <translation>Ausgabe-KBS</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1703,8 +1705,10 @@ The camera's position and attitude come from ground control points observed in t
 Image: the photo. DSM: height raster (needed for a true orthophoto).
 Ground control file: an OpenDroneMap gcp_list.txt or CSV points file with observations in this image; or Ground control point layer: a point layer with one feature per observation and fields name, image, px, py (optional z, role; pixel origin at the upper-left corner, y down).
 Known orientation: instead of GCPs, a file with x y z omega phi kappa (degrees, photogrammetric convention; a header row as Pix4D writes it, or JSON), optionally focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 and a CRS line.
-Focal length and Sensor width: interior orientation (the sensor's long side); default the EXIF focal length.
+Focal length and Sensor width: interior orientation in mm (the sensor's long side); 0 or empty = the EXIF focal length.
 Mode: a true orthophoto on the DSM, or a planar (projective) rectification through the GCPs for comparison on flat ground; with a DSM the log and the output 'Planar rectification: 95th percentile of its offset' say how far the planar result is off because of relief.
+Resolution: cell size in CRS units (0 = the ground sample distance).
+Output CRS: default the CRS of the GCPs or of the known orientation.
 GCP residuals: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
         <translation>Orthorektifiziert ein Foto — auch eines, das zu keinem Block gehört, etwa eine einzelne Schrägaufnahme oder ein alter Abzug — auf einem vorhandenen DOM, zum Beispiel einem DOM aus Airborne Laserscanning (ALS) in beliebigem KBS (es wird im Lauf umprojiziert).
 
@@ -1713,8 +1717,10 @@ Position und Lage der Kamera ergeben sich aus im Foto gemessenen Passpunkten (r�
 Bild: das Foto. DSM: Höhenraster (für ein wahres Orthophoto nötig).
 Passpunktdatei: eine OpenDroneMap gcp_list.txt oder CSV-Punktdatei mit Messungen in diesem Bild; oder Passpunktlayer: ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, role; Pixelursprung in der linken oberen Ecke, y nach unten).
 Bekannte Orientierung: statt Passpunkten eine Datei mit x y z omega phi kappa (Grad, photogrammetrische Konvention; eine Kopfzeile wie von Pix4D geschrieben, oder JSON), optional focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 und eine KBS-Zeile.
-Brennweite und Sensorbreite: innere Orientierung (die lange Seite des Sensors); Vorgabe ist die EXIF-Brennweite.
+Brennweite und Sensorbreite: innere Orientierung in mm (die lange Seite des Sensors); 0 oder leer = die EXIF-Brennweite.
 Modus: ein wahres Orthophoto auf dem DOM oder eine ebene (projektive) Entzerrung über die Passpunkte zum Vergleich auf flachem Gelände; mit DOM sagen das Protokoll und die Ausgabe 'Ebene Entzerrung: 95. Perzentil ihres Versatzes', wie weit das ebene Ergebnis wegen des Reliefs abweicht.
+Auflösung: Zellgröße in KBS-Einheiten (0 = die Bodenauflösung).
+Ausgabe-KBS: Vorgabe ist das KBS der Passpunkte oder der bekannten Orientierung.
 Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in der Ebene).</translation>
     </message>
 </context>
@@ -1799,92 +1805,62 @@ Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und 
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="84"/>
-        <source>Smallest blur score (0 = only relative to the set)</source>
-        <translation>Kleinster Schärfewert (0 = nur relativ zum Satz)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="84"/>
-        <source>Leave flagged images out of the prepared folder</source>
-        <translation>Markierte Bilder aus dem vorbereiteten Ordner weglassen</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
-        <source>Scanned film: fiducial marks, common frame, masks</source>
-        <translation>Gescannter Film: Rahmenmarken, gemeinsamer Rahmen, Masken</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="97"/>
-        <source>Calibrated fiducial coordinates in mm (file path or text)</source>
-        <translation>Kalibrierte Rahmenmarken-Koordinaten in mm (Dateipfad oder Text)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="100"/>
-        <source>Calibrated focal length in mm (0 = unknown)</source>
-        <translation>Kalibrierte Brennweite in mm (0 = unbekannt)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="100"/>
+        <location filename="../processing_provider/prepare_images.py" line="99"/>
         <source>Flag images below this fraction of the set&apos;s median blur score</source>
         <translation>Bilder unter diesem Bruchteil des mittleren Schärfewerts des Satzes markieren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="100"/>
+        <location filename="../processing_provider/prepare_images.py" line="99"/>
         <source>Fiducial mark type</source>
         <translation>Art der Rahmenmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="100"/>
+        <location filename="../processing_provider/prepare_images.py" line="99"/>
         <source>Fiducial positions</source>
         <translation>Lage der Rahmenmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="100"/>
+        <location filename="../processing_provider/prepare_images.py" line="99"/>
         <source>Template image of one fiducial mark</source>
         <translation>Vorlagenbild einer Rahmenmarke</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="100"/>
+        <location filename="../processing_provider/prepare_images.py" line="99"/>
         <source>Scan resolution in dpi when not in the files (0 = from the files)</source>
         <translation>Scanauflösung in dpi, wenn nicht in den Dateien (0 = aus den Dateien)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="113"/>
-        <source>Prepared images (skipped: &lt;workspace&gt;/prepared)</source>
-        <translation>Vorbereitete Bilder (ausgelassen: &lt;workspace&gt;/prepared)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="116"/>
+        <location filename="../processing_provider/prepare_images.py" line="115"/>
         <source>Folder of prepared images</source>
         <translation>Ordner der vorbereiteten Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="117"/>
+        <location filename="../processing_provider/prepare_images.py" line="116"/>
         <source>Flagged images</source>
         <translation>Markierte Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="118"/>
+        <location filename="../processing_provider/prepare_images.py" line="117"/>
         <source>Excluded images</source>
         <translation>Ausgeschlossene Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="119"/>
+        <location filename="../processing_provider/prepare_images.py" line="118"/>
         <source>Screening record (JSON)</source>
         <translation>Prüfprotokoll (JSON)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="156"/>
+        <location filename="../processing_provider/prepare_images.py" line="155"/>
         <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
         <translation>{} Bilder: {} markiert, {} ausgeschlossen, {} im vorbereiteten Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="158"/>
+        <location filename="../processing_provider/prepare_images.py" line="157"/>
         <source>Blurriest first (blur score, % of the set&apos;s median):</source>
         <translation>Unschärfste zuerst (Schärfewert, % des Medians des Satzes):</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="166"/>
+        <location filename="../processing_provider/prepare_images.py" line="165"/>
         <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
         <translation>Vorbereitete Scans: {} x {} px, Pixelgröße {:.6g} {}{}</translation>
     </message>
@@ -1894,57 +1870,87 @@ Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und 
         <translation>Bilder vorbereiten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="91"/>
-        <source>Mask polygons: areas to ignore, in pixel coordinates (optional text field &apos;image&apos;)</source>
-        <translation>Maskenpolygone: zu ignorierende Bereiche in Pixelkoordinaten (optionales Textfeld 'image')</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="151"/>
+        <location filename="../processing_provider/prepare_images.py" line="150"/>
         <source>MASKS layer &apos;{}&apos;</source>
         <translation>MASKS-Layer '{}'</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="186"/>
+        <location filename="../processing_provider/prepare_images.py" line="185"/>
         <source>feature {}</source>
         <translation>Objekt {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="190"/>
+        <location filename="../processing_provider/prepare_images.py" line="189"/>
         <source>MASKS layer &apos;{}&apos;: {} has no geometry: skipped</source>
         <translation>MASKS-Layer '{}': {} hat keine Geometrie: übersprungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="193"/>
+        <location filename="../processing_provider/prepare_images.py" line="192"/>
         <source>MASKS layer &apos;{}&apos;: {} is a {} geometry, not a polygon</source>
         <translation>MASKS-Layer '{}': {} ist eine {}-Geometrie, kein Polygon</translation>
     </message>
     <message>
+        <location filename="../processing_provider/prepare_images.py" line="84"/>
+        <source>Smallest blur score (0 = relative only)</source>
+        <translation>Kleinster Schärfewert (0 = nur relativ)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="84"/>
+        <source>Leave flagged images out</source>
+        <translation>Markierte Bilder weglassen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="91"/>
+        <source>Mask polygons</source>
+        <translation>Maskenpolygone</translation>
+    </message>
+    <message>
         <location filename="../processing_provider/prepare_images.py" line="94"/>
-        <source>Sky masks: hide the sky and the horizon of oblique photos from the alignment</source>
-        <translation>Himmelsmasken: Himmel und Horizont von Schrägaufnahmen vor der Ausrichtung verbergen</translation>
+        <source>Sky masks for oblique photos</source>
+        <translation>Himmelsmasken für Schrägaufnahmen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="95"/>
+        <source>Scanned film (fiducial marks)</source>
+        <translation>Gescannter Film (Rahmenmarken)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <source>Fiducial coordinates (mm)</source>
+        <translation>Rahmenmarken-Koordinaten (mm)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="112"/>
+        <source>Prepared images</source>
+        <translation>Vorbereitete Bilder</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="99"/>
+        <source>Calibrated focal length (mm)</source>
+        <translation>Kalibrierte Brennweite (mm)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
         <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for &apos;Align images&apos;, and the Workspace folder, which records a decision per image (screening.json) for the accuracy report.
 
-The blur score is the variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged &apos;blurry&apos; below a fraction of the median of the set (Flag images below this fraction of the set&apos;s median blur score, advanced), or below the Smallest blur score when that is set (absolute scores depend on the scene: sand scores far lower than roofs).
-Images with more than 5 % clipped highlights or shadows, a mean brightness far from the set&apos;s, or a very small dynamic range are flagged for their exposure. With &apos;Leave flagged images out of the prepared folder&apos; ticked they are left out; otherwise they are kept and only reported.
+The blur score is the variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged &apos;blurry&apos; below a fraction of the median of the set (Flag images below this fraction of the set&apos;s median blur score, advanced), or below the Smallest blur score when that is set (0 = only relative to the set; absolute scores depend on the scene: sand scores far lower than roofs).
+Images with more than 5 % clipped highlights or shadows, a mean brightness far from the set&apos;s, or a very small dynamic range are flagged for their exposure. With &apos;Leave flagged images out&apos; ticked they are left out of the prepared folder; otherwise they are kept and only reported.
 
-Mask polygons: optional polygon layer of areas to ignore (a boom, the drone&apos;s shadow, a date stamp, a frame border), in the image&apos;s pixel coordinates: origin at the upper-left corner of the image, x right, y down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is &lt;= 0). A text field &apos;image&apos; names the image a polygon belongs to; empty (or no such field) applies it to every image. The polygons are written into the per-image masks (workspace/masks/&lt;image&gt;.png, merged with any mask already there): &apos;Align images&apos; finds no features under them, the orthophoto does not use those pixels, and blur and exposure are measured outside them. For scanned film the coordinates are those of the prepared images (the common fiducial frame, so one polygon fits every frame).
-Sky masks: for oblique photos the sky (clouds included) and the haze along the horizon are found automatically and written into the per-image masks, so that &apos;Align images&apos; takes no tie points from clouds that move between shots; a photo without sky (looking straight down) gets no sky mask.
+Mask polygons: optional polygon layer of areas to ignore in the alignment and the orthophoto (a boom, the drone&apos;s shadow, a date stamp, a frame border), in the image&apos;s pixel coordinates: origin at the upper-left corner of the image, x right, y down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is &lt;= 0). A text field &apos;image&apos; names the image a polygon belongs to; empty (or no such field) applies it to every image. The polygons are written into the per-image masks (workspace/masks/&lt;image&gt;.png, merged with any mask already there): &apos;Align images&apos; finds no features under them, the orthophoto does not use those pixels, and blur and exposure are measured outside them. For scanned film the coordinates are those of the prepared images (the common fiducial frame, so one polygon fits every frame).
+Sky masks for oblique photos: the sky (clouds included) and the haze along the horizon are found automatically and written into the per-image masks, so that &apos;Align images&apos; takes no tie points from clouds that move between shots; a photo without sky (looking straight down) gets no sky mask.
 
-Scanned film: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. Calibrated fiducial coordinates: the calibration certificate&apos;s fiducial coordinates in mm, as a file or pasted text, one &apos;id x y&apos; line per mark (x right, y up), optionally &apos;PP x y&apos; (principal point) and &apos;focal f&apos;. Without them the mean layout of the set is used, centred on the fiducial centre. With the Calibrated focal length (or &apos;focal&apos; in the certificate) the prepared images carry the focal length in pixels for the alignment.
+Scanned film (fiducial marks): fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. Fiducial coordinates: the calibration certificate&apos;s calibrated fiducial coordinates in mm, as a file path or pasted text, one &apos;id x y&apos; line per mark (x right, y up), optionally &apos;PP x y&apos; (principal point) and &apos;focal f&apos;. Without them the mean layout of the set is used, centred on the fiducial centre. With the Calibrated focal length (0 = unknown; or &apos;focal&apos; in the certificate) the prepared images carry the focal length in pixels for the alignment.
 
 Prepared images: the folder of prepared images (replaced as a whole; it must be new, empty or written by an earlier run); when skipped, &lt;workspace&gt;/prepared.</source>
         <translation>Prüft einen Ordner mit Fotos auf Unschärfe und Belichtung und findet bei gescanntem historischem Film die Rahmenmarken und rechnet jeden Scan in einen gemeinsamen Kamerarahmen um. Das Ergebnis ist ein Ordner vorbereiteter Bilder für 'Bilder ausrichten' und der Arbeitsbereich-Ordner, der je Bild eine Entscheidung festhält (screening.json) für den Genauigkeitsbericht.
 
-Der Schärfewert ist die Varianz des Laplace-Operators auf einer grauen Kopie von 1024 px Breite, 90. Perzentil eines Rasters von 8 x 6 Kacheln (Himmel oder Wasser in einem Teil des Bildes zählt nicht dagegen). Höher ist schärfer. Ein Bild wird als 'unscharf' markiert unter einem Bruchteil des Medians des Satzes (Bilder unter diesem Bruchteil des mittleren Schärfewerts des Satzes markieren, erweitert) oder unter dem Kleinsten Schärfewert, wenn gesetzt (absolute Werte hängen von der Szene ab: Sand erreicht weit weniger als Dächer).
-Bilder mit mehr als 5 % beschnittenen Lichtern oder Schatten, einer mittleren Helligkeit weit weg von der des Satzes oder einem sehr kleinen Dynamikumfang werden wegen ihrer Belichtung markiert. Mit 'Markierte Bilder aus dem vorbereiteten Ordner weglassen' werden sie weggelassen; sonst bleiben sie und werden nur gemeldet.
+Der Schärfewert ist die Varianz des Laplace-Operators auf einer grauen Kopie von 1024 px Breite, 90. Perzentil eines Rasters von 8 x 6 Kacheln (Himmel oder Wasser in einem Teil des Bildes zählt nicht dagegen). Höher ist schärfer. Ein Bild wird als 'unscharf' markiert unter einem Bruchteil des Medians des Satzes (Bilder unter diesem Bruchteil des mittleren Schärfewerts des Satzes markieren, erweitert) oder unter dem Kleinsten Schärfewert, wenn gesetzt (0 = nur relativ zum Satz; absolute Werte hängen von der Szene ab: Sand erreicht weit weniger als Dächer).
+Bilder mit mehr als 5 % beschnittenen Lichtern oder Schatten, einer mittleren Helligkeit weit weg von der des Satzes oder einem sehr kleinen Dynamikumfang werden wegen ihrer Belichtung markiert. Mit 'Markierte Bilder weglassen' werden sie aus dem vorbereiteten Ordner weggelassen; sonst bleiben sie und werden nur gemeldet.
 
-Maskenpolygone: optionaler Polygon-Layer mit zu ignorierenden Bereichen (ein Ausleger, der Schatten der Drohne, ein Datumsstempel, ein Bildrand) in den Pixelkoordinaten des Bildes: Ursprung in der oberen linken Ecke, x nach rechts, y nach unten, oder y = -Zeile, wie der QGIS-Georeferenzierer ein Foto zeigt (erkannt, wenn jedes y &lt;= 0 ist). Ein Textfeld 'image' nennt das Bild, zu dem ein Polygon gehört; leer (oder ohne dieses Feld) gilt es für jedes Bild. Die Polygone werden in die Masken je Bild geschrieben (workspace/masks/&lt;Bild&gt;.png, mit einer vorhandenen Maske vereinigt): 'Bilder ausrichten' findet darunter keine Merkmale, das Orthophoto verwendet diese Pixel nicht, und Schärfe und Belichtung werden außerhalb gemessen. Bei gescanntem Film sind es die Koordinaten der vorbereiteten Bilder (der gemeinsame Rahmenmarken-Rahmen, so passt ein Polygon zu jedem Bild).
-Himmelsmasken: bei Schrägaufnahmen werden der Himmel (samt Wolken) und der Dunst am Horizont automatisch gefunden und in die Masken je Bild geschrieben, damit 'Bilder ausrichten' keine Verknüpfungspunkte aus Wolken nimmt, die zwischen den Aufnahmen ziehen; ein Foto ohne Himmel (senkrecht nach unten) erhält keine Himmelsmaske.
+Maskenpolygone: optionaler Polygon-Layer mit Bereichen, die Ausrichtung und Orthophoto ignorieren sollen (ein Ausleger, der Schatten der Drohne, ein Datumsstempel, ein Bildrand) in den Pixelkoordinaten des Bildes: Ursprung in der oberen linken Ecke, x nach rechts, y nach unten, oder y = -Zeile, wie der QGIS-Georeferenzierer ein Foto zeigt (erkannt, wenn jedes y &lt;= 0 ist). Ein Textfeld 'image' nennt das Bild, zu dem ein Polygon gehört; leer (oder ohne dieses Feld) gilt es für jedes Bild. Die Polygone werden in die Masken je Bild geschrieben (workspace/masks/&lt;Bild&gt;.png, mit einer vorhandenen Maske vereinigt): 'Bilder ausrichten' findet darunter keine Merkmale, das Orthophoto verwendet diese Pixel nicht, und Schärfe und Belichtung werden außerhalb gemessen. Bei gescanntem Film sind es die Koordinaten der vorbereiteten Bilder (der gemeinsame Rahmenmarken-Rahmen, so passt ein Polygon zu jedem Bild).
+Himmelsmasken für Schrägaufnahmen: der Himmel (samt Wolken) und der Dunst am Horizont werden automatisch gefunden und in die Masken je Bild geschrieben, damit 'Bilder ausrichten' keine Verknüpfungspunkte aus Wolken nimmt, die zwischen den Aufnahmen ziehen; ein Foto ohne Himmel (senkrecht nach unten) erhält keine Himmelsmaske.
 
-Gescannter Film: Rahmenmarken (Kreuze, Punkte, Punkte in Kreisen; in den Ecken und/oder Seitenmitten, oder wie ein Vorlagenbild einer Marke) werden auf Bruchteile eines Pixels gefunden, jeder Scan wird durch eine affine Transformation in den gemeinsamen Rahmenmarken-Rahmen umgerechnet, alle gleich groß und mit dem Bildhauptpunkt in der Mitte, und Masken (workspace/masks) verbergen Filmrand, Datenstreifen und die Marken vor der Zuordnung. Kalibrierte Rahmenmarken-Koordinaten: die Rahmenmarken-Koordinaten des Kalibrierzertifikats in mm, als Datei oder eingefügter Text, eine Zeile 'id x y' je Marke (x nach rechts, y nach oben), optional 'PP x y' (Bildhauptpunkt) und 'focal f'. Ohne sie wird die mittlere Anordnung des Satzes verwendet, zentriert auf die Rahmenmitte. Mit der Kalibrierten Brennweite (oder 'focal' im Zertifikat) tragen die vorbereiteten Bilder die Brennweite in Pixeln für die Ausrichtung.
+Gescannter Film (Rahmenmarken): Rahmenmarken (Kreuze, Punkte, Punkte in Kreisen; in den Ecken und/oder Seitenmitten, oder wie ein Vorlagenbild einer Marke) werden auf Bruchteile eines Pixels gefunden, jeder Scan wird durch eine affine Transformation in den gemeinsamen Rahmenmarken-Rahmen umgerechnet, alle gleich groß und mit dem Bildhauptpunkt in der Mitte, und Masken (workspace/masks) verbergen Filmrand, Datenstreifen und die Marken vor der Zuordnung. Rahmenmarken-Koordinaten: die kalibrierten Rahmenmarken-Koordinaten des Kalibrierzertifikats in mm, als Dateipfad oder eingefügter Text, eine Zeile 'id x y' je Marke (x nach rechts, y nach oben), optional 'PP x y' (Bildhauptpunkt) und 'focal f'. Ohne sie wird die mittlere Anordnung des Satzes verwendet, zentriert auf die Rahmenmitte. Mit der Kalibrierten Brennweite (0 = unbekannt; oder 'focal' im Zertifikat) tragen die vorbereiteten Bilder die Brennweite in Pixeln für die Ausrichtung.
 
 Vorbereitete Bilder: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetzt; er muss neu, leer oder von einem früheren Lauf geschrieben sein); wenn ausgelassen, &lt;workspace&gt;/prepared.</translation>
     </message>
@@ -1952,47 +1958,37 @@ Vorbereitete Bilder: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetz
 <context>
     <name>ReliefVisualisationAlgorithm</name>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="41"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
-        <source>Elevation raster (instead of the workspace&apos;s)</source>
-        <translation>Höhenraster (statt dem des Arbeitsbereichs)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="45"/>
         <source>Surface</source>
         <translation>Oberfläche</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="45"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="45"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="45"/>
         <source>Visualisation</source>
         <translation>Visualisierung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="50"/>
-        <source>Visualisation (default: in &lt;workspace&gt;/terrain/relief)</source>
-        <translation>Visualisierung (Vorgabe: in &lt;workspace&gt;/terrain/relief)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="53"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="55"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="78"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="80"/>
         <source>Give a workspace folder, or an elevation raster and where to write the visualisation</source>
         <translation>Geben Sie einen Arbeitsbereich-Ordner an, oder ein Höhenraster und wohin die Visualisierung geschrieben wird</translation>
     </message>
@@ -2002,21 +1998,36 @@ Vorbereitete Bilder: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetz
         <translation>Reliefvisualisierung</translation>
     </message>
     <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="41"/>
+        <source>VAT blend</source>
+        <translation>VAT-Mischung</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="45"/>
+        <source>Elevation raster</source>
+        <translation>Höhenraster</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="52"/>
+        <source>Relief raster</source>
+        <translation>Reliefraster</translation>
+    </message>
+    <message>
         <location filename="../ui/catalog.py" line="7"/>
         <source>Relief visualisations for reading earthworks, hollow ways, ridge and furrow and field boundaries, computed with rvt-py (the Relief Visualization Toolbox&apos;s library) with RVT&apos;s default parameters, converted from the 1 m DEMs RVT was made for to this raster&apos;s cell size.
 
 Workspace folder: a workspace with a DTM (Build DTM) or DSM.
 Elevation raster: any DTM/DSM in a projected CRS instead (optional).
 Surface: the workspace&apos;s DTM (bare earth, default) or DSM.
-Visualisation: sky-view factor, openness (positive, negative), simple local relief model, multi-scale relief model, multi-direction hillshade, local dominance, or the VAT blend.
-The output &apos;Visualisation&apos;: where to write it (default: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</source>
+Visualisation: sky-view factor, openness (positive, negative), simple local relief model, multi-scale relief model, multi-direction hillshade, local dominance, or the VAT blend (visualisation for archaeological topography).
+Relief raster: where to write it (default: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</source>
         <translation>Reliefvisualisierungen zum Lesen von Erdwerken, Hohlwegen, Wölbäckern und Flurgrenzen, berechnet mit rvt-py (der Bibliothek der Relief Visualization Toolbox) mit den Standardparametern von RVT, umgerechnet von den 1-m-Geländemodellen, für die RVT gemacht ist, auf die Zellgröße dieses Rasters.
 
 Arbeitsbereich-Ordner: ein Arbeitsbereich mit DGM (DGM erzeugen) oder DOM.
 Höhenraster: stattdessen ein beliebiges DGM/DOM in einem projizierten KBS (optional).
 Oberfläche: das DGM des Arbeitsbereichs (nackte Erde, Vorgabe) oder sein DOM.
-Visualisierung: Sky-View-Faktor, Offenheit (positiv, negativ), einfaches lokales Reliefmodell, mehrskaliges Reliefmodell, Schummerung aus mehreren Richtungen, lokale Dominanz oder die VAT-Mischung.
-Die Ausgabe 'Visualisierung': wohin sie geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</translation>
+Visualisierung: Sky-View-Faktor, Offenheit (positiv, negativ), einfaches lokales Reliefmodell, mehrskaliges Reliefmodell, Schummerung aus mehreren Richtungen, lokale Dominanz oder die VAT-Mischung (Visualisierung für archäologische Topographie).
+Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</translation>
     </message>
 </context>
 <context>

@@ -4,19 +4,9 @@
 <context>
     <name>AccuracyReportAlgorithm</name>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="70"/>
+        <location filename="../processing_provider/accuracy_report.py" line="71"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/accuracy_report.py" line="70"/>
-        <source>Compute the bundle adjustment covariance (uncertainty section and layers)</source>
-        <translation>Calcola la covarianza della compensazione a stelle proiettive (sezione e layer dell'incertezza)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/accuracy_report.py" line="76"/>
-        <source>Report (default: &lt;workspace&gt;/report.html)</source>
-        <translation>Rapporto (predefinito: &lt;workspace&gt;/report.html)</translation>
     </message>
     <message>
         <location filename="../processing_provider/accuracy_report.py" line="79"/>
@@ -54,20 +44,30 @@
         <translation>Rapporto di accuratezza</translation>
     </message>
     <message>
+        <location filename="../processing_provider/accuracy_report.py" line="71"/>
+        <source>Compute uncertainty</source>
+        <translation>Calcola l'incertezza</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/accuracy_report.py" line="76"/>
+        <source>Report</source>
+        <translation>Rapporto</translation>
+    </message>
+    <message>
         <location filename="../ui/catalog.py" line="7"/>
         <source>Writes one self-contained HTML report of a workspace (plots embedded, readable offline) and returns its key figures.
 
 Sections of the report. Summary — images given / aligned / not aligned and why, image screening, cameras with their calibrated parameters and standard deviations, GSD, area, CRS, processing times and parameters. Orientation quality: reprojection errors, tie-point track lengths, image connectivity, camera positions with residuals. Georeferencing: control and check points with dX dY dZ and image residuals, residual vectors, RMSE per set, NSSDA (FGDC-STD-007.3-1998) accuracy statements at 95 % confidence, ASPRS 2014 and 2023 accuracy classes, camera-position residuals, outliers. Uncertainty: standard deviations of cameras and tie points from the bundle adjustment covariance. Products: DSM and orthomosaic previews, resolution, valid fraction. Sections whose stage has not run are skipped with a note.
 
 Workspace folder: a workspace folder (at least aligned).
-Compute the bundle adjustment covariance: computes it (seconds for hundreds of images) and writes &lt;workspace&gt;/uncertainty/cameras.gpkg and points.gpkg.
+Compute uncertainty: computes the bundle adjustment covariance (seconds for hundreds of images) for the uncertainty section and writes &lt;workspace&gt;/uncertainty/cameras.gpkg and points.gpkg.
 Report: the report file (default: &lt;workspace&gt;/report.html). It is written under a temporary name and renamed when complete.</source>
         <translation>Scrive un rapporto HTML autonomo di un'area di lavoro (grafici incorporati, leggibile offline) e ne restituisce le cifre principali.
 
 Sezioni del rapporto. Sintesi — immagini fornite / orientate / non orientate e perché, controllo delle immagini, camere con i parametri calibrati e le deviazioni standard, GSD, area, SR, tempi e parametri di elaborazione. Qualità dell'orientamento: errori di riproiezione, lunghezze delle tracce dei punti di legame, connessioni tra immagini, posizioni delle camere con residui. Georeferenziazione: punti d'appoggio e di controllo con dX dY dZ e residui in immagine, vettori dei residui, RMSE per gruppo, accuratezza NSSDA (FGDC-STD-007.3-1998) al 95 % di confidenza, classi di accuratezza ASPRS 2014 e 2023, residui delle posizioni delle camere, valori anomali. Incertezza: deviazioni standard delle camere e dei punti di legame dalla covarianza della compensazione. Prodotti: anteprime di DSM e ortomosaico, risoluzione, frazione valida. Le sezioni la cui fase non è stata eseguita vengono saltate con una nota.
 
 Cartella dell'area di lavoro: una cartella dell'area di lavoro (almeno orientata).
-Calcola la covarianza della compensazione a stelle proiettive: calcola la covarianza (secondi per centinaia di immagini) e scrive &lt;workspace&gt;/uncertainty/cameras.gpkg e points.gpkg.
+Calcola l'incertezza: calcola la covarianza della compensazione a stelle proiettive (secondi per centinaia di immagini) per la sezione dell'incertezza e scrive &lt;workspace&gt;/uncertainty/cameras.gpkg e points.gpkg.
 Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Viene scritto con un nome provvisorio e rinominato quando è completo.</translation>
     </message>
 </context>
@@ -253,11 +253,6 @@ Metodo di ricostruzione (avanzato): 'incremental' (COLMAP, predefinito) o 'globa
         <translation>Processi paralleli (0 = uno per core)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="61"/>
-        <source>DSM (default: &lt;workspace&gt;/dsm.tif)</source>
-        <translation>DSM (predefinito: &lt;workspace&gt;/dsm.tif)</translation>
-    </message>
-    <message>
         <location filename="../processing_provider/build_dsm.py" line="63"/>
         <source>Point cloud (LAS)</source>
         <translation>Nuvola di punti (LAS)</translation>
@@ -326,76 +321,66 @@ Scheduler Dask (avanzato): calcola le coppie stereo su un cluster Dask (tcp://ho
 
 Una nuova esecuzione dopo un annullamento riprende: le coppie già elaborate sono riutilizzate da &lt;workspace&gt;/dense/.</translation>
     </message>
+    <message>
+        <location filename="../processing_provider/build_dsm.py" line="61"/>
+        <source>DSM</source>
+        <translation>DSM</translation>
+    </message>
 </context>
 <context>
     <name>BuildDtmAlgorithm</name>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="52"/>
+        <location filename="../processing_provider/build_dtm.py" line="53"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="54"/>
-        <source>DSM file (default: the workspace&apos;s)</source>
-        <translation>File DSM (predefinito: quello dell'area di lavoro)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_dtm.py" line="54"/>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
         <source>Contour interval in metres (0 = none)</source>
         <translation>Equidistanza delle curve di livello in metri (0 = nessuna)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="54"/>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
         <source>Ground filter slope (rise over run)</source>
         <translation>Pendenza del filtro del terreno (dislivello su distanza)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="54"/>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
         <source>Largest object radius in metres</source>
         <translation>Raggio massimo degli oggetti in metri</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="54"/>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
         <source>Height above ground of an object in metres</source>
         <translation>Altezza di un oggetto sul terreno in metri</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="64"/>
-        <source>DTM (default: &lt;workspace&gt;/dtm.tif)</source>
-        <translation>DTM (predefinito: &lt;workspace&gt;/dtm.tif)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_dtm.py" line="66"/>
-        <source>Contours (default: &lt;workspace&gt;/terrain/contours.gpkg)</source>
-        <translation>Curve di livello (predefinito: &lt;workspace&gt;/terrain/contours.gpkg)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_dtm.py" line="69"/>
+        <location filename="../processing_provider/build_dtm.py" line="70"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="70"/>
+        <location filename="../processing_provider/build_dtm.py" line="71"/>
         <source>DTM source</source>
         <translation>Origine del DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="71"/>
+        <location filename="../processing_provider/build_dtm.py" line="72"/>
         <source>Classified point cloud</source>
         <translation>Nuvola di punti classificata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="72"/>
+        <location filename="../processing_provider/build_dtm.py" line="73"/>
         <source>Share of DSM cells on the ground</source>
         <translation>Frazione delle celle del DSM sul terreno</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="73"/>
+        <location filename="../processing_provider/build_dtm.py" line="74"/>
         <source>Share of DTM cells interpolated</source>
         <translation>Frazione delle celle del DTM interpolate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="100"/>
+        <location filename="../processing_provider/build_dtm.py" line="101"/>
         <source>Give a workspace folder, or a DSM file and where to write the DTM</source>
         <translation>Indica una cartella dell'area di lavoro, oppure un file DSM e dove scrivere il DTM</translation>
     </message>
@@ -403,6 +388,21 @@ Una nuova esecuzione dopo un annullamento riprende: le coppie già elaborate son
         <location filename="../ui/catalog.py" line="7"/>
         <source>Build DTM</source>
         <translation>Genera DTM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="55"/>
+        <source>DSM file</source>
+        <translation>File DSM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="65"/>
+        <source>DTM</source>
+        <translation>DTM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_dtm.py" line="67"/>
+        <source>Contours</source>
+        <translation>Curve di livello</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -414,7 +414,8 @@ Workspace folder: a workspace with a DSM (optional when a DSM file is given).
 DSM file: any DSM in a projected CRS (metres); default: the workspace&apos;s.
 Contour interval: contour lines every this many metres into a GeoPackage (0 = none).
 Slope, largest object radius and height threshold (advanced): SMRF&apos;s parameters (PDAL&apos;s defaults).
-DTM: where to write it (default: &lt;workspace&gt;/dtm.tif).</source>
+DTM: where to write it (default: &lt;workspace&gt;/dtm.tif).
+Contours: where to write the contour lines (default: &lt;workspace&gt;/terrain/contours.gpkg).</source>
         <translation>Un modello digitale del terreno (suolo nudo) dal DSM: edifici, alberi e colture rimossi, il terreno interpolato sotto di essi.
 
 Il filtro del terreno è SMRF (Pingel et al. 2013, l'algoritmo di filters.smrf di PDAL) sulla griglia del DSM; sotto ogni oggetto rimosso il terreno è una thin-plate spline attraverso il terreno intorno. Il DTM è un Cloud-Optimized GeoTIFF esattamente sulla griglia del DSM; accanto, terrain/dtm-source.tif indica quali celle sono terreno misurato (1) e quali interpolate (2). La nuvola di punti della fase DSM, se ne ha scritta una, è copiata con le classi ASPRS 2 (terreno) e 1 (non classificato) in terrain/points-classified.las.
@@ -423,7 +424,8 @@ Cartella dell'area di lavoro: un'area di lavoro con DSM (facoltativa se è indic
 File DSM: qualsiasi DSM in un SR proiettato (metri); predefinito: quello dell'area di lavoro.
 Equidistanza: curve di livello ogni tanti metri in un GeoPackage (0 = nessuna).
 Pendenza, raggio massimo degli oggetti e soglia di altezza (avanzati): i parametri di SMRF (i valori predefiniti di PDAL).
-DTM: dove scriverlo (predefinito: &lt;workspace&gt;/dtm.tif).</translation>
+DTM: dove scriverlo (predefinito: &lt;workspace&gt;/dtm.tif).
+Curve di livello: dove scrivere le curve di livello (predefinito: &lt;workspace&gt;/terrain/contours.gpkg).</translation>
     </message>
 </context>
 <context>
@@ -1600,92 +1602,57 @@ I valori anomali (una misura errata, un errore di battitura in una coordinata) s
 <context>
     <name>OrthorectifyImageAlgorithm</name>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="60"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
         <source>Image</source>
         <translation>Immagine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
-        <source>Ground control file (gcp_list.txt or CSV)</source>
-        <translation>File dei punti d'appoggio (gcp_list.txt o CSV)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
-        <source>Ground control point layer (one feature per observation)</source>
-        <translation>Layer dei punti d'appoggio (un elemento per misura)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
-        <source>Known orientation (x y z omega phi kappa)</source>
-        <translation>Orientamento noto (x y z omega phi kappa)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
-        <source>Focal length in mm (0 = from EXIF)</source>
-        <translation>Focale in mm (0 = dall'EXIF)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
-        <source>Sensor width (long side) in mm</source>
-        <translation>Larghezza del sensore (lato lungo) in mm</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
         <source>Mode</source>
         <translation>Modalità</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
-        <source>Resolution in CRS units (0 = ground sample distance)</source>
-        <translation>Risoluzione in unità del SR (0 = GSD)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
-        <source>Output CRS (default: the GCPs&apos; or orientation&apos;s CRS)</source>
-        <translation>SR di output (predefinito: quello dei punti d'appoggio o dell'orientamento)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="76"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="78"/>
         <source>Orthophoto</source>
         <translation>Ortofoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="77"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="79"/>
         <source>GCP residuals</source>
         <translation>Residui dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="79"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="81"/>
         <source>GCP residual RMSE (pixels)</source>
         <translation>RMSE dei residui dei punti d'appoggio (pixel)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="80"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="82"/>
         <source>Planar rectification: 95th percentile of its offset from the true position (CRS units)</source>
         <translation>Raddrizzamento piano: 95° percentile del suo scostamento dalla posizione vera (unità del SR)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="96"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="98"/>
         <source>Give ground control points observed in the image (GCPS or GCP_LAYER) or its orientation (ORIENTATION)</source>
         <translation>Indica i punti d'appoggio misurati nell'immagine (GCPS o GCP_LAYER) o il suo orientamento (ORIENTATION)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="102"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="104"/>
         <source>RESIDUALS must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>RESIDUALS deve essere un file GeoPackage (.gpkg), ricevuto {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="115"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="117"/>
         <source>{} ({}): {:.2f} px</source>
         <translation>{} ({}): {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="90"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="92"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
@@ -1693,6 +1660,41 @@ I valori anomali (una misura errata, un errore di battitura in una coordinata) s
         <location filename="../ui/catalog.py" line="7"/>
         <source>Orthorectify image</source>
         <translation>Ortorettifica immagine</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>Ground control file</source>
+        <translation>File dei punti d'appoggio</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>Ground control point layer</source>
+        <translation>Layer dei punti d'appoggio</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>Known orientation</source>
+        <translation>Orientamento noto</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>Focal length (mm)</source>
+        <translation>Focale (mm)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>Sensor width (mm)</source>
+        <translation>Larghezza del sensore (mm)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>Resolution (0 = automatic)</source>
+        <translation>Risoluzione (0 = automatica)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <source>Output CRS</source>
+        <translation>SR di output</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1703,8 +1705,10 @@ The camera's position and attitude come from ground control points observed in t
 Image: the photo. DSM: height raster (needed for a true orthophoto).
 Ground control file: an OpenDroneMap gcp_list.txt or CSV points file with observations in this image; or Ground control point layer: a point layer with one feature per observation and fields name, image, px, py (optional z, role; pixel origin at the upper-left corner, y down).
 Known orientation: instead of GCPs, a file with x y z omega phi kappa (degrees, photogrammetric convention; a header row as Pix4D writes it, or JSON), optionally focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 and a CRS line.
-Focal length and Sensor width: interior orientation (the sensor's long side); default the EXIF focal length.
+Focal length and Sensor width: interior orientation in mm (the sensor's long side); 0 or empty = the EXIF focal length.
 Mode: a true orthophoto on the DSM, or a planar (projective) rectification through the GCPs for comparison on flat ground; with a DSM the log and the output 'Planar rectification: 95th percentile of its offset' say how far the planar result is off because of relief.
+Resolution: cell size in CRS units (0 = the ground sample distance).
+Output CRS: default the CRS of the GCPs or of the known orientation.
 GCP residuals: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
         <translation>Ortorettifica una fotografia — anche una che non fa parte di alcun blocco, come una singola obliqua o una vecchia stampa — su un DSM esistente, ad esempio un DSM da laser scanning aereo (ALS) in qualsiasi SR (riproiettato al volo).
 
@@ -1713,8 +1717,10 @@ Posizione e assetto della camera derivano dai punti d'appoggio misurati nella fo
 Immagine: la foto. DSM: raster delle quote (necessario per un'ortofoto vera).
 File dei punti d'appoggio: un gcp_list.txt di OpenDroneMap o un file CSV di punti con misure in questa immagine; oppure Layer dei punti d'appoggio: un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, role; origine dei pixel nell'angolo in alto a sinistra, y verso il basso).
 Orientamento noto: al posto dei punti d'appoggio, un file con x y z omega phi kappa (gradi, convenzione fotogrammetrica; una riga di intestazione come la scrive Pix4D, o JSON), facoltativamente focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 e una riga del SR.
-Focale e Larghezza del sensore: orientamento interno (il lato lungo del sensore); predefinita la focale EXIF.
+Focale e Larghezza del sensore: orientamento interno in mm (il lato lungo del sensore); 0 o vuoto = la focale EXIF.
 Modalità: un'ortofoto vera sul DSM, o un raddrizzamento piano (proiettivo) tramite i punti d'appoggio per confronto su terreno piatto; con un DSM il registro e il risultato 'Raddrizzamento piano: 95° percentile del suo scostamento' dicono di quanto il risultato piano si discosta a causa del rilievo.
+Risoluzione: dimensione della cella in unità del SR (0 = il GSD).
+SR di output: predefinito il SR dei punti d'appoggio o dell'orientamento noto.
 Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in metri sul piano).</translation>
     </message>
 </context>
@@ -1799,92 +1805,62 @@ Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="84"/>
-        <source>Smallest blur score (0 = only relative to the set)</source>
-        <translation>Punteggio di nitidezza minimo (0 = solo relativo all'insieme)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="84"/>
-        <source>Leave flagged images out of the prepared folder</source>
-        <translation>Escludi le immagini segnalate dalla cartella preparata</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
-        <source>Scanned film: fiducial marks, common frame, masks</source>
-        <translation>Pellicola scansionata: marche fiduciali, fotogramma comune, maschere</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="97"/>
-        <source>Calibrated fiducial coordinates in mm (file path or text)</source>
-        <translation>Coordinate calibrate delle marche fiduciali in mm (percorso di file o testo)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="100"/>
-        <source>Calibrated focal length in mm (0 = unknown)</source>
-        <translation>Focale calibrata in mm (0 = sconosciuta)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="100"/>
+        <location filename="../processing_provider/prepare_images.py" line="99"/>
         <source>Flag images below this fraction of the set&apos;s median blur score</source>
         <translation>Segnala le immagini sotto questa frazione del punteggio di nitidezza mediano dell'insieme</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="100"/>
+        <location filename="../processing_provider/prepare_images.py" line="99"/>
         <source>Fiducial mark type</source>
         <translation>Tipo di marca fiduciale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="100"/>
+        <location filename="../processing_provider/prepare_images.py" line="99"/>
         <source>Fiducial positions</source>
         <translation>Posizioni delle marche fiduciali</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="100"/>
+        <location filename="../processing_provider/prepare_images.py" line="99"/>
         <source>Template image of one fiducial mark</source>
         <translation>Immagine modello di una marca fiduciale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="100"/>
+        <location filename="../processing_provider/prepare_images.py" line="99"/>
         <source>Scan resolution in dpi when not in the files (0 = from the files)</source>
         <translation>Risoluzione di scansione in dpi se non nei file (0 = dai file)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="113"/>
-        <source>Prepared images (skipped: &lt;workspace&gt;/prepared)</source>
-        <translation>Immagini preparate (se omesso: &lt;workspace&gt;/prepared)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="116"/>
+        <location filename="../processing_provider/prepare_images.py" line="115"/>
         <source>Folder of prepared images</source>
         <translation>Cartella delle immagini preparate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="117"/>
+        <location filename="../processing_provider/prepare_images.py" line="116"/>
         <source>Flagged images</source>
         <translation>Immagini segnalate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="118"/>
+        <location filename="../processing_provider/prepare_images.py" line="117"/>
         <source>Excluded images</source>
         <translation>Immagini escluse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="119"/>
+        <location filename="../processing_provider/prepare_images.py" line="118"/>
         <source>Screening record (JSON)</source>
         <translation>Registro del controllo (JSON)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="156"/>
+        <location filename="../processing_provider/prepare_images.py" line="155"/>
         <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
         <translation>{} immagini: {} segnalate, {} escluse, {} nella cartella preparata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="158"/>
+        <location filename="../processing_provider/prepare_images.py" line="157"/>
         <source>Blurriest first (blur score, % of the set&apos;s median):</source>
         <translation>Le più sfocate per prime (punteggio di nitidezza, % della mediana dell'insieme):</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="166"/>
+        <location filename="../processing_provider/prepare_images.py" line="165"/>
         <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
         <translation>Scansioni preparate: {} x {} px, dimensione del pixel {:.6g} {}{}</translation>
     </message>
@@ -1894,57 +1870,87 @@ Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui
         <translation>Prepara immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="91"/>
-        <source>Mask polygons: areas to ignore, in pixel coordinates (optional text field &apos;image&apos;)</source>
-        <translation>Poligoni di maschera: aree da ignorare, in coordinate pixel (campo di testo opzionale 'image')</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/prepare_images.py" line="151"/>
+        <location filename="../processing_provider/prepare_images.py" line="150"/>
         <source>MASKS layer &apos;{}&apos;</source>
         <translation>layer MASKS '{}'</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="186"/>
+        <location filename="../processing_provider/prepare_images.py" line="185"/>
         <source>feature {}</source>
         <translation>elemento {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="190"/>
+        <location filename="../processing_provider/prepare_images.py" line="189"/>
         <source>MASKS layer &apos;{}&apos;: {} has no geometry: skipped</source>
         <translation>layer MASKS '{}': {} non ha geometria: saltato</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="193"/>
+        <location filename="../processing_provider/prepare_images.py" line="192"/>
         <source>MASKS layer &apos;{}&apos;: {} is a {} geometry, not a polygon</source>
         <translation>layer MASKS '{}': {} è una geometria {}, non un poligono</translation>
     </message>
     <message>
+        <location filename="../processing_provider/prepare_images.py" line="84"/>
+        <source>Smallest blur score (0 = relative only)</source>
+        <translation>Punteggio di nitidezza minimo (0 = solo relativo)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="84"/>
+        <source>Leave flagged images out</source>
+        <translation>Escludi le immagini segnalate</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="91"/>
+        <source>Mask polygons</source>
+        <translation>Poligoni di maschera</translation>
+    </message>
+    <message>
         <location filename="../processing_provider/prepare_images.py" line="94"/>
-        <source>Sky masks: hide the sky and the horizon of oblique photos from the alignment</source>
-        <translation>Maschere del cielo: nascondi il cielo e l'orizzonte delle foto oblique all'allineamento</translation>
+        <source>Sky masks for oblique photos</source>
+        <translation>Maschere del cielo per foto oblique</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="95"/>
+        <source>Scanned film (fiducial marks)</source>
+        <translation>Pellicola scansionata (marche fiduciali)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <source>Fiducial coordinates (mm)</source>
+        <translation>Coordinate delle marche fiduciali (mm)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="112"/>
+        <source>Prepared images</source>
+        <translation>Immagini preparate</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/prepare_images.py" line="99"/>
+        <source>Calibrated focal length (mm)</source>
+        <translation>Focale calibrata (mm)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
         <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for &apos;Align images&apos;, and the Workspace folder, which records a decision per image (screening.json) for the accuracy report.
 
-The blur score is the variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged &apos;blurry&apos; below a fraction of the median of the set (Flag images below this fraction of the set&apos;s median blur score, advanced), or below the Smallest blur score when that is set (absolute scores depend on the scene: sand scores far lower than roofs).
-Images with more than 5 % clipped highlights or shadows, a mean brightness far from the set&apos;s, or a very small dynamic range are flagged for their exposure. With &apos;Leave flagged images out of the prepared folder&apos; ticked they are left out; otherwise they are kept and only reported.
+The blur score is the variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged &apos;blurry&apos; below a fraction of the median of the set (Flag images below this fraction of the set&apos;s median blur score, advanced), or below the Smallest blur score when that is set (0 = only relative to the set; absolute scores depend on the scene: sand scores far lower than roofs).
+Images with more than 5 % clipped highlights or shadows, a mean brightness far from the set&apos;s, or a very small dynamic range are flagged for their exposure. With &apos;Leave flagged images out&apos; ticked they are left out of the prepared folder; otherwise they are kept and only reported.
 
-Mask polygons: optional polygon layer of areas to ignore (a boom, the drone&apos;s shadow, a date stamp, a frame border), in the image&apos;s pixel coordinates: origin at the upper-left corner of the image, x right, y down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is &lt;= 0). A text field &apos;image&apos; names the image a polygon belongs to; empty (or no such field) applies it to every image. The polygons are written into the per-image masks (workspace/masks/&lt;image&gt;.png, merged with any mask already there): &apos;Align images&apos; finds no features under them, the orthophoto does not use those pixels, and blur and exposure are measured outside them. For scanned film the coordinates are those of the prepared images (the common fiducial frame, so one polygon fits every frame).
-Sky masks: for oblique photos the sky (clouds included) and the haze along the horizon are found automatically and written into the per-image masks, so that &apos;Align images&apos; takes no tie points from clouds that move between shots; a photo without sky (looking straight down) gets no sky mask.
+Mask polygons: optional polygon layer of areas to ignore in the alignment and the orthophoto (a boom, the drone&apos;s shadow, a date stamp, a frame border), in the image&apos;s pixel coordinates: origin at the upper-left corner of the image, x right, y down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is &lt;= 0). A text field &apos;image&apos; names the image a polygon belongs to; empty (or no such field) applies it to every image. The polygons are written into the per-image masks (workspace/masks/&lt;image&gt;.png, merged with any mask already there): &apos;Align images&apos; finds no features under them, the orthophoto does not use those pixels, and blur and exposure are measured outside them. For scanned film the coordinates are those of the prepared images (the common fiducial frame, so one polygon fits every frame).
+Sky masks for oblique photos: the sky (clouds included) and the haze along the horizon are found automatically and written into the per-image masks, so that &apos;Align images&apos; takes no tie points from clouds that move between shots; a photo without sky (looking straight down) gets no sky mask.
 
-Scanned film: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. Calibrated fiducial coordinates: the calibration certificate&apos;s fiducial coordinates in mm, as a file or pasted text, one &apos;id x y&apos; line per mark (x right, y up), optionally &apos;PP x y&apos; (principal point) and &apos;focal f&apos;. Without them the mean layout of the set is used, centred on the fiducial centre. With the Calibrated focal length (or &apos;focal&apos; in the certificate) the prepared images carry the focal length in pixels for the alignment.
+Scanned film (fiducial marks): fiducial marks (crosses, dots, dots in circles; in the corners and/or the side middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is resampled by an affine transform into the common fiducial frame, all with the same size and the principal point at the centre, and masks (workspace/masks) hide the film border, data strips and the marks from matching. Fiducial coordinates: the calibration certificate&apos;s calibrated fiducial coordinates in mm, as a file path or pasted text, one &apos;id x y&apos; line per mark (x right, y up), optionally &apos;PP x y&apos; (principal point) and &apos;focal f&apos;. Without them the mean layout of the set is used, centred on the fiducial centre. With the Calibrated focal length (0 = unknown; or &apos;focal&apos; in the certificate) the prepared images carry the focal length in pixels for the alignment.
 
 Prepared images: the folder of prepared images (replaced as a whole; it must be new, empty or written by an earlier run); when skipped, &lt;workspace&gt;/prepared.</source>
         <translation>Controlla una cartella di fotografie per sfocatura ed esposizione e, per le pellicole storiche scansionate, trova le marche fiduciali e ricampiona ogni scansione in un unico fotogramma della camera. Il risultato è una cartella di immagini preparate per 'Allinea immagini' e la Cartella dell'area di lavoro, che registra una decisione per immagine (screening.json) per il rapporto di accuratezza.
 
-Il punteggio di nitidezza è la varianza del laplaciano su una copia in grigio larga 1024 px, 90° percentile di una griglia di 8 x 6 tasselli (cielo o acqua in una parte del fotogramma non vanno a suo sfavore). Più alto è più nitido. Un'immagine è segnalata come 'sfocata' sotto una frazione della mediana dell'insieme (Segnala le immagini sotto questa frazione del punteggio di nitidezza mediano dell'insieme, avanzato), o sotto il Punteggio di nitidezza minimo se impostato (i punteggi assoluti dipendono dalla scena: la sabbia ottiene molto meno dei tetti).
-Vengono segnalate per l'esposizione le immagini con più del 5 % di luci o ombre tagliate, una luminosità media lontana da quella dell'insieme o una gamma dinamica molto ridotta. Con 'Escludi le immagini segnalate dalla cartella preparata' attivo sono escluse; altrimenti vengono mantenute e solo riportate.
+Il punteggio di nitidezza è la varianza del laplaciano su una copia in grigio larga 1024 px, 90° percentile di una griglia di 8 x 6 tasselli (cielo o acqua in una parte del fotogramma non vanno a suo sfavore). Più alto è più nitido. Un'immagine è segnalata come 'sfocata' sotto una frazione della mediana dell'insieme (Segnala le immagini sotto questa frazione del punteggio di nitidezza mediano dell'insieme, avanzato), o sotto il Punteggio di nitidezza minimo se impostato (0 = solo relativo all'insieme; i punteggi assoluti dipendono dalla scena: la sabbia ottiene molto meno dei tetti).
+Vengono segnalate per l'esposizione le immagini con più del 5 % di luci o ombre tagliate, una luminosità media lontana da quella dell'insieme o una gamma dinamica molto ridotta. Con 'Escludi le immagini segnalate' attivo sono escluse dalla cartella preparata; altrimenti vengono mantenute e solo riportate.
 
-Poligoni di maschera: layer poligonale opzionale delle aree da ignorare (un braccio, l'ombra del drone, un timbro con la data, un bordo del fotogramma), nelle coordinate pixel dell'immagine: origine nell'angolo superiore sinistro, x verso destra, y verso il basso, oppure y = -riga come il georeferenziatore di QGIS mostra una foto (riconosciuto quando ogni y è &lt;= 0). Un campo di testo 'image' indica l'immagine a cui appartiene un poligono; vuoto (o senza tale campo) vale per ogni immagine. I poligoni vengono scritti nelle maschere per immagine (workspace/masks/&lt;immagine&gt;.png, unite a una maschera già presente): 'Allinea immagini' non trova caratteristiche sotto di essi, l'ortofoto non usa quei pixel, e nitidezza ed esposizione vengono misurate al di fuori. Per la pellicola scansionata valgono le coordinate delle immagini preparate (il riferimento comune delle marche fiduciali, così un poligono vale per ogni fotogramma).
-Maschere del cielo: nelle foto oblique il cielo (nuvole comprese) e la foschia lungo l'orizzonte sono trovati automaticamente e scritti nelle maschere per immagine, così 'Allinea immagini' non prende punti di legame dalle nuvole che si spostano tra uno scatto e l'altro; una foto senza cielo (rivolta verso il basso) non riceve una maschera del cielo.
+Poligoni di maschera: layer poligonale opzionale delle aree che allineamento e ortofoto devono ignorare (un braccio, l'ombra del drone, un timbro con la data, un bordo del fotogramma), nelle coordinate pixel dell'immagine: origine nell'angolo superiore sinistro, x verso destra, y verso il basso, oppure y = -riga come il georeferenziatore di QGIS mostra una foto (riconosciuto quando ogni y è &lt;= 0). Un campo di testo 'image' indica l'immagine a cui appartiene un poligono; vuoto (o senza tale campo) vale per ogni immagine. I poligoni vengono scritti nelle maschere per immagine (workspace/masks/&lt;immagine&gt;.png, unite a una maschera già presente): 'Allinea immagini' non trova caratteristiche sotto di essi, l'ortofoto non usa quei pixel, e nitidezza ed esposizione vengono misurate al di fuori. Per la pellicola scansionata valgono le coordinate delle immagini preparate (il riferimento comune delle marche fiduciali, così un poligono vale per ogni fotogramma).
+Maschere del cielo per foto oblique: il cielo (nuvole comprese) e la foschia lungo l'orizzonte sono trovati automaticamente e scritti nelle maschere per immagine, così 'Allinea immagini' non prende punti di legame dalle nuvole che si spostano tra uno scatto e l'altro; una foto senza cielo (rivolta verso il basso) non riceve una maschera del cielo.
 
-Pellicola scansionata: le marche fiduciali (croci, punti, punti in cerchi; negli angoli e/o a metà dei lati, o come un'immagine modello di una marca) sono trovate con precisione sub-pixel, ogni scansione è ricampionata con una trasformazione affine nel fotogramma fiduciale comune, tutte della stessa dimensione e con il punto principale al centro, e delle maschere (workspace/masks) nascondono alla corrispondenza il bordo della pellicola, le strisce di dati e le marche. Coordinate calibrate delle marche fiduciali: le coordinate delle marche fiduciali del certificato di calibrazione in mm, come file o testo incollato, una riga 'id x y' per marca (x a destra, y in alto), facoltativamente 'PP x y' (punto principale) e 'focal f'. Senza di esse si usa la disposizione media dell'insieme, centrata sul centro fiduciale. Con la Focale calibrata (o 'focal' nel certificato) le immagini preparate riportano la focale in pixel per l'allineamento.
+Pellicola scansionata (marche fiduciali): le marche fiduciali (croci, punti, punti in cerchi; negli angoli e/o a metà dei lati, o come un'immagine modello di una marca) sono trovate con precisione sub-pixel, ogni scansione è ricampionata con una trasformazione affine nel fotogramma fiduciale comune, tutte della stessa dimensione e con il punto principale al centro, e delle maschere (workspace/masks) nascondono alla corrispondenza il bordo della pellicola, le strisce di dati e le marche. Coordinate delle marche fiduciali: le coordinate calibrate delle marche fiduciali del certificato di calibrazione in mm, come percorso di file o testo incollato, una riga 'id x y' per marca (x a destra, y in alto), facoltativamente 'PP x y' (punto principale) e 'focal f'. Senza di esse si usa la disposizione media dell'insieme, centrata sul centro fiduciale. Con la Focale calibrata (0 = sconosciuta; o 'focal' nel certificato) le immagini preparate riportano la focale in pixel per l'allineamento.
 
 Immagini preparate: la cartella delle immagini preparate (sostituita per intero; deve essere nuova, vuota o scritta da un'esecuzione precedente); se omessa, &lt;workspace&gt;/prepared.</translation>
     </message>
@@ -1952,47 +1958,37 @@ Immagini preparate: la cartella delle immagini preparate (sostituita per intero;
 <context>
     <name>ReliefVisualisationAlgorithm</name>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="41"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
-        <source>Elevation raster (instead of the workspace&apos;s)</source>
-        <translation>Raster delle quote (invece di quello dell'area di lavoro)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="45"/>
         <source>Surface</source>
         <translation>Superficie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="45"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="45"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="43"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="45"/>
         <source>Visualisation</source>
         <translation>Visualizzazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="50"/>
-        <source>Visualisation (default: in &lt;workspace&gt;/terrain/relief)</source>
-        <translation>Visualizzazione (predefinito: in &lt;workspace&gt;/terrain/relief)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="53"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="55"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="78"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="80"/>
         <source>Give a workspace folder, or an elevation raster and where to write the visualisation</source>
         <translation>Indica una cartella dell'area di lavoro, oppure un raster delle quote e dove scrivere la visualizzazione</translation>
     </message>
@@ -2002,21 +1998,36 @@ Immagini preparate: la cartella delle immagini preparate (sostituita per intero;
         <translation>Visualizzazione del rilievo</translation>
     </message>
     <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="41"/>
+        <source>VAT blend</source>
+        <translation>Miscela VAT</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="45"/>
+        <source>Elevation raster</source>
+        <translation>Raster delle quote</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/relief_visualisation.py" line="52"/>
+        <source>Relief raster</source>
+        <translation>Raster del rilievo</translation>
+    </message>
+    <message>
         <location filename="../ui/catalog.py" line="7"/>
         <source>Relief visualisations for reading earthworks, hollow ways, ridge and furrow and field boundaries, computed with rvt-py (the Relief Visualization Toolbox&apos;s library) with RVT&apos;s default parameters, converted from the 1 m DEMs RVT was made for to this raster&apos;s cell size.
 
 Workspace folder: a workspace with a DTM (Build DTM) or DSM.
 Elevation raster: any DTM/DSM in a projected CRS instead (optional).
 Surface: the workspace&apos;s DTM (bare earth, default) or DSM.
-Visualisation: sky-view factor, openness (positive, negative), simple local relief model, multi-scale relief model, multi-direction hillshade, local dominance, or the VAT blend.
-The output &apos;Visualisation&apos;: where to write it (default: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</source>
+Visualisation: sky-view factor, openness (positive, negative), simple local relief model, multi-scale relief model, multi-direction hillshade, local dominance, or the VAT blend (visualisation for archaeological topography).
+Relief raster: where to write it (default: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</source>
         <translation>Visualizzazioni del rilievo per leggere terrapieni, strade incassate, campi baulati e confini di campi, calcolate con rvt-py (la libreria del Relief Visualization Toolbox) con i parametri predefiniti di RVT, convertiti dai DEM a 1 m per cui RVT è fatto alla dimensione di cella di questo raster.
 
 Cartella dell'area di lavoro: un'area di lavoro con DTM (Genera DTM) o DSM.
 Raster delle quote: in alternativa qualsiasi DTM/DSM in un SR proiettato (facoltativo).
 Superficie: il DTM dell'area di lavoro (suolo nudo, predefinito) o il DSM.
-Visualizzazione: fattore di vista del cielo, apertura (positiva, negativa), modello semplice del rilievo locale, modello del rilievo a più scale, ombreggiatura da più direzioni, dominanza locale o la miscela VAT.
-Il risultato 'Visualizzazione': dove scriverla (predefinito: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</translation>
+Visualizzazione: fattore di vista del cielo, apertura (positiva, negativa), modello semplice del rilievo locale, modello del rilievo a più scale, ombreggiatura da più direzioni, dominanza locale o la miscela VAT (visualizzazione per la topografia archeologica).
+Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relief/&lt;surface&gt;-&lt;visualisation&gt;.tif).</translation>
     </message>
 </context>
 <context>

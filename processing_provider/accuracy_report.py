@@ -60,7 +60,8 @@ class AccuracyReportAlgorithm(AlgorithmBase):
         "from the bundle adjustment covariance. Products: DSM and orthomosaic previews, resolution, valid "
         "fraction. Sections whose stage has not run are skipped with a note.\n\n"
         "Workspace folder: a workspace folder (at least aligned).\n"
-        "Compute the bundle adjustment covariance: computes it (seconds for hundreds of images) and writes "
+        "Compute uncertainty: computes the bundle adjustment covariance (seconds for hundreds of images) for the "
+        "uncertainty section and writes "
         "<workspace>/uncertainty/cameras.gpkg and points.gpkg.\n"
         "Report: the report file (default: <workspace>/report.html). It is written under a temporary name and "
         "renamed when complete."
@@ -70,11 +71,10 @@ class AccuracyReportAlgorithm(AlgorithmBase):
         params.add(
             self,
             params.folder(self.WORKSPACE, self.tr("Workspace folder")),
-            params.flag(self.UNCERTAINTY, self.tr(
-                "Compute the bundle adjustment covariance (uncertainty section and layers)"), default=True),
+            params.flag(self.UNCERTAINTY, self.tr("Compute uncertainty"), default=True),
         )
         self.addParameter(QgsProcessingParameterFileDestination(
-            self.OUTPUT_HTML, self.tr("Report (default: <workspace>/report.html)"), fileFilter="HTML files (*.html)",
+            self.OUTPUT_HTML, self.tr("Report"), fileFilter="HTML files (*.html)",
             optional=True, createByDefault=False))
         self.addOutput(QgsProcessingOutputFolder(self.OUT_WORKSPACE, self.tr("Workspace")))
         self.addOutput(QgsProcessingOutputFile(self.CAMERA_PRECISION, self.tr("Camera precision (GeoPackage)")))

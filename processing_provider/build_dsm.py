@@ -59,7 +59,7 @@ class BuildDsmAlgorithm(AlgorithmBase):
                     "Dask scheduler address (empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER)"))),
         )
         self.addParameter(QgsProcessingParameterRasterDestination(
-            self.OUTPUT_DSM, self.tr("DSM (default: <workspace>/dsm.tif)"), optional=True, createByDefault=False))
+            self.OUTPUT_DSM, self.tr("DSM"), optional=True, createByDefault=False))
         self.addParameter(QgsProcessingParameterFileDestination(
             self.OUTPUT_POINT_CLOUD, self.tr("Point cloud (LAS)"), fileFilter="LAS point cloud (*.las)",
             optional=True, createByDefault=False))

@@ -45,7 +45,8 @@ class BuildDtmAlgorithm(AlgorithmBase):
         "DSM file: any DSM in a projected CRS (metres); default: the workspace's.\n"
         "Contour interval: contour lines every this many metres into a GeoPackage (0 = none).\n"
         "Slope, largest object radius and height threshold (advanced): SMRF's parameters (PDAL's defaults).\n"
-        "DTM: where to write it (default: <workspace>/dtm.tif)."
+        "DTM: where to write it (default: <workspace>/dtm.tif).\n"
+        "Contours: where to write the contour lines (default: <workspace>/terrain/contours.gpkg)."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
@@ -53,7 +54,7 @@ class BuildDtmAlgorithm(AlgorithmBase):
                                         behavior=QgsProcessingParameterFile.Behavior.Folder, optional=True)
         params.add(
             self, ws,
-            QgsProcessingParameterRasterLayer(self.DSM, self.tr("DSM file (default: the workspace's)"),
+            QgsProcessingParameterRasterLayer(self.DSM, self.tr("DSM file"),
                                               optional=True),
             params.number(self.CONTOUR_INTERVAL, self.tr("Contour interval in metres (0 = none)"), 0.0),
             *params.advanced(
@@ -62,9 +63,9 @@ class BuildDtmAlgorithm(AlgorithmBase):
                 params.number(self.THRESHOLD, self.tr("Height above ground of an object in metres"), 0.5, 0.05)),
         )
         self.addParameter(QgsProcessingParameterRasterDestination(
-            self.OUTPUT_DTM, self.tr("DTM (default: <workspace>/dtm.tif)"), optional=True, createByDefault=False))
+            self.OUTPUT_DTM, self.tr("DTM"), optional=True, createByDefault=False))
         self.addParameter(QgsProcessingParameterFileDestination(
-            self.OUTPUT_CONTOURS, self.tr("Contours (default: <workspace>/terrain/contours.gpkg)"),
+            self.OUTPUT_CONTOURS, self.tr("Contours"),
             fileFilter="GeoPackage (*.gpkg)", optional=True, createByDefault=False))
         self.addOutput(QgsProcessingOutputFolder(self.OUT_WORKSPACE, self.tr("Workspace")))
         self.addOutput(QgsProcessingOutputRasterLayer(self.OUTPUT_SOURCE, self.tr("DTM source")))

@@ -30,7 +30,7 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
     RMSE_PX = "RMSE_PX"
     PLANAR_OFFSET_P95 = "PLANAR_OFFSET_P95"
     MODES = ("ortho", "planar")
-    MODE_LABELS = ("True orthophoto on the DSM", "Planar rectification (projective, flat ground)")
+    MODE_LABELS = ("True orthophoto on the DSM", "Planar rectification (flat ground)")
     HELP = (
         "Orthorectifies one photograph — also one that is not part of any block, such as a single oblique or an "
         "old print — on an existing DSM, for example an airborne laser scanning (ALS) DSM in any CRS (it is "
@@ -47,12 +47,14 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
         "Known orientation: instead of GCPs, a file with x y z omega phi kappa (degrees, photogrammetric convention; "
         "a header row as Pix4D writes it, or JSON), optionally focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 "
         "and a CRS line.\n"
-        "Focal length and Sensor width: interior orientation (the sensor's long side); default the EXIF focal "
-        "length.\n"
+        "Focal length and Sensor width: interior orientation in mm (the sensor's long side); 0 or empty = the "
+        "EXIF focal length.\n"
         "Mode: a true orthophoto on the DSM, or a planar (projective) rectification through the GCPs for "
         "comparison on flat ground; with a DSM the log and the output "
         "'Planar rectification: 95th percentile of its offset' say how far the planar result is "
         "off because of relief.\n"
+        "Resolution: cell size in CRS units (0 = the ground sample distance).\n"
+        "Output CRS: default the CRS of the GCPs or of the known orientation.\n"
         "GCP residuals: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane)."
     )
 
@@ -62,16 +64,16 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
         params.add(
             self,
             QgsProcessingParameterRasterLayer(self.DSM, self.tr("DSM"), optional=True),
-            params.gcp_file(self.GCPS, self.tr("Ground control file (gcp_list.txt or CSV)")),
-            params.gcp_layer(self.GCP_LAYER, self.tr("Ground control point layer (one feature per observation)")),
+            params.gcp_file(self.GCPS, self.tr("Ground control file")),
+            params.gcp_layer(self.GCP_LAYER, self.tr("Ground control point layer")),
             QgsProcessingParameterFile(
-                self.ORIENTATION, self.tr("Known orientation (x y z omega phi kappa)"), optional=True,
+                self.ORIENTATION, self.tr("Known orientation"), optional=True,
                 fileFilter="Orientation (*.txt *.csv *.json);;All files (*)"),
-            params.number(self.FOCAL_MM, self.tr("Focal length in mm (0 = from EXIF)"), optional=True),
-            params.number(self.SENSOR_WIDTH_MM, self.tr("Sensor width (long side) in mm"), optional=True),
+            params.number(self.FOCAL_MM, self.tr("Focal length (mm)"), optional=True),
+            params.number(self.SENSOR_WIDTH_MM, self.tr("Sensor width (mm)"), optional=True),
             params.choice(self.MODE, self.tr("Mode"), self.MODE_LABELS),
-            params.number(self.RESOLUTION, self.tr("Resolution in CRS units (0 = ground sample distance)")),
-            params.target_crs(self.CRS, self.tr("Output CRS (default: the GCPs' or orientation's CRS)")),
+            params.number(self.RESOLUTION, self.tr("Resolution (0 = automatic)")),
+            params.target_crs(self.CRS, self.tr("Output CRS")),
         )
         self.addParameter(QgsProcessingParameterRasterDestination(self.OUTPUT, self.tr("Orthophoto")))
         self.addParameter(QgsProcessingParameterVectorDestination(

@@ -51,12 +51,12 @@ class PrepareImagesAlgorithm(AlgorithmBase):
         "The blur score is the variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of "
         "tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is "
         "flagged 'blurry' below a fraction of the median of the set (Flag images below this fraction of the "
-        "set's median blur score, advanced), or below the Smallest blur score when that is set (absolute scores "
-        "depend on the scene: sand scores far lower than roofs).\n"
+        "set's median blur score, advanced), or below the Smallest blur score when that is set (0 = only relative "
+        "to the set; absolute scores depend on the scene: sand scores far lower than roofs).\n"
         "Images with more than 5 % clipped highlights or shadows, a mean brightness far from the set's, or a "
-        "very small dynamic range are flagged for their exposure. With 'Leave flagged images out of the prepared "
-        "folder' ticked they are left out; otherwise they are kept and only reported.\n\n"
-        "Mask polygons: optional polygon layer of areas to ignore (a boom, the drone's shadow, a date stamp, a frame "
+        "very small dynamic range are flagged for their exposure. With 'Leave flagged images out' ticked they are "
+        "left out of the prepared folder; otherwise they are kept and only reported.\n\n"
+        "Mask polygons: optional polygon layer of areas to ignore in the alignment and the orthophoto (a boom, the drone's shadow, a date stamp, a frame "
         "border), in the image's pixel coordinates: origin at the upper-left corner of the image, x right, y "
         "down, or y = -row as the QGIS georeferencer shows a photo (detected when every y is <= 0). A text field "
         "'image' names the image a polygon belongs to; empty (or no such field) applies it to every image. "
@@ -64,17 +64,17 @@ class PrepareImagesAlgorithm(AlgorithmBase):
         "already there): 'Align images' finds no features under them, the orthophoto does not use those pixels, "
         "and blur and exposure are measured outside them. For scanned film the coordinates are those of the "
         "prepared images (the common fiducial frame, so one polygon fits every frame).\n"
-        "Sky masks: for oblique photos the sky (clouds included) and the haze along the horizon are found "
+        "Sky masks for oblique photos: the sky (clouds included) and the haze along the horizon are found "
         "automatically and written into the per-image masks, so that 'Align images' takes no tie points from "
         "clouds that move between shots; a photo without sky (looking straight down) gets no sky mask.\n\n"
-        "Scanned film: fiducial marks (crosses, dots, dots in circles; in the corners and/or the side "
+        "Scanned film (fiducial marks): fiducial marks (crosses, dots, dots in circles; in the corners and/or the side "
         "middles, or like a template image of one mark) are found to a fraction of a pixel, each scan is "
         "resampled by an affine transform into the common fiducial frame, all with the same size and the "
         "principal point at the centre, and masks (workspace/masks) hide the film border, data strips and "
-        "the marks from matching. Calibrated fiducial coordinates: the calibration certificate's fiducial coordinates "
-        "in mm, as a file or pasted text, one 'id x y' line per mark (x right, y up), optionally 'PP x y' "
+        "the marks from matching. Fiducial coordinates: the calibration certificate's calibrated fiducial "
+        "coordinates in mm, as a file path or pasted text, one 'id x y' line per mark (x right, y up), optionally 'PP x y' "
         "(principal point) and 'focal f'. Without them the mean layout of the set is used, centred on the "
-        "fiducial centre. With the Calibrated focal length (or 'focal' in the certificate) the prepared images carry "
+        "fiducial centre. With the Calibrated focal length (0 = unknown; or 'focal' in the certificate) the prepared images carry "
         "the focal length in pixels for the alignment.\n\n"
         "Prepared images: the folder of prepared images (replaced as a whole; it must be new, empty or written by an "
         "earlier run); when skipped, <workspace>/prepared."
@@ -85,21 +85,20 @@ class PrepareImagesAlgorithm(AlgorithmBase):
             self,
             params.folder(self.IMAGES, self.tr("Folder of images")),
             params.workspace_destination(self.WORKSPACE, self.tr("Workspace folder")),
-            params.number(self.BLUR_THRESHOLD, self.tr("Smallest blur score (0 = only relative to the set)")),
-            params.flag(self.EXCLUDE_FLAGGED, self.tr("Leave flagged images out of the prepared folder")),
+            params.number(self.BLUR_THRESHOLD, self.tr("Smallest blur score (0 = relative only)")),
+            params.flag(self.EXCLUDE_FLAGGED, self.tr("Leave flagged images out")),
         )
         self.addParameter(QgsProcessingParameterFeatureSource(
-            self.MASKS, self.tr("Mask polygons: areas to ignore, in pixel coordinates (optional text field 'image')"),
+            self.MASKS, self.tr("Mask polygons"),
             [QgsProcessing.SourceType.TypeVectorPolygon], optional=True))
-        self.addParameter(params.flag(self.SKY_MASKS, self.tr(
-            "Sky masks: hide the sky and the horizon of oblique photos from the alignment")))
-        self.addParameter(params.flag(self.SCANNED_FILM, self.tr("Scanned film: fiducial marks, common frame, masks")))
+        self.addParameter(params.flag(self.SKY_MASKS, self.tr("Sky masks for oblique photos")))
+        self.addParameter(params.flag(self.SCANNED_FILM, self.tr("Scanned film (fiducial marks)")))
         self.addParameter(QgsProcessingParameterString(
-            self.FIDUCIAL_COORDINATES, self.tr("Calibrated fiducial coordinates in mm (file path or text)"),
+            self.FIDUCIAL_COORDINATES, self.tr("Fiducial coordinates (mm)"),
             multiLine=True, optional=True))
         params.add(
             self,
-            params.number(self.FOCAL_LENGTH_MM, self.tr("Calibrated focal length in mm (0 = unknown)")),
+            params.number(self.FOCAL_LENGTH_MM, self.tr("Calibrated focal length (mm)")),
             *params.advanced(
                 params.number(self.BLUR_RELATIVE, self.tr(
                     "Flag images below this fraction of the set's median blur score"), default=0.4, maxValue=1.0),
@@ -111,7 +110,7 @@ class PrepareImagesAlgorithm(AlgorithmBase):
                     "Scan resolution in dpi when not in the files (0 = from the files)"))),
         )
         self.addParameter(QgsProcessingParameterFolderDestination(
-            self.OUTPUT, self.tr("Prepared images (skipped: <workspace>/prepared)"), optional=True,
+            self.OUTPUT, self.tr("Prepared images"), optional=True,
             createByDefault=False))
         self.addOutput(QgsProcessingOutputFolder(self.PREPARED_IMAGES, self.tr("Folder of prepared images")))
         self.addOutput(QgsProcessingOutputNumber(self.FLAGGED, self.tr("Flagged images")))

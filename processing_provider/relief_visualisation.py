@@ -31,24 +31,26 @@ class ReliefVisualisationAlgorithm(AlgorithmBase):
         "Elevation raster: any DTM/DSM in a projected CRS instead (optional).\n"
         "Surface: the workspace's DTM (bare earth, default) or DSM.\n"
         "Visualisation: sky-view factor, openness (positive, negative), simple local relief model, multi-scale "
-        "relief model, multi-direction hillshade, local dominance, or the VAT blend.\n"
-        "The output 'Visualisation': where to write it (default: <workspace>/terrain/relief/<surface>-<visualisation>.tif)."
+        "relief model, multi-direction hillshade, local dominance, or the VAT blend (visualisation for archaeological topography).\n"
+        "Relief raster: where to write it (default: <workspace>/terrain/relief/<surface>-<visualisation>.tif)."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
         from ..core.terrain.options import VISUALISATIONS
 
+        vat = self.tr("VAT blend")  # the option's full label is too wide for the dialog
+        options = [vat if key == "vat" else self.tr(label) for key, label in VISUALISATIONS]
         ws = QgsProcessingParameterFile(self.WORKSPACE, self.tr("Workspace folder"),
                                         behavior=QgsProcessingParameterFile.Behavior.Folder, optional=True)
         params.add(
             self, ws,
-            QgsProcessingParameterRasterLayer(self.INPUT, self.tr("Elevation raster (instead of the workspace's)"),
+            QgsProcessingParameterRasterLayer(self.INPUT, self.tr("Elevation raster"),
                                               optional=True),
             params.choice(self.SOURCE, self.tr("Surface"), [self.tr("DTM"), self.tr("DSM")]),
-            params.choice(self.VISUALISATION, self.tr("Visualisation"), [self.tr(label) for _, label in VISUALISATIONS]),
+            params.choice(self.VISUALISATION, self.tr("Visualisation"), options),
         )
         self.addParameter(QgsProcessingParameterRasterDestination(
-            self.OUTPUT, self.tr("Visualisation (default: in <workspace>/terrain/relief)"), optional=True,
+            self.OUTPUT, self.tr("Relief raster"), optional=True,
             createByDefault=False))
         self.addOutput(QgsProcessingOutputFolder(self.OUT_WORKSPACE, self.tr("Workspace")))
 
