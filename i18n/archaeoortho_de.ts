@@ -1602,17 +1602,17 @@ Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erk
 <context>
     <name>OrthorectifyImageAlgorithm</name>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="61"/>
         <source>Image</source>
         <translation>Bild</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Mode</source>
         <translation>Modus</translation>
     </message>
@@ -1662,37 +1662,37 @@ Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erk
         <translation>Bild orthorektifizieren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Ground control point layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Known orientation</source>
         <translation>Bekannte Orientierung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Focal length (mm)</source>
         <translation>Brennweite (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Sensor width (mm)</source>
         <translation>Sensorbreite (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Resolution (0 = automatic)</source>
         <translation>Auflösung (0 = automatisch)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Output CRS</source>
         <translation>Ausgabe-KBS</translation>
     </message>
@@ -1722,6 +1722,16 @@ Modus: ein wahres Orthophoto auf dem DOM oder eine ebene (projektive) Entzerrung
 Auflösung: Zellgröße in KBS-Einheiten (0 = die Bodenauflösung).
 Ausgabe-KBS: Vorgabe ist das KBS der Passpunkte oder der bekannten Orientierung.
 Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in der Ebene).</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <source>True orthophoto on the DSM</source>
+        <translation>Echtes Orthofoto auf dem DOM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <source>Planar rectification (flat ground)</source>
+        <translation>Ebene Entzerrung (flaches Gelände)</translation>
     </message>
 </context>
 <context>

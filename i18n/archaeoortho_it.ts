@@ -1602,17 +1602,17 @@ I valori anomali (una misura errata, un errore di battitura in una coordinata) s
 <context>
     <name>OrthorectifyImageAlgorithm</name>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="62"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="61"/>
         <source>Image</source>
         <translation>Immagine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Mode</source>
         <translation>Modalità</translation>
     </message>
@@ -1662,37 +1662,37 @@ I valori anomali (una misura errata, un errore di battitura in una coordinata) s
         <translation>Ortorettifica immagine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Ground control point layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Known orientation</source>
         <translation>Orientamento noto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Focal length (mm)</source>
         <translation>Focale (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Sensor width (mm)</source>
         <translation>Larghezza del sensore (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Resolution (0 = automatic)</source>
         <translation>Risoluzione (0 = automatica)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="64"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Output CRS</source>
         <translation>SR di output</translation>
     </message>
@@ -1722,6 +1722,16 @@ Modalità: un'ortofoto vera sul DSM, o un raddrizzamento piano (proiettivo) tram
 Risoluzione: dimensione della cella in unità del SR (0 = il GSD).
 SR di output: predefinito il SR dei punti d'appoggio o dell'orientamento noto.
 Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in metri sul piano).</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <source>True orthophoto on the DSM</source>
+        <translation>Ortofoto vera sul DSM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <source>Planar rectification (flat ground)</source>
+        <translation>Raddrizzamento piano (terreno piatto)</translation>
     </message>
 </context>
 <context>

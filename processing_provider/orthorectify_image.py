@@ -30,7 +30,6 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
     RMSE_PX = "RMSE_PX"
     PLANAR_OFFSET_P95 = "PLANAR_OFFSET_P95"
     MODES = ("ortho", "planar")
-    MODE_LABELS = ("True orthophoto on the DSM", "Planar rectification (flat ground)")
     HELP = (
         "Orthorectifies one photograph — also one that is not part of any block, such as a single oblique or an "
         "old print — on an existing DSM, for example an airborne laser scanning (ALS) DSM in any CRS (it is "
@@ -71,7 +70,8 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
                 fileFilter="Orientation (*.txt *.csv *.json);;All files (*)"),
             params.number(self.FOCAL_MM, self.tr("Focal length (mm)"), optional=True),
             params.number(self.SENSOR_WIDTH_MM, self.tr("Sensor width (mm)"), optional=True),
-            params.choice(self.MODE, self.tr("Mode"), self.MODE_LABELS),
+            params.choice(self.MODE, self.tr("Mode"), (self.tr("True orthophoto on the DSM"),
+                                                        self.tr("Planar rectification (flat ground)"))),
             params.number(self.RESOLUTION, self.tr("Resolution (0 = automatic)")),
             params.target_crs(self.CRS, self.tr("Output CRS")),
         )

@@ -281,3 +281,12 @@ def test_run_pipeline_passes_gcps_upright_on_to_the_georeferencing(plugin, tmp_p
             pipeline.run_pipeline(str(images), str(tmp_path / "ws"),
                                   control=pipeline.Control(gcp_path=str(gcp), gcps_upright=value))
         assert got["gcps_upright"] is value
+
+
+def test_orthorectify_mode_options_are_translated(plugin, german):
+    """The Mode drop-down of Orthorectify image is German in a German QGIS (its options were plain strings)."""
+    from qgis.core import QgsApplication
+
+    a = QgsApplication.processingRegistry().algorithmById("archaeoortho:orthorectifyimage").create()
+    options = a.parameterDefinition("MODE").options()
+    assert options == ["Echtes Orthofoto auf dem DOM", "Ebene Entzerrung (flaches Gelände)"]
