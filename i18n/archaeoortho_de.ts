@@ -1515,17 +1515,12 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Projektionszentren (Welt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="80"/>
-        <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS)</source>
-        <translation>Passpunkte (GCPS oder GCP_LAYER) und/oder Kamerapositionen (CAMERA_POSITIONS oder USE_EXIF_GPS) angeben</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="91"/>
+        <location filename="../processing_provider/georeference.py" line="92"/>
         <source>outlier left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="95"/>
+        <location filename="../processing_provider/georeference.py" line="96"/>
         <source>CRS {}; control RMSE XY {} m, Z {} m; check RMSE XY {} m, Z {} m</source>
         <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
     </message>
@@ -1598,6 +1593,11 @@ Ziel-KBS: Vorgabe ist das KBS der Passpunktdatei. Kamerakalibrierung verfeinern:
 GCP-Pixel auf aufrechten Fotos gemessen: ankreuzen, wenn die Pixelkoordinaten auf den Fotos gemessen wurden, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden (wie in Webbrowsern und Bildbetrachtern); sie werden in das gespeicherte Pixelraster jedes Fotos umgerechnet (ungedreht gespeicherte Fotos bleiben unverändert).
 Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erkannt, im Protokoll genannt und ausgelassen.</translation>
     </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="80"/>
+        <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS)</source>
+        <translation>Passpunkte (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) angeben</translation>
+    </message>
 </context>
 <context>
     <name>OrthorectifyImageAlgorithm</name>
@@ -1635,11 +1635,6 @@ Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erk
         <location filename="../processing_provider/orthorectify_image.py" line="82"/>
         <source>Planar rectification: 95th percentile of its offset from the true position (CRS units)</source>
         <translation>Ebene Entzerrung: 95. Perzentil ihres Versatzes gegen die wahre Lage (KBS-Einheiten)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="98"/>
-        <source>Give ground control points observed in the image (GCPS or GCP_LAYER) or its orientation (ORIENTATION)</source>
-        <translation>Im Bild gemessene Passpunkte (GCPS oder GCP_LAYER) oder seine Orientierung (ORIENTATION) angeben</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="104"/>
@@ -1732,6 +1727,11 @@ Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und 
         <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Planar rectification (flat ground)</source>
         <translation>Ebene Entzerrung (flaches Gelände)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="98"/>
+        <source>Give ground control points observed in the image (Ground control file or Ground control point layer: GCPS, GCP_LAYER) or its Known orientation (ORIENTATION)</source>
+        <translation>Im Bild gemessene Passpunkte (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER) oder seine Bekannte Orientierung (ORIENTATION) angeben</translation>
     </message>
 </context>
 <context>
@@ -2171,12 +2171,7 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>Genauigkeitsbericht (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="115"/>
-        <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
-        <translation>Geben Sie Passpunkte (GCPS oder GCP_LAYER) und/oder Kamerapositionen (CAMERA_POSITIONS oder USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="147"/>
+        <location filename="../processing_provider/run_pipeline.py" line="148"/>
         <source>Seconds per stage: {}</source>
         <translation>Sekunden pro Stufe: {}</translation>
     </message>
@@ -2291,6 +2286,11 @@ Die Georeferenzierung braucht Passpunkte (eine Passpunktdatei oder ein Passpunkt
 Das DGM erzeugen: nach dem DOM ein DGM der nackten Erde (wie 'DGM erzeugen'). Höhenlinienabstand (erweitert): Höhenlinien des DGM in diesem Abstand (wie 'Höhenlinien'; 0 = keine). Reliefvisualisierungen (erweitert): die gewählten werden aus dem DGM berechnet (wie 'Reliefvisualisierung'). Beide brauchen das DGM.
 Die übrigen Parameter sind die der einzelnen Stufen (siehe deren Hilfe); 0 bedeutet automatisch.
 Ausgaben: das DOM, das Orthomosaik und der Genauigkeitsbericht (HTML) sowie die wichtigsten Kennzahlen.</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="115"/>
+        <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
+        <translation>Geben Sie Passpunkte (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
     </message>
 </context>
 </TS>

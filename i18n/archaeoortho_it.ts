@@ -1515,17 +1515,12 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Centri di presa (mondo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="80"/>
-        <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS)</source>
-        <translation>Indica i punti d'appoggio (GCPS o GCP_LAYER) e/o le posizioni delle camere (CAMERA_POSITIONS o USE_EXIF_GPS)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="91"/>
+        <location filename="../processing_provider/georeference.py" line="92"/>
         <source>outlier left out: {}</source>
         <translation>valore anomalo escluso: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="95"/>
+        <location filename="../processing_provider/georeference.py" line="96"/>
         <source>CRS {}; control RMSE XY {} m, Z {} m; check RMSE XY {} m, Z {} m</source>
         <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
     </message>
@@ -1598,6 +1593,11 @@ SR di destinazione: predefinito quello del file dei punti d'appoggio. Affina la 
 Pixel dei GCP misurati sulle foto raddrizzate: da spuntare quando le coordinate pixel sono state misurate sulle foto mostrate diritte secondo il loro orientamento EXIF, come le mostrano i browser e i visualizzatori di foto; sono convertite nella griglia di pixel memorizzata di ogni foto (le foto memorizzate senza rotazione restano invariate).
 I valori anomali (una misura errata, un errore di battitura in una coordinata) sono individuati, nominati nel registro ed esclusi.</translation>
     </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="80"/>
+        <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS)</source>
+        <translation>Indica i punti d&apos;appoggio (File o Layer dei punti d&apos;appoggio: GCPS, GCP_LAYER) e/o le posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS)</translation>
+    </message>
 </context>
 <context>
     <name>OrthorectifyImageAlgorithm</name>
@@ -1635,11 +1635,6 @@ I valori anomali (una misura errata, un errore di battitura in una coordinata) s
         <location filename="../processing_provider/orthorectify_image.py" line="82"/>
         <source>Planar rectification: 95th percentile of its offset from the true position (CRS units)</source>
         <translation>Raddrizzamento piano: 95° percentile del suo scostamento dalla posizione vera (unità del SR)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="98"/>
-        <source>Give ground control points observed in the image (GCPS or GCP_LAYER) or its orientation (ORIENTATION)</source>
-        <translation>Indica i punti d'appoggio misurati nell'immagine (GCPS o GCP_LAYER) o il suo orientamento (ORIENTATION)</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="104"/>
@@ -1732,6 +1727,11 @@ Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui
         <location filename="../processing_provider/orthorectify_image.py" line="63"/>
         <source>Planar rectification (flat ground)</source>
         <translation>Raddrizzamento piano (terreno piatto)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="98"/>
+        <source>Give ground control points observed in the image (Ground control file or Ground control point layer: GCPS, GCP_LAYER) or its Known orientation (ORIENTATION)</source>
+        <translation>Indica i punti d&apos;appoggio osservati nell&apos;immagine (File o Layer dei punti d&apos;appoggio: GCPS, GCP_LAYER) o il suo Orientamento noto (ORIENTATION)</translation>
     </message>
 </context>
 <context>
@@ -2171,12 +2171,7 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Rapporto di accuratezza (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="115"/>
-        <source>Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
-        <translation>Indicare punti di appoggio (GCPS o GCP_LAYER) e/o posizioni delle camere (CAMERA_POSITIONS o USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="147"/>
+        <location filename="../processing_provider/run_pipeline.py" line="148"/>
         <source>Seconds per stage: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -2291,6 +2286,11 @@ La georeferenziazione richiede punti di appoggio (un file o un layer dei punti d
 Genera il DTM: dopo il DSM, un DTM del suolo nudo (come 'Genera DTM'). Equidistanza (avanzato): curve di livello del DTM con questa equidistanza (come 'Curve di livello'; 0 = nessuna). Visualizzazioni del rilievo (avanzato): quelle scelte sono calcolate dal DTM (come 'Visualizzazione del rilievo'). Entrambe richiedono il DTM.
 Gli altri parametri sono quelli delle singole fasi (vedi il loro aiuto); 0 significa automatico.
 Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali.</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="115"/>
+        <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
+        <translation>Indicare punti di appoggio (File o Layer dei punti d&apos;appoggio: GCPS, GCP_LAYER) e/o posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
     </message>
 </context>
 </TS>

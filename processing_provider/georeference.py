@@ -78,7 +78,8 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         if not params.has_control(gcp_path, gcps, positions, self.parameterAsBoolean(
                 parameters, self.USE_EXIF_GPS, context)):
             raise QgsProcessingException(self.tr(
-                "Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS)"))
+                "Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions "
+                "(Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS)"))
         progress = FeedbackProgress(feedback)
         result = self.run_core(
             georeference_workspace, workspace, gcp_path=gcp_path, gcps=gcps, check_points=checks,

@@ -96,8 +96,8 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
         orientation = params.read_optional_file(self, parameters, self.ORIENTATION, context)
         if gcps is None and orientation is None:
             raise QgsProcessingException(self.tr(
-                "Give ground control points observed in the image (GCPS or GCP_LAYER) or its orientation "
-                "(ORIENTATION)"))
+                "Give ground control points observed in the image (Ground control file or Ground control point layer: "
+                "GCPS, GCP_LAYER) or its Known orientation (ORIENTATION)"))
         crs_text = params.read_crs(self, parameters, self.CRS, context)
         residuals = self.parameterAsOutputLayer(parameters, self.RESIDUALS, context) or None
         if residuals and not residuals.lower().endswith(".gpkg"):

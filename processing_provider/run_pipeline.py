@@ -113,8 +113,9 @@ class RunPipelineAlgorithm(AlgorithmBase):
         use_gps = self.parameterAsBoolean(p, self.USE_EXIF_GPS, context)
         if not params.has_control(gcp_path, gcps, positions, use_gps):
             raise QgsProcessingException(self.tr(
-                "Give ground control (GCPS or GCP_LAYER) and/or camera positions (CAMERA_POSITIONS or USE_EXIF_GPS): "
-                "the DSM and orthophoto need a georeferenced block"))
+                "Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions "
+                "(Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and "
+                "orthophoto need a georeferenced block"))
         crs_text = params.read_crs(self, p, self.CRS, context)
         checks = params.read_names(self, p, self.CHECK_POINTS, context)
         workers = self.parameterAsInt(p, self.WORKERS, context)
