@@ -355,6 +355,33 @@ def test_far_field_of_an_oblique_is_left_to_the_near_view(tmp_path):
     assert float(xa0[oka0].max()) > b_hi  # ... and reaches past B in its own orthophoto
 
 
+def test_far_field_limit_keeps_the_ground_of_a_vertical_beside_tall_objects(tmp_path):
+    """A vertical photo 30 m over flat ground with a 22 m tower (a tree line) beside its footprint: the image
+    resolves the tower's top far finer than any ground, and a limit taken from that best would cut all its
+    ground.  The best is taken on the ground: the footprint is filled as without a limit."""
+    crs, offset, res = syn.CRS, np.array(syn.ORIGIN), 1.0
+    dsm = np.full((300, 400), 100.0, np.float32)
+    xs0, ys0 = -150.0, 150.0
+    dsm[150 - 5:150 + 5, 150 + 25:150 + 35] = 122.0  # local x 25..35, y -5..5: outside the 40 x 30 m footprint
+    gt = (xs0 + offset[0], res, 0.0, ys0 + offset[1], 0.0, -res)
+    dsm_path = rastermod.write_cog(os.path.join(str(tmp_path), "dsm.tif"), dsm, gt, crs)
+    cam = _pinhole()
+    c = np.array([0.0, 0.0, 130.0])
+    path = os.path.join(str(tmp_path), "V.tif")
+    cv2.imwrite(path, np.full((cam.height, cam.width, 3), 200, np.uint8))
+    cams = [OrthoCamera("V.tif", path, cam, Pose.from_centre(syn.look_at(c, c - [0, 0, 1.0], np.array([0, 1.0, 0])), c))]
+    filled = {}
+    for factor in (3.0, 0.0):
+        out = str(tmp_path / f"mosaic_{factor:g}.tif")
+        build_orthomosaic(cams, dsm_path, crs, offset, out, OrthoOptions(gsd_factor=factor, blending="none",
+                                                                         exposure=False, resolution=0.5))
+        xs, _val, ok = _values_along_x(out, offset)
+        inside = (xs > -18) & (xs < 18)  # the footprint is x -20..20 m on the line y = 0
+        filled[factor] = float(ok[inside].mean())
+    assert filled[0.0] == 1.0
+    assert filled[3.0] == 1.0, filled
+
+
 # ---------------------------------------------------------------------------
 # the orbit end to end: prepare (sky masks) -> align -> georeference -> DSM -> orthomosaic, against the truth
 # ---------------------------------------------------------------------------

@@ -72,8 +72,8 @@ def resolution_limited(cam: OrthoCamera, offset: np.ndarray, fp: Footprint, z_lo
                        factor: float) -> Tuple[Footprint, float]:
     """(the footprint trimmed to where the image resolves the ground within ``factor`` x its best, its best ground
     resolution): the image sampled on a GSD_SAMPLES grid (border included), the rays met with the planes z_lo and
-    z_hi, the ground resolution there (OrthoCamera.ground_resolution); the convex hull of the points within
-    GSD_MARGIN x the limit.  ``fp`` and nan when nothing is sampled."""
+    z_hi, the ground resolution there (OrthoCamera.ground_resolution); the best is taken on the z_lo plane (the
+    ground), the footprint is the convex hull of the points of both planes within GSD_MARGIN x the limit.  ``fp`` and nan when nothing is sampled."""
     w, h = cam.camera.width, cam.camera.height
     gx, gy = np.meshgrid(np.linspace(0.0, w, GSD_SAMPLES[0]), np.linspace(0.0, h, GSD_SAMPLES[1]))
     xn = cam.camera.unproject(np.column_stack([gx.ravel(), gy.ravel()]))
@@ -88,9 +88,12 @@ def resolution_limited(cam: OrthoCamera, offset: np.ndarray, fp: Footprint, z_lo
         gsd.append(cam.ground_resolution(p))
     pts_a, gsd_a = np.concatenate(pts), np.concatenate(gsd)
     fin = np.isfinite(gsd_a)
-    if not fin.any():
+    low = np.isfinite(gsd[0])
+    if not fin.any() or not low.any():
         return fp, float("nan")
-    best = float(gsd_a[fin].min())
+    # the best on the low plane (the ground): on z_hi (tree tops, roofs, a hill beside the flight) an image
+    # resolves finer than anywhere on the ground, and that limit would cut the ground of every image there
+    best = float(gsd[0][low].min())
     sel = fin & (gsd_a <= GSD_MARGIN * factor * best)
     if sel.sum() < 3:
         return fp, best
