@@ -92,10 +92,9 @@ class BuildDtmAlgorithm(AlgorithmBase):
             result = self.run_core(stage.build_dtm_workspace, workspace, dsm=dsm, output_dtm=output_dtm,
                                    contour_interval=interval, options=options, progress=progress)
             if contours and result.contours_path:
-                import shutil
+                from ..core.common.files import atomic_copy
 
-                shutil.copyfile(result.contours_path, contours)
-                result.contours_path = contours
+                result.contours_path = atomic_copy(result.contours_path, contours)
         else:
             if not dsm or not output_dtm:
                 raise QgsProcessingException(self.tr(

@@ -71,10 +71,9 @@ class ReliefVisualisationAlgorithm(AlgorithmBase):
             result = self.run_core(stage.relief_workspace, workspace, [key], source=source, progress=progress)
             path = result.paths[key]
             if output and os.path.abspath(output) != os.path.abspath(path):
-                import shutil
+                from ..core.common.files import atomic_copy
 
-                shutil.copyfile(path, output)
-                path = output
+                path = atomic_copy(path, output)
         else:
             if not dem or not output:
                 raise QgsProcessingException(self.tr(

@@ -210,3 +210,34 @@ def test_a_round_not_kept_puts_the_database_back(tmp_path, monkeypatch):
     assert con.execute("SELECT COUNT(*) FROM keypoints").fetchone()[0] == 1  # ...are gone again
     con.close()
     assert not os.path.exists(str(db) + ".before-escalation")
+
+
+def test_a_cancelled_round_puts_the_database_back(tmp_path, monkeypatch):
+    """A Cancel (or any failure) in the middle of a round: the exception goes on, and the database is the one
+    before the round (not the round's half-changed features and matches)."""
+    import core.align.escalation as esc
+    from core.common.progress import Cancelled, NullProgress
+
+    db = tmp_path / "database.db"
+    con = sqlite3.connect(db)
+    con.execute("CREATE TABLE keypoints (image_id INTEGER, rows INTEGER)")
+    con.execute("INSERT INTO keypoints VALUES (1, 10)")
+    con.commit()
+    con.close()
+
+    def cancelled_round(ctx, k, reason, ordered, left, progress):
+        c = sqlite3.connect(ctx.db_path)
+        c.execute("DELETE FROM keypoints")  # features forgotten, then the user cancels
+        c.commit()
+        c.close()
+        raise Cancelled("cancelled by the user")
+
+    monkeypatch.setattr(esc, "_run_round", cancelled_round)
+    ctx = esc.EscalationContext(None, str(db), str(tmp_path), str(tmp_path), ["a", "b", "c"], [], {}, AlignOptions(),
+                                [], None, [], lambda p: [], lambda reg, oth: {}, lambda: {"c": 1})
+    with pytest.raises(Cancelled):
+        esc.escalate(ctx, [_Rec(["a", "b"])], NullProgress())
+    con = sqlite3.connect(db)
+    assert con.execute("SELECT COUNT(*) FROM keypoints").fetchone()[0] == 1
+    con.close()
+    assert not os.path.exists(str(db) + ".before-escalation")

@@ -346,6 +346,13 @@ def escalate(ctx: EscalationContext, ordered, progress: Progress):
                 ordered = new
             else:  # the database goes back to the features and matches of the result kept (a re-run reuses them)
                 os.replace(backup, ctx.db_path)
+        except BaseException:  # a cancel or a failure in the round: the database as it was before it
+            try:
+                os.replace(backup, ctx.db_path)
+            except OSError as err:
+                progress.warning(f"escalation round {k}: could not put {ctx.db_path} back ({err}); a re-run "
+                                 "extracts the features of the images of this round again")
+            raise
         finally:
             if os.path.exists(backup):
                 os.unlink(backup)

@@ -79,6 +79,18 @@ def atomic_output(path: str) -> Iterator[str]:
         raise
 
 
+def atomic_copy(src: str, dst: str) -> str:
+    """Copy the file ``src`` to ``dst`` atomically (a crash or cancel leaves ``dst`` as it was); nothing to do when
+    both name the same file.  Returns ``dst``."""
+    import shutil
+
+    if os.path.exists(dst) and os.path.samefile(src, dst):
+        return dst
+    with atomic_output(dst) as tmp:
+        shutil.copyfile(src, tmp)
+    return dst
+
+
 def _honour_umask(path: str) -> None:
     """Files made with mkstemp / NamedTemporaryFile inside a product are 0600: give them the umask's mode."""
     if os.path.isfile(path) and not os.path.islink(path):

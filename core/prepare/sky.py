@@ -215,7 +215,9 @@ def horizon_keep(camera: Intrinsics, rotation: np.ndarray, up: Sequence[float] =
     u = u / np.linalg.norm(u)
     with np.errstate(invalid="ignore"):
         elev = np.degrees(np.arcsin(np.clip((d @ u) / np.linalg.norm(d, axis=-1), -1.0, 1.0)))
-    elev = np.where(np.isfinite(elev), elev, 90.0).astype(np.float32)
+    # a pixel whose ray the lens model cannot give (beyond a strong distortion's valid radius) is kept: it says
+    # nothing of the horizon, and the corners of a vertical photo are ground
+    elev = np.where(np.isfinite(elev), elev, -90.0).astype(np.float32)
     # pixel centres of the wanted grid in camera pixels, then in the coarse grid's cells
     px = (np.arange(cols) + 0.5) * (w / cols) / step
     py = (np.arange(rows) + 0.5) * (h / rows) / step
