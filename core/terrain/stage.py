@@ -211,5 +211,4 @@ def relief_workspace(workspace_dir: str, keys: Sequence[str], source: str = "dtm
     return r
 
 
-__all__ = ["build_dtm", "build_dtm_workspace", "relief", "relief_workspace", "write_contours", "DtmResult",
-           "ReliefResult", "TerrainError"]
+__all__ = ["build_dtm", "build_dtm_workspace", "relief", "relief_workspace", "DtmResult", "ReliefResult"]
