@@ -326,7 +326,7 @@ def test_processing_prepare_images_with_mask_polygons(plugin, tmp_path):
     from qgis.core import NULL, QgsApplication, QgsProcessingException
 
     alg = QgsApplication.processingRegistry().algorithmById("archaeoortho:prepareimages")
-    assert "MASKS" in {p.name() for p in alg.parameterDefinitions()} and "MASKS:" in alg.shortHelpString()
+    assert "MASKS" in {p.name() for p in alg.parameterDefinitions()} and "Mask polygons:" in alg.shortHelpString()
     names = TOLEDO_STRIP[:2]
     images = copy_images(os.path.join(SAMPLE, "images"), names, str(tmp_path / "images"))
     # georeferencer style (y = -row): the left half of the first image, a corner of every image
