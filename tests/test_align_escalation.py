@@ -241,3 +241,39 @@ def test_a_cancelled_round_puts_the_database_back(tmp_path, monkeypatch):
     assert con.execute("SELECT COUNT(*) FROM keypoints").fetchone()[0] == 1
     con.close()
     assert not os.path.exists(str(db) + ".before-escalation")
+
+
+def test_round_two_counts_the_pairs_round_one_found_even_when_its_result_was_not_kept(tmp_path, monkeypatch):
+    """Round 1 verifies a pair for c but maps no better, so its database is put back (c has no pair there again):
+    round 2 still runs for c, since round 1's richer features showed that c shares ground with the block."""
+    import core.align.escalation as esc
+    from core.common.progress import NullProgress
+
+    db = tmp_path / "database.db"
+    con = sqlite3.connect(db)
+    con.execute("CREATE TABLE verified (image TEXT)")
+    con.commit()
+    con.close()
+    rounds = []
+
+    def partners():
+        c = sqlite3.connect(db)
+        n = c.execute("SELECT COUNT(*) FROM verified WHERE image = 'c'").fetchone()[0]
+        c.close()
+        return {"c": n}
+
+    def worse_round(ctx, k, reason, ordered, left, progress):
+        rounds.append((k, list(left)))
+        if k == 1:
+            c = sqlite3.connect(ctx.db_path)
+            c.execute("INSERT INTO verified VALUES ('c')")  # round 1's features give c a verified pair...
+            c.commit()
+            c.close()
+        return esc.EscalationRound(k, reason, {n: "?" for n in left}, list(left), [], {}, 1, 2, 1, 1, 1), []
+
+    monkeypatch.setattr(esc, "_run_round", worse_round)
+    ctx = esc.EscalationContext(None, str(db), str(tmp_path), str(tmp_path), ["a", "b", "c"], [], {}, AlignOptions(),
+                                [], None, [], lambda p: [], lambda reg, oth: {}, partners)
+    esc.escalate(ctx, [_Rec(["a", "b"])], NullProgress())
+    assert partners() == {"c": 0}  # ...but its database was put back (its mapping was not better)
+    assert rounds == [(1, ["c"]), (2, ["c"])]

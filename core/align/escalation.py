@@ -301,12 +301,16 @@ def _backup_database(db_path: str) -> str:
     return backup
 
 
-def _hopeful(ctx: EscalationContext, registered: Set[str], others: List[List[str]], progress: Progress) -> List[str]:
+def _hopeful(ctx: EscalationContext, registered: Set[str], others: List[List[str]], progress: Progress,
+             round1: Optional[Dict[str, int]] = None) -> List[str]:
     """The images round 2 (affine shape + DSP, the slow features) is worth running for: those still outside the
     main block that, after round 1's richer features, share a verified pair with some image or sit in another
     component.  An image without any verified pair after round 1 shares no ground with the block (a foreign
-    photo, sky, water): round 2 would not change that and is not run for it."""
-    partners = ctx.partners()
+    photo, sky, water): round 2 would not change that and is not run for it.  ``round1``: the verified partners
+    counted right after round 1 (its database may have been put back since, when its result was not kept)."""
+    partners = dict(ctx.partners())
+    for n, c in (round1 or {}).items():
+        partners[n] = max(partners.get(n, 0), c)
     in_other = {n for comp in others for n in comp}
     left = [n for n in ctx.order if n not in registered]
     hopeful = [n for n in left if n in in_other or partners.get(n, 0) > 0]
@@ -329,19 +333,22 @@ def escalate(ctx: EscalationContext, ordered, progress: Progress):
     progress.warning(f"fast path: {reason}; escalating for the images left out")
     first_left = [n for n in ctx.order if n not in registered]
     left = first_left
+    round1_partners: Dict[str, int] = {}
     for k in (1, 2):
         if k == 2:
             registered, others = block_state(ordered)
             reason = escalation_reason(len(ctx.order), registered, others)
             if reason is None:
                 break
-            left = _hopeful(ctx, registered, others, progress)
+            left = _hopeful(ctx, registered, others, progress, round1_partners)
             if not left:
                 break
         backup = _backup_database(ctx.db_path)
         try:
             row, new = _run_round(ctx, k, reason, ordered, left, SubProgress(progress, (k - 1) / 2.0, k / 2.0))
             record.rounds.append(row)
+            if k == 1:
+                round1_partners = ctx.partners()  # before its database may be put back
             if row.kept:
                 ordered = new
             else:  # the database goes back to the features and matches of the result kept (a re-run reuses them)
