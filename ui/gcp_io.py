@@ -37,13 +37,16 @@ class GcpImportExport:
                 self.import_file(path, merge=merge, upright=upright)
 
     def photo_orientations(self):
-        """{image: EXIF orientation} of the workspace's photos that a photo viewer shows turned (not 1)."""
+        """{image: EXIF orientation} of the workspace's photos that a photo viewer shows turned (not 1): as the
+        alignment recorded it, read from the photo only in a workspace that predates the record."""
         out = {}
         for im in self.store.images():
-            try:
-                o = exif_orientation(im["path"]) if im.get("path") and os.path.exists(im["path"]) else 1
-            except ImageError:
-                o = 1
+            o = im.get("orientation")
+            if o is None:
+                try:
+                    o = exif_orientation(im["path"]) if im.get("path") and os.path.exists(im["path"]) else 1
+                except ImageError:
+                    o = 1
             if o != 1:
                 out[im["name"]] = o
         return out

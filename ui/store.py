@@ -149,14 +149,16 @@ class GcpStore(QObject):
         return gs
 
     def images(self):
-        """[{name, path, width, height}] of the workspace's photos, in manifest order."""
+        """[{name, path, width, height, orientation}] of the workspace's photos, in manifest order (orientation:
+        the EXIF orientation the alignment recorded, None in older workspaces)."""
         if self.workspace is None:
             return []
         out = []
         base = self.workspace.data.get("images_dir") or ""
         for im in self.workspace.data.get("images", []):
             path = im.get("path") or os.path.join(base, im["name"])
-            out.append({"name": im["name"], "path": path, "width": im.get("width"), "height": im.get("height")})
+            out.append({"name": im["name"], "path": path, "width": im.get("width"), "height": im.get("height"),
+                        "orientation": im.get("orientation")})
         return out
 
     def image_sizes(self):
