@@ -400,15 +400,11 @@ def test_the_dock_imports_gcp_coordinates_measured_on_the_upright_photo(dock, oc
     assert dock.open_workspace(ws)
     assert dock.photo_orientations() == {OCHOTA_PHOTO: 6}
     # a workspace aligned today records the orientation: the import does not open the photos for it
-    from archaeoortho.ui import gcp_io
-
     for im in dock.store.workspace.data["images"]:
         im["orientation"] = 6
-    real, gcp_io.exif_orientation = gcp_io.exif_orientation, None  # would raise if called
-    try:
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr("archaeoortho.ui.gcp_io.exif_orientation", None)  # would raise if called
         assert dock.photo_orientations() == {OCHOTA_PHOTO: 6}
-    finally:
-        gcp_io.exif_orientation = real
     gs = dock.import_file(str(path), upright=True)
     assert gs is not None
     o = dock.store.gcps.by_name("W1").observations
