@@ -104,7 +104,8 @@ def resolution_limited(cam: OrthoCamera, offset: np.ndarray, fp: Footprint, z_lo
     xmax, ymax = np.minimum(poly.max(axis=0), fp.bbox[2:])
     if xmax <= xmin or ymax <= ymin:
         return fp, best
-    gsd_fp = best if best > 1.05 * fp.gsd else fp.gsd  # an oblique's best view, not the nadir it does not see
+    best_all = float(gsd_a[fin].min())  # the footprint's resolution: as without the limit (the mosaic's cell)
+    gsd_fp = best_all if best_all > 1.05 * fp.gsd else fp.gsd  # an oblique's best view, not the nadir it misses
     return Footprint(poly, (float(xmin), float(ymin), float(xmax), float(ymax)), float(gsd_fp), fp.z_ref), best
 
 
