@@ -67,6 +67,15 @@ class _Image:
         self.name = name
 
 
+def _sql(db, *statements):
+    """Run ``statements`` on the SQLite database ``db`` and commit."""
+    con = sqlite3.connect(db)
+    for st in statements:
+        con.execute(st)
+    con.commit()
+    con.close()
+
+
 class _Rec:
     """The two things block_state reads of a pycolmap.Reconstruction."""
 
@@ -186,17 +195,10 @@ def test_a_round_not_kept_puts_the_database_back(tmp_path, monkeypatch):
     from core.common.progress import NullProgress
 
     db = tmp_path / "database.db"
-    con = sqlite3.connect(db)
-    con.execute("CREATE TABLE keypoints (image_id INTEGER, rows INTEGER)")
-    con.execute("INSERT INTO keypoints VALUES (1, 10)")
-    con.commit()
-    con.close()
+    _sql(db, "CREATE TABLE keypoints (image_id INTEGER, rows INTEGER)", "INSERT INTO keypoints VALUES (1, 10)")
 
     def worse_round(ctx, k, reason, ordered, left, progress):
-        c = sqlite3.connect(ctx.db_path)
-        c.execute("DELETE FROM keypoints")  # the round's new features...
-        c.commit()
-        c.close()
+        _sql(ctx.db_path, "DELETE FROM keypoints")  # the round's new features...
         return esc.EscalationRound(k, reason, {n: "?" for n in left}, list(left), [], {}, 1, 2, 1, 1, 1), []
 
     monkeypatch.setattr(esc, "_run_round", worse_round)
@@ -219,17 +221,10 @@ def test_a_cancelled_round_puts_the_database_back(tmp_path, monkeypatch):
     from core.common.progress import Cancelled, NullProgress
 
     db = tmp_path / "database.db"
-    con = sqlite3.connect(db)
-    con.execute("CREATE TABLE keypoints (image_id INTEGER, rows INTEGER)")
-    con.execute("INSERT INTO keypoints VALUES (1, 10)")
-    con.commit()
-    con.close()
+    _sql(db, "CREATE TABLE keypoints (image_id INTEGER, rows INTEGER)", "INSERT INTO keypoints VALUES (1, 10)")
 
     def cancelled_round(ctx, k, reason, ordered, left, progress):
-        c = sqlite3.connect(ctx.db_path)
-        c.execute("DELETE FROM keypoints")  # features forgotten, then the user cancels
-        c.commit()
-        c.close()
+        _sql(ctx.db_path, "DELETE FROM keypoints")  # features forgotten, then the user cancels
         raise Cancelled("cancelled by the user")
 
     monkeypatch.setattr(esc, "_run_round", cancelled_round)
@@ -250,10 +245,7 @@ def test_round_two_counts_the_pairs_round_one_found_even_when_its_result_was_not
     from core.common.progress import NullProgress
 
     db = tmp_path / "database.db"
-    con = sqlite3.connect(db)
-    con.execute("CREATE TABLE verified (image TEXT)")
-    con.commit()
-    con.close()
+    _sql(db, "CREATE TABLE verified (image TEXT)")
     rounds = []
 
     def partners():
@@ -265,10 +257,7 @@ def test_round_two_counts_the_pairs_round_one_found_even_when_its_result_was_not
     def worse_round(ctx, k, reason, ordered, left, progress):
         rounds.append((k, list(left)))
         if k == 1:
-            c = sqlite3.connect(ctx.db_path)
-            c.execute("INSERT INTO verified VALUES ('c')")  # round 1's features give c a verified pair...
-            c.commit()
-            c.close()
+            _sql(ctx.db_path, "INSERT INTO verified VALUES ('c')")  # round 1's features give c a verified pair...
         return esc.EscalationRound(k, reason, {n: "?" for n in left}, list(left), [], {}, 1, 2, 1, 1, 1), []
 
     monkeypatch.setattr(esc, "_run_round", worse_round)
