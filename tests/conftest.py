@@ -67,6 +67,18 @@ def qgis_process():
     return exe, env
 
 
+@pytest.fixture(scope="module")
+def plugin(qgis_iface, qgis_processing):
+    """The plugin loaded and its Processing provider registered, once per test module (a module may define its
+    own)."""
+    import archaeoortho
+
+    p = archaeoortho.classFactory(qgis_iface)
+    p.initProcessing()
+    yield p
+    p.unload()
+
+
 @pytest.fixture(scope="session")
 def toledo_strip(tmp_path_factory):
     d = tmp_path_factory.mktemp("toledo strip")

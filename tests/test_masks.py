@@ -297,16 +297,6 @@ def test_align_extracts_no_keypoints_under_the_masks(tmp_path):
 # the Processing algorithm, as QGIS runs it (pytest-qgis)
 # ---------------------------------------------------------------------------
 
-@pytest.fixture(scope="module")
-def plugin(qgis_iface, qgis_processing):
-    import archaeoortho
-
-    p = archaeoortho.classFactory(qgis_iface)
-    p.initProcessing()
-    yield p
-    p.unload()
-
-
 def _polygon_layer(features):
     from qgis.core import QgsFeature, QgsGeometry, QgsPointXY, QgsVectorLayer
 

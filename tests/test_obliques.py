@@ -197,16 +197,6 @@ def test_prepare_stage_writes_sky_masks(two_renders, tmp_path):
     assert not res2.masks
 
 
-@pytest.fixture(scope="module")
-def plugin(qgis_iface, qgis_processing):
-    import archaeoortho
-
-    p = archaeoortho.classFactory(qgis_iface)
-    p.initProcessing()
-    yield p
-    p.unload()
-
-
 def test_processing_exposes_sky_masks_and_the_gsd_factor(plugin, two_renders, tmp_path):
     from qgis import processing
     from qgis.core import QgsApplication

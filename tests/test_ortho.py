@@ -653,16 +653,6 @@ def test_orientation_files_are_read(tmp_path):
 # Processing (pytest-qgis, offscreen)
 # ---------------------------------------------------------------------------
 
-@pytest.fixture(scope="module")
-def plugin(qgis_iface, qgis_processing):
-    import archaeoortho
-
-    p = archaeoortho.classFactory(qgis_iface)
-    p.initProcessing()
-    yield p
-    p.unload()
-
-
 def test_processing_algorithms(scene, plugin, tmp_path):
     from qgis import processing
     from qgis.core import QgsApplication, QgsProcessingException, QgsRasterLayer, QgsVectorLayer

@@ -18,16 +18,6 @@ ALL_ALGORITHMS = ("prepareimages", "alignimages", "georeference", "builddsm", "b
                   "orthorectifyimage", "builddtm", "reliefvisualisation", "contours", "runpipeline")
 
 
-@pytest.fixture(scope="module")
-def plugin(qgis_iface, qgis_processing):
-    import archaeoortho
-
-    p = archaeoortho.classFactory(qgis_iface)
-    p.initProcessing()
-    yield p
-    p.unload()
-
-
 def _dialog(alg_id):
     from processing.gui import ParametersPanel
     from processing.gui.AlgorithmDialog import AlgorithmDialog

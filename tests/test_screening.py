@@ -184,16 +184,6 @@ def test_cancel_leaves_no_complete_looking_output(tmp_path):
 # the Processing algorithm, as QGIS runs it (pytest-qgis)
 # ---------------------------------------------------------------------------
 
-@pytest.fixture(scope="module")
-def plugin(qgis_iface, qgis_processing):
-    import archaeoortho
-
-    p = archaeoortho.classFactory(qgis_iface)
-    p.initProcessing()
-    yield p
-    p.unload()
-
-
 def test_processing_prepare_images(plugin, toledo_with_bad_copies, tmp_path):
     from qgis import processing
     from qgis.core import QgsApplication, QgsProcessingFeedback
