@@ -173,7 +173,7 @@ def low_pits(dsm, depth=1.0, size=5):
     filter grid); PDAL pipelines put filters.elm or filters.outlier before filters.csf for the same reason."""
     from scipy import ndimage
 
-    from core.terrain.ground import push_pull
+    from core.io.raster import push_pull
 
     valid = np.isfinite(dsm)
     med = ndimage.median_filter(push_pull(np.nan_to_num(dsm), valid), size=size, mode="nearest")

@@ -259,6 +259,43 @@ def test_dsm_file_is_a_cog_with_crs_and_nodata(built):
     assert {"matching", "fusion", "dsm", "total"} <= set(st["timings"])
 
 
+def test_dsm_source_raster_says_measured_or_interpolated(built):
+    """dense/dsm-source.tif: the DSM's grid, 1 where a height was measured, 2 where a hole was filled, 0 = nodata;
+    the accuracy against the synthetic truth, measured and interpolated cells apart."""
+    from osgeo import gdal
+
+    block, r = built
+    z, gt, _, x, y, truth = _truth_grid(block, r.dsm_path)
+    assert r.source_path == os.path.join(r.workspace, "dense", "dsm-source.tif")
+    src_ds = gdal.Open(r.source_path)
+    assert (src_ds.RasterXSize, src_ds.RasterYSize) == (z.shape[1], z.shape[0])
+    assert np.allclose(src_ds.GetGeoTransform(), gt) and "32633" in src_ds.GetProjection()
+    assert src_ds.GetMetadataItem("ARCHAEOORTHO_PRODUCT") == "dsm-source"
+    src = src_ds.GetRasterBand(1).ReadAsArray()
+    assert set(np.unique(src)) <= {0, dsm.SOURCE_MEASURED, dsm.SOURCE_INTERPOLATED}
+    assert ((src > 0) == np.isfinite(z)).all()  # nodata exactly where the DSM has none
+    assert r.measured_fraction + r.interpolated_fraction == pytest.approx(r.valid_fraction, abs=1e-6)
+    assert r.measured_fraction >= 0.9 and r.valid_fraction >= 0.99  # the holes inside the cameras' hull are filled
+    st = Workspace.open(r.workspace).stage("dsm")
+    assert st["outputs"]["dsm_source"] == "dense/dsm-source.tif"
+    assert st["results"]["MEASURED_FRACTION"] == pytest.approx(r.measured_fraction)
+    walls = np.zeros(z.shape, dtype=bool)
+    for b in block.scene.buildings:
+        walls |= b.contains(x, y, 2 * gt[1]) & ~b.contains(x, y, -2 * gt[1])
+    err = z - truth
+    measured = (src == dsm.SOURCE_MEASURED) & ~walls
+    rmse = float(np.sqrt(np.mean(err[measured] ** 2)))
+    assert rmse <= 1.5 * block.gsd, f"measured cells: RMSE {rmse:.3f} m > 1.5 GSD"
+    interp = src == dsm.SOURCE_INTERPOLATED
+    assert interp.sum() > 0  # the occlusions beside the walls: filled, and said so
+    # an interpolated cell is a guess from its borders (mostly the ground a wall hides: drawn from the hole's low
+    # side): within the building heights, and mostly within a metre or two (1.25 m median here)
+    assert np.abs(err[interp]).max() <= max(b.roof for b in block.scene.buildings) - truth[np.isfinite(truth)].min()
+    assert np.median(np.abs(err[interp])) <= 2.0
+    print(f"measured {100 * r.measured_fraction:.1f} % (RMSE {rmse:.3f} m), interpolated "
+          f"{100 * r.interpolated_fraction:.1f} % (RMSE {float(np.sqrt(np.mean(err[interp] ** 2))):.2f} m)")
+
+
 def test_point_cloud_las_in_world_coordinates(built):
     block, r = built
     xyz, rgb, header = dsm.read_las(r.point_cloud_path)

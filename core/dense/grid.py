@@ -6,7 +6,8 @@ the *highest cluster* of heights (the points within ``cluster_tol`` of the
 cell's 90th percentile), so a cell on a roof edge shows the roof, not a mean of
 roof and ground, and a lone low point under a crown does not pull it down.
 Small holes (at most ``max_hole_cells`` cells) are filled from their borders;
-larger ones stay nodata.  The grid itself and the GeoTIFF are
+larger ones inside the camera hull by a smooth surface (:func:`fill_region`), up to a
+distance; every filled cell is flagged interpolated (:func:`source_raster`).  The grid itself and the GeoTIFF are
 :mod:`core.io.raster`'s.
 """
 from __future__ import annotations
@@ -19,7 +20,7 @@ import numpy as np
 
 from ..common.errors import require
 from ..common.progress import NullProgress, Progress, check_cancel
-from ..io.raster import Grid
+from ..io.raster import SOURCE_INTERPOLATED, SOURCE_MEASURED, Grid, push_pull
 
 TILE = 1024  # cells per tile side for rasterisation
 
@@ -115,6 +116,80 @@ def fill_small_holes(dsm: np.ndarray, max_hole_cells: int = 16, iterations: int 
             break
         out[todo] = (s[todo] / k[todo]).astype(out.dtype)
     return out
+
+
+def raised_borders(dsm: np.ndarray, holes: np.ndarray, ring_cells: int, step: float) -> np.ndarray:
+    """The cells with data within ``ring_cells`` of a hole that stand more than ``step`` above the lowest tenth
+    of that hole's ring: roofs and crowns beside an occlusion (the hidden cells behind a wall are ground)."""
+    from scipy import ndimage
+
+    lab, n = ndimage.label(holes, structure=np.ones((3, 3)))
+    if n == 0 or ring_cells <= 0:
+        return np.zeros(dsm.shape, dtype=bool)
+    near = ndimage.grey_dilation(lab, size=(2 * ring_cells + 1, 2 * ring_cells + 1))
+    ring = (near > 0) & np.isfinite(dsm) & ~holes
+    if not ring.any():
+        return ring
+    ids, z = near[ring], dsm[ring].astype(np.float64)
+    order = np.lexsort((z, ids))
+    ids, z = ids[order], z[order]
+    starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
+    counts = np.diff(np.r_[starts, len(ids)])
+    low = np.full(n + 1, np.inf)
+    low[ids[starts]] = z[starts + (counts - 1) // 10]  # the 10th percentile of each ring
+    out = np.zeros(dsm.shape, dtype=bool)
+    out[ring] = dsm[ring] > low[near[ring]] + step
+    return out
+
+
+def fill_region(dsm: np.ndarray, region: np.ndarray, max_distance_cells: float, ring_cells: int = 0,
+                step: float = 2.0) -> np.ndarray:
+    """``dsm`` with its nodata cells inside ``region`` filled by a smooth 2.5-D surface from the cells with data
+    (push-pull: :func:`core.io.raster.push_pull`), those at most ``max_distance_cells`` from a cell with data
+    (0 = any distance); the others stay NaN.  With ``ring_cells`` the surface is drawn from the low side of each
+    hole: the cells within ``ring_cells`` of it more than ``step`` metres above its ring's lowest tenth (a roof
+    beside the ground a wall hides) do not pull it up (:func:`raised_borders`)."""
+    cv2 = require("cv2", "the DSM hole fill")
+    known = np.isfinite(dsm)
+    todo = region & ~known
+    if not todo.any() or not known.any():
+        return dsm
+    if max_distance_cells > 0:  # float32 distances (SciPy's would be float64 plus indices: 3 x the memory)
+        dist = cv2.distanceTransform((~known).astype(np.uint8), cv2.DIST_L2, 5)
+        todo &= dist <= max_distance_cells
+        del dist
+    rows, cols = np.nonzero(todo)
+    if len(rows) == 0:
+        return dsm
+    # only the window around the holes (plus a margin of data) goes through the pyramid
+    pad = 64
+    r0, r1 = max(0, rows.min() - pad), min(dsm.shape[0], rows.max() + pad + 1)
+    c0, c1 = max(0, cols.min() - pad), min(dsm.shape[1], cols.max() + pad + 1)
+    win = dsm[r0:r1, c0:c1]
+    base = known[r0:r1, c0:c1] & ~raised_borders(win, todo[r0:r1, c0:c1], ring_cells, step)
+    filled = push_pull(np.nan_to_num(win), base)
+    out = dsm.copy()
+    out[rows, cols] = filled[rows - r0, cols - c0].astype(out.dtype)
+    return out
+
+
+def enclosed_holes(dsm: np.ndarray) -> np.ndarray:
+    """The nodata cells of holes that do not touch the raster's edge (surrounded by data)."""
+    from scipy import ndimage
+
+    lab, n = ndimage.label(~np.isfinite(dsm))
+    if n == 0:
+        return np.zeros(dsm.shape, dtype=bool)
+    inner = np.ones(n + 1, dtype=bool)
+    inner[0] = False
+    inner[np.unique(np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]]))] = False
+    return inner[lab]
+
+
+def source_raster(measured: np.ndarray, dsm: np.ndarray) -> np.ndarray:
+    """uint8 per cell: SOURCE_MEASURED where ``measured``, SOURCE_INTERPOLATED where ``dsm`` holds a height that
+    was not measured (a filled hole), 0 = nodata."""
+    return np.where(measured, SOURCE_MEASURED, np.where(np.isfinite(dsm), SOURCE_INTERPOLATED, 0)).astype(np.uint8)
 
 
 def remove_speckles(dsm: np.ndarray, max_cells: int = 4) -> np.ndarray:

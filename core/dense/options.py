@@ -33,6 +33,10 @@ class DenseOptions:
     min_consistent: int = 2  # pairs that must agree on a pixel
     depth_tolerance_px: float = 1.0  # agreement tolerance, in disparity pixels of the weakest pair
     max_hole_cells: int = 16
+    # holes inside the convex hull of the camera centres (or enclosed by data, for one strip) are filled with a smooth
+    # 2.5-D surface (push-pull from their borders) up to this many metres from a measured cell, and flagged
+    # interpolated in dense/dsm-source.tif; 0 = no such fill (the holes stay nodata)
+    fill_max_distance: float = 50.0
     # no dense point from the sky: pixels whose ray points less than this many degrees below the horizontal (the
     # horizon of the georeferenced pose, core.prepare.sky.horizon_keep) are dropped, as are the black pixels of
     # the images' masks; None = keep everything above the horizon (terrain rising above the cameras)

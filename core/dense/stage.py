@@ -6,9 +6,11 @@
 3. **Fusion per image** (:mod:`.fusion`): a pixel that ``min_consistent`` pairs agree on becomes a point.
 4. **DSM** (:mod:`.grid`): the fused points are rasterised tile by tile at RESOLUTION (default: 2 x the median
    ground sample distance, and never finer than the matching pixel) with the median of the highest height
-   cluster per cell; speckles dropped, small holes filled, large holes left nodata; a float32
+   cluster per cell; speckles dropped, small holes filled, the holes inside the convex hull of the camera
+   centres filled by a smooth 2.5-D surface up to ``fill_max_distance`` from the data; a float32
    Cloud-Optimized GeoTIFF with overviews in the workspace CRS, written atomically
-   (:mod:`core.io.raster`).  Optionally a LAS 1.2 point cloud with RGB.
+   (:mod:`core.io.raster`), and beside it ``dense/dsm-source.tif`` on the same grid: 1 = measured, 2 =
+   interpolated (every filled cell), 0 = nodata.  Optionally a LAS 1.2 point cloud with RGB.
 
 Engine ``cuda`` runs COLMAP's patch-match stereo and fusion instead of 2-3 (:mod:`.points`; only where
 pycolmap was built with CUDA: ``pycolmap.has_cuda``); the DSM step is the same.
@@ -60,6 +62,9 @@ class DsmStageResult:
     timings: Dict[str, float]
     warnings: List[str] = field(default_factory=list)
     log_lines: List[str] = field(default_factory=list)
+    source_path: str = ""  # dense/dsm-source.tif: 1 measured, 2 interpolated, 0 nodata
+    measured_fraction: Optional[float] = None  # of the cells inside the camera centres' hull
+    interpolated_fraction: Optional[float] = None
 
 
 class _Journal:
@@ -148,8 +153,9 @@ def build_dsm_workspace(workspace_dir: str, resolution: float = 0.0, quality: st
         t0 = time.time()
         meta = {"ARCHAEOORTHO_STAGE": "dsm", "RESOLUTION": res, "QUALITY": options.quality, "ENGINE": engine,
                 "PAIRS": n_pairs, "POINTS": n_points}
-        grid, valid_fraction = _write_dsm(dsm_path, point_files, views, offset, crs, res, gsd, options, meta,
-                                          progress)
+        grid, fractions = _write_dsm(dsm_path, lay.dsm_source, point_files, views, offset, crs, res, gsd, options,
+                                     meta, progress)
+        valid_fraction = fractions["valid"]
         job.timings["dsm"] = time.time() - t0
 
         # 5. point cloud
@@ -161,25 +167,28 @@ def build_dsm_workspace(workspace_dir: str, resolution: float = 0.0, quality: st
             job.log.append(f"point cloud: {n_written} points -> {pc_path}")
         job.timings["total"] = time.time() - job.t_start
         job.log.append("seconds: " + ", ".join(f"{k.replace('_', ' ')} {v:.1f}" for k, v in job.timings.items()))
-        job.log.append(f"DSM {grid.width} x {grid.height} cells at {res:g} m, valid fraction {valid_fraction:.3f} "
-                       "inside the convex hull of the camera centres")
+        job.log.append(f"DSM {grid.width} x {grid.height} cells at {res:g} m, inside the convex hull of the camera "
+                       f"centres {100 * fractions['measured']:.1f} % measured, {100 * fractions['interpolated']:.1f} % "
+                       f"interpolated (filled holes, flagged in {lay.rel(lay.dsm_source)})")
         for line in job.log[-2:]:
             progress.info(line)
         for k, v in job.timings.items():
             if k != "total":
                 ws.record_timing(DSM, k, v)
-        outputs = {"dsm": lay.rel(dsm_path)}
+        outputs = {"dsm": lay.rel(dsm_path), "dsm_source": lay.rel(lay.dsm_source)}
         if pc_path:
             outputs["point_cloud"] = lay.rel(pc_path)
         run.finish(outputs=outputs,
-                   results={"VALID_FRACTION": valid_fraction, "pairs": n_pairs, "pairs_reused": n_reused,
+                   results={"VALID_FRACTION": valid_fraction, "MEASURED_FRACTION": fractions["measured"],
+                            "INTERPOLATED_FRACTION": fractions["interpolated"], "pairs": n_pairs, "pairs_reused": n_reused,
                             "points": n_points, "resolution": res, "gsd": gsd, "width": grid.width,
                             "height": grid.height, "warnings": job.warnings})
     progress.report(1.0, f"DSM: {grid.width} x {grid.height} cells at {res:g} m")
     return DsmStageResult(workspace=ws.root, dsm_path=dsm_path, point_cloud_path=pc_path, crs=crs or "",
                           resolution=res, valid_fraction=valid_fraction, pairs=n_pairs, pairs_reused=n_reused,
                           points=n_points, timings={k: round(v, 3) for k, v in job.timings.items()},
-                          warnings=job.warnings, log_lines=job.log)
+                          warnings=job.warnings, log_lines=job.log, source_path=lay.dsm_source,
+                          measured_fraction=fractions["measured"], interpolated_fraction=fractions["interpolated"])
 
 
 def _checked_arguments(options: Optional[DenseOptions], quality: str, engine: str,
@@ -271,26 +280,43 @@ def _pairs(views: Dict[int, View], xyz: np.ndarray, tracks: Sequence[np.ndarray]
     return pairs, stats
 
 
-def _write_dsm(dsm_path: str, point_files: List[PointFile], views: Dict[int, View], offset: np.ndarray,
-               crs: Optional[str], res: float, gsd: float, options: DenseOptions, metadata: dict,
-               progress: Progress) -> Tuple[raster.Grid, float]:
-    """Rasterise the points, clean the raster, write the COG; (grid, valid fraction inside the cameras' hull)."""
+def _write_dsm(dsm_path: str, source_path: str, point_files: List[PointFile], views: Dict[int, View],
+               offset: np.ndarray, crs: Optional[str], res: float, gsd: float, options: DenseOptions, metadata: dict,
+               progress: Progress) -> Tuple[raster.Grid, Dict[str, float]]:
+    """Rasterise the points, clean the raster, fill its holes inside the cameras' hull, write the COG and its
+    source raster (1 measured, 2 interpolated); (grid, fractions: 'valid', 'measured', 'interpolated' of the cells
+    inside the cameras' hull, or of the raster for one strip)."""
     check_cancel(progress)
     boxes = np.array([pf.robust_bbox for pf in point_files if pf.count > 0])
     xmin, ymin = boxes[:, 0].min() + offset[0], boxes[:, 1].min() + offset[1]
     xmax, ymax = boxes[:, 2].max() + offset[0], boxes[:, 3].max() + offset[1]
     grid = raster.Grid.covering(xmin, ymin, xmax, ymax, res)
     dsm, _counts = gridding.rasterize_points(point_files, grid, offset, cluster_tol=max(3 * res, 4 * gsd),
-                                             progress=SubProgress(progress, 0.88, 0.93))
+                                             progress=SubProgress(progress, 0.88, 0.92))
     del _counts
     dsm = gridding.remove_speckles(dsm, max_cells=4)
+    measured = np.isfinite(dsm)
     dsm = gridding.fill_small_holes(dsm, options.max_hole_cells)
     centres = np.array([v.centre[:2] + offset[:2] for v in views.values()])
-    hull = gridding.convex_hull_xy(centres)
-    valid_fraction = gridding.footprint_valid_fraction(dsm, gridding.polygon_mask(grid, hull))
-    if valid_fraction is None:  # one strip: the hull is a line; use the cells the points cover
-        valid_fraction = float(np.isfinite(dsm).mean())
+    hull = gridding.polygon_mask(grid, gridding.convex_hull_xy(centres))
+    if not hull.any():  # one strip: the hull is a line; judge (and fill) the cells the data surrounds
+        hull = None
+    if options.fill_max_distance > 0:
+        check_cancel(progress)
+        region = hull if hull is not None else gridding.enclosed_holes(dsm)
+        dsm = gridding.fill_region(dsm, region, options.fill_max_distance / res,
+                                   ring_cells=max(2, int(round(3.0 / res))), step=2.0)
+    source = gridding.source_raster(measured, dsm)
+    judged = source[hull] if hull is not None else source
+    fractions = {"valid": float((judged > 0).mean()), "measured": float((judged == raster.SOURCE_MEASURED).mean()),
+                 "interpolated": float((judged == raster.SOURCE_INTERPOLATED).mean())}
     check_cancel(progress)
-    raster.write_cog(dsm_path, dsm, grid.geotransform, crs, progress=SubProgress(progress, 0.93, 0.97),
-                     metadata=dict(metadata, VALID_FRACTION=round(valid_fraction, 4)))
-    return grid, valid_fraction
+    figures = {"VALID_FRACTION": round(fractions["valid"], 4), "MEASURED_FRACTION": round(fractions["measured"], 4),
+               "INTERPOLATED_FRACTION": round(fractions["interpolated"], 4)}
+    # the source first: a complete DSM always has its own beside it
+    raster.write_classes(source_path, source, grid.geotransform, crs,
+                         f"DSM source: {raster.SOURCE_MEASURED} measured, {raster.SOURCE_INTERPOLATED} interpolated",
+                         dict(figures, ARCHAEOORTHO_PRODUCT="dsm-source", DSM=os.path.basename(dsm_path)))
+    raster.write_cog(dsm_path, dsm, grid.geotransform, crs, progress=SubProgress(progress, 0.92, 0.96),
+                     metadata=dict(metadata, **figures))
+    return grid, fractions

@@ -155,6 +155,70 @@ def write_cog(path: str, array: np.ndarray, geotransform: Sequence[float], crs: 
     return path
 
 
+# measured / interpolated: the values of the source rasters beside a DSM (dense/dsm-source.tif) or a DTM
+# (terrain/dtm-source.tif); 0 = nodata
+SOURCE_MEASURED = 1
+SOURCE_INTERPOLATED = 2
+
+
+def write_classes(path: str, array: np.ndarray, geotransform: Sequence[float], crs: Optional[str],
+                  description: str, metadata: Optional[dict] = None) -> str:
+    """A class raster (small integers, 0 = nodata, e.g. SOURCE_MEASURED / SOURCE_INTERPOLATED) as a COG on the
+    grid ``geotransform``, written atomically like :func:`write_cog`."""
+    data = np.where(array > 0, array.astype(np.float32), np.nan)
+    return write_cog(path, data, geotransform, crs, nodata=0.0, description=description, metadata=metadata)
+
+
+def push_pull(z: np.ndarray, known: np.ndarray) -> np.ndarray:
+    """``z`` with the unknown cells filled from the known ones: a pyramid of means (push) and back (pull, bilinear),
+    relaxed a few times at each level (a smooth membrane).  Unknown everywhere: NaN."""
+    z = np.where(known, z, 0.0).astype(np.float64)
+    if not known.any():
+        return np.full(z.shape, np.nan)
+    if known.all():
+        return z
+    h, w = z.shape
+    if h <= 2 and w <= 2:
+        return np.where(known, z, z[known].mean())
+    # push: 2 x 2 block means of the known cells
+    hp, wp = h + h % 2, w + w % 2
+    zs = np.zeros((hp, wp))
+    ws = np.zeros((hp, wp))
+    zs[:h, :w] = z * known
+    ws[:h, :w] = known
+    zsum = zs.reshape(hp // 2, 2, wp // 2, 2).sum(axis=(1, 3))
+    wsum = ws.reshape(hp // 2, 2, wp // 2, 2).sum(axis=(1, 3))
+    coarse_known = wsum > 0
+    coarse = push_pull(np.where(coarse_known, zsum / np.maximum(wsum, 1e-12), 0.0), coarse_known)
+    # pull: bilinear back onto this level's cell centres
+    up = _upsample(coarse, h, w)
+    out = np.where(known, z, up)
+    unknown = ~known
+    for _ in range(4):  # Jacobi relaxation of the unknown cells (edges replicated)
+        p = np.pad(out, 1, mode="edge")
+        avg = 0.25 * (p[:-2, 1:-1] + p[2:, 1:-1] + p[1:-1, :-2] + p[1:-1, 2:])
+        out[unknown] = avg[unknown]
+    return out
+
+
+def _upsample(coarse: np.ndarray, h: int, w: int) -> np.ndarray:
+    """Bilinear values of a 2x coarser grid at the centres of an h x w grid (edges replicated)."""
+    ch, cw = coarse.shape
+    fr = np.clip((np.arange(h) + 0.5) / 2.0 - 0.5, 0, ch - 1)
+    fc = np.clip((np.arange(w) + 0.5) / 2.0 - 0.5, 0, cw - 1)
+    r0 = np.minimum(np.floor(fr).astype(int), max(ch - 2, 0))
+    c0 = np.minimum(np.floor(fc).astype(int), max(cw - 2, 0))
+    r1 = np.minimum(r0 + 1, ch - 1)
+    c1 = np.minimum(c0 + 1, cw - 1)
+    ty = (fr - r0)[:, None]
+    tx = (fc - c0)[None, :]
+    a = coarse[np.ix_(r0, c0)]
+    b = coarse[np.ix_(r0, c1)]
+    c = coarse[np.ix_(r1, c0)]
+    d = coarse[np.ix_(r1, c1)]
+    return (1 - ty) * ((1 - tx) * a + tx * b) + ty * ((1 - tx) * c + tx * d)
+
+
 # ---------------------------------------------------------------------------
 # reading (our DSM or an external one, e.g. ALS)
 # ---------------------------------------------------------------------------

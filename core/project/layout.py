@@ -38,10 +38,12 @@ RESIDUALS_JSON = "residuals.json"
 RESIDUALS_GPKG = "residuals.gpkg"
 FOOTPRINTS_GPKG = "footprints.gpkg"  # written by the dock (ui/layers.py)
 CONTROL_JSON = "control.json"
+AUTOCONTROL_JSON = "autocontrol.json"  # the automatic control's candidates (role auto) and figures
 EDITOR_JSON = "gcp_editor.json"
 ADJUSTMENT_INPUTS_JSON = "adjustment_inputs.json"
 DENSE_DIR = "dense"
 DSM_TIF = "dsm.tif"
+DSM_SOURCE_TIF = "dsm-source.tif"  # in dense/: 1 measured, 2 interpolated (a hole filled), 0 nodata
 ORTHOMOSAIC_TIF = "orthomosaic.tif"
 REPORT_HTML = "report.html"
 UNCERTAINTY_DIR = "uncertainty"
@@ -182,6 +184,10 @@ class Layout:
         return self.path(GEOREF_DIR, CONTROL_JSON)
 
     @property
+    def autocontrol_json(self) -> str:
+        return self.path(GEOREF_DIR, AUTOCONTROL_JSON)
+
+    @property
     def editor_json(self) -> str:
         return self.path(GEOREF_DIR, EDITOR_JSON)
 
@@ -225,6 +231,11 @@ class Layout:
     @property
     def default_dsm(self) -> str:
         return self.path(DSM_TIF)
+
+    @property
+    def dsm_source(self) -> str:
+        """Beside the DSM, on its grid: which cells are measured (1) and which interpolated (2, holes filled)."""
+        return self.path(DENSE_DIR, DSM_SOURCE_TIF)
 
     def dsm(self) -> Optional[str]:
         """The workspace's DSM: the DSM stage's recorded output, else <workspace>/dsm.tif; None if absent."""

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 from typing import Tuple
 
 from ..common.errors import ArchaeoOrthoError
+from ..io import raster
 
 # the relief visualisations (Processing enum order; file name = key)
 VISUALISATIONS: Tuple[Tuple[str, str], ...] = (
@@ -20,9 +21,9 @@ VISUALISATIONS: Tuple[Tuple[str, str], ...] = (
 )
 VISUALISATION_KEYS = tuple(k for k, _ in VISUALISATIONS)
 
-# measured ground / interpolated: the values of the DTM's source raster (terrain/dtm-source.tif)
-SOURCE_MEASURED = 1
-SOURCE_INTERPOLATED = 2
+# measured ground / interpolated: the values of the DTM's source raster (terrain/dtm-source.tif), the DSM's
+SOURCE_MEASURED = raster.SOURCE_MEASURED
+SOURCE_INTERPOLATED = raster.SOURCE_INTERPOLATED
 
 
 class TerrainError(ArchaeoOrthoError, RuntimeError):

@@ -83,10 +83,8 @@ def write_float(path: str, array: np.ndarray, elev: Elevation, description: str,
 
 
 def write_classes(path: str, array: np.ndarray, elev: Elevation, description: str, metadata: dict) -> str:
-    """A class raster (small integers, 0 = nodata) as a COG on the grid of ``elev``."""
-    data = np.where(array > 0, array.astype(np.float32), np.nan)
-    return raster.write_cog(path, data, elev.geotransform, elev.crs_wkt or None, nodata=0.0,
-                            description=description, metadata=metadata)
+    """A class raster (small integers, 0 = nodata) as a COG on the grid of ``elev`` (core.io.raster.write_classes)."""
+    return raster.write_classes(path, array, elev.geotransform, elev.crs_wkt or None, description, metadata)
 
 
 def same_grid(a: str, b: str) -> Optional[str]:
