@@ -529,17 +529,70 @@ def _canvas_geometry(camera: CameraModel, s: int):
     return canvas_xn, map_x, map_y, vignetting
 
 
+@dataclass(frozen=True)
+class Radiometry:
+    """A known radiometric model for :func:`render_image` (issue 14): instead of the fixed vignetting, the radial
+    fall-off ``1 + k1 r^2 + k2 r^4`` (r = distance from the principal point / the half diagonal), a hot spot
+    ``1 + hot * exp(-theta^2 / (2 hot_width^2))`` (theta = angle between the view ray and the direction the
+    sunlight travels: the sun at ``sun_azimuth_deg`` (from local +x towards +y) and ``sun_elevation_deg``), and
+    per image an exposure gain exp(N(0, exposure_sigma)) times a linear ramp of +-``ramp`` across the image in a
+    random direction (light that changed between the photos)."""
+
+    k1: float = -0.25
+    k2: float = 0.05
+    hot: float = 0.12
+    hot_width_deg: float = 10.0
+    sun_azimuth_deg: float = 200.0
+    sun_elevation_deg: float = 65.0
+    exposure_sigma: float = 0.08
+    ramp: float = 0.03
+
+    def falloff(self, r: np.ndarray) -> np.ndarray:
+        r2 = np.asarray(r, dtype=float) ** 2
+        return 1.0 + self.k1 * r2 + self.k2 * r2 * r2
+
+    def antisolar(self) -> np.ndarray:
+        """The direction the sunlight travels (local frame, z up): a view ray along it sees the hot spot."""
+        a, e = math.radians(self.sun_azimuth_deg), math.radians(self.sun_elevation_deg)
+        return -np.array([math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), math.sin(e)])
+
+    def hot_spot(self, rays: np.ndarray) -> np.ndarray:
+        d = rays / np.linalg.norm(rays, axis=-1, keepdims=True)
+        theta = np.arccos(np.clip(d @ self.antisolar(), -1.0, 1.0))
+        return 1.0 + self.hot * np.exp(-0.5 * (theta / math.radians(self.hot_width_deg)) ** 2)
+
+    def image_gain(self, camera: CameraModel, seed: int) -> np.ndarray:
+        """(height, width) exposure gain x ramp of one image (seeded)."""
+        rng = np.random.default_rng(10_007 + seed)
+        g = math.exp(rng.normal(0.0, self.exposure_sigma))
+        a = rng.uniform(0.0, 2 * math.pi)
+        jj, ii = np.meshgrid(np.arange(camera.width) + 0.5, np.arange(camera.height) + 0.5)
+        t = ((jj - camera.width / 2) * math.cos(a) + (ii - camera.height / 2) * math.sin(a)) / (0.5 * math.hypot(
+            camera.width, camera.height))
+        return (g * (1.0 + self.ramp * t)).astype(np.float32)
+
+    def pixel_falloff(self, camera: CameraModel) -> np.ndarray:
+        jj, ii = np.meshgrid(np.arange(camera.width) + 0.5, np.arange(camera.height) + 0.5)
+        r = np.hypot(jj - camera.cx, ii - camera.cy) / (0.5 * math.hypot(camera.width, camera.height))
+        return self.falloff(r).astype(np.float32)
+
+
 def render_image(scene: Scene, camera: CameraModel, shot: Shot, supersample: int = 2, noise: float = 1.5,
-                 seed: int = 0) -> np.ndarray:
+                 seed: int = 0, radiometry: Optional[Radiometry] = None) -> np.ndarray:
     """Grey uint8 image (height, width) of ``shot``: the undistorted canvas (``supersample`` x the pixel
     density) is ray-cast into the height field, blurred a little (optics, anti-aliasing), and the lens
     distortion is applied with cv2.remap: each distorted pixel takes the canvas value at its undistorted
-    position.  Vignetting and sensor noise added."""
+    position.  Vignetting and sensor noise added; with ``radiometry`` its fall-off, hot spot and per-image gain
+    instead of the fixed vignetting."""
     s = int(supersample)
     canvas_xn, map_x, map_y, vignetting = _canvas_geometry(camera, s)
-    xyz = _ray_cast(scene, shot.centre, shot.rays(canvas_xn))
+    rays = shot.rays(canvas_xn)
+    xyz = _ray_cast(scene, shot.centre, rays)
     canvas = _surface_value(scene, xyz).astype(np.float32)
     del xyz
+    if radiometry is not None:
+        canvas = canvas * radiometry.hot_spot(rays).astype(np.float32)
+        vignetting = radiometry.pixel_falloff(camera) * radiometry.image_gain(camera, seed)
     canvas = cv2.GaussianBlur(canvas, (0, 0), 0.45 * s)
     img = cv2.remap(canvas, map_x, map_y, cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE)
     img = img * vignetting * 255.0
@@ -752,11 +805,13 @@ class SyntheticBlock:
         return out, noise
 
     # ---- images
-    def render(self, folder: str, supersample: int = 2, ext: str = ".jpg", quality: int = 95) -> List[str]:
+    def render(self, folder: str, supersample: int = 2, ext: str = ".jpg", quality: int = 95,
+               radiometry: Optional["Radiometry"] = None) -> List[str]:
         os.makedirs(folder, exist_ok=True)
         paths = []
         for k, s in enumerate(self.shots):
-            img = render_image(self.scene, self.camera, s, supersample, seed=self.seed * 1000 + k)
+            img = render_image(self.scene, self.camera, s, supersample, seed=self.seed * 1000 + k,
+                               radiometry=radiometry)
             path = os.path.join(folder, s.name if s.name.lower().endswith(ext) else s.name + ext)
             params = [cv2.IMWRITE_JPEG_QUALITY, quality] if ext.lower() in (".jpg", ".jpeg") else []
             if not cv2.imwrite(path, cv2.cvtColor(img, cv2.COLOR_GRAY2BGR), params):

@@ -20,6 +20,7 @@ from .cameras import OrthoCamera
 from .grid import _box_intersects, _tiles
 from .options import OrthoOptions
 from .pixels import _CACHE, _gdal
+from .radiometry_fit import fit_radiometry
 from .seams import _Plan, _plan_mosaic
 from .surface import _Dsm, fill_dsm_gaps
 from .tiles import _DSM_CACHE, _render_tile, _TileUnit
@@ -42,6 +43,7 @@ class MosaicResult:
     per_image: Dict[str, str] = field(default_factory=dict)
     seamlines_path: Optional[str] = None
     gains: Dict[str, float] = field(default_factory=dict)
+    radiometry: Dict[str, Any] = field(default_factory=dict)  # the fitted model's figures (core.ortho.radiometry)
     timings: Dict[str, float] = field(default_factory=dict)
     warnings: List[str] = field(default_factory=list)
     log_lines: List[str] = field(default_factory=list)
@@ -102,9 +104,10 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
                        f"{100 * plan.seam_after:.1f} % after moving them to where the images agree; exposure gains "
                        f"{min(plan.gains):.3f}..{max(plan.gains):.3f}")
             progress.info(log[-1])
+            model, summary = _radiometry(prep, dsm, offset, plan, options, log, timings, SubProgress(progress, 0.2, 0.25))
             t0 = time.time()
             n_valid, fill_cells = _run_tiles(prep, plan, dsm_path, crs, offset, output, options, bands, dtype,
-                                             SubProgress(progress, 0.2, 0.85 if per_image_folder else 0.97))
+                                             SubProgress(progress, 0.25, 0.85 if per_image_folder else 0.97), model)
             timings["mosaic"] = time.time() - t0
             valid_fraction = n_valid / float(grid.width * grid.height)
             labels = np.load(plan.labels_path)
@@ -131,7 +134,7 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
             return MosaicResult(path=output, crs=crs, resolution=grid.resolution, gsd=prep.gsd, width=grid.width,
                                 height=grid.height, images=[c.name for c in prep.cameras],
                                 valid_fraction=valid_fraction, per_image=per_image, seamlines_path=seamlines_path,
-                                gains={c.name: g for c, g in zip(prep.cameras, plan.gains)},
+                                gains={c.name: g for c, g in zip(prep.cameras, plan.gains)}, radiometry=summary,
                                 timings={k: round(v, 3) for k, v in timings.items()}, warnings=prep.warnings,
                                 log_lines=log)
     finally:
@@ -141,8 +144,27 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
         shutil.rmtree(workdir, ignore_errors=True)
 
 
+def _radiometry(prep: _Prepared, dsm: _Dsm, offset, plan: _Plan, options: OrthoOptions, log: List[str],
+                timings: Dict[str, float], progress: Progress):
+    """The radiometric model (core.ortho.radiometry_fit) when asked for, its lines in ``log``; with a model
+    the plan's exposure gains become the model's gains at the images' centres (the which-image layer's)."""
+    if not options.radiometry:
+        return None, {}
+    t0 = time.time()
+    model, lines = fit_radiometry(prep, dsm, offset, np.load(plan.labels_path), plan.k, plan.gains,
+                                  options.hot_spot, progress)
+    timings["radiometry"] = time.time() - t0
+    for line in lines:
+        log.append(line)
+        progress.info(line)
+    if model is None:
+        return None, {}
+    plan.gains = [model.scalar_gain(i) for i in range(len(prep.cameras))]
+    return model, dict(model.summary)
+
+
 def _run_tiles(prep: _Prepared, plan: _Plan, dsm_path: str, crs, offset, output: str, options: OrthoOptions,
-               bands: int, dtype: str, progress: Progress) -> Tuple[int, int]:
+               bands: int, dtype: str, progress: Progress, radiometry=None) -> Tuple[int, int]:
     grid = prep.grid
     work = os.path.join(os.path.dirname(os.path.abspath(output)), ".work-" + os.path.basename(output))
     writer = _RasterWriter(work, grid.width, grid.height, bands, dtype, grid.geotransform, crs)
@@ -168,7 +190,7 @@ def _run_tiles(prep: _Prepared, plan: _Plan, dsm_path: str, crs, offset, output:
         units.append(_TileUnit(i, r0, c0, h, w, halo, asdict(grid), dsm_path, crs, [float(v) for v in offset],
                                prep.cameras, prep.metas, prep.visibility, present, others, plan.gains,
                                plan.labels_path, k, (plan.height, plan.width), plan.feather_cells, options.blending,
-                               options.interpolation, options.cache_mb))
+                               options.interpolation, options.cache_mb, radiometry))
     del labels
     n_valid = 0
     fill = 0

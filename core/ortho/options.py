@@ -32,6 +32,10 @@ class OrthoOptions:
     height_tolerance: float = 0.0  # m below the sight line still counted visible; 0 = max(0.1, DSM cell)
     fill_dsm_gaps_m: float = 25.0  # DSM gaps inside the data's hull, up to this far from a height, interpolated
     exposure: bool = True  # per-image gain compensation in the mosaic
+    # vignetting and hot spot fitted from the overlaps and removed, seams levelled by a smooth gain field per image
+    # (core.ortho.radiometry; applied only where it makes the overlaps agree better); replaces the exposure gains
+    radiometry: bool = True
+    hot_spot: bool = True  # with radiometry: also the sun-relative hot spot
     avoid_relief: bool = True  # keep seamlines off buildings and trees
     seam_iterations: int = 2  # passes moving the seamlines towards where the images agree (0 = off)
     seam_alpha: float = 5.0  # weight of the view cost against the seam cost in those moves

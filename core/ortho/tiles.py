@@ -14,6 +14,7 @@ from .blend import _multiband
 from .cameras import OrthoCamera
 from .grid import _cell_centres
 from .pixels import _CACHE, ImageMeta
+from .radiometry import RadiometryModel, point_gains
 from .sampling import sample_camera
 from .surface import _Dsm
 from .visibility import Visibility
@@ -46,6 +47,7 @@ class _TileUnit:
     blending: str
     interpolation: str
     cache_mb: int
+    radiometry: Optional[RadiometryModel] = None  # the per-point correction (replaces ``gains``)
 
 
 _DSM_CACHE: Dict[Tuple[str, Optional[str]], _Dsm] = {}
@@ -104,7 +106,7 @@ def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str
         s = sample_camera(cam, unit.metas[ci], off, x, y, z, unit.visibility[ci], unit.interpolation)
         if not s.valid.any():
             continue
-        vals = s.values * np.float32(unit.gains[ci])
+        vals = s.values * point_gains(unit.radiometry, unit.gains[ci], ci, cam, off, x, y, z, s.valid)
         if unit.blending == "feather" and unit.feather_cells > 0:
             onehot = (lab == ci).astype(np.float32)
             ksz = 2 * unit.feather_cells + 1
@@ -136,7 +138,8 @@ def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str
             better = s.valid & (s.cost < fill_cost[idx])
             if better.any():
                 sel = idx[better]
-                fill_vals[sel] = s.values[better] * np.float32(unit.gains[ci])
+                fill_vals[sel] = s.values[better] * point_gains(unit.radiometry, unit.gains[ci], ci, unit.cameras[ci],
+                                                                off, x[sel], y[sel], z[sel], np.ones(len(sel), bool))
                 fill_cost[sel] = s.cost[better]
                 counts[ci] = counts.get(ci, 0) + int(better.sum())
         filled = need & np.isfinite(fill_cost)

@@ -1,0 +1,211 @@
+"""Radiometry of the mosaic (issue 14): per camera the radial fall-off (vignetting) and the hot spot, fitted from
+the overlaps of the photos and removed, then a smooth gain field per image that levels the seams.
+
+The model, in the log of the grey value of ground point p in image i of camera group g:
+
+    log I_i(p) = log L(p) + f_g(r) + h_g * exp(-theta^2 / (2 s^2)) + b_i + c_i . phi(u, v)
+
+with f_g(r) = a1 r^2 + a2 r^4 + a3 r^6 (r: distance from the principal point / the half diagonal), theta the angle
+between the view ray and the direction the sunlight travels (one direction and width s for the block, found by a
+grid search), b_i one exposure per image, and phi = (1, u, v, u^2, uv, v^2) a low-order field over the image
+(u, v in -1..1), fitted last and held near 1.  The unknown ground L(p) cancels in the differences of two images
+at one cell, which are fitted by iteratively reweighted least squares (Cauchy weights: moving things, shadows
+and misregistration count little).  The correction divides the model out; its mean over the sampled cells is 1,
+so the mosaic keeps its overall brightness.  The fit lives in :mod:`core.ortho.radiometry_fit`."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from .block import _Prepared
+from .cameras import OrthoCamera
+from .sampling import sample_camera
+from .surface import _Dsm
+
+FIELD_TERMS = 6  # 1, u, v, u^2, uv, v^2
+MAX_CORRECTION = 2.0  # the correction stays within 1 / this .. this
+CHUNK = 8  # cells of a chunk in which the disagreement of two images is one median
+
+
+@dataclass
+class RadiometryModel:
+    """The fitted model (picklable: it travels with each mosaic tile to the workers)."""
+
+    groups: List[int]  # per image: its camera group (index into falloff / hot)
+    falloff: List[List[float]]  # per group: a1, a2, a3 of f(r) (log)
+    hot: List[float]  # per group: amplitude (log)
+    antisolar: List[float]  # unit vector, local frame: the direction the sunlight travels
+    hot_width: float  # radians
+    exposure: List[float]  # per image: b_i (log)
+    fields: List[List[float]]  # per image: FIELD_TERMS coefficients (log)
+    norm: float = 0.0  # added to every log correction (the mean correction over the samples is 1)
+    summary: Dict[str, object] = field(default_factory=dict)
+
+    def falloff_at(self, group: int, r) -> np.ndarray:
+        """The fitted fall-off V(r) = exp(f(r)) of a camera group (1 at the principal point)."""
+        r2 = np.asarray(r, dtype=float) ** 2
+        a1, a2, a3 = self.falloff[group]
+        return np.exp(a1 * r2 + a2 * r2 ** 2 + a3 * r2 ** 3)
+
+    def log_model(self, images: np.ndarray, r: np.ndarray, u: np.ndarray, v: np.ndarray, rays: np.ndarray,
+                  terms: str = "vhef") -> np.ndarray:
+        """The model's log brightness factor of observations (image index, r, u, v, unit view rays (N, 3)):
+        ``terms`` any of v (fall-off), h (hot spot), e (exposure), f (field)."""
+        images = np.asarray(images, dtype=np.int64)
+        out = np.zeros(len(images), dtype=np.float64)
+        g = np.asarray(self.groups, dtype=np.int64)[images]
+        if "v" in terms:
+            a = np.asarray(self.falloff, dtype=np.float64)[g]
+            r2 = np.asarray(r, dtype=np.float64) ** 2
+            out += a[:, 0] * r2 + a[:, 1] * r2 ** 2 + a[:, 2] * r2 ** 3
+        if "h" in terms and any(h != 0.0 for h in self.hot):
+            out += np.asarray(self.hot, dtype=np.float64)[g] * hot_spot_shape(rays, self.antisolar, self.hot_width)
+        if "e" in terms:
+            out += np.asarray(self.exposure, dtype=np.float64)[images]
+        if "f" in terms:
+            c = np.asarray(self.fields, dtype=np.float64)[images]
+            out += np.einsum("nk,nk->n", c, field_terms(u, v))
+        return out
+
+    def correction(self, images, r, u, v, rays) -> np.ndarray:
+        """Multiplicative correction (N,) float32 of observations: exp(norm - model), within the bounds."""
+        lc = self.norm - self.log_model(images, r, u, v, rays)
+        return np.exp(np.clip(lc, -math.log(MAX_CORRECTION), math.log(MAX_CORRECTION))).astype(np.float32)
+
+    def scalar_gain(self, image: int) -> float:
+        """The correction of an image at its principal point (for the which-image layer's gain field)."""
+        return float(math.exp(self.norm - self.exposure[image] - self.fields[image][0]))
+
+
+def field_terms(u, v) -> np.ndarray:
+    u = np.asarray(u, dtype=np.float64)
+    v = np.asarray(v, dtype=np.float64)
+    return np.stack([np.ones_like(u), u, v, u * u, u * v, v * v], axis=-1)
+
+
+def hot_spot_shape(rays: np.ndarray, antisolar: Sequence[float], width: float) -> np.ndarray:
+    """exp(-theta^2 / (2 width^2)) of unit rays (N, 3) against the antisolar direction."""
+    cosang = np.clip(np.asarray(rays, dtype=np.float64) @ np.asarray(antisolar, dtype=np.float64), -1.0, 1.0)
+    theta = np.arccos(cosang)
+    return np.exp(-0.5 * (theta / width) ** 2)
+
+
+def observation_geometry(cam: OrthoCamera, xyz_local: np.ndarray):
+    """(ok, r, u, v, unit rays) of local ground points in one image: r from the principal point / the half
+    diagonal, u and v from the image centre / the half width and height (-1..1)."""
+    px, _depth, ok = cam.project(xyz_local)
+    w, h = cam.camera.width, cam.camera.height
+    r = np.hypot(px[:, 0] - cam.camera.cx, px[:, 1] - cam.camera.cy) / (0.5 * math.hypot(w, h))
+    u = (px[:, 0] - 0.5 * w) / (0.5 * w)
+    v = (px[:, 1] - 0.5 * h) / (0.5 * h)
+    d = np.asarray(xyz_local, dtype=np.float64) - cam.centre
+    rays = d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-12)
+    return ok, r, u, v, rays
+
+
+def point_gains(model: Optional[RadiometryModel], gain: float, index: int, cam: OrthoCamera,
+                offset: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """(N, 1) float32 factors of world points (x, y, z) of image ``index`` in the mosaic: the radiometric
+    correction where ``valid`` (1 elsewhere), or the scalar exposure ``gain`` without a model."""
+    n = len(x)
+    if model is None:
+        return np.full((n, 1), gain, dtype=np.float32)
+    out = np.ones((n, 1), dtype=np.float32)
+    idx = np.flatnonzero(valid)
+    if not len(idx):
+        return out
+    xyz = np.column_stack([x[idx] - offset[0], y[idx] - offset[1], np.nan_to_num(z[idx]) - offset[2]])
+    _ok, r, u, v, rays = observation_geometry(cam, xyz)
+    out[idx, 0] = model.correction(np.full(len(idx), index), r, u, v, rays)
+    return out
+
+
+def _scale(dtype: str) -> float:
+    dt = np.dtype(dtype)
+    return float(np.iinfo(dt).max) if dt.kind in "ui" else 0.0
+
+
+def _grey_ok(values: np.ndarray, valid: np.ndarray, scale: float) -> Tuple[np.ndarray, np.ndarray]:
+    """(grey, usable): the band mean, usable where valid, not dark (3 % of full scale) and no band saturated."""
+    grey = values.mean(axis=1)
+    ok = valid & (grey > (0.03 * scale if scale else 0.0))
+    if scale:
+        ok &= values.max(axis=1) < 0.97 * scale
+    return grey, ok
+
+
+def chunk_disagreement(images_a: np.ndarray, images_b: np.ndarray, cells: np.ndarray, cols: int,
+                       diff: np.ndarray, min_count: int = 4) -> float:
+    """Median over chunks (two images, CHUNK x CHUNK cells) of |the chunk's median log difference|, as a
+    fraction (exp - 1); nan without a chunk."""
+    if not len(diff):
+        return float("nan")
+    lo, hi = np.minimum(images_a, images_b), np.maximum(images_a, images_b)
+    sign = np.where(images_a <= images_b, 1.0, -1.0)
+    rr, cc = np.divmod(cells, cols)
+    n_img, br, bc = int(hi.max()) + 1, int(rr.max()) // CHUNK + 1, int(cols) // CHUNK + 1
+    key = ((lo.astype(np.int64) * n_img + hi) * br + rr // CHUNK) * bc + cc // CHUNK
+    d = sign * diff
+    order = np.lexsort((d, key))
+    key, d = key[order], d[order]
+    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    counts = np.diff(np.r_[starts, len(key)])
+    starts, counts = starts[counts >= min_count], counts[counts >= min_count]
+    if not len(starts):
+        return float("nan")
+    meds = np.abs(0.5 * (d[starts + (counts - 1) // 2] + d[starts + counts // 2]))
+    return float(math.exp(np.median(meds)) - 1.0)
+
+
+def seam_steps(model: Optional[RadiometryModel], labels: np.ndarray, k: int, prep: _Prepared, dsm: _Dsm,
+               offset: np.ndarray, gains: Sequence[float], max_points: int = 60_000) -> Tuple[float, float]:
+    """The median brightness step across the seamlines of the plan (``labels``: planning cells of ``k`` output
+    cells): at the middle of every edge between two images' cells both images are sampled; per chunk of the
+    seam the median log ratio, the median of its size over the chunks (a fraction).  (with the exposure
+    ``gains``, with the model); nan where there is no seam."""
+    grid = prep.grid
+    p = k * grid.resolution
+    pts = []
+    for horizontal in (True, False):
+        la, lb = (labels[:, :-1], labels[:, 1:]) if horizontal else (labels[:-1], labels[1:])
+        rr, cc = np.nonzero((la != lb) & (la >= 0) & (lb >= 0))
+        xs = grid.x0 + (cc + (1.0 if horizontal else 0.5)) * p
+        ys = grid.y0 - (rr + (0.5 if horizontal else 1.0)) * p
+        pts.append((xs, ys, la[rr, cc], lb[rr, cc], rr * labels.shape[1] + cc))
+    x, y, ia, ib, cell = (np.concatenate([q[j] for q in pts]) for j in range(5))
+    if not len(x):
+        return float("nan"), float("nan")
+    if len(x) > max_points:
+        pick = np.random.default_rng(3).choice(len(x), max_points, replace=False)
+        x, y, ia, ib, cell = x[pick], y[pick], ia[pick], ib[pick], cell[pick]
+    z = dsm.sample(x, y).astype(np.float64)
+    scale = _scale(prep.metas[0].dtype)
+    raw = {0: np.full(len(x), np.nan), 1: np.full(len(x), np.nan)}
+    cor = {0: np.full(len(x), np.nan), 1: np.full(len(x), np.nan)}
+    for i in np.unique(np.concatenate([ia, ib])):
+        cam = prep.cameras[i]
+        for side, lab in ((0, ia), (1, ib)):
+            sel = np.flatnonzero(lab == i)
+            if not len(sel):
+                continue
+            s = sample_camera(cam, prep.metas[i], offset, x[sel], y[sel], z[sel], prep.visibility[i], "bilinear")
+            grey, ok = _grey_ok(s.values, s.valid, scale)
+            sel, grey = sel[ok], grey[ok]
+            if not len(sel):
+                continue
+            raw[side][sel] = np.log(np.maximum(grey, 1e-6)) + math.log(max(gains[i], 1e-6))
+            if model is not None:
+                xyz = np.column_stack([x[sel] - offset[0], y[sel] - offset[1], z[sel] - offset[2]])
+                _ok, r, u, v, rays = observation_geometry(cam, xyz)
+                corr = model.correction(np.full(len(sel), i), r, u, v, rays)
+                cor[side][sel] = np.log(np.maximum(grey, 1e-6)) + np.log(corr)
+    ok = np.isfinite(raw[0]) & np.isfinite(raw[1])
+    before = chunk_disagreement(ia[ok], ib[ok], cell[ok], labels.shape[1], (raw[0] - raw[1])[ok], 3)
+    if model is None:
+        return before, before
+    ok = np.isfinite(cor[0]) & np.isfinite(cor[1])
+    after = chunk_disagreement(ia[ok], ib[ok], cell[ok], labels.shape[1], (cor[0] - cor[1])[ok], 3)
+    return before, after
