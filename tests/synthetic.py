@@ -203,6 +203,7 @@ class Scene:
     buildings: List[Building]
     texture_res: float = 0.04  # m per texture cell
     height_res: float = 0.06  # m per height-raster cell
+    epoch: int = 0  # 0: the scene as always; 1, 2: two epochs of it (see make_scene(epoch=...))
     _rasters: Dict[str, np.ndarray] = field(default_factory=dict, repr=False)
 
     # ---- analytic truth
@@ -328,6 +329,15 @@ class Scene:
             cv2.line(edges, tuple(int(v) for v in np.round(p[0] * 16)), tuple(int(v) for v in np.round(p[1] * 16)),
                      float(rng.choice([-1.2, 1.2])), thickness=int(rng.uniform(0.3, 1.0) / self.texture_res),
                      lineType=cv2.LINE_AA, shift=4)
+        if self.epoch == 2:  # another season: new crop marks (patches and lines) over the old fields
+            rng2 = np.random.default_rng(self.seed + 303)
+            for _ in range(25):
+                cxy = rng2.uniform([0, 0], [nx, ny])
+                half = rng2.uniform(1.0, 8.0, 2) / self.texture_res
+                box = cv2.boxPoints(((float(cxy[0]), float(cxy[1])), (float(2 * half[0]), float(2 * half[1])),
+                                     float(rng2.uniform(0, 180))))
+                cv2.fillConvexPoly(edges, np.round(box * 16).astype(np.int32), float(rng2.uniform(-1.0, 1.0)),
+                                   lineType=cv2.LINE_AA, shift=4)
         edges = cv2.GaussianBlur(edges, (0, 0), 0.08 / self.texture_res)
         tex += 0.8 * edges
         # scene features: roofs (stripes), ditch (darker), shading from the height field
@@ -353,7 +363,8 @@ class Scene:
         gy_, gx_ = np.gradient(h.astype(np.float64), self.height_res)
         gx_ = np.clip(gx_, -2, 2)
         gy_ = np.clip(gy_, -2, 2)
-        shade = (1.0 + 0.5 * gx_ + 0.3 * gy_) / np.sqrt(1.0 + gx_ ** 2 + gy_ ** 2)
+        sun = (-0.4, 0.45) if self.epoch == 2 else (0.5, 0.3)  # epoch 2: the sun from another side
+        shade = (1.0 + sun[0] * gx_ + sun[1] * gy_) / np.sqrt(1.0 + gx_ ** 2 + gy_ ** 2)
         shade = cv2.resize(shade.astype(np.float32), (nx, ny), interpolation=cv2.INTER_LINEAR)
         tex = 0.5 + 0.16 * tex
         tex *= np.clip(shade, 0.3, 1.3)
@@ -362,7 +373,7 @@ class Scene:
 
 
 def make_scene(seed: int, bounds: Tuple[float, float, float, float], base_z: float = 150.0,
-               n_buildings: int = 5) -> Scene:
+               n_buildings: int = 5, epoch: int = 0) -> Scene:
     """Hills, a ditch across the area and ``n_buildings`` boxes (4-8 m tall) at seeded random places."""
     rng = np.random.default_rng(seed)
     xmin, ymin, xmax, ymax = bounds
@@ -392,7 +403,34 @@ def make_scene(seed: int, bounds: Tuple[float, float, float, float], base_z: flo
         buildings.append(b)
         scene.buildings = list(buildings)
     scene.buildings = buildings
+    if epoch:
+        _epoch_changes(scene, epoch)
     return scene
+
+
+def _epoch_changes(scene: Scene, epoch: int) -> None:
+    """Epochs 1 and 2 of a scene (the same terrain, ``make_scene(epoch=...)``): a car (a 2 x 4.5 m box, 1.5 m
+    tall) parked at one place in epoch 1 and at another in epoch 2; in epoch 2 also a new building, new crop
+    marks and the sun from another side (``Scene.texture_raster``)."""
+    scene.epoch = int(epoch)
+    rng = np.random.default_rng(scene.seed + 404)
+    xmin, ymin, xmax, ymax = scene.bounds
+    w, h = xmax - xmin, ymax - ymin
+    spots = []
+    for _ in range(400):
+        cx, cy = rng.uniform(xmin + 0.2 * w, xmax - 0.2 * w), rng.uniform(ymin + 0.2 * h, ymax - 0.2 * h)
+        if not scene.near_feature(cx, cy, 9.0) and all(math.hypot(cx - a, cy - b) > 15.0 for a, b in spots):
+            spots.append((cx, cy))
+        if len(spots) == 3:
+            break
+    (c1, c2, c3) = spots
+    car = c1 if epoch == 1 else c2
+    ang = float(rng.uniform(0, math.pi))
+    ground = float(scene.ground_at(*car))
+    scene.buildings.append(Building(car[0], car[1], 1.0, 2.25, ang, ground + 1.5))
+    if epoch == 2:
+        ground = float(scene.ground_at(*c3))
+        scene.buildings.append(Building(c3[0], c3[1], 4.0, 3.0, ang + 0.5, ground + 5.0))
 
 
 # --------------------------------------------------------------------------------------------------
@@ -949,9 +987,11 @@ def vertical_block(seed: int = 1, camera: CameraModel = DEFAULT_CAMERA, altitude
                    n_strips: int = 3, per_strip: int = 6, forward_overlap: float = 0.75,
                    side_overlap: float = 0.35, attitude_sigma_deg: float = 1.0, position_jitter: float = 0.5,
                    orbit: int = 0, orbit_tilt_deg: float = 30.0, n_buildings: int = 5,
-                   gcp_grid: Tuple[int, int] = (4, 3), roofs: int = 2) -> SyntheticBlock:
+                   gcp_grid: Tuple[int, int] = (4, 3), roofs: int = 2, epoch: int = 0) -> SyntheticBlock:
     """Parallel strips along local x (serpentine: every other strip flown the other way), image x along
-    track; optionally ``orbit`` oblique shots on a circle around the centre looking at it."""
+    track; optionally ``orbit`` oblique shots on a circle around the centre looking at it.  ``epoch`` 1 or 2: the
+    same terrain in two epochs (``make_scene(epoch=...)``: a car that moved, a new building, new crop marks,
+    another sun); 0 (default): the scene as always."""
     rng = np.random.default_rng(seed)
     along = camera.width * altitude / camera.fx
     across = camera.height * altitude / camera.fy
@@ -961,7 +1001,7 @@ def vertical_block(seed: int = 1, camera: CameraModel = DEFAULT_CAMERA, altitude
     widthy = (n_strips - 1) * spacing
     margin = 0.6 * max(along, across) + 5.0
     bounds = (-length / 2 - margin, -widthy / 2 - margin, length / 2 + margin, widthy / 2 + margin)
-    scene = make_scene(seed, bounds, n_buildings=n_buildings)
+    scene = make_scene(seed, bounds, n_buildings=n_buildings, epoch=epoch)
     z_fly = scene.base_z + altitude
     shots: List[Shot] = []
     for si in range(n_strips):

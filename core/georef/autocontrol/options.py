@@ -1,0 +1,50 @@
+"""The options of the automatic control (``core.georef.autocontrol``): defaults in one place."""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any, Optional
+
+AUTO = "auto"  # the role of an automatic GCP candidate in georef/autocontrol.json
+
+
+@dataclass
+class AutoControlOptions:
+    """``gsd``: the common ground resolution of the match (None: the coarser of the reference's and the photos');
+    ``max_pixels``: the provisional orthophoto's largest side (the resolution is made coarser beyond it);
+    ``ratio``: Lowe's ratio test; ``ransac_px``: the similarity's inlier distance (common-grid pixels);
+    ``tile_px``, ``tile_ransac_px``: the per-tile affine refinement; ``max_candidates``: matches tied back to
+    the photos (the best of a grid over the block); ``search_px``: how far a point is searched in the other
+    photos around its prediction through the model; ``min_score``: their normalised cross-correlation;
+    ``max_relief``: metres of DSM relief within the point's neighbourhood beyond which its height is not
+    trusted (walls, trees, roof edges); ``dsm_sigma``: metres (None: the DSM's cell size); ``rotations``:
+    degrees tried when there is no prior (the features are rotation invariant; these help at a coarse level), until
+    one gives ``coarse_enough`` inliers; ``coarse_pixels``: the provisional orthophoto's side at that level."""
+
+    gsd: Optional[float] = None
+    max_pixels: int = 3000
+    n_features: int = 10000
+    ratio: float = 0.85
+    ransac_px: float = 4.0
+    tile_px: int = 192
+    tile_ransac_px: float = 1.5
+    min_tile_matches: int = 6
+    max_candidates: int = 160
+    search_px: float = 25.0
+    template_half: int = 15
+    min_score: float = 0.7
+    max_triangulation_px: float = 2.0
+    max_relief: float = 0.6
+    dsm_sigma: Optional[float] = None
+    min_candidates: int = 4
+    rotations: tuple = (0.0, 90.0, 180.0, 270.0)
+    coarse_pixels: int = 1000
+    coarse_enough: int = 150
+
+    @classmethod
+    def of(cls, options: Optional["AutoControlOptions"] = None, **kwargs: Any) -> "AutoControlOptions":
+        base = options if options is not None else cls()
+        return dataclasses.replace(base, **kwargs) if kwargs else base
+
+
+__all__ = ["AUTO", "AutoControlOptions"]

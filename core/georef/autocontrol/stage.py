@@ -1,0 +1,247 @@
+"""Automatic control of a workspace: ``autocontrol_workspace`` (what the Processing algorithm calls).
+
+1. the prior: rough camera positions (EXIF GPS, or given) in the reference CRS give a similarity model -> world;
+   with none, the block's level frame is matched to the whole reference over rotations (``coarse_search``), and
+   that match gives the similarity;
+2. the provisional orthophoto at the common resolution, matched to the reference (``matching.match_orthos``);
+3. the matches tied back to the photos, with heights from the DSM (``candidates``), spread over the block;
+4. ``georef/autocontrol.json`` (the candidates, role ``auto``, with why each dropped one was dropped, and the
+   figures), then the usual georeferencing with the kept ones as control points (``auto_NNN``) and its outlier
+   rejection (``core.georef.stage.georeference_workspace``: ``georef/control.json``, the residuals, the cameras).
+"""
+from __future__ import annotations
+
+import math
+import os
+import time
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional, Sequence
+
+import numpy as np
+
+from ...common.progress import NullProgress, Progress, SubProgress
+from ...geometry.crs import transform_points
+from ...geometry.similarity import Similarity
+from ...io.gcp import CHECK, CONTROL, CameraPosition, GCPSet, GroundPoint
+from ...project.layout import Layout, write_json
+from ...project.workspace import Workspace
+from ..options import GeorefOptions
+from ..stage import GeorefStageResult, georeference_workspace
+from .candidates import KEPT, Candidate, consistent, spread, tie_back
+from .errors import AutoControlError
+from .matching import apply2, coarse_search, match_orthos
+from .options import AutoControlOptions
+from .provisional import (
+    Frame,
+    block_extent,
+    camera_centres,
+    frame_from_positions,
+    level_frame,
+    provisional_ortho,
+    registered,
+    sparse_points,
+)
+from .reference import Reference
+
+FORMAT = "archaeoortho-autocontrol"
+PRIOR_AUTO, PRIOR_GPS, PRIOR_NONE = "auto", "gps", "none"
+
+
+@dataclass
+class AutoControlResult:
+    workspace: str
+    crs: str
+    prior: str
+    gsd: float
+    figures: Dict[str, float]
+    candidates: List[Candidate]
+    georef: Optional[GeorefStageResult]
+    n_kept: int  # automatic GCPs the adjustment kept
+    cameras_path: Optional[str]
+    timings: Dict[str, float] = field(default_factory=dict)
+    messages: List[str] = field(default_factory=list)
+
+
+def _photos(ws: Workspace) -> Dict[str, str]:
+    out = {}
+    for im in ws.data.get("images", []):
+        p = im.get("path") or os.path.join(ws.data.get("images_dir") or "", im["name"])
+        if os.path.isfile(p):
+            out[im["name"]] = p
+    return out
+
+
+def _gps_positions(ws: Workspace, crs: str) -> List[CameraPosition]:
+    rows = [(im["name"], im["gps"]) for im in ws.data.get("images", []) if im.get("gps")]
+    if not rows:
+        return []
+    xyz = transform_points(np.array([[g[0], g[1], g[2] if len(g) > 2 and g[2] is not None else 0.0]
+                                     for _, g in rows], dtype=float), "EPSG:4326", crs)
+    return [CameraPosition(n, float(p[0]), float(p[1]), float(p[2])) for (n, _), p in zip(rows, xyz)]
+
+
+def _photo_gsd(rec, frame: Frame) -> float:
+    """The photos' median ground resolution in frame units: height above the sparse points over the focal."""
+    z = float(np.median(frame.model_to_frame.apply(sparse_points(rec))[:, 2]))
+    out = []
+    for name, c in camera_centres(rec).items():
+        im = next(i for i in registered(rec) if i.name == name)
+        cam = rec.cameras[im.camera_id]
+        f = float(cam.mean_focal_length())
+        out.append(abs(frame.model_to_frame.apply(c[None])[0, 2] - z) / max(f, 1e-9))
+    return float(np.median(out))
+
+
+def _coarse_prior(rec, photos, reference: Reference, opt: AutoControlOptions, progress: Progress,
+                  messages: List[str]) -> Frame:
+    """No prior: the block's level frame matched to the whole reference over rotations; the similarity it gives
+    (its height from the DSM at the matches) becomes the prior."""
+    lev = level_frame(rec)
+    ext = block_extent(rec, lev)
+    res0 = max(ext[2] - ext[0], ext[3] - ext[1]) / opt.coarse_pixels
+    prov = provisional_ortho(rec, lev, photos, res0, SubProgress(progress, 0.0, 0.5), ext)
+    b = reference.bounds
+    res_r = max(reference.gsd, max(b[2] - b[0], b[3] - b[1]) / (2 * opt.coarse_pixels))
+    ref, valid, gt = reference.grey(b, res_r)
+    m, n, angle = coarse_search(prov.grey, prov.valid, ref, valid, opt)
+    messages.append(f"no prior: the coarse search over {len(opt.rotations)} rotations found {n} matches "
+                    f"(best with the orthophoto turned {angle:g} degrees)")
+    if m is None or n < 8:
+        raise AutoControlError(f"no prior and the reference orthophoto {reference.ortho_path} does not match the "
+                               f"block at a coarse level ({n} matches agree): give rough camera positions or a "
+                               "reference that covers the block more tightly")
+    # frame xy -> ortho pixel -> reference pixel -> world xy: an affine that is a similarity
+    to_px = np.array([[1.0 / res0, 0.0, -ext[0] / res0 - 0.5], [0.0, -1.0 / res0, prov.y0 / res0 - 0.5]])
+    to_world = np.array([[gt[1], 0.0, gt[0] + 0.5 * gt[1]], [0.0, gt[5], gt[3] + 0.5 * gt[5]]])
+    a3 = np.vstack([to_world, [0, 0, 1]]) @ np.vstack([m, [0, 0, 1]]) @ np.vstack([to_px, [0, 0, 1]])
+    s = math.sqrt(abs(np.linalg.det(a3[:2, :2])))
+    r2 = a3[:2, :2] / s
+    r3 = np.eye(3)
+    r3[:2, :2] = r2
+    xy = np.array([[0.5 * (ext[0] + ext[2]), 0.5 * (ext[1] + ext[3])]])
+    centre_world = apply2(a3[:2], xy)[0]
+    pts = lev.model_to_frame.apply(sparse_points(rec))
+    zw = reference.heights(*apply2(a3[:2], pts[::max(1, len(pts) // 500), :2]).T)
+    z0 = float(np.nanmedian(zw)) - s * float(np.median(pts[:, 2])) if np.isfinite(zw).any() else 0.0
+    frame_to_world = Similarity(s, r3, np.r_[a3[:2, 2], z0])
+    offset = np.round(np.r_[centre_world, 0.0], 0)
+    world = Similarity.translation_only(-offset).compose(frame_to_world).compose(lev.model_to_frame)
+    return Frame(world, offset)
+
+
+def _prior(ws, rec, photos, reference, prior, positions, opt, progress, messages) -> Frame:
+    crs = reference.crs
+    if positions is None and prior in (PRIOR_AUTO, PRIOR_GPS):
+        positions = _gps_positions(ws, crs)
+        if prior == PRIOR_GPS and len(positions) < 3:
+            raise AutoControlError(f"prior 'gps': {len(positions)} photo(s) of workspace {ws.root} carry EXIF GPS, "
+                                   "3 are needed")
+    if positions is not None and len(positions) >= 3 and prior != PRIOR_NONE:
+        messages.append(f"prior: {len(positions)} rough camera positions")
+        return frame_from_positions(rec, positions)
+    messages.append("prior: none (searching rotation and scale)")
+    return _coarse_prior(rec, photos, reference, opt, progress, messages)
+
+
+def find_candidates(ws: Workspace, rec, reference: Reference, prior: str = PRIOR_AUTO,
+                    positions: Optional[Sequence[CameraPosition]] = None,
+                    options: Optional[AutoControlOptions] = None, progress: Optional[Progress] = None):
+    """(candidates, figures, messages, common resolution, timings) of an aligned block against the reference."""
+    opt = AutoControlOptions.of(options)
+    progress = progress or NullProgress()
+    photos = _photos(ws)
+    messages: List[str] = []
+    t = {"start": time.time()}
+    frame = _prior(ws, rec, photos, reference, prior, positions, opt, SubProgress(progress, 0.0, 0.2), messages)
+    t["prior"] = time.time()
+    ext = block_extent(rec, frame)
+    g = opt.gsd or max(reference.gsd, _photo_gsd(rec, frame), max(ext[2] - ext[0], ext[3] - ext[1]) / opt.max_pixels)
+    prov = provisional_ortho(rec, frame, photos, g, SubProgress(progress, 0.2, 0.4), ext)
+    t["orthophoto"] = time.time()
+    margin = 0.15 * max(ext[2] - ext[0], ext[3] - ext[1]) + 10.0 * g
+    off = frame.offset
+    box = (ext[0] + off[0] - margin, ext[1] + off[1] - margin, ext[2] + off[0] + margin, ext[3] + off[1] + margin)
+    ref, valid, gt = reference.grey(box, g)
+    ms = match_orthos(prov.grey, prov.valid, ref, valid, opt)
+    t["matching"] = time.time()
+    messages.append(f"matching at {g:.3g} per pixel: {ms.n_features[0]} / {ms.n_features[1]} features, "
+                    f"{ms.n_found} matches, {ms.n_similarity} fit one similarity, {len(ms.src)} fit their tiles")
+    sel = spread(ms.src, ms.residual, opt.max_candidates, prov.grey.shape)
+    world_xy = np.column_stack([gt[0] + (ms.dst[sel, 0] + 0.5) * gt[1], gt[3] + (ms.dst[sel, 1] + 0.5) * gt[5]])
+    cands = tie_back(rec, frame, prov, ms.src[sel], world_xy, ms.residual[sel], reference, photos, opt,
+                     SubProgress(progress, 0.4, 0.9))
+    t["photos"] = time.time()
+    n_obs = sum(1 for c in cands if c.status == KEPT)
+    consistent(cands, max(10.0 * g, 0.5))
+    n_kept = sum(1 for c in cands if c.status == KEPT)
+    messages.append(f"{len(cands)} candidates tied back to the photos: {n_obs} seen in at least 2 photos with a "
+                    f"trusted DSM height, {n_kept} agree with one similarity")
+    figures = {"features_ortho": ms.n_features[0], "features_reference": ms.n_features[1], "matches": ms.n_found,
+               "similarity_inliers": ms.n_similarity, "tile_inliers": int(len(ms.src)), "candidates": len(cands),
+               "observed": n_obs, "consistent": n_kept}
+    timings = {k: t[k] - t["start"] for k in ("prior", "orthophoto", "matching", "photos")}
+    return cands, figures, messages, g, timings
+
+
+def autocontrol_workspace(workspace_dir: str, reference_ortho: str, reference_dsm: str, prior: str = PRIOR_AUTO,
+                          camera_positions: Optional[Sequence[CameraPosition]] = None,
+                          check_points: Optional[GCPSet] = None, options: Optional[AutoControlOptions] = None,
+                          georef_options: Optional[GeorefOptions] = None,
+                          progress: Optional[Progress] = None) -> AutoControlResult:
+    """Georeference an aligned workspace with automatic control from a reference orthophoto and DSM.
+
+    ``prior``: "auto" (EXIF GPS when 3 photos carry it, else none), "gps", or "none" (search rotation and scale);
+    ``camera_positions``: rough positions in the reference's CRS instead of EXIF GPS; ``check_points``: ground
+    points evaluated as check points (role check, in the reference's CRS).  Raises AutoControlError when fewer
+    than ``options.min_candidates`` candidates are kept."""
+    opt = AutoControlOptions.of(options)
+    progress = progress or NullProgress()
+    ws = Workspace.open(workspace_dir)
+    lay = Layout(ws)
+    if not lay.has_aligned_model():
+        raise AutoControlError(f"workspace {ws.root} has no aligned model: run 'Align images' first")
+    rec = lay.load_aligned_model()
+    reference = Reference(reference_ortho, reference_dsm)
+    t0 = time.time()
+    try:
+        cands, figures, messages, g, timings = find_candidates(ws, rec, reference, prior, camera_positions, opt,
+                                                               SubProgress(progress, 0.0, 0.7))
+    finally:
+        reference.close()
+    for m in messages:
+        progress.info(m)
+    kept = [c for c in cands if c.status == KEPT]
+    crs = reference.crs
+    doc = {"format": FORMAT, "version": 1, "reference_ortho": os.path.abspath(reference_ortho),
+           "reference_dsm": os.path.abspath(reference_dsm), "crs": crs, "prior": prior, "gsd": g,
+           "figures": figures, "messages": messages, "candidates": [c.to_dict() for c in cands]}
+    os.makedirs(lay.georef_dir, exist_ok=True)
+    write_json(lay.autocontrol_json, doc)
+    if len(kept) < opt.min_candidates:
+        raise AutoControlError(f"automatic control against {reference_ortho}: {len(kept)} candidate(s) kept, "
+                               f"{opt.min_candidates} needed ({'; '.join(messages)}); see {lay.autocontrol_json}")
+    gcps = GCPSet(crs, [GroundPoint(c.name, c.x, c.y, c.z, c.sigma_xy, c.sigma_z, CONTROL, list(c.observations))
+                        for c in kept], source=lay.autocontrol_json)
+    for p in (check_points.points if check_points is not None else []):
+        gcps.points.append(GroundPoint(p.name, p.x, p.y, p.z, p.sigma_xy, p.sigma_z, CHECK, list(p.observations)))
+    t1 = time.time()
+    res = georeference_workspace(ws.root, gcps=gcps, crs=crs, options=georef_options,
+                                 progress=SubProgress(progress, 0.7, 1.0))
+    timings["adjustment"] = time.time() - t1
+    timings["total"] = time.time() - t0
+    n_used = _count_used(lay, {c.name for c in kept})
+    figures["kept"] = n_used
+    msg = f"automatic control: {n_used} of {len(kept)} automatic GCPs kept by the adjustment"
+    progress.info(msg)
+    messages.append(msg)
+    doc.update(figures=figures, messages=messages, timings=timings)
+    write_json(lay.autocontrol_json, doc)
+    return AutoControlResult(ws.root, crs, prior, g, figures, cands, res, n_used, res.cameras_path, timings, messages)
+
+
+def _count_used(lay: Layout, names) -> int:
+    rows = (lay.residuals() or {}).get("points", [])
+    return sum(1 for r in rows if r.get("name") in names and r.get("status") == "used")
+
+
+__all__ = ["AutoControlResult", "PRIOR_AUTO", "PRIOR_GPS", "PRIOR_NONE", "autocontrol_workspace", "find_candidates"]
