@@ -28,6 +28,7 @@ def algorithms():
     """One instance of every algorithm, in toolbox order: the one list of them."""
     from .accuracy_report import AccuracyReportAlgorithm
     from .align_images import AlignImagesAlgorithm
+    from .auto_control import AutoControlAlgorithm
     from .build_dsm import BuildDsmAlgorithm
     from .build_dtm import BuildDtmAlgorithm
     from .build_orthophoto import BuildOrthophotoAlgorithm
@@ -40,4 +41,5 @@ def algorithms():
 
     return [AlignImagesAlgorithm(), GeoreferenceAlgorithm(), BuildDsmAlgorithm(), PrepareImagesAlgorithm(),
             AccuracyReportAlgorithm(), BuildOrthophotoAlgorithm(), OrthorectifyImageAlgorithm(),
-            RunPipelineAlgorithm(), BuildDtmAlgorithm(), ReliefVisualisationAlgorithm(), ContoursAlgorithm()]
+            RunPipelineAlgorithm(), BuildDtmAlgorithm(), ReliefVisualisationAlgorithm(), ContoursAlgorithm(),
+            AutoControlAlgorithm()]

@@ -147,3 +147,33 @@ def test_a_reference_of_another_place_is_refused_by_name(tmp_path, epochs):
         autocontrol_workspace(ws_dir, ortho, dsm, prior="gps", camera_positions=cams, options=FAST)
     with pytest.raises(AutoControlError, match="missing.tif"):
         autocontrol_workspace(ws_dir, str(tmp_path / "missing.tif"), dsm)
+
+
+def test_qgis_process_runs_autocontrol(tmp_path, epochs):
+    """archaeoortho:autocontrol headless: the workspace georeferenced (no prior: the photos carry no GPS), the
+    camera layer in the reference CRS, the number of automatic GCPs kept; a missing reference named, no
+    traceback."""
+    import subprocess
+
+    from tests.conftest import qgis_process
+
+    exe, env = qgis_process()
+    block, photos, ortho, dsm = epochs
+    ws_dir = _workspace(tmp_path, block, photos, "ws")
+
+    def run(*args):
+        return subprocess.run([exe, "--json", "run", "archaeoortho:autocontrol", "--", *args], env=env,
+                              capture_output=True, text=True, timeout=600)
+
+    out = run(f"WORKSPACE={ws_dir}", f"REFERENCE_ORTHO={ortho}", f"REFERENCE_DSM={dsm}", "PRIOR=0")
+    assert out.returncode == 0, out.stderr[-3000:] + out.stdout[-3000:]
+    res = json.loads(out.stdout)["results"]
+    assert res["AUTO_GCPS"] >= 20 and res["MATCHES"] > res["AUTO_GCPS"]
+    assert os.path.samefile(res["WORKSPACE"], ws_dir) and os.path.isfile(res["CAMERAS"].split("|")[0])
+    assert res["GCP_RMSE_XY"] < REF_GSD
+    assert Workspace.open(ws_dir).crs == syn.CRS
+    assert np.median(_camera_errors(ws_dir, block)) <= 1.5 * REF_GSD
+    bad = str(tmp_path / "nowhere.tif")
+    out = run(f"WORKSPACE={ws_dir}", f"REFERENCE_ORTHO={bad}", f"REFERENCE_DSM={dsm}")
+    text = out.stdout + out.stderr
+    assert out.returncode != 0 and "Traceback" not in text, text[-2000:]

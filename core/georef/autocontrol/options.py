@@ -29,7 +29,7 @@ class AutoControlOptions:
     tile_px: int = 192
     tile_ransac_px: float = 1.5
     min_tile_matches: int = 6
-    max_candidates: int = 160
+    max_candidates: int = 120
     search_px: float = 25.0
     template_half: int = 15
     min_score: float = 0.7
