@@ -226,6 +226,91 @@ Rekonstruktionsverfahren (erweitert): 'incremental' (COLMAP, Standard) oder 'glo
     </message>
 </context>
 <context>
+    <name>AutoControlAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <source>Aligned workspace</source>
+        <translation>Ausgerichteter Arbeitsbereich</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <source>Reference orthophoto</source>
+        <translation>Referenz-Orthophoto</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <source>Reference DSM</source>
+        <translation>Referenz-DOM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <source>Rough position</source>
+        <translation>Ungefähre Lage</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <source>auto</source>
+        <translation>automatisch</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <source>EXIF GPS</source>
+        <translation>EXIF-GPS</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <source>none</source>
+        <translation>keine</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="53"/>
+        <source>Workspace</source>
+        <translation>Arbeitsbereich</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <source>Camera centres (world)</source>
+        <translation>Projektionszentren (Welt)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="55"/>
+        <source>Automatic GCPs kept</source>
+        <translation>Behaltene automatische Passpunkte</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="56"/>
+        <source>Matches found</source>
+        <translation>Gefundene Zuordnungen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="72"/>
+        <source>outlier left out: {}</source>
+        <translation>Ausreißer ausgelassen: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Automatic control from a reference orthophoto</source>
+        <translation>Automatische Passpunkte aus einem Referenz-Orthophoto</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Georeferences an aligned block with no hand-picked ground control: a provisional orthophoto of the block is matched to a reference orthophoto (a national orthophoto, an earlier block&apos;s orthomosaic) at a common resolution, each match is found again in the photos and takes its height from the reference DSM, and these automatic GCPs enter the usual GCP-constrained adjustment, which leaves out the outliers. Changes between the two dates (crops, cars, new buildings, another sun) are tolerated: what stays is used, and the log says how many matches survived each step.
+
+Aligned workspace: the block to georeference (its photos must still be where the alignment found them).
+Reference orthophoto: any north-up raster in a projected CRS, grey or colour; the result is in its CRS.
+Reference DSM: a DSM or DTM covering the block, heights in metres.
+Rough position: the photos&apos; EXIF GPS when at least three carry it (auto), always (EXIF GPS), or never (none: rotation and scale are searched over the whole reference, which then should not be much larger than the block).
+Outputs: the camera centres in the reference CRS, the number of automatic GCPs the adjustment kept, the matches found; georef/autocontrol.json lists every candidate with why it was kept or dropped.</source>
+        <translation>Georeferenziert einen ausgerichteten Block ohne von Hand gesetzte Passpunkte: ein vorläufiges Orthophoto des Blocks wird bei gemeinsamer Auflösung mit einem Referenz-Orthophoto (einem amtlichen Orthophoto, dem Orthomosaik eines früheren Blocks) zugeordnet, jede Zuordnung wird in den Fotos wiedergefunden und erhält ihre Höhe aus dem Referenz-DOM, und diese automatischen Passpunkte gehen in die übliche passpunktgestützte Ausgleichung ein, die die Ausreißer auslässt. Änderungen zwischen den beiden Zeitpunkten (Feldfrüchte, Autos, neue Gebäude, ein anderer Sonnenstand) werden hingenommen: was bleibt, wird genutzt, und das Protokoll nennt, wie viele Zuordnungen jeden Schritt überstanden haben.
+
+Ausgerichteter Arbeitsbereich: der zu georeferenzierende Block (seine Fotos müssen noch dort liegen, wo die Ausrichtung sie gefunden hat).
+Referenz-Orthophoto: ein beliebiges genordetes Raster in einem projizierten KBS, grau oder farbig; das Ergebnis ist in seinem KBS.
+Referenz-DOM: ein DOM oder DGM, das den Block abdeckt, Höhen in Metern.
+Ungefähre Lage: das EXIF-GPS der Fotos, wenn mindestens drei es tragen (automatisch), immer (EXIF-GPS) oder nie (keine: Drehung und Maßstab werden über die ganze Referenz gesucht, die dann nicht viel größer als der Block sein sollte).
+Ausgaben: die Projektionszentren im KBS der Referenz, die Zahl der automatischen Passpunkte, die die Ausgleichung behalten hat, die gefundenen Zuordnungen; georef/autocontrol.json führt jeden Kandidaten auf, mit dem Grund, warum er behalten oder verworfen wurde.</translation>
+    </message>
+</context>
+<context>
     <name>BuildDsmAlgorithm</name>
     <message>
         <location filename="../processing_provider/build_dsm.py" line="50"/>

@@ -226,6 +226,91 @@ Metodo di ricostruzione (avanzato): 'incremental' (COLMAP, predefinito) o 'globa
     </message>
 </context>
 <context>
+    <name>AutoControlAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <source>Aligned workspace</source>
+        <translation>Area di lavoro allineata</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <source>Reference orthophoto</source>
+        <translation>Ortofoto di riferimento</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <source>Reference DSM</source>
+        <translation>DSM di riferimento</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <source>Rough position</source>
+        <translation>Posizione approssimativa</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <source>auto</source>
+        <translation>automatica</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <source>EXIF GPS</source>
+        <translation>GPS EXIF</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <source>none</source>
+        <translation>nessuna</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="53"/>
+        <source>Workspace</source>
+        <translation>Area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <source>Camera centres (world)</source>
+        <translation>Centri di presa (mondo)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="55"/>
+        <source>Automatic GCPs kept</source>
+        <translation>GCP automatici mantenuti</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="56"/>
+        <source>Matches found</source>
+        <translation>Corrispondenze trovate</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="72"/>
+        <source>outlier left out: {}</source>
+        <translation>valore anomalo escluso: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Automatic control from a reference orthophoto</source>
+        <translation>Punti di controllo automatici da un&apos;ortofoto di riferimento</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>Georeferences an aligned block with no hand-picked ground control: a provisional orthophoto of the block is matched to a reference orthophoto (a national orthophoto, an earlier block&apos;s orthomosaic) at a common resolution, each match is found again in the photos and takes its height from the reference DSM, and these automatic GCPs enter the usual GCP-constrained adjustment, which leaves out the outliers. Changes between the two dates (crops, cars, new buildings, another sun) are tolerated: what stays is used, and the log says how many matches survived each step.
+
+Aligned workspace: the block to georeference (its photos must still be where the alignment found them).
+Reference orthophoto: any north-up raster in a projected CRS, grey or colour; the result is in its CRS.
+Reference DSM: a DSM or DTM covering the block, heights in metres.
+Rough position: the photos&apos; EXIF GPS when at least three carry it (auto), always (EXIF GPS), or never (none: rotation and scale are searched over the whole reference, which then should not be much larger than the block).
+Outputs: the camera centres in the reference CRS, the number of automatic GCPs the adjustment kept, the matches found; georef/autocontrol.json lists every candidate with why it was kept or dropped.</source>
+        <translation>Georeferenzia un blocco allineato senza punti di controllo scelti a mano: un&apos;ortofoto provvisoria del blocco viene abbinata a un&apos;ortofoto di riferimento (un&apos;ortofoto nazionale, l&apos;ortomosaico di un blocco precedente) a una risoluzione comune, ogni corrispondenza viene ritrovata nelle foto e prende la quota dal DSM di riferimento, e questi GCP automatici entrano nella consueta compensazione vincolata ai GCP, che esclude i valori anomali. I cambiamenti tra le due date (colture, auto, nuovi edifici, un altro sole) sono tollerati: si usa ciò che resta, e il registro dice quante corrispondenze hanno superato ogni passo.
+
+Area di lavoro allineata: il blocco da georeferenziare (le sue foto devono trovarsi ancora dove l&apos;allineamento le ha trovate).
+Ortofoto di riferimento: un raster qualsiasi orientato a nord in un SR proiettato, in scala di grigi o a colori; il risultato è nel suo SR.
+DSM di riferimento: un DSM o DTM che copre il blocco, quote in metri.
+Posizione approssimativa: il GPS EXIF delle foto quando almeno tre lo hanno (automatica), sempre (GPS EXIF) o mai (nessuna: rotazione e scala vengono cercate su tutto il riferimento, che allora non dovrebbe essere molto più grande del blocco).
+Output: i centri di presa nel SR del riferimento, il numero di GCP automatici mantenuti dalla compensazione, le corrispondenze trovate; georef/autocontrol.json elenca ogni candidato con il motivo per cui è stato mantenuto o scartato.</translation>
+    </message>
+</context>
+<context>
     <name>BuildDsmAlgorithm</name>
     <message>
         <location filename="../processing_provider/build_dsm.py" line="50"/>
