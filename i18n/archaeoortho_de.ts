@@ -92,57 +92,57 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
 <context>
     <name>AlignImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>One camera for all images</source>
         <translation>Eine Kamera für alle Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="59"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Camera centres</source>
         <translation>Projektionszentren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="60"/>
+        <location filename="../processing_provider/align_images.py" line="65"/>
         <source>Registered images</source>
         <translation>Orientierte Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="61"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Mean reprojection error (px)</source>
         <translation>Mittlerer Rückprojektionsfehler (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="85"/>
+        <location filename="../processing_provider/align_images.py" line="91"/>
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
         <translation>{} von {} Bildern orientiert, mittlerer Rückprojektionsfehler {:.3f} px, {} Punkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="88"/>
+        <location filename="../processing_provider/align_images.py" line="98"/>
         <source>Images not registered:</source>
         <translation>Nicht orientierte Bilder:</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="91"/>
+        <location filename="../processing_provider/align_images.py" line="101"/>
         <source>Seconds per step: {}</source>
         <translation>Sekunden je Schritt: {}</translation>
     </message>
@@ -152,34 +152,49 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
         <translation>Bilder ausrichten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Mapper</source>
         <translation>Rekonstruktionsverfahren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Matching image size (px)</source>
         <translation>Bildgröße für die Zuordnung (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Features per image</source>
         <translation>Merkmale je Bild</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Affine-invariant features</source>
         <translation>Affin-invariante Merkmale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Focal length (mm)</source>
         <translation>Brennweite (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Sensor width (mm)</source>
         <translation>Sensorbreite (mm)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="49"/>
+        <source>Retry images left out</source>
+        <translation>Ausgelassene Bilder erneut versuchen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="94"/>
+        <source>Retry {} ({} features): {} image(s) left out; main block {} -&gt; {} images{}</source>
+        <translation>Neuer Versuch {} ({}-Merkmale): {} Bild(er) ausgelassen; Hauptblock {} -&gt; {} Bilder{}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="94"/>
+        <source> (not better: the previous result kept)</source>
+        <translation> (nicht besser: das vorige Ergebnis bleibt)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -189,14 +204,16 @@ Pair selection: &apos;auto&apos; uses EXIF GPS neighbours when the images carry 
 Camera model: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
 Matching image size: the longest side the images are scaled to for matching (0 = full size). Features per image: 0 = automatic (about 4000 per megapixel). Affine-invariant features help with oblique views and are slower.
 Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).
-Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).</source>
+Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).
+Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
         <translation>Structure from Motion: SIFT-Merkmale, Paarauswahl, robuste Zuordnung (RANSAC), inkrementelle Rekonstruktion mit Selbstkalibrierung (Brennweite, Bildhauptpunkt, Objektivverzeichnung) und eine abschließende Bündelblockausgleichung. Das Ergebnis wird im Arbeitsbereich-Ordner gespeichert, den die folgenden Schritte (Georeferenzieren, DOM erzeugen, Orthophoto erzeugen) als Eingabe nehmen. Ein erneuter Lauf setzt fort: bereits berechnete Merkmale und Zuordnungen werden wiederverwendet.
 
-Paarauswahl: 'auto' nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
-Kameramodell: 'AUTO' schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
+Paarauswahl: &apos;auto&apos; nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
+Kameramodell: &apos;AUTO&apos; schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
 Bildgröße für die Zuordnung: die längste Seite, auf die die Bilder für die Zuordnung verkleinert werden (0 = volle Größe). Merkmale je Bild: 0 = automatisch (etwa 4000 je Megapixel). Affin-invariante Merkmale helfen bei Schrägaufnahmen und sind langsamer.
 Brennweite und Sensorbreite: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern (0 = aus EXIF / unbekannt).
-Rekonstruktionsverfahren (erweitert): 'incremental' (COLMAP, Standard) oder 'global' (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).</translation>
+Rekonstruktionsverfahren (erweitert): &apos;incremental&apos; (COLMAP, Standard) oder &apos;global&apos; (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).
+Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen Einstellungen auslassen, oder ein in Teile zerfallener Block werden mit reicheren Merkmalen (schwächeren für kontrastarme Bilder, affinen für steile Schrägaufnahmen) und mehr Paaren erneut versucht; das Protokoll und sfm/alignment.json sagen, was erneut versucht wurde und warum.</translation>
     </message>
 </context>
 <context>
@@ -465,7 +482,7 @@ Ein erneuter Lauf nach einem Abbruch setzt fort und verwendet die bereits zugeor
         <translation>Anteil der interpolierten DGM-Zellen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="101"/>
+        <location filename="../processing_provider/build_dtm.py" line="100"/>
         <source>Give a workspace folder, or a DSM file and where to write the DTM</source>
         <translation>Geben Sie einen Arbeitsbereich-Ordner an, oder eine DOM-Datei und wohin das DGM geschrieben wird</translation>
     </message>
@@ -716,7 +733,7 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Ein DOM- oder DGM-Rasterlayer (z. B. ein ALS-DOM): ein auf der Karte gemessener Punkt erhält seine Höhe daraus (bilinear). Leer: Z von Hand eingeben.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="64"/>
+        <location filename="../ui/gcp_io.py" line="67"/>
         <source>Add</source>
         <translation>Hinzufügen</translation>
     </message>
@@ -746,7 +763,7 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>In die Kartenansicht klicken, um X und Y des gewählten Punkts zu setzen (Z aus dem Höhenlayer)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="61"/>
+        <location filename="../ui/gcp_io.py" line="64"/>
         <source>Import</source>
         <translation>Importieren</translation>
     </message>
@@ -956,7 +973,7 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>{}: jedes Foto, das ihn voraussichtlich zeigt, hat eine Messung</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="127"/>
+        <location filename="../ui/gcp_io.py" line="130"/>
         <source>Import ground control</source>
         <translation>Passpunkte importieren</translation>
     </message>
@@ -966,107 +983,107 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Passpunkte (*.txt *.csv);;Alle Dateien (*)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="57"/>
+        <location filename="../ui/gcp_io.py" line="60"/>
         <source>Replace the current points, or add the imported ones to them (same names are updated)?</source>
         <translation>Die vorhandenen Punkte ersetzen oder die importierten hinzufügen (gleichnamige werden aktualisiert)?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="61"/>
+        <location filename="../ui/gcp_io.py" line="64"/>
         <source>Replace</source>
         <translation>Ersetzen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="103"/>
+        <location filename="../ui/gcp_io.py" line="106"/>
         <source>import {}</source>
         <translation>{} importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="104"/>
+        <location filename="../ui/gcp_io.py" line="107"/>
         <source>warnings</source>
         <translation>Warnungen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="111"/>
+        <location filename="../ui/gcp_io.py" line="114"/>
         <source>Imported {} points and {} observations from {}</source>
         <translation>{} Punkte und {} Messungen aus {} importiert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="124"/>
+        <location filename="../ui/gcp_io.py" line="127"/>
         <source>No point layer in the project</source>
         <translation>Kein Punktlayer im Projekt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="127"/>
+        <location filename="../ui/gcp_io.py" line="130"/>
         <source>Point layer (one feature per observation: name, image, px, py)</source>
         <translation>Punktlayer (ein Objekt je Messung: name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="142"/>
+        <location filename="../ui/gcp_io.py" line="145"/>
         <source>Layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Layer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="169"/>
+        <location filename="../ui/gcp_io.py" line="172"/>
         <source>OpenDroneMap gcp_list (*.txt)</source>
         <translation>OpenDroneMap gcp_list (*.txt)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="169"/>
+        <location filename="../ui/gcp_io.py" line="172"/>
         <source>CSV points + observations (*.csv)</source>
         <translation>CSV-Punkte + Messungen (*.csv)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="170"/>
+        <location filename="../ui/gcp_io.py" line="173"/>
         <source>Export ground control</source>
         <translation>Passpunkte exportieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="181"/>
+        <location filename="../ui/gcp_io.py" line="184"/>
         <source>The points have no CRS yet: pick one on the map or import a file first</source>
         <translation>Die Punkte haben noch kein KBS: zuerst einen auf der Karte messen oder eine Datei importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="190"/>
+        <location filename="../ui/gcp_io.py" line="193"/>
         <source>Exported {} points to {}</source>
         <translation>{} Punkte nach {} exportiert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="190"/>
+        <location filename="../ui/gcp_io.py" line="193"/>
         <source> ({} without coordinates left out)</source>
         <translation> ({} ohne Koordinaten ausgelassen)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="195"/>
+        <location filename="../ui/gcp_io.py" line="198"/>
         <source>Export ground control as a layer</source>
         <translation>Passpunkte als Layer exportieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="195"/>
+        <location filename="../ui/gcp_io.py" line="198"/>
         <source>GeoPackage (*.gpkg)</source>
         <translation>GeoPackage (*.gpkg)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="226"/>
+        <location filename="../ui/gcp_io.py" line="229"/>
         <source>Cannot write {}: {}</source>
         <translation>{} kann nicht geschrieben werden: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="229"/>
+        <location filename="../ui/gcp_io.py" line="232"/>
         <source>Exported {} observations to {}</source>
         <translation>{} Messungen nach {} exportiert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="229"/>
+        <location filename="../ui/gcp_io.py" line="232"/>
         <source> (points without observations left out: {})</source>
         <translation> (Punkte ohne Messungen ausgelassen: {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="233"/>
+        <location filename="../ui/gcp_io.py" line="236"/>
         <source>GCP observations</source>
         <translation>Passpunktmessungen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="235"/>
+        <location filename="../ui/gcp_io.py" line="238"/>
         <source>Cannot add {} to the project</source>
         <translation>{} kann nicht zum Projekt hinzugefügt werden</translation>
     </message>
@@ -1186,12 +1203,12 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Georeferenzierung mit {} Passpunkten…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="57"/>
+        <location filename="../ui/gcp_io.py" line="60"/>
         <source>How were the pixel coordinates measured?</source>
         <translation>Wie wurden die Pixelkoordinaten gemessen?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="68"/>
+        <location filename="../ui/gcp_io.py" line="71"/>
         <source>Coordinates measured on upright photos ({} photos are stored turned: EXIF orientation); leave unticked for the stored pixel grid (COLMAP&apos;s, OpenDroneMap&apos;s)</source>
         <translation>Koordinaten auf aufrecht gedrehten Fotos gemessen ({} Fotos sind gedreht gespeichert: EXIF-Ausrichtung); nicht ankreuzen für das gespeicherte Pixelraster (das von COLMAP und OpenDroneMap)</translation>
     </message>
@@ -1359,102 +1376,102 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
 <context>
     <name>GcpStore</name>
     <message>
-        <location filename="../ui/store.py" line="252"/>
+        <location filename="../ui/store.py" line="254"/>
         <source>a point named {} exists already</source>
         <translation>ein Punkt namens {} existiert bereits</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="240"/>
+        <location filename="../ui/store.py" line="242"/>
         <source>add point {}</source>
         <translation>Punkt {} hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="247"/>
+        <location filename="../ui/store.py" line="249"/>
         <source>remove point {}</source>
         <translation>Punkt {} entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="263"/>
+        <location filename="../ui/store.py" line="265"/>
         <source>set {} of {}</source>
         <translation>{} von {} setzen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="323"/>
+        <location filename="../ui/store.py" line="325"/>
         <source>place {} in {}</source>
         <translation>{} in {} messen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="331"/>
+        <location filename="../ui/store.py" line="333"/>
         <source>remove {} from {}</source>
         <translation>{} aus {} entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="409"/>
+        <location filename="../ui/store.py" line="411"/>
         <source>set CRS</source>
         <translation>KBS setzen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="291"/>
+        <location filename="../ui/store.py" line="293"/>
         <source>no position</source>
         <translation>keine Position</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="296"/>
+        <location filename="../ui/store.py" line="298"/>
         <source>({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)</source>
         <translation>({:.0f}, {:.0f}) liegt außerhalb des Fotos {} ({} × {} px)</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="303"/>
+        <location filename="../ui/store.py" line="305"/>
         <source>({:.0f}, {:.0f}) is inside the mask of {}</source>
         <translation>({:.0f}, {:.0f}) liegt in der Maske von {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="311"/>
+        <location filename="../ui/store.py" line="313"/>
         <source>{} not placed: {}</source>
         <translation>{} nicht gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="355"/>
+        <location filename="../ui/store.py" line="357"/>
         <source>{} points replaced by {} from the file</source>
         <translation>{} Punkte durch {} aus der Datei ersetzt</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="389"/>
+        <location filename="../ui/store.py" line="391"/>
         <source>added {} points: {}</source>
         <translation>{} Punkte hinzugefügt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="391"/>
+        <location filename="../ui/store.py" line="393"/>
         <source>coordinates updated from the file: {}</source>
         <translation>Koordinaten aus der Datei aktualisiert: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="393"/>
+        <location filename="../ui/store.py" line="395"/>
         <source>role set by the file: {}</source>
         <translation>Rolle von der Datei gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="395"/>
+        <location filename="../ui/store.py" line="397"/>
         <source>role kept (the file gives none): {}</source>
         <translation>Rolle beibehalten (die Datei nennt keine): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="397"/>
+        <location filename="../ui/store.py" line="399"/>
         <source>σ set by the file: {}</source>
         <translation>σ von der Datei gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="399"/>
+        <location filename="../ui/store.py" line="401"/>
         <source>{} observations added</source>
         <translation>{} Messungen hinzugefügt</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="401"/>
+        <location filename="../ui/store.py" line="403"/>
         <source>placed observations kept (the file has others): {}</source>
         <translation>gesetzte Messungen beibehalten (die Datei hat andere): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="402"/>
+        <location filename="../ui/store.py" line="404"/>
         <source>nothing changed</source>
         <translation>nichts geändert</translation>
     </message>
@@ -2083,7 +2100,7 @@ Vorbereitete Bilder: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetz
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="80"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="79"/>
         <source>Give a workspace folder, or an elevation raster and where to write the visualisation</source>
         <translation>Geben Sie einen Arbeitsbereich-Ordner an, oder ein Höhenraster und wohin die Visualisierung geschrieben wird</translation>
     </message>

@@ -92,57 +92,57 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
 <context>
     <name>AlignImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>One camera for all images</source>
         <translation>Una sola camera per tutte le immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="59"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Camera centres</source>
         <translation>Centri di presa</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="60"/>
+        <location filename="../processing_provider/align_images.py" line="65"/>
         <source>Registered images</source>
         <translation>Immagini orientate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="61"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Mean reprojection error (px)</source>
         <translation>Errore medio di riproiezione (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="85"/>
+        <location filename="../processing_provider/align_images.py" line="91"/>
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
         <translation>Orientate {} di {} immagini, errore medio di riproiezione {:.3f} px, {} punti</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="88"/>
+        <location filename="../processing_provider/align_images.py" line="98"/>
         <source>Images not registered:</source>
         <translation>Immagini non orientate:</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="91"/>
+        <location filename="../processing_provider/align_images.py" line="101"/>
         <source>Seconds per step: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -152,34 +152,49 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
         <translation>Allinea immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Mapper</source>
         <translation>Metodo di ricostruzione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Matching image size (px)</source>
         <translation>Dimensione per la corrispondenza (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Features per image</source>
         <translation>Feature per immagine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Affine-invariant features</source>
         <translation>Feature invarianti affini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Focal length (mm)</source>
         <translation>Focale (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="45"/>
+        <location filename="../processing_provider/align_images.py" line="49"/>
         <source>Sensor width (mm)</source>
         <translation>Larghezza del sensore (mm)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="49"/>
+        <source>Retry images left out</source>
+        <translation>Riprova le immagini escluse</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="94"/>
+        <source>Retry {} ({} features): {} image(s) left out; main block {} -&gt; {} images{}</source>
+        <translation>Nuovo tentativo {} (caratteristiche {}): {} immagine/i escluse; blocco principale {} -&gt; {} immagini{}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="94"/>
+        <source> (not better: the previous result kept)</source>
+        <translation> (non migliore: resta il risultato precedente)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -189,14 +204,16 @@ Pair selection: &apos;auto&apos; uses EXIF GPS neighbours when the images carry 
 Camera model: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
 Matching image size: the longest side the images are scaled to for matching (0 = full size). Features per image: 0 = automatic (about 4000 per megapixel). Affine-invariant features help with oblique views and are slower.
 Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).
-Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).</source>
-        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell'obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella dell'area di lavoro, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
+Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).
+Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
+        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell&apos;obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella dell&apos;area di lavoro, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
 
-Selezione delle coppie: 'auto' usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
-Modello di camera: 'AUTO' stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
+Selezione delle coppie: &apos;auto&apos; usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
+Modello di camera: &apos;AUTO&apos; stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
 Dimensione per la corrispondenza: il lato maggiore a cui le immagini sono ridotte per la corrispondenza (0 = dimensione piena). Feature per immagine: 0 = automatico (circa 4000 per megapixel). Le feature invarianti affini aiutano con le prese oblique e sono più lente.
-Focale e Larghezza del sensore: orientamento interno quando manca l'EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri (0 = dall'EXIF / sconosciuta).
-Metodo di ricostruzione (avanzato): 'incremental' (COLMAP, predefinito) o 'global' (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).</translation>
+Focale e Larghezza del sensore: orientamento interno quando manca l&apos;EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri (0 = dall&apos;EXIF / sconosciuta).
+Metodo di ricostruzione (avanzato): &apos;incremental&apos; (COLMAP, predefinito) o &apos;global&apos; (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).
+Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni rapide escludono, o un blocco diviso in parti, vengono riprovate con caratteristiche più ricche (più deboli per fotogrammi a basso contrasto, affini per oblique ripide) e più coppie; il registro e sfm/alignment.json dicono cosa è stato riprovato e perché.</translation>
     </message>
 </context>
 <context>
@@ -290,7 +307,7 @@ Metodo di ricostruzione (avanzato): 'incremental' (COLMAP, predefinito) o 'globa
     <message>
         <location filename="../ui/catalog.py" line="7"/>
         <source>Automatic control from a reference orthophoto</source>
-        <translation>Punti di controllo automatici da un&apos;ortofoto di riferimento</translation>
+        <translation>Punti di controllo automatici da un'ortofoto di riferimento</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -301,9 +318,9 @@ Reference orthophoto: any north-up raster in a projected CRS, grey or colour; th
 Reference DSM: a DSM or DTM covering the block, heights in metres.
 Rough position: the photos&apos; EXIF GPS when at least three carry it (auto), always (EXIF GPS), or never (none: rotation and scale are searched over the whole reference, which then should not be much larger than the block).
 Outputs: the camera centres in the reference CRS, the number of automatic GCPs the adjustment kept, the matches found; georef/autocontrol.json lists every candidate with why it was kept or dropped.</source>
-        <translation>Georeferenzia un blocco allineato senza punti di controllo scelti a mano: un&apos;ortofoto provvisoria del blocco viene abbinata a un&apos;ortofoto di riferimento (un&apos;ortofoto nazionale, l&apos;ortomosaico di un blocco precedente) a una risoluzione comune, ogni corrispondenza viene ritrovata nelle foto e prende la quota dal DSM di riferimento, e questi GCP automatici entrano nella consueta compensazione vincolata ai GCP, che esclude i valori anomali. I cambiamenti tra le due date (colture, auto, nuovi edifici, un altro sole) sono tollerati: si usa ciò che resta, e il registro dice quante corrispondenze hanno superato ogni passo.
+        <translation>Georeferenzia un blocco allineato senza punti di controllo scelti a mano: un'ortofoto provvisoria del blocco viene abbinata a un'ortofoto di riferimento (un'ortofoto nazionale, l'ortomosaico di un blocco precedente) a una risoluzione comune, ogni corrispondenza viene ritrovata nelle foto e prende la quota dal DSM di riferimento, e questi GCP automatici entrano nella consueta compensazione vincolata ai GCP, che esclude i valori anomali. I cambiamenti tra le due date (colture, auto, nuovi edifici, un altro sole) sono tollerati: si usa ciò che resta, e il registro dice quante corrispondenze hanno superato ogni passo.
 
-Area di lavoro allineata: il blocco da georeferenziare (le sue foto devono trovarsi ancora dove l&apos;allineamento le ha trovate).
+Area di lavoro allineata: il blocco da georeferenziare (le sue foto devono trovarsi ancora dove l'allineamento le ha trovate).
 Ortofoto di riferimento: un raster qualsiasi orientato a nord in un SR proiettato, in scala di grigi o a colori; il risultato è nel suo SR.
 DSM di riferimento: un DSM o DTM che copre il blocco, quote in metri.
 Posizione approssimativa: il GPS EXIF delle foto quando almeno tre lo hanno (automatica), sempre (GPS EXIF) o mai (nessuna: rotazione e scala vengono cercate su tutto il riferimento, che allora non dovrebbe essere molto più grande del blocco).
@@ -465,7 +482,7 @@ Una nuova esecuzione dopo un annullamento riprende: le coppie già elaborate son
         <translation>Frazione delle celle del DTM interpolate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="101"/>
+        <location filename="../processing_provider/build_dtm.py" line="100"/>
         <source>Give a workspace folder, or a DSM file and where to write the DTM</source>
         <translation>Indica una cartella dell'area di lavoro, oppure un file DSM e dove scrivere il DTM</translation>
     </message>
@@ -716,7 +733,7 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Un layer raster DSM o DTM (ad es. un DSM ALS): un punto misurato sulla mappa ne prende la quota (bilineare). Vuoto: inserire Z a mano.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="64"/>
+        <location filename="../ui/gcp_io.py" line="67"/>
         <source>Add</source>
         <translation>Aggiungi</translation>
     </message>
@@ -746,7 +763,7 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Fai clic sulla mappa per impostare X e Y del punto selezionato (Z dal layer delle quote)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="61"/>
+        <location filename="../ui/gcp_io.py" line="64"/>
         <source>Import</source>
         <translation>Importa</translation>
     </message>
@@ -956,7 +973,7 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>{}: ogni foto in cui è previsto ha una misura</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="127"/>
+        <location filename="../ui/gcp_io.py" line="130"/>
         <source>Import ground control</source>
         <translation>Importa punti d'appoggio</translation>
     </message>
@@ -966,107 +983,107 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Punti d'appoggio (*.txt *.csv);;Tutti i file (*)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="57"/>
+        <location filename="../ui/gcp_io.py" line="60"/>
         <source>Replace the current points, or add the imported ones to them (same names are updated)?</source>
         <translation>Sostituire i punti attuali o aggiungere quelli importati (quelli con lo stesso nome vengono aggiornati)?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="61"/>
+        <location filename="../ui/gcp_io.py" line="64"/>
         <source>Replace</source>
         <translation>Sostituisci</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="103"/>
+        <location filename="../ui/gcp_io.py" line="106"/>
         <source>import {}</source>
         <translation>importa {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="104"/>
+        <location filename="../ui/gcp_io.py" line="107"/>
         <source>warnings</source>
         <translation>avvisi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="111"/>
+        <location filename="../ui/gcp_io.py" line="114"/>
         <source>Imported {} points and {} observations from {}</source>
         <translation>Importati {} punti e {} misure da {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="124"/>
+        <location filename="../ui/gcp_io.py" line="127"/>
         <source>No point layer in the project</source>
         <translation>Nessun layer di punti nel progetto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="127"/>
+        <location filename="../ui/gcp_io.py" line="130"/>
         <source>Point layer (one feature per observation: name, image, px, py)</source>
         <translation>Layer di punti (un elemento per misura: name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="142"/>
+        <location filename="../ui/gcp_io.py" line="145"/>
         <source>Layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="169"/>
+        <location filename="../ui/gcp_io.py" line="172"/>
         <source>OpenDroneMap gcp_list (*.txt)</source>
         <translation>OpenDroneMap gcp_list (*.txt)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="169"/>
+        <location filename="../ui/gcp_io.py" line="172"/>
         <source>CSV points + observations (*.csv)</source>
         <translation>Punti CSV + misure (*.csv)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="170"/>
+        <location filename="../ui/gcp_io.py" line="173"/>
         <source>Export ground control</source>
         <translation>Esporta punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="181"/>
+        <location filename="../ui/gcp_io.py" line="184"/>
         <source>The points have no CRS yet: pick one on the map or import a file first</source>
         <translation>I punti non hanno ancora un SR: misurane uno sulla mappa o importa prima un file</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="190"/>
+        <location filename="../ui/gcp_io.py" line="193"/>
         <source>Exported {} points to {}</source>
         <translation>Esportati {} punti in {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="190"/>
+        <location filename="../ui/gcp_io.py" line="193"/>
         <source> ({} without coordinates left out)</source>
         <translation> ({} senza coordinate esclusi)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="195"/>
+        <location filename="../ui/gcp_io.py" line="198"/>
         <source>Export ground control as a layer</source>
         <translation>Esporta i punti d'appoggio come layer</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="195"/>
+        <location filename="../ui/gcp_io.py" line="198"/>
         <source>GeoPackage (*.gpkg)</source>
         <translation>GeoPackage (*.gpkg)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="226"/>
+        <location filename="../ui/gcp_io.py" line="229"/>
         <source>Cannot write {}: {}</source>
         <translation>Impossibile scrivere {}: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="229"/>
+        <location filename="../ui/gcp_io.py" line="232"/>
         <source>Exported {} observations to {}</source>
         <translation>Esportate {} misure in {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="229"/>
+        <location filename="../ui/gcp_io.py" line="232"/>
         <source> (points without observations left out: {})</source>
         <translation> (punti senza misure esclusi: {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="233"/>
+        <location filename="../ui/gcp_io.py" line="236"/>
         <source>GCP observations</source>
         <translation>Misure dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="235"/>
+        <location filename="../ui/gcp_io.py" line="238"/>
         <source>Cannot add {} to the project</source>
         <translation>Impossibile aggiungere {} al progetto</translation>
     </message>
@@ -1186,12 +1203,12 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Georeferenziazione con {} punti d'appoggio…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="57"/>
+        <location filename="../ui/gcp_io.py" line="60"/>
         <source>How were the pixel coordinates measured?</source>
         <translation>Come sono state misurate le coordinate pixel?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="68"/>
+        <location filename="../ui/gcp_io.py" line="71"/>
         <source>Coordinates measured on upright photos ({} photos are stored turned: EXIF orientation); leave unticked for the stored pixel grid (COLMAP&apos;s, OpenDroneMap&apos;s)</source>
         <translation>Coordinate misurate sulle foto raddrizzate ({} foto sono salvate ruotate: orientamento EXIF); lasciare deselezionato per la griglia di pixel salvata (quella di COLMAP e OpenDroneMap)</translation>
     </message>
@@ -1359,102 +1376,102 @@ Curve di livello: il GeoPackage da scrivere.</translation>
 <context>
     <name>GcpStore</name>
     <message>
-        <location filename="../ui/store.py" line="252"/>
+        <location filename="../ui/store.py" line="254"/>
         <source>a point named {} exists already</source>
         <translation>esiste già un punto chiamato {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="240"/>
+        <location filename="../ui/store.py" line="242"/>
         <source>add point {}</source>
         <translation>aggiungi il punto {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="247"/>
+        <location filename="../ui/store.py" line="249"/>
         <source>remove point {}</source>
         <translation>rimuovi il punto {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="263"/>
+        <location filename="../ui/store.py" line="265"/>
         <source>set {} of {}</source>
         <translation>imposta {} di {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="323"/>
+        <location filename="../ui/store.py" line="325"/>
         <source>place {} in {}</source>
         <translation>misura {} in {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="331"/>
+        <location filename="../ui/store.py" line="333"/>
         <source>remove {} from {}</source>
         <translation>rimuovi {} da {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="409"/>
+        <location filename="../ui/store.py" line="411"/>
         <source>set CRS</source>
         <translation>imposta il SR</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="291"/>
+        <location filename="../ui/store.py" line="293"/>
         <source>no position</source>
         <translation>nessuna posizione</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="296"/>
+        <location filename="../ui/store.py" line="298"/>
         <source>({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)</source>
         <translation>({:.0f}, {:.0f}) è fuori dalla foto {} ({} × {} px)</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="303"/>
+        <location filename="../ui/store.py" line="305"/>
         <source>({:.0f}, {:.0f}) is inside the mask of {}</source>
         <translation>({:.0f}, {:.0f}) è dentro la maschera di {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="311"/>
+        <location filename="../ui/store.py" line="313"/>
         <source>{} not placed: {}</source>
         <translation>{} non posizionato: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="355"/>
+        <location filename="../ui/store.py" line="357"/>
         <source>{} points replaced by {} from the file</source>
         <translation>{} punti sostituiti da {} dal file</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="389"/>
+        <location filename="../ui/store.py" line="391"/>
         <source>added {} points: {}</source>
         <translation>aggiunti {} punti: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="391"/>
+        <location filename="../ui/store.py" line="393"/>
         <source>coordinates updated from the file: {}</source>
         <translation>coordinate aggiornate dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="393"/>
+        <location filename="../ui/store.py" line="395"/>
         <source>role set by the file: {}</source>
         <translation>ruolo impostato dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="395"/>
+        <location filename="../ui/store.py" line="397"/>
         <source>role kept (the file gives none): {}</source>
         <translation>ruolo mantenuto (il file non ne indica): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="397"/>
+        <location filename="../ui/store.py" line="399"/>
         <source>σ set by the file: {}</source>
         <translation>σ impostata dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="399"/>
+        <location filename="../ui/store.py" line="401"/>
         <source>{} observations added</source>
         <translation>{} misure aggiunte</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="401"/>
+        <location filename="../ui/store.py" line="403"/>
         <source>placed observations kept (the file has others): {}</source>
         <translation>misure posizionate mantenute (il file ne ha altre): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="402"/>
+        <location filename="../ui/store.py" line="404"/>
         <source>nothing changed</source>
         <translation>nulla è cambiato</translation>
     </message>
@@ -1681,7 +1698,7 @@ I valori anomali (una misura errata, un errore di battitura in una coordinata) s
     <message>
         <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS)</source>
-        <translation>Indica i punti d&apos;appoggio (File o Layer dei punti d&apos;appoggio: GCPS, GCP_LAYER) e/o le posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS)</translation>
+        <translation>Indica i punti d'appoggio (File o Layer dei punti d'appoggio: GCPS, GCP_LAYER) e/o le posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS)</translation>
     </message>
 </context>
 <context>
@@ -1816,7 +1833,7 @@ Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="98"/>
         <source>Give ground control points observed in the image (Ground control file or Ground control point layer: GCPS, GCP_LAYER) or its Known orientation (ORIENTATION)</source>
-        <translation>Indica i punti d&apos;appoggio osservati nell&apos;immagine (File o Layer dei punti d&apos;appoggio: GCPS, GCP_LAYER) o il suo Orientamento noto (ORIENTATION)</translation>
+        <translation>Indica i punti d'appoggio osservati nell'immagine (File o Layer dei punti d'appoggio: GCPS, GCP_LAYER) o il suo Orientamento noto (ORIENTATION)</translation>
     </message>
 </context>
 <context>
@@ -2083,7 +2100,7 @@ Immagini preparate: la cartella delle immagini preparate (sostituita per intero;
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="80"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="79"/>
         <source>Give a workspace folder, or an elevation raster and where to write the visualisation</source>
         <translation>Indica una cartella dell'area di lavoro, oppure un raster delle quote e dove scrivere la visualizzazione</translation>
     </message>
@@ -2375,7 +2392,7 @@ Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le ci
     <message>
         <location filename="../processing_provider/run_pipeline.py" line="115"/>
         <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
-        <translation>Indicare punti di appoggio (File o Layer dei punti d&apos;appoggio: GCPS, GCP_LAYER) e/o posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
+        <translation>Indicare punti di appoggio (File o Layer dei punti d'appoggio: GCPS, GCP_LAYER) e/o posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
     </message>
 </context>
 </TS>

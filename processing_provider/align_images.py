@@ -20,6 +20,7 @@ class AlignImagesAlgorithm(AlgorithmBase):
     SENSOR_WIDTH_MM = "SENSOR_WIDTH_MM"
     SINGLE_CAMERA = "SINGLE_CAMERA"
     MAPPER = "MAPPER"
+    ESCALATE = "ESCALATE"
     CAMERAS = "CAMERAS"
     REGISTERED_IMAGES = "REGISTERED_IMAGES"
     MEAN_REPROJECTION_ERROR = "MEAN_REPROJECTION_ERROR"
@@ -38,7 +39,10 @@ class AlignImagesAlgorithm(AlgorithmBase):
         "Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal "
         "length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).\n"
         "Mapper (advanced): 'incremental' (COLMAP, the default) or 'global' (GLOMAP: rotation averaging and "
-        "global positioning, often faster on large blocks; a Cancel takes effect only when it has finished)."
+        "global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).\n"
+        "Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are "
+        "retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) "
+        "and more pairs; the log and sfm/alignment.json say what was retried and why."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
@@ -54,7 +58,8 @@ class AlignImagesAlgorithm(AlgorithmBase):
             params.number(self.FOCAL_MM, self.tr("Focal length (mm)")),
             params.number(self.SENSOR_WIDTH_MM, self.tr("Sensor width (mm)")),
             params.flag(self.SINGLE_CAMERA, self.tr("One camera for all images")),
-            *params.advanced(params.choice(self.MAPPER, self.tr("Mapper"), MAPPERS)),
+            *params.advanced(params.choice(self.MAPPER, self.tr("Mapper"), MAPPERS),
+                             params.flag(self.ESCALATE, self.tr("Retry images left out"), default=True)),
         )
         self.addOutput(QgsProcessingOutputVectorLayer(self.CAMERAS, self.tr("Camera centres")))
         self.addOutput(QgsProcessingOutputNumber(self.REGISTERED_IMAGES, self.tr("Registered images")))
@@ -80,10 +85,15 @@ class AlignImagesAlgorithm(AlgorithmBase):
             focal_mm=focal_mm or None,
             sensor_width_mm=sensor_mm or None,
             mapper=params.read_choice(self, parameters, self.MAPPER, context, MAPPERS),
+            escalate=self.parameterAsBoolean(parameters, self.ESCALATE, context),
         )
         result = self.run_core(align, images, workspace, options, FeedbackProgress(feedback))
         feedback.pushInfo(self.tr("Registered {} of {} images, mean reprojection error {:.3f} px, {} points").format(
             result.registered, result.images_given, result.mean_reprojection_error, result.num_points3d))
+        for r in (result.escalation or {}).get("rounds", []):
+            feedback.pushInfo(self.tr("Retry {} ({} features): {} image(s) left out; main block {} -> {} images{}").format(
+                r["round"], r["kind"], len(r["left_out"]), r["registered_before"], r["registered_after"],
+                "" if r["kept"] else self.tr(" (not better: the previous result kept)")))
         if result.unregistered:
             feedback.pushInfo(self.tr("Images not registered:"))
             for name, why in result.unregistered.items():

@@ -3,7 +3,7 @@
 The small-frame failure: five Toledo frames (sample/toledo) cropped and downsampled to 1152 x 640 px, contrast
 lowered to 12 % (a flat, hazy scan: no EXIF, the interior orientation given as FOCAL_MM / SENSOR_WIDTH_MM).
 At 1152 px the fast path starts SIFT at octave 0 and finds too few features: the block does not build.
-Escalation (upsampled SIFT, more features, affine shape + DSP, more pairs) registers every frame in one block.
+Escalation (upsampled SIFT, more and fainter features, more pairs) registers every frame in one block.
 """
 import json
 import os
@@ -19,6 +19,7 @@ from core.align.escalation import (
     escalated_sift,
     escalation_reason,
     forget_features,
+    kind_order,
     round_pairs,
 )
 from core.align.options import AlignError, AlignOptions
@@ -101,8 +102,22 @@ def test_escalation_reason_and_settings():
     assert s["first_octave"] == -1 and s["peak_threshold"] < 0.0066 and "domain_size_pooling" not in s
     assert s["max_num_features"] == ESCALATION_MIN_FEATURES
     assert escalated_sift(AlignOptions(max_features=6000), 4000, 3000)["max_num_features"] == 12000
-    s2 = escalated_sift(AlignOptions(), 1152, 640, 2)  # round 2 adds affine shape + domain-size pooling
-    assert s2["estimate_affine_shape"] and s2["domain_size_pooling"] and s2["first_octave"] == -1
+    s2 = escalated_sift(AlignOptions(), 1152, 640, "affine")  # affine shape at SIFT's default threshold, no DSP
+    assert s2["estimate_affine_shape"] and "domain_size_pooling" not in s2 and "peak_threshold" not in s2
+    assert s2["first_octave"] == -1 and s2["max_num_features"] == 4096
+    assert escalated_sift(AlignOptions(max_features=6000), 4000, 3000, "affine")["max_num_features"] == 6000
+    with pytest.raises(ValueError, match="unknown escalation kind"):
+        escalated_sift(AlignOptions(), 1152, 640, "dsp")
+
+
+def test_the_round_that_fits_the_failure_runs_first():
+    viewpoint = "matched 7 image(s) but could not be registered (too few 2D-3D correspondences)"
+    texture = "no verified matches with any other image (no overlap, blur or too little texture)"
+    component = "in a separate component (#2, 3 images) that shares too few matches with the main block"
+    assert kind_order({"a": viewpoint, "b": viewpoint, "c": texture}, ["a", "b", "c"]) == ("affine", "faint")
+    assert kind_order({"a": texture, "b": texture}, ["a", "b"]) == ("faint", "affine")
+    assert kind_order({"a": component, "b": viewpoint}, ["a", "b"]) == ("faint", "affine")  # no majority
+    assert kind_order({}, ["a"]) == ("faint", "affine")
 
 
 def test_round_pairs_rematch_what_changed_and_add_pairs_for_the_left_out():
@@ -140,6 +155,7 @@ def test_fast_path_fails_on_small_low_contrast_frames_and_escalation_fixes_it(sm
     assert record["reason"].startswith("5 of 5 images not in the main block")
     first = record["rounds"][0]
     assert first["sift"]["first_octave"] == -1 and first["kept"] and first["registered_after"] == 5
+    assert first["kind"] == "faint"  # no verified pair anywhere: a texture/contrast failure, fainter features first
     assert sorted(first["re_extracted"]) == sorted(n.replace(".JPG", ".png") for n in SMALL_FRAMES)
     for n in SMALL_FRAMES:  # per image: why it was escalated, what was done and the outcome
         one = record["images"][n.replace(".JPG", ".png")]
@@ -197,9 +213,9 @@ def test_a_round_not_kept_puts_the_database_back(tmp_path, monkeypatch):
     db = tmp_path / "database.db"
     _sql(db, "CREATE TABLE keypoints (image_id INTEGER, rows INTEGER)", "INSERT INTO keypoints VALUES (1, 10)")
 
-    def worse_round(ctx, k, reason, ordered, left, progress):
+    def worse_round(ctx, k, reason, ordered, left, progress, kind="faint"):
         _sql(ctx.db_path, "DELETE FROM keypoints")  # the round's new features...
-        return esc.EscalationRound(k, reason, {n: "?" for n in left}, list(left), [], {}, 1, 2, 1, 1, 1), []
+        return esc.EscalationRound(k, reason, kind, {n: "?" for n in left}, list(left), [], {}, 1, 2, 1, 1, 1), []
 
     monkeypatch.setattr(esc, "_run_round", worse_round)
     ctx = esc.EscalationContext(None, str(db), str(tmp_path), str(tmp_path), ["a", "b", "c"], [], {}, AlignOptions(),
@@ -223,7 +239,7 @@ def test_a_cancelled_round_puts_the_database_back(tmp_path, monkeypatch):
     db = tmp_path / "database.db"
     _sql(db, "CREATE TABLE keypoints (image_id INTEGER, rows INTEGER)", "INSERT INTO keypoints VALUES (1, 10)")
 
-    def cancelled_round(ctx, k, reason, ordered, left, progress):
+    def cancelled_round(ctx, k, reason, ordered, left, progress, kind="faint"):
         _sql(ctx.db_path, "DELETE FROM keypoints")  # features forgotten, then the user cancels
         raise Cancelled("cancelled by the user")
 
@@ -254,15 +270,15 @@ def test_round_two_counts_the_pairs_round_one_found_even_when_its_result_was_not
         c.close()
         return {"c": n}
 
-    def worse_round(ctx, k, reason, ordered, left, progress):
-        rounds.append((k, list(left)))
+    def worse_round(ctx, k, reason, ordered, left, progress, kind="faint"):
+        rounds.append((k, kind, list(left)))
         if k == 1:
             _sql(ctx.db_path, "INSERT INTO verified VALUES ('c')")  # round 1's features give c a verified pair...
-        return esc.EscalationRound(k, reason, {n: "?" for n in left}, list(left), [], {}, 1, 2, 1, 1, 1), []
+        return esc.EscalationRound(k, reason, kind, {n: "?" for n in left}, list(left), [], {}, 1, 2, 1, 1, 1), []
 
     monkeypatch.setattr(esc, "_run_round", worse_round)
     ctx = esc.EscalationContext(None, str(db), str(tmp_path), str(tmp_path), ["a", "b", "c"], [], {}, AlignOptions(),
                                 [], None, [], lambda p: [], lambda reg, oth: {}, partners)
     esc.escalate(ctx, [_Rec(["a", "b"])], NullProgress())
     assert partners() == {"c": 0}  # ...but its database was put back (its mapping was not better)
-    assert rounds == [(1, ["c"]), (2, ["c"])]
+    assert rounds == [(1, "faint", ["c"]), (2, "affine", ["c"])]  # no diagnosis: faint first

@@ -4,20 +4,27 @@ The fast path (``features`` + ``pairs``) is tuned for speed on typical drone fra
 from ``UPSAMPLE_BELOW`` px, about 4000 features per megapixel, spatial or sequential pairs.  On other frames
 (small scans, low texture, low overlap) it can leave images unregistered or split the block into components
 where pycolmap's default pipeline (upsampled SIFT, 8192 features, exhaustive pairs) does not.  After the first
-mapping, :func:`escalate` retries *only the images left out of the main block and their neighbours*, the
-cheaper retry first:
+mapping, :func:`escalate` retries *only the images left out of the main block and their neighbours*, in
+one or two rounds of two kinds, the one that fits the failure first:
 
-1. **round 1** -- the left-out images, plus the registered images they matched best (from the database's raw
-   matches) and the cameras next to those in the model ("guided by what did register"), are extracted again
-   with upsampled SIFT (``first_octave = -1``), twice the features (at least 8192) and a third of SIFT's peak
-   threshold (faint, low-contrast features); their old matches are removed; they are matched again on the
-   original pairs plus new pairs: every pair among the left-out images and each left-out image with every
-   neighbour;
-2. **round 2** (only when round 1 still leaves images out or the block split) -- the same with affine-shape
-   estimation and domain-size pooling (features that survive strong perspective and scale change; slower),
-   on every image with exhaustive pairs in a block of up to ``ESCALATE_ALL_MAX`` images; in a larger block on
-   the left-out images and their neighbours (chosen again), each left-out image paired with every registered
-   image: the cost stays that of the images that failed, not of the block.
+- **faint** -- for images with no verified pair or in a separate component (too little texture or contrast,
+  weak links): the left-out images, plus the registered images they matched best (from the database's raw
+  matches) and the cameras next to those in the model ("guided by what did register"), are extracted again
+  with upsampled SIFT (``first_octave = -1``), twice the features (at least 8192) and a third of SIFT's peak
+  threshold (faint, low-contrast features); their old matches are removed; they are matched again on the
+  original pairs plus new pairs: every pair among the left-out images and each left-out image with every
+  neighbour;
+- **affine** -- for images that matched others but could not be registered (too few 2D-3D correspondences:
+  strong perspective change, the 65 deg views of an orbit): upsampled SIFT with affine-shape estimation
+  (features that survive strong perspective and scale change) at SIFT's default threshold and at least 4096
+  features, on every image with exhaustive pairs in a block of up to ``ESCALATE_ALL_MAX`` images; in a larger
+  block on the left-out images and their neighbours (chosen again), each left-out image paired with every
+  registered image: the cost stays that of the images that failed, not of the block.  (Domain-size pooling
+  is not used: on the synthetic orbit it tripled the feature time and registered no image more than affine
+  shape alone; measured in docs/measurements.md.)
+
+The kind most of the left-out images call for runs first; the other runs second only when images are still out
+and have shared a verified pair with some image (a foreign photo is not escalated twice).
 
 After each round the mapping runs again on the enlarged database (one merged reconstruction); a round's result
 is kept only when it registers more images in the main block (or as many in fewer components); otherwise the
@@ -42,9 +49,11 @@ from .options import AlignOptions
 
 ESCALATION_MIN_FEATURES = 8192  # pycolmap's default SIFT budget: the escalated budget is never below it
 ESCALATION_PEAK_THRESHOLD = 0.02 / 3 / 3  # a third of SIFT's default (0.02 / octave_resolution): faint features
+AFFINE_MIN_FEATURES = 4096  # the affine round's budget: as many registered as with 8192, matching ~4x cheaper
+KINDS = ("faint", "affine")
 ANCHORS_PER_IMAGE = 6  # registered images a left-out image matched best
 MODEL_NEIGHBOURS = 3  # registered cameras next to each anchor in the model
-ESCALATE_ALL_MAX = 20  # round 2 re-extracts and matches every image exhaustively in a block this small
+ESCALATE_ALL_MAX = 20  # an affine round re-extracts and matches every image exhaustively in a block this small
 PAIR_ID_BASE = 2147483647  # COLMAP: pair_id = image_id1 * 2147483647 + image_id2 (image_id1 < image_id2)
 
 
@@ -54,6 +63,7 @@ class EscalationRound:
 
     round: int
     reason: str
+    kind: str  # "faint" or "affine" (see the module's docstring)
     left_out: Dict[str, str]  # image -> why it was outside the main block before this round
     re_extracted: List[str]
     neighbours: List[str]  # registered images re-extracted with the left-out ones
@@ -106,15 +116,25 @@ def escalation_reason(n_images: int, registered: Set[str], others: Sequence[Sequ
     return "; ".join(parts) or None
 
 
-def escalated_sift(options: AlignOptions, width: int, height: int, round_: int = 1) -> Dict[str, object]:
-    """The SIFT settings of escalation round ``round_``: upsampled, more and fainter features; from round 2 also
-    affine shape + domain-size pooling."""
+def escalated_sift(options: AlignOptions, width: int, height: int, kind: str = "faint") -> Dict[str, object]:
+    """The SIFT settings of an escalation round of ``kind``: "faint" -- upsampled, more and fainter features;
+    "affine" -- upsampled with affine-shape estimation at SIFT's default threshold."""
+    if kind not in KINDS:
+        raise ValueError(f"unknown escalation kind {kind!r}; one of {', '.join(KINDS)}")
     base = int(options.max_features or auto_max_features(width, height, options.max_image_size))
-    out: Dict[str, object] = {"first_octave": -1, "max_num_features": max(ESCALATION_MIN_FEATURES, 2 * base),
-                              "peak_threshold": ESCALATION_PEAK_THRESHOLD}
-    if round_ >= 2:
-        out.update(estimate_affine_shape=True, domain_size_pooling=True)
-    return out
+    if kind == "affine":
+        return {"first_octave": -1, "max_num_features": max(AFFINE_MIN_FEATURES, base),
+                "estimate_affine_shape": True}
+    return {"first_octave": -1, "max_num_features": max(ESCALATION_MIN_FEATURES, 2 * base),
+            "peak_threshold": ESCALATION_PEAK_THRESHOLD}
+
+
+def kind_order(why: Dict[str, str], left: Sequence[str]) -> Tuple[str, str]:
+    """The order of the two kinds of round for the ``left`` out images, from the diagnosis ``why`` (image ->
+    the reason it is outside the main block): "affine" first when most of them matched other images but could
+    not be registered (a viewpoint problem), "faint" first otherwise (no verified pair, a separate component)."""
+    viewpoint = sum(1 for n in left if "could not be registered" in why.get(n, ""))
+    return ("affine", "faint") if viewpoint * 2 > len(left) else ("faint", "affine")
 
 
 def _pair_counts(db_path: str) -> Tuple[Dict[int, str], Dict[Tuple[str, str], int]]:
@@ -239,29 +259,31 @@ def _better(new, old) -> bool:
     return (len(rn), -len(on)) > (len(ro), -len(oo))
 
 
-def _round_images(ctx: EscalationContext, k: int, registered: Set[str], left: List[str], ordered):
-    """(neighbours, exhaustive) of round ``k``: round 2 takes every image (exhaustive pairs) in a block of up
-    to ESCALATE_ALL_MAX images."""
-    if k >= 2 and len(ctx.order) <= ESCALATE_ALL_MAX:
+def _round_images(ctx: EscalationContext, kind: str, registered: Set[str], left: List[str], ordered):
+    """(neighbours, exhaustive) of a round of ``kind``: an affine round takes every image (exhaustive pairs) in
+    a block of up to ESCALATE_ALL_MAX images (features of one kind on both sides of every pair)."""
+    if kind == "affine" and len(ctx.order) <= ESCALATE_ALL_MAX:
         return [n for n in ctx.order if n in registered], True
     neighbours = choose_neighbours(ctx.db_path, ctx.order, registered, left, ordered[0] if ordered else None)
     return neighbours, False
 
 
 def _run_round(ctx: EscalationContext, k: int, reason: str, ordered, left: List[str],
-               progress: Progress) -> Tuple[EscalationRound, list]:
-    """Round ``k``: re-extract the ``left`` out images and their neighbours, match them again, map again."""
+               progress: Progress, kind: str = "faint") -> Tuple[EscalationRound, list]:
+    """Round ``k`` of ``kind``: re-extract the ``left`` out images and their neighbours, match them again, map
+    again."""
     t0 = time.time()
     registered, others = block_state(ordered)
     why = ctx.diagnose(registered, others)
-    neighbours, exhaustive = _round_images(ctx, k, registered, left, ordered)
+    neighbours, exhaustive = _round_images(ctx, kind, registered, left, ordered)
     redo = [n for n in ctx.order if n in set(left) | set(neighbours)]
     g0 = max(ctx.groups, key=lambda g: g.width * g.height)
-    sift = escalated_sift(ctx.options, g0.width, g0.height, k)
-    extra = ", affine shape + DSP" if sift.get("domain_size_pooling") else ""
-    progress.info(f"escalation round {k} ({reason}): {len(left)} image(s) left out, re-extracting {len(redo)} "
-                  f"with upsampled SIFT (first octave -1), {sift['max_num_features']} features, peak threshold "
-                  f"{sift['peak_threshold']:.4f}{extra}")
+    sift = escalated_sift(ctx.options, g0.width, g0.height, kind)
+    extra = ", affine shape" if sift.get("estimate_affine_shape") else ""
+    threshold = sift.get("peak_threshold")
+    progress.info(f"escalation round {k}, {kind} ({reason}): {len(left)} image(s) left out, re-extracting "
+                  f"{len(redo)} with upsampled SIFT (first octave -1), {sift['max_num_features']} features"
+                  + (f", peak threshold {threshold:.4f}" if threshold else "") + extra)
     for n in left:
         progress.info(f"escalation round {k}: {n}: {why.get(n, 'not in the main block')}")
     forget_features(ctx.db_path, redo)
@@ -269,7 +291,7 @@ def _run_round(ctx: EscalationContext, k: int, reason: str, ordered, left: List[
                      SubProgress(progress, 0.0, 0.4), ctx.mask_path, ctx.masked, sift=sift)
     t_features = time.time() - t0
     pairs = round_pairs(ctx.pairs, left, neighbours, ctx.order, exhaustive)
-    if k >= 2 and not exhaustive:  # a larger block: each left-out image with every registered one
+    if kind == "affine" and not exhaustive:  # a larger block: each left-out image with every registered one
         pairs = sorted(set(pairs) | {(min(a, b), max(a, b)) for a in left for b in registered})
     progress.info(f"escalation round {k}: matching {len(pairs)} pairs")
     match_pairs(ctx.pycolmap, ctx.db_path, pairs, ctx.work_dir, ctx.options, SubProgress(progress, 0.4, 0.7))
@@ -277,7 +299,7 @@ def _run_round(ctx: EscalationContext, k: int, reason: str, ordered, left: List[
     check_cancel(progress)
     new = ctx.mapping(SubProgress(progress, 0.7, 1.0))
     reg_new, others_new = block_state(new)
-    row = EscalationRound(k, reason, {n: why.get(n, "") for n in left}, redo, [n for n in neighbours if n in redo],
+    row = EscalationRound(k, reason, kind, {n: why.get(n, "") for n in left}, redo, [n for n in neighbours if n in redo],
                           sift, len(pairs), len(registered), (len(others) + 1) if ordered else 0, len(reg_new),
                           (len(others_new) + 1) if new else 0, kept=_better(new, ordered),
                           seconds=round(time.time() - t0, 2),
@@ -303,7 +325,7 @@ def _backup_database(db_path: str) -> str:
 
 def _hopeful(ctx: EscalationContext, registered: Set[str], others: List[List[str]], progress: Progress,
              round1: Optional[Dict[str, int]] = None) -> List[str]:
-    """The images round 2 (affine shape + DSP, the slow features) is worth running for: those still outside the
+    """The images round 2 (the other kind of features) is worth running for: those still outside the
     main block that, after round 1's richer features, share a verified pair with some image or sit in another
     component.  An image without any verified pair after round 1 shares no ground with the block (a foreign
     photo, sky, water): round 2 would not change that and is not run for it.  ``round1``: the verified partners
@@ -333,8 +355,9 @@ def escalate(ctx: EscalationContext, ordered, progress: Progress):
     progress.warning(f"fast path: {reason}; escalating for the images left out")
     first_left = [n for n in ctx.order if n not in registered]
     left = first_left
+    kinds = kind_order(ctx.diagnose(registered, others), first_left)
     round1_partners: Dict[str, int] = {}
-    for k in (1, 2):
+    for k, kind in zip((1, 2), kinds):
         if k == 2:
             registered, others = block_state(ordered)
             reason = escalation_reason(len(ctx.order), registered, others)
@@ -345,7 +368,8 @@ def escalate(ctx: EscalationContext, ordered, progress: Progress):
                 break
         backup = _backup_database(ctx.db_path)
         try:
-            row, new = _run_round(ctx, k, reason, ordered, left, SubProgress(progress, (k - 1) / 2.0, k / 2.0))
+            row, new = _run_round(ctx, k, reason, ordered, left, SubProgress(progress, (k - 1) / 2.0, k / 2.0),
+                                  kind=kind)
             record.rounds.append(row)
             if k == 1:
                 round1_partners = ctx.partners()  # before its database may be put back
@@ -371,8 +395,8 @@ def escalate(ctx: EscalationContext, ordered, progress: Progress):
         done = [r.round for r in record.rounds if n in r.left_out]
         record.images[n] = {"why": record.rounds[0].left_out.get(n, ""), "rounds": done,
                             "registered": n in final,
-                            "escalated": [("upsampled SIFT (first octave -1), more and fainter features"
-                                           + (", affine shape + DSP" if r.round >= 2 else "")
+                            "escalated": [(("upsampled SIFT (first octave -1) with affine shape" if r.kind == "affine"
+                                            else "upsampled SIFT (first octave -1), more and fainter features")
                                            + f", {r.pairs_matched} pairs matched again") for r in record.rounds
                                           if n in r.left_out]}
     return ordered, record
