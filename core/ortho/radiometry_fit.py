@@ -34,7 +34,8 @@ MAX_PAIRS = 500_000
 SEARCH_PAIRS = 60_000  # pairs the hot spot's direction is searched on
 MIN_PAIRS = 2000
 PRIOR_FALLOFF, PRIOR_HOT, PRIOR_EXPOSURE = 1.0, 0.5, 0.5  # prior sigmas (log), all centred on 0
-PRIOR_FIELD = (0.1, 0.05, 0.05, 0.05, 0.05, 0.05)
+PRIOR_FIELD = (0.05, 0.02, 0.02, 0.01, 0.01, 0.01)  # constant, linear, quadratic: a gentle field
+FIELD_GAIN = 0.9  # the fields are kept only if they cut the overlaps' disagreement to this share of it
 HOT_WIDTHS_DEG = (6.0, 10.0, 16.0)
 
 
@@ -274,6 +275,10 @@ def _fit_model(obs: _Obs, a, b, groups: np.ndarray, n_groups: int, n_images: int
                       FIELD_TERMS * n_images)
     prior_f = np.tile(np.asarray(PRIOR_FIELD), n_images)
     p2, w, sigma = _irls(x2, y2, prior_f, iterations=2, w=w, dense=len(prior_f) <= 2000)
+    ia, ib, cells = obs.image[a], obs.image[b], obs.cell[a]
+    if not chunk_disagreement(ia, ib, cells, obs.shape[1], y2 - x2 @ p2) < \
+            FIELD_GAIN * chunk_disagreement(ia, ib, cells, obs.shape[1], y2):
+        p2 = np.zeros_like(p2)  # the fields would only fit noise (weak overlaps): left out
     progress.report(0.9, "radiometry: gain fields fitted")
     model = RadiometryModel(groups=[int(g) for g in groups], falloff=falloff.tolist(), hot=hot.tolist(),
                             antisolar=[float(v) for v in antisolar], hot_width=float(width),
@@ -305,7 +310,8 @@ def fit_from_samples(obs: _Obs, prep: _Prepared, hot_spot: bool, progress: Progr
     summary.update({"overlap_step_before": before, "overlap_step_after": after, "camera_ids": ids,
                     "falloff": {str(cid): [round(float(model.falloff_at(g, r)), 4) for r in (0.25, 0.5, 0.75, 1.0)]
                                 for g, cid in enumerate(ids)},
-                    "hot_spot": [round(h, 4) for h in model.hot]})
+                    "hot_spot": [round(h, 4) for h in model.hot], "antisolar": [round(v, 5) for v in model.antisolar],
+                    "hot_width_deg": round(math.degrees(model.hot_width), 2)})
     if not (after < before):
         summary["skipped"] = (f"the fit does not make the overlaps agree better ({100 * before:.1f} % before, "
                               f"{100 * after:.1f} % after)")

@@ -3,8 +3,8 @@ mosaic inside run_stage() and records its outputs."""
 from __future__ import annotations
 
 import os
-from dataclasses import asdict, dataclass, replace
-from typing import Dict, List, Optional, Tuple
+from dataclasses import asdict, dataclass, field, replace
+from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 
@@ -35,6 +35,7 @@ class OrthoStageResult:
     timings: Dict[str, float]
     warnings: List[str]
     log_lines: List[str]
+    radiometry: Dict[str, Any] = field(default_factory=dict)  # the radiometric correction's figures (if applied)
 
 
 def workspace_dsm(ws: Workspace) -> Optional[str]:
@@ -85,7 +86,8 @@ def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = Non
             "resolution": result.resolution, "gsd": result.gsd, "width": result.width, "height": result.height,
             "images": len(result.images), "valid_fraction": result.valid_fraction, "warnings": result.warnings})
     return OrthoStageResult(lay.root, output, crs, result.resolution, result.images, result.valid_fraction,
-                            per_image_folder, seamlines, result.timings, result.warnings, result.log_lines)
+                            per_image_folder, seamlines, result.timings, result.warnings, result.log_lines,
+                            result.radiometry)
 
 
 def _check_photos(ws: Workspace, cams: List[OrthoCamera]) -> List[str]:
