@@ -378,8 +378,8 @@ def test_far_field_limit_keeps_the_ground_of_a_vertical_beside_tall_objects(tmp_
 
 @pytest.fixture(scope="module")
 def orbit_run(orbit, tmp_path_factory):
-    """The 16 orbit images rendered, sky-masked by 'Prepare images', aligned (affine-shape SIFT, the option for
-    oblique sets), georeferenced with 5 control points, matched (full quality) and mosaicked; a few minutes."""
+    """The 16 orbit images rendered, sky-masked by 'Prepare images', aligned (default options: the fast path,
+    then escalation's affine-shape round for the views it leaves out), georeferenced with 5 control points, matched (full quality) and mosaicked; a few minutes."""
     import time
 
     from core.align.options import AlignOptions
@@ -399,7 +399,8 @@ def orbit_run(orbit, tmp_path_factory):
     prep = prepare_images_workspace(str(root / "photos"), ws, options=PrepareOptions(sky_masks=True))
     t["prepare"] = time.time() - t0
     t0 = time.time()
-    aligned = align(prep.prepared_dir, ws, AlignOptions(pairing="exhaustive", num_threads=2, affine_features=True))
+    # default features: the fast path leaves 65 deg views out, the escalation's affine round brings them in
+    aligned = align(prep.prepared_dir, ws, AlignOptions(pairing="exhaustive", num_threads=2))
     t["align"] = time.time() - t0
     control = orbit.spread_control(5)
     t0 = time.time()
@@ -433,6 +434,8 @@ def test_orbit_every_camera_registered_and_no_sky_tie_point(orbit, orbit_run):
     from core.align.stage import load_model
 
     assert orbit_run["aligned"].registered == len(orbit.shots)
+    esc = orbit_run["aligned"].escalation  # where the fast path left views out, the affine round brought them in
+    assert esc is None or any(r["kind"] == "affine" and r["kept"] for r in esc["rounds"]), esc
     rec = load_model(orbit_run["ws"])
     n_kp = n_tie = 0
     for im in rec.images.values():
