@@ -613,6 +613,11 @@ Höhenlinien: wohin die Höhenlinien geschrieben werden (Vorgabe: &lt;workspace&
         <translation>Nahtlinien</translation>
     </message>
     <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="74"/>
+        <source>Seamlines to follow</source>
+        <translation>Zu befolgende Nahtlinien</translation>
+    </message>
+    <message>
         <location filename="../processing_provider/build_orthophoto.py" line="108"/>
         <source>Seamlines must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>Nahtlinien müssen eine GeoPackage-Datei (.gpkg) sein, erhalten: {}</translation>
@@ -636,7 +641,8 @@ Seam blending: feather (a ramp across seams), multiband (Laplacian pyramid: no v
 Far-field limit (advanced): each image is used only where its ground resolution is within this factor of its best, so the stretched far field of an oblique (towards the horizon) is left out and the mosaic takes those cells from a nearer view; cells no image sees finely enough stay empty. 0 = off (default 3).
 Orthomosaic: Cloud-Optimized GeoTIFF with overviews, the images&apos; bands and data type (8/16 bit kept) plus an alpha band (default &lt;workspace&gt;/orthomosaic.tif).
 Per-image orthophotos folder: optional folder for one true orthophoto per image (COG).
-Seamlines: optional GeoPackage of polygons naming the image each part of the mosaic comes from.
+Seamlines: optional GeoPackage of polygons naming the image each part of the mosaic comes from (one polygon per image, its name in the field &apos;image&apos;); edit it to move a seam.
+Seamlines to follow: optional edited seamlines (polygons with the field &apos;image&apos;, in the mosaic&apos;s CRS): where a polygon names an image, the mosaic takes that image where it sees the ground (the log says where it does not); automatic seams elsewhere. Reshape a polygon, or draw one and name its image, to move a seam off a crop mark or a moving car, and run again.
 Dask scheduler (advanced): render the tiles on a Dask cluster (tcp://host:8786) whose workers see the workspace path; empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER.</source>
         <translation>Wahre Orthophotos und das Orthomosaik eines georeferenzierten Arbeitsbereichs.
 
@@ -650,7 +656,8 @@ Auflösung: Zellgröße in KBS-Einheiten; 0 = die Bodenauflösung der Bilder.
 Fernfeld-Grenze (erweitert): jedes Bild wird nur dort verwendet, wo seine Bodenauflösung innerhalb dieses Faktors seiner besten liegt; so bleibt das gedehnte Fernfeld einer Schrägaufnahme (zum Horizont hin) weg, und das Mosaik nimmt diese Zellen aus einer näheren Ansicht; Zellen, die kein Bild fein genug sieht, bleiben leer. 0 = aus (Vorgabe 3).
 Orthomosaik: Cloud-Optimized GeoTIFF mit Übersichten, den Kanälen und dem Datentyp der Bilder (8/16 Bit bleiben) und einem Alphakanal (Vorgabe &lt;workspace&gt;/orthomosaic.tif).
 Ordner für Einzelbild-Orthophotos: optionaler Ordner für ein wahres Orthophoto je Bild (COG).
-Nahtlinien: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem jeder Teil des Mosaiks stammt.
+Nahtlinien: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem jeder Teil des Mosaiks stammt (ein Polygon je Bild, sein Name im Feld 'image'); bearbeiten Sie es, um eine Naht zu verschieben.
+Zu befolgende Nahtlinien: optionale bearbeitete Nahtlinien (Polygone mit dem Feld 'image', im KBS des Mosaiks): wo ein Polygon ein Bild nennt, nimmt das Mosaik dieses Bild, wo es den Boden sieht (das Protokoll sagt, wo nicht); anderswo automatische Nähte. Formen Sie ein Polygon um oder zeichnen Sie eines und nennen Sie sein Bild, um eine Naht von einem Bewuchsmerkmal oder einem fahrenden Auto wegzulegen, und starten Sie erneut.
 Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786) rechnen, dessen Worker den Pfad des Arbeitsbereichs sehen; leer = dieser Rechner, oder $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
     </message>
 </context>

@@ -613,6 +613,11 @@ Curve di livello: dove scrivere le curve di livello (predefinito: &lt;workspace&
         <translation>Linee di giunzione</translation>
     </message>
     <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="74"/>
+        <source>Seamlines to follow</source>
+        <translation>Linee di giunzione da seguire</translation>
+    </message>
+    <message>
         <location filename="../processing_provider/build_orthophoto.py" line="108"/>
         <source>Seamlines must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>Le linee di giunzione devono essere un file GeoPackage (.gpkg), ricevuto {}</translation>
@@ -636,7 +641,8 @@ Seam blending: feather (a ramp across seams), multiband (Laplacian pyramid: no v
 Far-field limit (advanced): each image is used only where its ground resolution is within this factor of its best, so the stretched far field of an oblique (towards the horizon) is left out and the mosaic takes those cells from a nearer view; cells no image sees finely enough stay empty. 0 = off (default 3).
 Orthomosaic: Cloud-Optimized GeoTIFF with overviews, the images&apos; bands and data type (8/16 bit kept) plus an alpha band (default &lt;workspace&gt;/orthomosaic.tif).
 Per-image orthophotos folder: optional folder for one true orthophoto per image (COG).
-Seamlines: optional GeoPackage of polygons naming the image each part of the mosaic comes from.
+Seamlines: optional GeoPackage of polygons naming the image each part of the mosaic comes from (one polygon per image, its name in the field &apos;image&apos;); edit it to move a seam.
+Seamlines to follow: optional edited seamlines (polygons with the field &apos;image&apos;, in the mosaic&apos;s CRS): where a polygon names an image, the mosaic takes that image where it sees the ground (the log says where it does not); automatic seams elsewhere. Reshape a polygon, or draw one and name its image, to move a seam off a crop mark or a moving car, and run again.
 Dask scheduler (advanced): render the tiles on a Dask cluster (tcp://host:8786) whose workers see the workspace path; empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER.</source>
         <translation>Ortofoto vere e l'ortomosaico di un'area di lavoro georeferenziata.
 
@@ -650,7 +656,8 @@ Sfumatura delle giunzioni: feather (rampa attraverso le giunzioni), multiband (p
 Limite del campo lontano (avanzato): ogni immagine è usata solo dove la sua risoluzione al suolo è entro questo fattore della sua migliore, così il campo lontano allungato di una foto obliqua (verso l'orizzonte) è escluso e il mosaico prende quelle celle da una vista più vicina; le celle che nessuna immagine vede abbastanza finemente restano vuote. 0 = spento (predefinito 3).
 Ortomosaico: Cloud-Optimized GeoTIFF con panoramiche, le bande e il tipo di dato delle immagini (8/16 bit conservati) più una banda alfa (predefinito &lt;workspace&gt;/orthomosaic.tif).
 Cartella delle ortofoto per immagine: cartella facoltativa per un'ortofoto vera per immagine (COG).
-Linee di giunzione: GeoPackage facoltativo di poligoni che indicano l'immagine da cui proviene ogni parte del mosaico.
+Linee di giunzione: GeoPackage facoltativo di poligoni che indicano l'immagine da cui proviene ogni parte del mosaico (un poligono per immagine, il suo nome nel campo 'image'); modificarlo per spostare una giunzione.
+Linee di giunzione da seguire: linee di giunzione modificate facoltative (poligoni con il campo 'image', nel SR del mosaico): dove un poligono indica un'immagine, il mosaico usa quell'immagine dove vede il terreno (il registro dice dove no); altrove giunzioni automatiche. Rimodellare un poligono, o disegnarne uno e indicarne l'immagine, per spostare una giunzione da una traccia nelle colture o da un'auto in movimento, ed eseguire di nuovo.
 Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:8786) i cui worker vedono il percorso dell'area di lavoro; vuoto = questo computer, oppure $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
     </message>
 </context>

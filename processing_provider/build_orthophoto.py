@@ -1,8 +1,10 @@
 """Build orthophoto: thin adapter over core.ortho.stage.build_orthophoto_workspace."""
 from qgis.core import (
+    QgsProcessing,
     QgsProcessingException,
     QgsProcessingOutputFolder,
     QgsProcessingOutputNumber,
+    QgsProcessingParameterFeatureSource,
     QgsProcessingParameterFolderDestination,
     QgsProcessingParameterRasterDestination,
     QgsProcessingParameterRasterLayer,
@@ -29,6 +31,7 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
     OUTPUT = "OUTPUT"
     PER_IMAGE_FOLDER = "PER_IMAGE_FOLDER"
     SEAMLINES = "SEAMLINES"
+    SEAMLINES_IN = "SEAMLINES_IN"
     OUT_WORKSPACE = "WORKSPACE"  # the same name as the input: models chain stages through it
     VALID_FRACTION = "VALID_FRACTION"
     RESOLUTION_USED = "RESOLUTION_USED"
@@ -57,7 +60,12 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
         "Orthomosaic: Cloud-Optimized GeoTIFF with overviews, the images' bands and data type (8/16 bit kept) plus "
         "an alpha band (default <workspace>/orthomosaic.tif).\n"
         "Per-image orthophotos folder: optional folder for one true orthophoto per image (COG).\n"
-        "Seamlines: optional GeoPackage of polygons naming the image each part of the mosaic comes from.\n"
+        "Seamlines: optional GeoPackage of polygons naming the image each part of the mosaic comes from (one "
+        "polygon per image, its name in the field 'image'); edit it to move a seam.\n"
+        "Seamlines to follow: optional edited seamlines (polygons with the field 'image', in the mosaic's CRS): "
+        "where a polygon names an image, the mosaic takes that image where it sees the ground (the log says where "
+        "it does not); automatic seams elsewhere. Reshape a polygon, or draw one and name its image, to move a "
+        "seam off a crop mark or a moving car, and run again.\n"
         "Dask scheduler (advanced): render the tiles on a Dask cluster (tcp://host:8786) whose workers see the "
         "workspace path; empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER."
     )
@@ -72,6 +80,9 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
                 defaultValue="", optional=True),
             params.number(self.RESOLUTION, self.tr("Resolution")),
             params.blending(self.BLENDING, self.tr("Seam blending")),
+            QgsProcessingParameterFeatureSource(
+                self.SEAMLINES_IN, self.tr("Seamlines to follow"), [QgsProcessing.SourceType.TypeVectorPolygon],
+                optional=True),
             *params.advanced(
                 params.choice(self.INTERPOLATION, self.tr("Resampling"), self.INTERPOLATIONS),
                 params.number(self.GSD_FACTOR, self.tr(
@@ -92,6 +103,17 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
         self.addOutput(QgsProcessingOutputNumber(self.RESOLUTION_USED, self.tr("Resolution used")))
         self.addOutput(QgsProcessingOutputNumber(self.IMAGES_USED, self.tr("Images in the mosaic")))
 
+    def seamlines_in(self, parameters, context, feedback):
+        """The edited seamlines as a file the core reads ('path|layername=...'; a layer that is not a file is
+        written to a temporary GeoPackage first); None when not given."""
+        if not parameters.get(self.SEAMLINES_IN):
+            return None
+        path, layer = self.parameterAsCompatibleSourceLayerPathAndLayerName(
+            parameters, self.SEAMLINES_IN, context, ["gpkg", "shp", "geojson", "fgb"], "gpkg", feedback)
+        if not path:
+            return None
+        return f"{path}|layername={layer}" if layer else path
+
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
         from ..core.ortho.options import OrthoOptions
         from ..core.ortho.stage import build_orthophoto_workspace
@@ -111,7 +133,8 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
             interpolation=params.read_choice(self, parameters, self.INTERPOLATION, context, self.INTERPOLATIONS),
             gsd_factor=self.parameterAsDouble(parameters, self.GSD_FACTOR, context),
             workers=self.parameterAsInt(parameters, self.WORKERS, context),
-            scheduler=params.read_scheduler(self, parameters, self.SCHEDULER, context))
+            scheduler=params.read_scheduler(self, parameters, self.SCHEDULER, context),
+            seamlines_in=self.seamlines_in(parameters, context, feedback))
         progress = FeedbackProgress(feedback)
         result = self.run_core(
             build_orthophoto_workspace, workspace, dsm_path=dsm_path,

@@ -13,14 +13,16 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..common import parallel
-from ..common.files import atomic_output, owned_tempdir
+from ..common.files import owned_tempdir
 from ..common.progress import NullProgress, Progress, SubProgress
+from ..io import raster as dsmmod
 from .block import _check_kind, _Prepared, prepare_block, write_camera_ortho
 from .cameras import OrthoCamera
 from .grid import _box_intersects, _tiles
 from .options import OrthoOptions
-from .pixels import _CACHE, _gdal
+from .pixels import _CACHE
 from .radiometry_fit import fit_radiometry
+from .seamlines import read_seamline_edits, write_seamlines
 from .seams import _Plan, _plan_mosaic
 from .surface import _Dsm, fill_dsm_gaps
 from .tiles import _DSM_CACHE, _render_tile, _TileUnit
@@ -59,6 +61,7 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
     options = options or OrthoOptions()
     options.check()
     progress = progress or NullProgress()
+    edits = read_seamline_edits(options.seamlines_in, [c.name for c in cameras], crs) if options.seamlines_in else None
     offset = np.asarray(offset, dtype=float)
     t_start = time.time()
     timings: Dict[str, float] = {}
@@ -97,13 +100,16 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
                        f"at {grid.resolution:g} ({bands} band(s) {dtype}), blending {options.blending}")
             progress.info(log[-1])
             t0 = time.time()
-            plan = _plan_mosaic(prep, dsm, offset, options, workdir, SubProgress(progress, 0.12, 0.2))
+            plan = _plan_mosaic(prep, dsm, offset, options, workdir, SubProgress(progress, 0.12, 0.2), edits)
             timings["planning"] = time.time() - t0
             log.append(f"seamlines: {plan.relief_blobs} raised objects, {plan.relief_reassigned} given whole to one "
                        f"image; mean brightness difference across the seams {100 * plan.seam_before:.1f} % before and "
                        f"{100 * plan.seam_after:.1f} % after moving them to where the images agree; exposure gains "
                        f"{min(plan.gains):.3f}..{max(plan.gains):.3f}")
             progress.info(log[-1])
+            for note in plan.notes:
+                log.append(note)
+                progress.info(note)
             model, summary = _radiometry(prep, dsm, offset, plan, options, log, timings, SubProgress(progress, 0.2, 0.25))
             t0 = time.time()
             n_valid, fill_cells = _run_tiles(prep, plan, dsm_path, crs, offset, output, options, bands, dtype,
@@ -129,7 +135,8 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
                 timings["per_image"] = time.time() - t0
             timings["total"] = time.time() - t_start
             log.append(f"mosaic {output}: {100 * valid_fraction:.1f} % of the cells have data, {fill_cells} cells "
-                       "filled from another image where the planned one is occluded")
+                       f"filled from another image where the planned one is occluded ({plan.hidden_cells} of them "
+                       "hidden from every image by the DSM: from the image that hides them least)")
             progress.report(1.0, "orthomosaic done")
             return MosaicResult(path=output, crs=crs, resolution=grid.resolution, gsd=prep.gsd, width=grid.width,
                                 height=grid.height, images=[c.name for c in prep.cameras],
@@ -190,7 +197,7 @@ def _run_tiles(prep: _Prepared, plan: _Plan, dsm_path: str, crs, offset, output:
         units.append(_TileUnit(i, r0, c0, h, w, halo, asdict(grid), dsm_path, crs, [float(v) for v in offset],
                                prep.cameras, prep.metas, prep.visibility, present, others, plan.gains,
                                plan.labels_path, k, (plan.height, plan.width), plan.feather_cells, options.blending,
-                               options.interpolation, options.cache_mb, radiometry))
+                               options.interpolation, options.cache_mb, radiometry, fill_hidden=options.fill_hidden))
     del labels
     n_valid = 0
     fill = 0
@@ -201,6 +208,7 @@ def _run_tiles(prep: _Prepared, plan: _Plan, dsm_path: str, crs, offset, output:
                 writer.write(res["r0"], res["c0"], res["values"], res["valid"])
                 n_valid += int(res["valid"].sum())
                 fill += res["fill_cells"]
+                plan.hidden_cells += res.get("hidden_cells", 0)
                 del res
                 _trim_heap()
         writer.finish(output, options.compress, None,
@@ -230,39 +238,9 @@ def _trim_heap() -> None:
 
 
 def _write_sources_gpkg(path: str, labels: np.ndarray, prep: _Prepared, plan: _Plan, crs: Optional[str]) -> str:
-    """Polygons of the image each part of the mosaic comes from (the seamlines are their borders)."""
-    gdal = _gdal()
-    from osgeo import ogr, osr
-
-    ogr.UseExceptions()
+    """One polygon per image of the part of the mosaic it gives (the seamlines are their borders): editable, and
+    taken back by Build orthophoto's SEAMLINES_IN (core.ortho.seamlines)."""
     grid = prep.grid
-    p = plan.k * grid.resolution
-    mem = gdal.GetDriverByName("MEM").Create("", plan.width, plan.height, 1, gdal.GDT_Int32)
-    mem.SetGeoTransform((grid.x0, p, 0.0, grid.y0, 0.0, -p))
-    band = mem.GetRasterBand(1)
-    band.WriteArray(labels.astype(np.int32))
-    band.SetNoDataValue(-1)
-    srs = None
-    if crs:
-        srs = osr.SpatialReference()
-        srs.SetFromUserInput(crs)
-        srs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
-    with atomic_output(path) as tmp:
-        ds = ogr.GetDriverByName("GPKG").CreateDataSource(tmp)
-        lyr = ds.CreateLayer("mosaic_sources", srs, ogr.wkbPolygon)
-        lyr.CreateField(ogr.FieldDefn("label", ogr.OFTInteger))
-        gdal.Polygonize(band, band.GetMaskBand(), lyr, 0, [], callback=None)
-        lyr.CreateField(ogr.FieldDefn("image", ogr.OFTString))
-        lyr.CreateField(ogr.FieldDefn("camera_id", ogr.OFTInteger))
-        lyr.CreateField(ogr.FieldDefn("gain", ogr.OFTReal))
-        lyr.StartTransaction()
-        for f in lyr:
-            i = f.GetField("label")
-            if i is not None and 0 <= i < len(prep.cameras):
-                f.SetField("image", prep.cameras[i].name)
-                f.SetField("camera_id", prep.cameras[i].camera_id)
-                f.SetField("gain", plan.gains[i])
-                lyr.SetFeature(f)
-        lyr.CommitTransaction()
-        ds = None
-    return path
+    pgrid = dsmmod.Grid(grid.x0, grid.y0, plan.k * grid.resolution, plan.width, plan.height)
+    return write_seamlines(path, labels, pgrid, [c.name for c in prep.cameras],
+                           [c.camera_id for c in prep.cameras], plan.gains, crs)

@@ -32,6 +32,12 @@ class OrthoOptions:
     height_tolerance: float = 0.0  # m below the sight line still counted visible; 0 = max(0.1, DSM cell)
     fill_dsm_gaps_m: float = 25.0  # DSM gaps inside the data's hull, up to this far from a height, interpolated
     exposure: bool = True  # per-image gain compensation in the mosaic
+    # a mosaic cell every image has hidden (by the DSM: often a spike of a noisy crown) but inside an image takes
+    # the image that hides it least, so the mosaic has no holes; False: such cells stay nodata
+    fill_hidden: bool = True
+    # edited seamlines (a GeoPackage, path[|layername=...]: polygons with an 'image' field): where a polygon names
+    # an image the mosaic takes that image (where it sees the ground), automatic seams elsewhere
+    seamlines_in: Optional[str] = None
     # vignetting and hot spot fitted from the overlaps and removed, seams levelled by a smooth gain field per image
     # (core.ortho.radiometry; applied only where it makes the overlaps agree better); replaces the exposure gains
     radiometry: bool = True

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
@@ -16,6 +16,7 @@ from .block import _Prepared
 from .grid import _cell_centres, _subgrid
 from .options import OrthoOptions
 from .sampling import sample_camera
+from .seamlines import SeamlineEdits, force_edits
 from .surface import _Dsm
 
 PLANNING_GSD = 4.0  # planning cell = 4 x GSD
@@ -35,10 +36,13 @@ class _Plan:
     relief_reassigned: int
     seam_before: float = float("nan")  # mean brightness disagreement of the two images along the seams
     seam_after: float = float("nan")
+    hidden_cells: int = 0  # mosaic cells hidden from every image, taken from the least hidden one (tiles)
+    forced_cells: int = 0  # planning cells given to the image an edited seamline polygon names (SEAMLINES_IN)
+    notes: List[str] = field(default_factory=list)  # lines for the log (the edited seamlines' outcome)
 
 
 def _plan_mosaic(prep: _Prepared, dsm: _Dsm, offset: np.ndarray, options: OrthoOptions, workdir: str,
-                 progress: Progress) -> _Plan:
+                 progress: Progress, edits: Optional[SeamlineEdits] = None) -> _Plan:
     grid = prep.grid
     k = max(1, int(round(PLANNING_GSD * prep.gsd / grid.resolution)))
     while math.ceil(grid.width / k) * math.ceil(grid.height / k) > MAX_PLANNING_CELLS:
@@ -97,11 +101,14 @@ def _plan_mosaic(prep: _Prepared, dsm: _Dsm, offset: np.ndarray, options: OrthoO
     blobs = reassigned = 0
     if options.avoid_relief and np.isfinite(zp).any():
         blobs, reassigned = _avoid_relief(labels, zp, p, windows, costs, options.relief_height)
+    forced, notes = 0, []
+    if edits is not None:  # edited seamlines: the image each polygon names, where it sees the ground
+        forced, notes = force_edits(labels, pgrid, edits, [c.name for c in prep.cameras], costs, windows)
     np.save(os.path.join(workdir, "labels.npy"), labels)
     progress.report(1.0, "mosaic planned")
     feather = max(1, int(round(options.feather_gsd * prep.gsd / (2 * p)))) if options.blending == "feather" else 0
     return _Plan(k, pw, ph, os.path.join(workdir, "labels.npy"), gains, windows, feather, blobs, reassigned,
-                 seam_before, seam_after)
+                 seam_before, seam_after, forced_cells=forced, notes=notes)
 
 
 def _avoid_relief(labels: np.ndarray, zp: np.ndarray, p: float, windows, costs, relief_height: float

@@ -18,6 +18,7 @@ from ..project.workspace import Workspace
 from .cameras import OrthoCamera, cameras_from_reconstruction, select_cameras
 from .mosaic import WORK_PREFIX, build_orthomosaic
 from .options import OrthoError, OrthoOptions
+from .seamlines import edits_fingerprint
 
 STAGE = ORTHOPHOTO
 
@@ -70,6 +71,8 @@ def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = Non
                                                   if k not in ("workers", "scheduler", "cache_mb")}}
     inputs = {"dsm": file_fingerprint(dsm_path), "images": fingerprint(sorted(c.name for c in cams)),
               **lay.model_fingerprints()}
+    if options.seamlines_in:  # edited seamlines (SEAMLINES_IN): a changed file re-runs the stage
+        inputs["seamlines_in"] = edits_fingerprint(options.seamlines_in)
     with run_stage(lay.ws, STAGE, params, inputs) as run:
         for debris in clean_debris(os.path.dirname(output), WORK_PREFIX):
             progress.info(f"removed {debris}, left by a killed run")

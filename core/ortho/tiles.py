@@ -17,7 +17,7 @@ from .pixels import _CACHE, ImageMeta
 from .radiometry import RadiometryModel, point_gains
 from .sampling import sample_camera
 from .surface import _Dsm
-from .visibility import Visibility
+from .visibility import Visibility, _table
 
 
 @dataclass
@@ -48,6 +48,7 @@ class _TileUnit:
     interpolation: str
     cache_mb: int
     radiometry: Optional[RadiometryModel] = None  # the per-point correction (replaces ``gains``)
+    fill_hidden: bool = True  # a cell hidden from every image takes the least hidden one (no holes)
 
 
 _DSM_CACHE: Dict[Tuple[str, Optional[str]], _Dsm] = {}
@@ -145,6 +146,10 @@ def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str
         filled = need & np.isfinite(fill_cost)
     else:
         filled = need
+    hidden = np.zeros(hh * ww, dtype=bool)
+    if unit.fill_hidden:
+        hidden = _fill_hidden(unit, off, x, y, z, need & ~filled, fill_vals, counts)
+        filled |= hidden
     valid = (wsum > 1e-6) | filled
     if unit.blending == "multiband":
         out = _multiband(layers, fill_vals, filled, hh, ww, bands)
@@ -158,4 +163,37 @@ def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str
     out = out.reshape(hh, ww, bands)[rr0:rr0 + unit.h, cc0:cc0 + unit.w]
     valid = valid.reshape(hh, ww)[rr0:rr0 + unit.h, cc0:cc0 + unit.w]
     return {"index": unit.index, "r0": unit.r0, "c0": unit.c0, "values": out, "valid": valid,
-            "fill_cells": int(filled.reshape(hh, ww)[rr0:rr0 + unit.h, cc0:cc0 + unit.w].sum())}
+            "fill_cells": int(filled.reshape(hh, ww)[rr0:rr0 + unit.h, cc0:cc0 + unit.w].sum()),
+            "hidden_cells": int(hidden.reshape(hh, ww)[rr0:rr0 + unit.h, cc0:cc0 + unit.w].sum())}
+
+
+def _fill_hidden(unit: _TileUnit, off: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, left: np.ndarray,
+                 fill_vals: np.ndarray, counts: Dict[int, int]) -> np.ndarray:
+    """Cells with a height that no image sees (each has them hidden) but that lie inside an image (its frame,
+    mask and far-field limit): the value of the image that hides them least (Visibility.hidden_by), so the
+    mosaic has no holes where the ground is photographed: the specks and cracks a noisy DSM (tree crowns, the
+    ramp of a wall) cuts out of every image.  Writes ``fill_vals``; returns the cells filled."""
+    idx = np.flatnonzero(left & np.isfinite(z))
+    out = np.zeros(left.shape, dtype=bool)
+    if not len(idx):
+        return out
+    best = np.full(len(idx), np.inf)
+    for ci in list(unit.primary) + list(unit.secondary):
+        vis = unit.visibility[ci]
+        if vis is None:
+            continue
+        s = sample_camera(unit.cameras[ci], unit.metas[ci], off, x[idx], y[idx], z[idx], None, unit.interpolation)
+        if not s.valid.any():
+            continue
+        sel = np.flatnonzero(s.valid)
+        depth = np.full(len(idx), np.inf)
+        depth[sel] = vis.hidden_by(x[idx[sel]], y[idx[sel]], z[idx[sel]], _table(vis)) + 1e-3 * s.cost[sel]
+        better = depth < best
+        if better.any():
+            sel = idx[better]
+            fill_vals[sel] = s.values[better] * point_gains(unit.radiometry, unit.gains[ci], ci, unit.cameras[ci],
+                                                            off, x[sel], y[sel], z[sel], np.ones(len(sel), bool))
+            best[better] = depth[better]
+            counts[ci] = counts.get(ci, 0) + int(better.sum())
+    out[idx[np.isfinite(best)]] = True
+    return out

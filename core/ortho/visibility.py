@@ -159,6 +159,25 @@ class Visibility:
         vis = (self.height - z - self.tolerance) * m <= r
         return vis | ~inside
 
+    def hidden_by(self, x: np.ndarray, y: np.ndarray, z: np.ndarray, table: Optional[np.ndarray] = None
+                  ) -> np.ndarray:
+        """How far (m) the surface rises above the sight line from each ground point to the camera: how much the
+        point would have to be raised to be seen (0 where it is visible).  The mosaic takes a cell that every image
+        has hidden from the least hidden one (a spike of a noisy DSM hides as little as a few cm)."""
+        tab = self.load() if table is None else table
+        dx = x - self.nadir[0]
+        dy = y - self.nadir[1]
+        r = np.hypot(dx, dy)
+        a = np.mod(np.arctan2(dy, dx) - self.phi0, 2 * np.pi)
+        j = np.rint(a / self.dphi).astype(np.int64)
+        inside = np.ones(j.shape, dtype=bool) if self.full_circle else (j >= 0) & (j < self.n_phi)
+        j = j % self.n_phi if self.full_circle else np.clip(j, 0, self.n_phi - 1)
+        k = np.clip(np.floor(r / self.dr).astype(np.int64) - 1, 0, self.n_r - 1)
+        m = tab[j, k].astype(np.float64)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            need = np.where(m > 0, (self.height - z - self.tolerance) - r / np.where(m > 0, m, 1.0), 0.0)
+        return np.where(inside, np.maximum(need, 0.0), 0.0)
+
 
 def build_visibility(cam: OrthoCamera, offset: np.ndarray, fp: Footprint, dsm: _Dsm, tolerance: float,
                      path: str = "") -> Visibility:
