@@ -205,6 +205,10 @@ class Scene:
     height_res: float = 0.06  # m per height-raster cell
     epoch: int = 0  # 0: the scene as always; 1, 2: two epochs of it (see make_scene(epoch=...))
     _rasters: Dict[str, np.ndarray] = field(default_factory=dict, repr=False)
+    # a low-texture patch (bare soil, uniform crops, sand): inside this local box (xmin, ymin, xmax, ymax) the
+    # ground's texture keeps only ``low_texture_contrast`` of its contrast (roofs keep theirs); None = none
+    low_texture: Optional[Tuple[float, float, float, float]] = None
+    low_texture_contrast: float = 0.1
 
     # ---- analytic truth
     def ground_at(self, x, y) -> np.ndarray:
@@ -366,10 +370,25 @@ class Scene:
         sun = (-0.4, 0.45) if self.epoch == 2 else (0.5, 0.3)  # epoch 2: the sun from another side
         shade = (1.0 + sun[0] * gx_ + sun[1] * gy_) / np.sqrt(1.0 + gx_ ** 2 + gy_ ** 2)
         shade = cv2.resize(shade.astype(np.float32), (nx, ny), interpolation=cv2.INTER_LINEAR)
+        if self.low_texture is not None:
+            _flatten_texture(self, tex, xs, ys)
         tex = 0.5 + 0.16 * tex
         tex *= np.clip(shade, 0.3, 1.3)
         self._rasters["texture"] = np.clip(tex, 0.02, 0.98).astype(np.float32)
         return self._rasters["texture"]
+
+
+def _flatten_texture(scene: Scene, tex: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> None:
+    """Scale the texture (around its mean) inside ``scene.low_texture`` by its contrast factor, roofs excepted."""
+    x0, y0, x1, y1 = scene.low_texture
+    win = scene._window(x0, y0, x1, y1, scene.texture_res)
+    yy, xx = np.meshgrid(ys[win[0]], xs[win[1]], indexing="ij")
+    inside = (xx >= x0) & (xx <= x1) & (yy >= y0) & (yy <= y1)
+    for b in scene.buildings:
+        inside &= ~b.contains(xx, yy)
+    sub = tex[win]
+    mean = float(sub[inside].mean()) if inside.any() else 0.0
+    sub[inside] = mean + scene.low_texture_contrast * (sub[inside] - mean)
 
 
 def make_scene(seed: int, bounds: Tuple[float, float, float, float], base_z: float = 150.0,
@@ -987,10 +1006,13 @@ def vertical_block(seed: int = 1, camera: CameraModel = DEFAULT_CAMERA, altitude
                    n_strips: int = 3, per_strip: int = 6, forward_overlap: float = 0.75,
                    side_overlap: float = 0.35, attitude_sigma_deg: float = 1.0, position_jitter: float = 0.5,
                    orbit: int = 0, orbit_tilt_deg: float = 30.0, n_buildings: int = 5,
-                   gcp_grid: Tuple[int, int] = (4, 3), roofs: int = 2, epoch: int = 0) -> SyntheticBlock:
+                   gcp_grid: Tuple[int, int] = (4, 3), roofs: int = 2, epoch: int = 0,
+                   low_texture: Optional[Tuple[float, float, float, float]] = None,
+                   low_texture_contrast: float = 0.1) -> SyntheticBlock:
     """Parallel strips along local x (serpentine: every other strip flown the other way), image x along
-    track; optionally ``orbit`` oblique shots on a circle around the centre looking at it.  ``epoch`` 1 or 2: the
-    same terrain in two epochs (``make_scene(epoch=...)``: a car that moved, a new building, new crop marks,
+    track; optionally ``orbit`` oblique shots on a circle around the centre looking at it.  ``low_texture``:
+    a low-texture patch (Scene.low_texture) as fractions (x0, y0, x1, y1) of the scene's bounds.  ``epoch`` 1 or 2:
+    the same terrain in two epochs (``make_scene(epoch=...)``: a car that moved, a new building, new crop marks,
     another sun); 0 (default): the scene as always."""
     rng = np.random.default_rng(seed)
     along = camera.width * altitude / camera.fx
@@ -1002,6 +1024,11 @@ def vertical_block(seed: int = 1, camera: CameraModel = DEFAULT_CAMERA, altitude
     margin = 0.6 * max(along, across) + 5.0
     bounds = (-length / 2 - margin, -widthy / 2 - margin, length / 2 + margin, widthy / 2 + margin)
     scene = make_scene(seed, bounds, n_buildings=n_buildings, epoch=epoch)
+    if low_texture is not None:
+        fx0, fy0, fx1, fy1 = low_texture
+        bw, bh = bounds[2] - bounds[0], bounds[3] - bounds[1]
+        scene.low_texture = (bounds[0] + fx0 * bw, bounds[1] + fy0 * bh, bounds[0] + fx1 * bw, bounds[1] + fy1 * bh)
+        scene.low_texture_contrast = low_texture_contrast
     z_fly = scene.base_z + altitude
     shots: List[Shot] = []
     for si in range(n_strips):

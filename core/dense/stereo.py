@@ -37,6 +37,7 @@ class PairUnit:
     uniqueness: int
     lr_tolerance: float
     threads: int
+    coarse: bool = True  # a second matching at half the resolution checks and completes the fine one
 
 
 def _to_gray8(img: np.ndarray) -> np.ndarray:
@@ -180,6 +181,97 @@ def _zbuffer(shape: Tuple[int, int], px: np.ndarray, py: np.ndarray, depth: np.n
     return out
 
 
+def _match_lr(left: np.ndarray, right: np.ndarray, block: int, dmin: int, num: int, uniqueness: int,
+              cancel_path: Optional[str] = None) -> Tuple[np.ndarray, np.ndarray]:
+    """SGBM both ways on two row-aligned images of one size: (disparity indexed by the left image's x, disparity
+    indexed by the right image's x), float32 pixels, NaN where SGBM found none."""
+    cv2 = require("cv2", "dense matching")
+    w = left.shape[1]
+    # pad both sides so SGBM's invalid bands (the first maxD columns, and the last |minD|) hold no image
+    pad = int(max(abs(dmin), abs(dmin + num))) + 1
+    lp = cv2.copyMakeBorder(left, 0, 0, pad, pad, cv2.BORDER_CONSTANT, value=0)
+    rp = cv2.copyMakeBorder(right, 0, 0, pad, pad, cv2.BORDER_CONSTANT, value=0)
+    sgbm = _sgbm(block, dmin, num, uniqueness)
+    check_unit_cancel(cancel_path)
+    disp_l = (sgbm.compute(lp, rp).astype(np.float32) / 16.0)[:, pad:pad + w]
+    check_unit_cancel(cancel_path)
+    disp_r = sgbm.compute(np.ascontiguousarray(rp[:, ::-1]), np.ascontiguousarray(lp[:, ::-1]))
+    disp_r = (disp_r.astype(np.float32) / 16.0)[:, ::-1][:, pad:pad + w]
+    invalid = dmin - 0.5
+    disp_l[disp_l <= invalid] = np.nan
+    disp_r[disp_r <= invalid] = np.nan
+    return np.ascontiguousarray(disp_l), np.ascontiguousarray(disp_r)
+
+
+def lr_checked(disp_l: np.ndarray, disp_r: np.ndarray, tolerance: float) -> np.ndarray:
+    """``disp_l`` where the right image's disparity at the matched pixel agrees within ``tolerance``, else NaN."""
+    w = disp_l.shape[1]
+    with np.errstate(invalid="ignore"):
+        xr = np.round(np.arange(w, dtype=np.float32)[None, :] - disp_l)
+        ok = np.isfinite(disp_l) & (xr >= 0) & (xr <= w - 1)
+        xri = np.clip(np.nan_to_num(xr), 0, w - 1).astype(np.int64)
+        back = np.take_along_axis(disp_r, xri, axis=1)
+        ok &= np.abs(back - disp_l) <= tolerance
+    return np.where(ok, disp_l, np.nan).astype(np.float32)
+
+
+COARSE_AGREEMENT_PX = 2.0  # a fine disparity this far outside its coarse neighbourhood's range is a blunder
+COARSE_FLAT_PX = 2.0  # a fine hole takes the coarse disparity where the coarse neighbourhood spans at most this
+
+
+def coarse_to_fine(fine: np.ndarray, coarse: np.ndarray) -> np.ndarray:
+    """The fine (left, LR-checked) disparity map completed and checked by a map matched at half the resolution
+    (``coarse``, LR-checked, in its own pixels): a fine disparity outside the range of the coarse ones around it
+    (3 x 3 coarse pixels, x 2, +- COARSE_AGREEMENT_PX) is dropped (a streak, a wrong minimum on weak texture); a
+    fine pixel without a disparity takes the coarse one where the coarse neighbourhood (5 x 5) is smooth (not
+    near a roof edge: edges stay the fine matching's)."""
+    cv2 = require("cv2", "dense matching")
+    h, w = fine.shape
+    valid_c = np.isfinite(coarse)
+    big = np.float32(1e6)
+    lo = cv2.erode(np.where(valid_c, coarse, big).astype(np.float32), np.ones((3, 3), np.uint8))
+    hi = cv2.dilate(np.where(valid_c, coarse, -big).astype(np.float32), np.ones((3, 3), np.uint8))
+    have = (lo < big / 2) & (hi > -big / 2)
+    # coarse pixel c covers fine pixels 2c, 2c + 1 (pyrDown): nearest-neighbour upsampling, disparities x 2
+    rows = np.minimum(np.arange(h) // 2, coarse.shape[0] - 1)
+    cols = np.minimum(np.arange(w) // 2, coarse.shape[1] - 1)
+
+    def up(a):
+        return a[rows][:, cols]
+
+    lo_f, hi_f, have_f = 2.0 * up(lo), 2.0 * up(hi), up(have)
+    out = fine.copy()
+    with np.errstate(invalid="ignore"):
+        blunder = np.isfinite(out) & have_f & ((out < lo_f - COARSE_AGREEMENT_PX) | (out > hi_f + COARSE_AGREEMENT_PX))
+    out[blunder] = np.nan
+    # the coarse value itself, bilinear (pixel centres: fine x = 2 c + 0.5), where the coarse neighbourhood is smooth
+    k5 = np.ones((5, 5), np.uint8)  # wider: no coarse value within 2 coarse pixels of a jump (its blurred edge)
+    lo5 = cv2.erode(np.where(valid_c, coarse, big).astype(np.float32), k5)
+    hi5 = cv2.dilate(np.where(valid_c, coarse, -big).astype(np.float32), k5)
+    all_valid = cv2.erode(valid_c.astype(np.uint8), k5) > 0  # and no coarse hole there (an edge's occlusion)
+    smooth = up(all_valid & (hi5 - lo5 <= COARSE_FLAT_PX / 2.0))
+    val = 2.0 * cv2.resize(np.nan_to_num(coarse).astype(np.float32), (w, h), interpolation=cv2.INTER_LINEAR)
+    take = ~np.isfinite(out) & smooth
+    out[take] = val[take]
+    return out
+
+
+def _disparity(li: np.ndarray, rj: np.ndarray, block: int, dmin: int, num: int, unit: "PairUnit",
+               cancel_path: Optional[str]) -> np.ndarray:
+    """The left image's disparity map (NaN = none): SGBM both ways + left-right check, coarse-to-fine completed."""
+    cv2 = require("cv2", "dense matching")
+    disp_l, disp_r = _match_lr(li, rj, block, dmin, num, unit.uniqueness, cancel_path)
+    fine = lr_checked(disp_l, disp_r, unit.lr_tolerance)
+    del disp_l, disp_r
+    if not unit.coarse or min(li.shape) < 64:
+        return fine
+    cmin = int(math.floor(dmin / 2.0)) - 1
+    cnum = int(16 * math.ceil(max(16, math.ceil(num / 2.0) + 2) / 16.0))
+    cl, cr = _match_lr(cv2.pyrDown(li), cv2.pyrDown(rj), block, cmin, cnum, unit.uniqueness, cancel_path)
+    coarse = lr_checked(cl, cr, unit.lr_tolerance)
+    return coarse_to_fine(fine, coarse)
+
+
 def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
     """The unit of work: one stereo pair -> depth maps of both images, saved to ``unit.out_path``."""
     cv2 = require("cv2", "dense matching")
@@ -209,29 +301,14 @@ def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
     mi = cv2.remap(ones_i, rect.maps_i[0], rect.maps_i[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT) == 255
     mj = cv2.remap(ones_j, rect.maps_j[0], rect.maps_j[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT) == 255
     del ones_i, ones_j
-    # pad both sides so SGBM's invalid bands (the first maxD columns, and the last |minD|) hold no image
-    pad = int(max(abs(dmin), abs(dmin + num))) + 1
-    lp = cv2.copyMakeBorder(li, 0, 0, pad, pad, cv2.BORDER_CONSTANT, value=0)
-    rp = cv2.copyMakeBorder(rj, 0, 0, pad, pad, cv2.BORDER_CONSTANT, value=0)
-    sgbm = _sgbm(unit.block_size, dmin, num, unit.uniqueness)
+    disp = _disparity(li, rj, unit.block_size, dmin, num, unit, cancel_path)
     check_unit_cancel(cancel_path)
-    disp_l = sgbm.compute(lp, rp).astype(np.float32) / 16.0
-    check_unit_cancel(cancel_path)
-    disp_r = sgbm.compute(np.ascontiguousarray(rp[:, ::-1]), np.ascontiguousarray(lp[:, ::-1]))
-    disp_r = (disp_r.astype(np.float32) / 16.0)[:, ::-1]
-    check_unit_cancel(cancel_path)
-    disp_l = disp_l[:, pad:pad + w]
-    disp_r = disp_r[:, pad:pad + w]  # indexed by the right image's x
-    invalid = dmin - 0.5
-    valid = (disp_l > invalid) & mi
-    rows, xs = np.nonzero(valid)
-    d = disp_l[rows, xs]
+    rows, xs = np.nonzero(np.isfinite(disp) & mi)
+    d = disp[rows, xs]
     xr = xs - d
     ok = (xr >= 0) & (xr <= w - 1)
     rows, xs, d, xr = rows[ok], xs[ok], d[ok], xr[ok]
-    xri = np.round(xr).astype(np.int64)
-    dr = disp_r[rows, np.clip(xri, 0, w - 1)]
-    ok = (dr > invalid) & mj[rows, np.clip(xri, 0, w - 1)] & (np.abs(dr - d) <= unit.lr_tolerance)
+    ok = mj[rows, np.clip(np.round(xr).astype(np.int64), 0, w - 1)]
     denom = d - rect.cx_i + rect.cx_j
     ok &= denom > 0.05
     rows, xs, d, xr, denom = rows[ok], xs[ok], d[ok], xr[ok], denom[ok]
