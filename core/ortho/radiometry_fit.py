@@ -29,9 +29,9 @@ from .sampling import sample_camera
 from .surface import _Dsm
 
 SAMPLE_GSD = 4.0  # sample cell = 4 x GSD (at least)
-MAX_SAMPLE_CELLS = 150_000
-MAX_PAIRS = 500_000
-SEARCH_PAIRS = 60_000  # pairs the hot spot's direction is searched on
+MAX_SAMPLE_CELLS = 100_000
+MAX_PAIRS = 300_000
+SEARCH_PAIRS = 30_000  # pairs the hot spot's direction is searched on
 MIN_PAIRS = 2000
 PRIOR_FALLOFF, PRIOR_HOT, PRIOR_EXPOSURE = 1.0, 0.5, 0.5  # prior sigmas (log), all centred on 0
 PRIOR_FIELD = (0.05, 0.02, 0.02, 0.01, 0.01, 0.01)  # constant, linear, quadratic: a gentle field
@@ -259,7 +259,7 @@ def _fit_model(obs: _Obs, a, b, groups: np.ndarray, n_groups: int, n_images: int
         antisolar, width = found[0], found[1]
         e = hot_spot_shape(obs.rays.astype(np.float64), antisolar, width)
         x1 = sparse.hstack([xa, sparse.csr_matrix(_hot_columns(e, obs, a, b, groups, n_groups))]).tocsr()
-        p1, w, sigma = _irls(x1, y, np.concatenate([prior_a, np.full(n_groups, PRIOR_HOT)]), w=w)
+        p1, w, sigma = _irls(x1, y, np.concatenate([prior_a, np.full(n_groups, PRIOR_HOT)]), iterations=3, w=w)
         p, hot = p1[:-n_groups], p1[-n_groups:]
         x1p = x1 @ p1
     else:
