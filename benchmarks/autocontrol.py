@@ -8,6 +8,12 @@ scale searched); their recovered camera centres are compared with ``toledo/camer
 the figures (matches, automatic GCPs, camera errors, the autocontrol step's time).
 
     python benchmarks/autocontrol.py [--workdir DIR] [--prior none|gps] [--fresh]
+
+Measured (2 cores shared, nice 19; reference 276 s once, cached): the FC300X block with no prior, 618 matches,
+306 fit one similarity, 218 their tiles, 43 automatic GCPs kept; camera centres vs cameras_32617.txt: median
+0.89 m, largest 1.95 m (the FC350 reference's own cameras, georeferenced by EXIF GPS: median 0.69 m against the
+same file); autocontrol 53-81 s (rotation search 24 s, adjustment with focal + distortion refined 33 s).  Without
+refining the FC300X's calibration (10 photos self-calibrated alone) the median was 1.75 m.
 """
 import argparse
 import json

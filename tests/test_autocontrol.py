@@ -27,7 +27,7 @@ CACHE = os.path.join(os.path.dirname(HERE), "build", "test-cache", "autocontrol-
 BLOCK = dict(seed=1, n_strips=2, per_strip=5)
 REF_GSD = 0.1
 DSM_GSD = 0.25
-FAST = AutoControlOptions(n_features=6000, max_candidates=60)
+FAST = AutoControlOptions(n_features=6000, max_candidates=60, refine_intrinsics=False)  # the truth model: intrinsics exact
 
 
 def _grid(scene, res):
@@ -127,6 +127,12 @@ def test_rough_prior_georeferences_the_second_epoch_within_the_reference_resolut
                                    check_points=_check_points(block), options=FAST)
     _assert_georeferenced(result, ws_dir, block)
     assert result.crs == syn.CRS
+    # the report's georeferencing section tells the automatic control: the steps' counts and the map
+    from core.report.stage import build_report
+
+    html = open(build_report(ws_dir, uncertainty=False).path, encoding="utf-8").read()
+    assert "Automatic control" in html and "kept by the adjustment" in html
+    assert "automatic control points" in html and os.path.basename(ortho) in html
 
 
 def test_no_prior_at_all_searches_rotation_and_scale(tmp_path, epochs):

@@ -19,7 +19,10 @@ class AutoControlOptions:
     ``max_relief``: metres of DSM relief within the point's neighbourhood beyond which its height is not
     trusted (walls, trees, roof edges); ``dsm_sigma``: metres (None: the DSM's cell size); ``rotations``:
     degrees tried when there is no prior (the features are rotation invariant; these help at a coarse level), until
-    one gives ``coarse_enough`` inliers; ``coarse_pixels``: the provisional orthophoto's side at that level."""
+    one gives ``coarse_enough`` inliers; ``coarse_pixels``: the provisional orthophoto's side at that level;
+    ``refine_intrinsics``: what the adjustment refines of the cameras (as ``GeorefOptions``): by default focal
+    length and distortion, which dozens of automatic GCPs over the block determine (on Toledo's FC300X photos the
+    camera centres' median error falls from 1.75 m to 0.85 m)."""
 
     gsd: Optional[float] = None
     max_pixels: int = 3000
@@ -40,6 +43,7 @@ class AutoControlOptions:
     rotations: tuple = (0.0, 90.0, 180.0, 270.0)
     coarse_pixels: int = 1000
     coarse_enough: int = 150
+    refine_intrinsics: Any = True
 
     @classmethod
     def of(cls, options: Optional["AutoControlOptions"] = None, **kwargs: Any) -> "AutoControlOptions":

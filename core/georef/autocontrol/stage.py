@@ -192,7 +192,8 @@ def autocontrol_workspace(workspace_dir: str, reference_ortho: str, reference_ds
 
     ``prior``: "auto" (EXIF GPS when 3 photos carry it, else none), "gps", or "none" (search rotation and scale);
     ``camera_positions``: rough positions in the reference's CRS instead of EXIF GPS; ``check_points``: ground
-    points evaluated as check points (role check, in the reference's CRS).  Raises AutoControlError when fewer
+    points evaluated as check points (role check, in the reference's CRS); ``georef_options``: the adjustment's
+    options (its ``refine_intrinsics`` replaces ``options.refine_intrinsics``).  Raises AutoControlError when fewer
     than ``options.min_candidates`` candidates are kept."""
     opt = AutoControlOptions.of(options)
     progress = progress or NullProgress()
@@ -225,7 +226,8 @@ def autocontrol_workspace(workspace_dir: str, reference_ortho: str, reference_ds
     for p in (check_points.points if check_points is not None else []):
         gcps.points.append(GroundPoint(p.name, p.x, p.y, p.z, p.sigma_xy, p.sigma_z, CHECK, list(p.observations)))
     t1 = time.time()
-    res = georeference_workspace(ws.root, gcps=gcps, crs=crs, options=georef_options,
+    refine = georef_options.refine_intrinsics if georef_options is not None else opt.refine_intrinsics
+    res = georeference_workspace(ws.root, gcps=gcps, crs=crs, options=georef_options, refine_intrinsics=refine,
                                  progress=SubProgress(progress, 0.7, 1.0))
     timings["adjustment"] = time.time() - t1
     timings["total"] = time.time() - t0

@@ -11,6 +11,7 @@ from ..context import ReportContext, Skip
 from ..figures import embed, equal_xy, new_figure, nice
 from ..html import badge, cell, crs_label, esc, fmt, kv, num, table, td
 from ..residuals import accuracy_figures, camera_position_figures, residual_rows
+from . import autocontrol
 from .standards import accuracy_statements
 
 
@@ -55,6 +56,7 @@ def section(ctx: ReportContext) -> str:
     if cams:
         parts.append(_camera_residuals(ctx, cams))
     parts.append(_outliers(ctx, res, acc))
+    parts.append(autocontrol.subsection(ctx))  # '' unless automatic control georeferenced the block
     _glance_accuracy(ctx, acc)
     return "".join(parts)
 
