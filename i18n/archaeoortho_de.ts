@@ -208,11 +208,11 @@ Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global
 Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
         <translation>Structure from Motion: SIFT-Merkmale, Paarauswahl, robuste Zuordnung (RANSAC), inkrementelle Rekonstruktion mit Selbstkalibrierung (Brennweite, Bildhauptpunkt, Objektivverzeichnung) und eine abschließende Bündelblockausgleichung. Das Ergebnis wird im Arbeitsbereich-Ordner gespeichert, den die folgenden Schritte (Georeferenzieren, DOM erzeugen, Orthophoto erzeugen) als Eingabe nehmen. Ein erneuter Lauf setzt fort: bereits berechnete Merkmale und Zuordnungen werden wiederverwendet.
 
-Paarauswahl: &apos;auto&apos; nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
-Kameramodell: &apos;AUTO&apos; schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
+Paarauswahl: 'auto' nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
+Kameramodell: 'AUTO' schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
 Bildgröße für die Zuordnung: die längste Seite, auf die die Bilder für die Zuordnung verkleinert werden (0 = volle Größe). Merkmale je Bild: 0 = automatisch (etwa 4000 je Megapixel). Affin-invariante Merkmale helfen bei Schrägaufnahmen und sind langsamer.
 Brennweite und Sensorbreite: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern (0 = aus EXIF / unbekannt).
-Rekonstruktionsverfahren (erweitert): &apos;incremental&apos; (COLMAP, Standard) oder &apos;global&apos; (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).
+Rekonstruktionsverfahren (erweitert): 'incremental' (COLMAP, Standard) oder 'global' (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).
 Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen Einstellungen auslassen, oder ein in Teile zerfallener Block werden mit reicheren Merkmalen (schwächeren für kontrastarme Bilder, affinen für steile Schrägaufnahmen) und mehr Paaren erneut versucht; das Protokoll und sfm/alignment.json sagen, was erneut versucht wurde und warum.</translation>
     </message>
 </context>
@@ -533,22 +533,22 @@ Höhenlinien: wohin die Höhenlinien geschrieben werden (Vorgabe: &lt;workspace&
 <context>
     <name>BuildOrthophotoAlgorithm</name>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="90"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="107"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="91"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="108"/>
         <source>Share of mosaic cells with data</source>
         <translation>Anteil der Mosaikzellen mit Daten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="92"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="109"/>
         <source>Resolution used</source>
         <translation>Verwendete Auflösung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="93"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="110"/>
         <source>Images in the mosaic</source>
         <translation>Bilder im Mosaik</translation>
     </message>
@@ -558,74 +558,79 @@ Höhenlinien: wohin die Höhenlinien geschrieben werden (Vorgabe: &lt;workspace&
         <translation>Orthophoto erzeugen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Georeferenced workspace</source>
         <translation>Georeferenzierter Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Images</source>
         <translation>Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Resolution</source>
         <translation>Auflösung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Seam blending</source>
         <translation>Überblendung der Nähte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Resampling</source>
         <translation>Resampling</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Parallel tile workers</source>
         <translation>Parallele Kachel-Prozesse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Dask scheduler</source>
         <translation>Dask-Scheduler</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="82"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="99"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="85"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="102"/>
         <source>Per-image orthophotos folder</source>
         <translation>Ordner für Einzelbild-Orthophotos</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="88"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="105"/>
         <source>Seamlines</source>
         <translation>Nahtlinien</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="74"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Seamlines to follow</source>
         <translation>Zu befolgende Nahtlinien</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="108"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="136"/>
         <source>Seamlines must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>Nahtlinien müssen eine GeoPackage-Datei (.gpkg) sein, erhalten: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Far-field limit (× best ground resolution, 0 = off)</source>
         <translation>Fernfeld-Grenze (× beste Bodenauflösung, 0 = aus)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
+        <source>Even out vignetting and hot spot</source>
+        <translation>Vignettierung und Hotspot ausgleichen</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -638,6 +643,7 @@ DSM: optional raster (e.g. an ALS DSM, in any CRS: reprojected on the fly); defa
 Images: a subset, e.g. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; or &apos;group:NIR&apos; (a camera group by id or by make/model), &apos;!name&apos; to leave one out. Empty: all images.
 Resolution: cell size in CRS units; 0 = the images&apos; ground sample distance.
 Seam blending: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness and no ghosting), none (hard cut).
+Even out vignetting and hot spot: the darkening towards the photos&apos; corners, the bright patch opposite the sun and the exposure of each photo are measured where the photos overlap and removed, then a smooth gain per photo levels the seams, so photos taken at different times meet without a brightness step (used only where it makes the overlaps agree better; off: one exposure gain per photo).
 Far-field limit (advanced): each image is used only where its ground resolution is within this factor of its best, so the stretched far field of an oblique (towards the horizon) is left out and the mosaic takes those cells from a nearer view; cells no image sees finely enough stay empty. 0 = off (default 3).
 Orthomosaic: Cloud-Optimized GeoTIFF with overviews, the images&apos; bands and data type (8/16 bit kept) plus an alpha band (default &lt;workspace&gt;/orthomosaic.tif).
 Per-image orthophotos folder: optional folder for one true orthophoto per image (COG).
@@ -648,16 +654,17 @@ Dask scheduler (advanced): render the tiles on a Dask cluster (tcp://host:8786) 
 
 Jede Zelle nimmt ihre Höhe aus dem DOM und wird über das vollständige Kameramodell (Orientierung, Brennweite, Bildhauptpunkt, Objektivverzeichnung) in die Bilder projiziert. Eine Zelle, die in einem Bild von höherer Oberfläche verdeckt ist (eine Mauer, ein Baum, ein Hügel), bleibt aus diesem Bild weg, so dass Gebäude nicht kippen und nichts doppelt erscheint; das Mosaik füllt sie aus einem Bild, das sie sieht. Jeder Teil des Mosaiks stammt aus dem Bild, das am senkrechtesten und am nächsten zu seiner Mitte darauf blickt; Nahtlinien laufen um Gebäude und Bäume; Helligkeitsunterschiede zwischen den Bildern werden ausgeglichen und Nähte überblendet.
 
-Georeferenzierter Arbeitsbereich: ein Arbeitsbereich mit DOM (zuerst 'DOM erzeugen' ausführen) oder ein DOM angeben.
+Georeferenzierter Arbeitsbereich: ein Arbeitsbereich mit DOM (zuerst &apos;DOM erzeugen&apos; ausführen) oder ein DOM angeben.
 DOM: optionales Raster (z. B. ein ALS-DOM, in beliebigem KBS: wird im Lauf umprojiziert); Vorgabe ist das DOM des Arbeitsbereichs.
-Bilder: eine Auswahl, z. B. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' oder 'group:NIR' (eine Kameragruppe nach Nummer oder Hersteller/Modell), '!name' lässt eines weg. Leer: alle Bilder.
+Bilder: eine Auswahl, z. B. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; oder &apos;group:NIR&apos; (eine Kameragruppe nach Nummer oder Hersteller/Modell), &apos;!name&apos; lässt eines weg. Leer: alle Bilder.
 Auflösung: Zellgröße in KBS-Einheiten; 0 = die Bodenauflösung der Bilder.
 Überblendung der Nähte: feather (Rampe über die Nähte), multiband (Laplace-Pyramide: keine sichtbare Naht in der Helligkeit und keine Geisterbilder), none (harter Schnitt).
+Vignettierung und Hotspot ausgleichen: die Abdunklung zu den Ecken der Fotos, der helle Fleck gegenüber der Sonne und die Belichtung jedes Fotos werden dort gemessen, wo sich die Fotos überlappen, und entfernt; dann gleicht eine glatte Verstärkung je Foto die Nähte an, so dass Fotos verschiedener Zeitpunkte ohne Helligkeitssprung aneinanderstoßen (nur angewandt, wo die Überlappungen dadurch besser übereinstimmen; aus: ein Belichtungsfaktor je Foto).
 Fernfeld-Grenze (erweitert): jedes Bild wird nur dort verwendet, wo seine Bodenauflösung innerhalb dieses Faktors seiner besten liegt; so bleibt das gedehnte Fernfeld einer Schrägaufnahme (zum Horizont hin) weg, und das Mosaik nimmt diese Zellen aus einer näheren Ansicht; Zellen, die kein Bild fein genug sieht, bleiben leer. 0 = aus (Vorgabe 3).
 Orthomosaik: Cloud-Optimized GeoTIFF mit Übersichten, den Kanälen und dem Datentyp der Bilder (8/16 Bit bleiben) und einem Alphakanal (Vorgabe &lt;workspace&gt;/orthomosaic.tif).
 Ordner für Einzelbild-Orthophotos: optionaler Ordner für ein wahres Orthophoto je Bild (COG).
-Nahtlinien: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem jeder Teil des Mosaiks stammt (ein Polygon je Bild, sein Name im Feld 'image'); bearbeiten Sie es, um eine Naht zu verschieben.
-Zu befolgende Nahtlinien: optionale bearbeitete Nahtlinien (Polygone mit dem Feld 'image', im KBS des Mosaiks): wo ein Polygon ein Bild nennt, nimmt das Mosaik dieses Bild, wo es den Boden sieht (das Protokoll sagt, wo nicht); anderswo automatische Nähte. Formen Sie ein Polygon um oder zeichnen Sie eines und nennen Sie sein Bild, um eine Naht von einem Bewuchsmerkmal oder einem fahrenden Auto wegzulegen, und starten Sie erneut.
+Nahtlinien: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem jeder Teil des Mosaiks stammt (ein Polygon je Bild, sein Name im Feld &apos;image&apos;); bearbeiten Sie es, um eine Naht zu verschieben.
+Zu befolgende Nahtlinien: optionale bearbeitete Nahtlinien (Polygone mit dem Feld &apos;image&apos;, im KBS des Mosaiks): wo ein Polygon ein Bild nennt, nimmt das Mosaik dieses Bild, wo es den Boden sieht (das Protokoll sagt, wo nicht); anderswo automatische Nähte. Formen Sie ein Polygon um oder zeichnen Sie eines und nennen Sie sein Bild, um eine Naht von einem Bewuchsmerkmal oder einem fahrenden Auto wegzulegen, und starten Sie erneut.
 Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786) rechnen, dessen Worker den Pfad des Arbeitsbereichs sehen; leer = dieser Rechner, oder $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
     </message>
 </context>

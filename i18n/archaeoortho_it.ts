@@ -206,13 +206,13 @@ Matching image size: the longest side the images are scaled to for matching (0 =
 Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).
 Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).
 Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
-        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell&apos;obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella dell&apos;area di lavoro, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
+        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell'obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella dell'area di lavoro, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
 
-Selezione delle coppie: &apos;auto&apos; usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
-Modello di camera: &apos;AUTO&apos; stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
+Selezione delle coppie: 'auto' usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
+Modello di camera: 'AUTO' stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
 Dimensione per la corrispondenza: il lato maggiore a cui le immagini sono ridotte per la corrispondenza (0 = dimensione piena). Feature per immagine: 0 = automatico (circa 4000 per megapixel). Le feature invarianti affini aiutano con le prese oblique e sono più lente.
-Focale e Larghezza del sensore: orientamento interno quando manca l&apos;EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri (0 = dall&apos;EXIF / sconosciuta).
-Metodo di ricostruzione (avanzato): &apos;incremental&apos; (COLMAP, predefinito) o &apos;global&apos; (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).
+Focale e Larghezza del sensore: orientamento interno quando manca l'EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri (0 = dall'EXIF / sconosciuta).
+Metodo di ricostruzione (avanzato): 'incremental' (COLMAP, predefinito) o 'global' (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).
 Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni rapide escludono, o un blocco diviso in parti, vengono riprovate con caratteristiche più ricche (più deboli per fotogrammi a basso contrasto, affini per oblique ripide) e più coppie; il registro e sfm/alignment.json dicono cosa è stato riprovato e perché.</translation>
     </message>
 </context>
@@ -533,22 +533,22 @@ Curve di livello: dove scrivere le curve di livello (predefinito: &lt;workspace&
 <context>
     <name>BuildOrthophotoAlgorithm</name>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="90"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="107"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="91"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="108"/>
         <source>Share of mosaic cells with data</source>
         <translation>Frazione delle celle del mosaico con dati</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="92"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="109"/>
         <source>Resolution used</source>
         <translation>Risoluzione usata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="93"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="110"/>
         <source>Images in the mosaic</source>
         <translation>Immagini nel mosaico</translation>
     </message>
@@ -558,74 +558,79 @@ Curve di livello: dove scrivere le curve di livello (predefinito: &lt;workspace&
         <translation>Genera ortofoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Georeferenced workspace</source>
         <translation>Area di lavoro georeferenziata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Images</source>
         <translation>Immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Resolution</source>
         <translation>Risoluzione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Seam blending</source>
         <translation>Sfumatura delle giunzioni</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Resampling</source>
         <translation>Ricampionamento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Parallel tile workers</source>
         <translation>Processi paralleli per tessera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Dask scheduler</source>
         <translation>Scheduler Dask</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="82"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="99"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="85"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="102"/>
         <source>Per-image orthophotos folder</source>
         <translation>Cartella delle ortofoto per immagine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="88"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="105"/>
         <source>Seamlines</source>
         <translation>Linee di giunzione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="74"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Seamlines to follow</source>
         <translation>Linee di giunzione da seguire</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="108"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="136"/>
         <source>Seamlines must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>Le linee di giunzione devono essere un file GeoPackage (.gpkg), ricevuto {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="66"/>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Far-field limit (× best ground resolution, 0 = off)</source>
         <translation>Limite del campo lontano (× miglior risoluzione al suolo, 0 = spento)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
+        <source>Even out vignetting and hot spot</source>
+        <translation>Compensa vignettatura e hot spot</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -638,27 +643,29 @@ DSM: optional raster (e.g. an ALS DSM, in any CRS: reprojected on the fly); defa
 Images: a subset, e.g. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; or &apos;group:NIR&apos; (a camera group by id or by make/model), &apos;!name&apos; to leave one out. Empty: all images.
 Resolution: cell size in CRS units; 0 = the images&apos; ground sample distance.
 Seam blending: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness and no ghosting), none (hard cut).
+Even out vignetting and hot spot: the darkening towards the photos&apos; corners, the bright patch opposite the sun and the exposure of each photo are measured where the photos overlap and removed, then a smooth gain per photo levels the seams, so photos taken at different times meet without a brightness step (used only where it makes the overlaps agree better; off: one exposure gain per photo).
 Far-field limit (advanced): each image is used only where its ground resolution is within this factor of its best, so the stretched far field of an oblique (towards the horizon) is left out and the mosaic takes those cells from a nearer view; cells no image sees finely enough stay empty. 0 = off (default 3).
 Orthomosaic: Cloud-Optimized GeoTIFF with overviews, the images&apos; bands and data type (8/16 bit kept) plus an alpha band (default &lt;workspace&gt;/orthomosaic.tif).
 Per-image orthophotos folder: optional folder for one true orthophoto per image (COG).
 Seamlines: optional GeoPackage of polygons naming the image each part of the mosaic comes from (one polygon per image, its name in the field &apos;image&apos;); edit it to move a seam.
 Seamlines to follow: optional edited seamlines (polygons with the field &apos;image&apos;, in the mosaic&apos;s CRS): where a polygon names an image, the mosaic takes that image where it sees the ground (the log says where it does not); automatic seams elsewhere. Reshape a polygon, or draw one and name its image, to move a seam off a crop mark or a moving car, and run again.
 Dask scheduler (advanced): render the tiles on a Dask cluster (tcp://host:8786) whose workers see the workspace path; empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER.</source>
-        <translation>Ortofoto vere e l'ortomosaico di un'area di lavoro georeferenziata.
+        <translation>Ortofoto vere e l&apos;ortomosaico di un&apos;area di lavoro georeferenziata.
 
-Ogni cella prende la quota dal DSM ed è proiettata nelle immagini con il modello completo della camera (orientamento, focale, punto principale, distorsione dell'obiettivo). Una cella nascosta in un'immagine da una superficie più alta (un muro, un albero, una collina) viene esclusa da quell'immagine, così gli edifici non pendono e nulla compare due volte; il mosaico la riempie da un'immagine che la vede. Ogni parte del mosaico proviene dall'immagine che la guarda nel modo più verticale e più vicino al suo centro; le linee di giunzione girano attorno a edifici e alberi; le differenze di luminosità tra le immagini sono compensate e le giunzioni sfumate.
+Ogni cella prende la quota dal DSM ed è proiettata nelle immagini con il modello completo della camera (orientamento, focale, punto principale, distorsione dell&apos;obiettivo). Una cella nascosta in un&apos;immagine da una superficie più alta (un muro, un albero, una collina) viene esclusa da quell&apos;immagine, così gli edifici non pendono e nulla compare due volte; il mosaico la riempie da un&apos;immagine che la vede. Ogni parte del mosaico proviene dall&apos;immagine che la guarda nel modo più verticale e più vicino al suo centro; le linee di giunzione girano attorno a edifici e alberi; le differenze di luminosità tra le immagini sono compensate e le giunzioni sfumate.
 
-Area di lavoro georeferenziata: un'area di lavoro con DSM (eseguire prima 'Genera DSM'), oppure indicare un DSM.
-DSM: raster facoltativo (ad es. un DSM ALS, in qualsiasi SR: riproiettato al volo); predefinito il DSM dell'area di lavoro.
-Immagini: un sottoinsieme, ad es. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' o 'group:NIR' (un gruppo di camere per numero o per marca/modello), '!nome' per escluderne una. Vuoto: tutte le immagini.
+Area di lavoro georeferenziata: un&apos;area di lavoro con DSM (eseguire prima &apos;Genera DSM&apos;), oppure indicare un DSM.
+DSM: raster facoltativo (ad es. un DSM ALS, in qualsiasi SR: riproiettato al volo); predefinito il DSM dell&apos;area di lavoro.
+Immagini: un sottoinsieme, ad es. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; o &apos;group:NIR&apos; (un gruppo di camere per numero o per marca/modello), &apos;!nome&apos; per escluderne una. Vuoto: tutte le immagini.
 Risoluzione: dimensione della cella in unità del SR; 0 = il GSD delle immagini.
 Sfumatura delle giunzioni: feather (rampa attraverso le giunzioni), multiband (piramide laplaciana: nessuna giunzione visibile nella luminosità e nessun effetto fantasma), none (taglio netto).
-Limite del campo lontano (avanzato): ogni immagine è usata solo dove la sua risoluzione al suolo è entro questo fattore della sua migliore, così il campo lontano allungato di una foto obliqua (verso l'orizzonte) è escluso e il mosaico prende quelle celle da una vista più vicina; le celle che nessuna immagine vede abbastanza finemente restano vuote. 0 = spento (predefinito 3).
+Compensa vignettatura e hot spot: l&apos;oscuramento verso gli angoli delle foto, la macchia chiara opposta al sole e l&apos;esposizione di ogni foto sono misurati dove le foto si sovrappongono e rimossi, poi un guadagno regolare per foto livella le giunzioni, così foto scattate in momenti diversi si uniscono senza salti di luminosità (applicato solo dove le sovrapposizioni concordano meglio; disattivato: un guadagno di esposizione per foto).
+Limite del campo lontano (avanzato): ogni immagine è usata solo dove la sua risoluzione al suolo è entro questo fattore della sua migliore, così il campo lontano allungato di una foto obliqua (verso l&apos;orizzonte) è escluso e il mosaico prende quelle celle da una vista più vicina; le celle che nessuna immagine vede abbastanza finemente restano vuote. 0 = spento (predefinito 3).
 Ortomosaico: Cloud-Optimized GeoTIFF con panoramiche, le bande e il tipo di dato delle immagini (8/16 bit conservati) più una banda alfa (predefinito &lt;workspace&gt;/orthomosaic.tif).
-Cartella delle ortofoto per immagine: cartella facoltativa per un'ortofoto vera per immagine (COG).
-Linee di giunzione: GeoPackage facoltativo di poligoni che indicano l'immagine da cui proviene ogni parte del mosaico (un poligono per immagine, il suo nome nel campo 'image'); modificarlo per spostare una giunzione.
-Linee di giunzione da seguire: linee di giunzione modificate facoltative (poligoni con il campo 'image', nel SR del mosaico): dove un poligono indica un'immagine, il mosaico usa quell'immagine dove vede il terreno (il registro dice dove no); altrove giunzioni automatiche. Rimodellare un poligono, o disegnarne uno e indicarne l'immagine, per spostare una giunzione da una traccia nelle colture o da un'auto in movimento, ed eseguire di nuovo.
-Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:8786) i cui worker vedono il percorso dell'area di lavoro; vuoto = questo computer, oppure $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
+Cartella delle ortofoto per immagine: cartella facoltativa per un&apos;ortofoto vera per immagine (COG).
+Linee di giunzione: GeoPackage facoltativo di poligoni che indicano l&apos;immagine da cui proviene ogni parte del mosaico (un poligono per immagine, il suo nome nel campo &apos;image&apos;); modificarlo per spostare una giunzione.
+Linee di giunzione da seguire: linee di giunzione modificate facoltative (poligoni con il campo &apos;image&apos;, nel SR del mosaico): dove un poligono indica un&apos;immagine, il mosaico usa quell&apos;immagine dove vede il terreno (il registro dice dove no); altrove giunzioni automatiche. Rimodellare un poligono, o disegnarne uno e indicarne l&apos;immagine, per spostare una giunzione da una traccia nelle colture o da un&apos;auto in movimento, ed eseguire di nuovo.
+Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:8786) i cui worker vedono il percorso dell&apos;area di lavoro; vuoto = questo computer, oppure $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
     </message>
 </context>
 <context>

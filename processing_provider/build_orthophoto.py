@@ -32,6 +32,7 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
     PER_IMAGE_FOLDER = "PER_IMAGE_FOLDER"
     SEAMLINES = "SEAMLINES"
     SEAMLINES_IN = "SEAMLINES_IN"
+    RADIOMETRY = "RADIOMETRY"
     OUT_WORKSPACE = "WORKSPACE"  # the same name as the input: models chain stages through it
     VALID_FRACTION = "VALID_FRACTION"
     RESOLUTION_USED = "RESOLUTION_USED"
@@ -54,6 +55,10 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
         "Resolution: cell size in CRS units; 0 = the images' ground sample distance.\n"
         "Seam blending: feather (a ramp across seams), multiband (Laplacian pyramid: no visible seam in brightness "
         "and no ghosting), none (hard cut).\n"
+        "Even out vignetting and hot spot: the darkening towards the photos' corners, the bright patch opposite the "
+        "sun and the exposure of each photo are measured where the photos overlap and removed, then a smooth gain "
+        "per photo levels the seams, so photos taken at different times meet without a brightness step (used only "
+        "where it makes the overlaps agree better; off: one exposure gain per photo).\n"
         "Far-field limit (advanced): each image is used only where its ground resolution is within this factor of "
         "its best, so the stretched far field of an oblique (towards the horizon) is left out and the mosaic takes "
         "those cells from a nearer view; cells no image sees finely enough stay empty. 0 = off (default 3).\n"
@@ -80,6 +85,7 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
                 defaultValue="", optional=True),
             params.number(self.RESOLUTION, self.tr("Resolution")),
             params.blending(self.BLENDING, self.tr("Seam blending")),
+            params.flag(self.RADIOMETRY, self.tr("Even out vignetting and hot spot"), default=True),
             QgsProcessingParameterFeatureSource(
                 self.SEAMLINES_IN, self.tr("Seamlines to follow"), [QgsProcessing.SourceType.TypeVectorPolygon],
                 optional=True),
@@ -132,6 +138,7 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
         options = OrthoOptions(
             interpolation=params.read_choice(self, parameters, self.INTERPOLATION, context, self.INTERPOLATIONS),
             gsd_factor=self.parameterAsDouble(parameters, self.GSD_FACTOR, context),
+            radiometry=self.parameterAsBoolean(parameters, self.RADIOMETRY, context),
             workers=self.parameterAsInt(parameters, self.WORKERS, context),
             scheduler=params.read_scheduler(self, parameters, self.SCHEDULER, context),
             seamlines_in=self.seamlines_in(parameters, context, feedback))
