@@ -129,3 +129,27 @@ def _gdal_cache(mb: int):
         yield
     finally:
         gdal.SetCacheMax(old)
+
+
+def interior_nodata(path: str) -> int:
+    """The nodata cells of a mosaic (alpha 0, or NaN in a float mosaic) that data encloses: not connected (4-way)
+    to the raster's border through nodata; the holes and cracks inside the mosaic, for benchmarks and checks.  It
+    also counts ground that no image sees but data encloses (behind a roof at the block's border, beyond the images'
+    edge), so it need not be 0 where every photographed cell has data."""
+    from scipy import ndimage
+
+    gdal = _gdal()
+    ds = gdal.Open(path)
+    if ds is None:
+        raise OrthoError(f"cannot open {path}")
+    last = ds.GetRasterBand(ds.RasterCount)
+    if last.GetColorInterpretation() == gdal.GCI_AlphaBand:
+        nodata = last.ReadAsArray() == 0
+    else:
+        nodata = ~np.isfinite(ds.GetRasterBand(1).ReadAsArray().astype(np.float32))
+    ds = None
+    lab, n = ndimage.label(nodata)
+    if not n:
+        return 0
+    edge = np.unique(np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]]))
+    return int((nodata & ~np.isin(lab, edge[edge > 0])).sum())
