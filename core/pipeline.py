@@ -1,4 +1,4 @@
-"""The whole chain in one call: align -> georeference -> DSM -> orthomosaic -> DTM (+ relief) -> report.
+"""The whole chain in one call: (prepare: sky masks ->) align -> georeference -> DSM -> orthomosaic -> DTM (+ relief) -> report.
 
 ``run_pipeline`` calls each room's stage entry point in order on one workspace (``core.align.stage.align``,
 ``core.georef.stage.georeference_workspace``, ``core.dense.stage.build_dsm_workspace``,
@@ -26,7 +26,9 @@ from .io.gcp import GCPSet, apply_check_points, read_camera_positions, read_gcps
 from .io.images import check_image_folder, list_images
 from .ortho.options import OrthoOptions
 from .ortho.stage import build_orthophoto_workspace
-from .project.stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, RELIEF, REPORT, TERRAIN, StageError
+from .prepare.options import PrepareOptions
+from .prepare.stage import prepare_images_workspace
+from .project.stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, PREPARE, RELIEF, REPORT, TERRAIN, StageError
 from .report.options import ReportOptions
 from .report.stage import build_report
 from .terrain.stage import build_dtm_workspace, relief_workspace
@@ -68,6 +70,7 @@ class PipelineOptions:
     make_dtm: bool = True  # the DTM (seconds for a DSM of a few million cells)
     contour_interval: float = 0.0  # m; 0 = no contours
     relief: Sequence[str] = ()  # relief visualisations of the DTM (core.terrain.options.VISUALISATIONS); slow
+    sky_masks: bool = False  # obliques: a prepare stage first (screening + sky masks), the prepared photos aligned
 
 
 @dataclass
@@ -76,6 +79,7 @@ class PipelineResult:
     workspace: str
     align: object
     georef: Optional[GeorefStageResult]
+    prepare: object = None
     dsm: object = None
     ortho: object = None
     report: object = None
@@ -86,7 +90,7 @@ class PipelineResult:
 
 
 # the share of the progress bar of each stage
-SPANS = {ALIGN: (0.0, 0.40), GEOREFERENCE: (0.40, 0.45), DSM: (0.45, 0.75), ORTHOPHOTO: (0.75, 0.9),
+SPANS = {PREPARE: (0.0, 0.05), ALIGN: (0.0, 0.40), GEOREFERENCE: (0.40, 0.45), DSM: (0.45, 0.75), ORTHOPHOTO: (0.75, 0.9),
          TERRAIN: (0.9, 0.92), RELIEF: (0.92, 0.95), REPORT: (0.95, 1.0)}
 
 
@@ -110,7 +114,7 @@ def check_inputs(images_dir: str, control: Control) -> None:
 
 def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[PipelineOptions] = None,
                  control: Optional[Control] = None, progress: Optional[Progress] = None) -> PipelineResult:
-    """The whole chain in one call: align -> georeference -> DSM -> orthomosaic -> report.
+    """The whole chain in one call: (prepare: sky masks ->) align -> georeference -> DSM -> orthomosaic -> report.
 
     The same stage functions the single Processing algorithms call, in order, on one workspace; every
     stage records itself in workspace.json as when run alone, so a re-run resumes (features, matches and
@@ -127,8 +131,8 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
     check_inputs(images_dir, ctl)
     seconds: Dict[str, float] = {}
 
-    def run(name, fn, *args, **kwargs):
-        lo, hi = SPANS[name]
+    def run(name, fn, *args, span=None, **kwargs):
+        lo, hi = span or SPANS[name]
         progress.info(f"--- stage {name} ---")
         t0 = time.time()
         out = fn(*args, progress=SubProgress(progress, lo, hi), **kwargs)
@@ -136,7 +140,16 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
         return out
 
     res = PipelineResult(workspace=os.path.abspath(workspace_dir), align=None, georef=None, seconds=seconds)
-    res.align = run(ALIGN, align, images_dir, workspace_dir, opt.align)
+    aligned_from = images_dir
+    if opt.sky_masks:  # the photos with their sky masks, so that no tie or dense point comes from the sky
+        res.prepare = run(PREPARE, prepare_images_workspace, images_dir, workspace_dir,
+                          options=PrepareOptions(sky_masks=True))
+        res.warnings += res.prepare.warnings
+        progress.info(f"prepare: {len(res.prepare.masks)} sky mask(s), {res.prepare.kept} of "
+                      f"{len(res.prepare.images)} photos kept")
+        aligned_from = res.prepare.prepared_dir
+    res.align = run(ALIGN, align, aligned_from, workspace_dir, opt.align,
+                    span=(SPANS[PREPARE][1], SPANS[ALIGN][1]) if opt.sky_masks else None)
     res.georef = run(GEOREFERENCE, georeference_workspace, workspace_dir, gcp_path=ctl.gcp_path, gcps=ctl.gcps,
                      check_points=ctl.check_points, camera_positions_path=ctl.camera_positions_path,
                      use_exif_gps=ctl.use_exif_gps, crs=ctl.crs, refine_intrinsics=opt.georef.refine_intrinsics,

@@ -654,17 +654,17 @@ Dask scheduler (advanced): render the tiles on a Dask cluster (tcp://host:8786) 
 
 Jede Zelle nimmt ihre Höhe aus dem DOM und wird über das vollständige Kameramodell (Orientierung, Brennweite, Bildhauptpunkt, Objektivverzeichnung) in die Bilder projiziert. Eine Zelle, die in einem Bild von höherer Oberfläche verdeckt ist (eine Mauer, ein Baum, ein Hügel), bleibt aus diesem Bild weg, so dass Gebäude nicht kippen und nichts doppelt erscheint; das Mosaik füllt sie aus einem Bild, das sie sieht. Jeder Teil des Mosaiks stammt aus dem Bild, das am senkrechtesten und am nächsten zu seiner Mitte darauf blickt; Nahtlinien laufen um Gebäude und Bäume; Helligkeitsunterschiede zwischen den Bildern werden ausgeglichen und Nähte überblendet.
 
-Georeferenzierter Arbeitsbereich: ein Arbeitsbereich mit DOM (zuerst &apos;DOM erzeugen&apos; ausführen) oder ein DOM angeben.
+Georeferenzierter Arbeitsbereich: ein Arbeitsbereich mit DOM (zuerst 'DOM erzeugen' ausführen) oder ein DOM angeben.
 DOM: optionales Raster (z. B. ein ALS-DOM, in beliebigem KBS: wird im Lauf umprojiziert); Vorgabe ist das DOM des Arbeitsbereichs.
-Bilder: eine Auswahl, z. B. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; oder &apos;group:NIR&apos; (eine Kameragruppe nach Nummer oder Hersteller/Modell), &apos;!name&apos; lässt eines weg. Leer: alle Bilder.
+Bilder: eine Auswahl, z. B. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' oder 'group:NIR' (eine Kameragruppe nach Nummer oder Hersteller/Modell), '!name' lässt eines weg. Leer: alle Bilder.
 Auflösung: Zellgröße in KBS-Einheiten; 0 = die Bodenauflösung der Bilder.
 Überblendung der Nähte: feather (Rampe über die Nähte), multiband (Laplace-Pyramide: keine sichtbare Naht in der Helligkeit und keine Geisterbilder), none (harter Schnitt).
 Vignettierung und Hotspot ausgleichen: die Abdunklung zu den Ecken der Fotos, der helle Fleck gegenüber der Sonne und die Belichtung jedes Fotos werden dort gemessen, wo sich die Fotos überlappen, und entfernt; dann gleicht eine glatte Verstärkung je Foto die Nähte an, so dass Fotos verschiedener Zeitpunkte ohne Helligkeitssprung aneinanderstoßen (nur angewandt, wo die Überlappungen dadurch besser übereinstimmen; aus: ein Belichtungsfaktor je Foto).
 Fernfeld-Grenze (erweitert): jedes Bild wird nur dort verwendet, wo seine Bodenauflösung innerhalb dieses Faktors seiner besten liegt; so bleibt das gedehnte Fernfeld einer Schrägaufnahme (zum Horizont hin) weg, und das Mosaik nimmt diese Zellen aus einer näheren Ansicht; Zellen, die kein Bild fein genug sieht, bleiben leer. 0 = aus (Vorgabe 3).
 Orthomosaik: Cloud-Optimized GeoTIFF mit Übersichten, den Kanälen und dem Datentyp der Bilder (8/16 Bit bleiben) und einem Alphakanal (Vorgabe &lt;workspace&gt;/orthomosaic.tif).
 Ordner für Einzelbild-Orthophotos: optionaler Ordner für ein wahres Orthophoto je Bild (COG).
-Nahtlinien: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem jeder Teil des Mosaiks stammt (ein Polygon je Bild, sein Name im Feld &apos;image&apos;); bearbeiten Sie es, um eine Naht zu verschieben.
-Zu befolgende Nahtlinien: optionale bearbeitete Nahtlinien (Polygone mit dem Feld &apos;image&apos;, im KBS des Mosaiks): wo ein Polygon ein Bild nennt, nimmt das Mosaik dieses Bild, wo es den Boden sieht (das Protokoll sagt, wo nicht); anderswo automatische Nähte. Formen Sie ein Polygon um oder zeichnen Sie eines und nennen Sie sein Bild, um eine Naht von einem Bewuchsmerkmal oder einem fahrenden Auto wegzulegen, und starten Sie erneut.
+Nahtlinien: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem jeder Teil des Mosaiks stammt (ein Polygon je Bild, sein Name im Feld 'image'); bearbeiten Sie es, um eine Naht zu verschieben.
+Zu befolgende Nahtlinien: optionale bearbeitete Nahtlinien (Polygone mit dem Feld 'image', im KBS des Mosaiks): wo ein Polygon ein Bild nennt, nimmt das Mosaik dieses Bild, wo es den Boden sieht (das Protokoll sagt, wo nicht); anderswo automatische Nähte. Formen Sie ein Polygon um oder zeichnen Sie eines und nennen Sie sein Bild, um eine Naht von einem Bewuchsmerkmal oder einem fahrenden Auto wegzulegen, und starten Sie erneut.
 Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786) rechnen, dessen Worker den Pfad des Arbeitsbereichs sehen; leer = dieser Rechner, oder $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
     </message>
 </context>
@@ -1641,7 +1641,7 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="109"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
@@ -2242,52 +2242,52 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Write the accuracy report</source>
         <translation>Genauigkeitsbericht schreiben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="95"/>
+        <location filename="../processing_provider/run_pipeline.py" line="100"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="96"/>
+        <location filename="../processing_provider/run_pipeline.py" line="101"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="97"/>
+        <location filename="../processing_provider/run_pipeline.py" line="102"/>
         <source>Accuracy report (HTML)</source>
         <translation>Genauigkeitsbericht (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="148"/>
+        <location filename="../processing_provider/run_pipeline.py" line="154"/>
         <source>Seconds per stage: {}</source>
         <translation>Sekunden pro Stufe: {}</translation>
     </message>
@@ -2297,94 +2297,104 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>Gesamte Verarbeitung ausführen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Ground control layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Check points</source>
         <translation>Kontrollpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Use EXIF GPS positions</source>
         <translation>EXIF-GPS-Positionen verwenden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Target CRS</source>
         <translation>Ziel-KBS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Matching image size (px)</source>
         <translation>Bildgröße für die Zuordnung (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>DSM resolution (m)</source>
         <translation>DOM-Auflösung (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Matching quality</source>
         <translation>Zuordnungsqualität</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Orthomosaic resolution</source>
         <translation>Auflösung des Orthomosaiks</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Seam blending</source>
         <translation>Überblendung der Nähte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Parallel workers</source>
         <translation>Parallele Prozesse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Dask scheduler</source>
         <translation>Dask-Scheduler</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Build the DTM</source>
         <translation>Das DGM erzeugen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Contour interval (m, 0 = none)</source>
         <translation>Höhenlinienabstand (m, 0 = keine)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Relief visualisations</source>
         <translation>Reliefvisualisierungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="94"/>
+        <location filename="../processing_provider/run_pipeline.py" line="99"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>GCP-Pixel auf aufrechten Fotos gemessen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="120"/>
+        <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
+        <translation>Geben Sie Passpunkte (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <source>Sky masks (oblique photos)</source>
+        <translation>Himmelsmasken (Schrägaufnahmen)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -2392,21 +2402,18 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
 
 Folder of images: the photos. Workspace folder: where every product is written.
 Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in &apos;Georeference&apos; (the pixel coordinates measured on the photos shown upright by their EXIF orientation).
+Sky masks (oblique photos): first a &apos;Prepare images&apos; stage finds the sky and the horizon haze in each photo and masks them, so that no tie point or DSM point comes from the sky; the prepared photos are aligned (off by default: photos looking straight down need none).
 Build the DTM: after the DSM, a bare-earth DTM (as &apos;Build DTM&apos;). Contour interval (advanced): contour lines of the DTM at this interval (as &apos;Contours&apos;; 0 = none). Relief visualisations (advanced): those chosen are computed from the DTM (as &apos;Relief visualisation&apos;). Both need the DTM.
 The other parameters are those of the single stages (see their help); 0 means automatic.
 Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures.</source>
         <translation>Die gesamte Verarbeitung in einem Aufruf, für die Stapelverarbeitung: Bilder ausrichten, Georeferenzieren, DOM erzeugen, Orthophoto erzeugen und Genauigkeitsbericht in einem Arbeitsbereich. Es werden dieselben Funktionen wie in den einzelnen Algorithmen aufgerufen; ein erneuter Lauf setzt fort (bereits berechnete Merkmale, Zuordnungen und Stereopaare werden wiederverwendet).
 
 Bilderordner: die Fotos. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben werden.
-Die Georeferenzierung braucht Passpunkte (eine Passpunktdatei oder ein Passpunktlayer, Kontrollpunkte werden zurückgehalten) und/oder Kamerapositionen (eine CSV-Datei der Kamerapositionen oder EXIF-GPS-Positionen verwenden): ohne sie wird die Verarbeitung abgelehnt, da ein DOM einen metrischen Maßstab und eine Lotrichtung braucht. GCP-Pixel auf aufrechten Fotos gemessen: wie bei 'Georeferenzieren' (die Pixelkoordinaten auf den Fotos gemessen, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden).
-Das DGM erzeugen: nach dem DOM ein DGM der nackten Erde (wie 'DGM erzeugen'). Höhenlinienabstand (erweitert): Höhenlinien des DGM in diesem Abstand (wie 'Höhenlinien'; 0 = keine). Reliefvisualisierungen (erweitert): die gewählten werden aus dem DGM berechnet (wie 'Reliefvisualisierung'). Beide brauchen das DGM.
+Die Georeferenzierung braucht Passpunkte (eine Passpunktdatei oder ein Passpunktlayer, Kontrollpunkte werden zurückgehalten) und/oder Kamerapositionen (eine CSV-Datei der Kamerapositionen oder EXIF-GPS-Positionen verwenden): ohne sie wird die Verarbeitung abgelehnt, da ein DOM einen metrischen Maßstab und eine Lotrichtung braucht. GCP-Pixel auf aufrechten Fotos gemessen: wie bei &apos;Georeferenzieren&apos; (die Pixelkoordinaten auf den Fotos gemessen, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden).
+Himmelsmasken (Schrägaufnahmen): zuerst findet eine Stufe &apos;Bilder vorbereiten&apos; den Himmel und den Dunst am Horizont in jedem Foto und maskiert sie, damit kein Verknüpfungs- oder DOM-Punkt aus dem Himmel stammt; die vorbereiteten Fotos werden ausgerichtet (standardmäßig aus: senkrecht aufgenommene Fotos brauchen keine).
+Das DGM erzeugen: nach dem DOM ein DGM der nackten Erde (wie &apos;DGM erzeugen&apos;). Höhenlinienabstand (erweitert): Höhenlinien des DGM in diesem Abstand (wie &apos;Höhenlinien&apos;; 0 = keine). Reliefvisualisierungen (erweitert): die gewählten werden aus dem DGM berechnet (wie &apos;Reliefvisualisierung&apos;). Beide brauchen das DGM.
 Die übrigen Parameter sind die der einzelnen Stufen (siehe deren Hilfe); 0 bedeutet automatisch.
 Ausgaben: das DOM, das Orthomosaik und der Genauigkeitsbericht (HTML) sowie die wichtigsten Kennzahlen.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="115"/>
-        <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
-        <translation>Geben Sie Passpunkte (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
     </message>
 </context>
 </TS>

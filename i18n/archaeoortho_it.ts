@@ -650,22 +650,22 @@ Per-image orthophotos folder: optional folder for one true orthophoto per image 
 Seamlines: optional GeoPackage of polygons naming the image each part of the mosaic comes from (one polygon per image, its name in the field &apos;image&apos;); edit it to move a seam.
 Seamlines to follow: optional edited seamlines (polygons with the field &apos;image&apos;, in the mosaic&apos;s CRS): where a polygon names an image, the mosaic takes that image where it sees the ground (the log says where it does not); automatic seams elsewhere. Reshape a polygon, or draw one and name its image, to move a seam off a crop mark or a moving car, and run again.
 Dask scheduler (advanced): render the tiles on a Dask cluster (tcp://host:8786) whose workers see the workspace path; empty = this computer, or $ARCHAEOORTHO_DASK_SCHEDULER.</source>
-        <translation>Ortofoto vere e l&apos;ortomosaico di un&apos;area di lavoro georeferenziata.
+        <translation>Ortofoto vere e l'ortomosaico di un'area di lavoro georeferenziata.
 
-Ogni cella prende la quota dal DSM ed è proiettata nelle immagini con il modello completo della camera (orientamento, focale, punto principale, distorsione dell&apos;obiettivo). Una cella nascosta in un&apos;immagine da una superficie più alta (un muro, un albero, una collina) viene esclusa da quell&apos;immagine, così gli edifici non pendono e nulla compare due volte; il mosaico la riempie da un&apos;immagine che la vede. Ogni parte del mosaico proviene dall&apos;immagine che la guarda nel modo più verticale e più vicino al suo centro; le linee di giunzione girano attorno a edifici e alberi; le differenze di luminosità tra le immagini sono compensate e le giunzioni sfumate.
+Ogni cella prende la quota dal DSM ed è proiettata nelle immagini con il modello completo della camera (orientamento, focale, punto principale, distorsione dell'obiettivo). Una cella nascosta in un'immagine da una superficie più alta (un muro, un albero, una collina) viene esclusa da quell'immagine, così gli edifici non pendono e nulla compare due volte; il mosaico la riempie da un'immagine che la vede. Ogni parte del mosaico proviene dall'immagine che la guarda nel modo più verticale e più vicino al suo centro; le linee di giunzione girano attorno a edifici e alberi; le differenze di luminosità tra le immagini sono compensate e le giunzioni sfumate.
 
-Area di lavoro georeferenziata: un&apos;area di lavoro con DSM (eseguire prima &apos;Genera DSM&apos;), oppure indicare un DSM.
-DSM: raster facoltativo (ad es. un DSM ALS, in qualsiasi SR: riproiettato al volo); predefinito il DSM dell&apos;area di lavoro.
-Immagini: un sottoinsieme, ad es. &apos;DJI_00*.JPG&apos;, &apos;IMG_0012.tif, IMG_0013.tif&apos;, &apos;group:2&apos; o &apos;group:NIR&apos; (un gruppo di camere per numero o per marca/modello), &apos;!nome&apos; per escluderne una. Vuoto: tutte le immagini.
+Area di lavoro georeferenziata: un'area di lavoro con DSM (eseguire prima 'Genera DSM'), oppure indicare un DSM.
+DSM: raster facoltativo (ad es. un DSM ALS, in qualsiasi SR: riproiettato al volo); predefinito il DSM dell'area di lavoro.
+Immagini: un sottoinsieme, ad es. 'DJI_00*.JPG', 'IMG_0012.tif, IMG_0013.tif', 'group:2' o 'group:NIR' (un gruppo di camere per numero o per marca/modello), '!nome' per escluderne una. Vuoto: tutte le immagini.
 Risoluzione: dimensione della cella in unità del SR; 0 = il GSD delle immagini.
 Sfumatura delle giunzioni: feather (rampa attraverso le giunzioni), multiband (piramide laplaciana: nessuna giunzione visibile nella luminosità e nessun effetto fantasma), none (taglio netto).
-Compensa vignettatura e hot spot: l&apos;oscuramento verso gli angoli delle foto, la macchia chiara opposta al sole e l&apos;esposizione di ogni foto sono misurati dove le foto si sovrappongono e rimossi, poi un guadagno regolare per foto livella le giunzioni, così foto scattate in momenti diversi si uniscono senza salti di luminosità (applicato solo dove le sovrapposizioni concordano meglio; disattivato: un guadagno di esposizione per foto).
-Limite del campo lontano (avanzato): ogni immagine è usata solo dove la sua risoluzione al suolo è entro questo fattore della sua migliore, così il campo lontano allungato di una foto obliqua (verso l&apos;orizzonte) è escluso e il mosaico prende quelle celle da una vista più vicina; le celle che nessuna immagine vede abbastanza finemente restano vuote. 0 = spento (predefinito 3).
+Compensa vignettatura e hot spot: l'oscuramento verso gli angoli delle foto, la macchia chiara opposta al sole e l'esposizione di ogni foto sono misurati dove le foto si sovrappongono e rimossi, poi un guadagno regolare per foto livella le giunzioni, così foto scattate in momenti diversi si uniscono senza salti di luminosità (applicato solo dove le sovrapposizioni concordano meglio; disattivato: un guadagno di esposizione per foto).
+Limite del campo lontano (avanzato): ogni immagine è usata solo dove la sua risoluzione al suolo è entro questo fattore della sua migliore, così il campo lontano allungato di una foto obliqua (verso l'orizzonte) è escluso e il mosaico prende quelle celle da una vista più vicina; le celle che nessuna immagine vede abbastanza finemente restano vuote. 0 = spento (predefinito 3).
 Ortomosaico: Cloud-Optimized GeoTIFF con panoramiche, le bande e il tipo di dato delle immagini (8/16 bit conservati) più una banda alfa (predefinito &lt;workspace&gt;/orthomosaic.tif).
-Cartella delle ortofoto per immagine: cartella facoltativa per un&apos;ortofoto vera per immagine (COG).
-Linee di giunzione: GeoPackage facoltativo di poligoni che indicano l&apos;immagine da cui proviene ogni parte del mosaico (un poligono per immagine, il suo nome nel campo &apos;image&apos;); modificarlo per spostare una giunzione.
-Linee di giunzione da seguire: linee di giunzione modificate facoltative (poligoni con il campo &apos;image&apos;, nel SR del mosaico): dove un poligono indica un&apos;immagine, il mosaico usa quell&apos;immagine dove vede il terreno (il registro dice dove no); altrove giunzioni automatiche. Rimodellare un poligono, o disegnarne uno e indicarne l&apos;immagine, per spostare una giunzione da una traccia nelle colture o da un&apos;auto in movimento, ed eseguire di nuovo.
-Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:8786) i cui worker vedono il percorso dell&apos;area di lavoro; vuoto = questo computer, oppure $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
+Cartella delle ortofoto per immagine: cartella facoltativa per un'ortofoto vera per immagine (COG).
+Linee di giunzione: GeoPackage facoltativo di poligoni che indicano l'immagine da cui proviene ogni parte del mosaico (un poligono per immagine, il suo nome nel campo 'image'); modificarlo per spostare una giunzione.
+Linee di giunzione da seguire: linee di giunzione modificate facoltative (poligoni con il campo 'image', nel SR del mosaico): dove un poligono indica un'immagine, il mosaico usa quell'immagine dove vede il terreno (il registro dice dove no); altrove giunzioni automatiche. Rimodellare un poligono, o disegnarne uno e indicarne l'immagine, per spostare una giunzione da una traccia nelle colture o da un'auto in movimento, ed eseguire di nuovo.
+Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:8786) i cui worker vedono il percorso dell'area di lavoro; vuoto = questo computer, oppure $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
     </message>
 </context>
 <context>
@@ -1641,7 +1641,7 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="109"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
@@ -2242,52 +2242,52 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Write the accuracy report</source>
         <translation>Scrivi il rapporto di accuratezza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="95"/>
+        <location filename="../processing_provider/run_pipeline.py" line="100"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="96"/>
+        <location filename="../processing_provider/run_pipeline.py" line="101"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="97"/>
+        <location filename="../processing_provider/run_pipeline.py" line="102"/>
         <source>Accuracy report (HTML)</source>
         <translation>Rapporto di accuratezza (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="148"/>
+        <location filename="../processing_provider/run_pipeline.py" line="154"/>
         <source>Seconds per stage: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -2297,94 +2297,104 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Esegui l'intera elaborazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Ground control layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Check points</source>
         <translation>Punti di controllo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Use EXIF GPS positions</source>
         <translation>Usa le posizioni GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Target CRS</source>
         <translation>SR di destinazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Matching image size (px)</source>
         <translation>Dimensione per la corrispondenza (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>DSM resolution (m)</source>
         <translation>Risoluzione del DSM (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Matching quality</source>
         <translation>Qualità della corrispondenza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Orthomosaic resolution</source>
         <translation>Risoluzione dell'ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Seam blending</source>
         <translation>Sfumatura delle giunzioni</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Parallel workers</source>
         <translation>Processi paralleli</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Dask scheduler</source>
         <translation>Scheduler Dask</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Build the DTM</source>
         <translation>Genera il DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Contour interval (m, 0 = none)</source>
         <translation>Equidistanza (m, 0 = nessuna)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>Relief visualisations</source>
         <translation>Visualizzazioni del rilievo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="94"/>
+        <location filename="../processing_provider/run_pipeline.py" line="99"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="67"/>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>Pixel dei GCP misurati sulle foto raddrizzate</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="120"/>
+        <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
+        <translation>Indicare punti di appoggio (File o Layer dei punti d'appoggio: GCPS, GCP_LAYER) e/o posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <source>Sky masks (oblique photos)</source>
+        <translation>Maschere del cielo (foto oblique)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -2392,21 +2402,18 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
 
 Folder of images: the photos. Workspace folder: where every product is written.
 Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in &apos;Georeference&apos; (the pixel coordinates measured on the photos shown upright by their EXIF orientation).
+Sky masks (oblique photos): first a &apos;Prepare images&apos; stage finds the sky and the horizon haze in each photo and masks them, so that no tie point or DSM point comes from the sky; the prepared photos are aligned (off by default: photos looking straight down need none).
 Build the DTM: after the DSM, a bare-earth DTM (as &apos;Build DTM&apos;). Contour interval (advanced): contour lines of the DTM at this interval (as &apos;Contours&apos;; 0 = none). Relief visualisations (advanced): those chosen are computed from the DTM (as &apos;Relief visualisation&apos;). Both need the DTM.
 The other parameters are those of the single stages (see their help); 0 means automatic.
 Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures.</source>
-        <translation>L'intera elaborazione in una sola chiamata, per l'uso in batch: Allinea immagini, Georeferenzia, Crea DSM, Crea ortofoto e Rapporto di accuratezza su un solo spazio di lavoro. Chiama le stesse funzioni dei singoli algoritmi, e una nuova esecuzione riprende (caratteristiche, corrispondenze e coppie dense già calcolate vengono riutilizzate).
+        <translation>L&apos;intera elaborazione in una sola chiamata, per l&apos;uso in batch: Allinea immagini, Georeferenzia, Crea DSM, Crea ortofoto e Rapporto di accuratezza su un solo spazio di lavoro. Chiama le stesse funzioni dei singoli algoritmi, e una nuova esecuzione riprende (caratteristiche, corrispondenze e coppie dense già calcolate vengono riutilizzate).
 
-Cartella delle immagini: le foto. Cartella dell'area di lavoro: dove sono scritti tutti i prodotti.
-La georeferenziazione richiede punti di appoggio (un file o un layer dei punti d'appoggio, punti di controllo esclusi) e/o posizioni delle camere (un CSV delle posizioni delle camere o Usa le posizioni GPS EXIF): senza di essi l'elaborazione viene rifiutata, perché un DSM richiede una scala metrica e una direzione verticale. Pixel dei GCP misurati sulle foto raddrizzate: come in 'Georeferenzia' (le coordinate pixel misurate sulle foto mostrate diritte secondo il loro orientamento EXIF).
-Genera il DTM: dopo il DSM, un DTM del suolo nudo (come 'Genera DTM'). Equidistanza (avanzato): curve di livello del DTM con questa equidistanza (come 'Curve di livello'; 0 = nessuna). Visualizzazioni del rilievo (avanzato): quelle scelte sono calcolate dal DTM (come 'Visualizzazione del rilievo'). Entrambe richiedono il DTM.
+Cartella delle immagini: le foto. Cartella dell&apos;area di lavoro: dove sono scritti tutti i prodotti.
+La georeferenziazione richiede punti di appoggio (un file o un layer dei punti d&apos;appoggio, punti di controllo esclusi) e/o posizioni delle camere (un CSV delle posizioni delle camere o Usa le posizioni GPS EXIF): senza di essi l&apos;elaborazione viene rifiutata, perché un DSM richiede una scala metrica e una direzione verticale. Pixel dei GCP misurati sulle foto raddrizzate: come in &apos;Georeferenzia&apos; (le coordinate pixel misurate sulle foto mostrate diritte secondo il loro orientamento EXIF).
+Maschere del cielo (foto oblique): prima una fase &apos;Prepara immagini&apos; trova il cielo e la foschia all&apos;orizzonte in ogni foto e li maschera, perché nessun punto di legame o del DSM provenga dal cielo; si allineano le foto preparate (disattivato per impostazione predefinita: le foto nadirali non ne hanno bisogno).
+Genera il DTM: dopo il DSM, un DTM del suolo nudo (come &apos;Genera DTM&apos;). Equidistanza (avanzato): curve di livello del DTM con questa equidistanza (come &apos;Curve di livello&apos;; 0 = nessuna). Visualizzazioni del rilievo (avanzato): quelle scelte sono calcolate dal DTM (come &apos;Visualizzazione del rilievo&apos;). Entrambe richiedono il DTM.
 Gli altri parametri sono quelli delle singole fasi (vedi il loro aiuto); 0 significa automatico.
-Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="115"/>
-        <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
-        <translation>Indicare punti di appoggio (File o Layer dei punti d'appoggio: GCPS, GCP_LAYER) e/o posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
+Risultati: il DSM, l&apos;ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali.</translation>
     </message>
 </context>
 </TS>

@@ -37,6 +37,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
     CONTOUR_INTERVAL = "CONTOUR_INTERVAL"
     RELIEF = "RELIEF"
     GCPS_UPRIGHT = "GCPS_UPRIGHT"
+    SKY_MASKS = "SKY_MASKS"
     DTM = "DTM"
     WORKERS = "WORKERS"
     SCHEDULER = "DASK_SCHEDULER"
@@ -56,6 +57,9 @@ class RunPipelineAlgorithm(AlgorithmBase):
         "positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a "
         "DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in "
         "'Georeference' (the pixel coordinates measured on the photos shown upright by their EXIF orientation).\n"
+        "Sky masks (oblique photos): first a 'Prepare images' stage finds the sky and the horizon haze in each "
+        "photo and masks them, so that no tie point or DSM point comes from the sky; the prepared photos are "
+        "aligned (off by default: photos looking straight down need none).\n"
         "Build the DTM: after the DSM, a bare-earth DTM (as 'Build DTM'). Contour interval (advanced): contour lines "
         "of the DTM at this interval (as 'Contours'; 0 = none). Relief visualisations (advanced): those chosen "
         "are computed from the DTM (as 'Relief visualisation'). Both need the DTM.\n"
@@ -78,6 +82,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
             params.pairing(self.PAIRING, self.tr("Pair selection")),
             params.camera_model(self.CAMERA_MODEL, self.tr("Camera model")),
             params.max_image_size(self.MAX_IMAGE_SIZE, self.tr("Matching image size (px)")),
+            params.flag(self.SKY_MASKS, self.tr("Sky masks (oblique photos)")),
             params.flag(self.REFINE_INTRINSICS, self.tr("Refine camera calibration")),
             params.dsm_resolution(self.DSM_RESOLUTION, self.tr("DSM resolution (m)")),
             params.quality(self.QUALITY, self.tr("Matching quality")),
@@ -138,7 +143,8 @@ class RunPipelineAlgorithm(AlgorithmBase):
                 make_report=self.parameterAsBoolean(p, self.REPORT_ENABLED, context),
                 make_dtm=self.parameterAsBoolean(p, self.DTM_ENABLED, context),
                 contour_interval=self.parameterAsDouble(p, self.CONTOUR_INTERVAL, context),
-                relief=params.read_relief(self, p, self.RELIEF, context)),
+                relief=params.read_relief(self, p, self.RELIEF, context),
+                sky_masks=self.parameterAsBoolean(p, self.SKY_MASKS, context)),
             control=pipeline.Control(gcp_path=gcp_path, gcps=gcps, check_points=checks,
                                      camera_positions_path=positions, use_exif_gps=use_gps, crs=crs_text,
                                      gcps_upright=self.parameterAsBoolean(p, self.GCPS_UPRIGHT, context)),

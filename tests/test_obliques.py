@@ -378,45 +378,30 @@ def test_far_field_limit_keeps_the_ground_of_a_vertical_beside_tall_objects(tmp_
 
 @pytest.fixture(scope="module")
 def orbit_run(orbit, tmp_path_factory):
-    """The 16 orbit images rendered, sky-masked by 'Prepare images', aligned (default options: the fast path,
-    then escalation's affine-shape round for the views it leaves out), georeferenced with 5 control points, matched (full quality) and mosaicked; a few minutes."""
+    """The 16 orbit images rendered and put through the pipeline with sky masks (as Run pipeline's SKY_MASKS):
+    'Prepare images' masks the sky, the prepared photos are aligned (default options: the fast path, then
+    escalation's affine-shape round for the views it leaves out), georeferenced with 5 control points, matched
+    (full quality) and mosaicked; a few minutes."""
     import time
 
     from core.align.options import AlignOptions
-    from core.align.stage import align
-    from core.dense.stage import build_dsm_workspace
-    from core.georef.stage import georeference_workspace
-    from core.ortho.stage import build_orthophoto_workspace
-    from core.prepare.stage import prepare_images_workspace
+    from core.pipeline import Control, PipelineOptions, run_pipeline
 
     root = tmp_path_factory.mktemp("orbit")
     ws = str(root / "ws")
-    t = {}
     t0 = time.time()
     orbit.render(str(root / "photos"))
-    t["render"] = time.time() - t0
-    t0 = time.time()
-    prep = prepare_images_workspace(str(root / "photos"), ws, options=PrepareOptions(sky_masks=True))
-    t["prepare"] = time.time() - t0
-    t0 = time.time()
-    # default features: the fast path leaves 65 deg views out, the escalation's affine round brings them in
-    aligned = align(prep.prepared_dir, ws, AlignOptions(pairing="exhaustive", num_threads=2))
-    t["align"] = time.time() - t0
+    render = time.time() - t0
     control = orbit.spread_control(5)
-    t0 = time.time()
-    geo = georeference_workspace(ws, gcps=orbit.gcp_set(control, noise_px=0.4))
-    t["georef"] = time.time() - t0
-    t0 = time.time()
-    dsm = build_dsm_workspace(ws, quality="full")
-    t["dsm"] = time.time() - t0
-    t0 = time.time()
-    ortho = build_orthophoto_workspace(ws)
-    t["ortho"] = time.time() - t0
-    print("\n[orbit] " + ", ".join(f"{k} {v:.0f} s" for k, v in t.items())
+    res = run_pipeline(str(root / "photos"), ws, PipelineOptions(
+        align=AlignOptions(pairing="exhaustive", num_threads=2), dsm_quality="full", make_report=False,
+        make_dtm=False, sky_masks=True), Control(gcps=orbit.gcp_set(control, noise_px=0.4)))
+    prep, aligned, dsm, ortho = res.prepare, res.align, res.dsm, res.ortho
+    print(f"\n[orbit] render {render:.0f} s, " + ", ".join(f"{k} {v:.0f} s" for k, v in res.seconds.items())
           + f"; registered {aligned.registered}/{len(orbit.shots)}, {aligned.num_points3d} points, reprojection "
           f"{aligned.mean_reprojection_error:.3f} px; sky masks {len(prep.masks)}; DSM {dsm.points} points; "
           f"mosaic at {ortho.resolution:g} m")
-    return dict(ws=ws, prep=prep, aligned=aligned, geo=geo, dsm=dsm, ortho=ortho, control=control)
+    return dict(ws=ws, prep=prep, aligned=aligned, geo=res.georef, dsm=dsm, ortho=ortho, control=control)
 
 
 @pytest.mark.slow
