@@ -9,6 +9,8 @@ objects above a local ground estimate, and writes a hillshade PNG of the DSM.
 
     python benchmarks/dense.py [--workspace DIR] [--quality half] [--workers 0] [--resume]
                                [--png PATH] [--point-cloud]
+    python benchmarks/dense.py --synthetic 600,1200 [--contrast 0.03]   (seconds per megapixel at two sizes of
+                               one synthetic block, quality full; fill and accuracy against the truth)
 """
 import argparse
 import json
@@ -107,6 +109,7 @@ def child(args):
     with open(args.result, "w") as f:
         json.dump({"wall": wall, "dsm": r.dsm_path, "point_cloud": r.point_cloud_path, "pairs": r.pairs,
                    "pairs_reused": r.pairs_reused, "points": r.points, "valid_fraction": r.valid_fraction,
+                   "measured_fraction": r.measured_fraction, "interpolated_fraction": r.interpolated_fraction,
                    "resolution": r.resolution, "timings": r.timings, "log": r.log_lines,
                    "pair_seconds": [s["seconds"] for s in pairs], "pair_cpu": [s.get("cpu_seconds", 0.0) for s in pairs], "pair_megapixels": [s["megapixels"] for s in pairs],
                    "pair_valid_fraction": [s.get("valid_fraction", 0.0) for s in pairs]}, f)
@@ -157,8 +160,70 @@ def figures_png(dsm_path, png):
     return raised
 
 
+def synthetic(widths, contrast, quality):
+    """The same synthetic block (tests/test_dense_fill.py's: 2 strips of 6, a low-texture patch in the west) with
+    its camera at each of ``widths`` pixels across: seconds and CPU seconds per megapixel matched, peak RSS, the
+    DSM's measured / interpolated share of the cameras' hull and its accuracy (measured cells) against the truth."""
+    import resource
+
+    from core.common.progress import NullProgress
+    from core.dense import stage as dense
+    from core.dense.options import DenseOptions
+    from core.dense.stereo import read_pair_summary
+    from core.io import raster
+    from tests import synthetic as syn
+    from tests.workspaces import synthetic_workspace
+
+    base = syn.CameraModel(400, 300, 325.0, 325.0, 201.9, 148.1, k1=-0.08, k2=0.02, p1=0.0006, p2=-0.0004)
+    print(f"\n== dense matching, synthetic block (low-texture patch at {contrast:g} of the contrast), "
+          f"quality {quality} ==")
+    print("  width  MP/pair  pairs  s/pair  s/MP  cpu-s/MP  measured %  interpolated %  median |dz| m  "
+          "peak RSS MiB")
+    for width in widths:
+        f = width / 400.0
+        cam = syn.CameraModel(width, int(round(300 * f)), 325.0 * f, 325.0 * f, 201.9 * f, 148.1 * f, k1=-0.08,
+                              k2=0.02, p1=0.0006, p2=-0.0004) if width != 400 else base
+        block = syn.vertical_block(seed=8, camera=cam, altitude=40.0, n_strips=2, per_strip=6, forward_overlap=0.8,
+                                   side_overlap=0.5, gcp_grid=(2, 2), roofs=0, low_texture=(0.0, 0.0, 0.41, 1.0),
+                                   low_texture_contrast=contrast)
+        root = os.path.join(ROOT, "build", "bench-dense", f"synthetic-{width}-{contrast:g}")
+        images = os.path.join(root, "images")
+        if not os.path.exists(os.path.join(root, "rendered")):
+            t0 = time.time()
+            block.render(images)
+            open(os.path.join(root, "rendered"), "w").close()
+            print(f"  (rendered {len(block.shots)} images of {cam.width} x {cam.height} px in {time.time() - t0:.0f} s)")
+        ws = os.path.join(root, "ws")
+        shutil.rmtree(ws, ignore_errors=True)
+        rec = block.truth_reconstruction(model_from_local=None, noise_px=0.2, n_points=1500)
+        synthetic_workspace(ws, block, rec, images_dir=images, georeferenced=True, crs=syn.CRS, offset=syn.ORIGIN)
+        r = dense.build_dsm_workspace(ws, quality=quality, options=DenseOptions(workers=1), progress=NullProgress())
+        from glob import glob
+
+        pairs = [read_pair_summary(p) for p in glob(os.path.join(ws, "dense", "pairs-*", "*.npz"))]
+        pairs = [p for p in pairs if not p.get("skipped")]
+        secs = sum(p["seconds"] for p in pairs)
+        cpu = sum(p.get("cpu_seconds", 0.0) for p in pairs)
+        mp = sum(p["megapixels"] for p in pairs)
+        z, gt, _ = raster.read_dsm(r.dsm_path)
+        src, _, _ = raster.read_dsm(r.source_path)
+        h, w = z.shape
+        xs = gt[0] + (np.arange(w) + 0.5) * gt[1] - syn.ORIGIN[0]
+        ys = gt[3] + (np.arange(h) + 0.5) * gt[5] - syn.ORIGIN[1]
+        x, y = np.meshgrid(xs, ys)
+        err = z - block.scene.height_at(x, y)
+        med = float(np.median(np.abs(err[np.nan_to_num(src) == raster.SOURCE_MEASURED])))
+        rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+        print(f"  {width:5d}  {mp / max(len(pairs), 1):7.2f}  {len(pairs):5d}  {secs / max(len(pairs), 1):6.2f}  "
+              f"{secs / mp:4.2f}  {cpu / mp:8.2f}  {100 * r.measured_fraction:10.1f}  "
+              f"{100 * r.interpolated_fraction:14.1f}  {med:13.3f}  {rss:12.0f}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--synthetic", default=None, metavar="W1,W2",
+                    help="instead of Toledo: the synthetic block with its camera W1, W2 ... px wide (e.g. 600,1200)")
+    ap.add_argument("--contrast", type=float, default=0.03, help="the synthetic low-texture patch's contrast")
     ap.add_argument("--workspace", default=os.path.join(ROOT, "build", "bench-dense", "toledo-ws"))
     ap.add_argument("--images", default=os.path.join(DATA, "toledo", "images"))
     ap.add_argument("--crs", default="EPSG:32617")
@@ -172,6 +237,10 @@ def main():
     args = ap.parse_args()
     if args.child:
         child(args)
+        return
+    if args.synthetic:
+        synthetic([int(v) for v in args.synthetic.split(",")], args.contrast,
+                  args.quality if args.quality != "half" else "full")
         return
     if not os.path.isdir(args.images):
         raise SystemExit(f"no images at {args.images}")
@@ -203,7 +272,8 @@ def main():
           f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print(f"  peak RSS: {r['peak_rss_tree_mib']:.0f} MiB for the whole process tree ({r['processes_at_peak']} processes), "
           f"{r['peak_rss_single_mib']:.0f} MiB for the largest single process (limit 4096 MiB)")
-    print(f"  VALID_FRACTION inside the convex hull of the image centres: {r['valid_fraction']:.3f}")
+    print(f"  inside the convex hull of the image centres: VALID_FRACTION {r['valid_fraction']:.3f}, measured "
+          f"{r.get('measured_fraction') or 0:.3f}, interpolated {r.get('interpolated_fraction') or 0:.3f}")
     if len(raised):
         print(f"  raised objects (> 2.5 m above local ground): {len(raised)} cells, "
               f"height percentiles 50/90/99: {np.percentile(raised, 50):.1f} / {np.percentile(raised, 90):.1f} / "
