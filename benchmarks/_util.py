@@ -4,15 +4,19 @@ import subprocess
 import threading
 import time
 
+LAST_RUN = {}  # run_measured's last child: {"cpu": user + system CPU seconds} (load-independent, unlike the wall)
+
 
 def run_measured(cmd, env=None, cwd=None, log_path=None):
-    """Run ``cmd``; return (exit code, wall seconds, peak RSS in MiB of the child)."""
+    """Run ``cmd``; return (exit code, wall seconds, peak RSS in MiB of the child); the child's CPU seconds go
+    to ``LAST_RUN["cpu"]``."""
     out = open(log_path, "w") if log_path else subprocess.DEVNULL
     t0 = time.time()
     proc = subprocess.Popen(cmd, env=env, cwd=cwd, stdout=out, stderr=subprocess.STDOUT)
     _, status, usage = os.wait4(proc.pid, 0)
     wall = time.time() - t0
     proc.returncode = os.waitstatus_to_exitcode(status)
+    LAST_RUN["cpu"] = usage.ru_utime + usage.ru_stime
     if log_path:
         out.close()
     return proc.returncode, wall, usage.ru_maxrss / 1024.0

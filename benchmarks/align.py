@@ -32,7 +32,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 sys.path.insert(0, ROOT)
-from _util import run_measured  # noqa: E402
+from _util import LAST_RUN, run_measured  # noqa: E402
 
 DEFAULT_IMAGES = os.path.join(os.path.dirname(ROOT), "shared", "data", "toledo", "images")
 
@@ -230,7 +230,7 @@ def _cached(path, run, *args, **kw):
     """The run's {result, wall, rss} kept at ``path``; run only when it is not there."""
     if os.path.exists(path):
         return json.load(open(path))
-    out = dict(zip(("result", "wall", "rss"), run(*args, **kw)))
+    out = dict(zip(("result", "wall", "rss"), run(*args, **kw)), cpu=LAST_RUN.get("cpu"))
     with open(path, "w") as f:
         json.dump(out, f, indent=1)
     return out
@@ -259,9 +259,15 @@ def table(a):
     print("\n" + _table_text(rows))
 
 
+def _secs(run):
+    """'wall s (CPU s)': the CPU seconds of the child do not depend on what else the machine runs."""
+    cpu = f" ({run['cpu']:.0f} CPU s)" if run.get("cpu") else ""
+    return f"{run['wall']:.1f} s{cpu}"
+
+
 def _table_text(rows):
-    out = ["| set | images | ours: registered | ours: reprojection | ours: wall | escalated | "
-           "pycolmap defaults: registered | reprojection | wall | ours / pycolmap |",
+    out = ["| set | images | ours: registered | ours: reprojection | ours: wall (CPU) | escalated | "
+           "pycolmap defaults: registered | reprojection | wall (CPU) | ours / pycolmap, CPU |",
            "|---|---|---|---|---|---|---|---|---|---|"]
     for name, n, note, mine, theirs in rows:
         cells = [name + (f" ({note})" if note else ""), str(n)]
@@ -270,20 +276,21 @@ def _table_text(rows):
             esc = r.get("escalation")
             what = "no"
             if esc:
-                what = "; ".join(f"round {x['round']}: {len(x['left_out'])} left out, {len(x['re_extracted'])} "
+                what = "; ".join(f"round {x['round']} ({x.get('kind', '')}): {len(x['left_out'])} left out, {len(x['re_extracted'])} "
                                  f"re-extracted, {x['registered_before']} -> {x['registered_after']}"
                                  for x in esc["rounds"])
             split = f" + {len(r['others'])} other component(s)" if r.get("others") else ""
-            cells += [f"{r['registered']}/{n}{split}", f"{r['mre']:.3f} px", f"{mine['wall']:.1f} s", what]
+            cells += [f"{r['registered']}/{n}{split}", f"{r['mre']:.3f} px", _secs(mine), what]
         else:
             cells += ["", "", "", ""]
         if theirs:
             p = theirs["result"]
             cells += [f"{p['registered']}/{n}", "n/a" if p["mre"] is None else f"{p['mre']:.3f} px",
-                      f"{theirs['wall']:.1f} s"]
+                      _secs(theirs)]
         else:
             cells += ["", "", ""]
-        cells.append(f"{mine['wall'] / theirs['wall']:.2f}" if mine and theirs else "")
+        both = mine and theirs and mine.get("cpu") and theirs.get("cpu")
+        cells.append(f"{mine['cpu'] / theirs['cpu']:.2f}" if both else "")
         out.append("| " + " | ".join(cells) + " |")
     return "\n".join(out)
 
