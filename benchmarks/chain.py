@@ -43,7 +43,22 @@ def child(images, ws, result, report):
                    "seconds": r.seconds, "camera_rmse": r.georef.figures.get("CAMERA_RMSE_XYZ"),
                    "dsm_valid": r.dsm.valid_fraction, "pairs": r.dsm.pairs, "points": r.dsm.points,
                    "ortho_valid": r.ortho.valid_fraction, "ortho_resolution": r.ortho.resolution,
-                   "dsm_resolution": r.dsm.resolution}, f)
+                   "dsm_resolution": r.dsm.resolution,
+                   # issue 14's figures (absent before it: None): the DSM's measured / interpolated share of the
+                   # cameras' hull, the radiometric correction's seam step, the nodata cells data encloses
+                   "dsm_measured": getattr(r.dsm, "measured_fraction", None),
+                   "dsm_interpolated": getattr(r.dsm, "interpolated_fraction", None),
+                   "radiometry": getattr(r.ortho, "radiometry", None),
+                   "interior_nodata": _interior_nodata(r.ortho.orthomosaic)}, f)
+
+
+def _interior_nodata(path):
+    """core.ortho.writer.interior_nodata where this checkout has it (None before issue 14)."""
+    try:
+        from core.ortho.writer import interior_nodata
+    except ImportError:
+        return None
+    return interior_nodata(path)
 
 
 def one_run(images, names, workdir, report):
@@ -142,6 +157,10 @@ def main():
         print(f"  georeference ({'camera positions' if a.synthetic else 'EXIF GPS'}): camera RMSE XYZ {cam}")
         print(f"  DSM: {r['pairs']} pairs, {r['points']} points, {r['dsm_resolution']:.3f} m cells, valid "
               f"{r['dsm_valid']:.3f}; orthomosaic {r['ortho_resolution']:.3f} m cells, valid {r['ortho_valid']:.3f}")
+        rad = r.get("radiometry") or {}
+        print(f"  DSM measured / interpolated (of the cameras' hull): {r.get('dsm_measured')} / "
+              f"{r.get('dsm_interpolated')}; mosaic nodata cells enclosed by data: {r.get('interior_nodata')}; "
+              f"radiometry: {json.dumps(rad) if rad else 'n/a'}")
         print(f"  per image: {r['wall'] / n:.1f} s", flush=True)
     if len(runs) > 1:
         xs = [r["n"] for r in runs]
