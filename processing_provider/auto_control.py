@@ -3,6 +3,7 @@ from qgis.core import (
     QgsProcessingOutputFolder,
     QgsProcessingOutputNumber,
     QgsProcessingOutputVectorLayer,
+    QgsProcessingParameterExtent,
     QgsProcessingParameterRasterLayer,
 )
 
@@ -19,6 +20,8 @@ class AutoControlAlgorithm(AlgorithmBase):
     REFERENCE_ORTHO = "REFERENCE_ORTHO"
     REFERENCE_DSM = "REFERENCE_DSM"
     PRIOR = "PRIOR"
+    REFERENCE_GSD = "REFERENCE_GSD"
+    REFERENCE_EXTENT = "REFERENCE_EXTENT"
     OUT_WORKSPACE = "WORKSPACE"  # the same name as the input: models chain stages through it
     CAMERAS = "CAMERAS"
     AUTO_GCPS = "AUTO_GCPS"
@@ -32,11 +35,17 @@ class AutoControlAlgorithm(AlgorithmBase):
         "between the two dates (crops, cars, new buildings, another sun) are tolerated: what stays is used, and "
         "the log says how many matches survived each step.\n\n"
         "Aligned workspace: the block to georeference (its photos must still be where the alignment found them).\n"
-        "Reference orthophoto: any north-up raster in a projected CRS, grey or colour; the result is in its CRS.\n"
-        "Reference DSM: a DSM or DTM covering the block, heights in metres.\n"
+        "Reference orthophoto: any north-up raster in a projected CRS, grey or colour; the result is in its CRS. "
+        "A layer that is no local file (WMS, XYZ, WCS, a virtual raster) is saved for the block's extent to "
+        "georef/reference-ortho.tif (a Web Mercator or geographic one in the DSM's CRS, else the UTM zone's).\n"
+        "Reference DSM: a DSM or DTM covering the block, heights in metres (a WCS layer is saved to "
+        "georef/reference-dsm.tif).\n"
         "Rough position: the photos' EXIF GPS when at least three carry it (auto), always (EXIF GPS), or never "
         "(none: rotation and scale are searched over the whole reference, which then should not be much larger "
         "than the block).\n"
+        "Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least "
+        "0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos' EXIF GPS positions plus a "
+        "margin, else the other reference's extent.\n"
         "Outputs: the camera centres in the reference CRS, the number of automatic GCPs the adjustment kept, the "
         "matches found; georef/autocontrol.json lists every candidate with why it was kept or dropped."
     )
@@ -49,6 +58,10 @@ class AutoControlAlgorithm(AlgorithmBase):
             QgsProcessingParameterRasterLayer(self.REFERENCE_DSM, self.tr("Reference DSM")),
             params.choice(self.PRIOR, self.tr("Rough position"),
                           [self.tr("auto"), self.tr("EXIF GPS"), self.tr("none")], 0),
+            *params.advanced(
+                params.number(self.REFERENCE_GSD, self.tr("Reference resolution for web layers (m, 0: auto)")),
+                QgsProcessingParameterExtent(self.REFERENCE_EXTENT, self.tr("Area to fetch from web layers"),
+                                             optional=True)),
         )
         self.addOutput(QgsProcessingOutputFolder(self.OUT_WORKSPACE, self.tr("Workspace")))
         self.addOutput(QgsProcessingOutputVectorLayer(self.CAMERAS, self.tr("Camera centres (world)")))
@@ -59,14 +72,22 @@ class AutoControlAlgorithm(AlgorithmBase):
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
         from ..core.georef.autocontrol.stage import autocontrol_workspace
+        from .reference_layers import resolve_references
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         ortho = self.parameterAsRasterLayer(parameters, self.REFERENCE_ORTHO, context)
         dsm = self.parameterAsRasterLayer(parameters, self.REFERENCE_DSM, context)
         prior = PRIORS[self.parameterAsEnum(parameters, self.PRIOR, context)]
         progress = FeedbackProgress(feedback)
-        result = self.run_core(autocontrol_workspace, workspace, _path(ortho), _path(dsm), prior=prior,
-                               progress=progress)
+        extent = self.parameterAsExtent(parameters, self.REFERENCE_EXTENT, context)
+        ortho_path, dsm_path = self.run_core(
+            resolve_references, ortho, dsm, workspace,
+            gsd=self.parameterAsDouble(parameters, self.REFERENCE_GSD, context) or None,
+            extent=extent if not extent.isNull() else None,
+            extent_crs=self.parameterAsExtentCrs(parameters, self.REFERENCE_EXTENT, context),
+            progress=FeedbackProgress(feedback, 0.0, 0.1), context=context.transformContext())
+        result = self.run_core(autocontrol_workspace, workspace, ortho_path, dsm_path, prior=prior,
+                               progress=FeedbackProgress(feedback, 0.1, 1.0))
         progress.push_result(result.georef.warnings)
         for o in result.georef.outliers:
             feedback.pushWarning(self.tr("outlier left out: {}").format(o))
@@ -77,6 +98,3 @@ class AutoControlAlgorithm(AlgorithmBase):
             out[n] = f.get(n)
         return out
 
-
-def _path(layer):
-    return layer.source().split("|")[0] if layer is not None else ""

@@ -4,6 +4,8 @@ from qgis.core import (
     QgsProcessingOutputFolder,
     QgsProcessingOutputNumber,
     QgsProcessingOutputVectorLayer,
+    QgsProcessingParameterExtent,
+    QgsProcessingParameterRasterLayer,
 )
 
 from . import params
@@ -22,6 +24,11 @@ class GeoreferenceAlgorithm(AlgorithmBase):
     CRS = "CRS"
     REFINE_INTRINSICS = "REFINE_INTRINSICS"
     GCPS_UPRIGHT = "GCPS_UPRIGHT"
+    REFERENCE_ORTHO = "REFERENCE_ORTHO"
+    REFERENCE_DSM = "REFERENCE_DSM"
+    REFERENCE_GSD = "REFERENCE_GSD"
+    REFERENCE_EXTENT = "REFERENCE_EXTENT"
+    AUTO_GCPS = "AUTO_GCPS"
     OUT_WORKSPACE = "WORKSPACE"  # the same name as the input: models chain stages through it
     RESIDUALS = "RESIDUALS"
     CAMERAS = "CAMERAS"
@@ -43,7 +50,20 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         "GCP pixels measured on upright photos: tick when the pixel coordinates were measured on the photos shown "
         "upright by their EXIF orientation, as web browsers and photo viewers show them; they are turned into the "
         "stored pixel grid of each photo (photos stored without a turn are unchanged).\n"
-        "Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out."
+        "Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.\n\n"
+        "Automatic control: give a reference orthophoto and a reference DSM (any raster layer: a file, or a WMS, "
+        "XYZ or WCS layer, which is saved for the block's extent to georef/reference-ortho.tif and "
+        "georef/reference-dsm.tif) and the block is georeferenced with no hand-picked GCP, as 'Automatic control "
+        "from a reference orthophoto' does; the result is in the reference orthophoto's CRS (a Web Mercator or "
+        "geographic layer is saved in the DSM's CRS, else in the UTM zone). Ground control given as well is not "
+        "used to fix the block: all its points become check points, an independent measure of the automatic "
+        "control. Camera positions or Use EXIF GPS positions give the rough position (else EXIF GPS when three "
+        "photos carry it, else rotation and scale are searched). The calibration is refined in any case "
+        "(focal length and distortion: the automatic GCPs determine them).\n"
+        "Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at "
+        "least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos' EXIF GPS positions "
+        "plus a margin, else the other reference's extent.\n"
+        "Automatic GCPs kept: how many automatic GCPs the adjustment kept (none without automatic control)."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
@@ -58,10 +78,19 @@ class GeoreferenceAlgorithm(AlgorithmBase):
             params.target_crs(self.CRS, self.tr("Target CRS")),
             params.flag(self.REFINE_INTRINSICS, self.tr("Refine camera calibration")),
             params.flag(self.GCPS_UPRIGHT, self.tr("GCP pixels measured on upright photos")),
+            QgsProcessingParameterRasterLayer(self.REFERENCE_ORTHO, self.tr("Reference orthophoto (automatic "
+                                                                            "control)"), optional=True),
+            QgsProcessingParameterRasterLayer(self.REFERENCE_DSM, self.tr("Reference DSM (automatic control)"),
+                                              optional=True),
+            *params.advanced(
+                params.number(self.REFERENCE_GSD, self.tr("Reference resolution for web layers (m, 0: auto)")),
+                QgsProcessingParameterExtent(self.REFERENCE_EXTENT, self.tr("Area to fetch from web layers"),
+                                             optional=True)),
         )
         self.addOutput(QgsProcessingOutputFolder(self.OUT_WORKSPACE, self.tr("Workspace")))
         self.addOutput(QgsProcessingOutputVectorLayer(self.RESIDUALS, self.tr("GCP residuals")))
         self.addOutput(QgsProcessingOutputVectorLayer(self.CAMERAS, self.tr("Camera centres (world)")))
+        self.addOutput(QgsProcessingOutputNumber(self.AUTO_GCPS, self.tr("Automatic GCPs kept")))
         for n in self.NUMBERS:
             self.addOutput(QgsProcessingOutputNumber(n, n))
 
@@ -75,6 +104,11 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         crs_text = params.read_crs(self, parameters, self.CRS, context)
         gcps = params.read_gcp_layer(self, parameters, self.GCP_LAYER, context, self.tr(
             "GCP layer {} lacks the field '{}' (needs name, image, px, py)"))
+        ortho = self.parameterAsRasterLayer(parameters, self.REFERENCE_ORTHO, context)
+        dsm = self.parameterAsRasterLayer(parameters, self.REFERENCE_DSM, context)
+        if ortho is not None or dsm is not None:
+            return self._automatic(parameters, context, feedback, workspace, ortho, dsm, gcp_path, gcps, checks,
+                                   positions, crs_text)
         if not params.has_control(gcp_path, gcps, positions, self.parameterAsBoolean(
                 parameters, self.USE_EXIF_GPS, context)):
             raise QgsProcessingException(self.tr(
@@ -97,10 +131,77 @@ class GeoreferenceAlgorithm(AlgorithmBase):
             result.crs, _fmt(f["GCP_RMSE_XY"]), _fmt(f["GCP_RMSE_Z"]), _fmt(f["CHECK_RMSE_XY"]),
             _fmt(f["CHECK_RMSE_Z"])))
         out = {self.OUT_WORKSPACE: result.workspace, self.RESIDUALS: result.residuals_path,
-               self.CAMERAS: result.cameras_path}
+               self.CAMERAS: result.cameras_path, self.AUTO_GCPS: None}
         for n in self.NUMBERS:
             out[n] = f.get(n)
         return out
+
+    def _automatic(self, parameters, context, feedback, workspace, ortho, dsm, gcp_path, gcps, checks, positions,
+                   crs_text):
+        """Automatic control (core autocontrol_workspace) from the reference layers; the given ground control
+        becomes check points."""
+        from ..core.georef.autocontrol.stage import PRIOR_AUTO, PRIOR_GPS, autocontrol_workspace
+        from . import reference_layers as refs
+
+        if ortho is None or dsm is None:
+            raise QgsProcessingException(self.tr("Automatic control needs both a reference orthophoto and a "
+                                                 "reference DSM (REFERENCE_ORTHO, REFERENCE_DSM); {} is missing")
+                                         .format("REFERENCE_ORTHO" if ortho is None else "REFERENCE_DSM"))
+        progress = FeedbackProgress(feedback)
+        extent = self.parameterAsExtent(parameters, self.REFERENCE_EXTENT, context)
+        extent_crs = self.parameterAsExtentCrs(parameters, self.REFERENCE_EXTENT, context)
+        ortho_path, dsm_path = self.run_core(
+            refs.resolve_references, ortho, dsm, workspace,
+            gsd=self.parameterAsDouble(parameters, self.REFERENCE_GSD, context) or None,
+            extent=extent if not extent.isNull() else None, extent_crs=extent_crs,
+            progress=FeedbackProgress(feedback, 0.0, 0.1), context=context.transformContext())
+        crs = self.run_core(refs.reference_crs, ortho_path)
+        if crs_text and crs_text != crs:
+            feedback.pushWarning(self.tr("Target CRS {} is not used: automatic control georeferences in the "
+                                         "reference orthophoto's CRS {}").format(crs_text, crs))
+        check = self.run_core(_check_points, workspace, gcp_path, gcps, checks, crs)
+        cams = None
+        if positions:
+            from ..core.io.gcp import read_camera_positions
+
+            pos_crs, cams = self.run_core(read_camera_positions, positions)
+            cams = refs.positions_in(cams, pos_crs, crs)
+        prior = PRIOR_GPS if self.parameterAsBoolean(parameters, self.USE_EXIF_GPS, context) and not cams \
+            else PRIOR_AUTO
+        result = self.run_core(autocontrol_workspace, workspace, ortho_path, dsm_path, prior=prior,
+                               camera_positions=cams, check_points=check,
+                               progress=FeedbackProgress(feedback, 0.1, 1.0))
+        georef = result.georef
+        progress.push_result(georef.warnings)
+        for o in georef.outliers:
+            feedback.pushWarning(self.tr("outlier left out: {}").format(o))
+        for line in georef.report_lines:
+            feedback.pushInfo(line)
+        f = georef.figures
+        feedback.pushInfo(self.tr("Automatic control: {} automatic GCPs kept; CRS {}; check RMSE XY {} m, Z {} m")
+                          .format(result.n_kept, result.crs, _fmt(f.get("CHECK_RMSE_XY")),
+                                  _fmt(f.get("CHECK_RMSE_Z"))))
+        out = {self.OUT_WORKSPACE: result.workspace, self.RESIDUALS: georef.residuals_path,
+               self.CAMERAS: result.cameras_path, self.AUTO_GCPS: result.n_kept}
+        for n in self.NUMBERS:
+            out[n] = f.get(n)
+        return out
+
+
+def _check_points(workspace, gcp_path, gcps, checks, crs):
+    """The ground control given beside the automatic control, read as Georeference reads it, as check points in
+    the reference's CRS (None when none is given)."""
+    from ..core.io import gcp as gcpmod
+    from ..core.project.workspace import Workspace
+    from .reference_layers import as_check_points
+
+    if gcp_path:
+        ws = Workspace.open(workspace)
+        sizes = {im["name"]: (im["width"], im["height"]) for im in ws.data.get("images", [])}
+        gcps = gcpmod.read_gcps(gcp_path, image_names=list(sizes), image_sizes=sizes, default_crs=crs)
+    if gcps is not None and checks:
+        gcpmod.apply_check_points(gcps, list(checks))
+    return as_check_points(gcps, crs)
 
 
 def _fmt(v):

@@ -58,3 +58,21 @@ def synthetic_workspace(root, block, rec, *, names=None, images_dir=None, photos
             write_json(lay.transform_json, {"crs": crs, "offset": [float(v) for v in offset]})
             run.finish(outputs={"model": lay.rel(lay.georef_model_dir), "transform": lay.rel(lay.transform_json)})
     return ws.root
+
+
+def set_exif_gps(root, positions, crs):
+    """Record ``positions`` (core.io.gcp.CameraPosition in ``crs``) as the photos' EXIF GPS (lon, lat, height) in
+    the workspace's image list, as the aligner records a photo's GPS; photos without a position keep theirs."""
+    import numpy as np
+
+    from core.geometry.crs import transform_points
+
+    ws = Workspace.open(str(root))
+    by_name = {c.image: c for c in positions}
+    rows = [im for im in ws.data.get("images", []) if im["name"] in by_name]
+    xyz = transform_points(np.array([[by_name[im["name"]].x, by_name[im["name"]].y, by_name[im["name"]].z]
+                                     for im in rows], dtype=float), crs, "EPSG:4326")
+    for im, p in zip(rows, xyz):
+        im["gps"] = [float(p[0]), float(p[1]), float(p[2])]
+    ws.save()
+    return ws.root

@@ -37,6 +37,7 @@ except ImportError:
     from qgis.PyQt.QtWidgets import QAction
 
 from ..core.project.stages import ALIGN
+from .gcp_autocontrol import GcpAutoControl
 from .gcp_io import GcpImportExport
 from .gcp_placement import GcpPlacement
 from .gcp_table import (
@@ -60,7 +61,7 @@ DEFAULT_WIDTH = 440  # the dock's width when QGIS first shows it (its size hint)
 PHOTO_DOCK_HEIGHT = 540  # the photo dock's height when first shown (plugin.show_dock), at most 62 % of the window
 
 
-class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
+class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpAutoControl, QgsDockWidget):
     """Ground control of one workspace.  ``iface`` may be None (tests); ``canvas`` then is given.
 
     The shell: widgets, wiring, the workspace, the selection.  Placement (map and photos), import / export
@@ -120,6 +121,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         lay.addLayout(self._build_tolerance_row())
         lay.addWidget(self.tol_source)
         lay.addLayout(self._build_refine_row())
+        lay.addWidget(self._build_autocontrol_box())  # ui/gcp_autocontrol.py: the Georeference button's other mode
         lay.addLayout(self._build_adjustment_row())
         self.summary = QLabel()
         self.summary.setWordWrap(True)
@@ -292,7 +294,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, QgsDockWidget):
         self.act_export_file.triggered.connect(self.choose_export_file)
         self.act_export_layer.triggered.connect(self.choose_export_layer)
         self.act_results.triggered.connect(self.load_results_in_background)
-        self.btn_georef.clicked.connect(self.run_georeference)
+        self.btn_georef.clicked.connect(self.georeference_clicked)
         self.btn_cancel.clicked.connect(self.cancel_task)
         self.tol_spin.valueChanged.connect(self._tolerance_changed)
         self.tol_spin.valueChanged.connect(lambda _v: self.show_tolerance_source())

@@ -39,6 +39,8 @@ RESIDUALS_GPKG = "residuals.gpkg"
 FOOTPRINTS_GPKG = "footprints.gpkg"  # written by the dock (ui/layers.py)
 CONTROL_JSON = "control.json"
 AUTOCONTROL_JSON = "autocontrol.json"  # the automatic control's candidates (role auto) and figures
+REFERENCE_ORTHO_TIF = "reference-ortho.tif"  # in georef/: a web / virtual reference layer saved for the block
+REFERENCE_DSM_TIF = "reference-dsm.tif"
 EDITOR_JSON = "gcp_editor.json"
 ADJUSTMENT_INPUTS_JSON = "adjustment_inputs.json"
 DENSE_DIR = "dense"
@@ -186,6 +188,14 @@ class Layout:
     @property
     def autocontrol_json(self) -> str:
         return self.path(GEOREF_DIR, AUTOCONTROL_JSON)
+
+    @property
+    def reference_ortho_tif(self) -> str:
+        return self.path(GEOREF_DIR, REFERENCE_ORTHO_TIF)
+
+    @property
+    def reference_dsm_tif(self) -> str:
+        return self.path(GEOREF_DIR, REFERENCE_DSM_TIF)
 
     @property
     def editor_json(self) -> str:

@@ -1,0 +1,141 @@
+"""The GCP dock's automatic control (issue 16 item 1): a mode of the georeference panel.
+
+Ticked, the panel's Georeference button georeferences the block with no hand-picked GCP, from a reference
+orthophoto and a reference DSM picked among the project's raster layers (files, or WMS / XYZ / WCS layers, saved
+for the block's extent in the worker thread by processing_provider/reference_layers.py: qgis.core only).  It runs
+core.georef.autocontrol.stage.autocontrol_workspace in a ui.tasks.CoreTask, as the dock's adjustment does; the
+dock's points, if any, become check points (as in Processing's Georeference).  When it ends, the table shows
+what the stage wrote to georef/control.json (the automatic GCPs auto_NNN and the check points) and the map the
+cameras and the automatic GCPs' residuals.  A mixin of ui.gcp_dock.GcpDock; its strings are in the dock's
+translation context.
+"""
+from qgis.core import Qgis, QgsMapLayerProxyModel, QgsProject
+from qgis.gui import QgsMapLayerComboBox
+from qgis.PyQt.QtCore import QCoreApplication
+from qgis.PyQt.QtWidgets import QFormLayout, QGroupBox
+
+from ..core.project.stages import ALIGN
+from . import layers
+from .tasks import CoreTask
+
+translate = QCoreApplication.translate
+
+
+def autocontrol_then_prepare(root, ortho_layer, dsm_layer, check_points=None, extent=None, extent_crs=None,
+                             progress=None):
+    """In the worker thread: the reference layers as files (saved when they are web layers), the automatic
+    control, then the image footprints the result layers show.  Returns (AutoControlResult, footprints)."""
+    from ..core.common.progress import SubProgress
+    from ..core.georef.autocontrol.stage import autocontrol_workspace
+    from ..processing_provider import reference_layers as refs
+
+    ortho, dsm = refs.resolve_references(ortho_layer, dsm_layer, root, extent=extent, extent_crs=extent_crs,
+                                         progress=SubProgress(progress, 0.0, 0.1))
+    check = refs.as_check_points(check_points, refs.reference_crs(ortho))
+    result = autocontrol_workspace(root, ortho, dsm, check_points=check, progress=SubProgress(progress, 0.1, 0.97))
+    return result, layers.footprints_path(root)
+
+
+class GcpAutoControl:
+    """The 'Automatic control' box of the georeference panel and its task."""
+
+    def _build_autocontrol_box(self):
+        self.auto_box = QGroupBox(translate("GcpDock", "Automatic control from a reference orthophoto"))
+        self.auto_box.setCheckable(True)
+        self.auto_box.setChecked(False)
+        self.auto_box.setToolTip(translate(
+            "GcpDock", "Georeference with no hand-picked GCP: the block is matched to a reference orthophoto and "
+                       "takes its heights from a reference DSM. The points of the table become check points."))
+        form = QFormLayout(self.auto_box)
+        form.setContentsMargins(4, 2, 4, 2)
+        self.auto_ortho_combo, self.auto_dsm_combo = QgsMapLayerComboBox(), QgsMapLayerComboBox()
+        for combo, tip in ((self.auto_ortho_combo, translate(
+                "GcpDock", "A reference orthophoto: a raster file, or a WMS / XYZ layer (saved for the block's "
+                           "extent, from the photos' GPS or the map extent)")),
+                           (self.auto_dsm_combo, translate(
+                               "GcpDock", "A reference DSM or DTM (heights in metres): a raster file or a WCS layer"))):
+            combo.setFilters(QgsMapLayerProxyModel.Filter.RasterLayer)
+            combo.setAllowEmptyLayer(True)
+            combo.setLayer(None)
+            combo.setToolTip(tip)
+        form.addRow(translate("GcpDock", "Reference orthophoto:"), self.auto_ortho_combo)
+        form.addRow(translate("GcpDock", "Reference DSM:"), self.auto_dsm_combo)
+        self.auto_box.toggled.connect(self._autocontrol_toggled)
+        self._autocontrol_toggled(False)
+        return self.auto_box
+
+    def _autocontrol_toggled(self, on):
+        for w in (self.auto_ortho_combo, self.auto_dsm_combo):
+            w.setVisible(bool(on))
+        if hasattr(self, "refine_box"):  # the automatic control refines focal length and distortion in any case
+            self.refine_box.setEnabled(not on)
+        if hasattr(self, "btn_georef"):
+            self.btn_georef.setToolTip(
+                translate("GcpDock", "Georeference from the reference orthophoto and DSM (in the background)") if on
+                else translate("GcpDock", "Run the adjustment with these points (in the background)"))
+
+    def autocontrol_mode(self):
+        return self.auto_box.isChecked()
+
+    def georeference_clicked(self):
+        """The Georeference button: the automatic control when its box is ticked, else the adjustment."""
+        return self.run_autocontrol() if self.autocontrol_mode() else self.run_georeference()
+
+    def run_autocontrol(self):
+        """Georeference with automatic control in a background task; never raises (messages in the dock)."""
+        if self.store.workspace is None or self._busy():
+            return None
+        if not self.store.stage_done(ALIGN):
+            self.message(translate("GcpDock", "The block is not aligned yet: run Align images first"),
+                         Qgis.MessageLevel.Warning)
+            return None
+        ortho, dsm = self.auto_ortho_combo.currentLayer(), self.auto_dsm_combo.currentLayer()
+        if ortho is None or dsm is None:
+            self.message(translate("GcpDock", "Automatic control: choose a reference orthophoto and a reference DSM "
+                                              "layer"), Qgis.MessageLevel.Warning)
+            return None
+        root = self.store.root
+        gs = self.store.usable_gcps()
+        extent = crs = None
+        if self.canvas is not None:  # used for web layers when the photos carry no GPS
+            extent, crs = self.canvas.extent(), self.canvas.mapSettings().destinationCrs()
+            from ..processing_provider.reference_layers import gps_lonlat
+
+            if gps_lonlat(root):
+                extent = crs = None
+
+        def done(outcome):
+            result, footprints = outcome
+            self._task_ended()
+            self.progress.setValue(100)
+            self.open_workspace(root)  # the table: the automatic GCPs and the check points the stage used
+            self.load_results(kinds=("cameras",), footprints=footprints)
+            self._load_automatic_gcps()
+            f = result.georef.figures
+            text = translate("GcpDock", "Automatic control: {} automatic GCPs kept of {} matches; georeferenced in "
+                                        "{}.").format(result.n_kept, result.figures.get("matches"), result.crs)
+            if f.get("CHECK_N"):
+                text += " " + translate("GcpDock", "Check points: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).").format(
+                    f.get("CHECK_RMSE_XY") or 0.0, f.get("CHECK_RMSE_Z") or 0.0, f.get("CHECK_N"))
+            self.message(text, Qgis.MessageLevel.Success)
+            self.auto_result = result
+
+        self.auto_result = None
+        task = CoreTask(translate("GcpDock", "ArchaeoOrtho: automatic control"), autocontrol_then_prepare,
+                        (root, ortho, dsm), {"check_points": gs if gs.points else None, "extent": extent,
+                                             "extent_crs": crs},
+                        on_done=done, on_error=self._task_failed)
+        self.message(translate("GcpDock", "Automatic control against {} and {}\u2026").format(ortho.name(), dsm.name()))
+        return self._start_task(task)
+
+    def _load_automatic_gcps(self):
+        """The automatic GCPs (and the check points) with their residual vectors, as a styled layer."""
+        lay = self.store.layout
+        if lay is None:
+            return []
+        import os
+
+        if not os.path.exists(lay.residuals_gpkg):
+            return []
+        return layers.load_residuals(lay.residuals_gpkg, QgsProject.instance(), layers.workspace_group_name(
+            self.store.root), name=translate("GcpDock", "Automatic GCPs (residuals)"))
