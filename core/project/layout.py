@@ -18,7 +18,7 @@ from typing import Any, Dict, Optional, Tuple
 
 from ..common.errors import ArchaeoOrthoError, require
 from ..common.files import atomic_write_text
-from .stages import ALIGN, DSM, GEOREFERENCE, TERRAIN
+from .stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, TERRAIN
 from .workspace import Workspace
 
 # folder and file names inside a workspace (the workspace format: changing one breaks old workspaces)
@@ -260,6 +260,16 @@ class Layout:
     @property
     def default_orthomosaic(self) -> str:
         return self.path(ORTHOMOSAIC_TIF)
+
+    def orthomosaic(self) -> Optional[str]:
+        """The workspace's orthomosaic: the orthophoto stage's recorded output, else <workspace>/orthomosaic.tif;
+        None if absent."""
+        out = (self.ws.stage(ORTHOPHOTO).get("outputs") or {}).get("orthomosaic")
+        if out:
+            p = self.resolve(out)
+            if os.path.isfile(p):
+                return p
+        return self.default_orthomosaic if os.path.isfile(self.default_orthomosaic) else None
 
     @property
     def default_report(self) -> str:
