@@ -4,8 +4,10 @@ triangulation -> two depth maps.
 Both images are read at the QUALITY downscale, lens distortion removed and the pair rectified in one remap from
 the known poses (both cameras turned to a common orientation whose x axis is the baseline, so the epipolar lines
 are rows); the disparity range comes from the shared sparse points (0.5-99.5 % plus a margin); OpenCV
-semi-global matching (StereoSGBM, Hirschmüller 2008) runs left->right and right->left; a left-right consistency
-check keeps a match; it is triangulated and written into two depth maps, one on each image's own (distorted,
+semi-global matching (StereoSGBM, Hirschmüller 2008) runs coarse to fine: the pair halved until that range is
+about 64 disparities wide, matched there over all of it (left->right and right->left, left-right check), and each
+finer level piece by piece over the disparities its coarser level found there (so the search does not grow with
+the resolution), checked and completed by it; it is triangulated and written into two depth maps, one on each image's own (distorted,
 downscaled) pixel grid, saved as one ``.npz`` per pair (the cache a re-run reuses).
 """
 from __future__ import annotations
@@ -37,7 +39,7 @@ class PairUnit:
     uniqueness: int
     lr_tolerance: float
     threads: int
-    coarse: bool = True  # a second matching at half the resolution checks and completes the fine one
+    coarse: bool = True  # coarse to fine (a pyramid, see _disparity); False: one matching over the whole range
 
 
 def _to_gray8(img: np.ndarray) -> np.ndarray:
@@ -154,10 +156,10 @@ def disparity_range(unit: PairUnit, rect: Rectification) -> Tuple[int, int]:
     return dmin, num
 
 
-def _sgbm(block: int, dmin: int, num: int, uniqueness: int):
+def _sgbm(block: int, dmin: int, num: int, uniqueness: int, disp12: int = -1):
     cv2 = require("cv2", "dense matching")
     return cv2.StereoSGBM_create(minDisparity=dmin, numDisparities=num, blockSize=block,
-                                 P1=8 * block * block, P2=32 * block * block, disp12MaxDiff=-1,
+                                 P1=8 * block * block, P2=32 * block * block, disp12MaxDiff=disp12,
                                  preFilterCap=63, uniquenessRatio=uniqueness, speckleWindowSize=100,
                                  speckleRange=2, mode=cv2.STEREO_SGBM_MODE_SGBM_3WAY)
 
@@ -171,14 +173,20 @@ def _sample_rows(arr: np.ndarray, rows: np.ndarray, xs: np.ndarray) -> np.ndarra
 
 
 def _zbuffer(shape: Tuple[int, int], px: np.ndarray, py: np.ndarray, depth: np.ndarray) -> np.ndarray:
-    out = np.full(shape, np.nan, dtype=np.float32)
+    """The nearest depth per pixel of ``shape`` (NaN where none): written in any order, then rewritten where a
+    point is nearer than what its pixel holds until none is (a few rounds: few points share a pixel); no sort."""
     c = np.round(px).astype(np.int64)
     r = np.round(py).astype(np.int64)
     ok = (c >= 0) & (c < shape[1]) & (r >= 0) & (r < shape[0]) & (depth > 0)
-    c, r, d = c[ok], r[ok], depth[ok]
-    order = np.argsort(-d.astype(np.float32))  # nearest written last: it wins
-    out[r[order], c[order]] = d[order]
-    return out
+    lin = r[ok] * shape[1] + c[ok]
+    d = depth[ok].astype(np.float32)
+    flat = np.full(shape[0] * shape[1], np.inf, dtype=np.float32)
+    while len(lin):
+        flat[lin] = d
+        nearer = d < flat[lin]
+        lin, d = lin[nearer], d[nearer]
+    flat[np.isinf(flat)] = np.nan
+    return flat.reshape(shape)
 
 
 def _match_lr(left: np.ndarray, right: np.ndarray, block: int, dmin: int, num: int, uniqueness: int,
@@ -256,20 +264,195 @@ def coarse_to_fine(fine: np.ndarray, coarse: np.ndarray) -> np.ndarray:
     return out
 
 
-def _disparity(li: np.ndarray, rj: np.ndarray, block: int, dmin: int, num: int, unit: "PairUnit",
-               cancel_path: Optional[str]) -> np.ndarray:
-    """The left image's disparity map (NaN = none): SGBM both ways + left-right check, coarse-to-fine completed."""
+PYRAMID_MAX_DISPARITIES = 64  # the coarsest level searches the whole range; go down until it is about this wide
+PYRAMID_MIN_SIDE = 96  # px: no level smaller than this on its short side
+TILE_PX = 384  # the finer levels match tiles of this side, each over the disparities its coarser level found there
+TILE_CONTEXT_PX = 24  # rows and columns of context around a tile (SGBM's path aggregation; dropped after)
+TILE_RANGE_MARGIN_PX = 3  # disparities searched beyond twice the coarser level's range around the tile
+EDGE_JUMP_PX = 3.0  # a disparity step this large between neighbours of the coarser level marks a depth edge
+EDGE_MIN_PIXELS = 60  # ... on this many coarser pixels around a tile (a wall; one blunder's speck marks 25)
+TILE_MIN_PRIOR = 16  # coarser disparities a tile's window needs; fewer -> the window grows, then the whole range
+
+
+def pyramid_levels(num: int, shape: Tuple[int, int]) -> int:
+    """How many times the rectified pair is halved so that its coarsest level searches about
+    PYRAMID_MAX_DISPARITIES (at least 1: the half-resolution level also checks and completes the fine one)."""
+    k = 1
+    while num / 2 ** k > PYRAMID_MAX_DISPARITIES and min(shape) / 2 ** (k + 1) >= PYRAMID_MIN_SIDE and k < 6:
+        k += 1
+    return k
+
+
+def _tile_range(prior: np.ndarray, y0: int, y1: int, x0: int, x1: int, dmin: int, num: int) -> Optional[Tuple[int, int]]:
+    """(lowest, highest) disparity to search in fine tile [y0:y1, x0:x1] from the coarser level's map ``prior``
+    (half the size, half the disparities): twice its range over the tile and its context, +- the margin; the window
+    grows where the coarser level has (almost) nothing; None = nothing anywhere near (search the whole range)."""
+    ph, pw = prior.shape
+    grow = TILE_CONTEXT_PX
+    while True:
+        win = prior[max(0, (y0 - grow) // 2):min(ph, (y1 + grow) // 2 + 1),
+                    max(0, (x0 - grow) // 2):min(pw, (x1 + grow) // 2 + 1)]
+        vals = win[np.isfinite(win)]
+        if vals.size >= TILE_MIN_PRIOR:
+            break
+        if win.shape == prior.shape or grow > 4 * TILE_PX:
+            return None
+        grow *= 2
+    lo = max(dmin, int(math.floor(2.0 * float(vals.min()))) - TILE_RANGE_MARGIN_PX)
+    hi = min(dmin + num - 1, int(math.ceil(2.0 * float(vals.max()))) + TILE_RANGE_MARGIN_PX)
+    if hi <= lo:
+        return None
+    return lo, hi
+
+
+def _runs(cells: list, ctx: int, height: int) -> list:
+    """Split one band's cells (None = nothing to match, else (x0, x1, lo, hi, two_way)) into runs matched by one
+    SGBM call each, at the least estimated cost: a run costs (width + context + its disparities, twice for two
+    passes) x its rows x its disparities; joining cells widens the search, splitting repeats the margins."""
+    n = len(cells)
+
+    def cost(i, j):  # cells i..j-1 as one run; None if it holds nothing
+        live = [c for c in cells[i:j] if c is not None]
+        if not live:
+            return 0.0, None
+        lo, hi = min(c[2] for c in live), max(c[3] for c in live)
+        tw = any(c[4] for c in live)
+        tn = int(16 * math.ceil((hi - lo + 1) / 16.0))
+        width = live[-1][1] - live[0][0]
+        ways = 2 if tw else 1
+        return ways * (width + 2 * ctx + ways * tn) * (height + 2 * ctx) * tn, (live[0][0], live[-1][1], lo, hi, tw)
+
+    best = [0.0] + [math.inf] * n
+    back = [0] * (n + 1)
+    for j in range(1, n + 1):
+        for i in range(j - 1, -1, -1):
+            c, _ = cost(i, j)
+            if best[i] + c < best[j]:
+                best[j], back[j] = best[i] + c, i
+    runs, j = [], n
+    while j > 0:
+        i = back[j]
+        run = cost(i, j)[1]
+        if run is not None:
+            runs.append(run)
+        j = i
+    return runs[::-1]
+
+
+def _match_tiled(left: np.ndarray, right: np.ndarray, prior: np.ndarray, block: int, dmin: int, num: int,
+                 unit: "PairUnit", cancel_path: Optional[str], edges_two_way: bool = False) -> Tuple[np.ndarray, dict]:
+    """Left-right checked disparity of a rectified pair matched piece by piece, each piece over the disparities the
+    coarser level (``prior``) found around it: the search no longer grows with the resolution.
+
+    The pair is cut into bands of TILE_PX rows and each band into cells of TILE_PX / 2 columns; a cell's range is
+    twice the coarser level's around it (``_tile_range``); neighbouring cells are joined into runs where one wider
+    search costs less than repeating the margins (``_runs``); cells with no image in either view are skipped. A run
+    is matched once, with OpenCV's own left-right check (disp12MaxDiff: the right image's disparities from the same
+    aggregated costs), or, with ``edges_two_way`` where the coarser level shows a depth edge (EDGE_MIN_PIXELS of
+    its pixels span EDGE_JUMP_PX over 5 x 5), both ways with a full second pass, which keeps the occluded side of a
+    wall out (one pass fattens a roof by a cell or two). Returns the map and {tiles: runs matched, skipped cells,
+    two-way runs, mean disparities searched}."""
     cv2 = require("cv2", "dense matching")
-    disp_l, disp_r = _match_lr(li, rj, block, dmin, num, unit.uniqueness, cancel_path)
-    fine = lr_checked(disp_l, disp_r, unit.lr_tolerance)
-    del disp_l, disp_r
+    h, w = left.shape
+    out = np.full((h, w), np.nan, np.float32)
+    ctx = TILE_CONTEXT_PX
+    pad = ctx + 2 * num + max(abs(dmin), abs(dmin + num)) + 16
+    lp = cv2.copyMakeBorder(left, 0, 0, pad, pad, cv2.BORDER_CONSTANT, value=0)
+    rp = cv2.copyMakeBorder(right, 0, 0, pad, pad, cv2.BORDER_CONSTANT, value=0)
+    edge = np.zeros(prior.shape, bool)
+    if edges_two_way:  # the coarser level's disparity range over 5 x 5 (across an occlusion's hole too)
+        valid = np.isfinite(prior)
+        k5 = np.ones((5, 5), np.uint8)
+        big = np.float32(1e6)
+        lo5 = cv2.erode(np.where(valid, prior, big).astype(np.float32), k5)
+        hi5 = cv2.dilate(np.where(valid, prior, -big).astype(np.float32), k5)
+        edge = (lo5 < big / 2) & (hi5 - lo5 > EDGE_JUMP_PX / 2.0)
+    ph, pw = prior.shape
+    cell = max(32, TILE_PX // 2)
+    runs_done = skipped = searched = two_ways = 0
+    for y0 in range(0, h, TILE_PX):
+        y1 = min(h, y0 + TILE_PX)
+        ya, yb = max(0, y0 - ctx), min(h, y1 + ctx)
+        cells = []
+        for x0 in range(0, w, cell):
+            x1 = min(w, x0 + cell)
+            if not left[y0:y1, x0:x1].any():
+                cells.append(None)
+                skipped += 1
+                continue
+            rng = _tile_range(prior, y0, y1, x0, x1, dmin, num)
+            lo, hi = rng if rng is not None else (dmin, dmin + num - 1)
+            if not right[y0:y1, max(0, x0 - hi):max(0, min(w, x1 - lo))].any():
+                cells.append(None)  # the cell's ground is outside the other image
+                skipped += 1
+                continue
+            tw = int(np.count_nonzero(edge[max(0, (y0 - ctx) // 2):min(ph, (y1 + ctx) // 2 + 1),
+                                           max(0, (x0 - ctx) // 2):min(pw, (x1 + ctx) // 2 + 1)])) >= EDGE_MIN_PIXELS
+            cells.append((x0, x1, lo, hi, tw))
+        for x0, x1, lo, hi, tw in _runs(cells, ctx, y1 - y0):
+            check_unit_cancel(cancel_path)
+            tn = int(16 * math.ceil((hi - lo + 1) / 16.0))
+            # crop disparity dd = d - lo in [0, tn): the left crop starts tn + ctx before the run (SGBM's first tn
+            # columns have no full range); the right crop is the left one shifted by lo (and for two passes ends
+            # tn + ctx after the run, for the right-to-left pass's own first columns)
+            xa, xb = x0 - ctx - tn, x1 + ctx + (tn if tw else 0)
+            lc = lp[ya:yb, xa + pad:xb + pad]
+            rc = rp[ya:yb, xa + pad - lo:xb + pad - lo]
+            if tw:
+                sgbm = _sgbm(block, 0, tn, unit.uniqueness)
+                dl = sgbm.compute(lc, rc).astype(np.float32) / 16.0
+                dr = sgbm.compute(np.ascontiguousarray(rc[:, ::-1]), np.ascontiguousarray(lc[:, ::-1]))
+                dr = np.ascontiguousarray((dr.astype(np.float32) / 16.0)[:, ::-1])
+                dl[dl < -0.5] = np.nan
+                dr[dr < -0.5] = np.nan
+                chk = lr_checked(dl, dr, unit.lr_tolerance)
+                two_ways += 1
+            else:
+                sgbm = _sgbm(block, 0, tn, unit.uniqueness, max(1, int(round(unit.lr_tolerance))))
+                chk = sgbm.compute(lc, rc).astype(np.float32) / 16.0
+                chk[chk < -0.5] = np.nan
+            out[y0:y1, x0:x1] = chk[y0 - ya:y1 - ya, x0 - xa:x1 - xa] + lo
+            runs_done += 1
+            searched += tn
+    return out, {"tiles": runs_done, "skipped": skipped, "two_way": two_ways,
+                 "disparities": searched / max(1, runs_done)}
+
+
+def _disparity(li: np.ndarray, rj: np.ndarray, block: int, dmin: int, num: int, unit: "PairUnit",
+               cancel_path: Optional[str], stats: Optional[dict] = None) -> np.ndarray:
+    """The left image's disparity map (NaN = none), coarse to fine: the pair halved ``pyramid_levels`` times, the
+    coarsest level matched over the whole range (SGBM both ways + left-right check), each finer level tile by tile
+    over the range its coarser level found there, then checked and completed by it (``coarse_to_fine``)."""
+    cv2 = require("cv2", "dense matching")
     if not unit.coarse or min(li.shape) < 64:
-        return fine
-    cmin = int(math.floor(dmin / 2.0)) - 1
-    cnum = int(16 * math.ceil(max(16, math.ceil(num / 2.0) + 2) / 16.0))
-    cl, cr = _match_lr(cv2.pyrDown(li), cv2.pyrDown(rj), block, cmin, cnum, unit.uniqueness, cancel_path)
-    coarse = lr_checked(cl, cr, unit.lr_tolerance)
-    return coarse_to_fine(fine, coarse)
+        disp_l, disp_r = _match_lr(li, rj, block, dmin, num, unit.uniqueness, cancel_path)
+        return lr_checked(disp_l, disp_r, unit.lr_tolerance)
+    levels = pyramid_levels(num, li.shape)
+    pyr = [(li, rj)]
+    for _ in range(levels):
+        pyr.append((cv2.pyrDown(pyr[-1][0]), cv2.pyrDown(pyr[-1][1])))
+
+    def level_range(k):
+        lo = int(math.floor(dmin / 2.0 ** k)) - (1 if k else 0)
+        hi = int(math.ceil((dmin + num) / 2.0 ** k)) + (1 if k else 0)
+        return lo, int(16 * math.ceil(max(16, hi - lo) / 16.0))
+
+    lo, n = level_range(levels)
+    cl, cr = _match_lr(pyr[levels][0], pyr[levels][1], block, lo, n, unit.uniqueness, cancel_path)
+    disp = lr_checked(cl, cr, unit.lr_tolerance)
+    del cl, cr
+    info = {"levels": levels, "coarsest_disparities": n}
+    for k in range(levels - 1, -1, -1):
+        lo, n = level_range(k)
+        fine, tinfo = _match_tiled(pyr[k][0], pyr[k][1], disp, block, lo, n, unit, cancel_path,
+                                   edges_two_way=k == 0)
+        disp = coarse_to_fine(fine, disp)
+        if k == 0:
+            info.update(tiles=tinfo["tiles"], tiles_skipped=tinfo["skipped"], tiles_two_way=tinfo["two_way"],
+                        disparities_searched=round(tinfo["disparities"], 1))
+    if stats is not None:
+        stats.update(info)
+    return disp
 
 
 def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
@@ -301,7 +484,8 @@ def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
     mi = cv2.remap(ones_i, rect.maps_i[0], rect.maps_i[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT) == 255
     mj = cv2.remap(ones_j, rect.maps_j[0], rect.maps_j[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT) == 255
     del ones_i, ones_j
-    disp = _disparity(li, rj, unit.block_size, dmin, num, unit, cancel_path)
+    pyramid: dict = {}
+    disp = _disparity(li, rj, unit.block_size, dmin, num, unit, cancel_path, pyramid)
     check_unit_cancel(cancel_path)
     rows, xs = np.nonzero(np.isfinite(disp) & mi)
     d = disp[rows, xs]
@@ -330,6 +514,7 @@ def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
     rel_err = zmed / (rect.f * rect.baseline) if len(z) else 0.0
     summary.update(valid=int(len(z)), valid_fraction=float(len(z) / max(1, int(mi.sum()))),
                    megapixels=(wi_ * hi_ + wj_ * hj_) / 1e6, rectified=[w, h], disparities=[dmin, num],
+                   pyramid=pyramid,
                    rel_err=rel_err, seconds=time.time() - t0, cpu_seconds=time.process_time() - c0)
     check_unit_cancel(cancel_path)
     _save_pair(unit.out_path, map_i, map_j, rel_err, summary)
