@@ -7,8 +7,8 @@ are rows); the disparity range comes from the shared sparse points (0.5-99.5 % p
 semi-global matching (StereoSGBM, Hirschmüller 2008) runs coarse to fine: the pair halved until that range is
 about 64 disparities wide, matched there over all of it (left->right and right->left, left-right check), and each
 finer level piece by piece over the disparities its coarser level found there (so the search does not grow with
-the resolution), checked and completed by it; it is triangulated and written into two depth maps, one on each image's own (distorted,
-downscaled) pixel grid, saved as one ``.npz`` per pair (the cache a re-run reuses).
+the resolution), checked and completed by it; a match is triangulated and written into two depth maps, one on
+each image's own (distorted, downscaled) pixel grid, saved as one ``.npz`` per pair (the cache a re-run reuses).
 """
 from __future__ import annotations
 
