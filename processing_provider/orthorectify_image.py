@@ -3,6 +3,7 @@ from qgis.core import (
     QgsProcessingException,
     QgsProcessingOutputNumber,
     QgsProcessingParameterFile,
+    QgsProcessingParameterPoint,
     QgsProcessingParameterRasterDestination,
     QgsProcessingParameterRasterLayer,
     QgsProcessingParameterVectorDestination,
@@ -20,6 +21,10 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
     GCPS = "GCPS"
     GCP_LAYER = "GCP_LAYER"
     ORIENTATION = "ORIENTATION"
+    REFERENCE_ORTHO = "REFERENCE_ORTHO"
+    LOCATION = "LOCATION"
+    SEARCH_RADIUS = "SEARCH_RADIUS"
+    AUTO_GCPS = "AUTO_GCPS"
     FOCAL_MM = "FOCAL_MM"
     SENSOR_WIDTH_MM = "SENSOR_WIDTH_MM"
     MODE = "MODE"
@@ -46,6 +51,13 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
         "Known orientation: instead of GCPs, a file with x y z omega phi kappa (degrees, photogrammetric convention; "
         "a header row as Pix4D writes it, or JSON), optionally focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 "
         "and a CRS line.\n"
+        "Reference orthophoto (automatic control): with no GCPs and no known orientation, the photo is matched to "
+        "this orthophoto (any CRS, any resolution; the DSM is then the reference DSM) and the matches become "
+        "automatic GCPs (auto_001, ...) for the space resection: no hand-picked point, the heading need not be "
+        "known, obliques work too, and the focal length is estimated when the photo has none. Rough location: a "
+        "point on the ground the photo shows (any CRS; empty = anywhere on the reference); Search radius: how far "
+        "off it may be (metres). The log says how many matches survived each step; the GCP residuals list the "
+        "automatic GCPs.\n"
         "Focal length and Sensor width: interior orientation in mm (the sensor's long side); 0 or empty = the "
         "EXIF focal length.\n"
         "Mode: a true orthophoto on the DSM, or a planar (projective) rectification through the GCPs for "
@@ -68,6 +80,10 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
             QgsProcessingParameterFile(
                 self.ORIENTATION, self.tr("Known orientation"), optional=True,
                 fileFilter="Orientation (*.txt *.csv *.json);;All files (*)"),
+            QgsProcessingParameterRasterLayer(
+                self.REFERENCE_ORTHO, self.tr("Reference orthophoto (automatic control)"), optional=True),
+            QgsProcessingParameterPoint(self.LOCATION, self.tr("Rough location (automatic control)"), optional=True),
+            params.number(self.SEARCH_RADIUS, self.tr("Search radius (m)"), default=50.0),
             params.number(self.FOCAL_MM, self.tr("Focal length (mm)"), optional=True),
             params.number(self.SENSOR_WIDTH_MM, self.tr("Sensor width (mm)"), optional=True),
             params.choice(self.MODE, self.tr("Mode"), (self.tr("True orthophoto on the DSM"),
@@ -79,6 +95,7 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
         self.addParameter(QgsProcessingParameterVectorDestination(
             self.RESIDUALS, self.tr("GCP residuals"), optional=True, createByDefault=False))
         self.addOutput(QgsProcessingOutputNumber(self.RMSE_PX, self.tr("GCP residual RMSE (pixels)")))
+        self.addOutput(QgsProcessingOutputNumber(self.AUTO_GCPS, self.tr("Automatic GCPs used")))
         self.addOutput(QgsProcessingOutputNumber(self.PLANAR_OFFSET_P95, self.tr(
             "Planar rectification: 95th percentile of its offset from the true position (CRS units)")))
 
@@ -94,10 +111,16 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
         if layer_gcps is not None:
             gcps = layer_gcps
         orientation = params.read_optional_file(self, parameters, self.ORIENTATION, context)
-        if gcps is None and orientation is None:
+        ref_layer = self.parameterAsRasterLayer(parameters, self.REFERENCE_ORTHO, context)
+        if gcps is None and orientation is None and ref_layer is None:
             raise QgsProcessingException(self.tr(
                 "Give ground control points observed in the image (Ground control file or Ground control point layer: "
-                "GCPS, GCP_LAYER) or its Known orientation (ORIENTATION)"))
+                "GCPS, GCP_LAYER), its Known orientation (ORIENTATION) or a Reference orthophoto for automatic "
+                "control (REFERENCE_ORTHO)"))
+        location = None
+        if ref_layer is not None and parameters.get(self.LOCATION) not in (None, ""):
+            p = self.parameterAsPoint(parameters, self.LOCATION, context, ref_layer.crs())  # in the reference's CRS
+            location = (p.x(), p.y())
         crs_text = params.read_crs(self, parameters, self.CRS, context)
         residuals = self.parameterAsOutputLayer(parameters, self.RESIDUALS, context) or None
         if residuals and not residuals.lower().endswith(".gpkg"):
@@ -111,9 +134,12 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
             sensor_width_mm=self.parameterAsDouble(parameters, self.SENSOR_WIDTH_MM, context) or None,
             mode=params.read_choice(self, parameters, self.MODE, context, self.MODES), crs=crs_text,
             resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context), residuals_path=residuals,
-            progress=progress)
+            progress=progress, reference_ortho=ref_layer.source() if ref_layer is not None else None,
+            location=location, search_radius=self.parameterAsDouble(parameters, self.SEARCH_RADIUS, context) or 50.0)
         progress.push_result(result.warnings, result.log_lines)
         for r in result.residuals:
             feedback.pushInfo(self.tr("{} ({}): {:.2f} px").format(r["name"], r["role"], r["res_px"]))
+        auto = result.auto_control
         return {self.OUTPUT: result.output, self.RESIDUALS: result.residuals_path, self.RMSE_PX: result.rmse_px,
+                self.AUTO_GCPS: auto["kept"] if auto else 0,
                 self.PLANAR_OFFSET_P95: (result.planar_error or {}).get("p95_m")}

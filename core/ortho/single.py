@@ -47,6 +47,7 @@ class SingleImageResult:
     residuals_path: Optional[str] = None
     warnings: List[str] = field(default_factory=list)
     log_lines: List[str] = field(default_factory=list)
+    auto_control: Optional[Dict[str, Any]] = None  # the automatic control's figures (matches, GCPs kept)
 
 
 def _image_observations(gcps, name: str) -> List[Tuple[Any, Any]]:
@@ -92,8 +93,10 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
                        resolution: float = 0.0, residuals_path: Optional[str] = None,
                        estimate_intrinsics="auto", mask_path: Optional[str] = None,
                        camera: Optional[Intrinsics] = None,
-                       options: Optional[OrthoOptions] = None, progress: Optional[Progress] = None
-                       ) -> SingleImageResult:
+                       options: Optional[OrthoOptions] = None, progress: Optional[Progress] = None,
+                       reference_ortho: Optional[str] = None, location: Optional[Tuple[float, float]] = None,
+                       search_radius: float = 50.0, location_crs: Optional[str] = None,
+                       control_options=None) -> SingleImageResult:
     """Orthorectify one image (even one outside any block) on an existing DSM.
 
     Orientation from ``gcps`` (a GCP file path or a core.gcp.GCPSet with observations in this image: space
@@ -102,7 +105,14 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
     on the DSM (required; reprojected on the fly when in another CRS); "planar": projective rectification
     through the control points onto a plane, and, when a DSM is given, how far that is off.  ``camera``: a
     calibrated interior orientation (e.g. the block's camera), kept as it is unless ``estimate_intrinsics`` is
-    True; an orientation file without x..kappa is taken as interior orientation too.  Writes a COG at
+    True; an orientation file without x..kappa is taken as interior orientation too.
+
+    Automatic control (no GCP, no orientation): ``reference_ortho`` (an orthophoto raster) with ``dsm_path`` as
+    the reference DSM, ``location`` (rough x, y of the ground the photo shows, in ``location_crs``, default the
+    reference's CRS; None: anywhere on the reference) and ``search_radius`` (how far off it may be):
+    :func:`core.georef.autocontrol.single.control_photo` finds GCPs (``auto_001`` ...) by matching the photo
+    to the reference, and the space resection uses them (``control_options``: its
+    :class:`~core.georef.autocontrol.single.PhotoControlOptions`).  Writes a COG at
     ``output`` and optionally the GCP residuals to the GeoPackage ``residuals_path``.  ``options`` is not
     modified (RESOLUTION goes into a copy)."""
     progress = progress or NullProgress()
@@ -112,13 +122,18 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
                                 focal_px=focal_px, estimate_intrinsics=estimate_intrinsics, mask_path=mask_path,
                                 camera=camera, residuals_path=residuals_path)
     single.check()
-    _check_inputs(image_path, dsm_path, gcps, orientation, single.mode)
+    auto = reference_ortho is not None and gcps is None and orientation is None
+    _check_inputs(image_path, dsm_path, gcps, orientation, single.mode, reference_ortho)
     try:
         check_image(image_path)  # the alignment's check: a truncated or corrupt photo is refused, named
     except ImageError as e:
         raise OrthoError(str(e)) from e
     run = _Run(os.path.basename(image_path), image_meta(image_path), progress)
     orient, single.camera = _orientation_input(orientation, gcps is None, run, image_path, single.camera)
+    auto_figures = None
+    if auto:
+        gcps, auto_figures = _auto_control(image_path, reference_ortho, dsm_path, location, search_radius,
+                                           location_crs, single, run, control_options, SubProgress(progress, 0, 0.1))
     if isinstance(gcps, str):
         try:
             gcps = gcpmod.read_gcps(gcps, default_crs=single.crs)  # a CSV without a CRS line: the CRS parameter
@@ -138,7 +153,8 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
     progress.report(0.1, "oriented")
     ocam = OrthoCamera(run.name, os.path.abspath(image_path), ext.cam, ext.pose, 0, single.mask_path)
     result = SingleImageResult(output, single.mode, work_crs, 0.0, 0.0, orientation_out, ext.source, ext.rmse,
-                               ext.residuals, ext.outliers, ext.estimated, warnings=run.warnings, log_lines=run.log)
+                               ext.residuals, ext.outliers, ext.estimated, warnings=run.warnings, log_lines=run.log,
+                               auto_control=auto_figures)
     _rectify(result, ocam, run, ctl, offset, dsm_path, options, single.residuals_path)
     return result
 
@@ -184,11 +200,17 @@ class _Exterior:
     estimated: bool = False
 
 
-def _check_inputs(image_path: str, dsm_path: Optional[str], gcps, orientation, mode: str) -> None:
+def _check_inputs(image_path: str, dsm_path: Optional[str], gcps, orientation, mode: str,
+                  reference_ortho: Optional[str] = None) -> None:
     if not image_path or not os.path.isfile(image_path):
         raise OrthoError(f"image {image_path} does not exist")
-    if gcps is None and orientation is None:
-        raise OrthoError("give ground control points observed in the image (GCPS) or its orientation (ORIENTATION)")
+    if gcps is None and orientation is None and reference_ortho is None:
+        raise OrthoError("give ground control points observed in the image (GCPS), its orientation (ORIENTATION), "
+                         "or a reference orthophoto for automatic control (REFERENCE_ORTHO)")
+    if reference_ortho is not None and gcps is None and orientation is None:
+        if not dsm_path:
+            raise OrthoError(f"automatic control against {reference_ortho} needs the reference DSM too: give DSM")
+        return
     if mode == "ortho" and not dsm_path:
         raise OrthoError("a true orthophoto needs a DSM; give DSM, or choose MODE planar for flat ground")
     if mode == "planar" and gcps is None:
@@ -211,6 +233,37 @@ def _orientation_input(orientation, exterior: bool, run: _Run, image_path: str, 
                                    interior.get("k1", 0.0), interior.get("k2", 0.0), interior.get("p1", 0.0),
                                    interior.get("p2", 0.0))
     return None, camera
+
+
+def _auto_control(image_path: str, reference_ortho: str, dsm_path: str, location, search_radius: float,
+                  location_crs: Optional[str], single: SingleImageOptions, run: _Run, control_options,
+                  progress: Progress) -> Tuple[Any, Dict[str, Any]]:
+    """(GCP set of the automatic control, its figures): the photo matched to the reference orthophoto and DSM;
+    the camera it estimates becomes the interior orientation unless one was given."""
+    from ..georef.autocontrol.errors import AutoControlError
+    from ..georef.autocontrol.single import control_photo
+
+    focal = None
+    if single.camera is None:
+        focal, f_source = _focal(run.meta, image_path, single.focal_px, single.focal_mm, single.sensor_width_mm, None)
+        run.info(f"automatic control of {run.name} against {reference_ortho}: focal length "
+                 + (f"{focal:.1f} px ({f_source})" if focal else "unknown, estimated"))
+    try:
+        pc = control_photo(image_path, reference_ortho, dsm_path, location, search_radius, location_crs,
+                           camera=single.camera, focal_px=focal, estimate_intrinsics=single.estimate_intrinsics,
+                           options=control_options, progress=progress)
+    except AutoControlError as e:
+        raise OrthoError(str(e)) from e
+    for m in pc.messages:
+        run.info(m)
+    for w_ in pc.warnings:
+        run.warn(w_)
+    if single.camera is None:
+        single.camera = pc.camera
+    if single.crs is None:
+        single.crs = pc.crs
+    figures = dict(pc.figures, centre=[float(v) for v in pc.centre], crs=pc.crs)
+    return pc.gcps, figures
 
 
 def _working_crs(crs: Optional[str], dsm_path: Optional[str], gcps, orient: Optional[dict], run: _Run
