@@ -33,6 +33,7 @@ def algorithms():
     from .build_dtm import BuildDtmAlgorithm
     from .build_orthophoto import BuildOrthophotoAlgorithm
     from .contours import ContoursAlgorithm
+    from .dsm_difference import DsmDifferenceAlgorithm
     from .georeference import GeoreferenceAlgorithm
     from .orthorectify_image import OrthorectifyImageAlgorithm
     from .prepare_images import PrepareImagesAlgorithm
@@ -42,4 +43,4 @@ def algorithms():
     return [AlignImagesAlgorithm(), GeoreferenceAlgorithm(), BuildDsmAlgorithm(), PrepareImagesAlgorithm(),
             AccuracyReportAlgorithm(), BuildOrthophotoAlgorithm(), OrthorectifyImageAlgorithm(),
             RunPipelineAlgorithm(), BuildDtmAlgorithm(), ReliefVisualisationAlgorithm(), ContoursAlgorithm(),
-            AutoControlAlgorithm()]
+            AutoControlAlgorithm(), DsmDifferenceAlgorithm()]

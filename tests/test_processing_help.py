@@ -15,7 +15,8 @@ _KEEP = []
 DIALOG_ALGORITHMS = ("alignimages", "georeference", "runpipeline", "buildorthophoto")
 # every algorithm of the provider: the help of each names its parameters by the form's labels
 ALL_ALGORITHMS = ("prepareimages", "alignimages", "georeference", "builddsm", "buildorthophoto", "accuracyreport",
-                  "orthorectifyimage", "builddtm", "reliefvisualisation", "contours", "runpipeline", "autocontrol")
+                  "orthorectifyimage", "builddtm", "reliefvisualisation", "contours", "runpipeline", "autocontrol",
+                  "dsmdifference")
 
 
 def _dialog(alg_id):
