@@ -40,7 +40,7 @@ def child(images, ws, result, report):
     with open(result, "w") as f:
         json.dump({"registered": r.align.registered, "images": r.align.images_given,
                    "mre": r.align.mean_reprojection_error, "align_timings": r.align.timings,
-                   "seconds": r.seconds, "camera_rmse": r.georef.figures.get("CAMERA_RMSE_XYZ"),
+                   "seconds": r.seconds, "cpu_seconds": getattr(r, "cpu_seconds", None), "camera_rmse": r.georef.figures.get("CAMERA_RMSE_XYZ"),
                    "dsm_valid": r.dsm.valid_fraction, "pairs": r.dsm.pairs, "points": r.dsm.points,
                    "ortho_valid": r.ortho.valid_fraction, "ortho_resolution": r.ortho.resolution,
                    "dsm_resolution": r.dsm.resolution,
@@ -151,6 +151,9 @@ def main():
         print(f"\n{n} images: wall {r['wall']:.0f} s ({stages}); peak RSS (process tree) {r['peak_rss_mib']:.0f} MiB "
               f"(during {r['peak_stage']})",
               flush=True)
+        if r.get("cpu_seconds"):
+            cpu = ", ".join(f"{k} {v:.0f}" for k, v in r["cpu_seconds"].items())
+            print(f"  CPU seconds: {sum(r['cpu_seconds'].values()):.0f} ({cpu})")
         al = ", ".join(f"{k} {v:.0f}" for k, v in r["align_timings"].items())
         print(f"  align: {r['registered']}/{r['images']} registered, {r['mre']:.3f} px ({al} s)")
         cam = "n/a" if r["camera_rmse"] is None else f"{r['camera_rmse']:.2f} m"

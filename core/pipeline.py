@@ -86,6 +86,8 @@ class PipelineResult:
     dtm: object = None
     relief: object = None
     seconds: Dict[str, float] = field(default_factory=dict)
+    # CPU seconds per stage (this process and its pool workers, os.times(): load-independent, unlike ``seconds``)
+    cpu_seconds: Dict[str, float] = field(default_factory=dict)
     warnings: List[str] = field(default_factory=list)
 
 
@@ -130,16 +132,23 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
                          "run 'Align images'")
     check_inputs(images_dir, ctl)
     seconds: Dict[str, float] = {}
+    cpu_seconds: Dict[str, float] = {}
+
+    def cpu_now() -> float:
+        t = os.times()  # pool workers count once they have ended (each stage's pool ends with the stage)
+        return t.user + t.system + t.children_user + t.children_system
 
     def run(name, fn, *args, span=None, **kwargs):
         lo, hi = span or SPANS[name]
         progress.info(f"--- stage {name} ---")
-        t0 = time.time()
+        t0, c0 = time.time(), cpu_now()
         out = fn(*args, progress=SubProgress(progress, lo, hi), **kwargs)
         seconds[name] = round(time.time() - t0, 2)
+        cpu_seconds[name] = round(cpu_now() - c0, 2)
         return out
 
-    res = PipelineResult(workspace=os.path.abspath(workspace_dir), align=None, georef=None, seconds=seconds)
+    res = PipelineResult(workspace=os.path.abspath(workspace_dir), align=None, georef=None, seconds=seconds,
+                         cpu_seconds=cpu_seconds)
     aligned_from = images_dir
     if opt.sky_masks:  # the photos with their sky masks, so that no tie or dense point comes from the sky
         res.prepare = run(PREPARE, prepare_images_workspace, images_dir, workspace_dir,
