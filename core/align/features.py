@@ -12,6 +12,7 @@ afresh.
 from __future__ import annotations
 
 import hashlib
+import math
 import os
 import shutil
 from typing import Dict, List, Optional, Sequence, Tuple
@@ -21,7 +22,17 @@ from ..common.files import atomic_output, atomic_write_text, fingerprint
 from ..common.progress import Progress, check_cancel
 from ..io.images import CameraGroup, ImageInfo
 from ..prepare.masks import MaskError, find_mask, mask_file_name, png_size
-from .options import CAMERA_MODELS, EXTRACT_BLOCK, MATCH_BLOCK, UPSAMPLE_BELOW, AlignError, AlignOptions
+from .options import (
+    AUTO_FEATURE_MEGAPIXELS,
+    AUTO_FEATURES_PER_MP,
+    AUTO_FEATURES_RANGE,
+    CAMERA_MODELS,
+    EXTRACT_BLOCK,
+    MATCH_BLOCK,
+    UPSAMPLE_BELOW,
+    AlignError,
+    AlignOptions,
+)
 
 
 def choose_camera_model(requested: str, n_images: int, min_images_opencv: int = 10) -> str:
@@ -53,6 +64,12 @@ def database_key(groups: List[CameraGroup], options: AlignOptions, images_dir: s
     octave = sift_first_octave(options, g0.width, g0.height)
     if octave != -1:  # COLMAP's default (-1) keeps the key of earlier workspaces
         what["first_octave"] = octave
+    size = feature_image_size(g0.width, g0.height, options.max_image_size)
+    if size < max(g0.width, g0.height) and not options.max_image_size:  # the auto size: only where it scales
+        what["feature_image_size"] = size
+    n_auto = auto_max_features(g0.width, g0.height, options.max_image_size)
+    if not options.max_features and n_auto == AUTO_FEATURES_RANGE[1]:  # the cap (8192 before it was 4096)
+        what["auto_features"] = n_auto
     if photos_key:  # the photos' content: another photo under the same name is extracted afresh
         what["photos"] = photos_key
     return fingerprint(what)
@@ -81,11 +98,25 @@ def setup_database(pycolmap, db_path: str, groups: List[CameraGroup], options: A
         db.close()
 
 
+def feature_image_size(width: int, height: int, max_image_size: int = 0) -> int:
+    """The long side (px) of the image SIFT runs on: ``max_image_size`` when given (> 0), else the photo's own up to
+    AUTO_FEATURE_MEGAPIXELS, scaled down to that beyond."""
+    side = max(width, height)
+    if max_image_size and max_image_size > 0:
+        return min(side, int(max_image_size))
+    mp = width * height / 1e6
+    if mp <= AUTO_FEATURE_MEGAPIXELS:
+        return side
+    return int(side * math.sqrt(AUTO_FEATURE_MEGAPIXELS / mp))
+
+
 def auto_max_features(width: int, height: int, max_image_size: int = 0) -> int:
-    """Features per image when the user leaves it at 0: ~4000 per megapixel matched, 2048..8192."""
-    scale = min(1.0, max_image_size / max(width, height)) if max_image_size else 1.0
+    """Features per image when the user leaves it at 0: AUTO_FEATURES_PER_MP per megapixel of the image the
+    features come from (``feature_image_size``), within AUTO_FEATURES_RANGE."""
+    scale = feature_image_size(width, height, max_image_size) / max(width, height)
     mp = width * height * scale * scale / 1e6
-    return int(min(8192, max(2048, round(4000 * mp, -2))))
+    lo, hi = AUTO_FEATURES_RANGE
+    return int(min(hi, max(lo, round(AUTO_FEATURES_PER_MP * mp, -2))))
 
 
 def file_hash(path: str) -> str:
@@ -138,9 +169,7 @@ def sift_first_octave(options: AlignOptions, width: int, height: int) -> int:
     features enough; ``options.first_octave`` overrides."""
     if options.first_octave is not None:
         return int(options.first_octave)
-    side = max(width, height)
-    if options.max_image_size and options.max_image_size > 0:
-        side = min(side, options.max_image_size)
+    side = feature_image_size(width, height, options.max_image_size)
     return -1 if side < UPSAMPLE_BELOW else 0
 
 
@@ -153,8 +182,7 @@ def extract_features(pycolmap, db_path, images_dir, groups, camera_ids, options,
     g0 = max(groups, key=lambda g: g.width * g.height)
     eo.sift.max_num_features = int(options.max_features or auto_max_features(g0.width, g0.height,
                                                                               options.max_image_size))
-    if options.max_image_size and options.max_image_size > 0:
-        eo.max_image_size = int(options.max_image_size)
+    eo.max_image_size = feature_image_size(g0.width, g0.height, options.max_image_size)
     eo.sift.first_octave = sift_first_octave(options, g0.width, g0.height)
     eo.num_threads = options.num_threads
     if options.affine_features:

@@ -16,6 +16,12 @@ LOOP_STRIDE = 10
 MAX_LOOP_ANCHORS = 30
 AUTO_EXHAUSTIVE_MAX = 100
 UPSAMPLE_BELOW = 1000  # long side (px, at the matching scale) below which SIFT starts on a 2x upsampled image
+# MAX_IMAGE_SIZE 0 (auto): larger photos are scaled to this many megapixels for the features only (the DSM and the
+# orthophotos use every pixel): SIFT's finest octave on a 4-16 MP photo costs 4-16 x for features the budget
+# below drops anyway (COLMAP keeps the largest-scale ones)
+AUTO_FEATURE_MEGAPIXELS = 2.0
+AUTO_FEATURES_PER_MP = 4000  # MAX_FEATURES 0 (auto): this many per megapixel of the image the features come from,
+AUTO_FEATURES_RANGE = (2048, 4096)  # within these bounds (matching and mapping grow with the count, the model not)
 MATCH_BLOCK = 24  # pairs per matching call: the unit of progress and cancel
 EXTRACT_BLOCK = 2  # images per extraction call: the unit of progress and cancel
 MAPPERS = ("incremental", "global")
@@ -30,8 +36,8 @@ class AlignError(ArchaeoOrthoError, RuntimeError):
 class AlignOptions:
     pairing: str = "auto"
     camera_model: str = "AUTO"
-    max_image_size: int = 0  # 0 = full size; downscale for feature extraction only
-    max_features: int = 0  # 0 = auto: about 4000 per megapixel, between 2048 and 8192
+    max_image_size: int = 0  # long side for the features only; 0 = auto (at most AUTO_FEATURE_MEGAPIXELS)
+    max_features: int = 0  # 0 = auto: AUTO_FEATURES_PER_MP per megapixel within AUTO_FEATURES_RANGE
     affine_features: bool = False  # affine-shape SIFT + domain-size pooling (oblique sets)
     grouping: str = GROUP_AUTO  # auto / single / per_image
     focal_mm: Optional[float] = None
