@@ -51,9 +51,9 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         "upright by their EXIF orientation, as web browsers and photo viewers show them; they are turned into the "
         "stored pixel grid of each photo (photos stored without a turn are unchanged).\n"
         "Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.\n\n"
-        "Automatic control: give a reference orthophoto and a reference DSM (any raster layer: a file, or a WMS, "
+        "Given a reference orthophoto and a reference DSM (any raster layer: a file, or a WMS, "
         "XYZ or WCS layer, which is saved for the block's extent to georef/reference-ortho.tif and "
-        "georef/reference-dsm.tif) and the block is georeferenced with no hand-picked GCP, as 'Automatic control "
+        "georef/reference-dsm.tif), the block is georeferenced with no hand-picked GCP, as 'Automatic control "
         "from a reference orthophoto' does; the result is in the reference orthophoto's CRS (a Web Mercator or "
         "geographic layer is saved in the DSM's CRS, else in the UTM zone). Ground control given as well is not "
         "used to fix the block: all its points become check points, an independent measure of the automatic "
@@ -63,7 +63,8 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         "Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at "
         "least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos' EXIF GPS positions "
         "plus a margin, else the other reference's extent.\n"
-        "Automatic GCPs kept: how many automatic GCPs the adjustment kept (none without automatic control)."
+        "Outputs: besides the usual ones, the number of automatic GCPs the adjustment kept (none without "
+        "automatic control)."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
@@ -78,10 +79,8 @@ class GeoreferenceAlgorithm(AlgorithmBase):
             params.target_crs(self.CRS, self.tr("Target CRS")),
             params.flag(self.REFINE_INTRINSICS, self.tr("Refine camera calibration")),
             params.flag(self.GCPS_UPRIGHT, self.tr("GCP pixels measured on upright photos")),
-            QgsProcessingParameterRasterLayer(self.REFERENCE_ORTHO, self.tr("Reference orthophoto (automatic "
-                                                                            "control)"), optional=True),
-            QgsProcessingParameterRasterLayer(self.REFERENCE_DSM, self.tr("Reference DSM (automatic control)"),
-                                              optional=True),
+            QgsProcessingParameterRasterLayer(self.REFERENCE_ORTHO, self.tr("Reference orthophoto"), optional=True),
+            QgsProcessingParameterRasterLayer(self.REFERENCE_DSM, self.tr("Reference DSM"), optional=True),
             *params.advanced(
                 params.number(self.REFERENCE_GSD, self.tr("Reference resolution for web layers (m, 0: auto)")),
                 QgsProcessingParameterExtent(self.REFERENCE_EXTENT, self.tr("Area to fetch from web layers"),

@@ -265,7 +265,7 @@ def test_dock_automatic_control(dock, epochs, xyz_uri, tmp_path):  # noqa: F811 
     dock.auto_dsm_combo.setLayer(dsm_layer)
     dock.btn_georef.click()
     assert dock.task is not None and not dock.btn_georef.isEnabled()
-    wait_task(dock, 400)
+    wait_task(dock, 1200)  # about a minute on 2 idle cores; much longer under a benchmark's load
     assert dock.last_task_error is None, dock.last_task_error
     result = dock.auto_result
     assert result is not None and result.n_kept >= 10
@@ -276,6 +276,7 @@ def test_dock_automatic_control(dock, epochs, xyz_uri, tmp_path):  # noqa: F811 
     assert "Automatic GCPs (residuals)" in names_on_map
     assert dock.store.figures.get("GCP_N", 0) >= 10
     os.makedirs(os.path.dirname(SCREENSHOT), exist_ok=True)
+    dock.resize(760, 800)  # a few more rows of the table
     process(100)
     dock.grab().save(SCREENSHOT)
     assert os.path.getsize(SCREENSHOT) > 10_000

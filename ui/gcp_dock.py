@@ -65,7 +65,8 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpAutoControl, QgsDockWi
     """Ground control of one workspace.  ``iface`` may be None (tests); ``canvas`` then is given.
 
     The shell: widgets, wiring, the workspace, the selection.  Placement (map and photos), import / export
-    and the background tasks are its mixins (ui/gcp_placement.py, ui/gcp_io.py, ui/gcp_tasks.py)."""
+    and the background tasks are its mixins (ui/gcp_placement.py, ui/gcp_io.py, ui/gcp_tasks.py; the automatic
+    control, the Georeference button's other mode: ui/gcp_autocontrol.py)."""
 
     def __init__(self, iface=None, canvas=None, parent=None):
         super().__init__(parent)
