@@ -4,7 +4,9 @@ no GCP and no prior, its orthophoto on the earlier block's DSM, and the differen
 The earlier block is epoch 1 of the synthetic scene as a georeferenced workspace whose products are the scene's
 truth (a true orthophoto at 0.1 m and a DSM at 0.25 m, EPSG:32633: the reference rasters tests/test_autocontrol.py
 caches); the later block is epoch 2 (new crop marks, the car parked elsewhere, a new building, the sun from the
-other side), its photos rendered once (the same cache) and aligned in an arbitrary model frame.
+other side), its photos rendered once (the same cache) and aligned in an arbitrary model frame.  The difference
+is taken against epoch 2's truth DSM on another grid (the figures exactly) and against its own DSM built from the
+registered photos (the chain).
 """
 import json
 import os
@@ -183,6 +185,33 @@ def test_dsm_difference_shows_the_new_building_and_the_moved_car(registered, tmp
     assert r.median == pytest.approx(np.median(v), abs=1e-4) and r.std == pytest.approx(v.std(), rel=1e-4)
     assert r.p5 <= r.median <= r.p95 and r.changed == int((np.abs(v) > 1.0).sum())
     assert sum(m.sum() for m in inside.values()) <= r.changed and not (np.abs(d[rest]) > 1.0).any()
+
+
+def test_dsm_difference_against_the_second_epochs_own_dsm(registered, tmp_path):
+    """The chain: epoch 2's DSM built from its photos as registered (Build DSM), minus epoch 1's: the new building
+    and the moved car stand out, and where nothing changed the two surfaces agree (the registration's Z)."""
+    from core.dense.stage import build_dsm_workspace
+
+    b1, b2, ws1, ws2, _ = registered
+    dsm2 = build_dsm_workspace(ws2).dsm_path
+    r = dsm_difference(Layout(Workspace.open(ws1)).dsm(), dsm2, str(tmp_path / "difference.tif"))
+    d, gt, _ = read_dsm(r.path)
+    x, y = np.meshgrid(gt[0] + (np.arange(d.shape[1]) + 0.5) * gt[1] - syn.ORIGIN[0],
+                       gt[3] + (np.arange(d.shape[0]) + 0.5) * gt[5] - syn.ORIGIN[1])
+    new, car1, car2 = b2.scene.buildings[6], b1.scene.buildings[5], b2.scene.buildings[5]
+    inside = [b.contains(x, y, margin=-0.5) & np.isfinite(d) for b in (new, car2, car1)]
+    near = np.zeros(d.shape, bool)
+    for b in b1.scene.buildings + b2.scene.buildings:
+        near |= b.contains(x, y, margin=1.0)
+    rest = np.isfinite(d) & ~near
+    height = new.roof - float(b2.scene.ground_at(new.cx, new.cy))
+    print(f"\nepoch 2's own DSM - epoch 1's: {r.cells} cells, building min {d[inside[0]].min():.2f} m, car new place "
+          f"min {d[inside[1]].min():.2f} m, old place max {d[inside[2]].max():.2f} m; elsewhere median "
+          f"{np.median(d[rest]):.4f} m, 95 % |d| {np.percentile(np.abs(d[rest]), 95):.3f} m")
+    assert all(m.sum() >= 10 for m in inside) and rest.sum() > 10000
+    assert (d[inside[0]] > height / 2).all()
+    assert (d[inside[1]] > 0.75).all() and (d[inside[2]] < -0.75).all()
+    assert abs(np.median(d[rest])) < 0.1 and np.percentile(np.abs(d[rest]), 95) < 0.2
 
 
 # ---------------------------------------------------------------------------------------------------------------
