@@ -139,7 +139,7 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
         progress.push_result(result.warnings, result.log_lines)
         for r in result.residuals:
             feedback.pushInfo(self.tr("{} ({}): {:.2f} px").format(r["name"], r["role"], r["res_px"]))
-        auto = result.auto_control
+        auto = getattr(result, "auto_control", None)
         return {self.OUTPUT: result.output, self.RESIDUALS: result.residuals_path, self.RMSE_PX: result.rmse_px,
                 self.AUTO_GCPS: auto["kept"] if auto else 0,
                 self.PLANAR_OFFSET_P95: (result.planar_error or {}).get("p95_m")}

@@ -170,7 +170,7 @@ def test_qgis_process_orthorectifies_with_automatic_control(setup, tmp_path):
     run = subprocess.run([exe, "--json", "run", "archaeoortho:orthorectifyimage", "--", f"IMAGE={photos['vertical.jpg']}",
                           f"DSM={dsm}", f"REFERENCE_ORTHO={ortho}", f"LOCATION={lon:.8f},{lat:.8f} [EPSG:4326]",
                           "SEARCH_RADIUS=30", "FOCAL_MM=6.5", "SENSOR_WIDTH_MM=8", "RESOLUTION=0.2", f"OUTPUT={out}", f"RESIDUALS={res}"],
-                         env=env, capture_output=True, text=True, timeout=600)
+                         env=env, capture_output=True, text=True, timeout=1200)
     assert run.returncode == 0, run.stderr[-3000:] + run.stdout[-3000:]
     results = json.loads(run.stdout)["results"]
     assert os.path.isfile(results["OUTPUT"]) and results["AUTO_GCPS"] >= 30 and results["RMSE_PX"] < 1.0

@@ -62,7 +62,7 @@ class PhotoControlOptions:
     homography_px: float = 8.0
     min_matches: int = 15
     good_matches: int = 60
-    passes: int = 2
+    passes: int = 1
     max_points: int = 200
     max_relief: float = 0.6
     sigma_px: float = 1.0
@@ -402,7 +402,8 @@ def _control(image_path, ref: Reference, location, search_radius, location_crs, 
     fine_box = (max(box[0], g[:, 0].min() - 0.3 * span[0]), max(box[1], g[:, 1].min() - 0.3 * span[1]),
                 min(box[2], g[:, 0].max() + 0.3 * span[0]), min(box[3], g[:, 1].max() + 0.3 * span[1]))
     fine_res = max(ref.gsd, max(fine_box[2] - fine_box[0], fine_box[3] - fine_box[1]) / opt.max_pixels)
-    if fine_res == res:  # the same grid: a crop of the first window and its features
+    area = (fine_box[2] - fine_box[0]) * (fine_box[3] - fine_box[1])
+    if fine_res == res and area >= 0.8 * (box[2] - box[0]) * (box[3] - box[1]):  # nearly all of the first window
         fine, f_ref = _crop(win, f_win, fine_box)
     else:
         fine = _window(ref, fine_box, fine_res)
