@@ -18,8 +18,8 @@ options) on the same images, the second reference; ratios are printed against ea
 pipeline on every shared set and the synthetic small frames, and prints one table: registered images, mean
 reprojection error, wall seconds, what was escalated.  Each run's result is kept under
 ``<workdir>/table/<set>/`` and reused by the next ``--table`` (delete it to measure again); ``--only`` runs one
-side.  ``ochota_kap`` (16 MP) is measured on half-size copies (2304 x 1728, EXIF kept): on 2 cores its full
-frames take too long for one run of the table.
+side.  ``ochota_kap`` is measured on half-size copies (2304 x 1728, EXIF kept) and, as ``ochota_kap_full``, on
+its 16 MP frames.
 """
 import argparse
 import json
@@ -148,7 +148,7 @@ def _has_gps(images):
 
 
 SHARED = os.path.join(os.path.dirname(ROOT), "shared", "data")
-TABLE_SETS = ("small", "toledo", "copr", "caliterra", "ochota_kap", "toledo_2400", "synthetic_mixed")
+TABLE_SETS = ("small", "toledo", "copr", "caliterra", "ochota_kap", "ochota_kap_full", "toledo_2400", "synthetic_mixed")
 
 
 def _write_jpeg_with_exif(path, pixels, cam, make, model):
@@ -223,6 +223,8 @@ def table_set(name, work):
     if name == "ochota_kap":
         return _half_size_copies(os.path.join(SHARED, name, "images"), os.path.join(work, "ochota-half")), {}, \
             "half size (2304 x 1728), EXIF kept"
+    if name == "ochota_kap_full":
+        return os.path.join(SHARED, "ochota_kap", "images"), {}, "full size (4608 x 3456, 16 MP)"
     return os.path.join(SHARED, name, "images"), {}, ""
 
 

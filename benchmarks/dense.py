@@ -160,7 +160,7 @@ def figures_png(dsm_path, png):
     return raised
 
 
-def synthetic(widths, contrast, quality):
+def synthetic(widths, contrast, quality, strips=2, per_strip=6, workers=1):
     """The same synthetic block (tests/test_dense_fill.py's: 2 strips of 6, a low-texture patch in the west) with
     its camera at each of ``widths`` pixels across: seconds and CPU seconds per megapixel matched, peak RSS, the
     DSM's measured / interpolated share of the cameras' hull and its accuracy (measured cells) against the truth."""
@@ -183,21 +183,23 @@ def synthetic(widths, contrast, quality):
         f = width / 400.0
         cam = syn.CameraModel(width, int(round(300 * f)), 325.0 * f, 325.0 * f, 201.9 * f, 148.1 * f, k1=-0.08,
                               k2=0.02, p1=0.0006, p2=-0.0004) if width != 400 else base
-        block = syn.vertical_block(seed=8, camera=cam, altitude=40.0, n_strips=2, per_strip=6, forward_overlap=0.8,
+        block = syn.vertical_block(seed=8, camera=cam, altitude=40.0, n_strips=strips, per_strip=per_strip, forward_overlap=0.8,
                                    side_overlap=0.5, gcp_grid=(2, 2), roofs=0, low_texture=(0.0, 0.0, 0.41, 1.0),
                                    low_texture_contrast=contrast)
-        root = os.path.join(ROOT, "build", "bench-dense", f"synthetic-{width}-{contrast:g}")
+        size = "" if (strips, per_strip) == (2, 6) else f"-{strips}x{per_strip}"
+        root = os.path.join(ROOT, "build", "bench-dense", f"synthetic-{width}-{contrast:g}{size}")
         images = os.path.join(root, "images")
         if not os.path.exists(os.path.join(root, "rendered")):
             t0 = time.time()
-            block.render(images)
+            block.render(images, supersample=1 if cam.width > 3000 else 2)  # 16 MP x 4 rays: > 10 GiB to cast
             open(os.path.join(root, "rendered"), "w").close()
             print(f"  (rendered {len(block.shots)} images of {cam.width} x {cam.height} px in {time.time() - t0:.0f} s)")
         ws = os.path.join(root, "ws")
         shutil.rmtree(ws, ignore_errors=True)
         rec = block.truth_reconstruction(model_from_local=None, noise_px=0.2, n_points=1500)
         synthetic_workspace(ws, block, rec, images_dir=images, georeferenced=True, crs=syn.CRS, offset=syn.ORIGIN)
-        r = dense.build_dsm_workspace(ws, quality=quality, options=DenseOptions(workers=1), progress=NullProgress())
+        r = dense.build_dsm_workspace(ws, quality=quality, options=DenseOptions(workers=workers),
+                                      progress=NullProgress())
         from glob import glob
 
         pairs = [read_pair_summary(p) for p in glob(os.path.join(ws, "dense", "pairs-*", "*.npz"))]
@@ -227,7 +229,9 @@ def main():
     ap.add_argument("--workspace", default=os.path.join(ROOT, "build", "bench-dense", "toledo-ws"))
     ap.add_argument("--images", default=os.path.join(DATA, "toledo", "images"))
     ap.add_argument("--crs", default="EPSG:32617")
-    ap.add_argument("--quality", default="half")
+    ap.add_argument("--quality", default=None, help="matching quality (default: half for Toledo, full synthetic)")
+    ap.add_argument("--strips", type=int, default=2, help="synthetic: strips of the block")
+    ap.add_argument("--per-strip", type=int, default=6, help="synthetic: images per strip")
     ap.add_argument("--workers", type=int, default=0)
     ap.add_argument("--resume", action="store_true", help="keep the pair cache (measures a resumed run)")
     ap.add_argument("--point-cloud", action="store_true", help="also write dense/points.las")
@@ -239,9 +243,10 @@ def main():
         child(args)
         return
     if args.synthetic:
-        synthetic([int(v) for v in args.synthetic.split(",")], args.contrast,
-                  args.quality if args.quality != "half" else "full")
+        synthetic([int(v) for v in args.synthetic.split(",")], args.contrast, args.quality or "full", args.strips,
+                  args.per_strip, args.workers or 1)
         return
+    args.quality = args.quality or "half"
     if not os.path.isdir(args.images):
         raise SystemExit(f"no images at {args.images}")
     ensure_georeferenced(args.images, args.workspace, args.crs)

@@ -465,7 +465,9 @@ def _sample(raster: np.ndarray, mx: np.ndarray, my: np.ndarray, interpolation=cv
     pad = rows * 1024 - n
     fx = np.pad(mx.reshape(-1).astype(np.float32), (0, pad)).reshape(rows, 1024)
     fy = np.pad(my.reshape(-1).astype(np.float32), (0, pad)).reshape(rows, 1024)
-    out = cv2.remap(raster, fx, fy, interpolation, borderMode=cv2.BORDER_REPLICATE)
+    step = 32000  # cv2.remap takes maps of fewer than 32767 rows (16 MP photos rendered supersampled have more)
+    out = np.concatenate([cv2.remap(raster, fx[r:r + step], fy[r:r + step], interpolation,
+                                    borderMode=cv2.BORDER_REPLICATE) for r in range(0, rows, step)])
     return out.reshape(-1)[:n].reshape(shape)
 
 
