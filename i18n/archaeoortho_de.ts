@@ -92,57 +92,57 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
 <context>
     <name>AlignImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>One camera for all images</source>
         <translation>Eine Kamera für alle Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="65"/>
         <source>Camera centres</source>
         <translation>Projektionszentren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="65"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Registered images</source>
         <translation>Orientierte Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="67"/>
         <source>Mean reprojection error (px)</source>
         <translation>Mittlerer Rückprojektionsfehler (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="91"/>
+        <location filename="../processing_provider/align_images.py" line="92"/>
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
         <translation>{} von {} Bildern orientiert, mittlerer Rückprojektionsfehler {:.3f} px, {} Punkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="98"/>
+        <location filename="../processing_provider/align_images.py" line="99"/>
         <source>Images not registered:</source>
         <translation>Nicht orientierte Bilder:</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="101"/>
+        <location filename="../processing_provider/align_images.py" line="102"/>
         <source>Seconds per step: {}</source>
         <translation>Sekunden je Schritt: {}</translation>
     </message>
@@ -152,47 +152,47 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
         <translation>Bilder ausrichten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Mapper</source>
         <translation>Rekonstruktionsverfahren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Matching image size (px)</source>
         <translation>Bildgröße für die Zuordnung (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Features per image</source>
         <translation>Merkmale je Bild</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Affine-invariant features</source>
         <translation>Affin-invariante Merkmale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Focal length (mm)</source>
         <translation>Brennweite (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Sensor width (mm)</source>
         <translation>Sensorbreite (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Retry images left out</source>
         <translation>Ausgelassene Bilder erneut versuchen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="94"/>
+        <location filename="../processing_provider/align_images.py" line="95"/>
         <source>Retry {} ({} features): {} image(s) left out; main block {} -&gt; {} images{}</source>
         <translation>Neuer Versuch {} ({}-Merkmale): {} Bild(er) ausgelassen; Hauptblock {} -&gt; {} Bilder{}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="94"/>
+        <location filename="../processing_provider/align_images.py" line="95"/>
         <source> (not better: the previous result kept)</source>
         <translation> (nicht besser: das vorige Ergebnis bleibt)</translation>
     </message>
@@ -202,18 +202,11 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
 
 Pair selection: &apos;auto&apos; uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
 Camera model: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
-Matching image size: the longest side the images are scaled to for matching (0 = full size). Features per image: 0 = automatic (about 4000 per megapixel). Affine-invariant features help with oblique views and are slower.
+Matching image size: the longest side the images are scaled to for the features (0 = automatic: photos of up to 2 megapixels as they are, larger ones scaled to 2 megapixels; the DSM and the orthophotos use every pixel). Features per image: 0 = automatic (about 4000 per megapixel, 2048 to 4096). Affine-invariant features help with oblique views and are slower.
 Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).
 Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).
 Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
-        <translation>Structure from Motion: SIFT-Merkmale, Paarauswahl, robuste Zuordnung (RANSAC), inkrementelle Rekonstruktion mit Selbstkalibrierung (Brennweite, Bildhauptpunkt, Objektivverzeichnung) und eine abschließende Bündelblockausgleichung. Das Ergebnis wird im Arbeitsbereich-Ordner gespeichert, den die folgenden Schritte (Georeferenzieren, DOM erzeugen, Orthophoto erzeugen) als Eingabe nehmen. Ein erneuter Lauf setzt fort: bereits berechnete Merkmale und Zuordnungen werden wiederverwendet.
-
-Paarauswahl: 'auto' nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
-Kameramodell: 'AUTO' schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
-Bildgröße für die Zuordnung: die längste Seite, auf die die Bilder für die Zuordnung verkleinert werden (0 = volle Größe). Merkmale je Bild: 0 = automatisch (etwa 4000 je Megapixel). Affin-invariante Merkmale helfen bei Schrägaufnahmen und sind langsamer.
-Brennweite und Sensorbreite: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern (0 = aus EXIF / unbekannt).
-Rekonstruktionsverfahren (erweitert): 'incremental' (COLMAP, Standard) oder 'global' (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).
-Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen Einstellungen auslassen, oder ein in Teile zerfallener Block werden mit reicheren Merkmalen (schwächeren für kontrastarme Bilder, affinen für steile Schrägaufnahmen) und mehr Paaren erneut versucht; das Protokoll und sfm/alignment.json sagen, was erneut versucht wurde und warum.</translation>
+        <translation type="unfinished"></translation>
     </message>
 </context>
 <context>
@@ -245,62 +238,62 @@ Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen 
 <context>
     <name>AutoControlAlgorithm</name>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>Aligned workspace</source>
         <translation>Ausgerichteter Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>Reference orthophoto</source>
         <translation>Referenz-Orthophoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>Reference DSM</source>
         <translation>Referenz-DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>Rough position</source>
         <translation>Ungefähre Lage</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>auto</source>
         <translation>automatisch</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>EXIF GPS</source>
         <translation>EXIF-GPS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>none</source>
         <translation>keine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="53"/>
+        <location filename="../processing_provider/auto_control.py" line="66"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="67"/>
         <source>Camera centres (world)</source>
         <translation>Projektionszentren (Welt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="55"/>
+        <location filename="../processing_provider/auto_control.py" line="68"/>
         <source>Automatic GCPs kept</source>
         <translation>Behaltene automatische Passpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="56"/>
+        <location filename="../processing_provider/auto_control.py" line="69"/>
         <source>Matches found</source>
         <translation>Gefundene Zuordnungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="72"/>
+        <location filename="../processing_provider/auto_control.py" line="93"/>
         <source>outlier left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
@@ -310,21 +303,26 @@ Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen 
         <translation>Automatische Passpunkte aus einem Referenz-Orthophoto</translation>
     </message>
     <message>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <source>Reference resolution for web layers (m, 0: auto)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <source>Area to fetch from web layers</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../ui/catalog.py" line="7"/>
         <source>Georeferences an aligned block with no hand-picked ground control: a provisional orthophoto of the block is matched to a reference orthophoto (a national orthophoto, an earlier block&apos;s orthomosaic) at a common resolution, each match is found again in the photos and takes its height from the reference DSM, and these automatic GCPs enter the usual GCP-constrained adjustment, which leaves out the outliers. Changes between the two dates (crops, cars, new buildings, another sun) are tolerated: what stays is used, and the log says how many matches survived each step.
 
 Aligned workspace: the block to georeference (its photos must still be where the alignment found them).
-Reference orthophoto: any north-up raster in a projected CRS, grey or colour; the result is in its CRS.
-Reference DSM: a DSM or DTM covering the block, heights in metres.
+Reference orthophoto: any north-up raster in a projected CRS, grey or colour; the result is in its CRS. A layer that is no local file (WMS, XYZ, WCS, a virtual raster) is saved for the block&apos;s extent to georef/reference-ortho.tif (a Web Mercator or geographic one in the DSM&apos;s CRS, else the UTM zone&apos;s).
+Reference DSM: a DSM or DTM covering the block, heights in metres (a WCS layer is saved to georef/reference-dsm.tif).
 Rough position: the photos&apos; EXIF GPS when at least three carry it (auto), always (EXIF GPS), or never (none: rotation and scale are searched over the whole reference, which then should not be much larger than the block).
+Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos&apos; EXIF GPS positions plus a margin, else the other reference&apos;s extent.
 Outputs: the camera centres in the reference CRS, the number of automatic GCPs the adjustment kept, the matches found; georef/autocontrol.json lists every candidate with why it was kept or dropped.</source>
-        <translation>Georeferenziert einen ausgerichteten Block ohne von Hand gesetzte Passpunkte: ein vorläufiges Orthophoto des Blocks wird bei gemeinsamer Auflösung mit einem Referenz-Orthophoto (einem amtlichen Orthophoto, dem Orthomosaik eines früheren Blocks) zugeordnet, jede Zuordnung wird in den Fotos wiedergefunden und erhält ihre Höhe aus dem Referenz-DOM, und diese automatischen Passpunkte gehen in die übliche passpunktgestützte Ausgleichung ein, die die Ausreißer auslässt. Änderungen zwischen den beiden Zeitpunkten (Feldfrüchte, Autos, neue Gebäude, ein anderer Sonnenstand) werden hingenommen: was bleibt, wird genutzt, und das Protokoll nennt, wie viele Zuordnungen jeden Schritt überstanden haben.
-
-Ausgerichteter Arbeitsbereich: der zu georeferenzierende Block (seine Fotos müssen noch dort liegen, wo die Ausrichtung sie gefunden hat).
-Referenz-Orthophoto: ein beliebiges genordetes Raster in einem projizierten KBS, grau oder farbig; das Ergebnis ist in seinem KBS.
-Referenz-DOM: ein DOM oder DGM, das den Block abdeckt, Höhen in Metern.
-Ungefähre Lage: das EXIF-GPS der Fotos, wenn mindestens drei es tragen (automatisch), immer (EXIF-GPS) oder nie (keine: Drehung und Maßstab werden über die ganze Referenz gesucht, die dann nicht viel größer als der Block sein sollte).
-Ausgaben: die Projektionszentren im KBS der Referenz, die Zahl der automatischen Passpunkte, die die Ausgleichung behalten hat, die gefundenen Zuordnungen; georef/autocontrol.json führt jeden Kandidaten auf, mit dem Grund, warum er behalten oder verworfen wurde.</translation>
+        <translation type="unfinished"></translation>
     </message>
 </context>
 <context>
@@ -705,44 +703,101 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
     </message>
 </context>
 <context>
+    <name>DsmDifferenceAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="36"/>
+        <source>Earlier DSM</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="36"/>
+        <source>Later DSM</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="41"/>
+        <source>Difference</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="42"/>
+        <source>Median difference (m)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="43"/>
+        <source>Standard deviation of the difference (m)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="44"/>
+        <source>Cells compared</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="45"/>
+        <source>Cells changed by more than 1 m</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="55"/>
+        <source>{} cells compared: median {:.3f} m, mean {:.3f} m, std {:.3f} m, 5-95 % {:.3f} .. {:.3f} m; {} cells changed by more than {:g} m</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>DSM difference</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>The later DSM minus the earlier one, on the earlier one&apos;s grid, shows what changed between two epochs of a site (the later DSM is warped there with GDAL, bilinear, from any CRS). A cell is nodata where either DSM has none. The log gives the cells compared, the median, mean and standard deviation of the difference, its 5th and 95th percentiles and the cells that changed by more than 1 m; a median near 0 says the two epochs are registered on each other.
+
+Earlier DSM: the DSM the difference is measured from (its grid is the output&apos;s).
+Later DSM: the DSM of the other epoch (e.g. a block registered to the earlier one with Automatic control).
+Difference: where to write the float32 Cloud-Optimized GeoTIFF of later minus earlier (metres).</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
     <name>GcpDock</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="74"/>
+        <location filename="../ui/gcp_dock.py" line="76"/>
         <source>ArchaeoOrtho ground control</source>
         <translation>ArchaeoOrtho Passpunkte</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="91"/>
+        <location filename="../ui/gcp_dock.py" line="93"/>
         <source>ArchaeoOrtho photos</source>
         <translation>ArchaeoOrtho Fotos</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="140"/>
+        <location filename="../ui/gcp_dock.py" line="143"/>
         <source>Workspace:</source>
         <translation>Arbeitsbereich:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="347"/>
+        <location filename="../ui/gcp_dock.py" line="350"/>
         <source>none open</source>
         <translation>keiner geöffnet</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="147"/>
+        <location filename="../ui/gcp_dock.py" line="150"/>
         <source>Open a workspace folder (made by Align images)</source>
         <translation>Einen Arbeitsbereich-Ordner öffnen (von 'Bilder ausrichten' angelegt)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="149"/>
+        <location filename="../ui/gcp_dock.py" line="152"/>
         <source>Choose a folder of photos and a workspace folder, and align the photos</source>
         <translation>Einen Fotoordner und einen Arbeitsbereich-Ordner wählen und die Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="156"/>
+        <location filename="../ui/gcp_dock.py" line="159"/>
         <source>Heights (Z) from:</source>
         <translation>Höhen (Z) aus:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="161"/>
+        <location filename="../ui/gcp_dock.py" line="164"/>
         <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
         <translation>Ein DOM- oder DGM-Rasterlayer (z. B. ein ALS-DOM): ein auf der Karte gemessener Punkt erhält seine Höhe daraus (bilinear). Leer: Z von Hand eingeben.</translation>
     </message>
@@ -752,17 +807,17 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="176"/>
+        <location filename="../ui/gcp_dock.py" line="179"/>
         <source>Add a ground point</source>
         <translation>Einen Passpunkt hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="177"/>
+        <location filename="../ui/gcp_dock.py" line="180"/>
         <source>Remove</source>
         <translation>Entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="178"/>
+        <location filename="../ui/gcp_dock.py" line="181"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Den gewählten Passpunkt mit seinen Messungen entfernen</translation>
     </message>
@@ -772,7 +827,7 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Auf der Karte messen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="181"/>
+        <location filename="../ui/gcp_dock.py" line="184"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>In die Kartenansicht klicken, um X und Y des gewählten Punkts zu setzen (Z aus dem Höhenlayer)</translation>
     </message>
@@ -782,92 +837,92 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="189"/>
+        <location filename="../ui/gcp_dock.py" line="192"/>
         <source>Export</source>
         <translation>Exportieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="204"/>
+        <location filename="../ui/gcp_dock.py" line="207"/>
         <source>Undo</source>
         <translation>Rückgängig</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="205"/>
+        <location filename="../ui/gcp_dock.py" line="208"/>
         <source>Redo</source>
         <translation>Wiederholen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="215"/>
+        <location filename="../ui/gcp_dock.py" line="218"/>
         <source>Undo: {}</source>
         <translation>Rückgängig: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="217"/>
+        <location filename="../ui/gcp_dock.py" line="220"/>
         <source>Redo: {}</source>
         <translation>Wiederholen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="196"/>
+        <location filename="../ui/gcp_dock.py" line="199"/>
         <source>Load results</source>
         <translation>Ergebnisse laden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="197"/>
+        <location filename="../ui/gcp_dock.py" line="200"/>
         <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Die Produkte des Arbeitsbereichs als gestaltete Layer zur Karte hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="249"/>
+        <location filename="../ui/gcp_dock.py" line="252"/>
         <source>Residual tolerance:</source>
         <translation>Residuen-Toleranz:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="255"/>
+        <location filename="../ui/gcp_dock.py" line="258"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="264"/>
+        <location filename="../ui/gcp_dock.py" line="267"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="265"/>
+        <location filename="../ui/gcp_dock.py" line="268"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Die Ausgleichung Brennweite, Bildhauptpunkt und Verzeichnung verfeinern lassen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="272"/>
+        <location filename="../ui/gcp_dock.py" line="275"/>
         <source>Georeference</source>
         <translation>Georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="273"/>
+        <location filename="../ui/gcp_dock.py" line="276"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Die Ausgleichung mit diesen Punkten ausführen (im Hintergrund)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="274"/>
+        <location filename="../ui/gcp_dock.py" line="277"/>
         <source>Cancel</source>
         <translation>Abbrechen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="324"/>
+        <location filename="../ui/gcp_dock.py" line="327"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="331"/>
+        <location filename="../ui/gcp_dock.py" line="334"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Einen ArchaeoOrtho-Arbeitsbereich öffnen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="377"/>
+        <location filename="../ui/gcp_dock.py" line="380"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} Fotos; der Block ist noch nicht ausgerichtet: 'Bilder ausrichten' (oder 'Neu aus Fotos') ausführen, um vorhergesagte Positionen zu erhalten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="380"/>
+        <location filename="../ui/gcp_dock.py" line="383"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} Fotos, {} Passpunkte. {}</translation>
     </message>
@@ -907,7 +962,7 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>ArchaeoOrtho: Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="518"/>
+        <location filename="../ui/gcp_dock.py" line="521"/>
         <source>CRS: {}</source>
         <translation>KBS: {}</translation>
     </message>
@@ -1177,32 +1232,32 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>(Korrelation {:.2f}, {:.0f} px von der geometrischen Vorhersage)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="146"/>
+        <location filename="../ui/gcp_dock.py" line="149"/>
         <source>Open…</source>
         <translation>Öffnen…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="148"/>
+        <location filename="../ui/gcp_dock.py" line="151"/>
         <source>New from photos…</source>
         <translation>Neu aus Fotos…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="184"/>
+        <location filename="../ui/gcp_dock.py" line="187"/>
         <source>From file (gcp_list.txt, CSV)…</source>
         <translation>Aus Datei (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="185"/>
+        <location filename="../ui/gcp_dock.py" line="188"/>
         <source>From a point layer…</source>
         <translation>Aus einem Punktlayer…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="187"/>
+        <location filename="../ui/gcp_dock.py" line="190"/>
         <source>To file (gcp_list.txt, CSV)…</source>
         <translation>In Datei (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="188"/>
+        <location filename="../ui/gcp_dock.py" line="191"/>
         <source>To a GeoPackage layer…</source>
         <translation>In einen GeoPackage-Layer…</translation>
     </message>
@@ -1287,37 +1342,37 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>{} ist ausgewählt: wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="212"/>
+        <location filename="../ui/gcp_dock.py" line="215"/>
         <source>Undo (Ctrl+Z)</source>
         <translation>Rückgängig (Strg+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="212"/>
+        <location filename="../ui/gcp_dock.py" line="215"/>
         <source>Redo (Ctrl+Shift+Z)</source>
         <translation>Wiederholen (Strg+Umschalt+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="398"/>
+        <location filename="../ui/gcp_dock.py" line="401"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px.</source>
         <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="403"/>
+        <location filename="../ui/gcp_dock.py" line="406"/>
         <source>Not aligned ({}): {}</source>
         <translation>Nicht ausgerichtet ({}): {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="404"/>
+        <location filename="../ui/gcp_dock.py" line="407"/>
         <source>(marked in the photo strip; hover for the reason)</source>
         <translation>(in der Fotoleiste markiert; der Grund steht im Tooltip)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="423"/>
+        <location filename="../ui/gcp_dock.py" line="426"/>
         <source>✗ not aligned</source>
         <translation>✗ nicht ausgerichtet</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="424"/>
+        <location filename="../ui/gcp_dock.py" line="427"/>
         <source>{}: not aligned: {}</source>
         <translation>{}: nicht ausgerichtet: {}</translation>
     </message>
@@ -1385,6 +1440,71 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <location filename="../ui/gcp_tasks.py" line="111"/>
         <source>Opening {}…</source>
         <translation>{} wird geöffnet…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="43"/>
+        <source>Automatic control from a reference orthophoto</source>
+        <translation type="unfinished">Automatische Passpunkte aus einem Referenz-Orthophoto</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="46"/>
+        <source>Georeference with no hand-picked GCP: the block is matched to a reference orthophoto and takes its heights from a reference DSM. The points of the table become check points.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="52"/>
+        <source>A reference orthophoto: a raster file, or a WMS / XYZ layer (saved for the block&apos;s extent, from the photos&apos; GPS or the map extent)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="52"/>
+        <source>A reference DSM or DTM (heights in metres): a raster file or a WCS layer</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="61"/>
+        <source>Reference orthophoto:</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="62"/>
+        <source>Reference DSM:</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="73"/>
+        <source>Georeference from the reference orthophoto and DSM (in the background)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="94"/>
+        <source>Automatic control: choose a reference orthophoto and a reference DSM layer</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="115"/>
+        <source>Automatic control: {} automatic GCPs kept of {} matches; georeferenced in {}.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="118"/>
+        <source>Check points: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="124"/>
+        <source>ArchaeoOrtho: automatic control</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="128"/>
+        <source>Automatic control against {} and {}…</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="140"/>
+        <source>Automatic GCPs (residuals)</source>
+        <translation type="unfinished"></translation>
     </message>
 </context>
 <context>
@@ -1611,32 +1731,32 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
 <context>
     <name>GeoreferenceAlgorithm</name>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="62"/>
+        <location filename="../processing_provider/georeference.py" line="89"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="63"/>
+        <location filename="../processing_provider/georeference.py" line="90"/>
         <source>GCP residuals</source>
         <translation>Passpunkt-Residuen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="64"/>
+        <location filename="../processing_provider/georeference.py" line="91"/>
         <source>Camera centres (world)</source>
         <translation>Projektionszentren (Welt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="92"/>
+        <location filename="../processing_provider/georeference.py" line="176"/>
         <source>outlier left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="96"/>
+        <location filename="../processing_provider/georeference.py" line="129"/>
         <source>CRS {}; control RMSE XY {} m, Z {} m; check RMSE XY {} m, Z {} m</source>
         <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
     </message>
@@ -1651,44 +1771,89 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>Georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Aligned workspace</source>
         <translation>Ausgerichteter Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Ground control layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Check points</source>
         <translation>Kontrollpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Use EXIF GPS positions</source>
         <translation>EXIF-GPS-Positionen verwenden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Target CRS</source>
         <translation>Ziel-KBS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>GCP-Pixel auf aufrechten Fotos gemessen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="113"/>
+        <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS)</source>
+        <translation>Passpunkte (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) angeben</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="71"/>
+        <source>Reference orthophoto</source>
+        <translation type="unfinished">Referenz-Orthophoto</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="71"/>
+        <source>Reference DSM</source>
+        <translation type="unfinished">Referenz-DOM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="71"/>
+        <source>Reference resolution for web layers (m, 0: auto)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="71"/>
+        <source>Area to fetch from web layers</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="92"/>
+        <source>Automatic GCPs kept</source>
+        <translation type="unfinished">Behaltene automatische Passpunkte</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="146"/>
+        <source>Automatic control needs both a reference orthophoto and a reference DSM (REFERENCE_ORTHO, REFERENCE_DSM); {} is missing</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="159"/>
+        <source>Target CRS {} is not used: automatic control georeferences in the reference orthophoto&apos;s CRS {}</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="180"/>
+        <source>Automatic control: {} automatic GCPs kept; CRS {}; check RMSE XY {} m, Z {} m</source>
+        <translation type="unfinished"></translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1699,71 +1864,63 @@ Check points: comma-separated names that become check points.
 Camera positions: CSV &apos;image,x,y,z[,sigma]&apos; (optional CRS line). Use EXIF GPS positions: use the photos&apos; GPS.
 Target CRS: default the ground control file&apos;s. Refine camera calibration: let the adjustment refine focal length, principal point and distortion.
 GCP pixels measured on upright photos: tick when the pixel coordinates were measured on the photos shown upright by their EXIF orientation, as web browsers and photo viewers show them; they are turned into the stored pixel grid of each photo (photos stored without a turn are unchanged).
-Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.</source>
-        <translation>Legt den ausgerichteten Block mit Passpunkten (GCPs) und/oder Kamerapositionen in einem echten Koordinatenbezugssystem fest. Sie wirken in der Bündelblockausgleichung, so dass sie auch Drift und Verbiegung des Blocks beseitigen, was eine 7-Parameter-Transformation (Helmert) nicht kann. Kontrollpunkte nehmen an der Ausgleichung nicht teil: sie werden danach trianguliert und mit ihren vermessenen Koordinaten verglichen.
+Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.
 
-Passpunktdatei: eine OpenDroneMap gcp_list.txt (KBS-Zeile, dann 'x y z px py image [name]') oder eine CSV-Punktdatei mit passender '&lt;name&gt;_observations.csv'. Passpunktlayer: alternativ ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, sx, sy, sz, role).
-Kontrollpunkte: durch Kommas getrennte Namen, die zu Kontrollpunkten werden.
-Kamerapositionen: CSV 'image,x,y,z[,sigma]' (optionale KBS-Zeile). EXIF-GPS-Positionen verwenden: das GPS der Fotos verwenden.
-Ziel-KBS: Vorgabe ist das KBS der Passpunktdatei. Kamerakalibrierung verfeinern: die Ausgleichung verfeinert Brennweite, Bildhauptpunkt und Verzeichnung.
-GCP-Pixel auf aufrechten Fotos gemessen: ankreuzen, wenn die Pixelkoordinaten auf den Fotos gemessen wurden, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden (wie in Webbrowsern und Bildbetrachtern); sie werden in das gespeicherte Pixelraster jedes Fotos umgerechnet (ungedreht gespeicherte Fotos bleiben unverändert).
-Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erkannt, im Protokoll genannt und ausgelassen.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="80"/>
-        <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS)</source>
-        <translation>Passpunkte (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) angeben</translation>
+Given a reference orthophoto and a reference DSM (any raster layer: a file, or a WMS, XYZ or WCS layer, which is saved for the block&apos;s extent to georef/reference-ortho.tif and georef/reference-dsm.tif), the block is georeferenced with no hand-picked GCP, as &apos;Automatic control from a reference orthophoto&apos; does; the result is in the reference orthophoto&apos;s CRS (a Web Mercator or geographic layer is saved in the DSM&apos;s CRS, else in the UTM zone). Ground control given as well is not used to fix the block: all its points become check points, an independent measure of the automatic control. Camera positions or Use EXIF GPS positions give the rough position (else EXIF GPS when three photos carry it, else rotation and scale are searched). The calibration is refined in any case (focal length and distortion: the automatic GCPs determine them).
+Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos&apos; EXIF GPS positions plus a margin, else the other reference&apos;s extent.
+Outputs: besides the usual ones, the number of automatic GCPs the adjustment kept (none without automatic control).</source>
+        <translation type="unfinished"></translation>
     </message>
 </context>
 <context>
     <name>OrthorectifyImageAlgorithm</name>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="61"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="73"/>
         <source>Image</source>
         <translation>Bild</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Mode</source>
         <translation>Modus</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="78"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="94"/>
         <source>Orthophoto</source>
         <translation>Orthophoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="79"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="95"/>
         <source>GCP residuals</source>
         <translation>Passpunkt-Residuen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="81"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="97"/>
         <source>GCP residual RMSE (pixels)</source>
         <translation>RMSE der Passpunktresiduen (Pixel)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="82"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="99"/>
         <source>Planar rectification: 95th percentile of its offset from the true position (CRS units)</source>
         <translation>Ebene Entzerrung: 95. Perzentil ihres Versatzes gegen die wahre Lage (KBS-Einheiten)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="104"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="127"/>
         <source>RESIDUALS must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>RESIDUALS muss eine GeoPackage-Datei (.gpkg) sein, erhalten: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="117"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="141"/>
         <source>{} ({}): {:.2f} px</source>
         <translation>{} ({}): {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="92"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="109"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
@@ -1773,39 +1930,74 @@ Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erk
         <translation>Bild orthorektifizieren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Ground control point layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Known orientation</source>
         <translation>Bekannte Orientierung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Focal length (mm)</source>
         <translation>Brennweite (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Sensor width (mm)</source>
         <translation>Sensorbreite (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Resolution (0 = automatic)</source>
         <translation>Auflösung (0 = automatisch)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Output CRS</source>
         <translation>Ausgabe-KBS</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
+        <source>True orthophoto on the DSM</source>
+        <translation>Echtes Orthofoto auf dem DOM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
+        <source>Planar rectification (flat ground)</source>
+        <translation>Ebene Entzerrung (flaches Gelände)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
+        <source>Reference orthophoto (automatic control)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
+        <source>Rough location (automatic control)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
+        <source>Search radius (m)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="98"/>
+        <source>Automatic GCPs used</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="116"/>
+        <source>Give ground control points observed in the image (Ground control file or Ground control point layer: GCPS, GCP_LAYER), its Known orientation (ORIENTATION) or a Reference orthophoto for automatic control (REFERENCE_ORTHO)</source>
+        <translation type="unfinished"></translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1816,38 +2008,13 @@ The camera's position and attitude come from ground control points observed in t
 Image: the photo. DSM: height raster (needed for a true orthophoto).
 Ground control file: an OpenDroneMap gcp_list.txt or CSV points file with observations in this image; or Ground control point layer: a point layer with one feature per observation and fields name, image, px, py (optional z, role; pixel origin at the upper-left corner, y down).
 Known orientation: instead of GCPs, a file with x y z omega phi kappa (degrees, photogrammetric convention; a header row as Pix4D writes it, or JSON), optionally focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 and a CRS line.
+Reference orthophoto (automatic control): with no GCPs and no known orientation, the photo is matched to this orthophoto (any CRS, any resolution; the DSM is then the reference DSM) and the matches become automatic GCPs (auto_001, ...) for the space resection: no hand-picked point, the heading need not be known, obliques work too, and the focal length is estimated when the photo has none. Rough location: a point on the ground the photo shows (any CRS; empty = anywhere on the reference); Search radius: how far off it may be (metres). The log says how many matches survived each step; the GCP residuals list the automatic GCPs.
 Focal length and Sensor width: interior orientation in mm (the sensor's long side); 0 or empty = the EXIF focal length.
 Mode: a true orthophoto on the DSM, or a planar (projective) rectification through the GCPs for comparison on flat ground; with a DSM the log and the output 'Planar rectification: 95th percentile of its offset' say how far the planar result is off because of relief.
 Resolution: cell size in CRS units (0 = the ground sample distance).
 Output CRS: default the CRS of the GCPs or of the known orientation.
 GCP residuals: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
-        <translation>Orthorektifiziert ein Foto — auch eines, das zu keinem Block gehört, etwa eine einzelne Schrägaufnahme oder ein alter Abzug — auf einem vorhandenen DOM, zum Beispiel einem DOM aus Airborne Laserscanning (ALS) in beliebigem KBS (es wird im Lauf umprojiziert).
-
-Position und Lage der Kamera ergeben sich aus im Foto gemessenen Passpunkten (räumlicher Rückwärtsschnitt: mindestens 4 Punkte; ein falscher Punkt unter 5 oder mehr wird gefunden und ausgelassen; ab 6 Punkten werden auch Brennweite und radiale Verzeichnung k1 geschätzt, wo die Punkte sie bestimmen) oder aus einer bekannten Orientierung.
-
-Bild: das Foto. DSM: Höhenraster (für ein wahres Orthophoto nötig).
-Passpunktdatei: eine OpenDroneMap gcp_list.txt oder CSV-Punktdatei mit Messungen in diesem Bild; oder Passpunktlayer: ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, role; Pixelursprung in der linken oberen Ecke, y nach unten).
-Bekannte Orientierung: statt Passpunkten eine Datei mit x y z omega phi kappa (Grad, photogrammetrische Konvention; eine Kopfzeile wie von Pix4D geschrieben, oder JSON), optional focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 und eine KBS-Zeile.
-Brennweite und Sensorbreite: innere Orientierung in mm (die lange Seite des Sensors); 0 oder leer = die EXIF-Brennweite.
-Modus: ein wahres Orthophoto auf dem DOM oder eine ebene (projektive) Entzerrung über die Passpunkte zum Vergleich auf flachem Gelände; mit DOM sagen das Protokoll und die Ausgabe 'Ebene Entzerrung: 95. Perzentil ihres Versatzes', wie weit das ebene Ergebnis wegen des Reliefs abweicht.
-Auflösung: Zellgröße in KBS-Einheiten (0 = die Bodenauflösung).
-Ausgabe-KBS: Vorgabe ist das KBS der Passpunkte oder der bekannten Orientierung.
-Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in der Ebene).</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
-        <source>True orthophoto on the DSM</source>
-        <translation>Echtes Orthofoto auf dem DOM</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
-        <source>Planar rectification (flat ground)</source>
-        <translation>Ebene Entzerrung (flaches Gelände)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="98"/>
-        <source>Give ground control points observed in the image (Ground control file or Ground control point layer: GCPS, GCP_LAYER) or its Known orientation (ORIENTATION)</source>
-        <translation>Im Bild gemessene Passpunkte (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER) oder seine Bekannte Orientierung (ORIENTATION) angeben</translation>
+        <translation type="unfinished"></translation>
     </message>
 </context>
 <context>
@@ -2409,9 +2576,9 @@ Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key f
         <translation>Die gesamte Verarbeitung in einem Aufruf, für die Stapelverarbeitung: Bilder ausrichten, Georeferenzieren, DOM erzeugen, Orthophoto erzeugen und Genauigkeitsbericht in einem Arbeitsbereich. Es werden dieselben Funktionen wie in den einzelnen Algorithmen aufgerufen; ein erneuter Lauf setzt fort (bereits berechnete Merkmale, Zuordnungen und Stereopaare werden wiederverwendet).
 
 Bilderordner: die Fotos. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben werden.
-Die Georeferenzierung braucht Passpunkte (eine Passpunktdatei oder ein Passpunktlayer, Kontrollpunkte werden zurückgehalten) und/oder Kamerapositionen (eine CSV-Datei der Kamerapositionen oder EXIF-GPS-Positionen verwenden): ohne sie wird die Verarbeitung abgelehnt, da ein DOM einen metrischen Maßstab und eine Lotrichtung braucht. GCP-Pixel auf aufrechten Fotos gemessen: wie bei &apos;Georeferenzieren&apos; (die Pixelkoordinaten auf den Fotos gemessen, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden).
-Himmelsmasken (Schrägaufnahmen): zuerst findet eine Stufe &apos;Bilder vorbereiten&apos; den Himmel und den Dunst am Horizont in jedem Foto und maskiert sie, damit kein Verknüpfungs- oder DOM-Punkt aus dem Himmel stammt; die vorbereiteten Fotos werden ausgerichtet (standardmäßig aus: senkrecht aufgenommene Fotos brauchen keine).
-Das DGM erzeugen: nach dem DOM ein DGM der nackten Erde (wie &apos;DGM erzeugen&apos;). Höhenlinienabstand (erweitert): Höhenlinien des DGM in diesem Abstand (wie &apos;Höhenlinien&apos;; 0 = keine). Reliefvisualisierungen (erweitert): die gewählten werden aus dem DGM berechnet (wie &apos;Reliefvisualisierung&apos;). Beide brauchen das DGM.
+Die Georeferenzierung braucht Passpunkte (eine Passpunktdatei oder ein Passpunktlayer, Kontrollpunkte werden zurückgehalten) und/oder Kamerapositionen (eine CSV-Datei der Kamerapositionen oder EXIF-GPS-Positionen verwenden): ohne sie wird die Verarbeitung abgelehnt, da ein DOM einen metrischen Maßstab und eine Lotrichtung braucht. GCP-Pixel auf aufrechten Fotos gemessen: wie bei 'Georeferenzieren' (die Pixelkoordinaten auf den Fotos gemessen, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden).
+Himmelsmasken (Schrägaufnahmen): zuerst findet eine Stufe 'Bilder vorbereiten' den Himmel und den Dunst am Horizont in jedem Foto und maskiert sie, damit kein Verknüpfungs- oder DOM-Punkt aus dem Himmel stammt; die vorbereiteten Fotos werden ausgerichtet (standardmäßig aus: senkrecht aufgenommene Fotos brauchen keine).
+Das DGM erzeugen: nach dem DOM ein DGM der nackten Erde (wie 'DGM erzeugen'). Höhenlinienabstand (erweitert): Höhenlinien des DGM in diesem Abstand (wie 'Höhenlinien'; 0 = keine). Reliefvisualisierungen (erweitert): die gewählten werden aus dem DGM berechnet (wie 'Reliefvisualisierung'). Beide brauchen das DGM.
 Die übrigen Parameter sind die der einzelnen Stufen (siehe deren Hilfe); 0 bedeutet automatisch.
 Ausgaben: das DOM, das Orthomosaik und der Genauigkeitsbericht (HTML) sowie die wichtigsten Kennzahlen.</translation>
     </message>

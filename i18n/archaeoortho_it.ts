@@ -92,57 +92,57 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
 <context>
     <name>AlignImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>One camera for all images</source>
         <translation>Una sola camera per tutte le immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="65"/>
         <source>Camera centres</source>
         <translation>Centri di presa</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="65"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Registered images</source>
         <translation>Immagini orientate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="67"/>
         <source>Mean reprojection error (px)</source>
         <translation>Errore medio di riproiezione (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="91"/>
+        <location filename="../processing_provider/align_images.py" line="92"/>
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
         <translation>Orientate {} di {} immagini, errore medio di riproiezione {:.3f} px, {} punti</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="98"/>
+        <location filename="../processing_provider/align_images.py" line="99"/>
         <source>Images not registered:</source>
         <translation>Immagini non orientate:</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="101"/>
+        <location filename="../processing_provider/align_images.py" line="102"/>
         <source>Seconds per step: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -152,47 +152,47 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
         <translation>Allinea immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Mapper</source>
         <translation>Metodo di ricostruzione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Matching image size (px)</source>
         <translation>Dimensione per la corrispondenza (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Features per image</source>
         <translation>Feature per immagine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Affine-invariant features</source>
         <translation>Feature invarianti affini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Focal length (mm)</source>
         <translation>Focale (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Sensor width (mm)</source>
         <translation>Larghezza del sensore (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="49"/>
+        <location filename="../processing_provider/align_images.py" line="50"/>
         <source>Retry images left out</source>
         <translation>Riprova le immagini escluse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="94"/>
+        <location filename="../processing_provider/align_images.py" line="95"/>
         <source>Retry {} ({} features): {} image(s) left out; main block {} -&gt; {} images{}</source>
         <translation>Nuovo tentativo {} (caratteristiche {}): {} immagine/i escluse; blocco principale {} -&gt; {} immagini{}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="94"/>
+        <location filename="../processing_provider/align_images.py" line="95"/>
         <source> (not better: the previous result kept)</source>
         <translation> (non migliore: resta il risultato precedente)</translation>
     </message>
@@ -202,18 +202,11 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
 
 Pair selection: &apos;auto&apos; uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
 Camera model: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
-Matching image size: the longest side the images are scaled to for matching (0 = full size). Features per image: 0 = automatic (about 4000 per megapixel). Affine-invariant features help with oblique views and are slower.
+Matching image size: the longest side the images are scaled to for the features (0 = automatic: photos of up to 2 megapixels as they are, larger ones scaled to 2 megapixels; the DSM and the orthophotos use every pixel). Features per image: 0 = automatic (about 4000 per megapixel, 2048 to 4096). Affine-invariant features help with oblique views and are slower.
 Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).
 Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).
 Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
-        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell'obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella dell'area di lavoro, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
-
-Selezione delle coppie: 'auto' usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
-Modello di camera: 'AUTO' stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
-Dimensione per la corrispondenza: il lato maggiore a cui le immagini sono ridotte per la corrispondenza (0 = dimensione piena). Feature per immagine: 0 = automatico (circa 4000 per megapixel). Le feature invarianti affini aiutano con le prese oblique e sono più lente.
-Focale e Larghezza del sensore: orientamento interno quando manca l'EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri (0 = dall'EXIF / sconosciuta).
-Metodo di ricostruzione (avanzato): 'incremental' (COLMAP, predefinito) o 'global' (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).
-Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni rapide escludono, o un blocco diviso in parti, vengono riprovate con caratteristiche più ricche (più deboli per fotogrammi a basso contrasto, affini per oblique ripide) e più coppie; il registro e sfm/alignment.json dicono cosa è stato riprovato e perché.</translation>
+        <translation type="unfinished"></translation>
     </message>
 </context>
 <context>
@@ -245,62 +238,62 @@ Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni 
 <context>
     <name>AutoControlAlgorithm</name>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>Aligned workspace</source>
         <translation>Area di lavoro allineata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>Reference orthophoto</source>
         <translation>Ortofoto di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>Reference DSM</source>
         <translation>DSM di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>Rough position</source>
         <translation>Posizione approssimativa</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>auto</source>
         <translation>automatica</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>EXIF GPS</source>
         <translation>GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="45"/>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>none</source>
         <translation>nessuna</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="53"/>
+        <location filename="../processing_provider/auto_control.py" line="66"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="67"/>
         <source>Camera centres (world)</source>
         <translation>Centri di presa (mondo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="55"/>
+        <location filename="../processing_provider/auto_control.py" line="68"/>
         <source>Automatic GCPs kept</source>
         <translation>GCP automatici mantenuti</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="56"/>
+        <location filename="../processing_provider/auto_control.py" line="69"/>
         <source>Matches found</source>
         <translation>Corrispondenze trovate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="72"/>
+        <location filename="../processing_provider/auto_control.py" line="93"/>
         <source>outlier left out: {}</source>
         <translation>valore anomalo escluso: {}</translation>
     </message>
@@ -310,21 +303,26 @@ Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni 
         <translation>Punti di controllo automatici da un'ortofoto di riferimento</translation>
     </message>
     <message>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <source>Reference resolution for web layers (m, 0: auto)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <source>Area to fetch from web layers</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
         <location filename="../ui/catalog.py" line="7"/>
         <source>Georeferences an aligned block with no hand-picked ground control: a provisional orthophoto of the block is matched to a reference orthophoto (a national orthophoto, an earlier block&apos;s orthomosaic) at a common resolution, each match is found again in the photos and takes its height from the reference DSM, and these automatic GCPs enter the usual GCP-constrained adjustment, which leaves out the outliers. Changes between the two dates (crops, cars, new buildings, another sun) are tolerated: what stays is used, and the log says how many matches survived each step.
 
 Aligned workspace: the block to georeference (its photos must still be where the alignment found them).
-Reference orthophoto: any north-up raster in a projected CRS, grey or colour; the result is in its CRS.
-Reference DSM: a DSM or DTM covering the block, heights in metres.
+Reference orthophoto: any north-up raster in a projected CRS, grey or colour; the result is in its CRS. A layer that is no local file (WMS, XYZ, WCS, a virtual raster) is saved for the block&apos;s extent to georef/reference-ortho.tif (a Web Mercator or geographic one in the DSM&apos;s CRS, else the UTM zone&apos;s).
+Reference DSM: a DSM or DTM covering the block, heights in metres (a WCS layer is saved to georef/reference-dsm.tif).
 Rough position: the photos&apos; EXIF GPS when at least three carry it (auto), always (EXIF GPS), or never (none: rotation and scale are searched over the whole reference, which then should not be much larger than the block).
+Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos&apos; EXIF GPS positions plus a margin, else the other reference&apos;s extent.
 Outputs: the camera centres in the reference CRS, the number of automatic GCPs the adjustment kept, the matches found; georef/autocontrol.json lists every candidate with why it was kept or dropped.</source>
-        <translation>Georeferenzia un blocco allineato senza punti di controllo scelti a mano: un'ortofoto provvisoria del blocco viene abbinata a un'ortofoto di riferimento (un'ortofoto nazionale, l'ortomosaico di un blocco precedente) a una risoluzione comune, ogni corrispondenza viene ritrovata nelle foto e prende la quota dal DSM di riferimento, e questi GCP automatici entrano nella consueta compensazione vincolata ai GCP, che esclude i valori anomali. I cambiamenti tra le due date (colture, auto, nuovi edifici, un altro sole) sono tollerati: si usa ciò che resta, e il registro dice quante corrispondenze hanno superato ogni passo.
-
-Area di lavoro allineata: il blocco da georeferenziare (le sue foto devono trovarsi ancora dove l'allineamento le ha trovate).
-Ortofoto di riferimento: un raster qualsiasi orientato a nord in un SR proiettato, in scala di grigi o a colori; il risultato è nel suo SR.
-DSM di riferimento: un DSM o DTM che copre il blocco, quote in metri.
-Posizione approssimativa: il GPS EXIF delle foto quando almeno tre lo hanno (automatica), sempre (GPS EXIF) o mai (nessuna: rotazione e scala vengono cercate su tutto il riferimento, che allora non dovrebbe essere molto più grande del blocco).
-Output: i centri di presa nel SR del riferimento, il numero di GCP automatici mantenuti dalla compensazione, le corrispondenze trovate; georef/autocontrol.json elenca ogni candidato con il motivo per cui è stato mantenuto o scartato.</translation>
+        <translation type="unfinished"></translation>
     </message>
 </context>
 <context>
@@ -705,44 +703,101 @@ Curve di livello: il GeoPackage da scrivere.</translation>
     </message>
 </context>
 <context>
+    <name>DsmDifferenceAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="36"/>
+        <source>Earlier DSM</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="36"/>
+        <source>Later DSM</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="41"/>
+        <source>Difference</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="42"/>
+        <source>Median difference (m)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="43"/>
+        <source>Standard deviation of the difference (m)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="44"/>
+        <source>Cells compared</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="45"/>
+        <source>Cells changed by more than 1 m</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/dsm_difference.py" line="55"/>
+        <source>{} cells compared: median {:.3f} m, mean {:.3f} m, std {:.3f} m, 5-95 % {:.3f} .. {:.3f} m; {} cells changed by more than {:g} m</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>DSM difference</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="7"/>
+        <source>The later DSM minus the earlier one, on the earlier one&apos;s grid, shows what changed between two epochs of a site (the later DSM is warped there with GDAL, bilinear, from any CRS). A cell is nodata where either DSM has none. The log gives the cells compared, the median, mean and standard deviation of the difference, its 5th and 95th percentiles and the cells that changed by more than 1 m; a median near 0 says the two epochs are registered on each other.
+
+Earlier DSM: the DSM the difference is measured from (its grid is the output&apos;s).
+Later DSM: the DSM of the other epoch (e.g. a block registered to the earlier one with Automatic control).
+Difference: where to write the float32 Cloud-Optimized GeoTIFF of later minus earlier (metres).</source>
+        <translation type="unfinished"></translation>
+    </message>
+</context>
+<context>
     <name>GcpDock</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="74"/>
+        <location filename="../ui/gcp_dock.py" line="76"/>
         <source>ArchaeoOrtho ground control</source>
         <translation>ArchaeoOrtho punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="91"/>
+        <location filename="../ui/gcp_dock.py" line="93"/>
         <source>ArchaeoOrtho photos</source>
         <translation>ArchaeoOrtho foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="140"/>
+        <location filename="../ui/gcp_dock.py" line="143"/>
         <source>Workspace:</source>
         <translation>Area di lavoro:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="347"/>
+        <location filename="../ui/gcp_dock.py" line="350"/>
         <source>none open</source>
         <translation>nessuna aperta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="147"/>
+        <location filename="../ui/gcp_dock.py" line="150"/>
         <source>Open a workspace folder (made by Align images)</source>
         <translation>Apri una cartella dell'area di lavoro (creata da 'Allinea immagini')</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="149"/>
+        <location filename="../ui/gcp_dock.py" line="152"/>
         <source>Choose a folder of photos and a workspace folder, and align the photos</source>
         <translation>Scegli una cartella di foto e una cartella dell'area di lavoro e allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="156"/>
+        <location filename="../ui/gcp_dock.py" line="159"/>
         <source>Heights (Z) from:</source>
         <translation>Quote (Z) da:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="161"/>
+        <location filename="../ui/gcp_dock.py" line="164"/>
         <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
         <translation>Un layer raster DSM o DTM (ad es. un DSM ALS): un punto misurato sulla mappa ne prende la quota (bilineare). Vuoto: inserire Z a mano.</translation>
     </message>
@@ -752,17 +807,17 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Aggiungi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="176"/>
+        <location filename="../ui/gcp_dock.py" line="179"/>
         <source>Add a ground point</source>
         <translation>Aggiungi un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="177"/>
+        <location filename="../ui/gcp_dock.py" line="180"/>
         <source>Remove</source>
         <translation>Rimuovi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="178"/>
+        <location filename="../ui/gcp_dock.py" line="181"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Rimuovi il punto d'appoggio selezionato e le sue misure</translation>
     </message>
@@ -772,7 +827,7 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Misura sulla mappa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="181"/>
+        <location filename="../ui/gcp_dock.py" line="184"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>Fai clic sulla mappa per impostare X e Y del punto selezionato (Z dal layer delle quote)</translation>
     </message>
@@ -782,92 +837,92 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Importa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="189"/>
+        <location filename="../ui/gcp_dock.py" line="192"/>
         <source>Export</source>
         <translation>Esporta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="204"/>
+        <location filename="../ui/gcp_dock.py" line="207"/>
         <source>Undo</source>
         <translation>Annulla</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="205"/>
+        <location filename="../ui/gcp_dock.py" line="208"/>
         <source>Redo</source>
         <translation>Ripeti</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="215"/>
+        <location filename="../ui/gcp_dock.py" line="218"/>
         <source>Undo: {}</source>
         <translation>Annulla: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="217"/>
+        <location filename="../ui/gcp_dock.py" line="220"/>
         <source>Redo: {}</source>
         <translation>Ripeti: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="196"/>
+        <location filename="../ui/gcp_dock.py" line="199"/>
         <source>Load results</source>
         <translation>Carica risultati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="197"/>
+        <location filename="../ui/gcp_dock.py" line="200"/>
         <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Aggiungi i prodotti dell'area di lavoro alla mappa come layer con stile</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="249"/>
+        <location filename="../ui/gcp_dock.py" line="252"/>
         <source>Residual tolerance:</source>
         <translation>Tolleranza dei residui:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="255"/>
+        <location filename="../ui/gcp_dock.py" line="258"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="264"/>
+        <location filename="../ui/gcp_dock.py" line="267"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="265"/>
+        <location filename="../ui/gcp_dock.py" line="268"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Lascia che la compensazione affini focale, punto principale e distorsione</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="272"/>
+        <location filename="../ui/gcp_dock.py" line="275"/>
         <source>Georeference</source>
         <translation>Georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="273"/>
+        <location filename="../ui/gcp_dock.py" line="276"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Esegui la compensazione con questi punti (in background)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="274"/>
+        <location filename="../ui/gcp_dock.py" line="277"/>
         <source>Cancel</source>
         <translation>Interrompi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="324"/>
+        <location filename="../ui/gcp_dock.py" line="327"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="331"/>
+        <location filename="../ui/gcp_dock.py" line="334"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Apri un'area di lavoro ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="377"/>
+        <location filename="../ui/gcp_dock.py" line="380"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} foto; il blocco non è ancora allineato: esegui 'Allinea immagini' (o 'Nuova dalle foto') per avere le posizioni previste</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="380"/>
+        <location filename="../ui/gcp_dock.py" line="383"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} foto, {} punti d'appoggio. {}</translation>
     </message>
@@ -907,7 +962,7 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>ArchaeoOrtho: allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="518"/>
+        <location filename="../ui/gcp_dock.py" line="521"/>
         <source>CRS: {}</source>
         <translation>SR: {}</translation>
     </message>
@@ -1177,32 +1232,32 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>(correlazione {:.2f}, {:.0f} px dalla previsione geometrica)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="146"/>
+        <location filename="../ui/gcp_dock.py" line="149"/>
         <source>Open…</source>
         <translation>Apri…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="148"/>
+        <location filename="../ui/gcp_dock.py" line="151"/>
         <source>New from photos…</source>
         <translation>Nuova dalle foto…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="184"/>
+        <location filename="../ui/gcp_dock.py" line="187"/>
         <source>From file (gcp_list.txt, CSV)…</source>
         <translation>Da file (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="185"/>
+        <location filename="../ui/gcp_dock.py" line="188"/>
         <source>From a point layer…</source>
         <translation>Da un layer di punti…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="187"/>
+        <location filename="../ui/gcp_dock.py" line="190"/>
         <source>To file (gcp_list.txt, CSV)…</source>
         <translation>Su file (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="188"/>
+        <location filename="../ui/gcp_dock.py" line="191"/>
         <source>To a GeoPackage layer…</source>
         <translation>Su un layer GeoPackage…</translation>
     </message>
@@ -1287,37 +1342,37 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>{} è selezionato: scegli una foto nella striscia sotto e fai clic sul punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="212"/>
+        <location filename="../ui/gcp_dock.py" line="215"/>
         <source>Undo (Ctrl+Z)</source>
         <translation>Annulla (Ctrl+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="212"/>
+        <location filename="../ui/gcp_dock.py" line="215"/>
         <source>Redo (Ctrl+Shift+Z)</source>
         <translation>Ripeti (Ctrl+Maiusc+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="398"/>
+        <location filename="../ui/gcp_dock.py" line="401"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px.</source>
         <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="403"/>
+        <location filename="../ui/gcp_dock.py" line="406"/>
         <source>Not aligned ({}): {}</source>
         <translation>Non allineate ({}): {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="404"/>
+        <location filename="../ui/gcp_dock.py" line="407"/>
         <source>(marked in the photo strip; hover for the reason)</source>
         <translation>(segnate nella striscia delle foto; il motivo è nel suggerimento)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="423"/>
+        <location filename="../ui/gcp_dock.py" line="426"/>
         <source>✗ not aligned</source>
         <translation>✗ non allineata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="424"/>
+        <location filename="../ui/gcp_dock.py" line="427"/>
         <source>{}: not aligned: {}</source>
         <translation>{}: non allineata: {}</translation>
     </message>
@@ -1385,6 +1440,71 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <location filename="../ui/gcp_tasks.py" line="111"/>
         <source>Opening {}…</source>
         <translation>Apertura di {}…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="43"/>
+        <source>Automatic control from a reference orthophoto</source>
+        <translation type="unfinished">Punti di controllo automatici da un'ortofoto di riferimento</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="46"/>
+        <source>Georeference with no hand-picked GCP: the block is matched to a reference orthophoto and takes its heights from a reference DSM. The points of the table become check points.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="52"/>
+        <source>A reference orthophoto: a raster file, or a WMS / XYZ layer (saved for the block&apos;s extent, from the photos&apos; GPS or the map extent)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="52"/>
+        <source>A reference DSM or DTM (heights in metres): a raster file or a WCS layer</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="61"/>
+        <source>Reference orthophoto:</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="62"/>
+        <source>Reference DSM:</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="73"/>
+        <source>Georeference from the reference orthophoto and DSM (in the background)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="94"/>
+        <source>Automatic control: choose a reference orthophoto and a reference DSM layer</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="115"/>
+        <source>Automatic control: {} automatic GCPs kept of {} matches; georeferenced in {}.</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="118"/>
+        <source>Check points: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="124"/>
+        <source>ArchaeoOrtho: automatic control</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="128"/>
+        <source>Automatic control against {} and {}…</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="140"/>
+        <source>Automatic GCPs (residuals)</source>
+        <translation type="unfinished"></translation>
     </message>
 </context>
 <context>
@@ -1611,32 +1731,32 @@ Curve di livello: il GeoPackage da scrivere.</translation>
 <context>
     <name>GeoreferenceAlgorithm</name>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="62"/>
+        <location filename="../processing_provider/georeference.py" line="89"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="63"/>
+        <location filename="../processing_provider/georeference.py" line="90"/>
         <source>GCP residuals</source>
         <translation>Residui dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="64"/>
+        <location filename="../processing_provider/georeference.py" line="91"/>
         <source>Camera centres (world)</source>
         <translation>Centri di presa (mondo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="92"/>
+        <location filename="../processing_provider/georeference.py" line="176"/>
         <source>outlier left out: {}</source>
         <translation>valore anomalo escluso: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="96"/>
+        <location filename="../processing_provider/georeference.py" line="129"/>
         <source>CRS {}; control RMSE XY {} m, Z {} m; check RMSE XY {} m, Z {} m</source>
         <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
     </message>
@@ -1651,44 +1771,89 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>Georeferenzia</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Aligned workspace</source>
         <translation>Area di lavoro allineata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Ground control layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Check points</source>
         <translation>Punti di controllo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Use EXIF GPS positions</source>
         <translation>Usa le posizioni GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Target CRS</source>
         <translation>SR di destinazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="50"/>
+        <location filename="../processing_provider/georeference.py" line="71"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>Pixel dei GCP misurati sulle foto raddrizzate</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="113"/>
+        <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS)</source>
+        <translation>Indica i punti d'appoggio (File o Layer dei punti d'appoggio: GCPS, GCP_LAYER) e/o le posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="71"/>
+        <source>Reference orthophoto</source>
+        <translation type="unfinished">Ortofoto di riferimento</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="71"/>
+        <source>Reference DSM</source>
+        <translation type="unfinished">DSM di riferimento</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="71"/>
+        <source>Reference resolution for web layers (m, 0: auto)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="71"/>
+        <source>Area to fetch from web layers</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="92"/>
+        <source>Automatic GCPs kept</source>
+        <translation type="unfinished">GCP automatici mantenuti</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="146"/>
+        <source>Automatic control needs both a reference orthophoto and a reference DSM (REFERENCE_ORTHO, REFERENCE_DSM); {} is missing</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="159"/>
+        <source>Target CRS {} is not used: automatic control georeferences in the reference orthophoto&apos;s CRS {}</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="180"/>
+        <source>Automatic control: {} automatic GCPs kept; CRS {}; check RMSE XY {} m, Z {} m</source>
+        <translation type="unfinished"></translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1699,71 +1864,63 @@ Check points: comma-separated names that become check points.
 Camera positions: CSV &apos;image,x,y,z[,sigma]&apos; (optional CRS line). Use EXIF GPS positions: use the photos&apos; GPS.
 Target CRS: default the ground control file&apos;s. Refine camera calibration: let the adjustment refine focal length, principal point and distortion.
 GCP pixels measured on upright photos: tick when the pixel coordinates were measured on the photos shown upright by their EXIF orientation, as web browsers and photo viewers show them; they are turned into the stored pixel grid of each photo (photos stored without a turn are unchanged).
-Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.</source>
-        <translation>Fissa il blocco allineato in un sistema di riferimento reale con punti d'appoggio (GCP) e/o posizioni delle camere, usati all'interno della compensazione a stelle proiettive in modo che eliminino anche la deriva e la flessione del blocco, cosa che una trasformazione a 7 parametri (Helmert) non può fare. I punti di controllo non partecipano alla compensazione: vengono triangolati in seguito e confrontati con le loro coordinate rilevate.
+Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.
 
-File dei punti d'appoggio: un gcp_list.txt di OpenDroneMap (riga del SR, poi 'x y z px py image [name]') o un file CSV di punti con il corrispondente '&lt;name&gt;_observations.csv'. Layer dei punti d'appoggio: in alternativa un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, sx, sy, sz, role).
-Punti di controllo: nomi separati da virgole che diventano punti di controllo.
-Posizioni delle camere: CSV 'image,x,y,z[,sigma]' (riga del SR facoltativa). Usa le posizioni GPS EXIF: usa il GPS delle foto.
-SR di destinazione: predefinito quello del file dei punti d'appoggio. Affina la calibrazione della camera: la compensazione affina focale, punto principale e distorsione.
-Pixel dei GCP misurati sulle foto raddrizzate: da spuntare quando le coordinate pixel sono state misurate sulle foto mostrate diritte secondo il loro orientamento EXIF, come le mostrano i browser e i visualizzatori di foto; sono convertite nella griglia di pixel memorizzata di ogni foto (le foto memorizzate senza rotazione restano invariate).
-I valori anomali (una misura errata, un errore di battitura in una coordinata) sono individuati, nominati nel registro ed esclusi.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/georeference.py" line="80"/>
-        <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS)</source>
-        <translation>Indica i punti d'appoggio (File o Layer dei punti d'appoggio: GCPS, GCP_LAYER) e/o le posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS)</translation>
+Given a reference orthophoto and a reference DSM (any raster layer: a file, or a WMS, XYZ or WCS layer, which is saved for the block&apos;s extent to georef/reference-ortho.tif and georef/reference-dsm.tif), the block is georeferenced with no hand-picked GCP, as &apos;Automatic control from a reference orthophoto&apos; does; the result is in the reference orthophoto&apos;s CRS (a Web Mercator or geographic layer is saved in the DSM&apos;s CRS, else in the UTM zone). Ground control given as well is not used to fix the block: all its points become check points, an independent measure of the automatic control. Camera positions or Use EXIF GPS positions give the rough position (else EXIF GPS when three photos carry it, else rotation and scale are searched). The calibration is refined in any case (focal length and distortion: the automatic GCPs determine them).
+Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos&apos; EXIF GPS positions plus a margin, else the other reference&apos;s extent.
+Outputs: besides the usual ones, the number of automatic GCPs the adjustment kept (none without automatic control).</source>
+        <translation type="unfinished"></translation>
     </message>
 </context>
 <context>
     <name>OrthorectifyImageAlgorithm</name>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="61"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="73"/>
         <source>Image</source>
         <translation>Immagine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Mode</source>
         <translation>Modalità</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="78"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="94"/>
         <source>Orthophoto</source>
         <translation>Ortofoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="79"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="95"/>
         <source>GCP residuals</source>
         <translation>Residui dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="81"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="97"/>
         <source>GCP residual RMSE (pixels)</source>
         <translation>RMSE dei residui dei punti d'appoggio (pixel)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="82"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="99"/>
         <source>Planar rectification: 95th percentile of its offset from the true position (CRS units)</source>
         <translation>Raddrizzamento piano: 95° percentile del suo scostamento dalla posizione vera (unità del SR)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="104"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="127"/>
         <source>RESIDUALS must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>RESIDUALS deve essere un file GeoPackage (.gpkg), ricevuto {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="117"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="141"/>
         <source>{} ({}): {:.2f} px</source>
         <translation>{} ({}): {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="92"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="109"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
@@ -1773,39 +1930,74 @@ I valori anomali (una misura errata, un errore di battitura in una coordinata) s
         <translation>Ortorettifica immagine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Ground control point layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Known orientation</source>
         <translation>Orientamento noto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Focal length (mm)</source>
         <translation>Focale (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Sensor width (mm)</source>
         <translation>Larghezza del sensore (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Resolution (0 = automatic)</source>
         <translation>Risoluzione (0 = automatica)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Output CRS</source>
         <translation>SR di output</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
+        <source>True orthophoto on the DSM</source>
+        <translation>Ortofoto vera sul DSM</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
+        <source>Planar rectification (flat ground)</source>
+        <translation>Raddrizzamento piano (terreno piatto)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
+        <source>Reference orthophoto (automatic control)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
+        <source>Rough location (automatic control)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
+        <source>Search radius (m)</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="98"/>
+        <source>Automatic GCPs used</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="116"/>
+        <source>Give ground control points observed in the image (Ground control file or Ground control point layer: GCPS, GCP_LAYER), its Known orientation (ORIENTATION) or a Reference orthophoto for automatic control (REFERENCE_ORTHO)</source>
+        <translation type="unfinished"></translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1816,38 +2008,13 @@ The camera's position and attitude come from ground control points observed in t
 Image: the photo. DSM: height raster (needed for a true orthophoto).
 Ground control file: an OpenDroneMap gcp_list.txt or CSV points file with observations in this image; or Ground control point layer: a point layer with one feature per observation and fields name, image, px, py (optional z, role; pixel origin at the upper-left corner, y down).
 Known orientation: instead of GCPs, a file with x y z omega phi kappa (degrees, photogrammetric convention; a header row as Pix4D writes it, or JSON), optionally focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 and a CRS line.
+Reference orthophoto (automatic control): with no GCPs and no known orientation, the photo is matched to this orthophoto (any CRS, any resolution; the DSM is then the reference DSM) and the matches become automatic GCPs (auto_001, ...) for the space resection: no hand-picked point, the heading need not be known, obliques work too, and the focal length is estimated when the photo has none. Rough location: a point on the ground the photo shows (any CRS; empty = anywhere on the reference); Search radius: how far off it may be (metres). The log says how many matches survived each step; the GCP residuals list the automatic GCPs.
 Focal length and Sensor width: interior orientation in mm (the sensor's long side); 0 or empty = the EXIF focal length.
 Mode: a true orthophoto on the DSM, or a planar (projective) rectification through the GCPs for comparison on flat ground; with a DSM the log and the output 'Planar rectification: 95th percentile of its offset' say how far the planar result is off because of relief.
 Resolution: cell size in CRS units (0 = the ground sample distance).
 Output CRS: default the CRS of the GCPs or of the known orientation.
 GCP residuals: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
-        <translation>Ortorettifica una fotografia — anche una che non fa parte di alcun blocco, come una singola obliqua o una vecchia stampa — su un DSM esistente, ad esempio un DSM da laser scanning aereo (ALS) in qualsiasi SR (riproiettato al volo).
-
-Posizione e assetto della camera derivano dai punti d'appoggio misurati nella foto (resezione spaziale: almeno 4 punti; un punto errato su 5 o più viene individuato ed escluso; con 6 o più si stimano anche la focale e la distorsione radiale k1 dove i punti le determinano), oppure da un orientamento noto.
-
-Immagine: la foto. DSM: raster delle quote (necessario per un'ortofoto vera).
-File dei punti d'appoggio: un gcp_list.txt di OpenDroneMap o un file CSV di punti con misure in questa immagine; oppure Layer dei punti d'appoggio: un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, role; origine dei pixel nell'angolo in alto a sinistra, y verso il basso).
-Orientamento noto: al posto dei punti d'appoggio, un file con x y z omega phi kappa (gradi, convenzione fotogrammetrica; una riga di intestazione come la scrive Pix4D, o JSON), facoltativamente focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 e una riga del SR.
-Focale e Larghezza del sensore: orientamento interno in mm (il lato lungo del sensore); 0 o vuoto = la focale EXIF.
-Modalità: un'ortofoto vera sul DSM, o un raddrizzamento piano (proiettivo) tramite i punti d'appoggio per confronto su terreno piatto; con un DSM il registro e il risultato 'Raddrizzamento piano: 95° percentile del suo scostamento' dicono di quanto il risultato piano si discosta a causa del rilievo.
-Risoluzione: dimensione della cella in unità del SR (0 = il GSD).
-SR di output: predefinito il SR dei punti d'appoggio o dell'orientamento noto.
-Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in metri sul piano).</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
-        <source>True orthophoto on the DSM</source>
-        <translation>Ortofoto vera sul DSM</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="63"/>
-        <source>Planar rectification (flat ground)</source>
-        <translation>Raddrizzamento piano (terreno piatto)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="98"/>
-        <source>Give ground control points observed in the image (Ground control file or Ground control point layer: GCPS, GCP_LAYER) or its Known orientation (ORIENTATION)</source>
-        <translation>Indica i punti d'appoggio osservati nell'immagine (File o Layer dei punti d'appoggio: GCPS, GCP_LAYER) o il suo Orientamento noto (ORIENTATION)</translation>
+        <translation type="unfinished"></translation>
     </message>
 </context>
 <context>
@@ -2406,14 +2573,14 @@ Sky masks (oblique photos): first a &apos;Prepare images&apos; stage finds the s
 Build the DTM: after the DSM, a bare-earth DTM (as &apos;Build DTM&apos;). Contour interval (advanced): contour lines of the DTM at this interval (as &apos;Contours&apos;; 0 = none). Relief visualisations (advanced): those chosen are computed from the DTM (as &apos;Relief visualisation&apos;). Both need the DTM.
 The other parameters are those of the single stages (see their help); 0 means automatic.
 Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures.</source>
-        <translation>L&apos;intera elaborazione in una sola chiamata, per l&apos;uso in batch: Allinea immagini, Georeferenzia, Crea DSM, Crea ortofoto e Rapporto di accuratezza su un solo spazio di lavoro. Chiama le stesse funzioni dei singoli algoritmi, e una nuova esecuzione riprende (caratteristiche, corrispondenze e coppie dense già calcolate vengono riutilizzate).
+        <translation>L'intera elaborazione in una sola chiamata, per l'uso in batch: Allinea immagini, Georeferenzia, Crea DSM, Crea ortofoto e Rapporto di accuratezza su un solo spazio di lavoro. Chiama le stesse funzioni dei singoli algoritmi, e una nuova esecuzione riprende (caratteristiche, corrispondenze e coppie dense già calcolate vengono riutilizzate).
 
-Cartella delle immagini: le foto. Cartella dell&apos;area di lavoro: dove sono scritti tutti i prodotti.
-La georeferenziazione richiede punti di appoggio (un file o un layer dei punti d&apos;appoggio, punti di controllo esclusi) e/o posizioni delle camere (un CSV delle posizioni delle camere o Usa le posizioni GPS EXIF): senza di essi l&apos;elaborazione viene rifiutata, perché un DSM richiede una scala metrica e una direzione verticale. Pixel dei GCP misurati sulle foto raddrizzate: come in &apos;Georeferenzia&apos; (le coordinate pixel misurate sulle foto mostrate diritte secondo il loro orientamento EXIF).
-Maschere del cielo (foto oblique): prima una fase &apos;Prepara immagini&apos; trova il cielo e la foschia all&apos;orizzonte in ogni foto e li maschera, perché nessun punto di legame o del DSM provenga dal cielo; si allineano le foto preparate (disattivato per impostazione predefinita: le foto nadirali non ne hanno bisogno).
-Genera il DTM: dopo il DSM, un DTM del suolo nudo (come &apos;Genera DTM&apos;). Equidistanza (avanzato): curve di livello del DTM con questa equidistanza (come &apos;Curve di livello&apos;; 0 = nessuna). Visualizzazioni del rilievo (avanzato): quelle scelte sono calcolate dal DTM (come &apos;Visualizzazione del rilievo&apos;). Entrambe richiedono il DTM.
+Cartella delle immagini: le foto. Cartella dell'area di lavoro: dove sono scritti tutti i prodotti.
+La georeferenziazione richiede punti di appoggio (un file o un layer dei punti d'appoggio, punti di controllo esclusi) e/o posizioni delle camere (un CSV delle posizioni delle camere o Usa le posizioni GPS EXIF): senza di essi l'elaborazione viene rifiutata, perché un DSM richiede una scala metrica e una direzione verticale. Pixel dei GCP misurati sulle foto raddrizzate: come in 'Georeferenzia' (le coordinate pixel misurate sulle foto mostrate diritte secondo il loro orientamento EXIF).
+Maschere del cielo (foto oblique): prima una fase 'Prepara immagini' trova il cielo e la foschia all'orizzonte in ogni foto e li maschera, perché nessun punto di legame o del DSM provenga dal cielo; si allineano le foto preparate (disattivato per impostazione predefinita: le foto nadirali non ne hanno bisogno).
+Genera il DTM: dopo il DSM, un DTM del suolo nudo (come 'Genera DTM'). Equidistanza (avanzato): curve di livello del DTM con questa equidistanza (come 'Curve di livello'; 0 = nessuna). Visualizzazioni del rilievo (avanzato): quelle scelte sono calcolate dal DTM (come 'Visualizzazione del rilievo'). Entrambe richiedono il DTM.
 Gli altri parametri sono quelli delle singole fasi (vedi il loro aiuto); 0 significa automatico.
-Risultati: il DSM, l&apos;ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali.</translation>
+Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali.</translation>
     </message>
 </context>
 </TS>
