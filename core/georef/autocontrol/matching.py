@@ -35,6 +35,11 @@ def rootsift(grey: np.ndarray, valid: Optional[np.ndarray] = None, n_features: i
         mask = cv2.erode(valid.astype(np.uint8) * 255, np.ones((9, 9), np.uint8))
     sift = cv2.SIFT_create(nfeatures=int(n_features))
     kps, desc = sift.detectAndCompute(img, mask)
+    return root_features(kps, desc)
+
+
+def root_features(kps, desc) -> "Features":
+    """OpenCV SIFT keypoints + descriptors as RootSIFT Features (L1-normalised, square-rooted)."""
     if desc is None or not len(kps):
         return Features(np.zeros((0, 2), np.float32), np.zeros((0, 128), np.float32), np.zeros(0, np.float32))
     desc = desc.astype(np.float32)
@@ -172,5 +177,5 @@ def coarse_search(ortho: np.ndarray, ortho_valid: np.ndarray, ref: np.ndarray, r
     return best
 
 
-__all__ = ["Features", "MatchSet", "apply2", "coarse_search", "match_orthos", "ratio_matches", "rootsift",
+__all__ = ["Features", "MatchSet", "apply2", "coarse_search", "match_orthos", "ratio_matches", "root_features", "rootsift",
            "similarity_ransac", "tile_refine"]

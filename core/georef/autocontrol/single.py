@@ -34,7 +34,7 @@ from ...geometry.crs import transform_points
 from ...io import gcp as gcpmod
 from ...io.images import read_image, to_grey
 from .errors import AutoControlError
-from .matching import Features, match_orthos, ratio_matches, rootsift
+from .matching import Features, match_orthos, ratio_matches, root_features, rootsift
 from .options import AUTO, AutoControlOptions
 from .reference import Reference
 
@@ -121,13 +121,7 @@ def affine_rootsift(grey: np.ndarray, n_features: int, max_tilt: float) -> Featu
     else:
         det = cv2.SIFT_create(nfeatures=int(n_features))
     kps, desc = det.detectAndCompute(img, None)
-    if desc is None or not len(kps):
-        return Features(np.zeros((0, 2), np.float32), np.zeros((0, 128), np.float32), np.zeros(0, np.float32))
-    desc = desc.astype(np.float32)
-    desc /= np.maximum(desc.sum(axis=1, keepdims=True), 1e-9)
-    desc = np.sqrt(desc)
-    xy = np.array([k.pt for k in kps], dtype=np.float32)
-    return Features(xy, desc, np.array([k.size for k in kps], dtype=np.float32))
+    return root_features(kps, desc)
 
 
 @dataclass
