@@ -1976,16 +1976,6 @@ Outputs: besides the usual ones, the number of automatic GCPs the adjustment kep
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="75"/>
-        <source>Reference orthophoto (automatic control)</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
-        <source>Rough location (automatic control)</source>
-        <translation type="unfinished"></translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Search radius (m)</source>
         <translation type="unfinished"></translation>
     </message>
@@ -2014,6 +2004,16 @@ Mode: a true orthophoto on the DSM, or a planar (projective) rectification throu
 Resolution: cell size in CRS units (0 = the ground sample distance).
 Output CRS: default the CRS of the GCPs or of the known orientation.
 GCP residuals: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
+        <translation type="unfinished"></translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
+        <source>Reference orthophoto</source>
+        <translation type="unfinished">Ortofoto di riferimento</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/orthorectify_image.py" line="75"/>
+        <source>Rough location</source>
         <translation type="unfinished"></translation>
     </message>
 </context>

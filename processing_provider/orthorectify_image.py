@@ -81,8 +81,8 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
                 self.ORIENTATION, self.tr("Known orientation"), optional=True,
                 fileFilter="Orientation (*.txt *.csv *.json);;All files (*)"),
             QgsProcessingParameterRasterLayer(
-                self.REFERENCE_ORTHO, self.tr("Reference orthophoto (automatic control)"), optional=True),
-            QgsProcessingParameterPoint(self.LOCATION, self.tr("Rough location (automatic control)"), optional=True),
+                self.REFERENCE_ORTHO, self.tr("Reference orthophoto"), optional=True),
+            QgsProcessingParameterPoint(self.LOCATION, self.tr("Rough location"), optional=True),
             params.number(self.SEARCH_RADIUS, self.tr("Search radius (m)"), default=50.0),
             params.number(self.FOCAL_MM, self.tr("Focal length (mm)"), optional=True),
             params.number(self.SENSOR_WIDTH_MM, self.tr("Sensor width (mm)"), optional=True),
