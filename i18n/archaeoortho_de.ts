@@ -206,7 +206,14 @@ Matching image size: the longest side the images are scaled to for the features 
 Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).
 Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).
 Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
-        <translation type="unfinished"></translation>
+        <translation>Structure from Motion: SIFT-Merkmale, Paarauswahl, robuste Zuordnung (RANSAC), inkrementelle Rekonstruktion mit Selbstkalibrierung (Brennweite, Bildhauptpunkt, Objektivverzeichnung) und eine abschließende Bündelblockausgleichung. Das Ergebnis wird im Arbeitsbereich-Ordner gespeichert, den die folgenden Schritte (Georeferenzieren, DOM erzeugen, Orthophoto erzeugen) als Eingabe nehmen. Ein erneuter Lauf setzt fort: bereits berechnete Merkmale und Zuordnungen werden wiederverwendet.
+
+Paarauswahl: &apos;auto&apos; nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
+Kameramodell: &apos;AUTO&apos; schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
+Bildgröße für die Zuordnung: die längste Seite, auf die die Bilder für die Merkmale verkleinert werden (0 = automatisch: Fotos bis 2 Megapixel unverändert, größere auf 2 Megapixel verkleinert; DOM und Orthophotos nutzen jedes Pixel). Merkmale je Bild: 0 = automatisch (etwa 4000 je Megapixel, 2048 bis 4096). Affin-invariante Merkmale helfen bei Schrägaufnahmen und sind langsamer.
+Brennweite und Sensorbreite: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern (0 = aus EXIF / unbekannt).
+Rekonstruktionsverfahren (erweitert): &apos;incremental&apos; (COLMAP, Standard) oder &apos;global&apos; (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).
+Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen Einstellungen auslassen, oder ein in Teile zerfallener Block werden mit reicheren Merkmalen (schwächeren für kontrastarme Bilder, affinen für steile Schrägaufnahmen) und mehr Paaren erneut versucht; das Protokoll und sfm/alignment.json sagen, was erneut versucht wurde und warum.</translation>
     </message>
 </context>
 <context>
@@ -305,12 +312,12 @@ Retry images left out (advanced, on): images the fast settings leave out, or a b
     <message>
         <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>Reference resolution for web layers (m, 0: auto)</source>
-        <translation type="unfinished"></translation>
+        <translation>Referenzauflösung für Weblayer (m, 0: auto)</translation>
     </message>
     <message>
         <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>Area to fetch from web layers</source>
-        <translation type="unfinished"></translation>
+        <translation>Aus Weblayern abzurufender Bereich</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -322,7 +329,14 @@ Reference DSM: a DSM or DTM covering the block, heights in metres (a WCS layer i
 Rough position: the photos&apos; EXIF GPS when at least three carry it (auto), always (EXIF GPS), or never (none: rotation and scale are searched over the whole reference, which then should not be much larger than the block).
 Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos&apos; EXIF GPS positions plus a margin, else the other reference&apos;s extent.
 Outputs: the camera centres in the reference CRS, the number of automatic GCPs the adjustment kept, the matches found; georef/autocontrol.json lists every candidate with why it was kept or dropped.</source>
-        <translation type="unfinished"></translation>
+        <translation>Georeferenziert einen ausgerichteten Block ohne von Hand gesetzte Passpunkte: ein vorläufiges Orthophoto des Blocks wird bei gemeinsamer Auflösung mit einem Referenz-Orthophoto (einem amtlichen Orthophoto, dem Orthomosaik eines früheren Blocks) zugeordnet, jede Zuordnung wird in den Fotos wiedergefunden und erhält ihre Höhe aus dem Referenz-DOM, und diese automatischen Passpunkte gehen in die übliche passpunktgestützte Ausgleichung ein, die die Ausreißer auslässt. Änderungen zwischen den beiden Zeitpunkten (Feldfrüchte, Autos, neue Gebäude, ein anderer Sonnenstand) werden hingenommen: was bleibt, wird genutzt, und das Protokoll nennt, wie viele Zuordnungen jeden Schritt überstanden haben.
+
+Ausgerichteter Arbeitsbereich: der zu georeferenzierende Block (seine Fotos müssen noch dort liegen, wo die Ausrichtung sie gefunden hat).
+Referenz-Orthophoto: ein beliebiges genordetes Raster in einem projizierten KBS, grau oder farbig; das Ergebnis ist in seinem KBS. Ein Layer, der keine lokale Datei ist (WMS, XYZ, WCS, ein virtuelles Raster), wird für die Ausdehnung des Blocks nach georef/reference-ortho.tif gespeichert (ein Web-Mercator- oder geographischer im KBS des DOM, sonst in dem der UTM-Zone).
+Referenz-DOM: ein DOM oder DGM, das den Block abdeckt, Höhen in Metern (ein WCS-Layer wird nach georef/reference-dsm.tif gespeichert).
+Ungefähre Lage: das EXIF-GPS der Fotos, wenn mindestens drei es tragen (automatisch), immer (EXIF-GPS) oder nie (keine: Drehung und Maßstab werden über die ganze Referenz gesucht, die dann nicht viel größer als der Block sein sollte).
+Referenzauflösung: Meter je Pixel, mit denen ein Weblayer gespeichert wird (0: 0,25 m; das DOM mit der doppelten, mindestens 0,5 m). Abzurufender Bereich: die Ausdehnung, für die ein Weblayer gespeichert wird; leer: die EXIF-GPS-Positionen der Fotos mit einem Rand, sonst die Ausdehnung der anderen Referenz.
+Ausgaben: die Projektionszentren im KBS der Referenz, die Zahl der automatischen Passpunkte, die die Ausgleichung behalten hat, die gefundenen Zuordnungen; georef/autocontrol.json führt jeden Kandidaten auf, mit dem Grund, warum er behalten oder verworfen wurde.</translation>
     </message>
 </context>
 <context>
@@ -707,47 +721,47 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="36"/>
         <source>Earlier DSM</source>
-        <translation type="unfinished"></translation>
+        <translation>Früheres DOM</translation>
     </message>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="36"/>
         <source>Later DSM</source>
-        <translation type="unfinished"></translation>
+        <translation>Späteres DOM</translation>
     </message>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="41"/>
         <source>Difference</source>
-        <translation type="unfinished"></translation>
+        <translation>Differenz</translation>
     </message>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="42"/>
         <source>Median difference (m)</source>
-        <translation type="unfinished"></translation>
+        <translation>Median der Differenz (m)</translation>
     </message>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="43"/>
         <source>Standard deviation of the difference (m)</source>
-        <translation type="unfinished"></translation>
+        <translation>Standardabweichung der Differenz (m)</translation>
     </message>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="44"/>
         <source>Cells compared</source>
-        <translation type="unfinished"></translation>
+        <translation>Verglichene Zellen</translation>
     </message>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="45"/>
         <source>Cells changed by more than 1 m</source>
-        <translation type="unfinished"></translation>
+        <translation>Um mehr als 1 m veränderte Zellen</translation>
     </message>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="55"/>
         <source>{} cells compared: median {:.3f} m, mean {:.3f} m, std {:.3f} m, 5-95 % {:.3f} .. {:.3f} m; {} cells changed by more than {:g} m</source>
-        <translation type="unfinished"></translation>
+        <translation>{} Zellen verglichen: Median {:.3f} m, Mittel {:.3f} m, Std.-Abw. {:.3f} m, 5-95 % {:.3f} .. {:.3f} m; {} Zellen um mehr als {:g} m verändert</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
         <source>DSM difference</source>
-        <translation type="unfinished"></translation>
+        <translation>DOM-Differenz</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -756,7 +770,11 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
 Earlier DSM: the DSM the difference is measured from (its grid is the output&apos;s).
 Later DSM: the DSM of the other epoch (e.g. a block registered to the earlier one with Automatic control).
 Difference: where to write the float32 Cloud-Optimized GeoTIFF of later minus earlier (metres).</source>
-        <translation type="unfinished"></translation>
+        <translation>Das spätere DOM minus das frühere, im Raster des früheren, zeigt, was sich zwischen zwei Zeitpunkten einer Fundstelle verändert hat (das spätere DOM wird dazu mit GDAL bilinear aus einem beliebigen KBS umgerechnet). Eine Zelle ist NoData, wo eines der beiden DOM keine Daten hat. Das Protokoll nennt die verglichenen Zellen, Median, Mittel und Standardabweichung der Differenz, ihr 5. und 95. Perzentil und die Zellen, die sich um mehr als 1 m verändert haben; ein Median nahe 0 zeigt, dass die beiden Zeitpunkte aufeinander registriert sind.
+
+Früheres DOM: das DOM, von dem aus die Differenz gemessen wird (sein Raster ist das der Ausgabe).
+Späteres DOM: das DOM des anderen Zeitpunkts (z. B. eines Blocks, der mit &apos;Automatische Passpunkte&apos; auf den früheren registriert wurde).
+Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (Meter) geschrieben wird.</translation>
     </message>
 </context>
 <context>
@@ -1444,67 +1462,67 @@ Difference: where to write the float32 Cloud-Optimized GeoTIFF of later minus ea
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="43"/>
         <source>Automatic control from a reference orthophoto</source>
-        <translation type="unfinished">Automatische Passpunkte aus einem Referenz-Orthophoto</translation>
+        <translation>Automatisch aus Referenz-Orthophoto</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="46"/>
         <source>Georeference with no hand-picked GCP: the block is matched to a reference orthophoto and takes its heights from a reference DSM. The points of the table become check points.</source>
-        <translation type="unfinished"></translation>
+        <translation>Georeferenzieren ohne von Hand gesetzte Passpunkte: der Block wird einem Referenz-Orthophoto zugeordnet und nimmt seine Höhen aus einem Referenz-DOM. Die Punkte der Tabelle werden Kontrollpunkte.</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="52"/>
         <source>A reference orthophoto: a raster file, or a WMS / XYZ layer (saved for the block&apos;s extent, from the photos&apos; GPS or the map extent)</source>
-        <translation type="unfinished"></translation>
+        <translation>Ein Referenz-Orthophoto: eine Rasterdatei oder ein WMS-/XYZ-Layer (für die Ausdehnung des Blocks gespeichert, aus dem GPS der Fotos oder der Kartenausdehnung)</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="52"/>
         <source>A reference DSM or DTM (heights in metres): a raster file or a WCS layer</source>
-        <translation type="unfinished"></translation>
+        <translation>Ein Referenz-DOM oder -DGM (Höhen in Metern): eine Rasterdatei oder ein WCS-Layer</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="61"/>
         <source>Reference orthophoto:</source>
-        <translation type="unfinished"></translation>
+        <translation>Referenz-Orthophoto:</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="62"/>
         <source>Reference DSM:</source>
-        <translation type="unfinished"></translation>
+        <translation>Referenz-DOM:</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="73"/>
         <source>Georeference from the reference orthophoto and DSM (in the background)</source>
-        <translation type="unfinished"></translation>
+        <translation>Aus Referenz-Orthophoto und -DOM georeferenzieren (im Hintergrund)</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="94"/>
         <source>Automatic control: choose a reference orthophoto and a reference DSM layer</source>
-        <translation type="unfinished"></translation>
+        <translation>Automatische Passpunkte: ein Referenz-Orthophoto und einen Referenz-DOM-Layer wählen</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="115"/>
         <source>Automatic control: {} automatic GCPs kept of {} matches; georeferenced in {}.</source>
-        <translation type="unfinished"></translation>
+        <translation>Automatische Passpunkte: {} automatische Passpunkte von {} Zuordnungen behalten; georeferenziert in {}.</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="118"/>
         <source>Check points: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</source>
-        <translation type="unfinished"></translation>
+        <translation>Kontrollpunkte: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="124"/>
         <source>ArchaeoOrtho: automatic control</source>
-        <translation type="unfinished"></translation>
+        <translation>ArchaeoOrtho: automatische Passpunkte</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="128"/>
         <source>Automatic control against {} and {}…</source>
-        <translation type="unfinished"></translation>
+        <translation>Automatische Passpunkte gegen {} und {}…</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="140"/>
         <source>Automatic GCPs (residuals)</source>
-        <translation type="unfinished"></translation>
+        <translation>Automatische Passpunkte (Residuen)</translation>
     </message>
 </context>
 <context>
@@ -1818,42 +1836,42 @@ Difference: where to write the float32 Cloud-Optimized GeoTIFF of later minus ea
     <message>
         <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Reference orthophoto</source>
-        <translation type="unfinished">Referenz-Orthophoto</translation>
+        <translation>Referenz-Orthophoto</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Reference DSM</source>
-        <translation type="unfinished">Referenz-DOM</translation>
+        <translation>Referenz-DOM</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Reference resolution for web layers (m, 0: auto)</source>
-        <translation type="unfinished"></translation>
+        <translation>Referenzauflösung für Weblayer (m, 0: auto)</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Area to fetch from web layers</source>
-        <translation type="unfinished"></translation>
+        <translation>Aus Weblayern abzurufender Bereich</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="92"/>
         <source>Automatic GCPs kept</source>
-        <translation type="unfinished">Behaltene automatische Passpunkte</translation>
+        <translation>Behaltene automatische Passpunkte</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="146"/>
         <source>Automatic control needs both a reference orthophoto and a reference DSM (REFERENCE_ORTHO, REFERENCE_DSM); {} is missing</source>
-        <translation type="unfinished"></translation>
+        <translation>Automatische Passpunkte brauchen ein Referenz-Orthophoto und ein Referenz-DOM (REFERENCE_ORTHO, REFERENCE_DSM); {} fehlt</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="159"/>
         <source>Target CRS {} is not used: automatic control georeferences in the reference orthophoto&apos;s CRS {}</source>
-        <translation type="unfinished"></translation>
+        <translation>Ziel-KBS {} wird nicht verwendet: automatische Passpunkte georeferenzieren im KBS {} des Referenz-Orthophotos</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="180"/>
         <source>Automatic control: {} automatic GCPs kept; CRS {}; check RMSE XY {} m, Z {} m</source>
-        <translation type="unfinished"></translation>
+        <translation>Automatische Passpunkte: {} automatische Passpunkte behalten; KBS {}; Kontroll-RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1869,7 +1887,18 @@ Outliers (a wrong observation, a typo in a coordinate) are detected, named in th
 Given a reference orthophoto and a reference DSM (any raster layer: a file, or a WMS, XYZ or WCS layer, which is saved for the block&apos;s extent to georef/reference-ortho.tif and georef/reference-dsm.tif), the block is georeferenced with no hand-picked GCP, as &apos;Automatic control from a reference orthophoto&apos; does; the result is in the reference orthophoto&apos;s CRS (a Web Mercator or geographic layer is saved in the DSM&apos;s CRS, else in the UTM zone). Ground control given as well is not used to fix the block: all its points become check points, an independent measure of the automatic control. Camera positions or Use EXIF GPS positions give the rough position (else EXIF GPS when three photos carry it, else rotation and scale are searched). The calibration is refined in any case (focal length and distortion: the automatic GCPs determine them).
 Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos&apos; EXIF GPS positions plus a margin, else the other reference&apos;s extent.
 Outputs: besides the usual ones, the number of automatic GCPs the adjustment kept (none without automatic control).</source>
-        <translation type="unfinished"></translation>
+        <translation>Legt den ausgerichteten Block mit Passpunkten (GCPs) und/oder Kamerapositionen in einem echten Koordinatenbezugssystem fest. Sie wirken in der Bündelblockausgleichung, so dass sie auch Drift und Verbiegung des Blocks beseitigen, was eine 7-Parameter-Transformation (Helmert) nicht kann. Kontrollpunkte nehmen an der Ausgleichung nicht teil: sie werden danach trianguliert und mit ihren vermessenen Koordinaten verglichen.
+
+Passpunktdatei: eine OpenDroneMap gcp_list.txt (KBS-Zeile, dann &apos;x y z px py image [name]&apos;) oder eine CSV-Punktdatei mit passender &apos;&lt;name&gt;_observations.csv&apos;. Passpunktlayer: alternativ ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, sx, sy, sz, role).
+Kontrollpunkte: durch Kommas getrennte Namen, die zu Kontrollpunkten werden.
+Kamerapositionen: CSV &apos;image,x,y,z[,sigma]&apos; (optionale KBS-Zeile). EXIF-GPS-Positionen verwenden: das GPS der Fotos verwenden.
+Ziel-KBS: Vorgabe ist das KBS der Passpunktdatei. Kamerakalibrierung verfeinern: die Ausgleichung verfeinert Brennweite, Bildhauptpunkt und Verzeichnung.
+GCP-Pixel auf aufrechten Fotos gemessen: ankreuzen, wenn die Pixelkoordinaten auf den Fotos gemessen wurden, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden (wie in Webbrowsern und Bildbetrachtern); sie werden in das gespeicherte Pixelraster jedes Fotos umgerechnet (ungedreht gespeicherte Fotos bleiben unverändert).
+Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erkannt, im Protokoll genannt und ausgelassen.
+
+Mit einem Referenz-Orthophoto und einem Referenz-DOM (ein beliebiger Rasterlayer: eine Datei oder ein WMS-, XYZ- oder WCS-Layer, der für die Ausdehnung des Blocks nach georef/reference-ortho.tif und georef/reference-dsm.tif gespeichert wird) wird der Block ohne von Hand gesetzte Passpunkte georeferenziert, wie es &apos;Automatische Passpunkte aus einem Referenz-Orthophoto&apos; tut; das Ergebnis ist im KBS des Referenz-Orthophotos (ein Web-Mercator- oder geographischer Layer wird im KBS des DOM gespeichert, sonst in der UTM-Zone). Zusätzlich angegebene Passpunkte legen den Block nicht fest: alle ihre Punkte werden Kontrollpunkte, ein unabhängiges Maß der automatischen Passpunkte. Kamerapositionen oder EXIF-GPS-Positionen verwenden geben die ungefähre Lage (sonst EXIF-GPS, wenn drei Fotos es tragen, sonst werden Drehung und Maßstab gesucht). Die Kalibrierung wird in jedem Fall verfeinert (Brennweite und Verzeichnung: die automatischen Passpunkte bestimmen sie).
+Referenzauflösung: Meter je Pixel, mit denen ein Weblayer gespeichert wird (0: 0,25 m; das DOM mit der doppelten, mindestens 0,5 m). Abzurufender Bereich: die Ausdehnung, für die ein Weblayer gespeichert wird; leer: die EXIF-GPS-Positionen der Fotos mit einem Rand, sonst die Ausdehnung der anderen Referenz.
+Ausgaben: neben den üblichen die Zahl der automatischen Passpunkte, die die Ausgleichung behalten hat (keine ohne automatische Passpunkte).</translation>
     </message>
 </context>
 <context>
@@ -1977,17 +2006,17 @@ Outputs: besides the usual ones, the number of automatic GCPs the adjustment kep
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Search radius (m)</source>
-        <translation type="unfinished"></translation>
+        <translation>Suchradius (m)</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="98"/>
         <source>Automatic GCPs used</source>
-        <translation type="unfinished"></translation>
+        <translation>Verwendete automatische Passpunkte</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="116"/>
         <source>Give ground control points observed in the image (Ground control file or Ground control point layer: GCPS, GCP_LAYER), its Known orientation (ORIENTATION) or a Reference orthophoto for automatic control (REFERENCE_ORTHO)</source>
-        <translation type="unfinished"></translation>
+        <translation>Im Bild gemessene Passpunkte angeben (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER), seine bekannte Orientierung (ORIENTATION) oder ein Referenz-Orthophoto für automatische Passpunkte (REFERENCE_ORTHO)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -2004,17 +2033,29 @@ Mode: a true orthophoto on the DSM, or a planar (projective) rectification throu
 Resolution: cell size in CRS units (0 = the ground sample distance).
 Output CRS: default the CRS of the GCPs or of the known orientation.
 GCP residuals: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
-        <translation type="unfinished"></translation>
+        <translation>Orthorektifiziert ein Foto — auch eines, das zu keinem Block gehört, etwa eine einzelne Schrägaufnahme oder ein alter Abzug — auf einem vorhandenen DOM, zum Beispiel einem DOM aus Airborne Laserscanning (ALS) in beliebigem KBS (es wird im Lauf umprojiziert).
+
+Position und Lage der Kamera ergeben sich aus im Foto gemessenen Passpunkten (räumlicher Rückwärtsschnitt: mindestens 4 Punkte; ein falscher Punkt unter 5 oder mehr wird gefunden und ausgelassen; ab 6 Punkten werden auch Brennweite und radiale Verzeichnung k1 geschätzt, wo die Punkte sie bestimmen) oder aus einer bekannten Orientierung.
+
+Bild: das Foto. DSM: Höhenraster (für ein wahres Orthophoto nötig).
+Passpunktdatei: eine OpenDroneMap gcp_list.txt oder CSV-Punktdatei mit Messungen in diesem Bild; oder Passpunktlayer: ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, role; Pixelursprung in der linken oberen Ecke, y nach unten).
+Bekannte Orientierung: statt Passpunkten eine Datei mit x y z omega phi kappa (Grad, photogrammetrische Konvention; eine Kopfzeile wie von Pix4D geschrieben, oder JSON), optional focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 und eine KBS-Zeile.
+Referenz-Orthophoto (automatische Passpunkte): ohne Passpunkte und ohne bekannte Orientierung wird das Foto diesem Orthophoto zugeordnet (beliebiges KBS, beliebige Auflösung; das DOM ist dann das Referenz-DOM), und die Zuordnungen werden automatische Passpunkte (auto_001, ...) für den räumlichen Rückwärtsschnitt: kein von Hand gesetzter Punkt, die Blickrichtung muss nicht bekannt sein, auch Schrägaufnahmen gehen, und die Brennweite wird geschätzt, wenn das Foto keine hat. Ungefährer Ort: ein Punkt am Boden, den das Foto zeigt (beliebiges KBS; leer = irgendwo auf der Referenz); Suchradius: wie weit er danebenliegen darf (Meter). Das Protokoll nennt, wie viele Zuordnungen jeden Schritt überstanden haben; die Passpunkt-Residuen führen die automatischen Passpunkte auf.
+Brennweite und Sensorbreite: innere Orientierung in mm (die lange Seite des Sensors); 0 oder leer = die EXIF-Brennweite.
+Modus: ein wahres Orthophoto auf dem DOM oder eine ebene (projektive) Entzerrung über die Passpunkte zum Vergleich auf flachem Gelände; mit DOM sagen das Protokoll und die Ausgabe &apos;Ebene Entzerrung: 95. Perzentil ihres Versatzes&apos;, wie weit das ebene Ergebnis wegen des Reliefs abweicht.
+Auflösung: Zellgröße in KBS-Einheiten (0 = die Bodenauflösung).
+Ausgabe-KBS: Vorgabe ist das KBS der Passpunkte oder der bekannten Orientierung.
+Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in der Ebene).</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Reference orthophoto</source>
-        <translation type="unfinished">Referenz-Orthophoto</translation>
+        <translation>Referenz-Orthophoto</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Rough location</source>
-        <translation type="unfinished"></translation>
+        <translation>Ungefährer Ort</translation>
     </message>
 </context>
 <context>

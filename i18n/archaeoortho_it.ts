@@ -206,7 +206,14 @@ Matching image size: the longest side the images are scaled to for the features 
 Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).
 Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).
 Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
-        <translation type="unfinished"></translation>
+        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell&apos;obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella dell&apos;area di lavoro, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
+
+Selezione delle coppie: &apos;auto&apos; usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
+Modello di camera: &apos;AUTO&apos; stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
+Dimensione per la corrispondenza: il lato maggiore a cui le immagini sono ridotte per le feature (0 = automatico: foto fino a 2 megapixel così come sono, quelle più grandi ridotte a 2 megapixel; il DSM e le ortofoto usano ogni pixel). Feature per immagine: 0 = automatico (circa 4000 per megapixel, da 2048 a 4096). Le feature invarianti affini aiutano con le prese oblique e sono più lente.
+Focale e Larghezza del sensore: orientamento interno quando manca l&apos;EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri (0 = dall&apos;EXIF / sconosciuta).
+Metodo di ricostruzione (avanzato): &apos;incremental&apos; (COLMAP, predefinito) o &apos;global&apos; (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).
+Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni rapide escludono, o un blocco diviso in parti, vengono riprovate con caratteristiche più ricche (più deboli per fotogrammi a basso contrasto, affini per oblique ripide) e più coppie; il registro e sfm/alignment.json dicono cosa è stato riprovato e perché.</translation>
     </message>
 </context>
 <context>
@@ -305,12 +312,12 @@ Retry images left out (advanced, on): images the fast settings leave out, or a b
     <message>
         <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>Reference resolution for web layers (m, 0: auto)</source>
-        <translation type="unfinished"></translation>
+        <translation>Risoluzione di riferimento per layer web (m, 0: auto)</translation>
     </message>
     <message>
         <location filename="../processing_provider/auto_control.py" line="54"/>
         <source>Area to fetch from web layers</source>
-        <translation type="unfinished"></translation>
+        <translation>Area da scaricare dai layer web</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -322,7 +329,14 @@ Reference DSM: a DSM or DTM covering the block, heights in metres (a WCS layer i
 Rough position: the photos&apos; EXIF GPS when at least three carry it (auto), always (EXIF GPS), or never (none: rotation and scale are searched over the whole reference, which then should not be much larger than the block).
 Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos&apos; EXIF GPS positions plus a margin, else the other reference&apos;s extent.
 Outputs: the camera centres in the reference CRS, the number of automatic GCPs the adjustment kept, the matches found; georef/autocontrol.json lists every candidate with why it was kept or dropped.</source>
-        <translation type="unfinished"></translation>
+        <translation>Georeferenzia un blocco allineato senza punti di controllo scelti a mano: un&apos;ortofoto provvisoria del blocco viene abbinata a un&apos;ortofoto di riferimento (un&apos;ortofoto nazionale, l&apos;ortomosaico di un blocco precedente) a una risoluzione comune, ogni corrispondenza viene ritrovata nelle foto e prende la quota dal DSM di riferimento, e questi GCP automatici entrano nella consueta compensazione vincolata ai GCP, che esclude i valori anomali. I cambiamenti tra le due date (colture, auto, nuovi edifici, un altro sole) sono tollerati: si usa ciò che resta, e il registro dice quante corrispondenze hanno superato ogni passo.
+
+Area di lavoro allineata: il blocco da georeferenziare (le sue foto devono trovarsi ancora dove l&apos;allineamento le ha trovate).
+Ortofoto di riferimento: un raster qualsiasi orientato a nord in un SR proiettato, in scala di grigi o a colori; il risultato è nel suo SR. Un layer che non è un file locale (WMS, XYZ, WCS, un raster virtuale) viene salvato per l&apos;estensione del blocco in georef/reference-ortho.tif (uno Web Mercator o geografico nel SR del DSM, altrimenti in quello della zona UTM).
+DSM di riferimento: un DSM o DTM che copre il blocco, quote in metri (un layer WCS viene salvato in georef/reference-dsm.tif).
+Posizione approssimativa: il GPS EXIF delle foto quando almeno tre lo hanno (automatica), sempre (GPS EXIF) o mai (nessuna: rotazione e scala vengono cercate su tutto il riferimento, che allora non dovrebbe essere molto più grande del blocco).
+Risoluzione di riferimento: metri per pixel con cui si salva un layer web (0: 0,25 m; il DSM al doppio, almeno 0,5 m). Area da scaricare: l&apos;estensione per cui si salva un layer web; vuota: le posizioni GPS EXIF delle foto più un margine, altrimenti l&apos;estensione dell&apos;altro riferimento.
+Output: i centri di presa nel SR del riferimento, il numero di GCP automatici mantenuti dalla compensazione, le corrispondenze trovate; georef/autocontrol.json elenca ogni candidato con il motivo per cui è stato mantenuto o scartato.</translation>
     </message>
 </context>
 <context>
@@ -707,47 +721,47 @@ Curve di livello: il GeoPackage da scrivere.</translation>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="36"/>
         <source>Earlier DSM</source>
-        <translation type="unfinished"></translation>
+        <translation>DSM precedente</translation>
     </message>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="36"/>
         <source>Later DSM</source>
-        <translation type="unfinished"></translation>
+        <translation>DSM successivo</translation>
     </message>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="41"/>
         <source>Difference</source>
-        <translation type="unfinished"></translation>
+        <translation>Differenza</translation>
     </message>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="42"/>
         <source>Median difference (m)</source>
-        <translation type="unfinished"></translation>
+        <translation>Mediana della differenza (m)</translation>
     </message>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="43"/>
         <source>Standard deviation of the difference (m)</source>
-        <translation type="unfinished"></translation>
+        <translation>Deviazione standard della differenza (m)</translation>
     </message>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="44"/>
         <source>Cells compared</source>
-        <translation type="unfinished"></translation>
+        <translation>Celle confrontate</translation>
     </message>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="45"/>
         <source>Cells changed by more than 1 m</source>
-        <translation type="unfinished"></translation>
+        <translation>Celle cambiate di più di 1 m</translation>
     </message>
     <message>
         <location filename="../processing_provider/dsm_difference.py" line="55"/>
         <source>{} cells compared: median {:.3f} m, mean {:.3f} m, std {:.3f} m, 5-95 % {:.3f} .. {:.3f} m; {} cells changed by more than {:g} m</source>
-        <translation type="unfinished"></translation>
+        <translation>{} celle confrontate: mediana {:.3f} m, media {:.3f} m, dev. std. {:.3f} m, 5-95 % {:.3f} .. {:.3f} m; {} celle cambiate di più di {:g} m</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
         <source>DSM difference</source>
-        <translation type="unfinished"></translation>
+        <translation>Differenza tra DSM</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -756,7 +770,11 @@ Curve di livello: il GeoPackage da scrivere.</translation>
 Earlier DSM: the DSM the difference is measured from (its grid is the output&apos;s).
 Later DSM: the DSM of the other epoch (e.g. a block registered to the earlier one with Automatic control).
 Difference: where to write the float32 Cloud-Optimized GeoTIFF of later minus earlier (metres).</source>
-        <translation type="unfinished"></translation>
+        <translation>Il DSM successivo meno quello precedente, sulla griglia del precedente, mostra cosa è cambiato tra due epoche di un sito (il DSM successivo vi viene ricampionato con GDAL, bilineare, da qualsiasi SR). Una cella è nodata dove uno dei due DSM non ha dati. Il registro riporta le celle confrontate, mediana, media e deviazione standard della differenza, il 5° e il 95° percentile e le celle cambiate di più di 1 m; una mediana vicina a 0 dice che le due epoche sono registrate l&apos;una sull&apos;altra.
+
+DSM precedente: il DSM da cui si misura la differenza (la sua griglia è quella dell&apos;output).
+DSM successivo: il DSM dell&apos;altra epoca (ad es. un blocco registrato sul precedente con il controllo automatico).
+Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno precedente (metri).</translation>
     </message>
 </context>
 <context>
@@ -1444,67 +1462,67 @@ Difference: where to write the float32 Cloud-Optimized GeoTIFF of later minus ea
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="43"/>
         <source>Automatic control from a reference orthophoto</source>
-        <translation type="unfinished">Punti di controllo automatici da un'ortofoto di riferimento</translation>
+        <translation>Controllo automatico da ortofoto</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="46"/>
         <source>Georeference with no hand-picked GCP: the block is matched to a reference orthophoto and takes its heights from a reference DSM. The points of the table become check points.</source>
-        <translation type="unfinished"></translation>
+        <translation>Georeferenziare senza punti d&apos;appoggio scelti a mano: il blocco viene abbinato a un&apos;ortofoto di riferimento e prende le quote da un DSM di riferimento. I punti della tabella diventano punti di controllo.</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="52"/>
         <source>A reference orthophoto: a raster file, or a WMS / XYZ layer (saved for the block&apos;s extent, from the photos&apos; GPS or the map extent)</source>
-        <translation type="unfinished"></translation>
+        <translation>Un&apos;ortofoto di riferimento: un file raster, o un layer WMS / XYZ (salvato per l&apos;estensione del blocco, dal GPS delle foto o dall&apos;estensione della mappa)</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="52"/>
         <source>A reference DSM or DTM (heights in metres): a raster file or a WCS layer</source>
-        <translation type="unfinished"></translation>
+        <translation>Un DSM o DTM di riferimento (quote in metri): un file raster o un layer WCS</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="61"/>
         <source>Reference orthophoto:</source>
-        <translation type="unfinished"></translation>
+        <translation>Ortofoto di riferimento:</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="62"/>
         <source>Reference DSM:</source>
-        <translation type="unfinished"></translation>
+        <translation>DSM di riferimento:</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="73"/>
         <source>Georeference from the reference orthophoto and DSM (in the background)</source>
-        <translation type="unfinished"></translation>
+        <translation>Georeferenzia dall&apos;ortofoto e dal DSM di riferimento (in background)</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="94"/>
         <source>Automatic control: choose a reference orthophoto and a reference DSM layer</source>
-        <translation type="unfinished"></translation>
+        <translation>Controllo automatico: scegliere un&apos;ortofoto di riferimento e un layer DSM di riferimento</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="115"/>
         <source>Automatic control: {} automatic GCPs kept of {} matches; georeferenced in {}.</source>
-        <translation type="unfinished"></translation>
+        <translation>Controllo automatico: {} GCP automatici mantenuti su {} corrispondenze; georeferenziato in {}.</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="118"/>
         <source>Check points: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</source>
-        <translation type="unfinished"></translation>
+        <translation>Punti di controllo: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="124"/>
         <source>ArchaeoOrtho: automatic control</source>
-        <translation type="unfinished"></translation>
+        <translation>ArchaeoOrtho: controllo automatico</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="128"/>
         <source>Automatic control against {} and {}…</source>
-        <translation type="unfinished"></translation>
+        <translation>Controllo automatico rispetto a {} e {}…</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="140"/>
         <source>Automatic GCPs (residuals)</source>
-        <translation type="unfinished"></translation>
+        <translation>GCP automatici (residui)</translation>
     </message>
 </context>
 <context>
@@ -1818,42 +1836,42 @@ Difference: where to write the float32 Cloud-Optimized GeoTIFF of later minus ea
     <message>
         <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Reference orthophoto</source>
-        <translation type="unfinished">Ortofoto di riferimento</translation>
+        <translation>Ortofoto di riferimento</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Reference DSM</source>
-        <translation type="unfinished">DSM di riferimento</translation>
+        <translation>DSM di riferimento</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Reference resolution for web layers (m, 0: auto)</source>
-        <translation type="unfinished"></translation>
+        <translation>Risoluzione di riferimento per layer web (m, 0: auto)</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="71"/>
         <source>Area to fetch from web layers</source>
-        <translation type="unfinished"></translation>
+        <translation>Area da scaricare dai layer web</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="92"/>
         <source>Automatic GCPs kept</source>
-        <translation type="unfinished">GCP automatici mantenuti</translation>
+        <translation>GCP automatici mantenuti</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="146"/>
         <source>Automatic control needs both a reference orthophoto and a reference DSM (REFERENCE_ORTHO, REFERENCE_DSM); {} is missing</source>
-        <translation type="unfinished"></translation>
+        <translation>Il controllo automatico richiede sia un&apos;ortofoto sia un DSM di riferimento (REFERENCE_ORTHO, REFERENCE_DSM); manca {}</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="159"/>
         <source>Target CRS {} is not used: automatic control georeferences in the reference orthophoto&apos;s CRS {}</source>
-        <translation type="unfinished"></translation>
+        <translation>Il SR di destinazione {} non è usato: il controllo automatico georeferenzia nel SR {} dell&apos;ortofoto di riferimento</translation>
     </message>
     <message>
         <location filename="../processing_provider/georeference.py" line="180"/>
         <source>Automatic control: {} automatic GCPs kept; CRS {}; check RMSE XY {} m, Z {} m</source>
-        <translation type="unfinished"></translation>
+        <translation>Controllo automatico: {} GCP automatici mantenuti; SR {}; RMSE di controllo XY {} m, Z {} m</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1869,7 +1887,18 @@ Outliers (a wrong observation, a typo in a coordinate) are detected, named in th
 Given a reference orthophoto and a reference DSM (any raster layer: a file, or a WMS, XYZ or WCS layer, which is saved for the block&apos;s extent to georef/reference-ortho.tif and georef/reference-dsm.tif), the block is georeferenced with no hand-picked GCP, as &apos;Automatic control from a reference orthophoto&apos; does; the result is in the reference orthophoto&apos;s CRS (a Web Mercator or geographic layer is saved in the DSM&apos;s CRS, else in the UTM zone). Ground control given as well is not used to fix the block: all its points become check points, an independent measure of the automatic control. Camera positions or Use EXIF GPS positions give the rough position (else EXIF GPS when three photos carry it, else rotation and scale are searched). The calibration is refined in any case (focal length and distortion: the automatic GCPs determine them).
 Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos&apos; EXIF GPS positions plus a margin, else the other reference&apos;s extent.
 Outputs: besides the usual ones, the number of automatic GCPs the adjustment kept (none without automatic control).</source>
-        <translation type="unfinished"></translation>
+        <translation>Fissa il blocco allineato in un sistema di riferimento reale con punti d&apos;appoggio (GCP) e/o posizioni delle camere, usati all&apos;interno della compensazione a stelle proiettive in modo che eliminino anche la deriva e la flessione del blocco, cosa che una trasformazione a 7 parametri (Helmert) non può fare. I punti di controllo non partecipano alla compensazione: vengono triangolati in seguito e confrontati con le loro coordinate rilevate.
+
+File dei punti d&apos;appoggio: un gcp_list.txt di OpenDroneMap (riga del SR, poi &apos;x y z px py image [name]&apos;) o un file CSV di punti con il corrispondente &apos;&lt;name&gt;_observations.csv&apos;. Layer dei punti d&apos;appoggio: in alternativa un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, sx, sy, sz, role).
+Punti di controllo: nomi separati da virgole che diventano punti di controllo.
+Posizioni delle camere: CSV &apos;image,x,y,z[,sigma]&apos; (riga del SR facoltativa). Usa le posizioni GPS EXIF: usa il GPS delle foto.
+SR di destinazione: predefinito quello del file dei punti d&apos;appoggio. Affina la calibrazione della camera: la compensazione affina focale, punto principale e distorsione.
+Pixel dei GCP misurati sulle foto raddrizzate: da spuntare quando le coordinate pixel sono state misurate sulle foto mostrate diritte secondo il loro orientamento EXIF, come le mostrano i browser e i visualizzatori di foto; sono convertite nella griglia di pixel memorizzata di ogni foto (le foto memorizzate senza rotazione restano invariate).
+I valori anomali (una misura errata, un errore di battitura in una coordinata) sono individuati, nominati nel registro ed esclusi.
+
+Con un&apos;ortofoto di riferimento e un DSM di riferimento (un layer raster qualsiasi: un file, o un layer WMS, XYZ o WCS, che viene salvato per l&apos;estensione del blocco in georef/reference-ortho.tif e georef/reference-dsm.tif), il blocco viene georeferenziato senza punti d&apos;appoggio scelti a mano, come fa &apos;Punti di controllo automatici da un&apos;ortofoto di riferimento&apos;; il risultato è nel SR dell&apos;ortofoto di riferimento (un layer Web Mercator o geografico viene salvato nel SR del DSM, altrimenti nella zona UTM). I punti d&apos;appoggio forniti in più non fissano il blocco: tutti i loro punti diventano punti di controllo, una misura indipendente del controllo automatico. Posizioni delle camere o Usa le posizioni GPS EXIF danno la posizione approssimativa (altrimenti il GPS EXIF quando tre foto lo hanno, altrimenti si cercano rotazione e scala). La calibrazione viene affinata in ogni caso (focale e distorsione: le determinano i GCP automatici).
+Risoluzione di riferimento: metri per pixel con cui si salva un layer web (0: 0,25 m; il DSM al doppio, almeno 0,5 m). Area da scaricare: l&apos;estensione per cui si salva un layer web; vuota: le posizioni GPS EXIF delle foto più un margine, altrimenti l&apos;estensione dell&apos;altro riferimento.
+Output: oltre ai consueti, il numero di GCP automatici mantenuti dalla compensazione (nessuno senza controllo automatico).</translation>
     </message>
 </context>
 <context>
@@ -1977,17 +2006,17 @@ Outputs: besides the usual ones, the number of automatic GCPs the adjustment kep
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Search radius (m)</source>
-        <translation type="unfinished"></translation>
+        <translation>Raggio di ricerca (m)</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="98"/>
         <source>Automatic GCPs used</source>
-        <translation type="unfinished"></translation>
+        <translation>GCP automatici usati</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="116"/>
         <source>Give ground control points observed in the image (Ground control file or Ground control point layer: GCPS, GCP_LAYER), its Known orientation (ORIENTATION) or a Reference orthophoto for automatic control (REFERENCE_ORTHO)</source>
-        <translation type="unfinished"></translation>
+        <translation>Indicare punti d&apos;appoggio misurati nell&apos;immagine (File dei punti d&apos;appoggio o Layer dei punti d&apos;appoggio: GCPS, GCP_LAYER), il suo orientamento noto (ORIENTATION) o un&apos;ortofoto di riferimento per il controllo automatico (REFERENCE_ORTHO)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -2004,17 +2033,29 @@ Mode: a true orthophoto on the DSM, or a planar (projective) rectification throu
 Resolution: cell size in CRS units (0 = the ground sample distance).
 Output CRS: default the CRS of the GCPs or of the known orientation.
 GCP residuals: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
-        <translation type="unfinished"></translation>
+        <translation>Ortorettifica una fotografia — anche una che non fa parte di alcun blocco, come una singola obliqua o una vecchia stampa — su un DSM esistente, ad esempio un DSM da laser scanning aereo (ALS) in qualsiasi SR (riproiettato al volo).
+
+Posizione e assetto della camera derivano dai punti d&apos;appoggio misurati nella foto (resezione spaziale: almeno 4 punti; un punto errato su 5 o più viene individuato ed escluso; con 6 o più si stimano anche la focale e la distorsione radiale k1 dove i punti le determinano), oppure da un orientamento noto.
+
+Immagine: la foto. DSM: raster delle quote (necessario per un&apos;ortofoto vera).
+File dei punti d&apos;appoggio: un gcp_list.txt di OpenDroneMap o un file CSV di punti con misure in questa immagine; oppure Layer dei punti d&apos;appoggio: un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, role; origine dei pixel nell&apos;angolo in alto a sinistra, y verso il basso).
+Orientamento noto: al posto dei punti d&apos;appoggio, un file con x y z omega phi kappa (gradi, convenzione fotogrammetrica; una riga di intestazione come la scrive Pix4D, o JSON), facoltativamente focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 e una riga del SR.
+Ortofoto di riferimento (controllo automatico): senza punti d&apos;appoggio e senza orientamento noto, la foto viene abbinata a questa ortofoto (qualsiasi SR, qualsiasi risoluzione; il DSM è allora il DSM di riferimento) e le corrispondenze diventano punti d&apos;appoggio automatici (auto_001, ...) per la resezione spaziale: nessun punto scelto a mano, la direzione di presa non deve essere nota, funzionano anche le oblique, e la focale viene stimata quando la foto non ne ha. Posizione approssimativa: un punto sul terreno che la foto mostra (qualsiasi SR; vuoto = ovunque sul riferimento); Raggio di ricerca: quanto può essere lontano (metri). Il registro dice quante corrispondenze hanno superato ogni passo; i residui dei punti d&apos;appoggio elencano i punti d&apos;appoggio automatici.
+Focale e Larghezza del sensore: orientamento interno in mm (il lato lungo del sensore); 0 o vuoto = la focale EXIF.
+Modalità: un&apos;ortofoto vera sul DSM, o un raddrizzamento piano (proiettivo) tramite i punti d&apos;appoggio per confronto su terreno piatto; con un DSM il registro e il risultato &apos;Raddrizzamento piano: 95° percentile del suo scostamento&apos; dicono di quanto il risultato piano si discosta a causa del rilievo.
+Risoluzione: dimensione della cella in unità del SR (0 = il GSD).
+SR di output: predefinito il SR dei punti d&apos;appoggio o dell&apos;orientamento noto.
+Residui dei punti d&apos;appoggio: GeoPackage dei punti d&apos;appoggio con i loro residui in pixel (e in metri sul piano).</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Reference orthophoto</source>
-        <translation type="unfinished">Ortofoto di riferimento</translation>
+        <translation>Ortofoto di riferimento</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="75"/>
         <source>Rough location</source>
-        <translation type="unfinished"></translation>
+        <translation>Posizione approssimativa</translation>
     </message>
 </context>
 <context>
