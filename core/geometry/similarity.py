@@ -129,13 +129,25 @@ def _non_degenerate(p: np.ndarray, min_ratio: float = 1e-3) -> bool:
     return float(np.linalg.norm(np.cross(e1, e2))) > min_ratio * longest ** 2
 
 
+def _draws_needed(inlier_ratio: float, confidence: float, sample: int = 3, floor: int = 50) -> int:
+    """Random minimal samples after which one all-inlier sample has been drawn with ``confidence``:
+    log(1 - confidence) / log(1 - w^sample) (Fischler & Bolles; Hartley & Zisserman 4.7), at least ``floor``."""
+    p = min(max(inlier_ratio, 0.0), 1.0) ** sample
+    if p >= 1.0:
+        return floor
+    if p <= 0.0:
+        return 2 ** 31
+    return max(floor, int(math.ceil(math.log(1.0 - confidence) / math.log(1.0 - p))))
+
+
 def helmert_ransac(src, dst, threshold: float, max_iterations: int = 2000, seed: int = 0,
-                   min_inliers: int = 3, weights=None) -> HelmertResult:
+                   min_inliers: int = 3, weights=None, confidence: float = 0.9999) -> HelmertResult:
     """Robust similarity: RANSAC (MSAC score) over minimal 3-point sets + LO refit on the inliers.
 
     ``threshold`` is the largest 3-D distance (target units) at which a point counts
     as an inlier.  All 3-point sets are tried when there are at most
-    ``max_iterations`` of them, random ones otherwise.
+    ``max_iterations`` of them, random ones otherwise, until one all-inlier set has been drawn
+    with ``confidence`` at the best inlier ratio found so far (at most ``max_iterations``; 1: all of them).
     """
     src = np.asarray(src, dtype=float).reshape(-1, 3)
     dst = np.asarray(dst, dtype=float).reshape(-1, 3)
@@ -152,13 +164,17 @@ def helmert_ransac(src, dst, threshold: float, max_iterations: int = 2000, seed:
         r2 = np.sum((dst - tr.apply(src)) ** 2, axis=1)
         return float(np.minimum(r2, thr2).sum()), r2 < thr2
 
-    if math.comb(n, 3) <= max_iterations:
+    exhaustive = math.comb(n, 3) <= max_iterations
+    if exhaustive:
         samples: Iterable[Tuple[int, ...]] = itertools.combinations(range(n), 3)
     else:
         rng = np.random.default_rng(seed)
         samples = (tuple(rng.choice(n, 3, replace=False)) for _ in range(max_iterations))
     best: Optional[Tuple[float, np.ndarray]] = None
-    for idx in samples:
+    needed = max_iterations
+    for k, idx in enumerate(samples):
+        if k >= needed:
+            break  # random draws: enough for the inlier ratio found so far (the adaptive RANSAC bound)
         sel = list(idx)
         if not (_non_degenerate(src[sel]) and _non_degenerate(dst[sel])):
             continue
@@ -169,6 +185,8 @@ def helmert_ransac(src, dst, threshold: float, max_iterations: int = 2000, seed:
         sc, inl = score(tr)
         if best is None or sc < best[0]:
             best = (sc, inl)
+            if not exhaustive and confidence < 1.0:  # 1: every draw, as before the bound
+                needed = min(max_iterations, _draws_needed(int(inl.sum()) / n, confidence))
     if best is None or best[1].sum() < max(3, min_inliers):
         found = 0 if best is None else int(best[1].sum())
         raise ValueError(f"helmert_ransac: no similarity fits {max(3, min_inliers)} of the {n} points "
