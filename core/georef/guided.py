@@ -408,11 +408,13 @@ def _camera_geometry(rec, name: str):
 def refine_by_matching(rec, ref_image: str, ref_xy: Sequence[float], ref_gray: np.ndarray,
                        tgt_image: str, tgt_xy: Sequence[float], tgt_gray: np.ndarray, xyz_model: Sequence[float],
                        radius: float = 250.0, half: int = 20, min_score: float = 0.6,
-                       min_margin: float = 0.08) -> Optional[Match]:
+                       min_margin: float = 0.08, normal: Optional[Sequence[float]] = None) -> Optional[Match]:
     """Look for the point observed at ``ref_xy`` in ``ref_image`` around its predicted position ``tgt_xy``
     in ``tgt_image``: the reference photo's neighbourhood of the point is re-projected into the target
     photo's geometry through the plane that faces the reference camera at the point's depth (``xyz_model``
-    gives the depth), then searched by normalised cross-correlation within ``radius`` pixels.
+    gives the depth), or through the plane of ``normal`` (model coordinates: the ground's up for obliques, whose
+    views of the ground differ by more than a turn), then searched by normalised cross-correlation within
+    ``radius`` pixels.
 
     Returns the sub-pixel match, or None when it is weak (score < ``min_score``), ambiguous (another peak
     within ``min_margin`` of the best), at the edge of the search window, or out of the image.
@@ -428,7 +430,10 @@ def refine_by_matching(rec, ref_image: str, ref_xy: Sequence[float], ref_gray: n
         return None
     ray = np.r_[np.asarray(cam_r.cam_from_img(np.asarray(ref_xy, dtype=float).reshape(1, 2))).reshape(2), 1.0]
     x0 = c_r + depth * (rot_r.T @ ray)  # the observed point at the predicted depth
-    normal = rot_r.T @ np.array([0.0, 0.0, 1.0])  # plane facing the reference camera
+    if normal is None:
+        normal = rot_r.T @ np.array([0.0, 0.0, 1.0])  # plane facing the reference camera
+    else:
+        normal = np.asarray(normal, dtype=float) / max(float(np.linalg.norm(normal)), 1e-12)
     p0 = project_point(rec, x0, [tgt_image], margin=-1e9)  # no frame test: the window is checked below
     if tgt_image not in p0:
         return None

@@ -88,6 +88,9 @@ def tie_back(rec, frame: Frame, prov: ProvisionalOrtho, src: np.ndarray, world_x
     progress = progress or NullProgress()
     g = prov.res
     to_model = frame.model_to_frame.inverse()
+    # the patches are re-projected through the ground's plane (the frame's up in the model), not the one facing
+    # the first photo: the same for vertical photos, and what lets obliques seen from other sides match
+    up = frame.model_to_frame.rotation.T @ np.array([0.0, 0.0, 1.0]) if opt.ground_plane else None
     lookup = {im.name: im for im in registered(rec)}
     grey = _Photos(photos)
     dsm_sigma = opt.dsm_sigma if opt.dsm_sigma is not None else reference.dsm_gsd
@@ -115,11 +118,12 @@ def tie_back(rec, frame: Frame, prov: ProvisionalOrtho, src: np.ndarray, world_x
             continue
         x, y = prov.frame_xy(col, row)
         p_model = to_model.apply(np.array([[float(x), float(y), float(prov.surface.sample(x, y))]]))[0]
-        _observe(rec, c, prov.names[k], p_model, lookup, grey, opt)
+        _observe(rec, c, prov.names[k], p_model, lookup, grey, opt, up)
     return out
 
 
-def _observe(rec, c: Candidate, first: str, p_model: np.ndarray, lookup, grey: _Photos, opt) -> None:
+def _observe(rec, c: Candidate, first: str, p_model: np.ndarray, lookup, grey: _Photos, opt,
+             up: Optional[np.ndarray] = None) -> None:
     """The candidate's observations: its pixel in the photo the orthophoto took it from, then the matches in
     the other photos; triangulated in the model (``c.model_xyz``) or dropped."""
     px, inside, _ = project(rec, lookup[first], p_model[None])
@@ -137,7 +141,8 @@ def _observe(rec, c: Candidate, first: str, p_model: np.ndarray, lookup, grey: _
         if not ok[0]:
             continue
         m = refine_by_matching(rec, first, u0, grey[first], name, (float(pj[0, 0]), float(pj[0, 1])), grey[name],
-                               p_model, radius=opt.search_px, half=opt.template_half, min_score=opt.min_score)
+                               p_model, radius=opt.search_px, half=opt.template_half, min_score=opt.min_score,
+                               normal=up)
         if m is not None:
             obs.append(Observation(name, m.x, m.y))
             scores.append(m.score)

@@ -16,6 +16,7 @@ class AutoControlOptions:
     ``tile_px``, ``tile_ransac_px``: the per-tile affine refinement; ``max_candidates``: matches tied back to
     the photos (the best of a grid over the block); ``search_px``: how far a point is searched in the other
     photos around its prediction through the model; ``min_score``: their normalised cross-correlation;
+    ``ground_plane``: the patches compared through the ground's plane (else the plane facing the first photo);
     ``max_relief``: metres of DSM relief within the point's neighbourhood beyond which its height is not
     trusted (walls, trees, roof edges); ``dsm_sigma``: metres (None: the DSM's cell size); ``rotations``:
     degrees tried when there is no prior (the features are rotation invariant; these help at a coarse level), until
@@ -36,6 +37,7 @@ class AutoControlOptions:
     search_px: float = 25.0
     template_half: int = 15
     min_score: float = 0.7
+    ground_plane: bool = True
     max_triangulation_px: float = 2.0
     max_relief: float = 0.6
     dsm_sigma: Optional[float] = None
