@@ -26,14 +26,19 @@ class OrthoCamera:
     mask_path: Optional[str] = None
     max_gsd: Optional[float] = None  # ground points this image resolves coarser than this (m/px) are not used
 
-    def ground_resolution(self, xyz_local: np.ndarray) -> np.ndarray:
+    def ground_resolution(self, xyz_local: np.ndarray, projected: Optional[Tuple[np.ndarray, np.ndarray]] = None
+                          ) -> np.ndarray:
         """Ground sample distance (N,) of this image at local points (N, 3): metres of level ground per pixel in
         the worst direction (1 / the smallest singular value of d pixel / d (x, y)), by finite differences through
-        the full camera model; inf where a point does not project."""
+        the full camera model; inf where a point does not project.  ``projected``: (pixels, depth) of the points
+        from :meth:`project` where the caller has them (points that project: saves one projection)."""
         xyz = np.atleast_2d(np.asarray(xyz_local, dtype=float))
-        depth = np.maximum(self.pose.to_camera(xyz)[..., 2], 1e-6)
+        if projected is None:
+            p0, depth, ok0 = self.project(xyz)
+        else:
+            (p0, depth), ok0 = projected, True
+        depth = np.maximum(depth, 1e-6)
         h = (depth / max(self.camera.focal, 1e-9))[:, None]  # about one pixel on the ground
-        p0, _, ok0 = self.project(xyz)
         px, _, okx = self.project(xyz + h * np.array([1.0, 0.0, 0.0]))
         py, _, oky = self.project(xyz + h * np.array([0.0, 1.0, 0.0]))
         a, c = (px - p0).T / h[:, 0]

@@ -93,10 +93,14 @@ def hot_spot_shape(rays: np.ndarray, antisolar: Sequence[float], width: float) -
     return np.exp(-0.5 * (theta / width) ** 2)
 
 
-def observation_geometry(cam: OrthoCamera, xyz_local: np.ndarray):
+def observation_geometry(cam: OrthoCamera, xyz_local: np.ndarray, px: Optional[np.ndarray] = None):
     """(ok, r, u, v, unit rays) of local ground points in one image: r from the principal point / the half
-    diagonal, u and v from the image centre / the half width and height (-1..1)."""
-    px, _depth, ok = cam.project(xyz_local)
+    diagonal, u and v from the image centre / the half width and height (-1..1).  ``px``: the points' pixels
+    where the caller has projected them already (ok is then all true)."""
+    if px is None:
+        px, _depth, ok = cam.project(xyz_local)
+    else:
+        ok = np.ones(len(px), dtype=bool)
     w, h = cam.camera.width, cam.camera.height
     r = np.hypot(px[:, 0] - cam.camera.cx, px[:, 1] - cam.camera.cy) / (0.5 * math.hypot(w, h))
     u = (px[:, 0] - 0.5 * w) / (0.5 * w)
@@ -107,9 +111,11 @@ def observation_geometry(cam: OrthoCamera, xyz_local: np.ndarray):
 
 
 def point_gains(model: Optional[RadiometryModel], gain: float, index: int, cam: OrthoCamera,
-                offset: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, valid: np.ndarray) -> np.ndarray:
+                offset: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, valid: np.ndarray,
+                projected: Optional[Tuple[np.ndarray, np.ndarray]] = None) -> np.ndarray:
     """(N, 1) float32 factors of world points (x, y, z) of image ``index`` in the mosaic: the radiometric
-    correction where ``valid`` (1 elsewhere), or the scalar exposure ``gain`` without a model."""
+    correction where ``valid`` (1 elsewhere), or the scalar exposure ``gain`` without a model.  ``projected``:
+    (local points (N, 3), their pixels (N, 2)) where the caller has them (Sampled.xyz, Sampled.px)."""
     n = len(x)
     if model is None:
         return np.full((n, 1), gain, dtype=np.float32)
@@ -117,8 +123,12 @@ def point_gains(model: Optional[RadiometryModel], gain: float, index: int, cam: 
     idx = np.flatnonzero(valid)
     if not len(idx):
         return out
-    xyz = np.column_stack([x[idx] - offset[0], y[idx] - offset[1], np.nan_to_num(z[idx]) - offset[2]])
-    _ok, r, u, v, rays = observation_geometry(cam, xyz)
+    if projected is not None:
+        xyz, px = projected[0][idx], projected[1][idx]
+    else:
+        xyz = np.column_stack([x[idx] - offset[0], y[idx] - offset[1], np.nan_to_num(z[idx]) - offset[2]])
+        px = None
+    _ok, r, u, v, rays = observation_geometry(cam, xyz, px)
     out[idx, 0] = model.correction(np.full(len(idx), index), r, u, v, rays)
     return out
 

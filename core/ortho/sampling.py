@@ -18,6 +18,8 @@ class Sampled:
     values: np.ndarray  # (N, bands) float32 (only rows where valid are meaningful)
     valid: np.ndarray  # (N,) bool
     cost: np.ndarray  # (N,) float32, inf where not valid
+    xyz: Optional[np.ndarray] = None  # (N, 3) the points in the local frame (height 0 where it is not finite)
+    px: Optional[np.ndarray] = None  # (N, 2) their pixels (meaningful where valid)
 
 
 def sample_camera(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.ndarray, y: np.ndarray,
@@ -27,14 +29,14 @@ def sample_camera(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.n
     n = x.size
     finite = np.isfinite(z)
     xyz = np.column_stack([x - offset[0], y - offset[1], np.where(finite, z, 0.0) - offset[2]])
-    px, _depth, ok = cam.project(xyz)
+    px, depth, ok = cam.project(xyz)
     ok &= finite
     if vis is not None and ok.any():
         idx = np.flatnonzero(ok)
         ok[idx] = vis.visible(x[idx], y[idx], z[idx], _table(vis))
     if cam.max_gsd and ok.any():  # the stretched far field of an oblique: left to the images that see it nearer
         idx = np.flatnonzero(ok)
-        ok[idx] = cam.ground_resolution(xyz[idx]) <= cam.max_gsd
+        ok[idx] = cam.ground_resolution(xyz[idx], (px[idx], depth[idx])) <= cam.max_gsd
     mask = _mask(cam.mask_path)
     if mask is not None and ok.any():
         idx = np.flatnonzero(ok)
@@ -44,7 +46,7 @@ def sample_camera(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.n
     cost = np.full(n, np.inf, dtype=np.float32)
     values = np.zeros((n, meta.bands), dtype=np.float32)
     if not ok.any():
-        return Sampled(values, ok, cost)
+        return Sampled(values, ok, cost, xyz, px)
     idx = np.flatnonzero(ok)
     c = cam.centre
     dxy = np.hypot(xyz[idx, 0] - c[0], xyz[idx, 1] - c[1])
@@ -62,4 +64,4 @@ def sample_camera(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.n
         y1 = min(meta.height, int(math.ceil(v.max())) + pad + 1)
         win = _image_window(cam.path, meta, x0, y0, x1, y1)
         values[idx] = _remap(win, u - x0, v - y0, interpolation)
-    return Sampled(values, ok, cost)
+    return Sampled(values, ok, cost, xyz, px)

@@ -96,18 +96,12 @@ def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str
 
     acc = np.zeros((hh * ww, bands), dtype=np.float64) if unit.blending != "multiband" else None
     wsum = np.zeros(hh * ww, dtype=np.float64)
-    any_valid = np.zeros(hh * ww, dtype=bool)
-    best_cost = np.full(hh * ww, np.inf, dtype=np.float32)
     layers = []  # multiband: (values, weight)
     counts: Dict[int, int] = {}
     for ci in unit.primary:
         if cancel_path and os.path.exists(cancel_path):
             raise Cancelled("cancelled by the user")
         cam = unit.cameras[ci]
-        s = sample_camera(cam, unit.metas[ci], off, x, y, z, unit.visibility[ci], unit.interpolation)
-        if not s.valid.any():
-            continue
-        vals = s.values * point_gains(unit.radiometry, unit.gains[ci], ci, cam, off, x, y, z, s.valid)
         if unit.blending == "feather" and unit.feather_cells > 0:
             onehot = (lab == ci).astype(np.float32)
             ksz = 2 * unit.feather_cells + 1
@@ -115,22 +109,35 @@ def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str
             wgt = cv2.remap(soft, map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE).ravel()
         else:
             wgt = (hard == ci).astype(np.float32).ravel()
-        wgt = np.where(s.valid, wgt, 0.0)
-        any_valid |= s.valid
-        better = s.cost < best_cost
-        best_cost[better] = s.cost[better]
-        if unit.blending == "multiband":
+        if unit.blending == "multiband":  # the pyramids see the whole image (push-pull fills its holes)
+            s = sample_camera(cam, unit.metas[ci], off, x, y, z, unit.visibility[ci], unit.interpolation)
+            if not s.valid.any():
+                continue
+            vals = s.values * point_gains(unit.radiometry, unit.gains[ci], ci, cam, off, x, y, z, s.valid)
+            wgt = np.where(s.valid, wgt, 0.0)
             layers.append((vals, s.valid, wgt))
-        else:
-            acc += vals * wgt[:, None]
-        wsum += wgt
+            wsum += wgt
+            continue
+        # feather / none: only the cells this image weighs in on (its label's cells and the feathering ramp)
+        sel = np.flatnonzero(wgt > 0)
+        if not len(sel):
+            continue
+        s = sample_camera(cam, unit.metas[ci], off, x[sel], y[sel], z[sel], unit.visibility[ci], unit.interpolation)
+        if not s.valid.any():
+            continue
+        sel, vals = sel[s.valid], s.values[s.valid]
+        w_sel = wgt[sel]
+        vals = vals * point_gains(unit.radiometry, unit.gains[ci], ci, cam, off, x[sel], y[sel], z[sel],
+                                  np.ones(len(sel), bool), (s.xyz[s.valid], s.px[s.valid]))
+        acc[sel] += vals * w_sel[:, None]
+        wsum[sel] += w_sel
     # cells whose planned image cannot see them: the best image that does (primary first, then the others)
     need = wsum <= 1e-6
     fill_vals = np.zeros((hh * ww, bands), dtype=np.float32)
     fill_cost = np.full(hh * ww, np.inf, dtype=np.float32)
     if need.any():
         order = list(unit.primary) + list(unit.secondary)
-        idx = np.flatnonzero(need)
+        idx = np.flatnonzero(need & np.isfinite(z))  # no height: no image can give the cell a value
         for ci in order:
             if not len(idx):
                 break
