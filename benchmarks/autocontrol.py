@@ -37,6 +37,19 @@ refining the FC300X's calibration (10 photos self-calibrated alone) the median w
 (reference rebuilt from the tree of that day, 519 s): 571 matches, 264 / 189, 41 kept, camera centres median
 1.87 m, max 3.94 m, autocontrol 16-24 CPU s; the same (1.86 / 3.94 m) with the ground-plane patches and the
 RANSAC bound of that day turned off on the same workspaces, so the change comes from the reference or alignment.
+Diagnosis (2 Dec): the error is a common shift (+1.52, +1.10 m; 0.82 m median around it) and a 5 % stretch along
+the strips, not the reference nor the truth: the 57 photos aligned together and georeferenced by EXIF GPS put the
+FC300X cameras 0.79 m median, mean (-0.08, -0.01) m off the file (an along-track GPS lag, +-0.8 m by strip), and the
+reference's FC350 cameras 0.29 m off that block.  The FC300X photos self-calibrated alone take f 730 px, k2 0
+(the joint block: 703.5 px, k2 0.018; a tie-point-only bundle from there settles at 690 px with a lower cost), so
+the block sits 18.6 m too high and bowed (the automatic GCPs' dZ a bowl of 0.00018 m^-1, RMS 0.52 m); the
+adjustment with focal + distortion refined leaves them as they are (focal unchanged after 50 or 400 iterations:
+``core.georef.bundle``'s damping floor is 1e-9 of the largest diagonal, a ridge on the weak parameters; per
+column it converges in 36 iterations without intrinsics, 1.79 -> 1.54 m; with them it still creeps, 1.87 -> 1.46 m
+after 200).  With the joint block's FC300X calibration held fixed the same 41 automatic GCPs give median 0.89 m,
+max 1.95 m, GCP RMSE Z 0.22 m.  The FC300X self-calibration also changes from one alignment to the next: a rerun on the same tree and reference
+aligned them at f 691.4 px: 578 matches, 294 / 205, 37 kept, median 1.05 m, max 2.89 m (mean +0.64, +0.79 m,
+0.76 m around it, the same stretch along the strips); autocontrol 18 CPU s.
 """
 import argparse
 import json
@@ -269,12 +282,13 @@ def main():
     seconds = time.time() - t
     rec, tr = Layout(Workspace.open(ws)).load_georef_model()
     truth = true_centres()
-    errs = []
+    errs, vecs = [], {}
     for im in rec.images.values():
         m = np.asarray(im.cam_from_world().matrix())
         c = -m[:, :3].T @ m[:, 3] + np.asarray(tr["offset"], dtype=float)
         if im.name in truth:
-            errs.append(float(np.hypot(c[0] - truth[im.name][0], c[1] - truth[im.name][1])))
+            vecs[im.name] = (c[0] - truth[im.name][0], c[1] - truth[im.name][1], c[2])
+            errs.append(float(np.hypot(*vecs[im.name][:2])))
     f = r.georef.figures
     print(json.dumps({"prior": a.prior, "autocontrol_seconds": round(seconds, 1),
                       "autocontrol_cpu_s": round(c1.user + c1.system - c0.user - c0.system, 1), "timings": r.timings,
@@ -282,6 +296,13 @@ def main():
                       "camera_xy_error_median_m": float(np.median(errs)) if errs else None,
                       "camera_xy_error_max_m": float(np.max(errs)) if errs else None, "cameras": len(errs)},
                      indent=1))
+    if vecs:  # the error's pattern: a common shift, and what is left around it
+        d = np.array([v[:2] for v in vecs.values()])
+        focal = ", ".join(f"{cam.mean_focal_length():.1f}" for cam in rec.cameras.values())
+        print(f"camera errors: mean ({d[:, 0].mean():+.2f}, {d[:, 1].mean():+.2f}) m, around it median "
+              f"{np.median(np.hypot(*(d - d.mean(axis=0)).T)):.2f} m; focal length {focal} px")
+        for n in sorted(vecs):
+            print(f"  {n}: dx {vecs[n][0]:+.2f} m, dy {vecs[n][1]:+.2f} m, camera Z {vecs[n][2]:.1f} m")
     for m in r.messages:
         print("  ", m)
 
