@@ -9,7 +9,7 @@ from typing import Any, Optional, Tuple
 import numpy as np
 
 from ..common.errors import require
-from .options import OrthoError
+from .options import OrthoError, OrthoOptions
 
 
 class _LRU:
@@ -37,7 +37,7 @@ class _LRU:
         self.size = 0
 
 
-_CACHE = _LRU(256 << 20)
+_CACHE = _LRU(OrthoOptions.cache_mb << 20)  # each stage sets its options.cache_mb
 _WHOLE_IMAGE_MAX = 96 << 20  # images up to this size are decoded whole and cached; larger ones read by window
 
 
