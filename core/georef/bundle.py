@@ -118,6 +118,26 @@ def outside_image(camera, ob: Observation) -> bool:
     return not (0.0 <= float(ob.x) <= w and 0.0 <= float(ob.y) <= h)
 
 
+FIELD_MARGIN = 1.25
+
+
+def field_radius(camera, margin: float = FIELD_MARGIN) -> float:
+    """The largest normalised image-plane radius (x/z, y/z) an observation of ``camera`` may have: the image
+    corners' undistorted radius times ``margin``.  A polynomial distortion model turns back on itself beyond
+    its range, so a point far outside the field of view (one triangulated close to the camera's plane) can
+    reproject into the image; such an observation's distortion derivatives grow with r^5 and freeze the
+    distortion parameters.  Infinite for a camera without a size."""
+    w, h = float(camera.width), float(camera.height)
+    if w <= 0 or h <= 0:
+        return float("inf")
+    corners = np.array([[0.0, 0.0], [w, 0.0], [0.0, h], [w, h], [w / 2, 0.0], [0.0, h / 2], [w, h / 2],
+                        [w / 2, h]])
+    xy = np.asarray(camera.cam_from_img(corners), dtype=float)
+    r = np.hypot(xy[:, 0], xy[:, 1])
+    r = r[np.isfinite(r)]
+    return float(margin * r.max()) if len(r) else float("inf")
+
+
 @dataclass
 class Observations:
     """Observation arrays of the adjustment (one row per 2-D observation)."""
@@ -148,7 +168,7 @@ class BundleProblem:
 
     def __init__(self, frames_r, frames_c, img_frame, img_cam, img_rs, img_ts, cameras, cam_free,
                  points, obs: Observations, point_prior, point_prior_sigma, cam_prior_img, cam_prior_xyz,
-                 cam_prior_sigma, huber_px: float = 2.0):
+                 cam_prior_sigma, huber_px: float = 2.0, focal_prior: float = 0.0):
         self.R = np.asarray(frames_r, dtype=float).copy()  # (F,3,3) rig_from_world rotation
         self.C = np.asarray(frames_c, dtype=float).copy()  # (F,3) rig centre in world
         self.img_frame = np.asarray(img_frame, dtype=int)
@@ -173,6 +193,23 @@ class BundleProblem:
         self.nc = 6 * self.nf + int(self.intr_offset[-1])
         self.npt = len(self.X)
         self.iterations = 0
+        self.field = np.array([field_radius(c) for c in cameras], dtype=float)  # per camera, see field_radius
+        # a prior on each free focal length parameter: its starting value (the alignment's self-calibration),
+        # sigma = focal_prior x that value (0: none).  On flat ground the focal length and the flying height
+        # trade against each other almost freely; the prior keeps the calibration where nothing in the data
+        # says otherwise instead of letting it wander along that valley
+        self.fp_col, self.fp_value, self.fp_sigma = [], [], []
+        if focal_prior > 0:
+            for k, cam in enumerate(self.cameras):
+                fidx = set(int(i) for i in cam.focal_length_idxs())
+                for j, idx in enumerate(self.cam_free[k]):
+                    if int(idx) in fidx:
+                        v = float(cam.params[idx])
+                        self.fp_col.append((k, j, int(idx)))
+                        self.fp_value.append(v)
+                        self.fp_sigma.append(focal_prior * abs(v))
+        self.fp_value = np.asarray(self.fp_value, dtype=float)
+        self.fp_sigma = np.asarray(self.fp_sigma, dtype=float)
 
     # --- state -------------------------------------------------------------
     def state(self):
@@ -204,6 +241,13 @@ class BundleProblem:
         xc = np.einsum("nij,nj->ni", self.Rs[img], xr) + self.ts[img]
         return img, f, xr, xc
 
+    def _in_field(self, img: np.ndarray, xc: np.ndarray) -> np.ndarray:
+        """In front of the camera and inside its field of view (``field_radius``)."""
+        z = xc[:, 2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = np.hypot(xc[:, 0], xc[:, 1]) / z
+        return (z > 0) & (r <= self.field[self.img_cam[img]])
+
     def reprojection(self, sel: Optional[np.ndarray] = None) -> Tuple[np.ndarray, np.ndarray]:
         """Pixel residual vectors (M,2) of the selected observations, and whether in front."""
         o = self.obs
@@ -215,7 +259,7 @@ class BundleProblem:
             m = cams == k
             if np.any(m):
                 uv[m] = project(cam, xc[m])
-        return uv - o.xy[sel], xc[:, 2] > 0
+        return uv - o.xy[sel], self._in_field(img, xc)
 
     def camera_centres(self) -> np.ndarray:
         """Projection centres (per image) in world."""
@@ -229,6 +273,12 @@ class BundleProblem:
     def camera_prior_residuals(self) -> np.ndarray:
         idx = np.flatnonzero(self.cp_active)
         return (self.camera_centres()[self.cp_img[idx]] - self.cp_xyz[idx]) / self.cp_sigma[idx]
+
+    def focal_prior_residuals(self) -> np.ndarray:
+        if not len(self.fp_col):
+            return np.zeros(0)
+        now = np.array([self.cameras[k].params[idx] for k, _, idx in self.fp_col], dtype=float)
+        return (now - self.fp_value) / self.fp_sigma
 
     def _huber_weights(self, s: np.ndarray, robust: np.ndarray) -> np.ndarray:
         return huber_weights(s, robust, self.huber)
@@ -245,6 +295,7 @@ class BundleProblem:
         c = float(rho.sum())
         c += float(np.sum(self.point_prior_residuals() ** 2))
         c += float(np.sum(self.camera_prior_residuals() ** 2))
+        c += float(np.sum(self.focal_prior_residuals() ** 2))
         return 0.5 * c
 
     # --- linear system ------------------------------------------------------
@@ -264,7 +315,7 @@ class BundleProblem:
                 uv[mk] = project(cam, xc[mk])
                 jpi[mk] = project_jacobian(cam, xc[mk])
         res = uv - o.xy[sel]
-        front = (xc[:, 2] > 0) & np.all(np.isfinite(res), axis=1) & np.all(np.isfinite(jpi), axis=(1, 2))
+        front = self._in_field(img, xc) & np.all(np.isfinite(res), axis=1) & np.all(np.isfinite(jpi), axis=(1, 2))
         s = np.linalg.norm(np.where(front[:, None], res, 0.0), axis=1) / o.sigma[sel]
         sw = np.sqrt(self._huber_weights(s, o.robust[sel])) / o.sigma[sel] * front
         res = np.where(front[:, None], res, 0.0) * sw[:, None]
@@ -328,6 +379,13 @@ class BundleProblem:
                 vals_r.append(inv_s[:, a])
             r_all.append(rc.reshape(-1))
             nrow += 3 * len(cidx)
+        # focal length priors
+        if len(self.fp_col):
+            rows_r.append(nrow + np.arange(len(self.fp_col)))
+            cols_r.append(np.array([6 * self.nf + self.intr_offset[k] + j for k, j, _ in self.fp_col]))
+            vals_r.append(1.0 / self.fp_sigma)
+            r_all.append(self.focal_prior_residuals())
+            nrow += len(self.fp_col)
         jac = sp.csr_matrix((np.concatenate(vals_r), (np.concatenate(rows_r), np.concatenate(cols_r))),
                             shape=(nrow, self.nc + 3 * self.npt))
         return jac, np.concatenate(r_all)
@@ -358,8 +416,11 @@ class BundleProblem:
         rhs = -gc + w_vinv @ gp
         hcc = h[:nc, :nc]
         dcc = hcc.diagonal()
-        fl = 1e-9 * max(float(dcc.max()), 1e-12)
-        damp = lam * np.maximum(dcc, fl) + fl
+        # Marquardt damping on each column's own diagonal, with a floor relative to that column: the camera
+        # unknowns mix radians, metres, pixels and distortion coefficients, and a floor relative to the largest
+        # diagonal (a rotation's) put a ridge on the weak ones (focal length, k2) that held them for hundreds of
+        # iterations
+        damp = (lam + 1e-9) * np.maximum(dcc, 1e-12 * max(float(dcc.max()), 1e-12))
         schur = (hcc - w_vinv @ hcp.T).tocsr() + sp.diags(damp)
         if nc <= self.DENSE_MAX:
             sd = schur.toarray()
@@ -594,7 +655,7 @@ def _camera_priors(images: _Images, cam_pos, offset):
 
 def build_problem(rec, lookup, ba_points, tri, cam_pos, offset, model_to_local, groups, gcp_pixel_sigma,
                   tie_pixel_sigma, huber_px, max_observations, min_intrinsics_images, warn: Callable[[str], None],
-                  progress=None):
+                  progress=None, focal_prior: float = 0.0):
     """The adjustment of ``rec`` (local frame) with the control points ``ba_points`` (their model-frame
     triangulations ``tri``) and the camera positions ``cam_pos``.  Returns the problem, the tie point ids
     (rows of ``prob.X``), each control point's row and observation rows, and figures of the problem."""
@@ -613,7 +674,7 @@ def build_problem(rec, lookup, ba_points, tri, cam_pos, offset, model_to_local, 
     prob = BundleProblem(np.asarray(images.frames_r).reshape(-1, 3, 3), np.asarray(images.frames_c).reshape(-1, 3),
                          images.img_frame, images.img_cam, np.asarray(images.img_rs).reshape(-1, 3, 3),
                          np.asarray(images.img_ts).reshape(-1, 3), cameras, cam_free, np.asarray(xyz).reshape(-1, 3),
-                         obs, prior, prior_s, cp_img, cp_xyz, cp_sig, huber_px)
+                         obs, prior, prior_s, cp_img, cp_xyz, cp_sig, huber_px, focal_prior=focal_prior)
     prob.cam_pos_images = [cp.image for cp, _ in cam_pos]
     info = {"images": len(images.reg_ids), "frames": len(images.frame_ids), "cameras": len(images.camera_ids),
             "tie_points_total": len(tracks), "tie_observations_total": total_obs,

@@ -19,7 +19,9 @@ class GeorefOptions:
 
     ``refine_intrinsics``: False; True (focal + distortion); "all" (also the principal point); or a subset of
     ("focal", "principal_point", "extra").  ``outlier_threshold``: pixels; ``outlier_sigma``: normalised
-    coordinate residual; ``helmert_threshold``: metres (None: from the point spread and sigmas)."""
+    coordinate residual; ``helmert_threshold``: metres (None: from the point spread and sigmas).
+    ``focal_prior``: where the focal length is refined, the standard deviation of a prior on it at the
+    alignment's value, relative to that value (0.01: 1 %; 0: none)."""
 
     refine_intrinsics: Any = False
     outlier_threshold: float = 5.0
@@ -36,6 +38,7 @@ class GeorefOptions:
     crs: Optional[str] = None
     copy_model: bool = True
     placeholder_sigma_z: float = PLACEHOLDER_SIGMA_Z
+    focal_prior: float = 0.01
 
     @classmethod
     def of(cls, options: Optional["GeorefOptions"] = None, **kwargs: Any) -> "GeorefOptions":
