@@ -23,6 +23,7 @@ from ..common.progress import NullProgress, Progress, check_cancel
 from ..io.raster import SOURCE_INTERPOLATED, SOURCE_MEASURED, Grid, push_pull
 
 TILE = 1024  # cells per tile side for rasterisation
+Z_QUANTUM = 1e-4  # cell_statistic's height step, of the cluster tolerance
 
 
 @dataclass
@@ -56,25 +57,34 @@ def footprint_valid_fraction(dsm: np.ndarray, mask: np.ndarray) -> Optional[floa
 def cell_statistic(cells: np.ndarray, z: np.ndarray, n_cells: int, cluster_tol: float,
                    upper_quantile: float = 0.9) -> Tuple[np.ndarray, np.ndarray]:
     """Per cell: (value, count), value = median of the points within ``cluster_tol`` below the
-    cell's ``upper_quantile`` height (the highest cluster).  NaN where a cell has no point."""
+    cell's ``upper_quantile`` height (the highest cluster).  NaN where a cell has no point.
+
+    The points are ordered by (cell, height) with one sort of 64-bit integers: the cell in the high bits, the
+    height above the lowest one in steps of Z_QUANTUM x ``cluster_tol`` (or finer: 2^31 steps over the heights)
+    in the low 32 (a lexsort of two keys costs 4-5 times as much); heights come back within half a step."""
     value = np.full(n_cells, np.nan, dtype=np.float32)
     count = np.zeros(n_cells, dtype=np.int32)
     if len(z) == 0:
         return value, count
-    order = np.lexsort((z, cells))
-    c = cells[order]
-    zs = z[order].astype(np.float64)
+    z = np.asarray(z, dtype=np.float64)
+    zmin = float(z.min())
+    span = float(z.max()) - zmin
+    step = max(span / 2.0 ** 31, Z_QUANTUM * cluster_tol) if cluster_tol > 0 else span / 2.0 ** 31
+    step = step if step > 0 else 1.0
+    key = np.asarray(cells, dtype=np.int64) << 32
+    key |= np.round((z - zmin) / step).astype(np.int64)
+    key.sort()
+    c = key >> 32
+    zs = (key & 0xFFFFFFFF).astype(np.float64) * step + zmin
     starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
     ends = np.r_[starts[1:], len(c)]
     n = ends - starts
     ucell = c[starts]
     q_idx = starts + np.floor((n - 1) * upper_quantile).astype(np.int64)
     q = zs[q_idx]
-    # first index in each cell with z >= q - tol: search on a key that is sorted by (cell, z)
-    zmin = zs.min()
-    span = zs.max() - zmin + 2 * cluster_tol + 1.0
-    key = (np.arange(len(starts)).repeat(n) * span) + (zs - zmin)
-    first = np.searchsorted(key, np.arange(len(starts)) * span + (q - cluster_tol - zmin), side="left")
+    # first index in each cell with z >= q - tol: on the sorted keys (cell, height step)
+    low = np.maximum(np.ceil((q - cluster_tol - zmin) / step - 1e-9), 0).astype(np.int64)
+    first = np.searchsorted(key, (ucell << 32) | low, side="left")
     first = np.clip(first, starts, q_idx)
     last = np.maximum(q_idx, first)  # include up to the quantile point (higher ones are outlier candidates)
     mid_lo = (first + last) // 2
