@@ -120,6 +120,50 @@ def test_fusion_keeps_what_two_pairs_confirm():
     assert fused[3, 3] == pytest.approx(50.0125, abs=1e-3) and n[3, 3] == 4
 
 
+def test_the_quick_horizon_test_never_skips_a_mask_that_drops_pixels():
+    """_all_below_horizon lets fusion skip the full-size horizon mask: it may say so only where that mask keeps
+    every pixel (a sweep of tilts from nadir to past the horizon, the camera rolled too)."""
+    from core.prepare.sky import horizon_keep
+
+    quick_true = 0
+    for tilt in np.arange(0.0, 95.0, 2.5):
+        for roll in (0.0, 20.0):
+            t, r = np.radians(tilt), np.radians(roll)
+            # nadir camera (looking down -z, image y towards -y), tilted about the world x axis, rolled about its axis
+            nadir = np.array([[1.0, 0, 0], [0, -1.0, 0], [0, 0, -1.0]])
+            rx = np.array([[1, 0, 0], [0, np.cos(t), -np.sin(t)], [0, np.sin(t), np.cos(t)]])
+            rz = np.array([[np.cos(r), -np.sin(r), 0], [np.sin(r), np.cos(r), 0], [0, 0, 1]])
+            rot = rz @ nadir @ rx.T
+            v = View(1, "a.jpg", "", CAMERA.width, CAMERA.height, "OPENCV", tuple(CAMERA.params), rot, np.zeros(3))
+            full = horizon_keep(v.camera, rot, (0.0, 0.0, 1.0), 1.0)
+            quick = fusion._all_below_horizon(v, 1.0)
+            assert not quick or full.all(), (tilt, roll)
+            quick_true += quick
+            if tilt == 0.0:
+                assert quick  # a vertical photo skips the mask
+            if tilt >= 70.0:
+                assert not full.all() and not quick  # its view (half field 25 degrees) reaches the horizon
+    assert quick_true >= 8
+
+
+def test_pair_depth_maps_round_trip_within_their_uint16_steps(tmp_path):
+    rng = np.random.default_rng(3)
+    m = rng.uniform(20.0, 400.0, (30, 40)).astype(np.float32)
+    m[5:9, 3:30] = np.nan
+    m[0, 0] = 0.01  # a depth far below the others keeps its absolute precision
+    path = str(tmp_path / "1-2.npz")
+    stereo._save_pair(path, m, m[::-1].copy(), 0.01, {"key": "1-2"})
+    got = stereo.read_depth(path, "i")
+    assert got.dtype == np.float32 and np.array_equal(np.isnan(got), np.isnan(m))
+    err = np.abs(got - m)[np.isfinite(m)]
+    assert err.max() <= 1.01 * np.nanmax(m) / (2 * stereo.DEPTH_LEVELS)  # half a step: 3 mm at 400 m
+    assert got[0, 0] > 0
+    assert np.allclose(stereo.read_depth(path, "j"), m[::-1], atol=0.004, rtol=0, equal_nan=True)
+    assert stereo.read_pair_summary(path)["key"] == "1-2"
+    stereo._save_pair(path, None, None, 0.0, {"key": "1-2", "skipped": "x"})
+    assert stereo.read_depth(path, "i").size == 0
+
+
 def test_cell_statistic_takes_the_highest_cluster():
     cells = np.array([0, 0, 0, 0, 0, 1, 1, 1, 2])
     z = np.array([10.0, 10.1, 15.0, 15.1, 15.2, 3.0, 3.1, 2.9, 7.0])

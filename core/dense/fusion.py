@@ -7,6 +7,7 @@ the mean of the agreeing ones, and it is back-projected with the camera model an
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import List, Optional, Tuple
 
@@ -19,6 +20,7 @@ from ..prepare.masks import read_keep
 from ..prepare.sky import horizon_keep
 from .options import DenseError
 from .pairs import View, load_scaled
+from .stereo import read_depth
 
 
 @dataclass
@@ -39,13 +41,26 @@ def sky_free(view: View, depth: np.ndarray, sky_margin_deg: Optional[float]) -> 
     pixels of the image's mask."""
     cv2 = require("cv2", "depth fusion")
     out = depth.copy()
-    if sky_margin_deg is not None:
+    if sky_margin_deg is not None and not _all_below_horizon(view, sky_margin_deg):
         out[~horizon_keep(view.camera, view.R, (0.0, 0.0, 1.0), sky_margin_deg, shape=depth.shape)] = np.nan
     if view.mask_path:
         keep = read_keep(view.mask_path, view.width, view.height).astype(np.uint8)
         keep = cv2.resize(keep, (depth.shape[1], depth.shape[0]), interpolation=cv2.INTER_NEAREST) > 0
         out[~keep] = np.nan
     return out
+
+
+HORIZON_PROBE_PX = 64  # the quick test of a whole image below the horizon samples its rays this far apart
+
+
+def _all_below_horizon(view: View, margin_deg: float) -> bool:
+    """True when every pixel of ``view`` looks more than ``margin_deg`` below the horizon (a vertical photo: no
+    full-size horizon mask needed), judged on rays HORIZON_PROBE_PX apart with that margin raised by three times
+    the angle such a step spans (the elevation between two probes cannot climb more)."""
+    slack = 3.0 * math.degrees(HORIZON_PROBE_PX / max(1.0, min(view.camera_matrix()[0][[0, 1], [0, 1]])))
+    probe = (max(2, view.height // HORIZON_PROBE_PX + 1), max(2, view.width // HORIZON_PROBE_PX + 1))
+    return bool(horizon_keep(view.camera, view.R, (0.0, 0.0, 1.0), margin_deg + slack, shape=probe,
+                             step=HORIZON_PROBE_PX).all())
 
 
 def fuse_depth_maps(maps: np.ndarray, rel_tol: np.ndarray, min_consistent: int) -> Tuple[np.ndarray, np.ndarray]:
@@ -93,8 +108,7 @@ def fuse_image(unit: FuseUnit, cancel_path: Optional[str] = None) -> dict:
     check_unit_cancel(cancel_path)
     maps, errs = [], []
     for path, role, rel_err in unit.maps:
-        with np.load(path) as d:
-            m = d["depth_" + role]
+        m = read_depth(path, role)
         if m.size:
             maps.append(m)
             errs.append(rel_err)
