@@ -148,7 +148,8 @@ def _has_gps(images):
 
 
 SHARED = os.path.join(os.path.dirname(ROOT), "shared", "data")
-TABLE_SETS = ("small", "toledo", "copr", "caliterra", "ochota_kap", "ochota_kap_full", "toledo_2400", "synthetic_mixed")
+TABLE_SETS = ("small", "toledo", "copr", "caliterra", "ochota_kap", "ochota_kap_full", "toledo_2400", "synthetic_mixed",
+              "orbit")
 
 
 def _write_jpeg_with_exif(path, pixels, cam, make, model):
@@ -220,6 +221,14 @@ def table_set(name, work):
         if not os.path.isdir(d):
             synthetic_mixed(d)
         return d, {}, "orbit 6 x 45 deg + 6 x 65 deg (480 x 360) + 6 verticals (640 x 480, another camera)"
+    if name == "orbit":  # issue 13 item 4's synthetic orbit as tests/test_obliques.py renders it (sky not masked)
+        import tests.synthetic as syn
+        from tests.test_obliques import ORBIT
+
+        d = os.path.join(work, "orbit")
+        if not os.path.isdir(d):
+            syn.orbit_block(**ORBIT).render(d)
+        return d, {}, "8 x 45 deg + 8 x 65 deg off nadir (480 x 360), horizon and sky in the 65 deg views"
     if name == "ochota_kap":
         return _half_size_copies(os.path.join(SHARED, name, "images"), os.path.join(work, "ochota-half")), {}, \
             "half size (2304 x 1728), EXIF kept"

@@ -50,6 +50,15 @@ after 200).  With the joint block's FC300X calibration held fixed the same 41 au
 max 1.95 m, GCP RMSE Z 0.22 m.  The FC300X self-calibration also changes from one alignment to the next: a rerun on the same tree and reference
 aligned them at f 691.4 px: 578 matches, 294 / 205, 37 kept, median 1.05 m, max 2.89 m (mean +0.64, +0.79 m,
 0.76 m around it, the same stretch along the strips); autocontrol 18 CPU s.
+After d10b473 (the bundle adjustment leaves out observations beyond the field of view, damps each camera column on
+its own diagonal, holds a refined focal length with a 1 % prior; 2 Dec): on the cached f-730 workspace that gave
+1.87 m, 1.17 m median (max 3.05 m, mean +0.76, +0.99 m; k2 0.000 -> 0.018 as the joint block's, 16 iterations
+instead of 50 at the limit); on two fresh alignments (f 692.0 / 692.1 px) 1.48 / 1.41 m median (max 3.07 /
+2.91 m), 32 / 34 automatic GCPs, each 0.79 / 0.76 m around a common shift of (+1.27, +0.71) / (+1.19, +0.68) m.
+Within each strip the error runs along the strip (dy +0.58 -> -1.15 m northbound, +0.46 -> +2.93 m southbound,
+about 3.5 % of the distance): the FC350 reference's own cameras, adjusted to their EXIF GPS, show the same
+along-strip trend against the file (along-track residual +0.8 -> -0.1 m over four photos in most strips, mean
++0.32 m), so part of it is in the GPS positions the file holds, not in the automatic control.
 """
 import argparse
 import json

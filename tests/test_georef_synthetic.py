@@ -176,6 +176,28 @@ def test_truth_model_georeferenced_with_five_control_points(block):
     assert max(err) < 0.1
 
 
+def test_control_sigma_far_below_the_fit_is_named(block):
+    """Control coordinates with metre-level errors (handheld GPS) given at the default 0.02 m: the adjustment
+    says their sigma is far below how well the block fits them; at a sigma of their size, or exact, it does not."""
+    import dataclasses
+
+    rec = block.truth_reconstruction()
+    control = block.spread_control(6)
+    gcps = block.gcp_set(control, noise_px=GCP_NOISE_PX)
+    rng = np.random.default_rng(3)
+    noisy = [dataclasses.replace(p, x=p.x + rng.normal(0, 1.0), y=p.y + rng.normal(0, 1.0))
+             if p.role == CONTROL else p for p in gcps.points]
+
+    def warned(points):
+        result = georeference(rec, dataclasses.replace(gcps, points=points))
+        return [w for w in result.warnings if "sigma XY" in w]
+
+    msg = warned(noisy)
+    assert len(msg) == 1 and "0.02 m" in msg[0] and "handheld GPS" in msg[0], msg
+    assert not warned([dataclasses.replace(p, sigma_xy=1.0) for p in noisy])
+    assert not warned(gcps.points)
+
+
 @pytest.fixture(scope="module")
 def strip():
     return syn.single_strip(seed=3, n=12)
