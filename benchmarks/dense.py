@@ -84,6 +84,7 @@ def run_child(args):
     result["peak_rss_tree_mib"] = peak["sum"] / 2 ** 20
     result["peak_rss_single_mib"] = usage.ru_maxrss / 1024.0
     result["processes_at_peak"] = peak["procs"]
+    result["cpu_tree"] = usage.ru_utime + usage.ru_stime
     return result
 
 
@@ -106,8 +107,11 @@ def child(args):
         s = read_pair_summary(p)
         if not s.get("skipped"):
             pairs.append(s)
+    import resource
+
+    own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
     with open(args.result, "w") as f:
-        json.dump({"wall": wall, "dsm": r.dsm_path, "point_cloud": r.point_cloud_path, "pairs": r.pairs,
+        json.dump({"wall": wall, "cpu_self": own.ru_utime + own.ru_stime, "cpu_workers": kids.ru_utime + kids.ru_stime, "dsm": r.dsm_path, "point_cloud": r.point_cloud_path, "pairs": r.pairs,
                    "pairs_reused": r.pairs_reused, "points": r.points, "valid_fraction": r.valid_fraction,
                    "measured_fraction": r.measured_fraction, "interpolated_fraction": r.interpolated_fraction,
                    "resolution": r.resolution, "timings": r.timings, "log": r.log_lines,
@@ -273,6 +277,8 @@ def main():
               f"per megapixel {cpu.sum() / mp.sum():.2f}")
         print(f"  matched share of the rectified left image per pair: median {np.median(r['pair_valid_fraction']):.2f}")
     print("  stage seconds: " + ", ".join(f"{k} {v:.1f}" for k, v in r["timings"].items()))
+    print(f"  CPU seconds: {r['cpu_tree']:.1f} for the whole stage (process tree), {r['cpu_workers']:.1f} of them in pool "
+          f"workers (matching, fusion), {r['cpu_self']:.1f} in the stage's own process (pair selection, DSM)")
     print(f"  total seconds (wall, child process): {r['wall']:.1f}; machine load average now "
           f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print(f"  peak RSS: {r['peak_rss_tree_mib']:.0f} MiB for the whole process tree ({r['processes_at_peak']} processes), "
