@@ -68,22 +68,32 @@ def fuse_depth_maps(maps: np.ndarray, rel_tol: np.ndarray, min_consistent: int) 
     (|d_l - d_m| <= rel_tol * d_m); kept where at least ``min_consistent`` maps agree; value = their mean.
     Returns (depth with NaN, number of agreeing maps)."""
     k = maps.shape[0]
-    best_n = np.zeros(maps.shape[1:], dtype=np.int16)
-    best_v = np.full(maps.shape[1:], np.nan, dtype=np.float32)
-    for m in range(k):
-        ref = maps[m]
-        tol = rel_tol[m] * ref
-        agree = np.zeros(maps.shape[1:], dtype=np.int16)
-        total = np.zeros(maps.shape[1:], dtype=np.float64)
-        for ll in range(k):
-            with np.errstate(invalid="ignore"):
-                a = np.abs(maps[ll] - ref) <= np.maximum(tol, rel_tol[ll] * ref)
-            agree += a
-            total += np.where(a, maps[ll], 0.0)
-        better = agree > best_n
-        best_n = np.where(better, agree, best_n)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            best_v = np.where(better, (total / np.maximum(agree, 1)).astype(np.float32), best_v)
+    maps = np.asarray(maps, dtype=np.float32)
+    shape = maps.shape[1:]
+    best_n = np.zeros(shape, dtype=np.int16)
+    best_v = np.full(shape, np.nan, dtype=np.float32)
+    tol_l = [np.float32(t) for t in np.asarray(rel_tol, dtype=np.float64)]
+    diff = np.empty(shape, np.float32)
+    lim = np.empty(shape, np.float32)
+    a = np.empty(shape, bool)
+    agree = np.empty(shape, np.int16)
+    total = np.empty(shape, np.float32)
+    better = np.empty(shape, bool)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for m in range(k):
+            ref = maps[m]
+            agree.fill(0)
+            total.fill(0.0)
+            for ll in range(k):  # all in place: float32, no temporaries (the maps are float32 anyway)
+                np.subtract(maps[ll], ref, out=diff)
+                np.abs(diff, out=diff)
+                np.multiply(ref, max(tol_l[m], tol_l[ll]), out=lim)
+                np.less_equal(diff, lim, out=a)
+                agree += a
+                np.add(total, maps[ll], out=total, where=a)
+            np.greater(agree, best_n, out=better)
+            np.copyto(best_n, agree, where=better)
+            np.divide(total, agree, out=best_v, where=better)
     keep = best_n >= max(1, min_consistent)
     return np.where(keep, best_v, np.nan).astype(np.float32), best_n
 
