@@ -18,7 +18,9 @@ class AutoControlOptions:
     photos around its prediction through the model; ``min_score``: their normalised cross-correlation;
     ``ground_plane``: the patches compared through the ground's plane (else the plane facing the first photo);
     ``max_relief``: metres of DSM relief within the point's neighbourhood beyond which its height is not
-    trusted (walls, trees, roof edges); ``dsm_sigma``: metres (None: the DSM's cell size); ``rotations``:
+    trusted (walls, trees, roof edges); ``dsm_sigma``: metres, the DSM's own height noise in a point's sigma Z
+    (None: a third of the DSM's cell size, as the height comes from a plane through 3 x 3 samples; the plane's
+    misfit and slope are added to it); ``rotations``:
     degrees tried when there is no prior (the features are rotation invariant; these help at a coarse level), until
     one gives ``coarse_enough`` inliers; ``coarse_pixels``: the provisional orthophoto's side at that level;
     ``refine_intrinsics``: what the adjustment refines of the cameras (as ``GeorefOptions``): by default focal
