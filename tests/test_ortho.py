@@ -696,3 +696,28 @@ def test_processing_algorithms(scene, plugin, tmp_path):
         processing.run("archaeoortho:orthorectifyimage", {
             "IMAGE": os.path.join(images, SINGLE), "DSM": dsm, "GCPS": gcp_file, "FOCAL_MM": 3.25,
             "SENSOR_WIDTH_MM": 4.0, "OUTPUT": str(tmp_path / "few.tif")})
+
+
+def test_image_window_reads_pixel_interleaved_and_remaps_views(tmp_path):
+    """_read_window gives (rows, cols, bands) as the file holds them (1, 3 and 5 bands, 8 and 16 bit), and _remap
+    of a window view (not contiguous: no copy is made of it) equals that of a copy, pixel for pixel."""
+    from core.ortho.pixels import _read_window, _remap
+
+    rng = np.random.default_rng(3)
+    for bands, dtype, gdt in ((1, np.uint8, gdal.GDT_Byte), (3, np.uint8, gdal.GDT_Byte),
+                              (5, np.uint16, gdal.GDT_UInt16)):
+        a = rng.integers(0, 250, (bands, 40, 60)).astype(dtype) * (1 + 200 * (dtype == np.uint16))
+        path = str(tmp_path / f"im{bands}.tif")
+        ds = gdal.GetDriverByName("GTiff").Create(path, 60, 40, bands, gdt)
+        for b in range(bands):
+            ds.GetRasterBand(b + 1).WriteArray(a[b])
+        ds = None
+        win = _read_window(path, 7, 5, 50, 31)
+        assert win.shape == (26, 43, bands) and win.dtype == dtype
+        assert np.array_equal(win, np.moveaxis(a, 0, -1)[5:31, 7:50])
+        view = _read_window(path, 0, 0, 60, 40)[5:31, 7:50]
+        assert not view.flags["C_CONTIGUOUS"]
+        mx, my = rng.uniform(0, 42, 500), rng.uniform(0, 25, 500)
+        assert np.array_equal(_remap(view, mx, my, "bilinear"), _remap(np.ascontiguousarray(view), mx, my, "bilinear"))
+        got = _remap(view, np.array([3.0, 40.0]), np.array([2.0, 20.0]), "nearest")
+        assert np.array_equal(got, np.stack([view[2, 3], view[20, 40]]).astype(np.float32))

@@ -33,14 +33,17 @@ class OrthoCamera:
         the full camera model; inf where a point does not project.  ``projected``: (pixels, depth) of the points
         from :meth:`project` where the caller has them (points that project: saves one projection)."""
         xyz = np.atleast_2d(np.asarray(xyz_local, dtype=float))
+        xc = self.pose.to_camera(xyz)
         if projected is None:
-            p0, depth, ok0 = self.project(xyz)
+            p0, depth, ok0 = self._project_camera_frame(xc)
         else:
             (p0, depth), ok0 = projected, True
         depth = np.maximum(depth, 1e-6)
         h = (depth / max(self.camera.focal, 1e-9))[:, None]  # about one pixel on the ground
-        px, _, okx = self.project(xyz + h * np.array([1.0, 0.0, 0.0]))
-        py, _, oky = self.project(xyz + h * np.array([0.0, 1.0, 0.0]))
+        # the points moved by h along world x and y, in the camera frame: xc + h R e (one rotation, not three)
+        rot = self.pose.rotation
+        px, _, okx = self._project_camera_frame(xc + h * rot[:, 0])
+        py, _, oky = self._project_camera_frame(xc + h * rot[:, 1])
         a, c = (px - p0).T / h[:, 0]
         b, d = (py - p0).T / h[:, 0]
         t = a * a + b * b + c * c + d * d
@@ -56,7 +59,10 @@ class OrthoCamera:
 
     def project(self, xyz_local: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(pixels (N, 2), depth (N,), ok (N,): in front, trusted by the lens model and inside the image)."""
-        xc = self.pose.to_camera(xyz_local)
+        return self._project_camera_frame(self.pose.to_camera(xyz_local))
+
+    def _project_camera_frame(self, xc: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`project` of points already in the camera frame."""
         px, ok = self.camera.project(xc)
         ok &= self.camera.inside(px) & np.all(np.isfinite(px), axis=-1)
         return px, xc[..., 2], ok

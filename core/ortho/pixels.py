@@ -72,13 +72,17 @@ def image_meta(path: str) -> ImageMeta:
 
 def _read_window(path: str, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
     gdal = _gdal()
+    from osgeo import gdal_array
+
     ds = gdal.Open(path)
-    arr = ds.ReadAsArray(x0, y0, x1 - x0, y1 - y0)
-    if arr.ndim == 2:
-        arr = arr[:, :, None]
-    else:
-        arr = np.moveaxis(arr, 0, -1)
-    return np.ascontiguousarray(arr)
+    w, h, bands = x1 - x0, y1 - y0, ds.RasterCount
+    gdt = ds.GetRasterBand(1).DataType
+    dtype = np.dtype(gdal_array.GDALTypeCodeToNumericTypeCode(gdt))
+    # read pixel-interleaved (rows, cols, bands) directly: half the time of a band-sequential read and a copy
+    isz = dtype.itemsize
+    buf = ds.ReadRaster(x0, y0, w, h, buf_type=gdt, buf_pixel_space=bands * isz, buf_line_space=bands * isz * w,
+                        buf_band_space=isz)
+    return np.frombuffer(bytearray(buf) if isinstance(buf, bytes) else buf, dtype=dtype).reshape(h, w, bands)
 
 
 def _image_window(path: str, meta: ImageMeta, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
@@ -127,7 +131,9 @@ def _remap(src: np.ndarray, mx: np.ndarray, my: np.ndarray, interpolation: str, 
     if border_nan:
         border, kw = cv2.BORDER_CONSTANT, {"borderValue": float("nan")}
     for b0 in range(0, bands, 4):
-        part = np.ascontiguousarray(src[:, :, b0:b0 + 4])
+        # up to 4 bands: the window itself (cv2 takes its row stride; a copy of it per call cost as much as
+        # the remap), more: 4 bands at a time, copied
+        part = src if bands <= 4 else np.ascontiguousarray(src[:, :, b0:b0 + 4])
         if part.shape[2] == 1:
             part = part[:, :, 0]
         elif part.shape[2] == 2:  # remap takes 1, 3 or 4 channels

@@ -136,20 +136,19 @@ def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str
     fill_vals = np.zeros((hh * ww, bands), dtype=np.float32)
     fill_cost = np.full(hh * ww, np.inf, dtype=np.float32)
     if need.any():
-        order = list(unit.primary) + list(unit.secondary)
+        # the view cost of every image first (no pixels), then the values of each cell from its best image only
         idx = np.flatnonzero(need & np.isfinite(z))  # no height: no image can give the cell a value
-        for ci in order:
+        best = np.full(len(idx), -1, dtype=np.int64)
+        for ci in list(unit.primary) + list(unit.secondary):
             if not len(idx):
                 break
             s = sample_camera(unit.cameras[ci], unit.metas[ci], off, x[idx], y[idx], z[idx], unit.visibility[ci],
-                              unit.interpolation)
+                              unit.interpolation, want_values=False)
             better = s.valid & (s.cost < fill_cost[idx])
             if better.any():
-                sel = idx[better]
-                fill_vals[sel] = s.values[better] * point_gains(unit.radiometry, unit.gains[ci], ci, unit.cameras[ci],
-                                                                off, x[sel], y[sel], z[sel], np.ones(len(sel), bool))
-                fill_cost[sel] = s.cost[better]
-                counts[ci] = counts.get(ci, 0) + int(better.sum())
+                fill_cost[idx[better]] = s.cost[better]
+                best[better] = ci
+        _fill_values(unit, off, x, y, z, idx, best, unit.visibility, fill_vals, counts)
         filled = need & np.isfinite(fill_cost)
     else:
         filled = need
@@ -185,11 +184,13 @@ def _fill_hidden(unit: _TileUnit, off: np.ndarray, x: np.ndarray, y: np.ndarray,
     if not len(idx):
         return out
     best = np.full(len(idx), np.inf)
+    winner = np.full(len(idx), -1, dtype=np.int64)
     for ci in list(unit.primary) + list(unit.secondary):
         vis = unit.visibility[ci]
         if vis is None:
             continue
-        s = sample_camera(unit.cameras[ci], unit.metas[ci], off, x[idx], y[idx], z[idx], None, unit.interpolation)
+        s = sample_camera(unit.cameras[ci], unit.metas[ci], off, x[idx], y[idx], z[idx], None, unit.interpolation,
+                          want_values=False)
         if not s.valid.any():
             continue
         sel = np.flatnonzero(s.valid)
@@ -197,10 +198,24 @@ def _fill_hidden(unit: _TileUnit, off: np.ndarray, x: np.ndarray, y: np.ndarray,
         depth[sel] = vis.hidden_by(x[idx[sel]], y[idx[sel]], z[idx[sel]], _table(vis)) + 1e-3 * s.cost[sel]
         better = depth < best
         if better.any():
-            sel = idx[better]
-            fill_vals[sel] = s.values[better] * point_gains(unit.radiometry, unit.gains[ci], ci, unit.cameras[ci],
-                                                            off, x[sel], y[sel], z[sel], np.ones(len(sel), bool))
             best[better] = depth[better]
-            counts[ci] = counts.get(ci, 0) + int(better.sum())
+            winner[better] = ci
+    _fill_values(unit, off, x, y, z, idx, winner, [None] * len(unit.cameras), fill_vals, counts)
     out[idx[np.isfinite(best)]] = True
     return out
+
+
+def _fill_values(unit: _TileUnit, off: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, idx: np.ndarray,
+                 winner: np.ndarray, visibility: List[Optional[Visibility]], fill_vals: np.ndarray,
+                 counts: Dict[int, int]) -> None:
+    """The values (with their radiometric gains) of the cells ``idx`` from the image ``winner`` picked for each
+    (-1: none), sampled once per image and cell, into ``fill_vals``."""
+    for ci in np.unique(winner[winner >= 0]):
+        ci = int(ci)
+        sel = idx[winner == ci]
+        s = sample_camera(unit.cameras[ci], unit.metas[ci], off, x[sel], y[sel], z[sel], visibility[ci],
+                          unit.interpolation)
+        sel, vals = sel[s.valid], s.values[s.valid]  # all of them: the same test that picked the image
+        fill_vals[sel] = vals * point_gains(unit.radiometry, unit.gains[ci], ci, unit.cameras[ci], off, x[sel],
+                                            y[sel], z[sel], np.ones(len(sel), bool), (s.xyz[s.valid], s.px[s.valid]))
+        counts[ci] = counts.get(ci, 0) + len(sel)

@@ -10,7 +10,6 @@ import numpy as np
 
 from ..dense.grid import convex_hull_xy
 from .cameras import OrthoCamera
-from .pixels import _CACHE
 from .surface import _Dsm
 
 MAX_POLAR_CELLS = 12_000_000
@@ -233,6 +232,10 @@ def build_visibility(cam: OrthoCamera, offset: np.ndarray, fp: Footprint, dsm: _
 
 
 def _table(vis: Visibility) -> np.ndarray:
+    """The table, memory-mapped from its file (a mosaic tile reads only the rows of the angles it spans; the
+    pages stay in the system's file cache, not in this process, and the image cache keeps the decoded photos:
+    toledo_2400's 57 tables are 2.3 GB, loaded whole they pushed the photos and each other out of the cache,
+    2,400 table loads and 2,400 photo decodes for 80 tiles)."""
     if vis.table is not None:
         return vis.table
-    return _CACHE.get(("vis", vis.path), lambda: (np.load(vis.path), vis.nbytes()))
+    return np.load(vis.path, mmap_mode="r")
