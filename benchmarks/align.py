@@ -225,7 +225,7 @@ def table_set(name, work):
         import tests.synthetic as syn
         from tests.test_obliques import ORBIT
 
-        d = os.path.join(work, "orbit")
+        d = os.path.join(work, "orbit-photos")
         if not os.path.isdir(d):
             syn.orbit_block(**ORBIT).render(d)
         return d, {}, "8 x 45 deg + 8 x 65 deg off nadir (480 x 360), horizon and sky in the 65 deg views"
