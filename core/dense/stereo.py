@@ -166,10 +166,14 @@ def _sgbm(block: int, dmin: int, num: int, uniqueness: int, disp12: int = -1):
 
 def _sample_rows(arr: np.ndarray, rows: np.ndarray, xs: np.ndarray) -> np.ndarray:
     """Linear interpolation of arr[rows, xs] along x (xs float, inside [0, width - 1])."""
-    x0 = np.floor(xs).astype(np.int64)
-    x0 = np.clip(x0, 0, arr.shape[1] - 2)
-    t = xs - x0
-    return (1 - t) * arr[rows, x0] + t * arr[rows, x0 + 1]
+    w = arr.shape[1]
+    x0 = np.minimum(xs.astype(np.int64), w - 2)  # xs >= 0: truncation is the floor
+    t = (xs - x0).astype(np.float32)
+    flat = arr.reshape(-1)
+    idx = rows.astype(np.int64) * w + x0
+    a = flat[idx]
+    idx += 1
+    return a + t * (flat[idx] - a)
 
 
 def _zbuffer(shape: Tuple[int, int], px: np.ndarray, py: np.ndarray, depth: np.ndarray) -> np.ndarray:
@@ -270,6 +274,8 @@ TILE_PX = 384  # the finer levels match tiles of this side, each over the dispar
 TILE_CONTEXT_PX = 24  # rows and columns of context around a tile (SGBM's path aggregation; dropped after)
 TILE_RANGE_MARGIN_PX = 3  # disparities searched beyond twice the coarser level's range around the tile
 EDGE_JUMP_PX = 3.0  # a disparity step this large between neighbours of the coarser level marks a depth edge
+EDGE_JUMP_REL = 0.03  # ... and at least this share of the pair's disparity (3 % of the camera's height: the noise
+# of weak texture grows with the disparity, a wall's step too; 1.2 m at 40 m)
 EDGE_MIN_PIXELS = 60  # ... on this many coarser pixels around a tile (a wall; one blunder's speck marks 25)
 TILE_MIN_PRIOR = 16  # coarser disparities a tile's window needs; fewer -> the window grows, then the whole range
 
@@ -340,7 +346,8 @@ def _runs(cells: list, ctx: int, height: int) -> list:
 
 
 def _match_tiled(left: np.ndarray, right: np.ndarray, prior: np.ndarray, block: int, dmin: int, num: int,
-                 unit: "PairUnit", cancel_path: Optional[str], edges_two_way: bool = False) -> Tuple[np.ndarray, dict]:
+                 unit: "PairUnit", cancel_path: Optional[str], edges_two_way: bool = False,
+                 shift: float = 0.0) -> Tuple[np.ndarray, dict]:
     """Left-right checked disparity of a rectified pair matched piece by piece, each piece over the disparities the
     coarser level (``prior``) found around it: the search no longer grows with the resolution.
 
@@ -349,7 +356,8 @@ def _match_tiled(left: np.ndarray, right: np.ndarray, prior: np.ndarray, block: 
     search costs less than repeating the margins (``_runs``); cells with no image in either view are skipped. A run
     is matched once, with OpenCV's own left-right check (disp12MaxDiff: the right image's disparities from the same
     aggregated costs), or, with ``edges_two_way`` where the coarser level shows a depth edge (EDGE_MIN_PIXELS of
-    its pixels span EDGE_JUMP_PX over 5 x 5), both ways with a full second pass, which keeps the occluded side of a
+    its pixels span EDGE_JUMP_PX, and EDGE_JUMP_REL of the median geometric disparity, the prior less ``shift``
+    (cx_i - cx_j at this level), over 5 x 5), both ways with a full second pass, which keeps the occluded side of a
     wall out (one pass fattens a roof by a cell or two). Returns the map and {tiles: runs matched, skipped cells,
     two-way runs, mean disparities searched}."""
     cv2 = require("cv2", "dense matching")
@@ -366,7 +374,9 @@ def _match_tiled(left: np.ndarray, right: np.ndarray, prior: np.ndarray, block: 
         big = np.float32(1e6)
         lo5 = cv2.erode(np.where(valid, prior, big).astype(np.float32), k5)
         hi5 = cv2.dilate(np.where(valid, prior, -big).astype(np.float32), k5)
-        edge = (lo5 < big / 2) & (hi5 - lo5 > EDGE_JUMP_PX / 2.0)
+        geo = prior[valid] - shift / 2.0
+        jump = max(EDGE_JUMP_PX / 2.0, EDGE_JUMP_REL * float(np.median(geo))) if geo.size else EDGE_JUMP_PX / 2.0
+        edge = (lo5 < big / 2) & (hi5 - lo5 > jump)
     ph, pw = prior.shape
     cell = max(32, TILE_PX // 2)
     runs_done = skipped = searched = two_ways = 0
@@ -419,7 +429,7 @@ def _match_tiled(left: np.ndarray, right: np.ndarray, prior: np.ndarray, block: 
 
 
 def _disparity(li: np.ndarray, rj: np.ndarray, block: int, dmin: int, num: int, unit: "PairUnit",
-               cancel_path: Optional[str], stats: Optional[dict] = None) -> np.ndarray:
+               cancel_path: Optional[str], stats: Optional[dict] = None, shift: float = 0.0) -> np.ndarray:
     """The left image's disparity map (NaN = none), coarse to fine: the pair halved ``pyramid_levels`` times, the
     coarsest level matched over the whole range (SGBM both ways + left-right check), each finer level tile by tile
     over the range its coarser level found there, then checked and completed by it (``coarse_to_fine``)."""
@@ -445,7 +455,7 @@ def _disparity(li: np.ndarray, rj: np.ndarray, block: int, dmin: int, num: int, 
     for k in range(levels - 1, -1, -1):
         lo, n = level_range(k)
         fine, tinfo = _match_tiled(pyr[k][0], pyr[k][1], disp, block, lo, n, unit, cancel_path,
-                                   edges_two_way=k == 0)
+                                   edges_two_way=k == 0, shift=shift / 2.0 ** k)
         disp = coarse_to_fine(fine, disp)
         if k == 0:
             info.update(tiles=tinfo["tiles"], tiles_skipped=tinfo["skipped"], tiles_two_way=tinfo["two_way"],
@@ -485,7 +495,7 @@ def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
     mj = cv2.remap(ones_j, rect.maps_j[0], rect.maps_j[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT) == 255
     del ones_i, ones_j
     pyramid: dict = {}
-    disp = _disparity(li, rj, unit.block_size, dmin, num, unit, cancel_path, pyramid)
+    disp = _disparity(li, rj, unit.block_size, dmin, num, unit, cancel_path, pyramid, rect.cx_i - rect.cx_j)
     check_unit_cancel(cancel_path)
     rows, xs = np.nonzero(np.isfinite(disp) & mi)
     d = disp[rows, xs]
