@@ -276,7 +276,7 @@ TILE_RANGE_MARGIN_PX = 3  # disparities searched beyond twice the coarser level'
 EDGE_JUMP_PX = 3.0  # a disparity step this large between neighbours of the coarser level marks a depth edge
 EDGE_JUMP_REL = 0.03  # ... and at least this share of the pair's disparity (3 % of the camera's height: the noise
 # of weak texture grows with the disparity, a wall's step too; 1.2 m at 40 m)
-EDGE_MIN_PIXELS = 60  # ... on this many coarser pixels around a tile (a wall; one blunder's speck marks 25)
+EDGE_MIN_PIXELS = 200  # ... on this many coarser pixels around a tile (a wall: its 5 px band along 40 rows; specks less)
 TILE_MIN_PRIOR = 16  # coarser disparities a tile's window needs; fewer -> the window grows, then the whole range
 
 
