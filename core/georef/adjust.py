@@ -512,24 +512,29 @@ def _final_provisional_messages(run: _Run, adj: _Adjustment) -> None:
 SIGMA_CHECK_FACTOR = 10.0  # the rigid block misses the control points by more than this many sigmas: say so
 
 
-def _sigma_check(run: _Run, result: GeorefResult) -> None:
+def _sigma_check(run: _Run, result: GeorefResult, consistency: Optional[Dict[str, Any]] = None) -> None:
     """Warn where the control points' stated accuracy is far better than the block can agree with: the rigid
     block (the Helmert step) misses the control points used by more than SIGMA_CHECK_FACTOR x their sigma XY
-    (RMS, at least 4 points, at least 0.1 m).  With such sigmas the adjustment bends the block to fit the points
-    (handheld GPS read as survey grade; a file without sigma columns gets 0.02 m)."""
+    (the median point, so that one wrong coordinate, which the outlier tests name, does not count; at least 4
+    points, at least 0.1 m), and no more than half of them agree with each other through the rigid block (the
+    consistency test: then a few wrong coordinates, named by it, are the cause, not the sigma).  With such sigmas
+    the adjustment bends the block to fit the points (handheld GPS read as survey grade; a file without sigma
+    columns gets 0.02 m)."""
     given = {p.name: p for p in run.points}
     rows = [r for r in result.helmert_points if r.status == USED and r.role == CONTROL and r.dx is not None
-            and r.name in given and math.isfinite(r.dx) and math.isfinite(r.dy)]
+            and r.name in given and r.name not in run.rejected_ctrl and math.isfinite(r.dx) and math.isfinite(r.dy)]
     if len(rows) < 4:
         return
-    rms = math.sqrt(sum(r.dx ** 2 + r.dy ** 2 for r in rows) / len(rows))
+    miss = float(np.median([math.hypot(r.dx, r.dy) for r in rows]))
     sig = float(np.median([given[r.name].sigma_xy for r in rows]))
-    if rms < 0.1 or rms < SIGMA_CHECK_FACTOR * sig:
+    if miss < 0.1 or miss < SIGMA_CHECK_FACTOR * sig:
+        return
+    if consistency and 2 * len(consistency.get("consistent") or ()) > len(rows):
         return
     run.warn(f"the control points' sigma XY ({sig:g} m) is far below how well the block fits them: "
-             f"{len(rows)} control points miss the rigid block by {rms:.2f} m RMS ({rms / sig:.0f} sigma), and "
-             f"the adjustment bends the block to fit them; if their coordinates are metre-level (handheld GPS, "
-             f"read off a map) give the file sigma columns of that size (a file without them gets "
+             f"{len(rows)} control points miss the rigid block by {miss:.2f} m (median, {miss / sig:.0f} sigma), "
+             f"and the adjustment bends the block to fit them; if their coordinates are metre-level (handheld "
+             f"GPS, read off a map) give the file sigma columns of that size (a file without them gets "
              f"{GroundPoint.sigma_xy:g} m)")
 
 
@@ -567,7 +572,7 @@ def _update_and_evaluate(run: _Run, adj: _Adjustment, result: GeorefResult, came
     result.refined_intrinsics = {int(cid): [float(v) for v in rec.cameras[cid].params]
                                  for cid in adj.sel_info.get("refined_cameras", [])}
     result.adjusted = True
-    _sigma_check(run, result)
+    _sigma_check(run, result, stats.get("control_consistency"))
     run.timings["total"] = time.time() - run.t_start
     stats["timings"] = run.timings
     stats.pop("refined_cameras", None)
