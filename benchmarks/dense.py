@@ -111,7 +111,8 @@ def child(args):
 
     own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
     with open(args.result, "w") as f:
-        json.dump({"wall": wall, "cpu_self": own.ru_utime + own.ru_stime, "cpu_workers": kids.ru_utime + kids.ru_stime, "dsm": r.dsm_path, "point_cloud": r.point_cloud_path, "pairs": r.pairs,
+        json.dump({"wall": wall, "cpu_self": own.ru_utime + own.ru_stime, "cpu_workers": kids.ru_utime + kids.ru_stime,
+                   "dsm": r.dsm_path, "point_cloud": r.point_cloud_path, "pairs": r.pairs,
                    "pairs_reused": r.pairs_reused, "points": r.points, "valid_fraction": r.valid_fraction,
                    "measured_fraction": r.measured_fraction, "interpolated_fraction": r.interpolated_fraction,
                    "resolution": r.resolution, "timings": r.timings, "log": r.log_lines,

@@ -146,6 +146,28 @@ def test_the_quick_horizon_test_never_skips_a_mask_that_drops_pixels():
     assert quick_true >= 8
 
 
+def test_depth_edges_are_walls_not_weak_texture_streaks():
+    """The finest level is matched both ways only at the coarser level's depth edges (stereo.edge_mask): a wall's
+    step marks them along its outline, more than a tile needs; weak texture's streaks (2.8 px jumps on a disparity
+    of 100) do not, unless the pair's geometric disparity is small (the same jump is then a real step)."""
+    rng = np.random.default_rng(5)
+    ground = np.full((200, 300), 100.0, np.float32)
+    streaks = ground.copy()
+    for r in rng.integers(0, 200, 40):
+        streaks[r, :] += 1.4 * rng.choice([-1.0, 1.0])  # up to 2.8 px between neighbouring streaks
+    assert not stereo.edge_mask(streaks).any()
+    wall = streaks.copy()
+    wall[60:120, 100:160] += 12.0  # a roof 12 coarse px above the ground
+    edge = stereo.edge_mask(wall)
+    assert edge[56:124, 96:164].sum() >= stereo.EDGE_MIN_PIXELS and not edge[140:, :].any()
+    assert not edge[75:105, 115:145].any()  # inside the roof: no edge
+    # the same streaks with the disparity mostly the rectification's shift (cx_i - cx_j = 180: 10 px geometric)
+    assert stereo.edge_mask(streaks, shift=180.0).sum() > 1000
+    holes = wall.copy()
+    holes[:, :40] = np.nan  # no data: no edge from it
+    assert not stereo.edge_mask(holes)[:, :38].any()
+
+
 def test_pair_depth_maps_round_trip_within_their_uint16_steps(tmp_path):
     rng = np.random.default_rng(3)
     m = rng.uniform(20.0, 400.0, (30, 40)).astype(np.float32)

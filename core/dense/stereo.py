@@ -345,6 +345,21 @@ def _runs(cells: list, ctx: int, height: int) -> list:
     return runs[::-1]
 
 
+def edge_mask(prior: np.ndarray, shift: float = 0.0) -> np.ndarray:
+    """The coarser level's depth edges: pixels whose 5 x 5 disparity range (across an occlusion's hole too) exceeds
+    EDGE_JUMP_PX / 2 (the coarser level's pixels) and EDGE_JUMP_REL of the median geometric disparity (the prior
+    less ``shift`` / 2, the finer level's cx_i - cx_j at this level)."""
+    cv2 = require("cv2", "dense matching")
+    valid = np.isfinite(prior)
+    k5 = np.ones((5, 5), np.uint8)
+    big = np.float32(1e6)
+    lo5 = cv2.erode(np.where(valid, prior, big).astype(np.float32), k5)
+    hi5 = cv2.dilate(np.where(valid, prior, -big).astype(np.float32), k5)
+    geo = prior[valid] - shift / 2.0
+    jump = max(EDGE_JUMP_PX / 2.0, EDGE_JUMP_REL * float(np.median(geo))) if geo.size else EDGE_JUMP_PX / 2.0
+    return (lo5 < big / 2) & (hi5 - lo5 > jump)
+
+
 def _match_tiled(left: np.ndarray, right: np.ndarray, prior: np.ndarray, block: int, dmin: int, num: int,
                  unit: "PairUnit", cancel_path: Optional[str], edges_two_way: bool = False,
                  shift: float = 0.0) -> Tuple[np.ndarray, dict]:
@@ -367,16 +382,7 @@ def _match_tiled(left: np.ndarray, right: np.ndarray, prior: np.ndarray, block: 
     pad = ctx + 2 * num + max(abs(dmin), abs(dmin + num)) + 16
     lp = cv2.copyMakeBorder(left, 0, 0, pad, pad, cv2.BORDER_CONSTANT, value=0)
     rp = cv2.copyMakeBorder(right, 0, 0, pad, pad, cv2.BORDER_CONSTANT, value=0)
-    edge = np.zeros(prior.shape, bool)
-    if edges_two_way:  # the coarser level's disparity range over 5 x 5 (across an occlusion's hole too)
-        valid = np.isfinite(prior)
-        k5 = np.ones((5, 5), np.uint8)
-        big = np.float32(1e6)
-        lo5 = cv2.erode(np.where(valid, prior, big).astype(np.float32), k5)
-        hi5 = cv2.dilate(np.where(valid, prior, -big).astype(np.float32), k5)
-        geo = prior[valid] - shift / 2.0
-        jump = max(EDGE_JUMP_PX / 2.0, EDGE_JUMP_REL * float(np.median(geo))) if geo.size else EDGE_JUMP_PX / 2.0
-        edge = (lo5 < big / 2) & (hi5 - lo5 > jump)
+    edge = edge_mask(prior, shift) if edges_two_way else np.zeros(prior.shape, bool)
     ph, pw = prior.shape
     cell = max(32, TILE_PX // 2)
     runs_done = skipped = searched = two_ways = 0

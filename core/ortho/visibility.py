@@ -131,9 +131,6 @@ class Visibility:
     path: str = ""
     table: Optional[np.ndarray] = field(default=None, repr=False)
 
-    def nbytes(self) -> int:
-        return self.n_phi * self.n_r * 4
-
     def load(self) -> np.ndarray:
         if self.table is None:
             self.table = np.load(self.path)
