@@ -93,3 +93,29 @@ def test_atomic_output_replaces_folders(tmp_path):
             f.write("y")
     assert os.listdir(target) == ["new.bin"]
     assert sorted(os.listdir(tmp_path)) == ["model"]
+
+
+def test_stage_records_missing_read_as_none_damaged_name_the_file(tmp_path):
+    """A record that is not there yet (before its stage) is None; one that is there but damaged or not UTF-8
+    raises the caller's error naming the file -- never mistaken for a missing record."""
+    from core.common.files import read_json_record
+    from core.prepare.stage import load_screening
+    from core.report.errors import ReportError
+
+    assert read_json_record(str(tmp_path / "absent.json"), ReportError) is None
+    assert load_screening(str(tmp_path)) is None
+    good = tmp_path / "good.json"
+    good.write_text('{"a": [1, 2]}', encoding="utf-8")
+    assert read_json_record(str(good), ReportError) == {"a": [1, 2]}
+    for name, data in (("cut.json", b'{"a": [1, 2'), ("latin.json", b'{"a": "\xe9"}')):
+        p = tmp_path / name
+        p.write_bytes(data)
+        with pytest.raises(ReportError) as e:
+            read_json_record(str(p), ReportError)
+        assert str(p) in str(e.value) and "cannot be read" in str(e.value)
+    from core.project.layout import SCREENING_JSON
+    (tmp_path / SCREENING_JSON).parent.mkdir(parents=True, exist_ok=True)
+    (tmp_path / SCREENING_JSON).write_text("{", encoding="utf-8")
+    with pytest.raises(WorkspaceError) as e:
+        load_screening(str(tmp_path))
+    assert SCREENING_JSON.split("/")[-1] in str(e.value)

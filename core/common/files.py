@@ -13,7 +13,7 @@ import shutil
 import socket
 import tempfile
 import time
-from typing import Any, Dict, Iterator, Optional
+from typing import Any, Dict, Iterator, Optional, Type
 
 
 def _read_umask() -> int:
@@ -267,6 +267,18 @@ def clean_partials(folder: str, depth: int = 2, temp_age_s: float = 60.0) -> lis
             elif depth > 0 and entry.is_dir(follow_symlinks=False) and not name.startswith("."):
                 removed += clean_partials(entry.path, depth - 1, temp_age_s)
     return removed
+
+
+def read_json_record(path: str, error: Type[Exception]) -> Optional[Any]:
+    """The JSON document at ``path``, or None when there is no such file; ``error`` naming the file when it
+    exists but cannot be read or parsed (a damaged record is never mistaken for a missing one)."""
+    if not os.path.isfile(path):
+        return None
+    try:
+        with open(path, encoding="utf-8") as f:
+            return json.load(f)
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise error(f"{path} cannot be read: {e}") from e
 
 
 def file_fingerprint(path: str) -> str:

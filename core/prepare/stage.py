@@ -20,7 +20,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from ..common.files import atomic_output, atomic_write_text, file_fingerprint, fingerprint
+from ..common.files import atomic_output, atomic_write_text, file_fingerprint, fingerprint, read_json_record
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..io.images import list_images, read_image_info
 from ..project.layout import SCREENING_JSON, Layout
@@ -358,11 +358,4 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
 
 def load_screening(workspace_dir: str) -> Optional[dict]:
     """The screening record of a workspace (for the report), or None before 'Prepare images'."""
-    path = os.path.join(workspace_dir, SCREENING_JSON)
-    if not os.path.isfile(path):
-        return None
-    try:
-        with open(path, encoding="utf-8") as f:
-            return json.load(f)
-    except (OSError, json.JSONDecodeError) as e:
-        raise WorkspaceError(f"{path} cannot be read: {e}") from e
+    return read_json_record(os.path.join(workspace_dir, SCREENING_JSON), WorkspaceError)

@@ -12,6 +12,7 @@ from typing import Any, Dict, Optional, Tuple
 import numpy as np
 
 from ..common.errors import require
+from ..common.files import read_json_record
 from ..common.progress import Progress
 from ..georef.uncertainty import collect_observations
 from ..project.layout import Layout
@@ -23,13 +24,7 @@ from .html import crs_label
 
 
 def _read_json(path: str) -> Optional[Dict[str, Any]]:
-    if not os.path.isfile(path):
-        return None
-    try:
-        with open(path, encoding="utf-8") as f:
-            return json.load(f)
-    except (OSError, json.JSONDecodeError) as e:
-        raise ReportError(f"{path} cannot be read: {e}") from e
+    return read_json_record(path, ReportError)
 
 
 class ReportData:
