@@ -323,7 +323,10 @@ def _bad_rasters(root):
                      "EPSG:4326")
     tiny = str(root / "tiny.tif")
     raster.write_cog(tiny, np.ones((8, 8)), gt, syn.CRS)
-    return {empty: "no data", degrees: "geographic CRS", tiny: "too small"}
+    text = root / "notes.tif"
+    text.write_text("not a raster")
+    return {empty: "no data", degrees: "geographic CRS", tiny: "too small", str(text): "not a raster GDAL can read",
+            str(root / "missing.tif"): "does not exist"}
 
 
 @pytest.mark.parametrize("entry", ["dtm", "relief", "contours"])

@@ -18,6 +18,7 @@ import numpy as np
 from ..common.progress import NullProgress, Progress, check_cancel
 from ..io import raster
 from .options import TerrainError
+from .rasters import check_north_up, open_raster
 
 CHANGE_THRESHOLD = 1.0  # metres: a cell whose height changed by more than this counts as changed
 
@@ -60,17 +61,7 @@ class _Raster:
 def _open(path: str, what: str) -> _Raster:
     """A DSM's grid and CRS; TerrainError naming the file when it is missing, not a raster, has no CRS or no
     north-up georeferencing."""
-    from osgeo import gdal
-
-    gdal.UseExceptions()
-    if not os.path.isfile(path):
-        raise TerrainError(f"the {what} {path} does not exist")
-    try:
-        ds = gdal.Open(path)
-    except RuntimeError as e:
-        raise TerrainError(f"the {what} {path} is not a raster GDAL can read: {e}") from e
-    if ds is None or ds.RasterCount < 1:
-        raise TerrainError(f"the {what} {path} is not a raster GDAL can read (no band)")
+    ds = open_raster(path, what)
     gt = ds.GetGeoTransform(can_return_null=True)
     wkt = ds.GetProjection() or ""
     if gt is None:
@@ -78,8 +69,7 @@ def _open(path: str, what: str) -> _Raster:
     if not wkt:
         raise TerrainError(f"the {what} {path} has no CRS: assign its CRS first (Raster > Projections > Assign "
                            "Projection) so that it can be compared with the other DSM")
-    if gt[2] or gt[4]:
-        raise TerrainError(f"the {what} {path} is rotated (geotransform {gt}): warp it to a north-up grid first")
+    check_north_up(path, what, gt)
     return _Raster(path, wkt, tuple(gt), ds.RasterXSize, ds.RasterYSize, ds.GetRasterBand(1).GetNoDataValue())
 
 

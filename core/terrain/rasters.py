@@ -27,10 +27,10 @@ class Elevation:
         return self.z.shape
 
 
-def read_elevation(path: str, what: str = "DSM") -> Elevation:
-    """The whole raster ``path`` (band 1) as metres; TerrainError naming the file for a raster that cannot be a
-    terrain model: unreadable, geographic CRS (degrees), rotated or non-square cells, too small, no data."""
-    from osgeo import gdal, osr
+def open_raster(path: str, what: str):
+    """The GDAL dataset of ``path``; TerrainError naming the file (as the ``what`` it was given as) when it is
+    missing, not a raster GDAL can read, or has no band."""
+    from osgeo import gdal
 
     gdal.UseExceptions()
     if not os.path.isfile(path):
@@ -38,7 +38,24 @@ def read_elevation(path: str, what: str = "DSM") -> Elevation:
     try:
         ds = gdal.Open(path)
     except RuntimeError as e:
-        raise TerrainError(f"cannot read the {what} {path}: {e}") from e
+        raise TerrainError(f"the {what} {path} is not a raster GDAL can read: {e}") from e
+    if ds is None or ds.RasterCount < 1:
+        raise TerrainError(f"the {what} {path} is not a raster GDAL can read (no band)")
+    return ds
+
+
+def check_north_up(path: str, what: str, gt) -> None:
+    """TerrainError naming the file when its geotransform ``gt`` is rotated."""
+    if gt[2] or gt[4]:
+        raise TerrainError(f"the {what} {path} is rotated (geotransform {gt}): warp it to a north-up grid first")
+
+
+def read_elevation(path: str, what: str = "DSM") -> Elevation:
+    """The whole raster ``path`` (band 1) as metres; TerrainError naming the file for a raster that cannot be a
+    terrain model: unreadable, geographic CRS (degrees), rotated or non-square cells, too small, no data."""
+    from osgeo import osr
+
+    ds = open_raster(path, what)
     gt = ds.GetGeoTransform()
     wkt = ds.GetProjection() or ""
     unit = 1.0
@@ -49,8 +66,7 @@ def read_elevation(path: str, what: str = "DSM") -> Elevation:
                                "terrain model needs metres; reproject it to a projected CRS (e.g. its UTM zone) "
                                "with Raster > Projections > Warp first")
         unit = float(srs.GetLinearUnits() or 1.0)
-    if gt[2] or gt[4]:
-        raise TerrainError(f"the {what} {path} is rotated (geotransform {gt}): warp it to a north-up grid first")
+    check_north_up(path, what, gt)
     if abs(abs(gt[1]) - abs(gt[5])) > 1e-6 * abs(gt[1]):
         raise TerrainError(f"the {what} {path} has non-square cells ({gt[1]:g} x {abs(gt[5]):g}): resample it to "
                            "square cells first")
