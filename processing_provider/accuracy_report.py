@@ -88,12 +88,12 @@ class AccuracyReportAlgorithm(AlgorithmBase):
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         output = self.parameterAsFileOutput(parameters, self.OUTPUT_HTML, context) or None
+        progress = FeedbackProgress(feedback)
         result = self.run_core(
             report.build_report, workspace, output,
             uncertainty=self.parameterAsBoolean(parameters, self.UNCERTAINTY, context),
-            progress=FeedbackProgress(feedback))
-        for w in result.warnings:
-            feedback.pushWarning(w)
+            progress=progress)
+        progress.push_result(result.warnings)
         skipped = {k: v for k, v in result.sections.items() if v != "ok"}
         for k, v in skipped.items():
             feedback.pushInfo(self.tr("section {} skipped: {}").format(k, v))

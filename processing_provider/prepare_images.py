@@ -148,10 +148,9 @@ class PrepareImagesAlgorithm(AlgorithmBase):
         if source is not None:
             options.mask_polygons = self.mask_polygons(source, feedback)
             options.mask_source = self.tr("MASKS layer '{}'").format(source.sourceName())
-        result = self.run_core(prepare_images_workspace, images, workspace, output or None, options,
-                               FeedbackProgress(feedback))
-        for w in result.warnings:
-            feedback.pushWarning(w)
+        progress = FeedbackProgress(feedback)
+        result = self.run_core(prepare_images_workspace, images, workspace, output or None, options, progress)
+        progress.push_result(result.warnings)
         feedback.pushInfo(self.tr("{} images: {} flagged, {} excluded, {} in the prepared folder").format(
             len(result.images), result.flagged, result.excluded, result.kept))
         feedback.pushInfo(self.tr("Blurriest first (blur score, % of the set's median):"))

@@ -125,6 +125,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
         checks = params.read_names(self, p, self.CHECK_POINTS, context)
         workers = self.parameterAsInt(p, self.WORKERS, context)
         scheduler = params.read_scheduler(self, p, self.SCHEDULER, context)
+        progress = FeedbackProgress(feedback)
         result = self.run_core(
             pipeline.run_pipeline,
             self.parameterAsFile(p, self.IMAGES, context), self.parameterAsString(p, self.WORKSPACE, context),
@@ -148,9 +149,8 @@ class RunPipelineAlgorithm(AlgorithmBase):
             control=pipeline.Control(gcp_path=gcp_path, gcps=gcps, check_points=checks,
                                      camera_positions_path=positions, use_exif_gps=use_gps, crs=crs_text,
                                      gcps_upright=self.parameterAsBoolean(p, self.GCPS_UPRIGHT, context)),
-            progress=FeedbackProgress(feedback))
-        for w in result.warnings:
-            feedback.pushWarning(w)
+            progress=progress)
+        progress.push_result(result.warnings)  # those the stages did not log while they ran
         feedback.pushInfo(self.tr("Seconds per stage: {}").format(
             ", ".join(f"{k} {v:.1f}" for k, v in result.seconds.items())))
         g = result.georef.figures

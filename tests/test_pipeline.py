@@ -83,6 +83,8 @@ def test_runpipeline_from_qgis_process_and_resume(strip, tmp_path):
     assert res["DSM_VALID_FRACTION"] > 0.8 and res["ORTHO_VALID_FRACTION"] > 0.6
     _check_products(res["DSM"], res["ORTHOMOSAIC"], res["REPORT"])
     assert any("Seconds per stage" in line for line in doc["log"]["info"])
+    warnings = doc["log"].get("warning", [])  # each once: the stages log them as they run, the end adds none again
+    assert len(warnings) == len(set(warnings)), warnings
     # a second run resumes: features and matches are reused, the products are rewritten whole
     before = os.path.getmtime(res["DSM"])
     out2 = subprocess.run(args, env=env, capture_output=True, text=True, timeout=900)
