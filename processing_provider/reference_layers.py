@@ -2,7 +2,8 @@
 remote raster is saved to a GeoTIFF in the workspace for the extent the block needs (core reads files only).
 
 qgis.core only (no qgis.gui, no processing): used by the Georeference / Automatic control algorithms and by the
-dock's automatic control (ui/gcp_autocontrol.py), in a worker thread there (the provider is cloned).
+dock's automatic control (ui/gcp_autocontrol.py), in a worker thread there: the dock passes LayerSnapshots
+taken on the GUI thread (the provider cloned there), never the project's layers.
 
 - the extent: given (a map extent, the algorithm's REFERENCE_EXTENT), else the block's rough extent from the
   photos' EXIF GPS plus a margin, else the other reference's extent when that one is a file, else the layer's own
@@ -42,6 +43,47 @@ IMAGE_TYPES = (Qgis.DataType.ARGB32, Qgis.DataType.ARGB32_Premultiplied)
 
 class ReferenceLayerError(ArchaeoOrthoError, RuntimeError):
     """A reference layer cannot be saved for the automatic control: the message names the layer and why."""
+
+
+class LayerSnapshot:
+    """What the saving needs of a map layer, taken on the thread that owns the layer (the GUI thread in the
+    dock): its name, source, CRS and extent, and a clone of its provider.  A worker thread then reads the
+    snapshot, never the project's layer, which the map canvas renders and the user may remove meanwhile (a
+    layer and its provider are not thread-safe).  It answers the few QgsMapLayer calls this module makes."""
+
+    def __init__(self, layer):
+        self._name, self._provider_type, self._source = layer.name(), layer.providerType(), layer.source()
+        self._valid = layer.isValid()
+        self._crs = QgsCoordinateReferenceSystem(layer.crs())
+        self._extent = QgsRectangle(layer.extent())
+        provider = layer.dataProvider() if self._valid else None
+        self._provider = provider.clone() if provider is not None and local_file(layer) is None else None
+
+    def name(self):
+        return self._name
+
+    def providerType(self):  # noqa: N802 (the QgsMapLayer names)
+        return self._provider_type
+
+    def source(self):
+        return self._source
+
+    def isValid(self):  # noqa: N802
+        return self._valid
+
+    def crs(self):
+        return self._crs
+
+    def extent(self):
+        return self._extent
+
+    def dataProvider(self):  # noqa: N802
+        return self._provider
+
+
+def snapshot(layer):
+    """A LayerSnapshot of ``layer`` (None stays None): call it on the layer's own thread."""
+    return None if layer is None else LayerSnapshot(layer)
 
 
 def local_file(layer):
@@ -250,8 +292,8 @@ def resolve_references(ortho_layer, dsm_layer, workspace_dir, gsd=None, extent=N
     return paths[0], paths[1]
 
 
-__all__ = ["DEFAULT_GSD", "MAX_PIXELS", "ReferenceLayerError", "gps_extent", "local_file", "resolve_references",
-           "save_layer", "target_crs"]
+__all__ = ["DEFAULT_GSD", "MAX_PIXELS", "LayerSnapshot", "ReferenceLayerError", "gps_extent", "local_file",
+           "resolve_references", "save_layer", "snapshot", "target_crs"]
 
 
 def reference_crs(ortho_path):

@@ -265,6 +265,9 @@ def test_dock_automatic_control(dock, epochs, xyz_uri, tmp_path):  # noqa: F811 
     dock.auto_dsm_combo.setLayer(dsm_layer)
     dock.btn_georef.click()
     assert dock.task is not None and not dock.btn_georef.isEnabled()
+    # the user removes the reference layers while the task runs: the worker reads snapshots the dock took on the
+    # GUI thread, never the project's layers (which the canvas renders, and which are gone now)
+    QgsProject.instance().removeMapLayers([ortho_layer.id(), dsm_layer.id()])
     wait_task(dock, 1200)  # about a minute on 2 idle cores; much longer under a benchmark's load
     assert dock.last_task_error is None, dock.last_task_error
     result = dock.auto_result

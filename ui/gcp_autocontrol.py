@@ -121,8 +121,11 @@ class GcpAutoControl:
             self.auto_result = result
 
         self.auto_result = None
+        from ..processing_provider.reference_layers import snapshot
+
+        # the worker reads snapshots taken here, on the GUI thread, not the project's layers the canvas renders
         task = CoreTask(translate("GcpDock", "ArchaeoOrtho: automatic control"), autocontrol_then_prepare,
-                        (root, ortho, dsm), {"check_points": gs if gs.points else None, "extent": extent,
+                        (root, snapshot(ortho), snapshot(dsm)), {"check_points": gs if gs.points else None, "extent": extent,
                                              "extent_crs": crs},
                         on_done=done, on_error=self._task_failed)
         self.message(translate("GcpDock", "Automatic control against {} and {}\u2026").format(ortho.name(), dsm.name()))
