@@ -3,6 +3,7 @@ orthorectification."""
 from __future__ import annotations
 
 import math
+import threading
 from typing import Optional, Tuple
 
 import numpy as np
@@ -36,6 +37,7 @@ class _Dsm:
         ys = (gt[3], gt[3] + self.reader.height * gt[5])
         self.bounds = (min(xs), min(ys), max(xs), max(ys))
         self.reprojected = bool(crs and self.info.crs_wkt and not _same_crs(self.info.crs_wkt, crs))
+        self._lock = threading.Lock()  # one GDAL dataset: window reads from threads take turns
 
     def close(self):
         self.reader.close()
@@ -45,7 +47,8 @@ class _Dsm:
 
     def window(self, box: Tuple[float, float, float, float]) -> Tuple[np.ndarray, Tuple[float, ...]]:
         """Heights of the cells covering ``box`` (full resolution), with their geotransform; (0, 0) if outside."""
-        return self.reader.read_window(*box)
+        with self._lock:
+            return self.reader.read_window(*box)
 
     def window_sampler(self, box: Tuple[float, float, float, float], margin_cells: int = 2):
         """A bilinear sampler over one window read once: f(x, y) -> z (NaN outside)."""
