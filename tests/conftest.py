@@ -92,6 +92,23 @@ def toledo_strip(tmp_path_factory):
 _EXIT_STATUS = {}
 
 
+def pytest_sessionstart(session):
+    """A crash in C++ (SIGSEGV, SIGABRT) prints every thread's Python stack to stderr: enabled again here, after
+    QGIS has started (pytest-qgis starts it at configure time), so a handler set meanwhile cannot hide it (an
+    intermittent SIGSEGV of the QGIS 3.40 leg at test_dock_automatic_control left no trace)."""
+    import faulthandler
+
+    # the real stderr: pytest's fd capture has fd 2 point at a temporary file, lost when the process dies
+    capman = session.config.pluginmanager.getplugin("capturemanager")
+    err = getattr(getattr(capman, "_global_capturing", None), "err", None)
+    fd = getattr(err, "targetfd_save", None)
+    _FAULT_FILE["file"] = os.fdopen(os.dup(fd), "w") if isinstance(fd, int) else sys.__stderr__
+    faulthandler.enable(file=_FAULT_FILE["file"], all_threads=True)
+
+
+_FAULT_FILE = {}
+
+
 def pytest_sessionfinish(session, exitstatus):
     _EXIT_STATUS["status"] = int(exitstatus)
 
