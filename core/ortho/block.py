@@ -148,12 +148,7 @@ def _visibility_tables(cams, fps, offset, dsm: _Dsm, tol: float, workdir: str, o
         check_cancel(progress)
         return i, build_visibility(cams[i], offset, fps[i], dsm, tol, os.path.join(workdir, f"vis_{i:05d}.npy"))
 
-    threads = max(1, min(2 if cpu_count() <= 2 else 4, len(cams)))
-    if threads == 1:
-        for i in range(len(cams)):
-            out[i] = one(i)[1]
-            progress.report((i + 1) / len(cams), f"visibility {i + 1}/{len(cams)}: {cams[i].name}")
-        return
+    threads = max(1, min(cpu_count(), 4, len(cams)))  # one image (a single orthophoto): one thread
     with cf.ThreadPoolExecutor(threads) as ex:
         futures = [ex.submit(one, i) for i in range(len(cams))]
         try:
