@@ -2,6 +2,7 @@
 figures read back from the database and the model (verified partners, camera rows, camera summary)."""
 from __future__ import annotations
 
+import math
 from typing import Dict, List
 
 import numpy as np
@@ -84,6 +85,39 @@ def _map_global(pycolmap, db_path, images_dir, out_dir, n_images, options, progr
     check_cancel(progress)
     progress.report(1.0, "mapping: global SfM done")
     return recs
+
+
+# a registered camera whose focal length is outside these multiples of the image's long side is degenerate (COLMAP's
+# own bounds for bogus cameras): a view self-calibrated from a few points can come back from the mapper with a
+# focal of 10^8 px, and the bundle adjustment then diverges on it (the block's mean reprojection error 10^151)
+MIN_FOCAL_RATIO, MAX_FOCAL_RATIO = 0.1, 10.0
+
+
+def degenerate_camera(cam) -> str:
+    """Why a camera's parameters are degenerate, or "" when they are not: non-finite values, or a focal length
+    outside MIN_FOCAL_RATIO..MAX_FOCAL_RATIO times the long side (distortion is not judged: a wide lens may have
+    large coefficients)."""
+    params = [float(v) for v in cam.params]
+    if not all(math.isfinite(v) for v in params):
+        return "its camera parameters are not finite"
+    if cam.has_bogus_params(MIN_FOCAL_RATIO, MAX_FOCAL_RATIO, math.inf):
+        return (f"could not be registered: the mapper gave it a degenerate camera (focal "
+                f"{cam.mean_focal_length():.4g} px for a {cam.width} x {cam.height} photo)")
+    return ""
+
+
+def drop_degenerate(rec) -> Dict[str, str]:
+    """De-register the images of ``rec`` whose camera is degenerate (see :func:`degenerate_camera`); returns
+    image name -> why.  Their observations go with them, so neither the bundle adjustment nor a later stage
+    sees them."""
+    dropped: Dict[str, str] = {}
+    for image_id in list(rec.reg_image_ids()):
+        im = rec.images[image_id]
+        why = degenerate_camera(rec.cameras[im.camera_id])
+        if why:
+            dropped[im.name] = why
+            rec.deregister_frame(im.frame_id)
+    return dropped
 
 
 def final_bundle_adjustment(pycolmap, rec, options: AlignOptions, progress: Progress):

@@ -38,6 +38,7 @@ from .features import database_key, extract_features, file_hash, masks_for_colma
 from .mapping import (
     camera_rows,
     camera_summary,
+    drop_degenerate,
     final_bundle_adjustment,
     run_mapping,
     verified_pairs,
@@ -95,8 +96,9 @@ def _read_images(images_dir: str, options: AlignOptions,
 
 
 def diagnose_unregistered(infos: Sequence[ImageInfo], registered: Set[str], others: Sequence[Sequence[str]],
-                          partners: Dict[str, int]) -> Dict[str, str]:
-    """Why each image outside the main block is not registered: image -> reason."""
+                          partners: Dict[str, int], degenerate: Optional[Dict[str, str]] = None) -> Dict[str, str]:
+    """Why each image outside the main block is not registered: image -> reason.  ``degenerate``: the images
+    de-registered for a degenerate camera (mapping.drop_degenerate), with why."""
     in_other = {n: k for k, comp in enumerate(others, start=2) for n in comp}
     unregistered: Dict[str, str] = {}
     for im in infos:
@@ -106,6 +108,8 @@ def diagnose_unregistered(infos: Sequence[ImageInfo], registered: Set[str], othe
             k = in_other[im.name]
             unregistered[im.name] = (f"in a separate component (#{k}, {len(others[k - 2])} images) that "
                                      "shares too few matches with the main block")
+        elif im.name in (degenerate or {}):
+            unregistered[im.name] = f"matched {partners.get(im.name, 0)} image(s) but {degenerate[im.name]}"
         elif partners.get(im.name, 0) == 0:
             unregistered[im.name] = "no verified matches with any other image (no overlap, blur or too little texture)"
         else:
@@ -140,14 +144,23 @@ def _no_reconstruction(partners: Dict[str, int], n_images: int, n_pairs: int) ->
 
 
 def _mapping(pycolmap, lay: Layout, db_path: str, images_dir: str, n_images: int, options: AlignOptions,
-             progress: Progress):
-    """The reconstructions, largest first; mapping works in a scratch folder removed afterwards."""
+             progress: Progress, degenerate: Optional[Dict[str, str]] = None):
+    """The reconstructions, largest first, without the images the mapper gave a degenerate camera (those go to
+    ``degenerate``: name -> why, added to: the reason an image left out in the end was last left out for); mapping works in a scratch folder removed afterwards."""
     map_tmp = os.path.join(lay.sfm_dir, ".mapping")
     shutil.rmtree(map_tmp, ignore_errors=True)
     os.makedirs(map_tmp)
     recs = run_mapping(pycolmap, db_path, images_dir, map_tmp, n_images, options, progress)
     shutil.rmtree(map_tmp, ignore_errors=True)
-    return sorted(recs.values(), key=lambda r: r.num_reg_images(), reverse=True) if recs else []
+    dropped: Dict[str, str] = {}
+    for rec in (recs.values() if recs else ()):
+        dropped.update(drop_degenerate(rec))
+    for name, why in dropped.items():
+        progress.warning(f"mapping: {name} {why}: left out of the block")
+    if degenerate is not None:
+        degenerate.update(dropped)
+    kept = [r for r in (recs.values() if recs else ()) if r.num_reg_images() > 0]
+    return sorted(kept, key=lambda r: r.num_reg_images(), reverse=True)
 
 
 @dataclass
@@ -272,14 +285,17 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
             progress.info(f"pair selection: {pairing_used}, {len(pairs)} pairs for {len(infos)} images")
             match_pairs(pycolmap, db_path, pairs, lay.sfm_dir, options, SubProgress(progress, 0.35, 0.65))
         # 4. mapping, then escalation where the fast path left images out or split the block
+        degenerate: Dict[str, str] = {}  # images a mapping gave a degenerate camera: name -> why
         with run.step("mapping", save=False):
             ordered = _mapping(pycolmap, lay, db_path, images_dir, len(infos), options,
-                               SubProgress(progress, 0.65, 0.90))
+                               SubProgress(progress, 0.65, 0.90), degenerate)
         ctx = EscalationContext(pycolmap, db_path, lay.sfm_dir, images_dir, [im.name for im in infos], groups,
                                 camera_ids, options, pairs, mask_path, list(masks),
-                                lambda p: _mapping(pycolmap, lay, db_path, images_dir, len(infos), options, p),
+                                lambda p: _mapping(pycolmap, lay, db_path, images_dir, len(infos), options, p,
+                                                   degenerate),
                                 lambda reg, oth: diagnose_unregistered(
-                                    infos, reg, oth, verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS)),
+                                    infos, reg, oth, verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS),
+                                    degenerate),
                                 lambda: verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS))
         with run.step("escalation", save=False):
             ordered, escalation = escalate(ctx, ordered, SubProgress(progress, 0.90, 0.93))
@@ -292,8 +308,14 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
         with run.step("bundle_adjustment", save=False):
             progress.report(0.94, "final bundle adjustment")
             pp = final_bundle_adjustment(pycolmap, rec, options, progress)
+            diverged = drop_degenerate(rec)  # a camera with few points the adjustment sent off: out, and again
+            if diverged:
+                for name, why in diverged.items():
+                    progress.warning(f"final bundle adjustment: {name} {why}: left out of the block")
+                degenerate.update(diverged)
+                pp = final_bundle_adjustment(pycolmap, rec, options, progress)
         registered = {rec.images[i].name for i in rec.reg_image_ids()}
-        unregistered = diagnose_unregistered(infos, registered, others, partners)
+        unregistered = diagnose_unregistered(infos, registered, others, partners, degenerate)
         _report_unregistered(progress, unregistered, others, len(registered))
         check_cancel(progress)
 
