@@ -28,7 +28,11 @@ from .options import (
     AUTO_FEATURES_RANGE,
     CAMERA_MODELS,
     EXTRACT_BLOCK,
+    EXTRACT_BLOCK_MEGAPIXELS,
     MATCH_BLOCK,
+    MATCH_BLOCK_KEYPOINTS,
+    MAX_EXTRACT_BLOCK,
+    MAX_MATCH_BLOCK,
     UPSAMPLE_BELOW,
     AlignError,
     AlignOptions,
@@ -173,6 +177,21 @@ def sift_first_octave(options: AlignOptions, width: int, height: int) -> int:
     return -1 if side < UPSAMPLE_BELOW else 0
 
 
+def extract_block(width: int, height: int, max_image_size: int = 0, first_octave: int = 0) -> int:
+    """Images per extraction call: about EXTRACT_BLOCK_MEGAPIXELS of SIFT's work (at the features' scale, an
+    upsampled image four times its pixels), within EXTRACT_BLOCK..MAX_EXTRACT_BLOCK."""
+    scale = feature_image_size(width, height, max_image_size) / max(width, height)
+    mp = width * height * scale * scale / 1e6 * (4.0 if first_octave < 0 else 1.0)
+    return int(min(MAX_EXTRACT_BLOCK, max(EXTRACT_BLOCK, EXTRACT_BLOCK_MEGAPIXELS // max(mp, 1e-6))))
+
+
+def match_block(mean_keypoints: float) -> int:
+    """Pairs per matching call: MATCH_BLOCK at MATCH_BLOCK_KEYPOINTS keypoints per image, more for fewer (the
+    cost of a pair grows with the product of the counts), within MATCH_BLOCK..MAX_MATCH_BLOCK."""
+    ratio = MATCH_BLOCK_KEYPOINTS / max(1.0, float(mean_keypoints))
+    return int(min(MAX_MATCH_BLOCK, max(MATCH_BLOCK, round(MATCH_BLOCK * ratio * ratio))))
+
+
 def extract_features(pycolmap, db_path, images_dir, groups, camera_ids, options, progress: Progress,
                      mask_path: Optional[str] = None, masked: Optional[Sequence[str]] = None,
                      sift: Optional[Dict[str, object]] = None):
@@ -199,11 +218,12 @@ def extract_features(pycolmap, db_path, images_dir, groups, camera_ids, options,
     todo: List[Tuple[CameraGroup, List[str]]] = []
     for g in groups:
         rest = [n for n in g.images if n not in done]
+        size = extract_block(g.width, g.height, options.max_image_size, int(eo.sift.first_octave))
         # COLMAP skips an image whose mask is missing when mask_path is set: masked and unmasked images go
         # in separate blocks (in file order), only the masked ones with mask_path
         block: List[str] = []
         for n in rest:
-            if block and (len(block) >= EXTRACT_BLOCK or (n in masked) != (block[0] in masked)):
+            if block and (len(block) >= size or (n in masked) != (block[0] in masked)):
                 todo.append((g, block))
                 block = []
             block.append(n)
@@ -233,6 +253,7 @@ def match_pairs(pycolmap, db_path, pairs, work_dir, options, progress: Progress)
     db = pycolmap.Database.open(db_path)
     try:
         id_by_name = {im.name: im.image_id for im in db.read_all_images()}
+        size = match_block(db.num_keypoints() / max(1, len(id_by_name)))
         todo = []
         for a, b in pairs:
             if a not in id_by_name or b not in id_by_name:
@@ -247,9 +268,9 @@ def match_pairs(pycolmap, db_path, pairs, work_dir, options, progress: Progress)
     mo.num_threads = options.num_threads
     vo = pycolmap.TwoViewGeometryOptions()
     list_path = os.path.join(work_dir, "pairs-block.txt")
-    for start in range(0, len(todo), MATCH_BLOCK):
+    for start in range(0, len(todo), size):
         check_cancel(progress)
-        block = todo[start:start + MATCH_BLOCK]
+        block = todo[start:start + size]
         atomic_write_text(list_path, "".join(f"{a} {b}\n" for a, b in block))
         po = pycolmap.ImportedPairingOptions()
         po.match_list_path = list_path
@@ -258,5 +279,5 @@ def match_pairs(pycolmap, db_path, pairs, work_dir, options, progress: Progress)
                                        verification_options=vo, device=pycolmap.Device.cpu,
                                        cancellation_token=token)
         check_cancel(progress)
-        done = min(len(todo), start + MATCH_BLOCK)
+        done = min(len(todo), start + size)
         progress.report(done / max(1, len(todo)), f"matching: {done}/{len(todo)} pairs")
