@@ -107,6 +107,41 @@ def test_georeference_from_the_toolbox_loads_styled_layers(plugin, aligned, qgis
     _render(QgsProject.instance(), [residuals, cams, layers["footprints"]], "toolbox-georeference-layers.png")
 
 
+def test_footprints_not_written_say_why(plugin, aligned, monkeypatch):
+    """No footprints before the georeference, silently (nothing to draw yet); a failure to write them after it
+    is said in the message log with the reason (it used to be swallowed), and the loading goes on (None)."""
+    from archaeoortho.core.georef.stage import georeference_workspace
+    from archaeoortho.core.project.layout import Layout
+    from archaeoortho.core.project.workspace import Workspace
+    from archaeoortho.ui import layers
+    from qgis.core import QgsApplication
+
+    ws, gcp_file = aligned
+    logged = []
+
+    def on_message(text, tag, level):
+        if tag == "ArchaeoOrtho":
+            logged.append(text)
+
+    log = QgsApplication.messageLog()
+    log.messageReceived.connect(on_message)
+    try:
+        assert layers.footprints_path(ws) is None and not logged  # not georeferenced yet
+        georeference_workspace(ws, gcp_file)
+        path = Layout(Workspace.open(ws)).footprints_gpkg
+        assert layers.footprints_path(ws) == path and os.path.isfile(path)
+        from archaeoortho.core.georef import guided
+
+        def disk_full(path, *args, **kwargs):
+            raise OSError(28, "No space left on device", path)
+
+        monkeypatch.setattr(guided, "write_footprints_gpkg", disk_full)
+        assert layers.footprints_path(ws) is None
+    finally:
+        log.messageReceived.disconnect(on_message)
+    assert any("footprints" in m and "not written" in m and "No space left" in m for m in logged), logged
+
+
 def test_hook_registers_only_our_outputs(plugin, aligned):
     from qgis.core import QgsApplication, QgsProcessingContext, QgsProcessingFeedback, QgsProject
 

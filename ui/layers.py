@@ -525,18 +525,22 @@ def footprints_path(workspace):
         from ..core.georef.stage import load_georef_model
     except ImportError:
         return None
+    from ..core.common.errors import ArchaeoOrthoError
+
     try:
         rec, transform = load_georef_model(workspace)
-    except Exception:  # noqa: BLE001 - not georeferenced or no pycolmap: no footprints
+    except ArchaeoOrthoError:  # not georeferenced (yet): no footprints, nothing to say
         return None
-    z = [p.xyz[2] for p in rec.points3D.values()]
-    if not z:
-        return None
-    prints = guided.image_footprints(rec, float(np.median(z)))
-    path = workspace_layout(workspace).footprints_gpkg
     try:
+        z = [p.xyz[2] for p in rec.points3D.values()]
+        if not z:
+            return None
+        prints = guided.image_footprints(rec, float(np.median(z)))
+        path = workspace_layout(workspace).footprints_gpkg
         return guided.write_footprints_gpkg(path, prints, transform.get("offset", (0, 0, 0)), transform.get("crs"))
-    except Exception:  # noqa: BLE001 - a missing GPKG driver must not stop the loading of the rest
+    except Exception as err:  # noqa: BLE001 - the footprints must not stop the loading of the rest: said, not hidden
+        QgsMessageLog.logMessage(f"image footprints of {workspace} not written: {type(err).__name__}: {err}",
+                                 "ArchaeoOrtho", Qgis.MessageLevel.Warning)
         return None
 
 
