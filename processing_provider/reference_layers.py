@@ -203,7 +203,14 @@ def save_layer(layer, path, extent, crs, res, what="orthophoto", progress=None, 
     where = f"{grid.toString(2)} in {crs.authid()} at {res:g} per pixel ({cols} x {rows})"
     if progress is not None:
         progress.info(f"saving the reference {what} {describe(layer)}: {where}")
-    err = writer.writeRaster(pipe, cols, rows, grid, crs, context, feedback)
+    try:
+        err = writer.writeRaster(pipe, cols, rows, grid, crs, context, feedback)
+    finally:
+        # the pipe (with its provider clone) and the feedback die here, in the thread that made them: the
+        # feedback and its slot refer to each other, and Python's cycle collector would delete that QObject
+        # later in whatever thread runs Python then
+        feedback.progressChanged.disconnect(progressed)
+        del pipe, writer
     if feedback.isCanceled() or (progress is not None and progress.is_cancelled()):
         _remove(tmp)
         raise Cancelled(f"saving the reference {what} {layer.name()}")

@@ -9,7 +9,7 @@ what the stage wrote to georef/control.json (the automatic GCPs auto_NNN and the
 cameras and the automatic GCPs' residuals.  A mixin of ui.gcp_dock.GcpDock; its strings are in the dock's
 translation context.
 """
-from qgis.core import Qgis, QgsMapLayerProxyModel, QgsProject
+from qgis.core import Qgis, QgsCoordinateTransformContext, QgsMapLayerProxyModel, QgsProject
 from qgis.gui import QgsMapLayerComboBox
 from qgis.PyQt.QtCore import QCoreApplication
 from qgis.PyQt.QtWidgets import QFormLayout, QGroupBox
@@ -22,7 +22,7 @@ translate = QCoreApplication.translate
 
 
 def autocontrol_then_prepare(root, ortho_layer, dsm_layer, check_points=None, extent=None, extent_crs=None,
-                             progress=None):
+                             context=None, progress=None):
     """In the worker thread: the reference layers as files (saved when they are web layers), the automatic
     control, then the image footprints the result layers show.  Returns (AutoControlResult, footprints)."""
     from ..core.common.progress import SubProgress
@@ -30,7 +30,7 @@ def autocontrol_then_prepare(root, ortho_layer, dsm_layer, check_points=None, ex
     from ..processing_provider import reference_layers as refs
 
     ortho, dsm = refs.resolve_references(ortho_layer, dsm_layer, root, extent=extent, extent_crs=extent_crs,
-                                         progress=SubProgress(progress, 0.0, 0.1))
+                                         progress=SubProgress(progress, 0.0, 0.1), context=context)
     check = refs.as_check_points(check_points, refs.reference_crs(ortho))
     result = autocontrol_workspace(root, ortho, dsm, check_points=check, progress=SubProgress(progress, 0.1, 0.97))
     return result, layers.footprints_path(root)
@@ -124,9 +124,11 @@ class GcpAutoControl:
         from ..processing_provider.reference_layers import snapshot
 
         # the worker reads snapshots taken here, on the GUI thread, not the project's layers the canvas renders
+        # and the project's transform context, copied here: QgsProject is not read from the worker either
+        context = QgsCoordinateTransformContext(QgsProject.instance().transformContext())
         task = CoreTask(translate("GcpDock", "ArchaeoOrtho: automatic control"), autocontrol_then_prepare,
                         (root, snapshot(ortho), snapshot(dsm)), {"check_points": gs if gs.points else None, "extent": extent,
-                                             "extent_crs": crs},
+                                             "extent_crs": crs, "context": context},
                         on_done=done, on_error=self._task_failed)
         self.message(translate("GcpDock", "Automatic control against {} and {}\u2026").format(ortho.name(), dsm.name()))
         return self._start_task(task)

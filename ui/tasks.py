@@ -87,6 +87,19 @@ class CoreTask(QgsTask):
         except Exception as e:  # noqa: BLE001 - an exception escaping a C++ virtual would abort QGIS
             log_traceback(self.description(), e)
             _tell_user(self.description(), e)
+        finally:
+            self._release()
+
+    def _release(self):
+        """Drop the inputs here, in the main thread, when the task has ended.  They may hold Qt objects made in
+        the main thread (the dock's layer snapshots hold provider clones); kept, they would die with the task
+        whenever Python's cycle collector gets to it (the task and its progress adapter refer to each other),
+        in whatever thread happens to run Python then, and a QObject must not be deleted from another thread."""
+        self.fn = None
+        self.args = ()
+        self.kwargs = {}
+        self.on_done = self.on_error = None
+        self.progress_adapter.task = None  # the cycle task <-> adapter, broken: the task dies by reference count
 
 
 def log_traceback(what, error):
