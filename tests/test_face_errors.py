@@ -81,3 +81,41 @@ def test_guided_read_gray_names_the_unreadable_photo(tmp_path):
     bad.write_text("text, not JPEG")
     with pytest.raises(ArchaeoOrthoError, match="not_a_photo.jpg"):
         read_gray(str(bad))
+
+
+def test_core_task_releases_its_inputs_in_the_main_thread_when_it_ends():
+    """A CoreTask's inputs (the dock's layer snapshots hold provider clones, Qt objects of the main thread) are
+    released when it ends, in the main thread, by reference count: not left to Python's cycle collector, which
+    would free them later in whatever thread runs Python then.  The task runs in QGIS's task manager here."""
+    import gc
+    import threading
+    import time
+
+    from archaeoortho.ui.tasks import CoreTask
+    from qgis.core import QgsApplication
+    from qgis.PyQt.QtCore import QCoreApplication
+
+    freed = []
+
+    class Input:
+        def __del__(self):
+            freed.append(threading.current_thread() is threading.main_thread())
+
+    def work(thing, progress=None):
+        progress.report(0.5, "half way")
+        return "done"
+
+    done = []
+    gc.disable()  # only reference counts free things in this test
+    try:
+        task = CoreTask("release", work, (Input(),), on_done=done.append)
+        QgsApplication.taskManager().addTask(task)
+        t0 = time.time()
+        while not done and time.time() - t0 < 30:
+            QCoreApplication.processEvents()
+            time.sleep(0.01)
+        assert done == ["done"]
+        assert freed == [True]  # freed already, and in the main thread
+        assert task.progress_adapter.task is None  # no task <-> adapter cycle left
+    finally:
+        gc.enable()
