@@ -2,7 +2,6 @@
 interpolated (dense/dsm-source.tif), and a synthetic block with a low-texture ground patch (bare soil, uniform
 crops) measured, its accuracy against the truth reported apart for measured and interpolated cells."""
 import os
-import shutil
 
 import numpy as np
 import pytest
@@ -14,6 +13,7 @@ from core.io import raster
 from tests import synthetic as syn
 from tests.conftest import ROOT
 from tests.test_dense import CAMERA, _truth_grid, make_workspace
+from tests.workspaces import rendered_once
 
 # ---------------------------------------------------------------------------
 # units: the fill and the source raster
@@ -130,12 +130,7 @@ def _block():
 def lowtex(tmp_path_factory):
     """The DSM stage on the low-texture block (images rendered once, cached under build/)."""
     block = _block()
-    images = os.path.join(CACHE, "images")
-    done = os.path.join(CACHE, "done")
-    if not os.path.exists(done):
-        shutil.rmtree(images, ignore_errors=True)
-        block.render(images)
-        open(done, "w").close()
+    images = rendered_once(block, CACHE)
     root = tmp_path_factory.mktemp("dense lowtex")
     ws = make_workspace(str(root / "ws"), block, images_dir=images)
     r = dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=1))

@@ -13,7 +13,6 @@ The photos are rendered once and cached under build/test-cache (about a minute).
 import glob
 import json
 import os
-import shutil
 
 import numpy as np
 import pytest
@@ -21,7 +20,8 @@ import pytest
 from core.dense import stage as dense
 from core.dense.options import DenseOptions
 from tests import synthetic as syn
-from tests.test_dense import _truth_grid, make_workspace
+from tests.test_dense import _truth_grid, make_workspace, wall_offsets
+from tests.workspaces import rendered_once
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CACHE = os.path.join(ROOT, "build", "test-cache", "dense-walls-x4-v1")
@@ -42,12 +42,7 @@ def _block():
 @pytest.fixture(scope="module")
 def walls(tmp_path_factory):
     block = _block()
-    images = os.path.join(CACHE, "images")
-    done = os.path.join(CACHE, "done")
-    if not os.path.exists(done):
-        shutil.rmtree(images, ignore_errors=True)
-        block.render(images)
-        open(done, "w").close()
+    images = rendered_once(block, CACHE)
     root = tmp_path_factory.mktemp("dense walls")
     ws = make_workspace(str(root / "ws"), block, images_dir=images)
     r = dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=1))
@@ -73,26 +68,11 @@ def test_full_resolution_pairs_reach_the_two_way_path(walls):
 
 
 def test_walls_stay_sharp_at_full_resolution(walls):
-    from scipy import ndimage
-
     block, _, r = walls
     z, gt, _, x, y, truth = _truth_grid(block, r.dsm_path)
     cell = abs(gt[1])
     assert cell < 0.07  # the full-resolution grid (the 400 x 300 block's is 0.23 m)
-    covered = np.isfinite(z)
-    checked, worst = 0, {}
-    for b in block.scene.buildings:
-        inside = b.contains(x, y)
-        if inside.sum() == 0 or (inside & covered).sum() < 0.9 * inside.sum():
-            continue  # not (fully) seen by the block
-        near = b.contains(x, y, 6.0)
-        ground = float(np.median(truth[near & ~b.contains(x, y, 1.0)]))
-        mid = 0.5 * (b.roof + ground)
-        high = truth > mid
-        wrong = near & covered & ((z > mid) != high)
-        outline = high ^ ndimage.binary_erosion(high)
-        dist = ndimage.distance_transform_edt(~outline) * cell  # metres from the true outline
-        worst[(round(b.cx), round(b.cy))] = float(dist[wrong].max()) if wrong.any() else 0.0
-        checked += 1
-    assert checked >= 2
+    offsets = wall_offsets(block, z, x, y, truth)
+    assert len(offsets) >= 2
+    worst = {(round(b.cx), round(b.cy)): cells * cell for b, cells in offsets}  # metres from the true outline
     assert max(worst.values()) <= WALL_TOLERANCE_M, worst

@@ -76,3 +76,17 @@ def set_exif_gps(root, positions, crs):
         im["gps"] = [float(p[0]), float(p[1]), float(p[2])]
     ws.save()
     return ws.root
+
+
+def rendered_once(block, cache_dir):
+    """``cache_dir``/images: the block's photos, rendered the first time and kept (a ``done`` file marks a complete
+    rendering; an interrupted one is rendered again)."""
+    import shutil
+
+    images = os.path.join(cache_dir, "images")
+    done = os.path.join(cache_dir, "done")
+    if not os.path.exists(done):
+        shutil.rmtree(images, ignore_errors=True)
+        block.render(images)
+        open(done, "w").close()
+    return images

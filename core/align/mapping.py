@@ -99,7 +99,7 @@ def degenerate_camera(cam) -> str:
     large coefficients)."""
     params = [float(v) for v in cam.params]
     if not all(math.isfinite(v) for v in params):
-        return "its camera parameters are not finite"
+        return "could not be registered: the mapper gave it non-finite camera parameters"
     if cam.has_bogus_params(MIN_FOCAL_RATIO, MAX_FOCAL_RATIO, math.inf):
         return (f"could not be registered: the mapper gave it a degenerate camera (focal "
                 f"{cam.mean_focal_length():.4g} px for a {cam.width} x {cam.height} photo)")

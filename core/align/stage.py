@@ -145,8 +145,9 @@ def _no_reconstruction(partners: Dict[str, int], n_images: int, n_pairs: int) ->
 
 def _mapping(pycolmap, lay: Layout, db_path: str, images_dir: str, n_images: int, options: AlignOptions,
              progress: Progress, degenerate: Optional[Dict[str, str]] = None):
-    """The reconstructions, largest first, without the images the mapper gave a degenerate camera (those go to
-    ``degenerate``: name -> why, added to: the reason an image left out in the end was last left out for); mapping works in a scratch folder removed afterwards."""
+    """The reconstructions, largest first, without the images the mapper gave a degenerate camera: those are added
+    to ``degenerate`` (name -> why; an image's entry says why a mapping last left it out).  The mapping works in a
+    scratch folder removed afterwards."""
     map_tmp = os.path.join(lay.sfm_dir, ".mapping")
     shutil.rmtree(map_tmp, ignore_errors=True)
     os.makedirs(map_tmp)
@@ -308,8 +309,11 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
         with run.step("bundle_adjustment", save=False):
             progress.report(0.94, "final bundle adjustment")
             pp = final_bundle_adjustment(pycolmap, rec, options, progress)
-            diverged = drop_degenerate(rec)  # a camera with few points the adjustment sent off: out, and again
-            if diverged:
+            # a camera with few points the adjustment sent off goes out, and the adjustment runs again (until none)
+            for _ in range(len(infos)):
+                diverged = drop_degenerate(rec)
+                if not diverged:
+                    break
                 for name, why in diverged.items():
                     progress.warning(f"final bundle adjustment: {name} {why}: left out of the block")
                 degenerate.update(diverged)

@@ -138,28 +138,18 @@ def prepare_block(cameras: Sequence[OrthoCamera], dsm: _Dsm, offset: np.ndarray,
 
 def _visibility_tables(cams, fps, offset, dsm: _Dsm, tol: float, workdir: str, out: List[Optional[Visibility]],
                        progress: Progress) -> None:
-    """The visibility tables into ``out``, on one thread per core: numpy and OpenCV release the GIL on the
-    tables' arrays and the DSM's window reads take turns (toledo_2400: 57 tables, 17 s on one core)."""
-    import concurrent.futures as cf
+    """The visibility tables into ``out``, on one thread per core (at most 4): numpy and OpenCV release the GIL on
+    the tables' arrays and the DSM's window reads take turns (toledo_2400: 57 tables, 17 s on one core)."""
+    from ..common.parallel import cpu_count, make_executor, run_units
 
-    from ..common.parallel import cpu_count
-
-    def one(i):
-        check_cancel(progress)
-        return i, build_visibility(cams[i], offset, fps[i], dsm, tol, os.path.join(workdir, f"vis_{i:05d}.npy"))
+    def one(i, _cancel_path):
+        return build_visibility(cams[i], offset, fps[i], dsm, tol, os.path.join(workdir, f"vis_{i:05d}.npy"))
 
     threads = max(1, min(cpu_count(), 4, len(cams)))  # one image (a single orthophoto): one thread
-    with cf.ThreadPoolExecutor(threads) as ex:
-        futures = [ex.submit(one, i) for i in range(len(cams))]
-        try:
-            for done, fut in enumerate(cf.as_completed(futures), 1):
-                i, v = fut.result()
-                out[i] = v
-                progress.report(done / len(cams), f"visibility {done}/{len(cams)}: {cams[i].name}")
-        except BaseException:
-            for fut in futures:
-                fut.cancel()
-            raise
+    with make_executor(threads, kind="thread") as ex:
+        for i, v in run_units(ex, one, list(range(len(cams))), progress, label="visibility",
+                              describe=lambda i: cams[i].name):
+            out[i] = v
 
 
 def _limit_resolution(cams: Sequence[OrthoCamera], fps: Sequence[Footprint], offset: np.ndarray, z_lo: float,
