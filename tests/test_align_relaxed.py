@@ -86,3 +86,35 @@ def test_the_second_pass_registers_the_steep_views_the_first_pass_left_out(orbit
     assert max(err[n] for n in late) <= 0.5
     assert max(err.values()) <= 0.5
     assert both.mean_reprojection_error < 0.5
+
+
+def test_no_second_pass_for_images_without_a_verified_pair_into_the_block(monkeypatch, tmp_path):
+    """A left-out photo that shares no verified pair with the block (a foreign photo) cannot be registered: the
+    second pass is not run for it (it would reload the whole database for nothing)."""
+    import pycolmap
+
+    class _Rec:
+        def __init__(self, names):
+            self.images = {k: type("I", (), {"name": n})() for k, n in enumerate(names)}
+
+        def reg_image_ids(self):
+            return list(self.images)
+
+        def num_reg_images(self):
+            return len(self.images)
+
+        def write(self, path):
+            written.append(path)
+
+    calls, written = [], []
+    monkeypatch.setattr(pycolmap, "incremental_mapping", lambda *a, **k: calls.append(1) or {})
+    recs = {0: _Rec(["a.jpg", "b.jpg", "c.jpg"])}
+    opts = pycolmap.IncrementalPipelineOptions()
+    links = [("a.jpg", "b.jpg"), ("b.jpg", "c.jpg"), ("d.jpg", "e.jpg")]
+    monkeypatch.setattr(mapping, "verified_links", lambda *a: (["a.jpg", "b.jpg", "c.jpg", "d.jpg", "e.jpg"], links))
+    out = mapping._register_rest(pycolmap, recs, "db", "imgs", str(tmp_path), 5, opts, NullProgress(), None)
+    assert out is recs and not calls and not written
+    # with a verified pair from a left-out photo into the block the pass runs (and, finding nothing, keeps the block)
+    links.append(("c.jpg", "d.jpg"))
+    out = mapping._register_rest(pycolmap, recs, "db", "imgs", str(tmp_path), 5, opts, NullProgress(), None)
+    assert calls == [1] and written and out[0] is recs[0]

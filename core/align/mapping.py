@@ -13,20 +13,29 @@ from ..common.progress import Progress, check_cancel
 from .options import AlignOptions
 
 
-def verified_partners(pycolmap, db_path, min_inliers: int) -> Dict[str, int]:
+def verified_links(pycolmap, db_path, min_inliers: int):
+    """(every image name, the name pairs of the database with at least ``min_inliers`` verified inliers)."""
     db = pycolmap.Database.open(db_path)
     try:
         names = {im.image_id: im.name for im in db.read_all_images()}
         pair_ids, counts = db.read_two_view_geometry_num_inliers()
-        partners = {n: 0 for n in names.values()}
+        links = []
         for pid, c in zip(pair_ids, counts):
             if c >= min_inliers:
                 i, j = pycolmap.pair_id_to_image_pair(pid)
-                partners[names[i]] += 1
-                partners[names[j]] += 1
-        return partners
+                links.append((names[i], names[j]))
+        return list(names.values()), links
     finally:
         db.close()
+
+
+def verified_partners(pycolmap, db_path, min_inliers: int) -> Dict[str, int]:
+    names, links = verified_links(pycolmap, db_path, min_inliers)
+    partners = {n: 0 for n in names}
+    for a, b in links:
+        partners[a] += 1
+        partners[b] += 1
+    return partners
 
 
 def verified_pairs(pycolmap, db_path, min_inliers: int) -> int:
@@ -89,6 +98,11 @@ def _register_rest(pycolmap, recs, db_path, images_dir, out_dir, n_images, opts,
     key, best = max(recs.items(), key=lambda kv: kv[1].num_reg_images())
     before = {best.images[i].name for i in best.reg_image_ids()}
     if len(before) >= n_images or len(before) < 3:
+        return recs
+    # only an image with a verified pair into the block can be registered: without one (a foreign photo) the pass
+    # would reload the whole database for nothing
+    _names, links = verified_links(pycolmap, db_path, opts.min_num_matches)
+    if not any((a in before) != (b in before) for a, b in links):
         return recs
     in_dir = os.path.join(out_dir, "continue-in")
     cont_dir = os.path.join(out_dir, "continue")
