@@ -15,13 +15,16 @@ import pytest
 
 from core.align.escalation import (
     ESCALATION_MIN_FEATURES,
+    WEAK_MIN_TIES,
     block_state,
     escalated_sift,
     escalation_reason,
     forget_features,
     kind_order,
     round_pairs,
+    weak_images,
 )
+from core.align.mapping import RELAXED_ABS_POSE_MIN_INLIERS
 from core.align.options import AlignError, AlignOptions
 from core.align.stage import align
 from tests.conftest import SAMPLE
@@ -64,8 +67,9 @@ def _options(**kw):
 
 
 class _Image:
-    def __init__(self, name):
+    def __init__(self, name, ties=500):
         self.name = name
+        self.num_points3D = ties
 
 
 def _sql(db, *statements):
@@ -78,10 +82,10 @@ def _sql(db, *statements):
 
 
 class _Rec:
-    """The two things block_state reads of a pycolmap.Reconstruction."""
+    """What block_state and weak_images read of a pycolmap.Reconstruction (``ties``: name -> tie points)."""
 
-    def __init__(self, names):
-        self.images = {k: _Image(n) for k, n in enumerate(names)}
+    def __init__(self, names, ties=None):
+        self.images = {k: _Image(n, (ties or {}).get(n, 500)) for k, n in enumerate(names)}
 
     def reg_image_ids(self):
         return list(self.images)
@@ -108,6 +112,53 @@ def test_escalation_reason_and_settings():
     assert escalated_sift(AlignOptions(max_features=6000), 4000, 3000, "affine")["max_num_features"] == 6000
     with pytest.raises(ValueError, match="unknown escalation kind"):
         escalated_sift(AlignOptions(), 1152, 640, "dsp")
+
+
+def test_weakly_tied_images_are_named_with_the_figures():
+    ties = {"a": 300, "b": 280, "c": 13, "d": 250, "e": 29, "f": 30, "g": 45}
+    weak = weak_images([_Rec(list(ties), ties)])
+    assert sorted(weak) == ["c", "e"]  # fewer than COLMAP's 30 to register; 30 and 45 are not weak
+    assert "tied by only 13 points" in weak["c"] and "median 45" in weak["c"]
+    assert weak_images([]) == {} and weak_images([_Rec(["a", "b"], {"a": 5, "b": 5})]) == {}  # a stereo pair
+    assert escalation_reason(3, {"a", "b", "c"}, [], ["c"]) == "1 image(s) of the block weakly tied"
+    assert kind_order({"c": weak["c"], "e": weak["e"]}, ["c", "e"]) == ("affine", "faint")
+    assert RELAXED_ABS_POSE_MIN_INLIERS < WEAK_MIN_TIES  # what the relaxed pass registers on can be escalated
+
+
+def test_a_weakly_tied_image_is_escalated_and_the_stronger_result_kept(tmp_path, monkeypatch):
+    """Every image registered, one on 13 tie points: an affine round runs for it alone (it stays registered,
+    not a neighbour), and its result is kept because it ties that image well; a round that leaves it weak is not."""
+    import core.align.escalation as esc
+    from core.common.progress import NullProgress
+
+    db = tmp_path / "database.db"
+    _sql(db, "CREATE TABLE keypoints (image_id INTEGER, rows INTEGER)")
+    names = ["a", "b", "c", "d"]
+    weak = _Rec(names, {"a": 300, "b": 280, "c": 13, "d": 250})
+    strong = _Rec(names, {"a": 310, "b": 290, "c": 140, "d": 260})
+    seen = []
+
+    def round_(ctx, k, reason, ordered, left, progress, kind="faint"):
+        seen.append((k, kind, list(left), reason))
+        new = [strong] if outcome == "strong" else [_Rec(names, {"a": 300, "b": 280, "c": 20, "d": 250})]
+        return esc.EscalationRound(k, reason, kind, {n: "?" for n in left}, list(left), [], {}, 1, 4, 1, 4, 1,
+                                   kept=esc._better(new, ordered)), new
+
+    monkeypatch.setattr(esc, "_run_round", round_)
+    ctx = esc.EscalationContext(None, str(db), str(tmp_path), str(tmp_path), names, [], {}, AlignOptions(), [],
+                                None, [], lambda p: [], lambda reg, oth: {}, lambda: {n: 3 for n in names})
+    outcome = "strong"
+    out, record = esc.escalate(ctx, [weak], NullProgress())
+    assert out == [strong] and seen == [(1, "affine", ["c"], "1 image(s) of the block weakly tied")]
+    assert record.images["c"] == {"why": "?", "rounds": [1], "registered": True, "tie_points": 140, "weak": False,
+                                  "escalated": ["upsampled SIFT (first octave -1) with affine shape, "
+                                                "1 pairs matched again"]}
+    seen.clear()
+    outcome = "still weak"
+    out, record = esc.escalate(ctx, [weak], NullProgress())
+    assert out == [weak] and [s[:3] for s in seen] == [(1, "affine", ["c"]), (2, "faint", ["c"])]
+    assert record.images["c"]["registered"] and record.images["c"]["weak"] and record.images["c"]["tie_points"] == 13
+    assert esc.escalate(ctx, [strong], NullProgress()) == ([strong], None)  # nothing weak: no escalation
 
 
 def test_the_round_that_fits_the_failure_runs_first():

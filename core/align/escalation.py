@@ -23,6 +23,11 @@ one or two rounds of two kinds, the one that fits the failure first:
   is not used: on the synthetic orbit it tripled the feature time and registered no image more than affine
   shape alone; measured in docs/measurements.md.)
 
+An image in the main block that is tied by too few points (:func:`weak_images`: fewer than WEAK_MIN_TIES,
+typically a steep view the mapping's relaxed second pass placed on 15-29 correspondences) is escalated as a left-out one of the "affine" kind (it matched, but weakly): it stays
+registered whatever the round gives, and a round is kept when it leaves fewer such images (as many registered,
+in as many components).
+
 The kind most of the left-out images call for runs first; the other runs second only when images are still out
 and have shared a verified pair with some image (a foreign photo is not escalated twice).
 
@@ -54,6 +59,9 @@ KINDS = ("faint", "affine")
 ANCHORS_PER_IMAGE = 6  # registered images a left-out image matched best
 MODEL_NEIGHBOURS = 3  # registered cameras next to each anchor in the model
 ESCALATE_ALL_MAX = 20  # an affine round re-extracts and matches every image exhaustively in a block this small
+# an image of the main block tied by fewer points than COLMAP asks of an image to register it (the mapper's
+# abs_pose_min_num_inliers, 30) is "weakly tied" and escalated
+WEAK_MIN_TIES = 30
 PAIR_ID_BASE = 2147483647  # COLMAP: pair_id = image_id1 * 2147483647 + image_id2 (image_id1 < image_id2)
 
 
@@ -106,13 +114,33 @@ def block_state(ordered) -> Tuple[Set[str], List[List[str]]]:
     return main, others
 
 
-def escalation_reason(n_images: int, registered: Set[str], others: Sequence[Sequence[str]]) -> Optional[str]:
-    """Why the fast path's result needs escalation, or None when every image is in one block."""
+def weak_images(ordered) -> Dict[str, str]:
+    """The images of the main block (``ordered[0]``) tied by fewer than WEAK_MIN_TIES points: image -> why.
+    Such an image is registered (by the mapping's relaxed second pass, or its points thinned by the final
+    adjustment), but its pose rests on fewer points than COLMAP asks of a registration: the synthetic orbit's
+    steepest view, placed by the relaxed pass on 13 tie points where the affine round gives it ~135.  Not
+    relative to the block: an edge image of copr with 57 tie points in a block of median 1,389 is well placed."""
+    if not ordered:
+        return {}
+    rec = ordered[0]
+    ties = {rec.images[i].name: int(rec.images[i].num_points3D) for i in rec.reg_image_ids()}
+    if len(ties) < 3:
+        return {}
+    median = float(np.median(list(ties.values())))
+    return {n: (f"registered, but tied by only {t} points (fewer than {WEAK_MIN_TIES}; the block's median "
+                f"{median:.0f})") for n, t in sorted(ties.items()) if t < WEAK_MIN_TIES}
+
+
+def escalation_reason(n_images: int, registered: Set[str], others: Sequence[Sequence[str]],
+                      weak: Sequence[str] = ()) -> Optional[str]:
+    """Why the fast path's result needs escalation, or None when every image is in one block, well tied."""
     parts = []
     if len(registered) < n_images:
         parts.append(f"{n_images - len(registered)} of {n_images} images not in the main block")
     if others:
         parts.append(f"the block split into {len(others) + 1} components")
+    if weak:
+        parts.append(f"{len(weak)} image(s) of the block weakly tied")
     return "; ".join(parts) or None
 
 
@@ -132,8 +160,8 @@ def escalated_sift(options: AlignOptions, width: int, height: int, kind: str = "
 def kind_order(why: Dict[str, str], left: Sequence[str]) -> Tuple[str, str]:
     """The order of the two kinds of round for the ``left`` out images, from the diagnosis ``why`` (image ->
     the reason it is outside the main block): "affine" first when most of them matched other images but could
-    not be registered (a viewpoint problem), "faint" first otherwise (no verified pair, a separate component)."""
-    viewpoint = sum(1 for n in left if "could not be registered" in why.get(n, ""))
+    not be registered, or were registered weakly tied (a viewpoint problem), "faint" first otherwise (no verified pair, a separate component)."""
+    viewpoint = sum(1 for n in left if "could not be registered" in why.get(n, "") or "tied by only" in why.get(n, ""))
     return ("affine", "faint") if viewpoint * 2 > len(left) else ("faint", "affine")
 
 
@@ -254,9 +282,9 @@ class EscalationContext:
 
 def _better(new, old) -> bool:
     """Does the reconstruction list ``new`` beat ``old``: more images in the main block, or as many in fewer
-    components."""
+    components, or as many in as many components with fewer weakly tied images (:func:`weak_images`)."""
     (rn, on), (ro, oo) = block_state(new), block_state(old)
-    return (len(rn), -len(on)) > (len(ro), -len(oo))
+    return (len(rn), -len(on), -len(weak_images(new))) > (len(ro), -len(oo), -len(weak_images(old)))
 
 
 def _round_images(ctx: EscalationContext, kind: str, registered: Set[str], left: List[str], ordered):
@@ -274,14 +302,15 @@ def _run_round(ctx: EscalationContext, k: int, reason: str, ordered, left: List[
     again."""
     t0 = time.time()
     registered, others = block_state(ordered)
-    why = ctx.diagnose(registered, others)
-    neighbours, exhaustive = _round_images(ctx, kind, registered, left, ordered)
+    why = {**ctx.diagnose(registered, others), **weak_images(ordered)}
+    anchors = registered - set(left)  # a weakly tied image is escalated as a left-out one, not as a neighbour
+    neighbours, exhaustive = _round_images(ctx, kind, anchors, left, ordered)
     redo = [n for n in ctx.order if n in set(left) | set(neighbours)]
     g0 = max(ctx.groups, key=lambda g: g.width * g.height)
     sift = escalated_sift(ctx.options, g0.width, g0.height, kind)
     extra = ", affine shape" if sift.get("estimate_affine_shape") else ""
     threshold = sift.get("peak_threshold")
-    progress.info(f"escalation round {k}, {kind} ({reason}): {len(left)} image(s) left out, re-extracting "
+    progress.info(f"escalation round {k}, {kind} ({reason}): {len(left)} image(s) to bring in, re-extracting "
                   f"{len(redo)} with upsampled SIFT (first octave -1), {sift['max_num_features']} features"
                   + (f", peak threshold {threshold:.4f}" if threshold else "") + extra)
     for n in left:
@@ -292,7 +321,7 @@ def _run_round(ctx: EscalationContext, k: int, reason: str, ordered, left: List[
     t_features = time.time() - t0
     pairs = round_pairs(ctx.pairs, left, neighbours, ctx.order, exhaustive)
     if kind == "affine" and not exhaustive:  # a larger block: each left-out image with every registered one
-        pairs = sorted(set(pairs) | {(min(a, b), max(a, b)) for a in left for b in registered})
+        pairs = sorted(set(pairs) | {(min(a, b), max(a, b)) for a in left for b in anchors if a != b})
     progress.info(f"escalation round {k}: matching {len(pairs)} pairs")
     match_pairs(ctx.pycolmap, ctx.db_path, pairs, ctx.work_dir, ctx.options, SubProgress(progress, 0.4, 0.7))
     t_matching = time.time() - t0 - t_features
@@ -348,22 +377,25 @@ def escalate(ctx: EscalationContext, ordered, progress: Progress):
     if not ctx.options.escalate:
         return ordered, None
     registered, others = block_state(ordered)
-    reason = escalation_reason(len(ctx.order), registered, others)
+    weak = weak_images(ordered)
+    reason = escalation_reason(len(ctx.order), registered, others, list(weak))
     if reason is None:
         return ordered, None
     record = Escalation(reason)
-    progress.warning(f"fast path: {reason}; escalating for the images left out")
-    first_left = [n for n in ctx.order if n not in registered]
+    progress.warning(f"fast path: {reason}; escalating for the images left out" + (" or weakly tied" if weak else ""))
+    first_left = [n for n in ctx.order if n not in registered or n in weak]
     left = first_left
-    kinds = kind_order(ctx.diagnose(registered, others), first_left)
+    kinds = kind_order({**ctx.diagnose(registered, others), **weak}, first_left)
     round1_partners: Dict[str, int] = {}
     for k, kind in zip((1, 2), kinds):
         if k == 2:
             registered, others = block_state(ordered)
-            reason = escalation_reason(len(ctx.order), registered, others)
+            weak = weak_images(ordered)
+            reason = escalation_reason(len(ctx.order), registered, others, list(weak))
             if reason is None:
                 break
             left = _hopeful(ctx, registered, others, progress, round1_partners)
+            left += [n for n in ctx.order if n in weak]
             if not left:
                 break
         backup = _backup_database(ctx.db_path)
@@ -391,13 +423,22 @@ def escalate(ctx: EscalationContext, ordered, progress: Progress):
                       f"{row.components_before} -> {row.components_after} component(s), {row.seconds:.1f} s"
                       + ("" if row.kept else "; not better, the previous result kept"))
     final, _ = block_state(ordered)
+    still_weak = weak_images(ordered)
+    ties = _ties(ordered)
     for n in first_left:
         done = [r.round for r in record.rounds if n in r.left_out]
         record.images[n] = {"why": record.rounds[0].left_out.get(n, ""), "rounds": done,
-                            "registered": n in final,
+                            "registered": n in final, "tie_points": ties.get(n, 0), "weak": n in still_weak,
                             "escalated": [(("upsampled SIFT (first octave -1) with affine shape" if r.kind == "affine"
                                             else "upsampled SIFT (first octave -1), more and fainter features")
                                            + f", {r.pairs_matched} pairs matched again") for r in record.rounds
                                           if n in r.left_out]}
     return ordered, record
 
+
+def _ties(ordered) -> Dict[str, int]:
+    """Image name -> tie points in the main block."""
+    if not ordered:
+        return {}
+    rec = ordered[0]
+    return {rec.images[i].name: int(rec.images[i].num_points3D) for i in rec.reg_image_ids()}
