@@ -24,9 +24,9 @@ one or two rounds of two kinds, the one that fits the failure first:
   shape alone; measured in docs/measurements.md.)
 
 An image in the main block that is tied by too few points (:func:`weak_images`: fewer than WEAK_MIN_TIES,
-typically a steep view the mapping's relaxed second pass placed on 15-29 correspondences) is escalated as a left-out one of the "affine" kind (it matched, but weakly): it stays
-registered whatever the round gives, and a round is kept when it leaves fewer such images (as many registered,
-in as many components).
+typically a steep view the mapping's relaxed second pass placed on 15-29 correspondences) is escalated as a
+left-out one of the "affine" kind (it matched, but weakly): it stays registered whatever the round gives, and a
+round is kept when it leaves fewer such images (as many registered, in as many components).
 
 The kind most of the left-out images call for runs first; the other runs second only when images are still out
 and have shared a verified pair with some image (a foreign photo is not escalated twice).
@@ -120,10 +120,7 @@ def weak_images(ordered) -> Dict[str, str]:
     adjustment), but its pose rests on fewer points than COLMAP asks of a registration: the synthetic orbit's
     steepest view, placed by the relaxed pass on 13 tie points where the affine round gives it ~135.  Not
     relative to the block: an edge image of copr with 57 tie points in a block of median 1,389 is well placed."""
-    if not ordered:
-        return {}
-    rec = ordered[0]
-    ties = {rec.images[i].name: int(rec.images[i].num_points3D) for i in rec.reg_image_ids()}
+    ties = _ties(ordered)
     if len(ties) < 3:
         return {}
     median = float(np.median(list(ties.values())))
@@ -160,7 +157,8 @@ def escalated_sift(options: AlignOptions, width: int, height: int, kind: str = "
 def kind_order(why: Dict[str, str], left: Sequence[str]) -> Tuple[str, str]:
     """The order of the two kinds of round for the ``left`` out images, from the diagnosis ``why`` (image ->
     the reason it is outside the main block): "affine" first when most of them matched other images but could
-    not be registered, or were registered weakly tied (a viewpoint problem), "faint" first otherwise (no verified pair, a separate component)."""
+    not be registered, or were registered weakly tied (a viewpoint problem), "faint" first otherwise (no verified
+    pair, a separate component)."""
     viewpoint = sum(1 for n in left if "could not be registered" in why.get(n, "") or "tied by only" in why.get(n, ""))
     return ("affine", "faint") if viewpoint * 2 > len(left) else ("faint", "affine")
 
