@@ -335,3 +335,21 @@ def test_qgis_process_takes_the_edited_seamlines(scene, auto, edit, tmp_path):
     text = out.stdout + out.stderr
     assert out.returncode != 0 and bad in text and f"did you mean '{b_name}'" in text, text[-2000:]
     assert "Traceback" not in text, text[-2000:]
+
+
+def test_the_plan_spans_a_photo_in_at_most_about_300_cells():
+    """The planning cell is 4 GSD for photos up to 1200 px and grows with larger photos, so a photo of the same
+    ground at 2 x the pixels is planned on cells of the same size in metres (not 4 x as many)."""
+    from core.ortho.pixels import ImageMeta
+    from core.ortho.seams import PLANNING_GSD, PLANNING_MAX_CELLS_ACROSS, planning_gsd
+
+    def metas(w, h, n=3):
+        return [ImageMeta(w, h, 3, "uint8") for _ in range(n)]
+
+    assert planning_gsd(metas(400, 300)) == PLANNING_GSD
+    assert planning_gsd(metas(1200, 900)) == PLANNING_GSD  # toledo: 300 cells of 4 GSD
+    assert planning_gsd(metas(2400, 1800)) == pytest.approx(8.0)  # toledo_2400: 300 cells of 8 GSD
+    assert planning_gsd(metas(900, 4608)) == pytest.approx(4608 / PLANNING_MAX_CELLS_ACROSS)  # portrait 16 MP
+    # the median photo decides: one large photo among small ones does not coarsen the plan
+    assert planning_gsd(metas(1200, 900, 4) + metas(6000, 4000, 1)) == PLANNING_GSD
+    assert planning_gsd([]) == PLANNING_GSD

@@ -102,7 +102,8 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
             t0 = time.time()
             plan = _plan_mosaic(prep, dsm, offset, options, workdir, SubProgress(progress, 0.12, 0.2), edits)
             timings["planning"] = time.time() - t0
-            log.append(f"seamlines: {plan.relief_blobs} raised objects, {plan.relief_reassigned} given whole to one "
+            log.append(f"seamlines: planned on cells of {plan.k * grid.resolution:.3g} m ({plan.k} mosaic cells); "
+                       f"{plan.relief_blobs} raised objects, {plan.relief_reassigned} given whole to one "
                        f"image; mean brightness difference across the seams {100 * plan.seam_before:.1f} % before and "
                        f"{100 * plan.seam_after:.1f} % after moving them to where the images agree; exposure gains "
                        f"{min(plan.gains):.3f}..{max(plan.gains):.3f}")
