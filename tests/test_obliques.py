@@ -345,6 +345,25 @@ def test_far_field_of_an_oblique_is_left_to_the_near_view(tmp_path):
     assert float(xa0[oka0].max()) > b_hi  # ... and reaches past B in its own orthophoto
 
 
+def test_only_images_that_reach_past_the_limit_are_tested_cell_by_cell(tmp_path):
+    """The far-field limit per mosaic cell costs two more projections of every cell: an image whose coarsest ground
+    resolution is well within 3 x its best (the vertical B) is not tested, the oblique A (its far field reaches
+    past the limit) is, and its footprint is trimmed; the limit is what the test above checks cell by cell."""
+    from core.ortho.block import UNLIMITED_MARGIN, _limit_resolution
+    from core.ortho.visibility import camera_footprint, resolution_limited
+
+    cams, _dsm, _crs, offset = _flat_pair(str(tmp_path))
+    fps = [camera_footprint(c, offset, 100.0, 100.0) for c in cams]
+    out_c, out_f = _limit_resolution(cams, fps, offset, 100.0, 100.0, 3.0)
+    a, b = out_c
+    assert a.max_gsd is not None and b.max_gsd is None
+    _, best_a, worst_a = resolution_limited(cams[0], offset, fps[0], 100.0, 100.0, 3.0)
+    assert worst_a > 3.0 * best_a  # the far field A leaves out
+    _, best_b, worst_b = resolution_limited(cams[1], offset, fps[1], 100.0, 100.0, 3.0)
+    assert 1.0 <= worst_b / best_b < 3.0 / UNLIMITED_MARGIN  # a vertical: within the margin, nothing to test
+    assert out_f[0].bbox[2] < fps[0].bbox[2] - 50  # A's footprint trimmed where it passes the limit
+
+
 def test_far_field_limit_keeps_the_ground_of_a_vertical_beside_tall_objects(tmp_path):
     """A vertical photo 30 m over flat ground with a 22 m tower (a tree line) beside its footprint: the image
     resolves the tower's top far finer than any ground, and a limit taken from that best would cut all its

@@ -68,15 +68,19 @@ GSD_MARGIN = 1.3  # the trimmed footprint reaches this much beyond the limit (th
 
 
 def resolution_limited(cam: OrthoCamera, offset: np.ndarray, fp: Footprint, z_lo: float, z_hi: float,
-                       factor: float) -> Tuple[Footprint, float]:
+                       factor: float) -> Tuple[Footprint, float, float]:
     """(the footprint trimmed to where the image resolves the ground within ``factor`` x its best, its best ground
-    resolution): the image sampled on a GSD_SAMPLES grid (border included), the rays met with the planes z_lo and
-    z_hi, the ground resolution there (OrthoCamera.ground_resolution); the best is taken on the z_lo plane (the
-    ground), the footprint is the convex hull of the points of both planes within GSD_MARGIN x the limit.  ``fp`` and nan when nothing is sampled."""
+    resolution, its worst): the image sampled on a GSD_SAMPLES grid (border included), the rays met with the planes
+    z_lo and z_hi, the ground resolution there (OrthoCamera.ground_resolution); the best is taken on the z_lo plane
+    (the ground), the footprint is the convex hull of the points of both planes within GSD_MARGIN x the limit.
+    The worst is the coarsest on the z_lo plane (along a ray the ground resolution grows with the distance, so no
+    ground between the planes is resolved coarser), inf where a sampled ray misses that plane (the horizon of an
+    oblique).  ``fp``, nan and nan when nothing is sampled."""
     w, h = cam.camera.width, cam.camera.height
     gx, gy = np.meshgrid(np.linspace(0.0, w, GSD_SAMPLES[0]), np.linspace(0.0, h, GSD_SAMPLES[1]))
     xn = cam.camera.unproject(np.column_stack([gx.ravel(), gy.ravel()]))
     d = np.column_stack([xn, np.ones(len(xn))]) @ cam.pose.rotation
+    n_rays = len(d)
     d = d[np.isfinite(d).all(axis=1) & (d[:, 2] < -1e-9)]
     c = cam.centre
     pts, gsd = [], []
@@ -89,23 +93,25 @@ def resolution_limited(cam: OrthoCamera, offset: np.ndarray, fp: Footprint, z_lo
     fin = np.isfinite(gsd_a)
     low = np.isfinite(gsd[0])
     if not fin.any() or not low.any():
-        return fp, float("nan")
+        return fp, float("nan"), float("nan")
     # the best on the low plane (the ground): on z_hi (tree tops, roofs, a hill beside the flight) an image
     # resolves finer than anywhere on the ground, and that limit would cut the ground of every image there
     best = float(gsd[0][low].min())
+    worst = float(gsd[0][low].max()) if len(gsd[0]) == n_rays else float("inf")  # every ray meets the ground
     sel = fin & (gsd_a <= GSD_MARGIN * factor * best)
     if sel.sum() < 3:
-        return fp, best
+        return fp, best, worst
     poly = convex_hull_xy(pts_a[sel] + offset[:2])
     if len(poly) < 3:
-        return fp, best
+        return fp, best, worst
     xmin, ymin = np.maximum(poly.min(axis=0), fp.bbox[:2])
     xmax, ymax = np.minimum(poly.max(axis=0), fp.bbox[2:])
     if xmax <= xmin or ymax <= ymin:
-        return fp, best
+        return fp, best, worst
     best_all = float(gsd_a[fin].min())  # the footprint's resolution: as without the limit (the mosaic's cell)
     gsd_fp = best_all if best_all > 1.05 * fp.gsd else fp.gsd  # an oblique's best view, not the nadir it misses
-    return Footprint(poly, (float(xmin), float(ymin), float(xmax), float(ymax)), float(gsd_fp), fp.z_ref), best
+    return (Footprint(poly, (float(xmin), float(ymin), float(xmax), float(ymax)), float(gsd_fp), fp.z_ref), best,
+            worst)
 
 
 def _point_in_polygon(poly: np.ndarray, x: float, y: float) -> bool:
