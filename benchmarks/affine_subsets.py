@@ -4,7 +4,8 @@ The escalation's affine round re-extracts every image of a small block with upsa
 matches every pair again (core/align/escalation.py); on the orbit it brings the steep views in but costs more
 than pycolmap's whole default pipeline.  This script runs our fast path once (escalation off), then on copies of
 its database re-extracts only a subset of the images with the affine round's SIFT settings, matches every pair
-that touches a re-extracted image, maps from scratch and prints per subset: images re-extracted, pairs matched,
+that touches a re-extracted image, maps anew with the stage's mapping (its relaxed second pass included) and
+prints per subset: images re-extracted, pairs matched,
 seconds (features, matching, mapping), images registered and the tie points of the steep views.  The subsets:
 the escalated images only, the escalated images and their steep (65 deg) neighbours, every steep view, and every
 image (today's round).  pycolmap's default pipeline on the same photos is the reference line.
@@ -44,6 +45,10 @@ def fast_ties(ws):
 def affine_round(pycolmap, images, source_db, work, redo, sift):
     """Re-extract ``redo`` with ``sift`` in a copy of ``source_db``, match every pair touching them, map."""
     from core.align.escalation import forget_features
+    from core.align.features import match_pairs
+    from core.align.mapping import run_mapping
+    from core.align.options import AlignOptions
+    from core.common.progress import NullProgress
 
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(os.path.join(work, "sparse"))
@@ -68,18 +73,11 @@ def affine_round(pycolmap, images, source_db, work, redo, sift):
                                   device=pycolmap.Device.cpu)
     t1 = time.time()
     pairs = sorted({tuple(sorted((a, b))) for a in redo for b in names if a != b})
-    list_path = os.path.join(work, "pairs.txt")
-    with open(list_path, "w") as f:
-        f.write("".join(f"{a} {b}\n" for a, b in pairs))
-    po = pycolmap.ImportedPairingOptions()
-    po.match_list_path = list_path
-    pycolmap.match_image_pairs(db_path, matching_options=pycolmap.FeatureMatchingOptions(), pairing_options=po,
-                               verification_options=pycolmap.TwoViewGeometryOptions(), device=pycolmap.Device.cpu)
+    options = AlignOptions()
+    match_pairs(pycolmap, db_path, pairs, work, options, NullProgress())
     t2 = time.time()
-    opts = pycolmap.IncrementalPipelineOptions()
-    opts.ba_refine_principal_point = False
-    opts.mapper.ba_global_ignore_redundant_points3D = True
-    recs = pycolmap.incremental_mapping(db_path, images, os.path.join(work, "sparse"), options=opts)
+    # the stage's own mapping (its relaxed second pass included), as an escalation round maps
+    recs = run_mapping(pycolmap, db_path, images, os.path.join(work, "sparse"), len(names), options, NullProgress())
     t3 = time.time()
     rec = max(recs.values(), key=lambda r: r.num_reg_images()) if recs else None
     ties = {rec.images[i].name: int(rec.images[i].num_points3D) for i in rec.reg_image_ids()} if rec else {}
@@ -124,7 +122,7 @@ def main():
         total = o["features"] + o["matching"] + o["mapping"]
         print(f"| {label} | {len(redo)} | {o['pairs']} | {o['features']:.2f} | {o['matching']:.2f} | "
               f"{o['mapping']:.2f} | {total:.2f} | {len(o['ties'])}/{len(names)} | {min(tie.values())} "
-              f"({', '.join(f'{n[:-4]} {t}' for n, t in tie.items() if t < 30) or 'all >= 30'}) |", flush=True)
+              f"({', '.join(f'{n[:-4]} {t}' for n, t in tie.items() if t < WEAK_MIN_TIES) or f'all >= {WEAK_MIN_TIES}'}) |", flush=True)
 
 
 if __name__ == "__main__":

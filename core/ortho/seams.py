@@ -49,7 +49,7 @@ class _Plan:
 def planning_gsd(metas) -> float:
     """The planning cell in GSD: PLANNING_GSD, coarser where the photos' median long side exceeds
     PLANNING_MAX_CELLS_ACROSS of those cells."""
-    sides = [max(m.width, m.height) for m in metas if m is not None]
+    sides = [max(m.width, m.height) for m in metas]
     if not sides:
         return PLANNING_GSD
     return max(PLANNING_GSD, float(np.median(sides)) / PLANNING_MAX_CELLS_ACROSS)
