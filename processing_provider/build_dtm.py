@@ -90,11 +90,8 @@ class BuildDtmAlgorithm(AlgorithmBase):
         progress = FeedbackProgress(feedback)
         if workspace:
             result = self.run_core(stage.build_dtm_workspace, workspace, dsm=dsm, output_dtm=output_dtm,
-                                   contour_interval=interval, options=options, progress=progress)
-            if contours and result.contours_path:
-                from ..core.common.files import atomic_copy
-
-                result.contours_path = atomic_copy(result.contours_path, contours)
+                                   contour_interval=interval, options=options, progress=progress,
+                                   contours_copy=contours)
         else:
             if not dsm or not output_dtm:
                 raise QgsProcessingException(self.tr(

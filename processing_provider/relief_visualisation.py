@@ -68,12 +68,9 @@ class ReliefVisualisationAlgorithm(AlgorithmBase):
         output = self.parameterAsOutputLayer(parameters, self.OUTPUT, context) or None
         progress = FeedbackProgress(feedback)
         if workspace and not dem:
-            result = self.run_core(stage.relief_workspace, workspace, [key], source=source, progress=progress)
+            result = self.run_core(stage.relief_workspace, workspace, [key], source=source, progress=progress,
+                                   copy_to=output)
             path = result.paths[key]
-            if output and os.path.abspath(output) != os.path.abspath(path):
-                from ..core.common.files import atomic_copy
-
-                path = atomic_copy(path, output)
         else:
             if not dem or not output:
                 raise QgsProcessingException(self.tr(

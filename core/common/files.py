@@ -281,6 +281,36 @@ def read_json_record(path: str, error: Type[Exception]) -> Optional[Any]:
         raise error(f"{path} cannot be read: {e}") from e
 
 
+def same_path(a: str, b: str) -> bool:
+    """Whether ``a`` and ``b`` name the same file: the same file on disk (links, case-insensitive file systems), or
+    the same normalised absolute path when either does not exist yet."""
+    if not a or not b:
+        return False
+    try:
+        if os.path.exists(a) and os.path.exists(b):
+            return os.path.samefile(a, b)
+    except OSError:
+        pass
+    return os.path.normcase(os.path.realpath(a)) == os.path.normcase(os.path.realpath(b))
+
+
+def refuse_overwriting_inputs(outputs: Dict[str, Optional[str]], inputs: Dict[str, Optional[str]],
+                              error: Type[Exception]) -> None:
+    """``error`` naming the file when an output (what -> path; None = not written) is one of the inputs (what ->
+    path), or when two outputs are the same file: checked before any work, so that no input is ever replaced by
+    a product made from it."""
+    for out_what, out in outputs.items():
+        for in_what, src in inputs.items():
+            if out and src and same_path(out, src):
+                raise error(f"the {out_what} would overwrite its input, the {in_what} {src}: choose another output "
+                            "file")
+    named = [(w, p) for w, p in outputs.items() if p]
+    for i, (wa, pa) in enumerate(named):
+        for wb, pb in named[i + 1:]:
+            if same_path(pa, pb):
+                raise error(f"the {wa} and the {wb} would be written to one file ({pa}): choose other output files")
+
+
 def file_fingerprint(path: str) -> str:
     """Cheap fingerprint of a file: size, mtime and a hash of its first 64 KiB."""
     st = os.stat(path)

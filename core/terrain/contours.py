@@ -7,13 +7,25 @@ import os
 
 import numpy as np
 
-from ..common.files import atomic_output
+from ..common.files import atomic_output, refuse_overwriting_inputs
 from ..common.progress import NullProgress, Progress, check_cancel
 from .options import TerrainError
 from .rasters import read_elevation
 
 LAYER = "contours"
 ELEVATION_FIELD = "elevation"
+
+
+CONTOUR_EXTENSIONS = (".gpkg",)
+
+
+def check_contours_output(output: str) -> None:
+    """TerrainError unless ``output`` names a GeoPackage (contours are written as one: a file named .shp or .tif
+    holding a GeoPackage would mislead every program that opens it)."""
+    ext = os.path.splitext(output)[1].lower()
+    if ext not in CONTOUR_EXTENSIONS:
+        raise TerrainError(f"contours are written as a GeoPackage: give an output file ending in .gpkg, not "
+                           f"{ext or 'no extension'} ({output})")
 
 
 def write_contours(raster_path: str, output: str, interval: float, progress: Progress = None,
@@ -27,6 +39,8 @@ def write_contours(raster_path: str, output: str, interval: float, progress: Pro
     progress = progress or NullProgress()
     if not (interval > 0 and math.isfinite(interval)):
         raise TerrainError(f"the contour interval must be a positive number of metres, got {interval}")
+    refuse_overwriting_inputs({"contours": output}, {what: raster_path}, TerrainError)
+    check_contours_output(output)
     elev = read_elevation(raster_path, what)  # the checks: projected, data, size
     zmin, zmax = float(np.nanmin(elev.z)), float(np.nanmax(elev.z))
     n_levels = (zmax - zmin) / (interval * elev.unit)

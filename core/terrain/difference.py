@@ -15,6 +15,7 @@ from typing import Any, Dict, Optional, Tuple
 
 import numpy as np
 
+from ..common.files import refuse_overwriting_inputs
 from ..common.progress import NullProgress, Progress, check_cancel
 from ..io import raster
 from .options import TerrainError
@@ -118,9 +119,7 @@ def dsm_difference(dsm_a: str, dsm_b: str, output: str, resolution: Optional[flo
     CRS, rotated, the two not overlapping or sharing no cell with data."""
     progress = progress or NullProgress()
     a, b = _open(dsm_a, "DSM A"), _open(dsm_b, "DSM B")
-    for p in (a.path, b.path):
-        if os.path.exists(output) and os.path.samefile(output, p):
-            raise TerrainError(f"the DSM difference would overwrite its input {p}: choose another output file")
+    refuse_overwriting_inputs({"DSM difference": output}, {"DSM A": a.path, "DSM B": b.path}, TerrainError)
     gt, w, h = _grid(a, resolution)
     za = _warp(a, a.wkt, gt, w, h)
     progress.report(0.3, "DSM A read")

@@ -21,14 +21,14 @@ from typing import Dict, List, Optional, Sequence
 
 import numpy as np
 
-from ..common.files import file_fingerprint
+from ..common.files import atomic_copy, file_fingerprint, refuse_overwriting_inputs, same_path
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..project.layout import Layout
 from ..project.stages import RELIEF, TERRAIN, run_stage
 from ..project.workspace import Workspace
 from . import relief as rv
 from .classify import classify_las
-from .contours import write_contours
+from .contours import check_contours_output, write_contours
 from .ground import filter_ground
 from .options import (
     SOURCE_INTERPOLATED,
@@ -77,8 +77,17 @@ def build_dtm(dsm_path: str, output_dtm: str, options: Optional[GroundOptions] =
     progress = progress or NullProgress()
     options = options or GroundOptions()
     t0 = time.time()
-    elev = read_elevation(dsm_path, "DSM")
     source_path = source_path or os.path.splitext(output_dtm)[0] + "-source.tif"
+    if contour_interval and contour_interval > 0:
+        contours_path = contours_path or os.path.splitext(output_dtm)[0] + "-contours.gpkg"
+    refuse_overwriting_inputs(
+        {"DTM": output_dtm, "DTM source raster": source_path,
+         "contours": contours_path if contour_interval and contour_interval > 0 else None,
+         "classified point cloud": classified_point_cloud if point_cloud else None},
+        {"DSM": dsm_path, "point cloud": point_cloud}, TerrainError)
+    if contour_interval and contour_interval > 0:
+        check_contours_output(contours_path)
+    elev = read_elevation(dsm_path, "DSM")
     res = filter_ground(elev.z, elev.cell, options, SubProgress(progress, 0.0, 0.8))
     timings = {"ground_filter": time.time() - t0}
     check_cancel(progress)
@@ -108,7 +117,7 @@ def build_dtm(dsm_path: str, output_dtm: str, options: Optional[GroundOptions] =
                              f"{classified_point_cloud}")
     if contour_interval and contour_interval > 0:
         t1 = time.time()
-        out.contours_path = contours_path or os.path.splitext(output_dtm)[0] + "-contours.gpkg"
+        out.contours_path = contours_path
         out.contour_lines = write_contours(output_dtm, out.contours_path, contour_interval,
                                            SubProgress(progress, 0.9, 1.0))
         timings["contours"] = time.time() - t1
@@ -122,8 +131,10 @@ def build_dtm(dsm_path: str, output_dtm: str, options: Optional[GroundOptions] =
 
 def build_dtm_workspace(workspace_dir: str, dsm: Optional[str] = None, output_dtm: Optional[str] = None,
                         contour_interval: float = 0.0, options: Optional[GroundOptions] = None,
-                        classify_points: bool = True, progress: Optional[Progress] = None) -> DtmResult:
-    """The terrain stage of a workspace: its DSM (or ``dsm``) -> DTM, source, classified points, contours."""
+                        classify_points: bool = True, progress: Optional[Progress] = None,
+                        contours_copy: Optional[str] = None) -> DtmResult:
+    """The terrain stage of a workspace: its DSM (or ``dsm``) -> DTM, source, classified points, contours (and a
+    copy of the contours at ``contours_copy``).  No output may be an input (checked before any work)."""
     ws = Workspace.open(workspace_dir)
     lay = Layout(ws)
     dsm_path = os.path.abspath(dsm) if dsm else lay.dsm()
@@ -132,6 +143,10 @@ def build_dtm_workspace(workspace_dir: str, dsm: Optional[str] = None, output_dt
     options = options or GroundOptions()
     dtm_path = os.path.abspath(output_dtm) if output_dtm else lay.default_dtm
     pc = lay.point_cloud() if classify_points else None
+    refuse_overwriting_inputs({"DTM": dtm_path, "contours": contours_copy}, {"DSM": dsm_path, "point cloud": pc},
+                              TerrainError)
+    if contours_copy:
+        check_contours_output(contours_copy)
     params = {"dsm": dsm_path, "output_dtm": dtm_path, "contour_interval": contour_interval,
               "options": dict(vars(options))}
     with run_stage(ws, TERRAIN, params, {"dsm": file_fingerprint(dsm_path)}) as run:
@@ -151,6 +166,8 @@ def build_dtm_workspace(workspace_dir: str, dsm: Optional[str] = None, output_dt
                                              "contour_interval": contour_interval, "contour_lines": r.contour_lines,
                                              "points": r.points, "ground_points": r.ground_points})
     r.workspace = ws.root
+    if contours_copy and r.contours_path:
+        r.contours_path = atomic_copy(r.contours_path, contours_copy)
     return r
 
 
@@ -164,6 +181,9 @@ def relief(dem_path: str, keys: Sequence[str], output_dir: str, prefix: str = "d
     bad = [k for k in keys if k not in VISUALISATION_KEYS]
     if bad or not keys:
         raise TerrainError(f"unknown relief visualisation(s) {bad or keys}: choose from {', '.join(VISUALISATION_KEYS)}")
+    targets = {key: (outputs or {}).get(key) or os.path.join(output_dir, f"{prefix}-{key}.tif") for key in keys}
+    refuse_overwriting_inputs({f"{key} visualisation": path for key, path in targets.items()}, {what: dem_path},
+                              TerrainError)
     elev = read_elevation(dem_path, what)
     paths, timings = {}, {}
     for i, key in enumerate(keys):
@@ -171,7 +191,7 @@ def relief(dem_path: str, keys: Sequence[str], output_dir: str, prefix: str = "d
         sub = SubProgress(progress, i / len(keys), (i + 1) / len(keys))
         sub.report(0.0, f"relief visualisation: {key}")
         image = rv.compute(key, elev.z, elev.cell, options, sub)
-        path = (outputs or {}).get(key) or os.path.join(output_dir, f"{prefix}-{key}.tif")
+        path = targets[key]
         lo, hi = rv.DISPLAY_RANGE[key]
         write_float(path, image, elev, f"{key} ({rv.UNITS[key]})",
                     {"ARCHAEOORTHO_STAGE": "relief", "ARCHAEOORTHO_PRODUCT": f"relief-{key}", "RELIEF": key,
@@ -187,8 +207,10 @@ def relief(dem_path: str, keys: Sequence[str], output_dir: str, prefix: str = "d
 
 
 def relief_workspace(workspace_dir: str, keys: Sequence[str], source: str = "dtm",
-                     options: Optional[ReliefOptions] = None, progress: Optional[Progress] = None) -> ReliefResult:
-    """The relief stage: visualisations of the workspace's DTM (``source`` 'dtm') or DSM ('dsm')."""
+                     options: Optional[ReliefOptions] = None, progress: Optional[Progress] = None,
+                     copy_to: Optional[str] = None) -> ReliefResult:
+    """The relief stage: visualisations of the workspace's DTM (``source`` 'dtm') or DSM ('dsm'); with
+    ``copy_to`` (one visualisation), a copy of it there as well (never over the DTM or DSM it is made from)."""
     ws = Workspace.open(workspace_dir)
     lay = Layout(ws)
     if source not in ("dtm", "dsm"):
@@ -197,6 +219,10 @@ def relief_workspace(workspace_dir: str, keys: Sequence[str], source: str = "dtm
     if not dem:
         stage = "Build DTM" if source == "dtm" else "Build DSM"
         raise TerrainError(f"workspace {ws.root} has no {source.upper()}: run '{stage}' first")
+    if copy_to and len(keys) != 1:
+        raise TerrainError("a copy of the relief visualisation needs exactly one visualisation")
+    refuse_overwriting_inputs({f"{keys[0]} visualisation" if keys else "visualisation": copy_to},
+                              {source.upper(): dem}, TerrainError)
     params = {"source": source, "keys": list(keys), "options": dict(vars(options or ReliefOptions()))}
     inputs = {source: file_fingerprint(dem)}
     recorded = {k: v for k, v in (ws.stage(RELIEF).get("outputs") or {}).items()  # the others made before
@@ -208,6 +234,8 @@ def relief_workspace(workspace_dir: str, keys: Sequence[str], source: str = "dtm
             ws.record_timing(RELIEF, f"{source}-{k}", v)
         run.finish(outputs=recorded, results={"cell": r.cell, "radii": r.radii, "source": source})
     r.workspace = ws.root
+    if copy_to and not same_path(copy_to, r.paths[keys[0]]):
+        r.paths[keys[0]] = atomic_copy(r.paths[keys[0]], copy_to)
     return r
 
 

@@ -1,0 +1,130 @@
+"""No algorithm writes over its own input (issue 36, item 1): the output path equal to an input is refused before
+any work, with a message naming the file, and the input stays byte for byte as it was; contours are refused under
+an extension that is not the GeoPackage they are written as (item 8)."""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import subprocess
+
+import pytest
+
+from core.common.files import refuse_overwriting_inputs, same_path
+from core.io import raster
+from core.project.layout import Layout
+from core.project.stages import TERRAIN
+from core.project.workspace import Workspace
+from core.terrain.contours import write_contours
+from core.terrain.options import TerrainError
+from core.terrain.stage import build_dtm, build_dtm_workspace, relief
+from tests import synthetic as syn
+from tests.test_terrain import _workspace_with_dsm, synthetic_dsm
+
+
+def _digest(path) -> str:
+    with open(path, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest()
+
+
+@pytest.fixture(scope="module")
+def dsm(tmp_path_factory):
+    """(scene, DSM path) of the terrain tests' synthetic DSM."""
+    root = tmp_path_factory.mktemp("overwrite")
+    scene, _x, _y, z, gt, _b, _t = synthetic_dsm()
+    path = str(root / "dsm.tif")
+    raster.write_cog(path, z, gt, syn.CRS)
+    return scene, path
+
+
+def test_same_path_sees_links_and_files_not_yet_written(tmp_path):
+    a = tmp_path / "a.tif"
+    a.write_bytes(b"x")
+    link = tmp_path / "link.tif"
+    os.symlink(a, link)
+    assert same_path(str(a), str(link))
+    assert same_path(str(tmp_path / "sub" / ".." / "new.tif"), str(tmp_path / "new.tif"))
+    assert not same_path(str(a), str(tmp_path / "b.tif"))
+    with pytest.raises(TerrainError, match="the DTM and the contours would be written to one file"):
+        refuse_overwriting_inputs({"DTM": str(a), "contours": str(link)}, {}, TerrainError)
+
+
+def test_build_dtm_refuses_to_write_over_its_dsm(dsm):
+    _scene, path = dsm
+    before = _digest(path)
+    with pytest.raises(TerrainError, match=r"DTM would overwrite its input, the DSM .*dsm\.tif"):
+        build_dtm(path, path)
+    with pytest.raises(TerrainError, match="contours would overwrite its input"):
+        build_dtm(path, path + ".dtm.tif", contour_interval=1.0, contours_path=path)
+    assert _digest(path) == before
+
+
+def test_relief_and_contours_refuse_to_write_over_their_input(dsm, tmp_path):
+    pytest.importorskip("rvt.vis")
+    _scene, path = dsm
+    before = _digest(path)
+    with pytest.raises(TerrainError, match="slrm visualisation would overwrite its input"):
+        relief(path, ["slrm"], str(tmp_path), outputs={"slrm": path}, what="DSM")
+    with pytest.raises(TerrainError, match="contours would overwrite its input"):
+        write_contours(path, path, 1.0)
+    assert _digest(path) == before
+
+
+def test_contours_are_refused_under_an_extension_they_are_not(dsm, tmp_path):
+    _scene, path = dsm
+    for name in ("c.shp", "c.tif", "c"):
+        with pytest.raises(TerrainError, match=r"GeoPackage: give an output file ending in \.gpkg"):
+            write_contours(path, str(tmp_path / name), 1.0)
+        assert not os.path.exists(tmp_path / name)
+    assert write_contours(path, str(tmp_path / "c.GPKG"), 2.0) > 0
+
+
+def test_workspace_dtm_over_the_workspace_dsm_is_refused_and_recorded_nowhere(dsm, tmp_path):
+    scene, path = dsm
+    root, _ = _workspace_with_dsm(tmp_path / "ws", path, scene)
+    lay = Layout(Workspace.open(root))
+    before = _digest(lay.default_dsm)
+    with pytest.raises(TerrainError, match="DTM would overwrite its input"):
+        build_dtm_workspace(root, dsm=lay.default_dsm, output_dtm=lay.default_dsm)
+    with pytest.raises(TerrainError, match="contours would overwrite its input"):
+        build_dtm_workspace(root, contour_interval=1.0, contours_copy=lay.default_dsm)
+    ws = Workspace.open(root)
+    assert _digest(lay.default_dsm) == before
+    assert not ws.stage_done(TERRAIN) and ws.stage(TERRAIN).get("status") != "failed"
+
+
+def test_qgis_process_refuses_output_equal_to_input(dsm, tmp_path):
+    """The cases as a user ran them: builddtm WORKSPACE=ws DSM=ws/dsm.tif OUTPUT_DTM=ws/dsm.tif, contours
+    INPUT=x.tif OUTPUT=x.tif: a message naming the file, exit non-zero, no traceback, the DSM unchanged."""
+    from tests.conftest import qgis_process
+
+    exe, env = qgis_process()
+    scene, path = dsm
+    root, _ = _workspace_with_dsm(tmp_path / "ws", path, scene)
+    ws_dsm = os.path.join(root, "dsm.tif")
+    before = _digest(ws_dsm)
+    for alg, args in (("builddtm", [f"WORKSPACE={root}", f"DSM={ws_dsm}", f"OUTPUT_DTM={ws_dsm}"]),
+                      ("contours", [f"INPUT={ws_dsm}", "INTERVAL=1", f"OUTPUT={ws_dsm}"])):
+        out = subprocess.run([exe, "--json", "run", f"archaeoortho:{alg}", "--", *args], env=env,
+                             capture_output=True, text=True, timeout=600)
+        text = out.stdout + out.stderr
+        assert out.returncode != 0, text[-2000:]
+        assert "would overwrite its input" in text and ws_dsm in text and "Traceback" not in text, text[-2000:]
+        assert _digest(ws_dsm) == before
+    record = json.load(open(os.path.join(root, "workspace.json")))
+    assert (record.get("stages") or {}).get(TERRAIN, {}).get("status") != "done"
+
+
+def test_relief_copy_over_the_workspace_dtm_is_refused(dsm, tmp_path):
+    pytest.importorskip("rvt.vis")
+    scene, path = dsm
+    root, _ = _workspace_with_dsm(tmp_path / "ws", path, scene)
+    from core.terrain.stage import relief_workspace
+
+    lay = Layout(Workspace.open(root))
+    before = _digest(lay.default_dsm)
+    with pytest.raises(TerrainError, match="slrm visualisation would overwrite its input, the DSM"):
+        relief_workspace(root, ["slrm"], source="dsm", copy_to=lay.default_dsm)
+    assert _digest(lay.default_dsm) == before
+    r = relief_workspace(root, ["slrm"], source="dsm", copy_to=str(tmp_path / "slrm.tif"))
+    assert os.path.samefile(r.paths["slrm"], tmp_path / "slrm.tif")
