@@ -391,3 +391,21 @@ def test_error_carries_line_and_field(tmp_path):
         read_calibration(str(path))
     assert (err.value.line, err.value.field) == (4, "k2")
     assert math.isclose(read_calibration(_data("same_camera.yaml"))[0].k2, 0.01)
+
+
+def test_yaml_exponents_without_a_dot_are_numbers(tmp_path):
+    # PyYAML (YAML 1.1) reads 5e-05 as a string; a certificate copied by hand has such values
+    path = tmp_path / "c.yaml"
+    path.write_text(_GOOD_CAMERA + "p2: -5e-05\nk1: '1.5E-3'\n")
+    (cal,) = read_calibration(str(path))
+    assert (cal.p2, cal.k1) == (-5e-05, 1.5e-3)
+
+
+def test_metashape_without_adjusted_calibration_says_so(tmp_path):
+    path = tmp_path / "cams.xml"
+    path.write_text('<document>\n <chunk>\n  <sensors>\n   <sensor id="0" label="s">\n'
+                    '    <calibration type="frame" class="initial">\n     <resolution width="400" height="300"/>\n'
+                    '     <f>500</f>\n    </calibration>\n   </sensor>\n  </sensors>\n </chunk>\n</document>\n')
+    (cal,) = read_calibration(str(path))
+    assert cal.colmap_model() == ("PINHOLE", [500.0, 500.0, 200.0, 150.0])
+    assert "initial one (line 5)" in cal.notes[0]

@@ -356,7 +356,7 @@ def _load_yaml(path: str, text: str) -> Any:
     Loader.add_constructor("tag:yaml.org,2002:map", mapping)
     Loader.add_constructor("tag:yaml.org,2002:seq", sequence)
     try:
-        return yaml.load(text, Loader=Loader)  # noqa: S506 (a SafeLoader subclass)
+        return yaml.load(text, Loader=Loader)  # a SafeLoader: no Python objects
     except yaml.MarkedYAMLError as e:
         mark = e.problem_mark or e.context_mark
         line = mark.line + 1 if mark is not None else None
@@ -407,7 +407,10 @@ def _load_json(path: str, text: str) -> Any:
     decoder.parse_array = parse_array
     decoder.scan_once = json.scanner.py_make_scanner(decoder)
     try:
-        return decoder.decode(text)
+        try:
+            return decoder.decode(text)
+        except (TypeError, AttributeError):  # the json module's internals changed: values without lines
+            return json.loads(text)
     except json.JSONDecodeError as e:
         raise CalibrationError(path, e.lineno, "", f"not valid JSON: {e.msg} (column {e.colno})") from None
 
@@ -454,8 +457,8 @@ class _Fields:
             return None
         value = self.data[key]
         if not isinstance(value, (list, tuple)) or (count is not None and len(value) != count):
-            n = f"{count} numbers" if count else "a list of numbers"
-            raise self.fail(key, f"{key} must be {n} [{', '.join(['x', 'y'][:count or 2])}], got {value!r}")
+            n = f"{count} numbers [x, y]" if count == 2 else (f"{count} numbers" if count else "a list of numbers")
+            raise self.fail(key, f"{key} must be {n}, got {value!r}")
         return [self._as_number(key, v, positive, f"{key}[{i}]", _line_of(value, i)) for i, v in enumerate(value)]
 
     def size(self, key: str) -> Optional[Tuple[int, int]]:
@@ -832,6 +835,8 @@ def _read_opencv_mapping(path: str, data: Any) -> List[CameraCalibration]:
     if w is None or h is None:
         raise fl.fail("image_width", "image_width and image_height are needed: the size of the images the "
                                      "calibration refers to", _line_of(data))
+    if w != int(w) or h != int(h):
+        raise fl.fail("image_width", f"image_width and image_height must be whole numbers, got {w} x {h}")
     w, h = int(w), int(h)
     cx, cy = k[2] + 0.5, k[5] + 0.5  # OpenCV: pixel centres at integers
     _check_principal_point(fl, mkey, cx, cy, w, h)
@@ -920,7 +925,11 @@ def _read_xml(path: str, text: str) -> List[CameraCalibration]:
         for s in sensors:
             cals = list(s.iter("calibration"))
             cal = next((c for c in cals if c.attrib.get("class") == "adjusted"), cals[0])
-            cams.append(_metashape_camera(path, cal, s.attrib.get("label", s.attrib.get("id", "")), s))
+            cam = _metashape_camera(path, cal, s.attrib.get("label", s.attrib.get("id", "")), s)
+            if cal.attrib.get("class", "adjusted") != "adjusted":
+                cam.notes.append(f"{cam.label()}: the file holds no adjusted calibration; its "
+                                 f"{cal.attrib['class']} one (line {cal.line}) is used")
+            cams.append(cam)
         return cams
     raise CalibrationError(path, root.line, root.tag, f"an XML file with root <{root.tag}> is not a calibration "
                            "this plugin reads: expected OpenCV's <opencv_storage> or Metashape's <calibration>")
