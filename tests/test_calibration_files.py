@@ -409,3 +409,16 @@ def test_metashape_without_adjusted_calibration_says_so(tmp_path):
     (cal,) = read_calibration(str(path))
     assert cal.colmap_model() == ("PINHOLE", [500.0, 500.0, 200.0, 150.0])
     assert "initial one (line 5)" in cal.notes[0]
+
+
+def test_the_documented_example_reads(tmp_path):
+    doc = os.path.join(os.path.dirname(DATA), "..", "..", "docs", "calibration.md")
+    with open(doc, encoding="utf-8") as fh:
+        text = fh.read()
+    example = text.split("```yaml\n", 1)[1].split("```", 1)[0]
+    path = tmp_path / "camera.yaml"
+    path.write_text(example, encoding="utf-8")
+    (cal,) = read_calibration(str(path))
+    assert (cal.name, cal.adjust, cal.images) == ("RC20_15UAG", "fixed", ["1971_*.tif"])
+    assert (cal.cx_px, cal.cy_px) == pytest.approx((5749.8, 5749.45))  # as the table of fields says
+    np.testing.assert_allclose([cal.k1, cal.k2, cal.k3], RC20_K, rtol=2e-3)  # its table is rounded to 1 nm
