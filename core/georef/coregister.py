@@ -163,10 +163,20 @@ def _inliers(r: np.ndarray, usable: np.ndarray) -> np.ndarray:
     return ok & (np.abs(r - med) <= OUTLIER_NMAD * spread)
 
 
-def _step(sample: Sampler, shift: np.ndarray, p: np.ndarray, model: _Model, usable: np.ndarray,
-          horizontal: bool) -> Tuple[np.ndarray, ...]:
-    """One Gauss-Newton step at ``shift``, ``p``: (increment of shift, increment of p, inlier mask, covariance of
-    the parameters (normal-matrix inverse times the residual NMAD squared), residuals, x, y)."""
+@dataclass
+class _Step:
+    d_shift: np.ndarray  # increment of the shift (metres)
+    d_p: np.ndarray  # increment of the model's parameters
+    inliers: np.ndarray  # bool over the samples
+    cov: np.ndarray  # covariance of (sx, sy, p...) (normal-matrix inverse x the residual NMAD squared)
+    change: float  # the largest height change of the model's increment over the inliers
+    spread: float  # NMAD of the inliers' residuals after the step
+    relief: float  # RMS height change of a one-cell shift over the inliers (RMS gradient x cell)
+
+
+def _step(sample: Sampler, shift: np.ndarray, p: np.ndarray, model: _Model, usable: np.ndarray, horizontal: bool,
+          cell: float) -> _Step:
+    """One Gauss-Newton step at ``shift``, ``p``."""
     x, y, dh, gx, gy = sample(shift)
     m = model.matrix(x, y)
     r = dh - m @ p
@@ -179,44 +189,59 @@ def _step(sample: Sampler, shift: np.ndarray, p: np.ndarray, model: _Model, usab
     if horizontal:
         a = np.column_stack([-gx[inl], -gy[inl], a])
     sol, *_ = np.linalg.lstsq(a, r[inl], rcond=None)
+    spread = nmad(r[inl] - a @ sol)
     try:
-        cov = np.linalg.inv(a.T @ a) * nmad(r[inl] - a @ sol) ** 2
+        cov = np.linalg.inv(a.T @ a) * spread ** 2
     except np.linalg.LinAlgError:
         cov = np.full((a.shape[1], a.shape[1]), np.inf)
-    if horizontal:
-        return sol[:2], sol[2:], inl, cov, r, x, y
-    return np.zeros(2), sol, inl, np.pad(cov, ((2, 0), (2, 0)), constant_values=np.inf), r, x, y
+    if not horizontal:
+        sol = np.r_[0.0, 0.0, sol]
+        cov = np.pad(cov, ((2, 0), (2, 0)), constant_values=np.inf)
+    change = float(np.max(np.abs(m[inl] @ sol[2:])))
+    relief = float(np.sqrt(np.mean(gx[inl] ** 2 + gy[inl] ** 2))) * cell
+    return _Step(sol[:2], sol[2:], inl, cov, change, spread, relief)
+
+
+def _iterate(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, max_iterations: int,
+             tolerance: float, horizontal: bool, progress: Progress):
+    """Gauss-Newton from no shift until the shift changes by less than ``tolerance`` cells and the model by less
+    than a twentieth of the residual NMAD: (shift, parameters, iterations, converged, last step)."""
+    shift, p = np.zeros(2), np.zeros(model.size)
+    st, it, converged = None, 0, False
+    for it in range(1, max_iterations + 1):
+        check_cancel(progress)
+        st = _step(sample, shift, p, model, usable, horizontal, cell)
+        size = float(np.hypot(*st.d_shift))
+        if size > MAX_STEP_CELLS * cell:
+            st.d_shift = st.d_shift * (MAX_STEP_CELLS * cell / size)
+        shift, p = shift + st.d_shift, p + st.d_p
+        progress.report(min(0.95, it / max_iterations), f"co-registration iteration {it}: shift {shift[0]:.2f}, "
+                        f"{shift[1]:.2f} m")
+        if size < tolerance * cell and st.change < max(0.05 * st.spread, 1e-4):
+            converged = True
+            break
+    return shift, p, it, converged, st
 
 
 def _fit(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, max_iterations: int, tolerance: float,
          progress: Progress) -> CoregResult:
-    """Iterate :func:`_step` from no shift until the increments are small; the result with its statistics."""
+    """The co-registration and its statistics.  The shift is dropped (and the heights fitted again) when the
+    terrain cannot fix it: its standard error over UNDETERMINED_CELLS cells, or a one-cell shift changing the
+    heights by less than two residual NMADs (the gradient is then mostly noise)."""
     messages: List[str] = []
-    shift, p = np.zeros(2), np.zeros(model.size)
-    _, _, dh0, _, _ = sample(shift)
+    _, _, dh0, _, _ = sample(np.zeros(2))
     before = dh0[usable & np.isfinite(dh0)]
-    step = 0.0
-    horizontal, converged, it = True, False, 0
-    for it in range(1, max_iterations + 1):
-        check_cancel(progress)
-        d_shift, d_p, inl, cov, r, x, y = _step(sample, shift, p, model, usable, horizontal)
-        if it == 1 and max(math.sqrt(max(cov[0, 0], 0)), math.sqrt(max(cov[1, 1], 0))) > UNDETERMINED_CELLS * cell:
-            horizontal = False
-            messages.append("the terrain is too flat (or too little of it is stable) to determine a horizontal "
-                            "shift: only the heights were co-registered (dx = dy = 0)")
-            d_shift, d_p, inl, cov, r, x, y = _step(sample, shift, p, model, usable, horizontal)
-        step = float(np.hypot(*d_shift))
-        if step > MAX_STEP_CELLS * cell:
-            d_shift = d_shift * (MAX_STEP_CELLS * cell / step)
-        shift, p = shift + d_shift, p + d_p
-        change = float(np.max(np.abs(model.matrix(x[inl], y[inl]) @ d_p)))
-        spread = nmad(r[inl])
-        progress.report(min(0.95, it / max_iterations), f"co-registration iteration {it}: shift {shift[0]:.2f}, "
-                        f"{shift[1]:.2f} m")
-        if step < tolerance * cell and change < max(0.05 * spread, 1e-4):
-            converged = True
-            break
-    # final state: the vertical bias as the median of the stable residuals, the statistics
+    shift, p, it, converged, st = _iterate(sample, usable, model, cell, max_iterations, tolerance, True, progress)
+    horizontal = True
+    sigma = math.sqrt(max(st.cov[0, 0], st.cov[1, 1], 0.0))
+    if not (sigma <= UNDETERMINED_CELLS * cell) or st.relief < 2 * st.spread:
+        horizontal = False
+        messages.append(f"the terrain is too flat (a one-cell shift changes the heights by {st.relief:.2g} m RMS, the "
+                        f"residuals spread {st.spread:.2g} m) to determine a horizontal shift: only the heights were "
+                        "co-registered (dx = dy = 0)")
+        shift, p, it, converged, st = _iterate(sample, usable, model, cell, max_iterations, tolerance, False,
+                                               progress)
+    # the vertical bias as the median of the stable residuals, the statistics
     x, y, dh, gx, gy = sample(shift)
     r = dh - model.matrix(x, y) @ p
     steep = np.hypot(gx, gy) > math.tan(math.radians(MAX_SLOPE_DEG))
@@ -227,8 +252,9 @@ def _fit(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, max_it
     after = r[usable & np.isfinite(r)]
     dz, tilt, dome = model.coefficients(p)
     if not converged:
-        messages.append(f"not converged after {max_iterations} iterations (last shift change {step:.3g} m): the "
-                        "surfaces may differ by more than a shift and a tilt, or share too little stable terrain")
+        messages.append(f"not converged after {max_iterations} iterations (last shift change "
+                        f"{float(np.hypot(*st.d_shift)):.3g} m): the surfaces may differ by more than a shift and a "
+                        "tilt, or share too little stable terrain")
     n_cmp = int(after.size)
     return CoregResult(
         shift=(float(shift[0]), float(shift[1]), dz), tilt=tilt, dome=dome, origin=model.origin, iterations=it,
@@ -237,7 +263,7 @@ def _fit(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, max_it
         median_after=float(np.median(after)) if after.size else math.nan, n_cells=int(inl.sum()),
         n_compared=n_cmp, stable_fraction=float(inl.sum()) / max(n_cmp, 1), cell=float(cell),
         shift_sigma=tuple(float(math.sqrt(max(v, 0.0))) if math.isfinite(v) else math.nan
-                          for v in np.diag(cov)[:3]),
+                          for v in np.diag(st.cov)[:3]),
         horizontal_determined=horizontal, messages=messages)
 
 
