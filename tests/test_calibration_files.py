@@ -422,3 +422,14 @@ def test_the_documented_example_reads(tmp_path):
     assert (cal.name, cal.adjust, cal.images) == ("RC20_15UAG", "fixed", ["1971_*.tif"])
     assert (cal.cx_px, cal.cy_px) == pytest.approx((5749.8, 5749.45))  # as the table of fields says
     np.testing.assert_allclose([cal.k1, cal.k2, cal.k3], RC20_K, rtol=2e-3)  # its table is rounded to 1 nm
+
+
+def test_error_forms_and_pickling():
+    import pickle
+    err = CalibrationError("/data/c.yaml", 3, "k1", "k1 must be a number")
+    assert str(err) == "c.yaml, line 3: k1 must be a number"
+    back = pickle.loads(pickle.dumps(err))
+    assert (str(back), back.file, back.line, back.field) == (str(err), "/data/c.yaml", 3, "k1")
+    plain = CalibrationError("the camera does not fit")
+    assert str(plain) == "the camera does not fit" and plain.file == "" and plain.line is None
+    assert str(pickle.loads(pickle.dumps(plain))) == str(plain)

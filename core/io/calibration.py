@@ -68,16 +68,25 @@ _TABLE_TERMS = 3
 
 
 class CalibrationError(ArchaeoOrthoError, ValueError):
-    """A camera calibration file cannot be used; the message names the file, the line and the field."""
+    """A camera calibration file cannot be used; the message names the file, the line and the field.
 
-    def __init__(self, file: str, line: Optional[int], fieldname: str, problem: str):
+    ``CalibrationError(file, line, field, problem)`` gives "file.yaml, line 7: problem" (``file``, ``line`` and
+    ``field`` kept as attributes); ``CalibrationError(message)`` is a plain message."""
+
+    def __init__(self, file: str, line: Optional[int] = None, fieldname: str = "", problem: Optional[str] = None):
+        if problem is None:  # a plain message
+            file, problem = "", file
         self.file = file
         self.line = line
         self.field = fieldname
-        where = os.path.basename(file) if file else "calibration"
-        if line:
+        self.problem = problem
+        where = os.path.basename(file) if file else ""
+        if where and line:
             where += f", line {line}"
-        super().__init__(f"{where}: {problem}")
+        super().__init__(f"{where}: {problem}" if where else problem)
+
+    def __reduce__(self):  # pickled across process pools with its attributes
+        return type(self), (self.file, self.line, self.field, self.problem)
 
 
 @dataclass
