@@ -190,7 +190,7 @@ def test_disk_full_reports_the_stage_error_and_records_later(small_disk, capfd):
     assert "ZipFile.__del__" not in capfd.readouterr().err
     # no partial file anywhere
     leftovers = [os.path.join(dp, f) for dp, _, fs in os.walk(ws.root) for f in fs]
-    assert leftovers == [ws.manifest_path], leftovers
+    assert leftovers == [ws.manifest_path, ws.manifest_path + ".lock"], leftovers  # the lock is no partial file
     assert stage_status(ws.root, DSM) == RUNNING  # what the disk holds: the recording could not be written
     # once there is room: the next open (same process) reads interrupted, and the next run records normally
     os.unlink(filler)
@@ -221,7 +221,7 @@ def test_recording_failure_never_replaces_the_error(tmp_path, monkeypatch):
     assert e.value is original
     assert "could not be recorded failed" in " ".join(e.value.__notes__)
     monkeypatch.setattr(os, "replace", real_replace)
-    assert not [n for n in os.listdir(tmp_path) if n != MANIFEST]  # the manifest's temp file went too
+    assert not [n for n in os.listdir(tmp_path) if n not in (MANIFEST, MANIFEST + ".lock")]  # its temp file went too
     assert Workspace.open(str(tmp_path)).stage(DSM)["status"] == INTERRUPTED
     # a failure that can be recorded is recorded as before
     with pytest.raises(ValueError):

@@ -23,7 +23,7 @@ def test_create_reopen_and_stage_records(tmp_path):
     assert rec["outputs"]["model"] == "sfm/model"
     assert again.data["format_version"] == wsmod.FORMAT_VERSION
     # no temp files left beside the manifest
-    assert sorted(os.listdir(tmp_path / "ws")) == ["workspace.json"]
+    assert sorted(os.listdir(tmp_path / "ws")) == ["workspace.json", wsmod.LOCK]  # the lock stays (flock)
 
 
 def test_invalidate_later_stages(tmp_path):

@@ -8,15 +8,24 @@ its inputs, status, timings and output paths.
 Every write of the manifest is atomic (temporary file + ``os.replace``), and a
 manifest that is damaged or written by a newer format version is never
 overwritten: opening it raises :class:`WorkspaceError`.
+
+Several processes may work on one workspace at once (two stages started together, the dock and a
+``qgis_process`` run): every write is a read-modify-write under a lock (``workspace.json.lock``).  What this
+object changed since it last read or wrote the manifest (a stage record, the CRS, the image list) replaces the
+manifest's value; everything else comes from the manifest on disk, so no process drops another's stage record.
+A stage that ends done after an earlier stage of the flow finished while it ran was made from that stage's
+previous products: it is recorded stale, not done.
 """
 from __future__ import annotations
 
+import contextlib
+import copy
 import datetime as _dt
 import json
 import os
 import tempfile
 import time
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, Iterator, List, Optional
 
 from ..common.errors import ArchaeoOrthoError
 from ..common.files import atomic_write_text, clean_partials, owner_alive, process_owner
@@ -24,6 +33,8 @@ from .stages import DONE, INTERRUPTED, PENDING, RUNNING, STAGE_ORDER, STALE, STA
 
 FORMAT_VERSION = 1
 MANIFEST = "workspace.json"
+LOCK = MANIFEST + ".lock"
+LOCK_TIMEOUT_S = 60.0  # a writer holds the lock for a read and a write of a small file: far less than this
 
 # (workspace root, stage) of the stages this process runs now: a "running" record of this process that is not
 # here ended without recording its outcome (the manifest could not be written: disk full)
@@ -44,6 +55,9 @@ class Workspace:
         self.root = os.path.abspath(root)
         self.data = data
         self._t0: Dict[str, float] = {}
+        self._base: Dict[str, Any] = copy.deepcopy(data)  # the manifest as last read or written here
+        self._lock_depth = 0
+        self._lock_file = None
 
     # --- opening -------------------------------------------------------
     @classmethod
@@ -135,11 +149,66 @@ class Workspace:
 
     # --- manifest ------------------------------------------------------
     def save(self) -> None:
-        self.data["modified"] = _now()
+        """Write the manifest: under the lock, what this object changed over what is on disk now."""
+        with self.locked():
+            self._merge_from_disk()
+            self.data["modified"] = _now()
+            try:
+                atomic_write_text(self.manifest_path, json.dumps(self.data, indent=2, sort_keys=False, default=str))
+            except OSError as e:
+                raise WorkspaceError(f"cannot write {self.manifest_path}: {e.strerror or e}") from e
+            self._base = copy.deepcopy(self.data)
+
+    @contextlib.contextmanager
+    def locked(self) -> Iterator[None]:
+        """Hold the workspace's manifest lock (re-entrant within this object): other processes' saves wait."""
+        if self._lock_depth:
+            self._lock_depth += 1
+            try:
+                yield
+            finally:
+                self._lock_depth -= 1
+            return
         try:
-            atomic_write_text(self.manifest_path, json.dumps(self.data, indent=2, sort_keys=False, default=str))
+            f = open(self.path(LOCK), "a+b")
         except OSError as e:
-            raise WorkspaceError(f"cannot write {self.manifest_path}: {e.strerror or e}") from e
+            raise WorkspaceError(f"cannot write {self.path(LOCK)}: {e.strerror or e}") from e
+        try:
+            _lock(f, self.path(LOCK))
+            self._lock_depth, self._lock_file = 1, f
+            try:
+                yield
+            finally:
+                self._lock_depth, self._lock_file = 0, None
+                _unlock(f)
+        finally:
+            f.close()
+
+    def _merge_from_disk(self) -> None:
+        """Take into ``self.data`` what other processes wrote since this object last read or wrote the manifest:
+        every top-level value and stage record this object has not changed itself (records are updated in place,
+        so a record held by a running stage stays the one in the manifest)."""
+        try:
+            with open(self.manifest_path, encoding="utf-8") as f:
+                disk = json.load(f)
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+            return  # gone or damaged since it was opened: this object's view is the one to write
+        if not isinstance(disk, dict) or _shape_problem(disk) or disk.get("format_version") != FORMAT_VERSION:
+            return
+        base = self._base
+        for key, value in disk.items():
+            if key in ("stages", "modified"):
+                continue
+            if key not in self.data or self.data.get(key) == base.get(key):
+                self.data[key] = value
+        ours, base_stages = self.data.setdefault("stages", {}), base.get("stages") or {}
+        for name, rec in (disk.get("stages") or {}).items():
+            mine = ours.get(name)
+            if mine is None:
+                ours[name] = rec
+            elif mine == base_stages.get(name) and mine != rec:
+                mine.clear()
+                mine.update(rec)
 
     def stage(self, name: str) -> Dict[str, Any]:
         return self.data["stages"].get(name, {"status": PENDING})
@@ -150,6 +219,11 @@ class Workspace:
     def begin_stage(self, name: str, parameters: Dict[str, Any], inputs: Optional[Dict[str, str]] = None) -> None:
         """Record ``name`` running in this process (its owner: host, pid, process start).  Refuses while another
         live process runs the same stage; otherwise the partial files of killed runs go first."""
+        with self.locked():
+            self._merge_from_disk()
+            self._begin_stage(name, parameters, inputs)
+
+    def _begin_stage(self, name: str, parameters: Dict[str, Any], inputs: Optional[Dict[str, str]]) -> None:
         rec = self.data["stages"].setdefault(name, {})
         self._refuse_if_running_elsewhere(name, rec)
         if not self._running_elsewhere():
@@ -198,19 +272,38 @@ class Workspace:
         results: Optional[Dict[str, Any]] = None,
         error: Optional[str] = None,
     ) -> None:
-        rec = self.data["stages"].setdefault(name, {})
-        t0 = self._t0.pop(name, None)
-        _ACTIVE.discard((self.root, name))
-        rec["status"] = status
-        rec["finished"] = _now()
-        if t0 is not None:
-            rec.setdefault("timings", {})["total"] = round(time.time() - t0, 3)
-        if outputs is not None:
-            rec["outputs"] = outputs
-        if results is not None:
-            rec["results"] = results
-        rec["error"] = error
-        self.save()
+        with self.locked():
+            self._merge_from_disk()
+            rec = self.data["stages"].setdefault(name, {})
+            t0 = self._t0.pop(name, None)
+            _ACTIVE.discard((self.root, name))
+            rec["status"] = status
+            rec["finished"] = _now()
+            if t0 is not None:
+                rec.setdefault("timings", {})["total"] = round(time.time() - t0, 3)
+            if outputs is not None:
+                rec["outputs"] = outputs
+            if results is not None:
+                rec["results"] = results
+            rec["error"] = error
+            changed = self._earlier_finished_since(name, rec.get("started")) if status == DONE else None
+            if changed:
+                rec["status"] = STALE
+                rec["error"] = (f"made while stage {changed} ran again (it finished at "
+                                f"{self.data['stages'][changed].get('finished')}): its products may come from "
+                                f"{changed}'s previous results; run {name} again")
+            self.save()
+
+    def _earlier_finished_since(self, name: str, started: Optional[str]) -> Optional[str]:
+        """An earlier stage of the flow that finished done after ``started`` (while ``name`` ran; the times are in
+        whole seconds, so a stage that began in the second another ended, as in a pipeline, does not count)."""
+        if not started or name not in STAGE_ORDER:
+            return None
+        for earlier in STAGE_ORDER[:STAGE_ORDER.index(name)]:
+            rec = self.data["stages"].get(earlier) or {}
+            if rec.get("status") == DONE and isinstance(rec.get("finished"), str) and rec["finished"] > started:
+                return earlier
+        return None
 
     def invalidate_after(self, name: str, order: Optional[List[str]] = None) -> None:
         """Mark the stages after ``name`` in ``order`` (default: the stage order) as stale (inputs changed)."""
@@ -218,11 +311,13 @@ class Workspace:
             order = STAGE_ORDER
         if name not in order:
             return
-        for later in order[order.index(name) + 1:]:
-            rec = self.data["stages"].get(later)
-            if rec and rec.get("status") == DONE:
-                rec["status"] = STALE
-        self.save()
+        with self.locked():
+            self._merge_from_disk()
+            for later in order[order.index(name) + 1:]:
+                rec = self.data["stages"].get(later)
+                if rec and rec.get("status") == DONE:
+                    rec["status"] = STALE
+            self.save()
 
     # --- convenience ---------------------------------------------------
     @property
@@ -232,6 +327,41 @@ class Workspace:
     @crs.setter
     def crs(self, value: Optional[str]) -> None:
         self.data["crs"] = value
+
+
+def _lock(f, path: str) -> None:
+    """An exclusive lock on the open file ``f`` (fcntl on POSIX, msvcrt on Windows), waiting up to
+    LOCK_TIMEOUT_S; WorkspaceError naming the lock file after that."""
+    deadline = time.monotonic() + LOCK_TIMEOUT_S
+    while True:
+        try:
+            if os.name == "nt":
+                import msvcrt
+
+                f.seek(0)
+                msvcrt.locking(f.fileno(), msvcrt.LK_NBLCK, 1)
+            else:
+                import fcntl
+
+                fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return
+        except OSError as e:
+            if time.monotonic() > deadline:
+                raise WorkspaceError(f"{path} stayed locked by another process for {LOCK_TIMEOUT_S:.0f} s ({e}): "
+                                     "another stage may be writing this workspace; try again") from e
+            time.sleep(0.02)
+
+
+def _unlock(f) -> None:
+    if os.name == "nt":
+        import msvcrt
+
+        f.seek(0)
+        msvcrt.locking(f.fileno(), msvcrt.LK_UNLCK, 1)
+    else:
+        import fcntl
+
+        fcntl.flock(f.fileno(), fcntl.LOCK_UN)
 
 
 def _shape_problem(data: Dict[str, Any]) -> Optional[str]:
