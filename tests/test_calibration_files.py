@@ -327,7 +327,7 @@ BAD = [
     ("calib.yaml", "cameras:\n  - name: a\n    " + _GOOD_CAMERA.replace("\n", "\n    ") + "\n  - name: a\n    "
      + _GOOD_CAMERA.replace("\n", "\n    "), ["calib.yaml, line 7", "two cameras are named 'a'"]),
     ("calib.yaml", _GOOD_CAMERA + "radial_distortion_table:\n  - [10, 1.0]\n  - [20, 2.0]\n",
-     ["calib.yaml, line 5", "radial_distortion_table needs at least 3 different radii"]),
+     ["calib.yaml, line 4", "radial_distortion_table needs at least 3 different radii"]),
     ("calib.yaml", _GOOD_CAMERA + "radial_distortion_table:\n  - [10, 1.0]\n  - [20]\n  - [30, 2.0]\n",
      ["calib.yaml, line 6", "row 2 of radial_distortion_table"]),
     ("calib.yaml", _GOOD_CAMERA + "sigmas:\n  focal_length_mm: 0\n",
@@ -361,6 +361,13 @@ BAD = [
     ("ms.xml", "<calibration>\n  <width>640</width>\n  <height>480</height>\n  <f>300\n</calibration>\n",
      ["ms.xml, line 5", "not valid XML"]),
     ("other.xml", "<svg>\n</svg>\n", ["other.xml, line 1", "<svg>"]),
+    ("oty.yaml", "c:\n  type: opencv\n  im_size: [640, 480]\n  focal_len: 0.8\n  k4: 0.1\n",
+     ["oty.yaml, line 5", "camera 'c'", "k4 is not supported"]),
+    ("opencv.yml", "%YAML:1.0\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n  rows: 3\n"
+     "  cols: 3\n  dt: d\n  data: [500., 0., 319.5, 0., 500., 239.5, 0., 0., 1.]\n"
+     "distortion_coefficients: !!opencv-matrix\n  rows: 1\n  cols: 8\n  dt: d\n"
+     "  data: [0.1, 0., 0., 0., 0., 0.2, 0., 0.]\n",
+     ["opencv.yml, line 9", "distortion_coefficients: only k1, k2, p1, p2, k3 are supported"]),
     ("calib.yaml", "focal: 50\n", ["calib.yaml, line 1", "not a camera calibration"]),
     ("calib.yaml", "\n\n", ["calib.yaml", "empty"]),
 ]

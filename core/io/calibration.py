@@ -91,7 +91,12 @@ class CalibrationError(ArchaeoOrthoError, ValueError):
 
 @dataclass
 class CameraCalibration:
-    """One camera's interior orientation, in pixels of a ``width`` x ``height`` image (COLMAP's convention)."""
+    """One camera's interior orientation, in pixels of a ``width`` x ``height`` image (COLMAP's convention).
+
+    ``focal_y_px`` is None for square pixels; ``sigmas`` holds a priori standard deviations under the names
+    focal_px, cx_px, cy_px (pixels) and k1..p2; ``pixel_size_mm`` is the x pixel size (y's is
+    pixel_size_mm * fy / fx); ``fiducials_mm`` are x right, y up from the fiducial centre; ``notes`` say what
+    the reader assumed or dropped (for the log)."""
 
     name: str
     source: str
@@ -352,7 +357,7 @@ def _load_yaml(path: str, text: str) -> Any:
                 raise CalibrationError(path, k_node.start_mark.line + 1, str(key),
                                        f"'{key}' is given twice (first on line {m.lines[key]})")
             m[key] = loader.construct_object(v_node, deep=True)
-            m.lines[key] = v_node.start_mark.line + 1
+            m.lines[key] = k_node.start_mark.line + 1  # the key's line (a block value starts below it)
 
     def sequence(loader, node):
         s = _Seq()
