@@ -440,3 +440,27 @@ def test_error_forms_and_pickling():
     plain = CalibrationError("the camera does not fit")
     assert str(plain) == "the camera does not fit" and plain.file == "" and plain.line is None
     assert str(pickle.loads(pickle.dumps(plain))) == str(plain)
+
+
+def test_resampled_frame_and_the_scan_preparations_fiducials():
+    from core.prepare.scans import parse_fiducial_coordinates
+    cal = read_calibration(_data("rc20_certificate.yaml"))[0]
+    assert cal.principal_point_mm == pytest.approx((-0.004, 0.011))
+    # the scan preparation reads the certificate's marks relative to the principal point
+    spec = parse_fiducial_coordinates(cal.fiducial_coordinates_text())
+    assert spec.focal_length_mm == pytest.approx(152.817)
+    by_id = {spec.ids[s]: spec.points[s] for s in spec.points}
+    for name, (x, y) in cal.fiducials_mm.items():
+        assert by_id[name] == pytest.approx((x + 0.004, y - 0.011))
+    # the camera of images resampled to 25 um pixels with the principal point at their centre
+    frame = cal.for_resampled_frame(9000, 9000, 0.025)
+    assert frame.focal_px == pytest.approx(152.817 / 0.025) and (frame.cx_px, frame.cy_px) == (4500.0, 4500.0)
+    assert frame.sigmas["focal_px"] == pytest.approx(0.003 / 0.025)
+    # a ray lands where the certificate puts it: mm from the principal point (y up) over the pixel size
+    xyz = np.array([[0.0, 0.0, 1.0], [0.3, -0.2, 1.0], [-0.5, 0.45, 2.0]])
+    xn, yn = xyz[:, 0] / xyz[:, 2], xyz[:, 1] / xyz[:, 2]
+    xd, yd = _brown(xn, yn, cal.k1, cal.k2, cal.k3, 0, 0)
+    expected = np.stack([4500 + 152.817 * xd / 0.025, 4500 + 152.817 * yd / 0.025], axis=1)
+    np.testing.assert_allclose(_pycolmap_project(frame, xyz), expected, atol=1e-6)
+    with pytest.raises(CalibrationError, match="focal length in mm"):
+        read_calibration(_data("same_camera_cameras.txt"))[0].for_resampled_frame(100, 100, 0.1)

@@ -163,6 +163,50 @@ class CameraCalibration:
                         focal_y_px=None if _same(fx, fy) else fy, cx_px=self.cx_px * sx, cy_px=self.cy_px * sy,
                         sigmas=sig, pixel_size_mm=None if self.pixel_size_mm is None else self.pixel_size_mm / sx)
 
+    @property
+    def principal_point_mm(self) -> Optional[Tuple[float, float]]:
+        """(x0, y0) mm from the image centre, x right, y up (the certificate's convention); None without a
+        pixel size."""
+        if self.pixel_size_mm is None:
+            return None
+        py = self.pixel_size_mm * self.fx / self.fy
+        return (self.cx_px - self.width / 2.0) * self.pixel_size_mm, (self.height / 2.0 - self.cy_px) * py
+
+    def for_resampled_frame(self, width: int, height: int, pixel_size_mm: float) -> CameraCalibration:
+        """The camera of images resampled into the calibrated frame with the principal point at their centre
+        and square pixels of ``pixel_size_mm`` (what core.prepare.scans writes when given
+        :meth:`fiducial_coordinates_text`): focal = focal_mm / pixel size, (cx, cy) = (width/2, height/2); the
+        distortion (on normalised coordinates) is unchanged."""
+        if self.focal_mm is None or self.pixel_size_mm is None:
+            raise CalibrationError(self.source, None, "focal_length_mm",
+                                   f"{self.label()}: resampling into the calibrated frame needs the focal "
+                                   f"length in mm and the pixel size")
+        if width <= 0 or height <= 0 or not pixel_size_mm > 0:
+            raise CalibrationError(self.source, None, "pixel_size_mm",
+                                   f"{self.label()}: the resampled frame needs a positive size and pixel size, "
+                                   f"got {width} x {height} px of {pixel_size_mm} mm")
+        sx, sy = self.pixel_size_mm / pixel_size_mm, self.pixel_size_mm * self.fx / self.fy / pixel_size_mm
+        sig = dict(self.sigmas)
+        for key, s in (("focal_px", sx), ("cx_px", sx), ("cy_px", sy)):
+            if key in sig:
+                sig[key] = sig[key] * s
+        return _replace(self, width=int(width), height=int(height), focal_px=self.focal_mm / pixel_size_mm,
+                        focal_y_px=None, cx_px=width / 2.0, cy_px=height / 2.0, sigmas=sig,
+                        pixel_size_mm=float(pixel_size_mm))
+
+    def fiducial_coordinates_text(self) -> str:
+        """The fiducials, principal point and focal length as core.prepare.scans reads them
+        (ScanOptions.fiducial_coordinates): "id x y" lines in mm, "PP x0 y0", "focal f"."""
+        if not self.fiducials_mm:
+            raise CalibrationError(self.source, None, "fiducials_mm", f"{self.label()} has no fiducials_mm")
+        lines = [f"{re.sub(r'[^0-9A-Za-z_.-]+', '_', k)} {x!r} {y!r}" for k, (x, y) in self.fiducials_mm.items()]
+        pp = self.principal_point_mm
+        if pp is not None:
+            lines.append(f"PP {pp[0]!r} {pp[1]!r}")
+        if self.focal_mm is not None:
+            lines.append(f"focal {self.focal_mm!r}")
+        return "\n".join(lines) + "\n"
+
     def colmap_model(self) -> Tuple[str, List[float]]:
         """The simplest COLMAP model that holds this camera exactly, and its parameters (pycolmap's order).
 
