@@ -128,3 +128,33 @@ def test_relief_copy_over_the_workspace_dtm_is_refused(dsm, tmp_path):
     assert _digest(lay.default_dsm) == before
     r = relief_workspace(root, ["slrm"], source="dsm", copy_to=str(tmp_path / "slrm.tif"))
     assert os.path.samefile(r.paths["slrm"], tmp_path / "slrm.tif")
+
+
+def test_an_image_given_as_a_dsm_is_refused_naming_what_it_is(dsm, tmp_path):
+    """The RGBA orthomosaic given as the DSM to builddtm, reliefvisualisation and dsmdifference (issue 36 item 5:
+    a median 'change' of 142 m), and a relief visualisation given as a DSM."""
+    from osgeo import gdal
+
+    from core.terrain.difference import dsm_difference
+
+    _scene, path = dsm
+    src = gdal.Open(path)
+    rgba = str(tmp_path / "orthomosaic.tif")
+    out = gdal.GetDriverByName("GTiff").Create(rgba, src.RasterXSize, src.RasterYSize, 4, gdal.GDT_Byte,
+                                               ["PHOTOMETRIC=RGB", "ALPHA=YES"])
+    out.SetGeoTransform(src.GetGeoTransform())
+    out.SetProjection(src.GetProjection())
+    for i in range(4):
+        out.GetRasterBand(i + 1).Fill(120 + i)
+    out = None
+    with pytest.raises(TerrainError, match=r"orthomosaic\.tif is an image, not heights: 4 band\(s\) of Byte"):
+        build_dtm(rgba, str(tmp_path / "dtm.tif"))
+    with pytest.raises(TerrainError, match="is an image, not heights"):
+        relief(rgba, ["slrm"], str(tmp_path), what="DSM")
+    with pytest.raises(TerrainError, match="DSM B .*is an image, not heights"):
+        dsm_difference(path, rgba, str(tmp_path / "diff.tif"))
+    tagged = str(tmp_path / "slrm.tif")
+    gdal.Translate(tagged, path, metadataOptions=["ARCHAEOORTHO_PRODUCT=relief-slrm"])
+    with pytest.raises(TerrainError, match="ArchaeoOrtho relief-slrm raster, not heights"):
+        build_dtm(tagged, str(tmp_path / "dtm2.tif"))
+    assert not os.path.exists(tmp_path / "dtm.tif") and not os.path.exists(tmp_path / "diff.tif")

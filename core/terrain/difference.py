@@ -19,7 +19,7 @@ from ..common.files import refuse_overwriting_inputs
 from ..common.progress import NullProgress, Progress, check_cancel
 from ..io import raster
 from .options import TerrainError
-from .rasters import check_north_up, open_raster
+from .rasters import check_elevation_kind, check_north_up, open_raster
 
 CHANGE_THRESHOLD = 1.0  # metres: a cell whose height changed by more than this counts as changed
 
@@ -63,6 +63,7 @@ def _open(path: str, what: str) -> _Raster:
     """A DSM's grid and CRS; TerrainError naming the file when it is missing, not a raster, has no CRS or no
     north-up georeferencing."""
     ds = open_raster(path, what)
+    check_elevation_kind(ds, path, what)
     gt = ds.GetGeoTransform(can_return_null=True)
     wkt = ds.GetProjection() or ""
     if gt is None:

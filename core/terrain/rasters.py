@@ -50,12 +50,37 @@ def check_north_up(path: str, what: str, gt) -> None:
         raise TerrainError(f"the {what} {path} is rotated (geotransform {gt}): warp it to a north-up grid first")
 
 
+ELEVATION_PRODUCTS = ("dtm", "dsm", None)  # ARCHAEOORTHO_PRODUCT values that are heights (None: not ours)
+
+
+def check_elevation_kind(ds, path: str, what: str) -> None:
+    """TerrainError naming the file and what it holds when the raster is of a kind that cannot be heights: an
+    image (RGB / RGBA bands, 8-bit colour, a palette: the orthomosaic given as a DSM) or one of the plugin's own
+    non-elevation products (a DSM/DTM source raster, a relief visualisation)."""
+    from osgeo import gdal
+
+    product = (ds.GetMetadata() or {}).get("ARCHAEOORTHO_PRODUCT")
+    if product not in ELEVATION_PRODUCTS:
+        raise TerrainError(f"the {what} {path} is an ArchaeoOrtho {product} raster, not heights: give a DSM or DTM")
+    colours = {gdal.GCI_RedBand: "red", gdal.GCI_GreenBand: "green", gdal.GCI_BlueBand: "blue",
+               gdal.GCI_AlphaBand: "alpha", gdal.GCI_PaletteIndex: "palette"}
+    bands = [ds.GetRasterBand(i + 1) for i in range(ds.RasterCount)]
+    interp = [colours.get(b.GetColorInterpretation()) for b in bands]
+    dtype = gdal.GetDataTypeName(bands[0].DataType)
+    if any(interp) or (ds.RasterCount >= 3 and dtype == "Byte"):
+        kinds = "/".join(c or "grey" for c in interp)
+        raise TerrainError(f"the {what} {path} is an image, not heights: {ds.RasterCount} band(s) of {dtype} "
+                           f"({kinds}); an orthophoto or a rendered picture cannot be a terrain model: give a DSM "
+                           "or DTM (one band of heights)")
+
+
 def read_elevation(path: str, what: str = "DSM") -> Elevation:
     """The whole raster ``path`` (band 1) as metres; TerrainError naming the file for a raster that cannot be a
     terrain model: unreadable, geographic CRS (degrees), rotated or non-square cells, too small, no data."""
     from osgeo import osr
 
     ds = open_raster(path, what)
+    check_elevation_kind(ds, path, what)
     gt = ds.GetGeoTransform()
     wkt = ds.GetProjection() or ""
     unit = 1.0
