@@ -464,3 +464,12 @@ def test_resampled_frame_and_the_scan_preparations_fiducials():
     np.testing.assert_allclose(_pycolmap_project(frame, xyz), expected, atol=1e-6)
     with pytest.raises(CalibrationError, match="focal length in mm"):
         read_calibration(_data("same_camera_cameras.txt"))[0].for_resampled_frame(100, 100, 0.1)
+
+
+def test_a_certificate_typed_in_windows_1252_reads_and_a_binary_file_does_not(tmp_path):
+    path = tmp_path / "c.yaml"
+    path.write_bytes(("# pixel 5 \u00b5m\n" + _GOOD_CAMERA).encode("cp1252"))
+    assert read_calibration(str(path))[0].pixel_size_mm == 0.005
+    path.write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00")
+    with pytest.raises(CalibrationError, match="not a text file"):
+        read_calibration(str(path))

@@ -299,15 +299,18 @@ def read_calibration(path: str) -> List[CameraCalibration]:
     cameras.txt, Metashape XML), told apart by their content."""
     path = os.fspath(path)
     try:
-        with open(path, encoding="utf-8-sig") as fh:
-            text = fh.read()
+        with open(path, "rb") as fh:
+            raw = fh.read()
     except FileNotFoundError as e:
         raise CalibrationError(path, None, "", "the calibration file does not exist") from e
-    except UnicodeDecodeError as e:
-        raise CalibrationError(path, None, "", "the file is not a text file (UTF-8): is it a calibration "
-                                               "file?") from e
     except OSError as e:
         raise CalibrationError(path, None, "", f"cannot read the file: {e.strerror or e}") from e
+    if b"\0" in raw:
+        raise CalibrationError(path, None, "", "the file is not a text file: is it a calibration file?")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:  # a certificate typed on Windows (a 'µ' in a comment): Windows-1252 / Latin-1
+        text = raw.decode("cp1252", errors="replace")
     stripped = text.lstrip()
     if not stripped:
         raise CalibrationError(path, None, "", "the file is empty")
