@@ -117,7 +117,7 @@ class CameraCalibration:
     pixel_size_mm: Optional[float] = None
     fiducials_mm: Dict[str, Tuple[float, float]] = field(default_factory=dict)
     focal_mm: Optional[float] = None
-    notes: List[str] = field(default_factory=list)  # what the reader assumed or dropped, for the log
+    notes: List[str] = field(default_factory=list)  # what the reader assumed or dropped (the caller names the camera)
 
     @property
     def fx(self) -> float:
@@ -691,7 +691,7 @@ def _own_distortion(fl: _Fields, focal_mm: Optional[float]) -> Tuple[Dict[str, f
     radii, values = _own_table(fl)
     (k1, k2, k3), rms, worst = fit_radial_distortion(radii, values, focal_mm)
     dist.update(k1=k1, k2=k2, k3=k3)
-    note = (f"{fl.who or 'the camera'}: k1..k3 fitted to {len(radii)} rows of the radial distortion table, "
+    note = (f"k1..k3 fitted to {len(radii)} rows of the radial distortion table, "
             f"residual rms {rms:.3f} um, largest {worst:.3f} um")
     return dist, [note]
 
@@ -852,7 +852,7 @@ def _orthority_focal(fl: _Fields, w: int, h: int) -> Tuple[float, float, List[st
         return f[0] * w / sensor[0], f[1] * h / sensor[1], []
     notes = []
     if h > w:
-        notes.append(f"{fl.who or 'the camera'}: focal_len without sensor_size is taken as normalised by the "
+        notes.append(f"focal_len without sensor_size is taken as normalised by the "
                      f"image width ({w} px), as Orthority's code does; its documentation says by the larger side "
                      f"({h} px): give sensor_size to remove the doubt")
     return f[0] * w, f[1] * w, notes
@@ -988,7 +988,7 @@ def _read_xml(path: str, text: str) -> List[CameraCalibration]:
             cal = next((c for c in cals if c.attrib.get("class") == "adjusted"), cals[0])
             cam = _metashape_camera(path, cal, s.attrib.get("label", s.attrib.get("id", "")), s)
             if cal.attrib.get("class", "adjusted") != "adjusted":
-                cam.notes.append(f"{cam.label()}: the file holds no adjusted calibration; its "
+                cam.notes.append(f"the file holds no adjusted calibration for it; its "
                                  f"{cal.attrib['class']} one (line {cal.line}) is used")
             cams.append(cam)
         return cams
@@ -1051,7 +1051,7 @@ def _metashape_camera(path: str, cal: _Element, name: str, sensor: Optional[_Ele
         if shift > SKEW_LIMIT_PX:
             raise fl.fail("b2", f"the skew b2 = {v['b2']} moves the frame's edge by {shift:.2f} px; COLMAP has no "
                                 f"skew: recalibrate with b2 fixed at 0")
-        notes.append(f"{fl.who or 'the camera'}: skew b2 = {v['b2']} dropped (moves the frame's edge by "
+        notes.append(f"skew b2 = {v['b2']} dropped (moves the frame's edge by "
                      f"{shift:.3f} px)")
     fx, fy = v["f"] + v["b1"], v["f"]
     cx, cy = w / 2.0 + v["cx"], h / 2.0 + v["cy"]
