@@ -158,3 +158,26 @@ def test_an_image_given_as_a_dsm_is_refused_naming_what_it_is(dsm, tmp_path):
     with pytest.raises(TerrainError, match="ArchaeoOrtho relief-slrm raster, not heights"):
         build_dtm(tagged, str(tmp_path / "dtm2.tif"))
     assert not os.path.exists(tmp_path / "dtm.tif") and not os.path.exists(tmp_path / "diff.tif")
+
+
+def test_a_stale_dsm_or_dtm_is_refused(dsm, tmp_path):
+    """After a re-georeference (into another CRS) the DSM on disk describes the old block: builddtm and the relief
+    refuse it (issue 36 item 6) instead of building from it and recording done."""
+    from core.project.stages import DSM, GEOREFERENCE, STALE, run_stage
+    from core.terrain.stage import relief_workspace
+
+    scene, path = dsm
+    root, _ = _workspace_with_dsm(tmp_path / "ws", path, scene)
+    build_dtm_workspace(root)  # done on the current DSM
+    ws = Workspace.open(root)
+    with run_stage(ws, GEOREFERENCE, {"crs": "EPSG:32633"}) as run:  # georeferenced again: DSM, DTM stale
+        run.finish(outputs={})
+    assert Workspace.open(root).stage(DSM)["status"] == STALE
+    with pytest.raises(TerrainError, match="DSM of workspace .* is stale: .*run 'Build DSM' again"):
+        build_dtm_workspace(root)
+    with pytest.raises(TerrainError, match="DTM of workspace .* is stale: .*run 'Build DTM' again"):
+        relief_workspace(root, ["slrm"], source="dtm")
+    assert Workspace.open(root).stage(TERRAIN)["status"] == STALE
+    # a DSM file given explicitly (outside the workspace's records) is the user's choice
+    r = build_dtm_workspace(root, dsm=path, output_dtm=str(tmp_path / "other-dtm.tif"))
+    assert os.path.isfile(r.dtm_path)

@@ -24,7 +24,7 @@ import numpy as np
 from ..common.files import atomic_copy, file_fingerprint, refuse_overwriting_inputs, same_path
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..project.layout import Layout
-from ..project.stages import RELIEF, TERRAIN, run_stage
+from ..project.stages import DSM, RELIEF, STALE, TERRAIN, run_stage
 from ..project.workspace import Workspace
 from . import relief as rv
 from .classify import classify_las
@@ -129,6 +129,17 @@ def build_dtm(dsm_path: str, output_dtm: str, options: Optional[GroundOptions] =
     return out
 
 
+def _refuse_stale(ws: Workspace, stage: str, what: str, run_hint: str) -> None:
+    """TerrainError when the workspace's ``what`` (the product of ``stage``) is stale: an earlier stage ran again
+    after it was made (a re-georeference into another CRS leaves the old DSM on disk), so a product made from it
+    would describe the old block."""
+    rec = ws.stage(stage)
+    if rec.get("status") == STALE:
+        why = f" ({rec['error']})" if rec.get("error") else ""
+        raise TerrainError(f"the {what} of workspace {ws.root} is stale: an earlier stage ran again after it was "
+                           f"made{why}; run '{run_hint}' again first, or give a {what} file")
+
+
 def build_dtm_workspace(workspace_dir: str, dsm: Optional[str] = None, output_dtm: Optional[str] = None,
                         contour_interval: float = 0.0, options: Optional[GroundOptions] = None,
                         classify_points: bool = True, progress: Optional[Progress] = None,
@@ -140,6 +151,8 @@ def build_dtm_workspace(workspace_dir: str, dsm: Optional[str] = None, output_dt
     dsm_path = os.path.abspath(dsm) if dsm else lay.dsm()
     if not dsm_path:
         raise TerrainError(f"workspace {ws.root} has no DSM: run 'Build DSM' first (or give a DSM file)")
+    if not dsm or (lay.dsm() and same_path(dsm_path, lay.dsm())):
+        _refuse_stale(ws, DSM, "DSM", "Build DSM")
     options = options or GroundOptions()
     dtm_path = os.path.abspath(output_dtm) if output_dtm else lay.default_dtm
     pc = lay.point_cloud() if classify_points else None
@@ -219,6 +232,8 @@ def relief_workspace(workspace_dir: str, keys: Sequence[str], source: str = "dtm
     if not dem:
         stage = "Build DTM" if source == "dtm" else "Build DSM"
         raise TerrainError(f"workspace {ws.root} has no {source.upper()}: run '{stage}' first")
+    _refuse_stale(ws, TERRAIN if source == "dtm" else DSM, source.upper(),
+                  "Build DTM" if source == "dtm" else "Build DSM")
     if copy_to and len(keys) != 1:
         raise TerrainError("a copy of the relief visualisation needs exactly one visualisation")
     refuse_overwriting_inputs({f"{keys[0]} visualisation" if keys else "visualisation": copy_to},
