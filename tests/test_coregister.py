@@ -338,3 +338,33 @@ def test_errors(tmp_path, rugged, rugged_ref):
     with pytest.raises(CoregError, match="furlong.tif: the band's height unit"):
         coregister_rasters(feet, ref_path)
     assert issubclass(CoregError, ArchaeoOrthoError)
+
+
+def test_agrees_with_xdem_nuthkaab(rugged, rugged_ref):
+    """Against xdem's NuthKaab on the same pair (no tilt: xdem's Nuth & Kääb fits the shift alone) where xdem is
+    installed.  xdem is not in requirements-dev.txt (rasterio, pyproj, geopandas, pandas with their own GDAL/PROJ;
+    rasterio 1.4.4 breaks with affine 3): run it from a throw-away venv, see benchmarks/coregister.py."""
+    xdem = pytest.importorskip("xdem")
+    rasterio = pytest.importorskip("rasterio")
+    from affine import Affine
+    from osgeo import gdal
+
+    ref, ref_gt = rugged_ref
+    shift, dz = (37.0, -21.0), 3.2
+    dsm, gt = block_dsm(rugged, shift, dz)
+    ours = coregister_dems(dsm, gt, ref, ref_gt, tilt=False)
+    mem = gdal.GetDriverByName("MEM").Create("", dsm.shape[1], dsm.shape[0], 1, gdal.GDT_Float32)
+    mem.SetGeoTransform(gt)
+    mem.GetRasterBand(1).SetNoDataValue(float("nan"))
+    mem.GetRasterBand(1).WriteArray(dsm)
+    bounds = (X0, Y0, X0 + ref.shape[1] * REF_CELL, Y0 + ref.shape[0] * REF_CELL)
+    on_ref = gdal.Warp("", mem, format="MEM", outputBounds=bounds, width=ref.shape[1], height=ref.shape[0],
+                       resampleAlg="average", dstNodata=float("nan")).ReadAsArray()
+    nk = xdem.coreg.NuthKaab()
+    nk.fit(ref.astype(np.float32), on_ref, transform=Affine.from_gdal(*ref_gt),
+           crs=rasterio.crs.CRS.from_epsg(32633), random_state=42)
+    aff = nk.meta["outputs"]["affine"]
+    theirs = np.array([aff["shift_x"], aff["shift_y"], aff["shift_z"]])
+    assert np.hypot(*(theirs[:2] - shift)) < 0.1 * REF_CELL  # xdem 0.2.3: 0.66 m
+    assert np.hypot(*(np.array(ours.shift[:2]) - theirs[:2])) < 0.1 * REF_CELL
+    assert abs(ours.shift[2] - theirs[2]) < 0.1
