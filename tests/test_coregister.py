@@ -285,18 +285,53 @@ def write(path, z, gt, crs, nodata=-9999.0, unit=""):
 
 
 def test_rasters_other_crs_and_feet(tmp_path, rugged, rugged_ref):
-    """The reference in a TM CRS without an EPSG code, the DSM in EPSG:32633 (the same projection: the warp
-    path runs, the truth is unchanged) with heights in feet."""
+    """The reference in a TM CRS without an EPSG code (UTM 33N's projection on WGS 84), the DSM in EPSG:25833
+    (ETRS89 / UTM 33N: another CRS, so the DSM is reprojected; PROJ maps one onto the other within 0.1 mm here,
+    so the truth holds) with heights in feet."""
     ref, ref_gt = rugged_ref
     shift, dz, tilt = (37.0, -21.0), 3.2, (8e-4, -5e-4)
     dsm, gt = block_dsm(rugged, shift, dz, tilt)
     ref_path = write(tmp_path / "ref.tif", ref, ref_gt, TM_WKT)
-    dsm_path = write(tmp_path / "dsm.tif", dsm / 0.3048, gt, "EPSG:32633", unit="ft")
+    dsm_path = write(tmp_path / "dsm.tif", dsm / 0.3048, gt, "EPSG:25833", unit="ft")
     res = coregister_rasters(dsm_path, ref_path)
     assert res.converged
     assert math.hypot(res.shift[0] - shift[0], res.shift[1] - shift[1]) < 0.1 * REF_CELL
     check_correction(res, dz, tilt, tol=0.1)
     assert any("converted to metres" in m for m in res.messages)
+
+
+def test_rasters_in_feet_with_a_stable_mask(tmp_path, rugged, rugged_ref):
+    """A CRS in US survey feet (EPSG:2263) for both, heights in feet: the result is in metres; a stable-terrain
+    mask file (1 = stable) on its own grid keeps the fit to the east half."""
+    ref, ref_gt = rugged_ref
+    shift, dz, tilt = (20.0, 30.0), -2.0, (3e-4, 4e-4)
+    dsm, gt = block_dsm(rugged, shift, dz, tilt)
+    ft = 1200.0 / 3937.0
+    to_ft = lambda g: tuple(v / ft for v in g)  # noqa: E731
+    ref_path = write(tmp_path / "ref.tif", ref / ft, to_ft(ref_gt), "EPSG:2263", unit="US survey foot")
+    dsm_path = write(tmp_path / "dsm.tif", dsm / ft, to_ft(gt), "EPSG:2263", unit="ftUS")
+    mask = np.zeros((80, 80))
+    mask[:, 40:] = 1.0
+    mask_gt = (X0, EXTENT / 80, 0.0, Y0 + EXTENT, 0.0, -EXTENT / 80)
+    mask_path = write(tmp_path / "stable.tif", mask, to_ft(mask_gt), "EPSG:2263", nodata=255)
+    res = coregister_rasters(dsm_path, ref_path, stable_mask_path=mask_path)
+    assert res.converged and res.cell == pytest.approx(REF_CELL)
+    assert math.hypot(res.shift[0] - shift[0], res.shift[1] - shift[1]) < 0.1 * REF_CELL
+    check_correction(res, dz, tilt, tol=0.1)
+    assert res.origin[0] > CENTRE[0] + 500  # the east half only
+
+
+def test_cancel(rugged, rugged_ref):
+    from core.common.progress import Cancelled, NullProgress
+
+    class Stop(NullProgress):
+        def is_cancelled(self):
+            return True
+
+    ref, ref_gt = rugged_ref
+    dsm, gt = block_dsm(rugged, (10.0, 10.0), 0.0, outliers=False)
+    with pytest.raises(Cancelled):
+        coregister_dems(dsm, gt, ref, ref_gt, progress=Stop())
 
 
 def test_errors(tmp_path, rugged, rugged_ref):

@@ -575,6 +575,14 @@ def _open_source(path: str, what: str) -> Tuple[_Source, float, List[str]]:
     return src, xy_unit, messages
 
 
+def _same_crs(a: str, b: str) -> bool:
+    _, osr = _gdal()
+    sa, sb = osr.SpatialReference(wkt=a), osr.SpatialReference(wkt=b)
+    for srs in (sa, sb):
+        srs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+    return bool(sa.IsSame(sb))
+
+
 def coregister_rasters(dem_path: str, ref_path: str, *, stable_mask_path: Optional[str] = None, tilt: bool = True,
                        dome: bool = False, max_iterations: int = 20, tolerance: float = 0.01,
                        progress: Optional[Progress] = None) -> CoregResult:
@@ -588,6 +596,8 @@ def coregister_rasters(dem_path: str, ref_path: str, *, stable_mask_path: Option
         without = dem if not dem.wkt else ref
         raise CoregError(f"the {without.name} has no CRS while the other has one: it cannot be reprojected; assign "
                          "its CRS first (Raster > Projections > Assign Projection)")
+    if dem.wkt and ref.wkt and dem.wkt != ref.wkt and _same_crs(dem.wkt, ref.wkt):
+        dem.wkt = ref.wkt  # the same CRS spelt otherwise: no reprojection
     stable = None
     if stable_mask_path:
         stable, _, _ = _open_source(stable_mask_path, "stable-terrain mask")
