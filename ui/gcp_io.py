@@ -218,7 +218,9 @@ class GcpImportExport:
             for o in p.observations:
                 f = QgsFeature(mem.fields())
                 f.setGeometry(QgsGeometry(QgsPoint(p.x, p.y, p.z)))
-                f.setAttributes([p.name, o.image, o.x, o.y, p.z, p.sigma_xy, p.sigma_xy, p.sigma_z, p.role])
+                # sigmas the source did not give stay empty (NULL): read back, they are estimated again
+                sig = [p.sigma_xy, p.sigma_xy, p.sigma_z] if p.sigma_given else [None, None, None]
+                f.setAttributes([p.name, o.image, o.x, o.y, p.z, *sig, p.role])
                 feats.append(f)
         pr.addFeatures(feats)
         opts = QgsVectorFileWriter.SaveVectorOptions()

@@ -237,7 +237,8 @@ class GcpStore(QObject):
             raise ValueError(self.tr("a point named {} exists already").format(name))
 
         def fn(gs):
-            gs.points.append(gcpmod.GroundPoint(name, float(x), float(y), float(z), role=role))
+            # no sigma typed yet: the georeferencing estimates it from the data until the user sets one
+            gs.points.append(gcpmod.GroundPoint(name, float(x), float(y), float(z), role=role, sigma_given=False))
             return name
         return self.edit(self.tr("add point {}").format(name), fn)
 

@@ -71,6 +71,18 @@ from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..geometry.similarity import HelmertResult, helmert_ransac
 from ..io.gcp import CHECK, CONTROL, CameraPosition, GCPSet, GroundPoint
 from .bundle import BundleProblem, build_problem, outside_image, set_point_active, write_back
+from .control_sigma import (
+    CAMERA_GROUP,
+    CONTROL_GROUP,
+    SigmaEstimate,
+    VarianceGroup,
+    estimate_group,
+    fit_residuals,
+    ground_sample_distance,
+    intersection_precision,
+    lmeds_sigma,
+    variance_components,
+)
 from .errors import GeorefError
 from .options import GeorefOptions
 from .outliers import (
@@ -118,6 +130,8 @@ class _Run:
     rejected_ctrl: set = field(default_factory=set)
     # control points off the Helmert fit, left out of the first adjustment and re-tested against the adjusted block
     provisional: Dict[str, Outlier] = field(default_factory=dict)
+    # sigmas estimated for control points / camera positions given without them (core.georef.control_sigma)
+    sigma_estimates: Dict[str, SigmaEstimate] = field(default_factory=dict)
 
     @property
     def control(self) -> List[GroundPoint]:
@@ -181,6 +195,7 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
     _placeholder_heights(run)
     fit = _initial_similarity(run, camera_positions)
     _helmert_outliers(run, fit)
+    _estimate_sigmas(run, fit)
     consistency = _consistency(run, fit)
     run.timings["helmert"] = time.time() - run.t_start
     run.progress.report(0.08, f"Helmert from {int(fit.helmert.inliers.sum())} {fit.source}")
@@ -192,10 +207,12 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
     helmert_rows = _evaluate_points(run.rec, run.points, fit.offset, run.rejected_ctrl, run.lookup, run.all_names,
                                     opt.outlier_threshold)
     result = GeorefResult(run.rec, model_to_local, fit.offset, run.crs, fit.source, helmert_points=helmert_rows,
-                          warnings=run.warnings, outliers=run.outliers, adjusted=False)
+                          warnings=run.warnings, outliers=run.outliers, adjusted=False,
+                          sigma_estimates=[e.to_dict() for e in run.sigma_estimates.values()])
     stats: Dict[str, Any] = {"helmert_threshold_m": fit.threshold, "helmert_inliers": int(fit.helmert.inliers.sum()),
                              "helmert_scale": model_to_local.scale, "placeholder_z": run.placeholder_z,
                              "control_consistency": consistency.to_dict() if consistency else None}
+    stats["sigma_estimates"] = result.sigma_estimates
     if not opt.adjust:
         result.points = helmert_rows
         result.cameras = _camera_rows(run.rec, run.cam_pos, fit.offset, run.lookup)
@@ -321,6 +338,13 @@ def _initial_similarity(run: _Run, camera_positions) -> _Fit:
         raise GeorefError(_too_little_control(run, camera_positions))
     offset = _round_offset(world)
     world_local = world - offset
+    free = np.array([not o.sigma_given for o in objs])
+    if free.any():  # sigmas not given: the RANSAC threshold from a robust scale of the data instead
+        s0 = lmeds_sigma(model, world_local)
+        if s0 is not None:
+            if source == "control points" and run.placeholder_z is not None:
+                s0 = max(s0, run.opt.placeholder_sigma_z)
+            sig[free] = s0
     extent = float(np.max(np.linalg.norm(world_local - world_local.mean(axis=0), axis=1)))
     thr = run.opt.helmert_threshold or max(0.05 * extent, 10.0 * float(np.median(sig)), 0.05)
     try:
@@ -371,6 +395,66 @@ def _helmert_outliers(run: _Run, fit: _Fit) -> None:
     if source == "camera positions":
         bad = {fit.objs[k].image for k in np.flatnonzero(~hel.inliers)}
         run.cam_pos = [(cp, im) for cp, im in run.cam_pos if cp.image not in bad]
+
+
+def _estimate_sigmas(run: _Run, fit: _Fit) -> None:
+    """Step 1 of core.georef.control_sigma: the control points and camera positions given without sigmas get
+    sigmas from the rigid fit's residuals (robust, floored at what the block resolves), in place of their
+    placeholders; the adjustment refines them (``_variance_components``)."""
+    free_pts = [p for p in run.usable if not p.sigma_given]
+    free_cams = [cp for cp, _ in run.cam_pos if not cp.sigma_given]
+    if not free_pts and not free_cams:
+        return
+    tr, px = fit.helmert.transform, run.opt.gcp_pixel_sigma
+    v_fit, r_fit = fit_residuals(tr, fit.model, fit.world_local, fit.helmert.inliers)
+    in_fit = {(o.name if fit.source == "control points" else o.image): k for k, o in enumerate(fit.objs)
+              if fit.helmert.inliers[k]}
+    gsd = ground_sample_distance(run.rec) * tr.scale * px
+    if free_pts:
+        views = [(run.tri[p.name].xyz, [ob.image for k, ob in enumerate(p.observations) if run.tri[p.name].used[k]])
+                 for p in free_pts]
+        fxy, fz = intersection_precision(run.rec, run.lookup, views, px, tr)
+        floor = (fxy, fz) if math.isfinite(fxy) else (gsd, gsd)
+        if run.placeholder_z is not None:
+            floor = (floor[0], max(floor[1], run.opt.placeholder_sigma_z))
+        rows = []
+        for p in free_pts:
+            if fit.source == "control points":
+                if p.name in in_fit:
+                    rows.append((p.name, v_fit[in_fit[p.name]], r_fit[in_fit[p.name]]))
+            else:
+                d = np.array([p.x, p.y, p.z]) - fit.offset - tr.apply(run.tri[p.name].xyz)
+                rows.append((p.name, d, np.ones(3)))
+        prior = (float(np.median([p.sigma_xy for p in free_pts])), float(np.median([p.sigma_z for p in free_pts])))
+        est = _group_estimate(CONTROL_GROUP, [p.name for p in free_pts], rows, floor, prior)
+        run.sigma_estimates[CONTROL_GROUP] = est
+        names = set(est.names)
+        run.usable = [dataclasses.replace(p, sigma_xy=est.sigma_xy, sigma_z=est.sigma_z) if p.name in names else p
+                      for p in run.usable]
+    if free_cams:
+        rows = []
+        for cp, im in run.cam_pos:
+            if cp.sigma_given:
+                continue
+            if fit.source == "camera positions":
+                if cp.image in in_fit:
+                    rows.append((cp.image, v_fit[in_fit[cp.image]], r_fit[in_fit[cp.image]]))
+                continue
+            d = np.array([cp.x, cp.y, cp.z]) - fit.offset - tr.apply(np.asarray(im.projection_center()))
+            rows.append((cp.image, np.nan_to_num(d), np.array([1.0, 1.0, 1.0 if math.isfinite(cp.z) else 0.0])))
+        prior = (float(np.median([c.sigma_xy for c in free_cams])), float(np.median([c.sigma_z for c in free_cams])))
+        est = _group_estimate(CAMERA_GROUP, [c.image for c in free_cams], rows, (gsd, gsd), prior)
+        run.sigma_estimates[CAMERA_GROUP] = est
+        run.cam_pos = [(dataclasses.replace(cp, sigma_xy=est.sigma_xy, sigma_z=est.sigma_z), im)
+                       if not cp.sigma_given else (cp, im) for cp, im in run.cam_pos]
+    for est in run.sigma_estimates.values():
+        run.progress.info(est.message())
+
+
+def _group_estimate(group: str, names: List[str], rows, floor, prior) -> SigmaEstimate:
+    v = np.array([r[1] for r in rows], dtype=float).reshape(-1, 3)
+    r = np.array([r[2] for r in rows], dtype=float).reshape(-1, 3)
+    return estimate_group(group, names, [r[0] for r in rows], v, r, floor, prior)
 
 
 def _consistency(run: _Run, fit: _Fit) -> Optional[Consistency]:
@@ -430,6 +514,11 @@ def _adjust(run: _Run, fit: _Fit, groups, stats: Dict[str, Any]) -> _Adjustment:
         _outlier_rounds(run, adj)
         if not _readmit(run, adj):
             break
+    if _variance_components(run, adj):
+        while True:  # the outlier tests again, at the estimated sigmas
+            _outlier_rounds(run, adj)
+            if not _readmit(run, adj):
+                break
     _final_provisional_messages(run, adj)
     run.timings["adjustment"] = time.time() - t0
     stats.update({"adjustment_iterations": adj.iterations, "outlier_rounds": adj.rounds,
@@ -438,6 +527,31 @@ def _adjust(run: _Run, fit: _Fit, groups, stats: Dict[str, Any]) -> _Adjustment:
                   "helmert_retests": {nm: {k: v for k, v in t.items() if k != "xyz"}
                                       for nm, t in adj.retests.items()}})
     return adj
+
+
+def _variance_components(run: _Run, adj: _Adjustment) -> bool:
+    """Step 2 of core.georef.control_sigma: the estimated sigmas refined by variance components in the
+    adjustment, the problem solved at them.  True if there was anything to estimate."""
+    prob = adj.prob
+    groups = []
+    est = run.sigma_estimates.get(CONTROL_GROUP)
+    if est is not None:
+        rows = np.array([adj.gcp_index[nm] for nm in est.names if nm in adj.gcp_index], dtype=int)
+        if len(rows):
+            groups.append(VarianceGroup("point", rows, est, (est.floor_xy, est.floor_z)))
+    est = run.sigma_estimates.get(CAMERA_GROUP)
+    if est is not None:
+        names = set(est.names)
+        rows = np.array([k for k, img in enumerate(prob.cam_pos_images) if img in names], dtype=int)
+        if len(rows):
+            groups.append(VarianceGroup("camera", rows, est, (est.floor_xy, est.floor_z)))
+    if not groups:
+        return False
+    run.progress.report(0.8, "estimating the accuracy of the control given without sigmas")
+    variance_components(prob, groups, max_iterations=run.opt.max_iterations)
+    for g in groups:
+        run.progress.info(g.estimate.message())
+    return True
 
 
 def _outlier_rounds(run: _Run, adj: _Adjustment) -> None:
@@ -518,9 +632,9 @@ def _sigma_check(run: _Run, result: GeorefResult, consistency: Optional[Dict[str
     (the median point, so that one wrong coordinate, which the outlier tests name, does not count; at least 4
     points, at least 0.1 m), and no more than half of them agree with each other through the rigid block (the
     consistency test: then a few wrong coordinates, named by it, are the cause, not the sigma).  With such sigmas
-    the adjustment bends the block to fit the points (handheld GPS read as survey grade; a file without sigma
-    columns gets 0.02 m)."""
-    given = {p.name: p for p in run.points}
+    the adjustment bends the block to fit the points (handheld GPS read as survey grade).  Only points whose
+    sigmas were given: the others' sigmas are estimated from the data (``_estimate_sigmas``)."""
+    given = {p.name: p for p in run.points if p.sigma_given}
     rows = [r for r in result.helmert_points if r.status == USED and r.role == CONTROL and r.dx is not None
             and r.name in given and r.name not in run.rejected_ctrl and math.isfinite(r.dx) and math.isfinite(r.dy)]
     if len(rows) < 4:
@@ -534,8 +648,8 @@ def _sigma_check(run: _Run, result: GeorefResult, consistency: Optional[Dict[str
     run.warn(f"the control points' sigma XY ({sig:g} m) is far below how well the block fits them: "
              f"{len(rows)} control points miss the rigid block by {miss:.2f} m (median, {miss / sig:.0f} sigma), "
              f"and the adjustment bends the block to fit them; if their coordinates are metre-level (handheld "
-             f"GPS, read off a map) give the file sigma columns of that size (a file without them gets "
-             f"{GroundPoint.sigma_xy:g} m)")
+             f"GPS, read off a map) give the file sigma columns of that size, or none: without sigmas their "
+             f"accuracy is estimated from the data")
 
 
 def _update_and_evaluate(run: _Run, adj: _Adjustment, result: GeorefResult, camera_positions,
@@ -572,12 +686,29 @@ def _update_and_evaluate(run: _Run, adj: _Adjustment, result: GeorefResult, came
     result.refined_intrinsics = {int(cid): [float(v) for v in rec.cameras[cid].params]
                                  for cid in adj.sel_info.get("refined_cameras", [])}
     result.adjusted = True
+    result.sigma_estimates = stats["sigma_estimates"] = [e.to_dict() for e in run.sigma_estimates.values()]
+    _set_used_sigmas(adj, result)
     _sigma_check(run, result, stats.get("control_consistency"))
     run.timings["total"] = time.time() - run.t_start
     stats["timings"] = run.timings
     stats.pop("refined_cameras", None)
     result.statistics = stats
     progress.report(1.0, "georeferencing done")
+
+
+def _set_used_sigmas(adj: _Adjustment, result: GeorefResult) -> None:
+    """The sigmas each control point and camera position had in the adjustment (given or estimated), on their
+    residual rows."""
+    prob = adj.prob
+    for r in result.points:
+        k = adj.gcp_index.get(r.name)
+        if r.role == CONTROL and k is not None:
+            r.sigma_xy, r.sigma_z = float(prob.pps[k, 0]), float(prob.pps[k, 2])
+    sig = {img: prob.cp_sigma[k] for k, img in enumerate(prob.cam_pos_images)}
+    for c in result.cameras:
+        if c.image in sig:
+            c.sigma_xy = float(sig[c.image][0])
+            c.sigma_z = float(sig[c.image][2]) if sig[c.image][2] < 1e11 else None
 
 
 def _check_crs(crs: str, warn: Callable[[str], None]) -> None:

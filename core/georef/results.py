@@ -45,6 +45,9 @@ class PointResidual:
     n_obs: int = 0  # observations used in the triangulation
     observations: List[Dict[str, Any]] = field(default_factory=list)  # {"image", "px"} (px None: not used)
     notes: List[str] = field(default_factory=list)
+    # control points: the sigmas the adjustment weighted the coordinates with (given, or estimated from the data)
+    sigma_xy: Optional[float] = None
+    sigma_z: Optional[float] = None
 
     @property
     def error_3d(self) -> Optional[float]:
@@ -55,7 +58,8 @@ class PointResidual:
     def to_dict(self) -> Dict[str, Any]:
         return {"name": self.name, "role": self.role, "status": self.status, "x": self.x, "y": self.y,
                 "z": self.z, "dx": self.dx, "dy": self.dy, "dz": self.dz, "n_obs": self.n_obs,
-                "observations": self.observations, "notes": self.notes}
+                "observations": self.observations, "notes": self.notes, "sigma_xy": self.sigma_xy,
+                "sigma_z": self.sigma_z}
 
 
 @dataclass
@@ -68,6 +72,8 @@ class CameraResidual:
     dy: float
     dz: float
     used: bool = True
+    sigma_xy: Optional[float] = None  # the sigmas the adjustment weighted the position with (given or estimated)
+    sigma_z: Optional[float] = None
 
     def to_dict(self) -> Dict[str, Any]:
         return dict(self.__dict__)
@@ -113,6 +119,9 @@ class GeorefResult:
     adjusted: bool = True
     refined_intrinsics: Dict[int, List[float]] = field(default_factory=dict)
     statistics: Dict[str, Any] = field(default_factory=dict)  # iterations, sizes, timings
+    # control points / camera positions given without sigmas: their estimated sigmas, one dict per group
+    # (core.georef.control_sigma.SigmaEstimate.to_dict)
+    sigma_estimates: List[Dict[str, Any]] = field(default_factory=list)
 
     @property
     def similarity(self) -> Similarity:
@@ -164,6 +173,7 @@ class GeorefResult:
             "mean_reprojection_error_px": _finite_or_none(self.mean_reprojection_error),
             "gcp_reprojection_error_px": _finite_or_none(self.gcp_reprojection_error),
             "refined_intrinsics": {str(k): v for k, v in self.refined_intrinsics.items()},
+            "sigma_estimates": list(self.sigma_estimates),
             "warnings": list(self.warnings),
             "outliers": [o.to_dict() for o in self.outliers],
             "statistics": self.statistics,

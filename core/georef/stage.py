@@ -72,7 +72,7 @@ def _exif_positions(ws: Workspace, crs: str) -> List[gcpmod.CameraPosition]:
     xy = transform_points(lonlat, "EPSG:4326", crs)
     # EXIF altitude is kept as it is (normally above mean sea level): only X and Y are transformed
     return [gcpmod.CameraPosition(image=n, x=float(p[0]), y=float(p[1]), z=float(g[2]),
-                                  sigma_xy=EXIF_SIGMA_XY, sigma_z=EXIF_SIGMA_Z)
+                                  sigma_xy=EXIF_SIGMA_XY, sigma_z=EXIF_SIGMA_Z, sigma_given=False)
             for (n, g), p in zip(rows, xy)]
 
 

@@ -623,6 +623,8 @@ def _control_inputs(residuals: Dict[str, Any], sigmas: Dict[str, Tuple[float, fl
         if p.get("status") != "used" or p.get("dx") is None:
             continue
         sxy, sz = sigmas.get(p["name"], (0.02, 0.05))
+        if p.get("sigma_xy") is not None and p.get("sigma_z") is not None:  # the adjustment's (given or estimated)
+            sxy, sz = float(p["sigma_xy"]), float(p["sigma_z"])
         if placeholder:
             sz = max(sz, PLACEHOLDER_SIGMA_Z)
         given = np.array([p["x"], p["y"], p["z"]], dtype=float) - offset
@@ -641,6 +643,8 @@ def _camera_priors(residuals: Dict[str, Any], sigmas, offset: np.ndarray) -> Lis
             continue
         z = c.get("z")
         sxy, sz = sig.get(c["image"], default)
+        if c.get("sigma_xy") is not None:  # the adjustment's (given, or estimated where the source gave none)
+            sxy, sz = float(c["sigma_xy"]), float(c["sigma_z"]) if c.get("sigma_z") is not None else sz
         xyz = np.array([c["x"], c["y"], np.nan if z is None else z], dtype=float) - offset
         priors.append(CameraPrior(c["image"], xyz, np.array([sxy, sxy, sz], dtype=float)))
     return priors

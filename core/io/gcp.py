@@ -33,6 +33,21 @@ CSV (a pair of files)
     ``control`` (default, also ``gcp``) or ``check`` (also ``checkpoint``,
     ``cp``).
 
+Sigmas given or not (``GroundPoint.sigma_given``, ``CameraPosition.sigma_given``)
+    A gcp_list.txt carries no sigmas; a CSV row, a layer row or a camera-position row
+    may leave them out.  The readers mark such points ``sigma_given=False``: their
+    sigmas hold the defaults (0.02 / 0.05 m; camera positions the caller's defaults)
+    only as placeholders, and the georeferencing estimates their accuracy from the
+    data (``core.georef.control_sigma``).  A row with any sigma cell counts as given
+    (a missing component keeps its default).  A point constructed directly
+    (``GroundPoint(name, x, y, z, ...)``) is taken at its word: ``sigma_given``
+    defaults to True, the defaults included; the dock marks the points a user adds
+    without typing a sigma.  ``GCPSet.to_dict`` keeps the flag; a dict without it
+    (an older workspace's control.json) counts as not given when its sigmas are
+    exactly the defaults, which only a file without sigmas produced.  The CSV writer
+    leaves the sigma cells empty for points without given sigmas, so they read back
+    the same.
+
 Camera positions (see ``read_camera_positions``)
     ``image,x,y,z[,sigma[,sigma_z]]`` rows (comma or whitespace separated, an
     optional header row), or ``x y [z] image`` rows as in OpenDroneMap's
@@ -72,17 +87,30 @@ class Observation:
     y: float
 
 
+DEFAULT_SIGMA_XY = 0.02  # m: a ground point's sigmas when its source gives none (placeholders, see sigma_given)
+DEFAULT_SIGMA_Z = 0.05
+
+
 @dataclass
 class GroundPoint:
     name: str
     x: float
     y: float
     z: float
-    sigma_xy: float = 0.02
-    sigma_z: float = 0.05
+    sigma_xy: float = DEFAULT_SIGMA_XY
+    sigma_z: float = DEFAULT_SIGMA_Z
     role: str = CONTROL  # CONTROL or CHECK
     observations: List[Observation] = field(default_factory=list)
     dropped: List[str] = field(default_factory=list)  # why the reader dropped observations, one entry each
+    # the sigmas are the source's (a file's sigma columns, a user's entry, a computed accuracy); False: the source
+    # gave none, the sigmas above are placeholders and the georeferencing estimates them (module notes).  Setting
+    # sigma_xy or sigma_z on a point (p.sigma_xy = 0.5: a user's entry) marks them given
+    sigma_given: bool = True
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name in ("sigma_xy", "sigma_z") and "sigma_given" in self.__dict__:  # not while __init__ runs
+            object.__setattr__(self, "sigma_given", True)
+        object.__setattr__(self, name, value)
 
     def images(self) -> List[str]:
         """Names of the images this point is observed in, in order, without repeats."""
@@ -134,7 +162,7 @@ class GCPSet:
             "crs": self.crs,
             "points": [
                 {"name": p.name, "x": p.x, "y": p.y, "z": p.z, "sigma_xy": p.sigma_xy, "sigma_z": p.sigma_z,
-                 "role": p.role,
+                 "sigma_given": p.sigma_given, "role": p.role,
                  "observations": [{"image": o.image, "x": o.x, "y": o.y} for o in p.observations]}
                 for p in self.points
             ],
@@ -148,9 +176,12 @@ class GCPSet:
         for p in d.get("points", []):
             obs = [Observation(str(o["image"]), float(o["x"]), float(o["y"]))
                    for o in p.get("observations", [])]
-            pts.append(GroundPoint(str(p["name"]), float(p["x"]), float(p["y"]), float(p["z"]),
-                                   float(p.get("sigma_xy", 0.02)), float(p.get("sigma_z", 0.05)),
-                                   str(p.get("role", CONTROL)), obs))
+            sxy, sz = float(p.get("sigma_xy", DEFAULT_SIGMA_XY)), float(p.get("sigma_z", DEFAULT_SIGMA_Z))
+            given = p.get("sigma_given")
+            if given is None:  # an older control.json: the defaults exactly are what a file without sigmas gave
+                given = (sxy, sz) != (DEFAULT_SIGMA_XY, DEFAULT_SIGMA_Z)
+            pts.append(GroundPoint(str(p["name"]), float(p["x"]), float(p["y"]), float(p["z"]), sxy, sz,
+                                   str(p.get("role", CONTROL)), obs, sigma_given=bool(given)))
         return cls(str(d.get("crs", "")), pts, list(d.get("warnings", [])), str(d.get("source", "")))
 
 
@@ -162,6 +193,7 @@ class CameraPosition:
     z: float
     sigma_xy: float = 5.0
     sigma_z: float = 10.0
+    sigma_given: bool = True  # False: the source gave no sigma (a positions file without them, EXIF GPS)
 
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -515,7 +547,7 @@ def read_odm_gcp_list(path: PathLike, image_names: Optional[Iterable[str]] = Non
                 raise GCPError(f"{path}:{lineno}: point {name} has coordinates ({x}, {y}, {z}) here but "
                                f"({p.x}, {p.y}, {p.z}) on line {first}")
         else:
-            named[name] = (GroundPoint(name, x, y, z), lineno)
+            named[name] = (GroundPoint(name, x, y, z, sigma_given=False), lineno)
             by_xyz_named.setdefault((x, y, z), []).append(name)
     order: List[GroundPoint] = []
     placed = set()
@@ -533,7 +565,7 @@ def read_odm_gcp_list(path: PathLike, image_names: Optional[Iterable[str]] = Non
             elif key in groups:
                 p = groups[key]
             else:
-                p = GroundPoint("", x, y, z)
+                p = GroundPoint("", x, y, z, sigma_given=False)
                 groups[key] = p
                 generated.append((p, lineno))
         if id(p) not in placed:
@@ -577,7 +609,7 @@ def _writable_token(s: str, what: str) -> str:
 def write_odm_gcp_list(gcpset: GCPSet, path: PathLike) -> None:
     """Write an OpenDroneMap ``gcp_list.txt``: the CRS line, then one tab-separated line per observation
     ``x y z px py image name`` (plus ``check`` for check points).  Numbers are written so that they read back
-    exactly; sigmas are not part of the format (they revert to the defaults on reading).  Points without
+    exactly; sigmas are not part of the format (they read back as not given, ``sigma_given=False``).  Points without
     observations cannot be expressed in the format and are listed in ``#`` comments."""
     crs = " ".join(gcpset.crs.split())
     if not crs:
@@ -748,7 +780,7 @@ def read_csv_gcps(points_path: PathLike, observations_path: Optional[PathLike] =
             raise GCPError(f"{points_path}:{lineno}: unknown role {role_text!r} for point {name} "
                            f"(use '{CONTROL}' or '{CHECK}')")
         sigma_z = sig.get("sz", defaults.sigma_z)
-        gs.points.append(GroundPoint(name, x, y, z, sigma_xy, sigma_z, _ROLES[role_text]))
+        gs.points.append(GroundPoint(name, x, y, z, sigma_xy, sigma_z, _ROLES[role_text], sigma_given=bool(sig)))
         first_line[name] = lineno
     if not gs.points:
         gs.warnings.append(f"{points_path}: no points")
@@ -791,15 +823,16 @@ def _csv_text(rows: Iterable[Sequence[Any]]) -> str:
 def write_csv_gcps(gcpset: GCPSet, points_path: PathLike,
                    observations_path: Optional[PathLike] = None) -> Tuple[str, str]:
     """Write the CSV pair; returns (points path, observations path).  The points file starts with a
-    ``# crs: ...`` comment line, then ``name,x,y,z,sx,sy,sz,role`` (sx = sy = sigma_xy)."""
+    ``# crs: ...`` comment line, then ``name,x,y,z,sx,sy,sz,role`` (sx = sy = sigma_xy; empty for a point
+    whose sigmas were not given, so that it reads back the same)."""
     obs_path = os.fspath(observations_path) if observations_path is not None \
         else default_observations_path(points_path)
     head = f"# crs: {' '.join(gcpset.crs.split())}\n"
     pts = [("name", "x", "y", "z", "sx", "sy", "sz", "role")]
     obs = [("name", "image", "px", "py")]
     for p in gcpset.points:
-        pts.append((p.name, _fmt(p.x), _fmt(p.y), _fmt(p.z), _fmt(p.sigma_xy), _fmt(p.sigma_xy),
-                    _fmt(p.sigma_z), p.role))
+        sig = (_fmt(p.sigma_xy), _fmt(p.sigma_xy), _fmt(p.sigma_z)) if p.sigma_given else ("", "", "")
+        pts.append((p.name, _fmt(p.x), _fmt(p.y), _fmt(p.z), *sig, p.role))
         for o in p.observations:
             obs.append((p.name, o.image, _fmt(o.x), _fmt(o.y)))
     _write_text(points_path, head + _csv_text(pts))
@@ -878,7 +911,8 @@ def gcps_from_rows(rows: Iterable[Mapping[str, Any]], crs: str, *, source_name: 
             raise GCPError(str(e).replace(f"{source_name}:{row}:", f"{source_name}: row {row}:", 1)) from None
 
     for k, raw in enumerate(rows, start=1):
-        r = {str(key).strip().lower(): v for key, v in raw.items()}
+        # a QGIS NULL (an empty attribute, e.g. a sigma not given) is missing, as None is
+        r = {str(key).strip().lower(): (None if _is_null(v) else v) for key, v in raw.items()}
         name = str(r.get("name") if r.get("name") is not None else "").strip()
         if not name:
             raise GCPError(f"{source_name}: row {k}: empty point name")
@@ -898,7 +932,8 @@ def gcps_from_rows(rows: Iterable[Mapping[str, Any]], crs: str, *, source_name: 
             if role_text not in _ROLES:
                 raise GCPError(f"{source_name}: row {k}: unknown role {role_text!r} for point {name} "
                                f"(use '{CONTROL}' or '{CHECK}')")
-            p = GroundPoint(name, x, y, z, sxy, sig.get("sz", defaults.sigma_z), _ROLES[role_text])
+            p = GroundPoint(name, x, y, z, sxy, sig.get("sz", defaults.sigma_z), _ROLES[role_text],
+                            sigma_given=bool(sig))
             gs.points.append(p)
             first[name] = k
         elif (p.x, p.y, p.z) != (x, y, z):
@@ -912,6 +947,12 @@ def gcps_from_rows(rows: Iterable[Mapping[str, Any]], crs: str, *, source_name: 
             upright=upright_orientations)
     _check_units(gs, source_name)
     return gs
+
+
+def _is_null(v: Any) -> bool:
+    """None, or a NULL attribute value of a layer (a QVariant, whose isNull() says so; no Qt import here)."""
+    is_null = getattr(v, "isNull", None)
+    return v is None or (callable(is_null) and bool(is_null()))
 
 
 def check_units(gcpset: GCPSet, target_crs: Optional[str] = None) -> None:
@@ -977,7 +1018,8 @@ def read_camera_positions(path: PathLike, default_sigma_xy: float = 5.0, default
       OpenDroneMap's geo.txt order).
 
     One ``sigma`` applies to all three axes; ``sigma_xy`` / ``sigma_z`` columns set them separately; missing
-    sigmas take ``default_sigma_xy`` / ``default_sigma_z``.  A missing z (e.g. ``x y image`` rows) is NaN,
+    sigmas take ``default_sigma_xy`` / ``default_sigma_z`` and mark the position ``sigma_given=False`` (the
+    georeferencing then estimates their accuracy).  A missing z (e.g. ``x y image`` rows) is NaN,
     meaning unknown height: a consumer must then constrain only x and y of that camera.
 
     The returned CRS is the file's CRS line, else ``crs`` (None when neither: the caller's CRS, usually the
@@ -1053,7 +1095,7 @@ def read_camera_positions(path: PathLike, default_sigma_xy: float = 5.0, default
                              f"{first_row[image]}); keeping the first")
             continue
         first_row[image] = ln
-        out.append(CameraPosition(image, x, y, z, sxy, sz))
+        out.append(CameraPosition(image, x, y, z, sxy, sz, sigma_given=bool(sig)))
     use_crs = file_crs or (normalize_crs(crs) if crs else None)
     if use_crs:
         _check_crs_for_file(use_crs, path, crs_line if file_crs else None, warn_list)
@@ -1068,7 +1110,7 @@ def read_camera_positions(path: PathLike, default_sigma_xy: float = 5.0, default
 
 
 __all__ = [
-    "CHECK", "CONTROL", "CameraPosition", "GCPError", "GCPSet", "GroundPoint", "Observation", "apply_check_points",
+    "CHECK", "CONTROL", "CameraPosition", "DEFAULT_SIGMA_XY", "DEFAULT_SIGMA_Z", "GCPError", "GCPSet", "GroundPoint", "Observation", "apply_check_points",
     "check_units", "default_observations_path", "detect_gcp_format", "gcps_from_rows", "observations_to_stored",
     "read_camera_positions",
     "read_csv_gcps", "read_gcps", "read_odm_gcp_list", "write_csv_gcps", "write_gcps", "write_odm_gcp_list",

@@ -1,5 +1,5 @@
-"""The georeferencing section: control and check points, RMSE per set, residual vectors, camera-position
-residuals, outliers and the "at a glance" accuracy lines."""
+"""The georeferencing section: control and check points, RMSE per set, the accuracy estimated for control given
+without sigmas, residual vectors, camera-position residuals, outliers and the "at a glance" accuracy lines."""
 from __future__ import annotations
 
 import math
@@ -38,6 +38,7 @@ def section(ctx: ReportContext) -> str:
         ("GCP observation reprojection error in the adjustment (mean; control held at its coordinates "
          "within its sigmas)", f"{fmt(res.get('gcp_reprojection_error_px'), 3)} px"),
     ])]
+    parts.append(_sigma_estimates(ctx, res))
     if acc["placeholder_z"]:
         parts.append('<p class="warn">Every control point has the same height (a placeholder, not a surveyed '
                      "Z): the Z residuals measure departure from one level surface, not height accuracy; no "
@@ -59,6 +60,42 @@ def section(ctx: ReportContext) -> str:
     parts.append(autocontrol.subsection(ctx))  # '' unless automatic control georeferenced the block
     _glance_accuracy(ctx, acc)
     return "".join(parts)
+
+
+def _sigma_estimates(ctx: ReportContext, res: Dict[str, Any]) -> str:
+    """The sigmas estimated for control points / camera positions given without them (core.georef.control_sigma),
+    '' when every sigma was given."""
+    ests = res.get("sigma_estimates") or []
+    if not ests:
+        return ""
+    rows = []
+    for e in ests:
+        grp = str(e.get("group", ""))
+        key = "control" if grp.startswith("control") else "camera"
+        how = {"helmert": "rigid fit", "helmert + variance components":
+               f"rigid fit + variance components ({e.get('iterations', 0)} it.)",
+               "residuals": "residuals (no redundancy)", "none": "placeholders kept"}.get(e.get("method"),
+                                                                                         e.get("method"))
+        rows.append([td(grp), td(e.get("n")), cell(e.get("sigma_xy_m"), 3, f"sigma.{key}.xy"),
+                     cell(e.get("sigma_z_m"), 3, f"sigma.{key}.z"), cell(e.get("helmert_xy_m"), 3),
+                     cell(e.get("helmert_z_m"), 3), cell(e.get("floor_xy_m"), 3), cell(e.get("floor_z_m"), 3),
+                     td(f"{e.get('prior_xy_m', float('nan')):g} / {e.get('prior_z_m', float('nan')):g}"), td(how),
+                     td(", ".join(e.get("excluded") or []) or "–")])
+        pre = "CONTROL" if key == "control" else "CAMERA_POSITION"
+        ctx.figures.update({f"{pre}_SIGMA_XY": num(e.get("sigma_xy_m")), f"{pre}_SIGMA_Z": num(e.get("sigma_z_m"))})
+        ctx.glance.append(badge("ok", esc(f"{grp} without sigma: accuracy estimated from the data, sigma XY "
+                                          f"{fmt(e.get('sigma_xy_m'), 3)} m, Z {fmt(e.get('sigma_z_m'), 3)} m")))
+    return ("<h3>Accuracy of the control given without sigmas, estimated from the data</h3>" + table(
+        ["group", "n", "σ XY", "σ Z", "rigid fit σ XY", "rigid fit σ Z", "floor XY", "floor Z", "placeholders",
+         "estimated from", "left out as suspect"], rows)
+        + '<p class="note">Metres. The files gave no sigmas for these points (or positions), so their accuracy was '
+          "estimated: first from the residuals of the rigid (7-parameter) fit of the block onto them, divided by "
+          "their redundancy, with the suspect ones left out; then refined by variance components in the "
+          "adjustment (their share of the weighted residuals over their share of the redundancy, the tie points "
+          "the reference). The adjustment weighted them with the estimate: metre-level control leaves the block "
+          "as rigid as the rigid fit, precise control lets it bend where the tie points allow. The floor is the "
+          "block's own precision at the points (their forward intersection at the adjustment's pixel sigma): "
+          "nothing finer can be told from the data.</p>")
 
 
 def _points_table(ctx: ReportContext, points: Sequence[Dict[str, Any]]) -> str:
