@@ -2,7 +2,8 @@
 
 1. ``--size N`` (default 4000): a synthetic N x N DSM at 5 m (tests/test_coregister.py's rugged terrain, shifted,
    tilted, with a forest, buildings and noise) against a 25 m reference DEM, both written as GeoTIFFs; then
-   ``coregister_rasters`` (warps the DSM from the file) and ``coregister_dems`` (the DSM read whole as float32
+   ``coregister_rasters`` (warps the DSM from the file; also from a copy in EPSG:25833, reprojected) and
+   ``coregister_dems`` (the DSM read whole as float32
    first, as a caller holding it would), each in a child process: seconds and peak resident memory (the child's
    ru_maxrss above its RSS after the imports), and the errors against the truth.
 2. ``--xdem``: the same synthetic pairs as the tests (6 km at 5 m against 25 m), ours against xdem's NuthKaab
@@ -67,12 +68,23 @@ def _errors(res, shift, dz, tilt, xs, ys):
 
 
 def child(mode: str, dsm_path: str, ref_path: str, size: int) -> None:
+    import tracemalloc
+
     from core.georef.coregister import coregister_dems, coregister_rasters
 
     base = _rss_mib()
+    tracemalloc.start()
     t = time.perf_counter()
     if mode == "rasters":
         res = coregister_rasters(dsm_path, ref_path)
+    elif mode == "reprojected":  # the DSM in EPSG:25833, the reference in EPSG:32633: warped across CRSs
+        from osgeo import gdal
+
+        gdal.UseExceptions()
+        other = dsm_path.replace("dsm.tif", "dsm-25833.tif")
+        gdal.Translate(other, dsm_path, outputSRS="EPSG:25833")
+        t = time.perf_counter()
+        res = coregister_rasters(other, ref_path)
     else:
         from osgeo import gdal
 
@@ -83,11 +95,13 @@ def child(mode: str, dsm_path: str, ref_path: str, size: int) -> None:
         res = coregister_dems(dsm, ds.GetGeoTransform(), ref, rds.GetGeoTransform(), dem_nodata=-9999.0)
     seconds = time.perf_counter() - t
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    numpy_peak = tracemalloc.get_traced_memory()[1] / 2 ** 20
     bx, by = X0 + 1000.0, Y0 + 1000.0
     side = size * FINE
     xs = np.array([bx, bx + side, bx, bx + side, bx + side / 2])
     ys = np.array([by, by, by + side, by + side, by + side / 2])
     out = {"mode": mode, "seconds": round(seconds, 2), "peak_mib_above_imports": round(peak - base, 1),
+           "python_numpy_peak_mib": round(numpy_peak, 1),
            "compared_cells": res.n_compared, **_errors(res, TRUTH["shift"], TRUTH["dz"], TRUTH["tilt"], xs, ys)}
     print(json.dumps(out))
 
@@ -124,7 +138,7 @@ def size_run(size: int) -> None:
         del dsm, ref
         print(f"{size} x {size} DSM at {FINE:g} m ({side / 1000:g} km) against a {n_ref} x {n_ref} reference at "
               f"{REF_CELL:g} m")
-        for mode in ("rasters", "arrays"):
+        for mode in ("rasters", "reprojected", "arrays"):
             out = subprocess.run([sys.executable, __file__, "--child", mode, dsm_path, ref_path, str(size)],
                                  capture_output=True, text=True, check=True)
             print(out.stdout.strip())

@@ -164,6 +164,21 @@ def test_dome(rugged, rugged_ref):
     assert plane_only.nmad_after > 2 * res.nmad_after
 
 
+def test_large_grids_are_compared_coarser(rugged, rugged_ref, monkeypatch):
+    """Beyond MAX_GRID_CELLS the comparison grid takes a coarser multiple of the cell (bounded memory); the
+    shift is still found to a tenth of that cell."""
+    import core.georef.coregister as coregister
+
+    monkeypatch.setattr(coregister, "MAX_GRID_CELLS", 20000)  # the 6 km overlap has 57600 cells at 25 m
+    ref, ref_gt = rugged_ref
+    shift, dz, tilt = (37.0, -21.0), 3.2, (8e-4, -5e-4)
+    dsm, gt = block_dsm(rugged, shift, dz, tilt)
+    res = coregister_dems(dsm, gt, ref, ref_gt)
+    assert res.cell == 2 * REF_CELL and any("compared on a 50 grid" in m for m in res.messages)
+    assert math.hypot(res.shift[0] - shift[0], res.shift[1] - shift[1]) < 0.1 * res.cell
+    check_correction(res, dz, tilt, tol=0.15)
+
+
 def test_flat_terrain_holds_the_horizontal_shift():
     terrain = Terrain(3, 0, 0.0, 100.0, 200.0)  # a plain at 500 m
     ref, ref_gt = reference(terrain, noise=0.05)

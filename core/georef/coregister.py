@@ -51,8 +51,8 @@ from ..io.raster import bilinear
 OUTLIER_NMAD = 3.0  # residuals beyond this many NMADs of the median are not stable terrain
 MAX_SLOPE_DEG = 70.0  # steeper cells (cliffs, walls) are left out of the fit
 MIN_CELLS = 100  # stable cells needed for a fit
-MAX_GRID_CELLS = 16_000_000  # the comparison grid is coarsened beyond this (64 MiB per float32 copy)
-MAX_FIT_CELLS = 1_000_000  # a fixed random subset of the compared cells enters the fit
+MAX_GRID_CELLS = 4_000_000  # the comparison grid is coarsened beyond this (16 MiB per float32 copy)
+MAX_FIT_CELLS = 500_000  # a fixed random subset of the compared cells enters the fit (as xdem's default)
 MAX_STEP_CELLS = 4.0  # the horizontal increment of one iteration is limited to this many cells
 UNDETERMINED_CELLS = 0.25  # the shift's standard error (cells) above which the terrain is too flat for it
 DEM_MARGIN_CELLS = 8  # the DEM is kept this far around the overlap, for shifted samples
@@ -75,7 +75,7 @@ class CoregResult:
     median_before: float = math.nan
     median_after: float = math.nan
     n_cells: int = 0  # stable cells (or points) in the final fit
-    n_compared: int = 0  # cells (or points) where both surfaces have a height
+    n_compared: int = 0  # cells (of the fit's subset) or points where both surfaces have a height
     stable_fraction: float = 0.0  # n_cells / n_compared
     cell: float = 0.0  # the comparison grid's cell (metres); the reference's cell for points
     shift_sigma: Tuple[float, float, float] = (math.nan, math.nan, math.nan)  # standard errors of dx, dy, dz
