@@ -19,8 +19,10 @@ from core.georef.coregister import (
     control_points_from_coregistration,
     coregister_dems,
     coregister_points,
+    coregister_points_file,
     coregister_rasters,
     nmad,
+    reference_window,
 )
 
 X0, Y0 = 500000.0, 4600000.0  # lower-left corner of the reference
@@ -233,6 +235,31 @@ def test_points(rugged, rugged_ref):
     assert 12 <= len(pc) <= 16 and pc.index is not None
     assert np.all(pc.index >= 2000)  # never a raised point
     np.testing.assert_allclose(pc.block_xyz, pts[pc.index])
+
+
+def test_points_against_a_file_in_another_crs(tmp_path, rugged, rugged_ref):
+    """The sparse cloud in EPSG:32633 against a reference file in EPSG:25833 with heights in feet, read over the
+    points only and reprojected into the points' CRS."""
+    ref, ref_gt = rugged_ref
+    shift, dz, tilt = (12.0, -25.0), 1.5, (-4e-4, 2e-4)
+    rng = np.random.default_rng(8)
+    n = 5000
+    x = rng.uniform(BLOCK[0], BLOCK[0] + 3000.0, n)  # a quarter of the block: the window is smaller than the file
+    y = rng.uniform(BLOCK[1], BLOCK[1] + 3000.0, n)
+    qx, qy = x + shift[0], y + shift[1]
+    z = rugged.at(qx, qy) - correction(qx, qy, dz, tilt) + rng.normal(0, 0.3, n)
+    ref_path = write(tmp_path / "ref.tif", ref / 0.3048, ref_gt, "EPSG:25833", unit="ft")
+    res = coregister_points_file(np.column_stack([x, y, z]), ref_path, crs="EPSG:32633")
+    assert res.converged
+    assert math.hypot(res.shift[0] - shift[0], res.shift[1] - shift[1]) < 0.1 * REF_CELL
+    err = res.correction(qx[:50], qy[:50]) - correction(qx[:50], qy[:50], dz, tilt)
+    assert np.max(np.abs(err)) < 0.1
+    win, gt, _ = reference_window(ref_path, x.min(), y.min(), x.max(), y.max(), crs="EPSG:32633")
+    assert win.size < ref.size / 2 and win.dtype == np.float32
+    with pytest.raises(CoregError, match="ref.tif has no height over"):
+        reference_window(ref_path, 0.0, 0.0, 10.0, 10.0, crs="EPSG:32633")
+    with pytest.raises(CoregError, match="not in metres"):
+        coregister_points_file(np.column_stack([x, y, z]), ref_path, crs="EPSG:4326")
 
 
 def test_control_points_remove_the_tilt(rugged, rugged_ref):

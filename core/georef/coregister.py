@@ -32,7 +32,8 @@ the file).
 
 Entry points: :func:`coregister_dems` (arrays + GDAL geotransforms), :func:`coregister_rasters` (two files: CRS,
 linear and vertical units, nodata), :func:`coregister_points` (the sparse cloud against a reference DEM, sampled
-bilinearly), :func:`control_points_from_coregistration` (well-distributed pseudo control points on flat, stable,
+bilinearly; :func:`coregister_points_file` reads the reference over the points only, reprojected into the
+points' CRS: :func:`reference_window`), :func:`control_points_from_coregistration` (well-distributed pseudo control points on flat, stable,
 well-measured cells for the adjustment).  Bad input is a :class:`CoregError` naming the raster.
 """
 from __future__ import annotations
@@ -672,6 +673,63 @@ def coregister_points(points_xyz: np.ndarray, ref: np.ndarray, ref_transform: Se
     return result
 
 
+def reference_window(ref_path: str, xmin: float, ymin: float, xmax: float, ymax: float, *,
+                     crs: Optional[str] = None, margin_cells: int = DEM_MARGIN_CELLS
+                     ) -> Tuple[np.ndarray, Tuple[float, ...], List[str]]:
+    """The part of the reference DEM file over a box (and ``margin_cells`` around it) as (float32 metres with
+    NaN, its geotransform, messages): in ``crs`` (a metric CRS: the file is reprojected on the fly) or in the
+    file's own metric CRS.  For :func:`coregister_points` and :func:`control_points_from_coregistration` without
+    reading a national DEM whole."""
+    from ..io.raster import DsmReader
+
+    _, osr = _gdal()
+    src, xy_unit, messages = _open_source(ref_path, "reference DEM")
+    if crs:
+        srs = osr.SpatialReference()
+        try:
+            srs.SetFromUserInput(crs)
+        except RuntimeError as e:
+            raise CoregError(f"unknown CRS {crs!r} for the points: {e}") from e
+        if srs.IsGeographic() or abs((srs.GetLinearUnits() or 1.0) - 1.0) > 1e-9:
+            raise CoregError(f"the points' CRS {crs!r} is not in metres: co-register in a projected metric CRS")
+        if not src.wkt:
+            raise CoregError(f"the {src.name} has no CRS: it cannot be reprojected into {crs!r}; assign its CRS "
+                             "first")
+    elif abs(xy_unit - 1.0) > 1e-9:
+        raise CoregError(f"the {src.name} is in a CRS whose unit is {xy_unit:g} m: give the points' metric CRS so "
+                         "that it is read reprojected")
+    with DsmReader(ref_path, target_crs=crs) as reader:
+        m = margin_cells * abs(reader.geotransform[1])
+        arr, gt = reader.read_window(xmin - m, ymin - m, xmax + m, ymax + m)
+    if arr.size == 0 or not np.isfinite(arr).any():
+        raise CoregError(f"the {src.name} has no height over {xmin:.1f}, {ymin:.1f}, {xmax:.1f}, {ymax:.1f}: does it "
+                         "cover the block, and is the CRS of each right?")
+    arr = arr.astype(np.float32)
+    if src.zscale != 1.0:
+        arr *= np.float32(src.zscale)
+    return arr, tuple(gt), messages
+
+
+def coregister_points_file(points_xyz: np.ndarray, ref_path: str, *, crs: Optional[str] = None,
+                           stable: Optional[np.ndarray] = None, tilt: bool = True, dome: bool = False,
+                           max_iterations: int = 20, tolerance: float = 0.01,
+                           progress: Optional[Progress] = None) -> CoregResult:
+    """:func:`coregister_points` against the reference DEM file ``ref_path``, read over the points only
+    (:func:`reference_window`; in ``crs``, the points' metric CRS, when given)."""
+    pts = np.asarray(points_xyz, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] < 3:
+        raise CoregError(f"the points must be an N x 3 array, got shape {pts.shape}")
+    ok = np.all(np.isfinite(pts[:, :3]), axis=1)
+    if not ok.any():
+        raise CoregError("no point with finite coordinates")
+    lo, hi = pts[ok, :2].min(axis=0), pts[ok, :2].max(axis=0)
+    ref, gt, messages = reference_window(ref_path, lo[0], lo[1], hi[0], hi[1], crs=crs)
+    result = coregister_points(pts, ref, gt, stable=stable, tilt=tilt, dome=dome, max_iterations=max_iterations,
+                               tolerance=tolerance, progress=progress, ref_name=f"reference DEM {ref_path}")
+    result.messages[:0] = messages
+    return result
+
+
 # ---------------------------------------------------------------------------
 # pseudo control points for the adjustment
 # ---------------------------------------------------------------------------
@@ -785,4 +843,4 @@ def control_points_from_coregistration(result: CoregResult, ref: np.ndarray, ref
 
 
 __all__ = ["CoregError", "CoregResult", "PseudoControl", "control_points_from_coregistration", "coregister_dems",
-           "coregister_points", "coregister_rasters", "nmad"]
+           "coregister_points", "coregister_points_file", "coregister_rasters", "nmad", "reference_window"]
