@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence
 
 from .align.options import AlignOptions
-from .align.stage import align
+from .align.stage import align, check_options
 from .common.progress import NullProgress, Progress, SubProgress
 from .dense.options import DenseOptions
 from .dense.stage import build_dsm_workspace
@@ -131,6 +131,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
                          "USE_EXIF_GPS) to georeference the block before the DSM and orthophoto; to align only, "
                          "run 'Align images'")
     check_inputs(images_dir, ctl)
+    check_options(opt.align)  # a bad calibration file or choice: before the prepare and the alignment
     seconds: Dict[str, float] = {}
     cpu_seconds: Dict[str, float] = {}
 

@@ -22,6 +22,7 @@ from ..common.files import atomic_output, atomic_write_text, fingerprint
 from ..common.progress import Progress, check_cancel
 from ..io.images import CameraGroup, ImageInfo
 from ..prepare.masks import MaskError, find_mask, mask_file_name, png_size
+from .calibrated import GivenCamera, colmap_camera
 from .options import (
     AUTO_FEATURE_MEGAPIXELS,
     AUTO_FEATURES_PER_MP,
@@ -80,9 +81,11 @@ def database_key(groups: List[CameraGroup], options: AlignOptions, images_dir: s
 
 
 def setup_database(pycolmap, db_path: str, groups: List[CameraGroup], options: AlignOptions, key: str,
-                   known_key: Optional[str]) -> Dict[str, int]:
-    """Create (or check) the database's cameras; returns camera_id per group key.  A database at ``db_path``
-    made for ``known_key`` is removed first when the ``key`` of this run differs."""
+                   known_key: Optional[str], given: Optional[Dict[str, GivenCamera]] = None) -> Dict[str, int]:
+    """Create (or update) the database's cameras; returns camera_id per group key.  A database at ``db_path``
+    made for ``known_key`` is removed first when the ``key`` of this run differs.  ``given``: group key -> its
+    given interior orientation (core.align.calibrated): that camera gets the calibration's model and parameters
+    (the features do not depend on them, so a database kept from an earlier run takes this run's cameras)."""
     if os.path.exists(db_path) and known_key != key:
         os.unlink(db_path)  # different images or extraction settings: start afresh
     db = pycolmap.Database.open(db_path)
@@ -91,11 +94,11 @@ def setup_database(pycolmap, db_path: str, groups: List[CameraGroup], options: A
         existing = {c.camera_id: c for c in db.read_all_cameras()}
         for g in groups:
             model = choose_camera_model(options.camera_model, len(g.images), options.min_images_opencv)
+            cam = colmap_camera(pycolmap, g, (given or {}).get(g.key), model)
             if g.camera_id in existing:
+                db.update_camera(cam)
                 ids[g.key] = g.camera_id
                 continue
-            cam = pycolmap.Camera.create_from_model_name(g.camera_id, model, g.focal_px, g.width, g.height)
-            cam.has_prior_focal_length = g.focal_source != "default"
             ids[g.key] = db.write_camera(cam, use_camera_id=True)
         return ids
     finally:

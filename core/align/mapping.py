@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import os
-from typing import Dict, List
+from typing import Collection, Dict, List, Sequence
 
 import numpy as np
 
@@ -48,13 +48,23 @@ def verified_pairs(pycolmap, db_path, min_inliers: int) -> int:
         db.close()
 
 
-def run_mapping(pycolmap, db_path, images_dir, out_dir, n_images, options, progress: Progress):
+def run_mapping(pycolmap, db_path, images_dir, out_dir, n_images, options, progress: Progress,
+                hold_all: bool = False):
+    """The reconstructions of the database.  ``hold_all``: every camera's intrinsics are given and held
+    (core.align.calibrated): no adjustment of the mapping refines focal length, principal point or distortion.
+    COLMAP's switches are global: with some cameras held and some estimated the mapping refines all, and the stage
+    sets the held ones back to their given values before the final bundle adjustment holds them."""
     if options.mapper == "global" and n_images <= 2:
         progress.info("mapping: two images, mapped with the incremental mapper (the global mapper needs tracks of "
                       "three or more views)")
     elif options.mapper == "global":
-        return _map_global(pycolmap, db_path, images_dir, out_dir, n_images, options, progress)
+        return _map_global(pycolmap, db_path, images_dir, out_dir, n_images, options, progress, hold_all)
     opts = pycolmap.IncrementalPipelineOptions()
+    if hold_all:
+        opts.ba_refine_focal_length = False
+        opts.ba_refine_extra_params = False
+        opts.mapper.abs_pose_refine_focal_length = False
+        opts.mapper.abs_pose_refine_extra_params = False
     opts.num_threads = options.num_threads
     opts.random_seed = options.seed
     opts.mapper.random_seed = options.seed
@@ -136,10 +146,15 @@ def min_model_size(n_images: int) -> int:
     return 2 if n_images <= 2 else 3
 
 
-def _map_global(pycolmap, db_path, images_dir, out_dir, n_images, options, progress: Progress):
+def _map_global(pycolmap, db_path, images_dir, out_dir, n_images, options, progress: Progress,
+                hold_all: bool = False):
     """GLOMAP's global pipeline (rotation averaging, global positioning, bundle adjustment).  pycolmap 4.2
     gives it no cancellation token and no progress callback: a cancel takes effect when it returns."""
     opts = pycolmap.GlobalPipelineOptions()
+    if hold_all:
+        opts.mapper.bundle_adjustment.refine_focal_length = False
+        opts.mapper.bundle_adjustment.refine_extra_params = False
+        opts.mapper.bundle_adjustment.refine_principal_point = False
     opts.num_threads = options.num_threads
     opts.random_seed = options.seed
     opts.min_model_size = min_model_size(n_images)
@@ -184,21 +199,44 @@ def drop_degenerate(rec) -> Dict[str, str]:
     return dropped
 
 
-def final_bundle_adjustment(pycolmap, rec, options: AlignOptions, progress: Progress):
+def final_bundle_adjustment(pycolmap, rec, options: AlignOptions, progress: Progress,
+                            held: Collection[int] = ()):
+    """The final global bundle adjustment; the cameras ``held`` (ids) keep their intrinsics constant.  Returns
+    whether the principal point was refined (of the cameras not held)."""
     ba = pycolmap.BundleAdjustmentOptions()
     ba.print_summary = False
     counts: Dict[int, int] = {}
     for im in rec.images.values():
         if im.has_pose:
             counts[im.camera_id] = counts.get(im.camera_id, 0) + 1
-    ba.refine_principal_point = bool(options.refine_principal_point and counts
-                                     and min(counts.values()) >= options.min_images_opencv)
+    free = {cid: n for cid, n in counts.items() if cid not in held}
+    ba.refine_principal_point = bool(options.refine_principal_point and free
+                                     and min(free.values()) >= options.min_images_opencv)
     ba.ceres.loss_function_type = pycolmap.LossFunctionType.CAUCHY
     ba.ceres.solver_options.max_num_iterations = 30  # the mapper's last global BA has already converged
-    with CancelWatcher(progress) as token:
-        pycolmap.bundle_adjustment(rec, ba, cancellation_token=token)
+    if counts and not free:  # every camera held: the adjustment's own switches (and its cancellation token)
+        ba.refine_focal_length = ba.refine_extra_params = ba.refine_principal_point = False
+    if free and any(cid in counts for cid in held):
+        _adjust_holding(pycolmap, rec, ba, [cid for cid in held if cid in counts])
+    else:
+        with CancelWatcher(progress) as token:
+            pycolmap.bundle_adjustment(rec, ba, cancellation_token=token)
     check_cancel(progress)
     return ba.refine_principal_point
+
+
+def _adjust_holding(pycolmap, rec, ba, held: Sequence[int]) -> None:
+    """pycolmap.bundle_adjustment's own steps (observations behind a camera dropped, every registered image, the
+    gauge fixed on two cameras) with the ``held`` cameras' intrinsics constant (pycolmap gives this path no
+    cancellation token: a cancel takes effect when it returns)."""
+    pycolmap.ObservationManager(rec).filter_observations_with_negative_depth()
+    config = pycolmap.BundleAdjustmentConfig()
+    for image_id in rec.reg_image_ids():
+        config.add_image(image_id)
+    for cid in held:
+        config.set_constant_cam_intrinsics(cid)
+    config.fix_gauge(pycolmap.BundleAdjustmentGauge.TWO_CAMS_FROM_WORLD)
+    pycolmap.create_default_bundle_adjuster(ba, config, rec).solve()
 
 
 def camera_rows(rec) -> List[dict]:

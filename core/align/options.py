@@ -32,6 +32,10 @@ EXTRACT_BLOCK = 2  # images per extraction call at least
 EXTRACT_BLOCK_MEGAPIXELS = 8.0  # megapixels SIFT works through per extraction call (an upsampled image counts 4 x)
 MAX_EXTRACT_BLOCK = 64
 MAPPERS = ("incremental", "global")
+# what the adjustments may change of a camera's interior orientation (core.align.calibrated): "auto" = fixed where a
+# calibration (file, or a film scan's restituted interior orientation) is given, estimated elsewhere
+INTRINSICS = ("auto", "fixed", "refined", "estimated")
+HELD = ("fixed", "refined")  # modes whose intrinsics the alignment keeps constant (refined: with priors in georef)
 MIN_VERIFIED_INLIERS = 15  # a pair with fewer inliers does not count as "matched" in the diagnosis
 
 
@@ -58,3 +62,13 @@ class AlignOptions:
     first_octave: Optional[int] = None  # SIFT's first octave; None = auto (-1, upsampled, below UPSAMPLE_BELOW px)
     seed: int = 1
     escalate: bool = True  # retry images left out / a split block with richer features and pairs (escalation.py)
+    calibration: Optional[str] = None  # a camera calibration file (core.io.calibration), None: none
+    intrinsics: str = "auto"  # one of INTRINSICS; a camera's own ``adjust`` in the calibration file overrides it
+
+    def check(self) -> None:
+        """AlignError for a value out of its choices (before any work)."""
+        if self.mapper not in MAPPERS:
+            raise AlignError(f"unknown mapper {self.mapper!r}; choose one of {', '.join(MAPPERS)}")
+        if self.intrinsics not in INTRINSICS:
+            raise AlignError(f"unknown intrinsics choice {self.intrinsics!r}; choose one of {', '.join(INTRINSICS)} "
+                             "(auto: fixed where a calibration is given, estimated elsewhere)")

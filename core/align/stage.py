@@ -33,6 +33,15 @@ from ..io.vector import write_cameras_gpkg
 from ..project.layout import Layout
 from ..project.stages import ALIGN, run_stage
 from ..project.workspace import Workspace
+from .calibrated import (
+    GivenCamera,
+    held_cameras,
+    intrinsics_record,
+    plan_cameras,
+    read_calibrations,
+    restore_held,
+    scan_interior,
+)
 from .escalation import EscalationContext, block_state, escalate
 from .features import database_key, extract_features, file_hash, masks_for_colmap, match_pairs, setup_database
 from .mapping import (
@@ -44,7 +53,7 @@ from .mapping import (
     verified_pairs,
     verified_partners,
 )
-from .options import MAPPERS, MIN_VERIFIED_INLIERS, AlignError, AlignOptions
+from .options import MIN_VERIFIED_INLIERS, AlignError, AlignOptions
 from .pairs import select_pairs
 from .photos import PHOTO_FINGERPRINTS, fingerprint_photos
 
@@ -70,6 +79,7 @@ class AlignResult:
     cameras: List[dict]
     masked_images: int = 0
     escalation: Optional[dict] = None  # what was escalated and why (core.align.escalation), None when not needed
+    intrinsics: Optional[List[dict]] = None  # per camera: mode, given values and sigmas, final values (calibrated)
 
 
 def _json(obj) -> str:
@@ -144,15 +154,20 @@ def _no_reconstruction(partners: Dict[str, int], n_images: int, n_pairs: int) ->
 
 
 def _mapping(pycolmap, lay: Layout, db_path: str, images_dir: str, n_images: int, options: AlignOptions,
-             progress: Progress, degenerate: Optional[Dict[str, str]] = None):
+             progress: Progress, degenerate: Optional[Dict[str, str]] = None,
+             held: Optional[Tuple[Dict[int, GivenCamera], bool]] = None):
     """The reconstructions, largest first, without the images the mapper gave a degenerate camera: those are added
     to ``degenerate`` (name -> why; an image's entry says why a mapping last left it out).  The mapping works in a
-    scratch folder removed afterwards."""
+    scratch folder removed afterwards.  ``held``: (camera id -> given interior orientation of the cameras held,
+    whether that is every camera); the held cameras come back with exactly their given values."""
+    held_ids, hold_all = held or ({}, False)
     map_tmp = os.path.join(lay.sfm_dir, ".mapping")
     shutil.rmtree(map_tmp, ignore_errors=True)
     os.makedirs(map_tmp)
-    recs = run_mapping(pycolmap, db_path, images_dir, map_tmp, n_images, options, progress)
+    recs = run_mapping(pycolmap, db_path, images_dir, map_tmp, n_images, options, progress, hold_all=hold_all)
     shutil.rmtree(map_tmp, ignore_errors=True)
+    for rec in (recs.values() if recs else ()):
+        restore_held(rec, held_ids)
     dropped: Dict[str, str] = {}
     for rec in (recs.values() if recs else ()):
         dropped.update(drop_degenerate(rec))
@@ -174,6 +189,12 @@ class _Photos:
     groups: List[CameraGroup]
     fingerprints: Dict[str, str]  # image name -> content fingerprint (core.align.photos)
     seconds: float
+    given: Dict[str, GivenCamera]  # group key -> its given interior orientation (core.align.calibrated)
+
+    def held(self) -> Tuple[Dict[int, GivenCamera], bool]:
+        """(camera id -> given, of the cameras the alignment holds; whether every camera is held)."""
+        ids = held_cameras(self.groups, self.given)
+        return ids, bool(ids) and len(ids) == len(self.groups)
 
 
 def _database_path(lay: Layout, record: dict, key: str, keep_previous: bool) -> Tuple[str, Optional[str]]:
@@ -203,15 +224,19 @@ def _setup(pycolmap, lay: Layout, photos: _Photos, options: AlignOptions, record
                       "no features where they are black")
     key = database_key(groups, options, photos.images_dir, masks_key, fingerprint(photos.fingerprints))
     db_path, known_key = _database_path(lay, record, key, keep_previous)
-    camera_ids = setup_database(pycolmap, db_path, groups, options, key, known_key)
+    camera_ids = setup_database(pycolmap, db_path, groups, options, key, known_key, photos.given)
     return db_path, mask_path, masks, camera_ids
 
 
-def _read_folder(images_dir: str, options: AlignOptions, progress: Progress) -> _Photos:
-    """The usable photos of ``images_dir`` and their fingerprints; AlignError with fewer than two."""
+def _read_folder(pycolmap, lay: Layout, images_dir: str, options: AlignOptions, calibrations: list,
+                 progress: Progress) -> _Photos:
+    """The usable photos of ``images_dir``, their fingerprints and their cameras' given interior orientations
+    (a calibration file's, film scans' restituted by Prepare images); AlignError with fewer than two."""
     t0 = time.time()
     infos, skipped, groups = _read_images(images_dir, options, progress)
-    return _Photos(images_dir, infos, skipped, groups, fingerprint_photos(infos), time.time() - t0)
+    groups, given = plan_cameras(pycolmap, groups, infos, calibrations, scan_interior(lay.scans_json, infos),
+                                 options, progress)
+    return _Photos(images_dir, infos, skipped, groups, fingerprint_photos(infos), time.time() - t0, given)
 
 
 def _previous_alignment(ws: Workspace, lay: Layout) -> Optional[dict]:
@@ -231,6 +256,14 @@ def _keep_previous(ws: Workspace, previous: dict) -> None:
     ws.save()
 
 
+def check_options(options: AlignOptions) -> list:
+    """The checks of the alignment's options that need no photo: AlignError for a choice out of its values,
+    CalibrationError (file, line, field) for a calibration file that cannot be read.  Returns the
+    calibrations read (core.io.calibration.CameraCalibration)."""
+    options.check()
+    return read_calibrations(options)
+
+
 def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] = None,
           progress: Optional[Progress] = None) -> AlignResult:
     """Run the alignment stage.  Raises AlignError / ImageError / WorkspaceError / Cancelled.
@@ -239,8 +272,7 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
     database, the model and the later stages' records are replaced only when the new alignment succeeds."""
     options = options or AlignOptions()
     progress = progress or NullProgress()
-    if options.mapper not in MAPPERS:
-        raise AlignError(f"unknown mapper {options.mapper!r}; choose one of {', '.join(MAPPERS)}")
+    calibrations = check_options(options)  # a mistyped choice or a bad calibration file fails before any work
     pycolmap = load_pycolmap("the alignment")
     t_start = time.time()
     images_dir = os.path.abspath(images_dir)
@@ -250,7 +282,7 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
         raise AlignError(str(e)) from e
     ws = Workspace.create_or_open(workspace_dir)  # checks writability before any work
     lay = Layout(ws)
-    photos = _read_folder(images_dir, options, progress)
+    photos = _read_folder(pycolmap, lay, images_dir, options, calibrations, progress)
     previous = _previous_alignment(ws, lay)
     try:
         return _run(pycolmap, ws, lay, photos, options, previous is not None, t_start, progress)
@@ -289,11 +321,11 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
         degenerate: Dict[str, str] = {}  # images a mapping gave a degenerate camera: name -> why
         with run.step("mapping", save=False):
             ordered = _mapping(pycolmap, lay, db_path, images_dir, len(infos), options,
-                               SubProgress(progress, 0.65, 0.90), degenerate)
+                               SubProgress(progress, 0.65, 0.90), degenerate, photos.held())
         ctx = EscalationContext(pycolmap, db_path, lay.sfm_dir, images_dir, [im.name for im in infos], groups,
                                 camera_ids, options, pairs, mask_path, list(masks),
                                 lambda p: _mapping(pycolmap, lay, db_path, images_dir, len(infos), options, p,
-                                                   degenerate),
+                                                   degenerate, photos.held()),
                                 lambda reg, oth: diagnose_unregistered(
                                     infos, reg, oth, verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS),
                                     degenerate),
@@ -305,10 +337,11 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
             raise _no_reconstruction(partners, len(infos), verified_pairs(pycolmap, db_path, MIN_VERIFIED_INLIERS))
         rec = ordered[0]
         _registered, others = block_state(ordered)
-        # 5. final global bundle adjustment
+        # 5. final global bundle adjustment (the held cameras' intrinsics constant)
+        held = photos.held()[0]
         with run.step("bundle_adjustment", save=False):
             progress.report(0.94, "final bundle adjustment")
-            pp = final_bundle_adjustment(pycolmap, rec, options, progress)
+            pp = final_bundle_adjustment(pycolmap, rec, options, progress, held)
             # a camera with few points the adjustment sent off goes out, and the adjustment runs again (until none)
             for _ in range(len(infos)):
                 diverged = drop_degenerate(rec)
@@ -317,7 +350,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
                 for name, why in diverged.items():
                     progress.warning(f"final bundle adjustment: {name} {why}: left out of the block")
                 degenerate.update(diverged)
-                pp = final_bundle_adjustment(pycolmap, rec, options, progress)
+                pp = final_bundle_adjustment(pycolmap, rec, options, progress, held)
         registered = {rec.images[i].name for i in rec.reg_image_ids()}
         unregistered = diagnose_unregistered(infos, registered, others, partners, degenerate)
         _report_unregistered(progress, unregistered, others, len(registered))
@@ -338,6 +371,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
             pairing_used=pairing_used, num_pairs=len(pairs), timings={k: round(v, 3) for k, v in timings.items()},
             cameras=camera_summary(rec), masked_images=len(masks),
             escalation=escalation.to_dict() if escalation else None,
+            intrinsics=intrinsics_record(pycolmap, groups, photos.given, rec),
         )
         figures = {k: v for k, v in asdict(result).items() if k not in ("workspace", "model_dir", "cameras_path")}
         figures["principal_point_refined"] = pp

@@ -156,6 +156,13 @@ class Layout:
         """sfm/alignment.json (figures of the alignment), {} if absent."""
         return read_json(self.alignment_json) or {}
 
+    def camera_intrinsics(self) -> Dict[int, Dict[str, Any]]:
+        """camera id -> what the alignment recorded of its interior orientation (``intrinsics`` in
+        sfm/alignment.json, core.align.calibrated.intrinsics_record: mode fixed / refined / estimated, source,
+        COLMAP model, given values and sigmas by parameter name, final values); {} for an alignment without it."""
+        rows = self.alignment().get("intrinsics") or []
+        return {int(r["camera_id"]): r for r in rows if isinstance(r, dict) and "camera_id" in r}
+
     # --- georeference ----------------------------------------------------
     @property
     def georef_dir(self) -> str:

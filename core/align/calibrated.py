@@ -1,0 +1,264 @@
+"""Calibrated cameras: which camera of the block takes which given interior orientation, and what the
+adjustments may change of it.
+
+Sources of a given interior orientation, per camera group (core.io.images.group_cameras):
+
+- a calibration file (``AlignOptions.calibration``, read by :func:`core.io.calibration.read_calibration`): one
+  calibration applies to every image; several are matched per image by their ``images`` glob patterns, else by
+  their name against the photo's EXIF camera model, else by the image size (a calibration with patterns takes only
+  the images they match).  Images of one group that take different calibrations make separate cameras.  A photo
+  whose size differs from the calibration's (a scan at another resolution) takes it ``scaled_to`` its size;
+- a film scan restituted by Prepare images (``scans.json``: its ``interior_orientation``, the principal point at
+  the prepared image's centre and the focal length in pixels where it is known), for the prepared images;
+- FOCAL_MM + SENSOR_WIDTH_MM (or a focal length in pixels) when ``intrinsics`` is ``fixed`` or ``refined``: the
+  focal length, the principal point at the image centre, no distortion.
+
+The mode (``AlignOptions.intrinsics``, overridden per camera by the file's ``adjust``): ``fixed`` keeps the given
+values through the alignment and the georeference; ``refined`` keeps them through the alignment (COLMAP has no
+priors on intrinsics) and lets the georeference refine them with priors at the given values weighted by their
+sigmas; ``estimated`` starts the self-calibration from them (today's behaviour where nothing is given).  ``auto``
+is ``fixed`` where something is given, ``estimated`` elsewhere.
+
+The alignment records per camera (``sfm/alignment.json``, ``intrinsics``: :func:`intrinsics_record`) the mode,
+the source, the given values and sigmas and the final values; the georeference reads it back
+(``core.project.layout.Layout.camera_intrinsics``).
+"""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field, replace
+from typing import Dict, List, Optional, Sequence, Tuple
+
+from ..common.progress import Progress
+from ..io.images import CameraGroup, ImageInfo
+from ..project.layout import read_json
+from .options import HELD, AlignError, AlignOptions
+
+FOCAL_SOURCE = "FOCAL_MM / SENSOR_WIDTH_MM"
+RECORD_FORMAT = 1
+# the names a calibration's sigmas may use for a COLMAP parameter (the first that is given counts)
+SIGMA_ALIASES = {
+    "f": ("f", "focal", "focal_px"), "fx": ("fx", "focal_x", "focal", "focal_px"),
+    "fy": ("fy", "focal_y", "focal_y_px", "focal", "focal_px"), "cx": ("cx", "cx_px"), "cy": ("cy", "cy_px"),
+    "k": ("k", "k1"),
+}
+
+
+@dataclass
+class GivenCamera:
+    """A camera's given interior orientation as the alignment uses it (COLMAP model and parameters)."""
+
+    mode: str  # fixed / refined / estimated
+    source: str  # the calibration file, the scans.json, or FOCAL_SOURCE
+    name: str
+    model: str
+    params: List[float]
+    sigmas: Dict[str, float] = field(default_factory=dict)  # COLMAP parameter name -> sigma (px: focal, pp)
+    matched_by: str = ""
+    scaled_from: Optional[Tuple[int, int]] = None
+
+    @property
+    def held(self) -> bool:
+        return self.mode in HELD
+
+
+def read_calibrations(options: AlignOptions) -> list:
+    """The calibrations of ``options.calibration`` (empty without one).  CalibrationError (an ArchaeoOrthoError)
+    naming the file, the line and the field for a bad file; AlignError for a file that is not there."""
+    if not options.calibration:
+        return []
+    path = options.calibration
+    if not os.path.isfile(path):
+        raise AlignError(f"calibration file {path} does not exist" if not os.path.exists(path)
+                         else f"calibration file {path} is a folder, not a file")
+    from ..io.calibration import read_calibration
+
+    cals = list(read_calibration(path))
+    if not cals:
+        raise AlignError(f"calibration file {path}: no camera in it")
+    return cals
+
+
+def scan_interior(scans_json: str, infos: Sequence[ImageInfo]) -> Dict[str, dict]:
+    """image name -> the restituted interior orientation of the film scans Prepare images wrote (``scans.json``)
+    for the images of ``infos`` it made whose focal length in pixels is known and whose size is the frame's."""
+    data = read_json(scans_json) if os.path.isfile(scans_json) else None
+    io = (data or {}).get("interior_orientation") or {}
+    if not io.get("focal_px"):
+        return {}
+    prepared = {s.get("prepared_name") for s in (data or {}).get("scans", [])}
+    size = (io.get("width"), io.get("height"))
+    return {im.name: io for im in infos if im.name in prepared and (im.width, im.height) == size}
+
+
+def match_calibration(info: ImageInfo, cals: Sequence) -> Tuple[Optional[object], str]:
+    """(the calibration of a photo, how it was matched) or (None, ""): the one whose ``images`` patterns match
+    its name (a calibration with patterns takes only those images), else the only calibration of the file, else
+    the one named as the photo's EXIF camera model, else the only one of the photo's size."""
+    hit = [c for c in cals if c.images and c.applies_to(info.name)]
+    if len(hit) > 1:
+        raise AlignError(f"calibration file {hit[0].source}: image {info.name} matches the images patterns of both "
+                         f"{hit[0].label()} and {hit[1].label()}")
+    if hit:
+        return hit[0], "its images patterns"
+    free = [c for c in cals if not c.images]
+    if len(cals) == 1 and free:
+        return free[0], "the only calibration"
+    model = (info.model or "").strip().lower()
+    hit = [c for c in free if model and (c.name or "").strip().lower() == model]
+    if hit:
+        return hit[0], "the EXIF camera model"
+    hit = [c for c in free if (c.width, c.height) == (info.width, info.height)]
+    if len(hit) == 1:
+        return hit[0], "the image size"
+    return None, ""
+
+
+def _param_names(pycolmap, model: str) -> List[str]:
+    cam = pycolmap.Camera.create_from_model_name(1, model, 1.0, 2, 2)
+    return [s.strip() for s in cam.params_info.split(",")]
+
+
+def _sigmas(names: Sequence[str], given: Dict[str, float]) -> Dict[str, float]:
+    out = {}
+    for n in names:
+        for alias in SIGMA_ALIASES.get(n, (n,)):
+            v = given.get(alias) if given else None
+            if v is not None and math.isfinite(float(v)) and float(v) > 0:
+                out[n] = float(v)
+                break
+    return out
+
+
+def _from_calibration(pycolmap, cal, info: ImageInfo, mode: str, how: str) -> GivenCamera:
+    source = getattr(cal, "source", "") or ""
+    scaled_from = None
+    if (cal.width, cal.height) != (info.width, info.height):
+        scaled_from = (cal.width, cal.height)
+        try:
+            cal = cal.scaled_to(info.width, info.height)
+        except ValueError as e:  # CalibrationError is one: it names the file and the field
+            raise AlignError(f"calibration file {source}: camera {cal.name!r} ({cal.width} x {cal.height} px) does "
+                             f"not fit image {info.name} ({info.width} x {info.height} px): {e}") from e
+    model, params = cal.colmap_model()
+    names = _param_names(pycolmap, model)
+    return GivenCamera(mode=(cal.adjust or mode), source=source, name=cal.name or "", model=model,
+                       params=[float(v) for v in params], sigmas=_sigmas(names, cal.sigmas or {}), matched_by=how,
+                       scaled_from=scaled_from)
+
+
+def _simple(focal: float, width: int, height: int, cx: Optional[float] = None, cy: Optional[float] = None):
+    return "SIMPLE_RADIAL", [float(focal), float(width / 2.0 if cx is None else cx),
+                             float(height / 2.0 if cy is None else cy), 0.0]
+
+
+def _given_for(pycolmap, info: ImageInfo, cals, scans: Dict[str, dict], options: AlignOptions,
+               ) -> Optional[GivenCamera]:
+    """The given interior orientation of one photo (None: nothing given, self-calibrated as always)."""
+    chosen = options.intrinsics
+    if cals:
+        cal, how = match_calibration(info, cals)
+        if cal is not None:
+            return _from_calibration(pycolmap, cal, info, "fixed" if chosen == "auto" else chosen, how)
+    if info.name in scans:
+        io = scans[info.name]
+        pp = io.get("principal_point_px") or [None, None]
+        model, params = _simple(io["focal_px"], info.width, info.height, pp[0], pp[1])
+        return GivenCamera("fixed" if chosen == "auto" else chosen, "scans.json", "film scan interior orientation",
+                           model, params, matched_by="Prepare images restituted it")
+    if chosen in HELD and info.focal_source == "manual" and info.focal_px:
+        model, params = _simple(info.focal_px, info.width, info.height)
+        return GivenCamera(chosen, FOCAL_SOURCE, "focal length given", model, params, matched_by="the focal length")
+    return None
+
+
+def plan_cameras(pycolmap, groups: List[CameraGroup], infos: Sequence[ImageInfo], cals, scans: Dict[str, dict],
+                 options: AlignOptions, progress: Progress) -> Tuple[List[CameraGroup], Dict[str, GivenCamera]]:
+    """(the camera groups, split where their photos take different calibrations, renumbered; group key -> its
+    given interior orientation, for the groups that have one).  AlignError when ``fixed`` or ``refined`` is asked
+    and no camera has anything given."""
+    by_name = {im.name: im for im in infos}
+    for cal in cals:
+        for note in getattr(cal, "notes", None) or []:
+            progress.info(f"calibration {cal.source}, {cal.label()}: {note}")
+    out: List[CameraGroup] = []
+    plan: Dict[str, GivenCamera] = {}
+    for g in groups:
+        parts: Dict[str, Tuple[Optional[GivenCamera], List[str]]] = {}
+        for n in g.images:
+            given = _given_for(pycolmap, by_name[n], cals, scans, options)
+            tag = "" if given is None else f"{given.source}|{given.name}|{given.model}|{given.params}"
+            parts.setdefault(tag, (given, []))[1].append(n)
+        for tag, (given, names) in parts.items():
+            key = g.key if len(parts) == 1 else f"{g.key}|{tag}"
+            sub = replace(g, camera_id=len(out) + 1, key=key, images=list(names))
+            out.append(sub)
+            if given is not None:
+                plan[key] = given
+    if options.intrinsics in HELD and not plan:
+        raise AlignError(f"intrinsics {options.intrinsics!r} needs a given interior orientation: a calibration file "
+                         "(CALIBRATION), or the focal length and sensor width (FOCAL_MM, SENSOR_WIDTH_MM), or film "
+                         "scans restituted by 'Prepare images' with a known focal length")
+    for g in out:
+        given = plan.get(g.key)
+        what = (f"{given.mode}, {given.model} from {given.source}"
+                + (f" ({given.name!r}, matched by {given.matched_by})" if given.name else "")
+                + (f", scaled from {given.scaled_from[0]} x {given.scaled_from[1]} px" if given.scaled_from else "")
+                if given else "estimated (self-calibration), no calibration given")
+        progress.info(f"camera {g.camera_id} ({len(g.images)} image(s), {g.width} x {g.height} px): interior "
+                      f"orientation {what}")
+    return out, plan
+
+
+def colmap_camera(pycolmap, group: CameraGroup, given: Optional[GivenCamera], model: str):
+    """The database camera of ``group``: the given model and parameters where a calibration is given (its focal
+    length a prior), else ``model`` from the group's focal prior (today's camera)."""
+    if given is None:
+        cam = pycolmap.Camera.create_from_model_name(group.camera_id, model, group.focal_px, group.width,
+                                                     group.height)
+        cam.has_prior_focal_length = group.focal_source != "default"
+        return cam
+    cam = pycolmap.Camera.create_from_model_name(group.camera_id, given.model, given.params[0], group.width,
+                                                 group.height)
+    cam.params = [float(v) for v in given.params]
+    cam.has_prior_focal_length = True
+    return cam
+
+
+def held_cameras(groups: Sequence[CameraGroup], plan: Dict[str, GivenCamera]) -> Dict[int, GivenCamera]:
+    """camera id -> given, of the cameras whose intrinsics the alignment keeps constant."""
+    return {g.camera_id: plan[g.key] for g in groups if g.key in plan and plan[g.key].held}
+
+
+def restore_held(rec, held: Dict[int, GivenCamera]) -> None:
+    """Set the held cameras of ``rec`` back to exactly their given values (a mapping whose adjustments refine the
+    other cameras' intrinsics moves them too: COLMAP's refinement switches are global)."""
+    for cid, given in held.items():
+        if cid in rec.cameras:
+            rec.cameras[cid].params = [float(v) for v in given.params]
+
+
+def intrinsics_record(pycolmap, groups: Sequence[CameraGroup], plan: Dict[str, GivenCamera], rec) -> List[dict]:
+    """Per camera of the block: its mode, source, given values and sigmas, and the final values."""
+    rows = []
+    for g in groups:
+        given = plan.get(g.key)
+        cam = rec.cameras[g.camera_id] if g.camera_id in rec.cameras else None
+        row = {"camera_id": g.camera_id, "images": len(g.images), "width": g.width, "height": g.height,
+               "mode": given.mode if given else "estimated", "source": given.source if given else None,
+               "name": given.name if given else None, "matched_by": given.matched_by if given else None,
+               "scaled_from": list(given.scaled_from) if given and given.scaled_from else None}
+        if given is not None:
+            names = _param_names(pycolmap, given.model)
+            row.update(model=given.model, given=dict(zip(names, given.params)), sigmas=dict(given.sigmas))
+        if cam is not None:
+            names = [s.strip() for s in cam.params_info.split(",")]
+            row["final_model"] = cam.model.name
+            row["final"] = {n: float(v) for n, v in zip(names, cam.params)}
+        rows.append(row)
+    return rows
+
+
+__all__ = ["FOCAL_SOURCE", "GivenCamera", "colmap_camera", "held_cameras", "intrinsics_record",
+           "match_calibration", "plan_cameras", "read_calibrations", "restore_held", "scan_interior"]
