@@ -502,7 +502,8 @@ def _adjust(run: _Run, fit: _Fit, groups, stats: Dict[str, Any]) -> _Adjustment:
     ba_points = [p for p in run.usable if p.name not in run.rejected_ctrl or p.name in run.provisional]
     built = build_problem(run.rec, run.lookup, ba_points, run.tri, run.cam_pos, fit.offset, fit.helmert.transform,
                           groups, opt.gcp_pixel_sigma, opt.tie_pixel_sigma, opt.huber_px, opt.max_observations,
-                          opt.min_intrinsics_images, run.warn, run.progress, focal_prior=opt.focal_prior)
+                          opt.min_intrinsics_images, run.warn, run.progress, focal_prior=opt.focal_prior,
+                          intrinsics=opt.camera_intrinsics)
     adj = _Adjustment(*built, ba_points=ba_points)
     for nm in run.provisional:
         set_point_active(adj.prob, adj.gcp_index[nm], adj.gcp_obs_rows[nm], False)

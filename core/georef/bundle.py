@@ -22,6 +22,7 @@ from ..common.progress import NullProgress, check_cancel
 from ..geometry.similarity import rodrigues, skew
 from ..io.gcp import Observation
 from .errors import GeorefError
+from .options import REFINED_FOCAL_SIGMA, REFINED_PP_SIGMA, REFINED_RADIAL_SIGMA, REFINED_TANGENTIAL_SIGMA
 
 # ----------------------------------------------------------------------------
 # projection and its derivatives
@@ -168,7 +169,8 @@ class BundleProblem:
 
     def __init__(self, frames_r, frames_c, img_frame, img_cam, img_rs, img_ts, cameras, cam_free,
                  points, obs: Observations, point_prior, point_prior_sigma, cam_prior_img, cam_prior_xyz,
-                 cam_prior_sigma, huber_px: float = 2.0, focal_prior: float = 0.0):
+                 cam_prior_sigma, huber_px: float = 2.0, focal_prior: float = 0.0,
+                 intrinsic_priors: Optional[Dict[int, List[Tuple[int, float, float]]]] = None):
         self.R = np.asarray(frames_r, dtype=float).copy()  # (F,3,3) rig_from_world rotation
         self.C = np.asarray(frames_c, dtype=float).copy()  # (F,3) rig centre in world
         self.img_frame = np.asarray(img_frame, dtype=int)
@@ -197,10 +199,21 @@ class BundleProblem:
         # a prior on each free focal length parameter: its starting value (the alignment's self-calibration),
         # sigma = focal_prior x that value (0: none).  On flat ground the focal length and the flying height
         # trade against each other almost freely; the prior keeps the calibration where nothing in the data
-        # says otherwise instead of letting it wander along that valley
+        # says otherwise instead of letting it wander along that valley.  ``intrinsic_priors``: camera index ->
+        # (parameter index, given value, sigma) of a camera refined from a given calibration, in its place
         self.fp_col, self.fp_value, self.fp_sigma = [], [], []
+        own = intrinsic_priors or {}
+        for k, rows in own.items():
+            free_k = [int(i) for i in self.cam_free[k]]
+            for idx, value, sigma in rows:
+                if int(idx) in free_k:
+                    self.fp_col.append((k, free_k.index(int(idx)), int(idx)))
+                    self.fp_value.append(float(value))
+                    self.fp_sigma.append(float(sigma))
         if focal_prior > 0:
             for k, cam in enumerate(self.cameras):
+                if k in own:
+                    continue
                 fidx = set(int(i) for i in cam.focal_length_idxs())
                 for j, idx in enumerate(self.cam_free[k]):
                     if int(idx) in fidx:
@@ -552,14 +565,59 @@ def _index_images(rec) -> _Images:
     return out
 
 
-def _free_intrinsics(rec, images: _Images, groups, min_intrinsics_images: int, warn: Callable[[str], None]):
-    """Copies of the cameras, the indices of their free parameters, and the ids of the refined ones."""
+def given_priors(cam, record: Dict[str, Any]) -> List[Tuple[int, float, float]]:
+    """(parameter index, given value, sigma) of every parameter of ``cam``, a camera the alignment recorded as
+    ``refined`` (``record``: core.align.calibrated.intrinsics_record's row): the given sigma where the calibration
+    has one, else REFINED_*_SIGMA (core.georef.options)."""
+    names = [n.strip() for n in cam.params_info.split(",")]
+    given = record.get("given") or {}
+    sigmas = record.get("sigmas") or {}
+    long_side = float(max(cam.width, cam.height))
+    out = []
+    for idx, name in enumerate(names):
+        value = float(given.get(name, cam.params[idx]))
+        sigma = sigmas.get(name)
+        if sigma is None or not sigma > 0:
+            if name in ("f", "fx", "fy"):
+                sigma = REFINED_FOCAL_SIGMA * abs(value)
+            elif name in ("cx", "cy"):
+                sigma = REFINED_PP_SIGMA * long_side
+            elif name in ("p1", "p2"):
+                sigma = REFINED_TANGENTIAL_SIGMA
+            else:
+                sigma = REFINED_RADIAL_SIGMA
+        out.append((idx, value, float(sigma)))
+    return out
+
+
+def _free_intrinsics(rec, images: _Images, groups, min_intrinsics_images: int, warn: Callable[[str], None],
+                     given: Optional[Dict[int, Dict[str, Any]]] = None):
+    """Copies of the cameras, the indices of their free parameters, the ids of the refined ones, the priors of
+    those refined from a given calibration (camera index -> given_priors) and the ids of the fixed ones.
+
+    ``given``: camera id -> the alignment's record of its interior orientation (GeorefOptions.camera_intrinsics):
+    ``fixed`` is never refined, ``refined`` is refined (every parameter) with priors at its given values,
+    ``estimated`` (or no record) follows ``groups``."""
     cameras = [copy.copy(rec.cameras[cid]) for cid in images.camera_ids]
     cam_free = []
     refined = []
-    for cid, cam in zip(images.camera_ids, cameras):
+    priors: Dict[int, List[Tuple[int, float, float]]] = {}
+    fixed: List[int] = []
+    for k, (cid, cam) in enumerate(zip(images.camera_ids, cameras)):
         free: List[int] = []
-        if groups and images.images_per_cam[cid] >= min_intrinsics_images:
+        record = (given or {}).get(cid) or {}
+        mode = record.get("mode", "estimated")
+        if mode == "refined" and record.get("model") not in (None, cam.model.name):
+            warn(f"camera {cid}: the calibration's model {record.get('model')} is not the model's "
+                 f"{cam.model.name}: its intrinsics follow refine_intrinsics")
+            mode = "estimated"
+        if mode == "fixed":
+            fixed.append(cid)
+        elif mode == "refined":
+            priors[k] = given_priors(cam, record)
+            free = [idx for idx, _, _ in priors[k]]
+            refined.append(cid)
+        elif groups and images.images_per_cam[cid] >= min_intrinsics_images:
             if "focal" in groups:
                 free += list(cam.focal_length_idxs())
             if "principal_point" in groups:
@@ -570,7 +628,7 @@ def _free_intrinsics(rec, images: _Images, groups, min_intrinsics_images: int, w
         elif groups:
             warn(f"camera {cid}: only {images.images_per_cam[cid]} image(s), intrinsics kept fixed")
         cam_free.append(sorted(set(free)))
-    return cameras, cam_free, refined
+    return cameras, cam_free, refined, priors, fixed
 
 
 @dataclass
@@ -655,13 +713,21 @@ def _camera_priors(images: _Images, cam_pos, offset):
 
 def build_problem(rec, lookup, ba_points, tri, cam_pos, offset, model_to_local, groups, gcp_pixel_sigma,
                   tie_pixel_sigma, huber_px, max_observations, min_intrinsics_images, warn: Callable[[str], None],
-                  progress=None, focal_prior: float = 0.0):
+                  progress=None, focal_prior: float = 0.0, intrinsics: Optional[Dict[int, Dict[str, Any]]] = None):
     """The adjustment of ``rec`` (local frame) with the control points ``ba_points`` (their model-frame
     triangulations ``tri``) and the camera positions ``cam_pos``.  Returns the problem, the tie point ids
-    (rows of ``prob.X``), each control point's row and observation rows, and figures of the problem."""
+    (rows of ``prob.X``), each control point's row and observation rows, and figures of the problem.
+    ``intrinsics``: camera id -> the alignment's record of its interior orientation (see _free_intrinsics)."""
     progress = progress or NullProgress()
     images = _index_images(rec)
-    cameras, cam_free, refined = _free_intrinsics(rec, images, groups, min_intrinsics_images, warn)
+    cameras, cam_free, refined, priors, fixed = _free_intrinsics(rec, images, groups, min_intrinsics_images, warn,
+                                                                 intrinsics)
+    if fixed:
+        progress.info(f"camera(s) {', '.join(str(c) for c in fixed)}: calibrated interior orientation fixed, not "
+                      f"refined{' (whatever refine_intrinsics says)' if groups else ''}")
+    if priors:
+        progress.info(f"camera(s) {', '.join(str(images.camera_ids[k]) for k in priors)}: interior orientation "
+                      "refined with priors at the calibration's values (weighted by its sigmas)")
     tracks, tie_ids, xyz, rows = _tie_points(rec, images, max_observations, tie_pixel_sigma)
     n_tie, n_tie_obs = len(xyz), len(rows.img)
     total_obs = sum(len(v) for v in tracks.values())
@@ -674,13 +740,15 @@ def build_problem(rec, lookup, ba_points, tri, cam_pos, offset, model_to_local, 
     prob = BundleProblem(np.asarray(images.frames_r).reshape(-1, 3, 3), np.asarray(images.frames_c).reshape(-1, 3),
                          images.img_frame, images.img_cam, np.asarray(images.img_rs).reshape(-1, 3, 3),
                          np.asarray(images.img_ts).reshape(-1, 3), cameras, cam_free, np.asarray(xyz).reshape(-1, 3),
-                         obs, prior, prior_s, cp_img, cp_xyz, cp_sig, huber_px, focal_prior=focal_prior)
+                         obs, prior, prior_s, cp_img, cp_xyz, cp_sig, huber_px, focal_prior=focal_prior,
+                         intrinsic_priors=priors)
     prob.cam_pos_images = [cp.image for cp, _ in cam_pos]
     info = {"images": len(images.reg_ids), "frames": len(images.frame_ids), "cameras": len(images.camera_ids),
             "tie_points_total": len(tracks), "tie_observations_total": total_obs,
             "tie_points_adjusted": n_tie, "tie_observations_adjusted": n_tie_obs,
             "control_points_adjusted": len(ba_points), "camera_priors": len(cam_pos),
-            "subsampled": n_tie < len(tracks), "refined_cameras": refined,
+            "subsampled": n_tie < len(tracks), "refined_cameras": refined, "fixed_cameras": fixed,
+            "prior_cameras": [images.camera_ids[k] for k in priors],
             "_frame_ids": images.frame_ids, "_camera_ids": images.camera_ids}
     if n_tie < len(tracks):
         progress.info(f"adjusting {n_tie} of {len(tracks)} tie points ({n_tie_obs} of {total_obs} "

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Any, Optional, Tuple
+from typing import Any, Dict, Optional, Tuple
 
 INTRINSIC_GROUPS = ("focal", "principal_point", "extra")
 
@@ -11,6 +11,12 @@ EXIF_SIGMA_XY = 3.0  # m: consumer GNSS in EXIF, the a priori sigmas of EXIF GPS
 EXIF_SIGMA_Z = 5.0
 FILE_POSITION_SIGMAS = (5.0, 10.0)  # m: a positions file's sigmas when the workspace did not save them
 PLACEHOLDER_SIGMA_Z = 1.0  # m: sigma Z of control points whose heights are all the same placeholder
+# a camera the alignment recorded as "refined" (a calibration given with its sigmas, core.align.calibrated) is refined
+# with a prior on each parameter at its given value; where the calibration gives no sigma for a parameter:
+REFINED_FOCAL_SIGMA = 0.01  # relative to the focal length (1 %)
+REFINED_PP_SIGMA = 0.005  # relative to the image's long side (0.5 %: 5 px on a 1000 px photo)
+REFINED_RADIAL_SIGMA = 0.02  # k1, k2, k3 ... (normalised image coordinates)
+REFINED_TANGENTIAL_SIGMA = 0.002  # p1, p2
 
 
 @dataclass
@@ -21,7 +27,12 @@ class GeorefOptions:
     ("focal", "principal_point", "extra").  ``outlier_threshold``: pixels; ``outlier_sigma``: normalised
     coordinate residual; ``helmert_threshold``: metres (None: from the point spread and sigmas).
     ``focal_prior``: where the focal length is refined, the standard deviation of a prior on it at the
-    alignment's value, relative to that value (0.01: 1 %; 0: none)."""
+    alignment's value, relative to that value (0.01: 1 %; 0: none).
+    ``camera_intrinsics``: camera id -> what the alignment recorded of its interior orientation
+    (core.project.layout.Layout.camera_intrinsics; None: read from the workspace by the stage, {}: none): a
+    ``fixed`` camera is never refined, whatever ``refine_intrinsics`` says; a ``refined`` one is refined (every
+    parameter) with priors at its given values weighted by its given sigmas (REFINED_*_SIGMA where the
+    calibration gives none); an ``estimated`` one follows ``refine_intrinsics`` and ``focal_prior``."""
 
     refine_intrinsics: Any = False
     outlier_threshold: float = 5.0
@@ -39,6 +50,7 @@ class GeorefOptions:
     copy_model: bool = True
     placeholder_sigma_z: float = PLACEHOLDER_SIGMA_Z
     focal_prior: float = 0.01
+    camera_intrinsics: Optional[Dict[int, Dict[str, Any]]] = None
 
     @classmethod
     def of(cls, options: Optional["GeorefOptions"] = None, **kwargs: Any) -> "GeorefOptions":
@@ -69,4 +81,5 @@ class GeorefOptions:
 
 
 __all__ = ["EXIF_SIGMA_XY", "EXIF_SIGMA_Z", "FILE_POSITION_SIGMAS", "GeorefOptions", "INTRINSIC_GROUPS",
-           "PLACEHOLDER_SIGMA_Z"]
+           "PLACEHOLDER_SIGMA_Z", "REFINED_FOCAL_SIGMA", "REFINED_PP_SIGMA", "REFINED_RADIAL_SIGMA",
+           "REFINED_TANGENTIAL_SIGMA"]

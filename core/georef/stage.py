@@ -188,6 +188,8 @@ def georeference_workspace(workspace_dir: str, gcp_path: Optional[str] = None,
         params["gcps_upright"] = True
     inputs = {k: file_fingerprint(v) for k, v in (("gcps", gcp_path), ("positions", camera_positions_path)) if v}
     opt = GeorefOptions.of(options, refine_intrinsics=refine_intrinsics, crs=target)
+    if opt.camera_intrinsics is None:  # the alignment's calibrated cameras: fixed ones stay, refined ones get priors
+        opt = dataclasses.replace(opt, camera_intrinsics=lay.camera_intrinsics())
     with run_stage(ws, GEOREF, params, inputs) as run:
         with run.step("adjustment", save=False):
             try:
@@ -242,7 +244,8 @@ def adjustment_inputs(gcps: Optional[gcpmod.GCPSet], cams: Sequence[gcpmod.Camer
             "gcps": gcps.to_dict() if gcps is not None else None,
             "camera_positions": [dataclasses.asdict(c) for c in cams],
             "camera_positions_source": source,
-            "refine_intrinsics": opt.refine_intrinsics}
+            "refine_intrinsics": opt.refine_intrinsics,
+            "intrinsics_modes": {str(cid): r.get("mode") for cid, r in (opt.camera_intrinsics or {}).items()}}
 
 
 def _figures(result: GeorefResult) -> Dict[str, Optional[float]]:

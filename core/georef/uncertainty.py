@@ -584,8 +584,12 @@ def workspace_inputs(ws, rec) -> Tuple[List[ControlInput], List[CameraPrior], Di
     priors = _camera_priors(residuals, _camera_sigmas(inputs, params), offset)
     if refine == "all" or (isinstance(refine, (list, tuple)) and "principal_point" in refine):
         pp = True
-    # intrinsics that stayed at their alignment values still get their precision in this block
+    # intrinsics that stayed at their alignment values still get their precision in this block; a calibration
+    # held fixed (core.align.calibrated) has none to get
     free = default_free_intrinsics(rec, pp)
+    for cid, record in lay.camera_intrinsics().items():
+        if record.get("mode") == "fixed" and cid in free:
+            free[cid] = []
     return control, priors, free, offset
 
 

@@ -8,6 +8,7 @@ import numpy as np
 
 from ...common.progress import check_cancel
 from ...georef import accuracy
+from ...georef.bundle import given_priors
 from ..context import ReportContext, Skip
 from ..figures import embed, equal_xy, new_figure, nice
 from ..html import badge, cell, esc, fmt, kv, num, table, td
@@ -88,9 +89,55 @@ def section(ctx: ReportContext) -> str:
         ctx.glance.append(badge("warn", f"{len(bad)} image(s) with more than twice the median reprojection "
                                           f"error: {esc(', '.join(bad[:6]))}{' …' if len(bad) > 6 else ''}"))
     check_cancel(ctx.progress)
+    parts.append(interior_orientation(ctx))
     parts.append(_connectivity(ctx))
     parts.append(_camera_plot(ctx))
     return "".join(parts)
+
+
+# a refined parameter further than this many sigmas from its given value is named in a warning
+MOVED_SIGMAS = 3.0
+
+
+def interior_orientation(ctx: ReportContext) -> str:
+    """Per camera with a given calibration (sfm/alignment.json ``intrinsics``): what was held; for a refined camera
+    how far each parameter moved from its given value, in its sigma (the prior the georeference used), with a
+    warning beyond MOVED_SIGMAS; for a fixed one whether it kept its values."""
+    d = ctx.d
+    records = d.layout.camera_intrinsics()
+    given = {cid: r for cid, r in records.items() if r.get("given")}
+    if not given:
+        return ""
+    rows, far = [], []
+    for cid, r in sorted(given.items()):
+        cam = d.rec.cameras[cid] if cid in d.rec.cameras else None
+        if cam is None:
+            continue
+        names = [n.strip() for n in cam.params_info.split(",")]
+        sigma = {names[i]: s for i, _, s in given_priors(cam, r)}
+        for name, value in zip(names, cam.params):
+            g = num(r["given"].get(name))
+            moved = None if g is None else float(value) - g
+            in_sigma = None if moved is None or r["mode"] != "refined" else moved / sigma[name]
+            if in_sigma is not None and abs(in_sigma) > MOVED_SIGMAS:
+                far.append(f"camera {cid} {name} {in_sigma:+.1f} σ")
+            if r["mode"] == "fixed" and moved:
+                far.append(f"camera {cid} {name} moved {moved:+.3g} although fixed")
+            rows.append([td(cid), td(r["mode"]), td(name), cell(g, 6), cell(sigma[name] if r["mode"] == "refined"
+                                                                             else None, 6),
+                         cell(value, 6), cell(moved, 6), cell(in_sigma, 2)])
+    modes = ", ".join(f"camera {cid}: {r['mode']} ({esc(os.path.basename(str(r.get('source') or '')))})"
+                      for cid, r in sorted(given.items()))
+    if far:
+        ctx.warnings.append("interior orientation moved beyond its given sigmas: " + "; ".join(far))
+        ctx.glance.append(badge("warn", esc("calibration moved beyond " + f"{MOVED_SIGMAS:g} σ: " + "; ".join(far))))
+    return ("<h3>Interior orientation</h3>"
+            + f'<p data-key="intrinsics.modes">Given calibrations: {modes}. Fixed: held at the given values through '
+            "the alignment and the georeference; refined: refined in the georeference with priors at the given "
+            "values (σ from the calibration, else the defaults of core.georef.options).</p>"
+            + (f'<p class="warn" data-key="intrinsics.warning">Moved beyond {MOVED_SIGMAS:g} σ: '
+               f'{esc("; ".join(far))}</p>' if far else "")
+            + table(["camera", "mode", "parameter", "given", "σ", "final", "moved", "moved (σ)"], rows))
 
 
 def _connectivity(ctx: ReportContext) -> str:
