@@ -204,6 +204,8 @@ Pair selection: &apos;auto&apos; uses EXIF GPS neighbours when the images carry 
 Camera model: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
 Matching image size: the longest side the images are scaled to for the features (0 = automatic: photos of up to 2 megapixels as they are, larger ones scaled to 2 megapixels; the DSM and the orthophotos use every pixel). Features per image: 0 = automatic (about 4000 per megapixel, 2048 to 4096). Affine-invariant features help with oblique views and are slower.
 Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).
+Camera calibration file: a calibrated camera&apos;s interior orientation (ArchaeoOrtho&apos;s YAML/JSON, Orthority interior parameters, OpenCV, COLMAP cameras.txt or Metashape XML); several cameras are matched to the photos by their image patterns, camera model or image size; a photo of another resolution takes it scaled. A file that cannot be read stops the run before any work, naming the file, the line and the field.
+Interior orientation: what the adjustments may change of a camera: &apos;fixed&apos; keeps the given values through the alignment and the georeference (also with automatic control), &apos;refined&apos; lets the georeference refine them with the calibration&apos;s standard deviations as priors, &apos;estimated&apos; self-calibrates from them. &apos;auto&apos; is &apos;fixed&apos; where a calibration is given (the file, or film scans restituted by Prepare images) and &apos;estimated&apos; elsewhere; a camera&apos;s own &apos;adjust&apos; in the file overrides it. With &apos;fixed&apos; or &apos;refined&apos; and no file, the focal length and sensor width are the given values. The log, sfm/alignment.json and the accuracy report say per camera what was held.
 Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).
 Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
         <translation>Structure from Motion: SIFT-Merkmale, Paarauswahl, robuste Zuordnung (RANSAC), inkrementelle Rekonstruktion mit Selbstkalibrierung (Brennweite, Bildhauptpunkt, Objektivverzeichnung) und eine abschließende Bündelblockausgleichung. Das Ergebnis wird im Arbeitsbereich-Ordner gespeichert, den die folgenden Schritte (Georeferenzieren, DOM erzeugen, Orthophoto erzeugen) als Eingabe nehmen. Ein erneuter Lauf setzt fort: bereits berechnete Merkmale und Zuordnungen werden wiederverwendet.
@@ -212,8 +214,22 @@ Paarauswahl: &apos;auto&apos; nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS trage
 Kameramodell: &apos;AUTO&apos; schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
 Bildgröße für die Zuordnung: die längste Seite, auf die die Bilder für die Merkmale verkleinert werden (0 = automatisch: Fotos bis 2 Megapixel unverändert, größere auf 2 Megapixel verkleinert; DOM und Orthophotos nutzen jedes Pixel). Merkmale je Bild: 0 = automatisch (etwa 4000 je Megapixel, 2048 bis 4096). Affin-invariante Merkmale helfen bei Schrägaufnahmen und sind langsamer.
 Brennweite und Sensorbreite: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern (0 = aus EXIF / unbekannt).
+Kamerakalibrierungsdatei: die innere Orientierung einer kalibrierten Kamera (YAML/JSON von ArchaeoOrtho, innere Parameter von Orthority, OpenCV, COLMAP cameras.txt oder Metashape-XML); mehrere Kameras werden den Fotos über ihre Bildmuster, das Kameramodell oder die Bildgröße zugeordnet; ein Foto anderer Auflösung erhält sie skaliert. Eine Datei, die sich nicht lesen lässt, beendet den Lauf vor jeder Arbeit und nennt Datei, Zeile und Feld.
+Innere Orientierung: was die Ausgleichungen an einer Kamera ändern dürfen: &apos;fixed&apos; hält die gegebenen Werte durch Ausrichtung und Georeferenzierung (auch mit automatischen Passpunkten), &apos;refined&apos; lässt die Georeferenzierung sie mit den Standardabweichungen der Kalibrierung als Vorinformation verbessern, &apos;estimated&apos; kalibriert ausgehend von ihnen selbst. &apos;auto&apos; ist &apos;fixed&apos;, wo eine Kalibrierung gegeben ist (die Datei oder von &apos;Bilder vorbereiten&apos; entzerrte Filmscans), sonst &apos;estimated&apos;; ein eigenes &apos;adjust&apos; einer Kamera in der Datei geht vor. Mit &apos;fixed&apos; oder &apos;refined&apos; und ohne Datei sind Brennweite und Sensorbreite die gegebenen Werte. Protokoll, sfm/alignment.json und der Genauigkeitsbericht sagen je Kamera, was gehalten wurde.
 Rekonstruktionsverfahren (erweitert): &apos;incremental&apos; (COLMAP, Standard) oder &apos;global&apos; (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).
 Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen Einstellungen auslassen, oder ein in Teile zerfallener Block werden mit reicheren Merkmalen (schwächeren für kontrastarme Bilder, affinen für steile Schrägaufnahmen) und mehr Paaren erneut versucht; das Protokoll und sfm/alignment.json sagen, was erneut versucht wurde und warum.</translation>
+    </message>
+    <message>
+        <source>Camera calibration file</source>
+        <translation>Kamerakalibrierungsdatei</translation>
+    </message>
+    <message>
+        <source>Interior orientation</source>
+        <translation>Innere Orientierung</translation>
+    </message>
+    <message>
+        <source>Camera {}: interior orientation {} ({})</source>
+        <translation>Kamera {}: innere Orientierung {} ({})</translation>
     </message>
 </context>
 <context>
@@ -2610,6 +2626,7 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
 
 Folder of images: the photos. Workspace folder: where every product is written.
 Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in &apos;Georeference&apos; (the pixel coordinates measured on the photos shown upright by their EXIF orientation).
+Camera calibration file and Interior orientation (advanced): as in &apos;Align images&apos; (a calibrated camera held fixed through the whole chain, or refined with its standard deviations).
 Sky masks (oblique photos): first a &apos;Prepare images&apos; stage finds the sky and the horizon haze in each photo and masks them, so that no tie point or DSM point comes from the sky; the prepared photos are aligned (off by default: photos looking straight down need none).
 Build the DTM: after the DSM, a bare-earth DTM (as &apos;Build DTM&apos;). Contour interval (advanced): contour lines of the DTM at this interval (as &apos;Contours&apos;; 0 = none). Relief visualisations (advanced): those chosen are computed from the DTM (as &apos;Relief visualisation&apos;). Both need the DTM.
 The other parameters are those of the single stages (see their help); 0 means automatic.
@@ -2618,10 +2635,19 @@ Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key f
 
 Bilderordner: die Fotos. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben werden.
 Die Georeferenzierung braucht Passpunkte (eine Passpunktdatei oder ein Passpunktlayer, Kontrollpunkte werden zurückgehalten) und/oder Kamerapositionen (eine CSV-Datei der Kamerapositionen oder EXIF-GPS-Positionen verwenden): ohne sie wird die Verarbeitung abgelehnt, da ein DOM einen metrischen Maßstab und eine Lotrichtung braucht. GCP-Pixel auf aufrechten Fotos gemessen: wie bei 'Georeferenzieren' (die Pixelkoordinaten auf den Fotos gemessen, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden).
+Kamerakalibrierungsdatei und Innere Orientierung (erweitert): wie in &apos;Bilder ausrichten&apos; (eine kalibrierte Kamera durch die ganze Kette festgehalten oder mit ihren Standardabweichungen verbessert).
 Himmelsmasken (Schrägaufnahmen): zuerst findet eine Stufe 'Bilder vorbereiten' den Himmel und den Dunst am Horizont in jedem Foto und maskiert sie, damit kein Verknüpfungs- oder DOM-Punkt aus dem Himmel stammt; die vorbereiteten Fotos werden ausgerichtet (standardmäßig aus: senkrecht aufgenommene Fotos brauchen keine).
 Das DGM erzeugen: nach dem DOM ein DGM der nackten Erde (wie 'DGM erzeugen'). Höhenlinienabstand (erweitert): Höhenlinien des DGM in diesem Abstand (wie 'Höhenlinien'; 0 = keine). Reliefvisualisierungen (erweitert): die gewählten werden aus dem DGM berechnet (wie 'Reliefvisualisierung'). Beide brauchen das DGM.
 Die übrigen Parameter sind die der einzelnen Stufen (siehe deren Hilfe); 0 bedeutet automatisch.
 Ausgaben: das DOM, das Orthomosaik und der Genauigkeitsbericht (HTML) sowie die wichtigsten Kennzahlen.</translation>
+    </message>
+    <message>
+        <source>Camera calibration file</source>
+        <translation>Kamerakalibrierungsdatei</translation>
+    </message>
+    <message>
+        <source>Interior orientation</source>
+        <translation>Innere Orientierung</translation>
     </message>
 </context>
 </TS>

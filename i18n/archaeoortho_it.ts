@@ -204,6 +204,8 @@ Pair selection: &apos;auto&apos; uses EXIF GPS neighbours when the images carry 
 Camera model: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
 Matching image size: the longest side the images are scaled to for the features (0 = automatic: photos of up to 2 megapixels as they are, larger ones scaled to 2 megapixels; the DSM and the orthophotos use every pixel). Features per image: 0 = automatic (about 4000 per megapixel, 2048 to 4096). Affine-invariant features help with oblique views and are slower.
 Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).
+Camera calibration file: a calibrated camera&apos;s interior orientation (ArchaeoOrtho&apos;s YAML/JSON, Orthority interior parameters, OpenCV, COLMAP cameras.txt or Metashape XML); several cameras are matched to the photos by their image patterns, camera model or image size; a photo of another resolution takes it scaled. A file that cannot be read stops the run before any work, naming the file, the line and the field.
+Interior orientation: what the adjustments may change of a camera: &apos;fixed&apos; keeps the given values through the alignment and the georeference (also with automatic control), &apos;refined&apos; lets the georeference refine them with the calibration&apos;s standard deviations as priors, &apos;estimated&apos; self-calibrates from them. &apos;auto&apos; is &apos;fixed&apos; where a calibration is given (the file, or film scans restituted by Prepare images) and &apos;estimated&apos; elsewhere; a camera&apos;s own &apos;adjust&apos; in the file overrides it. With &apos;fixed&apos; or &apos;refined&apos; and no file, the focal length and sensor width are the given values. The log, sfm/alignment.json and the accuracy report say per camera what was held.
 Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).
 Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
         <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell&apos;obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella dell&apos;area di lavoro, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
@@ -212,8 +214,22 @@ Selezione delle coppie: &apos;auto&apos; usa i vicini secondo il GPS EXIF quando
 Modello di camera: &apos;AUTO&apos; stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
 Dimensione per la corrispondenza: il lato maggiore a cui le immagini sono ridotte per le feature (0 = automatico: foto fino a 2 megapixel così come sono, quelle più grandi ridotte a 2 megapixel; il DSM e le ortofoto usano ogni pixel). Feature per immagine: 0 = automatico (circa 4000 per megapixel, da 2048 a 4096). Le feature invarianti affini aiutano con le prese oblique e sono più lente.
 Focale e Larghezza del sensore: orientamento interno quando manca l&apos;EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri (0 = dall&apos;EXIF / sconosciuta).
+File di calibrazione della camera: l&apos;orientamento interno di una camera calibrata (YAML/JSON di ArchaeoOrtho, parametri interni di Orthority, OpenCV, COLMAP cameras.txt o XML di Metashape); più camere sono assegnate alle foto secondo i loro modelli di nome, il modello della camera o la dimensione dell&apos;immagine; una foto di altra risoluzione la riceve scalata. Un file che non si può leggere ferma l&apos;elaborazione prima di ogni lavoro, indicando file, riga e campo.
+Orientamento interno: cosa le compensazioni possono cambiare di una camera: &apos;fixed&apos; mantiene i valori dati attraverso l&apos;allineamento e la georeferenziazione (anche con il controllo automatico), &apos;refined&apos; lascia che la georeferenziazione li affini con le deviazioni standard della calibrazione come informazione a priori, &apos;estimated&apos; si autocalibra a partire da essi. &apos;auto&apos; è &apos;fixed&apos; dove è data una calibrazione (il file, o scansioni di pellicola raddrizzate da &apos;Prepara immagini&apos;) e &apos;estimated&apos; altrove; un &apos;adjust&apos; proprio di una camera nel file ha la precedenza. Con &apos;fixed&apos; o &apos;refined&apos; e senza file, la lunghezza focale e la larghezza del sensore sono i valori dati. Il registro, sfm/alignment.json e il rapporto di accuratezza dicono per ogni camera cosa è stato mantenuto.
 Metodo di ricostruzione (avanzato): &apos;incremental&apos; (COLMAP, predefinito) o &apos;global&apos; (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).
 Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni rapide escludono, o un blocco diviso in parti, vengono riprovate con caratteristiche più ricche (più deboli per fotogrammi a basso contrasto, affini per oblique ripide) e più coppie; il registro e sfm/alignment.json dicono cosa è stato riprovato e perché.</translation>
+    </message>
+    <message>
+        <source>Camera calibration file</source>
+        <translation>File di calibrazione della camera</translation>
+    </message>
+    <message>
+        <source>Interior orientation</source>
+        <translation>Orientamento interno</translation>
+    </message>
+    <message>
+        <source>Camera {}: interior orientation {} ({})</source>
+        <translation>Camera {}: orientamento interno {} ({})</translation>
     </message>
 </context>
 <context>
@@ -2610,6 +2626,7 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
 
 Folder of images: the photos. Workspace folder: where every product is written.
 Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in &apos;Georeference&apos; (the pixel coordinates measured on the photos shown upright by their EXIF orientation).
+Camera calibration file and Interior orientation (advanced): as in &apos;Align images&apos; (a calibrated camera held fixed through the whole chain, or refined with its standard deviations).
 Sky masks (oblique photos): first a &apos;Prepare images&apos; stage finds the sky and the horizon haze in each photo and masks them, so that no tie point or DSM point comes from the sky; the prepared photos are aligned (off by default: photos looking straight down need none).
 Build the DTM: after the DSM, a bare-earth DTM (as &apos;Build DTM&apos;). Contour interval (advanced): contour lines of the DTM at this interval (as &apos;Contours&apos;; 0 = none). Relief visualisations (advanced): those chosen are computed from the DTM (as &apos;Relief visualisation&apos;). Both need the DTM.
 The other parameters are those of the single stages (see their help); 0 means automatic.
@@ -2618,10 +2635,19 @@ Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key f
 
 Cartella delle immagini: le foto. Cartella dell'area di lavoro: dove sono scritti tutti i prodotti.
 La georeferenziazione richiede punti di appoggio (un file o un layer dei punti d'appoggio, punti di controllo esclusi) e/o posizioni delle camere (un CSV delle posizioni delle camere o Usa le posizioni GPS EXIF): senza di essi l'elaborazione viene rifiutata, perché un DSM richiede una scala metrica e una direzione verticale. Pixel dei GCP misurati sulle foto raddrizzate: come in 'Georeferenzia' (le coordinate pixel misurate sulle foto mostrate diritte secondo il loro orientamento EXIF).
+File di calibrazione della camera e Orientamento interno (avanzato): come in &apos;Allinea immagini&apos; (una camera calibrata mantenuta fissa per tutta la catena, o affinata con le sue deviazioni standard).
 Maschere del cielo (foto oblique): prima una fase 'Prepara immagini' trova il cielo e la foschia all'orizzonte in ogni foto e li maschera, perché nessun punto di legame o del DSM provenga dal cielo; si allineano le foto preparate (disattivato per impostazione predefinita: le foto nadirali non ne hanno bisogno).
 Genera il DTM: dopo il DSM, un DTM del suolo nudo (come 'Genera DTM'). Equidistanza (avanzato): curve di livello del DTM con questa equidistanza (come 'Curve di livello'; 0 = nessuna). Visualizzazioni del rilievo (avanzato): quelle scelte sono calcolate dal DTM (come 'Visualizzazione del rilievo'). Entrambe richiedono il DTM.
 Gli altri parametri sono quelli delle singole fasi (vedi il loro aiuto); 0 significa automatico.
 Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali.</translation>
+    </message>
+    <message>
+        <source>Camera calibration file</source>
+        <translation>File di calibrazione della camera</translation>
+    </message>
+    <message>
+        <source>Interior orientation</source>
+        <translation>Orientamento interno</translation>
     </message>
 </context>
 </TS>

@@ -21,6 +21,8 @@ class AlignImagesAlgorithm(AlgorithmBase):
     SINGLE_CAMERA = "SINGLE_CAMERA"
     MAPPER = "MAPPER"
     ESCALATE = "ESCALATE"
+    CALIBRATION = "CALIBRATION"
+    INTRINSICS = "INTRINSICS"
     CAMERAS = "CAMERAS"
     REGISTERED_IMAGES = "REGISTERED_IMAGES"
     MEAN_REPROJECTION_ERROR = "MEAN_REPROJECTION_ERROR"
@@ -39,6 +41,18 @@ class AlignImagesAlgorithm(AlgorithmBase):
         "Affine-invariant features help with oblique views and are slower.\n"
         "Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal "
         "length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).\n"
+        "Camera calibration file: a calibrated camera's interior orientation (ArchaeoOrtho's YAML/JSON, Orthority "
+        "interior parameters, OpenCV, COLMAP cameras.txt or Metashape XML); several cameras are matched to the "
+        "photos by their image patterns, camera model or image size; a photo of another resolution takes it "
+        "scaled. A file that cannot be read stops the run before any work, naming the file, the line and the "
+        "field.\n"
+        "Interior orientation: what the adjustments may change of a camera: 'fixed' keeps the given values through "
+        "the alignment and the georeference (also with automatic control), 'refined' lets the georeference refine "
+        "them with the calibration's standard deviations as priors, 'estimated' self-calibrates from them. 'auto' "
+        "is 'fixed' where a calibration is given (the file, or film scans restituted by Prepare images) and "
+        "'estimated' elsewhere; a camera's own 'adjust' in the file overrides it. With 'fixed' or 'refined' and no "
+        "file, the focal length and sensor width are the given values. The log, sfm/alignment.json and the "
+        "accuracy report say per camera what was held.\n"
         "Mapper (advanced): 'incremental' (COLMAP, the default) or 'global' (GLOMAP: rotation averaging and "
         "global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).\n"
         "Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are "
@@ -58,6 +72,8 @@ class AlignImagesAlgorithm(AlgorithmBase):
             params.flag(self.AFFINE_FEATURES, self.tr("Affine-invariant features")),
             params.number(self.FOCAL_MM, self.tr("Focal length (mm)")),
             params.number(self.SENSOR_WIDTH_MM, self.tr("Sensor width (mm)")),
+            params.calibration_file(self.CALIBRATION, self.tr("Camera calibration file")),
+            params.intrinsics(self.INTRINSICS, self.tr("Interior orientation")),
             params.flag(self.SINGLE_CAMERA, self.tr("One camera for all images")),
             *params.advanced(params.choice(self.MAPPER, self.tr("Mapper"), MAPPERS),
                              params.flag(self.ESCALATE, self.tr("Retry images left out"), default=True)),
@@ -87,6 +103,8 @@ class AlignImagesAlgorithm(AlgorithmBase):
             sensor_width_mm=sensor_mm or None,
             mapper=params.read_choice(self, parameters, self.MAPPER, context, MAPPERS),
             escalate=self.parameterAsBoolean(parameters, self.ESCALATE, context),
+            calibration=params.read_optional_file(self, parameters, self.CALIBRATION, context),
+            intrinsics=params.read_intrinsics(self, parameters, self.INTRINSICS, context),
         )
         result = self.run_core(align, images, workspace, options, FeedbackProgress(feedback))
         feedback.pushInfo(self.tr("Registered {} of {} images, mean reprojection error {:.3f} px, {} points").format(
@@ -99,6 +117,10 @@ class AlignImagesAlgorithm(AlgorithmBase):
             feedback.pushInfo(self.tr("Images not registered:"))
             for name, why in result.unregistered.items():
                 feedback.pushInfo(f"  {name}: {why}")
+        for cam in result.intrinsics or []:
+            if cam.get("source"):
+                feedback.pushInfo(self.tr("Camera {}: interior orientation {} ({})").format(
+                    cam["camera_id"], cam["mode"], cam["source"]))
         feedback.pushInfo(self.tr("Seconds per step: {}").format(
             ", ".join(f"{k} {v:.1f}" for k, v in result.timings.items())))
         return {

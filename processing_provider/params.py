@@ -24,6 +24,7 @@ from qgis.core import (
 PAIRINGS = ["auto", "exhaustive", "sequential", "spatial"]
 CAMERA_MODELS = ["AUTO", "SIMPLE_RADIAL", "RADIAL", "OPENCV", "FULL_OPENCV"]
 MAPPERS = ["incremental", "global"]
+INTRINSICS = ["auto", "fixed", "refined", "estimated"]  # core.align.options.INTRINSICS
 QUALITIES = ("full", "half", "quarter")
 ENGINES = ("cpu", "cuda")
 BLENDINGS = ("feather", "multiband", "none")
@@ -31,6 +32,7 @@ INTERPOLATIONS = ("bilinear", "cubic", "nearest")
 
 GCP_FILE_FILTER = "GCP files (*.txt *.csv);;All files (*)"
 CSV_FILE_FILTER = "CSV/text (*.csv *.txt);;All files (*)"
+CALIBRATION_FILE_FILTER = "Camera calibrations (*.yaml *.yml *.json *.xml *.txt);;All files (*)"
 GCP_LAYER_FIELDS = ("name", "image", "px", "py")
 
 
@@ -93,6 +95,28 @@ def camera_model(name, label):
 
 def max_image_size(name, label):
     return integer(name, label)
+
+
+def calibration_file(name, label):
+    """A camera calibration file (core.io.calibration reads it), optional."""
+    return QgsProcessingParameterFile(name, label, optional=True, fileFilter=CALIBRATION_FILE_FILTER)
+
+
+def intrinsics(name, label):
+    """What the adjustments may change of the cameras' interior orientation: its values are the words
+    (INTRINSICS=fixed on the command line)."""
+    return QgsProcessingParameterEnum(name, label, options=INTRINSICS, defaultValue=INTRINSICS[0],
+                                      usesStaticStrings=True)
+
+
+def read_intrinsics(alg, parameters, name, context):
+    """The intrinsics choice as given (core.align.options.AlignOptions.check refuses an unknown one)."""
+    value = parameters.get(name)
+    if value is None or value == "":
+        return INTRINSICS[0]
+    if isinstance(value, int) and 0 <= value < len(INTRINSICS):
+        return INTRINSICS[value]
+    return alg.parameterAsEnumString(parameters, name, context) or str(value)
 
 
 # --- ground control --------------------------------------------------------------------------------------

@@ -27,6 +27,8 @@ class RunPipelineAlgorithm(AlgorithmBase):
     PAIRING = "PAIRING"
     CAMERA_MODEL = "CAMERA_MODEL"
     MAX_IMAGE_SIZE = "MAX_IMAGE_SIZE"
+    CALIBRATION = "CALIBRATION"
+    INTRINSICS = "INTRINSICS"
     REFINE_INTRINSICS = "REFINE_INTRINSICS"
     DSM_RESOLUTION = "DSM_RESOLUTION"
     QUALITY = "QUALITY"
@@ -57,6 +59,8 @@ class RunPipelineAlgorithm(AlgorithmBase):
         "positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a "
         "DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in "
         "'Georeference' (the pixel coordinates measured on the photos shown upright by their EXIF orientation).\n"
+        "Camera calibration file and Interior orientation (advanced): as in 'Align images' (a calibrated camera "
+        "held fixed through the whole chain, or refined with its standard deviations).\n"
         "Sky masks (oblique photos): first a 'Prepare images' stage finds the sky and the horizon haze in each "
         "photo and masks them, so that no tie point or DSM point comes from the sky; the prepared photos are "
         "aligned (off by default: photos looking straight down need none).\n"
@@ -91,6 +95,8 @@ class RunPipelineAlgorithm(AlgorithmBase):
             params.flag(self.REPORT_ENABLED, self.tr("Write the accuracy report"), default=True),
             params.flag(self.DTM_ENABLED, self.tr("Build the DTM"), default=True),
             *params.advanced(
+                params.calibration_file(self.CALIBRATION, self.tr("Camera calibration file")),
+                params.intrinsics(self.INTRINSICS, self.tr("Interior orientation")),
                 params.workers(self.WORKERS, self.tr("Parallel workers")),
                 params.scheduler(self.SCHEDULER, self.tr("Dask scheduler")),
                 params.number(self.CONTOUR_INTERVAL, self.tr("Contour interval (m, 0 = none)")),
@@ -133,7 +139,9 @@ class RunPipelineAlgorithm(AlgorithmBase):
                 align=AlignOptions(
                     pairing=params.read_choice(self, p, self.PAIRING, context, PAIRINGS),
                     camera_model=params.read_choice(self, p, self.CAMERA_MODEL, context, CAMERA_MODELS),
-                    max_image_size=self.parameterAsInt(p, self.MAX_IMAGE_SIZE, context)),
+                    max_image_size=self.parameterAsInt(p, self.MAX_IMAGE_SIZE, context),
+                    calibration=params.read_optional_file(self, p, self.CALIBRATION, context),
+                    intrinsics=params.read_intrinsics(self, p, self.INTRINSICS, context)),
                 georef=GeorefOptions(refine_intrinsics=self.parameterAsBoolean(p, self.REFINE_INTRINSICS, context)),
                 dsm_resolution=self.parameterAsDouble(p, self.DSM_RESOLUTION, context),
                 dsm_quality=params.read_choice(self, p, self.QUALITY, context, QUALITIES),

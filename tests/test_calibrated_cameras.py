@@ -1,0 +1,329 @@
+"""Calibrated cameras (issue 32, item 1): a given interior orientation is held fixed, refined with priors or
+estimated, through the alignment, the georeference and the report (core.align.calibrated).
+
+End to end on a small rendered vertical block (2 strips x 5 photos of 800 x 600 px, tests/synthetic.py's camera:
+650 px, OPENCV distortion), the photos cached under build/test-cache.  Measured on this block (5 control points,
+camera centres against the truth after the georeference; docs/measurements.md has the table): fixed at the true
+calibration the focal length stays 650.000 px and the centres are off by 0.050 m XY / 0.016 m Z RMS; estimated
+from the same start it drifts to 651.41 px (+0.22 %) and the centres by 0.157 / 0.097 m (0.097 / 0.070 with
+refine_intrinsics); self-calibrated without any calibration 652.24 px (+0.35 %), 0.165 / 0.156 m.
+"""
+import json
+import os
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from core.align.calibrated import plan_cameras, scan_interior
+from core.align.options import AlignError, AlignOptions
+from core.align.stage import align, load_model
+from core.common.errors import ArchaeoOrthoError
+from core.common.progress import NullProgress
+from core.georef.adjust import georeference
+from core.georef.stage import georeference_workspace, load_georef_model
+from core.io.gcp import CHECK
+from core.io.images import CameraGroup, ImageInfo
+from core.project.layout import Layout
+from core.project.workspace import Workspace
+from core.report.sections.orientation import interior_orientation
+from tests import synthetic as syn
+from tests.workspaces import rendered_once
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+CACHE = os.path.join(ROOT, "build", "test-cache", "calibrated-v1")
+NAMES = ["fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2"]
+
+
+class _Log(NullProgress):
+    def __init__(self):
+        super().__init__()
+        self.lines = []
+
+    def info(self, message):
+        self.lines.append(message)
+
+    def warning(self, message):
+        self.lines.append(message)
+
+
+@pytest.fixture(scope="module")
+def block():
+    return syn.vertical_block(seed=1, n_strips=2, per_strip=5)
+
+
+@pytest.fixture(scope="module")
+def images(block):
+    return rendered_once(block, CACHE)
+
+
+def write_calibration(path, cam, focal=None, **extra):
+    """ArchaeoOrtho's own calibration format (JSON) of a tests/synthetic.py CameraModel."""
+    doc = {"name": "synthetic", "image_size_px": [cam.width, cam.height], "focal_length_px": focal or cam.fx,
+           "principal_point_px": [cam.cx, cam.cy], "k1": cam.k1, "k2": cam.k2, "p1": cam.p1, "p2": cam.p2}
+    doc.update(extra)
+    with open(path, "w") as f:
+        json.dump(doc, f)
+    return str(path)
+
+
+def _options(**kw):
+    return AlignOptions(num_threads=2, pairing="exhaustive", **kw)
+
+
+def _centre_errors(block, ws):
+    rec, transform = load_georef_model(ws)
+    offset = np.asarray(transform["offset"], dtype=float)
+    return np.array([np.asarray(im.projection_center()) + offset - (block.shot(im.name).centre + syn.ORIGIN)
+                     for im in rec.images.values() if im.has_pose])
+
+
+@pytest.fixture(scope="module")
+def fixed_ws(block, images, tmp_path_factory):
+    root = tmp_path_factory.mktemp("calibrated")
+    cal = write_calibration(root / "camera.json", block.camera)
+    log = _Log()
+    result = align(images, str(root / "ws"), _options(calibration=cal), log)
+    return str(root / "ws"), cal, result, log
+
+
+def test_a_fixed_calibration_is_held_through_alignment_and_georeference(block, fixed_ws):
+    ws, cal, result, log = fixed_ws
+    assert result.registered == len(block.shots)
+    (cam,) = load_model(ws).cameras.values()
+    assert cam.model.name == "OPENCV"
+    assert np.max(np.abs(np.asarray(cam.params) - block.camera.params)) <= 1e-9
+    # the record: mode, source, given values, final values; and the log names the camera's calibration
+    (record,) = Layout(Workspace.open(ws)).camera_intrinsics().values()
+    assert record["mode"] == "fixed" and record["source"] == cal and record["matched_by"] == "the only calibration"
+    assert record["given"]["fx"] == block.camera.fx and record["final"]["fx"] == block.camera.fx
+    assert any("interior orientation fixed, OPENCV from" in ln for ln in log.lines), log.lines
+    # the georeference asked to refine everything keeps it, and says so once
+    gcps = block.gcp_set(block.spread_control(5), noise_px=0.4)
+    glog = _Log()
+    res = georeference_workspace(ws, gcps=gcps, crs=syn.CRS, refine_intrinsics="all", progress=glog)
+    rec, _ = load_georef_model(ws)
+    (cam,) = rec.cameras.values()
+    assert np.max(np.abs(np.asarray(cam.params) - block.camera.params)) <= 1e-9
+    assert len([ln for ln in glog.lines if "calibrated interior orientation fixed" in ln]) == 1, glog.lines
+    err = _centre_errors(block, ws)
+    rmse_xy, rmse_z = float(np.sqrt(np.mean(np.sum(err[:, :2] ** 2, axis=1)))), float(np.sqrt(np.mean(err[:, 2] ** 2)))
+    print(f"\n[fixed] focal {cam.params[0]:.6f} px; camera centres RMSE XY {rmse_xy:.3f} m Z {rmse_z:.3f} m; "
+          f"check XY {res.figures['CHECK_RMSE_XY']:.3f} Z {res.figures['CHECK_RMSE_Z']:.3f} m")
+    assert rmse_xy <= 1.0 * block.gsd and rmse_z <= 1.0 * block.gsd  # measured 0.050 / 0.016 m, GSD 0.077 m
+    # the report's table: fixed, nothing moved
+    ctx = SimpleNamespace(d=SimpleNamespace(layout=Layout(Workspace.open(ws)), rec=rec), warnings=[], glance=[])
+    html = interior_orientation(ctx)
+    assert "camera 1: fixed" in html and not ctx.warnings
+
+
+def test_a_wrong_start_value_moves_when_estimated(block, images, tmp_path):
+    """The same block from a calibration 8 % off, intrinsics estimated: the self-calibration moves the focal
+    length back towards the truth (this is what a fixed camera must not do, so the test above can fail)."""
+    given = block.camera.fx * 1.08
+    cal = write_calibration(tmp_path / "wrong.json", block.camera, focal=given)
+    align(images, str(tmp_path / "ws"), _options(calibration=cal, intrinsics="estimated"))
+    (cam,) = load_model(str(tmp_path / "ws")).cameras.values()
+    print(f"\n[estimated from {given:.1f} px] focal after alignment {cam.params[0]:.3f} px (truth {block.camera.fx})")
+    assert abs(cam.params[0] - given) > 0.5 * (given - block.camera.fx)
+    assert abs(cam.params[0] - block.camera.fx) < 0.01 * block.camera.fx
+    (record,) = Layout(Workspace.open(str(tmp_path / "ws"))).camera_intrinsics().values()
+    assert record["mode"] == "estimated" and record["given"]["fx"] == pytest.approx(given)
+
+
+def _refined_record(cam, sigmas, **changes):
+    given = dict(zip(NAMES, cam.with_params(**changes).params))
+    return {1: {"camera_id": 1, "mode": "refined", "model": "OPENCV", "given": given, "sigmas": sigmas,
+                "source": "camera.json"}}
+
+
+def test_a_refined_camera_stays_within_its_sigmas_where_the_data_agree(block):
+    rec = block.truth_reconstruction()
+    sigmas = {"fx": 2.0, "fy": 2.0, "cx": 2.0, "cy": 2.0, "k1": 0.005}
+    record = _refined_record(block.camera, sigmas)
+    gcps = block.gcp_set(block.spread_control(5), noise_px=0.4)
+    result = georeference(rec, gcps, camera_intrinsics=record)
+    assert result.statistics["prior_cameras"] == [1]
+    cam = result.reconstruction.cameras[1]
+    moved = {n: (float(v) - record[1]["given"][n]) for n, v in zip(NAMES, cam.params)}
+    print("\n[refined] moved: " + ", ".join(f"{n} {m:+.4g}" for n, m in moved.items()))
+    assert any(abs(m) > 0 for m in moved.values())  # refined, not held
+    for n in ("fx", "fy", "cx", "cy", "k1"):
+        assert abs(moved[n]) < 3 * sigmas[n], (n, moved[n])
+    assert result.rmse(CHECK)["xy"] <= block.gsd
+    # the estimated camera of the same call without a record follows refine_intrinsics (off: held as aligned)
+    plain = georeference(block.truth_reconstruction(), gcps)
+    assert plain.statistics["prior_cameras"] == [] and not plain.refined_intrinsics
+
+
+def test_the_report_warns_when_a_refined_parameter_moved_beyond_three_sigma(block):
+    rec = block.truth_reconstruction(n_points=50)
+    record = _refined_record(block.camera, {"fx": 1.0}, fx=block.camera.fx - 10.0)  # the model's is 10 sigma off
+    layout = SimpleNamespace(camera_intrinsics=lambda: record)
+    ctx = SimpleNamespace(d=SimpleNamespace(layout=layout, rec=rec), warnings=[], glance=[])
+    html = interior_orientation(ctx)
+    assert "+10.0 σ" in ctx.warnings[0] and "camera 1 fx" in ctx.warnings[0]
+    assert "moved (σ)" in html
+    record[1]["given"]["fx"] = block.camera.fx - 2.0  # 2 sigma: no warning
+    ctx.warnings.clear()
+    interior_orientation(ctx)
+    assert not ctx.warnings
+
+
+def test_a_fixed_camera_is_not_refined_whatever_refine_intrinsics_says(block):
+    wrong = block.camera.with_params(fx=block.camera.fx * 1.02, fy=block.camera.fy * 1.02)
+    gcps = block.gcp_set(block.spread_control(5), noise_px=0.4)
+    record = {1: {"camera_id": 1, "mode": "fixed", "model": "OPENCV", "given": dict(zip(NAMES, wrong.params))}}
+    for refine in (True, "all", ("focal",)):
+        result = georeference(block.truth_reconstruction(camera=wrong), gcps, refine_intrinsics=refine,
+                              camera_intrinsics=record)
+        assert list(result.reconstruction.cameras[1].params) == list(wrong.params)
+        assert result.statistics["fixed_cameras"] == [1]
+    moved = georeference(block.truth_reconstruction(camera=wrong), gcps, refine_intrinsics=True)
+    assert moved.reconstruction.cameras[1].params[0] != wrong.params[0]  # without the record it is refined
+
+
+# ------------------------------------------------------------------------------------------------------------
+# which camera takes which calibration
+# ------------------------------------------------------------------------------------------------------------
+
+def _info(name, model="", width=800, height=600, focal_px=None, source="default"):
+    return ImageInfo(name=name, path=name, width=width, height=height, bands=1, dtype="Byte", model=model,
+                     focal_px=focal_px or 0.85 * max(width, height), focal_source=source)
+
+
+def _group(infos, key="g"):
+    im = infos[0]
+    return CameraGroup(camera_id=1, key=key, make="", model=im.model, width=im.width, height=im.height,
+                       focal_px=im.focal_px, focal_source=im.focal_source, images=[i.name for i in infos])
+
+
+def _read(path):
+    from core.io.calibration import read_calibration
+
+    return read_calibration(str(path))
+
+
+def test_several_calibrations_match_by_pattern_model_and_size_and_scale_to_a_scan(tmp_path):
+    import pycolmap
+
+    doc = {"cameras": [
+        {"name": "RC30", "image_size_px": [800, 600], "focal_length_px": 650.0, "images": ["strip1_*"]},
+        {"name": "DMC", "image_size_px": [800, 600], "focal_length_px": 700.0},
+        {"name": "other", "image_size_px": [400, 400], "focal_length_px": 300.0, "adjust": "refined"},
+    ]}
+    path = tmp_path / "cams.json"
+    path.write_text(json.dumps(doc))
+    cals = _read(path)
+    infos = [_info("strip1_01.tif"), _info("strip1_02.tif"), _info("b.jpg", model="DMC"),
+             _info("c.jpg", width=400, height=400), _info("d.jpg", width=1600, height=1600),
+             _info("e.jpg", width=640, height=480)]
+    groups = [_group(infos[:3], "a"), _group(infos[3:4], "c"), _group(infos[4:5], "d"), _group(infos[5:], "e")]
+    log = _Log()
+    out, plan = plan_cameras(pycolmap, groups, infos, cals, {}, AlignOptions(), log)
+    by_image = {n: plan.get(g.key) for g in out for n in g.images}
+    assert by_image["strip1_01.tif"].name == "RC30" and by_image["strip1_01.tif"].mode == "fixed"
+    assert by_image["b.jpg"].name == "DMC" and by_image["b.jpg"].matched_by == "the EXIF camera model"
+    assert by_image["c.jpg"].name == "other" and by_image["c.jpg"].mode == "refined"  # the file's adjust
+    assert by_image["e.jpg"] is None  # no calibration fits: estimated, as today
+    assert len(out) == 5 and [g.camera_id for g in out] == [1, 2, 3, 4, 5]  # group a split in two
+    # 1600 x 1600 matches no calibration by size; one calibration alone applies to every photo, scaled
+    out1, plan1 = plan_cameras(pycolmap, [_group(infos[4:5], "d")], infos[4:5], cals[2:], {}, AlignOptions(), log)
+    given = plan1["d"]
+    assert given.scaled_from == (400, 400) and given.params[0] == pytest.approx(1200.0)
+    assert by_image["d.jpg"] is None
+    assert any(ln.startswith("camera 5 (1 image(s), 640 x 480 px)") and "estimated" in ln for ln in log.lines)
+
+
+def test_focal_length_and_film_scans_as_given_interior_orientations(tmp_path):
+    import pycolmap
+
+    manual = [_info("a.tif", focal_px=1000.0, source="manual"), _info("b.tif", focal_px=1000.0, source="manual")]
+    g = _group(manual)
+    _, plan = plan_cameras(pycolmap, [g], manual, [], {}, AlignOptions(), NullProgress())
+    assert plan == {}  # auto: FOCAL_MM / SENSOR_WIDTH_MM work as before
+    _, plan = plan_cameras(pycolmap, [g], manual, [], {}, AlignOptions(intrinsics="fixed"), NullProgress())
+    assert plan["g"].mode == "fixed" and plan["g"].params == [1000.0, 400.0, 300.0, 0.0]
+    with pytest.raises(AlignError, match="needs a given interior orientation"):
+        plan_cameras(pycolmap, [_group([_info("c.jpg")])], [_info("c.jpg")], [], {}, AlignOptions(intrinsics="refined"),
+                     NullProgress())
+    # Prepare images' restituted film scans: fixed under auto
+    scans = tmp_path / "scans.json"
+    scans.write_text(json.dumps({"interior_orientation": {"focal_px": 1234.5, "width": 800, "height": 600,
+                                                          "principal_point_px": [400.0, 300.0]},
+                                 "scans": [{"prepared_name": "a.tif"}, {"prepared_name": "b.tif"}]}))
+    io = scan_interior(str(scans), manual)
+    _, plan = plan_cameras(pycolmap, [g], manual, [], io, AlignOptions(), NullProgress())
+    assert plan["g"].mode == "fixed" and plan["g"].source == "scans.json" and plan["g"].params[0] == 1234.5
+
+
+# ------------------------------------------------------------------------------------------------------------
+# bad input: before any work
+# ------------------------------------------------------------------------------------------------------------
+
+def test_a_bad_calibration_file_or_choice_fails_before_feature_extraction(images, tmp_path):
+    bad = tmp_path / "camera.json"
+    bad.write_text('{"name": "x", "image_size_px": [800, 600],\n "focal_length_px": -5}\n')
+    ws = tmp_path / "ws"
+    with pytest.raises(ArchaeoOrthoError) as e:
+        align(images, str(ws), _options(calibration=str(bad)))
+    assert "camera.json" in str(e.value) and "line 2" in str(e.value) and "focal_length_px" in str(e.value)
+    assert not ws.exists()  # nothing done: no workspace, no database
+    with pytest.raises(AlignError, match="calibration file .*missing.json does not exist"):
+        align(images, str(ws), _options(calibration=str(tmp_path / "missing.json")))
+    with pytest.raises(AlignError, match="unknown intrinsics choice 'fixd'"):
+        align(images, str(ws), _options(intrinsics="fixd"))
+    assert not ws.exists()
+
+
+# ------------------------------------------------------------------------------------------------------------
+# Processing
+# ------------------------------------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def align_algorithm(plugin):
+    from qgis.core import QgsApplication
+
+    return QgsApplication.processingRegistry().algorithmById("archaeoortho:alignimages").create()
+
+
+def _run(alg, parameters):
+    from qgis.core import QgsProcessingContext, QgsProcessingFeedback
+
+    context, feedback = QgsProcessingContext(), QgsProcessingFeedback()
+    ok, why = alg.checkParameterValues(parameters, context)
+    if not ok:
+        raise ValueError(why)
+    return alg.processAlgorithm(parameters, context, feedback)
+
+
+def test_align_images_with_a_calibration_for_one_strip_holds_that_camera(align_algorithm, block, images, tmp_path):
+    """Processing's Align images with CALIBRATION for the photos of strip 1 only: they become a camera held at
+    exactly the given values, strip 2 a camera self-calibrated as today (mixed cameras: the mapping refines both,
+    the held one is set back and kept constant in the final adjustment); the record says which is which."""
+    cal = write_calibration(tmp_path / "strip1.json", block.camera, images=["S1_*"])
+    out = _run(align_algorithm, {"IMAGES": images, "WORKSPACE": str(tmp_path / "ws"), "CALIBRATION": cal,
+                                 "PAIRING": 1, "MAX_FEATURES": 2048})
+    assert out["REGISTERED_IMAGES"] == len(block.shots)
+    records = Layout(Workspace.open(str(tmp_path / "ws"))).camera_intrinsics()
+    modes = {r["mode"]: r for r in records.values()}
+    assert set(modes) == {"fixed", "estimated"}
+    rec = load_model(str(tmp_path / "ws"))
+    held = rec.cameras[modes["fixed"]["camera_id"]]
+    assert np.max(np.abs(np.asarray(held.params) - block.camera.params)) <= 1e-9
+    other = rec.cameras[modes["estimated"]["camera_id"]]
+    assert other.model.name != "OPENCV" or list(other.params) != list(held.params)
+    print(f"\n[mixed] held {held.params[0]:.6f} px; strip 2 self-calibrated {other.model.name} {other.params[0]:.2f} px")
+
+
+def test_align_images_refuses_a_mistyped_interior_orientation_and_a_bad_file(align_algorithm, images, tmp_path):
+    from qgis.core import QgsProcessingException
+
+    with pytest.raises(ValueError, match="INTRINSICS|Interior orientation"):
+        _run(align_algorithm, {"IMAGES": images, "WORKSPACE": str(tmp_path / "ws"), "INTRINSICS": "fixd"})
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("name: x\nimage_size_px: [800, 600]\nfocal_length_px: none\n")
+    with pytest.raises(QgsProcessingException, match="bad.yaml"):
+        _run(align_algorithm, {"IMAGES": images, "WORKSPACE": str(tmp_path / "ws"), "CALIBRATION": str(bad)})
+    assert not (tmp_path / "ws").exists()
+    assert "fixed" in align_algorithm.parameterDefinition("INTRINSICS").options()
