@@ -7,6 +7,7 @@ ALS or national DEM is); the "block DSM" is the terrain at 5 m over the inner 6 
 15 m) and a hole of nodata: the outliers the co-registration must leave out.  Truth in the module's convention:
 DSM(p) = H(p + s) - correction(p + s), so the result must give shift = s and correction = the applied one.
 """
+import json
 import math
 
 import numpy as np
@@ -125,6 +126,7 @@ def test_rugged_shift_tilt_and_outliers(rugged, rugged_ref):
     assert res.nmad_after < 0.3 < res.nmad_before
     assert abs(res.median_after) < 0.1
     assert res.cell == REF_CELL and 2 <= res.iterations <= 10
+    assert json.loads(json.dumps(res.as_dict()))["shift"] == list(res.shift)
     # apply(): a DSM point lands on the terrain
     p = np.array([[BLOCK[0] + 2000.0, BLOCK[1] + 3000.0, 0.0]])
     q = p[0, :2] + shift

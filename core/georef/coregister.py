@@ -2,10 +2,10 @@
 
 Nuth & Kääb (2011) with a tilt and an optional dome, solved jointly and iterated.  For a DEM whose coordinates
 are off by ``s`` (the thing that is at ``p + s`` in the reference is at ``p`` in the DEM) and whose heights are
-off by ``dz`` and a smooth surface, the elevation difference is, to first order,
+off by ``dz`` and a smooth surface, the elevation difference to the reference is, to first order,
 
-    dh(q) = R(q) - D(q - s) = tan(slope) * |s| * cos(angle(s) - aspect) + dz + plane(q) + dome(q)
-          = -dR/dx * sx - dR/dy * sy + dz + plane(q) + dome(q)
+    dh(q) = R(q) - D(q) = tan(slope) * |s| * cos(direction(s) - aspect) + dz + plane(q) + dome(q)
+                        = -dR/dx * sx - dR/dy * sy + dz + plane(q) + dome(q)
 
 (aspect: the direction of steepest descent, clockwise from north).  Nuth & Kääb divide by tan(slope) and fit the
 cosine to medians of aspect bins, then take the median of dh as the vertical bias; the same relation is solved here
@@ -32,15 +32,22 @@ the file).
 
 Entry points: :func:`coregister_dems` (arrays + GDAL geotransforms), :func:`coregister_rasters` (two files: CRS,
 linear and vertical units, nodata), :func:`coregister_points` (the sparse cloud against a reference DEM, sampled
-bilinearly; :func:`coregister_points_file` reads the reference over the points only, reprojected into the
-points' CRS: :func:`reference_window`), :func:`control_points_from_coregistration` (well-distributed pseudo control points on flat, stable,
-well-measured cells for the adjustment).  Bad input is a :class:`CoregError` naming the raster.
+bilinearly; :func:`coregister_points_file` reads the reference over the points only, reprojected into the points'
+CRS: :func:`reference_window`), :func:`control_points_from_coregistration` (well-distributed pseudo control
+points on flat, stable, well-measured cells, for the adjustment).  Bad input is a :class:`CoregError` naming the
+raster.
+
+Why not xdem (or codem, PDAL): xdem needs rasterio, pyproj, geopandas, pandas and xarray (wheels with their own
+GDAL and PROJ beside QGIS's), which QGIS's Python on Windows and macOS does not have; its NuthKaab fits the shift
+alone, so a tilt of the block pulls it off (benchmarks/coregister.py: 22 m on the tilted synthetic pair where this
+module finds 0.01 m; without tilt both are within 0.03 cell).  tests/test_coregister.py compares with xdem where it
+is installed.
 """
 from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
@@ -56,6 +63,7 @@ MAX_GRID_CELLS = 4_000_000  # the comparison grid is coarsened beyond this (16 M
 MAX_FIT_CELLS = 500_000  # a fixed random subset of the compared cells enters the fit (as xdem's default)
 MAX_STEP_CELLS = 4.0  # the horizontal increment of one iteration is limited to this many cells
 UNDETERMINED_CELLS = 0.25  # the shift's standard error (cells) above which the terrain is too flat for it
+FLAT_NMADS = 2.0  # ... or when a one-cell shift changes the heights by less than this many residual NMADs (RMS)
 DEM_MARGIN_CELLS = 8  # the DEM is kept this far around the overlap, for shifted samples
 
 
@@ -97,6 +105,11 @@ class CoregResult:
         p[:, 1] += self.shift[1]
         p[:, 2] += self.correction(p[:, 0], p[:, 1])
         return p
+
+    def as_dict(self) -> dict:
+        """The result as plain JSON-ready values (for the manifest and the report)."""
+        out = asdict(self)
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in out.items()}
 
     def summary(self) -> str:
         dx, dy, dz = self.shift
@@ -235,7 +248,7 @@ def _fit(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, max_it
     shift, p, it, converged, st = _iterate(sample, usable, model, cell, max_iterations, tolerance, True, progress)
     horizontal = True
     sigma = math.sqrt(max(st.cov[0, 0], st.cov[1, 1], 0.0))
-    if not (sigma <= UNDETERMINED_CELLS * cell) or st.relief < 2 * st.spread:
+    if not (sigma <= UNDETERMINED_CELLS * cell) or st.relief < FLAT_NMADS * st.spread:
         horizontal = False
         messages.append(f"the terrain is too flat (a one-cell shift changes the heights by {st.relief:.2g} m RMS, the "
                         f"residuals spread {st.spread:.2g} m) to determine a horizontal shift: only the heights were "
@@ -351,11 +364,11 @@ def _has_data(ds) -> bool:
     return False
 
 
-def _warp(src: _Source, dst_wkt: str, gt: Tuple[float, ...], w: int, h: int) -> np.ndarray:
+def _warp(src: _Source, dst_wkt: str, gt: Tuple[float, ...], w: int, h: int, src_cell: float) -> np.ndarray:
     """``src`` on the grid (gt, w, h) of ``dst_wkt`` as float32 metres, NaN = nodata: averaged where its cells
-    are finer, bilinear where not."""
+    (``src_cell``, in the units of ``gt``) are finer, bilinear where not."""
     gdal, _ = _gdal()
-    alg = "average" if src.cell < 0.75 * abs(gt[1]) else "bilinear"
+    alg = "average" if src_cell < 0.75 * abs(gt[1]) else "bilinear"
     bounds = (gt[0], gt[3] + h * gt[5], gt[0] + w * gt[1], gt[3])
     kw = dict(format="MEM", outputBounds=bounds, width=w, height=h, resampleAlg=alg, outputType=gdal.GDT_Float32,
               dstNodata=float("nan"), multithread=False)
@@ -424,11 +437,11 @@ def _pair(dem: _Source, ref: _Source, stable: Optional[_Source], xy_unit: float 
     w, h = c1 - c0, r1 - r0
     m = DEM_MARGIN_CELLS
     dem_gt = (gt[0] - m * cell, cell, 0.0, gt[3] + m * cell, 0.0, -cell)
-    z_ref = _warp(ref, ref.wkt, gt, w, h)
-    z_dem = _warp(dem, ref.wkt, dem_gt, w + 2 * m, h + 2 * m)
+    z_ref = _warp(ref, ref.wkt, gt, w, h, ref.cell)
+    z_dem = _warp(dem, ref.wkt, dem_gt, w + 2 * m, h + 2 * m, dem_cell)
     mask = None
-    if stable is not None:
-        mask = _warp(stable, ref.wkt, gt, w, h) >= 0.5
+    if stable is not None:  # the share of stable area in each cell (averaged whatever the mask's cell)
+        mask = _warp(stable, ref.wkt, gt, w, h, 0.0) >= 0.5
     if not np.isfinite(z_ref).any():
         raise CoregError(f"the {ref.name} has no height where it overlaps the {dem.name}")
     if not np.isfinite(z_dem[m:m + h, m:m + w]).any():
