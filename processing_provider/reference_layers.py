@@ -305,16 +305,15 @@ __all__ = ["DEFAULT_GSD", "MAX_PIXELS", "LayerSnapshot", "ReferenceLayerError", 
 
 def reference_crs(ortho_path):
     """'EPSG:n' (or the WKT) of a reference orthophoto file: the CRS the automatic control's result is in."""
-    from osgeo import gdal, osr
+    from osgeo import gdal
+
+    from ..core.geometry.crs import crs_identifier
 
     ds = gdal.Open(ortho_path)
     wkt = ds.GetProjection() if ds is not None else ""
     if not wkt:
         raise ReferenceLayerError(f"reference orthophoto {ortho_path} has no CRS")
-    srs = osr.SpatialReference(wkt=wkt)
-    srs.AutoIdentifyEPSG()
-    code = srs.GetAuthorityCode(None)
-    return f"EPSG:{code}" if code else wkt
+    return crs_identifier(wkt)
 
 
 def as_check_points(gcps, crs):

@@ -324,3 +324,86 @@ def _transform_one(ct, p: Sequence[float]) -> Tuple[float, float, float]:
         return tuple(ct.TransformPoint(*p))[:3]
     except RuntimeError:
         return (math.inf, math.inf, math.inf)
+
+
+def _srs_quiet(crs: str):
+    """osr.SpatialReference of ``crs`` (GIS axis order) or None when it does not parse; never raises."""
+    osr = _osr()
+    if osr is None or not crs:
+        return None
+    srs = osr.SpatialReference()
+    with _quiet_gdal():
+        try:
+            if srs.SetFromUserInput(normalize_crs(crs)) != 0:
+                return None
+        except RuntimeError:
+            return None
+    srs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+    return srs
+
+
+def epsg_code(crs: Optional[str]) -> Optional[int]:
+    """The EPSG code a CRS carries (``EPSG:n``, a WKT whose root has ``AUTHORITY["EPSG", n]`` / ``ID``) or that
+    GDAL identifies with certainty (a UTM zone written as a PROJ string); None for a CRS that has none, such as a
+    national transverse Mercator given by its parameters.  Never raises: GDAL's ``AutoIdentifyEPSG`` fails with
+    "Unsupported SRS" on such a CRS when exceptions are on, which is an answer (no code), not an error."""
+    if not crs:
+        return None
+    srs = _srs_quiet(crs)
+    if srs is None:
+        pyproj = _pyproj()
+        if pyproj is None:
+            m = re.fullmatch(r"EPSG:(\d+)", normalize_crs(crs))
+            return int(m.group(1)) if m else None
+        try:
+            code = pyproj.CRS.from_user_input(normalize_crs(crs)).to_epsg(min_confidence=100)
+        except Exception:  # noqa: BLE001 - pyproj's CRSError and friends: no code
+            return None
+        return int(code) if code else None
+    with _quiet_gdal():
+        name, code = srs.GetAuthorityName(None), srs.GetAuthorityCode(None)
+        if not code:
+            try:
+                if srs.AutoIdentifyEPSG() == 0:
+                    name, code = srs.GetAuthorityName(None), srs.GetAuthorityCode(None)
+            except RuntimeError:  # "OGR Error: Unsupported SRS" with exceptions enabled
+                code = None
+    if code and (name or "EPSG").upper() == "EPSG" and str(code).isdigit():
+        return int(code)
+    return None
+
+
+def crs_identifier(crs: Optional[str]) -> str:
+    """How the plugin records a CRS: ``EPSG:n`` when it has an EPSG code (:func:`epsg_code`), else the CRS as
+    given (a raster's WKT, a PROJ string), which every reader here accepts; '' for none."""
+    if not crs:
+        return ""
+    code = epsg_code(crs)
+    return f"EPSG:{code}" if code else str(crs).strip()
+
+
+def linear_unit(crs: str) -> Tuple[str, float]:
+    """(unit name, metres per unit) of a projected CRS's axes ('degree', NaN for a geographic one); ('', NaN)
+    when it cannot be read."""
+    srs = _srs_quiet(crs)
+    if srs is None:
+        return "", math.nan
+    if srs.IsGeographic():
+        return "degree", math.nan
+    name = srs.GetLinearUnitsName() or ""
+    return name, float(srs.GetLinearUnits() or math.nan)
+
+
+def is_mercator(crs: str) -> bool:
+    """True for a (Web) Mercator projection: its scale grows as 1 / cos(latitude) (1.3 at 40 degrees), so its
+    metres are not ground metres away from the equator."""
+    srs = _srs_quiet(crs)
+    if srs is None or not srs.IsProjected():
+        return False
+    method = (srs.GetAttrValue("PROJECTION") or "").lower()
+    return method.startswith("mercator") or "pseudo" in method and "mercator" in method
+
+
+__all__ = ["CRSError", "WKT_START", "check_coordinates_match_crs", "crs_identifier", "crs_is_geographic",
+           "crs_status", "epsg_code", "is_mercator", "linear_unit", "looks_like_crs", "normalize_crs",
+           "transform_points", "utm_epsg_for_lonlat", "validate_crs"]

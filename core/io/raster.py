@@ -24,6 +24,7 @@ import numpy as np
 from ..common.errors import ArchaeoOrthoError
 from ..common.files import atomic_output
 from ..common.progress import NullProgress, Progress, check_cancel
+from ..geometry.crs import epsg_code
 
 NODATA = -9999.0
 
@@ -54,15 +55,17 @@ def crs_to_wkt(crs: Optional[str]) -> str:
 
 
 def crs_epsg(crs: Optional[str]) -> Tuple[Optional[int], bool]:
-    """(EPSG code or None, is_geographic) of a CRS string."""
+    """(EPSG code or None, is_geographic) of a CRS string; a CRS with no EPSG code (a national transverse
+    Mercator given by its parameters) gives None, not GDAL's "Unsupported SRS"."""
     if not crs:
         return None, False
     _, osr = _gdal()
     srs = osr.SpatialReference()
-    srs.SetFromUserInput(crs)
-    srs.AutoIdentifyEPSG()
-    code = srs.GetAuthorityCode(None)
-    return (int(code) if code and code.isdigit() else None), bool(srs.IsGeographic())
+    try:
+        srs.SetFromUserInput(crs)
+    except RuntimeError as e:
+        raise DsmError(f"unknown CRS {crs!r}: {e}") from e
+    return epsg_code(crs), bool(srs.IsGeographic())
 
 
 # ---------------------------------------------------------------------------

@@ -109,7 +109,9 @@ def crs_label(crs: Optional[str]) -> str:
         for m, conf in srs.FindMatches() or []:
             if conf >= 70 and m.GetAuthorityCode(None):
                 return f"~{m.GetAuthorityName(None)}:{m.GetAuthorityCode(None)} ({m.GetName()})"
-        return srs.GetName() or str(crs)
+        proj = srs.ExportToProj4() if srs.IsProjected() or srs.IsGeographic() else ""
+        name = srs.GetName() or "unnamed CRS"
+        return f"{name} (no EPSG code: {proj.strip()})" if proj else (srs.GetName() or str(crs))
     except Exception:  # noqa: BLE001 - GDAL raises or returns codes depending on UseExceptions
         return str(crs)
 

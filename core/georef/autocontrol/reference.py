@@ -12,6 +12,7 @@ from typing import Tuple
 import numpy as np
 
 from ...common.errors import require
+from ...geometry.crs import crs_identifier
 from ...io.raster import DsmError, DsmReader
 from .errors import AutoControlError
 
@@ -57,12 +58,8 @@ class Reference:
 
     @property
     def crs(self) -> str:
-        """'EPSG:n' when the CRS has an EPSG code, else its WKT."""
-        osr = require("osgeo.osr", "reading the reference orthophoto")
-        srs = osr.SpatialReference(wkt=self.crs_wkt)
-        srs.AutoIdentifyEPSG()
-        code = srs.GetAuthorityCode(None)
-        return f"EPSG:{code}" if code else self.crs_wkt
+        """'EPSG:n' when the CRS has an EPSG code, else its WKT (a national CRS without one is as good)."""
+        return crs_identifier(self.crs_wkt)
 
     def grey(self, box: Tuple[float, float, float, float], res: float
              ) -> Tuple[np.ndarray, np.ndarray, Tuple[float, ...]]:

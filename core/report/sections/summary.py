@@ -39,8 +39,8 @@ def section(ctx: ReportContext) -> str:
     else:
         ctx.figures.update(IMAGES=len(images) or None, REGISTERED_IMAGES=None)
         rows.append(("Images given", str(len(images))))
-    crs_txt = ("none (local model frame)" if not d.crs else d.crs_label if str(d.crs) in d.crs_label
-               else f"{d.crs_label}: {d.crs}")
+    crs_txt = ("none (local model frame)" if not d.crs else d.crs_label
+               if str(d.crs) in d.crs_label or "no EPSG code" in d.crs_label else f"{d.crs_label}: {d.crs}")
     rows.append(("Coordinate reference system", esc(crs_txt)))
     parts.append(kv(rows))
 
