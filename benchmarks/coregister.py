@@ -3,17 +3,18 @@
 1. ``--size N`` (default 4000): a synthetic N x N DSM at 5 m (tests/test_coregister.py's rugged terrain, shifted,
    tilted, with a forest, buildings and noise) against a 25 m reference DEM, both written as GeoTIFFs; then
    ``coregister_rasters`` (warps the DSM from the file; also from a copy in EPSG:25833, reprojected) and
-   ``coregister_dems`` (the DSM read whole as float32
-   first, as a caller holding it would), each in a child process: seconds and peak resident memory (the child's
-   ru_maxrss above its RSS after the imports), and the errors against the truth.
+   ``coregister_dems`` (the DSM read whole as float32 first, as a caller holding it would, then 25 pseudo control
+   points from it), each in a child process: seconds, peak resident memory (the child's ru_maxrss above its RSS
+   after the imports; NumPy's part by tracemalloc) and the errors against the truth.
 2. ``--xdem``: the same synthetic pairs as the tests (6 km at 5 m against 25 m), ours against xdem's NuthKaab
-   (and NuthKaab + Deramp(poly_order=1) where the pair is tilted) on the DSM averaged onto the reference grid
-   (xdem compares on one grid).  xdem is not in requirements-dev.txt: it brings rasterio, pyproj, geopandas,
-   pandas and xarray with their own GDAL/PROJ wheels and raised SciPy 1.10 -> 1.15 here, which neither QGIS's
-   Python nor the project's venv may take; run this part from a throw-away venv:
+   (and Deramp(poly_order=1) after or before it where the pair is tilted) on the DSM averaged onto the reference
+   grid (xdem compares on one grid).  xdem is not in requirements-dev.txt: xdem 0.2.3 brings geoutils, rasterio,
+   pyproj, geopandas, pandas and xarray (rasterio and pyproj as wheels with their own GDAL and PROJ beside the
+   system's), and rasterio 1.4.4 fails with the affine 3.0.1 that pip picks ("TransformError: Invalid inputs";
+   affine<3 works); QGIS's Python on Windows and macOS has none of them.  Run this part from a throw-away venv:
 
-       python3 -m venv --system-site-packages /tmp/xdemvenv
-       /tmp/xdemvenv/bin/pip install -c build/constraints.txt xdem
+       /usr/bin/python3 -m venv --system-site-packages /tmp/xdemvenv
+       /tmp/xdemvenv/bin/pip install -c build/constraints.txt xdem "affine<3" pytest
        /tmp/xdemvenv/bin/python benchmarks/coregister.py --xdem
 
 usage: python benchmarks/coregister.py [--size N] [--xdem]
@@ -70,9 +71,10 @@ def _errors(res, shift, dz, tilt, xs, ys):
 def child(mode: str, dsm_path: str, ref_path: str, size: int) -> None:
     import tracemalloc
 
-    from core.georef.coregister import coregister_dems, coregister_rasters
+    from core.georef.coregister import control_points_from_coregistration, coregister_dems, coregister_rasters
 
     base = _rss_mib()
+    extra = {}
     tracemalloc.start()
     t = time.perf_counter()
     if mode == "rasters":
@@ -93,6 +95,10 @@ def child(mode: str, dsm_path: str, ref_path: str, size: int) -> None:
         dsm = ds.GetRasterBand(1).ReadAsArray()
         ref = rds.GetRasterBand(1).ReadAsArray()
         res = coregister_dems(dsm, ds.GetGeoTransform(), ref, rds.GetGeoTransform(), dem_nodata=-9999.0)
+        t_pc = time.perf_counter()
+        pc = control_points_from_coregistration(res, ref, rds.GetGeoTransform(), dem=dsm,
+                                                dem_transform=ds.GetGeoTransform(), n=25)
+        extra = {"control_points": len(pc), "control_points_seconds": round(time.perf_counter() - t_pc, 2)}
     seconds = time.perf_counter() - t
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     numpy_peak = tracemalloc.get_traced_memory()[1] / 2 ** 20
@@ -102,7 +108,8 @@ def child(mode: str, dsm_path: str, ref_path: str, size: int) -> None:
     ys = np.array([by, by, by + side, by + side, by + side / 2])
     out = {"mode": mode, "seconds": round(seconds, 2), "peak_mib_above_imports": round(peak - base, 1),
            "python_numpy_peak_mib": round(numpy_peak, 1),
-           "compared_cells": res.n_compared, **_errors(res, TRUTH["shift"], TRUTH["dz"], TRUTH["tilt"], xs, ys)}
+           "compared_cells": res.n_compared, **_errors(res, TRUTH["shift"], TRUTH["dz"], TRUTH["tilt"], xs, ys),
+           **extra}
     print(json.dumps(out))
 
 
