@@ -40,7 +40,7 @@ class AutoControlAlgorithm(AlgorithmBase):
         "georef/reference-ortho.tif (a Web Mercator or geographic one in the DSM's CRS, else the UTM zone's).\n"
         "Reference DSM: a DSM or DTM covering the block, heights in metres (a WCS layer is saved to "
         "georef/reference-dsm.tif).\n"
-        "Rough position: the photos' EXIF GPS when at least three carry it (auto), always (EXIF GPS), or never "
+        "Rough position: the photos' EXIF GPS when at least two carry it (auto), always (EXIF GPS), or never "
         "(none: rotation and scale are searched over the whole reference, which then should not be much larger "
         "than the block).\n"
         "Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least "

@@ -137,7 +137,10 @@ def match_orthos(ortho: np.ndarray, ortho_valid: np.ndarray, ref: np.ndarray, re
     near = np.linalg.norm(apply2(m, src) - dst, axis=1) <= 3.0 * opt.ransac_px
     keep, res = tile_refine(src[near], dst[near], opt.tile_px, opt.tile_ransac_px, opt.min_tile_matches)
     s, d, r = src[near][keep], dst[near][keep], res[keep]
-    return MatchSet(s, d, r, m, len(ia), int(inl.sum()), (len(fa.xy), len(fb.xy)))
+    # SIFT gives a keypoint one descriptor per dominant orientation: the same match twice is one point, not two
+    _, first = np.unique(np.round(np.column_stack([s, d]), 1), axis=0, return_index=True)
+    first = np.sort(first)
+    return MatchSet(s[first], d[first], r[first], m, len(ia), int(inl.sum()), (len(fa.xy), len(fb.xy)))
 
 
 def _turned(cv2, img: np.ndarray, valid: np.ndarray, angle: float):

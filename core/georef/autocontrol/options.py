@@ -17,10 +17,10 @@ class AutoControlOptions:
     the photos (the best of a grid over the block); ``search_px``: how far a point is searched in the other
     photos around its prediction through the model; ``min_score``: their normalised cross-correlation;
     ``ground_plane``: the patches compared through the ground's plane (else the plane facing the first photo);
-    ``max_relief``: metres of DSM relief within the point's neighbourhood beyond which its height is not
-    trusted (walls, trees, roof edges); ``dsm_sigma``: metres, the DSM's own height noise in a point's sigma Z
-    (None: a third of the DSM's cell size, as the height comes from a plane through 3 x 3 samples; the plane's
-    misfit and slope are added to it); ``rotations``:
+    ``dsm_sigma``: the DSM's own height noise in a point's sigma Z, in its units (None: a third of the DSM's cell
+    size, as the height comes from a plane through 3 x 3 samples); the plane's slope and misfit (walls, trees,
+    roof edges, houses within a coarse DEM's cell) are added to it: a weight, never a rejection
+    (``candidates.height_sigma``); ``rotations``:
     degrees tried when there is no prior (the features are rotation invariant; these help at a coarse level), until
     one gives ``coarse_enough`` inliers; ``coarse_pixels``: the provisional orthophoto's side at that level;
     ``refine_intrinsics``: what the adjustment refines of the cameras (as ``GeorefOptions``): by default focal
@@ -41,7 +41,6 @@ class AutoControlOptions:
     min_score: float = 0.7
     ground_plane: bool = True
     max_triangulation_px: float = 2.0
-    max_relief: float = 0.6
     dsm_sigma: Optional[float] = None
     min_candidates: int = 4
     rotations: tuple = (0.0, 90.0, 180.0, 270.0)

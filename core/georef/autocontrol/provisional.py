@@ -77,13 +77,35 @@ def frame_from_positions(rec, positions: Sequence[CameraPosition], threshold: fl
     similarity model -> world - offset of the camera centres."""
     centres = camera_centres(rec)
     rows = [(centres[p.image], np.array([p.x, p.y, p.z], dtype=float)) for p in positions if p.image in centres]
-    if len(rows) < 3:
-        raise AutoControlError(f"a prior from camera positions needs 3 of the block's photos; {len(rows)} matched")
+    if len(rows) < 2:
+        raise AutoControlError(f"a prior from camera positions needs 2 of the block's photos; {len(rows)} matched")
     src = np.array([a for a, _ in rows])
     dst = np.array([b for _, b in rows])
     offset = np.round(dst.mean(axis=0), 0)
+    if len(rows) == 2:  # a pair: its baseline gives scale and azimuth, the tie points' plane the vertical
+        return _frame_from_pair(rec, src, dst - offset, offset)
     fit = helmert_ransac(src, dst - offset, threshold)
     return Frame(fit.transform, offset)
+
+
+def _frame_from_pair(rec, src: np.ndarray, dst: np.ndarray, offset: np.ndarray) -> Frame:
+    """The prior of two camera positions: the level frame (z along the tie points' plane normal) turned, scaled
+    and moved so that the two cameras' horizontal baseline lands on theirs, heights on their mean."""
+    lev = level_frame(rec)
+    a = lev.model_to_frame.apply(src)
+    da, db = a[1, :2] - a[0, :2], dst[1, :2] - dst[0, :2]
+    la, lb = float(np.hypot(*da)), float(np.hypot(*db))
+    if la <= 0 or lb <= 0:
+        raise AutoControlError("a prior from two camera positions needs them apart (the two photos' positions "
+                               "coincide)")
+    scale = lb / la
+    turn = math.atan2(db[1], db[0]) - math.atan2(da[1], da[0])
+    r = np.array([[math.cos(turn), -math.sin(turn), 0.0], [math.sin(turn), math.cos(turn), 0.0], [0.0, 0.0, 1.0]])
+    moved = scale * a @ r.T
+    t = (dst - moved).mean(axis=0)
+    if not np.all(np.isfinite(dst[:, 2])):
+        t[2] = 0.0
+    return Frame(Similarity(scale, r, t).compose(lev.model_to_frame), offset)
 
 
 @dataclass

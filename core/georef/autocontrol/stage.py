@@ -20,14 +20,24 @@ from typing import Dict, List, Optional, Sequence
 import numpy as np
 
 from ...common.progress import NullProgress, Progress, SubProgress
-from ...geometry.crs import transform_points
+from ...geometry.crs import linear_unit, transform_points
 from ...geometry.similarity import Similarity
 from ...io.gcp import CHECK, CONTROL, CameraPosition, GCPSet, GroundPoint
 from ...project.layout import Layout, write_json
 from ...project.workspace import Workspace
 from ..options import GeorefOptions
 from ..stage import GeorefStageResult, georeference_workspace
-from .candidates import KEPT, Candidate, consistent, spread, tie_back
+from .candidates import (
+    KEPT,
+    Candidate,
+    consistent,
+    drop_counts,
+    estimate_own_sigma,
+    own_sigma_prior,
+    set_own_sigma,
+    spread,
+    tie_back,
+)
 from .errors import AutoControlError
 from .matching import apply2, coarse_search, match_orthos
 from .options import AutoControlOptions
@@ -133,14 +143,51 @@ def _prior(ws, rec, photos, reference, prior, positions, opt, progress, messages
     crs = reference.crs
     if positions is None and prior in (PRIOR_AUTO, PRIOR_GPS):
         positions = _gps_positions(ws, crs)
-        if prior == PRIOR_GPS and len(positions) < 3:
+        if prior == PRIOR_GPS and len(positions) < 2:
             raise AutoControlError(f"prior 'gps': {len(positions)} photo(s) of workspace {ws.root} carry EXIF GPS, "
-                                   "3 are needed")
-    if positions is not None and len(positions) >= 3 and prior != PRIOR_NONE:
+                                   "2 are needed")
+    if positions is not None and len(positions) >= 2 and prior != PRIOR_NONE:
         messages.append(f"prior: {len(positions)} rough camera positions")
         return frame_from_positions(rec, positions)
     messages.append("prior: none (searching rotation and scale)")
     return _coarse_prior(rec, photos, reference, opt, progress, messages)
+
+
+def _check_block_pixels(ext, g: float, reference: Reference, photo_gsd: float, opt: AutoControlOptions) -> None:
+    """AutoControlError, before the match, when the block spans fewer pixels of the match's grid than one tile
+    of the per-tile affine (``opt.tile_px``): a handful of the reference's features, too few to place the block
+    (Toledo's 150 m FC300X block against a 2 m orthophoto: 107 pixels, 16 matches, and a block placed 67 m off
+    by a repeated pattern of houses, or 2 candidates)."""
+    side = max(ext[2] - ext[0], ext[3] - ext[1])
+    px = side / g
+    if px >= opt.tile_px:
+        return
+    name, metres = linear_unit(reference.crs_wkt)
+    unit = "m" if metres == 1.0 else name or "units"
+    what = (f"the reference orthophoto {reference.ortho_path} is too coarse for a block this small"
+            if g <= reference.gsd * 1.0001 else
+            f"the photos' ground resolution ({photo_gsd:.3g} {unit}) is too coarse for a block this small")
+    raise AutoControlError(f"{what}: the block spans {side:.0f} {unit}, {px:.0f} pixels of {g:.3g} {unit}, and the "
+                           f"automatic control needs at least {opt.tile_px} (one tile of its per-tile match); use a "
+                           f"reference with cells of {side / opt.tile_px:.2g} {unit} or finer, a larger block, or "
+                           "hand-picked control points")
+
+
+def _own_height_sigma(cands, reference: Reference, g: float, opt: AutoControlOptions, messages: List[str]) -> float:
+    """The reference DSM's own height noise in the candidates' sigma Z: ``opt.dsm_sigma`` when given, else
+    estimated from the candidates that agree with one similarity (``candidates.estimate_own_sigma``: between the
+    match's grid ``g`` and the prior, a third of the DSM's cell); the candidates' sigma Z are set from it."""
+    prior = own_sigma_prior(reference.dsm_gsd, opt.dsm_sigma)
+    if opt.dsm_sigma is not None:
+        return prior
+    own = estimate_own_sigma(cands, g, prior)
+    if own is None:
+        return prior
+    set_own_sigma(cands, own)
+    messages.append(f"reference DSM heights: sigma {own:.3g} from the candidates that agree (at most a third of "
+                    f"its {reference.dsm_gsd:.3g} cell, {prior:.3g}; at least the match's grid, {g:.3g}), plus each "
+                    "point's slope and roughness")
+    return own
 
 
 def find_candidates(ws: Workspace, rec, reference: Reference, prior: str = PRIOR_AUTO,
@@ -155,7 +202,9 @@ def find_candidates(ws: Workspace, rec, reference: Reference, prior: str = PRIOR
     frame = _prior(ws, rec, photos, reference, prior, positions, opt, SubProgress(progress, 0.0, 0.2), messages)
     t["prior"] = time.time()
     ext = block_extent(rec, frame)
-    g = opt.gsd or max(reference.gsd, _photo_gsd(rec, frame), max(ext[2] - ext[0], ext[3] - ext[1]) / opt.max_pixels)
+    photo_gsd = _photo_gsd(rec, frame)
+    g = opt.gsd or max(reference.gsd, photo_gsd, max(ext[2] - ext[0], ext[3] - ext[1]) / opt.max_pixels)
+    _check_block_pixels(ext, g, reference, photo_gsd, opt)
     prov = provisional_ortho(rec, frame, photos, g, SubProgress(progress, 0.2, 0.4), ext)
     t["orthophoto"] = time.time()
     margin = 0.15 * max(ext[2] - ext[0], ext[3] - ext[1]) + 10.0 * g
@@ -172,13 +221,21 @@ def find_candidates(ws: Workspace, rec, reference: Reference, prior: str = PRIOR
                      SubProgress(progress, 0.4, 0.9))
     t["photos"] = time.time()
     n_obs = sum(1 for c in cands if c.status == KEPT)
-    consistent(cands, max(10.0 * g, 0.5))
+    # what the block may be off beyond each candidate's own sigmas: a few cells of the match's grid (was 10 g but
+    # at least 0.5 m, one 3-D distance: a height from a 10-30 m DEM was judged by the orthophoto's cell)
+    consistent(cands, 10.0 * g)
     n_kept = sum(1 for c in cands if c.status == KEPT)
+    own = _own_height_sigma(cands, reference, g, opt, messages)
     messages.append(f"{len(cands)} candidates tied back to the photos: {n_obs} seen in at least 2 photos with a "
-                    f"trusted DSM height, {n_kept} agree with one similarity")
+                    f"DSM height, {n_kept} agree with one similarity")
+    dropped = drop_counts(cands)
+    if dropped:
+        messages.append("candidates dropped: " + "; ".join(f"{n} {r}" for r, n in dropped.items()))
     figures = {"features_ortho": ms.n_features[0], "features_reference": ms.n_features[1], "matches": ms.n_found,
                "similarity_inliers": ms.n_similarity, "tile_inliers": int(len(ms.src)), "candidates": len(cands),
-               "observed": n_obs, "consistent": n_kept}
+               "observed": n_obs, "consistent": n_kept,
+               "block_reference_pixels": round(max(ext[2] - ext[0], ext[3] - ext[1]) / reference.gsd, 1),
+               "dsm_sigma": own}
     timings = {k: t[k] - t["start"] for k in ("prior", "orthophoto", "matching", "photos")}
     return cands, figures, messages, g, timings
 
@@ -190,9 +247,9 @@ def autocontrol_workspace(workspace_dir: str, reference_ortho: str, reference_ds
                           progress: Optional[Progress] = None) -> AutoControlResult:
     """Georeference an aligned workspace with automatic control from a reference orthophoto and DSM.
 
-    ``prior``: "auto" (EXIF GPS when 3 photos carry it, else none), "gps", or "none" (search rotation and scale);
+    ``prior``: "auto" (EXIF GPS when 2 photos carry it, else none), "gps", or "none" (search rotation and scale);
     ``camera_positions``: rough positions in the reference's CRS instead of EXIF GPS; ``check_points``: ground
-    points evaluated as check points (role check, in the reference's CRS); ``georef_options``: the adjustment's
+    points evaluated as check points (role check; taken from their set's CRS into the reference's); ``georef_options``: the adjustment's
     options (its ``refine_intrinsics`` replaces ``options.refine_intrinsics``).  Raises AutoControlError when fewer
     than ``options.min_candidates`` candidates are kept."""
     opt = AutoControlOptions.of(options)
@@ -215,16 +272,17 @@ def autocontrol_workspace(workspace_dir: str, reference_ortho: str, reference_ds
     crs = reference.crs
     doc = {"format": FORMAT, "version": 1, "reference_ortho": os.path.abspath(reference_ortho),
            "reference_dsm": os.path.abspath(reference_dsm), "crs": crs, "prior": prior, "gsd": g,
-           "figures": figures, "messages": messages, "candidates": [c.to_dict() for c in cands]}
+           "figures": figures, "dropped": drop_counts(cands), "messages": messages,
+           "candidates": [c.to_dict() for c in cands]}
     os.makedirs(lay.georef_dir, exist_ok=True)
     write_json(lay.autocontrol_json, doc)
     if len(kept) < opt.min_candidates:
         raise AutoControlError(f"automatic control against {reference_ortho}: {len(kept)} candidate(s) kept, "
-                               f"{opt.min_candidates} needed ({'; '.join(messages)}); see {lay.autocontrol_json}")
+                               f"{opt.min_candidates} needed{_coarse_hint(figures, g, opt)} "
+                               f"({'; '.join(messages)}); see {lay.autocontrol_json}")
     gcps = GCPSet(crs, [GroundPoint(c.name, c.x, c.y, c.z, c.sigma_xy, c.sigma_z, CONTROL, list(c.observations))
                         for c in kept], source=lay.autocontrol_json)
-    for p in (check_points.points if check_points is not None else []):
-        gcps.points.append(GroundPoint(p.name, p.x, p.y, p.z, p.sigma_xy, p.sigma_z, CHECK, list(p.observations)))
+    gcps.points.extend(_checks_in(check_points, crs))
     t1 = time.time()
     refine = georef_options.refine_intrinsics if georef_options is not None else opt.refine_intrinsics
     res = georeference_workspace(ws.root, gcps=gcps, crs=crs, options=georef_options, refine_intrinsics=refine,
@@ -239,6 +297,31 @@ def autocontrol_workspace(workspace_dir: str, reference_ortho: str, reference_ds
     doc.update(figures=figures, messages=messages, timings=timings)
     write_json(lay.autocontrol_json, doc)
     return AutoControlResult(ws.root, crs, prior, g, figures, cands, res, n_used, res.cameras_path, timings, messages)
+
+
+def _checks_in(check_points: Optional[GCPSet], crs: str) -> List[GroundPoint]:
+    """The check points as role check, taken from their set's CRS into the reference's ``crs`` (a national one
+    without an EPSG code: the user's points are usually in another)."""
+    pts = list(check_points.points) if check_points is not None else []
+    if not pts:
+        return []
+    xyz = np.array([[p.x, p.y, p.z] for p in pts], dtype=float)
+    if check_points.crs and check_points.crs != crs:
+        xyz = transform_points(xyz, check_points.crs, crs)
+    return [GroundPoint(p.name, float(a[0]), float(a[1]), float(a[2]), p.sigma_xy, p.sigma_z, CHECK,
+                        list(p.observations)) for p, a in zip(pts, xyz)]
+
+
+def _coarse_hint(figures: Dict, g: float, opt: AutoControlOptions) -> str:
+    """': the reference is too coarse for a block this small ...' when the block spans fewer reference pixels
+    than one matching tile (the per-tile affine, the spread of the candidates: the block is a handful of the
+    reference's features), else ''."""
+    px = float(figures.get("block_reference_pixels") or 0.0)
+    if not 0.0 < px < opt.tile_px:
+        return ""
+    return (f": the reference is too coarse for a block this small (the block spans {px:.0f} of its pixels, the "
+            f"match ran at {g:.3g} per pixel; a reference with cells {opt.tile_px / px:.1f} x finer, or a larger "
+            "block, gives enough matches)")
 
 
 def _count_used(lay: Layout, names) -> int:

@@ -9,10 +9,12 @@ from typing import Any, Dict, List
 
 import numpy as np
 
+from ...geometry.crs import linear_unit
+from ...georef.autocontrol.candidates import KEPT, reason
 from ...project.layout import read_json
 from ..context import ReportContext
 from ..figures import embed, equal_xy, new_figure
-from ..html import esc, fmt, kv, table
+from ..html import crs_label, esc, fmt, kv, table
 
 _STEPS = (("matches", "matches found (ratio test)"), ("similarity_inliers", "fit one similarity (RANSAC)"),
           ("tile_inliers", "fit the affine of their tile"), ("candidates", "tied back to the photos"),
@@ -32,16 +34,24 @@ def subsection(ctx: ReportContext) -> str:
         ("Reference orthophoto", esc(doc.get("reference_ortho", "–"))),
         ("Reference DSM", esc(doc.get("reference_dsm", "–"))),
         ("Rough position (prior)", esc(doc.get("prior", "–"))),
-        ("Common resolution of the match", f"{fmt(doc.get('gsd'), 3)} m"),
+        ("Reference CRS", esc(crs_label(doc.get("crs")))),
+        ("Common resolution of the match", f"{fmt(doc.get('gsd'), 3)} {_unit(doc.get('crs'))} per pixel"),
     ])]
     parts.append(table(["step", "matches / points"], [[label, str(f[k])] for k, label in _STEPS if k in f],
                        raw=False))
-    dropped = Counter(c["status"].split(" (")[0] for c in cands if c.get("status") != "kept")
+    dropped = doc.get("dropped") or dict(Counter(reason(c["status"]) for c in cands
+                                                 if c.get("status") != KEPT).most_common())
     if dropped:
-        parts.append(table(["dropped because", "candidates"], [[k, str(v)] for k, v in dropped.most_common()],
+        parts.append(table(["dropped because", "candidates"], [[k, str(v)] for k, v in dropped.items()],
                            raw=False))
     parts.append(_map(cands, rows))
     return "".join(parts)
+
+
+def _unit(crs) -> str:
+    """'m' for a CRS in metres, else its unit's name (US survey foot, ...) as the CRS declares it."""
+    name, metres = linear_unit(str(crs or ""))
+    return "m" if metres == 1.0 else (name or "units")
 
 
 def _map(cands: List[Dict[str, Any]], rows: Dict[str, Dict[str, Any]]) -> str:
