@@ -135,6 +135,26 @@ def test_rugged_shift_tilt_and_outliers(rugged, rugged_ref):
     assert abs(out[2] - rugged.at(out[0], out[1])) < 0.1
 
 
+def test_finer_reference_and_much_forest(rugged):
+    """A 5 m reference (ALS) against a 25 m DSM (the DSM's grid is then the comparison grid, the reference is
+    averaged onto it), with 40 % of the DSM under forest (+18 m): still the shift to a tenth of a cell."""
+    n = int(EXTENT / FINE)
+    xs = X0 + (np.arange(n) + 0.5) * FINE
+    ys = Y0 + EXTENT - (np.arange(n) + 0.5) * FINE
+    ref = rugged.grid(xs, ys).astype(np.float32)
+    ref_gt = (X0, FINE, 0.0, Y0 + EXTENT, 0.0, -FINE)
+    shift, dz, tilt = (-33.0, 14.0), 0.8, (-6e-4, 3e-4)
+    dsm, gt = block_dsm(rugged, shift, dz, tilt, outliers=False)
+    m, k = dsm.shape[0], int(REF_CELL / FINE)
+    coarse = dsm.reshape(m // k, k, m // k, k).mean(axis=(1, 3))
+    coarse[:, : int(0.4 * coarse.shape[1])] += 18.0  # the west 40 % is forest
+    res = coregister_dems(coarse, (gt[0], REF_CELL, 0.0, gt[3], 0.0, -REF_CELL), ref, ref_gt)
+    assert res.cell == REF_CELL and res.converged
+    assert math.hypot(res.shift[0] - shift[0], res.shift[1] - shift[1]) < 0.1 * REF_CELL
+    check_correction(res, dz, tilt, tol=0.1)
+    assert res.stable_fraction < 0.65
+
+
 def test_without_tilt_term_the_tilt_stays_in_the_residuals(rugged, rugged_ref):
     ref, ref_gt = rugged_ref
     dsm, gt = block_dsm(rugged, (10.0, 5.0), 1.0, (8e-4, -5e-4))

@@ -12,7 +12,8 @@ cosine to medians of aspect bins, then take the median of dh as the vertical bia
 in its multiplied form, by least squares over every stable cell together with the plane (and dome) terms, so that a
 tilt or a dome does not leak into the shift and flat cells (tan(slope) -> 0) need no special case.  Each iteration
 resamples the DEM at the shifted positions (bilinear), recomputes dh, keeps the stable cells (``stable_mask``, not
-too steep, within ``OUTLIER_NMAD`` NMADs of the median residual: new buildings, forest, landslides drop out) and
+too steep, within ``OUTLIER_NMAD`` spreads (as an NMAD) of the centre of the residuals' shortest half: new
+buildings, forest, landslides drop out, up to nearly half of the overlap, where a median would follow them) and
 adds the increment; it stops when the shift changes by less than ``tolerance`` cells and the model by less than
 a twentieth of the residual NMAD.  The vertical bias is finally set to the median of the stable residuals.
 
@@ -56,7 +57,7 @@ from ..common.errors import ArchaeoOrthoError
 from ..common.progress import NullProgress, Progress, check_cancel
 from ..io.raster import bilinear
 
-OUTLIER_NMAD = 3.0  # residuals beyond this many NMADs of the median are not stable terrain
+OUTLIER_NMAD = 3.0  # residuals beyond this many spreads of the shortest half's centre are not stable terrain
 MAX_SLOPE_DEG = 70.0  # steeper cells (cliffs, walls) are left out of the fit
 MIN_CELLS = 100  # stable cells needed for a fit
 MAX_GRID_CELLS = 4_000_000  # the comparison grid is coarsened beyond this (16 MiB per float32 copy)
@@ -168,13 +169,26 @@ class _Model:
 Sampler = Callable[[np.ndarray], Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
 
 
+def shorth(values: np.ndarray) -> Tuple[float, float]:
+    """(centre, spread) of the shortest interval holding half of the finite values: its midpoint, and its length
+    / 1.349 (the standard deviation for normal values, as the NMAD).  Unlike the median it stays on the larger
+    population when up to half of the values are one block of outliers (40 % of the DSM under forest)."""
+    v = np.sort(np.asarray(values, dtype=float)[np.isfinite(values)])
+    if v.size < 2:
+        return (float(v[0]) if v.size else math.nan), 0.0
+    k = v.size // 2
+    widths = v[k:] - v[: v.size - k]
+    i = int(np.argmin(widths))
+    return float(0.5 * (v[i] + v[i + k])), float(widths[i] / 1.349)
+
+
 def _inliers(r: np.ndarray, usable: np.ndarray) -> np.ndarray:
+    """The samples within OUTLIER_NMAD spreads of the residuals' shortest half."""
     ok = usable & np.isfinite(r)
     if not ok.any():
         return ok
-    med = np.median(r[ok])
-    spread = max(nmad(r[ok]), 1e-6)
-    return ok & (np.abs(r - med) <= OUTLIER_NMAD * spread)
+    centre, spread = shorth(r[ok])
+    return ok & (np.abs(r - centre) <= OUTLIER_NMAD * max(spread, 1e-6))
 
 
 @dataclass
@@ -250,9 +264,9 @@ def _fit(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, max_it
     sigma = math.sqrt(max(st.cov[0, 0], st.cov[1, 1], 0.0))
     if not (sigma <= UNDETERMINED_CELLS * cell) or st.relief < FLAT_NMADS * st.spread:
         horizontal = False
-        messages.append(f"the terrain is too flat (a one-cell shift changes the heights by {st.relief:.2g} m RMS, the "
-                        f"residuals spread {st.spread:.2g} m) to determine a horizontal shift: only the heights were "
-                        "co-registered (dx = dy = 0)")
+        messages.append(f"the terrain is too flat, or the surfaces differ too much (a one-cell shift changes the "
+                        f"heights by {st.relief:.2g} m RMS, the residuals spread {st.spread:.2g} m), to determine a "
+                        "horizontal shift: only the heights were co-registered (dx = dy = 0)")
         shift, p, it, converged, st = _iterate(sample, usable, model, cell, max_iterations, tolerance, False,
                                                progress)
     # the vertical bias as the median of the stable residuals, the statistics
@@ -856,4 +870,4 @@ def control_points_from_coregistration(result: CoregResult, ref: np.ndarray, ref
 
 
 __all__ = ["CoregError", "CoregResult", "PseudoControl", "control_points_from_coregistration", "coregister_dems",
-           "coregister_points", "coregister_points_file", "coregister_rasters", "nmad", "reference_window"]
+           "coregister_points", "coregister_points_file", "coregister_rasters", "nmad", "reference_window", "shorth"]
