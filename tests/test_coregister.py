@@ -127,6 +127,13 @@ def test_rugged_shift_tilt_and_outliers(rugged, rugged_ref):
     assert abs(res.median_after) < 0.1
     assert res.cell == REF_CELL and 2 <= res.iterations <= 10
     assert json.loads(json.dumps(res.as_dict()))["shift"] == list(res.shift)
+    # apply_to_grid(): the DSM moved and corrected lies on the terrain (away from the forest and buildings)
+    fixed, fixed_gt = res.apply_to_grid(dsm, gt)
+    assert fixed.dtype == np.float32 and fixed_gt[0] == pytest.approx(gt[0] + res.shift[0])
+    xs = fixed_gt[0] + (np.arange(600, 1200) + 0.5) * FINE
+    ys = fixed_gt[3] - (np.arange(600, 1200) + 0.5) * FINE
+    assert nmad(fixed[600:, 600:] - rugged.grid(xs, ys)) < 0.75  # the 0.5 m noise
+    assert abs(np.median(fixed[600:, 600:] - rugged.grid(xs, ys))) < 0.1
     # apply(): a DSM point lands on the terrain
     p = np.array([[BLOCK[0] + 2000.0, BLOCK[1] + 3000.0, 0.0]])
     q = p[0, :2] + shift

@@ -107,6 +107,20 @@ class CoregResult:
         p[:, 2] += self.correction(p[:, 0], p[:, 1])
         return p
 
+    def apply_to_grid(self, z: np.ndarray, geotransform: Sequence[float]) -> Tuple[np.ndarray, Tuple[float, ...]]:
+        """A DEM on the reference: (heights + correction as float32, the geotransform moved by (dx, dy)).  Row
+        blocks, so no float64 copy of a large DEM is made."""
+        gt = tuple(float(v) for v in geotransform)
+        gt = (gt[0] + self.shift[0], gt[1], gt[2], gt[3] + self.shift[1], gt[4], gt[5])
+        z = np.asarray(z)
+        out = np.empty(z.shape, np.float32)
+        xs = gt[0] + (np.arange(z.shape[1]) + 0.5) * gt[1]
+        for r0 in range(0, z.shape[0], 256):
+            r1 = min(z.shape[0], r0 + 256)
+            ys = gt[3] + (np.arange(r0, r1) + 0.5) * gt[5]
+            out[r0:r1] = z[r0:r1] + self.correction(xs[None, :], ys[:, None])
+        return out, gt
+
     def as_dict(self) -> dict:
         """The result as plain JSON-ready values (for the manifest and the report)."""
         out = asdict(self)
