@@ -304,16 +304,15 @@ __all__ = ["DEFAULT_GSD", "MAX_PIXELS", "LayerSnapshot", "ReferenceLayerError", 
 
 
 def reference_crs(ortho_path):
-    """'EPSG:n' (or the WKT) of a reference orthophoto file: the CRS the automatic control's result is in."""
-    from osgeo import gdal
+    """'EPSG:n' (or the WKT) of a reference orthophoto file: the CRS the automatic control's result is in (its
+    own; the UTM zone's for a geographic or Web Mercator file)."""
+    from ..core.georef.autocontrol.errors import AutoControlError
+    from ..core.georef.autocontrol.reference import result_crs
 
-    from ..core.geometry.crs import crs_identifier
-
-    ds = gdal.Open(ortho_path)
-    wkt = ds.GetProjection() if ds is not None else ""
-    if not wkt:
-        raise ReferenceLayerError(f"reference orthophoto {ortho_path} has no CRS")
-    return crs_identifier(wkt)
+    try:
+        return result_crs(ortho_path)
+    except AutoControlError as e:
+        raise ReferenceLayerError(str(e)) from e
 
 
 def as_check_points(gcps, crs):

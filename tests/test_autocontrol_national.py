@@ -27,7 +27,7 @@ from core.georef.autocontrol.candidates import (
 )
 from core.georef.autocontrol.errors import AutoControlError
 from core.georef.autocontrol.options import AutoControlOptions
-from core.georef.autocontrol.reference import Reference
+from core.georef.autocontrol.reference import Reference, result_crs
 from core.io.raster import crs_epsg, write_cog
 from tests import synthetic as syn
 from tests.national import degrade, has_no_epsg, national_wkt
@@ -98,7 +98,8 @@ def _rasters(folder, ortho_crs, dsm_crs, res=0.5, dsm_res=2.0, size=120.0):
     write_cog(dsm_utm, z, (gx, dsm_res, 0.0, gy, 0.0, -dsm_res), "EPSG:32633")
     if dsm_crs == "EPSG:32633":
         return ortho, dsm_utm
-    return ortho, degrade(dsm_utm, os.path.join(folder, "dsm.tif"), dsm_res, crs_to_wkt(dsm_crs))
+    res = dsm_res / 111320.0 if dsm_crs == "EPSG:4326" else dsm_res  # degrees for a geographic DSM
+    return ortho, degrade(dsm_utm, os.path.join(folder, "dsm.tif"), res, crs_to_wkt(dsm_crs))
 
 
 @pytest.mark.parametrize("dsm_in", ["national", "utm"])
@@ -108,6 +109,7 @@ def test_a_reference_in_a_national_crs_is_read_in_it(tmp_path, exceptions_on, ds
     ref = Reference(ortho, dsm)
     try:
         assert ref.crs == ref.crs_wkt and epsg_code(ref.crs) is None  # no traceback, the WKT itself
+        assert result_crs(ortho) == ref.crs and not ref.notes
         assert math.isclose(ref.gsd, 0.5)
         grey, valid, gt = ref.grey(ref.bounds, 1.0)
         assert valid.mean() > 0.9 and grey[valid].std() > 10
@@ -306,3 +308,40 @@ def test_a_pair_from_one_strip_is_placed_from_two_rough_positions(tmp_path, nati
     assert all(len(c.observations) == 2 for c in kept)
     exy, ez = _camera_errors(ws_dir, block, wkt)
     assert np.max(exy) <= 2.0 * 0.5 and np.max(ez) <= 3.0 * 0.5
+
+
+def test_a_web_mercator_or_geographic_reference_is_worked_in_metres(tmp_path, exceptions_on):
+    """A Web Mercator orthophoto (its metres 1 / cos(latitude) ground metres) and a DSM in longitude / latitude:
+    the control is made in the UTM zone of the orthophoto's centre, said in a note, heights unchanged."""
+    ortho, dsm = _rasters(str(tmp_path), "EPSG:3857", "EPSG:4326", res=0.5, dsm_res=2.0)
+    ref = Reference(ortho, dsm)
+    try:
+        assert ref.crs == "EPSG:32633" and any("Mercator" in n and "EPSG:32633" in n for n in ref.notes)
+        assert result_crs(ortho) == "EPSG:32633"  # what the faces give check points and positions in
+        lat = 41.5
+        assert ref.gsd == pytest.approx(0.5 * math.cos(math.radians(lat)), rel=0.05)  # ground metres
+        utm = np.array([[500030.0, 4600060.0], [500090.0, 4600030.0]])
+        np.testing.assert_allclose(ref.heights(utm[:, 0], utm[:, 1]), 100.0 + 0.05 * (utm[:, 0] - 500000.0),
+                                   atol=0.1)
+        grey, valid, _ = ref.grey(ref.bounds, 1.0)
+        assert valid.mean() > 0.5 and grey[valid].std() > 10
+    finally:
+        ref.close()
+
+
+def test_dsm_heights_in_feet_are_read_in_the_orthophotos_unit(tmp_path, exceptions_on):
+    """A DSM whose band says its heights are in feet: taken to the orthophoto's metres (a unit read, not
+    assumed)."""
+    from osgeo import gdal
+
+    ortho, dsm = _rasters(str(tmp_path), "EPSG:32633", "EPSG:32633")
+    ds = gdal.Open(dsm)
+    feet = gdal.Translate(str(tmp_path / "dsm_ft.tif"), ds, scaleParams=[[0, 1, 0, 1 / 0.3048]], outputType=gdal.GDT_Float32)
+    feet.GetRasterBand(1).SetUnitType("ft")
+    feet = None
+    ref = Reference(ortho, str(tmp_path / "dsm_ft.tif"))
+    try:
+        assert ref.z_scale == pytest.approx(0.3048) and any("ft" in n for n in ref.notes)
+        np.testing.assert_allclose(ref.heights(np.array([500030.0]), np.array([4600060.0])), [101.5], atol=0.05)
+    finally:
+        ref.close()

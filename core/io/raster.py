@@ -68,6 +68,39 @@ def crs_epsg(crs: Optional[str]) -> Tuple[Optional[int], bool]:
     return epsg_code(crs), bool(srs.IsGeographic())
 
 
+_FEET = {"ft": 0.3048, "foot": 0.3048, "feet": 0.3048, "international foot": 0.3048, "ft-us": 1200.0 / 3937.0,
+         "us-ft": 1200.0 / 3937.0, "ftus": 1200.0 / 3937.0, "us survey foot": 1200.0 / 3937.0,
+         "foot_us": 1200.0 / 3937.0}
+_METRES = {"m", "metre", "meter", "metres", "meters"}
+
+
+def height_unit(path: str) -> Tuple[str, float, str]:
+    """(unit name, metres per unit, where it was read) of a DSM's heights: the band's unit type when it declares
+    one ('ft', 'US survey foot', 'm'), else a compound CRS's vertical unit, else the unit of a projected CRS
+    whose axes are not in metres (a state plane DEM in feet), else metres ('' where nothing says: a DEM in a
+    geographic or metric CRS)."""
+    gdal, osr = _gdal()
+    ds = gdal.Open(path)
+    unit = (ds.GetRasterBand(1).GetUnitType() or "").strip()
+    if unit:
+        low = unit.lower()
+        if low in _FEET:
+            return unit, _FEET[low], "the band's unit"
+        if low in _METRES:
+            return unit, 1.0, "the band's unit"
+    wkt = ds.GetProjection() or ""
+    if wkt:
+        srs = osr.SpatialReference(wkt=wkt)
+        if srs.IsCompound() or srs.IsVertical():
+            try:
+                return "vertical CRS unit", float(srs.GetTargetLinearUnits("VERT_CS") or 1.0), "its vertical CRS"
+            except RuntimeError:
+                pass
+        if srs.IsProjected() and abs(srs.GetLinearUnits() - 1.0) > 1e-9:
+            return srs.GetLinearUnitsName() or "unit", float(srs.GetLinearUnits()), "its CRS's axes"
+    return "metre", 1.0, ""
+
+
 # ---------------------------------------------------------------------------
 # grid
 # ---------------------------------------------------------------------------
@@ -514,4 +547,4 @@ def read_las(path: str) -> Tuple[np.ndarray, np.ndarray, dict]:
 
 
 __all__ = ["Grid", "write_cog", "open_dsm", "DsmReader", "DsmInfo", "read_dsm", "write_las", "read_las", "DsmError",
-           "NODATA", "bilinear", "crs_to_wkt", "crs_epsg"]
+           "NODATA", "bilinear", "crs_to_wkt", "crs_epsg", "height_unit"]

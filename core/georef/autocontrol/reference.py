@@ -7,19 +7,51 @@ another one, ``core.io.raster.DsmReader``).
 from __future__ import annotations
 
 import os
-from typing import Tuple
+from typing import List, Tuple
 
 import numpy as np
 
 from ...common.errors import require
-from ...geometry.crs import crs_identifier
-from ...io.raster import DsmError, DsmReader
+from ...geometry.crs import CRSError, crs_identifier, is_mercator, linear_unit, transform_points, utm_epsg_for_lonlat
+from ...io.raster import DsmError, DsmReader, crs_to_wkt, height_unit
 from .errors import AutoControlError
 
 
+def _working_crs(path: str, ds, gt, wkt: str) -> Tuple[str, str]:
+    """(WKT, note) of the CRS the control is made in: the orthophoto's own, unless it is geographic (degrees) or
+    a Mercator (Web Mercator's metres are 1 / cos(latitude) ground metres: 1.3 at 40 degrees), then the UTM zone
+    of its centre, with a note that says so ('' otherwise)."""
+    unit = linear_unit(wkt)[0]
+    if unit != "degree" and not is_mercator(wkt):
+        return wkt, ""
+    centre = np.array([[gt[0] + 0.5 * ds.RasterXSize * gt[1], gt[3] + 0.5 * ds.RasterYSize * gt[5]]])
+    try:
+        lon, lat = transform_points(centre, wkt, "EPSG:4326")[0]
+    except CRSError as e:
+        raise AutoControlError(f"reference orthophoto {path}: its CRS cannot be taken to a metric one: {e}") from e
+    code = utm_epsg_for_lonlat(lon, lat)
+    kind = "geographic (degrees)" if unit == "degree" else "a Mercator projection (not ground metres)"
+    return crs_to_wkt(f"EPSG:{code}"), (f"reference orthophoto {os.path.basename(path)} is in a CRS that is {kind}: "
+                                        f"the automatic control works in EPSG:{code} (UTM), and its result is in it")
+
+
+def result_crs(ortho_path: str) -> str:
+    """The CRS the automatic control's result is in for this reference orthophoto ('EPSG:n' or a WKT): its own,
+    or the UTM zone of its centre for a geographic or Mercator one; the faces give check points and camera
+    positions in it."""
+    gdal = require("osgeo.gdal", "reading the reference orthophoto")
+    ds = gdal.Open(ortho_path)
+    wkt = ds.GetProjection() if ds is not None else ""
+    if not wkt:
+        raise AutoControlError(f"reference orthophoto {ortho_path} has no CRS")
+    return crs_identifier(_working_crs(ortho_path, ds, ds.GetGeoTransform(), wkt)[0])
+
+
 class Reference:
-    """``ortho_path``, ``dsm_path``: rasters GDAL reads, north-up; the DSM's heights are in the unit of the
-    orthophoto's CRS (metres)."""
+    """``ortho_path``, ``dsm_path``: rasters GDAL reads, north-up, in any CRS (a national one without an EPSG
+    code too).  The control is made in the orthophoto's CRS (``crs_wkt``), or in the UTM zone of its centre when
+    that CRS is geographic or a Mercator (``notes`` says so); the DSM is read in it, its heights scaled to that
+    CRS's unit from the unit the DSM declares (``core.io.raster.height_unit``)."""
 
     def __init__(self, ortho_path: str, dsm_path: str):
         gdal = require("osgeo.gdal", "reading the reference orthophoto")
@@ -38,9 +70,16 @@ class Reference:
         if gt[2] != 0 or gt[4] != 0:
             raise AutoControlError(f"reference orthophoto {ortho_path} is rotated (geotransform {gt}): warp it "
                                    "north-up first")
-        self.crs_wkt = ds.GetProjection() or ""
-        if not self.crs_wkt:
+        source_wkt = ds.GetProjection() or ""
+        if not source_wkt:
             raise AutoControlError(f"reference orthophoto {ortho_path} has no CRS")
+        self.notes: List[str] = []
+        self.source_crs_wkt = source_wkt
+        self.crs_wkt, note = _working_crs(ortho_path, ds, gt, source_wkt)
+        self.notes += [note] if note else []
+        if self.crs_wkt != source_wkt:  # read through a warped VRT: the grid, its cell and bounds in metres
+            ds = gdal.AutoCreateWarpedVRT(ds, source_wkt, self.crs_wkt, gdal.GRA_Bilinear)
+            gt = ds.GetGeoTransform()
         self.ortho_path, self.dsm_path = ortho_path, dsm_path
         self.geotransform = tuple(gt)
         self.gsd = float(abs(gt[1]))
@@ -55,6 +94,16 @@ class Reference:
         except DsmError as e:
             raise AutoControlError(f"reference DSM {dsm_path}: {e}") from e
         self.dsm_gsd = float(abs(self.dsm.geotransform[1]))
+        unit, metres, where = height_unit(dsm_path)
+        self.z_scale = metres / self._axis_metres()
+        if where and abs(self.z_scale - 1.0) > 1e-9:
+            self.notes.append(f"reference DSM heights in {unit} ({where}): scaled by {self.z_scale:.6g} to the "
+                              "orthophoto's CRS unit")
+
+    def _axis_metres(self) -> float:
+        """Metres per unit of the working CRS's axes."""
+        metres = linear_unit(self.crs_wkt)[1]
+        return metres if metres == metres and metres > 0 else 1.0
 
     @property
     def crs(self) -> str:
@@ -87,8 +136,9 @@ class Reference:
         return grey, valid, (xmin, res, 0.0, ymax, 0.0, -res)
 
     def heights(self, x, y) -> np.ndarray:
-        """DSM heights (NaN outside / nodata) at points of the orthophoto's CRS."""
-        return self.dsm.sample(x, y)
+        """DSM heights (NaN outside / nodata) at points of the working CRS, in its unit."""
+        z = self.dsm.sample(x, y)
+        return z * self.z_scale if self.z_scale != 1.0 else z
 
     def relief(self, x, y, radius: float) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(height, slope, misfit) around each point: a plane through the 3 x 3 DSM samples ``radius`` apart
@@ -112,4 +162,4 @@ class Reference:
         self._ds = None
 
 
-__all__ = ["Reference"]
+__all__ = ["Reference", "result_crs"]
