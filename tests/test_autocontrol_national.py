@@ -345,3 +345,22 @@ def test_dsm_heights_in_feet_are_read_in_the_orthophotos_unit(tmp_path, exceptio
         np.testing.assert_allclose(ref.heights(np.array([500030.0]), np.array([4600060.0])), [101.5], atol=0.05)
     finally:
         ref.close()
+
+
+def test_products_carry_a_crs_without_epsg_code(tmp_path, exceptions_on):
+    """The later stages' writers with the workspace's WKT CRS: a DSM GeoTIFF keeps it, the LAS point cloud
+    gets its WKT VLR (no GeoKey: there is no code), no 'Unsupported SRS' on the way."""
+    from osgeo import gdal, osr
+
+    from core.io.raster import read_las, write_las
+
+    wkt = national_wkt(*TOLEDO)
+    path = write_cog(str(tmp_path / "dsm.tif"), np.ones((4, 4), np.float32), (300000.0, 1.0, 0.0, 150000.0, 0.0, -1.0),
+                     wkt)
+    assert osr.SpatialReference(wkt=gdal.Open(path).GetProjection()).IsSame(osr.SpatialReference(wkt=wkt))
+    n = write_las(str(tmp_path / "dense.las"), [(np.zeros((3, 3)), np.zeros((3, 3), np.uint8))],
+                  (300000.0, 150000.0, 0.0), wkt)
+    _, _, header = read_las(str(tmp_path / "dense.las"))
+    assert n == 3 and [rid for _, rid, _ in header["vlrs"]] == [2112]
+    stored = header["vlrs"][0][2].rstrip(b"\0").decode()
+    assert osr.SpatialReference(wkt=stored).IsSame(osr.SpatialReference(wkt=wkt))
