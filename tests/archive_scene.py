@@ -11,7 +11,7 @@ No scanned archive sortie is at hand, so this makes one whose truth is known (pu
   buildings and halls, another season (the sun from another side, a tone curve) and colour;
 - **cameras** (:class:`FrameCamera`): a film metric camera (152.82 mm lens, a 230 x 230 mm picture area with cut
   corners, 4 or 8 fiducial marks, cross in a ring, bright on the dark film border), each frame *scanned*: 0.2 mm
-  pixels (1250 x 1250), a small scan rotation, a film affinity (x and y scales differing by 0.2 %), an offset,
+  pixels (1300 x 1300: 260 mm), a small scan rotation, a film affinity (x and y scales differing by 0.2 %), an offset,
   film grain; and a digital metric frame (120 mm lens, 92.16 x 165.888 mm sensor, 640 x 1152 px of 0.144 mm);
 - **flight**: strips along local x at about 5000 m (about 4600 m above the mean ground), 60 % forward overlap,
   30 % side overlap; 4 frames = one strip, 12 frames = two strips of 6 flown in opposite directions;
@@ -41,7 +41,7 @@ from tests.synthetic import Shot, _ray_cast, look_at, small_rotation
 ARCHIVE_PROJ = ("+proj=tmerc +lat_0=0 +lon_0=13.6666666667 +k=0.99985 +x_0=415000 +y_0=-4850000 +ellps=bessel "
                 "+towgs84=577.326,90.129,463.919,5.137,1.474,5.297,2.4232 +units=m +no_defs")
 ORIGIN = np.array([406000.0, 406000.0, 0.0])  # world = local + ORIGIN (about 13.55 E, 47.45 N)
-VERSION = "archive-v2"  # part of the cache marker: bump when the rendering changes
+VERSION = "archive-v4"  # part of the cache marker: bump when the rendering changes
 
 
 def archive_wkt() -> str:
@@ -500,7 +500,7 @@ class FrameCamera:
     fiducials_mm: Tuple[Tuple[str, float, float], ...] = ()
     mark_mm: float = 4.0  # outer diameter of a fiducial mark
     pixel_mm: float = 0.2  # scan pixel (film) or sensor pixel (digital)
-    size_px: Tuple[int, int] = (1250, 1250)  # width, height of the scan / the image
+    size_px: Tuple[int, int] = (1300, 1300)  # width, height of the scan / the image
 
     def calibration(self) -> dict:
         """The camera's calibration as a plain dict (a calibration file writer's input)."""
@@ -534,13 +534,13 @@ def film_camera(fiducials: int = 8, seed: int = 0) -> FrameCamera:
     """A 152.82 mm / 23 cm film metric camera with 4 (side) or 8 (side + corner) fiducials, calibrated coordinates
     a few hundredths of a mm off their nominal places."""
     rng = np.random.default_rng(900 + seed)
-    nominal = [("1", -117.0, 0.0), ("2", 117.0, 0.0), ("3", 0.0, 117.0), ("4", 0.0, -117.0)]
+    nominal = [("1", -119.5, 0.0), ("2", 119.5, 0.0), ("3", 0.0, 119.5), ("4", 0.0, -119.5)]  # 2.5 mm clear
     if fiducials == 8:
         nominal += [("5", -110.0, 110.0), ("6", 110.0, 110.0), ("7", 110.0, -110.0), ("8", -110.0, -110.0)]
     elif fiducials != 4:
         raise ValueError("fiducials: 4 or 8")
     fids = tuple((k, round(x + rng.normal(0, 0.01), 3), round(y + rng.normal(0, 0.01), 3)) for k, x, y in nominal)
-    return FrameCamera("film", 152.82, (0.012, -0.008), (115.0, 115.0), 25.0, fids, 4.0, 0.2, (1250, 1250))
+    return FrameCamera("film", 152.82, (0.012, -0.008), (115.0, 115.0), 25.0, fids, 4.0, 0.2, (1300, 1300))
 
 
 def digital_camera() -> FrameCamera:
@@ -937,7 +937,7 @@ def archive_block(kind: str = "film", n_frames: int = 4, seed: int = 1, out_dir:
                   progress=None) -> ArchiveBlock:
     """An archive block with its truth; the frames (and the modern reference) rendered into ``out_dir`` once.
 
-    ``out_dir``/images/*.tif: the scans (film: 1250 x 1250 grey) or the digital frames (640 x 1152 grey);
+    ``out_dir``/images/*.tif: the scans (film: 1300 x 1300 grey) or the digital frames (640 x 1152 grey);
     control_3m.csv (+ _observations.csv): the control points with N(0, 3 m) noise on X, Y and Z (seeded), no
     sigma columns, a ``# crs:`` WKT line, noisy pixel observations (N(0, 0.3 px)); control_true.csv: the same
     points' true coordinates; check.csv (+ observations): the check points, true; truth.json: everything;
