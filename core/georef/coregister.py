@@ -64,8 +64,10 @@ MAX_GRID_CELLS = 4_000_000  # the comparison grid is coarsened beyond this (16 M
 MAX_FIT_CELLS = 500_000  # a fixed random subset of the compared cells enters the fit (as xdem's default)
 MAX_STEP_CELLS = 4.0  # the horizontal increment of one iteration is limited to this many cells
 UNDETERMINED_CELLS = 0.25  # the shift's standard error (cells) above which the terrain is too flat for it
-FLAT_NMADS = 2.0  # ... or when a one-cell shift changes the heights by less than this many residual NMADs (RMS)
+FLAT_NMADS = 1.0  # ... or when a one-cell shift changes the heights (RMS) by less than this many residual NMADs
 DEM_MARGIN_CELLS = 8  # the DEM is kept this far around the overlap, for shifted samples
+SEARCH_CELLS = 4  # the start is searched on whole cells this far around no shift
+SEARCH_SAMPLES = 10_000  # ... on this many samples
 
 
 class CoregError(ArchaeoOrthoError, ValueError):
@@ -179,8 +181,9 @@ class _Model:
         return float(p[0]), tilt, dome
 
 
-# sample(shift) -> (x, y, dh, gx, gy): reference positions, R - D there, the reference's gradient; NaN = no data
-Sampler = Callable[[np.ndarray], Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
+# sample(shift, subset=None) -> (x, y, dh, gx, gy): reference positions, R - D there, the reference's gradient
+# (NaN = no data), of every sample or of the indices ``subset``
+Sampler = Callable[..., Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
 
 
 def shorth(values: np.ndarray) -> Tuple[float, float]:
@@ -245,10 +248,13 @@ def _step(sample: Sampler, shift: np.ndarray, p: np.ndarray, model: _Model, usab
 
 
 def _iterate(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, max_iterations: int,
-             tolerance: float, horizontal: bool, progress: Progress):
-    """Gauss-Newton from no shift until the shift changes by less than ``tolerance`` cells and the model by less
-    than a twentieth of the residual NMAD: (shift, parameters, iterations, converged, last step)."""
-    shift, p = np.zeros(2), np.zeros(model.size)
+             tolerance: float, horizontal: bool, progress: Progress, shift: Optional[np.ndarray] = None,
+             p: Optional[np.ndarray] = None):
+    """Gauss-Newton from ``shift``, ``p`` (none, zeros) until the shift changes by less than ``tolerance`` cells
+    and the model by less than a twentieth of the residual NMAD: (shift, parameters, iterations, converged, last
+    step)."""
+    shift = np.zeros(2) if shift is None else np.array(shift, dtype=float)
+    p = np.zeros(model.size) if p is None else np.array(p, dtype=float)
     st, it, converged = None, 0, False
     for it in range(1, max_iterations + 1):
         check_cancel(progress)
@@ -265,15 +271,59 @@ def _iterate(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, ma
     return shift, p, it, converged, st
 
 
+def _search(sample: Sampler, usable: np.ndarray, cell: float) -> np.ndarray:
+    """The start of the iterations: the shift, on whole cells within SEARCH_CELLS (every second cell, then the
+    cells around the best), whose height differences have the narrowest shortest half (on a fixed subset of
+    SEARCH_SAMPLES samples); no shift unless one is clearly better (a tenth narrower).  While the shift is large,
+    changed areas (a forest on one side) are not told from the terrain by their residuals, and a least-squares
+    step would follow them."""
+    idx = np.flatnonzero(usable)
+    if idx.size > SEARCH_SAMPLES:
+        idx = np.sort(np.random.default_rng(1).choice(idx, SEARCH_SAMPLES, replace=False))
+
+    def spread(i: int, j: int) -> float:
+        dh = sample(np.array([i * cell, j * cell]), idx)[2]
+        ok = np.isfinite(dh)
+        return shorth(dh[ok])[1] if ok.sum() >= max(MIN_CELLS, 0.5 * idx.size) else math.inf
+
+    k = SEARCH_CELLS
+    tried = {(i, j): spread(i, j) for i in range(-k, k + 1, 2) for j in range(-k, k + 1, 2)}
+    bi, bj = min(tried, key=tried.get)
+    for i in range(bi - 1, bi + 2):
+        for j in range(bj - 1, bj + 2):
+            if (i, j) not in tried:
+                tried[(i, j)] = spread(i, j)
+    bi, bj = min(tried, key=tried.get)
+    return np.array([bi * cell, bj * cell]) if tried[(bi, bj)] < 0.9 * tried[(0, 0)] else np.zeros(2)
+
+
+def _staged(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, max_iterations: int,
+            tolerance: float, horizontal: bool, progress: Progress):
+    """:func:`_iterate` with the shift and dz alone first, then the whole model from there: while the shift is
+    large, changed areas (a forest on one side) are not yet told from the terrain and a tilt would take them up."""
+    if not horizontal:
+        return _iterate(sample, usable, model, cell, max_iterations, tolerance, horizontal, progress)
+    start = _search(sample, usable, cell)
+    if model.size == 1:
+        return _iterate(sample, usable, model, cell, max_iterations, tolerance, True, progress, start)
+    plain = _Model(model.origin, model.scale, False, False)
+    shift, p0, it0, _, _ = _iterate(sample, usable, plain, cell, max_iterations, 0.1, True, progress, start)
+    p = np.zeros(model.size)
+    p[0] = p0[0]
+    shift, p, it, converged, st = _iterate(sample, usable, model, cell, max_iterations, tolerance, True, progress,
+                                           shift, p)
+    return shift, p, it0 + it, converged, st
+
+
 def _fit(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, max_iterations: int, tolerance: float,
          progress: Progress) -> CoregResult:
     """The co-registration and its statistics.  The shift is dropped (and the heights fitted again) when the
     terrain cannot fix it: its standard error over UNDETERMINED_CELLS cells, or a one-cell shift changing the
-    heights by less than two residual NMADs (the gradient is then mostly noise)."""
+    heights by less than the residual NMAD (the gradient is then mostly noise)."""
     messages: List[str] = []
     _, _, dh0, _, _ = sample(np.zeros(2))
     before = dh0[usable & np.isfinite(dh0)]
-    shift, p, it, converged, st = _iterate(sample, usable, model, cell, max_iterations, tolerance, True, progress)
+    shift, p, it, converged, st = _staged(sample, usable, model, cell, max_iterations, tolerance, True, progress)
     horizontal = True
     sigma = math.sqrt(max(st.cov[0, 0], st.cov[1, 1], 0.0))
     if not (sigma <= UNDETERMINED_CELLS * cell) or st.relief < FLAT_NMADS * st.spread:
@@ -502,10 +552,12 @@ def _grid_sampler(pair: _Pair, seed: int = 0) -> Tuple[Sampler, np.ndarray]:
     del gr, gc
     dg = pair.dem_gt
 
-    def sample(shift: np.ndarray):
-        fc = (x - shift[0] - dg[0]) / dg[1] - 0.5
-        fr = (y - shift[1] - dg[3]) / dg[5] - 0.5
-        return x, y, z - bilinear(pair.dem, fc, fr), gx, gy
+    def sample(shift: np.ndarray, sub: Optional[np.ndarray] = None):
+        xs, ys, zs = (x, y, z) if sub is None else (x[sub], y[sub], z[sub])
+        fc = (xs - shift[0] - dg[0]) / dg[1] - 0.5
+        fr = (ys - shift[1] - dg[3]) / dg[5] - 0.5
+        dh = zs - bilinear(pair.dem, fc, fr)
+        return (xs, ys, dh, gx, gy) if sub is None else (xs, ys, dh, gx[sub], gy[sub])
 
     return sample, np.ones(idx.size, dtype=bool)
 
@@ -693,11 +745,12 @@ def coregister_points(points_xyz: np.ndarray, ref: np.ndarray, ref_transform: Se
     gx, gy = gc / np.float32(wgt[1]), gr / np.float32(wgt[5])
     xy, z = pts[:, :2], pts[:, 2]
 
-    def sample(shift: np.ndarray):
-        qx, qy = xy[:, 0] + shift[0], xy[:, 1] + shift[1]
+    def sample(shift: np.ndarray, sub: Optional[np.ndarray] = None):
+        p, zs = (xy, z) if sub is None else (xy[sub], z[sub])
+        qx, qy = p[:, 0] + shift[0], p[:, 1] + shift[1]
         fc = (qx - wgt[0]) / wgt[1] - 0.5
         fr = (qy - wgt[3]) / wgt[5] - 0.5
-        return qx, qy, bilinear(win, fc, fr) - z, bilinear(gx, fc, fr), bilinear(gy, fc, fr)
+        return qx, qy, bilinear(win, fc, fr) - zs, bilinear(gx, fc, fr), bilinear(gy, fc, fr)
 
     usable = keep if stable is None else keep & np.asarray(stable, dtype=bool).reshape(-1)
     _, _, dh, _, _ = sample(np.zeros(2))
