@@ -15,7 +15,12 @@ resamples the DEM at the shifted positions (bilinear), recomputes dh, keeps the 
 too steep, within ``OUTLIER_NMAD`` spreads (as an NMAD) of the centre of the residuals' shortest half: new
 buildings, forest, landslides drop out, up to nearly half of the overlap, where a median would follow them) and
 adds the increment; it stops when the shift changes by less than ``tolerance`` cells and the model by less than
-a twentieth of the residual NMAD.  The vertical bias is finally set to the median of the stable residuals.
+a twentieth of the residual NMAD.  The iterations start from the whole-cell shift (within ``SEARCH_CELLS``) whose
+differences have the narrowest shortest half, and fit the shift and dz alone before the tilt: while the shift is
+large, changed areas are not told from the terrain by their residuals and a tilt would take up a forest on one
+side.  The vertical bias is finally set to the median of the stable residuals.  Where the terrain cannot fix the
+shift (flat, or the surfaces too different), dx = dy = 0 is held, ``horizontal_determined`` is False and a
+message says why.
 
 Conventions (metres, the reference's horizontal CRS):
 
