@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from osgeo import gdal
 
+from core.common.progress import NullProgress
 from core.geometry.camera import Intrinsics, Pose
 from core.io import raster as rastermod
 from core.ortho.cameras import OrthoCamera
@@ -104,8 +105,18 @@ def test_sky_detector_masks_the_sky_and_keeps_the_ground(orbit, two_renders, tmp
     prior = np.ones(truth.shape, bool)
     prior[-20:, :] = False  # e.g. a date stamp at the bottom
     cv2.imwrite(os.path.join(masks, steep.name + ".png"), np.where(prior, 255, 0).astype(np.uint8))
-    res = sky.write_sky_masks(images, [steep.name, mild.name], masks)
+    infos = []
+
+    class Log(NullProgress):
+        def info(self, message):
+            infos.append(message)
+
+    res = sky.write_sky_masks(images, [steep.name, mild.name], masks, progress=Log())
     assert set(res.masks) == {steep.name}
+    # the log says how much each mask took (issue 36 item 7)
+    last = int(np.flatnonzero((~keep).any(axis=1))[-1])
+    assert infos == [f"sky mask: {steep.name}: {100 * (1 - keep.mean()):.1f} % of the photo (rows 0\u2013{last})"]
+    assert res.sky_rows[steep.name] == (0, last)
     written = read_keep(find_mask(masks, steep.name), CAM.width, CAM.height)
     assert np.array_equal(written, keep & prior)
     assert find_mask(masks, mild.name) is None
@@ -135,6 +146,104 @@ def test_sky_detector_finds_no_sky_in_vertical_photos():
                              per_strip=2, gcp_grid=(2, 2), roofs=0)
     grey = syn.render_image(blk.scene, blk.camera, blk.shots[0])
     assert sky.sky_keep(grey).all()
+
+
+def _pale_band(img: np.ndarray, depth: float = 0.35, alpha: float = 0.75, colour=(228, 228, 226)) -> np.ndarray:
+    """``img`` (RGB) with a pale band over its upper part (over-exposure, haze): ``alpha`` at the upper edge,
+    fading out at ``depth`` of the height."""
+    h = img.shape[0]
+    a = np.clip(alpha * (1.0 - (np.arange(h) / h) / depth), 0.0, 1.0)[:, None, None]
+    out = img.astype(np.float32) * (1.0 - a) + np.asarray(colour, np.float32) * a
+    return np.clip(np.round(out), 0, 255).astype(np.uint8)
+
+
+def _paint_road(img: np.ndarray, top: np.ndarray, bottom: float, x0: float, slope: float, half: float,
+                grey=(200, 200, 198)) -> np.ndarray:
+    """``img`` with a smooth pale road (RGB ``grey``) from row ``top[col]`` down to ``bottom`` of the height,
+    centred at ``x0`` of the width and drifting ``slope`` of it over the height, ``half`` of the width wide."""
+    h, w = img.shape[:2]
+    yy, xx = np.mgrid[0:h, 0:w]
+    road = (np.abs(xx - (x0 + slope * yy / h) * w) < half * w) & (yy >= top[None, :]) & (yy < bottom * h)
+    out = img.copy()
+    out[road] = (np.asarray(grey, np.float32)
+                 + np.random.default_rng(1).normal(0.0, 1.0, (int(road.sum()), 3))).clip(0, 255).astype(np.uint8)
+    return out
+
+
+@pytest.fixture(scope="module")
+def nadir_pale(orbit):
+    """A nadir-ish photo of the orbit's site (11 degrees off nadir: no sky at all) with a pale band over its upper
+    part (over-exposed, hazy field) and a smooth pale road from the upper edge down to 93 % of the height, as in
+    issue 36 item 7 (about 2 s)."""
+    base = orbit.scene.base_z
+    c = np.array([3.0, -8.0, base + 40.0])
+    shot = syn.Shot("NADIR.jpg", syn.look_at(c, np.array([3.0, 0.0, base]), np.array([0.0, 0.0, 1.0])), c)
+    img = syn.render_oblique_image(orbit.scene, orbit.camera, shot, seed=5)
+    assert not orbit.sky_mask(shot).any()
+    img = _paint_road(img, np.zeros(img.shape[1], int), 0.93, 0.3, 0.08, 0.025, grey=(178, 174, 168))
+    return _pale_band(img)
+
+
+def test_sky_mask_stops_at_the_horizon(orbit, two_renders, nadir_pale):
+    """Issue 36 item 7: a pale band over the top of a nadir-ish photo and the smooth road below it were masked
+    as sky down to near the lower edge (row 336 of 360 here; row 877 of 900 on the Toledo photos).  The sky's lower
+    edge must follow a horizon (one smooth line across the photo) and the mask stops there."""
+    from tests.conftest import SAMPLE, TOLEDO_STRIP
+
+    keep = sky.sky_keep(nadir_pale)
+    assert (~keep).mean() < 0.005, f"nadir-ish photo masked {(~keep).mean():.1%}"
+    # three real vertical photos under a pale band (the issue's case)
+    for name in TOLEDO_STRIP[:3]:
+        img = cv2.cvtColor(cv2.imread(os.path.join(SAMPLE, "images", name)), cv2.COLOR_BGR2RGB)
+        for depth, alpha, grey in ((0.3, 0.7, 220), (0.25, 0.85, 235)):
+            keep = sky.sky_keep(_pale_band(img, depth, alpha, (grey,) * 3))
+            assert (~keep).mean() < 0.005, (name, depth, alpha, (~keep).mean())
+    # the oblique, and the oblique with a pale road from the horizon down: the mask stops at the true horizon
+    steep, _, paths = two_renders
+    img = cv2.cvtColor(cv2.imread(paths[steep.name]), cv2.COLOR_BGR2RGB)
+    truth = orbit.sky_mask(steep)
+    h = truth.shape[0]
+    horizon = truth.sum(axis=0)  # rows of sky per column
+    road = _paint_road(img, horizon, 0.85, 0.6, -0.15, 0.03)
+    tol = SkyOptions().horizon_tolerance + SkyOptions().margin + 0.01  # of the height: the band and the haze
+    for label, im in (("oblique", img), ("oblique and a pale road", road)):
+        keep = sky.sky_keep(im)
+        below = (~keep).sum(axis=0) - horizon  # rows masked below the true horizon, per column
+        print(f"\n{label}: masked {(~keep).mean():.3f}, below the horizon {below.min()}..{below.max()} rows")
+        assert not (truth & keep).any(), label
+        assert below.min() >= 0 and below.max() <= tol * h, (label, below.min(), below.max())
+
+
+def _with_xmp_pitch(src: str, dst: str, pitch: float) -> None:
+    """A copy of the JPEG ``src`` with a DJI XMP packet (APP1) giving the gimbal pitch."""
+    xmp = (b'<?xpacket begin="" id="W5M0MpCehiHzreSzNTczkc9d"?><x:xmpmeta xmlns:x="adobe:ns:meta/"><rdf:RDF '
+           b'xmlns:rdf="http://www.w3.org/1999/02/22-rdf-syntax-ns#"><rdf:Description '
+           b'xmlns:drone-dji="http://www.dji.com/drone-dji/1.0/" drone-dji:GimbalRollDegree="+0.00" '
+           b'drone-dji:GimbalPitchDegree="%+.2f"/></rdf:RDF></x:xmpmeta><?xpacket end="w"?>' % pitch)
+    payload = b"http://ns.adobe.com/xap/1.0/\x00" + xmp
+    data = open(src, "rb").read()
+    assert data[:2] == b"\xff\xd8"
+    with open(dst, "wb") as f:
+        f.write(data[:2] + b"\xff\xe1" + (len(payload) + 2).to_bytes(2, "big") + payload + data[2:])
+
+
+def test_sky_mask_follows_the_camera_pitch(orbit, two_renders, tmp_path):
+    """Where the photo records its camera's pitch (a drone's XMP), a camera looking down too steeply to see the
+    horizon gets no mask whatever its pixels look like, and one that sees it keeps the mask of its pixels."""
+    from core.io.images import xmp_camera_pitch
+
+    steep, _, paths = two_renders
+    nadir, tilted = str(tmp_path / "nadir.jpg"), str(tmp_path / "tilted.jpg")
+    _with_xmp_pitch(paths[steep.name], nadir, -90.0)
+    _with_xmp_pitch(paths[steep.name], tilted, -25.0)  # 65 degrees off nadir: the truth
+    assert xmp_camera_pitch(nadir) == -90.0 and xmp_camera_pitch(tilted) == -25.0
+    assert xmp_camera_pitch(paths[steep.name]) is None
+    assert sky.detect_sky(nadir).all()
+    assert np.array_equal(sky.detect_sky(tilted), sky.detect_sky(paths[steep.name]))
+    # the geometry: 25 degrees above the axis (f = 300 px, 360 rows) is row 180 - 300 tan 25 = 40.1
+    assert sky.horizon_row_of_pitch(-25.0, 300.0, 360) == pytest.approx(180 - 300 * math.tan(math.radians(25)))
+    assert sky.horizon_row_of_pitch(-90.0, 300.0, 360, below_deg=5.0) < -1000
+    assert sky.horizon_row_of_pitch(-89.95, 300.0, 360) == -math.inf
 
 
 def test_horizon_of_the_pose_is_the_true_horizon(orbit):

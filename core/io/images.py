@@ -180,6 +180,23 @@ def exif_orientation(path: str) -> int:
     return _orientation_value(open_image(path).GetMetadataItem("EXIF_Orientation"))
 
 
+XMP_SCAN_BYTES = 262144  # the XMP packet of a drone photo sits in its first APP1 segments (DJI: within 64 KiB)
+_PITCH_RE = re.compile(rb"(?:Gimbal|Camera)PitchDegree(?:\s*=\s*[\"']|>)\s*([-+]?\d+(?:\.\d+)?)")
+
+
+def xmp_camera_pitch(path: str) -> Optional[float]:
+    """The camera's pitch in degrees above the horizontal (-90: straight down) as a drone writes it in the XMP
+    packet (DJI ``drone-dji:GimbalPitchDegree``, Parrot ``CameraPitchDegree``); None when the photo has none.
+    Reads the first ``XMP_SCAN_BYTES`` of the file; OSError when it cannot be read."""
+    with open(path, "rb") as f:
+        head = f.read(XMP_SCAN_BYTES)
+    m = _PITCH_RE.search(head)
+    if not m:
+        return None
+    value = float(m.group(1))
+    return value if -180.0 <= value <= 180.0 else None
+
+
 def _check_orientation(orientation: int) -> int:
     o = int(orientation)
     if o not in ORIENTATION_STEPS:

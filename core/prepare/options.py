@@ -64,3 +64,10 @@ class SkyOptions:
     min_fraction: float = 0.005  # a smaller region at the upper edge is no sky
     min_top_cover: float = 0.25  # the sky spans at least this share of the upper edge (and never reaches the lower)
     margin: float = 0.015  # the mask reaches this fraction of the image height beyond the sky (the horizon's haze)
+    # the horizon: the sky's lower edge follows one smooth line (a straight horizon, bent by the lens) within this
+    # fraction of the image height over at least min_horizon_cover of the width; the mask stops there
+    horizon_tolerance: float = 0.015
+    min_horizon_cover: float = 0.7
+    # where the photo records its camera's pitch (a drone's XMP): no sky more than this far below the horizon the
+    # pitch and the focal length give (the gimbal's accuracy, a guessed focal length, a small roll)
+    pitch_slack_deg: float = 5.0

@@ -10,12 +10,18 @@ noise) and the haze along the horizon matches anything.
   of ``SkyOptions.analysis_size``) that are bright and bluish or pale, keeps the connected regions of them that
   touch the upper edge and do not reach the lower one (a smooth field or road running across a vertical photo
   does) and together span at least ``min_top_cover`` of it, fills their holes (clouds, a bird: what the lower
-  edge cannot reach without crossing the sky), and widens the result by
-  ``SkyOptions.margin`` of the image height downwards to take the horizon's mixed pixels.  A region under
-  ``min_fraction`` of the image is no sky (a pale roof at the upper edge of a vertical photo).
+  edge cannot reach without crossing the sky).  The sky stops at the horizon: its lower edge must follow one
+  smooth line (a straight horizon bent by the lens, fitted robustly) within ``horizon_tolerance`` of the height
+  over ``min_horizon_cover`` of the width, and the mask is cut there; a region whose lower edge follows no such
+  line is no sky (a pale or over-exposed band over the top of a vertical photo, whose lower edge is ragged, and
+  a road running down from it).  Where the photo records its camera's pitch (a drone's XMP) the mask stops where
+  the geometry puts the horizon too, and a camera looking down too steeply to see it gets none.  The result is
+  widened by ``SkyOptions.margin`` of the image height downwards to take the horizon's mixed pixels.  A region
+  under ``min_fraction`` of the image is no sky (a pale roof at the upper edge of a vertical photo).
 - :func:`write_sky_masks` writes those masks through the mask machinery of :mod:`core.prepare.masks`
   (``masks/<image>.png``, white = use, merged with a mask the image already has): the alignment's feature
-  extraction then ignores the sky (COLMAP's ``mask_path``), as it ignores a scan's film border.
+  extraction then ignores the sky (COLMAP's ``mask_path``), as it ignores a scan's film border; the log says, per
+  photo, how much the mask took ("sky mask: IMG_1.jpg: 12.3 % of the photo (rows 0–214)").
 - :func:`horizon_keep` (after alignment, from the adjusted pose): the pixels whose ray points less than
   ``margin_deg`` below the horizontal (and everything above it).  The vertical is the georeferenced frame's z, or
   :func:`estimate_up` from an aligned, not yet georeferenced model (the normal of the tie points' best plane,
@@ -30,6 +36,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass, field
+from itertools import combinations
 from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
@@ -37,18 +44,31 @@ import numpy as np
 from ..common.errors import require
 from ..common.progress import NullProgress, Progress, check_cancel
 from ..geometry.camera import Intrinsics
-from ..io.images import ORIENTATION_STEPS, exif_orientation, full_scale, read_image, to_upright
+from ..io.images import (
+    ORIENTATION_STEPS,
+    exif_orientation,
+    full_scale,
+    read_image,
+    read_image_info,
+    to_upright,
+    upright_size,
+    xmp_camera_pitch,
+)
 from .masks import find_mask, mask_file_name, read_keep, write_keep
 from .options import SkyOptions
 
-__all__ = ["SkyResult", "detect_sky", "estimate_up", "horizon_keep", "sky_keep", "write_horizon_masks",
-           "write_sky_masks"]
+__all__ = ["SkyResult", "detect_sky", "estimate_up", "horizon_keep", "horizon_row_of_pitch", "masked_rows",
+           "sky_keep", "write_horizon_masks", "write_sky_masks"]
+
+
+WIDEST_FOCAL_FACTOR = 0.5  # focal length / long side of the widest usual lens (about 90 degrees across)
 
 
 @dataclass
 class SkyResult:
     masks: Dict[str, str] = field(default_factory=dict)  # image -> mask file written
     sky_fraction: Dict[str, float] = field(default_factory=dict)  # image -> share of its pixels hidden as sky
+    sky_rows: Dict[str, Tuple[int, int]] = field(default_factory=dict)  # image -> first, last row of its sky (upright)
     warnings: List[str] = field(default_factory=list)
 
 
@@ -106,20 +126,12 @@ def _down_to_the_ground(cand: np.ndarray, columns: np.ndarray) -> np.ndarray:
     return (np.arange(h)[:, None] < first[None, :]) & ok[None, :]
 
 
-def sky_keep(img: np.ndarray, options: Optional[SkyOptions] = None, orientation: int = 1) -> np.ndarray:
-    """(height, width) bool of an image array (rows, cols[, bands]): True = use, False = sky.
-
-    ``orientation``: the photo's EXIF orientation (the sky is searched at the upper edge of the upright photo)."""
+def _sky_region(small: np.ndarray, options: SkyOptions) -> np.ndarray:
+    """The sky candidates of an upright analysis-size image: the smooth, bright, bluish or pale regions touching
+    the upper edge, spanning ``min_top_cover`` of it, never reaching the lower edge, down to the ground in their
+    columns, with their holes (clouds, a bird: what the lower edge cannot reach without crossing them) filled.
+    All False when there are none.  Not yet limited to a horizon (:func:`_horizon_line`)."""
     cv2 = require("cv2", "sky masks")
-    options = options or SkyOptions()
-    img = img if img.ndim == 3 else img[:, :, None]
-    height, width = img.shape[:2]
-    up = to_upright(img, orientation)
-    uh, uw = up.shape[:2]
-    s = min(1.0, options.analysis_size / float(max(uh, uw)))
-    small = up if s >= 1.0 else cv2.resize(up, (max(1, round(uw * s)), max(1, round(uh * s))),
-                                           interpolation=cv2.INTER_AREA)
-    small = small if small.ndim == 3 else small[:, :, None]
     cand = _candidates(small, options).astype(np.uint8)
     cand = cv2.morphologyEx(cand, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
     n, labels = cv2.connectedComponents(cand, connectivity=4)
@@ -131,23 +143,124 @@ def sky_keep(img: np.ndarray, options: Optional[SkyOptions] = None, orientation:
     sky = np.isin(labels, ids) if n > 1 and ids else np.zeros(cand.shape, bool)
     band = max(1, int(round(0.05 * sky.shape[0])))
     if sky[:band].any(axis=0).mean() < options.min_top_cover:
-        sky[:] = False
+        return np.zeros(cand.shape, bool)
     sky |= _down_to_the_ground(cand > 0, sky[:band].any(axis=0))
-    if sky.mean() < options.min_fraction:
-        return np.ones((height, width), bool)
-    # holes (clouds, a bird): what the lower edge cannot reach without crossing the sky is sky too
     ground = (~sky).astype(np.uint8)
     n, labels = cv2.connectedComponents(ground, connectivity=4)
     edge = np.unique(labels[-1])
-    sky = ~np.isin(labels, edge[edge > 0])
-    m = max(1, int(round(options.margin * sky.shape[0])))
+    return ~np.isin(labels, edge[edge > 0])
+
+
+def _horizon_line(sky: np.ndarray, tol: float, min_cover: float) -> Optional[np.ndarray]:
+    """The horizon under a sky region (rows, cols): per column, the row (float, may be < 0 where it leaves
+    through the upper edge) of one smooth curve (a parabola: a straight horizon bent by the lens) that the lower
+    edge of the sky follows within ``tol`` rows over at least ``min_cover`` of the width; None when it follows
+    none (a pale band over a field, a road running down the photo: their lower edge is ragged or deep in a few
+    columns).  Columns above the curve (a tree or a roof on the skyline) are allowed, as are columns below it
+    (haze, a pale field beyond the horizon): the caller stops the sky at the curve."""
+    h, w = sky.shape
+    ground = ~sky
+    low = np.where(ground.any(axis=0), ground.argmax(axis=0), h).astype(float)  # first ground row per column
+    x = (np.arange(w) + 0.5) / w - 0.5
+    basis = np.vander(x, 3)
+    # RANSAC over every triple of 32 columns spread over the width (4960 candidates, deterministic)
+    idx = np.unique(np.linspace(0, w - 1, min(32, w)).round().astype(int))
+    if len(idx) < 3:
+        return None
+    triples = np.array(list(combinations(idx, 3)))
+    a, b = basis[triples], low[triples]
+    ok = np.abs(np.linalg.det(a)) > 1e-12
+    coef = np.linalg.solve(a[ok], b[ok][..., None])[..., 0]
+    coef = coef[np.abs(coef[:, 0]) <= 0.3 * h]  # a lens bends a horizon by a few % of the height, not more
+
+    def inliers(c: np.ndarray) -> np.ndarray:
+        fit = basis @ c.T  # (w, k)
+        return (np.abs(low[:, None] - fit) <= tol) & ((low[:, None] > 0) | (fit < 0))
+
+    if not len(coef):
+        return None
+    best = coef[int(np.argmax(inliers(coef).sum(axis=0)))]
+    inl = inliers(best[None])[:, 0]
+    if inl.sum() >= 3:  # least squares on the inliers of the best candidate
+        best = np.linalg.lstsq(basis[inl], low[inl], rcond=None)[0]
+        inl = inliers(best[None])[:, 0]
+    if inl.mean() < min_cover:
+        return None
+    return basis @ best
+
+
+def sky_keep(img: np.ndarray, options: Optional[SkyOptions] = None, orientation: int = 1,
+             horizon_row: Optional[float] = None) -> np.ndarray:
+    """(height, width) bool of an image array (rows, cols[, bands]): True = use, False = sky.
+
+    ``orientation``: the photo's EXIF orientation (the sky is searched at the upper edge of the upright photo).
+    The sky stops at the horizon: the smooth line its lower edge follows across the photo; a bright smooth region
+    at the upper edge whose lower edge follows no such line (a pale or over-exposed band over a field, a road
+    running down a vertical photo) is no sky.  ``horizon_row``: where the camera's geometry puts the horizon
+    (a row of the upright photo at this size, :func:`horizon_row_of_pitch`; -inf: out of view), when known: no
+    mask reaches more than ``SkyOptions.horizon_tolerance`` below it."""
+    cv2 = require("cv2", "sky masks")
+    options = options or SkyOptions()
+    img = img if img.ndim == 3 else img[:, :, None]
+    height, width = img.shape[:2]
+    up = to_upright(img, orientation)
+    uh, uw = up.shape[:2]
+    if horizon_row is not None and horizon_row + options.horizon_tolerance * uh < 0:
+        return np.ones((height, width), bool)  # the camera cannot see the horizon (a vertical photo)
+    s = min(1.0, options.analysis_size / float(max(uh, uw)))
+    small = up if s >= 1.0 else cv2.resize(up, (max(1, round(uw * s)), max(1, round(uh * s))),
+                                           interpolation=cv2.INTER_AREA)
+    small = small if small.ndim == 3 else small[:, :, None]
+    sky = _sky_region(small, options)
+    if sky.mean() < options.min_fraction:
+        return np.ones((height, width), bool)
+    sh = sky.shape[0]
+    tol = max(2.0, options.horizon_tolerance * sh)
+    line = _horizon_line(sky, tol, options.min_horizon_cover)
+    if line is None:
+        return np.ones((height, width), bool)
+    if horizon_row is not None:
+        line = np.minimum(line, horizon_row * sh / uh)
+    sky &= np.arange(sh)[:, None] < (line + tol)[None, :]
+    if sky.mean() < options.min_fraction:
+        return np.ones((height, width), bool)
+    m = max(1, int(round(options.margin * sh)))
     sky = cv2.dilate(sky.astype(np.uint8), cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * m + 1, 2 * m + 1))) > 0
     full = cv2.resize(sky.astype(np.uint8), (uw, uh), interpolation=cv2.INTER_NEAREST) > 0
     return ~_from_upright(full, orientation).reshape(height, width)
 
 
+def horizon_row_of_pitch(pitch_deg: float, focal_px: float, height: int, below_deg: float = 0.0) -> float:
+    """The row of the upright photo (``height`` rows, principal point at its centre) where a camera pitched
+    ``pitch_deg`` above the horizontal (-90: straight down) sees the directions ``below_deg`` under the horizon;
+    -inf when they lie beyond the upper edge's side of the view (a vertical photo sees no horizon)."""
+    above_axis = -float(below_deg) - float(pitch_deg)  # degrees above the optical axis
+    if above_axis >= 89.9:
+        return -math.inf
+    if above_axis <= -89.9:
+        return math.inf
+    return height / 2.0 - focal_px * math.tan(math.radians(above_axis))
+
+
+def _geometry_horizon(path: str, orientation: int, options: SkyOptions) -> Optional[float]:
+    """The row of the upright photo below which no sky can be (``pitch_slack_deg`` under the horizon: the gimbal's
+    accuracy, a small roll), or None when the camera's pitch is unknown.  The pitch from the drone's XMP
+    (:func:`core.io.images.xmp_camera_pitch`), the focal length from EXIF (without one, the widest usual lens)."""
+    pitch = xmp_camera_pitch(path)
+    if pitch is None:
+        return None
+    info = read_image_info(path)
+    _, uh = upright_size(orientation, info.width, info.height)
+    # without a focal length in EXIF, the widest usual lens (the horizon comes into view soonest)
+    focal = float(info.focal_px) if info.focal_px and info.focal_source != "default" else \
+        WIDEST_FOCAL_FACTOR * max(info.width, info.height)
+    return horizon_row_of_pitch(pitch, focal, uh, options.pitch_slack_deg)
+
+
 def detect_sky(path: str, options: Optional[SkyOptions] = None) -> np.ndarray:
-    """The sky detector on one photo file: (height, width) bool in the stored pixel grid, True = use."""
+    """The sky detector on one photo file: (height, width) bool in the stored pixel grid, True = use.  Where the
+    photo records its camera's pitch (a drone's XMP) the sky stops where the geometry puts the horizon, and a
+    camera looking down too steeply to see it gets no mask."""
     options = options or SkyOptions()
     orientation = exif_orientation(path)
     from osgeo import gdal
@@ -155,12 +268,23 @@ def detect_sky(path: str, options: Optional[SkyOptions] = None) -> np.ndarray:
     ds = gdal.Open(path)
     width, height = ds.RasterXSize, ds.RasterYSize
     ds = None
+    row = _geometry_horizon(path, orientation, options)
     img = read_image(path, max(2 * options.analysis_size, 64))
-    keep = sky_keep(img, options, orientation)
+    if row is not None:
+        _, uh = upright_size(orientation, width, height)
+        _, ih = upright_size(orientation, img.shape[1], img.shape[0])
+        row = row * ih / uh
+    keep = sky_keep(img, options, orientation, horizon_row=row)
     if keep.shape != (height, width):
         cv2 = require("cv2", "sky masks")
         keep = cv2.resize(keep.astype(np.uint8), (width, height), interpolation=cv2.INTER_NEAREST) > 0
     return keep
+
+
+def masked_rows(keep: np.ndarray, orientation: int = 1) -> Tuple[int, int]:
+    """(first, last) row of the upright photo holding a masked pixel of ``keep`` (stored grid); (-1, -1): none."""
+    rows = np.flatnonzero((~to_upright(keep, orientation)).any(axis=1))
+    return (int(rows[0]), int(rows[-1])) if len(rows) else (-1, -1)
 
 
 def write_sky_masks(images_dir: str, names: Sequence[str], out_dir: str, options: Optional[SkyOptions] = None,
@@ -168,7 +292,8 @@ def write_sky_masks(images_dir: str, names: Sequence[str], out_dir: str, options
                     progress: Optional[Progress] = None) -> SkyResult:
     """Detect the sky in every image of ``names`` and write ``<out_dir>/<image>.png`` for those that show some,
     merged (logical AND of the areas to use) with ``base_masks[name]`` or, without one, the mask
-    :func:`core.prepare.masks.find_mask` finds in ``out_dir``.  Images without sky get no new mask."""
+    :func:`core.prepare.masks.find_mask` finds in ``out_dir``.  Images without sky get no new mask.  Logs, per
+    masked image, the share of the photo the sky took and its rows (of the upright photo)."""
     options = options or SkyOptions()
     progress = progress or NullProgress()
     base_masks = dict(base_masks or {})
@@ -176,16 +301,21 @@ def write_sky_masks(images_dir: str, names: Sequence[str], out_dir: str, options
     os.makedirs(out_dir, exist_ok=True)
     for i, n in enumerate(names):
         check_cancel(progress)
-        keep = detect_sky(os.path.join(images_dir, n), options)
+        path = os.path.join(images_dir, n)
+        keep = detect_sky(path, options)
         progress.report((i + 1) / max(1, len(names)), f"sky: {n}")
         if keep.all():
             continue
+        fraction = 1.0 - float(keep.mean())
+        first, last = masked_rows(keep, exif_orientation(path))
+        res.sky_rows[n] = (first, last)
+        progress.info(f"sky mask: {n}: {100.0 * fraction:.1f} % of the photo (rows {first}\u2013{last})")
         base = base_masks.get(n) or find_mask(out_dir, n)
         if base:
             keep &= read_keep(base, keep.shape[1], keep.shape[0])
-        path = os.path.join(out_dir, mask_file_name(n))
-        write_keep(path, keep)
-        res.masks[n] = path
+        out = os.path.join(out_dir, mask_file_name(n))
+        write_keep(out, keep)
+        res.masks[n] = out
         res.sky_fraction[n] = round(1.0 - float(keep.mean()), 4)
         if not keep.any():
             res.warnings.append(f"the sky mask of {n} hides the whole image: no feature can be found in it")
