@@ -10,6 +10,7 @@ import signal
 import sys
 import threading
 import traceback
+import weakref
 
 from qgis.core import Qgis, QgsApplication, QgsMessageLog, QgsProcessingAlgorithm, QgsProcessingException
 from qgis.PyQt.QtCore import QCoreApplication
@@ -55,6 +56,12 @@ def check_dependencies(modules, purpose=""):
     raise QgsProcessingException(message)
 
 
+# feedback -> the (kind, message) lines pushed to it: shared by every FeedbackProgress of that feedback, since an
+# algorithm may give its core calls their own (a share of the progress bar each, georeference and autocontrol do)
+# and push the result's lines through another at the end: each line reaches the log once all the same
+_PUSHED_TO = weakref.WeakKeyDictionary()
+
+
 class FeedbackProgress:
     """The core Progress protocol on top of a QgsProcessingFeedback."""
 
@@ -63,7 +70,8 @@ class FeedbackProgress:
         self.start = start
         self.end = end
         self._last_message = None
-        self._pushed = set()  # (kind, message) already in the log: a result's lines are not pushed twice
+        # (kind, message) already in this feedback's log: a result's lines are not pushed twice
+        self._pushed = set() if feedback is None else _PUSHED_TO.setdefault(feedback, set())
 
     def report(self, fraction, message=""):
         if self.feedback is None:
@@ -84,7 +92,8 @@ class FeedbackProgress:
 
     def push_result(self, warnings=(), lines=()):
         """After the core call: its result's warnings and log lines that the core did not push while it ran
-        (the core pushes most of them through :meth:`info` / :meth:`warning` already; each appears once)."""
+        (the core pushes most of them through :meth:`info` / :meth:`warning` already, of this FeedbackProgress
+        or another on the same feedback; each appears once)."""
         for w in warnings:
             if ("warning", w) not in self._pushed:
                 self.warning(w)

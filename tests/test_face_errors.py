@@ -119,3 +119,36 @@ def test_core_task_releases_its_inputs_in_the_main_thread_when_it_ends():
         assert task.progress_adapter.task is None  # no task <-> adapter cycle left
     finally:
         gc.enable()
+
+
+def test_each_warning_reaches_the_log_once_whichever_progress_pushed_it():
+    """Issue 36 item 14: warnings appeared twice in the log of Georeference with automatic control and of
+    Automatic control: their core call pushed each warning through its own FeedbackProgress (a share of the
+    progress bar) and the algorithm then pushed the result's warnings through another, whose record of what was
+    already pushed was empty.  The record is the feedback's, shared by every FeedbackProgress on it."""
+    from archaeoortho.processing_provider.base import FeedbackProgress
+    from qgis.core import QgsProcessingFeedback
+
+    class Log(QgsProcessingFeedback):
+        def __init__(self):
+            super().__init__()
+            self.lines = []
+
+        def pushWarning(self, warning):  # noqa: N802 (QGIS API name)
+            self.lines.append(("warning", warning))
+
+        def pushInfo(self, info):  # noqa: N802 (QGIS API name)
+            self.lines.append(("info", info))
+
+    feedback = Log()
+    progress = FeedbackProgress(feedback)
+    core = FeedbackProgress(feedback, 0.1, 1.0)  # as georeference.py / auto_control.py give their core call
+    core.warning("outlier A12 left out")
+    core.info("12 automatic GCPs")
+    progress.push_result(["outlier A12 left out", "weak geometry"], ["12 automatic GCPs", "done"])
+    assert feedback.lines == [("warning", "outlier A12 left out"), ("info", "12 automatic GCPs"),
+                              ("warning", "weak geometry"), ("info", "done")]
+    # another run (another feedback) starts with an empty record
+    other = Log()
+    FeedbackProgress(other).push_result(["outlier A12 left out"])
+    assert other.lines == [("warning", "outlier A12 left out")]

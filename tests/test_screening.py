@@ -145,17 +145,44 @@ def test_output_folder_with_foreign_files_is_refused(tmp_path):
         prepare_images_workspace(str(images), str(tmp_path / "ws"), str(images))
 
 
-def test_corrupt_file_is_named(tmp_path):
-    from core.io.images import ImageError
+def _bad_files(folder) -> dict:
+    """A 0-byte photo, a text file named .jpg, a truncated download in ``folder``: name -> why it is skipped."""
+    data = open(os.path.join(SAMPLE, "images", SOURCE), "rb").read()
+    (folder / "empty.JPG").write_bytes(b"")
+    (folder / "notes.jpg").write_text("not a photo")
+    (folder / "broken.JPG").write_bytes(data[: len(data) // 3])
+    return {"empty.JPG": "empty file (0 bytes)", "notes.jpg": "not a readable image",
+            "broken.JPG": "image data is corrupt or truncated"}
+
+
+def test_unusable_files_are_skipped_with_a_warning_as_align_does(tmp_path):
+    """Issue 36 item 14: Prepare images stopped at the first unreadable file (and a 0-byte one was never named)
+    where Align images skips both with a warning.  One rule: each file skipped with a warning naming it and why,
+    in the result and the stage's results; fewer than 2 usable images is refused, naming the skipped files."""
+    from core.io.images import scan_images
+    from core.prepare.screening import ScreeningError
     from core.prepare.stage import prepare_images_workspace
+    from core.project.workspace import Workspace
 
     images = tmp_path / "img"
     shutil.copytree(os.path.join(SAMPLE, "images"), images, ignore=lambda d, names: names[3:])
-    data = open(os.path.join(SAMPLE, "images", SOURCE), "rb").read()
-    (images / "broken.JPG").write_bytes(data[: len(data) // 3])  # a truncated download
-    with pytest.raises(ImageError, match="broken.JPG"):
-        prepare_images_workspace(str(images), str(tmp_path / "ws"), str(tmp_path / "out"))
-    assert not os.path.exists(tmp_path / "out")
+    bad = _bad_files(images)
+    res = prepare_images_workspace(str(images), str(tmp_path / "ws"), str(tmp_path / "out"))
+    assert res.kept == 3 and sorted(os.listdir(tmp_path / "out")) == sorted(
+        [n for n in os.listdir(images) if n not in bad] + [".archaeoortho-prepared"])
+    for name, why in bad.items():
+        assert sum(name in w and why in w for w in res.warnings) == 1, (name, res.warnings)
+    _, align_rule = scan_images(str(images))  # what Align images says of the same folder
+    assert [w for w in res.warnings if w in align_rule] == align_rule
+    assert Workspace.open(str(tmp_path / "ws")).stage("prepare")["results"]["skipped_files"] == align_rule
+    # one usable image left: refused before any work, naming what was skipped and why
+    for n in os.listdir(images):
+        if n not in bad and n != sorted(os.listdir(images))[0]:
+            os.unlink(images / n)
+    with pytest.raises(ScreeningError, match="only one usable image .* at least 2 are needed") as e:
+        prepare_images_workspace(str(images), str(tmp_path / "ws2"), str(tmp_path / "out2"))
+    assert all(name in str(e.value) and why in str(e.value) for name, why in bad.items()), str(e.value)
+    assert not os.path.exists(tmp_path / "out2")
 
 
 def test_cancel_leaves_no_complete_looking_output(tmp_path):
@@ -217,3 +244,60 @@ def test_processing_prepare_images(plugin, toledo_with_bad_copies, tmp_path):
         (tmp_path / "busy" / "notes.txt").write_text("mine")
         processing.run("archaeoortho:prepareimages", {
             "IMAGES": toledo_with_bad_copies, "WORKSPACE": str(tmp_path / "ws"), "OUTPUT": str(tmp_path / "busy")})
+
+
+def _mentions(text: str, needle: str) -> int:
+    return sum(needle in line for line in text.splitlines())
+
+
+def _error_lines(text: str) -> int:
+    """How many lines of a failed qgis_process run's output carry its error (the one after "ERROR:")."""
+    first = next(line for line in text.splitlines() if line.startswith("ERROR:\t"))
+    return _mentions(text, first[len("ERROR:\t"):].strip())
+
+
+def test_qgis_process_names_each_skipped_file_once_and_adds_no_error_line(tmp_path):
+    """Issue 36 item 14 through qgis_process, as a user runs it: Prepare images names each skipped file once
+    (stdout and stderr together), and a refusal is printed no more often than QGIS prints any algorithm's error.
+    (QGIS itself prints an error three times: QgsProcessingAlgorithm::run logs it to the message log and calls
+    feedback.reportError, whose base class logs it again, and qgis_process echoes every critical message-log
+    line to stderr besides its own "ERROR:" line: native:buffer does the same.)"""
+    import subprocess
+
+    from osgeo import ogr
+
+    from tests.conftest import qgis_process
+
+    exe, env = qgis_process()
+    images = tmp_path / "img"
+    shutil.copytree(os.path.join(SAMPLE, "images"), images, ignore=lambda d, names: names[2:])
+    bad = _bad_files(images)
+
+    def run(*args):
+        out = subprocess.run([exe, "run", *args], env=env, capture_output=True, text=True, timeout=300)
+        return out.returncode, out.stdout + out.stderr
+
+    rc, text = run("archaeoortho:prepareimages", "--", f"IMAGES={images}", f"WORKSPACE={tmp_path / 'ws'}")
+    assert rc == 0, text[-3000:]
+    for name, why in bad.items():
+        assert _mentions(text, f"{name}: {why}") == 1, (name, text[-3000:])
+    # one usable image: refused, the message printed as often as QGIS prints a native algorithm's error
+    for n in sorted(os.listdir(images))[1:]:
+        if n not in bad:
+            os.unlink(images / n)
+    rc, text = run("archaeoortho:prepareimages", "--", f"IMAGES={images}", f"WORKSPACE={tmp_path / 'ws2'}")
+    assert rc != 0
+    ours = _error_lines(text)
+    assert "only one usable image" in text
+    line = str(tmp_path / "line.gpkg")
+    ds = ogr.GetDriverByName("GPKG").CreateDataSource(line)
+    layer = ds.CreateLayer("l", None, ogr.wkbLineString)
+    feature = ogr.Feature(layer.GetLayerDefn())
+    feature.SetGeometry(ogr.CreateGeometryFromWkt("LINESTRING (0 0, 1 1)"))
+    layer.CreateFeature(feature)
+    ds = None
+    rc, native = run("native:buffer", "--", f"INPUT={line}", "DISTANCE=1", f"OUTPUT={tmp_path / 'no' / 'b.gpkg'}")
+    assert rc != 0
+    baseline = _error_lines(native)
+    print(f"\nan error is printed {ours} times by prepareimages, {baseline} times by native:buffer")
+    assert 1 <= ours <= baseline, (ours, baseline, text[-2000:])

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..common.files import atomic_output, atomic_write_text, file_fingerprint, fingerprint, read_json_record
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
-from ..io.images import list_images, read_image_info
+from ..io.images import list_images, scan_images
 from ..project.layout import SCREENING_JSON, Layout
 from ..project.stages import PREPARE, run_stage
 from ..project.workspace import Workspace, WorkspaceError
@@ -129,14 +129,19 @@ def _summary(quality: Sequence[ImageQuality]) -> dict:
     }
 
 
-def _check_images(images_dir: str, names: Sequence[str], progress: Progress) -> Dict[str, Tuple[int, int]]:
-    """Header check of every file: a corrupt file stops the stage before any work, by name."""
-    sizes: Dict[str, Tuple[int, int]] = {}
-    for i, n in enumerate(names):
-        info = read_image_info(os.path.join(images_dir, n), n)
-        sizes[n] = (info.width, info.height)
-        progress.report(0.03 * (i + 1) / len(names), f"checking {n}")
-    return sizes
+def _check_images(images_dir: str, progress: Progress) -> Tuple[List[str], Dict[str, Tuple[int, int]], List[str]]:
+    """(usable images, their sizes, warnings naming each skipped file and why) by the rule of 'Align images'
+    (:func:`core.io.images.scan_images`: every file is opened and its pixels decoded; an empty file, a file that is
+    not an image, a truncated one is skipped with a warning); ScreeningError, before any work, when fewer than 2
+    usable images remain."""
+    infos, skipped = scan_images(images_dir, progress=SubProgress(progress, 0.0, 0.03))
+    for w in skipped:
+        progress.warning(w)
+    if len(infos) < 2:
+        found = f"only one usable image ({infos[0].name})" if infos else "no usable image"
+        why = ("; ".join(skipped)) if skipped else "no other image file"
+        raise ScreeningError(f"{found} in {images_dir}: at least 2 are needed ({why})")
+    return [i.name for i in infos], {i.name: (i.width, i.height) for i in infos}, skipped
 
 
 def _parameters(options: PrepareOptions, output_dir: str, polygons: Sequence) -> dict:
@@ -265,7 +270,9 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
     for scanned film ``<workspace>/scans.json`` and ``<workspace>/masks/<prepared
     image name>.png`` (COLMAP's convention: white = use, black = ignore), and
     the stage record.  Raises ImageError (naming the file), ScreeningError,
-    core.prepare.scans.ScanError, WorkspaceError or Cancelled.
+    core.prepare.scans.ScanError, WorkspaceError or Cancelled.  A file that cannot be used (empty, not an
+    image, truncated) is skipped with a warning naming it and why (in ``warnings`` and the stage's
+    ``skipped_files``), as 'Align images' skips it; fewer than 2 usable images is a ScreeningError.
     """
     options = options or PrepareOptions()
     progress = progress or NullProgress()
@@ -280,7 +287,8 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
     _check_output_dir(output_dir, images_dir, ws.root)
     warnings: List[str] = []
     t0 = time.time()
-    sizes = _check_images(images_dir, names, progress)
+    names, sizes, skipped = _check_images(images_dir, progress)
+    warnings.extend(skipped)
     check_seconds = time.time() - t0
     polygons = list(options.mask_polygons or [])
     params = _parameters(options, output_dir, polygons)
@@ -342,6 +350,7 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
                 "decisions": {q.name: {"decision": q.decision, "flags": q.flags} for q in quality},
                 "interior_orientation": io, "masks": len(written_masks),
                 "user_masked_images": {n: user_masked[n] for n in sorted(user_masked)},
+                "skipped_files": list(skipped),
                 **({"sky_masked_images": {n: sky_masked[n] for n in sorted(sky_masked)}} if options.sky_masks else {}),
                 "total_seconds": round(time.time() - t_start, 2)})
     finally:
