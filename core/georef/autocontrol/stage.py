@@ -225,9 +225,9 @@ def find_candidates(ws: Workspace, rec, reference: Reference, prior: str = PRIOR
     # at least 0.5 m, one 3-D distance: a height from a 10-30 m DEM was judged by the orthophoto's cell)
     consistent(cands, 10.0 * g)
     n_kept = sum(1 for c in cands if c.status == KEPT)
-    own = _own_height_sigma(cands, reference, g, opt, messages)
     messages.append(f"{len(cands)} candidates tied back to the photos: {n_obs} seen in at least 2 photos with a "
                     f"DSM height, {n_kept} agree with one similarity")
+    own = _own_height_sigma(cands, reference, g, opt, messages)
     dropped = drop_counts(cands)
     if dropped:
         messages.append("candidates dropped: " + "; ".join(f"{n} {r}" for r, n in dropped.items()))
