@@ -322,6 +322,8 @@ def test_control_points_remove_the_tilt(rugged, rugged_ref):
     # sigmas scale with the data: a quarter of the 25 m cell; about the residual NMAD in height on flat cells
     assert np.allclose(pc.sigma_xy, REF_CELL / 4)
     assert np.all(pc.sigma_z >= res.nmad_after) and np.median(pc.sigma_z) < 3 * res.nmad_after + 0.1
+    stated = control_points_from_coregistration(res, ref, ref_gt, dem=dsm, dem_transform=gt, n=25, ref_sigma_z=2.0)
+    np.testing.assert_allclose(stated.sigma_z, np.hypot(pc.sigma_z, 2.0))
     # the reference coordinates are the truth (the terrain at the shifted position)
     assert np.all(np.abs(pc.xyz[:, :2] - pc.block_xyz[:, :2] - shift) < 0.5)
     assert np.max(np.abs(pc.xyz[:, 2] - rugged.at(pc.xyz[:, 0], pc.xyz[:, 1]))) < 0.5

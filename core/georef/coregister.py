@@ -895,14 +895,16 @@ def _spread(x: np.ndarray, y: np.ndarray, score: np.ndarray, n: int) -> np.ndarr
 def control_points_from_coregistration(result: CoregResult, ref: np.ndarray, ref_transform: Sequence[float], *,
                                        dem: Optional[np.ndarray] = None, dem_transform: Optional[Sequence[float]] = None,
                                        points: Optional[np.ndarray] = None, n: int = 25,
-                                       ref_nodata: Optional[float] = None) -> PseudoControl:
+                                       ref_nodata: Optional[float] = None, ref_sigma_z: float = 0.0) -> PseudoControl:
     """Up to ``n`` well-distributed pseudo control points from ``result``: on flat, stable, well-measured cells
     (the residual after the co-registration within two NMADs, the block's surface smooth around it), one per
     block of a grid over the overlap.  Give the DEM (heights, NaN = nodata, and its geotransform) or the points
     (N x 3) the co-registration was made with.
 
     sigma_xy = max(a quarter of the comparison cell, 3 x the shift's standard error) (the cell size when the
-    terrain could not fix the shift); sigma_z = hypot(NMAD after, tan(slope) x sigma_xy)."""
+    terrain could not fix the shift); sigma_z = hypot(NMAD after, tan(slope) x sigma_xy, ``ref_sigma_z``) (the
+    reference's own systematic height error where it is known, e.g. a national DEM's stated accuracy: the NMAD
+    holds only its random part)."""
     if (dem is None) == (points is None):
         raise CoregError("give either the DEM (with its geotransform) or the points for the pseudo control points")
     if dem is not None and dem_transform is None:
@@ -936,7 +938,7 @@ def control_points_from_coregistration(result: CoregResult, ref: np.ndarray, ref
     cand = np.flatnonzero(ok)
     score = (np.abs(r[cand]) + tan[cand] * sxy + rough[cand]) / noise
     pick = cand[_spread(qx[cand], qy[cand], score, n)]
-    sz = np.hypot(noise, tan[pick] * sxy)
+    sz = np.sqrt(noise ** 2 + (tan[pick] * sxy) ** 2 + float(ref_sigma_z) ** 2)
     return PseudoControl(np.column_stack([px[pick], py[pick], zb[pick]]), np.column_stack([qx[pick], qy[pick],
                          zr[pick]]), np.full(pick.size, sxy), sz, None if index is None else index[pick])
 
