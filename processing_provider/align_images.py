@@ -104,7 +104,7 @@ class AlignImagesAlgorithm(AlgorithmBase):
             mapper=params.read_choice(self, parameters, self.MAPPER, context, MAPPERS),
             escalate=self.parameterAsBoolean(parameters, self.ESCALATE, context),
             calibration=params.read_optional_file(self, parameters, self.CALIBRATION, context),
-            intrinsics=params.read_intrinsics(self, parameters, self.INTRINSICS, context),
+            intrinsics=params.read_choice(self, parameters, self.INTRINSICS, context, params.INTRINSICS),
         )
         result = self.run_core(align, images, workspace, options, FeedbackProgress(feedback))
         feedback.pushInfo(self.tr("Registered {} of {} images, mean reprojection error {:.3f} px, {} points").format(

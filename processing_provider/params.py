@@ -103,20 +103,8 @@ def calibration_file(name, label):
 
 
 def intrinsics(name, label):
-    """What the adjustments may change of the cameras' interior orientation: its values are the words
-    (INTRINSICS=fixed on the command line)."""
-    return QgsProcessingParameterEnum(name, label, options=INTRINSICS, defaultValue=INTRINSICS[0],
-                                      usesStaticStrings=True)
-
-
-def read_intrinsics(alg, parameters, name, context):
-    """The intrinsics choice as given (core.align.options.AlignOptions.check refuses an unknown one)."""
-    value = parameters.get(name)
-    if value is None or value == "":
-        return INTRINSICS[0]
-    if isinstance(value, int) and 0 <= value < len(INTRINSICS):
-        return INTRINSICS[value]
-    return alg.parameterAsEnumString(parameters, name, context) or str(value)
+    """What the adjustments may change of the cameras' interior orientation (core.align.options.INTRINSICS)."""
+    return choice(name, label, INTRINSICS)
 
 
 # --- ground control --------------------------------------------------------------------------------------

@@ -141,7 +141,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
                     camera_model=params.read_choice(self, p, self.CAMERA_MODEL, context, CAMERA_MODELS),
                     max_image_size=self.parameterAsInt(p, self.MAX_IMAGE_SIZE, context),
                     calibration=params.read_optional_file(self, p, self.CALIBRATION, context),
-                    intrinsics=params.read_intrinsics(self, p, self.INTRINSICS, context)),
+                    intrinsics=params.read_choice(self, p, self.INTRINSICS, context, params.INTRINSICS)),
                 georef=GeorefOptions(refine_intrinsics=self.parameterAsBoolean(p, self.REFINE_INTRINSICS, context)),
                 dsm_resolution=self.parameterAsDouble(p, self.DSM_RESOLUTION, context),
                 dsm_quality=params.read_choice(self, p, self.QUALITY, context, QUALITIES),

@@ -274,6 +274,13 @@ def test_a_bad_calibration_file_or_choice_fails_before_feature_extraction(images
     with pytest.raises(AlignError, match="unknown intrinsics choice 'fixd'"):
         align(images, str(ws), _options(intrinsics="fixd"))
     assert not ws.exists()
+    # the pipeline checks it before its first stage (here the prepare stage of sky masks)
+    from core.pipeline import Control, PipelineOptions, run_pipeline
+
+    with pytest.raises(ArchaeoOrthoError, match="camera.json, line 2"):
+        run_pipeline(images, str(ws), PipelineOptions(align=_options(calibration=str(bad)), sky_masks=True),
+                     Control(use_exif_gps=True))
+    assert not ws.exists()
 
 
 # ------------------------------------------------------------------------------------------------------------
@@ -326,7 +333,32 @@ def test_align_images_refuses_a_mistyped_interior_orientation_and_a_bad_file(ali
     with pytest.raises(QgsProcessingException, match="bad.yaml"):
         _run(align_algorithm, {"IMAGES": images, "WORKSPACE": str(tmp_path / "ws"), "CALIBRATION": str(bad)})
     assert not (tmp_path / "ws").exists()
-    assert "fixed" in align_algorithm.parameterDefinition("INTRINSICS").options()
+    assert align_algorithm.parameterDefinition("INTRINSICS").options() == ["auto", "fixed", "refined", "estimated"]
+    # a valid choice reaches the core: 'fixed' with nothing given is refused before the features
+    with pytest.raises(QgsProcessingException, match="intrinsics 'fixed' needs a given interior orientation"):
+        _run(align_algorithm, {"IMAGES": images, "WORKSPACE": str(tmp_path / "ws"), "INTRINSICS": 1})
+    assert not (tmp_path / "ws" / "sfm").exists()
+
+
+def test_run_pipeline_passes_the_calibration_through_its_align_options(plugin, tmp_path, monkeypatch):
+    from archaeoortho.core import pipeline
+    from qgis.core import QgsApplication, QgsProcessingException
+
+    alg = QgsApplication.processingRegistry().algorithmById("archaeoortho:runpipeline").create()
+    seen = {}
+
+    def fake_run_pipeline(images, workspace, options=None, control=None, progress=None):
+        seen["align"] = options.align
+        raise RuntimeError("stop")
+
+    monkeypatch.setattr(pipeline, "run_pipeline", fake_run_pipeline)
+    cal = tmp_path / "camera.json"
+    cal.write_text("{}")
+    (tmp_path / "images").mkdir()
+    with pytest.raises(QgsProcessingException):
+        _run(alg, {"IMAGES": str(tmp_path / "images"), "WORKSPACE": str(tmp_path / "ws"), "USE_EXIF_GPS": True,
+                   "CALIBRATION": str(cal), "INTRINSICS": 2})
+    assert seen["align"].calibration == str(cal) and seen["align"].intrinsics == "refined"
 
 
 # ------------------------------------------------------------------------------------------------------------
