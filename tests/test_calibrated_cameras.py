@@ -28,6 +28,7 @@ from core.project.layout import Layout
 from core.project.workspace import Workspace
 from core.report.sections.orientation import interior_orientation
 from tests import synthetic as syn
+from tests.test_autocontrol import epochs  # noqa: F401 - the automatic control's two epochs, rendered once
 from tests.workspaces import rendered_once
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -466,3 +467,28 @@ def test_film_scans_restituted_by_prepare_images_keep_their_interior_orientation
     print(f"\n[film, scans.json fixed] focal {camera.params[0]:.3f} px; centres RMSE XY {rmse_xy:.2f} m, Z {rmse_z:.2f} m "
           f"(GSD {block.gsd:.2f} m)")
     assert len(err) == 4 and rmse_xy <= block.gsd and rmse_z <= block.gsd
+
+
+def test_the_automatic_control_keeps_a_fixed_camera(tmp_path, epochs):  # noqa: F811 - the fixture imported above
+    """The automatic control refines focal length and distortion by default (AutoControlOptions.refine_intrinsics);
+    a camera the alignment recorded as fixed comes out of it with exactly its values (the same run without the
+    record moves them: the test can fail)."""
+    from core.georef.autocontrol.options import AutoControlOptions
+    from core.georef.autocontrol.stage import autocontrol_workspace
+    from tests.workspaces import synthetic_workspace
+
+    block, photos, ortho, dsm = epochs
+    options = AutoControlOptions(n_features=6000, max_candidates=60)  # refine_intrinsics: its default (True)
+    assert options.refine_intrinsics
+    record = {"camera_id": 1, "mode": "fixed", "model": "OPENCV", "source": "camera.json",
+              "given": dict(zip(NAMES, block.camera.params))}
+    params = {}
+    for label, alignment in (("fixed", {"intrinsics": [record]}), ("estimated", None)):
+        ws = synthetic_workspace(str(tmp_path / label), block, block.truth_reconstruction(seed=5), photos=photos,
+                                 alignment=alignment)
+        cams, _ = block.camera_positions(sigma=3.0)
+        autocontrol_workspace(ws, ortho, dsm, prior="gps", camera_positions=cams, options=options)
+        (cam,) = Layout(Workspace.open(ws)).load_georef_model()[0].cameras.values()
+        params[label] = np.asarray(cam.params, dtype=float)
+    assert np.array_equal(params["fixed"], np.asarray(block.camera.params, dtype=float))
+    assert not np.array_equal(params["estimated"], np.asarray(block.camera.params, dtype=float))
