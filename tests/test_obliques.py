@@ -184,7 +184,7 @@ def nadir_pale(orbit):
     return _pale_band(img)
 
 
-def test_sky_mask_stops_at_the_horizon(orbit, two_renders, nadir_pale):
+def test_sky_mask_stops_at_the_horizon(orbit, two_renders, nadir_pale, tmp_path):
     """Issue 36 item 7: a pale band over the top of a nadir-ish photo and the smooth road below it were masked
     as sky down to near the lower edge (row 336 of 360 here; row 877 of 900 on the Toledo photos).  The sky's lower
     edge must follow a horizon (one smooth line across the photo) and the mask stops there."""
@@ -192,6 +192,18 @@ def test_sky_mask_stops_at_the_horizon(orbit, two_renders, nadir_pale):
 
     keep = sky.sky_keep(nadir_pale)
     assert (~keep).mean() < 0.005, f"nadir-ish photo masked {(~keep).mean():.1%}"
+    # the log says why the bright band at its top got no mask
+    infos = []
+
+    class Log(NullProgress):
+        def info(self, message):
+            infos.append(message)
+
+    images = tmp_path / "images"
+    images.mkdir()
+    cv2.imwrite(str(images / "NADIR.jpg"), cv2.cvtColor(nadir_pale, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, 95])
+    res = sky.write_sky_masks(str(images), ["NADIR.jpg"], str(tmp_path / "masks"), progress=Log())
+    assert not res.masks and infos == [f"sky mask: NADIR.jpg: none, {sky.NO_HORIZON}"]
     # three real vertical photos under a pale band (the issue's case)
     for name in TOLEDO_STRIP[:3]:
         img = cv2.cvtColor(cv2.imread(os.path.join(SAMPLE, "images", name)), cv2.COLOR_BGR2RGB)

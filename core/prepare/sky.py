@@ -189,9 +189,21 @@ def _horizon_line(sky: np.ndarray, tol: float, min_cover: float) -> Optional[np.
     return basis @ best
 
 
+NO_HORIZON = "a smooth bright region along the upper edge, but its lower edge follows no horizon line across the " \
+    "photo (a pale or over-exposed band, haze, a hilly skyline): not masked"
+
+
 def sky_keep(img: np.ndarray, options: Optional[SkyOptions] = None, orientation: int = 1,
              horizon_row: Optional[float] = None) -> np.ndarray:
-    """(height, width) bool of an image array (rows, cols[, bands]): True = use, False = sky.
+    """(height, width) bool of an image array (rows, cols[, bands]): True = use, False = sky (see
+    :func:`_sky_verdict`)."""
+    return _sky_verdict(img, options, orientation, horizon_row)[0]
+
+
+def _sky_verdict(img: np.ndarray, options: Optional[SkyOptions] = None, orientation: int = 1,
+                 horizon_row: Optional[float] = None) -> Tuple[np.ndarray, str]:
+    """((height, width) bool of an image array (rows, cols[, bands]): True = use, False = sky; why a sky-like
+    region was not masked, "" when it was or there was none).
 
     ``orientation``: the photo's EXIF orientation (the sky is searched at the upper edge of the upright photo).
     The sky stops at the horizon: the smooth line its lower edge follows across the photo; a bright smooth region
@@ -206,28 +218,28 @@ def sky_keep(img: np.ndarray, options: Optional[SkyOptions] = None, orientation:
     up = to_upright(img, orientation)
     uh, uw = up.shape[:2]
     if horizon_row is not None and horizon_row + options.horizon_tolerance * uh < 0:
-        return np.ones((height, width), bool)  # the camera cannot see the horizon (a vertical photo)
+        return np.ones((height, width), bool), ""  # the camera cannot see the horizon (a vertical photo)
     s = min(1.0, options.analysis_size / float(max(uh, uw)))
     small = up if s >= 1.0 else cv2.resize(up, (max(1, round(uw * s)), max(1, round(uh * s))),
                                            interpolation=cv2.INTER_AREA)
     small = small if small.ndim == 3 else small[:, :, None]
     sky = _sky_region(small, options)
     if sky.mean() < options.min_fraction:
-        return np.ones((height, width), bool)
+        return np.ones((height, width), bool), ""
     sh = sky.shape[0]
     tol = max(2.0, options.horizon_tolerance * sh)
     line = _horizon_line(sky, tol, options.min_horizon_cover)
     if line is None:
-        return np.ones((height, width), bool)
+        return np.ones((height, width), bool), NO_HORIZON
     if horizon_row is not None:
         line = np.minimum(line, horizon_row * sh / uh)
     sky &= np.arange(sh)[:, None] < (line + tol)[None, :]
     if sky.mean() < options.min_fraction:
-        return np.ones((height, width), bool)
+        return np.ones((height, width), bool), ""
     m = max(1, int(round(options.margin * sh)))
     sky = cv2.dilate(sky.astype(np.uint8), cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * m + 1, 2 * m + 1))) > 0
     full = cv2.resize(sky.astype(np.uint8), (uw, uh), interpolation=cv2.INTER_NEAREST) > 0
-    return ~_from_upright(full, orientation).reshape(height, width)
+    return ~_from_upright(full, orientation).reshape(height, width), ""
 
 
 def horizon_row_of_pitch(pitch_deg: float, focal_px: float, height: int, below_deg: float = 0.0) -> float:
@@ -242,43 +254,49 @@ def horizon_row_of_pitch(pitch_deg: float, focal_px: float, height: int, below_d
     return height / 2.0 - focal_px * math.tan(math.radians(above_axis))
 
 
-def _geometry_horizon(path: str, orientation: int, options: SkyOptions) -> Optional[float]:
-    """The row of the upright photo below which no sky can be (``pitch_slack_deg`` under the horizon: the gimbal's
-    accuracy, a small roll), or None when the camera's pitch is unknown.  The pitch from the drone's XMP
+def _geometry_horizon(path: str, orientation: int, options: SkyOptions) -> Tuple[Optional[float], Optional[float]]:
+    """(the row of the upright photo below which no sky can be (``pitch_slack_deg`` under the horizon: the gimbal's
+    accuracy, a small roll), the camera's pitch), both None when the pitch is unknown.  The pitch from the drone's XMP
     (:func:`core.io.images.xmp_camera_pitch`), the focal length from EXIF (without one, the widest usual lens)."""
     pitch = xmp_camera_pitch(path)
     if pitch is None:
-        return None
+        return None, None
     info = read_image_info(path)
     _, uh = upright_size(orientation, info.width, info.height)
     # without a focal length in EXIF, the widest usual lens (the horizon comes into view soonest)
     focal = float(info.focal_px) if info.focal_px and info.focal_source != "default" else \
         WIDEST_FOCAL_FACTOR * max(info.width, info.height)
-    return horizon_row_of_pitch(pitch, focal, uh, options.pitch_slack_deg)
+    return horizon_row_of_pitch(pitch, focal, uh, options.pitch_slack_deg), pitch
 
 
 def detect_sky(path: str, options: Optional[SkyOptions] = None) -> np.ndarray:
     """The sky detector on one photo file: (height, width) bool in the stored pixel grid, True = use.  Where the
     photo records its camera's pitch (a drone's XMP) the sky stops where the geometry puts the horizon, and a
     camera looking down too steeply to see it gets no mask."""
-    options = options or SkyOptions()
+    return _detect(path, options or SkyOptions())[0]
+
+
+def _detect(path: str, options: SkyOptions) -> Tuple[np.ndarray, str]:
+    """:func:`detect_sky` and why a sky-like region was not masked ("" when it was, or there was none)."""
     orientation = exif_orientation(path)
     from osgeo import gdal
 
     ds = gdal.Open(path)
     width, height = ds.RasterXSize, ds.RasterYSize
     ds = None
-    row = _geometry_horizon(path, orientation, options)
+    row, pitch = _geometry_horizon(path, orientation, options)
     img = read_image(path, max(2 * options.analysis_size, 64))
     if row is not None:
         _, uh = upright_size(orientation, width, height)
         _, ih = upright_size(orientation, img.shape[1], img.shape[0])
         row = row * ih / uh
-    keep = sky_keep(img, options, orientation, horizon_row=row)
+    keep, note = _sky_verdict(img, options, orientation, horizon_row=row)
+    if note and pitch is not None:
+        note = f"{note} (camera pitch {pitch:+.1f} deg in the photo's XMP)"
     if keep.shape != (height, width):
         cv2 = require("cv2", "sky masks")
         keep = cv2.resize(keep.astype(np.uint8), (width, height), interpolation=cv2.INTER_NEAREST) > 0
-    return keep
+    return keep, note
 
 
 def masked_rows(keep: np.ndarray, orientation: int = 1) -> Tuple[int, int]:
@@ -293,7 +311,8 @@ def write_sky_masks(images_dir: str, names: Sequence[str], out_dir: str, options
     """Detect the sky in every image of ``names`` and write ``<out_dir>/<image>.png`` for those that show some,
     merged (logical AND of the areas to use) with ``base_masks[name]`` or, without one, the mask
     :func:`core.prepare.masks.find_mask` finds in ``out_dir``.  Images without sky get no new mask.  Logs, per
-    masked image, the share of the photo the sky took and its rows (of the upright photo)."""
+    masked image, the share of the photo the sky took and its rows (of the upright photo), and why an image whose
+    upper edge looked like sky got none."""
     options = options or SkyOptions()
     progress = progress or NullProgress()
     base_masks = dict(base_masks or {})
@@ -302,9 +321,11 @@ def write_sky_masks(images_dir: str, names: Sequence[str], out_dir: str, options
     for i, n in enumerate(names):
         check_cancel(progress)
         path = os.path.join(images_dir, n)
-        keep = detect_sky(path, options)
+        keep, note = _detect(path, options)
         progress.report((i + 1) / max(1, len(names)), f"sky: {n}")
         if keep.all():
+            if note:
+                progress.info(f"sky mask: {n}: none, {note}")
             continue
         fraction = 1.0 - float(keep.mean())
         first, last = masked_rows(keep, exif_orientation(path))
