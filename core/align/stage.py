@@ -381,6 +381,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
                             "mean_reprojection_error": mre, "points3d": result.num_points3d,
                             "pairing": pairing_used, "pairs": len(pairs), "masked_images": len(masks),
                             "escalation_rounds": len(escalation.rounds) if escalation else 0,
+                            "skipped_files": list(photos.skipped),
                             "total_seconds": round(time.time() - t_start, 2)})
     # later stages were built on the previous model: run_stage marked them stale
     progress.report(1.0, f"aligned {result.registered}/{len(infos)} images, {mre:.3f} px")
