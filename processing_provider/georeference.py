@@ -33,7 +33,7 @@ class GeoreferenceAlgorithm(AlgorithmBase):
     RESIDUALS = "RESIDUALS"
     CAMERAS = "CAMERAS"
     NUMBERS = ("GCP_RMSE_XY", "GCP_RMSE_Z", "CHECK_RMSE_XY", "CHECK_RMSE_Z", "CAMERA_RMSE_XYZ", "CAMERA_RMSE_XY",
-               "NSSDA_H", "NSSDA_V")
+               "NSSDA_H", "NSSDA_V", "DEM_CONTROL_N")
     HELP = (
         "Fixes the aligned block in a real coordinate reference system with ground control points (GCPs) "
         "and/or camera positions, used inside the bundle adjustment so that they also remove the block's "
@@ -60,6 +60,13 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         "control. Camera positions or Use EXIF GPS positions give the rough position (else EXIF GPS when three "
         "photos carry it, else rotation and scale are searched). The calibration is refined in any case "
         "(focal length and distortion: the automatic GCPs determine them).\n"
+        "A reference DSM given alone (a DEM file in any projected CRS, heights in metres or feet) adds DEM control: "
+        "after the adjustment the block's sparse points are co-registered on it (shift, tilt, dome) and the block "
+        "is adjusted again with DEM-derived control points (dem001, ...), which remove tilt, height offset and doming "
+        "the photos cannot see; the co-registration is logged and saved to georef/dem_control.json. Heights: the "
+        "control points' when there are any, else the DEM's (camera positions' heights are moved onto it). Without "
+        "GCPs or camera positions the photos' EXIF GPS place the block. A DEM off the block or too coarse for it is "
+        "refused before the adjustment.\n"
         "Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at "
         "least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos' EXIF GPS positions "
         "plus a margin, else the other reference's extent.\n"
@@ -105,10 +112,20 @@ class GeoreferenceAlgorithm(AlgorithmBase):
             "GCP layer {} lacks the field '{}' (needs name, image, px, py)"))
         ortho = self.parameterAsRasterLayer(parameters, self.REFERENCE_ORTHO, context)
         dsm = self.parameterAsRasterLayer(parameters, self.REFERENCE_DSM, context)
-        if ortho is not None or dsm is not None:
+        if ortho is not None:
             return self._automatic(parameters, context, feedback, workspace, ortho, dsm, gcp_path, gcps, checks,
                                    positions, crs_text)
-        if not params.has_control(gcp_path, gcps, positions, self.parameterAsBoolean(
+        options = None
+        if dsm is not None:  # DEM control: the reference DSM alone
+            from ..core.georef.options import GeorefOptions
+            from .reference_layers import describe, local_file
+
+            if local_file(dsm) is None:
+                raise QgsProcessingException(self.tr(
+                    "Reference DSM {} given alone (DEM control) must be a raster file on disk; a web layer is "
+                    "fetched only for the automatic control, with a reference orthophoto").format(describe(dsm)))
+            options = GeorefOptions(reference_dem=local_file(dsm))
+        elif not params.has_control(gcp_path, gcps, positions, self.parameterAsBoolean(
                 parameters, self.USE_EXIF_GPS, context)):
             raise QgsProcessingException(self.tr(
                 "Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions "
@@ -119,7 +136,8 @@ class GeoreferenceAlgorithm(AlgorithmBase):
             camera_positions_path=positions,
             use_exif_gps=self.parameterAsBoolean(parameters, self.USE_EXIF_GPS, context),
             crs=crs_text, refine_intrinsics=self.parameterAsBoolean(parameters, self.REFINE_INTRINSICS, context),
-            progress=progress, gcps_upright=self.parameterAsBoolean(parameters, self.GCPS_UPRIGHT, context))
+            progress=progress, gcps_upright=self.parameterAsBoolean(parameters, self.GCPS_UPRIGHT, context),
+            options=options)
         progress.push_result(result.warnings)
         for o in result.outliers:
             feedback.pushWarning(self.tr("outlier left out: {}").format(o))

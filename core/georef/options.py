@@ -32,7 +32,12 @@ class GeorefOptions:
     (core.project.layout.Layout.camera_intrinsics; None: read from the workspace by the stage, {}: none): a
     ``fixed`` camera is never refined, whatever ``refine_intrinsics`` says; a ``refined`` one is refined (every
     parameter) with priors at its given values weighted by its given sigmas (REFINED_*_SIGMA where the
-    calibration gives none); an ``estimated`` one follows ``refine_intrinsics`` and ``focal_prior``."""
+    calibration gives none); an ``estimated`` one follows ``refine_intrinsics`` and ``focal_prior``.
+
+    ``reference_dem``: a reference DEM file (any projected CRS, heights in metres or feet): the georeference stage
+    co-registers the adjusted block's sparse points on it and adjusts again with up to ``reference_dem_points`` DEM
+    control points (core.georef.demcontrol); ``reference_dem_sigma_z``: the reference's stated height accuracy
+    (metres, 0: unknown), added to their sigma Z.  The adjustment itself (``georeference``) ignores these."""
 
     refine_intrinsics: Any = False
     outlier_threshold: float = 5.0
@@ -51,6 +56,9 @@ class GeorefOptions:
     placeholder_sigma_z: float = PLACEHOLDER_SIGMA_Z
     focal_prior: float = 0.01
     camera_intrinsics: Optional[Dict[int, Dict[str, Any]]] = None
+    reference_dem: Optional[str] = None
+    reference_dem_points: int = 25
+    reference_dem_sigma_z: float = 0.0
 
     @classmethod
     def of(cls, options: Optional["GeorefOptions"] = None, **kwargs: Any) -> "GeorefOptions":

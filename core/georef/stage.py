@@ -5,7 +5,9 @@ aligned model and the ground control, runs :func:`core.georef.adjust.georeferenc
 and saves, through ``core.project.layout``: ``georef/model`` (local frame), ``transform.json``,
 ``residuals.json``, ``residuals.gpkg``, ``control.json``, the camera layer, and ``adjustment_inputs.json``
 (the GCPs with roles and sigmas, the camera positions with sigmas and the target CRS the adjustment used,
-which ``core.georef.uncertainty`` reads back).
+which ``core.georef.uncertainty`` reads back).  With ``GeorefOptions.reference_dem`` the block is co-registered on
+that DEM after the adjustment and adjusted again with DEM control points (``core.georef.demcontrol``):
+``dem_control.json`` records the co-registration and the points.
 """
 from __future__ import annotations
 
@@ -30,7 +32,9 @@ from ..project.layout import Layout, write_json
 from ..project.stages import GEOREFERENCE, StageError, run_stage
 from ..project.workspace import Workspace
 from . import accuracy
+from . import demcontrol as demmod
 from .adjust import georeference
+from .coregister import CoregError
 from .options import EXIF_SIGMA_XY, EXIF_SIGMA_Z, GeorefOptions
 from .results import GeorefResult
 
@@ -48,6 +52,7 @@ class GeorefStageResult:
     warnings: List[str] = field(default_factory=list)
     outliers: List[str] = field(default_factory=list)
     report_lines: List[str] = field(default_factory=list)
+    dem_control: Optional[Dict[str, Any]] = None  # georef/dem_control.json's content, with a reference DEM
 
 
 def model_path(ws: Workspace) -> str:
@@ -173,13 +178,19 @@ def georeference_workspace(workspace_dir: str, gcp_path: Optional[str] = None,
     are converted to the stored grid with each photo's EXIF orientation.
 
     ``options``: further :class:`~core.georef.options.GeorefOptions` of the adjustment (``refine_intrinsics``
-    and the target CRS come from the keywords)."""
+    and the target CRS come from the keywords).  Its ``reference_dem`` adds DEM control (core.georef.demcontrol);
+    given alone (no GCPs, no camera positions), the photos' EXIF GPS place the block."""
     progress = progress or NullProgress()
     ws = Workspace.open(workspace_dir)
     lay = Layout(ws)
     if not lay.has_aligned_model():
         raise StageError(f"workspace {ws.root} has no aligned model: run 'Align images' first")
     rec = lay.load_aligned_model()
+    dem_path = options.reference_dem if options is not None else None
+    if dem_path and not (gcp_path or gcps is not None or camera_positions_path or use_exif_gps):
+        use_exif_gps = True
+        progress.info(f"reference DEM {dem_path} without ground control or camera positions: the photos' EXIF GPS "
+                      "place the block, the DEM fixes its heights, tilt and dome")
     gcps, cams, target = _read_control(ws, gcp_path, gcps, check_points, camera_positions_path, use_exif_gps, crs,
                                        progress, gcps_upright=gcps_upright)
     params = {"gcps": gcp_path, "check_points": list(check_points), "camera_positions": camera_positions_path,
@@ -190,17 +201,25 @@ def georeference_workspace(workspace_dir: str, gcp_path: Optional[str] = None,
     opt = GeorefOptions.of(options, refine_intrinsics=refine_intrinsics, crs=target)
     if opt.camera_intrinsics is None:  # the alignment's calibrated cameras: fixed ones stay, refined ones get priors
         opt = dataclasses.replace(opt, camera_intrinsics=lay.camera_intrinsics())
+    if dem_path:  # a reference off the block or too coarse for it is refused before the adjustment
+        progress.report(0.0, "checking the reference DEM against the block")
+        demmod.precheck(rec, gcps, cams, opt, dem_path, target)
+        params["reference_dem"] = os.path.abspath(dem_path)
+        inputs["reference_dem"] = file_fingerprint(dem_path)
+    dem = None
     with run_stage(ws, GEOREF, params, inputs) as run:
         with run.step("adjustment", save=False):
-            try:
-                result = georeference(rec, gcps, cams or None, progress=SubProgress(progress, 0.0, 0.9), options=opt)
-            except ArchaeoOrthoError:  # the GCP file's warnings reach the user in this outcome too
-                for w in gcps.warnings if gcps is not None else []:
-                    progress.warning(w)
-                raise
+            result = _adjust(rec, gcps, cams, opt, SubProgress(progress, 0.0, 0.45 if dem_path else 0.9))
+        if dem_path:
+            with run.step("dem control", save=False):
+                result, gcps, cams, dem = _dem_control(rec, result, gcps, cams, opt, target, progress)
         source = "file" if camera_positions_path else ("exif" if cams else None)
         outputs, residuals_path, cameras_path = _save_products(lay, result, gcps, cams, source, target, opt)
         figures = _figures(result)
+        if dem is not None:
+            write_json(lay.dem_control_json, dem.as_dict())
+            outputs["dem_control"] = lay.rel(lay.dem_control_json)
+            figures.update(_dem_figures(dem))
         ws.crs = target
         run.finish(outputs=outputs, results=figures)
     progress.report(1.0, "georeferenced")
@@ -208,7 +227,48 @@ def georeference_workspace(workspace_dir: str, gcp_path: Optional[str] = None,
                              residuals_path=residuals_path, cameras_path=cameras_path, warnings=list(result.warnings),
                              outliers=[o.message or f"{o.kind} {o.name}: {o.residual:.3g} {o.unit}"
                                        for o in result.outliers],
-                             report_lines=_report_lines(result))
+                             report_lines=_report_lines(result),
+                             dem_control=dem.as_dict() if dem is not None else None)
+
+
+def _adjust(rec, gcps: Optional[gcpmod.GCPSet], cams: Sequence[gcpmod.CameraPosition], opt: GeorefOptions,
+            progress: Progress) -> GeorefResult:
+    try:
+        return georeference(rec, gcps, list(cams) or None, progress=progress, options=opt)
+    except ArchaeoOrthoError:  # the GCP file's warnings reach the user in this outcome too
+        for w in gcps.warnings if gcps is not None else []:
+            progress.warning(w)
+        raise
+
+
+def _dem_control(rec, first: GeorefResult, gcps: Optional[gcpmod.GCPSet], cams: List[gcpmod.CameraPosition],
+                 opt: GeorefOptions, target: str, progress: Progress):
+    """The adjusted block co-registered on the reference DEM and adjusted again with DEM control points:
+    (result, ground control, camera positions, DemControl)."""
+    placeholder = first.statistics.get("placeholder_z") is not None
+    heights = demmod.HEIGHTS_CONTROL if demmod.has_height_control(gcps) and not placeholder else demmod.HEIGHTS_DEM
+    dc = demmod.dem_control(first.reconstruction, first.offset, opt.reference_dem, target, heights=heights,
+                            n=opt.reference_dem_points, ref_sigma_z=opt.reference_dem_sigma_z,
+                            taken=[p.name for p in gcps.points] if gcps is not None else (),
+                            progress=SubProgress(progress, 0.45, 0.5))
+    for m in dc.messages:
+        progress.info(m)
+    gcps2, cams2 = demmod.with_dem_control(gcps, cams, dc)
+    result = _adjust(rec, gcps2, cams2, opt, SubProgress(progress, 0.5, 0.9))
+    try:
+        dc.after = demmod.coregister_block(result.reconstruction, result.offset, opt.reference_dem, target)[0]
+    except CoregError as e:
+        progress.warning(f"the block adjusted with the DEM control could not be co-registered again: {e}")
+    for m in demmod.after_messages(dc, _figures(first), _figures(result)):
+        progress.info(m)
+    return result, gcps2, cams2, dc
+
+
+def _dem_figures(dc) -> Dict[str, Optional[float]]:
+    co, after = dc.coregistration, dc.after
+    return {"DEM_CONTROL_N": len(dc.points), "DEM_SHIFT_DZ": float(co.shift[2]),
+            "DEM_NMAD_BEFORE": float(co.nmad_before), "DEM_NMAD_AFTER": float(co.nmad_after),
+            "DEM_NMAD_FINAL": float(after.nmad_before) if after is not None else None}
 
 
 def _save_products(lay: Layout, result: GeorefResult, gcps: Optional[gcpmod.GCPSet],

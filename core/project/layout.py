@@ -43,6 +43,7 @@ REFERENCE_ORTHO_TIF = "reference-ortho.tif"  # in georef/: a web / virtual refer
 REFERENCE_DSM_TIF = "reference-dsm.tif"
 EDITOR_JSON = "gcp_editor.json"
 ADJUSTMENT_INPUTS_JSON = "adjustment_inputs.json"
+DEM_CONTROL_JSON = "dem_control.json"  # in georef/: the co-registration on a reference DEM and its control points
 DENSE_DIR = "dense"
 DSM_TIF = "dsm.tif"
 DSM_SOURCE_TIF = "dsm-source.tif"  # in dense/: 1 measured, 2 interpolated (a hole filled), 0 nodata
@@ -211,6 +212,10 @@ class Layout:
     @property
     def adjustment_inputs_json(self) -> str:
         return self.path(GEOREF_DIR, ADJUSTMENT_INPUTS_JSON)
+
+    @property
+    def dem_control_json(self) -> str:
+        return self.path(GEOREF_DIR, DEM_CONTROL_JSON)
 
     def is_georeferenced(self) -> bool:
         return self.ws.stage_done(GEOREFERENCE) and os.path.isdir(self.georef_model_dir)

@@ -1,0 +1,254 @@
+"""DEM control (issue 32 item 4, core/georef/demcontrol.py): a reference DEM fed back into the adjustment.
+
+The block is tests/synthetic.py's vertical block (3 strips x 6 photos, GSD 7.7 cm), its sparse model built from the
+truth; it is georeferenced from camera positions whose heights are biased as a GPS's often are: +1.5 m and a tilt
+of 2 cm/m along the strips and -1 cm/m across (sigma 3 m XY / 5 m Z as given).  A similarity to those positions
+tilts the whole block, which its photos cannot see: the check points (every ground mark) come out about 1.6 m off in
+Z.  The reference DEM is the scene's true surface averaged onto 0.5 m cells (6.5 GSD), warped into a transverse
+Mercator CRS without an EPSG code (tests/national.py) and written in feet: with it, the check points' Z error must
+drop to about a GSD (compared with the truth).  Bad references (off the block, a 25 m DEM under a 150 m block, all
+nodata, in degrees) are refused by name before the adjustment runs; and the Processing algorithm with a
+REFERENCE_DSM alone runs the same (EXIF GPS placing the block).
+"""
+import json
+import os
+
+import numpy as np
+import pytest
+
+from core.common.errors import ArchaeoOrthoError
+from core.georef.options import GeorefOptions
+from core.georef.stage import georeference_workspace
+from core.io.gcp import CHECK, CONTROL
+from tests import synthetic as syn
+from tests.national import degrade, national_wkt
+from tests.workspaces import set_exif_gps, synthetic_workspace
+
+FOOT = 0.3048
+FINE = 0.1  # m: the true surface is sampled at this cell, then averaged onto the reference's
+REF_CELL = 0.5  # m: 6.5 x the GSD
+BIAS_Z, TILT_X, TILT_Y = 1.5, 0.02, -0.01  # the camera positions' height bias: offset (m) and tilt (m/m)
+
+
+class Recorder:
+    def __init__(self):
+        self.infos, self.warnings = [], []
+
+    def report(self, fraction, message=""):
+        pass
+
+    def is_cancelled(self):
+        return False
+
+    def info(self, message):
+        self.infos.append(message)
+
+    def warning(self, message):
+        self.warnings.append(message)
+
+
+def _write(path, z, gt, wkt, nodata=-9999.0, unit=""):
+    from osgeo import gdal
+
+    ds = gdal.GetDriverByName("GTiff").Create(path, z.shape[1], z.shape[0], 1, gdal.GDT_Float32)
+    ds.SetGeoTransform(gt)
+    ds.SetProjection(wkt)
+    band = ds.GetRasterBand(1)
+    band.SetNoDataValue(nodata)
+    if unit:
+        band.SetUnitType(unit)
+    band.WriteArray(z.astype(np.float32))
+    ds = None
+    return path
+
+
+def _to_feet(path):
+    from osgeo import gdal
+
+    ds = gdal.Open(path, gdal.GA_Update)
+    band = ds.GetRasterBand(1)
+    a, nd = band.ReadAsArray(), band.GetNoDataValue()
+    band.WriteArray(np.where(a == nd, nd, a / FOOT).astype(np.float32))
+    band.SetUnitType("ft")
+    ds = None
+    return path
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory):
+    """(block, truth model, folder, fine surface file, reference DEM (national CRS, feet), biased positions)."""
+    from osgeo import osr
+
+    from core.geometry.crs import transform_points
+
+    folder = tmp_path_factory.mktemp("demcontrol")
+    block = syn.vertical_block(seed=1)
+    rec = block.truth_reconstruction()
+    b = block.scene.bounds
+    xs = np.arange(b[0], b[2], FINE) + FINE / 2
+    ys = np.arange(b[3], b[1], -FINE) - FINE / 2
+    gx, gy = np.meshgrid(xs, ys)
+    z = block.scene.height_at(gx.ravel(), gy.ravel()).reshape(gx.shape)
+    utm = osr.SpatialReference()
+    utm.ImportFromEPSG(32633)
+    fine = _write(str(folder / "fine.tif"), z, (b[0] + syn.ORIGIN[0], FINE, 0.0, b[3] + syn.ORIGIN[1], 0.0, -FINE),
+                  utm.ExportToWkt())
+    lon, lat = transform_points(np.array([[syn.ORIGIN[0], syn.ORIGIN[1], 0.0]]), syn.CRS, "EPSG:4326")[0][:2]
+    wkt = national_wkt(lon, lat)
+    ref = _to_feet(degrade(fine, str(folder / "reference_ft.tif"), REF_CELL, wkt))
+    positions, _ = block.camera_positions(sigma=0.3, seed=13)
+    c = np.mean([[p.x, p.y] for p in positions], axis=0)
+    for p in positions:
+        p.z += BIAS_Z + TILT_X * (p.x - c[0]) + TILT_Y * (p.y - c[1])
+    return block, rec, folder, fine, wkt, ref, positions
+
+
+def _positions_file(folder, positions):
+    path = str(folder / "positions.csv")
+    with open(path, "w") as f:
+        f.write(f"{syn.CRS}\nimage,x,y,z,sigma_xy,sigma_z\n")
+        for p in positions:
+            f.write(f"{p.image},{p.x:.3f},{p.y:.3f},{p.z:.3f},3,5\n")
+    return path
+
+
+def _run(root, scene, options=None):
+    block, rec, folder, _, _, _, positions = scene
+    ws = synthetic_workspace(root, block, rec)
+    progress = Recorder()
+    result = georeference_workspace(ws, gcps=block.gcp_set([], noise_px=0.4), crs=syn.CRS, options=options,
+                                    camera_positions_path=_positions_file(folder, positions), progress=progress)
+    return ws, result, progress
+
+
+def test_the_reference_dem_removes_the_tilt_and_offset_of_gps_heights(scene, tmp_path):
+    block, _, _, _, _, ref, _ = scene
+    _, plain, _ = _run(tmp_path / "plain", scene)
+    ws, res, progress = _run(tmp_path / "dem", scene, GeorefOptions(reference_dem=ref))
+    f0, f1 = plain.figures, res.figures
+    g = block.gsd
+    print(f"\nDEM control, GSD {g:.3f} m: check points (n={f1['CHECK_N']}) RMSE XY {f0['CHECK_RMSE_XY']:.3f} -> "
+          f"{f1['CHECK_RMSE_XY']:.3f} m, Z {f0['CHECK_RMSE_Z']:.3f} -> {f1['CHECK_RMSE_Z']:.3f} m; "
+          f"{f1['DEM_CONTROL_N']} DEM control points, NMAD {f1['DEM_NMAD_BEFORE']:.3f} -> {f1['DEM_NMAD_FINAL']:.3f} m")
+    print("\n".join(progress.infos))
+    assert f0["CHECK_N"] == f1["CHECK_N"] == len(block.gcps)
+    assert f0["CHECK_RMSE_Z"] > 1.0  # the biased heights are there without the DEM
+    assert f1["CHECK_RMSE_Z"] <= 1.5 * g and f1["CHECK_RMSE_Z"] <= 0.1 * f0["CHECK_RMSE_Z"]
+    assert f1["CHECK_RMSE_XY"] <= f0["CHECK_RMSE_XY"] + g  # the XY is the positions', not made worse
+    assert f1["DEM_CONTROL_N"] >= 10 and f1["DEM_NMAD_FINAL"] <= 2 * g
+    # the record: the co-registration, which heights won, the points in the workspace's CRS with observations
+    doc = json.load(open(os.path.join(ws, "georef", "dem_control.json")))
+    assert doc["heights"] == "reference DEM" and doc["reference_dem"] == ref
+    assert doc["coregistration"]["shift"][2] == pytest.approx(-BIAS_Z, abs=0.3)
+    control = json.load(open(os.path.join(ws, "georef", "control.json")))
+    dem = [p for p in control["points"] if p["name"].startswith("dem")]
+    assert len(dem) == f1["DEM_CONTROL_N"] and all(p["role"] == CONTROL and len(p["observations"]) >= 2 for p in dem)
+    truth_z = block.scene.height_at(np.array([p["x"] for p in dem]) - syn.ORIGIN[0],
+                                    np.array([p["y"] for p in dem]) - syn.ORIGIN[1])
+    assert np.median(np.abs(np.array([p["z"] for p in dem]) - truth_z)) < 0.2  # feet read as feet, CRS taken over
+    assert sorted(p["name"] for p in control["points"] if p["role"] == CHECK) == sorted(p.name for p in block.gcps)
+    rec = json.load(open(os.path.join(ws, "workspace.json")))["stages"]["georeference"]
+    assert rec["parameters"]["reference_dem"] == ref and rec["results"]["DEM_CONTROL_N"] == f1["DEM_CONTROL_N"]
+    assert any("heights: the reference DEM's win" in m for m in progress.infos)
+    assert any("heights in ft" in m for m in progress.infos)
+
+
+def _shifted(src, dst, dx):
+    from osgeo import gdal
+
+    gdal.Translate(dst, src)
+    ds = gdal.Open(dst, gdal.GA_Update)
+    gt = list(ds.GetGeoTransform())
+    gt[0] += dx
+    ds.SetGeoTransform(gt)
+    ds = None
+    return dst
+
+
+def test_bad_references_are_refused_by_name_before_the_adjustment(scene, tmp_path, monkeypatch):
+    from osgeo import gdal, osr
+
+    import core.georef.stage as stage
+
+    block, _, folder, fine, wkt, _, _ = scene
+
+    def no_adjustment(*args, **kwargs):
+        raise AssertionError("the adjustment ran")
+
+    monkeypatch.setattr(stage, "georeference", no_adjustment)
+    far = _shifted(fine, str(tmp_path / "far.tif"), 5000.0)
+    coarse = degrade(fine, str(tmp_path / "coarse25.tif"), 25.0, wkt)
+    empty = str(tmp_path / "empty.tif")
+    ds = gdal.Open(fine)
+    _write(empty, np.full((50, 60), -9999.0), ds.GetGeoTransform(), ds.GetProjection())
+    wgs = osr.SpatialReference()
+    wgs.ImportFromEPSG(4326)
+    degrees = str(tmp_path / "degrees.tif")
+    gdal.Warp(degrees, fine, dstSRS=wgs.ExportToWkt(), xRes=5e-6, yRes=5e-6)
+    cases = [(far, "does not overlap|has no height over"), (coarse, "too coarse for a block this small: \\d+ cells"),
+             (empty, "every cell is nodata"), (degrees, "geographic CRS"),
+             (str(tmp_path / "missing.tif"), "does not exist")]
+    for path, pattern in cases:
+        with pytest.raises(ArchaeoOrthoError, match=pattern) as err:
+            _run(tmp_path / ("ws_" + os.path.basename(path)), scene, GeorefOptions(reference_dem=path))
+        assert path in str(err.value), str(err.value)
+        print(f"\n{os.path.basename(path)}: {err.value}")
+
+
+def test_processing_georeference_with_a_reference_dsm_alone(scene, tmp_path, qgis_app):
+    """Georeference with REFERENCE_DSM and the ground marks as check points; the block placed by the photos' EXIF
+    GPS (biased heights) as USE_EXIF_GPS says, compared with the same run without the DSM."""
+    from archaeoortho.processing_provider.georeference import GeoreferenceAlgorithm
+    from qgis.core import QgsProcessingContext, QgsProcessingFeedback, QgsProject, QgsRasterLayer
+
+    from core.io.gcp import write_odm_gcp_list
+
+    block, rec, _, _, _, ref, positions = scene
+    gcp_file = str(tmp_path / "gcp_list.txt")
+    write_odm_gcp_list(block.gcp_set([], noise_px=0.4), gcp_file)
+    names = ",".join(p.name for p in block.gcps)
+    context = QgsProcessingContext()
+    context.setProject(QgsProject.instance())
+    out = {}
+    for label, dsm in (("plain", None), ("dem", QgsRasterLayer(ref, "national DEM in feet", "gdal"))):
+        ws = synthetic_workspace(tmp_path / label, block, rec)
+        set_exif_gps(ws, positions, syn.CRS)
+        alg = GeoreferenceAlgorithm()
+        alg.initAlgorithm()
+        p = {"WORKSPACE": ws, "GCPS": gcp_file, "CHECK_POINTS": names, "USE_EXIF_GPS": True, "CRS": syn.CRS}
+        if dsm is not None:
+            assert dsm.isValid()
+            p["REFERENCE_DSM"] = dsm
+        out[label] = alg.processAlgorithm(p, context, QgsProcessingFeedback())
+    print(f"\nProcessing, EXIF GPS: check Z {out['plain']['CHECK_RMSE_Z']:.3f} m without, "
+          f"{out['dem']['CHECK_RMSE_Z']:.3f} m with REFERENCE_DSM ({out['dem']['DEM_CONTROL_N']} DEM control points)")
+    assert out["plain"]["DEM_CONTROL_N"] is None and out["dem"]["DEM_CONTROL_N"] >= 10
+    assert out["dem"]["CHECK_RMSE_Z"] <= 0.2 * out["plain"]["CHECK_RMSE_Z"]
+    assert os.path.isfile(os.path.join(out["dem"]["WORKSPACE"], "georef", "dem_control.json"))
+
+
+def test_control_points_heights_win_over_a_dem_in_another_vertical_datum(scene, tmp_path):
+    """Four control points at the corners fix the block; the reference DEM's heights are 30 m off (another vertical
+    datum): the control points' heights win, the DEM control adds only the shape and the check points stay where
+    the control puts them."""
+    from osgeo import gdal
+
+    block, rec, _, fine, _, _, _ = scene
+    lifted = str(tmp_path / "lifted.tif")
+    gdal.Translate(lifted, fine, scaleParams=[[0, 1, 30, 31]], outputType=gdal.GDT_Float32)
+    ref = degrade(lifted, str(tmp_path / "lifted_05.tif"), REF_CELL, gdal.Open(fine).GetProjection())
+    control = block.spread_control(4)
+    out = {}
+    for label, options in (("plain", None), ("dem", GeorefOptions(reference_dem=ref))):
+        ws = synthetic_workspace(tmp_path / label, block, rec)
+        progress = Recorder()
+        out[label] = georeference_workspace(ws, gcps=block.gcp_set(control, noise_px=0.4), crs=syn.CRS,
+                                            options=options, progress=progress).figures
+    doc = json.load(open(os.path.join(tmp_path, "dem", "georef", "dem_control.json")))
+    print(f"\ncontrol points' heights: check Z {out['plain']['CHECK_RMSE_Z']:.3f} m without, "
+          f"{out['dem']['CHECK_RMSE_Z']:.3f} m with the DEM 30 m off (dz {doc['coregistration']['shift'][2]:.2f} m)")
+    assert doc["heights"] == "control points" and doc["camera_dz"] == 0.0
+    assert doc["coregistration"]["shift"][2] == pytest.approx(30.0, abs=0.3)
+    assert out["dem"]["CHECK_RMSE_Z"] <= out["plain"]["CHECK_RMSE_Z"] + 0.5 * block.gsd
+    assert out["dem"]["CHECK_RMSE_Z"] <= 1.5 * block.gsd
+    assert any("heights: the control points' win" in m for m in progress.infos)
