@@ -11,7 +11,8 @@ frame) of 4 frames (one strip) and 12 frames (two strips), then runs the plugin'
    where the option exists);
 3. ``core.georef.stage.georeference_workspace`` twice with the "3 m" control (N(0, 3 m) on X, Y, Z) given without
    sigmas (a CSV name,x,y,z,role: the reader's default sigmas) and the true check points: Helmert only
-   (``GeorefOptions(adjust=False)``) and the adjustment (default options).
+   (``GeorefOptions(adjust=False)``) and the adjustment (default options); for comparison a third run of the
+   adjustment with the same control given with sigmas of 3 m (sx, sy, sz columns).
 
 Prints check-point RMSE XY and Z (m and GSD), camera centre errors against the truth (median / max, m and GSD) and
 the focal length found against the true one, both solutions side by side.  No assertions.  Baseline from the
@@ -104,13 +105,16 @@ def prepare(block, ws):
     return res.prepared_dir, to_prepared, p, (w, h), lines
 
 
-def write_control(block, path, to_image):
-    """Control (3 m) + check (true) in one CSV without sigma columns (name,x,y,z,role) + observations."""
+def write_control(block, path, to_image, sigma=None):
+    """Control (3 m) + check (true) in one CSV, without sigma columns (name,x,y,z,role; the reader's defaults) or
+    with ``sigma`` (m) as sx, sy, sz of every point, + the observations file."""
     wkt = arch.archive_wkt()
-    rows, obs = [f"# crs: {wkt}", "name,x,y,z,role"], ["name,image,px,py"]
+    head = "name,x,y,z,role" + (",sx,sy,sz" if sigma else "")
+    rows, obs = [f"# crs: {wkt}", head], ["name,image,px,py"]
     for p in block.points:
         xyz = p.xyz_3m if p.role == "control" else p.xyz
-        rows.append(f"{p.name},{xyz[0]:.3f},{xyz[1]:.3f},{xyz[2]:.3f},{p.role}")
+        rows.append(f"{p.name},{xyz[0]:.3f},{xyz[1]:.3f},{xyz[2]:.3f},{p.role}"
+                    + (f",{sigma:g},{sigma:g},{sigma:g}" if sigma else ""))
         for img, px in sorted(p.noisy_observations.items()):
             q = to_image(img, px)
             obs.append(f"{p.name},{img},{q[0]:.3f},{q[1]:.3f}")
@@ -133,12 +137,13 @@ def solution(block, ws, gcp_path, options, pixel_mm):
         centre = np.asarray(im.projection_center(), float) + offset
         errs.append(np.linalg.norm(centre - block.frame(im.name).centre_world))
     cams = list(rec.cameras.values())
-    focal_px = float(np.mean([c.focal_length for c in cams]))
+    focal_px = float(np.mean([c.mean_focal_length() for c in cams]))
+    model = "; ".join(f"{c.model.name} {np.round(np.asarray(c.params, float), 5).tolist()}" for c in cams)
     f = res.figures
     return {"xy": f.get("CHECK_RMSE_XY"), "z": f.get("CHECK_RMSE_Z"), "n": f.get("CHECK_N"),
             "gcp_xy": f.get("GCP_RMSE_XY"), "gcp_z": f.get("GCP_RMSE_Z"),
             "cam_med": float(np.median(errs)), "cam_max": float(np.max(errs)), "registered": len(errs),
-            "focal_mm": focal_px * pixel_mm, "seconds": seconds, "outliers": res.outliers, "warnings": res.warnings}
+            "focal_mm": focal_px * pixel_mm, "seconds": seconds, "model": model, "outliers": res.outliers, "warnings": res.warnings}
 
 
 def _fmt(v, gsd):
@@ -156,7 +161,7 @@ def run(kind, n, args):
     print(f"\n{kind}, {n} frames (seed {args.seed}): {block.camera.size_px[0]} x {block.camera.size_px[1]} px, GSD "
           f"{gsd:.2f} m, ground {hr.min():.0f}-{hr.max():.0f} m, flying height ~{block.frames[0].centre_world[2]:.0f} m; "
           f"{len(block.control)} control (3 m, no sigma), {len(block.check)} check points; block {t_block:.1f} s "
-          f"(rendering {block.render_seconds:.1f} s, 0 when cached)")
+          f"({'cached; ' if t_block < block.render_seconds else ''}rendering took {block.render_seconds:.1f} s)")
     ws = os.path.join(work, "ws")
     shutil.rmtree(ws, ignore_errors=True)
     images = block.paths["images"]
@@ -189,10 +194,13 @@ def run(kind, n, args):
           f"SENSOR_WIDTH_MM {max(size) * pixel_mm:.3f}" + (f"; AlignOptions also has {extra} (left at defaults: "
                                                              f"{[getattr(opts, k) for k in extra]})" if extra else ""))
     gcp_path = write_control(block, os.path.join(work, "control_for_georef.csv"), to_image)
+    gcp_sigma_path = write_control(block, os.path.join(work, "control_sigma3.csv"), to_image, sigma=3.0)
     sols = {}
-    for label, gopt in (("Helmert only", GeorefOptions(adjust=False)), ("adjusted", GeorefOptions())):
+    for label, gopt, path in (("Helmert only", GeorefOptions(adjust=False), gcp_path),
+                              ("adjusted", GeorefOptions(), gcp_path),
+                              ("adjusted, sigma 3 m given", GeorefOptions(), gcp_sigma_path)):
         try:
-            sols[label] = solution(block, ws, gcp_path, gopt, pixel_mm)
+            sols[label] = solution(block, ws, path, gopt, pixel_mm)
         except Exception as e:
             print(f"  georeference ({label}) FAILED: {type(e).__name__}: {e}")
             traceback.print_exc(limit=4)
@@ -210,11 +218,12 @@ def run(kind, n, args):
             ("seconds", lambda s: f"{s['seconds']:.1f}")]
     for name, fn in rows:
         print(f"  {name:<30}" + "".join(f"{fn(sols[lab]):>28}" for lab in labels))
+    print(f"  camera (px): {sols[labels[0]]['model']}")
     for lab in labels:
         s = sols[lab]
         if s["outliers"] or s["warnings"]:
             print(f"  {lab}: outliers {s['outliers'][:6]}; warnings {s['warnings'][:4]}")
-    if len(sols) == 2:
+    if "Helmert only" in sols and "adjusted" in sols:
         h, a = sols["Helmert only"], sols["adjusted"]
         worse = [k for k in ("xy", "z") if h[k] is not None and a[k] is not None and a[k] > h[k] * 1.05]
         print(f"  adjustment vs Helmert: {'WORSE in ' + ', '.join(worse) if worse else 'not worse'} "

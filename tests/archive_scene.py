@@ -679,6 +679,15 @@ class GroundPointTruth:
 
 @dataclass
 class ArchiveBlock:
+    """A rendered (or only planned) archive block and its truth.
+
+    ``frames``: name, true pose (``shot``: camera-from-world rotation and centre, local), the scan geometry (film mm
+    -> scan px); ``points``: control (``role`` "control", with ``xyz_3m``) and check points, world coordinates in
+    ARCHIVE_PROJ, exact and noisy pixel observations; ``camera.calibration()``: the calibration dict;
+    ``interior(name)``: a frame's interior orientation as scanned; ``project(name, xyz)``: world -> (px, film mm);
+    ``paths``: images, control_csv (3 m, no sigma), control_true_csv, check_csv, calibration, truth (json), ortho,
+    dem; ``gsd``: m at the mean ground height."""
+
     kind: str
     terrain: ArchiveTerrain
     camera: FrameCamera
