@@ -252,3 +252,40 @@ def test_control_points_heights_win_over_a_dem_in_another_vertical_datum(scene, 
     assert out["dem"]["CHECK_RMSE_Z"] <= out["plain"]["CHECK_RMSE_Z"] + 0.5 * block.gsd
     assert out["dem"]["CHECK_RMSE_Z"] <= 1.5 * block.gsd
     assert any("heights: the control points' win" in m for m in progress.infos)
+
+
+def test_the_shift_is_used_where_the_terrain_fixes_it_else_the_heights_alone():
+    """On rugged terrain (tests/test_coregister.py's, 25 m reference) the shift of points off by (-30, 18) m is
+    found and used; on a gently curved slope a tilted block's shift is not (a shift and a tilt mimic each other
+    there), and the heights alone give dz, tilt and dome back (known truth)."""
+    from core.georef.demcontrol import coregister_xyz, heights_only
+    from tests import test_coregister as tc
+
+    terrain = tc.Terrain(1, 40, 400.0, 150.0, 1500.0)
+    ref, gt = tc.reference(terrain, noise=0.2)
+    rng = np.random.default_rng(7)
+    n = 8000
+    x = rng.uniform(tc.BLOCK[0], tc.BLOCK[0] + tc.BLOCK[2], n)
+    y = rng.uniform(tc.BLOCK[1], tc.BLOCK[1] + tc.BLOCK[2], n)
+    shift, dz, tilt = (-30.0, 18.0), -4.0, (5e-4, 6e-4)
+    qx, qy = x + shift[0], y + shift[1]
+    z = terrain.at(qx, qy) - tc.correction(qx, qy, dz, tilt) + rng.normal(0, 0.3, n)
+    res = coregister_xyz(np.column_stack([x, y, z]), ref, gt)
+    assert res.horizontal_determined and np.hypot(res.shift[0] - shift[0], res.shift[1] - shift[1]) < 0.1 * tc.REF_CELL
+    tc.check_correction(res, dz, tilt, tol=0.15)
+    # a gently curved slope (no feature to fix a shift) under a tilted, domed block
+    cell, size = 1.0, 300.0
+    xs = (np.arange(int(size / cell)) + 0.5) * cell
+    gx, gy = np.meshgrid(xs, size - xs)
+    surface = 100.0 + 0.05 * gx + 1e-4 * (gx - 150.0) ** 2
+    pts = np.column_stack([rng.uniform(20, 280, n), rng.uniform(20, 280, n)])
+    truth = 100.0 + 0.05 * pts[:, 0] + 1e-4 * (pts[:, 0] - 150.0) ** 2
+    u, v = pts[:, 0] - 150.0, pts[:, 1] - 150.0
+    applied = 2.0 + 0.01 * u - 0.005 * v + 2e-5 * u * u  # what the reference has above the block
+    block = np.column_stack([pts, truth - applied + rng.normal(0, 0.05, n)])
+    gt2 = (0.0, cell, 0.0, size, 0.0, -cell)
+    for res in (coregister_xyz(block, surface, gt2), heights_only(block, surface, gt2)):
+        assert not res.horizontal_determined and res.shift[:2] == (0.0, 0.0)
+        err = res.correction(pts[:, 0], pts[:, 1]) - applied
+        assert np.max(np.abs(err)) < 0.05, np.max(np.abs(err))
+        assert res.nmad_after < 0.1 and res.nmad_before > 0.5

@@ -252,17 +252,24 @@ def coregister_block(rec, offset: Sequence[float], ref_path: str, crs: str, prog
     (:func:`heights_only`, a message says why)."""
     xyz, ids = sparse_points(rec, offset)
     ref, gt, messages, cells = check_coverage(xyz, ref_path, crs)
-    name = f"reference DEM {ref_path}"
+    result = coregister_xyz(xyz, ref, gt, f"reference DEM {ref_path}", progress)
+    result.messages[:0] = messages
+    return result, xyz, ids, ref, gt, cells
+
+
+def coregister_xyz(xyz: np.ndarray, ref: np.ndarray, gt: Sequence[float], name: str = "reference DEM",
+                   progress: Optional[Progress] = None) -> CoregResult:
+    """Points (N x 3, the reference's CRS) on the reference window: the co-registration with a tilt and a dome
+    where its horizontal shift holds (:func:`_shift_trusted`), else the heights alone (:func:`heights_only`)."""
     full = coregister_points(xyz, ref, gt, tilt=True, dome=True, progress=progress, ref_name=name)
     plain = coregister_points(xyz, ref, gt, tilt=True, dome=False, ref_name=name)
     trusted, why = _shift_trusted(full, plain)
-    result = full
-    if not trusted:
-        result = heights_only(xyz, ref, gt)
-        result.messages.append(f"the horizontal shift (dx {full.shift[0]:.2f} m, dy {full.shift[1]:.2f} m) is not "
-                               f"used: {why}; the heights alone were co-registered (dz, tilt, dome)")
-    result.messages[:0] = messages
-    return result, xyz, ids, ref, gt, cells
+    if trusted:
+        return full
+    result = heights_only(xyz, ref, gt)
+    result.messages.append(f"the horizontal shift (dx {full.shift[0]:.2f} m, dy {full.shift[1]:.2f} m) is not "
+                           f"used: {why}; the heights alone were co-registered (dz, tilt, dome)")
+    return result
 
 
 def _names(n: int, taken: Sequence[str]) -> List[str]:
@@ -357,10 +364,24 @@ def after_messages(dc: DemControl, before: Dict[str, Any], after: Dict[str, Any]
     return out
 
 
+def after_warning(dc: DemControl) -> Optional[str]:
+    """A warning when the block adjusted with the DEM control still departs from the reference by far more than
+    the co-registration's residual spread: its shape could not follow (a camera calibration held fixed)."""
+    if dc.after is None:
+        return None
+    final, fit = dc.after.nmad_before, max(dc.coregistration.nmad_after, 1e-3)
+    if not final > 3.0 * fit:
+        return None
+    return (f"the block adjusted with the DEM control still departs from the reference DEM by {final:.3g} m (NMAD; "
+            f"{fit:.3g} m after the co-registration): its shape cannot follow the DEM control points; a camera "
+            "calibration held fixed and wrong? Refine the camera calibration")
+
+
 def _f(v) -> str:
     return "n/a" if v is None else f"{v:.3f}"
 
 
 __all__ = ["DEM_PREFIX", "DemControl", "DemControlError", "HEIGHTS_CONTROL", "HEIGHTS_DEM", "after_messages",
-           "cells_under", "check_coverage", "coregister_block", "dem_control", "has_height_control", "precheck",
+           "after_warning", "cells_under", "check_coverage",
+           "coregister_block", "coregister_xyz", "heights_only", "dem_control", "has_height_control", "precheck",
            "sparse_points", "track_observations", "vertical_datum", "with_dem_control"]

@@ -261,6 +261,10 @@ def _dem_control(rec, first: GeorefResult, gcps: Optional[gcpmod.GCPSet], cams: 
         progress.warning(f"the block adjusted with the DEM control could not be co-registered again: {e}")
     for m in demmod.after_messages(dc, _figures(first), _figures(result)):
         progress.info(m)
+    warning = demmod.after_warning(dc)
+    if warning:
+        result.warnings.append(warning)
+        progress.warning(warning)
     return result, gcps2, cams2, dc
 
 
