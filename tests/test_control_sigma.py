@@ -5,6 +5,7 @@ The rule: on the same check points the constrained adjustment is never worse tha
 more than 10 %; where the data do not support bending the block it stays (nearly) rigid, where they do (precise
 control on a sagging strip) it bends.  Figures are printed (pytest -s)."""
 import dataclasses
+import os
 
 import numpy as np
 import pytest
@@ -296,3 +297,46 @@ def test_camera_positions_without_sigma_are_estimated(block, rec, tmp_path):
     assert 1.0 <= e["sigma_xy_m"] <= 4.0 and 1.0 <= e["sigma_z_m"] <= 4.0, e
     assert all(c.sigma_xy == pytest.approx(e["sigma_xy_m"]) for c in result.cameras)
     _not_worse(chk, hel, block.gsd)
+
+
+def test_the_stage_records_the_estimate_and_the_report_and_the_precision_use_it(block, tmp_path):
+    """Through the workspace: georef/residuals.json holds the estimate and each control point's sigma, the run's
+    results the figures, the report's georeferencing section shows it (keyed numbers equal to the file's), and
+    the precision (core.georef.uncertainty) weights the control with it rather than the placeholder."""
+    import json
+    import re
+
+    import pycolmap
+
+    from core.georef import uncertainty
+    from core.georef.stage import georeference_workspace
+    from core.project.workspace import Workspace
+    from core.report import stage as report
+    from tests.workspaces import synthetic_workspace
+
+    rec = block.truth_reconstruction(n_points=800)
+    ws = synthetic_workspace(str(tmp_path / "ws"), block, rec, images_dir="/synthetic/images")
+    control = block.spread_control(8)
+    gcps = _noisy(block.gcp_set(control, noise_px=GCP_NOISE_PX), 3.0, seed=7)
+    path = str(tmp_path / "gcp_list.txt")
+    write_odm_gcp_list(gcps, path)
+    georeference_workspace(ws, gcp_path=path)
+    with open(os.path.join(ws, "georef", "residuals.json"), encoding="utf-8") as f:
+        res = json.load(f)
+    (e,) = res["sigma_estimates"]
+    assert 1.5 <= e["sigma_xy_m"] <= 6.0
+    used = [p for p in res["points"] if p["status"] == "used"]
+    assert len(used) == len(control) and all(p["sigma_xy"] == e["sigma_xy_m"] for p in used)
+    # the precision weights the control with the estimate
+    w = Workspace.open(ws)
+    model = pycolmap.Reconstruction()
+    model.read_binary(w.path("georef", "model"))
+    ctl, _, _, _ = uncertainty.workspace_inputs(w, model)
+    assert ctl and all(c.sigma[0] == e["sigma_xy_m"] and c.sigma[2] == e["sigma_z_m"] for c in ctl)
+    # the report
+    built = report.build_report(ws)
+    with open(built.path, encoding="utf-8") as f:
+        text = f.read()
+    assert "estimated from the data" in text
+    m = re.search(r'data-key="sigma\.control\.xy" data-value="([^"]+)"', text)
+    assert m and float(m.group(1)) == pytest.approx(e["sigma_xy_m"], rel=1e-6)
