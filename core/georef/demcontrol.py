@@ -53,6 +53,7 @@ from ..io.raster import bilinear
 from .coregister import (
     MIN_CELLS,
     OUTLIER_NMAD,
+    CoregError,
     CoregResult,
     control_points_from_coregistration,
     coregister_points,
@@ -200,6 +201,9 @@ def heights_only(xyz: np.ndarray, ref: np.ndarray, gt: Sequence[float], dome: bo
     pts = np.asarray(xyz, dtype=float)
     dh = bilinear(ref, (pts[:, 0] - gt[0]) / gt[1] - 0.5, (pts[:, 1] - gt[3]) / gt[5] - 0.5) - pts[:, 2]
     ok = np.isfinite(dh)
+    if ok.sum() < MIN_CELLS:
+        raise CoregError(f"too few points on the reference DEM: {int(ok.sum())} with a reference height (at least "
+                         f"{MIN_CELLS} needed)")
     x0, y0 = (float(v) for v in pts[ok, :2].mean(axis=0))
     scale = max(float(np.max(np.ptp(pts[ok, :2], axis=0))) / 2.0, 1.0)
     u, v = (pts[:, 0] - x0) / scale, (pts[:, 1] - y0) / scale
@@ -261,14 +265,22 @@ def coregister_xyz(xyz: np.ndarray, ref: np.ndarray, gt: Sequence[float], name: 
                    progress: Optional[Progress] = None) -> CoregResult:
     """Points (N x 3, the reference's CRS) on the reference window: the co-registration with a tilt and a dome
     where its horizontal shift holds (:func:`_shift_trusted`), else the heights alone (:func:`heights_only`)."""
-    full = coregister_points(xyz, ref, gt, tilt=True, dome=True, progress=progress, ref_name=name)
-    plain = coregister_points(xyz, ref, gt, tilt=True, dome=False, ref_name=name)
-    trusted, why = _shift_trusted(full, plain)
-    if trusted:
-        return full
+    try:
+        full = coregister_points(xyz, ref, gt, tilt=True, dome=True, progress=progress, ref_name=name)
+        plain = coregister_points(xyz, ref, gt, tilt=True, dome=False, ref_name=name)
+    except CoregError as e:  # the shift's fit failed (too few stable points once shifted): the heights may hold
+        full, (trusted, why) = None, (False, str(e))
+    else:
+        trusted, why = _shift_trusted(full, plain)
+        if trusted:
+            return full
     result = heights_only(xyz, ref, gt)
-    result.messages.append(f"the horizontal shift (dx {full.shift[0]:.2f} m, dy {full.shift[1]:.2f} m) is not "
-                           f"used: {why}; the heights alone were co-registered (dz, tilt, dome)")
+    if result.n_cells < MIN_CELLS:
+        raise CoregError(f"cannot co-register the block on the {name}: {result.n_cells} stable points "
+                         f"(at least {MIN_CELLS} needed); {why}")
+    shift = f" (dx {full.shift[0]:.2f} m, dy {full.shift[1]:.2f} m)" if full is not None else ""
+    result.messages.append(f"the horizontal shift{shift} is not used: {why}; the heights alone were co-registered "
+                           "(dz, tilt, dome)")
     return result
 
 
