@@ -44,8 +44,9 @@ def _ncc(a, b):
 
 
 def _patch_pair(block, point, name_a, name_b, images, half=20, offset=(0.0, 0.0)):
-    """The patch of frame A around the point's observation (+ offset, px) and frame B resampled into A's patch
-    geometry through the local affine A -> B of the true ground around the point (projected into both)."""
+    """The patch of frame A around the point's stated observation (+ offset, px) and the patch of frame B around
+    its stated observation, resampled into A's patch geometry by the linear part of the local affine A -> B of the
+    true ground around the point (projected into both)."""
     t = block.terrain
     local = point.xyz - arch.ORIGIN
     d = np.array([(dx, dy) for dx in (-150.0, 0.0, 150.0) for dy in (-150.0, 0.0, 150.0)])
@@ -55,7 +56,7 @@ def _patch_pair(block, point, name_a, name_b, images, half=20, offset=(0.0, 0.0)
     pb, _ = block.project(name_b, ground)
     aff, *_ = np.linalg.lstsq(np.column_stack([pa, np.ones(len(pa))]), pb, rcond=None)  # (3, 2)
     ca = point.observations[name_a] + np.asarray(offset)
-    cb = np.append(point.observations[name_a], 1.0) @ aff
+    cb = point.observations[name_b]  # each frame's own stated position; the affine gives only the patch's shape
     u, v = np.meshgrid(np.arange(-half, half + 1, dtype=np.float64), np.arange(-half, half + 1, dtype=np.float64))
     # OpenCV samples at pixel centres: a COLMAP pixel coordinate p is OpenCV p - 0.5
     a = cv2.remap(images[name_a], (ca[0] + u - 0.5).astype(np.float32), (ca[1] + v - 0.5).astype(np.float32),
@@ -87,10 +88,11 @@ def _correlations(block):
 def test_projected_points_land_on_the_same_texture(which, request):
     block = request.getfixturevalue(which)
     truth, beside = _correlations(block)
-    # the truth correlates better than any of 8 positions 10 px away, for every point, and well in general
+    # the truth correlates better than any of 8 positions 10 px away, for every point, and well in general (a stated
+    # position 1 px off in one frame brings the film block's median to 0.87, 2 px to 0.68; the truth gives 0.98)
     assert np.all(truth > beside), list(zip([p.name for p in block.points], truth.round(2), beside.round(2)))
-    assert np.median(truth) > 0.8, truth.round(2)
-    assert truth.min() > 0.6, truth.round(2)
+    assert np.median(truth) > 0.9, truth.round(2)
+    assert truth.min() > 0.75, truth.round(2)
     assert np.median(beside) < np.median(truth) - 0.3, (truth.round(2), beside.round(2))
 
 
