@@ -112,11 +112,11 @@ def _positions_file(folder, positions):
     return path
 
 
-def _run(root, scene, options=None):
+def _run(root, scene, options=None, crs=syn.CRS):
     block, rec, folder, _, _, _, positions = scene
     ws = synthetic_workspace(root, block, rec)
     progress = Recorder()
-    result = georeference_workspace(ws, gcps=block.gcp_set([], noise_px=0.4), crs=syn.CRS, options=options,
+    result = georeference_workspace(ws, gcps=block.gcp_set([], noise_px=0.4), crs=crs, options=options,
                                     camera_positions_path=_positions_file(folder, positions), progress=progress)
     return ws, result, progress
 
@@ -193,6 +193,9 @@ def test_bad_references_are_refused_by_name_before_the_adjustment(scene, tmp_pat
             _run(tmp_path / ("ws_" + os.path.basename(path)), scene, GeorefOptions(reference_dem=path))
         assert path in str(err.value), str(err.value)
         print(f"\n{os.path.basename(path)}: {err.value}")
+    with pytest.raises(ArchaeoOrthoError, match="needs a target CRS in metres; EPSG:2227 is in units of 0.3048") as err:
+        _run(tmp_path / "ws_feet", scene, GeorefOptions(reference_dem=scene[5]), crs="EPSG:2227")
+    print(f"\ntarget CRS in feet: {err.value}")
 
 
 def test_processing_georeference_with_a_reference_dsm_alone(scene, tmp_path, qgis_app):

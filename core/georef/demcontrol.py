@@ -123,9 +123,35 @@ def track_observations(rec, point_id: int) -> List[Observation]:
     return out
 
 
+def block_points(xyz: np.ndarray) -> np.ndarray:
+    """The rows of ``xyz`` that are the block: finite, and inside the box of the 1st to 99th percentiles grown by
+    a quarter of its size on each side (a few stray points far off would make the reference window huge)."""
+    ok = np.all(np.isfinite(xyz), axis=1)
+    if ok.sum() < 10:
+        return ok
+    lo, hi = np.percentile(xyz[ok, :2], [1.0, 99.0], axis=0)
+    grow = 0.25 * np.maximum(hi - lo, 1e-6)
+    return ok & np.all((xyz[:, :2] >= lo - grow) & (xyz[:, :2] <= hi + grow), axis=1)
+
+
 def _window(xyz: np.ndarray, ref_path: str, crs: str) -> Tuple[np.ndarray, Tuple[float, ...], List[str]]:
     lo, hi = xyz[:, :2].min(axis=0), xyz[:, :2].max(axis=0)
     return reference_window(ref_path, lo[0], lo[1], hi[0], hi[1], crs=crs)
+
+
+def check_metric(crs: str, ref_path: str) -> None:
+    """DemControlError unless the workspace's CRS is projected in metres (the co-registration's slopes and shifts)."""
+    from osgeo import osr
+
+    srs = osr.SpatialReference()
+    try:
+        srs.SetFromUserInput(crs)
+    except RuntimeError as e:
+        raise DemControlError(f"the target CRS {_short(crs)!r} is unknown: {e}") from e
+    if srs.IsGeographic() or abs((srs.GetLinearUnits() or 1.0) - 1.0) > 1e-9:
+        unit = "degrees" if srs.IsGeographic() else f"units of {srs.GetLinearUnits():g} m"
+        raise DemControlError(f"DEM control with the reference DEM {ref_path} needs a target CRS in metres; "
+                              f"{_short(crs)} is in {unit}: give a projected metric CRS (CRS), e.g. the UTM zone")
 
 
 def cells_under(xyz: np.ndarray, ref: np.ndarray, gt: Sequence[float]) -> int:
@@ -142,7 +168,7 @@ def check_coverage(xyz: np.ndarray, ref_path: str, crs: str) -> Tuple[np.ndarray
     """(reference window, its geotransform, messages, cells under the block): DemControlError (or the
     co-registration's CoregError) naming the file when the reference is off the block or too coarse for it: fewer
     than the co-registration's MIN_CELLS cells with a height under the block's points."""
-    pts = xyz[np.all(np.isfinite(xyz), axis=1)]
+    pts = xyz[block_points(xyz)]
     if len(pts) < 3:
         raise DemControlError(f"the block has {len(pts)} sparse point(s): nothing to co-register with the reference "
                               f"DEM {ref_path}")
@@ -189,6 +215,7 @@ def precheck(rec, gcps: Optional[GCPSet], cams: Sequence[CameraPosition], option
     errors of :func:`check_coverage` before the adjustment runs.  Returns the cells under the block."""
     from .adjust import georeference
 
+    check_metric(crs, ref_path)
     opt = dataclasses.replace(options, adjust=False, crs=crs)
     placed = georeference(rec, gcps, list(cams) or None, progress=NullProgress(), options=opt)
     xyz, _ = sparse_points(placed.reconstruction, placed.offset)
@@ -255,6 +282,8 @@ def coregister_block(rec, offset: Sequence[float], ref_path: str, crs: str, prog
     tilt and a dome where the horizontal shift holds (:func:`_shift_trusted`), else the heights alone
     (:func:`heights_only`, a message says why)."""
     xyz, ids = sparse_points(rec, offset)
+    keep = block_points(xyz)
+    xyz, ids = xyz[keep], ids[keep]
     ref, gt, messages, cells = check_coverage(xyz, ref_path, crs)
     result = coregister_xyz(xyz, ref, gt, f"reference DEM {ref_path}", progress)
     result.messages[:0] = messages
@@ -394,6 +423,6 @@ def _f(v) -> str:
 
 
 __all__ = ["DEM_PREFIX", "DemControl", "DemControlError", "HEIGHTS_CONTROL", "HEIGHTS_DEM", "after_messages",
-           "after_warning", "cells_under", "check_coverage",
+           "after_warning", "block_points", "cells_under", "check_coverage", "check_metric",
            "coregister_block", "coregister_xyz", "heights_only", "dem_control", "has_height_control", "precheck",
            "sparse_points", "track_observations", "vertical_datum", "with_dem_control"]
