@@ -153,7 +153,7 @@ def _fmt(v, gsd):
 def run(kind, n, args):
     work = os.path.join(args.workdir, f"{kind}{n}-s{args.seed}" + (f"-fid{args.fiducials}" if kind == "film" else ""))
     t0 = time.time()
-    block = arch.archive_block(kind, n, seed=args.seed, out_dir=os.path.join(work, "block"), reference=False,
+    block = arch.archive_block(kind, n, seed=args.seed, out_dir=os.path.join(work, "block"), reference="dem",
                                fiducials=args.fiducials)
     t_block = time.time() - t0
     hr = block.terrain.height_raster()
@@ -196,9 +196,11 @@ def run(kind, n, args):
     gcp_path = write_control(block, os.path.join(work, "control_for_georef.csv"), to_image)
     gcp_sigma_path = write_control(block, os.path.join(work, "control_sigma3.csv"), to_image, sigma=3.0)
     sols = {}
-    for label, gopt, path in (("Helmert only", GeorefOptions(adjust=False), gcp_path),
-                              ("adjusted", GeorefOptions(), gcp_path),
-                              ("adjusted, sigma 3 m given", GeorefOptions(), gcp_sigma_path)):
+    runs = [("Helmert only", GeorefOptions(adjust=False), gcp_path), ("adjusted", GeorefOptions(), gcp_path),
+            ("adjusted, sigma 3 m given", GeorefOptions(), gcp_sigma_path)]
+    if hasattr(GeorefOptions(), "reference_dem"):
+        runs.append(("adjusted + modern DEM", GeorefOptions(reference_dem=block.paths["dem"]), gcp_path))
+    for label, gopt, path in runs:
         try:
             sols[label] = solution(block, ws, path, gopt, pixel_mm)
         except Exception as e:

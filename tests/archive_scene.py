@@ -897,7 +897,7 @@ def _write_points(path: str, points: Sequence[GroundPointTruth], which: str, crs
 
 
 def write_reference(terrain: ArchiveTerrain, out_dir: str, ortho_res: float = 2.0, dem_res: float = 25.0,
-                    bounds=None, detail_res: float = 3.0) -> Tuple[str, str]:
+                    bounds=None, detail_res: float = 3.0, ortho: bool = True) -> Tuple[Optional[str], str]:
     """The epoch-1 orthophoto (RGB, JPEG in a tiled GeoTIFF) and the 25 m DEM of the ground, both in
     ARCHIVE_PROJ (no EPSG code) over ``bounds`` (default the terrain's).  The ortho's texture is computed at
     ``detail_res`` and resampled (bicubic) to ``ortho_res`` (time: the texture costs per cell)."""
@@ -908,10 +908,30 @@ def write_reference(terrain: ArchiveTerrain, out_dir: str, ortho_res: float = 2.
     b = bounds or terrain.bounds
     xmin, ymin, xmax, ymax = b
     drv = gdal.GetDriverByName("GTiff")
-    ortho = os.path.join(out_dir, "modern_ortho_2m.tif")
+    ortho_path = os.path.join(out_dir, "modern_ortho_2m.tif") if ortho else None
+    if ortho_path:
+        _write_ortho(terrain, ortho_path, b, ortho_res, detail_res, wkt)
+    dem = os.path.join(out_dir, "modern_dem_25m.tif")
+    xs, ys = terrain.grid(dem_res, b)
+    xx, yy = np.meshgrid(xs, ys)
+    z = terrain.ground_at(xx, yy).astype(np.float32)
+    ds = drv.Create(dem + ".tmp.tif", len(xs), len(ys), 1, gdal.GDT_Float32, ["COMPRESS=DEFLATE", "PREDICTOR=3"])
+    ds.SetGeoTransform((xmin + ORIGIN[0], dem_res, 0.0, ymax + ORIGIN[1], 0.0, -dem_res))
+    ds.SetProjection(wkt)
+    ds.GetRasterBand(1).WriteArray(z)
+    ds.GetRasterBand(1).SetNoDataValue(-9999.0)
+    ds = None
+    os.replace(dem + ".tmp.tif", dem)
+    return ortho_path, dem
+
+
+def _write_ortho(terrain: ArchiveTerrain, ortho: str, b, ortho_res: float, detail_res: float, wkt: str) -> None:
+    from osgeo import gdal
+
+    xmin, _, xmax, ymax = b
     xs, ys = terrain.grid(ortho_res, b)
-    ds = drv.Create(ortho + ".tmp.tif", len(xs), len(ys), 3, gdal.GDT_Byte,
-                    ["TILED=YES", "COMPRESS=JPEG", "JPEG_QUALITY=90", "PHOTOMETRIC=YCBCR"])
+    ds = gdal.GetDriverByName("GTiff").Create(ortho + ".tmp.tif", len(xs), len(ys), 3, gdal.GDT_Byte,
+                                              ["TILED=YES", "COMPRESS=JPEG", "JPEG_QUALITY=90", "PHOTOMETRIC=YCBCR"])
     ds.SetGeoTransform((xmin + ORIGIN[0], ortho_res, 0.0, ymax + ORIGIN[1], 0.0, -ortho_res))
     ds.SetProjection(wkt)
     xd = np.arange(xmin - 2 * detail_res, xmax + 3 * detail_res, detail_res)
@@ -927,22 +947,10 @@ def write_reference(terrain: ArchiveTerrain, out_dir: str, ortho_res: float = 2.
             ds.GetRasterBand(bnd + 1).WriteArray(rgb[..., bnd], 0, r0)
     ds = None
     os.replace(ortho + ".tmp.tif", ortho)
-    dem = os.path.join(out_dir, "modern_dem_25m.tif")
-    xs, ys = terrain.grid(dem_res, b)
-    xx, yy = np.meshgrid(xs, ys)
-    z = terrain.ground_at(xx, yy).astype(np.float32)
-    ds = drv.Create(dem + ".tmp.tif", len(xs), len(ys), 1, gdal.GDT_Float32, ["COMPRESS=DEFLATE", "PREDICTOR=3"])
-    ds.SetGeoTransform((xmin + ORIGIN[0], dem_res, 0.0, ymax + ORIGIN[1], 0.0, -dem_res))
-    ds.SetProjection(wkt)
-    ds.GetRasterBand(1).WriteArray(z)
-    ds.GetRasterBand(1).SetNoDataValue(-9999.0)
-    ds = None
-    os.replace(dem + ".tmp.tif", dem)
-    return ortho, dem
 
 
 def archive_block(kind: str = "film", n_frames: int = 4, seed: int = 1, out_dir: Optional[str] = None,
-                  fiducials: int = 8, reference: bool = True, supersample: int = 1,
+                  fiducials: int = 8, reference=True, supersample: int = 1,
                   progress=None) -> ArchiveBlock:
     """An archive block with its truth; the frames (and the modern reference) rendered into ``out_dir`` once.
 
@@ -950,7 +958,8 @@ def archive_block(kind: str = "film", n_frames: int = 4, seed: int = 1, out_dir:
     control_3m.csv (+ _observations.csv): the control points with N(0, 3 m) noise on X, Y and Z (seeded), no
     sigma columns, a ``# crs:`` WKT line, noisy pixel observations (N(0, 0.3 px)); control_true.csv: the same
     points' true coordinates; check.csv (+ observations): the check points, true; truth.json: everything;
-    modern_ortho_2m.tif, modern_dem_25m.tif: the reference of epoch 1."""
+    modern_ortho_2m.tif, modern_dem_25m.tif: the reference of epoch 1 (``reference``: True both, "dem" the DEM only,
+    False none)."""
     block = build_block(kind, n_frames, seed, out_dir or "", fiducials)
     if out_dir is None:
         return block
@@ -959,7 +968,8 @@ def archive_block(kind: str = "film", n_frames: int = 4, seed: int = 1, out_dir:
     images = os.path.join(out_dir, "images")
     block.paths = {"images": images, "truth": os.path.join(out_dir, "truth.json")}
     done = os.path.join(out_dir, "done")
-    marker = f"{VERSION} {kind} {n_frames} {seed} {fiducials} {int(reference)} {supersample}"
+    ref = int(reference) if isinstance(reference, bool) else reference
+    marker = f"{VERSION} {kind} {n_frames} {seed} {fiducials} {ref} {supersample}"
     if os.path.exists(done) and open(done).read().strip() == marker:
         with open(block.paths["truth"]) as fh:
             old = json.load(fh)
@@ -986,7 +996,9 @@ def archive_block(kind: str = "film", n_frames: int = 4, seed: int = 1, out_dir:
     if reference:
         block.terrain._rasters.pop("texture", None)  # the old epoch's texture is not needed any more
         t1 = time.time()
-        block.paths["ortho"], block.paths["dem"] = write_reference(block.terrain, out_dir)
+        ortho, block.paths["dem"] = write_reference(block.terrain, out_dir, ortho=reference != "dem")
+        if ortho:
+            block.paths["ortho"] = ortho
         if progress:
             progress(f"reference written ({time.time() - t1:.1f} s)")
     with open(block.paths["truth"], "w") as fh:
