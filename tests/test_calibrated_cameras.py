@@ -236,6 +236,32 @@ def test_several_calibrations_match_by_pattern_model_and_size_and_scale_to_a_sca
     assert any(ln.startswith("camera 5 (1 image(s), 640 x 480 px)") and "estimated" in ln for ln in log.lines)
 
 
+def test_a_calibration_that_matches_no_photo_is_refused_and_an_unused_camera_warned(tmp_path):
+    """A file given for the block whose camera misses every photo (images patterns that match no name) was
+    silently ignored under auto ('no calibration given' in the log, self-calibrated) and under fixed refused as if
+    no file had been given; now an error naming the file, the camera, its patterns and the photos.  A camera of a
+    several-camera file that no photo takes is a warning."""
+    import pycolmap
+
+    path = tmp_path / "camx.json"
+    path.write_text(json.dumps({"name": "X", "images": ["X_*.tif"], "image_size_px": [640, 1152],
+                                "focal_length_px": 833.3}))
+    infos = [_info("D1_01.tif", width=640, height=1152), _info("D1_02.tif", width=640, height=1152)]
+    for mode in ("auto", "fixed", "estimated"):
+        with pytest.raises(AlignError, match=r"camx\.json: no photo matches camera 'X' \(images X_\*\.tif\)"
+                                             r".* 2 photo\(s\): D1_01\.tif, D1_02\.tif; 640 x 1152 px"):
+            plan_cameras(pycolmap, [_group(infos)], infos, _read(path), {}, AlignOptions(intrinsics=mode),
+                         NullProgress())
+    path.write_text(json.dumps({"cameras": [
+        {"name": "X", "images": ["X_*.tif"], "image_size_px": [640, 1152], "focal_length_px": 833.3},
+        {"name": "DMC", "image_size_px": [640, 1152], "focal_length_px": 833.3}]}))
+    log = _Log()
+    _, plan = plan_cameras(pycolmap, [_group(infos)], infos, _read(path), {}, AlignOptions(), log)
+    assert plan["g"].name == "DMC"
+    assert any("camx.json: no photo matches camera 'X' (images X_*.tif); it is not used" in ln
+               for ln in log.lines), log.lines
+
+
 def test_focal_length_and_film_scans_as_given_interior_orientations(tmp_path):
     import pycolmap
 

@@ -182,6 +182,7 @@ def plan_cameras(pycolmap, groups: List[CameraGroup], infos: Sequence[ImageInfo]
     for cal in cals:
         for note in getattr(cal, "notes", None) or []:
             progress.info(f"calibration {cal.source}, {cal.label()}: {note}")
+    _check_calibrations_used(cals, infos, progress)
     out: List[CameraGroup] = []
     plan: Dict[str, GivenCamera] = {}
     for g in groups:
@@ -209,6 +210,43 @@ def plan_cameras(pycolmap, groups: List[CameraGroup], infos: Sequence[ImageInfo]
         progress.info(f"camera {g.camera_id} ({len(g.images)} image(s), {g.width} x {g.height} px): interior "
                       f"orientation {what}")
     return out, plan
+
+
+def _describe_calibration(cal) -> str:
+    """How a calibration is matched to photos, for a message: its name, images patterns or size."""
+    how = (f"images {', '.join(cal.images)}" if cal.images
+           else f"{cal.width} x {cal.height} px" + (f", EXIF camera model '{cal.name}'" if cal.name else ""))
+    return f"{cal.label()} ({how})"
+
+
+def _check_calibrations_used(cals: Sequence, infos: Sequence[ImageInfo], progress: Progress) -> None:
+    """A calibration file whose cameras match no photo is an error (it was given to be used: a wrong file, or
+    images patterns or a camera name that miss the photos' names); a camera of the file no photo takes is a
+    warning (a file of several cameras may hold more than this block uses)."""
+    if not cals or not infos:
+        return
+    used = set()
+    for im in infos:
+        cal, _ = match_calibration(im, cals)
+        if cal is not None:
+            used.add(id(cal))
+    if used:
+        for cal in cals:
+            if id(cal) not in used:
+                progress.warning(f"calibration file {os.path.basename(cal.source)}: no photo matches "
+                                 f"{_describe_calibration(cal)}; it is not used")
+        return
+    sizes = sorted({(im.width, im.height) for im in infos})
+    models = sorted({(im.model or "").strip() for im in infos} - {""})
+    names = [im.name for im in infos]
+    photos = (f"{len(infos)} photo(s): {', '.join(names[:3])}{', ...' if len(names) > 3 else ''}; "
+              f"{', '.join(f'{w} x {h}' for w, h in sizes)} px; EXIF camera model "
+              + (", ".join(f"'{m}'" for m in models) if models else "none"))
+    raise AlignError(f"calibration file {os.path.basename(cals[0].source)}: no photo matches "
+                     f"{'' if len(cals) == 1 else 'any of its cameras: '}"
+                     f"{'; '.join(_describe_calibration(c) for c in cals)}. A camera is matched by its images "
+                     f"patterns, else (without patterns) by its name against the photos' EXIF camera model, else "
+                     f"by the image size; one camera without patterns applies to every photo. The {photos}")
 
 
 def colmap_camera(pycolmap, group: CameraGroup, given: Optional[GivenCamera], model: str):
