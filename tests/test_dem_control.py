@@ -292,3 +292,23 @@ def test_the_shift_is_used_where_the_terrain_fixes_it_else_the_heights_alone():
         err = res.correction(pts[:, 0], pts[:, 1]) - applied
         assert np.max(np.abs(err)) < 0.05, np.max(np.abs(err))
         assert res.nmad_after < 0.1 and res.nmad_before > 0.5
+
+
+def test_a_reference_with_many_cells_under_the_block_is_read_coarser(scene, monkeypatch):
+    """Beyond MAX_WINDOW_CELLS cells under the block the reference is averaged onto a coarser grid in its own CRS
+    (here 20 000: 0.5 m -> 1 m), still in feet read as feet and reprojected into the block's CRS."""
+    import core.georef.demcontrol as dm
+
+    block, _, _, _, _, ref, _ = scene
+    xyz, _ = block.tie_points(3000, seed=3)
+    world = xyz + syn.ORIGIN
+    full, gt_full, _, n_full = dm.check_coverage(world, ref, syn.CRS)
+    monkeypatch.setattr(dm, "MAX_WINDOW_CELLS", 20_000)
+    arr, gt, messages, n = dm.check_coverage(world, ref, syn.CRS)
+    print(f"\n{messages}: {n_full} -> {n} cells under the block, cell {gt_full[1]:.2f} -> {gt[1]:.2f} m")
+    assert any("read averaged onto" in m and ref in m for m in messages) and all("reference.vrt" not in m
+                                                                                   for m in messages)
+    assert 1.9 <= gt[1] / gt_full[1] <= 4.0 and arr.size * 3 < full.size
+    z = dm.bilinear(arr, (world[:, 0] - gt[0]) / gt[1] - 0.5, (world[:, 1] - gt[3]) / gt[5] - 0.5)
+    ok = np.isfinite(z)
+    assert ok.mean() > 0.9 and np.median(np.abs(z[ok] - world[ok, 2])) < 0.3  # metres, on the true surface

@@ -42,15 +42,18 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from ..common.errors import ArchaeoOrthoError
 from ..common.progress import NullProgress, Progress
 from ..io.gcp import CONTROL, CameraPosition, GCPSet, GroundPoint, Observation
 from ..io.raster import bilinear
 from .coregister import (
+    DEM_MARGIN_CELLS,
     MIN_CELLS,
     OUTLIER_NMAD,
     CoregError,
@@ -65,6 +68,7 @@ from .errors import GeorefError
 
 DEM_PREFIX = "dem"  # DEM control points are named dem001, dem002, ...
 FORMAT = "archaeoortho-dem-control"
+MAX_WINDOW_CELLS = 4_000_000  # the reference is averaged onto a coarser grid beyond this many cells under the block
 HEIGHTS_CONTROL = "control points"
 HEIGHTS_DEM = "reference DEM"
 
@@ -135,8 +139,53 @@ def block_points(xyz: np.ndarray) -> np.ndarray:
 
 
 def _window(xyz: np.ndarray, ref_path: str, crs: str) -> Tuple[np.ndarray, Tuple[float, ...], List[str]]:
+    """The reference over the points' box in ``crs`` (metres), averaged onto a coarser grid in the reference's own
+    CRS first where the box holds more than MAX_WINDOW_CELLS of its cells (a 10 km archive block on a 1 m DEM)."""
+    import tempfile
+
     lo, hi = xyz[:, :2].min(axis=0), xyz[:, :2].max(axis=0)
-    return reference_window(ref_path, lo[0], lo[1], hi[0], hi[1], crs=crs)
+    with tempfile.TemporaryDirectory(prefix="archaeoortho-demcontrol-") as tmp:
+        path, note = _coarsened(ref_path, lo, hi, crs, os.path.join(tmp, "reference.vrt"))
+        try:
+            arr, gt, messages = reference_window(path, lo[0], lo[1], hi[0], hi[1], crs=crs)
+        except CoregError as e:  # named by the user's file, not the coarser copy
+            raise CoregError(str(e).replace(path, ref_path)) from e
+    return arr, gt, [m.replace(path, ref_path) for m in messages] + ([note] if note else [])
+
+
+def _coarsened(ref_path: str, lo: np.ndarray, hi: np.ndarray, crs: str, out: str) -> Tuple[str, str]:
+    """(``ref_path``, '') when the box holds at most MAX_WINDOW_CELLS of the reference's cells, else (a warped VRT
+    ``out`` averaging the reference onto a grid k times coarser over the box, in its own CRS and units, a message)."""
+    from osgeo import gdal
+
+    from ..geometry.crs import transform_points
+
+    ds = gdal.Open(os.path.abspath(ref_path)) if os.path.isfile(ref_path) else None
+    wkt = ds.GetProjection() if ds is not None else ""
+    if not wkt:
+        return ref_path, ""  # reference_window names what is wrong with it
+    corners = np.array([[lo[0], lo[1], 0.0], [hi[0], lo[1], 0.0], [lo[0], hi[1], 0.0], [hi[0], hi[1], 0.0]])
+    try:
+        c = transform_points(corners, crs, wkt)
+    except ArchaeoOrthoError:
+        return ref_path, ""
+    gt = ds.GetGeoTransform()
+    cell = abs(gt[1])
+    cells = (np.ptp(c[:, 0]) / cell + 2 * DEM_MARGIN_CELLS) * (np.ptp(c[:, 1]) / abs(gt[5]) + 2 * DEM_MARGIN_CELLS)
+    if cells <= MAX_WINDOW_CELLS:
+        return ref_path, ""
+    k = int(math.ceil(math.sqrt(cells / MAX_WINDOW_CELLS)))
+    m = DEM_MARGIN_CELLS * cell * k
+    band = ds.GetRasterBand(1)
+    nodata = band.GetNoDataValue()
+    warped = gdal.Warp(out, ds, format="VRT", outputBounds=(c[:, 0].min() - m, c[:, 1].min() - m, c[:, 0].max() + m,
+                                                             c[:, 1].max() + m),
+                       xRes=cell * k, yRes=abs(gt[5]) * k, resampleAlg="average", outputType=gdal.GDT_Float32,
+                       srcNodata=nodata, dstNodata=nodata if nodata is not None else -9999.0)
+    warped.GetRasterBand(1).SetUnitType(band.GetUnitType() or "")
+    warped = None
+    return out, (f"the reference DEM {ref_path} is read averaged onto {k} x its cell ({cell * k:.3g} CRS units) over "
+                 f"the block: {cells:,.0f} of its cells lie under it, more than {MAX_WINDOW_CELLS:,}")
 
 
 def check_metric(crs: str, ref_path: str) -> None:
