@@ -254,7 +254,11 @@ def _dem_control(rec, first: GeorefResult, gcps: Optional[gcpmod.GCPSet], cams: 
     for m in dc.messages:
         progress.info(m)
     gcps2, cams2 = demmod.with_dem_control(gcps, cams, dc)
-    result = _adjust(rec, gcps2, cams2, opt, SubProgress(progress, 0.5, 0.9))
+    try:
+        result = _adjust(rec, gcps2, cams2, opt, SubProgress(progress, 0.5, 0.9))
+    except ArchaeoOrthoError as e:  # say which adjustment failed: the block adjusted without them was fine
+        raise demmod.DemControlError(f"the adjustment with the {len(dc.points)} DEM control points from "
+                                     f"{opt.reference_dem} failed: {e}") from e
     try:
         dc.after = demmod.coregister_block(result.reconstruction, result.offset, opt.reference_dem, target)[0]
     except CoregError as e:
