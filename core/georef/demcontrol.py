@@ -182,6 +182,8 @@ def _coarsened(ref_path: str, lo: np.ndarray, hi: np.ndarray, crs: str, out: str
                                                              c[:, 1].max() + m),
                        xRes=cell * k, yRes=abs(gt[5]) * k, resampleAlg="average", outputType=gdal.GDT_Float32,
                        srcNodata=nodata, dstNodata=nodata if nodata is not None else -9999.0)
+    if warped is None:  # read it whole as before
+        return ref_path, ""
     warped.GetRasterBand(1).SetUnitType(band.GetUnitType() or "")
     warped = None
     return out, (f"the reference DEM {ref_path} is read averaged onto {k} x its cell ({cell * k:.3g} CRS units) over "
