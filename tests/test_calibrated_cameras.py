@@ -262,6 +262,41 @@ def test_a_calibration_that_matches_no_photo_is_refused_and_an_unused_camera_war
                for ln in log.lines), log.lines
 
 
+def test_a_calibration_with_k3_never_frees_the_rational_terms(tmp_path):
+    """A calibration with k3 (every certificate's distortion table fits one) is COLMAP's FULL_OPENCV, whose k4..k6
+    are zero by construction.  Estimated, the alignment's self-calibration freed them with k1..k3 (4 archive frames:
+    k1 = 55, k4 = 55, k2 = -113, k5 = -113): it now starts OPENCV from the calibration, k3 left out and said so;
+    fixed and refined keep FULL_OPENCV, and the georeference refines k1..k3, p1, p2 but never k4..k6."""
+    import pycolmap
+
+    from core.georef.bundle import _free_intrinsics
+
+    path = tmp_path / "cam.json"
+    path.write_text(json.dumps({"name": "DMC", "image_size_px": [640, 1152], "focal_length_px": 833.3,
+                                "k1": -0.01, "k2": 0.002, "k3": -0.0003}))
+    infos = [_info("a.tif", width=640, height=1152), _info("b.tif", width=640, height=1152)]
+    log = _Log()
+    _, plan = plan_cameras(pycolmap, [_group(infos)], infos, _read(path), {}, AlignOptions(intrinsics="estimated"),
+                           log)
+    assert plan["g"].model == "OPENCV" and plan["g"].params == [833.3, 833.3, 320.0, 576.0, -0.01, 0.002, 0.0, 0.0]
+    assert any("k3 = -0.0003 of the calibration left out" in ln for ln in log.lines), log.lines
+    for mode in ("fixed", "refined"):
+        _, plan = plan_cameras(pycolmap, [_group(infos)], infos, _read(path), {}, AlignOptions(intrinsics=mode),
+                               NullProgress())
+        assert plan["g"].model == "FULL_OPENCV" and plan["g"].params[8] == -0.0003
+    given = plan["g"]
+    cam = pycolmap.Camera.create_from_model_name(1, "FULL_OPENCV", 833.3, 640, 1152)
+    cam.params = given.params
+    names = [n.strip() for n in cam.params_info.split(",")]
+    images = SimpleNamespace(camera_ids=[1], images_per_cam={1: 4})
+    record = {"mode": "refined", "model": "FULL_OPENCV", "given": dict(zip(names, given.params))}
+    for mode, expect in (("refined", ["fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"]),
+                         ("estimated", ["fx", "fy", "k1", "k2", "p1", "p2", "k3"])):
+        _, free, _, _, _ = _free_intrinsics(SimpleNamespace(cameras={1: cam}), images, ("focal", "extra"), 1,
+                                            log.warning, {1: dict(record, mode=mode)})
+        assert [names[i] for i in free[0]] == expect, mode
+
+
 def test_focal_length_and_film_scans_as_given_interior_orientations(tmp_path):
     import pycolmap
 

@@ -57,6 +57,7 @@ class GivenCamera:
     sigmas: Dict[str, float] = field(default_factory=dict)  # COLMAP parameter name -> sigma (px: focal, pp)
     matched_by: str = ""
     scaled_from: Optional[Tuple[int, int]] = None
+    note: str = ""  # what the alignment changed of the calibration (for the log)
 
     @property
     def held(self) -> bool:
@@ -142,10 +143,19 @@ def _from_calibration(pycolmap, cal, info: ImageInfo, mode: str, how: str) -> Gi
             raise AlignError(f"calibration file {source}: camera {cal.name!r} ({cal.width} x {cal.height} px) does "
                              f"not fit image {info.name} ({info.width} x {info.height} px): {e}") from e
     model, params = cal.colmap_model()
+    mode = cal.adjust or mode
+    note = ""
+    if mode == "estimated" and model == "FULL_OPENCV":
+        # COLMAP's only model with k3 also has the rational terms k4..k6, and its self-calibration frees all
+        # the extra parameters together: a few photos cannot tell k1..k3 from k4..k6 (4 archive frames came
+        # out with k1 = 55, k4 = 55).  A first guess does not need k3: OPENCV (k1, k2, p1, p2) from it
+        note = (f"k3 = {params[8]:.6g} of the calibration left out of the self-calibration (OPENCV: k1, k2, p1, "
+                f"p2; COLMAP's model with k3 would estimate the rational terms k4..k6 along with it)")
+        model, params = "OPENCV", params[:8]
     names = _param_names(pycolmap, model)
-    return GivenCamera(mode=(cal.adjust or mode), source=source, name=cal.name or "", model=model,
+    return GivenCamera(mode=mode, source=source, name=cal.name or "", model=model,
                        params=[float(v) for v in params], sigmas=_sigmas(names, cal.sigmas or {}), matched_by=how,
-                       scaled_from=scaled_from)
+                       scaled_from=scaled_from, note=note)
 
 
 def _simple(focal: float, width: int, height: int, cx: Optional[float] = None, cy: Optional[float] = None):
@@ -206,6 +216,7 @@ def plan_cameras(pycolmap, groups: List[CameraGroup], infos: Sequence[ImageInfo]
         what = (f"{given.mode}, {given.model} from {given.source}"
                 + (f" ({given.name!r}, matched by {given.matched_by})" if given.name else "")
                 + (f", scaled from {given.scaled_from[0]} x {given.scaled_from[1]} px" if given.scaled_from else "")
+                + (f"; {given.note}" if given.note else "")
                 if given else "estimated (self-calibration), no calibration given")
         progress.info(f"camera {g.camera_id} ({len(g.images)} image(s), {g.width} x {g.height} px): interior "
                       f"orientation {what}")

@@ -120,6 +120,9 @@ def outside_image(camera, ob: Observation) -> bool:
 
 
 FIELD_MARGIN = 1.25
+# FULL_OPENCV's rational terms: a calibration file's FULL_OPENCV camera (one with k3) holds them at 0 by
+# construction (core.io.calibration.CameraCalibration.colmap_model), so they are never free for such a camera
+CALIBRATION_ZERO_TERMS = ("k4", "k5", "k6")
 
 
 def field_radius(camera, margin: float = FIELD_MARGIN) -> float:
@@ -627,6 +630,9 @@ def _free_intrinsics(rec, images: _Images, groups, min_intrinsics_images: int, w
             refined.append(cid)
         elif groups:
             warn(f"camera {cid}: only {images.images_per_cam[cid]} image(s), intrinsics kept fixed")
+        if record.get("given") and free:  # a calibration file's camera: its structural zeros stay 0
+            names = [n.strip() for n in cam.params_info.split(",")]
+            free = [idx for idx in free if names[idx] not in CALIBRATION_ZERO_TERMS]
         cam_free.append(sorted(set(free)))
     return cameras, cam_free, refined, priors, fixed
 
