@@ -312,3 +312,20 @@ def test_a_reference_with_many_cells_under_the_block_is_read_coarser(scene, monk
     z = dm.bilinear(arr, (world[:, 0] - gt[0]) / gt[1] - 0.5, (world[:, 1] - gt[3]) / gt[5] - 0.5)
     ok = np.isfinite(z)
     assert ok.mean() > 0.9 and np.median(np.abs(z[ok] - world[ok, 2])) < 0.3  # metres, on the true surface
+
+
+def test_a_block_that_cannot_follow_its_dem_control_is_warned_about():
+    """The warning compares the block's departure from the DEM after the second adjustment with the DEM control
+    points' sigma Z (a block held by a wrong fixed calibration departs by 30 x; one within its sigmas is fine)."""
+    from core.georef.coregister import CoregResult
+    from core.georef.demcontrol import HEIGHTS_DEM, DemControl, after_warning
+    from core.io.gcp import GroundPoint
+
+    pts = [GroundPoint(f"dem{k:03d}", 0.0, 0.0, 0.0, 2.5, sz) for k, sz in enumerate((0.04, 0.05, 0.06), 1)]
+    dc = DemControl("ref.tif", syn.CRS, CoregResult((0.0, 0.0, -1.5), nmad_before=0.9, nmad_after=0.045), pts,
+                    HEIGHTS_DEM)
+    assert after_warning(dc) is None  # not adjusted again yet
+    dc.after = CoregResult((0.0, 0.0, 0.0), nmad_before=1.49)
+    assert "could not follow" in after_warning(dc) and "0.05 m" in after_warning(dc)
+    dc.after = CoregResult((0.0, 0.0, 0.0), nmad_before=0.12)
+    assert after_warning(dc) is None

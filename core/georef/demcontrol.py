@@ -457,16 +457,18 @@ def after_messages(dc: DemControl, before: Dict[str, Any], after: Dict[str, Any]
 
 
 def after_warning(dc: DemControl) -> Optional[str]:
-    """A warning when the block adjusted with the DEM control still departs from the reference by far more than
-    the co-registration's residual spread: its shape could not follow (a camera calibration held fixed)."""
-    if dc.after is None:
+    """A warning when the block adjusted with the DEM control still departs from the reference by more than 3 x
+    what the DEM control points allow (their median sigma Z, at least the co-registration's residual NMAD): its
+    shape could not follow them (a camera calibration held fixed and wrong, or other control far stronger)."""
+    if dc.after is None or not dc.points:
         return None
-    final, fit = dc.after.nmad_before, max(dc.coregistration.nmad_after, 1e-3)
-    if not final > 3.0 * fit:
+    allowed = max(float(np.median([p.sigma_z for p in dc.points])), dc.coregistration.nmad_after, 1e-3)
+    final = dc.after.nmad_before
+    if not final > 3.0 * allowed:
         return None
-    return (f"the block adjusted with the DEM control still departs from the reference DEM by {final:.3g} m (NMAD; "
-            f"{fit:.3g} m after the co-registration): its shape cannot follow the DEM control points; a camera "
-            "calibration held fixed and wrong? Refine the camera calibration")
+    return (f"the block adjusted with the DEM control still departs from the reference DEM by {final:.3g} m (NMAD), "
+            f"more than 3 x the DEM control points' sigma Z ({allowed:.3g} m): its shape could not follow them; a "
+            "camera calibration held fixed and wrong (refine it), or other control given far stronger sigmas?")
 
 
 def _f(v) -> str:
