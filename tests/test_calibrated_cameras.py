@@ -171,6 +171,47 @@ def test_the_report_warns_when_a_refined_parameter_moved_beyond_three_sigma(bloc
     assert not ctx.warnings
 
 
+def test_the_report_reads_like_the_certificate(tmp_path):
+    """The report's camera table for a certificate (focal length in mm, pixel size, principal point offset, a
+    distortion table: FULL_OPENCV): the parameters in a certificate's order with their names, FULL_OPENCV's k4..k6
+    (zero by construction) left out, a line per camera in mm (focal length, principal point from the centre, x right
+    y up) and the radial distortion at the corner; an estimated focal length's move also in percent."""
+    import re
+
+    import pycolmap
+
+    path = tmp_path / "camera.yaml"
+    path.write_text("name: DMC120\nimage_size_px: [640, 1152]\npixel_size_mm: 0.144\nfocal_length_mm: 120.0\n"
+                    "principal_point_mm: [0.05, -0.03]\nk1: -0.01\nk2: 0.002\nk3: -0.0003\n")
+    infos = [_info("a.tif", width=640, height=1152), _info("b.tif", width=640, height=1152)]
+    _, plan = plan_cameras(pycolmap, [_group(infos)], infos, _read(path), {}, AlignOptions(), NullProgress())
+    cam = pycolmap.Camera.create_from_model_name(1, "FULL_OPENCV", 1.0, 640, 1152)
+    cam.params = plan["g"].params
+    rec = SimpleNamespace(cameras={1: cam})
+    groups = [_group(infos)]
+    groups[0] = CameraGroup(**{**groups[0].__dict__, "camera_id": 1})
+    from core.align.calibrated import intrinsics_record
+
+    (record,) = intrinsics_record(pycolmap, groups, plan, rec)
+    assert record["pixel_size_mm"] == 0.144
+    layout = SimpleNamespace(camera_intrinsics=lambda: {1: record})
+    ctx = SimpleNamespace(d=SimpleNamespace(layout=layout, rec=rec), warnings=[], glance=[])
+    html = interior_orientation(ctx)
+    labels = re.findall(r"<tr><td>1</td><td>fixed</td><td>([^<]+)</td>", html)
+    assert labels == ["focal length fx (px)", "focal length fy (px)", "principal point cx (px)",
+                      "principal point cy (px)", "radial k1", "radial k2", "radial k3", "tangential p1",
+                      "tangential p2"], labels
+    assert ("camera 1 'DMC120' (camera.yaml), fixed; focal length 120.000 mm given, 120.000 mm final; principal "
+            "point (+0.050, -0.030) mm given, (+0.050, -0.030) mm final") in html, html
+    assert "radial distortion at the image corner -3.66 px given, -3.66 px final" in html
+    assert "core.georef.options" not in html and not ctx.warnings
+    # estimated: the focal length moved -1.73 %
+    cam.params = [819.0, 819.0] + list(plan["g"].params[2:])
+    record["mode"] = "estimated"
+    html = interior_orientation(ctx)
+    assert "-14.333333 (-1.72 %)" in html and "117.936 mm final" in html, html
+
+
 def test_a_fixed_camera_is_not_refined_whatever_refine_intrinsics_says(block):
     wrong = block.camera.with_params(fx=block.camera.fx * 1.02, fy=block.camera.fy * 1.02)
     gcps = block.gcp_set(block.spread_control(5), noise_px=0.4)

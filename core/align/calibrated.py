@@ -58,6 +58,7 @@ class GivenCamera:
     matched_by: str = ""
     scaled_from: Optional[Tuple[int, int]] = None
     note: str = ""  # what the alignment changed of the calibration (for the log)
+    pixel_size_mm: Optional[float] = None  # the x pixel size where the calibration gives one (the report's mm)
 
     @property
     def held(self) -> bool:
@@ -155,7 +156,7 @@ def _from_calibration(pycolmap, cal, info: ImageInfo, mode: str, how: str) -> Gi
     names = _param_names(pycolmap, model)
     return GivenCamera(mode=mode, source=source, name=cal.name or "", model=model,
                        params=[float(v) for v in params], sigmas=_sigmas(names, cal.sigmas or {}), matched_by=how,
-                       scaled_from=scaled_from, note=note)
+                       scaled_from=scaled_from, note=note, pixel_size_mm=getattr(cal, "pixel_size_mm", None))
 
 
 def _simple(focal: float, width: int, height: int, cx: Optional[float] = None, cy: Optional[float] = None):
@@ -300,7 +301,8 @@ def intrinsics_record(pycolmap, groups: Sequence[CameraGroup], plan: Dict[str, G
                "scaled_from": list(given.scaled_from) if given and given.scaled_from else None}
         if given is not None:
             names = _param_names(pycolmap, given.model)
-            row.update(model=given.model, given=dict(zip(names, given.params)), sigmas=dict(given.sigmas))
+            row.update(model=given.model, given=dict(zip(names, given.params)), sigmas=dict(given.sigmas),
+                       pixel_size_mm=given.pixel_size_mm)
         if cam is not None:
             names = [s.strip() for s in cam.params_info.split(",")]
             row["final_model"] = cam.model.name

@@ -3,12 +3,19 @@ positions."""
 from __future__ import annotations
 
 import os
+from typing import Optional
 
 import numpy as np
 
 from ...common.progress import check_cancel
 from ...georef import accuracy
-from ...georef.bundle import given_priors
+from ...georef.bundle import CALIBRATION_ZERO_TERMS, given_priors
+from ...georef.options import (
+    REFINED_FOCAL_SIGMA,
+    REFINED_PP_SIGMA,
+    REFINED_RADIAL_SIGMA,
+    REFINED_TANGENTIAL_SIGMA,
+)
 from ..context import ReportContext, Skip
 from ..figures import embed, equal_xy, new_figure, nice
 from ..html import badge, cell, esc, fmt, kv, num, table, td
@@ -99,33 +106,95 @@ def section(ctx: ReportContext) -> str:
 MOVED_SIGMAS = 3.0
 
 
+# the parameters in the order a calibration certificate lists them, with their names for a person
+_PARAM_ORDER = ("f", "fx", "fy", "cx", "cy", "k", "k1", "k2", "k3", "p1", "p2")
+_PARAM_LABEL = {"f": "focal length f (px)", "fx": "focal length fx (px)", "fy": "focal length fy (px)",
+                "cx": "principal point cx (px)", "cy": "principal point cy (px)", "k": "radial k1", "k1": "radial k1",
+                "k2": "radial k2", "k3": "radial k3", "p1": "tangential p1", "p2": "tangential p2"}
+
+
+def _corner_distortion_px(params: dict, width: float, height: float) -> Optional[float]:
+    """The radial distortion (px, positive outward) at the image corner of a camera's k1..k3 (OpenCV's model,
+    normalised coordinates), measured from the principal point; None without a focal length."""
+    f = num(params.get("f", params.get("fx")))
+    cx, cy = num(params.get("cx")), num(params.get("cy"))
+    if not f or cx is None or cy is None:
+        return None
+    rho = max(float(np.hypot(x - cx, y - cy)) for x in (0.0, width) for y in (0.0, height)) / f
+    ks = [num(params.get(k)) or 0.0 for k in ("k1", "k2", "k3")]
+    if "k" in params:
+        ks[0] = num(params["k"]) or 0.0
+    return round(float(f * rho * (ks[0] * rho ** 2 + ks[1] * rho ** 4 + ks[2] * rho ** 6)), 2) + 0.0  # no -0.00
+
+
+def _camera_in_mm(cid, r: dict, final: dict) -> str:
+    """One line per camera in the certificate's units: focal length and principal point in mm (x right, y up
+    from the image centre) given and final, where the calibration gave the pixel size; the radial distortion at
+    the image corner in px."""
+    name = f" '{r['name']}'" if r.get("name") else ""
+    src = os.path.basename(str(r.get("source") or ""))
+    parts = [f"camera {cid}{name} ({esc(src)}), {r['mode']}"]
+    g = r["given"]
+    w, h = num(r.get("width")), num(r.get("height"))
+    px = num(r.get("pixel_size_mm"))
+    if px and w and h:
+        def mm(p):
+            fx = num(p.get("f", p.get("fx")))
+            fy = num(p.get("f", p.get("fy"))) or fx
+            py = px * fx / fy
+            return fx * px, (num(p["cx"]) - w / 2.0) * px, (h / 2.0 - num(p["cy"])) * py
+
+        gf, gx, gy = (round(v, 3) + 0.0 for v in mm(g))
+        ff, fx0, fy0 = (round(v, 3) + 0.0 for v in mm(final))
+        parts.append(f"focal length {gf:.3f} mm given, {ff:.3f} mm final; principal point ({gx:+.3f}, {gy:+.3f}) "
+                     f"mm given, ({fx0:+.3f}, {fy0:+.3f}) mm final (from the image centre, x right, y up); pixel "
+                     f"{px:.4g} mm")
+    if w and h:
+        dg, df = _corner_distortion_px(g, w, h), _corner_distortion_px(final, w, h)
+        if dg is not None and df is not None:
+            parts.append(f"radial distortion at the image corner {dg:+.2f} px given, {df:+.2f} px final")
+    return "; ".join(parts) + "."
+
+
 def interior_orientation(ctx: ReportContext) -> str:
     """Per camera with a given calibration (sfm/alignment.json ``intrinsics``): what was held; for a refined camera
     how far each parameter moved from its given value, in its sigma (the prior the georeference used), with a
-    warning beyond MOVED_SIGMAS; for a fixed one whether it kept its values."""
+    warning beyond MOVED_SIGMAS; for a fixed one whether it kept its values.  The parameters in a certificate's
+    order (focal length, principal point, k1..k3, p1, p2; FULL_OPENCV's k4..k6, zero for a calibration, left
+    out), the focal length's move also in percent, and a line per camera in mm where the pixel size is known."""
     d = ctx.d
     records = d.layout.camera_intrinsics()
     given = {cid: r for cid, r in records.items() if r.get("given")}
     if not given:
         return ""
-    rows, far = [], []
+    rows, far, lines = [], [], []
     for cid, r in sorted(given.items()):
         cam = d.rec.cameras[cid] if cid in d.rec.cameras else None
         if cam is None:
             continue
         names = [n.strip() for n in cam.params_info.split(",")]
         sigma = {names[i]: s for i, _, s in given_priors(cam, r)}
-        for name, value in zip(names, cam.params):
+        final = {n: float(v) for n, v in zip(names, cam.params)}
+        order = sorted(range(len(names)), key=lambda i: (_PARAM_ORDER.index(names[i]) if names[i] in _PARAM_ORDER
+                                                         else len(_PARAM_ORDER) + i))
+        for i in order:
+            name, value = names[i], float(cam.params[i])
             g = num(r["given"].get(name))
-            moved = None if g is None else float(value) - g
+            if name in CALIBRATION_ZERO_TERMS and not g and not value:
+                continue
+            moved = None if g is None else value - g
             in_sigma = None if moved is None or r["mode"] != "refined" else moved / sigma[name]
             if in_sigma is not None and abs(in_sigma) > MOVED_SIGMAS:
                 far.append(f"camera {cid} {name} {in_sigma:+.1f} σ")
             if r["mode"] == "fixed" and moved:
                 far.append(f"camera {cid} {name} moved {moved:+.3g} although fixed")
-            rows.append([td(cid), td(r["mode"]), td(name), cell(g, 6), cell(sigma[name] if r["mode"] == "refined"
-                                                                             else None, 6),
-                         cell(value, 6), cell(moved, 6), cell(in_sigma, 2)])
+            moved_cell = cell(moved, 6)
+            if moved and name in ("f", "fx", "fy") and g:
+                moved_cell = f'<td class="n">{moved:+.6f} ({100.0 * moved / g:+.2f} %)</td>'
+            rows.append([td(cid), td(r["mode"]), td(_PARAM_LABEL.get(name, name)), cell(g, 6),
+                         cell(sigma[name] if r["mode"] == "refined" else None, 6), cell(value, 6), moved_cell,
+                         cell(in_sigma, 2)])
+        lines.append(f"<li>{_camera_in_mm(cid, r, final)}</li>")
     modes = ", ".join(f"camera {cid}: {r['mode']} ({esc(os.path.basename(str(r.get('source') or '')))})"
                       for cid, r in sorted(given.items()))
     if far:
@@ -134,9 +203,14 @@ def interior_orientation(ctx: ReportContext) -> str:
     return ("<h3>Interior orientation</h3>"
             + f'<p data-key="intrinsics.modes">Given calibrations: {modes}. Fixed: held at the given values through '
             "the alignment and the georeference; refined: refined in the georeference with priors at the given "
-            "values (σ from the calibration, else the defaults of core.georef.options).</p>"
+            f"values (σ from the calibration file, else {100 * REFINED_FOCAL_SIGMA:g} % of the focal length, "
+            f"{100 * REFINED_PP_SIGMA:g} % of the image's long side for the principal point, "
+            f"{REFINED_RADIAL_SIGMA:g} for k1..k3, {REFINED_TANGENTIAL_SIGMA:g} for p1, p2); estimated: "
+            "self-calibrated from the given values. Pixels: (0, 0) is the upper-left corner of the image, y down; "
+            "k1..k3, p1, p2 are OpenCV's coefficients on normalised image coordinates.</p>"
             + (f'<p class="warn" data-key="intrinsics.warning">Moved beyond {MOVED_SIGMAS:g} σ: '
                f'{esc("; ".join(far))}</p>' if far else "")
+            + f'<ul data-key="intrinsics.mm">{"".join(lines)}</ul>'
             + table(["camera", "mode", "parameter", "given", "σ", "final", "moved", "moved (σ)"], rows))
 
 
