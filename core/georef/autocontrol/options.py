@@ -13,7 +13,8 @@ class AutoControlOptions:
     """``gsd``: the common ground resolution of the match (None: the coarser of the reference's and the photos');
     ``max_pixels``: the provisional orthophoto's largest side (the resolution is made coarser beyond it);
     ``ratio``: Lowe's ratio test; ``ransac_px``: the similarity's inlier distance (common-grid pixels);
-    ``tile_px``, ``tile_ransac_px``: the per-tile affine refinement; ``max_candidates``: matches tied back to
+    ``tile_px``, ``tile_ransac_px``: the per-tile affine refinement (a block that spans fewer pixels of
+    the common grid than one tile is refused before the match: too coarse a reference for a block this small); ``max_candidates``: matches tied back to
     the photos (the best of a grid over the block); ``search_px``: how far a point is searched in the other
     photos around its prediction through the model; ``min_score``: their normalised cross-correlation;
     ``ground_plane``: the patches compared through the ground's plane (else the plane facing the first photo);

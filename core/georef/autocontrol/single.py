@@ -48,8 +48,10 @@ class PhotoControlOptions:
     ``photo_pixels``: the photo's largest side for the first match; ``max_tilt``: the largest simulated tilt of
     the affine views (1: plain SIFT); ``homography_px``: the first match's RANSAC threshold (reference pixels);
     ``min_matches``: homography inliers needed (``good_matches``: enough without the affine views); ``passes``: re-renderings through the pose; ``max_points``: the
-    GCPs kept for the resection (the best of a grid over the photo); ``max_relief``: metres of DSM misfit around a
-    point beyond which its height is not trusted; ``focal_factors``: focal lengths tried (times the photo's long
+    GCPs kept for the resection (the best of a grid over the photo); ``max_relief``: DSM misfit around a point
+    beyond which its height is not trusted, in the DSM's units (None: ``relief_cells`` x the coarser of the match's
+    grid and the DSM's cell: 0.62 m at a 0.25 m DSM, as the 0.6 m it was; 25 m at a 10 m DEM, whose cells hold
+    whole houses); ``focal_factors``: focal lengths tried (times the photo's long
     side) when the photo has none."""
 
     reach: Optional[float] = None
@@ -64,7 +66,8 @@ class PhotoControlOptions:
     good_matches: int = 60
     passes: int = 1
     max_points: int = 200
-    max_relief: float = 0.6
+    max_relief: Optional[float] = None
+    relief_cells: float = 2.5
     sigma_px: float = 1.0
     focal_factors: Tuple[float, ...] = (0.6, 0.8, 1.0, 1.25, 1.6, 2.0, 2.6, 3.4)
     match: AutoControlOptions = field(default_factory=lambda: AutoControlOptions(
@@ -283,9 +286,11 @@ def _ground_points(ms, win: _Window, ref: Reference, to_photo, photo: _Photo, op
     """(world XYZ (N, 3), photo COLMAP pixels (N, 2), match residuals) of the matches reference window (src) ->
     rectified photo (dst), on trustworthy heights, thinned to the best per cell of a grid over the photo."""
     xy = win.world(ms.src)
-    z, _slope, misfit = ref.relief(xy[:, 0], xy[:, 1], 2.0 * max(win.gt[1], ref.dsm_gsd))
+    cell = max(win.gt[1], ref.dsm_gsd)
+    z, _slope, misfit = ref.relief(xy[:, 0], xy[:, 1], 2.0 * cell)
     px = to_photo(ms.dst) + 0.5
-    ok = np.isfinite(z) & (misfit <= opt.max_relief) & np.all(np.isfinite(px), axis=1)
+    max_relief = opt.max_relief if opt.max_relief is not None else opt.relief_cells * cell
+    ok = np.isfinite(z) & (misfit <= max_relief) & np.all(np.isfinite(px), axis=1)
     ok &= (px[:, 0] >= 0) & (px[:, 1] >= 0) & (px[:, 0] <= photo.width) & (px[:, 1] <= photo.height)
     xyz, px, res = np.column_stack([xy, z])[ok], px[ok], np.asarray(ms.residual)[ok]
     if len(xyz) > opt.max_points:
