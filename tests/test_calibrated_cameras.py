@@ -99,6 +99,10 @@ def test_a_fixed_calibration_is_held_through_alignment_and_georeference(block, f
     assert record["mode"] == "fixed" and record["source"] == cal and record["matched_by"] == "the only calibration"
     assert record["given"]["fx"] == block.camera.fx and record["final"]["fx"] == block.camera.fx
     assert any("interior orientation fixed, OPENCV from" in ln for ln in log.lines), log.lines
+    # the camera line states the calibration's focal length, not the EXIF / default prior the group had
+    assert any(ln.startswith("camera 1: ") and f"focal {block.camera.fx:.1f} px (fixed, camera.json)" in ln
+               for ln in log.lines), log.lines
+    assert not any("focal prior" in ln for ln in log.lines), log.lines
     # the georeference asked to refine everything keeps it, and says so once
     gcps = block.gcp_set(block.spread_control(5), noise_px=0.4)
     glog = _Log()

@@ -299,8 +299,11 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
     inputs = {"images": fingerprint([(im.name, im.width, im.height) for im in infos])}
     with run_stage(ws, STAGE, asdict(options), inputs) as run:
         for g in groups:
-            progress.info(f"camera {g.camera_id}: {g.make} {g.model} {g.width}x{g.height}, focal prior "
-                          f"{g.focal_px:.1f} px ({g.focal_source}), {len(g.images)} images")
+            given = photos.given.get(g.key)
+            focal = (f"focal {given.params[0]:.1f} px ({given.mode}, {os.path.basename(given.source)})" if given is not None
+                     else f"focal prior {g.focal_px:.1f} px ({g.focal_source})")
+            progress.info(f"camera {g.camera_id}: {g.make} {g.model} {g.width}x{g.height}, {focal}, "
+                          f"{len(g.images)} images")
         os.makedirs(lay.sfm_dir, exist_ok=True)
         db_path, mask_path, masks, camera_ids = _setup(pycolmap, lay, photos, options, run.record, keep_previous,
                                                        progress)
