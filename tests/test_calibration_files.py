@@ -234,6 +234,23 @@ def test_scaled_to_halves_pixel_values_and_keeps_mm():
         cal.scaled_to(5750, 5000)
 
 
+def test_a_photo_of_another_aspect_ratio_names_the_file_the_line_and_the_photo(tmp_path):
+    """A calibration for 1152 x 1152 px given for 640 x 1152 px photos: the message names the file, the line of
+    the image size and its field, and the photo (was: no line, the file and the camera named twice)."""
+    own = tmp_path / "aspect.yaml"
+    own.write_text("name: DMC120\nfocal_length_px: 833.3\nimage_size_px: [1152, 1152]\n")
+    cols = tmp_path / "cameras.txt"
+    cols.write_text("# COLMAP\n1 PINHOLE 640 480 500 500 320 240\n2 PINHOLE 1152 1152 833.3 833.3 576 576\n")
+    for path, line, fld, cam in ((own, 3, "image_size_px", "camera 'DMC120'"), (cols, 3, "WIDTH HEIGHT", "camera '2'")):
+        cal = read_calibration(str(path))[-1]
+        with pytest.raises(CalibrationError) as e:
+            cal.scaled_to(640, 1152, "D1_01.tif")
+        assert (e.value.line, e.value.field) == (line, fld)
+        assert str(e.value) == (f"{path.name}, line {line}: {cam} is calibrated for 1152 x 1152 px images ({fld}); "
+                                f"the photo D1_01.tif of 640 x 1152 px has another aspect ratio (1.0000 against "
+                                f"0.5556): is it cropped or turned, or is the calibration's image size wrong?")
+
+
 def _cal(**kw):
     base = dict(name="c", source="x.yaml", width=400, height=300, focal_px=500.0, focal_y_px=None,
                 cx_px=201.0, cy_px=149.0)

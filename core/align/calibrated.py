@@ -138,11 +138,7 @@ def _from_calibration(pycolmap, cal, info: ImageInfo, mode: str, how: str) -> Gi
     scaled_from = None
     if (cal.width, cal.height) != (info.width, info.height):
         scaled_from = (cal.width, cal.height)
-        try:
-            cal = cal.scaled_to(info.width, info.height)
-        except ValueError as e:  # CalibrationError is one: it names the file and the field
-            raise AlignError(f"calibration file {source}: camera {cal.name!r} ({cal.width} x {cal.height} px) does "
-                             f"not fit image {info.name} ({info.width} x {info.height} px): {e}") from e
+        cal = cal.scaled_to(info.width, info.height, info.name)  # CalibrationError: the file, line, field, photo
     model, params = cal.colmap_model()
     mode = cal.adjust or mode
     note = ""

@@ -118,6 +118,8 @@ class CameraCalibration:
     fiducials_mm: Dict[str, Tuple[float, float]] = field(default_factory=dict)
     focal_mm: Optional[float] = None
     notes: List[str] = field(default_factory=list)  # what the reader assumed or dropped (the caller names the camera)
+    size_field: str = ""  # the field that gave the image size and its line (for messages about the size)
+    size_line: Optional[int] = None
 
     @property
     def fx(self) -> float:
@@ -141,19 +143,22 @@ class CameraCalibration:
         return any(fnmatch.fnmatchcase(base, p.lower()) or fnmatch.fnmatchcase(image_name.lower(), p.lower())
                    for p in self.images)
 
-    def scaled_to(self, width: int, height: int) -> CameraCalibration:
+    def scaled_to(self, width: int, height: int, image_name: str = "") -> CameraCalibration:
         """The same camera for an image of ``width`` x ``height`` pixels (a scan at another resolution, a
-        downscaled copy): pixel values scale about the image corner, millimetre values stay."""
+        downscaled copy): pixel values scale about the image corner, millimetre values stay.  ``image_name``
+        names the image in the message of a size that does not fit (another aspect ratio)."""
         if width <= 0 or height <= 0:
             raise CalibrationError(self.source, None, "width",
                                    f"{self.label()}: the image size must be positive, got {width} x {height}")
         sx, sy = width / self.width, height / self.height
         if abs(sx / sy - 1.0) > ASPECT_TOLERANCE:
+            what = f"the photo {image_name}" if image_name else "an image"
+            given = f" ({self.size_field})" if self.size_field else ""
             raise CalibrationError(
-                self.source, None, "image_size_px",
-                f"{self.label()} is calibrated for {self.width} x {self.height} px images; an image of "
+                self.source, self.size_line, self.size_field or "image_size_px",
+                f"{self.label()} is calibrated for {self.width} x {self.height} px images{given}; {what} of "
                 f"{width} x {height} px has another aspect ratio ({self.width / self.height:.4f} against "
-                f"{width / height:.4f}): is it cropped or turned?")
+                f"{width / height:.4f}): is it cropped or turned, or is the calibration's image size wrong?")
         fx, fy = self.fx * sx, self.fy * sy
         sig = dict(self.sigmas)
         for key, s in (("focal_px", sx), ("cx_px", sx), ("cy_px", sy)):
@@ -638,7 +643,8 @@ def _own_camera(path: str, data: dict, default_adjust: Optional[str], index: str
     return CameraCalibration(
         name=name, source=path, width=w, height=h, focal_px=fx, focal_y_px=None if _same(fx, fy) else fy,
         cx_px=cx, cy_px=cy, **dist, sigmas=_own_sigmas(fl, px, py), adjust=_adjust(fl, default=default_adjust),
-        images=_own_images(fl), pixel_size_mm=px, fiducials_mm=_own_fiducials(fl), focal_mm=focal_mm, notes=notes)
+        images=_own_images(fl), pixel_size_mm=px, fiducials_mm=_own_fiducials(fl), focal_mm=focal_mm, notes=notes,
+        size_field="image_size_px", size_line=_line_of(data, "image_size_px"))
 
 
 def _own_pixel_size(fl: _Fields, w: int, h: int) -> Tuple[Optional[float], Optional[float]]:
@@ -839,7 +845,8 @@ def _orthority_camera(path: str, name: str, data: dict) -> CameraCalibration:
         raise fl.fail(next(t for t in DISTORTION_TERMS if fl.has(t)),
                       "a pinhole camera has no distortion coefficients: use type brown or opencv")
     return CameraCalibration(name=name, source=path, width=w, height=h, focal_px=fx,
-                             focal_y_px=None if _same(fx, fy) else fy, cx_px=cx, cy_px=cy, **dist, notes=notes)
+                             focal_y_px=None if _same(fx, fy) else fy, cx_px=cx, cy_px=cy, **dist, notes=notes,
+                             size_field="im_size", size_line=_line_of(data, "im_size"))
 
 
 def _orthority_focal(fl: _Fields, w: int, h: int) -> Tuple[float, float, List[str]]:
@@ -905,7 +912,8 @@ def _read_opencv_mapping(path: str, data: Any) -> List[CameraCalibration]:
         raise fl.fail(mkey, f"{mkey}: the focal lengths must be positive, got fx {k[0]}, fy {k[4]}")
     return [CameraCalibration(name="", source=path, width=w, height=h, focal_px=k[0],
                               focal_y_px=None if _same(k[0], k[4]) else k[4], cx_px=cx, cy_px=cy,
-                              k1=dist[0], k2=dist[1], p1=dist[2], p2=dist[3], k3=dist[4])]
+                              k1=dist[0], k2=dist[1], p1=dist[2], p2=dist[3], k3=dist[4],
+                              size_field="image_width", size_line=_line_of(data, "image_width"))]
 
 
 def _cv_matrix_values(fl: _Fields, key: str, value: Any) -> List[float]:
@@ -1058,7 +1066,8 @@ def _metashape_camera(path: str, cal: _Element, name: str, sensor: Optional[_Ele
     _check_principal_point(fl, "cx", cx, cy, w, h)
     return CameraCalibration(name=name, source=path, width=w, height=h, focal_px=fx,
                              focal_y_px=None if _same(fx, fy) else fy, cx_px=cx, cy_px=cy, k1=v["k1"], k2=v["k2"],
-                             k3=v["k3"], p1=v["p2"], p2=v["p1"], notes=notes)
+                             k3=v["k3"], p1=v["p2"], p2=v["p1"], notes=notes, size_field="width",
+                             size_line=_line_of(m, "width"))
 
 
 # ---------------------------------------------------------------------------
@@ -1110,7 +1119,8 @@ def _read_colmap_txt(path: str, text: str) -> List[CameraCalibration]:
                                    "positive")
         out.append(CameraCalibration(name=cam_id, source=path, width=w, height=h, focal_px=fx,
                                      focal_y_px=None if _same(fx, fy) else fy, cx_px=p["cx"], cy_px=p["cy"],
-                                     **{t: p.get(t, 0.0) for t in DISTORTION_TERMS}))
+                                     **{t: p.get(t, 0.0) for t in DISTORTION_TERMS}, size_field="WIDTH HEIGHT",
+                                     size_line=n))
     if not out:
         raise CalibrationError(path, None, "", "the COLMAP cameras file lists no camera")
     _check_unique_names(path, out, [None] * len(out))
