@@ -81,6 +81,7 @@ from .control_sigma import (
     ground_sample_distance,
     intersection_precision,
     lmeds_sigma,
+    tie_point_sigma,
     variance_components,
 )
 from .errors import GeorefError
@@ -405,7 +406,12 @@ def _estimate_sigmas(run: _Run, fit: _Fit) -> None:
     free_cams = [cp for cp, _ in run.cam_pos if not cp.sigma_given]
     if not free_pts and not free_cams:
         return
-    tr, px = fit.helmert.transform, run.opt.gcp_pixel_sigma
+    tr = fit.helmert.transform
+    # the floor's pixel sigma: the tie points' own noise (what the block resolves), at most the adjustment's
+    px = run.opt.gcp_pixel_sigma
+    s0 = tie_point_sigma(run.rec)
+    if math.isfinite(s0) and s0 > 0:
+        px = min(px, s0)
     v_fit, r_fit = fit_residuals(tr, fit.model, fit.world_local, fit.helmert.inliers)
     in_fit = {(o.name if fit.source == "control points" else o.image): k for k, o in enumerate(fit.objs)
               if fit.helmert.inliers[k]}

@@ -80,6 +80,7 @@ def _sigma_estimates(ctx: ReportContext, res: Dict[str, Any]) -> str:
                      cell(e.get("sigma_z_m"), 3, f"sigma.{key}.z"), cell(e.get("helmert_xy_m"), 3),
                      cell(e.get("helmert_z_m"), 3), cell(e.get("floor_xy_m"), 3), cell(e.get("floor_z_m"), 3),
                      td(f"{e.get('prior_xy_m', float('nan')):g} / {e.get('prior_z_m', float('nan')):g}"), td(how),
+                     cell(e.get("pixel_sigma"), 2),
                      td(", ".join(e.get("excluded") or []) or "–")])
         pre = "CONTROL" if key == "control" else "CAMERA_POSITION"
         ctx.figures.update({f"{pre}_SIGMA_XY": num(e.get("sigma_xy_m")), f"{pre}_SIGMA_Z": num(e.get("sigma_z_m"))})
@@ -87,12 +88,12 @@ def _sigma_estimates(ctx: ReportContext, res: Dict[str, Any]) -> str:
                                           f"{fmt(e.get('sigma_xy_m'), 3)} m, Z {fmt(e.get('sigma_z_m'), 3)} m")))
     return ("<h3>Accuracy of the control given without sigmas, estimated from the data</h3>" + table(
         ["group", "n", "σ XY", "σ Z", "rigid fit σ XY", "rigid fit σ Z", "floor XY", "floor Z", "placeholders",
-         "estimated from", "left out as suspect"], rows)
+         "estimated from", "image σ (px)", "left out as suspect"], rows)
         + '<p class="note">Metres. The files gave no sigmas for these points (or positions), so their accuracy was '
           "estimated: first from the residuals of the rigid (7-parameter) fit of the block onto them, divided by "
           "their redundancy, with the suspect ones left out; then refined by variance components in the "
-          "adjustment (their share of the weighted residuals over their share of the redundancy, the tie points "
-          "the reference). The adjustment weighted them with the estimate: metre-level control leaves the block "
+          "adjustment (their share of the weighted residuals over their share of the redundancy), the image "
+          "observations' own sigma estimated alongside (image σ). The adjustment weighted them with the estimate: metre-level control leaves the block "
           "as rigid as the rigid fit, precise control lets it bend where the tie points allow. The floor is the "
           "block's own precision at the points (their forward intersection at the adjustment's pixel sigma): "
           "nothing finer can be told from the data.</p>")
