@@ -20,7 +20,7 @@ issue (a real archive block, plain SfM + Helmert on six metre-level control poin
 GSD; the adjustment must never be worse than the Helmert solution.
 
     python benchmarks/archive.py [--frames 4 12] [--kind film|digital] [--seed 1] [--workdir DIR] [--no-prepare]
-                                 [--fiducials 4|8]
+                                 [--fiducials 4|8] [--calibration]
 """
 import argparse
 import math
@@ -105,6 +105,18 @@ def prepare(block, ws):
     return res.prepared_dir, to_prepared, p, (w, h), lines
 
 
+def write_calibration(cal, path):
+    """The calibration dict as an ArchaeoOrtho calibration file (JSON), the intrinsics held fixed."""
+    import json
+
+    with open(path, "w") as fh:
+        json.dump({"format": "archaeoortho-calibration", "version": 1, "cameras": [{
+            "name": f"archive-{cal['kind']}", "adjust": "fixed", "image_size_px": cal["image_size_px"],
+            "pixel_size_mm": cal["pixel_size_mm"], "focal_length_mm": cal["focal_mm"],
+            "principal_point_mm": cal["principal_point_mm"]}]}, fh, indent=1)
+    return path
+
+
 def write_control(block, path, to_image, sigma=None):
     """Control (3 m) + check (true) in one CSV, without sigma columns (name,x,y,z,role; the reader's defaults) or
     with ``sigma`` (m) as sx, sy, sz of every point, + the observations file."""
@@ -152,6 +164,8 @@ def _fmt(v, gsd):
 
 def run(kind, n, args):
     work = os.path.join(args.workdir, f"{kind}{n}-s{args.seed}" + (f"-fid{args.fiducials}" if kind == "film" else ""))
+    if args.calibration:
+        work += "-cal"
     t0 = time.time()
     block = arch.archive_block(kind, n, seed=args.seed, out_dir=os.path.join(work, "block"), reference="dem",
                                fiducials=args.fiducials)
@@ -182,6 +196,12 @@ def run(kind, n, args):
             shutil.rmtree(ws, ignore_errors=True)
     opts = AlignOptions(pairing="exhaustive", focal_mm=cal["focal_mm"], sensor_width_mm=max(size) * pixel_mm,
                         num_threads=args.threads)
+    if args.calibration:
+        if not hasattr(opts, "calibration") or kind != "digital":
+            print("  --calibration: needs AlignOptions.calibration and the digital camera; skipped")
+            return
+        opts.calibration = write_calibration(cal, os.path.join(work, "camera.json"))
+        print(f"  calibration file {opts.calibration} (adjust: fixed), AlignOptions.intrinsics {opts.intrinsics!r}")
     extra = [k for k in ("calibration", "intrinsics") if hasattr(opts, k)]
     t0 = time.time()
     try:
@@ -241,6 +261,8 @@ def main():
     ap.add_argument("--no-prepare", action="store_true", help="film: align the raw scans (no fiducial restitution)")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--fiducials", type=int, default=8, choices=(4, 8), help="film: 4 (sides) or 8 fiducial marks")
+    ap.add_argument("--calibration", action="store_true",
+                    help="digital: align with the calibration as a file (AlignOptions.calibration, held fixed)")
     args = ap.parse_args()
     for n in args.frames:
         run(args.kind, n, args)
