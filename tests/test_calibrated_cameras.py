@@ -342,6 +342,22 @@ def test_a_calibration_with_k3_never_frees_the_rational_terms(tmp_path):
         assert [names[i] for i in free[0]] == expect, mode
 
 
+def test_a_focal_length_given_besides_the_calibration_that_disagrees_is_warned(tmp_path):
+    """CALIBRATION (120 mm: 833.3 px) with FOCAL_MM 150 mm (1041.7 px): the calibration wins, as before, but no
+    longer silently; a focal length within 2 % (or none given) says nothing."""
+    import pycolmap
+
+    path = tmp_path / "cam.json"
+    path.write_text(json.dumps({"name": "DMC", "image_size_px": [640, 1152], "focal_length_px": 833.3}))
+    for focal, warned in ((1041.7, True), (840.0, False)):
+        infos = [_info(n, width=640, height=1152, focal_px=focal, source="manual") for n in ("a.tif", "b.tif")]
+        log = _Log()
+        _, plan = plan_cameras(pycolmap, [_group(infos)], infos, _read(path), {}, AlignOptions(), log)
+        assert plan["g"].params[0] == 833.3
+        hits = [ln for ln in log.lines if "focal length given (FOCAL_MM / SENSOR_WIDTH_MM) 1041.7 px (+25.0 %)" in ln]
+        assert bool(hits) == warned, log.lines
+
+
 def test_focal_length_and_film_scans_as_given_interior_orientations(tmp_path):
     import pycolmap
 

@@ -217,7 +217,30 @@ def plan_cameras(pycolmap, groups: List[CameraGroup], infos: Sequence[ImageInfo]
                 if given else "estimated (self-calibration), no calibration given")
         progress.info(f"camera {g.camera_id} ({len(g.images)} image(s), {g.width} x {g.height} px): interior "
                       f"orientation {what}")
+        _check_focal_agrees(g, given, progress)
     return out, plan
+
+
+# a calibration file's focal length further than this (relative) from the one typed in (FOCAL_MM) or read from
+# EXIF is named in a warning: one of the two belongs to another camera or lens, or a unit is wrong
+FOCAL_DISAGREES = 0.02
+
+
+def _check_focal_agrees(g: CameraGroup, given: Optional[GivenCamera], progress: Progress) -> None:
+    if given is None or given.source in ("scans.json", FOCAL_SOURCE) or not g.focal_px:
+        return
+    if g.focal_source == "manual":
+        other = "the focal length given (FOCAL_MM / SENSOR_WIDTH_MM)"
+    elif g.focal_source.startswith("exif"):
+        other = "the photos' EXIF focal length"
+    else:
+        return
+    f = float(given.params[0])
+    if abs(g.focal_px / f - 1.0) > FOCAL_DISAGREES:
+        progress.warning(f"camera {g.camera_id}: the calibration {os.path.basename(given.source)} gives a focal "
+                         f"length of {f:.1f} px, {other} {g.focal_px:.1f} px ({100.0 * (g.focal_px / f - 1.0):+.1f} "
+                         f"%); the calibration's is used: check that it is this camera's and that its units are "
+                         f"right")
 
 
 def _describe_calibration(cal) -> str:
