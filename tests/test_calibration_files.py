@@ -338,6 +338,10 @@ BAD = [
      ["calib.yaml, line 4", "adjust must be one of fixed, refined, estimated, got 'free'"]),
     ("calib.yaml", _GOOD_CAMERA + "focal_lenght_mm: 4\n",
      ["calib.yaml, line 4", "unknown field 'focal_lenght_mm'", "did you mean"]),
+    ("calib.yaml", "cameras:\n  - name: a\n    " + _GOOD_CAMERA.replace("\n", "\n    ") + "focal_lenght_mm: 4\n",
+     ["calib.yaml, line 6: camera 'a': unknown field 'focal_lenght_mm' (did you mean focal_length_mm"]),
+    ("cameras.txt", "1 PINHOLE 640 480 500 500 3200 240\n",
+     ["cameras.txt, line 1", "camera 1: the principal point (3200.00, 240.00) px lies outside the 640 x 480"]),
     ("calib.yaml", "cameras:\n  - name: a\n    " + _GOOD_CAMERA.replace("\n", "\n    ")
      + "principal_point_px: [3200, 240]\n",
      ["calib.yaml, line 6", "camera 'a'", "principal point", "outside"]),

@@ -548,7 +548,8 @@ class _Fields:
             if key not in known:
                 close = [k for k in known if k.split("_")[0] == str(key).split("_")[0]]
                 hint = f" (did you mean {' or '.join(close[:3])}?)" if close else ""
-                raise self.fail(str(key), f"unknown field '{key}' in {what}{hint}; see docs/calibration.md")
+                where = f" in {what}" if what else ""
+                raise self.fail(str(key), f"unknown field '{key}'{where}{hint}; see docs/calibration.md")
 
 
 def _adjust(fl: _Fields, key: str = "adjust", default: Optional[str] = None) -> Optional[str]:
@@ -618,7 +619,7 @@ def _check_unique_names(path: str, cams: List[CameraCalibration], lines: List[Op
 def _own_camera(path: str, data: dict, default_adjust: Optional[str], index: str) -> CameraCalibration:
     name = str(data.get("name") or "")
     fl = _Fields(path, data, f"camera '{name}'" if name else index)
-    fl.check_known(sorted(_OWN_CAMERA_KEYS), f"a camera ({fl.who or 'the camera'})")
+    fl.check_known(sorted(_OWN_CAMERA_KEYS), "")  # the message's prefix names the camera
     size = fl.size("image_size_px")
     if size is None:
         raise fl.fail("image_size_px", "image_size_px [width, height] is missing: the size of the images (px) "
@@ -1117,6 +1118,10 @@ def _read_colmap_txt(path: str, text: str) -> List[CameraCalibration]:
         if fx <= 0 or fy <= 0 or w <= 0 or h <= 0:
             raise CalibrationError(path, n, "PARAMS", f"camera {cam_id}: the focal length and image size must be "
                                    "positive")
+        if not (0.0 <= p["cx"] <= w and 0.0 <= p["cy"] <= h):
+            raise CalibrationError(path, n, "PARAMS", f"camera {cam_id}: the principal point ({p['cx']:.2f}, "
+                                   f"{p['cy']:.2f}) px lies outside the {w} x {h} px image: check its units and "
+                                   f"origin")
         out.append(CameraCalibration(name=cam_id, source=path, width=w, height=h, focal_px=fx,
                                      focal_y_px=None if _same(fx, fy) else fy, cx_px=p["cx"], cy_px=p["cy"],
                                      **{t: p.get(t, 0.0) for t in DISTORTION_TERMS}, size_field="WIDTH HEIGHT",
