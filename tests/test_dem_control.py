@@ -233,20 +233,24 @@ def test_processing_georeference_with_a_reference_dsm_alone(scene, tmp_path, qgi
 def test_control_points_heights_win_over_a_dem_in_another_vertical_datum(scene, tmp_path):
     """Four control points at the corners fix the block; the reference DEM's heights are 30 m off (another vertical
     datum): the control points' heights win, the DEM control adds only the shape and the check points stay where
-    the control puts them."""
+    the control puts them.  The same DEM in the control's datum agrees with it: both hold the heights."""
     from osgeo import gdal
 
     block, rec, _, fine, _, _, _ = scene
     lifted = str(tmp_path / "lifted.tif")
     gdal.Translate(lifted, fine, scaleParams=[[0, 1, 30, 31]], outputType=gdal.GDT_Float32)
     ref = degrade(lifted, str(tmp_path / "lifted_05.tif"), REF_CELL, gdal.Open(fine).GetProjection())
+    same = degrade(fine, str(tmp_path / "same_05.tif"), REF_CELL, gdal.Open(fine).GetProjection())
     control = block.spread_control(4)
     out = {}
-    for label, options in (("plain", None), ("dem", GeorefOptions(reference_dem=ref))):
+    for label, options in (("plain", None), ("dem", GeorefOptions(reference_dem=ref)),
+                           ("same", GeorefOptions(reference_dem=same))):
         ws = synthetic_workspace(tmp_path / label, block, rec)
         progress = Recorder()
         out[label] = georeference_workspace(ws, gcps=block.gcp_set(control, noise_px=0.4), crs=syn.CRS,
                                             options=options, progress=progress).figures
+        if label == "dem":
+            assert any("heights: the control points' win" in m for m in progress.infos)
     doc = json.load(open(os.path.join(tmp_path, "dem", "georef", "dem_control.json")))
     print(f"\ncontrol points' heights: check Z {out['plain']['CHECK_RMSE_Z']:.3f} m without, "
           f"{out['dem']['CHECK_RMSE_Z']:.3f} m with the DEM 30 m off (dz {doc['coregistration']['shift'][2]:.2f} m)")
@@ -254,7 +258,12 @@ def test_control_points_heights_win_over_a_dem_in_another_vertical_datum(scene, 
     assert doc["coregistration"]["shift"][2] == pytest.approx(30.0, abs=0.3)
     assert out["dem"]["CHECK_RMSE_Z"] <= out["plain"]["CHECK_RMSE_Z"] + 0.5 * block.gsd
     assert out["dem"]["CHECK_RMSE_Z"] <= 1.5 * block.gsd
-    assert any("heights: the control points' win" in m for m in progress.infos)
+    same = json.load(open(os.path.join(tmp_path, "same", "georef", "dem_control.json")))
+    print(f"the DEM in the control's datum: check Z {out['same']['CHECK_RMSE_Z']:.3f} m (dz "
+          f"{same['coregistration']['shift'][2]:+.3f} m, 3 sigma {3 * same['level_sigma']:.3f} m)")
+    assert same["heights"] == "control points and reference DEM" and same["camera_dz"] == 0.0
+    assert out["same"]["CHECK_RMSE_Z"] <= out["plain"]["CHECK_RMSE_Z"] + 0.5 * block.gsd
+    assert any("heights: the control points and the reference DEM" in m for m in progress.infos)
 
 
 def test_the_shift_is_used_where_the_terrain_fixes_it_else_the_heights_alone():

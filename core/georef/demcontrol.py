@@ -20,10 +20,15 @@ Heights.  The reference's heights are in its vertical datum (orthometric for mos
 positions are ellipsoidal or above mean sea level, surveyed control in its own datum.  One set of heights wins and
 the log says which:
 
-- with control points (3 or more with observations) their heights win: the DEM control points' heights are moved by
-  the co-registration's vertical offset ``dz`` (the datum difference between the control and the DEM) and stay at
-  the block's horizontal position (the DEM's own horizontal error is not the block's), so they add the block's
-  shape only (the tilt and dome between the control points);
+- with control points (3 or more with observations) whose mean height disagrees with the DEM's beyond 3 sigma (the
+  control's residual RMS over sqrt(n), the DEM control's sigma Z over sqrt(n), the reference's stated accuracy):
+  their heights win; the DEM control points' heights are moved by the co-registration's vertical offset ``dz``
+  (the datum difference between the control and the DEM) and stay at the block's horizontal position (the DEM's
+  own horizontal error is not the block's), so they add the block's shape only (the tilt and dome between the
+  control points);
+- with control points that agree with the DEM within that: both hold the heights, weighed by their sigmas (the DEM
+  control points at the block's horizontal position and the DEM's heights): metre-level archive control does not
+  hold the block's level against a good DEM;
 - without, the reference DEM's heights win: the DEM control points sit at the shifted position and the reference's
   height, and the camera positions' heights are moved by ``dz`` (one constant: the datum difference and the GPS's
   bias), so that a geoid undulation of tens of metres does not make every camera an outlier; what remains between
@@ -71,6 +76,7 @@ FORMAT = "archaeoortho-dem-control"
 MAX_WINDOW_CELLS = 4_000_000  # the reference is averaged onto a coarser grid beyond this many cells under the block
 HEIGHTS_CONTROL = "control points"
 HEIGHTS_DEM = "reference DEM"
+HEIGHTS_BOTH = "control points and reference DEM"
 
 
 class DemControlError(GeorefError):
@@ -85,7 +91,8 @@ class DemControl:
     crs: str
     coregistration: CoregResult
     points: List[GroundPoint]
-    heights: str  # HEIGHTS_CONTROL or HEIGHTS_DEM
+    heights: str  # HEIGHTS_CONTROL, HEIGHTS_BOTH or HEIGHTS_DEM
+    level_sigma: float = math.nan  # the 3-sigma test's sigma of the control's and the DEM's mean heights (m)
     camera_dz: float = 0.0  # added to the camera positions' heights (HEIGHTS_DEM)
     cells: int = 0  # reference cells under the block's sparse points
     vertical_datum: str = ""
@@ -95,7 +102,8 @@ class DemControl:
     def as_dict(self) -> Dict[str, Any]:
         """What georef/dem_control.json holds."""
         return {"format": FORMAT, "version": 1, "reference_dem": self.reference, "crs": self.crs,
-                "vertical_datum": self.vertical_datum, "heights": self.heights, "camera_dz": self.camera_dz,
+                "vertical_datum": self.vertical_datum, "heights": self.heights, "level_sigma": self.level_sigma,
+                "camera_dz": self.camera_dz,
                 "cells": self.cells, "n_points": len(self.points),
                 "coregistration": self.coregistration.as_dict(),
                 "after": self.after.as_dict() if self.after is not None else None,
@@ -374,11 +382,23 @@ def _names(n: int, taken: Sequence[str]) -> List[str]:
     return out
 
 
-def dem_control(rec, offset: Sequence[float], ref_path: str, crs: str, *, heights: str, n: int = 25,
-                ref_sigma_z: float = 0.0, taken: Sequence[str] = (), progress: Optional[Progress] = None
+def _heights(control: Optional[Tuple[float, int]], dz: float, sigma_z: np.ndarray, ref_sigma_z: float
+             ) -> Tuple[str, float]:
+    """(which heights win, the sigma of the test) from the control's (residual RMS Z, n) or None (module notes)."""
+    if control is None:
+        return HEIGHTS_DEM, math.nan
+    rms, n = control
+    sig = math.sqrt(max(rms, 1e-3) ** 2 / max(n, 1) + float(np.median(sigma_z)) ** 2 / max(len(sigma_z), 1)
+                    + float(ref_sigma_z) ** 2)
+    return (HEIGHTS_CONTROL if abs(dz) > 3.0 * sig else HEIGHTS_BOTH), sig
+
+
+def dem_control(rec, offset: Sequence[float], ref_path: str, crs: str, *, control: Optional[Tuple[float, int]],
+                n: int = 25, ref_sigma_z: float = 0.0, taken: Sequence[str] = (), progress: Optional[Progress] = None
                 ) -> DemControl:
-    """The DEM control of an adjusted block: co-registration and control points (see the module notes for
-    ``heights``: HEIGHTS_CONTROL or HEIGHTS_DEM).  ``taken``: ground point names already in use."""
+    """The DEM control of an adjusted block: co-registration and control points.  ``control``: (RMS Z of the
+    control points' residuals, their number) when 3 or more control points fix the block's heights, else None (the
+    module notes say which heights win).  ``taken``: ground point names already in use."""
     progress = progress or NullProgress()
     co, xyz, ids, ref, gt, cells = coregister_block(rec, offset, ref_path, crs, progress)
     pc = control_points_from_coregistration(co, ref, gt, points=xyz, n=n, ref_sigma_z=ref_sigma_z)
@@ -388,13 +408,15 @@ def dem_control(rec, offset: Sequence[float], ref_path: str, crs: str, *, height
     k = len(pc)
     sxy = pc.sigma_xy * math.sqrt(k)
     dz = float(co.shift[2])
+    heights, level_sigma = _heights(control, dz, pc.sigma_z, ref_sigma_z)
     pts = []
     for name, i, b, q, sx, sz in zip(_names(k, taken), pc.index, pc.block_xyz, pc.xyz, sxy, pc.sigma_z):
-        x, y, z = (b[0], b[1], q[2] - dz) if heights == HEIGHTS_CONTROL else (q[0], q[1], q[2])
+        x, y, z = (q[0], q[1], q[2]) if heights == HEIGHTS_DEM else (b[0], b[1], q[2] - (dz if heights ==
+                                                                                          HEIGHTS_CONTROL else 0.0))
         pts.append(GroundPoint(name, float(x), float(y), float(z), float(sx), float(sz), CONTROL,
                                track_observations(rec, int(ids[int(i)])), sigma_given=True))
     dc = DemControl(ref_path, crs, co, pts, heights, camera_dz=dz if heights == HEIGHTS_DEM else 0.0, cells=cells,
-                    vertical_datum=vertical_datum(ref_path))
+                    vertical_datum=vertical_datum(ref_path), level_sigma=level_sigma)
     dc.messages = _messages(dc, pc.sigma_z)
     return dc
 
@@ -414,8 +436,13 @@ def _messages(dc: DemControl, sigma_z: np.ndarray) -> List[str]:
                f"{co.nmad_after:.3g} m, the slope over the reference's {co.cell:.3g} m cells)")
     if dc.heights == HEIGHTS_CONTROL:
         out.append(f"heights: the control points' win; the reference DEM (vertical datum: {datum}) lies "
-                   f"{abs(co.shift[2]):.2f} m {'above' if co.shift[2] > 0 else 'below'} them on average, removed from "
-                   "the DEM control points, which add the block's shape (tilt, dome) between the control points")
+                   f"{abs(co.shift[2]):.2f} m {'above' if co.shift[2] > 0 else 'below'} them on average (beyond 3 x "
+                   f"{dc.level_sigma:.2g} m: another datum), removed from the DEM control points, which add the "
+                   "block's shape (tilt, dome) between the control points")
+    elif dc.heights == HEIGHTS_BOTH:
+        out.append(f"heights: the control points and the reference DEM (vertical datum: {datum}) agree within their "
+                   f"accuracy ({co.shift[2]:+.2f} m, within 3 x {dc.level_sigma:.2g} m): both hold the block's "
+                   "heights, weighed by their sigmas")
     else:
         out.append(f"heights: the reference DEM's win (vertical datum: {datum}); the camera positions' heights "
                    f"(GPS: ellipsoidal, or above mean sea level) lay {abs(co.shift[2]):.2f} m "
@@ -475,7 +502,8 @@ def _f(v) -> str:
     return "n/a" if v is None else f"{v:.3f}"
 
 
-__all__ = ["DEM_PREFIX", "DemControl", "DemControlError", "HEIGHTS_CONTROL", "HEIGHTS_DEM", "after_messages",
+__all__ = ["DEM_PREFIX", "DemControl", "DemControlError", "HEIGHTS_BOTH", "HEIGHTS_CONTROL", "HEIGHTS_DEM",
+           "after_messages",
            "after_warning", "block_points", "cells_under", "check_coverage", "check_metric",
            "coregister_block", "coregister_xyz", "heights_only", "dem_control", "has_height_control", "precheck",
            "sparse_points", "track_observations", "vertical_datum", "with_dem_control"]

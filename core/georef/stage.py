@@ -246,8 +246,10 @@ def _dem_control(rec, first: GeorefResult, gcps: Optional[gcpmod.GCPSet], cams: 
     """The adjusted block co-registered on the reference DEM and adjusted again with DEM control points:
     (result, ground control, camera positions, DemControl)."""
     placeholder = first.statistics.get("placeholder_z") is not None
-    heights = demmod.HEIGHTS_CONTROL if demmod.has_height_control(gcps) and not placeholder else demmod.HEIGHTS_DEM
-    dc = demmod.dem_control(first.reconstruction, first.offset, opt.reference_dem, target, heights=heights,
+    ctl = first.rmse(gcpmod.CONTROL)
+    control = ((float(ctl["z"]), int(ctl["n"])) if demmod.has_height_control(gcps) and not placeholder and ctl["n"]
+               and ctl["z"] is not None else None)
+    dc = demmod.dem_control(first.reconstruction, first.offset, opt.reference_dem, target, control=control,
                             n=opt.reference_dem_points, ref_sigma_z=opt.reference_dem_sigma_z,
                             taken=[p.name for p in gcps.points] if gcps is not None else (),
                             progress=SubProgress(progress, 0.45, 0.5))
