@@ -209,6 +209,13 @@ def test_the_report_reads_like_the_certificate(tmp_path):
             "point (+0.050, -0.030) mm given, (+0.050, -0.030) mm final") in html, html
     assert "radial distortion at the image corner -3.66 px given, -3.66 px final" in html
     assert "core.georef.options" not in html and not ctx.warnings
+    assert "Flying height" not in html  # not georeferenced
+    ctx.d.georeferenced = True
+    ctx.d.centres = lambda: np.array([[0.0, 0.0, 5000.0], [1.0, 0.0, 5010.0]])
+    ctx.d.tie_xyz = lambda: np.array([[0.0, 0.0, 400.0], [0.0, 0.0, 420.0], [0.0, 0.0, 410.0]])
+    html = interior_orientation(ctx)
+    assert ("Flying height above the ground: 4,595 m (the camera centres' median height less the tie points'); "
+            "camera 1: focal length 120.000 mm, photo scale 1:38,292.") in html, html
     # estimated: the focal length moved -1.73 %
     cam.params = [819.0, 819.0] + list(plan["g"].params[2:])
     record["mode"] = "estimated"
