@@ -340,6 +340,8 @@ BAD = [
      ["calib.yaml, line 4", "unknown field 'focal_lenght_mm'", "did you mean"]),
     ("calib.yaml", "cameras:\n  - name: a\n    " + _GOOD_CAMERA.replace("\n", "\n    ") + "focal_lenght_mm: 4\n",
      ["calib.yaml, line 6: camera 'a': unknown field 'focal_lenght_mm' (did you mean focal_length_mm"]),
+    ("gcp.csv", "# crs: EPSG:32633\nname,x,y,z\nG01,404293.4,403841.5,448.6\n",
+     ["gcp.csv: not a camera calibration this plugin reads"]),
     ("cameras.txt", "1 PINHOLE 640 480 500 500 3200 240\n",
      ["cameras.txt, line 1", "camera 1: the principal point (3200.00, 240.00) px lies outside the 640 x 480"]),
     ("calib.yaml", "cameras:\n  - name: a\n    " + _GOOD_CAMERA.replace("\n", "\n    ")

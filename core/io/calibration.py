@@ -332,7 +332,14 @@ def read_calibration(path: str) -> List[CameraCalibration]:
     return _read_mapping(path, data)
 
 
+_NOT_A_CALIBRATION = ("not a camera calibration this plugin reads: expected ArchaeoOrtho's format (cameras: / "
+                      "focal_length_mm ...), Orthority interior parameters (im_size, focal_len ...), OpenCV "
+                      "(camera_matrix ...), COLMAP cameras.txt or Metashape XML; see docs/calibration.md")
+
+
 def _read_mapping(path: str, data: Any) -> List[CameraCalibration]:
+    if not isinstance(data, (dict, list)):  # plain text (a CSV, a note) reads as one YAML value
+        raise CalibrationError(path, None, "", _NOT_A_CALIBRATION)
     if not isinstance(data, dict):
         raise CalibrationError(path, _line_of(data), "", "the file must hold a mapping of fields (a calibration "
                                                          "of one or more cameras), not a list or a single value")
@@ -344,10 +351,7 @@ def _read_mapping(path: str, data: Any) -> List[CameraCalibration]:
     if "im_size" in keys or isinstance(data.get("camera"), dict) or (
             data and all(isinstance(v, dict) and ("im_size" in v or "type" in v) for v in data.values())):
         return _read_orthority(path, data)
-    raise CalibrationError(path, _line_of(data), "", "not a camera calibration this plugin reads: expected "
-                           "ArchaeoOrtho's format (cameras: / focal_length_mm ...), Orthority interior "
-                           "parameters (im_size, focal_len ...), OpenCV (camera_matrix ...), COLMAP cameras.txt "
-                           "or Metashape XML; see docs/calibration.md")
+    raise CalibrationError(path, _line_of(data), "", _NOT_A_CALIBRATION)
 
 
 # ---------------------------------------------------------------------------
