@@ -209,6 +209,13 @@ def test_the_report_reads_like_the_certificate(tmp_path):
             "point (+0.050, -0.030) mm given, (+0.050, -0.030) mm final") in html, html
     assert "radial distortion at the image corner -3.66 px given, -3.66 px final" in html
     assert "core.georef.options" not in html and not ctx.warnings
+    # the summary's camera table leaves FULL_OPENCV's zero k4..k6 out too
+    from core.report.sections.summary import _cameras
+
+    sctx = SimpleNamespace(d=SimpleNamespace(rec=SimpleNamespace(cameras={1: cam}, image=None),
+                                             obs=SimpleNamespace(image_ids=[])), unc=None, unc_error="")
+    summary = _cameras(sctx)
+    assert "<b>k3</b> -0.000300" in summary and "<b>k4</b>" not in summary, summary
     assert "Flying height" not in html  # not georeferenced
     ctx.d.georeferenced = True
     ctx.d.centres = lambda: np.array([[0.0, 0.0, 5000.0], [1.0, 0.0, 5010.0]])

@@ -109,6 +109,8 @@ def _cameras(ctx: ReportContext) -> str:
         n_img = sum(1 for i in d.obs.image_ids if int(d.rec.image(int(i)).camera_id) == int(cid))
         params = []
         for k, (n, v) in enumerate(zip(names, cam.params)):
+            if n in ("k4", "k5", "k6") and float(v) == 0.0:  # FULL_OPENCV of a calibration: zero by construction
+                continue
             sd = info["std"][k] if info else None
             dec = 2 if abs(v) >= 10 else 6
             txt = f"{v:.{dec}f}" + (f" ± {sd:.{dec}f}" if sd is not None else (" (fixed)" if info else ""))
