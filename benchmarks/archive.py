@@ -20,7 +20,8 @@ issue (a real archive block, plain SfM + Helmert on six metre-level control poin
 GSD; the adjustment must never be worse than the Helmert solution.
 
     python benchmarks/archive.py [--frames 4 12] [--kind film|digital] [--seed 1] [--workdir DIR] [--no-prepare]
-                                 [--fiducials 4|8] [--calibration]
+                                 [--fiducials 4|8] [--side-mm 117]
+                                 [--calibration]
 """
 import argparse
 import math
@@ -184,9 +185,11 @@ def run(kind, n, args):
     work = os.path.join(args.workdir, f"{kind}{n}-s{args.seed}" + (f"-fid{args.fiducials}" if kind == "film" else ""))
     if args.calibration:
         work += "-cal"
+    if args.side_mm != 119.5:
+        work += f"-side{args.side_mm:g}"
     t0 = time.time()
     block = arch.archive_block(kind, n, seed=args.seed, out_dir=os.path.join(work, "block"), reference="dem",
-                               fiducials=args.fiducials)
+                               fiducials=args.fiducials, side_mm=args.side_mm)
     t_block = time.time() - t0
     hr = block.terrain.height_raster()
     gsd = block.gsd
@@ -282,6 +285,8 @@ def main():
     ap.add_argument("--no-prepare", action="store_true", help="film: align the raw scans (no fiducial restitution)")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--fiducials", type=int, default=8, choices=(4, 8), help="film: 4 (sides) or 8 fiducial marks")
+    ap.add_argument("--side-mm", type=float, default=119.5,
+                    help="film: the side fiducials' distance from the centre (117: their rings touch the picture)")
     ap.add_argument("--calibration", action="store_true",
                     help="digital: align with the calibration as a file (AlignOptions.calibration, held fixed)")
     args = ap.parse_args()

@@ -530,11 +530,13 @@ class FrameCamera:
         return np.stack([xn, yn, np.ones_like(xn)], axis=-1)
 
 
-def film_camera(fiducials: int = 8, seed: int = 0) -> FrameCamera:
+def film_camera(fiducials: int = 8, seed: int = 0, side_mm: float = 119.5) -> FrameCamera:
     """A 152.82 mm / 23 cm film metric camera with 4 (side) or 8 (side + corner) fiducials, calibrated coordinates
-    a few hundredths of a mm off their nominal places."""
+    a few hundredths of a mm off their nominal places.  ``side_mm``: the side marks' distance from the centre
+    (119.5: their 4 mm rings 2.5 mm clear of the 115 mm picture edge; 117: the rings touch it)."""
     rng = np.random.default_rng(900 + seed)
-    nominal = [("1", -119.5, 0.0), ("2", 119.5, 0.0), ("3", 0.0, 119.5), ("4", 0.0, -119.5)]  # 2.5 mm clear
+    s = float(side_mm)
+    nominal = [("1", -s, 0.0), ("2", s, 0.0), ("3", 0.0, s), ("4", 0.0, -s)]
     if fiducials == 8:
         nominal += [("5", -110.0, 110.0), ("6", 110.0, 110.0), ("7", 110.0, -110.0), ("8", -110.0, -110.0)]
     elif fiducials != 4:
@@ -782,10 +784,10 @@ def _flight(kind: str, n_frames: int, cam: FrameCamera, z_fly: float, mean_groun
 
 def build_block(kind: str = "film", n_frames: int = 4, seed: int = 1, out_dir: str = "", fiducials: int = 8,
                 z_fly: float = 5000.0, relief: float = 450.0, obs_noise_px: float = 0.3,
-                control_sigma: float = 3.0) -> ArchiveBlock:
+                control_sigma: float = 3.0, side_mm: float = 119.5) -> ArchiveBlock:
     """The block and its truth, not rendered (fast: the terrain's height raster only)."""
     rng = np.random.default_rng(seed)
-    cam = film_camera(fiducials, seed) if kind == "film" else digital_camera()
+    cam = film_camera(fiducials, seed, side_mm) if kind == "film" else digital_camera()
     base_z = 200.0
     mean_ground = base_z + 0.45 * relief
     stations, (along, across) = _flight(kind, n_frames, cam, z_fly, mean_ground, 0.6, 0.3, rng)
@@ -950,7 +952,7 @@ def _write_ortho(terrain: ArchiveTerrain, ortho: str, b, ortho_res: float, detai
 
 
 def archive_block(kind: str = "film", n_frames: int = 4, seed: int = 1, out_dir: Optional[str] = None,
-                  fiducials: int = 8, reference=True, supersample: int = 1,
+                  fiducials: int = 8, reference=True, supersample: int = 1, side_mm: float = 119.5,
                   progress=None) -> ArchiveBlock:
     """An archive block with its truth; the frames (and the modern reference) rendered into ``out_dir`` once.
 
@@ -960,7 +962,7 @@ def archive_block(kind: str = "film", n_frames: int = 4, seed: int = 1, out_dir:
     points' true coordinates; check.csv (+ observations): the check points, true; truth.json: everything;
     modern_ortho_2m.tif, modern_dem_25m.tif: the reference of epoch 1 (``reference``: True both, "dem" the DEM only,
     False none)."""
-    block = build_block(kind, n_frames, seed, out_dir or "", fiducials)
+    block = build_block(kind, n_frames, seed, out_dir or "", fiducials, side_mm=side_mm)
     if out_dir is None:
         return block
     os.makedirs(os.path.join(out_dir, "images"), exist_ok=True)
@@ -969,7 +971,8 @@ def archive_block(kind: str = "film", n_frames: int = 4, seed: int = 1, out_dir:
     block.paths = {"images": images, "truth": os.path.join(out_dir, "truth.json")}
     done = os.path.join(out_dir, "done")
     ref = int(reference) if isinstance(reference, bool) else reference
-    marker = f"{VERSION} {kind} {n_frames} {seed} {fiducials} {ref} {supersample}"
+    marker = f"{VERSION} {kind} {n_frames} {seed} {fiducials} {ref} {supersample}" + (
+        f" side {side_mm:g}" if side_mm != 119.5 else "")
     if os.path.exists(done) and open(done).read().strip() == marker:
         with open(block.paths["truth"]) as fh:
             old = json.load(fh)
