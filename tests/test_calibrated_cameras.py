@@ -372,6 +372,38 @@ def test_a_focal_length_given_besides_the_calibration_that_disagrees_is_warned(t
         assert bool(hits) == warned, log.lines
 
 
+def test_a_certificate_given_for_prepared_film_scans_takes_the_prepared_frame(tmp_path):
+    """A film certificate (image_size_px of the raw 1300 px scans at 0.2 mm, focal 152.82 mm) given with the scans
+    Prepare images cut to the 1240 px fiducial frame at 0.200029 mm: the camera is the certificate's millimetres
+    in the prepared frame (763.99 px, principal point at the centre), as docs/calibration.md says; it was scaled
+    as if the scan had been resampled to 1240 px (728.8 px: -4.6 %, held fixed; the reprojection error 0.251 px
+    against 0.250 px did not show it).  Without millimetres the pixel values are scaled as before."""
+    import pycolmap
+
+    path = tmp_path / "film.yaml"
+    path.write_text("name: RC-152\nimage_size_px: [1300, 1300]\npixel_size_mm: 0.2\nfocal_length_mm: 152.82\n"
+                    "principal_point_mm: [0.012, -0.008]\nk1: -0.001\n")
+    scans = tmp_path / "scans.json"
+    scans.write_text(json.dumps({"interior_orientation": {
+        "frame_units": "mm", "calibrated_fiducials": True, "pixel_size": 0.2000289800162121, "width": 1240,
+        "height": 1240, "principal_point_px": [620.0, 620.0], "focal_length_mm": None, "focal_px": None},
+        "scans": [{"prepared_name": "F1_01.tif"}, {"prepared_name": "F1_02.tif"}]}))
+    infos = [_info(n, width=1240, height=1240, focal_px=763.99, source="exif35") for n in ("F1_01.tif", "F1_02.tif")]
+    log = _Log()
+    _, plan = plan_cameras(pycolmap, [_group(infos)], infos, _read(path), scan_interior(str(scans), infos),
+                           AlignOptions(), log)
+    given = plan["g"]
+    assert given.params[0] == pytest.approx(152.82 / 0.2000289800162121) and given.params[1:3] == [620.0, 620.0]
+    assert given.params[3] == -0.001 and given.scaled_from is None and given.mode == "fixed"
+    assert "in the frame Prepare images restituted (0.200029 mm pixels: 152.82 mm = 763.99 px)" in given.matched_by
+    assert not [ln for ln in log.lines if "focal length of" in ln], log.lines  # agrees with the prepared focal
+    # a calibration in pixels only (no mm) is scaled as before
+    path.write_text("name: px\nimage_size_px: [1300, 1300]\nfocal_length_px: 764.1\n")
+    _, plan = plan_cameras(pycolmap, [_group(infos)], infos, _read(path), scan_interior(str(scans), infos),
+                           AlignOptions(), NullProgress())
+    assert plan["g"].scaled_from == (1300, 1300) and plan["g"].params[0] == pytest.approx(764.1 * 1240 / 1300)
+
+
 def test_focal_length_and_film_scans_as_given_interior_orientations(tmp_path):
     import pycolmap
 

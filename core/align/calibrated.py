@@ -84,10 +84,11 @@ def read_calibrations(options: AlignOptions) -> list:
 
 def scan_interior(scans_json: str, infos: Sequence[ImageInfo]) -> Dict[str, dict]:
     """image name -> the restituted interior orientation of the film scans Prepare images wrote (``scans.json``)
-    for the images of ``infos`` it made whose focal length in pixels is known and whose size is the frame's."""
+    for the images of ``infos`` it made whose size is the frame's, where the focal length in pixels or the frame's
+    pixel size in mm is known (a calibration file's millimetre values then give the prepared images' camera)."""
     data = read_json(scans_json) if os.path.isfile(scans_json) else None
     io = (data or {}).get("interior_orientation") or {}
-    if not io.get("focal_px"):
+    if not io.get("focal_px") and not (io.get("frame_units") == "mm" and io.get("pixel_size")):
         return {}
     prepared = {s.get("prepared_name") for s in (data or {}).get("scans", [])}
     size = (io.get("width"), io.get("height"))
@@ -133,10 +134,27 @@ def _sigmas(names: Sequence[str], given: Dict[str, float]) -> Dict[str, float]:
     return out
 
 
-def _from_calibration(pycolmap, cal, info: ImageInfo, mode: str, how: str) -> GivenCamera:
+def _in_prepared_frame(cal, info: ImageInfo, frame: Optional[dict]):
+    """The calibration for a film scan Prepare images restituted into a frame of known pixel size (mm): a
+    certificate's focal length in mm over the prepared pixel size, the principal point at the image centre (where
+    the restitution puts it), the distortion unchanged; None where the calibration or the frame lacks millimetres."""
+    if (not frame or frame.get("frame_units") != "mm" or not frame.get("pixel_size")
+            or getattr(cal, "focal_mm", None) is None or getattr(cal, "pixel_size_mm", None) is None):
+        return None
+    return cal.for_resampled_frame(info.width, info.height, float(frame["pixel_size"]))
+
+
+def _from_calibration(pycolmap, cal, info: ImageInfo, mode: str, how: str, frame: Optional[dict] = None
+                      ) -> GivenCamera:
     source = getattr(cal, "source", "") or ""
     scaled_from = None
-    if (cal.width, cal.height) != (info.width, info.height):
+    prepared = _in_prepared_frame(cal, info, frame)
+    if prepared is not None:
+        # a certificate's image size is the raw scan's: the prepared images are cut to the frame, not rescaled
+        how += (f", in the frame Prepare images restituted ({prepared.pixel_size_mm:.6g} mm pixels: "
+                f"{prepared.focal_mm:.6g} mm = {prepared.focal_px:.2f} px)")
+        cal = prepared
+    elif (cal.width, cal.height) != (info.width, info.height):
         scaled_from = (cal.width, cal.height)
         cal = cal.scaled_to(info.width, info.height, info.name)  # CalibrationError: the file, line, field, photo
     model, params = cal.colmap_model()
@@ -167,8 +185,9 @@ def _given_for(pycolmap, info: ImageInfo, cals, scans: Dict[str, dict], options:
     if cals:
         cal, how = match_calibration(info, cals)
         if cal is not None:
-            return _from_calibration(pycolmap, cal, info, "fixed" if chosen == "auto" else chosen, how)
-    if info.name in scans:
+            return _from_calibration(pycolmap, cal, info, "fixed" if chosen == "auto" else chosen, how,
+                                     scans.get(info.name))
+    if info.name in scans and scans[info.name].get("focal_px"):
         io = scans[info.name]
         pp = io.get("principal_point_px") or [None, None]
         model, params = _simple(io["focal_px"], info.width, info.height, pp[0], pp[1])
