@@ -82,7 +82,7 @@ def estimate_own_sigma(cands: Sequence[Candidate], floor: float, cap: float, min
     robust variance component, bounded to [``floor``, ``cap``]; None with fewer than ``min_points``.
 
     ``cap`` is the prior (a third of the DSM's cell): the data may only make the heights tighter; ``floor`` (the
-    match's grid) keeps a few heights from pinning the block.  Toledo's DSM averaged to 10 m: the prior, 3.3 m,
+    photos' ground resolution: the block's own precision) keeps a few heights from pinning the block.  Toledo's DSM averaged to 10 m: the prior, 3.3 m,
     let the FC300X block tilt (camera centres 1.7 m median off); its heights agree to about 0.5 m."""
     rows = [(c.x, c.y, c.z_residual, c.sigma_z_terrain) for c in cands
             if c.status == KEPT and c.z_residual is not None and math.isfinite(c.z_residual)]

@@ -173,20 +173,22 @@ def _check_block_pixels(ext, g: float, reference: Reference, photo_gsd: float, o
                            "hand-picked control points")
 
 
-def _own_height_sigma(cands, reference: Reference, g: float, opt: AutoControlOptions, messages: List[str]) -> float:
+def _own_height_sigma(cands, reference: Reference, photo_gsd: float, opt: AutoControlOptions,
+                      messages: List[str]) -> float:
     """The reference DSM's own height noise in the candidates' sigma Z: ``opt.dsm_sigma`` when given, else
     estimated from the candidates that agree with one similarity (``candidates.estimate_own_sigma``: between the
-    match's grid ``g`` and the prior, a third of the DSM's cell); the candidates' sigma Z are set from it."""
+    photos' ground resolution, the block's own precision, and the prior, a third of the DSM's cell); the
+    candidates' sigma Z are set from it."""
     prior = own_sigma_prior(reference.dsm_gsd, opt.dsm_sigma)
     if opt.dsm_sigma is not None:
         return prior
-    own = estimate_own_sigma(cands, g, prior)
+    own = estimate_own_sigma(cands, photo_gsd, prior)
     if own is None:
         return prior
     set_own_sigma(cands, own)
     messages.append(f"reference DSM heights: sigma {own:.3g} from the candidates that agree (at most a third of "
-                    f"its {reference.dsm_gsd:.3g} cell, {prior:.3g}; at least the match's grid, {g:.3g}), plus each "
-                    "point's slope and roughness")
+                    f"its {reference.dsm_gsd:.3g} cell, {prior:.3g}; at least the photos' ground resolution, "
+                    f"{photo_gsd:.3g}), plus each point's slope and roughness")
     return own
 
 
@@ -227,7 +229,7 @@ def find_candidates(ws: Workspace, rec, reference: Reference, prior: str = PRIOR
     n_kept = sum(1 for c in cands if c.status == KEPT)
     messages.append(f"{len(cands)} candidates tied back to the photos: {n_obs} seen in at least 2 photos with a "
                     f"DSM height, {n_kept} agree with one similarity")
-    own = _own_height_sigma(cands, reference, g, opt, messages)
+    own = _own_height_sigma(cands, reference, photo_gsd, opt, messages)
     dropped = drop_counts(cands)
     if dropped:
         messages.append("candidates dropped: " + "; ".join(f"{n} {r}" for r, n in dropped.items()))
