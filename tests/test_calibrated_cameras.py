@@ -404,6 +404,20 @@ def test_a_certificate_given_for_prepared_film_scans_takes_the_prepared_frame(tm
     assert plan["g"].scaled_from == (1300, 1300) and plan["g"].params[0] == pytest.approx(764.1 * 1240 / 1300)
 
 
+def test_no_reconstruction_with_a_held_camera_points_at_the_calibration():
+    """A 120 mm frame held at a 12 mm calibration (83.3 px instead of 833.3) leaves the mapper no initial pair:
+    the error said only 'baseline too short ... add photos taken from other positions'; it now names the held
+    camera and its file.  Without a held camera the message is unchanged."""
+    from core.align.calibrated import GivenCamera
+    from core.align.stage import _no_reconstruction
+
+    held = {1: GivenCamera("fixed", "/x/focal12.yaml", "DMC120", "PINHOLE", [83.33, 83.33, 320.0, 576.0])}
+    msg = str(_no_reconstruction({"a.tif": 3, "b.tif": 3}, 4, 5, held))
+    assert "add photos taken from other positions. The interior orientation was held as given (camera 1: focal " \
+           "83.3 px from focal12.yaml)" in msg and "Interior orientation 'estimated'" in msg
+    assert "held as given" not in str(_no_reconstruction({"a.tif": 3, "b.tif": 3}, 4, 5))
+
+
 def test_focal_length_and_film_scans_as_given_interior_orientations(tmp_path):
     import pycolmap
 

@@ -139,18 +139,28 @@ def _report_unregistered(progress: Progress, unregistered: Dict[str, str], other
         )
 
 
-def _no_reconstruction(partners: Dict[str, int], n_images: int, n_pairs: int) -> AlignError:
+def _no_reconstruction(partners: Dict[str, int], n_images: int, n_pairs: int,
+                       held: Optional[Dict[int, GivenCamera]] = None) -> AlignError:
+    """The error of a mapping that built nothing; ``held``: the cameras whose given interior orientation the
+    mapping held (a wrong calibration makes every initial pair fail too, which the message then says)."""
     isolated = [n for n, c in partners.items() if c == 0]
     if isolated:
         return AlignError(
             "no reconstruction could be built: the images do not overlap enough. "
             f"{len(isolated)} of {n_images} images share no verified matches with any other image"
             f" ({', '.join(isolated[:10])}{' ...' if len(isolated) > 10 else ''})")
+    calibration = ""
+    if held:
+        cams = "; ".join(f"camera {cid}: focal {g.params[0]:.1f} px from {os.path.basename(g.source)}"
+                         for cid, g in sorted(held.items()))
+        calibration = (f". The interior orientation was held as given ({cams}): a wrong focal length, pixel size "
+                       "or image size in the calibration also leaves no pair to triangulate; check it, or run with "
+                       "Interior orientation 'estimated' to see what the photos say")
     return AlignError(
         f"no reconstruction could be built: every one of the {n_images} images shares verified matches "
         f"({n_pairs} image pair(s) with {MIN_VERIFIED_INLIERS} or more inliers), but the mapper found no initial "
         "pair it could triangulate (baseline too short for the distance, e.g. photos taken from one spot, or "
-        "matches on a repeated pattern); add photos taken from other positions")
+        "matches on a repeated pattern); add photos taken from other positions" + calibration)
 
 
 def _mapping(pycolmap, lay: Layout, db_path: str, images_dir: str, n_images: int, options: AlignOptions,
@@ -337,7 +347,8 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
             ordered, escalation = escalate(ctx, ordered, SubProgress(progress, 0.90, 0.93))
         partners = verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS)
         if not ordered:
-            raise _no_reconstruction(partners, len(infos), verified_pairs(pycolmap, db_path, MIN_VERIFIED_INLIERS))
+            raise _no_reconstruction(partners, len(infos), verified_pairs(pycolmap, db_path, MIN_VERIFIED_INLIERS),
+                                     photos.held()[0])
         rec = ordered[0]
         _registered, others = block_state(ordered)
         # 5. final global bundle adjustment (the held cameras' intrinsics constant)
