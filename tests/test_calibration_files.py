@@ -471,6 +471,7 @@ def test_resampled_frame_and_the_scan_preparations_fiducials():
     assert cal.principal_point_mm == pytest.approx((-0.004, 0.011))
     # the scan preparation reads the certificate's marks relative to the principal point
     spec = parse_fiducial_coordinates(cal.fiducial_coordinates_text())
+    assert "\nPP -0.004 0.011\n" in cal.fiducial_coordinates_text()  # as typed, not 0.010999999999967258
     assert spec.focal_length_mm == pytest.approx(152.817)
     by_id = {spec.ids[s]: spec.points[s] for s in spec.points}
     for name, (x, y) in cal.fiducials_mm.items():

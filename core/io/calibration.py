@@ -206,8 +206,8 @@ class CameraCalibration:
             raise CalibrationError(self.source, None, "fiducials_mm", f"{self.label()} has no fiducials_mm")
         lines = [f"{re.sub(r'[^0-9A-Za-z_.-]+', '_', k)} {x!r} {y!r}" for k, (x, y) in self.fiducials_mm.items()]
         pp = self.principal_point_mm
-        if pp is not None:
-            lines.append(f"PP {pp[0]!r} {pp[1]!r}")
+        if pp is not None:  # to the nanometre: the pixel round trip's float noise (0.011999999999989087) is no value
+            lines.append(f"PP {round(pp[0], 9)!r} {round(pp[1], 9)!r}")
         if self.focal_mm is not None:
             lines.append(f"focal {self.focal_mm!r}")
         return "\n".join(lines) + "\n"
