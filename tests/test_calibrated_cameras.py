@@ -370,6 +370,12 @@ def test_a_focal_length_given_besides_the_calibration_that_disagrees_is_warned(t
         assert plan["g"].params[0] == 833.3
         hits = [ln for ln in log.lines if "focal length given (FOCAL_MM / SENSOR_WIDTH_MM) 1041.7 px (+25.0 %)" in ln]
         assert bool(hits) == warned, log.lines
+    # EXIF (a rounded 35 mm equivalent as a rule): 5 % off says nothing, 25 % does
+    for focal, warned in ((875.0, False), (1041.7, True)):
+        infos = [_info(n, width=640, height=1152, focal_px=focal, source="exif35") for n in ("a.tif", "b.tif")]
+        log = _Log()
+        plan_cameras(pycolmap, [_group(infos)], infos, _read(path), {}, AlignOptions(), log)
+        assert any("the photos' EXIF focal length" in ln for ln in log.lines) == warned, log.lines
 
 
 def test_a_certificate_given_for_prepared_film_scans_takes_the_prepared_frame(tmp_path):

@@ -241,21 +241,23 @@ def plan_cameras(pycolmap, groups: List[CameraGroup], infos: Sequence[ImageInfo]
 
 
 # a calibration file's focal length further than this (relative) from the one typed in (FOCAL_MM) or read from
-# EXIF is named in a warning: one of the two belongs to another camera or lens, or a unit is wrong
+# EXIF is named in a warning: one of the two belongs to another camera or lens, or a unit is wrong.  EXIF's focal
+# length (often a rounded 35 mm equivalent) is a few percent off a calibrated one as a rule: 10 % there
 FOCAL_DISAGREES = 0.02
+EXIF_FOCAL_DISAGREES = 0.10
 
 
 def _check_focal_agrees(g: CameraGroup, given: Optional[GivenCamera], progress: Progress) -> None:
     if given is None or given.source in ("scans.json", FOCAL_SOURCE) or not g.focal_px:
         return
     if g.focal_source == "manual":
-        other = "the focal length given (FOCAL_MM / SENSOR_WIDTH_MM)"
+        other, limit = "the focal length given (FOCAL_MM / SENSOR_WIDTH_MM)", FOCAL_DISAGREES
     elif g.focal_source.startswith("exif"):
-        other = "the photos' EXIF focal length"
+        other, limit = "the photos' EXIF focal length", EXIF_FOCAL_DISAGREES
     else:
         return
     f = float(given.params[0])
-    if abs(g.focal_px / f - 1.0) > FOCAL_DISAGREES:
+    if abs(g.focal_px / f - 1.0) > limit:
         progress.warning(f"camera {g.camera_id}: the calibration {os.path.basename(given.source)} gives a focal "
                          f"length of {f:.1f} px, {other} {g.focal_px:.1f} px ({100.0 * (g.focal_px / f - 1.0):+.1f} "
                          f"%); the calibration's is used: check that it is this camera's and that its units are "
