@@ -327,6 +327,11 @@ def test_the_stage_records_the_estimate_and_the_report_and_the_precision_use_it(
     assert 1.5 <= e["sigma_xy_m"] <= 6.0
     used = [p for p in res["points"] if p["status"] == "used"]
     assert len(used) == len(control) and all(p["sigma_xy"] == e["sigma_xy_m"] for p in used)
+    from core.project.stages import GEOREFERENCE
+
+    figures = Workspace.open(ws).stage(GEOREFERENCE)["results"]  # the georef record
+    assert figures["CONTROL_SIGMA_XY"] == e["sigma_xy_m"] and figures["CONTROL_SIGMA_Z"] == e["sigma_z_m"]
+    assert figures["CAMERA_POSITION_SIGMA_XY"] is None
     # the precision weights the control with the estimate
     w = Workspace.open(ws)
     model = pycolmap.Reconstruction()

@@ -344,6 +344,11 @@ def _figures(result: GeorefResult) -> Dict[str, Optional[float]]:
         "NSSDA_H": nssda_h, "NSSDA_V": nssda_v,
         "MEAN_REPROJECTION_ERROR": float(result.mean_reprojection_error),
         "HELMERT_CHECK_RMSE_XY": result.rmse(gcpmod.CHECK, helmert=True)["xy"],
+        # the sigmas estimated for control given without them (core.georef.control_sigma); None where given
+        **{f"{key}_SIGMA_{axis.upper()}": next((e[f"sigma_{axis}_m"] for e in result.sigma_estimates
+                                                if e["group"] == group), None)
+           for key, group in (("CONTROL", "control points"), ("CAMERA_POSITION", "camera positions"))
+           for axis in ("xy", "z")},
     }
 
 
