@@ -450,6 +450,9 @@ def _estimate_sigmas(run: _Run, fit: _Fit) -> None:
             rows.append((cp.image, np.nan_to_num(d), np.array([1.0, 1.0, 1.0 if math.isfinite(cp.z) else 0.0])))
         prior = (float(np.median([c.sigma_xy for c in free_cams])), float(np.median([c.sigma_z for c in free_cams])))
         est = _group_estimate(CAMERA_GROUP, [c.image for c in free_cams], rows, (gsd, gsd), prior)
+        if not any(math.isfinite(c.z) for c in free_cams):  # positions without heights: no Z to estimate
+            est.sigma_z, est.helmert_z = prior[1], float("nan")
+            est.note = "no heights: sigma Z not estimated"
         run.sigma_estimates[CAMERA_GROUP] = est
         run.cam_pos = [(dataclasses.replace(cp, sigma_xy=est.sigma_xy, sigma_z=est.sigma_z), im)
                        if not cp.sigma_given else (cp, im) for cp, im in run.cam_pos]
