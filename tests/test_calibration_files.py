@@ -314,10 +314,12 @@ def test_orthority_normalised_focal_and_flat_form(tmp_path):
     p.write_text("name: drone\ntype: pinhole\nim_size: [1000, 750]\nfocal_len: 0.8\ncx: -0.01\ncy: 0.02\n")
     (cal,) = read_calibration(str(p))
     assert cal.name == "drone" and cal.colmap_model() == ("PINHOLE", [800.0, 800.0, 490.0, 395.0])
-    assert cal.notes == []
+    assert cal.notes == [] and cal.warnings == []
     p.write_text("cam:\n  type: opencv\n  im_size: [750, 1000]\n  focal_len: 0.8\n  k1: -0.1\n")
     (cal,) = read_calibration(str(p))
-    assert cal.focal_px == 600.0 and "width" in cal.notes[0]  # Orthority's code: focal_len x image width
+    assert cal.focal_px == 600.0 and "width" in cal.warnings[0]  # Orthority's code: focal_len x image width
+    # the doubt is a warning that gives both readings (a 44 % difference on a 640 x 1152 frame)
+    assert "600.0 px (750 px wide)" in cal.warnings[0] and "would be 800.0 px (1000 px)" in cal.warnings[0]
     assert cal.colmap_model()[0] == "SIMPLE_RADIAL"
 
 

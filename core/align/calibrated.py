@@ -208,6 +208,8 @@ def plan_cameras(pycolmap, groups: List[CameraGroup], infos: Sequence[ImageInfo]
     for cal in cals:
         for note in getattr(cal, "notes", None) or []:
             progress.info(f"calibration {cal.source}, {cal.label()}: {note}")
+        for doubt in getattr(cal, "warnings", None) or []:
+            progress.warning(f"calibration {os.path.basename(cal.source)}, {cal.label()}: {doubt}")
     _check_calibrations_used(cals, infos, progress)
     out: List[CameraGroup] = []
     plan: Dict[str, GivenCamera] = {}

@@ -118,6 +118,7 @@ class CameraCalibration:
     fiducials_mm: Dict[str, Tuple[float, float]] = field(default_factory=dict)
     focal_mm: Optional[float] = None
     notes: List[str] = field(default_factory=list)  # what the reader assumed or dropped (the caller names the camera)
+    warnings: List[str] = field(default_factory=list)  # assumptions that may well be wrong (the log warns)
     size_field: str = ""  # the field that gave the image size and its line (for messages about the size)
     size_line: Optional[int] = None
 
@@ -262,6 +263,7 @@ class CameraCalibration:
         kw["sigmas"] = {str(k): float(v) for k, v in (kw.get("sigmas") or {}).items()}
         kw["images"] = [str(p) for p in (kw.get("images") or [])]
         kw["notes"] = [str(n) for n in (kw.get("notes") or [])]
+        kw["warnings"] = [str(n) for n in (kw.get("warnings") or [])]
         return cls(**kw)
 
 
@@ -274,7 +276,7 @@ def _replace(cal: CameraCalibration, **changes) -> CameraCalibration:
     d.update(changes)
     for key in ("sigmas", "fiducials_mm"):
         d[key] = dict(d[key])
-    for key in ("images", "notes"):
+    for key in ("images", "notes", "warnings"):
         d[key] = list(d[key])
     return CameraCalibration(**d)
 
@@ -841,7 +843,7 @@ def _orthority_camera(path: str, name: str, data: dict) -> CameraCalibration:
     if size is None:
         raise fl.fail("im_size", "im_size [width, height] is missing", _line_of(data))
     w, h = size
-    fx, fy, notes = _orthority_focal(fl, w, h)
+    fx, fy, warnings = _orthority_focal(fl, w, h)
     cx = w / 2.0 + max(w, h) * fl.number("cx", default=0.0)
     cy = h / 2.0 + max(w, h) * fl.number("cy", default=0.0)
     _check_principal_point(fl, "cx", cx, cy, w, h)
@@ -850,7 +852,7 @@ def _orthority_camera(path: str, name: str, data: dict) -> CameraCalibration:
         raise fl.fail(next(t for t in DISTORTION_TERMS if fl.has(t)),
                       "a pinhole camera has no distortion coefficients: use type brown or opencv")
     return CameraCalibration(name=name, source=path, width=w, height=h, focal_px=fx,
-                             focal_y_px=None if _same(fx, fy) else fy, cx_px=cx, cy_px=cy, **dist, notes=notes,
+                             focal_y_px=None if _same(fx, fy) else fy, cx_px=cx, cy_px=cy, **dist, warnings=warnings,
                              size_field="im_size", size_line=_line_of(data, "im_size"))
 
 
@@ -862,12 +864,13 @@ def _orthority_focal(fl: _Fields, w: int, h: int) -> Tuple[float, float, List[st
     sensor = fl.numbers("sensor_size", 2, positive=True)
     if sensor is not None:
         return f[0] * w / sensor[0], f[1] * h / sensor[1], []
-    notes = []
-    if h > w:
-        notes.append(f"focal_len without sensor_size is taken as normalised by the "
-                     f"image width ({w} px), as Orthority's code does; its documentation says by the larger side "
-                     f"({h} px): give sensor_size to remove the doubt")
-    return f[0] * w, f[1] * w, notes
+    warnings = []
+    if h > w:  # the two readings differ by h / w: a portrait image's focal length is in doubt
+        warnings.append(f"focal_len {f[0]:g} without sensor_size is taken as normalised by the image width: "
+                        f"{f[0] * w:.1f} px ({w} px wide), as Orthority's code does; its documentation says by the "
+                        f"larger side, which would be {f[0] * h:.1f} px ({h} px): give sensor_size to remove the "
+                        f"doubt")
+    return f[0] * w, f[1] * w, warnings
 
 
 # ---------------------------------------------------------------------------
