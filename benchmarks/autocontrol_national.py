@@ -15,19 +15,20 @@ dropped per reason, the automatic GCPs kept, the camera errors (median / max), t
 ``--code DIR``: import ``core`` from another checkout (e.g. a worktree of the commit before, for the "before"
 figures); the degradation helper and the cached workspaces stay this tree's.
 
-Measured (5 Dec 2026, 2 cores shared, nice 19; three alignments of the FC300X block, focal 691.4-691.6 px; before:
-c14fb72 on the same alignments; camera centres XY against ``cameras_32617.txt``, median / max):
+Measured (5 Dec 2026, 2 cores shared, nice 19; camera centres XY against ``cameras_32617.txt``, median (max);
+after: 15e1475 on three alignments of the FC300X block (f 691.4 px); before: c14fb72 on three others (f 691.4-691.6
+px; the first of the three "after" alignments is the last of these)):
 
-=================  =====================================================  ==================================
+=================  =====================================================  ===================================
 reference          before (c14fb72)                                       after
-=================  =====================================================  ==================================
-0.15 / 0.63 m UTM  0.73, 0.66 m (max 1.6-1.8); 37-41 GCPs                 0.80, 0.71, 0.68 m (max 1.5-1.9);
-(as made)                                                                 37-40 GCPs, DSM sigma 0.16-0.17 m
-0.6 / 10 m tmerc   traceback: "OGR Error: Unsupported SRS"               0.74, 0.79, 0.83 m (max 1.5-1.8);
-no EPSG code                                                              85-101 GCPs, DSM sigma 0.6 m
-0.6 / 10 m UTM     1.37, 1.19, 1.38 m (max 3.1-3.7); 47-57 GCPs; 39, 31,  0.81, 0.71, 0.68 m (max 1.2-1.9);
-                   36 of 80-99 candidates dropped "DSM not a plane        78-97 GCPs; 3-4 dropped "found in
-                   there", 0-2 "found in no other photo", 0-1 "off the    no other photo"
+=================  =====================================================  ===================================
+0.15 / 0.63 m UTM  0.73, 0.66 m (1.6-1.8); 37-41 GCPs                     0.68, 0.70, 0.78 m (1.5-1.9); 35-42
+(as made)                                                                 GCPs, DSM sigma 0.16-0.21 m
+0.6 / 10 m tmerc   traceback: "OGR Error: Unsupported SRS"               0.86, 0.85, 0.85 m (1.3-1.6); 75-102
+no EPSG code                                                              GCPs, DSM sigma 0.40-0.49 m
+0.6 / 10 m UTM     1.37, 1.19, 1.38 m (3.1-3.7); 47-57 GCPs; 39, 31,  0.73, 0.76, 0.80 m (0.9-1.3); 75-92
+                   36 of 80-99 candidates dropped "DSM not a plane        GCPs; 3-5 dropped "found in no other
+                   there", 0-2 "found in no other photo", 0-1 "off the    photo"
                    similarity of the others"
 2 / 20 m tmerc     traceback                                              refused in 3 CPU s: "the reference
                                                                           orthophoto ... is too coarse for a
@@ -38,20 +39,26 @@ no EPSG code                                                              85-101
                                                                           of 1.1 m or finer ..."
 2 / 20 m UTM       "0 / 2 / 0 candidate(s) kept, 4 needed": 7-9 of 7-11   refused, the same message
                    dropped "DSM not a plane there"
-=================  =====================================================  ==================================
+1 / 10 m tmerc     (not run)                                              2.35, 2.67, 2.70 m (5.2-5.6); 32-34
+                                                                          GCPs from 60-61 matches
+1 / 10 m UTM       (not run)                                              0.66, 0.78, 0.71 m (2.3-2.5); 33-34
+=================  =====================================================  ===================================
 
-Autocontrol 8-9 CPU s at 0.6 / 10 m, 15-16 at 0.15 / 0.63 m.  Part of the error left is a common shift (up to 0.8 m;
-the FC350 reference is georeferenced by its EXIF GPS, its cameras 0.69 m median off the same file).  With the DEM's own sigma at its prior (a third of the 10 m cell, 3.3 m) instead of estimated from
-the candidates, the block tilted: 0.90 / 1.70 m median (tmerc / UTM); with the relief limit lifted but no refusal
-at 2 / 20 m, one run placed the block 67 m off on a repeated pattern of houses (6 GCPs, 2.2 m RMS) and another
-5.6 m off.  Beyond the issue's cases (one alignment, tmerc): 0.6 / 30 m 2.59 m median (85 GCPs; the 30 m DEM's
-heights over a block of 5 of its cells tilt it), 1 / 10 m 2.35 m and 1 / 30 m 3.79 m (33 / 32 GCPs from 61
-matches: the 150 m block spans 213 cells of 1 m, just above the refusal's 192).
+Autocontrol 8-10 CPU s at 0.6 / 10 m, 15-16 at 0.15 / 0.63 m.  Part of the error left is a common shift (up to
+0.6 m; the FC350 reference is georeferenced by its EXIF GPS, its cameras 0.69 m median off the same file).  With
+the DEM's own sigma at its prior (a third of the 10 m cell, 3.3 m) instead of estimated from the candidates, the
+block tilted: 0.90 / 1.70 m median (tmerc / UTM); with the estimate bounded below by the match's grid (0.6 m)
+instead of the photos' GSD (0.16 m): 0.74-0.83 / 0.68-0.81 m median but max up to 1.8 / 1.9 m; with the relief
+limit lifted but no refusal at 2 / 20 m, one run placed the block 67 m off on a repeated pattern of houses (6 GCPs,
+2.2 m RMS) and another 5.6 m off.  At 1 m the 150 m block (213 cells, just above the refusal's 192) gives about
+60 matches; in the tmerc case their heights from the 10 m DEM tilt the block (their weighted misfit to the
+0.63 m DSM is a plane of 0.4 %), hence 2.4-2.7 m.  With the grid floor (one alignment): 0.6 / 30 m 2.6 m (tmerc
+and UTM; a 30 m DEM over a block of 5 of its cells), 1 / 30 m 3.8 m.
 
 ``--archive digital:4,digital:12``: tests/archive_scene.py's digital metric frames (120 mm, 5.4-5.5 m GSD, 450 m
 relief) against the decades-later 2 m orthophoto / 25 m DEM in its tmerc CRS without an EPSG code, interior
 orientation fixed, no prior: 4 frames: 101 GCPs, check points 0.41 GSD XY / 0.56 GSD Z (6), camera centres 0.37
-GSD median (max 1.1); 12 frames: 89 GCPs, 0.28 / 0.86 GSD (14), 0.36 GSD (max 0.66); 6.2 / 12.9 CPU s.
+GSD median (max 1.1); 12 frames: 89 GCPs, 0.28 / 0.86 GSD (14), 0.36 GSD (max 0.66); 5.9 / 12.6 CPU s.
 """
 import argparse
 import importlib.util
