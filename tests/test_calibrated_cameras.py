@@ -324,7 +324,8 @@ def test_a_calibration_that_matches_no_photo_is_refused_and_an_unused_camera_war
 def test_a_calibration_with_k3_never_frees_the_rational_terms(tmp_path):
     """A calibration with k3 (every certificate's distortion table fits one) is COLMAP's FULL_OPENCV, whose k4..k6
     are zero by construction.  Estimated, the alignment's self-calibration freed them with k1..k3 (4 archive frames:
-    k1 = 55, k4 = 55, k2 = -113, k5 = -113): it now starts OPENCV from the calibration, k3 left out and said so;
+    k1 = 55, k4 = 55, k2 = -113, k5 = -113): it now starts RADIAL (square pixels, no p1, p2) or OPENCV from the
+    calibration, k3 left out and said so;
     fixed and refined keep FULL_OPENCV, and the georeference refines k1..k3, p1, p2 but never k4..k6."""
     import pycolmap
 
@@ -337,8 +338,16 @@ def test_a_calibration_with_k3_never_frees_the_rational_terms(tmp_path):
     log = _Log()
     _, plan = plan_cameras(pycolmap, [_group(infos)], infos, _read(path), {}, AlignOptions(intrinsics="estimated"),
                            log)
-    assert plan["g"].model == "OPENCV" and plan["g"].params == [833.3, 833.3, 320.0, 576.0, -0.01, 0.002, 0.0, 0.0]
-    assert any("k3 = -0.0003 of the calibration left out" in ln for ln in log.lines), log.lines
+    # square pixels, no tangential terms: RADIAL (one focal length; OPENCV's fx, fy came out -1.73 / -2.13 % and the
+    # centres 82 m low, RADIAL's f -1.72 % and 73 m on the archive block)
+    assert plan["g"].model == "RADIAL" and plan["g"].params == [833.3, 320.0, 576.0, -0.01, 0.002]
+    assert any("k3 = -0.0003 of the calibration left out of the self-calibration (RADIAL" in ln for ln in log.lines)
+    tangential = tmp_path / "tangential.json"
+    tangential.write_text(json.dumps({"name": "DMC", "image_size_px": [640, 1152], "focal_length_px": 833.3,
+                                      "k1": -0.01, "k2": 0.002, "k3": -0.0003, "p1": 1e-4}))
+    _, plan = plan_cameras(pycolmap, [_group(infos)], infos, _read(tangential), {},
+                           AlignOptions(intrinsics="estimated"), NullProgress())
+    assert plan["g"].model == "OPENCV" and plan["g"].params == [833.3, 833.3, 320.0, 576.0, -0.01, 0.002, 1e-4, 0.0]
     for mode in ("fixed", "refined"):
         _, plan = plan_cameras(pycolmap, [_group(infos)], infos, _read(path), {}, AlignOptions(intrinsics=mode),
                                NullProgress())

@@ -161,12 +161,18 @@ def _from_calibration(pycolmap, cal, info: ImageInfo, mode: str, how: str, frame
     mode = cal.adjust or mode
     note = ""
     if mode == "estimated" and model == "FULL_OPENCV":
+        params_k3 = params[8]
         # COLMAP's only model with k3 also has the rational terms k4..k6, and its self-calibration frees all
         # the extra parameters together: a few photos cannot tell k1..k3 from k4..k6 (4 archive frames came
-        # out with k1 = 55, k4 = 55).  A first guess does not need k3: OPENCV (k1, k2, p1, p2) from it
-        note = (f"k3 = {params[8]:.6g} of the calibration left out of the self-calibration (OPENCV: k1, k2, p1, "
-                f"p2; COLMAP's model with k3 would estimate the rational terms k4..k6 along with it)")
-        model, params = "OPENCV", params[:8]
+        # out with k1 = 55, k4 = 55).  A first guess does not need k3: RADIAL (k1, k2; one focal length for square
+        # pixels without tangential terms: OPENCV's fx, fy drifted apart, -1.73 / -2.13 %) or OPENCV from it
+        fx, fy, cx, cy, k1, k2, p1, p2 = params[:8]
+        if p1 == 0.0 and p2 == 0.0 and fx == fy:  # square pixels, no tangential terms: one focal length
+            model, params, kept = "RADIAL", [fx, cx, cy, k1, k2], "RADIAL: f, k1, k2"
+        else:
+            model, params, kept = "OPENCV", params[:8], "OPENCV: k1, k2, p1, p2"
+        note = (f"k3 = {params_k3:.6g} of the calibration left out of the self-calibration ({kept}; COLMAP's "
+                f"model with k3 would estimate the rational terms k4..k6 along with it)")
     names = _param_names(pycolmap, model)
     return GivenCamera(mode=mode, source=source, name=cal.name or "", model=model,
                        params=[float(v) for v in params], sigmas=_sigmas(names, cal.sigmas or {}), matched_by=how,
