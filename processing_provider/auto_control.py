@@ -1,5 +1,6 @@
 """Automatic control: thin adapter over core.georef.autocontrol.stage.autocontrol_workspace."""
 from qgis.core import (
+    QgsProcessingException,
     QgsProcessingOutputFolder,
     QgsProcessingOutputNumber,
     QgsProcessingOutputVectorLayer,
@@ -43,6 +44,10 @@ class AutoControlAlgorithm(AlgorithmBase):
         "height weighs by the DEM's slope and roughness there), heights in metres or in the unit the raster "
         "declares (a WCS layer is saved to "
         "georef/reference-dsm.tif).\n"
+        "A reference DSM alone (no orthophoto, a raster file on disk) is enough: the block is placed by the photos' "
+        "EXIF GPS, then co-registered to the DSM (shift, tilt, dome: Nuth & Kääb on the sparse points), and "
+        "DEM-derived control points enter the adjustment (georef/dem_control.json; the same as Georeference with "
+        "a reference DSM alone).\n"
         "Rough position: the photos' EXIF GPS when at least two carry it (auto), always (EXIF GPS), or never "
         "(none: rotation and scale are searched over the whole reference, which then should not be much larger "
         "than the block).\n"
@@ -57,7 +62,7 @@ class AutoControlAlgorithm(AlgorithmBase):
         params.add(
             self,
             params.folder(self.WORKSPACE, self.tr("Aligned workspace")),
-            QgsProcessingParameterRasterLayer(self.REFERENCE_ORTHO, self.tr("Reference orthophoto")),
+            QgsProcessingParameterRasterLayer(self.REFERENCE_ORTHO, self.tr("Reference orthophoto"), optional=True),
             QgsProcessingParameterRasterLayer(self.REFERENCE_DSM, self.tr("Reference DSM")),
             params.choice(self.PRIOR, self.tr("Rough position"),
                           [self.tr("auto"), self.tr("EXIF GPS"), self.tr("none")], 0),
@@ -81,6 +86,8 @@ class AutoControlAlgorithm(AlgorithmBase):
         ortho = self.parameterAsRasterLayer(parameters, self.REFERENCE_ORTHO, context)
         dsm = self.parameterAsRasterLayer(parameters, self.REFERENCE_DSM, context)
         prior = PRIORS[self.parameterAsEnum(parameters, self.PRIOR, context)]
+        if ortho is None and dsm is not None:
+            return self._dem_control(workspace, dsm, prior, feedback)
         progress = FeedbackProgress(feedback)
         extent = self.parameterAsExtent(parameters, self.REFERENCE_EXTENT, context)
         ortho_path, dsm_path = self.run_core(
@@ -101,3 +108,30 @@ class AutoControlAlgorithm(AlgorithmBase):
             out[n] = f.get(n)
         return out
 
+    def _dem_control(self, workspace, dsm, prior, feedback):
+        """A reference DSM alone: the block placed by EXIF GPS and co-registered to the DSM (DEM control: core
+        georeference_workspace with GeorefOptions.reference_dem)."""
+        from ..core.georef.options import GeorefOptions
+        from ..core.georef.stage import georeference_workspace
+        from .reference_layers import describe, local_file
+
+        if local_file(dsm) is None:
+            raise QgsProcessingException(self.tr(
+                "Reference DSM {} given without a reference orthophoto (DEM control) must be a raster file on disk; "
+                "a web layer is fetched only with a reference orthophoto").format(describe(dsm)))
+        if prior == "none":
+            raise QgsProcessingException(self.tr(
+                "A reference DSM alone (DEM control) places the block by the photos' EXIF GPS: choose Rough "
+                "position auto or EXIF GPS, or give a reference orthophoto as well"))
+        progress = FeedbackProgress(feedback)
+        result = self.run_core(georeference_workspace, workspace, use_exif_gps=True,
+                               options=GeorefOptions(reference_dem=local_file(dsm)), progress=progress)
+        progress.push_result(result.warnings)
+        for o in result.outliers:
+            feedback.pushWarning(self.tr("outlier left out: {}").format(o))
+        f = result.figures
+        out = {self.OUT_WORKSPACE: result.workspace, self.CAMERAS: result.cameras_path,
+               self.AUTO_GCPS: f.get("DEM_CONTROL_N"), self.MATCHES: None}
+        for n in self.NUMBERS:
+            out[n] = f.get(n)
+        return out

@@ -338,3 +338,41 @@ def test_a_block_that_cannot_follow_its_dem_control_is_warned_about():
     assert "could not follow" in after_warning(dc) and "0.05 m" in after_warning(dc)
     dc.after = CoregResult((0.0, 0.0, 0.0), nmad_before=0.12)
     assert after_warning(dc) is None
+
+
+def test_automatic_control_with_a_reference_dsm_alone_is_dem_control(scene, tmp_path, qgis_app):
+    """Issue 32 item 4: 'available from Georeference and the automatic control (a REFERENCE_DSM alone is enough)':
+    the automatic control with no reference orthophoto runs the DEM control of Georeference (EXIF GPS placing the
+    block); without any rough position it says what to give instead of running."""
+    from archaeoortho.processing_provider.auto_control import AutoControlAlgorithm
+    from archaeoortho.processing_provider.georeference import GeoreferenceAlgorithm
+    from qgis.core import (
+        QgsProcessingContext,
+        QgsProcessingException,
+        QgsProcessingFeedback,
+        QgsProject,
+        QgsRasterLayer,
+    )
+
+    block, rec, _, _, _, ref, positions = scene
+    context = QgsProcessingContext()
+    context.setProject(QgsProject.instance())
+    dsm = QgsRasterLayer(ref, "national DEM in feet", "gdal")
+    assert dsm.isValid()
+    out = {}
+    for label, cls, extra in (("auto", AutoControlAlgorithm, {"PRIOR": 0}),
+                              ("georef", GeoreferenceAlgorithm, {"USE_EXIF_GPS": True})):
+        ws = synthetic_workspace(tmp_path / label, block, rec)
+        set_exif_gps(ws, positions, syn.CRS)
+        alg = cls()
+        alg.initAlgorithm()
+        out[label] = alg.processAlgorithm({"WORKSPACE": ws, "REFERENCE_DSM": dsm, **extra}, context,
+                                          QgsProcessingFeedback())
+    assert out["auto"]["AUTO_GCPS"] >= 10 and out["auto"]["AUTO_GCPS"] == out["georef"]["DEM_CONTROL_N"]
+    assert out["auto"]["GCP_RMSE_Z"] == pytest.approx(out["georef"]["GCP_RMSE_Z"], rel=1e-6)
+    assert os.path.isfile(os.path.join(out["auto"]["WORKSPACE"], "georef", "dem_control.json"))
+    alg = AutoControlAlgorithm()
+    alg.initAlgorithm()
+    with pytest.raises(QgsProcessingException, match="EXIF GPS"):
+        alg.processAlgorithm({"WORKSPACE": out["auto"]["WORKSPACE"], "REFERENCE_DSM": dsm, "PRIOR": 2}, context,
+                             QgsProcessingFeedback())
