@@ -74,12 +74,12 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
 <context>
     <name>AlgorithmBase</name>
     <message>
-        <location filename="../processing_provider/base.py" line="226"/>
+        <location filename="../processing_provider/base.py" line="235"/>
         <source>Cancelled: {}</source>
         <translation>Abgebrochen: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/base.py" line="135"/>
+        <location filename="../processing_provider/base.py" line="144"/>
         <source>Outputs not styled: {}</source>
         <translation>Ausgaben nicht gestaltet: {}</translation>
     </message>
@@ -92,57 +92,57 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
 <context>
     <name>AlignImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>One camera for all images</source>
         <translation>Eine Kamera für alle Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="65"/>
+        <location filename="../processing_provider/align_images.py" line="81"/>
         <source>Camera centres</source>
         <translation>Projektionszentren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="82"/>
         <source>Registered images</source>
         <translation>Orientierte Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="67"/>
+        <location filename="../processing_provider/align_images.py" line="83"/>
         <source>Mean reprojection error (px)</source>
         <translation>Mittlerer Rückprojektionsfehler (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="92"/>
+        <location filename="../processing_provider/align_images.py" line="110"/>
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
         <translation>{} von {} Bildern orientiert, mittlerer Rückprojektionsfehler {:.3f} px, {} Punkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="99"/>
+        <location filename="../processing_provider/align_images.py" line="117"/>
         <source>Images not registered:</source>
         <translation>Nicht orientierte Bilder:</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="102"/>
+        <location filename="../processing_provider/align_images.py" line="124"/>
         <source>Seconds per step: {}</source>
         <translation>Sekunden je Schritt: {}</translation>
     </message>
@@ -152,47 +152,47 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
         <translation>Bilder ausrichten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Mapper</source>
         <translation>Rekonstruktionsverfahren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Matching image size (px)</source>
         <translation>Bildgröße für die Zuordnung (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Features per image</source>
         <translation>Merkmale je Bild</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Affine-invariant features</source>
         <translation>Affin-invariante Merkmale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Focal length (mm)</source>
         <translation>Brennweite (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Sensor width (mm)</source>
         <translation>Sensorbreite (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Retry images left out</source>
         <translation>Ausgelassene Bilder erneut versuchen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="95"/>
+        <location filename="../processing_provider/align_images.py" line="113"/>
         <source>Retry {} ({} features): {} image(s) left out; main block {} -&gt; {} images{}</source>
         <translation>Neuer Versuch {} ({}-Merkmale): {} Bild(er) ausgelassen; Hauptblock {} -&gt; {} Bilder{}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="95"/>
+        <location filename="../processing_provider/align_images.py" line="113"/>
         <source> (not better: the previous result kept)</source>
         <translation> (nicht besser: das vorige Ergebnis bleibt)</translation>
     </message>
@@ -210,24 +210,27 @@ Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global
 Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
         <translation>Structure from Motion: SIFT-Merkmale, Paarauswahl, robuste Zuordnung (RANSAC), inkrementelle Rekonstruktion mit Selbstkalibrierung (Brennweite, Bildhauptpunkt, Objektivverzeichnung) und eine abschließende Bündelblockausgleichung. Das Ergebnis wird im Arbeitsbereich-Ordner gespeichert, den die folgenden Schritte (Georeferenzieren, DOM erzeugen, Orthophoto erzeugen) als Eingabe nehmen. Ein erneuter Lauf setzt fort: bereits berechnete Merkmale und Zuordnungen werden wiederverwendet.
 
-Paarauswahl: &apos;auto&apos; nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
-Kameramodell: &apos;AUTO&apos; schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
+Paarauswahl: 'auto' nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
+Kameramodell: 'AUTO' schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
 Bildgröße für die Zuordnung: die längste Seite, auf die die Bilder für die Merkmale verkleinert werden (0 = automatisch: Fotos bis 2 Megapixel unverändert, größere auf 2 Megapixel verkleinert; DOM und Orthophotos nutzen jedes Pixel). Merkmale je Bild: 0 = automatisch (etwa 4000 je Megapixel, 2048 bis 4096). Affin-invariante Merkmale helfen bei Schrägaufnahmen und sind langsamer.
 Brennweite und Sensorbreite: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern (0 = aus EXIF / unbekannt).
 Kamerakalibrierungsdatei: die innere Orientierung einer kalibrierten Kamera (YAML/JSON von ArchaeoOrtho, innere Parameter von Orthority, OpenCV, COLMAP cameras.txt oder Metashape-XML); mehrere Kameras werden den Fotos über ihre Bildmuster, das Kameramodell oder die Bildgröße zugeordnet; ein Foto anderer Auflösung erhält sie skaliert. Eine Datei, die sich nicht lesen lässt, beendet den Lauf vor jeder Arbeit und nennt Datei, Zeile und Feld.
-Innere Orientierung: was die Ausgleichungen an einer Kamera ändern dürfen: &apos;fixed&apos; hält die gegebenen Werte durch Ausrichtung und Georeferenzierung (auch mit automatischen Passpunkten), &apos;refined&apos; lässt die Georeferenzierung sie mit den Standardabweichungen der Kalibrierung als Vorinformation verbessern, &apos;estimated&apos; kalibriert ausgehend von ihnen selbst. &apos;auto&apos; ist &apos;fixed&apos;, wo eine Kalibrierung gegeben ist (die Datei oder von &apos;Bilder vorbereiten&apos; entzerrte Filmscans), sonst &apos;estimated&apos;; ein eigenes &apos;adjust&apos; einer Kamera in der Datei geht vor. Mit &apos;fixed&apos; oder &apos;refined&apos; und ohne Datei sind Brennweite und Sensorbreite die gegebenen Werte. Protokoll, sfm/alignment.json und der Genauigkeitsbericht sagen je Kamera, was gehalten wurde.
-Rekonstruktionsverfahren (erweitert): &apos;incremental&apos; (COLMAP, Standard) oder &apos;global&apos; (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).
+Innere Orientierung: was die Ausgleichungen an einer Kamera ändern dürfen: 'fixed' hält die gegebenen Werte durch Ausrichtung und Georeferenzierung (auch mit automatischen Passpunkten), 'refined' lässt die Georeferenzierung sie mit den Standardabweichungen der Kalibrierung als Vorinformation verbessern, 'estimated' kalibriert ausgehend von ihnen selbst. 'auto' ist 'fixed', wo eine Kalibrierung gegeben ist (die Datei oder von 'Bilder vorbereiten' entzerrte Filmscans), sonst 'estimated'; ein eigenes 'adjust' einer Kamera in der Datei geht vor. Mit 'fixed' oder 'refined' und ohne Datei sind Brennweite und Sensorbreite die gegebenen Werte. Protokoll, sfm/alignment.json und der Genauigkeitsbericht sagen je Kamera, was gehalten wurde.
+Rekonstruktionsverfahren (erweitert): 'incremental' (COLMAP, Standard) oder 'global' (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).
 Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen Einstellungen auslassen, oder ein in Teile zerfallener Block werden mit reicheren Merkmalen (schwächeren für kontrastarme Bilder, affinen für steile Schrägaufnahmen) und mehr Paaren erneut versucht; das Protokoll und sfm/alignment.json sagen, was erneut versucht wurde und warum.</translation>
     </message>
     <message>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Camera calibration file</source>
         <translation>Kamerakalibrierungsdatei</translation>
     </message>
     <message>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Interior orientation</source>
         <translation>Innere Orientierung</translation>
     </message>
     <message>
+        <location filename="../processing_provider/align_images.py" line="122"/>
         <source>Camera {}: interior orientation {} ({})</source>
         <translation>Kamera {}: innere Orientierung {} ({})</translation>
     </message>
@@ -261,62 +264,62 @@ Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen 
 <context>
     <name>AutoControlAlgorithm</name>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>Aligned workspace</source>
         <translation>Ausgerichteter Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>Reference orthophoto</source>
         <translation>Referenz-Orthophoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>Reference DSM</source>
         <translation>Referenz-DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>Rough position</source>
         <translation>Ungefähre Lage</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>auto</source>
         <translation>automatisch</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>EXIF GPS</source>
         <translation>EXIF-GPS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>none</source>
         <translation>keine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="66"/>
+        <location filename="../processing_provider/auto_control.py" line="74"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="67"/>
+        <location filename="../processing_provider/auto_control.py" line="75"/>
         <source>Camera centres (world)</source>
         <translation>Projektionszentren (Welt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="68"/>
+        <location filename="../processing_provider/auto_control.py" line="76"/>
         <source>Automatic GCPs kept</source>
         <translation>Behaltene automatische Passpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="69"/>
+        <location filename="../processing_provider/auto_control.py" line="77"/>
         <source>Matches found</source>
         <translation>Gefundene Zuordnungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="93"/>
+        <location filename="../processing_provider/auto_control.py" line="131"/>
         <source>outlier left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
@@ -326,30 +329,42 @@ Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen 
         <translation>Automatische Passpunkte aus einem Referenz-Orthophoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>Reference resolution for web layers (m, 0: auto)</source>
         <translation>Referenzauflösung für Weblayer (m, 0: auto)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>Area to fetch from web layers</source>
         <translation>Aus Weblayern abzurufender Bereich</translation>
     </message>
     <message>
+        <location filename="../processing_provider/auto_control.py" line="119"/>
+        <source>Reference DSM {} given without a reference orthophoto (DEM control) must be a raster file on disk; a web layer is fetched only with a reference orthophoto</source>
+        <translation>Referenz-DOM {} ohne Referenz-Orthophoto (DGM-Passpunkte) muss eine Rasterdatei auf dem Datenträger sein; ein Weblayer wird nur mit einem Referenz-Orthophoto abgerufen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="123"/>
+        <source>A reference DSM alone (DEM control) places the block by the photos&apos; EXIF GPS: choose Rough position auto or EXIF GPS, or give a reference orthophoto as well</source>
+        <translation>Ein Referenz-DOM allein (DGM-Passpunkte) platziert den Block durch das EXIF-GPS der Fotos: Ungefähre Lage automatisch oder EXIF-GPS wählen oder zusätzlich ein Referenz-Orthophoto angeben</translation>
+    </message>
+    <message>
         <location filename="../ui/catalog.py" line="7"/>
-        <source>Georeferences an aligned block with no hand-picked ground control: a provisional orthophoto of the block is matched to a reference orthophoto (a national orthophoto, an earlier block&apos;s orthomosaic) at a common resolution, each match is found again in the photos and takes its height from the reference DSM, and these automatic GCPs enter the usual GCP-constrained adjustment, which leaves out the outliers. Changes between the two dates (crops, cars, new buildings, another sun) are tolerated: what stays is used, and the log says how many matches survived each step.
+        <source>Georeferences an aligned block with no hand-picked ground control: a provisional orthophoto of the block is matched to a reference orthophoto (a national orthophoto, an earlier block's orthomosaic) at a common resolution, each match is found again in the photos and takes its height from the reference DSM, and these automatic GCPs enter the usual GCP-constrained adjustment, which leaves out the outliers. Changes between the two dates (crops, cars, new buildings, another sun) are tolerated: what stays is used, and the log says how many matches survived each step.
 
 Aligned workspace: the block to georeference (its photos must still be where the alignment found them).
-Reference orthophoto: any north-up raster, grey or colour, in any CRS (a national one without an EPSG code too); the result is in its CRS (a geographic or Web Mercator file: in the UTM zone of its centre). A layer that is no local file (WMS, XYZ, WCS, a virtual raster) is saved for the block&apos;s extent to georef/reference-ortho.tif (a Web Mercator or geographic one in the DSM&apos;s CRS, else the UTM zone&apos;s).
-Reference DSM: a DSM or DTM covering the block, in any CRS and resolution (a 10-30 m DEM too: each height weighs by the DEM&apos;s slope and roughness there), heights in metres or in the unit the raster declares (a WCS layer is saved to georef/reference-dsm.tif).
-Rough position: the photos&apos; EXIF GPS when at least two carry it (auto), always (EXIF GPS), or never (none: rotation and scale are searched over the whole reference, which then should not be much larger than the block).
-Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos&apos; EXIF GPS positions plus a margin, else the other reference&apos;s extent.
+Reference orthophoto: any north-up raster, grey or colour, in any CRS (a national one without an EPSG code too); the result is in its CRS (a geographic or Web Mercator file: in the UTM zone of its centre). A layer that is no local file (WMS, XYZ, WCS, a virtual raster) is saved for the block's extent to georef/reference-ortho.tif (a Web Mercator or geographic one in the DSM's CRS, else the UTM zone's).
+Reference DSM: a DSM or DTM covering the block, in any CRS and resolution (a 10-30 m DEM too: each height weighs by the DEM's slope and roughness there), heights in metres or in the unit the raster declares (a WCS layer is saved to georef/reference-dsm.tif).
+A reference DSM alone (no orthophoto, a raster file on disk) is enough: the block is placed by the photos' EXIF GPS, then co-registered to the DSM (shift, tilt, dome: Nuth &amp; Kääb on the sparse points), and DEM-derived control points enter the adjustment (georef/dem_control.json; the same as Georeference with a reference DSM alone).
+Rough position: the photos' EXIF GPS when at least two carry it (auto), always (EXIF GPS), or never (none: rotation and scale are searched over the whole reference, which then should not be much larger than the block).
+Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos' EXIF GPS positions plus a margin, else the other reference's extent.
 Outputs: the camera centres in the reference CRS, the number of automatic GCPs the adjustment kept, the matches found; georef/autocontrol.json lists every candidate with why it was kept or dropped.</source>
         <translation>Georeferenziert einen ausgerichteten Block ohne von Hand gesetzte Passpunkte: ein vorläufiges Orthophoto des Blocks wird bei gemeinsamer Auflösung mit einem Referenz-Orthophoto (einem amtlichen Orthophoto, dem Orthomosaik eines früheren Blocks) zugeordnet, jede Zuordnung wird in den Fotos wiedergefunden und erhält ihre Höhe aus dem Referenz-DOM, und diese automatischen Passpunkte gehen in die übliche passpunktgestützte Ausgleichung ein, die die Ausreißer auslässt. Änderungen zwischen den beiden Zeitpunkten (Feldfrüchte, Autos, neue Gebäude, ein anderer Sonnenstand) werden hingenommen: was bleibt, wird genutzt, und das Protokoll nennt, wie viele Zuordnungen jeden Schritt überstanden haben.
 
 Ausgerichteter Arbeitsbereich: der zu georeferenzierende Block (seine Fotos müssen noch dort liegen, wo die Ausrichtung sie gefunden hat).
 Referenz-Orthophoto: ein beliebiges genordetes Raster, grau oder farbig, in einem beliebigen KBS (auch einem amtlichen ohne EPSG-Code); das Ergebnis ist in seinem KBS (eine geographische oder Web-Mercator-Datei: in dem der UTM-Zone ihrer Mitte). Ein Layer, der keine lokale Datei ist (WMS, XYZ, WCS, ein virtuelles Raster), wird für die Ausdehnung des Blocks nach georef/reference-ortho.tif gespeichert (ein Web-Mercator- oder geographischer im KBS des DOM, sonst in dem der UTM-Zone).
 Referenz-DOM: ein DOM oder DGM, das den Block abdeckt, in beliebigem KBS und beliebiger Auflösung (auch ein DGM mit 10-30 m: jede Höhe wird nach Neigung und Rauheit des DGM an ihrer Stelle gewichtet), Höhen in Metern oder in der Einheit, die das Raster angibt (ein WCS-Layer wird nach georef/reference-dsm.tif gespeichert).
+Ein Referenz-DOM allein (ohne Orthophoto, eine Rasterdatei auf dem Datenträger) genügt: der Block wird durch das EXIF-GPS der Fotos platziert, dann auf das DOM koregistriert (Verschiebung, Kippung, Wölbung: Nuth &amp; Kääb auf den Punkten des dünnen Modells), und aus dem DGM abgeleitete Passpunkte gehen in die Ausgleichung ein (georef/dem_control.json; wie Georeferenzieren mit einem Referenz-DOM allein).
 Ungefähre Lage: das EXIF-GPS der Fotos, wenn mindestens zwei es tragen (automatisch), immer (EXIF-GPS) oder nie (keine: Drehung und Maßstab werden über die ganze Referenz gesucht, die dann nicht viel größer als der Block sein sollte).
 Referenzauflösung: Meter je Pixel, mit denen ein Weblayer gespeichert wird (0: 0,25 m; das DOM mit der doppelten, mindestens 0,5 m). Abzurufender Bereich: die Ausdehnung, für die ein Weblayer gespeichert wird; leer: die EXIF-GPS-Positionen der Fotos mit einem Rand, sonst die Ausdehnung der anderen Referenz.
 Ausgaben: die Projektionszentren im KBS der Referenz, die Zahl der automatischen Passpunkte, die die Ausgleichung behalten hat, die gefundenen Zuordnungen; georef/autocontrol.json führt jeden Kandidaten auf, mit dem Grund, warum er behalten oder verworfen wurde.</translation>
@@ -510,7 +525,7 @@ Ein erneuter Lauf nach einem Abbruch setzt fort und verwendet die bereits zugeor
         <translation>Anteil der interpolierten DGM-Zellen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="100"/>
+        <location filename="../processing_provider/build_dtm.py" line="97"/>
         <source>Give a workspace folder, or a DSM file and where to write the DTM</source>
         <translation>Geben Sie einen Arbeitsbereich-Ordner an, oder eine DOM-Datei und wohin das DGM geschrieben wird</translation>
     </message>
@@ -789,7 +804,7 @@ Difference: where to write the float32 Cloud-Optimized GeoTIFF of later minus ea
         <translation>Das spätere DOM minus das frühere, im Raster des früheren, zeigt, was sich zwischen zwei Zeitpunkten einer Fundstelle verändert hat (das spätere DOM wird dazu mit GDAL bilinear aus einem beliebigen KBS umgerechnet). Eine Zelle ist NoData, wo eines der beiden DOM keine Daten hat. Das Protokoll nennt die verglichenen Zellen, Median, Mittel und Standardabweichung der Differenz, ihr 5. und 95. Perzentil und die Zellen, die sich um mehr als 1 m verändert haben; ein Median nahe 0 zeigt, dass die beiden Zeitpunkte aufeinander registriert sind.
 
 Früheres DOM: das DOM, von dem aus die Differenz gemessen wird (sein Raster ist das der Ausgabe).
-Späteres DOM: das DOM des anderen Zeitpunkts (z. B. eines Blocks, der mit &apos;Automatische Passpunkte&apos; auf den früheren registriert wurde).
+Späteres DOM: das DOM des anderen Zeitpunkts (z. B. eines Blocks, der mit 'Automatische Passpunkte' auf den früheren registriert wurde).
 Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (Meter) geschrieben wird.</translation>
     </message>
 </context>
@@ -1166,27 +1181,27 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>GeoPackage (*.gpkg)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="229"/>
+        <location filename="../ui/gcp_io.py" line="231"/>
         <source>Cannot write {}: {}</source>
         <translation>{} kann nicht geschrieben werden: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="232"/>
+        <location filename="../ui/gcp_io.py" line="234"/>
         <source>Exported {} observations to {}</source>
         <translation>{} Messungen nach {} exportiert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="232"/>
+        <location filename="../ui/gcp_io.py" line="234"/>
         <source> (points without observations left out: {})</source>
         <translation> (Punkte ohne Messungen ausgelassen: {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="236"/>
+        <location filename="../ui/gcp_io.py" line="238"/>
         <source>GCP observations</source>
         <translation>Passpunktmessungen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="238"/>
+        <location filename="../ui/gcp_io.py" line="240"/>
         <source>Cannot add {} to the project</source>
         <translation>{} kann nicht zum Projekt hinzugefügt werden</translation>
     </message>
@@ -1526,17 +1541,17 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>Kontrollpunkte: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="124"/>
+        <location filename="../ui/gcp_autocontrol.py" line="129"/>
         <source>ArchaeoOrtho: automatic control</source>
         <translation>ArchaeoOrtho: automatische Passpunkte</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="128"/>
+        <location filename="../ui/gcp_autocontrol.py" line="133"/>
         <source>Automatic control against {} and {}…</source>
         <translation>Automatische Passpunkte gegen {} und {}…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="140"/>
+        <location filename="../ui/gcp_autocontrol.py" line="145"/>
         <source>Automatic GCPs (residuals)</source>
         <translation>Automatische Passpunkte (Residuen)</translation>
     </message>
@@ -1544,102 +1559,102 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
 <context>
     <name>GcpStore</name>
     <message>
-        <location filename="../ui/store.py" line="254"/>
+        <location filename="../ui/store.py" line="255"/>
         <source>a point named {} exists already</source>
         <translation>ein Punkt namens {} existiert bereits</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="242"/>
+        <location filename="../ui/store.py" line="243"/>
         <source>add point {}</source>
         <translation>Punkt {} hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="249"/>
+        <location filename="../ui/store.py" line="250"/>
         <source>remove point {}</source>
         <translation>Punkt {} entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="265"/>
+        <location filename="../ui/store.py" line="266"/>
         <source>set {} of {}</source>
         <translation>{} von {} setzen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="325"/>
+        <location filename="../ui/store.py" line="326"/>
         <source>place {} in {}</source>
         <translation>{} in {} messen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="333"/>
+        <location filename="../ui/store.py" line="334"/>
         <source>remove {} from {}</source>
         <translation>{} aus {} entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="411"/>
+        <location filename="../ui/store.py" line="412"/>
         <source>set CRS</source>
         <translation>KBS setzen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="293"/>
+        <location filename="../ui/store.py" line="294"/>
         <source>no position</source>
         <translation>keine Position</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="298"/>
+        <location filename="../ui/store.py" line="299"/>
         <source>({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)</source>
         <translation>({:.0f}, {:.0f}) liegt außerhalb des Fotos {} ({} × {} px)</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="305"/>
+        <location filename="../ui/store.py" line="306"/>
         <source>({:.0f}, {:.0f}) is inside the mask of {}</source>
         <translation>({:.0f}, {:.0f}) liegt in der Maske von {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="313"/>
+        <location filename="../ui/store.py" line="314"/>
         <source>{} not placed: {}</source>
         <translation>{} nicht gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="357"/>
+        <location filename="../ui/store.py" line="358"/>
         <source>{} points replaced by {} from the file</source>
         <translation>{} Punkte durch {} aus der Datei ersetzt</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="391"/>
+        <location filename="../ui/store.py" line="392"/>
         <source>added {} points: {}</source>
         <translation>{} Punkte hinzugefügt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="393"/>
+        <location filename="../ui/store.py" line="394"/>
         <source>coordinates updated from the file: {}</source>
         <translation>Koordinaten aus der Datei aktualisiert: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="395"/>
+        <location filename="../ui/store.py" line="396"/>
         <source>role set by the file: {}</source>
         <translation>Rolle von der Datei gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="397"/>
+        <location filename="../ui/store.py" line="398"/>
         <source>role kept (the file gives none): {}</source>
         <translation>Rolle beibehalten (die Datei nennt keine): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="399"/>
+        <location filename="../ui/store.py" line="400"/>
         <source>σ set by the file: {}</source>
         <translation>σ von der Datei gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="401"/>
+        <location filename="../ui/store.py" line="402"/>
         <source>{} observations added</source>
         <translation>{} Messungen hinzugefügt</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="403"/>
+        <location filename="../ui/store.py" line="404"/>
         <source>placed observations kept (the file has others): {}</source>
         <translation>gesetzte Messungen beibehalten (die Datei hat andere): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="404"/>
+        <location filename="../ui/store.py" line="405"/>
         <source>nothing changed</source>
         <translation>nichts geändert</translation>
     </message>
@@ -1765,37 +1780,37 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
 <context>
     <name>GeoreferenceAlgorithm</name>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="89"/>
+        <location filename="../processing_provider/georeference.py" line="96"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="90"/>
+        <location filename="../processing_provider/georeference.py" line="97"/>
         <source>GCP residuals</source>
         <translation>Passpunkt-Residuen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="91"/>
+        <location filename="../processing_provider/georeference.py" line="98"/>
         <source>Camera centres (world)</source>
         <translation>Projektionszentren (Welt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="176"/>
+        <location filename="../processing_provider/georeference.py" line="194"/>
         <source>outlier left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="129"/>
+        <location filename="../processing_provider/georeference.py" line="147"/>
         <source>CRS {}; control RMSE XY {} m, Z {} m; check RMSE XY {} m, Z {} m</source>
         <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="114"/>
+        <location filename="../processing_provider/run_pipeline.py" line="120"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
@@ -1805,89 +1820,94 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>Georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Aligned workspace</source>
         <translation>Ausgerichteter Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Ground control layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Check points</source>
         <translation>Kontrollpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Use EXIF GPS positions</source>
         <translation>EXIF-GPS-Positionen verwenden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Target CRS</source>
         <translation>Ziel-KBS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>GCP-Pixel auf aufrechten Fotos gemessen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="113"/>
+        <location filename="../processing_provider/georeference.py" line="130"/>
         <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS)</source>
         <translation>Passpunkte (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) angeben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Reference orthophoto</source>
         <translation>Referenz-Orthophoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Reference DSM</source>
         <translation>Referenz-DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Reference resolution for web layers (m, 0: auto)</source>
         <translation>Referenzauflösung für Weblayer (m, 0: auto)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Area to fetch from web layers</source>
         <translation>Aus Weblayern abzurufender Bereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="92"/>
+        <location filename="../processing_provider/georeference.py" line="99"/>
         <source>Automatic GCPs kept</source>
         <translation>Behaltene automatische Passpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="146"/>
+        <location filename="../processing_provider/georeference.py" line="164"/>
         <source>Automatic control needs both a reference orthophoto and a reference DSM (REFERENCE_ORTHO, REFERENCE_DSM); {} is missing</source>
         <translation>Automatische Passpunkte brauchen ein Referenz-Orthophoto und ein Referenz-DOM (REFERENCE_ORTHO, REFERENCE_DSM); {} fehlt</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="159"/>
+        <location filename="../processing_provider/georeference.py" line="177"/>
         <source>Target CRS {} is not used: automatic control georeferences in the reference orthophoto&apos;s CRS {}</source>
         <translation>Ziel-KBS {} wird nicht verwendet: automatische Passpunkte georeferenzieren im KBS {} des Referenz-Orthophotos</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="180"/>
+        <location filename="../processing_provider/georeference.py" line="198"/>
         <source>Automatic control: {} automatic GCPs kept; CRS {}; check RMSE XY {} m, Z {} m</source>
         <translation>Automatische Passpunkte: {} automatische Passpunkte behalten; KBS {}; Kontroll-RMSE XY {} m, Z {} m</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="124"/>
+        <source>Reference DSM {} given alone (DEM control) must be a raster file on disk; a web layer is fetched only for the automatic control, with a reference orthophoto</source>
+        <translation>Allein angegebenes Referenz-DOM {} (DGM-Passpunkte) muss eine Rasterdatei auf dem Datenträger sein; ein Weblayer wird nur für die automatischen Passpunkte abgerufen, mit einem Referenz-Orthophoto</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1901,18 +1921,20 @@ GCP pixels measured on upright photos: tick when the pixel coordinates were meas
 Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.
 
 Given a reference orthophoto and a reference DSM (any raster layer: a file, or a WMS, XYZ or WCS layer, which is saved for the block&apos;s extent to georef/reference-ortho.tif and georef/reference-dsm.tif), the block is georeferenced with no hand-picked GCP, as &apos;Automatic control from a reference orthophoto&apos; does; the result is in the reference orthophoto&apos;s CRS (a Web Mercator or geographic layer is saved in the DSM&apos;s CRS, else in the UTM zone). Ground control given as well is not used to fix the block: all its points become check points, an independent measure of the automatic control. Camera positions or Use EXIF GPS positions give the rough position (else EXIF GPS when three photos carry it, else rotation and scale are searched). The calibration is refined in any case (focal length and distortion: the automatic GCPs determine them).
+A reference DSM given alone (a DEM file in any projected CRS, heights in metres or feet) adds DEM control: after the adjustment the block&apos;s sparse points are co-registered on it (shift, tilt, dome) and the block is adjusted again with DEM-derived control points (dem001, ...), which remove tilt, height offset and doming the photos cannot see; the co-registration is logged and saved to georef/dem_control.json. Heights: the control points&apos; when there are any, else the DEM&apos;s (camera positions&apos; heights are moved onto it). Without GCPs or camera positions the photos&apos; EXIF GPS place the block. A DEM off the block or too coarse for it is refused before the adjustment.
 Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos&apos; EXIF GPS positions plus a margin, else the other reference&apos;s extent.
 Outputs: besides the usual ones, the number of automatic GCPs the adjustment kept (none without automatic control).</source>
         <translation>Legt den ausgerichteten Block mit Passpunkten (GCPs) und/oder Kamerapositionen in einem echten Koordinatenbezugssystem fest. Sie wirken in der Bündelblockausgleichung, so dass sie auch Drift und Verbiegung des Blocks beseitigen, was eine 7-Parameter-Transformation (Helmert) nicht kann. Kontrollpunkte nehmen an der Ausgleichung nicht teil: sie werden danach trianguliert und mit ihren vermessenen Koordinaten verglichen.
 
-Passpunktdatei: eine OpenDroneMap gcp_list.txt (KBS-Zeile, dann &apos;x y z px py image [name]&apos;) oder eine CSV-Punktdatei mit passender &apos;&lt;name&gt;_observations.csv&apos;. Passpunktlayer: alternativ ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, sx, sy, sz, role).
+Passpunktdatei: eine OpenDroneMap gcp_list.txt (KBS-Zeile, dann 'x y z px py image [name]') oder eine CSV-Punktdatei mit passender '&lt;name&gt;_observations.csv'. Passpunktlayer: alternativ ein Punktlayer mit einem Objekt je Messung und den Feldern name, image, px, py (optional z, sx, sy, sz, role).
 Kontrollpunkte: durch Kommas getrennte Namen, die zu Kontrollpunkten werden.
-Kamerapositionen: CSV &apos;image,x,y,z[,sigma]&apos; (optionale KBS-Zeile). EXIF-GPS-Positionen verwenden: das GPS der Fotos verwenden.
+Kamerapositionen: CSV 'image,x,y,z[,sigma]' (optionale KBS-Zeile). EXIF-GPS-Positionen verwenden: das GPS der Fotos verwenden.
 Ziel-KBS: Vorgabe ist das KBS der Passpunktdatei. Kamerakalibrierung verfeinern: die Ausgleichung verfeinert Brennweite, Bildhauptpunkt und Verzeichnung.
 GCP-Pixel auf aufrechten Fotos gemessen: ankreuzen, wenn die Pixelkoordinaten auf den Fotos gemessen wurden, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden (wie in Webbrowsern und Bildbetrachtern); sie werden in das gespeicherte Pixelraster jedes Fotos umgerechnet (ungedreht gespeicherte Fotos bleiben unverändert).
 Ausreißer (eine falsche Messung, ein Tippfehler in einer Koordinate) werden erkannt, im Protokoll genannt und ausgelassen.
 
-Mit einem Referenz-Orthophoto und einem Referenz-DOM (ein beliebiger Rasterlayer: eine Datei oder ein WMS-, XYZ- oder WCS-Layer, der für die Ausdehnung des Blocks nach georef/reference-ortho.tif und georef/reference-dsm.tif gespeichert wird) wird der Block ohne von Hand gesetzte Passpunkte georeferenziert, wie es &apos;Automatische Passpunkte aus einem Referenz-Orthophoto&apos; tut; das Ergebnis ist im KBS des Referenz-Orthophotos (ein Web-Mercator- oder geographischer Layer wird im KBS des DOM gespeichert, sonst in der UTM-Zone). Zusätzlich angegebene Passpunkte legen den Block nicht fest: alle ihre Punkte werden Kontrollpunkte, ein unabhängiges Maß der automatischen Passpunkte. Kamerapositionen oder EXIF-GPS-Positionen verwenden geben die ungefähre Lage (sonst EXIF-GPS, wenn drei Fotos es tragen, sonst werden Drehung und Maßstab gesucht). Die Kalibrierung wird in jedem Fall verfeinert (Brennweite und Verzeichnung: die automatischen Passpunkte bestimmen sie).
+Mit einem Referenz-Orthophoto und einem Referenz-DOM (ein beliebiger Rasterlayer: eine Datei oder ein WMS-, XYZ- oder WCS-Layer, der für die Ausdehnung des Blocks nach georef/reference-ortho.tif und georef/reference-dsm.tif gespeichert wird) wird der Block ohne von Hand gesetzte Passpunkte georeferenziert, wie es 'Automatische Passpunkte aus einem Referenz-Orthophoto' tut; das Ergebnis ist im KBS des Referenz-Orthophotos (ein Web-Mercator- oder geographischer Layer wird im KBS des DOM gespeichert, sonst in der UTM-Zone). Zusätzlich angegebene Passpunkte legen den Block nicht fest: alle ihre Punkte werden Kontrollpunkte, ein unabhängiges Maß der automatischen Passpunkte. Kamerapositionen oder EXIF-GPS-Positionen verwenden geben die ungefähre Lage (sonst EXIF-GPS, wenn drei Fotos es tragen, sonst werden Drehung und Maßstab gesucht). Die Kalibrierung wird in jedem Fall verfeinert (Brennweite und Verzeichnung: die automatischen Passpunkte bestimmen sie).
+Ein allein angegebenes Referenz-DOM (eine DGM-Datei in einem beliebigen projizierten KBS, Höhen in Metern oder Fuß) fügt DGM-Passpunkte hinzu: nach der Ausgleichung werden die Punkte des dünnen Modells des Blocks darauf koregistriert (Verschiebung, Kippung, Wölbung), und der Block wird mit aus dem DGM abgeleiteten Passpunkten (dem001, ...) erneut ausgeglichen, die Kippung, Höhenversatz und Wölbung beseitigen, die die Fotos nicht sehen können; die Koregistrierung wird protokolliert und in georef/dem_control.json gespeichert. Höhen: die der Passpunkte, wenn es welche gibt, sonst die des DGM (die Höhen der Kamerapositionen werden darauf verschoben). Ohne Passpunkte oder Kamerapositionen platziert das EXIF-GPS der Fotos den Block. Ein DGM, das neben dem Block liegt oder für ihn zu grob ist, wird vor der Ausgleichung abgelehnt.
 Referenzauflösung: Meter je Pixel, mit denen ein Weblayer gespeichert wird (0: 0,25 m; das DOM mit der doppelten, mindestens 0,5 m). Abzurufender Bereich: die Ausdehnung, für die ein Weblayer gespeichert wird; leer: die EXIF-GPS-Positionen der Fotos mit einem Rand, sonst die Ausdehnung der anderen Referenz.
 Ausgaben: neben den üblichen die Zahl der automatischen Passpunkte, die die Ausgleichung behalten hat (keine ohne automatische Passpunkte).</translation>
     </message>
@@ -2058,7 +2080,7 @@ Passpunktdatei: eine OpenDroneMap gcp_list.txt oder CSV-Punktdatei mit Messungen
 Bekannte Orientierung: statt Passpunkten eine Datei mit x y z omega phi kappa (Grad, photogrammetrische Konvention; eine Kopfzeile wie von Pix4D geschrieben, oder JSON), optional focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 und eine KBS-Zeile.
 Referenz-Orthophoto (automatische Passpunkte): ohne Passpunkte und ohne bekannte Orientierung wird das Foto diesem Orthophoto zugeordnet (beliebiges KBS, beliebige Auflösung; das DOM ist dann das Referenz-DOM), und die Zuordnungen werden automatische Passpunkte (auto_001, ...) für den räumlichen Rückwärtsschnitt: kein von Hand gesetzter Punkt, die Blickrichtung muss nicht bekannt sein, auch Schrägaufnahmen gehen, und die Brennweite wird geschätzt, wenn das Foto keine hat. Ungefährer Ort: ein Punkt am Boden, den das Foto zeigt (beliebiges KBS; leer = irgendwo auf der Referenz); Suchradius: wie weit er danebenliegen darf (Meter). Das Protokoll nennt, wie viele Zuordnungen jeden Schritt überstanden haben; die Passpunkt-Residuen führen die automatischen Passpunkte auf.
 Brennweite und Sensorbreite: innere Orientierung in mm (die lange Seite des Sensors); 0 oder leer = die EXIF-Brennweite.
-Modus: ein wahres Orthophoto auf dem DOM oder eine ebene (projektive) Entzerrung über die Passpunkte zum Vergleich auf flachem Gelände; mit DOM sagen das Protokoll und die Ausgabe &apos;Ebene Entzerrung: 95. Perzentil ihres Versatzes&apos;, wie weit das ebene Ergebnis wegen des Reliefs abweicht.
+Modus: ein wahres Orthophoto auf dem DOM oder eine ebene (projektive) Entzerrung über die Passpunkte zum Vergleich auf flachem Gelände; mit DOM sagen das Protokoll und die Ausgabe 'Ebene Entzerrung: 95. Perzentil ihres Versatzes', wie weit das ebene Ergebnis wegen des Reliefs abweicht.
 Auflösung: Zellgröße in KBS-Einheiten (0 = die Bodenauflösung).
 Ausgabe-KBS: Vorgabe ist das KBS der Passpunkte oder der bekannten Orientierung.
 Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und Metern in der Ebene).</translation>
@@ -2200,17 +2222,17 @@ Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und 
         <translation>Prüfprotokoll (JSON)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="155"/>
+        <location filename="../processing_provider/prepare_images.py" line="154"/>
         <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
         <translation>{} Bilder: {} markiert, {} ausgeschlossen, {} im vorbereiteten Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="157"/>
+        <location filename="../processing_provider/prepare_images.py" line="156"/>
         <source>Blurriest first (blur score, % of the set&apos;s median):</source>
         <translation>Unschärfste zuerst (Schärfewert, % des Medians des Satzes):</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="165"/>
+        <location filename="../processing_provider/prepare_images.py" line="164"/>
         <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
         <translation>Vorbereitete Scans: {} x {} px, Pixelgröße {:.6g} {}{}</translation>
     </message>
@@ -2225,17 +2247,17 @@ Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und 
         <translation>MASKS-Layer '{}'</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="185"/>
+        <location filename="../processing_provider/prepare_images.py" line="184"/>
         <source>feature {}</source>
         <translation>Objekt {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="189"/>
+        <location filename="../processing_provider/prepare_images.py" line="188"/>
         <source>MASKS layer &apos;{}&apos;: {} has no geometry: skipped</source>
         <translation>MASKS-Layer '{}': {} hat keine Geometrie: übersprungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="192"/>
+        <location filename="../processing_provider/prepare_images.py" line="191"/>
         <source>MASKS layer &apos;{}&apos;: {} is a {} geometry, not a polygon</source>
         <translation>MASKS-Layer '{}': {} ist eine {}-Geometrie, kein Polygon</translation>
     </message>
@@ -2338,7 +2360,7 @@ Vorbereitete Bilder: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetz
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="79"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="76"/>
         <source>Give a workspace folder, or an elevation raster and where to write the visualisation</source>
         <translation>Geben Sie einen Arbeitsbereich-Ordner an, oder ein Höhenraster und wohin die Visualisierung geschrieben wird</translation>
     </message>
@@ -2403,42 +2425,42 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>nicht trianguliert</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="701"/>
+        <location filename="../ui/layers.py" line="705"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="660"/>
+        <location filename="../ui/layers.py" line="664"/>
         <source>DSM hillshade</source>
         <translation>DOM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="702"/>
+        <location filename="../ui/layers.py" line="706"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="703"/>
+        <location filename="../ui/layers.py" line="707"/>
         <source>Cameras</source>
         <translation>Kameras</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="671"/>
+        <location filename="../ui/layers.py" line="675"/>
         <source>Camera footprints</source>
         <translation>Bildfußabdrücke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="678"/>
+        <location filename="../ui/layers.py" line="682"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Passpunkt-Residuen (Vektoren x{})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="704"/>
+        <location filename="../ui/layers.py" line="708"/>
         <source>Point cloud</source>
         <translation>Punktwolke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="712"/>
+        <location filename="../ui/layers.py" line="716"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
@@ -2448,17 +2470,17 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>{} ({})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="705"/>
+        <location filename="../ui/layers.py" line="709"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="685"/>
+        <location filename="../ui/layers.py" line="689"/>
         <source>DTM hillshade</source>
         <translation>DGM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="706"/>
+        <location filename="../ui/layers.py" line="710"/>
         <source>Contours</source>
         <translation>Höhenlinien</translation>
     </message>
@@ -2466,52 +2488,52 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Write the accuracy report</source>
         <translation>Genauigkeitsbericht schreiben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="100"/>
+        <location filename="../processing_provider/run_pipeline.py" line="106"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="101"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="102"/>
+        <location filename="../processing_provider/run_pipeline.py" line="108"/>
         <source>Accuracy report (HTML)</source>
         <translation>Genauigkeitsbericht (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="154"/>
+        <location filename="../processing_provider/run_pipeline.py" line="162"/>
         <source>Seconds per stage: {}</source>
         <translation>Sekunden pro Stufe: {}</translation>
     </message>
@@ -2521,102 +2543,102 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>Gesamte Verarbeitung ausführen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Ground control layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Check points</source>
         <translation>Kontrollpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Use EXIF GPS positions</source>
         <translation>EXIF-GPS-Positionen verwenden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Target CRS</source>
         <translation>Ziel-KBS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Matching image size (px)</source>
         <translation>Bildgröße für die Zuordnung (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>DSM resolution (m)</source>
         <translation>DOM-Auflösung (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Matching quality</source>
         <translation>Zuordnungsqualität</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Orthomosaic resolution</source>
         <translation>Auflösung des Orthomosaiks</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Seam blending</source>
         <translation>Überblendung der Nähte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Parallel workers</source>
         <translation>Parallele Prozesse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Dask scheduler</source>
         <translation>Dask-Scheduler</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Build the DTM</source>
         <translation>Das DGM erzeugen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Contour interval (m, 0 = none)</source>
         <translation>Höhenlinienabstand (m, 0 = keine)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Relief visualisations</source>
         <translation>Reliefvisualisierungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="105"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>GCP-Pixel auf aufrechten Fotos gemessen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="120"/>
+        <location filename="../processing_provider/run_pipeline.py" line="126"/>
         <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Geben Sie Passpunkte (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Sky masks (oblique photos)</source>
         <translation>Himmelsmasken (Schrägaufnahmen)</translation>
     </message>
@@ -2635,17 +2657,19 @@ Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key f
 
 Bilderordner: die Fotos. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben werden.
 Die Georeferenzierung braucht Passpunkte (eine Passpunktdatei oder ein Passpunktlayer, Kontrollpunkte werden zurückgehalten) und/oder Kamerapositionen (eine CSV-Datei der Kamerapositionen oder EXIF-GPS-Positionen verwenden): ohne sie wird die Verarbeitung abgelehnt, da ein DOM einen metrischen Maßstab und eine Lotrichtung braucht. GCP-Pixel auf aufrechten Fotos gemessen: wie bei 'Georeferenzieren' (die Pixelkoordinaten auf den Fotos gemessen, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden).
-Kamerakalibrierungsdatei und Innere Orientierung (erweitert): wie in &apos;Bilder ausrichten&apos; (eine kalibrierte Kamera durch die ganze Kette festgehalten oder mit ihren Standardabweichungen verbessert).
+Kamerakalibrierungsdatei und Innere Orientierung (erweitert): wie in 'Bilder ausrichten' (eine kalibrierte Kamera durch die ganze Kette festgehalten oder mit ihren Standardabweichungen verbessert).
 Himmelsmasken (Schrägaufnahmen): zuerst findet eine Stufe 'Bilder vorbereiten' den Himmel und den Dunst am Horizont in jedem Foto und maskiert sie, damit kein Verknüpfungs- oder DOM-Punkt aus dem Himmel stammt; die vorbereiteten Fotos werden ausgerichtet (standardmäßig aus: senkrecht aufgenommene Fotos brauchen keine).
 Das DGM erzeugen: nach dem DOM ein DGM der nackten Erde (wie 'DGM erzeugen'). Höhenlinienabstand (erweitert): Höhenlinien des DGM in diesem Abstand (wie 'Höhenlinien'; 0 = keine). Reliefvisualisierungen (erweitert): die gewählten werden aus dem DGM berechnet (wie 'Reliefvisualisierung'). Beide brauchen das DGM.
 Die übrigen Parameter sind die der einzelnen Stufen (siehe deren Hilfe); 0 bedeutet automatisch.
 Ausgaben: das DOM, das Orthomosaik und der Genauigkeitsbericht (HTML) sowie die wichtigsten Kennzahlen.</translation>
     </message>
     <message>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Camera calibration file</source>
         <translation>Kamerakalibrierungsdatei</translation>
     </message>
     <message>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Interior orientation</source>
         <translation>Innere Orientierung</translation>
     </message>

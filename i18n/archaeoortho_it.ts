@@ -74,12 +74,12 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
 <context>
     <name>AlgorithmBase</name>
     <message>
-        <location filename="../processing_provider/base.py" line="226"/>
+        <location filename="../processing_provider/base.py" line="235"/>
         <source>Cancelled: {}</source>
         <translation>Annullato: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/base.py" line="135"/>
+        <location filename="../processing_provider/base.py" line="144"/>
         <source>Outputs not styled: {}</source>
         <translation>Output senza stile: {}</translation>
     </message>
@@ -92,57 +92,57 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
 <context>
     <name>AlignImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>One camera for all images</source>
         <translation>Una sola camera per tutte le immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="65"/>
+        <location filename="../processing_provider/align_images.py" line="81"/>
         <source>Camera centres</source>
         <translation>Centri di presa</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="82"/>
         <source>Registered images</source>
         <translation>Immagini orientate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="67"/>
+        <location filename="../processing_provider/align_images.py" line="83"/>
         <source>Mean reprojection error (px)</source>
         <translation>Errore medio di riproiezione (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="92"/>
+        <location filename="../processing_provider/align_images.py" line="110"/>
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
         <translation>Orientate {} di {} immagini, errore medio di riproiezione {:.3f} px, {} punti</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="99"/>
+        <location filename="../processing_provider/align_images.py" line="117"/>
         <source>Images not registered:</source>
         <translation>Immagini non orientate:</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="102"/>
+        <location filename="../processing_provider/align_images.py" line="124"/>
         <source>Seconds per step: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -152,47 +152,47 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
         <translation>Allinea immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Mapper</source>
         <translation>Metodo di ricostruzione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Matching image size (px)</source>
         <translation>Dimensione per la corrispondenza (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Features per image</source>
         <translation>Feature per immagine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Affine-invariant features</source>
         <translation>Feature invarianti affini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Focal length (mm)</source>
         <translation>Focale (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Sensor width (mm)</source>
         <translation>Larghezza del sensore (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="50"/>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Retry images left out</source>
         <translation>Riprova le immagini escluse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="95"/>
+        <location filename="../processing_provider/align_images.py" line="113"/>
         <source>Retry {} ({} features): {} image(s) left out; main block {} -&gt; {} images{}</source>
         <translation>Nuovo tentativo {} (caratteristiche {}): {} immagine/i escluse; blocco principale {} -&gt; {} immagini{}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="95"/>
+        <location filename="../processing_provider/align_images.py" line="113"/>
         <source> (not better: the previous result kept)</source>
         <translation> (non migliore: resta il risultato precedente)</translation>
     </message>
@@ -208,26 +208,29 @@ Camera calibration file: a calibrated camera&apos;s interior orientation (Archae
 Interior orientation: what the adjustments may change of a camera: &apos;fixed&apos; keeps the given values through the alignment and the georeference (also with automatic control), &apos;refined&apos; lets the georeference refine them with the calibration&apos;s standard deviations as priors, &apos;estimated&apos; self-calibrates from them. &apos;auto&apos; is &apos;fixed&apos; where a calibration is given (the file, or film scans restituted by Prepare images) and &apos;estimated&apos; elsewhere; a camera&apos;s own &apos;adjust&apos; in the file overrides it. With &apos;fixed&apos; or &apos;refined&apos; and no file, the focal length and sensor width are the given values. The log, sfm/alignment.json and the accuracy report say per camera what was held.
 Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).
 Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
-        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell&apos;obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella dell&apos;area di lavoro, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
+        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell'obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella dell'area di lavoro, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
 
-Selezione delle coppie: &apos;auto&apos; usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
-Modello di camera: &apos;AUTO&apos; stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
+Selezione delle coppie: 'auto' usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
+Modello di camera: 'AUTO' stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
 Dimensione per la corrispondenza: il lato maggiore a cui le immagini sono ridotte per le feature (0 = automatico: foto fino a 2 megapixel così come sono, quelle più grandi ridotte a 2 megapixel; il DSM e le ortofoto usano ogni pixel). Feature per immagine: 0 = automatico (circa 4000 per megapixel, da 2048 a 4096). Le feature invarianti affini aiutano con le prese oblique e sono più lente.
-Focale e Larghezza del sensore: orientamento interno quando manca l&apos;EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri (0 = dall&apos;EXIF / sconosciuta).
-File di calibrazione della camera: l&apos;orientamento interno di una camera calibrata (YAML/JSON di ArchaeoOrtho, parametri interni di Orthority, OpenCV, COLMAP cameras.txt o XML di Metashape); più camere sono assegnate alle foto secondo i loro modelli di nome, il modello della camera o la dimensione dell&apos;immagine; una foto di altra risoluzione la riceve scalata. Un file che non si può leggere ferma l&apos;elaborazione prima di ogni lavoro, indicando file, riga e campo.
-Orientamento interno: cosa le compensazioni possono cambiare di una camera: &apos;fixed&apos; mantiene i valori dati attraverso l&apos;allineamento e la georeferenziazione (anche con il controllo automatico), &apos;refined&apos; lascia che la georeferenziazione li affini con le deviazioni standard della calibrazione come informazione a priori, &apos;estimated&apos; si autocalibra a partire da essi. &apos;auto&apos; è &apos;fixed&apos; dove è data una calibrazione (il file, o scansioni di pellicola raddrizzate da &apos;Prepara immagini&apos;) e &apos;estimated&apos; altrove; un &apos;adjust&apos; proprio di una camera nel file ha la precedenza. Con &apos;fixed&apos; o &apos;refined&apos; e senza file, la lunghezza focale e la larghezza del sensore sono i valori dati. Il registro, sfm/alignment.json e il rapporto di accuratezza dicono per ogni camera cosa è stato mantenuto.
-Metodo di ricostruzione (avanzato): &apos;incremental&apos; (COLMAP, predefinito) o &apos;global&apos; (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).
+Focale e Larghezza del sensore: orientamento interno quando manca l'EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri (0 = dall'EXIF / sconosciuta).
+File di calibrazione della camera: l'orientamento interno di una camera calibrata (YAML/JSON di ArchaeoOrtho, parametri interni di Orthority, OpenCV, COLMAP cameras.txt o XML di Metashape); più camere sono assegnate alle foto secondo i loro modelli di nome, il modello della camera o la dimensione dell'immagine; una foto di altra risoluzione la riceve scalata. Un file che non si può leggere ferma l'elaborazione prima di ogni lavoro, indicando file, riga e campo.
+Orientamento interno: cosa le compensazioni possono cambiare di una camera: 'fixed' mantiene i valori dati attraverso l'allineamento e la georeferenziazione (anche con il controllo automatico), 'refined' lascia che la georeferenziazione li affini con le deviazioni standard della calibrazione come informazione a priori, 'estimated' si autocalibra a partire da essi. 'auto' è 'fixed' dove è data una calibrazione (il file, o scansioni di pellicola raddrizzate da 'Prepara immagini') e 'estimated' altrove; un 'adjust' proprio di una camera nel file ha la precedenza. Con 'fixed' o 'refined' e senza file, la lunghezza focale e la larghezza del sensore sono i valori dati. Il registro, sfm/alignment.json e il rapporto di accuratezza dicono per ogni camera cosa è stato mantenuto.
+Metodo di ricostruzione (avanzato): 'incremental' (COLMAP, predefinito) o 'global' (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).
 Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni rapide escludono, o un blocco diviso in parti, vengono riprovate con caratteristiche più ricche (più deboli per fotogrammi a basso contrasto, affini per oblique ripide) e più coppie; il registro e sfm/alignment.json dicono cosa è stato riprovato e perché.</translation>
     </message>
     <message>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Camera calibration file</source>
         <translation>File di calibrazione della camera</translation>
     </message>
     <message>
+        <location filename="../processing_provider/align_images.py" line="64"/>
         <source>Interior orientation</source>
         <translation>Orientamento interno</translation>
     </message>
     <message>
+        <location filename="../processing_provider/align_images.py" line="122"/>
         <source>Camera {}: interior orientation {} ({})</source>
         <translation>Camera {}: orientamento interno {} ({})</translation>
     </message>
@@ -261,62 +264,62 @@ Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni 
 <context>
     <name>AutoControlAlgorithm</name>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>Aligned workspace</source>
         <translation>Area di lavoro allineata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>Reference orthophoto</source>
         <translation>Ortofoto di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>Reference DSM</source>
         <translation>DSM di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>Rough position</source>
         <translation>Posizione approssimativa</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>auto</source>
         <translation>automatica</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>EXIF GPS</source>
         <translation>GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>none</source>
         <translation>nessuna</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="66"/>
+        <location filename="../processing_provider/auto_control.py" line="74"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="67"/>
+        <location filename="../processing_provider/auto_control.py" line="75"/>
         <source>Camera centres (world)</source>
         <translation>Centri di presa (mondo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="68"/>
+        <location filename="../processing_provider/auto_control.py" line="76"/>
         <source>Automatic GCPs kept</source>
         <translation>GCP automatici mantenuti</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="69"/>
+        <location filename="../processing_provider/auto_control.py" line="77"/>
         <source>Matches found</source>
         <translation>Corrispondenze trovate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="93"/>
+        <location filename="../processing_provider/auto_control.py" line="131"/>
         <source>outlier left out: {}</source>
         <translation>valore anomalo escluso: {}</translation>
     </message>
@@ -326,32 +329,44 @@ Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni 
         <translation>Punti di controllo automatici da un'ortofoto di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>Reference resolution for web layers (m, 0: auto)</source>
         <translation>Risoluzione di riferimento per layer web (m, 0: auto)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="54"/>
+        <location filename="../processing_provider/auto_control.py" line="62"/>
         <source>Area to fetch from web layers</source>
         <translation>Area da scaricare dai layer web</translation>
     </message>
     <message>
+        <location filename="../processing_provider/auto_control.py" line="119"/>
+        <source>Reference DSM {} given without a reference orthophoto (DEM control) must be a raster file on disk; a web layer is fetched only with a reference orthophoto</source>
+        <translation>Il DSM di riferimento {} fornito senza ortofoto di riferimento (controllo DEM) deve essere un file raster su disco; un layer web viene scaricato solo con un'ortofoto di riferimento</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/auto_control.py" line="123"/>
+        <source>A reference DSM alone (DEM control) places the block by the photos&apos; EXIF GPS: choose Rough position auto or EXIF GPS, or give a reference orthophoto as well</source>
+        <translation>Un DSM di riferimento da solo (controllo DEM) posiziona il blocco con il GPS EXIF delle foto: scegli Posizione approssimativa automatica o GPS EXIF, oppure fornisci anche un'ortofoto di riferimento</translation>
+    </message>
+    <message>
         <location filename="../ui/catalog.py" line="7"/>
-        <source>Georeferences an aligned block with no hand-picked ground control: a provisional orthophoto of the block is matched to a reference orthophoto (a national orthophoto, an earlier block&apos;s orthomosaic) at a common resolution, each match is found again in the photos and takes its height from the reference DSM, and these automatic GCPs enter the usual GCP-constrained adjustment, which leaves out the outliers. Changes between the two dates (crops, cars, new buildings, another sun) are tolerated: what stays is used, and the log says how many matches survived each step.
+        <source>Georeferences an aligned block with no hand-picked ground control: a provisional orthophoto of the block is matched to a reference orthophoto (a national orthophoto, an earlier block's orthomosaic) at a common resolution, each match is found again in the photos and takes its height from the reference DSM, and these automatic GCPs enter the usual GCP-constrained adjustment, which leaves out the outliers. Changes between the two dates (crops, cars, new buildings, another sun) are tolerated: what stays is used, and the log says how many matches survived each step.
 
 Aligned workspace: the block to georeference (its photos must still be where the alignment found them).
-Reference orthophoto: any north-up raster, grey or colour, in any CRS (a national one without an EPSG code too); the result is in its CRS (a geographic or Web Mercator file: in the UTM zone of its centre). A layer that is no local file (WMS, XYZ, WCS, a virtual raster) is saved for the block&apos;s extent to georef/reference-ortho.tif (a Web Mercator or geographic one in the DSM&apos;s CRS, else the UTM zone&apos;s).
-Reference DSM: a DSM or DTM covering the block, in any CRS and resolution (a 10-30 m DEM too: each height weighs by the DEM&apos;s slope and roughness there), heights in metres or in the unit the raster declares (a WCS layer is saved to georef/reference-dsm.tif).
-Rough position: the photos&apos; EXIF GPS when at least two carry it (auto), always (EXIF GPS), or never (none: rotation and scale are searched over the whole reference, which then should not be much larger than the block).
-Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos&apos; EXIF GPS positions plus a margin, else the other reference&apos;s extent.
+Reference orthophoto: any north-up raster, grey or colour, in any CRS (a national one without an EPSG code too); the result is in its CRS (a geographic or Web Mercator file: in the UTM zone of its centre). A layer that is no local file (WMS, XYZ, WCS, a virtual raster) is saved for the block's extent to georef/reference-ortho.tif (a Web Mercator or geographic one in the DSM's CRS, else the UTM zone's).
+Reference DSM: a DSM or DTM covering the block, in any CRS and resolution (a 10-30 m DEM too: each height weighs by the DEM's slope and roughness there), heights in metres or in the unit the raster declares (a WCS layer is saved to georef/reference-dsm.tif).
+A reference DSM alone (no orthophoto, a raster file on disk) is enough: the block is placed by the photos' EXIF GPS, then co-registered to the DSM (shift, tilt, dome: Nuth &amp; Kääb on the sparse points), and DEM-derived control points enter the adjustment (georef/dem_control.json; the same as Georeference with a reference DSM alone).
+Rough position: the photos' EXIF GPS when at least two carry it (auto), always (EXIF GPS), or never (none: rotation and scale are searched over the whole reference, which then should not be much larger than the block).
+Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos' EXIF GPS positions plus a margin, else the other reference's extent.
 Outputs: the camera centres in the reference CRS, the number of automatic GCPs the adjustment kept, the matches found; georef/autocontrol.json lists every candidate with why it was kept or dropped.</source>
-        <translation>Georeferenzia un blocco allineato senza punti di controllo scelti a mano: un&apos;ortofoto provvisoria del blocco viene abbinata a un&apos;ortofoto di riferimento (un&apos;ortofoto nazionale, l&apos;ortomosaico di un blocco precedente) a una risoluzione comune, ogni corrispondenza viene ritrovata nelle foto e prende la quota dal DSM di riferimento, e questi GCP automatici entrano nella consueta compensazione vincolata ai GCP, che esclude i valori anomali. I cambiamenti tra le due date (colture, auto, nuovi edifici, un altro sole) sono tollerati: si usa ciò che resta, e il registro dice quante corrispondenze hanno superato ogni passo.
+        <translation>Georeferenzia un blocco allineato senza punti di controllo scelti a mano: un'ortofoto provvisoria del blocco viene abbinata a un'ortofoto di riferimento (un'ortofoto nazionale, l'ortomosaico di un blocco precedente) a una risoluzione comune, ogni corrispondenza viene ritrovata nelle foto e prende la quota dal DSM di riferimento, e questi GCP automatici entrano nella consueta compensazione vincolata ai GCP, che esclude i valori anomali. I cambiamenti tra le due date (colture, auto, nuovi edifici, un altro sole) sono tollerati: si usa ciò che resta, e il registro dice quante corrispondenze hanno superato ogni passo.
 
-Area di lavoro allineata: il blocco da georeferenziare (le sue foto devono trovarsi ancora dove l&apos;allineamento le ha trovate).
-Ortofoto di riferimento: un raster qualsiasi orientato a nord, in scala di grigi o a colori, in un SR qualsiasi (anche uno nazionale senza codice EPSG); il risultato è nel suo SR (un file geografico o Web Mercator: in quello della zona UTM del suo centro). Un layer che non è un file locale (WMS, XYZ, WCS, un raster virtuale) viene salvato per l&apos;estensione del blocco in georef/reference-ortho.tif (uno Web Mercator o geografico nel SR del DSM, altrimenti in quello della zona UTM).
-DSM di riferimento: un DSM o DTM che copre il blocco, in un SR e a una risoluzione qualsiasi (anche un DEM da 10-30 m: ogni quota pesa secondo la pendenza e la rugosità del DEM in quel punto), quote in metri o nell&apos;unità che il raster dichiara (un layer WCS viene salvato in georef/reference-dsm.tif).
+Area di lavoro allineata: il blocco da georeferenziare (le sue foto devono trovarsi ancora dove l'allineamento le ha trovate).
+Ortofoto di riferimento: un raster qualsiasi orientato a nord, in scala di grigi o a colori, in un SR qualsiasi (anche uno nazionale senza codice EPSG); il risultato è nel suo SR (un file geografico o Web Mercator: in quello della zona UTM del suo centro). Un layer che non è un file locale (WMS, XYZ, WCS, un raster virtuale) viene salvato per l'estensione del blocco in georef/reference-ortho.tif (uno Web Mercator o geografico nel SR del DSM, altrimenti in quello della zona UTM).
+DSM di riferimento: un DSM o DTM che copre il blocco, in un SR e a una risoluzione qualsiasi (anche un DEM da 10-30 m: ogni quota pesa secondo la pendenza e la rugosità del DEM in quel punto), quote in metri o nell'unità che il raster dichiara (un layer WCS viene salvato in georef/reference-dsm.tif).
+Un DSM di riferimento da solo (senza ortofoto, un file raster su disco) è sufficiente: il blocco viene posizionato con il GPS EXIF delle foto, poi co-registrato sul DSM (traslazione, inclinazione, cupola: Nuth &amp; Kääb sui punti sparsi), e punti d'appoggio derivati dal DEM entrano nella compensazione (georef/dem_control.json; lo stesso di Georeferenzia con un DSM di riferimento da solo).
 Posizione approssimativa: il GPS EXIF delle foto quando almeno due lo hanno (automatica), sempre (GPS EXIF) o mai (nessuna: rotazione e scala vengono cercate su tutto il riferimento, che allora non dovrebbe essere molto più grande del blocco).
-Risoluzione di riferimento: metri per pixel con cui si salva un layer web (0: 0,25 m; il DSM al doppio, almeno 0,5 m). Area da scaricare: l&apos;estensione per cui si salva un layer web; vuota: le posizioni GPS EXIF delle foto più un margine, altrimenti l&apos;estensione dell&apos;altro riferimento.
+Risoluzione di riferimento: metri per pixel con cui si salva un layer web (0: 0,25 m; il DSM al doppio, almeno 0,5 m). Area da scaricare: l'estensione per cui si salva un layer web; vuota: le posizioni GPS EXIF delle foto più un margine, altrimenti l'estensione dell'altro riferimento.
 Output: i centri di presa nel SR del riferimento, il numero di GCP automatici mantenuti dalla compensazione, le corrispondenze trovate; georef/autocontrol.json elenca ogni candidato con il motivo per cui è stato mantenuto o scartato.</translation>
     </message>
 </context>
@@ -510,7 +525,7 @@ Una nuova esecuzione dopo un annullamento riprende: le coppie già elaborate son
         <translation>Frazione delle celle del DTM interpolate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dtm.py" line="100"/>
+        <location filename="../processing_provider/build_dtm.py" line="97"/>
         <source>Give a workspace folder, or a DSM file and where to write the DTM</source>
         <translation>Indica una cartella dell'area di lavoro, oppure un file DSM e dove scrivere il DTM</translation>
     </message>
@@ -786,10 +801,10 @@ Curve di livello: il GeoPackage da scrivere.</translation>
 Earlier DSM: the DSM the difference is measured from (its grid is the output&apos;s).
 Later DSM: the DSM of the other epoch (e.g. a block registered to the earlier one with Automatic control).
 Difference: where to write the float32 Cloud-Optimized GeoTIFF of later minus earlier (metres).</source>
-        <translation>Il DSM successivo meno quello precedente, sulla griglia del precedente, mostra cosa è cambiato tra due epoche di un sito (il DSM successivo vi viene ricampionato con GDAL, bilineare, da qualsiasi SR). Una cella è nodata dove uno dei due DSM non ha dati. Il registro riporta le celle confrontate, mediana, media e deviazione standard della differenza, il 5° e il 95° percentile e le celle cambiate di più di 1 m; una mediana vicina a 0 dice che le due epoche sono registrate l&apos;una sull&apos;altra.
+        <translation>Il DSM successivo meno quello precedente, sulla griglia del precedente, mostra cosa è cambiato tra due epoche di un sito (il DSM successivo vi viene ricampionato con GDAL, bilineare, da qualsiasi SR). Una cella è nodata dove uno dei due DSM non ha dati. Il registro riporta le celle confrontate, mediana, media e deviazione standard della differenza, il 5° e il 95° percentile e le celle cambiate di più di 1 m; una mediana vicina a 0 dice che le due epoche sono registrate l'una sull'altra.
 
-DSM precedente: il DSM da cui si misura la differenza (la sua griglia è quella dell&apos;output).
-DSM successivo: il DSM dell&apos;altra epoca (ad es. un blocco registrato sul precedente con il controllo automatico).
+DSM precedente: il DSM da cui si misura la differenza (la sua griglia è quella dell'output).
+DSM successivo: il DSM dell'altra epoca (ad es. un blocco registrato sul precedente con il controllo automatico).
 Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno precedente (metri).</translation>
     </message>
 </context>
@@ -1166,27 +1181,27 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>GeoPackage (*.gpkg)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="229"/>
+        <location filename="../ui/gcp_io.py" line="231"/>
         <source>Cannot write {}: {}</source>
         <translation>Impossibile scrivere {}: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="232"/>
+        <location filename="../ui/gcp_io.py" line="234"/>
         <source>Exported {} observations to {}</source>
         <translation>Esportate {} misure in {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="232"/>
+        <location filename="../ui/gcp_io.py" line="234"/>
         <source> (points without observations left out: {})</source>
         <translation> (punti senza misure esclusi: {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="236"/>
+        <location filename="../ui/gcp_io.py" line="238"/>
         <source>GCP observations</source>
         <translation>Misure dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_io.py" line="238"/>
+        <location filename="../ui/gcp_io.py" line="240"/>
         <source>Cannot add {} to the project</source>
         <translation>Impossibile aggiungere {} al progetto</translation>
     </message>
@@ -1483,12 +1498,12 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="46"/>
         <source>Georeference with no hand-picked GCP: the block is matched to a reference orthophoto and takes its heights from a reference DSM. The points of the table become check points.</source>
-        <translation>Georeferenziare senza punti d&apos;appoggio scelti a mano: il blocco viene abbinato a un&apos;ortofoto di riferimento e prende le quote da un DSM di riferimento. I punti della tabella diventano punti di controllo.</translation>
+        <translation>Georeferenziare senza punti d'appoggio scelti a mano: il blocco viene abbinato a un'ortofoto di riferimento e prende le quote da un DSM di riferimento. I punti della tabella diventano punti di controllo.</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="52"/>
         <source>A reference orthophoto: a raster file, or a WMS / XYZ layer (saved for the block&apos;s extent, from the photos&apos; GPS or the map extent)</source>
-        <translation>Un&apos;ortofoto di riferimento: un file raster, o un layer WMS / XYZ (salvato per l&apos;estensione del blocco, dal GPS delle foto o dall&apos;estensione della mappa)</translation>
+        <translation>Un'ortofoto di riferimento: un file raster, o un layer WMS / XYZ (salvato per l'estensione del blocco, dal GPS delle foto o dall'estensione della mappa)</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="52"/>
@@ -1508,12 +1523,12 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="73"/>
         <source>Georeference from the reference orthophoto and DSM (in the background)</source>
-        <translation>Georeferenzia dall&apos;ortofoto e dal DSM di riferimento (in background)</translation>
+        <translation>Georeferenzia dall'ortofoto e dal DSM di riferimento (in background)</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="94"/>
         <source>Automatic control: choose a reference orthophoto and a reference DSM layer</source>
-        <translation>Controllo automatico: scegliere un&apos;ortofoto di riferimento e un layer DSM di riferimento</translation>
+        <translation>Controllo automatico: scegliere un'ortofoto di riferimento e un layer DSM di riferimento</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="115"/>
@@ -1526,17 +1541,17 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>Punti di controllo: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="124"/>
+        <location filename="../ui/gcp_autocontrol.py" line="129"/>
         <source>ArchaeoOrtho: automatic control</source>
         <translation>ArchaeoOrtho: controllo automatico</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="128"/>
+        <location filename="../ui/gcp_autocontrol.py" line="133"/>
         <source>Automatic control against {} and {}…</source>
         <translation>Controllo automatico rispetto a {} e {}…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="140"/>
+        <location filename="../ui/gcp_autocontrol.py" line="145"/>
         <source>Automatic GCPs (residuals)</source>
         <translation>GCP automatici (residui)</translation>
     </message>
@@ -1544,102 +1559,102 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
 <context>
     <name>GcpStore</name>
     <message>
-        <location filename="../ui/store.py" line="254"/>
+        <location filename="../ui/store.py" line="255"/>
         <source>a point named {} exists already</source>
         <translation>esiste già un punto chiamato {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="242"/>
+        <location filename="../ui/store.py" line="243"/>
         <source>add point {}</source>
         <translation>aggiungi il punto {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="249"/>
+        <location filename="../ui/store.py" line="250"/>
         <source>remove point {}</source>
         <translation>rimuovi il punto {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="265"/>
+        <location filename="../ui/store.py" line="266"/>
         <source>set {} of {}</source>
         <translation>imposta {} di {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="325"/>
+        <location filename="../ui/store.py" line="326"/>
         <source>place {} in {}</source>
         <translation>misura {} in {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="333"/>
+        <location filename="../ui/store.py" line="334"/>
         <source>remove {} from {}</source>
         <translation>rimuovi {} da {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="411"/>
+        <location filename="../ui/store.py" line="412"/>
         <source>set CRS</source>
         <translation>imposta il SR</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="293"/>
+        <location filename="../ui/store.py" line="294"/>
         <source>no position</source>
         <translation>nessuna posizione</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="298"/>
+        <location filename="../ui/store.py" line="299"/>
         <source>({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)</source>
         <translation>({:.0f}, {:.0f}) è fuori dalla foto {} ({} × {} px)</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="305"/>
+        <location filename="../ui/store.py" line="306"/>
         <source>({:.0f}, {:.0f}) is inside the mask of {}</source>
         <translation>({:.0f}, {:.0f}) è dentro la maschera di {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="313"/>
+        <location filename="../ui/store.py" line="314"/>
         <source>{} not placed: {}</source>
         <translation>{} non posizionato: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="357"/>
+        <location filename="../ui/store.py" line="358"/>
         <source>{} points replaced by {} from the file</source>
         <translation>{} punti sostituiti da {} dal file</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="391"/>
+        <location filename="../ui/store.py" line="392"/>
         <source>added {} points: {}</source>
         <translation>aggiunti {} punti: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="393"/>
+        <location filename="../ui/store.py" line="394"/>
         <source>coordinates updated from the file: {}</source>
         <translation>coordinate aggiornate dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="395"/>
+        <location filename="../ui/store.py" line="396"/>
         <source>role set by the file: {}</source>
         <translation>ruolo impostato dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="397"/>
+        <location filename="../ui/store.py" line="398"/>
         <source>role kept (the file gives none): {}</source>
         <translation>ruolo mantenuto (il file non ne indica): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="399"/>
+        <location filename="../ui/store.py" line="400"/>
         <source>σ set by the file: {}</source>
         <translation>σ impostata dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="401"/>
+        <location filename="../ui/store.py" line="402"/>
         <source>{} observations added</source>
         <translation>{} misure aggiunte</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="403"/>
+        <location filename="../ui/store.py" line="404"/>
         <source>placed observations kept (the file has others): {}</source>
         <translation>misure posizionate mantenute (il file ne ha altre): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="404"/>
+        <location filename="../ui/store.py" line="405"/>
         <source>nothing changed</source>
         <translation>nulla è cambiato</translation>
     </message>
@@ -1765,37 +1780,37 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
 <context>
     <name>GeoreferenceAlgorithm</name>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="89"/>
+        <location filename="../processing_provider/georeference.py" line="96"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="90"/>
+        <location filename="../processing_provider/georeference.py" line="97"/>
         <source>GCP residuals</source>
         <translation>Residui dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="91"/>
+        <location filename="../processing_provider/georeference.py" line="98"/>
         <source>Camera centres (world)</source>
         <translation>Centri di presa (mondo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="176"/>
+        <location filename="../processing_provider/georeference.py" line="194"/>
         <source>outlier left out: {}</source>
         <translation>valore anomalo escluso: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="129"/>
+        <location filename="../processing_provider/georeference.py" line="147"/>
         <source>CRS {}; control RMSE XY {} m, Z {} m; check RMSE XY {} m, Z {} m</source>
         <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="114"/>
+        <location filename="../processing_provider/run_pipeline.py" line="120"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
@@ -1805,89 +1820,94 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>Georeferenzia</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Aligned workspace</source>
         <translation>Area di lavoro allineata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Ground control layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Check points</source>
         <translation>Punti di controllo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Use EXIF GPS positions</source>
         <translation>Usa le posizioni GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Target CRS</source>
         <translation>SR di destinazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>Pixel dei GCP misurati sulle foto raddrizzate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="113"/>
+        <location filename="../processing_provider/georeference.py" line="130"/>
         <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS)</source>
         <translation>Indica i punti d'appoggio (File o Layer dei punti d'appoggio: GCPS, GCP_LAYER) e/o le posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Reference orthophoto</source>
         <translation>Ortofoto di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Reference DSM</source>
         <translation>DSM di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Reference resolution for web layers (m, 0: auto)</source>
         <translation>Risoluzione di riferimento per layer web (m, 0: auto)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="71"/>
+        <location filename="../processing_provider/georeference.py" line="78"/>
         <source>Area to fetch from web layers</source>
         <translation>Area da scaricare dai layer web</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="92"/>
+        <location filename="../processing_provider/georeference.py" line="99"/>
         <source>Automatic GCPs kept</source>
         <translation>GCP automatici mantenuti</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="146"/>
+        <location filename="../processing_provider/georeference.py" line="164"/>
         <source>Automatic control needs both a reference orthophoto and a reference DSM (REFERENCE_ORTHO, REFERENCE_DSM); {} is missing</source>
-        <translation>Il controllo automatico richiede sia un&apos;ortofoto sia un DSM di riferimento (REFERENCE_ORTHO, REFERENCE_DSM); manca {}</translation>
+        <translation>Il controllo automatico richiede sia un'ortofoto sia un DSM di riferimento (REFERENCE_ORTHO, REFERENCE_DSM); manca {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="159"/>
+        <location filename="../processing_provider/georeference.py" line="177"/>
         <source>Target CRS {} is not used: automatic control georeferences in the reference orthophoto&apos;s CRS {}</source>
-        <translation>Il SR di destinazione {} non è usato: il controllo automatico georeferenzia nel SR {} dell&apos;ortofoto di riferimento</translation>
+        <translation>Il SR di destinazione {} non è usato: il controllo automatico georeferenzia nel SR {} dell'ortofoto di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="180"/>
+        <location filename="../processing_provider/georeference.py" line="198"/>
         <source>Automatic control: {} automatic GCPs kept; CRS {}; check RMSE XY {} m, Z {} m</source>
         <translation>Controllo automatico: {} GCP automatici mantenuti; SR {}; RMSE di controllo XY {} m, Z {} m</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/georeference.py" line="124"/>
+        <source>Reference DSM {} given alone (DEM control) must be a raster file on disk; a web layer is fetched only for the automatic control, with a reference orthophoto</source>
+        <translation>Il DSM di riferimento {} fornito da solo (controllo DEM) deve essere un file raster su disco; un layer web viene scaricato solo per il controllo automatico, con un'ortofoto di riferimento</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -1901,19 +1921,21 @@ GCP pixels measured on upright photos: tick when the pixel coordinates were meas
 Outliers (a wrong observation, a typo in a coordinate) are detected, named in the log and left out.
 
 Given a reference orthophoto and a reference DSM (any raster layer: a file, or a WMS, XYZ or WCS layer, which is saved for the block&apos;s extent to georef/reference-ortho.tif and georef/reference-dsm.tif), the block is georeferenced with no hand-picked GCP, as &apos;Automatic control from a reference orthophoto&apos; does; the result is in the reference orthophoto&apos;s CRS (a Web Mercator or geographic layer is saved in the DSM&apos;s CRS, else in the UTM zone). Ground control given as well is not used to fix the block: all its points become check points, an independent measure of the automatic control. Camera positions or Use EXIF GPS positions give the rough position (else EXIF GPS when three photos carry it, else rotation and scale are searched). The calibration is refined in any case (focal length and distortion: the automatic GCPs determine them).
+A reference DSM given alone (a DEM file in any projected CRS, heights in metres or feet) adds DEM control: after the adjustment the block&apos;s sparse points are co-registered on it (shift, tilt, dome) and the block is adjusted again with DEM-derived control points (dem001, ...), which remove tilt, height offset and doming the photos cannot see; the co-registration is logged and saved to georef/dem_control.json. Heights: the control points&apos; when there are any, else the DEM&apos;s (camera positions&apos; heights are moved onto it). Without GCPs or camera positions the photos&apos; EXIF GPS place the block. A DEM off the block or too coarse for it is refused before the adjustment.
 Reference resolution: metres per pixel a web layer is saved at (0: 0.25 m; the DSM at twice that, at least 0.5 m). Area to fetch: the extent a web layer is saved for; empty: the photos&apos; EXIF GPS positions plus a margin, else the other reference&apos;s extent.
 Outputs: besides the usual ones, the number of automatic GCPs the adjustment kept (none without automatic control).</source>
-        <translation>Fissa il blocco allineato in un sistema di riferimento reale con punti d&apos;appoggio (GCP) e/o posizioni delle camere, usati all&apos;interno della compensazione a stelle proiettive in modo che eliminino anche la deriva e la flessione del blocco, cosa che una trasformazione a 7 parametri (Helmert) non può fare. I punti di controllo non partecipano alla compensazione: vengono triangolati in seguito e confrontati con le loro coordinate rilevate.
+        <translation>Fissa il blocco allineato in un sistema di riferimento reale con punti d'appoggio (GCP) e/o posizioni delle camere, usati all'interno della compensazione a stelle proiettive in modo che eliminino anche la deriva e la flessione del blocco, cosa che una trasformazione a 7 parametri (Helmert) non può fare. I punti di controllo non partecipano alla compensazione: vengono triangolati in seguito e confrontati con le loro coordinate rilevate.
 
-File dei punti d&apos;appoggio: un gcp_list.txt di OpenDroneMap (riga del SR, poi &apos;x y z px py image [name]&apos;) o un file CSV di punti con il corrispondente &apos;&lt;name&gt;_observations.csv&apos;. Layer dei punti d&apos;appoggio: in alternativa un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, sx, sy, sz, role).
+File dei punti d'appoggio: un gcp_list.txt di OpenDroneMap (riga del SR, poi 'x y z px py image [name]') o un file CSV di punti con il corrispondente '&lt;name&gt;_observations.csv'. Layer dei punti d'appoggio: in alternativa un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, sx, sy, sz, role).
 Punti di controllo: nomi separati da virgole che diventano punti di controllo.
-Posizioni delle camere: CSV &apos;image,x,y,z[,sigma]&apos; (riga del SR facoltativa). Usa le posizioni GPS EXIF: usa il GPS delle foto.
-SR di destinazione: predefinito quello del file dei punti d&apos;appoggio. Affina la calibrazione della camera: la compensazione affina focale, punto principale e distorsione.
+Posizioni delle camere: CSV 'image,x,y,z[,sigma]' (riga del SR facoltativa). Usa le posizioni GPS EXIF: usa il GPS delle foto.
+SR di destinazione: predefinito quello del file dei punti d'appoggio. Affina la calibrazione della camera: la compensazione affina focale, punto principale e distorsione.
 Pixel dei GCP misurati sulle foto raddrizzate: da spuntare quando le coordinate pixel sono state misurate sulle foto mostrate diritte secondo il loro orientamento EXIF, come le mostrano i browser e i visualizzatori di foto; sono convertite nella griglia di pixel memorizzata di ogni foto (le foto memorizzate senza rotazione restano invariate).
 I valori anomali (una misura errata, un errore di battitura in una coordinata) sono individuati, nominati nel registro ed esclusi.
 
-Con un&apos;ortofoto di riferimento e un DSM di riferimento (un layer raster qualsiasi: un file, o un layer WMS, XYZ o WCS, che viene salvato per l&apos;estensione del blocco in georef/reference-ortho.tif e georef/reference-dsm.tif), il blocco viene georeferenziato senza punti d&apos;appoggio scelti a mano, come fa &apos;Punti di controllo automatici da un&apos;ortofoto di riferimento&apos;; il risultato è nel SR dell&apos;ortofoto di riferimento (un layer Web Mercator o geografico viene salvato nel SR del DSM, altrimenti nella zona UTM). I punti d&apos;appoggio forniti in più non fissano il blocco: tutti i loro punti diventano punti di controllo, una misura indipendente del controllo automatico. Posizioni delle camere o Usa le posizioni GPS EXIF danno la posizione approssimativa (altrimenti il GPS EXIF quando tre foto lo hanno, altrimenti si cercano rotazione e scala). La calibrazione viene affinata in ogni caso (focale e distorsione: le determinano i GCP automatici).
-Risoluzione di riferimento: metri per pixel con cui si salva un layer web (0: 0,25 m; il DSM al doppio, almeno 0,5 m). Area da scaricare: l&apos;estensione per cui si salva un layer web; vuota: le posizioni GPS EXIF delle foto più un margine, altrimenti l&apos;estensione dell&apos;altro riferimento.
+Con un'ortofoto di riferimento e un DSM di riferimento (un layer raster qualsiasi: un file, o un layer WMS, XYZ o WCS, che viene salvato per l'estensione del blocco in georef/reference-ortho.tif e georef/reference-dsm.tif), il blocco viene georeferenziato senza punti d'appoggio scelti a mano, come fa 'Punti di controllo automatici da un'ortofoto di riferimento'; il risultato è nel SR dell'ortofoto di riferimento (un layer Web Mercator o geografico viene salvato nel SR del DSM, altrimenti nella zona UTM). I punti d'appoggio forniti in più non fissano il blocco: tutti i loro punti diventano punti di controllo, una misura indipendente del controllo automatico. Posizioni delle camere o Usa le posizioni GPS EXIF danno la posizione approssimativa (altrimenti il GPS EXIF quando tre foto lo hanno, altrimenti si cercano rotazione e scala). La calibrazione viene affinata in ogni caso (focale e distorsione: le determinano i GCP automatici).
+Un DSM di riferimento fornito da solo (un file DEM in un SR proiettato qualsiasi, quote in metri o piedi) aggiunge il controllo DEM: dopo la compensazione i punti sparsi del blocco vengono co-registrati su di esso (traslazione, inclinazione, cupola) e il blocco viene compensato di nuovo con punti d'appoggio derivati dal DEM (dem001, ...), che eliminano l'inclinazione, lo scostamento in quota e l'effetto cupola che le foto non possono vedere; la co-registrazione viene riportata nel registro e salvata in georef/dem_control.json. Quote: quelle dei punti d'appoggio quando ce ne sono, altrimenti quelle del DEM (le quote delle posizioni delle camere vengono spostate su di esso). Senza GCP né posizioni delle camere il GPS EXIF delle foto posiziona il blocco. Un DEM fuori dal blocco o troppo grossolano per esso viene rifiutato prima della compensazione.
+Risoluzione di riferimento: metri per pixel con cui si salva un layer web (0: 0,25 m; il DSM al doppio, almeno 0,5 m). Area da scaricare: l'estensione per cui si salva un layer web; vuota: le posizioni GPS EXIF delle foto più un margine, altrimenti l'estensione dell'altro riferimento.
 Output: oltre ai consueti, il numero di GCP automatici mantenuti dalla compensazione (nessuno senza controllo automatico).</translation>
     </message>
 </context>
@@ -2032,7 +2054,7 @@ Output: oltre ai consueti, il numero di GCP automatici mantenuti dalla compensaz
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="116"/>
         <source>Give ground control points observed in the image (Ground control file or Ground control point layer: GCPS, GCP_LAYER), its Known orientation (ORIENTATION) or a Reference orthophoto for automatic control (REFERENCE_ORTHO)</source>
-        <translation>Indicare punti d&apos;appoggio misurati nell&apos;immagine (File dei punti d&apos;appoggio o Layer dei punti d&apos;appoggio: GCPS, GCP_LAYER), il suo orientamento noto (ORIENTATION) o un&apos;ortofoto di riferimento per il controllo automatico (REFERENCE_ORTHO)</translation>
+        <translation>Indicare punti d'appoggio misurati nell'immagine (File dei punti d'appoggio o Layer dei punti d'appoggio: GCPS, GCP_LAYER), il suo orientamento noto (ORIENTATION) o un'ortofoto di riferimento per il controllo automatico (REFERENCE_ORTHO)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="7"/>
@@ -2051,17 +2073,17 @@ Output CRS: default the CRS of the GCPs or of the known orientation.
 GCP residuals: GeoPackage of the GCPs with their residuals in pixels (and metres on the plane).</source>
         <translation>Ortorettifica una fotografia — anche una che non fa parte di alcun blocco, come una singola obliqua o una vecchia stampa — su un DSM esistente, ad esempio un DSM da laser scanning aereo (ALS) in qualsiasi SR (riproiettato al volo).
 
-Posizione e assetto della camera derivano dai punti d&apos;appoggio misurati nella foto (resezione spaziale: almeno 4 punti; un punto errato su 5 o più viene individuato ed escluso; con 6 o più si stimano anche la focale e la distorsione radiale k1 dove i punti le determinano), oppure da un orientamento noto.
+Posizione e assetto della camera derivano dai punti d'appoggio misurati nella foto (resezione spaziale: almeno 4 punti; un punto errato su 5 o più viene individuato ed escluso; con 6 o più si stimano anche la focale e la distorsione radiale k1 dove i punti le determinano), oppure da un orientamento noto.
 
-Immagine: la foto. DSM: raster delle quote (necessario per un&apos;ortofoto vera).
-File dei punti d&apos;appoggio: un gcp_list.txt di OpenDroneMap o un file CSV di punti con misure in questa immagine; oppure Layer dei punti d&apos;appoggio: un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, role; origine dei pixel nell&apos;angolo in alto a sinistra, y verso il basso).
-Orientamento noto: al posto dei punti d&apos;appoggio, un file con x y z omega phi kappa (gradi, convenzione fotogrammetrica; una riga di intestazione come la scrive Pix4D, o JSON), facoltativamente focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 e una riga del SR.
-Ortofoto di riferimento (controllo automatico): senza punti d&apos;appoggio e senza orientamento noto, la foto viene abbinata a questa ortofoto (qualsiasi SR, qualsiasi risoluzione; il DSM è allora il DSM di riferimento) e le corrispondenze diventano punti d&apos;appoggio automatici (auto_001, ...) per la resezione spaziale: nessun punto scelto a mano, la direzione di presa non deve essere nota, funzionano anche le oblique, e la focale viene stimata quando la foto non ne ha. Posizione approssimativa: un punto sul terreno che la foto mostra (qualsiasi SR; vuoto = ovunque sul riferimento); Raggio di ricerca: quanto può essere lontano (metri). Il registro dice quante corrispondenze hanno superato ogni passo; i residui dei punti d&apos;appoggio elencano i punti d&apos;appoggio automatici.
+Immagine: la foto. DSM: raster delle quote (necessario per un'ortofoto vera).
+File dei punti d'appoggio: un gcp_list.txt di OpenDroneMap o un file CSV di punti con misure in questa immagine; oppure Layer dei punti d'appoggio: un layer di punti con un elemento per misura e i campi name, image, px, py (facoltativi z, role; origine dei pixel nell'angolo in alto a sinistra, y verso il basso).
+Orientamento noto: al posto dei punti d'appoggio, un file con x y z omega phi kappa (gradi, convenzione fotogrammetrica; una riga di intestazione come la scrive Pix4D, o JSON), facoltativamente focal_mm, sensor_width_mm, cx, cy, k1, k2, p1, p2 e una riga del SR.
+Ortofoto di riferimento (controllo automatico): senza punti d'appoggio e senza orientamento noto, la foto viene abbinata a questa ortofoto (qualsiasi SR, qualsiasi risoluzione; il DSM è allora il DSM di riferimento) e le corrispondenze diventano punti d'appoggio automatici (auto_001, ...) per la resezione spaziale: nessun punto scelto a mano, la direzione di presa non deve essere nota, funzionano anche le oblique, e la focale viene stimata quando la foto non ne ha. Posizione approssimativa: un punto sul terreno che la foto mostra (qualsiasi SR; vuoto = ovunque sul riferimento); Raggio di ricerca: quanto può essere lontano (metri). Il registro dice quante corrispondenze hanno superato ogni passo; i residui dei punti d'appoggio elencano i punti d'appoggio automatici.
 Focale e Larghezza del sensore: orientamento interno in mm (il lato lungo del sensore); 0 o vuoto = la focale EXIF.
-Modalità: un&apos;ortofoto vera sul DSM, o un raddrizzamento piano (proiettivo) tramite i punti d&apos;appoggio per confronto su terreno piatto; con un DSM il registro e il risultato &apos;Raddrizzamento piano: 95° percentile del suo scostamento&apos; dicono di quanto il risultato piano si discosta a causa del rilievo.
+Modalità: un'ortofoto vera sul DSM, o un raddrizzamento piano (proiettivo) tramite i punti d'appoggio per confronto su terreno piatto; con un DSM il registro e il risultato 'Raddrizzamento piano: 95° percentile del suo scostamento' dicono di quanto il risultato piano si discosta a causa del rilievo.
 Risoluzione: dimensione della cella in unità del SR (0 = il GSD).
-SR di output: predefinito il SR dei punti d&apos;appoggio o dell&apos;orientamento noto.
-Residui dei punti d&apos;appoggio: GeoPackage dei punti d&apos;appoggio con i loro residui in pixel (e in metri sul piano).</translation>
+SR di output: predefinito il SR dei punti d'appoggio o dell'orientamento noto.
+Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui in pixel (e in metri sul piano).</translation>
     </message>
     <message>
         <location filename="../processing_provider/orthorectify_image.py" line="75"/>
@@ -2200,17 +2222,17 @@ Residui dei punti d&apos;appoggio: GeoPackage dei punti d&apos;appoggio con i lo
         <translation>Registro del controllo (JSON)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="155"/>
+        <location filename="../processing_provider/prepare_images.py" line="154"/>
         <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
         <translation>{} immagini: {} segnalate, {} escluse, {} nella cartella preparata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="157"/>
+        <location filename="../processing_provider/prepare_images.py" line="156"/>
         <source>Blurriest first (blur score, % of the set&apos;s median):</source>
         <translation>Le più sfocate per prime (punteggio di nitidezza, % della mediana dell'insieme):</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="165"/>
+        <location filename="../processing_provider/prepare_images.py" line="164"/>
         <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
         <translation>Scansioni preparate: {} x {} px, dimensione del pixel {:.6g} {}{}</translation>
     </message>
@@ -2225,17 +2247,17 @@ Residui dei punti d&apos;appoggio: GeoPackage dei punti d&apos;appoggio con i lo
         <translation>layer MASKS '{}'</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="185"/>
+        <location filename="../processing_provider/prepare_images.py" line="184"/>
         <source>feature {}</source>
         <translation>elemento {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="189"/>
+        <location filename="../processing_provider/prepare_images.py" line="188"/>
         <source>MASKS layer &apos;{}&apos;: {} has no geometry: skipped</source>
         <translation>layer MASKS '{}': {} non ha geometria: saltato</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="192"/>
+        <location filename="../processing_provider/prepare_images.py" line="191"/>
         <source>MASKS layer &apos;{}&apos;: {} is a {} geometry, not a polygon</source>
         <translation>layer MASKS '{}': {} è una geometria {}, non un poligono</translation>
     </message>
@@ -2338,7 +2360,7 @@ Immagini preparate: la cartella delle immagini preparate (sostituita per intero;
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/relief_visualisation.py" line="79"/>
+        <location filename="../processing_provider/relief_visualisation.py" line="76"/>
         <source>Give a workspace folder, or an elevation raster and where to write the visualisation</source>
         <translation>Indica una cartella dell'area di lavoro, oppure un raster delle quote e dove scrivere la visualizzazione</translation>
     </message>
@@ -2403,42 +2425,42 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>non triangolato</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="701"/>
+        <location filename="../ui/layers.py" line="705"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="660"/>
+        <location filename="../ui/layers.py" line="664"/>
         <source>DSM hillshade</source>
         <translation>Ombreggiatura del DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="702"/>
+        <location filename="../ui/layers.py" line="706"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="703"/>
+        <location filename="../ui/layers.py" line="707"/>
         <source>Cameras</source>
         <translation>Camere</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="671"/>
+        <location filename="../ui/layers.py" line="675"/>
         <source>Camera footprints</source>
         <translation>Impronte delle immagini</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="678"/>
+        <location filename="../ui/layers.py" line="682"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Residui dei punti d'appoggio (vettori x{})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="704"/>
+        <location filename="../ui/layers.py" line="708"/>
         <source>Point cloud</source>
         <translation>Nuvola di punti</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="712"/>
+        <location filename="../ui/layers.py" line="716"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
@@ -2448,17 +2470,17 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>{} ({})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="705"/>
+        <location filename="../ui/layers.py" line="709"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="685"/>
+        <location filename="../ui/layers.py" line="689"/>
         <source>DTM hillshade</source>
         <translation>Ombreggiatura del DTM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="706"/>
+        <location filename="../ui/layers.py" line="710"/>
         <source>Contours</source>
         <translation>Curve di livello</translation>
     </message>
@@ -2466,52 +2488,52 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Write the accuracy report</source>
         <translation>Scrivi il rapporto di accuratezza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="100"/>
+        <location filename="../processing_provider/run_pipeline.py" line="106"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="101"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="102"/>
+        <location filename="../processing_provider/run_pipeline.py" line="108"/>
         <source>Accuracy report (HTML)</source>
         <translation>Rapporto di accuratezza (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="154"/>
+        <location filename="../processing_provider/run_pipeline.py" line="162"/>
         <source>Seconds per stage: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -2521,102 +2543,102 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Esegui l'intera elaborazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Ground control layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Check points</source>
         <translation>Punti di controllo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Use EXIF GPS positions</source>
         <translation>Usa le posizioni GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Target CRS</source>
         <translation>SR di destinazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Matching image size (px)</source>
         <translation>Dimensione per la corrispondenza (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>DSM resolution (m)</source>
         <translation>Risoluzione del DSM (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Matching quality</source>
         <translation>Qualità della corrispondenza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Orthomosaic resolution</source>
         <translation>Risoluzione dell'ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Seam blending</source>
         <translation>Sfumatura delle giunzioni</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Parallel workers</source>
         <translation>Processi paralleli</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Dask scheduler</source>
         <translation>Scheduler Dask</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Build the DTM</source>
         <translation>Genera il DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Contour interval (m, 0 = none)</source>
         <translation>Equidistanza (m, 0 = nessuna)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Relief visualisations</source>
         <translation>Visualizzazioni del rilievo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="105"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>Pixel dei GCP misurati sulle foto raddrizzate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="120"/>
+        <location filename="../processing_provider/run_pipeline.py" line="126"/>
         <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Indicare punti di appoggio (File o Layer dei punti d'appoggio: GCPS, GCP_LAYER) e/o posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="71"/>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Sky masks (oblique photos)</source>
         <translation>Maschere del cielo (foto oblique)</translation>
     </message>
@@ -2635,17 +2657,19 @@ Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key f
 
 Cartella delle immagini: le foto. Cartella dell'area di lavoro: dove sono scritti tutti i prodotti.
 La georeferenziazione richiede punti di appoggio (un file o un layer dei punti d'appoggio, punti di controllo esclusi) e/o posizioni delle camere (un CSV delle posizioni delle camere o Usa le posizioni GPS EXIF): senza di essi l'elaborazione viene rifiutata, perché un DSM richiede una scala metrica e una direzione verticale. Pixel dei GCP misurati sulle foto raddrizzate: come in 'Georeferenzia' (le coordinate pixel misurate sulle foto mostrate diritte secondo il loro orientamento EXIF).
-File di calibrazione della camera e Orientamento interno (avanzato): come in &apos;Allinea immagini&apos; (una camera calibrata mantenuta fissa per tutta la catena, o affinata con le sue deviazioni standard).
+File di calibrazione della camera e Orientamento interno (avanzato): come in 'Allinea immagini' (una camera calibrata mantenuta fissa per tutta la catena, o affinata con le sue deviazioni standard).
 Maschere del cielo (foto oblique): prima una fase 'Prepara immagini' trova il cielo e la foschia all'orizzonte in ogni foto e li maschera, perché nessun punto di legame o del DSM provenga dal cielo; si allineano le foto preparate (disattivato per impostazione predefinita: le foto nadirali non ne hanno bisogno).
 Genera il DTM: dopo il DSM, un DTM del suolo nudo (come 'Genera DTM'). Equidistanza (avanzato): curve di livello del DTM con questa equidistanza (come 'Curve di livello'; 0 = nessuna). Visualizzazioni del rilievo (avanzato): quelle scelte sono calcolate dal DTM (come 'Visualizzazione del rilievo'). Entrambe richiedono il DTM.
 Gli altri parametri sono quelli delle singole fasi (vedi il loro aiuto); 0 significa automatico.
 Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali.</translation>
     </message>
     <message>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Camera calibration file</source>
         <translation>File di calibrazione della camera</translation>
     </message>
     <message>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Interior orientation</source>
         <translation>Orientamento interno</translation>
     </message>
