@@ -149,8 +149,17 @@ def test_a_reference_of_another_place_is_refused_by_name(tmp_path, epochs):
     ortho, dsm = write_reference(syn.vertical_block(epoch=1, **BLOCK).scene, str(tmp_path), shift=(5000.0, 0.0))
     ws_dir = _workspace(tmp_path, block, photos, "ws")
     cams, _ = block.camera_positions(sigma=3.0)
-    with pytest.raises(AutoControlError, match="ref_ortho.tif"):
+    # the record of the control in use (an earlier run's) is never replaced by a failed run's (issue 36 item 2:
+    # the report then described the failed run for a block controlled by another)
+    lay = Layout(Workspace.open(ws_dir))
+    os.makedirs(lay.georef_dir, exist_ok=True)
+    in_use = '{"format": "archaeoortho-autocontrol", "the control": "in use"}'
+    with open(lay.autocontrol_json, "w") as f:
+        f.write(in_use)
+    with pytest.raises(AutoControlError, match="ref_ortho.tif") as e:
         autocontrol_workspace(ws_dir, ortho, dsm, prior="gps", camera_positions=cams, options=FAST)
+    assert open(lay.autocontrol_json).read() == in_use
+    assert lay.autocontrol_failed_json in str(e.value) and "candidates" in json.load(open(lay.autocontrol_failed_json))
     with pytest.raises(AutoControlError, match="missing.tif"):
         autocontrol_workspace(ws_dir, str(tmp_path / "missing.tif"), dsm)
 

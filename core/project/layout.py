@@ -39,6 +39,7 @@ RESIDUALS_GPKG = "residuals.gpkg"
 FOOTPRINTS_GPKG = "footprints.gpkg"  # written by the dock (ui/layers.py)
 CONTROL_JSON = "control.json"
 AUTOCONTROL_JSON = "autocontrol.json"  # the automatic control's candidates (role auto) and figures
+AUTOCONTROL_FAILED_JSON = "autocontrol-failed.json"  # the candidates of a run that failed (the record in use stays)
 REFERENCE_ORTHO_TIF = "reference-ortho.tif"  # in georef/: a web / virtual reference layer saved for the block
 REFERENCE_DSM_TIF = "reference-dsm.tif"
 EDITOR_JSON = "gcp_editor.json"
@@ -196,6 +197,12 @@ class Layout:
     @property
     def autocontrol_json(self) -> str:
         return self.path(GEOREF_DIR, AUTOCONTROL_JSON)
+
+    @property
+    def autocontrol_failed_json(self) -> str:
+        """The candidates of the last automatic control that failed: autocontrol.json stays the record of the
+        control in use."""
+        return self.path(GEOREF_DIR, AUTOCONTROL_FAILED_JSON)
 
     @property
     def reference_ortho_tif(self) -> str:

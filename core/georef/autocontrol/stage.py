@@ -19,6 +19,7 @@ from typing import Dict, List, Optional, Sequence
 
 import numpy as np
 
+from ...common.files import remove_path
 from ...common.progress import NullProgress, Progress, SubProgress
 from ...geometry.crs import linear_unit, transform_points
 from ...geometry.similarity import Similarity
@@ -277,11 +278,13 @@ def autocontrol_workspace(workspace_dir: str, reference_ortho: str, reference_ds
            "figures": figures, "dropped": drop_counts(cands), "messages": messages,
            "candidates": [c.to_dict() for c in cands]}
     os.makedirs(lay.georef_dir, exist_ok=True)
-    write_json(lay.autocontrol_json, doc)
+    # the candidates go to autocontrol-failed.json until the adjustment has succeeded: autocontrol.json stays the
+    # record of the control in use (a failed run must not describe a block controlled by another)
+    write_json(lay.autocontrol_failed_json, doc)
     if len(kept) < opt.min_candidates:
         raise AutoControlError(f"automatic control against {reference_ortho}: {len(kept)} candidate(s) kept, "
                                f"{opt.min_candidates} needed{_coarse_hint(figures, g, opt)} "
-                               f"({'; '.join(messages)}); see {lay.autocontrol_json}")
+                               f"({'; '.join(messages)}); see {lay.autocontrol_failed_json}")
     gcps = GCPSet(crs, [GroundPoint(c.name, c.x, c.y, c.z, c.sigma_xy, c.sigma_z, CONTROL, list(c.observations))
                         for c in kept], source=lay.autocontrol_json)
     gcps.points.extend(_checks_in(check_points, crs))
@@ -289,6 +292,7 @@ def autocontrol_workspace(workspace_dir: str, reference_ortho: str, reference_ds
     refine = georef_options.refine_intrinsics if georef_options is not None else opt.refine_intrinsics
     res = georeference_workspace(ws.root, gcps=gcps, crs=crs, options=georef_options, refine_intrinsics=refine,
                                  progress=SubProgress(progress, 0.7, 1.0))
+    remove_path(lay.autocontrol_failed_json)
     timings["adjustment"] = time.time() - t1
     timings["total"] = time.time() - t0
     n_used = _count_used(lay, {c.name for c in kept})
