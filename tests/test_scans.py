@@ -410,3 +410,177 @@ def test_processing_prepare_scanned_film(synthetic_scans, qgis_processing, qgis_
         ["frame_001.tif.png", "frame_002.tif.png", "frame_003.tif.png"]
     doc = json.load(open(os.path.join(res["WORKSPACE"], "scans.json")))
     assert doc["calibrated"] and doc["interior_orientation"]["focal_length_mm"] == pytest.approx(FOCAL_MM, abs=1e-3)
+
+
+# ---------------------------------------------------------------------------
+# a 4-mark camera whose side marks' rings touch the picture (tests/archive_scene.py, side_mm=117)
+# ---------------------------------------------------------------------------
+
+CACHE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "build", "test-cache")
+CORNERS = ("TL", "TR", "BR", "BL")
+
+
+@pytest.fixture(scope="module")
+def touching_block():
+    """Four 1300 px scans of the archive film camera with 4 side marks (cross in a ring) whose rings touch the
+    picture: large "dot" templates correlate better inside the picture than the real marks do.  Rendered once
+    (about 10 s) and cached under build/test-cache."""
+    from tests import archive_scene as arch
+
+    return arch.archive_block("film", 4, seed=1, out_dir=os.path.join(CACHE, f"{arch.VERSION}-film4-fid4-side117"),
+                              fiducials=4, side_mm=117, reference=False)
+
+
+def _calibrated_text(cam, shift=None):
+    """The camera's fiducial coordinates as "id x y" lines, PP and focal; ``shift``: (id, dx, dy) mm added."""
+    lines = []
+    for k, x, y in cam.fiducials_mm:
+        if shift and shift[0] == k:
+            x, y = x + shift[1], y + shift[2]
+        lines.append(f"{k} {x} {y}")
+    return "\n".join(lines) + f"\nPP {cam.ppa_mm[0]} {cam.ppa_mm[1]}\nfocal {cam.focal_mm}\n"
+
+
+def _mark_errors(block, res, ids=None):
+    """Distance (scan px) of every used mark from its true place; slot -> certificate id by direction."""
+    from core.prepare.scans import parse_fiducial_coordinates
+
+    ids = ids or parse_fiducial_coordinates(_calibrated_text(block.camera)).ids
+    out = {}
+    for s in res.scans:
+        truth = block.fiducials_scan(s.name)
+        for f in s.fiducials:
+            if f.slot in res.frame:
+                t = truth[ids[f.slot]]
+                out[(s.name, f.slot)] = math.hypot(f.x - t[0], f.y - t[1])
+    return out
+
+
+def _paths(block, names=None):
+    return [os.path.join(block.paths["images"], n) for n in (names or block.names)]
+
+
+def test_side_marks_touching_the_picture_found_with_calibrated_coordinates(touching_block, tmp_path):
+    """The geometry, not the correlation, picks the marks: all four at their true place, the restitution's pixel
+    and rotation right, and no warning about a mark (not even about corners this camera does not have)."""
+    from core.prepare.options import ScanOptions
+    from core.prepare.scans import prepare_scans
+
+    block = touching_block
+    res = prepare_scans(_paths(block), str(tmp_path), str(tmp_path),
+                        ScanOptions(fiducial_coordinates=_calibrated_text(block.camera), scan_pixel_size_mm=0.2))
+    errors = _mark_errors(block, res)
+    assert len(errors) == 16 and max(errors.values()) < 0.5, errors
+    assert not res.left_out and len(res.scans) == 4
+    for s in res.scans:
+        assert {f.slot for f in s.fiducials} == {"T", "R", "B", "L"}, s.name
+        assert s.rms_px < 0.3 and s.scan_pixel_size == pytest.approx(0.2, rel=2e-3)
+        assert s.rotation_deg == pytest.approx(block.frame(s.name).scan.rotation_deg, abs=0.02)
+    assert res.pixel_size == pytest.approx(0.2, rel=2e-3)
+    assert not [w for w in res.warnings if "fiducial" in w], res.warnings
+
+
+def test_side_marks_touching_the_picture_found_without_calibrated_coordinates(touching_block, tmp_path):
+    """Without coordinates the set's own geometry decides (opposite marks share one midpoint): the four side
+    marks, and not a word about the corner windows where the camera has no marks."""
+    from core.prepare.options import ScanOptions
+    from core.prepare.scans import prepare_scans
+
+    block = touching_block
+    res = prepare_scans(_paths(block), str(tmp_path), str(tmp_path), ScanOptions())
+    assert set(res.frame) == {"T", "R", "B", "L"} and not res.left_out
+    errors = _mark_errors(block, res)
+    assert len(errors) == 16 and max(errors.values()) < 0.5, errors
+    assert not [w for w in res.warnings if "fiducial" in w], res.warnings
+    assert not any(f.slot in CORNERS for s in res.scans for f in s.fiducials)
+
+
+def test_detection_searches_only_the_calibrated_positions(touching_block):
+    from core.prepare.options import ScanOptions
+    from core.prepare.scans import detect_fiducials, parse_fiducial_coordinates
+
+    block = touching_block
+    cal = parse_fiducial_coordinates(_calibrated_text(block.camera))
+    fids, warnings = detect_fiducials(_paths(block)[0], ScanOptions(), frame=cal.points)
+    assert {f.slot for f in fids} == {"T", "R", "B", "L"} and not warnings
+
+
+def _displace_mark(block, name, mark_id, dx, out_dir):
+    """A copy of the scan with the mark ``mark_id`` moved ``dx`` px to the right (its patch of 2 marks)."""
+    img = cv2.imread(os.path.join(block.paths["images"], name), cv2.IMREAD_UNCHANGED)
+    x, y = (int(round(v)) for v in block.fiducials_scan(name)[mark_id])
+    r = int(2 * block.camera.mark_mm / block.camera.pixel_mm)
+    patch = img[y - r:y + r, x - r:x + r].copy()
+    img[y - r:y + r, x - r + dx:x + r + dx] = patch
+    path = os.path.join(out_dir, name)
+    assert cv2.imwrite(path, img)
+    return path
+
+
+def test_a_scan_whose_marks_do_not_fit_is_left_out(touching_block, tmp_path):
+    """A mark 3 px off in one scan leaves 0.75 px residuals on its four marks: over 4 x the limit (0.1 px here),
+    so that scan is left out by name, the others prepared; with one scan left the stage fails, naming it."""
+    from core.prepare.options import ScanOptions
+    from core.prepare.scans import ScanError, prepare_scans
+
+    block = touching_block
+    bad = block.names[1]
+    (tmp_path / "scans").mkdir()
+    (tmp_path / "out").mkdir()
+    paths = _paths(block)
+    paths[1] = _displace_mark(block, bad, "1", 3, str(tmp_path / "scans"))
+    opts = ScanOptions(fiducial_coordinates=_calibrated_text(block.camera), max_residual_px=0.1)
+    res = prepare_scans(paths, str(tmp_path / "out"), str(tmp_path / "out"), opts)
+    assert [s.name for s in res.scans] == [n for n in block.names if n != bad]
+    assert list(res.left_out) == [bad] and "fiducial" in res.left_out[bad]
+    assert not os.path.exists(tmp_path / "out" / bad)
+    assert any(w.startswith(f"{bad}: left out: fiducial") for w in res.warnings), res.warnings
+    with pytest.raises(ScanError, match=rf"fewer than 2 scans.*{bad}: left out"):
+        prepare_scans(paths[:2], str(tmp_path / "out"), str(tmp_path / "out"), opts)
+
+
+def test_implausible_fits_by_shape_and_scale():
+    """Film shrinkage keeps x and y scales within tenths of a percent and the axes square; the scan pixel over
+    the file's resolution is one value for the set.  A fit 10 % anisotropic or 30 % off in scale is left out."""
+    from core.prepare.scans import Fiducial, _implausible_fits
+
+    def fit(sx, sy, skew=0.0):
+        m = np.array([[sx, skew, 650.0], [0.0, -sy, 650.0]])
+        used = [Fiducial(s, 0.0, 0.0, 0.9, "cross_ring", 20.0, 1, residual_px=0.05) for s in ("T", "R", "B", "L")]
+        return m, used, [], []
+
+    fits = {"a": fit(5.0, 4.99), "b": fit(5.01, 5.0), "c": fit(4.0, 4.0), "d": fit(5.5, 5.0),
+            "e": fit(3.6, 3.6), "f": fit(5.0, 5.0, skew=0.5)}
+    res = {"a": 0.2, "b": 0.2, "c": 0.25, "d": 0.2, "e": 0.2, "f": 0.2}  # c: scanned at a coarser resolution
+    out = _implausible_fits(fits, True, res, 3.0)
+    assert set(out) == {"d", "e", "f"}, out
+    assert "x and y +10.0 % apart" in out["d"] and "off the set's other scans" in out["e"]
+    assert all(v.startswith(f"{k}: left out: ") for k, v in out.items())
+    assert _implausible_fits(fits, True, {}, 3.0).keys() == {"d", "f"}  # resolution unknown: no scale test
+
+
+def test_prepare_stage_with_a_scan_left_out(touching_block, tmp_path):
+    """The stage reports the prepared scans under their own names when one scan is left out (the screening
+    record was matched to the originals by position), and records which scan and why."""
+    import shutil
+
+    from core.prepare.options import PrepareOptions, ScanOptions
+    from core.prepare.stage import prepare_images_workspace
+
+    block = touching_block
+    folder = tmp_path / "scans"
+    folder.mkdir()
+    bad = block.names[1]
+    for n in block.names:
+        if n != bad:
+            shutil.copyfile(os.path.join(block.paths["images"], n), folder / n)
+    _displace_mark(block, bad, "1", 3, str(folder))
+    opts = PrepareOptions(scanned_film=True, scan=ScanOptions(fiducial_coordinates=_calibrated_text(block.camera),
+                                                              max_residual_px=0.1))
+    res = prepare_images_workspace(str(folder), str(tmp_path / "ws"), str(tmp_path / "prepared"), opts)
+    good = [n for n in block.names if n != bad]
+    assert sorted(q.name for q in res.images) == good
+    assert sorted(n for n in os.listdir(res.prepared_dir) if n.endswith(".tif")) == good
+    assert any(w.startswith(f"{bad}: left out") for w in res.warnings)
+    rec = json.load(open(os.path.join(res.workspace, "workspace.json")))["stages"]["prepare"]["results"]
+    assert list(rec["left_out_scans"]) == [bad] and sorted(rec["decisions"]) == good

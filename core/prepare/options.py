@@ -30,7 +30,9 @@ class ScanOptions:
     margin: Optional[float] = None  # frame units beyond the outermost fiducial centres; default 1 mark size
     detect_size: int = 1200  # long side of the reduced scan used for the coarse search
     min_score: float = 0.6  # smallest correlation accepted for a mark
-    max_residual_px: float = 3.0  # a mark further than this from the affine fit is dropped (>= 5 marks)
+    # a mark further than this from the affine fit is dropped (>= 5 marks), else a warning; a scan with a mark over
+    # 4 x this is left out (core.prepare.scans.prepare_scans)
+    max_residual_px: float = 3.0
     mask_border: bool = True  # mask the film border and data strips outside the picture area
     mask_margin_px: float = 4.0  # extra inward margin of the masks, output pixels
 

@@ -14,7 +14,12 @@ Steps (:func:`prepare_scans`):
    normalised cross-correlation with procedurally drawn templates (``cross``,
    ``dot``, ``ring_dot`` = dot in a circle, ``cross_ring``) at a range of sizes
    and both polarities, or with a user-provided template image, in eight
-   search windows (four corners, four side middles).  Each hit is refined in
+   search windows (four corners, four side middles; with calibrated
+   coordinates only the windows of the calibrated marks).  Each window keeps
+   its hits of every kind at a few places; geometry chooses among them before
+   correlation does: the hits that fit the calibrated coordinates under one
+   similarity, or without them, opposite hits around one common midpoint
+   (:func:`_choose_marks`).  Each chosen hit is refined in
    the full-resolution scan: correlation peak, then, for the point-symmetric
    built-in marks, the centre of symmetry (phase correlation of the patch with
    its 180-degree rotation, iterated), which is sub-pixel and insensitive to
@@ -27,7 +32,8 @@ Steps (:func:`prepare_scans`):
    consistent across the set (a tree crown that looks like a dot) are dropped.
 3. **Affine restitution**: per scan a 6-parameter affine from frame to scan
    pixels (least squares; residuals reported, outliers dropped when five or
-   more marks are found), then every scan is resampled (bicubic, after an
+   more marks are found; a scan whose fit cannot be a film's is left out
+   with a warning, see :func:`prepare_scans`), then every scan is resampled (bicubic, after an
    anti-alias filter when shrinking) strip by strip into an image of identical
    size centred on the principal point, written as a lossless tiled GeoTIFF-
    less TIFF with the interior orientation in its metadata (``EXIF_FocalLength``
@@ -85,9 +91,11 @@ class Fiducial:
     size_px: float  # outer size of the mark in scan pixels
     polarity: int  # +1 bright mark on a dark ground, -1 dark on bright
     residual_px: Optional[float] = None
+    note: Optional[str] = None  # a refinement's warning, reported only when the mark is used
 
     def to_dict(self) -> dict:
         d = asdict(self)
+        d.pop("note")
         for k in ("x", "y"):
             d[k] = round(d[k], 3)
         d["score"] = round(d["score"], 3)
@@ -142,9 +150,11 @@ class ScanSet:
     image_area: Optional[Tuple[float, float, float, float]]  # x0, y0, x1, y1 output pixels
     interior_orientation: dict
     warnings: List[str] = field(default_factory=list)
+    left_out: Dict[str, str] = field(default_factory=dict)  # scan name -> why it was not restituted
 
     def to_dict(self) -> dict:
         return {
+            "left_out": self.left_out,
             "frame": {k: [round(v[0], 5), round(v[1], 5)] for k, v in self.frame.items()},
             "units": self.units, "calibrated": self.calibrated, "width": self.width, "height": self.height,
             "pixel_size": self.pixel_size,
@@ -410,12 +420,23 @@ def _quadratic_peak(r: np.ndarray, i: int, j: int) -> Tuple[float, float]:
 
 def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
                      template: Optional[np.ndarray] = None,
-                     hints: Optional[Dict[str, str]] = None) -> Tuple[List[Fiducial], List[str]]:
+                     hints: Optional[Dict[str, str]] = None,
+                     frame: Optional[Dict[str, Tuple[float, float]]] = None) -> Tuple[List[Fiducial], List[str]]:
     """Find the fiducial marks of one scan.  Returns (marks with a score >= min_score, warnings).
 
     Positions are sub-pixel, in full-resolution pixels of the scan (corner convention).
     ``hints`` (slot -> mark kind, from an earlier scan of the set) narrows the
     search to that kind; a slot where it fails is searched with every kind.
+
+    Every search window keeps its hits of each mark kind at up to three places;
+    which hit is the mark is decided by geometry before correlation (:func:`_choose_marks`):
+    with ``frame`` (the calibrated fiducial coordinates, slot -> (x, y) mm, y
+    up) the hits that fit it under one similarity transform win, and only the
+    windows of the frame's slots are searched; without it, the hits whose
+    opposite pairs share one midpoint (a fiducial layout is point-symmetric and
+    an affine scan keeps midpoints).  Correlation then only ranks the hits at
+    one place.  A large dot template in the picture can correlate better than
+    a real mark whose ring touches the picture; it must not win.
     """
     options = options or ScanOptions()
     if options.layout not in LAYOUTS:
@@ -431,11 +452,21 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
     g = to_grey(small)
     h, w = g.shape
     kx, ky = full_w / w, full_h / h
-    windows = _windows(h, w, LAYOUTS[options.layout])
+    slots = [s for s in LAYOUTS[options.layout] if frame is None or s in frame]
+    windows = _windows(h, w, slots)
     kinds = MARK_KINDS if options.fiducial_type == "auto" else (options.fiducial_type,)
     groups = _coarse_templates(template, kinds, min(h, w), 0.5 * (kx + ky))
-    coarse = _coarse_search(g, windows, groups, hints or {}, options.min_score)
-    warnings: List[str] = []
+    frame_px = None if frame is None else {k: (v[0], -v[1]) for k, v in frame.items()}  # y down, as the image
+    hints = hints or {}
+    cands = _coarse_search(g, windows, groups, hints, options.min_score)
+    coarse, left = _choose_marks(cands, frame_px)
+    if any(s in hints for s in cands) and (any(s in hints and s not in coarse for s in cands) or len(coarse) < 3):
+        # a hinted kind that does not fit: every kind in every window
+        cands = _coarse_search(g, windows, groups, {}, options.min_score)
+        coarse, left = _choose_marks(cands, frame_px)
+    name = os.path.basename(path)
+    warnings: List[str] = [f"{name}: fiducial {s}: the marks found there do not fit the "
+                           f"{'calibrated coordinates' if frame else 'other marks'}; left out" for s in left]
     if not coarse:
         return [], warnings
     angle = _rotation_deg({k: (v[1], v[2]) for k, v in coarse.items()})
@@ -443,9 +474,10 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
     mark_frac = _mark_fraction(template) if template is not None else 1.0
     out: List[Fiducial] = []
     for slot, hit in coarse.items():
-        f = _refine_mark(ds, path, slot, hit, template, angle, (kx, ky), symmetric_template, mark_frac, warnings)
+        f = _refine_mark(ds, path, slot, hit, template, angle, (kx, ky), symmetric_template, mark_frac)
         if f is not None:
             out.append(f)
+    warnings.extend(f.note for f in out if f.note)
     return out, warnings
 
 
@@ -467,50 +499,169 @@ def _coarse_templates(template: Optional[np.ndarray], kinds: Sequence[str], shor
 
 def _coarse_search(g: np.ndarray, windows: Dict[str, Tuple[int, int, int, int]],
                    groups: Dict[str, List[Tuple[float, np.ndarray]]], hints: Dict[str, str],
-                   min_score: float) -> Dict[str, tuple]:
-    """Best (score, x, y, polarity, kind, size) per window on the reduced scan, for the windows with a mark."""
+                   min_score: float) -> Dict[str, List[tuple]]:
+    """Per window, the hits (score, x, y, polarity, kind, size, z) of every kind that reach ``min_score`` on the
+    reduced scan, at up to three distinct places per kind, strongest first (z: the correlation's evidence, below);
+    windows without a hit are left out.
+    A window with a hint is searched with the hinted kind only, unless it has no hit there."""
     def z_of(sc, tpl):
         # a large template that correlates well is stronger evidence than a small one (a dot of
         # five pixels also fits every full stop of a data strip): rank by atanh(r) * sqrt(side)
         return math.atanh(min(max(sc, 0.0), 0.999)) * math.sqrt(max(tpl.shape))
 
+    def local(win, cx, cy, r):  # a small window around a place, inside the search window
+        return (max(win[0], int(cx - r)), max(win[1], int(cy - r)), min(win[2], int(cx + r) + 1),
+                min(win[3], int(cy + r) + 1))
+
     def search(win, kinds_here):
-        best, best_z = (-1.0,), -np.inf
+        hits = []
         for kind in kinds_here:
-            cands = groups[kind]
-            tried = [(_best_match(g, win, tpl), s, tpl) for s, tpl in cands]
-            if kind != "template":
-                # thin rings and bars are sensitive to scale: refine the size around the two best
-                for (_m, s0, _t) in sorted(tried, key=lambda t: -t[0][0])[:2]:
+            tried = [(_best_match(g, win, tpl), s, tpl) for s, tpl in groups[kind]]
+            # distinct places, the strongest evidence first; a place a little under min_score may reach it at
+            # the mark's own size (a ring cut by the picture edge correlates less at the grid's sizes)
+            places: List[Tuple[float, float, float, tuple]] = []
+            for (sc, cx, cy, pol), s, tpl in sorted(tried, key=lambda t: -z_of(t[0][0], t[2])):
+                if sc < 0.85 * min_score or any(math.hypot(cx - x, cy - y) <= 0.5 * max(s, q) for x, y, q, _ in places):
+                    continue
+                places.append((cx, cy, s, (sc, cx, cy, pol, kind, s, z_of(sc, tpl))))
+                if len(places) == 3:
+                    break
+            for cx, cy, s0, first in places:
+                best = first if first[0] >= min_score else None
+                if kind != "template":  # thin rings and bars are sensitive to scale: refine the size here
                     for f in (0.88, 0.94, 1.06, 1.12):
                         tpl = render_mark(kind, s0 * f)
-                        tried.append((_best_match(g, win, tpl), s0 * f, tpl))
-            for (sc, cx, cy, pol), s, tpl in tried:
-                z = z_of(sc, tpl)
-                if sc >= min_score and z > best_z:
-                    best, best_z = (sc, cx, cy, pol, kind, s), z
-        return best
+                        sc, x, y, pol = _best_match(g, local(win, cx, cy, max(2.0, 0.25 * s0)), tpl)
+                        z = z_of(sc, tpl)
+                        if sc >= min_score and (best is None or z > best[6]):
+                            best = (sc, x, y, pol, kind, s0 * f, z)
+                if best is not None:
+                    hits.append(best)
+        return sorted(hits, key=lambda t: -t[6])
 
-    coarse = {}
+    out = {}
     for slot, win in windows.items():
-        best = (-1.0,)
-        if hints.get(slot) in groups:
-            best = search(win, [hints[slot]])
-        if best[0] < min_score:
-            best = search(win, list(groups))
-        if best[0] >= min_score:
-            coarse[slot] = best
-    return coarse
+        hits = search(win, [hints[slot]]) if hints.get(slot) in groups else []
+        if not hits:
+            hits = search(win, list(groups))
+        if hits:
+            out[slot] = hits
+    return out
+
+
+def _hit_tolerance(hit: tuple, radius: float) -> float:
+    """How far (reduced pixels) a coarse hit may lie from its predicted place and still be the mark: a quarter of
+    the mark, 1 % of the layout's radius (film shrinkage, a scanner's affinity, the similarity's simplification),
+    at least 2 pixels (the coarse grid)."""
+    return max(2.0, 0.25 * hit[5], 0.01 * radius)
+
+
+def _choose_marks(cands: Dict[str, List[tuple]], frame: Optional[Dict[str, Tuple[float, float]]]
+                  ) -> Tuple[Dict[str, tuple], List[str]]:
+    """One hit per window, chosen by geometry first: returns (slot -> hit, slots whose hits fit nothing).
+
+    ``frame`` (slot -> (x, y), y down, any unit): every pair of hits in two windows gives a similarity frame ->
+    reduced scan; the one under which most windows have a hit at their predicted place wins (then the smaller
+    RMS of its refit); each of those windows takes its strongest hit at that place, the others none.  Without a
+    frame: the midpoint of the opposite pairs (TL-BR, T-B, ...) that most pairs of hits share is the fiducial
+    centre; a pair of windows with hits around it takes its strongest such pair (see :func:`_choose_symmetric`).
+    With fewer than two windows (or no agreement) the strongest hit of each window is kept.
+    """
+    best = {s: h[0] for s, h in cands.items() if h}
+    if len(best) < 2:
+        return best, []
+    if frame is None:
+        return _choose_symmetric(cands), []
+    slots = [s for s in best if s in frame]
+    hits = [(s, h) for s in slots for h in cands[s]]
+    fr = {s: np.array(frame[s], float) for s in slots}
+    radius_fr = max(float(np.hypot(*(fr[s] - np.mean(list(fr.values()), axis=0)))) for s in slots)
+
+    def assign(sc, rot, t):
+        pred = {s: sc * rot @ fr[s] + t for s in slots}
+        tol_r = sc * radius_fr
+        chosen = {}
+        for s in slots:
+            near = [h for h in cands[s] if math.hypot(h[1] - pred[s][0], h[2] - pred[s][1]) <= _hit_tolerance(h, tol_r)]
+            if near:
+                chosen[s] = max(near, key=lambda h: h[6])
+        return chosen
+
+    top, top_key = {}, (0, 0.0)
+    for i, (sa, ha) in enumerate(hits):
+        for sb, hb in hits[i + 1:]:
+            if sa == sb:
+                continue
+            sc, rot, t = _similarity(np.array([fr[sa], fr[sb]]), np.array([ha[1:3], hb[1:3]], float))
+            if not sc > 0:
+                continue
+            chosen = assign(sc, rot, t)
+            if len(chosen) < 2:
+                continue
+            src = np.array([fr[s] for s in chosen])
+            dst = np.array([chosen[s][1:3] for s in chosen], float)
+            sc2, rot2, t2 = _similarity(src, dst)
+            chosen = assign(sc2, rot2, t2) or chosen  # the refit's own choice
+            src = np.array([fr[s] for s in chosen])
+            dst = np.array([chosen[s][1:3] for s in chosen], float)
+            sc2, rot2, t2 = _similarity(src, dst)
+            rms = float(np.sqrt(np.mean(np.sum((src @ (sc2 * rot2).T + t2 - dst) ** 2, axis=1))))
+            key = (len(chosen), -rms)
+            if key > top_key:
+                top, top_key = chosen, key
+    if len(top) < 2:
+        return best, []
+    return top, [s for s in slots if s not in top]
+
+
+def _choose_symmetric(cands: Dict[str, List[tuple]]) -> Dict[str, tuple]:
+    """Without calibrated coordinates: hits of opposite windows around one common midpoint (see _choose_marks).
+
+    A pair of hits counts when its midpoint lies within a tenth of the mark (2 px at least: the coarse grid) of
+    the centre and it runs along its slots' direction: within 10 degrees for T-B and L-R (a scan lies nearly
+    upright, or the windows would not hold the marks), 20 for the diagonals (the frame's aspect ratio).  When
+    two pairs or more agree, a pair of windows whose hits do not is left out without a word: the camera has no
+    marks there (the corners of a camera with side marks only); a window whose opposite has no hit keeps its
+    strongest hit."""
+    best = {s: h[0] for s, h in cands.items() if h}
+    pairs = [(a, b) for a, b in OPPOSITE.items() if a in best and b in best]
+    if len(pairs) < 2:
+        return best
+    mids = []
+    for a, b in pairs:
+        ideal = math.atan2(-(SLOTS[b][1] - SLOTS[a][1]), SLOTS[b][0] - SLOTS[a][0])  # image y down
+        limit = math.radians(10.0 if 0 in SLOTS[a] else 20.0)
+        for ha in cands[a]:
+            for hb in cands[b]:
+                turn = math.atan2(hb[2] - ha[2], hb[1] - ha[1]) - ideal
+                if abs((turn + math.pi) % (2 * math.pi) - math.pi) <= limit:
+                    mids.append((a, b, ha, hb, 0.5 * (ha[1] + hb[1]), 0.5 * (ha[2] + hb[2]),
+                                 max(2.0, 0.1 * max(ha[5], hb[5]))))
+    top, top_key = {}, (0, 0.0)
+    for _a, _b, _ha, _hb, mx, my, _tol in mids:
+        chosen = {}
+        for a, b, ha, hb, x, y, tol in mids:
+            if math.hypot(x - mx, y - my) <= tol and ((a, b) not in chosen or ha[6] + hb[6] > chosen[(a, b)][0]):
+                chosen[(a, b)] = (ha[6] + hb[6], ha, hb)
+        key = (len(chosen), sum(v[0] for v in chosen.values()))
+        if key > top_key:
+            top, top_key = chosen, key
+    if len(top) < 2:
+        return best
+    out = {s: h for s, h in best.items() if not any(s in p for p in pairs)}  # no opposite hit to test it with
+    for (a, b), (_z, ha, hb) in top.items():
+        out[a], out[b] = ha, hb
+    return out
 
 
 def _refine_mark(ds, path: str, slot: str, hit: tuple, template: Optional[np.ndarray], angle: float,
-                 k: Tuple[float, float], symmetric_template: bool, mark_frac: float,
-                 warnings: List[str]) -> Optional[Fiducial]:
+                 k: Tuple[float, float], symmetric_template: bool, mark_frac: float) -> Optional[Fiducial]:
     """A coarse hit refined in the full-resolution scan: correlation peak, then the centre of symmetry."""
     cv2 = require("cv2", "scanned film")
 
-    sc, cx, cy, pol, kind, s = hit
+    sc, cx, cy, pol, kind, s = hit[:6]
     kx, ky = k
+    note = None
     full_w, full_h = ds.RasterXSize, ds.RasterYSize
     fx, fy = (cx + 0.5) * kx - 0.5, (cy + 0.5) * ky - 0.5  # full-res pixel-centre coordinates
     size_full = s * 0.5 * (kx + ky)
@@ -556,12 +707,11 @@ def _refine_mark(ds, path: str, slot: str, hit: tuple, template: Optional[np.nda
         if ok and math.hypot(qx - px, qy - py) <= max(2.0 * red, 0.25 * size_full):
             px, py = qx, qy
         else:
-            warnings.append(f"{os.path.basename(path)}: fiducial {slot}: centre of symmetry not found, "
-                            "correlation peak used")
+            note = f"{os.path.basename(path)}: fiducial {slot}: centre of symmetry not found, correlation peak used"
     cx_full, cy_full = x0 + px + 0.5, y0 + py + 0.5
     extent = _mark_extent(ds, cx_full, cy_full, size_full)
     return Fiducial(slot=slot, x=cx_full, y=cy_full, score=min(sc, fine_score) if fine_score > 0 else sc,
-                    kind=kind, size_px=max(size_full, extent), polarity=int(pol))
+                    kind=kind, size_px=max(size_full, extent), polarity=int(pol), note=note)
 
 
 def _mark_extent(ds, x: float, y: float, size: float) -> float:
@@ -763,6 +913,59 @@ def _fit_scan(frame: Dict[str, Tuple[float, float]], fids: List[Fiducial], max_r
             warnings.append(f"{name}: fiducial residuals up to {err.max():.1f} px (limit {max_residual:g}): "
                             "check the marks or the calibrated coordinates")
         return m, use, dropped, warnings
+
+
+def _implausible_fits(fits: Dict[str, tuple], calibrated: bool, res_mm: Dict[str, Optional[float]],
+                      max_residual: float) -> Dict[str, str]:
+    """Scans whose affine cannot be a restitution: scan name -> the warning that names it and says why.
+
+    Residuals a little over ``max_residual`` are a warning (a worn mark, a scratch); a scan is left out when
+
+    - a residual exceeds 4 x ``max_residual`` (with four marks the affine keeps only two redundancies, so a mark
+      found tens of pixels from the real one shows as a fraction of that: something else was found);
+    - the affine is not a film's: x and y scales more than 2 % apart or axes more than 2 degrees from square
+      (shrinkage and scanners stay well under 0.5 %); with three scans or more, measured from the set's median,
+      with two from their mean when they agree (a scanner with non-square pixels gives the whole set one shape);
+    - with three scans or more of known resolution (file tags or ``scan_pixel_size_mm``): its scan pixel in
+      frame units, over that resolution, is more than 5 % off the set's median (film shrinkage differs by
+      tenths of a percent; a wrong resolution given for the whole set moves them all alike).
+
+    A wrong restitution would otherwise travel silently into the alignment (wrong pixel size, a rotated
+    frame); a user expects the set's good scans prepared and the bad one named, so it is left out with a
+    warning, and the stage fails when fewer than two scans remain (:func:`prepare_scans`).
+    """
+    shape = {}
+    for n, (m, _used, _d, _w) in fits.items():
+        ex, ey = m[:, 0], m[:, 1]  # the frame's axes in the scan
+        cos = float(ex @ ey) / float(np.linalg.norm(ex) * np.linalg.norm(ey))
+        shape[n] = (float(np.linalg.norm(ex) / np.linalg.norm(ey)) - 1.0, math.degrees(math.asin(max(-1.0, min(1.0, cos)))))
+    ref = np.median(np.array(list(shape.values())), axis=0) if len(fits) >= 3 else np.zeros(2)
+    if len(fits) == 2:  # two scans of one shape (a scanner's non-square pixels) are that shape
+        a, b = shape.values()
+        if abs(a[0] - b[0]) <= 0.02 and abs(a[1] - b[1]) <= 2.0:
+            ref = 0.5 * (np.array(a) + np.array(b))
+    # frame units per scan pixel over the file's resolution: one value for the set whatever the scans' dpi
+    ratio = {n: 1.0 / math.sqrt(abs(np.linalg.det(f[0][:, :2]))) / res_mm[n] for n, f in fits.items() if res_mm.get(n)}
+    ref_ratio = float(np.median(list(ratio.values()))) if len(ratio) >= 3 else None
+    out = {}
+    for n, (_m, used, _d, _w) in fits.items():
+        worst = max(used, key=lambda f: f.residual_px or 0.0)
+        aniso, skew = shape[n]
+        if worst.residual_px > 4.0 * max_residual:
+            why = (f"fiducial {worst.slot} lies {worst.residual_px:.1f} px from the affine fit (limit {max_residual:g}, "
+                   f"{4 * max_residual:g} at most): the marks found do not fit the "
+                   f"{'calibrated coordinates' if calibrated else 'set'}")
+        elif abs(aniso - ref[0]) > 0.02 or abs(skew - ref[1]) > 2.0:
+            why = (f"the fiducial fit scales x and y {100 * aniso:+.1f} % apart and skews the axes by {skew:.1f} deg"
+                   + (f" (the set: {100 * ref[0]:+.1f} %, {ref[1]:.1f} deg)" if ref.any() else "")
+                   + ": not a film's shrinkage")
+        elif ref_ratio and n in ratio and abs(ratio[n] / ref_ratio - 1.0) > 0.05:
+            why = (f"the fiducial fit gives {ratio[n] * res_mm[n]:.4f} mm scan pixels at a resolution of "
+                   f"{res_mm[n]:.4f} mm, {100 * (ratio[n] / ref_ratio - 1):+.1f} % off the set's other scans")
+        else:
+            continue
+        out[n] = f"{n}: left out: {why}; check the marks (fiducial type, template) or the coordinates"
+    return out
 
 
 def _consistent_slots(dets: Dict[str, List[Fiducial]], tol_frac: float = 0.01) -> Tuple[List[str], List[str]]:
@@ -973,7 +1176,14 @@ def _prepared_names(paths: Sequence[str]) -> List[str]:
 
 def prepare_scans(paths: Sequence[str], out_dir: str, masks_dir: str, options: Optional[ScanOptions] = None,
                   progress: Optional[Progress] = None) -> ScanSet:
-    """Detect fiducials in every scan, resample all into one frame, write prepared images and masks."""
+    """Detect fiducials in every scan, resample all into one frame, write prepared images and masks.
+
+    A scan whose fiducial fit cannot be a restitution (residuals over 4 x ``max_residual_px``, a shape or scale
+    unlike a film's or the set's: :func:`_implausible_fits`) is left out: no prepared image, no mask, a warning
+    that names it and says why, and ``ScanSet.left_out``; the good scans of the set are prepared.  ScanError when
+    fewer than 2 scans would remain (the message names each scan left out and why): never a restitution that
+    is silently wrong.  Residuals over ``max_residual_px`` but under that are warnings.
+    """
     options = options or ScanOptions()
     progress = progress or NullProgress()
     if not paths:
@@ -989,11 +1199,20 @@ def prepare_scans(paths: Sequence[str], out_dir: str, masks_dir: str, options: O
     # 2. the frame
     frame, units, calibrated = _set_frame(dets, res_mm, calib, options, warnings)
 
-    # 3. per-scan affine
+    # 3. per-scan affine; a scan whose marks do not fit the frame is left out
     fits: Dict[str, Tuple[np.ndarray, List[Fiducial], List[str], List[str]]] = {}
     for n in names:
         fits[n] = _fit_scan(frame, dets[n], options.max_residual_px, n)
+    left_out = _implausible_fits(fits, calibrated, {n: options.scan_pixel_size_mm or res_mm[n] for n in names},
+                                 options.max_residual_px)
+    if left_out and len(names) - len(left_out) < 2:
+        raise ScanError("fewer than 2 scans can be restituted: " + "; ".join(left_out.values()))
+    warnings.extend(left_out.values())
+    paths = [p_ for p_, n in zip(paths, names) if n not in left_out]
+    names = [n for n in names if n not in left_out]
+    for n in names:
         warnings.extend(fits[n][3])
+        warnings.extend(f.note for f in fits[n][1] if f.note)
     scan_px = {n: 1.0 / math.sqrt(abs(np.linalg.det(fits[n][0][:, :2]))) for n in names}  # frame units / scan px
     p = float(options.output_pixel_size or np.median(list(scan_px.values())))
     mark_size = float(np.median([f.size_px * scan_px[n] for n in names for f in fits[n][1]]))
@@ -1042,7 +1261,7 @@ def prepare_scans(paths: Sequence[str], out_dir: str, masks_dir: str, options: O
         progress.report(0.9 + 0.1 * (i + 1) / len(scans), f"masks: {i + 1}/{len(scans)}")
     return ScanSet(scans=scans, frame={k: (float(v[0]), float(v[1])) for k, v in frame.items()}, units=units,
                    calibrated=calibrated, width=width, height=height, pixel_size=p, image_area=image_area,
-                   interior_orientation=io, warnings=warnings)
+                   interior_orientation=io, warnings=warnings, left_out=left_out)
 
 
 def _detect_set(paths: Sequence[str], names: Sequence[str], options: ScanOptions,
@@ -1055,17 +1274,19 @@ def _detect_set(paths: Sequence[str], names: Sequence[str], options: ScanOptions
     hints: Dict[str, str] = {}
     for i, (p, n) in enumerate(zip(paths, names)):
         check_cancel(progress)
-        fids, w = detect_fiducials(p, options, template, hints)
+        fids, w = detect_fiducials(p, options, template, hints, calib.points if calib is not None else None)
         for f in fids:
             hints.setdefault(f.slot, f.kind)
-        warnings.extend(w)
+        notes = {f.note for f in fids}
+        warnings.extend(x for x in w if x not in notes)  # a mark's note only when it is used (prepare_scans)
         if calib is not None:
             fids = [f for f in fids if f.slot in calib.points]
         if len(fids) < 3:
+            misfit = "".join(f"; {x.split(': ', 1)[1]}" for x in w if x not in notes)
             raise ScanError(f"{p}: only {len(fids)} fiducial mark(s) found "
                             f"({', '.join(f.slot for f in fids) or 'none'}; best correlation must reach "
-                            f"{options.min_score:g}); at least 3 are needed. Check the fiducial type and layout, "
-                            "or give a template image of one mark")
+                            f"{options.min_score:g}{misfit}); at least 3 are needed. Check the fiducial type and "
+                            "layout, or give a template image of one mark")
         dets[n] = fids
         ds = open_image(p)
         sizes[n] = (ds.RasterXSize, ds.RasterYSize)

@@ -272,7 +272,9 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
     the stage record.  Raises ImageError (naming the file), ScreeningError,
     core.prepare.scans.ScanError, WorkspaceError or Cancelled.  A file that cannot be used (empty, not an
     image, truncated) is skipped with a warning naming it and why (in ``warnings`` and the stage's
-    ``skipped_files``), as 'Align images' skips it; fewer than 2 usable images is a ScreeningError.
+    ``skipped_files``), as 'Align images' skips it; fewer than 2 usable images is a ScreeningError.  A scan
+    whose fiducial marks cannot give its restitution is left out the same way (a warning naming it and why,
+    the stage's ``left_out_scans``; :func:`core.prepare.scans.prepare_scans`).
     """
     options = options or PrepareOptions()
     progress = progress or NullProgress()
@@ -321,10 +323,12 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
                 screen_masks.update(sc.mask_files)
                 with run.step("screening", save=False):
                     quality = screen_folder(sc.folder, options.screening, sp, sc.names, screen_masks, check=False)
-                # screening measured prepared scans: report under the original names
-                for orig, q in zip(names, quality):
+                # screening measured prepared scans: report under the original names (a scan left out by
+                # the restitution has none)
+                original = {v: k for k, v in sc.aliases.items()}
+                for q in quality:
                     q.prepared_name = q.name
-                    q.name = orig
+                    q.name = original.get(q.name, q.name)
                 check_cancel(progress)
                 _fill_prepared(tmp, images_dir, quality, options.scanned_film)
                 check_cancel(progress)
@@ -351,6 +355,8 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
                 "interior_orientation": io, "masks": len(written_masks),
                 "user_masked_images": {n: user_masked[n] for n in sorted(user_masked)},
                 "skipped_files": list(skipped),
+                **({"left_out_scans": dict(sc.scan_set.left_out)} if sc.scan_set is not None and sc.scan_set.left_out
+                   else {}),
                 **({"sky_masked_images": {n: sky_masked[n] for n in sorted(sky_masked)}} if options.sky_masks else {}),
                 "total_seconds": round(time.time() - t_start, 2)})
     finally:
