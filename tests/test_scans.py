@@ -478,6 +478,10 @@ def test_side_marks_touching_the_picture_found_with_calibrated_coordinates(touch
         assert s.rotation_deg == pytest.approx(block.frame(s.name).scan.rotation_deg, abs=0.02)
     assert res.pixel_size == pytest.approx(0.2, rel=2e-3)
     assert not [w for w in res.warnings if "fiducial" in w], res.warnings
+    # the marks' size (masks, margin) is the 4 mm ring's, not the picture it touches (was 116 px, 23 mm)
+    mark_px = block.camera.mark_mm / block.camera.pixel_mm
+    assert all(f.size_px <= 2.0 * mark_px for s in res.scans for f in s.fiducials)
+    assert res.width <= 2 * math.ceil((117.0 + 2.0 * block.camera.mark_mm) / 0.2)
 
 
 def test_side_marks_touching_the_picture_found_without_calibrated_coordinates(touching_block, tmp_path):

@@ -710,6 +710,8 @@ def _refine_mark(ds, path: str, slot: str, hit: tuple, template: Optional[np.nda
             note = f"{os.path.basename(path)}: fiducial {slot}: centre of symmetry not found, correlation peak used"
     cx_full, cy_full = x0 + px + 0.5, y0 + py + 0.5
     extent = _mark_extent(ds, cx_full, cy_full, size_full)
+    if kind in ("cross", "ring_dot", "cross_ring"):  # the template is the whole mark (a cross at least 0.7 of a ring)
+        extent = min(extent, 1.5 * size_full)  # a ring touching the picture does not make the picture the mark
     return Fiducial(slot=slot, x=cx_full, y=cy_full, score=min(sc, fine_score) if fine_score > 0 else sc,
                     kind=kind, size_px=max(size_full, extent), polarity=int(pol), note=note)
 
