@@ -30,8 +30,10 @@ def check_contours_output(output: str) -> None:
 
 def write_contours(raster_path: str, output: str, interval: float, progress: Progress = None,
                    what: str = "DTM") -> int:
-    """Contours of ``raster_path`` every ``interval`` (its height units) into ``output`` (GeoPackage, layer
-    'contours', fields 'id', 'elevation'); returns the number of lines."""
+    """Contours of ``raster_path`` every ``interval`` metres into ``output`` (GeoPackage, layer 'contours', fields
+    'id', 'elevation' in metres); returns the number of lines.  A raster whose CRS is in feet has its heights in
+    feet: the interval is converted (1 m, not 1 ft), and so is the elevation field (the lines' own Z stays the
+    raster's)."""
     from osgeo import gdal, ogr, osr
 
     gdal.UseExceptions()
@@ -43,7 +45,7 @@ def write_contours(raster_path: str, output: str, interval: float, progress: Pro
     check_contours_output(output)
     elev = read_elevation(raster_path, what)  # the checks: projected, data, size
     zmin, zmax = float(np.nanmin(elev.z)), float(np.nanmax(elev.z))
-    n_levels = (zmax - zmin) / (interval * elev.unit)
+    n_levels = (zmax - zmin) / interval  # elev.z is in metres
     if n_levels > 5000:
         raise TerrainError(f"a contour interval of {interval:g} gives {n_levels:.0f} levels over the "
                            f"{zmax - zmin:.1f} m of {raster_path}: choose a larger interval")
@@ -56,7 +58,8 @@ def write_contours(raster_path: str, output: str, interval: float, progress: Pro
         lyr = out.CreateLayer(LAYER, srs, ogr.wkbLineString25D)
         lyr.CreateField(ogr.FieldDefn("id", ogr.OFTInteger))
         lyr.CreateField(ogr.FieldDefn(ELEVATION_FIELD, ogr.OFTReal))
-        opts = [f"LEVEL_INTERVAL={interval:g}", "ID_FIELD=0", "ELEV_FIELD=1"]  # field indices
+        # field indices; the interval in the raster's own height units
+        opts = [f"LEVEL_INTERVAL={interval / elev.unit!r}", "ID_FIELD=0", "ELEV_FIELD=1"]
         nd = band.GetNoDataValue()
         if nd is not None:
             opts.append(f"NODATA={nd:g}")
@@ -71,6 +74,19 @@ def write_contours(raster_path: str, output: str, interval: float, progress: Pro
             check_cancel(progress)
             raise TerrainError(f"cannot make contours of {raster_path}: {e}") from e
         n = lyr.GetFeatureCount()
+        if elev.unit != 1.0:
+            _elevations_in_metres(out, lyr, elev.unit)
         out = None
     ds = None
     return n
+
+
+def _elevations_in_metres(ds, lyr, unit: float) -> None:
+    """The elevation field of every contour times ``unit`` (metres per height unit of the raster), rounded to the
+    millimetre so that a 1 m interval reads 1, 2, 3."""
+    ds.StartTransaction()
+    lyr.ResetReading()
+    for f in lyr:
+        f.SetField(ELEVATION_FIELD, round(f.GetFieldAsDouble(ELEVATION_FIELD) * unit, 3))
+        lyr.SetFeature(f)
+    ds.CommitTransaction()

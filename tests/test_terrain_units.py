@@ -1,0 +1,37 @@
+"""Heights in feet (issue 36 item 4): contours asked every metre of a DSM in a CRS in US survey feet are drawn every
+metre (were every foot), and their elevation field is in metres."""
+from __future__ import annotations
+
+import numpy as np
+from osgeo import gdal, ogr, osr
+
+from core.terrain.contours import ELEVATION_FIELD, LAYER, write_contours
+
+US_FOOT = 1200.0 / 3937.0
+
+
+def _dsm_in_feet(path: str) -> float:
+    """A tilted plane from 100 to 130 m, written in feet in EPSG:3734 (Ohio North, US survey feet); its range (m)."""
+    n = 64
+    z_m = np.tile(np.linspace(100.0, 130.0, n), (n, 1))
+    ds = gdal.GetDriverByName("GTiff").Create(path, n, n, 1, gdal.GDT_Float32)
+    ds.SetGeoTransform((2200000.0, 3.0, 0.0, 700000.0, 0.0, -3.0))  # 3 ft cells
+    srs = osr.SpatialReference()
+    srs.ImportFromEPSG(3734)
+    ds.SetProjection(srs.ExportToWkt())
+    ds.GetRasterBand(1).WriteArray((z_m / US_FOOT).astype(np.float32))
+    ds = None
+    return 30.0
+
+
+def test_contours_of_a_dsm_in_feet_are_every_metre_in_metres(tmp_path):
+    path = str(tmp_path / "dsm_ft.tif")
+    _dsm_in_feet(path)
+    out = str(tmp_path / "c.gpkg")
+    n = write_contours(path, out, 1.0, what="DSM")
+    ds = ogr.Open(out)
+    levels = sorted({round(f.GetField(ELEVATION_FIELD), 3) for f in ds.GetLayerByName(LAYER)})
+    # every metre from 101 to 129 (1-ft contours were 3.28 x as many, at 328.084 ft ...)
+    assert 28 <= len(levels) <= 31 and n == len(levels), levels
+    assert np.allclose(levels, np.round(levels), atol=0.002), levels
+    assert 100.0 <= levels[0] <= 101.0 and 129.0 <= levels[-1] <= 130.0, levels
