@@ -35,3 +35,24 @@ def test_contours_of_a_dsm_in_feet_are_every_metre_in_metres(tmp_path):
     assert 28 <= len(levels) <= 31 and n == len(levels), levels
     assert np.allclose(levels, np.round(levels), atol=0.002), levels
     assert 100.0 <= levels[0] <= 101.0 and 129.0 <= levels[-1] <= 130.0, levels
+
+
+def test_the_difference_of_a_dsm_in_feet_and_one_in_metres_is_in_metres(tmp_path):
+    """dsmdifference of a metre DSM and the same surface in feet reported 22 m of change everywhere."""
+    from core.io.raster import height_unit
+    from core.terrain.difference import dsm_difference
+
+    feet = str(tmp_path / "dsm_ft.tif")
+    _dsm_in_feet(feet)
+    metres = str(tmp_path / "dsm_m.tif")
+    gdal.Translate(metres, feet)
+    ds = gdal.Open(metres, gdal.GA_Update)
+    band = ds.GetRasterBand(1)
+    band.WriteArray(band.ReadAsArray() * US_FOOT + 0.5)  # the same surface in metres, 0.5 m higher
+    band.SetUnitType("m")
+    ds = None
+    assert abs(height_unit(feet)[1] - US_FOOT) < 1e-12 and height_unit(metres)[1] == 1.0
+    out = str(tmp_path / "diff.tif")
+    r = dsm_difference(feet, metres, out)
+    assert abs(r.median - 0.5) < 0.01 and r.p95 - r.p5 < 0.02, r
+    assert height_unit(out)[1] == 1.0  # the difference says it is in metres, on the grid in feet

@@ -147,8 +147,9 @@ class Grid:
 
 def write_cog(path: str, array: np.ndarray, geotransform: Sequence[float], crs: Optional[str],
               nodata: float = NODATA, progress: Optional[Progress] = None,
-              description: str = "DSM", metadata: Optional[dict] = None) -> str:
-    """Write a single-band float32 Cloud-Optimized GeoTIFF (DEFLATE, overviews) atomically.
+              description: str = "DSM", metadata: Optional[dict] = None, unit: str = "") -> str:
+    """Write a single-band float32 Cloud-Optimized GeoTIFF (DEFLATE, overviews) atomically; ``unit``: the band's
+    unit type where the values' unit is not the CRS's (a difference in metres on a grid in feet: "m").
 
     NaN cells become ``nodata``.  ``crs`` None writes no CRS (local frame).  A cancel or crash
     leaves no file at ``path`` (a previous complete file stays until the new one is complete)."""
@@ -164,6 +165,8 @@ def write_cog(path: str, array: np.ndarray, geotransform: Sequence[float], crs: 
         band = mem.GetRasterBand(1)
         band.SetNoDataValue(float(nodata))
         band.SetDescription(description)
+        if unit:
+            band.SetUnitType(unit)
         band.WriteArray(data)
         if metadata:
             mem.SetMetadata({str(k): str(v) for k, v in metadata.items()})

@@ -114,7 +114,8 @@ def _warp(r: _Raster, wkt: str, gt: Tuple[float, ...], w: int, h: int) -> np.nda
 
 def dsm_difference(dsm_a: str, dsm_b: str, output: str, resolution: Optional[float] = None,
                    threshold: float = CHANGE_THRESHOLD, progress: Optional[Progress] = None) -> DsmDifference:
-    """Write ``b - a`` (float32 Cloud-Optimized GeoTIFF, nodata where either DSM has none) on the grid of
+    """Write ``b - a`` in metres (float32 Cloud-Optimized GeoTIFF, nodata where either DSM has none; each DSM's
+    heights read in their own unit, io.raster.height_unit) on the grid of
     ``dsm_a`` to ``output`` and return its figures.  ``resolution``: cells of that size over a's extent instead
     of a's own cells (both warped, bilinear).  Raises TerrainError naming the file: missing, not a raster, no
     CRS, rotated, the two not overlapping or sharing no cell with data."""
@@ -122,10 +123,11 @@ def dsm_difference(dsm_a: str, dsm_b: str, output: str, resolution: Optional[flo
     a, b = _open(dsm_a, "DSM A"), _open(dsm_b, "DSM B")
     refuse_overwriting_inputs({"DSM difference": output}, {"DSM A": a.path, "DSM B": b.path}, TerrainError)
     gt, w, h = _grid(a, resolution)
-    za = _warp(a, a.wkt, gt, w, h)
+    # heights in metres, each from its own unit (a DSM in feet against one in metres was 22 m of "change")
+    za = _warp(a, a.wkt, gt, w, h) * raster.height_unit(a.path)[1]
     progress.report(0.3, "DSM A read")
     check_cancel(progress)
-    zb = _warp(b, a.wkt, gt, w, h)
+    zb = _warp(b, a.wkt, gt, w, h) * raster.height_unit(b.path)[1]
     progress.report(0.6, "DSM B warped onto the grid of DSM A")
     check_cancel(progress)
     if not np.isfinite(zb).any():
@@ -143,7 +145,7 @@ def dsm_difference(dsm_a: str, dsm_b: str, output: str, resolution: Optional[flo
                         int(np.count_nonzero(np.abs(v) > threshold)), float(threshold), res, w, h)
     meta = {"dsm_a": os.path.abspath(dsm_a), "dsm_b": os.path.abspath(dsm_b),
             **{k: f"{val:.6g}" if isinstance(val, float) else val for k, val in out.figures().items()}}
-    raster.write_cog(output, d, gt, a.wkt, description="DSM difference (B - A)", metadata=meta,
+    raster.write_cog(output, d, gt, a.wkt, description="DSM difference (B - A), metres", metadata=meta, unit="m",
                      progress=progress)
     progress.report(1.0, "DSM difference written")
     return out

@@ -20,7 +20,7 @@ class Elevation:
     geotransform: Tuple[float, ...]
     crs_wkt: str
     cell: float  # metres
-    unit: float  # metres per CRS unit (the heights are scaled by it, and back on writing)
+    unit: float  # metres per height unit (io.raster.height_unit: the heights are scaled by it, and back on writing)
 
     @property
     def shape(self) -> Tuple[int, int]:
@@ -83,14 +83,16 @@ def read_elevation(path: str, what: str = "DSM") -> Elevation:
     check_elevation_kind(ds, path, what)
     gt = ds.GetGeoTransform()
     wkt = ds.GetProjection() or ""
-    unit = 1.0
+    xy_unit = 1.0
     if wkt:
         srs = osr.SpatialReference(wkt=wkt)
         if srs.IsGeographic():
             raise TerrainError(f"the {what} {path} is in a geographic CRS ({srs.GetName()}, cells in degrees): a "
                                "terrain model needs metres; reproject it to a projected CRS (e.g. its UTM zone) "
                                "with Raster > Projections > Warp first")
-        unit = float(srs.GetLinearUnits() or 1.0)
+        xy_unit = float(srs.GetLinearUnits() or 1.0)
+    unit = raster.height_unit(path)[1]  # the heights' own unit: the band's, a vertical CRS's, else the axes'
+
     check_north_up(path, what, gt)
     if abs(abs(gt[1]) - abs(gt[5])) > 1e-6 * abs(gt[1]):
         raise TerrainError(f"the {what} {path} has non-square cells ({gt[1]:g} x {abs(gt[5]):g}): resample it to "
@@ -112,7 +114,7 @@ def read_elevation(path: str, what: str = "DSM") -> Elevation:
     if n_valid < MIN_CELLS * MIN_CELLS:
         raise TerrainError(f"the {what} {path} has only {n_valid} cells with data: too few for a terrain model "
                            f"(at least {MIN_CELLS * MIN_CELLS})")
-    return Elevation(path, z * unit, tuple(gt), wkt, abs(gt[1]) * unit, unit)
+    return Elevation(path, z * unit, tuple(gt), wkt, abs(gt[1]) * xy_unit, unit)
 
 
 def write_float(path: str, array: np.ndarray, elev: Elevation, description: str, metadata: dict,
