@@ -499,3 +499,18 @@ def test_a_certificate_typed_in_windows_1252_reads_and_a_binary_file_does_not(tm
     path.write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00")
     with pytest.raises(CalibrationError, match="not a text file"):
         read_calibration(str(path))
+
+
+def test_prepare_images_reads_the_fiducials_of_a_calibration_file():
+    """The certificate typed once: Prepare images' fiducial coordinates may be the calibration file Align images
+    reads (was refused: 'expected id x y'); a calibration without fiducials says so, naming the file."""
+    from core.prepare.scans import ScanError, parse_fiducial_coordinates
+
+    path = _data("rc20_certificate.yaml")
+    cal = read_calibration(path)[0]
+    from_file = parse_fiducial_coordinates(path)
+    from_text = parse_fiducial_coordinates(cal.fiducial_coordinates_text())
+    assert from_file.focal_length_mm == pytest.approx(152.817)
+    assert from_file.points == from_text.points and from_file.ids == from_text.ids and len(from_file.points) == 4
+    with pytest.raises(ScanError, match=r"same_camera\.yaml: no camera of this calibration file gives fiducial"):
+        parse_fiducial_coordinates(_data("same_camera.yaml"))

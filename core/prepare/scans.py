@@ -759,8 +759,29 @@ def _mark_extent(ds, x: float, y: float, size: float) -> float:
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 
 
+CALIBRATION_FILE_EXTENSIONS = (".yaml", ".yml", ".json", ".xml")  # a camera calibration (core.io.calibration)
+
+
+def _fiducials_of_calibration(path: str) -> str:
+    """The fiducial coordinates (and principal point, focal length) of the one camera of a calibration file that
+    has them, as parse_fiducial_coordinates' text; ScanError naming the file when none or several have them."""
+    from ..io.calibration import CalibrationError, read_calibration
+
+    try:
+        cams = [c for c in read_calibration(path) if c.fiducials_mm]
+    except CalibrationError as e:
+        raise ScanError(str(e)) from e
+    if len(cams) != 1:
+        which = "no camera of this calibration file gives" if not cams else f"{len(cams)} cameras of it give"
+        raise ScanError(f"{path}: {which} fiducial coordinates; the scans need exactly one camera's (or give the "
+                        "marks as text: 'id x y' per line, in mm)")
+    return cams[0].fiducial_coordinates_text()
+
+
 def parse_fiducial_coordinates(spec: str) -> CalibratedFiducials:
-    """Calibrated fiducial coordinates from a file path or text.
+    """Calibrated fiducial coordinates from a file path or text; a camera calibration file (.yaml, .yml, .json,
+    .xml: core.io.calibration, the one its Align images reads) gives its camera's fiducials, principal point and
+    focal length.
 
     One mark per line: ``id x y`` (or ``x y``), in mm, x right, y up (the
     calibration certificate's photo coordinates); separators: spaces, commas,
@@ -772,7 +793,9 @@ def parse_fiducial_coordinates(spec: str) -> CalibratedFiducials:
     centre of all marks.
     """
     text = spec
-    if spec and os.path.isfile(spec):
+    if spec and os.path.isfile(spec) and spec.lower().endswith(CALIBRATION_FILE_EXTENSIONS):
+        text = _fiducials_of_calibration(spec)
+    elif spec and os.path.isfile(spec):
         try:
             with open(spec, encoding="utf-8-sig") as f:
                 text = f.read()
