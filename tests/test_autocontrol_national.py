@@ -364,3 +364,29 @@ def test_products_carry_a_crs_without_epsg_code(tmp_path, exceptions_on):
     assert n == 3 and [rid for _, rid, _ in header["vlrs"]] == [2112]
     stored = header["vlrs"][0][2].rstrip(b"\0").decode()
     assert osr.SpatialReference(wkt=stored).IsSame(osr.SpatialReference(wkt=wkt))
+
+
+def test_a_virtual_reference_whose_source_is_gone_is_named_before_any_work(tmp_path):
+    """Issue 36 item 10: a VRT reference whose source file was moved ended in a traceback from gdal.Warp in
+    Reference.grey, after the matching had started; now the reference is refused when opened, naming both files."""
+    from osgeo import gdal, osr
+
+    from core.georef.autocontrol.errors import AutoControlError
+    from core.georef.autocontrol.reference import Reference
+
+    srs = osr.SpatialReference()
+    srs.ImportFromEPSG(32633)
+    paths = {}
+    for name in ("ortho", "dsm"):
+        ds = gdal.GetDriverByName("GTiff").Create(str(tmp_path / f"{name}.tif"), 64, 64, 1, gdal.GDT_Float32)
+        ds.SetGeoTransform((500000.0, 1.0, 0.0, 4000000.0, 0.0, -1.0))
+        ds.SetProjection(srs.ExportToWkt())
+        ds.GetRasterBand(1).Fill(100.0)
+        ds = None
+        paths[name] = str(tmp_path / f"{name}.tif")
+    vrt = str(tmp_path / "ortho.vrt")
+    gdal.BuildVRT(vrt, [paths["ortho"]])
+    Reference(vrt, paths["dsm"]).close()  # while its source is there
+    os.rename(paths["ortho"], str(tmp_path / "moved.tif"))
+    with pytest.raises(AutoControlError, match=r"ortho\.vrt refers to .*ortho\.tif, which does not exist"):
+        Reference(vrt, paths["dsm"])

@@ -47,6 +47,37 @@ def result_crs(ortho_path: str) -> str:
     return crs_identifier(_working_crs(ortho_path, ds, ds.GetGeoTransform(), wkt)[0])
 
 
+def _vrt_sources(ds, path: str) -> List[str]:
+    """The files a virtual raster's bands read (GDAL's GetFileList leaves out the missing ones)."""
+    import xml.etree.ElementTree as ET
+
+    if ds.GetDriver().ShortName != "VRT":
+        return []
+    text = (ds.GetMetadata("xml:VRT") or [""])[0]
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError:
+        return []
+    out = []
+    for el in root.iter("SourceFilename"):
+        name = (el.text or "").strip()
+        if name and el.get("relativeToVRT") == "1":
+            name = os.path.join(os.path.dirname(os.path.abspath(path)), name)
+        out.append(name)
+    return out
+
+
+def _check_sources(path: str, ds, what: str) -> None:
+    """AutoControlError naming ``path`` and the missing file when a raster made of other files (a VRT, a
+    GeoTIFF with an external mask or overview) refers to one that does not exist (issue 36 item 10: a traceback
+    from gdal.Warp, after the matching had started)."""
+    for f in _vrt_sources(ds, path) if ds is not None else []:
+        if f.startswith("/vsi") or os.path.exists(f):
+            continue
+        raise AutoControlError(f"{what} {path} refers to {f}, which does not exist (a virtual raster whose source "
+                               "file was moved or deleted?): make it point to the file, or give the file itself")
+
+
 class Reference:
     """``ortho_path``, ``dsm_path``: rasters GDAL reads, north-up, in any CRS (a national one without an EPSG
     code too).  The control is made in the orthophoto's CRS (``crs_wkt``), or in the UTM zone of its centre when
@@ -64,6 +95,7 @@ class Reference:
             raise AutoControlError(f"reference orthophoto {ortho_path} is not a raster GDAL can read: {e}") from e
         if ds is None or ds.RasterCount < 1:
             raise AutoControlError(f"reference orthophoto {ortho_path} is not a raster GDAL can read")
+        _check_sources(ortho_path, ds, "reference orthophoto")
         gt = ds.GetGeoTransform(can_return_null=True)
         if gt is None:
             raise AutoControlError(f"reference orthophoto {ortho_path} has no georeferencing (geotransform)")
@@ -89,6 +121,10 @@ class Reference:
         self.n_bands = ds.RasterCount
         self._gdal = gdal
         self._ds = ds
+        try:
+            _check_sources(dsm_path, gdal.Open(dsm_path), "reference DSM")
+        except RuntimeError as e:
+            raise AutoControlError(f"reference DSM {dsm_path} is not a raster GDAL can read: {e}") from e
         try:
             self.dsm = DsmReader(dsm_path, self.crs_wkt)
         except DsmError as e:
@@ -118,8 +154,12 @@ class Reference:
         w = max(1, int(round((xmax - xmin) / res)))
         h = max(1, int(round((ymax - ymin) / res)))
         alg = "average" if res > 1.2 * self.gsd else "bilinear"
-        out = self._gdal.Warp("", self._ds, format="MEM", outputBounds=(xmin, ymax - h * res, xmin + w * res, ymax),
-                              width=w, height=h, resampleAlg=alg, dstAlpha=True)
+        try:
+            out = self._gdal.Warp("", self._ds, format="MEM",
+                                  outputBounds=(xmin, ymax - h * res, xmin + w * res, ymax),
+                                  width=w, height=h, resampleAlg=alg, dstAlpha=True)
+        except RuntimeError as e:  # a source of a virtual raster gone since it was opened, a damaged tile
+            raise AutoControlError(f"reference orthophoto {self.ortho_path} cannot be read over the block: {e}") from e
         if out is None:
             raise AutoControlError(f"reference orthophoto {self.ortho_path}: cannot resample it to {res:g} per pixel")
         bands = [out.GetRasterBand(k + 1).ReadAsArray().astype(np.float32) for k in range(out.RasterCount)]
