@@ -390,3 +390,48 @@ def test_a_virtual_reference_whose_source_is_gone_is_named_before_any_work(tmp_p
     os.rename(paths["ortho"], str(tmp_path / "moved.tif"))
     with pytest.raises(AutoControlError, match=r"ortho\.vrt refers to .*ortho\.tif, which does not exist"):
         Reference(vrt, paths["dsm"])
+
+
+def test_a_wrong_reference_is_named_with_what_is_wrong_before_any_work(tmp_path):
+    """Issue 36 item 12: an orthophoto of 1 x 1 pixel or all nodata, a DSM that is a picture or all nodata, the two
+    swapped: each said which reference is wrong and why (was '0 candidate(s) kept, 4 needed' after the work);
+    nothing is written beside the user's files."""
+    from osgeo import gdal, osr
+
+    from core.georef.autocontrol.errors import AutoControlError
+    from core.georef.autocontrol.reference import Reference
+
+    srs = osr.SpatialReference()
+    srs.ImportFromEPSG(32633)
+
+    def raster(name, n, bands, dtype, fill, nodata=None, unit="", rgb=False):
+        path = str(tmp_path / name)
+        ds = gdal.GetDriverByName("GTiff").Create(path, n, n, bands, dtype, ["PHOTOMETRIC=RGB"] if rgb else [])
+        ds.SetGeoTransform((500000.0, 1.0, 0.0, 4000000.0, 0.0, -1.0))
+        ds.SetProjection(srs.ExportToWkt())
+        for k in range(bands):
+            band = ds.GetRasterBand(k + 1)
+            if nodata is not None:
+                band.SetNoDataValue(nodata)
+            if unit:
+                band.SetUnitType(unit)
+            band.Fill(fill)
+        ds = None
+        return path
+
+    ortho = raster("ortho.tif", 64, 3, gdal.GDT_Byte, 120, rgb=True)
+    dsm = raster("dsm.tif", 64, 1, gdal.GDT_Float32, 150.0, unit="m")
+    Reference(ortho, dsm).close()  # the right ones
+    cases = [
+        (raster("one.tif", 1, 3, gdal.GDT_Byte, 120, rgb=True), dsm, r"one\.tif is 1 x 1 pixels: too small"),
+        (raster("empty.tif", 64, 1, gdal.GDT_Byte, 0, nodata=0), dsm, r"orthophoto .*empty\.tif has no data"),
+        (ortho, raster("nodsm.tif", 64, 1, gdal.GDT_Float32, -9999.0, nodata=-9999.0),
+         r"DSM .*nodsm\.tif has no data"),
+        (ortho, ortho, r"DSM .*ortho\.tif is a picture"),
+        (dsm, ortho, "the references look swapped"),
+    ]
+    before = sorted(os.listdir(tmp_path))
+    for o, d, message in cases:
+        with pytest.raises(AutoControlError, match=message):
+            Reference(o, d)
+    assert sorted(os.listdir(tmp_path)) == before  # no .aux.xml written beside them

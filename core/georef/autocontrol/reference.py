@@ -67,6 +67,51 @@ def _vrt_sources(ds, path: str) -> List[str]:
     return out
 
 
+MIN_REFERENCE_PIXELS = 16  # a reference smaller than this on a side cannot be matched
+
+
+def _is_heights(gdal, ds) -> bool:
+    """Whether a raster says it holds heights: one band with a length unit, or one of the plugin's DSM / DTM."""
+    product = (ds.GetMetadata() or {}).get("ARCHAEOORTHO_PRODUCT")
+    unit = (ds.GetRasterBand(1).GetUnitType() or "").strip().lower()
+    return ds.RasterCount == 1 and (product in ("dsm", "dtm") or unit in ("m", "metre", "meter", "metres", "ft",
+                                                                          "foot", "feet", "us survey foot"))
+
+
+def _is_picture(gdal, ds) -> bool:
+    """Whether a raster is a picture: red / green / blue / palette bands, or three or more bands of bytes."""
+    colours = (gdal.GCI_RedBand, gdal.GCI_GreenBand, gdal.GCI_BlueBand, gdal.GCI_PaletteIndex)
+    bands = [ds.GetRasterBand(k + 1) for k in range(ds.RasterCount)]
+    return any(b.GetColorInterpretation() in colours for b in bands) or (
+        ds.RasterCount >= 3 and bands[0].DataType == gdal.GDT_Byte)
+
+
+def _check_kinds(gdal, ortho_path: str, ortho, dsm_path: str) -> None:
+    """AutoControlError saying which reference is wrong and why, before any work (issue 36 item 12: these all
+    ended in '0 candidate(s) kept, 4 needed'): an orthophoto that is a few pixels or has no data, a DSM that is
+    a picture or has no data, the two swapped."""
+    w, h = ortho.RasterXSize, ortho.RasterYSize
+    if min(w, h) < MIN_REFERENCE_PIXELS:
+        raise AutoControlError(f"reference orthophoto {ortho_path} is {w} x {h} pixels: too small to match photos "
+                               f"against (at least {MIN_REFERENCE_PIXELS} x {MIN_REFERENCE_PIXELS})")
+    dsm = gdal.Open(dsm_path)
+    if _is_heights(gdal, ortho) and _is_picture(gdal, dsm):
+        raise AutoControlError(f"the references look swapped: the orthophoto {ortho_path} holds heights and the "
+                               f"DSM {dsm_path} is a picture; give the orthophoto as the orthophoto and the DSM "
+                               "as the DSM")
+    if _is_picture(gdal, dsm):
+        raise AutoControlError(f"reference DSM {dsm_path} is a picture ({dsm.RasterCount} bands of "
+                               f"{gdal.GetDataTypeName(dsm.GetRasterBand(1).DataType)}), not heights: give a DSM "
+                               "or DTM (one band of heights)")
+    for what, path, ds in (("reference orthophoto", ortho_path, ortho), ("reference DSM", dsm_path, dsm)):
+        try:
+            ds.GetRasterBand(1).ComputeRasterMinMax(True)  # a sample (overviews); writes nothing beside the file
+        except RuntimeError as e:
+            if "no valid pixels" in str(e).lower():
+                raise AutoControlError(f"{what} {path} has no data: every pixel is nodata") from e
+            raise AutoControlError(f"{what} {path} cannot be read: {e}") from e
+
+
 def _check_sources(path: str, ds, what: str) -> None:
     """AutoControlError naming ``path`` and the missing file when a raster made of other files (a VRT, a
     GeoTIFF with an external mask or overview) refers to one that does not exist (issue 36 item 10: a traceback
@@ -96,6 +141,7 @@ class Reference:
         if ds is None or ds.RasterCount < 1:
             raise AutoControlError(f"reference orthophoto {ortho_path} is not a raster GDAL can read")
         _check_sources(ortho_path, ds, "reference orthophoto")
+        _check_kinds(gdal, ortho_path, ds, dsm_path)
         gt = ds.GetGeoTransform(can_return_null=True)
         if gt is None:
             raise AutoControlError(f"reference orthophoto {ortho_path} has no georeferencing (geotransform)")
