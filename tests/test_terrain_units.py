@@ -56,3 +56,34 @@ def test_the_difference_of_a_dsm_in_feet_and_one_in_metres_is_in_metres(tmp_path
     r = dsm_difference(feet, metres, out)
     assert abs(r.median - 0.5) < 0.01 and r.p95 - r.p5 < 0.02, r
     assert height_unit(out)[1] == 1.0  # the difference says it is in metres, on the grid in feet
+
+
+def test_a_dsm_too_large_for_the_memory_is_refused_before_reading(tmp_path, monkeypatch):
+    """Issue 36 item 11: a 60,000 x 60,000 sparse DSM ended in a MemoryError after allocating; now the size is
+    checked against the memory available before anything is read, and the message says what to do."""
+    import pytest
+
+    from core.terrain import rasters
+    from core.terrain.difference import dsm_difference
+    from core.terrain.options import TerrainError
+    from core.terrain.stage import build_dtm
+
+    path = str(tmp_path / "huge.tif")
+    srs = osr.SpatialReference()
+    srs.ImportFromEPSG(32633)
+    ds = gdal.GetDriverByName("GTiff").Create(path, 60000, 60000, 1, gdal.GDT_Float32,
+                                              ["TILED=YES", "SPARSE_OK=TRUE", "COMPRESS=DEFLATE"])
+    ds.SetGeoTransform((500000.0, 0.1, 0.0, 4000000.0, 0.0, -0.1))
+    ds.SetProjection(srs.ExportToWkt())
+    ds.GetRasterBand(1).SetNoDataValue(-9999.0)
+    ds = None
+    monkeypatch.setattr(rasters, "available_memory", lambda: 16 * 2 ** 30)  # a 16 GiB laptop
+    with pytest.raises(TerrainError, match=r"huge\.tif is 60000 x 60000 cells: its terrain products need about "
+                                           r"\d+\.\d GiB of memory, 16\.0 GiB is available; resample"):
+        build_dtm(path, str(tmp_path / "dtm.tif"))
+    with pytest.raises(TerrainError, match="60000 x 60000 cells"):
+        dsm_difference(path, path, str(tmp_path / "diff.tif"))
+    # a DSM that fits is read as before
+    small = str(tmp_path / "dsm_ft.tif")
+    _dsm_in_feet(small)
+    assert rasters.read_elevation(small).z.shape == (64, 64)

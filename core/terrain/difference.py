@@ -19,7 +19,7 @@ from ..common.files import refuse_overwriting_inputs
 from ..common.progress import NullProgress, Progress, check_cancel
 from ..io import raster
 from .options import TerrainError
-from .rasters import check_elevation_kind, check_north_up, open_raster
+from .rasters import check_elevation_kind, check_memory, check_north_up, open_raster
 
 CHANGE_THRESHOLD = 1.0  # metres: a cell whose height changed by more than this counts as changed
 
@@ -112,6 +112,9 @@ def _warp(r: _Raster, wkt: str, gt: Tuple[float, ...], w: int, h: int) -> np.nda
     return z
 
 
+DIFFERENCE_BYTES_PER_CELL = 48  # two float64 grids, the difference, the mask and the float32 copy written
+
+
 def dsm_difference(dsm_a: str, dsm_b: str, output: str, resolution: Optional[float] = None,
                    threshold: float = CHANGE_THRESHOLD, progress: Optional[Progress] = None) -> DsmDifference:
     """Write ``b - a`` in metres (float32 Cloud-Optimized GeoTIFF, nodata where either DSM has none; each DSM's
@@ -123,6 +126,7 @@ def dsm_difference(dsm_a: str, dsm_b: str, output: str, resolution: Optional[flo
     a, b = _open(dsm_a, "DSM A"), _open(dsm_b, "DSM B")
     refuse_overwriting_inputs({"DSM difference": output}, {"DSM A": a.path, "DSM B": b.path}, TerrainError)
     gt, w, h = _grid(a, resolution)
+    check_memory(a.path, "DSM A", w, h, bytes_per_cell=DIFFERENCE_BYTES_PER_CELL)
     # heights in metres, each from its own unit (a DSM in feet against one in metres was 22 m of "change")
     za = _warp(a, a.wkt, gt, w, h) * raster.height_unit(a.path)[1]
     progress.report(0.3, "DSM A read")

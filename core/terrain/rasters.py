@@ -7,10 +7,14 @@ from typing import Optional, Tuple
 
 import numpy as np
 
+from ..common.parallel import available_memory
 from ..io import raster
 from .options import TerrainError
 
 MIN_CELLS = 16  # the smallest raster side the filters work on
+# bytes of memory per cell the terrain products need at their peak: Build DTM held 6.5 GiB for a 7,220 x 6,052
+# DSM (issue 33: 43.7 M cells, about 19 float64 copies); a raster that needs more than is available is refused
+PEAK_BYTES_PER_CELL = 160
 
 
 @dataclass
@@ -74,6 +78,18 @@ def check_elevation_kind(ds, path: str, what: str) -> None:
                            "or DTM (one band of heights)")
 
 
+def check_memory(path: str, what: str, w: int, h: int, bytes_per_cell: int = PEAK_BYTES_PER_CELL) -> None:
+    """TerrainError before any reading when a raster of w x h cells needs more memory than is available (issue 36
+    item 11: a 60,000 x 60,000 sparse DSM ended in a MemoryError after allocating gigabytes)."""
+    need = float(w) * float(h) * bytes_per_cell
+    avail = available_memory()
+    if avail is not None and need > avail:
+        raise TerrainError(f"the {what} {path} is {w} x {h} cells: its terrain products need about "
+                           f"{need / 2 ** 30:.1f} GiB of memory, {avail / 2 ** 30:.1f} GiB is available; resample "
+                           "it to a coarser cell (Raster > Projections > Warp) or clip it to the area of interest "
+                           "first")
+
+
 def read_elevation(path: str, what: str = "DSM") -> Elevation:
     """The whole raster ``path`` (band 1) as metres; TerrainError naming the file for a raster that cannot be a
     terrain model: unreadable, geographic CRS (degrees), rotated or non-square cells, too small, no data."""
@@ -101,6 +117,7 @@ def read_elevation(path: str, what: str = "DSM") -> Elevation:
     if w < MIN_CELLS or h < MIN_CELLS:
         raise TerrainError(f"the {what} {path} is {w} x {h} cells: too small for a terrain model (at least "
                            f"{MIN_CELLS} x {MIN_CELLS} cells)")
+    check_memory(path, what, w, h)
     band = ds.GetRasterBand(1)
     z = band.ReadAsArray().astype(np.float64)
     nd = band.GetNoDataValue()
