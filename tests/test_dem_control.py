@@ -105,10 +105,9 @@ def scene(tmp_path_factory):
 
 def _positions_file(folder, positions):
     path = str(folder / "positions.csv")
-    with open(path, "w") as f:
-        f.write(f"{syn.CRS}\nimage,x,y,z,sigma_xy,sigma_z\n")
-        for p in positions:
-            f.write(f"{p.image},{p.x:.3f},{p.y:.3f},{p.z:.3f},3,5\n")
+    rows = [f"{p.image},{p.x:.3f},{p.y:.3f},{p.z:.3f},3,5\n" for p in positions]
+    with open(path, "w") as out:
+        out.writelines([f"{syn.CRS}\nimage,x,y,z,sigma_xy,sigma_z\n", *rows])
     return path
 
 
