@@ -28,24 +28,13 @@ from core.project.layout import Layout
 from core.project.workspace import Workspace
 from core.report.sections.orientation import interior_orientation
 from tests import synthetic as syn
+from tests.test_align_relaxed import _Log  # a progress that keeps the log lines
 from tests.test_autocontrol import epochs  # noqa: F401 - the automatic control's two epochs, rendered once
 from tests.workspaces import rendered_once
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CACHE = os.path.join(ROOT, "build", "test-cache", "calibrated-v1")
 NAMES = ["fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2"]
-
-
-class _Log(NullProgress):
-    def __init__(self):
-        super().__init__()
-        self.lines = []
-
-    def info(self, message):
-        self.lines.append(message)
-
-    def warning(self, message):
-        self.lines.append(message)
 
 
 @pytest.fixture(scope="module")

@@ -51,6 +51,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..common.errors import ArchaeoOrthoError, MissingDependencyError
+from ..geometry.camera import MODELS
 
 ADJUST_MODES = ("fixed", "refined", "estimated")
 
@@ -1082,14 +1083,6 @@ def _metashape_camera(path: str, cal: _Element, name: str, sensor: Optional[_Ele
 # COLMAP cameras.txt
 # ---------------------------------------------------------------------------
 
-_COLMAP_MODELS = {
-    "SIMPLE_PINHOLE": ("f", "cx", "cy"),
-    "PINHOLE": ("fx", "fy", "cx", "cy"),
-    "SIMPLE_RADIAL": ("f", "cx", "cy", "k1"),
-    "RADIAL": ("f", "cx", "cy", "k1", "k2"),
-    "OPENCV": ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2"),
-    "FULL_OPENCV": ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"),
-}
 _COLMAP_LINE = re.compile(r"^\s*\d+\s+[A-Z0-9_]+\s+\d+\s+\d+(\s+\S+)+\s*$")
 
 
@@ -1105,10 +1098,10 @@ def _read_colmap_txt(path: str, text: str) -> List[CameraCalibration]:
             continue
         parts = line.split()
         cam_id, model = parts[0], parts[1]
-        if model not in _COLMAP_MODELS:
+        if model not in MODELS:
             raise CalibrationError(path, n, "MODEL", f"camera {cam_id}: the COLMAP model {model} is not supported "
-                                   f"(supported: {', '.join(_COLMAP_MODELS)})")
-        names = _COLMAP_MODELS[model]
+                                   f"(supported: {', '.join(MODELS)})")
+        names = MODELS[model]
         if len(parts) - 4 != len(names):
             raise CalibrationError(path, n, "PARAMS", f"camera {cam_id}: {model} takes {len(names)} parameters "
                                    f"({', '.join(names)}), got {len(parts) - 4}")
