@@ -139,7 +139,13 @@ def test_every_status_the_code_writes_is_known(tmp_path):
     for status in STATUSES:
         ws.data["stages"][f"s-{status}"] = {"status": status}
     ws.save()
-    Workspace.open(str(tmp_path))  # all accepted
+    reopened = Workspace.open(str(tmp_path))  # all accepted, each read back as written
+    assert {n: s["status"] for n, s in reopened.data["stages"].items() if n.startswith("s-")} == \
+        {f"s-{status}": status for status in STATUSES}
+    ws.data["stages"]["s-bogus"] = {"status": "finished"}  # and a status the code never writes is refused
+    ws.save()
+    with pytest.raises(WorkspaceError, match="finished"):
+        Workspace.open(str(tmp_path))
 
 
 # ---------------------------------------------------------------------------------------------------------------
