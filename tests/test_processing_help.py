@@ -213,7 +213,7 @@ def test_build_orthophoto_output_is_named_orthomosaic_in_the_workspace_group(plu
     run_dialog_loading()
     run_dialog_loading()  # a re-run
     loaded = [lyr for lyr in project.mapLayers().values() if isinstance(lyr, QgsRasterLayer)]
-    assert [lyr.name() for lyr in loaded] == ["Orthomosaic"]
+    assert [lyr.name() for lyr in loaded] == ["Orthomosaic \u2014 Site 7"]  # named after its workspace
     root = project.layerTreeRoot()
     group = root.findGroup("ArchaeoOrtho: Site 7")
     assert group is not None

@@ -412,7 +412,7 @@ def test_products_load_styled_in_qgis(scene_dsm, tmp_path, qgis_new_project):
     assert by_kind["contours"].labelsEnabled() and by_kind["contours"].featureCount() > 10
     reliefs = [lyr for lyr in loaded if lyr.customProperty(layers.KIND_PROPERTY) == "relief"]
     names = sorted(lyr.name() for lyr in reliefs)
-    assert names == ["Openness (negative) (DTM)", "Sky-view factor (DTM)"], names
+    assert names == ["Openness (negative) (DTM) \u2014 ws", "Sky-view factor (DTM) \u2014 ws"], names
     for lyr in reliefs:
         r = lyr.renderer()
         assert r.type() == "singlebandgray"

@@ -232,6 +232,85 @@ def test_orthomosaic_rgb_with_transparent_alpha_or_nodata(tmp_path, qgis_new_pro
     assert layers.output_kind("VALID_FRACTION", "") is None
 
 
+def _products(folder):
+    """A workspace folder with a DSM, an orthomosaic (RGBA) and a DTM where its Layout puts them."""
+    from archaeoortho.ui import layers
+
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, "workspace.json"), "w", encoding="utf-8") as fh:
+        fh.writelines(["{}"])
+    lay = layers.workspace_layout(folder)
+    for path, bands in ((lay.default_dsm, 1), (lay.default_orthomosaic, 4), (lay.default_dtm, 1)):
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        _raster(path, bands, nodata=-9999 if bands == 1 else None, alpha=bands == 4)
+    return folder
+
+
+def _rendered(layer_list, extent):
+    """The layers (first on top) drawn over white, 200 x 200 px, as an (n, n, 3) array."""
+    from qgis.core import QgsMapRendererSequentialJob, QgsMapSettings
+    from qgis.PyQt.QtCore import QSize
+    from qgis.PyQt.QtGui import QColor
+
+    settings = QgsMapSettings()
+    settings.setLayers(layer_list)
+    settings.setExtent(extent)
+    settings.setDestinationCrs(layer_list[0].crs())
+    settings.setOutputSize(QSize(200, 200))
+    settings.setBackgroundColor(QColor("white"))
+    job = QgsMapRendererSequentialJob(settings)
+    job.start()
+    job.waitForFinished()
+    image = job.renderedImage()
+    return np.array([[QColor(image.pixel(x, y)).getRgb()[:3] for x in range(200)] for y in range(200)], float)
+
+
+def test_orthomosaic_reads_true_over_the_terrain_layers(tmp_path, qgis_new_project):
+    """A workspace's group: points over the orthomosaic, the orthomosaic over the DTM and DSM and their hillshades
+    (the DTM's multiplied hillshade, loaded last, lay over the orthomosaic and darkened it by ~19 %: issue 36 item
+    16).  The group as drawn shows the orthomosaic's own colours."""
+    from archaeoortho.ui import layers
+    from qgis.core import QgsProject
+
+    ws = _products(str(tmp_path / "site"))
+    loaded = layers.load_workspace_results(ws, QgsProject.instance())
+    by_kind = {lyr.customProperty(layers.KIND_PROPERTY): lyr for lyr in loaded}
+    assert {"dsm", "hillshade", "ortho", "dtm", "dtmhillshade"} <= set(by_kind)
+    root = QgsProject.instance().layerTreeRoot()
+    group = root.findGroup(layers.workspace_group_name(ws))
+    order = [c.layer().customProperty(layers.KIND_PROPERTY) for c in group.children()]
+    assert order == ["ortho", "dtmhillshade", "dtm", "hillshade", "dsm"], order
+    ortho = by_kind["ortho"]
+    extent = ortho.extent()
+    extent.scale(0.8)  # inside the mosaic, its transparent left edge included
+    alone = _rendered([ortho], extent)
+    drawn = _rendered(root.checkedLayers(), extent)  # as the canvas draws the project, top first
+    valid = alone.sum(axis=2) < 3 * 255  # where the mosaic covers the white background
+    assert valid.mean() > 0.5
+    change = np.abs(drawn[valid] - alone[valid]).mean() / alone[valid].mean()
+    print(f"\n[layers] the orthomosaic as the group draws it differs from it alone by {100 * change:.1f} %")
+    assert change < 0.01
+
+
+def test_layers_named_after_their_workspace(tmp_path, qgis_new_project):
+    """Two workspaces loaded: their DSMs and orthomosaics are told apart by name in a raster layer box (the dock's
+    reference boxes listed 'DSM' and 'DSM': issue 36 item 17)."""
+    from archaeoortho.ui import layers
+    from qgis.core import QgsMapLayerProxyModel, QgsProject
+    from qgis.gui import QgsMapLayerComboBox
+
+    for name in ("toledo", "ochota"):
+        layers.load_workspace_results(_products(str(tmp_path / name)), QgsProject.instance())
+    combo = QgsMapLayerComboBox()
+    combo.setFilters(QgsMapLayerProxyModel.Filter.RasterLayer)
+    names = [combo.itemText(i) for i in range(combo.count())]
+    assert len(names) == len(set(names)) == 10, names
+    assert {"DSM \u2014 toledo", "DSM \u2014 ochota", "Orthomosaic \u2014 toledo", "Orthomosaic \u2014 ochota",
+            "DTM hillshade \u2014 ochota"} <= set(names), names
+    outside = _raster(str(tmp_path / "loose.tif"), 4, alpha=True)  # a file of no workspace keeps the plain name
+    assert [lyr.name() for lyr in layers.load_orthomosaic(outside, QgsProject.instance())] == ["Orthomosaic"]
+
+
 def test_nothing_styled_under_qgis_process_platform():
     """With QGIS's platform reported as qgis_process the hook does nothing and imports no ui module."""
     code = (

@@ -56,6 +56,13 @@ DTM_HILLSHADE = "dtmhillshade"
 RELIEF = "relief"
 CONTOURS = "contours"
 
+# the order of a workspace's group, top to bottom: points and lines over the pictures, the orthomosaic over the
+# terrain rasters, each hillshade right over its elevation model.  A hillshade drawn with 'multiply' above the
+# orthomosaic darkened it (the DTM's, loaded last, by about 19 %: issue 36 item 16); under it, it shades only
+# its DSM or DTM, which the orthomosaic covers until it is switched off.
+GROUP_ORDER = (RESIDUALS, CAMERAS, FOOTPRINTS, CONTOURS, POINT_CLOUD, ORTHO, RELIEF, DTM_HILLSHADE, DTM, HILLSHADE,
+               DSM)
+
 # residual point status (core.georef) -> colour
 STATUS_COLOURS = {"used": "#1a9641", "check": "#2b83ba", "rejected": "#d7191c", "not triangulated": "#888888"}
 
@@ -369,6 +376,32 @@ def style_contours(layer):
     return layer
 
 
+def workspace_of(path, levels=3):
+    """The workspace folder a product file lies in (the nearest folder above it with a workspace manifest), None
+    for a file outside any workspace."""
+    from ..core.project.layout import MANIFEST
+
+    folder = os.path.dirname(os.path.abspath(str(path).split("|")[0]))
+    for _ in range(levels):
+        if os.path.isfile(os.path.join(folder, MANIFEST)):
+            return folder
+        parent = os.path.dirname(folder)
+        if parent == folder:
+            break
+        folder = parent
+    return None
+
+
+def product_name(label, path, workspace=None):
+    """A product layer's name with its workspace's: 'DSM — toledo', so that two workspaces' DSMs and orthomosaics
+    are told apart in the layer lists (the dock's reference boxes showed two 'DSM': issue 36 item 17)."""
+    workspace = workspace or workspace_of(path)
+    if not workspace:
+        return label
+    return QCoreApplication.translate("ResultLayers", "{} \u2014 {}").format(
+        label, os.path.basename(os.path.normpath(workspace)))
+
+
 def relief_name(path):
     """The layer name of a relief visualisation file: its visualisation and surface ('Sky-view factor (DTM)')."""
     meta = _file_metadata(path)
@@ -384,25 +417,26 @@ def relief_name(path):
                                                                         else "DTM")
 
 
-def load_dtm(path, project=None, group=None, name=None):
+def load_dtm(path, project=None, group=None, name=None, workspace=None):
     """DTM as two layers: the pseudocolour and a multiplied hillshade above it."""
     project = project or QgsProject.instance()
     remove_loaded(project, path, (DTM, DTM_HILLSHADE))
-    dtm = QgsRasterLayer(path, name or QCoreApplication.translate("ResultLayers", "DTM"))
+    dtm = QgsRasterLayer(path, name or product_name(QCoreApplication.translate("ResultLayers", "DTM"), path, workspace))
     if not dtm.isValid():
         return []
     style_dtm(dtm)
-    shade = QgsRasterLayer(path, QCoreApplication.translate("ResultLayers", "DTM hillshade"))
+    shade = QgsRasterLayer(path, product_name(QCoreApplication.translate("ResultLayers", "DTM hillshade"), path,
+                                              workspace))
     style_hillshade(shade)
     _mark(shade, DTM_HILLSHADE)
     return [lyr for lyr in (add_layer(project, dtm, group, path), add_layer(project, shade, group, path))
             if lyr is not None]
 
 
-def load_relief(path, project=None, group=None, name=None):
+def load_relief(path, project=None, group=None, name=None, workspace=None):
     project = project or QgsProject.instance()
     remove_loaded(project, path, (RELIEF,))
-    layer = QgsRasterLayer(path, name or relief_name(path))
+    layer = QgsRasterLayer(path, name or product_name(relief_name(path), path, workspace))
     if not layer.isValid():
         return []
     style_relief(layer)
@@ -451,35 +485,56 @@ def _group(project, name):
     return group
 
 
+def _rank(node):
+    """A layer node's place in GROUP_ORDER; -1 (the top) for a layer or group of the user's."""
+    layer = node.layer() if hasattr(node, "layer") else None
+    kind = layer.customProperty(KIND_PROPERTY, "") if layer is not None else ""
+    return GROUP_ORDER.index(kind) if kind in GROUP_ORDER else -1
+
+
+def _index_in_group(group, kind, skip=None):
+    """Where a layer of ``kind`` goes in ``group``: above the first of a later kind in GROUP_ORDER (the top of
+    its own kind: a re-run's layer comes first), the user's layers staying on top."""
+    rank = GROUP_ORDER.index(kind) if kind in GROUP_ORDER else -1
+    children = [c for c in group.children() if c is not skip]
+    for i, child in enumerate(children):
+        if _rank(child) >= rank and rank >= 0:
+            return i
+    return len(children) if rank >= 0 else 0
+
+
 def add_layer(project, layer, group=None, path=None):
-    """Add ``layer`` to ``project`` (at the top of ``group`` when given) and remember its source."""
+    """Add ``layer`` to ``project`` (in ``group`` when given, at its kind's place: GROUP_ORDER) and remember
+    its source."""
     layer.setCustomProperty(PATH_PROPERTY, path or layer.source().split("|")[0])
     node = _group(project, group)
     if project.addMapLayer(layer, node is None) is None:
         return None
     if node is not None:
-        node.insertLayer(0, layer)
+        node.insertLayer(_index_in_group(node, layer.customProperty(KIND_PROPERTY, "")), layer)
     return layer
 
 
-def load_dsm(path, project=None, group=None, name=None):
+def load_dsm(path, project=None, group=None, name=None, workspace=None):
     """DSM as two layers: the pseudocolour and a multiplied hillshade above it."""
     project = project or QgsProject.instance()
     remove_loaded(project, path, (DSM, HILLSHADE))
-    dsm = QgsRasterLayer(path, name or QCoreApplication.translate("ResultLayers", "DSM"))
+    dsm = QgsRasterLayer(path, name or product_name(QCoreApplication.translate("ResultLayers", "DSM"), path, workspace))
     if not dsm.isValid():
         return []
     style_dsm(dsm)
-    shade = QgsRasterLayer(path, QCoreApplication.translate("ResultLayers", "DSM hillshade"))
+    shade = QgsRasterLayer(path, product_name(QCoreApplication.translate("ResultLayers", "DSM hillshade"), path,
+                                              workspace))
     style_hillshade(shade)
     return [lyr for lyr in (add_layer(project, dsm, group, path), add_layer(project, shade, group, path))
             if lyr is not None]
 
 
-def load_orthomosaic(path, project=None, group=None, name=None):
+def load_orthomosaic(path, project=None, group=None, name=None, workspace=None):
     project = project or QgsProject.instance()
     remove_loaded(project, path, (ORTHO,))
-    layer = QgsRasterLayer(path, name or QCoreApplication.translate("ResultLayers", "Orthomosaic"))
+    layer = QgsRasterLayer(path, name or product_name(QCoreApplication.translate("ResultLayers", "Orthomosaic"), path,
+                                                      workspace))
     if not layer.isValid():
         return []
     style_orthomosaic(layer)
@@ -557,7 +612,7 @@ def load_residuals(path, project=None, group=None, name=None):
     return [layer] if add_layer(project, layer, group, path) is not None else []
 
 
-def load_point_cloud(path, project=None, group=None, name=None):
+def load_point_cloud(path, project=None, group=None, name=None, workspace=None):
     """A LAS/LAZ point cloud where this QGIS build has the PDAL provider; [] otherwise."""
     if "pdal" not in QgsProviderRegistry.instance().providerList():
         return []
@@ -565,7 +620,8 @@ def load_point_cloud(path, project=None, group=None, name=None):
 
     project = project or QgsProject.instance()
     remove_loaded(project, path, (POINT_CLOUD,))
-    layer = QgsPointCloudLayer(path, name or QCoreApplication.translate("ResultLayers", "Point cloud"), "pdal")
+    layer = QgsPointCloudLayer(path, name or product_name(QCoreApplication.translate("ResultLayers", "Point cloud"),
+                                                          path, workspace), "pdal")
     if not layer.isValid():
         return []
     _mark(layer, POINT_CLOUD)
@@ -579,16 +635,17 @@ def load_workspace_results(workspace, project=None, group=None):
     loaded = []
     lay = workspace_layout(workspace)
     candidates = [
-        (lay.default_dsm, load_dsm, {}),
-        (lay.default_orthomosaic, load_orthomosaic, {}),
+        (lay.default_dsm, load_dsm, {"workspace": workspace}),
+        (lay.default_orthomosaic, load_orthomosaic, {"workspace": workspace}),
         (lay.cameras_gpkg, load_cameras, {"workspace": workspace}),
         (lay.residuals_gpkg, load_residuals, {}),
-        (lay.default_dtm, load_dtm, {}),
+        (lay.default_dtm, load_dtm, {"workspace": workspace}),
         (lay.contours_gpkg, load_contours, {}),
     ]
     relief_dir = os.path.dirname(lay.relief("x"))
     if os.path.isdir(relief_dir):
-        candidates += [(os.path.join(relief_dir, n), load_relief, {}) for n in sorted(os.listdir(relief_dir))
+        candidates += [(os.path.join(relief_dir, n), load_relief, {"workspace": workspace})
+                       for n in sorted(os.listdir(relief_dir))
                        if n.endswith(".tif")]
     for path, fn, kw in candidates:
         if os.path.exists(path):
@@ -654,14 +711,15 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
         path = layer.source().split("|")[0]
         layer.setCustomProperty(PATH_PROPERTY, path)
         group = workspace_group_name(self.workspace) if self.workspace else None
-        if group:  # with the workspace's other layers (the dock's Load results puts them there too); first, so
-            # that a hillshade or footprints added below go on top of it
+        if group:  # with the workspace's other layers (the dock's Load results puts them there too), at its kind's
+            # place (GROUP_ORDER): the orthomosaic over the hillshades
             _replace_older(project, layer, path, self.kind)
-            move_to_group(project, layer, group)
+            move_to_group(project, layer, group, self.kind)
         if self.kind == DSM:
             style_dsm(layer)
             remove_loaded(project, path, (HILLSHADE,))
-            shade = QgsRasterLayer(path, QCoreApplication.translate("ResultLayers", "DSM hillshade"))
+            shade = QgsRasterLayer(path, product_name(QCoreApplication.translate("ResultLayers", "DSM hillshade"),
+                                                      path, self.workspace))
             if shade.isValid():
                 style_hillshade(shade)
                 add_layer(project, shade, group, path)
@@ -686,19 +744,26 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
         elif self.kind == DTM:
             style_dtm(layer)
             remove_loaded(project, path, (DTM_HILLSHADE,))
-            shade = QgsRasterLayer(path, QCoreApplication.translate("ResultLayers", "DTM hillshade"))
+            shade = QgsRasterLayer(path, product_name(QCoreApplication.translate("ResultLayers", "DTM hillshade"),
+                                                      path, self.workspace))
             if shade.isValid():
                 style_hillshade(shade)
                 _mark(shade, DTM_HILLSHADE)
                 add_layer(project, shade, group, path)
         elif self.kind == RELIEF:
             style_relief(layer)
-            layer.setName(relief_name(path))
+            layer.setName(product_name(relief_name(path), path, self.workspace))
         elif self.kind == CONTOURS:
             style_contours(layer)
         name = _output_layer_name(self.kind)
         if name:  # not the parameter's label ("Orthomosaic (default: <workspace>/orthomosaic.tif)")
-            layer.setName(name)
+            layer.setName(product_name(name, path, self.workspace) if self.kind in RASTER_KINDS else name)
+        if group:  # styled: its kind known, it takes its place in the group (a hillshade under the orthomosaic)
+            move_to_group(project, layer, group, self.kind)
+
+
+# the kinds named after their workspace: the raster layers, which the dock's reference boxes list
+RASTER_KINDS = (DSM, HILLSHADE, ORTHO, DTM, DTM_HILLSHADE, RELIEF, POINT_CLOUD)
 
 
 def _output_layer_name(kind):
@@ -727,15 +792,19 @@ def _replace_older(project, layer, path, kind):
         project.removeMapLayers(drop)
 
 
-def move_to_group(project, layer, group_name):
-    """Move ``layer``'s node to the top of the group ``group_name`` (made when missing)."""
+def move_to_group(project, layer, group_name, kind=None):
+    """Move ``layer``'s node into the group ``group_name`` (made when missing), at its kind's place (GROUP_ORDER;
+    the top without a kind)."""
     root = project.layerTreeRoot()
     node = root.findLayer(layer.id())
     group = _group(project, group_name)
-    if node is None or group is None or node.parent() is group:
+    if node is None or group is None:
+        return
+    index = _index_in_group(group, kind or layer.customProperty(KIND_PROPERTY, ""), skip=node)
+    if node.parent() is group and group.children().index(node) == index:
         return
     parent = node.parent()
-    group.insertChildNode(0, node.clone())
+    group.insertChildNode(index, node.clone())
     parent.removeChildNode(node)
 
 
