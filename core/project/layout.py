@@ -45,6 +45,10 @@ REFERENCE_DSM_TIF = "reference-dsm.tif"
 EDITOR_JSON = "gcp_editor.json"
 ADJUSTMENT_INPUTS_JSON = "adjustment_inputs.json"
 DEM_CONTROL_JSON = "dem_control.json"  # in georef/: the co-registration on a reference DEM and its control points
+TARGETS_DIR = "targets"  # in georef/: Find targets' products
+TARGETS_GCP_LIST = "gcp_list.txt"  # the observations found (ODM form, read by Georeference)
+TARGETS_GPKG = "targets.gpkg"  # the found marks for review
+TARGETS_JSON = "targets.json"  # every observation with its quality, the counts and what did not fit
 DENSE_DIR = "dense"
 DSM_TIF = "dsm.tif"
 DSM_SOURCE_TIF = "dsm-source.tif"  # in dense/: 1 measured, 2 interpolated (a hole filled), 0 nodata
@@ -219,6 +223,22 @@ class Layout:
     @property
     def adjustment_inputs_json(self) -> str:
         return self.path(GEOREF_DIR, ADJUSTMENT_INPUTS_JSON)
+
+    @property
+    def targets_dir(self) -> str:
+        return self.path(GEOREF_DIR, TARGETS_DIR)
+
+    @property
+    def targets_gcp_list(self) -> str:
+        return self.path(GEOREF_DIR, TARGETS_DIR, TARGETS_GCP_LIST)
+
+    @property
+    def targets_gpkg(self) -> str:
+        return self.path(GEOREF_DIR, TARGETS_DIR, TARGETS_GPKG)
+
+    @property
+    def targets_json(self) -> str:
+        return self.path(GEOREF_DIR, TARGETS_DIR, TARGETS_JSON)
 
     @property
     def dem_control_json(self) -> str:
