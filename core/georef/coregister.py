@@ -619,23 +619,18 @@ def coregister_dems(dem: np.ndarray, dem_transform: Sequence[float], ref: np.nda
 # files: CRS and units
 # ---------------------------------------------------------------------------
 
-_FEET = {"ft": 0.3048, "foot": 0.3048, "feet": 0.3048, "international foot": 0.3048,
-         "us survey foot": 1200.0 / 3937.0, "us-ft": 1200.0 / 3937.0, "ftus": 1200.0 / 3937.0,
-         "foot_us": 1200.0 / 3937.0}
-_METRES = {"", "m", "metre", "meter", "metres", "meters"}
-
-
 def _height_unit(band, srs, path: str) -> Tuple[float, str]:
-    """(metres per height unit, message): the band's unit type, else the vertical CRS's, else metres."""
+    """(metres per height unit, message): io.raster.height_unit's rule, the one every reader of heights follows
+    (the band's unit type, else a vertical CRS's, else a projected CRS's axes in feet, else metres); a band
+    unit that is neither metres nor feet is refused."""
+    from ..io.raster import height_unit
+
     unit = (band.GetUnitType() or "").strip().lower()
-    if unit in _FEET:
-        return _FEET[unit], f"{path}: heights in {unit}, converted to metres"
-    if unit and unit not in _METRES:
+    name, factor, where = height_unit(path)
+    if unit and not where:  # a unit type height_unit does not know ('cm', 'dm', 'mm', ...)
         raise CoregError(f"{path}: the band's height unit '{unit}' is not metres or feet; convert it to metres first")
-    if not unit and srs is not None and srs.IsCompound():
-        factor = srs.GetTargetLinearUnits("VERT_CS") or 1.0
-        if abs(factor - 1.0) > 1e-9:
-            return float(factor), f"{path}: heights in the vertical CRS's unit ({factor:g} m), converted to metres"
+    if where and abs(factor - 1.0) > 1e-9:
+        return float(factor), f"{path}: heights in {name} ({where}: {factor:g} m), converted to metres"
     return 1.0, ""
 
 
@@ -700,6 +695,7 @@ def coregister_rasters(dem_path: str, ref_path: str, *, stable_mask_path: Option
     stable = None
     if stable_mask_path:
         stable, _, _ = _open_source(stable_mask_path, "stable-terrain mask")
+        stable.zscale = 1.0  # 0 / 1 flags, not heights in the CRS's unit
         if not stable.wkt and ref.wkt:
             stable.wkt = ref.wkt
     pair = _pair(dem, ref, stable, ref_unit)
@@ -803,10 +799,7 @@ def reference_window(ref_path: str, xmin: float, ymin: float, xmax: float, ymax:
     if arr.size == 0 or not np.isfinite(arr).any():
         raise CoregError(f"the {src.name} has no height over {xmin:.1f}, {ymin:.1f}, {xmax:.1f}, {ymax:.1f}: does it "
                          "cover the block, and is the CRS of each right?")
-    arr = arr.astype(np.float32)
-    if src.zscale != 1.0:
-        arr *= np.float32(src.zscale)
-    return arr, tuple(gt), messages
+    return arr.astype(np.float32), tuple(gt), messages  # in metres: DsmReader converts the heights
 
 
 def coregister_points_file(points_xyz: np.ndarray, ref_path: str, *, crs: Optional[str] = None,

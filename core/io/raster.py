@@ -24,7 +24,7 @@ import numpy as np
 from ..common.errors import ArchaeoOrthoError
 from ..common.files import atomic_output
 from ..common.progress import NullProgress, Progress, check_cancel
-from ..geometry.crs import epsg_code
+from ..geometry.crs import epsg_code, linear_unit
 
 NODATA = -9999.0
 
@@ -99,6 +99,13 @@ def height_unit(path: str) -> Tuple[str, float, str]:
         if srs.IsProjected() and abs(srs.GetLinearUnits() - 1.0) > 1e-9:
             return srs.GetLinearUnitsName() or "unit", float(srs.GetLinearUnits()), "its CRS's axes"
     return "metre", 1.0, ""
+
+
+def axis_metres(crs_wkt: str) -> float:
+    """Metres per unit of a CRS's horizontal axes: 1 for a metric, geographic or missing CRS (heights are
+    then in metres), 0.3048... for one in feet."""
+    metres = linear_unit(crs_wkt)[1] if crs_wkt else math.nan
+    return metres if metres == metres and metres > 0 else 1.0
 
 
 # ---------------------------------------------------------------------------
@@ -302,7 +309,11 @@ def open_dsm(path: str) -> DsmInfo:
 
 class DsmReader:
     """Reads heights from a DSM, optionally reprojected into ``target_crs`` on the fly (a GDAL warped
-    VRT, so an ALS DSM in another CRS works without a copy).  Heights are float64 with NaN for nodata.
+    VRT, so an ALS DSM in another CRS works without a copy).  Heights are float64 with NaN for nodata, in the
+    unit of the CRS they are read in (``target_crs``, else the DSM's own; metres for a geographic or metric
+    one): converted from the unit the DSM declares (:func:`height_unit`: a band in feet, a vertical CRS in feet,
+    a state plane DEM in feet read into UTM), the one conversion every reader of heights goes through
+    (``z_scale``: the factor applied, ``z_unit``: (unit, metres per unit, where it was read)).
 
     with DsmReader(path, target_crs="EPSG:32617") as dsm:
         z = dsm.sample(x, y)                 # bilinear, world coordinates of target_crs
@@ -325,6 +336,10 @@ class DsmReader:
         self.width, self.height = self._ds.RasterXSize, self._ds.RasterYSize
         self.nodata = self._ds.GetRasterBand(1).GetNoDataValue()
         self.crs_wkt = self._ds.GetProjection()
+        self.z_unit = height_unit(path)
+        self.z_scale = self.z_unit[1] / axis_metres(self.crs_wkt)
+        if abs(self.z_scale - 1.0) < 1e-12:
+            self.z_scale = 1.0
         self._cache: Optional[np.ndarray] = None
 
     def __enter__(self):
@@ -343,6 +358,8 @@ class DsmReader:
         if self.nodata is not None:
             arr[arr == self.nodata] = np.nan
         arr[~np.isfinite(arr)] = np.nan
+        if self.z_scale != 1.0:
+            arr *= self.z_scale
         return arr
 
     def read_window(self, xmin: float, ymin: float, xmax: float, ymax: float) -> Tuple[np.ndarray, Tuple[float, ...]]:
@@ -550,4 +567,5 @@ def read_las(path: str) -> Tuple[np.ndarray, np.ndarray, dict]:
 
 
 __all__ = ["Grid", "write_cog", "open_dsm", "DsmReader", "DsmInfo", "read_dsm", "write_las", "read_las", "DsmError",
+           "axis_metres",
            "NODATA", "bilinear", "crs_to_wkt", "crs_epsg", "height_unit"]

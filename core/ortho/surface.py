@@ -174,5 +174,7 @@ def fill_dsm_gaps(dsm_path: str, out_path: str, max_distance: float) -> Tuple[st
     if n == 0:
         return dsm_path, 0
     srs = ds.GetSpatialRef()
-    dsmmod.write_cog(out_path, result, gt, srs.ExportToWkt() if srs is not None else None)
+    # the band's unit kept: a DSM in feet on a metric grid is read in feet from the copy too (io.raster.height_unit)
+    dsmmod.write_cog(out_path, result, gt, srs.ExportToWkt() if srs is not None else None,
+                     unit=(band.GetUnitType() or "").strip())
     return out_path, n

@@ -13,7 +13,7 @@ import numpy as np
 
 from ...common.errors import require
 from ...geometry.crs import CRSError, crs_identifier, is_mercator, linear_unit, transform_points, utm_epsg_for_lonlat
-from ...io.raster import DsmError, DsmReader, crs_to_wkt, height_unit
+from ...io.raster import DsmError, DsmReader, crs_to_wkt
 from .errors import AutoControlError
 
 
@@ -176,16 +176,11 @@ class Reference:
         except DsmError as e:
             raise AutoControlError(f"reference DSM {dsm_path}: {e}") from e
         self.dsm_gsd = float(abs(self.dsm.geotransform[1]))
-        unit, metres, where = height_unit(dsm_path)
-        self.z_scale = metres / self._axis_metres()
+        unit, _metres, where = self.dsm.z_unit
+        self.z_scale = self.dsm.z_scale  # applied by the reader (io.raster's one conversion of heights)
         if where and abs(self.z_scale - 1.0) > 1e-9:
             self.notes.append(f"reference DSM heights in {unit} ({where}): scaled by {self.z_scale:.6g} to the "
                               "orthophoto's CRS unit")
-
-    def _axis_metres(self) -> float:
-        """Metres per unit of the working CRS's axes."""
-        metres = linear_unit(self.crs_wkt)[1]
-        return metres if metres == metres and metres > 0 else 1.0
 
     @property
     def crs(self) -> str:
@@ -223,8 +218,7 @@ class Reference:
 
     def heights(self, x, y) -> np.ndarray:
         """DSM heights (NaN outside / nodata) at points of the working CRS, in its unit."""
-        z = self.dsm.sample(x, y)
-        return z * self.z_scale if self.z_scale != 1.0 else z
+        return self.dsm.sample(x, y)
 
     def relief(self, x, y, radius: float) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(height, slope, misfit) around each point: a plane through the 3 x 3 DSM samples ``radius`` apart
@@ -243,9 +237,51 @@ class Reference:
         slope = np.hypot(coef[1], coef[2])
         return coef[0], slope, misfit
 
+    def check_covers(self, box: Tuple[float, float, float, float], block: str = "the block") -> None:
+        """AutoControlError naming the reference that does not cover ``box`` (xmin, ymin, xmax, ymax of the working
+        CRS), before any matching (issue 36 item 12: a reference 5 km away or without data there ended in '0
+        candidate(s) kept, 4 needed'): the orthophoto or the DSM lying elsewhere (how far, and where each is), or
+        holding no data over it."""
+        xmin, ymin, xmax, ymax = box
+        unit = _unit_name(self.crs_wkt)
+        where = f"{block} ({xmin:.0f}..{xmax:.0f}, {ymin:.0f}..{ymax:.0f} {unit} in {_short_crs(self.crs)})"
+        dsm_gt = self.dsm.geotransform
+        dsm_b = (dsm_gt[0], dsm_gt[3] + self.dsm.height * dsm_gt[5], dsm_gt[0] + self.dsm.width * dsm_gt[1],
+                 dsm_gt[3])
+        for what, path, b in (("reference orthophoto", self.ortho_path, self.bounds),
+                              ("reference DSM", self.dsm_path, dsm_b)):
+            gap = max(b[0] - xmax, xmin - b[2], b[1] - ymax, ymin - b[3])
+            if gap >= 0:
+                raise AutoControlError(
+                    f"{what} {path} does not cover {where}: it covers {b[0]:.0f}..{b[2]:.0f}, {b[1]:.0f}..{b[3]:.0f}, "
+                    f"{_distance(gap, unit)} away. Is it the reference of this site, and are the photos' GPS "
+                    "positions (or the rough positions given) and the reference's CRS right?")
+        side = max(xmax - xmin, ymax - ymin)
+        _grey, valid, _gt = self.grey(box, max(side / 128.0, self.gsd))
+        if not valid.any():
+            raise AutoControlError(f"reference orthophoto {self.ortho_path} has no data over {where}: every "
+                                   "pixel there is nodata (transparent); give an orthophoto with imagery there")
+        gx, gy = np.meshgrid(np.linspace(xmin, xmax, 24), np.linspace(ymin, ymax, 24))
+        if not np.isfinite(self.heights(gx.ravel(), gy.ravel())).any():
+            raise AutoControlError(f"reference DSM {self.dsm_path} has no data over {where}: every cell there is "
+                                   "nodata; give a DSM with heights there")
+
     def close(self) -> None:
         self.dsm.close()
         self._ds = None
+
+
+def _unit_name(wkt: str) -> str:
+    name, metres = linear_unit(wkt)
+    return "m" if metres == 1.0 else (name or "units")
+
+
+def _short_crs(crs: str) -> str:
+    return crs if len(crs) < 40 else "the orthophoto's CRS"
+
+
+def _distance(gap: float, unit: str) -> str:
+    return f"{gap / 1000.0:.1f} km" if unit == "m" and gap >= 1000.0 else f"{gap:.0f} {unit}"
 
 
 __all__ = ["Reference", "result_crs"]
