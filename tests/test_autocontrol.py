@@ -156,8 +156,22 @@ def test_a_reference_of_another_place_is_refused_by_name(tmp_path, epochs):
     in_use = '{"format": "archaeoortho-autocontrol", "the control": "in use"}'
     with open(lay.autocontrol_json, "w") as f:
         f.write(in_use)
-    with pytest.raises(AutoControlError, match="ref_ortho.tif") as e:
+    # 5 km away: named before any matching (issue 36 item 12), with where it lies
+    with pytest.raises(AutoControlError, match=r"ref_ortho.tif does not cover the block .* 4\.[0-9] km away"):
         autocontrol_workspace(ws_dir, ortho, dsm, prior="gps", camera_positions=cams, options=FAST)
+    assert open(lay.autocontrol_json).read() == in_use
+    # over the block but of nothing like it (noise): the matching fails, its candidates in autocontrol-failed.json
+    from osgeo import gdal
+
+    src = gdal.Open(epochs[2])
+    noise = str(tmp_path / "noise" / "ref_ortho.tif")
+    os.makedirs(os.path.dirname(noise))
+    rng = np.random.default_rng(5)
+    write_cog(noise, rng.integers(1, 255, size=(src.RasterYSize, src.RasterXSize)).astype(np.float32),
+              src.GetGeoTransform(), syn.CRS)
+    src = None
+    with pytest.raises(AutoControlError, match="ref_ortho.tif") as e:
+        autocontrol_workspace(ws_dir, noise, epochs[3], prior="gps", camera_positions=cams, options=FAST)
     assert open(lay.autocontrol_json).read() == in_use
     assert lay.autocontrol_failed_json in str(e.value) and "candidates" in json.load(open(lay.autocontrol_failed_json))
     with pytest.raises(AutoControlError, match="missing.tif"):

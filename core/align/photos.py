@@ -47,6 +47,11 @@ def check_photos(ws: Workspace, photos: Mapping[str, str]) -> List[str]:
     missing = sorted(n for n, p in photos.items() if not os.path.isfile(p))
     if missing:
         folder = os.path.dirname(photos[missing[0]]) or "."
+        if not os.path.isdir(folder):  # the whole folder moved or renamed after the alignment
+            raise ImageError(f"the photos' folder {folder} no longer exists ({len(missing)} photo(s) of the aligned "
+                             f"model were read from it: {_list(missing)}): the photos were moved or the folder "
+                             "renamed after 'Align images'; put the folder back, or re-run 'Align images' on the "
+                             "photos where they are now")
         raise ImageError(f"{len(missing)} photo(s) of the aligned model are missing from {folder}: {_list(missing)}; "
                          "put them back or re-run 'Align images' on the photos as they are now")
     if not isinstance(recorded, dict):

@@ -274,7 +274,42 @@ def _working_crs(crs: Optional[str], dsm_path: Optional[str], gcps, orient: Opti
         work_crs = dsm_info.crs_wkt
     if not work_crs:
         run.warn("no CRS given: coordinates are taken as they are (no CRS written)")
+    elif _geographic(work_crs):
+        work_crs = _projected_crs(crs, work_crs, dsm_info, gcps, orient, run)
     return work_crs
+
+
+def _geographic(crs: str) -> bool:
+    from ..geometry.crs import CRSError, crs_is_geographic
+
+    try:
+        return crs_is_geographic(crs)
+    except CRSError:
+        return False
+
+
+def _projected_crs(crs: Optional[str], work_crs: str, dsm_info, gcps, orient: Optional[dict], run: _Run) -> str:
+    """A geographic working CRS (degrees; issue 36 item 13: the resection then said 'points lie nearly on one
+    line'): OrthoError when the CRS parameter asked for it, else the UTM zone of the control (or the orientation,
+    or the DSM), said in the log."""
+    from ..geometry.crs import utm_epsg_for_lonlat
+
+    if gcps is not None and gcps.points:
+        src = gcps.crs or work_crs
+        xy = np.array([[np.mean([p.x for p in gcps.points]), np.mean([p.y for p in gcps.points])]])
+    elif orient is not None and "x" in orient:
+        src, xy = orient.get("crs") or work_crs, np.array([[orient["x"], orient["y"]]])
+    else:
+        b = dsm_info.bounds
+        src, xy = dsm_info.crs_wkt, np.array([[0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3])]])
+    lon, lat = transform_points(xy, src, "EPSG:4326")[0]
+    code = utm_epsg_for_lonlat(float(lon), float(lat))
+    if crs:
+        raise OrthoError(f"CRS {crs} is geographic (degrees): a space resection and an orthophoto need a projected "
+                         f"CRS in metres; give a projected CRS, e.g. EPSG:{code} (the UTM zone of the image)")
+    run.info(f"the control / DSM CRS is geographic (degrees): {run.name} is oriented and orthorectified in "
+             f"EPSG:{code} (the UTM zone of the image), and the orthophoto is written in it")
+    return f"EPSG:{code}"
 
 
 def _ground_control(gcps, orient: Optional[dict], work_crs: Optional[str], run: _Run) -> _Control:

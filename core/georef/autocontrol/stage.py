@@ -73,12 +73,23 @@ class AutoControlResult:
     messages: List[str] = field(default_factory=list)
 
 
-def _photos(ws: Workspace) -> Dict[str, str]:
+def _photos(ws: Workspace, rec=None) -> Dict[str, str]:
+    """{name: path} of the photos of the aligned model ``rec`` (all the workspace's without it); AutoControlError
+    naming the folder when they were moved after the alignment (they were left out silently, and the provisional
+    orthophoto came out empty)."""
+    from ...align.photos import check_photos
+    from ...io.images import ImageError
+
     out = {}
+    names = {im.name for im in registered(rec)} if rec is not None else None
     for im in ws.data.get("images", []):
-        p = im.get("path") or os.path.join(ws.data.get("images_dir") or "", im["name"])
-        if os.path.isfile(p):
-            out[im["name"]] = p
+        if names is not None and im["name"] not in names:
+            continue
+        out[im["name"]] = im.get("path") or os.path.join(ws.data.get("images_dir") or "", im["name"])
+    try:
+        check_photos(ws, out)
+    except ImageError as e:
+        raise AutoControlError(str(e)) from e
     return out
 
 
@@ -199,7 +210,7 @@ def find_candidates(ws: Workspace, rec, reference: Reference, prior: str = PRIOR
     """(candidates, figures, messages, common resolution, timings) of an aligned block against the reference."""
     opt = AutoControlOptions.of(options)
     progress = progress or NullProgress()
-    photos = _photos(ws)
+    photos = _photos(ws, rec)
     messages: List[str] = list(reference.notes)
     t = {"start": time.time()}
     frame = _prior(ws, rec, photos, reference, prior, positions, opt, SubProgress(progress, 0.0, 0.2), messages)
@@ -208,11 +219,14 @@ def find_candidates(ws: Workspace, rec, reference: Reference, prior: str = PRIOR
     photo_gsd = _photo_gsd(rec, frame)
     g = opt.gsd or max(reference.gsd, photo_gsd, max(ext[2] - ext[0], ext[3] - ext[1]) / opt.max_pixels)
     _check_block_pixels(ext, g, reference, photo_gsd, opt)
-    prov = provisional_ortho(rec, frame, photos, g, SubProgress(progress, 0.2, 0.4), ext)
-    t["orthophoto"] = time.time()
     margin = 0.15 * max(ext[2] - ext[0], ext[3] - ext[1]) + 10.0 * g
     off = frame.offset
     box = (ext[0] + off[0] - margin, ext[1] + off[1] - margin, ext[2] + off[0] + margin, ext[3] + off[1] + margin)
+    placed = "coarse match" if any(m.startswith("prior: none") for m in messages) else "rough camera positions"
+    reference.check_covers((ext[0] + off[0], ext[1] + off[1], ext[2] + off[0], ext[3] + off[1]),
+                           f"the block placed by its {placed}")
+    prov = provisional_ortho(rec, frame, photos, g, SubProgress(progress, 0.2, 0.4), ext)
+    t["orthophoto"] = time.time()
     ref, valid, gt = reference.grey(box, g)
     ms = match_orthos(prov.grey, prov.valid, ref, valid, opt)
     t["matching"] = time.time()
