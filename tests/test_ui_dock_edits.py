@@ -646,15 +646,16 @@ def test_diagnosis_of_large_residuals_is_shown_in_the_dock(dock, block, photos, 
     label = dock.diagnosis
     assert not label.isHidden()
     assert any(wrong.name in line for line in dock.store.diagnosis)
-    assert wrong.name in label.text() or wrong.name in label.toolTip()
-    # the first message shown (two lines at most), every message in the tooltip; the table keeps its room
+    assert wrong.name in label.text()
+    # every message shown whole (they were cut at 100 characters: issue 36 item 18); the dock's body scrolls, the
+    # table keeps its rows
     for line in dock.store.diagnosis:
-        assert line.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;") in label.toolTip()
-    if len(dock.store.diagnosis) > 1:
-        assert f"+{len(dock.store.diagnosis) - 1}" in label.text()
+        assert line.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;") in label.text()
     dock.resize(dock.sizeHint())
     process(50)
-    assert label.height() <= 3.5 * label.fontMetrics().lineSpacing(), "the diagnosis takes more than 3 lines"
+    from archaeoortho.ui.gcp_dock import TABLE_MIN_ROWS
+
+    assert dock.table.height() >= TABLE_MIN_ROWS * dock.table.verticalHeader().defaultSectionSize()
     # a workspace without an adjustment: no diagnosis shown
     ws2 = make_workspace(str(tmp_path), block, photos, name="ws2")
     assert dock.open_workspace(ws2)

@@ -645,3 +645,146 @@ def test_open_button_reads_the_block_model_in_a_task(default_dock, georef_ws, mo
     assert dock.__dict__.get("_prebuilt_model") is None  # used by load_predictor, not read again
     assert dock.current_name() is not None and dock.predictions
     print(f"\n[open button] click {click_ms:.0f} ms on the GUI thread; workspace open after {total_ms:.0f} ms")
+
+
+# --------------------------------------------------------------------------------------------------
+# issue 36 items 18-20: the dock on a small screen, long messages, the whole diagnosis
+# --------------------------------------------------------------------------------------------------
+
+SCREEN_HEIGHT = 768
+WINDOW_FRAME = 30  # the window manager's title bar: the main window gets the rest of the screen
+
+
+def _qgis_main_window(canvas):
+    """A main window dressed as QGIS's: a menu bar, two toolbar rows and a status bar, the map canvas in the
+    middle, and the Processing Toolbox and Results Viewer (QGIS's own docks) on the right."""
+    from processing.gui.ProcessingToolbox import ProcessingToolbox
+    from processing.gui.ResultsDock import ResultsDock
+    from qgis.core import QgsApplication
+    from qgis.PyQt.QtCore import Qt
+    from qgis.PyQt.QtWidgets import QLabel, QMainWindow
+
+    win = QMainWindow()
+    win.setCentralWidget(canvas)
+    _qgis_like(win)
+    for title in ("Project", "Edit", "View", "Layer", "Settings", "Plugins", "Vector", "Raster", "Processing",
+                  "Help"):
+        win.menuBar().addMenu(title)
+    for row, icons in enumerate((("mActionFileNew.svg", "mActionFileOpen.svg", "mActionFileSave.svg"),
+                                 ("mActionPan.svg", "mActionZoomIn.svg", "mActionZoomOut.svg"))):
+        if row:
+            win.addToolBarBreak()
+        bar = win.addToolBar(f"toolbar {row}")
+        for icon in icons:
+            bar.addAction(QgsApplication.getThemeIcon(icon), icon)
+    win.statusBar().addWidget(QLabel("Coordinate 500000, 4600000"))
+    toolbox, results = ProcessingToolbox(), ResultsDock()
+    for dock in (toolbox, results):
+        win.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, dock)
+    return win, (toolbox, results)
+
+
+def _inside(widget, win):
+    """Whether ``widget`` is shown whole inside the main window."""
+    top_left = widget.mapTo(win, widget.rect().topLeft())
+    bottom_right = widget.mapTo(win, widget.rect().bottomRight())
+    return widget.isVisible() and top_left.y() >= 0 and bottom_right.y() < win.height() and bottom_right.x() < win.width()
+
+
+def test_dock_fits_a_768_px_screen_beside_the_toolbox_and_results_viewer(qgis_canvas, qgis_new_project, georef_ws):
+    """On a 1000 px screen with the Toolbox and Results Viewer docked on the right, the GCP dock made the main
+    window 1057 px tall and its Georeference / Cancel row went off-screen (issue 36 item 20).  Its body scrolls
+    now: with QGIS's menu, toolbars, status bar and both docks the window fits a 768 px screen, and the
+    Georeference row and the status line stay in view."""
+    from archaeoortho.ui.gcp_dock import GcpDock
+    from qgis.PyQt.QtCore import Qt
+
+    win, others = _qgis_main_window(qgis_canvas)
+    available = SCREEN_HEIGHT - WINDOW_FRAME
+    d = GcpDock(None, qgis_canvas, parent=win)
+    try:
+        win.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, d)
+        win.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, d.photo_dock)
+        win.resize(1366, available)
+        win.show()
+        process(100)
+        _default_sizes(win, d)
+        assert d.open_workspace(georef_ws)
+        d.message("5 photos, 5 ground points. Predicted positions from the georeferenced block.")
+        process(200)
+        others_min = sum(o.minimumSizeHint().height() for o in others)
+        print(f"\n[768 px] GCP dock minimum {d.minimumSizeHint().height()} px (Toolbox + Results Viewer "
+              f"{others_min} px), main window minimum {win.minimumSizeHint().height()} px, window {win.height()} px, "
+              f"dock {d.height()} px")
+        assert win.minimumSizeHint().height() <= available
+        assert win.height() <= available
+        for w in (d.btn_georef, d.btn_cancel, d.progress, d.status):
+            assert _inside(w, win), w
+        assert d.table.height() >= 3 * d.table.verticalHeader().defaultSectionSize()
+        # the body scrolls to what does not fit: the automatic control box
+        assert d.body_scroll.verticalScrollBar().maximum() > 0 and d.auto_box.visibleRegion().isEmpty()
+        d.body_scroll.ensureWidgetVisible(d.auto_box)
+        process(50)
+        assert not d.auto_box.visibleRegion().isEmpty()
+        shot = os.path.join(ROOT, "build", "screenshots", "ui", "gcp-dock-768.png")
+        os.makedirs(os.path.dirname(shot), exist_ok=True)
+        assert win.grab().save(shot)
+    finally:
+        d.cleanup()
+        qgis_canvas.setParent(None)
+        win.close()
+
+
+def test_a_long_message_wraps_and_scrolls_and_leaves_the_table_alone(default_dock, georef_ws):
+    """A failed automatic control's message (several hundred characters, file paths without a space) ran off the
+    dock and squeezed the GCP table to one row (issue 36 item 19): it is wrapped inside the dock's width, at most
+    a few lines high, scrolls for the rest, and the table keeps its rows."""
+    from archaeoortho.ui.gcp_dock import STATUS_LINES, TABLE_MIN_ROWS
+
+    dock = default_dock
+    assert dock.open_workspace(georef_ws)
+    process(100)
+    width, table_height = dock.width(), dock.table.height()
+    path = "/data/references/" + "national_orthophoto_tiles_" * 8 + "merged.vrt"
+    text = ("Automatic control: 0 candidate(s) kept, 4 needed: the reference orthophoto " + path + " does not "
+            "cover the block (its extent lies 5.2 km to the north-east of the photos' GPS positions); the reference "
+            "DSM " + path.replace("orthophoto", "dsm") + " holds no height over the block. Choose references that "
+            "cover the photographed area, or move the map to it when the photos carry no GPS. ") * 2
+    dock.message(text)
+    process(200)
+    status = dock.status
+    print(f"\n[long message] {len(text)} characters: status {status.width()} x {status.height()} px, table "
+          f"{table_height} -> {dock.table.height()} px, dock width {width} -> {dock.width()} px")
+    assert status.text() == text  # the whole message, nothing cut
+    assert dock.width() == width
+    right = status.mapTo(dock, status.rect().topRight()).x()
+    assert right < dock.width()
+    assert status.height() <= (STATUS_LINES + 1) * status.fontMetrics().lineSpacing()
+    assert status.verticalScrollBar().maximum() > 0  # the rest is there, scrolled to
+    rows = dock.table.verticalHeader().defaultSectionSize()
+    assert dock.table.height() >= TABLE_MIN_ROWS * rows
+    assert dock.table.height() >= table_height - 2 * status.fontMetrics().lineSpacing()
+
+
+def test_the_diagnosis_is_shown_whole(default_dock, georef_ws):
+    """The adjustment's diagnosis was cut at 100 characters, hiding the finding (four automatic GCPs suspect, the
+    worst 1.54 m): every message is shown whole (issue 36 item 18, the dock's half)."""
+    from qgis.PyQt.QtGui import QTextDocument
+
+    dock = default_dock
+    assert dock.open_workspace(georef_ws)
+    lines = ["Check point residuals are 3.1 times the control residuals: the control may be biased (a shifted "
+             "point, a datum mix-up); compare the control file with the survey's.",
+             "4 automatic GCPs are suspect (residuals over 3 sigma): auto_017 1.54 m, auto_052 1.21 m, auto_008 "
+             "0.97 m, auto_033 0.91 m; they lie on the block's edge where the reference DSM is coarsest."]
+    dock.store.diagnosis = lines
+    dock.show_diagnosis()
+    process(100)
+    doc = QTextDocument()
+    doc.setHtml(dock.diagnosis.text())
+    shown = " ".join(doc.toPlainText().split())
+    for line in lines:
+        assert line in shown
+    dock.body_scroll.ensureWidgetVisible(dock.diagnosis)
+    process(50)
+    assert dock.diagnosis.isVisible() and dock.diagnosis.verticalScrollBar().maximum() == 0  # whole, unscrolled

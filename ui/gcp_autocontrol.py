@@ -65,8 +65,13 @@ class GcpAutoControl:
         return self.auto_box
 
     def _autocontrol_toggled(self, on):
+        """Unticked, the box folds to its title: the combos and their labels take no room (issue 36 item 20)."""
+        form = self.auto_box.layout()
         for w in (self.auto_ortho_combo, self.auto_dsm_combo):
             w.setVisible(bool(on))
+            label = form.labelForField(w)
+            if label is not None:
+                label.setVisible(bool(on))
         if hasattr(self, "refine_box"):  # the automatic control refines focal length and distortion in any case
             self.refine_box.setEnabled(not on)
         if hasattr(self, "btn_georef"):

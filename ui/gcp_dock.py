@@ -53,12 +53,17 @@ from .gcp_table import (
 )
 from .gcp_tasks import GcpTasks
 from .map_tool import GcpMapTool, GcpMarkers
+from .message_view import FitScrollArea, MessageView
 from .photo_viewer import PhotoPanel
 from .store import GcpStore
 
 KEY_COLUMNS = (NAME, OBS, DXY, DZ, PX)  # visible at the dock's default width (tests/test_ui_dock_layout.py)
 DEFAULT_WIDTH = 440  # the dock's width when QGIS first shows it (its size hint)
 PHOTO_DOCK_HEIGHT = 540  # the photo dock's height when first shown (plugin.show_dock), at most 62 % of the window
+BODY_MIN_HEIGHT = 64  # the scrolled body's least height (two rows; it scrolls): the dock fits beside QGIS's own docks
+TABLE_MIN_ROWS = 4  # the GCP table never shows fewer rows (a long message squeezed it to one, issue 36 item 19)
+STATUS_LINES = 5  # the status line grows to this many lines, then scrolls
+DIAGNOSIS_LINES = 40  # the diagnosis is shown whole up to this many lines (it was cut at 100 characters)
 
 
 class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpAutoControl, QgsDockWidget):
@@ -106,8 +111,16 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpAutoControl, QgsDockWi
 
     # ------------------------------------------------------------------ layout
     def _build(self):
+        """The body (workspace, table, settings, results) scrolls; the Georeference / Cancel row and the status
+        line under it stay in view: the dock fits a 768 px screen beside the Toolbox and the Results Viewer
+        (issue 36 item 20), and a long message scrolls in a few lines instead of squeezing the table (item 19)."""
         w = QWidget(self)
-        lay = QVBoxLayout(w)
+        outer = QVBoxLayout(w)
+        outer.setContentsMargins(0, 0, 0, 2)
+        outer.setSpacing(2)
+        self.body_scroll = FitScrollArea(w, min_height=BODY_MIN_HEIGHT)
+        body = QWidget(self.body_scroll)
+        lay = QVBoxLayout(body)
         lay.setContentsMargins(4, 4, 4, 4)
         lay.addLayout(self._build_workspace_row())
         self.align_label = QLabel()  # the alignment's result, kept on screen (not the status line's next message)
@@ -116,26 +129,30 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpAutoControl, QgsDockWi
         self.align_label.setVisible(False)
         lay.addWidget(self.align_label)
         lay.addLayout(self._build_heights_row())
-        for bar in self._build_toolbar(w):
+        for bar in self._build_toolbar(body):
             lay.addWidget(bar)
-        lay.addWidget(self._build_table(w), 1)
+        lay.addWidget(self._build_table(body), 1)
         lay.addLayout(self._build_tolerance_row())
         lay.addWidget(self.tol_source)
         lay.addLayout(self._build_refine_row())
         lay.addWidget(self._build_autocontrol_box())  # ui/gcp_autocontrol.py: the Georeference button's other mode
-        lay.addLayout(self._build_adjustment_row())
         self.summary = QLabel()
         self.summary.setWordWrap(True)
         self.summary.setTextFormat(Qt.TextFormat.RichText)
         lay.addWidget(self.summary)
-        self.diagnosis = QLabel()  # the adjustment's diagnosis of large residuals (GcpPlacement.show_diagnosis)
-        self.diagnosis.setWordWrap(True)
-        self.diagnosis.setTextFormat(Qt.TextFormat.RichText)
+        # the adjustment's diagnosis of large residuals (GcpPlacement.show_diagnosis), every line of it
+        self.diagnosis = MessageView(body, max_lines=DIAGNOSIS_LINES, min_lines=DIAGNOSIS_LINES, rich=True)
         self.diagnosis.setVisible(False)
         lay.addWidget(self.diagnosis)
-        self.status = QLabel()
-        self.status.setWordWrap(True)
-        lay.addWidget(self.status)
+        self.body_scroll.setWidget(body)
+        outer.addWidget(self.body_scroll, 1)
+        bottom = QVBoxLayout()
+        bottom.setContentsMargins(4, 0, 4, 0)
+        bottom.setSpacing(2)
+        bottom.addLayout(self._build_adjustment_row())
+        self.status = MessageView(w, max_lines=STATUS_LINES, min_lines=1)
+        bottom.addWidget(self.status)
+        outer.addLayout(bottom)
         self.setWidget(w)
 
     def _build_workspace_row(self):
@@ -243,6 +260,8 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpAutoControl, QgsDockWi
         # after them; the model's column numbers stay (only the view's order changes)
         for visual, column in enumerate(KEY_COLUMNS):
             header.moveSection(header.visualIndex(column), visual)
+        rows = TABLE_MIN_ROWS * self.table.verticalHeader().defaultSectionSize()
+        self.table.setMinimumHeight(rows + self.table.horizontalHeader().sizeHint().height() + 2 * self.table.frameWidth())
         triggers = QAbstractItemView.EditTrigger
         self.table.setEditTriggers(triggers.DoubleClicked | triggers.EditKeyPressed | triggers.AnyKeyPressed)
         return self.table

@@ -85,28 +85,25 @@ class GcpPlacement:
         self.tol_spin.setToolTip(translate("GcpDock", "Residuals up to this are green, up to 3 times yellow, beyond "
                                            "red. Now: {}").format(text))
 
-    def diagnosis_text(self, shown=1):
-        """The last adjustment's diagnosis (its warnings and outliers, georef/residuals.json) as rich text: the
-        first ``shown`` messages (the dock keeps room for the table), then how many more; None: all of them."""
+    def diagnosis_text(self, shown=None):
+        """The last adjustment's diagnosis (its warnings and outliers, georef/residuals.json) as rich text, one
+        bullet per message: the first ``shown`` messages and how many more; None (the dock): all of them, whole
+        (the finding, e.g. four automatic GCPs suspect and the worst, was cut at 100 characters: issue 36 item 18)."""
         lines = self.store.diagnosis
         if not lines:
             return ""
         title = "<b>" + translate("GcpDock", "Diagnosis of the adjustment:") + "</b>"
-        if shown is None:
-            return title + "<br>" + "<br>".join("\u2022 " + html.escape(t) for t in lines)
-        text = " ".join(lines[:shown])
-        if len(text) > 100:  # about three lines of the dock at its default width: the table keeps its room
-            text = text[:100].rsplit(" ", 1)[0] + " \u2026"
-        more = len(lines) - min(shown, len(lines))
-        return title + " " + html.escape(text) + (f" <i>(+{more})</i>" if more else "")
+        listed = lines if shown is None else lines[:shown]
+        more = len(lines) - len(listed)
+        return title + "<br>" + "<br>".join("\u2022 " + html.escape(t) for t in listed) + (
+            f" <i>(+{more})</i>" if more else "")
 
     def show_diagnosis(self):
-        """The diagnosis under the summary: its first message, all of them in the tooltip."""
+        """The diagnosis under the summary, every message whole (the dock's body scrolls)."""
         label = getattr(self, "diagnosis", None)
         if label is not None:
             text = self.diagnosis_text()
             label.setText(text)
-            label.setToolTip(self.diagnosis_text(shown=None))
             label.setVisible(bool(text))
 
     # ------------------------------------------------------------------ map tool
