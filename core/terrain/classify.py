@@ -32,7 +32,7 @@ def classify_las(las_in: str, las_out: str, dtm: Elevation, source: np.ndarray, 
     scale = np.asarray(struct.unpack_from("<3d", head, 131))
     off = np.asarray(struct.unpack_from("<3d", head, 155))
     gt = dtm.geotransform
-    heights = dtm.z / dtm.unit
+    heights = dtm.z if dtm.unit == 1.0 else dtm.z / dtm.unit
     n_ground = 0
     with atomic_output(las_out) as tmp:
         shutil.copyfile(las_in, tmp)

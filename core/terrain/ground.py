@@ -10,37 +10,60 @@ algorithm behind PDAL's ``filters.smrf``, here on the DSM raster (NumPy/SciPy, n
 3. the provisional ground surface: the non-object blocks, the objects filled in between, back on the DSM grid;
 4. a DSM cell is ground when it lies within ``threshold + scalar x local slope`` of that surface;
 5. the DTM: measured ground where ground, and under the objects (and in the DSM's inner holes) a thin-plate
-   spline fitted to the ring of ground around each object (SciPy's RBFInterpolator), push-pull for the tiny ones.
+   spline fitted to the ring of ground around each object (SciPy's RBFInterpolator), push-pull of the ground
+   around it for the tiny ones.
+
+Steps 1, 4 and 5 run on the DSM's full resolution by tiles (``GroundOptions.tile``; issue 33: the whole raster
+as float64 copies took 6 GiB for 44 M cells): the block medians by tiles of whole blocks, the classification on
+each tile with a margin its slope and dilation reach, each object filled from its own box; what is held whole
+is one byte a cell of masks, the object labels and the float32 DTM.  The result does not depend on the tiles.
 
 Negative features (ditches, hollow ways) are kept: an opening removes only what stands up.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Tuple
+from typing import Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
 from ..common.progress import NullProgress, Progress, check_cancel
 from ..io.raster import push_pull
-from .options import SOURCE_INTERPOLATED, SOURCE_MEASURED, GroundOptions
+from .options import SOURCE_INTERPOLATED, SOURCE_MEASURED, TILE_CELLS, GroundOptions
+from .rasters import tiles
 
 
 @dataclass
 class GroundResult:
-    dtm: np.ndarray  # float64, NaN where no ground can be given (outside the DSM's data)
+    dtm: np.ndarray  # float32, NaN where no ground can be given (outside the DSM's data)
     ground: np.ndarray  # bool: the DSM cell is measured ground
     source: np.ndarray  # uint8: SOURCE_MEASURED, SOURCE_INTERPOLATED, 0 = nodata
-    provisional: np.ndarray  # the provisional ground surface (for diagnostics)
+    valid_cells: int = 0  # cells of the DSM with data
+
+
+class _InMemory:
+    """A DSM array (metres, NaN = nodata) read by windows like a raster file (core.terrain.rasters.Elevation)."""
+
+    def __init__(self, z: np.ndarray):
+        self.z = z
+        self.shape = z.shape
+
+    def read(self, r0: int, r1: int, c0: int, c1: int) -> np.ndarray:
+        return np.array(self.z[r0:r1, c0:c1], dtype=np.float64)
+
+
+def _windowed(dsm):
+    return _InMemory(dsm) if isinstance(dsm, np.ndarray) else dsm
 
 
 # ---------------------------------------------------------------- filling holes
 
-def resample_to(coarse: np.ndarray, factor: int, h: int, w: int) -> np.ndarray:
-    """Bilinear values of a grid ``factor`` x coarser (block-aligned) at the centres of an h x w grid."""
+def resample_to(coarse: np.ndarray, factor: int, h: int, w: int, r0: int = 0, c0: int = 0) -> np.ndarray:
+    """Bilinear values of a grid ``factor`` x coarser (block-aligned) at the centres of an h x w grid (the
+    window of a finer grid starting at row ``r0``, column ``c0``)."""
     ch, cw = coarse.shape
-    fr = np.clip((np.arange(h) + 0.5) / factor - 0.5, 0, ch - 1)
-    fc = np.clip((np.arange(w) + 0.5) / factor - 0.5, 0, cw - 1)
+    fr = np.clip((np.arange(r0, r0 + h) + 0.5) / factor - 0.5, 0, ch - 1)
+    fc = np.clip((np.arange(c0, c0 + w) + 0.5) / factor - 0.5, 0, cw - 1)
     r0 = np.minimum(np.floor(fr).astype(int), max(ch - 2, 0))
     c0 = np.minimum(np.floor(fc).astype(int), max(cw - 2, 0))
     r1 = np.minimum(r0 + 1, ch - 1)
@@ -96,17 +119,63 @@ def smrf_objects(zmin: np.ndarray, cell: float, options: GroundOptions, progress
     return objects
 
 
-def filter_ground(dsm: np.ndarray, cell: float, options: GroundOptions,
-                  progress: Progress = None) -> GroundResult:
-    """Ground cells and the DTM of a DSM (NaN = nodata) with square cells of ``cell`` metres."""
+def _coarse_surface(dsm, factor: int, tile: int, valid: np.ndarray) -> np.ndarray:
+    """The block medians of the DSM (:func:`_block_surface`) read tile by tile (tiles of whole blocks);
+    ``valid`` (the DSM's data mask, whole) is filled on the way."""
+    h, w = dsm.shape
+    out = np.full((-(-h // factor), -(-w // factor)), np.nan)
+    step = factor * max(1, tile // factor)
+    for r0, r1, c0, c1 in tiles(h, w, step):
+        z = dsm.read(r0, r1, c0, c1)
+        valid[r0:r1, c0:c1] = np.isfinite(z)
+        out[r0 // factor:-(-r1 // factor), c0 // factor:-(-c1 // factor)] = _block_surface(z, factor)
+    return out
+
+
+def _classify_tile(dsm, provisional_c: np.ndarray, factor: int, window: Tuple[int, int, int, int], margin: int,
+                   cell: float, options: GroundOptions, grow: int) -> Tuple[np.ndarray, np.ndarray]:
+    """(ground, heights) of the tile ``window`` (r0, r1, c0, c1): steps 3-4 on the tile and a ``margin`` around it
+    (the slope's differences and the dilation by ``grow`` cells reach that far: the tile's cells come out as on
+    the whole raster)."""
+    from scipy import ndimage
+
+    h, w = dsm.shape
+    r0, r1, c0, c1 = window
+    a0, a1, b0, b1 = max(0, r0 - margin), min(h, r1 + margin), max(0, c0 - margin), min(w, c1 + margin)
+    z = dsm.read(a0, a1, b0, b1)
+    provisional = resample_to(provisional_c, factor, a1 - a0, b1 - b0, a0, b0)
+    gy, gx = np.gradient(provisional, cell)
+    slope = np.hypot(gx, gy)
+    del gx, gy
+    valid = np.isfinite(z)
+    dz = z - provisional
+    del provisional
+    with np.errstate(invalid="ignore"):
+        ground = valid & (dz <= options.threshold + options.scalar * slope) & (dz >= -2.0 * options.threshold)
+    ground &= ~ndimage.binary_dilation(valid & ~ground, iterations=grow)  # the blurred feet of walls and crowns
+    core = (slice(r0 - a0, r1 - a0), slice(c0 - b0, c1 - b0))
+    return ground[core], z[core]
+
+
+def filter_ground(dsm, cell: float, options: GroundOptions, progress: Progress = None,
+                  tile: Optional[int] = None, check_data: Optional[Callable[[int], None]] = None) -> GroundResult:
+    """Ground cells and the DTM of a DSM (NaN = nodata) with square cells of ``cell`` metres.  ``dsm``: an array
+    or a raster read by windows (core.terrain.rasters.Elevation); the full-resolution steps run by tiles of
+    ``tile`` cells (``options.tile``; the result does not depend on it), so only masks, labels and the DTM are
+    ever whole.  ``check_data``: called with the number of cells with data once it is known (it may raise)."""
     from scipy import ndimage
 
     progress = progress or NullProgress()
-    valid = np.isfinite(dsm)
+    dsm = _windowed(dsm)
+    tile = int(tile or options.tile)
     h, w = dsm.shape
+    valid = np.zeros((h, w), dtype=bool)
     factor = max(1, int(round(options.filter_cell / cell)))
     coarse_cell = cell * factor
-    zmin = _block_surface(dsm, factor)
+    zmin = _coarse_surface(dsm, factor, tile, valid)
+    n_valid = int(np.count_nonzero(valid))
+    if check_data is not None:
+        check_data(n_valid)
     coarse_valid = np.isfinite(zmin)
     coarse_valid &= ~low_outliers(push_pull(np.nan_to_num(zmin), coarse_valid), coarse_valid, 2 * options.threshold)
     zfill = push_pull(np.nan_to_num(zmin), coarse_valid)
@@ -116,17 +185,17 @@ def filter_ground(dsm: np.ndarray, cell: float, options: GroundOptions,
     skirt = int(np.ceil(options.skirt / coarse_cell))
     grown = ndimage.binary_dilation(objects, iterations=skirt) if skirt else objects
     provisional_c = push_pull(zfill, ~grown) if (~grown).any() else zfill
-    provisional = resample_to(provisional_c, factor, h, w)
-    gy, gx = np.gradient(provisional, cell)
-    slope = np.hypot(gx, gy)
-    dz = dsm - provisional
-    with np.errstate(invalid="ignore"):
-        ground = valid & (dz <= options.threshold + options.scalar * slope) & (dz >= -2.0 * options.threshold)
     grow = max(1, int(round(options.dilate / cell))) if options.dilate > 0 else 1
-    ground &= ~ndimage.binary_dilation(valid & ~ground, iterations=grow)  # the blurred feet of walls and crowns
+    ground = np.zeros((h, w), dtype=bool)
+    dtm = np.full((h, w), np.nan, dtype=np.float32)
+    for r0, r1, c0, c1 in tiles(h, w, tile):
+        check_cancel(progress)
+        g, z = _classify_tile(dsm, provisional_c, factor, (r0, r1, c0, c1), grow + 2, cell, options, grow)
+        ground[r0:r1, c0:c1] = g
+        dtm[r0:r1, c0:c1] = np.where(g, z, np.nan)
     progress.report(0.6, "ground filter: interpolating under the objects")
-    dtm, source = interpolate_ground(dsm, ground, valid, cell, progress)
-    return GroundResult(dtm=dtm, ground=ground, source=source, provisional=provisional)
+    source = interpolate_ground(dsm, ground, valid, cell, progress, tile=tile, dtm=dtm)[1]
+    return GroundResult(dtm=dtm, ground=ground, source=source, valid_cells=n_valid)
 
 
 # ---------------------------------------------------------------- interpolation under the objects
@@ -140,55 +209,95 @@ def _outside(valid: np.ndarray) -> np.ndarray:
     return np.isin(lab, edge[edge > 0])
 
 
-def interpolate_ground(dsm: np.ndarray, ground: np.ndarray, valid: np.ndarray, cell: float,
-                       progress: Progress) -> Tuple[np.ndarray, np.ndarray]:
-    """(DTM, source): ground cells measured; every other cell inside the data interpolated."""
+def interpolate_ground(dsm, ground: np.ndarray, valid: np.ndarray, cell: float, progress: Progress = None,
+                       tile: int = TILE_CELLS, dtm: Optional[np.ndarray] = None) -> Tuple[np.ndarray, np.ndarray]:
+    """(DTM, source): ground cells measured; every other cell inside the data interpolated, object by object from
+    the ground around it only (the result does not depend on ``tile``, the side of the tiles the DSM is read by).
+    ``dtm``: the measured ground already in place (float32, filled in place); else made from ``dsm``."""
     from scipy import ndimage
 
-    outside = _outside(valid)
-    dtm = np.where(ground, dsm, np.nan)
-    fill = push_pull(np.nan_to_num(dsm), ground)
-    holes = ~ground & ~outside
+    progress = progress or NullProgress()
+    dsm = _windowed(dsm)
+    h, w = ground.shape
+    if dtm is None:
+        dtm = np.full((h, w), np.nan, dtype=np.float32)
+        for r0, r1, c0, c1 in tiles(h, w, tile):
+            dtm[r0:r1, c0:c1] = np.where(ground[r0:r1, c0:c1], dsm.read(r0, r1, c0, c1), np.nan)
+    holes = ~ground & ~_outside(valid)
+    source = holes.astype(np.uint8) * np.uint8(SOURCE_INTERPOLATED)
+    source[ground] = SOURCE_MEASURED
     lab, n = ndimage.label(holes, structure=np.ones((3, 3)))
+    del holes
+    objects = ndimage.find_objects(lab)
     ring = max(3, int(round(1.5 / cell)))
-    for i, sl in enumerate(ndimage.find_objects(lab)):
-        if i % 64 == 0:
-            check_cancel(progress)
-            progress.report(0.6 + 0.35 * i / max(n, 1), f"ground filter: object {i + 1} of {n}")
-        comp = lab[sl] == i + 1
-        if comp.sum() < 16:
-            dtm[sl][comp] = fill[sl][comp]
-            continue
-        dtm[sl][comp] = _spline_fill(dsm, ground, lab, i + 1, sl, ring, fill)
-    source = np.where(ground, SOURCE_MEASURED, np.where(holes, SOURCE_INTERPOLATED, 0)).astype(np.uint8)
-    dtm[outside] = np.nan
+    tile = max(1, int(tile))
+    margin = 4 * ring  # an object whose box and ring fit in its tile and this margin is done from the tile's read
+    by_tile: Dict[Tuple[int, int], List[int]] = {}
+    for i, sl in enumerate(objects):
+        by_tile.setdefault((sl[0].start // tile, sl[1].start // tile), []).append(i)
+    done = 0
+    for (ti, tj), members in sorted(by_tile.items()):
+        r0, c0 = ti * tile, tj * tile
+        win = (max(0, r0 - margin), min(h, r0 + tile + margin), max(0, c0 - margin), min(w, c0 + tile + margin))
+        z = None
+        for i in members:
+            if done % 64 == 0:
+                check_cancel(progress)
+                progress.report(0.6 + 0.35 * done / max(n, 1), f"ground filter: object {done + 1} of {n}")
+            done += 1
+            box = _box(objects[i], ring, h, w)
+            if win[0] <= box[0] and box[1] <= win[1] and win[2] <= box[2] and box[3] <= win[3]:
+                if z is None:
+                    z = dsm.read(*win)
+                part = z[box[0] - win[0]:box[1] - win[0], box[2] - win[2]:box[3] - win[2]]
+            else:  # larger than the margin: its own read
+                part = dsm.read(*box)
+            _fill_object(dtm, part, ground, lab, i + 1, box, ring)
+    dtm[source == 0] = np.nan
     return dtm, source
 
 
-def _spline_fill(dsm, ground, lab, label, sl, ring, fill) -> np.ndarray:
-    """A thin-plate spline through the ground ring around component ``label`` (bbox ``sl``), at its cells."""
+def _box(sl, ring: int, h: int, w: int) -> Tuple[int, int, int, int]:
+    """The bounding box ``sl`` of an object grown by ``ring`` cells, clipped to the raster: (r0, r1, c0, c1)."""
+    return (max(0, sl[0].start - ring), min(h, sl[0].stop + ring), max(0, sl[1].start - ring),
+            min(w, sl[1].stop + ring))
+
+
+def _fill_object(dtm, z, ground, lab, label, box, ring) -> None:
+    """The DTM under object ``label`` from the DSM ``z`` of ``box`` (its bounding box grown by ``ring`` cells): a thin-plate spline through the ground ring, or for a small object (or too little ring) the membrane
+    (push-pull) of the ground in the box."""
+    r0, r1, c0, c1 = box
+    comp = lab[r0:r1, c0:c1] == label
+    known = ground[r0:r1, c0:c1]
+    values = None
+    if comp.sum() >= 16:
+        values = _spline_fill(z, known, comp, label, ring)
+    if values is None:
+        values = push_pull(np.nan_to_num(z), known)[comp] if known.any() else np.nan
+    dtm[r0:r1, c0:c1][comp] = values
+
+
+def _spline_fill(z, known, comp, label, ring) -> Optional[np.ndarray]:
+    """A thin-plate spline through the ground ring around the object ``comp`` (all in its grown box), at its
+    cells; None when the ring has too few points or the spline cannot be solved."""
     from scipy import ndimage
     from scipy.interpolate import RBFInterpolator
 
-    h, w = dsm.shape
-    r0, r1 = max(0, sl[0].start - ring), min(h, sl[0].stop + ring)
-    c0, c1 = max(0, sl[1].start - ring), min(w, sl[1].stop + ring)
-    comp = lab[r0:r1, c0:c1] == label
-    around = ndimage.binary_dilation(comp, iterations=ring) & ground[r0:r1, c0:c1] & ~comp
+    around = ndimage.binary_dilation(comp, iterations=ring) & known & ~comp
     rr, cc = np.nonzero(around)
     inside_r, inside_c = np.nonzero(comp)
     if len(rr) < 10:
-        return fill[r0:r1, c0:c1][comp]
+        return None
     if len(rr) > 600:
         pick = np.random.default_rng(label).choice(len(rr), 600, replace=False)
         rr, cc = rr[pick], cc[pick]
     pts = np.column_stack([rr, cc]).astype(np.float64)
-    vals = dsm[r0:r1, c0:c1][rr, cc]
+    vals = z[rr, cc]
     scale = max(comp.shape)
     try:
         rbf = RBFInterpolator(pts / scale, vals, kernel="thin_plate_spline", smoothing=1e-3 * len(pts), degree=1)
         q = np.column_stack([inside_r, inside_c]).astype(np.float64) / scale
         out = np.concatenate([rbf(q[i:i + 200_000]) for i in range(0, len(q), 200_000)])
     except (np.linalg.LinAlgError, ValueError):
-        return fill[r0:r1, c0:c1][comp]
+        return None
     return np.clip(out, vals.min(), vals.max())  # a spline may overshoot between noisy ring points: never above

@@ -26,6 +26,9 @@ SOURCE_MEASURED = raster.SOURCE_MEASURED
 SOURCE_INTERPOLATED = raster.SOURCE_INTERPOLATED
 
 
+TILE_CELLS = 1024  # the side of the tiles the terrain products are computed and written by (memory, not result)
+
+
 class TerrainError(ArchaeoOrthoError, RuntimeError):
     """The DTM, a relief visualisation or contours cannot be made from this raster; the message names the file
     and the problem."""
@@ -45,6 +48,7 @@ class GroundOptions:
     filter_cell: float = 0.5  # m, the grid of the morphological opening (finer DSMs are reduced to it)
     dilate: float = 0.0  # m, objects grown by this much (0 = one DSM cell: the blurred foot of a wall)
     skirt: float = 2.0  # m around the objects where the provisional surface is interpolated (blurred walls)
+    tile: int = TILE_CELLS  # cells: the side of the tiles the full-resolution steps run by (memory; same result)
 
 
 @dataclass

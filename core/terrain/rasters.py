@@ -9,26 +9,44 @@ import numpy as np
 
 from ..common.parallel import available_memory
 from ..io import raster
-from .options import TerrainError
+from .options import TILE_CELLS, TerrainError
 
 MIN_CELLS = 16  # the smallest raster side the filters work on
-# bytes of memory per cell the terrain products need at their peak: Build DTM held 6.5 GiB for a 7,220 x 6,052
-# DSM (issue 33: 43.7 M cells, about 19 float64 copies); a raster that needs more than is available is refused
-PEAK_BYTES_PER_CELL = 160
+# bytes of memory per cell the terrain products need at their peak: Build DTM holds its masks, labels and the
+# DTM whole (about 12 bytes a cell; the heights are read and processed by tiles), plus tiles and GDAL's cache
+# (issue 33: 6.0 GiB before for a 7,220 x 6,052 DSM, 160 bytes a cell); a raster that needs more than is
+# available is refused
+PEAK_BYTES_PER_CELL = 24
 
 
 @dataclass
 class Elevation:
     path: str
-    z: np.ndarray  # float64, NaN = nodata, in metres
+    z: Optional[np.ndarray]  # float64, NaN = nodata, in metres; None: read by windows (:meth:`read`)
     geotransform: Tuple[float, ...]
     crs_wkt: str
     cell: float  # metres
     unit: float  # metres per height unit (io.raster.height_unit: the heights are scaled by it, and back on writing)
+    size: Tuple[int, int] = (0, 0)  # rows, columns
 
     @property
     def shape(self) -> Tuple[int, int]:
-        return self.z.shape
+        return self.z.shape if self.z is not None else self.size
+
+    def read(self, r0: int, r1: int, c0: int, c1: int) -> np.ndarray:
+        """Rows r0:r1, columns c0:c1 as float64 metres (NaN = nodata), from memory or from the file."""
+        if self.z is not None:
+            return np.array(self.z[r0:r1, c0:c1], dtype=np.float64)
+        from osgeo import gdal
+
+        ds = gdal.Open(self.path)
+        band = ds.GetRasterBand(1)
+        z = band.ReadAsArray(c0, r0, c1 - c0, r1 - r0).astype(np.float64)
+        nd = band.GetNoDataValue()
+        if nd is not None:
+            z[z == nd] = np.nan
+        z[~np.isfinite(z)] = np.nan
+        return z * self.unit if self.unit != 1.0 else z
 
 
 def open_raster(path: str, what: str):
@@ -90,9 +108,12 @@ def check_memory(path: str, what: str, w: int, h: int, bytes_per_cell: int = PEA
                            "first")
 
 
-def read_elevation(path: str, what: str = "DSM") -> Elevation:
+def read_elevation(path: str, what: str = "DSM", whole: bool = True,
+                   bytes_per_cell: int = PEAK_BYTES_PER_CELL) -> Elevation:
     """The whole raster ``path`` (band 1) as metres; TerrainError naming the file for a raster that cannot be a
-    terrain model: unreadable, geographic CRS (degrees), rotated or non-square cells, too small, no data."""
+    terrain model: unreadable, geographic CRS (degrees), rotated or non-square cells, too small, no data.
+    ``whole`` False: the checks on the file only, the heights read by windows later (:meth:`Elevation.read`;
+    the caller checks the data with :func:`check_data`)."""
     from osgeo import osr
 
     ds = open_raster(path, what)
@@ -117,7 +138,9 @@ def read_elevation(path: str, what: str = "DSM") -> Elevation:
     if w < MIN_CELLS or h < MIN_CELLS:
         raise TerrainError(f"the {what} {path} is {w} x {h} cells: too small for a terrain model (at least "
                            f"{MIN_CELLS} x {MIN_CELLS} cells)")
-    check_memory(path, what, w, h)
+    check_memory(path, what, w, h, bytes_per_cell)
+    if not whole:
+        return Elevation(path, None, tuple(gt), wkt, abs(gt[1]) * xy_unit, unit, (h, w))
     band = ds.GetRasterBand(1)
     z = band.ReadAsArray().astype(np.float64)
     nd = band.GetNoDataValue()
@@ -125,13 +148,25 @@ def read_elevation(path: str, what: str = "DSM") -> Elevation:
         z[z == nd] = np.nan
     z[~np.isfinite(z)] = np.nan
     ds = None
-    n_valid = int(np.isfinite(z).sum())
+    check_data(path, what, int(np.isfinite(z).sum()), w, h)
+    return Elevation(path, z * unit, tuple(gt), wkt, abs(gt[1]) * xy_unit, unit, (h, w))
+
+
+def check_data(path: str, what: str, n_valid: int, w: int, h: int) -> None:
+    """TerrainError naming the file when it has no data or too few cells with data for a terrain model."""
     if n_valid == 0:
         raise TerrainError(f"the {what} {path} has no data: every one of its {w} x {h} cells is nodata")
     if n_valid < MIN_CELLS * MIN_CELLS:
         raise TerrainError(f"the {what} {path} has only {n_valid} cells with data: too few for a terrain model "
                            f"(at least {MIN_CELLS * MIN_CELLS})")
-    return Elevation(path, z * unit, tuple(gt), wkt, abs(gt[1]) * xy_unit, unit)
+
+
+def tiles(h: int, w: int, size: int):
+    """(r0, r1, c0, c1) of the tiles of ``size`` x ``size`` cells covering an h x w raster, row by row."""
+    size = max(1, int(size))
+    for r0 in range(0, h, size):
+        for c0 in range(0, w, size):
+            yield r0, min(h, r0 + size), c0, min(w, c0 + size)
 
 
 def write_float(path: str, array: np.ndarray, elev: Elevation, description: str, metadata: dict,
@@ -142,9 +177,75 @@ def write_float(path: str, array: np.ndarray, elev: Elevation, description: str,
                             description=description, metadata=metadata)
 
 
-def write_classes(path: str, array: np.ndarray, elev: Elevation, description: str, metadata: dict) -> str:
-    """A class raster (small integers, 0 = nodata) as a COG on the grid of ``elev`` (core.io.raster.write_classes)."""
-    return raster.write_classes(path, array, elev.geotransform, elev.crs_wkt or None, description, metadata)
+def write_float_tiles(path: str, tile_values, elev: Elevation, description: str, metadata: dict,
+                      heights: bool = True, tile: int = TILE_CELLS, progress=None,
+                      nodata: float = raster.NODATA) -> str:
+    """A float32 COG on the grid of ``elev`` written tile by tile: ``tile_values(r0, r1, c0, c1)`` gives the
+    values (metres when ``heights``, NaN = nodata) of each tile; they go into a temporary tiled GeoTIFF beside
+    ``path``, then into the COG (atomically: core.io.raster.write_cog's options), so the raster is never whole
+    in memory."""
+    from osgeo import gdal
+
+    from ..common.files import atomic_output
+    from ..common.progress import NullProgress, check_cancel
+
+    gdal.UseExceptions()
+    progress = progress or NullProgress()
+    h, w = elev.shape
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    with atomic_output(path) as tmp:
+        work = tmp + ".tiles.tif"
+        try:
+            ds = gdal.GetDriverByName("GTiff").Create(work, w, h, 1, gdal.GDT_Float32, [
+                "TILED=YES", "BLOCKXSIZE=256", "BLOCKYSIZE=256", "COMPRESS=DEFLATE", "ZLEVEL=1", "BIGTIFF=IF_SAFER"])
+            ds.SetGeoTransform(tuple(float(v) for v in elev.geotransform))
+            if elev.crs_wkt:
+                ds.SetProjection(elev.crs_wkt)
+            band = ds.GetRasterBand(1)
+            band.SetNoDataValue(float(nodata))
+            band.SetDescription(description)
+            ds.SetMetadata({str(k): str(v) for k, v in metadata.items()})
+            for r0, r1, c0, c1 in tiles(h, w, tile):
+                values = np.asarray(tile_values(r0, r1, c0, c1), dtype=np.float32)
+                if heights and elev.unit != 1.0:
+                    values = values / np.float32(elev.unit)
+                band.WriteArray(np.where(np.isfinite(values), values, np.float32(nodata)), c0, r0)
+                check_cancel(progress)
+            ds.FlushCache()
+            ds = band = None
+
+            def cb(fraction, _msg, _data):
+                progress.report(fraction, "writing Cloud-Optimized GeoTIFF")
+                return 0 if progress.is_cancelled() else 1
+
+            opts = gdal.TranslateOptions(format="COG", creationOptions=[
+                "COMPRESS=DEFLATE", "PREDICTOR=YES", "BLOCKSIZE=256", "OVERVIEWS=IGNORE_EXISTING",
+                "OVERVIEW_RESAMPLING=AVERAGE", "BIGTIFF=IF_SAFER"], callback=cb)
+            try:
+                out = gdal.Translate(tmp, work, options=opts)
+            except RuntimeError as e:
+                check_cancel(progress)
+                raise TerrainError(f"cannot write {path}: {e}") from e
+            if out is None:
+                check_cancel(progress)
+                raise TerrainError(f"cannot write {path}")
+            out.FlushCache()
+            out = None
+        finally:
+            if os.path.exists(work):
+                os.remove(work)
+    return path
+
+
+def write_classes(path: str, array: np.ndarray, elev: Elevation, description: str, metadata: dict,
+                  tile: int = TILE_CELLS) -> str:
+    """A class raster (small integers, 0 = nodata) as a COG on the grid of ``elev`` (as core.io.raster.write_classes
+    writes it: float32, nodata 0), written tile by tile."""
+    def values(r0, r1, c0, c1):
+        part = array[r0:r1, c0:c1]
+        return np.where(part > 0, part.astype(np.float32), np.float32(np.nan))
+
+    return write_float_tiles(path, values, elev, description, metadata, heights=False, tile=tile, nodata=0.0)
 
 
 def same_grid(a: str, b: str) -> Optional[str]:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Dict, List, Optional, Sequence
 
 import numpy as np
@@ -38,7 +38,7 @@ from .options import (
     ReliefOptions,
     TerrainError,
 )
-from .rasters import read_elevation, write_classes, write_float
+from .rasters import check_data, read_elevation, write_classes, write_float, write_float_tiles
 
 
 @dataclass
@@ -87,28 +87,30 @@ def build_dtm(dsm_path: str, output_dtm: str, options: Optional[GroundOptions] =
         {"DSM": dsm_path, "point cloud": point_cloud}, TerrainError)
     if contour_interval and contour_interval > 0:
         check_contours_output(contours_path)
-    elev = read_elevation(dsm_path, "DSM")
-    res = filter_ground(elev.z, elev.cell, options, SubProgress(progress, 0.0, 0.8))
+    elev = read_elevation(dsm_path, "DSM", whole=False)  # read by tiles
+    h, w = elev.shape
+    res = filter_ground(elev, elev.cell, options, SubProgress(progress, 0.0, 0.8),
+                        check_data=lambda n: check_data(dsm_path, "DSM", n, w, h))
     timings = {"ground_filter": time.time() - t0}
     check_cancel(progress)
-    valid = np.isfinite(elev.z)
-    ground_fraction = float(res.ground.sum() / max(valid.sum(), 1))
-    interpolated = float((res.source == SOURCE_INTERPOLATED).sum() / max((res.source > 0).sum(), 1))
+    ground_fraction = float(np.count_nonzero(res.ground) / max(res.valid_cells, 1))
+    interpolated = float(np.count_nonzero(res.source == SOURCE_INTERPOLATED) / max(np.count_nonzero(res.source), 1))
     meta = {"ARCHAEOORTHO_STAGE": "terrain", "ARCHAEOORTHO_PRODUCT": "dtm", "GROUND_FILTER": "SMRF",
             "SMRF_SLOPE": options.slope, "SMRF_WINDOW_M": options.window, "SMRF_THRESHOLD_M": options.threshold,
             "SMRF_SCALAR": options.scalar, "SOURCE_DSM": os.path.abspath(dsm_path),
             "GROUND_FRACTION": f"{ground_fraction:.4f}"}
-    write_float(output_dtm, res.dtm, elev, "DTM (bare earth)", meta, progress=SubProgress(progress, 0.8, 0.88))
+    write_float_tiles(output_dtm, lambda r0, r1, c0, c1: res.dtm[r0:r1, c0:c1], elev, "DTM (bare earth)", meta,
+                      tile=options.tile, progress=SubProgress(progress, 0.8, 0.88))
     write_classes(source_path, res.source, elev, "DTM source: 1 measured ground, 2 interpolated",
                   {"ARCHAEOORTHO_PRODUCT": "dtm-source", "VALUES": f"{SOURCE_MEASURED}=measured ground, "
-                   f"{SOURCE_INTERPOLATED}=interpolated"})
+                   f"{SOURCE_INTERPOLATED}=interpolated"}, tile=options.tile)
     out = DtmResult(dtm_path=output_dtm, source_path=source_path, dsm_path=dsm_path, cell=elev.cell,
                     ground_fraction=ground_fraction, interpolated_fraction=interpolated, timings=timings)
     out.log_lines.append(f"DTM {elev.shape[1]} x {elev.shape[0]} cells at {elev.cell:g} m: {ground_fraction:.1%} of "
                          f"the DSM's cells ground, {interpolated:.1%} of the DTM interpolated -> {output_dtm}")
     if point_cloud and classified_point_cloud:
         t1 = time.time()
-        dtm_elev = read_elevation(output_dtm, "DTM")
+        dtm_elev = replace(elev, path=output_dtm, z=res.dtm)  # the DTM as written (float32, metres)
         out.points, out.ground_points = classify_las(point_cloud, classified_point_cloud, dtm_elev, res.source,
                                                      options.threshold)
         out.point_cloud_path = classified_point_cloud
