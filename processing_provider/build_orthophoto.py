@@ -83,7 +83,7 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
             QgsProcessingParameterString(
                 self.IMAGES_FILTER, self.tr("Images"),
                 defaultValue="", optional=True),
-            params.number(self.RESOLUTION, self.tr("Resolution")),
+            params.number(self.RESOLUTION, self.tr("Resolution (CRS units, 0 = GSD)")),
             params.blending(self.BLENDING, self.tr("Seam blending")),
             params.flag(self.RADIOMETRY, self.tr("Even out vignetting and hot spot"), default=True),
             QgsProcessingParameterFeatureSource(
