@@ -1115,3 +1115,70 @@ __all__ = [
     "read_camera_positions",
     "read_csv_gcps", "read_gcps", "read_odm_gcp_list", "write_csv_gcps", "write_gcps", "write_odm_gcp_list",
 ]
+
+
+def _odm_target_line(toks: List[str], path: PathLike, lineno: int) -> Tuple[float, float, float, Optional[str]]:
+    """x, y, z and name of one line of a targets file in the gcp_list.txt form, with or without pixel columns."""
+    x, y, z = (_num(toks[k], w, path, lineno) for k, w in ((0, "x"), (1, "y"), (2, "z")))
+    if len(toks) in (4, 5) and not _is_number(toks[3]):
+        return x, y, z, toks[3]  # x y z name [check]
+    if len(toks) >= 6 and _is_number(toks[3]) and _is_number(toks[4]):
+        return x, y, z, toks[6] if len(toks) > 6 else None  # x y z px py image [name]
+    raise GCPError(f"{path}:{lineno}: expected 'x y z name' or 'x y z px py image name', found {len(toks)} "
+                   f"field(s): {' '.join(toks)!r}")
+
+
+def read_target_coordinates(path: PathLike, default_crs: Optional[str] = None) -> GCPSet:
+    """Surveyed targets, coordinates only (Find targets): a CSV points file (``name,x,y,z[,sigma_xy,sigma_z]``, any
+    observations ignored) or a gcp_list.txt whose pixel columns may be absent (``x y z name``) or present on some
+    lines only (``x y z px py image name``; the pixel columns are ignored).  ``default_crs``: the CRS of a file that
+    names none (a gcp_list.txt without its CRS line); none at all is a GCPError saying to give it.  Points without
+    a name are named by their coordinates' order (``gcp_<n>``); one name with two positions is an error naming
+    both lines."""
+    if detect_gcp_format(path) == "csv":
+        gs = read_csv_gcps(path, default_crs=default_crs)
+        for p in gs.points:
+            p.observations = []
+        gs.warnings = [w for w in gs.warnings if "no observations file" not in w and "no usable observation" not in w]
+        return gs
+    rows: List[Tuple[int, List[str]]] = []
+    for n, line in enumerate(_read_lines(path), start=1):
+        s = line.split("#", 1)[0].strip()
+        if s:
+            rows.append((n, s.split()))
+    if not rows:
+        raise GCPError(f"{path}: empty: no targets")
+    first_n, first = rows[0]
+    if len(first) >= 4 and all(_is_number(t) for t in first[:3]):
+        if not default_crs:
+            raise GCPError(f"{path}:{first_n}: no CRS line before the first target: give the CRS (the "
+                           "algorithm's CRS parameter) or add it as the file's first line (e.g. EPSG:32611)")
+        crs = normalize_crs(default_crs)
+    else:
+        crs = normalize_crs(" ".join(first))
+        rows = rows[1:]
+    gs = GCPSet(crs=crs, source=str(path))
+    _check_crs_for_file(crs, path, first_n, gs.warnings)
+    seen: Dict[str, Tuple[GroundPoint, int]] = {}
+    by_xyz: Dict[Tuple[float, float, float], GroundPoint] = {}
+    for lineno, toks in rows:
+        x, y, z, name = _odm_target_line(toks, path, lineno)
+        if name is None:
+            p = by_xyz.get((x, y, z))
+            if p is None:
+                name = f"gcp_{len(gs.points) + 1}"
+            else:
+                continue
+        if name in seen:
+            p, first_line = seen[name]
+            if (p.x, p.y, p.z) != (x, y, z):
+                raise GCPError(f"{path}:{lineno}: target {name} has coordinates ({x}, {y}, {z}) here but "
+                               f"({p.x}, {p.y}, {p.z}) on line {first_line}")
+            continue
+        p = GroundPoint(name, x, y, z, sigma_given=False)
+        seen[name] = (p, lineno)
+        by_xyz.setdefault((x, y, z), p)
+        gs.points.append(p)
+    if not gs.points:
+        raise GCPError(f"{path}: no targets")
+    return gs
