@@ -80,8 +80,10 @@ def _raster(ctx: ReportContext, path: str, title: str, dem: bool) -> str:
                      f"{stage_vf:.3f}"))
     results = (ctx.d.manifest.get("stages", {}).get("dsm") or {}).get("results") or {}
     if dem and num(results.get("MEASURED_FRACTION")) is not None:
-        info.append(("Inside that hull: measured / interpolated (filled holes, dense/dsm-source.tif)",
-                     f"{num(results['MEASURED_FRACTION']):.3f} / {num(results.get('INTERPOLATED_FRACTION')) or 0:.3f}"))
+        info.append(("Inside that hull: measured / interpolated (filled holes) / removed as blunders "
+                     "(dense/dsm-source.tif)",
+                     f"{num(results['MEASURED_FRACTION']):.3f} / {num(results.get('INTERPOLATED_FRACTION')) or 0:.3f}"
+                     f" / {num(results.get('REMOVED_FRACTION')) or 0:.3f}"))
     # the key figure is the stage's own (the Processing output VALID_FRACTION): inside the camera centres'
     # convex hull; the whole raster's share is shown beside it above
     ctx.figures[f"{'DSM' if dem else 'ORTHO'}_VALID_FRACTION"] = stage_vf if stage_vf is not None else frac
