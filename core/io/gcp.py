@@ -1119,6 +1119,9 @@ __all__ = [
 
 def _odm_target_line(toks: List[str], path: PathLike, lineno: int) -> Tuple[float, float, float, Optional[str]]:
     """x, y, z and name of one line of a targets file in the gcp_list.txt form, with or without pixel columns."""
+    if len(toks) < 4:
+        raise GCPError(f"{path}:{lineno}: expected 'x y z name' or 'x y z px py image name', found {len(toks)} "
+                       f"field(s): {' '.join(toks)!r}")
     x, y, z = (_num(toks[k], w, path, lineno) for k, w in ((0, "x"), (1, "y"), (2, "z")))
     if len(toks) in (4, 5) and not _is_number(toks[3]):
         return x, y, z, toks[3]  # x y z name [check]
