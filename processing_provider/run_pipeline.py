@@ -1,7 +1,7 @@
 """Run pipeline: thin adapter over core.pipeline.run_pipeline (align -> georeference -> DSM -> orthomosaic -> report)."""
 from qgis.core import (
     QgsProcessingException,
-    QgsProcessingOutputFile,
+    QgsProcessingOutputHtml,
     QgsProcessingOutputNumber,
     QgsProcessingOutputRasterLayer,
 )
@@ -90,7 +90,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
             params.flag(self.REFINE_INTRINSICS, self.tr("Refine camera calibration")),
             params.dsm_resolution(self.DSM_RESOLUTION, self.tr("DSM resolution (m)")),
             params.quality(self.QUALITY, self.tr("Matching quality")),
-            params.number(self.ORTHO_RESOLUTION, self.tr("Orthomosaic resolution")),
+            params.number(self.ORTHO_RESOLUTION, self.tr("Orthomosaic resolution (CRS units, 0 = GSD)")),
             params.blending(self.BLENDING, self.tr("Seam blending")),
             params.flag(self.REPORT_ENABLED, self.tr("Write the accuracy report"), default=True),
             params.flag(self.DTM_ENABLED, self.tr("Build the DTM"), default=True),
@@ -105,7 +105,9 @@ class RunPipelineAlgorithm(AlgorithmBase):
         self.addOutput(QgsProcessingOutputRasterLayer(self.DTM, self.tr("DTM")))
         self.addOutput(QgsProcessingOutputRasterLayer(self.DSM, self.tr("DSM")))
         self.addOutput(QgsProcessingOutputRasterLayer(self.ORTHOMOSAIC, self.tr("Orthomosaic")))
-        self.addOutput(QgsProcessingOutputFile(self.REPORT, self.tr("Accuracy report (HTML)")))
+        # an HTML output: the toolbox dialog lists it in the Results Viewer, which opens it (a plain file output
+        # was nowhere in the GUI: issue 36 item 15)
+        self.addOutput(QgsProcessingOutputHtml(self.REPORT, self.tr("Accuracy report (HTML)")))
         for name, label in self.NUMBERS:
             self.addOutput(QgsProcessingOutputNumber(name, self.tr(label)))
 
