@@ -39,7 +39,7 @@
         <translation>Bericht geschrieben: {} ({} s)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Accuracy report</source>
         <translation>Genauigkeitsbericht</translation>
     </message>
@@ -54,7 +54,7 @@
         <translation>Bericht</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Writes one self-contained HTML report of a workspace (plots embedded, readable offline) and returns its key figures.
 
 Sections of the report. Summary — images given / aligned / not aligned and why, image screening, cameras with their calibrated parameters and standard deviations, GSD, area, CRS, processing times and parameters. Orientation quality: reprojection errors, tie-point track lengths, image connectivity, camera positions with residuals. Georeferencing: control and check points with dX dY dZ and image residuals, residual vectors, RMSE per set, NSSDA (FGDC-STD-007.3-1998) accuracy statements at 95 % confidence, ASPRS 2014 and 2023 accuracy classes, camera-position residuals, outliers. Uncertainty: standard deviations of cameras and tie points from the bundle adjustment covariance. Products: DSM and orthomosaic previews, resolution, valid fraction. Sections whose stage has not run are skipped with a note.
@@ -84,7 +84,7 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
         <translation>Ausgaben nicht gestaltet: {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Photogrammetry</source>
         <translation>Photogrammetrie</translation>
     </message>
@@ -147,7 +147,7 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
         <translation>Sekunden je Schritt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Align images</source>
         <translation>Bilder ausrichten</translation>
     </message>
@@ -197,7 +197,7 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
         <translation> (nicht besser: das vorige Ergebnis bleibt)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Structure from motion: SIFT features, pair selection, robust matching (RANSAC), incremental mapping with self-calibration (focal length, principal point, lens distortion) and a final bundle adjustment. The result is stored in the workspace folder, which the following stages (Georeference, Build DSM, Build orthophoto) take as input. A re-run resumes: features and matches already computed are reused.
 
 Pair selection: &apos;auto&apos; uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
@@ -324,7 +324,7 @@ Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen 
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Automatic control from a reference orthophoto</source>
         <translation>Automatische Passpunkte aus einem Referenz-Orthophoto</translation>
     </message>
@@ -349,7 +349,7 @@ Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen 
         <translation>Ein Referenz-DOM allein (DGM-Passpunkte) platziert den Block durch das EXIF-GPS der Fotos: Ungefähre Lage automatisch oder EXIF-GPS wählen oder zusätzlich ein Referenz-Orthophoto angeben</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Georeferences an aligned block with no hand-picked ground control: a provisional orthophoto of the block is matched to a reference orthophoto (a national orthophoto, an earlier block's orthomosaic) at a common resolution, each match is found again in the photos and takes its height from the reference DSM, and these automatic GCPs enter the usual GCP-constrained adjustment, which leaves out the outliers. Changes between the two dates (crops, cars, new buildings, another sun) are tolerated: what stays is used, and the log says how many matches survived each step.
 
 Aligned workspace: the block to georeference (its photos must still be where the alignment found them).
@@ -428,7 +428,7 @@ Ausgaben: die Projektionszentren im KBS der Referenz, die Zahl der automatischen
         <translation>DOM {} ({} m Zellen), Anteil gültiger Zellen {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Build DSM</source>
         <translation>DOM erzeugen</translation>
     </message>
@@ -438,7 +438,7 @@ Ausgaben: die Projektionszentren im KBS der Referenz, die Zahl der automatischen
         <translation>Adresse des Dask-Schedulers (leer = dieser Rechner, oder $ARCHAEOORTHO_DASK_SCHEDULER)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Dense matching of the georeferenced block and a digital surface model (DSM).
 
 Stereo pairs are chosen from the sparse model (shared tie points, baseline-to-depth ratio, viewing angle); each pair is undistorted and rectified from the known poses and matched with semi-global matching (OpenCV SGBM) with a left-right check; a pixel is kept where at least two independent pairs agree. The fused points are rasterised (median of the highest height cluster per cell), small holes are filled and large ones left nodata.
@@ -530,7 +530,7 @@ Ein erneuter Lauf nach einem Abbruch setzt fort und verwendet die bereits zugeor
         <translation>Geben Sie einen Arbeitsbereich-Ordner an, oder eine DOM-Datei und wohin das DGM geschrieben wird</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Build DTM</source>
         <translation>DGM erzeugen</translation>
     </message>
@@ -550,7 +550,7 @@ Ein erneuter Lauf nach einem Abbruch setzt fort und verwendet die bereits zugeor
         <translation>Höhenlinien</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>A digital terrain model (bare earth) from the DSM: buildings, trees and crops removed, the ground interpolated under them.
 
 The ground filter is SMRF (Pingel et al. 2013, the algorithm of PDAL&apos;s filters.smrf) on the DSM&apos;s grid; under each removed object the ground is a thin-plate spline through the ground around it. The DTM is a Cloud-Optimized GeoTIFF on the DSM&apos;s exact grid; beside it terrain/dtm-source.tif says which cells are measured ground (1) and which interpolated (2). The DSM stage&apos;s point cloud, if it wrote one, is copied with ASPRS classes 2 (ground) and 1 (unclassified) to terrain/points-classified.las.
@@ -596,7 +596,7 @@ Höhenlinien: wohin die Höhenlinien geschrieben werden (Vorgabe: &lt;workspace&
         <translation>Bilder im Mosaik</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Build orthophoto</source>
         <translation>Orthophoto erzeugen</translation>
     </message>
@@ -614,11 +614,6 @@ Höhenlinien: wohin die Höhenlinien geschrieben werden (Vorgabe: &lt;workspace&
         <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Images</source>
         <translation>Bilder</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
-        <source>Resolution</source>
-        <translation>Auflösung</translation>
     </message>
     <message>
         <location filename="../processing_provider/build_orthophoto.py" line="79"/>
@@ -676,7 +671,7 @@ Höhenlinien: wohin die Höhenlinien geschrieben werden (Vorgabe: &lt;workspace&
         <translation>Vignettierung und Hotspot ausgleichen</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>True orthophotos and the orthomosaic of a georeferenced workspace.
 
 Every cell takes its height from the DSM and is projected through the full camera model (pose, focal length, principal point, lens distortion) into the images. A cell hidden from an image by higher surface (a wall, a tree, a hill) is left out of that image, so buildings do not lean and nothing appears twice; the mosaic fills it from an image that sees it. Each part of the mosaic comes from the image that looks at it most vertically and closest to its centre; seamlines go around buildings and trees; brightness differences between images are evened out and seams blended.
@@ -710,6 +705,179 @@ Nahtlinien: optionales GeoPackage mit Polygonen, die das Bild nennen, aus dem je
 Zu befolgende Nahtlinien: optionale bearbeitete Nahtlinien (Polygone mit dem Feld 'image', im KBS des Mosaiks): wo ein Polygon ein Bild nennt, nimmt das Mosaik dieses Bild, wo es den Boden sieht (das Protokoll sagt, wo nicht); anderswo automatische Nähte. Formen Sie ein Polygon um oder zeichnen Sie eines und nennen Sie sein Bild, um eine Naht von einem Bewuchsmerkmal oder einem fahrenden Auto wegzulegen, und starten Sie erneut.
 Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786) rechnen, dessen Worker den Pfad des Arbeitsbereichs sehen; leer = dieser Rechner, oder $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
     </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
+        <source>Resolution (CRS units, 0 = GSD)</source>
+        <translation>Auflösung (KBS-Einheiten, 0 = GSD)</translation>
+    </message>
+</context>
+<context>
+    <name>Choices</name>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>auto</source>
+        <translation>automatisch (auto)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>exhaustive</source>
+        <translation>alle Paare (exhaustive)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>sequential</source>
+        <translation>aufeinanderfolgend (sequential)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>spatial</source>
+        <translation>räumlich (spatial)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>incremental</source>
+        <translation>inkrementell (incremental)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>global</source>
+        <translation>global</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>fixed</source>
+        <translation>fest (fixed)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>refined</source>
+        <translation>verfeinert (refined)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>estimated</source>
+        <translation>geschätzt (estimated)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>full</source>
+        <translation>voll (full)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>half</source>
+        <translation>halb (half)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>quarter</source>
+        <translation>Viertel (quarter)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>feather</source>
+        <translation>weiche Naht (feather)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>multiband</source>
+        <translation>Mehrband (multiband)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>none</source>
+        <translation>keine (none)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>bilinear</source>
+        <translation>bilinear</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>cubic</source>
+        <translation>kubisch (cubic)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>nearest</source>
+        <translation>nächster Nachbar (nearest)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>cross</source>
+        <translation>Kreuz (cross)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>dot</source>
+        <translation>Punkt (dot)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>ring_dot</source>
+        <translation>Punkt im Ring (ring_dot)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>cross_ring</source>
+        <translation>Kreuz im Ring (cross_ring)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>corners</source>
+        <translation>Ecken (corners)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>sides</source>
+        <translation>Seitenmitten (sides)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>eight</source>
+        <translation>acht (eight)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Sky-view factor</source>
+        <translation>Sky-View-Faktor</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Openness (positive)</source>
+        <translation>Offenheit (positiv)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Openness (negative)</source>
+        <translation>Offenheit (negativ)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Simple local relief model</source>
+        <translation>Einfaches lokales Reliefmodell</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Multi-scale relief model</source>
+        <translation>Mehrskaliges Reliefmodell</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Multi-direction hillshade</source>
+        <translation>Schummerung aus mehreren Richtungen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Local dominance</source>
+        <translation>Lokale Dominanz</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>VAT (visualisation for archaeological topography, blend)</source>
+        <translation>VAT (Visualisierung für archäologische Topographie, Mischung)</translation>
+    </message>
 </context>
 <context>
     <name>ContoursAlgorithm</name>
@@ -724,7 +892,7 @@ Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786)
         <translation>Abstand in Metern</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Contours</source>
         <translation>Höhenlinien</translation>
     </message>
@@ -734,7 +902,7 @@ Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786)
         <translation>Höhenlinien</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Contour lines of a DTM or DSM at a chosen interval (GDAL&apos;s contour generator) into a GeoPackage layer &apos;contours&apos; whose &apos;elevation&apos; field labels them.
 
 Elevation raster: a DTM or DSM in a projected CRS (metres).
@@ -790,12 +958,12 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <translation>{} Zellen verglichen: Median {:.3f} m, Mittel {:.3f} m, Std.-Abw. {:.3f} m, 5-95 % {:.3f} .. {:.3f} m; {} Zellen um mehr als {:g} m verändert</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>DSM difference</source>
         <translation>DOM-Differenz</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>The later DSM minus the earlier one, on the earlier one&apos;s grid, shows what changed between two epochs of a site (the later DSM is warped there with GDAL, bilinear, from any CRS). A cell is nodata where either DSM has none. The log gives the cells compared, the median, mean and standard deviation of the difference, its 5th and 95th percentiles and the cells that changed by more than 1 m; a median near 0 says the two epochs are registered on each other.
 
 Earlier DSM: the DSM the difference is measured from (its grid is the output&apos;s).
@@ -811,42 +979,42 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
 <context>
     <name>GcpDock</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="76"/>
+        <location filename="../ui/gcp_dock.py" line="81"/>
         <source>ArchaeoOrtho ground control</source>
         <translation>ArchaeoOrtho Passpunkte</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="93"/>
+        <location filename="../ui/gcp_dock.py" line="98"/>
         <source>ArchaeoOrtho photos</source>
         <translation>ArchaeoOrtho Fotos</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="143"/>
+        <location filename="../ui/gcp_dock.py" line="160"/>
         <source>Workspace:</source>
         <translation>Arbeitsbereich:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="350"/>
+        <location filename="../ui/gcp_dock.py" line="369"/>
         <source>none open</source>
         <translation>keiner geöffnet</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="150"/>
+        <location filename="../ui/gcp_dock.py" line="167"/>
         <source>Open a workspace folder (made by Align images)</source>
         <translation>Einen Arbeitsbereich-Ordner öffnen (von 'Bilder ausrichten' angelegt)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="152"/>
+        <location filename="../ui/gcp_dock.py" line="169"/>
         <source>Choose a folder of photos and a workspace folder, and align the photos</source>
         <translation>Einen Fotoordner und einen Arbeitsbereich-Ordner wählen und die Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="159"/>
+        <location filename="../ui/gcp_dock.py" line="176"/>
         <source>Heights (Z) from:</source>
         <translation>Höhen (Z) aus:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="164"/>
+        <location filename="../ui/gcp_dock.py" line="181"/>
         <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
         <translation>Ein DOM- oder DGM-Rasterlayer (z. B. ein ALS-DOM): ein auf der Karte gemessener Punkt erhält seine Höhe daraus (bilinear). Leer: Z von Hand eingeben.</translation>
     </message>
@@ -856,27 +1024,27 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>Hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="179"/>
+        <location filename="../ui/gcp_dock.py" line="196"/>
         <source>Add a ground point</source>
         <translation>Einen Passpunkt hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="180"/>
+        <location filename="../ui/gcp_dock.py" line="197"/>
         <source>Remove</source>
         <translation>Entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="181"/>
+        <location filename="../ui/gcp_dock.py" line="198"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Den gewählten Passpunkt mit seinen Messungen entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="196"/>
+        <location filename="../ui/gcp_placement.py" line="193"/>
         <source>Pick on map</source>
         <translation>Auf der Karte messen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="184"/>
+        <location filename="../ui/gcp_dock.py" line="201"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>In die Kartenansicht klicken, um X und Y des gewählten Punkts zu setzen (Z aus dem Höhenlayer)</translation>
     </message>
@@ -886,97 +1054,97 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>Importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="192"/>
+        <location filename="../ui/gcp_dock.py" line="209"/>
         <source>Export</source>
         <translation>Exportieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="207"/>
+        <location filename="../ui/gcp_dock.py" line="224"/>
         <source>Undo</source>
         <translation>Rückgängig</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="208"/>
+        <location filename="../ui/gcp_dock.py" line="225"/>
         <source>Redo</source>
         <translation>Wiederholen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="218"/>
+        <location filename="../ui/gcp_dock.py" line="235"/>
         <source>Undo: {}</source>
         <translation>Rückgängig: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="220"/>
+        <location filename="../ui/gcp_dock.py" line="237"/>
         <source>Redo: {}</source>
         <translation>Wiederholen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="199"/>
+        <location filename="../ui/gcp_dock.py" line="216"/>
         <source>Load results</source>
         <translation>Ergebnisse laden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="200"/>
+        <location filename="../ui/gcp_dock.py" line="217"/>
         <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Die Produkte des Arbeitsbereichs als gestaltete Layer zur Karte hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="252"/>
+        <location filename="../ui/gcp_dock.py" line="271"/>
         <source>Residual tolerance:</source>
         <translation>Residuen-Toleranz:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="258"/>
+        <location filename="../ui/gcp_dock.py" line="277"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="267"/>
+        <location filename="../ui/gcp_dock.py" line="286"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="268"/>
+        <location filename="../ui/gcp_dock.py" line="287"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Die Ausgleichung Brennweite, Bildhauptpunkt und Verzeichnung verfeinern lassen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="275"/>
+        <location filename="../ui/gcp_dock.py" line="294"/>
         <source>Georeference</source>
         <translation>Georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="276"/>
+        <location filename="../ui/gcp_dock.py" line="295"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Die Ausgleichung mit diesen Punkten ausführen (im Hintergrund)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="277"/>
+        <location filename="../ui/gcp_dock.py" line="296"/>
         <source>Cancel</source>
         <translation>Abbrechen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="327"/>
+        <location filename="../ui/gcp_dock.py" line="346"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="334"/>
+        <location filename="../ui/gcp_dock.py" line="353"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Einen ArchaeoOrtho-Arbeitsbereich öffnen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="380"/>
+        <location filename="../ui/gcp_dock.py" line="399"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} Fotos; der Block ist noch nicht ausgerichtet: 'Bilder ausrichten' (oder 'Neu aus Fotos') ausführen, um vorhergesagte Positionen zu erhalten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="383"/>
+        <location filename="../ui/gcp_dock.py" line="402"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} Fotos, {} Passpunkte. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="284"/>
+        <location filename="../ui/gcp_placement.py" line="281"/>
         <source>no predicted positions: {}</source>
         <translation>keine vorhergesagten Positionen: {}</translation>
     </message>
@@ -1011,82 +1179,82 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>ArchaeoOrtho: Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="521"/>
+        <location filename="../ui/gcp_dock.py" line="540"/>
         <source>CRS: {}</source>
         <translation>KBS: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="120"/>
+        <location filename="../ui/gcp_placement.py" line="117"/>
         <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Auf der Karte an die Position des gewählten Punkts klicken (Esc beendet)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="184"/>
+        <location filename="../ui/gcp_placement.py" line="181"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (aus {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="187"/>
+        <location filename="../ui/gcp_placement.py" line="184"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Keine Höhe an dieser Stelle in {}: Z bleibt unverändert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="190"/>
+        <location filename="../ui/gcp_placement.py" line="187"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="396"/>
+        <location filename="../ui/gcp_placement.py" line="393"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="398"/>
+        <location filename="../ui/gcp_placement.py" line="395"/>
         <source>predicted</source>
         <translation>vorhergesagt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="421"/>
+        <location filename="../ui/gcp_placement.py" line="418"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Einen Passpunkt in der Tabelle wählen oder hinzufügen, dann im Foto darauf klicken.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="428"/>
+        <location filename="../ui/gcp_placement.py" line="425"/>
         <source>from the point&apos;s other observations</source>
         <translation>aus den übrigen Messungen des Punkts</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="429"/>
+        <location filename="../ui/gcp_placement.py" line="426"/>
         <source>from the georeferenced block</source>
         <translation>aus dem georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="430"/>
+        <location filename="../ui/gcp_placement.py" line="427"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>aus den bereits gemessenen Punkten (Ähnlichkeitstransformation)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="441"/>
+        <location filename="../ui/gcp_placement.py" line="438"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Gemessen bei x {:.2f}, y {:.2f}. Klicken zum Versetzen, ziehen oder Entf zum Entfernen.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="444"/>
+        <location filename="../ui/gcp_placement.py" line="441"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Vorhergesagt {}. Eingabetaste übernimmt und geht weiter (Leertaste: übernehmen), ziehen oder dorthin klicken, wo der Punkt wirklich ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="456"/>
+        <location filename="../ui/gcp_placement.py" line="453"/>
         <source>Click where {} is in this photo.</source>
         <translation>Dorthin klicken, wo {} in diesem Foto ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="476"/>
+        <location filename="../ui/gcp_placement.py" line="473"/>
         <source>Select or add a ground point first</source>
         <translation>Zuerst einen Passpunkt wählen oder hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="523"/>
+        <location filename="../ui/gcp_placement.py" line="520"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: jedes Foto, das ihn voraussichtlich zeigt, hat eine Messung</translation>
     </message>
@@ -1271,42 +1439,42 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>seither bearbeitet: erneut ausführen zum Aktualisieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="431"/>
+        <location filename="../ui/gcp_placement.py" line="428"/>
         <source>by matching its look in another photo</source>
         <translation>durch Abgleich mit seinem Aussehen in einem anderen Foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="435"/>
+        <location filename="../ui/gcp_placement.py" line="432"/>
         <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
         <translation>(Korrelation {:.2f}, {:.0f} px von der geometrischen Vorhersage)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="149"/>
+        <location filename="../ui/gcp_dock.py" line="166"/>
         <source>Open…</source>
         <translation>Öffnen…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="151"/>
+        <location filename="../ui/gcp_dock.py" line="168"/>
         <source>New from photos…</source>
         <translation>Neu aus Fotos…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="187"/>
+        <location filename="../ui/gcp_dock.py" line="204"/>
         <source>From file (gcp_list.txt, CSV)…</source>
         <translation>Aus Datei (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="188"/>
+        <location filename="../ui/gcp_dock.py" line="205"/>
         <source>From a point layer…</source>
         <translation>Aus einem Punktlayer…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="190"/>
+        <location filename="../ui/gcp_dock.py" line="207"/>
         <source>To file (gcp_list.txt, CSV)…</source>
         <translation>In Datei (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="191"/>
+        <location filename="../ui/gcp_dock.py" line="208"/>
         <source>To a GeoPackage layer…</source>
         <translation>In einen GeoPackage-Layer…</translation>
     </message>
@@ -1351,77 +1519,77 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot. Jetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="94"/>
+        <location filename="../ui/gcp_placement.py" line="95"/>
         <source>Diagnosis of the adjustment:</source>
         <translation>Diagnose der Ausgleichung:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="175"/>
+        <location filename="../ui/gcp_placement.py" line="172"/>
         <source>Moved {:.2f} m (Undo: Ctrl+Z).</source>
         <translation>Um {:.2f} m verschoben (Rückgängig: Strg+Z).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="398"/>
+        <location filename="../ui/gcp_placement.py" line="395"/>
         <source>near the edge</source>
         <translation>nahe am Rand</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="447"/>
+        <location filename="../ui/gcp_placement.py" line="444"/>
         <source>{} is predicted where it cannot be placed: {}. Click where the point is if you see it, or press Enter for the next photo.</source>
         <translation>{} wird dort vorhergesagt, wo er nicht gesetzt werden kann: {}. Klicken Sie auf den Punkt, wenn Sie ihn sehen, oder drücken Sie die Eingabetaste für das nächste Foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="453"/>
+        <location filename="../ui/gcp_placement.py" line="450"/>
         <source>Click where {} is in this photo, or use Pick on map (or type X, Y, Z in the table) to have it predicted in the photos.</source>
         <translation>Klicken Sie in diesem Foto auf {}, oder nutzen Sie „Auf der Karte messen“ (oder geben Sie X, Y, Z in der Tabelle ein), damit er in den Fotos vorhergesagt wird.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="466"/>
+        <location filename="../ui/gcp_placement.py" line="463"/>
         <source>{}: the workspace has no photos to place it in.</source>
         <translation>{}: der Arbeitsbereich hat keine Fotos, in denen er gesetzt werden kann.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="468"/>
+        <location filename="../ui/gcp_placement.py" line="465"/>
         <source>{} is selected: use Pick on map or type X, Y, Z in the table, or choose a photo in the strip below and click on the point.</source>
         <translation>{} ist ausgewählt: nutzen Sie „Auf der Karte messen“ oder geben Sie X, Y, Z in der Tabelle ein, oder wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="470"/>
+        <location filename="../ui/gcp_placement.py" line="467"/>
         <source>{} is selected: choose a photo in the strip below and click on the point.</source>
         <translation>{} ist ausgewählt: wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="215"/>
+        <location filename="../ui/gcp_dock.py" line="232"/>
         <source>Undo (Ctrl+Z)</source>
         <translation>Rückgängig (Strg+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="215"/>
+        <location filename="../ui/gcp_dock.py" line="232"/>
         <source>Redo (Ctrl+Shift+Z)</source>
         <translation>Wiederholen (Strg+Umschalt+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="401"/>
+        <location filename="../ui/gcp_dock.py" line="420"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px.</source>
         <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="406"/>
+        <location filename="../ui/gcp_dock.py" line="425"/>
         <source>Not aligned ({}): {}</source>
         <translation>Nicht ausgerichtet ({}): {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="407"/>
+        <location filename="../ui/gcp_dock.py" line="426"/>
         <source>(marked in the photo strip; hover for the reason)</source>
         <translation>(in der Fotoleiste markiert; der Grund steht im Tooltip)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="426"/>
+        <location filename="../ui/gcp_dock.py" line="445"/>
         <source>✗ not aligned</source>
         <translation>✗ nicht ausgerichtet</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="427"/>
+        <location filename="../ui/gcp_dock.py" line="446"/>
         <source>{}: not aligned: {}</source>
         <translation>{}: nicht ausgerichtet: {}</translation>
     </message>
@@ -1431,32 +1599,32 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>Nicht ausgerichtet: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="142"/>
+        <location filename="../ui/gcp_placement.py" line="139"/>
         <source>pick on map</source>
         <translation>auf der Karte messen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="433"/>
+        <location filename="../ui/gcp_placement.py" line="430"/>
         <source>(no Z yet: at the height of the block&apos;s tie points)</source>
         <translation>(noch kein Z: auf der Höhe der Verknüpfungspunkte des Blocks)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="167"/>
+        <location filename="../ui/gcp_placement.py" line="164"/>
         <source>{} not moved</source>
         <translation>{} nicht verschoben</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="196"/>
+        <location filename="../ui/gcp_placement.py" line="193"/>
         <source>{} is placed in {} photos. Move it {:.2f} m to the picked position, or add a new point there?</source>
         <translation>{} ist in {} Fotos gesetzt. Um {:.2f} m an die gemessene Position verschieben, oder dort einen neuen Punkt anlegen?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="200"/>
+        <location filename="../ui/gcp_placement.py" line="197"/>
         <source>Move {}</source>
         <translation>{} verschieben</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="201"/>
+        <location filename="../ui/gcp_placement.py" line="198"/>
         <source>New point</source>
         <translation>Neuer Punkt</translation>
     </message>
@@ -1521,37 +1689,37 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>Referenz-DOM:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="73"/>
+        <location filename="../ui/gcp_autocontrol.py" line="78"/>
         <source>Georeference from the reference orthophoto and DSM (in the background)</source>
         <translation>Aus Referenz-Orthophoto und -DOM georeferenzieren (im Hintergrund)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="94"/>
+        <location filename="../ui/gcp_autocontrol.py" line="99"/>
         <source>Automatic control: choose a reference orthophoto and a reference DSM layer</source>
         <translation>Automatische Passpunkte: ein Referenz-Orthophoto und einen Referenz-DOM-Layer wählen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="115"/>
+        <location filename="../ui/gcp_autocontrol.py" line="120"/>
         <source>Automatic control: {} automatic GCPs kept of {} matches; georeferenced in {}.</source>
         <translation>Automatische Passpunkte: {} automatische Passpunkte von {} Zuordnungen behalten; georeferenziert in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="118"/>
+        <location filename="../ui/gcp_autocontrol.py" line="123"/>
         <source>Check points: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</source>
         <translation>Kontrollpunkte: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="129"/>
+        <location filename="../ui/gcp_autocontrol.py" line="134"/>
         <source>ArchaeoOrtho: automatic control</source>
         <translation>ArchaeoOrtho: automatische Passpunkte</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="133"/>
+        <location filename="../ui/gcp_autocontrol.py" line="138"/>
         <source>Automatic control against {} and {}…</source>
         <translation>Automatische Passpunkte gegen {} und {}…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="145"/>
+        <location filename="../ui/gcp_autocontrol.py" line="150"/>
         <source>Automatic GCPs (residuals)</source>
         <translation>Automatische Passpunkte (Residuen)</translation>
     </message>
@@ -1810,12 +1978,12 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="120"/>
+        <location filename="../processing_provider/run_pipeline.py" line="122"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Georeference</source>
         <translation>Georeferenzieren</translation>
     </message>
@@ -1910,7 +2078,7 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>Allein angegebenes Referenz-DOM {} (DGM-Passpunkte) muss eine Rasterdatei auf dem Datenträger sein; ein Weblayer wird nur für die automatischen Passpunkte abgerufen, mit einem Referenz-Orthophoto</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Fixes the aligned block in a real coordinate reference system with ground control points (GCPs) and/or camera positions, used inside the bundle adjustment so that they also remove the block&apos;s drift and bending, which a 7-parameter (Helmert) transform cannot. Check points take no part in the adjustment: they are triangulated afterwards and compared with their surveyed coordinates.
 
 Ground control file: an OpenDroneMap gcp_list.txt (CRS line, then &apos;x y z px py image [name]&apos;) or a CSV points file with a matching &apos;&lt;name&gt;_observations.csv&apos;. Ground control layer: alternatively a point layer with one feature per observation and fields name, image, px, py (optional z, sx, sy, sz, role).
@@ -1992,7 +2160,7 @@ Ausgaben: neben den üblichen die Zahl der automatischen Passpunkte, die die Aus
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Orthorectify image</source>
         <translation>Bild orthorektifizieren</translation>
     </message>
@@ -2057,7 +2225,7 @@ Ausgaben: neben den üblichen die Zahl der automatischen Passpunkte, die die Aus
         <translation>Im Bild gemessene Passpunkte angeben (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER), seine bekannte Orientierung (ORIENTATION) oder ein Referenz-Orthophoto für automatische Passpunkte (REFERENCE_ORTHO)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Orthorectifies one photograph — also one that is not part of any block, such as a single oblique or an old print — on an existing DSM, for example an airborne laser scanning (ALS) DSM in any CRS (it is reprojected on the fly).
 
 The camera's position and attitude come from ground control points observed in the photo (space resection: at least 4 points; one wrong point among 5 or more is found and left out; with 6 or more the focal length and the radial distortion k1 are estimated too where the points determine them), or from a known orientation.
@@ -2237,7 +2405,7 @@ Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und 
         <translation>Vorbereitete Scans: {} x {} px, Pixelgröße {:.6g} {}{}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Prepare images</source>
         <translation>Bilder vorbereiten</translation>
     </message>
@@ -2302,7 +2470,7 @@ Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und 
         <translation>Kalibrierte Brennweite (mm)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for &apos;Align images&apos;, and the Workspace folder, which records a decision per image (screening.json) for the accuracy report.
 
 The blur score is the variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged &apos;blurry&apos; below a fraction of the median of the set (Flag images below this fraction of the set&apos;s median blur score, advanced), or below the Smallest blur score when that is set (0 = only relative to the set; absolute scores depend on the scene: sand scores far lower than roofs).
@@ -2365,7 +2533,7 @@ Vorbereitete Bilder: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetz
         <translation>Geben Sie einen Arbeitsbereich-Ordner an, oder ein Höhenraster und wohin die Visualisierung geschrieben wird</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Relief visualisation</source>
         <translation>Reliefvisualisierung</translation>
     </message>
@@ -2385,7 +2553,7 @@ Vorbereitete Bilder: der Ordner der vorbereiteten Bilder (wird als Ganzes ersetz
         <translation>Reliefraster</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Relief visualisations for reading earthworks, hollow ways, ridge and furrow and field boundaries, computed with rvt-py (the Relief Visualization Toolbox&apos;s library) with RVT&apos;s default parameters, converted from the 1 m DEMs RVT was made for to this raster&apos;s cell size.
 
 Workspace folder: a workspace with a DTM (Build DTM) or DSM.
@@ -2405,84 +2573,89 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
 <context>
     <name>ResultLayers</name>
     <message>
-        <location filename="../ui/layers.py" line="271"/>
+        <location filename="../ui/layers.py" line="278"/>
         <source>control (used)</source>
         <translation>Passpunkt (verwendet)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="272"/>
+        <location filename="../ui/layers.py" line="279"/>
         <source>check point</source>
         <translation>Kontrollpunkt</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="273"/>
+        <location filename="../ui/layers.py" line="280"/>
         <source>rejected (outlier)</source>
         <translation>verworfen (Ausreißer)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="274"/>
+        <location filename="../ui/layers.py" line="281"/>
         <source>not triangulated</source>
         <translation>nicht trianguliert</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="705"/>
+        <location filename="../ui/layers.py" line="770"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="664"/>
+        <location filename="../ui/layers.py" line="721"/>
         <source>DSM hillshade</source>
         <translation>DOM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="706"/>
+        <location filename="../ui/layers.py" line="771"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="707"/>
+        <location filename="../ui/layers.py" line="772"/>
         <source>Cameras</source>
         <translation>Kameras</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="675"/>
+        <location filename="../ui/layers.py" line="733"/>
         <source>Camera footprints</source>
         <translation>Bildfußabdrücke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="682"/>
+        <location filename="../ui/layers.py" line="740"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Passpunkt-Residuen (Vektoren x{})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="708"/>
+        <location filename="../ui/layers.py" line="773"/>
         <source>Point cloud</source>
         <translation>Punktwolke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="716"/>
+        <location filename="../ui/layers.py" line="781"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="383"/>
+        <location filename="../ui/layers.py" line="416"/>
         <source>{} ({})</source>
         <translation>{} ({})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="709"/>
+        <location filename="../ui/layers.py" line="774"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="689"/>
+        <location filename="../ui/layers.py" line="747"/>
         <source>DTM hillshade</source>
         <translation>DGM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="710"/>
+        <location filename="../ui/layers.py" line="775"/>
         <source>Contours</source>
         <translation>Höhenlinien</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="401"/>
+        <source>{} — {}</source>
+        <translation>{} — {}</translation>
     </message>
 </context>
 <context>
@@ -2528,17 +2701,17 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="108"/>
+        <location filename="../processing_provider/run_pipeline.py" line="110"/>
         <source>Accuracy report (HTML)</source>
         <translation>Genauigkeitsbericht (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="162"/>
+        <location filename="../processing_provider/run_pipeline.py" line="164"/>
         <source>Seconds per stage: {}</source>
         <translation>Sekunden pro Stufe: {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Run pipeline</source>
         <translation>Gesamte Verarbeitung ausführen</translation>
     </message>
@@ -2589,11 +2762,6 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
     </message>
     <message>
         <location filename="../processing_provider/run_pipeline.py" line="75"/>
-        <source>Orthomosaic resolution</source>
-        <translation>Auflösung des Orthomosaiks</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Seam blending</source>
         <translation>Überblendung der Nähte</translation>
     </message>
@@ -2633,7 +2801,7 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>GCP-Pixel auf aufrechten Fotos gemessen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="126"/>
+        <location filename="../processing_provider/run_pipeline.py" line="128"/>
         <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Geben Sie Passpunkte (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
     </message>
@@ -2643,7 +2811,7 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>Himmelsmasken (Schrägaufnahmen)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>The whole chain in one call, for batch use: Align images, Georeference, Build DSM, Build orthophoto and Accuracy report on one workspace. It calls the same functions as the single algorithms, and a re-run resumes (features, matches and dense pairs already computed are reused).
 
 Folder of images: the photos. Workspace folder: where every product is written.
@@ -2672,6 +2840,11 @@ Ausgaben: das DOM, das Orthomosaik und der Genauigkeitsbericht (HTML) sowie die 
         <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Interior orientation</source>
         <translation>Innere Orientierung</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <source>Orthomosaic resolution (CRS units, 0 = GSD)</source>
+        <translation>Orthomosaik-Auflösung (KBS-Einh., 0 = GSD)</translation>
     </message>
 </context>
 </TS>

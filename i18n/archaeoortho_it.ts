@@ -39,7 +39,7 @@
         <translation>rapporto scritto: {} ({} s)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Accuracy report</source>
         <translation>Rapporto di accuratezza</translation>
     </message>
@@ -54,7 +54,7 @@
         <translation>Rapporto</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Writes one self-contained HTML report of a workspace (plots embedded, readable offline) and returns its key figures.
 
 Sections of the report. Summary — images given / aligned / not aligned and why, image screening, cameras with their calibrated parameters and standard deviations, GSD, area, CRS, processing times and parameters. Orientation quality: reprojection errors, tie-point track lengths, image connectivity, camera positions with residuals. Georeferencing: control and check points with dX dY dZ and image residuals, residual vectors, RMSE per set, NSSDA (FGDC-STD-007.3-1998) accuracy statements at 95 % confidence, ASPRS 2014 and 2023 accuracy classes, camera-position residuals, outliers. Uncertainty: standard deviations of cameras and tie points from the bundle adjustment covariance. Products: DSM and orthomosaic previews, resolution, valid fraction. Sections whose stage has not run are skipped with a note.
@@ -84,7 +84,7 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
         <translation>Output senza stile: {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Photogrammetry</source>
         <translation>Fotogrammetria</translation>
     </message>
@@ -147,7 +147,7 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
         <translation>Secondi per fase: {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Align images</source>
         <translation>Allinea immagini</translation>
     </message>
@@ -197,7 +197,7 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
         <translation> (non migliore: resta il risultato precedente)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Structure from motion: SIFT features, pair selection, robust matching (RANSAC), incremental mapping with self-calibration (focal length, principal point, lens distortion) and a final bundle adjustment. The result is stored in the workspace folder, which the following stages (Georeference, Build DSM, Build orthophoto) take as input. A re-run resumes: features and matches already computed are reused.
 
 Pair selection: &apos;auto&apos; uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
@@ -324,7 +324,7 @@ Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni 
         <translation>valore anomalo escluso: {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Automatic control from a reference orthophoto</source>
         <translation>Punti di controllo automatici da un'ortofoto di riferimento</translation>
     </message>
@@ -349,7 +349,7 @@ Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni 
         <translation>Un DSM di riferimento da solo (controllo DEM) posiziona il blocco con il GPS EXIF delle foto: scegli Posizione approssimativa automatica o GPS EXIF, oppure fornisci anche un'ortofoto di riferimento</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Georeferences an aligned block with no hand-picked ground control: a provisional orthophoto of the block is matched to a reference orthophoto (a national orthophoto, an earlier block's orthomosaic) at a common resolution, each match is found again in the photos and takes its height from the reference DSM, and these automatic GCPs enter the usual GCP-constrained adjustment, which leaves out the outliers. Changes between the two dates (crops, cars, new buildings, another sun) are tolerated: what stays is used, and the log says how many matches survived each step.
 
 Aligned workspace: the block to georeference (its photos must still be where the alignment found them).
@@ -428,7 +428,7 @@ Output: i centri di presa nel SR del riferimento, il numero di GCP automatici ma
         <translation>DSM {} (celle di {} m), frazione valida {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Build DSM</source>
         <translation>Genera DSM</translation>
     </message>
@@ -438,7 +438,7 @@ Output: i centri di presa nel SR del riferimento, il numero di GCP automatici ma
         <translation>Indirizzo dello scheduler Dask (vuoto = questo computer, oppure $ARCHAEOORTHO_DASK_SCHEDULER)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Dense matching of the georeferenced block and a digital surface model (DSM).
 
 Stereo pairs are chosen from the sparse model (shared tie points, baseline-to-depth ratio, viewing angle); each pair is undistorted and rectified from the known poses and matched with semi-global matching (OpenCV SGBM) with a left-right check; a pixel is kept where at least two independent pairs agree. The fused points are rasterised (median of the highest height cluster per cell), small holes are filled and large ones left nodata.
@@ -530,7 +530,7 @@ Una nuova esecuzione dopo un annullamento riprende: le coppie già elaborate son
         <translation>Indica una cartella dell'area di lavoro, oppure un file DSM e dove scrivere il DTM</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Build DTM</source>
         <translation>Genera DTM</translation>
     </message>
@@ -550,7 +550,7 @@ Una nuova esecuzione dopo un annullamento riprende: le coppie già elaborate son
         <translation>Curve di livello</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>A digital terrain model (bare earth) from the DSM: buildings, trees and crops removed, the ground interpolated under them.
 
 The ground filter is SMRF (Pingel et al. 2013, the algorithm of PDAL&apos;s filters.smrf) on the DSM&apos;s grid; under each removed object the ground is a thin-plate spline through the ground around it. The DTM is a Cloud-Optimized GeoTIFF on the DSM&apos;s exact grid; beside it terrain/dtm-source.tif says which cells are measured ground (1) and which interpolated (2). The DSM stage&apos;s point cloud, if it wrote one, is copied with ASPRS classes 2 (ground) and 1 (unclassified) to terrain/points-classified.las.
@@ -596,7 +596,7 @@ Curve di livello: dove scrivere le curve di livello (predefinito: &lt;workspace&
         <translation>Immagini nel mosaico</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Build orthophoto</source>
         <translation>Genera ortofoto</translation>
     </message>
@@ -614,11 +614,6 @@ Curve di livello: dove scrivere le curve di livello (predefinito: &lt;workspace&
         <location filename="../processing_provider/build_orthophoto.py" line="79"/>
         <source>Images</source>
         <translation>Immagini</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
-        <source>Resolution</source>
-        <translation>Risoluzione</translation>
     </message>
     <message>
         <location filename="../processing_provider/build_orthophoto.py" line="79"/>
@@ -676,7 +671,7 @@ Curve di livello: dove scrivere le curve di livello (predefinito: &lt;workspace&
         <translation>Compensa vignettatura e hot spot</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>True orthophotos and the orthomosaic of a georeferenced workspace.
 
 Every cell takes its height from the DSM and is projected through the full camera model (pose, focal length, principal point, lens distortion) into the images. A cell hidden from an image by higher surface (a wall, a tree, a hill) is left out of that image, so buildings do not lean and nothing appears twice; the mosaic fills it from an image that sees it. Each part of the mosaic comes from the image that looks at it most vertically and closest to its centre; seamlines go around buildings and trees; brightness differences between images are evened out and seams blended.
@@ -710,6 +705,179 @@ Linee di giunzione: GeoPackage facoltativo di poligoni che indicano l'immagine d
 Linee di giunzione da seguire: linee di giunzione modificate facoltative (poligoni con il campo 'image', nel SR del mosaico): dove un poligono indica un'immagine, il mosaico usa quell'immagine dove vede il terreno (il registro dice dove no); altrove giunzioni automatiche. Rimodellare un poligono, o disegnarne uno e indicarne l'immagine, per spostare una giunzione da una traccia nelle colture o da un'auto in movimento, ed eseguire di nuovo.
 Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:8786) i cui worker vedono il percorso dell'area di lavoro; vuoto = questo computer, oppure $ARCHAEOORTHO_DASK_SCHEDULER.</translation>
     </message>
+    <message>
+        <location filename="../processing_provider/build_orthophoto.py" line="79"/>
+        <source>Resolution (CRS units, 0 = GSD)</source>
+        <translation>Risoluzione (unità del SR, 0 = GSD)</translation>
+    </message>
+</context>
+<context>
+    <name>Choices</name>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>auto</source>
+        <translation>automatica (auto)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>exhaustive</source>
+        <translation>tutte le coppie (exhaustive)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>sequential</source>
+        <translation>sequenziale (sequential)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>spatial</source>
+        <translation>spaziale (spatial)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>incremental</source>
+        <translation>incrementale (incremental)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>global</source>
+        <translation>globale (global)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>fixed</source>
+        <translation>fisso (fixed)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>refined</source>
+        <translation>affinato (refined)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>estimated</source>
+        <translation>stimato (estimated)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>full</source>
+        <translation>piena (full)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>half</source>
+        <translation>metà (half)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>quarter</source>
+        <translation>un quarto (quarter)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>feather</source>
+        <translation>sfumata (feather)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>multiband</source>
+        <translation>multibanda (multiband)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>none</source>
+        <translation>nessuna (none)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>bilinear</source>
+        <translation>bilineare (bilinear)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>cubic</source>
+        <translation>cubica (cubic)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>nearest</source>
+        <translation>vicino più prossimo (nearest)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>cross</source>
+        <translation>croce (cross)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>dot</source>
+        <translation>punto (dot)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>ring_dot</source>
+        <translation>punto in un anello (ring_dot)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>cross_ring</source>
+        <translation>croce in un anello (cross_ring)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>corners</source>
+        <translation>angoli (corners)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>sides</source>
+        <translation>metà dei lati (sides)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>eight</source>
+        <translation>otto (eight)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Sky-view factor</source>
+        <translation>Fattore di vista del cielo (sky-view factor)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Openness (positive)</source>
+        <translation>Apertura (positiva)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Openness (negative)</source>
+        <translation>Apertura (negativa)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Simple local relief model</source>
+        <translation>Modello semplice del rilievo locale</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Multi-scale relief model</source>
+        <translation>Modello del rilievo multiscala</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Multi-direction hillshade</source>
+        <translation>Ombreggiatura da più direzioni</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Local dominance</source>
+        <translation>Dominanza locale</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>VAT (visualisation for archaeological topography, blend)</source>
+        <translation>VAT (visualizzazione per la topografia archeologica, fusione)</translation>
+    </message>
 </context>
 <context>
     <name>ContoursAlgorithm</name>
@@ -724,7 +892,7 @@ Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:878
         <translation>Equidistanza in metri</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Contours</source>
         <translation>Curve di livello</translation>
     </message>
@@ -734,7 +902,7 @@ Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:878
         <translation>Curve di livello</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Contour lines of a DTM or DSM at a chosen interval (GDAL&apos;s contour generator) into a GeoPackage layer &apos;contours&apos; whose &apos;elevation&apos; field labels them.
 
 Elevation raster: a DTM or DSM in a projected CRS (metres).
@@ -790,12 +958,12 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <translation>{} celle confrontate: mediana {:.3f} m, media {:.3f} m, dev. std. {:.3f} m, 5-95 % {:.3f} .. {:.3f} m; {} celle cambiate di più di {:g} m</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>DSM difference</source>
         <translation>Differenza tra DSM</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>The later DSM minus the earlier one, on the earlier one&apos;s grid, shows what changed between two epochs of a site (the later DSM is warped there with GDAL, bilinear, from any CRS). A cell is nodata where either DSM has none. The log gives the cells compared, the median, mean and standard deviation of the difference, its 5th and 95th percentiles and the cells that changed by more than 1 m; a median near 0 says the two epochs are registered on each other.
 
 Earlier DSM: the DSM the difference is measured from (its grid is the output&apos;s).
@@ -811,42 +979,42 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
 <context>
     <name>GcpDock</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="76"/>
+        <location filename="../ui/gcp_dock.py" line="81"/>
         <source>ArchaeoOrtho ground control</source>
         <translation>ArchaeoOrtho punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="93"/>
+        <location filename="../ui/gcp_dock.py" line="98"/>
         <source>ArchaeoOrtho photos</source>
         <translation>ArchaeoOrtho foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="143"/>
+        <location filename="../ui/gcp_dock.py" line="160"/>
         <source>Workspace:</source>
         <translation>Area di lavoro:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="350"/>
+        <location filename="../ui/gcp_dock.py" line="369"/>
         <source>none open</source>
         <translation>nessuna aperta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="150"/>
+        <location filename="../ui/gcp_dock.py" line="167"/>
         <source>Open a workspace folder (made by Align images)</source>
         <translation>Apri una cartella dell'area di lavoro (creata da 'Allinea immagini')</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="152"/>
+        <location filename="../ui/gcp_dock.py" line="169"/>
         <source>Choose a folder of photos and a workspace folder, and align the photos</source>
         <translation>Scegli una cartella di foto e una cartella dell'area di lavoro e allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="159"/>
+        <location filename="../ui/gcp_dock.py" line="176"/>
         <source>Heights (Z) from:</source>
         <translation>Quote (Z) da:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="164"/>
+        <location filename="../ui/gcp_dock.py" line="181"/>
         <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
         <translation>Un layer raster DSM o DTM (ad es. un DSM ALS): un punto misurato sulla mappa ne prende la quota (bilineare). Vuoto: inserire Z a mano.</translation>
     </message>
@@ -856,27 +1024,27 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>Aggiungi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="179"/>
+        <location filename="../ui/gcp_dock.py" line="196"/>
         <source>Add a ground point</source>
         <translation>Aggiungi un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="180"/>
+        <location filename="../ui/gcp_dock.py" line="197"/>
         <source>Remove</source>
         <translation>Rimuovi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="181"/>
+        <location filename="../ui/gcp_dock.py" line="198"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Rimuovi il punto d'appoggio selezionato e le sue misure</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="196"/>
+        <location filename="../ui/gcp_placement.py" line="193"/>
         <source>Pick on map</source>
         <translation>Misura sulla mappa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="184"/>
+        <location filename="../ui/gcp_dock.py" line="201"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>Fai clic sulla mappa per impostare X e Y del punto selezionato (Z dal layer delle quote)</translation>
     </message>
@@ -886,97 +1054,97 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>Importa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="192"/>
+        <location filename="../ui/gcp_dock.py" line="209"/>
         <source>Export</source>
         <translation>Esporta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="207"/>
+        <location filename="../ui/gcp_dock.py" line="224"/>
         <source>Undo</source>
         <translation>Annulla</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="208"/>
+        <location filename="../ui/gcp_dock.py" line="225"/>
         <source>Redo</source>
         <translation>Ripeti</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="218"/>
+        <location filename="../ui/gcp_dock.py" line="235"/>
         <source>Undo: {}</source>
         <translation>Annulla: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="220"/>
+        <location filename="../ui/gcp_dock.py" line="237"/>
         <source>Redo: {}</source>
         <translation>Ripeti: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="199"/>
+        <location filename="../ui/gcp_dock.py" line="216"/>
         <source>Load results</source>
         <translation>Carica risultati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="200"/>
+        <location filename="../ui/gcp_dock.py" line="217"/>
         <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Aggiungi i prodotti dell'area di lavoro alla mappa come layer con stile</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="252"/>
+        <location filename="../ui/gcp_dock.py" line="271"/>
         <source>Residual tolerance:</source>
         <translation>Tolleranza dei residui:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="258"/>
+        <location filename="../ui/gcp_dock.py" line="277"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="267"/>
+        <location filename="../ui/gcp_dock.py" line="286"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="268"/>
+        <location filename="../ui/gcp_dock.py" line="287"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Lascia che la compensazione affini focale, punto principale e distorsione</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="275"/>
+        <location filename="../ui/gcp_dock.py" line="294"/>
         <source>Georeference</source>
         <translation>Georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="276"/>
+        <location filename="../ui/gcp_dock.py" line="295"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Esegui la compensazione con questi punti (in background)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="277"/>
+        <location filename="../ui/gcp_dock.py" line="296"/>
         <source>Cancel</source>
         <translation>Interrompi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="327"/>
+        <location filename="../ui/gcp_dock.py" line="346"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="334"/>
+        <location filename="../ui/gcp_dock.py" line="353"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Apri un'area di lavoro ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="380"/>
+        <location filename="../ui/gcp_dock.py" line="399"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} foto; il blocco non è ancora allineato: esegui 'Allinea immagini' (o 'Nuova dalle foto') per avere le posizioni previste</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="383"/>
+        <location filename="../ui/gcp_dock.py" line="402"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} foto, {} punti d'appoggio. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="284"/>
+        <location filename="../ui/gcp_placement.py" line="281"/>
         <source>no predicted positions: {}</source>
         <translation>nessuna posizione prevista: {}</translation>
     </message>
@@ -1011,82 +1179,82 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>ArchaeoOrtho: allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="521"/>
+        <location filename="../ui/gcp_dock.py" line="540"/>
         <source>CRS: {}</source>
         <translation>SR: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="120"/>
+        <location filename="../ui/gcp_placement.py" line="117"/>
         <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Fai clic sulla mappa nella posizione del punto selezionato (Esc per terminare)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="184"/>
+        <location filename="../ui/gcp_placement.py" line="181"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (da {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="187"/>
+        <location filename="../ui/gcp_placement.py" line="184"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Nessuna quota in questo punto in {}: Z invariata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="190"/>
+        <location filename="../ui/gcp_placement.py" line="187"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="396"/>
+        <location filename="../ui/gcp_placement.py" line="393"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="398"/>
+        <location filename="../ui/gcp_placement.py" line="395"/>
         <source>predicted</source>
         <translation>prevista</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="421"/>
+        <location filename="../ui/gcp_placement.py" line="418"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Seleziona o aggiungi un punto d'appoggio nella tabella, poi fai clic su di esso nella foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="428"/>
+        <location filename="../ui/gcp_placement.py" line="425"/>
         <source>from the point&apos;s other observations</source>
         <translation>dalle altre misure del punto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="429"/>
+        <location filename="../ui/gcp_placement.py" line="426"/>
         <source>from the georeferenced block</source>
         <translation>dal blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="430"/>
+        <location filename="../ui/gcp_placement.py" line="427"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>dai punti già misurati (trasformazione di similitudine)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="441"/>
+        <location filename="../ui/gcp_placement.py" line="438"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Misurato in x {:.2f}, y {:.2f}. Fai clic per spostarlo, trascinalo o premi Canc per rimuoverlo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="444"/>
+        <location filename="../ui/gcp_placement.py" line="441"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Previsto {}. Premi Invio per accettarlo e proseguire (Spazio: accetta), trascinalo o fai clic dove si trova davvero il punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="456"/>
+        <location filename="../ui/gcp_placement.py" line="453"/>
         <source>Click where {} is in this photo.</source>
         <translation>Fai clic dove si trova {} in questa foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="476"/>
+        <location filename="../ui/gcp_placement.py" line="473"/>
         <source>Select or add a ground point first</source>
         <translation>Seleziona o aggiungi prima un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="523"/>
+        <location filename="../ui/gcp_placement.py" line="520"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: ogni foto in cui è previsto ha una misura</translation>
     </message>
@@ -1271,42 +1439,42 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>modificato da allora: riesegui per aggiornare</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="431"/>
+        <location filename="../ui/gcp_placement.py" line="428"/>
         <source>by matching its look in another photo</source>
         <translation>confrontandone l'aspetto in un'altra foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="435"/>
+        <location filename="../ui/gcp_placement.py" line="432"/>
         <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
         <translation>(correlazione {:.2f}, {:.0f} px dalla previsione geometrica)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="149"/>
+        <location filename="../ui/gcp_dock.py" line="166"/>
         <source>Open…</source>
         <translation>Apri…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="151"/>
+        <location filename="../ui/gcp_dock.py" line="168"/>
         <source>New from photos…</source>
         <translation>Nuova dalle foto…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="187"/>
+        <location filename="../ui/gcp_dock.py" line="204"/>
         <source>From file (gcp_list.txt, CSV)…</source>
         <translation>Da file (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="188"/>
+        <location filename="../ui/gcp_dock.py" line="205"/>
         <source>From a point layer…</source>
         <translation>Da un layer di punti…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="190"/>
+        <location filename="../ui/gcp_dock.py" line="207"/>
         <source>To file (gcp_list.txt, CSV)…</source>
         <translation>Su file (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="191"/>
+        <location filename="../ui/gcp_dock.py" line="208"/>
         <source>To a GeoPackage layer…</source>
         <translation>Su un layer GeoPackage…</translation>
     </message>
@@ -1351,77 +1519,77 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>I residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi. Ora: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="94"/>
+        <location filename="../ui/gcp_placement.py" line="95"/>
         <source>Diagnosis of the adjustment:</source>
         <translation>Diagnosi della compensazione:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="175"/>
+        <location filename="../ui/gcp_placement.py" line="172"/>
         <source>Moved {:.2f} m (Undo: Ctrl+Z).</source>
         <translation>Spostato di {:.2f} m (Annulla: Ctrl+Z).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="398"/>
+        <location filename="../ui/gcp_placement.py" line="395"/>
         <source>near the edge</source>
         <translation>vicino al bordo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="447"/>
+        <location filename="../ui/gcp_placement.py" line="444"/>
         <source>{} is predicted where it cannot be placed: {}. Click where the point is if you see it, or press Enter for the next photo.</source>
         <translation>{} è previsto dove non può essere posizionato: {}. Fai clic sul punto se lo vedi, o premi Invio per la foto successiva.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="453"/>
+        <location filename="../ui/gcp_placement.py" line="450"/>
         <source>Click where {} is in this photo, or use Pick on map (or type X, Y, Z in the table) to have it predicted in the photos.</source>
         <translation>Fai clic su {} in questa foto, oppure usa Misura sulla mappa (o scrivi X, Y, Z nella tabella) per farlo prevedere nelle foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="466"/>
+        <location filename="../ui/gcp_placement.py" line="463"/>
         <source>{}: the workspace has no photos to place it in.</source>
         <translation>{}: l'area di lavoro non ha foto in cui posizionarlo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="468"/>
+        <location filename="../ui/gcp_placement.py" line="465"/>
         <source>{} is selected: use Pick on map or type X, Y, Z in the table, or choose a photo in the strip below and click on the point.</source>
         <translation>{} è selezionato: usa Misura sulla mappa o scrivi X, Y, Z nella tabella, oppure scegli una foto nella striscia sotto e fai clic sul punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="470"/>
+        <location filename="../ui/gcp_placement.py" line="467"/>
         <source>{} is selected: choose a photo in the strip below and click on the point.</source>
         <translation>{} è selezionato: scegli una foto nella striscia sotto e fai clic sul punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="215"/>
+        <location filename="../ui/gcp_dock.py" line="232"/>
         <source>Undo (Ctrl+Z)</source>
         <translation>Annulla (Ctrl+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="215"/>
+        <location filename="../ui/gcp_dock.py" line="232"/>
         <source>Redo (Ctrl+Shift+Z)</source>
         <translation>Ripeti (Ctrl+Maiusc+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="401"/>
+        <location filename="../ui/gcp_dock.py" line="420"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px.</source>
         <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="406"/>
+        <location filename="../ui/gcp_dock.py" line="425"/>
         <source>Not aligned ({}): {}</source>
         <translation>Non allineate ({}): {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="407"/>
+        <location filename="../ui/gcp_dock.py" line="426"/>
         <source>(marked in the photo strip; hover for the reason)</source>
         <translation>(segnate nella striscia delle foto; il motivo è nel suggerimento)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="426"/>
+        <location filename="../ui/gcp_dock.py" line="445"/>
         <source>✗ not aligned</source>
         <translation>✗ non allineata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="427"/>
+        <location filename="../ui/gcp_dock.py" line="446"/>
         <source>{}: not aligned: {}</source>
         <translation>{}: non allineata: {}</translation>
     </message>
@@ -1431,32 +1599,32 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>Non allineate: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="142"/>
+        <location filename="../ui/gcp_placement.py" line="139"/>
         <source>pick on map</source>
         <translation>misura sulla mappa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="433"/>
+        <location filename="../ui/gcp_placement.py" line="430"/>
         <source>(no Z yet: at the height of the block&apos;s tie points)</source>
         <translation>(ancora nessuna Z: all'altezza dei punti di legame del blocco)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="167"/>
+        <location filename="../ui/gcp_placement.py" line="164"/>
         <source>{} not moved</source>
         <translation>{} non spostato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="196"/>
+        <location filename="../ui/gcp_placement.py" line="193"/>
         <source>{} is placed in {} photos. Move it {:.2f} m to the picked position, or add a new point there?</source>
         <translation>{} è posizionato in {} foto. Spostarlo di {:.2f} m nella posizione misurata, o aggiungere lì un nuovo punto?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="200"/>
+        <location filename="../ui/gcp_placement.py" line="197"/>
         <source>Move {}</source>
         <translation>Sposta {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="201"/>
+        <location filename="../ui/gcp_placement.py" line="198"/>
         <source>New point</source>
         <translation>Nuovo punto</translation>
     </message>
@@ -1521,37 +1689,37 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>DSM di riferimento:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="73"/>
+        <location filename="../ui/gcp_autocontrol.py" line="78"/>
         <source>Georeference from the reference orthophoto and DSM (in the background)</source>
         <translation>Georeferenzia dall'ortofoto e dal DSM di riferimento (in background)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="94"/>
+        <location filename="../ui/gcp_autocontrol.py" line="99"/>
         <source>Automatic control: choose a reference orthophoto and a reference DSM layer</source>
         <translation>Controllo automatico: scegliere un'ortofoto di riferimento e un layer DSM di riferimento</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="115"/>
+        <location filename="../ui/gcp_autocontrol.py" line="120"/>
         <source>Automatic control: {} automatic GCPs kept of {} matches; georeferenced in {}.</source>
         <translation>Controllo automatico: {} GCP automatici mantenuti su {} corrispondenze; georeferenziato in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="118"/>
+        <location filename="../ui/gcp_autocontrol.py" line="123"/>
         <source>Check points: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</source>
         <translation>Punti di controllo: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="129"/>
+        <location filename="../ui/gcp_autocontrol.py" line="134"/>
         <source>ArchaeoOrtho: automatic control</source>
         <translation>ArchaeoOrtho: controllo automatico</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="133"/>
+        <location filename="../ui/gcp_autocontrol.py" line="138"/>
         <source>Automatic control against {} and {}…</source>
         <translation>Controllo automatico rispetto a {} e {}…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="145"/>
+        <location filename="../ui/gcp_autocontrol.py" line="150"/>
         <source>Automatic GCPs (residuals)</source>
         <translation>GCP automatici (residui)</translation>
     </message>
@@ -1810,12 +1978,12 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="120"/>
+        <location filename="../processing_provider/run_pipeline.py" line="122"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Georeference</source>
         <translation>Georeferenzia</translation>
     </message>
@@ -1910,7 +2078,7 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>Il DSM di riferimento {} fornito da solo (controllo DEM) deve essere un file raster su disco; un layer web viene scaricato solo per il controllo automatico, con un'ortofoto di riferimento</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Fixes the aligned block in a real coordinate reference system with ground control points (GCPs) and/or camera positions, used inside the bundle adjustment so that they also remove the block&apos;s drift and bending, which a 7-parameter (Helmert) transform cannot. Check points take no part in the adjustment: they are triangulated afterwards and compared with their surveyed coordinates.
 
 Ground control file: an OpenDroneMap gcp_list.txt (CRS line, then &apos;x y z px py image [name]&apos;) or a CSV points file with a matching &apos;&lt;name&gt;_observations.csv&apos;. Ground control layer: alternatively a point layer with one feature per observation and fields name, image, px, py (optional z, sx, sy, sz, role).
@@ -1992,7 +2160,7 @@ Output: oltre ai consueti, il numero di GCP automatici mantenuti dalla compensaz
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Orthorectify image</source>
         <translation>Ortorettifica immagine</translation>
     </message>
@@ -2057,7 +2225,7 @@ Output: oltre ai consueti, il numero di GCP automatici mantenuti dalla compensaz
         <translation>Indicare punti d'appoggio misurati nell'immagine (File dei punti d'appoggio o Layer dei punti d'appoggio: GCPS, GCP_LAYER), il suo orientamento noto (ORIENTATION) o un'ortofoto di riferimento per il controllo automatico (REFERENCE_ORTHO)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Orthorectifies one photograph — also one that is not part of any block, such as a single oblique or an old print — on an existing DSM, for example an airborne laser scanning (ALS) DSM in any CRS (it is reprojected on the fly).
 
 The camera's position and attitude come from ground control points observed in the photo (space resection: at least 4 points; one wrong point among 5 or more is found and left out; with 6 or more the focal length and the radial distortion k1 are estimated too where the points determine them), or from a known orientation.
@@ -2237,7 +2405,7 @@ Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui
         <translation>Scansioni preparate: {} x {} px, dimensione del pixel {:.6g} {}{}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Prepare images</source>
         <translation>Prepara immagini</translation>
     </message>
@@ -2302,7 +2470,7 @@ Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui
         <translation>Focale calibrata (mm)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Screens a folder of photographs for blur and exposure and, for scanned historical film, finds the fiducial marks and resamples every scan into one camera frame. The result is a folder of prepared images for &apos;Align images&apos;, and the Workspace folder, which records a decision per image (screening.json) for the accuracy report.
 
 The blur score is the variance of the Laplacian on a grey copy 1024 px wide, 90th percentile of an 8 x 6 grid of tiles (sky or water in part of a frame does not count against it). Higher is sharper. An image is flagged &apos;blurry&apos; below a fraction of the median of the set (Flag images below this fraction of the set&apos;s median blur score, advanced), or below the Smallest blur score when that is set (0 = only relative to the set; absolute scores depend on the scene: sand scores far lower than roofs).
@@ -2365,7 +2533,7 @@ Immagini preparate: la cartella delle immagini preparate (sostituita per intero;
         <translation>Indica una cartella dell'area di lavoro, oppure un raster delle quote e dove scrivere la visualizzazione</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Relief visualisation</source>
         <translation>Visualizzazione del rilievo</translation>
     </message>
@@ -2385,7 +2553,7 @@ Immagini preparate: la cartella delle immagini preparate (sostituita per intero;
         <translation>Raster del rilievo</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Relief visualisations for reading earthworks, hollow ways, ridge and furrow and field boundaries, computed with rvt-py (the Relief Visualization Toolbox&apos;s library) with RVT&apos;s default parameters, converted from the 1 m DEMs RVT was made for to this raster&apos;s cell size.
 
 Workspace folder: a workspace with a DTM (Build DTM) or DSM.
@@ -2405,84 +2573,89 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
 <context>
     <name>ResultLayers</name>
     <message>
-        <location filename="../ui/layers.py" line="271"/>
+        <location filename="../ui/layers.py" line="278"/>
         <source>control (used)</source>
         <translation>appoggio (usato)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="272"/>
+        <location filename="../ui/layers.py" line="279"/>
         <source>check point</source>
         <translation>punto di controllo</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="273"/>
+        <location filename="../ui/layers.py" line="280"/>
         <source>rejected (outlier)</source>
         <translation>scartato (valore anomalo)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="274"/>
+        <location filename="../ui/layers.py" line="281"/>
         <source>not triangulated</source>
         <translation>non triangolato</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="705"/>
+        <location filename="../ui/layers.py" line="770"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="664"/>
+        <location filename="../ui/layers.py" line="721"/>
         <source>DSM hillshade</source>
         <translation>Ombreggiatura del DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="706"/>
+        <location filename="../ui/layers.py" line="771"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="707"/>
+        <location filename="../ui/layers.py" line="772"/>
         <source>Cameras</source>
         <translation>Camere</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="675"/>
+        <location filename="../ui/layers.py" line="733"/>
         <source>Camera footprints</source>
         <translation>Impronte delle immagini</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="682"/>
+        <location filename="../ui/layers.py" line="740"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Residui dei punti d'appoggio (vettori x{})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="708"/>
+        <location filename="../ui/layers.py" line="773"/>
         <source>Point cloud</source>
         <translation>Nuvola di punti</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="716"/>
+        <location filename="../ui/layers.py" line="781"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="383"/>
+        <location filename="../ui/layers.py" line="416"/>
         <source>{} ({})</source>
         <translation>{} ({})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="709"/>
+        <location filename="../ui/layers.py" line="774"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="689"/>
+        <location filename="../ui/layers.py" line="747"/>
         <source>DTM hillshade</source>
         <translation>Ombreggiatura del DTM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="710"/>
+        <location filename="../ui/layers.py" line="775"/>
         <source>Contours</source>
         <translation>Curve di livello</translation>
+    </message>
+    <message>
+        <location filename="../ui/layers.py" line="401"/>
+        <source>{} — {}</source>
+        <translation>{} — {}</translation>
     </message>
 </context>
 <context>
@@ -2528,17 +2701,17 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="108"/>
+        <location filename="../processing_provider/run_pipeline.py" line="110"/>
         <source>Accuracy report (HTML)</source>
         <translation>Rapporto di accuratezza (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="162"/>
+        <location filename="../processing_provider/run_pipeline.py" line="164"/>
         <source>Seconds per stage: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Run pipeline</source>
         <translation>Esegui l'intera elaborazione</translation>
     </message>
@@ -2589,11 +2762,6 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
     </message>
     <message>
         <location filename="../processing_provider/run_pipeline.py" line="75"/>
-        <source>Orthomosaic resolution</source>
-        <translation>Risoluzione dell'ortomosaico</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Seam blending</source>
         <translation>Sfumatura delle giunzioni</translation>
     </message>
@@ -2633,7 +2801,7 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Pixel dei GCP misurati sulle foto raddrizzate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="126"/>
+        <location filename="../processing_provider/run_pipeline.py" line="128"/>
         <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Indicare punti di appoggio (File o Layer dei punti d'appoggio: GCPS, GCP_LAYER) e/o posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
     </message>
@@ -2643,7 +2811,7 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Maschere del cielo (foto oblique)</translation>
     </message>
     <message>
-        <location filename="../ui/catalog.py" line="7"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>The whole chain in one call, for batch use: Align images, Georeference, Build DSM, Build orthophoto and Accuracy report on one workspace. It calls the same functions as the single algorithms, and a re-run resumes (features, matches and dense pairs already computed are reused).
 
 Folder of images: the photos. Workspace folder: where every product is written.
@@ -2672,6 +2840,11 @@ Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le ci
         <location filename="../processing_provider/run_pipeline.py" line="75"/>
         <source>Interior orientation</source>
         <translation>Orientamento interno</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <source>Orthomosaic resolution (CRS units, 0 = GSD)</source>
+        <translation>Risoluzione ortomosaico (unità SR, 0 = GSD)</translation>
     </message>
 </context>
 </TS>

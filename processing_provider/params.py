@@ -4,7 +4,9 @@ A builder makes one parameter definition (type, default, range, options, file fi
 turns a parameter's value into what the core call takes, so that a parameter common to several
 algorithms is defined once.  The algorithm gives the name (its class constant) and the label, already
 translated with its own ``self.tr("...")``: every algorithm's strings stay in its class, the translation
-context that pylupdate5 and AlgorithmBase.tr() share.  This module holds no user-facing text.
+context that pylupdate5 and AlgorithmBase.tr() share.  This module holds no user-facing text; a choice's options
+are the core's values ("auto", "half", "feather"), shown translated in the "Choices" context (option_label):
+i18n/make_catalog.py lists the option lists below for pylupdate5.
 """
 from qgis.core import (
     QgsProcessing,
@@ -19,8 +21,10 @@ from qgis.core import (
     QgsProcessingParameterNumber,
     QgsProcessingParameterString,
 )
+from qgis.PyQt.QtCore import QCoreApplication
 
-# enum options: the values the core takes, in the order of the parameter's options
+# enum options: the values the core takes, in the order of the parameter's options (shown translated:
+# option_label; i18n/make_catalog.py CHOICE_LISTS names the lists whose values are translated)
 PAIRINGS = ["auto", "exhaustive", "sequential", "spatial"]
 CAMERA_MODELS = ["AUTO", "SIMPLE_RADIAL", "RADIAL", "OPENCV", "FULL_OPENCV"]
 MAPPERS = ["incremental", "global"]
@@ -75,8 +79,18 @@ def flag(name, label, default=False):
     return QgsProcessingParameterBoolean(name, label, defaultValue=default)
 
 
+CHOICES_CONTEXT = "Choices"
+
+
+def option_label(option):
+    """What an enum option shows: its translation in the "Choices" context (German 'halb (half)'), the value
+    itself in English.  The parameter's value stays the option's index, read by read_choice, in any language
+    (German choice values were shown in English: issue 36 item 21)."""
+    return QCoreApplication.translate(CHOICES_CONTEXT, option)
+
+
 def choice(name, label, options, default=0):
-    return QgsProcessingParameterEnum(name, label, options=list(options), defaultValue=default)
+    return QgsProcessingParameterEnum(name, label, options=[option_label(o) for o in options], defaultValue=default)
 
 
 def read_choice(alg, parameters, name, context, options):
@@ -208,8 +222,8 @@ def relief_choice(name, label):
     """Relief visualisations to make (several may be chosen; none by default: they take minutes)."""
     from ..core.terrain.options import VISUALISATIONS
 
-    return QgsProcessingParameterEnum(name, label, options=[lab for _, lab in VISUALISATIONS], allowMultiple=True,
-                                      optional=True, defaultValue=[])
+    return QgsProcessingParameterEnum(name, label, options=[option_label(lab) for _, lab in VISUALISATIONS],
+                                      allowMultiple=True, optional=True, defaultValue=[])
 
 
 def read_relief(alg, parameters, name, context):

@@ -110,6 +110,57 @@ def test_italian_translation_loads(qgis_iface, locale_setting, tmp_path):
         p.unload()
 
 
+@pytest.mark.parametrize("lang, expected", [
+    ("de", {("runpipeline", "QUALITY"): ["voll (full)", "halb (half)", "Viertel (quarter)"],
+            ("buildorthophoto", "BLENDING"): ["weiche Naht (feather)", "Mehrband (multiband)", "keine (none)"],
+            ("alignimages", "PAIRING"): ["automatisch (auto)", "alle Paare (exhaustive)",
+                                         "aufeinanderfolgend (sequential)", "räumlich (spatial)"],
+            ("reliefvisualisation", "VISUALISATION"): "Sky-View-Faktor",
+            ("runpipeline", "ORTHO_RESOLUTION"): "Orthomosaik-Auflösung (KBS-Einh., 0 = GSD)"}),
+    ("it", {("runpipeline", "QUALITY"): ["piena (full)", "metà (half)", "un quarto (quarter)"],
+            ("alignimages", "INTRINSICS"): ["automatica (auto)", "fisso (fixed)", "affinato (refined)",
+                                            "stimato (estimated)"],
+            ("buildorthophoto", "RESOLUTION"): "Risoluzione (unità del SR, 0 = GSD)"}),
+])
+def test_choice_values_and_units_translated(qgis_iface, locale_setting, tmp_path, lang, expected):
+    """The options of the choices ('auto', 'half', 'feather' ...) were English in a German or Italian QGIS (issue
+    36 item 21): they show translated, the core's value beside it, and a run still takes the option by its index;
+    the orthomosaic's resolution gives its unit."""
+    import archaeoortho
+    from archaeoortho.processing_provider import params
+    from qgis.core import QgsApplication, QgsProcessingContext
+
+    _qm(lang, tmp_path)
+    locale_setting(lang)
+    p = archaeoortho.classFactory(qgis_iface)
+    try:
+        p.initProcessing()
+        reg = QgsApplication.processingRegistry()
+        for (alg_id, name), want in expected.items():
+            definition = reg.algorithmById("archaeoortho:" + alg_id).parameterDefinition(name)
+            if isinstance(want, list):
+                assert definition.options() == want, (alg_id, name)
+            elif hasattr(definition, "options"):
+                assert want in definition.options(), (alg_id, name, definition.options())
+            else:
+                assert definition.description() == want, (alg_id, name)
+        alg = reg.algorithmById("archaeoortho:runpipeline").create()
+        assert params.read_choice(alg, {"QUALITY": 1}, "QUALITY", QgsProcessingContext(), params.QUALITIES) == "half"
+    finally:
+        p.unload()
+    locale_setting("en")
+    english = archaeoortho.classFactory(qgis_iface)  # no translator: the core's values, the units in English
+    try:
+        assert english.translator is None
+        english.initProcessing()
+        pipeline = QgsApplication.processingRegistry().algorithmById("archaeoortho:runpipeline")
+        assert pipeline.parameterDefinition("QUALITY").options() == ["full", "half", "quarter"]
+        assert pipeline.parameterDefinition("ORTHO_RESOLUTION").description() == (
+            "Orthomosaic resolution (CRS units, 0 = GSD)")
+    finally:
+        english.unload()
+
+
 def test_english_without_a_translation(qgis_iface, locale_setting):
     import archaeoortho
 
