@@ -76,3 +76,37 @@ def test_build_dtm_by_small_tiles_writes_the_same_rasters(tmp_path):
     # the in-memory filter gives what the file gives
     mem = filter_ground(z.astype(np.float32).astype(np.float64), CELL, GroundOptions())
     assert np.array_equal(np.where(np.isfinite(mem.dtm), mem.dtm, -9999.0).astype(np.float32), dtm)
+
+
+def _write(path, z):
+    srs = osr.SpatialReference()
+    srs.ImportFromEPSG(32633)
+    ds = gdal.GetDriverByName("GTiff").Create(path, z.shape[1], z.shape[0], 1, gdal.GDT_Float32)
+    ds.SetGeoTransform((500000.0, CELL, 0.0, 4600000.0, 0.0, -CELL))
+    ds.SetProjection(srs.ExportToWkt())
+    ds.GetRasterBand(1).SetNoDataValue(-9999.0)
+    ds.GetRasterBand(1).WriteArray(np.where(np.isfinite(z), z, -9999.0))
+    ds = None
+    return path
+
+
+def test_relief_by_small_tiles_equals_the_whole_raster(tmp_path):
+    """Each visualisation computed by tiles with the margin its radius reaches (radii shortened so that the
+    230 x 310 raster holds several tiles) is the one computed on the whole raster."""
+    pytest.importorskip("rvt.vis")
+    from core.terrain import relief as rv
+    from core.terrain.options import VISUALISATION_KEYS, ReliefOptions
+    from core.terrain.stage import relief
+
+    dem = _write(str(tmp_path / "dem.tif"), _dsm())
+    short = dict(svf_radius=0.6, slrm_radius=0.8, msrm_feature_max=1.5, ld_min_radius=0.3, ld_max_radius=0.6,
+                 svf_directions=8, mhs_directions=4)
+    small, whole = ReliefOptions(tile=1, **short), ReliefOptions(tile=100_000, **short)
+    assert all(rv.tile_cells(k, CELL, small) < 150 for k in VISUALISATION_KEYS)  # several tiles each
+    a = relief(dem, VISUALISATION_KEYS, str(tmp_path / "tiled"), options=small)
+    b = relief(dem, VISUALISATION_KEYS, str(tmp_path / "whole"), options=whole)
+    for key in VISUALISATION_KEYS:
+        x, y = (gdal.Open(r.paths[key]).ReadAsArray() for r in (a, b))
+        assert np.array_equal(x == -9999.0, y == -9999.0), key
+        lo, hi = rv.DISPLAY_RANGE[key]
+        assert np.abs(x - y).max() <= 1e-5 * (hi - lo), (key, np.abs(x - y).max())

@@ -5,12 +5,10 @@ from __future__ import annotations
 import math
 import os
 
-import numpy as np
-
 from ..common.files import atomic_output, refuse_overwriting_inputs
 from ..common.progress import NullProgress, Progress, check_cancel
 from .options import TerrainError
-from .rasters import read_elevation
+from .rasters import read_elevation, scan
 
 LAYER = "contours"
 ELEVATION_FIELD = "elevation"
@@ -43,8 +41,8 @@ def write_contours(raster_path: str, output: str, interval: float, progress: Pro
         raise TerrainError(f"the contour interval must be a positive number of metres, got {interval}")
     refuse_overwriting_inputs({"contours": output}, {what: raster_path}, TerrainError)
     check_contours_output(output)
-    elev = read_elevation(raster_path, what)  # the checks: projected, data, size
-    zmin, zmax = float(np.nanmin(elev.z)), float(np.nanmax(elev.z))
+    elev = read_elevation(raster_path, what, whole=False)  # the checks: projected, size; then by tiles: data
+    _n, zmin, zmax = scan(elev, what)
     n_levels = (zmax - zmin) / interval  # elev.z is in metres
     if n_levels > 5000:
         raise TerrainError(f"a contour interval of {interval:g} gives {n_levels:.0f} levels over the "

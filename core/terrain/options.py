@@ -72,6 +72,7 @@ class ReliefOptions:
     ld_observer_height: float = 1.7  # m
     max_radius_cells: int = 120
     vertical_exaggeration: float = 1.0
+    tile: int = 2 * TILE_CELLS  # cells: the least side of the tiles a visualisation is computed by (memory)
 
 
 @dataclass

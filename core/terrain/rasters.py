@@ -161,6 +161,22 @@ def check_data(path: str, what: str, n_valid: int, w: int, h: int) -> None:
                            f"(at least {MIN_CELLS * MIN_CELLS})")
 
 
+def scan(elev: Elevation, what: str, tile: int = TILE_CELLS) -> Tuple[int, float, float]:
+    """(cells with data, lowest, highest height in metres) of ``elev`` read tile by tile; TerrainError naming the
+    file (:func:`check_data`) when it has no data or too little."""
+    h, w = elev.shape
+    n, lo, hi = 0, np.inf, -np.inf
+    for r0, r1, c0, c1 in tiles(h, w, tile):
+        z = elev.read(r0, r1, c0, c1)
+        ok = np.isfinite(z)
+        k = int(np.count_nonzero(ok))
+        if k:
+            n += k
+            lo, hi = min(lo, float(z[ok].min())), max(hi, float(z[ok].max()))
+    check_data(elev.path, what, n, w, h)
+    return n, lo, hi
+
+
 def tiles(h: int, w: int, size: int):
     """(r0, r1, c0, c1) of the tiles of ``size`` x ``size`` cells covering an h x w raster, row by row."""
     size = max(1, int(size))

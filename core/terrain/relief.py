@@ -53,6 +53,50 @@ def compute(key: str, dem: np.ndarray, cell: float, options: ReliefOptions = Non
     return out
 
 
+def reach(key: str, cell: float, options: ReliefOptions) -> int:
+    """How many cells from a cell the visualisation ``key`` looks (its largest radius; 1 for the slope of a
+    hillshade): a tile computed with this margin around it is the whole raster's."""
+    o = options
+    svf = cells(o, o.svf_radius, cell, lo=3)
+    if key in ("svf", "openness_pos", "openness_neg", "vat"):
+        return svf + 1
+    if key == "slrm":
+        return cells(o, o.slrm_radius, cell, cap=False, lo=2) + 1
+    if key == "msrm":  # rvt.vis.msrm's largest mean filter: n ** scaling cells
+        fmin = max(o.msrm_feature_min, 2 * cell)
+        n = int(np.ceil(((max(o.msrm_feature_max, fmin) - cell) / (2 * cell)) ** (1 / int(o.msrm_scaling))))
+        return n ** int(o.msrm_scaling) + 1
+    if key == "ld":
+        return max(cells(o, o.ld_min_radius, cell, lo=2) + 1, cells(o, o.ld_max_radius, cell, lo=3)) + 1
+    return 1
+
+
+def tile_cells(key: str, cell: float, options: ReliefOptions) -> int:
+    """The side of the tiles ``key`` is computed by: ``options.tile``, at least four times its margin (the
+    margin is computed again around each tile)."""
+    return max(int(options.tile), 4 * reach(key, cell, options))
+
+
+def tiled(key: str, elev, options: ReliefOptions, progress: Progress) -> Callable:
+    """A function of a tile (r0, r1, c0, c1) giving the visualisation ``key`` of the elevation raster ``elev``
+    (core.terrain.rasters.Elevation, read by windows) there: computed on the tile and the margin its radius
+    reaches (:func:`reach`), so a tile is as it is in the whole raster, which is never in memory."""
+    h, w = elev.shape
+    margin = reach(key, elev.cell, options) + 1
+    tile = tile_cells(key, elev.cell, options)
+    n_tiles = max(1, -(-h // tile) * -(-w // tile))
+    done = [0]
+
+    def values(r0: int, r1: int, c0: int, c1: int) -> np.ndarray:
+        a0, a1, b0, b1 = max(0, r0 - margin), min(h, r1 + margin), max(0, c0 - margin), min(w, c1 + margin)
+        image = compute(key, elev.read(a0, a1, b0, b1), elev.cell, options, progress)
+        done[0] += 1
+        progress.report(done[0] / n_tiles, f"relief visualisation: {key}, tile {done[0]} of {n_tiles}")
+        return image[r0 - a0:r1 - a0, c0 - b0:c1 - b0]
+
+    return values
+
+
 def _svf(vis, dem, cell, o, opns=False):
     r = cells(o, o.svf_radius, cell, lo=3)
     res = vis.sky_view_factor(dem=dem.copy(), resolution=cell, compute_svf=not opns, compute_opns=opns,

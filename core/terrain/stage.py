@@ -38,7 +38,7 @@ from .options import (
     ReliefOptions,
     TerrainError,
 )
-from .rasters import check_data, read_elevation, write_classes, write_float, write_float_tiles
+from .rasters import check_data, read_elevation, scan, write_classes, write_float_tiles
 
 
 @dataclass
@@ -199,19 +199,20 @@ def relief(dem_path: str, keys: Sequence[str], output_dir: str, prefix: str = "d
     targets = {key: (outputs or {}).get(key) or os.path.join(output_dir, f"{prefix}-{key}.tif") for key in keys}
     refuse_overwriting_inputs({f"{key} visualisation": path for key, path in targets.items()}, {what: dem_path},
                               TerrainError)
-    elev = read_elevation(dem_path, what)
+    elev = read_elevation(dem_path, what, whole=False)  # read by tiles
+    scan(elev, what, options.tile)
     paths, timings = {}, {}
     for i, key in enumerate(keys):
         t0 = time.time()
         sub = SubProgress(progress, i / len(keys), (i + 1) / len(keys))
         sub.report(0.0, f"relief visualisation: {key}")
-        image = rv.compute(key, elev.z, elev.cell, options, sub)
         path = targets[key]
         lo, hi = rv.DISPLAY_RANGE[key]
-        write_float(path, image, elev, f"{key} ({rv.UNITS[key]})",
-                    {"ARCHAEOORTHO_STAGE": "relief", "ARCHAEOORTHO_PRODUCT": f"relief-{key}", "RELIEF": key,
-                     "DISPLAY_MIN": lo, "DISPLAY_MAX": hi, "SOURCE": os.path.abspath(dem_path),
-                     "RVT_REFERENCE_CELL_M": options.reference_cell}, heights=False)
+        write_float_tiles(path, rv.tiled(key, elev, options, sub), elev, f"{key} ({rv.UNITS[key]})",
+                          {"ARCHAEOORTHO_STAGE": "relief", "ARCHAEOORTHO_PRODUCT": f"relief-{key}", "RELIEF": key,
+                           "DISPLAY_MIN": lo, "DISPLAY_MAX": hi, "SOURCE": os.path.abspath(dem_path),
+                           "RVT_REFERENCE_CELL_M": options.reference_cell},
+                          heights=False, tile=rv.tile_cells(key, elev.cell, options))
         paths[key] = path
         timings[key] = round(time.time() - t0, 3)
         progress.info(f"{key}: {path} ({timings[key]:.1f} s)")
