@@ -23,7 +23,7 @@ from .geometry.crs import validate_crs
 from .georef.options import GeorefOptions
 from .georef.stage import GeorefStageResult, georeference_workspace
 from .io.gcp import GCPSet, apply_check_points, read_camera_positions, read_gcps
-from .io.images import check_image_folder, list_images
+from .io.images import list_images, require_images
 from .ortho.options import OrthoOptions
 from .ortho.stage import build_orthophoto_workspace
 from .prepare.options import PrepareOptions
@@ -101,7 +101,7 @@ def check_inputs(images_dir: str, control: Control) -> None:
     EPSG code or a bad GCP file would throw away): the image folder, the CRS, the GCP file (its CRS line, its
     rows, the images it names, the check points) and the camera positions file.  Raises the readers' errors
     (ImageError, CRSError, GCPError: each names the file or value and the problem)."""
-    check_image_folder(images_dir, "IMAGES folder")
+    require_images(images_dir, "IMAGES folder")  # missing, unreadable or empty: before a workspace is created
     if control.crs:
         validate_crs(control.crs)
     if control.gcp_path:

@@ -271,3 +271,159 @@ def test_orthorectify_image_with_geographic_control_works_in_utm(tmp_path):
     assert np.linalg.norm(got - centre) < 0.5, got - centre
     with pytest.raises(OrthoError, match=r"CRS EPSG:4326 is geographic .* EPSG:32617"):
         orthorectify_image(photo, str(tmp_path / "o2.tif"), dsm_ll, gcps=gcps, focal_px=400.0, crs="EPSG:4326")
+
+
+def test_seamlines_without_a_crs_or_naming_a_filtered_photo_are_named(tmp_path):
+    """A seamlines shapefile without its .prj: its CRS is unknown, said (the edits were ignored); a polygon naming a
+    photo IMAGES_FILTER leaves out: said so (was 'not one of the N images of this mosaic')."""
+    from osgeo import ogr
+
+    from core.ortho.seamlines import SeamlineError, read_seamline_edits
+
+    shp = str(tmp_path / "edits.shp")
+    ds = ogr.GetDriverByName("ESRI Shapefile").CreateDataSource(shp)
+    lyr = ds.CreateLayer("edits", None, ogr.wkbPolygon)
+    lyr.CreateField(ogr.FieldDefn("image", ogr.OFTString))
+    for name in ("a.jpg", "c.jpg"):
+        f = ogr.Feature(lyr.GetLayerDefn())
+        f.SetField("image", name)
+        f.SetGeometry(ogr.CreateGeometryFromWkt(f"POLYGON(({X0} {Y0},{X0 + 5} {Y0},{X0 + 5} {Y0 + 5},{X0} {Y0}))"))
+        lyr.CreateFeature(f)
+    ds = None
+    assert not os.path.exists(str(tmp_path / "edits.prj"))
+    with pytest.raises(SeamlineError, match=r"edits\.shp: the layer's CRS is unknown .*\.prj"):
+        read_seamline_edits(shp, ["a.jpg", "b.jpg"], UTM17)
+    srs = osr.SpatialReference()
+    srs.SetFromUserInput(UTM17)
+    with open(str(tmp_path / "edits.prj"), "w") as fh:
+        fh.write(srs.ExportToWkt())
+    with pytest.raises(SeamlineError, match=r"names the image 'c.jpg', which IMAGES_FILTER 'a\*, b\*' leaves out"):
+        read_seamline_edits(shp, ["a.jpg", "b.jpg"], UTM17, left_out=["c.jpg"], images_filter="a*, b*")
+    assert [n for n, _ in read_seamline_edits(shp, ["a.jpg", "b.jpg", "c.jpg"], UTM17).polygons] == ["a.jpg", "c.jpg"]
+
+
+def test_a_read_only_workspace_is_refused_before_any_work(tmp_path, monkeypatch):
+    """One check in core.project for every stage (Workspace.begin_stage), made first by the stages that work
+    before they begin (the automatic control: a read-only workspace failed after 13 s of matching).  Root writes
+    anywhere, so the folder's refusal is simulated where the check asks the file system."""
+    import tempfile
+
+    from core.georef.autocontrol.stage import autocontrol_workspace
+    from core.project.workspace import Workspace, WorkspaceError
+    from tests import synthetic as syn
+    from tests.workspaces import synthetic_workspace
+
+    block = syn.vertical_block(seed=1, n_strips=1, per_strip=3)
+    ws_dir = synthetic_workspace(str(tmp_path / "ws"), block, block.truth_reconstruction())
+    before = open(os.path.join(ws_dir, "workspace.json")).read()
+
+    def refuse(*args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)
+    with pytest.raises(WorkspaceError, match=r"workspace folder .*ws is not writable \(Permission denied\): nothing"):
+        Workspace.open(ws_dir).begin_stage("dsm", {})
+    with pytest.raises(WorkspaceError, match="is not writable"):  # before the references are even opened
+        autocontrol_workspace(ws_dir, str(tmp_path / "no_ortho.tif"), str(tmp_path / "no_dsm.tif"))
+    assert open(os.path.join(ws_dir, "workspace.json")).read() == before
+
+
+def test_an_empty_images_folder_creates_no_workspace(tmp_path):
+    """Align images and the pipeline refuse an IMAGES folder without photos before a workspace is created (issue
+    36 item 21)."""
+    from core import pipeline
+    from core.align.options import AlignError
+    from core.align.stage import align
+    from core.io.images import ImageError
+
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    (empty / "notes.txt").write_text("flight log")
+    ws = tmp_path / "ws"
+    with pytest.raises(AlignError, match=r"empty holds no readable images .*notes\.txt"):
+        align(str(empty), str(ws))
+    assert not ws.exists()
+    with pytest.raises(ImageError, match=r"IMAGES folder .*empty holds no readable images"):
+        pipeline.run_pipeline(str(empty), str(ws), control=pipeline.Control(use_exif_gps=True))
+    assert not ws.exists()
+
+
+# ---------------------------------------------------------------------------
+# item 21: log noise and units, the report's "At a glance"
+# ---------------------------------------------------------------------------
+
+def test_bundle_adjustment_prints_one_progress_text_and_a_summary():
+    """The bundle adjustment's iterations share one progress text (the faces print a text when it changes: 20
+    'bundle adjustment: iteration N, cost ...' lines before) and end with one summary line."""
+    from core.common.progress import NullProgress
+    from tests.test_bundle_solver import problem
+
+    class Texts(NullProgress):
+        def __init__(self):
+            self.texts = []
+
+        def report(self, fraction, message=""):
+            if message and (not self.texts or self.texts[-1] != message):
+                self.texts.append(message)
+
+    prob, _ = problem([714.0, 714.0, 600.0, 450.0, 0.0, 0.0, 0.0, 0.0])
+    rec = Texts()
+    info = prob.solve(max_iterations=50, progress=rec)
+    assert info["iterations"] >= 3
+    assert rec.texts == ["bundle adjustment", f"bundle adjustment: {info['iterations']} iteration(s), cost "
+                                              f"{info['initial_cost']:.6g} -> {info['final_cost']:.6g}"]
+
+
+def test_log_units_and_the_glance_line_explaining_sigma_beside_the_camera_rmse():
+    from core.geometry.crs import unit_symbol
+    from core.report.page import precision_badge
+
+    assert [unit_symbol(c) for c in (UTM17, OHIO_N_FT, "EPSG:2231", "EPSG:4326", None)] == \
+        ["m", "US ft", "US ft", "deg", "model units"]
+    assert unit_symbol("EPSG:2927") == "US ft" and unit_symbol("EPSG:27700") == "m"
+
+    class Unc:
+        n_control = 0
+
+        def summary(self):
+            return {"point_std_xy_median": 10.8, "point_std_z_median": 6.8}
+
+    line = precision_badge(Unc(), 0.147, 0.54)
+    assert "σXY 10.800 m" in line and "camera position RMSE (0.54 m) is how closely the block fits" in line
+    assert "datum included" in line and "camera position RMSE" not in precision_badge(Unc(), 0.147)
+
+
+# ---------------------------------------------------------------------------
+# item 18: suspect automatic GCPs dropped and the block adjusted without them
+# ---------------------------------------------------------------------------
+
+def test_suspect_control_points_are_dropped_when_asked_and_the_block_adjusted_without_them():
+    """The pattern of the issue (4 of 101 automatic GCPs suspect, the worst 1.54 m, all kept): with
+    drop_suspect_control (the automatic control's setting) the suspects are rejected, named as such, and the
+    check point lands where it belongs; without it they are only named, as for hand-picked control."""
+    from core.georef.adjust import georeference
+    from core.georef.options import GeorefOptions
+    from core.io import gcp as gcpmod
+    from tests.test_georef import MODEL_FROM_WORLD, SPREAD, _block, _gcps
+
+    rec, _ = _block(MODEL_FROM_WORLD)
+    xy = dict(SPREAD, f=(40.0, 8.0), g=(20.0, 50.0))
+
+    def control():
+        gcps = _gcps(rec, MODEL_FROM_WORLD, xy, noise_px=0.2)
+        for p in gcps.points:
+            if p.name == "b":
+                p.x += 1.5
+            if p.name == "g":
+                p.y -= 2.0
+        gcpmod.apply_check_points(gcps, ["e"])
+        return gcps
+
+    kept = georeference(rec, control())
+    dropped = georeference(rec, control(), options=GeorefOptions(drop_suspect_control=True))
+    status = {r.name: r.status for r in dropped.points}
+    assert status["b"] == status["g"] == "rejected" and status["a"] == "used"
+    assert {r.name: r.status for r in kept.points}["g"] == "used"
+    assert [(o.name, o.stage) for o in dropped.outliers if o.stage == "consistency"] == [("g", "consistency"),
+                                                                                       ("b", "consistency")]
+    assert dropped.rmse("check")["xy"] < 0.5 * kept.rmse("check")["xy"]

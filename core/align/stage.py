@@ -28,7 +28,15 @@ from typing import Dict, List, Optional, Sequence, Set, Tuple
 from ..common.cancel import load_pycolmap
 from ..common.files import atomic_output, atomic_write_text, fingerprint
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
-from ..io.images import CameraGroup, ImageError, ImageInfo, check_image_folder, group_cameras, scan_images
+from ..io.images import (
+    CameraGroup,
+    ImageError,
+    ImageInfo,
+    check_image_folder,
+    group_cameras,
+    require_images,
+    scan_images,
+)
 from ..io.vector import write_cameras_gpkg
 from ..project.layout import Layout
 from ..project.stages import ALIGN, run_stage
@@ -288,6 +296,7 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
     images_dir = os.path.abspath(images_dir)
     try:
         check_image_folder(images_dir)  # does not exist / is a file / cannot be read: before the workspace
+        require_images(images_dir)  # empty: before the workspace too (issue 36 item 21: it was created)
     except ImageError as e:
         raise AlignError(str(e)) from e
     ws = Workspace.create_or_open(workspace_dir)  # checks writability before any work

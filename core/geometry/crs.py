@@ -394,6 +394,23 @@ def linear_unit(crs: str) -> Tuple[str, float]:
     return name, float(srs.GetLinearUnits() or math.nan)
 
 
+def unit_symbol(crs: Optional[str]) -> str:
+    """The unit of a CRS's horizontal axes for log lines: 'm', 'ft' (international foot), 'US ft', 'deg', else its
+    name; 'model units' without a CRS (a local frame)."""
+    if not crs:
+        return "model units"
+    name, metres = linear_unit(crs)
+    if name == "degree":
+        return "deg"
+    if metres == 1.0:
+        return "m"
+    if metres == metres and abs(metres - 0.3048) < 1e-9:
+        return "ft"
+    if metres == metres and abs(metres - 1200.0 / 3937.0) < 1e-9:
+        return "US ft"
+    return name or "units"
+
+
 def is_mercator(crs: str) -> bool:
     """True for a (Web) Mercator projection: its scale grows as 1 / cos(latitude) (1.3 at 40 degrees), so its
     metres are not ground metres away from the equator."""
@@ -406,4 +423,4 @@ def is_mercator(crs: str) -> bool:
 
 __all__ = ["CRSError", "WKT_START", "check_coordinates_match_crs", "crs_identifier", "crs_is_geographic",
            "crs_status", "epsg_code", "is_mercator", "linear_unit", "looks_like_crs", "normalize_crs",
-           "transform_points", "utm_epsg_for_lonlat", "validate_crs"]
+           "transform_points", "unit_symbol", "utm_epsg_for_lonlat", "validate_crs"]

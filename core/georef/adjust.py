@@ -482,7 +482,25 @@ def _consistency(run: _Run, fit: _Fit) -> Optional[Consistency]:
     elif consistency is not None and not consistency.consistent:
         run.warn(f"no 4 control points agree with the block within {tol:.3f} m: either the "
                  "block is deformed or several coordinates are wrong")
+    if consistency is not None and run.opt.drop_suspect_control:
+        _drop_suspects(run, consistency)
     return consistency
+
+
+def _drop_suspects(run: _Run, consistency: Consistency) -> None:
+    """The suspect control points left out of the adjustment for good (``drop_suspect_control``: automatic
+    control), when the ones that agree are at least 3 and outnumber them."""
+    agree, suspects = consistency.consistent, [n for n in consistency.suspects if n not in run.rejected_ctrl]
+    if not suspects or len(agree) < 3 or len(suspects) >= len(agree):
+        return
+    for n in suspects:
+        r = float(consistency.residuals.get(n, float("nan")))
+        run.outliers.append(Outlier("control point", n, r, "m", "consistency",
+                                    message=f"control point {n} disagrees with the others through the block "
+                                            f"({r:.2f} m): suspect, dropped from the adjustment"))
+        run.rejected_ctrl.add(n)
+    run.progress.info(f"{len(suspects)} suspect control point(s) dropped from the adjustment: "
+                      + ", ".join(f"{n} ({consistency.residuals.get(n, float('nan')):.2f} m)" for n in suspects))
 
 
 @dataclass

@@ -480,13 +480,16 @@ class BundleProblem:
                     break
                 self.restore(st)
                 lam *= 5
-            progress.report(min(1.0, it / max_iterations), f"bundle adjustment: iteration {it}, cost {cost:.6g}")
+            # one progress text for the whole loop (the log printed each iteration's line: 20 alike), the figures
+            # in the summary below
+            progress.report(min(1.0, it / max_iterations), "bundle adjustment")
             if not accepted:
                 break
             stalled = stalled + 1 if rel < tolerance else 0
             if stalled >= 2:
                 break
         self.iterations += it
+        progress.report(1.0, f"bundle adjustment: {it} iteration(s), cost {cost0:.6g} -> {cost:.6g}")
         return {"iterations": it, "initial_cost": cost0, "final_cost": cost}
 
 

@@ -37,7 +37,12 @@ class GeorefOptions:
     ``reference_dem``: a reference DEM file (any projected CRS, heights in metres or feet): the georeference stage
     co-registers the adjusted block's sparse points on it and adjusts again with up to ``reference_dem_points`` DEM
     control points (core.georef.demcontrol); ``reference_dem_sigma_z``: the reference's stated height accuracy
-    (metres, 0: unknown), added to their sigma Z.  The adjustment itself (``georeference``) ignores these."""
+    (metres, 0: unknown), added to their sigma Z.  The adjustment itself (``georeference``) ignores these.
+
+    ``drop_suspect_control``: control points the consistency check names as suspect (they disagree with the
+    others through the block) are dropped before the adjustment, not only named in a warning; the automatic
+    control sets it (its points are many and a suspect one is a wrong match far more often than a sign of a
+    deformed block: 4 of 101 flagged, the worst 1.54 m off, were kept and bent the block before)."""
 
     refine_intrinsics: Any = False
     outlier_threshold: float = 5.0
@@ -59,6 +64,7 @@ class GeorefOptions:
     reference_dem: Optional[str] = None
     reference_dem_points: int = 25
     reference_dem_sigma_z: float = 0.0
+    drop_suspect_control: bool = False
 
     @classmethod
     def of(cls, options: Optional["GeorefOptions"] = None, **kwargs: Any) -> "GeorefOptions":

@@ -107,6 +107,17 @@ def check_image_folder(folder: str, what: str = "image folder") -> None:
         raise ImageError(f"{what} {folder} cannot be read (permission denied)")
 
 
+def require_images(folder: str, what: str = "image folder") -> List[str]:
+    """:func:`list_images`, ImageError when the folder holds none (before a workspace is created for it)."""
+    names = list_images(folder)
+    if not names:
+        others = [n for n in os.listdir(folder) if not n.startswith(".")]
+        raise ImageError(f"{what} {folder} holds no readable images ({', '.join(IMAGE_EXTENSIONS)})"
+                         + (f": its {len(others)} entries are other files or folders (e.g. {others[0]})" if others
+                            else ": it is empty") + "; give the folder that holds the photos")
+    return names
+
+
 def list_images(folder: str) -> List[str]:
     """Names (relative to ``folder``) of files with an image extension, sorted; no recursion."""
     check_image_folder(folder)

@@ -15,6 +15,7 @@ import numpy as np
 from ..common import parallel
 from ..common.files import owned_tempdir
 from ..common.progress import NullProgress, Progress, SubProgress
+from ..geometry.crs import unit_symbol
 from ..io import raster as dsmmod
 from .block import _check_kind, _Prepared, prepare_block, write_camera_ortho
 from .cameras import OrthoCamera
@@ -96,8 +97,9 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
             bands, dtype = _check_kind(prep.metas, prep.cameras)
             grid = prep.grid
             timings["visibility"] = time.time() - t0
-            log.append(f"{len(prep.cameras)} images, GSD {prep.gsd:.3f}, mosaic {grid.width} x {grid.height} cells "
-                       f"at {grid.resolution:g} ({bands} band(s) {dtype}), blending {options.blending}")
+            unit = unit_symbol(crs)
+            log.append(f"{len(prep.cameras)} images, GSD {prep.gsd:.3f} {unit}, mosaic {grid.width} x {grid.height} "
+                       f"cells at {grid.resolution:g} {unit} ({bands} band(s) {dtype}), blending {options.blending}")
             progress.info(log[-1])
             t0 = time.time()
             plan = _plan_mosaic(prep, dsm, offset, options, workdir, SubProgress(progress, 0.12, 0.2), edits)

@@ -56,7 +56,8 @@ def edits_fingerprint(source: str) -> str:
     return (file_fingerprint(path) + (f"|{layer}" if layer else "")) if os.path.isfile(path) else ""
 
 
-def _match_name(value: str, names: Sequence[str], where: str) -> str:
+def _find(value: str, names: Sequence[str]) -> Optional[str]:
+    """``value`` among ``names``: as it is, in another case, or by its stem when only one has it."""
     if value in names:
         return value
     low = {n.lower(): n for n in names}
@@ -66,8 +67,19 @@ def _match_name(value: str, names: Sequence[str], where: str) -> str:
     for n in names:
         stems.setdefault(os.path.splitext(n)[0].lower(), []).append(n)
     hit = stems.get(os.path.splitext(value)[0].lower(), [])
-    if len(hit) == 1:
-        return hit[0]
+    return hit[0] if len(hit) == 1 else None
+
+
+def _match_name(value: str, names: Sequence[str], where: str, left_out: Sequence[str] = (),
+                images_filter: Optional[str] = None) -> str:
+    hit = _find(value, names)
+    if hit is not None:
+        return hit
+    out = _find(value, left_out)
+    if out is not None:
+        raise SeamlineError(f"{where} names the image {out!r}, which IMAGES_FILTER {images_filter or ''!r} leaves "
+                            "out of this mosaic: add it to the filter, or give the polygon one of the images the "
+                            "mosaic is made of")
     close = difflib.get_close_matches(value, list(names), n=3, cutoff=0.5)
     hint = (f"did you mean {', '.join(repr(c) for c in close)}?" if close else
             f"the mosaic's images are {', '.join(list(names)[:8])}{' ...' if len(names) > 8 else ''}")
@@ -79,8 +91,12 @@ def _check_crs(path: str, lyr, crs: Optional[str]) -> None:
     from osgeo import osr
 
     srs = lyr.GetSpatialRef()
-    if srs is None or not crs:
+    if not crs:
         return
+    if srs is None:  # the polygons were ignored: placed nowhere near the mosaic, or in another CRS's numbers
+        raise SeamlineError(f"seamlines {path}: the layer's CRS is unknown (a shapefile without its .prj file?), so "
+                            f"its polygons cannot be placed on the mosaic in {crs}: save the layer with the "
+                            f"mosaic's CRS ({crs}), or edit the seamlines GeoPackage the mosaic wrote")
     want = osr.SpatialReference()
     want.SetFromUserInput(crs)
     if not srs.IsSame(want):
@@ -91,9 +107,11 @@ def _check_crs(path: str, lyr, crs: Optional[str]) -> None:
                             f"the mosaic's CRS (save the layer in {crs}, or edit the seamlines the mosaic wrote)")
 
 
-def read_seamline_edits(source: str, names: Sequence[str], crs: Optional[str]) -> SeamlineEdits:
+def read_seamline_edits(source: str, names: Sequence[str], crs: Optional[str], left_out: Sequence[str] = (),
+                        images_filter: Optional[str] = None) -> SeamlineEdits:
     """The polygons of an edited seamlines layer (``source``: a file path, or 'path|layername=...'), checked
-    against the mosaic's image ``names`` and ``crs``.  SeamlineError naming the file and the problem."""
+    against the mosaic's image ``names`` and ``crs``.  SeamlineError naming the file and the problem (an image
+    of ``left_out``: left out by ``images_filter``)."""
     from osgeo import ogr
 
     gdal = _gdal()
@@ -135,7 +153,8 @@ def read_seamline_edits(source: str, names: Sequence[str], crs: Optional[str]) -
             flat = ogr.GT_Flatten(geom.GetGeometryType())
         if flat not in (ogr.wkbPolygon, ogr.wkbMultiPolygon):
             raise SeamlineError(f"{where}: feature {feat.GetFID()} is a {geom.GetGeometryName()}, not a polygon")
-        out.polygons.append((_match_name(value, names, f"{where}, feature {feat.GetFID()},"), bytes(geom.ExportToWkb())))
+        name = _match_name(value, names, f"{where}, feature {feat.GetFID()},", left_out, images_filter)
+        out.polygons.append((name, bytes(geom.ExportToWkb())))
     return out
 
 

@@ -18,7 +18,7 @@ from ..project.workspace import Workspace
 from .cameras import OrthoCamera, cameras_from_reconstruction, select_cameras
 from .mosaic import WORK_PREFIX, build_orthomosaic
 from .options import OrthoError, OrthoOptions
-from .seamlines import edits_fingerprint
+from .seamlines import edits_fingerprint, read_seamline_edits
 
 STAGE = ORTHOPHOTO
 
@@ -74,6 +74,9 @@ def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = Non
     if options.seamlines_in:  # edited seamlines (SEAMLINES_IN): a changed file re-runs the stage
         inputs["seamlines_in"] = edits_fingerprint(options.seamlines_in)
     with run_stage(lay.ws, STAGE, params, inputs) as run:
+        if options.seamlines_in:  # before any work: a polygon naming an image the filter leaves out is named so
+            read_seamline_edits(options.seamlines_in, [c.name for c in cams], crs,
+                                left_out=_left_out(lay, cams), images_filter=images_filter)
         for debris in clean_debris(os.path.dirname(output), WORK_PREFIX):
             progress.info(f"removed {debris}, left by a killed run")
         result = build_orthomosaic(cams, dsm_path, crs, offset, output, options, per_image_folder, seamlines, progress)
@@ -91,6 +94,13 @@ def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = Non
     return OrthoStageResult(lay.root, output, crs, result.resolution, result.images, result.valid_fraction,
                             per_image_folder, seamlines, result.timings, result.warnings, result.log_lines,
                             result.radiometry)
+
+
+def _left_out(lay: Layout, cams: List[OrthoCamera]) -> List[str]:
+    """The oriented images of the model that IMAGES_FILTER left out of the mosaic."""
+    chosen = {c.name for c in cams}
+    rec, _ = lay.load_georef_model()
+    return sorted(rec.image(i).name for i in rec.reg_image_ids() if rec.image(i).name not in chosen)
 
 
 def _check_photos(ws: Workspace, cams: List[OrthoCamera]) -> List[str]:

@@ -213,12 +213,21 @@ class Workspace:
     def stage(self, name: str) -> Dict[str, Any]:
         return self.data["stages"].get(name, {"status": PENDING})
 
+    def require_writable(self) -> None:
+        """WorkspaceError naming the folder when it cannot be written (read-only, another user's): the one check
+        every stage makes before its work (``begin_stage``; the automatic control and the pipeline call it
+        first, as they work before their stages begin)."""
+        check_writable(self.root)
+
     def stage_done(self, name: str) -> bool:
         return self.stage(name).get("status") == DONE
 
     def begin_stage(self, name: str, parameters: Dict[str, Any], inputs: Optional[Dict[str, str]] = None) -> None:
         """Record ``name`` running in this process (its owner: host, pid, process start).  Refuses while another
-        live process runs the same stage; otherwise the partial files of killed runs go first."""
+        live process runs the same stage; otherwise the partial files of killed runs go first.  A workspace that
+        cannot be written is refused here, before the stage's work (issue 36 item 13: a read-only one failed after
+        it)."""
+        self.require_writable()
         with self.locked():
             self._merge_from_disk()
             self._begin_stage(name, parameters, inputs)
@@ -407,4 +416,5 @@ def check_writable(folder: str) -> None:
         os.close(fd)
         os.unlink(tmp)
     except OSError as e:
-        raise WorkspaceError(f"workspace folder {folder} is not writable: {e.strerror or e}") from e
+        raise WorkspaceError(f"workspace folder {folder} is not writable ({e.strerror or e}): nothing was done; "
+                             "make it writable, or copy the workspace to a folder you can write") from e

@@ -9,7 +9,7 @@ import os
 from typing import Any, Dict, List, Optional, Sequence
 
 from .context import ReportContext
-from .html import badge, duration, esc, esc_json, fmt
+from .html import badge, duration, esc, esc_json, fmt, num
 
 # the plugin folder (metadata.txt holds the version)
 _PLUGIN_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -86,26 +86,33 @@ def cards(fig: Dict[str, Any], georef: bool) -> str:
     if fig.get("ASPRS_2014_H_CLASS_CM") is not None:
         add("ASPRS 2014 horizontal class", fmt(fig["ASPRS_2014_H_CLASS_CM"], 1, "cm"))
     if fig.get("CAMERA_RMSE_XY") is not None:
-        add("camera position RMSE XY", fmt(fig["CAMERA_RMSE_XY"], 2, "m"))
+        add("camera position RMSE XY (the block's fit to the positions)", fmt(fig["CAMERA_RMSE_XY"], 2, "m"))
     if fig.get("POINT_STD_XY_MEDIAN") is not None and georef:
-        add("tie point σXY / σZ (median)", f"{fmt(fig['POINT_STD_XY_MEDIAN'], 3)} / "
-                                            f"{fmt(fig.get('POINT_STD_Z_MEDIAN'), 3)} m")
+        add("tie point σXY / σZ (median; predicted ground uncertainty, datum included)",
+            f"{fmt(fig['POINT_STD_XY_MEDIAN'], 3)} / {fmt(fig.get('POINT_STD_Z_MEDIAN'), 3)} m")
     if fig.get("DSM_VALID_FRACTION") is not None:
         add("DSM valid fraction", fmt(fig["DSM_VALID_FRACTION"], 3))
     return '<div class="cards">' + "".join(cards) + "</div>"
 
 
-def precision_badge(unc, gsd: Optional[float]) -> str:
-    """Green when the tie points' median sigma XY is within 3 GSD, amber (with the likely reason) beyond."""
+def precision_badge(unc, gsd: Optional[float], camera_rmse: Optional[float] = None) -> str:
+    """Green when the tie points' median sigma XY is within 3 GSD, amber (with the likely reason) beyond; with
+    camera positions, what each figure measures (issue 36 item 21: a σ of 10.8 m beside a camera RMSE of 0.54 m
+    read as a contradiction)."""
     s = unc.summary()
     sxy, sz = s["point_std_xy_median"], s["point_std_z_median"]
     txt = f"precision from the adjustment: tie points σXY {fmt(sxy, 3)} m, σZ {fmt(sz, 3)} m (median)"
+    if camera_rmse is not None and sxy is not None:
+        txt += (f". σ is how uncertain the ground points' position is, the datum included: the whole block may "
+                "shift and tilt within the camera positions' stated accuracy; the camera position RMSE "
+                f"({camera_rmse:.2f} m) is how closely the block fits those positions, which says nothing of "
+                "their own error")
     if sxy is None or gsd is None or sxy <= 3 * gsd:
         return badge("ok", esc(txt))
     why = (" — the datum is weak: positions of limited accuracy (e.g. EXIF GPS) leave the block free to shift and "
            "tilt; add ground control points" if not unc.n_control else
            " — the control does not hold the block well (too few or badly spread control points)")
-    return badge("warn", esc(txt + f", more than 3 × the GSD ({gsd:.3f} m)" + why))
+    return badge("warn", esc(txt + f"; more than 3 × the GSD ({gsd:.3f} m)" + why))
 
 
 def glance_lines(ctx: ReportContext, figures: Dict[str, Any], status: Dict[str, str]) -> List[str]:
@@ -119,7 +126,7 @@ def glance_lines(ctx: ReportContext, figures: Dict[str, Any], status: Dict[str, 
     else:
         lines.insert(0, badge("bad", "no aligned model: run 'Align images'"))
     if ctx.unc is not None and ctx.d.georeferenced:
-        lines.append(precision_badge(ctx.unc, ctx.gsd))
+        lines.append(precision_badge(ctx.unc, ctx.gsd, num(figures.get("CAMERA_RMSE_XY"))))
     if status.get("products") != "ok":
         lines.append(badge("note", "no DSM / orthomosaic yet"))
     return lines

@@ -30,7 +30,7 @@ from ...common.errors import require
 from ...common.progress import NullProgress, Progress, check_cancel
 from ...geometry import resection as rs
 from ...geometry.camera import Intrinsics, Pose, project_points
-from ...geometry.crs import transform_points
+from ...geometry.crs import transform_points, unit_symbol
 from ...io import gcp as gcpmod
 from ...io.images import read_image, to_grey
 from .errors import AutoControlError
@@ -389,7 +389,8 @@ def _control(image_path, ref: Reference, location, search_radius, location_crs, 
     win = _window(ref, box, res)
     h, src, dst, counts, f_win = _first_match(photo, win, opt, ref, where)
     messages.append(f"{photo.name}: {counts['ratio_matches']} ratio-test matches with {os.path.basename(ref.ortho_path)}"
-                    f" at {res:.3g} per pixel, {counts['homography_inliers']} agree on one view (homography)")
+                    f" at {res:.3g} {unit_symbol(ref.crs_wkt)} per pixel, {counts['homography_inliers']} agree on one "
+                    "view (homography)")
     progress.report(0.3, "first match")
     check_cancel(progress)
     if camera is None and focal_px:

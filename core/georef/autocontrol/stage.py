@@ -21,7 +21,7 @@ import numpy as np
 
 from ...common.files import remove_path
 from ...common.progress import NullProgress, Progress, SubProgress
-from ...geometry.crs import linear_unit, transform_points
+from ...geometry.crs import linear_unit, transform_points, unit_symbol
 from ...geometry.similarity import Similarity
 from ...io.gcp import CHECK, CONTROL, CameraPosition, GCPSet, GroundPoint
 from ...project.layout import Layout, write_json
@@ -230,7 +230,8 @@ def find_candidates(ws: Workspace, rec, reference: Reference, prior: str = PRIOR
     ref, valid, gt = reference.grey(box, g)
     ms = match_orthos(prov.grey, prov.valid, ref, valid, opt)
     t["matching"] = time.time()
-    messages.append(f"matching at {g:.3g} per pixel: {ms.n_features[0]} / {ms.n_features[1]} features, "
+    messages.append(f"matching at {g:.3g} {unit_symbol(reference.crs_wkt)} per pixel: {ms.n_features[0]} / "
+                    f"{ms.n_features[1]} features, "
                     f"{ms.n_found} matches, {ms.n_similarity} fit one similarity, {len(ms.src)} fit their tiles")
     sel = spread(ms.src, ms.residual, opt.max_candidates, prov.grey.shape)
     world_xy = np.column_stack([gt[0] + (ms.dst[sel, 0] + 0.5) * gt[1], gt[3] + (ms.dst[sel, 1] + 0.5) * gt[5]])
@@ -272,6 +273,7 @@ def autocontrol_workspace(workspace_dir: str, reference_ortho: str, reference_ds
     opt = AutoControlOptions.of(options)
     progress = progress or NullProgress()
     ws = Workspace.open(workspace_dir)
+    ws.require_writable()  # before the matching: a read-only workspace failed after it
     lay = Layout(ws)
     if not lay.has_aligned_model():
         raise AutoControlError(f"workspace {ws.root} has no aligned model: run 'Align images' first")
@@ -304,14 +306,24 @@ def autocontrol_workspace(workspace_dir: str, reference_ortho: str, reference_ds
     gcps.points.extend(_checks_in(check_points, crs))
     t1 = time.time()
     refine = georef_options.refine_intrinsics if georef_options is not None else opt.refine_intrinsics
-    res = georeference_workspace(ws.root, gcps=gcps, crs=crs, options=georef_options, refine_intrinsics=refine,
-                                 progress=SubProgress(progress, 0.7, 1.0))
+    # suspect automatic GCPs (the adjustment's consistency check) are dropped, not only named (issue 36 item 18)
+    res = georeference_workspace(ws.root, gcps=gcps, crs=crs,
+                                 options=GeorefOptions.of(georef_options, drop_suspect_control=True),
+                                 refine_intrinsics=refine, progress=SubProgress(progress, 0.7, 1.0))
     remove_path(lay.autocontrol_failed_json)
     timings["adjustment"] = time.time() - t1
     timings["total"] = time.time() - t0
     n_used = _count_used(lay, {c.name for c in kept})
+    suspects = _suspects_dropped(lay, {c.name for c in kept})
     figures["kept"] = n_used
+    figures["suspect_dropped"] = len(suspects)
     msg = f"automatic control: {n_used} of {len(kept)} automatic GCPs kept by the adjustment"
+    if suspects:
+        msg += (f", {len(suspects)} suspect dropped (they disagree with the others through the block: "
+                + ", ".join(f"{n} {r:.2f} m" for n, r in suspects[:6]) + (" ..." if len(suspects) > 6 else "") + ")")
+    others = len(kept) - n_used - len(suspects)
+    if others > 0:
+        msg += f", {others} rejected as outliers by the adjustment"
     progress.info(msg)
     messages.append(msg)
     doc.update(figures=figures, messages=messages, timings=timings)
@@ -342,6 +354,16 @@ def _coarse_hint(figures: Dict, g: float, opt: AutoControlOptions) -> str:
     return (f": the reference is too coarse for a block this small (the block spans {px:.0f} of its pixels, the "
             f"match ran at {g:.3g} per pixel; a reference with cells {opt.tile_px / px:.1f} x finer, or a larger "
             "block, gives enough matches)")
+
+
+def _suspects_dropped(lay: Layout, names) -> List[tuple]:
+    """(name, metres off) of the automatic GCPs the adjustment's consistency check dropped as suspect, worst first."""
+    res = lay.residuals() or {}
+    cc = (res.get("statistics") or {}).get("control_consistency") or {}
+    rejected = {r.get("name") for r in res.get("points", []) if r.get("status") == "rejected"}
+    off = cc.get("residuals_m") or {}
+    return sorted(((n, float(off.get(n, float("nan")))) for n in cc.get("suspects") or []
+                   if n in names and n in rejected), key=lambda t: -t[1])
 
 
 def _count_used(lay: Layout, names) -> int:
