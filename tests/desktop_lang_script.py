@@ -2,6 +2,8 @@
 default sizes and a workspace opened in the GCP dock, as a new user meets them; a screenshot of the window.
 
 Driven by tests/test_ui_dock_layout.py (test_qgis_desktop_lang_de); writes log.json and screen.png to $AO_OUT.
+With AO_PROCESSING_DOCKS=1 the Processing Toolbox and Results Viewer are shown first (docked on the right, where
+the GCP dock goes too: issue 36 item 20).
 """
 import json
 import os
@@ -47,6 +49,10 @@ def start():
     log["icon_on_plugins_toolbar"] = p.action in bar.actions()
     w = bar.widgetForAction(p.action)
     log["icon_shown"] = bool(w is not None and w.isVisible())
+    if os.environ.get("AO_PROCESSING_DOCKS"):
+        processing = plugins["processing"]
+        for dock in (processing.toolbox, processing.resultsDock):
+            dock.setUserVisible(True)
     QTimer.singleShot(1500, click)
 
 
@@ -73,6 +79,10 @@ def look():
     log["dock"] = [d.width(), d.height()]
     log["photo_dock"] = [d.photo_dock.width(), d.photo_dock.height()]
     log["photo_view_height"] = d.photo_panel.view.height()
+    log["screen"] = [QApplication.primaryScreen().size().width(), QApplication.primaryScreen().size().height()]
+    log["dock_minimum_height"] = d.minimumSizeHint().height()
+    log["georef_row_bottom"] = max(w.mapToGlobal(w.rect().bottomLeft()).y() for w in (d.btn_georef, d.btn_cancel))
+    log["georef_row_visible"] = d.btn_georef.isVisible() and d.btn_cancel.isVisible()
     hidden = []
     for bar in d.findChildren(QToolBar):
         ext = bar.findChild(QToolButton, "qt_toolbar_ext_button")

@@ -573,10 +573,9 @@ def test_gui_thread_times_of_open_results_and_georeference(default_dock, georef_
 
 
 @pytest.mark.slow
-def test_qgis_desktop_lang_de(georef_ws, tmp_path):
-    """`qgis --lang de` under Xvfb, a copy of the test profile (QGIS writes the language into it): the plugin
-    speaks German, its icon is on the (visible) Plugins toolbar, and a click on it opens the docks at their
-    default sizes with nothing hidden.  The screenshot goes to docs/screenshots/qgis-desktop-de.png."""
+def _qgis_desktop(georef_ws, tmp_path, lang, **env_extra):
+    """QGIS desktop under Xvfb on a 1366 x 768 screen running tests/desktop_lang_script.py: its log and the path
+    of its screenshot."""
     import json
     import shutil
     import subprocess
@@ -595,13 +594,24 @@ def test_qgis_desktop_lang_de(georef_ws, tmp_path):
     env = dict(os.environ)
     env.pop("QT_QPA_PLATFORM", None)
     env.update(AO_OUT=str(out), AO_WORKSPACE=georef_ws, QGIS_PLUGINPATH=PLUGINS, QGIS_CUSTOM_CONFIG_PATH=str(profile),
-               PYTHONPATH=os.pathsep.join([sysconfig.get_paths()["purelib"], env.get("PYTHONPATH", "")]))
+               PYTHONPATH=os.pathsep.join([sysconfig.get_paths()["purelib"], env.get("PYTHONPATH", "")]), **env_extra)
     script = os.path.join(ROOT, "tests", "desktop_lang_script.py")
-    subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1366x768x24", "qgis", "--lang", "de", "--nologo",
+    subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1366x768x24", "qgis", "--lang", lang, "--nologo",
                     "--noversioncheck", "--code", script], env=env, capture_output=True, timeout=300)
     log = json.load(open(out / "log.json"))
-    print(f"\n[qgis --lang de] {json.dumps(log, ensure_ascii=False)}")
     assert "error" not in log, log.get("error")
+    return log, out / "screen.png"
+
+
+def test_qgis_desktop_lang_de(georef_ws, tmp_path):
+    """`qgis --lang de` under Xvfb, a copy of the test profile (QGIS writes the language into it): the plugin
+    speaks German, its icon is on the (visible) Plugins toolbar, and a click on it opens the docks at their
+    default sizes with nothing hidden.  The screenshot goes to docs/screenshots/qgis-desktop-de.png."""
+    import json
+    import shutil
+
+    log, screen = _qgis_desktop(georef_ws, tmp_path, "de")
+    print(f"\n[qgis --lang de] {json.dumps(log, ensure_ascii=False)}")
     assert "archaeoortho" in log["plugins"] and log["translator"]
     assert log["icon_on_plugins_toolbar"] and log["plugins_toolbar_visible"] and log["icon_shown"]
     assert log["texts"]["open"] == "Öffnen…" and log["texts"]["new"] == "Neu aus Fotos…"
@@ -611,7 +621,24 @@ def test_qgis_desktop_lang_de(georef_ws, tmp_path):
     assert log["photo_view_height"] >= 180
     assert log["window"][0] <= 1366 and log["window"][1] <= 768  # the docks' minimum sizes fit the screen
     os.makedirs(SHOTS, exist_ok=True)
-    shutil.copyfile(out / "screen.png", os.path.join(SHOTS, "qgis-desktop-de.png"))
+    shutil.copyfile(screen, os.path.join(SHOTS, "qgis-desktop-de.png"))
+
+
+def test_qgis_desktop_with_the_toolbox_and_results_viewer(georef_ws, tmp_path):
+    """QGIS itself on a 768 px screen with the Processing Toolbox and Results Viewer shown (docked on the right,
+    as QGIS puts them) before the GCP dock: the main window stays within the screen and the Georeference / Cancel
+    row is on it (the dock made the window 1057 px tall on a 1000 px screen: issue 36 item 20)."""
+    import json
+    import shutil
+
+    log, screen = _qgis_desktop(georef_ws, tmp_path, "en", AO_PROCESSING_DOCKS="1")
+    print(f"\n[qgis, Toolbox + Results Viewer] {json.dumps({k: log.get(k) for k in ('screen', 'window', 'dock', 'dock_minimum_height', 'georef_row_bottom', 'georef_row_visible')})}")
+    shot = os.path.join(ROOT, "build", "screenshots", "ui", "qgis-desktop-768-processing-docks.png")
+    os.makedirs(os.path.dirname(shot), exist_ok=True)
+    shutil.copyfile(screen, shot)
+    assert log["window"][1] <= log["screen"][1] == 768
+    assert log["georef_row_visible"] and log["georef_row_bottom"] < log["screen"][1]
+    assert log["texts"]["georef"] == "Georeference"
 
 
 def test_open_button_reads_the_block_model_in_a_task(default_dock, georef_ws, monkeypatch):
@@ -726,6 +753,14 @@ def test_dock_fits_a_768_px_screen_beside_the_toolbox_and_results_viewer(qgis_ca
         d.body_scroll.ensureWidgetVisible(d.auto_box)
         process(50)
         assert not d.auto_box.visibleRegion().isEmpty()
+        folded = d.auto_box.height()  # unticked: its title only; ticked: the reference boxes under it
+        d.auto_box.setChecked(True)
+        process(50)
+        assert d.auto_ortho_combo.isVisible() and d.auto_dsm_combo.isVisible()
+        assert d.auto_box.height() >= folded + 2 * d.auto_ortho_combo.height()
+        d.auto_box.setChecked(False)
+        process(50)
+        assert not d.auto_ortho_combo.isVisible() and d.auto_box.height() == folded
         shot = os.path.join(ROOT, "build", "screenshots", "ui", "gcp-dock-768.png")
         os.makedirs(os.path.dirname(shot), exist_ok=True)
         assert win.grab().save(shot)
@@ -763,7 +798,7 @@ def test_a_long_message_wraps_and_scrolls_and_leaves_the_table_alone(default_doc
     assert status.verticalScrollBar().maximum() > 0  # the rest is there, scrolled to
     rows = dock.table.verticalHeader().defaultSectionSize()
     assert dock.table.height() >= TABLE_MIN_ROWS * rows
-    assert dock.table.height() >= table_height - 2 * status.fontMetrics().lineSpacing()
+    assert dock.table.height() >= table_height - STATUS_LINES * status.fontMetrics().lineSpacing()  # bounded
 
 
 def test_the_diagnosis_is_shown_whole(default_dock, georef_ws):

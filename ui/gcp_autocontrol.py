@@ -67,6 +67,8 @@ class GcpAutoControl:
     def _autocontrol_toggled(self, on):
         """Unticked, the box folds to its title: the combos and their labels take no room (issue 36 item 20)."""
         form = self.auto_box.layout()
+        # folded: the title's line alone (the style draws the box's empty frame under it otherwise)
+        self.auto_box.setMaximumHeight(16777215 if on else self.auto_box.fontMetrics().height() + 6)
         for w in (self.auto_ortho_combo, self.auto_dsm_combo):
             w.setVisible(bool(on))
             label = form.labelForField(w)
