@@ -5,7 +5,8 @@ by a 640 x 480 pinhole camera from a grid of nadir shots and a few obliques.  Th
 homography of the texture (rendered 2x supersampled, then averaged), so the truth of a target's centre is its
 projection.  One target is covered by an occluder in one photo; targets cut by a photo's border are there
 naturally.  ``visible`` says, per photo, which targets a machine should find: whole in the frame (with a margin
-of a tenth of the target) and not covered.
+of a pixel), not covered, and at least ``MIN_SIDE_PX`` on its shortest side (``small`` lists the
+whole ones under that: the far side of the obliques, 12 px markers whose cells are 2 px).
 
 The aligned model is built from the truth (poses, camera, tie points on the plane), moved into an arbitrary
 model frame (a similarity), as an alignment would give it.
@@ -24,6 +25,7 @@ SLOPE = (0.03, -0.02)  # ground z = a x + b y
 OFFSET = np.array([500000.0, 4000000.0, 100.0])  # local -> world (EPSG:32611)
 SIZE = 0.5  # target side (m)
 W, H, F = 640, 480, 560.0
+MIN_SIDE_PX = 20.0  # a target whose shortest side is smaller in a photo is not asked for (the far side of obliques)
 
 
 @dataclass
@@ -47,6 +49,8 @@ class Scene:
     truth: Dict[str, Dict[str, Tuple[float, float]]] = field(default_factory=dict)  # image -> name -> px
     visible: Dict[str, List[str]] = field(default_factory=dict)
     occluded: List[Tuple[str, str]] = field(default_factory=list)
+    small: List[Tuple[str, str]] = field(default_factory=list)  # whole but under MIN_SIDE_PX: not asked for
+    cut: List[Tuple[str, str]] = field(default_factory=list)  # the target's central half not all in the photo
 
 
 def _targets(seed: int) -> List[Target]:
@@ -152,19 +156,28 @@ def render(folder: str, seed: int = 5) -> Scene:
         scene.truth[name], scene.visible[name] = {}, []
         for t in targets:
             c = project(rot, centre, [[t.x, t.y, t.z]])[0]
-            half = 0.6 * SIZE
+            half = 0.5 * SIZE
             corners = project(rot, centre, [[t.x + dx, t.y + dy, t.z + SLOPE[0] * dx + SLOPE[1] * dy]
                                             for dx in (-half, half) for dy in (-half, half)])
             scene.truth[name][t.name] = (float(c[0]), float(c[1]))
-            whole = bool(np.all((corners >= 0) & (corners <= [W, H])))
+            whole = bool(np.all((corners >= 1) & (corners <= [W - 1, H - 1])))
             if whole and not scene.occluded and k >= 1:
-                # the first whole target of the second photo gets a pole across its centre
+                # the first whole target of the second photo gets a pole laid over its centre from one side
                 x, y = int(c[0]), int(c[1])
-                img[y - 3:y + 4, max(0, x - 30):x + 30] = 90.0
+                img[y - 3:y + 4, max(0, x - 40):x + 4] = 90.0
                 scene.occluded.append((name, t.name))
                 continue
-            if whole:
+            quad = corners[[0, 1, 3, 2]]
+            side = min(np.linalg.norm(quad - np.roll(quad, 1, axis=0), axis=1))
+            if whole and side >= MIN_SIDE_PX:
                 scene.visible[name].append(t.name)
+            elif whole:
+                scene.small.append((name, t.name))
+            else:
+                inner = project(rot, centre, [[t.x + dx, t.y + dy, t.z + SLOPE[0] * dx + SLOPE[1] * dy]
+                                              for dx in (-SIZE / 4, SIZE / 4) for dy in (-SIZE / 4, SIZE / 4)])
+                if not np.all((inner >= 0) & (inner <= [W, H])):
+                    scene.cut.append((name, t.name))
         path = os.path.join(folder, name)
         cv2.imwrite(path, np.clip(img, 0, 255).astype(np.uint8))
         scene.photos[name] = path

@@ -1,55 +1,127 @@
-"""Find targets (issue 34): the detectors against a rendered block's truth, and the targets file's errors.
+"""Find targets (issue 34): surveyed coordinates in, sub-pixel observations out, against a rendered block's truth.
 
 The block (tests/targets_scene.py) is a tilted ground plane with checkerboard, circular and ArUco targets seen from
-nadir and oblique shots; one target is covered by a pole in one photo, others are cut by photo borders.  What is
-asserted here is what the detectors achieve today; the whole chain (ties, constellation, names) is not yet asserted
-(see the issue's report: the constellation match still refuses the synthetic block as ambiguous).
+nadir and oblique shots, in an arbitrary model frame (no GPS, no click); one target is covered by a pole laid over
+its centre in one photo, others run out of photos at the border.  Find targets must find the targets each photo
+shows whole (recall >= 95 %), give no wrong name, be within 0.3 px of the truth, and find nothing of a target
+covered or cut by the border.
 """
 import math
+import os
+import types
 
 import numpy as np
 import pytest
 
+from core.georef.targets import constellation
 from core.georef.targets.detect import detect_image
+from core.georef.targets.options import FindTargetsOptions
+from core.georef.targets.stage import code_names, find_targets
 from core.io import gcp as gcpmod
+from core.project.layout import Layout, LayoutError
+from core.project.workspace import Workspace
 from tests import targets_scene
+from tests.workspaces import synthetic_workspace
 
 
 @pytest.fixture(scope="module")
-def scene(tmp_path_factory):
-    return targets_scene.render(str(tmp_path_factory.mktemp("targets") / "photos"))
+def block(tmp_path_factory):
+    root = tmp_path_factory.mktemp("targets")
+    scene = targets_scene.render(str(root / "photos"))
+    rec = targets_scene.reconstruction(scene)
+    names = [s[0] for s in scene.shots]
+    fake = types.SimpleNamespace(camera=types.SimpleNamespace(width=targets_scene.W, height=targets_scene.H),
+                                 names=names)
+    ws = synthetic_workspace(str(root / "ws"), fake, rec, photos=scene.photos)
+    csv = targets_scene.write_targets_csv(scene, str(root / "targets.csv"))
+    result = find_targets(ws, csv, FindTargetsOptions(num_threads=2))
+    return scene, ws, csv, result
 
 
-def _errors(scene, kind):
+def _error(scene, o):
+    tx, ty = scene.truth[o.image][o.name]
+    return math.hypot(o.x - tx, o.y - ty)
+
+
+def test_targets_are_found_named_and_placed_to_sub_pixel_without_a_prior(block):
+    scene, _, _, r = block
+    visible = {(i, n) for i, v in scene.visible.items() for n in v}
+    found = {(o.image, o.name): o for o in r.observations}
+    assert len(visible) >= 25  # whole, large enough: the nadir shots and the near side of the obliques
+    hits = visible & set(found)
+    assert len(hits) >= 0.95 * len(visible), sorted(visible - set(found))
+    for o in r.observations:  # no wrong name: every observation at its own target's truth
+        nearest = min(scene.truth[o.image], key=lambda n: math.hypot(o.x - scene.truth[o.image][n][0],
+                                                                      o.y - scene.truth[o.image][n][1]))
+        assert nearest == o.name and _error(scene, o) < 1.5, (o, nearest, _error(scene, o))
+    for kind in ("checkerboard", "circle", "aruco"):
+        e = [_error(scene, found[k]) for k in hits if found[k].kind == kind]
+        assert len(e) >= 5, kind
+        assert math.sqrt(np.mean(np.square(e))) <= 0.3 and max(e) <= 0.5, (kind, e)
+    # a target covered at its centre, or whose central half runs out of the photo, is left out, not guessed
+    assert scene.occluded and not set(scene.occluded) & set(found)
+    edge = [k for k in scene.cut if all(-10 < v < 650 for v in scene.truth[k[0]][k[1]])]
+    assert len(edge) >= 3 and not set(scene.cut) & set(found)
+    assert r.n_targets == len(scene.targets) and not r.mirrored and not r.reports
+
+
+def test_the_observations_file_is_what_georeference_reads(block):
+    scene, ws, csv, r = block
+    lay = Layout(Workspace.open(ws))
+    assert r.gcps_path == lay.targets_gcp_list and os.path.isfile(r.layer_path)
+    gs = gcpmod.read_gcps(r.gcps_path, image_names=list(scene.photos))
+    assert gs.n_observations() == r.n_observations and gs.crs == r.crs
+    assert {p.name for p in gs.points} == {t.name for t in scene.targets}
+    survey = gcpmod.read_target_coordinates(csv)
+    for p in gs.points:  # the surveyed coordinates travel unchanged
+        q = survey.by_name(p.name)
+        assert (p.x, p.y, p.z) == (q.x, q.y, q.z)
+    assert all(0.0 < o.quality <= 1.0 and o.found for o in r.observations)
+
+
+@pytest.mark.parametrize("kind", ["checkerboard", "circle", "aruco"])
+def test_each_detector_alone_is_within_a_third_of_a_pixel(block, kind):
+    scene = block[0]
     kinds = {t.name: t.kind for t in scene.targets}
-    found, errors, occluded = 0, [], 0
+    errors = []
     for name, path in scene.photos.items():
         cands = detect_image(name, path, ("checkerboard", "circle", "cross"), ("DICT_4X4_50",), 8, 0.2)
         for tn in scene.visible[name]:
-            if kinds[tn] != kind:
-                continue
-            tx, ty = scene.truth[name][tn]
-            d = [math.hypot(c.x - tx, c.y - ty) for c in cands if c.kind == kind]
-            found += 1
-            errors.append(min(d) if d and min(d) < 2.0 else None)
-        for im, tn in scene.occluded:
-            if im == name:
+            if kinds[tn] == kind:
                 tx, ty = scene.truth[name][tn]
-                occluded += any(math.hypot(c.x - tx, c.y - ty) < 3.0 for c in cands)
-    return errors, occluded
-
-
-@pytest.mark.parametrize("kind, rms_px, max_px", [("checkerboard", 0.2, 0.3), ("aruco", 0.35, 0.8)])
-def test_targets_whole_in_the_photo_are_found_at_sub_pixel(scene, kind, rms_px, max_px):
-    errors, occluded = _errors(scene, kind)
-    assert len(errors) >= 8  # the block shows each kind whole several times
+                d = [math.hypot(c.x - tx, c.y - ty) for c in cands if c.kind == kind]
+                errors.append(min(d) if d and min(d) < 2.0 else None)
     hits = [e for e in errors if e is not None]
-    assert len(hits) >= 0.95 * len(errors), f"{kind}: {len(hits)} of {len(errors)} found"
-    assert math.sqrt(np.mean(np.square(hits))) <= rms_px and max(hits) <= max_px, hits
-    assert occluded == 0  # the target under the pole is left out, not guessed
+    assert len(errors) >= 5 and len(hits) >= 0.95 * len(errors), errors
+    assert math.sqrt(np.mean(np.square(hits))) <= 0.3, hits
 
 
-def test_targets_file_errors_name_the_file_and_line(tmp_path):
+def test_a_regular_constellation_is_not_named_by_guess():
+    # a 3 x 3 grid of targets: a quarter turn fits as well as the truth, so position alone cannot name them
+    g = np.array([[x, y, 0.0] for x in (0.0, 10.0, 20.0) for y in (0.0, 10.0, 20.0)])
+    rot = np.array([[0.6, -0.8, 0.0], [0.8, 0.6, 0.0], [0.0, 0.0, 1.0]])
+    model = 0.1 * g @ rot.T + [3.0, -2.0, 1.0]
+    m = constellation.match_constellation(model, g + [500000.0, 4000000.0, 0.0], [f"t{k}" for k in range(9)])
+    assert m.names == {} and "no name given" in m.reports[0]
+    # one target off the pattern breaks the symmetry: all named, correctly
+    g2 = np.vstack([g, [[26.0, 3.0, 0.0]]])
+    model2 = 0.1 * g2 @ rot.T + [3.0, -2.0, 1.0]
+    names = [f"t{k}" for k in range(10)]
+    m2 = constellation.match_constellation(model2, g2, names)
+    assert m2.names == {k: names[k] for k in range(10)}, m2.reports
+    # a coded mark whose code names another target is reported, never assigned
+    codes = [None] * 10
+    codes[4] = "t7"
+    m3 = constellation.match_constellation(model2, g2, names, codes)
+    assert 4 not in m3.names and any("coded t7 sits at target t4" in s for s in m3.reports)
+
+
+def test_code_names():
+    assert code_names(["aruco_3", "T07", "12", "base", "x3"]) == {7: "T07", 12: "12"}
+
+
+def test_errors_name_the_file_the_line_and_what_to_do(block, tmp_path):
+    scene, ws, csv, _ = block
     p = tmp_path / "targets.txt"
     p.write_text("235269.88 3811198.11 0.0 gcp02\n")
     with pytest.raises(gcpmod.GCPError, match=r"targets.txt:1: no CRS line .*give the CRS"):
@@ -62,3 +134,12 @@ def test_targets_file_errors_name_the_file_and_line(tmp_path):
     p.write_text("EPSG:32611\n1 2 3 a\n1 2 4 10 20 IMG_1.jpg a\n")
     with pytest.raises(gcpmod.GCPError, match=r"targets.txt:3: target a has coordinates .* on line 2"):
         gcpmod.read_target_coordinates(str(p))
+    q = tmp_path / "no crs.csv"
+    q.write_text("name,x,y,z\na,1,2,3\n")
+    with pytest.raises(gcpmod.GCPError, match="no CRS: give it"):
+        find_targets(ws, str(q))
+    empty = Workspace.create_or_open(str(tmp_path / "not aligned"))
+    with pytest.raises(LayoutError, match="run 'Align images' first"):
+        find_targets(empty.root, csv)
+    with pytest.raises(Exception, match="would be written over the targets file"):
+        find_targets(ws, csv, FindTargetsOptions(output=csv))

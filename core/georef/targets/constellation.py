@@ -2,7 +2,8 @@
 
 Every triangle of marks is compared by shape (its sides' ratios, free of scale) with every triangle of
 targets; each pair of similar triangles gives a similarity (Umeyama, scale free), tried as it is and with the
-survey mirrored (x negated: swapped or flipped axes); the hypothesis that brings the most marks within the
+survey mirrored (x negated: swapped or flipped axes) when it does not fit as given (a planar constellation fits
+its mirror image too, turned over); the hypothesis that brings the most marks within the
 tolerance of a distinct target wins, refitted on them.  A mark is named only when its nearest target is within
 the tolerance and clearly nearer than the next; a coded mark whose code names another target, or a named
 mark left outside the tolerance after the refit, is reported, never assigned.
@@ -114,6 +115,8 @@ def match_constellation(model: np.ndarray, world: np.ndarray, names: Sequence[st
     top = np.argsort(-wts, kind="stable")[:2 * len(world) + 4]
     best, second = None, None
     for mirrored in (False, True):
+        if mirrored and best is not None and len(best[2]) >= min(min_marks, len(world)):
+            break  # the mirror only when the survey as given does not fit: a planar constellation fits both
         w = (world - centre) @ MIRROR.T if mirrored else world - centre
         for mt, wt in _hypotheses(model[top], w, 0.03, 4000, wts[top]):
             mt = top[mt]
@@ -135,7 +138,8 @@ def match_constellation(model: np.ndarray, world: np.ndarray, names: Sequence[st
         out.reports.append(f"no similarity brings {min(min_marks, len(world))} or more of the {len(model)} "
                            f"triangulated marks onto distinct targets within {tol:.3g}: no name given")
         return out
-    if second is not None and _conflict(best[2], second[2]) and second[0][0] >= 0.8 * best[0][0]:
+    margin = 0.5 * float(np.median([wts[i] for i, _ in best[2]]))  # half a typical mark's evidence
+    if second is not None and _conflict(best[2], second[2]) and second[0][0] > best[0][0] - margin:
         out.reports.append(f"two ways of naming the marks fit almost equally well ({best[0][0]:.0f} and "
                            f"{second[0][0]:.0f} tied observations on targets within {tol:.3g}): no name given, "
                            "rather than a wrong one (a regular constellation, or coordinates that disagree with the "
@@ -147,8 +151,8 @@ def match_constellation(model: np.ndarray, world: np.ndarray, names: Sequence[st
 def _mutual(model_w: np.ndarray, world: np.ndarray, taken: Dict[int, Tuple[int, float]], xy_only: bool,
             evidence: np.ndarray) -> Dict[int, Tuple[int, float]]:
     """Beyond the tolerance (a survey or a block off by metres): a well-evidenced mark (tied in three photos or
-    more) and a target that are each other's nearest among the ones left, closer than half the distance to the
-    target's neighbouring target."""
+    more) and a target that are each other's nearest among the ones left, the mark nearer to the target than the
+    target's nearest neighbouring target is (each such naming is reported)."""
     used = {j for j, _ in taken.values()}
     free_m = [i for i in range(len(model_w)) if i not in taken and evidence[i] >= 3]
     free_w = [j for j in range(len(world)) if j not in used]
@@ -161,16 +165,16 @@ def _mutual(model_w: np.ndarray, world: np.ndarray, taken: Dict[int, Tuple[int, 
     out = {}
     for a, i in enumerate(free_m):
         b = int(np.argmin(dist[a]))
-        if int(np.argmin(dist[:, b])) == a and dist[a, b] < 0.75 * nn[free_w[b]]:
+        if int(np.argmin(dist[:, b])) == a and dist[a, b] < nn[free_w[b]]:
             out[i] = (free_w[b], float(dist[a, b]))
     return out
 
 
 def _conflict(a: frozenset, b: frozenset) -> bool:
-    """Two matches give one mark different names, or one name to different marks."""
-    ma, mb = dict(a), dict(b)
-    wa, wb = {j: i for i, j in a}, {j: i for i, j in b}
-    return any(mb.get(i, j) != j for i, j in ma.items()) or any(wb.get(j, i) != i for j, i in wa.items())
+    """Two matches give a mark different names (two marks at one target, the same naming otherwise, is one
+    similarity: not a conflict)."""
+    mb = dict(b)
+    return any(mb.get(i, j) != j for i, j in a)
 
 
 def _refit(out: Constellation, model, world, centre, names, codes, best, xy_only, tol,
