@@ -410,6 +410,7 @@ def relief_name(path):
         from ..core.terrain.options import VISUALISATIONS
 
         label = dict(VISUALISATIONS).get(key, key)
+        label = QCoreApplication.translate("Choices", label)  # as Processing's option (params.option_label)
     except ImportError:  # pragma: no cover
         label = key
     surface = os.path.basename(path).split("-", 1)[0].upper()
