@@ -11,6 +11,11 @@ objects above a local ground estimate, and writes a hillshade PNG of the DSM.
                                [--png PATH] [--point-cloud]
     python benchmarks/dense.py --synthetic 600,1200 [--contrast 0.03]   (seconds per megapixel at two sizes of
                                one synthetic block, quality full; fill and accuracy against the truth)
+    python benchmarks/dense.py --farmland full|small [--contrast 0.15] [--strips 4 --per-strip 10]
+                               [--quality half]   (issue 33: tests/lowtexture_scene.py's farmland, 3600 x 2700
+                               px or the test's 640 x 480: measured / interpolated / removed fractions, blunder
+                               count, RMSE over the fields against the truth; run under /usr/bin/time -v for
+                               the peak RSS)
 """
 import argparse
 import json
@@ -226,11 +231,70 @@ def synthetic(widths, contrast, quality, strips=2, per_strip=6, workers=1):
               f"{100 * r.interpolated_fraction:14.1f}  {med:13.3f}  {rss:12.0f}")
 
 
+def farmland(size, contrast, quality, strips, per_strip, workers):
+    """The DSM stage on tests/lowtexture_scene.py's farmland block against its truth."""
+    from core.common.progress import NullProgress
+    from core.dense import stage as dense
+    from core.dense.options import DenseOptions
+    from core.io import raster
+    from tests import lowtexture_scene as lt
+    from tests import synthetic as syn
+    from tests.test_dense_lowtexture import blunder_count
+    from tests.workspaces import synthetic_workspace
+
+    block = lt.full_block(strips, per_strip, contrast) if size == "full" else lt.small_block(contrast)
+    root = os.path.join(ROOT, "build", "bench-dense", f"farmland-{size}-{contrast:g}-{len(block.shots)}")
+    images = os.path.join(root, "images")
+    if not os.path.exists(os.path.join(root, "rendered")):
+        t0 = time.time()
+        block.render(images)
+        open(os.path.join(root, "rendered"), "w").close()
+        print(f"  (rendered {len(block.shots)} images of {block.camera.width} x {block.camera.height} px in "
+              f"{time.time() - t0:.0f} s)")
+    ws = os.path.join(root, "ws")
+    shutil.rmtree(ws, ignore_errors=True)
+    rec = block.truth_reconstruction(model_from_local=None, noise_px=0.3, n_points=1500 if size != "full" else 6000)
+    synthetic_workspace(ws, block, rec, images_dir=images, georeferenced=True, crs=syn.CRS, offset=syn.ORIGIN)
+    t0, c0 = time.time(), time.process_time()
+    r = dense.build_dsm_workspace(ws, quality=quality, options=DenseOptions(workers=workers), progress=NullProgress())
+    wall = time.time() - t0
+    import resource
+
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = time.process_time() - c0 + kids.ru_utime + kids.ru_stime
+    z, gt, _ = raster.read_dsm(r.dsm_path)
+    src, _, _ = raster.read_dsm(r.source_path)
+    src = np.nan_to_num(src)
+    h, w = z.shape
+    x, y = np.meshgrid(gt[0] + (np.arange(w) + 0.5) * gt[1] - syn.ORIGIN[0],
+                       gt[3] + (np.arange(h) + 0.5) * gt[5] - syn.ORIGIN[1])
+    err = z - block.scene.height_at(x, y)
+    fields = block.scene.field_mask(x, y)
+    gsd = block.gsd
+    print(f"\n== DSM of the farmland block ({size}: {len(block.shots)} photos of {block.camera.width} x "
+          f"{block.camera.height} px, GSD {gsd:.3f} m, fields at {contrast:g} of their contrast), quality {quality} ==")
+    for line in r.log_lines:
+        print("  " + line)
+    print(f"  measured {r.measured_fraction:.3f}, interpolated {r.interpolated_fraction:.3f}, removed "
+          f"{r.removed_fraction:.4f} of the cameras' hull ({r.removed_cells} cells removed in all)")
+    for name, m in (("fields, measured cells", fields & (src == raster.SOURCE_MEASURED)),
+                    ("fields, every cell with a height", fields & np.isfinite(z))):
+        e = err[m]
+        print(f"  {name}: RMSE {np.sqrt(np.mean(e ** 2)):.3f} m = {np.sqrt(np.mean(e ** 2)) / gsd:.2f} GSD, median "
+              f"|dz| {np.median(np.abs(e)) / gsd:.2f} GSD, 95 % {np.percentile(np.abs(e), 95) / gsd:.2f} GSD")
+    print(f"  blunders (cells more than 100 GSD = 5 m at 4.9 cm from their 15 x 15 median): "
+          f"{blunder_count(z, 100 * gsd)}")
+    print(f"  DSM stage: {wall:.0f} s wall, {cpu:.0f} CPU-s (this process and its workers)")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--synthetic", default=None, metavar="W1,W2",
                     help="instead of Toledo: the synthetic block with its camera W1, W2 ... px wide (e.g. 600,1200)")
-    ap.add_argument("--contrast", type=float, default=0.03, help="the synthetic low-texture patch's contrast")
+    ap.add_argument("--contrast", type=float, default=None,
+                    help="the synthetic low-texture patch's contrast (0.03), or the farmland's (0.15)")
+    ap.add_argument("--farmland", choices=("full", "small"), default=None,
+                    help="instead of Toledo: tests/lowtexture_scene.py's farmland block (issue 33)")
     ap.add_argument("--workspace", default=os.path.join(ROOT, "build", "bench-dense", "toledo-ws"))
     ap.add_argument("--images", default=os.path.join(DATA, "toledo", "images"))
     ap.add_argument("--crs", default="EPSG:32617")
@@ -247,8 +311,15 @@ def main():
     if args.child:
         child(args)
         return
+    if args.farmland:
+        farmland(args.farmland, 0.15 if args.contrast is None else args.contrast,
+                 args.quality or ("half" if args.farmland == "full" else "full"),
+                 args.strips if args.strips != 2 else (4 if args.farmland == "full" else 2), args.per_strip if
+                 args.per_strip != 6 else (10 if args.farmland == "full" else 5), args.workers or 1)
+        return
     if args.synthetic:
-        synthetic([int(v) for v in args.synthetic.split(",")], args.contrast, args.quality or "full", args.strips,
+        synthetic([int(v) for v in args.synthetic.split(",")], 0.03 if args.contrast is None else args.contrast,
+                  args.quality or "full", args.strips,
                   args.per_strip, args.workers or 1)
         return
     args.quality = args.quality or "half"

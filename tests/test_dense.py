@@ -345,9 +345,12 @@ def test_dsm_source_raster_says_measured_or_interpolated(built):
     assert np.allclose(src_ds.GetGeoTransform(), gt) and "32633" in src_ds.GetProjection()
     assert src_ds.GetMetadataItem("ARCHAEOORTHO_PRODUCT") == "dsm-source"
     src = src_ds.GetRasterBand(1).ReadAsArray()
-    assert set(np.unique(src)) <= {0, dsm.SOURCE_MEASURED, dsm.SOURCE_INTERPOLATED}
-    assert ((src > 0) == np.isfinite(z)).all()  # nodata exactly where the DSM has none
-    assert r.measured_fraction + r.interpolated_fraction == pytest.approx(r.valid_fraction, abs=1e-6)
+    from core.dense.grid import SOURCE_REMOVED
+
+    assert set(np.unique(src)) <= {0, dsm.SOURCE_MEASURED, dsm.SOURCE_INTERPOLATED, SOURCE_REMOVED}
+    assert (np.isin(src, (dsm.SOURCE_MEASURED, dsm.SOURCE_INTERPOLATED)) <= np.isfinite(z)).all()
+    assert (np.isfinite(z) <= (src > 0)).all()  # a height: measured, interpolated or removed (and filled)
+    assert r.measured_fraction + r.interpolated_fraction <= r.valid_fraction + 1e-6
     assert r.measured_fraction >= 0.9 and r.valid_fraction >= 0.99  # the holes inside the cameras' hull are filled
     st = Workspace.open(r.workspace).stage("dsm")
     assert st["outputs"]["dsm_source"] == "dense/dsm-source.tif"

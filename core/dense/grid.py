@@ -196,10 +196,17 @@ def enclosed_holes(dsm: np.ndarray) -> np.ndarray:
     return inner[lab]
 
 
-def source_raster(measured: np.ndarray, dsm: np.ndarray) -> np.ndarray:
-    """uint8 per cell: SOURCE_MEASURED where ``measured``, SOURCE_INTERPOLATED where ``dsm`` holds a height that
-    was not measured (a filled hole), 0 = nodata."""
-    return np.where(measured, SOURCE_MEASURED, np.where(np.isfinite(dsm), SOURCE_INTERPOLATED, 0)).astype(np.uint8)
+SOURCE_REMOVED = 3  # dense/dsm-source.tif: a measured height removed as a blunder (interpolated where a fill reached)
+
+
+def source_raster(measured: np.ndarray, dsm: np.ndarray, removed: Optional[np.ndarray] = None) -> np.ndarray:
+    """uint8 per cell: SOURCE_MEASURED where ``measured``, SOURCE_REMOVED where ``removed`` (a blunder taken out:
+    its height in ``dsm``, if any, is interpolated), SOURCE_INTERPOLATED where ``dsm`` holds a height that was not
+    measured (a filled hole), 0 = nodata."""
+    out = np.where(measured, SOURCE_MEASURED, np.where(np.isfinite(dsm), SOURCE_INTERPOLATED, 0)).astype(np.uint8)
+    if removed is not None:
+        out[removed & ~measured] = SOURCE_REMOVED
+    return out
 
 
 def remove_speckles(dsm: np.ndarray, max_cells: int = 4) -> np.ndarray:
@@ -287,3 +294,128 @@ def convex_hull_xy(points_xy: np.ndarray) -> np.ndarray:
     except Exception:  # collinear points (one strip)  # noqa: BLE001
         return pts
     return pts[hull.vertices]
+
+
+def supporting_views(files: Sequence[PointFile], grid: Grid, offset: Sequence[float], dsm: np.ndarray,
+                     tolerance: np.ndarray, progress: Optional[Progress] = None, tile: int = TILE) -> np.ndarray:
+    """Per cell of ``dsm``: how many point files (one per image: its fused depth map) hold a point within
+    ``tolerance`` (metres, a scalar or per cell) of the cell's height; uint8, 0 where the cell has none."""
+    progress = progress or NullProgress()
+    off = np.asarray(offset, dtype=np.float64)
+    tol = np.broadcast_to(np.asarray(tolerance, dtype=np.float32), dsm.shape)
+    views = np.zeros(dsm.shape, dtype=np.uint8)
+    res = grid.resolution
+    for r0 in range(0, grid.height, tile):
+        for c0 in range(0, grid.width, tile):
+            check_cancel(progress)
+            h, w = min(tile, grid.height - r0), min(tile, grid.width - c0)
+            txmin = grid.x0 + c0 * res - off[0]
+            tymax = grid.y0 - r0 * res - off[1]
+            zt = dsm[r0:r0 + h, c0:c0 + w].reshape(-1)
+            tt = np.ascontiguousarray(tol[r0:r0 + h, c0:c0 + w]).reshape(-1)
+            acc = views[r0:r0 + h, c0:c0 + w].reshape(-1).astype(np.int32)
+            for pf in files:
+                bx0, by0, bx1, by1 = pf.bbox
+                if bx1 < txmin or bx0 > txmin + w * res or by1 < tymax - h * res or by0 > tymax:
+                    continue
+                xyz, _ = pf.load()
+                ix = np.floor((xyz[:, 0].astype(np.float64) - txmin) / res).astype(np.int64)
+                iy = np.floor((tymax - xyz[:, 1].astype(np.float64)) / res).astype(np.int64)
+                m = (ix >= 0) & (ix < w) & (iy >= 0) & (iy < h)
+                cell = iy[m] * w + ix[m]
+                near = np.abs(xyz[m, 2].astype(np.float64) + off[2] - zt[cell]) <= tt[cell]
+                hit = np.zeros(h * w, dtype=bool)
+                hit[cell[near]] = True
+                acc += hit
+            views[r0:r0 + h, c0:c0 + w] = np.minimum(acc, 255).reshape(h, w).astype(np.uint8)
+    return views
+
+
+def robust_surface(dsm: np.ndarray, block: int, band: int = 64) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(a robust local surface, its local spread, where it has support) of ``dsm`` (NaN = none): the median and
+    the 10-90 % range of each ``block`` x ``block`` block of cells, then per block the median of its 3 x 3 blocks'
+    medians (the support is 3 ``block`` cells across: a blunder patch under half of it does not move it) and the
+    largest of their ranges, upsampled bilinearly to the cells; blocks without data around take a smooth fill
+    (push-pull) and are False in the third array.  Works ``band`` block rows at a time (memory: those rows)."""
+    cv2 = require("cv2", "the DSM blunder filter")
+    from scipy import ndimage
+
+    h, w = dsm.shape
+    bh, bw = -(-h // block), -(-w // block)
+    med = np.full((bh, bw), np.nan, np.float32)
+    spread = np.zeros((bh, bw), np.float32)
+    import warnings
+
+    for b0 in range(0, bh, band):
+        b1 = min(bh, b0 + band)
+        pad = np.full(((b1 - b0) * block, bw * block), np.nan, np.float32)
+        rows = dsm[b0 * block:b1 * block]
+        pad[:rows.shape[0], :w] = rows
+        blocks = pad.reshape(b1 - b0, block, bw, block).transpose(0, 2, 1, 3).reshape(b1 - b0, bw, block * block)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN blocks: NaN
+            q = np.nanpercentile(blocks, [10, 50, 90], axis=2).astype(np.float32)
+        med[b0:b1], spread[b0:b1] = q[1], np.nan_to_num(q[2] - q[0])
+    valid = np.isfinite(med)
+    big = np.float32(1e9)
+    # the median of the 3 x 3 blocks' medians, blocks without data left out: each holds -big once and +big once
+    # among 18 values (their ranks cancel), each with data its median twice
+    lo_p = np.pad(np.where(valid, med, -big), 1, constant_values=-big)
+    hi_p = np.pad(np.where(valid, med, big), 1, constant_values=big)
+    surf = np.median(np.stack([a[1 + dy:1 + dy + bh, 1 + dx:1 + dx + bw] for a in (lo_p, hi_p)
+                               for dy in (-1, 0, 1) for dx in (-1, 0, 1)]), axis=0).astype(np.float32)
+    supported = ndimage.maximum_filter(valid, 3) & (np.abs(surf) < big / 2)
+    spread = ndimage.maximum_filter(spread, 3)
+    if supported.any() and not supported.all():
+        surf = push_pull(np.where(supported, surf, 0.0), supported).astype(np.float32)
+    elif not supported.any():
+        surf = np.full((bh, bw), np.nan, np.float32)
+    size = (bw * block, bh * block)
+    up = cv2.resize(surf, size, interpolation=cv2.INTER_LINEAR)[:h, :w]
+    sp = cv2.resize(spread, size, interpolation=cv2.INTER_LINEAR)[:h, :w]
+    sup = cv2.resize(supported.astype(np.uint8), size, interpolation=cv2.INTER_NEAREST)[:h, :w] > 0
+    return up, sp, sup
+
+
+BLUNDER_MIN_VIEWS = 2  # a cell that this many images' fused points confirm is kept whatever its height
+BLUNDER_BLOCK = 5  # cells: the robust surface's blocks (support 3 x 5 = 15 cells; and 45 for the wide one)
+BLUNDER_NEAR_GSD = 3.0  # a cell fewer images confirm is a blunder this far from the narrow surface (x GSD)...
+BLUNDER_WIDE_GSD = 6.0  # ... or this far from the wide one (each raised to BLUNDER_SPREAD x the local 10-90 %
+BLUNDER_SPREAD = 1.5  # spread: slopes, crowns and walls; at a block's edge the surface lags the slope)
+BLUNDER_FAR_GSD = 60.0  # where no cell around is confirmed: this far from the surface of all cells (3 m at 5 cm)
+
+
+def find_blunders(dsm: np.ndarray, views: np.ndarray, gsd: float) -> np.ndarray:
+    """The cells of ``dsm`` to remove as blunders: those fewer than BLUNDER_MIN_VIEWS images confirm (``views``,
+    :func:`supporting_views`) that lie farther from a robust local surface of the confirmed cells
+    (:func:`robust_surface`, 15 and 45 cells across) than BLUNDER_NEAR_GSD / BLUNDER_WIDE_GSD ground sample
+    distances or 1.5 x the local spread, whichever is larger (rough ground, crowns and walls raise it); where no cell
+    around is confirmed, those farther than BLUNDER_FAR_GSD GSD (or twice the spread) from the surface of all
+    cells (the pits at a block's edge).  Walls, trees and buildings that several images see stay."""
+    have = np.isfinite(dsm)
+    weak = have & (views < BLUNDER_MIN_VIEWS)
+    if not weak.any():
+        return weak
+    out = np.zeros(dsm.shape, dtype=bool)
+    confirmed = np.where(views >= BLUNDER_MIN_VIEWS, dsm, np.nan).astype(np.float32)
+    if np.isfinite(confirmed).any():
+        for block, k in ((BLUNDER_BLOCK, BLUNDER_NEAR_GSD), (3 * BLUNDER_BLOCK, BLUNDER_WIDE_GSD)):
+            surf, spread, sup = robust_surface(confirmed, block)
+            with np.errstate(invalid="ignore"):
+                out |= weak & sup & (np.abs(dsm - surf) > np.maximum(k * gsd, BLUNDER_SPREAD * spread))
+    surf, spread, sup = robust_surface(dsm.astype(np.float32), 3 * BLUNDER_BLOCK)
+    with np.errstate(invalid="ignore"):
+        out |= weak & (np.abs(dsm - surf) > np.maximum(BLUNDER_FAR_GSD * gsd, 2.0 * spread))
+    # ... but a cell within the heights of the confirmed cells around it (5 x 5, +- BLUNDER_NEAR_GSD) continues them:
+    # the strip beside a wall that one image sees, a roof's or a crown's edge
+    cv2 = require("cv2", "the DSM blunder filter")
+    big = np.float32(1e9)
+    known = np.isfinite(confirmed)
+    k5 = np.ones((5, 5), np.uint8)
+    lo = cv2.erode(np.where(known, confirmed, big).astype(np.float32), k5)
+    hi = cv2.dilate(np.where(known, confirmed, -big).astype(np.float32), k5)
+    del confirmed
+    slack = np.float32(BLUNDER_NEAR_GSD * gsd)
+    with np.errstate(invalid="ignore"):
+        out &= ~((lo < big / 2) & (dsm >= lo - slack) & (dsm <= hi + slack))
+    return out

@@ -8,8 +8,8 @@ from ..common.errors import ArchaeoOrthoError
 
 QUALITIES = {"full": 1.0, "half": 0.5, "quarter": 0.25}  # QUALITY -> image downscale for matching
 ENGINES = ("cpu", "cuda")
-CACHE_VERSION = 4  # of the per-pair depth map cache (dense/pairs-<key>/); 2: coarse-to-fine; 3: tiled pyramid;
-# 4: uint16 depth maps (x step_i / step_j), stored
+CACHE_VERSION = 5  # of the per-pair depth map cache (dense/pairs-<key>/); 2: coarse-to-fine; 3: tiled pyramid;
+# 4: uint16 depth maps (x step_i / step_j), stored; 5: equalised pairs, fine_uniqueness
 
 # options that say where the work runs, not what it computes (not recorded among the stage's parameters)
 EXECUTION_OPTIONS = ("workers", "executor", "scheduler")
@@ -29,7 +29,12 @@ class DenseOptions:
     ideal_baseline_ratio: float = 0.3
     max_view_angle: float = 40.0  # degrees between the optical axes
     block_size: int = 0  # SGBM block; 0 = auto (5 at full/half, 3 at quarter)
-    uniqueness: int = 10
+    uniqueness: int = 10  # SGBM's uniqueness ratio where a level searches the whole range (the coarsest)
+    # ... and on the finer levels, which search only around what their coarser level found: a periodic texture
+    # (furrows, crop rows) has its second minimum a period away, outside that window, so 10 there only dropped
+    # faint texture; fusion's agreement of several pairs and the DSM's blunder filter judge what it lets through
+    fine_uniqueness: int = 3
+    equalize: bool = True  # local contrast equalisation (CLAHE) of each rectified pair before matching
     lr_tolerance: float = 1.0  # px
     min_consistent: int = 2  # pairs that must agree on a pixel
     depth_tolerance_px: float = 1.0  # agreement tolerance, in disparity pixels of the weakest pair

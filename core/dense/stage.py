@@ -10,7 +10,9 @@
    centres filled by a smooth 2.5-D surface up to ``fill_max_distance`` from the data; a float32
    Cloud-Optimized GeoTIFF with overviews in the workspace CRS, written atomically
    (:mod:`core.io.raster`), and beside it ``dense/dsm-source.tif`` on the same grid: 1 = measured, 2 =
-   interpolated (every filled cell), 0 = nodata.  Optionally a LAS 1.2 point cloud with RGB.
+   interpolated (every filled cell), 3 = removed (a blunder, :func:`.grid.find_blunders`: a cell fewer than two
+   images confirm, far from the robust surface of those that are confirmed; interpolated where a fill reaches),
+   0 = nodata.  Optionally a LAS 1.2 point cloud with RGB.
 
 Engine ``cuda`` runs COLMAP's patch-match stereo and fusion instead of 2-3 (:mod:`.points`; only where
 pycolmap was built with CUDA: ``pycolmap.has_cuda``); the DSM step is the same.
@@ -62,9 +64,11 @@ class DsmStageResult:
     timings: Dict[str, float]
     warnings: List[str] = field(default_factory=list)
     log_lines: List[str] = field(default_factory=list)
-    source_path: str = ""  # dense/dsm-source.tif: 1 measured, 2 interpolated, 0 nodata
+    source_path: str = ""  # dense/dsm-source.tif: 1 measured, 2 interpolated, 3 removed (a blunder), 0 nodata
     measured_fraction: Optional[float] = None  # of the cells inside the camera centres' hull
     interpolated_fraction: Optional[float] = None
+    removed_fraction: Optional[float] = None
+    removed_cells: int = 0
 
 
 class _Journal:
@@ -169,7 +173,8 @@ def build_dsm_workspace(workspace_dir: str, resolution: float = 0.0, quality: st
         job.log.append("seconds: " + ", ".join(f"{k.replace('_', ' ')} {v:.1f}" for k, v in job.timings.items()))
         job.log.append(f"DSM {grid.width} x {grid.height} cells at {res:g} m, inside the convex hull of the camera "
                        f"centres {100 * fractions['measured']:.1f} % measured, {100 * fractions['interpolated']:.1f} % "
-                       f"interpolated (filled holes, flagged in {lay.rel(lay.dsm_source)})")
+                       f"interpolated (filled holes), {100 * fractions['removed']:.1f} % removed as blunders "
+                       f"({fractions['removed_cells']} cells in all; flagged in {lay.rel(lay.dsm_source)})")
         for line in job.log[-2:]:
             progress.info(line)
         for k, v in job.timings.items():
@@ -180,7 +185,9 @@ def build_dsm_workspace(workspace_dir: str, resolution: float = 0.0, quality: st
             outputs["point_cloud"] = lay.rel(pc_path)
         run.finish(outputs=outputs,
                    results={"VALID_FRACTION": valid_fraction, "MEASURED_FRACTION": fractions["measured"],
-                            "INTERPOLATED_FRACTION": fractions["interpolated"], "pairs": n_pairs, "pairs_reused": n_reused,
+                            "INTERPOLATED_FRACTION": fractions["interpolated"],
+                            "REMOVED_FRACTION": fractions["removed"], "removed_cells": fractions["removed_cells"],
+                            "pairs": n_pairs, "pairs_reused": n_reused,
                             "points": n_points, "resolution": res, "gsd": gsd, "width": grid.width,
                             "height": grid.height, "warnings": job.warnings})
     progress.report(1.0, f"DSM: {grid.width} x {grid.height} cells at {res:g} m")
@@ -188,7 +195,8 @@ def build_dsm_workspace(workspace_dir: str, resolution: float = 0.0, quality: st
                           resolution=res, valid_fraction=valid_fraction, pairs=n_pairs, pairs_reused=n_reused,
                           points=n_points, timings={k: round(v, 3) for k, v in job.timings.items()},
                           warnings=job.warnings, log_lines=job.log, source_path=lay.dsm_source,
-                          measured_fraction=fractions["measured"], interpolated_fraction=fractions["interpolated"])
+                          measured_fraction=fractions["measured"], interpolated_fraction=fractions["interpolated"],
+                          removed_fraction=fractions["removed"], removed_cells=fractions["removed_cells"])
 
 
 def _checked_arguments(options: Optional[DenseOptions], quality: str, engine: str,
@@ -284,17 +292,24 @@ def _write_dsm(dsm_path: str, source_path: str, point_files: List[PointFile], vi
                offset: np.ndarray, crs: Optional[str], res: float, gsd: float, options: DenseOptions, metadata: dict,
                progress: Progress) -> Tuple[raster.Grid, Dict[str, float]]:
     """Rasterise the points, clean the raster, fill its holes inside the cameras' hull, write the COG and its
-    source raster (1 measured, 2 interpolated); (grid, fractions: 'valid', 'measured', 'interpolated' of the cells
-    inside the cameras' hull, or of the raster for one strip)."""
+    source raster (1 measured, 2 interpolated, 3 removed as a blunder: :func:`grid.find_blunders`); (grid,
+    fractions: 'valid', 'measured', 'interpolated', 'removed' of the cells inside the cameras' hull, or of the
+    raster for one strip; 'removed_cells': all the cells removed)."""
     check_cancel(progress)
     boxes = np.array([pf.robust_bbox for pf in point_files if pf.count > 0])
     xmin, ymin = boxes[:, 0].min() + offset[0], boxes[:, 1].min() + offset[1]
     xmax, ymax = boxes[:, 2].max() + offset[0], boxes[:, 3].max() + offset[1]
     grid = raster.Grid.covering(xmin, ymin, xmax, ymax, res)
-    dsm, _counts = gridding.rasterize_points(point_files, grid, offset, cluster_tol=max(3 * res, 4 * gsd),
+    cluster_tol = max(3 * res, 4 * gsd)
+    dsm, _counts = gridding.rasterize_points(point_files, grid, offset, cluster_tol=cluster_tol,
                                              progress=SubProgress(progress, 0.88, 0.92))
     del _counts
     dsm = gridding.remove_speckles(dsm, max_cells=4)
+    # blunders: cells fewer than two images confirm, far from the robust surface of those that are confirmed
+    views_ok = gridding.supporting_views(point_files, grid, offset, dsm, cluster_tol)
+    removed = gridding.find_blunders(dsm, views_ok, gsd)
+    del views_ok
+    dsm[removed] = np.nan
     measured = np.isfinite(dsm)
     dsm = gridding.fill_small_holes(dsm, options.max_hole_cells)
     centres = np.array([v.centre[:2] + offset[:2] for v in views.values()])
@@ -306,16 +321,20 @@ def _write_dsm(dsm_path: str, source_path: str, point_files: List[PointFile], vi
         region = hull if hull is not None else gridding.enclosed_holes(dsm)
         dsm = gridding.fill_region(dsm, region, options.fill_max_distance / res,
                                    ring_cells=max(2, int(round(3.0 / res))), step=2.0)
-    source = gridding.source_raster(measured, dsm)
+    source = gridding.source_raster(measured, dsm, removed)
     judged = source[hull] if hull is not None else source
-    fractions = {"valid": float((judged > 0).mean()), "measured": float((judged == raster.SOURCE_MEASURED).mean()),
-                 "interpolated": float((judged == raster.SOURCE_INTERPOLATED).mean())}
+    have = np.isfinite(dsm[hull]) if hull is not None else np.isfinite(dsm)
+    fractions = {"valid": float(have.mean()), "measured": float((judged == raster.SOURCE_MEASURED).mean()),
+                 "interpolated": float((judged == raster.SOURCE_INTERPOLATED).mean()),
+                 "removed": float((judged == gridding.SOURCE_REMOVED).mean()), "removed_cells": int(removed.sum())}
     check_cancel(progress)
     figures = {"VALID_FRACTION": round(fractions["valid"], 4), "MEASURED_FRACTION": round(fractions["measured"], 4),
-               "INTERPOLATED_FRACTION": round(fractions["interpolated"], 4)}
+               "INTERPOLATED_FRACTION": round(fractions["interpolated"], 4),
+               "REMOVED_FRACTION": round(fractions["removed"], 4)}
     # the source first: a complete DSM always has its own beside it
     raster.write_classes(source_path, source, grid.geotransform, crs,
-                         f"DSM source: {raster.SOURCE_MEASURED} measured, {raster.SOURCE_INTERPOLATED} interpolated",
+                         f"DSM source: {raster.SOURCE_MEASURED} measured, {raster.SOURCE_INTERPOLATED} interpolated, "
+                         f"{gridding.SOURCE_REMOVED} removed (a blunder; interpolated where filled)",
                          dict(figures, ARCHAEOORTHO_PRODUCT="dsm-source", DSM=os.path.basename(dsm_path)))
     raster.write_cog(dsm_path, dsm, grid.geotransform, crs, progress=SubProgress(progress, 0.92, 0.96),
                      metadata=dict(metadata, **figures))
