@@ -34,6 +34,7 @@ def algorithms():
     from .build_orthophoto import BuildOrthophotoAlgorithm
     from .contours import ContoursAlgorithm
     from .dsm_difference import DsmDifferenceAlgorithm
+    from .find_targets import FindTargetsAlgorithm
     from .georeference import GeoreferenceAlgorithm
     from .orthorectify_image import OrthorectifyImageAlgorithm
     from .prepare_images import PrepareImagesAlgorithm
@@ -43,4 +44,4 @@ def algorithms():
     return [AlignImagesAlgorithm(), GeoreferenceAlgorithm(), BuildDsmAlgorithm(), PrepareImagesAlgorithm(),
             AccuracyReportAlgorithm(), BuildOrthophotoAlgorithm(), OrthorectifyImageAlgorithm(),
             RunPipelineAlgorithm(), BuildDtmAlgorithm(), ReliefVisualisationAlgorithm(), ContoursAlgorithm(),
-            AutoControlAlgorithm(), DsmDifferenceAlgorithm()]
+            AutoControlAlgorithm(), DsmDifferenceAlgorithm(), FindTargetsAlgorithm()]
