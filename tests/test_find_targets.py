@@ -143,3 +143,18 @@ def test_errors_name_the_file_the_line_and_what_to_do(block, tmp_path):
         find_targets(empty.root, csv)
     with pytest.raises(Exception, match="would be written over the targets file"):
         find_targets(ws, csv, FindTargetsOptions(output=csv))
+
+
+def test_the_processing_algorithm_writes_the_file_and_the_counts(block, plugin, tmp_path):
+    import processing
+    from qgis.core import QgsProcessingException
+
+    scene, ws, csv, r = block
+    out = str(tmp_path / "found.txt")
+    res = processing.run("archaeoortho:findtargets", {"WORKSPACE": ws, "TARGETS": csv, "GCPS": out,
+                                                       "TARGET_KIND": 0})
+    assert res["GCPS"] == out and res["TARGETS_FOUND"] == r.n_targets
+    assert res["OBSERVATIONS_FOUND"] == r.n_observations == gcpmod.read_gcps(out).n_observations()
+    assert os.path.isfile(res["MARKS"]) and res["WORKSPACE"] == ws
+    with pytest.raises(QgsProcessingException, match="would be written over the targets file"):
+        processing.run("archaeoortho:findtargets", {"WORKSPACE": ws, "TARGETS": csv, "GCPS": csv})
