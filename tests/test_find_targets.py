@@ -77,15 +77,32 @@ def test_the_observations_file_is_what_georeference_reads(block):
         q = survey.by_name(p.name)
         assert (p.x, p.y, p.z) == (q.x, q.y, q.z)
     assert all(0.0 < o.quality <= 1.0 and o.found for o in r.observations)
+    # the marks' sizes on the ground, through the constellation's scale: the painted targets' (m)
+    for kind, size in (("checkerboard", 0.5), ("circle", 0.3), ("aruco", 0.4)):
+        s = np.median([o.size_m for o in r.observations if o.kind == kind])
+        assert 0.8 < s / size < 1.25, (kind, s)
+
+
+def test_a_target_size_unlike_the_marks_leaves_them_out(block, tmp_path):
+    scene, ws, csv, _ = block
+    r = find_targets(ws, csv, FindTargetsOptions(target_size=5.0, output=str(tmp_path / "gcps.txt"),
+                                                 layer=str(tmp_path / "found.gpkg"), num_threads=2))
+    assert r.n_observations == 0 and all("size unlike the target's 5" in t.note for t in r.targets)
+
+
+@pytest.fixture(scope="module")
+def detections(block):
+    scene = block[0]
+    return {name: detect_image(name, path, ("checkerboard", "circle", "cross"), ("DICT_4X4_50",), 8, 0.2)
+            for name, path in scene.photos.items()}
 
 
 @pytest.mark.parametrize("kind", ["checkerboard", "circle", "aruco"])
-def test_each_detector_alone_is_within_a_third_of_a_pixel(block, kind):
+def test_each_detector_alone_is_within_a_third_of_a_pixel(block, detections, kind):
     scene = block[0]
     kinds = {t.name: t.kind for t in scene.targets}
     errors = []
-    for name, path in scene.photos.items():
-        cands = detect_image(name, path, ("checkerboard", "circle", "cross"), ("DICT_4X4_50",), 8, 0.2)
+    for name, cands in detections.items():
         for tn in scene.visible[name]:
             if kinds[tn] == kind:
                 tx, ty = scene.truth[name][tn]

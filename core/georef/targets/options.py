@@ -22,7 +22,8 @@ KINDS: Tuple[str, ...] = (AUTO,) + PLAIN_KINDS + DICTIONARIES
 class FindTargetsOptions:
     """``kind``: AUTO (crosses, checkerboards, circles and ``DEFAULT_DICTIONARY`` markers), one of PLAIN_KINDS or
     an OpenCV ArUco/AprilTag dictionary name.  ``target_size``: the target's side or diameter (m), when known:
-    candidates whose size in the photo disagrees with it by more than a factor 2 are left out.  ``crs``: the
+    marks whose size on the ground (pixels x depth / focal length x the constellation's scale) disagrees with it
+    by more than a factor 2 are left out.  ``crs``: the
     coordinates' CRS where the targets file names none.  ``output``: the gcp_list.txt to write (default: the
     workspace's georef/targets/gcp_list.txt); ``layer``: the GeoPackage of the found marks (default beside it).
     ``min_size_px``: the smallest target (side or diameter, pixels) looked for; ``max_size_fraction``: the

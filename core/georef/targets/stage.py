@@ -59,6 +59,7 @@ class FoundObservation:
     size_px: float
     source: str
     found: bool = True  # found by the machine, not placed by hand (the dock's mark)
+    size_m: Optional[float] = None  # the mark's size on the ground (world units), through the constellation's scale
 
 
 @dataclass
@@ -186,30 +187,54 @@ def _predict(rec, gs: gcpmod.GCPSet, named: Dict[str, List[Candidate]], cands: D
     return out
 
 
+def _ground_sizes(rec, cs: Sequence[Candidate], xyz, scale: Optional[float]) -> List[Optional[float]]:
+    """Each mark's size on the ground: pixels x depth / focal length x the model's scale (None without one)."""
+    if xyz is None or scale is None:
+        return [None] * len(cs)
+    lookup = {rec.image(i).name: rec.image(i) for i in rec.reg_image_ids()}
+    out: List[Optional[float]] = []
+    for c in cs:
+        im = lookup[c.image]
+        m = np.asarray(im.cam_from_world().matrix())
+        depth = float((m[:, :3] @ np.asarray(xyz) + m[:, 3])[2])
+        out.append(c.size_px * depth / float(rec.cameras[im.camera_id].mean_focal_length()) * scale)
+    return out
+
+
 def _finish(rec, gs, found: Dict[str, List[Candidate]], sources, tol_px: float, match: Constellation,
-            track_fit: Dict[str, float]) -> tuple:
+            target_size: Optional[float]) -> tuple:
     observations: List[FoundObservation] = []
     targets: List[TargetStatus] = []
+    track_fit = {match.names[i]: match.residuals[i] for i in match.names}
+    scale = match.similarity.scale if match.similarity is not None else None
     for p in gs.points:
         cs = found.get(p.name, [])
-        note = ""
+        notes = []
         res = np.full(len(cs), np.nan)
+        xyz = None
         if len(cs) >= 2:
             t = triangulate_observations(rec, [gcpmod.Observation(c.image, c.x, c.y) for c in cs],
                                          max_error_px=tol_px)
+            xyz = t.xyz
             if t.xyz is None:
-                cs, res, note = [], np.zeros(0), "its marks do not intersect in the block"
+                cs, res = [], np.zeros(0)
+                notes.append("its marks do not intersect in the block")
             else:
                 keep = [i for i in range(len(cs)) if t.used[i]]
-                dropped = len(cs) - len(keep)
-                if dropped:
-                    note = f"{dropped} mark(s) off the others by more than {tol_px:.2g} px left out"
+                if len(cs) > len(keep):
+                    notes.append(f"{len(cs) - len(keep)} mark(s) off the others by more than {tol_px:.2g} px left out")
                 cs, res = [cs[i] for i in keep], t.residuals_px[keep]
-        for c, r in zip(cs, res):
+        sizes = _ground_sizes(rec, cs, xyz, scale)
+        if target_size:
+            keep = [i for i, sz in enumerate(sizes) if sz is None or 0.5 <= sz / target_size <= 2.0]
+            if len(keep) < len(cs):
+                notes.append(f"{len(cs) - len(keep)} mark(s) of a size unlike the target's {target_size:g} left out")
+            cs, res, sizes = [cs[i] for i in keep], res[keep], [sizes[i] for i in keep]
+        for c, r, sz in zip(cs, res, sizes):
             observations.append(FoundObservation(p.name, c.image, c.x, c.y, c.kind, c.quality, float(r), c.size_px,
-                                                 sources.get(id(c), PROJECTED)))
+                                                 sources.get(id(c), PROJECTED), size_m=sz))
         targets.append(TargetStatus(p.name, p.x, p.y, p.z, bool(cs), len(cs), track_fit.get(p.name),
-                                    note or ("" if cs else "not found")))
+                                    "; ".join(notes) or ("" if cs else "not found")))
     return observations, targets
 
 
@@ -269,8 +294,7 @@ def find_targets(workspace: str, targets: str, options: Optional[FindTargetsOpti
     sources = {id(c): TIED for v in named.values() for c in v}
     kinds = {match.names[i]: tracks[i].kind for i in match.names}
     found = _predict(rec, gs, named, cands, kinds, tol_px, result.reports)
-    fits = {match.names[i]: match.residuals[i] for i in match.names}
-    result.observations, result.targets = _finish(rec, gs, found, sources, tol_px, match, fits)
+    result.observations, result.targets = _finish(rec, gs, found, sources, tol_px, match, options.target_size)
     result.seconds = time.time() - t0
     _write(lay, gs, result)
     if progress is not None:
