@@ -104,6 +104,9 @@ def test_georeference_from_the_toolbox_loads_styled_layers(plugin, aligned, qgis
     for layer in (cams, residuals):
         assert layer.labeling().settings().placement == over_point, layer.name()
     assert layers["footprints"].featureCount() == cams.featureCount()
+    site = os.path.basename(os.path.normpath(ws))  # named after their workspace (issue 36 item 17)
+    assert cams.name() == f"Cameras \u2014 {site}" and residuals.name().endswith(f" \u2014 {site}")
+    assert layers["footprints"].name() == f"Camera footprints \u2014 {site}"
     _render(QgsProject.instance(), [residuals, cams, layers["footprints"]], "toolbox-georeference-layers.png")
 
 

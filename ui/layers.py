@@ -393,8 +393,8 @@ def workspace_of(path, levels=3):
 
 
 def product_name(label, path, workspace=None):
-    """A product layer's name with its workspace's: 'DSM — toledo', so that two workspaces' DSMs and orthomosaics
-    are told apart in the layer lists (the dock's reference boxes showed two 'DSM': issue 36 item 17)."""
+    """A product layer's name with its workspace's: 'DSM — toledo', so that two workspaces' DSMs, orthomosaics and
+    cameras are told apart in the layer lists (the dock's reference boxes showed two 'DSM': issue 36 item 17)."""
     workspace = workspace or workspace_of(path)
     if not workspace:
         return label
@@ -444,11 +444,11 @@ def load_relief(path, project=None, group=None, name=None, workspace=None):
     return [layer] if add_layer(project, layer, group, path) is not None else []
 
 
-def load_contours(path, project=None, group=None, name=None):
+def load_contours(path, project=None, group=None, name=None, workspace=None):
     project = project or QgsProject.instance()
     remove_loaded(project, path, (CONTOURS,))
-    layer = QgsVectorLayer(f"{path}|layername=contours", name or QCoreApplication.translate(
-        "ResultLayers", "Contours"), "ogr")
+    layer = QgsVectorLayer(f"{path}|layername=contours", name or product_name(QCoreApplication.translate(
+        "ResultLayers", "Contours"), path, workspace), "ogr")
     if not layer.isValid():
         return []
     style_contours(layer)
@@ -547,7 +547,8 @@ def load_cameras(path, project=None, group=None, name=None, workspace=None, foot
     georeferenced workspace, the image footprints on the mean ground height (``footprints``: the GeoPackage
     footprints_path() wrote already, in a background task; else written now)."""
     project = project or QgsProject.instance()
-    layer = QgsVectorLayer(path, name or QCoreApplication.translate("ResultLayers", "Cameras"), "ogr")
+    layer = QgsVectorLayer(path, name or product_name(QCoreApplication.translate("ResultLayers", "Cameras"), path,
+                                                      workspace), "ogr")
     if not layer.isValid() or not has_real_crs(layer.crs()):
         return []
     remove_loaded(project, path, (CAMERAS,))
@@ -555,7 +556,8 @@ def load_cameras(path, project=None, group=None, name=None, workspace=None, foot
     foot = footprints or (footprints_path(workspace) if workspace else None)
     if foot:
         remove_loaded(project, foot, (FOOTPRINTS,))
-        fl = QgsVectorLayer(foot, QCoreApplication.translate("ResultLayers", "Camera footprints"), "ogr")
+        fl = QgsVectorLayer(foot, product_name(QCoreApplication.translate("ResultLayers", "Camera footprints"), foot,
+                                               workspace), "ogr")
         if fl.isValid():
             style_footprints(fl)
             out.append(add_layer(project, fl, group, foot))
@@ -600,7 +602,7 @@ def footprints_path(workspace):
         return None
 
 
-def load_residuals(path, project=None, group=None, name=None):
+def load_residuals(path, project=None, group=None, name=None, workspace=None):
     project = project or QgsProject.instance()
     layer = QgsVectorLayer(path, "residuals", "ogr")
     if not layer.isValid():
@@ -608,8 +610,8 @@ def load_residuals(path, project=None, group=None, name=None):
     remove_loaded(project, path, (RESIDUALS,))
     style_residuals(layer)
     factor = layer.customProperty("archaeoortho/exaggeration", 1.0)
-    layer.setName(name or QCoreApplication.translate("ResultLayers", "GCP residuals (vectors x{})").format(
-        f"{float(factor):g}"))
+    layer.setName(name or product_name(QCoreApplication.translate("ResultLayers", "GCP residuals (vectors x{})").format(
+        f"{float(factor):g}"), path, workspace))
     return [layer] if add_layer(project, layer, group, path) is not None else []
 
 
@@ -639,9 +641,9 @@ def load_workspace_results(workspace, project=None, group=None):
         (lay.default_dsm, load_dsm, {"workspace": workspace}),
         (lay.default_orthomosaic, load_orthomosaic, {"workspace": workspace}),
         (lay.cameras_gpkg, load_cameras, {"workspace": workspace}),
-        (lay.residuals_gpkg, load_residuals, {}),
+        (lay.residuals_gpkg, load_residuals, {"workspace": workspace}),
         (lay.default_dtm, load_dtm, {"workspace": workspace}),
-        (lay.contours_gpkg, load_contours, {}),
+        (lay.contours_gpkg, load_contours, {"workspace": workspace}),
     ]
     relief_dir = os.path.dirname(lay.relief("x"))
     if os.path.isdir(relief_dir):
@@ -731,15 +733,16 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
             foot = footprints_path(self.workspace) if self.workspace else None
             if foot:
                 remove_loaded(project, foot, (FOOTPRINTS,))
-                fl = QgsVectorLayer(foot, QCoreApplication.translate("ResultLayers", "Camera footprints"), "ogr")
+                fl = QgsVectorLayer(foot, product_name(QCoreApplication.translate(
+                    "ResultLayers", "Camera footprints"), foot, self.workspace), "ogr")
                 if fl.isValid():
                     style_footprints(fl)
                     add_layer(project, fl, group, foot)
         elif self.kind == RESIDUALS:
             style_residuals(layer)
             factor = layer.customProperty("archaeoortho/exaggeration", 1.0)
-            layer.setName(QCoreApplication.translate("ResultLayers", "GCP residuals (vectors x{})").format(
-                f"{float(factor):g}"))
+            layer.setName(product_name(QCoreApplication.translate("ResultLayers", "GCP residuals (vectors x{})").format(
+                f"{float(factor):g}"), path, self.workspace))
         elif self.kind == POINT_CLOUD:
             _mark(layer, POINT_CLOUD)
         elif self.kind == DTM:
@@ -758,13 +761,10 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
             style_contours(layer)
         name = _output_layer_name(self.kind)
         if name:  # not the parameter's label ("Orthomosaic (default: <workspace>/orthomosaic.tif)")
-            layer.setName(product_name(name, path, self.workspace) if self.kind in RASTER_KINDS else name)
+            layer.setName(product_name(name, path, self.workspace))
         if group:  # styled: its kind known, it takes its place in the group (a hillshade under the orthomosaic)
             move_to_group(project, layer, group, self.kind)
 
-
-# the kinds named after their workspace: the raster layers, which the dock's reference boxes list
-RASTER_KINDS = (DSM, HILLSHADE, ORTHO, DTM, DTM_HILLSHADE, RELIEF, POINT_CLOUD)
 
 
 def _output_layer_name(kind):
