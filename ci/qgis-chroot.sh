@@ -1,31 +1,36 @@
 #!/usr/bin/env bash
-# The QGIS 3.40 test leg: runs this repository's `make test` inside a Debian 13 (trixie) chroot, which has
-# QGIS 3.40, Python 3.13 and NumPy 2.x (the host leg is Debian 12: QGIS 3.22, Python 3.11, NumPy 1.24).
+# A QGIS test leg in a Debian chroot: runs this repository's `make test` inside a chroot of another Debian
+# release, so the plugin is tested on the QGIS, Python and NumPy that release ships.  Two legs use it:
 #
-#   make test-qgis340 [PYTEST_ARGS=...]          (or: APT_PACKAGES="..." ci/qgis340.sh)
+#   make test-qgis340   LEG=qgis340 SUITE=trixie: QGIS 3.40, Python 3.13, NumPy 2.2 (Debian 13)
+#   make test-qgis344   LEG=qgis344 SUITE=sid:    QGIS 3.44, Python 3.14, NumPy 2.4 (Debian unstable; the last
+#                                                 Qt5 QGIS: what sid ships moves, the leg logs the versions)
 #
-# The chroot is cached OUTSIDE the repository (CI clones afresh every run) at $QGIS340_CHROOT
-# (default /var/cache/archaeoortho/trixie) and rebuilt when missing or when its package list changed
-# (debootstrap + apt-get: about 4-6 minutes).  Each run bind-mounts the repository and ../shared (read-only;
-# the tests look for ../shared/data) at their own paths, plus /proc /dev /sys, and unmounts them on exit, also
-# on failure.  Inside, `make test` keeps its venv, apt stamp and QGIS profile under build/qgis340/, apart from
-# the host's .venv and build/; the plugin link build/qgis-plugins/archaeoortho is shared (same target).
+# (the host leg, `make test`, is Debian 12: QGIS 3.22, Python 3.11, NumPy 1.24).
+#
+# The chroot is cached OUTSIDE the repository (CI clones afresh every run) at $QGIS_CHROOT (default
+# /var/cache/archaeoortho/$SUITE) and rebuilt when missing or when its package list changed (debootstrap +
+# apt-get: about 4-6 minutes).  Each run bind-mounts the repository and ../shared (read-only; the tests look for
+# ../shared/data) at their own paths, plus /proc /dev /sys, and unmounts them on exit, also on failure.
+# Inside, `make test` keeps its venv, apt stamp and QGIS profile under build/$LEG/, apart from the host's .venv
+# and build/; the plugin link build/qgis-plugins/archaeoortho is shared (same target).
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-CHROOT=${QGIS340_CHROOT:-/var/cache/archaeoortho/trixie}
-SUITE=${QGIS340_SUITE:-trixie}
+LEG=${LEG:?set LEG (qgis340, qgis344), as the Makefile does}
+SUITE=${SUITE:?set SUITE (the Debian release: trixie, sid), as the Makefile does}
+CHROOT=${QGIS_CHROOT:-/var/cache/archaeoortho/$SUITE}
 MIRROR=${DEBIAN_MIRROR:-http://deb.debian.org/debian}
 SHARED=$(dirname "$ROOT")/shared
 PYTEST_ARGS=${PYTEST_ARGS:-}
 : "${APT_PACKAGES:?set APT_PACKAGES to the apt list of the Makefile, as make test-qgis340 does}"
 
 if [ "$(id -u)" != 0 ]; then
-  exec sudo APT_PACKAGES="$APT_PACKAGES" PYTEST_ARGS="$PYTEST_ARGS" QGIS340_CHROOT="$CHROOT" \
-    QGIS340_SUITE="$SUITE" DEBIAN_MIRROR="$MIRROR" "${BASH_SOURCE[0]}" "$@"
+  exec sudo APT_PACKAGES="$APT_PACKAGES" PYTEST_ARGS="$PYTEST_ARGS" QGIS_CHROOT="$CHROOT" LEG="$LEG" \
+    SUITE="$SUITE" DEBIAN_MIRROR="$MIRROR" "${BASH_SOURCE[0]}" "$@"
 fi
 
-log() { echo "qgis340: $*" >&2; }
+log() { echo "$LEG: $*" >&2; }
 
 # Every mount point at or below $1, deepest first (read from /proc/self/mounts; octal escapes kept as is).
 mounts_under() {
@@ -96,6 +101,9 @@ build_chroot() {
   debootstrap --variant=minbase "$SUITE" "$new" "$MIRROR" >"$CHROOT.debootstrap.log" 2>&1 \
     || { tail -20 "$CHROOT.debootstrap.log" >&2; remove_tree "$new"; exit 1; }
   host_config "$new"
+  # A mirror may serve a frozen copy of a release whose Release file is past its Valid-Until date (sid's is
+  # valid for a week): apt then refuses it as expired.  The packages are still checked against the signature.
+  echo 'Acquire::Check-Valid-Until "false";' >"$new/etc/apt/apt.conf.d/99archaeoortho-valid-until"
   mount_system "$new"
   log "apt-get install: $(echo $WANT)"
   if ! { in_chroot "$new" apt-get update -q && \
@@ -145,8 +153,8 @@ log "$(in_chroot "$CHROOT" sh -c 'echo QGIS $(dpkg-query -W -f "\${Version}" qgi
 $(python3 -c "import numpy; print(numpy.__version__)")')"
 test_start=$SECONDS
 rc=0
-in_chroot "$CHROOT" make -C "$ROOT" test VENV="$ROOT/build/qgis340/venv" BUILD="$ROOT/build/qgis340" \
+in_chroot "$CHROOT" make -C "$ROOT" test VENV="$ROOT/build/$LEG/venv" BUILD="$ROOT/build/$LEG" \
   PLUGINS="$ROOT/build/qgis-plugins" PYTEST_ARGS="$PYTEST_ARGS" || rc=$?
-log "make test (QGIS 3.40) exited $rc after $(( (SECONDS - test_start) / 60 )) min $(( (SECONDS - test_start) % 60 )) s;" \
+log "make test ($LEG) exited $rc after $(( (SECONDS - test_start) / 60 )) min $(( (SECONDS - test_start) % 60 )) s;" \
   "whole leg $(( (SECONDS - start) / 60 )) min $(( (SECONDS - start) % 60 )) s"
 exit $rc
