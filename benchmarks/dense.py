@@ -231,8 +231,9 @@ def synthetic(widths, contrast, quality, strips=2, per_strip=6, workers=1):
               f"{100 * r.interpolated_fraction:14.1f}  {med:13.3f}  {rss:12.0f}")
 
 
-def farmland(size, contrast, quality, strips, per_strip, workers):
-    """The DSM stage on tests/lowtexture_scene.py's farmland block against its truth."""
+def farmland(size, contrast, quality, strips, per_strip, workers, out_dir=None):
+    """The DSM stage on tests/lowtexture_scene.py's farmland block against its truth (photos rendered once under
+    ``out_dir``, default build/bench-dense)."""
     from core.common.progress import NullProgress
     from core.dense import stage as dense
     from core.dense.options import DenseOptions
@@ -243,7 +244,8 @@ def farmland(size, contrast, quality, strips, per_strip, workers):
     from tests.workspaces import synthetic_workspace
 
     block = lt.full_block(strips, per_strip, contrast) if size == "full" else lt.small_block(contrast)
-    root = os.path.join(ROOT, "build", "bench-dense", f"farmland-{size}-{contrast:g}-{len(block.shots)}")
+    root = os.path.join(out_dir or os.path.join(ROOT, "build", "bench-dense"),
+                        f"farmland-{size}-{contrast:g}-{len(block.shots)}")
     images = os.path.join(root, "images")
     if not os.path.exists(os.path.join(root, "rendered")):
         t0 = time.time()
@@ -251,7 +253,7 @@ def farmland(size, contrast, quality, strips, per_strip, workers):
         open(os.path.join(root, "rendered"), "w").close()
         print(f"  (rendered {len(block.shots)} images of {block.camera.width} x {block.camera.height} px in "
               f"{time.time() - t0:.0f} s)")
-    ws = os.path.join(root, "ws")
+    ws = os.path.join(root, "ws-" + os.path.basename(ROOT))  # one per source tree (a comparison with another)
     shutil.rmtree(ws, ignore_errors=True)
     rec = block.truth_reconstruction(model_from_local=None, noise_px=0.3, n_points=1500 if size != "full" else 6000)
     synthetic_workspace(ws, block, rec, images_dir=images, georeferenced=True, crs=syn.CRS, offset=syn.ORIGIN)
@@ -276,7 +278,8 @@ def farmland(size, contrast, quality, strips, per_strip, workers):
     for line in r.log_lines:
         print("  " + line)
     print(f"  measured {r.measured_fraction:.3f}, interpolated {r.interpolated_fraction:.3f}, removed "
-          f"{r.removed_fraction:.4f} of the cameras' hull ({r.removed_cells} cells removed in all)")
+          f"{getattr(r, 'removed_fraction', 0.0):.4f} of the cameras' hull ({getattr(r, 'removed_cells', 0)} cells "
+          "removed in all)")
     for name, m in (("fields, measured cells", fields & (src == raster.SOURCE_MEASURED)),
                     ("fields, every cell with a height", fields & np.isfinite(z))):
         e = err[m]
@@ -302,6 +305,7 @@ def main():
     ap.add_argument("--strips", type=int, default=2, help="synthetic: strips of the block")
     ap.add_argument("--per-strip", type=int, default=6, help="synthetic: images per strip")
     ap.add_argument("--workers", type=int, default=0)
+    ap.add_argument("--out", default=None, help="--farmland: where its photos and workspaces go (build/bench-dense)")
     ap.add_argument("--resume", action="store_true", help="keep the pair cache (measures a resumed run)")
     ap.add_argument("--point-cloud", action="store_true", help="also write dense/points.las")
     ap.add_argument("--png", default=None, help="hillshade PNG (default beside the workspace)")
@@ -315,7 +319,7 @@ def main():
         farmland(args.farmland, 0.15 if args.contrast is None else args.contrast,
                  args.quality or ("half" if args.farmland == "full" else "full"),
                  args.strips if args.strips != 2 else (4 if args.farmland == "full" else 2), args.per_strip if
-                 args.per_strip != 6 else (10 if args.farmland == "full" else 5), args.workers or 1)
+                 args.per_strip != 6 else (10 if args.farmland == "full" else 5), args.workers or 1, args.out)
         return
     if args.synthetic:
         synthetic([int(v) for v in args.synthetic.split(",")], 0.03 if args.contrast is None else args.contrast,

@@ -28,9 +28,9 @@ import numpy as np
 from tests import synthetic as syn
 
 FURROW_PERIOD = 0.75  # m, ploughed fields
-FURROW_ANGLE_DEG = 30.0  # to the flight strips (local x)
+FURROW_ANGLE_DEG = 30.0  # the furrows' lines to the flight strips (local x)
 CROP_PERIOD = 0.5  # m, crop rows
-CROP_ANGLE_DEG = 95.0
+CROP_ANGLE_DEG = 95.0  # the rows' lines to the strips
 GRAIN_RES = 0.02  # m per cell of the tiled soil-grain noise
 
 
@@ -50,7 +50,7 @@ class FarmScene(syn.Scene):
     field_seeds: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     field_kind: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
     field_tone: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    field_angle: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    field_angle: np.ndarray = field(default_factory=lambda: np.zeros(0))  # of the furrows' / rows' lines, from x
     road: Tuple[Tuple[float, float], Tuple[float, float], float] = ((0.0, 0.0), (1.0, 0.0), 2.5)
     trees: List[Tree] = field(default_factory=list)
     contrast: float = 1.0  # scales every texture amplitude of the fields
@@ -128,7 +128,7 @@ class FarmScene(syn.Scene):
         tone = self.field_tone.astype(np.float32)[fi]
         ang = self.field_angle.astype(np.float32)[fi]
         kind = self.field_kind[fi]
-        along = x * np.cos(ang) + y * np.sin(ang)
+        along = y * np.cos(ang) - x * np.sin(ang)  # across the lines
         grain = _grain(self.seed, x, y)  # soil grain: faint, fine
         moist = _grain(self.seed + 7, x / 40.0, y / 40.0)  # broad soil moisture / crop marks
         c = np.float32(self.contrast)

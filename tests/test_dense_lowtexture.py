@@ -71,7 +71,7 @@ def test_source_raster_flags_removed_cells():
 # ---------------------------------------------------------------------------
 
 CONTRAST = 0.15  # of the fields' texture: furrows of about +-0.5 grey level under 1.5 of noise
-CACHE = os.path.join(ROOT, "build", "test-cache", f"dense-farmland-v1-{CONTRAST:g}")
+CACHE = os.path.join(ROOT, "build", "test-cache", f"dense-farmland-v2-{CONTRAST:g}")
 
 
 @pytest.fixture(scope="module")
@@ -88,19 +88,30 @@ def farmland(tmp_path_factory):
     return block, r, z, np.nan_to_num(src).astype(np.uint8), x, y
 
 
+def _rmse_gsd(err: np.ndarray, gsd: float) -> float:
+    return float(np.sqrt(np.mean(err ** 2)) / gsd)
+
+
 def test_farmland_dsm_is_mostly_measured_and_near_the_truth_on_the_fields(farmland):
-    """Before issue 33: 87 % measured, the measured fields' RMSE 20 GSD (pits of 1-4 m that one image's
-    periodic mismatch made, spread by the fill); now >= 85 % measured, the blunders removed."""
+    """Before issue 33: 84.5 % measured; the fields' RMSE inside the cameras' hull 10.6 GSD over the measured cells
+    and 37.7 GSD over every cell (pits of 1-5 m from periodic mismatches, spread by the fill), 29.7 GSD over the
+    measured fields of the whole DSM.  Now 88.2 % measured; 1.48, 1.59 and 1.96 GSD."""
+    from scipy.spatial import Delaunay
+
     block, r, z, src, x, y = farmland
     gsd = block.gsd
     assert r.measured_fraction >= 0.85
     assert r.measured_fraction + r.interpolated_fraction + r.removed_fraction == pytest.approx(1.0, abs=0.01)
-    fields = block.scene.field_mask(x, y) & (src == raster.SOURCE_MEASURED)
-    assert fields.sum() > 0.2 * z.size  # (the raster holds nodata around the block too)
-    err = np.abs(z - block.scene.height_at(x, y))[fields]
-    assert np.median(err) <= 1.0 * gsd
-    assert np.percentile(err, 95) <= 5.0 * gsd
-    assert np.sqrt(np.mean(err ** 2)) <= 6.0 * gsd  # was 20 GSD: the remaining error is a few consistent pits
+    centres = np.array([s.centre[:2] for s in block.shots])
+    hull = Delaunay(centres).find_simplex(np.column_stack([x.ravel(), y.ravel()])).reshape(x.shape) >= 0
+    fields = block.scene.field_mask(x, y)
+    measured = fields & (src == raster.SOURCE_MEASURED)
+    err = z - block.scene.height_at(x, y)
+    assert (measured & hull).sum() > 0.5 * (fields & hull).sum()
+    assert _rmse_gsd(err[measured & hull], gsd) <= 2.0
+    assert _rmse_gsd(err[fields & hull & np.isfinite(z)], gsd) <= 2.5  # the interpolated cells too
+    assert _rmse_gsd(err[measured], gsd) <= 3.0  # beyond the hull too: the block's edge, fewer views
+    assert np.median(np.abs(err[measured])) <= 1.0 * gsd
 
 
 def test_farmland_blunders_are_removed_and_flagged(farmland):
