@@ -150,11 +150,11 @@ def match_constellation(model: np.ndarray, world: np.ndarray, names: Sequence[st
 
 def _mutual(model_w: np.ndarray, world: np.ndarray, taken: Dict[int, Tuple[int, float]], xy_only: bool,
             evidence: np.ndarray) -> Dict[int, Tuple[int, float]]:
-    """Beyond the tolerance (a survey or a block off by metres): a well-evidenced mark (tied in three photos or
-    more) and a target that are each other's nearest among the ones left, the mark nearer to the target than the
+    """Beyond the tolerance (a survey or a block off by metres): a mark (tied in two photos or more, on the
+    block's surface) and a target that are each other's nearest among the ones left, the mark nearer to the target than the
     target's nearest neighbouring target is (each such naming is reported)."""
     used = {j for j, _ in taken.values()}
-    free_m = [i for i in range(len(model_w)) if i not in taken and evidence[i] >= 3]
+    free_m = [i for i in range(len(model_w)) if i not in taken and evidence[i] >= 2]
     free_w = [j for j in range(len(world)) if j not in used]
     if not free_m or not free_w:
         return {}

@@ -184,7 +184,34 @@ def _predict(rec, gs: gcpmod.GCPSet, named: Dict[str, List[Candidate]], cands: D
                 continue  # nothing there, or two marks close to the projection: left out, not guessed
             out.setdefault(name, []).append(free[k])
             taken.add((image, round(free[k].x, 3), round(free[k].y, 3)))
+    _loose(pred, out, cands, kinds, taken, reports)
     return out
+
+
+def _loose(pred, out: Dict[str, List[Candidate]], cands: Dict[str, List[Candidate]], kinds: Dict[str, str],
+           taken: set, reports: List[str]) -> None:
+    """A target not tied in two photos has only the similarity's projection, off by the survey's misfit: in each
+    photo, the free mark and the projection that are each other's nearest (among the free marks and all the
+    targets' projections there) join, if nearer than half the distance to the next target's projection."""
+    for name, per_image in pred.items():
+        if len(out.get(name, [])) >= 2:
+            continue  # projected through its own rays: the tight search above decides
+        for image, p in per_image.items():
+            if any(c.image == image for c in out.get(name, [])):
+                continue
+            others = [q for n, v in pred.items() if n != name and image in v for q in [v[image]]]
+            free = [c for c in cands.get(image, []) if (c.image, round(c.x, 3), round(c.y, 3)) not in taken
+                    and (name not in kinds or c.kind == kinds[name])]
+            if not others or not free:
+                continue
+            spacing = min(math.hypot(q.x - p.x, q.y - p.y) for q in others)
+            c = min(free, key=lambda c: math.hypot(c.x - p.x, c.y - p.y))
+            d = math.hypot(c.x - p.x, c.y - p.y)
+            if d < 0.5 * spacing and all(math.hypot(c.x - q.x, c.y - q.y) > d for q in others):
+                out.setdefault(name, []).append(c)
+                taken.add((image, round(c.x, 3), round(c.y, 3)))
+                reports.append(f"target {name} in {image}: the only mark near its projection, {d:.0f} px from it "
+                               f"(the survey and the block disagree there): check it")
 
 
 def _ground_sizes(rec, cs: Sequence[Candidate], xyz, scale: Optional[float]) -> List[Optional[float]]:
