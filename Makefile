@@ -92,7 +92,7 @@ lint: venv
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/flake8 .
 
-I18N_SOURCES := $(shell ls *.py processing_provider/*.py ui/*.py 2>/dev/null)
+I18N_SOURCES := $(shell ls *.py processing_provider/*.py qgisio/*.py ui/*.py 2>/dev/null)
 transup: apt
 	python3 i18n/make_catalog.py && python3 i18n/update_ts.py -noobsolete
 

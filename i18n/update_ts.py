@@ -20,7 +20,7 @@ import tokenize
 import unicodedata
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SOURCE_GLOBS = ("", "processing_provider", "ui")  # *.py in these folders (as the Makefile's I18N_SOURCES)
+SOURCE_GLOBS = ("", "processing_provider", "qgisio", "ui")  # *.py in these folders (as the Makefile's I18N_SOURCES)
 TS_FILES = ("i18n/archaeoortho_de.ts", "i18n/archaeoortho_it.ts")
 
 # an escape preceded by an even number of backslashes (so "\\u2026" - an escaped backslash - stays)

@@ -80,7 +80,7 @@ class AutoControlAlgorithm(AlgorithmBase):
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
         from ..core.georef.autocontrol.stage import autocontrol_workspace
-        from .reference_layers import resolve_references
+        from ..qgisio.reference_layers import resolve_references
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         ortho = self.parameterAsRasterLayer(parameters, self.REFERENCE_ORTHO, context)
@@ -113,7 +113,7 @@ class AutoControlAlgorithm(AlgorithmBase):
         georeference_workspace with GeorefOptions.reference_dem)."""
         from ..core.georef.options import GeorefOptions
         from ..core.georef.stage import georeference_workspace
-        from .reference_layers import describe, local_file
+        from ..qgisio.reference_layers import describe, local_file
 
         if local_file(dsm) is None:
             raise QgsProcessingException(self.tr(

@@ -131,12 +131,12 @@ class AlgorithmBase(QgsProcessingAlgorithm):
 
     def register_styled_outputs(self, results, context, feedback=None):
         """Post-processing hook: outputs that are ours (DSM, orthomosaic, cameras, residuals, point cloud)
-        are loaded on completion with their styles (ui/layers.py: qgis.core only).  Never under
+        are loaded on completion with their styles (qgisio/layers.py: qgis.core only).  Never under
         qgis_process; a problem here is a warning, never a failed run."""
         if not self.STYLE_OUTPUTS or not styling_enabled():
             return 0
         try:
-            from ..ui.layers import register_outputs
+            from ..qgisio.layers import register_outputs
 
             return register_outputs(self, results, context)
         except Exception as e:  # noqa: BLE001 - styling must never fail an algorithm that worked

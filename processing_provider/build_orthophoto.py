@@ -38,7 +38,7 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
     RESOLUTION_USED = "RESOLUTION_USED"
     IMAGES_USED = "IMAGES_USED"
     BLENDINGS = params.BLENDINGS
-    OUTPUT_KINDS = {OUTPUT: "ortho"}  # the output's style and layer name (ui/layers.py): its id does not say
+    OUTPUT_KINDS = {OUTPUT: "ortho"}  # the output's style and layer name (qgisio/layers.py): its id does not say
     INTERPOLATIONS = params.INTERPOLATIONS
     HELP = (
         "True orthophotos and the orthomosaic of a georeferenced workspace.\n\n"

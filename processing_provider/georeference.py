@@ -118,7 +118,7 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         options = None
         if dsm is not None:  # DEM control: the reference DSM alone
             from ..core.georef.options import GeorefOptions
-            from .reference_layers import describe, local_file
+            from ..qgisio.reference_layers import describe, local_file
 
             if local_file(dsm) is None:
                 raise QgsProcessingException(self.tr(
@@ -158,7 +158,7 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         """Automatic control (core autocontrol_workspace) from the reference layers; the given ground control
         becomes check points."""
         from ..core.georef.autocontrol.stage import PRIOR_AUTO, PRIOR_GPS, autocontrol_workspace
-        from . import reference_layers as refs
+        from ..qgisio import reference_layers as refs
 
         if ortho is None or dsm is None:
             raise QgsProcessingException(self.tr("Automatic control needs both a reference orthophoto and a "
@@ -210,7 +210,7 @@ def _check_points(workspace, gcp_path, gcps, checks, crs):
     the reference's CRS (None when none is given)."""
     from ..core.io import gcp as gcpmod
     from ..core.project.workspace import Workspace
-    from .reference_layers import as_check_points
+    from ..qgisio.reference_layers import as_check_points
 
     if gcp_path:
         ws = Workspace.open(workspace)

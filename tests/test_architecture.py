@@ -157,3 +157,45 @@ def test_every_core_error_derives_from_the_one_base():
 def test_each_stage_room_has_options_and_stage(room):
     for f in ("options.py", "stage.py"):
         assert os.path.isfile(os.path.join(CORE, room, f)), f"core/{room}/{f} missing"
+
+
+# the faces and the QGIS floor under them: a package may import only the packages listed (and itself, core, qgis)
+FACES = {"processing_provider": {"qgisio"}, "ui": {"qgisio"}, "qgisio": set()}
+
+
+def _package_imports(package):
+    """(path, line, imported top-level plugin package) for every import in package/*.py, in functions too."""
+    for path in sorted(os.path.join(ROOT, package, f) for f in os.listdir(os.path.join(ROOT, package))
+                       if f.endswith(".py")):
+        with open(path, encoding="utf-8") as fh:
+            tree = ast.parse(fh.read(), path)
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom):
+                if node.level == 1:
+                    top = package
+                elif node.level == 2:
+                    top = (node.module or "").split(".")[0]
+                else:
+                    mod = node.module or ""
+                    top = mod.split(".")[1] if mod.startswith("archaeoortho.") else ""
+                if node.level == 2 and not node.module:  # from .. import x
+                    for a in node.names:
+                        yield path, node.lineno, a.name
+                elif top:
+                    yield path, node.lineno, top
+
+
+def test_faces_import_only_core_and_the_qgis_floor():
+    """processing_provider/ and ui/ never import each other (a headless qgis_process run pulls nothing from ui/):
+    what both need lives in qgisio/, which imports neither face and no widget."""
+    bad = []
+    for package, allowed in FACES.items():
+        for path, line, top in _package_imports(package):
+            if top in FACES and top != package and top not in allowed:
+                bad.append(f"{os.path.relpath(path, ROOT)}:{line}: {package} imports {top}")
+    for path in sorted(os.listdir(os.path.join(ROOT, "qgisio"))):
+        if path.endswith(".py"):
+            with open(os.path.join(ROOT, "qgisio", path), encoding="utf-8") as fh:
+                if "QtWidgets" in fh.read():
+                    bad.append(f"qgisio/{path}: imports widgets (QtWidgets): they belong in ui/")
+    assert not bad, "imports across the faces:\n" + "\n".join(bad)

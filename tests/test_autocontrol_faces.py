@@ -107,7 +107,7 @@ def _warped(src, gt, shape):
 
 def test_an_xyz_layer_is_saved_for_the_requested_extent(epochs, xyz_uri, tmp_path):
     import cv2
-    from archaeoortho.processing_provider.reference_layers import save_layer
+    from archaeoortho.qgisio.reference_layers import save_layer
     from osgeo import gdal, osr
     from qgis.core import QgsCoordinateReferenceSystem, QgsRectangle
 
@@ -136,7 +136,7 @@ def test_an_xyz_layer_is_saved_for_the_requested_extent(epochs, xyz_uri, tmp_pat
 
 def test_a_failed_fetch_a_cancel_and_the_pixel_cap(epochs, xyz_uri, tmp_path, monkeypatch):
     from archaeoortho.core.common.progress import Cancelled
-    from archaeoortho.processing_provider import reference_layers as refs
+    from archaeoortho.qgisio import reference_layers as refs
     from qgis.core import QgsCoordinateReferenceSystem, QgsRectangle
 
     utm = QgsCoordinateReferenceSystem(syn.CRS)
@@ -172,7 +172,7 @@ def test_the_extent_comes_from_the_photos_gps(epochs, xyz_uri, tmp_path):
     the margin; the DSM file is used as it is."""
     from archaeoortho.core.project.layout import Layout
     from archaeoortho.core.project.workspace import Workspace
-    from archaeoortho.processing_provider import reference_layers as refs
+    from archaeoortho.qgisio import reference_layers as refs
     from osgeo import gdal
     from qgis.core import QgsRasterLayer
 

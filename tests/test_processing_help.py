@@ -170,7 +170,7 @@ def test_build_orthophoto_output_is_named_orthomosaic_in_the_workspace_group(plu
     """As the toolbox dialog loads a ticked destination: the layer is 'Orthomosaic' (not the parameter's label
     'Orthomosaic (default: <workspace>/orthomosaic.tif)') and sits in the workspace's group with its other
     layers; a re-run replaces it."""
-    from archaeoortho.ui import layers
+    from archaeoortho.qgisio import layers
     from processing.gui.Postprocessing import handleAlgorithmResults
     from qgis.core import (
         QgsApplication,

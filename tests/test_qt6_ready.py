@@ -33,7 +33,7 @@ GONE_IN_QT6 = {"QRegExp", "QRegExpValidator", "QTextCodec", "QTextDecoder", "QTe
 
 
 def plugin_sources():
-    files = glob.glob(os.path.join(ROOT, "ui", "*.py")) + glob.glob(os.path.join(ROOT, "processing_provider", "*.py"))
+    files = [f for d in ("ui", "processing_provider", "qgisio") for f in glob.glob(os.path.join(ROOT, d, "*.py"))]
     return sorted(files) + [os.path.join(ROOT, "plugin.py")]
 
 

@@ -398,7 +398,7 @@ def test_qgis_process_runs_the_terrain_algorithms(scene_dsm, tmp_path):
 @pytest.mark.usefixtures("qgis_processing")
 def test_products_load_styled_in_qgis(scene_dsm, tmp_path, qgis_new_project):
     pytest.importorskip("rvt.vis")
-    from archaeoortho.ui import layers
+    from archaeoortho.qgisio import layers
     from qgis.core import QgsProject, QgsSingleBandGrayRenderer
 
     scene, x, y, path, buildings, trees = scene_dsm

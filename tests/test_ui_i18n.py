@@ -146,7 +146,7 @@ def test_choice_values_and_units_translated(qgis_iface, locale_setting, tmp_path
                 assert definition.description() == want, (alg_id, name)
         alg = reg.algorithmById("archaeoortho:runpipeline").create()
         assert params.read_choice(alg, {"QUALITY": 1}, "QUALITY", QgsProcessingContext(), params.QUALITIES) == "half"
-        from archaeoortho.ui.layers import relief_name  # a relief layer is named as the option was
+        from archaeoortho.qgisio.layers import relief_name  # a relief layer is named as the option was
 
         assert relief_name(str(tmp_path / "dtm-svf.tif")) == {"de": "Sky-View-Faktor (DTM)",
                                                               "it": "Fattore di vista del cielo (sky-view factor) (DTM)"}[lang]

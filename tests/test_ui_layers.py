@@ -116,7 +116,7 @@ def test_footprints_not_written_say_why(plugin, aligned, monkeypatch):
     from archaeoortho.core.georef.stage import georeference_workspace
     from archaeoortho.core.project.layout import Layout
     from archaeoortho.core.project.workspace import Workspace
-    from archaeoortho.ui import layers
+    from archaeoortho.qgisio import layers
     from qgis.core import QgsApplication
 
     ws, gcp_file = aligned
@@ -161,7 +161,7 @@ def test_hook_registers_only_our_outputs(plugin, aligned):
 
 
 def test_dsm_pseudocolour_and_hillshade(tmp_path, qgis_new_project):
-    from archaeoortho.ui import layers
+    from archaeoortho.qgisio import layers
     from qgis.core import QgsProject
 
     path = _raster(str(tmp_path / "dsm.tif"), 1, nodata=-9999)
@@ -180,7 +180,7 @@ def test_dsm_pseudocolour_and_hillshade(tmp_path, qgis_new_project):
 def test_a_failing_style_step_is_logged_and_reported_not_raised(tmp_path, qgis_new_project, monkeypatch):
     """QGIS calls postProcessLayer from C++: an exception escaping it would abort QGIS.  A styling bug is
     caught, logged with its traceback and reported to the run's feedback; the layer stays loaded."""
-    from archaeoortho.ui import layers
+    from archaeoortho.qgisio import layers
     from qgis.core import QgsApplication, QgsProcessingContext, QgsProcessingFeedback, QgsProject, QgsRasterLayer
 
     path = _raster(str(tmp_path / "o.tif"), 3, nodata=0)
@@ -221,7 +221,7 @@ def test_a_failing_style_step_is_logged_and_reported_not_raised(tmp_path, qgis_n
 
 
 def test_orthomosaic_rgb_with_transparent_alpha_or_nodata(tmp_path, qgis_new_project):
-    from archaeoortho.ui import layers
+    from archaeoortho.qgisio import layers
     from qgis.core import QgsProject
 
     with_alpha = layers.load_orthomosaic(_raster(str(tmp_path / "a.tif"), 4, alpha=True), QgsProject.instance())[0]
@@ -237,7 +237,7 @@ def test_orthomosaic_rgb_with_transparent_alpha_or_nodata(tmp_path, qgis_new_pro
 
 def _products(folder):
     """A workspace folder with a DSM, an orthomosaic (RGBA) and a DTM where its Layout puts them."""
-    from archaeoortho.ui import layers
+    from archaeoortho.qgisio import layers
 
     os.makedirs(folder, exist_ok=True)
     with open(os.path.join(folder, "workspace.json"), "w", encoding="utf-8") as fh:
@@ -272,7 +272,7 @@ def test_orthomosaic_reads_true_over_the_terrain_layers(tmp_path, qgis_new_proje
     """A workspace's group: points over the orthomosaic, the orthomosaic over the DTM and DSM and their hillshades
     (the DTM's multiplied hillshade, loaded last, lay over the orthomosaic and darkened it by ~19 %: issue 36 item
     16).  The group as drawn shows the orthomosaic's own colours."""
-    from archaeoortho.ui import layers
+    from archaeoortho.qgisio import layers
     from qgis.core import QgsProject
 
     ws = _products(str(tmp_path / "site"))
@@ -298,7 +298,7 @@ def test_orthomosaic_reads_true_over_the_terrain_layers(tmp_path, qgis_new_proje
 def test_layers_named_after_their_workspace(tmp_path, qgis_new_project):
     """Two workspaces loaded: their DSMs and orthomosaics are told apart by name in a raster layer box (the dock's
     reference boxes listed 'DSM' and 'DSM': issue 36 item 17)."""
-    from archaeoortho.ui import layers
+    from archaeoortho.qgisio import layers
     from qgis.core import QgsMapLayerProxyModel, QgsProject
     from qgis.gui import QgsMapLayerComboBox
 

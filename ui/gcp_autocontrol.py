@@ -2,7 +2,7 @@
 
 Ticked, the panel's Georeference button georeferences the block with no hand-picked GCP, from a reference
 orthophoto and a reference DSM picked among the project's raster layers (files, or WMS / XYZ / WCS layers, saved
-for the block's extent in the worker thread by processing_provider/reference_layers.py: qgis.core only).  It runs
+for the block's extent in the worker thread by qgisio/reference_layers.py: qgis.core only).  It runs
 core.georef.autocontrol.stage.autocontrol_workspace in a ui.tasks.CoreTask, as the dock's adjustment does; the
 dock's points, if any, become check points (as in Processing's Georeference).  When it ends, the table shows
 what the stage wrote to georef/control.json (the automatic GCPs auto_NNN and the check points) and the map the
@@ -15,7 +15,7 @@ from qgis.PyQt.QtCore import QCoreApplication
 from qgis.PyQt.QtWidgets import QFormLayout, QGroupBox
 
 from ..core.project.stages import ALIGN
-from . import layers
+from ..qgisio import layers
 from .tasks import CoreTask
 
 translate = QCoreApplication.translate
@@ -27,7 +27,7 @@ def autocontrol_then_prepare(root, ortho_layer, dsm_layer, check_points=None, ex
     control, then the image footprints the result layers show.  Returns (AutoControlResult, footprints)."""
     from ..core.common.progress import SubProgress
     from ..core.georef.autocontrol.stage import autocontrol_workspace
-    from ..processing_provider import reference_layers as refs
+    from ..qgisio import reference_layers as refs
 
     ortho, dsm = refs.resolve_references(ortho_layer, dsm_layer, root, extent=extent, extent_crs=extent_crs,
                                          progress=SubProgress(progress, 0.0, 0.1), context=context)
@@ -106,7 +106,7 @@ class GcpAutoControl:
         extent = crs = None
         if self.canvas is not None:  # used for web layers when the photos carry no GPS
             extent, crs = self.canvas.extent(), self.canvas.mapSettings().destinationCrs()
-            from ..processing_provider.reference_layers import gps_lonlat
+            from ..qgisio.reference_layers import gps_lonlat
 
             if gps_lonlat(root):
                 extent = crs = None
@@ -128,7 +128,7 @@ class GcpAutoControl:
             self.auto_result = result
 
         self.auto_result = None
-        from ..processing_provider.reference_layers import snapshot
+        from ..qgisio.reference_layers import snapshot
 
         # the worker reads snapshots taken here, on the GUI thread, not the project's layers the canvas renders
         # and the project's transform context, copied here: QgsProject is not read from the worker either

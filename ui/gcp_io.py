@@ -19,7 +19,7 @@ from qgis.PyQt.QtWidgets import QCheckBox, QFileDialog, QInputDialog, QMessageBo
 from ..core.geometry.crs import transform_points
 from ..core.io import gcp as gcpmod
 from ..core.io.images import ImageError, exif_orientation
-from . import layers
+from ..qgisio import layers
 
 translate = QCoreApplication.translate
 

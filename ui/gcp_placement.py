@@ -13,7 +13,7 @@ from qgis.PyQt.QtCore import QCoreApplication
 from qgis.PyQt.QtWidgets import QMessageBox
 
 from ..core.project.stages import ALIGN, GEOREFERENCE
-from . import layers
+from ..qgisio import layers
 from .raster import sample_height
 
 translate = QCoreApplication.translate

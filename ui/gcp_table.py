@@ -8,7 +8,7 @@ from qgis.PyQt.QtGui import QColor, QFont
 from qgis.PyQt.QtWidgets import QComboBox, QStyledItemDelegate
 
 from ..core.io import gcp as gcpmod
-from . import layers
+from ..qgisio import layers
 
 NAME, X, Y, Z, SXY, SZ, ROLE, OBS, DXY, DZ, PX = range(11)
 EDITABLE = {NAME, X, Y, Z, SXY, SZ, ROLE}

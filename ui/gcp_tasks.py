@@ -9,7 +9,7 @@ from qgis.PyQt.QtWidgets import QFileDialog
 
 from ..core.io import gcp as gcpmod
 from ..core.project.stages import ALIGN, GEOREFERENCE
-from . import layers
+from ..qgisio import layers
 from .gcp_table import fmt, short_crs
 from .tasks import CoreTask, start
 
