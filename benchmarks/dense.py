@@ -249,7 +249,7 @@ def farmland(size, contrast, quality, strips, per_strip, workers, out_dir=None):
     images = os.path.join(root, "images")
     if not os.path.exists(os.path.join(root, "rendered")):
         t0 = time.time()
-        block.render(images)
+        block.render(images, keep_existing=True)
         open(os.path.join(root, "rendered"), "w").close()
         print(f"  (rendered {len(block.shots)} images of {block.camera.width} x {block.camera.height} px in "
               f"{time.time() - t0:.0f} s)")
@@ -290,6 +290,57 @@ def farmland(size, contrast, quality, strips, per_strip, workers, out_dir=None):
     print(f"  DSM stage: {wall:.0f} s wall, {cpu:.0f} CPU-s (this process and its workers)")
 
 
+def diagnose(contrast, workers, out_dir=None):
+    """Per pair of the small farmland block, why the matching gives up on the fields: the share of the overlap
+    matched at the coarsest pyramid level (the whole disparity range: a periodic texture's repeats compete there)
+    and in the end, with the baseline's direction, under the settings before issue 33 and each change alone."""
+    from glob import glob
+
+    from core.common.progress import NullProgress
+    from core.dense import stage as dense
+    from core.dense.options import DenseOptions
+    from core.dense.stereo import read_pair_summary
+    from tests import lowtexture_scene as lt
+    from tests import synthetic as syn
+    from tests.workspaces import synthetic_workspace
+
+    block = lt.small_block(contrast)
+    root = os.path.join(out_dir or os.path.join(ROOT, "build", "bench-dense"), f"farmland-small-{contrast:g}-10")
+    images = os.path.join(root, "images")
+    if not os.path.exists(os.path.join(root, "rendered")):
+        block.render(images)
+        open(os.path.join(root, "rendered"), "w").close()
+    settings = {"neither (as before)": dict(equalize=False, fine_uniqueness=10),
+                "equalised only": dict(equalize=True, fine_uniqueness=10),
+                "fine uniqueness 3 only": dict(equalize=False, fine_uniqueness=3),
+                "both (default)": dict(equalize=True, fine_uniqueness=3)}
+    table, fractions = {}, {}
+    for name, opts in settings.items():
+        ws = os.path.join(root, "ws-diagnose")
+        shutil.rmtree(ws, ignore_errors=True)
+        rec = block.truth_reconstruction(model_from_local=None, noise_px=0.3, n_points=1500)
+        synthetic_workspace(ws, block, rec, images_dir=images, georeferenced=True, crs=syn.CRS, offset=syn.ORIGIN)
+        r = dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=workers, **opts),
+                                      progress=NullProgress())
+        fractions[name] = (r.measured_fraction, r.removed_fraction)
+        for p in glob(os.path.join(ws, "dense", "pairs-*", "*.npz")):
+            sm = read_pair_summary(p)
+            key = (sm["i"], sm["j"])
+            table.setdefault(key, {"azimuth": sm.get("baseline_azimuth"), "rel_err": sm.get("rel_err")})[name] = (
+                sm.get("pyramid", {}).get("coarsest_matched", float("nan")),
+                sm.get("pyramid", {}).get("overlap_matched", float("nan")))
+    print(f"\n== per pair: share of the overlap matched, coarsest level / in the end (farmland small, contrast "
+          f"{contrast:g}; furrows at {lt.FURROW_ANGLE_DEG:g} deg to the strips, rows at {lt.CROP_ANGLE_DEG:g}) ==")
+    names = list(settings)
+    print("  pair                    baseline az  depth err/px  " + "  ".join(f"{n[:22]:>22s}" for n in names))
+    for (i, j), row in sorted(table.items()):
+        cells = "  ".join(f"{row[n][0]:10.2f} / {row[n][1]:4.2f}    " if n in row else " " * 22 for n in names)
+        print(f"  {i:>10s} + {j:<10s}  {row['azimuth']:8.1f}  {row['rel_err'] or 0:12.4f}  {cells}")
+    for n in names:
+        print(f"  {n}: DSM measured {fractions[n][0]:.3f}, removed {fractions[n][1]:.4f} of the cameras' hull "
+              "(the blunder filter on in all four)")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--synthetic", default=None, metavar="W1,W2",
@@ -302,9 +353,13 @@ def main():
     ap.add_argument("--images", default=os.path.join(DATA, "toledo", "images"))
     ap.add_argument("--crs", default="EPSG:32617")
     ap.add_argument("--quality", default=None, help="matching quality (default: half for Toledo, full synthetic)")
-    ap.add_argument("--strips", type=int, default=2, help="synthetic: strips of the block")
-    ap.add_argument("--per-strip", type=int, default=6, help="synthetic: images per strip")
+    ap.add_argument("--strips", type=int, default=None, help="synthetic: strips of the block (2; farmland 4)")
+    ap.add_argument("--per-strip", type=int, default=None,
+                    help="synthetic: images per strip (6; farmland full 10)")
     ap.add_argument("--workers", type=int, default=0)
+    ap.add_argument("--diagnose", action="store_true",
+                    help="per pair of the small farmland block: the share matched at the coarsest level and in the end "
+                         "under the settings before issue 33 and each change alone")
     ap.add_argument("--out", default=None, help="--farmland: where its photos and workspaces go (build/bench-dense)")
     ap.add_argument("--resume", action="store_true", help="keep the pair cache (measures a resumed run)")
     ap.add_argument("--point-cloud", action="store_true", help="also write dense/points.las")
@@ -315,16 +370,19 @@ def main():
     if args.child:
         child(args)
         return
+    if args.diagnose:
+        diagnose(0.15 if args.contrast is None else args.contrast, args.workers or 1, args.out)
+        return
     if args.farmland:
+        full = args.farmland == "full"
         farmland(args.farmland, 0.15 if args.contrast is None else args.contrast,
-                 args.quality or ("half" if args.farmland == "full" else "full"),
-                 args.strips if args.strips != 2 else (4 if args.farmland == "full" else 2), args.per_strip if
-                 args.per_strip != 6 else (10 if args.farmland == "full" else 5), args.workers or 1, args.out)
+                 args.quality or ("half" if full else "full"), args.strips or (4 if full else 2),
+                 args.per_strip or (10 if full else 5), args.workers or 1, args.out)
         return
     if args.synthetic:
         synthetic([int(v) for v in args.synthetic.split(",")], 0.03 if args.contrast is None else args.contrast,
-                  args.quality or "full", args.strips,
-                  args.per_strip, args.workers or 1)
+                  args.quality or "full", args.strips or 2,
+                  args.per_strip or 6, args.workers or 1)
         return
     args.quality = args.quality or "half"
     if not os.path.isdir(args.images):

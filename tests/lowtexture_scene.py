@@ -203,12 +203,17 @@ def render_farm_image(scene: FarmScene, camera: syn.CameraModel, shot: syn.Shot,
 
 class FarmBlock(syn.SyntheticBlock):
     def render(self, folder: str, supersample: int = 1, ext: str = ".jpg", quality: int = 92,
-               radiometry=None) -> List[str]:
+               radiometry=None, keep_existing: bool = False) -> List[str]:
+        """The photos as JPEG in ``folder``; ``keep_existing``: those already there are not rendered again (an
+        interrupted rendering of a large block resumed)."""
         os.makedirs(folder, exist_ok=True)
         paths = []
         for k, s in enumerate(self.shots):
-            img = render_farm_image(self.scene, self.camera, s, supersample, seed=self.seed * 1000 + k)
             path = os.path.join(folder, s.name)
+            if keep_existing and os.path.isfile(path) and cv2.imread(path, cv2.IMREAD_GRAYSCALE) is not None:
+                paths.append(path)
+                continue
+            img = render_farm_image(self.scene, self.camera, s, supersample, seed=self.seed * 1000 + k)
             if not cv2.imwrite(path, cv2.cvtColor(img, cv2.COLOR_GRAY2BGR), [cv2.IMWRITE_JPEG_QUALITY, quality]):
                 raise OSError(f"cannot write {path}")
             paths.append(path)

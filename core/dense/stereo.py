@@ -478,7 +478,7 @@ def _disparity(li: np.ndarray, rj: np.ndarray, block: int, dmin: int, num: int, 
     cl, cr = _match_lr(pyr[levels][0], pyr[levels][1], block, lo, n, unit.uniqueness, cancel_path)
     disp = lr_checked(cl, cr, unit.lr_tolerance)
     del cl, cr
-    info = {"levels": levels, "coarsest_disparities": n}
+    info = {"levels": levels, "coarsest_disparities": n, "coarsest_map": np.isfinite(disp)}
     for k in range(levels - 1, -1, -1):
         lo, n = level_range(k)
         fine, tinfo = _match_tiled(pyr[k][0], pyr[k][1], disp, block, lo, n, unit, cancel_path,
@@ -490,6 +490,27 @@ def _disparity(li: np.ndarray, rj: np.ndarray, block: int, dmin: int, num: int, 
     if stats is not None:
         stats.update(info)
     return disp
+
+
+def _matched_shares(disp: np.ndarray, coarsest: Optional[np.ndarray], mi: np.ndarray, mj: np.ndarray,
+                    dmid: float) -> dict:
+    """The per-pair diagnosis (issue 33): of the left image's pixels whose ground the right image sees (at the
+    middle of the disparity range), the share matched at the coarsest pyramid level (over the whole range: where
+    a periodic texture's repeats compete) and in the end."""
+    h, w = disp.shape
+    shift = int(round(dmid))
+    overlap = np.zeros((h, w), bool)
+    if 0 <= shift < w:
+        overlap[:, shift:] = mi[:, shift:] & mj[:, :w - shift]
+    elif -w < shift < 0:
+        overlap[:, :w + shift] = mi[:, :w + shift] & mj[:, -shift:]
+    n = int(overlap.sum())
+    out = {"overlap_matched": round(float(np.isfinite(disp)[overlap].mean()), 4) if n else 0.0}
+    if coarsest is not None and n:
+        step_y, step_x = -(-h // coarsest.shape[0]), -(-w // coarsest.shape[1])
+        ov = overlap[::step_y, ::step_x][:coarsest.shape[0], :coarsest.shape[1]]
+        out["coarsest_matched"] = round(float(coarsest[:ov.shape[0], :ov.shape[1]][ov].mean()), 4) if ov.any() else 0.0
+    return out
 
 
 def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
@@ -526,6 +547,7 @@ def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
     pyramid: dict = {}
     disp = _disparity(li, rj, unit.block_size, dmin, num, unit, cancel_path, pyramid, rect.cx_i - rect.cx_j)
     check_unit_cancel(cancel_path)
+    pyramid.update(_matched_shares(disp, pyramid.pop("coarsest_map", None), mi, mj, dmin + 0.5 * num))
     rows, xs = np.nonzero(np.isfinite(disp) & mi)
     d = disp[rows, xs]
     xr = xs - d
@@ -554,7 +576,9 @@ def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
     map_j = _zbuffer((hj_, wj_), px_j, py_j, depth_j)
     zmed = float(np.median(z)) if len(z) else float("nan")
     rel_err = zmed / (rect.f * rect.baseline) if len(z) else 0.0
+    base = unit.vj.centre - unit.vi.centre
     summary.update(valid=int(len(z)), valid_fraction=float(len(z) / max(1, int(mi.sum()))),
+                   baseline_azimuth=round(math.degrees(math.atan2(base[1], base[0])), 1),
                    megapixels=(wi_ * hi_ + wj_ * hj_) / 1e6, rectified=[w, h], disparities=[dmin, num],
                    pyramid=pyramid,
                    rel_err=rel_err, seconds=time.time() - t0, cpu_seconds=time.process_time() - c0)
