@@ -1,6 +1,6 @@
 """Run independent units of work (stereo pairs, images, tiles) on an executor.
 
-One interface, several back-ends (DESIGN.md §6):
+One interface, several back-ends:
 
 - ``serial``: in this process, one unit at a time (workers=1; tests, debugging);
 - ``process``: a local :class:`concurrent.futures.ProcessPoolExecutor` (the default

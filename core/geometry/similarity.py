@@ -57,10 +57,6 @@ class Similarity:
         return pycolmap.Sim3d(self.scale, pycolmap.Rotation3d(self.rotation), self.translation)
 
     @classmethod
-    def from_sim3d(cls, sim) -> "Similarity":
-        return cls(float(np.asarray(sim.scale)), np.asarray(sim.rotation.matrix()), np.asarray(sim.translation))
-
-    @classmethod
     def translation_only(cls, t) -> "Similarity":
         return cls(1.0, np.eye(3), t)
 

@@ -1,7 +1,7 @@
 """Georeferencing: Helmert (7-parameter similarity), GCP- and position-constrained
 bundle adjustment, check points.
 
-Frames (DESIGN.md section 2):
+Frames:
 
 - *model frame*: the frame of the sparse model as alignment wrote it (arbitrary
   origin, orientation and scale);

@@ -25,7 +25,7 @@ A projection counts only where the point is in front of the camera, lands inside
 margin) and the lens model is trusted there: the pixel is undistorted back and must give the same
 ray, which rejects the wrap-around of distortion polynomials far outside the frame.
 
-Pixel convention: COLMAP's, origin at the upper-left corner of the upper-left pixel (DESIGN.md §4).
+Pixel convention: COLMAP's, origin at the upper-left corner of the upper-left pixel.
 """
 from __future__ import annotations
 

@@ -182,9 +182,6 @@ class GeorefResult:
     def to_dict(self) -> Dict[str, Any]:
         return {"transform": self.transform_dict(), "residuals": self.residuals_dict()}
 
-    def to_json(self, indent: int = 1) -> str:
-        return json.dumps(_jsonable(self.to_dict()), indent=indent, allow_nan=False)
-
     def save(self, folder: str) -> Dict[str, str]:
         """Write transform.json and residuals.json into ``folder`` (atomically); returns the paths."""
         os.makedirs(folder, exist_ok=True)

@@ -1,7 +1,7 @@
 """The orthophoto room: true orthophotos per image, the orthomosaic, and single-image orthorectification on an
 existing DSM.
 
-Pure Python + numpy + OpenCV + GDAL: no qgis, no Qt (DESIGN.md §1).
+Pure Python + numpy + OpenCV + GDAL: no qgis, no Qt (docs/architecture.md).
 
 How a cell of an orthophoto gets its value
 ------------------------------------------

@@ -44,7 +44,7 @@ Steps (:func:`prepare_scans`):
    (found from texture: the border is uniform, the median over the set decides)
    and a disc over every fiducial mark.
 
-Pixel coordinates follow DESIGN.md: origin at the upper-left corner of the
+Pixel coordinates follow COLMAP: origin at the upper-left corner of the
 upper-left pixel, x right, y down (a pixel centre is at i + 0.5).  No qgis here.
 """
 from __future__ import annotations

@@ -324,10 +324,6 @@ class Layout:
         return self.path(DTM_TIF)
 
     @property
-    def terrain_dir(self) -> str:
-        return self.path(TERRAIN_DIR)
-
-    @property
     def dtm_source(self) -> str:
         """Beside the DTM: which cells are measured ground (1) and which interpolated (2)."""
         return self.path(TERRAIN_DIR, DTM_SOURCE_TIF)

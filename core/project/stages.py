@@ -57,11 +57,6 @@ class StageError(ArchaeoOrthoError, RuntimeError):
     given, ...); the message says why and what to run or give."""
 
 
-def later_stages(name: str) -> List[str]:
-    """The stages after ``name`` in the flow (nothing for an unknown name)."""
-    return STAGE_ORDER[STAGE_ORDER.index(name) + 1:] if name in STAGE_ORDER else []
-
-
 class StageRun:
     """What a stage body records while it runs (see :func:`run_stage`)."""
 

@@ -1,4 +1,4 @@
-"""The on-disk project that flows between stages (DESIGN.md §2).
+"""The on-disk project that flows between stages.
 
 A workspace is a folder with ``workspace.json`` (the manifest) and one
 sub-folder per stage.  The manifest records the format version, the CRS, the
