@@ -7,7 +7,8 @@ Two modes:
 
 - ``terrain``: the terrain stages (Build DTM, relief, contours) on a synthetic DSM of the size issue 33 reports
   (7,220 x 6,052 cells at 4.9 cm: hills, ploughed fields, a road, buildings, trees, a ragged nodata edge), written
-  once as a GeoTIFF into --workdir;
+  once as a GeoTIFF into --workdir; --compare: the products of the first root against the second's (max / RMS
+  difference of each raster);
 - ``chain``: align, georeference (EXIF GPS, or camera_positions.csv beside the images), DSM, orthophoto, DTM,
   relief, contours and report on a folder of photos (e.g. ../shared/data/ochota_kap/images), one stage per
   process on one workspace.
@@ -16,9 +17,12 @@ Two modes:
 /tmp/wt-mem-before HEAD``) so that one invocation prints before / after:
 
     python benchmarks/memory.py terrain --root /tmp/wt-mem-before --root .
-    python benchmarks/memory.py chain --images ../shared/data/ochota_kap/images --root .
+    python benchmarks/memory.py chain --images ../shared/data/toledo_2400/images --count 30 --root /tmp/wt-mem-before
+    python benchmarks/memory.py chain --images ../shared/data/toledo_2400/images --reuse --root . \
+        --stages orthophoto,terrain,relief,report
 
---compare: the products of the first root against the second's (max / RMS difference of each raster).
+(ochota_kap has no GPS: its chain ends after the alignment.)  The orthophoto stage's seam brightness step before /
+after the radiometric correction is printed under it.
 """
 from __future__ import annotations
 
@@ -155,7 +159,10 @@ def child(args):
         build_dsm_workspace(args.out, progress=p)
     elif args.stage == "orthophoto":
         from core.ortho.stage import build_orthophoto_workspace
-        build_orthophoto_workspace(args.out, progress=p)
+        r = build_orthophoto_workspace(args.out, progress=p)
+        rad = getattr(r, "radiometry", None) or {}
+        print("RADIOMETRY " + json.dumps({k: rad.get(k) for k in ("seam_step_before", "seam_step_after",
+                                                                  "hot_width_deg", "hot_spot", "antisolar")}))
     elif args.stage == "terrain":
         from core.terrain.stage import build_dtm_workspace
         build_dtm_workspace(args.out, contour_interval=0.5, progress=p)
@@ -242,6 +249,13 @@ def chain(args):
     rows = {}
     for i, root in enumerate(args.root):
         d = os.path.join(args.workdir, f"chain-{i}")
+        if args.reuse:  # the stages given, on a copy of the workspace an earlier run left (its first root's)
+            fresh = os.path.join(args.workdir, f"chain-{i}-reuse")
+            shutil.rmtree(fresh, ignore_errors=True)
+            shutil.copytree(os.path.join(args.workdir, "chain-0"), fresh, symlinks=True)
+            d = fresh
+            rows[root] = _stages(root, args, os.path.join(d, "images"), os.path.join(d, "ws"), d)
+            continue
         shutil.rmtree(d, ignore_errors=True)
         sub = os.path.join(d, "images")
         os.makedirs(sub)
@@ -250,16 +264,23 @@ def chain(args):
         positions = os.path.join(os.path.dirname(images), "camera_positions.csv")
         if os.path.isfile(positions):
             shutil.copyfile(positions, os.path.join(d, "camera_positions.csv"))
-        ws = os.path.join(d, "ws")
         print(f"{root}: {len(names)} photos of {images}", flush=True)
-        rows[root] = []
-        for stage in args.stages.split(","):
-            r = run_stage(root, stage, sub, ws, d)
-            rows[root].append(r)
-            print(f"  {stage:14s} {r['cpu']:8.1f} CPU-s {r['wall']:8.1f} s  peak {r['rss'] / GIB:6.2f} GiB", flush=True)
-            if r["rc"]:
-                break
+        rows[root] = _stages(root, args, sub, os.path.join(d, "ws"), d)
     table(rows)
+
+
+def _stages(root, args, images, ws, logdir):
+    out = []
+    for stage in args.stages.split(","):
+        r = run_stage(root, stage, images, ws, logdir)
+        out.append(r)
+        print(f"  {stage:14s} {r['cpu']:8.1f} CPU-s {r['wall']:8.1f} s  peak {r['rss'] / GIB:6.2f} GiB", flush=True)
+        if stage == "orthophoto" and not r["rc"]:
+            with open(os.path.join(logdir, "orthophoto.log")) as fh:
+                print("".join(f"    {line}" for line in fh if line.startswith("RADIOMETRY")), end="")
+        if r["rc"]:
+            break
+    return out
 
 
 def table(rows):
@@ -285,6 +306,8 @@ def main():
     ap.add_argument("--images", default=os.path.join(os.path.dirname(ROOT), "shared", "data", "ochota_kap",
                                                      "images"))
     ap.add_argument("--count", type=int, default=0, help="the first N photos only")
+    ap.add_argument("--reuse", action="store_true",
+                    help="chain mode: run --stages on a copy of the workspace an earlier run left in --workdir")
     ap.add_argument("--stages", default="align,georeference,dsm,orthophoto,terrain,relief,report")
     ap.add_argument("--relief", default=",".join(RELIEF_KEYS), help="terrain mode: the relief visualisations")
     ap.add_argument("--compare", action="store_true", help="terrain mode: products of root 1 against root 2")
@@ -297,6 +320,7 @@ def main():
         args.root = os.path.abspath(args.root[0])
         return child(args)
     args.root = [os.path.abspath(r) for r in (args.root or [ROOT])]
+    args.workdir = os.path.abspath(args.workdir)
     args.relief = [k for k in args.relief.split(",") if k]
     return terrain(args) if args.mode == "terrain" else chain(args)
 

@@ -131,6 +131,11 @@ def build_dtm(dsm_path: str, output_dtm: str, options: Optional[GroundOptions] =
     return out
 
 
+def _result_options(options) -> dict:
+    """The options a stage's products depend on (its record's parameters): all but the tile size."""
+    return {k: v for k, v in vars(options).items() if k != "tile"}
+
+
 def _refuse_stale(ws: Workspace, stage: str, what: str, run_hint: str) -> None:
     """TerrainError when the workspace's ``what`` (the product of ``stage``) is stale: an earlier stage ran again
     after it was made (a re-georeference into another CRS leaves the old DSM on disk), so a product made from it
@@ -163,7 +168,7 @@ def build_dtm_workspace(workspace_dir: str, dsm: Optional[str] = None, output_dt
     if contours_copy:
         check_contours_output(contours_copy)
     params = {"dsm": dsm_path, "output_dtm": dtm_path, "contour_interval": contour_interval,
-              "options": dict(vars(options))}
+              "options": _result_options(options)}
     with run_stage(ws, TERRAIN, params, {"dsm": file_fingerprint(dsm_path)}) as run:
         r = build_dtm(dsm_path, dtm_path, options, source_path=lay.dtm_source, contour_interval=contour_interval,
                       contours_path=lay.contours_gpkg, point_cloud=pc,
@@ -241,7 +246,7 @@ def relief_workspace(workspace_dir: str, keys: Sequence[str], source: str = "dtm
         raise TerrainError("a copy of the relief visualisation needs exactly one visualisation")
     refuse_overwriting_inputs({f"{keys[0]} visualisation" if keys else "visualisation": copy_to},
                               {source.upper(): dem}, TerrainError)
-    params = {"source": source, "keys": list(keys), "options": dict(vars(options or ReliefOptions()))}
+    params = {"source": source, "keys": list(keys), "options": _result_options(options or ReliefOptions())}
     inputs = {source: file_fingerprint(dem)}
     recorded = {k: v for k, v in (ws.stage(RELIEF).get("outputs") or {}).items()  # the others made before
                 if os.path.isfile(lay.resolve(v))}
