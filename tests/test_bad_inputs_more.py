@@ -274,8 +274,9 @@ def test_orthorectify_image_with_geographic_control_works_in_utm(tmp_path):
 
 
 def test_seamlines_without_a_crs_or_naming_a_filtered_photo_are_named(tmp_path):
-    """A seamlines shapefile without its .prj: its CRS is unknown, said (the edits were ignored); a polygon naming a
-    photo IMAGES_FILTER leaves out: said so (was 'not one of the N images of this mosaic')."""
+    """A seamlines shapefile without its .prj: its CRS is unknown, said, and refused where none of its polygons
+    lies on the mosaic (the edits were ignored); a polygon naming a photo IMAGES_FILTER leaves out: said so (was
+    'not one of the N images of this mosaic')."""
     from osgeo import ogr
 
     from core.ortho.seamlines import SeamlineError, read_seamline_edits
@@ -291,8 +292,12 @@ def test_seamlines_without_a_crs_or_naming_a_filtered_photo_are_named(tmp_path):
         lyr.CreateFeature(f)
     ds = None
     assert not os.path.exists(str(tmp_path / "edits.prj"))
-    with pytest.raises(SeamlineError, match=r"edits\.shp: the layer's CRS is unknown .*\.prj"):
-        read_seamline_edits(shp, ["a.jpg", "b.jpg"], UTM17)
+    # nowhere on the mosaic (in another CRS's numbers): its CRS is named unknown (the edits were ignored)
+    with pytest.raises(SeamlineError, match=r"edits\.shp: the layer's CRS is unknown .*\.prj.* none of its 2 polygon"):
+        read_seamline_edits(shp, ["a.jpg", "b.jpg", "c.jpg"], UTM17, extent=(0.0, 0.0, 100.0, 100.0))
+    # on the mosaic: taken as its CRS, and the log says so
+    edits = read_seamline_edits(shp, ["a.jpg", "b.jpg", "c.jpg"], UTM17, extent=(X0 - 50, Y0 - 50, X0 + 50, Y0 + 50))
+    assert len(edits.polygons) == 2 and any("CRS is unknown" in n and UTM17 in n for n in edits.notes)
     srs = osr.SpatialReference()
     srs.SetFromUserInput(UTM17)
     with open(str(tmp_path / "edits.prj"), "w") as fh:

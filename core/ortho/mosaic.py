@@ -63,6 +63,8 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
     options.check()
     progress = progress or NullProgress()
     edits = read_seamline_edits(options.seamlines_in, [c.name for c in cameras], crs) if options.seamlines_in else None
+    for note in edits.notes if edits is not None else []:
+        progress.info(note)
     offset = np.asarray(offset, dtype=float)
     t_start = time.time()
     timings: Dict[str, float] = {}

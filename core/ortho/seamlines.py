@@ -35,6 +35,7 @@ class SeamlineEdits:
     source: str
     polygons: List[Tuple[str, bytes]] = field(default_factory=list)
     skipped: int = 0  # features without geometry or without an image (automatic seams there)
+    notes: List[str] = field(default_factory=list)  # for the log (a layer without a CRS taken as the mosaic's)
 
 
 def _split_source(source: str) -> Tuple[str, Optional[str]]:
@@ -91,12 +92,8 @@ def _check_crs(path: str, lyr, crs: Optional[str]) -> None:
     from osgeo import osr
 
     srs = lyr.GetSpatialRef()
-    if not crs:
+    if srs is None or not crs:
         return
-    if srs is None:  # the polygons were ignored: placed nowhere near the mosaic, or in another CRS's numbers
-        raise SeamlineError(f"seamlines {path}: the layer's CRS is unknown (a shapefile without its .prj file?), so "
-                            f"its polygons cannot be placed on the mosaic in {crs}: save the layer with the "
-                            f"mosaic's CRS ({crs}), or edit the seamlines GeoPackage the mosaic wrote")
     want = osr.SpatialReference()
     want.SetFromUserInput(crs)
     if not srs.IsSame(want):
@@ -107,11 +104,34 @@ def _check_crs(path: str, lyr, crs: Optional[str]) -> None:
                             f"the mosaic's CRS (save the layer in {crs}, or edit the seamlines the mosaic wrote)")
 
 
+def _unknown_crs(out: SeamlineEdits, path: str, crs: Optional[str], extent) -> None:
+    """A layer without a CRS (a shapefile without its .prj): taken as the mosaic's when its polygons lie on the
+    mosaic's ``extent`` (xmin, ymin, xmax, ymax; said in the log); SeamlineError when none does (issue 36 item
+    13: they were ignored, 'polygon(s) outside the mosaic', without a word on the CRS)."""
+    from osgeo import ogr
+
+    if not crs:
+        return
+    if extent is not None and out.polygons:
+        xmin, ymin, xmax, ymax = extent
+        on = 0
+        for _, wkb in out.polygons:
+            gx0, gx1, gy0, gy1 = ogr.CreateGeometryFromWkb(wkb).GetEnvelope()
+            on += int(gx0 <= xmax and gx1 >= xmin and gy0 <= ymax and gy1 >= ymin)
+        if not on:
+            raise SeamlineError(f"seamlines {path}: the layer's CRS is unknown (a shapefile without its .prj file?) "
+                                f"and none of its {len(out.polygons)} polygon(s) lies on the mosaic ({xmin:.0f}..{xmax:.0f}, "
+                                f"{ymin:.0f}..{ymax:.0f} in {crs}): save the layer in the mosaic's CRS ({crs}) with its CRS")
+    out.notes.append(f"seamlines {path}: the layer's CRS is unknown (no .prj?): its coordinates are taken as the "
+                     f"mosaic's CRS ({crs})")
+
+
 def read_seamline_edits(source: str, names: Sequence[str], crs: Optional[str], left_out: Sequence[str] = (),
-                        images_filter: Optional[str] = None) -> SeamlineEdits:
+                        images_filter: Optional[str] = None, extent=None) -> SeamlineEdits:
     """The polygons of an edited seamlines layer (``source``: a file path, or 'path|layername=...'), checked
     against the mosaic's image ``names`` and ``crs``.  SeamlineError naming the file and the problem (an image
-    of ``left_out``: left out by ``images_filter``)."""
+    of ``left_out``: left out by ``images_filter``; a layer without a CRS none of whose polygons lies on the
+    mosaic's ``extent``)."""
     from osgeo import ogr
 
     gdal = _gdal()
@@ -155,6 +175,8 @@ def read_seamline_edits(source: str, names: Sequence[str], crs: Optional[str], l
             raise SeamlineError(f"{where}: feature {feat.GetFID()} is a {geom.GetGeometryName()}, not a polygon")
         name = _match_name(value, names, f"{where}, feature {feat.GetFID()},", left_out, images_filter)
         out.polygons.append((name, bytes(geom.ExportToWkb())))
+    if lyr.GetSpatialRef() is None:
+        _unknown_crs(out, path, crs, extent)
     return out
 
 

@@ -9,6 +9,7 @@ from typing import Any, Dict, List, Optional, Tuple
 import numpy as np
 
 from ..align.photos import check_photos
+from ..common.errors import ArchaeoOrthoError
 from ..common.files import clean_debris, file_fingerprint, fingerprint
 from ..common.progress import NullProgress, Progress
 from ..io.images import ImageError
@@ -75,8 +76,8 @@ def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = Non
         inputs["seamlines_in"] = edits_fingerprint(options.seamlines_in)
     with run_stage(lay.ws, STAGE, params, inputs) as run:
         if options.seamlines_in:  # before any work: a polygon naming an image the filter leaves out is named so
-            read_seamline_edits(options.seamlines_in, [c.name for c in cams], crs,
-                                left_out=_left_out(lay, cams), images_filter=images_filter)
+            read_seamline_edits(options.seamlines_in, [c.name for c in cams], crs, left_out=_left_out(lay, cams),
+                                images_filter=images_filter, extent=_extent(dsm_path, crs))
         for debris in clean_debris(os.path.dirname(output), WORK_PREFIX):
             progress.info(f"removed {debris}, left by a killed run")
         result = build_orthomosaic(cams, dsm_path, crs, offset, output, options, per_image_folder, seamlines, progress)
@@ -94,6 +95,22 @@ def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = Non
     return OrthoStageResult(lay.root, output, crs, result.resolution, result.images, result.valid_fraction,
                             per_image_folder, seamlines, result.timings, result.warnings, result.log_lines,
                             result.radiometry)
+
+
+def _extent(dsm_path: str, crs: Optional[str]) -> Optional[Tuple[float, float, float, float]]:
+    """The DSM's bounds in the mosaic's CRS (the mosaic lies within them), None when they cannot be told."""
+    from ..geometry.crs import transform_points
+    from ..io.raster import DsmError, open_dsm
+
+    try:
+        info = open_dsm(dsm_path)
+        b = np.array([[info.bounds[0], info.bounds[1]], [info.bounds[2], info.bounds[3]],
+                      [info.bounds[0], info.bounds[3]], [info.bounds[2], info.bounds[1]]])
+        if crs and info.crs_wkt:
+            b = transform_points(b, info.crs_wkt, crs)
+    except (DsmError, ArchaeoOrthoError):
+        return None
+    return float(b[:, 0].min()), float(b[:, 1].min()), float(b[:, 0].max()), float(b[:, 1].max())
 
 
 def _left_out(lay: Layout, cams: List[OrthoCamera]) -> List[str]:
