@@ -432,3 +432,22 @@ def test_suspect_control_points_are_dropped_when_asked_and_the_block_adjusted_wi
     assert [(o.name, o.stage) for o in dropped.outliers if o.stage == "consistency"] == [("g", "consistency"),
                                                                                        ("b", "consistency")]
     assert dropped.rmse("check")["xy"] < 0.5 * kept.rmse("check")["xy"]
+
+
+def test_the_automatic_control_counts_name_the_suspects_dropped():
+    """'97 of 101 automatic GCPs kept, 4 suspect dropped (auto_012 1.54 m, ...)': the suspects named by the
+    adjustment's consistency check and rejected, worst first; a suspect re-admitted as used is not counted."""
+    from core.georef.autocontrol.stage import _count_used, _suspects_dropped
+
+    class Lay:
+        def residuals(self):
+            pts = [{"name": f"auto_{i:03d}", "status": "used"} for i in range(97)]
+            pts += [{"name": n, "status": "rejected"} for n in ("auto_097", "auto_098", "auto_099")]
+            pts += [{"name": "auto_100", "status": "used"}, {"name": "hand", "status": "rejected"}]
+            cc = {"suspects": ["auto_098", "auto_097", "auto_100", "hand"],
+                  "residuals_m": {"auto_097": 0.8, "auto_098": 1.54, "auto_100": 0.7, "hand": 3.0}}
+            return {"points": pts, "statistics": {"control_consistency": cc}}
+
+    names = {f"auto_{i:03d}" for i in range(101)}
+    assert _count_used(Lay(), names) == 98
+    assert _suspects_dropped(Lay(), names) == [("auto_098", 1.54), ("auto_097", 0.8)]
