@@ -110,6 +110,7 @@ def split_by_camera(images, workdir):
 def reference(images, workdir, fresh, control=None):
     from core import pipeline
     from core.common.progress import PrintProgress
+    from core.dense.options import DenseOptions
     from core.project.layout import Layout
     from core.project.workspace import Workspace
 
@@ -119,7 +120,8 @@ def reference(images, workdir, fresh, control=None):
         if fresh:
             shutil.rmtree(ws, ignore_errors=True)
         t = time.time()  # a workspace left by an interrupted run resumes (features and matches kept)
-        options = pipeline.PipelineOptions(make_report=False, make_dtm=False, dsm_quality="quarter")
+        options = pipeline.PipelineOptions(make_report=False, make_dtm=False,
+                                           dense=DenseOptions(quality="quarter"))
         r = pipeline.run_pipeline(images, ws, options,
                                   control or pipeline.Control(use_exif_gps=True), progress=PrintProgress("  ref "))
         with open(done, "w") as f:

@@ -525,6 +525,7 @@ def orbit_run(orbit, tmp_path_factory):
     import time
 
     from core.align.options import AlignOptions
+    from core.dense.options import DenseOptions
     from core.pipeline import Control, PipelineOptions, run_pipeline
 
     root = tmp_path_factory.mktemp("orbit")
@@ -534,7 +535,7 @@ def orbit_run(orbit, tmp_path_factory):
     render = time.time() - t0
     control = orbit.spread_control(5)
     res = run_pipeline(str(root / "photos"), ws, PipelineOptions(
-        align=AlignOptions(pairing="exhaustive", num_threads=2), dsm_quality="full", make_report=False,
+        align=AlignOptions(pairing="exhaustive", num_threads=2), dense=DenseOptions(quality="full"), make_report=False,
         make_dtm=False, sky_masks=True), Control(gcps=orbit.gcp_set(control, noise_px=0.4)))
     prep, aligned, dsm, ortho = res.prepare, res.align, res.dsm, res.ortho
     print(f"\n[orbit] render {render:.0f} s, " + ", ".join(f"{k} {v:.0f} s" for k, v in res.seconds.items())

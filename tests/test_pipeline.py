@@ -113,3 +113,42 @@ def test_core_run_pipeline_refuses_without_control(tmp_path):
     with pytest.raises(StageError, match="ground control"):
         run_pipeline(str(tmp_path / "photos"), str(tmp_path / "ws"))
     assert not (tmp_path / "ws").exists()
+
+
+def test_the_stage_options_are_the_settings(tmp_path, monkeypatch):
+    """PipelineOptions(dense=DenseOptions(quality="full"), ortho=OrthoOptions(blending="multiband")) ran at half
+    quality with feather blending: the pipeline's own dsm_quality / blending fields won (issue 35). Now the stages
+    get each stage's options once, and a stage's keyword left out means the options' value."""
+    import types
+
+    from core import pipeline
+    from core.dense.options import DenseError, DenseOptions
+    from core.dense.stage import _checked_arguments
+    from core.ortho.options import OrthoError, OrthoOptions
+    from core.ortho.stage import build_orthophoto_workspace
+
+    calls = {}
+
+    def spy(name):
+        def stage(*args, **kwargs):
+            calls[name] = kwargs
+            return types.SimpleNamespace(warnings=[])
+        return stage
+
+    for name in ("align", "georeference_workspace", "build_dsm_workspace", "build_orthophoto_workspace"):
+        monkeypatch.setattr(pipeline, name, spy(name))
+    monkeypatch.setattr(pipeline, "check_inputs", lambda *a: None)
+    dense, ortho = DenseOptions(quality="full"), OrthoOptions(blending="multiband", resolution=0.25)
+    pipeline.run_pipeline(str(tmp_path / "photos"), str(tmp_path / "ws"),
+                          pipeline.PipelineOptions(dense=dense, ortho=ortho, make_dtm=False, make_report=False),
+                          pipeline.Control(use_exif_gps=True))
+    assert calls["build_dsm_workspace"]["options"] is dense and "quality" not in calls["build_dsm_workspace"]
+    assert calls["build_orthophoto_workspace"]["options"] is ortho
+    assert not {"blending", "resolution"} & set(calls["build_orthophoto_workspace"])
+    # the stages themselves: no keyword = the options' value; a keyword given wins
+    assert _checked_arguments(dense, None, "cpu", 0.0)[0].quality == "full"
+    assert _checked_arguments(dense, "quarter", "cpu", 0.0)[0].quality == "quarter"
+    with pytest.raises(DenseError, match="QUALITY"):
+        _checked_arguments(DenseOptions(quality="fine"), None, "cpu", 0.0)
+    with pytest.raises(OrthoError, match="BLENDING"):  # the options' blending is checked, not a default's
+        build_orthophoto_workspace(str(tmp_path / "no-ws"), options=OrthoOptions(blending="smooth"))

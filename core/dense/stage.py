@@ -90,12 +90,13 @@ class _Journal:
         self.progress.info(line)
 
 
-def build_dsm_workspace(workspace_dir: str, resolution: float = 0.0, quality: str = DenseOptions.quality,
+def build_dsm_workspace(workspace_dir: str, resolution: float = 0.0, quality: Optional[str] = None,
                         engine: str = "cpu", output_dsm: Optional[str] = None,
                         output_point_cloud: Optional[str] = None, options: Optional[DenseOptions] = None,
                         progress: Optional[Progress] = None) -> DsmStageResult:
     """The DSM stage: dense matching + fusion -> ``dsm.tif`` (COG) and optionally a LAS point cloud.
 
+    ``quality`` None: ``options.quality`` (the options are the settings; a keyword given wins over them).
     ``options`` is not changed (the stage works on a copy with ``quality`` filled in).
     Raises DenseError (bad input, nothing matched), WorkspaceError, Cancelled."""
     progress = progress or NullProgress()

@@ -46,18 +46,21 @@ def workspace_dsm(ws: Workspace) -> Optional[str]:
 
 
 def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = None, images_filter: Optional[str] = None,
-                               resolution: float = 0.0, blending: str = "feather", output: Optional[str] = None,
+                               resolution: Optional[float] = None, blending: Optional[str] = None,
+                               output: Optional[str] = None,
                                per_image_folder: Optional[str] = None, seamlines: Optional[str] = None,
                                options: Optional[OrthoOptions] = None,
                                progress: Optional[Progress] = None) -> OrthoStageResult:
     """The orthophoto stage of a georeferenced workspace: orthomosaic (default <workspace>/orthomosaic.tif),
     optional per-image true orthophotos and the which-image layer.  Records the stage in workspace.json.
 
+    ``resolution`` / ``blending`` None: the options' (the options are the settings; a keyword given wins).
     ``options`` is not modified (RESOLUTION and BLENDING go into a copy).
     Raises OrthoError (bad input), WorkspaceError, Cancelled."""
     progress = progress or NullProgress()
     options = options or OrthoOptions()
-    options = replace(options, resolution=float(resolution or 0.0), blending=(blending or options.blending).lower())
+    options = replace(options, resolution=float(options.resolution if resolution is None else resolution or 0.0),
+                      blending=(blending or options.blending).lower())
     options.check()
     lay = Layout(Workspace.open(workspace_dir))
     dsm_path, crs, offset, cams = _inputs(lay, dsm_path, images_filter)
