@@ -188,8 +188,10 @@ def filter_ground(dsm, cell: float, options: GroundOptions, progress: Progress =
     grow = max(1, int(round(options.dilate / cell))) if options.dilate > 0 else 1
     ground = np.zeros((h, w), dtype=bool)
     dtm = np.full((h, w), np.nan, dtype=np.float32)
-    for r0, r1, c0, c1 in tiles(h, w, tile):
+    n_tiles = -(-h // tile) * -(-w // tile)
+    for i, (r0, r1, c0, c1) in enumerate(tiles(h, w, tile)):
         check_cancel(progress)
+        progress.report(0.5 + 0.1 * i / n_tiles, f"ground filter: tile {i + 1} of {n_tiles}")
         g, z = _classify_tile(dsm, provisional_c, factor, (r0, r1, c0, c1), grow + 2, cell, options, grow)
         ground[r0:r1, c0:c1] = g
         dtm[r0:r1, c0:c1] = np.where(g, z, np.nan)
