@@ -1117,31 +1117,31 @@ __all__ = [
 ]
 
 
-def _odm_target_line(toks: List[str], path: PathLike, lineno: int) -> Tuple[float, float, float, Optional[str]]:
-    """x, y, z and name of one line of a targets file in the gcp_list.txt form, with or without pixel columns."""
+def _odm_target_line(toks: List[str], path: PathLike, lineno: int):
+    """x, y, z, name and the click (an Observation, or None) of one line of a targets file in the gcp_list.txt
+    form, with or without pixel columns."""
     if len(toks) < 4:
         raise GCPError(f"{path}:{lineno}: expected 'x y z name' or 'x y z px py image name', found {len(toks)} "
                        f"field(s): {' '.join(toks)!r}")
     x, y, z = (_num(toks[k], w, path, lineno) for k, w in ((0, "x"), (1, "y"), (2, "z")))
     if len(toks) in (4, 5) and not _is_number(toks[3]):
-        return x, y, z, toks[3]  # x y z name [check]
-    if len(toks) >= 6 and _is_number(toks[3]) and _is_number(toks[4]):
-        return x, y, z, toks[6] if len(toks) > 6 else None  # x y z px py image [name]
+        return x, y, z, toks[3], None  # x y z name [check]
+    if len(toks) >= 6 and _is_number(toks[3]) and _is_number(toks[4]):  # x y z px py image [name]
+        return x, y, z, toks[6] if len(toks) > 6 else None, Observation(toks[5], float(toks[3]), float(toks[4]))
     raise GCPError(f"{path}:{lineno}: expected 'x y z name' or 'x y z px py image name', found {len(toks)} "
                    f"field(s): {' '.join(toks)!r}")
 
 
 def read_target_coordinates(path: PathLike, default_crs: Optional[str] = None) -> GCPSet:
-    """Surveyed targets, coordinates only (Find targets): a CSV points file (``name,x,y,z[,sigma_xy,sigma_z]``, any
-    observations ignored) or a gcp_list.txt whose pixel columns may be absent (``x y z name``) or present on some
-    lines only (``x y z px py image name``; the pixel columns are ignored).  ``default_crs``: the CRS of a file that
+    """Surveyed targets for Find targets: a CSV points file (``name,x,y,z[,sigma_xy,sigma_z]``, with its observations
+    file if there is one) or a gcp_list.txt whose pixel columns may be absent (``x y z name``) or present on some
+    lines only (``x y z px py image name``).  Pixel columns, where present, are the user's clicks: kept as the
+    points' observations (Find targets names the marks they fall on).  ``default_crs``: the CRS of a file that
     names none (a gcp_list.txt without its CRS line); none at all is a GCPError saying to give it.  Points without
     a name are named by their coordinates' order (``gcp_<n>``); one name with two positions is an error naming
     both lines."""
     if detect_gcp_format(path) == "csv":
         gs = read_csv_gcps(path, default_crs=default_crs)
-        for p in gs.points:
-            p.observations = []
         gs.warnings = [w for w in gs.warnings if "no observations file" not in w and "no usable observation" not in w]
         return gs
     rows: List[Tuple[int, List[str]]] = []
@@ -1165,20 +1165,22 @@ def read_target_coordinates(path: PathLike, default_crs: Optional[str] = None) -
     seen: Dict[str, Tuple[GroundPoint, int]] = {}
     by_xyz: Dict[Tuple[float, float, float], GroundPoint] = {}
     for lineno, toks in rows:
-        x, y, z, name = _odm_target_line(toks, path, lineno)
+        x, y, z, name, click = _odm_target_line(toks, path, lineno)
         if name is None:
             p = by_xyz.get((x, y, z))
             if p is None:
                 name = f"gcp_{len(gs.points) + 1}"
             else:
+                p.observations += [click] if click else []
                 continue
         if name in seen:
             p, first_line = seen[name]
             if (p.x, p.y, p.z) != (x, y, z):
                 raise GCPError(f"{path}:{lineno}: target {name} has coordinates ({x}, {y}, {z}) here but "
                                f"({p.x}, {p.y}, {p.z}) on line {first_line}")
+            p.observations += [click] if click else []
             continue
-        p = GroundPoint(name, x, y, z, sigma_given=False)
+        p = GroundPoint(name, x, y, z, sigma_given=False, observations=[click] if click else [])
         seen[name] = (p, lineno)
         by_xyz.setdefault((x, y, z), p)
         gs.points.append(p)
