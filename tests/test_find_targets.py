@@ -130,7 +130,7 @@ def test_a_regular_constellation_is_not_named_by_guess():
     codes = [None] * 10
     codes[4] = "t7"
     m3 = constellation.match_constellation(model2, g2, names, codes)
-    assert 4 not in m3.names and any("coded t7 sits at target t4" in s for s in m3.reports)
+    assert 4 not in m3.names and any("coded or clicked as t7 sits at target t4" in s for s in m3.reports)
 
 
 def test_code_names():
@@ -175,3 +175,30 @@ def test_the_processing_algorithm_writes_the_file_and_the_counts(block, plugin, 
     assert os.path.isfile(res["MARKS"]) and res["WORKSPACE"] == ws
     with pytest.raises(QgsProcessingException, match="would be written over the targets file"):
         processing.run("archaeoortho:findtargets", {"WORKSPACE": ws, "TARGETS": csv, "GCPS": csv})
+
+
+def test_clicks_in_the_targets_file_are_checked_against_the_constellation(block, tmp_path):
+    """A gcp_list.txt with a few pixel columns: a right click agrees; a click on another target's mark is reported
+    and followed neither for naming nor into the output."""
+    scene, ws, _, ref = block
+    photo = next(i for i, v in scene.visible.items() if "chk_a" in v and "chk_b" in v)
+    lines = ["EPSG:32611"]
+    for t in scene.targets:
+        w = np.array([t.x, t.y, t.z]) + targets_scene.OFFSET
+        lines.append(f"{w[0]:.4f} {w[1]:.4f} {w[2]:.4f} {t.name}")
+        if t.name == "chk_a":  # right
+            lines.append(f"{w[0]:.4f} {w[1]:.4f} {w[2]:.4f} {scene.truth[photo]['chk_a'][0]:.2f} "
+                         f"{scene.truth[photo]['chk_a'][1]:.2f} {photo} chk_a")
+        if t.name == "ring_a":  # on chk_b's mark
+            lines.append(f"{w[0]:.4f} {w[1]:.4f} {w[2]:.4f} {scene.truth[photo]['chk_b'][0]:.2f} "
+                         f"{scene.truth[photo]['chk_b'][1]:.2f} {photo} ring_a")
+    path = tmp_path / "clicked.txt"
+    path.write_text("\n".join(lines) + "\n")
+    r = find_targets(ws, str(path), FindTargetsOptions(output=str(tmp_path / "gcps.txt"),
+                                                        layer=str(tmp_path / "found.gpkg"), num_threads=2))
+    assert any("clicked as ring_a sits at target chk_b" in s for s in r.reports), r.reports
+    assert any(f"the click of ring_a in {photo} is on the mark of chk_b" in s for s in r.reports), r.reports
+    found = {(o.image, o.name): o for o in r.observations}
+    assert (photo, "ring_a") not in found and found[(photo, "chk_b")].found
+    assert all(_error(scene, o) < 1.5 for o in r.observations)  # no wrong name
+    assert {(o.image, o.name) for o in r.observations} == {(o.image, o.name) for o in ref.observations}

@@ -194,8 +194,8 @@ def _refit(out: Constellation, model, world, centre, names, codes, best, xy_only
                            "coordinates' axis order and CRS")
     for i, (j, d) in sorted(a.items()):
         if codes[i] is not None and codes[i] != names[j]:
-            out.reports.append(f"a mark coded {codes[i]} sits at target {names[j]} ({d:.3g} from it): "
-                               "not assigned")
+            out.reports.append(f"a mark coded or clicked as {codes[i]} sits at target {names[j]} ({d:.3g} from "
+                               "it): not assigned")
             continue
         out.names[i] = names[j]
         out.residuals[i] = d

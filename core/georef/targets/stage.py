@@ -35,6 +35,7 @@ from ...project.workspace import Workspace
 from ..errors import GeorefError
 from ..guided import Predictor
 from ..triangulate import triangulate_observations
+from .clicks import click_names, merge_names, unanswered
 from .constellation import Constellation, match_constellation
 from .detect import Candidate, detect_image
 from .options import FindTargetsOptions
@@ -42,6 +43,7 @@ from .tie import Track, on_surface, tie_candidates
 
 TIED = "tied"  # the observation's mark was tied across photos and matched to the constellation
 PROJECTED = "projected"  # found at the target's projection through the block
+CLICK = "click"  # the user's click in the targets file, which no mark found answers
 
 
 @dataclass
@@ -265,6 +267,16 @@ def _finish(rec, gs, found: Dict[str, List[Candidate]], sources, tol_px: float, 
     return observations, targets
 
 
+def _keep_clicks(result: FindTargetsResult, clicks: Dict[str, List[gcpmod.Observation]]) -> None:
+    """The user's clicks no mark answers go to the output as they are (found False: placed by hand)."""
+    for n, obs in clicks.items():
+        for ob in obs:
+            result.observations.append(FoundObservation(n, ob.image, ob.x, ob.y, CLICK, 1.0, float("nan"), 0.0,
+                                                        CLICK, found=False))
+        t = next(t for t in result.targets if t.name == n)
+        t.found, t.observations = True, t.observations + len(obs)
+
+
 def _write(lay: Layout, gs, result: FindTargetsResult) -> None:
     from ...io.vector import write_points_gpkg
 
@@ -309,19 +321,24 @@ def find_targets(workspace: str, targets: str, options: Optional[FindTargetsOpti
         progress.report(0.8, f"{result.candidates} candidate(s), {len(tracks)} tied across photos")
     names = [p.name for p in gs.points]
     codes = code_names(names)
+    clicks = {p.name: list(p.observations) for p in gs.points if p.observations}
     zs = [p.z for p in gs.points]
     xy_only = len(zs) >= 2 and max(zs) - min(zs) < 1e-6  # placeholder heights
+    labels = merge_names([codes.get(t.code) if t.code is not None else None for t in tracks],
+                         click_names(tracks, clicks, tol_px, result.reports), result.reports)
     match = match_constellation(np.array([t.xyz for t in tracks]).reshape(-1, 3),
-                                np.array([[p.x, p.y, p.z] for p in gs.points]), names,
-                                [codes.get(t.code) if t.code is not None else None for t in tracks], xy_only,
+                                np.array([[p.x, p.y, p.z] for p in gs.points]), names, labels, xy_only,
                                 weights=[len(t.candidates) for t in tracks])
     result.fit_tolerance, result.fit_rms, result.mirrored = match.tolerance, match.rms, match.mirrored
     result.reports += match.reports
+    if match.similarity is None:  # no constellation: the clicked (or coded) marks keep the names they carry
+        match.names = {i: n for i, n in enumerate(labels) if n is not None and labels.count(n) == 1}
     named = {match.names[i]: list(tracks[i].candidates) for i in match.names}
     sources = {id(c): TIED for v in named.values() for c in v}
     kinds = {match.names[i]: tracks[i].kind for i in match.names}
     found = _predict(rec, gs, named, cands, kinds, tol_px, result.reports)
     result.observations, result.targets = _finish(rec, gs, found, sources, tol_px, match, options.target_size)
+    _keep_clicks(result, unanswered(clicks, found, tol_px, result.reports))
     result.seconds = time.time() - t0
     _write(lay, gs, result)
     if progress is not None:
