@@ -8,6 +8,7 @@ covered or cut by the border.
 """
 import math
 import os
+import shutil
 import types
 
 import numpy as np
@@ -131,6 +132,39 @@ def test_a_regular_constellation_is_not_named_by_guess():
     codes[4] = "t7"
     m3 = constellation.match_constellation(model2, g2, names, codes)
     assert 4 not in m3.names and any("coded or clicked as t7 sits at target t4" in s for s in m3.reports)
+
+
+def test_a_gps_prior_names_a_regular_constellation():
+    # the 3 x 3 grid again: with the photos' EXIF GPS (here a model -> world similarity 1 m and 2 degrees off, with
+    # a 1 m misfit) the quarter turns are not tried and the grid is named, correctly
+    from core.geometry.similarity import Similarity
+
+    g = np.array([[x, y, 0.0] for x in (0.0, 10.0, 20.0) for y in (0.0, 10.0, 20.0)])
+    rot = np.array([[0.6, -0.8, 0.0], [0.8, 0.6, 0.0], [0.0, 0.0, 1.0]])
+    t0 = np.array([3.0, -2.0, 1.0])
+    model = 0.1 * g @ rot.T + t0
+    off = np.array([500000.0, 4000000.0, 0.0])
+    a = math.radians(2.0)
+    turn = np.array([[math.cos(a), -math.sin(a), 0.0], [math.sin(a), math.cos(a), 0.0], [0.0, 0.0, 1.0]])
+    prior = Similarity(10.0, turn @ rot.T, turn @ (-10.0 * rot.T @ t0) + off + [1.0, 0.0, 0.0])
+    names = [f"t{k}" for k in range(9)]
+    m = constellation.match_constellation(model, g + off, names, prior=prior, prior_tol=3.0)
+    assert m.names == {k: names[k] for k in range(9)}, m.reports
+
+
+def test_the_photos_gps_narrows_the_match_and_names_the_same(block, tmp_path):
+    from core.io.gcp import CameraPosition
+    from tests.workspaces import set_exif_gps
+
+    scene, ws, csv, ref = block
+    rng = np.random.default_rng(3)
+    gps = ws + " gps"
+    shutil.copytree(ws, gps)
+    pos = [CameraPosition(n, *(c + targets_scene.OFFSET + [*rng.normal(0, 1.5, 2), 0.0])) for n, _, c in scene.shots]
+    set_exif_gps(gps, pos, "EPSG:32611")
+    r = find_targets(gps, csv, FindTargetsOptions(num_threads=2))
+    assert r.prior.startswith(f"EXIF GPS of {len(scene.shots)} photos")
+    assert {(o.image, o.name) for o in r.observations} == {(o.image, o.name) for o in ref.observations}
 
 
 def test_code_names():

@@ -1,4 +1,4 @@
-"""The triangulated marks (model frame) matched to the surveyed targets (world): names without a prior.
+"""The triangulated marks (model frame) matched to the surveyed targets (world): names without a prior needed.
 
 Every triangle of marks is compared by shape (its sides' ratios, free of scale) with every triangle of
 targets; each pair of similar triangles gives a similarity (Umeyama, scale free), tried as it is and with the
@@ -92,13 +92,16 @@ def _hypotheses(model: np.ndarray, world: np.ndarray, shape_tol: float, limit: i
 def match_constellation(model: np.ndarray, world: np.ndarray, names: Sequence[str],
                         codes: Optional[Sequence[Optional[str]]] = None, xy_only: bool = False,
                         tol_fraction: float = 0.3, min_marks: int = 4,
-                        weights: Optional[Sequence[float]] = None) -> Constellation:
+                        weights: Optional[Sequence[float]] = None, prior: Optional[Similarity] = None,
+                        prior_tol: float = 0.0) -> Constellation:
     """Name the marks ``model`` (M, 3) after the targets ``world`` (K, 3) called ``names``; ``codes``: per mark,
     the target name its code gives (coded targets) or None.  Needs at least ``min_marks`` marks to agree (three
     always fit some triangle); fewer, or two hypotheses equally good with different names, name nothing.
     ``weights``: per mark, its evidence (the number of photos it was tied in): triangles are drawn from the
     best-evidenced marks (twice as many as targets, and four more) and a hypothesis scores the evidence it
-    brings onto targets."""
+    brings onto targets.  ``prior``: a rough model -> world similarity (EXIF GPS): a hypothesis that puts one of
+    its triangle's marks further than ``prior_tol`` plus the tolerance (horizontally) from where the prior puts it is
+    not tried, nor the mirror."""
     model = np.asarray(model, dtype=float).reshape(-1, 3)
     world = np.asarray(world, dtype=float).reshape(-1, 3)
     codes = list(codes) if codes is not None else [None] * len(model)
@@ -114,12 +117,17 @@ def match_constellation(model: np.ndarray, world: np.ndarray, names: Sequence[st
     wts = np.ones(len(model)) if weights is None else np.asarray(weights, dtype=float)
     top = np.argsort(-wts, kind="stable")[:2 * len(world) + 4]
     best, second = None, None
+    guess = prior.apply(model) - centre if prior is not None else None
     for mirrored in (False, True):
+        if mirrored and guess is not None:
+            break  # the GPS fixes the handedness
         if mirrored and best is not None and len(best[2]) >= min(min_marks, len(world)):
             break  # the mirror only when the survey as given does not fit: a planar constellation fits both
         w = (world - centre) @ MIRROR.T if mirrored else world - centre
         for mt, wt in _hypotheses(model[top], w, 0.03, 4000, wts[top]):
             mt = top[mt]
+            if guess is not None and np.linalg.norm(guess[mt, :2] - w[wt, :2], axis=1).max() > prior_tol + tol:
+                continue
             try:
                 sim = helmert_fit(model[mt], w[wt])
             except ValueError:

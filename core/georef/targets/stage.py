@@ -29,6 +29,7 @@ from typing import Dict, List, Optional, Sequence
 import numpy as np
 
 from ...common.progress import Progress, check_cancel
+from ...geometry.crs import CRSError
 from ...io import gcp as gcpmod
 from ...project.layout import Layout, write_json
 from ...project.workspace import Workspace
@@ -39,6 +40,7 @@ from .clicks import click_names, merge_names, unanswered
 from .constellation import Constellation, match_constellation
 from .detect import Candidate, detect_image
 from .options import FindTargetsOptions
+from .prior import Prior, gps_prior
 from .tie import Track, on_surface, tie_candidates
 
 TIED = "tied"  # the observation's mark was tied across photos and matched to the constellation
@@ -90,6 +92,7 @@ class FindTargetsResult:
     fit_tolerance: float = 0.0
     fit_rms: float = float("nan")
     mirrored: bool = False
+    prior: str = ""  # what narrowed the match ("EXIF GPS of n photos, x RMS"), empty without
     reports: List[str] = field(default_factory=list)  # what did not fit, never assigned
     seconds: float = 0.0
 
@@ -267,6 +270,19 @@ def _finish(rec, gs, found: Dict[str, List[Candidate]], sources, tol_px: float, 
     return observations, targets
 
 
+def _prior(ws: Workspace, rec, crs: str, result: FindTargetsResult) -> Optional[Prior]:
+    """The EXIF GPS prior, recorded in the result; None without GPS (or with GPS that the CRS cannot take,
+    reported)."""
+    try:
+        prior = gps_prior(ws, rec, crs)
+    except CRSError as e:
+        result.reports.append(f"the photos' EXIF GPS not used: {e}")
+        return None
+    if prior is not None:
+        result.prior = f"EXIF GPS of {prior.photos} photos, {prior.rms_xy:.3g} RMS"
+    return prior
+
+
 def _keep_clicks(result: FindTargetsResult, clicks: Dict[str, List[gcpmod.Observation]]) -> None:
     """The user's clicks no mark answers go to the output as they are (found False: placed by hand)."""
     for n, obs in clicks.items():
@@ -326,9 +342,12 @@ def find_targets(workspace: str, targets: str, options: Optional[FindTargetsOpti
     xy_only = len(zs) >= 2 and max(zs) - min(zs) < 1e-6  # placeholder heights
     labels = merge_names([codes.get(t.code) if t.code is not None else None for t in tracks],
                          click_names(tracks, clicks, tol_px, result.reports), result.reports)
+    prior = _prior(ws, rec, gs.crs, result)
     match = match_constellation(np.array([t.xyz for t in tracks]).reshape(-1, 3),
                                 np.array([[p.x, p.y, p.z] for p in gs.points]), names, labels, xy_only,
-                                weights=[len(t.candidates) for t in tracks])
+                                weights=[len(t.candidates) for t in tracks],
+                                prior=prior.similarity if prior else None,
+                                prior_tol=3.0 * prior.rms_xy if prior else 0.0)
     result.fit_tolerance, result.fit_rms, result.mirrored = match.tolerance, match.rms, match.mirrored
     result.reports += match.reports
     if match.similarity is None:  # no constellation: the clicked (or coded) marks keep the names they carry
