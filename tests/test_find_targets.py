@@ -197,7 +197,7 @@ def test_errors_name_the_file_the_line_and_what_to_do(block, tmp_path):
 
 
 def test_the_processing_algorithm_writes_the_file_and_the_counts(block, plugin, tmp_path):
-    import processing
+    from qgis import processing
     from qgis.core import QgsProcessingException
 
     scene, ws, csv, r = block
