@@ -163,10 +163,13 @@ def synthetic(threads):
     err = {k: math.hypot(o.x - scene.truth[o.image][o.name][0], o.y - scene.truth[o.image][o.name][1])
            for k, o in found.items()}
     wrong = [k for k, e in err.items() if e > 1.5]
+    edge = [k for k in scene.cut if all(-10 < v < max(targets_scene.W, targets_scene.H) + 10
+                                        for v in scene.truth[k[0]][k[1]])]
     print(f"\nsynthetic block ({len(scene.photos)} photos of {targets_scene.W} x {targets_scene.H}, "
           f"{len(scene.targets)} targets): {secs:.1f} s; recall {len(visible & set(found))} of {len(visible)} "
-          f"whole targets; {len(wrong)} wrong; the occluded and the {len(scene.cut)} cut ones found: "
-          f"{len(set(scene.occluded + scene.cut) & set(found))}; small ones found {len(set(scene.small) & set(found))}"
+          f"whole targets; {len(wrong)} wrong; found of the {len(scene.occluded)} occluded and the {len(edge)} cut by "
+          f"the border: {len(set(scene.occluded + scene.cut) & set(found))}; whole but under "
+          f"{targets_scene.MIN_SIDE_PX:g} px (not asked for) found {len(set(scene.small) & set(found))}"
           f" of {len(scene.small)}")
     for kind in ("checkerboard", "circle", "aruco"):
         e = [err[k] for k in visible & set(found) if found[k].kind == kind]
