@@ -163,8 +163,8 @@ def synthetic(threads):
     err = {k: math.hypot(o.x - scene.truth[o.image][o.name][0], o.y - scene.truth[o.image][o.name][1])
            for k, o in found.items()}
     wrong = [k for k, e in err.items() if e > 1.5]
-    edge = [k for k in scene.cut if all(-10 < v < max(targets_scene.W, targets_scene.H) + 10
-                                        for v in scene.truth[k[0]][k[1]])]
+    edge = [k for k in scene.cut if -10 < scene.truth[k[0]][k[1]][0] < targets_scene.W + 10
+            and -10 < scene.truth[k[0]][k[1]][1] < targets_scene.H + 10]
     print(f"\nsynthetic block ({len(scene.photos)} photos of {targets_scene.W} x {targets_scene.H}, "
           f"{len(scene.targets)} targets): {secs:.1f} s; recall {len(visible & set(found))} of {len(visible)} "
           f"whole targets; {len(wrong)} wrong; found of the {len(scene.occluded)} occluded and the {len(edge)} cut by "
