@@ -51,6 +51,7 @@ from .gcp_table import (
     RoleDelegate,
     short_crs,
 )
+from .gcp_targets import GcpTargets
 from .gcp_tasks import GcpTasks
 from .map_tool import GcpMapTool, GcpMarkers
 from .message_view import FitScrollArea, MessageView
@@ -66,12 +67,12 @@ STATUS_LINES = 5  # the status line grows to this many lines, then scrolls
 DIAGNOSIS_LINES = 40  # the diagnosis is shown whole up to this many lines (it was cut at 100 characters)
 
 
-class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpAutoControl, QgsDockWidget):
+class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoControl, QgsDockWidget):
     """Ground control of one workspace.  ``iface`` may be None (tests); ``canvas`` then is given.
 
     The shell: widgets, wiring, the workspace, the selection.  Placement (map and photos), import / export
     and the background tasks are its mixins (ui/gcp_placement.py, ui/gcp_io.py, ui/gcp_tasks.py; the automatic
-    control, the Georeference button's other mode: ui/gcp_autocontrol.py)."""
+    control, the Georeference button's other mode: ui/gcp_autocontrol.py; Find targets: ui/gcp_targets.py)."""
 
     def __init__(self, iface=None, canvas=None, parent=None):
         super().__init__(parent)
@@ -203,6 +204,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpAutoControl, QgsDockWi
         self.import_menu = QMenu(w)
         self.act_import_file = self.import_menu.addAction(self.tr("From file (gcp_list.txt, CSV)\u2026"))
         self.act_import_layer = self.import_menu.addAction(self.tr("From a point layer\u2026"))
+        self._build_targets_action(self.import_menu)  # ui/gcp_targets.py (a button more would not fit in German)
         self.export_menu = QMenu(w)
         self.act_export_file = self.export_menu.addAction(self.tr("To file (gcp_list.txt, CSV)\u2026"))
         self.act_export_layer = self.export_menu.addAction(self.tr("To a GeoPackage layer\u2026"))
@@ -338,6 +340,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpAutoControl, QgsDockWi
         p.confirmRequested.connect(self.confirm_prediction)
         p.nextRequested.connect(self.confirm_and_next)
         p.filterChanged.connect(lambda _on: self._update_thumbnails())
+        self._install_found_keys()  # ui/gcp_targets.py: one key confirms or rejects a found observation
 
     # ------------------------------------------------------------------ messages
     def message(self, text, level=Qgis.MessageLevel.Info):
@@ -537,6 +540,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpAutoControl, QgsDockWi
         self.btn_georef.setEnabled(has_ws and not busy)
         self.btn_cancel.setEnabled(busy)
         self.btn_new.setEnabled(not busy)
+        self.act_find_targets.setEnabled(has_ws and not busy)
         self.crs_label.setText(self.tr("CRS: {}").format(short_crs(self.store.crs)) if self.store.crs else "")
 
     # ------------------------------------------------------------------ points

@@ -28,6 +28,7 @@ class GcpTableModel(QAbstractTableModel):
         super().__init__(dock)
         self.dock = dock
         self.store = dock.store
+        self.found_info = None  # point name -> tooltip line on its found observations not confirmed, or None
 
     def tr(self, text):
         return QCoreApplication.translate("GcpTableModel", text)
@@ -112,9 +113,18 @@ class GcpTableModel(QAbstractTableModel):
         if role == Qt.ItemDataRole.BackgroundRole and col in (NAME, DXY, DZ, PX):
             colour, _ = self.quality(p.name)
             return colour
+        found = self.found_info(p.name) if self.found_info is not None and col in (NAME, OBS) else None
+        if found and role == Qt.ItemDataRole.ForegroundRole:
+            return QColor("#1f6fd1")  # observations found by Find targets, not confirmed yet
+        if found and role == Qt.ItemDataRole.FontRole:
+            f = QFont()
+            f.setBold(True)
+            return f
         if role == Qt.ItemDataRole.ToolTipRole:
             colour, text = self.quality(p.name)
             lines = [text] if text else []
+            if found:
+                lines.append(found)
             if r is not None:
                 lines += r.get("notes", [])
             if p.name in self.store.stale and r is not None:

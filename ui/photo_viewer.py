@@ -446,6 +446,11 @@ class PhotoPanel(QWidget):
         self.orientation_note = QLabel()  # says when the photo is shown turned from its stored grid
         self.orientation_note.setWordWrap(True)
         self.orientation_note.setVisible(False)
+        self.found_info = None  # (point, image) -> (tooltip, note) of an observation found by Find targets, or None
+        self.found_note = QLabel()  # says that the observation shown was found by Find targets, and the keys
+        self.found_note.setWordWrap(True)
+        self.found_note.setStyleSheet("color: #1f6fd1")
+        self.found_note.setVisible(False)
         self.hint.setWordWrap(True)
         self.view = PhotoView(self)
         self.thumbs = ThumbStrip(self)
@@ -491,6 +496,7 @@ class PhotoPanel(QWidget):
         tl.addLayout(bar)
         tl.addWidget(self.view, 1)
         tl.addWidget(self.orientation_note)
+        tl.addWidget(self.found_note)
         tl.addWidget(self.hint)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(2, 2, 2, 2)
@@ -644,8 +650,14 @@ class PhotoPanel(QWidget):
                 scene.removeItem(item)
         self.observation = self.prediction = None
         self.point_name = point_name or ""
+        found = self.found_info(point_name, self.image) if point_name and observation is not None \
+            and self.found_info is not None else None
+        self.found_note.setText(found[1] if found else "")
+        self.found_note.setVisible(bool(found))
         if point_name and observation is not None:
-            self.observation = MarkerItem(point_name, predicted=False, colour="#ff2a2a")
+            self.observation = MarkerItem(point_name, predicted=False, colour="#1f6fd1" if found else "#ff2a2a")
+            if found:
+                self.observation.setToolTip(found[0])
             self.observation.setPos(self._scene_point(observation))
             self.observation.moved.connect(self._marker_moved)
             scene.addItem(self.observation)

@@ -1,5 +1,10 @@
 """The GCP dock's state: one workspace, its ground control (georef/control.json), the last adjustment's
-residuals and an undo stack.  Every edit is saved at once, atomically."""
+residuals and an undo stack.  Every edit is saved at once, atomically.
+
+Observations found by Find targets (issue 34) carry a mark until the user confirms them: ``found``
+{point: {image: {x, y, quality, kind, source, residual_px}}}, saved beside the points in the dock's own
+control.json (key "found"; the ODM file format does not change).  A mark holds only while its observation stays
+where it was found: moved by hand, the observation is the user's; removed (rejected), the mark goes with it."""
 import copy
 import json
 import math
@@ -72,6 +77,21 @@ def _differs(a, b):
     return not (a == b or (isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b)))
 
 
+def _pruned(gs, found):
+    """The marks of ``found`` whose observation is still there, where it was found."""
+    out = {}
+    for name, per_image in found.items():
+        p = gs.by_name(name)
+        if p is None:
+            continue
+        here = {o.image: o for o in p.observations}
+        for image, info in per_image.items():
+            o = here.get(image)
+            if o is not None and abs(o.x - info["x"]) < 1e-6 and abs(o.y - info["y"]) < 1e-6:
+                out.setdefault(name, {})[image] = info
+    return out
+
+
 class GcpStore(QObject):
     """Ground control of one workspace with undo; emits ``changed`` after every edit."""
 
@@ -92,6 +112,7 @@ class GcpStore(QObject):
         self._masks = {}  # image name -> (mask path, mtime, keep array or None)
         self._undo_keys = UndoKeys(self.undo_stack, self)
         self.last_import_report = []  # what the last import changed (GcpStore.replace_all)
+        self.found = {}  # point -> image -> what Find targets said of the observation, until confirmed
 
     def install_undo_keys(self, *widgets):
         """Ctrl+Z / Ctrl+Shift+Z undo / redo when one of ``widgets`` has the focus."""
@@ -115,7 +136,7 @@ class GcpStore(QObject):
         """Open a workspace folder (raises core.workspace.WorkspaceError)."""
         ws = Workspace.open(path)
         self.workspace = ws
-        self.gcps = self._load_control(ws)
+        self.gcps, self.found = self._load_control(ws)
         self.settings = self._load_json(Layout(ws).editor_json) or {}
         self.undo_stack.clear()
         self.stale = set()
@@ -146,7 +167,15 @@ class GcpStore(QObject):
             gs = gcpmod.GCPSet(crs=ws.crs or "")
         if not gs.crs:
             gs.crs = ws.crs or ""
-        return gs
+        found = {}
+        for f in (data or {}).get("found", []) if isinstance((data or {}).get("found"), list) else []:
+            try:
+                info = {k: v for k, v in f.items() if k not in ("name", "image")}
+                info["x"], info["y"] = float(f["x"]), float(f["y"])
+                found.setdefault(str(f["name"]), {})[str(f["image"])] = info
+            except (KeyError, TypeError, ValueError, AttributeError):
+                continue  # a mark the dock cannot read: the observation stays, as one placed by hand
+        return gs, _pruned(gs, found)
 
     def images(self):
         """[{name, path, width, height, orientation}] of the workspace's photos, in manifest order (orientation:
@@ -179,6 +208,8 @@ class GcpStore(QObject):
         os.makedirs(lay.georef_dir, exist_ok=True)
         data = self.gcps.to_dict()
         data["warnings"] = []
+        data["found"] = [dict(info, name=name, image=image) for name, per_image in self.found.items()
+                         for image, info in per_image.items()]
         atomic_write_text(lay.control_json, json.dumps(data, indent=1))
 
     def save_settings(self, **values):
@@ -204,17 +235,20 @@ class GcpStore(QObject):
 
     # --- state and undo
     def _snapshot(self):
-        return copy.deepcopy(self.gcps.to_dict())
+        return {"gcps": copy.deepcopy(self.gcps.to_dict()), "found": copy.deepcopy(self.found)}
 
     def _set_state(self, state):
-        self.gcps = gcpmod.GCPSet.from_dict(copy.deepcopy(state))
+        self.gcps = gcpmod.GCPSet.from_dict(copy.deepcopy(state["gcps"]))
+        self.found = copy.deepcopy(state["found"])
         self.save()
         self.changed.emit()
 
     def edit(self, text, fn):
-        """Apply ``fn(gcps)`` as one undoable step named ``text``; returns what ``fn`` returns."""
+        """Apply ``fn(gcps)`` as one undoable step named ``text``; returns what ``fn`` returns.  The marks of
+        found observations that ``fn`` moved or removed go (``found``)."""
         before = self._snapshot()
         result = fn(self.gcps)
+        self.found = _pruned(self.gcps, self.found)
         after = self._snapshot()
         if after == before:
             return result
@@ -260,6 +294,8 @@ class GcpStore(QObject):
                 return
             for k, v in fields.items():
                 setattr(p, k, v)
+            if fields.get("name", name) != name and name in self.found:
+                self.found[fields["name"]] = self.found.pop(name)  # a renamed point keeps its marks
         if any(k in fields for k in ("x", "y", "z", "role")):
             self.stale.add(fields.get("name", name))
         what = ", ".join(sorted(fields))
@@ -340,6 +376,14 @@ class GcpStore(QObject):
         when the file gives them (``given``: {name: {"role", "sigma_xy", "sigma_z"}} as the reader saw them;
         without it, a file gives a role when it marks the point as a check point, and a sigma that is not the
         default); observations already placed stay.  Returns the list of what changed, one line per kind."""
+        self.stale.update(p.name for p in gcpset.points)
+        report = self.edit(text, self._merge_fn(gcpset, merge, given))
+        self.last_import_report = report
+        return report
+
+    def _merge_fn(self, gcpset, merge, given, kept_text=None):
+        """The edit of ``replace_all``: ``fn(gs)`` returning the report (``kept_text``: the line naming the
+        observations placed that stay, with {} for their list)."""
         defaults = gcpmod.GroundPoint("", 0.0, 0.0, 0.0)
 
         def says(p, field):
@@ -401,12 +445,63 @@ class GcpStore(QObject):
             if n_obs:
                 out.append(self.tr("{} observations added").format(n_obs))
             if kept_obs:
-                out.append(self.tr("placed observations kept (the file has others): {}").format(", ".join(kept_obs)))
+                out.append((kept_text or self.tr("placed observations kept (the file has others): {}")).format(
+                    ", ".join(kept_obs)))
             return out or [self.tr("nothing changed")]
+        return fn
+
+    # --- observations found by Find targets
+    def merge_found(self, gcpset, found, text):
+        """Find targets' outcome as one undoable step: ``gcpset`` (the surveyed targets with the observations
+        found) merged as an import does (``replace_all``); ``found``: {(point, image): info} with the quality.
+        An observation placed by hand (or confirmed) stays and keeps no mark; one found earlier and not confirmed
+        yet moves to where it is found now.  Returns the report lines."""
+        merge = self._merge_fn(gcpset, True, None, self.tr("observations placed by hand kept (found ones not "
+                                                          "used there): {}"))
+
+        def fn(gs):
+            for (name, image), info in found.items():
+                p = gs.by_name(name)
+                old = next((o for o in p.observations if o.image == image), None) if p is not None else None
+                if old is not None and image in self.found.get(name, {}):
+                    old.x, old.y = float(info["x"]), float(info["y"])
+            out = merge(gs)  # observations placed by hand stay: "placed observations kept" names them
+            for (name, image), info in found.items():
+                obs = next((o for o in gs.by_name(name).observations if o.image == image), None)
+                if obs is not None and not _differs(obs.x, float(info["x"])) and not _differs(obs.y, float(info["y"])):
+                    self.found.setdefault(name, {})[image] = dict(info, x=float(info["x"]), y=float(info["y"]))
+            return out
         self.stale.update(p.name for p in gcpset.points)
         report = self.edit(text, fn)
         self.last_import_report = report
         return report
+
+    def is_found(self, name, image):
+        """The mark of the observation of ``name`` in ``image`` found by Find targets and not confirmed yet."""
+        return self.found.get(name, {}).get(image)
+
+    def found_list(self):
+        """[(point, image)] of the found observations not confirmed yet, in the table's order."""
+        return [(p.name, o.image) for p in self.gcps.points for o in p.observations
+                if o.image in self.found.get(p.name, {})]
+
+    def confirm_found(self, name, image):
+        """The found observation becomes an ordinary one (undoable)."""
+        def fn(gs):
+            marks = self.found.get(name, {})
+            marks.pop(image, None)
+            if not marks:
+                self.found.pop(name, None)
+        return self.edit(self.tr("confirm {} in {}").format(name, image), fn)
+
+    def reject_found(self, name, image):
+        """The found observation goes (undoable)."""
+        def fn(gs):
+            p = gs.by_name(name)
+            if p is not None:
+                p.observations = [o for o in p.observations if o.image != image]
+        self.stale.add(name)
+        return self.edit(self.tr("reject {} in {}").format(name, image), fn)
 
     def set_crs(self, crs):
         return self.edit(self.tr("set CRS"), lambda gs: setattr(gs, "crs", crs))

@@ -1,0 +1,182 @@
+"""The GCP dock's Find targets (issue 34 item 4), offscreen, on tests/targets_scene.py's rendered block (tilted ground
+plane, checkerboard, circular and ArUco targets, nadir and oblique shots, an arbitrary model frame).
+
+The task fills the table with the observations found as one undoable step, marks them as found (saved with the
+dock's control and read back), never overwrites an observation placed by hand, lists what it did not find in the
+message area; Space / Enter confirm and Delete / R reject the found observation shown, in the photo view and the
+table, each going on to the next one.  Positions are checked against the rendered truth.
+"""
+import json
+import math
+import os
+import types
+
+import pytest
+
+from tests import targets_scene
+from tests.test_ui_dock import dock, process, wait_task  # noqa: F401 (fixtures and helpers of the dock tests)
+from tests.workspaces import synthetic_workspace
+
+pytestmark = pytest.mark.usefixtures("qgis_app")
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCREENSHOT = os.path.join(ROOT, "docs", "screenshots", "dock-find-targets.png")
+BLUE = "#1f6fd1"
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory):
+    root = tmp_path_factory.mktemp("dock_targets")
+    sc = targets_scene.render(str(root / "photos"))
+    csv = targets_scene.write_targets_csv(sc, str(root / "targets.csv"))
+    return sc, targets_scene.reconstruction(sc), csv
+
+
+@pytest.fixture
+def ws(scene, tmp_path):
+    sc, rec, _ = scene
+    fake = types.SimpleNamespace(camera=types.SimpleNamespace(width=targets_scene.W, height=targets_scene.H),
+                                 names=[s[0] for s in sc.shots])
+    return synthetic_workspace(str(tmp_path / "ws"), fake, rec, photos=sc.photos)
+
+
+def _observations(store):
+    return {(p.name, o.image): (o.x, o.y) for p in store.gcps.points for o in p.observations}
+
+
+def _find(dock, csv, **kw):  # noqa: F811 (the dock fixture)
+    assert dock.run_find_targets(csv, **kw) is not None and dock.task is not None
+    assert not dock.act_find_targets.isEnabled()  # one task at a time; the GUI runs meanwhile
+    wait_task(dock, 300)
+    assert dock.last_task_error is None, dock.last_task_error
+    return dock.targets_result
+
+
+def _hand_placed(dock, sc):  # noqa: F811
+    """A target placed by hand 2 px off its truth in the first photo that shows it whole, and a point of the
+    user's own: two undoable steps each."""
+    image = next(i for i, v in sc.visible.items() if "ring_b" in v)
+    tx, ty = sc.truth[image]["ring_b"]
+    t = next(t for t in sc.targets if t.name == "ring_b")
+    w = [t.x + targets_scene.OFFSET[0], t.y + targets_scene.OFFSET[1], t.z + targets_scene.OFFSET[2]]
+    dock.store.add_point("ring_b", *w)
+    dock.store.set_observation("ring_b", image, tx + 2.0, ty)
+    dock.store.add_point("wall_corner", w[0] + 1.0, w[1], w[2])
+    return image, (tx + 2.0, ty)
+
+
+def test_find_targets_fills_the_table_in_one_undoable_step_and_keeps_what_was_placed_by_hand(dock, ws, scene):  # noqa: F811,E501
+    sc, _, csv = scene
+    assert dock.open_workspace(ws)
+    hand_image, hand_xy = _hand_placed(dock, sc)
+    steps = dock.store.undo_stack.count()
+    r = _find(dock, csv)
+    assert dock.store.undo_stack.count() == steps + 1  # the whole outcome is one step
+    obs = _observations(dock.store)
+    assert obs[("ring_b", hand_image)] == hand_xy  # never overwritten by the found one
+    assert dock.store.is_found("ring_b", hand_image) is None
+    assert {p.name for p in dock.store.gcps.points} == {t.name for t in sc.targets} | {"wall_corner"}
+    found = dock.store.found_list()
+    assert len(found) >= 0.95 * sum(len(v) for v in sc.visible.values()) - 1
+    assert len(found) == r.n_observations - (1 if any(o.name == "ring_b" and o.image == hand_image
+                                                      for o in r.observations) else 0)
+    core = {(o.name, o.image): o for o in r.observations}
+    for name, image in found:  # what the core found, where the truth is; marked with its quality
+        x, y = obs[(name, image)]
+        assert (x, y) == (float(core[(name, image)].x), float(core[(name, image)].y))
+        assert math.hypot(x - sc.truth[image][name][0], y - sc.truth[image][name][1]) < 1.5, (name, image)
+        assert dock.store.is_found(name, image)["quality"] == round(float(core[(name, image)].quality), 3) > 0
+    text = dock.status.text()
+    assert text.startswith("Find targets: 9 of 9 targets found") and "Space or Enter" in text
+    # the table and the photo view show the marks: the first found observation is on screen, in blue
+    assert dock.current_found() == found[0]
+    assert dock.photo_panel.observation.colour.name() == BLUE and dock.photo_panel.found_note.isVisible()
+    assert "quality" in dock.photo_panel.observation.toolTip()
+    from qgis.PyQt.QtCore import Qt
+
+    row = [p.name for p in dock.store.gcps.points].index(found[0][0])
+    assert dock.model.data(dock.model.index(row, 0), Qt.ItemDataRole.ForegroundRole).name() == BLUE
+    assert "found by Find targets" in dock.model.data(dock.model.index(row, 0), Qt.ItemDataRole.ToolTipRole)
+    hand_row = [p.name for p in dock.store.gcps.points].index("wall_corner")
+    assert dock.model.data(dock.model.index(hand_row, 0), Qt.ItemDataRole.ForegroundRole) is None
+    assert "not confirmed yet" in dock.btn_georef.toolTip()
+    _screenshot(dock)
+    # saved with the dock's control and read back (not in the ODM file, which Georeference reads as always)
+    saved = json.load(open(dock.store.layout.control_json))
+    assert len(saved["found"]) == len(found)
+    assert dock.open_workspace(ws)
+    assert dock.store.found_list() == found and _observations(dock.store) == obs
+
+
+def _screenshot(dock):  # noqa: F811
+    """The dock beside its photo view, after Find targets: docs/screenshots/dock-find-targets.png."""
+    from qgis.PyQt.QtGui import QPainter, QPixmap
+
+    dock.resize(560, 720)
+    dock.photo_dock.resize(760, 720)
+    process(200)
+    a, b = dock.grab(), dock.photo_dock.grab()
+    out = QPixmap(a.width() + b.width(), max(a.height(), b.height()))
+    out.fill()
+    p = QPainter(out)
+    p.drawPixmap(0, 0, a)
+    p.drawPixmap(a.width(), 0, b)
+    p.end()
+    os.makedirs(os.path.dirname(SCREENSHOT), exist_ok=True)
+    out.save(SCREENSHOT)
+    assert os.path.getsize(SCREENSHOT) > 10_000
+
+
+def test_undo_takes_the_found_observations_away_in_one_step(dock, ws, scene):  # noqa: F811
+    sc, _, csv = scene
+    assert dock.open_workspace(ws)
+    hand_image, hand_xy = _hand_placed(dock, sc)
+    before, steps = _observations(dock.store), dock.store.undo_stack.count()
+    _find(dock, csv)
+    after = _observations(dock.store)
+    assert len(after) > len(before) + 20
+    dock.act_undo.trigger()
+    assert _observations(dock.store) == before and not dock.store.found_list()
+    assert {p.name for p in dock.store.gcps.points} == {"ring_b", "wall_corner"}
+    assert dock.store.undo_stack.count() == steps + 1 and dock.store.undo_stack.index() == steps
+    dock.act_redo.trigger()
+    assert _observations(dock.store) == after and dock.store.found_list()
+
+
+def test_one_key_confirms_or_rejects_each_found_observation(dock, ws, scene):  # noqa: F811
+    from qgis.PyQt.QtCore import Qt
+    from qgis.PyQt.QtTest import QTest
+
+    sc, _, csv = scene
+    assert dock.open_workspace(ws)
+    _find(dock, csv)
+    view, table = dock.photo_panel.view, dock.table
+    n = len(dock.store.found_list())
+    first = dock.current_found()
+    xy = _observations(dock.store)[first]
+    QTest.keyClick(view, Qt.Key.Key_Space)  # confirmed: an ordinary observation, where it was
+    assert dock.store.is_found(*first) is None and _observations(dock.store)[first] == xy
+    second = dock.current_found()
+    assert second is not None and second != first and len(dock.store.found_list()) == n - 1
+    QTest.keyClick(view, Qt.Key.Key_R)  # rejected: gone
+    assert second not in _observations(dock.store) and dock.store.is_found(*second) is None
+    third = dock.current_found()
+    assert third is not None and third not in (first, second)
+    QTest.keyClick(table, Qt.Key.Key_Return)  # the table's keys too
+    assert dock.store.is_found(*third) is None and third in _observations(dock.store)
+    fourth = dock.current_found()
+    QTest.keyClick(view, Qt.Key.Key_Delete)
+    assert fourth not in _observations(dock.store)
+    assert len(dock.store.found_list()) == n - 4
+    dock.act_undo.trigger()  # the rejection undone: the observation is back, marked as found
+    assert fourth in _observations(dock.store) and dock.store.is_found(*fourth) is not None
+    # a hand-placed observation shown: the view's own keys (Delete removes it) are left alone
+    name, image = first
+    dock.select_point(name)
+    dock.show_photo(image)
+    assert dock.current_found() is None
+    QTest.keyClick(view, Qt.Key.Key_Delete)
+    assert first not in _observations(dock.store)
+    # the flag survives a reload; confirmed ones stay ordinary
+    left = dock.store.found_list()
+    assert dock.open_workspace(ws) and dock.store.found_list() == left and dock.store.is_found(*third) is None
