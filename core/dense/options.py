@@ -8,8 +8,8 @@ from ..common.errors import ArchaeoOrthoError
 
 QUALITIES = {"full": 1.0, "half": 0.5, "quarter": 0.25}  # QUALITY -> image downscale for matching
 ENGINES = ("cpu", "cuda")
-CACHE_VERSION = 5  # of the per-pair depth map cache (dense/pairs-<key>/); 2: coarse-to-fine; 3: tiled pyramid;
-# 4: uint16 depth maps (x step_i / step_j), stored; 5: equalised pairs, fine_uniqueness
+CACHE_VERSION = 6  # of the per-pair depth map cache (dense/pairs-<key>/); 2: coarse-to-fine; 3: tiled pyramid;
+# 4: uint16 depth maps (x step_i / step_j), stored; 5: equalised pairs, fine_uniqueness; 6: COARSE_FLAT_PX 3
 
 # options that say where the work runs, not what it computes (not recorded among the stage's parameters)
 EXECUTION_OPTIONS = ("workers", "executor", "scheduler")

@@ -246,7 +246,10 @@ def lr_checked(disp_l: np.ndarray, disp_r: np.ndarray, tolerance: float) -> np.n
 
 
 COARSE_AGREEMENT_PX = 2.0  # a fine disparity this far outside its coarse neighbourhood's range is a blunder
-COARSE_FLAT_PX = 2.0  # a fine hole takes the coarse disparity where the coarse neighbourhood spans at most this
+COARSE_FLAT_PX = 3.0  # a fine hole takes the coarse disparity where the coarse neighbourhood spans at most this
+# (fine pixels; under EDGE_JUMP_PX: no wall; 2 until issue 33: the coarse level's noise on faint fields exceeded it
+# and the fine level, which loses faint texture, kept its holes: farmland 88.2 -> 90.7 % measured, RMSE inside the
+# cameras' hull unchanged at 1.5 GSD)
 
 
 def coarse_to_fine(fine: np.ndarray, coarse: np.ndarray) -> np.ndarray:
