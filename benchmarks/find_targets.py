@@ -5,7 +5,7 @@ COPR: the hand gcp_list.txt (27 observations of 10 targets) reduced to coordinat
 looked up among the found ones (within 1.5 px, named otherwise, missing); the observations the hand file does not
 have; then the block georeferenced twice, from the hand file and from the found file, with the same check points
 (gcp03, gcp06, gcp09, as benchmarks/georef.py), the residuals side by side.
-Synthetic: tests/targets_scene.py's block (checkerboard, circle, ArUco; obliques, an occluded target, targets cut
+Synthetic: tests/targets_scene.py's block (checkerboard, circle, ArUco, cross; obliques, an occluded target, targets cut
 by the border): recall, wrong names, error against the rendered truth per kind.
 
     python benchmarks/find_targets.py [--copr-workspace DIR] [--only copr|synthetic] [--threads N]
@@ -171,7 +171,7 @@ def synthetic(threads):
           f"the border: {len(set(scene.occluded + scene.cut) & set(found))}; whole but under "
           f"{targets_scene.MIN_SIDE_PX:g} px (not asked for) found {len(set(scene.small) & set(found))}"
           f" of {len(scene.small)}")
-    for kind in ("checkerboard", "circle", "aruco"):
+    for kind in ("checkerboard", "circle", "aruco", "cross"):
         e = [err[k] for k in visible & set(found) if found[k].kind == kind]
         print(f"  {kind:>12}: {len(e)} observations, error RMS {math.sqrt(np.mean(np.square(e))):.3f} px, "
               f"largest {max(e):.3f} px")

@@ -1,6 +1,6 @@
 """A small synthetic block with ground targets (Find targets, issue 34): the rendered truth of every mark.
 
-A tilted ground plane (sand-like texture, 5 mm texels) with checkerboard, circular and ArUco targets, photographed
+A tilted ground plane (sand-like texture, 5 mm texels) with checkerboard, circular, ArUco and cross targets, photographed
 by a 640 x 480 pinhole camera from a grid of nadir shots and a few obliques.  The plane makes every photo an exact
 homography of the texture (rendered 2x supersampled, then averaged), so the truth of a target's centre is its
 projection.  One target is covered by an occluder in one photo; targets cut by a photo's border are there
@@ -31,7 +31,7 @@ MIN_SIDE_PX = 20.0  # a target whose shortest side is smaller in a photo is not 
 @dataclass
 class Target:
     name: str
-    kind: str  # checkerboard, circle, aruco
+    kind: str  # checkerboard, circle, aruco, cross
     x: float
     y: float
     code: int = -1
@@ -56,7 +56,7 @@ class Scene:
 def _targets(seed: int) -> List[Target]:
     rng = np.random.default_rng(seed)
     kinds = [("checkerboard", "chk_" + c, -1) for c in "abc"] + [("circle", "ring_" + c, -1) for c in "abc"] \
-        + [("aruco", f"aruco_{k}", k) for k in (3, 7, 11)]
+        + [("aruco", f"aruco_{k}", k) for k in (3, 7, 11)] + [("cross", "cross_" + c, -1) for c in "ab"]
     pos: List[Tuple[float, float]] = []
     while len(pos) < len(kinds):
         p = (float(rng.uniform(2.0, EXTENT[0] - 2.0)), float(rng.uniform(2.0, EXTENT[1] - 2.0)))
@@ -77,6 +77,11 @@ def _paint(tex: np.ndarray, t: Target) -> None:
         r = 0.3 * n
         d = np.hypot(xx - n / 2, yy - n / 2)
         patch = np.where(d < r, 20.0, 235.0).astype(np.float32)
+    elif t.kind == "cross":  # a black tarp with a white cross (COPR's kind), bars a sixth of the side
+        patch[:] = 20.0
+        w = n // 6
+        patch[n // 2 - w // 2:n // 2 + w - w // 2, :] = 235.0
+        patch[:, n // 2 - w // 2:n // 2 + w - w // 2] = 235.0
     else:
         side = int(round(0.8 * n))
         marker = cv2.aruco.generateImageMarker(cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_4X4_50), t.code, side)

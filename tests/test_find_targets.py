@@ -1,8 +1,8 @@
 """Find targets (issue 34): surveyed coordinates in, sub-pixel observations out, against a rendered block's truth.
 
-The block (tests/targets_scene.py) is a tilted ground plane with checkerboard, circular and ArUco targets seen from
-nadir and oblique shots, in an arbitrary model frame (no GPS, no click); one target is covered by a pole laid over
-its centre in one photo, others run out of photos at the border.  Find targets must find the targets each photo
+The block (tests/targets_scene.py) is a tilted ground plane with checkerboard, circular, ArUco and cross targets seen
+from nadir and oblique shots, in an arbitrary model frame (no GPS, no click); one target is covered by a pole laid
+over its centre in one photo, others run out of photos at the border.  Find targets must find the targets each photo
 shows whole (recall >= 95 %), give no wrong name, be within 0.3 px of the truth, and find nothing of a target
 covered or cut by the border.
 """
@@ -55,7 +55,7 @@ def test_targets_are_found_named_and_placed_to_sub_pixel_without_a_prior(block):
         nearest = min(scene.truth[o.image], key=lambda n: math.hypot(o.x - scene.truth[o.image][n][0],
                                                                       o.y - scene.truth[o.image][n][1]))
         assert nearest == o.name and _error(scene, o) < 1.5, (o, nearest, _error(scene, o))
-    for kind in ("checkerboard", "circle", "aruco"):
+    for kind in ("checkerboard", "circle", "aruco", "cross"):
         e = [_error(scene, found[k]) for k in hits if found[k].kind == kind]
         assert len(e) >= 5, kind
         assert math.sqrt(np.mean(np.square(e))) <= 0.3 and max(e) <= 0.5, (kind, e)
@@ -80,7 +80,7 @@ def test_the_observations_file_is_what_georeference_reads(block):
         assert (p.x, p.y, p.z) == (q.x, q.y, q.z)
     assert all(0.0 < o.quality <= 1.0 and o.found for o in r.observations)
     # the marks' sizes on the ground, through the constellation's scale: the painted targets' (m)
-    for kind, size in (("checkerboard", 0.5), ("circle", 0.3), ("aruco", 0.4)):
+    for kind, size in (("checkerboard", 0.5), ("circle", 0.3), ("aruco", 0.4), ("cross", 0.5)):
         s = np.median([o.size_m for o in r.observations if o.kind == kind])
         assert 0.8 < s / size < 1.25, (kind, s)
 
@@ -99,7 +99,7 @@ def detections(block):
             for name, path in scene.photos.items()}
 
 
-@pytest.mark.parametrize("kind", ["checkerboard", "circle", "aruco"])
+@pytest.mark.parametrize("kind", ["checkerboard", "circle", "aruco", "cross"])
 def test_each_detector_alone_is_within_a_third_of_a_pixel(block, detections, kind):
     scene = block[0]
     kinds = {t.name: t.kind for t in scene.targets}
