@@ -180,3 +180,39 @@ def test_one_key_confirms_or_rejects_each_found_observation(dock, ws, scene):  #
     # the flag survives a reload; confirmed ones stay ordinary
     left = dock.store.found_list()
     assert dock.open_workspace(ws) and dock.store.found_list() == left and dock.store.is_found(*third) is None
+
+
+def test_the_dialog_the_errors_and_cancel(dock, ws, scene, tmp_path, monkeypatch):  # noqa: F811
+    """The dialog's values reach the task; a file without a CRS in a block without one is refused naming the file,
+    in the message area; a cancelled search changes nothing."""
+    from archaeoortho.ui import gcp_targets
+    from qgis.PyQt.QtWidgets import QDialog
+
+    sc, _, csv = scene
+    assert dock.open_workspace(ws)
+    dlg = gcp_targets.FindTargetsDialog(dock, ws, "EPSG:32611")
+    dlg.file.setFilePath(csv)
+    dlg.kind.setCurrentIndex(dlg.kind.findData("checkerboard"))
+    dlg.size.setValue(0.5)
+    assert dlg.values() == (csv, "checkerboard", 0.5)
+    dlg.size.setValue(0.0)
+    assert dlg.values()[2] is None  # shown as "unknown"
+    asked = []
+    monkeypatch.setattr(gcp_targets.FindTargetsDialog, "exec", lambda self: QDialog.DialogCode.Accepted)
+    monkeypatch.setattr(gcp_targets.FindTargetsDialog, "values", lambda self: (csv, "checkerboard", 0.5))
+    monkeypatch.setattr(dock, "run_find_targets", lambda *a: asked.append(a))
+    dock.choose_find_targets()
+    assert asked == [(csv, "checkerboard", 0.5)]
+    monkeypatch.undo()
+    bad = tmp_path / "no_crs.txt"
+    bad.write_text("1 2 3 T1\n")
+    assert dock.store.crs == ""  # neither the table nor the aligned block has one
+    _find_fails = dock.run_find_targets(str(bad))
+    assert _find_fails is not None
+    wait_task(dock, 120)
+    assert str(bad) in dock.status.text() and "CRS" in dock.status.text()
+    assert not dock.store.gcps.points and dock.store.undo_stack.count() == 0
+    dock.run_find_targets(csv)
+    dock.cancel_task()
+    wait_task(dock, 120)
+    assert dock.status.text() == "Cancelled" and not dock.store.gcps.points
