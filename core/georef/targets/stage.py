@@ -4,14 +4,20 @@ Surveyed coordinates in, sub-pixel observations out, no clicks:
 
 1. candidates on every registered photo (``detect``), in parallel;
 2. tied across photos by triangulation in the model frame (``tie``), the tolerance a multiple of the block's
-   own reprojection error and of the detection's precision;
+   own reprojection error and of the detection's precision; a tie off the block's surface is dropped;
 3. the triangulated marks matched to the surveyed constellation (``constellation``: a similarity from
-   triplets, scale and mirror searched; coded targets carry their names);
+   triplets, scale and mirror searched; coded targets carry their names, clicks in the targets file name the
+   marks they fall on (``clicks``), both checked by the geometry; the photos' EXIF GPS narrows the search
+   (``prior``));
 4. every named target projected into every photo through the block (``core.georef.guided.Predictor``: the
    heights of placeholder-Z surveys come from the tie points): the candidate at the projection joins, so a
    target seen in one photo only is found too;
 5. each target re-triangulated from its observations; an observation off the others by more than the tie
-   tolerance is dropped.
+   tolerance, or (with TARGET_SIZE) of another size on the ground, is dropped.
+
+Everything that did not fit is in ``FindTargetsResult.reports`` (never assigned); each observation carries
+its detector's quality, its residual and whether it was tied or projected (``FoundObservation``), each target
+its status (``TargetStatus``).
 
 Products (``core.project.layout``): an OpenDroneMap gcp_list.txt (what Georeference reads), a GeoPackage of the
 targets with what was found for review, and a JSON record with every observation's quality.
