@@ -149,7 +149,7 @@ def synthetic(threads):
 
     root = os.path.join(OUT, "synthetic")
     shutil.rmtree(root, ignore_errors=True)
-    scene = targets_scene.render(os.path.join(root, "photos"))
+    scene = targets_scene.render(os.path.join(root, "photos"), crosses=True)
     rec = targets_scene.reconstruction(scene)
     fake = types.SimpleNamespace(camera=types.SimpleNamespace(width=targets_scene.W, height=targets_scene.H),
                                  names=[s[0] for s in scene.shots])

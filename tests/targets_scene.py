@@ -53,10 +53,11 @@ class Scene:
     cut: List[Tuple[str, str]] = field(default_factory=list)  # the target's central half not all in the photo
 
 
-def _targets(seed: int) -> List[Target]:
+def _targets(seed: int, crosses: bool) -> List[Target]:
     rng = np.random.default_rng(seed)
     kinds = [("checkerboard", "chk_" + c, -1) for c in "abc"] + [("circle", "ring_" + c, -1) for c in "abc"] \
-        + [("aruco", f"aruco_{k}", k) for k in (3, 7, 11)] + [("cross", "cross_" + c, -1) for c in "ab"]
+        + [("aruco", f"aruco_{k}", k) for k in (3, 7, 11)] + ([("cross", "cross_" + c, -1) for c in "ab"]
+                                                             if crosses else [])
     pos: List[Tuple[float, float]] = []
     while len(pos) < len(kinds):
         p = (float(rng.uniform(2.0, EXTENT[0] - 2.0)), float(rng.uniform(2.0, EXTENT[1] - 2.0)))
@@ -146,9 +147,10 @@ def project(rot: np.ndarray, centre: np.ndarray, xyz: np.ndarray) -> np.ndarray:
     return np.c_[F * xc[:, 0] / xc[:, 2] + W / 2, F * xc[:, 1] / xc[:, 2] + H / 2]
 
 
-def render(folder: str, seed: int = 5) -> Scene:
-    """Render the block into ``folder``; returns the scene with its truth."""
-    targets = _targets(seed)
+def render(folder: str, seed: int = 5, crosses: bool = False) -> Scene:
+    """Render the block into ``folder``; returns the scene with its truth.  ``crosses``: two cross targets as well
+    (the nine others stay where they are)."""
+    targets = _targets(seed, crosses)
     tex = _texture(seed, targets)
     scene = Scene(targets, _shots())
     rng = np.random.default_rng(seed + 11)

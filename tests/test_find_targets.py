@@ -28,7 +28,7 @@ from tests.workspaces import synthetic_workspace
 @pytest.fixture(scope="module")
 def block(tmp_path_factory):
     root = tmp_path_factory.mktemp("targets")
-    scene = targets_scene.render(str(root / "photos"))
+    scene = targets_scene.render(str(root / "photos"), crosses=True)
     rec = targets_scene.reconstruction(scene)
     names = [s[0] for s in scene.shots]
     fake = types.SimpleNamespace(camera=types.SimpleNamespace(width=targets_scene.W, height=targets_scene.H),
