@@ -8,6 +8,7 @@ run through ``qgis_process`` as a user would, on a fresh copy, and classified:
 - traceback: a Python traceback reached the user;
 - silently wrong: exit 0 with wrong figures (checked);
 - unclean: refused, but after leaving something behind (a workspace created for an empty folder);
+- refused: an input the run should take (a photo to skip with a warning) stopped it;
 - lost data: an input or a recorded product changed (fingerprints before / after), whatever the exit.
 
     python benchmarks/bad_inputs.py [--workspace build/demo-workspace] [--before /tmp/wt-before] [--cases a,b]
@@ -228,6 +229,61 @@ def autocontrol_feet_dsm(ws, tmp):
                 protected=[ft, ortho], check=check)
 
 
+def _orientation(ws, tmp):
+    """(photo path, orientation JSON) of a photo of the block's RADIAL camera, from the georeferenced model."""
+    import pycolmap
+
+    sys.path.insert(0, ROOT)
+    from core.geometry.camera import opk_from_rotation
+
+    rec = pycolmap.Reconstruction(os.path.join(ws, "georef", "model"))
+    tf = json.load(open(os.path.join(ws, "georef", "transform.json")))
+    paths = {im["name"]: im["path"] for im in json.load(open(os.path.join(ws, "workspace.json")))["images"]}
+    for i in sorted(rec.reg_image_ids()):
+        im = rec.image(i)
+        cam = rec.cameras[im.camera_id]
+        if cam.model.name != "RADIAL":
+            continue
+        m = np.asarray(im.cam_from_world().matrix())
+        c = -m[:, :3].T @ m[:, 3] + np.asarray(tf["offset"], dtype=float)
+        om, ph, ka = opk_from_rotation(m[:, :3])
+        f, cx, cy, k1, k2 = (float(v) for v in cam.params)
+        doc = {"x": c[0], "y": c[1], "z": c[2], "omega": om, "phi": ph, "kappa": ka, "focal_px": f, "cx": cx,
+               "cy": cy, "k1": k1, "k2": k2, "crs": tf["crs"]}
+        path = os.path.join(tmp, "orientation.json")
+        with open(path, "w") as fh:
+            json.dump(doc, fh)
+        return paths[im.name], path
+    raise SystemExit("no photo of a RADIAL camera in the demo workspace")
+
+
+@case(4, "Orthorectify image (known orientation) on a DSM in US feet against the DSM in metres")
+def orthorectify_feet_dsm(ws, tmp):
+    photo, orient = _orientation(ws, tmp)
+    ft = _feet_dsm(os.path.join(ws, "dsm.tif"), os.path.join(tmp, "dsm_ft.tif"))
+    outs = [os.path.join(tmp, "single_m.tif"), os.path.join(tmp, "single_ft.tif")]
+
+    def check(out, _tmp):
+        gdal, _ = _gdal()
+        a, b = gdal.Open(outs[0]), gdal.Open(outs[1])
+        b = gdal.Warp("", b, format="MEM", outputBounds=_bounds(a), width=a.RasterXSize, height=a.RasterYSize)
+        pa, pb = a.ReadAsArray().astype(np.float32), b.ReadAsArray().astype(np.float32)
+        both = (pa[-1] > 0) & (pb[-1] > 0)
+        share = both.sum() / max(1, (pa[-1] > 0).sum())
+        diff = float(np.median(np.abs(pa[0][both] - pb[0][both]))) if both.any() else float("inf")
+        return share > 0.9 and diff < 4.0, (f"against the metre DSM's orthophoto: {100 * share:.0f} % of its cells, "
+                                            f"median grey difference {diff:.1f}")
+    return Spec([("orthorectifyimage", {"IMAGE": photo, "DSM": os.path.join(ws, "dsm.tif"), "ORIENTATION": orient,
+                                        "OUTPUT": outs[0]}),
+                 ("orthorectifyimage", {"IMAGE": photo, "DSM": ft, "ORIENTATION": orient, "OUTPUT": outs[1]})],
+                protected=[ft], check=check)
+
+
+def _bounds(ds):
+    gt = ds.GetGeoTransform()
+    return (gt[0], gt[3] + ds.RasterYSize * gt[5], gt[0] + ds.RasterXSize * gt[1], gt[3])
+
+
 @case(5, "builddtm of the RGBA orthomosaic as DSM", r"orthomosaic\.tif.*(band|colou?r|RGB|picture)")
 def rgba_as_dsm(ws, tmp):
     return Spec([("builddtm", {"WORKSPACE": ws, "DSM": os.path.join(ws, "orthomosaic.tif"),
@@ -423,6 +479,24 @@ def read_only(ws, tmp):
     return Spec([("builddtm", {"WORKSPACE": ws})], protected=[os.path.join(ws, "dtm.tif")], user="nobody")
 
 
+@case(14, "Prepare images on a folder with a 0-byte photo and a text file named .jpg")
+def prepare_unreadable(ws, tmp):
+    folder = os.path.join(tmp, "photos")
+    os.makedirs(folder)
+    for im in json.load(open(os.path.join(ws, "workspace.json")))["images"][:6]:
+        shutil.copy2(im["path"], folder)
+    open(os.path.join(folder, "empty.jpg"), "wb").close()
+    with open(os.path.join(folder, "notes.jpg"), "w") as fh:
+        fh.write("not a photo")
+
+    def check(out, _tmp):  # one rule with Align images: both skipped, each named once in a warning
+        text = out.get("text", "")
+        named = [n for n in ("empty.jpg", "notes.jpg") if n in text]
+        return len(named) == 2, f"skipped and named: {', '.join(named) or 'neither'}"
+    return Spec([("prepareimages", {"IMAGES": folder, "WORKSPACE": os.path.join(tmp, "new_ws"),
+                                    "OUTPUT": os.path.join(tmp, "prepared")})], check=check)
+
+
 @case(21, "an empty IMAGES folder", r"(no readable images|no images|holds no)")
 def empty_images(ws, tmp):
     empty = os.path.join(tmp, "empty")
@@ -521,6 +595,8 @@ def run_case(c, base, repo, build, keep):
     elif rc != 0:  # the user's message: the error lines (QGIS prints each one more than once)
         errors = list(dict.fromkeys(result.get("errors") or []))
         cls = "clean" if c["expect"] and any(re.search(c["expect"], ln, re.I) for ln in errors) else "unclear"
+        if c["expect"] is None:  # an input the run should take (skip, convert, reproject): refusing it is wrong
+            cls = "refused"
         note = errors[-1][:300] if errors else "(no message)"
         if spec.refused_check is not None:
             ok, left = spec.refused_check(result, tmp)
