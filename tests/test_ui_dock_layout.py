@@ -179,7 +179,8 @@ def test_qgis_lang_de_speaks_german(qgis_iface, qgis_canvas, qgis_language):
             texts = _german_dock_texts(dock)
             assert texts["open"] == "Öffnen…"
             assert texts["new"] == "Neu aus Fotos…"
-            assert texts["import"] == ["Aus Datei (gcp_list.txt, CSV)…", "Aus einem Punktlayer…"]
+            assert texts["import"] == ["Aus Datei (gcp_list.txt, CSV)…", "Aus einem Punktlayer…",
+                                     "Zielmarken auf den Fotos finden…"]
             assert texts["export"] == ["In Datei (gcp_list.txt, CSV)…", "In einen GeoPackage-Layer…"]
             assert dock.btn_georef.text() == "Georeferenzieren"
         finally:
@@ -615,7 +616,8 @@ def test_qgis_desktop_lang_de(georef_ws, tmp_path):
     assert "archaeoortho" in log["plugins"] and log["translator"]
     assert log["icon_on_plugins_toolbar"] and log["plugins_toolbar_visible"] and log["icon_shown"]
     assert log["texts"]["open"] == "Öffnen…" and log["texts"]["new"] == "Neu aus Fotos…"
-    assert log["texts"]["import"] == ["Aus Datei (gcp_list.txt, CSV)…", "Aus einem Punktlayer…"]
+    assert log["texts"]["import"] == ["Aus Datei (gcp_list.txt, CSV)…", "Aus einem Punktlayer…",
+                                     "Zielmarken auf den Fotos finden…"]
     assert log["texts"]["georef"] == "Georeferenzieren"
     assert log["toolbar_hidden"] == [] and log["key_columns_hidden"] == []
     assert log["photo_view_height"] >= 180
