@@ -172,7 +172,9 @@ class GcpTargets:
     def choose_find_targets(self):
         if self.store.workspace is None:
             return None
-        dlg = FindTargetsDialog(self, self.store.root or "", self.store.crs)
+        from .gcp_table import short_crs
+
+        dlg = FindTargetsDialog(self, self.store.root or "", short_crs(self.store.crs) if self.store.crs else "")
         if dlg.exec() != QDialog.DialogCode.Accepted:
             return None
         path, kind, size = dlg.values()
