@@ -977,44 +977,128 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
     </message>
 </context>
 <context>
+    <name>FindTargetsAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="59"/>
+        <source>Aligned workspace</source>
+        <translation>Ausgerichteter Arbeitsbereich</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="59"/>
+        <source>Targets (surveyed coordinates)</source>
+        <translation>Zielmarken (vermessene Koordinaten)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="59"/>
+        <source>CRS of the coordinates (where the file names none)</source>
+        <translation>KBS der Koordinaten (wenn die Datei keines nennt)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="59"/>
+        <source>Target kind</source>
+        <translation>Art der Zielmarken</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="59"/>
+        <source>Target size (m, 0: unknown)</source>
+        <translation>Größe der Zielmarken (m, 0: unbekannt)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="68"/>
+        <source>Observations found (gcp_list.txt)</source>
+        <translation>Gefundene Messungen (gcp_list.txt)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="71"/>
+        <source>Workspace</source>
+        <translation>Arbeitsbereich</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="72"/>
+        <source>Targets found (for review)</source>
+        <translation>Gefundene Zielmarken (zur Prüfung)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="73"/>
+        <source>Targets found</source>
+        <translation>Gefundene Zielmarken</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="74"/>
+        <source>Observations found</source>
+        <translation>Gefundene Messungen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="91"/>
+        <source>{} of {} targets found, {} observations; {} candidate marks, {} tied across photos</source>
+        <translation>{} von {} Zielmarken gefunden, {} Messungen; {} Kandidaten, {} über Fotos hinweg verknüpft</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Find targets</source>
+        <translation>Zielmarken finden</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Finds the surveyed ground targets on the photos of an aligned block and writes their observations, sub-pixel, as a gcp_list.txt that Georeference reads: no clicks. No GPS or first click is needed: marks are detected on every photo, tied across photos by triangulation in the block, and the triangulated marks are matched to the surveyed coordinates by their shape (a similarity found from triplets; scale and mirror searched; the photos&apos; EXIF GPS, where they have it, narrows the search); then every named target is projected into every photo and the mark there joins it. Coded targets (ArUco, AprilTag) carry their names: a target named by its code or ending in it (12, T12, aruco_12).
+
+Aligned workspace: the block (its photos must still be where the alignment found them).
+Targets: the surveyed coordinates, a CSV &apos;name,x,y,z[,sigma_xy,sigma_z]&apos; (CRS as a &apos;# crs: EPSG:xxxx&apos; line or the CRS parameter) or an OpenDroneMap gcp_list.txt whose pixel columns may be absent (&apos;x y z name&apos;) or partial: where present they are clicks that name the mark they fall on (checked against the constellation; a click on another target&apos;s mark is reported and left out).
+CRS: the coordinates&apos; CRS where the file names none.
+Target kind: auto (crosses, checkerboards, circles and ArUco 4x4 markers), one kind, or an ArUco / AprilTag dictionary.
+Target size: the target&apos;s side or diameter in metres (0: unknown); a mark whose size on the ground (its pixels at its distance, through the scale the constellation gives) differs from it by more than a factor 2 is left out.
+A target that a photo shows only in part, or covered, is left out rather than guessed; a mark that does not fit the surveyed constellation, or a naming that another fits almost as well, is reported in the log, never assigned.
+Outputs: the observations file (default georef/targets/gcp_list.txt in the workspace), a layer of the targets with what was found (georef/targets/targets.gpkg: observations, fit, residual) for review, the numbers of targets and observations found; georef/targets/targets.json lists every observation with its quality.</source>
+        <translation>Findet die vermessenen Zielmarken am Boden auf den Fotos eines ausgerichteten Blocks und schreibt ihre Messungen subpixelgenau als gcp_list.txt, die Georeferenzieren liest: ohne Klicks. Weder GPS noch ein erster Klick sind nötig: Marken werden auf jedem Foto erkannt, über die Fotos hinweg durch Triangulation im Block verknüpft, und die triangulierten Marken werden den vermessenen Koordinaten nach ihrer Form zugeordnet (eine Ähnlichkeitstransformation aus Dreiergruppen; Maßstab und Spiegelung werden gesucht; das EXIF-GPS der Fotos, wo vorhanden, engt die Suche ein); dann wird jede benannte Zielmarke in jedes Foto projiziert, und die Marke dort kommt hinzu. Codierte Zielmarken (ArUco, AprilTag) tragen ihre Namen: eine Zielmarke, die nach ihrem Code benannt ist oder auf ihn endet (12, T12, aruco_12).
+
+Ausgerichteter Arbeitsbereich: der Block (seine Fotos müssen noch dort liegen, wo die Ausrichtung sie fand).
+Zielmarken: die vermessenen Koordinaten, eine CSV-Datei 'name,x,y,z[,sigma_xy,sigma_z]' (KBS als Zeile '# crs: EPSG:xxxx' oder im Parameter KBS der Koordinaten) oder eine OpenDroneMap-gcp_list.txt, deren Pixelspalten fehlen ('x y z name') oder teilweise vorhanden sein dürfen: wo vorhanden, sind sie Klicks, die die Marke benennen, auf die sie fallen (gegen die Konstellation geprüft; ein Klick auf die Marke einer anderen Zielmarke wird gemeldet und ausgelassen).
+KBS der Koordinaten: das KBS der Koordinaten, wenn die Datei keines nennt.
+Art der Zielmarken: automatisch (Kreuze, Schachbretter, Kreise und ArUco-4x4-Marker), eine Art oder ein ArUco- / AprilTag-Wörterbuch.
+Größe der Zielmarken: Seitenlänge oder Durchmesser der Zielmarke in Metern (0: unbekannt); eine Marke, deren Größe am Boden (ihre Pixel in ihrer Entfernung, über den Maßstab der Konstellation) um mehr als den Faktor 2 davon abweicht, wird ausgelassen.
+Eine Zielmarke, die ein Foto nur teilweise oder verdeckt zeigt, wird ausgelassen statt geraten; eine Marke, die nicht zur vermessenen Konstellation passt, oder eine Benennung, zu der eine andere fast ebenso gut passt, wird im Protokoll gemeldet, nie zugeordnet.
+Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbeitsbereich), ein Layer der Zielmarken mit dem Gefundenen (georef/targets/targets.gpkg: Messungen, Passung, Residuum) zur Prüfung, die Anzahl gefundener Zielmarken und Messungen; georef/targets/targets.json listet jede Messung mit ihrer Güte.</translation>
+    </message>
+</context>
+<context>
     <name>GcpDock</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="82"/>
         <source>ArchaeoOrtho ground control</source>
         <translation>ArchaeoOrtho Passpunkte</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="98"/>
+        <location filename="../ui/gcp_dock.py" line="99"/>
         <source>ArchaeoOrtho photos</source>
         <translation>ArchaeoOrtho Fotos</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="160"/>
+        <location filename="../ui/gcp_dock.py" line="161"/>
         <source>Workspace:</source>
         <translation>Arbeitsbereich:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="369"/>
+        <location filename="../ui/gcp_dock.py" line="372"/>
         <source>none open</source>
         <translation>keiner geöffnet</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="167"/>
+        <location filename="../ui/gcp_dock.py" line="168"/>
         <source>Open a workspace folder (made by Align images)</source>
         <translation>Einen Arbeitsbereich-Ordner öffnen (von 'Bilder ausrichten' angelegt)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="169"/>
+        <location filename="../ui/gcp_dock.py" line="170"/>
         <source>Choose a folder of photos and a workspace folder, and align the photos</source>
         <translation>Einen Fotoordner und einen Arbeitsbereich-Ordner wählen und die Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="176"/>
+        <location filename="../ui/gcp_dock.py" line="177"/>
         <source>Heights (Z) from:</source>
         <translation>Höhen (Z) aus:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="181"/>
+        <location filename="../ui/gcp_dock.py" line="182"/>
         <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
         <translation>Ein DOM- oder DGM-Rasterlayer (z. B. ein ALS-DOM): ein auf der Karte gemessener Punkt erhält seine Höhe daraus (bilinear). Leer: Z von Hand eingeben.</translation>
     </message>
@@ -1024,17 +1108,17 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>Hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="196"/>
+        <location filename="../ui/gcp_dock.py" line="197"/>
         <source>Add a ground point</source>
         <translation>Einen Passpunkt hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="197"/>
+        <location filename="../ui/gcp_dock.py" line="198"/>
         <source>Remove</source>
         <translation>Entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="198"/>
+        <location filename="../ui/gcp_dock.py" line="199"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Den gewählten Passpunkt mit seinen Messungen entfernen</translation>
     </message>
@@ -1044,7 +1128,7 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>Auf der Karte messen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="201"/>
+        <location filename="../ui/gcp_dock.py" line="202"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>In die Kartenansicht klicken, um X und Y des gewählten Punkts zu setzen (Z aus dem Höhenlayer)</translation>
     </message>
@@ -1054,92 +1138,92 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>Importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="209"/>
+        <location filename="../ui/gcp_dock.py" line="211"/>
         <source>Export</source>
         <translation>Exportieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="224"/>
+        <location filename="../ui/gcp_dock.py" line="226"/>
         <source>Undo</source>
         <translation>Rückgängig</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="225"/>
+        <location filename="../ui/gcp_dock.py" line="227"/>
         <source>Redo</source>
         <translation>Wiederholen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="235"/>
+        <location filename="../ui/gcp_dock.py" line="237"/>
         <source>Undo: {}</source>
         <translation>Rückgängig: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="237"/>
+        <location filename="../ui/gcp_dock.py" line="239"/>
         <source>Redo: {}</source>
         <translation>Wiederholen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="216"/>
+        <location filename="../ui/gcp_dock.py" line="218"/>
         <source>Load results</source>
         <translation>Ergebnisse laden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="217"/>
+        <location filename="../ui/gcp_dock.py" line="219"/>
         <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Die Produkte des Arbeitsbereichs als gestaltete Layer zur Karte hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="271"/>
+        <location filename="../ui/gcp_dock.py" line="273"/>
         <source>Residual tolerance:</source>
         <translation>Residuen-Toleranz:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="277"/>
+        <location filename="../ui/gcp_dock.py" line="279"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="286"/>
+        <location filename="../ui/gcp_dock.py" line="288"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="287"/>
+        <location filename="../ui/gcp_dock.py" line="289"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Die Ausgleichung Brennweite, Bildhauptpunkt und Verzeichnung verfeinern lassen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="294"/>
+        <location filename="../ui/gcp_dock.py" line="296"/>
         <source>Georeference</source>
         <translation>Georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="295"/>
+        <location filename="../ui/gcp_dock.py" line="297"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Die Ausgleichung mit diesen Punkten ausführen (im Hintergrund)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="296"/>
+        <location filename="../ui/gcp_dock.py" line="298"/>
         <source>Cancel</source>
         <translation>Abbrechen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="346"/>
+        <location filename="../ui/gcp_dock.py" line="349"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="353"/>
+        <location filename="../ui/gcp_dock.py" line="356"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Einen ArchaeoOrtho-Arbeitsbereich öffnen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="399"/>
+        <location filename="../ui/gcp_dock.py" line="402"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} Fotos; der Block ist noch nicht ausgerichtet: 'Bilder ausrichten' (oder 'Neu aus Fotos') ausführen, um vorhergesagte Positionen zu erhalten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="402"/>
+        <location filename="../ui/gcp_dock.py" line="405"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} Fotos, {} Passpunkte. {}</translation>
     </message>
@@ -1179,7 +1263,7 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>ArchaeoOrtho: Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="540"/>
+        <location filename="../ui/gcp_dock.py" line="544"/>
         <source>CRS: {}</source>
         <translation>KBS: {}</translation>
     </message>
@@ -1449,32 +1533,32 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>(Korrelation {:.2f}, {:.0f} px von der geometrischen Vorhersage)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="166"/>
+        <location filename="../ui/gcp_dock.py" line="167"/>
         <source>Open…</source>
         <translation>Öffnen…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="168"/>
+        <location filename="../ui/gcp_dock.py" line="169"/>
         <source>New from photos…</source>
         <translation>Neu aus Fotos…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="204"/>
+        <location filename="../ui/gcp_dock.py" line="205"/>
         <source>From file (gcp_list.txt, CSV)…</source>
         <translation>Aus Datei (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="205"/>
+        <location filename="../ui/gcp_dock.py" line="206"/>
         <source>From a point layer…</source>
         <translation>Aus einem Punktlayer…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="207"/>
+        <location filename="../ui/gcp_dock.py" line="209"/>
         <source>To file (gcp_list.txt, CSV)…</source>
         <translation>In Datei (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="208"/>
+        <location filename="../ui/gcp_dock.py" line="210"/>
         <source>To a GeoPackage layer…</source>
         <translation>In einen GeoPackage-Layer…</translation>
     </message>
@@ -1559,37 +1643,37 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>{} ist ausgewählt: wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="232"/>
+        <location filename="../ui/gcp_dock.py" line="234"/>
         <source>Undo (Ctrl+Z)</source>
         <translation>Rückgängig (Strg+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="232"/>
+        <location filename="../ui/gcp_dock.py" line="234"/>
         <source>Redo (Ctrl+Shift+Z)</source>
         <translation>Wiederholen (Strg+Umschalt+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="420"/>
+        <location filename="../ui/gcp_dock.py" line="423"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px.</source>
         <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="425"/>
+        <location filename="../ui/gcp_dock.py" line="428"/>
         <source>Not aligned ({}): {}</source>
         <translation>Nicht ausgerichtet ({}): {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="426"/>
+        <location filename="../ui/gcp_dock.py" line="429"/>
         <source>(marked in the photo strip; hover for the reason)</source>
         <translation>(in der Fotoleiste markiert; der Grund steht im Tooltip)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="445"/>
+        <location filename="../ui/gcp_dock.py" line="448"/>
         <source>✗ not aligned</source>
         <translation>✗ nicht ausgerichtet</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="446"/>
+        <location filename="../ui/gcp_dock.py" line="449"/>
         <source>{}: not aligned: {}</source>
         <translation>{}: nicht ausgerichtet: {}</translation>
     </message>
@@ -1689,258 +1773,398 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <translation>Referenz-DOM:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="78"/>
+        <location filename="../ui/gcp_autocontrol.py" line="80"/>
         <source>Georeference from the reference orthophoto and DSM (in the background)</source>
         <translation>Aus Referenz-Orthophoto und -DOM georeferenzieren (im Hintergrund)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="99"/>
+        <location filename="../ui/gcp_autocontrol.py" line="101"/>
         <source>Automatic control: choose a reference orthophoto and a reference DSM layer</source>
         <translation>Automatische Passpunkte: ein Referenz-Orthophoto und einen Referenz-DOM-Layer wählen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="120"/>
+        <location filename="../ui/gcp_autocontrol.py" line="122"/>
         <source>Automatic control: {} automatic GCPs kept of {} matches; georeferenced in {}.</source>
         <translation>Automatische Passpunkte: {} automatische Passpunkte von {} Zuordnungen behalten; georeferenziert in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="123"/>
+        <location filename="../ui/gcp_autocontrol.py" line="125"/>
         <source>Check points: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</source>
         <translation>Kontrollpunkte: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="134"/>
+        <location filename="../ui/gcp_autocontrol.py" line="136"/>
         <source>ArchaeoOrtho: automatic control</source>
         <translation>ArchaeoOrtho: automatische Passpunkte</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="138"/>
+        <location filename="../ui/gcp_autocontrol.py" line="140"/>
         <source>Automatic control against {} and {}…</source>
         <translation>Automatische Passpunkte gegen {} und {}…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="150"/>
+        <location filename="../ui/gcp_autocontrol.py" line="152"/>
         <source>Automatic GCPs (residuals)</source>
         <translation>Automatische Passpunkte (Residuen)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="64"/>
+        <source>found by Find targets ({}), quality {:.2f}</source>
+        <translation>von Zielmarken finden gefunden ({}), Güte {:.2f}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="67"/>
+        <source>, {:.2f} px from the other photos&apos; rays</source>
+        <translation>, {:.2f} px von den Strahlen der anderen Fotos</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="78"/>
+        <source>Find targets</source>
+        <translation>Zielmarken finden</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="84"/>
+        <source>Surveyed coordinates (*.csv *.txt);;All files (*)</source>
+        <translation>Vermessene Koordinaten (*.csv *.txt);;Alle Dateien (*)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="85"/>
+        <source>A CSV name,x,y,z[,sigma_xy,sigma_z] or an ODM gcp_list.txt (its pixel columns may be absent)</source>
+        <translation>Eine CSV-Datei name,x,y,z[,sigma_xy,sigma_z] oder eine ODM-gcp_list.txt (ihre Pixelspalten dürfen fehlen)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="87"/>
+        <source>Surveyed coordinates:</source>
+        <translation>Vermessene Koordinaten:</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="90"/>
+        <source>auto (crosses, checkerboards, circles, ArUco 4x4)</source>
+        <translation>automatisch (Kreuze, Schachbretter, Kreise, ArUco 4x4)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="92"/>
+        <source>Target kind:</source>
+        <translation>Art der Zielmarken:</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="97"/>
+        <source>unknown</source>
+        <translation>unbekannt</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="98"/>
+        <source>The target&apos;s side or diameter: marks of another size are left out</source>
+        <translation>Seitenlänge oder Durchmesser der Zielmarke: Marken anderer Größe werden ausgelassen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="99"/>
+        <source>Target size:</source>
+        <translation>Größe der Zielmarken:</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="101"/>
+        <source>A file that names no CRS is read in {}.</source>
+        <translation>Eine Datei, die kein KBS nennt, wird in {} gelesen.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="101"/>
+        <source>The file must name its CRS (the table and the workspace have none).</source>
+        <translation>Die Datei muss ihr KBS nennen (Tabelle und Arbeitsbereich haben keines).</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="154"/>
+        <source>Find targets on the photos…</source>
+        <translation>Zielmarken auf den Fotos finden…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="155"/>
+        <source>Find the surveyed targets on the aligned photos (in the background): their observations fill the table, marked as found until you confirm them (Space or Enter) or reject them (Delete or R)</source>
+        <translation>Die vermessenen Zielmarken auf den ausgerichteten Fotos finden (im Hintergrund): ihre Messungen füllen die Tabelle, als gefunden markiert, bis Sie sie übernehmen (Leertaste oder Eingabe) oder verwerfen (Entf oder R)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="204"/>
+        <source>ArchaeoOrtho: find targets</source>
+        <translation>ArchaeoOrtho: Zielmarken finden</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="206"/>
+        <source>Looking for the targets of {} on the photos…</source>
+        <translation>Die Zielmarken aus {} werden auf den Fotos gesucht…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="224"/>
+        <source>find targets</source>
+        <translation>Zielmarken finden</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="225"/>
+        <source>Find targets: {} of {} targets found, {} observations, in {:.0f} s.</source>
+        <translation>Zielmarken finden: {} von {} Zielmarken gefunden, {} Messungen, in {:.0f} s.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="230"/>
+        <source>not found: {}</source>
+        <translation>nicht gefunden: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="234"/>
+        <source>Space or Enter: confirm the found observation shown; Delete or R: reject it. Georeference uses the found observations that are not rejected, confirmed or not.</source>
+        <translation>Leertaste oder Eingabe: die angezeigte gefundene Messung übernehmen; Entf oder R: sie verwerfen. Georeferenzieren verwendet die nicht verworfenen gefundenen Messungen, übernommen oder nicht.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="291"/>
+        <source>Every found observation is confirmed or rejected</source>
+        <translation>Jede gefundene Messung ist übernommen oder verworfen</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="307"/>
+        <source>Found by Find targets, not confirmed: Space or Enter confirms it, Delete or R rejects it (then the next one).</source>
+        <translation>Von Zielmarken finden gefunden, nicht übernommen: Leertaste oder Eingabe übernimmt sie, Entf oder R verwirft sie (dann die nächste).</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="315"/>
+        <source>{} observations found by Find targets, not confirmed: {}</source>
+        <translation>{} Messungen von Zielmarken finden gefunden, nicht übernommen: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="326"/>
+        <source>{} found observations are not confirmed yet: they are used as they are (reject the wrong ones first)</source>
+        <translation>{} gefundene Messungen sind noch nicht übernommen: sie werden so verwendet, wie sie sind (verwerfen Sie zuerst die falschen)</translation>
     </message>
 </context>
 <context>
     <name>GcpStore</name>
     <message>
-        <location filename="../ui/store.py" line="255"/>
+        <location filename="../ui/store.py" line="289"/>
         <source>a point named {} exists already</source>
         <translation>ein Punkt namens {} existiert bereits</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="243"/>
+        <location filename="../ui/store.py" line="277"/>
         <source>add point {}</source>
         <translation>Punkt {} hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="250"/>
+        <location filename="../ui/store.py" line="284"/>
         <source>remove point {}</source>
         <translation>Punkt {} entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="266"/>
+        <location filename="../ui/store.py" line="302"/>
         <source>set {} of {}</source>
         <translation>{} von {} setzen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="326"/>
+        <location filename="../ui/store.py" line="362"/>
         <source>place {} in {}</source>
         <translation>{} in {} messen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="334"/>
+        <location filename="../ui/store.py" line="370"/>
         <source>remove {} from {}</source>
         <translation>{} aus {} entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="412"/>
+        <location filename="../ui/store.py" line="507"/>
         <source>set CRS</source>
         <translation>KBS setzen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="294"/>
+        <location filename="../ui/store.py" line="330"/>
         <source>no position</source>
         <translation>keine Position</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="299"/>
+        <location filename="../ui/store.py" line="335"/>
         <source>({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)</source>
         <translation>({:.0f}, {:.0f}) liegt außerhalb des Fotos {} ({} × {} px)</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="306"/>
+        <location filename="../ui/store.py" line="342"/>
         <source>({:.0f}, {:.0f}) is inside the mask of {}</source>
         <translation>({:.0f}, {:.0f}) liegt in der Maske von {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="314"/>
+        <location filename="../ui/store.py" line="350"/>
         <source>{} not placed: {}</source>
         <translation>{} nicht gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="358"/>
+        <location filename="../ui/store.py" line="402"/>
         <source>{} points replaced by {} from the file</source>
         <translation>{} Punkte durch {} aus der Datei ersetzt</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="392"/>
+        <location filename="../ui/store.py" line="436"/>
         <source>added {} points: {}</source>
         <translation>{} Punkte hinzugefügt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="394"/>
+        <location filename="../ui/store.py" line="438"/>
         <source>coordinates updated from the file: {}</source>
         <translation>Koordinaten aus der Datei aktualisiert: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="396"/>
+        <location filename="../ui/store.py" line="440"/>
         <source>role set by the file: {}</source>
         <translation>Rolle von der Datei gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="398"/>
+        <location filename="../ui/store.py" line="442"/>
         <source>role kept (the file gives none): {}</source>
         <translation>Rolle beibehalten (die Datei nennt keine): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="400"/>
+        <location filename="../ui/store.py" line="444"/>
         <source>σ set by the file: {}</source>
         <translation>σ von der Datei gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="402"/>
+        <location filename="../ui/store.py" line="446"/>
         <source>{} observations added</source>
         <translation>{} Messungen hinzugefügt</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="404"/>
+        <location filename="../ui/store.py" line="448"/>
         <source>placed observations kept (the file has others): {}</source>
         <translation>gesetzte Messungen beibehalten (die Datei hat andere): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="405"/>
+        <location filename="../ui/store.py" line="450"/>
         <source>nothing changed</source>
         <translation>nichts geändert</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="459"/>
+        <source>observations placed by hand kept (found ones not used there): {}</source>
+        <translation>von Hand gesetzte Messungen beibehalten (gefundene dort nicht verwendet): {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="495"/>
+        <source>confirm {} in {}</source>
+        <translation>{} in {} übernehmen</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="504"/>
+        <source>reject {} in {}</source>
+        <translation>{} in {} verwerfen</translation>
     </message>
 </context>
 <context>
     <name>GcpTableModel</name>
     <message>
-        <location filename="../ui/gcp_table.py" line="36"/>
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>Name</source>
         <translation>Name</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="36"/>
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>X</source>
         <translation>X</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="36"/>
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>Y</source>
         <translation>Y</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="36"/>
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>Z</source>
         <translation>Z</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="37"/>
+        <location filename="../ui/gcp_table.py" line="38"/>
         <source>Role</source>
         <translation>Rolle</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="37"/>
+        <location filename="../ui/gcp_table.py" line="38"/>
         <source>Obs.</source>
         <translation>Mess.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="37"/>
+        <location filename="../ui/gcp_table.py" line="38"/>
         <source>dXY (m)</source>
         <translation>dXY (m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="37"/>
+        <location filename="../ui/gcp_table.py" line="38"/>
         <source>dZ (m)</source>
         <translation>dZ (m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="37"/>
+        <location filename="../ui/gcp_table.py" line="38"/>
         <source>px</source>
         <translation>px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="40"/>
+        <location filename="../ui/gcp_table.py" line="41"/>
         <source>check</source>
         <translation>Kontrolle</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="40"/>
+        <location filename="../ui/gcp_table.py" line="41"/>
         <source>control</source>
         <translation>Passpunkt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="52"/>
+        <location filename="../ui/gcp_table.py" line="53"/>
         <source>Horizontal residual after the adjustment (estimated from the photos minus given)</source>
         <translation>Lageresiduum nach der Ausgleichung (aus den Fotos geschätzt minus gegeben)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="53"/>
+        <location filename="../ui/gcp_table.py" line="54"/>
         <source>Vertical residual after the adjustment</source>
         <translation>Höhenresiduum nach der Ausgleichung</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="54"/>
+        <location filename="../ui/gcp_table.py" line="55"/>
         <source>Mean reprojection error of the point&apos;s observations (pixels)</source>
         <translation>Mittlerer Rückprojektionsfehler der Messungen des Punkts (Pixel)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="55"/>
+        <location filename="../ui/gcp_table.py" line="56"/>
         <source>Number of photos the point is placed in</source>
         <translation>Anzahl der Fotos, in denen der Punkt gemessen ist</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="68"/>
+        <location filename="../ui/gcp_table.py" line="69"/>
         <source>rejected as an outlier</source>
         <translation>als Ausreißer verworfen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="70"/>
+        <location filename="../ui/gcp_table.py" line="71"/>
         <source>not triangulated (fewer than 2 usable observations)</source>
         <translation>nicht trianguliert (weniger als 2 brauchbare Messungen)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="76"/>
+        <location filename="../ui/gcp_table.py" line="77"/>
         <source>within the tolerance</source>
         <translation>innerhalb der Toleranz</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="78"/>
+        <location filename="../ui/gcp_table.py" line="79"/>
         <source>up to 3 times the tolerance</source>
         <translation>bis zum Dreifachen der Toleranz</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="79"/>
+        <location filename="../ui/gcp_table.py" line="80"/>
         <source>more than 3 times the tolerance</source>
         <translation>mehr als das Dreifache der Toleranz</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="121"/>
+        <location filename="../ui/gcp_table.py" line="131"/>
         <source>edited since the last adjustment: run Georeference to update</source>
         <translation>seit der letzten Ausgleichung bearbeitet: 'Georeferenzieren' ausführen zum Aktualisieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="36"/>
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>σ XY</source>
         <translation>σ XY</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="36"/>
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>σ Z</source>
         <translation>σ Z</translation>
     </message>
@@ -2267,67 +2491,67 @@ Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und 
 <context>
     <name>PhotoPanel</name>
     <message>
-        <location filename="../ui/photo_viewer.py" line="466"/>
+        <location filename="../ui/photo_viewer.py" line="471"/>
         <source>Only photos that probably see the point</source>
         <translation>Nur Fotos, die den Punkt voraussichtlich zeigen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="469"/>
+        <location filename="../ui/photo_viewer.py" line="474"/>
         <source>Fit</source>
         <translation>Einpassen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="469"/>
+        <location filename="../ui/photo_viewer.py" line="474"/>
         <source>Show the whole photo (F)</source>
         <translation>Das ganze Foto zeigen (F)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="470"/>
+        <location filename="../ui/photo_viewer.py" line="475"/>
         <source>Zoom to point</source>
         <translation>Auf Punkt zoomen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="470"/>
+        <location filename="../ui/photo_viewer.py" line="475"/>
         <source>Zoom to the observation or prediction (Z)</source>
         <translation>Auf die Messung oder Vorhersage zoomen (Z)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="472"/>
+        <location filename="../ui/photo_viewer.py" line="477"/>
         <source>Confirm</source>
         <translation>Übernehmen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="472"/>
+        <location filename="../ui/photo_viewer.py" line="477"/>
         <source>Accept the predicted position (Space)</source>
         <translation>Die vorhergesagte Position übernehmen (Leertaste)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="474"/>
+        <location filename="../ui/photo_viewer.py" line="479"/>
         <source>Confirm &amp;&amp; next</source>
         <translation>Übernehmen &amp;&amp; weiter</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="474"/>
+        <location filename="../ui/photo_viewer.py" line="479"/>
         <source>Accept the prediction and show the next photo to place (Enter)</source>
         <translation>Die Vorhersage übernehmen und das nächste zu messende Foto zeigen (Eingabetaste)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="477"/>
+        <location filename="../ui/photo_viewer.py" line="482"/>
         <source>Remove</source>
         <translation>Entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="477"/>
+        <location filename="../ui/photo_viewer.py" line="482"/>
         <source>Remove the observation in this photo (Delete)</source>
         <translation>Die Messung in diesem Foto entfernen (Entf)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="653"/>
+        <location filename="../ui/photo_viewer.py" line="665"/>
         <source>{} (predicted)</source>
         <translation>{} (vorhergesagt)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="565"/>
+        <location filename="../ui/photo_viewer.py" line="571"/>
         <source>Shown upright (EXIF orientation {}: stored {} x {} px); pixel coordinates are those of the stored grid, as COLMAP and gcp_list.txt use them</source>
         <translation>Aufrecht gezeigt (EXIF-Ausrichtung {}: gespeichert {} x {} px); die Pixelkoordinaten sind die des gespeicherten Rasters, wie COLMAP und gcp_list.txt sie verwenden</translation>
     </message>
@@ -2573,87 +2797,87 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
 <context>
     <name>ResultLayers</name>
     <message>
-        <location filename="../ui/layers.py" line="278"/>
+        <location filename="../qgisio/layers.py" line="278"/>
         <source>control (used)</source>
         <translation>Passpunkt (verwendet)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="279"/>
+        <location filename="../qgisio/layers.py" line="279"/>
         <source>check point</source>
         <translation>Kontrollpunkt</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="280"/>
+        <location filename="../qgisio/layers.py" line="280"/>
         <source>rejected (outlier)</source>
         <translation>verworfen (Ausreißer)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="281"/>
+        <location filename="../qgisio/layers.py" line="281"/>
         <source>not triangulated</source>
         <translation>nicht trianguliert</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="770"/>
+        <location filename="../qgisio/layers.py" line="771"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="721"/>
+        <location filename="../qgisio/layers.py" line="724"/>
         <source>DSM hillshade</source>
         <translation>DOM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="771"/>
+        <location filename="../qgisio/layers.py" line="772"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="772"/>
+        <location filename="../qgisio/layers.py" line="773"/>
         <source>Cameras</source>
         <translation>Kameras</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="733"/>
+        <location filename="../qgisio/layers.py" line="736"/>
         <source>Camera footprints</source>
         <translation>Bildfußabdrücke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="740"/>
+        <location filename="../qgisio/layers.py" line="744"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Passpunkt-Residuen (Vektoren x{})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="773"/>
+        <location filename="../qgisio/layers.py" line="774"/>
         <source>Point cloud</source>
         <translation>Punktwolke</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="781"/>
+        <location filename="../qgisio/layers.py" line="782"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="416"/>
+        <location filename="../qgisio/layers.py" line="417"/>
         <source>{} ({})</source>
         <translation>{} ({})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="774"/>
+        <location filename="../qgisio/layers.py" line="775"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="747"/>
+        <location filename="../qgisio/layers.py" line="751"/>
         <source>DTM hillshade</source>
         <translation>DGM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="775"/>
+        <location filename="../qgisio/layers.py" line="776"/>
         <source>Contours</source>
         <translation>Höhenlinien</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="401"/>
+        <location filename="../qgisio/layers.py" line="401"/>
         <source>{} — {}</source>
         <translation>{} — {}</translation>
     </message>

@@ -977,44 +977,128 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
     </message>
 </context>
 <context>
+    <name>FindTargetsAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="59"/>
+        <source>Aligned workspace</source>
+        <translation>Area di lavoro allineata</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="59"/>
+        <source>Targets (surveyed coordinates)</source>
+        <translation>Target (coordinate rilevate)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="59"/>
+        <source>CRS of the coordinates (where the file names none)</source>
+        <translation>SR delle coordinate (se il file non ne indica uno)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="59"/>
+        <source>Target kind</source>
+        <translation>Tipo di target</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="59"/>
+        <source>Target size (m, 0: unknown)</source>
+        <translation>Dimensione dei target (m, 0: sconosciuta)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="68"/>
+        <source>Observations found (gcp_list.txt)</source>
+        <translation>Misure trovate (gcp_list.txt)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="71"/>
+        <source>Workspace</source>
+        <translation>Area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="72"/>
+        <source>Targets found (for review)</source>
+        <translation>Target trovati (da verificare)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="73"/>
+        <source>Targets found</source>
+        <translation>Target trovati</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="74"/>
+        <source>Observations found</source>
+        <translation>Misure trovate</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="91"/>
+        <source>{} of {} targets found, {} observations; {} candidate marks, {} tied across photos</source>
+        <translation>{} di {} target trovati, {} misure; {} segni candidati, {} collegati tra le foto</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Find targets</source>
+        <translation>Trova i target</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Finds the surveyed ground targets on the photos of an aligned block and writes their observations, sub-pixel, as a gcp_list.txt that Georeference reads: no clicks. No GPS or first click is needed: marks are detected on every photo, tied across photos by triangulation in the block, and the triangulated marks are matched to the surveyed coordinates by their shape (a similarity found from triplets; scale and mirror searched; the photos&apos; EXIF GPS, where they have it, narrows the search); then every named target is projected into every photo and the mark there joins it. Coded targets (ArUco, AprilTag) carry their names: a target named by its code or ending in it (12, T12, aruco_12).
+
+Aligned workspace: the block (its photos must still be where the alignment found them).
+Targets: the surveyed coordinates, a CSV &apos;name,x,y,z[,sigma_xy,sigma_z]&apos; (CRS as a &apos;# crs: EPSG:xxxx&apos; line or the CRS parameter) or an OpenDroneMap gcp_list.txt whose pixel columns may be absent (&apos;x y z name&apos;) or partial: where present they are clicks that name the mark they fall on (checked against the constellation; a click on another target&apos;s mark is reported and left out).
+CRS: the coordinates&apos; CRS where the file names none.
+Target kind: auto (crosses, checkerboards, circles and ArUco 4x4 markers), one kind, or an ArUco / AprilTag dictionary.
+Target size: the target&apos;s side or diameter in metres (0: unknown); a mark whose size on the ground (its pixels at its distance, through the scale the constellation gives) differs from it by more than a factor 2 is left out.
+A target that a photo shows only in part, or covered, is left out rather than guessed; a mark that does not fit the surveyed constellation, or a naming that another fits almost as well, is reported in the log, never assigned.
+Outputs: the observations file (default georef/targets/gcp_list.txt in the workspace), a layer of the targets with what was found (georef/targets/targets.gpkg: observations, fit, residual) for review, the numbers of targets and observations found; georef/targets/targets.json lists every observation with its quality.</source>
+        <translation>Trova i target a terra rilevati nelle foto di un blocco allineato e ne scrive le misure, al sub-pixel, in un gcp_list.txt che Georeferenzia legge: nessun clic. Non servono né GPS né un primo clic: i segni vengono rilevati in ogni foto, collegati tra le foto per triangolazione nel blocco, e i segni triangolati vengono abbinati alle coordinate rilevate in base alla loro forma (una similitudine trovata da terne; scala e specchiatura cercate; il GPS EXIF delle foto, dove c'è, restringe la ricerca); poi ogni target nominato viene proiettato in ogni foto e il segno lì presente gli si unisce. I target codificati (ArUco, AprilTag) portano il proprio nome: un target chiamato con il suo codice o che termina con esso (12, T12, aruco_12).
+
+Area di lavoro allineata: il blocco (le sue foto devono essere ancora dove l'allineamento le ha trovate).
+Target: le coordinate rilevate, un CSV 'name,x,y,z[,sigma_xy,sigma_z]' (SR come riga '# crs: EPSG:xxxx' o nel parametro SR delle coordinate) o un gcp_list.txt di OpenDroneMap le cui colonne dei pixel possono mancare ('x y z name') o essere parziali: dove presenti sono clic che danno il nome al segno su cui cadono (verificati rispetto alla costellazione; un clic sul segno di un altro target viene segnalato ed escluso).
+SR delle coordinate: l'SR delle coordinate se il file non ne indica uno.
+Tipo di target: automatico (croci, scacchiere, cerchi e marker ArUco 4x4), un solo tipo, o un dizionario ArUco / AprilTag.
+Dimensione dei target: lato o diametro del target in metri (0: sconosciuta); un segno la cui dimensione a terra (i suoi pixel alla sua distanza, tramite la scala data dalla costellazione) ne differisce di più di un fattore 2 viene escluso.
+Un target che una foto mostra solo in parte, o coperto, viene escluso invece che indovinato; un segno che non si adatta alla costellazione rilevata, o un'assegnazione di nomi che un'altra soddisfa quasi altrettanto bene, viene segnalato nel log, mai assegnato.
+Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area di lavoro), un layer dei target con quanto trovato (georef/targets/targets.gpkg: misure, adattamento, residuo) da verificare, il numero di target e di misure trovati; georef/targets/targets.json elenca ogni misura con la sua qualità.</translation>
+    </message>
+</context>
+<context>
     <name>GcpDock</name>
     <message>
-        <location filename="../ui/gcp_dock.py" line="81"/>
+        <location filename="../ui/gcp_dock.py" line="82"/>
         <source>ArchaeoOrtho ground control</source>
         <translation>ArchaeoOrtho punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="98"/>
+        <location filename="../ui/gcp_dock.py" line="99"/>
         <source>ArchaeoOrtho photos</source>
         <translation>ArchaeoOrtho foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="160"/>
+        <location filename="../ui/gcp_dock.py" line="161"/>
         <source>Workspace:</source>
         <translation>Area di lavoro:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="369"/>
+        <location filename="../ui/gcp_dock.py" line="372"/>
         <source>none open</source>
         <translation>nessuna aperta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="167"/>
+        <location filename="../ui/gcp_dock.py" line="168"/>
         <source>Open a workspace folder (made by Align images)</source>
         <translation>Apri una cartella dell'area di lavoro (creata da 'Allinea immagini')</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="169"/>
+        <location filename="../ui/gcp_dock.py" line="170"/>
         <source>Choose a folder of photos and a workspace folder, and align the photos</source>
         <translation>Scegli una cartella di foto e una cartella dell'area di lavoro e allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="176"/>
+        <location filename="../ui/gcp_dock.py" line="177"/>
         <source>Heights (Z) from:</source>
         <translation>Quote (Z) da:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="181"/>
+        <location filename="../ui/gcp_dock.py" line="182"/>
         <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
         <translation>Un layer raster DSM o DTM (ad es. un DSM ALS): un punto misurato sulla mappa ne prende la quota (bilineare). Vuoto: inserire Z a mano.</translation>
     </message>
@@ -1024,17 +1108,17 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>Aggiungi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="196"/>
+        <location filename="../ui/gcp_dock.py" line="197"/>
         <source>Add a ground point</source>
         <translation>Aggiungi un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="197"/>
+        <location filename="../ui/gcp_dock.py" line="198"/>
         <source>Remove</source>
         <translation>Rimuovi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="198"/>
+        <location filename="../ui/gcp_dock.py" line="199"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Rimuovi il punto d'appoggio selezionato e le sue misure</translation>
     </message>
@@ -1044,7 +1128,7 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>Misura sulla mappa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="201"/>
+        <location filename="../ui/gcp_dock.py" line="202"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>Fai clic sulla mappa per impostare X e Y del punto selezionato (Z dal layer delle quote)</translation>
     </message>
@@ -1054,92 +1138,92 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>Importa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="209"/>
+        <location filename="../ui/gcp_dock.py" line="211"/>
         <source>Export</source>
         <translation>Esporta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="224"/>
+        <location filename="../ui/gcp_dock.py" line="226"/>
         <source>Undo</source>
         <translation>Annulla</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="225"/>
+        <location filename="../ui/gcp_dock.py" line="227"/>
         <source>Redo</source>
         <translation>Ripeti</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="235"/>
+        <location filename="../ui/gcp_dock.py" line="237"/>
         <source>Undo: {}</source>
         <translation>Annulla: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="237"/>
+        <location filename="../ui/gcp_dock.py" line="239"/>
         <source>Redo: {}</source>
         <translation>Ripeti: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="216"/>
+        <location filename="../ui/gcp_dock.py" line="218"/>
         <source>Load results</source>
         <translation>Carica risultati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="217"/>
+        <location filename="../ui/gcp_dock.py" line="219"/>
         <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Aggiungi i prodotti dell'area di lavoro alla mappa come layer con stile</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="271"/>
+        <location filename="../ui/gcp_dock.py" line="273"/>
         <source>Residual tolerance:</source>
         <translation>Tolleranza dei residui:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="277"/>
+        <location filename="../ui/gcp_dock.py" line="279"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="286"/>
+        <location filename="../ui/gcp_dock.py" line="288"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="287"/>
+        <location filename="../ui/gcp_dock.py" line="289"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Lascia che la compensazione affini focale, punto principale e distorsione</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="294"/>
+        <location filename="../ui/gcp_dock.py" line="296"/>
         <source>Georeference</source>
         <translation>Georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="295"/>
+        <location filename="../ui/gcp_dock.py" line="297"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Esegui la compensazione con questi punti (in background)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="296"/>
+        <location filename="../ui/gcp_dock.py" line="298"/>
         <source>Cancel</source>
         <translation>Interrompi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="346"/>
+        <location filename="../ui/gcp_dock.py" line="349"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="353"/>
+        <location filename="../ui/gcp_dock.py" line="356"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Apri un'area di lavoro ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="399"/>
+        <location filename="../ui/gcp_dock.py" line="402"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} foto; il blocco non è ancora allineato: esegui 'Allinea immagini' (o 'Nuova dalle foto') per avere le posizioni previste</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="402"/>
+        <location filename="../ui/gcp_dock.py" line="405"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} foto, {} punti d'appoggio. {}</translation>
     </message>
@@ -1179,7 +1263,7 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>ArchaeoOrtho: allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="540"/>
+        <location filename="../ui/gcp_dock.py" line="544"/>
         <source>CRS: {}</source>
         <translation>SR: {}</translation>
     </message>
@@ -1449,32 +1533,32 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>(correlazione {:.2f}, {:.0f} px dalla previsione geometrica)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="166"/>
+        <location filename="../ui/gcp_dock.py" line="167"/>
         <source>Open…</source>
         <translation>Apri…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="168"/>
+        <location filename="../ui/gcp_dock.py" line="169"/>
         <source>New from photos…</source>
         <translation>Nuova dalle foto…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="204"/>
+        <location filename="../ui/gcp_dock.py" line="205"/>
         <source>From file (gcp_list.txt, CSV)…</source>
         <translation>Da file (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="205"/>
+        <location filename="../ui/gcp_dock.py" line="206"/>
         <source>From a point layer…</source>
         <translation>Da un layer di punti…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="207"/>
+        <location filename="../ui/gcp_dock.py" line="209"/>
         <source>To file (gcp_list.txt, CSV)…</source>
         <translation>Su file (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="208"/>
+        <location filename="../ui/gcp_dock.py" line="210"/>
         <source>To a GeoPackage layer…</source>
         <translation>Su un layer GeoPackage…</translation>
     </message>
@@ -1559,37 +1643,37 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>{} è selezionato: scegli una foto nella striscia sotto e fai clic sul punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="232"/>
+        <location filename="../ui/gcp_dock.py" line="234"/>
         <source>Undo (Ctrl+Z)</source>
         <translation>Annulla (Ctrl+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="232"/>
+        <location filename="../ui/gcp_dock.py" line="234"/>
         <source>Redo (Ctrl+Shift+Z)</source>
         <translation>Ripeti (Ctrl+Maiusc+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="420"/>
+        <location filename="../ui/gcp_dock.py" line="423"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px.</source>
         <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="425"/>
+        <location filename="../ui/gcp_dock.py" line="428"/>
         <source>Not aligned ({}): {}</source>
         <translation>Non allineate ({}): {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="426"/>
+        <location filename="../ui/gcp_dock.py" line="429"/>
         <source>(marked in the photo strip; hover for the reason)</source>
         <translation>(segnate nella striscia delle foto; il motivo è nel suggerimento)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="445"/>
+        <location filename="../ui/gcp_dock.py" line="448"/>
         <source>✗ not aligned</source>
         <translation>✗ non allineata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="446"/>
+        <location filename="../ui/gcp_dock.py" line="449"/>
         <source>{}: not aligned: {}</source>
         <translation>{}: non allineata: {}</translation>
     </message>
@@ -1689,258 +1773,398 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <translation>DSM di riferimento:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="78"/>
+        <location filename="../ui/gcp_autocontrol.py" line="80"/>
         <source>Georeference from the reference orthophoto and DSM (in the background)</source>
         <translation>Georeferenzia dall'ortofoto e dal DSM di riferimento (in background)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="99"/>
+        <location filename="../ui/gcp_autocontrol.py" line="101"/>
         <source>Automatic control: choose a reference orthophoto and a reference DSM layer</source>
         <translation>Controllo automatico: scegliere un'ortofoto di riferimento e un layer DSM di riferimento</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="120"/>
+        <location filename="../ui/gcp_autocontrol.py" line="122"/>
         <source>Automatic control: {} automatic GCPs kept of {} matches; georeferenced in {}.</source>
         <translation>Controllo automatico: {} GCP automatici mantenuti su {} corrispondenze; georeferenziato in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="123"/>
+        <location filename="../ui/gcp_autocontrol.py" line="125"/>
         <source>Check points: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</source>
         <translation>Punti di controllo: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="134"/>
+        <location filename="../ui/gcp_autocontrol.py" line="136"/>
         <source>ArchaeoOrtho: automatic control</source>
         <translation>ArchaeoOrtho: controllo automatico</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="138"/>
+        <location filename="../ui/gcp_autocontrol.py" line="140"/>
         <source>Automatic control against {} and {}…</source>
         <translation>Controllo automatico rispetto a {} e {}…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="150"/>
+        <location filename="../ui/gcp_autocontrol.py" line="152"/>
         <source>Automatic GCPs (residuals)</source>
         <translation>GCP automatici (residui)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="64"/>
+        <source>found by Find targets ({}), quality {:.2f}</source>
+        <translation>trovato da Trova i target ({}), qualità {:.2f}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="67"/>
+        <source>, {:.2f} px from the other photos&apos; rays</source>
+        <translation>, a {:.2f} px dai raggi delle altre foto</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="78"/>
+        <source>Find targets</source>
+        <translation>Trova i target</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="84"/>
+        <source>Surveyed coordinates (*.csv *.txt);;All files (*)</source>
+        <translation>Coordinate rilevate (*.csv *.txt);;Tutti i file (*)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="85"/>
+        <source>A CSV name,x,y,z[,sigma_xy,sigma_z] or an ODM gcp_list.txt (its pixel columns may be absent)</source>
+        <translation>Un CSV name,x,y,z[,sigma_xy,sigma_z] o un gcp_list.txt di ODM (le colonne dei pixel possono mancare)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="87"/>
+        <source>Surveyed coordinates:</source>
+        <translation>Coordinate rilevate:</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="90"/>
+        <source>auto (crosses, checkerboards, circles, ArUco 4x4)</source>
+        <translation>automatico (croci, scacchiere, cerchi, ArUco 4x4)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="92"/>
+        <source>Target kind:</source>
+        <translation>Tipo di target:</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="97"/>
+        <source>unknown</source>
+        <translation>sconosciuta</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="98"/>
+        <source>The target&apos;s side or diameter: marks of another size are left out</source>
+        <translation>Lato o diametro del target: i segni di altra dimensione vengono esclusi</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="99"/>
+        <source>Target size:</source>
+        <translation>Dimensione dei target:</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="101"/>
+        <source>A file that names no CRS is read in {}.</source>
+        <translation>Un file che non indica un SR viene letto in {}.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="101"/>
+        <source>The file must name its CRS (the table and the workspace have none).</source>
+        <translation>Il file deve indicare il suo SR (la tabella e l'area di lavoro non ne hanno).</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="154"/>
+        <source>Find targets on the photos…</source>
+        <translation>Trova i target nelle foto…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="155"/>
+        <source>Find the surveyed targets on the aligned photos (in the background): their observations fill the table, marked as found until you confirm them (Space or Enter) or reject them (Delete or R)</source>
+        <translation>Trova i target rilevati nelle foto allineate (in background): le loro misure riempiono la tabella, segnate come trovate finché non le confermi (Spazio o Invio) o le scarti (Canc o R)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="204"/>
+        <source>ArchaeoOrtho: find targets</source>
+        <translation>ArchaeoOrtho: trova i target</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="206"/>
+        <source>Looking for the targets of {} on the photos…</source>
+        <translation>Ricerca dei target di {} nelle foto…</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="224"/>
+        <source>find targets</source>
+        <translation>trova i target</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="225"/>
+        <source>Find targets: {} of {} targets found, {} observations, in {:.0f} s.</source>
+        <translation>Trova i target: {} di {} target trovati, {} misure, in {:.0f} s.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="230"/>
+        <source>not found: {}</source>
+        <translation>non trovati: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="234"/>
+        <source>Space or Enter: confirm the found observation shown; Delete or R: reject it. Georeference uses the found observations that are not rejected, confirmed or not.</source>
+        <translation>Spazio o Invio: conferma la misura trovata mostrata; Canc o R: scartala. Georeferenzia usa le misure trovate non scartate, confermate o no.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="291"/>
+        <source>Every found observation is confirmed or rejected</source>
+        <translation>Ogni misura trovata è confermata o scartata</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="307"/>
+        <source>Found by Find targets, not confirmed: Space or Enter confirms it, Delete or R rejects it (then the next one).</source>
+        <translation>Trovata da Trova i target, non confermata: Spazio o Invio la conferma, Canc o R la scarta (poi la prossima).</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="315"/>
+        <source>{} observations found by Find targets, not confirmed: {}</source>
+        <translation>{} misure trovate da Trova i target, non confermate: {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="326"/>
+        <source>{} found observations are not confirmed yet: they are used as they are (reject the wrong ones first)</source>
+        <translation>{} misure trovate non sono ancora confermate: vengono usate così come sono (scarta prima quelle sbagliate)</translation>
     </message>
 </context>
 <context>
     <name>GcpStore</name>
     <message>
-        <location filename="../ui/store.py" line="255"/>
+        <location filename="../ui/store.py" line="289"/>
         <source>a point named {} exists already</source>
         <translation>esiste già un punto chiamato {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="243"/>
+        <location filename="../ui/store.py" line="277"/>
         <source>add point {}</source>
         <translation>aggiungi il punto {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="250"/>
+        <location filename="../ui/store.py" line="284"/>
         <source>remove point {}</source>
         <translation>rimuovi il punto {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="266"/>
+        <location filename="../ui/store.py" line="302"/>
         <source>set {} of {}</source>
         <translation>imposta {} di {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="326"/>
+        <location filename="../ui/store.py" line="362"/>
         <source>place {} in {}</source>
         <translation>misura {} in {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="334"/>
+        <location filename="../ui/store.py" line="370"/>
         <source>remove {} from {}</source>
         <translation>rimuovi {} da {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="412"/>
+        <location filename="../ui/store.py" line="507"/>
         <source>set CRS</source>
         <translation>imposta il SR</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="294"/>
+        <location filename="../ui/store.py" line="330"/>
         <source>no position</source>
         <translation>nessuna posizione</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="299"/>
+        <location filename="../ui/store.py" line="335"/>
         <source>({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)</source>
         <translation>({:.0f}, {:.0f}) è fuori dalla foto {} ({} × {} px)</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="306"/>
+        <location filename="../ui/store.py" line="342"/>
         <source>({:.0f}, {:.0f}) is inside the mask of {}</source>
         <translation>({:.0f}, {:.0f}) è dentro la maschera di {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="314"/>
+        <location filename="../ui/store.py" line="350"/>
         <source>{} not placed: {}</source>
         <translation>{} non posizionato: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="358"/>
+        <location filename="../ui/store.py" line="402"/>
         <source>{} points replaced by {} from the file</source>
         <translation>{} punti sostituiti da {} dal file</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="392"/>
+        <location filename="../ui/store.py" line="436"/>
         <source>added {} points: {}</source>
         <translation>aggiunti {} punti: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="394"/>
+        <location filename="../ui/store.py" line="438"/>
         <source>coordinates updated from the file: {}</source>
         <translation>coordinate aggiornate dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="396"/>
+        <location filename="../ui/store.py" line="440"/>
         <source>role set by the file: {}</source>
         <translation>ruolo impostato dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="398"/>
+        <location filename="../ui/store.py" line="442"/>
         <source>role kept (the file gives none): {}</source>
         <translation>ruolo mantenuto (il file non ne indica): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="400"/>
+        <location filename="../ui/store.py" line="444"/>
         <source>σ set by the file: {}</source>
         <translation>σ impostata dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="402"/>
+        <location filename="../ui/store.py" line="446"/>
         <source>{} observations added</source>
         <translation>{} misure aggiunte</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="404"/>
+        <location filename="../ui/store.py" line="448"/>
         <source>placed observations kept (the file has others): {}</source>
         <translation>misure posizionate mantenute (il file ne ha altre): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="405"/>
+        <location filename="../ui/store.py" line="450"/>
         <source>nothing changed</source>
         <translation>nulla è cambiato</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="459"/>
+        <source>observations placed by hand kept (found ones not used there): {}</source>
+        <translation>misure posizionate a mano mantenute (quelle trovate lì non usate): {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="495"/>
+        <source>confirm {} in {}</source>
+        <translation>conferma {} in {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/store.py" line="504"/>
+        <source>reject {} in {}</source>
+        <translation>scarta {} in {}</translation>
     </message>
 </context>
 <context>
     <name>GcpTableModel</name>
     <message>
-        <location filename="../ui/gcp_table.py" line="36"/>
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>Name</source>
         <translation>Nome</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="36"/>
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>X</source>
         <translation>X</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="36"/>
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>Y</source>
         <translation>Y</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="36"/>
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>Z</source>
         <translation>Z</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="37"/>
+        <location filename="../ui/gcp_table.py" line="38"/>
         <source>Role</source>
         <translation>Ruolo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="37"/>
+        <location filename="../ui/gcp_table.py" line="38"/>
         <source>Obs.</source>
         <translation>Mis.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="37"/>
+        <location filename="../ui/gcp_table.py" line="38"/>
         <source>dXY (m)</source>
         <translation>dXY (m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="37"/>
+        <location filename="../ui/gcp_table.py" line="38"/>
         <source>dZ (m)</source>
         <translation>dZ (m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="37"/>
+        <location filename="../ui/gcp_table.py" line="38"/>
         <source>px</source>
         <translation>px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="40"/>
+        <location filename="../ui/gcp_table.py" line="41"/>
         <source>check</source>
         <translation>controllo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="40"/>
+        <location filename="../ui/gcp_table.py" line="41"/>
         <source>control</source>
         <translation>appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="52"/>
+        <location filename="../ui/gcp_table.py" line="53"/>
         <source>Horizontal residual after the adjustment (estimated from the photos minus given)</source>
         <translation>Residuo planimetrico dopo la compensazione (stimato dalle foto meno dato)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="53"/>
+        <location filename="../ui/gcp_table.py" line="54"/>
         <source>Vertical residual after the adjustment</source>
         <translation>Residuo altimetrico dopo la compensazione</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="54"/>
+        <location filename="../ui/gcp_table.py" line="55"/>
         <source>Mean reprojection error of the point&apos;s observations (pixels)</source>
         <translation>Errore medio di riproiezione delle misure del punto (pixel)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="55"/>
+        <location filename="../ui/gcp_table.py" line="56"/>
         <source>Number of photos the point is placed in</source>
         <translation>Numero di foto in cui il punto è misurato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="68"/>
+        <location filename="../ui/gcp_table.py" line="69"/>
         <source>rejected as an outlier</source>
         <translation>scartato come valore anomalo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="70"/>
+        <location filename="../ui/gcp_table.py" line="71"/>
         <source>not triangulated (fewer than 2 usable observations)</source>
         <translation>non triangolato (meno di 2 misure utilizzabili)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="76"/>
+        <location filename="../ui/gcp_table.py" line="77"/>
         <source>within the tolerance</source>
         <translation>entro la tolleranza</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="78"/>
+        <location filename="../ui/gcp_table.py" line="79"/>
         <source>up to 3 times the tolerance</source>
         <translation>fino al triplo della tolleranza</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="79"/>
+        <location filename="../ui/gcp_table.py" line="80"/>
         <source>more than 3 times the tolerance</source>
         <translation>oltre il triplo della tolleranza</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="121"/>
+        <location filename="../ui/gcp_table.py" line="131"/>
         <source>edited since the last adjustment: run Georeference to update</source>
         <translation>modificato dopo l'ultima compensazione: esegui 'Georeferenzia' per aggiornare</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="36"/>
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>σ XY</source>
         <translation>σ XY</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_table.py" line="36"/>
+        <location filename="../ui/gcp_table.py" line="37"/>
         <source>σ Z</source>
         <translation>σ Z</translation>
     </message>
@@ -2267,67 +2491,67 @@ Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui
 <context>
     <name>PhotoPanel</name>
     <message>
-        <location filename="../ui/photo_viewer.py" line="466"/>
+        <location filename="../ui/photo_viewer.py" line="471"/>
         <source>Only photos that probably see the point</source>
         <translation>Solo le foto che probabilmente vedono il punto</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="469"/>
+        <location filename="../ui/photo_viewer.py" line="474"/>
         <source>Fit</source>
         <translation>Adatta</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="469"/>
+        <location filename="../ui/photo_viewer.py" line="474"/>
         <source>Show the whole photo (F)</source>
         <translation>Mostra l'intera foto (F)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="470"/>
+        <location filename="../ui/photo_viewer.py" line="475"/>
         <source>Zoom to point</source>
         <translation>Zoom sul punto</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="470"/>
+        <location filename="../ui/photo_viewer.py" line="475"/>
         <source>Zoom to the observation or prediction (Z)</source>
         <translation>Zoom sulla misura o sulla previsione (Z)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="472"/>
+        <location filename="../ui/photo_viewer.py" line="477"/>
         <source>Confirm</source>
         <translation>Conferma</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="472"/>
+        <location filename="../ui/photo_viewer.py" line="477"/>
         <source>Accept the predicted position (Space)</source>
         <translation>Accetta la posizione prevista (Spazio)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="474"/>
+        <location filename="../ui/photo_viewer.py" line="479"/>
         <source>Confirm &amp;&amp; next</source>
         <translation>Conferma &amp;&amp; avanti</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="474"/>
+        <location filename="../ui/photo_viewer.py" line="479"/>
         <source>Accept the prediction and show the next photo to place (Enter)</source>
         <translation>Accetta la previsione e mostra la prossima foto da misurare (Invio)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="477"/>
+        <location filename="../ui/photo_viewer.py" line="482"/>
         <source>Remove</source>
         <translation>Rimuovi</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="477"/>
+        <location filename="../ui/photo_viewer.py" line="482"/>
         <source>Remove the observation in this photo (Delete)</source>
         <translation>Rimuovi la misura in questa foto (Canc)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="653"/>
+        <location filename="../ui/photo_viewer.py" line="665"/>
         <source>{} (predicted)</source>
         <translation>{} (previsto)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="565"/>
+        <location filename="../ui/photo_viewer.py" line="571"/>
         <source>Shown upright (EXIF orientation {}: stored {} x {} px); pixel coordinates are those of the stored grid, as COLMAP and gcp_list.txt use them</source>
         <translation>Mostrata raddrizzata (orientamento EXIF {}: salvata {} x {} px); le coordinate pixel sono quelle della griglia salvata, come le usano COLMAP e gcp_list.txt</translation>
     </message>
@@ -2573,87 +2797,87 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
 <context>
     <name>ResultLayers</name>
     <message>
-        <location filename="../ui/layers.py" line="278"/>
+        <location filename="../qgisio/layers.py" line="278"/>
         <source>control (used)</source>
         <translation>appoggio (usato)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="279"/>
+        <location filename="../qgisio/layers.py" line="279"/>
         <source>check point</source>
         <translation>punto di controllo</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="280"/>
+        <location filename="../qgisio/layers.py" line="280"/>
         <source>rejected (outlier)</source>
         <translation>scartato (valore anomalo)</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="281"/>
+        <location filename="../qgisio/layers.py" line="281"/>
         <source>not triangulated</source>
         <translation>non triangolato</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="770"/>
+        <location filename="../qgisio/layers.py" line="771"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="721"/>
+        <location filename="../qgisio/layers.py" line="724"/>
         <source>DSM hillshade</source>
         <translation>Ombreggiatura del DSM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="771"/>
+        <location filename="../qgisio/layers.py" line="772"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="772"/>
+        <location filename="../qgisio/layers.py" line="773"/>
         <source>Cameras</source>
         <translation>Camere</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="733"/>
+        <location filename="../qgisio/layers.py" line="736"/>
         <source>Camera footprints</source>
         <translation>Impronte delle immagini</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="740"/>
+        <location filename="../qgisio/layers.py" line="744"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Residui dei punti d'appoggio (vettori x{})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="773"/>
+        <location filename="../qgisio/layers.py" line="774"/>
         <source>Point cloud</source>
         <translation>Nuvola di punti</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="781"/>
+        <location filename="../qgisio/layers.py" line="782"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="416"/>
+        <location filename="../qgisio/layers.py" line="417"/>
         <source>{} ({})</source>
         <translation>{} ({})</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="774"/>
+        <location filename="../qgisio/layers.py" line="775"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="747"/>
+        <location filename="../qgisio/layers.py" line="751"/>
         <source>DTM hillshade</source>
         <translation>Ombreggiatura del DTM</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="775"/>
+        <location filename="../qgisio/layers.py" line="776"/>
         <source>Contours</source>
         <translation>Curve di livello</translation>
     </message>
     <message>
-        <location filename="../ui/layers.py" line="401"/>
+        <location filename="../qgisio/layers.py" line="401"/>
         <source>{} — {}</source>
         <translation>{} — {}</translation>
     </message>
