@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import copy
+import dataclasses
 import os
 import time
 from dataclasses import dataclass, field
@@ -22,7 +23,9 @@ from .dense.stage import build_dsm_workspace
 from .geometry.crs import validate_crs
 from .georef.options import GeorefOptions
 from .georef.stage import GeorefStageResult, georeference_workspace
-from .io.gcp import GCPSet, apply_check_points, read_camera_positions, read_gcps
+from .georef.targets.options import FindTargetsOptions
+from .georef.targets.stage import find_targets
+from .io.gcp import GCPSet, apply_check_points, read_camera_positions, read_gcps, read_target_coordinates
 from .io.images import list_images, require_images
 from .ortho.options import OrthoOptions
 from .ortho.stage import build_orthophoto_workspace
@@ -46,10 +49,13 @@ class Control:
     use_exif_gps: bool = False
     crs: Optional[str] = None
     gcps_upright: bool = False  # the GCPs' pixel coordinates were measured on upright photos (EXIF orientation)
+    # surveyed coordinates of targets laid on the ground (CSV or gcp_list.txt): Find targets finds them on the
+    # photos after the alignment, and its observations are the ground control (instead of gcp_path / gcps)
+    targets_path: Optional[str] = None
 
     def given(self) -> bool:
         return not (self.gcp_path is None and self.gcps is None and not self.camera_positions_path
-                    and not self.use_exif_gps)
+                    and not self.use_exif_gps and not self.targets_path)
 
 
 @dataclass
@@ -63,6 +69,7 @@ class PipelineOptions:
     dense: DenseOptions = field(default_factory=DenseOptions)
     ortho: OrthoOptions = field(default_factory=OrthoOptions)
     report: ReportOptions = field(default_factory=ReportOptions)  # uncertainty, write_layers
+    targets: FindTargetsOptions = field(default_factory=FindTargetsOptions)  # with Control.targets_path
     dsm_resolution: float = 0.0  # DSM cell size in CRS units; 0 = the images' median GSD (not a DenseOptions field)
     images_filter: Optional[str] = None
     make_report: bool = True  # False: the chain stops after the orthomosaic (and the terrain products)
@@ -84,6 +91,7 @@ class PipelineResult:
     report: object = None
     dtm: object = None
     relief: object = None
+    targets: object = None  # Find targets' result (core.georef.targets.stage.FindTargetsResult) when it ran
     seconds: Dict[str, float] = field(default_factory=dict)
     # CPU seconds per stage (this process and its pool workers, os.times(): load-independent, unlike ``seconds``)
     cpu_seconds: Dict[str, float] = field(default_factory=dict)
@@ -91,7 +99,8 @@ class PipelineResult:
 
 
 # the share of the progress bar of each stage
-SPANS = {PREPARE: (0.0, 0.05), ALIGN: (0.0, 0.40), GEOREFERENCE: (0.40, 0.45), DSM: (0.45, 0.75), ORTHOPHOTO: (0.75, 0.9),
+FIND_TARGETS = "find targets"  # not a recorded stage: its products (georef/targets/) feed the georeference
+SPANS = {PREPARE: (0.0, 0.05), ALIGN: (0.0, 0.40), FIND_TARGETS: (0.40, 0.42), GEOREFERENCE: (0.42, 0.45), DSM: (0.45, 0.75), ORTHOPHOTO: (0.75, 0.9),
          TERRAIN: (0.9, 0.92), RELIEF: (0.92, 0.95), REPORT: (0.95, 1.0)}
 
 
@@ -111,6 +120,11 @@ def check_inputs(images_dir: str, control: Control) -> None:
         apply_check_points(copy.deepcopy(control.gcps), list(control.check_points))
     if control.camera_positions_path:
         read_camera_positions(control.camera_positions_path)
+    if control.targets_path:
+        if control.gcp_path or control.gcps is not None:
+            raise StageError("give either ground control points (GCPS) or the targets to find on the photos "
+                             f"(TARGETS: {control.targets_path}), not both")
+        read_target_coordinates(control.targets_path, control.crs)
 
 
 def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[PipelineOptions] = None,
@@ -159,7 +173,16 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
         aligned_from = res.prepare.prepared_dir
     res.align = run(ALIGN, align, aligned_from, workspace_dir, opt.align,
                     span=(SPANS[PREPARE][1], SPANS[ALIGN][1]) if opt.sky_masks else None)
-    res.georef = run(GEOREFERENCE, georeference_workspace, workspace_dir, gcp_path=ctl.gcp_path, gcps=ctl.gcps,
+    gcp_path = ctl.gcp_path
+    if ctl.targets_path:  # the targets found on the photos are the ground control
+        res.targets = run(FIND_TARGETS, find_targets, workspace_dir, ctl.targets_path,
+                          dataclasses.replace(opt.targets, crs=opt.targets.crs or ctl.crs))
+        for note in res.targets.reports:
+            progress.info(f"find targets: {note}")
+        progress.info(f"find targets: {res.targets.n_targets} of {len(res.targets.targets)} targets found, "
+                      f"{res.targets.n_observations} observations")
+        gcp_path = res.targets.gcps_path
+    res.georef = run(GEOREFERENCE, georeference_workspace, workspace_dir, gcp_path=gcp_path, gcps=ctl.gcps,
                      check_points=ctl.check_points, camera_positions_path=ctl.camera_positions_path,
                      use_exif_gps=ctl.use_exif_gps, crs=ctl.crs, refine_intrinsics=opt.georef.refine_intrinsics,
                      options=opt.georef, gcps_upright=ctl.gcps_upright)

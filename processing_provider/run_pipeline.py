@@ -21,6 +21,8 @@ class RunPipelineAlgorithm(AlgorithmBase):
     GCPS = "GCPS"
     GCP_LAYER = "GCP_LAYER"
     CHECK_POINTS = "CHECK_POINTS"
+    TARGETS = "TARGETS"
+    TARGET_KIND = "TARGET_KIND"
     USE_EXIF_GPS = "USE_EXIF_GPS"
     CAMERA_POSITIONS = "CAMERA_POSITIONS"
     CRS = "CRS"
@@ -59,6 +61,9 @@ class RunPipelineAlgorithm(AlgorithmBase):
         "positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a "
         "DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in "
         "'Georeference' (the pixel coordinates measured on the photos shown upright by their EXIF orientation).\n"
+        "Targets to find (instead of a ground control file or layer): the surveyed coordinates of targets laid on "
+        "the ground; after the alignment 'Find targets' finds them on the photos and its observations are the "
+        "ground control (Target kind, advanced: as in 'Find targets').\n"
         "Camera calibration file and Interior orientation (advanced): as in 'Align images' (a calibrated camera "
         "held fixed through the whole chain, or refined with its standard deviations).\n"
         "Sky masks (oblique photos): first a 'Prepare images' stage finds the sky and the horizon haze in each "
@@ -72,12 +77,15 @@ class RunPipelineAlgorithm(AlgorithmBase):
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
+        from ..core.georef.targets.options import KINDS as TARGET_KINDS
+
         params.add(
             self,
             params.folder(self.IMAGES, self.tr("Folder of images")),
             params.workspace_destination(self.WORKSPACE, self.tr("Workspace folder")),
             params.gcp_file(self.GCPS, self.tr("Ground control file")),
             params.gcp_layer(self.GCP_LAYER, self.tr("Ground control layer")),
+            params.gcp_file(self.TARGETS, self.tr("Targets to find (surveyed coordinates)")),
             params.check_points(self.CHECK_POINTS, self.tr("Check points")),
             params.flag(self.GCPS_UPRIGHT, self.tr("GCP pixels measured on upright photos")),
             params.flag(self.USE_EXIF_GPS, self.tr("Use EXIF GPS positions")),
@@ -97,6 +105,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
             *params.advanced(
                 params.calibration_file(self.CALIBRATION, self.tr("Camera calibration file")),
                 params.intrinsics(self.INTRINSICS, self.tr("Interior orientation")),
+                params.choice(self.TARGET_KIND, self.tr("Target kind"), list(TARGET_KINDS), 0),
                 params.workers(self.WORKERS, self.tr("Parallel workers")),
                 params.scheduler(self.SCHEDULER, self.tr("Dask scheduler")),
                 params.number(self.CONTOUR_INTERVAL, self.tr("Contour interval (m, 0 = none)")),
@@ -116,6 +125,8 @@ class RunPipelineAlgorithm(AlgorithmBase):
         from ..core.align.options import AlignOptions
         from ..core.dense.options import DenseOptions
         from ..core.georef.options import GeorefOptions
+        from ..core.georef.targets.options import KINDS as TARGET_KINDS
+        from ..core.georef.targets.options import FindTargetsOptions
         from ..core.ortho.options import OrthoOptions
 
         p = parameters
@@ -124,9 +135,11 @@ class RunPipelineAlgorithm(AlgorithmBase):
         gcp_path = params.read_optional_file(self, p, self.GCPS, context)
         positions = params.read_optional_file(self, p, self.CAMERA_POSITIONS, context)
         use_gps = self.parameterAsBoolean(p, self.USE_EXIF_GPS, context)
-        if not params.has_control(gcp_path, gcps, positions, use_gps):
+        targets = params.read_optional_file(self, p, self.TARGETS, context)
+        if not params.has_control(gcp_path, gcps, positions, use_gps) and not targets:
             raise QgsProcessingException(self.tr(
-                "Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions "
+                "Give ground control (Ground control file or layer, or targets to find: GCPS, GCP_LAYER, TARGETS) "
+                "and/or camera positions "
                 "(Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and "
                 "orthophoto need a georeferenced block"))
         crs_text = params.read_crs(self, p, self.CRS, context)
@@ -144,6 +157,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
                     max_image_size=self.parameterAsInt(p, self.MAX_IMAGE_SIZE, context),
                     calibration=params.read_optional_file(self, p, self.CALIBRATION, context),
                     intrinsics=params.read_choice(self, p, self.INTRINSICS, context, params.INTRINSICS)),
+                targets=FindTargetsOptions(kind=TARGET_KINDS[self.parameterAsEnum(p, self.TARGET_KIND, context)]),
                 georef=GeorefOptions(refine_intrinsics=self.parameterAsBoolean(p, self.REFINE_INTRINSICS, context)),
                 dsm_resolution=self.parameterAsDouble(p, self.DSM_RESOLUTION, context),
                 dense=DenseOptions(quality=params.read_choice(self, p, self.QUALITY, context, QUALITIES),
@@ -158,6 +172,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
                 sky_masks=self.parameterAsBoolean(p, self.SKY_MASKS, context)),
             control=pipeline.Control(gcp_path=gcp_path, gcps=gcps, check_points=checks,
                                      camera_positions_path=positions, use_exif_gps=use_gps, crs=crs_text,
+                                     targets_path=targets,
                                      gcps_upright=self.parameterAsBoolean(p, self.GCPS_UPRIGHT, context)),
             progress=progress)
         progress.push_result(result.warnings)  # those the stages did not log while they ran

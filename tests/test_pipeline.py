@@ -152,3 +152,52 @@ def test_the_stage_options_are_the_settings(tmp_path, monkeypatch):
         _checked_arguments(DenseOptions(quality="fine"), None, "cpu", 0.0)
     with pytest.raises(OrthoError, match="BLENDING"):  # the options' blending is checked, not a default's
         build_orthophoto_workspace(str(tmp_path / "no-ws"), options=OrthoOptions(blending="smooth"))
+
+
+def test_the_pipeline_chains_find_targets_into_the_georeference(tmp_path, monkeypatch):
+    """Control(targets_path=...): after the alignment Find targets runs, and its observations file is the
+    georeference's ground control (issue 34: 'Run pipeline can chain both'); targets and GCPs together are
+    refused before any work, and a targets file that cannot be read is named before the alignment."""
+    import types
+
+    from core import pipeline
+    from core.geometry.crs import CRSError
+    from core.project.stages import StageError
+
+    calls = []
+
+    def spy(name, result=None):
+        def stage(*args, **kwargs):
+            calls.append((name, args, kwargs))
+            return result or types.SimpleNamespace(warnings=[])
+        return stage
+
+    found = types.SimpleNamespace(gcps_path=str(tmp_path / "ws" / "found.txt"), reports=["T9: fits no mark"],
+                                  n_targets=3, n_observations=9, targets=[1, 2, 3, 4], crs="EPSG:32611")
+    for name in ("align", "georeference_workspace", "build_dsm_workspace", "build_orthophoto_workspace"):
+        monkeypatch.setattr(pipeline, name, spy(name))
+    monkeypatch.setattr(pipeline, "find_targets", spy("find_targets", found))
+    targets = tmp_path / "targets.csv"
+    targets.write_text("# crs: EPSG:32611\nname,x,y,z\nT1,500000,4000000,10\nT2,500010,4000000,11\n"
+                       "T3,500000,4000010,12\nT4,500010,4000010,10\n")
+    photos = tmp_path / "photos"
+    photos.mkdir()
+    monkeypatch.setattr(pipeline, "require_images", lambda *a: None)
+    monkeypatch.setattr(pipeline, "list_images", lambda *a: [])
+    res = pipeline.run_pipeline(str(photos), str(tmp_path / "ws"), pipeline.PipelineOptions(
+        make_dtm=False, make_report=False), pipeline.Control(targets_path=str(targets)))
+    order = [c[0] for c in calls]
+    assert order == ["align", "find_targets", "georeference_workspace", "build_dsm_workspace",
+                     "build_orthophoto_workspace"]
+    assert calls[1][1][1] == str(targets) and res.targets is found
+    assert calls[2][2]["gcp_path"] == found.gcps_path and calls[2][2]["gcps"] is None
+    with pytest.raises(StageError, match="not both"):
+        pipeline.run_pipeline(str(photos), str(tmp_path / "ws2"), control=pipeline.Control(
+            targets_path=str(targets), gcp_path=str(targets)))
+    bad = tmp_path / "bad.csv"
+    bad.write_text("name,x,y,z\nT1,500000,north,10\n")
+    calls.clear()
+    with pytest.raises(CRSError, match="bad.csv"):  # core.io.gcp.GCPError is this class
+        pipeline.run_pipeline(str(photos), str(tmp_path / "ws3"), control=pipeline.Control(
+            targets_path=str(bad), crs="EPSG:32611"))
+    assert not calls  # nothing ran
