@@ -216,3 +216,26 @@ def test_the_dialog_the_errors_and_cancel(dock, ws, scene, tmp_path, monkeypatch
     dock.cancel_task()
     wait_task(dock, 120)
     assert dock.status.text() == "Cancelled" and not dock.store.gcps.points
+
+
+def test_a_click_in_the_targets_file_that_no_mark_answers_is_kept_as_placed_by_hand(dock, ws, scene, tmp_path):  # noqa: F811,E501
+    """A gcp_list.txt with a click (pixel columns) on a target the border cuts: the core keeps it, not found; the
+    dock takes it as an observation of the user's, with no mark to confirm."""
+    sc, _, _ = scene
+    image, name = next((i, n) for i, n in sc.cut if 0 < sc.truth[i][n][0] < targets_scene.W
+                       and 0 < sc.truth[i][n][1] < targets_scene.H)
+    tx, ty = sc.truth[image][name]
+    path = tmp_path / "gcp_list.txt"
+    with open(path, "w", encoding="utf-8") as out:
+        out.write("EPSG:32611\n")
+        for t in sc.targets:
+            w = [t.x + targets_scene.OFFSET[0], t.y + targets_scene.OFFSET[1], t.z + targets_scene.OFFSET[2]]
+            out.write(f"{w[0]:.4f} {w[1]:.4f} {w[2]:.4f} {t.name}\n")
+            if t.name == name:
+                out.write(f"{w[0]:.4f} {w[1]:.4f} {w[2]:.4f} {tx:.2f} {ty:.2f} {image} {t.name}\n")
+    assert dock.open_workspace(ws)
+    r = _find(dock, str(path))
+    assert [(o.name, o.image) for o in r.observations if not o.found] == [(name, image)]
+    assert _observations(dock.store)[(name, image)] == (round(tx, 2), round(ty, 2))
+    assert dock.store.is_found(name, image) is None and (name, image) not in dock.store.found_list()
+    assert len(dock.store.found_list()) == r.n_observations - 1

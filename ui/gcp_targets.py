@@ -220,7 +220,8 @@ class GcpTargets:
         for o in result.observations:
             if o.name in by_name:
                 by_name[o.name].observations.append(gcpmod.Observation(o.image, float(o.x), float(o.y)))
-                found[(o.name, o.image)] = found_info(o)
+                if o.found:  # else: the user's click in the targets file, which no mark answered: as placed by hand
+                    found[(o.name, o.image)] = found_info(o)
         if not survey.crs:
             survey.crs = result.crs
         lines = self.store.merge_found(survey, found, translate("GcpDock", "find targets"))
