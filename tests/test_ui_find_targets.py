@@ -94,6 +94,10 @@ def test_find_targets_fills_the_table_in_one_undoable_step_and_keeps_what_was_pl
     assert "quality" in dock.photo_panel.observation.toolTip()
     from qgis.PyQt.QtCore import Qt
 
+    strip = dock.photo_panel.thumbs
+    blue = {strip.item(i).data(Qt.ItemDataRole.UserRole) for i in range(strip.count())
+            if strip.item(i).foreground().color().name() == BLUE}
+    assert blue == {image for name, image in found if name == found[0][0]} and hand_image not in blue
     row = [p.name for p in dock.store.gcps.points].index(found[0][0])
     assert dock.model.data(dock.model.index(row, 0), Qt.ItemDataRole.ForegroundRole).name() == BLUE
     assert "found by Find targets" in dock.model.data(dock.model.index(row, 0), Qt.ItemDataRole.ToolTipRole)

@@ -438,6 +438,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoContro
 
     def _update_thumbnails(self):
         super()._update_thumbnails()
+        self._mark_found_thumbnails()  # ui/gcp_targets.py
         if not self.unaligned:
             return
         strip = self.photo_panel.thumbs

@@ -310,6 +310,21 @@ class GcpTargets:
         return found_text(info), translate("GcpDock", "Found by Find targets, not confirmed: Space or Enter "
                                                       "confirms it, Delete or R rejects it (then the next one).")
 
+    def _mark_found_thumbnails(self):
+        """The strip's photos where the selected point has a found observation not confirmed: in blue, the
+        tooltip with its quality."""
+        from qgis.PyQt.QtGui import QColor
+
+        name = self.current_name()
+        marks = self.store.found.get(name) if name else None
+        strip = self.photo_panel.thumbs
+        for i in range(strip.count() if marks else 0):
+            item = strip.item(i)
+            info = marks.get(item.data(Qt.ItemDataRole.UserRole))
+            if info is not None:
+                item.setForeground(QColor(FOUND_COLOUR))
+                item.setToolTip(item.toolTip() + "\n" + found_text(info))
+
     def _found_row(self, name):
         """The table's tooltip line for a point with found observations not confirmed, else None."""
         marks = self.store.found.get(name)
