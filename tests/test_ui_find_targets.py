@@ -243,3 +243,19 @@ def test_a_click_in_the_targets_file_that_no_mark_answers_is_kept_as_placed_by_h
     assert _observations(dock.store)[(name, image)] == (round(tx, 2), round(ty, 2))
     assert dock.store.is_found(name, image) is None and (name, image) not in dock.store.found_list()
     assert len(dock.store.found_list()) == r.n_observations - 1
+
+
+def test_the_targets_come_into_the_tables_crs(dock, ws, scene):  # noqa: F811
+    """A table in another CRS (UTM 11 south; the file: 11 north): the targets' coordinates are transformed into
+    it, as an import does; the observations are the same."""
+    sc, _, csv = scene
+    assert dock.open_workspace(ws)
+    dock.store.set_crs("EPSG:32711")
+    dock.store.add_point("wall_corner", 500001.0, 14000001.0, 100.0)
+    r = _find(dock, csv)
+    assert dock.store.crs == "EPSG:32711" and r.n_targets == len(sc.targets)
+    for t in sc.targets:
+        p = dock.store.gcps.by_name(t.name)
+        assert abs(p.x - (t.x + targets_scene.OFFSET[0])) < 1e-3
+        assert abs(p.y - (t.y + targets_scene.OFFSET[1] + 10_000_000.0)) < 1e-3
+        assert len(p.observations) == sum(1 for o in r.observations if o.name == t.name)

@@ -33,6 +33,7 @@ from qgis.PyQt.QtWidgets import (
 )
 
 from ..core.project.stages import ALIGN
+from ..qgisio import layers
 from .tasks import CoreTask
 
 translate = QCoreApplication.translate
@@ -224,7 +225,15 @@ class GcpTargets:
                     found[(o.name, o.image)] = found_info(o)
         if not survey.crs:
             survey.crs = result.crs
+        if self.store.crs and self.store.gcps.points and layers.qgs_crs(survey.crs) != layers.qgs_crs(self.store.crs):
+            from ..core.geometry.crs import transform_points  # the table's CRS, as an import does (GcpImportExport)
+
+            out = transform_points([(p.x, p.y, p.z) for p in survey.points], survey.crs, self.store.crs)
+            for p, q in zip(survey.points, out):
+                p.x, p.y = float(q[0]), float(q[1])
+            survey.crs = self.store.crs
         lines = self.store.merge_found(survey, found, translate("GcpDock", "find targets"))
+        self.load_predictor()  # the table's CRS may be the file's now (GcpPlacement)
         text = translate("GcpDock", "Find targets: {} of {} targets found, {} observations, in {:.0f} s.").format(
             result.n_targets, len(result.targets), result.n_observations, result.seconds)
         missing = [t.name for t in result.targets if not t.found]
