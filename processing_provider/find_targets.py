@@ -61,12 +61,12 @@ class FindTargetsAlgorithm(AlgorithmBase):
             params.folder(self.WORKSPACE, self.tr("Aligned workspace")),
             QgsProcessingParameterFile(self.TARGETS, self.tr("Targets (surveyed coordinates)"),
                                        fileFilter=params.GCP_FILE_FILTER),
-            params.target_crs(self.CRS, self.tr("CRS of the coordinates (where the file names none)")),
+            params.target_crs(self.CRS, self.tr("CRS (where the file names none)")),
             params.choice(self.TARGET_KIND, self.tr("Target kind"), list(KINDS), 0),
             *params.advanced(params.number(self.TARGET_SIZE, self.tr("Target size (m, 0: unknown)"))),
         )
         self.addParameter(QgsProcessingParameterFileDestination(
-            self.GCPS, self.tr("Observations found (gcp_list.txt)"), fileFilter="GCP list (*.txt)", optional=True,
+            self.GCPS, self.tr("Observations file"), fileFilter="GCP list (*.txt)", optional=True,
             createByDefault=False))
         self.addOutput(QgsProcessingOutputFolder(self.OUT_WORKSPACE, self.tr("Workspace")))
         self.addOutput(QgsProcessingOutputVectorLayer(self.MARKS, self.tr("Targets found (for review)")))

@@ -85,7 +85,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
             params.workspace_destination(self.WORKSPACE, self.tr("Workspace folder")),
             params.gcp_file(self.GCPS, self.tr("Ground control file")),
             params.gcp_layer(self.GCP_LAYER, self.tr("Ground control layer")),
-            params.gcp_file(self.TARGETS, self.tr("Targets to find (surveyed coordinates)")),
+            params.gcp_file(self.TARGETS, self.tr("Targets to find")),
             params.check_points(self.CHECK_POINTS, self.tr("Check points")),
             params.flag(self.GCPS_UPRIGHT, self.tr("GCP pixels measured on upright photos")),
             params.flag(self.USE_EXIF_GPS, self.tr("Use EXIF GPS positions")),
