@@ -144,7 +144,15 @@ def test_undo_takes_the_found_observations_away_in_one_step(dock, ws, scene):  #
     assert {p.name for p in dock.store.gcps.points} == {"ring_b", "wall_corner"}
     assert dock.store.undo_stack.count() == steps + 1 and dock.store.undo_stack.index() == steps
     dock.act_redo.trigger()
-    assert _observations(dock.store) == after and dock.store.found_list()
+    found = dock.store.found_list()
+    assert _observations(dock.store) == after and found
+    # Georeference uses them, confirmed or not; the marks stay
+    dock.btn_georef.click()
+    wait_task(dock, 300)
+    assert dock.last_task_error is None, dock.last_task_error
+    f = dock.store.figures
+    assert f["GCP_N"] == len(sc.targets) and f["GCP_RMSE_XY"] < 0.01 and f["GCP_RMSE_Z"] < 0.02, f
+    assert dock.store.found_list() == found
 
 
 def test_one_key_confirms_or_rejects_each_found_observation(dock, ws, scene):  # noqa: F811
