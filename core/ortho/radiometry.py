@@ -147,6 +147,67 @@ def _grey_ok(values: np.ndarray, valid: np.ndarray, scale: float) -> Tuple[np.nd
     return grey, ok
 
 
+FOOTPRINT_POINTS = 3  # per side: a grey value for the fit and the seam step is the mean of 3 x 3 ground points
+
+
+def _reduced(cam: OrthoCamera, meta, factor: float) -> np.ndarray:
+    """The photo reduced ``factor`` x by area (cv2.INTER_AREA: each pixel the mean of the photo's pixels it
+    covers), kept in the image cache."""
+    from ..common.errors import require
+    from .pixels import _CACHE, _image_window
+
+    def make():
+        cv2 = require("cv2", "orthophotos")
+        whole = _image_window(cam.path, meta, 0, 0, meta.width, meta.height)
+        w, h = max(1, int(round(meta.width / factor))), max(1, int(round(meta.height / factor)))
+        small = cv2.resize(np.ascontiguousarray(whole).astype(np.float32), (w, h), interpolation=cv2.INTER_AREA)
+        small = small.reshape(h, w, -1)
+        return small, small.nbytes
+
+    return _CACHE.get(("reduced", cam.path, factor), make)
+
+
+def sample_grey(cam: OrthoCamera, meta, offset: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, vis,
+                footprint: float, scale: float) -> Tuple[np.ndarray, np.ndarray]:
+    """(grey, usable) of ground points: the mean grey value over a square of ``footprint`` metres around each point
+    (FOOTPRINT_POINTS x FOOTPRINT_POINTS points at the point's height, on the photo reduced by area to about a
+    third of the footprint a pixel where its pixels are finer), usable where every point is.  The brightness of an area of the ground, the
+    same whatever the photos' resolution: one bilinear pixel of a full-resolution photo is the texture under it,
+    and two photos misregistered by a pixel disagree there by the texture's contrast, not by their brightness
+    (issue 33 item 4: the seam step of toledo_2400's 2400 px photos read higher than of their 1200 px copies)."""
+    from .pixels import _remap
+
+    n = FOOTPRINT_POINTS if footprint > 0 else 1
+    offs = ((np.arange(n) + 0.5) / n - 0.5) * footprint
+    acc = np.zeros(len(x), dtype=np.float64)
+    good = np.ones(len(x), dtype=bool)
+    factor = 0
+    for dy in offs:
+        for dx in offs:
+            s = sample_camera(cam, meta, offset, x + dx, y + dy, z, vis, "bilinear", want_values=False)
+            if not factor:  # the photo's ground pixel at these points: the reduction to a third of the footprint
+                idx = np.flatnonzero(s.valid)
+                depth = cam.pose.to_camera(s.xyz[idx])[:, 2] if len(idx) else np.ones(1)
+                gsd = float(np.median(depth)) / max(cam.camera.focal, 1e-9)
+                want = footprint / (n * gsd) if footprint > 0 and gsd > 0 else 1.0
+                # in steps of 2 ** (1/4) (a few reductions per photo in the cache), never finer than the photo
+                factor = 2.0 ** (math.floor(4.0 * math.log2(want)) / 4.0) if want > 1.0 else 1.0
+                src = _reduced(cam, meta, factor) if factor > 1.0 else None
+            idx = np.flatnonzero(s.valid)
+            values = np.zeros((len(x), meta.bands), dtype=np.float32)
+            if len(idx):
+                if src is None:
+                    s = sample_camera(cam, meta, offset, x + dx, y + dy, z, vis, "bilinear")
+                    values = s.values
+                else:
+                    sx, sy = src.shape[1] / meta.width, src.shape[0] / meta.height
+                    values[idx] = _remap(src, s.px[idx, 0] * sx - 0.5, s.px[idx, 1] * sy - 0.5, "bilinear")
+            grey, ok = _grey_ok(values, s.valid, scale)
+            acc += np.where(ok, grey, 0.0)
+            good &= ok
+    return acc / (n * n), good
+
+
 def chunk_disagreement(images_a: np.ndarray, images_b: np.ndarray, cells: np.ndarray, cols: int,
                        diff: np.ndarray, min_count: int = 4) -> float:
     """Median over chunks (two images, CHUNK x CHUNK cells) of |the chunk's median log difference|, as a
@@ -178,6 +239,7 @@ def seam_steps(model: Optional[RadiometryModel], labels: np.ndarray, k: int, pre
     ``gains``, with the model); nan where there is no seam."""
     grid = prep.grid
     p = k * grid.resolution
+    footprint = p  # the planning cells on either side of the edge, half each
     pts = []
     for horizontal in (True, False):
         la, lb = (labels[:, :-1], labels[:, 1:]) if horizontal else (labels[:-1], labels[1:])
@@ -201,8 +263,8 @@ def seam_steps(model: Optional[RadiometryModel], labels: np.ndarray, k: int, pre
             sel = np.flatnonzero(lab == i)
             if not len(sel):
                 continue
-            s = sample_camera(cam, prep.metas[i], offset, x[sel], y[sel], z[sel], prep.visibility[i], "bilinear")
-            grey, ok = _grey_ok(s.values, s.valid, scale)
+            grey, ok = sample_grey(cam, prep.metas[i], offset, x[sel], y[sel], z[sel], prep.visibility[i],
+                                   footprint, scale)
             sel, grey = sel[ok], grey[ok]
             if not len(sel):
                 continue

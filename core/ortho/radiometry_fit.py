@@ -17,15 +17,14 @@ from .grid import _cell_centres, _subgrid
 from .radiometry import (
     FIELD_TERMS,
     RadiometryModel,
-    _grey_ok,
     _scale,
     chunk_disagreement,
     field_terms,
     hot_spot_shape,
     observation_geometry,
+    sample_grey,
     seam_steps,
 )
-from .sampling import sample_camera
 from .surface import _Dsm
 
 SAMPLE_GSD = 4.0  # sample cell = 4 x GSD (at least)
@@ -72,8 +71,7 @@ def sample_overlaps(prep: _Prepared, dsm: _Dsm, offset: np.ndarray, progress: Pr
         r0, c0, h, w = sub
         xi, yi = _cell_centres(sgrid, r0, c0, h, w)
         zi = zs[r0:r0 + h, c0:c0 + w].ravel().astype(np.float64)
-        s = sample_camera(cam, meta, offset, xi, yi, zi, vis, "bilinear")
-        grey, ok = _grey_ok(s.values, s.valid, scale)
+        grey, ok = sample_grey(cam, meta, offset, xi, yi, zi, vis, sgrid.resolution, scale)
         idx = np.flatnonzero(ok)
         if len(idx):
             xyz = np.column_stack([xi[idx] - offset[0], yi[idx] - offset[1], zi[idx] - offset[2]])
