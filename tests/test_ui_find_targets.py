@@ -232,7 +232,8 @@ def test_the_dialog_the_errors_and_cancel(dock, ws, scene, tmp_path, monkeypatch
 
 def test_a_click_in_the_targets_file_that_no_mark_answers_is_kept_as_placed_by_hand(dock, ws, scene, tmp_path):  # noqa: F811,E501
     """A gcp_list.txt with a click (pixel columns) on a target the border cuts: the core keeps it, not found; the
-    dock takes it as an observation of the user's, with no mark to confirm."""
+    dock takes it as an observation of the user's, with no mark to confirm.  A target surveyed outside the photos
+    is said not found in the message area."""
     sc, _, _ = scene
     image, name = next((i, n) for i, n in sc.cut if 0 < sc.truth[i][n][0] < targets_scene.W
                        and 0 < sc.truth[i][n][1] < targets_scene.H)
@@ -245,8 +246,10 @@ def test_a_click_in_the_targets_file_that_no_mark_answers_is_kept_as_placed_by_h
             out.write(f"{w[0]:.4f} {w[1]:.4f} {w[2]:.4f} {t.name}\n")
             if t.name == name:
                 out.write(f"{w[0]:.4f} {w[1]:.4f} {w[2]:.4f} {tx:.2f} {ty:.2f} {image} {t.name}\n")
+        out.write(f"{w[0] + 60.0:.4f} {w[1] + 45.0:.4f} {w[2]:.4f} far_away\n")  # surveyed outside the photos
     assert dock.open_workspace(ws)
     r = _find(dock, str(path))
+    assert dock.status.text().splitlines()[1] == "not found: far_away"  # what did not fit, first
     assert [(o.name, o.image) for o in r.observations if not o.found] == [(name, image)]
     assert _observations(dock.store)[(name, image)] == (round(tx, 2), round(ty, 2))
     assert dock.store.is_found(name, image) is None and (name, image) not in dock.store.found_list()

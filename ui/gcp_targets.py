@@ -237,11 +237,12 @@ class GcpTargets:
         text = translate("GcpDock", "Find targets: {} of {} targets found, {} observations, in {:.0f} s.").format(
             result.n_targets, len(result.targets), result.n_observations, result.seconds)
         missing = [t.name for t in result.targets if not t.found]
-        details = list(lines)
+        details = []  # what did not fit first, then what the table gained
         if missing:
             details.append(translate("GcpDock", "not found: {}").format(", ".join(missing)))
-        details += [f"{t.name}: {t.note}" for t in result.targets if t.found and t.note]
         details += list(result.reports)
+        details += [f"{t.name}: {t.note}" for t in result.targets if t.found and t.note]
+        details += list(lines)
         if self.store.found_list():
             details.append(translate("GcpDock", "Space or Enter: confirm the found observation shown; Delete or R: "
                                                 "reject it. Georeference uses the found observations that are not "
