@@ -990,11 +990,6 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
     </message>
     <message>
         <location filename="../processing_provider/find_targets.py" line="59"/>
-        <source>CRS of the coordinates (where the file names none)</source>
-        <translation>KBS der Koordinaten (wenn die Datei keines nennt)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/find_targets.py" line="59"/>
         <source>Target kind</source>
         <translation>Art der Zielmarken</translation>
     </message>
@@ -1002,11 +997,6 @@ Differenz: wohin das float32-Cloud-Optimized-GeoTIFF von später minus früher (
         <location filename="../processing_provider/find_targets.py" line="59"/>
         <source>Target size (m, 0: unknown)</source>
         <translation>Größe der Zielmarken (m, 0: unbekannt)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/find_targets.py" line="68"/>
-        <source>Observations found (gcp_list.txt)</source>
-        <translation>Gefundene Messungen (gcp_list.txt)</translation>
     </message>
     <message>
         <location filename="../processing_provider/find_targets.py" line="71"/>
@@ -1052,12 +1042,22 @@ Outputs: the observations file (default georef/targets/gcp_list.txt in the works
         <translation>Findet die vermessenen Zielmarken am Boden auf den Fotos eines ausgerichteten Blocks und schreibt ihre Messungen subpixelgenau als gcp_list.txt, die Georeferenzieren liest: ohne Klicks. Weder GPS noch ein erster Klick sind nötig: Marken werden auf jedem Foto erkannt, über die Fotos hinweg durch Triangulation im Block verknüpft, und die triangulierten Marken werden den vermessenen Koordinaten nach ihrer Form zugeordnet (eine Ähnlichkeitstransformation aus Dreiergruppen; Maßstab und Spiegelung werden gesucht; das EXIF-GPS der Fotos, wo vorhanden, engt die Suche ein); dann wird jede benannte Zielmarke in jedes Foto projiziert, und die Marke dort kommt hinzu. Codierte Zielmarken (ArUco, AprilTag) tragen ihre Namen: eine Zielmarke, die nach ihrem Code benannt ist oder auf ihn endet (12, T12, aruco_12).
 
 Ausgerichteter Arbeitsbereich: der Block (seine Fotos müssen noch dort liegen, wo die Ausrichtung sie fand).
-Zielmarken: die vermessenen Koordinaten, eine CSV-Datei 'name,x,y,z[,sigma_xy,sigma_z]' (KBS als Zeile '# crs: EPSG:xxxx' oder im Parameter KBS der Koordinaten) oder eine OpenDroneMap-gcp_list.txt, deren Pixelspalten fehlen ('x y z name') oder teilweise vorhanden sein dürfen: wo vorhanden, sind sie Klicks, die die Marke benennen, auf die sie fallen (gegen die Konstellation geprüft; ein Klick auf die Marke einer anderen Zielmarke wird gemeldet und ausgelassen).
-KBS der Koordinaten: das KBS der Koordinaten, wenn die Datei keines nennt.
+Zielmarken: die vermessenen Koordinaten, eine CSV-Datei 'name,x,y,z[,sigma_xy,sigma_z]' (KBS als Zeile '# crs: EPSG:xxxx' oder im Parameter KBS) oder eine OpenDroneMap-gcp_list.txt, deren Pixelspalten fehlen ('x y z name') oder teilweise vorhanden sein dürfen: wo vorhanden, sind sie Klicks, die die Marke benennen, auf die sie fallen (gegen die Konstellation geprüft; ein Klick auf die Marke einer anderen Zielmarke wird gemeldet und ausgelassen).
+KBS: das KBS der Koordinaten, wenn die Datei keines nennt.
 Art der Zielmarken: automatisch (Kreuze, Schachbretter, Kreise und ArUco-4x4-Marker), eine Art oder ein ArUco- / AprilTag-Wörterbuch.
 Größe der Zielmarken: Seitenlänge oder Durchmesser der Zielmarke in Metern (0: unbekannt); eine Marke, deren Größe am Boden (ihre Pixel in ihrer Entfernung, über den Maßstab der Konstellation) um mehr als den Faktor 2 davon abweicht, wird ausgelassen.
 Eine Zielmarke, die ein Foto nur teilweise oder verdeckt zeigt, wird ausgelassen statt geraten; eine Marke, die nicht zur vermessenen Konstellation passt, oder eine Benennung, zu der eine andere fast ebenso gut passt, wird im Protokoll gemeldet, nie zugeordnet.
 Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbeitsbereich), ein Layer der Zielmarken mit dem Gefundenen (georef/targets/targets.gpkg: Messungen, Passung, Residuum) zur Prüfung, die Anzahl gefundener Zielmarken und Messungen; georef/targets/targets.json listet jede Messung mit ihrer Güte.</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="59"/>
+        <source>CRS (where the file names none)</source>
+        <translation>KBS (wenn die Datei keines nennt)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="68"/>
+        <source>Observations file</source>
+        <translation>Messungsdatei</translation>
     </message>
 </context>
 <context>
@@ -1263,7 +1263,7 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>ArchaeoOrtho: Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="544"/>
+        <location filename="../ui/gcp_dock.py" line="545"/>
         <source>CRS: {}</source>
         <translation>KBS: {}</translation>
     </message>
@@ -1668,12 +1668,12 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>(in der Fotoleiste markiert; der Grund steht im Tooltip)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="448"/>
+        <location filename="../ui/gcp_dock.py" line="449"/>
         <source>✗ not aligned</source>
         <translation>✗ nicht ausgerichtet</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="449"/>
+        <location filename="../ui/gcp_dock.py" line="450"/>
         <source>{}: not aligned: {}</source>
         <translation>{}: nicht ausgerichtet: {}</translation>
     </message>
@@ -1808,127 +1808,127 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Automatische Passpunkte (Residuen)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="64"/>
+        <location filename="../ui/gcp_targets.py" line="65"/>
         <source>found by Find targets ({}), quality {:.2f}</source>
         <translation>von Zielmarken finden gefunden ({}), Güte {:.2f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="67"/>
+        <location filename="../ui/gcp_targets.py" line="68"/>
         <source>, {:.2f} px from the other photos&apos; rays</source>
         <translation>, {:.2f} px von den Strahlen der anderen Fotos</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="78"/>
+        <location filename="../ui/gcp_targets.py" line="79"/>
         <source>Find targets</source>
         <translation>Zielmarken finden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="84"/>
+        <location filename="../ui/gcp_targets.py" line="85"/>
         <source>Surveyed coordinates (*.csv *.txt);;All files (*)</source>
         <translation>Vermessene Koordinaten (*.csv *.txt);;Alle Dateien (*)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="85"/>
+        <location filename="../ui/gcp_targets.py" line="86"/>
         <source>A CSV name,x,y,z[,sigma_xy,sigma_z] or an ODM gcp_list.txt (its pixel columns may be absent)</source>
         <translation>Eine CSV-Datei name,x,y,z[,sigma_xy,sigma_z] oder eine ODM-gcp_list.txt (ihre Pixelspalten dürfen fehlen)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="87"/>
+        <location filename="../ui/gcp_targets.py" line="88"/>
         <source>Surveyed coordinates:</source>
         <translation>Vermessene Koordinaten:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="90"/>
+        <location filename="../ui/gcp_targets.py" line="91"/>
         <source>auto (crosses, checkerboards, circles, ArUco 4x4)</source>
         <translation>automatisch (Kreuze, Schachbretter, Kreise, ArUco 4x4)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="92"/>
+        <location filename="../ui/gcp_targets.py" line="93"/>
         <source>Target kind:</source>
         <translation>Art der Zielmarken:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="97"/>
+        <location filename="../ui/gcp_targets.py" line="98"/>
         <source>unknown</source>
         <translation>unbekannt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="98"/>
+        <location filename="../ui/gcp_targets.py" line="99"/>
         <source>The target&apos;s side or diameter: marks of another size are left out</source>
         <translation>Seitenlänge oder Durchmesser der Zielmarke: Marken anderer Größe werden ausgelassen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="99"/>
+        <location filename="../ui/gcp_targets.py" line="100"/>
         <source>Target size:</source>
         <translation>Größe der Zielmarken:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="101"/>
+        <location filename="../ui/gcp_targets.py" line="102"/>
         <source>A file that names no CRS is read in {}.</source>
         <translation>Eine Datei, die kein KBS nennt, wird in {} gelesen.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="101"/>
+        <location filename="../ui/gcp_targets.py" line="102"/>
         <source>The file must name its CRS (the table and the workspace have none).</source>
         <translation>Die Datei muss ihr KBS nennen (Tabelle und Arbeitsbereich haben keines).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="154"/>
+        <location filename="../ui/gcp_targets.py" line="155"/>
         <source>Find targets on the photos…</source>
         <translation>Zielmarken auf den Fotos finden…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="155"/>
+        <location filename="../ui/gcp_targets.py" line="156"/>
         <source>Find the surveyed targets on the aligned photos (in the background): their observations fill the table, marked as found until you confirm them (Space or Enter) or reject them (Delete or R)</source>
         <translation>Die vermessenen Zielmarken auf den ausgerichteten Fotos finden (im Hintergrund): ihre Messungen füllen die Tabelle, als gefunden markiert, bis Sie sie übernehmen (Leertaste oder Eingabe) oder verwerfen (Entf oder R)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="204"/>
+        <location filename="../ui/gcp_targets.py" line="207"/>
         <source>ArchaeoOrtho: find targets</source>
         <translation>ArchaeoOrtho: Zielmarken finden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="206"/>
+        <location filename="../ui/gcp_targets.py" line="209"/>
         <source>Looking for the targets of {} on the photos…</source>
         <translation>Die Zielmarken aus {} werden auf den Fotos gesucht…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="224"/>
+        <location filename="../ui/gcp_targets.py" line="235"/>
         <source>find targets</source>
         <translation>Zielmarken finden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="225"/>
+        <location filename="../ui/gcp_targets.py" line="237"/>
         <source>Find targets: {} of {} targets found, {} observations, in {:.0f} s.</source>
         <translation>Zielmarken finden: {} von {} Zielmarken gefunden, {} Messungen, in {:.0f} s.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="230"/>
+        <location filename="../ui/gcp_targets.py" line="242"/>
         <source>not found: {}</source>
         <translation>nicht gefunden: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="234"/>
+        <location filename="../ui/gcp_targets.py" line="247"/>
         <source>Space or Enter: confirm the found observation shown; Delete or R: reject it. Georeference uses the found observations that are not rejected, confirmed or not.</source>
         <translation>Leertaste oder Eingabe: die angezeigte gefundene Messung übernehmen; Entf oder R: sie verwerfen. Georeferenzieren verwendet die nicht verworfenen gefundenen Messungen, übernommen oder nicht.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="291"/>
+        <location filename="../ui/gcp_targets.py" line="304"/>
         <source>Every found observation is confirmed or rejected</source>
         <translation>Jede gefundene Messung ist übernommen oder verworfen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="307"/>
+        <location filename="../ui/gcp_targets.py" line="320"/>
         <source>Found by Find targets, not confirmed: Space or Enter confirms it, Delete or R rejects it (then the next one).</source>
         <translation>Von Zielmarken finden gefunden, nicht übernommen: Leertaste oder Eingabe übernimmt sie, Entf oder R verwirft sie (dann die nächste).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="315"/>
+        <location filename="../ui/gcp_targets.py" line="343"/>
         <source>{} observations found by Find targets, not confirmed: {}</source>
         <translation>{} Messungen von Zielmarken finden gefunden, nicht übernommen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="326"/>
+        <location filename="../ui/gcp_targets.py" line="354"/>
         <source>{} found observations are not confirmed yet: they are used as they are (reject the wrong ones first)</source>
         <translation>{} gefundene Messungen sind noch nicht übernommen: sie werden so verwendet, wie sie sind (verwerfen Sie zuerst die falschen)</translation>
     </message>
@@ -2202,7 +2202,7 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="122"/>
+        <location filename="../processing_provider/run_pipeline.py" line="133"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
@@ -2885,52 +2885,52 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Write the accuracy report</source>
         <translation>Genauigkeitsbericht schreiben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="106"/>
+        <location filename="../processing_provider/run_pipeline.py" line="115"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="116"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="110"/>
+        <location filename="../processing_provider/run_pipeline.py" line="119"/>
         <source>Accuracy report (HTML)</source>
         <translation>Genauigkeitsbericht (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="164"/>
+        <location filename="../processing_provider/run_pipeline.py" line="179"/>
         <source>Seconds per stage: {}</source>
         <translation>Sekunden pro Stufe: {}</translation>
     </message>
@@ -2940,99 +2940,124 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>Gesamte Verarbeitung ausführen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Ground control layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Check points</source>
         <translation>Kontrollpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Use EXIF GPS positions</source>
         <translation>EXIF-GPS-Positionen verwenden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Target CRS</source>
         <translation>Ziel-KBS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Matching image size (px)</source>
         <translation>Bildgröße für die Zuordnung (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>DSM resolution (m)</source>
         <translation>DOM-Auflösung (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Matching quality</source>
         <translation>Zuordnungsqualität</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Seam blending</source>
         <translation>Überblendung der Nähte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Parallel workers</source>
         <translation>Parallele Prozesse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Dask scheduler</source>
         <translation>Dask-Scheduler</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Build the DTM</source>
         <translation>Das DGM erzeugen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Contour interval (m, 0 = none)</source>
         <translation>Höhenlinienabstand (m, 0 = keine)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Relief visualisations</source>
         <translation>Reliefvisualisierungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="105"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>GCP-Pixel auf aufrechten Fotos gemessen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="128"/>
-        <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
-        <translation>Geben Sie Passpunkte (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Sky masks (oblique photos)</source>
         <translation>Himmelsmasken (Schrägaufnahmen)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <source>Camera calibration file</source>
+        <translation>Kamerakalibrierungsdatei</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <source>Interior orientation</source>
+        <translation>Innere Orientierung</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <source>Orthomosaic resolution (CRS units, 0 = GSD)</source>
+        <translation>Orthomosaik-Auflösung (KBS-Einh., 0 = GSD)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <source>Targets to find</source>
+        <translation>Zu findende Zielmarken</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <source>Target kind</source>
+        <translation>Art der Zielmarken</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="140"/>
+        <source>Give ground control (Ground control file or layer, or targets to find: GCPS, GCP_LAYER, TARGETS) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
+        <translation>Geben Sie Passpunkte (Passpunktdatei oder Passpunktlayer oder zu findende Zielmarken: GCPS, GCP_LAYER, TARGETS) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="8"/>
@@ -3040,6 +3065,7 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
 
 Folder of images: the photos. Workspace folder: where every product is written.
 Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in &apos;Georeference&apos; (the pixel coordinates measured on the photos shown upright by their EXIF orientation).
+Targets to find (instead of a ground control file or layer): the surveyed coordinates of targets laid on the ground; after the alignment &apos;Find targets&apos; finds them on the photos and its observations are the ground control (Target kind, advanced: as in &apos;Find targets&apos;).
 Camera calibration file and Interior orientation (advanced): as in &apos;Align images&apos; (a calibrated camera held fixed through the whole chain, or refined with its standard deviations).
 Sky masks (oblique photos): first a &apos;Prepare images&apos; stage finds the sky and the horizon haze in each photo and masks them, so that no tie point or DSM point comes from the sky; the prepared photos are aligned (off by default: photos looking straight down need none).
 Build the DTM: after the DSM, a bare-earth DTM (as &apos;Build DTM&apos;). Contour interval (advanced): contour lines of the DTM at this interval (as &apos;Contours&apos;; 0 = none). Relief visualisations (advanced): those chosen are computed from the DTM (as &apos;Relief visualisation&apos;). Both need the DTM.
@@ -3049,26 +3075,12 @@ Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key f
 
 Bilderordner: die Fotos. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben werden.
 Die Georeferenzierung braucht Passpunkte (eine Passpunktdatei oder ein Passpunktlayer, Kontrollpunkte werden zurückgehalten) und/oder Kamerapositionen (eine CSV-Datei der Kamerapositionen oder EXIF-GPS-Positionen verwenden): ohne sie wird die Verarbeitung abgelehnt, da ein DOM einen metrischen Maßstab und eine Lotrichtung braucht. GCP-Pixel auf aufrechten Fotos gemessen: wie bei 'Georeferenzieren' (die Pixelkoordinaten auf den Fotos gemessen, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden).
+Zu findende Zielmarken (statt einer Passpunktdatei oder eines Passpunktlayers): die vermessenen Koordinaten von am Boden ausgelegten Zielmarken; nach der Ausrichtung findet 'Zielmarken finden' sie auf den Fotos, und seine Messungen sind die Passpunkte (Art der Zielmarken, erweitert: wie in 'Zielmarken finden').
 Kamerakalibrierungsdatei und Innere Orientierung (erweitert): wie in 'Bilder ausrichten' (eine kalibrierte Kamera durch die ganze Kette festgehalten oder mit ihren Standardabweichungen verbessert).
 Himmelsmasken (Schrägaufnahmen): zuerst findet eine Stufe 'Bilder vorbereiten' den Himmel und den Dunst am Horizont in jedem Foto und maskiert sie, damit kein Verknüpfungs- oder DOM-Punkt aus dem Himmel stammt; die vorbereiteten Fotos werden ausgerichtet (standardmäßig aus: senkrecht aufgenommene Fotos brauchen keine).
 Das DGM erzeugen: nach dem DOM ein DGM der nackten Erde (wie 'DGM erzeugen'). Höhenlinienabstand (erweitert): Höhenlinien des DGM in diesem Abstand (wie 'Höhenlinien'; 0 = keine). Reliefvisualisierungen (erweitert): die gewählten werden aus dem DGM berechnet (wie 'Reliefvisualisierung'). Beide brauchen das DGM.
 Die übrigen Parameter sind die der einzelnen Stufen (siehe deren Hilfe); 0 bedeutet automatisch.
 Ausgaben: das DOM, das Orthomosaik und der Genauigkeitsbericht (HTML) sowie die wichtigsten Kennzahlen.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
-        <source>Camera calibration file</source>
-        <translation>Kamerakalibrierungsdatei</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
-        <source>Interior orientation</source>
-        <translation>Innere Orientierung</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
-        <source>Orthomosaic resolution (CRS units, 0 = GSD)</source>
-        <translation>Orthomosaik-Auflösung (KBS-Einh., 0 = GSD)</translation>
     </message>
 </context>
 </TS>

@@ -990,11 +990,6 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
     </message>
     <message>
         <location filename="../processing_provider/find_targets.py" line="59"/>
-        <source>CRS of the coordinates (where the file names none)</source>
-        <translation>SR delle coordinate (se il file non ne indica uno)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/find_targets.py" line="59"/>
         <source>Target kind</source>
         <translation>Tipo di target</translation>
     </message>
@@ -1002,11 +997,6 @@ Differenza: dove scrivere il Cloud-Optimized GeoTIFF float32 di successivo meno 
         <location filename="../processing_provider/find_targets.py" line="59"/>
         <source>Target size (m, 0: unknown)</source>
         <translation>Dimensione dei target (m, 0: sconosciuta)</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/find_targets.py" line="68"/>
-        <source>Observations found (gcp_list.txt)</source>
-        <translation>Misure trovate (gcp_list.txt)</translation>
     </message>
     <message>
         <location filename="../processing_provider/find_targets.py" line="71"/>
@@ -1052,12 +1042,22 @@ Outputs: the observations file (default georef/targets/gcp_list.txt in the works
         <translation>Trova i target a terra rilevati nelle foto di un blocco allineato e ne scrive le misure, al sub-pixel, in un gcp_list.txt che Georeferenzia legge: nessun clic. Non servono né GPS né un primo clic: i segni vengono rilevati in ogni foto, collegati tra le foto per triangolazione nel blocco, e i segni triangolati vengono abbinati alle coordinate rilevate in base alla loro forma (una similitudine trovata da terne; scala e specchiatura cercate; il GPS EXIF delle foto, dove c'è, restringe la ricerca); poi ogni target nominato viene proiettato in ogni foto e il segno lì presente gli si unisce. I target codificati (ArUco, AprilTag) portano il proprio nome: un target chiamato con il suo codice o che termina con esso (12, T12, aruco_12).
 
 Area di lavoro allineata: il blocco (le sue foto devono essere ancora dove l'allineamento le ha trovate).
-Target: le coordinate rilevate, un CSV 'name,x,y,z[,sigma_xy,sigma_z]' (SR come riga '# crs: EPSG:xxxx' o nel parametro SR delle coordinate) o un gcp_list.txt di OpenDroneMap le cui colonne dei pixel possono mancare ('x y z name') o essere parziali: dove presenti sono clic che danno il nome al segno su cui cadono (verificati rispetto alla costellazione; un clic sul segno di un altro target viene segnalato ed escluso).
-SR delle coordinate: l'SR delle coordinate se il file non ne indica uno.
+Target: le coordinate rilevate, un CSV 'name,x,y,z[,sigma_xy,sigma_z]' (SR come riga '# crs: EPSG:xxxx' o nel parametro SR) o un gcp_list.txt di OpenDroneMap le cui colonne dei pixel possono mancare ('x y z name') o essere parziali: dove presenti sono clic che danno il nome al segno su cui cadono (verificati rispetto alla costellazione; un clic sul segno di un altro target viene segnalato ed escluso).
+SR: l'SR delle coordinate se il file non ne indica uno.
 Tipo di target: automatico (croci, scacchiere, cerchi e marker ArUco 4x4), un solo tipo, o un dizionario ArUco / AprilTag.
 Dimensione dei target: lato o diametro del target in metri (0: sconosciuta); un segno la cui dimensione a terra (i suoi pixel alla sua distanza, tramite la scala data dalla costellazione) ne differisce di più di un fattore 2 viene escluso.
 Un target che una foto mostra solo in parte, o coperto, viene escluso invece che indovinato; un segno che non si adatta alla costellazione rilevata, o un'assegnazione di nomi che un'altra soddisfa quasi altrettanto bene, viene segnalato nel log, mai assegnato.
 Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area di lavoro), un layer dei target con quanto trovato (georef/targets/targets.gpkg: misure, adattamento, residuo) da verificare, il numero di target e di misure trovati; georef/targets/targets.json elenca ogni misura con la sua qualità.</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="59"/>
+        <source>CRS (where the file names none)</source>
+        <translation>SR (se il file non ne indica uno)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/find_targets.py" line="68"/>
+        <source>Observations file</source>
+        <translation>File delle misure</translation>
     </message>
 </context>
 <context>
@@ -1263,7 +1263,7 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>ArchaeoOrtho: allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="544"/>
+        <location filename="../ui/gcp_dock.py" line="545"/>
         <source>CRS: {}</source>
         <translation>SR: {}</translation>
     </message>
@@ -1668,12 +1668,12 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>(segnate nella striscia delle foto; il motivo è nel suggerimento)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="448"/>
+        <location filename="../ui/gcp_dock.py" line="449"/>
         <source>✗ not aligned</source>
         <translation>✗ non allineata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="449"/>
+        <location filename="../ui/gcp_dock.py" line="450"/>
         <source>{}: not aligned: {}</source>
         <translation>{}: non allineata: {}</translation>
     </message>
@@ -1808,127 +1808,127 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>GCP automatici (residui)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="64"/>
+        <location filename="../ui/gcp_targets.py" line="65"/>
         <source>found by Find targets ({}), quality {:.2f}</source>
         <translation>trovato da Trova i target ({}), qualità {:.2f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="67"/>
+        <location filename="../ui/gcp_targets.py" line="68"/>
         <source>, {:.2f} px from the other photos&apos; rays</source>
         <translation>, a {:.2f} px dai raggi delle altre foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="78"/>
+        <location filename="../ui/gcp_targets.py" line="79"/>
         <source>Find targets</source>
         <translation>Trova i target</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="84"/>
+        <location filename="../ui/gcp_targets.py" line="85"/>
         <source>Surveyed coordinates (*.csv *.txt);;All files (*)</source>
         <translation>Coordinate rilevate (*.csv *.txt);;Tutti i file (*)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="85"/>
+        <location filename="../ui/gcp_targets.py" line="86"/>
         <source>A CSV name,x,y,z[,sigma_xy,sigma_z] or an ODM gcp_list.txt (its pixel columns may be absent)</source>
         <translation>Un CSV name,x,y,z[,sigma_xy,sigma_z] o un gcp_list.txt di ODM (le colonne dei pixel possono mancare)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="87"/>
+        <location filename="../ui/gcp_targets.py" line="88"/>
         <source>Surveyed coordinates:</source>
         <translation>Coordinate rilevate:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="90"/>
+        <location filename="../ui/gcp_targets.py" line="91"/>
         <source>auto (crosses, checkerboards, circles, ArUco 4x4)</source>
         <translation>automatico (croci, scacchiere, cerchi, ArUco 4x4)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="92"/>
+        <location filename="../ui/gcp_targets.py" line="93"/>
         <source>Target kind:</source>
         <translation>Tipo di target:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="97"/>
+        <location filename="../ui/gcp_targets.py" line="98"/>
         <source>unknown</source>
         <translation>sconosciuta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="98"/>
+        <location filename="../ui/gcp_targets.py" line="99"/>
         <source>The target&apos;s side or diameter: marks of another size are left out</source>
         <translation>Lato o diametro del target: i segni di altra dimensione vengono esclusi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="99"/>
+        <location filename="../ui/gcp_targets.py" line="100"/>
         <source>Target size:</source>
         <translation>Dimensione dei target:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="101"/>
+        <location filename="../ui/gcp_targets.py" line="102"/>
         <source>A file that names no CRS is read in {}.</source>
         <translation>Un file che non indica un SR viene letto in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="101"/>
+        <location filename="../ui/gcp_targets.py" line="102"/>
         <source>The file must name its CRS (the table and the workspace have none).</source>
         <translation>Il file deve indicare il suo SR (la tabella e l'area di lavoro non ne hanno).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="154"/>
+        <location filename="../ui/gcp_targets.py" line="155"/>
         <source>Find targets on the photos…</source>
         <translation>Trova i target nelle foto…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="155"/>
+        <location filename="../ui/gcp_targets.py" line="156"/>
         <source>Find the surveyed targets on the aligned photos (in the background): their observations fill the table, marked as found until you confirm them (Space or Enter) or reject them (Delete or R)</source>
         <translation>Trova i target rilevati nelle foto allineate (in background): le loro misure riempiono la tabella, segnate come trovate finché non le confermi (Spazio o Invio) o le scarti (Canc o R)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="204"/>
+        <location filename="../ui/gcp_targets.py" line="207"/>
         <source>ArchaeoOrtho: find targets</source>
         <translation>ArchaeoOrtho: trova i target</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="206"/>
+        <location filename="../ui/gcp_targets.py" line="209"/>
         <source>Looking for the targets of {} on the photos…</source>
         <translation>Ricerca dei target di {} nelle foto…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="224"/>
+        <location filename="../ui/gcp_targets.py" line="235"/>
         <source>find targets</source>
         <translation>trova i target</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="225"/>
+        <location filename="../ui/gcp_targets.py" line="237"/>
         <source>Find targets: {} of {} targets found, {} observations, in {:.0f} s.</source>
         <translation>Trova i target: {} di {} target trovati, {} misure, in {:.0f} s.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="230"/>
+        <location filename="../ui/gcp_targets.py" line="242"/>
         <source>not found: {}</source>
         <translation>non trovati: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="234"/>
+        <location filename="../ui/gcp_targets.py" line="247"/>
         <source>Space or Enter: confirm the found observation shown; Delete or R: reject it. Georeference uses the found observations that are not rejected, confirmed or not.</source>
         <translation>Spazio o Invio: conferma la misura trovata mostrata; Canc o R: scartala. Georeferenzia usa le misure trovate non scartate, confermate o no.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="291"/>
+        <location filename="../ui/gcp_targets.py" line="304"/>
         <source>Every found observation is confirmed or rejected</source>
         <translation>Ogni misura trovata è confermata o scartata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="307"/>
+        <location filename="../ui/gcp_targets.py" line="320"/>
         <source>Found by Find targets, not confirmed: Space or Enter confirms it, Delete or R rejects it (then the next one).</source>
         <translation>Trovata da Trova i target, non confermata: Spazio o Invio la conferma, Canc o R la scarta (poi la prossima).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="315"/>
+        <location filename="../ui/gcp_targets.py" line="343"/>
         <source>{} observations found by Find targets, not confirmed: {}</source>
         <translation>{} misure trovate da Trova i target, non confermate: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="326"/>
+        <location filename="../ui/gcp_targets.py" line="354"/>
         <source>{} found observations are not confirmed yet: they are used as they are (reject the wrong ones first)</source>
         <translation>{} misure trovate non sono ancora confermate: vengono usate così come sono (scarta prima quelle sbagliate)</translation>
     </message>
@@ -2202,7 +2202,7 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="122"/>
+        <location filename="../processing_provider/run_pipeline.py" line="133"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
@@ -2885,52 +2885,52 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Write the accuracy report</source>
         <translation>Scrivi il rapporto di accuratezza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="106"/>
+        <location filename="../processing_provider/run_pipeline.py" line="115"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="116"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="110"/>
+        <location filename="../processing_provider/run_pipeline.py" line="119"/>
         <source>Accuracy report (HTML)</source>
         <translation>Rapporto di accuratezza (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="164"/>
+        <location filename="../processing_provider/run_pipeline.py" line="179"/>
         <source>Seconds per stage: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -2940,99 +2940,124 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Esegui l'intera elaborazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Ground control layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Check points</source>
         <translation>Punti di controllo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Use EXIF GPS positions</source>
         <translation>Usa le posizioni GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Target CRS</source>
         <translation>SR di destinazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Matching image size (px)</source>
         <translation>Dimensione per la corrispondenza (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>DSM resolution (m)</source>
         <translation>Risoluzione del DSM (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Matching quality</source>
         <translation>Qualità della corrispondenza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Seam blending</source>
         <translation>Sfumatura delle giunzioni</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Parallel workers</source>
         <translation>Processi paralleli</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Dask scheduler</source>
         <translation>Scheduler Dask</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Build the DTM</source>
         <translation>Genera il DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Contour interval (m, 0 = none)</source>
         <translation>Equidistanza (m, 0 = nessuna)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Relief visualisations</source>
         <translation>Visualizzazioni del rilievo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="105"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>Pixel dei GCP misurati sulle foto raddrizzate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="128"/>
-        <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
-        <translation>Indicare punti di appoggio (File o Layer dei punti d'appoggio: GCPS, GCP_LAYER) e/o posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
         <source>Sky masks (oblique photos)</source>
         <translation>Maschere del cielo (foto oblique)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <source>Camera calibration file</source>
+        <translation>File di calibrazione della camera</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <source>Interior orientation</source>
+        <translation>Orientamento interno</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <source>Orthomosaic resolution (CRS units, 0 = GSD)</source>
+        <translation>Risoluzione ortomosaico (unità SR, 0 = GSD)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <source>Targets to find</source>
+        <translation>Target da trovare</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <source>Target kind</source>
+        <translation>Tipo di target</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="140"/>
+        <source>Give ground control (Ground control file or layer, or targets to find: GCPS, GCP_LAYER, TARGETS) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
+        <translation>Indicare punti di appoggio (File o Layer dei punti d'appoggio, o target da trovare: GCPS, GCP_LAYER, TARGETS) e/o posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="8"/>
@@ -3040,6 +3065,7 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
 
 Folder of images: the photos. Workspace folder: where every product is written.
 Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in &apos;Georeference&apos; (the pixel coordinates measured on the photos shown upright by their EXIF orientation).
+Targets to find (instead of a ground control file or layer): the surveyed coordinates of targets laid on the ground; after the alignment &apos;Find targets&apos; finds them on the photos and its observations are the ground control (Target kind, advanced: as in &apos;Find targets&apos;).
 Camera calibration file and Interior orientation (advanced): as in &apos;Align images&apos; (a calibrated camera held fixed through the whole chain, or refined with its standard deviations).
 Sky masks (oblique photos): first a &apos;Prepare images&apos; stage finds the sky and the horizon haze in each photo and masks them, so that no tie point or DSM point comes from the sky; the prepared photos are aligned (off by default: photos looking straight down need none).
 Build the DTM: after the DSM, a bare-earth DTM (as &apos;Build DTM&apos;). Contour interval (advanced): contour lines of the DTM at this interval (as &apos;Contours&apos;; 0 = none). Relief visualisations (advanced): those chosen are computed from the DTM (as &apos;Relief visualisation&apos;). Both need the DTM.
@@ -3049,26 +3075,12 @@ Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key f
 
 Cartella delle immagini: le foto. Cartella dell'area di lavoro: dove sono scritti tutti i prodotti.
 La georeferenziazione richiede punti di appoggio (un file o un layer dei punti d'appoggio, punti di controllo esclusi) e/o posizioni delle camere (un CSV delle posizioni delle camere o Usa le posizioni GPS EXIF): senza di essi l'elaborazione viene rifiutata, perché un DSM richiede una scala metrica e una direzione verticale. Pixel dei GCP misurati sulle foto raddrizzate: come in 'Georeferenzia' (le coordinate pixel misurate sulle foto mostrate diritte secondo il loro orientamento EXIF).
+Target da trovare (invece di un file o layer dei punti d'appoggio): le coordinate rilevate dei target posati a terra; dopo l'allineamento 'Trova i target' li trova nelle foto e le sue misure sono i punti d'appoggio (Tipo di target, avanzato: come in 'Trova i target').
 File di calibrazione della camera e Orientamento interno (avanzato): come in 'Allinea immagini' (una camera calibrata mantenuta fissa per tutta la catena, o affinata con le sue deviazioni standard).
 Maschere del cielo (foto oblique): prima una fase 'Prepara immagini' trova il cielo e la foschia all'orizzonte in ogni foto e li maschera, perché nessun punto di legame o del DSM provenga dal cielo; si allineano le foto preparate (disattivato per impostazione predefinita: le foto nadirali non ne hanno bisogno).
 Genera il DTM: dopo il DSM, un DTM del suolo nudo (come 'Genera DTM'). Equidistanza (avanzato): curve di livello del DTM con questa equidistanza (come 'Curve di livello'; 0 = nessuna). Visualizzazioni del rilievo (avanzato): quelle scelte sono calcolate dal DTM (come 'Visualizzazione del rilievo'). Entrambe richiedono il DTM.
 Gli altri parametri sono quelli delle singole fasi (vedi il loro aiuto); 0 significa automatico.
 Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
-        <source>Camera calibration file</source>
-        <translation>File di calibrazione della camera</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
-        <source>Interior orientation</source>
-        <translation>Orientamento interno</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/run_pipeline.py" line="75"/>
-        <source>Orthomosaic resolution (CRS units, 0 = GSD)</source>
-        <translation>Risoluzione ortomosaico (unità SR, 0 = GSD)</translation>
     </message>
 </context>
 </TS>
