@@ -192,6 +192,10 @@ def test_one_key_confirms_or_rejects_each_found_observation(dock, ws, scene):  #
     # the flag survives a reload; confirmed ones stay ordinary
     left = dock.store.found_list()
     assert dock.open_workspace(ws) and dock.store.found_list() == left and dock.store.is_found(*third) is None
+    # found again: what was confirmed stays confirmed; what the user removed comes back, to confirm or reject
+    _find(dock, csv)
+    assert dock.store.is_found(*third) is None and third in _observations(dock.store)
+    assert set(dock.store.found_list()) == set(left) | {first, second}
 
 
 def test_the_dialog_the_errors_and_cancel(dock, ws, scene, tmp_path, monkeypatch):  # noqa: F811

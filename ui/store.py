@@ -460,15 +460,19 @@ class GcpStore(QObject):
                                                           "used there): {}"))
 
         def fn(gs):
+            mine = set()  # observations placed by hand or confirmed: they stay, unmarked, wherever they are
             for (name, image), info in found.items():
                 p = gs.by_name(name)
                 old = next((o for o in p.observations if o.image == image), None) if p is not None else None
                 if old is not None and image in self.found.get(name, {}):
                     old.x, old.y = float(info["x"]), float(info["y"])
+                elif old is not None:
+                    mine.add((name, image))
             out = merge(gs)  # observations placed by hand stay: "placed observations kept" names them
             for (name, image), info in found.items():
                 obs = next((o for o in gs.by_name(name).observations if o.image == image), None)
-                if obs is not None and not _differs(obs.x, float(info["x"])) and not _differs(obs.y, float(info["y"])):
+                if (name, image) not in mine and obs is not None and not _differs(obs.x, float(info["x"])) \
+                        and not _differs(obs.y, float(info["y"])):
                     self.found.setdefault(name, {})[image] = dict(info, x=float(info["x"]), y=float(info["y"]))
             return out
         self.stale.update(p.name for p in gcpset.points)
