@@ -182,6 +182,11 @@ def test_one_key_confirms_or_rejects_each_found_observation(dock, ws, scene):  #
     assert len(dock.store.found_list()) == n - 4
     dock.act_undo.trigger()  # the rejection undone: the observation is back, marked as found
     assert fourth in _observations(dock.store) and dock.store.is_found(*fourth) is not None
+    dock.show_found(*fourth)
+    assert dock.photo_panel.btn_confirm.isEnabled()  # the mouse's way: the photo view's Confirm button
+    dock.photo_panel.btn_confirm.click()
+    assert dock.store.is_found(*fourth) is None and fourth in _observations(dock.store)
+    assert len(dock.store.found_list()) == n - 4
     # a hand-placed observation shown: the view's own keys (Delete removes it) are left alone
     name, image = first
     dock.select_point(name)
@@ -195,7 +200,7 @@ def test_one_key_confirms_or_rejects_each_found_observation(dock, ws, scene):  #
     # found again: what was confirmed stays confirmed; what the user removed comes back, to confirm or reject
     _find(dock, csv)
     assert dock.store.is_found(*third) is None and third in _observations(dock.store)
-    assert set(dock.store.found_list()) == set(left) | {first, second}
+    assert set(dock.store.found_list()) == set(left) | {first, second} and dock.store.is_found(*fourth) is None
 
 
 def test_the_dialog_the_errors_and_cancel(dock, ws, scene, tmp_path, monkeypatch):  # noqa: F811

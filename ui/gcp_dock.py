@@ -562,7 +562,10 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoContro
             self.store.remove_point(name)
 
     def confirm_prediction(self, image=None):
-        """Accept the prediction (GcpPlacement); a refinement still matching in the background ends first."""
+        """Accept the prediction (GcpPlacement); a refinement still matching in the background ends first.  A found
+        observation shown (Find targets) is confirmed instead (ui/gcp_targets.py)."""
+        if self.current_found() is not None and (image is None or image == self.photo_panel.image):
+            return self.confirm_found()
         self.wait_for_refinement(image or self.photo_panel.image)
         return super().confirm_prediction(image)
 

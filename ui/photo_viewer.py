@@ -673,7 +673,7 @@ class PhotoPanel(QWidget):
         self._update_buttons()
 
     def _update_buttons(self):
-        self.btn_confirm.setEnabled(self.prediction is not None)
+        self.btn_confirm.setEnabled(self.prediction is not None or self.found_note.isVisibleTo(self))
         self.btn_next.setEnabled(self.prediction is not None or getattr(self, "_has_next", False))
         self.btn_remove.setEnabled(self.observation is not None)
         self.btn_zoom.setEnabled(self.observation is not None or self.prediction is not None)
@@ -710,7 +710,7 @@ class PhotoPanel(QWidget):
             self.removeRequested.emit(self.image)
 
     def _confirm(self):
-        if self.image and self.prediction is not None:
+        if self.image and (self.prediction is not None or self.found_note.isVisibleTo(self)):  # a found observation
             self.confirmRequested.emit(self.image)
 
     def _next(self):
