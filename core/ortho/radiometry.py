@@ -160,7 +160,9 @@ def _reduced(cam: OrthoCamera, meta, factor: float) -> np.ndarray:
         cv2 = require("cv2", "orthophotos")
         whole = _image_window(cam.path, meta, 0, 0, meta.width, meta.height)
         w, h = max(1, int(round(meta.width / factor))), max(1, int(round(meta.height / factor)))
-        small = cv2.resize(np.ascontiguousarray(whole).astype(np.float32), (w, h), interpolation=cv2.INTER_AREA)
+        if whole.dtype not in (np.uint8, np.uint16, np.float32):  # the photo's own type where cv2 takes it
+            whole = whole.astype(np.float32)
+        small = cv2.resize(np.ascontiguousarray(whole), (w, h), interpolation=cv2.INTER_AREA)
         small = small.reshape(h, w, -1)
         return small, small.nbytes
 
