@@ -18,6 +18,7 @@ Conventions
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Optional, Sequence, Tuple
@@ -208,8 +209,13 @@ class Intrinsics:
         ok = z > 1e-9
         zs = np.where(ok, z, 1.0)
         xn = xc[..., :2] / zs[..., None]
-        if not self.native:
-            return self._pycolmap_project(xc), ok
+        if not self.native:  # pycolmap's model: trusted where the pixel unprojects to the same ray
+            px = self._pycolmap_project(xc)
+            with np.errstate(invalid="ignore"):
+                back = self._pycolmap_unproject(np.where(np.isfinite(px), px, 0.0))
+                ok &= np.all(np.isfinite(px), axis=-1) & (np.hypot(*np.moveaxis(back - xn, -1, 0))
+                                                          <= 1e-4 * (1.0 + np.hypot(xn[..., 0], xn[..., 1])))
+            return px, ok
         ok &= self.valid_normalized(xn)
         xd = self.distort(xn)
         px = np.stack([self.fx * xd[..., 0] + self.cx, self.fy * xd[..., 1] + self.cy], axis=-1)
@@ -266,6 +272,39 @@ class Pose:
 
 def project_points(pose: Pose, cam: Intrinsics, xyz: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
     return cam.project(pose.to_camera(xyz))
+
+
+@functools.lru_cache(maxsize=256)
+def _intrinsics(model: str, width: int, height: int, params: Tuple[float, ...]) -> Intrinsics:
+    return Intrinsics(model, width, height, params)
+
+
+def intrinsics_of(camera) -> Intrinsics:
+    """The :class:`Intrinsics` of a pycolmap camera, one object per distinct camera (so its trusted radius,
+    ``r_limit``, is computed once however many points are projected through it)."""
+    return _intrinsics(str(camera.model_name), int(camera.width), int(camera.height),
+                       tuple(float(p) for p in np.asarray(camera.params)))
+
+
+def project_in_image(camera, cam_from_world, xyz, margin: float = 0.0) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The one rule for where points are seen in a photo: (pixels (N, 2), seen (N,), centrality (N,)).
+
+    ``camera``: an :class:`Intrinsics` or a pycolmap camera; ``cam_from_world``: the image's 3 x 4 matrix;
+    ``xyz`` (N, 3) or (3,) in the same frame.  Seen: in front of the camera, within the lens model's trusted
+    radius (:meth:`Intrinsics.project`: ``r_limit``, or the round trip for models pycolmap alone knows) and inside
+    the frame by ``margin`` pixels (negative: that far outside).  Centrality: 0 at the image centre, 1 at a
+    corner.  Used by guided placement, the automatic control and Find targets alike, so a point is inside a
+    photo for all of them or for none."""
+    cam = camera if isinstance(camera, Intrinsics) else intrinsics_of(camera)
+    m = np.asarray(cam_from_world, dtype=float)
+    xc = np.atleast_2d(np.asarray(xyz, dtype=float)) @ m[:, :3].T + m[:, 3]
+    px, ok = cam.project(xc)
+    px = np.where(ok[:, None], px, np.nan)
+    with np.errstate(invalid="ignore"):
+        seen = ok & cam.inside(px, margin)
+    w, h = float(cam.width), float(cam.height)
+    centrality = np.hypot(px[:, 0] - 0.5 * w, px[:, 1] - 0.5 * h) / (0.5 * math.hypot(w, h))
+    return px, seen, centrality
 
 
 # ---------------------------------------------------------------------------

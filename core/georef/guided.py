@@ -22,8 +22,8 @@ pixels off in an oblique ray.  Then the height comes from the block itself: the 
 tie points nearest to the point's X, Y; and the similarity of an aligned block is fitted to X and Y only.
 
 A projection counts only where the point is in front of the camera, lands inside the image (with a
-margin) and the lens model is trusted there: the pixel is undistorted back and must give the same
-ray, which rejects the wrap-around of distortion polynomials far outside the frame.
+margin) and the lens model is trusted there (``geometry.camera.project_in_image``, the rule every stage
+uses), which rejects the wrap-around of distortion polynomials far outside the frame.
 
 Pixel convention: COLMAP's, origin at the upper-left corner of the upper-left pixel.
 """
@@ -37,6 +37,7 @@ import numpy as np
 
 from ..common.errors import require
 from ..common.files import atomic_output
+from ..geometry.camera import project_in_image
 from ..geometry.similarity import fit_similarity, helmert_fit
 from ..io.gcp import GCPSet, GroundPoint, Observation
 from .errors import GeorefError
@@ -83,24 +84,9 @@ def project_point(rec, xyz, images: Optional[Sequence[str]] = None, margin: floa
     out: Dict[str, Tuple[float, float, float]] = {}
     for name in names:
         im = lookup[name]
-        m = np.asarray(im.cam_from_world().matrix())
-        xc = m[:, :3] @ xyz + m[:, 3]
-        if not xc[2] > 1e-9:
-            continue
-        cam = rec.cameras[im.camera_id]
-        px = np.asarray(cam.img_from_cam(xc.reshape(1, 3), check_cheirality=False), dtype=float).reshape(2)
-        if not np.all(np.isfinite(px)):
-            continue
-        w, h = float(cam.width), float(cam.height)
-        if not (margin <= px[0] <= w - margin and margin <= px[1] <= h - margin):
-            continue
-        back = np.asarray(cam.cam_from_img(px.reshape(1, 2)), dtype=float).reshape(2)
-        ray = xc[:2] / xc[2]
-        if not np.all(np.isfinite(back)) or np.linalg.norm(back - ray) > 1e-4 * (1.0 + np.linalg.norm(ray)):
-            continue  # outside the domain where the distortion model is one-to-one
-        half_diag = 0.5 * math.hypot(w, h)
-        centrality = math.hypot(px[0] - 0.5 * w, px[1] - 0.5 * h) / half_diag
-        out[name] = (float(px[0]), float(px[1]), float(centrality))
+        px, seen, centrality = project_in_image(rec.cameras[im.camera_id], im.cam_from_world().matrix(), xyz, margin)
+        if seen[0]:
+            out[name] = (float(px[0, 0]), float(px[0, 1]), float(centrality[0]))
     return out
 
 

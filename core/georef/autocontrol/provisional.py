@@ -18,6 +18,7 @@ import numpy as np
 
 from ...common.errors import require
 from ...common.progress import NullProgress, Progress, check_cancel
+from ...geometry.camera import project_in_image
 from ...geometry.similarity import Similarity, helmert_ransac
 from ...io.gcp import CameraPosition
 from ...io.raster import push_pull
@@ -187,32 +188,11 @@ class ProvisionalOrtho:
         return self.x0 + (np.asarray(col) + 0.5) * self.res, self.y0 - (np.asarray(row) + 0.5) * self.res
 
 
-def _corner_radius(cam) -> float:
-    w, h = float(cam.width), float(cam.height)
-    corners = np.array([[0.0, 0.0], [w, 0.0], [0.0, h], [w, h]])
-    xn = np.asarray(cam.cam_from_img(corners), dtype=float)
-    return float(np.max(np.hypot(xn[:, 0], xn[:, 1])))
-
-
 def project(rec, im, xyz_model: np.ndarray, margin: float = 0.0):
-    """(pixels (N, 2), inside (N,), centrality (N,)) of model points in image ``im``: in front, inside the frame
-    by ``margin`` pixels and within the lens model's trusted radius; centrality 0 at the centre, 1 at a corner."""
-    cam = rec.cameras[im.camera_id]
-    m = np.asarray(im.cam_from_world().matrix())
-    xc = xyz_model @ m[:, :3].T + m[:, 3]
-    front = xc[:, 2] > 1e-9
-    xn = np.where(front[:, None], xc[:, :2] / np.where(front, xc[:, 2], 1.0)[:, None], 1e6)
-    trusted = front & (np.hypot(xn[:, 0], xn[:, 1]) <= 1.02 * _corner_radius(cam))
-    px = np.full((len(xc), 2), np.nan)
-    if trusted.any():
-        px[trusted] = np.asarray(cam.img_from_cam(np.column_stack([xn[trusted], np.ones(int(trusted.sum()))])),
-                                 dtype=float).reshape(-1, 2)
-    w, h = float(cam.width), float(cam.height)
-    with np.errstate(invalid="ignore"):
-        inside = trusted & (px[:, 0] >= margin) & (px[:, 0] <= w - margin) & (px[:, 1] >= margin) & \
-            (px[:, 1] <= h - margin)
-    centrality = np.hypot(px[:, 0] - 0.5 * w, px[:, 1] - 0.5 * h) / (0.5 * math.hypot(w, h))
-    return px, inside, centrality
+    """(pixels (N, 2), inside (N,), centrality (N,)) of model points in image ``im``: the one rule of
+    ``geometry.camera.project_in_image`` (in front, within the lens model's trusted radius, inside the frame by
+    ``margin`` pixels; centrality 0 at the centre, 1 at a corner)."""
+    return project_in_image(rec.cameras[im.camera_id], im.cam_from_world().matrix(), xyz_model, margin)
 
 
 def block_extent(rec, frame: Frame):
