@@ -214,9 +214,9 @@ def test_the_dialog_the_errors_and_cancel(dock, ws, scene, tmp_path, monkeypatch
     dlg = gcp_targets.FindTargetsDialog(dock, ws, "EPSG:32611")
     dlg.file.setFilePath(csv)
     dlg.kind.setCurrentIndex(dlg.kind.findData("checkerboard"))
-    dlg.size.setValue(0.5)
+    dlg.size_spin.setValue(0.5)
     assert dlg.values() == (csv, "checkerboard", 0.5)
-    dlg.size.setValue(0.0)
+    dlg.size_spin.setValue(0.0)
     assert dlg.values()[2] is None  # shown as "unknown"
     asked = []
     monkeypatch.setattr(gcp_targets.FindTargetsDialog, "exec", lambda self: QDialog.DialogCode.Accepted)

@@ -91,13 +91,13 @@ class FindTargetsDialog(QDialog):
             self.kind.addItem(translate("GcpDock", "auto (crosses, checkerboards, circles, ArUco 4x4)")
                               if k == "auto" else k, k)
         form.addRow(translate("GcpDock", "Target kind:"), self.kind)
-        self.size = QDoubleSpinBox(self)
-        self.size.setRange(0.0, 100.0)
-        self.size.setDecimals(3)
-        self.size.setSuffix(" m")
-        self.size.setSpecialValueText(translate("GcpDock", "unknown"))
-        self.size.setToolTip(translate("GcpDock", "The target's side or diameter: marks of another size are left out"))
-        form.addRow(translate("GcpDock", "Target size:"), self.size)
+        self.size_spin = QDoubleSpinBox(self)
+        self.size_spin.setRange(0.0, 100.0)
+        self.size_spin.setDecimals(3)
+        self.size_spin.setSuffix(" m")
+        self.size_spin.setSpecialValueText(translate("GcpDock", "unknown"))
+        self.size_spin.setToolTip(translate("GcpDock", "The target's side or diameter: marks of another size are left out"))
+        form.addRow(translate("GcpDock", "Target size:"), self.size_spin)
         lay.addLayout(form)
         note = QLabel(translate("GcpDock", "A file that names no CRS is read in {}.").format(crs) if crs else
                       translate("GcpDock", "The file must name its CRS (the table and the workspace have none)."))
@@ -110,7 +110,7 @@ class FindTargetsDialog(QDialog):
 
     def values(self):
         """(path, kind, target size or None)."""
-        return self.file.filePath(), self.kind.currentData(), (self.size.value() or None)
+        return self.file.filePath(), self.kind.currentData(), (self.size_spin.value() or None)
 
 
 class FoundKeys(QObject):
