@@ -699,9 +699,9 @@ def test_processing_algorithms(scene, plugin, tmp_path):
 
 
 def test_image_window_reads_pixel_interleaved_and_remaps_views(tmp_path):
-    """_read_window gives (rows, cols, bands) as the file holds them (1, 3 and 5 bands, 8 and 16 bit), and _remap
+    """_read_window gives (rows, cols, bands) as the file holds them (1, 3 and 5 bands, 8 and 16 bit), and remap_photo
     of a window view (not contiguous: no copy is made of it) equals that of a copy, pixel for pixel."""
-    from core.ortho.pixels import _read_window, _remap
+    from core.ortho.pixels import _read_window, remap_photo
 
     rng = np.random.default_rng(3)
     for bands, dtype, gdt in ((1, np.uint8, gdal.GDT_Byte), (3, np.uint8, gdal.GDT_Byte),
@@ -718,6 +718,6 @@ def test_image_window_reads_pixel_interleaved_and_remaps_views(tmp_path):
         view = _read_window(path, 0, 0, 60, 40)[5:31, 7:50]
         assert not view.flags["C_CONTIGUOUS"]
         mx, my = rng.uniform(0, 42, 500), rng.uniform(0, 25, 500)
-        assert np.array_equal(_remap(view, mx, my, "bilinear"), _remap(np.ascontiguousarray(view), mx, my, "bilinear"))
-        got = _remap(view, np.array([3.0, 40.0]), np.array([2.0, 20.0]), "nearest")
+        assert np.array_equal(remap_photo(view, mx, my, "bilinear"), remap_photo(np.ascontiguousarray(view), mx, my, "bilinear"))
+        got = remap_photo(view, np.array([3.0, 40.0]), np.array([2.0, 20.0]), "nearest")
         assert np.array_equal(got, np.stack([view[2, 3], view[20, 40]]).astype(np.float32))

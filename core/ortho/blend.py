@@ -9,7 +9,7 @@ import numpy as np
 from ..common.errors import require
 
 
-def _multiband(layers, fill_vals: np.ndarray, filled: np.ndarray, h: int, w: int, bands: int) -> np.ndarray:
+def multiband_blend(layers, fill_vals: np.ndarray, filled: np.ndarray, h: int, w: int, bands: int) -> np.ndarray:
     """Laplacian-pyramid blending of the layers (values, valid, weight) plus the hard fill."""
     cv2 = require("cv2", "orthophotos")
 

@@ -11,17 +11,17 @@ import numpy as np
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..io import raster as dsmmod
 from .cameras import OrthoCamera
-from .grid import _cell_centres, _fmt_box, _nice, _subgrid, _tiles, _union
+from .grid import box_union, cell_centre_coords, format_box, grid_tiles, nice_number, subgrid
 from .options import OrthoError, OrthoOptions
 from .pixels import ImageMeta, image_meta
 from .sampling import sample_camera
-from .surface import _Dsm
+from .surface import Dsm
 from .visibility import Footprint, Visibility, build_visibility, camera_footprint, resolution_limited
-from .writer import _RasterWriter
+from .writer import RasterWriter
 
 
 @dataclass
-class _Prepared:
+class PreparedBlock:
     cameras: List[OrthoCamera]
     metas: List[ImageMeta]
     footprints: List[Footprint]
@@ -32,9 +32,9 @@ class _Prepared:
     warnings: List[str]
 
 
-def prepare_block(cameras: Sequence[OrthoCamera], dsm: _Dsm, offset: np.ndarray, resolution: float,
+def prepare_block(cameras: Sequence[OrthoCamera], dsm: Dsm, offset: np.ndarray, resolution: float,
                   workdir: str, occlusion: bool = True, height_tolerance: float = 0.0,
-                  progress: Optional[Progress] = None, gsd_factor: float = 0.0) -> _Prepared:
+                  progress: Optional[Progress] = None, gsd_factor: float = 0.0) -> PreparedBlock:
     """Footprints, the output grid and per-image visibility tables; checks the DSM against the images.
     ``gsd_factor`` > 0: each image is used only where its ground resolution is within that factor of its best
     (its footprint trimmed, OrthoCamera.max_gsd set on a copy)."""
@@ -56,13 +56,13 @@ def prepare_block(cameras: Sequence[OrthoCamera], dsm: _Dsm, offset: np.ndarray,
     z0, _, _ = dsm.coarse(box0, 400_000)
     if z0.size == 0:
         raise OrthoError(
-            f"the DSM {dsm.path} does not cover the images: its extent {_fmt_box(dsm.bounds)} and the cameras' area "
-            f"{_fmt_box(box0)} (in {dsm.crs or 'the DSM CRS'}) do not overlap. Use a DSM of this area"
+            f"the DSM {dsm.path} does not cover the images: its extent {format_box(dsm.bounds)} and the cameras' area "
+            f"{format_box(box0)} (in {dsm.crs or 'the DSM CRS'}) do not overlap. Use a DSM of this area"
             + (" (or check the CRS: the DSM was reprojected)" if dsm.reprojected else ""))
     zf = z0[np.isfinite(z0)]
     if zf.size == 0:
         raise OrthoError(f"the DSM {dsm.path} has no valid height (all nodata) where the images are "
-                         f"({_fmt_box(box0)}): it cannot orthorectify them")
+                         f"({format_box(box0)}): it cannot orthorectify them")
     z_lo, z_hi = float(np.percentile(zf, 0.5)), float(np.percentile(zf, 99.9))
     below = [c.name for c, p in zip(cameras, centres) if p[2] <= z_hi]
     if below and len(below) == len(cameras):
@@ -92,7 +92,7 @@ def prepare_block(cameras: Sequence[OrthoCamera], dsm: _Dsm, offset: np.ndarray,
     if max(covered) == 0.0:
         raise OrthoError(
             f"the DSM {dsm.path} does not cover the images: no valid height under any of the {len(cams)} images' "
-            f"footprints (DSM extent {_fmt_box(dsm.bounds)}, images {_fmt_box(_union(f.bbox for f in fps))})")
+            f"footprints (DSM extent {format_box(dsm.bounds)}, images {format_box(box_union(f.bbox for f in fps))})")
     poor = [c.name for c, f in zip(cams, covered) if f < 0.5]
     if poor:
         warnings.append(f"the DSM covers less than half of the footprint of {len(poor)} image(s) "
@@ -109,8 +109,8 @@ def prepare_block(cameras: Sequence[OrthoCamera], dsm: _Dsm, offset: np.ndarray,
         metas.append(m)
     # grid
     gsd = float(np.median([f.gsd for f in fps]))
-    res = float(resolution) if resolution and resolution > 0 else _nice(gsd)
-    box = _union(f.bbox for f in fps)
+    res = float(resolution) if resolution and resolution > 0 else nice_number(gsd)
+    box = box_union(f.bbox for f in fps)
     zc, gx, gy = dsm.coarse(box, 1_000_000)
     ok = np.isfinite(zc)
     if not ok.any():
@@ -133,10 +133,10 @@ def prepare_block(cameras: Sequence[OrthoCamera], dsm: _Dsm, offset: np.ndarray,
     vis: List[Optional[Visibility]] = [None] * len(cams)
     if occlusion:
         _visibility_tables(cams, fps, offset, dsm, tol, workdir, vis, progress)
-    return _Prepared(cams, metas, fps, vis, grid, gsd, (z_lo, z_hi), warnings)
+    return PreparedBlock(cams, metas, fps, vis, grid, gsd, (z_lo, z_hi), warnings)
 
 
-def _visibility_tables(cams, fps, offset, dsm: _Dsm, tol: float, workdir: str, out: List[Optional[Visibility]],
+def _visibility_tables(cams, fps, offset, dsm: Dsm, tol: float, workdir: str, out: List[Optional[Visibility]],
                        progress: Progress) -> None:
     """The visibility tables into ``out``, on one thread per core (at most 4): numpy and OpenCV release the GIL on
     the tables' arrays and the DSM's window reads take turns (toledo_2400: 57 tables, 17 s on one core)."""
@@ -173,7 +173,7 @@ def _limit_resolution(cams: Sequence[OrthoCamera], fps: Sequence[Footprint], off
     return out_c, out_f
 
 
-def _check_kind(metas: Sequence[ImageMeta], cams: Sequence[OrthoCamera]) -> Tuple[int, str]:
+def check_kind(metas: Sequence[ImageMeta], cams: Sequence[OrthoCamera]) -> Tuple[int, str]:
     kinds = {}
     for m, c in zip(metas, cams):
         kinds.setdefault((m.bands, m.dtype), []).append(c.name)
@@ -186,25 +186,25 @@ def _check_kind(metas: Sequence[ImageMeta], cams: Sequence[OrthoCamera]) -> Tupl
     return bands, dtype
 
 
-def write_camera_ortho(cam: OrthoCamera, meta: ImageMeta, vis: Optional[Visibility], fp: Footprint, dsm: _Dsm,
+def write_camera_ortho(cam: OrthoCamera, meta: ImageMeta, vis: Optional[Visibility], fp: Footprint, dsm: Dsm,
                        offset: np.ndarray, grid: dsmmod.Grid, crs: Optional[str], out_path: str,
                        options: OrthoOptions, progress: Optional[Progress] = None) -> Optional[Dict[str, Any]]:
     """One image's true orthophoto on the cells of ``grid`` under its footprint, as a COG.  Returns the
     sub-grid and valid fraction, or None when the image covers no cell."""
     progress = progress or NullProgress()
-    sub = _subgrid(grid, fp.bbox)
+    sub = subgrid(grid, fp.bbox)
     if sub is None:
         return None
     r0, c0, h, w = sub
     g = dsmmod.Grid(grid.x0 + c0 * grid.resolution, grid.y0 - r0 * grid.resolution, grid.resolution, w, h)
     work = os.path.join(os.path.dirname(os.path.abspath(out_path)), ".work-" + os.path.basename(out_path))
-    writer = _RasterWriter(work, w, h, meta.bands, meta.dtype, g.geotransform, crs)
+    writer = RasterWriter(work, w, h, meta.bands, meta.dtype, g.geotransform, crs)
     n_valid = 0
     try:
-        tiles = _tiles(w, h, options.tile)
+        tiles = grid_tiles(w, h, options.tile)
         for k, (tr, tc, th, tw) in enumerate(tiles):
             check_cancel(progress)
-            x, y = _cell_centres(g, tr, tc, th, tw)
+            x, y = cell_centre_coords(g, tr, tc, th, tw)
             z = dsm.sample(x, y)
             s = sample_camera(cam, meta, offset, x, y, z, vis, options.interpolation)
             writer.write(tr, tc, s.values.reshape(th, tw, -1), s.valid.reshape(th, tw))

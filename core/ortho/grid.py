@@ -10,19 +10,19 @@ from ..io import raster as dsmmod
 from .options import OrthoError
 
 
-def _tiles(width: int, height: int, tile: int) -> List[Tuple[int, int, int, int]]:
+def grid_tiles(width: int, height: int, tile: int) -> List[Tuple[int, int, int, int]]:
     return [(r, c, min(tile, height - r), min(tile, width - c)) for r in range(0, height, tile)
             for c in range(0, width, tile)]
 
 
-def _cell_centres(grid: dsmmod.Grid, r0: int, c0: int, h: int, w: int) -> Tuple[np.ndarray, np.ndarray]:
+def cell_centre_coords(grid: dsmmod.Grid, r0: int, c0: int, h: int, w: int) -> Tuple[np.ndarray, np.ndarray]:
     xs = grid.x0 + (c0 + np.arange(w) + 0.5) * grid.resolution
     ys = grid.y0 - (r0 + np.arange(h) + 0.5) * grid.resolution
     gx, gy = np.meshgrid(xs, ys)
     return gx.ravel(), gy.ravel()
 
 
-def _subgrid(grid: dsmmod.Grid, bbox: Tuple[float, float, float, float]) -> Optional[Tuple[int, int, int, int]]:
+def subgrid(grid: dsmmod.Grid, bbox: Tuple[float, float, float, float]) -> Optional[Tuple[int, int, int, int]]:
     """(row0, col0, height, width) of the cells of ``grid`` covering ``bbox``, clipped; None if disjoint."""
     res = grid.resolution
     c0 = max(0, int(math.floor((bbox[0] - grid.x0) / res)))
@@ -34,11 +34,11 @@ def _subgrid(grid: dsmmod.Grid, bbox: Tuple[float, float, float, float]) -> Opti
     return r0, c0, r1 - r0, c1 - c0
 
 
-def _box_intersects(a, b) -> bool:
+def box_intersects(a, b) -> bool:
     return not (a[2] <= b[0] or a[0] >= b[2] or a[3] <= b[1] or a[1] >= b[3])
 
 
-def _nice(gsd: float) -> float:
+def nice_number(gsd: float) -> float:
     """GSD rounded to 2 significant digits."""
     if gsd <= 0 or not math.isfinite(gsd):
         raise OrthoError(f"cannot derive a resolution from a ground sample distance of {gsd}")
@@ -46,10 +46,10 @@ def _nice(gsd: float) -> float:
     return round(gsd / 10 ** e) * 10 ** e
 
 
-def _union(boxes: Iterable[Tuple[float, float, float, float]]) -> Tuple[float, float, float, float]:
+def box_union(boxes: Iterable[Tuple[float, float, float, float]]) -> Tuple[float, float, float, float]:
     b = np.array(list(boxes), dtype=float)
     return float(b[:, 0].min()), float(b[:, 1].min()), float(b[:, 2].max()), float(b[:, 3].max())
 
 
-def _fmt_box(b) -> str:
+def format_box(b) -> str:
     return f"[{b[0]:.1f}, {b[1]:.1f}] - [{b[2]:.1f}, {b[3]:.1f}]"

@@ -17,17 +17,17 @@ from ..common.files import owned_tempdir
 from ..common.progress import NullProgress, Progress, SubProgress
 from ..geometry.crs import unit_symbol
 from ..io import raster as dsmmod
-from .block import _check_kind, _Prepared, prepare_block, write_camera_ortho
+from .block import PreparedBlock, check_kind, prepare_block, write_camera_ortho
 from .cameras import OrthoCamera
-from .grid import _box_intersects, _tiles
+from .grid import box_intersects, grid_tiles
 from .options import OrthoOptions
-from .pixels import _CACHE
+from .pixels import PHOTO_CACHE
 from .radiometry_fit import fit_radiometry
 from .seamlines import read_seamline_edits, write_seamlines
-from .seams import _Plan, _plan_mosaic
-from .surface import _Dsm, fill_dsm_gaps
-from .tiles import _DSM_CACHE, _render_tile, _TileUnit
-from .writer import _gdal_cache, _RasterWriter
+from .seams import MosaicPlan, plan_mosaic
+from .surface import Dsm, fill_dsm_gaps
+from .tiles import DSM_CACHE, TileUnit, render_tile
+from .writer import RasterWriter, gdal_cache
 
 # the work folders of a run, beside its output (a killed run's are removed by the next: files.clean_debris)
 WORK_PREFIX = ".ortho-work-"
@@ -72,12 +72,12 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
     out_dir = os.path.dirname(os.path.abspath(output))
     os.makedirs(out_dir, exist_ok=True)
     workdir = owned_tempdir(WORK_PREFIX, out_dir)
-    _CACHE.max_bytes = options.cache_mb << 20
+    PHOTO_CACHE.max_bytes = options.cache_mb << 20
     source_dsm = dsm_path
     try:
         dsm_path, filled = fill_dsm_gaps(dsm_path, os.path.join(workdir, "dsm-gaps-filled.tif"),
                                          options.fill_dsm_gaps_m)
-        dsm = _Dsm(dsm_path, crs, name=source_dsm)
+        dsm = Dsm(dsm_path, crs, name=source_dsm)
     except BaseException:
         shutil.rmtree(workdir, ignore_errors=True)
         raise
@@ -87,7 +87,7 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
                    "file is unchanged)")
         progress.info(log[-1])
     try:
-        with _gdal_cache(64):
+        with gdal_cache(64):
             t0 = time.time()
             prep = prepare_block(cameras, dsm, offset, options.resolution, workdir, options.occlusion,
                                  options.height_tolerance, SubProgress(progress, 0.0, 0.12),
@@ -96,7 +96,7 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
                 progress.warning(w_)
             if dsm.reprojected:
                 log.append(f"DSM {source_dsm} reprojected on the fly into {crs}")
-            bands, dtype = _check_kind(prep.metas, prep.cameras)
+            bands, dtype = check_kind(prep.metas, prep.cameras)
             grid = prep.grid
             timings["visibility"] = time.time() - t0
             unit = unit_symbol(crs)
@@ -104,7 +104,7 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
                        f"cells at {grid.resolution:g} {unit} ({bands} band(s) {dtype}), blending {options.blending}")
             progress.info(log[-1])
             t0 = time.time()
-            plan = _plan_mosaic(prep, dsm, offset, options, workdir, SubProgress(progress, 0.12, 0.2), edits)
+            plan = plan_mosaic(prep, dsm, offset, options, workdir, SubProgress(progress, 0.12, 0.2), edits)
             timings["planning"] = time.time() - t0
             log.append(f"seamlines: planned on cells of {plan.k * grid.resolution:.3g} m ({plan.k} mosaic cells); "
                        f"{plan.relief_blobs} raised objects, {plan.relief_reassigned} given whole to one "
@@ -151,12 +151,12 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
                                 log_lines=log)
     finally:
         dsm.close()
-        _DSM_CACHE.clear()
-        _CACHE.clear()
+        DSM_CACHE.clear()
+        PHOTO_CACHE.clear()
         shutil.rmtree(workdir, ignore_errors=True)
 
 
-def _radiometry(prep: _Prepared, dsm: _Dsm, offset, plan: _Plan, options: OrthoOptions, log: List[str],
+def _radiometry(prep: PreparedBlock, dsm: Dsm, offset, plan: MosaicPlan, options: OrthoOptions, log: List[str],
                 timings: Dict[str, float], progress: Progress):
     """The radiometric model (core.ortho.radiometry_fit) when asked for, its lines in ``log``; with a model
     the plan's exposure gains become the model's gains at the images' centres (the which-image layer's)."""
@@ -175,18 +175,18 @@ def _radiometry(prep: _Prepared, dsm: _Dsm, offset, plan: _Plan, options: OrthoO
     return model, dict(model.summary)
 
 
-def _run_tiles(prep: _Prepared, plan: _Plan, dsm_path: str, crs, offset, output: str, options: OrthoOptions,
+def _run_tiles(prep: PreparedBlock, plan: MosaicPlan, dsm_path: str, crs, offset, output: str, options: OrthoOptions,
                bands: int, dtype: str, progress: Progress, radiometry=None) -> Tuple[int, int]:
     grid = prep.grid
     work = os.path.join(os.path.dirname(os.path.abspath(output)), ".work-" + os.path.basename(output))
-    writer = _RasterWriter(work, grid.width, grid.height, bands, dtype, grid.geotransform, crs)
+    writer = RasterWriter(work, grid.width, grid.height, bands, dtype, grid.geotransform, crs)
     halo = 0
     if options.blending == "multiband":
         halo = 64
     labels = np.load(plan.labels_path, mmap_mode="r")
     units = []
     k = plan.k
-    for i, (r0, c0, h, w) in enumerate(_tiles(grid.width, grid.height, options.tile)):
+    for i, (r0, c0, h, w) in enumerate(grid_tiles(grid.width, grid.height, options.tile)):
         m = plan.feather_cells + 1 + (halo // k + 1)
         pr0, pc0 = max(0, r0 // k - m), max(0, c0 // k - m)
         pr1, pc1 = min(plan.height, (r0 + h - 1) // k + 1 + m), min(plan.width, (c0 + w - 1) // k + 1 + m)
@@ -194,12 +194,12 @@ def _run_tiles(prep: _Prepared, plan: _Plan, dsm_path: str, crs, offset, output:
         tb = (grid.x0 + c0 * grid.resolution, grid.y0 - (r0 + h) * grid.resolution,
               grid.x0 + (c0 + w) * grid.resolution, grid.y0 - r0 * grid.resolution)
         cx, cy = 0.5 * (tb[0] + tb[2]), 0.5 * (tb[1] + tb[3])
-        others = [j for j, fp in enumerate(prep.footprints) if j not in present and _box_intersects(fp.bbox, tb)]
+        others = [j for j, fp in enumerate(prep.footprints) if j not in present and box_intersects(fp.bbox, tb)]
         others.sort(key=lambda j: math.hypot(prep.cameras[j].centre[0] + offset[0] - cx,
                                              prep.cameras[j].centre[1] + offset[1] - cy))
         if not present and not others:
             continue
-        units.append(_TileUnit(i, r0, c0, h, w, halo, asdict(grid), dsm_path, crs, [float(v) for v in offset],
+        units.append(TileUnit(i, r0, c0, h, w, halo, asdict(grid), dsm_path, crs, [float(v) for v in offset],
                                prep.cameras, prep.metas, prep.visibility, present, others, plan.gains,
                                plan.labels_path, k, (plan.height, plan.width), plan.feather_cells, options.blending,
                                options.interpolation, options.cache_mb, radiometry, fill_hidden=options.fill_hidden))
@@ -209,7 +209,7 @@ def _run_tiles(prep: _Prepared, plan: _Plan, dsm_path: str, crs, offset, output:
     try:
         workers = options.workers if options.workers and options.workers > 0 else 0
         with parallel.make_executor(workers, "auto", options.scheduler) as ex:
-            for _i, res in parallel.run_units(ex, _render_tile, units, progress, label="tile"):
+            for _i, res in parallel.run_units(ex, render_tile, units, progress, label="tile"):
                 writer.write(res["r0"], res["c0"], res["values"], res["valid"])
                 n_valid += int(res["valid"].sum())
                 fill += res["fill_cells"]
@@ -242,7 +242,7 @@ def _trim_heap() -> None:
         _LIBC.malloc_trim(0)
 
 
-def _write_sources_gpkg(path: str, labels: np.ndarray, prep: _Prepared, plan: _Plan, crs: Optional[str]) -> str:
+def _write_sources_gpkg(path: str, labels: np.ndarray, prep: PreparedBlock, plan: MosaicPlan, crs: Optional[str]) -> str:
     """One polygon per image of the part of the mosaic it gives (the seamlines are their borders): editable, and
     taken back by Build orthophoto's SEAMLINES_IN (core.ortho.seamlines)."""
     grid = prep.grid

@@ -51,7 +51,7 @@ class OrthoOptions:
     gsd_factor: float = 3.0
     compress: str = "DEFLATE"
     # decoded images kept in memory per tile worker (the visibility tables are memory-mapped from their files,
-    # core.ortho.visibility._table): 768 MB holds toledo_2400's 57 photos
+    # core.ortho.visibility.visibility_table): 768 MB holds toledo_2400's 57 photos
     # (13 MB each decoded); at 256 they pushed each other out (orthomosaic 308 -> 255 CPU s, tree peak 1,153 ->
     # 1,735 MiB); small photos never fill it
     cache_mb: int = 768

@@ -27,7 +27,7 @@ def _orientation_key(name: str) -> Optional[str]:
     return None
 
 
-def _normalise_orientation(d: Dict[str, Any], source: str, exterior: bool = True) -> Dict[str, Any]:
+def normalise_orientation(d: Dict[str, Any], source: str, exterior: bool = True) -> Dict[str, Any]:
     out: Dict[str, Any] = {}
     for k, v in d.items():
         key = _orientation_key(str(k))
@@ -82,8 +82,8 @@ def read_orientation(path: str, image_name: Optional[str] = None, exterior: bool
                 raise OrthoError(f"{path} holds no orientation for {image_name} (images: {', '.join(list(rows)[:6])})")
             merged = {k: v for k, v in d.items() if k != "images"}
             merged.update(hit[0])
-            return _normalise_orientation(merged, path, exterior)
-        return _normalise_orientation(d, path, exterior)
+            return normalise_orientation(merged, path, exterior)
+        return normalise_orientation(d, path, exterior)
     crs = None
     header: Optional[List[str]] = None
     rows: List[List[str]] = []
@@ -128,4 +128,4 @@ def read_orientation(path: str, image_name: Optional[str] = None, exterior: bool
     d = dict(hit[0])
     if crs and "crs" not in {_orientation_key(k) for k in d}:
         d["crs"] = crs
-    return _normalise_orientation(d, path, exterior)
+    return normalise_orientation(d, path, exterior)

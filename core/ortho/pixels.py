@@ -37,11 +37,11 @@ class _LRU:
         self.size = 0
 
 
-_CACHE = _LRU(OrthoOptions.cache_mb << 20)  # each stage sets its options.cache_mb
+PHOTO_CACHE = _LRU(OrthoOptions.cache_mb << 20)  # each stage sets its options.cache_mb
 _WHOLE_IMAGE_MAX = 96 << 20  # images up to this size are decoded whole and cached; larger ones read by window
 
 
-def _gdal():
+def load_gdal():
     from osgeo import gdal
 
     gdal.UseExceptions()
@@ -57,7 +57,7 @@ class ImageMeta:
 
 
 def image_meta(path: str) -> ImageMeta:
-    gdal = _gdal()
+    gdal = load_gdal()
     from osgeo import gdal_array
 
     try:
@@ -71,7 +71,7 @@ def image_meta(path: str) -> ImageMeta:
 
 
 def _read_window(path: str, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
-    gdal = _gdal()
+    gdal = load_gdal()
     from osgeo import gdal_array
 
     ds = gdal.Open(path)
@@ -85,15 +85,15 @@ def _read_window(path: str, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
     return np.frombuffer(bytearray(buf) if isinstance(buf, bytes) else buf, dtype=dtype).reshape(h, w, bands)
 
 
-def _image_window(path: str, meta: ImageMeta, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
+def image_window(path: str, meta: ImageMeta, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
     nbytes = meta.width * meta.height * meta.bands * np.dtype(meta.dtype).itemsize
     if nbytes <= _WHOLE_IMAGE_MAX:
-        whole = _CACHE.get(("img", path), lambda: (_read_window(path, 0, 0, meta.width, meta.height), nbytes))
+        whole = PHOTO_CACHE.get(("img", path), lambda: (_read_window(path, 0, 0, meta.width, meta.height), nbytes))
         return whole[y0:y1, x0:x1]
     return _read_window(path, x0, y0, x1, y1)
 
 
-def _mask(path: Optional[str]) -> Optional[np.ndarray]:
+def photo_mask(path: Optional[str]) -> Optional[np.ndarray]:
     if not path:
         return None
 
@@ -104,13 +104,13 @@ def _mask(path: Optional[str]) -> Optional[np.ndarray]:
         if m is None:
             raise OrthoError(f"mask {path} cannot be read")
         return m, m.nbytes
-    return _CACHE.get(("mask", path), make)
+    return PHOTO_CACHE.get(("mask", path), make)
 
 
 _CV_TYPES = ("uint8", "uint16", "int16", "float32")
 
 
-def _remap(src: np.ndarray, mx: np.ndarray, my: np.ndarray, interpolation: str, border_nan: bool = False
+def remap_photo(src: np.ndarray, mx: np.ndarray, my: np.ndarray, interpolation: str, border_nan: bool = False
            ) -> np.ndarray:
     """cv2.remap of 1-D coordinate arrays (rows of 1024, as remap wants short sides) -> (N, bands) float32."""
     cv2 = require("cv2", "orthophotos")

@@ -13,11 +13,11 @@ from ..geometry import resection as rs
 from ..geometry.camera import Intrinsics
 from ..io import raster as dsmmod
 from .cameras import OrthoCamera
-from .grid import _cell_centres, _nice, _tiles
+from .grid import cell_centre_coords, grid_tiles, nice_number
 from .options import OrthoError, OrthoOptions
-from .pixels import ImageMeta, _image_window, _mask, _remap
-from .surface import _Dsm
-from .writer import _RasterWriter
+from .pixels import ImageMeta, image_window, photo_mask, remap_photo
+from .surface import Dsm
+from .writer import RasterWriter
 
 
 @dataclass
@@ -33,8 +33,8 @@ def _undistorted_px(cam: Intrinsics, px: np.ndarray) -> np.ndarray:
     return np.stack([cam.fx * xn[..., 0] + cam.cx, cam.fy * xn[..., 1] + cam.cy], axis=-1)
 
 
-def _planar(ocam: OrthoCamera, meta: ImageMeta, pairs, control, xyz, px_all, offset: np.ndarray,
-            dsm: Optional[_Dsm], options: OrthoOptions, output: str, crs: Optional[str],
+def rectify_planar(ocam: OrthoCamera, meta: ImageMeta, pairs, control, xyz, px_all, offset: np.ndarray,
+            dsm: Optional[Dsm], options: OrthoOptions, output: str, crs: Optional[str],
             residuals: List[Dict[str, Any]], log: List[str], warn: Callable[[str], None], progress: Progress
             ) -> PlanarResult:
     """Projective rectification through the control points; with a DSM, how far it is off from the truth.
@@ -90,7 +90,7 @@ def _planar_grid(hom, cam: Intrinsics, name: str, offset: np.ndarray, resolution
     jac_d = 1.0
     c0 = hom.world_from_pixel(np.array([[cam.cx, cam.cy], [cam.cx + jac_d, cam.cy], [cam.cx, cam.cy + jac_d]]))
     gsd = math.sqrt(abs(np.cross(c0[1] - c0[0], c0[2] - c0[0])))
-    res = resolution if resolution > 0 else _nice(gsd)
+    res = resolution if resolution > 0 else nice_number(gsd)
     grid = dsmmod.Grid.covering(float(corners[:, 0].min()), float(corners[:, 1].min()), float(corners[:, 0].max()),
                                 float(corners[:, 1].max()), res, what="planar rectification")
     if grid.width * grid.height > 400_000_000:
@@ -103,13 +103,13 @@ def _write_planar(hom, ocam: OrthoCamera, meta: ImageMeta, grid: dsmmod.Grid, of
     """Write the rectified image as a COG at ``output``; returns the number of cells with data."""
     cam = ocam.camera
     work = os.path.join(os.path.dirname(os.path.abspath(output)), ".work-" + os.path.basename(output))
-    writer = _RasterWriter(work, grid.width, grid.height, meta.bands, meta.dtype, grid.geotransform, crs)
+    writer = RasterWriter(work, grid.width, grid.height, meta.bands, meta.dtype, grid.geotransform, crs)
     n_valid = 0
     try:
-        tiles = _tiles(grid.width, grid.height, options.tile)
+        tiles = grid_tiles(grid.width, grid.height, options.tile)
         for k, (r0, c0_, h, w) in enumerate(tiles):
             check_cancel(progress)
-            x, y = _cell_centres(grid, r0, c0_, h, w)
+            x, y = cell_centre_coords(grid, r0, c0_, h, w)
             pu = hom.pixel_from_world(np.column_stack([x - offset[0], y - offset[1]]))
             xn = np.column_stack([(pu[:, 0] - cam.cx) / cam.fx, (pu[:, 1] - cam.cy) / cam.fy])
             ok = cam.valid_normalized(xn)
@@ -122,9 +122,9 @@ def _write_planar(hom, ocam: OrthoCamera, meta: ImageMeta, grid: dsmmod.Grid, of
                 u, v = px[idx, 0] - 0.5, px[idx, 1] - 0.5
                 xa, ya = max(0, int(u.min()) - 3), max(0, int(v.min()) - 3)
                 xb, yb = min(meta.width, int(u.max()) + 4), min(meta.height, int(v.max()) + 4)
-                win = _image_window(ocam.path, meta, xa, ya, xb, yb)
-                vals[idx] = _remap(win, u - xa, v - ya, options.interpolation)
-                mask = _mask(ocam.mask_path)
+                win = image_window(ocam.path, meta, xa, ya, xb, yb)
+                vals[idx] = remap_photo(win, u - xa, v - ya, options.interpolation)
+                mask = photo_mask(ocam.mask_path)
                 if mask is not None:
                     ok[idx] &= mask[np.clip(px[idx, 1].astype(int), 0, mask.shape[0] - 1),
                                     np.clip(px[idx, 0].astype(int), 0, mask.shape[1] - 1)] >= 128
@@ -139,7 +139,7 @@ def _write_planar(hom, ocam: OrthoCamera, meta: ImageMeta, grid: dsmmod.Grid, of
     return n_valid
 
 
-def _planar_error(hom, ocam: OrthoCamera, grid: dsmmod.Grid, offset: np.ndarray, dsm: _Dsm
+def _planar_error(hom, ocam: OrthoCamera, grid: dsmmod.Grid, offset: np.ndarray, dsm: Dsm
                   ) -> Optional[Dict[str, float]]:
     """Displacement of planar rectification against the true geometry: ground (X, Y, DSM) -> image (pose) ->
     plane (homography); the difference is where the plane puts what truly lies at (X, Y).  None if the DSM

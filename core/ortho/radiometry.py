@@ -20,10 +20,10 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .block import _Prepared
+from .block import PreparedBlock
 from .cameras import OrthoCamera
 from .sampling import sample_camera
-from .surface import _Dsm
+from .surface import Dsm
 
 FIELD_TERMS = 6  # 1, u, v, u^2, uv, v^2
 MAX_CORRECTION = 2.0  # the correction stays within 1 / this .. this
@@ -133,7 +133,7 @@ def point_gains(model: Optional[RadiometryModel], gain: float, index: int, cam: 
     return out
 
 
-def _scale(dtype: str) -> float:
+def dtype_scale(dtype: str) -> float:
     dt = np.dtype(dtype)
     return float(np.iinfo(dt).max) if dt.kind in "ui" else 0.0
 
@@ -154,11 +154,11 @@ def _reduced(cam: OrthoCamera, meta, factor: float) -> np.ndarray:
     """The photo reduced ``factor`` x by area (cv2.INTER_AREA: each pixel the mean of the photo's pixels it
     covers), kept in the image cache."""
     from ..common.errors import require
-    from .pixels import _CACHE, _image_window
+    from .pixels import PHOTO_CACHE, image_window
 
     def make():
         cv2 = require("cv2", "orthophotos")
-        whole = _image_window(cam.path, meta, 0, 0, meta.width, meta.height)
+        whole = image_window(cam.path, meta, 0, 0, meta.width, meta.height)
         w, h = max(1, int(round(meta.width / factor))), max(1, int(round(meta.height / factor)))
         if whole.dtype not in (np.uint8, np.uint16, np.float32):  # the photo's own type where cv2 takes it
             whole = whole.astype(np.float32)
@@ -166,7 +166,7 @@ def _reduced(cam: OrthoCamera, meta, factor: float) -> np.ndarray:
         small = small.reshape(h, w, -1)
         return small, small.nbytes
 
-    return _CACHE.get(("reduced", cam.path, factor), make)
+    return PHOTO_CACHE.get(("reduced", cam.path, factor), make)
 
 
 def sample_grey(cam: OrthoCamera, meta, offset: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, vis,
@@ -178,7 +178,7 @@ def sample_grey(cam: OrthoCamera, meta, offset: np.ndarray, x: np.ndarray, y: np
     the texture under it, and two photos misregistered by a pixel disagree there by the texture's contrast, not by
     their brightness (issue 33 item 4: the seam step of toledo_2400's 2400 px photos read 6.1 %, of their 1200 px
     copies 5.2 %; now 3.2 and 3.3 %)."""
-    from .pixels import _remap
+    from .pixels import remap_photo
 
     n = FOOTPRINT_POINTS if footprint > 0 else 1
     offs = ((np.arange(n) + 0.5) / n - 0.5) * footprint
@@ -201,7 +201,7 @@ def sample_grey(cam: OrthoCamera, meta, offset: np.ndarray, x: np.ndarray, y: np
             idx = np.flatnonzero(s.valid)
             if src is not None and len(idx):
                 sx, sy = src.shape[1] / meta.width, src.shape[0] / meta.height
-                values[idx] = _remap(src, s.px[idx, 0] * sx - 0.5, s.px[idx, 1] * sy - 0.5, "bilinear")
+                values[idx] = remap_photo(src, s.px[idx, 0] * sx - 0.5, s.px[idx, 1] * sy - 0.5, "bilinear")
             grey, ok = _grey_ok(values, s.valid, scale)
             acc += np.where(ok, grey, 0.0)
             good &= ok
@@ -231,7 +231,7 @@ def chunk_disagreement(images_a: np.ndarray, images_b: np.ndarray, cells: np.nda
     return float(math.exp(np.median(meds)) - 1.0)
 
 
-def seam_steps(model: Optional[RadiometryModel], labels: np.ndarray, k: int, prep: _Prepared, dsm: _Dsm,
+def seam_steps(model: Optional[RadiometryModel], labels: np.ndarray, k: int, prep: PreparedBlock, dsm: Dsm,
                offset: np.ndarray, gains: Sequence[float], max_points: int = 60_000) -> Tuple[float, float]:
     """The median brightness step across the seamlines of the plan (``labels``: planning cells of ``k`` output
     cells): at the middle of every edge between two images' cells both images are sampled; per chunk of the
@@ -254,7 +254,7 @@ def seam_steps(model: Optional[RadiometryModel], labels: np.ndarray, k: int, pre
         pick = np.random.default_rng(3).choice(len(x), max_points, replace=False)
         x, y, ia, ib, cell = x[pick], y[pick], ia[pick], ib[pick], cell[pick]
     z = dsm.sample(x, y).astype(np.float64)
-    scale = _scale(prep.metas[0].dtype)
+    scale = dtype_scale(prep.metas[0].dtype)
     raw = {0: np.full(len(x), np.nan), 1: np.full(len(x), np.nan)}
     cor = {0: np.full(len(x), np.nan), 1: np.full(len(x), np.nan)}
     for i in np.unique(np.concatenate([ia, ib])):

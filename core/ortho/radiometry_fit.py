@@ -12,20 +12,20 @@ import numpy as np
 
 from ..common.progress import Progress, check_cancel
 from ..io import raster as dsmmod
-from .block import _Prepared
-from .grid import _cell_centres, _subgrid
+from .block import PreparedBlock
+from .grid import cell_centre_coords, subgrid
 from .radiometry import (
     FIELD_TERMS,
     RadiometryModel,
-    _scale,
     chunk_disagreement,
+    dtype_scale,
     field_terms,
     hot_spot_shape,
     observation_geometry,
     sample_grey,
     seam_steps,
 )
-from .surface import _Dsm
+from .surface import Dsm
 
 SAMPLE_GSD = 4.0  # sample cell = 4 x GSD (at least)
 MAX_SAMPLE_CELLS = 100_000
@@ -50,7 +50,7 @@ class _Obs:
     shape: Tuple[int, int]  # the sample grid (rows, cols)
 
 
-def sample_overlaps(prep: _Prepared, dsm: _Dsm, offset: np.ndarray, progress: Progress,
+def sample_overlaps(prep: PreparedBlock, dsm: Dsm, offset: np.ndarray, progress: Progress,
                     max_cells: int = MAX_SAMPLE_CELLS) -> _Obs:
     """Grey values of every image on a coarse grid of the mosaic, with their image geometry."""
     grid = prep.grid
@@ -58,18 +58,18 @@ def sample_overlaps(prep: _Prepared, dsm: _Dsm, offset: np.ndarray, progress: Pr
                int(math.ceil(math.sqrt(grid.width * grid.height / float(max_cells)))))
     sw, sh = int(math.ceil(grid.width / step)), int(math.ceil(grid.height / step))
     sgrid = dsmmod.Grid(grid.x0, grid.y0, step * grid.resolution, sw, sh)
-    x, y = _cell_centres(sgrid, 0, 0, sh, sw)
+    x, y = cell_centre_coords(sgrid, 0, 0, sh, sw)
     zs = dsm.sample(x, y).reshape(sh, sw)
-    scale = _scale(prep.metas[0].dtype)
+    scale = dtype_scale(prep.metas[0].dtype)
     parts: List[Tuple] = []
     n = len(prep.cameras)
     for i, (cam, meta, fp, vis) in enumerate(zip(prep.cameras, prep.metas, prep.footprints, prep.visibility)):
         check_cancel(progress)
-        sub = _subgrid(sgrid, fp.bbox)
+        sub = subgrid(sgrid, fp.bbox)
         if sub is None:
             continue
         r0, c0, h, w = sub
-        xi, yi = _cell_centres(sgrid, r0, c0, h, w)
+        xi, yi = cell_centre_coords(sgrid, r0, c0, h, w)
         zi = zs[r0:r0 + h, c0:c0 + w].ravel().astype(np.float64)
         grey, ok = sample_grey(cam, meta, offset, xi, yi, zi, vis, sgrid.resolution, scale)
         idx = np.flatnonzero(ok)
@@ -285,13 +285,13 @@ def _fit_model(obs: _Obs, a, b, groups: np.ndarray, n_groups: int, n_images: int
     return model, y2 - x2 @ p2
 
 
-def camera_groups(prep: _Prepared) -> Tuple[np.ndarray, List[int]]:
+def camera_groups(prep: PreparedBlock) -> Tuple[np.ndarray, List[int]]:
     """(group index per image, the camera ids of the groups)."""
     ids = sorted({int(c.camera_id) for c in prep.cameras})
     return np.array([ids.index(int(c.camera_id)) for c in prep.cameras], dtype=np.int64), ids
 
 
-def fit_from_samples(obs: _Obs, prep: _Prepared, hot_spot: bool, progress: Progress
+def fit_from_samples(obs: _Obs, prep: PreparedBlock, hot_spot: bool, progress: Progress
                      ) -> Tuple[Optional[RadiometryModel], Dict[str, object]]:
     """The model fitted on sampled observations, with the overlaps' disagreement before and after; None (and
     the reason in the summary) when the overlaps are too few or the fit does not make them agree better."""
@@ -317,7 +317,7 @@ def fit_from_samples(obs: _Obs, prep: _Prepared, hot_spot: bool, progress: Progr
     return model, summary
 
 
-def fit_radiometry(prep: _Prepared, dsm: _Dsm, offset: np.ndarray, labels: np.ndarray, k: int,
+def fit_radiometry(prep: PreparedBlock, dsm: Dsm, offset: np.ndarray, labels: np.ndarray, k: int,
                    gains: Sequence[float], hot_spot: bool, progress: Progress
                    ) -> Tuple[Optional[RadiometryModel], List[str]]:
     """The radiometric model of the mosaic (None when it is not applied) and its lines for the log; the model's

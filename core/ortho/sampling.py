@@ -9,8 +9,8 @@ from typing import Optional
 import numpy as np
 
 from .cameras import OrthoCamera
-from .pixels import ImageMeta, _image_window, _mask, _remap
-from .visibility import Visibility, _table
+from .pixels import ImageMeta, image_window, photo_mask, remap_photo
+from .visibility import Visibility, visibility_table
 
 
 @dataclass
@@ -33,11 +33,11 @@ def sample_camera(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.n
     ok &= finite
     if vis is not None and ok.any():
         idx = np.flatnonzero(ok)
-        ok[idx] = vis.visible(x[idx], y[idx], z[idx], _table(vis))
+        ok[idx] = vis.visible(x[idx], y[idx], z[idx], visibility_table(vis))
     if cam.max_gsd and ok.any():  # the stretched far field of an oblique: left to the images that see it nearer
         idx = np.flatnonzero(ok)
         ok[idx] = cam.ground_resolution(xyz[idx], (px[idx], depth[idx])) <= cam.max_gsd
-    mask = _mask(cam.mask_path)
+    mask = photo_mask(cam.mask_path)
     if mask is not None and ok.any():
         idx = np.flatnonzero(ok)
         mc = np.clip(px[idx, 0].astype(np.int64), 0, mask.shape[1] - 1)
@@ -62,6 +62,6 @@ def sample_camera(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.n
         y0 = max(0, int(math.floor(v.min())) - pad)
         x1 = min(meta.width, int(math.ceil(u.max())) + pad + 1)
         y1 = min(meta.height, int(math.ceil(v.max())) + pad + 1)
-        win = _image_window(cam.path, meta, x0, y0, x1, y1)
-        values[idx] = _remap(win, u - x0, v - y0, interpolation)
+        win = image_window(cam.path, meta, x0, y0, x1, y1)
+        values[idx] = remap_photo(win, u - x0, v - y0, interpolation)
     return Sampled(values, ok, cost, xyz, px)

@@ -18,7 +18,7 @@ import numpy as np
 from ..common.files import atomic_output
 from ..io import raster as dsmmod
 from .options import OrthoError
-from .pixels import _gdal
+from .pixels import load_gdal
 
 LAYER = "mosaic_sources"
 IMAGE_FIELD = "image"
@@ -134,7 +134,7 @@ def read_seamline_edits(source: str, names: Sequence[str], crs: Optional[str], l
     mosaic's ``extent``)."""
     from osgeo import ogr
 
-    gdal = _gdal()
+    gdal = load_gdal()
     ogr.UseExceptions()
     path, layer_name = _split_source(source)
     if not os.path.isfile(path):
@@ -184,12 +184,12 @@ def _rasterise(wkb: bytes, grid: dsmmod.Grid) -> Optional[Tuple[int, int, np.nda
     """(row0, col0, mask) of the cells of ``grid`` whose centre lies in the polygon; None when none does."""
     from osgeo import ogr
 
-    from .grid import _subgrid
+    from .grid import subgrid
 
-    gdal = _gdal()
+    gdal = load_gdal()
     geom = ogr.CreateGeometryFromWkb(wkb)
     xmin, xmax, ymin, ymax = geom.GetEnvelope()
-    sub = _subgrid(grid, (xmin, ymin, xmax, ymax))
+    sub = subgrid(grid, (xmin, ymin, xmax, ymax))
     if sub is None:
         return None
     r0, c0, h, w = sub
@@ -265,7 +265,7 @@ def write_seamlines(path: str, labels: np.ndarray, grid: dsmmod.Grid, names: Seq
     fields image, camera_id, gain and label, editable and taken back by read_seamline_edits."""
     from osgeo import ogr, osr
 
-    gdal = _gdal()
+    gdal = load_gdal()
     ogr.UseExceptions()
     mem = gdal.GetDriverByName("MEM").Create("", labels.shape[1], labels.shape[0], 1, gdal.GDT_Int32)
     mem.SetGeoTransform((grid.x0, grid.resolution, 0.0, grid.y0, 0.0, -grid.resolution))

@@ -12,12 +12,12 @@ import numpy as np
 from ..common.errors import require
 from ..common.progress import Progress, check_cancel
 from ..io import raster as dsmmod
-from .block import _Prepared
-from .grid import _cell_centres, _subgrid
+from .block import PreparedBlock
+from .grid import cell_centre_coords, subgrid
 from .options import OrthoOptions
 from .sampling import sample_camera
 from .seamlines import SeamlineEdits, force_edits
-from .surface import _Dsm
+from .surface import Dsm
 
 PLANNING_GSD = 4.0  # planning cell = 4 x GSD ...
 # ... and a photo spans at most about this many planning cells (its long side): the plan (which image, seams, raised
@@ -29,7 +29,7 @@ MAX_PLANNING_CELLS = 4096 * 4096
 
 
 @dataclass
-class _Plan:
+class MosaicPlan:
     k: int  # planning cell = k output cells
     width: int
     height: int
@@ -55,8 +55,8 @@ def planning_gsd(metas) -> float:
     return max(PLANNING_GSD, float(np.median(sides)) / PLANNING_MAX_CELLS_ACROSS)
 
 
-def _plan_mosaic(prep: _Prepared, dsm: _Dsm, offset: np.ndarray, options: OrthoOptions, workdir: str,
-                 progress: Progress, edits: Optional[SeamlineEdits] = None) -> _Plan:
+def plan_mosaic(prep: PreparedBlock, dsm: Dsm, offset: np.ndarray, options: OrthoOptions, workdir: str,
+                 progress: Progress, edits: Optional[SeamlineEdits] = None) -> MosaicPlan:
     grid = prep.grid
     k = max(1, int(round(planning_gsd(prep.metas) * prep.gsd / grid.resolution)))
     while math.ceil(grid.width / k) * math.ceil(grid.height / k) > MAX_PLANNING_CELLS:
@@ -69,7 +69,7 @@ def _plan_mosaic(prep: _Prepared, dsm: _Dsm, offset: np.ndarray, options: OrthoO
     rows = max(1, 1_000_000 // pw)
     for r0 in range(0, ph, rows):
         h = min(rows, ph - r0)
-        x, y = _cell_centres(pgrid, r0, 0, h, pw)
+        x, y = cell_centre_coords(pgrid, r0, 0, h, pw)
         zp[r0:r0 + h] = dsm.sample(x, y).reshape(h, pw)
     best = np.full((ph, pw), np.inf, dtype=np.float32)
     labels = np.full((ph, pw), -1, dtype=np.int32)
@@ -79,14 +79,14 @@ def _plan_mosaic(prep: _Prepared, dsm: _Dsm, offset: np.ndarray, options: OrthoO
     n = len(prep.cameras)
     for i, (cam, meta, fp, vis) in enumerate(zip(prep.cameras, prep.metas, prep.footprints, prep.visibility)):
         check_cancel(progress)
-        sub = _subgrid(pgrid, fp.bbox)
+        sub = subgrid(pgrid, fp.bbox)
         windows.append(sub)
         if sub is None:
             costs.append(None)
             greys.append(None)
             continue
         r0, c0, h, w = sub
-        x, y = _cell_centres(pgrid, r0, c0, h, w)
+        x, y = cell_centre_coords(pgrid, r0, c0, h, w)
         z = zp[r0:r0 + h, c0:c0 + w].ravel().astype(np.float64)
         s = sample_camera(cam, meta, offset, x, y, z, vis, "bilinear")
         cost = s.cost.reshape(h, w)
@@ -121,7 +121,7 @@ def _plan_mosaic(prep: _Prepared, dsm: _Dsm, offset: np.ndarray, options: OrthoO
     np.save(os.path.join(workdir, "labels.npy"), labels)
     progress.report(1.0, "mosaic planned")
     feather = max(1, int(round(options.feather_gsd * prep.gsd / (2 * p)))) if options.blending == "feather" else 0
-    return _Plan(k, pw, ph, os.path.join(workdir, "labels.npy"), gains, windows, feather, blobs, reassigned,
+    return MosaicPlan(k, pw, ph, os.path.join(workdir, "labels.npy"), gains, windows, feather, blobs, reassigned,
                  seam_before, seam_after, forced_cells=forced, notes=notes)
 
 

@@ -22,11 +22,11 @@ from .block import prepare_block, write_camera_ortho
 from .cameras import OrthoCamera
 from .mosaic import WORK_PREFIX
 from .options import OrthoError, OrthoOptions, SingleImageOptions
-from .orientation import _normalise_orientation, read_orientation
-from .pixels import _CACHE, ImageMeta, image_meta
-from .planar import _planar
-from .surface import _Dsm
-from .writer import _gdal_cache
+from .orientation import normalise_orientation, read_orientation
+from .pixels import PHOTO_CACHE, ImageMeta, image_meta
+from .planar import rectify_planar
+from .surface import Dsm
+from .writer import gdal_cache
 
 
 @dataclass
@@ -223,7 +223,7 @@ def _orientation_input(orientation, exterior: bool, run: _Run, image_path: str, 
     if orientation is None:
         return None, camera
     orient = (read_orientation(orientation, run.name, exterior=exterior) if isinstance(orientation, str)
-              else _normalise_orientation(dict(orientation), "ORIENTATION", exterior=exterior))
+              else normalise_orientation(dict(orientation), "ORIENTATION", exterior=exterior))
     if "omega" in orient:
         return orient, camera
     interior, meta = orient, run.meta
@@ -436,10 +436,10 @@ def _rectify(result: SingleImageResult, ocam: OrthoCamera, run: _Run, ctl: _Cont
     os.makedirs(out_dir, exist_ok=True)
     clean_debris(out_dir, WORK_PREFIX)
     workdir = owned_tempdir(WORK_PREFIX, out_dir)
-    _CACHE.max_bytes = options.cache_mb << 20
-    dsm = _Dsm(dsm_path, work_crs) if dsm_path else None
+    PHOTO_CACHE.max_bytes = options.cache_mb << 20
+    dsm = Dsm(dsm_path, work_crs) if dsm_path else None
     try:
-        with _gdal_cache(64):
+        with gdal_cache(64):
             if dsm is not None and dsm.reprojected:
                 run.info(f"DSM {dsm_path} reprojected on the fly into the working CRS")
             if mode == "ortho":
@@ -458,7 +458,7 @@ def _rectify(result: SingleImageResult, ocam: OrthoCamera, run: _Run, ctl: _Cont
                     raise OrthoError(f"no cell of the orthophoto of {name} has data: the DSM has no valid height "
                                      "where the image looks")
             else:
-                pr = _planar(ocam, run.meta, ctl.pairs, ctl.control, ctl.xyz, ctl.px, offset, dsm, options,
+                pr = rectify_planar(ocam, run.meta, ctl.pairs, ctl.control, ctl.xyz, ctl.px, offset, dsm, options,
                              result.output, work_crs, result.residuals, run.log, run.warn,
                              SubProgress(progress, 0.1, 1.0))
                 result.planar_rmse_m, result.planar_error = pr.rmse_m, pr.error
@@ -475,7 +475,7 @@ def _rectify(result: SingleImageResult, ocam: OrthoCamera, run: _Run, ctl: _Cont
     finally:
         if dsm is not None:
             dsm.close()
-        _CACHE.clear()
+        PHOTO_CACHE.clear()
         shutil.rmtree(workdir, ignore_errors=True)
 
 

@@ -11,10 +11,10 @@ import numpy as np
 from ..common.errors import require
 from ..io import raster as dsmmod
 from .options import OrthoError
-from .pixels import _remap
+from .pixels import remap_photo
 
 
-class _Dsm:
+class Dsm:
     """Heights from a DSM in the working CRS, in world coordinates (NaN = no height)."""
 
     def __init__(self, path: str, crs: Optional[str], name: Optional[str] = None):
@@ -67,7 +67,7 @@ class _Dsm:
             if arr.shape[0] < 2 or arr.shape[1] < 2 or max(arr.shape) >= 32767:
                 return dsmmod.bilinear(arr, fc, fr)
             # cv2.remap: bilinear, NaN where a neighbour is NaN (like dsm.bilinear), far faster
-            out = _remap(arr32[:, :, None], fc.ravel(), fr.ravel(), "bilinear", border_nan=True)[:, 0]
+            out = remap_photo(arr32[:, :, None], fc.ravel(), fr.ravel(), "bilinear", border_nan=True)[:, 0]
             return out.reshape(x.shape).astype(np.float64)
         return f
 

@@ -10,18 +10,18 @@ import numpy as np
 from ..common.errors import require
 from ..common.progress import Cancelled
 from ..io import raster as dsmmod
-from .blend import _multiband
+from .blend import multiband_blend
 from .cameras import OrthoCamera
-from .grid import _cell_centres
-from .pixels import _CACHE, ImageMeta
+from .grid import cell_centre_coords
+from .pixels import PHOTO_CACHE, ImageMeta
 from .radiometry import RadiometryModel, point_gains
 from .sampling import sample_camera
-from .surface import _Dsm
-from .visibility import Visibility, _table
+from .surface import Dsm
+from .visibility import Visibility, visibility_table
 
 
 @dataclass
-class _TileUnit:
+class TileUnit:
     """Everything one mosaic tile needs (picklable: runs in a pool worker or on a Dask cluster)."""
 
     index: int
@@ -51,22 +51,22 @@ class _TileUnit:
     fill_hidden: bool = True  # a cell hidden from every image takes the least hidden one (no holes)
 
 
-_DSM_CACHE: Dict[Tuple[str, Optional[str]], _Dsm] = {}
+DSM_CACHE: Dict[Tuple[str, Optional[str]], Dsm] = {}
 
 
-def _dsm_for(path: str, crs: Optional[str]) -> _Dsm:
+def _dsm_for(path: str, crs: Optional[str]) -> Dsm:
     key = (path, crs)
-    if key not in _DSM_CACHE:
-        _DSM_CACHE.clear()
-        _DSM_CACHE[key] = _Dsm(path, crs)
-    return _DSM_CACHE[key]
+    if key not in DSM_CACHE:
+        DSM_CACHE.clear()
+        DSM_CACHE[key] = Dsm(path, crs)
+    return DSM_CACHE[key]
 
 
-def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str, Any]:
+def render_tile(unit: TileUnit, cancel_path: Optional[str] = None) -> Dict[str, Any]:
     """Blend one mosaic tile: returns values (h, w, bands) float32, valid (h, w) and which-image counts."""
     cv2 = require("cv2", "orthophotos")
 
-    _CACHE.max_bytes = unit.cache_mb << 20
+    PHOTO_CACHE.max_bytes = unit.cache_mb << 20
     grid = dsmmod.Grid(**unit.grid)
     dsm = _dsm_for(unit.dsm_path, unit.crs)
     off = np.asarray(unit.offset, dtype=float)
@@ -75,7 +75,7 @@ def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str
     ar0, ac0 = max(0, unit.r0 - halo), max(0, unit.c0 - halo)
     ar1, ac1 = min(grid.height, unit.r0 + unit.h + halo), min(grid.width, unit.c0 + unit.w + halo)
     hh, ww = ar1 - ar0, ac1 - ac0
-    x, y = _cell_centres(grid, ar0, ac0, hh, ww)
+    x, y = cell_centre_coords(grid, ar0, ac0, hh, ww)
     z = dsm.sample(x, y)
     bands = unit.metas[0].bands
     labels_all = np.load(unit.labels_path, mmap_mode="r")
@@ -158,7 +158,7 @@ def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str
         filled |= hidden
     valid = (wsum > 1e-6) | filled
     if unit.blending == "multiband":
-        out = _multiband(layers, fill_vals, filled, hh, ww, bands)
+        out = multiband_blend(layers, fill_vals, filled, hh, ww, bands)
     else:
         out = np.zeros((hh * ww, bands), dtype=np.float32)
         ok = wsum > 1e-6
@@ -173,7 +173,7 @@ def _render_tile(unit: _TileUnit, cancel_path: Optional[str] = None) -> Dict[str
             "hidden_cells": int(hidden.reshape(hh, ww)[rr0:rr0 + unit.h, cc0:cc0 + unit.w].sum())}
 
 
-def _fill_hidden(unit: _TileUnit, off: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, left: np.ndarray,
+def _fill_hidden(unit: TileUnit, off: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, left: np.ndarray,
                  fill_vals: np.ndarray, counts: Dict[int, int]) -> np.ndarray:
     """Cells with a height that no image sees (each has them hidden) but that lie inside an image (its frame,
     mask and far-field limit): the value of the image that hides them least (Visibility.hidden_by), so the
@@ -195,7 +195,7 @@ def _fill_hidden(unit: _TileUnit, off: np.ndarray, x: np.ndarray, y: np.ndarray,
             continue
         sel = np.flatnonzero(s.valid)
         depth = np.full(len(idx), np.inf)
-        depth[sel] = vis.hidden_by(x[idx[sel]], y[idx[sel]], z[idx[sel]], _table(vis)) + 1e-3 * s.cost[sel]
+        depth[sel] = vis.hidden_by(x[idx[sel]], y[idx[sel]], z[idx[sel]], visibility_table(vis)) + 1e-3 * s.cost[sel]
         better = depth < best
         if better.any():
             best[better] = depth[better]
@@ -205,7 +205,7 @@ def _fill_hidden(unit: _TileUnit, off: np.ndarray, x: np.ndarray, y: np.ndarray,
     return out
 
 
-def _fill_values(unit: _TileUnit, off: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, idx: np.ndarray,
+def _fill_values(unit: TileUnit, off: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, idx: np.ndarray,
                  winner: np.ndarray, visibility: List[Optional[Visibility]], fill_vals: np.ndarray,
                  counts: Dict[int, int]) -> None:
     """The values (with their radiometric gains) of the cells ``idx`` from the image ``winner`` picked for each

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..dense.grid import convex_hull_xy
 from .cameras import OrthoCamera
-from .surface import _Dsm
+from .surface import Dsm
 
 MAX_POLAR_CELLS = 12_000_000
 
@@ -181,7 +181,7 @@ class Visibility:
         return np.where(inside, np.maximum(need, 0.0), 0.0)
 
 
-def build_visibility(cam: OrthoCamera, offset: np.ndarray, fp: Footprint, dsm: _Dsm, tolerance: float,
+def build_visibility(cam: OrthoCamera, offset: np.ndarray, fp: Footprint, dsm: Dsm, tolerance: float,
                      path: str = "") -> Visibility:
     """The polar occlusion table of ``cam`` over its footprint (saved to ``path`` when given)."""
     c = cam.centre + offset
@@ -234,7 +234,7 @@ def build_visibility(cam: OrthoCamera, offset: np.ndarray, fp: Footprint, dsm: _
     return vis
 
 
-def _table(vis: Visibility) -> np.ndarray:
+def visibility_table(vis: Visibility) -> np.ndarray:
     """The table, memory-mapped from its file (a mosaic tile reads only the rows of the angles it spans; the
     pages stay in the system's file cache, not in this process, and the image cache keeps the decoded photos:
     toledo_2400's 57 tables are 2.3 GB, loaded whole they pushed the photos and each other out of the cache,

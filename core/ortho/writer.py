@@ -12,7 +12,7 @@ from ..common.files import atomic_output
 from ..common.progress import NullProgress, Progress, check_cancel
 from ..io import raster as dsmmod
 from .options import OrthoError
-from .pixels import _gdal
+from .pixels import load_gdal
 
 
 def _alpha_value(dtype: str) -> Optional[float]:
@@ -22,11 +22,11 @@ def _alpha_value(dtype: str) -> Optional[float]:
     return None  # float images: nodata NaN instead of an alpha band
 
 
-class _RasterWriter:
+class RasterWriter:
     """A tiled GeoTIFF that tiles are written into, then translated to a COG (atomically)."""
 
     def __init__(self, path: str, width: int, height: int, bands: int, dtype: str, geotransform, crs: Optional[str]):
-        gdal = _gdal()
+        gdal = load_gdal()
         from osgeo import gdal_array
 
         self.path = path
@@ -70,7 +70,7 @@ class _RasterWriter:
     def finish(self, out_path: str, compress: str, progress: Optional[Progress], metadata: Optional[dict] = None
                ) -> None:
         """Translate to a Cloud-Optimized GeoTIFF at ``out_path`` (atomic) and delete the work file."""
-        gdal = _gdal()
+        gdal = load_gdal()
         progress = progress or NullProgress()
         if metadata:
             self.ds.SetMetadata({str(k): str(v) for k, v in metadata.items()})
@@ -115,14 +115,14 @@ _ZSTD: Optional[bool] = None
 def _has_zstd() -> bool:
     global _ZSTD
     if _ZSTD is None:
-        md = _gdal().GetDriverByName("GTiff").GetMetadataItem("DMD_CREATIONOPTIONLIST") or ""
+        md = load_gdal().GetDriverByName("GTiff").GetMetadataItem("DMD_CREATIONOPTIONLIST") or ""
         _ZSTD = "ZSTD" in md
     return _ZSTD
 
 
 @contextlib.contextmanager
-def _gdal_cache(mb: int):
-    gdal = _gdal()
+def gdal_cache(mb: int):
+    gdal = load_gdal()
     old = gdal.GetCacheMax()
     gdal.SetCacheMax(int(mb) << 20)
     try:
@@ -138,7 +138,7 @@ def interior_nodata(path: str) -> int:
     edge), so it need not be 0 where every photographed cell has data."""
     from scipy import ndimage
 
-    gdal = _gdal()
+    gdal = load_gdal()
     ds = gdal.Open(path)
     if ds is None:
         raise OrthoError(f"cannot open {path}")
