@@ -199,3 +199,14 @@ def test_faces_import_only_core_and_the_qgis_floor():
                 if "QtWidgets" in fh.read():
                     bad.append(f"qgisio/{path}: imports widgets (QtWidgets): they belong in ui/")
     assert not bad, "imports across the faces:\n" + "\n".join(bad)
+
+
+def test_no_private_name_imported_across_core_modules():
+    """A name another module needs is public (issue 35): `from .surface import _Dsm` hid an interface."""
+    bad = []
+    for name, path, tree, _ in _modules():
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and (node.level or (node.module or "").startswith("core")):
+                bad += [f"{os.path.relpath(path, ROOT)}:{node.lineno}: {node.module or '.'}.{a.name}" for a in node.names
+                        if a.name.startswith("_") and not a.name.startswith("__")]
+    assert not bad, "underscore names imported across modules (make them public):\n" + "\n".join(bad)
