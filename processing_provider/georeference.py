@@ -157,7 +157,8 @@ class GeoreferenceAlgorithm(AlgorithmBase):
                    crs_text):
         """Automatic control (core autocontrol_workspace) from the reference layers; the given ground control
         becomes check points."""
-        from ..core.georef.autocontrol.stage import PRIOR_AUTO, PRIOR_GPS, autocontrol_workspace
+        from ..core.georef.autocontrol.options import PRIOR_AUTO, PRIOR_GPS
+        from ..core.georef.autocontrol.stage import autocontrol_workspace
         from ..qgisio import reference_layers as refs
 
         if ortho is None or dsm is None:

@@ -179,7 +179,7 @@ def test_the_old_absolute_bound_would_have_dropped_the_coarse_dem_heights():
 
 
 def test_a_block_smaller_than_one_tile_of_the_reference_is_refused_by_name(tmp_path):
-    from core.georef.autocontrol.stage import _check_block_pixels
+    from core.georef.autocontrol.search import check_block_pixels as _check_block_pixels
 
     class Ref:
         ortho_path = str(tmp_path / "naip_2m.tif")

@@ -223,7 +223,7 @@ def test_photos_moved_after_the_alignment_name_the_missing_folder(tmp_path):
     """The photos' folder renamed after Align images: the stages that read them name it (the automatic control
     left the photos out silently and its provisional orthophoto came out empty)."""
     from core.georef.autocontrol.errors import AutoControlError
-    from core.georef.autocontrol.stage import _photos
+    from core.georef.autocontrol.search import photo_paths as _photos
     from core.project.workspace import Workspace
     from tests import synthetic as syn
     from tests.workspaces import synthetic_workspace

@@ -18,8 +18,8 @@ from ...project.layout import Layout, read_json, write_json
 from ...project.workspace import Workspace, WorkspaceError
 from ..options import GeorefOptions
 from .errors import AutoControlError
-from .options import AutoControlOptions
-from .stage import PRIOR_AUTO, AutoControlResult, autocontrol_workspace
+from .options import PRIOR_AUTO, AutoControlOptions
+from .stage import AutoControlResult, autocontrol_workspace
 
 
 def reference_products(reference_workspace_dir: str) -> Tuple[str, str]:

@@ -6,6 +6,8 @@ from dataclasses import dataclass
 from typing import Any, Optional
 
 AUTO = "auto"  # the role of an automatic GCP candidate in georef/autocontrol.json
+# where the block is first placed: EXIF GPS when 2 photos carry it (else none), the GPS, or a search over rotations
+PRIOR_AUTO, PRIOR_GPS, PRIOR_NONE = "auto", "gps", "none"
 
 
 @dataclass
@@ -55,4 +57,4 @@ class AutoControlOptions:
         return dataclasses.replace(base, **kwargs) if kwargs else base
 
 
-__all__ = ["AUTO", "AutoControlOptions"]
+__all__ = ["AUTO", "PRIOR_AUTO", "PRIOR_GPS", "PRIOR_NONE", "AutoControlOptions"]

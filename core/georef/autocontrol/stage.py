@@ -11,7 +11,6 @@
 """
 from __future__ import annotations
 
-import math
 import os
 import time
 from dataclasses import dataclass, field
@@ -21,8 +20,7 @@ import numpy as np
 
 from ...common.files import remove_path
 from ...common.progress import NullProgress, Progress, SubProgress
-from ...geometry.crs import linear_unit, transform_points, unit_symbol
-from ...geometry.similarity import Similarity
+from ...geometry.crs import transform_points
 from ...io.gcp import CHECK, CONTROL, CameraPosition, GCPSet, GroundPoint
 from ...project.layout import Layout, write_json
 from ...project.workspace import Workspace
@@ -31,31 +29,14 @@ from ..stage import GeorefStageResult, georeference_workspace
 from .candidates import (
     KEPT,
     Candidate,
-    consistent,
     drop_counts,
-    estimate_own_sigma,
-    own_sigma_prior,
-    set_own_sigma,
-    spread,
-    tie_back,
 )
 from .errors import AutoControlError
-from .matching import apply2, coarse_search, match_orthos
-from .options import AutoControlOptions
-from .provisional import (
-    Frame,
-    block_extent,
-    camera_centres,
-    frame_from_positions,
-    level_frame,
-    provisional_ortho,
-    registered,
-    sparse_points,
-)
+from .options import PRIOR_AUTO, AutoControlOptions
 from .reference import Reference
+from .search import find_candidates
 
 FORMAT = "archaeoortho-autocontrol"
-PRIOR_AUTO, PRIOR_GPS, PRIOR_NONE = "auto", "gps", "none"
 
 
 @dataclass
@@ -71,191 +52,6 @@ class AutoControlResult:
     cameras_path: Optional[str]
     timings: Dict[str, float] = field(default_factory=dict)
     messages: List[str] = field(default_factory=list)
-
-
-def _photos(ws: Workspace, rec=None) -> Dict[str, str]:
-    """{name: path} of the photos of the aligned model ``rec`` (all the workspace's without it); AutoControlError
-    naming the folder when they were moved after the alignment (they were left out silently, and the provisional
-    orthophoto came out empty)."""
-    from ...align.photos import check_photos
-    from ...io.images import ImageError
-
-    out = {}
-    names = {im.name for im in registered(rec)} if rec is not None else None
-    for im in ws.data.get("images", []):
-        if names is not None and im["name"] not in names:
-            continue
-        out[im["name"]] = im.get("path") or os.path.join(ws.data.get("images_dir") or "", im["name"])
-    try:
-        check_photos(ws, out)
-    except ImageError as e:
-        raise AutoControlError(str(e)) from e
-    return out
-
-
-def _gps_positions(ws: Workspace, crs: str) -> List[CameraPosition]:
-    rows = [(im["name"], im["gps"]) for im in ws.data.get("images", []) if im.get("gps")]
-    if not rows:
-        return []
-    xyz = transform_points(np.array([[g[0], g[1], g[2] if len(g) > 2 and g[2] is not None else 0.0]
-                                     for _, g in rows], dtype=float), "EPSG:4326", crs)
-    return [CameraPosition(n, float(p[0]), float(p[1]), float(p[2])) for (n, _), p in zip(rows, xyz)]
-
-
-def _photo_gsd(rec, frame: Frame) -> float:
-    """The photos' median ground resolution in frame units: height above the sparse points over the focal."""
-    z = float(np.median(frame.model_to_frame.apply(sparse_points(rec))[:, 2]))
-    out = []
-    for name, c in camera_centres(rec).items():
-        im = next(i for i in registered(rec) if i.name == name)
-        cam = rec.cameras[im.camera_id]
-        f = float(cam.mean_focal_length())
-        out.append(abs(frame.model_to_frame.apply(c[None])[0, 2] - z) / max(f, 1e-9))
-    return float(np.median(out))
-
-
-def _coarse_prior(rec, photos, reference: Reference, opt: AutoControlOptions, progress: Progress,
-                  messages: List[str]) -> Frame:
-    """No prior: the block's level frame matched to the whole reference over rotations; the similarity it gives
-    (its height from the DSM at the matches) becomes the prior."""
-    lev = level_frame(rec)
-    ext = block_extent(rec, lev)
-    res0 = max(ext[2] - ext[0], ext[3] - ext[1]) / opt.coarse_pixels
-    prov = provisional_ortho(rec, lev, photos, res0, SubProgress(progress, 0.0, 0.5), ext)
-    b = reference.bounds
-    res_r = max(reference.gsd, max(b[2] - b[0], b[3] - b[1]) / (2 * opt.coarse_pixels))
-    ref, valid, gt = reference.grey(b, res_r)
-    m, n, angle = coarse_search(prov.grey, prov.valid, ref, valid, opt)
-    messages.append(f"no prior: the coarse search over {len(opt.rotations)} rotations found {n} matches "
-                    f"(best with the orthophoto turned {angle:g} degrees)")
-    if m is None or n < 8:
-        raise AutoControlError(f"no prior and the reference orthophoto {reference.ortho_path} does not match the "
-                               f"block at a coarse level ({n} matches agree): give rough camera positions or a "
-                               "reference that covers the block more tightly")
-    # frame xy -> ortho pixel -> reference pixel -> world xy: an affine that is a similarity
-    to_px = np.array([[1.0 / res0, 0.0, -ext[0] / res0 - 0.5], [0.0, -1.0 / res0, prov.y0 / res0 - 0.5]])
-    to_world = np.array([[gt[1], 0.0, gt[0] + 0.5 * gt[1]], [0.0, gt[5], gt[3] + 0.5 * gt[5]]])
-    a3 = np.vstack([to_world, [0, 0, 1]]) @ np.vstack([m, [0, 0, 1]]) @ np.vstack([to_px, [0, 0, 1]])
-    s = math.sqrt(abs(np.linalg.det(a3[:2, :2])))
-    r2 = a3[:2, :2] / s
-    r3 = np.eye(3)
-    r3[:2, :2] = r2
-    xy = np.array([[0.5 * (ext[0] + ext[2]), 0.5 * (ext[1] + ext[3])]])
-    centre_world = apply2(a3[:2], xy)[0]
-    pts = lev.model_to_frame.apply(sparse_points(rec))
-    zw = reference.heights(*apply2(a3[:2], pts[::max(1, len(pts) // 500), :2]).T)
-    z0 = float(np.nanmedian(zw)) - s * float(np.median(pts[:, 2])) if np.isfinite(zw).any() else 0.0
-    frame_to_world = Similarity(s, r3, np.r_[a3[:2, 2], z0])
-    offset = np.round(np.r_[centre_world, 0.0], 0)
-    world = Similarity.translation_only(-offset).compose(frame_to_world).compose(lev.model_to_frame)
-    return Frame(world, offset)
-
-
-def _prior(ws, rec, photos, reference, prior, positions, opt, progress, messages) -> Frame:
-    crs = reference.crs
-    if positions is None and prior in (PRIOR_AUTO, PRIOR_GPS):
-        positions = _gps_positions(ws, crs)
-        if prior == PRIOR_GPS and len(positions) < 2:
-            raise AutoControlError(f"prior 'gps': {len(positions)} photo(s) of workspace {ws.root} carry EXIF GPS, "
-                                   "2 are needed")
-    if positions is not None and len(positions) >= 2 and prior != PRIOR_NONE:
-        messages.append(f"prior: {len(positions)} rough camera positions")
-        return frame_from_positions(rec, positions)
-    messages.append("prior: none (searching rotation and scale)")
-    return _coarse_prior(rec, photos, reference, opt, progress, messages)
-
-
-def _check_block_pixels(ext, g: float, reference: Reference, photo_gsd: float, opt: AutoControlOptions) -> None:
-    """AutoControlError, before the match, when the block spans fewer pixels of the match's grid than one tile
-    of the per-tile affine (``opt.tile_px``): a handful of the reference's features, too few to place the block
-    (Toledo's 150 m FC300X block against a 2 m orthophoto: 107 pixels, 16 matches, and a block placed 67 m off
-    by a repeated pattern of houses, or 2 candidates)."""
-    side = max(ext[2] - ext[0], ext[3] - ext[1])
-    px = side / g
-    if px >= opt.tile_px:
-        return
-    name, metres = linear_unit(reference.crs_wkt)
-    unit = "m" if metres == 1.0 else name or "units"
-    what = (f"the reference orthophoto {reference.ortho_path} is too coarse for a block this small"
-            if g <= reference.gsd * 1.0001 else
-            f"the photos' ground resolution ({photo_gsd:.3g} {unit}) is too coarse for a block this small")
-    raise AutoControlError(f"{what}: the block spans {side:.0f} {unit}, {px:.0f} pixels of {g:.3g} {unit}, and the "
-                           f"automatic control needs at least {opt.tile_px} (one tile of its per-tile match); use a "
-                           f"reference with cells of {side / opt.tile_px:.2g} {unit} or finer, a larger block, or "
-                           "hand-picked control points")
-
-
-def _own_height_sigma(cands, reference: Reference, photo_gsd: float, opt: AutoControlOptions,
-                      messages: List[str]) -> float:
-    """The reference DSM's own height noise in the candidates' sigma Z: ``opt.dsm_sigma`` when given, else
-    estimated from the candidates that agree with one similarity (``candidates.estimate_own_sigma``: between the
-    photos' ground resolution, the block's own precision, and the prior, a third of the DSM's cell); the
-    candidates' sigma Z are set from it."""
-    prior = own_sigma_prior(reference.dsm_gsd, opt.dsm_sigma)
-    if opt.dsm_sigma is not None:
-        return prior
-    own = estimate_own_sigma(cands, photo_gsd, prior)
-    if own is None:
-        return prior
-    set_own_sigma(cands, own)
-    messages.append(f"reference DSM heights: sigma {own:.3g} from the candidates that agree (at most a third of "
-                    f"its {reference.dsm_gsd:.3g} cell, {prior:.3g}; at least the photos' ground resolution, "
-                    f"{photo_gsd:.3g}), plus each point's slope and roughness")
-    return own
-
-
-def find_candidates(ws: Workspace, rec, reference: Reference, prior: str = PRIOR_AUTO,
-                    positions: Optional[Sequence[CameraPosition]] = None,
-                    options: Optional[AutoControlOptions] = None, progress: Optional[Progress] = None):
-    """(candidates, figures, messages, common resolution, timings) of an aligned block against the reference."""
-    opt = AutoControlOptions.of(options)
-    progress = progress or NullProgress()
-    photos = _photos(ws, rec)
-    messages: List[str] = list(reference.notes)
-    t = {"start": time.time()}
-    frame = _prior(ws, rec, photos, reference, prior, positions, opt, SubProgress(progress, 0.0, 0.2), messages)
-    t["prior"] = time.time()
-    ext = block_extent(rec, frame)
-    photo_gsd = _photo_gsd(rec, frame)
-    g = opt.gsd or max(reference.gsd, photo_gsd, max(ext[2] - ext[0], ext[3] - ext[1]) / opt.max_pixels)
-    _check_block_pixels(ext, g, reference, photo_gsd, opt)
-    margin = 0.15 * max(ext[2] - ext[0], ext[3] - ext[1]) + 10.0 * g
-    off = frame.offset
-    box = (ext[0] + off[0] - margin, ext[1] + off[1] - margin, ext[2] + off[0] + margin, ext[3] + off[1] + margin)
-    placed = "coarse match" if any(m.startswith("prior: none") for m in messages) else "rough camera positions"
-    reference.check_covers((ext[0] + off[0], ext[1] + off[1], ext[2] + off[0], ext[3] + off[1]),
-                           f"the block placed by its {placed}")
-    prov = provisional_ortho(rec, frame, photos, g, SubProgress(progress, 0.2, 0.4), ext)
-    t["orthophoto"] = time.time()
-    ref, valid, gt = reference.grey(box, g)
-    ms = match_orthos(prov.grey, prov.valid, ref, valid, opt)
-    t["matching"] = time.time()
-    messages.append(f"matching at {g:.3g} {unit_symbol(reference.crs_wkt)} per pixel: {ms.n_features[0]} / "
-                    f"{ms.n_features[1]} features, "
-                    f"{ms.n_found} matches, {ms.n_similarity} fit one similarity, {len(ms.src)} fit their tiles")
-    sel = spread(ms.src, ms.residual, opt.max_candidates, prov.grey.shape)
-    world_xy = np.column_stack([gt[0] + (ms.dst[sel, 0] + 0.5) * gt[1], gt[3] + (ms.dst[sel, 1] + 0.5) * gt[5]])
-    cands = tie_back(rec, frame, prov, ms.src[sel], world_xy, ms.residual[sel], reference, photos, opt,
-                     SubProgress(progress, 0.4, 0.9))
-    t["photos"] = time.time()
-    n_obs = sum(1 for c in cands if c.status == KEPT)
-    # what the block may be off beyond each candidate's own sigmas: a few cells of the match's grid (was 10 g but
-    # at least 0.5 m, one 3-D distance: a height from a 10-30 m DEM was judged by the orthophoto's cell)
-    consistent(cands, 10.0 * g)
-    n_kept = sum(1 for c in cands if c.status == KEPT)
-    messages.append(f"{len(cands)} candidates tied back to the photos: {n_obs} seen in at least 2 photos with a "
-                    f"DSM height, {n_kept} agree with one similarity")
-    own = _own_height_sigma(cands, reference, photo_gsd, opt, messages)
-    dropped = drop_counts(cands)
-    if dropped:
-        messages.append("candidates dropped: " + "; ".join(f"{n} {r}" for r, n in dropped.items()))
-    figures = {"features_ortho": ms.n_features[0], "features_reference": ms.n_features[1], "matches": ms.n_found,
-               "similarity_inliers": ms.n_similarity, "tile_inliers": int(len(ms.src)), "candidates": len(cands),
-               "observed": n_obs, "consistent": n_kept,
-               "block_reference_pixels": round(max(ext[2] - ext[0], ext[3] - ext[1]) / reference.gsd, 1),
-               "dsm_sigma": own}
-    timings = {k: t[k] - t["start"] for k in ("prior", "orthophoto", "matching", "photos")}
-    return cands, figures, messages, g, timings
 
 
 def autocontrol_workspace(workspace_dir: str, reference_ortho: str, reference_dsm: str, prior: str = PRIOR_AUTO,
@@ -281,10 +77,10 @@ def autocontrol_workspace(workspace_dir: str, reference_ortho: str, reference_ds
     reference = Reference(reference_ortho, reference_dsm)
     t0 = time.time()
     try:
-        cands, figures, messages, g, timings = find_candidates(ws, rec, reference, prior, camera_positions, opt,
-                                                               SubProgress(progress, 0.0, 0.7))
+        found = find_candidates(ws, rec, reference, prior, camera_positions, opt, SubProgress(progress, 0.0, 0.7))
     finally:
         reference.close()
+    cands, figures, messages, g, timings = found.candidates, found.figures, found.messages, found.gsd, found.timings
     for m in messages:
         progress.info(m)
     kept = [c for c in cands if c.status == KEPT]
@@ -371,4 +167,4 @@ def _count_used(lay: Layout, names) -> int:
     return sum(1 for r in rows if r.get("name") in names and r.get("status") == "used")
 
 
-__all__ = ["AutoControlResult", "PRIOR_AUTO", "PRIOR_GPS", "PRIOR_NONE", "autocontrol_workspace", "find_candidates"]
+__all__ = ["AutoControlResult", "autocontrol_workspace"]
