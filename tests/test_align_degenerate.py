@@ -9,8 +9,8 @@ import math
 
 import pytest
 
+from core.align.diagnosis import diagnose_unregistered
 from core.align.mapping import MAX_FOCAL_RATIO, degenerate_camera, drop_degenerate
-from core.align.stage import diagnose_unregistered
 from core.io.images import ImageInfo
 
 pycolmap = pytest.importorskip("pycolmap")

@@ -413,7 +413,7 @@ def test_no_reconstruction_with_a_held_camera_points_at_the_calibration():
     the error said only 'baseline too short ... add photos taken from other positions'; it now names the held
     camera and its file.  Without a held camera the message is unchanged."""
     from core.align.calibrated import GivenCamera
-    from core.align.stage import _no_reconstruction
+    from core.align.diagnosis import no_reconstruction_error as _no_reconstruction
 
     held = {1: GivenCamera("fixed", "/x/focal12.yaml", "DMC120", "PINHOLE", [83.33, 83.33, 320.0, 576.0])}
     msg = str(_no_reconstruction({"a.tif": 3, "b.tif": 3}, 4, 5, held))

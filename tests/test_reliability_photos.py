@@ -11,9 +11,10 @@ import shutil
 import numpy as np
 import pytest
 
+from core.align.diagnosis import no_reconstruction_error as _no_reconstruction
 from core.align.options import AlignError, AlignOptions
 from core.align.photos import PHOTO_FINGERPRINTS
-from core.align.stage import _no_reconstruction, align
+from core.align.stage import align
 from core.common.progress import NullProgress
 from core.dense.options import DenseError
 from core.dense.stage import _check_resolution, build_dsm_workspace

@@ -23,7 +23,7 @@ import os
 import shutil
 import time
 from dataclasses import asdict, dataclass
-from typing import Dict, List, Optional, Sequence, Set, Tuple
+from typing import Dict, List, Optional, Tuple
 
 from ..common.cancel import load_pycolmap
 from ..common.files import atomic_output, atomic_write_text, fingerprint
@@ -50,6 +50,7 @@ from .calibrated import (
     restore_held,
     scan_interior,
 )
+from .diagnosis import diagnose_unregistered, no_reconstruction_error, report_unregistered
 from .escalation import EscalationContext, block_state, escalate
 from .features import database_key, extract_features, file_hash, masks_for_colmap, match_pairs, setup_database
 from .mapping import (
@@ -111,64 +112,6 @@ def _read_images(images_dir: str, options: AlignOptions,
     except ImageError as e:
         raise AlignError(str(e)) from e
     return infos, skipped, groups
-
-
-def diagnose_unregistered(infos: Sequence[ImageInfo], registered: Set[str], others: Sequence[Sequence[str]],
-                          partners: Dict[str, int], degenerate: Optional[Dict[str, str]] = None) -> Dict[str, str]:
-    """Why each image outside the main block is not registered: image -> reason.  ``degenerate``: the images
-    de-registered for a degenerate camera (mapping.drop_degenerate), with why."""
-    in_other = {n: k for k, comp in enumerate(others, start=2) for n in comp}
-    unregistered: Dict[str, str] = {}
-    for im in infos:
-        if im.name in registered:
-            continue
-        if im.name in in_other:
-            k = in_other[im.name]
-            unregistered[im.name] = (f"in a separate component (#{k}, {len(others[k - 2])} images) that "
-                                     "shares too few matches with the main block")
-        elif im.name in (degenerate or {}):
-            unregistered[im.name] = f"matched {partners.get(im.name, 0)} image(s) but {degenerate[im.name]}"
-        elif partners.get(im.name, 0) == 0:
-            unregistered[im.name] = "no verified matches with any other image (no overlap, blur or too little texture)"
-        else:
-            unregistered[im.name] = (f"matched {partners[im.name]} image(s) but could not be registered "
-                                     "(too few 2D-3D correspondences)")
-    return unregistered
-
-
-def _report_unregistered(progress: Progress, unregistered: Dict[str, str], others: Sequence[Sequence[str]],
-                         n_registered: int) -> None:
-    for n, why in unregistered.items():
-        progress.warning(f"not registered: {n}: {why}")
-    if others:
-        progress.warning(
-            f"the images form {len(others) + 1} separate components; kept the largest ({n_registered} "
-            "images); others: " + "; ".join(f"#{k}: {', '.join(c)}" for k, c in enumerate(others, start=2))
-        )
-
-
-def _no_reconstruction(partners: Dict[str, int], n_images: int, n_pairs: int,
-                       held: Optional[Dict[int, GivenCamera]] = None) -> AlignError:
-    """The error of a mapping that built nothing; ``held``: the cameras whose given interior orientation the
-    mapping held (a wrong calibration makes every initial pair fail too, which the message then says)."""
-    isolated = [n for n, c in partners.items() if c == 0]
-    if isolated:
-        return AlignError(
-            "no reconstruction could be built: the images do not overlap enough. "
-            f"{len(isolated)} of {n_images} images share no verified matches with any other image"
-            f" ({', '.join(isolated[:10])}{' ...' if len(isolated) > 10 else ''})")
-    calibration = ""
-    if held:
-        cams = "; ".join(f"camera {cid}: focal {g.params[0]:.1f} px from {os.path.basename(g.source)}"
-                         for cid, g in sorted(held.items()))
-        calibration = (f". The interior orientation was held as given ({cams}): a wrong focal length, pixel size "
-                       "or image size in the calibration also leaves no pair to triangulate; check it, or run with "
-                       "Interior orientation 'estimated' to see what the photos say")
-    return AlignError(
-        f"no reconstruction could be built: every one of the {n_images} images shares verified matches "
-        f"({n_pairs} image pair(s) with {MIN_VERIFIED_INLIERS} or more inliers), but the mapper found no initial "
-        "pair it could triangulate (baseline too short for the distance, e.g. photos taken from one spot, or "
-        "matches on a repeated pattern); add photos taken from other positions" + calibration)
 
 
 def _mapping(pycolmap, lay: Layout, db_path: str, images_dir: str, n_images: int, options: AlignOptions,
@@ -356,7 +299,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
             ordered, escalation = escalate(ctx, ordered, SubProgress(progress, 0.90, 0.93))
         partners = verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS)
         if not ordered:
-            raise _no_reconstruction(partners, len(infos), verified_pairs(pycolmap, db_path, MIN_VERIFIED_INLIERS),
+            raise no_reconstruction_error(partners, len(infos), verified_pairs(pycolmap, db_path, MIN_VERIFIED_INLIERS),
                                      photos.held()[0])
         rec = ordered[0]
         _registered, others = block_state(ordered)
@@ -376,7 +319,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
                 pp = final_bundle_adjustment(pycolmap, rec, options, progress, held)
         registered = {rec.images[i].name for i in rec.reg_image_ids()}
         unregistered = diagnose_unregistered(infos, registered, others, partners, degenerate)
-        _report_unregistered(progress, unregistered, others, len(registered))
+        report_unregistered(progress, unregistered, others, len(registered))
         check_cancel(progress)
 
         # 6. write the model atomically; the new image list and database become the workspace's
