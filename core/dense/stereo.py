@@ -40,7 +40,7 @@ class PairUnit:
     lr_tolerance: float
     threads: int
     coarse: bool = True  # coarse to fine (a pyramid, see _disparity); False: one matching over the whole range
-    fine_uniqueness: int = 10  # SGBM's uniqueness ratio on the finer levels (DenseOptions.fine_uniqueness)
+    fine_uniqueness: int = 3  # SGBM's uniqueness ratio on the finer levels (DenseOptions.fine_uniqueness)
     equalize: bool = True  # local contrast equalisation of the rectified pair (:func:`equalized`)
 
 
