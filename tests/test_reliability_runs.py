@@ -128,7 +128,8 @@ def test_wrong_shape_is_refused_by_the_stages_too(tmp_path):
     with pytest.raises(WorkspaceError, match='"align"'):
         build_orthophoto_workspace(str(tmp_path))
     images = tmp_path / "images"
-    images.mkdir()
+    images.mkdir()  # a photo in it: an empty folder is refused before the workspace is opened
+    shutil.copy(os.path.join(ROOT, "sample", "toledo", "images", "1JI_0064.JPG"), images)
     with pytest.raises(WorkspaceError, match='"align"'):
         align(str(images), str(tmp_path))
     assert path.read_bytes() == before
