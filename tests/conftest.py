@@ -73,10 +73,31 @@ def plugin(qgis_iface, qgis_processing):
     own)."""
     import archaeoortho
 
+    _real_layer_tree_view(qgis_iface)
     p = archaeoortho.classFactory(qgis_iface)
     p.initProcessing()
     yield p
     p.unload()
+
+
+_VIEWS = []
+
+
+def _real_layer_tree_view(iface):
+    """From QGIS 3.44 the toolbox dialog's end of a run hands ``iface.layerTreeView()`` to C++
+    (QgsProcessingGuiUtils.addResultLayers), which refuses pytest-qgis's mock: a real view of the project's tree."""
+    from unittest import mock
+
+    if not isinstance(iface.layerTreeView(), mock.Mock):
+        return
+    from qgis.core import QgsLayerTreeModel, QgsProject
+    from qgis.gui import QgsLayerTreeView
+
+    view = QgsLayerTreeView()
+    model = QgsLayerTreeModel(QgsProject.instance().layerTreeRoot())
+    view.setModel(model)
+    _VIEWS.append((view, model))
+    iface.layerTreeView = lambda: view
 
 
 @pytest.fixture(scope="session")

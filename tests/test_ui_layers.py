@@ -18,6 +18,9 @@ pytestmark = pytest.mark.usefixtures("qgis_processing")
 def plugin(qgis_iface, qgis_processing):
     import archaeoortho
 
+    from tests.conftest import _real_layer_tree_view
+
+    _real_layer_tree_view(qgis_iface)  # QGIS 3.44's result loading hands it to C++
     p = archaeoortho.classFactory(qgis_iface)
     p.initProcessing()
     p.initGui()
