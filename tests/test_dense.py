@@ -417,8 +417,18 @@ def test_cancel_leaves_no_dsm_and_resume_skips_finished_pairs(block_dir, tmp_pat
     for p, m in mtimes.items():
         assert os.stat(p).st_mtime_ns == m  # the finished pairs were not matched again
 
-    # the third run reuses every pair
-    r = dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=1))
+    # the third run reuses every pair; the DSM's size is said once (it was printed twice: issue 36 item 21)
+    said = []
+
+    class Said(NullProgress):
+        def report(self, fraction, message=""):
+            said.append(message)
+
+        def info(self, message):
+            said.append(message)
+
+    r = dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=1), progress=Said())
+    assert sum(f"{r.resolution:g} m" in m and " cells at " in m for m in said) == 1, said
     assert r.pairs_reused == len(everything) == r.pairs
     assert os.path.isfile(r.dsm_path) and r.valid_fraction > 0.8
     assert any(f"{len(everything)} reused" in line for line in r.log_lines)

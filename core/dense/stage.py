@@ -191,7 +191,7 @@ def build_dsm_workspace(workspace_dir: str, resolution: float = 0.0, quality: Op
                             "pairs": n_pairs, "pairs_reused": n_reused,
                             "points": n_points, "resolution": res, "gsd": gsd, "width": grid.width,
                             "height": grid.height, "warnings": job.warnings})
-    progress.report(1.0, f"DSM: {grid.width} x {grid.height} cells at {res:g} m")
+    progress.report(1.0, "DSM done")  # its size and fractions are in the log line above (once: issue 36 item 21)
     return DsmStageResult(workspace=ws.root, dsm_path=dsm_path, point_cloud_path=pc_path, crs=crs or "",
                           resolution=res, valid_fraction=valid_fraction, pairs=n_pairs, pairs_reused=n_reused,
                           points=n_points, timings={k: round(v, 3) for k, v in job.timings.items()},
