@@ -230,8 +230,9 @@ class GcpTasks:
 
     def cancel_task(self):
         if self.task is not None:
-            self.task.cancel()
+            # said first: a task still queued ends within cancel() ('Cancelled'), which this must not overwrite
             self.message(translate("GcpDock", "Cancelling\u2026"))
+            self.task.cancel()
 
     def run_georeference(self):
         """Adjust the block with the current points in a background task; residuals update when it ends."""
