@@ -1966,7 +1966,7 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>{} aus {} entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="507"/>
+        <location filename="../ui/store.py" line="511"/>
         <source>set CRS</source>
         <translation>KBS setzen</translation>
     </message>
@@ -2041,12 +2041,12 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>von Hand gesetzte Messungen beibehalten (gefundene dort nicht verwendet): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="495"/>
+        <location filename="../ui/store.py" line="499"/>
         <source>confirm {} in {}</source>
         <translation>{} in {} übernehmen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="504"/>
+        <location filename="../ui/store.py" line="508"/>
         <source>reject {} in {}</source>
         <translation>{} in {} verwerfen</translation>
     </message>
@@ -2192,7 +2192,7 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Projektionszentren (Welt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="194"/>
+        <location filename="../processing_provider/georeference.py" line="195"/>
         <source>outlier left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
@@ -2282,17 +2282,17 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Behaltene automatische Passpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="164"/>
+        <location filename="../processing_provider/georeference.py" line="165"/>
         <source>Automatic control needs both a reference orthophoto and a reference DSM (REFERENCE_ORTHO, REFERENCE_DSM); {} is missing</source>
         <translation>Automatische Passpunkte brauchen ein Referenz-Orthophoto und ein Referenz-DOM (REFERENCE_ORTHO, REFERENCE_DSM); {} fehlt</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="177"/>
+        <location filename="../processing_provider/georeference.py" line="178"/>
         <source>Target CRS {} is not used: automatic control georeferences in the reference orthophoto&apos;s CRS {}</source>
         <translation>Ziel-KBS {} wird nicht verwendet: automatische Passpunkte georeferenzieren im KBS {} des Referenz-Orthophotos</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="198"/>
+        <location filename="../processing_provider/georeference.py" line="199"/>
         <source>Automatic control: {} automatic GCPs kept; CRS {}; check RMSE XY {} m, Z {} m</source>
         <translation>Automatische Passpunkte: {} automatische Passpunkte behalten; KBS {}; Kontroll-RMSE XY {} m, Z {} m</translation>
     </message>

@@ -1966,7 +1966,7 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>rimuovi {} da {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="507"/>
+        <location filename="../ui/store.py" line="511"/>
         <source>set CRS</source>
         <translation>imposta il SR</translation>
     </message>
@@ -2041,12 +2041,12 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>misure posizionate a mano mantenute (quelle trovate lì non usate): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="495"/>
+        <location filename="../ui/store.py" line="499"/>
         <source>confirm {} in {}</source>
         <translation>conferma {} in {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="504"/>
+        <location filename="../ui/store.py" line="508"/>
         <source>reject {} in {}</source>
         <translation>scarta {} in {}</translation>
     </message>
@@ -2192,7 +2192,7 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Centri di presa (mondo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="194"/>
+        <location filename="../processing_provider/georeference.py" line="195"/>
         <source>outlier left out: {}</source>
         <translation>valore anomalo escluso: {}</translation>
     </message>
@@ -2282,17 +2282,17 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>GCP automatici mantenuti</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="164"/>
+        <location filename="../processing_provider/georeference.py" line="165"/>
         <source>Automatic control needs both a reference orthophoto and a reference DSM (REFERENCE_ORTHO, REFERENCE_DSM); {} is missing</source>
         <translation>Il controllo automatico richiede sia un'ortofoto sia un DSM di riferimento (REFERENCE_ORTHO, REFERENCE_DSM); manca {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="177"/>
+        <location filename="../processing_provider/georeference.py" line="178"/>
         <source>Target CRS {} is not used: automatic control georeferences in the reference orthophoto&apos;s CRS {}</source>
         <translation>Il SR di destinazione {} non è usato: il controllo automatico georeferenzia nel SR {} dell'ortofoto di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="198"/>
+        <location filename="../processing_provider/georeference.py" line="199"/>
         <source>Automatic control: {} automatic GCPs kept; CRS {}; check RMSE XY {} m, Z {} m</source>
         <translation>Controllo automatico: {} GCP automatici mantenuti; SR {}; RMSE di controllo XY {} m, Z {} m</translation>
     </message>
