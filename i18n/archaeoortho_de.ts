@@ -1468,57 +1468,57 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Abgebrochen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="241"/>
+        <location filename="../ui/gcp_tasks.py" line="242"/>
         <source>The block is not aligned yet: run Align images first</source>
         <translation>Der Block ist noch nicht ausgerichtet: zuerst 'Bilder ausrichten' ausführen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="247"/>
+        <location filename="../ui/gcp_tasks.py" line="248"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>Die Ausgleichung braucht mindestens 3 Passpunkte mit Koordinaten und Messungen; vorhanden sind {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="265"/>
+        <location filename="../ui/gcp_tasks.py" line="266"/>
         <source>Outliers left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="266"/>
+        <location filename="../ui/gcp_tasks.py" line="267"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziert in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="269"/>
+        <location filename="../ui/gcp_tasks.py" line="270"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="278"/>
+        <location filename="../ui/gcp_tasks.py" line="279"/>
         <source>Not georeferenced yet.</source>
         <translation>Noch nicht georeferenziert.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="280"/>
+        <location filename="../ui/gcp_tasks.py" line="281"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Passpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="283"/>
+        <location filename="../ui/gcp_tasks.py" line="284"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Kontrollpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="286"/>
+        <location filename="../ui/gcp_tasks.py" line="287"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>Höhen sind Platzhalter: keine Höhengenauigkeit</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="288"/>
+        <location filename="../ui/gcp_tasks.py" line="289"/>
         <source>tie points {} px</source>
         <translation>Verknüpfungspunkte {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="290"/>
+        <location filename="../ui/gcp_tasks.py" line="291"/>
         <source>edited since: re-run to update</source>
         <translation>seither bearbeitet: erneut ausführen zum Aktualisieren</translation>
     </message>
@@ -1568,7 +1568,7 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Wird abgebrochen…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="272"/>
+        <location filename="../ui/gcp_tasks.py" line="273"/>
         <source>Georeferencing with {} control points…</source>
         <translation>Georeferenzierung mit {} Passpunkten…</translation>
     </message>
@@ -1718,17 +1718,17 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>ArchaeoOrtho: {} in {} verfeinern</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="304"/>
+        <location filename="../ui/gcp_tasks.py" line="305"/>
         <source>Results loaded</source>
         <translation>Ergebnisse geladen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="311"/>
+        <location filename="../ui/gcp_tasks.py" line="312"/>
         <source>ArchaeoOrtho: load results</source>
         <translation>ArchaeoOrtho: Ergebnisse laden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="313"/>
+        <location filename="../ui/gcp_tasks.py" line="314"/>
         <source>Loading the results…</source>
         <translation>Die Ergebnisse werden geladen…</translation>
     </message>

@@ -1468,57 +1468,57 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Interrotto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="241"/>
+        <location filename="../ui/gcp_tasks.py" line="242"/>
         <source>The block is not aligned yet: run Align images first</source>
         <translation>Il blocco non è ancora allineato: esegui prima 'Allinea immagini'</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="247"/>
+        <location filename="../ui/gcp_tasks.py" line="248"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>La compensazione richiede almeno 3 punti d'appoggio con coordinate e misure; ce ne sono {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="265"/>
+        <location filename="../ui/gcp_tasks.py" line="266"/>
         <source>Outliers left out: {}</source>
         <translation>Valori anomali esclusi: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="266"/>
+        <location filename="../ui/gcp_tasks.py" line="267"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziato in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="269"/>
+        <location filename="../ui/gcp_tasks.py" line="270"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="278"/>
+        <location filename="../ui/gcp_tasks.py" line="279"/>
         <source>Not georeferenced yet.</source>
         <translation>Non ancora georeferenziato.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="280"/>
+        <location filename="../ui/gcp_tasks.py" line="281"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Appoggio: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="283"/>
+        <location filename="../ui/gcp_tasks.py" line="284"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Controllo: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="286"/>
+        <location filename="../ui/gcp_tasks.py" line="287"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>le quote sono segnaposto: nessuna accuratezza verticale</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="288"/>
+        <location filename="../ui/gcp_tasks.py" line="289"/>
         <source>tie points {} px</source>
         <translation>punti di legame {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="290"/>
+        <location filename="../ui/gcp_tasks.py" line="291"/>
         <source>edited since: re-run to update</source>
         <translation>modificato da allora: riesegui per aggiornare</translation>
     </message>
@@ -1568,7 +1568,7 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Interruzione…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="272"/>
+        <location filename="../ui/gcp_tasks.py" line="273"/>
         <source>Georeferencing with {} control points…</source>
         <translation>Georeferenziazione con {} punti d'appoggio…</translation>
     </message>
@@ -1718,17 +1718,17 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>ArchaeoOrtho: affina {} in {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="304"/>
+        <location filename="../ui/gcp_tasks.py" line="305"/>
         <source>Results loaded</source>
         <translation>Risultati caricati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="311"/>
+        <location filename="../ui/gcp_tasks.py" line="312"/>
         <source>ArchaeoOrtho: load results</source>
         <translation>ArchaeoOrtho: carica i risultati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="313"/>
+        <location filename="../ui/gcp_tasks.py" line="314"/>
         <source>Loading the results…</source>
         <translation>Caricamento dei risultati…</translation>
     </message>
