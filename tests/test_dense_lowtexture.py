@@ -10,6 +10,7 @@ from core.dense import grid as gridding
 from core.dense import stage as dense
 from core.dense.options import DenseOptions
 from core.io import raster
+from core.project.workspace import Workspace
 from tests import lowtexture_scene as lt
 from tests import synthetic as syn
 from tests.conftest import ROOT
@@ -119,5 +120,5 @@ def test_farmland_blunders_are_removed_and_flagged(farmland):
     assert r.removed_cells > 0 and (src == gridding.SOURCE_REMOVED).sum() == r.removed_cells
     # the blunder count, scaled: cells more than 5 m at 4.9 cm GSD (100 GSD) from their 15 x 15 median
     assert blunder_count(z, 100 * block.gsd) == 0
-    st = dense.Workspace.open(r.workspace).stage("dsm")
+    st = Workspace.open(r.workspace).stage("dsm")
     assert st["results"]["REMOVED_FRACTION"] == pytest.approx(r.removed_fraction)
