@@ -138,7 +138,10 @@ def test_a_web_server_as_dask_scheduler_fails_within_the_deadline_naming_the_add
         srv.wait(10)
     assert isinstance(err, parallel.ParallelError), repr(err)
     assert f"cannot reach a Dask scheduler at tcp://127.0.0.1:{port}" in str(err)
-    assert "handshake" in str(err)
+    # the web server either keeps quiet (no handshake within the deadline) or answers the handshake with HTTP,
+    # which Dask reads as a frame of absurd length (Python 3.14's http.server answers at once): both say the
+    # address answers, but not as a Dask scheduler
+    assert "handshake" in str(err) or "not Dask's protocol" in str(err), str(err)
 
 
 @pytest.mark.parametrize("garbage", [b"\xff" * 16 + b"garbage" * 100,  # a length no decoder accepts
