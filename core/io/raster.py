@@ -178,27 +178,35 @@ def write_cog(path: str, array: np.ndarray, geotransform: Sequence[float], crs: 
         if metadata:
             mem.SetMetadata({str(k): str(v) for k, v in metadata.items()})
         check_cancel(progress)
-
-        def cb(fraction, _msg, _data):
-            progress.report(fraction, "writing Cloud-Optimized GeoTIFF")
-            return 0 if progress.is_cancelled() else 1
-
-        opts = gdal.TranslateOptions(format="COG", creationOptions=[
-            "COMPRESS=DEFLATE", "PREDICTOR=YES", "BLOCKSIZE=256", "OVERVIEWS=IGNORE_EXISTING",
-            "OVERVIEW_RESAMPLING=AVERAGE", "BIGTIFF=IF_SAFER"], callback=cb)
-        try:
-            out = gdal.Translate(tmp, mem, options=opts)
-        except RuntimeError as e:
-            check_cancel(progress)  # GDAL reports a user interrupt as an error
-            raise DsmError(f"cannot write {path}: {e}") from e
-        if out is None:
-            check_cancel(progress)
-            raise DsmError(f"cannot write {path}")
-        out.FlushCache()
-        out = None
+        translate_to_cog(mem, tmp, path, progress)
         mem = None
         check_cancel(progress)
     return path
+
+
+def translate_to_cog(source, tmp: str, path: str, progress: Progress, error=None) -> None:
+    """``source`` (a GDAL dataset or file) into the Cloud-Optimized GeoTIFF ``tmp`` (DEFLATE, overviews), the
+    progress reported and a cancel honoured; ``error`` (DsmError by default) names ``path`` when GDAL fails."""
+    gdal, _ = _gdal()
+    error = error or DsmError
+
+    def cb(fraction, _msg, _data):
+        progress.report(fraction, "writing Cloud-Optimized GeoTIFF")
+        return 0 if progress.is_cancelled() else 1
+
+    opts = gdal.TranslateOptions(format="COG", creationOptions=[
+        "COMPRESS=DEFLATE", "PREDICTOR=YES", "BLOCKSIZE=256", "OVERVIEWS=IGNORE_EXISTING",
+        "OVERVIEW_RESAMPLING=AVERAGE", "BIGTIFF=IF_SAFER"], callback=cb)
+    try:
+        out = gdal.Translate(tmp, source, options=opts)
+    except RuntimeError as e:
+        check_cancel(progress)  # GDAL reports a user interrupt as an error
+        raise error(f"cannot write {path}: {e}") from e
+    if out is None:
+        check_cancel(progress)
+        raise error(f"cannot write {path}")
+    out.FlushCache()
+    out = None
 
 
 # measured / interpolated: the values of the source rasters beside a DSM (dense/dsm-source.tif) or a DTM
@@ -566,6 +574,6 @@ def read_las(path: str) -> Tuple[np.ndarray, np.ndarray, dict]:
     return xyz, rgb, header
 
 
-__all__ = ["Grid", "write_cog", "open_dsm", "DsmReader", "DsmInfo", "read_dsm", "write_las", "read_las", "DsmError",
+__all__ = ["Grid", "write_cog", "translate_to_cog", "open_dsm", "DsmReader", "DsmInfo", "read_dsm", "write_las", "read_las", "DsmError",
            "axis_metres",
            "NODATA", "bilinear", "crs_to_wkt", "crs_epsg", "height_unit"]

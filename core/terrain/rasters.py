@@ -229,24 +229,7 @@ def write_float_tiles(path: str, tile_values, elev: Elevation, description: str,
                 check_cancel(progress)
             ds.FlushCache()
             ds = band = None
-
-            def cb(fraction, _msg, _data):
-                progress.report(fraction, "writing Cloud-Optimized GeoTIFF")
-                return 0 if progress.is_cancelled() else 1
-
-            opts = gdal.TranslateOptions(format="COG", creationOptions=[
-                "COMPRESS=DEFLATE", "PREDICTOR=YES", "BLOCKSIZE=256", "OVERVIEWS=IGNORE_EXISTING",
-                "OVERVIEW_RESAMPLING=AVERAGE", "BIGTIFF=IF_SAFER"], callback=cb)
-            try:
-                out = gdal.Translate(tmp, work, options=opts)
-            except RuntimeError as e:
-                check_cancel(progress)
-                raise TerrainError(f"cannot write {path}: {e}") from e
-            if out is None:
-                check_cancel(progress)
-                raise TerrainError(f"cannot write {path}")
-            out.FlushCache()
-            out = None
+            raster.translate_to_cog(work, tmp, path, progress, TerrainError)
         finally:
             if os.path.exists(work):
                 os.remove(work)
