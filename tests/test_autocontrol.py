@@ -79,7 +79,7 @@ def _check_points(block):
 
 def _camera_errors(ws_dir, block):
     rec, tr = Layout(Workspace.open(ws_dir)).load_georef_model()
-    off = np.asarray(tr["offset"], dtype=float)
+    off = tr.offset
     errs = []
     for im in rec.images.values():
         m = np.asarray(im.cam_from_world().matrix())

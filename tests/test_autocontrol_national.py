@@ -226,7 +226,7 @@ def _camera_errors(ws_dir, block, crs):
     names = sorted(im.name for im in rec.images.values())
     c = {im.name: -np.asarray(im.cam_from_world().matrix())[:, :3].T @ np.asarray(im.cam_from_world().matrix())[:, 3]
          for im in rec.images.values()}
-    world = np.array([c[n] for n in names]) + np.asarray(tr["offset"], dtype=float)
+    world = np.array([c[n] for n in names]) + tr.offset
     utm = transform_points(world, crs, syn.CRS)
     truth = np.array([block.shot(n).centre + syn.ORIGIN for n in names])
     return np.hypot(*(utm - truth)[:, :2].T), np.abs(utm - truth)[:, 2]

@@ -61,7 +61,7 @@ def orbit_run(tmp_path_factory):
 
 def _centre_errors(ws, orbit):
     rec, tr = Layout(Workspace.open(ws)).load_georef_model()
-    off = np.asarray(tr["offset"], dtype=float)
+    off = tr.offset
     out = {}
     for im in rec.images.values():
         m = np.asarray(im.cam_from_world().matrix())

@@ -63,7 +63,7 @@ def _options(**kw):
 
 def _centre_errors(block, ws):
     rec, transform = load_georef_model(ws)
-    offset = np.asarray(transform["offset"], dtype=float)
+    offset = transform.offset
     return np.array([np.asarray(im.projection_center()) + offset - (block.shot(im.name).centre + syn.ORIGIN)
                      for im in rec.images.values() if im.has_pose])
 
@@ -586,7 +586,7 @@ def test_four_archive_frames_keep_their_calibrated_focal_length_and_their_height
         align(block.paths["images"], ws, _options(**kw))
         georeference_workspace(ws, gcps=_archive_gcps(block), crs=arch.ARCHIVE_PROJ)
         rec, transform = load_georef_model(ws)
-        offset = np.asarray(transform["offset"], dtype=float)
+        offset = transform.offset
         err = np.array([np.asarray(im.projection_center()) + offset - block.frame(im.name).centre_world
                         for im in rec.images.values() if im.has_pose])
         (camera,) = rec.cameras.values()
@@ -645,7 +645,7 @@ def test_film_scans_restituted_by_prepare_images_keep_their_interior_orientation
     rec, transform = load_georef_model(ws)
     (camera,) = rec.cameras.values()
     assert abs(camera.params[0] - io["focal_px"]) <= 1e-9
-    offset = np.asarray(transform["offset"], dtype=float)
+    offset = transform.offset
     original = {s["prepared_name"]: s["name"] for s in scans["scans"]}
     err = np.array([np.asarray(im.projection_center()) + offset - block.frame(original[im.name]).centre_world
                     for im in rec.images.values() if im.has_pose])

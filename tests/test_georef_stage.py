@@ -59,7 +59,7 @@ def test_exif_gps_georeferencing_lines_up_with_surveyed_positions(aligned):
     # the adjusted model stays near the origin: world = local + offset
     centres = np.array([im.projection_center() for im in rec.images.values()])
     assert np.abs(centres).max() < 1000
-    assert transform["offset"][0] > 200000
+    assert transform.offset[0] > 200000
 
 
 def test_camera_positions_file_gives_the_crs(aligned, tmp_path):

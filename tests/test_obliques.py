@@ -593,7 +593,7 @@ def test_orbit_poses_within_the_nadir_tolerances(orbit, orbit_run):
     assert f["CHECK_N"] >= 5
     assert f["CHECK_RMSE_XY"] <= 1.0 * gsd and f["CHECK_RMSE_Z"] <= 1.5 * gsd
     rec, transform = Layout(Workspace.open(orbit_run["ws"])).load_georef_model()
-    offset = np.asarray(transform["offset"], dtype=float)
+    offset = transform.offset
     err = np.array([np.asarray(im.projection_center()) + offset - syn.ORIGIN - orbit.shot(im.name).centre
                     for im in rec.images.values()])
     rmse = np.sqrt(np.mean(err ** 2, axis=0))
@@ -627,7 +627,7 @@ def test_orbit_no_dense_point_from_the_sky(orbit, orbit_run):
 
     lay = Layout(Workspace.open(orbit_run["ws"]))
     rec, transform = lay.load_georef_model()
-    shift = np.asarray(transform["offset"], dtype=float) - syn.ORIGIN  # georef local -> synthetic local
+    shift = transform.offset - syn.ORIGIN  # georef local -> synthetic local
     fused = os.path.join(lay.dense_dir, "fused")
     total, near = 0, []
     for f in os.listdir(fused):

@@ -43,8 +43,8 @@ class GcpPlacement:
             if self.store.stage_done(GEOREFERENCE) and os.path.isdir(self.store.layout.georef_model_dir):
                 prebuilt = self._take_prebuilt_model(ws, True)  # read and measured in a task (GcpTasks), or None
                 rec, transform = prebuilt[:2] if prebuilt else load_georef_model(ws)
-                same = layers.qgs_crs(transform.get("crs", "")) == layers.qgs_crs(self.store.crs)
-                self.predictor = guided.Predictor(rec, transform.get("offset") if same else None)
+                same = layers.qgs_crs(transform.crs) == layers.qgs_crs(self.store.crs)
+                self.predictor = guided.Predictor(rec, transform.offset if same else None)
             else:
                 prebuilt = self._take_prebuilt_model(ws, False)
                 self.predictor = guided.Predictor(prebuilt[0] if prebuilt else align_stage.load_model(ws))

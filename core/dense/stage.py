@@ -110,9 +110,9 @@ def build_dsm_workspace(workspace_dir: str, resolution: float = 0.0, quality: Op
             raise DenseError("ENGINE 'cuda' needs pycolmap built with CUDA (pycolmap.has_cuda is False here); "
                              "use ENGINE 'cpu'")
     job = _Journal(progress)
-    rec, transform = lay.load_georef_model()
-    offset = np.asarray(transform.get("offset", [0.0, 0.0, 0.0]), dtype=np.float64)
-    crs = transform.get("crs") or ws.crs
+    rec, frame = lay.load_georef_model()
+    offset = frame.offset
+    crs = frame.crs or ws.crs
     images_dir = ws.data.get("images_dir") or ""
     views = _views(ws, rec, images_dir)
     for note in _check_photos(ws, views):

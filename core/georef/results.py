@@ -1,8 +1,8 @@
 """What a georeferencing returns: the residual rows, the outliers, and ``GeorefResult`` with its files.
 
 ``GeorefResult.save`` writes ``transform.json`` and ``residuals.json`` (the workspace format: the keys are
-read back by the report, the dock and older workspaces); ``load_transform`` reads a transform back with its
-``Similarity`` objects.
+read back by the report, the dock and older workspaces); ``core.project.frame.GeorefFrame`` (through
+``Layout.load_transform``) reads a transform back, typed.
 """
 from __future__ import annotations
 
@@ -217,20 +217,5 @@ def _atomic_write(path: str, text: str) -> None:
     atomic_write_text(path, text)
 
 
-def load_transform(path: str) -> Dict[str, Any]:
-    """Read transform.json (a file or the folder holding it): crs, offset, and the Similarity objects."""
-    if os.path.isdir(path):
-        path = os.path.join(path, TRANSFORM_FILE)
-    with open(path, encoding="utf-8") as f:
-        d = json.load(f)
-    out = dict(d)
-    out["offset"] = np.asarray(d["offset"], dtype=float)
-    for k in ("local_to_world", "model_to_local", "model_to_world"):
-        if k in d:
-            out[k] = Similarity.from_dict(d[k])
-    return out
-
-
-
 __all__ = ["CHECKED", "CameraResidual", "FORMAT_VERSION", "GeorefResult", "NOT_TRIANGULATED", "Outlier",
-           "PointResidual", "REJECTED", "RESIDUALS_FILE", "TRANSFORM_FILE", "USED", "load_transform"]
+           "PointResidual", "REJECTED", "RESIDUALS_FILE", "TRANSFORM_FILE", "USED"]

@@ -61,7 +61,7 @@ def model_path(ws: Workspace) -> str:
 
 
 def load_georef_model(workspace_dir: str):
-    """(pycolmap.Reconstruction in the local frame, transform dict with 'offset' and 'crs') of a
+    """(pycolmap.Reconstruction in the local frame, its core.project.frame.GeorefFrame) of a
     georeferenced workspace.  Raises StageError when the workspace is not georeferenced."""
     ws = Workspace.open(workspace_dir)
     if not ws.stage_done(GEOREF):

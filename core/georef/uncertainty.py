@@ -576,8 +576,7 @@ def workspace_inputs(ws, rec) -> Tuple[List[ControlInput], List[CameraPrior], Di
         return [], [], default_free_intrinsics(rec, pp), np.zeros(3)
     params = ws.stage(GEOREFERENCE).get("parameters", {}) or {}
     refine = params.get("refine_intrinsics")
-    transform = read_json(lay.transform_json) or {}
-    offset = np.asarray(transform.get("offset", [0.0, 0.0, 0.0]), dtype=float)
+    offset = lay.load_transform().offset
     residuals = lay.residuals() or {}
     inputs = read_json(lay.adjustment_inputs_json)
     control = _control_inputs(residuals, _control_sigmas(lay, inputs), offset)

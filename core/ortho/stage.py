@@ -145,9 +145,9 @@ def _inputs(lay: Layout, dsm_path: Optional[str], images_filter: Optional[str]
         raise OrthoError(f"workspace {ws.root} has no DSM: run 'Build DSM' first or give a DSM raster")
     if not os.path.isfile(dsm_path):
         raise OrthoError(f"DSM {dsm_path} does not exist")
-    rec, transform = lay.load_georef_model()
-    offset = np.asarray(transform.get("offset", [0.0, 0.0, 0.0]), dtype=float)
-    crs = transform.get("crs") or ws.crs
+    rec, frame = lay.load_georef_model()
+    offset = frame.offset
+    crs = frame.crs or ws.crs
     cams = cameras_from_reconstruction(rec, ws.data.get("images_dir") or "", lay.masks_dir)
     if not cams:
         raise OrthoError(f"the model of {ws.root} has no oriented image")

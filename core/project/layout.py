@@ -4,7 +4,7 @@ This module alone spells out product paths.  Stages, the report and the dock ask
 product instead of joining folder names themselves::
 
     lay = Layout(ws)
-    rec, transform = lay.load_georef_model()
+    rec, frame = lay.load_georef_model()  # frame: GeorefFrame (world = local + frame.offset)
     dsm = lay.dsm()
 
 Paths are absolute.  ``rel()`` turns a path into what the manifest records (relative inside the workspace,
@@ -18,6 +18,7 @@ from typing import Any, Dict, Optional, Tuple
 
 from ..common.errors import ArchaeoOrthoError, require
 from ..common.files import atomic_write_text
+from .frame import GeorefFrame
 from .stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, TERRAIN
 from .workspace import Workspace
 
@@ -253,15 +254,15 @@ class Layout:
             raise LayoutError(f"workspace {self.root} is not georeferenced (georeference stage: {state}): run "
                               f"'Georeference' first{'; ' + why if why else ''}")
 
-    def load_transform(self) -> Dict[str, Any]:
-        """georef/transform.json: the local frame's 'offset' and the 'crs' (and the similarity)."""
+    def load_transform(self) -> GeorefFrame:
+        """georef/transform.json as a typed frame (world = local + offset, in its CRS)."""
         t = read_json(self.transform_json)
         if t is None:
             raise LayoutError(f"{self.transform_json} is missing or damaged: run 'Georeference' again")
-        return t
+        return GeorefFrame.from_dict(t, self.transform_json)
 
-    def load_georef_model(self) -> Tuple[Any, Dict[str, Any]]:
-        """(pycolmap.Reconstruction in the local frame, transform dict) of a georeferenced workspace."""
+    def load_georef_model(self) -> Tuple[Any, GeorefFrame]:
+        """(pycolmap.Reconstruction in the local frame, its GeorefFrame) of a georeferenced workspace."""
         self.require_georeferenced()
         return self._read_model(self.georef_model_dir), self.load_transform()
 

@@ -38,8 +38,8 @@ class ReportData:
         self.alignment = _read_json(lay.alignment_json)
         self.georeferenced = lay.is_georeferenced()
         self.residuals = _read_json(lay.residuals_json) if self.georeferenced else None
-        self.transform = _read_json(lay.transform_json) if self.georeferenced else None
-        self.offset = np.asarray((self.transform or {}).get("offset", [0.0, 0.0, 0.0]), dtype=float)
+        self.frame = lay.load_transform() if self.georeferenced else None
+        self.offset = self.frame.offset if self.frame is not None else np.zeros(3)
         self.crs = ws.crs if self.georeferenced else None
         self.crs_label = crs_label(self.crs) if self.crs else None
         self.screening = _read_json(lay.screening_json)

@@ -28,10 +28,9 @@ def section(ctx: ReportContext) -> str:
     acc = accuracy_figures(res, ortho_res or ctx.gsd)
     ctx.acc = acc
     stats = acc["stats"]
-    tf = d.transform or {}
     parts = [kv([
         ("CRS", esc(crs_label(res.get("crs") or d.crs))),
-        ("Source of the datum", esc(tf.get("source", "–"))),
+        ("Source of the datum", esc((d.frame.source if d.frame is not None else "") or "–")),
         ("Local frame offset (world = local + offset)", esc(", ".join(f"{v:.1f}" for v in d.offset))),
         ("Tie-point reprojection error after the adjustment",
          f"{fmt(res.get('mean_reprojection_error_px'), 3)} px"),
