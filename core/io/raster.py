@@ -1,4 +1,5 @@
-"""Rasters and point clouds on disk: the DSM's Cloud-Optimized GeoTIFF, the DSM reader, LAS point clouds.
+"""Rasters and point clouds on disk: the one raster reader (:class:`RasterFile`), the DSM's Cloud-Optimized
+GeoTIFF, the DSM reader, LAS point clouds.
 
 This is the one module that writes and reads DSMs, so the orthophoto stage reads
 ours and an external one (an ALS DSM the user has) through the same helpers:
@@ -29,7 +30,11 @@ from ..geometry.crs import epsg_code, linear_unit
 NODATA = -9999.0
 
 
-class DsmError(ArchaeoOrthoError, RuntimeError):
+class RasterError(ArchaeoOrthoError, RuntimeError):
+    """A raster cannot be opened or read; the message names the file and says why."""
+
+
+class DsmError(RasterError):
     """A DSM cannot be written or read; the message says why."""
 
 
@@ -39,6 +44,102 @@ def _gdal():
     gdal.UseExceptions()
     osr.UseExceptions()
     return gdal, osr
+
+
+class RasterFile:
+    """A raster file opened with GDAL: the one place in core/ that opens rasters (DSMs, orthophotos, references,
+    photos, masks, products); errors are :class:`RasterError` naming the file and what it was meant to be.
+
+    with RasterFile(path, "reference orthophoto") as r:
+        r.width, r.height, r.count, r.geotransform, r.crs_wkt, r.nodata(1)
+        a = r.read(1, window=(x0, y0, w, h), out_shape=(h2, w2), resampling="average")
+        rgb = r.read_bands([1, 2, 3])
+
+    ``update=True`` opens it for writing (a product being finished).  ``dataset`` is the GDAL dataset, for the
+    GDAL operations that take one (warp, translate, polygonize); nothing else should need it.
+    """
+
+    def __init__(self, path: str, what: str = "raster", update: bool = False):
+        gdal, _ = _gdal()
+        self.path = path
+        self.what = what
+        if not (os.path.isfile(path) or path.startswith("/vsi")):
+            raise RasterError(f"{what} {path} does not exist")
+        try:
+            ds = gdal.Open(path, gdal.GA_Update if update else gdal.GA_ReadOnly)
+        except RuntimeError as e:
+            raise RasterError(f"{what} {path} is not a raster GDAL can read: {e}") from e
+        if ds is None or ds.RasterCount < 1:
+            raise RasterError(f"{what} {path} has no raster band")
+        self._ds = ds
+        self.width, self.height, self.count = ds.RasterXSize, ds.RasterYSize, ds.RasterCount
+        self.geotransform: Optional[Tuple[float, ...]] = ds.GetGeoTransform(can_return_null=True)
+        if self.geotransform is not None:
+            self.geotransform = tuple(self.geotransform)
+        self.crs_wkt: str = ds.GetProjection() or ""
+
+    @property
+    def dataset(self):
+        if self._ds is None:
+            raise RasterError(f"{self.what} {self.path} is closed")
+        return self._ds
+
+    def __enter__(self) -> "RasterFile":
+        return self
+
+    def __exit__(self, *exc) -> bool:
+        self.close()
+        return False
+
+    def close(self) -> None:
+        if self._ds is not None:
+            self._ds.FlushCache()
+        self._ds = None
+
+    def band(self, index: int = 1):
+        if not 1 <= index <= self.count:
+            raise RasterError(f"{self.what} {self.path} has {self.count} band(s), not band {index}")
+        return self.dataset.GetRasterBand(index)
+
+    def nodata(self, index: int = 1) -> Optional[float]:
+        return self.band(index).GetNoDataValue()
+
+    def metadata(self, index: Optional[int] = None, domain: str = "") -> dict:
+        src = self.dataset if index is None else self.band(index)
+        return src.GetMetadata(domain) or {}
+
+    def require_georeferenced(self, north_up: bool = True) -> Tuple[float, ...]:
+        """The geotransform; RasterError when the file has none (or is rotated, with ``north_up``)."""
+        gt = self.geotransform
+        if gt is None:
+            raise RasterError(f"{self.what} {self.path} has no georeferencing (geotransform)")
+        if north_up and (gt[2] != 0 or gt[4] != 0):
+            raise RasterError(f"{self.what} {self.path} is rotated (geotransform {gt}); warp it north-up first")
+        return gt
+
+    def read(self, index: int = 1, window: Optional[Tuple[int, int, int, int]] = None,
+             out_shape: Optional[Tuple[int, int]] = None, resampling: str = "nearest") -> np.ndarray:
+        """Band ``index`` (or the ``window`` (col, row, width, height) of it) as an array, resampled to
+        ``out_shape`` (rows, cols) when given (GDAL's overview-aware resampling: "nearest", "average", ...)."""
+        gdal, _ = _gdal()
+        x0, y0, w, h = window if window is not None else (0, 0, self.width, self.height)
+        kw = {}
+        if out_shape is not None:
+            kw = {"buf_xsize": int(out_shape[1]), "buf_ysize": int(out_shape[0]),
+                  "resample_alg": getattr(gdal, f"GRIORA_{resampling.capitalize()}", gdal.GRIORA_NearestNeighbour)}
+        try:
+            arr = self.band(index).ReadAsArray(int(x0), int(y0), int(w), int(h), **kw)
+        except RuntimeError as e:
+            raise RasterError(f"{self.what} {self.path}: band {index} cannot be read ({e})") from e
+        if arr is None:
+            raise RasterError(f"{self.what} {self.path}: band {index} cannot be read (window {window})")
+        return arr
+
+    def read_bands(self, indices: Optional[Sequence[int]] = None, window: Optional[Tuple[int, int, int, int]] = None,
+                   out_shape: Optional[Tuple[int, int]] = None, resampling: str = "nearest") -> np.ndarray:
+        """Several bands stacked (bands, rows, cols); every band when ``indices`` is None."""
+        indices = list(indices) if indices is not None else list(range(1, self.count + 1))
+        return np.stack([self.read(i, window, out_shape, resampling) for i in indices])
 
 
 def crs_to_wkt(crs: Optional[str]) -> str:
@@ -79,16 +180,16 @@ def height_unit(path: str) -> Tuple[str, float, str]:
     one ('ft', 'US survey foot', 'm'), else a compound CRS's vertical unit, else the unit of a projected CRS
     whose axes are not in metres (a state plane DEM in feet), else metres ('' where nothing says: a DEM in a
     geographic or metric CRS)."""
-    gdal, osr = _gdal()
-    ds = gdal.Open(path)
-    unit = (ds.GetRasterBand(1).GetUnitType() or "").strip()
+    _, osr = _gdal()
+    with RasterFile(path, "DSM") as r:
+        unit = (r.band(1).GetUnitType() or "").strip()
+        wkt = r.crs_wkt
     if unit:
         low = unit.lower()
         if low in _FEET:
             return unit, _FEET[low], "the band's unit"
         if low in _METRES:
             return unit, 1.0, "the band's unit"
-    wkt = ds.GetProjection() or ""
     if wkt:
         srs = osr.SpatialReference(wkt=wkt)
         if srs.IsCompound() or srs.IsVertical():
@@ -292,27 +393,19 @@ class DsmInfo:
 
 def open_dsm(path: str) -> DsmInfo:
     """Check and describe a DSM raster (ours or external).  Raises DsmError with a clear message."""
-    gdal, _ = _gdal()
-    if not os.path.isfile(path):
-        raise DsmError(f"DSM {path} does not exist")
     try:
-        ds = gdal.Open(path)
-    except RuntimeError as e:
-        raise DsmError(f"{path} is not a raster GDAL can read: {e}") from e
-    if ds.RasterCount < 1:
-        raise DsmError(f"{path} has no raster band")
-    gt = ds.GetGeoTransform(can_return_null=True)
-    if gt is None:
-        raise DsmError(f"{path} has no georeferencing (geotransform)")
-    if gt[2] != 0 or gt[4] != 0:
-        raise DsmError(f"{path} is rotated (geotransform {gt}); warp it north-up first")
-    w, h = ds.RasterXSize, ds.RasterYSize
-    xs = (gt[0], gt[0] + w * gt[1])
-    ys = (gt[3], gt[3] + h * gt[5])
-    band = ds.GetRasterBand(1)
-    return DsmInfo(path=path, width=w, height=h, geotransform=tuple(gt), crs_wkt=ds.GetProjection() or "",
-                   nodata=band.GetNoDataValue(), bounds=(min(xs), min(ys), max(xs), max(ys)),
-                   resolution=(abs(gt[1]), abs(gt[5])), metadata=ds.GetMetadata() or {})
+        with RasterFile(path, "DSM") as r:
+            gt = r.require_georeferenced()
+            w, h = r.width, r.height
+            xs = (gt[0], gt[0] + w * gt[1])
+            ys = (gt[3], gt[3] + h * gt[5])
+            return DsmInfo(path=path, width=w, height=h, geotransform=tuple(gt), crs_wkt=r.crs_wkt,
+                           nodata=r.nodata(1), bounds=(min(xs), min(ys), max(xs), max(ys)),
+                           resolution=(abs(gt[1]), abs(gt[5])), metadata=r.metadata())
+    except DsmError:
+        raise
+    except RasterError as e:
+        raise DsmError(str(e)) from e
 
 
 class DsmReader:
@@ -331,7 +424,8 @@ class DsmReader:
     def __init__(self, path: str, target_crs: Optional[str] = None, resampling: str = "bilinear"):
         gdal, osr = _gdal()
         self.info = open_dsm(path)
-        self._ds = gdal.Open(path)
+        self._file = RasterFile(path, "DSM")
+        self._ds = self._file.dataset
         if target_crs and self.info.crs_wkt:
             src = osr.SpatialReference(wkt=self.info.crs_wkt)
             dst = osr.SpatialReference()
@@ -359,6 +453,7 @@ class DsmReader:
 
     def close(self):
         self._ds = None
+        self._file.close()
         self._cache = None
 
     def _clean(self, arr: np.ndarray) -> np.ndarray:
@@ -574,6 +669,6 @@ def read_las(path: str) -> Tuple[np.ndarray, np.ndarray, dict]:
     return xyz, rgb, header
 
 
-__all__ = ["Grid", "write_cog", "translate_to_cog", "open_dsm", "DsmReader", "DsmInfo", "read_dsm", "write_las", "read_las", "DsmError",
-           "axis_metres",
+__all__ = ["Grid", "write_cog", "translate_to_cog", "open_dsm", "DsmReader", "DsmInfo", "read_dsm", "write_las",
+           "read_las", "DsmError", "RasterError", "RasterFile", "axis_metres",
            "NODATA", "bilinear", "crs_to_wkt", "crs_epsg", "height_unit"]
