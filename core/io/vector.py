@@ -4,7 +4,29 @@ from __future__ import annotations
 import os
 from typing import Dict, List, Optional, Sequence
 
+from ..common.errors import ArchaeoOrthoError
 from ..common.files import atomic_output
+
+
+class VectorError(ArchaeoOrthoError, RuntimeError):
+    """A vector file cannot be read; the message names the file and the problem."""
+
+
+def open_vector(path: str, what: str):
+    """The OGR dataset of the vector file ``path`` (``what`` it is meant to be, e.g. "seamlines", begins the
+    messages); VectorError when the file is missing, not a vector file GDAL can read, or holds no layer."""
+    from osgeo import gdal
+
+    gdal.UseExceptions()
+    if not os.path.isfile(path):
+        raise VectorError(f"{what} {path} does not exist")
+    try:
+        ds = gdal.OpenEx(path, gdal.OF_VECTOR)
+    except RuntimeError as e:
+        raise VectorError(f"{what} {path} is not a vector file GDAL can read: {e}") from e
+    if ds is None or ds.GetLayerCount() == 0:
+        raise VectorError(f"{what} {path} holds no vector layer")
+    return ds
 
 
 def write_points_gpkg(path: str, layer: str, rows: Sequence[Dict], fields: Sequence[tuple],

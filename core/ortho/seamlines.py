@@ -17,6 +17,7 @@ import numpy as np
 
 from ..common.files import atomic_output
 from ..io import raster as dsmmod
+from ..io.vector import VectorError, open_vector
 from .options import OrthoError
 from .pixels import load_gdal
 
@@ -134,17 +135,12 @@ def read_seamline_edits(source: str, names: Sequence[str], crs: Optional[str], l
     mosaic's ``extent``)."""
     from osgeo import ogr
 
-    gdal = load_gdal()
     ogr.UseExceptions()
     path, layer_name = _split_source(source)
-    if not os.path.isfile(path):
-        raise SeamlineError(f"seamlines {path} does not exist")
     try:
-        ds = gdal.OpenEx(path, gdal.OF_VECTOR)
-    except RuntimeError as e:
-        raise SeamlineError(f"seamlines {path} is not a vector file GDAL can read: {e}") from e
-    if ds is None or ds.GetLayerCount() == 0:
-        raise SeamlineError(f"seamlines {path} holds no vector layer")
+        ds = open_vector(path, "seamlines")
+    except VectorError as e:
+        raise SeamlineError(str(e)) from e
     if layer_name:
         lyr = ds.GetLayerByName(layer_name)
         if lyr is None:
