@@ -24,6 +24,7 @@ from core.align.escalation import (
     round_pairs,
     weak_images,
 )
+from core.align.features import Extraction, FeatureSettings
 from core.align.mapping import RELAXED_ABS_POSE_MIN_INLIERS
 from core.align.options import AlignError, AlignOptions
 from core.align.stage import align
@@ -63,7 +64,17 @@ def small_block(tmp_path_factory):
 
 
 def _options(**kw):
-    return AlignOptions(focal_mm=FOCAL_MM, sensor_width_mm=SENSOR_WIDTH_MM, **kw)
+    """The small frames' options; the texture probe off (core.align.firstpass would give these faint frames the
+    escalation's features at once): the escalation is what these tests exercise."""
+    return AlignOptions(focal_mm=FOCAL_MM, sensor_width_mm=SENSOR_WIDTH_MM, **{"texture_probe": False, **kw})
+
+
+def _context(db, tmp_path, names, partners):
+    """An escalation context over the database ``db`` whose steps do nothing (a test replaces _run_round)."""
+    import core.align.escalation as esc
+
+    return esc.EscalationContext(None, Extraction(str(db), str(tmp_path), [], {}), FeatureSettings(1000, 4096, 0),
+                                 str(tmp_path), names, AlignOptions(), [], lambda p: [], lambda reg, oth: {}, partners)
 
 
 class _Image:
@@ -145,8 +156,7 @@ def test_a_weakly_tied_image_is_escalated_and_the_stronger_result_kept(tmp_path,
                                    kept=esc._better(new, ordered)), new
 
     monkeypatch.setattr(esc, "_run_round", round_)
-    ctx = esc.EscalationContext(None, str(db), str(tmp_path), str(tmp_path), names, [], {}, AlignOptions(), [],
-                                None, [], lambda p: [], lambda reg, oth: {}, lambda: {n: 3 for n in names})
+    ctx = _context(db, tmp_path, names, lambda: {n: 3 for n in names})
     outcome = "strong"
     out, record = esc.escalate(ctx, [weak], NullProgress())
     assert out == [strong] and seen == [(1, "affine", ["c"], "1 image(s) of the block weakly tied")]
@@ -269,8 +279,7 @@ def test_a_round_not_kept_puts_the_database_back(tmp_path, monkeypatch):
         return esc.EscalationRound(k, reason, kind, {n: "?" for n in left}, list(left), [], {}, 1, 2, 1, 1, 1), []
 
     monkeypatch.setattr(esc, "_run_round", worse_round)
-    ctx = esc.EscalationContext(None, str(db), str(tmp_path), str(tmp_path), ["a", "b", "c"], [], {}, AlignOptions(),
-                                [], None, [], lambda p: [], lambda reg, oth: {}, lambda: {"c": 1})
+    ctx = _context(db, tmp_path, ["a", "b", "c"], lambda: {"c": 1})
     before = [_Rec(["a", "b"])]
     out, record = esc.escalate(ctx, before, NullProgress())
     assert out is before and [r.round for r in record.rounds] == [1, 2]  # c has a verified pair: round 2 ran
@@ -295,8 +304,7 @@ def test_a_cancelled_round_puts_the_database_back(tmp_path, monkeypatch):
         raise Cancelled("cancelled by the user")
 
     monkeypatch.setattr(esc, "_run_round", cancelled_round)
-    ctx = esc.EscalationContext(None, str(db), str(tmp_path), str(tmp_path), ["a", "b", "c"], [], {}, AlignOptions(),
-                                [], None, [], lambda p: [], lambda reg, oth: {}, lambda: {"c": 1})
+    ctx = _context(db, tmp_path, ["a", "b", "c"], lambda: {"c": 1})
     with pytest.raises(Cancelled):
         esc.escalate(ctx, [_Rec(["a", "b"])], NullProgress())
     con = sqlite3.connect(db)
@@ -328,8 +336,7 @@ def test_round_two_counts_the_pairs_round_one_found_even_when_its_result_was_not
         return esc.EscalationRound(k, reason, kind, {n: "?" for n in left}, list(left), [], {}, 1, 2, 1, 1, 1), []
 
     monkeypatch.setattr(esc, "_run_round", worse_round)
-    ctx = esc.EscalationContext(None, str(db), str(tmp_path), str(tmp_path), ["a", "b", "c"], [], {}, AlignOptions(),
-                                [], None, [], lambda p: [], lambda reg, oth: {}, partners)
+    ctx = _context(db, tmp_path, ["a", "b", "c"], partners)
     esc.escalate(ctx, [_Rec(["a", "b"])], NullProgress())
     assert partners() == {"c": 0}  # ...but its database was put back (its mapping was not better)
     assert rounds == [(1, "faint", ["c"]), (2, "affine", ["c"])]  # no diagnosis: faint first

@@ -49,11 +49,11 @@ from typing import Callable, Dict, List, Optional, Sequence, Set, Tuple
 import numpy as np
 
 from ..common.progress import Progress, SubProgress, check_cancel
-from .features import auto_max_features, extract_features, match_pairs
-from .options import AlignOptions
+from .features import Extraction, FeatureSettings, auto_max_features, extract_features, match_pairs
+from .options import FAINT_MIN_FEATURES, FAINT_PEAK_THRESHOLD, AlignOptions
 
-ESCALATION_MIN_FEATURES = 8192  # pycolmap's default SIFT budget: the escalated budget is never below it
-ESCALATION_PEAK_THRESHOLD = 0.02 / 3 / 3  # a third of SIFT's default (0.02 / octave_resolution): faint features
+ESCALATION_MIN_FEATURES = FAINT_MIN_FEATURES  # pycolmap's default SIFT budget: the escalated budget is never below it
+ESCALATION_PEAK_THRESHOLD = FAINT_PEAK_THRESHOLD  # a third of SIFT's default (0.02 / octave_resolution): faint features
 AFFINE_MIN_FEATURES = 4096  # the affine round's budget: as many registered as with 8192, matching ~4x cheaper
 KINDS = ("faint", "affine")
 ANCHORS_PER_IMAGE = 6  # registered images a left-out image matched best
@@ -141,12 +141,14 @@ def escalation_reason(n_images: int, registered: Set[str], others: Sequence[Sequ
     return "; ".join(parts) or None
 
 
-def escalated_sift(options: AlignOptions, width: int, height: int, kind: str = "faint") -> Dict[str, object]:
+def escalated_sift(options: AlignOptions, width: int, height: int, kind: str = "faint",
+                   budget: Optional[int] = None) -> Dict[str, object]:
     """The SIFT settings of an escalation round of ``kind``: "faint" -- upsampled, more and fainter features;
-    "affine" -- upsampled with affine-shape estimation at SIFT's default threshold."""
+    "affine" -- upsampled with affine-shape estimation at SIFT's default threshold.  ``budget``: the first
+    pass's features per photo (core.align.firstpass), else the options' (or the automatic) budget."""
     if kind not in KINDS:
         raise ValueError(f"unknown escalation kind {kind!r}; one of {', '.join(KINDS)}")
-    base = int(options.max_features or auto_max_features(width, height, options.max_image_size))
+    base = int(budget or options.max_features or auto_max_features(width, height, options.max_image_size))
     if kind == "affine":
         return {"first_octave": -1, "max_num_features": max(AFFINE_MIN_FEATURES, base),
                 "estimate_affine_shape": True}
@@ -263,19 +265,19 @@ class EscalationContext:
     """What :func:`escalate` needs from the stage: the database, the photos and the stage's steps."""
 
     pycolmap: object
-    db_path: str
+    job: Extraction  # the database, the photos, their cameras and masks
+    settings: FeatureSettings  # the first pass's features (core.align.firstpass): a round's start from them
     work_dir: str
-    images_dir: str
     order: List[str]  # every image name, in file order
-    groups: list
-    camera_ids: Dict[str, int]
     options: AlignOptions
     pairs: List[Tuple[str, str]]
-    mask_path: Optional[str]
-    masked: List[str]
     mapping: Callable[[Progress], list]  # runs the mapping on the database: reconstructions, largest first
     diagnose: Callable[[Set[str], List[List[str]]], Dict[str, str]]  # (registered, others) -> image -> why
     partners: Callable[[], Dict[str, int]]  # image -> how many images it shares a verified pair with
+
+    @property
+    def db_path(self) -> str:
+        return self.job.db_path
 
 
 def _better(new, old) -> bool:
@@ -304,8 +306,8 @@ def _run_round(ctx: EscalationContext, k: int, reason: str, ordered, left: List[
     anchors = registered - set(left)  # a weakly tied image is escalated as a left-out one, not as a neighbour
     neighbours, exhaustive = _round_images(ctx, kind, anchors, left, ordered)
     redo = [n for n in ctx.order if n in set(left) | set(neighbours)]
-    g0 = max(ctx.groups, key=lambda g: g.width * g.height)
-    sift = escalated_sift(ctx.options, g0.width, g0.height, kind)
+    g0 = max(ctx.job.groups, key=lambda g: g.width * g.height)
+    sift = escalated_sift(ctx.options, g0.width, g0.height, kind, ctx.settings.max_features)
     extra = ", affine shape" if sift.get("estimate_affine_shape") else ""
     threshold = sift.get("peak_threshold")
     progress.info(f"escalation round {k}, {kind} ({reason}): {len(left)} image(s) to bring in, re-extracting "
@@ -314,8 +316,7 @@ def _run_round(ctx: EscalationContext, k: int, reason: str, ordered, left: List[
     for n in left:
         progress.info(f"escalation round {k}: {n}: {why.get(n, 'not in the main block')}")
     forget_features(ctx.db_path, redo)
-    extract_features(ctx.pycolmap, ctx.db_path, ctx.images_dir, ctx.groups, ctx.camera_ids, ctx.options,
-                     SubProgress(progress, 0.0, 0.4), ctx.mask_path, ctx.masked, sift=sift)
+    extract_features(ctx.pycolmap, ctx.job, ctx.settings.with_sift(sift), ctx.options, SubProgress(progress, 0.0, 0.4))
     t_features = time.time() - t0
     pairs = round_pairs(ctx.pairs, left, neighbours, ctx.order, exhaustive)
     if kind == "affine" and not exhaustive:  # a larger block: each left-out image with every registered one

@@ -15,6 +15,7 @@ import hashlib
 import math
 import os
 import shutil
+from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence, Tuple
 
 from ..common.cancel import CancelWatcher
@@ -54,9 +55,10 @@ def choose_camera_model(requested: str, n_images: int, min_images_opencv: int = 
 
 
 def database_key(groups: List[CameraGroup], options: AlignOptions, images_dir: str, masks_key: Optional[str] = None,
-                 photos_key: Optional[str] = None) -> str:
+                 photos_key: Optional[str] = None, first_pass: Optional[Dict[str, object]] = None) -> str:
     """The key of what a database's features were extracted from: images (names, sizes, content), folder,
-    camera settings and masks; a database of another key is not reused."""
+    camera settings, masks and the first pass's settings where the texture probe (core.align.firstpass) chose
+    other than the default (``first_pass``); a database of another key is not reused."""
     what = {
         "groups": [(g.key, g.width, g.height, round(g.focal_px, 3), sorted(g.images)) for g in groups],
         "model": options.camera_model, "max_image_size": options.max_image_size,
@@ -75,6 +77,8 @@ def database_key(groups: List[CameraGroup], options: AlignOptions, images_dir: s
     n_auto = auto_max_features(g0.width, g0.height, options.max_image_size)
     if not options.max_features and n_auto == AUTO_FEATURES_RANGE[1]:  # the cap (8192 before it was 4096)
         what["auto_features"] = n_auto
+    if first_pass:  # richer settings chosen from the photos' texture: another choice extracts afresh
+        what["first_pass"] = first_pass
     if photos_key:  # the photos' content: another photo under the same name is extracted afresh
         what["photos"] = photos_key
     return fingerprint(what)
@@ -195,33 +199,79 @@ def match_block(mean_keypoints: float) -> int:
     return int(min(MAX_MATCH_BLOCK, max(MATCH_BLOCK, round(MATCH_BLOCK * ratio * ratio))))
 
 
-def extract_features(pycolmap, db_path, images_dir, groups, camera_ids, options, progress: Progress,
-                     mask_path: Optional[str] = None, masked: Optional[Sequence[str]] = None,
-                     sift: Optional[Dict[str, object]] = None):
-    """SIFT features of every image of ``groups`` the database has none for; ``sift`` overrides the SIFT
-    options (the escalation's upsampled, richer settings: core.align.escalation)."""
+@dataclass
+class FeatureSettings:
+    """The SIFT settings of one extraction: the long side (px) of the image SIFT runs on, the features kept per
+    image, SIFT's first octave and peak threshold (None: SIFT's default); ``extra``: other SIFT options (the
+    escalation's affine shape)."""
+
+    image_size: int
+    max_features: int
+    first_octave: int
+    peak_threshold: Optional[float] = None
+    extra: Dict[str, object] = field(default_factory=dict)
+
+    def with_sift(self, sift: Dict[str, object]) -> FeatureSettings:
+        """These settings with SIFT options overridden (``max_num_features``, ``first_octave``,
+        ``peak_threshold`` and any other SIFT option)."""
+        sift = dict(sift)
+        return FeatureSettings(self.image_size, int(sift.pop("max_num_features", self.max_features)),
+                               int(sift.pop("first_octave", self.first_octave)),
+                               sift.pop("peak_threshold", self.peak_threshold), {**self.extra, **sift})
+
+    def to_dict(self) -> Dict[str, object]:
+        out: Dict[str, object] = {"image_size": self.image_size, "max_features": self.max_features,
+                                  "first_octave": self.first_octave}
+        if self.peak_threshold is not None:
+            out["peak_threshold"] = round(float(self.peak_threshold), 6)
+        out.update(self.extra)
+        return out
+
+
+def default_settings(options: AlignOptions, width: int, height: int) -> FeatureSettings:
+    """The fast path's settings for photos of ``width`` x ``height`` (the options' values where the user set
+    them, else the automatic scale, budget and first octave)."""
+    return FeatureSettings(feature_image_size(width, height, options.max_image_size),
+                           int(options.max_features or auto_max_features(width, height, options.max_image_size)),
+                           sift_first_octave(options, width, height))
+
+
+@dataclass
+class Extraction:
+    """What an extraction works on: the database, the photos' folder, the camera groups with their database
+    ids, and COLMAP's mask folder with the images that have a mask."""
+
+    db_path: str
+    images_dir: str
+    groups: List[CameraGroup]
+    camera_ids: Dict[str, int]
+    mask_path: Optional[str] = None
+    masked: Sequence[str] = ()
+
+
+def _extraction_options(pycolmap, settings: FeatureSettings, options: AlignOptions):
     eo = pycolmap.FeatureExtractionOptions()
-    g0 = max(groups, key=lambda g: g.width * g.height)
-    eo.sift.max_num_features = int(options.max_features or auto_max_features(g0.width, g0.height,
-                                                                              options.max_image_size))
-    eo.max_image_size = feature_image_size(g0.width, g0.height, options.max_image_size)
-    eo.sift.first_octave = sift_first_octave(options, g0.width, g0.height)
+    eo.sift.max_num_features = int(settings.max_features)
+    eo.max_image_size = int(settings.image_size)
+    eo.sift.first_octave = int(settings.first_octave)
+    if settings.peak_threshold is not None:
+        eo.sift.peak_threshold = float(settings.peak_threshold)
     eo.num_threads = options.num_threads
     if options.affine_features:
         eo.sift.estimate_affine_shape = True
         eo.sift.domain_size_pooling = True
-    for k, v in (sift or {}).items():
+    for k, v in settings.extra.items():
         setattr(eo.sift, k, v)
-    db = pycolmap.Database.open(db_path)
-    try:
-        done = {im.name for im in db.read_all_images() if db.exists_keypoints(im.image_id)}
-    finally:
-        db.close()
-    masked = set(masked or ())
+    return eo
+
+
+def _extraction_blocks(job: Extraction, done, settings: FeatureSettings) -> List[Tuple[CameraGroup, List[str]]]:
+    masked = set(job.masked or ())
     todo: List[Tuple[CameraGroup, List[str]]] = []
-    for g in groups:
+    for g in job.groups:
         rest = [n for n in g.images if n not in done]
-        size = extract_block(g.width, g.height, options.max_image_size, int(eo.sift.first_octave))
+        scale = min(1.0, settings.image_size / max(g.width, g.height))
+        size = extract_block(g.width, g.height, int(round(max(g.width, g.height) * scale)), settings.first_octave)
         # COLMAP skips an image whose mask is missing when mask_path is set: masked and unmasked images go
         # in separate blocks (in file order), only the masked ones with mask_path
         block: List[str] = []
@@ -232,6 +282,20 @@ def extract_features(pycolmap, db_path, images_dir, groups, camera_ids, options,
             block.append(n)
         if block:
             todo.append((g, block))
+    return todo
+
+
+def extract_features(pycolmap, job: Extraction, settings: FeatureSettings, options: AlignOptions,
+                     progress: Progress) -> None:
+    """SIFT features with ``settings`` of every image of ``job.groups`` the database has none for."""
+    eo = _extraction_options(pycolmap, settings, options)
+    db = pycolmap.Database.open(job.db_path)
+    try:
+        done = {im.name for im in db.read_all_images() if db.exists_keypoints(im.image_id)}
+    finally:
+        db.close()
+    masked = set(job.masked or ())
+    todo = _extraction_blocks(job, done, settings)
     total = sum(len(b) for _, b in todo)
     if done:
         progress.info(f"features: {len(done)} images already extracted, reused")
@@ -239,11 +303,11 @@ def extract_features(pycolmap, db_path, images_dir, groups, camera_ids, options,
     for g, block in todo:
         check_cancel(progress)
         ro = pycolmap.ImageReaderOptions()
-        ro.existing_camera_id = camera_ids[g.key]
-        if mask_path and block[0] in masked:
-            ro.mask_path = mask_path  # <mask_path>/<image name>.png, black = no features
+        ro.existing_camera_id = job.camera_ids[g.key]
+        if job.mask_path and block[0] in masked:
+            ro.mask_path = job.mask_path  # <mask_path>/<image name>.png, black = no features
         with CancelWatcher(progress) as token:
-            pycolmap.extract_features(db_path, images_dir, image_names=block,
+            pycolmap.extract_features(job.db_path, job.images_dir, image_names=block,
                                       camera_mode=pycolmap.CameraMode.SINGLE, reader_options=ro,
                                       extraction_options=eo, device=pycolmap.Device.cpu,
                                       cancellation_token=token)

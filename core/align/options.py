@@ -22,6 +22,20 @@ UPSAMPLE_BELOW = 1000  # long side (px, at the matching scale) below which SIFT 
 AUTO_FEATURE_MEGAPIXELS = 2.0
 AUTO_FEATURES_PER_MP = 4000  # MAX_FEATURES 0 (auto): this many per megapixel of the image the features come from,
 AUTO_FEATURES_RANGE = (2048, 4096)  # within these bounds (matching and mapping grow with the count, the model not)
+# Faint features (the escalation's "faint" round, and the first pass where the texture probe finds the photos
+# starved): pycolmap's default budget at least, and a third of SIFT's default peak threshold (0.02 / octave
+# resolution 3)
+FAINT_MIN_FEATURES = 8192
+FAINT_PEAK_THRESHOLD = 0.02 / 3 / 3
+# The texture probe (core.align.firstpass): SIFT at the planned settings on up to PROBE_PHOTOS photos spread over
+# the block; a photo is starved when it fills less than PROBE_MIN_YIELD of the budget or its features hold less
+# than PROBE_MIN_COVERAGE of a PROBE_GRID-cell grid over the frame (a cell holds features when it has a quarter of
+# its even share of them); a setting is kept when at most PROBE_STARVED_SHARE of the probed photos starve
+PROBE_PHOTOS = 6
+PROBE_MIN_YIELD = 0.2  # caliterra's 1 MP photos fill 0.32 of 3,000 and all register; faint farmland 0.0-0.06
+PROBE_MIN_COVERAGE = 0.5
+PROBE_GRID = 8  # cells along the long side (the short side in proportion)
+PROBE_STARVED_SHARE = 0.2
 # The calls to COLMAP are made in blocks, the unit of progress (a cancel acts within a call, through its token).
 # Each call has a fixed cost (threads, reading the database): blocks are sized by the work in them, so that small
 # frames do not pay it per image or per pair (the synthetic orbit's 16 frames of 480 x 360: 10.3 -> 8.3 CPU s)
@@ -61,6 +75,7 @@ class AlignOptions:
     mapper: str = "incremental"  # incremental (COLMAP) or global (GLOMAP: rotation averaging + global positioning)
     first_octave: Optional[int] = None  # SIFT's first octave; None = auto (-1, upsampled, below UPSAMPLE_BELOW px)
     seed: int = 1
+    texture_probe: bool = True  # choose the first pass's features from the photos' texture (firstpass.py)
     escalate: bool = True  # retry images left out / a split block with richer features and pairs (escalation.py)
     calibration: Optional[str] = None  # a camera calibration file (core.io.calibration), None: none
     intrinsics: str = "auto"  # one of INTRINSICS; a camera's own ``adjust`` in the calibration file overrides it

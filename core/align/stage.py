@@ -52,7 +52,16 @@ from .calibrated import (
 )
 from .diagnosis import diagnose_unregistered, no_reconstruction_error, report_unregistered
 from .escalation import EscalationContext, block_state, escalate
-from .features import database_key, extract_features, file_hash, masks_for_colmap, match_pairs, setup_database
+from .features import (
+    Extraction,
+    database_key,
+    extract_features,
+    file_hash,
+    masks_for_colmap,
+    match_pairs,
+    setup_database,
+)
+from .firstpass import FirstPass, choose_first_pass
 from .mapping import (
     camera_rows,
     camera_summary,
@@ -89,6 +98,7 @@ class AlignResult:
     masked_images: int = 0
     escalation: Optional[dict] = None  # what was escalated and why (core.align.escalation), None when not needed
     intrinsics: Optional[List[dict]] = None  # per camera: mode, given values and sigmas, final values (calibrated)
+    first_pass: Optional[dict] = None  # the first pass's feature settings, why, and the texture probe's figures
 
 
 def _json(obj) -> str:
@@ -174,8 +184,8 @@ def _database_path(lay: Layout, record: dict, key: str, keep_previous: bool) -> 
 
 
 def _setup(pycolmap, lay: Layout, photos: _Photos, options: AlignOptions, record: dict, keep_previous: bool,
-           progress: Progress):
-    """Masks for COLMAP and the database's cameras: (database path, mask_path, image -> mask, camera ids)."""
+           first: FirstPass, progress: Progress):
+    """Masks for COLMAP and the database's cameras: (what the extraction works on, image -> mask)."""
     infos, groups = photos.infos, photos.groups
     mask_path, masks = masks_for_colmap(lay.masks_dir, infos, lay.sfm_dir)
     masks_key = fingerprint(sorted((n, file_hash(p)) for n, p in masks.items())) if masks else None
@@ -183,10 +193,10 @@ def _setup(pycolmap, lay: Layout, photos: _Photos, options: AlignOptions, record
         record["inputs"]["masks"] = masks_key
         progress.info(f"masks: {len(masks)} of {len(infos)} images have a mask ({lay.masks_dir}): "
                       "no features where they are black")
-    key = database_key(groups, options, photos.images_dir, masks_key, fingerprint(photos.fingerprints))
+    key = database_key(groups, options, photos.images_dir, masks_key, fingerprint(photos.fingerprints), first.key())
     db_path, known_key = _database_path(lay, record, key, keep_previous)
     camera_ids = setup_database(pycolmap, db_path, groups, options, key, known_key, photos.given)
-    return db_path, mask_path, masks, camera_ids
+    return Extraction(db_path, photos.images_dir, groups, camera_ids, mask_path, sorted(masks)), masks
 
 
 def _read_folder(pycolmap, lay: Layout, images_dir: str, options: AlignOptions, calibrations: list,
@@ -267,14 +277,17 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
             progress.info(f"camera {g.camera_id}: {g.make} {g.model} {g.width}x{g.height}, {focal}, "
                           f"{len(g.images)} images")
         os.makedirs(lay.sfm_dir, exist_ok=True)
-        db_path, mask_path, masks, camera_ids = _setup(pycolmap, lay, photos, options, run.record, keep_previous,
-                                                       progress)
+        g0 = max(groups, key=lambda g: g.width * g.height)
+        with run.step("probe", save=False):  # the first pass's features from the photos' texture and size
+            first = choose_first_pass(pycolmap, infos, options, g0.width, g0.height)
+        progress.info(first.log_line())
+        job, masks = _setup(pycolmap, lay, photos, options, run.record, keep_previous, first, progress)
+        db_path = job.db_path
         ws.save()
 
         # 2. features
         with run.step("features", save=False):
-            extract_features(pycolmap, db_path, images_dir, groups, camera_ids, options,
-                             SubProgress(progress, 0.02, 0.35), mask_path, list(masks))
+            extract_features(pycolmap, job, first.settings, options, SubProgress(progress, 0.02, 0.35))
         # 3. pairs + matching
         with run.step("matching", save=False):
             pairs, pairing_used, pw = select_pairs(infos, options.pairing, options.spatial_neighbours)
@@ -287,8 +300,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
         with run.step("mapping", save=False):
             ordered = _mapping(pycolmap, lay, db_path, images_dir, len(infos), options,
                                SubProgress(progress, 0.65, 0.90), degenerate, photos.held())
-        ctx = EscalationContext(pycolmap, db_path, lay.sfm_dir, images_dir, [im.name for im in infos], groups,
-                                camera_ids, options, pairs, mask_path, list(masks),
+        ctx = EscalationContext(pycolmap, job, first.settings, lay.sfm_dir, [im.name for im in infos], options, pairs,
                                 lambda p: _mapping(pycolmap, lay, db_path, images_dir, len(infos), options, p,
                                                    degenerate, photos.held()),
                                 lambda reg, oth: diagnose_unregistered(
@@ -337,7 +349,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
             pairing_used=pairing_used, num_pairs=len(pairs), timings={k: round(v, 3) for k, v in timings.items()},
             cameras=camera_summary(rec), masked_images=len(masks),
             escalation=escalation.to_dict() if escalation else None,
-            intrinsics=intrinsics_record(pycolmap, groups, photos.given, rec),
+            intrinsics=intrinsics_record(pycolmap, groups, photos.given, rec), first_pass=first.to_dict(),
         )
         figures = {k: v for k, v in asdict(result).items() if k not in ("workspace", "model_dir", "cameras_path")}
         figures["principal_point_refined"] = pp
@@ -347,6 +359,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
                             "mean_reprojection_error": mre, "points3d": result.num_points3d,
                             "pairing": pairing_used, "pairs": len(pairs), "masked_images": len(masks),
                             "escalation_rounds": len(escalation.rounds) if escalation else 0,
+                            "first_pass": first.level,
                             "skipped_files": list(photos.skipped),
                             "total_seconds": round(time.time() - t_start, 2)})
     # later stages were built on the previous model: run_stage marked them stale

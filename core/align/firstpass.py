@@ -1,0 +1,250 @@
+"""The first pass's feature settings, chosen from the photos' texture and size before any extraction (issue 33).
+
+The fast path takes SIFT features from a copy of at most AUTO_FEATURE_MEGAPIXELS with at most
+AUTO_FEATURES_RANGE[1] per photo: textured photos fill that budget many times over. Faint, periodic texture (a
+ploughed field at low contrast) does not: at SIFT's default peak threshold such a photo yields a few hundred
+features, the first mapping leaves most photos out, and the escalation (core.align.escalation) re-extracts and
+rematches nearly the whole block -- most of the alignment's time. :func:`choose_first_pass` runs pycolmap's own
+SIFT, at the settings of each level in turn, on up to PROBE_PHOTOS photos spread over the block (the same ones each
+run) and measures per photo its **yield** (features found / the level's budget) and **coverage** (the share of the
+cells of a PROBE_GRID grid over the frame holding at least a quarter of their even share of the features found). A
+photo with a yield under PROBE_MIN_YIELD or a coverage under PROBE_MIN_COVERAGE is starved; the first level at
+which at most PROBE_STARVED_SHARE of the probed photos starve is the first pass's (the last level otherwise):
+
+1. ``default`` -- today's settings (where textured photos stay: the probe is then the only cost);
+2. ``faint`` -- the same scale, FAINT_MIN_FEATURES features and a third of SIFT's peak threshold
+   (FAINT_PEAK_THRESHOLD);
+3. ``faint-fine`` -- also twice the scale: the photo's own pixels up to twice the default's long side, or, where
+   the photo is no larger than that, SIFT's first octave -1 (the image upsampled): the escalation's "faint"
+   settings.
+
+Scaling up at SIFT's default threshold is not a level: on tests/lowtexture_scene.py's 3600 x 2700 farmland it
+found 66 -> 115 features (contrast 0.15) and 234 -> 412 (contrast 0.4) from 2 to 9.7 megapixels, a yield under
+0.06 at every scale, where a third of the threshold at 2 megapixels found 590 and 8,029 (docs/measurements.md).
+
+The settings the user gave (a feature image size, a budget or a first octave) are kept as they are: no probe
+(nor with ``AlignOptions.texture_probe`` off).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass, field
+from typing import Dict, List, Optional, Sequence, Tuple
+
+import cv2
+import numpy as np
+
+from ..io.images import ImageInfo
+from .features import FeatureSettings, default_settings, sift_first_octave
+from .options import (
+    FAINT_MIN_FEATURES,
+    FAINT_PEAK_THRESHOLD,
+    PROBE_GRID,
+    PROBE_MIN_COVERAGE,
+    PROBE_MIN_YIELD,
+    PROBE_PHOTOS,
+    PROBE_STARVED_SHARE,
+    AlignOptions,
+)
+
+DEFAULT = "default"
+FAINT = "faint"
+FAINT_FINE = "faint-fine"
+
+
+@dataclass
+class ProbeResult:
+    """One probed photo at one level's settings."""
+
+    image: str
+    level: str
+    found: int
+    budget: int
+    coverage: float
+
+    @property
+    def yield_(self) -> float:
+        return self.found / max(1, self.budget)
+
+    @property
+    def starved(self) -> bool:
+        return self.yield_ < PROBE_MIN_YIELD or self.coverage < PROBE_MIN_COVERAGE
+
+    def to_dict(self) -> dict:
+        return {**asdict(self), "yield": round(self.yield_, 3), "coverage": round(self.coverage, 3),
+                "starved": self.starved}
+
+
+@dataclass
+class FirstPass:
+    """The first pass's settings, the level they come from, why, and what the probe measured."""
+
+    settings: FeatureSettings
+    level: str
+    reason: str
+    probe: List[ProbeResult] = field(default_factory=list)
+    seconds: float = 0.0
+
+    def key(self) -> Optional[Dict[str, object]]:
+        """What the database key holds of the choice: None for the default (the key of earlier workspaces)."""
+        return None if self.level == DEFAULT else {"level": self.level, **self.settings.to_dict()}
+
+    def to_dict(self) -> dict:
+        return {"level": self.level, "reason": self.reason, "settings": self.settings.to_dict(),
+                "probe_seconds": round(self.seconds, 2), "probe": [p.to_dict() for p in self.probe]}
+
+    def log_line(self) -> str:
+        s = self.settings
+        threshold = f", peak threshold {s.peak_threshold:.4f}" if s.peak_threshold is not None else ""
+        return (f"first pass: {self.level} features ({s.image_size} px long side, {s.max_features} per photo, "
+                f"first octave {s.first_octave}{threshold}): {self.reason}; probe {self.seconds:.1f} s")
+
+
+def levels(base: FeatureSettings, width: int, height: int) -> List[Tuple[str, FeatureSettings]]:
+    """The ladder of settings the probe tries, from the default (``base``) on (see the module's docstring)."""
+    side = max(width, height)
+    budget = max(FAINT_MIN_FEATURES, base.max_features)
+    out = [(DEFAULT, base),
+           (FAINT, FeatureSettings(base.image_size, budget, base.first_octave, FAINT_PEAK_THRESHOLD))]
+    if side > base.image_size:  # the photo's own pixels, up to twice the default's long side
+        fine = min(side, 2 * base.image_size)
+        octave = sift_first_octave(AlignOptions(max_image_size=fine), width, height)
+        out.append((FAINT_FINE, FeatureSettings(fine, budget, octave, FAINT_PEAK_THRESHOLD)))
+    elif base.first_octave >= 0:  # as large as it is: upsampled
+        out.append((FAINT_FINE, FeatureSettings(base.image_size, budget, -1, FAINT_PEAK_THRESHOLD)))
+    return out
+
+
+def probe_photos(names: Sequence[str], count: int = PROBE_PHOTOS) -> List[str]:
+    """Up to ``count`` of ``names`` (in their order) spread evenly over it, both ends included."""
+    names = list(names)
+    if len(names) <= count:
+        return names
+    picks = sorted({int(round(k * (len(names) - 1) / (count - 1))) for k in range(count)})
+    return [names[k] for k in picks]
+
+
+def read_grey(path: str, side: int, long_side: int) -> Optional[np.ndarray]:
+    """The photo at ``path`` (``side`` px on its long side) as 8-bit grey with ``long_side`` px on its long side
+    at most (None when OpenCV cannot read it); decoded at a reduced size (a JPEG's DCT scaling) where that is
+    still as large."""
+    flag = cv2.IMREAD_GRAYSCALE
+    for r, f in ((4, cv2.IMREAD_REDUCED_GRAYSCALE_4), (2, cv2.IMREAD_REDUCED_GRAYSCALE_2)):
+        if side // r >= long_side:
+            flag = f
+            break
+    img = cv2.imread(path, flag | cv2.IMREAD_IGNORE_ORIENTATION)
+    if img is None:
+        return None
+    return shrink(img, long_side)
+
+
+def shrink(img: np.ndarray, long_side: int) -> np.ndarray:
+    """``img`` scaled down (area averaging) to ``long_side`` px on its long side; as it is when not larger."""
+    h, w = img.shape[:2]
+    if max(h, w) <= long_side:
+        return np.ascontiguousarray(img)
+    s = long_side / max(h, w)
+    return cv2.resize(img, (max(1, int(round(w * s))), max(1, int(round(h * s)))), interpolation=cv2.INTER_AREA)
+
+
+def coverage(xy: np.ndarray, width: int, height: int, cells: int = PROBE_GRID) -> float:
+    """The share of the cells of a grid (``cells`` along the long side) holding at least a quarter of their even
+    share of the features at ``xy`` (pixel positions in a ``width`` x ``height`` frame)."""
+    nx, ny = (cells, max(1, round(cells * height / width))) if width >= height else \
+        (max(1, round(cells * width / height)), cells)
+    if len(xy) == 0:
+        return 0.0
+    gx = np.clip((xy[:, 0] / width * nx).astype(int), 0, nx - 1)
+    gy = np.clip((xy[:, 1] / height * ny).astype(int), 0, ny - 1)
+    counts = np.bincount(gy * nx + gx, minlength=nx * ny)
+    return float(np.mean(counts >= 0.25 * len(xy) / (nx * ny)))
+
+
+def sift_keypoints(pycolmap, grey: np.ndarray, settings: FeatureSettings) -> np.ndarray:
+    """pycolmap's SIFT with ``settings`` on the 8-bit image ``grey`` (already at the settings' size): (n, 2)
+    keypoint positions in its pixels."""
+    eo = pycolmap.FeatureExtractionOptions()
+    eo.num_threads = 1
+    eo.max_image_size = max(grey.shape)
+    eo.sift.max_num_features = int(settings.max_features)
+    eo.sift.first_octave = int(settings.first_octave)
+    if settings.peak_threshold is not None:
+        eo.sift.peak_threshold = float(settings.peak_threshold)
+    extractor = pycolmap.FeatureExtractor.create(eo, pycolmap.Device.cpu)
+    keypoints, _descriptors = extractor.extract_from_uint8_array(np.ascontiguousarray(grey))
+    return np.array([(k.x, k.y) for k in keypoints], dtype=np.float64).reshape(-1, 2)
+
+
+def probe(pycolmap, grey: np.ndarray, settings: FeatureSettings, name: str = "", level: str = "") -> ProbeResult:
+    """Yield and coverage of one photo (``grey``, at any size: scaled to the settings') at ``settings``."""
+    img = shrink(grey, settings.image_size)
+    xy = sift_keypoints(pycolmap, img, settings)
+    return ProbeResult(name, level, len(xy), int(settings.max_features), coverage(xy, img.shape[1], img.shape[0]))
+
+
+def decide(results: Sequence[ProbeResult], total: int) -> Optional[bool]:
+    """Whether a level is good enough from the ``results`` so far of ``total`` photos to probe: False as soon as
+    more than PROBE_STARVED_SHARE of them starved, True when all are probed and no more starved or when the first
+    half of them starved none (textured photos: the rest is not probed), None while undecided."""
+    starved = sum(1 for r in results if r.starved)
+    if starved > PROBE_STARVED_SHARE * total:
+        return False
+    if len(results) == total or (starved == 0 and 2 * len(results) >= total):
+        return True
+    return None
+
+
+def probe_order(names: Sequence[str]) -> List[str]:
+    """``names`` (spread over the block) reordered so that the first half spans it: ends and middle first."""
+    names = list(names)
+    if len(names) <= 2:
+        return names
+    first = [names[0], names[len(names) // 2], names[-1]]
+    return first + [n for n in names if n not in first]
+
+
+def _summary(level: str, results: Sequence[ProbeResult]) -> str:
+    starved = sum(1 for r in results if r.starved)
+    y = np.median([r.yield_ for r in results])
+    c = np.median([r.coverage for r in results])
+    return f"{level}: {starved} of {len(results)} probed photos starved (median yield {y:.2f}, coverage {c:.2f})"
+
+
+def choose_first_pass(pycolmap, infos: Sequence[ImageInfo], options: AlignOptions, width: int,
+                      height: int) -> FirstPass:
+    """The first pass's settings for the photos ``infos`` of the largest camera (``width`` x ``height``): the
+    first level of :func:`levels` the probe finds good enough (:func:`decide`), else the last, which is taken
+    without a probe (the richest the first pass gets)."""
+    base = default_settings(options, width, height)
+    if options.max_image_size or options.max_features or options.first_octave is not None:
+        return FirstPass(base, DEFAULT, "the feature size, budget or first octave set in the options")
+    if not options.texture_probe:
+        return FirstPass(base, DEFAULT, "the texture probe switched off in the options")
+    t0 = time.time()
+    ladder = levels(base, width, height)
+    chosen = probe_order(probe_photos([im for im in infos if (im.width, im.height) == (width, height)]))
+    photos: Dict[str, Optional[np.ndarray]] = {}
+    measured: List[ProbeResult] = []
+    why: List[str] = []
+    for level, settings in ladder[:-1]:
+        results: List[ProbeResult] = []
+        verdict: Optional[bool] = None
+        for im in chosen:
+            if im.name not in photos:
+                photos[im.name] = read_grey(im.path, max(width, height), max(s.image_size for _, s in ladder[:-1]))
+            if photos[im.name] is None:
+                continue  # OpenCV cannot read it (COLMAP may): the probe goes on without it
+            results.append(probe(pycolmap, photos[im.name], settings, im.name, level))
+            verdict = decide(results, sum(1 for im in chosen if photos.get(im.name, 0) is not None))
+            if verdict is not None:
+                break
+        if not results:
+            return FirstPass(base, DEFAULT, "no photo could be probed", seconds=time.time() - t0)
+        measured += results
+        why.append(_summary(level, results))
+        if verdict:
+            return FirstPass(settings, level, "; ".join(why), measured, time.time() - t0)
+    level, settings = ladder[-1]
+    why.append(f"{level} taken (the richest level)")
+    return FirstPass(settings, level, "; ".join(why), measured, time.time() - t0)
