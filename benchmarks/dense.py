@@ -101,8 +101,8 @@ def child(args):
 
     pc = os.path.join(args.workspace, "dense", "points.las") if args.point_cloud else None
     t0 = time.time()
-    r = dense.build_dsm_workspace(args.workspace, quality=args.quality, output_point_cloud=pc,
-                                  options=DenseOptions(workers=args.workers), progress=PrintProgress("  "))
+    r = dense.build_dsm_workspace(args.workspace, DenseOptions(quality=args.quality, output_point_cloud=pc,
+                                                               workers=args.workers), progress=PrintProgress("  "))
     wall = time.time() - t0
     # per-pair figures from the cache summaries
     from glob import glob
@@ -208,8 +208,7 @@ def synthetic(widths, contrast, quality, strips=2, per_strip=6, workers=1):
         shutil.rmtree(ws, ignore_errors=True)
         rec = block.truth_reconstruction(model_from_local=None, noise_px=0.2, n_points=1500)
         synthetic_workspace(ws, block, rec, images_dir=images, georeferenced=True, crs=syn.CRS, offset=syn.ORIGIN)
-        r = dense.build_dsm_workspace(ws, quality=quality, options=DenseOptions(workers=workers),
-                                      progress=NullProgress())
+        r = dense.build_dsm_workspace(ws, DenseOptions(quality=quality, workers=workers), progress=NullProgress())
         from glob import glob
 
         pairs = [read_pair_summary(p) for p in glob(os.path.join(ws, "dense", "pairs-*", "*.npz"))]
@@ -258,7 +257,7 @@ def farmland(size, contrast, quality, strips, per_strip, workers, out_dir=None):
     rec = block.truth_reconstruction(model_from_local=None, noise_px=0.3, n_points=1500 if size != "full" else 6000)
     synthetic_workspace(ws, block, rec, images_dir=images, georeferenced=True, crs=syn.CRS, offset=syn.ORIGIN)
     t0, c0 = time.time(), time.process_time()
-    r = dense.build_dsm_workspace(ws, quality=quality, options=DenseOptions(workers=workers), progress=NullProgress())
+    r = dense.build_dsm_workspace(ws, DenseOptions(quality=quality, workers=workers), progress=NullProgress())
     wall = time.time() - t0
     import resource
 
@@ -320,7 +319,7 @@ def diagnose(contrast, workers, out_dir=None):
         shutil.rmtree(ws, ignore_errors=True)
         rec = block.truth_reconstruction(model_from_local=None, noise_px=0.3, n_points=1500)
         synthetic_workspace(ws, block, rec, images_dir=images, georeferenced=True, crs=syn.CRS, offset=syn.ORIGIN)
-        r = dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=workers, **opts),
+        r = dense.build_dsm_workspace(ws, DenseOptions(quality="full", workers=workers, **opts),
                                       progress=NullProgress())
         fractions[name] = (r.measured_fraction, r.removed_fraction)
         for p in glob(os.path.join(ws, "dense", "pairs-*", "*.npz")):

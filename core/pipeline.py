@@ -60,9 +60,9 @@ class Control:
 
 @dataclass
 class PipelineOptions:
-    """Each stage's options, once, and the chain settings.  The DSM's quality is ``dense.quality``, the
-    orthomosaic's resolution and blending ``ortho.resolution`` and ``ortho.blending``: the stages take them from
-    their options and nothing here overrides them."""
+    """Each stage's options, once, and the chain settings.  The DSM's quality and resolution are
+    ``dense.quality`` and ``dense.resolution``, the orthomosaic's resolution and blending ``ortho.resolution`` and
+    ``ortho.blending``: the stages take them from their options and nothing here overrides them."""
 
     align: AlignOptions = field(default_factory=AlignOptions)
     georef: GeorefOptions = field(default_factory=GeorefOptions)  # refine_intrinsics and the adjustment
@@ -70,7 +70,6 @@ class PipelineOptions:
     ortho: OrthoOptions = field(default_factory=OrthoOptions)
     report: ReportOptions = field(default_factory=ReportOptions)  # uncertainty, write_layers
     targets: FindTargetsOptions = field(default_factory=FindTargetsOptions)  # with Control.targets_path
-    dsm_resolution: float = 0.0  # DSM cell size in CRS units; 0 = the images' median GSD (not a DenseOptions field)
     images_filter: Optional[str] = None
     make_report: bool = True  # False: the chain stops after the orthomosaic (and the terrain products)
     make_dtm: bool = True  # the DTM (seconds for a DSM of a few million cells)
@@ -187,7 +186,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
                      use_exif_gps=ctl.use_exif_gps, crs=ctl.crs, refine_intrinsics=opt.georef.refine_intrinsics,
                      options=opt.georef, gcps_upright=ctl.gcps_upright)
     res.warnings += res.georef.warnings
-    res.dsm = run(DSM, build_dsm_workspace, workspace_dir, resolution=opt.dsm_resolution, options=opt.dense)
+    res.dsm = run(DSM, build_dsm_workspace, workspace_dir, options=opt.dense)
     res.warnings += res.dsm.warnings
     res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, images_filter=opt.images_filter,
                     options=opt.ortho)

@@ -76,16 +76,14 @@ class BuildDsmAlgorithm(AlgorithmBase):
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         output_dsm = self.parameterAsOutputLayer(parameters, self.OUTPUT_DSM, context) or None
         output_pc = self.parameterAsFileOutput(parameters, self.OUTPUT_POINT_CLOUD, context) or None
-        options = DenseOptions(
-            workers=self.parameterAsInt(parameters, self.WORKERS, context),
-            scheduler=params.read_scheduler(self, parameters, self.SCHEDULER, context))
-        result = self.run_core(
-            dense.build_dsm_workspace, workspace,
-            resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context),
+        options = self.run_core(
+            DenseOptions, resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context),
             quality=params.read_choice(self, parameters, self.QUALITY, context, self.QUALITIES),
             engine=params.read_choice(self, parameters, self.ENGINE, context, self.ENGINES),
-            output_dsm=output_dsm, output_point_cloud=output_pc, options=options,
-            progress=FeedbackProgress(feedback))
+            output_dsm=output_dsm, output_point_cloud=output_pc,
+            workers=self.parameterAsInt(parameters, self.WORKERS, context),
+            scheduler=params.read_scheduler(self, parameters, self.SCHEDULER, context))
+        result = self.run_core(dense.build_dsm_workspace, workspace, options, FeedbackProgress(feedback))
         feedback.pushInfo(self.tr("DSM {} ({} m cells), valid fraction {}").format(
             result.dsm_path, result.resolution,
             "n/a" if result.valid_fraction is None else f"{result.valid_fraction:.3f}"))

@@ -51,9 +51,8 @@ def _raster(path):
 def test_dask_products_are_identical_to_the_local_run(block_root, cluster):
     local = _workspace(block_root, "local")
     remote = _workspace(block_root, "dask")
-    r_local = dense.build_dsm_workspace(local, quality="full", options=DenseOptions(workers=1))
-    r_dask = dense.build_dsm_workspace(remote, quality="full",
-                                       options=DenseOptions(scheduler=cluster.scheduler_address))
+    r_local = dense.build_dsm_workspace(local, DenseOptions(quality="full", workers=1))
+    r_dask = dense.build_dsm_workspace(remote, DenseOptions(quality="full", scheduler=cluster.scheduler_address))
     assert r_local.pairs == r_dask.pairs >= 4
     assert any("Dask" in line for line in r_dask.log_lines), r_dask.log_lines
     z_l, gt_l, _ = dsm.read_dsm(r_local.dsm_path)

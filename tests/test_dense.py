@@ -46,8 +46,8 @@ def built(block_dir):
     """The DSM stage on the synthetic block at full quality (the images are small), with a point cloud."""
     block, root = block_dir
     ws = make_workspace(os.path.join(root, "ws"), block, images_dir=os.path.join(root, "images"))
-    result = dense.build_dsm_workspace(ws, quality="full", output_point_cloud=os.path.join(root, "ws", "points.las"),
-                                       options=DenseOptions(workers=1))
+    result = dense.build_dsm_workspace(ws, DenseOptions(
+        quality="full", output_point_cloud=os.path.join(root, "ws", "points.las"), workers=1))
     return block, result
 
 
@@ -393,7 +393,7 @@ def test_cancel_leaves_no_dsm_and_resume_skips_finished_pairs(block_dir, tmp_pat
     ws = _copy_ws(root, tmp_path)
     prog = _CancelAfter(n=4)
     with pytest.raises(Cancelled):
-        dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=1), progress=prog)
+        dense.build_dsm_workspace(ws, DenseOptions(quality="full", workers=1), progress=prog)
     assert not os.path.exists(os.path.join(ws, "dsm.tif"))
     assert Workspace.open(ws).stage("dsm")["status"] == "cancelled"
 
@@ -408,8 +408,7 @@ def test_cancel_leaves_no_dsm_and_resume_skips_finished_pairs(block_dir, tmp_pat
     # resume on a process pool of two; cancel while the GeoTIFF is written: no dsm.tif, no partial file
     prog = _CancelAfter(when="writing Cloud-Optimized GeoTIFF")
     with pytest.raises(Cancelled):
-        dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=2, executor="process"),
-                                  progress=prog)
+        dense.build_dsm_workspace(ws, DenseOptions(quality="full", workers=2, executor="process"), progress=prog)
     assert not [f for f in os.listdir(ws) if "dsm" in f and f.endswith(".tif")]
     assert Workspace.open(ws).stage("dsm")["status"] == "cancelled"
     everything = pair_files()
@@ -427,7 +426,7 @@ def test_cancel_leaves_no_dsm_and_resume_skips_finished_pairs(block_dir, tmp_pat
         def info(self, message):
             said.append(message)
 
-    r = dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=1), progress=Said())
+    r = dense.build_dsm_workspace(ws, DenseOptions(quality="full", workers=1), progress=Said())
     assert sum(f"{r.resolution:g} m" in m and " cells at " in m for m in said) == 1, said
     assert r.pairs_reused == len(everything) == r.pairs
     assert os.path.isfile(r.dsm_path) and r.valid_fraction > 0.8
@@ -459,12 +458,12 @@ def test_bad_parameters_are_clear(block_dir, tmp_path):
     block, root = block_dir
     ws = _copy_ws(root, tmp_path)
     with pytest.raises(DenseError, match="QUALITY"):
-        dense.build_dsm_workspace(ws, quality="ultra")
+        DenseOptions(quality="ultra")
     with pytest.raises(DenseError, match="RESOLUTION"):
-        dense.build_dsm_workspace(ws, resolution=-1)
+        DenseOptions(resolution=-1)
     if not pycolmap.has_cuda:
         with pytest.raises(DenseError, match="CUDA"):
-            dense.build_dsm_workspace(ws, engine="cuda")
+            dense.build_dsm_workspace(ws, DenseOptions(engine="cuda"))
 
 
 # ---------------------------------------------------------------------------

@@ -133,7 +133,7 @@ def lowtex(tmp_path_factory):
     images = rendered_once(block, CACHE)
     root = tmp_path_factory.mktemp("dense lowtex")
     ws = make_workspace(str(root / "ws"), block, images_dir=images)
-    r = dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=1))
+    r = dense.build_dsm_workspace(ws, DenseOptions(quality="full", workers=1))
     z, gt, _, x, y, truth = _truth_grid(block, r.dsm_path)
     src, _, _ = raster.read_dsm(r.source_path)
     src = np.nan_to_num(src).astype(np.uint8)

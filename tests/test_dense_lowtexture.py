@@ -80,7 +80,7 @@ def farmland(tmp_path_factory):
     block = lt.small_block(CONTRAST)
     images = rendered_once(block, CACHE)
     ws = make_workspace(str(tmp_path_factory.mktemp("farmland") / "ws"), block, images_dir=images)
-    r = dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=1))
+    r = dense.build_dsm_workspace(ws, DenseOptions(quality="full", workers=1))
     z, gt, _ = raster.read_dsm(r.dsm_path)
     src, _, _ = raster.read_dsm(r.source_path)
     h, w = z.shape

@@ -45,7 +45,7 @@ def walls(tmp_path_factory):
     images = rendered_once(block, CACHE)
     root = tmp_path_factory.mktemp("dense walls")
     ws = make_workspace(str(root / "ws"), block, images_dir=images)
-    r = dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=1))
+    r = dense.build_dsm_workspace(ws, DenseOptions(quality="full", workers=1))
     return block, ws, r
 
 

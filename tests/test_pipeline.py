@@ -123,7 +123,6 @@ def test_the_stage_options_are_the_settings(tmp_path, monkeypatch):
 
     from core import pipeline
     from core.dense.options import DenseError, DenseOptions
-    from core.dense.stage import _checked_arguments
     from core.ortho.options import OrthoError, OrthoOptions
     from core.ortho.stage import build_orthophoto_workspace
 
@@ -142,14 +141,13 @@ def test_the_stage_options_are_the_settings(tmp_path, monkeypatch):
     pipeline.run_pipeline(str(tmp_path / "photos"), str(tmp_path / "ws"),
                           pipeline.PipelineOptions(dense=dense, ortho=ortho, make_dtm=False, make_report=False),
                           pipeline.Control(use_exif_gps=True))
-    assert calls["build_dsm_workspace"]["options"] is dense and "quality" not in calls["build_dsm_workspace"]
+    assert calls["build_dsm_workspace"]["options"] is dense and set(calls["build_dsm_workspace"]) == {"options",
+                                                                                                     "progress"}
     assert calls["build_orthophoto_workspace"]["options"] is ortho
     assert not {"blending", "resolution"} & set(calls["build_orthophoto_workspace"])
-    # the stages themselves: no keyword = the options' value; a keyword given wins
-    assert _checked_arguments(dense, None, "cpu", 0.0)[0].quality == "full"
-    assert _checked_arguments(dense, "quarter", "cpu", 0.0)[0].quality == "quarter"
+    # the stages themselves: no keyword = the options' value; a keyword given wins (the DSM stage takes none)
     with pytest.raises(DenseError, match="QUALITY"):
-        _checked_arguments(DenseOptions(quality="fine"), None, "cpu", 0.0)
+        DenseOptions(quality="fine")
     with pytest.raises(OrthoError, match="BLENDING"):  # the options' blending is checked, not a default's
         build_orthophoto_workspace(str(tmp_path / "no-ws"), options=OrthoOptions(blending="smooth"))
 

@@ -16,8 +16,9 @@ from core.align.options import AlignError, AlignOptions
 from core.align.photos import PHOTO_FINGERPRINTS
 from core.align.stage import align
 from core.common.progress import NullProgress
-from core.dense.options import DenseError
-from core.dense.stage import _check_resolution, build_dsm_workspace
+from core.dense.block import check_resolution
+from core.dense.options import DenseError, DenseOptions
+from core.dense.stage import build_dsm_workspace
 from core.geometry.crs import CRSError
 from core.io import raster as dsmmod
 from core.io.gcp import GCPError
@@ -197,14 +198,14 @@ def test_absurd_dsm_resolution_is_refused_before_matching(block_ws, tmp_path):
     for resolution, words in ((1e-5, "finer than a tenth of the images' ground sample distance"),
                               (1e4, "fewer than 2 cells across")):
         with pytest.raises(DenseError, match=words):
-            build_dsm_workspace(ws, resolution=resolution)
+            build_dsm_workspace(ws, DenseOptions(resolution=resolution))
     assert not os.path.exists(os.path.join(ws, "dense"))  # no pair was matched
     assert "dsm" not in Workspace.open(ws).data["stages"]
     # over 50,000 x 50,000 cells: a 100 km block at 1 cm (GSD 5 cm)
     xyz = np.array([[0.0, 0.0, 0.0], [1e5, 1e5, 0.0]] * 50)
     with pytest.raises(DenseError, match="10,000,001 x 10,000,001 cells"):
-        _check_resolution(0.01, 0.05, xyz, 0.1)
-    _check_resolution(0.1, 0.05, xyz[:, :] / 100, 0.1)  # 1 km at 10 cm: fine
+        check_resolution(0.01, 0.05, xyz, 0.1)
+    check_resolution(0.1, 0.05, xyz[:, :] / 100, 0.1)  # 1 km at 10 cm: fine
 
 
 # ---------------------------------------------------------------------------

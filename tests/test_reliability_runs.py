@@ -404,7 +404,7 @@ DSM_SCRIPT = textwrap.dedent("""
     import sys
     from core.dense import stage
     from core.dense.options import DenseOptions
-    stage.build_dsm_workspace(sys.argv[1], quality="full", options=DenseOptions(workers=2, executor="process"))
+    stage.build_dsm_workspace(sys.argv[1], DenseOptions(quality="full", workers=2, executor="process"))
 """)
 
 
@@ -437,7 +437,7 @@ def test_killed_dsm_run_leaves_no_worker_reads_interrupted_and_is_cleaned(dsm_bl
     rec = Workspace.open(ws).stage(DSM)
     assert rec["status"] == INTERRUPTED and f"pid {proc.pid}" in rec["error"]
 
-    r = dense.build_dsm_workspace(ws, quality="full", options=DenseOptions(workers=1))
+    r = dense.build_dsm_workspace(ws, DenseOptions(quality="full", workers=1))
     assert os.path.isfile(r.dsm_path) and Workspace.open(ws).stage(DSM)["status"] == "done"
     assert _cancel_dirs(ws) == []
     assert any(d in line and "killed run" in line for d in debris for line in r.log_lines)

@@ -1,6 +1,8 @@
 """The options of the DSM stage (defaults in this one place), its qualities and engines, and its error."""
 from __future__ import annotations
 
+import math
+import os
 from dataclasses import dataclass
 from typing import Optional
 
@@ -13,6 +15,8 @@ CACHE_VERSION = 6  # of the per-pair depth map cache (dense/pairs-<key>/); 2: co
 
 # options that say where the work runs, not what it computes (not recorded among the stage's parameters)
 EXECUTION_OPTIONS = ("workers", "executor", "scheduler")
+# options recorded among the stage's parameters beside the options (the outputs as absolute paths)
+STAGE_SETTINGS = ("resolution", "engine", "output_dsm", "output_point_cloud")
 
 
 class DenseError(ArchaeoOrthoError, RuntimeError):
@@ -21,7 +25,13 @@ class DenseError(ArchaeoOrthoError, RuntimeError):
 
 @dataclass
 class DenseOptions:
-    quality: str = "half"
+    """The settings of the DSM stage, checked when made (DenseError naming the bad one)."""
+
+    quality: str = "half"  # QUALITIES: the image downscale for matching
+    resolution: float = 0.0  # DSM cell size in metres; 0 = automatic (2 x the median GSD, see pairs.auto_resolution)
+    engine: str = "cpu"  # ENGINES: cpu (OpenCV SGBM) or cuda (COLMAP patch-match, pycolmap built with CUDA)
+    output_dsm: Optional[str] = None  # the DSM GeoTIFF; None = <workspace>/dsm.tif
+    output_point_cloud: Optional[str] = None  # a LAS point cloud; None = none
     partners: int = 5  # at most this many pairs chosen per image (greedy two-fold cover of its tie points)
     min_shared_points: int = 15
     min_baseline_ratio: float = 0.03
@@ -52,6 +62,19 @@ class DenseOptions:
     workers: int = 0  # 0 = one per core (bounded by memory)
     executor: str = "auto"  # auto / serial / process / thread
     scheduler: Optional[str] = None  # Dask scheduler address
+
+    def __post_init__(self):
+        self.quality = (self.quality or "half").lower()
+        if self.quality not in QUALITIES:
+            raise DenseError(f"unknown QUALITY {self.quality!r}; choose one of {', '.join(QUALITIES)}")
+        self.engine = (self.engine or "cpu").lower()
+        if self.engine not in ENGINES:
+            raise DenseError(f"unknown ENGINE {self.engine!r}; choose one of {', '.join(ENGINES)}")
+        if self.resolution is None or not math.isfinite(self.resolution) or self.resolution < 0:
+            raise DenseError(f"RESOLUTION must be 0 (automatic) or a positive number of metres, got {self.resolution}")
+        self.resolution = float(self.resolution)
+        self.output_dsm = os.path.abspath(self.output_dsm) if self.output_dsm else None
+        self.output_point_cloud = os.path.abspath(self.output_point_cloud) if self.output_point_cloud else None
 
     @property
     def scale(self) -> float:

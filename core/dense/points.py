@@ -11,6 +11,7 @@ import json
 import os
 import shutil
 import time
+from dataclasses import dataclass
 from typing import Callable, Dict, List, Tuple
 
 import numpy as np
@@ -19,8 +20,11 @@ from ..common.cancel import CancelWatcher, load_pycolmap
 from ..common.files import atomic_write_text, fingerprint, save_npz
 from ..common.parallel import cpu_count, describe_executor, make_executor, run_units
 from ..common.progress import Progress, SubProgress
+from ..project.layout import Layout
+from .block import DenseBlock
 from .fusion import FuseUnit, fuse_image
 from .grid import PointFile
+from .journal import Journal
 from .options import CACHE_VERSION, DenseError, DenseOptions
 from .pairs import PairInfo, View
 from .stereo import PairUnit, match_pair, read_pair_summary
@@ -42,16 +46,45 @@ def threads_per_unit(workers: int) -> int:
 # cpu: pairs -> depth maps -> fused points per image
 # ---------------------------------------------------------------------------
 
-def cpu_points(views: Dict[int, View], pairs: List[PairInfo], xyz: np.ndarray, options: DenseOptions,
-               dense_dir: str, model_fp: Dict[str, str], progress: Progress, warn: Say,
-               log: List[str]) -> Tuple[List[PointFile], int, int, Dict[str, float]]:
-    """(point files, pairs matched, pairs reused from the cache, timings) of the OpenCV engine."""
-    timings: Dict[str, float] = {}
+@dataclass
+class DensePoints:
+    """The fused points of the block (point files in the local frame) and the pairs matched for them."""
+
+    files: List[PointFile]
+    pairs: int  # pairs matched (0 with the cuda engine)
+    reused: int  # pairs (cuda: 0) whose depth maps a previous run left
+
+    @property
+    def count(self) -> int:
+        return sum(pf.count for pf in self.files)
+
+
+def dense_points(block: DenseBlock, options: DenseOptions, lay: Layout, model_fp: Dict[str, str],
+                 progress: Progress, journal: Journal) -> DensePoints:
+    """The block's fused points with ``options.engine``; DenseError when no pixel was confirmed."""
+    if options.engine == "cuda":
+        t0 = time.time()
+        files, n_reused = cuda_points(block.views, options.scale, lay.dense_dir, lay.georef_model_dir,
+                                      block.images_dir, model_fp, SubProgress(progress, 0.02, 0.88))
+        journal.timings["matching"] = time.time() - t0
+        points = DensePoints(files, 0, n_reused)
+    else:
+        points = cpu_points(block, options, lay.dense_dir, model_fp, progress, journal)
+    if points.count == 0:
+        raise DenseError("dense matching found no consistent surface point: the pairs matched but no pixel was "
+                         f"confirmed by {options.min_consistent} independent pairs (too little texture or overlap?)")
+    return points
+
+
+def cpu_points(block: DenseBlock, options: DenseOptions, dense_dir: str, model_fp: Dict[str, str],
+               progress: Progress, journal: Journal) -> DensePoints:
+    """The OpenCV engine's points (its matching and fusion seconds go to ``journal``)."""
+    views, pairs, xyz = block.views, block.pairs, block.xyz
     scale = options.scale
-    block = options.sgbm_block()
-    pair_dir = _pair_cache(dense_dir, model_fp, scale, block, options)
-    unit_mem = unit_memory(views, scale)
-    executor = make_executor(options.workers, options.executor, options.scheduler, unit_memory=unit_mem)
+    block_size = options.sgbm_block()
+    pair_dir = _pair_cache(dense_dir, model_fp, scale, block_size, options)
+    executor = make_executor(options.workers, options.executor, options.scheduler,
+                             unit_memory=unit_memory(views, scale))
     workers = getattr(executor, "_max_workers", 1) or 1
     where = describe_executor(executor)
     threads = threads_per_unit(workers)
@@ -60,7 +93,7 @@ def cpu_points(views: Dict[int, View], pairs: List[PairInfo], xyz: np.ndarray, o
     t0 = time.time()
 
     def unit(p: PairInfo, out: str) -> PairUnit:
-        return PairUnit(f"{p.i}-{p.j}", out, views[p.i], views[p.j], scale, xyz[p.point_idx], block,
+        return PairUnit(f"{p.i}-{p.j}", out, views[p.i], views[p.j], scale, xyz[p.point_idx], block_size,
                         options.uniqueness, options.lr_tolerance, threads,
                         fine_uniqueness=options.fine_uniqueness, equalize=options.equalize)
 
@@ -70,20 +103,19 @@ def cpu_points(views: Dict[int, View], pairs: List[PairInfo], xyz: np.ndarray, o
         for _i, summary in run_units(executor, match_pair, units, sub, label="pair",
                                      describe=lambda u: f"{u.vi.name} + {u.vj.name}", cancel_dir=dense_dir):
             summaries.append(summary)
-    timings["matching"] = time.time() - t0
-    matched = _matched(summaries, warn)
+    journal.timings["matching"] = time.time() - t0
+    matched = _matched(summaries, journal.warn)
     secs = [s["seconds"] for s in matched if "seconds" in s]
     mp = sum(s.get("megapixels", 0.0) for s in matched)
-    log.append(f"matching: {len(matched)} pairs ({n_reused} reused from a previous run), "
-               f"{np.mean(secs) if secs else 0:.2f} s per pair, {sum(secs) / max(mp, 1e-9):.2f} s per megapixel, "
-               f"{where}")
-    progress.info(log[-1])
+    journal.info(f"matching: {len(matched)} pairs ({n_reused} reused from a previous run), "
+                 f"{np.mean(secs) if secs else 0:.2f} s per pair, {sum(secs) / max(mp, 1e-9):.2f} s per megapixel, "
+                 f"{where}")
 
     # 3. fusion, image by image
     t0 = time.time()
-    files = _fuse(views, pairs, summaries, pair_dir, options, dense_dir, unit_mem, threads, progress)
-    timings["fusion"] = time.time() - t0
-    return files, len(matched), n_reused, timings
+    files = _fuse(block, summaries, pair_dir, options, dense_dir, threads, progress)
+    journal.timings["fusion"] = time.time() - t0
+    return DensePoints(files, len(matched), n_reused)
 
 
 def _pair_cache(dense_dir: str, model_fp: Dict[str, str], scale: float, block: int, options: DenseOptions) -> str:
@@ -140,9 +172,10 @@ def _matched(summaries: List[dict], warn: Say) -> List[dict]:
     return matched
 
 
-def _fuse(views: Dict[int, View], pairs: List[PairInfo], summaries: List[dict], pair_dir: str,
-          options: DenseOptions, dense_dir: str, unit_mem: int, threads: int, progress: Progress) -> List[PointFile]:
+def _fuse(block: DenseBlock, summaries: List[dict], pair_dir: str, options: DenseOptions, dense_dir: str,
+          threads: int, progress: Progress) -> List[PointFile]:
     """Fuse the depth maps of every image in ``min_consistent`` or more matched pairs -> point files."""
+    views, pairs = block.views, block.pairs
     by_key = {s["key"]: s for s in summaries}
     per_image: Dict[int, List[Tuple[str, str, float]]] = {}
     for p in pairs:
@@ -161,7 +194,8 @@ def _fuse(views: Dict[int, View], pairs: List[PairInfo], summaries: List[dict], 
                        os.path.join(fused_dir, f"{i}.npz"), threads, sky_margin_deg=options.sky_margin_deg)
               for i, maps in sorted(per_image.items()) if len(maps) >= options.min_consistent]
     files: List[PointFile] = []
-    executor = make_executor(options.workers, options.executor, options.scheduler, unit_memory=unit_mem)
+    executor = make_executor(options.workers, options.executor, options.scheduler,
+                             unit_memory=unit_memory(views, options.scale))
     with executor:
         for _i, r in run_units(executor, fuse_image, funits, SubProgress(progress, 0.75, 0.88), label="fusion",
                                describe=lambda u: u.view.name, cancel_dir=dense_dir):

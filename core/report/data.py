@@ -15,6 +15,7 @@ from ..common.errors import require
 from ..common.files import read_json_record
 from ..common.progress import Progress
 from ..georef.uncertainty import collect_observations
+from ..io.raster import RasterError, RasterFile
 from ..project.layout import Layout
 from ..project.stages import ALIGN, ORTHOPHOTO
 from ..project.workspace import Workspace
@@ -75,11 +76,9 @@ class ReportData:
         if not path:
             return None
         try:
-            from osgeo import gdal
-
-            ds = gdal.Open(path)
-            return abs(ds.GetGeoTransform()[1]) if ds is not None else None
-        except Exception:  # noqa: BLE001
+            with RasterFile(path, "orthomosaic") as r:
+                return abs(r.geotransform[1]) if r.geotransform else None
+        except RasterError:
             return None
 
     # --- derived ---------------------------------------------------------------------------------

@@ -116,11 +116,10 @@ def crs_label(crs: Optional[str]) -> str:
         return str(crs)
 
 
-def raster_crs_name(ds) -> str:
-    """The CRS of an open GDAL dataset, e.g. "EPSG:32633 (WGS 84 / UTM zone 33N)"; "none" without one."""
+def raster_crs_name(wkt: str) -> str:
+    """The name of a raster's CRS (its WKT), e.g. "EPSG:32633 (WGS 84 / UTM zone 33N)"; "none" without one."""
     from osgeo import osr
 
-    wkt = ds.GetProjection()
     if not wkt:
         return "none"
     srs = osr.SpatialReference(wkt=wkt)

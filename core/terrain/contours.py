@@ -7,6 +7,7 @@ import os
 
 from ..common.files import atomic_output, refuse_overwriting_inputs
 from ..common.progress import NullProgress, Progress, check_cancel
+from ..io.raster import RasterFile
 from .options import TerrainError
 from .rasters import read_elevation, scan
 
@@ -47,11 +48,10 @@ def write_contours(raster_path: str, output: str, interval: float, progress: Pro
     if n_levels > 5000:
         raise TerrainError(f"a contour interval of {interval:g} gives {n_levels:.0f} levels over the "
                            f"{zmax - zmin:.1f} m of {raster_path}: choose a larger interval")
-    ds = gdal.Open(raster_path)
-    band = ds.GetRasterBand(1)
     srs = osr.SpatialReference(wkt=elev.crs_wkt) if elev.crs_wkt else None
     os.makedirs(os.path.dirname(os.path.abspath(output)), exist_ok=True)
-    with atomic_output(output) as tmp:
+    with RasterFile(raster_path, f"the {what}") as src, atomic_output(output) as tmp:
+        band = src.band(1)
         out = ogr.GetDriverByName("GPKG").CreateDataSource(tmp)
         lyr = out.CreateLayer(LAYER, srs, ogr.wkbLineString25D)
         lyr.CreateField(ogr.FieldDefn("id", ogr.OFTInteger))
@@ -74,8 +74,7 @@ def write_contours(raster_path: str, output: str, interval: float, progress: Pro
         n = lyr.GetFeatureCount()
         if elev.unit != 1.0:
             _elevations_in_metres(out, lyr, elev.unit)
-        out = None
-    ds = None
+        out = band = None
     return n
 
 

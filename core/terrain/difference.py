@@ -62,17 +62,16 @@ class _Raster:
 def _open(path: str, what: str) -> _Raster:
     """A DSM's grid and CRS; TerrainError naming the file when it is missing, not a raster, has no CRS or no
     north-up georeferencing."""
-    ds = open_raster(path, what)
-    check_elevation_kind(ds, path, what)
-    gt = ds.GetGeoTransform(can_return_null=True)
-    wkt = ds.GetProjection() or ""
-    if gt is None:
-        raise TerrainError(f"the {what} {path} has no georeferencing (no geotransform): it cannot be compared")
-    if not wkt:
-        raise TerrainError(f"the {what} {path} has no CRS: assign its CRS first (Raster > Projections > Assign "
-                           "Projection) so that it can be compared with the other DSM")
-    check_north_up(path, what, gt)
-    return _Raster(path, wkt, tuple(gt), ds.RasterXSize, ds.RasterYSize, ds.GetRasterBand(1).GetNoDataValue())
+    with open_raster(path, what) as r:
+        check_elevation_kind(r, path, what)
+        gt, wkt = r.geotransform, r.crs_wkt
+        if gt is None:
+            raise TerrainError(f"the {what} {path} has no georeferencing (no geotransform): it cannot be compared")
+        if not wkt:
+            raise TerrainError(f"the {what} {path} has no CRS: assign its CRS first (Raster > Projections > "
+                               "Assign Projection) so that it can be compared with the other DSM")
+        check_north_up(path, what, gt)
+        return _Raster(path, wkt, tuple(gt), r.width, r.height, r.nodata(1))
 
 
 def _grid(a: _Raster, resolution: Optional[float]) -> Tuple[Tuple[float, ...], int, int]:
@@ -92,20 +91,20 @@ def _warp(r: _Raster, wkt: str, gt: Tuple[float, ...], w: int, h: int) -> np.nda
     from osgeo import gdal
 
     gdal.UseExceptions()
-    src = gdal.Open(r.path)
-    if wkt == r.wkt and tuple(gt) == r.gt and (w, h) == (r.width, r.height):
-        z = src.GetRasterBand(1).ReadAsArray().astype(np.float64)
-    else:
-        bounds = (gt[0], gt[3] + h * gt[5], gt[0] + w * gt[1], gt[3])
-        opts = gdal.WarpOptions(format="MEM", dstSRS=wkt, outputBounds=bounds, width=w, height=h,
-                                resampleAlg="bilinear", outputType=gdal.GDT_Float32, dstNodata=float("nan"),
-                                srcNodata=r.nodata, multithread=False)
-        try:
-            out = gdal.Warp("", src, options=opts)
-        except RuntimeError as e:
-            raise TerrainError(f"cannot warp {r.path} onto the grid of the other DSM: {e}") from e
-        z = out.GetRasterBand(1).ReadAsArray().astype(np.float64)
-        out = None
+    with raster.RasterFile(r.path, "DSM") as src:
+        if wkt == r.wkt and tuple(gt) == r.gt and (w, h) == (r.width, r.height):
+            z = src.read(1).astype(np.float64)
+        else:
+            bounds = (gt[0], gt[3] + h * gt[5], gt[0] + w * gt[1], gt[3])
+            opts = gdal.WarpOptions(format="MEM", dstSRS=wkt, outputBounds=bounds, width=w, height=h,
+                                    resampleAlg="bilinear", outputType=gdal.GDT_Float32, dstNodata=float("nan"),
+                                    srcNodata=r.nodata, multithread=False)
+            try:
+                out = gdal.Warp("", src.dataset, options=opts)
+            except RuntimeError as e:
+                raise TerrainError(f"cannot warp {r.path} onto the grid of the other DSM: {e}") from e
+            z = out.GetRasterBand(1).ReadAsArray().astype(np.float64)
+            out = None
     if r.nodata is not None:
         z[z == r.nodata] = np.nan
     z[~np.isfinite(z)] = np.nan

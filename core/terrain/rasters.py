@@ -37,33 +37,22 @@ class Elevation:
         """Rows r0:r1, columns c0:c1 as float64 metres (NaN = nodata), from memory or from the file."""
         if self.z is not None:
             return np.array(self.z[r0:r1, c0:c1], dtype=np.float64)
-        from osgeo import gdal
-
-        ds = gdal.Open(self.path)
-        band = ds.GetRasterBand(1)
-        z = band.ReadAsArray(c0, r0, c1 - c0, r1 - r0).astype(np.float64)
-        nd = band.GetNoDataValue()
+        with raster.RasterFile(self.path, "elevation raster") as r:
+            z = r.read(1, (c0, r0, c1 - c0, r1 - r0)).astype(np.float64)
+            nd = r.nodata(1)
         if nd is not None:
             z[z == nd] = np.nan
         z[~np.isfinite(z)] = np.nan
         return z * self.unit if self.unit != 1.0 else z
 
 
-def open_raster(path: str, what: str):
-    """The GDAL dataset of ``path``; TerrainError naming the file (as the ``what`` it was given as) when it is
-    missing, not a raster GDAL can read, or has no band."""
-    from osgeo import gdal
-
-    gdal.UseExceptions()
-    if not os.path.isfile(path):
-        raise TerrainError(f"the {what} {path} does not exist")
+def open_raster(path: str, what: str) -> raster.RasterFile:
+    """``path`` opened (:class:`core.io.raster.RasterFile`); TerrainError naming the file (as the ``what`` it was
+    given as) when it is missing, not a raster GDAL can read, or has no band."""
     try:
-        ds = gdal.Open(path)
-    except RuntimeError as e:
-        raise TerrainError(f"the {what} {path} is not a raster GDAL can read: {e}") from e
-    if ds is None or ds.RasterCount < 1:
-        raise TerrainError(f"the {what} {path} is not a raster GDAL can read (no band)")
-    return ds
+        return raster.RasterFile(path, f"the {what}")
+    except raster.RasterError as e:
+        raise TerrainError(str(e)) from e
 
 
 def check_north_up(path: str, what: str, gt) -> None:
@@ -75,23 +64,23 @@ def check_north_up(path: str, what: str, gt) -> None:
 ELEVATION_PRODUCTS = ("dtm", "dsm", None)  # ARCHAEOORTHO_PRODUCT values that are heights (None: not ours)
 
 
-def check_elevation_kind(ds, path: str, what: str) -> None:
+def check_elevation_kind(r: raster.RasterFile, path: str, what: str) -> None:
     """TerrainError naming the file and what it holds when the raster is of a kind that cannot be heights: an
     image (RGB / RGBA bands, 8-bit colour, a palette: the orthomosaic given as a DSM) or one of the plugin's own
     non-elevation products (a DSM/DTM source raster, a relief visualisation)."""
     from osgeo import gdal
 
-    product = (ds.GetMetadata() or {}).get("ARCHAEOORTHO_PRODUCT")
+    product = r.metadata().get("ARCHAEOORTHO_PRODUCT")
     if product not in ELEVATION_PRODUCTS:
         raise TerrainError(f"the {what} {path} is an ArchaeoOrtho {product} raster, not heights: give a DSM or DTM")
     colours = {gdal.GCI_RedBand: "red", gdal.GCI_GreenBand: "green", gdal.GCI_BlueBand: "blue",
                gdal.GCI_AlphaBand: "alpha", gdal.GCI_PaletteIndex: "palette"}
-    bands = [ds.GetRasterBand(i + 1) for i in range(ds.RasterCount)]
+    bands = [r.band(i + 1) for i in range(r.count)]
     interp = [colours.get(b.GetColorInterpretation()) for b in bands]
     dtype = gdal.GetDataTypeName(bands[0].DataType)
-    if any(interp) or (ds.RasterCount >= 3 and dtype == "Byte"):
+    if any(interp) or (r.count >= 3 and dtype == "Byte"):
         kinds = "/".join(c or "grey" for c in interp)
-        raise TerrainError(f"the {what} {path} is an image, not heights: {ds.RasterCount} band(s) of {dtype} "
+        raise TerrainError(f"the {what} {path} is an image, not heights: {r.count} band(s) of {dtype} "
                            f"({kinds}); an orthophoto or a rendered picture cannot be a terrain model: give a DSM "
                            "or DTM (one band of heights)")
 
@@ -116,38 +105,36 @@ def read_elevation(path: str, what: str = "DSM", whole: bool = True,
     the caller checks the data with :func:`check_data`)."""
     from osgeo import osr
 
-    ds = open_raster(path, what)
-    check_elevation_kind(ds, path, what)
-    gt = ds.GetGeoTransform()
-    wkt = ds.GetProjection() or ""
-    xy_unit = 1.0
-    if wkt:
-        srs = osr.SpatialReference(wkt=wkt)
-        if srs.IsGeographic():
-            raise TerrainError(f"the {what} {path} is in a geographic CRS ({srs.GetName()}, cells in degrees): a "
-                               "terrain model needs metres; reproject it to a projected CRS (e.g. its UTM zone) "
-                               "with Raster > Projections > Warp first")
-        xy_unit = float(srs.GetLinearUnits() or 1.0)
-    unit = raster.height_unit(path)[1]  # the heights' own unit: the band's, a vertical CRS's, else the axes'
+    with open_raster(path, what) as r:
+        check_elevation_kind(r, path, what)
+        gt = r.geotransform or (0.0, 1.0, 0.0, 0.0, 0.0, 1.0)  # GDAL's default for a raster with none
+        wkt = r.crs_wkt
+        xy_unit = 1.0
+        if wkt:
+            srs = osr.SpatialReference(wkt=wkt)
+            if srs.IsGeographic():
+                raise TerrainError(f"the {what} {path} is in a geographic CRS ({srs.GetName()}, cells in degrees): "
+                                   "a terrain model needs metres; reproject it to a projected CRS (e.g. its UTM "
+                                   "zone) with Raster > Projections > Warp first")
+            xy_unit = float(srs.GetLinearUnits() or 1.0)
+        unit = raster.height_unit(path)[1]  # the heights' own unit: the band's, a vertical CRS's, else the axes'
 
-    check_north_up(path, what, gt)
-    if abs(abs(gt[1]) - abs(gt[5])) > 1e-6 * abs(gt[1]):
-        raise TerrainError(f"the {what} {path} has non-square cells ({gt[1]:g} x {abs(gt[5]):g}): resample it to "
-                           "square cells first")
-    w, h = ds.RasterXSize, ds.RasterYSize
-    if w < MIN_CELLS or h < MIN_CELLS:
-        raise TerrainError(f"the {what} {path} is {w} x {h} cells: too small for a terrain model (at least "
-                           f"{MIN_CELLS} x {MIN_CELLS} cells)")
-    check_memory(path, what, w, h, bytes_per_cell)
-    if not whole:
-        return Elevation(path, None, tuple(gt), wkt, abs(gt[1]) * xy_unit, unit, (h, w))
-    band = ds.GetRasterBand(1)
-    z = band.ReadAsArray().astype(np.float64)
-    nd = band.GetNoDataValue()
+        check_north_up(path, what, gt)
+        if abs(abs(gt[1]) - abs(gt[5])) > 1e-6 * abs(gt[1]):
+            raise TerrainError(f"the {what} {path} has non-square cells ({gt[1]:g} x {abs(gt[5]):g}): resample it "
+                               "to square cells first")
+        w, h = r.width, r.height
+        if w < MIN_CELLS or h < MIN_CELLS:
+            raise TerrainError(f"the {what} {path} is {w} x {h} cells: too small for a terrain model (at least "
+                               f"{MIN_CELLS} x {MIN_CELLS} cells)")
+        check_memory(path, what, w, h, bytes_per_cell)
+        if not whole:
+            return Elevation(path, None, tuple(gt), wkt, abs(gt[1]) * xy_unit, unit, (h, w))
+        z = r.read(1).astype(np.float64)
+        nd = r.nodata(1)
     if nd is not None:
         z[z == nd] = np.nan
     z[~np.isfinite(z)] = np.nan
-    ds = None
     check_data(path, what, int(np.isfinite(z).sum()), w, h)
     return Elevation(path, z * unit, tuple(gt), wkt, abs(gt[1]) * xy_unit, unit, (h, w))
 
@@ -249,11 +236,9 @@ def write_classes(path: str, array: np.ndarray, elev: Elevation, description: st
 
 def same_grid(a: str, b: str) -> Optional[str]:
     """None when rasters ``a`` and ``b`` share size and geotransform, else what differs."""
-    from osgeo import gdal
-
-    da, db = gdal.Open(a), gdal.Open(b)
-    if (da.RasterXSize, da.RasterYSize) != (db.RasterXSize, db.RasterYSize):
-        return f"size {da.RasterXSize} x {da.RasterYSize} vs {db.RasterXSize} x {db.RasterYSize}"
-    if not np.allclose(da.GetGeoTransform(), db.GetGeoTransform()):
-        return f"geotransform {da.GetGeoTransform()} vs {db.GetGeoTransform()}"
+    with raster.RasterFile(a, "raster") as da, raster.RasterFile(b, "raster") as db:
+        if (da.width, da.height) != (db.width, db.height):
+            return f"size {da.width} x {da.height} vs {db.width} x {db.height}"
+        if not np.allclose(da.geotransform, db.geotransform):
+            return f"geotransform {da.geotransform} vs {db.geotransform}"
     return None

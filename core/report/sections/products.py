@@ -7,6 +7,7 @@ import os
 
 import numpy as np
 
+from ...io.raster import RasterError, RasterFile
 from ..context import ReportContext, Skip
 from ..errors import ReportError
 from ..figures import draw_dem, draw_image, embed, equal_xy, new_figure
@@ -33,34 +34,32 @@ def section(ctx: ReportContext) -> str:
 
 
 def _raster(ctx: ReportContext, path: str, title: str, dem: bool) -> str:
-    from osgeo import gdal
-
-    gdal.UseExceptions()
     try:
-        ds = gdal.Open(path)
-    except RuntimeError as e:
-        return f'<h3>{title}</h3><p class="warn">{esc(path)} cannot be read: {esc(e)}</p>'
-    w, h = ds.RasterXSize, ds.RasterYSize
-    gt = ds.GetGeoTransform()
+        ds = RasterFile(path, title.lower())
+    except RasterError as e:
+        return f'<h3>{title}</h3><p class="warn">{esc(path)} cannot be read: {esc(e.__cause__ or e)}</p>'
+    w, h = ds.width, ds.height
+    gt = ds.geotransform or (0.0, 1.0, 0.0, 0.0, 0.0, 1.0)  # GDAL's default for a raster with none
     step = max(1, int(math.ceil(max(w, h) / 900)))
     bw, bh = max(1, w // step), max(1, h // step)
-    b1 = ds.GetRasterBand(1)
-    nodata = b1.GetNoDataValue()
-    info = [("File", esc(os.path.relpath(path, ctx.d.ws.root))), ("Size", f"{w} × {h} cells, {ds.RasterCount} "
+    nodata = ds.nodata(1)
+    info = [("File", esc(os.path.relpath(path, ctx.d.ws.root))), ("Size", f"{w} × {h} cells, {ds.count} "
                                                                           "band(s)"),
             ("Resolution", f"{abs(gt[1]):.4g} × {abs(gt[5]):.4g} m"),
-            ("CRS", esc(raster_crs_name(ds)))]
+            ("CRS", esc(raster_crs_name(ds.crs_wkt)))]
     fig = new_figure(7.5, 6.0)
     ax = fig.add_subplot(111)
     extent = (gt[0], gt[0] + gt[1] * w, gt[3] + gt[5] * h, gt[3])
     try:
         if dem:
-            z = b1.ReadAsArray(buf_xsize=bw, buf_ysize=bh).astype(float)
+            z = ds.read(1, out_shape=(bh, bw)).astype(float)
         else:
             arr, alpha = _read_image(ds, bw, bh)
-    except RuntimeError as e:  # a damaged tile: GDAL's "IReadBlock failed ... TIFFReadEncodedTile() failed"
-        raise ReportError(f"the {title.lower()} {path} is damaged: GDAL cannot read its cells ({e}). Run the stage "
-                          f"that writes it again ('{'Build DSM' if dem else 'Build orthophoto'}')") from e
+    except RasterError as e:  # a damaged tile: GDAL's "IReadBlock failed ... TIFFReadEncodedTile() failed"
+        raise ReportError(f"the {title.lower()} {path} is damaged: GDAL cannot read its cells ({e.__cause__ or e}). "
+                          f"Run the stage that writes it again ('{'Build DSM' if dem else 'Build orthophoto'}')") from e
+    finally:
+        ds.close()
     if dem:
         valid = np.isfinite(z) & ((z != nodata) if nodata is not None else True)
         frac = float(valid.mean())
@@ -94,18 +93,19 @@ def _raster(ctx: ReportContext, path: str, title: str, dem: bool) -> str:
         " with hillshade (sun from the north-west, 45°)." if dem else "."))
 
 
-def _read_image(ds, bw: int, bh: int):
+def _read_image(ds: RasterFile, bw: int, bh: int):
     """The first three bands at (bw, bh) cells, and where they hold data (the alpha band, else the mask)."""
     from osgeo import gdal
 
-    bands = [ds.GetRasterBand(i + 1) for i in range(min(3, ds.RasterCount))]
-    arr = np.dstack([b.ReadAsArray(buf_xsize=bw, buf_ysize=bh).astype(float) for b in bands])
+    arr = np.dstack([ds.read(i + 1, out_shape=(bh, bw)).astype(float) for i in range(min(3, ds.count))])
     alpha = None
-    for i in range(ds.RasterCount):
-        b = ds.GetRasterBand(i + 1)
-        if b.GetColorInterpretation() == gdal.GCI_AlphaBand:
-            alpha = b.ReadAsArray(buf_xsize=bw, buf_ysize=bh) > 0
+    for i in range(ds.count):
+        if ds.band(i + 1).GetColorInterpretation() == gdal.GCI_AlphaBand:
+            alpha = ds.read(i + 1, out_shape=(bh, bw)) > 0
     if alpha is None:
-        mb = ds.GetRasterBand(1).GetMaskBand().ReadAsArray(buf_xsize=bw, buf_ysize=bh)
+        try:
+            mb = ds.band(1).GetMaskBand().ReadAsArray(buf_xsize=bw, buf_ysize=bh)
+        except RuntimeError as e:
+            raise RasterError(f"{ds.what} {ds.path}: its mask cannot be read ({e})") from e
         alpha = mb > 0
     return arr, alpha

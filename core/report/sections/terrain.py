@@ -9,6 +9,7 @@ from typing import List, Tuple
 
 import numpy as np
 
+from ...io.raster import RasterError, RasterFile
 from ...project.stages import RELIEF, TERRAIN
 from ...terrain.options import VISUALISATIONS
 from ..context import ReportContext
@@ -20,23 +21,18 @@ _LABELS = dict(VISUALISATIONS)
 
 def _read(path: str, max_side: int = 700):
     """(array at most ``max_side`` cells a side with NaN for nodata, extent, cell size, metadata) or None."""
-    from osgeo import gdal
-
-    gdal.UseExceptions()
     try:
-        ds = gdal.Open(path)
-        w, h = ds.RasterXSize, ds.RasterYSize
-        step = max(1, int(math.ceil(max(w, h) / max_side)))
-        band = ds.GetRasterBand(1)
-        z = band.ReadAsArray(buf_xsize=max(1, w // step), buf_ysize=max(1, h // step)).astype(float)
-    except RuntimeError:
+        with RasterFile(path, "terrain product") as r:
+            w, h = r.width, r.height
+            step = max(1, int(math.ceil(max(w, h) / max_side)))
+            z = r.read(1, out_shape=(max(1, h // step), max(1, w // step))).astype(float)
+            nd, gt, metadata = r.nodata(1), r.geotransform or (0.0, 1.0, 0.0, 0.0, 0.0, 1.0), r.metadata()
+    except RasterError:
         return None
-    nd = band.GetNoDataValue()
     if nd is not None:
         z[z == nd] = np.nan
-    gt = ds.GetGeoTransform()
     extent = (gt[0], gt[0] + gt[1] * w, gt[3] + gt[5] * h, gt[3])
-    return z, extent, abs(gt[1]) * w / z.shape[1], ds.GetMetadata() or {}
+    return z, extent, abs(gt[1]) * w / z.shape[1], metadata
 
 
 def subsection(ctx: ReportContext) -> str:
