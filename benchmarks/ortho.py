@@ -271,6 +271,7 @@ def main():
     if args.mosaic_only:
         return mosaic_only(args)
 
+    from core.ortho.options import OrthoOptions, SingleImageOptions
     from core.ortho.single import orthorectify_image
     from core.ortho.stage import build_orthophoto_workspace, workspace_dsm
     from core.project.workspace import Workspace
@@ -348,7 +349,8 @@ def main():
             gcps, *_ = transferred_gcps(args.workspace, name, n)
             out = os.path.join(args.out, f"single_{n}.tif")
             t0 = time.time()
-            r = orthorectify_image(img, out, dsm_used, gcps=gcps, resolution=res.resolution, **kw)
+            r = orthorectify_image(SingleImageOptions(img, out, dsm_used, gcps=gcps,
+                                                      ortho=OrthoOptions(resolution=res.resolution), **kw))
             s = shifts_against(out, mos)
             d = np.hypot(s[:, 0], s[:, 1]) if len(s) else np.zeros(0)
             print(f"  {label} ({time.time() - t0:.1f} s): GCP RMSE {r.rmse_px:.2f} px, left out "
@@ -364,7 +366,8 @@ def main():
         orientation = {"x": c[0], "y": c[1], "z": c[2], "omega": om, "phi": ph, "kappa": ka,
                        "focal_px": block_cam.focal, "cx": block_cam.cx, "cy": block_cam.cy, "crs": "EPSG:32617", **k}
         out2 = os.path.join(args.out, "single_orientation.tif")
-        orthorectify_image(img, out2, dsm_used, orientation=orientation, resolution=res.resolution)
+        orthorectify_image(SingleImageOptions(img, out2, dsm_used, orientation=orientation,
+                                              ortho=OrthoOptions(resolution=res.resolution)))
         s = shifts_against(out2, mos)
         d = np.hypot(s[:, 0], s[:, 1])
         print(f"  known orientation (x y z omega phi kappa + interior from the block): mean shift "

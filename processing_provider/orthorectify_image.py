@@ -101,6 +101,7 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
         from ..core.ortho import single as ortho
+        from ..core.ortho.options import OrthoOptions, SingleImageOptions
 
         image = self.parameterAsFile(parameters, self.IMAGE, context)
         dsm_layer = self.parameterAsRasterLayer(parameters, self.DSM, context)
@@ -127,15 +128,16 @@ class OrthorectifyImageAlgorithm(AlgorithmBase):
             raise QgsProcessingException(self.tr("RESIDUALS must be a GeoPackage (.gpkg) file, got {}").format(
                 residuals))
         progress = FeedbackProgress(feedback)
-        result = self.run_core(
-            ortho.orthorectify_image, image, self.parameterAsOutputLayer(parameters, self.OUTPUT, context),
+        options = self.run_core(
+            SingleImageOptions, image, self.parameterAsOutputLayer(parameters, self.OUTPUT, context),
             dsm_path=dsm_path, gcps=gcps, orientation=orientation,
             focal_mm=self.parameterAsDouble(parameters, self.FOCAL_MM, context) or None,
             sensor_width_mm=self.parameterAsDouble(parameters, self.SENSOR_WIDTH_MM, context) or None,
             mode=params.read_choice(self, parameters, self.MODE, context, self.MODES), crs=crs_text,
-            resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context), residuals_path=residuals,
-            progress=progress, reference_ortho=ref_layer.source() if ref_layer is not None else None,
+            ortho=OrthoOptions(resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context)),
+            residuals_path=residuals, reference_ortho=ref_layer.source() if ref_layer is not None else None,
             location=location, search_radius=self.parameterAsDouble(parameters, self.SEARCH_RADIUS, context) or 50.0)
+        result = self.run_core(ortho.orthorectify_image, options, progress=progress)
         progress.push_result(result.warnings, result.log_lines)
         for r in result.residuals:
             feedback.pushInfo(self.tr("{} ({}): {:.2f} px").format(r["name"], r["role"], r["res_px"]))

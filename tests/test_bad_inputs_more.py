@@ -127,6 +127,7 @@ def test_orthorectify_image_on_a_dsm_in_feet_matches_the_metre_dsm(tmp_path):
     """Orthorectify image with a known orientation on the same ground as a metre DSM and as a state plane DSM in
     feet: the same orthophoto (heights in feet read as metres put the ground 3.28 x higher: 656 m under a camera
     at 350 m, nothing of it right)."""
+    from core.ortho.options import OrthoOptions, SingleImageOptions
     from core.ortho.single import orthorectify_image
 
     metre, _ = _metre_dsm(tmp_path / "m.tif", cell=0.5, n=800)
@@ -138,7 +139,8 @@ def test_orthorectify_image_on_a_dsm_in_feet_matches_the_metre_dsm(tmp_path):
     outs = []
     for name, dsm in (("m", metre), ("ft", feet)):
         out = str(tmp_path / f"ortho_{name}.tif")
-        orthorectify_image(photo, out, dsm, orientation=dict(orient), resolution=0.5, crs=UTM17)
+        orthorectify_image(SingleImageOptions(photo, out, dsm, orientation=dict(orient), crs=UTM17,
+                                              ortho=OrthoOptions(resolution=0.5)))
         outs.append(gdal.Open(out))
     a, b = outs
     assert a.GetGeoTransform() == pytest.approx(b.GetGeoTransform(), abs=1.0)
@@ -248,7 +250,7 @@ def test_orthorectify_image_with_geographic_control_works_in_utm(tmp_path):
     from core.geometry.camera import Intrinsics, Pose, project_points, rotation_from_opk
     from core.geometry.crs import transform_points
     from core.io.gcp import GCPSet, GroundPoint, Observation
-    from core.ortho.options import OrthoError
+    from core.ortho.options import OrthoError, SingleImageOptions
     from core.ortho.single import orthorectify_image
 
     metre, _ = _metre_dsm(tmp_path / "m.tif", cell=0.5, n=800)
@@ -265,12 +267,13 @@ def test_orthorectify_image_with_geographic_control_works_in_utm(tmp_path):
     gcps = GCPSet("EPSG:4326", [GroundPoint(f"g{i}", float(a[0]), float(a[1]), float(a[2]),
                                             observations=[Observation("photo.png", float(p[0]), float(p[1]))])
                                 for i, (a, p) in enumerate(zip(ll, px))])
-    r = orthorectify_image(photo, str(tmp_path / "o.tif"), dsm_ll, gcps=gcps, focal_px=400.0)
+    r = orthorectify_image(SingleImageOptions(photo, str(tmp_path / "o.tif"), dsm_ll, gcps=gcps, focal_px=400.0))
     assert r.crs == UTM17 and any("geographic" in line and "EPSG:32617" in line for line in r.log_lines)
     got = np.array([r.orientation[k] for k in "xyz"])
     assert np.linalg.norm(got - centre) < 0.5, got - centre
     with pytest.raises(OrthoError, match=r"CRS EPSG:4326 is geographic .* EPSG:32617"):
-        orthorectify_image(photo, str(tmp_path / "o2.tif"), dsm_ll, gcps=gcps, focal_px=400.0, crs="EPSG:4326")
+        orthorectify_image(SingleImageOptions(photo, str(tmp_path / "o2.tif"), dsm_ll, gcps=gcps, focal_px=400.0,
+                                              crs="EPSG:4326"))
 
 
 def test_seamlines_without_a_crs_or_naming_a_filtered_photo_are_named(tmp_path):

@@ -19,7 +19,7 @@ from core.io import gcp as gcpmod
 from core.io import raster as dsmmod
 from core.ortho import seams
 from core.ortho.cameras import OrthoCamera, select_cameras
-from core.ortho.options import OrthoError, OrthoOptions
+from core.ortho.options import OrthoError, OrthoOptions, SingleImageOptions
 from core.ortho.orientation import read_orientation
 from core.ortho.single import orthorectify_image
 from core.ortho.stage import build_orthophoto_workspace
@@ -540,8 +540,8 @@ def test_single_image_by_resection_registers_to_the_truth_and_the_mosaic(scene, 
     block, _root, images, dsm, _ws = scene
     gcps = _image_gcps(block, SINGLE, 12, bad=4)
     out = str(tmp_path / "single.tif")
-    r = orthorectify_image(os.path.join(images, SINGLE), out, dsm, gcps=gcps, focal_px=331.0,
-                                 residuals_path=str(tmp_path / "res.gpkg"))
+    r = orthorectify_image(SingleImageOptions(os.path.join(images, SINGLE), out, dsm, gcps=gcps, focal_px=331.0,
+                                              residuals_path=str(tmp_path / "res.gpkg")))
     assert r.source == "resection" and r.outliers == ["T5"]
     assert r.rmse_px < 0.8
     assert r.estimated_intrinsics and abs(r.orientation["k1"] - CAMERA.k1) < 0.02
@@ -593,7 +593,7 @@ def test_single_image_with_known_orientation_and_a_dsm_in_another_crs(scene, tmp
     dsm3035 = str(tmp_path / "dsm_3035.tif")
     gdal.Warp(dsm3035, dsm, dstSRS="EPSG:3035", resampleAlg="bilinear")
     out = str(tmp_path / "single16.tif")
-    r = orthorectify_image(img16, out, dsm3035, orientation=str(orient))
+    r = orthorectify_image(SingleImageOptions(img16, out, dsm3035, orientation=str(orient)))
     assert r.source == "orientation" and any("reprojected" in line for line in r.log_lines)
     ds = gdal.Open(out)
     assert ds.RasterCount == 2 and ds.GetRasterBand(1).DataType == gdal.GDT_UInt16
@@ -608,8 +608,9 @@ def test_single_image_with_known_orientation_and_a_dsm_in_another_crs(scene, tmp
 def test_planar_rectification_and_how_far_it_is_off(scene, tmp_path):
     block, _root, images, dsm, _ws = scene
     gcps = _image_gcps(block, SINGLE, 8)
-    r = orthorectify_image(os.path.join(images, SINGLE), str(tmp_path / "planar.tif"), dsm, gcps=gcps,
-                                 focal_px=325.0, mode="planar", residuals_path=str(tmp_path / "res.gpkg"))
+    r = orthorectify_image(SingleImageOptions(os.path.join(images, SINGLE), str(tmp_path / "planar.tif"), dsm,
+                                              gcps=gcps, focal_px=325.0, mode="planar",
+                                              residuals_path=str(tmp_path / "res.gpkg")))
     assert r.mode == "planar" and r.planar_rmse_m < 0.5
     pe = r.planar_error
     # the roofs stand 4-8 m high: a plane through ground points misplaces them by metres
@@ -623,14 +624,15 @@ def test_too_few_gcps_name_how_many_are_needed(scene, tmp_path):
     _block, _root, images, dsm, _ws = scene
     gcps = _image_gcps(scene[0], SINGLE, 3)
     with pytest.raises(OrthoError, match=r"at least 4 ground control points .* found 3"):
-        orthorectify_image(os.path.join(images, SINGLE), str(tmp_path / "o.tif"), dsm, gcps=gcps,
-                                 focal_px=325.0)
+        orthorectify_image(SingleImageOptions(os.path.join(images, SINGLE), str(tmp_path / "o.tif"), dsm, gcps=gcps,
+                                              focal_px=325.0))
     with pytest.raises(OrthoError, match="needs a DSM"):
-        orthorectify_image(os.path.join(images, SINGLE), str(tmp_path / "o.tif"), None, gcps=gcps)
+        orthorectify_image(SingleImageOptions(os.path.join(images, SINGLE), str(tmp_path / "o.tif"), None,
+                                              gcps=gcps))
     gcps.points[0].observations[0].image = "another.jpg"
     with pytest.raises(OrthoError, match="found 2"):
-        orthorectify_image(os.path.join(images, SINGLE), str(tmp_path / "o.tif"), dsm, gcps=gcps,
-                                 focal_px=325.0, mode="planar")
+        orthorectify_image(SingleImageOptions(os.path.join(images, SINGLE), str(tmp_path / "o.tif"), dsm, gcps=gcps,
+                                              focal_px=325.0, mode="planar"))
     assert not os.path.exists(tmp_path / "o.tif")
 
 

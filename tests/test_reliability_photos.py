@@ -23,7 +23,7 @@ from core.geometry.crs import CRSError
 from core.io import raster as dsmmod
 from core.io.gcp import GCPError
 from core.io.images import ImageError, check_image, photo_fingerprint
-from core.ortho.options import OrthoError
+from core.ortho.options import OrthoError, SingleImageOptions
 from core.ortho.single import orthorectify_image
 from core.ortho.stage import build_orthophoto_workspace
 from core.pipeline import Control, run_pipeline
@@ -112,7 +112,7 @@ def test_orthorectify_image_refuses_a_truncated_jpeg(tmp_path):
                    "focal_px": 900.0, "crs": syn.CRS}
     out = tmp_path / "ortho.tif"
     with pytest.raises(OrthoError, match=r"cut\.jpg: image data is corrupt or truncated"):
-        orthorectify_image(str(photo), str(out), str(dsm), orientation=orientation)
+        orthorectify_image(SingleImageOptions(str(photo), str(out), str(dsm), orientation=orientation))
     assert not out.exists()
 
 

@@ -25,7 +25,7 @@ import pytest
 from osgeo import gdal
 
 from core.georef.autocontrol.single import PhotoControlOptions
-from core.ortho.options import OrthoError
+from core.ortho.options import OrthoError, OrthoOptions, SingleImageOptions
 from core.ortho.single import orthorectify_image
 from tests import synthetic as syn
 from tests.test_autocontrol import write_reference
@@ -118,9 +118,10 @@ def test_single_photo_is_oriented_and_orthorectified_by_automatic_control(setup,
     out = str(tmp_path / "ortho.tif")
     res_path = str(tmp_path / "res.gpkg")
     t0 = time.time()
-    r = orthorectify_image(photos[name], out, dsm, reference_ortho=ortho, location=_rough_location(ground, 60.0),
-                           search_radius=30.0, focal_px=focal, resolution=OUT_GSD, residuals_path=res_path,
-                           control_options=FAST)
+    r = orthorectify_image(SingleImageOptions(photos[name], out, dsm, reference_ortho=ortho,
+                                              location=_rough_location(ground, 60.0), search_radius=30.0,
+                                              focal_px=focal, ortho=OrthoOptions(resolution=OUT_GSD),
+                                              residuals_path=res_path, control=FAST))
     seconds = time.time() - t0
     centre = np.array([r.orientation[k] for k in "xyz"])
     err = float(np.linalg.norm(centre - (shot.centre + syn.ORIGIN)))
@@ -148,11 +149,12 @@ def test_a_location_far_off_is_refused_naming_the_photo_and_the_reference(setup,
     far = _rough_location(shots["oblique.jpg"][1], 0.0)
     far = (far[0] + 5000.0, far[1])
     with pytest.raises(OrthoError, match="oblique.jpg") as e:
-        orthorectify_image(photos["oblique.jpg"], str(tmp_path / "o.tif"), dsm, reference_ortho=ortho,
-                           location=far, search_radius=30.0, control_options=FAST)
+        orthorectify_image(SingleImageOptions(photos["oblique.jpg"], str(tmp_path / "o.tif"), dsm,
+                                              reference_ortho=ortho, location=far, search_radius=30.0, control=FAST))
     assert "ref_ortho.tif" in str(e.value)
     with pytest.raises(OrthoError, match="reference DSM"):
-        orthorectify_image(photos["oblique.jpg"], str(tmp_path / "o.tif"), None, reference_ortho=ortho, location=far)
+        orthorectify_image(SingleImageOptions(photos["oblique.jpg"], str(tmp_path / "o.tif"), None,
+                                              reference_ortho=ortho, location=far))
 
 
 def test_qgis_process_orthorectifies_with_automatic_control(setup, tmp_path):

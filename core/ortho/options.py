@@ -3,8 +3,8 @@ and the error they raise."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Any, Optional
+from dataclasses import dataclass, field
+from typing import Any, Optional, Tuple
 
 from ..common.errors import ArchaeoOrthoError
 from ..geometry.camera import Intrinsics
@@ -76,9 +76,24 @@ class OrthoOptions:
 
 @dataclass
 class SingleImageOptions:
-    """How one image is oriented and rectified by :func:`core.ortho.single.orthorectify_image` (its keywords of the
-    same names; OrthoOptions holds the rest: resolution, interpolation, occlusion, compression ...)."""
+    """What :func:`core.ortho.single.orthorectify_image` does with one image (even one outside any block): the
+    image, where the orthophoto goes, the DSM, how the image is oriented and how it is rectified.  ``ortho`` holds
+    the rest (resolution, interpolation, occlusion, compression ...).  The checks that need no file run here.
 
+    Orientation from ``gcps`` (a GCP file path or a core.io.gcp.GCPSet with observations in this image: space
+    resection, >= 4 control points, >= 6 to also estimate focal length and k1) or from ``orientation`` (a file for
+    :func:`core.ortho.orientation.read_orientation` or a dict with x, y, z, omega, phi, kappa; one without x..kappa
+    is interior orientation only).  Automatic control (no GCP, no orientation): ``reference_ortho`` (an orthophoto
+    raster) with ``dsm_path`` as the reference DSM, ``location`` (rough x, y of the ground the photo shows, in
+    ``location_crs``, default the reference's CRS; None: anywhere on the reference), ``search_radius`` (how far off
+    it may be) and ``control`` (a :class:`core.georef.autocontrol.single.PhotoControlOptions`, None: its
+    defaults)."""
+
+    image_path: str
+    output: str  # the orthophoto (Cloud-Optimized GeoTIFF)
+    dsm_path: Optional[str] = None  # required for mode "ortho" and automatic control
+    gcps: Any = None  # a GCP file path or a GCPSet
+    orientation: Any = None  # an orientation file path or a dict
     mode: str = "ortho"  # ortho: true orthophoto on the DSM / planar: projective, through the control points
     crs: Optional[str] = None  # working CRS; None = the GCPs', else the orientation's, else the DSM's
     focal_mm: Optional[float] = None  # with sensor_width_mm (the sensor's long side): the focal length
@@ -88,8 +103,33 @@ class SingleImageOptions:
     mask_path: Optional[str] = None  # white = use
     camera: Optional[Intrinsics] = None  # a calibrated interior orientation, kept unless estimate_intrinsics
     residuals_path: Optional[str] = None  # GeoPackage of the GCP residuals
+    reference_ortho: Optional[str] = None  # automatic control: the reference orthophoto
+    location: Optional[Tuple[float, float]] = None  # automatic control: rough x, y of the photo's ground
+    search_radius: float = 50.0  # automatic control: how far off ``location`` may be
+    location_crs: Optional[str] = None  # the CRS of ``location``; None: the reference's
+    control: Any = None  # automatic control: PhotoControlOptions
+    ortho: OrthoOptions = field(default_factory=OrthoOptions)  # resolution (0 = the image's GSD), interpolation ...
 
-    def check(self) -> None:
+    def __post_init__(self) -> None:
         self.mode = (self.mode or "ortho").lower()
+        self.ortho.check()
         if self.mode not in MODES:
             raise OrthoError(f"unknown MODE {self.mode!r}; choose one of {', '.join(MODES)}")
+        if self.gcps is None and self.orientation is None and self.reference_ortho is None:
+            raise OrthoError("give ground control points observed in the image (GCPS), its orientation "
+                             "(ORIENTATION), or a reference orthophoto for automatic control (REFERENCE_ORTHO)")
+        if self.auto_control:
+            if not self.dsm_path:
+                raise OrthoError(f"automatic control against {self.reference_ortho} needs the reference DSM too: "
+                                 "give DSM")
+            return
+        if self.mode == "ortho" and not self.dsm_path:
+            raise OrthoError("a true orthophoto needs a DSM; give DSM, or choose MODE planar for flat ground")
+        if self.mode == "planar" and self.gcps is None:
+            raise OrthoError("planar rectification needs at least 4 ground control points observed in the image "
+                             "(GCPS)")
+
+    @property
+    def auto_control(self) -> bool:
+        """Whether the image is controlled automatically against ``reference_ortho`` (no GCP, no orientation)."""
+        return self.reference_ortho is not None and self.gcps is None and self.orientation is None

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
-from typing import Any, Callable, Dict, List, Optional
+from dataclasses import dataclass, field
+from typing import Dict, Optional, Tuple
 
 import numpy as np
 
@@ -14,6 +14,7 @@ from ..geometry.camera import Intrinsics
 from ..io import raster as dsmmod
 from .cameras import OrthoCamera
 from .grid import cell_centre_coords, grid_tiles, nice_number
+from .imagecontrol import ImageControl, ImageRun
 from .options import OrthoError, OrthoOptions
 from .pixels import ImageMeta, image_window, photo_mask, remap_photo
 from .surface import Dsm
@@ -26,6 +27,16 @@ class PlanarResult:
     valid_fraction: float
     rmse_m: float  # of the control points on the plane
     error: Optional[Dict[str, float]] = None  # how far planar rectification is off given the DSM
+    # each control point's residual on the plane: name -> (dx_m, dy_m, res_m)
+    plane_residuals: Dict[str, Tuple[float, float, float]] = field(default_factory=dict)
+
+
+@dataclass
+class PlanarOutput:
+    """Where the planar rectification goes: the Cloud-Optimized GeoTIFF's path and its CRS (None: none written)."""
+
+    path: str
+    crs: Optional[str]
 
 
 def _undistorted_px(cam: Intrinsics, px: np.ndarray) -> np.ndarray:
@@ -33,30 +44,25 @@ def _undistorted_px(cam: Intrinsics, px: np.ndarray) -> np.ndarray:
     return np.stack([cam.fx * xn[..., 0] + cam.cx, cam.fy * xn[..., 1] + cam.cy], axis=-1)
 
 
-def rectify_planar(ocam: OrthoCamera, meta: ImageMeta, pairs, control, xyz, px_all, offset: np.ndarray,
-            dsm: Optional[Dsm], options: OrthoOptions, output: str, crs: Optional[str],
-            residuals: List[Dict[str, Any]], log: List[str], warn: Callable[[str], None], progress: Progress
-            ) -> PlanarResult:
+def rectify_planar(ocam: OrthoCamera, run: ImageRun, ctl: ImageControl, offset: np.ndarray, dsm: Optional[Dsm],
+                   options: OrthoOptions, output: PlanarOutput, progress: Progress) -> PlanarResult:
     """Projective rectification through the control points; with a DSM, how far it is off from the truth.
-    Adds the residuals on the plane (dx_m, dy_m, res_m) to the rows of ``residuals``."""
-    cam = ocam.camera
+    The residuals on the plane (dx_m, dy_m, res_m) come back in ``plane_residuals``."""
+    cam, control, warn = ocam.camera, ctl.control, run.warn
     try:
-        hom = rs.fit_homography(_undistorted_px(cam, px_all[control]), (xyz[control, :2] - offset[:2]),
-                                [pairs[i][0].name for i in control], image=ocam.name)
+        hom = rs.fit_homography(_undistorted_px(cam, ctl.px[control]), (ctl.xyz[control, :2] - offset[:2]),
+                                [ctl.pairs[i][0].name for i in control], image=ocam.name)
     except rs.ResectionError as e:
         raise OrthoError(str(e)) from e
     for w_ in hom.warnings:
         warn(w_)
-    by_name = {r.name: r for r in hom.residuals}
-    for row in residuals:
-        r = by_name.get(row["name"])
-        if r is not None:
-            row["dx_m"], row["dy_m"], row["res_m"] = r.dx, r.dy, r.residual
+    plane_residuals = {r.name: (r.dx, r.dy, r.residual) for r in hom.residuals}
     grid = _planar_grid(hom, cam, ocam.name, offset, options.resolution)
-    n_valid = _write_planar(hom, ocam, meta, grid, offset, options, output, crs, progress)
-    out = PlanarResult(grid.resolution, n_valid / float(grid.width * grid.height), hom.rmse_m)
-    log.append(f"planar rectification through {sum(r.used for r in hom.residuals)} control points: RMSE "
-               f"{hom.rmse_m:.3f} m on the plane")
+    n_valid = _write_planar(hom, ocam, run.meta, grid, offset, options, output, progress)
+    out = PlanarResult(grid.resolution, n_valid / float(grid.width * grid.height), hom.rmse_m,
+                       plane_residuals=plane_residuals)
+    run.log.append(f"planar rectification through {sum(r.used for r in hom.residuals)} control points: RMSE "
+                   f"{hom.rmse_m:.3f} m on the plane")
     if dsm is None:
         warn("no DSM given: how far planar rectification is off because of relief cannot be measured")
         return out
@@ -65,9 +71,9 @@ def rectify_planar(ocam: OrthoCamera, meta: ImageMeta, pairs, control, xyz, px_a
         warn("the DSM does not cover the image's ground: planar displacement not measured")
         return out
     pe = out.error
-    log.append(f"planar rectification is off by {pe['mean_m']:.2f} m on average, {pe['p95_m']:.2f} m at the 95th "
-               f"percentile and {pe['max_m']:.2f} m at most ({pe['p95_px']:.1f} cells at 95 %) over "
-               f"{pe['relief_m']:.1f} m of relief in the DSM")
+    run.log.append(f"planar rectification is off by {pe['mean_m']:.2f} m on average, {pe['p95_m']:.2f} m at the "
+                   f"95th percentile and {pe['max_m']:.2f} m at most ({pe['p95_px']:.1f} cells at 95 %) over "
+                   f"{pe['relief_m']:.1f} m of relief in the DSM")
     return out
 
 
@@ -99,11 +105,11 @@ def _planar_grid(hom, cam: Intrinsics, name: str, offset: np.ndarray, resolution
 
 
 def _write_planar(hom, ocam: OrthoCamera, meta: ImageMeta, grid: dsmmod.Grid, offset: np.ndarray,
-                  options: OrthoOptions, output: str, crs: Optional[str], progress: Progress) -> int:
-    """Write the rectified image as a COG at ``output``; returns the number of cells with data."""
+                  options: OrthoOptions, output: PlanarOutput, progress: Progress) -> int:
+    """Write the rectified image as a COG at ``output.path``; returns the number of cells with data."""
     cam = ocam.camera
-    work = os.path.join(os.path.dirname(os.path.abspath(output)), ".work-" + os.path.basename(output))
-    writer = RasterWriter(work, grid.width, grid.height, meta.bands, meta.dtype, grid.geotransform, crs)
+    work = os.path.join(os.path.dirname(os.path.abspath(output.path)), ".work-" + os.path.basename(output.path))
+    writer = RasterWriter(work, grid.width, grid.height, meta.bands, meta.dtype, grid.geotransform, output.crs)
     n_valid = 0
     try:
         tiles = grid_tiles(grid.width, grid.height, options.tile)
@@ -131,7 +137,7 @@ def _write_planar(hom, ocam: OrthoCamera, meta: ImageMeta, grid: dsmmod.Grid, of
             writer.write(r0, c0_, vals.reshape(h, w, -1), ok.reshape(h, w))
             n_valid += int(ok.sum())
             progress.report(0.8 * (k + 1) / len(tiles), f"planar rectification: tile {k + 1}/{len(tiles)}")
-        writer.finish(output, options.compress, SubProgress(progress, 0.8, 0.95),
+        writer.finish(output.path, options.compress, SubProgress(progress, 0.8, 0.95),
                       metadata={"ARCHAEOORTHO_STAGE": "planar rectification", "IMAGE": ocam.name})
     except BaseException:
         writer.abort()

@@ -20,11 +20,12 @@ from ..io.images import ImageError, check_image, read_image_info
 from ..io.vector import write_points_gpkg
 from .block import prepare_block, write_camera_ortho
 from .cameras import OrthoCamera
+from .imagecontrol import ImageControl, ImageRun
 from .mosaic import WORK_PREFIX
-from .options import OrthoError, OrthoOptions, SingleImageOptions
+from .options import OrthoError, SingleImageOptions
 from .orientation import normalise_orientation, read_orientation
 from .pixels import PHOTO_CACHE, ImageMeta, image_meta
-from .planar import rectify_planar
+from .planar import PlanarOutput, rectify_planar
 from .surface import Dsm
 from .writer import gdal_cache
 
@@ -87,59 +88,38 @@ def _focal(meta: ImageMeta, image_path: str, focal_px, focal_mm, sensor_width_mm
     return None, "none"
 
 
-def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = None, gcps=None,
-                       orientation=None, focal_mm: Optional[float] = None, sensor_width_mm: Optional[float] = None,
-                       focal_px: Optional[float] = None, mode: str = "ortho", crs: Optional[str] = None,
-                       resolution: float = 0.0, residuals_path: Optional[str] = None,
-                       estimate_intrinsics="auto", mask_path: Optional[str] = None,
-                       camera: Optional[Intrinsics] = None,
-                       options: Optional[OrthoOptions] = None, progress: Optional[Progress] = None,
-                       reference_ortho: Optional[str] = None, location: Optional[Tuple[float, float]] = None,
-                       search_radius: float = 50.0, location_crs: Optional[str] = None,
-                       control_options=None) -> SingleImageResult:
-    """Orthorectify one image (even one outside any block) on an existing DSM.
+def orthorectify_image(options: SingleImageOptions, progress: Optional[Progress] = None) -> SingleImageResult:
+    """Orthorectify one image (even one outside any block) on an existing DSM, as ``options`` say.
 
-    Orientation from ``gcps`` (a GCP file path or a core.gcp.GCPSet with observations in this image: space
-    resection, >= 4 control points, >= 6 to also estimate focal length and k1) or from ``orientation`` (a file
-    for :func:`read_orientation` or a dict with x, y, z, omega, phi, kappa).  ``mode`` "ortho": true orthophoto
-    on the DSM (required; reprojected on the fly when in another CRS); "planar": projective rectification
-    through the control points onto a plane, and, when a DSM is given, how far that is off.  ``camera``: a
-    calibrated interior orientation (e.g. the block's camera), kept as it is unless ``estimate_intrinsics`` is
-    True; an orientation file without x..kappa is taken as interior orientation too.
-
-    Automatic control (no GCP, no orientation): ``reference_ortho`` (an orthophoto raster) with ``dsm_path`` as
-    the reference DSM, ``location`` (rough x, y of the ground the photo shows, in ``location_crs``, default the
-    reference's CRS; None: anywhere on the reference) and ``search_radius`` (how far off it may be):
-    :func:`core.georef.autocontrol.single.control_photo` finds GCPs (``auto_001`` ...) by matching the photo
-    to the reference, and the space resection uses them (``control_options``: its
-    :class:`~core.georef.autocontrol.single.PhotoControlOptions`).  Writes a COG at
-    ``output`` and optionally the GCP residuals to the GeoPackage ``residuals_path``.  ``options`` is not
-    modified (RESOLUTION goes into a copy)."""
+    Orientation from the GCPs observed in the image (space resection) or from a known orientation; or, with a
+    reference orthophoto and no GCP, by automatic control: :func:`core.georef.autocontrol.single.control_photo`
+    finds GCPs (``auto_001`` ...) by matching the photo to the reference, and the space resection uses them.
+    Mode "ortho": true orthophoto on the DSM (reprojected on the fly when in another CRS); "planar": projective
+    rectification through the control points onto a plane, and, when a DSM is given, how far that is off.  A
+    calibrated ``camera`` is kept as it is unless ``estimate_intrinsics`` is True.  Writes a COG at
+    ``options.output`` and optionally the GCP residuals to the GeoPackage ``options.residuals_path``.  ``options``
+    is not modified (what the automatic control finds goes into a copy)."""
     progress = progress or NullProgress()
-    options = replace(options or OrthoOptions(), resolution=float(resolution or 0.0))
-    options.check()
-    single = SingleImageOptions(mode=mode, crs=crs, focal_mm=focal_mm, sensor_width_mm=sensor_width_mm,
-                                focal_px=focal_px, estimate_intrinsics=estimate_intrinsics, mask_path=mask_path,
-                                camera=camera, residuals_path=residuals_path)
-    single.check()
-    auto = reference_ortho is not None and gcps is None and orientation is None
-    _check_inputs(image_path, dsm_path, gcps, orientation, single.mode, reference_ortho)
+    single = replace(options)
+    image_path = single.image_path
+    if not image_path or not os.path.isfile(image_path):
+        raise OrthoError(f"image {image_path} does not exist")
     try:
         check_image(image_path)  # the alignment's check: a truncated or corrupt photo is refused, named
     except ImageError as e:
         raise OrthoError(str(e)) from e
-    run = _Run(os.path.basename(image_path), image_meta(image_path), progress)
-    orient, single.camera = _orientation_input(orientation, gcps is None, run, image_path, single.camera)
-    auto_figures = None
-    if auto:
-        gcps, auto_figures = _auto_control(image_path, reference_ortho, dsm_path, location, search_radius,
-                                           location_crs, single, run, control_options, SubProgress(progress, 0, 0.1))
+    run = ImageRun(os.path.basename(image_path), image_meta(image_path), progress)
+    orient, single.camera = _orientation_input(single.orientation, single.gcps is None, run, image_path,
+                                               single.camera)
+    gcps, auto_figures = single.gcps, None
+    if single.auto_control:
+        gcps, auto_figures = _auto_control(single, run, SubProgress(progress, 0, 0.1))
     if isinstance(gcps, str):
         try:
             gcps = gcpmod.read_gcps(gcps, default_crs=single.crs)  # a CSV without a CRS line: the CRS parameter
         except gcpmod.GCPError as e:
             raise OrthoError(str(e)) from e
-    work_crs = _working_crs(single.crs, dsm_path, gcps, orient, run)
+    work_crs = _working_crs(single.crs, single.dsm_path, gcps, orient, run)
     ctl = _ground_control(gcps, orient, work_crs, run)
     offset, c_world = _local_frame(orient, ctl, work_crs)
     cam0, estimate = _interior(single, orient, ctl, run, image_path)
@@ -152,41 +132,11 @@ def orthorectify_image(image_path: str, output: str, dsm_path: Optional[str] = N
              f"kappa {ka:.3f} deg")
     progress.report(0.1, "oriented")
     ocam = OrthoCamera(run.name, os.path.abspath(image_path), ext.cam, ext.pose, 0, single.mask_path)
-    result = SingleImageResult(output, single.mode, work_crs, 0.0, 0.0, orientation_out, ext.source, ext.rmse,
-                               ext.residuals, ext.outliers, ext.estimated, warnings=run.warnings, log_lines=run.log,
-                               auto_control=auto_figures)
-    _rectify(result, ocam, run, ctl, offset, dsm_path, options, single.residuals_path)
+    result = SingleImageResult(single.output, single.mode, work_crs, 0.0, 0.0, orientation_out, ext.source,
+                               ext.rmse, ext.residuals, ext.outliers, ext.estimated, warnings=run.warnings,
+                               log_lines=run.log, auto_control=auto_figures)
+    _rectify(result, ocam, run, ctl, offset, single)
     return result
-
-
-@dataclass
-class _Run:
-    """One call of orthorectify_image: the image, its messages and progress."""
-
-    name: str
-    meta: ImageMeta
-    progress: Progress
-    warnings: List[str] = field(default_factory=list)
-    log: List[str] = field(default_factory=list)
-
-    def warn(self, msg: str) -> None:
-        self.warnings.append(msg)
-        self.progress.warning(msg)
-
-    def info(self, msg: str) -> None:
-        self.log.append(msg)
-        self.progress.info(msg)
-
-
-@dataclass
-class _Control:
-    """Ground control observed in the image: (point, observation) pairs, their world XYZ (working CRS) and
-    pixels, and the indices of the control (not check) points."""
-
-    pairs: List[Tuple[Any, Any]] = field(default_factory=list)
-    xyz: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
-    px: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
-    control: List[int] = field(default_factory=list)
 
 
 @dataclass
@@ -200,24 +150,7 @@ class _Exterior:
     estimated: bool = False
 
 
-def _check_inputs(image_path: str, dsm_path: Optional[str], gcps, orientation, mode: str,
-                  reference_ortho: Optional[str] = None) -> None:
-    if not image_path or not os.path.isfile(image_path):
-        raise OrthoError(f"image {image_path} does not exist")
-    if gcps is None and orientation is None and reference_ortho is None:
-        raise OrthoError("give ground control points observed in the image (GCPS), its orientation (ORIENTATION), "
-                         "or a reference orthophoto for automatic control (REFERENCE_ORTHO)")
-    if reference_ortho is not None and gcps is None and orientation is None:
-        if not dsm_path:
-            raise OrthoError(f"automatic control against {reference_ortho} needs the reference DSM too: give DSM")
-        return
-    if mode == "ortho" and not dsm_path:
-        raise OrthoError("a true orthophoto needs a DSM; give DSM, or choose MODE planar for flat ground")
-    if mode == "planar" and gcps is None:
-        raise OrthoError("planar rectification needs at least 4 ground control points observed in the image (GCPS)")
-
-
-def _orientation_input(orientation, exterior: bool, run: _Run, image_path: str, camera: Optional[Intrinsics]
+def _orientation_input(orientation, exterior: bool, run: ImageRun, image_path: str, camera: Optional[Intrinsics]
                        ) -> Tuple[Optional[Dict[str, Any]], Optional[Intrinsics]]:
     """(exterior orientation or None, camera): an orientation without x..kappa is interior orientation only."""
     if orientation is None:
@@ -235,9 +168,7 @@ def _orientation_input(orientation, exterior: bool, run: _Run, image_path: str, 
     return None, camera
 
 
-def _auto_control(image_path: str, reference_ortho: str, dsm_path: str, location, search_radius: float,
-                  location_crs: Optional[str], single: SingleImageOptions, run: _Run, control_options,
-                  progress: Progress) -> Tuple[Any, Dict[str, Any]]:
+def _auto_control(single: SingleImageOptions, run: ImageRun, progress: Progress) -> Tuple[Any, Dict[str, Any]]:
     """(GCP set of the automatic control, its figures): the photo matched to the reference orthophoto and DSM;
     the camera it estimates becomes the interior orientation unless one was given."""
     from ..georef.autocontrol.errors import AutoControlError
@@ -245,13 +176,14 @@ def _auto_control(image_path: str, reference_ortho: str, dsm_path: str, location
 
     focal = None
     if single.camera is None:
-        focal, f_source = _focal(run.meta, image_path, single.focal_px, single.focal_mm, single.sensor_width_mm, None)
-        run.info(f"automatic control of {run.name} against {reference_ortho}: focal length "
+        focal, f_source = _focal(run.meta, single.image_path, single.focal_px, single.focal_mm,
+                                 single.sensor_width_mm, None)
+        run.info(f"automatic control of {run.name} against {single.reference_ortho}: focal length "
                  + (f"{focal:.1f} px ({f_source})" if focal else "unknown, estimated"))
     try:
-        pc = control_photo(image_path, reference_ortho, dsm_path, location, search_radius, location_crs,
-                           camera=single.camera, focal_px=focal, estimate_intrinsics=single.estimate_intrinsics,
-                           options=control_options, progress=progress)
+        pc = control_photo(single.image_path, single.reference_ortho, single.dsm_path, single.location,
+                           single.search_radius, single.location_crs, camera=single.camera, focal_px=focal,
+                           estimate_intrinsics=single.estimate_intrinsics, options=single.control, progress=progress)
     except AutoControlError as e:
         raise OrthoError(str(e)) from e
     for m in pc.messages:
@@ -266,7 +198,7 @@ def _auto_control(image_path: str, reference_ortho: str, dsm_path: str, location
     return pc.gcps, figures
 
 
-def _working_crs(crs: Optional[str], dsm_path: Optional[str], gcps, orient: Optional[dict], run: _Run
+def _working_crs(crs: Optional[str], dsm_path: Optional[str], gcps, orient: Optional[dict], run: ImageRun
                  ) -> Optional[str]:
     dsm_info = dsmmod.open_dsm(dsm_path) if dsm_path else None
     work_crs = crs or (gcps.crs if gcps is not None and gcps.crs else None) or (orient or {}).get("crs")
@@ -288,7 +220,7 @@ def _geographic(crs: str) -> bool:
         return False
 
 
-def _projected_crs(crs: Optional[str], work_crs: str, dsm_info, gcps, orient: Optional[dict], run: _Run) -> str:
+def _projected_crs(crs: Optional[str], work_crs: str, dsm_info, gcps, orient: Optional[dict], run: ImageRun) -> str:
     """A geographic working CRS (degrees; issue 36 item 13: the resection then said 'points lie nearly on one
     line'): OrthoError when the CRS parameter asked for it, else the UTM zone of the control (or the orientation,
     or the DSM), said in the log."""
@@ -312,10 +244,10 @@ def _projected_crs(crs: Optional[str], work_crs: str, dsm_info, gcps, orient: Op
     return f"EPSG:{code}"
 
 
-def _ground_control(gcps, orient: Optional[dict], work_crs: Optional[str], run: _Run) -> _Control:
+def _ground_control(gcps, orient: Optional[dict], work_crs: Optional[str], run: ImageRun) -> ImageControl:
     """The GCPs observed in this image, in the working CRS (OrthoError if a resection has too few)."""
     if gcps is None:
-        return _Control()
+        return ImageControl()
     name, meta = run.name, run.meta
     for w_ in getattr(gcps, "warnings", []):
         run.warn(w_)
@@ -338,10 +270,10 @@ def _ground_control(gcps, orient: Optional[dict], work_crs: Optional[str], run: 
                if not (0 <= px_all[i, 0] <= meta.width and 0 <= px_all[i, 1] <= meta.height)]
     if outside:
         run.warn(f"GCP observation(s) outside the {meta.width} x {meta.height} image {name}: {', '.join(outside)}")
-    return _Control(pairs, xyz, px_all, control)
+    return ImageControl(pairs, xyz, px_all, control)
 
 
-def _local_frame(orient: Optional[dict], ctl: _Control, work_crs: Optional[str]
+def _local_frame(orient: Optional[dict], ctl: ImageControl, work_crs: Optional[str]
                  ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
     """(offset of the local frame, camera centre in the working CRS when the orientation is given)."""
     if orient is None:
@@ -354,7 +286,7 @@ def _local_frame(orient: Optional[dict], ctl: _Control, work_crs: Optional[str]
     return np.array([round(c_world[0]), round(c_world[1]), 0.0]), c_world
 
 
-def _interior(single: SingleImageOptions, orient: Optional[dict], ctl: _Control, run: _Run, image_path: str
+def _interior(single: SingleImageOptions, orient: Optional[dict], ctl: ImageControl, run: ImageRun, image_path: str
               ) -> Tuple[Intrinsics, Any]:
     """(the starting interior orientation, whether the resection estimates focal length and k1)."""
     name, meta, camera = run.name, run.meta, single.camera
@@ -389,8 +321,8 @@ def _interior(single: SingleImageOptions, orient: Optional[dict], ctl: _Control,
     return cam0, estimate_intrinsics
 
 
-def _exterior(orient: Optional[dict], ctl: _Control, cam0: Intrinsics, estimate_intrinsics, c_world, offset,
-              run: _Run) -> _Exterior:
+def _exterior(orient: Optional[dict], ctl: ImageControl, cam0: Intrinsics, estimate_intrinsics, c_world, offset,
+              run: ImageRun) -> _Exterior:
     """The pose: from the orientation given (the GCPs then check it), else by space resection."""
     name, pairs, xyz, control = run.name, ctl.pairs, ctl.xyz, ctl.control
     if orient is not None:
@@ -428,14 +360,15 @@ def _exterior(orient: Optional[dict], ctl: _Control, cam0: Intrinsics, estimate_
     return ext
 
 
-def _rectify(result: SingleImageResult, ocam: OrthoCamera, run: _Run, ctl: _Control, offset: np.ndarray,
-             dsm_path: Optional[str], options: OrthoOptions, residuals_path: Optional[str]) -> None:
+def _rectify(result: SingleImageResult, ocam: OrthoCamera, run: ImageRun, ctl: ImageControl, offset: np.ndarray,
+             single: SingleImageOptions) -> None:
     """Write the true orthophoto (or the planar rectification) and the residuals layer; fills ``result``."""
     progress, name, mode, work_crs = run.progress, run.name, result.mode, result.crs
     out_dir = os.path.dirname(os.path.abspath(result.output))
     os.makedirs(out_dir, exist_ok=True)
     clean_debris(out_dir, WORK_PREFIX)
     workdir = owned_tempdir(WORK_PREFIX, out_dir)
+    options, dsm_path, residuals_path = single.ortho, single.dsm_path, single.residuals_path
     PHOTO_CACHE.max_bytes = options.cache_mb << 20
     dsm = Dsm(dsm_path, work_crs) if dsm_path else None
     try:
@@ -458,9 +391,11 @@ def _rectify(result: SingleImageResult, ocam: OrthoCamera, run: _Run, ctl: _Cont
                     raise OrthoError(f"no cell of the orthophoto of {name} has data: the DSM has no valid height "
                                      "where the image looks")
             else:
-                pr = rectify_planar(ocam, run.meta, ctl.pairs, ctl.control, ctl.xyz, ctl.px, offset, dsm, options,
-                             result.output, work_crs, result.residuals, run.log, run.warn,
-                             SubProgress(progress, 0.1, 1.0))
+                pr = rectify_planar(ocam, run, ctl, offset, dsm, options, PlanarOutput(result.output, work_crs),
+                                    SubProgress(progress, 0.1, 1.0))
+                for row in result.residuals:  # the residuals on the plane
+                    if row["name"] in pr.plane_residuals:
+                        row["dx_m"], row["dy_m"], row["res_m"] = pr.plane_residuals[row["name"]]
                 result.planar_rmse_m, result.planar_error = pr.rmse_m, pr.error
                 result.resolution, result.valid_fraction = pr.resolution, pr.valid_fraction
         run.info(f"{mode} orthophoto {result.output}: {result.resolution:g} per cell, "
