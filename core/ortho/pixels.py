@@ -9,6 +9,7 @@ from typing import Any, Optional, Tuple
 import numpy as np
 
 from ..common.errors import require
+from ..io.raster import RasterError, RasterFile
 from .options import OrthoError, OrthoOptions
 
 
@@ -56,32 +57,29 @@ class ImageMeta:
     dtype: str  # numpy dtype name
 
 
-def image_meta(path: str) -> ImageMeta:
-    gdal = load_gdal()
+def _numpy_dtype(gdal_type: int) -> np.dtype:
     from osgeo import gdal_array
 
+    return np.dtype(gdal_array.GDALTypeCodeToNumericTypeCode(gdal_type))
+
+
+def image_meta(path: str) -> ImageMeta:
     try:
-        ds = gdal.Open(path)
-    except RuntimeError as e:
-        raise OrthoError(f"image {path} cannot be read: {e}") from e
-    if ds is None or ds.RasterCount == 0:
-        raise OrthoError(f"image {path} cannot be read")
-    dt = np.dtype(gdal_array.GDALTypeCodeToNumericTypeCode(ds.GetRasterBand(1).DataType)).name
-    return ImageMeta(ds.RasterXSize, ds.RasterYSize, ds.RasterCount, dt)
+        with RasterFile(path, "image") as r:
+            return ImageMeta(r.width, r.height, r.count, _numpy_dtype(r.band(1).DataType).name)
+    except RasterError as e:
+        raise OrthoError(str(e)) from e
 
 
 def _read_window(path: str, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
-    gdal = load_gdal()
-    from osgeo import gdal_array
-
-    ds = gdal.Open(path)
-    w, h, bands = x1 - x0, y1 - y0, ds.RasterCount
-    gdt = ds.GetRasterBand(1).DataType
-    dtype = np.dtype(gdal_array.GDALTypeCodeToNumericTypeCode(gdt))
-    # read pixel-interleaved (rows, cols, bands) directly: half the time of a band-sequential read and a copy
-    isz = dtype.itemsize
-    buf = ds.ReadRaster(x0, y0, w, h, buf_type=gdt, buf_pixel_space=bands * isz, buf_line_space=bands * isz * w,
-                        buf_band_space=isz)
+    with RasterFile(path, "image") as r:
+        w, h, bands = x1 - x0, y1 - y0, r.count
+        gdt = r.band(1).DataType
+        dtype = _numpy_dtype(gdt)
+        # read pixel-interleaved (rows, cols, bands) directly: half the time of a band-sequential read and a copy
+        isz = dtype.itemsize
+        buf = r.dataset.ReadRaster(x0, y0, w, h, buf_type=gdt, buf_pixel_space=bands * isz,
+                                   buf_line_space=bands * isz * w, buf_band_space=isz)
     return np.frombuffer(bytearray(buf) if isinstance(buf, bytes) else buf, dtype=dtype).reshape(h, w, bands)
 
 

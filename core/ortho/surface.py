@@ -107,12 +107,11 @@ def _same_crs(wkt: str, crs: str) -> bool:
 FILL_MAX_CELLS = 120_000_000  # larger DSMs are used as they are (the fill works on the whole raster in memory)
 
 
-def _cell_size_m(ds, rows: np.ndarray, cols: np.ndarray) -> float:
-    """The larger side of a DSM cell in metres: the CRS's linear unit, or degrees at the latitude of the measured
-    cells (the middle of ``rows``); CRS units taken as metres without a CRS."""
-    gt = ds.GetGeoTransform()
+def _cell_size_m(gt: Tuple[float, ...], srs, rows: np.ndarray, cols: np.ndarray) -> float:
+    """The larger side of a DSM cell (geotransform ``gt``, CRS ``srs`` or None) in metres: the CRS's linear unit,
+    or degrees at the latitude of the measured cells (the middle of ``rows``); CRS units taken as metres without a
+    CRS."""
     dx, dy = abs(gt[1]), abs(gt[5])
-    srs = ds.GetSpatialRef()
     if srs is None:
         return max(dx, dy)
     if srs.IsGeographic():
@@ -131,16 +130,17 @@ def fill_dsm_gaps(dsm_path: str, out_path: str, max_distance: float) -> Tuple[st
 
     Returns (path of the DSM to use, cells filled): ``out_path`` when something was filled, else ``dsm_path``."""
     cv2 = require("cv2", "orthophotos")
-    from osgeo import gdal
+    from osgeo import gdal, osr
 
     if not max_distance or max_distance <= 0:
         return dsm_path, 0
-    ds = gdal.Open(dsm_path)
-    if ds is None or ds.RasterXSize * ds.RasterYSize > FILL_MAX_CELLS:
-        return dsm_path, 0
-    band = ds.GetRasterBand(1)
-    z = band.ReadAsArray().astype(np.float32)
-    nodata = band.GetNoDataValue()
+    with dsmmod.RasterFile(dsm_path, "DSM") as r:
+        if r.width * r.height > FILL_MAX_CELLS:
+            return dsm_path, 0
+        z = r.read(1).astype(np.float32)
+        nodata, unit = r.nodata(1), (r.band(1).GetUnitType() or "").strip()
+        gt, wkt, width, height = r.geotransform or (0.0, 1.0, 0.0, 0.0, 0.0, 1.0), r.crs_wkt, r.width, r.height
+    srs = osr.SpatialReference(wkt=wkt) if wkt else None
     valid = np.isfinite(z)
     if nodata is not None and np.isfinite(nodata):
         valid &= z != nodata
@@ -153,12 +153,11 @@ def fill_dsm_gaps(dsm_path: str, out_path: str, max_distance: float) -> Tuple[st
     gaps = (~valid) & inside.astype(bool)
     if not gaps.any():
         return dsm_path, 0
-    gt = ds.GetGeoTransform()
-    max_cells = max(1.0, max_distance / _cell_size_m(ds, rows, cols))
+    max_cells = max(1.0, max_distance / _cell_size_m(gt, srs, rows, cols))
     fill_value = -9999.0
-    mem = gdal.GetDriverByName("MEM").Create("", ds.RasterXSize, ds.RasterYSize, 1, gdal.GDT_Float32)
+    mem = gdal.GetDriverByName("MEM").Create("", width, height, 1, gdal.GDT_Float32)
     mem.SetGeoTransform(gt)
-    mem.SetProjection(ds.GetProjection())
+    mem.SetProjection(wkt)
     mb = mem.GetRasterBand(1)
     mb.SetNoDataValue(fill_value)
     mb.WriteArray(np.where(valid, z, fill_value).astype(np.float32))
@@ -173,8 +172,6 @@ def fill_dsm_gaps(dsm_path: str, out_path: str, max_distance: float) -> Tuple[st
     n = int(take.sum())
     if n == 0:
         return dsm_path, 0
-    srs = ds.GetSpatialRef()
     # the band's unit kept: a DSM in feet on a metric grid is read in feet from the copy too (io.raster.height_unit)
-    dsmmod.write_cog(out_path, result, gt, srs.ExportToWkt() if srs is not None else None,
-                     unit=(band.GetUnitType() or "").strip())
+    dsmmod.write_cog(out_path, result, gt, wkt or None, unit=unit)
     return out_path, n

@@ -11,6 +11,7 @@ import numpy as np
 from ..common.files import atomic_output
 from ..common.progress import NullProgress, Progress, check_cancel
 from ..io import raster as dsmmod
+from ..io.raster import RasterFile
 from .options import OrthoError
 from .pixels import load_gdal
 
@@ -139,15 +140,11 @@ def interior_nodata(path: str) -> int:
     from scipy import ndimage
 
     gdal = load_gdal()
-    ds = gdal.Open(path)
-    if ds is None:
-        raise OrthoError(f"cannot open {path}")
-    last = ds.GetRasterBand(ds.RasterCount)
-    if last.GetColorInterpretation() == gdal.GCI_AlphaBand:
-        nodata = last.ReadAsArray() == 0
-    else:
-        nodata = ~np.isfinite(ds.GetRasterBand(1).ReadAsArray().astype(np.float32))
-    ds = None
+    with RasterFile(path, "mosaic") as r:
+        if r.band(r.count).GetColorInterpretation() == gdal.GCI_AlphaBand:
+            nodata = r.read(r.count) == 0
+        else:
+            nodata = ~np.isfinite(r.read(1).astype(np.float32))
     lab, n = ndimage.label(nodata)
     if not n:
         return 0
