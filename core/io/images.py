@@ -15,6 +15,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..common.errors import ArchaeoOrthoError
+from .raster import RasterError, RasterFile
 
 IMAGE_EXTENSIONS = (".jpg", ".jpeg", ".tif", ".tiff", ".png")
 
@@ -133,11 +134,10 @@ def read_image_info(path: str, name: Optional[str] = None, manual_focal_mm: Opti
     """Open the image header, check that its pixels decode (:func:`check_image`), read EXIF.  Raises ImageError."""
     gdal = _gdal()
     name = name or os.path.basename(path)
-    ds = _checked_dataset(path)
-    w, h, nb = ds.RasterXSize, ds.RasterYSize, ds.RasterCount
-    band = ds.GetRasterBand(1)
-    dtype = gdal.GetDataTypeName(band.DataType)
-    md = ds.GetMetadata() or {}
+    with _checked_file(path) as r:
+        w, h, nb = r.width, r.height, r.count
+        dtype = gdal.GetDataTypeName(r.band(1).DataType)
+        md = r.metadata()
     info = ImageInfo(name=name, path=os.path.abspath(path), width=w, height=h, bands=nb, dtype=dtype)
     info.make = md.get("EXIF_Make", "").strip().strip("\x00")
     info.model = md.get("EXIF_Model", "").strip().strip("\x00")
@@ -188,7 +188,8 @@ def _orientation_value(text: Optional[str]) -> int:
 def exif_orientation(path: str) -> int:
     """The EXIF orientation (1-8) of a photo, 1 when it has none or an invalid one; reads the header only.
     ImageError naming the file when it cannot be opened."""
-    return _orientation_value(open_image(path).GetMetadataItem("EXIF_Orientation"))
+    with open_image(path) as r:
+        return _orientation_value(r.metadata().get("EXIF_Orientation"))
 
 
 XMP_SCAN_BYTES = 262144  # the XMP packet of a drone photo sits in its first APP1 segments (DJI: within 64 KiB)
@@ -272,9 +273,9 @@ def to_upright(arr: np.ndarray, orientation: int) -> np.ndarray:
     return np.ascontiguousarray(out)
 
 
-def _checked_dataset(path: str):
-    """The opened GDAL dataset of a photo whose pixels decode to the last row; ImageError naming the file and
-    the problem otherwise (see :func:`check_image`)."""
+def _checked_file(path: str) -> RasterFile:
+    """The opened photo (:class:`core.io.raster.RasterFile`) whose pixels decode to the last row; ImageError naming
+    the file and the problem otherwise (see :func:`check_image`)."""
     gdal = _gdal()
     if not os.path.exists(path):
         raise ImageError(f"{path}: the photo does not exist")
@@ -282,41 +283,49 @@ def _checked_dataset(path: str):
         raise ImageError(f"{path}: a folder, not an image file")
     if os.path.getsize(path) == 0:
         raise ImageError(f"{path}: empty file (0 bytes)")
-    ds = open_image(path)
-    w, h = ds.RasterXSize, ds.RasterYSize
+    r = open_image(path)
+    w, h = r.width, r.height
     # decode a strip at the bottom: a JPEG decodes sequentially, so this decodes the whole scan and a truncated
     # JPEG fails there (libjpeg only warns unless told); a truncated TIFF fails on its last strip or tile
     old = gdal.GetConfigOption("GDAL_ERROR_ON_LIBJPEG_WARNING")
     gdal.SetConfigOption("GDAL_ERROR_ON_LIBJPEG_WARNING", "TRUE")
     try:
-        for b in range(1, ds.RasterCount + 1):
-            arr = ds.GetRasterBand(b).ReadAsArray(0, max(0, h - 8), w, min(8, h))
-            if arr is None:
-                raise RuntimeError(f"no pixels in band {b}")
-    except RuntimeError as e:
-        raise ImageError(f"{path}: image data is corrupt or truncated ({str(e).strip()})") from e
+        for b in range(1, r.count + 1):
+            r.read(b, (0, max(0, h - 8), w, min(8, h)))
+    except RasterError as e:
+        r.close()
+        raise ImageError(f"{path}: image data is corrupt or truncated ({_gdal_reason(e)})") from e
     finally:
         gdal.SetConfigOption("GDAL_ERROR_ON_LIBJPEG_WARNING", old)
-    return ds
+    return r
 
 
-def open_image(path: str):
-    """The GDAL dataset of an image file; ImageError naming the file when GDAL cannot read it."""
-    gdal = _gdal()
+def _gdal_reason(e: RasterError) -> str:
+    """GDAL's own words in a RasterError (its cause), else the error's message."""
+    return str(e.__cause__ or e).strip()
+
+
+def open_image(path: str) -> RasterFile:
+    """The image file opened (:class:`core.io.raster.RasterFile`, a context manager); ImageError naming the file
+    when GDAL cannot read it."""
     try:
-        ds = gdal.Open(path)
-    except RuntimeError as e:
-        raise ImageError(f"{path}: not a readable image ({str(e).strip()})") from e
-    if ds is None or ds.RasterCount == 0:
-        raise ImageError(f"{path}: not a readable image")
-    return ds
+        return RasterFile(path, "image")
+    except RasterError as e:
+        reason = _gdal_reason(e) if e.__cause__ is not None else ""
+        raise ImageError(f"{path}: not a readable image" + (f" ({reason})" if reason else "")) from e
+
+
+def image_size(path: str) -> Tuple[int, int]:
+    """(width, height) of an image file from its header; ImageError naming the file when GDAL cannot read it."""
+    with open_image(path) as r:
+        return r.width, r.height
 
 
 def check_image(path: str) -> None:
     """The one check of a photo before its pixels are used (alignment, DSM, orthophoto, Orthorectify image):
     the file exists, is not empty, GDAL opens it and its pixels decode to the last row (a truncated or corrupt
     JPEG or TIFF fails).  Raises ImageError naming the file and the problem."""
-    _checked_dataset(path)
+    _checked_file(path).close()
 
 
 PHOTO_BLOCK = 65536  # bytes hashed at the start, the middle and the end of a photo
@@ -416,20 +425,14 @@ def group_cameras(images: Sequence[ImageInfo], mode: str = GROUP_AUTO) -> List[C
 
 def read_image(path: str, max_size: Optional[int] = None) -> np.ndarray:
     """Pixels as (rows, cols, bands) array in the file's data type, optionally downscaled."""
-    gdal = _gdal()
-    ds = gdal.Open(path)
-    w, h = ds.RasterXSize, ds.RasterYSize
-    if max_size and max(w, h) > max_size:
-        s = max_size / max(w, h)
-        bw, bh = max(1, round(w * s)), max(1, round(h * s))
-        arr = ds.ReadAsArray(buf_xsize=bw, buf_ysize=bh, resample_alg=gdal.GRIORA_Average)
-    else:
-        arr = ds.ReadAsArray()
-    if arr.ndim == 2:
-        arr = arr[:, :, None]
-    else:
-        arr = np.moveaxis(arr, 0, -1)
-    return arr
+    with open_image(path) as r:
+        w, h = r.width, r.height
+        if max_size and max(w, h) > max_size:
+            s = max_size / max(w, h)
+            arr = r.read_bands(out_shape=(max(1, round(h * s)), max(1, round(w * s))), resampling="average")
+        else:
+            arr = r.read_bands()
+    return np.moveaxis(arr, 0, -1)
 
 
 def full_scale(arr: np.ndarray) -> float:

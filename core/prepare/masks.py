@@ -33,7 +33,7 @@ import numpy as np
 
 from ..common.errors import ArchaeoOrthoError, require
 from ..common.files import atomic_output
-from ..io.images import ImageError, list_images
+from ..io.images import image_size, list_images
 
 MASKS_DIR = "masks"
 Y_AXES = ("auto", "down", "up")
@@ -102,19 +102,8 @@ def write_keep(path: str, keep: np.ndarray) -> None:
 
 def image_sizes(images_dir: str, names: Optional[Iterable[str]] = None) -> Dict[str, Tuple[int, int]]:
     """(width, height) of the images of a folder (headers only)."""
-    from osgeo import gdal
-
-    gdal.UseExceptions()
-    out = {}
-    for n in (list(names) if names is not None else list_images(images_dir)):
-        p = os.path.join(images_dir, n)
-        try:
-            ds = gdal.Open(p)
-            out[n] = (int(ds.RasterXSize), int(ds.RasterYSize))
-            ds = None
-        except RuntimeError as e:
-            raise ImageError(f"{p}: not a readable image ({str(e).strip()})") from e
-    return out
+    return {n: image_size(os.path.join(images_dir, n))
+            for n in (list(names) if names is not None else list_images(images_dir))}
 
 
 # ---------------------------------------------------------------------------

@@ -60,6 +60,7 @@ import numpy as np
 from ..common.errors import ArchaeoOrthoError, require
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..io.images import ImageError, open_image, read_image, to_grey
+from ..io.raster import RasterFile
 from .options import ScanOptions
 
 SCANS_JSON = "scans.json"
@@ -233,21 +234,18 @@ def _gdal():
     return gdal
 
 
-def _read_window(ds, x0: int, y0: int, w: int, h: int) -> np.ndarray:
-    arr = ds.ReadAsArray(int(x0), int(y0), int(w), int(h))
-    if arr.ndim == 2:
-        return arr[:, :, None]
-    return np.moveaxis(arr, 0, -1)
+def _read_window(scan: RasterFile, x0: int, y0: int, w: int, h: int) -> np.ndarray:
+    return np.moveaxis(scan.read_bands(window=(int(x0), int(y0), int(w), int(h))), 0, -1)
 
 
-def _grey_window(ds, x0: int, y0: int, w: int, h: int) -> np.ndarray:
-    arr = _read_window(ds, x0, y0, w, h)
+def _grey_window(scan: RasterFile, x0: int, y0: int, w: int, h: int) -> np.ndarray:
+    arr = _read_window(scan, x0, y0, w, h)
     return to_grey(arr, 255.0 if arr.dtype == np.uint8 else 65535.0 if arr.dtype == np.uint16 else 1.0)
 
 
-def scan_resolution_mm(ds) -> Optional[float]:
+def scan_resolution_mm(scan: RasterFile) -> Optional[float]:
     """Scan pixel size in mm from the file's resolution tags (TIFF or EXIF), when plausible (>= 300 dpi)."""
-    md = ds.GetMetadata() or {}
+    md = scan.metadata()
     for key, unit_key in (("TIFFTAG_XRESOLUTION", "TIFFTAG_RESOLUTIONUNIT"), ("EXIF_XResolution", "EXIF_ResolutionUnit")):
         if key in md:
             nums = re.findall(r"[-+]?\d*\.?\d+", md.get(key, ""))
@@ -443,8 +441,15 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
         raise ScanError(f"unknown fiducial layout {options.layout!r}; choose one of {', '.join(LAYOUTS)}")
     if options.fiducial_type not in FIDUCIAL_TYPES:
         raise ScanError(f"unknown fiducial type {options.fiducial_type!r}; choose one of {', '.join(FIDUCIAL_TYPES)}")
-    ds = open_image(path)
-    full_w, full_h = ds.RasterXSize, ds.RasterYSize
+    with open_image(path) as scan:
+        return _detect_in(scan, options, template, hints, frame)
+
+
+def _detect_in(scan: RasterFile, options: ScanOptions, template: Optional[np.ndarray], hints: Optional[Dict[str, str]],
+               frame: Optional[Dict[str, Tuple[float, float]]]) -> Tuple[List[Fiducial], List[str]]:
+    """:func:`detect_fiducials` in the opened scan."""
+    path = scan.path
+    full_w, full_h = scan.width, scan.height
     try:
         small = read_image(path, max_size=options.detect_size)
     except RuntimeError as e:
@@ -470,11 +475,10 @@ def detect_fiducials(path: str, options: Optional[ScanOptions] = None,
     if not coarse:
         return [], warnings
     angle = _rotation_deg({k: (v[1], v[2]) for k, v in coarse.items()})
-    symmetric_template = template is not None and is_point_symmetric(template)
-    mark_frac = _mark_fraction(template) if template is not None else 1.0
+    user = _UserTemplate.of(template)
     out: List[Fiducial] = []
     for slot, hit in coarse.items():
-        f = _refine_mark(ds, path, slot, hit, template, angle, (kx, ky), symmetric_template, mark_frac)
+        f = _refine_mark(scan, slot, hit, user, angle, (kx, ky))
         if f is not None:
             out.append(f)
     warnings.extend(f.note for f in out if f.note)
@@ -654,15 +658,32 @@ def _choose_symmetric(cands: Dict[str, List[tuple]]) -> Dict[str, tuple]:
     return out
 
 
-def _refine_mark(ds, path: str, slot: str, hit: tuple, template: Optional[np.ndarray], angle: float,
-                 k: Tuple[float, float], symmetric_template: bool, mark_frac: float) -> Optional[Fiducial]:
+@dataclass
+class _UserTemplate:
+    """The user's template image of one mark (None: the marks are rendered), whether it is point-symmetric (its
+    centre of symmetry refines the position) and the share of it the mark fills (the rest is margin)."""
+
+    image: Optional[np.ndarray]
+    symmetric: bool = False
+    mark_frac: float = 1.0
+
+    @classmethod
+    def of(cls, template: Optional[np.ndarray]) -> _UserTemplate:
+        if template is None:
+            return cls(None)
+        return cls(template, is_point_symmetric(template), _mark_fraction(template))
+
+
+def _refine_mark(scan: RasterFile, slot: str, hit: tuple, user: _UserTemplate, angle: float,
+                 k: Tuple[float, float]) -> Optional[Fiducial]:
     """A coarse hit refined in the full-resolution scan: correlation peak, then the centre of symmetry."""
     cv2 = require("cv2", "scanned film")
 
     sc, cx, cy, pol, kind, s = hit[:6]
     kx, ky = k
     note = None
-    full_w, full_h = ds.RasterXSize, ds.RasterYSize
+    path, template = scan.path, user.image
+    full_w, full_h = scan.width, scan.height
     fx, fy = (cx + 0.5) * kx - 0.5, (cy + 0.5) * ky - 0.5  # full-res pixel-centre coordinates
     size_full = s * 0.5 * (kx + ky)
     red = max(1.0, size_full / 96.0)  # correlate at most ~96 px marks; refine at full resolution
@@ -682,7 +703,7 @@ def _refine_mark(ds, path: str, slot: str, hit: tuple, template: Optional[np.nda
     x1, y1 = min(full_w, int(fx) + half + 1), min(full_h, int(fy) + half + 1)
     if x1 - x0 < 8 or y1 - y0 < 8:
         return None
-    gw = _grey_window(ds, x0, y0, x1 - x0, y1 - y0)
+    gw = _grey_window(scan, x0, y0, x1 - x0, y1 - y0)
     gs = gw if red == 1.0 else cv2.resize(gw, (max(8, int(round(gw.shape[1] / red))),
                                                 max(8, int(round(gw.shape[0] / red)))),
                                           interpolation=cv2.INTER_AREA)
@@ -701,22 +722,22 @@ def _refine_mark(ds, path: str, slot: str, hit: tuple, template: Optional[np.nda
     px = ((j + ox + (t.shape[1] - 1) / 2.0) + 0.5) * sx_ - 0.5  # window pixel-centre coordinates
     py = ((i + oy + (t.shape[0] - 1) / 2.0) + 0.5) * sy_ - 0.5
     if template is not None:
-        size_full *= mark_frac  # the mark itself, without the template's margin
-    if template is None or symmetric_template:
+        size_full *= user.mark_frac  # the mark itself, without the template's margin
+    if template is None or user.symmetric:
         qx, qy, ok = refine_symmetric(gw, px, py, size_full)
         if ok and math.hypot(qx - px, qy - py) <= max(2.0 * red, 0.25 * size_full):
             px, py = qx, qy
         else:
             note = f"{os.path.basename(path)}: fiducial {slot}: centre of symmetry not found, correlation peak used"
     cx_full, cy_full = x0 + px + 0.5, y0 + py + 0.5
-    extent = _mark_extent(ds, cx_full, cy_full, size_full)
+    extent = _mark_extent(scan, cx_full, cy_full, size_full)
     if kind in ("cross", "ring_dot", "cross_ring"):  # the template is the whole mark (a cross at least 0.7 of a ring)
         extent = min(extent, 1.5 * size_full)  # a ring touching the picture does not make the picture the mark
     return Fiducial(slot=slot, x=cx_full, y=cy_full, score=min(sc, fine_score) if fine_score > 0 else sc,
                     kind=kind, size_px=max(size_full, extent), polarity=int(pol), note=note)
 
 
-def _mark_extent(ds, x: float, y: float, size: float) -> float:
+def _mark_extent(scan: RasterFile, x: float, y: float, size: float) -> float:
     """Diameter (scan pixels) of the mark at (x, y): out to where its contrast with the ground ends.
 
     Guards the masks against a mark classified by its inner part only (the
@@ -726,8 +747,8 @@ def _mark_extent(ds, x: float, y: float, size: float) -> float:
     r = int(min(max(3.0 * size, 12.0), 400.0))
     xi, yi = int(x), int(y)
     x0, y0 = max(0, xi - r), max(0, yi - r)
-    x1, y1 = min(ds.RasterXSize, xi + r + 1), min(ds.RasterYSize, yi + r + 1)
-    g = _grey_window(ds, x0, y0, x1 - x0, y1 - y0)
+    x1, y1 = min(scan.width, xi + r + 1), min(scan.height, yi + r + 1)
+    g = _grey_window(scan, x0, y0, x1 - x0, y1 - y0)
     yy, xx = np.mgrid[y0:y1, x0:x1]
     d = np.hypot(xx + 0.5 - x, yy + 0.5 - y)
     core = d <= 0.5 * size
@@ -1048,9 +1069,9 @@ def restitute(path: str, out_to_scan: np.ndarray, width: int, height: int, out_p
 
     gdal = _gdal()
     progress = progress or NullProgress()
-    ds = open_image(path)
-    sw, sh, nb = ds.RasterXSize, ds.RasterYSize, ds.RasterCount
-    dtype = ds.GetRasterBand(1).DataType
+    scan = open_image(path)
+    sw, sh, nb = scan.width, scan.height, scan.count
+    dtype = scan.band(1).DataType
     shrink = math.sqrt(abs(np.linalg.det(out_to_scan[:, :2])))  # scan pixels per output pixel
     sigma = 0.5 * math.sqrt(shrink ** 2 - 1.0) if shrink > 1.05 else 0.0
     opts = ["TILED=YES", "COMPRESS=DEFLATE", "PREDICTOR=2", "BIGTIFF=IF_SAFER"]
@@ -1080,7 +1101,7 @@ def restitute(path: str, out_to_scan: np.ndarray, width: int, height: int, out_p
             if x1 <= x0 or y1 <= y0:
                 block = np.zeros((r1 - r0, width, nb), dtype=_np_dtype(dtype))
             else:
-                win = _read_window(ds, x0, y0, x1 - x0, y1 - y0)
+                win = _read_window(scan, x0, y0, x1 - x0, y1 - y0)
                 m = mcv.copy()
                 m[:, 2] = mcv[:, :2] @ np.array([0.0, r0]) + mcv[:, 2] - np.array([x0, y0])
                 chans = []
@@ -1099,7 +1120,7 @@ def restitute(path: str, out_to_scan: np.ndarray, width: int, height: int, out_p
         out.FlushCache()
     finally:
         out = None
-        ds = None
+        scan.close()
 
 
 def _np_dtype(gdal_type):
@@ -1156,12 +1177,25 @@ def _image_area_edges(grey: np.ndarray, valid: np.ndarray) -> Optional[Tuple[flo
             float(right) if right is not None else float(w), float(bottom) if bottom is not None else float(h))
 
 
-def write_mask(path: str, width: int, height: int, scan_to_out: np.ndarray, scan_w: int, scan_h: int,
-               image_area: Optional[Tuple[float, float, float, float]], fiducials: Sequence[Tuple[float, float, float]],
-               margin: float) -> None:
-    """Mask PNG, white = use, black = ignore: outside the scan, outside the picture area, over the marks."""
+@dataclass
+class MaskLayout:
+    """What the masks of a scan set share, in output pixels: the output size, the picture area (x0, y0, x1, y1;
+    None: the whole frame), the fiducial marks (x, y, radius) and the margin kept from each."""
+
+    width: int
+    height: int
+    image_area: Optional[Tuple[float, float, float, float]]
+    marks: Sequence[Tuple[float, float, float]]
+    margin: float
+
+
+def write_mask(path: str, layout: MaskLayout, scan_to_out: np.ndarray, scan_size: Tuple[int, int]) -> None:
+    """Mask PNG, white = use, black = ignore: outside the scan (``scan_size`` (width, height) pixels, put on the
+    output grid by ``scan_to_out``), outside the picture area, over the marks."""
     cv2 = require("cv2", "scanned film")
 
+    width, height, image_area, margin = layout.width, layout.height, layout.image_area, layout.margin
+    scan_w, scan_h = scan_size
     m = np.zeros((height, width), np.uint8)
     inset = margin + 2.0
     # the scan's rectangle, pulled in by ``inset`` output pixels, in output pixels
@@ -1179,7 +1213,7 @@ def write_mask(path: str, width: int, height: int, scan_to_out: np.ndarray, scan
         if ix1 > ix0 and iy1 > iy0:
             keep[iy0:iy1, ix0:ix1] = 255
         m &= keep
-    for x, y, r in fiducials:
+    for x, y, r in layout.marks:
         cv2.circle(m, (int(round(x * 16 - 8)), int(round(y * 16 - 8))), int(round((r + margin) * 16)), 0, -1,
                    lineType=cv2.LINE_8, shift=4)
     if not cv2.imwrite(path, m):
@@ -1278,11 +1312,11 @@ def prepare_scans(paths: Sequence[str], out_dir: str, masks_dir: str, options: O
                                      [sizes[s.name] for s in scans], width, height, warnings)
     marks_out = [((v[0] / p) + width / 2.0, height / 2.0 - v[1] / p, 0.75 * mark_size / p + 2.0)
                  for v in frame.values()]
+    layout = MaskLayout(width, height, image_area, marks_out, options.mask_margin_px)
     for i, s in enumerate(scans):
         check_cancel(progress)
         scan_to_out = np.linalg.inv(np.vstack([out_to_scans[s.name], [0, 0, 1]]))[:2]
-        write_mask(os.path.join(masks_dir, s.mask_name), width, height, scan_to_out, s.scan_width,
-                   s.scan_height, image_area, marks_out, options.mask_margin_px)
+        write_mask(os.path.join(masks_dir, s.mask_name), layout, scan_to_out, (s.scan_width, s.scan_height))
         progress.report(0.9 + 0.1 * (i + 1) / len(scans), f"masks: {i + 1}/{len(scans)}")
     return ScanSet(scans=scans, frame={k: (float(v[0]), float(v[1])) for k, v in frame.items()}, units=units,
                    calibrated=calibrated, width=width, height=height, pixel_size=p, image_area=image_area,
@@ -1313,10 +1347,9 @@ def _detect_set(paths: Sequence[str], names: Sequence[str], options: ScanOptions
                             f"{options.min_score:g}{misfit}); at least 3 are needed. Check the fiducial type and "
                             "layout, or give a template image of one mark")
         dets[n] = fids
-        ds = open_image(p)
-        sizes[n] = (ds.RasterXSize, ds.RasterYSize)
-        res_mm[n] = scan_resolution_mm(ds)
-        ds = None
+        with open_image(p) as scan:
+            sizes[n] = (scan.width, scan.height)
+            res_mm[n] = scan_resolution_mm(scan)
         sp.report((i + 1) / len(paths), f"fiducials: {i + 1}/{len(paths)} scans ({n}: {len(fids)} marks)")
     return dets, sizes, res_mm
 

@@ -41,7 +41,7 @@ import numpy as np
 
 from ..common.errors import ArchaeoOrthoError, require
 from ..common.progress import NullProgress, Progress, check_cancel
-from ..io.images import ImageError, full_scale, list_images, read_image, read_image_info, to_grey
+from ..io.images import ImageError, full_scale, image_size, list_images, read_image, read_image_info, to_grey
 from .options import ANALYSIS_SIZE, ScreeningOptions
 
 __all__ = ["EXCLUDE", "KEEP", "ImageQuality", "ScreeningError", "blur_score", "exposure_figures", "measure_image",
@@ -181,15 +181,7 @@ def measure_image(path: str, name: Optional[str] = None, mask_path: Optional[str
         info = read_image_info(path, name)  # clear ImageError for empty, corrupt or truncated files
         size = (info.width, info.height)
     else:
-        from osgeo import gdal
-
-        gdal.UseExceptions()
-        try:
-            ds = gdal.Open(path)
-            size = (ds.RasterXSize, ds.RasterYSize)
-            ds = None
-        except RuntimeError as e:
-            raise ImageError(f"{path}: not a readable image ({str(e).strip()})") from e
+        size = image_size(path)
     arr = read_for_analysis(path, analysis_size)
     scale = full_scale(arr)
     mask = None

@@ -48,6 +48,7 @@ from ..io.images import (
     ORIENTATION_STEPS,
     exif_orientation,
     full_scale,
+    image_size,
     read_image,
     read_image_info,
     to_upright,
@@ -279,11 +280,7 @@ def detect_sky(path: str, options: Optional[SkyOptions] = None) -> np.ndarray:
 def _detect(path: str, options: SkyOptions) -> Tuple[np.ndarray, str]:
     """:func:`detect_sky` and why a sky-like region was not masked ("" when it was, or there was none)."""
     orientation = exif_orientation(path)
-    from osgeo import gdal
-
-    ds = gdal.Open(path)
-    width, height = ds.RasterXSize, ds.RasterYSize
-    ds = None
+    width, height = image_size(path)
     row, pitch = _geometry_horizon(path, orientation, options)
     img = read_image(path, max(2 * options.analysis_size, 64))
     if row is not None:
