@@ -105,13 +105,24 @@ class Rectification:
     maps_j: Tuple[np.ndarray, np.ndarray]
 
 
-def rectify_pair(vi: View, vj: View, ki, di, kj, dj, size_i: Tuple[int, int], size_j: Tuple[int, int],
-                 max_growth: float = 3.0) -> Rectification:
+@dataclass
+class ScaledCamera:
+    """A view as read for matching: its OpenCV camera matrix and distortion at the QUALITY downscale and the
+    image's (width, height)."""
+
+    view: View
+    k: np.ndarray
+    dist: np.ndarray
+    size: Tuple[int, int]
+
+
+def rectify_pair(ci: ScaledCamera, cj: ScaledCamera, max_growth: float = 3.0) -> Rectification:
     """Rectify two calibrated views (Fusiello-style, from the known poses) into row-aligned images.
 
     Both rectified cameras share the rotation ``rn`` (x axis = the baseline from i to j) and focal f,
     so a point's disparity is d = x_i - x_j = f B / Z + cx_i - cx_j > 0."""
     cv2 = require("cv2", "dense matching")
+    vi, vj, ki, di, kj, dj, size_i, size_j = ci.view, cj.view, ci.k, ci.dist, cj.k, cj.dist, ci.size, cj.size
     b = vj.centre - vi.centre
     base = float(np.linalg.norm(b))
     if base <= 0:
@@ -301,6 +312,18 @@ EDGE_MIN_PIXELS = 200  # ... on this many coarser pixels around a tile (a wall: 
 TILE_MIN_PRIOR = 16  # coarser disparities a tile's window needs; fewer -> the window grows, then the whole range
 
 
+@dataclass
+class LevelPair:
+    """A rectified pair at one pyramid level and its disparity search: the row-aligned images (uint8), the lowest
+    disparity and how many are searched, and the principal points' offset cx_i - cx_j at this level."""
+
+    left: np.ndarray
+    right: np.ndarray
+    dmin: int
+    num: int
+    shift: float = 0.0
+
+
 def pyramid_levels(num: int, shape: Tuple[int, int]) -> int:
     """How many times the rectified pair is halved so that its coarsest level searches about
     PYRAMID_MAX_DISPARITIES (at least 1: the half-resolution level also checks and completes the fine one)."""
@@ -381,9 +404,8 @@ def edge_mask(prior: np.ndarray, shift: float = 0.0) -> np.ndarray:
     return (lo5 < big / 2) & (hi5 - lo5 > jump)
 
 
-def _match_tiled(left: np.ndarray, right: np.ndarray, prior: np.ndarray, block: int, dmin: int, num: int,
-                 unit: "PairUnit", cancel_path: Optional[str], edges_two_way: bool = False,
-                 shift: float = 0.0) -> Tuple[np.ndarray, dict]:
+def _match_tiled(level: LevelPair, prior: np.ndarray, unit: "PairUnit", cancel_path: Optional[str],
+                 edges_two_way: bool = False) -> Tuple[np.ndarray, dict]:
     """Left-right checked disparity of a rectified pair matched piece by piece, each piece over the disparities the
     coarser level (``prior``) found around it: the search no longer grows with the resolution.
 
@@ -393,10 +415,11 @@ def _match_tiled(left: np.ndarray, right: np.ndarray, prior: np.ndarray, block: 
     is matched once, with OpenCV's own left-right check (disp12MaxDiff: the right image's disparities from the same
     aggregated costs), or, with ``edges_two_way`` where the coarser level shows a depth edge (EDGE_MIN_PIXELS of
     its pixels span EDGE_JUMP_PX, and EDGE_JUMP_REL of the median geometric disparity, the prior less ``shift``
-    (cx_i - cx_j at this level), over 5 x 5), both ways with a full second pass, which keeps the occluded side of a
+    (``level.shift``), over 5 x 5), both ways with a full second pass, which keeps the occluded side of a
     wall out (one pass fattens a roof by a cell or two). Returns the map and {tiles: runs matched, skipped cells,
     two-way runs, mean disparities searched}."""
     cv2 = require("cv2", "dense matching")
+    left, right, dmin, num, shift, block = level.left, level.right, level.dmin, level.num, level.shift, unit.block_size
     h, w = left.shape
     out = np.full((h, w), np.nan, np.float32)
     ctx = TILE_CONTEXT_PX
@@ -458,12 +481,13 @@ def _match_tiled(left: np.ndarray, right: np.ndarray, prior: np.ndarray, block: 
                  "disparities": searched / max(1, runs_done)}
 
 
-def _disparity(li: np.ndarray, rj: np.ndarray, block: int, dmin: int, num: int, unit: "PairUnit",
-               cancel_path: Optional[str], stats: Optional[dict] = None, shift: float = 0.0) -> np.ndarray:
+def _disparity(pair: LevelPair, unit: "PairUnit", cancel_path: Optional[str],
+               stats: Optional[dict] = None) -> np.ndarray:
     """The left image's disparity map (NaN = none), coarse to fine: the pair halved ``pyramid_levels`` times, the
     coarsest level matched over the whole range (SGBM both ways + left-right check), each finer level tile by tile
     over the range its coarser level found there, then checked and completed by it (``coarse_to_fine``)."""
     cv2 = require("cv2", "dense matching")
+    li, rj, dmin, num, shift, block = pair.left, pair.right, pair.dmin, pair.num, pair.shift, unit.block_size
     if not unit.coarse or min(li.shape) < 64:
         disp_l, disp_r = _match_lr(li, rj, block, dmin, num, unit.uniqueness, cancel_path)
         return lr_checked(disp_l, disp_r, unit.lr_tolerance)
@@ -484,8 +508,8 @@ def _disparity(li: np.ndarray, rj: np.ndarray, block: int, dmin: int, num: int, 
     info = {"levels": levels, "coarsest_disparities": n, "coarsest_map": np.isfinite(disp)}
     for k in range(levels - 1, -1, -1):
         lo, n = level_range(k)
-        fine, tinfo = _match_tiled(pyr[k][0], pyr[k][1], disp, block, lo, n, unit, cancel_path,
-                                   edges_two_way=k == 0, shift=shift / 2.0 ** k)
+        fine, tinfo = _match_tiled(LevelPair(pyr[k][0], pyr[k][1], lo, n, shift / 2.0 ** k), disp, unit, cancel_path,
+                                   edges_two_way=k == 0)
         disp = coarse_to_fine(fine, disp)
         if k == 0:
             info.update(tiles=tinfo["tiles"], tiles_skipped=tinfo["skipped"], tiles_two_way=tinfo["two_way"],
@@ -530,7 +554,7 @@ def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
     hj_, wj_ = img_j.shape[:2]
     summary = {"key": unit.key, "i": unit.vi.name, "j": unit.vj.name, "valid": 0, "megapixels": 0.0}
     try:
-        rect = rectify_pair(unit.vi, unit.vj, ki, di, kj, dj, (wi_, hi_), (wj_, hj_))
+        rect = rectify_pair(ScaledCamera(unit.vi, ki, di, (wi_, hi_)), ScaledCamera(unit.vj, kj, dj, (wj_, hj_)))
         dmin, num = disparity_range(unit, rect)
     except DenseError as e:
         summary.update(skipped=str(e), seconds=time.time() - t0)
@@ -548,7 +572,7 @@ def match_pair(unit: PairUnit, cancel_path: Optional[str] = None) -> dict:
     if unit.equalize:
         li, rj = equalized(li), equalized(rj)
     pyramid: dict = {}
-    disp = _disparity(li, rj, unit.block_size, dmin, num, unit, cancel_path, pyramid, rect.cx_i - rect.cx_j)
+    disp = _disparity(LevelPair(li, rj, dmin, num, rect.cx_i - rect.cx_j), unit, cancel_path, pyramid)
     check_unit_cancel(cancel_path)
     pyramid.update(_matched_shares(disp, pyramid.pop("coarsest_map", None), mi, mj, dmin + 0.5 * num))
     rows, xs = np.nonzero(np.isfinite(disp) & mi)
