@@ -177,10 +177,20 @@ def sift_keypoints(pycolmap, grey: np.ndarray, settings: FeatureSettings) -> np.
 
 
 def probe(pycolmap, grey: np.ndarray, settings: FeatureSettings, name: str = "", level: str = "") -> ProbeResult:
-    """Yield and coverage of one photo (``grey``, at any size: scaled to the settings') at ``settings``."""
+    """Yield and coverage of one photo (``grey``, at any size: scaled to the settings') at ``settings``.  An
+    upsampled setting (first octave -1) is tried at octave 0 first: the upsampled octave only adds features to
+    those (COLMAP keeps the coarsest within the budget), so a photo not starved without it is not starved with
+    it, at a fifth of the cost (an 800 x 600 frame: 0.3 s instead of 1.4 s)."""
     img = shrink(grey, settings.image_size)
-    xy = sift_keypoints(pycolmap, img, settings)
-    return ProbeResult(name, level, len(xy), int(settings.max_features), coverage(xy, img.shape[1], img.shape[0]))
+    tries = [settings]
+    if settings.first_octave < 0:
+        tries.insert(0, FeatureSettings(settings.image_size, settings.max_features, 0, settings.peak_threshold))
+    for s in tries:
+        xy = sift_keypoints(pycolmap, img, s)
+        result = ProbeResult(name, level, len(xy), int(s.max_features), coverage(xy, img.shape[1], img.shape[0]))
+        if not result.starved:
+            break
+    return result
 
 
 def decide(results: Sequence[ProbeResult], total: int) -> Optional[bool]:
