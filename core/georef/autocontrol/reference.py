@@ -13,8 +13,16 @@ import numpy as np
 
 from ...common.errors import require
 from ...geometry.crs import CRSError, crs_identifier, is_mercator, linear_unit, transform_points, utm_epsg_for_lonlat
-from ...io.raster import DsmError, DsmReader, crs_to_wkt
+from ...io.raster import DsmError, DsmReader, RasterError, RasterFile, crs_to_wkt
 from .errors import AutoControlError
+
+
+def _open(path: str, what: str) -> RasterFile:
+    """The reference raster opened read-only; AutoControlError naming it when GDAL cannot read it."""
+    try:
+        return RasterFile(path, what)
+    except RasterError as e:
+        raise AutoControlError(str(e)) from e
 
 
 def _working_crs(path: str, ds, gt, wkt: str) -> Tuple[str, str]:
@@ -39,12 +47,11 @@ def result_crs(ortho_path: str) -> str:
     """The CRS the automatic control's result is in for this reference orthophoto ('EPSG:n' or a WKT): its own,
     or the UTM zone of its centre for a geographic or Mercator one; the faces give check points and camera
     positions in it."""
-    gdal = require("osgeo.gdal", "reading the reference orthophoto")
-    ds = gdal.Open(ortho_path)
-    wkt = ds.GetProjection() if ds is not None else ""
-    if not wkt:
-        raise AutoControlError(f"reference orthophoto {ortho_path} has no CRS")
-    return crs_identifier(_working_crs(ortho_path, ds, ds.GetGeoTransform(), wkt)[0])
+    with _open(ortho_path, "reference orthophoto") as raster:
+        wkt = raster.crs_wkt
+        if not wkt:
+            raise AutoControlError(f"reference orthophoto {ortho_path} has no CRS")
+        return crs_identifier(_working_crs(ortho_path, raster.dataset, raster.dataset.GetGeoTransform(), wkt)[0])
 
 
 def _vrt_sources(ds, path: str) -> List[str]:
@@ -86,7 +93,7 @@ def _is_picture(gdal, ds) -> bool:
         ds.RasterCount >= 3 and bands[0].DataType == gdal.GDT_Byte)
 
 
-def _check_kinds(gdal, ortho_path: str, ortho, dsm_path: str) -> None:
+def _check_kinds(gdal, ortho_path: str, ortho, dsm_path: str, dsm) -> None:
     """AutoControlError saying which reference is wrong and why, before any work (issue 36 item 12: these all
     ended in '0 candidate(s) kept, 4 needed'): an orthophoto that is a few pixels or has no data, a DSM that is
     a picture or has no data, the two swapped."""
@@ -94,7 +101,6 @@ def _check_kinds(gdal, ortho_path: str, ortho, dsm_path: str) -> None:
     if min(w, h) < MIN_REFERENCE_PIXELS:
         raise AutoControlError(f"reference orthophoto {ortho_path} is {w} x {h} pixels: too small to match photos "
                                f"against (at least {MIN_REFERENCE_PIXELS} x {MIN_REFERENCE_PIXELS})")
-    dsm = gdal.Open(dsm_path)
     if _is_heights(gdal, ortho) and _is_picture(gdal, dsm):
         raise AutoControlError(f"the references look swapped: the orthophoto {ortho_path} holds heights and the "
                                f"DSM {dsm_path} is a picture; give the orthophoto as the orthophoto and the DSM "
@@ -134,14 +140,12 @@ class Reference:
         for what, p in (("reference orthophoto", ortho_path), ("reference DSM", dsm_path)):
             if not p or not os.path.isfile(p):
                 raise AutoControlError(f"{what} {p!r} does not exist")
-        try:
-            ds = gdal.Open(ortho_path)
-        except RuntimeError as e:
-            raise AutoControlError(f"reference orthophoto {ortho_path} is not a raster GDAL can read: {e}") from e
-        if ds is None or ds.RasterCount < 1:
-            raise AutoControlError(f"reference orthophoto {ortho_path} is not a raster GDAL can read")
+        self._ortho = _open(ortho_path, "reference orthophoto")
+        ds = self._ortho.dataset
         _check_sources(ortho_path, ds, "reference orthophoto")
-        _check_kinds(gdal, ortho_path, ds, dsm_path)
+        with _open(dsm_path, "reference DSM") as dsm:
+            _check_kinds(gdal, ortho_path, ds, dsm_path, dsm.dataset)
+            _check_sources(dsm_path, dsm.dataset, "reference DSM")
         gt = ds.GetGeoTransform(can_return_null=True)
         if gt is None:
             raise AutoControlError(f"reference orthophoto {ortho_path} has no georeferencing (geotransform)")
@@ -167,10 +171,6 @@ class Reference:
         self.n_bands = ds.RasterCount
         self._gdal = gdal
         self._ds = ds
-        try:
-            _check_sources(dsm_path, gdal.Open(dsm_path), "reference DSM")
-        except RuntimeError as e:
-            raise AutoControlError(f"reference DSM {dsm_path} is not a raster GDAL can read: {e}") from e
         try:
             self.dsm = DsmReader(dsm_path, self.crs_wkt)
         except DsmError as e:
@@ -269,6 +269,7 @@ class Reference:
     def close(self) -> None:
         self.dsm.close()
         self._ds = None
+        self._ortho.close()
 
 
 def _unit_name(wkt: str) -> str:
