@@ -13,7 +13,7 @@ import pycolmap
 import pytest
 
 from core.geometry.similarity import rodrigues
-from core.georef.bundle import BundleProblem, Observations, field_radius
+from core.georef.bundle import BundleProblem, CameraPriors, Frames, Intrinsics, Observations, Points, field_radius
 
 W, H = 1200, 900
 TRUE = [700.0, 700.0, 600.0, 450.0, -0.06, 0.02, 0.0, 0.0]
@@ -78,9 +78,9 @@ def problem(start_params, relief=8.0, focal_prior=0.0, fold=False, seed=0):
     nf = len(R)
     cam = camera(start_params)
     free = [0, 1, 4, 5, 6, 7]
-    prob = BundleProblem(r0, c0, np.arange(nf), np.zeros(nf, dtype=int), np.tile(np.eye(3), (nf, 1, 1)),
-                         np.zeros((nf, 3)), [cam], [free], x0, obs, prior, sigma, [], np.zeros((0, 3)),
-                         np.zeros((0, 3)), focal_prior=focal_prior)
+    frames = Frames(r0, c0, np.arange(nf), np.zeros(nf, dtype=int), np.tile(np.eye(3), (nf, 1, 1)), np.zeros((nf, 3)))
+    prob = BundleProblem(frames, Intrinsics([cam], [free], focal_prior), Points(x0, prior, sigma), obs,
+                         CameraPriors([], np.zeros((0, 3)), np.zeros((0, 3))))
     return prob, C
 
 

@@ -70,7 +70,7 @@ from ..common.errors import require
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..geometry.similarity import HelmertResult, helmert_ransac
 from ..io.gcp import CHECK, CONTROL, CameraPosition, GCPSet, GroundPoint
-from .bundle import BundleProblem, build_problem, outside_image, set_point_active, write_back
+from .bundle import BundleProblem, Control, build_problem, outside_image, set_point_active, write_back
 from .control_sigma import (
     CAMERA_GROUP,
     CONTROL_GROUP,
@@ -190,7 +190,6 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
         kwargs["refine_intrinsics"] = refine_intrinsics
     opt = GeorefOptions.of(options, **kwargs)
     run = _start(reconstruction, gcps, opt, progress or NullProgress())
-    groups = opt.intrinsic_groups()
     _triangulate_control(run)
     _match_camera_positions(run, camera_positions)
     _placeholder_heights(run)
@@ -222,7 +221,7 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
         stats["timings"] = run.timings
         result.statistics = stats
         return result
-    adj = _adjust(run, fit, groups, stats)
+    adj = _adjust(run, fit, stats)
     _update_and_evaluate(run, adj, result, camera_positions, stats)
     return result
 
@@ -520,17 +519,14 @@ class _Adjustment:
     retests: Dict[str, Dict[str, Any]] = field(default_factory=dict)
 
 
-def _adjust(run: _Run, fit: _Fit, groups, stats: Dict[str, Any]) -> _Adjustment:
+def _adjust(run: _Run, fit: _Fit, stats: Dict[str, Any]) -> _Adjustment:
     """4. the constrained bundle adjustment, its outlier rounds and the re-tests of the provisional outliers."""
     check_cancel(run.progress)
     t0 = time.time()
-    opt = run.opt
     # the provisional outliers are part of the problem from the start, switched off until re-admitted
     ba_points = [p for p in run.usable if p.name not in run.rejected_ctrl or p.name in run.provisional]
-    built = build_problem(run.rec, run.lookup, ba_points, run.tri, run.cam_pos, fit.offset, fit.helmert.transform,
-                          groups, opt.gcp_pixel_sigma, opt.tie_pixel_sigma, opt.huber_px, opt.max_observations,
-                          opt.min_intrinsics_images, run.warn, run.progress, focal_prior=opt.focal_prior,
-                          intrinsics=opt.camera_intrinsics)
+    control = Control(ba_points, run.tri, run.cam_pos, fit.offset, fit.helmert.transform)
+    built = build_problem(run.rec, run.lookup, control, run.opt, run.warn, run.progress)
     adj = _Adjustment(*built, ba_points=ba_points)
     for nm in run.provisional:
         set_point_active(adj.prob, adj.gcp_index[nm], adj.gcp_obs_rows[nm], False)

@@ -22,7 +22,13 @@ from ..common.progress import NullProgress, check_cancel
 from ..geometry.similarity import rodrigues, skew
 from ..io.gcp import Observation
 from .errors import GeorefError
-from .options import REFINED_FOCAL_SIGMA, REFINED_PP_SIGMA, REFINED_RADIAL_SIGMA, REFINED_TANGENTIAL_SIGMA
+from .options import (
+    REFINED_FOCAL_SIGMA,
+    REFINED_PP_SIGMA,
+    REFINED_RADIAL_SIGMA,
+    REFINED_TANGENTIAL_SIGMA,
+    GeorefOptions,
+)
 
 # ----------------------------------------------------------------------------
 # projection and its derivatives
@@ -154,6 +160,50 @@ class Observations:
     active: np.ndarray  # (O,) bool
 
 
+@dataclass
+class Frames:
+    """The exterior orientation the adjustment starts from: the rig frames (rig_from_world rotation, centre in
+    world) and each image's frame, camera and fixed sensor_from_rig (identity for ordinary single cameras)."""
+
+    rotation: Any  # (F,3,3)
+    centre: Any  # (F,3)
+    img_frame: Any  # (I,) index into the frames
+    img_cam: Any  # (I,) index into the cameras
+    sensor_rotation: Any  # (I,3,3)
+    sensor_translation: Any  # (I,3)
+
+
+@dataclass
+class Intrinsics:
+    """The cameras (pycolmap.Camera copies, updated in place), the indices of each one's free parameters, and
+    their priors: ``focal_prior`` (sigma = focal_prior x the starting focal length, 0: none) and
+    ``given_priors``: camera index -> (parameter index, given value, sigma) of a camera refined from a given
+    calibration (instead of the focal prior)."""
+
+    cameras: List[Any]
+    free: List[Sequence[int]]
+    focal_prior: float = 0.0
+    given_priors: Optional[Dict[int, List[Tuple[int, float, float]]]] = None
+
+
+@dataclass
+class Points:
+    """The points of the adjustment (P,3) and their position priors (P,3, NaN where none) with sigmas (P,3)."""
+
+    xyz: Any
+    prior: Any
+    prior_sigma: Any
+
+
+@dataclass
+class CameraPriors:
+    """Priors on projection centres: the image rows (K,), the positions (K,3) and their sigmas (K,3)."""
+
+    img: Any
+    xyz: Any
+    sigma: Any
+
+
 class BundleProblem:
     """Sparse Levenberg-Marquardt bundle adjustment with priors.
 
@@ -170,28 +220,27 @@ class BundleProblem:
 
     DENSE_MAX = 6000
 
-    def __init__(self, frames_r, frames_c, img_frame, img_cam, img_rs, img_ts, cameras, cam_free,
-                 points, obs: Observations, point_prior, point_prior_sigma, cam_prior_img, cam_prior_xyz,
-                 cam_prior_sigma, huber_px: float = 2.0, focal_prior: float = 0.0,
-                 intrinsic_priors: Optional[Dict[int, List[Tuple[int, float, float]]]] = None):
-        self.R = np.asarray(frames_r, dtype=float).copy()  # (F,3,3) rig_from_world rotation
-        self.C = np.asarray(frames_c, dtype=float).copy()  # (F,3) rig centre in world
-        self.img_frame = np.asarray(img_frame, dtype=int)
-        self.img_cam = np.asarray(img_cam, dtype=int)
-        self.Rs = np.asarray(img_rs, dtype=float)
-        self.ts = np.asarray(img_ts, dtype=float)
+    def __init__(self, frames: Frames, intrinsics: Intrinsics, points: Points, obs: Observations,
+                 camera_priors: CameraPriors, huber_px: float = 2.0):
+        self.R = np.asarray(frames.rotation, dtype=float).copy()  # (F,3,3) rig_from_world rotation
+        self.C = np.asarray(frames.centre, dtype=float).copy()  # (F,3) rig centre in world
+        self.img_frame = np.asarray(frames.img_frame, dtype=int)
+        self.img_cam = np.asarray(frames.img_cam, dtype=int)
+        self.Rs = np.asarray(frames.sensor_rotation, dtype=float)
+        self.ts = np.asarray(frames.sensor_translation, dtype=float)
         self.cs = -np.einsum("nji,nj->ni", self.Rs, self.ts)  # sensor centre in the rig frame
+        cameras = intrinsics.cameras
         self.cameras = cameras  # list of pycolmap.Camera copies (updated in place)
-        self.cam_free = [np.asarray(f, dtype=int) for f in cam_free]
+        self.cam_free = [np.asarray(f, dtype=int) for f in intrinsics.free]
         self.intr_offset = np.cumsum([0] + [len(f) for f in self.cam_free])
-        self.X = np.asarray(points, dtype=float).copy()
+        self.X = np.asarray(points.xyz, dtype=float).copy()
         self.obs = obs
-        self.pp = np.asarray(point_prior, dtype=float)  # (P,3), NaN where no prior
-        self.pps = np.asarray(point_prior_sigma, dtype=float)  # (P,3)
+        self.pp = np.asarray(points.prior, dtype=float)  # (P,3), NaN where no prior
+        self.pps = np.asarray(points.prior_sigma, dtype=float)  # (P,3)
         self.has_pp = np.all(np.isfinite(self.pp), axis=1)
-        self.cp_img = np.asarray(cam_prior_img, dtype=int)
-        self.cp_xyz = np.asarray(cam_prior_xyz, dtype=float).reshape(-1, 3)
-        self.cp_sigma = np.asarray(cam_prior_sigma, dtype=float).reshape(-1, 3)
+        self.cp_img = np.asarray(camera_priors.img, dtype=int)
+        self.cp_xyz = np.asarray(camera_priors.xyz, dtype=float).reshape(-1, 3)
+        self.cp_sigma = np.asarray(camera_priors.sigma, dtype=float).reshape(-1, 3)
         self.cp_active = np.ones(len(self.cp_img), dtype=bool)
         self.huber = huber_px
         self.nf = len(self.R)
@@ -205,7 +254,8 @@ class BundleProblem:
         # says otherwise instead of letting it wander along that valley.  ``intrinsic_priors``: camera index ->
         # (parameter index, given value, sigma) of a camera refined from a given calibration, in its place
         self.fp_col, self.fp_value, self.fp_sigma = [], [], []
-        own = intrinsic_priors or {}
+        own = intrinsics.given_priors or {}
+        focal_prior = intrinsics.focal_prior
         for k, rows in own.items():
             free_k = [int(i) for i in self.cam_free[k]]
             for idx, value, sigma in rows:
@@ -678,9 +728,24 @@ def _tie_points(rec, images: _Images, max_observations: int, tie_pixel_sigma: fl
     return tracks, tie_ids, xyz, rows
 
 
-def _control_points(rec, lookup, images: _Images, ba_points, tri, offset, model_to_local, xyz, rows: _ObservationRows,
+@dataclass
+class Control:
+    """What ties the adjustment to the ground, in the local frame (world = local + ``offset``): the control points
+    that enter (GroundPoints), their model-frame triangulations by name (core.georef.triangulate), the camera
+    positions matched to their images ((CameraPosition, pycolmap.Image) pairs), and ``model_to_local``, the
+    similarity that took the model into the local frame."""
+
+    points: List[Any]
+    triangulations: Dict[str, Any]
+    camera_positions: List[Tuple[Any, Any]]
+    offset: np.ndarray
+    model_to_local: Any
+
+
+def _control_points(rec, lookup, images: _Images, control: Control, xyz, rows: _ObservationRows,
                     gcp_pixel_sigma: float):
     """Append the control points (position priors and their observations) to the points and rows."""
+    ba_points, tri, offset = control.points, control.triangulations, control.offset
     n_tie = len(xyz)
     prior = np.full((n_tie + len(ba_points), 3), np.nan)
     prior_s = np.ones((n_tie + len(ba_points), 3))
@@ -689,7 +754,7 @@ def _control_points(rec, lookup, images: _Images, ba_points, tri, offset, model_
     for p in ba_points:
         k = len(xyz)
         gcp_index[p.name] = k
-        xyz.append(model_to_local.apply(tri[p.name].xyz))
+        xyz.append(control.model_to_local.apply(tri[p.name].xyz))
         prior[k] = np.array([p.x, p.y, p.z]) - offset
         prior_s[k] = [p.sigma_xy, p.sigma_xy, p.sigma_z]
         own = []
@@ -720,37 +785,38 @@ def _camera_priors(images: _Images, cam_pos, offset):
     return cp_img, np.asarray(cp_xyz).reshape(-1, 3), np.asarray(cp_sig).reshape(-1, 3)
 
 
-def build_problem(rec, lookup, ba_points, tri, cam_pos, offset, model_to_local, groups, gcp_pixel_sigma,
-                  tie_pixel_sigma, huber_px, max_observations, min_intrinsics_images, warn: Callable[[str], None],
-                  progress=None, focal_prior: float = 0.0, intrinsics: Optional[Dict[int, Dict[str, Any]]] = None):
-    """The adjustment of ``rec`` (local frame) with the control points ``ba_points`` (their model-frame
-    triangulations ``tri``) and the camera positions ``cam_pos``.  Returns the problem, the tie point ids
-    (rows of ``prob.X``), each control point's row and observation rows, and figures of the problem.
-    ``intrinsics``: camera id -> the alignment's record of its interior orientation (see _free_intrinsics)."""
+def build_problem(rec, lookup, control: Control, opt: GeorefOptions, warn: Callable[[str], None], progress=None):
+    """The adjustment of ``rec`` (local frame) with the control points and camera positions of ``control``, the
+    sigmas, robust loss, tie point budget and intrinsics to refine of ``opt`` (its ``camera_intrinsics``: camera
+    id -> the alignment's record of its interior orientation, see _free_intrinsics).  Returns the problem, the
+    tie point ids (rows of ``prob.X``), each control point's row and observation rows, and figures of the
+    problem."""
     progress = progress or NullProgress()
+    groups = opt.intrinsic_groups()
+    ba_points, cam_pos = control.points, control.camera_positions
     images = _index_images(rec)
-    cameras, cam_free, refined, priors, fixed = _free_intrinsics(rec, images, groups, min_intrinsics_images, warn,
-                                                                 intrinsics)
+    cameras, cam_free, refined, priors, fixed = _free_intrinsics(rec, images, groups, opt.min_intrinsics_images, warn,
+                                                                 opt.camera_intrinsics)
     if fixed:
         progress.info(f"camera(s) {', '.join(str(c) for c in fixed)}: calibrated interior orientation fixed, not "
                       f"refined{' (whatever refine_intrinsics says)' if groups else ''}")
     if priors:
         progress.info(f"camera(s) {', '.join(str(images.camera_ids[k]) for k in priors)}: interior orientation "
                       "refined with priors at the calibration's values (weighted by its sigmas)")
-    tracks, tie_ids, xyz, rows = _tie_points(rec, images, max_observations, tie_pixel_sigma)
+    tracks, tie_ids, xyz, rows = _tie_points(rec, images, opt.max_observations, opt.tie_pixel_sigma)
     n_tie, n_tie_obs = len(xyz), len(rows.img)
     total_obs = sum(len(v) for v in tracks.values())
-    prior, prior_s, gcp_index, gcp_obs_rows = _control_points(rec, lookup, images, ba_points, tri, offset,
-                                                              model_to_local, xyz, rows, gcp_pixel_sigma)
+    prior, prior_s, gcp_index, gcp_obs_rows = _control_points(rec, lookup, images, control, xyz, rows,
+                                                              opt.gcp_pixel_sigma)
     obs = Observations(np.asarray(rows.img, dtype=int), np.asarray(rows.pt, dtype=int),
                        np.asarray(rows.xy, dtype=float).reshape(-1, 2), np.asarray(rows.sigma, dtype=float),
                        np.asarray(rows.robust, dtype=bool), np.ones(len(rows.img), dtype=bool))
-    cp_img, cp_xyz, cp_sig = _camera_priors(images, cam_pos, offset)
-    prob = BundleProblem(np.asarray(images.frames_r).reshape(-1, 3, 3), np.asarray(images.frames_c).reshape(-1, 3),
-                         images.img_frame, images.img_cam, np.asarray(images.img_rs).reshape(-1, 3, 3),
-                         np.asarray(images.img_ts).reshape(-1, 3), cameras, cam_free, np.asarray(xyz).reshape(-1, 3),
-                         obs, prior, prior_s, cp_img, cp_xyz, cp_sig, huber_px, focal_prior=focal_prior,
-                         intrinsic_priors=priors)
+    frames = Frames(np.asarray(images.frames_r).reshape(-1, 3, 3), np.asarray(images.frames_c).reshape(-1, 3),
+                    images.img_frame, images.img_cam, np.asarray(images.img_rs).reshape(-1, 3, 3),
+                    np.asarray(images.img_ts).reshape(-1, 3))
+    prob = BundleProblem(frames, Intrinsics(cameras, cam_free, opt.focal_prior, priors),
+                         Points(np.asarray(xyz).reshape(-1, 3), prior, prior_s), obs,
+                         CameraPriors(*_camera_priors(images, cam_pos, control.offset)), opt.huber_px)
     prob.cam_pos_images = [cp.image for cp, _ in cam_pos]
     info = {"images": len(images.reg_ids), "frames": len(images.frame_ids), "cameras": len(images.camera_ids),
             "tie_points_total": len(tracks), "tie_observations_total": total_obs,
@@ -785,6 +851,7 @@ def write_back(rec, prob: BundleProblem, tie_ids, frame_ids, camera_ids) -> None
 
 
 
-__all__ = ["BundleProblem", "Observations", "build_problem", "huber_weights", "intrinsics_jacobian", "inv3",
+__all__ = ["BundleProblem", "CameraPriors", "Control", "Frames", "Intrinsics", "Observations", "Points",
+           "build_problem", "huber_weights", "intrinsics_jacobian", "inv3",
            "outside_image", "pose_point_jacobians", "project", "project_jacobian", "select_tie_points",
            "set_point_active", "write_back"]
