@@ -69,6 +69,14 @@ def write_dsm(target: DsmTarget, point_files: List[PointFile], views: Dict[int, 
     return grid, fractions
 
 
+def describe(grid: raster.Grid, fractions: Dict[str, float], resolution: float, source_name: str) -> str:
+    """The log line of a DSM written by write_dsm (``source_name``: its source raster as the user sees it)."""
+    return (f"DSM {grid.width} x {grid.height} cells at {resolution:g} m, inside the convex hull of the camera "
+            f"centres {100 * fractions['measured']:.1f} % measured, {100 * fractions['interpolated']:.1f} % "
+            f"interpolated (filled holes), {100 * fractions['removed']:.1f} % removed as blunders "
+            f"({fractions['removed_cells']} cells in all; flagged in {source_name})")
+
+
 def _fractions(dsm: np.ndarray, source: np.ndarray, hull: Optional[np.ndarray],
                removed: np.ndarray) -> Dict[str, float]:
     judged = source[hull] if hull is not None else source
@@ -88,5 +96,5 @@ def _write(target: DsmTarget, grid: raster.Grid, dsm: np.ndarray, source: np.nda
                          f"DSM source: {raster.SOURCE_MEASURED} measured, {raster.SOURCE_INTERPOLATED} interpolated, "
                          f"{gridding.SOURCE_REMOVED} removed (a blunder; interpolated where filled)",
                          dict(figures, ARCHAEOORTHO_PRODUCT="dsm-source", DSM=os.path.basename(target.path)))
-    raster.write_cog(target.path, dsm, grid.geotransform, target.crs, progress=SubProgress(progress, 0.92, 0.96),
-                     metadata=dict(metadata, **figures))
+    raster.write_cog(target.path, dsm, grid.geotransform, target.crs,
+                     raster.BandLabel(metadata=dict(metadata, **figures)), SubProgress(progress, 0.92, 0.96))

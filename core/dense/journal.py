@@ -29,6 +29,12 @@ class Journal:
     def note(self, line: str) -> None:
         self.log.append(line)
 
+    def record_timings(self, ws, stage: str) -> None:
+        """Each step's seconds (not the total) into the workspace's record of ``stage``."""
+        for k, v in self.timings.items():
+            if k != "total":
+                ws.record_timing(stage, k, v)
+
     def close(self) -> None:
         """The total time, and a log line with every step's seconds."""
         self.timings["total"] = time.time() - self.t_start

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import Optional
 
 from ..common.errors import ArchaeoOrthoError
@@ -75,6 +75,13 @@ class DenseOptions:
         self.resolution = float(self.resolution)
         self.output_dsm = os.path.abspath(self.output_dsm) if self.output_dsm else None
         self.output_point_cloud = os.path.abspath(self.output_point_cloud) if self.output_point_cloud else None
+
+    def stage_parameters(self, dsm_path: str) -> dict:
+        """What the workspace records of these options (``dsm_path``: the DSM written; where the work runs left
+        out)."""
+        return {"resolution": self.resolution, "quality": self.quality, "engine": self.engine,
+                "output_dsm": dsm_path, "output_point_cloud": self.output_point_cloud,
+                "options": {k: v for k, v in asdict(self).items() if k not in EXECUTION_OPTIONS + STAGE_SETTINGS}}
 
     @property
     def scale(self) -> float:

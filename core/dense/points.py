@@ -12,7 +12,7 @@ import os
 import shutil
 import time
 from dataclasses import dataclass
-from typing import Callable, Dict, List, Tuple
+from typing import Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
@@ -20,10 +20,11 @@ from ..common.cancel import CancelWatcher, load_pycolmap
 from ..common.files import atomic_write_text, fingerprint, save_npz
 from ..common.parallel import cpu_count, describe_executor, make_executor, run_units
 from ..common.progress import Progress, SubProgress
+from ..io import raster
 from ..project.layout import Layout
 from .block import DenseBlock
 from .fusion import FuseUnit, fuse_image
-from .grid import PointFile
+from .grid import PointFile, stream_point_files
 from .journal import Journal
 from .options import CACHE_VERSION, DenseError, DenseOptions
 from .pairs import PairInfo, View
@@ -57,6 +58,11 @@ class DensePoints:
     @property
     def count(self) -> int:
         return sum(pf.count for pf in self.files)
+
+    def write_las(self, path: str, offset: np.ndarray, crs: Optional[str], progress: Progress) -> int:
+        """The points as a LAS 1.2 point cloud with RGB in ``crs`` (local frame + ``offset``); how many."""
+        return raster.write_las(path, stream_point_files(self.files), offset, crs, progress=progress,
+                                total=self.count)
 
 
 def dense_points(block: DenseBlock, options: DenseOptions, lay: Layout, model_fp: Dict[str, str],

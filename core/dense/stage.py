@@ -23,7 +23,6 @@ axis).  Georeference with GCPs, camera positions or the images' EXIF GPS first.
 """
 from __future__ import annotations
 
-import dataclasses
 import os
 import time
 from dataclasses import dataclass, field
@@ -33,15 +32,13 @@ from ..common.cancel import load_pycolmap
 from ..common.files import clean_debris
 from ..common.parallel import CANCEL_PREFIX
 from ..common.progress import NullProgress, Progress, SubProgress
-from ..io import raster
 from ..project.layout import Layout
 from ..project.stages import DSM, GEOREFERENCE, run_stage
 from ..project.workspace import Workspace
-from . import grid as gridding
 from .block import load_block
-from .dsm import DsmTarget, write_dsm
+from .dsm import DsmTarget, describe, write_dsm
 from .journal import Journal
-from .options import EXECUTION_OPTIONS, STAGE_SETTINGS, DenseError, DenseOptions
+from .options import DenseError, DenseOptions
 from .points import dense_points
 
 
@@ -88,11 +85,7 @@ def build_dsm_workspace(workspace_dir: str, options: Optional[DenseOptions] = No
     dsm_path = options.output_dsm or lay.default_dsm
     pc_path = options.output_point_cloud
     model_fp = lay.model_fingerprints(prefix="")
-    params = {"resolution": options.resolution, "quality": options.quality, "engine": options.engine,
-              "output_dsm": dsm_path, "output_point_cloud": pc_path,
-              "options": {k: v for k, v in dataclasses.asdict(options).items()
-                          if k not in EXECUTION_OPTIONS + STAGE_SETTINGS}}
-    with run_stage(ws, DSM, params, model_fp) as run:
+    with run_stage(ws, DSM, options.stage_parameters(dsm_path), model_fp) as run:
         os.makedirs(lay.dense_dir, exist_ok=True)
         for debris in clean_debris(lay.dense_dir, CANCEL_PREFIX):
             job.info(f"removed {debris}, left by a killed run")
@@ -111,20 +104,14 @@ def build_dsm_workspace(workspace_dir: str, options: Optional[DenseOptions] = No
         # 5. point cloud
         if pc_path:
             t0 = time.time()
-            n_written = raster.write_las(pc_path, gridding.stream_point_files(points.files), block.offset,
-                                         block.crs, progress=SubProgress(progress, 0.97, 1.0), total=n_points)
+            n_written = points.write_las(pc_path, block.offset, block.crs, SubProgress(progress, 0.97, 1.0))
             job.timings["point_cloud"] = time.time() - t0
             job.note(f"point cloud: {n_written} points -> {pc_path}")
         job.close()
-        job.note(f"DSM {grid.width} x {grid.height} cells at {res:g} m, inside the convex hull of the camera "
-                 f"centres {100 * fractions['measured']:.1f} % measured, {100 * fractions['interpolated']:.1f} % "
-                 f"interpolated (filled holes), {100 * fractions['removed']:.1f} % removed as blunders "
-                 f"({fractions['removed_cells']} cells in all; flagged in {lay.rel(lay.dsm_source)})")
+        job.note(describe(grid, fractions, res, lay.rel(lay.dsm_source)))
         for line in job.log[-2:]:
             progress.info(line)
-        for k, v in job.timings.items():
-            if k != "total":
-                ws.record_timing(DSM, k, v)
+        job.record_timings(ws, DSM)
         outputs = {"dsm": lay.rel(dsm_path), "dsm_source": lay.rel(lay.dsm_source)}
         if pc_path:
             outputs["point_cloud"] = lay.rel(pc_path)
