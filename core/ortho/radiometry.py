@@ -22,7 +22,7 @@ import numpy as np
 
 from .block import PreparedBlock
 from .cameras import OrthoCamera
-from .sampling import sample_camera
+from .sampling import camera_view, sample_camera
 from .surface import Dsm
 
 FIELD_TERMS = 6  # 1, u, v, u^2, uv, v^2
@@ -186,7 +186,7 @@ def sample_grey(cam: OrthoCamera, meta, offset: np.ndarray, x: np.ndarray, y: np
     good = np.ones(len(x), dtype=bool)
     src = None
     if footprint > 0:  # the photo's ground pixel at these points: reduced to a third of the footprint
-        s = sample_camera(cam, meta, offset, x, y, z, vis, "bilinear", want_values=False)
+        s = camera_view(cam, meta, offset, x, y, z, vis)
         idx = np.flatnonzero(s.valid)
         gsd = float(np.median(cam.pose.to_camera(s.xyz[idx])[:, 2])) / max(cam.camera.focal, 1e-9) if len(idx) \
             else 0.0
@@ -196,7 +196,8 @@ def sample_grey(cam: OrthoCamera, meta, offset: np.ndarray, x: np.ndarray, y: np
             src = _reduced(cam, meta, factor)
     for dy in offs:
         for dx in offs:
-            s = sample_camera(cam, meta, offset, x + dx, y + dy, z, vis, "bilinear", want_values=src is None)
+            s = (sample_camera(cam, meta, offset, x + dx, y + dy, z, vis, "bilinear") if src is None
+                 else camera_view(cam, meta, offset, x + dx, y + dy, z, vis))
             values = s.values
             idx = np.flatnonzero(s.valid)
             if src is not None and len(idx):

@@ -22,10 +22,10 @@ class Sampled:
     px: Optional[np.ndarray] = None  # (N, 2) their pixels (meaningful where valid)
 
 
-def sample_camera(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.ndarray, y: np.ndarray,
-                  z: np.ndarray, vis: Optional[Visibility], interpolation: str = "bilinear",
-                  want_values: bool = True) -> Sampled:
-    """Values of ground points (world, 1-D arrays) in one image, with validity and the view cost."""
+def camera_view(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.ndarray, y: np.ndarray,
+                z: np.ndarray, vis: Optional[Visibility]) -> Sampled:
+    """Where ground points (world, 1-D arrays) fall in one image, with validity (in front, inside, seen, not in
+    the far field, not masked) and the view cost; no pixel is read (``values`` stay 0)."""
     n = x.size
     finite = np.isfinite(z)
     xyz = np.column_stack([x - offset[0], y - offset[1], np.where(finite, z, 0.0) - offset[2]])
@@ -54,14 +54,23 @@ def sample_camera(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.n
     half_diag = 0.5 * math.hypot(cam.camera.width, cam.camera.height)
     rho = np.hypot(px[idx, 0] - cam.camera.cx, px[idx, 1] - cam.camera.cy) / half_diag
     cost[idx] = (rho * rho + (dxy / dz) ** 2).astype(np.float32)
-    if want_values:
-        u = px[idx, 0] - 0.5
-        v = px[idx, 1] - 0.5
+    return Sampled(values, ok, cost, xyz, px)
+
+
+def sample_camera(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.ndarray, y: np.ndarray,
+                  z: np.ndarray, vis: Optional[Visibility], interpolation: str = "bilinear") -> Sampled:
+    """Values of ground points (world, 1-D arrays) in one image, with validity and the view cost
+    (:func:`camera_view`, then the pixels read with ``interpolation``)."""
+    s = camera_view(cam, meta, offset, x, y, z, vis)
+    idx = np.flatnonzero(s.valid)
+    if len(idx):
+        u = s.px[idx, 0] - 0.5
+        v = s.px[idx, 1] - 0.5
         pad = 3
         x0 = max(0, int(math.floor(u.min())) - pad)
         y0 = max(0, int(math.floor(v.min())) - pad)
         x1 = min(meta.width, int(math.ceil(u.max())) + pad + 1)
         y1 = min(meta.height, int(math.ceil(v.max())) + pad + 1)
         win = image_window(cam.path, meta, x0, y0, x1, y1)
-        values[idx] = remap_photo(win, u - x0, v - y0, interpolation)
-    return Sampled(values, ok, cost, xyz, px)
+        s.values[idx] = remap_photo(win, u - x0, v - y0, interpolation)
+    return s

@@ -15,7 +15,7 @@ from .cameras import OrthoCamera
 from .grid import cell_centre_coords
 from .pixels import PHOTO_CACHE, ImageMeta
 from .radiometry import RadiometryModel, point_gains
-from .sampling import sample_camera
+from .sampling import camera_view, sample_camera
 from .surface import Dsm
 from .visibility import Visibility, visibility_table
 
@@ -142,8 +142,7 @@ def render_tile(unit: TileUnit, cancel_path: Optional[str] = None) -> Dict[str, 
         for ci in list(unit.primary) + list(unit.secondary):
             if not len(idx):
                 break
-            s = sample_camera(unit.cameras[ci], unit.metas[ci], off, x[idx], y[idx], z[idx], unit.visibility[ci],
-                              unit.interpolation, want_values=False)
+            s = camera_view(unit.cameras[ci], unit.metas[ci], off, x[idx], y[idx], z[idx], unit.visibility[ci])
             better = s.valid & (s.cost < fill_cost[idx])
             if better.any():
                 fill_cost[idx[better]] = s.cost[better]
@@ -189,8 +188,7 @@ def _fill_hidden(unit: TileUnit, off: np.ndarray, x: np.ndarray, y: np.ndarray, 
         vis = unit.visibility[ci]
         if vis is None:
             continue
-        s = sample_camera(unit.cameras[ci], unit.metas[ci], off, x[idx], y[idx], z[idx], None, unit.interpolation,
-                          want_values=False)
+        s = camera_view(unit.cameras[ci], unit.metas[ci], off, x[idx], y[idx], z[idx], None)
         if not s.valid.any():
             continue
         sel = np.flatnonzero(s.valid)
