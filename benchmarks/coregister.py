@@ -71,7 +71,12 @@ def _errors(res, shift, dz, tilt, xs, ys):
 def child(mode: str, dsm_path: str, ref_path: str, size: int) -> None:
     import tracemalloc
 
-    from core.georef.coregister import control_points_from_coregistration, coregister_dems, coregister_rasters
+    from core.georef.coregister import (
+        HeightGrid,
+        control_points_from_coregistration,
+        coregister_dems,
+        coregister_rasters,
+    )
 
     base = _rss_mib()
     extra = {}
@@ -94,10 +99,10 @@ def child(mode: str, dsm_path: str, ref_path: str, size: int) -> None:
         ds, rds = gdal.Open(dsm_path), gdal.Open(ref_path)
         dsm = ds.GetRasterBand(1).ReadAsArray()
         ref = rds.GetRasterBand(1).ReadAsArray()
-        res = coregister_dems(dsm, ds.GetGeoTransform(), ref, rds.GetGeoTransform(), dem_nodata=-9999.0)
+        res = coregister_dems(HeightGrid(dsm, ds.GetGeoTransform(), -9999.0), HeightGrid(ref, rds.GetGeoTransform()))
         t_pc = time.perf_counter()
-        pc = control_points_from_coregistration(res, ref, rds.GetGeoTransform(), dem=dsm,
-                                                dem_transform=ds.GetGeoTransform(), n=25)
+        pc = control_points_from_coregistration(res, HeightGrid(ref, rds.GetGeoTransform()),
+                                                dem=HeightGrid(dsm, ds.GetGeoTransform()), n=25)
         extra = {"control_points": len(pc), "control_points_seconds": round(time.perf_counter() - t_pc, 2)}
     seconds = time.perf_counter() - t
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
@@ -157,7 +162,7 @@ def xdem_run() -> None:
     from affine import Affine
     from osgeo import gdal
 
-    from core.georef.coregister import coregister_dems, nmad
+    from core.georef.coregister import CoregOptions, HeightGrid, coregister_dems, nmad
     from core.io.raster import bilinear
 
     gdal.UseExceptions()
@@ -179,7 +184,7 @@ def xdem_run() -> None:
                            Y0 + ref.shape[0] * REF_CELL), width=ref.shape[1], height=ref.shape[0],
                            resampleAlg="average", dstNodata=float("nan")).ReadAsArray()
         t = time.perf_counter()
-        ours = coregister_dems(dsm, gt, ref, ref_gt, tilt=any(tilt))
+        ours = coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt), options=CoregOptions(tilt=any(tilt)))
         t_ours = time.perf_counter() - t
         e = _errors(ours, shift, dz, tilt, xs, ys)
         print(f"  {name}: ours      shift ({ours.shift[0]:.2f}, {ours.shift[1]:.2f}) error {e['shift_error_m']} m, "

@@ -17,6 +17,8 @@ from core.common.errors import ArchaeoOrthoError
 from core.geometry.similarity import helmert_fit
 from core.georef.coregister import (
     CoregError,
+    CoregOptions,
+    HeightGrid,
     control_points_from_coregistration,
     coregister_dems,
     coregister_points,
@@ -115,7 +117,7 @@ def test_rugged_shift_tilt_and_outliers(rugged, rugged_ref):
     ref, ref_gt = rugged_ref
     shift, dz, tilt = (37.0, -21.0), 3.2, (8e-4, -5e-4)  # 1.5 and 0.8 reference cells; 4.8 m / 3 m over 6 km
     dsm, gt = block_dsm(rugged, shift, dz, tilt)
-    res = coregister_dems(dsm, gt, ref, ref_gt)
+    res = coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt))
     assert res.converged and res.horizontal_determined, res.messages
     assert abs(res.shift[0] - shift[0]) < 0.1 * REF_CELL and abs(res.shift[1] - shift[1]) < 0.1 * REF_CELL
     assert math.hypot(res.shift[0] - shift[0], res.shift[1] - shift[1]) < 0.5  # measured 0.02 m
@@ -155,7 +157,7 @@ def test_finer_reference_and_much_forest(rugged):
     m, k = dsm.shape[0], int(REF_CELL / FINE)
     coarse = dsm.reshape(m // k, k, m // k, k).mean(axis=(1, 3))
     coarse[:, : int(0.4 * coarse.shape[1])] += 18.0  # the west 40 % is forest
-    res = coregister_dems(coarse, (gt[0], REF_CELL, 0.0, gt[3], 0.0, -REF_CELL), ref, ref_gt)
+    res = coregister_dems(HeightGrid(coarse, (gt[0], REF_CELL, 0.0, gt[3], 0.0, -REF_CELL)), HeightGrid(ref, ref_gt))
     assert res.cell == REF_CELL and res.converged
     assert math.hypot(res.shift[0] - shift[0], res.shift[1] - shift[1]) < 0.1 * REF_CELL
     check_correction(res, dz, tilt, tol=0.1)
@@ -170,7 +172,7 @@ def test_large_shift_vertical_datum_and_forest_on_one_side(rugged, rugged_ref):
     shift, dz, tilt = (60.0, -45.0), -45.3, (1.2e-3, 4e-4)
     dsm, gt = block_dsm(rugged, shift, dz, tilt)
     dsm[:, :400] += 18.0
-    res = coregister_dems(dsm, gt, ref, ref_gt)
+    res = coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt))
     assert res.converged and res.horizontal_determined
     assert math.hypot(res.shift[0] - shift[0], res.shift[1] - shift[1]) < 0.1 * REF_CELL
     check_correction(res, dz, tilt, tol=0.1)
@@ -180,8 +182,8 @@ def test_large_shift_vertical_datum_and_forest_on_one_side(rugged, rugged_ref):
 def test_without_tilt_term_the_tilt_stays_in_the_residuals(rugged, rugged_ref):
     ref, ref_gt = rugged_ref
     dsm, gt = block_dsm(rugged, (10.0, 5.0), 1.0, (8e-4, -5e-4))
-    flat = coregister_dems(dsm, gt, ref, ref_gt, tilt=False)
-    tilted = coregister_dems(dsm, gt, ref, ref_gt)
+    flat = coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt), options=CoregOptions(tilt=False))
+    tilted = coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt))
     assert flat.tilt == (0.0, 0.0)
     assert flat.nmad_after > 5 * tilted.nmad_after  # +-2.4 m of plane against ~0.1 m noise
 
@@ -191,7 +193,7 @@ def test_gentle_terrain_subcell_shift():
     ref, ref_gt = reference(terrain, noise=0.1)
     shift, dz, tilt = (-8.0, 12.5), -1.7, (-3e-4, 2e-4)
     dsm, gt = block_dsm(terrain, shift, dz, tilt, noise=0.3)
-    res = coregister_dems(dsm, gt, ref, ref_gt)
+    res = coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt))
     assert res.converged
     assert math.hypot(res.shift[0] - shift[0], res.shift[1] - shift[1]) < 0.1 * REF_CELL, res.shift
     check_correction(res, dz, tilt, tol=0.1)
@@ -202,11 +204,11 @@ def test_dome(rugged, rugged_ref):
     dome = (-2e-7, 0.5e-7, -1.5e-7)  # -1.8 m / -1.35 m at the block's corners
     shift, dz, tilt = (15.0, 30.0), 2.0, (2e-4, 1e-4)
     dsm, gt = block_dsm(rugged, shift, dz, tilt, dome)
-    res = coregister_dems(dsm, gt, ref, ref_gt, dome=True)
+    res = coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt), options=CoregOptions(dome=True))
     assert res.converged
     assert math.hypot(res.shift[0] - shift[0], res.shift[1] - shift[1]) < 0.1 * REF_CELL
     check_correction(res, dz, tilt, dome, tol=0.15)
-    plane_only = coregister_dems(dsm, gt, ref, ref_gt)
+    plane_only = coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt))
     assert plane_only.nmad_after > 2 * res.nmad_after
 
 
@@ -219,7 +221,7 @@ def test_large_grids_are_compared_coarser(rugged, rugged_ref, monkeypatch):
     ref, ref_gt = rugged_ref
     shift, dz, tilt = (37.0, -21.0), 3.2, (8e-4, -5e-4)
     dsm, gt = block_dsm(rugged, shift, dz, tilt)
-    res = coregister_dems(dsm, gt, ref, ref_gt)
+    res = coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt))
     assert res.cell == 2 * REF_CELL and any("compared on a 50 grid" in m for m in res.messages)
     assert math.hypot(res.shift[0] - shift[0], res.shift[1] - shift[1]) < 0.1 * res.cell
     check_correction(res, dz, tilt, tol=0.15)
@@ -229,7 +231,7 @@ def test_flat_terrain_holds_the_horizontal_shift():
     terrain = Terrain(3, 0, 0.0, 100.0, 200.0)  # a plain at 500 m
     ref, ref_gt = reference(terrain, noise=0.05)
     dsm, gt = block_dsm(terrain, (40.0, 0.0), 2.5, (1e-4, 0.0), noise=0.2)
-    res = coregister_dems(dsm, gt, ref, ref_gt)
+    res = coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt))
     assert not res.horizontal_determined and res.shift[:2] == (0.0, 0.0)
     assert any("too flat" in m for m in res.messages)
     check_correction(res, 2.5, (1e-4, 0.0), tol=0.05)
@@ -238,10 +240,10 @@ def test_flat_terrain_holds_the_horizontal_shift():
 def test_not_converged_is_flagged(rugged, rugged_ref):
     ref, ref_gt = rugged_ref
     dsm, gt = block_dsm(rugged, (300.0, -200.0), 0.0)  # beyond the start's search (4 cells)
-    res = coregister_dems(dsm, gt, ref, ref_gt, max_iterations=1)
+    res = coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt), options=CoregOptions(max_iterations=1))
     assert not res.converged and res.iterations <= 2  # one with the shift alone, one with the tilt
     assert any("not converged" in m for m in res.messages)
-    full = coregister_dems(dsm, gt, ref, ref_gt)
+    full = coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt))
     assert full.converged and math.hypot(full.shift[0] - 300, full.shift[1] + 200) < 0.1 * REF_CELL
 
 
@@ -252,11 +254,11 @@ def test_stable_mask_and_nodata_value(rugged, rugged_ref):
     dsm = np.where(np.isnan(dsm), -9999.0, dsm).astype(np.float32)
     stable = np.ones(ref.shape, bool)
     stable[:, : ref.shape[1] // 2] = False  # only the east half is stable
-    res = coregister_dems(dsm, gt, ref, ref_gt, dem_nodata=-9999.0, stable_mask=stable)
+    res = coregister_dems(HeightGrid(dsm, gt, -9999.0), HeightGrid(ref, ref_gt), stable_mask=stable)
     assert math.hypot(res.shift[0] - shift[0], res.shift[1] - shift[1]) < 0.1 * REF_CELL
     assert res.origin[0] > CENTRE[0]  # the compared cells are the east half
     with pytest.raises(CoregError, match="shape"):
-        coregister_dems(dsm, gt, ref, ref_gt, stable_mask=stable[:10])
+        coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt), stable_mask=stable[:10])
 
 
 def test_points(rugged, rugged_ref):
@@ -270,12 +272,12 @@ def test_points(rugged, rugged_ref):
     z = rugged.at(qx, qy) - correction(qx, qy, dz, tilt) + rng.normal(0, 0.3, n)
     z[:2000] += rng.uniform(5, 20, 2000)  # trees and roofs
     pts = np.column_stack([x, y, z])
-    res = coregister_points(pts, ref, ref_gt)
+    res = coregister_points(pts, HeightGrid(ref, ref_gt))
     assert res.converged
     assert math.hypot(res.shift[0] - shift[0], res.shift[1] - shift[1]) < 0.1 * REF_CELL
     check_correction(res, dz, tilt, tol=0.1)
     assert res.stable_fraction < 0.95  # the 10 % raised points are left out
-    pc = control_points_from_coregistration(res, ref, ref_gt, points=pts, n=16)
+    pc = control_points_from_coregistration(res, HeightGrid(ref, ref_gt), points=pts, n=16)
     assert 12 <= len(pc) <= 16 and pc.index is not None
     assert np.all(pc.index >= 2000)  # never a raised point
     np.testing.assert_allclose(pc.block_xyz, pts[pc.index])
@@ -312,8 +314,8 @@ def test_control_points_remove_the_tilt(rugged, rugged_ref):
     ref, ref_gt = rugged_ref
     shift, dz, tilt = (37.0, -21.0), 3.2, (8e-4, -5e-4)
     dsm, gt = block_dsm(rugged, shift, dz, tilt)
-    res = coregister_dems(dsm, gt, ref, ref_gt)
-    pc = control_points_from_coregistration(res, ref, ref_gt, dem=dsm, dem_transform=gt, n=25)
+    res = coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt))
+    pc = control_points_from_coregistration(res, HeightGrid(ref, ref_gt), dem=HeightGrid(dsm, gt), n=25)
     assert 20 <= len(pc) <= 25
     # well distributed: every quadrant of the block has some
     bx, by, size = BLOCK
@@ -322,7 +324,8 @@ def test_control_points_remove_the_tilt(rugged, rugged_ref):
     # sigmas scale with the data: a quarter of the 25 m cell; about the residual NMAD in height on flat cells
     assert np.allclose(pc.sigma_xy, REF_CELL / 4)
     assert np.all(pc.sigma_z >= res.nmad_after) and np.median(pc.sigma_z) < 3 * res.nmad_after + 0.1
-    stated = control_points_from_coregistration(res, ref, ref_gt, dem=dsm, dem_transform=gt, n=25, ref_sigma_z=2.0)
+    stated = control_points_from_coregistration(res, HeightGrid(ref, ref_gt), dem=HeightGrid(dsm, gt), n=25,
+                                                ref_sigma_z=2.0)
     np.testing.assert_allclose(stated.sigma_z, np.hypot(pc.sigma_z, 2.0))
     # the reference coordinates are the truth (the terrain at the shifted position)
     assert np.all(np.abs(pc.xyz[:, :2] - pc.block_xyz[:, :2] - shift) < 0.5)
@@ -419,7 +422,7 @@ def test_cancel(rugged, rugged_ref):
     ref, ref_gt = rugged_ref
     dsm, gt = block_dsm(rugged, (10.0, 10.0), 0.0, outliers=False)
     with pytest.raises(Cancelled):
-        coregister_dems(dsm, gt, ref, ref_gt, progress=Stop())
+        coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt), progress=Stop())
 
 
 def test_errors(tmp_path, rugged, rugged_ref):
@@ -427,18 +430,18 @@ def test_errors(tmp_path, rugged, rugged_ref):
     dsm, gt = block_dsm(rugged, (0.0, 0.0), 0.0, outliers=False)
     far = (gt[0] + 50000.0,) + gt[1:]
     with pytest.raises(CoregError, match="do not overlap"):
-        coregister_dems(dsm, far, ref, ref_gt)
+        coregister_dems(HeightGrid(dsm, far), HeightGrid(ref, ref_gt))
     with pytest.raises(CoregError, match="every cell is nodata"):
-        coregister_dems(np.full((50, 50), np.nan), gt, ref, ref_gt, dem_name="DSM")
+        coregister_dems(HeightGrid(np.full((50, 50), np.nan), gt, name="DSM"), HeightGrid(ref, ref_gt))
     with pytest.raises(CoregError, match="too few cells"):  # overlaps by 4 x 4 reference cells
         corner = (X0 + EXTENT - 100.0, FINE, 0.0, Y0 + 100.0, 0.0, -FINE)
-        coregister_dems(dsm, corner, ref, ref_gt)
+        coregister_dems(HeightGrid(dsm, corner), HeightGrid(ref, ref_gt))
     with pytest.raises(CoregError, match="too few cells"):
-        coregister_dems(dsm, gt, ref, ref_gt, stable_mask=np.zeros(ref.shape, bool))
+        coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt), stable_mask=np.zeros(ref.shape, bool))
     with pytest.raises(CoregError, match="rotated"):
-        coregister_dems(dsm, (gt[0], FINE, 0.1, gt[3], 0.0, -FINE), ref, ref_gt)
+        coregister_dems(HeightGrid(dsm, (gt[0], FINE, 0.1, gt[3], 0.0, -FINE)), HeightGrid(ref, ref_gt))
     with pytest.raises(CoregError, match="do not overlap"):
-        coregister_points(np.array([[0.0, 0.0, 0.0]] * 200), ref, ref_gt)
+        coregister_points(np.array([[0.0, 0.0, 0.0]] * 200), HeightGrid(ref, ref_gt))
     # files: each message names the file
     ref_path = write(tmp_path / "ref.tif", ref, ref_gt, "EPSG:32633")
     dsm_path = write(tmp_path / "dsm.tif", dsm, gt, "EPSG:32633")
@@ -475,7 +478,7 @@ def test_agrees_with_xdem_nuthkaab(rugged, rugged_ref):
     ref, ref_gt = rugged_ref
     shift, dz = (37.0, -21.0), 3.2
     dsm, gt = block_dsm(rugged, shift, dz)
-    ours = coregister_dems(dsm, gt, ref, ref_gt, tilt=False)
+    ours = coregister_dems(HeightGrid(dsm, gt), HeightGrid(ref, ref_gt), options=CoregOptions(tilt=False))
     mem = gdal.GetDriverByName("MEM").Create("", dsm.shape[1], dsm.shape[0], 1, gdal.GDT_Float32)
     mem.SetGeoTransform(gt)
     mem.GetRasterBand(1).SetNoDataValue(float("nan"))

@@ -36,7 +36,7 @@ coarser multiple beyond that), and at most ``MAX_FIT_CELLS`` cells (a fixed rand
 memory is a few copies of the coarse grid, never of the full-resolution DSM (``coregister_rasters`` warps it from
 the file).
 
-Entry points: :func:`coregister_dems` (arrays + GDAL geotransforms), :func:`coregister_rasters` (two files: CRS,
+Entry points: :func:`coregister_dems` (:class:`HeightGrid`: arrays + GDAL geotransforms), :func:`coregister_rasters` (two files: CRS,
 linear and vertical units, nodata), :func:`coregister_points` (the sparse cloud against a reference DEM, sampled
 bilinearly; :func:`coregister_points_file` reads the reference over the points only, reprojected into the points'
 CRS: :func:`reference_window`), :func:`control_points_from_coregistration` (well-distributed pseudo control
@@ -52,15 +52,14 @@ is installed.
 from __future__ import annotations
 
 import math
-import os
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from ..common.errors import ArchaeoOrthoError
 from ..common.progress import NullProgress, Progress, check_cancel
-from ..io.raster import bilinear
+from ..io.raster import RasterError, RasterFile, bilinear
 
 OUTLIER_NMAD = 3.0  # residuals beyond this many spreads of the shortest half's centre are not stable terrain
 MAX_SLOPE_DEG = 70.0  # steeper cells (cliffs, walls) are left out of the fit
@@ -77,6 +76,30 @@ SEARCH_SAMPLES = 10_000  # ... on this many samples
 
 class CoregError(ArchaeoOrthoError, ValueError):
     """The co-registration cannot run with the given rasters or points; the message names them."""
+
+
+@dataclass(frozen=True)
+class CoregOptions:
+    """What the co-registration fits and how long it iterates: the shift and dz, with ``tilt`` a plane and with
+    ``dome`` a quadratic; at most ``max_iterations`` steps, until the shift changes by less than ``tolerance``
+    cells."""
+
+    tilt: bool = True
+    dome: bool = False
+    max_iterations: int = 20
+    tolerance: float = 0.01
+
+
+@dataclass
+class HeightGrid:
+    """Heights in metres on a north-up grid: a 2-D array, its GDAL geotransform, the value that means no height
+    (besides NaN; None: NaN only), and what it is called in messages ("" : the role's name, "DEM" or "reference
+    DEM")."""
+
+    array: np.ndarray
+    transform: Sequence[float]
+    nodata: Optional[float] = None
+    name: str = ""
 
 
 @dataclass
@@ -252,12 +275,22 @@ def _step(sample: Sampler, shift: np.ndarray, p: np.ndarray, model: _Model, usab
     return _Step(sol[:2], sol[2:], inl, cov, change, spread, relief)
 
 
-def _iterate(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, max_iterations: int,
-             tolerance: float, horizontal: bool, progress: Progress, shift: Optional[np.ndarray] = None,
-             p: Optional[np.ndarray] = None):
+@dataclass
+class _Samples:
+    """What a fit compares: the sampler of height differences, its 'usable' mask, the comparison cell (metres)."""
+
+    sample: Sampler
+    usable: np.ndarray
+    cell: float
+
+
+def _iterate(samples: _Samples, model: _Model, options: CoregOptions, horizontal: bool, progress: Progress,
+             shift: Optional[np.ndarray] = None, p: Optional[np.ndarray] = None):
     """Gauss-Newton from ``shift``, ``p`` (none, zeros) until the shift changes by less than ``tolerance`` cells
     and the model by less than a twentieth of the residual NMAD: (shift, parameters, iterations, converged, last
     step)."""
+    sample, usable, cell = samples.sample, samples.usable, samples.cell
+    max_iterations, tolerance = options.max_iterations, options.tolerance
     shift = np.zeros(2) if shift is None else np.array(shift, dtype=float)
     p = np.zeros(model.size) if p is None else np.array(p, dtype=float)
     st, it, converged = None, 0, False
@@ -302,33 +335,29 @@ def _search(sample: Sampler, usable: np.ndarray, cell: float) -> np.ndarray:
     return np.array([bi * cell, bj * cell]) if tried[(bi, bj)] < 0.9 * tried[(0, 0)] else np.zeros(2)
 
 
-def _staged(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, max_iterations: int,
-            tolerance: float, horizontal: bool, progress: Progress):
+def _staged(samples: _Samples, model: _Model, options: CoregOptions, progress: Progress):
     """:func:`_iterate` with the shift and dz alone first, then the whole model from there: while the shift is
     large, changed areas (a forest on one side) are not yet told from the terrain and a tilt would take them up."""
-    if not horizontal:
-        return _iterate(sample, usable, model, cell, max_iterations, tolerance, horizontal, progress)
-    start = _search(sample, usable, cell)
+    start = _search(samples.sample, samples.usable, samples.cell)
     if model.size == 1:
-        return _iterate(sample, usable, model, cell, max_iterations, tolerance, True, progress, start)
+        return _iterate(samples, model, options, True, progress, start)
     plain = _Model(model.origin, model.scale, False, False)
-    shift, p0, it0, _, _ = _iterate(sample, usable, plain, cell, max_iterations, 0.1, True, progress, start)
+    shift, p0, it0, _, _ = _iterate(samples, plain, replace(options, tolerance=0.1), True, progress, start)
     p = np.zeros(model.size)
     p[0] = p0[0]
-    shift, p, it, converged, st = _iterate(sample, usable, model, cell, max_iterations, tolerance, True, progress,
-                                           shift, p)
+    shift, p, it, converged, st = _iterate(samples, model, options, True, progress, shift, p)
     return shift, p, it0 + it, converged, st
 
 
-def _fit(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, max_iterations: int, tolerance: float,
-         progress: Progress) -> CoregResult:
+def _fit(samples: _Samples, model: _Model, options: CoregOptions, progress: Progress) -> CoregResult:
     """The co-registration and its statistics.  The shift is dropped (and the heights fitted again) when the
     terrain cannot fix it: its standard error over UNDETERMINED_CELLS cells, or a one-cell shift changing the
     heights by less than the residual NMAD (the gradient is then mostly noise)."""
     messages: List[str] = []
+    sample, usable, cell = samples.sample, samples.usable, samples.cell
     _, _, dh0, _, _ = sample(np.zeros(2))
     before = dh0[usable & np.isfinite(dh0)]
-    shift, p, it, converged, st = _staged(sample, usable, model, cell, max_iterations, tolerance, True, progress)
+    shift, p, it, converged, st = _staged(samples, model, options, progress)
     horizontal = True
     sigma = math.sqrt(max(st.cov[0, 0], st.cov[1, 1], 0.0))
     if not (sigma <= UNDETERMINED_CELLS * cell) or st.relief < FLAT_NMADS * st.spread:
@@ -336,8 +365,7 @@ def _fit(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, max_it
         messages.append(f"the terrain is too flat, or the surfaces differ too much (a one-cell shift changes the "
                         f"heights by {st.relief:.2g} m RMS, the residuals spread {st.spread:.2g} m), to determine a "
                         "horizontal shift: only the heights were co-registered (dx = dy = 0)")
-        shift, p, it, converged, st = _iterate(sample, usable, model, cell, max_iterations, tolerance, False,
-                                               progress)
+        shift, p, it, converged, st = _iterate(samples, model, options, False, progress)
     # the vertical bias as the median of the stable residuals, the statistics
     x, y, dh, gx, gy = sample(shift)
     r = dh - model.matrix(x, y) @ p
@@ -349,7 +377,7 @@ def _fit(sample: Sampler, usable: np.ndarray, model: _Model, cell: float, max_it
     after = r[usable & np.isfinite(r)]
     dz, tilt, dome = model.coefficients(p)
     if not converged:
-        messages.append(f"not converged after {max_iterations} iterations (last shift change "
+        messages.append(f"not converged after {options.max_iterations} iterations (last shift change "
                         f"{float(np.hypot(*st.d_shift)):.3g} m): the surfaces may differ by more than a shift and a "
                         "tilt, or share too little stable terrain")
     n_cmp = int(after.size)
@@ -575,8 +603,7 @@ def _model(x: np.ndarray, y: np.ndarray, tilt: bool, dome: bool) -> _Model:
     return _Model((x0, y0), scale, tilt, dome)
 
 
-def _run_pair(pair: _Pair, names: str, tilt: bool, dome: bool, max_iterations: int, tolerance: float,
-              progress: Optional[Progress]) -> CoregResult:
+def _run_pair(pair: _Pair, names: str, options: CoregOptions, progress: Optional[Progress]) -> CoregResult:
     progress = progress or NullProgress()
     sample, usable = _grid_sampler(pair)
     x, y, dh, _, _ = sample(np.zeros(2))
@@ -585,9 +612,9 @@ def _run_pair(pair: _Pair, names: str, tilt: bool, dome: bool, max_iterations: i
         raise CoregError(f"too few cells to co-register {names}: {int(valid.sum())} cells where both have a "
                          f"height and the reference has a slope{' on stable terrain' if pair.stable is not None else ''}"
                          f" (at least {MIN_CELLS} needed at the comparison cell of {abs(pair.gt[1]):g})")
-    model = _model(x[valid], y[valid], tilt, dome)
+    model = _model(x[valid], y[valid], options.tilt, options.dome)
     try:
-        result = _fit(sample, usable, model, abs(pair.gt[1]), max_iterations, tolerance, progress)
+        result = _fit(_Samples(sample, usable, abs(pair.gt[1])), model, options, progress)
     except CoregError as e:
         raise CoregError(f"cannot co-register {names}: {e}") from e
     result.messages[:0] = pair.messages
@@ -595,24 +622,23 @@ def _run_pair(pair: _Pair, names: str, tilt: bool, dome: bool, max_iterations: i
     return result
 
 
-def coregister_dems(dem: np.ndarray, dem_transform: Sequence[float], ref: np.ndarray, ref_transform: Sequence[float],
-                    *, dem_nodata: Optional[float] = None, ref_nodata: Optional[float] = None,
-                    stable_mask: Optional[np.ndarray] = None, tilt: bool = True, dome: bool = False,
-                    max_iterations: int = 20, tolerance: float = 0.01, progress: Optional[Progress] = None,
-                    dem_name: str = "DEM", ref_name: str = "reference DEM") -> CoregResult:
-    """Co-register ``dem`` onto ``ref`` (2-D height arrays in metres, NaN or ``*_nodata`` = no height; GDAL
-    geotransforms, north-up, both in the same metric CRS).  ``stable_mask``: bool on the grid of ``ref``, True
-    where the terrain did not change (optional; outliers are dropped anyway).  ``tolerance``: in cells."""
-    d = _array_source(dem, dem_transform, dem_nodata, dem_name)
-    r = _array_source(ref, ref_transform, ref_nodata, ref_name)
+def coregister_dems(dem: HeightGrid, ref: HeightGrid, *, stable_mask: Optional[np.ndarray] = None,
+                    options: Optional[CoregOptions] = None, progress: Optional[Progress] = None) -> CoregResult:
+    """Co-register ``dem`` onto ``ref`` (heights in metres, NaN or the grid's ``nodata`` = no height; north-up
+    geotransforms, both in the same metric CRS).  ``stable_mask``: bool on the grid of ``ref``, True where the
+    terrain did not change (optional; outliers are dropped anyway)."""
+    dem_name, ref_name = dem.name or "DEM", ref.name or "reference DEM"
+    d = _array_source(dem.array, dem.transform, dem.nodata, dem_name)
+    r = _array_source(ref.array, ref.transform, ref.nodata, ref_name)
     s = None
     if stable_mask is not None:
         mask = np.asarray(stable_mask)
-        if mask.shape != np.shape(ref):
-            raise CoregError(f"the stable mask must have the shape of the {ref_name} {np.shape(ref)}, got {mask.shape}")
-        s = _array_source(mask.astype(np.float32), ref_transform, None, "stable mask")
+        if mask.shape != np.shape(ref.array):
+            raise CoregError(f"the stable mask must have the shape of the {ref_name} {np.shape(ref.array)}, got "
+                             f"{mask.shape}")
+        s = _array_source(mask.astype(np.float32), ref.transform, None, "stable mask")
     pair = _pair(d, r, s)
-    return _run_pair(pair, f"the {dem_name} and the {ref_name}", tilt, dome, max_iterations, tolerance, progress)
+    return _run_pair(pair, f"the {dem_name} and the {ref_name}", options or CoregOptions(), progress)
 
 
 # ---------------------------------------------------------------------------
@@ -637,22 +663,18 @@ def _height_unit(band, srs, path: str) -> Tuple[float, str]:
 def _open_source(path: str, what: str) -> Tuple[_Source, float, List[str]]:
     """(source, metres per horizontal CRS unit, messages) of a raster file; CoregError naming it when it cannot
     be used (missing, unreadable, rotated, geographic CRS, no height)."""
-    gdal, osr = _gdal()
-    if not os.path.isfile(path):
-        raise CoregError(f"the {what} {path} does not exist")
+    _, osr = _gdal()
     try:
-        ds = gdal.Open(path)
-    except RuntimeError as e:
-        raise CoregError(f"the {what} {path} is not a raster GDAL can read: {e}") from e
-    if ds is None or ds.RasterCount < 1:
-        raise CoregError(f"the {what} {path} has no raster band")
-    gt = ds.GetGeoTransform(can_return_null=True)
-    if gt is None:
+        raster = RasterFile(path, f"the {what}")
+    except RasterError as e:  # missing, unreadable, no band: the message names the file
+        raise CoregError(str(e)) from e
+    if raster.geotransform is None:
         raise CoregError(f"the {what} {path} has no georeferencing (no geotransform)")
     name = f"{what} {path}"
-    gt = _check_transform(gt, name)
-    wkt = ds.GetProjection() or ""
-    band = ds.GetRasterBand(1)
+    gt = _check_transform(raster.geotransform, name)
+    wkt = raster.crs_wkt
+    ds = raster.dataset
+    band = raster.band(1)
     srs = osr.SpatialReference(wkt=wkt) if wkt else None
     xy_unit, messages = 1.0, []
     if srs is not None:
@@ -677,9 +699,8 @@ def _same_crs(a: str, b: str) -> bool:
     return bool(sa.IsSame(sb))
 
 
-def coregister_rasters(dem_path: str, ref_path: str, *, stable_mask_path: Optional[str] = None, tilt: bool = True,
-                       dome: bool = False, max_iterations: int = 20, tolerance: float = 0.01,
-                       progress: Optional[Progress] = None) -> CoregResult:
+def coregister_rasters(dem_path: str, ref_path: str, *, stable_mask_path: Optional[str] = None,
+                       options: Optional[CoregOptions] = None, progress: Optional[Progress] = None) -> CoregResult:
     """Co-register the DSM file ``dem_path`` onto the reference DEM file ``ref_path``.  Both are resampled onto
     the comparison grid by GDAL straight from the files (the DSM reprojected into the reference's CRS when they
     differ); heights in feet (band unit or vertical CRS) are converted to metres; the result is in metres (a
@@ -699,7 +720,7 @@ def coregister_rasters(dem_path: str, ref_path: str, *, stable_mask_path: Option
         if not stable.wkt and ref.wkt:
             stable.wkt = ref.wkt
     pair = _pair(dem, ref, stable, ref_unit)
-    result = _run_pair(pair, f"{dem_path} and {ref_path}", tilt, dome, max_iterations, tolerance, progress)
+    result = _run_pair(pair, f"{dem_path} and {ref_path}", options or CoregOptions(), progress)
     result.messages[:0] = m1 + m2
     return result
 
@@ -721,23 +742,23 @@ def _ref_window(ref: np.ndarray, gt: Tuple[float, ...], xy: np.ndarray, margin: 
     return win, (gt[0] + c0 * gt[1], gt[1], 0.0, gt[3] + r0 * gt[5], 0.0, gt[5])
 
 
-def coregister_points(points_xyz: np.ndarray, ref: np.ndarray, ref_transform: Sequence[float], *,
-                      ref_nodata: Optional[float] = None, stable: Optional[np.ndarray] = None, tilt: bool = True,
-                      dome: bool = False, max_iterations: int = 20, tolerance: float = 0.01,
-                      progress: Optional[Progress] = None, ref_name: str = "reference DEM") -> CoregResult:
+def coregister_points(points_xyz: np.ndarray, ref: HeightGrid, *, stable: Optional[np.ndarray] = None,
+                      options: Optional[CoregOptions] = None, progress: Optional[Progress] = None) -> CoregResult:
     """Co-register points (N x 3, the block's sparse cloud in the reference's metric CRS) onto ``ref``: the
     reference is sampled bilinearly at the shifted points.  ``stable``: bool per point (optional)."""
     progress = progress or NullProgress()
+    options = options or CoregOptions()
+    ref_name, ref_nodata = ref.name or "reference DEM", ref.nodata
     pts = np.asarray(points_xyz, dtype=float)
     if pts.ndim != 2 or pts.shape[1] < 3:
         raise CoregError(f"the points must be an N x 3 array, got shape {pts.shape}")
     pts = pts[:, :3]
     keep = np.all(np.isfinite(pts), axis=1)
-    gt = _check_transform(ref_transform, ref_name)
-    win, wgt = _ref_window(np.asarray(ref), gt, pts[keep], DEM_MARGIN_CELLS * abs(gt[1]))
+    gt = _check_transform(ref.transform, ref_name)
+    win, wgt = _ref_window(np.asarray(ref.array), gt, pts[keep], DEM_MARGIN_CELLS * abs(gt[1]))
     if win is None:
         raise CoregError(f"the points do not overlap the {ref_name}")
-    win = win.copy() if np.shares_memory(win, ref) else win
+    win = win.copy() if np.shares_memory(win, ref.array) else win
     if ref_nodata is not None:
         win[win == np.float32(ref_nodata)] = np.nan
     if not np.isfinite(win).any():
@@ -759,9 +780,9 @@ def coregister_points(points_xyz: np.ndarray, ref: np.ndarray, ref_transform: Se
     if valid.sum() < MIN_CELLS:
         raise CoregError(f"too few points on the {ref_name}: {int(valid.sum())} with a reference height "
                          f"(at least {MIN_CELLS} needed)")
-    model = _model(xy[valid, 0], xy[valid, 1], tilt, dome)
+    model = _model(xy[valid, 0], xy[valid, 1], options.tilt, options.dome)
     try:
-        result = _fit(sample, usable, model, abs(gt[1]), max_iterations, tolerance, progress)
+        result = _fit(_Samples(sample, usable, abs(gt[1])), model, options, progress)
     except CoregError as e:
         raise CoregError(f"cannot co-register the points onto the {ref_name}: {e}") from e
     progress.report(1.0, "co-registration done")
@@ -803,8 +824,7 @@ def reference_window(ref_path: str, xmin: float, ymin: float, xmax: float, ymax:
 
 
 def coregister_points_file(points_xyz: np.ndarray, ref_path: str, *, crs: Optional[str] = None,
-                           stable: Optional[np.ndarray] = None, tilt: bool = True, dome: bool = False,
-                           max_iterations: int = 20, tolerance: float = 0.01,
+                           stable: Optional[np.ndarray] = None, options: Optional[CoregOptions] = None,
                            progress: Optional[Progress] = None) -> CoregResult:
     """:func:`coregister_points` against the reference DEM file ``ref_path``, read over the points only
     (:func:`reference_window`; in ``crs``, the points' metric CRS, when given)."""
@@ -816,8 +836,8 @@ def coregister_points_file(points_xyz: np.ndarray, ref_path: str, *, crs: Option
         raise CoregError("no point with finite coordinates")
     lo, hi = pts[ok, :2].min(axis=0), pts[ok, :2].max(axis=0)
     ref, gt, messages = reference_window(ref_path, lo[0], lo[1], hi[0], hi[1], crs=crs)
-    result = coregister_points(pts, ref, gt, stable=stable, tilt=tilt, dome=dome, max_iterations=max_iterations,
-                               tolerance=tolerance, progress=progress, ref_name=f"reference DEM {ref_path}")
+    result = coregister_points(pts, HeightGrid(ref, gt, name=f"reference DEM {ref_path}"), stable=stable,
+                               options=options, progress=progress)
     result.messages[:0] = messages
     return result
 
@@ -885,13 +905,12 @@ def _spread(x: np.ndarray, y: np.ndarray, score: np.ndarray, n: int) -> np.ndarr
     return best[np.argsort(score[best])][:n]
 
 
-def control_points_from_coregistration(result: CoregResult, ref: np.ndarray, ref_transform: Sequence[float], *,
-                                       dem: Optional[np.ndarray] = None, dem_transform: Optional[Sequence[float]] = None,
+def control_points_from_coregistration(result: CoregResult, ref: HeightGrid, *, dem: Optional[HeightGrid] = None,
                                        points: Optional[np.ndarray] = None, n: int = 25,
-                                       ref_nodata: Optional[float] = None, ref_sigma_z: float = 0.0) -> PseudoControl:
+                                       ref_sigma_z: float = 0.0) -> PseudoControl:
     """Up to ``n`` well-distributed pseudo control points from ``result``: on flat, stable, well-measured cells
     (the residual after the co-registration within two NMADs, the block's surface smooth around it), one per
-    block of a grid over the overlap.  Give the DEM (heights, NaN = nodata, and its geotransform) or the points
+    block of a grid over the overlap.  Give the DEM (heights, NaN = nodata, with its geotransform) or the points
     (N x 3) the co-registration was made with.
 
     sigma_xy = max(a quarter of the comparison cell, 3 x the shift's standard error) (the cell size when the
@@ -900,20 +919,22 @@ def control_points_from_coregistration(result: CoregResult, ref: np.ndarray, ref
     holds only its random part)."""
     if (dem is None) == (points is None):
         raise CoregError("give either the DEM (with its geotransform) or the points for the pseudo control points")
-    if dem is not None and dem_transform is None:
+    if dem is not None and dem.transform is None:
         raise CoregError("the DEM's geotransform is needed for the pseudo control points")
-    gt = _check_transform(ref_transform, "reference DEM")
+    gt = _check_transform(ref.transform, "reference DEM")
+    ref_nodata = ref.nodata
+    dem_array, dem_transform = (None, None) if dem is None else (dem.array, dem.transform)
     if points is not None:
         xy = np.asarray(points, dtype=float)[:, :2] + np.array(result.shift[:2])
     else:
         dgt = _check_transform(dem_transform, "DEM")
-        hh, ww = np.shape(dem)
+        hh, ww = np.shape(dem_array)
         xy = np.array([[dgt[0], dgt[3] + hh * dgt[5]], [dgt[0] + ww * dgt[1], dgt[3]]]) + np.array(result.shift[:2])
-    win, wgt = _ref_window(np.asarray(ref), gt, xy[np.all(np.isfinite(xy), axis=1)], 0.0)
+    win, wgt = _ref_window(np.asarray(ref.array), gt, xy[np.all(np.isfinite(xy), axis=1)], 0.0)
     if win is None:
         raise CoregError("the block does not overlap the reference DEM")
     win = np.where(win == np.float32(ref_nodata), np.nan, win) if ref_nodata is not None else win
-    px, py, zb, qx, qy, rough, index = _candidates(result, win, wgt, dem, dem_transform, points)
+    px, py, zb, qx, qy, rough, index = _candidates(result, win, wgt, dem_array, dem_transform, points)
     fc, fr = (qx - wgt[0]) / wgt[1] - 0.5, (qy - wgt[3]) / wgt[5] - 0.5
     gr, gc = np.gradient(win)
     tan = np.hypot(bilinear(gc, fc, fr) / wgt[1], bilinear(gr, fc, fr) / wgt[5])
@@ -936,5 +957,5 @@ def control_points_from_coregistration(result: CoregResult, ref: np.ndarray, ref
                          zr[pick]]), np.full(pick.size, sxy), sz, None if index is None else index[pick])
 
 
-__all__ = ["CoregError", "CoregResult", "PseudoControl", "control_points_from_coregistration", "coregister_dems",
+__all__ = ["CoregError", "CoregOptions", "CoregResult", "HeightGrid", "PseudoControl", "control_points_from_coregistration", "coregister_dems",
            "coregister_points", "coregister_points_file", "coregister_rasters", "nmad", "reference_window", "shorth"]

@@ -62,7 +62,9 @@ from .coregister import (
     MIN_CELLS,
     OUTLIER_NMAD,
     CoregError,
+    CoregOptions,
     CoregResult,
+    HeightGrid,
     control_points_from_coregistration,
     coregister_points,
     nmad,
@@ -354,8 +356,9 @@ def coregister_xyz(xyz: np.ndarray, ref: np.ndarray, gt: Sequence[float], name: 
     """Points (N x 3, the reference's CRS) on the reference window: the co-registration with a tilt and a dome
     where its horizontal shift holds (:func:`_shift_trusted`), else the heights alone (:func:`heights_only`)."""
     try:
-        full = coregister_points(xyz, ref, gt, tilt=True, dome=True, progress=progress, ref_name=name)
-        plain = coregister_points(xyz, ref, gt, tilt=True, dome=False, ref_name=name)
+        grid = HeightGrid(ref, gt, name=name)
+        full = coregister_points(xyz, grid, options=CoregOptions(tilt=True, dome=True), progress=progress)
+        plain = coregister_points(xyz, grid, options=CoregOptions(tilt=True, dome=False))
     except CoregError as e:  # the shift's fit failed (too few stable points once shifted): the heights may hold
         full, (trusted, why) = None, (False, str(e))
     else:
@@ -401,7 +404,7 @@ def dem_control(rec, offset: Sequence[float], ref_path: str, crs: str, *, contro
     module notes say which heights win).  ``taken``: ground point names already in use."""
     progress = progress or NullProgress()
     co, xyz, ids, ref, gt, cells = coregister_block(rec, offset, ref_path, crs, progress)
-    pc = control_points_from_coregistration(co, ref, gt, points=xyz, n=n, ref_sigma_z=ref_sigma_z)
+    pc = control_points_from_coregistration(co, HeightGrid(ref, gt), points=xyz, n=n, ref_sigma_z=ref_sigma_z)
     if len(pc) < 3:
         raise DemControlError(f"the reference DEM {ref_path}: {len(pc)} DEM control point(s) on flat, stable terrain "
                               f"after the co-registration ({co.summary()}), at least 3 needed")
