@@ -164,8 +164,8 @@ def child(args):
         print("RADIOMETRY " + json.dumps({k: rad.get(k) for k in ("seam_step_before", "seam_step_after",
                                                                   "hot_width_deg", "hot_spot", "antisolar")}))
     elif args.stage == "terrain":
-        from core.terrain.stage import build_dtm_workspace
-        build_dtm_workspace(args.out, contour_interval=0.5, progress=p)
+        from core.terrain.stage import TerrainOptions, build_dtm_workspace
+        build_dtm_workspace(args.out, TerrainOptions(contour_interval=0.5), p)
     elif args.stage == "relief":
         from core.terrain.stage import relief_workspace
         relief_workspace(args.out, list(RELIEF_KEYS), source="dtm", progress=p)

@@ -240,7 +240,7 @@ def _slrm(dtm, gt, wkt, out_dir, name):
     from core.terrain.stage import relief
 
     path = os.path.join(out_dir, f"{name}.tif")
-    raster.write_cog(path, dtm, gt, wkt, description="DTM")
+    raster.write_cog(path, dtm, gt, wkt, raster.BandLabel("DTM"))
     return raster.read_dsm(relief(path, ["slrm"], out_dir, prefix=name).paths["slrm"])[0]
 
 

@@ -76,7 +76,7 @@ class BuildDtmAlgorithm(AlgorithmBase):
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
         from ..core.terrain import stage
-        from ..core.terrain.options import GroundOptions
+        from ..core.terrain.options import GroundOptions, TerrainOptions
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context) or None
         layer = self.parameterAsRasterLayer(parameters, self.DSM, context)
@@ -89,15 +89,15 @@ class BuildDtmAlgorithm(AlgorithmBase):
                                 threshold=self.parameterAsDouble(parameters, self.THRESHOLD, context))
         progress = FeedbackProgress(feedback)
         if workspace:
-            result = self.run_core(stage.build_dtm_workspace, workspace, dsm=dsm, output_dtm=output_dtm,
-                                   contour_interval=interval, options=options, progress=progress,
-                                   contours_copy=contours)
+            terrain = TerrainOptions(ground=options, contour_interval=interval, dsm=dsm, output_dtm=output_dtm,
+                                     contours_copy=contours)
+            result = self.run_core(stage.build_dtm_workspace, workspace, terrain, progress)
         else:
             if not dsm or not output_dtm:
                 raise QgsProcessingException(self.tr(
                     "Give a workspace folder, or a DSM file and where to write the DTM"))
-            result = self.run_core(stage.build_dtm, dsm, output_dtm, options, contour_interval=interval,
-                                   contours_path=contours, progress=progress)
+            result = self.run_core(stage.build_dtm, dsm, stage.DtmOutputs(output_dtm, contours=contours), options,
+                                   interval, progress=progress)
         return {self.OUT_WORKSPACE: result.workspace, self.OUTPUT_DTM: result.dtm_path,
                 self.OUTPUT_SOURCE: result.source_path, self.OUTPUT_POINT_CLOUD: result.point_cloud_path,
                 self.OUTPUT_CONTOURS: result.contours_path,

@@ -17,7 +17,7 @@ from core.project.stages import TERRAIN
 from core.project.workspace import Workspace
 from core.terrain.contours import write_contours
 from core.terrain.options import TerrainError
-from core.terrain.stage import build_dtm, build_dtm_workspace, relief
+from core.terrain.stage import DtmOutputs, TerrainOptions, build_dtm, build_dtm_workspace, relief
 from tests import synthetic as syn
 from tests.test_terrain import _workspace_with_dsm, synthetic_dsm
 
@@ -55,7 +55,7 @@ def test_build_dtm_refuses_to_write_over_its_dsm(dsm):
     with pytest.raises(TerrainError, match=r"DTM would overwrite its input, the DSM .*dsm\.tif"):
         build_dtm(path, path)
     with pytest.raises(TerrainError, match="contours would overwrite its input"):
-        build_dtm(path, path + ".dtm.tif", contour_interval=1.0, contours_path=path)
+        build_dtm(path, DtmOutputs(path + ".dtm.tif", contours=path), contour_interval=1.0)
     assert _digest(path) == before
 
 
@@ -85,9 +85,9 @@ def test_workspace_dtm_over_the_workspace_dsm_is_refused_and_recorded_nowhere(ds
     lay = Layout(Workspace.open(root))
     before = _digest(lay.default_dsm)
     with pytest.raises(TerrainError, match="DTM would overwrite its input"):
-        build_dtm_workspace(root, dsm=lay.default_dsm, output_dtm=lay.default_dsm)
+        build_dtm_workspace(root, TerrainOptions(dsm=lay.default_dsm, output_dtm=lay.default_dsm))
     with pytest.raises(TerrainError, match="contours would overwrite its input"):
-        build_dtm_workspace(root, contour_interval=1.0, contours_copy=lay.default_dsm)
+        build_dtm_workspace(root, TerrainOptions(contour_interval=1.0, contours_copy=lay.default_dsm))
     ws = Workspace.open(root)
     assert _digest(lay.default_dsm) == before
     assert not ws.stage_done(TERRAIN) and ws.stage(TERRAIN).get("status") != "failed"
@@ -179,5 +179,5 @@ def test_a_stale_dsm_or_dtm_is_refused(dsm, tmp_path):
         relief_workspace(root, ["slrm"], source="dtm")
     assert Workspace.open(root).stage(TERRAIN)["status"] == STALE
     # a DSM file given explicitly (outside the workspace's records) is the user's choice
-    r = build_dtm_workspace(root, dsm=path, output_dtm=str(tmp_path / "other-dtm.tif"))
+    r = build_dtm_workspace(root, TerrainOptions(dsm=path, output_dtm=str(tmp_path / "other-dtm.tif")))
     assert os.path.isfile(r.dtm_path)

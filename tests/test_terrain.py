@@ -20,7 +20,7 @@ from core.project.workspace import Workspace
 from core.terrain.contours import write_contours
 from core.terrain.options import SOURCE_INTERPOLATED, SOURCE_MEASURED, TerrainError
 from core.terrain.rasters import same_grid
-from core.terrain.stage import build_dtm, build_dtm_workspace, relief, relief_workspace
+from core.terrain.stage import TerrainOptions, build_dtm, build_dtm_workspace, relief, relief_workspace
 from tests import synthetic as syn
 
 GSD = 40.0 / 325.0  # m: the synthetic block of tests/test_dense.py (altitude 40 m, fx 325 px)
@@ -251,7 +251,7 @@ def _workspace_with_dsm(root, dsm_path, scene):
 def test_workspace_stage_classifies_the_point_cloud(scene_dsm, tmp_path):
     scene, x, y, path, buildings, trees = scene_dsm
     root, xyz = _workspace_with_dsm(tmp_path / "ws", path, scene)
-    r = build_dtm_workspace(root, contour_interval=1.0)
+    r = build_dtm_workspace(root, TerrainOptions(contour_interval=1.0))
     ws = Workspace.open(root)
     lay = Layout(ws)
     assert ws.stage_done(TERRAIN) and os.path.samefile(lay.dtm(), lay.default_dtm)
@@ -403,7 +403,7 @@ def test_products_load_styled_in_qgis(scene_dsm, tmp_path, qgis_new_project):
 
     scene, x, y, path, buildings, trees = scene_dsm
     root, _ = _workspace_with_dsm(tmp_path / "ws", path, scene)
-    build_dtm_workspace(root, contour_interval=1.0)
+    build_dtm_workspace(root, TerrainOptions(contour_interval=1.0))
     relief_workspace(root, ["svf", "openness_neg"])
     loaded = layers.load_workspace_results(root, QgsProject.instance())
     by_kind = {lyr.customProperty(layers.KIND_PROPERTY): lyr for lyr in loaded}

@@ -253,14 +253,27 @@ class Grid:
 # writing
 # ---------------------------------------------------------------------------
 
-def write_cog(path: str, array: np.ndarray, geotransform: Sequence[float], crs: Optional[str],
-              nodata: float = NODATA, progress: Optional[Progress] = None,
-              description: str = "DSM", metadata: Optional[dict] = None, unit: str = "") -> str:
-    """Write a single-band float32 Cloud-Optimized GeoTIFF (DEFLATE, overviews) atomically; ``unit``: the band's
-    unit type where the values' unit is not the CRS's (a difference in metres on a grid in feet: "m").
+@dataclass
+class BandLabel:
+    """How a written single-band raster labels its values: the band's description, its unit type where the
+    values' unit is not the CRS's (a difference in metres on a grid in feet: "m"), the nodata value NaN cells
+    become, and the file's metadata items."""
 
-    NaN cells become ``nodata``.  ``crs`` None writes no CRS (local frame).  A cancel or crash
+    description: str = "DSM"
+    unit: str = ""
+    nodata: float = NODATA
+    metadata: Optional[dict] = None
+
+
+def write_cog(path: str, array: np.ndarray, geotransform: Sequence[float], crs: Optional[str],
+              label: Optional[BandLabel] = None, progress: Optional[Progress] = None) -> str:
+    """Write a single-band float32 Cloud-Optimized GeoTIFF (DEFLATE, overviews) atomically, labelled by ``label``
+    (:class:`BandLabel`: a "DSM" band with nodata :data:`NODATA` by default).
+
+    NaN cells become the label's nodata.  ``crs`` None writes no CRS (local frame).  A cancel or crash
     leaves no file at ``path`` (a previous complete file stays until the new one is complete)."""
+    label = label or BandLabel()
+    nodata, description, unit, metadata = label.nodata, label.description, label.unit, label.metadata
     gdal, _ = _gdal()
     progress = progress or NullProgress()
     data = np.where(np.isfinite(array), array, nodata).astype(np.float32)
@@ -321,7 +334,7 @@ def write_classes(path: str, array: np.ndarray, geotransform: Sequence[float], c
     """A class raster (small integers, 0 = nodata, e.g. SOURCE_MEASURED / SOURCE_INTERPOLATED) as a COG on the
     grid ``geotransform``, written atomically like :func:`write_cog`."""
     data = np.where(array > 0, array.astype(np.float32), np.nan)
-    return write_cog(path, data, geotransform, crs, nodata=0.0, description=description, metadata=metadata)
+    return write_cog(path, data, geotransform, crs, BandLabel(description, nodata=0.0, metadata=metadata))
 
 
 def push_pull(z: np.ndarray, known: np.ndarray) -> np.ndarray:
@@ -669,6 +682,6 @@ def read_las(path: str) -> Tuple[np.ndarray, np.ndarray, dict]:
     return xyz, rgb, header
 
 
-__all__ = ["Grid", "write_cog", "translate_to_cog", "open_dsm", "DsmReader", "DsmInfo", "read_dsm", "write_las",
+__all__ = ["Grid", "BandLabel", "write_cog", "translate_to_cog", "open_dsm", "DsmReader", "DsmInfo", "read_dsm", "write_las",
            "read_las", "DsmError", "RasterError", "RasterFile", "axis_metres",
            "NODATA", "bilinear", "crs_to_wkt", "crs_epsg", "height_unit"]

@@ -173,5 +173,5 @@ def fill_dsm_gaps(dsm_path: str, out_path: str, max_distance: float) -> Tuple[st
     if n == 0:
         return dsm_path, 0
     # the band's unit kept: a DSM in feet on a metric grid is read in feet from the copy too (io.raster.height_unit)
-    dsmmod.write_cog(out_path, result, gt, wkt or None, unit=unit)
+    dsmmod.write_cog(out_path, result, gt, wkt or None, dsmmod.BandLabel(unit=unit))
     return out_path, n

@@ -148,8 +148,8 @@ def dsm_difference(dsm_a: str, dsm_b: str, output: str, resolution: Optional[flo
                         int(np.count_nonzero(np.abs(v) > threshold)), float(threshold), res, w, h)
     meta = {"dsm_a": os.path.abspath(dsm_a), "dsm_b": os.path.abspath(dsm_b),
             **{k: f"{val:.6g}" if isinstance(val, float) else val for k, val in out.figures().items()}}
-    raster.write_cog(output, d, gt, a.wkt, description="DSM difference (B - A), metres", metadata=meta, unit="m",
-                     progress=progress)
+    raster.write_cog(output, d, gt, a.wkt, raster.BandLabel("DSM difference (B - A), metres", "m", metadata=meta),
+                     progress)
     progress.report(1.0, "DSM difference written")
     return out
 

@@ -2,8 +2,9 @@
 error."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
-from typing import Tuple
+from typing import Optional, Tuple
 
 from ..common.errors import ArchaeoOrthoError
 from ..io import raster
@@ -77,10 +78,20 @@ class ReliefOptions:
 
 @dataclass
 class TerrainOptions:
+    """The terrain stage (Build DTM) of a workspace: the ground filter, contours, whether the DSM stage's point
+    cloud is classified, and the files that replace the workspace's (a DSM to read, where the DTM goes, a copy of
+    the contours)."""
+
     ground: GroundOptions = None  # type: ignore[assignment]
     contour_interval: float = 0.0  # m; 0 = no contours
     classify_point_cloud: bool = True
+    dsm: Optional[str] = None  # a DSM file instead of the workspace's
+    output_dtm: Optional[str] = None  # the DTM there instead of <workspace>/dtm.tif
+    contours_copy: Optional[str] = None  # a copy of the contours there (a .gpkg)
 
     def __post_init__(self):
         if self.ground is None:
             self.ground = GroundOptions()
+        if not (self.contour_interval >= 0 and math.isfinite(self.contour_interval)):
+            raise TerrainError(f"the contour interval must be 0 (no contours) or a positive number of metres, got "
+                               f"{self.contour_interval}")

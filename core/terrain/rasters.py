@@ -172,21 +172,12 @@ def tiles(h: int, w: int, size: int):
             yield r0, min(h, r0 + size), c0, min(w, c0 + size)
 
 
-def write_float(path: str, array: np.ndarray, elev: Elevation, description: str, metadata: dict,
-                heights: bool = True, progress=None) -> str:
-    """A float32 COG on the grid of ``elev`` (heights converted back to the CRS's units when ``heights``)."""
-    out = array / elev.unit if heights else array
-    return raster.write_cog(path, out, elev.geotransform, elev.crs_wkt or None, progress=progress,
-                            description=description, metadata=metadata)
-
-
-def write_float_tiles(path: str, tile_values, elev: Elevation, description: str, metadata: dict,
-                      heights: bool = True, tile: int = TILE_CELLS, progress=None,
-                      nodata: float = raster.NODATA) -> str:
+def write_float_tiles(path: str, tile_values, elev: Elevation, label: raster.BandLabel, heights: bool = True,
+                      tile: int = TILE_CELLS, progress=None) -> str:
     """A float32 COG on the grid of ``elev`` written tile by tile: ``tile_values(r0, r1, c0, c1)`` gives the
     values (metres when ``heights``, NaN = nodata) of each tile; they go into a temporary tiled GeoTIFF beside
     ``path``, then into the COG (atomically: core.io.raster.write_cog's options), so the raster is never whole
-    in memory."""
+    in memory; ``label`` (:class:`core.io.raster.BandLabel`): the band's description, nodata and the metadata."""
     from osgeo import gdal
 
     from ..common.files import atomic_output
@@ -194,6 +185,7 @@ def write_float_tiles(path: str, tile_values, elev: Elevation, description: str,
 
     gdal.UseExceptions()
     progress = progress or NullProgress()
+    nodata = label.nodata
     h, w = elev.shape
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with atomic_output(path) as tmp:
@@ -206,8 +198,10 @@ def write_float_tiles(path: str, tile_values, elev: Elevation, description: str,
                 ds.SetProjection(elev.crs_wkt)
             band = ds.GetRasterBand(1)
             band.SetNoDataValue(float(nodata))
-            band.SetDescription(description)
-            ds.SetMetadata({str(k): str(v) for k, v in metadata.items()})
+            band.SetDescription(label.description)
+            if label.unit:
+                band.SetUnitType(label.unit)
+            ds.SetMetadata({str(k): str(v) for k, v in (label.metadata or {}).items()})
             for r0, r1, c0, c1 in tiles(h, w, tile):
                 values = np.asarray(tile_values(r0, r1, c0, c1), dtype=np.float32)
                 if heights and elev.unit != 1.0:
@@ -231,7 +225,8 @@ def write_classes(path: str, array: np.ndarray, elev: Elevation, description: st
         part = array[r0:r1, c0:c1]
         return np.where(part > 0, part.astype(np.float32), np.float32(np.nan))
 
-    return write_float_tiles(path, values, elev, description, metadata, heights=False, tile=tile, nodata=0.0)
+    return write_float_tiles(path, values, elev, raster.BandLabel(description, nodata=0.0, metadata=metadata),
+                             heights=False, tile=tile)
 
 
 def same_grid(a: str, b: str) -> Optional[str]:
