@@ -186,11 +186,12 @@ def build_workspace(ws_dir):
 
 def mosaic_only(args):
     """Child process of the RSS measurement: one orthomosaic, prints JSON."""
+    from core.ortho.options import OrthoOptions
     from core.ortho.stage import build_orthophoto_workspace
 
     t0 = time.time()
-    res = build_orthophoto_workspace(args.workspace, dsm_path=args.dsm, resolution=args.resolution,
-                                     images_filter=args.filter, output=args.output)
+    res = build_orthophoto_workspace(args.workspace, OrthoOptions(dsm_path=args.dsm, resolution=args.resolution,
+                                                                  images_filter=args.filter, output=args.output))
     print(json.dumps({"seconds": time.time() - t0, "width": res.resolution and None, "resolution": res.resolution,
                       "timings": res.timings, "rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
 
@@ -294,10 +295,9 @@ def main():
     if not args.skip_pairs:
         folder = os.path.join(args.out, "per_image")
         t0 = time.time()
-        res = build_orthophoto_workspace(args.workspace, dsm_path=args.dsm,
-                                         output=os.path.join(args.out, "mosaic_all.tif"),
-                                         per_image_folder=folder,
-                                         seamlines=os.path.join(args.out, "seamlines.gpkg"))
+        res = build_orthophoto_workspace(args.workspace, OrthoOptions(
+            dsm_path=args.dsm, output=os.path.join(args.out, "mosaic_all.tif"), per_image_folder=folder,
+            seamlines=os.path.join(args.out, "seamlines.gpkg")))
         print(f"mosaic + {len(res.images)} per-image orthophotos at {res.resolution:g} m: {time.time() - t0:.1f} s "
               f"({', '.join(f'{k} {v:.1f}' for k, v in res.timings.items())})")
         for line in res.log_lines:
@@ -336,8 +336,8 @@ def main():
 
         name = args.single
         mos = os.path.join(args.out, "mosaic_without_single.tif")
-        res = build_orthophoto_workspace(args.workspace, dsm_path=args.dsm, images_filter=f"!{name}",
-                                         output=mos)
+        res = build_orthophoto_workspace(args.workspace, OrthoOptions(dsm_path=args.dsm, images_filter=f"!{name}",
+                                                                      output=mos))
         img = os.path.join(ws.data["images_dir"], name)
         print(f"single image {name}, against the mosaic of the other {len(res.images)} images (128 x 128 windows):")
         _gcps, rec, im, off = transferred_gcps(args.workspace, name, 4)

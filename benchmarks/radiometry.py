@@ -50,8 +50,8 @@ def _mosaics(ws: str, out: str, dsm=None):
     res = {}
     for on in (False, True):
         t0 = time.time()
-        r = build_orthophoto_workspace(ws, dsm_path=dsm, output=os.path.join(out, f"mosaic-{'on' if on else 'off'}.tif"),
-                                       options=OrthoOptions(radiometry=on))
+        r = build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm, radiometry=on,
+                                                        output=os.path.join(out, f"mosaic-{'on' if on else 'off'}.tif")))
         res[on] = (r, time.time() - t0)
     return res
 

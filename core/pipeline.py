@@ -188,8 +188,8 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
     res.warnings += res.georef.warnings
     res.dsm = run(DSM, build_dsm_workspace, workspace_dir, options=opt.dense)
     res.warnings += res.dsm.warnings
-    res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, images_filter=opt.images_filter,
-                    options=opt.ortho)
+    res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, options=opt.ortho if not opt.images_filter
+                    else dataclasses.replace(opt.ortho, images_filter=opt.images_filter))
     res.warnings += res.ortho.warnings
     if opt.make_dtm:
         res.dtm = run(TERRAIN, build_dtm_workspace, workspace_dir,

@@ -135,7 +135,12 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
         if seamlines and not seamlines.lower().endswith(".gpkg"):
             raise QgsProcessingException(self.tr("Seamlines must be a GeoPackage (.gpkg) file, got {}").format(
                 seamlines))
-        options = OrthoOptions(
+        options = self.run_core(
+            OrthoOptions, dsm_path=dsm_path,
+            images_filter=self.parameterAsString(parameters, self.IMAGES_FILTER, context).strip() or None,
+            resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context),
+            blending=params.read_choice(self, parameters, self.BLENDING, context, self.BLENDINGS),
+            output=output, per_image_folder=per_image, seamlines=seamlines,
             interpolation=params.read_choice(self, parameters, self.INTERPOLATION, context, self.INTERPOLATIONS),
             gsd_factor=self.parameterAsDouble(parameters, self.GSD_FACTOR, context),
             radiometry=self.parameterAsBoolean(parameters, self.RADIOMETRY, context),
@@ -143,13 +148,7 @@ class BuildOrthophotoAlgorithm(AlgorithmBase):
             scheduler=params.read_scheduler(self, parameters, self.SCHEDULER, context),
             seamlines_in=self.seamlines_in(parameters, context, feedback))
         progress = FeedbackProgress(feedback)
-        result = self.run_core(
-            build_orthophoto_workspace, workspace, dsm_path=dsm_path,
-            images_filter=self.parameterAsString(parameters, self.IMAGES_FILTER, context).strip() or None,
-            resolution=self.parameterAsDouble(parameters, self.RESOLUTION, context),
-            blending=params.read_choice(self, parameters, self.BLENDING, context, self.BLENDINGS),
-            output=output, per_image_folder=per_image, seamlines=seamlines, options=options,
-            progress=progress)
+        result = self.run_core(build_orthophoto_workspace, workspace, options, progress)
         progress.push_result(result.warnings, result.log_lines)
         return {self.OUT_WORKSPACE: result.workspace, self.OUTPUT: result.orthomosaic,
                 self.PER_IMAGE_FOLDER: result.per_image_folder, self.SEAMLINES: result.seamlines,

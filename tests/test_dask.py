@@ -61,9 +61,8 @@ def test_dask_products_are_identical_to_the_local_run(block_root, cluster):
     assert np.isfinite(z_l).mean() > 0.5
     np.testing.assert_array_equal(z_l, z_d)
 
-    o_local = build_orthophoto_workspace(local, options=OrthoOptions(workers=1, tile=128))
-    o_dask = build_orthophoto_workspace(
-        remote, options=OrthoOptions(tile=128, scheduler=cluster.scheduler_address))
+    o_local = build_orthophoto_workspace(local, OrthoOptions(workers=1, tile=128))
+    o_dask = build_orthophoto_workspace(remote, OrthoOptions(tile=128, scheduler=cluster.scheduler_address))
     a_l, g_l, p_l = _raster(o_local.orthomosaic)
     a_d, g_d, p_d = _raster(o_dask.orthomosaic)
     assert g_l == g_d and p_l == p_d

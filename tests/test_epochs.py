@@ -119,7 +119,7 @@ def test_orthophoto_of_the_second_epoch_on_the_earlier_dsm(registered):
     they belong, within 1.5 GSD."""
     _b1, b2, ws1, ws2, _ = registered
     dsm1 = Layout(Workspace.open(ws1)).dsm()
-    out = build_orthophoto_workspace(ws2, dsm_path=dsm1, options=OrthoOptions(radiometry=False))
+    out = build_orthophoto_workspace(ws2, OrthoOptions(dsm_path=dsm1, radiometry=False))
     assert Workspace.open(ws2).stage("orthophoto")["parameters"]["dsm"] == os.path.abspath(dsm1)
     ds = gdal.Open(out.orthomosaic)
     arr = ds.ReadAsArray().astype(np.float32)

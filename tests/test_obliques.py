@@ -446,9 +446,9 @@ def test_far_field_of_an_oblique_is_left_to_the_near_view(tmp_path):
     for factor in (3.0, 0.0):
         out = str(tmp_path / f"mosaic_{factor:g}.tif")
         per = str(tmp_path / f"per_{factor:g}")
-        build_orthomosaic(cams, dsm, crs, offset, out, OrthoOptions(gsd_factor=factor, blending="none",
-                                                                    exposure=False, radiometry=False, resolution=0.5),
-                          per_image_folder=per)
+        build_orthomosaic(cams, crs, offset, OrthoOptions(dsm_path=dsm, output=out, per_image_folder=per,
+                                                          gsd_factor=factor, blending="none", exposure=False,
+                                                          radiometry=False, resolution=0.5))
         results[factor] = (_values_along_x(out, offset), _values_along_x(os.path.join(per, "A.tif"), offset))
     (xs, val, ok), (xa, _va, oka) = results[3.0]
     b_lo, b_hi = 60 - 50.0 * 200 / 300.0, 60 + 50.0 * 200 / 300.0  # B's footprint on the line
@@ -503,8 +503,9 @@ def test_far_field_limit_keeps_the_ground_of_a_vertical_beside_tall_objects(tmp_
     filled = {}
     for factor in (3.0, 0.0):
         out = str(tmp_path / f"mosaic_{factor:g}.tif")
-        build_orthomosaic(cams, dsm_path, crs, offset, out, OrthoOptions(gsd_factor=factor, blending="none",
-                                                                         exposure=False, radiometry=False, resolution=0.5))
+        build_orthomosaic(cams, crs, offset, OrthoOptions(dsm_path=dsm_path, output=out, gsd_factor=factor,
+                                                          blending="none", exposure=False, radiometry=False,
+                                                          resolution=0.5))
         xs, _val, ok = _values_along_x(out, offset)
         inside = (xs > -18) & (xs < 18)  # the footprint is x -20..20 m on the line y = 0
         filled[factor] = float(ok[inside].mean())

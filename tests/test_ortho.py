@@ -65,9 +65,9 @@ def scene(tmp_path_factory):
 @pytest.fixture(scope="module")
 def mosaic(scene):
     block, root, _images, dsm, ws = scene
-    res = build_orthophoto_workspace(ws, dsm_path=dsm, blending="feather",
-                                           per_image_folder=os.path.join(ws, "ortho"),
-                                           seamlines=os.path.join(ws, "seamlines.gpkg"))
+    res = build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm, blending="feather",
+                                                      per_image_folder=os.path.join(ws, "ortho"),
+                                                      seamlines=os.path.join(ws, "seamlines.gpkg")))
     return res
 
 
@@ -293,8 +293,8 @@ def test_masked_pixels_stay_nodata(scene, tmp_path):
     mask = np.full((CAMERA.height, CAMERA.width), 255, np.uint8)
     mask[:, : CAMERA.width // 2] = 0
     cv2.imwrite(os.path.join(ws, "masks", "S2_02.jpg.png"), mask)
-    res = build_orthophoto_workspace(ws, dsm_path=dsm, resolution=0.2, images_filter="S2_02.jpg",
-                                           per_image_folder=str(tmp_path / "per"))
+    res = build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm, resolution=0.2, images_filter="S2_02.jpg",
+                                                      per_image_folder=str(tmp_path / "per")))
     a, gt = _read(os.path.join(str(tmp_path / "per"), "S2_02.tif"))
     h, w = a.shape[1:]
     cols, rows = np.meshgrid(np.arange(w), np.arange(h))
@@ -322,14 +322,14 @@ def test_subset_multiband_and_options(scene, tmp_path):
     """A subset by wildcard, multi-band blending, coarser resolution; all-images filter errors are clear."""
     block, _root, _images, dsm, ws = scene
     out = str(tmp_path / "strip2.tif")
-    res = build_orthophoto_workspace(ws, dsm_path=dsm, images_filter="S2_*, !S2_05.jpg", resolution=0.25,
-                                           blending="multiband", output=out)
+    res = build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm, images_filter="S2_*, !S2_05.jpg", resolution=0.25,
+                                                      blending="multiband", output=out))
     assert sorted(res.images) == [f"S2_0{i}.jpg" for i in range(1, 5)]
     assert res.resolution == 0.25
     ground, cell = _ground_shifts(block, out, count=40, n=16)
     assert len(ground) >= 20 and _rmse(ground) * cell <= block.gsd
     with pytest.raises(OrthoError, match="matches none"):
-        build_orthophoto_workspace(ws, dsm_path=dsm, images_filter="NIR_*", output=str(tmp_path / "x.tif"))
+        build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm, images_filter="NIR_*", output=str(tmp_path / "x.tif")))
 
 
 def test_select_cameras_by_name_wildcard_and_group():
@@ -383,7 +383,7 @@ def test_dsm_that_does_not_cover_the_images_is_refused(scene, tmp_path):
     _block, _root, _images, dsm, ws = scene
     far = _shifted_dsm(dsm, str(tmp_path / "far.tif"), dx=20000.0)
     with pytest.raises(OrthoError, match="does not cover"):
-        build_orthophoto_workspace(ws, dsm_path=far, output=str(tmp_path / "m.tif"))
+        build_orthophoto_workspace(ws, OrthoOptions(dsm_path=far, output=str(tmp_path / "m.tif")))
     assert Workspace.open(ws).stage("orthophoto")["status"] == "failed"
     assert not os.path.exists(tmp_path / "m.tif")
 
@@ -392,7 +392,7 @@ def test_all_nodata_dsm_is_refused(scene, tmp_path):
     _block, _root, _images, dsm, ws = scene
     empty = _shifted_dsm(dsm, str(tmp_path / "empty.tif"), fill=np.nan)
     with pytest.raises(OrthoError, match="no valid height"):
-        build_orthophoto_workspace(ws, dsm_path=empty, output=str(tmp_path / "m.tif"))
+        build_orthophoto_workspace(ws, OrthoOptions(dsm_path=empty, output=str(tmp_path / "m.tif")))
 
 
 def test_partial_dsm_warns_and_leaves_nodata(scene, tmp_path):
@@ -401,7 +401,7 @@ def test_partial_dsm_warns_and_leaves_nodata(scene, tmp_path):
     z[:, : z.shape[1] // 2] = np.nan  # the western half has no height
     half = dsmmod.write_cog(str(tmp_path / "half.tif"), z, gt, syn.CRS)
     ws2 = make_workspace(str(tmp_path / "ws"), block, scene[2], names=["S2_01.jpg", "S2_02.jpg", "S2_05.jpg"])
-    res = build_orthophoto_workspace(ws2, dsm_path=half, resolution=0.3)
+    res = build_orthophoto_workspace(ws2, OrthoOptions(dsm_path=half, resolution=0.3))
     assert any("less than half" in w for w in res.warnings)
     assert 0.05 < res.valid_fraction < 0.9
 
@@ -428,11 +428,11 @@ def test_dsm_gaps_inside_the_data_are_filled_for_the_orthophoto(scene, tmp_path)
         c, r = int((centre_x - g[0]) / g[1]), int((centre_y - g[3]) / g[5])
         return ds.GetRasterBand(ds.RasterCount).ReadAsArray(c - 2, r - 2, 5, 5)
 
-    res = build_orthophoto_workspace(ws2, dsm_path=holed, resolution=0.3, output=str(tmp_path / "filled.tif"))
+    res = build_orthophoto_workspace(ws2, OrthoOptions(dsm_path=holed, resolution=0.3, output=str(tmp_path / "filled.tif")))
     assert any("DSM gaps" in line and "interpolated" in line for line in res.log_lines), res.log_lines
     assert (alpha_at_centre(res.orthomosaic) > 0).all()
-    off = build_orthophoto_workspace(ws2, dsm_path=holed, resolution=0.3, output=str(tmp_path / "off.tif"),
-                                           options=OrthoOptions(fill_dsm_gaps_m=0.0))
+    off = build_orthophoto_workspace(ws2, OrthoOptions(dsm_path=holed, resolution=0.3, output=str(tmp_path / "off.tif"),
+                                                       fill_dsm_gaps_m=0.0))
     assert (alpha_at_centre(off.orthomosaic) == 0).all()
     assert open(holed, "rb").read() == before
     # the hull rule: a DSM covering half of the area is not extended (test_partial_dsm_warns_and_leaves_nodata)
@@ -479,7 +479,7 @@ def test_workspace_without_georeference_or_dsm_is_refused(scene, tmp_path):
     w.data["stages"]["georeference"] = {"status": "pending"}
     w.save()
     with pytest.raises(OrthoError, match="not georeferenced"):
-        build_orthophoto_workspace(ws, dsm_path=scene[3])
+        build_orthophoto_workspace(ws, OrthoOptions(dsm_path=scene[3]))
 
 
 class _CancelAfter(NullProgress):
@@ -499,8 +499,7 @@ def test_cancel_leaves_no_mosaic(scene, tmp_path):
     block, _root, images, dsm, _ws = scene
     ws = make_workspace(str(tmp_path / "ws"), block, images, names=["S2_02.jpg", "S2_03.jpg", "S2_04.jpg"])
     with pytest.raises(Cancelled):
-        build_orthophoto_workspace(ws, dsm_path=dsm, resolution=0.2,
-                                         options=OrthoOptions(tile=64), progress=_CancelAfter(2))
+        build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm, resolution=0.2, tile=64), progress=_CancelAfter(2))
     assert Workspace.open(ws).stage("orthophoto")["status"] == "cancelled"
     assert not [n for n in os.listdir(ws) if n.endswith(".tif") or n.startswith(".")]
 

@@ -49,8 +49,8 @@ def mosaics(tmp_path_factory):
     ws = make_workspace(str(root / "ws"), block, images)
     out = {}
     for on in (False, True):
-        out[on] = build_orthophoto_workspace(ws, dsm_path=dsm, output=str(root / f"mosaic_{int(on)}.tif"),
-                                             options=OrthoOptions(radiometry=on))
+        out[on] = build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm, output=str(root / f"mosaic_{int(on)}.tif"),
+                                                              radiometry=on))
     return block, out
 
 

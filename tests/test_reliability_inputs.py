@@ -250,14 +250,15 @@ def test_gap_filling_of_a_projected_dsm_in_feet_uses_metres(tmp_path):
 def test_a_dsm_beside_the_images_is_named_not_its_gap_filled_work_copy(tmp_path):
     from core.ortho.cameras import OrthoCamera
     from core.ortho.mosaic import build_orthomosaic
-    from core.ortho.options import OrthoError
+    from core.ortho.options import OrthoError, OrthoOptions
 
     dsm = tmp_path / "my dsm.tif"
     _gappy_dsm(dsm, "EPSG:32632", (1.0, 1.0), (700000.0, 5300000.0))  # has gaps: a filled work copy is made
     cam = OrthoCamera("IMG_1.JPG", str(tmp_path / "IMG_1.JPG"), cm.Intrinsics.simple(800, 600, 650.0),
                       cm.Pose.from_centre(cm.rotation_from_opk(0, 0, 0), [0.0, 0.0, 50.0]))
     with pytest.raises(OrthoError, match="does not cover the images") as e:
-        build_orthomosaic([cam], str(dsm), "EPSG:32632", [0.0, 0.0, 0.0], str(tmp_path / "out" / "mosaic.tif"))
+        build_orthomosaic([cam], "EPSG:32632", [0.0, 0.0, 0.0],
+                          OrthoOptions(dsm_path=str(dsm), output=str(tmp_path / "out" / "mosaic.tif")))
     assert str(dsm) in str(e.value)
     assert ".ortho-work-" not in str(e.value) and "gaps-filled" not in str(e.value)
 
@@ -417,8 +418,8 @@ def test_a_too_fine_orthophoto_grid_names_the_orthophoto_not_a_dsm(tmp_path):
     cam = OrthoCamera("IMG_1.png", str(img), cm.Intrinsics.simple(800, 600, 650.0),
                       cm.Pose.from_centre(cm.rotation_from_opk(0, 0, 0), [0.0, 0.0, 150.0]))
     with pytest.raises(ArchaeoOrthoError) as e:
-        build_orthomosaic([cam], str(dsm), "EPSG:32632", [700120.0, 5299880.0, 0.0], str(tmp_path / "o" / "m.tif"),
-                          OrthoOptions(resolution=1e-4))
+        build_orthomosaic([cam], "EPSG:32632", [700120.0, 5299880.0, 0.0],
+                          OrthoOptions(dsm_path=str(dsm), output=str(tmp_path / "o" / "m.tif"), resolution=1e-4))
     msg = str(e.value)
     assert "orthophoto" in msg and "DSM" not in msg.split("too large")[0], msg
     assert "RESOLUTION" in msg

@@ -23,7 +23,7 @@ from core.geometry.crs import CRSError
 from core.io import raster as dsmmod
 from core.io.gcp import GCPError
 from core.io.images import ImageError, check_image, photo_fingerprint
-from core.ortho.options import OrthoError, SingleImageOptions
+from core.ortho.options import OrthoError, OrthoOptions, SingleImageOptions
 from core.ortho.single import orthorectify_image
 from core.ortho.stage import build_orthophoto_workspace
 from core.pipeline import Control, run_pipeline
@@ -152,13 +152,13 @@ def test_changed_photo_is_refused_by_the_dsm_and_the_orthophoto(block_ws, tmp_pa
     images = shutil.copytree(images0, str(tmp_path / "images"))
     ws = _workspace(block, images, str(tmp_path / "ws"))
     log = Log()
-    res = build_orthophoto_workspace(ws, dsm_path=dsm, progress=log)  # the photos as aligned: accepted
+    res = build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm), progress=log)  # the photos as aligned: accepted
     assert os.path.isfile(res.orthomosaic) and not any("fingerprints" in m for m in log.lines)
     sizes = {n: os.path.getsize(os.path.join(images, n)) for n in block.names}
     target, other = max(sizes, key=sizes.get), min(sizes, key=sizes.get)
     _same_size_replacement(os.path.join(images, target), os.path.join(images0, other), os.path.join(images, target))
     with pytest.raises(OrthoError, match="changed since the alignment") as err:
-        build_orthophoto_workspace(ws, dsm_path=dsm)
+        build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm))
     assert target in str(err.value) and other not in str(err.value) and "Align images" in str(err.value)
     with pytest.raises(DenseError, match="changed since the alignment") as err:
         build_dsm_workspace(ws)
@@ -170,7 +170,7 @@ def test_workspace_without_fingerprints_still_works_with_a_note(block_ws, tmp_pa
     block, _root, images, dsm = block_ws
     ws = _workspace(block, images, str(tmp_path / "ws"), fingerprints=False)
     log = Log()
-    res = build_orthophoto_workspace(ws, dsm_path=dsm, progress=log)
+    res = build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm), progress=log)
     assert os.path.isfile(res.orthomosaic)
     assert any("recorded no photo fingerprints" in m for m in log.lines)
 
@@ -185,7 +185,7 @@ def test_truncated_photo_of_an_old_workspace_is_refused(block_ws, tmp_path):
     data = open(path, "rb").read()
     open(path, "wb").write(data[: len(data) // 3])
     with pytest.raises(OrthoError, match=f"{name}: image data is corrupt or truncated"):
-        build_orthophoto_workspace(ws, dsm_path=dsm)
+        build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm))
 
 
 # ---------------------------------------------------------------------------

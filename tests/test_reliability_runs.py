@@ -418,6 +418,7 @@ def _cancel_dirs(ws):
 def test_killed_dsm_run_leaves_no_worker_reads_interrupted_and_is_cleaned(dsm_block, tmp_path):
     from core.dense import stage as dense
     from core.dense.options import DenseOptions
+    from core.ortho.options import OrthoOptions
     from core.ortho.stage import build_orthophoto_workspace
 
     ws = _fresh_ws(dsm_block, tmp_path)
@@ -449,7 +450,7 @@ def test_killed_dsm_run_leaves_no_worker_reads_interrupted_and_is_cleaned(dsm_bl
     with open(os.path.join(dead, "dsm-gaps-filled.tif"), "wb") as f:
         f.write(b"\0" * 1000)
     live = owned_tempdir(".ortho-work-", ws)
-    build_orthophoto_workspace(ws, resolution=0.5)
+    build_orthophoto_workspace(ws, OrthoOptions(resolution=0.5))
     assert not os.path.exists(dead) and os.path.isdir(live)
 
 

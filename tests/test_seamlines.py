@@ -45,9 +45,9 @@ def scene(tmp_path_factory):
 def auto(scene):
     """The automatic mosaic with its per-image orthophotos and seamlines (no gains: exact comparisons)."""
     _block, root, _images, dsm, ws = scene
-    return build_orthophoto_workspace(ws, dsm_path=dsm, output=os.path.join(root, "auto.tif"),
-                                      per_image_folder=os.path.join(root, "per"),
-                                      seamlines=os.path.join(root, "seamlines.gpkg"), options=OrthoOptions(**PLAIN))
+    return build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm, output=os.path.join(root, "auto.tif"),
+                                                       per_image_folder=os.path.join(root, "per"),
+                                                       seamlines=os.path.join(root, "seamlines.gpkg"), **PLAIN))
 
 
 def _per(result, name):
@@ -103,8 +103,8 @@ def test_no_nodata_where_the_dsm_and_an_image_cover_the_cell(scene, auto, tmp_pa
     assert "hidden from every image" in " ".join(auto.log_lines)
     # the same block with cells hidden from every image left nodata (the strict true orthophoto): the holes
     # beside the buildings and along their walls that the test counts
-    strict = build_orthophoto_workspace(ws, dsm_path=dsm, output=str(tmp_path / "strict.tif"),
-                                        options=OrthoOptions(fill_hidden=False, **PLAIN))
+    strict = build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm, output=str(tmp_path / "strict.tif"),
+                                                         fill_hidden=False, **PLAIN))
     s_arr, s_gt = _read(strict.orthomosaic)
     assert s_gt == gt
     s_holes = covered & (s_arr[-1] == 0)
@@ -217,9 +217,9 @@ def edit(scene, auto):
 def test_an_edited_polygon_forces_its_image(scene, auto, edit, tmp_path):
     _block, root, _images, dsm, ws = scene
     path, a_name, b_name, far, (r, c), gt = edit
-    res = build_orthophoto_workspace(ws, dsm_path=dsm, output=str(tmp_path / "edited.tif"),
-                                     seamlines=str(tmp_path / "seams-out.gpkg"),
-                                     options=OrthoOptions(seamlines_in=path, **PLAIN))
+    res = build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm, output=str(tmp_path / "edited.tif"),
+                                                      seamlines=str(tmp_path / "seams-out.gpkg"),
+                                                      seamlines_in=path, **PLAIN))
     log = "\n".join(res.log_lines)
     print("\n" + log)
     assert f"seamlines {path}" in log and "given to the image they name" in log
@@ -285,8 +285,8 @@ def test_bad_seamlines_name_the_file_and_the_problem(scene, tmp_path):
         assert path in str(e.value)
     # through the stage: refused before any work, the stage recorded failed with that message
     with pytest.raises(SeamlineError, match="did you mean"):
-        build_orthophoto_workspace(ws, dsm_path=dsm, output=str(tmp_path / "x.tif"),
-                                   options=OrthoOptions(seamlines_in=cases[1][0]))
+        build_orthophoto_workspace(ws, OrthoOptions(dsm_path=dsm, output=str(tmp_path / "x.tif"),
+                                                    seamlines_in=cases[1][0]))
     assert not os.path.exists(tmp_path / "x.tif")
     # a QGIS layer source with its layer name; an empty image leaves the polygon to the automatic seams
     path = _gpkg(tmp_path / "ok.gpkg", [("s1_02.JPG", sq), (None, sq)])

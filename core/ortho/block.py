@@ -32,13 +32,14 @@ class PreparedBlock:
     warnings: List[str]
 
 
-def prepare_block(cameras: Sequence[OrthoCamera], dsm: Dsm, offset: np.ndarray, resolution: float,
-                  workdir: str, occlusion: bool = True, height_tolerance: float = 0.0,
-                  progress: Optional[Progress] = None, gsd_factor: float = 0.0) -> PreparedBlock:
-    """Footprints, the output grid and per-image visibility tables; checks the DSM against the images.
-    ``gsd_factor`` > 0: each image is used only where its ground resolution is within that factor of its best
-    (its footprint trimmed, OrthoCamera.max_gsd set on a copy)."""
+def prepare_block(cameras: Sequence[OrthoCamera], dsm: Dsm, offset: np.ndarray, options: OrthoOptions,
+                  workdir: str, progress: Optional[Progress] = None) -> PreparedBlock:
+    """Footprints, the output grid (``options.resolution``) and per-image visibility tables (with
+    ``options.occlusion``, ``options.height_tolerance``); checks the DSM against the images.
+    ``options.gsd_factor`` > 0: each image is used only where its ground resolution is within that factor of its
+    best (its footprint trimmed, OrthoCamera.max_gsd set on a copy)."""
     progress = progress or NullProgress()
+    resolution, gsd_factor = options.resolution, options.gsd_factor
     warnings: List[str] = []
     offset = np.asarray(offset, dtype=float)
     if not cameras:
@@ -129,9 +130,9 @@ def prepare_block(cameras: Sequence[OrthoCamera], dsm: Dsm, offset: np.ndarray, 
         raise OrthoError(f"a {grid.width} x {grid.height} orthophoto at {res:g} is too large: choose a coarser "
                          "RESOLUTION or fewer images")
     # visibility tables
-    tol = height_tolerance if height_tolerance and height_tolerance > 0 else max(0.1, dsm.res)
+    tol = options.height_tolerance if options.height_tolerance > 0 else max(0.1, dsm.res)
     vis: List[Optional[Visibility]] = [None] * len(cams)
-    if occlusion:
+    if options.occlusion:
         _visibility_tables(cams, fps, offset, dsm, tol, workdir, vis, progress)
     return PreparedBlock(cams, metas, fps, vis, grid, gsd, (z_lo, z_hi), warnings)
 
@@ -186,19 +187,19 @@ def check_kind(metas: Sequence[ImageMeta], cams: Sequence[OrthoCamera]) -> Tuple
     return bands, dtype
 
 
-def write_camera_ortho(cam: OrthoCamera, meta: ImageMeta, vis: Optional[Visibility], fp: Footprint, dsm: Dsm,
-                       offset: np.ndarray, grid: dsmmod.Grid, crs: Optional[str], out_path: str,
+def write_camera_ortho(prep: PreparedBlock, i: int, dsm: Dsm, offset: np.ndarray, out_path: str,
                        options: OrthoOptions, progress: Optional[Progress] = None) -> Optional[Dict[str, Any]]:
-    """One image's true orthophoto on the cells of ``grid`` under its footprint, as a COG.  Returns the
-    sub-grid and valid fraction, or None when the image covers no cell."""
+    """The true orthophoto of the block's image ``i`` on the cells of its grid under its footprint, as a COG in
+    the DSM's working CRS.  Returns the sub-grid and valid fraction, or None when the image covers no cell."""
     progress = progress or NullProgress()
+    cam, meta, vis, fp, grid = prep.cameras[i], prep.metas[i], prep.visibility[i], prep.footprints[i], prep.grid
     sub = subgrid(grid, fp.bbox)
     if sub is None:
         return None
     r0, c0, h, w = sub
     g = dsmmod.Grid(grid.x0 + c0 * grid.resolution, grid.y0 - r0 * grid.resolution, grid.resolution, w, h)
     work = os.path.join(os.path.dirname(os.path.abspath(out_path)), ".work-" + os.path.basename(out_path))
-    writer = RasterWriter(work, w, h, meta.bands, meta.dtype, g.geotransform, crs)
+    writer = RasterWriter(work, w, h, meta.bands, meta.dtype, g.geotransform, dsm.crs)
     n_valid = 0
     try:
         tiles = grid_tiles(w, h, options.tile)

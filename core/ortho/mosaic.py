@@ -20,7 +20,7 @@ from ..io import raster as dsmmod
 from .block import PreparedBlock, check_kind, prepare_block, write_camera_ortho
 from .cameras import OrthoCamera
 from .grid import box_intersects, grid_tiles
-from .options import OrthoOptions
+from .options import OrthoError, OrthoOptions
 from .pixels import PHOTO_CACHE
 from .radiometry_fit import fit_radiometry
 from .seamlines import read_seamline_edits, write_seamlines
@@ -52,15 +52,17 @@ class MosaicResult:
     log_lines: List[str] = field(default_factory=list)
 
 
-def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Optional[str], offset: Sequence[float],
-                      output: str, options: Optional[OrthoOptions] = None, per_image_folder: Optional[str] = None,
-                      seamlines_path: Optional[str] = None, progress: Optional[Progress] = None) -> MosaicResult:
-    """The orthomosaic of ``cameras`` (poses in the local frame, world = local + ``offset``) on a DSM.
+def build_orthomosaic(cameras: Sequence[OrthoCamera], crs: Optional[str], offset: Sequence[float],
+                      options: OrthoOptions, progress: Optional[Progress] = None) -> MosaicResult:
+    """The orthomosaic of ``cameras`` (poses in the local frame, world = local + ``offset``) on the DSM
+    ``options.dsm_path``.
 
-    Writes a COG at ``output`` (atomically), optionally one true orthophoto per image into
-    ``per_image_folder`` and the which-image polygons into the GeoPackage ``seamlines_path``."""
-    options = options or OrthoOptions()
-    options.check()
+    Writes a COG at ``options.output`` (atomically), optionally one true orthophoto per image into
+    ``options.per_image_folder`` and the which-image polygons into the GeoPackage ``options.seamlines``."""
+    if not options.dsm_path or not options.output:
+        raise OrthoError("an orthomosaic needs a DSM and an output path (OrthoOptions.dsm_path and .output)")
+    dsm_path, output = options.dsm_path, options.output
+    per_image_folder, seamlines_path = options.per_image_folder, options.seamlines
     progress = progress or NullProgress()
     edits = read_seamline_edits(options.seamlines_in, [c.name for c in cameras], crs) if options.seamlines_in else None
     for note in edits.notes if edits is not None else []:
@@ -89,9 +91,7 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
     try:
         with gdal_cache(64):
             t0 = time.time()
-            prep = prepare_block(cameras, dsm, offset, options.resolution, workdir, options.occlusion,
-                                 options.height_tolerance, SubProgress(progress, 0.0, 0.12),
-                                 gsd_factor=options.gsd_factor)
+            prep = prepare_block(cameras, dsm, offset, options, workdir, SubProgress(progress, 0.0, 0.12))
             for w_ in prep.warnings:
                 progress.warning(w_)
             if dsm.reprojected:
@@ -117,7 +117,7 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
                 progress.info(note)
             model, summary = _radiometry(prep, dsm, offset, plan, options, log, timings, SubProgress(progress, 0.2, 0.25))
             t0 = time.time()
-            n_valid, fill_cells = _run_tiles(prep, plan, dsm_path, crs, offset, output, options, bands, dtype,
+            n_valid, fill_cells = _run_tiles(prep, plan, dsm, offset, options,
                                              SubProgress(progress, 0.25, 0.85 if per_image_folder else 0.97), model)
             timings["mosaic"] = time.time() - t0
             valid_fraction = n_valid / float(grid.width * grid.height)
@@ -130,10 +130,9 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], dsm_path: str, crs: Option
                 t0 = time.time()
                 os.makedirs(per_image_folder, exist_ok=True)
                 sp = SubProgress(progress, 0.85, 1.0)
-                for i, (cam, meta, fp, vis) in enumerate(zip(prep.cameras, prep.metas, prep.footprints,
-                                                             prep.visibility)):
+                for i, cam in enumerate(prep.cameras):
                     path = os.path.join(per_image_folder, os.path.splitext(os.path.basename(cam.name))[0] + ".tif")
-                    info = write_camera_ortho(cam, meta, vis, fp, dsm, offset, grid, crs, path, options,
+                    info = write_camera_ortho(prep, i, dsm, offset, path, options,
                                               SubProgress(sp, i / len(prep.cameras), (i + 1) / len(prep.cameras)))
                     if info:
                         per_image[cam.name] = path
@@ -175,9 +174,12 @@ def _radiometry(prep: PreparedBlock, dsm: Dsm, offset, plan: MosaicPlan, options
     return model, dict(model.summary)
 
 
-def _run_tiles(prep: PreparedBlock, plan: MosaicPlan, dsm_path: str, crs, offset, output: str, options: OrthoOptions,
-               bands: int, dtype: str, progress: Progress, radiometry=None) -> Tuple[int, int]:
-    grid = prep.grid
+def _run_tiles(prep: PreparedBlock, plan: MosaicPlan, dsm: Dsm, offset, options: OrthoOptions, progress: Progress,
+               radiometry=None) -> Tuple[int, int]:
+    """The mosaic's tiles (core.ortho.tiles.render_tile, on the workers) written into ``options.output``, from
+    the DSM file ``dsm.file`` in ``dsm.crs``; (valid cells, cells filled from another image)."""
+    grid, output, crs = prep.grid, options.output, dsm.crs
+    bands, dtype = check_kind(prep.metas, prep.cameras)
     work = os.path.join(os.path.dirname(os.path.abspath(output)), ".work-" + os.path.basename(output))
     writer = RasterWriter(work, grid.width, grid.height, bands, dtype, grid.geotransform, crs)
     halo = 0
@@ -199,7 +201,7 @@ def _run_tiles(prep: PreparedBlock, plan: MosaicPlan, dsm_path: str, crs, offset
                                              prep.cameras[j].centre[1] + offset[1] - cy))
         if not present and not others:
             continue
-        units.append(TileUnit(i, r0, c0, h, w, halo, asdict(grid), dsm_path, crs, [float(v) for v in offset],
+        units.append(TileUnit(i, r0, c0, h, w, halo, asdict(grid), dsm.file, crs, [float(v) for v in offset],
                                prep.cameras, prep.metas, prep.visibility, present, others, plan.gains,
                                plan.labels_path, k, (plan.height, plan.width), plan.feather_cells, options.blending,
                                options.interpolation, options.cache_mb, radiometry, fill_hidden=options.fill_hidden))

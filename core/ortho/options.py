@@ -21,8 +21,15 @@ MODES = ("ortho", "planar")
 
 @dataclass
 class OrthoOptions:
-    """Options of the orthophoto stage (one dataclass, as OpenSfM's config)."""
+    """Options of the orthophoto stage (one dataclass, as OpenSfM's config): its inputs and outputs, and how the
+    mosaic is made.  Checked when made (OrthoError naming the setting)."""
 
+    dsm_path: Optional[str] = None  # the DSM; None = the workspace's (the DSM stage's output, else <workspace>/dsm.tif)
+    # which oriented images (core.ortho.cameras.select_cameras: names, globs, !exclusions, group:<camera>); None = all
+    images_filter: Optional[str] = None
+    output: Optional[str] = None  # the orthomosaic (a COG); None = <workspace>/orthomosaic.tif
+    per_image_folder: Optional[str] = None  # one true orthophoto per image written there; None = none
+    seamlines: Optional[str] = None  # the which-image polygons written to this GeoPackage; None = none
     resolution: float = 0.0  # output cell size in CRS units; 0 = the images' median ground sample distance
     blending: str = "feather"  # feather / multiband / none
     interpolation: str = "bilinear"  # bilinear / cubic / nearest
@@ -57,6 +64,12 @@ class OrthoOptions:
     cache_mb: int = 768
     workers: int = 1  # tile workers (core.parallel); 0 = one per core
     scheduler: Optional[str] = None  # Dask scheduler address
+
+    def __post_init__(self) -> None:
+        self.blending = (self.blending or "").lower()
+        if isinstance(self.resolution, (int, float)):
+            self.resolution = float(self.resolution)
+        self.check()
 
     def check(self) -> None:
         if self.blending not in BLENDINGS:

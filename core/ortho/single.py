@@ -376,12 +376,11 @@ def _rectify(result: SingleImageResult, ocam: OrthoCamera, run: ImageRun, ctl: I
             if dsm is not None and dsm.reprojected:
                 run.info(f"DSM {dsm_path} reprojected on the fly into the working CRS")
             if mode == "ortho":
-                prep = prepare_block([ocam], dsm, offset, options.resolution, workdir, options.occlusion,
-                                     options.height_tolerance, SubProgress(progress, 0.1, 0.3))
+                prep = prepare_block([ocam], dsm, offset, replace(options, gsd_factor=0.0), workdir,
+                                     SubProgress(progress, 0.1, 0.3))
                 for w_ in prep.warnings:
                     run.warn(w_)
-                info = write_camera_ortho(ocam, prep.metas[0], prep.visibility[0], prep.footprints[0], dsm, offset,
-                                          prep.grid, work_crs, result.output, options,
+                info = write_camera_ortho(prep, 0, dsm, offset, result.output, options,
                                           SubProgress(progress, 0.3, 1.0))
                 if info is None:
                     raise OrthoError(f"the DSM does not cover the ground seen by {name}")

@@ -22,6 +22,10 @@ from .options import OrthoError, OrthoOptions
 from .seamlines import edits_fingerprint, read_seamline_edits
 
 STAGE = ORTHOPHOTO
+# options left out of the stage's recorded parameters: how it runs (not what it makes), and the paths the
+# parameters record under their own names
+_NOT_RECORDED = ("workers", "scheduler", "cache_mb", "dsm_path", "images_filter", "output", "per_image_folder",
+                 "seamlines")
 
 
 @dataclass
@@ -45,59 +49,45 @@ def workspace_dsm(ws: Workspace) -> Optional[str]:
     return Layout(ws).dsm()
 
 
-def build_orthophoto_workspace(workspace_dir: str, dsm_path: Optional[str] = None, images_filter: Optional[str] = None,
-                               resolution: Optional[float] = None, blending: Optional[str] = None,
-                               output: Optional[str] = None,
-                               per_image_folder: Optional[str] = None, seamlines: Optional[str] = None,
-                               options: Optional[OrthoOptions] = None,
+def build_orthophoto_workspace(workspace_dir: str, options: Optional[OrthoOptions] = None,
                                progress: Optional[Progress] = None) -> OrthoStageResult:
     """The orthophoto stage of a georeferenced workspace: orthomosaic (default <workspace>/orthomosaic.tif),
-    optional per-image true orthophotos and the which-image layer.  Records the stage in workspace.json.
+    optional per-image true orthophotos and the which-image layer, as the options say (they are the settings:
+    the DSM, the images filter and the outputs included).  Records the stage in workspace.json.
 
-    ``resolution`` / ``blending`` None: the options' (the options are the settings; a keyword given wins).
-    ``options`` is not modified (RESOLUTION and BLENDING go into a copy).
+    ``options`` is not modified (the paths resolved go into a copy).
     Raises OrthoError (bad input), WorkspaceError, Cancelled."""
     progress = progress or NullProgress()
-    options = options or OrthoOptions()
-    options = replace(options, resolution=float(options.resolution if resolution is None else resolution or 0.0),
-                      blending=(blending or options.blending).lower())
-    options.check()
     lay = Layout(Workspace.open(workspace_dir))
-    dsm_path, crs, offset, cams = _inputs(lay, dsm_path, images_filter)
+    options, crs, offset, cams = _inputs(lay, options or OrthoOptions())
     for note in _check_photos(lay.ws, cams):
         progress.info(note)
-    output = os.path.abspath(output) if output else lay.default_orthomosaic
-    per_image_folder = os.path.abspath(per_image_folder) if per_image_folder else None
-    seamlines = os.path.abspath(seamlines) if seamlines else None
-    params = {"dsm": dsm_path, "images_filter": images_filter or "", "resolution": options.resolution,
-              "blending": options.blending, "output": output, "per_image_folder": per_image_folder,
-              "seamlines": seamlines, "options": {k: v for k, v in asdict(options).items()
-                                                  if k not in ("workers", "scheduler", "cache_mb")}}
-    inputs = {"dsm": file_fingerprint(dsm_path), "images": fingerprint(sorted(c.name for c in cams)),
+    params = {"dsm": options.dsm_path, "images_filter": options.images_filter or "", "resolution": options.resolution,
+              "blending": options.blending, "output": options.output, "per_image_folder": options.per_image_folder,
+              "seamlines": options.seamlines, "options": {k: v for k, v in asdict(options).items()
+                                                          if k not in _NOT_RECORDED}}
+    inputs = {"dsm": file_fingerprint(options.dsm_path), "images": fingerprint(sorted(c.name for c in cams)),
               **lay.model_fingerprints()}
     if options.seamlines_in:  # edited seamlines (SEAMLINES_IN): a changed file re-runs the stage
         inputs["seamlines_in"] = edits_fingerprint(options.seamlines_in)
     with run_stage(lay.ws, STAGE, params, inputs) as run:
         if options.seamlines_in:  # before any work: a polygon naming an image the filter leaves out is named so
             read_seamline_edits(options.seamlines_in, [c.name for c in cams], crs, left_out=_left_out(lay, cams),
-                                images_filter=images_filter, extent=_extent(dsm_path, crs))
-        for debris in clean_debris(os.path.dirname(output), WORK_PREFIX):
+                                images_filter=options.images_filter, extent=_extent(options.dsm_path, crs))
+        for debris in clean_debris(os.path.dirname(options.output), WORK_PREFIX):
             progress.info(f"removed {debris}, left by a killed run")
-        result = build_orthomosaic(cams, dsm_path, crs, offset, output, options, per_image_folder, seamlines, progress)
+        result = build_orthomosaic(cams, crs, offset, options, progress)
         for k_, v in result.timings.items():
             if k_ != "total":
                 lay.ws.record_timing(STAGE, k_, v)
-        outputs = {"orthomosaic": lay.rel(output)}
-        if per_image_folder:
-            outputs["per_image_folder"] = lay.rel(per_image_folder)
-        if seamlines:
-            outputs["seamlines"] = lay.rel(seamlines)
+        outputs = {key: lay.rel(path) for key, path in (("orthomosaic", options.output), ("per_image_folder",
+                   options.per_image_folder), ("seamlines", options.seamlines)) if path}
         run.finish(outputs=outputs, results={
             "resolution": result.resolution, "gsd": result.gsd, "width": result.width, "height": result.height,
             "images": len(result.images), "valid_fraction": result.valid_fraction, "warnings": result.warnings})
-    return OrthoStageResult(lay.root, output, crs, result.resolution, result.images, result.valid_fraction,
-                            per_image_folder, seamlines, result.timings, result.warnings, result.log_lines,
-                            result.radiometry)
+    return OrthoStageResult(lay.root, options.output, crs, result.resolution, result.images, result.valid_fraction,
+                            options.per_image_folder, options.seamlines, result.timings, result.warnings,
+                            result.log_lines, result.radiometry)
 
 
 def _extent(dsm_path: str, crs: Optional[str]) -> Optional[Tuple[float, float, float, float]]:
@@ -132,25 +122,29 @@ def _check_photos(ws: Workspace, cams: List[OrthoCamera]) -> List[str]:
         raise OrthoError(str(e)) from e
 
 
-def _inputs(lay: Layout, dsm_path: Optional[str], images_filter: Optional[str]
-            ) -> Tuple[str, Optional[str], np.ndarray, List[OrthoCamera]]:
-    """(DSM path, CRS, local frame offset, the chosen cameras) of a georeferenced workspace; OrthoError if unusable."""
+def _inputs(lay: Layout, options: OrthoOptions
+            ) -> Tuple[OrthoOptions, Optional[str], np.ndarray, List[OrthoCamera]]:
+    """(the options with the DSM and output paths resolved and absolute, CRS, local frame offset, the chosen
+    cameras) of a georeferenced workspace; OrthoError if unusable."""
     ws = lay.ws
     try:
         lay.require_georeferenced("an orthophoto needs the images in a map CRS")
     except LayoutError as e:
         raise OrthoError(str(e)) from e
-    dsm_path = os.path.abspath(dsm_path) if dsm_path else lay.dsm()
+    dsm_path = os.path.abspath(options.dsm_path) if options.dsm_path else lay.dsm()
     if not dsm_path:
         raise OrthoError(f"workspace {ws.root} has no DSM: run 'Build DSM' first or give a DSM raster")
     if not os.path.isfile(dsm_path):
         raise OrthoError(f"DSM {dsm_path} does not exist")
     rec, frame = lay.load_georef_model()
-    offset = frame.offset
-    crs = frame.crs or ws.crs
     cams = cameras_from_reconstruction(rec, ws.data.get("images_dir") or "", lay.masks_dir)
     if not cams:
         raise OrthoError(f"the model of {ws.root} has no oriented image")
-    cams = select_cameras(cams, images_filter, ws.data.get("camera_groups", []))
-    return dsm_path, crs, offset, cams
+    cams = select_cameras(cams, options.images_filter, ws.data.get("camera_groups", []))
+    options = replace(options, dsm_path=dsm_path, output=_absolute(options.output) or lay.default_orthomosaic,
+                      per_image_folder=_absolute(options.per_image_folder), seamlines=_absolute(options.seamlines))
+    return options, frame.crs or ws.crs, frame.offset, cams
 
+
+def _absolute(path: Optional[str]) -> Optional[str]:
+    return os.path.abspath(path) if path else None
