@@ -36,10 +36,10 @@ coarser multiple beyond that), and at most ``MAX_FIT_CELLS`` cells (a fixed rand
 memory is a few copies of the coarse grid, never of the full-resolution DSM (``coregister_rasters`` warps it from
 the file).
 
-Entry points: :func:`coregister_dems` (:class:`HeightGrid`: arrays + GDAL geotransforms), :func:`coregister_rasters` (two files: CRS,
-linear and vertical units, nodata), :func:`coregister_points` (the sparse cloud against a reference DEM, sampled
-bilinearly; :func:`coregister_points_file` reads the reference over the points only, reprojected into the points'
-CRS: :func:`reference_window`), :func:`control_points_from_coregistration` (well-distributed pseudo control
+Entry points: :func:`coregister_dems` (two :class:`HeightGrid`: arrays + GDAL geotransforms),
+:func:`coregister_rasters` (two files: CRS, linear and vertical units, nodata), :func:`coregister_points` (the
+sparse cloud against a reference DEM, sampled bilinearly; :func:`coregister_points_file` reads the reference over
+the points only, reprojected into the points' CRS: :func:`reference_window`), :func:`control_points_from_coregistration` (well-distributed pseudo control
 points on flat, stable, well-measured cells, for the adjustment).  Bad input is a :class:`CoregError` naming the
 raster.
 
@@ -957,5 +957,5 @@ def control_points_from_coregistration(result: CoregResult, ref: HeightGrid, *, 
                          zr[pick]]), np.full(pick.size, sxy), sz, None if index is None else index[pick])
 
 
-__all__ = ["CoregError", "CoregOptions", "CoregResult", "HeightGrid", "PseudoControl", "control_points_from_coregistration", "coregister_dems",
-           "coregister_points", "coregister_points_file", "coregister_rasters", "nmad", "reference_window", "shorth"]
+__all__ = ["CoregError", "CoregOptions", "CoregResult", "HeightGrid", "PseudoControl",
+           "control_points_from_coregistration", "coregister_dems", "coregister_points", "coregister_points_file", "coregister_rasters", "nmad", "reference_window", "shorth"]

@@ -56,7 +56,7 @@ import numpy as np
 from ..common.errors import ArchaeoOrthoError
 from ..common.progress import NullProgress, Progress
 from ..io.gcp import CONTROL, CameraPosition, GCPSet, GroundPoint, Observation
-from ..io.raster import bilinear
+from ..io.raster import RasterError, RasterFile, bilinear
 from .coregister import (
     DEM_MARGIN_CELLS,
     MIN_CELLS,
@@ -166,30 +166,39 @@ def _window(xyz: np.ndarray, ref_path: str, crs: str) -> Tuple[np.ndarray, Tuple
 def _coarsened(ref_path: str, lo: np.ndarray, hi: np.ndarray, crs: str, out: str) -> Tuple[str, str]:
     """(``ref_path``, '') when the box holds at most MAX_WINDOW_CELLS of the reference's cells, else (a warped VRT
     ``out`` averaging the reference onto a grid k times coarser over the box, in its own CRS and units, a message)."""
+    try:
+        raster = RasterFile(os.path.abspath(ref_path), "reference DEM")
+    except RasterError:
+        return ref_path, ""  # reference_window names what is wrong with it
+    with raster:
+        return _coarsened_raster(raster, ref_path, lo, hi, crs, out)
+
+
+def _coarsened_raster(raster: RasterFile, ref_path: str, lo: np.ndarray, hi: np.ndarray, crs: str, out: str
+                      ) -> Tuple[str, str]:
+    """:func:`_coarsened` on the open reference."""
     from osgeo import gdal
 
     from ..geometry.crs import transform_points
 
-    ds = gdal.Open(os.path.abspath(ref_path)) if os.path.isfile(ref_path) else None
-    wkt = ds.GetProjection() if ds is not None else ""
-    if not wkt:
+    wkt, gt = raster.crs_wkt, raster.geotransform
+    if not wkt or gt is None:
         return ref_path, ""  # reference_window names what is wrong with it
     corners = np.array([[lo[0], lo[1], 0.0], [hi[0], lo[1], 0.0], [lo[0], hi[1], 0.0], [hi[0], hi[1], 0.0]])
     try:
         c = transform_points(corners, crs, wkt)
     except ArchaeoOrthoError:
         return ref_path, ""
-    gt = ds.GetGeoTransform()
     cell = abs(gt[1])
     cells = (np.ptp(c[:, 0]) / cell + 2 * DEM_MARGIN_CELLS) * (np.ptp(c[:, 1]) / abs(gt[5]) + 2 * DEM_MARGIN_CELLS)
     if cells <= MAX_WINDOW_CELLS:
         return ref_path, ""
     k = int(math.ceil(math.sqrt(cells / MAX_WINDOW_CELLS)))
     m = DEM_MARGIN_CELLS * cell * k
-    band = ds.GetRasterBand(1)
+    band = raster.band(1)
     nodata = band.GetNoDataValue()
-    warped = gdal.Warp(out, ds, format="VRT", outputBounds=(c[:, 0].min() - m, c[:, 1].min() - m, c[:, 0].max() + m,
-                                                             c[:, 1].max() + m),
+    bounds = (c[:, 0].min() - m, c[:, 1].min() - m, c[:, 0].max() + m, c[:, 1].max() + m)
+    warped = gdal.Warp(out, raster.dataset, format="VRT", outputBounds=bounds,
                        xRes=cell * k, yRes=abs(gt[5]) * k, resampleAlg="average", outputType=gdal.GDT_Float32,
                        srcNodata=nodata, dstNodata=nodata if nodata is not None else -9999.0)
     if warped is None:  # read it whole as before
@@ -255,10 +264,10 @@ def _short(crs: str) -> str:
 
 def vertical_datum(ref_path: str) -> str:
     """The reference's vertical CRS as its file states it, else ''."""
-    from osgeo import gdal, osr
+    from osgeo import osr
 
-    ds = gdal.Open(ref_path)
-    wkt = ds.GetProjection() if ds is not None else ""
+    with RasterFile(ref_path, "reference DEM") as raster:
+        wkt = raster.crs_wkt
     if not wkt:
         return ""
     srs = osr.SpatialReference(wkt=wkt)
