@@ -118,10 +118,11 @@ def test_single_photo_is_oriented_and_orthorectified_by_automatic_control(setup,
     out = str(tmp_path / "ortho.tif")
     res_path = str(tmp_path / "res.gpkg")
     t0 = time.time()
-    r = orthorectify_image(SingleImageOptions(photos[name], out, dsm, reference_ortho=ortho,
-                                              location=_rough_location(ground, 60.0), search_radius=30.0,
-                                              focal_px=focal, ortho=OrthoOptions(resolution=OUT_GSD),
-                                              residuals_path=res_path, control=FAST))
+    options = SingleImageOptions(photos[name], out, dsm, reference_ortho=ortho, location=_rough_location(ground, 60.0),
+                                 search_radius=30.0, focal_px=focal, ortho=OrthoOptions(resolution=OUT_GSD),
+                                 residuals_path=res_path, control=FAST)
+    r = orthorectify_image(options)
+    assert options.camera is None and options.crs is None  # what the automatic control found went into a copy
     seconds = time.time() - t0
     centre = np.array([r.orientation[k] for k in "xyz"])
     err = float(np.linalg.norm(centre - (shot.centre + syn.ORIGIN)))
@@ -142,6 +143,22 @@ def test_single_photo_is_oriented_and_orthorectified_by_automatic_control(setup,
           f"{np.max(np.hypot(*shifts.T)):.2f}")
     assert len(shifts) >= 8
     assert rmse <= 1.5
+
+
+def test_single_image_options_refuse_a_bad_combination_when_made(tmp_path):
+    """The checks that need no file run when the options are made (Processing refuses before any work)."""
+    photo, out = str(tmp_path / "p.jpg"), str(tmp_path / "o.tif")
+    with pytest.raises(OrthoError, match="unknown MODE 'oblique'"):
+        SingleImageOptions(photo, out, "dsm.tif", orientation={}, mode="oblique")
+    with pytest.raises(OrthoError, match=r"GCPS\), its orientation \(ORIENTATION\), or a reference orthophoto"):
+        SingleImageOptions(photo, out, "dsm.tif")
+    with pytest.raises(OrthoError, match="ref.tif needs the reference DSM too"):
+        SingleImageOptions(photo, out, None, reference_ortho="ref.tif")
+    with pytest.raises(OrthoError, match="planar rectification needs at least 4 ground control points"):
+        SingleImageOptions(photo, out, "dsm.tif", orientation={}, mode="planar")
+    with pytest.raises(OrthoError, match="RESOLUTION must be 0"):
+        SingleImageOptions(photo, out, "dsm.tif", orientation={}, ortho=OrthoOptions(resolution=-1.0))
+    assert SingleImageOptions(photo, out, None, gcps="g.csv", mode="PLANAR").mode == "planar"
 
 
 def test_a_location_far_off_is_refused_naming_the_photo_and_the_reference(setup, tmp_path):
