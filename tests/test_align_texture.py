@@ -132,6 +132,10 @@ def test_coverage_and_the_decision():
     assert fp.decide([r(4000), r(100)], 6) is None  # not yet known
     assert fp.decide([r(4000), r(4000, 0.2)], 6) is None  # features in one corner only: starved
     assert fp.decide([r(4000)] * 5 + [r(100)], 6) is True
+    sparse = fp.ProbeResult("x", "default", 200, 4096, 0.9, "y", 20)  # few features, few verified matches
+    assert sparse.starved
+    sparse.matches = 2 * 30  # few features, but they match its neighbour (twice COLMAP's registration minimum)
+    assert not sparse.starved
 
 
 def test_the_database_key_follows_the_choice(tmp_path):

@@ -8,8 +8,11 @@ rematches nearly the whole block -- most of the alignment's time. :func:`choose_
 SIFT, at the settings of each level in turn, on up to PROBE_PHOTOS photos spread over the block (the same ones each
 run) and measures per photo its **yield** (features found / the level's budget) and **coverage** (the share of the
 cells of a PROBE_GRID grid over the frame holding at least a quarter of their even share of the features found). A
-photo with a yield under PROBE_MIN_YIELD or a coverage under PROBE_MIN_COVERAGE is starved; the first level at
-which at most PROBE_STARVED_SHARE of the probed photos starve is the first pass's (the last level otherwise):
+photo with a yield under PROBE_MIN_YIELD or a coverage under PROBE_MIN_COVERAGE is matched with its neighbour (the
+next photo in file order) as COLMAP would (ratio test, mutual best, a RANSAC fundamental matrix): it is starved
+when fewer than PROBE_MIN_MATCHES matches verify (few features that match are enough: the synthetic farmland at
+contrast 0.4 registers every photo with ~230 features each). The first level at which at most
+PROBE_STARVED_SHARE of the probed photos starve is the first pass's (the last level otherwise, without a probe):
 
 1. ``default`` -- today's settings (where textured photos stay: the probe is then the only cost);
 2. ``faint`` -- the same scale, FAINT_MIN_FEATURES features and a third of SIFT's peak threshold
@@ -41,6 +44,7 @@ from .options import (
     FAINT_PEAK_THRESHOLD,
     PROBE_GRID,
     PROBE_MIN_COVERAGE,
+    PROBE_MIN_MATCHES,
     PROBE_MIN_YIELD,
     PROBE_PHOTOS,
     PROBE_STARVED_SHARE,
@@ -61,6 +65,8 @@ class ProbeResult:
     found: int
     budget: int
     coverage: float
+    neighbour: Optional[str] = None  # the photo matched with it (a photo short of features or coverage)
+    matches: Optional[int] = None  # verified matches with ``neighbour``
 
     @property
     def yield_(self) -> float:
@@ -68,7 +74,11 @@ class ProbeResult:
 
     @property
     def starved(self) -> bool:
-        return self.yield_ < PROBE_MIN_YIELD or self.coverage < PROBE_MIN_COVERAGE
+        """Short of features or coverage, and (where it was matched) fewer verified matches with its neighbour
+        than PROBE_MIN_MATCHES."""
+        if _rich(self.found, self.coverage, self.budget):
+            return False
+        return self.matches is None or self.matches < PROBE_MIN_MATCHES
 
     def to_dict(self) -> dict:
         return {**asdict(self), "yield": round(self.yield_, 3), "coverage": round(self.coverage, 3),
@@ -161,9 +171,9 @@ def coverage(xy: np.ndarray, width: int, height: int, cells: int = PROBE_GRID) -
     return float(np.mean(counts >= 0.25 * len(xy) / (nx * ny)))
 
 
-def sift_keypoints(pycolmap, grey: np.ndarray, settings: FeatureSettings) -> np.ndarray:
+def sift_features(pycolmap, grey: np.ndarray, settings: FeatureSettings) -> Tuple[np.ndarray, np.ndarray]:
     """pycolmap's SIFT with ``settings`` on the 8-bit image ``grey`` (already at the settings' size): (n, 2)
-    keypoint positions in its pixels."""
+    keypoint positions in its pixels, (n, 128) descriptors."""
     eo = pycolmap.FeatureExtractionOptions()
     eo.num_threads = 1
     eo.max_image_size = max(grey.shape)
@@ -172,31 +182,86 @@ def sift_keypoints(pycolmap, grey: np.ndarray, settings: FeatureSettings) -> np.
     if settings.peak_threshold is not None:
         eo.sift.peak_threshold = float(settings.peak_threshold)
     extractor = pycolmap.FeatureExtractor.create(eo, pycolmap.Device.cpu)
-    keypoints, _descriptors = extractor.extract_from_uint8_array(np.ascontiguousarray(grey))
-    return np.array([(k.x, k.y) for k in keypoints], dtype=np.float64).reshape(-1, 2)
+    keypoints, descriptors = extractor.extract_from_uint8_array(np.ascontiguousarray(grey))
+    xy = np.array([(k.x, k.y) for k in keypoints], dtype=np.float64).reshape(-1, 2)
+    desc = np.asarray(descriptors.data, dtype=np.float32)
+    return xy, (desc.reshape(len(xy), -1) if len(xy) else np.zeros((0, 128), np.float32))
 
 
-def probe(pycolmap, grey: np.ndarray, settings: FeatureSettings, name: str = "", level: str = "") -> ProbeResult:
-    """Yield and coverage of one photo (``grey``, at any size: scaled to the settings') at ``settings``.  An
-    upsampled setting (first octave -1) is tried at octave 0 first: the upsampled octave only adds features to
-    those (COLMAP keeps the coarsest within the budget), so a photo not starved without it is not starved with
-    it, at a fifth of the cost (an 800 x 600 frame: 0.3 s instead of 1.4 s)."""
-    img = shrink(grey, settings.image_size)
-    tries = [settings]
+def verified_matches(a: Tuple[np.ndarray, np.ndarray], b: Tuple[np.ndarray, np.ndarray]) -> int:
+    """The matches of two photos' features (``(xy, descriptors)``) that a fundamental matrix verifies, as COLMAP
+    counts them: mutual nearest neighbours passing the ratio test (0.8), RANSAC with 4 px."""
+    (xa, da), (xb, db) = a, b
+    if len(xa) < 8 or len(xb) < 8:
+        return 0
+    matcher = cv2.BFMatcher(cv2.NORM_L2)
+    ab = matcher.knnMatch(da, db, k=2)
+    ba = {m[0].queryIdx: m[0].trainIdx for m in matcher.knnMatch(db, da, k=1) if m}
+    pairs = [(m[0].queryIdx, m[0].trainIdx) for m in ab
+             if len(m) == 2 and m[0].distance < 0.8 * m[1].distance and ba.get(m[0].trainIdx) == m[0].queryIdx]
+    if len(pairs) < 8:
+        return 0
+    ia, ib = np.array(pairs).T
+    _f, mask = cv2.findFundamentalMat(xa[ia], xb[ib], cv2.FM_RANSAC, 4.0, 0.999)
+    return int(mask.sum()) if mask is not None else 0
+
+
+class _Photos:
+    """The probe photos' grey images (read once, at the largest size a probed level needs) and their features
+    per level."""
+
+    def __init__(self, pycolmap, infos: Sequence[ImageInfo], long_side: int):
+        self.pycolmap = pycolmap
+        self.by_name = {im.name: im for im in infos}
+        self.long_side = long_side
+        self.grey: Dict[str, Optional[np.ndarray]] = {}
+        self.features: Dict[Tuple[str, str], Tuple[np.ndarray, np.ndarray, Tuple[int, int]]] = {}
+
+    def image(self, name: str) -> Optional[np.ndarray]:
+        if name not in self.grey:
+            im = self.by_name[name]
+            self.grey[name] = read_grey(im.path, max(im.width, im.height), self.long_side)
+        return self.grey[name]
+
+    def sift(self, name: str, level: str, settings: FeatureSettings):
+        """(xy, descriptors, (width, height) of the image SIFT ran on) of photo ``name`` at ``settings``."""
+        if (name, level) not in self.features:
+            img = shrink(self.image(name), settings.image_size)
+            xy, desc = sift_features(self.pycolmap, img, settings)
+            self.features[(name, level)] = (xy, desc, (img.shape[1], img.shape[0]))
+        return self.features[(name, level)]
+
+
+def _rich(found: int, cover: float, budget: int) -> bool:
+    return found >= PROBE_MIN_YIELD * budget and cover >= PROBE_MIN_COVERAGE
+
+
+def probe(photos: _Photos, name: str, neighbour: Optional[str], settings: FeatureSettings,
+          level: str) -> ProbeResult:
+    """Yield, coverage and (for a photo short of either) verified matches with its ``neighbour`` at ``settings``.
+    An upsampled setting (first octave -1) is tried at octave 0 first: the upsampled octave only adds features to
+    those (COLMAP keeps the coarsest within the budget), so a photo rich without it is rich with it, at a fifth of
+    the cost (an 800 x 600 frame: 0.3 s instead of 1.4 s)."""
+    tries = [(level, settings)]
     if settings.first_octave < 0:
-        tries.insert(0, FeatureSettings(settings.image_size, settings.max_features, 0, settings.peak_threshold))
-    for s in tries:
-        xy = sift_keypoints(pycolmap, img, s)
-        result = ProbeResult(name, level, len(xy), int(s.max_features), coverage(xy, img.shape[1], img.shape[0]))
-        if not result.starved:
-            break
+        tries.insert(0, (level + "@0", FeatureSettings(settings.image_size, settings.max_features, 0,
+                                                       settings.peak_threshold)))
+    for key, s in tries:
+        xy, desc, (w, h) = photos.sift(name, key, s)
+        result = ProbeResult(name, level, len(xy), int(s.max_features), coverage(xy, w, h))
+        if _rich(result.found, result.coverage, result.budget):
+            return result
+    if neighbour is not None and photos.image(neighbour) is not None:
+        other = photos.sift(neighbour, key, s)
+        result.neighbour = neighbour
+        result.matches = verified_matches((xy, desc), other[:2])
     return result
 
 
 def decide(results: Sequence[ProbeResult], total: int) -> Optional[bool]:
     """Whether a level is good enough from the ``results`` so far of ``total`` photos to probe: False as soon as
     more than PROBE_STARVED_SHARE of them starved, True when all are probed and no more starved or when the first
-    half of them starved none (textured photos: the rest is not probed), None while undecided."""
+    half of them starved none (the rest is not probed), None while undecided."""
     starved = sum(1 for r in results if r.starved)
     if starved > PROBE_STARVED_SHARE * total:
         return False
@@ -214,11 +279,25 @@ def probe_order(names: Sequence[str]) -> List[str]:
     return first + [n for n in names if n not in first]
 
 
+def neighbours(names: Sequence[str], picked: Sequence[str]) -> Dict[str, Optional[str]]:
+    """Each picked photo's neighbour: the next photo in ``names`` (file order: the order of a flight), the one
+    before for the last."""
+    index = {n: k for k, n in enumerate(names)}
+    out: Dict[str, Optional[str]] = {}
+    for n in picked:
+        k = index[n]
+        out[n] = names[k + 1] if k + 1 < len(names) else (names[k - 1] if k > 0 else None)
+    return out
+
+
 def _summary(level: str, results: Sequence[ProbeResult]) -> str:
     starved = sum(1 for r in results if r.starved)
     y = np.median([r.yield_ for r in results])
     c = np.median([r.coverage for r in results])
-    return f"{level}: {starved} of {len(results)} probed photos starved (median yield {y:.2f}, coverage {c:.2f})"
+    matched = [r.matches for r in results if r.matches is not None]
+    m = f", verified matches with a neighbour {int(np.median(matched))}" if matched else ""
+    return (f"{level}: {starved} of {len(results)} probed photos starved (median yield {y:.2f}, coverage {c:.2f}"
+            f"{m})")
 
 
 def choose_first_pass(pycolmap, infos: Sequence[ImageInfo], options: AlignOptions, width: int,
@@ -233,24 +312,23 @@ def choose_first_pass(pycolmap, infos: Sequence[ImageInfo], options: AlignOption
         return FirstPass(base, DEFAULT, "the texture probe switched off in the options")
     t0 = time.time()
     ladder = levels(base, width, height)
-    chosen = probe_order(probe_photos([im for im in infos if (im.width, im.height) == (width, height)]))
-    photos: Dict[str, Optional[np.ndarray]] = {}
+    same = [im for im in infos if (im.width, im.height) == (width, height)]
+    names = [im.name for im in same]
+    chosen = probe_order(probe_photos(names))
+    near = neighbours(names, chosen)
+    photos = _Photos(pycolmap, same, max(s.image_size for _, s in ladder[:-1]))
+    readable = [n for n in chosen if photos.image(n) is not None]  # OpenCV cannot read it: probed without it
+    if not readable:
+        return FirstPass(base, DEFAULT, "no photo could be probed", seconds=time.time() - t0)
     measured: List[ProbeResult] = []
     why: List[str] = []
     for level, settings in ladder[:-1]:
         results: List[ProbeResult] = []
-        verdict: Optional[bool] = None
-        for im in chosen:
-            if im.name not in photos:
-                photos[im.name] = read_grey(im.path, max(width, height), max(s.image_size for _, s in ladder[:-1]))
-            if photos[im.name] is None:
-                continue  # OpenCV cannot read it (COLMAP may): the probe goes on without it
-            results.append(probe(pycolmap, photos[im.name], settings, im.name, level))
-            verdict = decide(results, sum(1 for im in chosen if photos.get(im.name, 0) is not None))
+        for n in readable:
+            results.append(probe(photos, n, near[n], settings, level))
+            verdict = decide(results, len(readable))
             if verdict is not None:
                 break
-        if not results:
-            return FirstPass(base, DEFAULT, "no photo could be probed", seconds=time.time() - t0)
         measured += results
         why.append(_summary(level, results))
         if verdict:

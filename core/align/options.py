@@ -30,12 +30,17 @@ FAINT_PEAK_THRESHOLD = 0.02 / 3 / 3
 # The texture probe (core.align.firstpass): SIFT at the planned settings on up to PROBE_PHOTOS photos spread over
 # the block; a photo is starved when it fills less than PROBE_MIN_YIELD of the budget or its features hold less
 # than PROBE_MIN_COVERAGE of a PROBE_GRID-cell grid over the frame (a cell holds features when it has a quarter of
-# its even share of them); a setting is kept when at most PROBE_STARVED_SHARE of the probed photos starve
+# its even share of them) and verifies fewer than PROBE_MIN_MATCHES matches with its neighbour; a setting is kept
+# when at most PROBE_STARVED_SHARE of the probed photos starve
 PROBE_PHOTOS = 6
 PROBE_MIN_YIELD = 0.2  # caliterra's 1 MP photos fill 0.32 of 3,000 and all register; faint farmland 0.0-0.06
 PROBE_MIN_COVERAGE = 0.5
 PROBE_GRID = 8  # cells along the long side (the short side in proportion)
 PROBE_STARVED_SHARE = 0.2
+# a photo short of features or coverage is still not starved when it verifies this many matches with its neighbour
+# (twice COLMAP's 30 2D-3D inliers to register an image): the synthetic farmland at contrast 0.4 registers every
+# photo with 234 features per photo (a yield of 0.06), at 0.15 with 3-67 it does not
+PROBE_MIN_MATCHES = 60
 # The calls to COLMAP are made in blocks, the unit of progress (a cancel acts within a call, through its token).
 # Each call has a fixed cost (threads, reading the database): blocks are sized by the work in them, so that small
 # frames do not pay it per image or per pair (the synthetic orbit's 16 frames of 480 x 360: 10.3 -> 8.3 CPU s)
