@@ -88,6 +88,7 @@ from .errors import GeorefError
 from .options import GeorefOptions
 from .outliers import (
     Consistency,
+    ControlRows,
     control_consistency,
     control_thresholds,
     find_outlier,
@@ -518,6 +519,11 @@ class _Adjustment:
     readmitted: List[str] = field(default_factory=list)
     retests: Dict[str, Dict[str, Any]] = field(default_factory=dict)
 
+    @property
+    def control(self) -> ControlRows:
+        """The control points in the problem (sharing this bookkeeping's index, rows and removed set)."""
+        return ControlRows(self.ba_points, self.gcp_index, self.gcp_obs_rows, self.removed_points)
+
 
 def _adjust(run: _Run, fit: _Fit, stats: Dict[str, Any]) -> _Adjustment:
     """4. the constrained bundle adjustment, its outlier rounds and the re-tests of the provisional outliers."""
@@ -591,9 +597,7 @@ def _outlier_rounds(run: _Run, adj: _Adjustment) -> None:
         if pass_round > opt.max_outlier_rounds:
             break
         min_left = 0 if run.cam_pos else 3
-        found = find_outlier(adj.prob, adj.ba_points, adj.gcp_index, adj.gcp_obs_rows, adj.removed_points,
-                             opt.outlier_threshold, opt.outlier_sigma, len(adj.ba_points) - len(adj.removed_points),
-                             min_left)
+        found = find_outlier(adj.prob, adj.control, opt.outlier_threshold, opt.outlier_sigma, min_left)
         if found is None:
             break
         run.outliers.append(found)
@@ -609,8 +613,7 @@ def _readmit(run: _Run, adj: _Adjustment) -> bool:
     if not run.provisional:
         return False
     prob = adj.prob
-    thr_px, thr_z = control_thresholds(prob, adj.ba_points, adj.gcp_index, adj.gcp_obs_rows, adj.removed_points,
-                                       run.opt.outlier_threshold, run.opt.outlier_sigma)
+    thr_px, thr_z = control_thresholds(prob, adj.control, run.opt.outlier_threshold, run.opt.outlier_sigma)
     back = []
     for nm in run.provisional:
         t = retest_provisional(prob, adj.gcp_index[nm], adj.gcp_obs_rows[nm])

@@ -89,11 +89,29 @@ def control_consistency(model_xyz, world_xyz, names: Sequence[str], tolerance: f
                        xy_only)
 
 
-def gcp_residuals(prob: BundleProblem, ba_points, gcp_index, gcp_obs_rows, removed_points,
-                   px_threshold, sigma_threshold):
+@dataclass
+class ControlRows:
+    """The control points in a bundle problem: the GroundPoints that entered it (``points``), each one's row of
+    ``prob.X`` (``index``) and its observation rows with their images (``obs_rows``), and the names taken out of
+    the adjustment since (``removed``)."""
+
+    points: List[Any]
+    index: Dict[str, int]
+    obs_rows: Dict[str, List[Tuple[int, str]]]
+    removed: set
+
+    @property
+    def left(self) -> int:
+        """How many control points are still in the adjustment."""
+        return len(self.points) - len(self.removed)
+
+
+def gcp_residuals(prob: BundleProblem, control: ControlRows, px_threshold, sigma_threshold):
     """Residuals of the GCPs in the adjustment and the thresholds of the outlier tests: the pixel
     residuals of their active observations (thr_px = max(px_threshold, 5 x median)) and the largest
     normalised coordinate residual of each point (thr_z = max(sigma_threshold, 5 x median))."""
+    ba_points, gcp_index, gcp_obs_rows = control.points, control.index, control.obs_rows
+    removed_points = control.removed
     obs = prob.obs
     all_rows, owner = [], []
     for p in ba_points:
@@ -128,10 +146,10 @@ def gcp_residuals(prob: BundleProblem, ba_points, gcp_index, gcp_obs_rows, remov
     return all_rows, owner, px, thr_px, bad_obs_per_point, n_obs_per_point, names, z, thr_z
 
 
-def control_thresholds(prob: BundleProblem, ba_points, gcp_index, gcp_obs_rows, removed_points,
-                        px_threshold, sigma_threshold) -> Tuple[float, float]:
+def control_thresholds(prob: BundleProblem, control: ControlRows, px_threshold, sigma_threshold
+                       ) -> Tuple[float, float]:
     """(thr_px, thr_z) of the adjustment's outlier tests for the current state (see gcp_residuals)."""
-    res = gcp_residuals(prob, ba_points, gcp_index, gcp_obs_rows, removed_points, px_threshold, sigma_threshold)
+    res = gcp_residuals(prob, control, px_threshold, sigma_threshold)
     return res[3], res[8]
 
 
@@ -184,13 +202,15 @@ def retest_provisional(prob: BundleProblem, k: int, rows) -> Dict[str, Any]:
             "free_distance_m": float(np.linalg.norm(x_free - prior)) if x_free is not None else None}
 
 
-def find_outlier(prob: BundleProblem, ba_points, gcp_index, gcp_obs_rows, removed_points,
-                  px_threshold, sigma_threshold, n_control_left: int, min_left: int) -> Optional[Outlier]:
-    """The single worst GCP observation, control point or camera position beyond its threshold, removed."""
+def find_outlier(prob: BundleProblem, control: ControlRows, px_threshold, sigma_threshold, min_left: int
+                 ) -> Optional[Outlier]:
+    """The single worst GCP observation, control point or camera position beyond its threshold, removed; a control
+    point (or its last observation) only while more than ``min_left`` control points are left."""
     obs = prob.obs
+    gcp_index, gcp_obs_rows, n_control_left = control.index, control.obs_rows, control.left
     cands: List[Tuple[float, Outlier, Any]] = []
     all_rows, owner, px, thr_px, bad_obs_per_point, n_obs_per_point, names, z, thr_z = gcp_residuals(
-        prob, ba_points, gcp_index, gcp_obs_rows, removed_points, px_threshold, sigma_threshold)
+        prob, control, px_threshold, sigma_threshold)
     for (p, d), zz in zip(names, z):
         nb, nt = bad_obs_per_point.get(p.name, 0), n_obs_per_point.get(p.name, 0)
         if zz > thr_z and (nb == 0 or 2 * nb >= nt) and n_control_left > min_left:
@@ -244,5 +264,5 @@ def removed_cameras(outliers: List[Outlier]) -> set:
 
 
 
-__all__ = ["Consistency", "control_consistency", "control_thresholds", "find_outlier", "gcp_residuals",
+__all__ = ["Consistency", "ControlRows", "control_consistency", "control_thresholds", "find_outlier", "gcp_residuals",
            "removed_cameras", "retest_provisional"]
