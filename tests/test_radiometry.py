@@ -198,7 +198,7 @@ def test_too_few_overlaps_are_left_alone():
 def test_point_gains():
     """Without a model the scalar exposure gain; with one the correction at the points' image positions."""
     cam = SimpleNamespace()
-    g = point_gains(None, 1.25, 0, cam, np.zeros(3), np.zeros(4), np.zeros(4), np.zeros(4), np.ones(4, bool))
+    g = point_gains(None, 1.25, 0, cam, np.zeros((4, 3)), np.ones(4, bool))
     assert g.shape == (4, 1) and np.all(g == np.float32(1.25))
     model = RadiometryModel(groups=[0], falloff=[[-0.2, 0.0, 0.0]], hot=[0.0], antisolar=[0.0, 0.0, -1.0],
                             hot_width=0.2, exposure=[0.1], fields=[[0.0] * 6])
@@ -249,8 +249,8 @@ def test_grey_samples_are_an_area_of_the_ground_at_any_resolution(tmp_path):
     grey = {}
     for name, (w, h, gsd) in {"coarse": (100, 75, 0.1), "fine": (400, 300, 0.025)}.items():
         cam, meta = _nadir_photo(str(tmp_path / f"{name}.tif"), w, h, gsd)
-        grey[name, "point"] = sample_grey(cam, meta, np.zeros(3), x, y, z, None, 0.0, 255.0)
-        grey[name, "area"] = sample_grey(cam, meta, np.zeros(3), x, y, z, None, 0.4, 255.0)
+        grey[name, "point"] = sample_grey(cam, meta, np.zeros(3), x, y, z, None, 0.0)
+        grey[name, "area"] = sample_grey(cam, meta, np.zeros(3), x, y, z, None, 0.4)
     for key, (g, ok) in grey.items():
         assert ok.mean() > 0.9, key
     ok = np.logical_and.reduce([v[1] for v in grey.values()])

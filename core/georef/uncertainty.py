@@ -4,7 +4,8 @@ For the report (``core.report``) and its GeoPackage layers.  The model is linear
 solution (the georeferenced model ``georef/model`` in the local frame, or the aligned model) with the
 same observations and weights the georeferencing adjustment used (``core.georef``):
 
-- tie-point observations, sigma ``tie_sigma_px`` (1 px), Huber weights beyond ``huber_px`` (2 px);
+- tie-point observations, sigma ``tie_sigma_px`` (1 px), Huber weights beyond ``huber_px`` (2 px) (the fields of
+  :class:`CovarianceOptions`);
 - control-point observations, sigma ``gcp_sigma_px`` (1 px), and the control coordinates as priors with
   their sigma XY / Z (raised to 1 m in Z for placeholder heights, as ``core.georef`` does);
 - camera projection-centre priors with their sigmas (EXIF GPS: 3 m / 5 m; a positions file: its sigmas).
@@ -70,6 +71,19 @@ class ControlInput:
     sigma: np.ndarray  # (3,)
     given: np.ndarray  # given coordinates (local frame), for the prior residual
     observations: List[Tuple[str, float, float]]  # (image name, x px, y px)
+
+
+@dataclass(frozen=True)
+class CovarianceOptions:
+    """The observations' precision and the problem's limits: tie point and control point observations' sigmas
+    (pixels), the Huber threshold (pixels), at most ``max_observations`` tie point observations (the best observed
+    points), at most ``max_unknowns`` camera unknowns (the reduced system is dense)."""
+
+    tie_sigma_px: float = 1.0
+    gcp_sigma_px: float = 1.0
+    huber_px: float = 2.0
+    max_observations: int = 300_000
+    max_unknowns: int = 6000
 
 
 @dataclass
@@ -333,7 +347,18 @@ def _jacobians(rec, images, rows: _Rows, free: Dict[int, List[int]], intr_off: D
         n_cols[sel] = len(cols)
     jc *= sw[:, None, None]
     jp *= sw[:, None, None]
-    return jc, jp, cam_cols, n_cols
+    return _Jacobians(jc, jp, cam_cols, n_cols)
+
+
+@dataclass
+class _Jacobians:
+    """The weighted observation Jacobian: camera part (O, 2, width) with each row's camera columns and their
+    number, point part (O, 2, 3)."""
+
+    jc: np.ndarray
+    jp: np.ndarray
+    cam_cols: np.ndarray
+    n_cols: np.ndarray
 
 
 @dataclass
@@ -347,11 +372,12 @@ class _Normals:
     centres: np.ndarray  # (I, 3) projection centres
 
 
-def _normals(rows: _Rows, images, img_index, jc, jp, cam_cols, n_cols, nc: int,
-             camera_priors: Sequence[CameraPrior]) -> _Normals:
+def _normals(rows: _Rows, images, img_index, jac: _Jacobians, nc: int, camera_priors: Sequence[CameraPrior]
+             ) -> _Normals:
     """The normal equations, with the control-point and camera-position priors."""
     import scipy.sparse as sp
 
+    jc, jp, cam_cols, n_cols = jac.jc, jac.jp, jac.cam_cols, jac.n_cols
     n_o, n_pts = len(rows.img), len(rows.xyz)
     width = jc.shape[2]
     valid = np.arange(width)[None, :] < n_cols[:, None]  # (O, width)
@@ -493,13 +519,13 @@ def _camera_unknowns(cam_ids, free: Dict[int, List[int]], n_img: int) -> Tuple[i
 
 
 def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[CameraPrior] = (),
-             free_intrinsics: Optional[Dict[int, List[int]]] = None, tie_sigma_px: float = 1.0,
-             gcp_sigma_px: float = 1.0, huber_px: float = 2.0, max_observations: int = 300_000,
-             max_unknowns: int = 6000, offset=None, progress: Optional[Progress] = None,
-             observations: Optional[Observations] = None) -> UncertaintyResult:
+             free_intrinsics: Optional[Dict[int, List[int]]] = None, options: Optional[CovarianceOptions] = None,
+             offset=None, progress: Optional[Progress] = None, observations: Optional[Observations] = None
+             ) -> UncertaintyResult:
     """Covariance of the cameras, intrinsics and points of an adjusted block (see the module docstring)."""
     t0 = time.time()
     progress = progress or NullProgress()
+    opt = options or CovarianceOptions()
     notes: List[str] = []
     obs = observations if observations is not None else collect_observations(rec)
     n_img = len(obs.image_ids)
@@ -511,16 +537,17 @@ def estimate(rec, control: Sequence[ControlInput] = (), camera_priors: Sequence[
     free = free_intrinsics if free_intrinsics is not None else default_free_intrinsics(rec)
     free = {cid: list(free.get(cid, [])) for cid in cam_ids}
     nc, intr_off = _camera_unknowns(cam_ids, free, n_img)
-    if nc > max_unknowns:
-        raise UncertaintyError(f"{nc} camera unknowns: more than the dense covariance handles here ({max_unknowns})")
-    rows = _tie_rows(obs, max_observations, tie_sigma_px, notes)
-    _add_control(rec, rows, control, images, img_index, gcp_sigma_px)
+    if nc > opt.max_unknowns:
+        raise UncertaintyError(f"{nc} camera unknowns: more than the dense covariance handles here "
+                               f"({opt.max_unknowns})")
+    rows = _tie_rows(obs, opt.max_observations, opt.tie_sigma_px, notes)
+    _add_control(rec, rows, control, images, img_index, opt.gcp_sigma_px)
     n_pts, n_o = len(rows.xyz), len(rows.img)
-    w, sw = _weights(rows, huber_px)
+    w, sw = _weights(rows, opt.huber_px)
     progress.report(0.05, "covariance: Jacobian")
-    jc, jp, cam_cols, n_cols = _jacobians(rec, images, rows, free, intr_off, sw, progress)
+    jac = _jacobians(rec, images, rows, free, intr_off, sw, progress)
     progress.report(0.4, "covariance: normal equations")
-    nrm = _normals(rows, images, img_index, jc, jp, cam_cols, n_cols, nc, camera_priors)
+    nrm = _normals(rows, images, img_index, jac, nc, camera_priors)
     s_mat, npp_inv, bad = _reduce(nrm)
     n_ctl = len(rows.prior_idx)
     ncp_comp = nrm.n_cam_prior_comp
@@ -676,6 +703,6 @@ def write_layers(result: UncertaintyResult, folder: str, crs: Optional[str]) -> 
     return paths
 
 
-__all__ = ["CameraPrior", "ControlInput", "DATUM_CONTROL", "DATUM_FREE", "Observations", "UncertaintyError",
-           "UncertaintyResult", "collect_observations", "default_free_intrinsics", "estimate", "workspace_inputs",
-           "write_layers"]
+__all__ = ["CameraPrior", "ControlInput", "CovarianceOptions", "DATUM_CONTROL", "DATUM_FREE", "Observations",
+           "UncertaintyError", "UncertaintyResult", "collect_observations", "default_free_intrinsics", "estimate",
+           "workspace_inputs", "write_layers"]

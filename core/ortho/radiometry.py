@@ -110,25 +110,20 @@ def observation_geometry(cam: OrthoCamera, xyz_local: np.ndarray, px: Optional[n
     return ok, r, u, v, rays
 
 
-def point_gains(model: Optional[RadiometryModel], gain: float, index: int, cam: OrthoCamera,
-                offset: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, valid: np.ndarray,
-                projected: Optional[Tuple[np.ndarray, np.ndarray]] = None) -> np.ndarray:
-    """(N, 1) float32 factors of world points (x, y, z) of image ``index`` in the mosaic: the radiometric
-    correction where ``valid`` (1 elsewhere), or the scalar exposure ``gain`` without a model.  ``projected``:
-    (local points (N, 3), their pixels (N, 2)) where the caller has them (Sampled.xyz, Sampled.px)."""
-    n = len(x)
+def point_gains(model: Optional[RadiometryModel], gain: float, index: int, cam: OrthoCamera, xyz: np.ndarray,
+                valid: np.ndarray, px: Optional[np.ndarray] = None) -> np.ndarray:
+    """(N, 1) float32 factors of ground points of image ``index`` in the mosaic (``xyz``: (N, 3) in the local
+    frame, as Sampled.xyz): the radiometric correction where ``valid`` (1 elsewhere), or the scalar exposure
+    ``gain`` without a model.  ``px``: their pixels (N, 2) where the caller has them (Sampled.px), else
+    projected here."""
+    n = len(xyz)
     if model is None:
         return np.full((n, 1), gain, dtype=np.float32)
     out = np.ones((n, 1), dtype=np.float32)
     idx = np.flatnonzero(valid)
     if not len(idx):
         return out
-    if projected is not None:
-        xyz, px = projected[0][idx], projected[1][idx]
-    else:
-        xyz = np.column_stack([x[idx] - offset[0], y[idx] - offset[1], np.nan_to_num(z[idx]) - offset[2]])
-        px = None
-    _ok, r, u, v, rays = observation_geometry(cam, xyz, px)
+    _ok, r, u, v, rays = observation_geometry(cam, xyz[idx], None if px is None else px[idx])
     out[idx, 0] = model.correction(np.full(len(idx), index), r, u, v, rays)
     return out
 
@@ -170,16 +165,17 @@ def _reduced(cam: OrthoCamera, meta, factor: float) -> np.ndarray:
 
 
 def sample_grey(cam: OrthoCamera, meta, offset: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, vis,
-                footprint: float, scale: float) -> Tuple[np.ndarray, np.ndarray]:
+                footprint: float) -> Tuple[np.ndarray, np.ndarray]:
     """(grey, usable) of ground points: the mean grey value over a square of ``footprint`` metres around each point
     (FOOTPRINT_POINTS x FOOTPRINT_POINTS points at the point's height, on the photo reduced by area to about a
     third of the footprint a pixel where its pixels are finer), usable where every point is.  The brightness of an
     area of the ground, the same whatever the photos' resolution: one bilinear pixel of a full-resolution photo is
     the texture under it, and two photos misregistered by a pixel disagree there by the texture's contrast, not by
     their brightness (issue 33 item 4: the seam step of toledo_2400's 2400 px photos read 6.1 %, of their 1200 px
-    copies 5.2 %; now 3.2 and 3.3 %)."""
+    copies 5.2 %; now 3.2 and 3.3 %).  Dark and saturated: against the full scale of the image's data type."""
     from .pixels import remap_photo
 
+    scale = dtype_scale(meta.dtype)
     n = FOOTPRINT_POINTS if footprint > 0 else 1
     offs = ((np.arange(n) + 0.5) / n - 0.5) * footprint
     acc = np.zeros(len(x), dtype=np.float64)
@@ -255,7 +251,6 @@ def seam_steps(model: Optional[RadiometryModel], labels: np.ndarray, k: int, pre
         pick = np.random.default_rng(3).choice(len(x), max_points, replace=False)
         x, y, ia, ib, cell = x[pick], y[pick], ia[pick], ib[pick], cell[pick]
     z = dsm.sample(x, y).astype(np.float64)
-    scale = dtype_scale(prep.metas[0].dtype)
     raw = {0: np.full(len(x), np.nan), 1: np.full(len(x), np.nan)}
     cor = {0: np.full(len(x), np.nan), 1: np.full(len(x), np.nan)}
     for i in np.unique(np.concatenate([ia, ib])):
@@ -264,8 +259,7 @@ def seam_steps(model: Optional[RadiometryModel], labels: np.ndarray, k: int, pre
             sel = np.flatnonzero(lab == i)
             if not len(sel):
                 continue
-            grey, ok = sample_grey(cam, prep.metas[i], offset, x[sel], y[sel], z[sel], prep.visibility[i],
-                                   footprint, scale)
+            grey, ok = sample_grey(cam, prep.metas[i], offset, x[sel], y[sel], z[sel], prep.visibility[i], footprint)
             sel, grey = sel[ok], grey[ok]
             if not len(sel):
                 continue

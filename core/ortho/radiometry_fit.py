@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -18,7 +18,6 @@ from .radiometry import (
     FIELD_TERMS,
     RadiometryModel,
     chunk_disagreement,
-    dtype_scale,
     field_terms,
     hot_spot_shape,
     observation_geometry,
@@ -60,7 +59,6 @@ def sample_overlaps(prep: PreparedBlock, dsm: Dsm, offset: np.ndarray, progress:
     sgrid = dsmmod.Grid(grid.x0, grid.y0, step * grid.resolution, sw, sh)
     x, y = cell_centre_coords(sgrid, 0, 0, sh, sw)
     zs = dsm.sample(x, y).reshape(sh, sw)
-    scale = dtype_scale(prep.metas[0].dtype)
     parts: List[Tuple] = []
     n = len(prep.cameras)
     for i, (cam, meta, fp, vis) in enumerate(zip(prep.cameras, prep.metas, prep.footprints, prep.visibility)):
@@ -71,7 +69,7 @@ def sample_overlaps(prep: PreparedBlock, dsm: Dsm, offset: np.ndarray, progress:
         r0, c0, h, w = sub
         xi, yi = cell_centre_coords(sgrid, r0, c0, h, w)
         zi = zs[r0:r0 + h, c0:c0 + w].ravel().astype(np.float64)
-        grey, ok = sample_grey(cam, meta, offset, xi, yi, zi, vis, sgrid.resolution, scale)
+        grey, ok = sample_grey(cam, meta, offset, xi, yi, zi, vis, sgrid.resolution)
         idx = np.flatnonzero(ok)
         if len(idx):
             xyz = np.column_stack([xi[idx] - offset[0], yi[idx] - offset[1], zi[idx] - offset[2]])
@@ -180,9 +178,20 @@ def _antisolar(azimuth: float, off_nadir: float) -> np.ndarray:
                      -math.cos(off_nadir)])
 
 
-def _search_hot_spot(obs: _Obs, a, b, y, xa, w, sigma, groups, n_groups, prior_a) -> Optional[Tuple]:
+@dataclass
+class _BaseFit:
+    """The fall-off and exposure fit of the pairs' log differences that the hot spot is searched against."""
+
+    design: Any  # (pairs, unknowns) sparse design matrix
+    prior: np.ndarray  # the unknowns' prior sigmas
+    weights: np.ndarray  # the pairs' robust (IRLS) weights
+    sigma: float  # the residuals' robust sigma
+
+
+def _search_hot_spot(obs: _Obs, a, b, y, base: _BaseFit, groups, n_groups) -> Optional[Tuple]:
     """The hot spot's (antisolar direction, width, RSS with / without it) minimising the weighted residual of
-    the base model plus a hot-spot column per group on a subsample of the pairs; None if it does not help."""
+    the ``base`` model plus a hot-spot column per group on a subsample of the pairs; None if it does not help."""
+    xa, w, sigma, prior_a = base.design, base.weights, base.sigma, base.prior
     rng = np.random.default_rng(1)
     sel = rng.choice(len(a), min(len(a), SEARCH_PAIRS), replace=False)
     a_s, b_s, y_s = a[sel], b[sel], y[sel]
@@ -247,7 +256,7 @@ def _fit_model(obs: _Obs, a, b, groups: np.ndarray, n_groups: int, n_images: int
     check_cancel(progress)
     progress.report(0.3, "radiometry: fall-off fitted")
     antisolar, width, hot = np.array([0.0, 0.0, -1.0]), math.radians(10.0), np.zeros(n_groups)
-    found = _search_hot_spot(obs, a, b, y, xa, w, sigma, groups, n_groups, prior_a) if hot_spot else None
+    found = _search_hot_spot(obs, a, b, y, _BaseFit(xa, prior_a, w, sigma), groups, n_groups) if hot_spot else None
     check_cancel(progress)
     progress.report(0.6, "radiometry: hot spot searched")
     e = np.zeros(len(obs.logv))

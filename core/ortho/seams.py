@@ -236,12 +236,20 @@ def _seam_disagreement(labels: np.ndarray, windows, greys, scale: float) -> floa
     return tot / n / scale if n else 0.0
 
 
+# seamline moves (_refine_seams): how far a seam may move, in planning cells, and the brightness difference (a
+# fraction of full scale) that costs a seam edge as much as crossing it
+SEAM_BAND = 8
+SEAM_TOL = 0.05
+
+
 def _refine_seams(labels: np.ndarray, windows, costs, greys, scale: float, iterations: int = 1,
-                  alpha: float = 5.0, tol: float = 0.05, band: int = 8) -> np.ndarray:
-    """Move the seamline between every two adjacent images within a band of ``band`` planning cells to where the
+                  alpha: float = 5.0) -> np.ndarray:
+    """Move the seamline between every two adjacent images within a band of SEAM_BAND planning cells to where the
     two images agree and the scene has no edges: a minimum cut (scipy max-flow) of the band with the cost
     alpha * view cost per cell and, per seam edge, 1 + |grey_a - grey_b| / tol + mean gradient / tol
-    (brightness as a fraction of full scale).  Cells outside the band, or seen by only one of the two, stay."""
+    (brightness as a fraction of full scale, tol = SEAM_TOL).  Cells outside the band, or seen by only one of the
+    two, stay."""
+    tol, band = SEAM_TOL, SEAM_BAND
     cv2 = require("cv2", "orthophotos")
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import breadth_first_order, maximum_flow

@@ -51,6 +51,17 @@ class TileUnit:
     fill_hidden: bool = True  # a cell hidden from every image takes the least hidden one (no holes)
 
 
+@dataclass
+class _Cells:
+    """The cells of a tile (with its halo) on the ground: world x, y, the DSM's z (NaN: no height), flat, and the
+    block's local frame offset."""
+
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    offset: np.ndarray
+
+
 DSM_CACHE: Dict[Tuple[str, Optional[str]], Dsm] = {}
 
 
@@ -77,6 +88,7 @@ def render_tile(unit: TileUnit, cancel_path: Optional[str] = None) -> Dict[str, 
     hh, ww = ar1 - ar0, ac1 - ac0
     x, y = cell_centre_coords(grid, ar0, ac0, hh, ww)
     z = dsm.sample(x, y)
+    cells = _Cells(x, y, z, off)
     bands = unit.metas[0].bands
     labels_all = np.load(unit.labels_path, mmap_mode="r")
     k = unit.k
@@ -113,7 +125,7 @@ def render_tile(unit: TileUnit, cancel_path: Optional[str] = None) -> Dict[str, 
             s = sample_camera(cam, unit.metas[ci], off, x, y, z, unit.visibility[ci], unit.interpolation)
             if not s.valid.any():
                 continue
-            vals = s.values * point_gains(unit.radiometry, unit.gains[ci], ci, cam, off, x, y, z, s.valid)
+            vals = s.values * point_gains(unit.radiometry, unit.gains[ci], ci, cam, s.xyz, s.valid)
             wgt = np.where(s.valid, wgt, 0.0)
             layers.append((vals, s.valid, wgt))
             wsum += wgt
@@ -127,8 +139,8 @@ def render_tile(unit: TileUnit, cancel_path: Optional[str] = None) -> Dict[str, 
             continue
         sel, vals = sel[s.valid], s.values[s.valid]
         w_sel = wgt[sel]
-        vals = vals * point_gains(unit.radiometry, unit.gains[ci], ci, cam, off, x[sel], y[sel], z[sel],
-                                  np.ones(len(sel), bool), (s.xyz[s.valid], s.px[s.valid]))
+        vals = vals * point_gains(unit.radiometry, unit.gains[ci], ci, cam, s.xyz[s.valid], np.ones(len(sel), bool),
+                                  s.px[s.valid])
         acc[sel] += vals * w_sel[:, None]
         wsum[sel] += w_sel
     # cells whose planned image cannot see them: the best image that does (primary first, then the others)
@@ -147,13 +159,13 @@ def render_tile(unit: TileUnit, cancel_path: Optional[str] = None) -> Dict[str, 
             if better.any():
                 fill_cost[idx[better]] = s.cost[better]
                 best[better] = ci
-        _fill_values(unit, off, x, y, z, idx, best, unit.visibility, fill_vals, counts)
+        _fill_values(unit, cells, idx, best, unit.visibility, fill_vals, counts)
         filled = need & np.isfinite(fill_cost)
     else:
         filled = need
     hidden = np.zeros(hh * ww, dtype=bool)
     if unit.fill_hidden:
-        hidden = _fill_hidden(unit, off, x, y, z, need & ~filled, fill_vals, counts)
+        hidden = _fill_hidden(unit, cells, need & ~filled, fill_vals, counts)
         filled |= hidden
     valid = (wsum > 1e-6) | filled
     if unit.blending == "multiband":
@@ -172,12 +184,13 @@ def render_tile(unit: TileUnit, cancel_path: Optional[str] = None) -> Dict[str, 
             "hidden_cells": int(hidden.reshape(hh, ww)[rr0:rr0 + unit.h, cc0:cc0 + unit.w].sum())}
 
 
-def _fill_hidden(unit: TileUnit, off: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, left: np.ndarray,
-                 fill_vals: np.ndarray, counts: Dict[int, int]) -> np.ndarray:
+def _fill_hidden(unit: TileUnit, cells: _Cells, left: np.ndarray, fill_vals: np.ndarray,
+                 counts: Dict[int, int]) -> np.ndarray:
     """Cells with a height that no image sees (each has them hidden) but that lie inside an image (its frame,
     mask and far-field limit): the value of the image that hides them least (Visibility.hidden_by), so the
     mosaic has no holes where the ground is photographed: the specks and cracks a noisy DSM (tree crowns, the
     ramp of a wall) cuts out of every image.  Writes ``fill_vals``; returns the cells filled."""
+    off, x, y, z = cells.offset, cells.x, cells.y, cells.z
     idx = np.flatnonzero(left & np.isfinite(z))
     out = np.zeros(left.shape, dtype=bool)
     if not len(idx):
@@ -198,22 +211,22 @@ def _fill_hidden(unit: TileUnit, off: np.ndarray, x: np.ndarray, y: np.ndarray, 
         if better.any():
             best[better] = depth[better]
             winner[better] = ci
-    _fill_values(unit, off, x, y, z, idx, winner, [None] * len(unit.cameras), fill_vals, counts)
+    _fill_values(unit, cells, idx, winner, [None] * len(unit.cameras), fill_vals, counts)
     out[idx[np.isfinite(best)]] = True
     return out
 
 
-def _fill_values(unit: TileUnit, off: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, idx: np.ndarray,
-                 winner: np.ndarray, visibility: List[Optional[Visibility]], fill_vals: np.ndarray,
-                 counts: Dict[int, int]) -> None:
+def _fill_values(unit: TileUnit, cells: _Cells, idx: np.ndarray, winner: np.ndarray,
+                 visibility: List[Optional[Visibility]], fill_vals: np.ndarray, counts: Dict[int, int]) -> None:
     """The values (with their radiometric gains) of the cells ``idx`` from the image ``winner`` picked for each
     (-1: none), sampled once per image and cell, into ``fill_vals``."""
+    off, x, y, z = cells.offset, cells.x, cells.y, cells.z
     for ci in np.unique(winner[winner >= 0]):
         ci = int(ci)
         sel = idx[winner == ci]
         s = sample_camera(unit.cameras[ci], unit.metas[ci], off, x[sel], y[sel], z[sel], visibility[ci],
                           unit.interpolation)
         sel, vals = sel[s.valid], s.values[s.valid]  # all of them: the same test that picked the image
-        fill_vals[sel] = vals * point_gains(unit.radiometry, unit.gains[ci], ci, unit.cameras[ci], off, x[sel],
-                                            y[sel], z[sel], np.ones(len(sel), bool), (s.xyz[s.valid], s.px[s.valid]))
+        fill_vals[sel] = vals * point_gains(unit.radiometry, unit.gains[ci], ci, unit.cameras[ci], s.xyz[s.valid],
+                                            np.ones(len(sel), bool), s.px[s.valid])
         counts[ci] = counts.get(ci, 0) + len(sel)
