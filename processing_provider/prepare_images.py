@@ -149,7 +149,8 @@ class PrepareImagesAlgorithm(AlgorithmBase):
             options.mask_polygons = self.mask_polygons(source, feedback)
             options.mask_source = self.tr("MASKS layer '{}'").format(source.sourceName())
         progress = FeedbackProgress(feedback)
-        result = self.run_core(prepare_images_workspace, images, workspace, output or None, options, progress)
+        options.output_dir = output or None
+        result = self.run_core(prepare_images_workspace, images, workspace, options, progress)
         progress.push_result(result.warnings)
         feedback.pushInfo(self.tr("{} images: {} flagged, {} excluded, {} in the prepared folder").format(
             len(result.images), result.flagged, result.excluded, result.kept))

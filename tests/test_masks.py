@@ -215,13 +215,14 @@ def test_prepare_scanned_film_merges_polygons_with_the_scan_masks(tmp_path):
     for i, (photo, res, ang, off) in enumerate(SCAN_SETUP[:3], start=1):
         make_scan(os.path.join(SAMPLE, "images", photo), str(folder / f"frame_{i:03d}.tiff"), i, res, ang, off)
     scan = ScanOptions(fiducial_coordinates=calibration_text())
-    plain = prepare_images_workspace(str(folder), str(tmp_path / "ws1"), str(tmp_path / "p1"),
-                                     PrepareOptions(scanned_film=True, scan=scan))
+    plain = prepare_images_workspace(str(folder), str(tmp_path / "ws1"),
+                                     PrepareOptions(scanned_film=True, scan=scan, output_dir=str(tmp_path / "p1")))
     scan_mask = _read(os.path.join(plain.workspace, "masks", "frame_002.tif.png"))
     h, w = scan_mask.shape
     box = [(w * 0.4, h * 0.4), (w * 0.6, h * 0.4), (w * 0.6, h * 0.6), (w * 0.4, h * 0.6)]
-    r = prepare_images_workspace(str(folder), str(tmp_path / "ws2"), str(tmp_path / "p2"), PrepareOptions(
-        scanned_film=True, scan=scan, mask_polygons=[("frame_002.tiff", [box], "feature 1")]))  # the scan's own name
+    r = prepare_images_workspace(str(folder), str(tmp_path / "ws2"), PrepareOptions(
+        scanned_film=True, scan=scan, mask_polygons=[("frame_002.tiff", [box], "feature 1")],
+        output_dir=str(tmp_path / "p2")))  # the scan's own name
     assert r.user_masked == {"frame_002.tif": 1}
     masks = os.path.join(r.workspace, "masks")
     assert sorted(os.listdir(masks)) == ["frame_001.tif.png", "frame_002.tif.png", "frame_003.tif.png"]

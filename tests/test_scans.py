@@ -191,8 +191,9 @@ def prepared(synthetic_scans, tmp_path_factory):
 
     folder, truth = synthetic_scans
     root = tmp_path_factory.mktemp("prepared")
-    opts = PrepareOptions(scanned_film=True, scan=ScanOptions(fiducial_coordinates=calibration_text()))
-    result = prepare_images_workspace(folder, str(root / "ws"), str(root / "prepared images"), opts)
+    opts = PrepareOptions(scanned_film=True, scan=ScanOptions(fiducial_coordinates=calibration_text()),
+                          output_dir=str(root / "prepared images"))
+    result = prepare_images_workspace(folder, str(root / "ws"), opts)
     return result, truth
 
 
@@ -580,8 +581,8 @@ def test_prepare_stage_with_a_scan_left_out(touching_block, tmp_path):
             shutil.copyfile(os.path.join(block.paths["images"], n), folder / n)
     _displace_mark(block, bad, "1", 3, str(folder))
     opts = PrepareOptions(scanned_film=True, scan=ScanOptions(fiducial_coordinates=_calibrated_text(block.camera),
-                                                              max_residual_px=0.1))
-    res = prepare_images_workspace(str(folder), str(tmp_path / "ws"), str(tmp_path / "prepared"), opts)
+                                                              max_residual_px=0.1), output_dir=str(tmp_path / "prepared"))
+    res = prepare_images_workspace(str(folder), str(tmp_path / "ws"), opts)
     good = [n for n in block.names if n != bad]
     assert sorted(q.name for q in res.images) == good
     assert sorted(n for n in os.listdir(res.prepared_dir) if n.endswith(".tif")) == good

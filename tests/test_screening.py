@@ -105,8 +105,8 @@ def test_prepare_stage_records_decisions_and_excludes(toledo_with_bad_copies, tm
 
     ws = str(tmp_path / "ws")
     out = str(tmp_path / "prepared")
-    opts = PrepareOptions(screening=ScreeningOptions(exclude_flagged=True))
-    res = prepare_images_workspace(toledo_with_bad_copies, ws, out, opts)
+    opts = PrepareOptions(screening=ScreeningOptions(exclude_flagged=True), output_dir=out)
+    res = prepare_images_workspace(toledo_with_bad_copies, ws, opts)
     flagged = {q.name for q in res.images if q.flags}
     assert set(BLURS) | {"overexposed.JPG"} <= flagged
     assert res.excluded == len(flagged) and res.kept == 22 - len(flagged)
@@ -125,11 +125,12 @@ def test_prepare_stage_records_decisions_and_excludes(toledo_with_bad_copies, tm
     assert not os.path.exists(os.path.join(ws, "masks"))  # no scans, no masks (COLMAP wants all or none)
 
     # a re-run without exclusion replaces the prepared folder as a whole
-    res2 = prepare_images_workspace(toledo_with_bad_copies, ws, out, PrepareOptions())
+    res2 = prepare_images_workspace(toledo_with_bad_copies, ws, PrepareOptions(output_dir=out))
     assert res2.excluded == 0 and len([n for n in os.listdir(out) if not n.startswith(".")]) == 22
 
 
 def test_output_folder_with_foreign_files_is_refused(tmp_path):
+    from core.prepare.options import PrepareOptions
     from core.prepare.screening import ScreeningError
     from core.prepare.stage import prepare_images_workspace
 
@@ -139,10 +140,10 @@ def test_output_folder_with_foreign_files_is_refused(tmp_path):
     out.mkdir()
     (out / "thesis.docx").write_text("precious")
     with pytest.raises(ScreeningError, match="did not write"):
-        prepare_images_workspace(str(images), str(tmp_path / "ws"), str(out))
+        prepare_images_workspace(str(images), str(tmp_path / "ws"), PrepareOptions(output_dir=str(out)))
     assert (out / "thesis.docx").exists()
     with pytest.raises(ScreeningError, match="must not be the image folder"):
-        prepare_images_workspace(str(images), str(tmp_path / "ws"), str(images))
+        prepare_images_workspace(str(images), str(tmp_path / "ws"), PrepareOptions(output_dir=str(images)))
 
 
 def _bad_files(folder) -> dict:
@@ -160,6 +161,7 @@ def test_unusable_files_are_skipped_with_a_warning_as_align_does(tmp_path):
     where Align images skips both with a warning.  One rule: each file skipped with a warning naming it and why,
     in the result and the stage's results; fewer than 2 usable images is refused, naming the skipped files."""
     from core.io.images import scan_images
+    from core.prepare.options import PrepareOptions
     from core.prepare.screening import ScreeningError
     from core.prepare.stage import prepare_images_workspace
     from core.project.workspace import Workspace
@@ -167,7 +169,7 @@ def test_unusable_files_are_skipped_with_a_warning_as_align_does(tmp_path):
     images = tmp_path / "img"
     shutil.copytree(os.path.join(SAMPLE, "images"), images, ignore=lambda d, names: names[3:])
     bad = _bad_files(images)
-    res = prepare_images_workspace(str(images), str(tmp_path / "ws"), str(tmp_path / "out"))
+    res = prepare_images_workspace(str(images), str(tmp_path / "ws"), PrepareOptions(output_dir=str(tmp_path / "out")))
     assert res.kept == 3 and sorted(os.listdir(tmp_path / "out")) == sorted(
         [n for n in os.listdir(images) if n not in bad] + [".archaeoortho-prepared"])
     for name, why in bad.items():
@@ -180,13 +182,14 @@ def test_unusable_files_are_skipped_with_a_warning_as_align_does(tmp_path):
         if n not in bad and n != sorted(os.listdir(images))[0]:
             os.unlink(images / n)
     with pytest.raises(ScreeningError, match="only one usable image .* at least 2 are needed") as e:
-        prepare_images_workspace(str(images), str(tmp_path / "ws2"), str(tmp_path / "out2"))
+        prepare_images_workspace(str(images), str(tmp_path / "ws2"), PrepareOptions(output_dir=str(tmp_path / "out2")))
     assert all(name in str(e.value) and why in str(e.value) for name, why in bad.items()), str(e.value)
     assert not os.path.exists(tmp_path / "out2")
 
 
 def test_cancel_leaves_no_complete_looking_output(tmp_path):
     from core.common.progress import Cancelled, NullProgress
+    from core.prepare.options import PrepareOptions
     from core.prepare.stage import prepare_images_workspace
 
     class CancelAfter(NullProgress):
@@ -200,7 +203,8 @@ def test_cancel_leaves_no_complete_looking_output(tmp_path):
     images = tmp_path / "img"
     shutil.copytree(os.path.join(SAMPLE, "images"), images, ignore=lambda d, names: names[6:])
     with pytest.raises(Cancelled):
-        prepare_images_workspace(str(images), str(tmp_path / "ws"), str(tmp_path / "out"), progress=CancelAfter(3))
+        prepare_images_workspace(str(images), str(tmp_path / "ws"), PrepareOptions(output_dir=str(tmp_path / "out")),
+                                 progress=CancelAfter(3))
     assert not os.path.exists(tmp_path / "out")
     assert not os.path.exists(tmp_path / "ws" / "screening.json")
     manifest = json.load(open(tmp_path / "ws" / "workspace.json"))

@@ -51,6 +51,7 @@ class PrepareOptions:
     # sky masks (core.prepare.sky): high obliques showing the horizon; the sky is hidden from the alignment
     sky_masks: bool = False
     sky: Optional["SkyOptions"] = None  # when sky_masks (None = SkyOptions())
+    output_dir: Optional[str] = None  # the folder of prepared images (None = <workspace>/prepared)
 
 
 @dataclass

@@ -1,13 +1,9 @@
 """The "prepare" stage: screening, optional scanned-film restitution, user masks, the folder of prepared images.
 
-:func:`prepare_images_workspace` runs the scanned-film restitution of :mod:`core.prepare.scans` (fiducials,
-affine resampling, masks) when asked, rasterises the user's "ignore" polygons into the per-image masks
-(:mod:`core.prepare.masks`), screens every image (:mod:`core.prepare.screening`) and writes the folder of
-prepared images that "Align images" takes.
-
-Masks live in ``<workspace>/masks/<prepared image name>.png``.  The stage rewrites the masks it wrote last
-time; a mask it did not write (put there by hand) is merged into the new mask of its image and kept aside in
-``masks/.originals/`` so that the next run merges it again instead of the previous result.
+:func:`prepare_images_workspace` checks, runs and records the steps of :mod:`.folder`: the scanned-film
+restitution (:mod:`core.prepare.scans`), the user's "ignore" polygons and the sky rasterised into the per-image
+masks (:mod:`core.prepare.masks`, :mod:`core.prepare.sky`), the screening (:mod:`core.prepare.screening`) and
+the folder of prepared images that "Align images" takes.
 """
 from __future__ import annotations
 
@@ -15,29 +11,23 @@ import json
 import os
 import shutil
 import time
-from dataclasses import asdict, dataclass, field
-from typing import Dict, List, Optional, Sequence, Tuple
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional
 
-import numpy as np
-
-from ..common.files import atomic_output, atomic_write_text, file_fingerprint, fingerprint, read_json_record
-from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
-from ..io.images import list_images, scan_images
+from ..common.files import atomic_output, atomic_write_text, read_json_record
+from ..common.progress import NullProgress, Progress, check_cancel
+from ..io.images import list_images
 from ..project.layout import SCREENING_JSON, Layout
 from ..project.stages import PREPARE, run_stage
 from ..project.workspace import Workspace, WorkspaceError
-from . import masks as masksmod
-from . import scans
-from . import sky as skymod
-from .options import PrepareOptions, ScanOptions, SkyOptions
-from .screening import EXCLUDE, KEEP, ImageQuality, ScreeningError, screen_folder
+from . import folder
+from .folder import OUTPUT_MARKER
+from .options import PrepareOptions
+from .screening import ImageQuality, ScreeningError
 
 __all__ = ["OUTPUT_MARKER", "PrepareResult", "STAGE", "load_screening", "prepare_images_workspace"]
 
 STAGE = PREPARE
-OUTPUT_MARKER = ".archaeoortho-prepared"
-ORIGINALS = ".originals"  # masks/<this>/: masks this stage did not write, kept aside while it replaces them
-MASKS_STAGING = ".partial-masks-prepare"
 
 
 @dataclass
@@ -57,307 +47,75 @@ class PrepareResult:
     user_masked: Dict[str, int] = field(default_factory=dict)  # image -> user polygons applied
 
 
-@dataclass
-class _Screened:
-    """What the stage screens: the original images, or the prepared scans, with their masks."""
-    folder: str
-    names: List[str]
-    sizes: Dict[str, Tuple[int, int]]
-    aliases: Dict[str, str]  # original name -> prepared name (scanned film)
-    mask_files: Dict[str, str] = field(default_factory=dict)  # name -> staged mask
-    scan_set: Optional[scans.ScanSet] = None
-
-
-def _link_or_copy(src: str, dst: str) -> None:
-    try:
-        os.link(src, dst)
-    except OSError:
-        shutil.copy2(src, dst)
-
-
-def _check_output_dir(output_dir: str, images_dir: str, ws_root: str) -> None:
-    out = os.path.realpath(output_dir)
-    src = os.path.realpath(images_dir)
-    if out == src or src.startswith(out + os.sep):
-        raise ScreeningError(f"the output folder {output_dir} must not be the image folder or hold it: "
-                             "choose a new folder for the prepared images")
-    if out == os.path.realpath(ws_root) or os.path.realpath(ws_root).startswith(out + os.sep):
-        raise ScreeningError(f"the output folder {output_dir} must not be the workspace or hold it")
-    if os.path.isfile(output_dir):
-        raise ScreeningError(f"the output folder {output_dir} exists and is a file")
-    if os.path.isdir(output_dir) and os.listdir(output_dir) and \
-            not os.path.exists(os.path.join(output_dir, OUTPUT_MARKER)):
-        raise ScreeningError(f"the output folder {output_dir} already holds files that 'Prepare images' did not "
-                             "write; choose an empty or new folder (it is replaced as a whole)")
-
-
 def _json(obj) -> str:
     return json.dumps(obj, indent=2, default=str)
 
 
-def _foreign_mask(lay: Layout, name: str, ours: Sequence[str]) -> Optional[str]:
-    """A mask of ``name`` that this stage did not write (by hand, another tool), or None."""
-    kept = os.path.join(lay.masks_dir, ORIGINALS, masksmod.mask_file_name(name))
-    if os.path.isfile(kept):
-        return kept
-    ours = {os.path.normpath(r) for r in ours}
-    for cand in (masksmod.mask_file_name(name), os.path.splitext(name)[0] + ".png"):
-        p = os.path.join(lay.masks_dir, cand)
-        if os.path.isfile(p) and os.path.normpath(os.path.relpath(p, lay.root)) not in ours:
-            return p
-    return None
-
-
-def _polygon_record(polygons: Sequence, source: str) -> dict:
-    """JSON-able digest of the user polygons for the stage parameters; raises MaskError for a malformed one."""
-    polys = masksmod.to_polygons(polygons, source)
-    return {"count": len(polys), "images": sorted({p.image or "*" for p in polys}),
-            "fingerprint": fingerprint([(p.image, [np.round(r, 3).tolist() for r in p.rings]) for p in polys])}
-
-
-def _fingerprint_files(folder: str, names: Sequence[str]) -> str:
-    return fingerprint([(n, file_fingerprint(os.path.join(folder, n))) for n in names])
-
-
-def _summary(quality: Sequence[ImageQuality]) -> dict:
-    return {
-        "flagged": sum(1 for q in quality if q.flags),
-        "excluded": sum(1 for q in quality if q.decision == EXCLUDE),
-        "kept": sum(1 for q in quality if q.decision == KEEP),
-        "median": {k: round(float(np.median([getattr(q, k) for q in quality])), 5) for k in
-                   ("blur_score", "dynamic_range", "brightness", "exposure_score")},
-    }
-
-
-def _check_images(images_dir: str, progress: Progress) -> Tuple[List[str], Dict[str, Tuple[int, int]], List[str]]:
-    """(usable images, their sizes, warnings naming each skipped file and why) by the rule of 'Align images'
-    (:func:`core.io.images.scan_images`: every file is opened and its pixels decoded; an empty file, a file that is
-    not an image, a truncated one is skipped with a warning); ScreeningError, before any work, when fewer than 2
-    usable images remain."""
-    infos, skipped = scan_images(images_dir, progress=SubProgress(progress, 0.0, 0.03))
-    for w in skipped:
-        progress.warning(w)
-    if len(infos) < 2:
-        found = f"only one usable image ({infos[0].name})" if infos else "no usable image"
-        why = ("; ".join(skipped)) if skipped else "no other image file"
-        raise ScreeningError(f"{found} in {images_dir}: at least 2 are needed ({why})")
-    return [i.name for i in infos], {i.name: (i.width, i.height) for i in infos}, skipped
-
-
-def _parameters(options: PrepareOptions, output_dir: str, polygons: Sequence) -> dict:
-    params = {"screening": asdict(options.screening), "scanned_film": options.scanned_film,
-              "scan": asdict(options.scan) if options.scanned_film and options.scan is not None else None,
-              "output_dir": output_dir}
-    if options.sky_masks:
-        params["sky"] = asdict(options.sky or SkyOptions())
-    if polygons:  # a malformed polygon fails here, before the stage starts, by name
-        params["mask_polygons"] = dict(_polygon_record(polygons, options.mask_source), source=options.mask_source,
-                                       y_axis=options.mask_y_axis)
-    return params
-
-
-def _restitute_scans(images_dir: str, names: Sequence[str], tmp: str, staging: str, options: PrepareOptions,
-                     progress: Progress, warnings: List[str]) -> _Screened:
-    """Scanned film: every scan resampled into the fiducial frame (into ``tmp``), its mask into ``staging``."""
-    os.makedirs(staging)
-    scan_set = scans.prepare_scans([os.path.join(images_dir, n) for n in names], tmp, staging,
-                                   options.scan or ScanOptions(), SubProgress(progress, 0.03, 0.75))
-    warnings.extend(scan_set.warnings)
-    return _Screened(folder=tmp, names=[s.prepared_name for s in scan_set.scans],
-                     sizes={s.prepared_name: (scan_set.width, scan_set.height) for s in scan_set.scans},
-                     aliases={s.name: s.prepared_name for s in scan_set.scans},
-                     mask_files={s.prepared_name: os.path.join(staging, s.mask_name) for s in scan_set.scans},
-                     scan_set=scan_set)
-
-
-def _merge_user_masks(sc: _Screened, polygons: Sequence, foreign: Dict[str, str], staging: str,
-                      options: PrepareOptions, progress: Progress, warnings: List[str]) -> Dict[str, int]:
-    """The user's polygons and masks put in <workspace>/masks by hand merged into the staged masks; returns
-    image -> polygons applied."""
-    by_image, axis = masksmod.polygons_by_image(polygons, sc.names, sc.aliases, options.mask_source,
-                                                options.mask_y_axis)
-    bases = {n: [p for p in (sc.mask_files.get(n), foreign.get(n)) if p]
-             for n in sc.names if n in sc.mask_files or n in by_image}
-    os.makedirs(staging, exist_ok=True)
-    mres = masksmod.build_masks(by_image, sc.sizes, staging, bases, options.mask_source)
-    sc.mask_files.update(mres.masks)
-    warnings.extend(mres.warnings)
-    user_masked = {n: c for n, c in mres.polygons.items() if c}
-    if polygons:
-        progress.info(f"masks: {len(polygons)} polygons ({options.mask_source}, y "
-                      f"{'= -row' if axis == 'up' else 'down'}) hide parts of {len(user_masked)} "
-                      f"of {len(sc.names)} images")
-    return user_masked
-
-
-def _add_sky_masks(sc: _Screened, foreign: Dict[str, str], staging: str, options: PrepareOptions,
-                   progress: Progress, warnings: List[str]) -> Dict[str, float]:
-    """The sky detector (core.prepare.sky) on every image; its masks merged into the staged ones (or the masks put
-    in <workspace>/masks by hand); returns image -> share hidden as sky."""
-    bases = {n: sc.mask_files.get(n) or foreign.get(n) for n in sc.names}
-    res = skymod.write_sky_masks(sc.folder, sc.names, staging, options.sky or SkyOptions(), bases,
-                                 SubProgress(progress, 0.03, 0.2))
-    sc.mask_files.update(res.masks)
-    warnings.extend(res.warnings)
-    progress.info(f"sky: {len(res.masks)} of {len(sc.names)} images show sky, hidden from the alignment")
-    return dict(res.sky_fraction)
-
-
-def _fill_prepared(tmp: str, images_dir: str, quality: Sequence[ImageQuality], scanned_film: bool) -> None:
-    """The prepared folder: kept images only (links to the originals, or the prepared scans)."""
-    if not any(q.decision == KEEP for q in quality):
-        raise ScreeningError("every image was flagged and excluded; lower the thresholds or keep "
-                             "flagged images")
-    for q in quality:
-        if scanned_film:
-            if q.decision == EXCLUDE:
-                os.unlink(os.path.join(tmp, q.prepared_name))
-        elif q.decision == KEEP:
-            _link_or_copy(os.path.join(images_dir, q.name), os.path.join(tmp, q.name))
-    with open(os.path.join(tmp, OUTPUT_MARKER), "w", encoding="utf-8") as f:
-        f.write(f"prepared by ArchaeoOrtho from {images_dir}\n")
-
-
-def _place_masks(lay: Layout, previous_masks: Sequence[str], quality: Sequence[ImageQuality],
-                 mask_files: Dict[str, str]) -> List[str]:
-    """Replace the masks this stage wrote last time by the new ones; returns them relative to the workspace."""
-    masks_dir = lay.masks_dir
-    for rel in previous_masks:  # masks this stage wrote last time
-        p = lay.path(rel)
-        if os.path.isfile(p) and os.path.dirname(os.path.abspath(p)) == masks_dir:
-            os.unlink(p)
-    originals = os.path.join(masks_dir, ORIGINALS)
-    if os.path.isdir(originals):  # masks set aside last time go back to their place
-        for f in os.listdir(originals):
-            src, dst = os.path.join(originals, f), os.path.join(masks_dir, f)
-            if os.path.exists(dst):
-                os.unlink(src)  # replaced by hand since: the newer one stays
-            else:
-                os.replace(src, dst)
-        shutil.rmtree(originals, ignore_errors=True)
-    written = []
-    for q in quality:
-        src = mask_files.get(q.prepared_name)
-        if q.decision == KEEP and src and os.path.isfile(src):
-            os.makedirs(masks_dir, exist_ok=True)
-            dst = os.path.join(masks_dir, os.path.basename(src))
-            if os.path.isfile(dst):  # not ours: merged into the new mask, kept aside for the next run
-                os.makedirs(originals, exist_ok=True)
-                os.replace(dst, os.path.join(originals, os.path.basename(dst)))
-            os.replace(src, dst)
-            written.append(os.path.relpath(dst, lay.root))
-    return written
-
-
-def _screening_doc(images_dir: str, output_dir: str, options: PrepareOptions, quality: Sequence[ImageQuality],
-                   summary: dict) -> dict:
-    return {
-        "images_dir": images_dir, "prepared_dir": output_dir, "options": asdict(options.screening),
-        "scanned_film": options.scanned_film, "median": summary["median"],
-        "flagged": summary["flagged"], "excluded": summary["excluded"], "kept": summary["kept"],
-        "blurriest_first": [q.name for q in sorted(quality, key=lambda q: q.blur_rank)],
-        "images": [q.to_dict() for q in quality],
-    }
-
-
-def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Optional[str] = None,
-                             options: Optional[PrepareOptions] = None,
+def prepare_images_workspace(images_dir: str, workspace_dir: str, options: Optional[PrepareOptions] = None,
                              progress: Optional[Progress] = None) -> PrepareResult:
     """The "prepare" stage: screening, optional scanned-film restitution, the folder of prepared images.
 
-    Writes ``output_dir`` (default ``<workspace>/prepared``; replaced as a whole
-    and renamed into place only when complete), ``<workspace>/screening.json``,
-    for scanned film ``<workspace>/scans.json`` and ``<workspace>/masks/<prepared
-    image name>.png`` (COLMAP's convention: white = use, black = ignore), and
-    the stage record.  Raises ImageError (naming the file), ScreeningError,
-    core.prepare.scans.ScanError, WorkspaceError or Cancelled.  A file that cannot be used (empty, not an
-    image, truncated) is skipped with a warning naming it and why (in ``warnings`` and the stage's
-    ``skipped_files``), as 'Align images' skips it; fewer than 2 usable images is a ScreeningError.  A scan
-    whose fiducial marks cannot give its restitution is left out the same way (a warning naming it and why,
-    the stage's ``left_out_scans``; :func:`core.prepare.scans.prepare_scans`).
+    Writes ``options.output_dir`` (default ``<workspace>/prepared``; replaced as a whole and renamed into place
+    only when complete), ``<workspace>/screening.json``, for scanned film ``<workspace>/scans.json`` and
+    ``<workspace>/masks/<prepared image name>.png`` (COLMAP's convention: white = use, black = ignore), and the
+    stage record.  Raises ImageError (naming the file), ScreeningError, core.prepare.scans.ScanError,
+    WorkspaceError or Cancelled.  A file that cannot be used (empty, not an image, truncated) is skipped with a
+    warning naming it and why (in ``warnings`` and the stage's ``skipped_files``), as 'Align images' skips it;
+    fewer than 2 usable images is a ScreeningError.  A scan whose fiducial marks cannot give its restitution is
+    left out the same way (a warning naming it and why, the stage's ``left_out_scans``).
     """
     options = options or PrepareOptions()
     progress = progress or NullProgress()
     t_start = time.time()
     images_dir = os.path.abspath(images_dir)
-    names = list_images(images_dir)  # ImageError when the folder is missing
-    if not names:
+    if not list_images(images_dir):  # ImageError when the folder is missing
         raise ScreeningError(f"no images (.jpg, .tif, .png) in {images_dir}")
     ws = Workspace.create_or_open(workspace_dir)
     lay = Layout(ws)
-    output_dir = os.path.abspath(output_dir or lay.prepared_dir)
-    _check_output_dir(output_dir, images_dir, ws.root)
-    warnings: List[str] = []
+    output_dir = os.path.abspath(options.output_dir or lay.prepared_dir)
+    folder.check_output_dir(output_dir, images_dir, ws.root)
     t0 = time.time()
-    names, sizes, skipped = _check_images(images_dir, progress)
-    warnings.extend(skipped)
+    names, sizes, skipped = folder.check_images(images_dir, progress)
+    warnings: List[str] = list(skipped)
     check_seconds = time.time() - t0
-    polygons = list(options.mask_polygons or [])
-    params = _parameters(options, output_dir, polygons)
-    staging = lay.path(MASKS_STAGING)
+    params = folder.parameters(options, output_dir)
+    staging = lay.path(folder.MASKS_STAGING)
     try:
-        with run_stage(ws, STAGE, params, {"images": _fingerprint_files(images_dir, names)}) as run:
-            previous_masks = list((run.record.get("outputs") or {}).get("masks") or [])
+        with run_stage(ws, STAGE, params, {"images": folder.fingerprint_files(images_dir, names)}) as run:
+            place = folder.MaskPlace(lay, list((run.record.get("outputs") or {}).get("masks") or []), staging)
             with atomic_output(output_dir) as tmp:
                 os.makedirs(tmp)
                 shutil.rmtree(staging, ignore_errors=True)
-                if options.scanned_film:
-                    with run.step("scans", save=False):
-                        sc = _restitute_scans(images_dir, names, tmp, staging, options, progress, warnings)
-                    sp = SubProgress(progress, 0.75, 0.95)
-                else:
-                    sc = _Screened(folder=images_dir, names=list(names), sizes=sizes, aliases={})
-                    sp = SubProgress(progress, 0.03, 0.90)
-                # masks: the scans', the user's polygons and masks put in <workspace>/masks by hand, merged
-                foreign = {n: p for n in sc.names for p in [_foreign_mask(lay, n, previous_masks)] if p}
-                user_masked: Dict[str, int] = {}
-                if polygons or (sc.mask_files and foreign):
-                    with run.step("masks", save=False):
-                        user_masked = _merge_user_masks(sc, polygons, foreign, staging, options, progress,
-                                                        warnings)
-                sky_masked: Dict[str, float] = {}
-                if options.sky_masks:
-                    with run.step("sky", save=False):
-                        sky_masked = _add_sky_masks(sc, foreign, staging, options, progress, warnings)
-                screen_masks = dict(foreign)
-                screen_masks.update(sc.mask_files)
-                with run.step("screening", save=False):
-                    quality = screen_folder(sc.folder, options.screening, sp, sc.names, screen_masks, check=False)
-                # screening measured prepared scans: report under the original names (a scan left out by
-                # the restitution has none)
-                original = {v: k for k, v in sc.aliases.items()}
-                for q in quality:
-                    q.prepared_name = q.name
-                    q.name = original.get(q.name, q.name)
+                found = folder.screen_images(folder.Screened(images_dir, list(names), sizes, {}), tmp, place,
+                                             options, progress, run.step, warnings)
+                sc, quality = found.images, found.quality
                 check_cancel(progress)
-                _fill_prepared(tmp, images_dir, quality, options.scanned_film)
+                folder.fill_prepared(tmp, images_dir, quality, options.scanned_film)
                 check_cancel(progress)
                 progress.report(0.96, "writing the screening record")
                 # last step inside the atomic block: nothing below can be cancelled
-                written_masks = _place_masks(lay, previous_masks, quality, sc.mask_files)
+                written_masks = folder.place_masks(lay, place.previous, quality, sc.mask_files)
                 shutil.rmtree(staging, ignore_errors=True)
-                summary = _summary(quality)
-                atomic_write_text(lay.screening_json, _json(_screening_doc(images_dir, output_dir, options,
-                                                                           quality, summary)))
-                scans_path = None
+                summary = folder.screening_summary(quality)
+                atomic_write_text(lay.screening_json, _json(folder.screening_doc(images_dir, output_dir, options,
+                                                                                 quality, summary)))
                 if sc.scan_set is not None:
-                    scans_path = lay.scans_json
-                    atomic_write_text(scans_path, _json(sc.scan_set.to_dict()))
+                    atomic_write_text(lay.scans_json, _json(sc.scan_set.to_dict()))
+            scans_path = lay.scans_json if sc.scan_set is not None else None
             outputs = {"prepared_images": output_dir, "screening": lay.rel(lay.screening_json),
-                       "masks": written_masks}
-            if scans_path:
-                outputs["scans"] = os.path.basename(scans_path)
+                       "masks": written_masks, **({"scans": os.path.basename(scans_path)} if scans_path else {})}
             io = sc.scan_set.interior_orientation if sc.scan_set is not None else None
             run.finish(outputs=outputs, results={
                 "images": len(quality), "flagged": summary["flagged"], "excluded": summary["excluded"],
                 "kept": summary["kept"], "median_blur_score": summary["median"]["blur_score"],
                 "decisions": {q.name: {"decision": q.decision, "flags": q.flags} for q in quality},
                 "interior_orientation": io, "masks": len(written_masks),
-                "user_masked_images": {n: user_masked[n] for n in sorted(user_masked)},
+                "user_masked_images": {n: found.user_masked[n] for n in sorted(found.user_masked)},
                 "skipped_files": list(skipped),
                 **({"left_out_scans": dict(sc.scan_set.left_out)} if sc.scan_set is not None and sc.scan_set.left_out
                    else {}),
-                **({"sky_masked_images": {n: sky_masked[n] for n in sorted(sky_masked)}} if options.sky_masks else {}),
+                **({"sky_masked_images": {n: found.sky_masked[n] for n in sorted(found.sky_masked)}}
+                   if options.sky_masks else {}),
                 "total_seconds": round(time.time() - t_start, 2)})
     finally:
         shutil.rmtree(staging, ignore_errors=True)
@@ -368,7 +126,7 @@ def prepare_images_workspace(images_dir: str, workspace_dir: str, output_dir: Op
         workspace=ws.root, prepared_dir=output_dir, screening_path=lay.screening_json, images=quality,
         flagged=summary["flagged"], excluded=summary["excluded"], kept=summary["kept"],
         scans_path=scans_path, masks=[ws.path(m) for m in written_masks], interior_orientation=io,
-        warnings=warnings, timings=timings, user_masked=user_masked)
+        warnings=warnings, timings=timings, user_masked=found.user_masked)
 
 
 def load_screening(workspace_dir: str) -> Optional[dict]:
