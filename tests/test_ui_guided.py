@@ -197,8 +197,8 @@ def test_matching_refines_a_prediction_that_is_tens_of_pixels_off(block, georefe
         truth = p.observations[tgt]
         off = truth + np.array([40.0, -25.0])
         tried += 1
-        m = guided.refine_by_matching(rec, ref, p.observations[ref], gray[ref], tgt, off, gray[tgt], xyz,
-                                      radius=120)
+        m = guided.refine_by_matching(rec, guided.PhotoPoint(ref, p.observations[ref], gray[ref]),
+                                      guided.PhotoPoint(tgt, off, gray[tgt]), xyz, guided.MatchSearch(radius=120))
         if m is None:
             continue
         found += 1
@@ -209,7 +209,8 @@ def test_matching_refines_a_prediction_that_is_tens_of_pixels_off(block, georefe
     assert errs.max() < 1.0
     # nothing to find in a blank photo
     blank = np.full_like(gray[ref], 128)
-    assert guided.refine_by_matching(rec, ref, p.observations[ref], gray[ref], tgt, truth, blank, xyz) is None
+    assert guided.refine_by_matching(rec, guided.PhotoPoint(ref, p.observations[ref], gray[ref]),
+                                     guided.PhotoPoint(tgt, truth, blank), xyz) is None
     del pred
 
 

@@ -347,8 +347,8 @@ class GcpPlacement:
                 refs = sorted(point.observations, key=lambda o: self._baseline(o.image, image))
                 for ref in refs[:2]:
                     match = guided.refine_by_matching(
-                        self.predictor.rec, ref.image, (ref.x, ref.y), self._gray_image(ref.image), image,
-                        pred.xy, tgt, xyz, radius=min(600.0, 0.3 * size))
+                        self.predictor.rec, guided.PhotoPoint(ref.image, (ref.x, ref.y), self._gray_image(ref.image)),
+                        guided.PhotoPoint(image, pred.xy, tgt), xyz, guided.MatchSearch(radius=min(600.0, 0.3 * size)))
                     if match is not None:
                         break
             except Exception:  # noqa: BLE001 - matching is a help, never an obstacle

@@ -61,8 +61,9 @@ def match_in_background(rec, refs, image, image_path, pred_xy, xyz, radius, prog
     for k, (ref_image, ref_xy, ref_path) in enumerate(refs):
         check_cancel(progress)
         progress.report(k / max(1, len(refs)), ref_image)
-        match = guided.refine_by_matching(rec, ref_image, ref_xy, guided.read_gray(ref_path), image, pred_xy,
-                                          target, xyz, radius=radius)
+        match = guided.refine_by_matching(rec, guided.PhotoPoint(ref_image, ref_xy, guided.read_gray(ref_path)),
+                                          guided.PhotoPoint(image, pred_xy, target), xyz,
+                                          guided.MatchSearch(radius=radius))
         if match is not None:
             return match
     return None

@@ -375,6 +375,27 @@ class Match:
     shift: float  # distance from the prediction (pixels)
 
 
+@dataclass
+class PhotoPoint:
+    """A point in a photo: the image's name in the model, its pixel (x, y), and the photo as a 2-D uint8 / float
+    array (pixel centres at +0.5, as everywhere)."""
+
+    image: str
+    xy: Sequence[float]
+    gray: np.ndarray
+
+
+@dataclass(frozen=True)
+class MatchSearch:
+    """How a point is looked for in a photo: within ``radius`` pixels of its prediction, with a template of
+    2 x ``half`` + 1 pixels, accepted at a score of at least ``min_score`` and ``min_margin`` above any other peak."""
+
+    radius: float = 250.0
+    half: int = 20
+    min_score: float = 0.6
+    min_margin: float = 0.08
+
+
 def read_gray(path: str) -> np.ndarray:
     """A photo as an 8-bit grey array, pixels as stored (EXIF orientation not applied, as in COLMAP)."""
     cv2 = require("cv2", "reading the photos for guided placement")
@@ -391,21 +412,23 @@ def _camera_geometry(rec, name: str):
     return cam, m[:, :3], m[:, 3]
 
 
-def refine_by_matching(rec, ref_image: str, ref_xy: Sequence[float], ref_gray: np.ndarray,
-                       tgt_image: str, tgt_xy: Sequence[float], tgt_gray: np.ndarray, xyz_model: Sequence[float],
-                       radius: float = 250.0, half: int = 20, min_score: float = 0.6,
-                       min_margin: float = 0.08, normal: Optional[Sequence[float]] = None) -> Optional[Match]:
-    """Look for the point observed at ``ref_xy`` in ``ref_image`` around its predicted position ``tgt_xy``
-    in ``tgt_image``: the reference photo's neighbourhood of the point is re-projected into the target
+def refine_by_matching(rec, ref: PhotoPoint, tgt: PhotoPoint, xyz_model: Sequence[float],
+                       search: Optional[MatchSearch] = None, normal: Optional[Sequence[float]] = None
+                       ) -> Optional[Match]:
+    """Look for the point observed at ``ref.xy`` in ``ref.image`` around its predicted position ``tgt.xy``
+    in ``tgt.image``: the reference photo's neighbourhood of the point is re-projected into the target
     photo's geometry through the plane that faces the reference camera at the point's depth (``xyz_model``
     gives the depth), or through the plane of ``normal`` (model coordinates: the ground's up for obliques, whose
     views of the ground differ by more than a turn), then searched by normalised cross-correlation within
-    ``radius`` pixels.
+    ``search.radius`` pixels.
 
-    Returns the sub-pixel match, or None when it is weak (score < ``min_score``), ambiguous (another peak
-    within ``min_margin`` of the best), at the edge of the search window, or out of the image.
-    ``*_gray``: the photos as 2-D uint8 / float arrays (pixel centres at +0.5, as everywhere)."""
+    Returns the sub-pixel match, or None when it is weak (score < ``search.min_score``), ambiguous (another peak
+    within ``search.min_margin`` of the best), at the edge of the search window, or out of the image."""
     cv2 = require("cv2", "matching the GCP marks between photos")
+    search = search or MatchSearch()
+    ref_image, ref_xy, ref_gray = ref.image, ref.xy, ref.gray
+    tgt_image, tgt_xy, tgt_gray = tgt.image, tgt.xy, tgt.gray
+    radius, half, min_score, min_margin = search.radius, search.half, search.min_score, search.min_margin
     cam_r, rot_r, t_r = _camera_geometry(rec, ref_image)
     cam_t, rot_t, t_t = _camera_geometry(rec, tgt_image)
     c_r = -rot_r.T @ t_r
@@ -426,7 +449,7 @@ def refine_by_matching(rec, ref_image: str, ref_xy: Sequence[float], ref_gray: n
     p0 = np.array(p0[tgt_image][:2])
     shift0 = np.asarray(tgt_xy, dtype=float) - p0  # search around the prediction, template centred on p0
     r = int(math.ceil(radius + np.linalg.norm(shift0)))
-    ref = np.asarray(ref_gray, dtype=np.float32)
+    ref = np.asarray(ref_gray, dtype=np.float32)  # the arrays from here on
     tgt = np.asarray(tgt_gray, dtype=np.float32)
     # template: target pixels p0 + (du, dv) -> ray -> plane -> reference pixel; smaller near the frame's edge
     for h in (half, (3 * half) // 4, half // 2):
@@ -490,6 +513,6 @@ def refine_by_matching(rec, ref_image: str, ref_xy: Sequence[float], ref_gray: n
                  float(np.hypot(x - tgt_xy[0], y - tgt_xy[1])))
 
 
-__all__ = ["GEOREF", "HELMERT", "RAYS", "Match", "Prediction", "Predictor", "ground_sample_distance",
-           "image_footprints", "images_seeing", "project_point", "read_gray", "refine_by_matching",
+__all__ = ["GEOREF", "HELMERT", "RAYS", "Match", "MatchSearch", "PhotoPoint", "Prediction", "Predictor",
+           "ground_sample_distance", "image_footprints", "images_seeing", "project_point", "read_gray", "refine_by_matching",
            "write_footprints_gpkg"]

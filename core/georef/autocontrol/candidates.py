@@ -23,7 +23,7 @@ import numpy as np
 from ...common.progress import NullProgress, Progress, check_cancel
 from ...geometry.similarity import Similarity, helmert_fit
 from ...io.gcp import Observation
-from ..guided import refine_by_matching
+from ..guided import MatchSearch, PhotoPoint, refine_by_matching
 from ..triangulate import triangulate_observations
 from .options import AUTO
 from .provisional import Frame, ProvisionalOrtho, project, read_photo, registered
@@ -215,9 +215,9 @@ def _observe(rec, c: Candidate, first: str, p_model: np.ndarray, lookup, grey: _
         pj, ok, _ = project(rec, im, p_model[None], margin=margin)
         if not ok[0]:
             continue
-        m = refine_by_matching(rec, first, u0, grey[first], name, (float(pj[0, 0]), float(pj[0, 1])), grey[name],
-                               p_model, radius=opt.search_px, half=opt.template_half, min_score=opt.min_score,
-                               normal=up)
+        m = refine_by_matching(rec, PhotoPoint(first, u0, grey[first]),
+                               PhotoPoint(name, (float(pj[0, 0]), float(pj[0, 1])), grey[name]), p_model,
+                               MatchSearch(opt.search_px, opt.template_half, opt.min_score), normal=up)
         if m is not None:
             obs.append(Observation(name, m.x, m.y))
             scores.append(m.score)
