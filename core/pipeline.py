@@ -62,15 +62,17 @@ class Control:
 class PipelineOptions:
     """Each stage's options, once, and the chain settings.  The DSM's quality and resolution are
     ``dense.quality`` and ``dense.resolution``, the orthomosaic's resolution and blending ``ortho.resolution`` and
-    ``ortho.blending``: the stages take them from their options and nothing here overrides them."""
+    ``ortho.blending`` (its images filter ``ortho.images_filter``), the report's ``report``: the stages take them from
+    their options and nothing here overrides them."""
 
     align: AlignOptions = field(default_factory=AlignOptions)
     georef: GeorefOptions = field(default_factory=GeorefOptions)  # refine_intrinsics and the adjustment
     dense: DenseOptions = field(default_factory=DenseOptions)
     ortho: OrthoOptions = field(default_factory=OrthoOptions)
     report: ReportOptions = field(default_factory=ReportOptions)  # uncertainty, write_layers
+    # with sky_masks: the prepare stage's (screening, sky masks) before the alignment
+    prepare: PrepareOptions = field(default_factory=lambda: PrepareOptions(sky_masks=True))
     targets: FindTargetsOptions = field(default_factory=FindTargetsOptions)  # with Control.targets_path
-    images_filter: Optional[str] = None
     make_report: bool = True  # False: the chain stops after the orthomosaic (and the terrain products)
     make_dtm: bool = True  # the DTM (seconds for a DSM of a few million cells)
     contour_interval: float = 0.0  # m; 0 = no contours
@@ -164,8 +166,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
                          cpu_seconds=cpu_seconds)
     aligned_from = images_dir
     if opt.sky_masks:  # the photos with their sky masks, so that no tie or dense point comes from the sky
-        res.prepare = run(PREPARE, prepare_images_workspace, images_dir, workspace_dir,
-                          options=PrepareOptions(sky_masks=True))
+        res.prepare = run(PREPARE, prepare_images_workspace, images_dir, workspace_dir, options=opt.prepare)
         res.warnings += res.prepare.warnings
         progress.info(f"prepare: {len(res.prepare.masks)} sky mask(s), {res.prepare.kept} of "
                       f"{len(res.prepare.images)} photos kept")
@@ -188,8 +189,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
     res.warnings += res.georef.warnings
     res.dsm = run(DSM, build_dsm_workspace, workspace_dir, options=opt.dense)
     res.warnings += res.dsm.warnings
-    res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, options=opt.ortho if not opt.images_filter
-                    else dataclasses.replace(opt.ortho, images_filter=opt.images_filter))
+    res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, options=opt.ortho)
     res.warnings += res.ortho.warnings
     if opt.make_dtm:
         res.dtm = run(TERRAIN, build_dtm_workspace, workspace_dir,
@@ -197,8 +197,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
         if opt.relief:
             res.relief = run(RELIEF, relief_workspace, workspace_dir, list(opt.relief), source="dtm")
     if opt.make_report:
-        res.report = run(REPORT, build_report, workspace_dir, uncertainty=opt.report.uncertainty,
-                         write_layers=opt.report.write_layers)
+        res.report = run(REPORT, build_report, workspace_dir, options=opt.report)
         res.warnings += res.report.warnings
     progress.report(1.0, "pipeline done")
     return res
