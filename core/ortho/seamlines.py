@@ -15,6 +15,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from ..common.errors import ArchaeoOrthoError
 from ..common.files import atomic_output
 from ..io import raster as dsmmod
 from ..io.vector import VectorError, open_vector
@@ -125,6 +126,22 @@ def _unknown_crs(out: SeamlineEdits, path: str, crs: Optional[str], extent) -> N
                                 f"{ymin:.0f}..{ymax:.0f} in {crs}): save the layer in the mosaic's CRS ({crs}) with its CRS")
     out.notes.append(f"seamlines {path}: the layer's CRS is unknown (no .prj?): its coordinates are taken as the "
                      f"mosaic's CRS ({crs})")
+
+
+def dsm_extent(dsm_path: str, crs: Optional[str]) -> Optional[Tuple[float, float, float, float]]:
+    """The DSM's bounds in the mosaic's CRS (the mosaic lies within them: the ``extent`` of
+    :func:`read_seamline_edits`), None when they cannot be told."""
+    from ..geometry.crs import transform_points
+
+    try:
+        info = dsmmod.open_dsm(dsm_path)
+        b = np.array([[info.bounds[0], info.bounds[1]], [info.bounds[2], info.bounds[3]],
+                      [info.bounds[0], info.bounds[3]], [info.bounds[2], info.bounds[1]]])
+        if crs and info.crs_wkt:
+            b = transform_points(b, info.crs_wkt, crs)
+    except (dsmmod.DsmError, ArchaeoOrthoError):
+        return None
+    return float(b[:, 0].min()), float(b[:, 1].min()), float(b[:, 0].max()), float(b[:, 1].max())
 
 
 def read_seamline_edits(source: str, names: Sequence[str], crs: Optional[str], left_out: Sequence[str] = (),

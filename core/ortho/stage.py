@@ -9,7 +9,6 @@ from typing import Any, Dict, List, Optional, Tuple
 import numpy as np
 
 from ..align.photos import check_photos
-from ..common.errors import ArchaeoOrthoError
 from ..common.files import clean_debris, file_fingerprint, fingerprint
 from ..common.progress import NullProgress, Progress
 from ..io.images import ImageError
@@ -19,7 +18,7 @@ from ..project.workspace import Workspace
 from .cameras import OrthoCamera, cameras_from_reconstruction, select_cameras
 from .mosaic import WORK_PREFIX, build_orthomosaic
 from .options import OrthoError, OrthoOptions
-from .seamlines import edits_fingerprint, read_seamline_edits
+from .seamlines import dsm_extent, edits_fingerprint, read_seamline_edits
 
 STAGE = ORTHOPHOTO
 # options left out of the stage's recorded parameters: how it runs (not what it makes), and the paths the
@@ -73,7 +72,7 @@ def build_orthophoto_workspace(workspace_dir: str, options: Optional[OrthoOption
     with run_stage(lay.ws, STAGE, params, inputs) as run:
         if options.seamlines_in:  # before any work: a polygon naming an image the filter leaves out is named so
             read_seamline_edits(options.seamlines_in, [c.name for c in cams], crs, left_out=_left_out(lay, cams),
-                                images_filter=options.images_filter, extent=_extent(options.dsm_path, crs))
+                                images_filter=options.images_filter, extent=dsm_extent(options.dsm_path, crs))
         for debris in clean_debris(os.path.dirname(options.output), WORK_PREFIX):
             progress.info(f"removed {debris}, left by a killed run")
         result = build_orthomosaic(cams, crs, offset, options, progress)
@@ -88,22 +87,6 @@ def build_orthophoto_workspace(workspace_dir: str, options: Optional[OrthoOption
     return OrthoStageResult(lay.root, options.output, crs, result.resolution, result.images, result.valid_fraction,
                             options.per_image_folder, options.seamlines, result.timings, result.warnings,
                             result.log_lines, result.radiometry)
-
-
-def _extent(dsm_path: str, crs: Optional[str]) -> Optional[Tuple[float, float, float, float]]:
-    """The DSM's bounds in the mosaic's CRS (the mosaic lies within them), None when they cannot be told."""
-    from ..geometry.crs import transform_points
-    from ..io.raster import DsmError, open_dsm
-
-    try:
-        info = open_dsm(dsm_path)
-        b = np.array([[info.bounds[0], info.bounds[1]], [info.bounds[2], info.bounds[3]],
-                      [info.bounds[0], info.bounds[3]], [info.bounds[2], info.bounds[1]]])
-        if crs and info.crs_wkt:
-            b = transform_points(b, info.crs_wkt, crs)
-    except (DsmError, ArchaeoOrthoError):
-        return None
-    return float(b[:, 0].min()), float(b[:, 1].min()), float(b[:, 0].max()), float(b[:, 1].max())
 
 
 def _left_out(lay: Layout, cams: List[OrthoCamera]) -> List[str]:
