@@ -72,6 +72,7 @@ from .coregister import (
     shorth,
 )
 from .errors import GeorefError
+from .options import GeorefOptions
 
 DEM_PREFIX = "dem"  # DEM control points are named dem001, dem002, ...
 FORMAT = "archaeoortho-dem-control"
@@ -405,12 +406,17 @@ def _heights(control: Optional[Tuple[float, int]], dz: float, sigma_z: np.ndarra
     return (HEIGHTS_CONTROL if abs(dz) > 3.0 * sig else HEIGHTS_BOTH), sig
 
 
-def dem_control(rec, offset: Sequence[float], ref_path: str, crs: str, *, control: Optional[Tuple[float, int]],
-                n: int = 25, ref_sigma_z: float = 0.0, taken: Sequence[str] = (), progress: Optional[Progress] = None
-                ) -> DemControl:
-    """The DEM control of an adjusted block: co-registration and control points.  ``control``: (RMS Z of the
+def dem_control(rec, offset: Sequence[float], options: GeorefOptions, *, control: Optional[Tuple[float, int]],
+                taken: Sequence[str] = (), progress: Optional[Progress] = None) -> DemControl:
+    """The DEM control of an adjusted block (local frame world - ``offset``): co-registration on
+    ``options.reference_dem`` in ``options.crs`` (the target CRS) and up to ``options.reference_dem_points`` control
+    points (``options.reference_dem_sigma_z``: the reference's own height error).  ``control``: (RMS Z of the
     control points' residuals, their number) when 3 or more control points fix the block's heights, else None (the
     module notes say which heights win).  ``taken``: ground point names already in use."""
+    ref_path, crs = options.reference_dem, options.crs
+    if not ref_path or not crs:
+        raise DemControlError(f"DEM control needs a reference DEM and a target CRS (got {ref_path!r} and {crs!r})")
+    n, ref_sigma_z = options.reference_dem_points, options.reference_dem_sigma_z
     progress = progress or NullProgress()
     co, xyz, ids, ref, gt, cells = coregister_block(rec, offset, ref_path, crs, progress)
     pc = control_points_from_coregistration(co, HeightGrid(ref, gt), points=xyz, n=n, ref_sigma_z=ref_sigma_z)

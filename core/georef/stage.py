@@ -249,8 +249,7 @@ def _dem_control(rec, first: GeorefResult, gcps: Optional[gcpmod.GCPSet], cams: 
     ctl = first.rmse(gcpmod.CONTROL)
     control = ((float(ctl["z"]), int(ctl["n"])) if demmod.has_height_control(gcps) and not placeholder and ctl["n"]
                and ctl["z"] is not None else None)
-    dc = demmod.dem_control(first.reconstruction, first.offset, opt.reference_dem, target, control=control,
-                            n=opt.reference_dem_points, ref_sigma_z=opt.reference_dem_sigma_z,
+    dc = demmod.dem_control(first.reconstruction, first.offset, opt, control=control,
                             taken=[p.name for p in gcps.points] if gcps is not None else (),
                             progress=SubProgress(progress, 0.45, 0.5))
     for m in dc.messages:
