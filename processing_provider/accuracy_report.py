@@ -85,14 +85,14 @@ class AccuracyReportAlgorithm(AlgorithmBase):
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
         from ..core.report import stage as report
+        from ..core.report.options import ReportOptions
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         output = self.parameterAsFileOutput(parameters, self.OUTPUT_HTML, context) or None
         progress = FeedbackProgress(feedback)
-        result = self.run_core(
-            report.build_report, workspace, output,
-            uncertainty=self.parameterAsBoolean(parameters, self.UNCERTAINTY, context),
-            progress=progress)
+        options = ReportOptions(uncertainty=self.parameterAsBoolean(parameters, self.UNCERTAINTY, context),
+                                output_html=output)
+        result = self.run_core(report.build_report, workspace, options, progress)
         progress.push_result(result.warnings)
         skipped = {k: v for k, v in result.sections.items() if v != "ok"}
         for k, v in skipped.items():

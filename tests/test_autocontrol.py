@@ -128,9 +128,10 @@ def test_rough_prior_georeferences_the_second_epoch_within_the_reference_resolut
     _assert_georeferenced(result, ws_dir, block)
     assert result.crs == syn.CRS
     # the report's georeferencing section tells the automatic control: the steps' counts and the map
+    from core.report.options import ReportOptions
     from core.report.stage import build_report
 
-    html = open(build_report(ws_dir, uncertainty=False).path, encoding="utf-8").read()
+    html = open(build_report(ws_dir, ReportOptions(uncertainty=False)).path, encoding="utf-8").read()
     assert "Automatic control" in html and "kept by the adjustment" in html
     assert "automatic control points" in html and os.path.basename(ortho) in html
 

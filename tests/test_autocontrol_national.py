@@ -272,9 +272,10 @@ def test_the_synthetic_block_against_a_national_reference(tmp_path, national_epo
     cameras = ogr.Open(result.cameras_path.split("|")[0])
     assert cameras.GetLayer(0).GetSpatialRef().IsSame(osr.SpatialReference(wkt=wkt))
     cameras = None
+    from core.report.options import ReportOptions
     from core.report.stage import build_report
 
-    html = open(build_report(ws_dir, uncertainty=False).path, encoding="utf-8").read()
+    html = open(build_report(ws_dir, ReportOptions(uncertainty=False)).path, encoding="utf-8").read()
     assert "Automatic control" in html and "no EPSG code: +proj=tmerc" in html
     if doc["dropped"]:
         assert "dropped because" in html and next(iter(doc["dropped"])) in html

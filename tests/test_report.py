@@ -21,6 +21,7 @@ from core.project.workspace import Workspace, WorkspaceError
 from core.report import stage as report
 from core.report.figures import hillshade
 from core.report.html import esc
+from core.report.options import ReportOptions
 from core.report.page import read_report_data
 from tests import synthetic as syn
 from tests.workspaces import synthetic_workspace
@@ -185,7 +186,7 @@ def test_sections_are_skipped_cleanly_when_stages_are_missing(aligned, tmp_path)
                              "decision": "keep", "blur_rank": k} for k in range(1, 4)]}
     with open(os.path.join(ws, "screening.json"), "w", encoding="utf-8") as f:
         json.dump(screening, f)
-    result = report.build_report(ws, uncertainty=True, write_layers=False)
+    result = report.build_report(ws, ReportOptions(uncertainty=True, write_layers=False))
     text = open(result.path, encoding="utf-8").read()
     assert result.sections["summary"] == "ok" and result.sections["orientation"] == "ok"
     assert "not georeferenced" in result.sections["georeferencing"]
@@ -237,7 +238,7 @@ def test_products_previews_with_resolution_and_valid_fraction(georeferenced, tmp
     rgb = np.dstack([(xx % 256), (yy % 256), np.full_like(xx, 128)]).astype(np.uint8)
     alpha = np.where(xx < 240, 255, 0).astype(np.uint8)  # 80 % valid
     _write_raster(os.path.join(ws, "orthomosaic.tif"), rgb, gt, alpha=alpha)
-    result = report.build_report(ws, uncertainty=False)
+    result = report.build_report(ws, ReportOptions(uncertainty=False))
     text = open(result.path, encoding="utf-8").read()
     assert result.sections["products"] == "ok"
     assert result.figures["DSM_VALID_FRACTION"] == pytest.approx(0.75, abs=1e-9)
@@ -254,7 +255,7 @@ def test_products_previews_with_resolution_and_valid_fraction(georeferenced, tmp
     manifest = json.load(open(os.path.join(ws, "workspace.json")))
     manifest["stages"]["dsm"] = {"status": "done", "results": {"VALID_FRACTION": 0.93}}
     json.dump(manifest, open(os.path.join(ws, "workspace.json"), "w"))
-    result = report.build_report(ws, uncertainty=False)
+    result = report.build_report(ws, ReportOptions(uncertainty=False))
     assert result.figures["DSM_VALID_FRACTION"] == pytest.approx(0.93)
     assert '<span data-key="dsm.valid">0.750</span>' in open(result.path, encoding="utf-8").read()
 
@@ -280,7 +281,7 @@ def test_cancel_never_leaves_a_report_that_looks_complete(georeferenced, tmp_pat
     if os.path.exists(out):
         os.unlink(out)
     with pytest.raises(Cancelled):
-        report.build_report(ws, progress=_CancelAt("products"), uncertainty=False)  # the last section
+        report.build_report(ws, ReportOptions(uncertainty=False), _CancelAt("products"))  # the last section
     assert not os.path.exists(out)
     assert not [f for f in os.listdir(ws) if f.startswith(".partial")]
     assert Workspace.open(ws).stage("report")["status"] == "cancelled"

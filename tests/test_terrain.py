@@ -289,9 +289,10 @@ def test_workspace_stage_classifies_the_point_cloud(scene_dsm, tmp_path):
     assert rec["status"] == "done" and {"dtm-slrm", "dsm-slrm"} <= set(rec["outputs"])
 
     # the report lists and previews them
+    from core.report.options import ReportOptions
     from core.report.stage import build_report
 
-    rep = build_report(root, uncertainty=False)
+    rep = build_report(root, ReportOptions(uncertainty=False))
     with open(rep.path, encoding="utf-8") as f:
         html = f.read()
     assert rep.sections["products"] == "ok"

@@ -94,16 +94,15 @@ def _sections(ctx: ReportContext, progress: Progress) -> Tuple[List[str], Dict[s
     return body, status
 
 
-def build_report(workspace_dir: str, output_html: Optional[str] = None, *, uncertainty: bool = True,
-                 write_layers: bool = True, progress: Optional[Progress] = None,
-                 options: Optional[ReportOptions] = None) -> ReportResult:
+def build_report(workspace_dir: str, options: Optional[ReportOptions] = None,
+                 progress: Optional[Progress] = None) -> ReportResult:
     """Write the HTML report of a workspace (see the module docstring); returns where and the key figures.
 
-    ``output_html``: default ``<workspace>/report.html``.  ``uncertainty``: compute the bundle-adjustment
-    covariance (``write_layers``: and write ``<workspace>/uncertainty/cameras.gpkg`` and ``points.gpkg``);
-    ``options`` (a :class:`ReportOptions`) replaces both.  Raises WorkspaceError (not a workspace),
-    ReportError, Cancelled."""
-    opts = options or ReportOptions(uncertainty=uncertainty, write_layers=write_layers)
+    :class:`ReportOptions`: ``output_html`` (default ``<workspace>/report.html``), ``uncertainty`` (compute the
+    bundle-adjustment covariance) and ``write_layers`` (and write ``<workspace>/uncertainty/cameras.gpkg`` and
+    ``points.gpkg``).  Raises WorkspaceError (not a workspace), ReportError, Cancelled."""
+    opts = options or ReportOptions()
+    output_html = opts.output_html
     progress = progress or NullProgress()
     t0 = time.time()
     ws = Workspace.open(workspace_dir)
