@@ -347,6 +347,24 @@ def test_select_cameras_by_name_wildcard_and_group():
         names("zzz*")
 
 
+def test_ortho_options_are_checked_when_made_and_carry_the_paths(tmp_path):
+    """OrthoOptions are the orthophoto stage's only settings (issue 35): a bad value is refused when they are
+    made, naming the setting; the mosaic takes its DSM and output from them and names the one missing."""
+    from core.ortho.mosaic import build_orthomosaic
+
+    with pytest.raises(OrthoError, match="BLENDING 'smooth'"):
+        OrthoOptions(blending="smooth")
+    with pytest.raises(OrthoError, match="RESOLUTION"):
+        OrthoOptions(resolution=-1.0)
+    with pytest.raises(OrthoError, match="tile size"):
+        OrthoOptions(tile=16)
+    opt = OrthoOptions(blending="MultiBand", resolution=1)
+    assert opt.blending == "multiband" and isinstance(opt.resolution, float)
+    with pytest.raises(OrthoError, match="output path"):
+        build_orthomosaic([], "EPSG:32632", [0.0, 0.0, 0.0], OrthoOptions(dsm_path=str(tmp_path / "dsm.tif")))
+    assert not os.listdir(tmp_path)
+
+
 def test_seamlines_move_to_where_the_images_agree():
     """Two images, equal view cost at column 20, but they disagree (a moving object) on columns 17-23: the seam
     leaves that band."""
