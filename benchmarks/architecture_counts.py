@@ -2,7 +2,8 @@
 
 - functions and methods of core/ taking more than 8 parameters (self/cls not counted, *args/**kwargs counted once);
 - underscore names imported from another module of the plugin (``from .x import _y``);
-- modules that open a raster with ``gdal.Open`` (the raster readers; the goal is one, in ``core/io``);
+- modules outside ``core/io`` that open a file with ``gdal.Open`` / ``gdal.OpenEx`` (the goal: none; rasters are
+  read through ``core.io.raster.RasterFile``, vectors through ``core.io.vector``);
 - stage modules (``core/*/stage.py``) over 150 lines.
 
 Static (ast), no imports of the plugin; prints a table and the worst offenders.
@@ -48,7 +49,8 @@ def counts(root=ROOT, limit=8):
                         private.append(f"{rel}:{node.lineno} {node.module or '.'}.{alias.name}")
             elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr in
                   ("Open", "OpenEx") and isinstance(node.func.value, ast.Name) and node.func.value.id == "gdal"):
-                readers.append(rel)
+                if not rel.replace(os.sep, "/").startswith("core/io/"):
+                    readers.append(rel)
         if os.path.basename(path) == "stage.py":
             lines = text.count("\n")
             if lines > 150:
@@ -65,7 +67,7 @@ def main():
     c = counts(args.root)
     rows = [("functions over 8 parameters in core", len(c["wide"]), "<= 8"),
             ("underscore names imported across modules", len(c["private"]), "0"),
-            ("core modules calling gdal.Open", len(c["readers"]), "1 (core/io)"),
+            ("core modules outside core/io calling gdal.Open", len(c["readers"]), "0"),
             ("stage modules over 150 lines", len(c["stages"]), "-")]
     print(f"{'count':45s} {'now':>5s}  goal")
     for name, value, goal in rows:

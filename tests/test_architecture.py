@@ -130,6 +130,48 @@ def test_no_long_function_or_class_in_core():
     assert not long, "\n".join(long)
 
 
+MAX_PARAMETERS = 8
+# functions of core/ that may take more than MAX_PARAMETERS (issue 35: at most 8 of them), each with the reason
+WIDE_ALLOWED = {"core/geometry/camera.py:simple": "the OPENCV camera's own parameters, each with its default"}
+
+
+def _parameter_count(node):
+    a = node.args
+    names = [p.arg for p in a.posonlyargs + a.args + a.kwonlyargs]
+    if names and names[0] in ("self", "cls"):
+        names = names[1:]
+    return len(names) + (a.vararg is not None) + (a.kwarg is not None)
+
+
+def test_functions_take_at_most_8_parameters():
+    """What travels together is one typed object (an options dataclass, a named group), not a long list of
+    arguments; benchmarks/architecture_counts.py prints the widest."""
+    wide = []
+    for _, path, tree, _ in _modules():
+        rel = os.path.relpath(path, ROOT).replace(os.sep, "/")
+        for node in ast.walk(tree):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and _parameter_count(node) > MAX_PARAMETERS:
+                if f"{rel}:{node.name}" not in WIDE_ALLOWED:
+                    wide.append(f"{rel}:{node.lineno} {node.name}: {_parameter_count(node)} parameters")
+    assert len(WIDE_ALLOWED) <= 8
+    assert not wide, f"functions over {MAX_PARAMETERS} parameters:\n" + "\n".join(wide)
+
+
+def test_only_core_io_opens_files_with_gdal():
+    """One reader: rasters through core.io.raster.RasterFile (DsmReader for heights), vectors through
+    core.io.vector; no other module of core/ calls gdal.Open or gdal.OpenEx."""
+    bad = []
+    for name, path, tree, _ in _modules():
+        if _room(name) == "io":
+            continue
+        for node in ast.walk(tree):
+            if (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+                    and node.func.attr in ("Open", "OpenEx", "OpenShared") and isinstance(node.func.value, ast.Name)
+                    and node.func.value.id == "gdal"):
+                bad.append(f"{os.path.relpath(path, ROOT)}:{node.lineno} gdal.{node.func.attr}")
+    assert not bad, "files opened with GDAL outside core/io:\n" + "\n".join(bad)
+
+
 def test_every_core_error_derives_from_the_one_base():
     """Every class named *Error in core/ has ArchaeoOrthoError among its bases (directly or through another
     core error), so the faces catch one base."""
