@@ -167,8 +167,8 @@ def child(args):
         from core.terrain.stage import TerrainOptions, build_dtm_workspace
         build_dtm_workspace(args.out, TerrainOptions(contour_interval=0.5), p)
     elif args.stage == "relief":
-        from core.terrain.stage import relief_workspace
-        relief_workspace(args.out, list(RELIEF_KEYS), source="dtm", progress=p)
+        from core.terrain.stage import ReliefStageOptions, relief_workspace
+        relief_workspace(args.out, ReliefStageOptions(list(RELIEF_KEYS), source="dtm"), p)
     elif args.stage == "report":
         from core.report.stage import build_report
         build_report(args.out, progress=p)

@@ -34,7 +34,7 @@ from .prepare.stage import prepare_images_workspace
 from .project.stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, PREPARE, RELIEF, REPORT, TERRAIN, StageError
 from .report.options import ReportOptions
 from .report.stage import build_report
-from .terrain.stage import TerrainOptions, build_dtm_workspace, relief_workspace
+from .terrain.stage import ReliefStageOptions, TerrainOptions, build_dtm_workspace, relief_workspace
 
 
 @dataclass
@@ -195,7 +195,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
         res.dtm = run(TERRAIN, build_dtm_workspace, workspace_dir,
                       TerrainOptions(contour_interval=opt.contour_interval))
         if opt.relief:
-            res.relief = run(RELIEF, relief_workspace, workspace_dir, list(opt.relief), source="dtm")
+            res.relief = run(RELIEF, relief_workspace, workspace_dir, ReliefStageOptions(list(opt.relief), source="dtm"))
     if opt.make_report:
         res.report = run(REPORT, build_report, workspace_dir, options=opt.report)
         res.warnings += res.report.warnings

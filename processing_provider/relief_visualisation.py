@@ -58,7 +58,7 @@ class ReliefVisualisationAlgorithm(AlgorithmBase):
         import os
 
         from ..core.terrain import stage
-        from ..core.terrain.options import VISUALISATION_KEYS
+        from ..core.terrain.options import VISUALISATION_KEYS, ReliefStageOptions
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context) or None
         layer = self.parameterAsRasterLayer(parameters, self.INPUT, context)
@@ -68,8 +68,8 @@ class ReliefVisualisationAlgorithm(AlgorithmBase):
         output = self.parameterAsOutputLayer(parameters, self.OUTPUT, context) or None
         progress = FeedbackProgress(feedback)
         if workspace and not dem:
-            result = self.run_core(stage.relief_workspace, workspace, [key], source=source, progress=progress,
-                                   copy_to=output)
+            result = self.run_core(stage.relief_workspace, workspace,
+                                   ReliefStageOptions([key], source=source, copy_to=output), progress)
             path = result.paths[key]
         else:
             if not dem or not output:

@@ -119,14 +119,14 @@ def test_relief_copy_over_the_workspace_dtm_is_refused(dsm, tmp_path):
     pytest.importorskip("rvt.vis")
     scene, path = dsm
     root, _ = _workspace_with_dsm(tmp_path / "ws", path, scene)
-    from core.terrain.stage import relief_workspace
+    from core.terrain.stage import ReliefStageOptions, relief_workspace
 
     lay = Layout(Workspace.open(root))
     before = _digest(lay.default_dsm)
     with pytest.raises(TerrainError, match="slrm visualisation would overwrite its input, the DSM"):
-        relief_workspace(root, ["slrm"], source="dsm", copy_to=lay.default_dsm)
+        relief_workspace(root, ReliefStageOptions(["slrm"], source="dsm", copy_to=lay.default_dsm))
     assert _digest(lay.default_dsm) == before
-    r = relief_workspace(root, ["slrm"], source="dsm", copy_to=str(tmp_path / "slrm.tif"))
+    r = relief_workspace(root, ReliefStageOptions(["slrm"], source="dsm", copy_to=str(tmp_path / "slrm.tif")))
     assert os.path.samefile(r.paths["slrm"], tmp_path / "slrm.tif")
 
 
@@ -164,7 +164,7 @@ def test_a_stale_dsm_or_dtm_is_refused(dsm, tmp_path):
     """After a re-georeference (into another CRS) the DSM on disk describes the old block: builddtm and the relief
     refuse it (issue 36 item 6) instead of building from it and recording done."""
     from core.project.stages import DSM, GEOREFERENCE, STALE, run_stage
-    from core.terrain.stage import relief_workspace
+    from core.terrain.stage import ReliefStageOptions, relief_workspace
 
     scene, path = dsm
     root, _ = _workspace_with_dsm(tmp_path / "ws", path, scene)
@@ -176,7 +176,7 @@ def test_a_stale_dsm_or_dtm_is_refused(dsm, tmp_path):
     with pytest.raises(TerrainError, match="DSM of workspace .* is stale: .*run 'Build DSM' again"):
         build_dtm_workspace(root)
     with pytest.raises(TerrainError, match="DTM of workspace .* is stale: .*run 'Build DTM' again"):
-        relief_workspace(root, ["slrm"], source="dtm")
+        relief_workspace(root, ReliefStageOptions(["slrm"], source="dtm"))
     assert Workspace.open(root).stage(TERRAIN)["status"] == STALE
     # a DSM file given explicitly (outside the workspace's records) is the user's choice
     r = build_dtm_workspace(root, TerrainOptions(dsm=path, output_dtm=str(tmp_path / "other-dtm.tif")))

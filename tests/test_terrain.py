@@ -20,7 +20,14 @@ from core.project.workspace import Workspace
 from core.terrain.contours import write_contours
 from core.terrain.options import SOURCE_INTERPOLATED, SOURCE_MEASURED, TerrainError
 from core.terrain.rasters import same_grid
-from core.terrain.stage import TerrainOptions, build_dtm, build_dtm_workspace, relief, relief_workspace
+from core.terrain.stage import (
+    ReliefStageOptions,
+    TerrainOptions,
+    build_dtm,
+    build_dtm_workspace,
+    relief,
+    relief_workspace,
+)
 from tests import synthetic as syn
 
 GSD = 40.0 / 325.0  # m: the synthetic block of tests/test_dense.py (altitude 40 m, fx 325 px)
@@ -282,9 +289,9 @@ def test_workspace_stage_classifies_the_point_cloud(scene_dsm, tmp_path):
     with open(again, "rb") as f:
         assert f.read() == data
 
-    rr = relief_workspace(root, ["slrm"], source="dtm")
+    rr = relief_workspace(root, ReliefStageOptions(["slrm"], source="dtm"))
     assert os.path.samefile(rr.paths["slrm"], lay.relief("slrm", "dtm"))
-    relief_workspace(root, ["slrm"], source="dsm")
+    relief_workspace(root, ReliefStageOptions(["slrm"], source="dsm"))
     rec = Workspace.open(root).stage(RELIEF)
     assert rec["status"] == "done" and {"dtm-slrm", "dsm-slrm"} <= set(rec["outputs"])
 
@@ -308,7 +315,7 @@ def test_workspace_without_dsm_says_what_to_run(tmp_path):
     with pytest.raises(TerrainError, match="Build DSM"):
         build_dtm_workspace(ws.root)
     with pytest.raises(TerrainError, match="Build DTM"):
-        relief_workspace(ws.root, ["svf"])
+        relief_workspace(ws.root, ReliefStageOptions(["svf"]))
 
 
 # ---------------------------------------------------------------------------
@@ -405,7 +412,7 @@ def test_products_load_styled_in_qgis(scene_dsm, tmp_path, qgis_new_project):
     scene, x, y, path, buildings, trees = scene_dsm
     root, _ = _workspace_with_dsm(tmp_path / "ws", path, scene)
     build_dtm_workspace(root, TerrainOptions(contour_interval=1.0))
-    relief_workspace(root, ["svf", "openness_neg"])
+    relief_workspace(root, ReliefStageOptions(["svf", "openness_neg"]))
     loaded = layers.load_workspace_results(root, QgsProject.instance())
     by_kind = {lyr.customProperty(layers.KIND_PROPERTY): lyr for lyr in loaded}
     assert by_kind["dtm"].renderer().type() == "singlebandpseudocolor"

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Optional, Tuple
+from typing import Optional, Sequence, Tuple
 
 from ..common.errors import ArchaeoOrthoError
 from ..io import raster
@@ -95,3 +95,22 @@ class TerrainOptions:
         if not (self.contour_interval >= 0 and math.isfinite(self.contour_interval)):
             raise TerrainError(f"the contour interval must be 0 (no contours) or a positive number of metres, got "
                                f"{self.contour_interval}")
+
+
+@dataclass
+class ReliefStageOptions:
+    """The relief stage of a workspace: the visualisations ``keys`` (:data:`VISUALISATION_KEYS`) of its DTM or DSM
+    (``source``), RVT's parameters, and a copy of the one visualisation at ``copy_to``."""
+
+    keys: Sequence[str]
+    source: str = "dtm"  # dtm / dsm
+    relief: ReliefOptions = None  # type: ignore[assignment]
+    copy_to: Optional[str] = None
+
+    def __post_init__(self):
+        if self.relief is None:
+            self.relief = ReliefOptions()
+        if self.source not in ("dtm", "dsm"):
+            raise TerrainError(f"relief source must be 'dtm' or 'dsm', got {self.source!r}")
+        if self.copy_to and len(self.keys) != 1:
+            raise TerrainError("a copy of the relief visualisation needs exactly one visualisation")

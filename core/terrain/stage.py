@@ -9,7 +9,7 @@ made on files by :mod:`.products` (:func:`.products.build_dtm`, :func:`.products
 from __future__ import annotations
 
 import os
-from typing import Optional, Sequence
+from typing import Optional
 
 from ..common.files import atomic_copy, file_fingerprint, refuse_overwriting_inputs, same_path
 from ..common.progress import Progress
@@ -17,7 +17,7 @@ from ..project.layout import Layout
 from ..project.stages import DSM, RELIEF, STALE, TERRAIN, run_stage
 from ..project.workspace import Workspace
 from .contours import check_contours_output
-from .options import ReliefOptions, TerrainError, TerrainOptions
+from .options import ReliefStageOptions, TerrainError, TerrainOptions
 from .products import DtmOutputs, DtmResult, ReliefResult, build_dtm, relief
 
 
@@ -81,31 +81,29 @@ def build_dtm_workspace(workspace_dir: str, options: Optional[TerrainOptions] = 
     return r
 
 
-def relief_workspace(workspace_dir: str, keys: Sequence[str], source: str = "dtm",
-                     options: Optional[ReliefOptions] = None, progress: Optional[Progress] = None,
-                     copy_to: Optional[str] = None) -> ReliefResult:
-    """The relief stage: visualisations of the workspace's DTM (``source`` 'dtm') or DSM ('dsm'); with
-    ``copy_to`` (one visualisation), a copy of it there as well (never over the DTM or DSM it is made from)."""
+def relief_workspace(workspace_dir: str, options: ReliefStageOptions,
+                     progress: Optional[Progress] = None) -> ReliefResult:
+    """The relief stage: the visualisations ``options.keys`` of the workspace's DTM (``options.source`` 'dtm') or
+    DSM ('dsm'); with ``options.copy_to`` (one visualisation), a copy of it there as well (never over the DTM or
+    DSM it is made from)."""
+    keys, source, copy_to = list(options.keys), options.source, options.copy_to
     ws = Workspace.open(workspace_dir)
     lay = Layout(ws)
-    if source not in ("dtm", "dsm"):
-        raise TerrainError(f"relief source must be 'dtm' or 'dsm', got {source!r}")
     dem = lay.dtm() if source == "dtm" else lay.dsm()
     if not dem:
         stage = "Build DTM" if source == "dtm" else "Build DSM"
         raise TerrainError(f"workspace {ws.root} has no {source.upper()}: run '{stage}' first")
     _refuse_stale(ws, TERRAIN if source == "dtm" else DSM, source.upper(),
                   "Build DTM" if source == "dtm" else "Build DSM")
-    if copy_to and len(keys) != 1:
-        raise TerrainError("a copy of the relief visualisation needs exactly one visualisation")
     refuse_overwriting_inputs({f"{keys[0]} visualisation" if keys else "visualisation": copy_to},
                               {source.upper(): dem}, TerrainError)
-    params = {"source": source, "keys": list(keys), "options": _result_options(options or ReliefOptions())}
+    params = {"source": source, "keys": keys, "options": _result_options(options.relief)}
     inputs = {source: file_fingerprint(dem)}
     recorded = {k: v for k, v in (ws.stage(RELIEF).get("outputs") or {}).items()  # the others made before
                 if os.path.isfile(lay.resolve(v))}
     with run_stage(ws, RELIEF, params, inputs) as run:
-        r = relief(dem, keys, os.path.dirname(lay.relief("x", source)), source, options, progress, source.upper())
+        r = relief(dem, keys, os.path.dirname(lay.relief("x", source)), source, options.relief, progress,
+                   source.upper())
         recorded.update({f"{source}-{k}": lay.rel(p) for k, p in r.paths.items()})
         for k, v in r.timings.items():
             ws.record_timing(RELIEF, f"{source}-{k}", v)
@@ -117,4 +115,4 @@ def relief_workspace(workspace_dir: str, keys: Sequence[str], source: str = "dtm
 
 
 __all__ = ["build_dtm", "build_dtm_workspace", "relief", "relief_workspace", "DtmOutputs", "DtmResult", "ReliefResult",
-           "TerrainOptions"]
+           "ReliefStageOptions", "TerrainOptions"]
