@@ -46,7 +46,7 @@ def affine_round(pycolmap, images, source_db, work, redo, sift):
     """Re-extract ``redo`` with ``sift`` in a copy of ``source_db``, match every pair touching them, map."""
     from core.align.escalation import forget_features
     from core.align.features import match_pairs
-    from core.align.mapping import run_mapping
+    from core.align.mapping import MappingJob, run_mapping
     from core.align.options import AlignOptions
     from core.common.progress import NullProgress
 
@@ -77,7 +77,8 @@ def affine_round(pycolmap, images, source_db, work, redo, sift):
     match_pairs(pycolmap, db_path, pairs, work, options, NullProgress())
     t2 = time.time()
     # the stage's own mapping (its relaxed second pass included), as an escalation round maps
-    recs = run_mapping(pycolmap, db_path, images, os.path.join(work, "sparse"), len(names), options, NullProgress())
+    recs = run_mapping(pycolmap, MappingJob(db_path, images, os.path.join(work, "sparse"), len(names)), options,
+                       NullProgress())
     t3 = time.time()
     rec = max(recs.values(), key=lambda r: r.num_reg_images()) if recs else None
     ties = {rec.images[i].name: int(rec.images[i].num_points3D) for i in rec.reg_image_ids()} if rec else {}

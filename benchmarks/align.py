@@ -14,7 +14,10 @@ options) on the same images, the second reference; ratios are printed against ea
                                [--pycolmap-defaults] [--mapper incremental|global] [--chain]
     python benchmarks/align.py --table [--sets small,toledo,...] [--only ours|pycolmap]
 
-``--table`` runs ours (default options: the fast path, escalation where it fails) and pycolmap's default
+``--sets farmland`` (or ``farmland-0.4``) adds tests/lowtexture_scene.py's synthetic farmland (issue 33: 20
+photos of 3600 x 2700, faint furrows at contrast 0.15), rendered once under ``<workdir>/table``.
+
+``--table`` runs ours (default options: the texture probe's first pass, escalation where it fails) and pycolmap's default
 pipeline on every shared set and the synthetic small frames, and prints one table: registered images, mean
 reprojection error, wall seconds, what was escalated.  Each run's result is kept under
 ``<workdir>/table/<set>/`` and reused by the next ``--table`` (delete it to measure again); ``--only`` runs one
@@ -45,7 +48,7 @@ def ours(images, work, threads, mapper="incremental", extra=None):
             "print('RESULT', json.dumps({'registered': r.registered, 'images': r.images_given,"
             "'mre': r.mean_reprojection_error, 'timings': r.timings, 'pairs': r.num_pairs,"
             "'pairing': r.pairing_used, 'points': r.num_points3d, 'others': r.other_components,"
-            "'escalation': r.escalation}))") % (ROOT, images, ws, threads, mapper, dict(extra or {}))
+            "'escalation': r.escalation, 'first_pass': (r.first_pass or {}).get('level')}))") % (ROOT, images, ws, threads, mapper, dict(extra or {}))
     log = os.path.join(work, "archaeoortho.log")
     rc, wall, rss = run_measured([sys.executable, "-c", code], log_path=log)
     if rc != 0:
@@ -229,12 +232,28 @@ def table_set(name, work):
         if not os.path.isdir(d):
             syn.orbit_block(**ORBIT).render(d)
         return d, {}, "8 x 45 deg + 8 x 65 deg off nadir (480 x 360), horizon and sky in the 65 deg views"
+    if name.startswith("farmland"):  # issue 33: tests/lowtexture_scene.py's 3600 x 2700 farmland, "farmland-0.4"
+        return _farmland(work, float(name.split("-")[1]) if "-" in name else 0.15)
     if name == "ochota_kap":
         return _half_size_copies(os.path.join(SHARED, name, "images"), os.path.join(work, "ochota-half")), {}, \
             "half size (2304 x 1728), EXIF kept"
     if name == "ochota_kap_full":
         return os.path.join(SHARED, "ochota_kap", "images"), {}, "full size (4608 x 3456, 16 MP)"
     return os.path.join(SHARED, name, "images"), {}, ""
+
+
+def _farmland(work, contrast, strips=4, per_strip=5):
+    """(images, options, note) of the synthetic farmland block (tests/lowtexture_scene.py full_block: 3600 x 2700
+    px, faint furrows at ``contrast``), rendered once under ``work`` (no EXIF: the focal length is given)."""
+    from tests import lowtexture_scene as lt
+
+    block = lt.full_block(strips, per_strip, contrast)
+    d = os.path.join(work, f"farmland-{contrast:g}-{strips * per_strip}")
+    if not os.path.exists(os.path.join(d, "done")):
+        block.render(os.path.join(d, "images"), keep_existing=True)
+        open(os.path.join(d, "done"), "w").close()
+    return os.path.join(d, "images"), {"focal_px": block.camera.fx}, \
+        f"synthetic farmland, {strips} x {per_strip} photos of 3600 x 2700, furrows at contrast {contrast:g}, no EXIF"
 
 
 def _cached(path, run, *args, **kw):
@@ -290,6 +309,8 @@ def _table_text(rows):
                 what = "; ".join(f"round {x['round']} ({x.get('kind', '')}): {len(x['left_out'])} left out, {len(x['re_extracted'])} "
                                  f"re-extracted, {x['registered_before']} -> {x['registered_after']}"
                                  for x in esc["rounds"])
+            if r.get("first_pass"):  # the texture probe's choice (core.align.firstpass) and its seconds
+                what = f"first pass {r['first_pass']} (probe {r['timings'].get('probe', 0):.1f} s); " + what
             split = f" + {len(r['others'])} other component(s)" if r.get("others") else ""
             cells += [f"{r['registered']}/{n}{split}", f"{r['mre']:.3f} px", _secs(mine), what]
         else:

@@ -112,9 +112,11 @@ def test_no_second_pass_for_images_without_a_verified_pair_into_the_block(monkey
     opts = pycolmap.IncrementalPipelineOptions()
     links = [("a.jpg", "b.jpg"), ("b.jpg", "c.jpg"), ("d.jpg", "e.jpg")]
     monkeypatch.setattr(mapping, "verified_links", lambda *a: (["a.jpg", "b.jpg", "c.jpg", "d.jpg", "e.jpg"], links))
-    out = mapping._register_rest(pycolmap, recs, "db", "imgs", str(tmp_path), 5, opts, NullProgress(), None)
+    out = mapping._register_rest(pycolmap, recs, mapping.MappingJob("db", "imgs", str(tmp_path), 5), opts, NullProgress(),
+                                 None)
     assert out is recs and not calls and not written
     # with a verified pair from a left-out photo into the block the pass runs (and, finding nothing, keeps the block)
     links.append(("c.jpg", "d.jpg"))
-    out = mapping._register_rest(pycolmap, recs, "db", "imgs", str(tmp_path), 5, opts, NullProgress(), None)
+    out = mapping._register_rest(pycolmap, recs, mapping.MappingJob("db", "imgs", str(tmp_path), 5), opts, NullProgress(),
+                                 None)
     assert calls == [1] and written and out[0] is recs[0]

@@ -4,13 +4,27 @@ from __future__ import annotations
 
 import math
 import os
-from typing import Collection, Dict, List, Sequence
+import shutil
+from dataclasses import dataclass
+from typing import Collection, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from ..common.cancel import CancelWatcher
 from ..common.progress import Progress, check_cancel
+from .calibrated import GivenCamera, restore_held
 from .options import AlignOptions
+
+
+@dataclass
+class MappingJob:
+    """What a mapping works on: the database, the photos' folder, a scratch folder for COLMAP's models, and how
+    many images were given."""
+
+    db_path: str
+    images_dir: str
+    out_dir: str
+    n_images: int
 
 
 def verified_links(pycolmap, db_path, min_inliers: int):
@@ -48,17 +62,17 @@ def verified_pairs(pycolmap, db_path, min_inliers: int) -> int:
         db.close()
 
 
-def run_mapping(pycolmap, db_path, images_dir, out_dir, n_images, options, progress: Progress,
-                hold_all: bool = False):
+def run_mapping(pycolmap, job: MappingJob, options: AlignOptions, progress: Progress, hold_all: bool = False):
     """The reconstructions of the database.  ``hold_all``: every camera's intrinsics are given and held
     (core.align.calibrated): no adjustment of the mapping refines focal length, principal point or distortion.
     COLMAP's switches are global: with some cameras held and some estimated the mapping refines all, and the stage
     sets the held ones back to their given values before the final bundle adjustment holds them."""
+    n_images = job.n_images
     if options.mapper == "global" and n_images <= 2:
         progress.info("mapping: two images, mapped with the incremental mapper (the global mapper needs tracks of "
                       "three or more views)")
     elif options.mapper == "global":
-        return _map_global(pycolmap, db_path, images_dir, out_dir, n_images, options, progress, hold_all)
+        return _map_global(pycolmap, job, options, progress, hold_all)
     opts = pycolmap.IncrementalPipelineOptions()
     if hold_all:
         opts.ba_refine_focal_length = False
@@ -84,11 +98,11 @@ def run_mapping(pycolmap, db_path, images_dir, out_dir, n_images, options, progr
         progress.report(min(1.0, state["n"] / max(1, n_images)), f"mapping: registered image {state['n']}")
 
     with CancelWatcher(progress) as token:
-        recs = pycolmap.incremental_mapping(db_path, images_dir, out_dir, options=opts,
+        recs = pycolmap.incremental_mapping(job.db_path, job.images_dir, job.out_dir, options=opts,
                                             next_image_callback=on_next, cancellation_token=token)
     check_cancel(progress)
     if recs and n_images > 2:
-        recs = _register_rest(pycolmap, recs, db_path, images_dir, out_dir, n_images, opts, progress, on_next)
+        recs = _register_rest(pycolmap, recs, job, opts, progress, on_next)
     return recs
 
 
@@ -97,7 +111,7 @@ def run_mapping(pycolmap, db_path, images_dir, out_dir, n_images, options, progr
 RELAXED_ABS_POSE_MIN_INLIERS = 15
 
 
-def _register_rest(pycolmap, recs, db_path, images_dir, out_dir, n_images, opts, progress: Progress, on_next):
+def _register_rest(pycolmap, recs, job: MappingJob, opts, progress: Progress, on_next):
     """Register the images the mapping left out into its largest model, continued from where it stopped, with
     the 2D-3D inlier threshold relaxed to RELAXED_ABS_POSE_MIN_INLIERS.  The first pass keeps COLMAP's threshold
     so that every image it can place is placed on the full threshold; only what is left is tried on the relaxed
@@ -105,6 +119,7 @@ def _register_rest(pycolmap, recs, db_path, images_dir, out_dir, n_images, opts,
     registers 15 of 16 views where the first pass registers 13 (pycolmap's defaults: 15); poses, degenerate
     cameras and the final adjustment are checked as for any image.  Returns ``recs`` with the largest model
     replaced when the continuation registered more images."""
+    db_path, images_dir, out_dir, n_images = job.db_path, job.images_dir, job.out_dir, job.n_images
     key, best = max(recs.items(), key=lambda kv: kv[1].num_reg_images())
     before = {best.images[i].name for i in best.reg_image_ids()}
     if len(before) >= n_images or len(before) < 3:
@@ -146,8 +161,7 @@ def min_model_size(n_images: int) -> int:
     return 2 if n_images <= 2 else 3
 
 
-def _map_global(pycolmap, db_path, images_dir, out_dir, n_images, options, progress: Progress,
-                hold_all: bool = False):
+def _map_global(pycolmap, job: MappingJob, options: AlignOptions, progress: Progress, hold_all: bool = False):
     """GLOMAP's global pipeline (rotation averaging, global positioning, bundle adjustment).  pycolmap 4.2
     gives it no cancellation token and no progress callback: a cancel takes effect when it returns."""
     opts = pycolmap.GlobalPipelineOptions()
@@ -157,10 +171,10 @@ def _map_global(pycolmap, db_path, images_dir, out_dir, n_images, options, progr
         opts.mapper.bundle_adjustment.refine_principal_point = False
     opts.num_threads = options.num_threads
     opts.random_seed = options.seed
-    opts.min_model_size = min_model_size(n_images)
+    opts.min_model_size = min_model_size(job.n_images)
     progress.report(0.0, "mapping: global SfM (rotation averaging, global positioning, bundle adjustment)")
     check_cancel(progress)
-    recs = pycolmap.global_mapping(db_path, images_dir, out_dir, options=opts)
+    recs = pycolmap.global_mapping(job.db_path, job.images_dir, job.out_dir, options=opts)
     check_cancel(progress)
     progress.report(1.0, "mapping: global SfM done")
     return recs
@@ -260,3 +274,45 @@ def camera_summary(rec) -> List[dict]:
                     "height": int(cam.height), "params": [float(v) for v in cam.params],
                     "params_info": cam.params_info})
     return out
+
+
+def map_block(pycolmap, job: MappingJob, options: AlignOptions, progress: Progress,
+              degenerate: Optional[Dict[str, str]] = None,
+              held: Optional[Tuple[Dict[int, GivenCamera], bool]] = None) -> list:
+    """The reconstructions, largest first, without the images the mapper gave a degenerate camera: those are added
+    to ``degenerate`` (name -> why; an image's entry says why a mapping last left it out).  The mapping works in
+    ``job.out_dir``, removed afterwards.  ``held``: (camera id -> given interior orientation of the cameras held,
+    whether that is every camera); the held cameras come back with exactly their given values."""
+    held_ids, hold_all = held or ({}, False)
+    shutil.rmtree(job.out_dir, ignore_errors=True)
+    os.makedirs(job.out_dir)
+    recs = run_mapping(pycolmap, job, options, progress, hold_all=hold_all)
+    shutil.rmtree(job.out_dir, ignore_errors=True)
+    for rec in (recs.values() if recs else ()):
+        restore_held(rec, held_ids)
+    dropped: Dict[str, str] = {}
+    for rec in (recs.values() if recs else ()):
+        dropped.update(drop_degenerate(rec))
+    for name, why in dropped.items():
+        progress.warning(f"mapping: {name} {why}: left out of the block")
+    if degenerate is not None:
+        degenerate.update(dropped)
+    kept = [r for r in (recs.values() if recs else ()) if r.num_reg_images() > 0]
+    return sorted(kept, key=lambda r: r.num_reg_images(), reverse=True)
+
+
+def adjust_block(pycolmap, rec, options: AlignOptions, progress: Progress, held: Collection[int],
+                 degenerate: Dict[str, str]) -> bool:
+    """The final global bundle adjustment (the ``held`` cameras' intrinsics constant); a camera with few points
+    that the adjustment sent off goes out (added to ``degenerate``), and the adjustment runs again, until none.
+    Returns whether the principal point was refined."""
+    pp = final_bundle_adjustment(pycolmap, rec, options, progress, held)
+    for _ in range(rec.num_reg_images()):
+        diverged = drop_degenerate(rec)
+        if not diverged:
+            break
+        for name, why in diverged.items():
+            progress.warning(f"final bundle adjustment: {name} {why}: left out of the block")
+        degenerate.update(diverged)
+        pp = final_bundle_adjustment(pycolmap, rec, options, progress, held)
+    return pp

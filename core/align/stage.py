@@ -20,7 +20,6 @@ from __future__ import annotations
 import copy
 import json
 import os
-import shutil
 import time
 from dataclasses import asdict, dataclass
 from typing import Dict, List, Optional, Tuple
@@ -47,7 +46,6 @@ from .calibrated import (
     intrinsics_record,
     plan_cameras,
     read_calibrations,
-    restore_held,
     scan_interior,
 )
 from .diagnosis import diagnose_unregistered, no_reconstruction_error, report_unregistered
@@ -63,11 +61,11 @@ from .features import (
 )
 from .firstpass import FirstPass, choose_first_pass
 from .mapping import (
+    MappingJob,
+    adjust_block,
     camera_rows,
     camera_summary,
-    drop_degenerate,
-    final_bundle_adjustment,
-    run_mapping,
+    map_block,
     verified_pairs,
     verified_partners,
 )
@@ -122,32 +120,6 @@ def _read_images(images_dir: str, options: AlignOptions,
     except ImageError as e:
         raise AlignError(str(e)) from e
     return infos, skipped, groups
-
-
-def _mapping(pycolmap, lay: Layout, db_path: str, images_dir: str, n_images: int, options: AlignOptions,
-             progress: Progress, degenerate: Optional[Dict[str, str]] = None,
-             held: Optional[Tuple[Dict[int, GivenCamera], bool]] = None):
-    """The reconstructions, largest first, without the images the mapper gave a degenerate camera: those are added
-    to ``degenerate`` (name -> why; an image's entry says why a mapping last left it out).  The mapping works in a
-    scratch folder removed afterwards.  ``held``: (camera id -> given interior orientation of the cameras held,
-    whether that is every camera); the held cameras come back with exactly their given values."""
-    held_ids, hold_all = held or ({}, False)
-    map_tmp = os.path.join(lay.sfm_dir, ".mapping")
-    shutil.rmtree(map_tmp, ignore_errors=True)
-    os.makedirs(map_tmp)
-    recs = run_mapping(pycolmap, db_path, images_dir, map_tmp, n_images, options, progress, hold_all=hold_all)
-    shutil.rmtree(map_tmp, ignore_errors=True)
-    for rec in (recs.values() if recs else ()):
-        restore_held(rec, held_ids)
-    dropped: Dict[str, str] = {}
-    for rec in (recs.values() if recs else ()):
-        dropped.update(drop_degenerate(rec))
-    for name, why in dropped.items():
-        progress.warning(f"mapping: {name} {why}: left out of the block")
-    if degenerate is not None:
-        degenerate.update(dropped)
-    kept = [r for r in (recs.values() if recs else ()) if r.num_reg_images() > 0]
-    return sorted(kept, key=lambda r: r.num_reg_images(), reverse=True)
 
 
 @dataclass
@@ -297,12 +269,12 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
             match_pairs(pycolmap, db_path, pairs, lay.sfm_dir, options, SubProgress(progress, 0.35, 0.65))
         # 4. mapping, then escalation where the fast path left images out or split the block
         degenerate: Dict[str, str] = {}  # images a mapping gave a degenerate camera: name -> why
+        mapping_job = MappingJob(db_path, images_dir, os.path.join(lay.sfm_dir, ".mapping"), len(infos))
         with run.step("mapping", save=False):
-            ordered = _mapping(pycolmap, lay, db_path, images_dir, len(infos), options,
-                               SubProgress(progress, 0.65, 0.90), degenerate, photos.held())
+            ordered = map_block(pycolmap, mapping_job, options, SubProgress(progress, 0.65, 0.90), degenerate,
+                                photos.held())
         ctx = EscalationContext(pycolmap, job, first.settings, lay.sfm_dir, [im.name for im in infos], options, pairs,
-                                lambda p: _mapping(pycolmap, lay, db_path, images_dir, len(infos), options, p,
-                                                   degenerate, photos.held()),
+                                lambda p: map_block(pycolmap, mapping_job, options, p, degenerate, photos.held()),
                                 lambda reg, oth: diagnose_unregistered(
                                     infos, reg, oth, verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS),
                                     degenerate),
@@ -319,16 +291,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
         held = photos.held()[0]
         with run.step("bundle_adjustment", save=False):
             progress.report(0.94, "final bundle adjustment")
-            pp = final_bundle_adjustment(pycolmap, rec, options, progress, held)
-            # a camera with few points the adjustment sent off goes out, and the adjustment runs again (until none)
-            for _ in range(len(infos)):
-                diverged = drop_degenerate(rec)
-                if not diverged:
-                    break
-                for name, why in diverged.items():
-                    progress.warning(f"final bundle adjustment: {name} {why}: left out of the block")
-                degenerate.update(diverged)
-                pp = final_bundle_adjustment(pycolmap, rec, options, progress, held)
+            pp = adjust_block(pycolmap, rec, options, progress, held, degenerate)
         registered = {rec.images[i].name for i in rec.reg_image_ids()}
         unregistered = diagnose_unregistered(infos, registered, others, partners, degenerate)
         report_unregistered(progress, unregistered, others, len(registered))
