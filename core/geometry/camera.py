@@ -75,10 +75,12 @@ class Intrinsics:
 
     @classmethod
     def simple(cls, width: int, height: int, focal_px: float, cx: Optional[float] = None, cy: Optional[float] = None,
-               k1: float = 0.0, k2: float = 0.0, p1: float = 0.0, p2: float = 0.0) -> Intrinsics:
-        """An OPENCV camera with square pixels; the principal point defaults to the image centre."""
+               distortion: Sequence[float] = (0.0, 0.0, 0.0, 0.0)) -> Intrinsics:
+        """An OPENCV camera with square pixels; the principal point defaults to the image centre; ``distortion``:
+        OpenCV's (k1, k2, p1, p2)."""
         cx = width / 2.0 if cx is None else cx
         cy = height / 2.0 if cy is None else cy
+        k1, k2, p1, p2 = distortion
         return cls("OPENCV", int(width), int(height), (focal_px, focal_px, cx, cy, k1, k2, p1, p2))
 
     # --- parameters in OpenCV form

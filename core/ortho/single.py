@@ -163,8 +163,7 @@ def _orientation_input(orientation, exterior: bool, run: ImageRun, image_path: s
     if camera is None:
         f_i, _src = _focal(meta, image_path, None, None, None, interior)
         camera = Intrinsics.simple(meta.width, meta.height, f_i, interior.get("cx"), interior.get("cy"),
-                                   interior.get("k1", 0.0), interior.get("k2", 0.0), interior.get("p1", 0.0),
-                                   interior.get("p2", 0.0))
+                                   tuple(interior.get(k, 0.0) for k in ("k1", "k2", "p1", "p2")))
     return None, camera
 
 
@@ -314,8 +313,7 @@ def _interior(single: SingleImageOptions, orient: Optional[dict], ctl: ImageCont
                 "estimate it")
     o = orient or {}
     cam0 = camera.as_opencv() if camera is not None else Intrinsics.simple(
-        meta.width, meta.height, f_px, o.get("cx"), o.get("cy"), o.get("k1", 0.0), o.get("k2", 0.0),
-        o.get("p1", 0.0), o.get("p2", 0.0))
+        meta.width, meta.height, f_px, o.get("cx"), o.get("cy"), tuple(o.get(k, 0.0) for k in ("k1", "k2", "p1", "p2")))
     run.log.append(f"{name}: {meta.width} x {meta.height} px, {meta.bands} band(s) {meta.dtype}, focal {f_px:.1f} "
                    f"px ({f_source})")
     return cam0, estimate_intrinsics
