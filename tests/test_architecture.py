@@ -132,7 +132,7 @@ def test_no_long_function_or_class_in_core():
 
 MAX_PARAMETERS = 8
 # functions of core/ that may take more than MAX_PARAMETERS (issue 35: at most 8 of them), each with the reason
-WIDE_ALLOWED = {"core/geometry/camera.py:simple": "the OPENCV camera's own parameters, each with its default"}
+WIDE_ALLOWED = {}  # "core/room/module.py:function": "why its parameters cannot be grouped"
 
 
 def _parameter_count(node):
