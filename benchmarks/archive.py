@@ -141,7 +141,7 @@ def write_control(block, path, to_image, sigma=None):
 def solution(block, ws, gcp_path, options, pixel_mm):
     """Run the georeference stage; -> dict of figures against the truth."""
     t0 = time.time()
-    res = georeference_workspace(ws, gcp_path=gcp_path, options=options)
+    res = georeference_workspace(ws, GeorefOptions.of(options, gcp_path=gcp_path))
     seconds = time.time() - t0
     rec, transform = load_georef_model(ws)
     offset = np.asarray(transform["offset"], float)

@@ -192,7 +192,9 @@ def copr(a):
     from core.align.stage import align
     from core.common.progress import PrintProgress
     from core.geometry.similarity import helmert_fit
+    from core.georef.autocontrol.options import AutoControlOptions
     from core.georef.autocontrol.stage import autocontrol_workspace
+    from core.georef.options import GeorefOptions
     from core.georef.stage import georeference_workspace
     from core.io.gcp import read_gcps
 
@@ -216,7 +218,7 @@ def copr(a):
     if a.fresh or not os.path.isfile(os.path.join(a.workdir, "full.json")):
         t = time.time()
         al = align(every, full, progress=PrintProgress("  full "))
-        georeference_workspace(full, **control(every), progress=PrintProgress("  full "))
+        georeference_workspace(full, GeorefOptions(**control(every)), progress=PrintProgress("  full "))
         with open(os.path.join(a.workdir, "full.json"), "w") as f:
             json.dump({"seconds": time.time() - t, "registered": al.registered}, f)
     truth = centres_of(full)
@@ -227,7 +229,8 @@ def copr(a):
     al = align(odd, ws, progress=PrintProgress("  new "))
     print(f"odd photos: {al.registered} of {al.images_given} aligned in {time.time() - t:.0f} s")
     t, c0 = time.time(), os.times()
-    r = autocontrol_workspace(ws, ortho, dsm, prior=a.prior, progress=PrintProgress("  auto "))
+    r = autocontrol_workspace(ws, AutoControlOptions(reference_ortho=ortho, reference_dsm=dsm, prior=a.prior),
+                              progress=PrintProgress("  auto "))
     c1 = os.times()
     seconds = time.time() - t
     got = centres_of(ws)
@@ -278,6 +281,7 @@ def main():
 
     from core.align.stage import align
     from core.common.progress import PrintProgress
+    from core.georef.autocontrol.options import AutoControlOptions
     from core.georef.autocontrol.stage import autocontrol_workspace
     from core.project.layout import Layout
     from core.project.workspace import Workspace
@@ -294,7 +298,8 @@ def main():
     print(f"{NEW_CAMERA}: {al.registered} of {al.images_given} photos aligned in {time.time() - t:.0f} s "
           "(no GPS in the files)")
     t, c0 = time.time(), os.times()
-    r = autocontrol_workspace(ws, ortho, dsm, prior=a.prior, progress=PrintProgress("  auto "))
+    r = autocontrol_workspace(ws, AutoControlOptions(reference_ortho=ortho, reference_dsm=dsm, prior=a.prior),
+                              progress=PrintProgress("  auto "))
     c1 = os.times()
     seconds = time.time() - t
     rec, tr = Layout(Workspace.open(ws)).load_georef_model()

@@ -145,6 +145,7 @@ def run_case(bench, base_ws, workdir, ortho, dsm, label, truth, options=None):
     import numpy as np
 
     from core.common.progress import NullProgress
+    from core.georef.autocontrol.options import AutoControlOptions
     from core.georef.autocontrol.stage import autocontrol_workspace
 
     ws = os.path.join(workdir, "national", f"run-{label.replace('/', '_')}")
@@ -153,7 +154,8 @@ def run_case(bench, base_ws, workdir, ortho, dsm, label, truth, options=None):
     out = {"case": label}
     t, c0 = time.time(), os.times()
     try:
-        r = autocontrol_workspace(ws, ortho, dsm, prior="none", options=options, progress=NullProgress())
+        r = autocontrol_workspace(ws, AutoControlOptions.of(options, reference_ortho=ortho, reference_dsm=dsm,
+                                                            prior="none"), progress=NullProgress())
     except Exception as e:  # noqa: BLE001 - the refusal (or, before the fix, the traceback) is the figure
         out.update(error=f"{type(e).__name__}: {str(e)[:900]}")
         r = None
@@ -190,6 +192,7 @@ def archive(kind, n, workdir):
     from core.align.options import AlignOptions
     from core.align.stage import align
     from core.georef.autocontrol.candidates import drop_counts
+    from core.georef.autocontrol.options import AutoControlOptions
     from core.georef.autocontrol.stage import autocontrol_workspace
     from core.io.gcp import CHECK, GCPSet, GroundPoint, Observation
     from core.project.layout import Layout
@@ -216,7 +219,9 @@ def archive(kind, n, workdir):
                                                       for i, q in sorted(p.noisy_observations.items())])
                                          for p in block.points if p.role == "check"])
     t, c0 = time.time(), os.times()
-    r = autocontrol_workspace(run, block.paths["ortho"], block.paths["dem"], prior="none", check_points=checks)
+    r = autocontrol_workspace(run, AutoControlOptions(reference_ortho=block.paths["ortho"],
+                                                      reference_dsm=block.paths["dem"], prior="none",
+                                                      check_points=checks))
     c1 = os.times()
     rec, tr = Layout(Workspace.open(run)).load_georef_model()
     truth = {f.name: f.centre_world for f in block.frames}

@@ -156,9 +156,9 @@ def copr(n_sets):
 
 
 def _exif_positions(ws, crs):
-    from core.georef import stage as georef_stage
+    from core.georef.control_input import exif_positions
 
-    return georef_stage._exif_positions(Workspace.open(ws), crs)
+    return exif_positions(Workspace.open(ws), crs)
 
 
 def toledo():
@@ -209,6 +209,7 @@ def archive():
     import json
     import shutil
 
+    from core.georef.options import GeorefOptions
     from core.georef.stage import georeference_workspace
 
     base = os.path.join(ROOT, "build", "bench-archive")
@@ -228,7 +229,7 @@ def archive():
             shutil.copytree(os.path.join(src, "ws"), ws, ignore=shutil.ignore_patterns("georef", "*.lock"))
             try:
                 t0 = time.time()
-                georeference_workspace(ws, gcp_path=os.path.join(src, csv))
+                georeference_workspace(ws, GeorefOptions(gcp_path=os.path.join(src, csv)))
                 secs = time.time() - t0
             except Exception as e:  # noqa: BLE001 - a benchmark reports and goes on
                 print(f"  {d:<16} {label:<15} failed: {e}")

@@ -41,6 +41,7 @@ def ensure_georeferenced(images, ws, crs):
     from core.align.options import AlignOptions
     from core.align.stage import align
     from core.common.progress import PrintProgress
+    from core.georef.options import GeorefOptions
     from core.georef.stage import georeference_workspace
     from core.project.workspace import Workspace
 
@@ -55,7 +56,7 @@ def ensure_georeferenced(images, ws, crs):
         t0 = time.time()
         r = align(images, ws, AlignOptions(), PrintProgress("  align "))
         print(f"aligned {r.registered}/{r.images_given} in {time.time() - t0:.0f} s")
-    r = georeference_workspace(ws, use_exif_gps=True, crs=crs, progress=PrintProgress("  georef "))
+    r = georeference_workspace(ws, GeorefOptions(use_exif_gps=True, crs=crs), progress=PrintProgress("  georef "))
     print(f"georeferenced with EXIF GPS: camera RMSE {r.figures['CAMERA_RMSE_XYZ']:.2f} m")
 
 

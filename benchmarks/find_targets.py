@@ -31,6 +31,7 @@ from core.align.options import AlignOptions  # noqa: E402
 from core.align.stage import align  # noqa: E402
 from core.common.progress import PrintProgress  # noqa: E402
 from core.georef import stage as georef_stage  # noqa: E402
+from core.georef.options import GeorefOptions  # noqa: E402
 from core.georef.targets.options import FindTargetsOptions  # noqa: E402
 from core.georef.targets.stage import find_targets  # noqa: E402
 from core.io import gcp as gcpmod  # noqa: E402
@@ -101,7 +102,7 @@ def georeference_both(ws, hand_path, found_path):
         os.makedirs(copy)
         shutil.copytree(os.path.join(ws, "sfm"), os.path.join(copy, "sfm"))
         shutil.copy(os.path.join(ws, "workspace.json"), copy)
-        r = georef_stage.georeference_workspace(copy, gcp_path=path, check_points=CHECK)
+        r = georef_stage.georeference_workspace(copy, GeorefOptions(gcp_path=path, check_points=CHECK))
         with open(os.path.join(copy, "georef", "residuals.json"), encoding="utf-8") as fh:
             pts = {p["name"]: p for p in json.load(fh)["points"]}
         rows[label] = (r.figures, pts, r.outliers)

@@ -24,6 +24,7 @@ from core.align.options import AlignOptions  # noqa: E402
 from core.align.stage import align  # noqa: E402
 from core.common.progress import PrintProgress  # noqa: E402
 from core.georef import stage as georef_stage  # noqa: E402
+from core.georef.options import GeorefOptions  # noqa: E402
 from core.project.workspace import Workspace  # noqa: E402
 
 
@@ -161,14 +162,16 @@ def copr(ws, variants=True):
     tarp_ruler(ws)
     if variants:
         for refine in ("all", True):
-            r = georef_stage.georeference_workspace(ws, gcp_path=os.path.join(DATA, "copr", "gcp_list.txt"),
-                                                check_points=["gcp03", "gcp06", "gcp09"], refine_intrinsics=refine)
+            r = georef_stage.georeference_workspace(ws, GeorefOptions(
+                gcp_path=os.path.join(DATA, "copr", "gcp_list.txt"), check_points=["gcp03", "gcp06", "gcp09"],
+                refine_intrinsics=refine))
             f = r.figures
             print(f"variant REFINE_INTRINSICS={refine}: control RMSE XY {f['GCP_RMSE_XY']:.3f} m, check RMSE XY "
                   f"{f['CHECK_RMSE_XY']:.3f} m, tie points {f['MEAN_REPROJECTION_ERROR']:.3f} px")
     t0 = time.time()
-    r = georef_stage.georeference_workspace(ws, gcp_path=os.path.join(DATA, "copr", "gcp_list.txt"),
-                                        check_points=["gcp03", "gcp06", "gcp09"], progress=PrintProgress("  "))
+    r = georef_stage.georeference_workspace(ws, GeorefOptions(gcp_path=os.path.join(DATA, "copr", "gcp_list.txt"),
+                                                          check_points=["gcp03", "gcp06", "gcp09"]),
+                                        progress=PrintProgress("  "))
     secs = time.time() - t0
     res = json.load(open(os.path.join(ws, "georef", "residuals.json")))
     table(res["helmert_points"], "after the Helmert (7-parameter) step only:")
@@ -186,7 +189,8 @@ def copr(ws, variants=True):
 def toledo(ws):
     ensure_aligned(os.path.join(DATA, "toledo", "images"), ws)
     t0 = time.time()
-    r = georef_stage.georeference_workspace(ws, use_exif_gps=True, crs="EPSG:32617", progress=PrintProgress("  "))
+    r = georef_stage.georeference_workspace(ws, GeorefOptions(use_exif_gps=True, crs="EPSG:32617"),
+                                        progress=PrintProgress("  "))
     secs = time.time() - t0
     ref = {}
     for line in open(os.path.join(DATA, "toledo", "cameras_32617.txt")):

@@ -150,10 +150,11 @@ def child(args):
         from core.align.stage import align
         align(args.src, args.out, AlignOptions(), progress=p)
     elif args.stage == "georeference":
+        from core.georef.options import GeorefOptions
         from core.georef.stage import georeference_workspace
         positions = os.path.join(os.path.dirname(args.src), "camera_positions.csv")
         kw = {"camera_positions_path": positions} if os.path.isfile(positions) else {"use_exif_gps": True}
-        georeference_workspace(args.out, progress=p, **kw)
+        georeference_workspace(args.out, GeorefOptions(**kw), progress=p)
     elif args.stage == "dsm":
         from core.dense.stage import build_dsm_workspace
         build_dsm_workspace(args.out, progress=p)

@@ -177,10 +177,11 @@ def build_workspace(ws_dir):
     from core.align.stage import align
     from core.common.progress import PrintProgress
     from core.dense import stage as dense
+    from core.georef.options import GeorefOptions
     from core.georef.stage import georeference_workspace
 
     align(os.path.join(TOLEDO, "images"), ws_dir, progress=PrintProgress("align "))
-    georeference_workspace(ws_dir, use_exif_gps=True, crs="EPSG:32617", progress=PrintProgress("georef "))
+    georeference_workspace(ws_dir, GeorefOptions(use_exif_gps=True, crs="EPSG:32617"), progress=PrintProgress("georef "))
     dense.build_dsm_workspace(ws_dir, progress=PrintProgress("dsm "))
 
 

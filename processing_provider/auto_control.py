@@ -79,6 +79,7 @@ class AutoControlAlgorithm(AlgorithmBase):
             self.addOutput(QgsProcessingOutputNumber(n, n))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
+        from ..core.georef.autocontrol.options import AutoControlOptions
         from ..core.georef.autocontrol.stage import autocontrol_workspace
         from ..qgisio.reference_layers import resolve_references
 
@@ -96,7 +97,8 @@ class AutoControlAlgorithm(AlgorithmBase):
             extent=extent if not extent.isNull() else None,
             extent_crs=self.parameterAsExtentCrs(parameters, self.REFERENCE_EXTENT, context),
             progress=FeedbackProgress(feedback, 0.0, 0.1), context=context.transformContext())
-        result = self.run_core(autocontrol_workspace, workspace, ortho_path, dsm_path, prior=prior,
+        result = self.run_core(autocontrol_workspace, workspace,
+                               AutoControlOptions(reference_ortho=ortho_path, reference_dsm=dsm_path, prior=prior),
                                progress=FeedbackProgress(feedback, 0.1, 1.0))
         progress.push_result(result.georef.warnings)
         for o in result.georef.outliers:
@@ -124,8 +126,8 @@ class AutoControlAlgorithm(AlgorithmBase):
                 "A reference DSM alone (DEM control) places the block by the photos' EXIF GPS: choose Rough "
                 "position auto or EXIF GPS, or give a reference orthophoto as well"))
         progress = FeedbackProgress(feedback)
-        result = self.run_core(georeference_workspace, workspace, use_exif_gps=True,
-                               options=GeorefOptions(reference_dem=local_file(dsm)), progress=progress)
+        result = self.run_core(georeference_workspace, workspace,
+                               GeorefOptions(use_exif_gps=True, reference_dem=local_file(dsm)), progress=progress)
         progress.push_result(result.warnings)
         for o in result.outliers:
             feedback.pushWarning(self.tr("outlier left out: {}").format(o))

@@ -1,4 +1,6 @@
 """Georeference: thin adapter over core.georef.stage.georeference_workspace."""
+import dataclasses
+
 from qgis.core import (
     QgsProcessingException,
     QgsProcessingOutputFolder,
@@ -101,6 +103,7 @@ class GeoreferenceAlgorithm(AlgorithmBase):
             self.addOutput(QgsProcessingOutputNumber(n, n))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
+        from ..core.georef.options import GeorefOptions
         from ..core.georef.stage import georeference_workspace
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
@@ -115,29 +118,24 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         if ortho is not None:
             return self._automatic(parameters, context, feedback, workspace, ortho, dsm, gcp_path, gcps, checks,
                                    positions, crs_text)
-        options = None
+        options = GeorefOptions(gcp_path=gcp_path, gcps=gcps, check_points=checks, camera_positions_path=positions,
+                                use_exif_gps=self.parameterAsBoolean(parameters, self.USE_EXIF_GPS, context), crs=crs_text,
+                                refine_intrinsics=self.parameterAsBoolean(parameters, self.REFINE_INTRINSICS, context),
+                                gcps_upright=self.parameterAsBoolean(parameters, self.GCPS_UPRIGHT, context))
         if dsm is not None:  # DEM control: the reference DSM alone
-            from ..core.georef.options import GeorefOptions
             from ..qgisio.reference_layers import describe, local_file
 
             if local_file(dsm) is None:
                 raise QgsProcessingException(self.tr(
                     "Reference DSM {} given alone (DEM control) must be a raster file on disk; a web layer is "
                     "fetched only for the automatic control, with a reference orthophoto").format(describe(dsm)))
-            options = GeorefOptions(reference_dem=local_file(dsm))
-        elif not params.has_control(gcp_path, gcps, positions, self.parameterAsBoolean(
-                parameters, self.USE_EXIF_GPS, context)):
+            options = dataclasses.replace(options, reference_dem=local_file(dsm))
+        elif not params.has_control(gcp_path, gcps, positions, options.use_exif_gps):
             raise QgsProcessingException(self.tr(
                 "Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions "
                 "(Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS)"))
         progress = FeedbackProgress(feedback)
-        result = self.run_core(
-            georeference_workspace, workspace, gcp_path=gcp_path, gcps=gcps, check_points=checks,
-            camera_positions_path=positions,
-            use_exif_gps=self.parameterAsBoolean(parameters, self.USE_EXIF_GPS, context),
-            crs=crs_text, refine_intrinsics=self.parameterAsBoolean(parameters, self.REFINE_INTRINSICS, context),
-            progress=progress, gcps_upright=self.parameterAsBoolean(parameters, self.GCPS_UPRIGHT, context),
-            options=options)
+        result = self.run_core(georeference_workspace, workspace, options, progress=progress)
         progress.push_result(result.warnings)
         for o in result.outliers:
             feedback.pushWarning(self.tr("outlier left out: {}").format(o))
@@ -157,7 +155,7 @@ class GeoreferenceAlgorithm(AlgorithmBase):
                    crs_text):
         """Automatic control (core autocontrol_workspace) from the reference layers; the given ground control
         becomes check points."""
-        from ..core.georef.autocontrol.options import PRIOR_AUTO, PRIOR_GPS
+        from ..core.georef.autocontrol.options import PRIOR_AUTO, PRIOR_GPS, AutoControlOptions
         from ..core.georef.autocontrol.stage import autocontrol_workspace
         from ..qgisio import reference_layers as refs
 
@@ -186,9 +184,9 @@ class GeoreferenceAlgorithm(AlgorithmBase):
             cams = refs.positions_in(cams, pos_crs, crs)
         prior = PRIOR_GPS if self.parameterAsBoolean(parameters, self.USE_EXIF_GPS, context) and not cams \
             else PRIOR_AUTO
-        result = self.run_core(autocontrol_workspace, workspace, ortho_path, dsm_path, prior=prior,
-                               camera_positions=cams, check_points=check,
-                               progress=FeedbackProgress(feedback, 0.1, 1.0))
+        result = self.run_core(autocontrol_workspace, workspace, AutoControlOptions(
+            reference_ortho=ortho_path, reference_dsm=dsm_path, prior=prior, camera_positions=cams, check_points=check),
+            progress=FeedbackProgress(feedback, 0.1, 1.0))
         georef = result.georef
         progress.push_result(georef.warnings)
         for o in georef.outliers:

@@ -123,8 +123,9 @@ def test_rough_prior_georeferences_the_second_epoch_within_the_reference_resolut
     block, photos, ortho, dsm = epochs
     ws_dir = _workspace(tmp_path, block, photos, "ws")
     cams, _ = block.camera_positions(sigma=3.0)
-    result = autocontrol_workspace(ws_dir, ortho, dsm, prior="gps", camera_positions=cams,
-                                   check_points=_check_points(block), options=FAST)
+    result = autocontrol_workspace(ws_dir, AutoControlOptions.of(
+        FAST, reference_ortho=ortho, reference_dsm=dsm, prior="gps", camera_positions=cams,
+        check_points=_check_points(block)))
     _assert_georeferenced(result, ws_dir, block)
     assert result.crs == syn.CRS
     # the report's georeferencing section tells the automatic control: the steps' counts and the map
@@ -139,8 +140,8 @@ def test_rough_prior_georeferences_the_second_epoch_within_the_reference_resolut
 def test_no_prior_at_all_searches_rotation_and_scale(tmp_path, epochs):
     block, photos, ortho, dsm = epochs
     ws_dir = _workspace(tmp_path, block, photos, "ws")
-    result = autocontrol_workspace(ws_dir, ortho, dsm, prior="none", check_points=_check_points(block),
-                                   options=FAST)
+    result = autocontrol_workspace(ws_dir, AutoControlOptions.of(
+        FAST, reference_ortho=ortho, reference_dsm=dsm, prior="none", check_points=_check_points(block)))
     _assert_georeferenced(result, ws_dir, block)
     assert any("coarse search" in m for m in result.messages)
 
@@ -159,7 +160,8 @@ def test_a_reference_of_another_place_is_refused_by_name(tmp_path, epochs):
         f.write(in_use)
     # 5 km away: named before any matching (issue 36 item 12), with where it lies
     with pytest.raises(AutoControlError, match=r"ref_ortho.tif does not cover the block .* 4\.[0-9] km away"):
-        autocontrol_workspace(ws_dir, ortho, dsm, prior="gps", camera_positions=cams, options=FAST)
+        autocontrol_workspace(ws_dir, AutoControlOptions.of(FAST, reference_ortho=ortho, reference_dsm=dsm,
+                                                            prior="gps", camera_positions=cams))
     assert open(lay.autocontrol_json).read() == in_use
     # over the block but of nothing like it (noise): the matching fails, its candidates in autocontrol-failed.json
     from osgeo import gdal
@@ -172,11 +174,13 @@ def test_a_reference_of_another_place_is_refused_by_name(tmp_path, epochs):
               src.GetGeoTransform(), syn.CRS)
     src = None
     with pytest.raises(AutoControlError, match="ref_ortho.tif") as e:
-        autocontrol_workspace(ws_dir, noise, epochs[3], prior="gps", camera_positions=cams, options=FAST)
+        autocontrol_workspace(ws_dir, AutoControlOptions.of(FAST, reference_ortho=noise, reference_dsm=epochs[3],
+                                                            prior="gps", camera_positions=cams))
     assert open(lay.autocontrol_json).read() == in_use
     assert lay.autocontrol_failed_json in str(e.value) and "candidates" in json.load(open(lay.autocontrol_failed_json))
     with pytest.raises(AutoControlError, match="missing.tif"):
-        autocontrol_workspace(ws_dir, str(tmp_path / "missing.tif"), dsm)
+        autocontrol_workspace(ws_dir, AutoControlOptions(reference_ortho=str(tmp_path / "missing.tif"),
+                                                         reference_dsm=dsm))
 
 
 def test_qgis_process_runs_autocontrol(tmp_path, epochs):

@@ -250,10 +250,9 @@ def test_the_synthetic_block_against_a_national_reference(tmp_path, national_epo
     cams_nat = transform_points(np.array([[c.x, c.y, c.z] for c in cams]), syn.CRS, wkt)
     for c, p in zip(cams, cams_nat):
         c.x, c.y, c.z = (float(v) for v in p)
-    result = autocontrol_workspace(ws_dir, ortho, dsm, prior="gps", camera_positions=cams,
-                                   check_points=_check_points(block),
-                                   options=AutoControlOptions(n_features=6000, max_candidates=60,
-                                                              refine_intrinsics=False))
+    result = autocontrol_workspace(ws_dir, AutoControlOptions(
+        n_features=6000, max_candidates=60, refine_intrinsics=False, reference_ortho=ortho, reference_dsm=dsm,
+        prior="gps", camera_positions=cams, check_points=_check_points(block)))
     f = result.georef.figures
     print(f"\nnational reference: {result.figures}; check XY {f['CHECK_RMSE_XY']:.3f} m, Z {f['CHECK_RMSE_Z']:.3f} m; "
           f"{result.messages}")
@@ -300,9 +299,9 @@ def test_a_pair_from_one_strip_is_placed_from_two_rough_positions(tmp_path, nati
     xyz = transform_points(np.array([[c.x, c.y, c.z] for c in cams]), syn.CRS, wkt)
     for c, p in zip(cams, xyz):
         c.x, c.y, c.z = (float(v) for v in p)
-    result = autocontrol_workspace(ws_dir, ortho, dsm, prior="gps", camera_positions=cams,
-                                   options=AutoControlOptions(n_features=6000, max_candidates=60,
-                                                              refine_intrinsics=False))
+    result = autocontrol_workspace(ws_dir, AutoControlOptions(
+        n_features=6000, max_candidates=60, refine_intrinsics=False, reference_ortho=ortho, reference_dsm=dsm,
+        prior="gps", camera_positions=cams))
     print(f"\npair: {result.figures}; {result.messages}")
     assert result.n_kept >= 6
     kept = [c for c in result.candidates if c.status == KEPT]

@@ -15,6 +15,7 @@ import pytest
 
 from core.align.options import AlignOptions
 from core.align.stage import align
+from core.georef.autocontrol.options import AutoControlOptions
 from core.georef.autocontrol.stage import autocontrol_workspace
 from core.prepare.options import PrepareOptions
 from core.prepare.stage import prepare_images_workspace
@@ -49,7 +50,8 @@ def orbit_run(tmp_path_factory):
     al = align(prep.prepared_dir, ws, AlignOptions(pairing="exhaustive", num_threads=2))
     t1, c0 = time.time(), os.times()
     checks = orbit.gcp_set([], noise_px=0.3, only=[p.name for p in orbit.gcps if p.kind == "ground"])
-    result = autocontrol_workspace(ws, ortho, dsm, prior="none", check_points=checks)
+    result = autocontrol_workspace(ws, AutoControlOptions(reference_ortho=ortho, reference_dsm=dsm, prior="none",
+                                                          check_points=checks))
     c1 = os.times()
     print(f"\n[orbit autocontrol] prepare + align {t1 - t0:.0f} s ({al.registered}/{len(orbit.shots)} registered); "
           f"autocontrol {time.time() - t1:.0f} s, {c1.user + c1.system - c0.user - c0.system:.0f} CPU s; "

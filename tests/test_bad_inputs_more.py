@@ -316,6 +316,7 @@ def test_a_read_only_workspace_is_refused_before_any_work(tmp_path, monkeypatch)
     anywhere, so the folder's refusal is simulated where the check asks the file system."""
     import tempfile
 
+    from core.georef.autocontrol.options import AutoControlOptions
     from core.georef.autocontrol.stage import autocontrol_workspace
     from core.project.workspace import Workspace, WorkspaceError
     from tests import synthetic as syn
@@ -332,7 +333,8 @@ def test_a_read_only_workspace_is_refused_before_any_work(tmp_path, monkeypatch)
     with pytest.raises(WorkspaceError, match=r"workspace folder .*ws is not writable \(Permission denied\): nothing"):
         Workspace.open(ws_dir).begin_stage("dsm", {})
     with pytest.raises(WorkspaceError, match="is not writable"):  # before the references are even opened
-        autocontrol_workspace(ws_dir, str(tmp_path / "no_ortho.tif"), str(tmp_path / "no_dsm.tif"))
+        autocontrol_workspace(ws_dir, AutoControlOptions(reference_ortho=str(tmp_path / "no_ortho.tif"),
+                                                         reference_dsm=str(tmp_path / "no_dsm.tif")))
     assert open(os.path.join(ws_dir, "workspace.json")).read() == before
 
 
@@ -440,7 +442,7 @@ def test_suspect_control_points_are_dropped_when_asked_and_the_block_adjusted_wi
 def test_the_automatic_control_counts_name_the_suspects_dropped():
     """'97 of 101 automatic GCPs kept, 4 suspect dropped (auto_012 1.54 m, ...)': the suspects named by the
     adjustment's consistency check and rejected, worst first; a suspect re-admitted as used is not counted."""
-    from core.georef.autocontrol.stage import _count_used, _suspects_dropped
+    from core.georef.autocontrol.record import _count_used, _suspects_dropped
 
     class Lay:
         def residuals(self):

@@ -21,6 +21,7 @@ from core.align.stage import align, load_model
 from core.common.errors import ArchaeoOrthoError
 from core.common.progress import NullProgress
 from core.georef.adjust import georeference
+from core.georef.options import GeorefOptions
 from core.georef.stage import georeference_workspace, load_georef_model
 from core.io.gcp import CHECK
 from core.io.images import CameraGroup, ImageInfo
@@ -95,7 +96,7 @@ def test_a_fixed_calibration_is_held_through_alignment_and_georeference(block, f
     # the georeference asked to refine everything keeps it, and says so once
     gcps = block.gcp_set(block.spread_control(5), noise_px=0.4)
     glog = _Log()
-    res = georeference_workspace(ws, gcps=gcps, crs=syn.CRS, refine_intrinsics="all", progress=glog)
+    res = georeference_workspace(ws, GeorefOptions(gcps=gcps, crs=syn.CRS, refine_intrinsics="all"), progress=glog)
     rec, _ = load_georef_model(ws)
     (cam,) = rec.cameras.values()
     assert np.max(np.abs(np.asarray(cam.params) - block.camera.params)) <= 1e-9
@@ -584,7 +585,7 @@ def test_four_archive_frames_keep_their_calibrated_focal_length_and_their_height
     for label, kw in runs.items():
         ws = str(tmp_path / label)
         align(block.paths["images"], ws, _options(**kw))
-        georeference_workspace(ws, gcps=_archive_gcps(block), crs=arch.ARCHIVE_PROJ)
+        georeference_workspace(ws, GeorefOptions(gcps=_archive_gcps(block), crs=arch.ARCHIVE_PROJ))
         rec, transform = load_georef_model(ws)
         offset = transform.offset
         err = np.array([np.asarray(im.projection_center()) + offset - block.frame(im.name).centre_world
@@ -641,7 +642,8 @@ def test_film_scans_restituted_by_prepare_images_keep_their_interior_orientation
                                    float(io["height"] / 2.0 - y)))
         pts.append(GroundPoint(p.name, *(float(v) for v in p.xyz), 0.02, 0.05,
                                CONTROL if p.role == "control" else CHECK, obs))
-    georeference_workspace(ws, gcps=GCPSet(arch.ARCHIVE_PROJ, pts), crs=arch.ARCHIVE_PROJ, refine_intrinsics=True)
+    georeference_workspace(ws, GeorefOptions(gcps=GCPSet(arch.ARCHIVE_PROJ, pts), crs=arch.ARCHIVE_PROJ,
+                                         refine_intrinsics=True))
     rec, transform = load_georef_model(ws)
     (camera,) = rec.cameras.values()
     assert abs(camera.params[0] - io["focal_px"]) <= 1e-9
@@ -673,7 +675,8 @@ def test_the_automatic_control_keeps_a_fixed_camera(tmp_path, epochs):  # noqa: 
         ws = synthetic_workspace(str(tmp_path / label), block, block.truth_reconstruction(seed=5), photos=photos,
                                  alignment=alignment)
         cams, _ = block.camera_positions(sigma=3.0)
-        autocontrol_workspace(ws, ortho, dsm, prior="gps", camera_positions=cams, options=options)
+        autocontrol_workspace(ws, AutoControlOptions.of(options, reference_ortho=ortho, reference_dsm=dsm,
+                                                        prior="gps", camera_positions=cams))
         (cam,) = Layout(Workspace.open(ws)).load_georef_model()[0].cameras.values()
         params[label] = np.asarray(cam.params, dtype=float)
     assert np.array_equal(params["fixed"], np.asarray(block.camera.params, dtype=float))

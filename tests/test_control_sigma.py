@@ -309,6 +309,7 @@ def test_the_stage_records_the_estimate_and_the_report_and_the_precision_use_it(
     import pycolmap
 
     from core.georef import uncertainty
+    from core.georef.options import GeorefOptions
     from core.georef.stage import georeference_workspace
     from core.project.workspace import Workspace
     from core.report import stage as report
@@ -320,7 +321,7 @@ def test_the_stage_records_the_estimate_and_the_report_and_the_precision_use_it(
     gcps = _noisy(block.gcp_set(control, noise_px=GCP_NOISE_PX), 3.0, seed=7)
     path = str(tmp_path / "gcp_list.txt")
     write_odm_gcp_list(gcps, path)
-    georeference_workspace(ws, gcp_path=path)
+    georeference_workspace(ws, GeorefOptions(gcp_path=path))
     with open(os.path.join(ws, "georef", "residuals.json"), encoding="utf-8") as f:
         res = json.load(f)
     (e,) = res["sigma_estimates"]

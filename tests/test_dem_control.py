@@ -115,8 +115,9 @@ def _run(root, scene, options=None, crs=syn.CRS):
     block, rec, folder, _, _, _, positions = scene
     ws = synthetic_workspace(root, block, rec)
     progress = Recorder()
-    result = georeference_workspace(ws, gcps=block.gcp_set([], noise_px=0.4), crs=crs, options=options,
-                                    camera_positions_path=_positions_file(folder, positions), progress=progress)
+    options = GeorefOptions.of(options, gcps=block.gcp_set([], noise_px=0.4), crs=crs,
+                               camera_positions_path=_positions_file(folder, positions))
+    result = georeference_workspace(ws, options, progress=progress)
     return ws, result, progress
 
 
@@ -167,14 +168,14 @@ def _shifted(src, dst, dx):
 def test_bad_references_are_refused_by_name_before_the_adjustment(scene, tmp_path, monkeypatch):
     from osgeo import gdal, osr
 
-    import core.georef.stage as stage
+    import core.georef.adjustments as adjustments
 
     block, _, folder, fine, wkt, _, _ = scene
 
     def no_adjustment(*args, **kwargs):
         raise AssertionError("the adjustment ran")
 
-    monkeypatch.setattr(stage, "georeference", no_adjustment)
+    monkeypatch.setattr(adjustments, "georeference", no_adjustment)
     far = _shifted(fine, str(tmp_path / "far.tif"), 5000.0)
     coarse = degrade(fine, str(tmp_path / "coarse25.tif"), 25.0, wkt)
     empty = str(tmp_path / "empty.tif")
@@ -246,8 +247,8 @@ def test_control_points_heights_win_over_a_dem_in_another_vertical_datum(scene, 
                            ("same", GeorefOptions(reference_dem=same))):
         ws = synthetic_workspace(tmp_path / label, block, rec)
         progress = Recorder()
-        out[label] = georeference_workspace(ws, gcps=block.gcp_set(control, noise_px=0.4), crs=syn.CRS,
-                                            options=options, progress=progress).figures
+        out[label] = georeference_workspace(ws, GeorefOptions.of(options, gcps=block.gcp_set(control, noise_px=0.4),
+                                                                 crs=syn.CRS), progress=progress).figures
         if label == "dem":
             assert any("heights: the control points' win" in m for m in progress.infos)
     doc = json.load(open(os.path.join(tmp_path, "dem", "georef", "dem_control.json")))

@@ -21,6 +21,7 @@ from osgeo import gdal, osr
 
 from core.georef.autocontrol.epochs import register_epoch
 from core.georef.autocontrol.errors import AutoControlError
+from core.georef.autocontrol.options import AutoControlOptions
 from core.io.raster import read_dsm, write_cog
 from core.ortho.options import OrthoOptions
 from core.ortho.stage import build_orthophoto_workspace
@@ -71,7 +72,7 @@ def registered(tmp_path_factory):
     ws1 = _earlier_workspace(str(root / "epoch1"), b1)
     ws2 = synthetic_workspace(str(root / "epoch2"), b2, b2.truth_reconstruction(seed=5), photos=photos)
     checks = b2.gcp_set([], noise_px=0.3, only=[p.name for p in b2.gcps if p.kind == "ground"])
-    result = register_epoch(ws2, ws1, prior="none", check_points=checks, options=FAST)
+    result = register_epoch(ws2, ws1, AutoControlOptions.of(FAST, prior="none", check_points=checks))
     return b1, b2, ws1, ws2, result
 
 

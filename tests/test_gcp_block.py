@@ -110,6 +110,7 @@ def test_csv_and_point_layer_rows_follow_the_same_policy(tmp_path):
 def test_the_georeference_stage_uses_a_file_that_names_photos_outside_the_aligned_subset(tmp_path):
     """A synthetic block of which only a subset was aligned; its GCP file lists observations in every photo.
     The stage georeferences with the observations in the subset and reports the ones left out."""
+    from core.georef.options import GeorefOptions
     from core.georef.stage import georeference_workspace
     from core.project.layout import Layout
     from core.project.workspace import Workspace
@@ -127,7 +128,7 @@ def test_the_georeference_stage_uses_a_file_that_names_photos_outside_the_aligne
     gcpmod.write_odm_gcp_list(full, path)
     rec = block.truth_reconstruction(n_points=600, noise_px=0.3, images=subset)
     ws = synthetic_workspace(str(tmp_path / "ws"), block, rec, names=subset)
-    result = georeference_workspace(ws, gcp_path=path)
+    result = georeference_workspace(ws, GeorefOptions(gcp_path=path))
     lay = Layout(Workspace.open(ws))
     import json
 

@@ -7,6 +7,7 @@ import pytest
 from core.align.options import AlignOptions
 from core.align.stage import align
 from core.georef import stage as georef_stage
+from core.georef.options import GeorefOptions
 from core.io.gcp import GCPSet, GroundPoint, Observation
 from core.project.stages import StageError
 from core.project.workspace import Workspace
@@ -35,7 +36,7 @@ def _reference_positions():
 
 
 def test_exif_gps_georeferencing_lines_up_with_surveyed_positions(aligned):
-    result = georef_stage.georeference_workspace(aligned, use_exif_gps=True, crs="EPSG:32617")
+    result = georef_stage.georeference_workspace(aligned, GeorefOptions(use_exif_gps=True, crs="EPSG:32617"))
     assert result.crs == "EPSG:32617"
     assert result.figures["CAMERA_RMSE_XYZ"] is not None and result.figures["CAMERA_RMSE_XYZ"] < 5.0
     from osgeo import ogr
@@ -81,7 +82,7 @@ def test_camera_positions_file_gives_the_crs(aligned, tmp_path):
     csv = tmp_path / "positions.csv"
     csv.write_text("EPSG:3857\n" + "".join(f"{n},{x:.3f},{y:.3f},{z}\n" for n, (x, y, _), z in
                                             zip(names, merc, [250.0] * len(names))))
-    result = georef_stage.georeference_workspace(ws_dir, camera_positions_path=str(csv))
+    result = georef_stage.georeference_workspace(ws_dir, GeorefOptions(camera_positions_path=str(csv)))
     assert result.crs == "EPSG:3857"
     assert result.figures["CAMERA_RMSE_XY"] is not None and result.figures["CAMERA_RMSE_XY"] < 5.0
 
@@ -101,7 +102,7 @@ def test_the_stage_saves_its_adjustment_inputs_and_the_covariance_reads_them(ali
     names = sorted(set(ref) & set(TOLEDO_STRIP))
     csv = tmp_path / "positions.csv"
     csv.write_text("EPSG:32617\n" + "".join(f"{n} {ref[n][0]:.3f} {ref[n][1]:.3f} 250.0 2.5 7.5\n" for n in names))
-    georef_stage.georeference_workspace(ws_dir, camera_positions_path=str(csv))
+    georef_stage.georeference_workspace(ws_dir, GeorefOptions(camera_positions_path=str(csv)))
     with open(os.path.join(ws_dir, "georef", "adjustment_inputs.json"), encoding="utf-8") as f:
         inputs = json.load(f)
     assert inputs["crs"] == "EPSG:32617"
@@ -121,10 +122,10 @@ def test_too_few_control_points_is_a_clear_error(aligned):
                                                                   Observation("1JI_0067.JPG", 600, 300)]),
     ])
     with pytest.raises(StageError, match="at least 3 control points.*found 2"):
-        georef_stage.georeference_workspace(aligned, gcps=gcps)
+        georef_stage.georeference_workspace(aligned, GeorefOptions(gcps=gcps))
 
 
 def test_unaligned_workspace_is_refused(tmp_path):
     Workspace.create_or_open(str(tmp_path / "ws"))
     with pytest.raises(StageError, match="run 'Align images' first"):
-        georef_stage.georeference_workspace(str(tmp_path / "ws"), use_exif_gps=True)
+        georef_stage.georeference_workspace(str(tmp_path / "ws"), GeorefOptions(use_exif_gps=True))

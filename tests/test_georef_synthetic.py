@@ -438,6 +438,7 @@ def test_end_to_end_stage_names_and_ignores_an_observation_outside_the_image(ali
     """Through the workspace stage with a gcp_list.txt: an observation off the image is named in a warning
     and ignored, a 100 m typo is named as an outlier, the check points keep their accuracy."""
     from core.georef import stage as georef_stage
+    from core.georef.options import GeorefOptions
 
     blk, ws, _ = aligned_block
     ws_copy = str(tmp_path / "ws")
@@ -452,7 +453,7 @@ def test_end_to_end_stage_names_and_ignores_an_observation_outside_the_image(ali
     path = str(tmp_path / "gcp_list.txt")
     write_odm_gcp_list(gcps, path)
     t0 = time.time()
-    stage = georef_stage.georeference_workspace(ws_copy, gcp_path=path)
+    stage = georef_stage.georeference_workspace(ws_copy, GeorefOptions(gcp_path=path))
     print(f"\n[stage] {time.time() - t0:.1f} s: {stage.figures}\n  warnings: {stage.warnings}\n"
           f"  outliers: {stage.outliers}")
     assert any(off.name in w and img in w and "outside" in w for w in stage.warnings), stage.warnings

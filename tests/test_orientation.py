@@ -224,7 +224,8 @@ def test_the_georef_stage_reads_upright_gcps_of_a_turned_photo_into_the_stored_g
     before orientations were recorded) and the original photo: with ``gcps_upright`` only the turned photo's
     observations move; without it nothing moves."""
     from core.common.progress import NullProgress
-    from core.georef import stage as georef_stage
+    from core.georef import control_input
+    from core.georef.options import GeorefOptions
     from core.project.workspace import Workspace
 
     _, path, obs, gcp_file = copr_rotated
@@ -233,13 +234,13 @@ def test_the_georef_stage_reads_upright_gcps_of_a_turned_photo_into_the_stored_g
     ws.data["images"] = [{"name": ROTATED, "path": path, "width": 800, "height": 1200},
                          {"name": COPR_PHOTO, "path": original, "width": 1200, "height": 800, "orientation": 1}]
     ws.save()
-    assert georef_stage.photo_orientations(ws) == {ROTATED: 6}
+    assert control_input.photo_orientations(ws) == {ROTATED: 6}
     both = tmp_path / "both.txt"
     text = open(gcp_file).read()
     both.write_text(text + "".join(f"{line.replace(ROTATED, COPR_PHOTO)}\n" for line in text.splitlines()[1:]))
     for upright in (True, False):
-        gcps = georef_stage._read_control(ws, str(both), None, (), None, False, None, NullProgress(),
-                                          gcps_upright=upright)[0]
+        gcps = control_input.read_control(ws, GeorefOptions(gcp_path=str(both), gcps_upright=upright),
+                                          NullProgress())[0]
         for name, ox, oy in obs:
             p = gcps.by_name(name)
             at = {o.image: (o.x, o.y) for o in p.observations}

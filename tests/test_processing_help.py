@@ -258,11 +258,11 @@ def test_run_pipeline_passes_gcps_upright_on_to_the_georeferencing(plugin, tmp_p
         assert seen["control"].gcp_path == str(gcp)
     monkeypatch.undo()
 
-    # the pipeline itself: Control.gcps_upright -> georeference_workspace(gcps_upright=...)
+    # the pipeline itself: Control.gcps_upright -> georeference_workspace(GeorefOptions(gcps_upright=...))
     got = {}
 
-    def fake_georeference(workspace_dir, progress=None, **kwargs):
-        got.update(kwargs)
+    def fake_georeference(workspace_dir, options, progress=None):
+        got["options"] = options
         raise Stop()
 
     monkeypatch.setattr(pipeline, "check_inputs", lambda images_dir, control: None)
@@ -273,7 +273,7 @@ def test_run_pipeline_passes_gcps_upright_on_to_the_georeferencing(plugin, tmp_p
         with pytest.raises(Stop):
             pipeline.run_pipeline(str(images), str(tmp_path / "ws"),
                                   control=pipeline.Control(gcp_path=str(gcp), gcps_upright=value))
-        assert got["gcps_upright"] is value
+        assert got["options"].gcps_upright is value
 
 
 def test_orthorectify_mode_options_are_translated(plugin, german):

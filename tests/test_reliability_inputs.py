@@ -304,7 +304,8 @@ _UTM_ROWS = ["A,500000,4000000,100", "B,500100,4000000,101", "C,500000,4000100,1
 
 
 def test_gcp_warnings_reach_the_user_when_georeferencing_fails_and_counts_are_honest(tmp_path):
-    from core.georef import stage as georef_stage
+    from core.georef.control_input import read_control
+    from core.georef.options import GeorefOptions
     from core.project.stages import StageError
 
     ws = _workspace_with_images(tmp_path)
@@ -313,7 +314,7 @@ def test_gcp_warnings_reach_the_user_when_georeferencing_fails_and_counts_are_ho
           [f"D,IMG_{i}.JPG,{1000 + 10 * i},{800 + 10 * i}" for i in (1, 2)]
     path = _csv_gcps(tmp_path, "# crs: EPSG:32617", _UTM_ROWS, obs)
     with pytest.raises(StageError) as e:
-        georef_stage._read_control(ws, path, None, (), None, False, None, _Recorder())
+        read_control(ws, GeorefOptions(gcp_path=path), _Recorder())
     msg = str(e.value)
     assert "A (control, 2 observations, both dropped: outside the image)" in msg
     assert "D (control, 2 observations)" in msg
@@ -333,25 +334,26 @@ def test_gcp_warnings_are_kept_when_the_reader_itself_fails(tmp_path):
 
 
 def test_a_csv_gcp_file_without_crs_takes_the_crs_parameter(tmp_path):
-    from core.georef import stage as georef_stage
+    from core.georef.control_input import read_control
+    from core.georef.options import GeorefOptions
 
     ws = _workspace_with_images(tmp_path)
     obs = [f"{p},IMG_{i}.JPG,{1000 + 100 * k},{800 + 50 * i}" for k, p in enumerate("ABCD") for i in (1, 2)]
     path = _csv_gcps(tmp_path, None, _UTM_ROWS, obs)
-    gcps, _, target = georef_stage._read_control(ws, path, None, (), None, False, "EPSG:32617", _Recorder())
+    gcps, _, target = read_control(ws, GeorefOptions(gcp_path=path, crs="EPSG:32617"), _Recorder())
     assert gcps.crs == "EPSG:32617" and target == "EPSG:32617"
     assert [p.x for p in gcps.points] == [500000, 500100, 500000, 500100]
     # a file that names its CRS keeps it; the CRS parameter is then the target it is transformed into
     lonlat = ["A,-81.0,36.14,100", "B,-80.999,36.14,101", "C,-81.0,36.141,102", "D,-80.999,36.141,103"]
     path = _csv_gcps(tmp_path, "# crs: EPSG:4326", lonlat, obs)
-    gcps, _, target = georef_stage._read_control(ws, path, None, (), None, False, "EPSG:32617", _Recorder())
+    gcps, _, target = read_control(ws, GeorefOptions(gcp_path=path, crs="EPSG:32617"), _Recorder())
     assert target == "EPSG:32617" and 499000 < gcps.points[0].x < 501000 and 3.99e6 < gcps.points[0].y < 4.01e6
     # neither: the message says where the CRS can come from
     from core.io import gcp
 
     path = _csv_gcps(tmp_path, None, _UTM_ROWS, obs)
     with pytest.raises(gcp.GCPError, match="CRS parameter"):
-        georef_stage._read_control(ws, path, None, (), None, False, None, _Recorder())
+        read_control(ws, GeorefOptions(gcp_path=path), _Recorder())
 
 
 def _damaged_geotiff(path):

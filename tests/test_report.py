@@ -16,6 +16,7 @@ import pytest
 
 from core.common.progress import Cancelled, NullProgress
 from core.georef import accuracy, uncertainty
+from core.georef.options import GeorefOptions
 from core.georef.stage import georeference_workspace
 from core.project.workspace import Workspace, WorkspaceError
 from core.report import stage as report
@@ -65,7 +66,7 @@ def georeferenced(block, aligned, tmp_path_factory):
         for c in cams:
             f.write(f"{c.image},{c.x:.3f},{c.y:.3f},{c.z:.3f},0.5\n")
     gcps = block.gcp_set(block.spread_control(5), noise_px=0.4)
-    georeference_workspace(root, gcps=gcps, camera_positions_path=csv)
+    georeference_workspace(root, GeorefOptions(gcps=gcps, camera_positions_path=csv))
     return root
 
 

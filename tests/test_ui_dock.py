@@ -87,12 +87,13 @@ def quick_photos(blk, folder, res=0.05, step=8):
 def make_workspace(root, blk, photos, georeference_with=None, name="ws"):
     """An aligned workspace from the block's truth (model in an arbitrary frame); georeferenced with the
     GCPSet ``georeference_with`` when given.  Returns the workspace path."""
+    from archaeoortho.core.georef.options import GeorefOptions
     from archaeoortho.core.georef.stage import georeference_workspace
 
     rec = blk.truth_reconstruction(n_points=800, noise_px=0.3)
     ws = synthetic_workspace(os.path.join(root, name), blk, rec, photos=photos, cameras_gpkg=True)
     if georeference_with is not None:
-        georeference_workspace(ws, gcps=georeference_with)
+        georeference_workspace(ws, GeorefOptions(gcps=georeference_with))
     return ws
 
 @pytest.fixture(scope="module")

@@ -116,6 +116,7 @@ def test_georeference_from_the_toolbox_loads_styled_layers(plugin, aligned, qgis
 def test_footprints_not_written_say_why(plugin, aligned, monkeypatch):
     """No footprints before the georeference, silently (nothing to draw yet); a failure to write them after it
     is said in the message log with the reason (it used to be swallowed), and the loading goes on (None)."""
+    from archaeoortho.core.georef.options import GeorefOptions
     from archaeoortho.core.georef.stage import georeference_workspace
     from archaeoortho.core.project.layout import Layout
     from archaeoortho.core.project.workspace import Workspace
@@ -133,7 +134,7 @@ def test_footprints_not_written_say_why(plugin, aligned, monkeypatch):
     log.messageReceived.connect(on_message)
     try:
         assert layers.footprints_path(ws) is None and not logged  # not georeferenced yet
-        georeference_workspace(ws, gcp_file)
+        georeference_workspace(ws, GeorefOptions(gcp_path=gcp_file))
         path = Layout(Workspace.open(ws)).footprints_gpkg
         assert layers.footprints_path(ws) == path and os.path.isfile(path)
         from archaeoortho.core.georef import guided

@@ -26,13 +26,15 @@ def autocontrol_then_prepare(root, ortho_layer, dsm_layer, check_points=None, ex
     """In the worker thread: the reference layers as files (saved when they are web layers), the automatic
     control, then the image footprints the result layers show.  Returns (AutoControlResult, footprints)."""
     from ..core.common.progress import SubProgress
+    from ..core.georef.autocontrol.options import AutoControlOptions
     from ..core.georef.autocontrol.stage import autocontrol_workspace
     from ..qgisio import reference_layers as refs
 
     ortho, dsm = refs.resolve_references(ortho_layer, dsm_layer, root, extent=extent, extent_crs=extent_crs,
                                          progress=SubProgress(progress, 0.0, 0.1), context=context)
     check = refs.as_check_points(check_points, refs.reference_crs(ortho))
-    result = autocontrol_workspace(root, ortho, dsm, check_points=check, progress=SubProgress(progress, 0.1, 0.97))
+    result = autocontrol_workspace(root, AutoControlOptions(reference_ortho=ortho, reference_dsm=dsm, check_points=check),
+                                   SubProgress(progress, 0.1, 0.97))
     return result, layers.footprints_path(root)
 
 

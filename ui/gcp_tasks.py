@@ -7,6 +7,7 @@ from qgis.core import Qgis, QgsProject
 from qgis.PyQt.QtCore import QCoreApplication
 from qgis.PyQt.QtWidgets import QFileDialog
 
+from ..core.georef.options import GeorefOptions
 from ..core.io import gcp as gcpmod
 from ..core.project.stages import ALIGN, GEOREFERENCE
 from ..qgisio import layers
@@ -16,12 +17,12 @@ from .tasks import CoreTask, start
 translate = QCoreApplication.translate
 
 
-def georeference_then_prepare(root, progress=None, **kwargs):
+def georeference_then_prepare(root, options, progress=None):
     """The adjustment, then (still in the worker thread) the image footprints the result layers show: the dock's
     done() only adds layers (issue 18.5).  Returns (GeorefResult, footprints path or None)."""
     from ..core.georef import stage as georef_stage
 
-    result = georef_stage.georeference_workspace(root, progress=progress, **kwargs)
+    result = georef_stage.georeference_workspace(root, options, progress=progress)
     try:
         model = read_block_model(root)
     except Exception:  # noqa: BLE001 - the dock's load_predictor reads it again and reports the problem
@@ -268,8 +269,9 @@ class GcpTasks:
             self.message(translate("GcpDock", "Georeferenced in {}.").format(short_crs(result.crs)) + extra,
                          Qgis.MessageLevel.Warning if result.outliers else Qgis.MessageLevel.Success)
 
-        task = CoreTask(translate("GcpDock", "ArchaeoOrtho: georeference"), georeference_then_prepare, (root,),
-                        {"gcps": gs, "refine_intrinsics": self.refine_box.isChecked()},
+        options = GeorefOptions(gcps=gs, refine_intrinsics=self.refine_box.isChecked())
+        task = CoreTask(translate("GcpDock", "ArchaeoOrtho: georeference"), georeference_then_prepare, (root, options),
+                        {},
                         on_done=done, on_error=self._task_failed)
         self.message(translate("GcpDock", "Georeferencing with {} control points\u2026").format(n_control))
         return self._start_task(task)

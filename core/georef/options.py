@@ -3,7 +3,9 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Any, Dict, Optional, Tuple
+from typing import Any, Dict, Optional, Sequence, Tuple
+
+from ..io.gcp import GCPSet
 
 INTRINSIC_GROUPS = ("focal", "principal_point", "extra")
 
@@ -42,7 +44,14 @@ class GeorefOptions:
     ``drop_suspect_control``: control points the consistency check names as suspect (they disagree with the
     others through the block) are dropped before the adjustment, not only named in a warning; the automatic
     control sets it (its points are many and a suspect one is a wrong match far more often than a sign of a
-    deformed block: 4 of 101 flagged, the worst 1.54 m off, were kept and bent the block before)."""
+    deformed block: 4 of 101 flagged, the worst 1.54 m off, were kept and bent the block before).
+
+    The georeference stage's inputs (``core.georef.stage.georeference_workspace``; the adjustment ignores them):
+    ``gcp_path``: a GCP file (core.io.gcp.read_gcps), else ``gcps``: a ``core.io.gcp.GCPSet``; ``check_points``:
+    names of GCPs evaluated as check points; ``camera_positions_path``: a camera positions file, else
+    ``use_exif_gps``: the photos' EXIF GPS as camera positions; ``gcps_upright``: the GCP pixel coordinates were
+    measured on the photos shown upright (EXIF orientation applied), not in the stored grid.  ``crs``: the target
+    CRS (None: the GCPs', the workspace's, the positions', else the UTM zone of the photos' GPS)."""
 
     refine_intrinsics: Any = False
     outlier_threshold: float = 5.0
@@ -65,6 +74,12 @@ class GeorefOptions:
     reference_dem_points: int = 25
     reference_dem_sigma_z: float = 0.0
     drop_suspect_control: bool = False
+    gcp_path: Optional[str] = None
+    gcps: Optional[GCPSet] = None
+    check_points: Sequence[str] = ()
+    camera_positions_path: Optional[str] = None
+    use_exif_gps: bool = False
+    gcps_upright: bool = False
 
     @classmethod
     def of(cls, options: Optional["GeorefOptions"] = None, **kwargs: Any) -> "GeorefOptions":

@@ -158,11 +158,21 @@ class _Photos:
         return self._cache[name]
 
 
-def tie_back(rec, frame: Frame, prov: ProvisionalOrtho, src: np.ndarray, world_xy: np.ndarray,
-             residual: np.ndarray, reference, photos: Mapping[str, str], opt, progress: Optional[Progress] = None
-             ) -> List[Candidate]:
-    """Candidates of the matches ``src`` (orthophoto pixels) -> ``world_xy`` (reference CRS); every one is
-    returned, those dropped with ``status`` saying why."""
+@dataclass
+class TiePoints:
+    """Matches to tie back to the photos: ``src`` (N, 2) provisional orthophoto pixels, ``world_xy`` (N, 2) their
+    places in the reference CRS, ``residual`` (N,) their fit to the tiles' affines (common-grid pixels)."""
+
+    src: np.ndarray
+    world_xy: np.ndarray
+    residual: np.ndarray
+
+
+def tie_back(rec, frame: Frame, prov: ProvisionalOrtho, ties: TiePoints, reference, photos: Mapping[str, str], opt,
+             progress: Optional[Progress] = None) -> List[Candidate]:
+    """Candidates of the matches ``ties.src`` (orthophoto pixels) -> ``ties.world_xy`` (reference CRS); every one
+    is returned, those dropped with ``status`` saying why."""
+    src, world_xy, residual = ties.src, ties.world_xy, ties.residual
     progress = progress or NullProgress()
     g = prov.res
     to_model = frame.model_to_frame.inverse()
@@ -310,4 +320,4 @@ def drop_counts(cands: Sequence[Candidate]) -> Dict[str, int]:
 
 
 __all__ = ["KEPT", "Candidate", "consistent", "drop_counts", "estimate_own_sigma", "own_sigma_prior", "reason",
-           "set_own_sigma", "spread", "terrain_sigma", "tie_back"]
+           "set_own_sigma", "spread", "terrain_sigma", "tie_back", "TiePoints"]

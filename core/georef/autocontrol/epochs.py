@@ -10,15 +10,13 @@ built on one DSM (Build orthophoto's external DSM: the earlier block's) and thei
 from __future__ import annotations
 
 import os
-from typing import Optional, Sequence, Tuple
+from typing import Optional, Tuple
 
 from ...common.progress import Progress
-from ...io.gcp import CameraPosition, GCPSet
 from ...project.layout import Layout, read_json, write_json
 from ...project.workspace import Workspace, WorkspaceError
-from ..options import GeorefOptions
 from .errors import AutoControlError
-from .options import PRIOR_AUTO, AutoControlOptions
+from .options import AutoControlOptions
 from .stage import AutoControlResult, autocontrol_workspace
 
 
@@ -44,16 +42,13 @@ def reference_products(reference_workspace_dir: str) -> Tuple[str, str]:
     return ortho, dsm
 
 
-def register_epoch(workspace_dir: str, reference_workspace_dir: str, prior: str = PRIOR_AUTO,
-                   camera_positions: Optional[Sequence[CameraPosition]] = None,
-                   check_points: Optional[GCPSet] = None, options: Optional[AutoControlOptions] = None,
-                   georef_options: Optional[GeorefOptions] = None,
+def register_epoch(workspace_dir: str, reference_workspace_dir: str, options: Optional[AutoControlOptions] = None,
                    progress: Optional[Progress] = None) -> AutoControlResult:
     """Georeference the aligned workspace ``workspace_dir`` (another epoch: a second block or single photos) on
     the orthomosaic and DSM of the earlier, georeferenced workspace ``reference_workspace_dir``, with no GCP.
 
-    ``prior``, ``camera_positions``, ``check_points``, ``options``, ``georef_options``: as
-    :func:`~core.georef.autocontrol.stage.autocontrol_workspace`.  Raises AutoControlError for a reference
+    ``options``: as :func:`~core.georef.autocontrol.stage.autocontrol_workspace` (its references are the
+    earlier workspace's orthomosaic and DSM).  Raises AutoControlError for a reference
     workspace without those products (named), the same workspace twice, or too few automatic GCPs."""
     ortho, dsm = reference_products(reference_workspace_dir)
     ref_root = os.path.abspath(reference_workspace_dir)
@@ -62,9 +57,8 @@ def register_epoch(workspace_dir: str, reference_workspace_dir: str, prior: str 
                                "workspace as the reference")
     lay = Layout(Workspace.open(workspace_dir))
     try:
-        return autocontrol_workspace(workspace_dir, ortho, dsm, prior=prior, camera_positions=camera_positions,
-                                     check_points=check_points, options=options, georef_options=georef_options,
-                                     progress=progress)
+        return autocontrol_workspace(workspace_dir, AutoControlOptions.of(options, reference_ortho=ortho,
+                                                                          reference_dsm=dsm), progress)
     finally:  # also after a failure: autocontrol.json then tells which reference was tried
         doc = read_json(lay.autocontrol_json)
         if isinstance(doc, dict) and doc.get("reference_ortho") == os.path.abspath(ortho):

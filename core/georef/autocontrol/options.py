@@ -3,7 +3,10 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Any, Optional
+from typing import Any, Optional, Sequence
+
+from ...io.gcp import CameraPosition, GCPSet
+from ..options import GeorefOptions
 
 AUTO = "auto"  # the role of an automatic GCP candidate in georef/autocontrol.json
 # where the block is first placed: EXIF GPS when 2 photos carry it (else none), the GPS, or a search over rotations
@@ -28,7 +31,14 @@ class AutoControlOptions:
     one gives ``coarse_enough`` inliers; ``coarse_pixels``: the provisional orthophoto's side at that level;
     ``refine_intrinsics``: what the adjustment refines of the cameras (as ``GeorefOptions``): by default focal
     length and distortion, which dozens of automatic GCPs over the block determine (on Toledo's FC300X photos the
-    camera centres' median error falls from 1.75 m to 0.85 m)."""
+    camera centres' median error falls from 1.75 m to 0.85 m).
+
+    The inputs of ``autocontrol_workspace``: ``reference_ortho``, ``reference_dsm``: the reference orthophoto and
+    DSM files; ``prior``: "auto" (EXIF GPS when 2 photos carry it, else none), "gps", or "none" (search rotation
+    and scale); ``camera_positions``: rough positions in the reference's CRS instead of EXIF GPS;
+    ``check_points``: ground points evaluated as check points (role check; taken from their set's CRS into the
+    reference's); ``georef``: the adjustment's options (its ``refine_intrinsics`` replaces
+    ``refine_intrinsics``)."""
 
     gsd: Optional[float] = None
     max_pixels: int = 3000
@@ -50,6 +60,12 @@ class AutoControlOptions:
     coarse_pixels: int = 1000
     coarse_enough: int = 150
     refine_intrinsics: Any = True
+    reference_ortho: Optional[str] = None
+    reference_dsm: Optional[str] = None
+    prior: str = PRIOR_AUTO
+    camera_positions: Optional[Sequence[CameraPosition]] = None
+    check_points: Optional[GCPSet] = None
+    georef: Optional[GeorefOptions] = None
 
     @classmethod
     def of(cls, options: Optional["AutoControlOptions"] = None, **kwargs: Any) -> "AutoControlOptions":

@@ -8,7 +8,7 @@ import math
 import os
 import time
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Sequence
+from typing import Dict, List, Optional
 
 import numpy as np
 
@@ -20,6 +20,7 @@ from ...project.workspace import Workspace
 from .candidates import (
     KEPT,
     Candidate,
+    TiePoints,
     consistent,
     drop_counts,
     estimate_own_sigma,
@@ -133,8 +134,11 @@ def _coarse_prior(rec, photos, reference: Reference, opt: AutoControlOptions, pr
     return Frame(world, offset)
 
 
-def _prior(ws, rec, photos, reference, prior, positions, opt, progress, messages) -> Frame:
+def _prior(ws, rec, photos, reference, opt: AutoControlOptions, progress, messages) -> Frame:
+    """The block's frame in the reference CRS: from rough camera positions (``opt.camera_positions``, else the
+    photos' EXIF GPS unless ``opt.prior`` is "none"), else by the coarse search."""
     crs = reference.crs
+    prior, positions = opt.prior, opt.camera_positions
     if positions is None and prior in (PRIOR_AUTO, PRIOR_GPS):
         positions = _gps_positions(ws, crs)
         if prior == PRIOR_GPS and len(positions) < 2:
@@ -186,17 +190,16 @@ def _own_height_sigma(cands, reference: Reference, photo_gsd: float, opt: AutoCo
     return own
 
 
-def find_candidates(ws: Workspace, rec, reference: Reference, prior: str = PRIOR_AUTO,
-                    positions: Optional[Sequence[CameraPosition]] = None,
-                    options: Optional[AutoControlOptions] = None, progress: Optional[Progress] = None
-                    ) -> CandidateSearch:
-    """The candidates of an aligned block against the reference, with the search's figures and messages."""
+def find_candidates(ws: Workspace, rec, reference: Reference, options: Optional[AutoControlOptions] = None,
+                    progress: Optional[Progress] = None) -> CandidateSearch:
+    """The candidates of an aligned block against the reference, with the search's figures and messages (the
+    block placed by ``options.prior`` and ``options.camera_positions``)."""
     opt = AutoControlOptions.of(options)
     progress = progress or NullProgress()
     photos = photo_paths(ws, rec)
     messages: List[str] = list(reference.notes)
     t = {"start": time.time()}
-    frame = _prior(ws, rec, photos, reference, prior, positions, opt, SubProgress(progress, 0.0, 0.2), messages)
+    frame = _prior(ws, rec, photos, reference, opt, SubProgress(progress, 0.0, 0.2), messages)
     t["prior"] = time.time()
     ext = block_extent(rec, frame)
     photo_gsd = _photo_gsd(rec, frame)
@@ -218,7 +221,7 @@ def find_candidates(ws: Workspace, rec, reference: Reference, prior: str = PRIOR
                     f"{ms.n_found} matches, {ms.n_similarity} fit one similarity, {len(ms.src)} fit their tiles")
     sel = spread(ms.src, ms.residual, opt.max_candidates, prov.grey.shape)
     world_xy = np.column_stack([gt[0] + (ms.dst[sel, 0] + 0.5) * gt[1], gt[3] + (ms.dst[sel, 1] + 0.5) * gt[5]])
-    cands = tie_back(rec, frame, prov, ms.src[sel], world_xy, ms.residual[sel], reference, photos, opt,
+    cands = tie_back(rec, frame, prov, TiePoints(ms.src[sel], world_xy, ms.residual[sel]), reference, photos, opt,
                      SubProgress(progress, 0.4, 0.9))
     t["photos"] = time.time()
     n_obs = sum(1 for c in cands if c.status == KEPT)
