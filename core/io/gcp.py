@@ -364,18 +364,28 @@ def observations_to_stored(gcpset: GCPSet, image_sizes: ImageSizes, orientations
     return gcpset
 
 
-def _finish(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike,
-            image_names: Optional[Iterable[str]], image_sizes: Optional[ImageSizes],
-            unknown_images: str = "warn", point_where: Optional[Dict[int, str]] = None,
-            unit: str = "line", upright: Optional[Mapping[str, int]] = None) -> GCPSet:
+@dataclass
+class _Photos:
+    """What a reader knows of the block's photos to check observations against: ``names`` (None: any),
+    ``sizes`` {image: (width, height)} of the stored grid (None: bounds unchecked), ``unknown``: "warn" (an
+    observation in a photo not in the block is dropped with a warning) or "error"; ``upright``: {image: EXIF
+    orientation} of photos whose observations were measured on the upright photo."""
+    names: Optional[Iterable[str]]
+    sizes: Optional[ImageSizes]
+    unknown: str = "warn"
+    upright: Optional[Mapping[str, int]] = None
+
+
+def _finish(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike, photos: _Photos,
+            point_where: Optional[Dict[int, str]] = None, unit: str = "line") -> GCPSet:
     """Shared validation: unknown images, duplicate observations, bounds, points seen in < 2 images.
 
     ``obs_lines[id(point)]`` holds the source line (in ``path``) of each observation of that point;
     ``point_where[id(point)]`` where the point itself is defined, when that is elsewhere ("file:line").
-    ``unit``: "line" (file:line) or "row" (source: row n) in messages.  ``upright``: {image: EXIF orientation}
-    of photos whose observations were measured on the upright photo; they are converted to the stored grid
-    (``image_sizes`` gives the stored sizes) before the bounds check.
+    ``unit``: "line" (file:line) or "row" (source: row n) in messages.  The observations of ``photos.upright``
+    are converted to the stored grid (``photos.sizes`` gives the stored sizes) before the bounds check.
     """
+    image_names, image_sizes, unknown_images = photos.names, photos.sizes, photos.unknown
 
     def loc(n: int) -> str:
         if not n:
@@ -386,7 +396,7 @@ def _finish(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike,
         raise ValueError("unknown_images must be 'error' or 'warn'")
     names = _ImageLookup(image_names)
     sizes_lookup = _ImageLookup(image_sizes.keys()) if image_sizes is not None else None
-    rotations = _upright_table(upright, image_sizes, path)
+    rotations = _upright_table(photos.upright, image_sizes, path)
     unknown: Dict[str, List[Tuple[int, str]]] = {}
     matched = 0
     for p in gs.points:
@@ -455,12 +465,10 @@ def with_warnings(error: Exception, warnings: Sequence[str]) -> str:
 
 
 def _finish_checked(gs: GCPSet, obs_lines: Dict[int, List[int]], path: PathLike, units_path: PathLike,
-                    image_names: Optional[Iterable[str]], image_sizes: Optional[ImageSizes], unknown_images: str,
-                    point_where: Optional[Dict[int, str]] = None,
-                    upright: Optional[Mapping[str, int]] = None) -> GCPSet:
+                    photos: _Photos, point_where: Optional[Dict[int, str]] = None) -> GCPSet:
     """_finish and _check_units; a GCPError they raise carries the warnings collected before it."""
     try:
-        _finish(gs, obs_lines, path, image_names, image_sizes, unknown_images, point_where, upright=upright)
+        _finish(gs, obs_lines, path, photos, point_where)
         _check_units(gs, units_path)
     except GCPError as e:
         if not gs.warnings:
@@ -590,8 +598,8 @@ def read_odm_gcp_list(path: PathLike, image_names: Optional[Iterable[str]] = Non
     gs.points = order
     if not order:
         gs.warnings.append(f"{path}: no observations")
-    return _finish_checked(gs, obs_lines, path, path, image_names, image_sizes, unknown_images,
-                           upright=upright_orientations)
+    return _finish_checked(gs, obs_lines, path, path,
+                           _Photos(image_names, image_sizes, unknown_images, upright_orientations))
 
 
 def _fmt(v: float) -> str:
@@ -806,8 +814,8 @@ def read_csv_gcps(points_path: PathLike, observations_path: Optional[PathLike] =
             p.observations.append(Observation(img, px, py))
             obs_lines.setdefault(id(p), []).append(lineno)
     where = {id(p): f"{points_path}:{first_line[p.name]}" for p in gs.points}
-    return _finish_checked(gs, obs_lines, obs_path, points_path, image_names, image_sizes, unknown_images, where,
-                           upright=upright_orientations)
+    return _finish_checked(gs, obs_lines, obs_path, points_path,
+                           _Photos(image_names, image_sizes, unknown_images, upright_orientations), where)
 
 
 def _csv_text(rows: Iterable[Sequence[Any]]) -> str:
@@ -943,8 +951,8 @@ def gcps_from_rows(rows: Iterable[Mapping[str, Any]], crs: str, *, source_name: 
         obs_lines.setdefault(id(p), []).append(k)
     if not gs.points:
         gs.warnings.append(f"{source_name}: no ground control rows")
-    _finish(gs, obs_lines, source_name, image_names, image_sizes, unknown_images, unit="row",
-            upright=upright_orientations)
+    _finish(gs, obs_lines, source_name, _Photos(image_names, image_sizes, unknown_images, upright_orientations),
+            unit="row")
     _check_units(gs, source_name)
     return gs
 
