@@ -171,7 +171,7 @@ def _auto_control(single: SingleImageOptions, run: ImageRun, progress: Progress)
     """(GCP set of the automatic control, its figures): the photo matched to the reference orthophoto and DSM;
     the camera it estimates becomes the interior orientation unless one was given."""
     from ..georef.autocontrol.errors import AutoControlError
-    from ..georef.autocontrol.single import control_photo
+    from ..georef.autocontrol.single import KnownCamera, SearchArea, control_photo
 
     focal = None
     if single.camera is None:
@@ -180,9 +180,9 @@ def _auto_control(single: SingleImageOptions, run: ImageRun, progress: Progress)
         run.info(f"automatic control of {run.name} against {single.reference_ortho}: focal length "
                  + (f"{focal:.1f} px ({f_source})" if focal else "unknown, estimated"))
     try:
-        pc = control_photo(single.image_path, single.reference_ortho, single.dsm_path, single.location,
-                           single.search_radius, single.location_crs, camera=single.camera, focal_px=focal,
-                           estimate_intrinsics=single.estimate_intrinsics, options=single.control, progress=progress)
+        pc = control_photo(single.image_path, single.reference_ortho, single.dsm_path,
+                           SearchArea(single.location, single.search_radius, single.location_crs),
+                           KnownCamera(single.camera, focal, single.estimate_intrinsics), single.control, progress)
     except AutoControlError as e:
         raise OrthoError(str(e)) from e
     for m in pc.messages:

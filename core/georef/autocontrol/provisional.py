@@ -210,6 +210,21 @@ def read_photo(path: str) -> np.ndarray:
     return img
 
 
+@dataclass(frozen=True)
+class _Grid:
+    """A north-up grid of the frame: upper-left corner (``x0``, ``y0``), cells ``res`` wide, ``nx`` x ``ny``."""
+
+    x0: float
+    y0: float
+    res: float
+    nx: int
+    ny: int
+
+    def xy(self, cols, rows):
+        """Frame x, y of the centres of cells (``cols``, ``rows``)."""
+        return self.x0 + (cols + 0.5) * self.res, self.y0 - (rows + 0.5) * self.res
+
+
 def provisional_ortho(rec, frame: Frame, photos: Mapping[str, str], res: float,
                       progress: Optional[Progress] = None, extent=None) -> ProvisionalOrtho:
     """The provisional orthophoto of the block at ``res`` frame units per pixel (see the module notes);
@@ -231,7 +246,7 @@ def provisional_ortho(rec, frame: Frame, photos: Mapping[str, str], res: float,
     for k, im in enumerate(images):
         check_cancel(progress)
         progress.report(0.5 * k / len(images), f"provisional orthophoto: projecting {im.name}")
-        rows, cols = _footprint(rec, im, to_model, surface, xmin, ymax, res, nx, ny, step)
+        rows, cols = _footprint(rec, im, to_model, surface, _Grid(xmin, ymax, res, nx, ny), step)
         if rows is None:
             continue
         cc, rr = np.meshgrid(np.arange(cols.start, cols.stop), np.arange(rows.start, rows.stop))
@@ -257,11 +272,11 @@ def provisional_ortho(rec, frame: Frame, photos: Mapping[str, str], res: float,
     return ProvisionalOrtho(grey, best >= 0, xmin, ymax, res, best, u, v, [im.name for im in images], surface)
 
 
-def _footprint(rec, im, to_model: Similarity, surface: Surface, x0: float, y0: float, res: float, nx: int, ny: int,
-               step: int):
-    """The (rows, cols) slices of the grid that image ``im`` sees (from a grid ``step`` cells apart), or None."""
+def _footprint(rec, im, to_model: Similarity, surface: Surface, grid: _Grid, step: int):
+    """The (rows, cols) slices of ``grid`` that image ``im`` sees (from a grid ``step`` cells apart), or None."""
+    nx, ny = grid.nx, grid.ny
     cc, rr = np.meshgrid(np.arange(0, nx + step, step), np.arange(0, ny + step, step))
-    x, y = x0 + (cc + 0.5) * res, y0 - (rr + 0.5) * res
+    x, y = grid.xy(cc, rr)
     z = surface.sample(x, y)
     _, inside, _ = project(rec, im, to_model.apply(np.column_stack([x.ravel(), y.ravel(), z.ravel()])))
     if not inside.any():

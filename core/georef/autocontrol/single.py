@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass, field
-from typing import List, Optional, Sequence, Tuple
+from typing import Any, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -351,31 +351,48 @@ def _resect(xyz: np.ndarray, px: np.ndarray, camera: Optional[Intrinsics], photo
     return best[1]
 
 
-def control_photo(image_path: str, reference_ortho: str, reference_dsm: str, location: Optional[Sequence[float]],
-                  search_radius: float = 50.0, location_crs: Optional[str] = None, height: Optional[float] = None,
-                  camera: Optional[Intrinsics] = None, focal_px: Optional[float] = None,
-                  estimate_intrinsics="auto", options: Optional[PhotoControlOptions] = None,
-                  progress: Optional[Progress] = None) -> PhotoControl:
-    """Orient one photo by automatic control against a reference orthophoto and DSM (module docstring).
+@dataclass
+class SearchArea:
+    """Where a photo is looked for on the reference: ``location``, the rough (x, y) of the ground it shows, in
+    ``crs`` (None: the reference's CRS), or None to search the whole reference; ``radius``: how far off it may be
+    (metres); ``height``: roughly how high above the ground the photo was taken (only bounds the search)."""
 
-    ``location``: the rough (x, y) of the ground the photo shows, in ``location_crs`` (None: the reference's
-    CRS), or None to search the whole reference; ``search_radius``: how far off it may be (metres);
-    ``height``: roughly how high above the ground the photo was taken (only bounds the search); ``camera`` or
-    ``focal_px``: the interior orientation when known (else the focal length is estimated)."""
+    location: Optional[Sequence[float]] = None
+    radius: float = 50.0
+    crs: Optional[str] = None
+    height: Optional[float] = None
+
+
+@dataclass
+class KnownCamera:
+    """What is known of a photo's interior orientation: ``camera`` or ``focal_px`` (neither: the focal length is
+    estimated); ``estimate_intrinsics``: True / False / "auto" (as ``core.geometry.resection.space_resection``)."""
+
+    camera: Optional[Intrinsics] = None
+    focal_px: Optional[float] = None
+    estimate_intrinsics: Any = "auto"
+
+
+def control_photo(image_path: str, reference_ortho: str, reference_dsm: str, area: Optional[SearchArea] = None,
+                  known: Optional[KnownCamera] = None, options: Optional[PhotoControlOptions] = None,
+                  progress: Optional[Progress] = None) -> PhotoControl:
+    """Orient one photo by automatic control against a reference orthophoto and DSM (module docstring), looked
+    for in ``area`` (None: anywhere on the reference) with the interior orientation ``known`` (None: estimated)."""
     progress = progress or NullProgress()
     opt = options or PhotoControlOptions()
     if not image_path or not os.path.isfile(image_path):
         raise AutoControlError(f"automatic control: the photo {image_path!r} does not exist")
     ref = Reference(reference_ortho, reference_dsm)
     try:
-        return _control(image_path, ref, location, search_radius, location_crs, height, camera, focal_px,
-                        estimate_intrinsics, opt, progress)
+        return _control(image_path, ref, area or SearchArea(), known or KnownCamera(), opt, progress)
     finally:
         ref.close()
 
 
-def _control(image_path, ref: Reference, location, search_radius, location_crs, height, camera, focal_px,
-             estimate_intrinsics, opt: PhotoControlOptions, progress: Progress) -> PhotoControl:
+def _control(image_path, ref: Reference, area: SearchArea, known: KnownCamera, opt: PhotoControlOptions,
+             progress: Progress) -> PhotoControl:
+    location, search_radius, location_crs, height = area.location, area.radius, area.crs, area.height
+    camera, focal_px, estimate_intrinsics = known.camera, known.focal_px, known.estimate_intrinsics
     photo = _read_photo(image_path)
     messages: List[str] = []
     if location is not None and location_crs:
@@ -429,11 +446,11 @@ def _control(image_path, ref: Reference, location, search_radius, location_crs, 
         check_cancel(progress)
         if k < opt.passes:
             img, valid, to_photo = _rectify_pose(photo, fine, ref, result.pose, result.camera, offset)
-    return _finish(photo, ref, result, xyz, px, offset, figures, messages, opt)
+    return _finish(photo, ref, result, xyz, px, offset, figures, messages)
 
 
-def _finish(photo: _Photo, ref: Reference, r: rs.ResectionResult, xyz, px, offset, figures, messages,
-            opt: PhotoControlOptions) -> PhotoControl:
+def _finish(photo: _Photo, ref: Reference, r: rs.ResectionResult, xyz, px, offset, figures, messages
+            ) -> PhotoControl:
     crs = ref.crs
     sigma = max(ref.gsd, 1e-3)
     gs = gcpmod.GCPSet(crs, source=f"automatic control against {ref.ortho_path}")
@@ -457,4 +474,5 @@ def _finish(photo: _Photo, ref: Reference, r: rs.ResectionResult, xyz, px, offse
                         warnings)
 
 
-__all__ = ["AUTO_PREFIX", "PhotoControl", "PhotoControlOptions", "affine_rootsift", "control_photo"]
+__all__ = ["AUTO_PREFIX", "KnownCamera", "PhotoControl", "PhotoControlOptions", "SearchArea", "affine_rootsift",
+           "control_photo"]
