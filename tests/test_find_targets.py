@@ -120,18 +120,19 @@ def test_a_regular_constellation_is_not_named_by_guess():
     g = np.array([[x, y, 0.0] for x in (0.0, 10.0, 20.0) for y in (0.0, 10.0, 20.0)])
     rot = np.array([[0.6, -0.8, 0.0], [0.8, 0.6, 0.0], [0.0, 0.0, 1.0]])
     model = 0.1 * g @ rot.T + [3.0, -2.0, 1.0]
-    m = constellation.match_constellation(model, g + [500000.0, 4000000.0, 0.0], [f"t{k}" for k in range(9)])
+    m = constellation.match_constellation(constellation.Marks(model), g + [500000.0, 4000000.0, 0.0],
+                                          [f"t{k}" for k in range(9)])
     assert m.names == {} and "no name given" in m.reports[0]
     # one target off the pattern breaks the symmetry: all named, correctly
     g2 = np.vstack([g, [[26.0, 3.0, 0.0]]])
     model2 = 0.1 * g2 @ rot.T + [3.0, -2.0, 1.0]
     names = [f"t{k}" for k in range(10)]
-    m2 = constellation.match_constellation(model2, g2, names)
+    m2 = constellation.match_constellation(constellation.Marks(model2), g2, names)
     assert m2.names == {k: names[k] for k in range(10)}, m2.reports
     # a coded mark whose code names another target is reported, never assigned
     codes = [None] * 10
     codes[4] = "t7"
-    m3 = constellation.match_constellation(model2, g2, names, codes)
+    m3 = constellation.match_constellation(constellation.Marks(model2, codes), g2, names)
     assert 4 not in m3.names and any("coded or clicked as t7 sits at target t4" in s for s in m3.reports)
 
 
@@ -149,7 +150,7 @@ def test_a_gps_prior_names_a_regular_constellation():
     turn = np.array([[math.cos(a), -math.sin(a), 0.0], [math.sin(a), math.cos(a), 0.0], [0.0, 0.0, 1.0]])
     prior = Similarity(10.0, turn @ rot.T, turn @ (-10.0 * rot.T @ t0) + off + [1.0, 0.0, 0.0])
     names = [f"t{k}" for k in range(9)]
-    m = constellation.match_constellation(model, g + off, names, prior=prior, prior_tol=3.0)
+    m = constellation.match_constellation(constellation.Marks(model), g + off, names, prior=prior, prior_tol=3.0)
     assert m.names == {k: names[k] for k in range(9)}, m.reports
 
 

@@ -89,22 +89,31 @@ def _hypotheses(model: np.ndarray, world: np.ndarray, shape_tol: float, limit: i
     return [(m_ord[mi[k]], w_ord[wi[k]]) for k in order]
 
 
-def match_constellation(model: np.ndarray, world: np.ndarray, names: Sequence[str],
-                        codes: Optional[Sequence[Optional[str]]] = None, xy_only: bool = False,
-                        tol_fraction: float = 0.3, min_marks: int = 4,
-                        weights: Optional[Sequence[float]] = None, prior: Optional[Similarity] = None,
+@dataclass
+class Marks:
+    """Marks found on the photos and triangulated: ``xyz`` (M, 3) in the model; ``codes``: per mark, the target
+    name its code (coded targets) or a click gives, or None; ``weights``: per mark, its evidence (the number of
+    photos it was tied in; None: 1 each)."""
+
+    xyz: np.ndarray
+    codes: Optional[Sequence[Optional[str]]] = None
+    weights: Optional[Sequence[float]] = None
+
+
+def match_constellation(marks: Marks, world: np.ndarray, names: Sequence[str], xy_only: bool = False,
+                        tol_fraction: float = 0.3, min_marks: int = 4, prior: Optional[Similarity] = None,
                         prior_tol: float = 0.0) -> Constellation:
-    """Name the marks ``model`` (M, 3) after the targets ``world`` (K, 3) called ``names``; ``codes``: per mark,
-    the target name its code gives (coded targets) or None.  Needs at least ``min_marks`` marks to agree (three
-    always fit some triangle); fewer, or two hypotheses equally good with different names, name nothing.
-    ``weights``: per mark, its evidence (the number of photos it was tied in): triangles are drawn from the
-    best-evidenced marks (twice as many as targets, and four more) and a hypothesis scores the evidence it
-    brings onto targets.  ``prior``: a rough model -> world similarity (EXIF GPS): a hypothesis that puts one of
-    its triangle's marks further than ``prior_tol`` plus the tolerance (horizontally) from where the prior puts it is
-    not tried, nor the mirror."""
-    model = np.asarray(model, dtype=float).reshape(-1, 3)
+    """Name the marks ``marks.xyz`` (M, 3) after the targets ``world`` (K, 3) called ``names``; a mark with a
+    code names no other target.  Needs at least ``min_marks`` marks to agree (three always fit some triangle);
+    fewer, or two hypotheses equally good with different names, name nothing.  Triangles are drawn from the
+    best-evidenced marks (``marks.weights``: twice as many as targets, and four more) and a hypothesis scores
+    the evidence it brings onto targets.  ``prior``: a rough model -> world similarity (EXIF GPS): a hypothesis
+    that puts one of its triangle's marks further than ``prior_tol`` plus the tolerance (horizontally) from where
+    the prior puts it is not tried, nor the mirror."""
+    model = np.asarray(marks.xyz, dtype=float).reshape(-1, 3)
     world = np.asarray(world, dtype=float).reshape(-1, 3)
-    codes = list(codes) if codes is not None else [None] * len(model)
+    codes = list(marks.codes) if marks.codes is not None else [None] * len(model)
+    weights = marks.weights
     out = Constellation()
     if len(world) < 2 or len(model) < 3:
         out.reports.append(f"{len(model)} mark(s) triangulated and {len(world)} target(s): too few to match")
@@ -153,7 +162,7 @@ def match_constellation(model: np.ndarray, world: np.ndarray, names: Sequence[st
                            "rather than a wrong one (a regular constellation, or coordinates that disagree with the "
                            "block by about the targets' spacing); give coded targets or check the coordinates")
         return out
-    return _refit(out, model, world, centre, names, codes, best, xy_only, tol, wts)
+    return _refit(out, Marks(model, codes, wts), world - centre, names, best, xy_only, tol)
 
 
 def _mutual(model_w: np.ndarray, world: np.ndarray, taken: Dict[int, Tuple[int, float]], xy_only: bool,
@@ -185,10 +194,12 @@ def _conflict(a: frozenset, b: frozenset) -> bool:
     return any(mb.get(i, j) != j for i, j in a)
 
 
-def _refit(out: Constellation, model, world, centre, names, codes, best, xy_only, tol,
-           evidence: np.ndarray) -> Constellation:
+def _refit(out: Constellation, marks: Marks, world_c: np.ndarray, names, best, xy_only, tol) -> Constellation:
+    """The best hypothesis's similarity fitted to all its pairs (``world_c``: the targets about their centre), the
+    marks named after the targets it brings them onto."""
+    model, codes, evidence = marks.xyz, marks.codes, np.asarray(marks.weights, dtype=float)
     _, mirrored, key, sim = best
-    w = (world - centre) @ MIRROR.T if mirrored else world - centre
+    w = world_c @ MIRROR.T if mirrored else world_c
     pairs = sorted(key)
     if len(pairs) >= 3:
         sim, _ = fit_similarity(model[[i for i, _ in pairs]], w[[j for _, j in pairs]], xy_only=xy_only)

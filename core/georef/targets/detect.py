@@ -29,12 +29,15 @@ sectors broken by an occluder), is left out rather than guessed.
 from __future__ import annotations
 
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import List, Optional, Sequence, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .options import ARUCO, CHECKERBOARD, CIRCLE, CROSS
+from ...common.progress import Progress, check_cancel
+from .options import ARUCO, CHECKERBOARD, CIRCLE, CROSS, FindTargetsOptions
 
 
 @dataclass
@@ -545,3 +548,32 @@ def detect_image(image: str, path: str, plain: Sequence[str], dictionaries: Sequ
                    if all(math.hypot(c.x - m.x, c.y - m.y) > 0.75 * m.size_px for m in coded)]
     return coded + suppress(plain_found, 0.5)
 
+
+def photo_paths(ws, rec) -> Dict[str, str]:
+    """{name: path} of the workspace's photos registered in the model ``rec``."""
+    reg = {rec.image(i).name for i in rec.reg_image_ids()}
+    out = {}
+    for im in ws.data.get("images", []):
+        if im["name"] in reg:
+            out[im["name"]] = im.get("path") or os.path.join(ws.data.get("images_dir") or "", im["name"])
+    return out
+
+
+def detect_all(photos: Dict[str, str], options: FindTargetsOptions,
+               progress: Optional[Progress]) -> Dict[str, List[Candidate]]:
+    """The candidates on every photo of ``photos`` ({name: path}), detected in parallel threads."""
+    plain, dictionaries = options.kinds()
+    threads = options.num_threads or os.cpu_count() or 1
+    names = sorted(photos)
+    out: Dict[str, List[Candidate]] = {}
+
+    def one(n):
+        return detect_image(n, photos[n], plain, dictionaries, options.min_size_px, options.max_size_fraction)
+
+    with ThreadPoolExecutor(max_workers=threads) as pool:
+        for k, (n, found) in enumerate(zip(names, pool.map(one, names))):
+            out[n] = found
+            if progress is not None:
+                check_cancel(progress)
+                progress.report(0.7 * (k + 1) / max(1, len(names)), f"looking for targets: {n}")
+    return out
