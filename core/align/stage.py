@@ -17,49 +17,36 @@ features and more pairs for the images the fast path left out, or a split block;
 """
 from __future__ import annotations
 
-import copy
 import json
 import os
 import time
 from dataclasses import asdict, dataclass
-from typing import Dict, List, Optional, Tuple
+from typing import Dict, List, Optional
 
 from ..common.cancel import load_pycolmap
 from ..common.files import atomic_output, atomic_write_text, fingerprint
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..io.images import (
-    CameraGroup,
     ImageError,
-    ImageInfo,
     check_image_folder,
-    group_cameras,
     require_images,
-    scan_images,
 )
 from ..io.vector import write_cameras_gpkg
 from ..project.layout import Layout
-from ..project.stages import ALIGN, run_stage
+from ..project.stages import run_stage
 from ..project.workspace import Workspace
 from .calibrated import (
-    GivenCamera,
-    held_cameras,
     intrinsics_record,
-    plan_cameras,
     read_calibrations,
-    scan_interior,
 )
 from .diagnosis import diagnose_unregistered, no_reconstruction_error, report_unregistered
 from .escalation import EscalationContext, block_state, escalate
 from .features import (
-    Extraction,
-    database_key,
     extract_features,
-    file_hash,
-    masks_for_colmap,
     match_pairs,
-    setup_database,
 )
-from .firstpass import FirstPass, choose_first_pass
+from .firstpass import choose_first_pass
+from .inputs import Photos, read_folder
 from .mapping import (
     MappingJob,
     adjust_block,
@@ -71,10 +58,7 @@ from .mapping import (
 )
 from .options import MIN_VERIFIED_INLIERS, AlignError, AlignOptions
 from .pairs import select_pairs
-from .photos import PHOTO_FINGERPRINTS, fingerprint_photos
-
-STAGE = ALIGN
-STAGED_KEY = "staged_database_key"  # the align record's key of sfm/database.staged.db (a re-run in progress)
+from .record import STAGE, commit, keep_previous, prepare_database, previous_alignment
 
 
 @dataclass
@@ -101,102 +85,6 @@ class AlignResult:
 
 def _json(obj) -> str:
     return json.dumps(obj, indent=2, default=str)
-
-
-def _read_images(images_dir: str, options: AlignOptions,
-                 progress: Progress) -> Tuple[List[ImageInfo], List[str], List[CameraGroup]]:
-    """(usable images, warnings naming skipped files, camera groups); AlignError with fewer than 2 images."""
-    infos, skipped = scan_images(images_dir, options.focal_mm, options.sensor_width_mm, options.focal_px,
-                                 SubProgress(progress, 0.0, 0.02))
-    for w in skipped:
-        progress.warning(w)
-    if len(infos) == 0:
-        raise AlignError(f"no readable images in {images_dir}")
-    if len(infos) < 2:
-        raise AlignError(f"only one readable image in {images_dir} ({infos[0].name}): alignment needs at least 2 "
-                         "overlapping images (for a single photo use 'Orthorectify image')")
-    try:
-        groups = group_cameras(infos, options.grouping)
-    except ImageError as e:
-        raise AlignError(str(e)) from e
-    return infos, skipped, groups
-
-
-@dataclass
-class _Photos:
-    """What the alignment reads from the image folder before any work."""
-
-    images_dir: str
-    infos: List[ImageInfo]
-    skipped: List[str]
-    groups: List[CameraGroup]
-    fingerprints: Dict[str, str]  # image name -> content fingerprint (core.align.photos)
-    seconds: float
-    given: Dict[str, GivenCamera]  # group key -> its given interior orientation (core.align.calibrated)
-
-    def held(self) -> Tuple[Dict[int, GivenCamera], bool]:
-        """(camera id -> given, of the cameras the alignment holds; whether every camera is held)."""
-        ids = held_cameras(self.groups, self.given)
-        return ids, bool(ids) and len(ids) == len(self.groups)
-
-
-def _database_path(lay: Layout, record: dict, key: str, keep_previous: bool) -> Tuple[str, Optional[str]]:
-    """(the database this run works in, the key it was made for).  The workspace's database when it was made for
-    the same images and settings (a re-run after a cancel reuses its features and matches) or when there is no
-    previous alignment to keep; otherwise a staged database beside it (``sfm/database.staged.db``), swapped in
-    only when the new alignment succeeds, so a failed re-run leaves the previous alignment's database as it was."""
-    if not keep_previous or record.get("database_key") == key or not os.path.exists(lay.database):
-        record.pop(STAGED_KEY, None)
-        if os.path.exists(lay.staged_database):
-            os.unlink(lay.staged_database)
-        known, record["database_key"] = record.get("database_key"), key
-        return lay.database, known
-    known, record[STAGED_KEY] = record.get(STAGED_KEY), key
-    return lay.staged_database, known
-
-
-def _setup(pycolmap, lay: Layout, photos: _Photos, options: AlignOptions, record: dict, keep_previous: bool,
-           first: FirstPass, progress: Progress):
-    """Masks for COLMAP and the database's cameras: (what the extraction works on, image -> mask)."""
-    infos, groups = photos.infos, photos.groups
-    mask_path, masks = masks_for_colmap(lay.masks_dir, infos, lay.sfm_dir)
-    masks_key = fingerprint(sorted((n, file_hash(p)) for n, p in masks.items())) if masks else None
-    if masks:
-        record["inputs"]["masks"] = masks_key
-        progress.info(f"masks: {len(masks)} of {len(infos)} images have a mask ({lay.masks_dir}): "
-                      "no features where they are black")
-    key = database_key(groups, options, photos.images_dir, masks_key, fingerprint(photos.fingerprints), first.key())
-    db_path, known_key = _database_path(lay, record, key, keep_previous)
-    camera_ids = setup_database(pycolmap, db_path, groups, options, key, known_key, photos.given)
-    return Extraction(db_path, photos.images_dir, groups, camera_ids, mask_path, sorted(masks)), masks
-
-
-def _read_folder(pycolmap, lay: Layout, images_dir: str, options: AlignOptions, calibrations: list,
-                 progress: Progress) -> _Photos:
-    """The usable photos of ``images_dir``, their fingerprints and their cameras' given interior orientations
-    (a calibration file's, film scans' restituted by Prepare images); AlignError with fewer than two."""
-    t0 = time.time()
-    infos, skipped, groups = _read_images(images_dir, options, progress)
-    groups, given = plan_cameras(pycolmap, groups, infos, calibrations, scan_interior(lay.scans_json, infos),
-                                 options, progress)
-    return _Photos(images_dir, infos, skipped, groups, fingerprint_photos(infos), time.time() - t0, given)
-
-
-def _previous_alignment(ws: Workspace, lay: Layout) -> Optional[dict]:
-    """A copy of the align stage's record when the workspace holds a complete alignment (else None)."""
-    return copy.deepcopy(ws.data["stages"][STAGE]) if lay.has_aligned_model() else None
-
-
-def _keep_previous(ws: Workspace, previous: dict) -> None:
-    """After a failed or cancelled re-run: the previous alignment stays the workspace's (its record, image list,
-    database and model were not replaced); the attempt is recorded under ``last_attempt``."""
-    failed = ws.data["stages"].get(STAGE, {})
-    record = copy.deepcopy(previous)
-    record["last_attempt"] = {k: failed.get(k) for k in ("status", "started", "finished", "error", "parameters")}
-    if failed.get(STAGED_KEY):
-        record[STAGED_KEY] = failed[STAGED_KEY]  # a re-run of the same attempt resumes in the staged database
-    ws.data["stages"][STAGE] = record
-    ws.save()
 
 
 def check_options(options: AlignOptions) -> list:
@@ -226,17 +114,17 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
         raise AlignError(str(e)) from e
     ws = Workspace.create_or_open(workspace_dir)  # checks writability before any work
     lay = Layout(ws)
-    photos = _read_folder(pycolmap, lay, images_dir, options, calibrations, progress)
-    previous = _previous_alignment(ws, lay)
+    photos = read_folder(pycolmap, lay, images_dir, options, calibrations, progress)
+    previous = previous_alignment(ws, lay)
     try:
         return _run(pycolmap, ws, lay, photos, options, previous is not None, t_start, progress)
     except BaseException:
         if previous is not None:
-            _keep_previous(ws, previous)
+            keep_previous(ws, previous)
         raise
 
 
-def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOptions, keep_previous: bool,
+def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOptions, keep_previous: bool,
          t_start: float, progress: Progress) -> AlignResult:
     """The stage body inside run_stage(): features, matches, mapping, bundle adjustment, products."""
     infos, groups, images_dir = photos.infos, photos.groups, photos.images_dir
@@ -253,7 +141,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
         with run.step("probe", save=False):  # the first pass's features from the photos' texture and size
             first = choose_first_pass(pycolmap, infos, options, g0.width, g0.height)
         progress.info(first.log_line())
-        job, masks = _setup(pycolmap, lay, photos, options, run.record, keep_previous, first, progress)
+        job, masks = prepare_database(pycolmap, lay, photos, options, run.record, keep_previous, first, progress)
         db_path = job.db_path
         ws.save()
 
@@ -301,7 +189,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
         with atomic_output(lay.aligned_model_dir) as tmp:
             os.makedirs(tmp)
             rec.write_binary(tmp)
-        _commit(ws, lay, run.record, photos, db_path)
+        commit(ws, lay, run.record, photos, db_path)
         cameras_path = write_cameras_gpkg(ws.root, camera_rows(rec), crs=None)
         mre = float(rec.compute_mean_reprojection_error())
         timings = dict(images=photos.seconds, **run.timings)
@@ -328,19 +216,6 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: _Photos, options: AlignOp
     # later stages were built on the previous model: run_stage marked them stale
     progress.report(1.0, f"aligned {result.registered}/{len(infos)} images, {mre:.3f} px")
     return result
-
-
-def _commit(ws: Workspace, lay: Layout, record: dict, photos: _Photos, db_path: str) -> None:
-    """The new alignment succeeded: its image list, camera groups, photo fingerprints and database become the
-    workspace's (the manifest is saved when run_stage records the stage done)."""
-    if db_path != lay.database:
-        os.replace(db_path, lay.database)
-        record["database_key"] = record.pop(STAGED_KEY)
-    record.pop("last_attempt", None)
-    record[PHOTO_FINGERPRINTS] = photos.fingerprints
-    ws.data["images_dir"] = photos.images_dir
-    ws.data["images"] = [im.to_dict() for im in photos.infos]
-    ws.data["camera_groups"] = [asdict(g) for g in photos.groups]
 
 
 def load_model(workspace_dir: str):

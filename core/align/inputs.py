@@ -1,0 +1,62 @@
+"""What the alignment reads from the image folder before any work: the usable photos, their camera groups,
+content fingerprints and given interior orientations."""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Dict, List, Tuple
+
+from ..common.progress import Progress, SubProgress
+from ..io.images import CameraGroup, ImageError, ImageInfo, group_cameras, scan_images
+from ..project.layout import Layout
+from .calibrated import GivenCamera, held_cameras, plan_cameras, scan_interior
+from .options import AlignError, AlignOptions
+from .photos import fingerprint_photos
+
+
+def read_images(images_dir: str, options: AlignOptions,
+                 progress: Progress) -> Tuple[List[ImageInfo], List[str], List[CameraGroup]]:
+    """(usable images, warnings naming skipped files, camera groups); AlignError with fewer than 2 images."""
+    infos, skipped = scan_images(images_dir, options.focal_mm, options.sensor_width_mm, options.focal_px,
+                                 SubProgress(progress, 0.0, 0.02))
+    for w in skipped:
+        progress.warning(w)
+    if len(infos) == 0:
+        raise AlignError(f"no readable images in {images_dir}")
+    if len(infos) < 2:
+        raise AlignError(f"only one readable image in {images_dir} ({infos[0].name}): alignment needs at least 2 "
+                         "overlapping images (for a single photo use 'Orthorectify image')")
+    try:
+        groups = group_cameras(infos, options.grouping)
+    except ImageError as e:
+        raise AlignError(str(e)) from e
+    return infos, skipped, groups
+
+
+@dataclass
+class Photos:
+    """What the alignment reads from the image folder before any work."""
+
+    images_dir: str
+    infos: List[ImageInfo]
+    skipped: List[str]
+    groups: List[CameraGroup]
+    fingerprints: Dict[str, str]  # image name -> content fingerprint (core.align.photos)
+    seconds: float
+    given: Dict[str, GivenCamera]  # group key -> its given interior orientation (core.align.calibrated)
+
+    def held(self) -> Tuple[Dict[int, GivenCamera], bool]:
+        """(camera id -> given, of the cameras the alignment holds; whether every camera is held)."""
+        ids = held_cameras(self.groups, self.given)
+        return ids, bool(ids) and len(ids) == len(self.groups)
+
+
+def read_folder(pycolmap, lay: Layout, images_dir: str, options: AlignOptions, calibrations: list,
+                 progress: Progress) -> Photos:
+    """The usable photos of ``images_dir``, their fingerprints and their cameras' given interior orientations
+    (a calibration file's, film scans' restituted by Prepare images); AlignError with fewer than two."""
+    t0 = time.time()
+    infos, skipped, groups = read_images(images_dir, options, progress)
+    groups, given = plan_cameras(pycolmap, groups, infos, calibrations, scan_interior(lay.scans_json, infos),
+                                 options, progress)
+    return Photos(images_dir, infos, skipped, groups, fingerprint_photos(infos), time.time() - t0, given)
