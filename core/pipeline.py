@@ -34,7 +34,8 @@ from .prepare.stage import prepare_images_workspace
 from .project.stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, PREPARE, RELIEF, REPORT, TERRAIN, StageError
 from .report.options import ReportOptions
 from .report.stage import build_report
-from .terrain.stage import ReliefStageOptions, TerrainOptions, build_dtm_workspace, relief_workspace
+from .terrain.options import ReliefStageOptions, TerrainOptions
+from .terrain.stage import build_dtm_workspace, relief_workspace
 
 
 @dataclass
@@ -75,8 +76,9 @@ class PipelineOptions:
     targets: FindTargetsOptions = field(default_factory=FindTargetsOptions)  # with Control.targets_path
     make_report: bool = True  # False: the chain stops after the orthomosaic (and the terrain products)
     make_dtm: bool = True  # the DTM (seconds for a DSM of a few million cells)
-    contour_interval: float = 0.0  # m; 0 = no contours
-    relief: Sequence[str] = ()  # relief visualisations of the DTM (core.terrain.options.VISUALISATIONS); slow
+    terrain: TerrainOptions = field(default_factory=TerrainOptions)  # with make_dtm: the ground filter, contours
+    # with make_dtm: relief visualisations of the DTM (its keys: core.terrain.options.VISUALISATION_KEYS; slow)
+    relief: ReliefStageOptions = field(default_factory=lambda: ReliefStageOptions(()))
     sky_masks: bool = False  # obliques: a prepare stage first (screening + sky masks), the prepared photos aligned
 
 
@@ -182,20 +184,19 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
         progress.info(f"find targets: {res.targets.n_targets} of {len(res.targets.targets)} targets found, "
                       f"{res.targets.n_observations} observations")
         gcp_path = res.targets.gcps_path
-    georef = dataclasses.replace(opt.georef, gcp_path=gcp_path, gcps=ctl.gcps, check_points=ctl.check_points,
-                                 camera_positions_path=ctl.camera_positions_path, use_exif_gps=ctl.use_exif_gps,
-                                 crs=ctl.crs, gcps_upright=ctl.gcps_upright)
-    res.georef = run(GEOREFERENCE, georeference_workspace, workspace_dir, georef)
+    res.georef = run(GEOREFERENCE, georeference_workspace, workspace_dir, gcp_path=gcp_path, gcps=ctl.gcps,
+                     check_points=ctl.check_points, camera_positions_path=ctl.camera_positions_path,
+                     use_exif_gps=ctl.use_exif_gps, crs=ctl.crs, refine_intrinsics=opt.georef.refine_intrinsics,
+                     options=opt.georef, gcps_upright=ctl.gcps_upright)
     res.warnings += res.georef.warnings
     res.dsm = run(DSM, build_dsm_workspace, workspace_dir, options=opt.dense)
     res.warnings += res.dsm.warnings
     res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, options=opt.ortho)
     res.warnings += res.ortho.warnings
     if opt.make_dtm:
-        res.dtm = run(TERRAIN, build_dtm_workspace, workspace_dir,
-                      TerrainOptions(contour_interval=opt.contour_interval))
-        if opt.relief:
-            res.relief = run(RELIEF, relief_workspace, workspace_dir, ReliefStageOptions(list(opt.relief), source="dtm"))
+        res.dtm = run(TERRAIN, build_dtm_workspace, workspace_dir, opt.terrain)
+        if opt.relief.keys:
+            res.relief = run(RELIEF, relief_workspace, workspace_dir, opt.relief)
     if opt.make_report:
         res.report = run(REPORT, build_report, workspace_dir, options=opt.report)
         res.warnings += res.report.warnings

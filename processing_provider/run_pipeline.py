@@ -128,6 +128,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
         from ..core.georef.targets.options import KINDS as TARGET_KINDS
         from ..core.georef.targets.options import FindTargetsOptions
         from ..core.ortho.options import OrthoOptions
+        from ..core.terrain.options import ReliefStageOptions, TerrainOptions
 
         p = parameters
         gcps = params.read_gcp_layer(self, p, self.GCP_LAYER, context, QCoreApplication.translate(
@@ -167,8 +168,8 @@ class RunPipelineAlgorithm(AlgorithmBase):
                                    workers=workers, scheduler=scheduler),
                 make_report=self.parameterAsBoolean(p, self.REPORT_ENABLED, context),
                 make_dtm=self.parameterAsBoolean(p, self.DTM_ENABLED, context),
-                contour_interval=self.parameterAsDouble(p, self.CONTOUR_INTERVAL, context),
-                relief=params.read_relief(self, p, self.RELIEF, context),
+                terrain=TerrainOptions(contour_interval=self.parameterAsDouble(p, self.CONTOUR_INTERVAL, context)),
+                relief=ReliefStageOptions(params.read_relief(self, p, self.RELIEF, context)),
                 sky_masks=self.parameterAsBoolean(p, self.SKY_MASKS, context)),
             control=pipeline.Control(gcp_path=gcp_path, gcps=gcps, check_points=checks,
                                      camera_positions_path=positions, use_exif_gps=use_gps, crs=crs_text,
