@@ -184,10 +184,10 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
         progress.info(f"find targets: {res.targets.n_targets} of {len(res.targets.targets)} targets found, "
                       f"{res.targets.n_observations} observations")
         gcp_path = res.targets.gcps_path
-    res.georef = run(GEOREFERENCE, georeference_workspace, workspace_dir, gcp_path=gcp_path, gcps=ctl.gcps,
-                     check_points=ctl.check_points, camera_positions_path=ctl.camera_positions_path,
-                     use_exif_gps=ctl.use_exif_gps, crs=ctl.crs, refine_intrinsics=opt.georef.refine_intrinsics,
-                     options=opt.georef, gcps_upright=ctl.gcps_upright)
+    georef = dataclasses.replace(opt.georef, gcp_path=gcp_path, gcps=ctl.gcps, check_points=ctl.check_points,
+                                 camera_positions_path=ctl.camera_positions_path, use_exif_gps=ctl.use_exif_gps,
+                                 crs=ctl.crs, gcps_upright=ctl.gcps_upright)
+    res.georef = run(GEOREFERENCE, georeference_workspace, workspace_dir, georef)
     res.warnings += res.georef.warnings
     res.dsm = run(DSM, build_dsm_workspace, workspace_dir, options=opt.dense)
     res.warnings += res.dsm.warnings
