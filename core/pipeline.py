@@ -155,11 +155,11 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
         t = os.times()  # pool workers count once they have ended (each stage's pool ends with the stage)
         return t.user + t.system + t.children_user + t.children_system
 
-    def run(name, fn, *args, span=None, **kwargs):
+    def run(name, fn, *args, span=None):  # a stage entry point: its inputs, its options, then the progress
         lo, hi = span or SPANS[name]
         progress.info(f"--- stage {name} ---")
         t0, c0 = time.time(), cpu_now()
-        out = fn(*args, progress=SubProgress(progress, lo, hi), **kwargs)
+        out = fn(*args, SubProgress(progress, lo, hi))
         seconds[name] = round(time.time() - t0, 2)
         cpu_seconds[name] = round(cpu_now() - c0, 2)
         return out
@@ -168,7 +168,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
                          cpu_seconds=cpu_seconds)
     aligned_from = images_dir
     if opt.sky_masks:  # the photos with their sky masks, so that no tie or dense point comes from the sky
-        res.prepare = run(PREPARE, prepare_images_workspace, images_dir, workspace_dir, options=opt.prepare)
+        res.prepare = run(PREPARE, prepare_images_workspace, images_dir, workspace_dir, opt.prepare)
         res.warnings += res.prepare.warnings
         progress.info(f"prepare: {len(res.prepare.masks)} sky mask(s), {res.prepare.kept} of "
                       f"{len(res.prepare.images)} photos kept")
@@ -189,16 +189,16 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
                                  crs=ctl.crs, gcps_upright=ctl.gcps_upright)
     res.georef = run(GEOREFERENCE, georeference_workspace, workspace_dir, georef)
     res.warnings += res.georef.warnings
-    res.dsm = run(DSM, build_dsm_workspace, workspace_dir, options=opt.dense)
+    res.dsm = run(DSM, build_dsm_workspace, workspace_dir, opt.dense)
     res.warnings += res.dsm.warnings
-    res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, options=opt.ortho)
+    res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, opt.ortho)
     res.warnings += res.ortho.warnings
     if opt.make_dtm:
         res.dtm = run(TERRAIN, build_dtm_workspace, workspace_dir, opt.terrain)
         if opt.relief.keys:
             res.relief = run(RELIEF, relief_workspace, workspace_dir, opt.relief)
     if opt.make_report:
-        res.report = run(REPORT, build_report, workspace_dir, options=opt.report)
+        res.report = run(REPORT, build_report, workspace_dir, opt.report)
         res.warnings += res.report.warnings
     progress.report(1.0, "pipeline done")
     return res

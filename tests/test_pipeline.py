@@ -130,7 +130,7 @@ def test_the_stage_options_are_the_settings(tmp_path, monkeypatch):
 
     def spy(name):
         def stage(*args, **kwargs):
-            calls[name] = kwargs
+            calls[name] = (args, kwargs)
             return types.SimpleNamespace(warnings=[])
         return stage
 
@@ -141,10 +141,10 @@ def test_the_stage_options_are_the_settings(tmp_path, monkeypatch):
     pipeline.run_pipeline(str(tmp_path / "photos"), str(tmp_path / "ws"),
                           pipeline.PipelineOptions(dense=dense, ortho=ortho, make_dtm=False, make_report=False),
                           pipeline.Control(use_exif_gps=True))
-    assert calls["build_dsm_workspace"]["options"] is dense and set(calls["build_dsm_workspace"]) == {"options",
-                                                                                                     "progress"}
-    assert calls["build_orthophoto_workspace"]["options"] is ortho
-    assert not {"blending", "resolution"} & set(calls["build_orthophoto_workspace"])
+    # (workspace, options, progress): nothing beside the options
+    assert calls["build_dsm_workspace"][0][1] is dense and len(calls["build_dsm_workspace"][0]) == 3
+    assert calls["build_orthophoto_workspace"][0][1] is ortho and len(calls["build_orthophoto_workspace"][0]) == 3
+    assert not calls["build_dsm_workspace"][1] and not calls["build_orthophoto_workspace"][1]
     # the stages themselves: no keyword = the options' value; a keyword given wins (the DSM stage takes none)
     with pytest.raises(DenseError, match="QUALITY"):
         DenseOptions(quality="fine")
