@@ -462,6 +462,17 @@ def test_bad_parameters_are_clear(block_dir, tmp_path):
         DenseOptions(quality="ultra")
     with pytest.raises(DenseError, match="RESOLUTION"):
         DenseOptions(resolution=-1)
+    with pytest.raises(DenseError, match="ENGINE 'gpu'"):
+        DenseOptions(engine="gpu")
+    with pytest.raises(DenseError, match="RESOLUTION"):
+        DenseOptions(resolution=float("nan"))
+    # the options are the settings, checked and normalised when made (Processing and the pipeline build them)
+    made = DenseOptions(quality="FULL", engine="CPU", resolution=1, output_dsm="rel/dsm.tif")
+    assert (made.quality, made.engine, made.resolution) == ("full", "cpu", 1.0)
+    assert made.output_dsm == os.path.abspath("rel/dsm.tif") and made.output_point_cloud is None
+    recorded = made.stage_parameters("/ws/dsm.tif")  # the recorded parameters keep their shape
+    assert set(recorded) == {"resolution", "quality", "engine", "output_dsm", "output_point_cloud", "options"}
+    assert not {"resolution", "engine", "output_dsm", "workers", "scheduler"} & set(recorded["options"])
     if not pycolmap.has_cuda:
         with pytest.raises(DenseError, match="CUDA"):
             dense.build_dsm_workspace(ws, DenseOptions(engine="cuda"))
