@@ -544,3 +544,37 @@ def test_qgis_process_builds_a_dsm_with_a_process_pool(built, tmp_path):
     assert os.path.samefile(res["OUTPUT_DSM"], os.path.join(ws, "dsm.tif"))
     assert res["PAIRS"] >= 10 and res["VALID_FRACTION"] > 0.8
     assert "2 worker(s)" in out.stdout
+
+
+def test_the_cuda_engine_is_dispatched_with_the_blocks_views_and_the_layouts_folders(monkeypatch, tmp_path):
+    """points.dense_points with ENGINE cuda: COLMAP's driver gets the block's views, the QUALITY scale, the
+    workspace's dense and georeferenced model folders and the block's images folder; its points are the result
+    (no pair matched by the OpenCV engine), and none at all is the clear DenseError. Runs without CUDA: the
+    driver is replaced."""
+    import types
+
+    from core.dense import points
+    from core.dense.block import DenseBlock
+    from core.dense.journal import Journal
+
+    seen = {}
+
+    def fake_cuda(views, scale, dense_dir, model_dir, images_dir, model_fp, progress):
+        seen.update(views=views, scale=scale, dense_dir=dense_dir, model_dir=model_dir, images_dir=images_dir,
+                    model_fp=model_fp)
+        return [gridding.PointFile(str(tmp_path / "cuda.npz"), (0.0, 0.0, 1.0, 1.0), n_points)], 0
+
+    monkeypatch.setattr(points, "cuda_points", fake_cuda)
+    views = {1: "view 1", 2: "view 2"}
+    block = DenseBlock(views, np.zeros((0, 3)), [], 0, 0.05, 0.1, np.zeros(3), "EPSG:32633", "/photos", 0.0)
+    lay = types.SimpleNamespace(dense_dir=str(tmp_path / "dense"), georef_model_dir=str(tmp_path / "model"))
+    job = Journal(NullProgress())
+    n_points = 7
+    got = points.dense_points(block, DenseOptions(engine="cuda", quality="quarter"), lay, {"m": "1"},
+                              NullProgress(), job)
+    assert (got.count, got.pairs, got.reused) == (7, 0, 0) and "matching" in job.timings
+    assert seen == dict(views=views, scale=0.25, dense_dir=lay.dense_dir, model_dir=lay.georef_model_dir,
+                        images_dir="/photos", model_fp={"m": "1"})
+    n_points = 0
+    with pytest.raises(DenseError, match="no consistent surface point"):
+        points.dense_points(block, DenseOptions(engine="cuda"), lay, {}, NullProgress(), job)
