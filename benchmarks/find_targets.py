@@ -131,7 +131,7 @@ def copr(ws, threads):
     coords = coordinates_only(hand_path, os.path.join(OUT, "copr_targets.txt"))
     found_path = os.path.join(OUT, "copr_found_gcp_list.txt")
     t0 = time.time()
-    r = find_targets(ws, coords, FindTargetsOptions(num_threads=threads, output=found_path))
+    r = find_targets(ws, FindTargetsOptions(targets=coords, num_threads=threads, output=found_path))
     secs = time.time() - t0
     print(f"\nFind targets on COPR (auto: crosses, checkers, circles, ArUco 4x4): {secs:.1f} s on {threads} "
           f"thread(s); {r.candidates} candidate marks, {r.marks} tied across photos, {r.n_targets} of "
@@ -157,7 +157,7 @@ def synthetic(threads):
     ws = synthetic_workspace(os.path.join(root, "ws"), fake, rec, photos=scene.photos)
     csv = targets_scene.write_targets_csv(scene, os.path.join(root, "targets.csv"))
     t0 = time.time()
-    r = find_targets(ws, csv, FindTargetsOptions(num_threads=threads))
+    r = find_targets(ws, FindTargetsOptions(targets=csv, num_threads=threads))
     secs = time.time() - t0
     visible = {(i, n) for i, v in scene.visible.items() for n in v}
     found = {(o.image, o.name): o for o in r.observations}

@@ -177,8 +177,8 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
                     span=(SPANS[PREPARE][1], SPANS[ALIGN][1]) if opt.sky_masks else None)
     gcp_path = ctl.gcp_path
     if ctl.targets_path:  # the targets found on the photos are the ground control
-        res.targets = run(FIND_TARGETS, find_targets, workspace_dir, ctl.targets_path,
-                          dataclasses.replace(opt.targets, crs=opt.targets.crs or ctl.crs))
+        res.targets = run(FIND_TARGETS, find_targets, workspace_dir,
+                          dataclasses.replace(opt.targets, targets=ctl.targets_path, crs=opt.targets.crs or ctl.crs))
         for note in res.targets.reports:
             progress.info(f"find targets: {note}")
         progress.info(f"find targets: {res.targets.n_targets} of {len(res.targets.targets)} targets found, "

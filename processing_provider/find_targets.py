@@ -80,13 +80,13 @@ class FindTargetsAlgorithm(AlgorithmBase):
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context)
         size = self.parameterAsDouble(parameters, self.TARGET_SIZE, context)
         options = FindTargetsOptions(
+            targets=self.parameterAsFile(parameters, self.TARGETS, context),
             kind=KINDS[self.parameterAsEnum(parameters, self.TARGET_KIND, context)],
             target_size=size or None,
             crs=params.read_crs(self, parameters, self.CRS, context),
             output=self.parameterAsFileOutput(parameters, self.GCPS, context) or None)
         progress = FeedbackProgress(feedback)
-        result = self.run_core(find_targets, workspace, self.parameterAsFile(parameters, self.TARGETS, context),
-                               options, progress)
+        result = self.run_core(find_targets, workspace, options, progress)
         progress.push_result(result.reports)
         feedback.pushInfo(self.tr("{} of {} targets found, {} observations; {} candidate marks, {} tied across "
                                   "photos").format(result.n_targets, len(result.targets), result.n_observations,

@@ -35,7 +35,7 @@ def block(tmp_path_factory):
                                  names=names)
     ws = synthetic_workspace(str(root / "ws"), fake, rec, photos=scene.photos)
     csv = targets_scene.write_targets_csv(scene, str(root / "targets.csv"))
-    result = find_targets(ws, csv, FindTargetsOptions(num_threads=2))
+    result = find_targets(ws, FindTargetsOptions(targets=csv, num_threads=2))
     return scene, ws, csv, result
 
 
@@ -87,8 +87,8 @@ def test_the_observations_file_is_what_georeference_reads(block):
 
 def test_a_target_size_unlike_the_marks_leaves_them_out(block, tmp_path):
     scene, ws, csv, _ = block
-    r = find_targets(ws, csv, FindTargetsOptions(target_size=5.0, output=str(tmp_path / "gcps.txt"),
-                                                 layer=str(tmp_path / "found.gpkg"), num_threads=2))
+    r = find_targets(ws, FindTargetsOptions(targets=csv, target_size=5.0, output=str(tmp_path / "gcps.txt"),
+                                            layer=str(tmp_path / "found.gpkg"), num_threads=2))
     assert r.n_observations == 0 and all("size unlike the target's 5" in t.note for t in r.targets)
 
 
@@ -164,7 +164,7 @@ def test_the_photos_gps_narrows_the_match_and_names_the_same(block, tmp_path):
     shutil.copytree(ws, gps)
     pos = [CameraPosition(n, *(c + targets_scene.OFFSET + [*rng.normal(0, 1.5, 2), 0.0])) for n, _, c in scene.shots]
     set_exif_gps(gps, pos, "EPSG:32611")
-    r = find_targets(gps, csv, FindTargetsOptions(num_threads=2))
+    r = find_targets(gps, FindTargetsOptions(targets=csv, num_threads=2))
     assert r.prior.startswith(f"EXIF GPS of {len(scene.shots)} photos")
     assert {(o.image, o.name) for o in r.observations} == {(o.image, o.name) for o in ref.observations}
 
@@ -190,12 +190,12 @@ def test_errors_name_the_file_the_line_and_what_to_do(block, tmp_path):
     q = tmp_path / "no crs.csv"
     q.write_text("name,x,y,z\na,1,2,3\n")
     with pytest.raises(gcpmod.GCPError, match="no CRS: give it"):
-        find_targets(ws, str(q))
+        find_targets(ws, FindTargetsOptions(targets=str(q)))
     empty = Workspace.create_or_open(str(tmp_path / "not aligned"))
     with pytest.raises(LayoutError, match="run 'Align images' first"):
-        find_targets(empty.root, csv)
+        find_targets(empty.root, FindTargetsOptions(targets=csv))
     with pytest.raises(Exception, match="would be written over the targets file"):
-        find_targets(ws, csv, FindTargetsOptions(output=csv))
+        find_targets(ws, FindTargetsOptions(targets=csv, output=csv))
 
 
 def test_the_processing_algorithm_writes_the_file_and_the_counts(block, plugin, tmp_path):
@@ -230,8 +230,8 @@ def test_clicks_in_the_targets_file_are_checked_against_the_constellation(block,
                          f"{scene.truth[photo]['chk_b'][1]:.2f} {photo} ring_a")
     path = tmp_path / "clicked.txt"
     path.write_text("\n".join(lines) + "\n")
-    r = find_targets(ws, str(path), FindTargetsOptions(output=str(tmp_path / "gcps.txt"),
-                                                        layer=str(tmp_path / "found.gpkg"), num_threads=2))
+    r = find_targets(ws, FindTargetsOptions(targets=str(path), output=str(tmp_path / "gcps.txt"),
+                                            layer=str(tmp_path / "found.gpkg"), num_threads=2))
     assert any("clicked as ring_a sits at target chk_b" in s for s in r.reports), r.reports
     assert any(f"the click of ring_a in {photo} is on the mark of chk_b" in s for s in r.reports), r.reports
     found = {(o.image, o.name): o for o in r.observations}

@@ -187,7 +187,7 @@ def test_the_pipeline_chains_find_targets_into_the_georeference(tmp_path, monkey
     order = [c[0] for c in calls]
     assert order == ["align", "find_targets", "georeference_workspace", "build_dsm_workspace",
                      "build_orthophoto_workspace"]
-    assert calls[1][1][1] == str(targets) and res.targets is found
+    assert calls[1][1][1].targets == str(targets) and res.targets is found
     assert calls[2][1][1].gcp_path == found.gcps_path and calls[2][1][1].gcps is None
     with pytest.raises(StageError, match="not both"):
         pipeline.run_pipeline(str(photos), str(tmp_path / "ws2"), control=pipeline.Control(

@@ -17,6 +17,7 @@ constellation does not take, targets not found) is listed in the dock's message 
 
 A mixin of ui.gcp_dock.GcpDock; its strings are in the dock's translation context.
 """
+import dataclasses
 import math
 
 from qgis.core import Qgis
@@ -49,7 +50,7 @@ def find_targets_task(root, targets, options, progress=None):
     from ..core.georef.targets.stage import find_targets
     from ..core.io import gcp as gcpmod
 
-    result = find_targets(root, targets, options, progress=progress)
+    result = find_targets(root, dataclasses.replace(options, targets=targets), progress=progress)
     return result, gcpmod.read_target_coordinates(targets, options.crs)
 
 

@@ -27,7 +27,8 @@ class FindTargetsOptions:
     coordinates' CRS where the targets file names none.  ``output``: the gcp_list.txt to write (default: the
     workspace's georef/targets/gcp_list.txt); ``layer``: the GeoPackage of the found marks (default beside it).
     ``min_size_px``: the smallest target (side or diameter, pixels) looked for; ``max_size_fraction``: the
-    largest, as a fraction of the photo's shorter side."""
+    largest, as a fraction of the photo's shorter side.  ``targets``: the surveyed targets, a CSV or gcp_list.txt of
+    coordinates (pixel columns ignored): what Find targets looks for."""
 
     kind: str = AUTO
     target_size: Optional[float] = None
@@ -37,6 +38,7 @@ class FindTargetsOptions:
     min_size_px: float = 8.0
     max_size_fraction: float = 0.2
     num_threads: int = 0  # 0: as many as the machine has
+    targets: Optional[str] = None
 
     def kinds(self) -> Tuple[Tuple[str, ...], Tuple[str, ...]]:
         """(plain kinds, dictionaries) to look for."""

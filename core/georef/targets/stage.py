@@ -73,12 +73,15 @@ def _prior(ws: Workspace, rec, crs: str, result: FindTargetsResult) -> Optional[
     return prior
 
 
-def find_targets(workspace: str, targets: str, options: Optional[FindTargetsOptions] = None,
-                 progress: Optional[Progress] = None) -> FindTargetsResult:
-    """Find the surveyed ``targets`` (a CSV or gcp_list.txt of coordinates, pixel columns ignored) on the photos of
-    the aligned ``workspace``; write the observations found (gcp_list.txt), the review layer and the record."""
+def find_targets(workspace: str, options: FindTargetsOptions, progress: Optional[Progress] = None
+                 ) -> FindTargetsResult:
+    """Find the surveyed targets ``options.targets`` (a CSV or gcp_list.txt of coordinates, pixel columns
+    ignored) on the photos of the aligned ``workspace``; write the observations found (gcp_list.txt), the review
+    layer and the record."""
     t0 = time.time()
-    options = options or FindTargetsOptions()
+    targets = options.targets
+    if not targets:
+        raise GeorefError("Find targets: no targets file given (the surveyed coordinates of the targets)")
     ws = Workspace.open(workspace)
     lay = Layout(ws)
     rec = lay.load_aligned_model()  # LayoutError: run 'Align images' first
