@@ -5,6 +5,7 @@ import time
 from typing import Dict, List
 
 from ..common.progress import Progress
+from ..project.workspace import Workspace
 
 
 class Journal:
@@ -29,7 +30,7 @@ class Journal:
     def note(self, line: str) -> None:
         self.log.append(line)
 
-    def record_timings(self, ws, stage: str) -> None:
+    def record_timings(self, ws: Workspace, stage: str) -> None:
         """Each step's seconds (not the total) into the workspace's record of ``stage``."""
         for k, v in self.timings.items():
             if k != "total":
