@@ -1,7 +1,9 @@
 """Escalation: the fast path's features and pairs retried, richer, only where the fast path failed.
 
 The fast path (``features`` + ``pairs``) is tuned for speed on typical drone frames: SIFT starts at octave 0
-from ``UPSAMPLE_BELOW`` px, about 4000 features per megapixel, spatial or sequential pairs.  On other frames
+from ``UPSAMPLE_BELOW`` px, about 4000 features per megapixel, spatial or sequential pairs; where the texture probe
+(core.align.firstpass) finds the photos starved, its first pass already takes the faint settings below, and a
+round starts from the first pass's budget and scale.  On other frames
 (small scans, low texture, low overlap) it can leave images unregistered or split the block into components
 where pycolmap's default pipeline (upsampled SIFT, 8192 features, exhaustive pairs) does not.  After the first
 mapping, :func:`escalate` retries *only the images left out of the main block and their neighbours*, in

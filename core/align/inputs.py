@@ -2,6 +2,7 @@
 content fingerprints and given interior orientations."""
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass
 from typing import Dict, List, Tuple
@@ -44,6 +45,15 @@ class Photos:
     fingerprints: Dict[str, str]  # image name -> content fingerprint (core.align.photos)
     seconds: float
     given: Dict[str, GivenCamera]  # group key -> its given interior orientation (core.align.calibrated)
+
+    def log_cameras(self, progress: Progress) -> None:
+        """One line per camera: make, model, size, the focal length given or its prior, how many images."""
+        for g in self.groups:
+            given = self.given.get(g.key)
+            focal = (f"focal {given.params[0]:.1f} px ({given.mode}, {os.path.basename(given.source)})"
+                     if given is not None else f"focal prior {g.focal_px:.1f} px ({g.focal_source})")
+            progress.info(f"camera {g.camera_id}: {g.make} {g.model} {g.width}x{g.height}, {focal}, "
+                          f"{len(g.images)} images")
 
     def held(self) -> Tuple[Dict[int, GivenCamera], bool]:
         """(camera id -> given, of the cameras the alignment holds; whether every camera is held)."""

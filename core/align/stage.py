@@ -10,81 +10,39 @@
 - ``sfm/alignment.json``: figures and the list of images not registered, with why;
 - ``cameras.gpkg``: the camera positions (model frame).
 
-The algorithm modules: :mod:`.features` (cameras, masks, extraction, matching), :mod:`.pairs` (pair
-selection), :mod:`.mapping` (incremental or global mapping, bundle adjustment), :mod:`.escalation` (richer
+The algorithm modules: :mod:`.inputs` (the photos read before any work), :mod:`.firstpass` (the first pass's
+features chosen from the photos' texture), :mod:`.features` (cameras, masks, extraction, matching), :mod:`.pairs`
+(pair selection), :mod:`.mapping` (incremental or global mapping, bundle adjustment), :mod:`.escalation` (richer
 features and more pairs for the images the fast path left out, or a split block; ``escalation`` in
-``sfm/alignment.json`` says what was done per image and why); the options in :mod:`.options`.
+``sfm/alignment.json`` says what was done per image and why), :mod:`.diagnosis` (why an image is not
+registered); :mod:`.record` (the workspace's database and record) and :mod:`.result` (the products); the options
+in :mod:`.options`.
 """
 from __future__ import annotations
 
-import json
 import os
 import time
-from dataclasses import asdict, dataclass
-from typing import Dict, List, Optional
+from dataclasses import asdict
+from typing import Dict, Optional
 
 from ..common.cancel import load_pycolmap
-from ..common.files import atomic_output, atomic_write_text, fingerprint
+from ..common.files import fingerprint
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
-from ..io.images import (
-    ImageError,
-    check_image_folder,
-    require_images,
-)
-from ..io.vector import write_cameras_gpkg
+from ..io.images import ImageError, check_image_folder, require_images
 from ..project.layout import Layout
 from ..project.stages import run_stage
 from ..project.workspace import Workspace
-from .calibrated import (
-    intrinsics_record,
-    read_calibrations,
-)
+from .calibrated import read_calibrations
 from .diagnosis import diagnose_unregistered, no_reconstruction_error, report_unregistered
 from .escalation import EscalationContext, block_state, escalate
-from .features import (
-    extract_features,
-    match_pairs,
-)
+from .features import extract_features, match_pairs
 from .firstpass import choose_first_pass
 from .inputs import Photos, read_folder
-from .mapping import (
-    MappingJob,
-    adjust_block,
-    camera_rows,
-    camera_summary,
-    map_block,
-    verified_pairs,
-    verified_partners,
-)
+from .mapping import MappingJob, adjust_block, map_block, verified_pairs, verified_partners
 from .options import MIN_VERIFIED_INLIERS, AlignError, AlignOptions
 from .pairs import select_pairs
-from .record import STAGE, commit, keep_previous, prepare_database, previous_alignment
-
-
-@dataclass
-class AlignResult:
-    workspace: str
-    model_dir: str
-    cameras_path: str
-    images_given: int
-    registered: int
-    mean_reprojection_error: float
-    num_points3d: int
-    unregistered: Dict[str, str]  # image -> why
-    other_components: List[List[str]]
-    skipped_files: List[str]
-    pairing_used: str
-    num_pairs: int
-    timings: Dict[str, float]
-    cameras: List[dict]
-    masked_images: int = 0
-    escalation: Optional[dict] = None  # what was escalated and why (core.align.escalation), None when not needed
-    intrinsics: Optional[List[dict]] = None  # per camera: mode, given values and sigmas, final values (calibrated)
-    first_pass: Optional[dict] = None  # the first pass's feature settings, why, and the texture probe's figures
-
-
-def _json(obj) -> str:
-    return json.dumps(obj, indent=2, default=str)
+from .record import STAGE, keep_previous, prepare_database, previous_alignment
+from .result import AlignResult, Outcome, write_products
 
 
 def check_options(options: AlignOptions) -> list:
@@ -130,12 +88,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
     infos, groups, images_dir = photos.infos, photos.groups, photos.images_dir
     inputs = {"images": fingerprint([(im.name, im.width, im.height) for im in infos])}
     with run_stage(ws, STAGE, asdict(options), inputs) as run:
-        for g in groups:
-            given = photos.given.get(g.key)
-            focal = (f"focal {given.params[0]:.1f} px ({given.mode}, {os.path.basename(given.source)})" if given is not None
-                     else f"focal prior {g.focal_px:.1f} px ({g.focal_source})")
-            progress.info(f"camera {g.camera_id}: {g.make} {g.model} {g.width}x{g.height}, {focal}, "
-                          f"{len(g.images)} images")
+        photos.log_cameras(progress)
         os.makedirs(lay.sfm_dir, exist_ok=True)
         g0 = max(groups, key=lambda g: g.width * g.height)
         with run.step("probe", save=False):  # the first pass's features from the photos' texture and size
@@ -174,47 +127,20 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
             raise no_reconstruction_error(partners, len(infos), verified_pairs(pycolmap, db_path, MIN_VERIFIED_INLIERS),
                                      photos.held()[0])
         rec = ordered[0]
-        _registered, others = block_state(ordered)
+        others = block_state(ordered)[1]
         # 5. final global bundle adjustment (the held cameras' intrinsics constant)
-        held = photos.held()[0]
         with run.step("bundle_adjustment", save=False):
             progress.report(0.94, "final bundle adjustment")
-            pp = adjust_block(pycolmap, rec, options, progress, held, degenerate)
+            pp = adjust_block(pycolmap, rec, options, progress, photos.held()[0], degenerate)
         registered = {rec.images[i].name for i in rec.reg_image_ids()}
         unregistered = diagnose_unregistered(infos, registered, others, partners, degenerate)
         report_unregistered(progress, unregistered, others, len(registered))
         check_cancel(progress)
-
-        # 6. write the model atomically; the new image list and database become the workspace's
-        with atomic_output(lay.aligned_model_dir) as tmp:
-            os.makedirs(tmp)
-            rec.write_binary(tmp)
-        commit(ws, lay, run.record, photos, db_path)
-        cameras_path = write_cameras_gpkg(ws.root, camera_rows(rec), crs=None)
-        mre = float(rec.compute_mean_reprojection_error())
-        timings = dict(images=photos.seconds, **run.timings)
-        result = AlignResult(
-            workspace=ws.root, model_dir=lay.aligned_model_dir, cameras_path=cameras_path, images_given=len(infos),
-            registered=len(registered), mean_reprojection_error=mre, num_points3d=int(rec.num_points3D()),
-            unregistered=unregistered, other_components=others, skipped_files=photos.skipped,
-            pairing_used=pairing_used, num_pairs=len(pairs), timings={k: round(v, 3) for k, v in timings.items()},
-            cameras=camera_summary(rec), masked_images=len(masks),
-            escalation=escalation.to_dict() if escalation else None,
-            intrinsics=intrinsics_record(pycolmap, groups, photos.given, rec), first_pass=first.to_dict(),
-        )
-        figures = {k: v for k, v in asdict(result).items() if k not in ("workspace", "model_dir", "cameras_path")}
-        figures["principal_point_refined"] = pp
-        atomic_write_text(lay.alignment_json, _json(figures))
-        run.finish(outputs={"model": lay.rel(lay.aligned_model_dir), "cameras": lay.rel(cameras_path)},
-                   results={"registered": result.registered, "images": len(infos),
-                            "mean_reprojection_error": mre, "points3d": result.num_points3d,
-                            "pairing": pairing_used, "pairs": len(pairs), "masked_images": len(masks),
-                            "escalation_rounds": len(escalation.rounds) if escalation else 0,
-                            "first_pass": first.level,
-                            "skipped_files": list(photos.skipped),
-                            "total_seconds": round(time.time() - t_start, 2)})
+        outcome = Outcome(rec, unregistered, others, pairs, pairing_used, sorted(masks), escalation, first, pp,
+                          db_path)
+        result = write_products(pycolmap, ws, lay, run, photos, outcome, t_start)
     # later stages were built on the previous model: run_stage marked them stale
-    progress.report(1.0, f"aligned {result.registered}/{len(infos)} images, {mre:.3f} px")
+    progress.report(1.0, f"aligned {result.registered}/{len(infos)} images, {result.mean_reprojection_error:.3f} px")
     return result
 
 
