@@ -595,7 +595,7 @@ def footprints_path(workspace):
             return None
         prints = guided.image_footprints(rec, float(np.median(z)))
         path = workspace_layout(workspace).footprints_gpkg
-        return guided.write_footprints_gpkg(path, prints, transform.get("offset", (0, 0, 0)), transform.get("crs"))
+        return guided.write_footprints_gpkg(path, prints, transform.offset, transform.crs or None)
     except Exception as err:  # noqa: BLE001 - the footprints must not stop the loading of the rest: said, not hidden
         QgsMessageLog.logMessage(f"image footprints of {workspace} not written: {type(err).__name__}: {err}",
                                  "ArchaeoOrtho", Qgis.MessageLevel.Warning)
