@@ -144,7 +144,7 @@ def solution(block, ws, gcp_path, options, pixel_mm):
     res = georeference_workspace(ws, GeorefOptions.of(options, gcp_path=gcp_path))
     seconds = time.time() - t0
     rec, transform = load_georef_model(ws)
-    offset = np.asarray(transform["offset"], float)
+    offset = np.asarray(transform.offset, float)
     errs = []
     for im in rec.images.values():
         centre = np.asarray(im.projection_center(), float) + offset

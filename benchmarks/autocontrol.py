@@ -155,7 +155,7 @@ def centres_of(ws):
     for im in rec.images.values():
         if im.has_pose:
             m = np.asarray(im.cam_from_world().matrix())
-            out[im.name] = -m[:, :3].T @ m[:, 3] + np.asarray(tr["offset"], dtype=float)
+            out[im.name] = -m[:, :3].T @ m[:, 3] + np.asarray(tr.offset, dtype=float)
     return out
 
 
@@ -307,7 +307,7 @@ def main():
     errs, vecs = [], {}
     for im in rec.images.values():
         m = np.asarray(im.cam_from_world().matrix())
-        c = -m[:, :3].T @ m[:, 3] + np.asarray(tr["offset"], dtype=float)
+        c = -m[:, :3].T @ m[:, 3] + np.asarray(tr.offset, dtype=float)
         if im.name in truth:
             vecs[im.name] = (c[0] - truth[im.name][0], c[1] - truth[im.name][1], c[2])
             errs.append(float(np.hypot(*vecs[im.name][:2])))

@@ -136,7 +136,7 @@ def camera_errors(ws, truth):
         if im.has_pose and im.name in truth:
             m = np.asarray(im.cam_from_world().matrix())
             names.append(im.name)
-            xyz.append(-m[:, :3].T @ m[:, 3] + np.asarray(tr["offset"], dtype=float))
+            xyz.append(-m[:, :3].T @ m[:, 3] + np.asarray(tr.offset, dtype=float))
     utm = transform_points(np.array(xyz), w.crs, "EPSG:32617") if xyz else np.zeros((0, 3))
     return {n: (p[0] - truth[n][0], p[1] - truth[n][1]) for n, p in zip(names, utm)}
 
@@ -226,7 +226,7 @@ def archive(kind, n, workdir):
     rec, tr = Layout(Workspace.open(run)).load_georef_model()
     truth = {f.name: f.centre_world for f in block.frames}
     d = np.array([-np.asarray(im.cam_from_world().matrix())[:, :3].T @ np.asarray(im.cam_from_world().matrix())[:, 3]
-                  + np.asarray(tr["offset"], float) - truth[im.name] for im in rec.images.values() if im.name in truth])
+                  + np.asarray(tr.offset, float) - truth[im.name] for im in rec.images.values() if im.name in truth])
     f, g = r.georef.figures, block.gsd
     print(json.dumps({"case": f"archive {kind} {n} frames", "gsd_m": round(g, 2), "kept": r.n_kept,
                       "check_n": f.get("CHECK_N"), "check_xy_gsd": round(f["CHECK_RMSE_XY"] / g, 2),

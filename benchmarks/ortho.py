@@ -161,7 +161,7 @@ def sparse_dsm(ws_dir, path, res=0.5):
     from core.io import raster as dsmmod
 
     rec, transform = load_georef_model(ws_dir)
-    off = np.asarray(transform["offset"], dtype=float)
+    off = np.asarray(transform.offset, dtype=float)
     xyz = np.array([p.xyz for p in rec.points3D.values() if p.track.length() >= 3 and p.error < 2.0]) + off
     lo, hi = np.percentile(xyz[:, 2], [1, 99.5])
     xyz = xyz[(xyz[:, 2] >= lo - 5) & (xyz[:, 2] <= hi + 5)]
@@ -169,7 +169,7 @@ def sparse_dsm(ws_dir, path, res=0.5):
     xs, ys = grid.cell_centres()
     gx, gy = np.meshgrid(xs, ys)
     z = griddata(xyz[:, :2], xyz[:, 2], (gx, gy), method="linear")
-    dsmmod.write_cog(path, z.astype(np.float32), grid.geotransform, transform["crs"])
+    dsmmod.write_cog(path, z.astype(np.float32), grid.geotransform, transform.crs)
     return path
 
 
@@ -218,7 +218,7 @@ def transferred_gcps(ws_dir, name, n=10):
     from core.io import gcp as gcpmod
 
     rec, transform = load_georef_model(ws_dir)
-    off = np.asarray(transform["offset"], dtype=float)
+    off = np.asarray(transform.offset, dtype=float)
     im = next(i for i in rec.images.values() if i.name == name)
     cands = []
     for p2 in im.points2D:
@@ -236,7 +236,7 @@ def transferred_gcps(ws_dir, name, n=10):
     pts = [gcpmod.GroundPoint(f"B{k + 1}", *map(float, cands[i][1]),
                               observations=[gcpmod.Observation(name, float(cands[i][0][0]), float(cands[i][0][1]))])
            for k, i in enumerate(order)]
-    return gcpmod.GCPSet(transform["crs"], pts), rec, im, off
+    return gcpmod.GCPSet(transform.crs, pts), rec, im, off
 
 
 def shifts_against(path, mosaic_path, size=128, count=40):
