@@ -172,6 +172,22 @@ def test_only_core_io_opens_files_with_gdal():
     assert not bad, "files opened with GDAL outside core/io:\n" + "\n".join(bad)
 
 
+MAX_STAGE_LINES = 150
+
+
+def test_stage_modules_are_thin():
+    """A stage module is its entry point: options, checks, recording, calls into its room's algorithm modules
+    (the algorithms, loops and diagnoses live there)."""
+    long = []
+    for name, path, _, _ in _modules():
+        if name.endswith(".stage"):
+            with open(path, encoding="utf-8") as fh:
+                n = fh.read().count("\n")
+            if n > MAX_STAGE_LINES:
+                long.append(f"{os.path.relpath(path, ROOT)}: {n} lines (> {MAX_STAGE_LINES})")
+    assert not long, "stage modules that are not thin:\n" + "\n".join(long)
+
+
 def test_every_core_error_derives_from_the_one_base():
     """Every class named *Error in core/ has ArchaeoOrthoError among its bases (directly or through another
     core error), so the faces catch one base."""
