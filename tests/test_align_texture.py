@@ -115,6 +115,17 @@ def test_probe_photos_are_spread_and_the_same_each_run():
     assert fp.probe_photos(names[:4]) == names[:4]
 
 
+def test_the_neighbour_is_the_nearest_by_gps_else_the_next_in_file_order():
+    names = ["a", "b", "c", "d"]
+    assert fp.neighbours(names, ["a", "d"]) == {"a": "b", "d": "c"}
+    far = {"a": (0.0, 0.0), "b": (500.0, 0.0), "c": (10.0, 5.0), "d": (490.0, 3.0)}  # a strip's ends, side by side
+    assert fp.neighbours(names, ["a", "d"], far) == {"a": "c", "d": "b"}
+    assert fp.neighbours(names, ["a"], {"a": (0.0, 0.0)}) == {"a": "b"}  # not every photo located: file order
+    infos = [ImageInfo(n, n, 10, 10, 1, "uint8", gps=(16.0 + 0.001 * k, 52.0, 100.0)) for k, n in enumerate(names)]
+    xy = fp.gps_positions(infos)
+    assert xy["a"] == (0.0, 0.0) and xy["b"][0] == pytest.approx(111320 * 0.001 * math.cos(math.radians(52)))
+
+
 def test_coverage_and_the_decision():
     w, h = 800, 600
     rng = np.random.default_rng(1)

@@ -9,7 +9,7 @@ SIFT, at the settings of each level in turn, on up to PROBE_PHOTOS photos spread
 run) and measures per photo its **yield** (features found / the level's budget) and **coverage** (the share of the
 cells of a PROBE_GRID grid over the frame holding at least a quarter of their even share of the features found). A
 photo with a yield under PROBE_MIN_YIELD or a coverage under PROBE_MIN_COVERAGE is matched with its neighbour (the
-next photo in file order) as COLMAP would (ratio test, mutual best, a RANSAC fundamental matrix): it is starved
+nearest by EXIF GPS, else the next photo in file order) as COLMAP would (ratio test, mutual best, a RANSAC fundamental matrix): it is starved
 when fewer than PROBE_MIN_MATCHES matches verify (few features that match are enough: the synthetic farmland at
 contrast 0.4 registers every photo with ~230 features each). The first level at which at most
 PROBE_STARVED_SHARE of the probed photos starve is the first pass's (the last level otherwise, without a probe):
@@ -30,6 +30,7 @@ The settings the user gave (a feature image size, a budget or a first octave) ar
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import asdict, dataclass, field
 from typing import Dict, List, Optional, Sequence, Tuple
@@ -278,15 +279,32 @@ def probe_order(names: Sequence[str]) -> List[str]:
     return first + [n for n in names if n not in first]
 
 
-def neighbours(names: Sequence[str], picked: Sequence[str]) -> Dict[str, Optional[str]]:
-    """Each picked photo's neighbour: the next photo in ``names`` (file order: the order of a flight), the one
-    before for the last."""
+def neighbours(names: Sequence[str], picked: Sequence[str],
+               positions: Optional[Dict[str, Tuple[float, float]]] = None) -> Dict[str, Optional[str]]:
+    """Each picked photo's neighbour: the nearest other photo by ``positions`` (x, y in metres, from EXIF GPS) where
+    every photo has one, else the next photo in ``names`` (file order: the order of a flight), the one before for
+    the last."""
     index = {n: k for k, n in enumerate(names)}
     out: Dict[str, Optional[str]] = {}
     for n in picked:
+        if positions and len(positions) == len(names) and len(names) > 1:
+            x, y = positions[n]
+            out[n] = min((m for m in names if m != n),
+                         key=lambda m: (positions[m][0] - x) ** 2 + (positions[m][1] - y) ** 2)
+            continue
         k = index[n]
         out[n] = names[k + 1] if k + 1 < len(names) else (names[k - 1] if k > 0 else None)
     return out
+
+
+def gps_positions(infos: Sequence[ImageInfo]) -> Dict[str, Tuple[float, float]]:
+    """Local x, y (metres, equirectangular about the first) of the photos with EXIF GPS."""
+    located = [im for im in infos if im.gps]
+    if not located:
+        return {}
+    lon0, lat0 = located[0].gps[0], located[0].gps[1]
+    k = math.cos(math.radians(lat0))
+    return {im.name: ((im.gps[0] - lon0) * 111320.0 * k, (im.gps[1] - lat0) * 110540.0) for im in located}
 
 
 def _summary(level: str, results: Sequence[ProbeResult]) -> str:
@@ -314,7 +332,7 @@ def choose_first_pass(pycolmap, infos: Sequence[ImageInfo], options: AlignOption
     same = [im for im in infos if (im.width, im.height) == (width, height)]
     names = [im.name for im in same]
     chosen = probe_order(probe_photos(names))
-    near = neighbours(names, chosen)
+    near = neighbours(names, chosen, gps_positions(same))
     photos = _Photos(pycolmap, same, max(s.image_size for _, s in ladder[:-1]))
     readable = [n for n in chosen if photos.image(n) is not None]  # OpenCV cannot read it: probed without it
     if not readable:
