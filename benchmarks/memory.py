@@ -137,10 +137,10 @@ def child(args):
 
     p = NullProgress()
     if args.stage == "dtm":
-        from core.terrain.stage import build_dtm
+        from core.terrain.products import build_dtm
         build_dtm(args.src, os.path.join(args.out, "dtm.tif"), progress=p)
     elif args.stage.startswith("relief-"):
-        from core.terrain.stage import relief
+        from core.terrain.products import relief
         relief(args.src, [args.stage[7:]], args.out, prefix="dtm", progress=p)
     elif args.stage == "contours":
         from core.terrain.contours import write_contours
@@ -165,10 +165,12 @@ def child(args):
         print("RADIOMETRY " + json.dumps({k: rad.get(k) for k in ("seam_step_before", "seam_step_after",
                                                                   "hot_width_deg", "hot_spot", "antisolar")}))
     elif args.stage == "terrain":
-        from core.terrain.stage import TerrainOptions, build_dtm_workspace
+        from core.terrain.options import TerrainOptions
+        from core.terrain.stage import build_dtm_workspace
         build_dtm_workspace(args.out, TerrainOptions(contour_interval=0.5), p)
     elif args.stage == "relief":
-        from core.terrain.stage import ReliefStageOptions, relief_workspace
+        from core.terrain.options import ReliefStageOptions
+        from core.terrain.stage import relief_workspace
         relief_workspace(args.out, ReliefStageOptions(list(RELIEF_KEYS), source="dtm"), p)
     elif args.stage == "report":
         from core.report.stage import build_report

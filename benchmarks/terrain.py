@@ -112,7 +112,7 @@ def main(argv=None):
     from core.io import raster
     from core.project.layout import Layout
     from core.project.workspace import Workspace
-    from core.terrain.stage import build_dtm, relief
+    from core.terrain.products import build_dtm, relief
 
     lay = Layout(Workspace.open(args.workspace))
     dsm_path = lay.dsm()
@@ -237,7 +237,7 @@ def _runs(dsm, cell):
 
 def _slrm(dtm, gt, wkt, out_dir, name):
     from core.io import raster
-    from core.terrain.stage import relief
+    from core.terrain.products import relief
 
     path = os.path.join(out_dir, f"{name}.tif")
     raster.write_cog(path, dtm, gt, wkt, raster.BandLabel("DTM"))

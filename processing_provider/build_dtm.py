@@ -75,7 +75,7 @@ class BuildDtmAlgorithm(AlgorithmBase):
             "Share of DTM cells interpolated")))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
-        from ..core.terrain import stage
+        from ..core.terrain import products, stage
         from ..core.terrain.options import GroundOptions, TerrainOptions
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context) or None
@@ -96,7 +96,7 @@ class BuildDtmAlgorithm(AlgorithmBase):
             if not dsm or not output_dtm:
                 raise QgsProcessingException(self.tr(
                     "Give a workspace folder, or a DSM file and where to write the DTM"))
-            result = self.run_core(stage.build_dtm, dsm, stage.DtmOutputs(output_dtm, contours=contours), options,
+            result = self.run_core(products.build_dtm, dsm, products.DtmOutputs(output_dtm, contours=contours), options,
                                    interval, progress=progress)
         return {self.OUT_WORKSPACE: result.workspace, self.OUTPUT_DTM: result.dtm_path,
                 self.OUTPUT_SOURCE: result.source_path, self.OUTPUT_POINT_CLOUD: result.point_cloud_path,

@@ -57,7 +57,7 @@ class ReliefVisualisationAlgorithm(AlgorithmBase):
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
         import os
 
-        from ..core.terrain import stage
+        from ..core.terrain import products, stage
         from ..core.terrain.options import VISUALISATION_KEYS, ReliefStageOptions
 
         workspace = self.parameterAsFile(parameters, self.WORKSPACE, context) or None
@@ -75,7 +75,7 @@ class ReliefVisualisationAlgorithm(AlgorithmBase):
             if not dem or not output:
                 raise QgsProcessingException(self.tr(
                     "Give a workspace folder, or an elevation raster and where to write the visualisation"))
-            result = self.run_core(stage.relief, dem, [key], os.path.dirname(output), source, progress=progress,
+            result = self.run_core(products.relief, dem, [key], os.path.dirname(output), source, progress=progress,
                                    what=source.upper(), outputs={key: output})
             path = result.paths[key]
         return {self.OUT_WORKSPACE: workspace, self.OUTPUT: path}

@@ -16,8 +16,9 @@ from core.project.layout import Layout
 from core.project.stages import TERRAIN
 from core.project.workspace import Workspace
 from core.terrain.contours import write_contours
-from core.terrain.options import TerrainError
-from core.terrain.stage import DtmOutputs, TerrainOptions, build_dtm, build_dtm_workspace, relief
+from core.terrain.options import TerrainError, TerrainOptions
+from core.terrain.products import DtmOutputs, build_dtm, relief
+from core.terrain.stage import build_dtm_workspace
 from tests import synthetic as syn
 from tests.test_terrain import _workspace_with_dsm, synthetic_dsm
 
@@ -119,7 +120,8 @@ def test_relief_copy_over_the_workspace_dtm_is_refused(dsm, tmp_path):
     pytest.importorskip("rvt.vis")
     scene, path = dsm
     root, _ = _workspace_with_dsm(tmp_path / "ws", path, scene)
-    from core.terrain.stage import ReliefStageOptions, relief_workspace
+    from core.terrain.options import ReliefStageOptions
+    from core.terrain.stage import relief_workspace
 
     lay = Layout(Workspace.open(root))
     before = _digest(lay.default_dsm)
@@ -164,7 +166,8 @@ def test_a_stale_dsm_or_dtm_is_refused(dsm, tmp_path):
     """After a re-georeference (into another CRS) the DSM on disk describes the old block: builddtm and the relief
     refuse it (issue 36 item 6) instead of building from it and recording done."""
     from core.project.stages import DSM, GEOREFERENCE, STALE, run_stage
-    from core.terrain.stage import ReliefStageOptions, relief_workspace
+    from core.terrain.options import ReliefStageOptions
+    from core.terrain.stage import relief_workspace
 
     scene, path = dsm
     root, _ = _workspace_with_dsm(tmp_path / "ws", path, scene)

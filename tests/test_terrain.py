@@ -18,16 +18,10 @@ from core.project.layout import Layout
 from core.project.stages import DSM, RELIEF, TERRAIN, run_stage
 from core.project.workspace import Workspace
 from core.terrain.contours import write_contours
-from core.terrain.options import SOURCE_INTERPOLATED, SOURCE_MEASURED, TerrainError
+from core.terrain.options import SOURCE_INTERPOLATED, SOURCE_MEASURED, ReliefStageOptions, TerrainError, TerrainOptions
+from core.terrain.products import build_dtm, relief
 from core.terrain.rasters import same_grid
-from core.terrain.stage import (
-    ReliefStageOptions,
-    TerrainOptions,
-    build_dtm,
-    build_dtm_workspace,
-    relief,
-    relief_workspace,
-)
+from core.terrain.stage import build_dtm_workspace, relief_workspace
 from tests import synthetic as syn
 
 GSD = 40.0 / 325.0  # m: the synthetic block of tests/test_dense.py (altitude 40 m, fx 325 px)

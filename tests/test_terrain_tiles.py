@@ -52,7 +52,7 @@ def test_tiled_ground_filter_equals_the_untiled_one(untiled, tile):
 
 def test_build_dtm_by_small_tiles_writes_the_same_rasters(tmp_path):
     """The stage reads the DSM file by windows and writes the DTM and its source raster tile by tile."""
-    from core.terrain.stage import build_dtm
+    from core.terrain.products import build_dtm
 
     z = _dsm()
     path = str(tmp_path / "dsm.tif")
@@ -96,7 +96,7 @@ def test_relief_by_small_tiles_equals_the_whole_raster(tmp_path):
     pytest.importorskip("rvt.vis")
     from core.terrain import relief as rv
     from core.terrain.options import VISUALISATION_KEYS, ReliefOptions
-    from core.terrain.stage import relief
+    from core.terrain.products import relief
 
     dem = _write(str(tmp_path / "dem.tif"), _dsm())
     short = dict(svf_radius=0.6, slrm_radius=0.8, msrm_feature_max=1.5, ld_min_radius=0.3, ld_max_radius=0.6,

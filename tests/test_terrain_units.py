@@ -66,7 +66,7 @@ def test_a_dsm_too_large_for_the_memory_is_refused_before_reading(tmp_path, monk
     from core.terrain import rasters
     from core.terrain.difference import dsm_difference
     from core.terrain.options import TerrainError
-    from core.terrain.stage import build_dtm
+    from core.terrain.products import build_dtm
 
     path = str(tmp_path / "huge.tif")
     srs = osr.SpatialReference()
