@@ -21,11 +21,10 @@ from ..project.layout import SCREENING_JSON, Layout
 from ..project.stages import PREPARE, run_stage
 from ..project.workspace import Workspace, WorkspaceError
 from . import folder
-from .folder import OUTPUT_MARKER
 from .options import PrepareOptions
 from .screening import ImageQuality, ScreeningError
 
-__all__ = ["OUTPUT_MARKER", "PrepareResult", "STAGE", "load_screening", "prepare_images_workspace"]
+__all__ = ["PrepareResult", "STAGE", "load_screening", "prepare_images_workspace"]
 
 STAGE = PREPARE
 

@@ -114,5 +114,4 @@ def relief_workspace(workspace_dir: str, options: ReliefStageOptions,
     return r
 
 
-__all__ = ["build_dtm", "build_dtm_workspace", "relief", "relief_workspace", "DtmOutputs", "DtmResult", "ReliefResult",
-           "ReliefStageOptions", "TerrainOptions"]
+__all__ = ["build_dtm_workspace", "relief_workspace"]
