@@ -36,6 +36,7 @@ WORK = os.path.join(ROOT, "build", "bench-control-sigma")
 from core.align.options import AlignOptions  # noqa: E402
 from core.align.stage import align, load_model  # noqa: E402
 from core.georef.adjust import georeference  # noqa: E402
+from core.georef.options import GeorefOptions  # noqa: E402
 from core.io import gcp as gcpmod  # noqa: E402
 from core.project.workspace import Workspace  # noqa: E402
 
@@ -188,7 +189,7 @@ def toledo():
             ("targets 0.02 + EXIF 3 / 5 m stated", stated(ctl), [dataclasses.replace(c, sigma_given=True)
                                                                 for c in cams])):
         t0 = time.time()
-        res = georeference(rec, gcps, positions, crs=crs)
+        res = georeference(rec, gcps, positions, options=GeorefOptions(crs=crs))
         secs = time.time() - t0
         h, a = res.rmse(gcpmod.CHECK, helmert=True), res.rmse(gcpmod.CHECK)
         # camera centres: adjusted, and the Helmert step's (model_to_local applied to the aligned model)

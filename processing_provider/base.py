@@ -31,8 +31,13 @@ def _with_styled_outputs(process):
 
     @functools.wraps(process)
     def wrapper(self, parameters, context, feedback):
+        from ..core.common.errors import ArchaeoOrthoError, user_message
+
         check_dependencies(self.REQUIRES, self.displayName())
-        results = process(self, parameters, context, feedback)
+        try:
+            results = process(self, parameters, context, feedback)
+        except ArchaeoOrthoError as e:  # a stage's options refusing a value when made, before run_core
+            raise QgsProcessingException(user_message(e) or str(e)) from e
         self.register_styled_outputs(results, context, feedback)
         return results
 

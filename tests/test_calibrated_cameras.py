@@ -137,7 +137,7 @@ def test_a_refined_camera_stays_within_its_sigmas_where_the_data_agree(block):
     sigmas = {"fx": 2.0, "fy": 2.0, "cx": 2.0, "cy": 2.0, "k1": 0.005}
     record = _refined_record(block.camera, sigmas)
     gcps = block.gcp_set(block.spread_control(5), noise_px=0.4)
-    result = georeference(rec, gcps, camera_intrinsics=record)
+    result = georeference(rec, gcps, options=GeorefOptions(camera_intrinsics=record))
     assert result.statistics["prior_cameras"] == [1]
     cam = result.reconstruction.cameras[1]
     moved = {n: (float(v) - record[1]["given"][n]) for n, v in zip(NAMES, cam.params)}
@@ -225,11 +225,11 @@ def test_a_fixed_camera_is_not_refined_whatever_refine_intrinsics_says(block):
     gcps = block.gcp_set(block.spread_control(5), noise_px=0.4)
     record = {1: {"camera_id": 1, "mode": "fixed", "model": "OPENCV", "given": dict(zip(NAMES, wrong.params))}}
     for refine in (True, "all", ("focal",)):
-        result = georeference(block.truth_reconstruction(camera=wrong), gcps, refine_intrinsics=refine,
-                              camera_intrinsics=record)
+        result = georeference(block.truth_reconstruction(camera=wrong), gcps,
+                              options=GeorefOptions(refine_intrinsics=refine, camera_intrinsics=record))
         assert list(result.reconstruction.cameras[1].params) == list(wrong.params)
         assert result.statistics["fixed_cameras"] == [1]
-    moved = georeference(block.truth_reconstruction(camera=wrong), gcps, refine_intrinsics=True)
+    moved = georeference(block.truth_reconstruction(camera=wrong), gcps, options=GeorefOptions(refine_intrinsics=True))
     assert moved.reconstruction.cameras[1].params[0] != wrong.params[0]  # without the record it is refined
 
 

@@ -152,3 +152,24 @@ def test_each_warning_reaches_the_log_once_whichever_progress_pushed_it():
     other = Log()
     FeedbackProgress(other).push_result(["outlier A12 left out"])
     assert other.lines == [("warning", "outlier A12 left out")]
+
+
+def test_options_refused_when_made_in_process_algorithm_are_a_message():
+    """A stage's options check their values when made (issue 35): made in processAlgorithm before run_core, a
+    refusal is the run's message, not a traceback; a bug there still propagates as itself."""
+    from archaeoortho.core.georef.options import GeorefOptions
+    from archaeoortho.processing_provider.base import AlgorithmBase
+    from qgis.core import QgsProcessingException
+
+    class Bad(AlgorithmBase):
+        NAME = "bad"
+        REQUIRES = ()
+
+        def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 (QGIS API name)
+            GeorefOptions(outlier_threshold=parameters["t"])
+            return {}
+
+    with pytest.raises(QgsProcessingException, match=r"GeorefOptions.outlier_threshold must be a positive number"):
+        Bad().processAlgorithm({"t": -1.0}, None, None)
+    with pytest.raises(KeyError):  # a bug is not turned into a user message
+        Bad().processAlgorithm({}, None, None)

@@ -10,6 +10,7 @@ from core.geometry.similarity import Similarity, helmert_fit, helmert_ransac
 from core.georef.adjust import georeference
 from core.georef.bundle import outside_image
 from core.georef.errors import GeorefError
+from core.georef.options import GeorefOptions
 from core.georef.results import REJECTED
 from core.georef.triangulate import triangulate_observations
 from core.io import gcp as gcpmod
@@ -217,7 +218,7 @@ def test_a_typo_stays_out_after_the_retest_against_the_adjusted_block(block):
     t = r.statistics["helmert_retests"]["d"]
     assert t["sigma"] > 100 * t["threshold_sigma"] and t["free_distance_m"] == pytest.approx(100.0, rel=0.01)
     assert any("d is" in w and "adjusted block" in w and "excluded" in w for w in r.warnings)
-    h = georeference(rec, gcps, adjust=False)
+    h = georeference(rec, gcps, options=GeorefOptions(adjust=False))
     assert [o.name for o in h.outliers if o.kind == "control point"] == ["d"]
     assert any("d is" in w and "Helmert fit" in w for w in h.warnings)
     assert next(p for p in h.points if p.name == "d").status == REJECTED
@@ -260,7 +261,7 @@ def test_camera_positions_without_heights_alone_are_refused(block):
     cams = [gcpmod.CameraPosition(image=f"img{k + 1:02d}.jpg", x=c[0] + OFFSET[0], y=c[1] + OFFSET[1],
                                   z=float("nan")) for k, c in enumerate(centres)]
     with pytest.raises(GeorefError, match="without a height"):
-        georeference(rec, None, cams, crs="EPSG:32633")
+        georeference(rec, None, cams, options=GeorefOptions(crs="EPSG:32633"))
 
 
 def test_camera_positions_only_land_within_their_noise(block):
@@ -317,3 +318,17 @@ def test_control_points_that_disagree_with_the_block_by_metres_are_named(block):
     assert cons["rms_m"] < 0.05
     assert cons["residuals_m"]["g"] == pytest.approx(2.0, abs=0.2)
     assert any("b (" in w and "g (" in w and "suspect" in w for w in r.warnings)
+
+
+@pytest.mark.parametrize("field, value, what", [("refine_intrinsics", ("focal", "zoom"), "unknown group"),
+                                                ("outlier_threshold", 0.0, "outlier_threshold must be a positive"),
+                                                ("huber_px", float("nan"), "huber_px must be a positive"),
+                                                ("focal_prior", -0.01, "focal_prior must be zero or a positive"),
+                                                ("helmert_threshold", -2.0, "helmert_threshold must be a positive")])
+def test_georef_options_refuse_a_bad_value_when_made(field, value, what):
+    with pytest.raises(GeorefError, match=what):
+        GeorefOptions(**{field: value})
+
+
+def test_georef_options_take_one_check_point_name_as_a_list():
+    assert tuple(GeorefOptions(check_points="gcp03, gcp06").check_points) == ("gcp03", "gcp06")

@@ -19,6 +19,7 @@ import pytest
 from core.align.options import AlignOptions
 from core.align.stage import align, load_model
 from core.georef.adjust import georeference
+from core.georef.options import GeorefOptions
 from core.georef.results import CHECKED, REJECTED, USED
 from core.io.gcp import CHECK, CONTROL, read_gcps, write_odm_gcp_list
 from tests import synthetic as syn
@@ -238,7 +239,7 @@ def test_refined_intrinsics_repair_a_block_aligned_without_distortion(block):
     ba.print_summary = False
     pycolmap.bundle_adjustment(rec, ba)  # the block settles into its deformed shape
     gcps = block.gcp_set(block.spread_control(5), noise_px=GCP_NOISE_PX)
-    result = georeference(rec, gcps, refine_intrinsics=True)
+    result = georeference(rec, gcps, options=GeorefOptions(refine_intrinsics=True))
     _report("aligned without distortion, refine intrinsics", result, block.gsd)
     chk, hel = result.rmse(CHECK), result.rmse(CHECK, helmert=True)
     assert hel["xyz"] > 0.5  # the deformation is real...
@@ -263,7 +264,8 @@ def test_deformed_strip_keeps_its_good_control_points(strip):
     pycolmap.bundle_adjustment(rec, ba)
     ground = sorted((p for p in strip.gcps if p.kind == "ground"), key=lambda p: p.xyz[0])
     control = [ground[0].name, ground[1].name, ground[-1].name, ground[-2].name, ground[len(ground) // 2].name]
-    result = georeference(rec, strip.gcp_set(control, noise_px=GCP_NOISE_PX), refine_intrinsics=True)
+    result = georeference(rec, strip.gcp_set(control, noise_px=GCP_NOISE_PX),
+                          options=GeorefOptions(refine_intrinsics=True))
     _report("strip aligned without distortion", result, strip.gsd)
     assert not [o.name for o in result.outliers if o.kind == "control point"]
     chk = result.rmse(CHECK)

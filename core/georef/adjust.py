@@ -158,17 +158,15 @@ class _Fit:
 
 
 def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optional[Sequence[CameraPosition]] = None,
-                 refine_intrinsics=None, progress: Optional[Progress] = None,
-                 options: Optional[GeorefOptions] = None, **kwargs) -> GeorefResult:
+                 options: Optional[GeorefOptions] = None, progress: Optional[Progress] = None) -> GeorefResult:
     """Georeference a sparse model with GCPs and/or camera positions.
 
     ``reconstruction``: pycolmap.Reconstruction in the model frame (copied unless
     ``copy_model`` is False).  ``gcps``: control points (role CONTROL) enter the
     adjustment, check points (role CHECK) are only evaluated.
     ``camera_positions``: projection centres (same CRS as the GCPs) with sigmas.
-    ``options``: a :class:`~core.georef.options.GeorefOptions`; each of its fields may also be given as a
-    keyword (it replaces the field), as may ``refine_intrinsics``.
-    ``refine_intrinsics``: False; True (focal + distortion); "all" (also the
+    ``options``: a :class:`~core.georef.options.GeorefOptions` (None: the defaults), the only carrier of the
+    settings; its ``refine_intrinsics``: False; True (focal + distortion); "all" (also the
     principal point); or a subset of ("focal", "principal_point", "extra").
     ``outlier_threshold``: pixels; a GCP observation whose residual exceeds
     max(outlier_threshold, 5 x median) is removed.  ``outlier_sigma``: a control
@@ -187,9 +185,7 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
     ``placeholder_sigma_z`` and a warning says so (``statistics["placeholder_z"]``).
     Returns a GeorefResult whose reconstruction lies in the local frame world - offset.
     """
-    if refine_intrinsics is not None:
-        kwargs["refine_intrinsics"] = refine_intrinsics
-    opt = GeorefOptions.of(options, **kwargs)
+    opt = options if options is not None else GeorefOptions()
     run = _start(reconstruction, gcps, opt, progress or NullProgress())
     _triangulate_control(run)
     _match_camera_positions(run, camera_positions)

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 from typing import Any, Dict, Optional, Sequence, Tuple
 
@@ -80,6 +81,31 @@ class GeorefOptions:
     camera_positions_path: Optional[str] = None
     use_exif_gps: bool = False
     gcps_upright: bool = False
+
+    def __post_init__(self) -> None:
+        """GeorefError naming the option for a value out of its range or choices (before any work)."""
+        from .errors import GeorefError
+
+        try:
+            self.intrinsic_groups()
+        except ValueError as e:
+            raise GeorefError(str(e)) from e
+        positive = ("outlier_threshold", "outlier_sigma", "gcp_pixel_sigma", "tie_pixel_sigma", "huber_px",
+                    "max_observations", "max_iterations", "placeholder_sigma_z", "reference_dem_points")
+        for name in positive:
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise GeorefError(f"GeorefOptions.{name} must be a positive number, not {value!r}")
+        for name in ("focal_prior", "reference_dem_sigma_z", "max_outlier_rounds"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                raise GeorefError(f"GeorefOptions.{name} must be zero or a positive number, not {value!r}")
+        if self.helmert_threshold is not None and not (math.isfinite(self.helmert_threshold)
+                                                       and self.helmert_threshold > 0):
+            raise GeorefError(f"GeorefOptions.helmert_threshold must be a positive distance or None, not "
+                              f"{self.helmert_threshold!r}")
+        if isinstance(self.check_points, str):  # one name given as a string would be taken letter by letter
+            self.check_points = tuple(n.strip() for n in self.check_points.split(",") if n.strip())
 
     @classmethod
     def of(cls, options: Optional["GeorefOptions"] = None, **kwargs: Any) -> "GeorefOptions":
