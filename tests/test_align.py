@@ -214,3 +214,20 @@ def test_sift_first_octave_upsamples_only_small_images():
     assert sift_first_octave(o, 1200, 900) == 0  # the image itself has features enough
     assert sift_first_octave(AlignOptions(max_image_size=800), 4000, 3000) == -1  # matched at 800 px
     assert sift_first_octave(AlignOptions(first_octave=-1), 4000, 3000) == -1  # the user's choice
+
+
+@pytest.mark.parametrize("field, value, what", [("pairing", "exhaustiv", "unknown pairing 'exhaustiv'"),
+                                                ("camera_model", "opencv_fish", "unknown camera_model 'OPENCV_FISH'"),
+                                                ("grouping", "per-image", "unknown grouping 'per-image'"),
+                                                ("max_features", -1, "max_features must be a whole number"),
+                                                ("focal_mm", 0.0, "focal_mm must be a positive number"),
+                                                ("mapper", "glomap", "unknown mapper 'glomap'")])
+def test_align_options_refuse_a_bad_value_when_made(field, value, what):
+    """Issue 35: a mistyped choice fails when the options are made, before any feature extraction."""
+    with pytest.raises(AlignError, match=what):
+        AlignOptions(**{field: value})
+
+
+def test_align_options_normalise_the_case_of_choices():
+    o = AlignOptions(pairing="Spatial", camera_model="opencv", grouping="SINGLE")
+    assert (o.pairing, o.camera_model, o.grouping) == ("spatial", "OPENCV", "single")

@@ -1,13 +1,15 @@
 """The options of the alignment stage and its constants: every default in one place."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Optional
 
 from ..common.errors import ArchaeoOrthoError
-from ..io.images import GROUP_AUTO
+from ..io.images import GROUP_AUTO, GROUP_PER_IMAGE, GROUP_SINGLE
 
 PAIRINGS = ("auto", "exhaustive", "sequential", "spatial")
+GROUPINGS = (GROUP_AUTO, GROUP_SINGLE, GROUP_PER_IMAGE)
 CAMERA_MODELS = ("AUTO", "SIMPLE_RADIAL", "RADIAL", "OPENCV", "FULL_OPENCV")
 
 SPATIAL_NEIGHBOURS = 12
@@ -85,8 +87,34 @@ class AlignOptions:
     calibration: Optional[str] = None  # a camera calibration file (core.io.calibration), None: none
     intrinsics: str = "auto"  # one of INTRINSICS; a camera's own ``adjust`` in the calibration file overrides it
 
+    def __post_init__(self) -> None:
+        """The choices normalised (case) and every value checked when the options are made: a mistyped choice or
+        a value out of range fails before any work, naming the option."""
+        self.pairing = str(self.pairing or "auto").lower()
+        self.camera_model = str(self.camera_model or "AUTO").upper()
+        self.grouping = str(self.grouping or GROUP_AUTO).lower()
+        self.mapper = str(self.mapper or "incremental").lower()
+        self.intrinsics = str(self.intrinsics or "auto").lower()
+        self.check()
+
     def check(self) -> None:
-        """AlignError for a value out of its choices (before any work)."""
+        """AlignError for a value out of its choices or range (before any work)."""
+        for name, value, choices in (("pairing", self.pairing, PAIRINGS), ("camera_model", self.camera_model,
+                                                                           CAMERA_MODELS),
+                                     ("grouping", self.grouping, GROUPINGS)):
+            if value not in choices:
+                raise AlignError(f"unknown {name} {value!r}; choose one of {', '.join(choices)}")
+        for name in ("max_image_size", "max_features"):
+            value = getattr(self, name)
+            if not isinstance(value, int) or isinstance(value, bool) or value < 0:
+                raise AlignError(f"AlignOptions.{name} must be a whole number >= 0 (0: automatic), not {value!r}")
+        if not isinstance(self.spatial_neighbours, int) or self.spatial_neighbours < 1:
+            raise AlignError(f"AlignOptions.spatial_neighbours must be a whole number >= 1, not "
+                             f"{self.spatial_neighbours!r}")
+        for name in ("focal_mm", "sensor_width_mm", "focal_px"):
+            value = getattr(self, name)
+            if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise AlignError(f"AlignOptions.{name} must be a positive number or None, not {value!r}")
         if self.mapper not in MAPPERS:
             raise AlignError(f"unknown mapper {self.mapper!r}; choose one of {', '.join(MAPPERS)}")
         if self.intrinsics not in INTRINSICS:
