@@ -17,7 +17,7 @@ from core.common.progress import Cancelled, NullProgress
 from core.geometry import camera as gcam
 from core.io import gcp as gcpmod
 from core.io import raster as dsmmod
-from core.ortho import seams
+from core.ortho import planning
 from core.ortho.cameras import OrthoCamera, select_cameras
 from core.ortho.options import OrthoError, OrthoOptions, SingleImageOptions
 from core.ortho.orientation import read_orientation
@@ -377,9 +377,9 @@ def test_seamlines_move_to_where_the_images_agree():
     other[:, 17:24] += 80.0
     labels = np.where(x < 20, 0, 1).astype(np.int32)
     windows = [(0, 0, h, w), (0, 0, h, w)]
-    before = seams._seam_disagreement(labels, windows, [base, other], 255.0)
-    moved = seams._refine_seams(labels, windows, costs, [base, other], 255.0, 10)
-    after = seams._seam_disagreement(moved, windows, [base, other], 255.0)
+    before = planning._seam_disagreement(labels, windows, [base, other], 255.0)
+    moved = planning._refine_seams(labels, windows, costs, [base, other], 255.0, 10)
+    after = planning._seam_disagreement(moved, windows, [base, other], 255.0)
     cols = [int(np.flatnonzero(row == 1)[0]) for row in moved]
     assert all(c <= 17 or c >= 24 for c in cols), cols
     assert after < 0.2 * before

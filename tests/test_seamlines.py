@@ -341,7 +341,7 @@ def test_the_plan_spans_a_photo_in_at_most_about_300_cells():
     """The planning cell is 4 GSD for photos up to 1200 px and grows with larger photos, so a photo of the same
     ground at 2 x the pixels is planned on cells of the same size in metres (not 4 x as many)."""
     from core.ortho.pixels import ImageMeta
-    from core.ortho.seams import PLANNING_GSD, PLANNING_MAX_CELLS_ACROSS, planning_gsd
+    from core.ortho.planning import PLANNING_GSD, PLANNING_MAX_CELLS_ACROSS, planning_gsd
 
     def metas(w, h, n=3):
         return [ImageMeta(w, h, 3, "uint8") for _ in range(n)]

@@ -16,7 +16,7 @@ import numpy as np
 from ..geometry.similarity import fit_similarity
 from .bundle import BundleProblem
 from .results import Outlier
-from .triangulate import View, triangulate_views, view_residuals
+from .triangulate import PointView, triangulate_views, view_residuals
 
 
 @dataclass
@@ -170,7 +170,7 @@ def retest_provisional(prob: BundleProblem, k: int, rows) -> Dict[str, Any]:
         f = prob.img_frame[i]
         rot = prob.Rs[i] @ prob.R[f]
         m = np.column_stack([rot, prob.ts[i] - rot @ prob.C[f]])
-        views.append((View(int(r), img, prob.cameras[prob.img_cam[i]], m, o.xy[r].copy()), float(o.sigma[r])))
+        views.append((PointView(int(r), img, prob.cameras[prob.img_cam[i]], m, o.xy[r].copy()), float(o.sigma[r])))
     if len(views) < 2 or not np.all(np.isfinite(prob.pp[k])):
         return inf
     prior, ps = prob.pp[k], prob.pps[k]

@@ -19,7 +19,9 @@ from .bundle import outside_image, project, project_jacobian
 
 
 @dataclass
-class View:
+class PointView:
+    """A point seen in one image: the observation, the image's camera and pose."""
+
     index: int  # index into the observation list
     image: str
     camera: Any
@@ -66,7 +68,7 @@ def image_names(reconstruction) -> set:
 
 
 def collect_views(reconstruction, observations: Sequence[Observation], lookup: Dict[str, Any],
-                   all_names: Optional[set] = None) -> Tuple[List[View], List[str]]:
+                   all_names: Optional[set] = None) -> Tuple[List[PointView], List[str]]:
     views, notes = [], []
     for i, ob in enumerate(observations):
         im = lookup.get(ob.image)
@@ -81,12 +83,12 @@ def collect_views(reconstruction, observations: Sequence[Observation], lookup: D
             notes.append(f"observation in {ob.image} at ({ob.x:g}, {ob.y:g}) lies outside the image "
                          f"({cam.width} x {cam.height} px): skipped")
             continue
-        views.append(View(i, ob.image, cam, np.asarray(im.cam_from_world().matrix()),
+        views.append(PointView(i, ob.image, cam, np.asarray(im.cam_from_world().matrix()),
                            np.array([ob.x, ob.y], dtype=float)))
     return views, notes
 
 
-def triangulate_views(views: List[View]) -> Optional[np.ndarray]:
+def triangulate_views(views: List[PointView]) -> Optional[np.ndarray]:
     """Linear (DLT on undistorted normalised coordinates) + Gauss-Newton on pixel residuals."""
     if len(views) < 2:
         return None
@@ -114,7 +116,7 @@ def triangulate_views(views: List[View]) -> Optional[np.ndarray]:
     return refine_point(views, x)
 
 
-def view_residuals(views: List[View], x: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+def view_residuals(views: List[PointView], x: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
     """Pixel residual vectors (M,2) and depths (M,) of point x in the views."""
     res = np.empty((len(views), 2))
     depth = np.empty(len(views))
@@ -125,7 +127,7 @@ def view_residuals(views: List[View], x: np.ndarray) -> Tuple[np.ndarray, np.nda
     return res, depth
 
 
-def refine_point(views: List[View], x: np.ndarray, iterations: int = 15) -> np.ndarray:
+def refine_point(views: List[PointView], x: np.ndarray, iterations: int = 15) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     res, _ = view_residuals(views, x)
     cost = float(np.sum(res ** 2))
@@ -159,7 +161,7 @@ def refine_point(views: List[View], x: np.ndarray, iterations: int = 15) -> np.n
     return x
 
 
-def intersection_angle(views: List[View], x: np.ndarray) -> float:
+def intersection_angle(views: List[PointView], x: np.ndarray) -> float:
     dirs = []
     for v in views:
         c = -v.cam_from_world[:, :3].T @ v.cam_from_world[:, 3]
@@ -308,6 +310,6 @@ def refine_tie_points(rec, huber_px: float, progress, iterations: int = 10) -> N
 
 
 
-__all__ = ["Triangulation", "View", "collect_views", "image_names", "intersection_angle",
+__all__ = ["Triangulation", "PointView", "collect_views", "image_names", "intersection_angle",
            "refine_point", "refine_tie_points", "registered_images", "triangulate_observations",
            "triangulate_views", "view_residuals"]

@@ -47,8 +47,9 @@ Modules (each one concern; import a name from the module that defines it)
 options (OrthoOptions, SingleImageOptions, OrthoError), cameras (OrthoCamera, IMAGES_FILTER), surface (the DSM
 in the working CRS, gap filling), visibility (footprints, polar occlusion tables), pixels (image windows,
 masks, the cache, remap), sampling (where ground points fall in a camera, and its values there), grid (tiles
-and cells), writer (the COG writer), block (the set-up shared by mosaic and single images, per-image orthophotos), seams (planning,
-seamlines, exposure), blend (multi-band pyramids), tiles (one mosaic tile), mosaic (build_orthomosaic),
+and cells), writer (the COG writer), block (the set-up shared by mosaic and single images, per-image orthophotos), planning (the
+mosaic's plan: which image each cell takes, seams moved by minimum cut, exposure), seamlines (the seamlines
+GeoPackage read back with the user's edits), blend (multi-band pyramids), tiles (one mosaic tile), mosaic (build_orthomosaic),
 stage (the workspace stage), orientation (orientation files), imagecontrol (one image's run record and the
 ground control observed in it), planar (planar rectification), single (orthorectify_image).
 """

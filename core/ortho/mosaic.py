@@ -22,9 +22,9 @@ from .cameras import OrthoCamera
 from .grid import box_intersects, grid_tiles
 from .options import OrthoError, OrthoOptions
 from .pixels import PHOTO_CACHE
+from .planning import MosaicPlan, plan_mosaic
 from .radiometry_fit import fit_radiometry
 from .seamlines import read_seamline_edits, write_seamlines
-from .seams import MosaicPlan, plan_mosaic
 from .surface import Dsm, fill_dsm_gaps
 from .tiles import DSM_CACHE, TileUnit, render_tile
 from .writer import RasterWriter, gdal_cache
