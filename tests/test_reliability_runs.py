@@ -527,6 +527,7 @@ def _core(result):
     """A core entry point that logs as the real ones do (progress.info / warning while it runs) and returns
     the same lines in its result, plus one it did not push."""
     def run(*args, progress=None, **kwargs):
+        progress = progress if progress is not None else args[-1]  # entered as (inputs, options, progress)
         progress.info("mosaic: 3 images")
         progress.warning("image A is dark")
         return result
