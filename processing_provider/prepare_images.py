@@ -14,11 +14,12 @@ from qgis.core import (
     QgsWkbTypes,
 )
 
+from ..core.prepare import options as options_module
 from . import params
 from .base import AlgorithmBase, FeedbackProgress
 
-FIDUCIAL_TYPES = ["auto", "cross", "dot", "ring_dot", "cross_ring"]
-FIDUCIAL_LAYOUTS = ["auto", "corners", "sides", "eight"]
+FIDUCIAL_TYPES = list(options_module.FIDUCIAL_TYPES)  # the choices, defined once in core.prepare.options
+FIDUCIAL_LAYOUTS = list(options_module.LAYOUT_NAMES)
 
 
 class PrepareImagesAlgorithm(AlgorithmBase):

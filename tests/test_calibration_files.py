@@ -504,7 +504,8 @@ def test_a_certificate_typed_in_windows_1252_reads_and_a_binary_file_does_not(tm
 def test_prepare_images_reads_the_fiducials_of_a_calibration_file():
     """The certificate typed once: Prepare images' fiducial coordinates may be the calibration file Align images
     reads (was refused: 'expected id x y'); a calibration without fiducials says so, naming the file."""
-    from core.prepare.scans import ScanError, parse_fiducial_coordinates
+    from core.prepare.options import ScanError
+    from core.prepare.scans import parse_fiducial_coordinates
 
     path = _data("rc20_certificate.yaml")
     cal = read_calibration(path)[0]

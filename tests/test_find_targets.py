@@ -238,3 +238,16 @@ def test_clicks_in_the_targets_file_are_checked_against_the_constellation(block,
     assert (photo, "ring_a") not in found and found[(photo, "chk_b")].found
     assert all(_error(scene, o) < 1.5 for o in r.observations)  # no wrong name
     assert {(o.image, o.name) for o in r.observations} == {(o.image, o.name) for o in ref.observations}
+
+
+@pytest.mark.parametrize("kwargs, what", [({"kind": "crosses"}, "unknown target kind 'crosses'"),
+                                          ({"target_size": -0.5}, "target size must be a positive length"),
+                                          ({"max_size_fraction": 1.5}, "max_size_fraction must be in")])
+def test_find_targets_options_refuse_a_bad_value_when_made(kwargs, what):
+    from core.georef.errors import GeorefError
+    from core.georef.targets.options import FindTargetsOptions
+
+    with pytest.raises(GeorefError, match=what):
+        FindTargetsOptions(**kwargs)
+    assert FindTargetsOptions(kind="Cross").kind == "cross"
+    assert FindTargetsOptions(kind="dict_4x4_50").kind == "DICT_4X4_50"

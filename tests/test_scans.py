@@ -150,7 +150,8 @@ def synthetic_scans(tmp_path_factory):
 # ---------------------------------------------------------------------------
 
 def test_parse_fiducial_coordinates_assigns_slots_and_pp(tmp_path):
-    from core.prepare.scans import ScanError, parse_fiducial_coordinates
+    from core.prepare.options import ScanError
+    from core.prepare.scans import parse_fiducial_coordinates
 
     cal = parse_fiducial_coordinates(calibration_text())
     assert set(cal.points) == set(MARKS)
@@ -357,8 +358,8 @@ def test_uncalibrated_corner_marks_mean_frame(tmp_path):
 
 
 def test_too_few_marks_is_a_clear_error(tmp_path):
-    from core.prepare.options import ScanOptions
-    from core.prepare.scans import ScanError, prepare_scans
+    from core.prepare.options import ScanError, ScanOptions
+    from core.prepare.scans import prepare_scans
 
     img = os.path.join(SAMPLE, "images", TOLEDO_STRIP[0])  # a photo without any fiducial mark
     with pytest.raises(ScanError, match=TOLEDO_STRIP[0]):
@@ -525,8 +526,8 @@ def _displace_mark(block, name, mark_id, dx, out_dir):
 def test_a_scan_whose_marks_do_not_fit_is_left_out(touching_block, tmp_path):
     """A mark 3 px off in one scan leaves 0.75 px residuals on its four marks: over 4 x the limit (0.1 px here),
     so that scan is left out by name, the others prepared; with one scan left the stage fails, naming it."""
-    from core.prepare.options import ScanOptions
-    from core.prepare.scans import ScanError, prepare_scans
+    from core.prepare.options import ScanError, ScanOptions
+    from core.prepare.scans import prepare_scans
 
     block = touching_block
     bad = block.names[1]
@@ -589,3 +590,21 @@ def test_prepare_stage_with_a_scan_left_out(touching_block, tmp_path):
     assert any(w.startswith(f"{bad}: left out") for w in res.warnings)
     rec = json.load(open(os.path.join(res.workspace, "workspace.json")))["stages"]["prepare"]["results"]
     assert list(rec["left_out_scans"]) == [bad] and sorted(rec["decisions"]) == good
+
+
+def test_scan_options_refuse_a_bad_choice_when_made():
+    """Issue 35: the choices are checked when the options are made, before any scan is read; the layouts the
+    options accept are the ones the detector knows."""
+    from core.prepare.options import LAYOUT_NAMES, PrepareError, PrepareOptions, ScanError, ScanOptions
+    from core.prepare.scans import LAYOUTS
+
+    assert set(LAYOUT_NAMES) == set(LAYOUTS)
+    with pytest.raises(ScanError, match="unknown fiducial layout 'corner'"):
+        ScanOptions(layout="corner")
+    with pytest.raises(ScanError, match="unknown fiducial type 'ring'"):
+        ScanOptions(fiducial_type="ring")
+    with pytest.raises(ScanError, match="focal_length_mm must be a positive number"):
+        ScanOptions(focal_length_mm=-152.0)
+    with pytest.raises(PrepareError, match="unknown y axis 'upward'"):
+        PrepareOptions(mask_y_axis="upward")
+    assert ScanOptions(fiducial_type="Cross", layout="CORNERS").layout == "corners"

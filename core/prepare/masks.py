@@ -34,9 +34,9 @@ import numpy as np
 from ..common.errors import ArchaeoOrthoError, require
 from ..common.files import atomic_output
 from ..io.images import image_size, list_images
+from .options import Y_AXES
 
 MASKS_DIR = "masks"
-Y_AXES = ("auto", "down", "up")
 
 Ring = Sequence[Tuple[float, float]]
 

@@ -1,10 +1,25 @@
 """The options of the "prepare" stage (screening, scanned film, user masks): every default in one place."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Optional, Sequence
 
+from ..common.errors import ArchaeoOrthoError
+
 ANALYSIS_SIZE = 1024  # long side (px) at which screening measures every image
+MARK_KINDS = ("cross", "dot", "ring_dot", "cross_ring")  # the fiducial marks core.prepare.scans finds
+FIDUCIAL_TYPES = ("auto",) + MARK_KINDS
+LAYOUT_NAMES = ("auto", "corners", "sides", "eight")  # where the marks are (core.prepare.scans.LAYOUTS)
+Y_AXES = ("auto", "down", "up")  # the mask polygons' y axis: rows down, or y = -row (the QGIS georeferencer)
+
+
+class PrepareError(ArchaeoOrthoError, ValueError):
+    """The prepare stage's options refuse a value; the message names the option."""
+
+
+class ScanError(PrepareError):
+    """Scanned film cannot be prepared; the message names the file and the problem."""
 
 
 @dataclass
@@ -36,6 +51,21 @@ class ScanOptions:
     mask_border: bool = True  # mask the film border and data strips outside the picture area
     mask_margin_px: float = 4.0  # extra inward margin of the masks, output pixels
 
+    def __post_init__(self) -> None:
+        """ScanError naming the option for a choice or value out of range (before any scan is read)."""
+        self.fiducial_type = str(self.fiducial_type or "auto").lower()
+        self.layout = str(self.layout or "auto").lower()
+        if self.fiducial_type not in FIDUCIAL_TYPES:
+            raise ScanError(f"unknown fiducial type {self.fiducial_type!r}; choose one of {', '.join(FIDUCIAL_TYPES)}")
+        if self.layout not in LAYOUT_NAMES:
+            raise ScanError(f"unknown fiducial layout {self.layout!r}; choose one of {', '.join(LAYOUT_NAMES)}")
+        for name in ("focal_length_mm", "scan_pixel_size_mm", "output_pixel_size"):
+            value = getattr(self, name)
+            if value is not None and not (math.isfinite(value) and value > 0):
+                raise ScanError(f"ScanOptions.{name} must be a positive number or none, not {value!r}")
+        if not 0 < self.min_score <= 1:
+            raise ScanError(f"ScanOptions.min_score must be in (0, 1], not {self.min_score!r}")
+
 
 @dataclass
 class PrepareOptions:
@@ -52,6 +82,12 @@ class PrepareOptions:
     sky_masks: bool = False
     sky: Optional["SkyOptions"] = None  # when sky_masks (None = SkyOptions())
     output_dir: Optional[str] = None  # the folder of prepared images (None = <workspace>/prepared)
+
+    def __post_init__(self) -> None:
+        self.mask_y_axis = str(self.mask_y_axis or "auto").lower()
+        if self.mask_y_axis not in Y_AXES:
+            raise PrepareError(f"unknown y axis {self.mask_y_axis!r} of the mask polygons; choose one of "
+                            f"{', '.join(Y_AXES)}")
 
 
 @dataclass

@@ -57,11 +57,11 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from ..common.errors import ArchaeoOrthoError, require
+from ..common.errors import require
 from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
 from ..io.images import ImageError, open_image, read_image, to_grey
 from ..io.raster import RasterFile
-from .options import ScanOptions
+from .options import FIDUCIAL_TYPES, MARK_KINDS, ScanError, ScanOptions
 
 SCANS_JSON = "scans.json"
 
@@ -73,13 +73,7 @@ SLOTS: Dict[str, Tuple[int, int]] = {
 CORNER_SLOTS = ("TL", "TR", "BR", "BL")
 SIDE_SLOTS = ("T", "R", "B", "L")
 LAYOUTS = {"auto": tuple(SLOTS), "corners": CORNER_SLOTS, "sides": SIDE_SLOTS, "eight": tuple(SLOTS)}
-MARK_KINDS = ("cross", "dot", "ring_dot", "cross_ring")
-FIDUCIAL_TYPES = ("auto",) + MARK_KINDS
 OPPOSITE = {"TL": "BR", "TR": "BL", "T": "B", "L": "R"}
-
-
-class ScanError(ArchaeoOrthoError, ValueError):
-    """Scanned film cannot be prepared; the message names the file and the problem."""
 
 
 @dataclass

@@ -1,8 +1,11 @@
 """Options of Find targets (core.georef.targets.stage.find_targets)."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Optional, Tuple
+
+from ..errors import GeorefError
 
 AUTO = "auto"
 CROSS = "cross"
@@ -39,6 +42,21 @@ class FindTargetsOptions:
     max_size_fraction: float = 0.2
     num_threads: int = 0  # 0: as many as the machine has
     targets: Optional[str] = None
+
+    def __post_init__(self) -> None:
+        """GeorefError naming the option for a kind that is not one, or a size out of range (before any work)."""
+        kind = str(self.kind or AUTO)
+        low = kind.lower()
+        self.kind = low if low in (AUTO,) + PLAIN_KINDS else next((d for d in DICTIONARIES if d.lower() == low), kind)
+        if self.kind not in KINDS:
+            raise GeorefError(f"Find targets: unknown target kind {kind!r}; choose one of {', '.join(KINDS)}")
+        if self.target_size is not None and not (math.isfinite(self.target_size) and self.target_size > 0):
+            raise GeorefError(f"Find targets: the target size must be a positive length (m) or none, not "
+                              f"{self.target_size!r}")
+        if not (math.isfinite(self.min_size_px) and self.min_size_px > 0):
+            raise GeorefError(f"FindTargetsOptions.min_size_px must be a positive number, not {self.min_size_px!r}")
+        if not (0 < self.max_size_fraction <= 1):
+            raise GeorefError(f"FindTargetsOptions.max_size_fraction must be in (0, 1], not {self.max_size_fraction!r}")
 
     def kinds(self) -> Tuple[Tuple[str, ...], Tuple[str, ...]]:
         """(plain kinds, dictionaries) to look for."""
