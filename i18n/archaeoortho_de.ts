@@ -74,12 +74,12 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
 <context>
     <name>AlgorithmBase</name>
     <message>
-        <location filename="../processing_provider/base.py" line="235"/>
+        <location filename="../processing_provider/base.py" line="240"/>
         <source>Cancelled: {}</source>
         <translation>Abgebrochen: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/base.py" line="144"/>
+        <location filename="../processing_provider/base.py" line="149"/>
         <source>Outputs not styled: {}</source>
         <translation>Ausgaben nicht gestaltet: {}</translation>
     </message>
@@ -92,57 +92,57 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
 <context>
     <name>AlignImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>One camera for all images</source>
         <translation>Eine Kamera für alle Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="81"/>
+        <location filename="../processing_provider/align_images.py" line="83"/>
         <source>Camera centres</source>
         <translation>Projektionszentren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="82"/>
+        <location filename="../processing_provider/align_images.py" line="84"/>
         <source>Registered images</source>
         <translation>Orientierte Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="83"/>
+        <location filename="../processing_provider/align_images.py" line="85"/>
         <source>Mean reprojection error (px)</source>
         <translation>Mittlerer Rückprojektionsfehler (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="110"/>
+        <location filename="../processing_provider/align_images.py" line="112"/>
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
         <translation>{} von {} Bildern orientiert, mittlerer Rückprojektionsfehler {:.3f} px, {} Punkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="117"/>
+        <location filename="../processing_provider/align_images.py" line="119"/>
         <source>Images not registered:</source>
         <translation>Nicht orientierte Bilder:</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="124"/>
+        <location filename="../processing_provider/align_images.py" line="126"/>
         <source>Seconds per step: {}</source>
         <translation>Sekunden je Schritt: {}</translation>
     </message>
@@ -152,49 +152,64 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
         <translation>Bilder ausrichten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Mapper</source>
         <translation>Rekonstruktionsverfahren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Matching image size (px)</source>
         <translation>Bildgröße für die Zuordnung (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Features per image</source>
         <translation>Merkmale je Bild</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Affine-invariant features</source>
         <translation>Affin-invariante Merkmale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Focal length (mm)</source>
         <translation>Brennweite (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Sensor width (mm)</source>
         <translation>Sensorbreite (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Retry images left out</source>
         <translation>Ausgelassene Bilder erneut versuchen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="113"/>
+        <location filename="../processing_provider/align_images.py" line="115"/>
         <source>Retry {} ({} features): {} image(s) left out; main block {} -&gt; {} images{}</source>
         <translation>Neuer Versuch {} ({}-Merkmale): {} Bild(er) ausgelassen; Hauptblock {} -&gt; {} Bilder{}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="113"/>
+        <location filename="../processing_provider/align_images.py" line="115"/>
         <source> (not better: the previous result kept)</source>
         <translation> (nicht besser: das vorige Ergebnis bleibt)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="66"/>
+        <source>Camera calibration file</source>
+        <translation>Kamerakalibrierungsdatei</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="66"/>
+        <source>Interior orientation</source>
+        <translation>Innere Orientierung</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="124"/>
+        <source>Camera {}: interior orientation {} ({})</source>
+        <translation>Kamera {}: innere Orientierung {} ({})</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="8"/>
@@ -202,7 +217,7 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
 
 Pair selection: &apos;auto&apos; uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
 Camera model: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
-Matching image size: the longest side the images are scaled to for the features (0 = automatic: photos of up to 2 megapixels as they are, larger ones scaled to 2 megapixels; the DSM and the orthophotos use every pixel). Features per image: 0 = automatic (about 4000 per megapixel, 2048 to 4096). Affine-invariant features help with oblique views and are slower.
+Matching image size: the longest side the images are scaled to for the features (0 = automatic: photos of up to 2 megapixels as they are, larger ones scaled to 2 megapixels; the DSM and the orthophotos use every pixel). Features per image: 0 = automatic (about 4000 per megapixel, 2048 to 4096). With both at 0, a few photos are probed first: where faint, low-contrast texture (ploughed fields) starves them of features, the first pass takes 8192 fainter ones, at up to twice the size if needed (the log says so). Affine-invariant features help with oblique views and are slower.
 Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).
 Camera calibration file: a calibrated camera&apos;s interior orientation (ArchaeoOrtho&apos;s YAML/JSON, Orthority interior parameters, OpenCV, COLMAP cameras.txt or Metashape XML); several cameras are matched to the photos by their image patterns, camera model or image size; a photo of another resolution takes it scaled. A file that cannot be read stops the run before any work, naming the file, the line and the field.
 Interior orientation: what the adjustments may change of a camera: &apos;fixed&apos; keeps the given values through the alignment and the georeference (also with automatic control), &apos;refined&apos; lets the georeference refine them with the calibration&apos;s standard deviations as priors, &apos;estimated&apos; self-calibrates from them. &apos;auto&apos; is &apos;fixed&apos; where a calibration is given (the file, or film scans restituted by Prepare images) and &apos;estimated&apos; elsewhere; a camera&apos;s own &apos;adjust&apos; in the file overrides it. With &apos;fixed&apos; or &apos;refined&apos; and no file, the focal length and sensor width are the given values. The log, sfm/alignment.json and the accuracy report say per camera what was held.
@@ -212,27 +227,12 @@ Retry images left out (advanced, on): images the fast settings leave out, or a b
 
 Paarauswahl: 'auto' nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
 Kameramodell: 'AUTO' schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
-Bildgröße für die Zuordnung: die längste Seite, auf die die Bilder für die Merkmale verkleinert werden (0 = automatisch: Fotos bis 2 Megapixel unverändert, größere auf 2 Megapixel verkleinert; DOM und Orthophotos nutzen jedes Pixel). Merkmale je Bild: 0 = automatisch (etwa 4000 je Megapixel, 2048 bis 4096). Affin-invariante Merkmale helfen bei Schrägaufnahmen und sind langsamer.
+Bildgröße für die Zuordnung: die längste Seite, auf die die Bilder für die Merkmale verkleinert werden (0 = automatisch: Fotos bis 2 Megapixel unverändert, größere auf 2 Megapixel verkleinert; DOM und Orthophotos nutzen jedes Pixel). Merkmale je Bild: 0 = automatisch (etwa 4000 je Megapixel, 2048 bis 4096). Stehen beide auf 0, werden zuerst einige Fotos geprüft: wo schwache, kontrastarme Textur (gepflügte Felder) ihnen zu wenige Merkmale lässt, nimmt der erste Durchgang 8192 schwächere, wenn nötig bei bis zu doppelter Größe (das Protokoll sagt es). Affin-invariante Merkmale helfen bei Schrägaufnahmen und sind langsamer.
 Brennweite und Sensorbreite: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern (0 = aus EXIF / unbekannt).
 Kamerakalibrierungsdatei: die innere Orientierung einer kalibrierten Kamera (YAML/JSON von ArchaeoOrtho, innere Parameter von Orthority, OpenCV, COLMAP cameras.txt oder Metashape-XML); mehrere Kameras werden den Fotos über ihre Bildmuster, das Kameramodell oder die Bildgröße zugeordnet; ein Foto anderer Auflösung erhält sie skaliert. Eine Datei, die sich nicht lesen lässt, beendet den Lauf vor jeder Arbeit und nennt Datei, Zeile und Feld.
 Innere Orientierung: was die Ausgleichungen an einer Kamera ändern dürfen: 'fixed' hält die gegebenen Werte durch Ausrichtung und Georeferenzierung (auch mit automatischen Passpunkten), 'refined' lässt die Georeferenzierung sie mit den Standardabweichungen der Kalibrierung als Vorinformation verbessern, 'estimated' kalibriert ausgehend von ihnen selbst. 'auto' ist 'fixed', wo eine Kalibrierung gegeben ist (die Datei oder von 'Bilder vorbereiten' entzerrte Filmscans), sonst 'estimated'; ein eigenes 'adjust' einer Kamera in der Datei geht vor. Mit 'fixed' oder 'refined' und ohne Datei sind Brennweite und Sensorbreite die gegebenen Werte. Protokoll, sfm/alignment.json und der Genauigkeitsbericht sagen je Kamera, was gehalten wurde.
 Rekonstruktionsverfahren (erweitert): 'incremental' (COLMAP, Standard) oder 'global' (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).
 Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen Einstellungen auslassen, oder ein in Teile zerfallener Block werden mit reicheren Merkmalen (schwächeren für kontrastarme Bilder, affinen für steile Schrägaufnahmen) und mehr Paaren erneut versucht; das Protokoll und sfm/alignment.json sagen, was erneut versucht wurde und warum.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
-        <source>Camera calibration file</source>
-        <translation>Kamerakalibrierungsdatei</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
-        <source>Interior orientation</source>
-        <translation>Innere Orientierung</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="122"/>
-        <source>Camera {}: interior orientation {} ({})</source>
-        <translation>Kamera {}: innere Orientierung {} ({})</translation>
     </message>
 </context>
 <context>
@@ -319,7 +319,7 @@ Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen 
         <translation>Gefundene Zuordnungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="131"/>
+        <location filename="../processing_provider/auto_control.py" line="133"/>
         <source>outlier left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
@@ -339,12 +339,12 @@ Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen 
         <translation>Aus Weblayern abzurufender Bereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="119"/>
+        <location filename="../processing_provider/auto_control.py" line="121"/>
         <source>Reference DSM {} given without a reference orthophoto (DEM control) must be a raster file on disk; a web layer is fetched only with a reference orthophoto</source>
         <translation>Referenz-DOM {} ohne Referenz-Orthophoto (DGM-Passpunkte) muss eine Rasterdatei auf dem Datenträger sein; ein Weblayer wird nur mit einem Referenz-Orthophoto abgerufen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="123"/>
+        <location filename="../processing_provider/auto_control.py" line="125"/>
         <source>A reference DSM alone (DEM control) places the block by the photos&apos; EXIF GPS: choose Rough position auto or EXIF GPS, or give a reference orthophoto as well</source>
         <translation>Ein Referenz-DOM allein (DGM-Passpunkte) platziert den Block durch das EXIF-GPS der Fotos: Ungefähre Lage automatisch oder EXIF-GPS wählen oder zusätzlich ein Referenz-Orthophoto angeben</translation>
     </message>
@@ -423,7 +423,7 @@ Ausgaben: die Projektionszentren im KBS der Referenz, die Zahl der automatischen
         <translation>Verschmolzene Punkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="89"/>
+        <location filename="../processing_provider/build_dsm.py" line="87"/>
         <source>DSM {} ({} m cells), valid fraction {}</source>
         <translation>DOM {} ({} m Zellen), Anteil gültiger Zellen {}</translation>
     </message>
@@ -1243,22 +1243,22 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Vorhergesagte Positionen, sobald ein Punkt in 2 Fotos gemessen ist, und für alle Punkte, sobald 3 Punkte gemessen sind.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="173"/>
+        <location filename="../ui/gcp_tasks.py" line="175"/>
         <source>Folder of photos</source>
         <translation>Fotoordner</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="176"/>
+        <location filename="../ui/gcp_tasks.py" line="178"/>
         <source>Workspace folder (new or existing)</source>
         <translation>Arbeitsbereich-Ordner (neu oder vorhanden)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="189"/>
+        <location filename="../ui/gcp_tasks.py" line="191"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
         <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="196"/>
+        <location filename="../ui/gcp_tasks.py" line="198"/>
         <source>ArchaeoOrtho: align photos</source>
         <translation>ArchaeoOrtho: Fotos ausrichten</translation>
     </message>
@@ -1458,67 +1458,67 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>{} kann nicht zum Projekt hinzugefügt werden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="203"/>
+        <location filename="../ui/gcp_tasks.py" line="205"/>
         <source>A task of this dock is still running</source>
         <translation>Eine Aufgabe dieses Fensters läuft noch</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="226"/>
+        <location filename="../ui/gcp_tasks.py" line="228"/>
         <source>Cancelled</source>
         <translation>Abgebrochen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="242"/>
+        <location filename="../ui/gcp_tasks.py" line="244"/>
         <source>The block is not aligned yet: run Align images first</source>
         <translation>Der Block ist noch nicht ausgerichtet: zuerst 'Bilder ausrichten' ausführen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="248"/>
+        <location filename="../ui/gcp_tasks.py" line="250"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>Die Ausgleichung braucht mindestens 3 Passpunkte mit Koordinaten und Messungen; vorhanden sind {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="266"/>
+        <location filename="../ui/gcp_tasks.py" line="268"/>
         <source>Outliers left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="267"/>
+        <location filename="../ui/gcp_tasks.py" line="269"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziert in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="270"/>
+        <location filename="../ui/gcp_tasks.py" line="273"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="279"/>
+        <location filename="../ui/gcp_tasks.py" line="282"/>
         <source>Not georeferenced yet.</source>
         <translation>Noch nicht georeferenziert.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="281"/>
+        <location filename="../ui/gcp_tasks.py" line="284"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Passpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="284"/>
+        <location filename="../ui/gcp_tasks.py" line="287"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Kontrollpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="287"/>
+        <location filename="../ui/gcp_tasks.py" line="290"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>Höhen sind Platzhalter: keine Höhengenauigkeit</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="289"/>
+        <location filename="../ui/gcp_tasks.py" line="292"/>
         <source>tie points {} px</source>
         <translation>Verknüpfungspunkte {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="291"/>
+        <location filename="../ui/gcp_tasks.py" line="294"/>
         <source>edited since: re-run to update</source>
         <translation>seither bearbeitet: erneut ausführen zum Aktualisieren</translation>
     </message>
@@ -1563,12 +1563,12 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>In einen GeoPackage-Layer…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="234"/>
+        <location filename="../ui/gcp_tasks.py" line="236"/>
         <source>Cancelling…</source>
         <translation>Wird abgebrochen…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="273"/>
+        <location filename="../ui/gcp_tasks.py" line="276"/>
         <source>Georeferencing with {} control points…</source>
         <translation>Georeferenzierung mit {} Passpunkten…</translation>
     </message>
@@ -1678,7 +1678,7 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>{}: nicht ausgerichtet: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="192"/>
+        <location filename="../ui/gcp_tasks.py" line="194"/>
         <source>Not aligned: {}</source>
         <translation>Nicht ausgerichtet: {}</translation>
     </message>
@@ -1713,222 +1713,222 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Neuer Punkt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="145"/>
+        <location filename="../ui/gcp_tasks.py" line="147"/>
         <source>ArchaeoOrtho: refine {} in {}</source>
         <translation>ArchaeoOrtho: {} in {} verfeinern</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="305"/>
+        <location filename="../ui/gcp_tasks.py" line="308"/>
         <source>Results loaded</source>
         <translation>Ergebnisse geladen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="312"/>
+        <location filename="../ui/gcp_tasks.py" line="315"/>
         <source>ArchaeoOrtho: load results</source>
         <translation>ArchaeoOrtho: Ergebnisse laden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="314"/>
+        <location filename="../ui/gcp_tasks.py" line="317"/>
         <source>Loading the results…</source>
         <translation>Die Ergebnisse werden geladen…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="109"/>
+        <location filename="../ui/gcp_tasks.py" line="111"/>
         <source>ArchaeoOrtho: open workspace</source>
         <translation>ArchaeoOrtho: Arbeitsbereich öffnen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="111"/>
+        <location filename="../ui/gcp_tasks.py" line="113"/>
         <source>Opening {}…</source>
         <translation>{} wird geöffnet…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="43"/>
+        <location filename="../ui/gcp_autocontrol.py" line="45"/>
         <source>Automatic control from a reference orthophoto</source>
         <translation>Automatisch aus Referenz-Orthophoto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="46"/>
+        <location filename="../ui/gcp_autocontrol.py" line="48"/>
         <source>Georeference with no hand-picked GCP: the block is matched to a reference orthophoto and takes its heights from a reference DSM. The points of the table become check points.</source>
         <translation>Georeferenzieren ohne von Hand gesetzte Passpunkte: der Block wird einem Referenz-Orthophoto zugeordnet und nimmt seine Höhen aus einem Referenz-DOM. Die Punkte der Tabelle werden Kontrollpunkte.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="52"/>
+        <location filename="../ui/gcp_autocontrol.py" line="54"/>
         <source>A reference orthophoto: a raster file, or a WMS / XYZ layer (saved for the block&apos;s extent, from the photos&apos; GPS or the map extent)</source>
         <translation>Ein Referenz-Orthophoto: eine Rasterdatei oder ein WMS-/XYZ-Layer (für die Ausdehnung des Blocks gespeichert, aus dem GPS der Fotos oder der Kartenausdehnung)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="52"/>
+        <location filename="../ui/gcp_autocontrol.py" line="54"/>
         <source>A reference DSM or DTM (heights in metres): a raster file or a WCS layer</source>
         <translation>Ein Referenz-DOM oder -DGM (Höhen in Metern): eine Rasterdatei oder ein WCS-Layer</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="61"/>
+        <location filename="../ui/gcp_autocontrol.py" line="63"/>
         <source>Reference orthophoto:</source>
         <translation>Referenz-Orthophoto:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="62"/>
+        <location filename="../ui/gcp_autocontrol.py" line="64"/>
         <source>Reference DSM:</source>
         <translation>Referenz-DOM:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="80"/>
+        <location filename="../ui/gcp_autocontrol.py" line="82"/>
         <source>Georeference from the reference orthophoto and DSM (in the background)</source>
         <translation>Aus Referenz-Orthophoto und -DOM georeferenzieren (im Hintergrund)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="101"/>
+        <location filename="../ui/gcp_autocontrol.py" line="103"/>
         <source>Automatic control: choose a reference orthophoto and a reference DSM layer</source>
         <translation>Automatische Passpunkte: ein Referenz-Orthophoto und einen Referenz-DOM-Layer wählen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="122"/>
+        <location filename="../ui/gcp_autocontrol.py" line="124"/>
         <source>Automatic control: {} automatic GCPs kept of {} matches; georeferenced in {}.</source>
         <translation>Automatische Passpunkte: {} automatische Passpunkte von {} Zuordnungen behalten; georeferenziert in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="125"/>
+        <location filename="../ui/gcp_autocontrol.py" line="127"/>
         <source>Check points: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</source>
         <translation>Kontrollpunkte: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="136"/>
+        <location filename="../ui/gcp_autocontrol.py" line="138"/>
         <source>ArchaeoOrtho: automatic control</source>
         <translation>ArchaeoOrtho: automatische Passpunkte</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="140"/>
+        <location filename="../ui/gcp_autocontrol.py" line="142"/>
         <source>Automatic control against {} and {}…</source>
         <translation>Automatische Passpunkte gegen {} und {}…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="152"/>
+        <location filename="../ui/gcp_autocontrol.py" line="154"/>
         <source>Automatic GCPs (residuals)</source>
         <translation>Automatische Passpunkte (Residuen)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="65"/>
+        <location filename="../ui/gcp_targets.py" line="66"/>
         <source>found by Find targets ({}), quality {:.2f}</source>
         <translation>von Zielmarken finden gefunden ({}), Güte {:.2f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="68"/>
+        <location filename="../ui/gcp_targets.py" line="69"/>
         <source>, {:.2f} px from the other photos&apos; rays</source>
         <translation>, {:.2f} px von den Strahlen der anderen Fotos</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="79"/>
+        <location filename="../ui/gcp_targets.py" line="80"/>
         <source>Find targets</source>
         <translation>Zielmarken finden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="85"/>
+        <location filename="../ui/gcp_targets.py" line="86"/>
         <source>Surveyed coordinates (*.csv *.txt);;All files (*)</source>
         <translation>Vermessene Koordinaten (*.csv *.txt);;Alle Dateien (*)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="86"/>
+        <location filename="../ui/gcp_targets.py" line="87"/>
         <source>A CSV name,x,y,z[,sigma_xy,sigma_z] or an ODM gcp_list.txt (its pixel columns may be absent)</source>
         <translation>Eine CSV-Datei name,x,y,z[,sigma_xy,sigma_z] oder eine ODM-gcp_list.txt (ihre Pixelspalten dürfen fehlen)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="88"/>
+        <location filename="../ui/gcp_targets.py" line="89"/>
         <source>Surveyed coordinates:</source>
         <translation>Vermessene Koordinaten:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="91"/>
+        <location filename="../ui/gcp_targets.py" line="92"/>
         <source>auto (crosses, checkerboards, circles, ArUco 4x4)</source>
         <translation>automatisch (Kreuze, Schachbretter, Kreise, ArUco 4x4)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="93"/>
+        <location filename="../ui/gcp_targets.py" line="94"/>
         <source>Target kind:</source>
         <translation>Art der Zielmarken:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="98"/>
+        <location filename="../ui/gcp_targets.py" line="99"/>
         <source>unknown</source>
         <translation>unbekannt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="99"/>
+        <location filename="../ui/gcp_targets.py" line="100"/>
         <source>The target&apos;s side or diameter: marks of another size are left out</source>
         <translation>Seitenlänge oder Durchmesser der Zielmarke: Marken anderer Größe werden ausgelassen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="100"/>
+        <location filename="../ui/gcp_targets.py" line="101"/>
         <source>Target size:</source>
         <translation>Größe der Zielmarken:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="102"/>
+        <location filename="../ui/gcp_targets.py" line="103"/>
         <source>A file that names no CRS is read in {}.</source>
         <translation>Eine Datei, die kein KBS nennt, wird in {} gelesen.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="102"/>
+        <location filename="../ui/gcp_targets.py" line="103"/>
         <source>The file must name its CRS (the table and the workspace have none).</source>
         <translation>Die Datei muss ihr KBS nennen (Tabelle und Arbeitsbereich haben keines).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="155"/>
+        <location filename="../ui/gcp_targets.py" line="156"/>
         <source>Find targets on the photos…</source>
         <translation>Zielmarken auf den Fotos finden…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="156"/>
+        <location filename="../ui/gcp_targets.py" line="157"/>
         <source>Find the surveyed targets on the aligned photos (in the background): their observations fill the table, marked as found until you confirm them (Space or Enter) or reject them (Delete or R)</source>
         <translation>Die vermessenen Zielmarken auf den ausgerichteten Fotos finden (im Hintergrund): ihre Messungen füllen die Tabelle, als gefunden markiert, bis Sie sie übernehmen (Leertaste oder Eingabe) oder verwerfen (Entf oder R)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="207"/>
+        <location filename="../ui/gcp_targets.py" line="208"/>
         <source>ArchaeoOrtho: find targets</source>
         <translation>ArchaeoOrtho: Zielmarken finden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="209"/>
+        <location filename="../ui/gcp_targets.py" line="210"/>
         <source>Looking for the targets of {} on the photos…</source>
         <translation>Die Zielmarken aus {} werden auf den Fotos gesucht…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="235"/>
+        <location filename="../ui/gcp_targets.py" line="236"/>
         <source>find targets</source>
         <translation>Zielmarken finden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="237"/>
+        <location filename="../ui/gcp_targets.py" line="238"/>
         <source>Find targets: {} of {} targets found, {} observations, in {:.0f} s.</source>
         <translation>Zielmarken finden: {} von {} Zielmarken gefunden, {} Messungen, in {:.0f} s.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="242"/>
+        <location filename="../ui/gcp_targets.py" line="243"/>
         <source>not found: {}</source>
         <translation>nicht gefunden: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="247"/>
+        <location filename="../ui/gcp_targets.py" line="248"/>
         <source>Space or Enter: confirm the found observation shown; Delete or R: reject it. Georeference uses the found observations that are not rejected, confirmed or not.</source>
         <translation>Leertaste oder Eingabe: die angezeigte gefundene Messung übernehmen; Entf oder R: sie verwerfen. Georeferenzieren verwendet die nicht verworfenen gefundenen Messungen, übernommen oder nicht.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="304"/>
+        <location filename="../ui/gcp_targets.py" line="305"/>
         <source>Every found observation is confirmed or rejected</source>
         <translation>Jede gefundene Messung ist übernommen oder verworfen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="320"/>
+        <location filename="../ui/gcp_targets.py" line="321"/>
         <source>Found by Find targets, not confirmed: Space or Enter confirms it, Delete or R rejects it (then the next one).</source>
         <translation>Von Zielmarken finden gefunden, nicht übernommen: Leertaste oder Eingabe übernimmt sie, Entf oder R verwirft sie (dann die nächste).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="343"/>
+        <location filename="../ui/gcp_targets.py" line="344"/>
         <source>{} observations found by Find targets, not confirmed: {}</source>
         <translation>{} Messungen von Zielmarken finden gefunden, nicht übernommen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="354"/>
+        <location filename="../ui/gcp_targets.py" line="355"/>
         <source>{} found observations are not confirmed yet: they are used as they are (reject the wrong ones first)</source>
         <translation>{} gefundene Messungen sind noch nicht übernommen: sie werden so verwendet, wie sie sind (verwerfen Sie zuerst die falschen)</translation>
     </message>
@@ -2172,37 +2172,37 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
 <context>
     <name>GeoreferenceAlgorithm</name>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="96"/>
+        <location filename="../processing_provider/georeference.py" line="98"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="97"/>
+        <location filename="../processing_provider/georeference.py" line="99"/>
         <source>GCP residuals</source>
         <translation>Passpunkt-Residuen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="98"/>
+        <location filename="../processing_provider/georeference.py" line="100"/>
         <source>Camera centres (world)</source>
         <translation>Projektionszentren (Welt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="195"/>
+        <location filename="../processing_provider/georeference.py" line="193"/>
         <source>outlier left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="147"/>
+        <location filename="../processing_provider/georeference.py" line="145"/>
         <source>CRS {}; control RMSE XY {} m, Z {} m; check RMSE XY {} m, Z {} m</source>
         <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="133"/>
+        <location filename="../processing_provider/run_pipeline.py" line="134"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
@@ -2212,92 +2212,92 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Aligned workspace</source>
         <translation>Ausgerichteter Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Ground control layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Check points</source>
         <translation>Kontrollpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Use EXIF GPS positions</source>
         <translation>EXIF-GPS-Positionen verwenden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Target CRS</source>
         <translation>Ziel-KBS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>GCP-Pixel auf aufrechten Fotos gemessen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="130"/>
+        <location filename="../processing_provider/georeference.py" line="134"/>
         <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS)</source>
         <translation>Passpunkte (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) angeben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Reference orthophoto</source>
         <translation>Referenz-Orthophoto</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Reference DSM</source>
         <translation>Referenz-DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Reference resolution for web layers (m, 0: auto)</source>
         <translation>Referenzauflösung für Weblayer (m, 0: auto)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Area to fetch from web layers</source>
         <translation>Aus Weblayern abzurufender Bereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="99"/>
+        <location filename="../processing_provider/georeference.py" line="101"/>
         <source>Automatic GCPs kept</source>
         <translation>Behaltene automatische Passpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="165"/>
+        <location filename="../processing_provider/georeference.py" line="163"/>
         <source>Automatic control needs both a reference orthophoto and a reference DSM (REFERENCE_ORTHO, REFERENCE_DSM); {} is missing</source>
         <translation>Automatische Passpunkte brauchen ein Referenz-Orthophoto und ein Referenz-DOM (REFERENCE_ORTHO, REFERENCE_DSM); {} fehlt</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="178"/>
+        <location filename="../processing_provider/georeference.py" line="176"/>
         <source>Target CRS {} is not used: automatic control georeferences in the reference orthophoto&apos;s CRS {}</source>
         <translation>Ziel-KBS {} wird nicht verwendet: automatische Passpunkte georeferenzieren im KBS {} des Referenz-Orthophotos</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="199"/>
+        <location filename="../processing_provider/georeference.py" line="197"/>
         <source>Automatic control: {} automatic GCPs kept; CRS {}; check RMSE XY {} m, Z {} m</source>
         <translation>Automatische Passpunkte: {} automatische Passpunkte behalten; KBS {}; Kontroll-RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="124"/>
+        <location filename="../processing_provider/georeference.py" line="129"/>
         <source>Reference DSM {} given alone (DEM control) must be a raster file on disk; a web layer is fetched only for the automatic control, with a reference orthophoto</source>
         <translation>Allein angegebenes Referenz-DOM {} (DGM-Passpunkte) muss eine Rasterdatei auf dem Datenträger sein; ein Weblayer wird nur für die automatischen Passpunkte abgerufen, mit einem Referenz-Orthophoto</translation>
     </message>
@@ -2369,17 +2369,17 @@ Ausgaben: neben den üblichen die Zahl der automatischen Passpunkte, die die Aus
         <translation>Ebene Entzerrung: 95. Perzentil ihres Versatzes gegen die wahre Lage (KBS-Einheiten)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="127"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="128"/>
         <source>RESIDUALS must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>RESIDUALS muss eine GeoPackage-Datei (.gpkg) sein, erhalten: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="141"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="143"/>
         <source>{} ({}): {:.2f} px</source>
         <translation>{} ({}): {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="109"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="110"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
@@ -2444,7 +2444,7 @@ Ausgaben: neben den üblichen die Zahl der automatischen Passpunkte, die die Aus
         <translation>Verwendete automatische Passpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="116"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="117"/>
         <source>Give ground control points observed in the image (Ground control file or Ground control point layer: GCPS, GCP_LAYER), its Known orientation (ORIENTATION) or a Reference orthophoto for automatic control (REFERENCE_ORTHO)</source>
         <translation>Im Bild gemessene Passpunkte angeben (Passpunktdatei oder Passpunktlayer: GCPS, GCP_LAYER), seine bekannte Orientierung (ORIENTATION) oder ein Referenz-Orthophoto für automatische Passpunkte (REFERENCE_ORTHO)</translation>
     </message>
@@ -2559,72 +2559,72 @@ Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und 
 <context>
     <name>PrepareImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="84"/>
+        <location filename="../processing_provider/prepare_images.py" line="85"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="84"/>
+        <location filename="../processing_provider/prepare_images.py" line="85"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="99"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Flag images below this fraction of the set&apos;s median blur score</source>
         <translation>Bilder unter diesem Bruchteil des mittleren Schärfewerts des Satzes markieren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="99"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Fiducial mark type</source>
         <translation>Art der Rahmenmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="99"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Fiducial positions</source>
         <translation>Lage der Rahmenmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="99"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Template image of one fiducial mark</source>
         <translation>Vorlagenbild einer Rahmenmarke</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="99"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Scan resolution in dpi when not in the files (0 = from the files)</source>
         <translation>Scanauflösung in dpi, wenn nicht in den Dateien (0 = aus den Dateien)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="115"/>
+        <location filename="../processing_provider/prepare_images.py" line="116"/>
         <source>Folder of prepared images</source>
         <translation>Ordner der vorbereiteten Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="116"/>
+        <location filename="../processing_provider/prepare_images.py" line="117"/>
         <source>Flagged images</source>
         <translation>Markierte Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="117"/>
+        <location filename="../processing_provider/prepare_images.py" line="118"/>
         <source>Excluded images</source>
         <translation>Ausgeschlossene Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="118"/>
+        <location filename="../processing_provider/prepare_images.py" line="119"/>
         <source>Screening record (JSON)</source>
         <translation>Prüfprotokoll (JSON)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="154"/>
+        <location filename="../processing_provider/prepare_images.py" line="156"/>
         <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
         <translation>{} Bilder: {} markiert, {} ausgeschlossen, {} im vorbereiteten Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="156"/>
+        <location filename="../processing_provider/prepare_images.py" line="158"/>
         <source>Blurriest first (blur score, % of the set&apos;s median):</source>
         <translation>Unschärfste zuerst (Schärfewert, % des Medians des Satzes):</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="164"/>
+        <location filename="../processing_provider/prepare_images.py" line="166"/>
         <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
         <translation>Vorbereitete Scans: {} x {} px, Pixelgröße {:.6g} {}{}</translation>
     </message>
@@ -2634,62 +2634,62 @@ Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und 
         <translation>Bilder vorbereiten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="150"/>
+        <location filename="../processing_provider/prepare_images.py" line="151"/>
         <source>MASKS layer &apos;{}&apos;</source>
         <translation>MASKS-Layer '{}'</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="184"/>
+        <location filename="../processing_provider/prepare_images.py" line="186"/>
         <source>feature {}</source>
         <translation>Objekt {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="188"/>
+        <location filename="../processing_provider/prepare_images.py" line="190"/>
         <source>MASKS layer &apos;{}&apos;: {} has no geometry: skipped</source>
         <translation>MASKS-Layer '{}': {} hat keine Geometrie: übersprungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="191"/>
+        <location filename="../processing_provider/prepare_images.py" line="193"/>
         <source>MASKS layer &apos;{}&apos;: {} is a {} geometry, not a polygon</source>
         <translation>MASKS-Layer '{}': {} ist eine {}-Geometrie, kein Polygon</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="84"/>
+        <location filename="../processing_provider/prepare_images.py" line="85"/>
         <source>Smallest blur score (0 = relative only)</source>
         <translation>Kleinster Schärfewert (0 = nur relativ)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="84"/>
+        <location filename="../processing_provider/prepare_images.py" line="85"/>
         <source>Leave flagged images out</source>
         <translation>Markierte Bilder weglassen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="91"/>
+        <location filename="../processing_provider/prepare_images.py" line="92"/>
         <source>Mask polygons</source>
         <translation>Maskenpolygone</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="94"/>
+        <location filename="../processing_provider/prepare_images.py" line="95"/>
         <source>Sky masks for oblique photos</source>
         <translation>Himmelsmasken für Schrägaufnahmen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="95"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Scanned film (fiducial marks)</source>
         <translation>Gescannter Film (Rahmenmarken)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <location filename="../processing_provider/prepare_images.py" line="97"/>
         <source>Fiducial coordinates (mm)</source>
         <translation>Rahmenmarken-Koordinaten (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="112"/>
+        <location filename="../processing_provider/prepare_images.py" line="113"/>
         <source>Prepared images</source>
         <translation>Vorbereitete Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="99"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Calibrated focal length (mm)</source>
         <translation>Kalibrierte Brennweite (mm)</translation>
     </message>
@@ -2930,7 +2930,7 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>Genauigkeitsbericht (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="179"/>
+        <location filename="../processing_provider/run_pipeline.py" line="180"/>
         <source>Seconds per stage: {}</source>
         <translation>Sekunden pro Stufe: {}</translation>
     </message>
@@ -3055,7 +3055,7 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>Art der Zielmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="140"/>
+        <location filename="../processing_provider/run_pipeline.py" line="141"/>
         <source>Give ground control (Ground control file or layer, or targets to find: GCPS, GCP_LAYER, TARGETS) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Geben Sie Passpunkte (Passpunktdatei oder Passpunktlayer oder zu findende Zielmarken: GCPS, GCP_LAYER, TARGETS) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
     </message>

@@ -74,12 +74,12 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
 <context>
     <name>AlgorithmBase</name>
     <message>
-        <location filename="../processing_provider/base.py" line="235"/>
+        <location filename="../processing_provider/base.py" line="240"/>
         <source>Cancelled: {}</source>
         <translation>Annullato: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/base.py" line="144"/>
+        <location filename="../processing_provider/base.py" line="149"/>
         <source>Outputs not styled: {}</source>
         <translation>Output senza stile: {}</translation>
     </message>
@@ -92,57 +92,57 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
 <context>
     <name>AlignImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>One camera for all images</source>
         <translation>Una sola camera per tutte le immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="81"/>
+        <location filename="../processing_provider/align_images.py" line="83"/>
         <source>Camera centres</source>
         <translation>Centri di presa</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="82"/>
+        <location filename="../processing_provider/align_images.py" line="84"/>
         <source>Registered images</source>
         <translation>Immagini orientate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="83"/>
+        <location filename="../processing_provider/align_images.py" line="85"/>
         <source>Mean reprojection error (px)</source>
         <translation>Errore medio di riproiezione (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="110"/>
+        <location filename="../processing_provider/align_images.py" line="112"/>
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
         <translation>Orientate {} di {} immagini, errore medio di riproiezione {:.3f} px, {} punti</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="117"/>
+        <location filename="../processing_provider/align_images.py" line="119"/>
         <source>Images not registered:</source>
         <translation>Immagini non orientate:</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="124"/>
+        <location filename="../processing_provider/align_images.py" line="126"/>
         <source>Seconds per step: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -152,49 +152,64 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
         <translation>Allinea immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Mapper</source>
         <translation>Metodo di ricostruzione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Matching image size (px)</source>
         <translation>Dimensione per la corrispondenza (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Features per image</source>
         <translation>Feature per immagine</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Affine-invariant features</source>
         <translation>Feature invarianti affini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Focal length (mm)</source>
         <translation>Focale (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Sensor width (mm)</source>
         <translation>Larghezza del sensore (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
+        <location filename="../processing_provider/align_images.py" line="66"/>
         <source>Retry images left out</source>
         <translation>Riprova le immagini escluse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="113"/>
+        <location filename="../processing_provider/align_images.py" line="115"/>
         <source>Retry {} ({} features): {} image(s) left out; main block {} -&gt; {} images{}</source>
         <translation>Nuovo tentativo {} (caratteristiche {}): {} immagine/i escluse; blocco principale {} -&gt; {} immagini{}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="113"/>
+        <location filename="../processing_provider/align_images.py" line="115"/>
         <source> (not better: the previous result kept)</source>
         <translation> (non migliore: resta il risultato precedente)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="66"/>
+        <source>Camera calibration file</source>
+        <translation>File di calibrazione della camera</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="66"/>
+        <source>Interior orientation</source>
+        <translation>Orientamento interno</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="124"/>
+        <source>Camera {}: interior orientation {} ({})</source>
+        <translation>Camera {}: orientamento interno {} ({})</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="8"/>
@@ -202,7 +217,7 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
 
 Pair selection: &apos;auto&apos; uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
 Camera model: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
-Matching image size: the longest side the images are scaled to for the features (0 = automatic: photos of up to 2 megapixels as they are, larger ones scaled to 2 megapixels; the DSM and the orthophotos use every pixel). Features per image: 0 = automatic (about 4000 per megapixel, 2048 to 4096). Affine-invariant features help with oblique views and are slower.
+Matching image size: the longest side the images are scaled to for the features (0 = automatic: photos of up to 2 megapixels as they are, larger ones scaled to 2 megapixels; the DSM and the orthophotos use every pixel). Features per image: 0 = automatic (about 4000 per megapixel, 2048 to 4096). With both at 0, a few photos are probed first: where faint, low-contrast texture (ploughed fields) starves them of features, the first pass takes 8192 fainter ones, at up to twice the size if needed (the log says so). Affine-invariant features help with oblique views and are slower.
 Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).
 Camera calibration file: a calibrated camera&apos;s interior orientation (ArchaeoOrtho&apos;s YAML/JSON, Orthority interior parameters, OpenCV, COLMAP cameras.txt or Metashape XML); several cameras are matched to the photos by their image patterns, camera model or image size; a photo of another resolution takes it scaled. A file that cannot be read stops the run before any work, naming the file, the line and the field.
 Interior orientation: what the adjustments may change of a camera: &apos;fixed&apos; keeps the given values through the alignment and the georeference (also with automatic control), &apos;refined&apos; lets the georeference refine them with the calibration&apos;s standard deviations as priors, &apos;estimated&apos; self-calibrates from them. &apos;auto&apos; is &apos;fixed&apos; where a calibration is given (the file, or film scans restituted by Prepare images) and &apos;estimated&apos; elsewhere; a camera&apos;s own &apos;adjust&apos; in the file overrides it. With &apos;fixed&apos; or &apos;refined&apos; and no file, the focal length and sensor width are the given values. The log, sfm/alignment.json and the accuracy report say per camera what was held.
@@ -212,27 +227,12 @@ Retry images left out (advanced, on): images the fast settings leave out, or a b
 
 Selezione delle coppie: 'auto' usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS.
 Modello di camera: 'AUTO' stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
-Dimensione per la corrispondenza: il lato maggiore a cui le immagini sono ridotte per le feature (0 = automatico: foto fino a 2 megapixel così come sono, quelle più grandi ridotte a 2 megapixel; il DSM e le ortofoto usano ogni pixel). Feature per immagine: 0 = automatico (circa 4000 per megapixel, da 2048 a 4096). Le feature invarianti affini aiutano con le prese oblique e sono più lente.
+Dimensione per la corrispondenza: il lato maggiore a cui le immagini sono ridotte per le feature (0 = automatico: foto fino a 2 megapixel così come sono, quelle più grandi ridotte a 2 megapixel; il DSM e le ortofoto usano ogni pixel). Feature per immagine: 0 = automatico (circa 4000 per megapixel, da 2048 a 4096). Con entrambi a 0, alcune foto vengono prima sondate: dove una tessitura debole e poco contrastata (campi arati) lascia loro poche feature, il primo passaggio ne prende 8192 più deboli, fino al doppio della dimensione se serve (il log lo dice). Le feature invarianti affini aiutano con le prese oblique e sono più lente.
 Focale e Larghezza del sensore: orientamento interno quando manca l'EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri (0 = dall'EXIF / sconosciuta).
 File di calibrazione della camera: l'orientamento interno di una camera calibrata (YAML/JSON di ArchaeoOrtho, parametri interni di Orthority, OpenCV, COLMAP cameras.txt o XML di Metashape); più camere sono assegnate alle foto secondo i loro modelli di nome, il modello della camera o la dimensione dell'immagine; una foto di altra risoluzione la riceve scalata. Un file che non si può leggere ferma l'elaborazione prima di ogni lavoro, indicando file, riga e campo.
 Orientamento interno: cosa le compensazioni possono cambiare di una camera: 'fixed' mantiene i valori dati attraverso l'allineamento e la georeferenziazione (anche con il controllo automatico), 'refined' lascia che la georeferenziazione li affini con le deviazioni standard della calibrazione come informazione a priori, 'estimated' si autocalibra a partire da essi. 'auto' è 'fixed' dove è data una calibrazione (il file, o scansioni di pellicola raddrizzate da 'Prepara immagini') e 'estimated' altrove; un 'adjust' proprio di una camera nel file ha la precedenza. Con 'fixed' o 'refined' e senza file, la lunghezza focale e la larghezza del sensore sono i valori dati. Il registro, sfm/alignment.json e il rapporto di accuratezza dicono per ogni camera cosa è stato mantenuto.
 Metodo di ricostruzione (avanzato): 'incremental' (COLMAP, predefinito) o 'global' (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).
 Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni rapide escludono, o un blocco diviso in parti, vengono riprovate con caratteristiche più ricche (più deboli per fotogrammi a basso contrasto, affini per oblique ripide) e più coppie; il registro e sfm/alignment.json dicono cosa è stato riprovato e perché.</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
-        <source>Camera calibration file</source>
-        <translation>File di calibrazione della camera</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="64"/>
-        <source>Interior orientation</source>
-        <translation>Orientamento interno</translation>
-    </message>
-    <message>
-        <location filename="../processing_provider/align_images.py" line="122"/>
-        <source>Camera {}: interior orientation {} ({})</source>
-        <translation>Camera {}: orientamento interno {} ({})</translation>
     </message>
 </context>
 <context>
@@ -319,7 +319,7 @@ Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni 
         <translation>Corrispondenze trovate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="131"/>
+        <location filename="../processing_provider/auto_control.py" line="133"/>
         <source>outlier left out: {}</source>
         <translation>valore anomalo escluso: {}</translation>
     </message>
@@ -339,12 +339,12 @@ Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni 
         <translation>Area da scaricare dai layer web</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="119"/>
+        <location filename="../processing_provider/auto_control.py" line="121"/>
         <source>Reference DSM {} given without a reference orthophoto (DEM control) must be a raster file on disk; a web layer is fetched only with a reference orthophoto</source>
         <translation>Il DSM di riferimento {} fornito senza ortofoto di riferimento (controllo DEM) deve essere un file raster su disco; un layer web viene scaricato solo con un'ortofoto di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/auto_control.py" line="123"/>
+        <location filename="../processing_provider/auto_control.py" line="125"/>
         <source>A reference DSM alone (DEM control) places the block by the photos&apos; EXIF GPS: choose Rough position auto or EXIF GPS, or give a reference orthophoto as well</source>
         <translation>Un DSM di riferimento da solo (controllo DEM) posiziona il blocco con il GPS EXIF delle foto: scegli Posizione approssimativa automatica o GPS EXIF, oppure fornisci anche un'ortofoto di riferimento</translation>
     </message>
@@ -423,7 +423,7 @@ Output: i centri di presa nel SR del riferimento, il numero di GCP automatici ma
         <translation>Punti fusi</translation>
     </message>
     <message>
-        <location filename="../processing_provider/build_dsm.py" line="89"/>
+        <location filename="../processing_provider/build_dsm.py" line="87"/>
         <source>DSM {} ({} m cells), valid fraction {}</source>
         <translation>DSM {} (celle di {} m), frazione valida {}</translation>
     </message>
@@ -1243,22 +1243,22 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Posizioni previste quando un punto è misurato in 2 foto, e per tutti i punti quando ne sono misurati 3.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="173"/>
+        <location filename="../ui/gcp_tasks.py" line="175"/>
         <source>Folder of photos</source>
         <translation>Cartella delle foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="176"/>
+        <location filename="../ui/gcp_tasks.py" line="178"/>
         <source>Workspace folder (new or existing)</source>
         <translation>Cartella dell'area di lavoro (nuova o esistente)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="189"/>
+        <location filename="../ui/gcp_tasks.py" line="191"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
         <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="196"/>
+        <location filename="../ui/gcp_tasks.py" line="198"/>
         <source>ArchaeoOrtho: align photos</source>
         <translation>ArchaeoOrtho: allinea le foto</translation>
     </message>
@@ -1458,67 +1458,67 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Impossibile aggiungere {} al progetto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="203"/>
+        <location filename="../ui/gcp_tasks.py" line="205"/>
         <source>A task of this dock is still running</source>
         <translation>Un'operazione di questo pannello è ancora in corso</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="226"/>
+        <location filename="../ui/gcp_tasks.py" line="228"/>
         <source>Cancelled</source>
         <translation>Interrotto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="242"/>
+        <location filename="../ui/gcp_tasks.py" line="244"/>
         <source>The block is not aligned yet: run Align images first</source>
         <translation>Il blocco non è ancora allineato: esegui prima 'Allinea immagini'</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="248"/>
+        <location filename="../ui/gcp_tasks.py" line="250"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>La compensazione richiede almeno 3 punti d'appoggio con coordinate e misure; ce ne sono {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="266"/>
+        <location filename="../ui/gcp_tasks.py" line="268"/>
         <source>Outliers left out: {}</source>
         <translation>Valori anomali esclusi: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="267"/>
+        <location filename="../ui/gcp_tasks.py" line="269"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziato in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="270"/>
+        <location filename="../ui/gcp_tasks.py" line="273"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="279"/>
+        <location filename="../ui/gcp_tasks.py" line="282"/>
         <source>Not georeferenced yet.</source>
         <translation>Non ancora georeferenziato.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="281"/>
+        <location filename="../ui/gcp_tasks.py" line="284"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Appoggio: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="284"/>
+        <location filename="../ui/gcp_tasks.py" line="287"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Controllo: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="287"/>
+        <location filename="../ui/gcp_tasks.py" line="290"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>le quote sono segnaposto: nessuna accuratezza verticale</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="289"/>
+        <location filename="../ui/gcp_tasks.py" line="292"/>
         <source>tie points {} px</source>
         <translation>punti di legame {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="291"/>
+        <location filename="../ui/gcp_tasks.py" line="294"/>
         <source>edited since: re-run to update</source>
         <translation>modificato da allora: riesegui per aggiornare</translation>
     </message>
@@ -1563,12 +1563,12 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Su un layer GeoPackage…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="234"/>
+        <location filename="../ui/gcp_tasks.py" line="236"/>
         <source>Cancelling…</source>
         <translation>Interruzione…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="273"/>
+        <location filename="../ui/gcp_tasks.py" line="276"/>
         <source>Georeferencing with {} control points…</source>
         <translation>Georeferenziazione con {} punti d'appoggio…</translation>
     </message>
@@ -1678,7 +1678,7 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>{}: non allineata: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="192"/>
+        <location filename="../ui/gcp_tasks.py" line="194"/>
         <source>Not aligned: {}</source>
         <translation>Non allineate: {}</translation>
     </message>
@@ -1713,222 +1713,222 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Nuovo punto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="145"/>
+        <location filename="../ui/gcp_tasks.py" line="147"/>
         <source>ArchaeoOrtho: refine {} in {}</source>
         <translation>ArchaeoOrtho: affina {} in {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="305"/>
+        <location filename="../ui/gcp_tasks.py" line="308"/>
         <source>Results loaded</source>
         <translation>Risultati caricati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="312"/>
+        <location filename="../ui/gcp_tasks.py" line="315"/>
         <source>ArchaeoOrtho: load results</source>
         <translation>ArchaeoOrtho: carica i risultati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="314"/>
+        <location filename="../ui/gcp_tasks.py" line="317"/>
         <source>Loading the results…</source>
         <translation>Caricamento dei risultati…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="109"/>
+        <location filename="../ui/gcp_tasks.py" line="111"/>
         <source>ArchaeoOrtho: open workspace</source>
         <translation>ArchaeoOrtho: apri l'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="111"/>
+        <location filename="../ui/gcp_tasks.py" line="113"/>
         <source>Opening {}…</source>
         <translation>Apertura di {}…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="43"/>
+        <location filename="../ui/gcp_autocontrol.py" line="45"/>
         <source>Automatic control from a reference orthophoto</source>
         <translation>Controllo automatico da ortofoto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="46"/>
+        <location filename="../ui/gcp_autocontrol.py" line="48"/>
         <source>Georeference with no hand-picked GCP: the block is matched to a reference orthophoto and takes its heights from a reference DSM. The points of the table become check points.</source>
         <translation>Georeferenziare senza punti d'appoggio scelti a mano: il blocco viene abbinato a un'ortofoto di riferimento e prende le quote da un DSM di riferimento. I punti della tabella diventano punti di controllo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="52"/>
+        <location filename="../ui/gcp_autocontrol.py" line="54"/>
         <source>A reference orthophoto: a raster file, or a WMS / XYZ layer (saved for the block&apos;s extent, from the photos&apos; GPS or the map extent)</source>
         <translation>Un'ortofoto di riferimento: un file raster, o un layer WMS / XYZ (salvato per l'estensione del blocco, dal GPS delle foto o dall'estensione della mappa)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="52"/>
+        <location filename="../ui/gcp_autocontrol.py" line="54"/>
         <source>A reference DSM or DTM (heights in metres): a raster file or a WCS layer</source>
         <translation>Un DSM o DTM di riferimento (quote in metri): un file raster o un layer WCS</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="61"/>
+        <location filename="../ui/gcp_autocontrol.py" line="63"/>
         <source>Reference orthophoto:</source>
         <translation>Ortofoto di riferimento:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="62"/>
+        <location filename="../ui/gcp_autocontrol.py" line="64"/>
         <source>Reference DSM:</source>
         <translation>DSM di riferimento:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="80"/>
+        <location filename="../ui/gcp_autocontrol.py" line="82"/>
         <source>Georeference from the reference orthophoto and DSM (in the background)</source>
         <translation>Georeferenzia dall'ortofoto e dal DSM di riferimento (in background)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="101"/>
+        <location filename="../ui/gcp_autocontrol.py" line="103"/>
         <source>Automatic control: choose a reference orthophoto and a reference DSM layer</source>
         <translation>Controllo automatico: scegliere un'ortofoto di riferimento e un layer DSM di riferimento</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="122"/>
+        <location filename="../ui/gcp_autocontrol.py" line="124"/>
         <source>Automatic control: {} automatic GCPs kept of {} matches; georeferenced in {}.</source>
         <translation>Controllo automatico: {} GCP automatici mantenuti su {} corrispondenze; georeferenziato in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="125"/>
+        <location filename="../ui/gcp_autocontrol.py" line="127"/>
         <source>Check points: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</source>
         <translation>Punti di controllo: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="136"/>
+        <location filename="../ui/gcp_autocontrol.py" line="138"/>
         <source>ArchaeoOrtho: automatic control</source>
         <translation>ArchaeoOrtho: controllo automatico</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="140"/>
+        <location filename="../ui/gcp_autocontrol.py" line="142"/>
         <source>Automatic control against {} and {}…</source>
         <translation>Controllo automatico rispetto a {} e {}…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="152"/>
+        <location filename="../ui/gcp_autocontrol.py" line="154"/>
         <source>Automatic GCPs (residuals)</source>
         <translation>GCP automatici (residui)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="65"/>
+        <location filename="../ui/gcp_targets.py" line="66"/>
         <source>found by Find targets ({}), quality {:.2f}</source>
         <translation>trovato da Trova i target ({}), qualità {:.2f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="68"/>
+        <location filename="../ui/gcp_targets.py" line="69"/>
         <source>, {:.2f} px from the other photos&apos; rays</source>
         <translation>, a {:.2f} px dai raggi delle altre foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="79"/>
+        <location filename="../ui/gcp_targets.py" line="80"/>
         <source>Find targets</source>
         <translation>Trova i target</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="85"/>
+        <location filename="../ui/gcp_targets.py" line="86"/>
         <source>Surveyed coordinates (*.csv *.txt);;All files (*)</source>
         <translation>Coordinate rilevate (*.csv *.txt);;Tutti i file (*)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="86"/>
+        <location filename="../ui/gcp_targets.py" line="87"/>
         <source>A CSV name,x,y,z[,sigma_xy,sigma_z] or an ODM gcp_list.txt (its pixel columns may be absent)</source>
         <translation>Un CSV name,x,y,z[,sigma_xy,sigma_z] o un gcp_list.txt di ODM (le colonne dei pixel possono mancare)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="88"/>
+        <location filename="../ui/gcp_targets.py" line="89"/>
         <source>Surveyed coordinates:</source>
         <translation>Coordinate rilevate:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="91"/>
+        <location filename="../ui/gcp_targets.py" line="92"/>
         <source>auto (crosses, checkerboards, circles, ArUco 4x4)</source>
         <translation>automatico (croci, scacchiere, cerchi, ArUco 4x4)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="93"/>
+        <location filename="../ui/gcp_targets.py" line="94"/>
         <source>Target kind:</source>
         <translation>Tipo di target:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="98"/>
+        <location filename="../ui/gcp_targets.py" line="99"/>
         <source>unknown</source>
         <translation>sconosciuta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="99"/>
+        <location filename="../ui/gcp_targets.py" line="100"/>
         <source>The target&apos;s side or diameter: marks of another size are left out</source>
         <translation>Lato o diametro del target: i segni di altra dimensione vengono esclusi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="100"/>
+        <location filename="../ui/gcp_targets.py" line="101"/>
         <source>Target size:</source>
         <translation>Dimensione dei target:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="102"/>
+        <location filename="../ui/gcp_targets.py" line="103"/>
         <source>A file that names no CRS is read in {}.</source>
         <translation>Un file che non indica un SR viene letto in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="102"/>
+        <location filename="../ui/gcp_targets.py" line="103"/>
         <source>The file must name its CRS (the table and the workspace have none).</source>
         <translation>Il file deve indicare il suo SR (la tabella e l'area di lavoro non ne hanno).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="155"/>
+        <location filename="../ui/gcp_targets.py" line="156"/>
         <source>Find targets on the photos…</source>
         <translation>Trova i target nelle foto…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="156"/>
+        <location filename="../ui/gcp_targets.py" line="157"/>
         <source>Find the surveyed targets on the aligned photos (in the background): their observations fill the table, marked as found until you confirm them (Space or Enter) or reject them (Delete or R)</source>
         <translation>Trova i target rilevati nelle foto allineate (in background): le loro misure riempiono la tabella, segnate come trovate finché non le confermi (Spazio o Invio) o le scarti (Canc o R)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="207"/>
+        <location filename="../ui/gcp_targets.py" line="208"/>
         <source>ArchaeoOrtho: find targets</source>
         <translation>ArchaeoOrtho: trova i target</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="209"/>
+        <location filename="../ui/gcp_targets.py" line="210"/>
         <source>Looking for the targets of {} on the photos…</source>
         <translation>Ricerca dei target di {} nelle foto…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="235"/>
+        <location filename="../ui/gcp_targets.py" line="236"/>
         <source>find targets</source>
         <translation>trova i target</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="237"/>
+        <location filename="../ui/gcp_targets.py" line="238"/>
         <source>Find targets: {} of {} targets found, {} observations, in {:.0f} s.</source>
         <translation>Trova i target: {} di {} target trovati, {} misure, in {:.0f} s.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="242"/>
+        <location filename="../ui/gcp_targets.py" line="243"/>
         <source>not found: {}</source>
         <translation>non trovati: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="247"/>
+        <location filename="../ui/gcp_targets.py" line="248"/>
         <source>Space or Enter: confirm the found observation shown; Delete or R: reject it. Georeference uses the found observations that are not rejected, confirmed or not.</source>
         <translation>Spazio o Invio: conferma la misura trovata mostrata; Canc o R: scartala. Georeferenzia usa le misure trovate non scartate, confermate o no.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="304"/>
+        <location filename="../ui/gcp_targets.py" line="305"/>
         <source>Every found observation is confirmed or rejected</source>
         <translation>Ogni misura trovata è confermata o scartata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="320"/>
+        <location filename="../ui/gcp_targets.py" line="321"/>
         <source>Found by Find targets, not confirmed: Space or Enter confirms it, Delete or R rejects it (then the next one).</source>
         <translation>Trovata da Trova i target, non confermata: Spazio o Invio la conferma, Canc o R la scarta (poi la prossima).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="343"/>
+        <location filename="../ui/gcp_targets.py" line="344"/>
         <source>{} observations found by Find targets, not confirmed: {}</source>
         <translation>{} misure trovate da Trova i target, non confermate: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="354"/>
+        <location filename="../ui/gcp_targets.py" line="355"/>
         <source>{} found observations are not confirmed yet: they are used as they are (reject the wrong ones first)</source>
         <translation>{} misure trovate non sono ancora confermate: vengono usate così come sono (scarta prima quelle sbagliate)</translation>
     </message>
@@ -2172,37 +2172,37 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
 <context>
     <name>GeoreferenceAlgorithm</name>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="96"/>
+        <location filename="../processing_provider/georeference.py" line="98"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="97"/>
+        <location filename="../processing_provider/georeference.py" line="99"/>
         <source>GCP residuals</source>
         <translation>Residui dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="98"/>
+        <location filename="../processing_provider/georeference.py" line="100"/>
         <source>Camera centres (world)</source>
         <translation>Centri di presa (mondo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="195"/>
+        <location filename="../processing_provider/georeference.py" line="193"/>
         <source>outlier left out: {}</source>
         <translation>valore anomalo escluso: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="147"/>
+        <location filename="../processing_provider/georeference.py" line="145"/>
         <source>CRS {}; control RMSE XY {} m, Z {} m; check RMSE XY {} m, Z {} m</source>
         <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="133"/>
+        <location filename="../processing_provider/run_pipeline.py" line="134"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
@@ -2212,92 +2212,92 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Georeferenzia</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Aligned workspace</source>
         <translation>Area di lavoro allineata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Ground control layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Check points</source>
         <translation>Punti di controllo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Use EXIF GPS positions</source>
         <translation>Usa le posizioni GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Target CRS</source>
         <translation>SR di destinazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>Pixel dei GCP misurati sulle foto raddrizzate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="130"/>
+        <location filename="../processing_provider/georeference.py" line="134"/>
         <source>Give ground control (Ground control file or layer: GCPS, GCP_LAYER) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS)</source>
         <translation>Indica i punti d'appoggio (File o Layer dei punti d'appoggio: GCPS, GCP_LAYER) e/o le posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Reference orthophoto</source>
         <translation>Ortofoto di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Reference DSM</source>
         <translation>DSM di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Reference resolution for web layers (m, 0: auto)</source>
         <translation>Risoluzione di riferimento per layer web (m, 0: auto)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="78"/>
+        <location filename="../processing_provider/georeference.py" line="80"/>
         <source>Area to fetch from web layers</source>
         <translation>Area da scaricare dai layer web</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="99"/>
+        <location filename="../processing_provider/georeference.py" line="101"/>
         <source>Automatic GCPs kept</source>
         <translation>GCP automatici mantenuti</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="165"/>
+        <location filename="../processing_provider/georeference.py" line="163"/>
         <source>Automatic control needs both a reference orthophoto and a reference DSM (REFERENCE_ORTHO, REFERENCE_DSM); {} is missing</source>
         <translation>Il controllo automatico richiede sia un'ortofoto sia un DSM di riferimento (REFERENCE_ORTHO, REFERENCE_DSM); manca {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="178"/>
+        <location filename="../processing_provider/georeference.py" line="176"/>
         <source>Target CRS {} is not used: automatic control georeferences in the reference orthophoto&apos;s CRS {}</source>
         <translation>Il SR di destinazione {} non è usato: il controllo automatico georeferenzia nel SR {} dell'ortofoto di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="199"/>
+        <location filename="../processing_provider/georeference.py" line="197"/>
         <source>Automatic control: {} automatic GCPs kept; CRS {}; check RMSE XY {} m, Z {} m</source>
         <translation>Controllo automatico: {} GCP automatici mantenuti; SR {}; RMSE di controllo XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="124"/>
+        <location filename="../processing_provider/georeference.py" line="129"/>
         <source>Reference DSM {} given alone (DEM control) must be a raster file on disk; a web layer is fetched only for the automatic control, with a reference orthophoto</source>
         <translation>Il DSM di riferimento {} fornito da solo (controllo DEM) deve essere un file raster su disco; un layer web viene scaricato solo per il controllo automatico, con un'ortofoto di riferimento</translation>
     </message>
@@ -2369,17 +2369,17 @@ Output: oltre ai consueti, il numero di GCP automatici mantenuti dalla compensaz
         <translation>Raddrizzamento piano: 95° percentile del suo scostamento dalla posizione vera (unità del SR)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="127"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="128"/>
         <source>RESIDUALS must be a GeoPackage (.gpkg) file, got {}</source>
         <translation>RESIDUALS deve essere un file GeoPackage (.gpkg), ricevuto {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="141"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="143"/>
         <source>{} ({}): {:.2f} px</source>
         <translation>{} ({}): {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="109"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="110"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
@@ -2444,7 +2444,7 @@ Output: oltre ai consueti, il numero di GCP automatici mantenuti dalla compensaz
         <translation>GCP automatici usati</translation>
     </message>
     <message>
-        <location filename="../processing_provider/orthorectify_image.py" line="116"/>
+        <location filename="../processing_provider/orthorectify_image.py" line="117"/>
         <source>Give ground control points observed in the image (Ground control file or Ground control point layer: GCPS, GCP_LAYER), its Known orientation (ORIENTATION) or a Reference orthophoto for automatic control (REFERENCE_ORTHO)</source>
         <translation>Indicare punti d'appoggio misurati nell'immagine (File dei punti d'appoggio o Layer dei punti d'appoggio: GCPS, GCP_LAYER), il suo orientamento noto (ORIENTATION) o un'ortofoto di riferimento per il controllo automatico (REFERENCE_ORTHO)</translation>
     </message>
@@ -2559,72 +2559,72 @@ Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui
 <context>
     <name>PrepareImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="84"/>
+        <location filename="../processing_provider/prepare_images.py" line="85"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="84"/>
+        <location filename="../processing_provider/prepare_images.py" line="85"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="99"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Flag images below this fraction of the set&apos;s median blur score</source>
         <translation>Segnala le immagini sotto questa frazione del punteggio di nitidezza mediano dell'insieme</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="99"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Fiducial mark type</source>
         <translation>Tipo di marca fiduciale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="99"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Fiducial positions</source>
         <translation>Posizioni delle marche fiduciali</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="99"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Template image of one fiducial mark</source>
         <translation>Immagine modello di una marca fiduciale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="99"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Scan resolution in dpi when not in the files (0 = from the files)</source>
         <translation>Risoluzione di scansione in dpi se non nei file (0 = dai file)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="115"/>
+        <location filename="../processing_provider/prepare_images.py" line="116"/>
         <source>Folder of prepared images</source>
         <translation>Cartella delle immagini preparate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="116"/>
+        <location filename="../processing_provider/prepare_images.py" line="117"/>
         <source>Flagged images</source>
         <translation>Immagini segnalate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="117"/>
+        <location filename="../processing_provider/prepare_images.py" line="118"/>
         <source>Excluded images</source>
         <translation>Immagini escluse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="118"/>
+        <location filename="../processing_provider/prepare_images.py" line="119"/>
         <source>Screening record (JSON)</source>
         <translation>Registro del controllo (JSON)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="154"/>
+        <location filename="../processing_provider/prepare_images.py" line="156"/>
         <source>{} images: {} flagged, {} excluded, {} in the prepared folder</source>
         <translation>{} immagini: {} segnalate, {} escluse, {} nella cartella preparata</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="156"/>
+        <location filename="../processing_provider/prepare_images.py" line="158"/>
         <source>Blurriest first (blur score, % of the set&apos;s median):</source>
         <translation>Le più sfocate per prime (punteggio di nitidezza, % della mediana dell'insieme):</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="164"/>
+        <location filename="../processing_provider/prepare_images.py" line="166"/>
         <source>Prepared scans: {} x {} px, pixel size {:.6g} {}{}</source>
         <translation>Scansioni preparate: {} x {} px, dimensione del pixel {:.6g} {}{}</translation>
     </message>
@@ -2634,62 +2634,62 @@ Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui
         <translation>Prepara immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="150"/>
+        <location filename="../processing_provider/prepare_images.py" line="151"/>
         <source>MASKS layer &apos;{}&apos;</source>
         <translation>layer MASKS '{}'</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="184"/>
+        <location filename="../processing_provider/prepare_images.py" line="186"/>
         <source>feature {}</source>
         <translation>elemento {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="188"/>
+        <location filename="../processing_provider/prepare_images.py" line="190"/>
         <source>MASKS layer &apos;{}&apos;: {} has no geometry: skipped</source>
         <translation>layer MASKS '{}': {} non ha geometria: saltato</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="191"/>
+        <location filename="../processing_provider/prepare_images.py" line="193"/>
         <source>MASKS layer &apos;{}&apos;: {} is a {} geometry, not a polygon</source>
         <translation>layer MASKS '{}': {} è una geometria {}, non un poligono</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="84"/>
+        <location filename="../processing_provider/prepare_images.py" line="85"/>
         <source>Smallest blur score (0 = relative only)</source>
         <translation>Punteggio di nitidezza minimo (0 = solo relativo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="84"/>
+        <location filename="../processing_provider/prepare_images.py" line="85"/>
         <source>Leave flagged images out</source>
         <translation>Escludi le immagini segnalate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="91"/>
+        <location filename="../processing_provider/prepare_images.py" line="92"/>
         <source>Mask polygons</source>
         <translation>Poligoni di maschera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="94"/>
+        <location filename="../processing_provider/prepare_images.py" line="95"/>
         <source>Sky masks for oblique photos</source>
         <translation>Maschere del cielo per foto oblique</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="95"/>
+        <location filename="../processing_provider/prepare_images.py" line="96"/>
         <source>Scanned film (fiducial marks)</source>
         <translation>Pellicola scansionata (marche fiduciali)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="96"/>
+        <location filename="../processing_provider/prepare_images.py" line="97"/>
         <source>Fiducial coordinates (mm)</source>
         <translation>Coordinate delle marche fiduciali (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="112"/>
+        <location filename="../processing_provider/prepare_images.py" line="113"/>
         <source>Prepared images</source>
         <translation>Immagini preparate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/prepare_images.py" line="99"/>
+        <location filename="../processing_provider/prepare_images.py" line="100"/>
         <source>Calibrated focal length (mm)</source>
         <translation>Focale calibrata (mm)</translation>
     </message>
@@ -2930,7 +2930,7 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Rapporto di accuratezza (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="179"/>
+        <location filename="../processing_provider/run_pipeline.py" line="180"/>
         <source>Seconds per stage: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -3055,7 +3055,7 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Tipo di target</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="140"/>
+        <location filename="../processing_provider/run_pipeline.py" line="141"/>
         <source>Give ground control (Ground control file or layer, or targets to find: GCPS, GCP_LAYER, TARGETS) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Indicare punti di appoggio (File o Layer dei punti d'appoggio, o target da trovare: GCPS, GCP_LAYER, TARGETS) e/o posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
     </message>

@@ -26,7 +26,7 @@ CHOICES_CONTEXT = "Choices"  # processing_provider/params.CHOICES_CONTEXT
 CHOICE_LISTS = (
     ("processing_provider/params.py", ("PAIRINGS", "MAPPERS", "INTRINSICS", "QUALITIES", "BLENDINGS",
                                        "INTERPOLATIONS")),
-    ("processing_provider/prepare_images.py", ("FIDUCIAL_TYPES", "FIDUCIAL_LAYOUTS")),
+    ("core/prepare/options.py", ("FIDUCIAL_TYPES", "LAYOUT_NAMES")),
     ("core/terrain/options.py", ("VISUALISATIONS",)),
 )
 

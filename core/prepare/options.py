@@ -8,8 +8,8 @@ from typing import Optional, Sequence
 from ..common.errors import ArchaeoOrthoError
 
 ANALYSIS_SIZE = 1024  # long side (px) at which screening measures every image
-MARK_KINDS = ("cross", "dot", "ring_dot", "cross_ring")  # the fiducial marks core.prepare.scans finds
-FIDUCIAL_TYPES = ("auto",) + MARK_KINDS
+FIDUCIAL_TYPES = ("auto", "cross", "dot", "ring_dot", "cross_ring")  # literal: i18n/make_catalog.py reads it
+MARK_KINDS = FIDUCIAL_TYPES[1:]  # the fiducial marks core.prepare.scans finds
 LAYOUT_NAMES = ("auto", "corners", "sides", "eight")  # where the marks are (core.prepare.scans.LAYOUTS)
 Y_AXES = ("auto", "down", "up")  # the mask polygons' y axis: rows down, or y = -row (the QGIS georeferencer)
 
