@@ -22,8 +22,8 @@ from .surface import Dsm
 PLANNING_GSD = 4.0  # planning cell = 4 x GSD ...
 # ... and a photo spans at most about this many planning cells (its long side): the plan (which image, seams, raised
 # objects) is about the scene's objects, not the photo's pixels, so a larger photo of the same ground gets no finer
-# plan (toledo_2400's 2400 px photos plan at 8 GSD, the same 0.6 m cells as its 1200 px copies at 4 GSD: planning
-# 18.6 -> 5.8 s, the seam step 7.0 -> 6.3 %; docs/measurements.md); the tiles still feather and sample every cell
+# plan (2400 px photos plan at 8 GSD, the same cells on the ground as their 1200 px copies at 4 GSD; the figures
+# are in docs/measurements.md); the tiles still feather and sample every cell
 PLANNING_MAX_CELLS_ACROSS = 300
 MAX_PLANNING_CELLS = 4096 * 4096
 
