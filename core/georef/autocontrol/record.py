@@ -49,7 +49,7 @@ def _checks_in(check_points: Optional[GCPSet], crs: str) -> List[GroundPoint]:
                         list(p.observations)) for p, a in zip(pts, xyz)]
 
 
-def coarse_hint(figures: Dict, g: float, opt: AutoControlOptions) -> str:
+def coarse_hint(figures: Dict, match_gsd: float, opt: AutoControlOptions) -> str:
     """': the reference is too coarse for a block this small ...' when the block spans fewer reference pixels
     than one matching tile (the per-tile affine, the spread of the candidates: the block is a handful of the
     reference's features), else ''."""
@@ -57,7 +57,7 @@ def coarse_hint(figures: Dict, g: float, opt: AutoControlOptions) -> str:
     if not 0.0 < px < opt.tile_px:
         return ""
     return (f": the reference is too coarse for a block this small (the block spans {px:.0f} of its pixels, the "
-            f"match ran at {g:.3g} per pixel; a reference with cells {opt.tile_px / px:.1f} x finer, or a larger "
+            f"match ran at {match_gsd:.3g} per pixel; a reference with cells {opt.tile_px / px:.1f} x finer, or a larger "
             "block, gives enough matches)")
 
 

@@ -151,21 +151,21 @@ def _prior(ws, rec, photos, reference, opt: AutoControlOptions, progress, messag
     return _coarse_prior(rec, photos, reference, opt, progress, messages)
 
 
-def check_block_pixels(ext, g: float, reference: Reference, photo_gsd: float, opt: AutoControlOptions) -> None:
+def check_block_pixels(ext, match_gsd: float, reference: Reference, photo_gsd: float, opt: AutoControlOptions) -> None:
     """AutoControlError, before the match, when the block spans fewer pixels of the match's grid than one tile
     of the per-tile affine (``opt.tile_px``): a handful of the reference's features, too few to place the block
     (Toledo's 150 m FC300X block against a 2 m orthophoto: 107 pixels, 16 matches, and a block placed 67 m off
     by a repeated pattern of houses, or 2 candidates)."""
     side = max(ext[2] - ext[0], ext[3] - ext[1])
-    px = side / g
+    px = side / match_gsd
     if px >= opt.tile_px:
         return
     name, metres = linear_unit(reference.crs_wkt)
     unit = "m" if metres == 1.0 else name or "units"
     what = (f"the reference orthophoto {reference.ortho_path} is too coarse for a block this small"
-            if g <= reference.gsd * 1.0001 else
+            if match_gsd <= reference.gsd * 1.0001 else
             f"the photos' ground resolution ({photo_gsd:.3g} {unit}) is too coarse for a block this small")
-    raise AutoControlError(f"{what}: the block spans {side:.0f} {unit}, {px:.0f} pixels of {g:.3g} {unit}, and the "
+    raise AutoControlError(f"{what}: the block spans {side:.0f} {unit}, {px:.0f} pixels of {match_gsd:.3g} {unit}, and the "
                            f"automatic control needs at least {opt.tile_px} (one tile of its per-tile match); use a "
                            f"reference with cells of {side / opt.tile_px:.2g} {unit} or finer, a larger block, or "
                            "hand-picked control points")
