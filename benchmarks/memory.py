@@ -42,6 +42,7 @@ from _util import tree_rss  # noqa: E402
 
 RELIEF_KEYS = ("svf", "slrm", "mhs", "vat")
 GIB = 2 ** 30
+FOCAL_PX = [0.0]  # --focal-px, passed to the children (0: the alignment's default, EXIF or a guess)
 
 
 # ---------------------------------------------------------------- measuring a child
@@ -148,7 +149,7 @@ def child(args):
     elif args.stage == "align":
         from core.align.options import AlignOptions
         from core.align.stage import align
-        align(args.src, args.out, AlignOptions(), progress=p)
+        align(args.src, args.out, AlignOptions(focal_px=args.focal_px or None), progress=p)
     elif args.stage == "georeference":
         from core.georef.options import GeorefOptions
         from core.georef.stage import georeference_workspace
@@ -180,7 +181,8 @@ def child(args):
 
 
 def run_stage(root, stage, src, out, logdir):
-    cmd = [sys.executable, os.path.abspath(__file__), "--child", stage, "--src", src, "--out", out, "--root", root]
+    cmd = [sys.executable, os.path.abspath(__file__), "--child", stage, "--src", src, "--out", out, "--root", root,
+           "--focal-px", str(FOCAL_PX[0])]
     log = os.path.join(logdir, f"{stage}.log")
     rc, wall, cpu, rss = measure(cmd, log)
     if rc != 0:
@@ -314,6 +316,8 @@ def main():
     ap.add_argument("--stages", default="align,georeference,dsm,orthophoto,terrain,relief,report")
     ap.add_argument("--relief", default=",".join(RELIEF_KEYS), help="terrain mode: the relief visualisations")
     ap.add_argument("--compare", action="store_true", help="terrain mode: products of root 1 against root 2")
+    ap.add_argument("--focal-px", type=float, default=0.0,
+                    help="chain mode: the focal length in pixels given to the alignment (photos without EXIF)")
     ap.add_argument("--child", help=argparse.SUPPRESS)
     ap.add_argument("--src", help=argparse.SUPPRESS)
     ap.add_argument("--out", help=argparse.SUPPRESS)
@@ -323,6 +327,7 @@ def main():
         args.root = os.path.abspath(args.root[0])
         return child(args)
     args.root = [os.path.abspath(r) for r in (args.root or [ROOT])]
+    FOCAL_PX[0] = args.focal_px
     args.workdir = os.path.abspath(args.workdir)
     args.relief = [k for k in args.relief.split(",") if k]
     return terrain(args) if args.mode == "terrain" else chain(args)
