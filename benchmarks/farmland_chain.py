@@ -139,10 +139,18 @@ def pycolmap_reference(args, images):
 
 # ---------------------------------------------------------------- 3. judge
 
-def blunders(z, limit, size=15):
+def blunders(z, limit, size=15, mask=None):
+    """benchmarks/dense.py's count (tests/test_dense_lowtexture.py's blunder_count), or its cells within ``mask``."""
+    from scipy import ndimage
+
     from tests.test_dense_lowtexture import blunder_count
 
-    return blunder_count(z, limit, size)
+    if mask is None:
+        return blunder_count(z, limit, size)
+    have = np.isfinite(z)
+    idx = ndimage.distance_transform_edt(~have, return_distances=False, return_indices=True)
+    zf = z[tuple(idx)]
+    return int(((np.abs(zf - ndimage.median_filter(zf, size=size)) > limit) & have & mask).sum())
 
 
 def judge(args):
@@ -176,7 +184,7 @@ def judge(args):
     res = ((wsj.get("stages") or {}).get("dsm") or {}).get("results") or {}
     if res:
         print(f"DSM stage record: measured {res.get('MEASURED_FRACTION'):.3f}, interpolated "
-              f"{res.get('INTERPOLATED_FRACTION'):.3f}, removed {res.get('REMOVED_FRACTION'):.4f} "
+              f"{res.get('INTERPOLATED_FRACTION'):.3f}, removed {res.get('REMOVED_FRACTION'):.2g} "
               f"({res.get('removed_cells')} cells) of the cameras' hull; {res.get('width')} x {res.get('height')} "
               f"cells at {res.get('resolution')} m; {res.get('pairs')} pairs")
         outs = wsj["stages"]["dsm"].get("outputs") or {}
@@ -232,8 +240,13 @@ def _dsm_truth(block, dsm_path, src_path, gsd, syn, raster):
             print(f"  {name}, {label}: RMSE {rmse:.3f} m = {rmse / gsd:.2f} GSD (goal <= {GOALS['rmse_gsd']:g}), "
                   f"median |dz| {np.median(np.abs(e)) / gsd:.2f} GSD, 95 % {np.percentile(np.abs(e), 95) / gsd:.2f}"
                   " GSD")
+    far = np.zeros(z.shape, bool)  # the fields 3 m away from the road, trees and building: a step there is a blunder
+    for r0 in range(0, h, 512):
+        far[r0:r0 + 512] = block.scene.field_mask(x[r0:r0 + 512], y[r0:r0 + 512], margin=3.0)
     print(f"  blunders: {blunders(z, 3.0)} cells > 3 m and {blunders(z, 5.0)} > 5 m from their 15 x 15 median "
-          f"(the trees and the building included)")
+          f"(the trees and the building included); on the fields 3 m from them: {blunders(z, 3.0, mask=far)} and "
+          f"{blunders(z, 5.0, mask=far)}; field cells > 1 m off the truth (plane removed): "
+          f"{int((np.abs(np.nan_to_num(flat)) > 1.0).sum())}")
 
 
 def _read_json(path):
