@@ -20,6 +20,13 @@ Three steps (each skips what an earlier run left):
     nice -n 19 python benchmarks/farmland_chain.py --contrast 0.3 --workdir /work/bench33 [--jobs 2]
         [--steps render,chain,pycolmap,judge] [--small]
 
+The DSM stage again at quality full on a copy of the workspace, judged:
+
+    nice -n 19 python benchmarks/memory.py chain --images <folder>/images --workdir <folder>/chain --reuse \
+        --stages dsm --dsm-quality full
+    nice -n 19 python benchmarks/farmland_chain.py --contrast 0.3 --workdir /work/bench33 --steps judge \
+        --judge-run chain-0-reuse
+
 (``pycolmap``, not run by default: pycolmap's default pipeline on the same photos, benchmarks/align.py's, the
 reference of the alignment's CPU-s and registered photos.)
 
@@ -159,7 +166,7 @@ def judge(args):
 
     block = block_of(args)
     chain_dir = os.path.join(folder_of(args), "chain")
-    ws = os.path.join(chain_dir, "chain-0", "ws")
+    ws = os.path.join(chain_dir, args.judge_run, "ws")
     stages_path = os.path.join(chain_dir, "stages.json")
     rows = json.load(open(stages_path)) if os.path.isfile(stages_path) else []
     gsd = block.gsd
@@ -191,7 +198,7 @@ def judge(args):
         dsm_path = os.path.join(ws, outs.get("dsm", ""))
         if os.path.isfile(dsm_path):
             _dsm_truth(block, dsm_path, os.path.join(ws, outs.get("dsm_source", "")), gsd, syn, raster)
-    ortho = os.path.join(chain_dir, "chain-0", "orthophoto.log")
+    ortho = os.path.join(chain_dir, args.judge_run, "orthophoto.log")
     if os.path.isfile(ortho):
         for line in open(ortho):
             if line.startswith("RADIOMETRY"):
@@ -269,6 +276,9 @@ def main():
     ap.add_argument("--small", action="store_true", help="the fast test's block (10 photos of 640 x 480): a trial")
     ap.add_argument("--steps", default="render,chain,judge")
     ap.add_argument("--stages", default="", help="memory.py's --stages (default: all)")
+    ap.add_argument("--judge-run", default="chain-0",
+                    help="judge: the run under <folder>/chain (chain-0-reuse: memory.py chain --reuse's, e.g. the "
+                         "DSM at another --dsm-quality)")
     ap.add_argument("--render-part", type=int, default=-1, help=argparse.SUPPRESS)
     args = ap.parse_args()
     args.workdir = os.path.abspath(args.workdir)

@@ -42,6 +42,7 @@ from _util import tree_rss  # noqa: E402
 
 RELIEF_KEYS = ("svf", "slrm", "mhs", "vat")
 GIB = 2 ** 30
+DSM_QUALITY = [""]  # --dsm-quality, passed to the children ("": the DSM stage's default)
 FOCAL_PX = [0.0]  # --focal-px, passed to the children (0: the alignment's default, EXIF or a guess)
 
 
@@ -157,8 +158,9 @@ def child(args):
         kw = {"camera_positions_path": positions} if os.path.isfile(positions) else {"use_exif_gps": True}
         georeference_workspace(args.out, GeorefOptions(**kw), progress=p)
     elif args.stage == "dsm":
+        from core.dense.options import DenseOptions
         from core.dense.stage import build_dsm_workspace
-        build_dsm_workspace(args.out, progress=p)
+        build_dsm_workspace(args.out, DenseOptions(quality=args.dsm_quality) if args.dsm_quality else None, progress=p)
     elif args.stage == "orthophoto":
         from core.ortho.stage import build_orthophoto_workspace
         r = build_orthophoto_workspace(args.out, progress=p)
@@ -182,7 +184,7 @@ def child(args):
 
 def run_stage(root, stage, src, out, logdir):
     cmd = [sys.executable, os.path.abspath(__file__), "--child", stage, "--src", src, "--out", out, "--root", root,
-           "--focal-px", str(FOCAL_PX[0])]
+           "--focal-px", str(FOCAL_PX[0]), "--dsm-quality", DSM_QUALITY[0]]
     log = os.path.join(logdir, f"{stage}.log")
     rc, wall, cpu, rss = measure(cmd, log)
     if rc != 0:
@@ -318,6 +320,7 @@ def main():
     ap.add_argument("--compare", action="store_true", help="terrain mode: products of root 1 against root 2")
     ap.add_argument("--focal-px", type=float, default=0.0,
                     help="chain mode: the focal length in pixels given to the alignment (photos without EXIF)")
+    ap.add_argument("--dsm-quality", default="", help="chain mode: the DSM stage's quality (default: its own)")
     ap.add_argument("--child", help=argparse.SUPPRESS)
     ap.add_argument("--src", help=argparse.SUPPRESS)
     ap.add_argument("--out", help=argparse.SUPPRESS)
@@ -328,6 +331,7 @@ def main():
         return child(args)
     args.root = [os.path.abspath(r) for r in (args.root or [ROOT])]
     FOCAL_PX[0] = args.focal_px
+    DSM_QUALITY[0] = args.dsm_quality
     args.workdir = os.path.abspath(args.workdir)
     args.relief = [k for k in args.relief.split(",") if k]
     return terrain(args) if args.mode == "terrain" else chain(args)
