@@ -6,6 +6,7 @@ import os
 import numpy as np
 import pytest
 
+from core.dense import blunders
 from core.dense import grid as gridding
 from core.dense import stage as dense
 from core.dense.options import DenseOptions
@@ -38,7 +39,7 @@ def test_find_blunders_removes_lone_pits_and_keeps_what_several_views_confirm():
     edge[:, -4:] = True  # the block's edge: one image, the ground's height (kept)
     views[edge] = 1
     dsm[190:193, 236:239] -= 17.0  # a deep pit at the edge (the demo's)
-    out = gridding.find_blunders(dsm, views, gsd)
+    out = blunders.find_blunders(dsm, views, gsd)
     for y, x in pits:
         assert out[y:y + 3, x:x + 3].all(), (y, x)
     assert out[190:193, 236:239].all()
@@ -46,6 +47,47 @@ def test_find_blunders_removes_lone_pits_and_keeps_what_several_views_confirm():
     assert not out[edge & ~np.isin(np.arange(200), range(190, 193))[:, None]].any()
     assert out.sum() == 4 * 9 + 9 + int(out[99:101, 60:110].sum())
     assert out[99:101, 60:110].mean() < 0.2  # the building's edge mostly stays
+
+
+def test_pits_that_few_or_disagreeing_views_hold_are_removed_and_a_confirmed_building_stays():
+    """The demo's surviving pits (issue 33 item 3): single-view pits inside a tree crown, where the crown's spread
+    hides them from the robust-surface test; a streak of single-view pits along the data's edge; a pit in a roof
+    that two images hold (the two images of one pair: one wrong match).  A building, a courtyard and a pit that
+    several images confirm, the ground one image sees beside the building and a ditch stay."""
+    gsd = 0.05
+    tol = 4 * gsd  # the height within which a view confirms a cell
+    r, c = np.mgrid[0:240, 0:240].astype(np.float32)
+    dsm = 100.0 + 0.01 * c + 0.5 * np.sin(r / 30.0)
+    views = np.full(dsm.shape, 5, np.uint8)
+    crown = (r - 60) ** 2 + (c - 60) ** 2 < 30 ** 2  # a rough crown, 6-18 m
+    dsm[crown] += 6.0 + 12.0 * ((r[crown] * 7 + c[crown] * 13) % 5) / 4
+    views[crown] = 2
+    dsm[150:200, 120:180] += 9.0  # a building that several images confirm...
+    dsm[165:175, 140:150] -= 9.0  # ... round a courtyard they confirm too
+    dsm[100:103, 200:203] -= 4.0  # and a pit they confirm (a well)
+    dsm[60:140, 215] -= 2.0  # a ditch
+    views[150:200, 118:120] = 1  # the ground beside the building: one view
+    bad = np.zeros(dsm.shape, bool)
+    for y, x in ((50, 50), (70, 62), (58, 75), (45, 66)):  # single-view pits in the crown, 6-18 m deep
+        bad[y:y + 2, x:x + 2] = True
+        views[y:y + 2, x:x + 2] = 1
+    bad[185:188, 128:130] = True  # a pit in the roof two images hold
+    views[185:188, 128:130] = 2
+    dsm[bad] = 100.0 + 0.01 * c[bad]  # the ground's height
+    dsm[:, 234:] = np.nan  # the data's edge, and a streak of single-view pits along it
+    for k in range(8):
+        dsm[20 + k, 233 - (k % 2)] -= 15.0
+        views[20 + k, 233 - (k % 2)] = 1
+        bad[20 + k, 233 - (k % 2)] = True
+    out = blunders.find_blunders(dsm, views, gsd, tol)
+    missed = np.argwhere(bad & ~out)
+    assert len(missed) == 0, missed[:10]
+    kept = np.zeros(dsm.shape, bool)
+    kept[150:200, 118:180] = True  # the building, the courtyard and the ground one view sees beside it
+    kept[98:105, 198:205] = True
+    kept[55:145, 212:219] = True
+    assert not (out & kept & ~bad).any()
+    assert (out & ~bad).sum() <= 0.01 * bad.sum() + 2
 
 
 def blunder_count(z: np.ndarray, limit: float, size: int = 15) -> int:

@@ -1,6 +1,6 @@
 """The DSM from the fused points: rasterised, cleaned (speckles, blunders), its holes filled inside the camera
 centres' hull, written as a COG with its source raster (1 measured, 2 interpolated, 3 removed as a blunder:
-:func:`grid.find_blunders`, 0 nodata) beside it."""
+:func:`blunders.find_blunders`, 0 nodata) beside it."""
 from __future__ import annotations
 
 import os
@@ -12,6 +12,7 @@ import numpy as np
 from ..common.progress import Progress, SubProgress, check_cancel
 from ..io import raster
 from . import grid as gridding
+from .blunders import find_blunders
 from .grid import PointFile
 from .options import DenseOptions
 from .pairs import View
@@ -46,9 +47,10 @@ def write_dsm(target: DsmTarget, point_files: List[PointFile], views: Dict[int, 
                                              progress=SubProgress(progress, 0.88, 0.92))
     del _counts
     dsm = gridding.remove_speckles(dsm, max_cells=4)
-    # blunders: cells fewer than two images confirm, far from the robust surface of those that are confirmed
+    # blunders: cells fewer than two images confirm, far from the robust surface or the heights of those that are
+    # confirmed; small pits fewer than three confirm
     views_ok = gridding.supporting_views(point_files, grid, offset, dsm, cluster_tol)
-    removed = gridding.find_blunders(dsm, views_ok, gsd)
+    removed = find_blunders(dsm, views_ok, gsd, cluster_tol)
     del views_ok
     dsm[removed] = np.nan
     measured = np.isfinite(dsm)

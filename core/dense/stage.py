@@ -10,8 +10,9 @@
    centres filled by a smooth 2.5-D surface up to ``fill_max_distance`` from the data; a float32
    Cloud-Optimized GeoTIFF with overviews in the workspace CRS, written atomically
    (:mod:`core.io.raster`), and beside it ``dense/dsm-source.tif`` on the same grid: 1 = measured, 2 =
-   interpolated (every filled cell), 3 = removed (a blunder, :func:`.grid.find_blunders`: a cell fewer than two
-   images confirm, far from the robust surface of those that are confirmed; interpolated where a fill reaches),
+   interpolated (every filled cell), 3 = removed (a blunder, :func:`.blunders.find_blunders`: a cell fewer than two
+   images confirm, far from the robust surface of those that are confirmed, or a small pit fewer than three
+   confirm; interpolated where a fill reaches),
    0 = nodata.  Optionally a LAS 1.2 point cloud with RGB.
 
 Engine ``cuda`` runs COLMAP's patch-match stereo and fusion instead of 2-3 (:mod:`.points`; only where
