@@ -595,7 +595,7 @@ class Radiometry:
     ``1 + hot * exp(-theta^2 / (2 hot_width^2))`` (theta = angle between the view ray and the direction the
     sunlight travels: the sun at ``sun_azimuth_deg`` (from local +x towards +y) and ``sun_elevation_deg``), and
     per image an exposure gain exp(N(0, exposure_sigma)) times a linear ramp of +-``ramp`` across the image in a
-    random direction (light that changed between the photos)."""
+    random direction (light that changed between the photos), and with ``bend`` a soft edge of light across it."""
 
     k1: float = -0.25
     k2: float = 0.05
@@ -605,6 +605,7 @@ class Radiometry:
     sun_elevation_deg: float = 65.0
     exposure_sigma: float = 0.08
     ramp: float = 0.03
+    bend: float = 0.0  # per image a soft edge of light, 1 + bend * tanh(2 t), in another random direction
 
     def falloff(self, r: np.ndarray) -> np.ndarray:
         r2 = np.asarray(r, dtype=float) ** 2
@@ -628,7 +629,13 @@ class Radiometry:
         jj, ii = np.meshgrid(np.arange(camera.width) + 0.5, np.arange(camera.height) + 0.5)
         t = ((jj - camera.width / 2) * math.cos(a) + (ii - camera.height / 2) * math.sin(a)) / (0.5 * math.hypot(
             camera.width, camera.height))
-        return (g * (1.0 + self.ramp * t)).astype(np.float32)
+        gain = g * (1.0 + self.ramp * t)
+        if self.bend:  # a cloud's soft shadow edge across the photo: not a ramp, not a quadratic
+            b = rng.uniform(0.0, 2 * math.pi)
+            t2 = ((jj - camera.width / 2) * math.cos(b) + (ii - camera.height / 2) * math.sin(b)) / (0.5 * math.hypot(
+                camera.width, camera.height))
+            gain = gain * (1.0 + self.bend * np.tanh(2.0 * t2))
+        return gain.astype(np.float32)
 
     def pixel_falloff(self, camera: CameraModel) -> np.ndarray:
         jj, ii = np.meshgrid(np.arange(camera.width) + 0.5, np.arange(camera.height) + 0.5)

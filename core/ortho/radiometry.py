@@ -7,8 +7,9 @@ The model, in the log of the grey value of ground point p in image i of camera g
 
 with f_g(r) = a1 r^2 + a2 r^4 + a3 r^6 (r: distance from the principal point / the half diagonal), theta the angle
 between the view ray and the direction the sunlight travels (one direction and width s for the block, found by a
-grid search), b_i one exposure per image, and phi = (1, u, v, u^2, uv, v^2) a low-order field over the image
-(u, v in -1..1), fitted last and held near 1.  The unknown ground L(p) cancels in the differences of two images
+grid search), b_i one exposure per image, and phi = (1, u, v, u^2, uv, v^2, u^3, u^2 v, u v^2, v^3) a low-order
+field over the image (u, v in -1..1; the cubic terms since issue 33 item 4: light that changes across a photo is
+not always a ramp), fitted last and held near 1.  The unknown ground L(p) cancels in the differences of two images
 at one cell, which are fitted by iteratively reweighted least squares (Cauchy weights: moving things, shadows
 and misregistration count little).  The correction divides the model out; its mean over the sampled cells is 1,
 so the mosaic keeps its overall brightness.  The fit lives in :mod:`core.ortho.radiometry_fit`."""
@@ -25,7 +26,6 @@ from .cameras import OrthoCamera
 from .sampling import camera_view, sample_camera
 from .surface import Dsm
 
-FIELD_TERMS = 6  # 1, u, v, u^2, uv, v^2
 MAX_CORRECTION = 2.0  # the correction stays within 1 / this .. this
 CHUNK = 8  # cells of a chunk in which the disagreement of two images is one median
 
@@ -40,7 +40,7 @@ class RadiometryModel:
     antisolar: List[float]  # unit vector, local frame: the direction the sunlight travels
     hot_width: float  # radians
     exposure: List[float]  # per image: b_i (log)
-    fields: List[List[float]]  # per image: FIELD_TERMS coefficients (log)
+    fields: List[List[float]]  # per image: field_count(order) coefficients (log), the order's monomials
     norm: float = 0.0  # added to every log correction (the mean correction over the samples is 1)
     summary: Dict[str, object] = field(default_factory=dict)
 
@@ -67,7 +67,8 @@ class RadiometryModel:
             out += np.asarray(self.exposure, dtype=np.float64)[images]
         if "f" in terms:
             c = np.asarray(self.fields, dtype=np.float64)[images]
-            out += np.einsum("nk,nk->n", c, field_terms(u, v))
+            order = next(d for d in range(8) if field_count(d) >= c.shape[1])
+            out += np.einsum("nk,nk->n", c, field_terms(u, v, order))
         return out
 
     def correction(self, images, r, u, v, rays) -> np.ndarray:
@@ -80,10 +81,16 @@ class RadiometryModel:
         return float(math.exp(self.norm - self.exposure[image] - self.fields[image][0]))
 
 
-def field_terms(u, v) -> np.ndarray:
+def field_count(order: int) -> int:
+    """The number of terms of a polynomial field of degree ``order`` in u, v."""
+    return (order + 1) * (order + 2) // 2
+
+
+def field_terms(u, v, order: int) -> np.ndarray:
+    """(..., field_count(order)) the monomials u^(d-j) v^j, degree d = 0 .. order (1, u, v, u^2, uv, v^2, ...)."""
     u = np.asarray(u, dtype=np.float64)
     v = np.asarray(v, dtype=np.float64)
-    return np.stack([np.ones_like(u), u, v, u * u, u * v, v * v], axis=-1)
+    return np.stack([u ** (d - j) * v ** j for d in range(order + 1) for j in range(d + 1)], axis=-1)
 
 
 def hot_spot_shape(rays: np.ndarray, antisolar: Sequence[float], width: float) -> np.ndarray:
