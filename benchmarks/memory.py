@@ -150,7 +150,10 @@ def child(args):
     elif args.stage == "align":
         from core.align.options import AlignOptions
         from core.align.stage import align
-        align(args.src, args.out, AlignOptions(focal_px=args.focal_px or None), progress=p)
+        positions = os.path.join(os.path.dirname(args.src), "camera_positions.csv")  # as the pipeline passes it
+        kw = ({"camera_positions": positions} if os.path.isfile(positions)
+              and "camera_positions" in AlignOptions.__dataclass_fields__ else {})  # an older --root: none
+        align(args.src, args.out, AlignOptions(focal_px=args.focal_px or None, **kw), progress=p)
     elif args.stage == "georeference":
         from core.georef.options import GeorefOptions
         from core.georef.stage import georeference_workspace

@@ -147,7 +147,10 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
                          "USE_EXIF_GPS) to georeference the block before the DSM and orthophoto; to align only, "
                          "run 'Align images'")
     check_inputs(images_dir, ctl)
-    check_options(opt.align)  # a bad calibration file or choice: before the prepare and the alignment
+    align_options = opt.align  # the camera positions also choose the pairs where the photos have no EXIF GPS
+    if ctl.camera_positions_path and not align_options.camera_positions:
+        align_options = dataclasses.replace(align_options, camera_positions=ctl.camera_positions_path)
+    check_options(align_options)  # a bad calibration file or choice: before the prepare and the alignment
     seconds: Dict[str, float] = {}
     cpu_seconds: Dict[str, float] = {}
 
@@ -173,7 +176,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
         progress.info(f"prepare: {len(res.prepare.masks)} sky mask(s), {res.prepare.kept} of "
                       f"{len(res.prepare.images)} photos kept")
         aligned_from = res.prepare.prepared_dir
-    res.align = run(ALIGN, align, aligned_from, workspace_dir, opt.align,
+    res.align = run(ALIGN, align, aligned_from, workspace_dir, align_options,
                     span=(SPANS[PREPARE][1], SPANS[ALIGN][1]) if opt.sky_masks else None)
     gcp_path = ctl.gcp_path
     if ctl.targets_path:  # the targets found on the photos are the ground control

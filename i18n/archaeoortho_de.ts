@@ -92,57 +92,57 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
 <context>
     <name>AlignImagesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="70"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="70"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="70"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="70"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="70"/>
         <source>One camera for all images</source>
         <translation>Eine Kamera für alle Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="83"/>
+        <location filename="../processing_provider/align_images.py" line="88"/>
         <source>Camera centres</source>
         <translation>Projektionszentren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="84"/>
+        <location filename="../processing_provider/align_images.py" line="89"/>
         <source>Registered images</source>
         <translation>Orientierte Bilder</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="85"/>
+        <location filename="../processing_provider/align_images.py" line="90"/>
         <source>Mean reprojection error (px)</source>
         <translation>Mittlerer Rückprojektionsfehler (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="112"/>
+        <location filename="../processing_provider/align_images.py" line="118"/>
         <source>Registered {} of {} images, mean reprojection error {:.3f} px, {} points</source>
         <translation>{} von {} Bildern orientiert, mittlerer Rückprojektionsfehler {:.3f} px, {} Punkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="119"/>
+        <location filename="../processing_provider/align_images.py" line="125"/>
         <source>Images not registered:</source>
         <translation>Nicht orientierte Bilder:</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="126"/>
+        <location filename="../processing_provider/align_images.py" line="132"/>
         <source>Seconds per step: {}</source>
         <translation>Sekunden je Schritt: {}</translation>
     </message>
@@ -152,70 +152,75 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
         <translation>Bilder ausrichten</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="70"/>
         <source>Mapper</source>
         <translation>Rekonstruktionsverfahren</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="70"/>
         <source>Matching image size (px)</source>
         <translation>Bildgröße für die Zuordnung (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="70"/>
         <source>Features per image</source>
         <translation>Merkmale je Bild</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="70"/>
         <source>Affine-invariant features</source>
         <translation>Affin-invariante Merkmale</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="70"/>
         <source>Focal length (mm)</source>
         <translation>Brennweite (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="70"/>
         <source>Sensor width (mm)</source>
         <translation>Sensorbreite (mm)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="70"/>
         <source>Retry images left out</source>
         <translation>Ausgelassene Bilder erneut versuchen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="115"/>
+        <location filename="../processing_provider/align_images.py" line="121"/>
         <source>Retry {} ({} features): {} image(s) left out; main block {} -&gt; {} images{}</source>
         <translation>Neuer Versuch {} ({}-Merkmale): {} Bild(er) ausgelassen; Hauptblock {} -&gt; {} Bilder{}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="115"/>
+        <location filename="../processing_provider/align_images.py" line="121"/>
         <source> (not better: the previous result kept)</source>
         <translation> (nicht besser: das vorige Ergebnis bleibt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="70"/>
         <source>Camera calibration file</source>
         <translation>Kamerakalibrierungsdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="66"/>
+        <location filename="../processing_provider/align_images.py" line="70"/>
         <source>Interior orientation</source>
         <translation>Innere Orientierung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/align_images.py" line="124"/>
+        <location filename="../processing_provider/align_images.py" line="130"/>
         <source>Camera {}: interior orientation {} ({})</source>
         <translation>Kamera {}: innere Orientierung {} ({})</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/align_images.py" line="70"/>
+        <source>Camera positions (CSV)</source>
+        <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="8"/>
         <source>Structure from motion: SIFT features, pair selection, robust matching (RANSAC), incremental mapping with self-calibration (focal length, principal point, lens distortion) and a final bundle adjustment. The result is stored in the workspace folder, which the following stages (Georeference, Build DSM, Build orthophoto) take as input. A re-run resumes: features and matches already computed are reused.
 
-Pair selection: &apos;auto&apos; uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS.
+Pair selection: &apos;auto&apos; uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images otherwise, and sequential pairs with loop pairs for larger sets without GPS. Camera positions (CSV), optional: the photos&apos; positions in the file Georeference takes (a GNSS log, for photos without EXIF GPS) choose the pairs and the probed photos&apos; neighbours instead of EXIF GPS; they do not georeference the block.
 Camera model: &apos;AUTO&apos; estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with 10 or more images, and a simpler radial model below.
 Matching image size: the longest side the images are scaled to for the features (0 = automatic: photos of up to 2 megapixels as they are, larger ones scaled to 2 megapixels; the DSM and the orthophotos use every pixel). Features per image: 0 = automatic (about 4000 per megapixel, 2048 to 4096). With both at 0, a few photos are probed first: where faint, low-contrast texture (ploughed fields) starves them of features, the first pass takes 8192 fainter ones, at up to twice the size if needed (the log says so). Affine-invariant features help with oblique views and are slower.
 Focal length and Sensor width: interior orientation when EXIF is missing (scanned film): the focal length and the width of the long side of the frame, in millimetres (0 = from EXIF / unknown).
@@ -225,13 +230,13 @@ Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global
 Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
         <translation>Structure from Motion: SIFT-Merkmale, Paarauswahl, robuste Zuordnung (RANSAC), inkrementelle Rekonstruktion mit Selbstkalibrierung (Brennweite, Bildhauptpunkt, Objektivverzeichnung) und eine abschließende Bündelblockausgleichung. Das Ergebnis wird im Arbeitsbereich-Ordner gespeichert, den die folgenden Schritte (Georeferenzieren, DOM erzeugen, Orthophoto erzeugen) als Eingabe nehmen. Ein erneuter Lauf setzt fort: bereits berechnete Merkmale und Zuordnungen werden wiederverwendet.
 
-Paarauswahl: 'auto' nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren.
-Kameramodell: 'AUTO' schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
+Paarauswahl: &apos;auto&apos; nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren. Kamerapositionen (CSV), optional: die Positionen der Fotos in der Datei, die Georeferenzieren liest (ein GNSS-Protokoll, für Fotos ohne EXIF-GPS), wählen die Paare und die Nachbarn der geprüften Fotos statt EXIF-GPS; sie georeferenzieren den Block nicht.
+Kameramodell: &apos;AUTO&apos; schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
 Bildgröße für die Zuordnung: die längste Seite, auf die die Bilder für die Merkmale verkleinert werden (0 = automatisch: Fotos bis 2 Megapixel unverändert, größere auf 2 Megapixel verkleinert; DOM und Orthophotos nutzen jedes Pixel). Merkmale je Bild: 0 = automatisch (etwa 4000 je Megapixel, 2048 bis 4096). Stehen beide auf 0, werden zuerst einige Fotos geprüft: wo schwache, kontrastarme Textur (gepflügte Felder) ihnen zu wenige Merkmale lässt, nimmt der erste Durchgang 8192 schwächere, wenn nötig bei bis zu doppelter Größe (das Protokoll sagt es). Affin-invariante Merkmale helfen bei Schrägaufnahmen und sind langsamer.
 Brennweite und Sensorbreite: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern (0 = aus EXIF / unbekannt).
 Kamerakalibrierungsdatei: die innere Orientierung einer kalibrierten Kamera (YAML/JSON von ArchaeoOrtho, innere Parameter von Orthority, OpenCV, COLMAP cameras.txt oder Metashape-XML); mehrere Kameras werden den Fotos über ihre Bildmuster, das Kameramodell oder die Bildgröße zugeordnet; ein Foto anderer Auflösung erhält sie skaliert. Eine Datei, die sich nicht lesen lässt, beendet den Lauf vor jeder Arbeit und nennt Datei, Zeile und Feld.
-Innere Orientierung: was die Ausgleichungen an einer Kamera ändern dürfen: 'fixed' hält die gegebenen Werte durch Ausrichtung und Georeferenzierung (auch mit automatischen Passpunkten), 'refined' lässt die Georeferenzierung sie mit den Standardabweichungen der Kalibrierung als Vorinformation verbessern, 'estimated' kalibriert ausgehend von ihnen selbst. 'auto' ist 'fixed', wo eine Kalibrierung gegeben ist (die Datei oder von 'Bilder vorbereiten' entzerrte Filmscans), sonst 'estimated'; ein eigenes 'adjust' einer Kamera in der Datei geht vor. Mit 'fixed' oder 'refined' und ohne Datei sind Brennweite und Sensorbreite die gegebenen Werte. Protokoll, sfm/alignment.json und der Genauigkeitsbericht sagen je Kamera, was gehalten wurde.
-Rekonstruktionsverfahren (erweitert): 'incremental' (COLMAP, Standard) oder 'global' (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).
+Innere Orientierung: was die Ausgleichungen an einer Kamera ändern dürfen: &apos;fixed&apos; hält die gegebenen Werte durch Ausrichtung und Georeferenzierung (auch mit automatischen Passpunkten), &apos;refined&apos; lässt die Georeferenzierung sie mit den Standardabweichungen der Kalibrierung als Vorinformation verbessern, &apos;estimated&apos; kalibriert ausgehend von ihnen selbst. &apos;auto&apos; ist &apos;fixed&apos;, wo eine Kalibrierung gegeben ist (die Datei oder von &apos;Bilder vorbereiten&apos; entzerrte Filmscans), sonst &apos;estimated&apos;; ein eigenes &apos;adjust&apos; einer Kamera in der Datei geht vor. Mit &apos;fixed&apos; oder &apos;refined&apos; und ohne Datei sind Brennweite und Sensorbreite die gegebenen Werte. Protokoll, sfm/alignment.json und der Genauigkeitsbericht sagen je Kamera, was gehalten wurde.
+Rekonstruktionsverfahren (erweitert): &apos;incremental&apos; (COLMAP, Standard) oder &apos;global&apos; (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).
 Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen Einstellungen auslassen, oder ein in Teile zerfallener Block werden mit reicheren Merkmalen (schwächeren für kontrastarme Bilder, affinen für steile Schrägaufnahmen) und mehr Paaren erneut versucht; das Protokoll und sfm/alignment.json sagen, was erneut versucht wurde und warum.</translation>
     </message>
 </context>

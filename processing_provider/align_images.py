@@ -22,6 +22,7 @@ class AlignImagesAlgorithm(AlgorithmBase):
     MAPPER = "MAPPER"
     ESCALATE = "ESCALATE"
     CALIBRATION = "CALIBRATION"
+    CAMERA_POSITIONS = "CAMERA_POSITIONS"
     INTRINSICS = "INTRINSICS"
     CAMERAS = "CAMERAS"
     REGISTERED_IMAGES = "REGISTERED_IMAGES"
@@ -32,7 +33,10 @@ class AlignImagesAlgorithm(AlgorithmBase):
         "The result is stored in the workspace folder, which the following stages (Georeference, Build DSM, "
         "Build orthophoto) take as input. A re-run resumes: features and matches already computed are reused.\n\n"
         "Pair selection: 'auto' uses EXIF GPS neighbours when the images carry GPS, every pair for up to 100 images "
-        "otherwise, and sequential pairs with loop pairs for larger sets without GPS.\n"
+        "otherwise, and sequential pairs with loop pairs for larger sets without GPS. "
+        "Camera positions (CSV), optional: the photos' positions in the file Georeference takes (a GNSS log, for "
+        "photos without EXIF GPS) choose the pairs and the probed photos' neighbours instead of EXIF GPS; they do "
+        "not georeference the block.\n"
         "Camera model: 'AUTO' estimates focal length, principal point, k1, k2, p1, p2 (OPENCV) for cameras with "
         "10 or more images, and a simpler radial model below.\n"
         "Matching image size: the longest side the images are scaled to for the features (0 = automatic: photos "
@@ -74,6 +78,7 @@ class AlignImagesAlgorithm(AlgorithmBase):
             params.flag(self.AFFINE_FEATURES, self.tr("Affine-invariant features")),
             params.number(self.FOCAL_MM, self.tr("Focal length (mm)")),
             params.number(self.SENSOR_WIDTH_MM, self.tr("Sensor width (mm)")),
+            params.camera_positions(self.CAMERA_POSITIONS, self.tr("Camera positions (CSV)")),
             params.calibration_file(self.CALIBRATION, self.tr("Camera calibration file")),
             params.intrinsics(self.INTRINSICS, self.tr("Interior orientation")),
             params.flag(self.SINGLE_CAMERA, self.tr("One camera for all images")),
@@ -106,6 +111,7 @@ class AlignImagesAlgorithm(AlgorithmBase):
             mapper=params.read_choice(self, parameters, self.MAPPER, context, MAPPERS),
             escalate=self.parameterAsBoolean(parameters, self.ESCALATE, context),
             calibration=params.read_optional_file(self, parameters, self.CALIBRATION, context),
+            camera_positions=params.read_optional_file(self, parameters, self.CAMERA_POSITIONS, context),
             intrinsics=params.read_choice(self, parameters, self.INTRINSICS, context, params.INTRINSICS),
         )
         result = self.run_core(align, images, workspace, options, FeedbackProgress(feedback))

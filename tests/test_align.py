@@ -8,7 +8,7 @@ import pytest
 
 from core.align.features import choose_camera_model, sift_first_octave
 from core.align.options import MAX_LOOP_ANCHORS, SEQUENTIAL_OVERLAP, AlignError, AlignOptions
-from core.align.pairs import select_pairs
+from core.align.pairs import photo_positions, select_pairs
 from core.align.stage import align, load_model
 from core.common.progress import Cancelled, NullProgress
 from core.io.images import ImageInfo
@@ -56,6 +56,52 @@ def test_pair_selection_spatial_and_fallback():
     pairs, used, warnings = select_pairs(imgs, "spatial", spatial_neighbours=4)
     assert used == "exhaustive" and "falling back to exhaustive" in warnings[0]
     assert len(pairs) == 190
+
+
+def _positions_file(tmp_path, rows, crs_line):
+    path = tmp_path / "camera_positions.csv"
+    path.write_text((crs_line + "\n" if crs_line else "") + "image,x,y,z,sigma\n"
+                    + "".join(f"{n},{x},{y},120,2\n" for n, x, y in rows))
+    return str(path)
+
+
+@pytest.mark.parametrize("crs_line, step", [("EPSG:32633", (20.0, 15.0)), ("EPSG:4326", (0.00025, 0.00018)),
+                                            ("", (65.6, 49.2))])  # metres, degrees, a file's own units (feet)
+def test_camera_positions_choose_spatial_pairs_for_photos_without_gps(tmp_path, crs_line, step):
+    """Photos without EXIF GPS and a camera positions file (a GNSS log): spatial pairs by the file's positions
+    (nearest neighbours in a 2 x 10 strip block, not the far ends), the probe's neighbours from it too; the file
+    and EXIF GPS are not mixed; a file naming none of the photos, or one that cannot be read, fails when the
+    options are made, naming the file."""
+    from core.align.firstpass import neighbours
+    from core.io.gcp import GCPError
+
+    imgs = [_info(f"i{r}{c:02d}.jpg") for r in range(2) for c in range(10)]
+    x0, y0 = (500000.0, 4600000.0) if crs_line == "EPSG:32633" else ((10.0, 50.0) if crs_line else (0.0, 0.0))
+    # the file lists the photos in another order than the folder: the second strip first
+    rows = [(f"i{r}{c:02d}.jpg", x0 + c * step[0], y0 + r * step[1]) for r in (1, 0) for c in range(10)]
+    path = _positions_file(tmp_path, rows, crs_line)
+    options = AlignOptions(camera_positions=path)
+    positions = photo_positions(imgs, options.camera_positions)
+    assert sorted(positions) == sorted(im.name for im in imgs)
+    pairs, used, warnings = select_pairs(imgs, "auto", 4, positions)
+    assert used == "spatial" and not warnings
+    assert ("i000.jpg", "i001.jpg") in pairs and ("i000.jpg", "i100.jpg") in pairs
+    assert ("i000.jpg", "i009.jpg") not in pairs and ("i005.jpg", "i109.jpg") not in pairs
+    assert len(pairs) < 190
+    assert select_pairs(imgs, "auto", 4)[1] == "exhaustive"  # without the file: no positions, every pair
+    near = neighbours([im.name for im in imgs], ["i105.jpg"], positions)
+    assert near["i105.jpg"] in ("i104.jpg", "i106.jpg", "i005.jpg")  # by position, not i106 by file order alone
+    # EXIF GPS on the photos is not mixed with the file's frame: the file wins for every photo it names
+    imgs[0].gps = (10.0, 50.0, 100.0)
+    assert photo_positions(imgs, path)["i000.jpg"] == positions["i000.jpg"]
+    other = _positions_file(tmp_path, [("DSC_1.jpg", x0 + 1.0, y0 + 2.0)], crs_line)
+    with pytest.raises(AlignError, match="camera_positions.csv: no row names a photo"):
+        photo_positions(imgs, other)
+    (tmp_path / "bad.csv").write_text("image,x,y,z\ni000.jpg,abc,2,3\n")
+    with pytest.raises(GCPError, match="bad.csv"):
+        AlignOptions(camera_positions=str(tmp_path / "bad.csv"))
+    with pytest.raises(AlignError, match="camera_positions"):
+        AlignOptions(camera_positions=str(tmp_path / "none.csv"))
 
 
 def test_pair_selection_sequential_has_loop_pairs():

@@ -199,3 +199,33 @@ def test_the_pipeline_chains_find_targets_into_the_georeference(tmp_path, monkey
         pipeline.run_pipeline(str(photos), str(tmp_path / "ws3"), control=pipeline.Control(
             targets_path=str(bad), crs="EPSG:32611"))
     assert not calls  # nothing ran
+
+
+def test_the_camera_positions_also_choose_the_alignments_pairs(tmp_path, monkeypatch):
+    """Control(camera_positions_path=...) reaches the alignment as AlignOptions.camera_positions (spatial pairs
+    for photos without EXIF GPS, issue 33) and the georeference as before; an alignment's own file is kept."""
+    import types
+
+    from core import pipeline
+    from core.align.options import AlignOptions
+
+    calls = {}
+
+    def spy(name):
+        def stage(*args, **kwargs):
+            calls[name] = args
+            return types.SimpleNamespace(warnings=[])
+        return stage
+
+    for name in ("align", "georeference_workspace", "build_dsm_workspace", "build_orthophoto_workspace"):
+        monkeypatch.setattr(pipeline, name, spy(name))
+    monkeypatch.setattr(pipeline, "check_inputs", lambda *a: None)
+    log, own = tmp_path / "gnss.csv", tmp_path / "own.csv"
+    for f in (log, own):
+        f.write_text("EPSG:32633\nimage,x,y,z,sigma\na.jpg,500000,4600000,120,2\nb.jpg,500020,4600000,120,2\n")
+    for given, expected in ((AlignOptions(), str(log)), (AlignOptions(camera_positions=str(own)), str(own))):
+        pipeline.run_pipeline(str(tmp_path / "photos"), str(tmp_path / "ws"),
+                              pipeline.PipelineOptions(align=given, make_dtm=False, make_report=False),
+                              pipeline.Control(camera_positions_path=str(log)))
+        assert calls["align"][2].camera_positions == expected
+        assert calls["georeference_workspace"][1].camera_positions_path == str(log)

@@ -317,11 +317,12 @@ def _summary(level: str, results: Sequence[ProbeResult]) -> str:
             f"{m})")
 
 
-def choose_first_pass(pycolmap, infos: Sequence[ImageInfo], options: AlignOptions, width: int,
-                      height: int) -> FirstPass:
+def choose_first_pass(pycolmap, infos: Sequence[ImageInfo], options: AlignOptions, width: int, height: int,
+                      positions: Optional[Dict[str, Tuple[float, float]]] = None) -> FirstPass:
     """The first pass's settings for the photos ``infos`` of the largest camera (``width`` x ``height``): the
     first level of :func:`levels` the probe finds good enough (:func:`decide`), else the last, which is taken
-    without a probe (the richest the first pass gets)."""
+    without a probe (the richest the first pass gets).  ``positions``: the photos' horizontal positions
+    (:func:`.pairs.photo_positions`) for the probed photos' neighbours; None: their EXIF GPS."""
     base = default_settings(options, width, height)
     if options.max_image_size or options.max_features or options.first_octave is not None:
         return FirstPass(base, DEFAULT, "the feature size, budget or first octave set in the options")
@@ -332,7 +333,8 @@ def choose_first_pass(pycolmap, infos: Sequence[ImageInfo], options: AlignOption
     same = [im for im in infos if (im.width, im.height) == (width, height)]
     names = [im.name for im in same]
     chosen = probe_order(probe_photos(names))
-    near = neighbours(names, chosen, gps_positions(same))
+    near = neighbours(names, chosen, gps_positions(same) if positions is None
+                      else {n: positions[n] for n in names if n in positions})
     photos = _Photos(pycolmap, same, max(s.image_size for _, s in ladder[:-1]))
     readable = [n for n in chosen if photos.image(n) is not None]  # OpenCV cannot read it: probed without it
     if not readable:

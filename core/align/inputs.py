@@ -12,6 +12,7 @@ from ..io.images import CameraGroup, ImageError, ImageInfo, group_cameras, scan_
 from ..project.layout import Layout
 from .calibrated import GivenCamera, held_cameras, plan_cameras, scan_interior
 from .options import AlignError, AlignOptions
+from .pairs import photo_positions
 from .photos import fingerprint_photos
 
 
@@ -45,6 +46,7 @@ class Photos:
     fingerprints: Dict[str, str]  # image name -> content fingerprint (core.align.photos)
     seconds: float
     given: Dict[str, GivenCamera]  # group key -> its given interior orientation (core.align.calibrated)
+    positions: Dict[str, Tuple[float, float]]  # image name -> horizontal position (core.align.pairs.photo_positions)
 
     def log_cameras(self, progress: Progress) -> None:
         """One line per camera: make, model, size, the focal length given or its prior, how many images."""
@@ -69,4 +71,5 @@ def read_folder(pycolmap, lay: Layout, images_dir: str, options: AlignOptions, c
     infos, skipped, groups = read_images(images_dir, options, progress)
     groups, given = plan_cameras(pycolmap, groups, infos, calibrations, scan_interior(lay.scans_json, infos),
                                  options, progress)
-    return Photos(images_dir, infos, skipped, groups, fingerprint_photos(infos), time.time() - t0, given)
+    positions = photo_positions(infos, options.camera_positions)
+    return Photos(images_dir, infos, skipped, groups, fingerprint_photos(infos), time.time() - t0, given, positions)

@@ -2,10 +2,12 @@
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from typing import Optional
 
 from ..common.errors import ArchaeoOrthoError
+from ..io.gcp import read_camera_positions
 from ..io.images import GROUP_AUTO, GROUP_PER_IMAGE, GROUP_SINGLE
 
 PAIRINGS = ("auto", "exhaustive", "sequential", "spatial")
@@ -86,6 +88,9 @@ class AlignOptions:
     escalate: bool = True  # retry images left out / a split block with richer features and pairs (escalation.py)
     calibration: Optional[str] = None  # a camera calibration file (core.io.calibration), None: none
     intrinsics: str = "auto"  # one of INTRINSICS; a camera's own ``adjust`` in the calibration file overrides it
+    # a camera positions file (the georeference's format, e.g. a GNSS log): where given, its positions choose the
+    # pairs (spatial) and the probe's neighbours instead of EXIF GPS; it does not georeference the block
+    camera_positions: Optional[str] = None
 
     def __post_init__(self) -> None:
         """The choices normalised (case) and every value checked when the options are made: a mistyped choice or
@@ -115,6 +120,10 @@ class AlignOptions:
             value = getattr(self, name)
             if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise AlignError(f"AlignOptions.{name} must be a positive number or None, not {value!r}")
+        if self.camera_positions is not None:  # GCPError naming the file and the line it cannot read
+            if not (isinstance(self.camera_positions, str) and os.path.isfile(self.camera_positions)):
+                raise AlignError(f"AlignOptions.camera_positions: {self.camera_positions!r} is not a file")
+            read_camera_positions(self.camera_positions, warnings=[])
         if self.mapper not in MAPPERS:
             raise AlignError(f"unknown mapper {self.mapper!r}; choose one of {', '.join(MAPPERS)}")
         if self.intrinsics not in INTRINSICS:

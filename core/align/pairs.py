@@ -7,18 +7,24 @@
   ``MAX_LOOP_ANCHORS`` such anchor images: the stride grows with the set, so the
   pair count grows linearly, not quadratically, with the number of images);
 - ``spatial``: each image with its ``SPATIAL_NEIGHBOURS`` nearest neighbours by
-  EXIF GPS (horizontal distance), plus a sequential overlap of 3 as a safety
-  net; falls back to exhaustive with a warning when images lack GPS;
-- ``auto``: spatial when at least 80 % of the images carry GPS; otherwise
+  position (horizontal distance), plus a sequential overlap of 3 as a safety
+  net; falls back to exhaustive with a warning when images lack a position;
+- ``auto``: spatial when at least 80 % of the images have a position; otherwise
   exhaustive up to ``AUTO_EXHAUSTIVE_MAX`` images and sequential+loop beyond.
+
+A photo's position (:func:`photo_positions`) is its row in a camera positions file where one is given
+(``AlignOptions.camera_positions``: a GNSS log beside photos without EXIF GPS, in the georeference's format), else
+its EXIF GPS.
 """
 from __future__ import annotations
 
 import math
-from typing import List, Sequence, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from ..geometry.crs import crs_is_geographic
+from ..io.gcp import read_camera_positions
 from ..io.images import ImageInfo
 from .options import (
     AUTO_EXHAUSTIVE_MAX,
@@ -40,16 +46,44 @@ def gps_to_local_xy(gps: Sequence[Tuple[float, float, float]]) -> np.ndarray:
     return np.column_stack([x, y])
 
 
-def select_pairs(images: Sequence[ImageInfo], pairing: str,
-                 spatial_neighbours: int = SPATIAL_NEIGHBOURS) -> Tuple[List[Tuple[str, str]], str, List[str]]:
-    """Returns (pairs of image names, the pairing actually used, warnings)."""
+def photo_positions(images: Sequence[ImageInfo], camera_positions: Optional[str] = None
+                    ) -> Dict[str, Tuple[float, float]]:
+    """Image name -> horizontal position on a local plane (only distances between photos are used: metres for
+    EXIF GPS and a geographic file, the file's own units for a projected one or one without a CRS line).  With
+    ``camera_positions`` (a file :func:`core.io.gcp.read_camera_positions` reads; GCPError naming the file and
+    line when it cannot) the file's rows for photos of ``images`` and nothing else: a file and EXIF GPS are not
+    mixed, their frames differ.  AlignError when the file names none of the photos."""
+    if not camera_positions:
+        located = [im for im in images if im.gps]
+        xy = gps_to_local_xy([im.gps for im in located]) if located else []
+        return {im.name: (float(p[0]), float(p[1])) for im, p in zip(located, xy)}
+    crs, rows = read_camera_positions(camera_positions, warnings=[])
+    names = {im.name for im in images}
+    rows = [r for r in rows if r.image in names]
+    if not rows:
+        some = ", ".join(sorted(names)[:3])
+        raise AlignError(f"camera positions {camera_positions}: no row names a photo of the folder (photos such as "
+                         f"{some}); the image column must hold the photos' file names")
+    if crs and crs_is_geographic(crs):
+        xy = gps_to_local_xy([(r.x, r.y, 0.0) for r in rows])
+    else:
+        xy = np.array([(r.x, r.y) for r in rows], dtype=float)
+    return {r.image: (float(p[0]), float(p[1])) for r, p in zip(rows, xy)}
+
+
+def select_pairs(images: Sequence[ImageInfo], pairing: str, spatial_neighbours: int = SPATIAL_NEIGHBOURS,
+                 positions: Optional[Dict[str, Tuple[float, float]]] = None
+                 ) -> Tuple[List[Tuple[str, str]], str, List[str]]:
+    """Returns (pairs of image names, the pairing actually used, warnings).  ``positions``: the photos'
+    horizontal positions (:func:`photo_positions`); None: their EXIF GPS."""
     pairing = (pairing or "auto").lower()
     if pairing not in PAIRINGS:
         raise AlignError(f"unknown pairing {pairing!r}; choose one of {', '.join(PAIRINGS)}")
+    positions = photo_positions(images) if positions is None else positions
     warnings: List[str] = []
     n = len(images)
     names = [im.name for im in images]
-    with_gps = sum(1 for im in images if im.gps)
+    with_gps = sum(1 for im in images if im.name in positions)
     if pairing == "auto":
         if with_gps >= 0.8 * n and n > spatial_neighbours + 1:
             pairing = "spatial"
@@ -58,9 +92,10 @@ def select_pairs(images: Sequence[ImageInfo], pairing: str,
         else:
             pairing = "sequential"
     if pairing == "spatial" and with_gps < n:
-        missing = [im.name for im in images if not im.gps]
+        missing = [im.name for im in images if im.name not in positions]
         warnings.append(
-            f"spatial pairing needs EXIF GPS on every image; {len(missing)} lack it "
+            f"spatial pairing needs a position (EXIF GPS or a camera positions file) for every image; "
+            f"{len(missing)} lack it "
             f"({', '.join(missing[:5])}{'…' if len(missing) > 5 else ''}): falling back to exhaustive"
         )
         pairing = "exhaustive"
@@ -83,7 +118,7 @@ def select_pairs(images: Sequence[ImageInfo], pairing: str,
             for j in range(0, n, stride):
                 add(i, j)
     else:  # spatial
-        xy = gps_to_local_xy([im.gps for im in images])
+        xy = np.array([positions[m] for m in names], dtype=float)
         d = np.linalg.norm(xy[:, None, :] - xy[None, :, :], axis=2)
         k = min(spatial_neighbours, n - 1)
         for i in range(n):

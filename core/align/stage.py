@@ -92,7 +92,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
         os.makedirs(lay.sfm_dir, exist_ok=True)
         g0 = max(groups, key=lambda g: g.width * g.height)
         with run.step("probe", save=False):  # the first pass's features from the photos' texture and size
-            first = choose_first_pass(pycolmap, infos, options, g0.width, g0.height)
+            first = choose_first_pass(pycolmap, infos, options, g0.width, g0.height, photos.positions)
         progress.info(first.log_line())
         job, masks = prepare_database(pycolmap, lay, photos, options, run.record, keep_previous, first, progress)
         db_path = job.db_path
@@ -103,7 +103,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
             extract_features(pycolmap, job, first.settings, options, SubProgress(progress, 0.02, 0.35))
         # 3. pairs + matching
         with run.step("matching", save=False):
-            pairs, pairing_used, pw = select_pairs(infos, options.pairing, options.spatial_neighbours)
+            pairs, pairing_used, pw = select_pairs(infos, options.pairing, options.spatial_neighbours, photos.positions)
             for w in pw:
                 progress.warning(w)
             progress.info(f"pair selection: {pairing_used}, {len(pairs)} pairs for {len(infos)} images")
