@@ -205,6 +205,8 @@ def judge(args):
                 rad = json.loads(line[len("RADIOMETRY"):])
                 print(f"mosaic seam brightness step: {rad.get('seam_step_before')} before, "
                       f"{rad.get('seam_step_after')} after the radiometric correction (goal <= {GOALS['seam']:g})")
+                print(f"  on level ground ({rad.get('seam_level_fraction')} of the seam points): "
+                      f"{rad.get('seam_step_level_before')} before, {rad.get('seam_step_level_after')} after")
     pyc = _read_json(os.path.join(chain_dir, "pycolmap.json"))
     if pyc:
         align_cpu = next((r["cpu"] for r in rows if r["stage"] == "align" and not r["rc"]), None)

@@ -168,8 +168,9 @@ def child(args):
         from core.ortho.stage import build_orthophoto_workspace
         r = build_orthophoto_workspace(args.out, progress=p)
         rad = getattr(r, "radiometry", None) or {}
-        print("RADIOMETRY " + json.dumps({k: rad.get(k) for k in ("seam_step_before", "seam_step_after",
-                                                                  "hot_width_deg", "hot_spot", "antisolar")}))
+        print("RADIOMETRY " + json.dumps({k: rad.get(k) for k in (
+            "seam_step_before", "seam_step_after", "seam_step_level_before", "seam_step_level_after",
+            "seam_level_fraction", "hot_width_deg", "hot_spot", "antisolar")}))
     elif args.stage == "terrain":
         from core.terrain.options import TerrainOptions
         from core.terrain.stage import build_dtm_workspace

@@ -68,6 +68,8 @@ def _print_run(name: str, res) -> dict:
             print("  " + line)
     if s:
         print(f"seam brightness step (median): {100 * s['seam_step_before']:.2f} % -> {100 * s['seam_step_after']:.2f} %")
+        print(f"  on level ground ({100 * s['seam_level_fraction']:.0f} % of the seam points): "
+              f"{100 * s['seam_step_level_before']:.2f} % -> {100 * s['seam_step_level_after']:.2f} %")
         print(f"overlapping images disagree (median of chunks): {100 * s['overlap_step_before']:.2f} % -> "
               f"{100 * s['overlap_step_after']:.2f} %")
     return {"seconds_off": round(t_off, 2), "seconds_on": round(t_on, 2),

@@ -358,8 +358,8 @@ def fit_radiometry(prep: PreparedBlock, dsm: Dsm, offset: np.ndarray, labels: np
 
     obs = sample_overlaps(prep, dsm, offset, SubProgress(progress, 0.0, 0.4))
     model, summary = fit_from_samples(obs, prep, hot_spot, SubProgress(progress, 0.4, 0.85))
-    before, after = seam_steps(model, labels, k, prep, dsm, offset, gains)
-    summary.update({"seam_step_before": before, "seam_step_after": after})
+    summary.update(seam_steps(model, labels, k, prep, dsm, offset, gains))
+    before, after = summary["seam_step_before"], summary["seam_step_after"]
     progress.report(1.0, "radiometry fitted")
     if model is None:
         return None, [f"radiometry left as it is: {summary.get('skipped')}; brightness step across the seams "
@@ -379,6 +379,8 @@ def fit_radiometry(prep: PreparedBlock, dsm: Dsm, offset: np.ndarray, labels: np
                      f"{math.degrees(model.hot_width):.0f} deg wide, sun at {elev:.0f} deg elevation, "
                      f"azimuth {az:.0f} deg from the x axis")
     lines.append(f"radiometry: brightness step across the seams {100 * before:.1f} % before, {100 * after:.1f} % "
-                 f"after (median); between overlapping images {100 * summary['overlap_step_before']:.1f} % -> "
+                 f"after (median; on level ground, {100 * summary['seam_level_fraction']:.0f} % of the seam, "
+                 f"{100 * summary['seam_step_level_before']:.1f} % -> {100 * summary['seam_step_level_after']:.1f} %)"
+                 f"; between overlapping images {100 * summary['overlap_step_before']:.1f} % -> "
                  f"{100 * summary['overlap_step_after']:.1f} %")
     return model, lines
