@@ -115,9 +115,15 @@ def resolution_limited(cam: OrthoCamera, offset: np.ndarray, fp: Footprint, z_lo
 
 
 def _point_in_polygon(poly: np.ndarray, x: float, y: float) -> bool:
-    from matplotlib.path import Path
-
-    return bool(Path(poly).contains_point((x, y)))
+    """Whether (x, y) lies inside the closed polygon ``poly`` (N, 2), by the even-odd rule: a ray towards +x
+    crosses its edges an odd number of times.  Plain NumPy: matplotlib's Path did this, and its first import from
+    the stage's worker threads raced ("partially initialized module 'matplotlib'", QGIS 3.40 leg)."""
+    px, py = poly[:, 0], poly[:, 1]
+    qx, qy = np.roll(px, -1), np.roll(py, -1)
+    straddle = (py > y) != (qy > y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cross = px + (y - py) * (qx - px) / (qy - py)
+    return bool(np.count_nonzero(straddle & (x < cross)) % 2)
 
 
 @dataclass
