@@ -28,14 +28,16 @@ DATA = os.path.join(os.path.dirname(ROOT), "shared", "data")
 EXT = (".jpg", ".jpeg", ".tif", ".tiff")
 
 
-def child(images, ws, result, report):
+def child(images, ws, result, report, mapper="incremental"):
     from core import pipeline
+    from core.align.options import AlignOptions
     from core.common.progress import PrintProgress
 
     positions = os.path.join(os.path.dirname(images), "camera_positions.csv")
     control = (pipeline.Control(camera_positions_path=positions) if os.path.isfile(positions)
                else pipeline.Control(use_exif_gps=True))
-    r = pipeline.run_pipeline(images, ws, pipeline.PipelineOptions(make_report=report), control,
+    r = pipeline.run_pipeline(images, ws, pipeline.PipelineOptions(
+        align=AlignOptions(mapper=mapper), make_report=report), control,
                               progress=PrintProgress("  "))
     with open(result, "w") as f:
         json.dump({"registered": r.align.registered, "images": r.align.images_given,
@@ -61,9 +63,9 @@ def _interior_nodata(path):
     return interior_nodata(path)
 
 
-def one_run(images, names, workdir, report):
+def one_run(images, names, workdir, report, mapper="incremental"):
     n = len(names)
-    d = os.path.join(workdir, f"n{n}")
+    d = os.path.join(workdir, f"n{n}" + ("" if mapper == "incremental" else f"-{mapper}"))
     shutil.rmtree(d, ignore_errors=True)
     sub = os.path.join(d, "images")
     os.makedirs(sub)
@@ -76,6 +78,7 @@ def one_run(images, names, workdir, report):
     cmd = [sys.executable, os.path.abspath(__file__), "--child", sub, os.path.join(d, "ws"), result]
     if not report:
         cmd.append("--no-report")
+    cmd += ["--mapper", mapper]
     log = os.path.join(d, "chain.log")
     when = []
     rc, wall, rss = run_tree_measured(cmd, log_path=log, peak_at=when)
@@ -129,7 +132,8 @@ def fit_exponent(xs, ys):
 
 def main():
     if len(sys.argv) > 1 and sys.argv[1] == "--child":
-        child(sys.argv[2], sys.argv[3], sys.argv[4], "--no-report" not in sys.argv)
+        mapper = sys.argv[sys.argv.index("--mapper") + 1] if "--mapper" in sys.argv else "incremental"
+        child(sys.argv[2], sys.argv[3], sys.argv[4], "--no-report" not in sys.argv, mapper)
         return
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--images", default=os.path.join(DATA, "toledo", "images"))
@@ -137,18 +141,21 @@ def main():
     ap.add_argument("--workdir", default=os.path.join(ROOT, "build", "bench-chain"))
     ap.add_argument("--no-report", action="store_true")
     ap.add_argument("--synthetic", type=int, default=0, help="render a synthetic block of about N images")
+    ap.add_argument("--mapper", default="incremental", help="incremental, global, or both (each count runs twice)")
     a = ap.parse_args()
     images = os.path.abspath(synthetic_set(a.synthetic, a.workdir) if a.synthetic else a.images)
     names = sorted(n for n in os.listdir(images) if n.lower().endswith(EXT))
     counts = [int(c) for c in a.counts.split(",") if c.strip()] or [len(names)]
     workdir = os.path.join(a.workdir, os.path.basename(os.path.dirname(images)) or "set")
     print(f"images: {images} ({len(names)}); cores: {os.cpu_count()}; runs: {counts}", flush=True)
+    mappers = ["incremental", "global"] if a.mapper == "both" else [a.mapper]
     runs = []
-    for n in counts:
-        r = one_run(images, names[:n], workdir, not a.no_report)
+    for n, mapper in [(n, m) for n in counts for m in mappers]:
+        r = one_run(images, names[:n], workdir, not a.no_report, mapper)
+        r["mapper"] = mapper
         runs.append(r)
         stages = ", ".join(f"{k} {v:.0f}" for k, v in r["seconds"].items())
-        print(f"\n{n} images: wall {r['wall']:.0f} s ({stages}); peak RSS (process tree) {r['peak_rss_mib']:.0f} MiB "
+        print(f"\n{n} images, {mapper} mapping: wall {r['wall']:.0f} s ({stages}); peak RSS (process tree) {r['peak_rss_mib']:.0f} MiB "
               f"(during {r['peak_stage']})",
               flush=True)
         if r.get("cpu_seconds"):
@@ -165,9 +172,16 @@ def main():
               f"{r.get('dsm_interpolated')}; mosaic nodata cells enclosed by data: {r.get('interior_nodata')}; "
               f"radiometry: {json.dumps(rad) if rad else 'n/a'}")
         print(f"  per image: {r['wall'] / n:.1f} s", flush=True)
+    for mapper in mappers:
+        grown = [r for r in runs if r["mapper"] == mapper]
+        if len(grown) > 1:
+            _print_growth(mapper, grown)
+
+
+def _print_growth(mapper, runs):
     if len(runs) > 1:
         xs = [r["n"] for r in runs]
-        print("\ngrowth with the number of images (exponent of a power law fitted over the runs; 1 = linear):")
+        print(f"\ngrowth with the number of images, {mapper} mapping (exponent of a power law fitted over the runs; 1 = linear):")
         print(f"  whole chain time   {fit_exponent(xs, [r['wall'] for r in runs]):.2f}")
         for stage in runs[0]["seconds"]:
             print(f"  {stage:<18} {fit_exponent(xs, [r['seconds'].get(stage, 0.0) for r in runs]):.2f}")
