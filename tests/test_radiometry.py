@@ -6,6 +6,7 @@ hot spot 10 deg wide with the sun at 65 deg elevation, exposures varying by 8 % 
 is mosaicked with and without the correction: the recovered fall-off against the truth, the brightness step
 across the seamlines, and the mosaic against the scene's true albedo.  The fit itself is also checked on made-up
 overlaps (no rendering): outliers, a block without any defect, too few overlaps."""
+import json
 import math
 import os
 import warnings
@@ -121,6 +122,11 @@ def test_seam_step_within_two_percent(mosaics):
           f"{100 * s['seam_step_level_after']:.2f} %")
     assert 0.5 < s["seam_level_fraction"] <= 1.0
     assert s["seam_step_level_before"] > 0.02 and s["seam_step_level_after"] <= 0.02
+    # the stage's record keeps them (the report reads them there): the last run here is the corrected one
+    results = json.load(open(os.path.join(out[True].workspace, "workspace.json")))["stages"]["orthophoto"]["results"]
+    for key in ("seam_step_before", "seam_step_after", "seam_step_level_before", "seam_step_level_after",
+                "seam_level_fraction"):
+        assert results[key] == pytest.approx(s[key]), key
 
 
 def test_mosaic_against_the_true_albedo(mosaics):

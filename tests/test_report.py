@@ -259,6 +259,16 @@ def test_products_previews_with_resolution_and_valid_fraction(georeferenced, tmp
     result = report.build_report(ws, ReportOptions(uncertainty=False))
     assert result.figures["DSM_VALID_FRACTION"] == pytest.approx(0.93)
     assert '<span data-key="dsm.valid">0.750</span>' in open(result.path, encoding="utf-8").read()
+    assert "ortho.seam_step" not in open(result.path, encoding="utf-8").read()  # no correction recorded: no row
+    # the orthophoto stage's seam figures (core.ortho.radiometry.seam_figures): the whole seam and level ground
+    manifest["stages"]["orthophoto"] = {"status": "done", "results": {
+        "seam_step_before": 0.0365, "seam_step_after": 0.0241, "seam_step_level_before": 0.0238,
+        "seam_step_level_after": 0.0140, "seam_level_fraction": 0.583}}
+    json.dump(manifest, open(os.path.join(ws, "workspace.json"), "w"))
+    text = open(report.build_report(ws, ReportOptions(uncertainty=False)).path, encoding="utf-8").read()
+    assert '3.6 % → <span data-key="ortho.seam_step">2.4</span> %' in text
+    assert '2.4 % → <span data-key="ortho.seam_step_level">1.4</span> %' in text
+    assert "level ground (58 % of the seams" in text
 
 
 class _CancelAt(NullProgress):

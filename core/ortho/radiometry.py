@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -292,4 +292,20 @@ def seam_steps(model: Optional[RadiometryModel], labels: np.ndarray, k: int, pre
             out[key] = chunk_disagreement(ia[sel], ib[sel], cell[sel], labels.shape[1], (logs[0] - logs[1])[sel], 3)
     ok = np.isfinite(raw[0]) & np.isfinite(raw[1])
     out["seam_level_fraction"] = float(np.mean(level[ok])) if ok.any() else nan
+    return out
+
+
+# the radiometric correction's figures the record keeps (the report shows them): the median brightness step
+# across the seamlines before and after it, the same over level ground, and level ground's share of the seams
+SEAM_FIGURES = ("seam_step_before", "seam_step_after", "seam_step_level_before", "seam_step_level_after",
+                "seam_level_fraction")
+
+
+def seam_figures(radiometry: Dict[str, Any]) -> Dict[str, float]:
+    """The seam figures of the radiometric correction's summary that are numbers (none without a correction)."""
+    out = {}
+    for key in SEAM_FIGURES:
+        v = (radiometry or {}).get(key)
+        if isinstance(v, (int, float)) and math.isfinite(v):
+            out[key] = float(v)
     return out

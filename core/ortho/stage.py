@@ -18,6 +18,7 @@ from ..project.workspace import Workspace
 from .cameras import OrthoCamera, cameras_from_reconstruction, select_cameras
 from .mosaic import WORK_PREFIX, build_orthomosaic
 from .options import OrthoError, OrthoOptions
+from .radiometry import seam_figures
 from .seamlines import dsm_extent, edits_fingerprint, read_seamline_edits
 
 STAGE = ORTHOPHOTO
@@ -83,7 +84,8 @@ def build_orthophoto_workspace(workspace_dir: str, options: Optional[OrthoOption
                    options.per_image_folder), ("seamlines", options.seamlines)) if path}
         run.finish(outputs=outputs, results={
             "resolution": result.resolution, "gsd": result.gsd, "width": result.width, "height": result.height,
-            "images": len(result.images), "valid_fraction": result.valid_fraction, "warnings": result.warnings})
+            "images": len(result.images), "valid_fraction": result.valid_fraction, "warnings": result.warnings,
+            **seam_figures(result.radiometry)})
     return OrthoStageResult(lay.root, options.output, crs, result.resolution, result.images, result.valid_fraction,
                             options.per_image_folder, options.seamlines, result.timings, result.warnings,
                             result.log_lines, result.radiometry)

@@ -83,6 +83,8 @@ def _raster(ctx: ReportContext, path: str, title: str, dem: bool) -> str:
                      "(dense/dsm-source.tif)",
                      f"{num(results['MEASURED_FRACTION']):.3f} / {num(results.get('INTERPOLATED_FRACTION')) or 0:.3f}"
                      f" / {num(results.get('REMOVED_FRACTION')) or 0:.3f}"))
+    if not dem:
+        info += _seam_rows((ctx.d.manifest.get("stages", {}).get("orthophoto") or {}).get("results") or {})
     # the key figure is the stage's own (the Processing output VALID_FRACTION): inside the camera centres'
     # convex hull; the whole raster's share is shown beside it above
     ctx.figures[f"{'DSM' if dem else 'ORTHO'}_VALID_FRACTION"] = stage_vf if stage_vf is not None else frac
@@ -91,6 +93,24 @@ def _raster(ctx: ReportContext, path: str, title: str, dem: bool) -> str:
     ax.grid(False)
     return f"<h3>{title}</h3>" + kv(info) + embed(fig, f"{title} preview", f"{title} preview" + (
         " with hillshade (sun from the north-west, 45°)." if dem else "."))
+
+
+def _seam_rows(results) -> list:
+    """The orthophoto stage's seam figures (core.ortho.radiometry.seam_figures), where it recorded them."""
+    after, before = num(results.get("seam_step_after")), num(results.get("seam_step_before"))
+    if after is None:
+        return []
+    rows = [("Brightness step across the seamlines (median; before → after the radiometric correction)",
+             (f"{100 * before:.1f} % → " if before is not None else "")
+             + f'<span data-key="ortho.seam_step">{100 * after:.1f}</span> %')]
+    level, share = num(results.get("seam_step_level_after")), num(results.get("seam_level_fraction"))
+    if level is not None and share is not None:
+        lb = num(results.get("seam_step_level_before"))
+        rows.append((f"The same over level ground ({100 * share:.0f} % of the seams; at crowns, walls and roof "
+                     "edges two photos see different sides, which no brightness model levels)",
+                     (f"{100 * lb:.1f} % → " if lb is not None else "")
+                     + f'<span data-key="ortho.seam_step_level">{100 * level:.1f}</span> %'))
+    return rows
 
 
 def _read_image(ds: RasterFile, bw: int, bh: int):
