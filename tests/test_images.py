@@ -30,6 +30,46 @@ def test_exif_focal_and_gps_toledo():
     assert alt == pytest.approx(122.3)
 
 
+def _tiff_with_exif(path, exif):
+    """A 16-bit single-band TIFF (a multispectral band file) whose EXIF tags GDAL keeps in its EXIF domain."""
+    from osgeo import gdal
+
+    ds = gdal.GetDriverByName("GTiff").Create(str(path), 64, 48, 1, gdal.GDT_UInt16)
+    ds.GetRasterBand(1).WriteArray(np.full((48, 64), 1000, np.uint16))
+    ds.SetMetadata(exif, "EXIF")
+    ds = None
+    return str(path)
+
+
+def test_exif_of_a_tiff_band_file(tmp_path):
+    """GDAL shows a TIFF's EXIF only in its EXIF domain: the GPS and focal length of a band TIFF are read (issue 37:
+    a Sequoia band folder through Run pipeline stopped with 'no target CRS' although every band carries GPS)."""
+    path = _tiff_with_exif(tmp_path / "IMG_0000_NIR.TIF", {
+        "EXIF_GPSLatitude": "(41) (25) (43.2518)", "EXIF_GPSLatitudeRef": "N", "EXIF_GPSLongitude": "(81) (36) (21.1874)",
+        "EXIF_GPSLongitudeRef": "W", "EXIF_GPSAltitude": "(347.723)", "EXIF_GPSAltitudeRef": "0x00",
+        "EXIF_FocalLength": "(3.98)", "EXIF_Orientation": "1"})
+    info = read_image_info(path)
+    assert (info.bands, info.dtype) == (1, "UInt16")
+    assert info.focal_mm == pytest.approx(3.98)
+    lon, lat, alt = info.gps
+    assert lat == pytest.approx(41 + 25 / 60 + 43.2518 / 3600)
+    assert lon == pytest.approx(-(81 + 36 / 60 + 21.1874 / 3600))
+    assert alt == pytest.approx(347.723)
+    assert read_image_info(_tiff_with_exif(tmp_path / "none.tif", {})).gps is None
+
+
+def test_exif_of_the_real_sequoia_bands():
+    """The four band TIFFs of the Sequoia capture: each carries the capture's GPS in its TIFF EXIF IFD."""
+    folder = shared("sequoia_sample")
+    for band in ("GRE", "RED", "REG", "NIR"):
+        info = read_image_info(os.path.join(folder, f"IMG_161122_163234_0000_{band}.TIF"))
+        assert (info.width, info.height, info.dtype) == (1280, 960, "UInt16")
+        lon, lat, alt = info.gps
+        assert lat == pytest.approx(41 + 25 / 60 + 43.2518 / 3600, abs=2e-5), band
+        assert lon == pytest.approx(-(81 + 36 / 60 + 21.1874 / 3600), abs=2e-5), band
+        assert info.focal_mm == pytest.approx(3.98)
+
+
 def test_exif_focal_plane_resolution_copr():
     info = read_image_info(shared("copr", "images", "IMG_0037.jpg"))
     # 30 mm x 4865.6 px/inch / 25.4, scaled from 4272 px to 1200 px wide

@@ -137,7 +137,7 @@ def read_image_info(path: str, name: Optional[str] = None, manual_focal_mm: Opti
     with _checked_file(path) as r:
         w, h, nb = r.width, r.height, r.count
         dtype = gdal.GetDataTypeName(r.band(1).DataType)
-        md = r.metadata()
+        md = photo_metadata(r)
     info = ImageInfo(name=name, path=os.path.abspath(path), width=w, height=h, bands=nb, dtype=dtype)
     info.make = md.get("EXIF_Make", "").strip().strip("\x00")
     info.model = md.get("EXIF_Model", "").strip().strip("\x00")
@@ -185,11 +185,20 @@ def _orientation_value(text: Optional[str]) -> int:
     return value if value in ORIENTATION_STEPS else 1
 
 
+def photo_metadata(r: RasterFile) -> Dict[str, str]:
+    """A photo's metadata with its EXIF tags: GDAL shows a JPEG's EXIF in the default domain and a TIFF's (the
+    band files of multispectral cameras: Parrot Sequoia, MicaSense, DJI P4M) only in the ``EXIF`` domain; the
+    default domain's value wins where both have a key."""
+    md = dict(r.metadata(domain="EXIF"))
+    md.update(r.metadata())
+    return md
+
+
 def exif_orientation(path: str) -> int:
     """The EXIF orientation (1-8) of a photo, 1 when it has none or an invalid one; reads the header only.
     ImageError naming the file when it cannot be opened."""
     with open_image(path) as r:
-        return _orientation_value(r.metadata().get("EXIF_Orientation"))
+        return _orientation_value(photo_metadata(r).get("EXIF_Orientation"))
 
 
 XMP_SCAN_BYTES = 262144  # the XMP packet of a drone photo sits in its first APP1 segments (DJI: within 64 KiB)
