@@ -465,10 +465,41 @@ def _sample(raster: np.ndarray, mx: np.ndarray, my: np.ndarray, interpolation=cv
     pad = rows * 1024 - n
     fx = np.pad(mx.reshape(-1).astype(np.float32), (0, pad)).reshape(rows, 1024)
     fy = np.pad(my.reshape(-1).astype(np.float32), (0, pad)).reshape(rows, 1024)
-    step = 32000  # cv2.remap takes maps of fewer than 32767 rows (16 MP photos rendered supersampled have more)
-    out = np.concatenate([cv2.remap(raster, fx[r:r + step], fy[r:r + step], interpolation,
-                                    borderMode=cv2.BORDER_REPLICATE) for r in range(0, rows, step)])
+    # cv2.remap takes maps and sources of fewer than 32767 rows and columns: 16 MP photos rendered supersampled
+    # have more map rows, the texture of a 1,000-photo block more source columns (then each run of 16 map rows,
+    # neighbouring pixels of one photo, is sampled from the window of the texture it covers)
+    big = max(raster.shape[:2]) >= _REMAP_LIMIT
+    step = 16 if big else 32000
+    out = np.concatenate([_remap(raster, fx[r:r + step], fy[r:r + step], interpolation, big)
+                          for r in range(0, rows, step)])
     return out.reshape(-1)[:n].reshape(shape)
+
+
+_REMAP_LIMIT = 32767
+
+
+def _remap(raster: np.ndarray, fx: np.ndarray, fy: np.ndarray, interpolation, windowed: bool) -> np.ndarray:
+    if not windowed:
+        return cv2.remap(raster, fx, fy, interpolation, borderMode=cv2.BORDER_REPLICATE)
+    h, w = raster.shape[:2]
+    ok = np.isfinite(fx) & np.isfinite(fy)
+    if not ok.any():
+        return cv2.remap(raster[:2, :2], fx, fy, interpolation, borderMode=cv2.BORDER_REPLICATE)
+    x0 = int(np.clip(np.floor(fx[ok].min()) - 2, 0, w - 1))
+    x1 = int(np.clip(np.ceil(fx[ok].max()) + 3, x0 + 1, w))
+    y0 = int(np.clip(np.floor(fy[ok].min()) - 2, 0, h - 1))
+    y1 = int(np.clip(np.ceil(fy[ok].max()) + 3, y0 + 1, h))
+    if x1 - x0 >= _REMAP_LIMIT or y1 - y0 >= _REMAP_LIMIT:
+        if len(fx) > 1:  # the map rows span too much of the texture: one row at a time
+            return np.concatenate([_remap(raster, fx[i:i + 1], fy[i:i + 1], interpolation, True)
+                                   for i in range(len(fx))])
+        half = fx.shape[1] // 2
+        if half == 0:
+            raise ValueError("a texture window over cv2.remap's limit for one pixel")
+        return np.concatenate([_remap(raster, fx[:, :half], fy[:, :half], interpolation, True),
+                               _remap(raster, fx[:, half:], fy[:, half:], interpolation, True)], axis=1)
+    window = np.ascontiguousarray(raster[y0:y1, x0:x1])
+    return cv2.remap(window, fx - np.float32(x0), fy - np.float32(y0), interpolation, borderMode=cv2.BORDER_REPLICATE)
 
 
 def _ray_cast(scene: Scene, centre: np.ndarray, dirs: np.ndarray, step: float = 0.4,
