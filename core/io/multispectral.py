@@ -1,0 +1,667 @@
+"""Multispectral and NIR rigs (issue 37): a band file's metadata, the captures of a block, the primary band.
+
+A multispectral rig (Parrot Sequoia, MicaSense RedEdge / Altum, DJI P4 Multispectral / Mavic 3M) writes one file
+per band per capture; each file says in its XMP packet which band it is, which camera of the rig took it, which
+capture it belongs to, its lens model and its radiometric calibration.  :func:`read_band_info` reads that into a
+typed :class:`BandInfo` (a field a file does not carry is None: nothing is guessed); :func:`read_block` groups
+band files into :class:`Capture` objects and checks the block (:class:`MultispectralError` for what cannot be
+built, warning lines for what is built with less); :func:`primary_band` picks the band the geometry is built on.
+
+Tag names, checked against (public material, read for this module; no code copied):
+- Pix4D "Specifications of XMP Camera tags" (namespace ``Camera``, http://pix4d.com/camera/1.0/): ModelType,
+  PrincipalPoint (mm), PerspectiveFocalLength (mm), PerspectiveDistortion (R1, R2, R3, T1, T2),
+  FisheyeAffineMatrix (C, D, E, F), FisheyePolynomial, RigName, RigCameraIndex, RigRelatives (rotation from the
+  rig's reference camera, degrees), CaptureUUID, BandName / CentralWavelength / WavelengthFWHM / BlackCurrent
+  (rdf:Seq, one item per band);
+- OpenDroneMap ``opendm/photo.py`` (reads all three vendors): capture id from ``drone-dji:CaptureUUID``,
+  ``MicaSense:CaptureId``, ``Camera:CaptureUUID``; ``Camera:VignettingCenter`` / ``VignettingPolynomial``;
+  ``Camera:Irradiance`` / ``SpectralIrradiance`` / ``HorizontalIrradiance`` / ``IrradianceScaleToSIUnits``;
+  ``drone-dji:SensorGain`` / ``SensorGainAdjustment``; and ``opendm/multispectral.py`` (its primary band rule);
+- MicaSense ``imageprocessing/micasense/metadata.py``: ``XMP:CaptureId``, ``PrincipalPoint`` (mm),
+  ``PerspectiveFocalLength`` with ``PerspectiveFocalLengthUnits``, ``PerspectiveDistortion``, EXIF
+  ``BlackLevel`` (mean of its values), gain = ISO / 100 (not applied here: ``iso`` is kept as read);
+- DJI "P4 Multispectral Image Processing Guide" (v1.0 2020.07): ``drone-dji:CalibratedOpticalCenterX/Y``
+  (vignetting centre, px), ``VignettingData`` (k0..k5 of a polynomial in the radius in px), ``DewarpData``
+  ("date;fx,fy,cx,cy,k1,k2,p1,p2,k3", cx / cy relative to the optical centre), ``Irradiance``,
+  ``SensorGain``, ``SensorGainAdjustment``, ``ExposureTime`` (microseconds), black level 4096 (EXIF);
+- Sequoia ``IrradianceList``: base64 of little-endian records ``uint64 timestamp (us), uint16 CH0, uint16 CH1,
+  uint16 gain index, uint16 integration time (ms), float yaw, pitch, roll`` (28 bytes), the layout given on
+  Parrot's developer forum ("details of irradiance list tag for sunshine sensor", quoted in public scripts that
+  decode it with ``struct.iter_unpack("qHHHHfff", ...)``).
+
+``LineReadoutTime`` is kept as the number written: the material above gives no unit (the Sequoia writes 23076 on
+its 1280 x 960 band cameras and 47500 on its 4608 x 3456 RGB camera).
+
+Pure: the standard library, NumPy and GDAL (through :class:`core.io.raster.RasterFile`); no qgis, no Qt.
+"""
+from __future__ import annotations
+
+import base64
+import binascii
+import os
+import re
+import struct
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from datetime import datetime, timedelta
+from typing import Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from ..common.errors import ArchaeoOrthoError
+from .images import IMAGE_EXTENSIONS, XMP_SCAN_BYTES, photo_metadata
+from .raster import RasterError, RasterFile
+
+
+class MultispectralError(ArchaeoOrthoError, ValueError):
+    """A set of band files that cannot be used as it is; the message names the files and the problem."""
+
+
+# XMP namespaces by a piece of their URI -> the prefix the vendors write (the prefix in a file may differ)
+NAMESPACES = (("pix4d.com/camera", "Camera"), ("dji.com/drone-dji", "drone-dji"),
+              ("micasense.com/MicaSense", "MicaSense"), ("micasense.com/DLS", "DLS"),
+              ("ns.sensefly.com", "sensefly"), ("www.w3.org/1999/02/22-rdf-syntax-ns", "rdf"))
+RDF = "{http://www.w3.org/1999/02/22-rdf-syntax-ns#}"
+
+# a file stamped within this many seconds of a capture of its rig belongs to it when it carries no capture id.
+# The Sequoia sample's RGB frame (no CaptureUUID) is stamped 68 ms after its four band frames, which spread over
+# 10 ms; the Sequoia, MicaSense and DJI rigs capture at most about twice a second, so 0.1 s cannot join two
+# captures (group_captures warns when one is closer than twice this)
+DEFAULT_TIME_TOLERANCE_S = 0.1
+
+SEQUOIA_RECORD = struct.Struct("<QHHHHfff")  # one IrradianceList record, 28 bytes
+
+RGB_NAMES = ("rgb", "redgreenblue")
+# the bands each index needs: named in the warning for a capture that lacks one
+INDEX_BANDS = (("NDVI", ("nir", "red")), ("NDRE", ("nir", "rededge")), ("GNDVI", ("nir", "green")))
+
+
+@dataclass(frozen=True)
+class LensModel:
+    """The band camera's interior orientation as the file gives it (nothing converted).
+
+    ``kind``: "fisheye" / "perspective" (Pix4D ``Camera:ModelType``), "opencv" (DJI ``DewarpData``: OpenCV's
+    Brown model in pixels), None when the file names none.  ``principal_point_mm``: Pix4D / MicaSense
+    ``PrincipalPoint`` (millimetres).  ``focal_length`` in ``focal_length_unit`` ("mm" unless MicaSense's
+    ``PerspectiveFocalLengthUnits`` says otherwise).  ``distortion``: Pix4D R1, R2, R3, T1, T2, or DJI k1, k2,
+    p1, p2, k3.  ``fisheye_affine``: C, D, E, F; ``fisheye_polynomial``: p0..p3.  ``dewarp``: DJI fx, fy, cx,
+    cy (px) and ``dewarp_date``; ``optical_center_px``: DJI ``CalibratedOpticalCenterX/Y``."""
+    kind: Optional[str] = None
+    principal_point_mm: Optional[Tuple[float, ...]] = None
+    focal_length: Optional[float] = None
+    focal_length_unit: Optional[str] = None
+    distortion: Optional[Tuple[float, ...]] = None
+    fisheye_affine: Optional[Tuple[float, ...]] = None
+    fisheye_polynomial: Optional[Tuple[float, ...]] = None
+    dewarp: Optional[Tuple[float, ...]] = None
+    dewarp_date: Optional[str] = None
+    optical_center_px: Optional[Tuple[float, ...]] = None
+
+
+@dataclass(frozen=True)
+class Vignetting:
+    """A vignetting model as given.  ``model``: "poly2d" (Sequoia ``VignettingPolynomial2D``: coefficient i
+    multiplies x^a y^b with (a, b) the i-th pair of ``VignettingPolynomial2DName``, x, y the pixel position
+    divided by the width / height) or "radial" (MicaSense ``VignettingPolynomial`` / DJI ``VignettingData``:
+    coefficients of r, r^2, ... with r the distance in px from ``center_px``).  ``source``: the tag read."""
+    model: str
+    coefficients: Tuple[float, ...]
+    exponents: Optional[Tuple[Tuple[int, int], ...]] = None
+    center_px: Optional[Tuple[float, ...]] = None
+    source: str = ""
+
+
+@dataclass(frozen=True)
+class SunshineRecord:
+    """One record of the Sequoia sunshine sensor's ``IrradianceList``: raw counts of its two channels, the gain
+    index and integration time they were taken with, and the sensor's attitude (degrees)."""
+    timestamp_us: int
+    ch0: int
+    ch1: int
+    gain_index: int
+    integration_ms: int
+    yaw: float
+    pitch: float
+    roll: float
+
+
+@dataclass(frozen=True)
+class Irradiance:
+    """The sun sensor's reading for this band.  ``value``: MicaSense ``Camera:Irradiance`` /
+    ``SpectralIrradiance`` or DJI ``Irradiance`` as written (MicaSense DLS2 values in the unit that
+    ``scale_to_si`` converts to W/m^2/nm); ``horizontal``: MicaSense ``HorizontalIrradiance``; ``records``: the
+    Sequoia's decoded ``IrradianceList`` (raw counts, not W/m^2); ``source``: the tag read."""
+    value: Optional[float] = None
+    horizontal: Optional[float] = None
+    scale_to_si: Optional[float] = None
+    records: Tuple[SunshineRecord, ...] = ()
+    source: str = ""
+
+
+@dataclass(frozen=True)
+class BandInfo:
+    """What one band file says about itself; None where it says nothing."""
+    path: str
+    band_name: Optional[str]
+    band_names: Tuple[str, ...]
+    width: int
+    height: int
+    central_wavelength_nm: Optional[float] = None
+    fwhm_nm: Optional[float] = None
+    rig_name: Optional[str] = None
+    rig_camera_index: Optional[int] = None
+    rig_relatives: Optional[Tuple[float, ...]] = None
+    capture_id: Optional[str] = None
+    timestamp: Optional[datetime] = None
+    make: Optional[str] = None
+    model: Optional[str] = None
+    lens: LensModel = field(default_factory=LensModel)
+    black_level: Optional[float] = None
+    vignetting: Optional[Vignetting] = None
+    band_gain: Optional[float] = None
+    gain_adjustment: Optional[float] = None
+    exposure_s: Optional[float] = None
+    iso: Optional[float] = None
+    irradiance: Optional[Irradiance] = None
+    line_readout_time: Optional[float] = None
+    sensor_temperature_c: Optional[float] = None
+
+    @property
+    def name(self) -> str:
+        return os.path.basename(self.path)
+
+    @property
+    def is_rgb(self) -> bool:
+        return (self.band_name or "").lower() in RGB_NAMES
+
+    @property
+    def has_calibration(self) -> bool:
+        """True when the file carries any radiometric calibration (black level, vignetting, sun sensor)."""
+        return self.black_level is not None or self.vignetting is not None or self.irradiance is not None
+
+
+# ---------------------------------------------------------------- XMP
+def _prefix(uri: str) -> str:
+    for piece, prefix in NAMESPACES:
+        if piece in uri:
+            return prefix
+    return uri
+
+
+def _qname(tag: str) -> str:
+    """'{uri}Local' -> 'Prefix:Local' with the vendor's usual prefix."""
+    if tag.startswith("{"):
+        uri, local = tag[1:].split("}", 1)
+        return f"{_prefix(uri)}:{local}"
+    return tag
+
+
+def _element_value(el) -> str:
+    """An XMP property written as an element: its rdf:Seq / rdf:Bag / rdf:Alt items joined by commas, else its
+    text (items such as Sequoia's VignettingPolynomial2DName are themselves comma lists)."""
+    items = [(li.text or "").strip() for li in el.iter(RDF + "li")]
+    if items:
+        return ",".join(items)
+    return (el.text or "").strip()
+
+
+def parse_xmp(xmp: str) -> Dict[str, str]:
+    """The properties of an XMP packet as {"Prefix:Name": text}, attribute form (``Camera:BandName="NIR"``) and
+    element form (``<Camera:BandName><rdf:Seq><rdf:li>NIR</rdf:li>...``) alike; sequences joined by commas.
+    Prefixes are the vendors' usual ones whatever the file declares (by namespace URI).  A packet that is not
+    well-formed XML (undeclared prefixes happen) is read for its attributes only; {} when there is none."""
+    start, end = xmp.find("<x:xmpmeta"), xmp.rfind("</x:xmpmeta>")
+    if start < 0 or end < start:
+        return {}
+    text = xmp[start:end + len("</x:xmpmeta>")]
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError:
+        return {m.group(1): m.group(2) for m in re.finditer(r'([A-Za-z][\w-]*:\w+)\s*=\s*"([^"]*)"', text)}
+    out: Dict[str, str] = {}
+    for desc in root.iter(RDF + "Description"):
+        for key, value in desc.attrib.items():
+            out.setdefault(_qname(key), value.strip())
+        for child in desc:
+            out.setdefault(_qname(child.tag), _element_value(child))
+    return out
+
+
+def read_xmp(r: RasterFile) -> str:
+    """The XMP packet of an opened file: GDAL's ``xml:XMP`` domain (TIFF tag 700, JPEG APP1), else the first
+    ``XMP_SCAN_BYTES`` of the file scanned for it; "" when it has none."""
+    md = r.metadata(domain="xml:XMP")
+    packets = list(md.values()) if isinstance(md, dict) else list(md or [])
+    if packets:
+        return "\n".join(packets)
+    try:
+        with open(r.path, "rb") as f:
+            head = f.read(XMP_SCAN_BYTES)
+    except OSError:
+        return ""
+    start, end = head.find(b"<x:xmpmeta"), head.find(b"</x:xmpmeta>")
+    return head[start:end + 12].decode("utf-8", "replace") if 0 <= start < end else ""
+
+
+# ---------------------------------------------------------------- values
+def numbers(text: Optional[str]) -> Optional[Tuple[float, ...]]:
+    """The numbers in a comma / space / semicolon separated list ("(0.0018)", "1/800" and "+1.5" included);
+    None when the text is absent or holds something else."""
+    if text is None:
+        return None
+    out = []
+    for part in re.split(r"[,\s;]+", text.strip().strip("()")):
+        part = part.strip("()")
+        if not part:
+            continue
+        try:
+            if "/" in part:
+                num, den = part.split("/", 1)
+                out.append(float(num) / float(den))
+            else:
+                out.append(float(part))
+        except (ValueError, ZeroDivisionError):
+            return None
+    return tuple(out) if out else None
+
+
+def _first(tags: Dict[str, str], *names: str) -> Optional[str]:
+    for n in names:
+        v = (tags.get(n) or "").strip("\x00 ")
+        if v:
+            return v
+    return None
+
+
+def _number(tags: Dict[str, str], *names: str) -> Optional[float]:
+    """The first of ``names`` present as a number (a one-item sequence's item; several: their mean, as
+    MicaSense's black level of a 2 x 2 pattern)."""
+    for n in names:
+        vals = numbers(tags.get(n))
+        if vals:
+            return float(np.mean(vals))
+    return None
+
+
+def _vector(tags: Dict[str, str], *names: str) -> Optional[Tuple[float, ...]]:
+    for n in names:
+        vals = numbers(tags.get(n))
+        if vals:
+            return vals
+    return None
+
+
+def _timestamp(md: Dict[str, str]) -> Optional[datetime]:
+    """EXIF DateTimeOriginal plus its SubSecTimeOriginal (else SubSecTime) as the digits after the decimal point
+    (the camera's clock; no time zone)."""
+    text = (md.get("EXIF_DateTimeOriginal") or "").strip().strip("\x00")
+    try:
+        t = datetime.strptime(text, "%Y:%m:%d %H:%M:%S")
+    except ValueError:
+        return None
+    sub = (md.get("EXIF_SubSecTime_Original") or md.get("EXIF_SubSecTime") or "").strip().strip("\x00")
+    if sub.isdigit():
+        t += timedelta(seconds=float("0." + sub))
+    return t
+
+
+def decode_irradiance_list(text: str) -> Tuple[SunshineRecord, ...]:
+    """The Sequoia sunshine sensor records of an ``IrradianceList`` (base64, whitespace allowed); () when it is
+    not base64 of whole 28-byte records."""
+    try:
+        raw = base64.b64decode("".join(text.split()), validate=True)
+    except (binascii.Error, ValueError):
+        return ()
+    if not raw or len(raw) % SEQUOIA_RECORD.size:
+        return ()
+    return tuple(SunshineRecord(*rec) for rec in SEQUOIA_RECORD.iter_unpack(raw))
+
+
+# ---------------------------------------------------------------- the parts of a BandInfo
+def lens_model(tags: Dict[str, str]) -> LensModel:
+    """Pix4D / MicaSense ``Camera:`` lens tags, or DJI ``drone-dji:DewarpData`` (see :class:`LensModel`)."""
+    kind = _first(tags, "Camera:ModelType")
+    dewarp, dewarp_date, dewarp_k = None, None, None
+    text = _first(tags, "drone-dji:DewarpData")
+    if text:
+        date, _, values = text.rpartition(";")
+        vals = numbers(values)
+        if vals and len(vals) == 9:
+            dewarp, dewarp_k, dewarp_date = vals[:4], vals[4:], (date.strip() or None)
+    distortion = _vector(tags, "Camera:PerspectiveDistortion") or dewarp_k
+    center = None
+    cx, cy = _number(tags, "drone-dji:CalibratedOpticalCenterX"), _number(tags, "drone-dji:CalibratedOpticalCenterY")
+    if cx is not None and cy is not None:
+        center = (cx, cy)
+    focal = _number(tags, "Camera:PerspectiveFocalLength")
+    unit = _first(tags, "Camera:PerspectiveFocalLengthUnits") or ("mm" if focal is not None else None)
+    if focal is None and _number(tags, "drone-dji:CalibratedFocalLength") is not None:
+        focal, unit = _number(tags, "drone-dji:CalibratedFocalLength"), "px"
+    return LensModel(kind=kind.lower() if kind else ("opencv" if dewarp is not None else None),
+                     principal_point_mm=_vector(tags, "Camera:PrincipalPoint"), focal_length=focal,
+                     focal_length_unit=unit, distortion=distortion,
+                     fisheye_affine=_vector(tags, "Camera:FisheyeAffineMatrix"),
+                     fisheye_polynomial=_vector(tags, "Camera:FisheyePolynomial"),
+                     dewarp=dewarp, dewarp_date=dewarp_date, optical_center_px=center)
+
+
+def vignetting(tags: Dict[str, str], lens: LensModel) -> Optional[Vignetting]:
+    """Sequoia ``VignettingPolynomial2D`` (+ ``...2DName``), MicaSense ``VignettingCenter`` +
+    ``VignettingPolynomial``, DJI ``VignettingData`` (centre: ``CalibratedOpticalCenterX/Y``); None when none."""
+    coeffs = _vector(tags, "Camera:VignettingPolynomial2D")
+    if coeffs:
+        names = _vector(tags, "Camera:VignettingPolynomial2DName")
+        pairs = None
+        if names and len(names) == 2 * len(coeffs):
+            pairs = tuple((int(names[2 * i]), int(names[2 * i + 1])) for i in range(len(coeffs)))
+        return Vignetting("poly2d", coeffs, exponents=pairs, source="Camera:VignettingPolynomial2D")
+    for tag, center_tag in (("Camera:VignettingPolynomial", "Camera:VignettingCenter"),
+                            ("drone-dji:VignettingData", None)):
+        coeffs = _vector(tags, tag)
+        if coeffs:
+            center = _vector(tags, center_tag) if center_tag else lens.optical_center_px
+            return Vignetting("radial", coeffs, center_px=center, source=tag)
+    return None
+
+
+def irradiance(tags: Dict[str, str]) -> Optional[Irradiance]:
+    """The sun sensor's reading: Sequoia ``IrradianceList`` decoded, MicaSense ``Camera:Irradiance`` /
+    ``SpectralIrradiance`` / ``HorizontalIrradiance`` (+ ``IrradianceScaleToSIUnits``), DJI
+    ``drone-dji:Irradiance`` or ``Camera:Irradiance``; None when none."""
+    records = decode_irradiance_list(tags.get("Camera:IrradianceList", ""))
+    value_tags = ("Camera:Irradiance", "Camera:SpectralIrradiance", "drone-dji:Irradiance")
+    source = next((t for t in value_tags if numbers(tags.get(t))), None)
+    horizontal = _number(tags, "Camera:HorizontalIrradiance")
+    if not records and source is None and horizontal is None:
+        return None
+    if records:
+        source = "Camera:IrradianceList"
+    return Irradiance(value=_number(tags, *value_tags), horizontal=horizontal,
+                      scale_to_si=_number(tags, "Camera:IrradianceScaleToSIUnits"), records=records,
+                      source=source or "Camera:HorizontalIrradiance")
+
+
+def _band_names(tags: Dict[str, str], bands: int) -> Tuple[Optional[str], Tuple[str, ...]]:
+    """(the band's name, the names as listed): one name for a band file; "RGB" for a colour frame (a
+    three-item Red, Green, Blue sequence such as the Sequoia's RGB JPG, or a three-band file naming none)."""
+    text = _first(tags, "Camera:BandName", "drone-dji:BandName")
+    names = tuple(n.strip() for n in text.split(",") if n.strip()) if text else ()
+    if len(names) == 1:
+        return names[0], names
+    if (names and sorted(n.lower() for n in names) == ["blue", "green", "red"]) or (not names and bands == 3):
+        return "RGB", names
+    return (",".join(names) or None), names
+
+
+def read_band_info(path: str) -> BandInfo:
+    """The multispectral metadata of one band file (TIFF or JPEG): XMP through GDAL's ``xml:XMP`` domain, EXIF
+    through :func:`core.io.images.photo_metadata`.  MultispectralError naming the file when GDAL cannot open it."""
+    try:
+        r = RasterFile(path, "band file")
+    except RasterError as e:
+        raise MultispectralError(f"{path}: not a readable image ({e})") from e
+    with r:
+        tags = parse_xmp(read_xmp(r))
+        md = photo_metadata(r)
+        width, height, count = r.width, r.height, r.count
+    name, names = _band_names(tags, count)
+    lens = lens_model(tags)
+    index = _number(tags, "Camera:RigCameraIndex", "DLS:SensorId", "drone-dji:SensorIndex")
+    exposure = _number(md, "EXIF_ExposureTime")
+    if exposure is None and _number(tags, "drone-dji:ExposureTime") is not None:
+        exposure = _number(tags, "drone-dji:ExposureTime") * 1e-6
+    return BandInfo(
+        path=path, band_name=name, band_names=names, width=width, height=height,
+        central_wavelength_nm=_number(tags, "Camera:CentralWavelength", "drone-dji:CentralWavelength"),
+        fwhm_nm=_number(tags, "Camera:WavelengthFWHM", "drone-dji:WavelengthFWHM"),
+        rig_name=_first(tags, "Camera:RigName"), rig_camera_index=None if index is None else int(index),
+        rig_relatives=_vector(tags, "Camera:RigRelatives"),
+        capture_id=_first(tags, "Camera:CaptureUUID", "drone-dji:CaptureUUID", "MicaSense:CaptureId"),
+        timestamp=_timestamp(md), make=_first(md, "EXIF_Make", "TIFFTAG_MAKE"),
+        model=_first(md, "EXIF_Model", "TIFFTAG_MODEL"), lens=lens,
+        black_level=_number({**md, **tags}, "Camera:BlackCurrent", "Camera:BlackLevel", "drone-dji:BlackLevel",
+                            "drone-dji:BlackCurrent", "EXIF_BlackLevel"),
+        vignetting=vignetting(tags, lens),
+        band_gain=_number(tags, "Camera:BandGain", "drone-dji:SensorGain"),
+        gain_adjustment=_number(tags, "drone-dji:SensorGainAdjustment"), exposure_s=exposure,
+        iso=_number(md, "EXIF_ISOSpeedRatings", "EXIF_ISOSpeed", "EXIF_PhotographicSensitivity"),
+        irradiance=irradiance(tags), line_readout_time=_number(tags, "Camera:LineReadoutTime"),
+        sensor_temperature_c=_number(tags, "Camera:SensorTemperature"))
+
+
+# ---------------------------------------------------------------- captures
+def band_key(name: Optional[str]) -> str:
+    """A band name compared across vendors: lower case, letters and digits only ("Red edge" -> "rededge")."""
+    return re.sub(r"[^a-z0-9]", "", (name or "").lower())
+
+
+@dataclass(frozen=True)
+class Capture:
+    """The band files of one trigger of the rig.  ``capture_id``: the files' capture id, else
+    "<rig> <time>" for files matched by time; ``timestamp``: the earliest of its files'."""
+    capture_id: str
+    rig_name: Optional[str]
+    timestamp: Optional[datetime]
+    bands: Tuple[BandInfo, ...]
+
+    @property
+    def band_names(self) -> Tuple[str, ...]:
+        return tuple(b.band_name or "?" for b in self.bands)
+
+    def band(self, name: str) -> Optional[BandInfo]:
+        key = band_key(name)
+        return next((b for b in self.bands if band_key(b.band_name) == key), None)
+
+
+@dataclass(frozen=True)
+class Block:
+    """The captures of a set of band files, every band name seen (rig camera order, RGB last) and the warnings
+    of :func:`check_captures` (what is built with less)."""
+    captures: Tuple[Capture, ...]
+    band_names: Tuple[str, ...]
+    warnings: Tuple[str, ...]
+
+
+def _names(infos: Sequence[BandInfo], most: int = 6) -> str:
+    names = [b.name for b in infos]
+    more = f" and {len(names) - most} more" if len(names) > most else ""
+    return ", ".join(names[:most]) + more
+
+
+def _time(t: Optional[datetime]) -> str:
+    return t.isoformat(sep=" ", timespec="milliseconds") if t else "no time"
+
+
+def _seconds(a: datetime, b: datetime) -> float:
+    return abs((a - b).total_seconds())
+
+
+def _nearest(groups: Dict[str, List[BandInfo]], info: BandInfo, tolerance_s: float) -> Optional[str]:
+    """The key of the group of ``info``'s rig whose earliest file lies nearest in time, within the tolerance."""
+    best, best_dt = None, tolerance_s
+    for key, members in groups.items():
+        times = [m.timestamp for m in members if m.timestamp is not None]
+        if not times or members[0].rig_name != info.rig_name:
+            continue
+        dt = _seconds(min(times), info.timestamp)
+        if dt <= best_dt:
+            best, best_dt = key, dt
+    return best
+
+
+def group_captures(infos: Sequence[BandInfo], tolerance_s: float = DEFAULT_TIME_TOLERANCE_S) -> List[Capture]:
+    """Band files grouped into captures: by capture id (Sequoia / DJI CaptureUUID, MicaSense CaptureId); a file
+    without one joins the capture of its rig stamped nearest to it within ``tolerance_s`` (the Sequoia's RGB
+    frame), else starts one with the files of its rig stamped within the tolerance.  A file with neither id nor
+    time is left out here (:func:`check_captures` names it).  Captures in time order."""
+    groups: Dict[str, List[BandInfo]] = {}
+    for info in infos:
+        if info.capture_id:
+            groups.setdefault(info.capture_id, []).append(info)
+    loose = sorted((i for i in infos if not i.capture_id and i.timestamp is not None), key=lambda i: i.timestamp)
+    for info in loose:
+        key = _nearest(groups, info, tolerance_s)
+        if key is None:
+            key = f"{info.rig_name or 'camera'} {_time(info.timestamp)}"
+            groups.setdefault(key, [])
+        groups[key].append(info)
+    captures = []
+    for key, members in groups.items():
+        times = [m.timestamp for m in members if m.timestamp is not None]
+        order = sorted(members, key=lambda b: (b.is_rgb, b.rig_camera_index if b.rig_camera_index is not None
+                                               else 99, b.name))
+        captures.append(Capture(key, members[0].rig_name, min(times) if times else None, tuple(order)))
+    return sorted(captures, key=lambda c: (c.timestamp or datetime.min, c.capture_id))
+
+
+def _id_errors(captures: Sequence[Capture], tolerance_s: float) -> List[str]:
+    """Files of two captures under one capture id (copied or renamed files): their times differ more than the
+    tolerance; and duplicate bands in one capture."""
+    errors = []
+    for cap in captures:
+        tagged = [b for b in cap.bands if b.capture_id == cap.capture_id and b.timestamp is not None]
+        if tagged and _seconds(max(b.timestamp for b in tagged), min(b.timestamp for b in tagged)) > tolerance_s:
+            listed = ", ".join(f"{b.name} ({_time(b.timestamp)})" for b in sorted(tagged, key=lambda b: b.timestamp))
+            errors.append(f"capture id {cap.capture_id} is carried by files taken at different times: {listed}; "
+                          f"files of two captures share one id (copied or renamed files?): keep one capture's "
+                          f"files under each id")
+        seen: Dict[str, List[BandInfo]] = {}
+        for b in cap.bands:
+            seen.setdefault(band_key(b.band_name), []).append(b)
+        for dup in (v for v in seen.values() if len(v) > 1):
+            errors.append(f"capture {cap.capture_id} has band {dup[0].band_name} twice ({_names(dup)}): "
+                          f"remove the copies so that one file is left per band")
+    return errors
+
+
+def _missing_band_warnings(captures: Sequence[Capture], names: Sequence[str]) -> List[str]:
+    warnings = []
+    for cap in captures:
+        have = {band_key(n) for n in cap.band_names}
+        lacks = [n for n in names if band_key(n) not in have]
+        if not lacks:
+            continue
+        lost = [idx for idx, needs in INDEX_BANDS if any(band_key(n) in needs for n in lacks)]
+        also = f"; {', '.join(lost)} not available for that capture" if lost else ""
+        warnings.append(f"capture {cap.capture_id} ({_time(cap.timestamp)}) lacks {', '.join(lacks)} "
+                        f"(files: {_names(cap.bands)}): its other bands are used{also}")
+    return warnings
+
+
+def _calibration_warnings(infos: Sequence[BandInfo]) -> List[str]:
+    """Band files (not RGB frames, which carry no radiometric model) with no black level, vignetting or sun
+    sensor reading, by band."""
+    bare: Dict[str, List[BandInfo]] = {}
+    for b in infos:
+        if not b.is_rgb and not b.has_calibration:
+            bare.setdefault(b.band_name or "?", []).append(b)
+    return [f"band {name}: {len(files)} file(s) carry no radiometric calibration (no black level, vignetting "
+            f"or sun-sensor reading: {_names(files)}): they are used for the geometry and their raw values are "
+            f"mosaicked, but no reflectance is computed for that band" for name, files in bare.items()]
+
+
+def block_band_names(captures: Sequence[Capture]) -> Tuple[str, ...]:
+    """Every band name of the captures once, in rig camera order (RGB last)."""
+    seen: Dict[str, BandInfo] = {}
+    for cap in captures:
+        for b in cap.bands:
+            seen.setdefault(band_key(b.band_name), b)
+    order = sorted(seen.values(), key=lambda b: (b.is_rgb, b.rig_camera_index if b.rig_camera_index is not None
+                                                 else 99, band_key(b.band_name)))
+    return tuple(b.band_name for b in order)
+
+
+def check_captures(infos: Sequence[BandInfo], captures: Sequence[Capture],
+                   tolerance_s: float = DEFAULT_TIME_TOLERANCE_S) -> List[str]:
+    """Check a block before any work.  MultispectralError (every problem, each naming its files) for what
+    cannot be built right: a file that names no band (not a band file of a rig), a file with neither capture id
+    nor time (no capture can be found for it), files of two captures under one capture id, a band twice in one
+    capture (which file is meant cannot be told).  The warnings returned are for what is built with less: a
+    capture that lacks a band the others have (its other bands are used; the indices that need the missing band
+    are not available there), band files without radiometric calibration (geometry only, no reflectance)."""
+    errors = [f"{b.name}: its XMP names no band (Camera:BandName): not a band file of a multispectral rig"
+              for b in infos if not b.band_name]
+    placed = {id(b) for cap in captures for b in cap.bands}
+    lost = [b for b in infos if b.band_name and id(b) not in placed]
+    if lost:
+        errors.append(f"{_names(lost)}: no capture id in the XMP and no EXIF DateTimeOriginal: the capture "
+                      f"these files belong to cannot be found")
+    errors += _id_errors(captures, tolerance_s)
+    if errors:
+        raise MultispectralError("the band files cannot be used as they are:\n- " + "\n- ".join(errors))
+    return (_missing_band_warnings(captures, block_band_names(captures))
+            + _calibration_warnings([b for cap in captures for b in cap.bands]))
+
+
+def band_files(folder: str) -> List[str]:
+    """The image files of a folder (sorted); MultispectralError naming the folder when it has none."""
+    if not os.path.isdir(folder):
+        raise MultispectralError(f"{folder}: not a folder")
+    files = sorted(os.path.join(folder, n) for n in os.listdir(folder) if n.lower().endswith(IMAGE_EXTENSIONS))
+    if not files:
+        raise MultispectralError(f"{folder}: no image files ({', '.join(IMAGE_EXTENSIONS)})")
+    return files
+
+
+def read_block(paths: Sequence[str], tolerance_s: float = DEFAULT_TIME_TOLERANCE_S) -> Block:
+    """The band files read (:func:`read_band_info`), grouped into captures and checked (:func:`check_captures`:
+    MultispectralError before any work, else the block with its warnings)."""
+    infos = [read_band_info(p) for p in paths]
+    captures = group_captures(infos, tolerance_s)
+    warnings = check_captures(infos, captures, tolerance_s)
+    return Block(tuple(captures), block_band_names(captures), tuple(warnings))
+
+
+# ---------------------------------------------------------------- primary band
+TEXTURE_SIZE = 320  # long side (px) of the decimated read the texture is measured on
+
+
+@dataclass(frozen=True)
+class PrimaryBand:
+    """The band the geometry (matching, alignment) is built on, why, and the texture scores measured (empty
+    when an RGB camera decided it)."""
+    name: str
+    reason: str
+    scores: Dict[str, float] = field(default_factory=dict)
+
+
+def texture(path: str, size: int = TEXTURE_SIZE) -> float:
+    """Gradient energy of the photo's first band read decimated (GDAL average) to ``size`` px on its long side,
+    its values scaled to their 1-99 percentile range: contrast and gain do not count, edges do; averaging the
+    pixels down also averages the sensor noise out.  MultispectralError naming the file when it cannot be read."""
+    try:
+        with RasterFile(path, "band file") as r:
+            scale = min(1.0, size / max(r.width, r.height))
+            shape = (max(2, round(r.height * scale)), max(2, round(r.width * scale)))
+            a = r.read(1, out_shape=shape, resampling="average").astype(np.float64)
+    except RasterError as e:
+        raise MultispectralError(f"{path}: cannot be read for its texture ({e})") from e
+    lo, hi = np.percentile(a, [1.0, 99.0])
+    if hi <= lo:
+        return 0.0
+    a = (a - lo) / (hi - lo)
+    gy, gx = np.gradient(a)
+    return float(np.mean(gx * gx + gy * gy))
+
+
+def primary_band(block: Block, sample: int = 3) -> PrimaryBand:
+    """The primary band: the RGB camera when a capture has one (most texture and detail, and the frame a user
+    recognises); else the band with the most texture (:func:`texture`, median over up to ``sample`` captures
+    holding the most bands, spread over the block).  Measured rather than taken from a vendor default (ODM's is
+    RGB, then Green, then Blue): which band is sharpest depends on the scene (NIR over vegetation, green over bare
+    soil and stone), and reading ``sample`` decimated frames per band costs a fraction of a second."""
+    if any(b.is_rgb for cap in block.captures for b in cap.bands):
+        rgb = next(b for cap in block.captures for b in cap.bands if b.is_rgb)
+        return PrimaryBand(rgb.band_name, "the RGB camera of the rig")
+    if not block.captures:
+        raise MultispectralError("no capture to choose a primary band from")
+    most = max(len(c.bands) for c in block.captures)
+    full = [c for c in block.captures if len(c.bands) == most]
+    picks = [full[i] for i in sorted({round(k * (len(full) - 1) / max(1, sample - 1)) for k in range(sample)})]
+    values: Dict[str, List[float]] = {}
+    for cap in picks:
+        for b in cap.bands:
+            values.setdefault(b.band_name, []).append(texture(b.path))
+    scores = {name: float(np.median(v)) for name, v in values.items()}
+    name = max(scores, key=lambda n: scores[n])
+    return PrimaryBand(name, f"the most texture (gradient energy) over {len(picks)} capture(s)", scores)
