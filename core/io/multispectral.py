@@ -217,7 +217,8 @@ def parse_xmp(xmp: str) -> Dict[str, str]:
     try:
         root = ET.fromstring(text)
     except ET.ParseError:
-        return {m.group(1): m.group(2) for m in re.finditer(r'([A-Za-z][\w-]*:\w+)\s*=\s*"([^"]*)"', text)}
+        return {m.group(1): m.group(2) for m in re.finditer(r'([A-Za-z][\w-]*:\w+)\s*=\s*"([^"]*)"', text)
+                if not m.group(1).startswith("xmlns:")}
     out: Dict[str, str] = {}
     for desc in root.iter(RDF + "Description"):
         for key, value in desc.attrib.items():
@@ -462,6 +463,13 @@ class Block:
     warnings: Tuple[str, ...]
 
 
+def band_order(b: BandInfo) -> Tuple[bool, int, float]:
+    """Sort key of bands: rig camera index, else central wavelength, RGB frames last (a stable sort keeps the
+    files' order among bands that give neither)."""
+    index = b.rig_camera_index if b.rig_camera_index is not None else 1 << 16
+    return b.is_rgb, index, b.central_wavelength_nm if b.central_wavelength_nm is not None else float("inf")
+
+
 def _names(infos: Sequence[BandInfo], most: int = 6) -> str:
     names = [b.name for b in infos]
     more = f" and {len(names) - most} more" if len(names) > most else ""
@@ -508,8 +516,7 @@ def group_captures(infos: Sequence[BandInfo], tolerance_s: float = DEFAULT_TIME_
     captures = []
     for key, members in groups.items():
         times = [m.timestamp for m in members if m.timestamp is not None]
-        order = sorted(members, key=lambda b: (b.is_rgb, b.rig_camera_index if b.rig_camera_index is not None
-                                               else 99, b.name))
+        order = sorted(members, key=band_order)
         captures.append(Capture(key, members[0].rig_name, min(times) if times else None, tuple(order)))
     return sorted(captures, key=lambda c: (c.timestamp or datetime.min, c.capture_id))
 
@@ -561,13 +568,12 @@ def _calibration_warnings(infos: Sequence[BandInfo]) -> List[str]:
 
 
 def block_band_names(captures: Sequence[Capture]) -> Tuple[str, ...]:
-    """Every band name of the captures once, in rig camera order (RGB last)."""
+    """Every band name of the captures once, in :func:`band_order`."""
     seen: Dict[str, BandInfo] = {}
     for cap in captures:
         for b in cap.bands:
             seen.setdefault(band_key(b.band_name), b)
-    order = sorted(seen.values(), key=lambda b: (b.is_rgb, b.rig_camera_index if b.rig_camera_index is not None
-                                                 else 99, band_key(b.band_name)))
+    order = sorted(seen.values(), key=band_order)
     return tuple(b.band_name for b in order)
 
 
