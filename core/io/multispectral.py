@@ -16,6 +16,8 @@ Tag names, checked against (public material, read for this module; no code copie
 - OpenDroneMap ``opendm/photo.py`` (reads all three vendors): capture id from ``drone-dji:CaptureUUID``,
   ``MicaSense:CaptureId``, ``Camera:CaptureUUID``; ``Camera:VignettingCenter`` / ``VignettingPolynomial``;
   ``Camera:Irradiance`` / ``SpectralIrradiance`` / ``HorizontalIrradiance`` / ``IrradianceScaleToSIUnits``;
+  (``Camera:BlackLevel`` for MicaSense and DJI is read as the issue names it; the sources above give their black
+  level in EXIF ``BlackLevel``, which is read too when GDAL shows it as ``EXIF_BlackLevel``);
   ``drone-dji:SensorGain`` / ``SensorGainAdjustment``; and ``opendm/multispectral.py`` (its primary band rule);
 - MicaSense ``imageprocessing/micasense/metadata.py``: ``XMP:CaptureId``, ``PrincipalPoint`` (mm),
   ``PerspectiveFocalLength`` with ``PerspectiveFocalLengthUnits``, ``PerspectiveDistortion``, EXIF
@@ -65,8 +67,8 @@ RDF = "{http://www.w3.org/1999/02/22-rdf-syntax-ns#}"
 
 # a file stamped within this many seconds of a capture of its rig belongs to it when it carries no capture id.
 # The Sequoia sample's RGB frame (no CaptureUUID) is stamped 68 ms after its four band frames, which spread over
-# 10 ms; the Sequoia, MicaSense and DJI rigs capture at most about twice a second, so 0.1 s cannot join two
-# captures (group_captures warns when one is closer than twice this)
+# 10 ms; a rig triggered at most a few times a second keeps its captures well over 0.1 s apart (not checked
+# here: a file without id between two captures closer than the tolerance joins the nearer one)
 DEFAULT_TIME_TOLERANCE_S = 0.1
 
 SEQUOIA_RECORD = struct.Struct("<QHHHHfff")  # one IrradianceList record, 28 bytes
