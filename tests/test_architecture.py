@@ -12,7 +12,7 @@ CORE = os.path.join(ROOT, "core")
 MAX_FUNCTION_LINES = 120
 MAX_CLASS_LINES = 400
 # the rooms in the order data flows; a room may import only rooms before it (and itself)
-LAYERS = [["common"], ["geometry"], ["project"], ["io"], ["prepare"], ["align"], ["georef"], ["dense"], ["ortho", "terrain"],
+LAYERS = [["common"], ["geometry"], ["project"], ["io"], ["prepare"], ["align"], ["georef"], ["dense"], ["ortho", "terrain", "spectral"],
           ["report"], ["pipeline"]]
 
 

@@ -135,6 +135,21 @@ class RasterFile:
             raise RasterError(f"{self.what} {self.path}: band {index} cannot be read (window {window})")
         return arr
 
+    def read_mask(self, index: int = 1, window: Optional[Tuple[int, int, int, int]] = None) -> Optional[np.ndarray]:
+        """Where band ``index`` is valid by the file's own mask (a per-dataset mask: the alpha band, an internal or
+        .msk mask), as a bool array of the ``window``; None when the file has no such mask (every cell valid, or
+        only a nodata value, which the caller compares with the values)."""
+        gdal, _ = _gdal()
+        flags = self.band(index).GetMaskFlags()
+        if flags & gdal.GMF_ALL_VALID or not flags & gdal.GMF_PER_DATASET:
+            return None
+        x0, y0, w, h = window if window is not None else (0, 0, self.width, self.height)
+        try:
+            arr = self.band(index).GetMaskBand().ReadAsArray(int(x0), int(y0), int(w), int(h))
+        except RuntimeError as e:
+            raise RasterError(f"{self.what} {self.path}: the mask of band {index} cannot be read ({e})") from e
+        return np.asarray(arr) > 0
+
     def read_bands(self, indices: Optional[Sequence[int]] = None, window: Optional[Tuple[int, int, int, int]] = None,
                    out_shape: Optional[Tuple[int, int]] = None, resampling: str = "nearest") -> np.ndarray:
         """Several bands stacked (bands, rows, cols); every band when ``indices`` is None."""
