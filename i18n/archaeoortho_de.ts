@@ -2886,6 +2886,11 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <source>{} — {}</source>
         <translation>{} — {}</translation>
     </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="391"/>
+        <source>Spectral index</source>
+        <translation>Spektralindex</translation>
+    </message>
 </context>
 <context>
     <name>RunPipelineAlgorithm</name>
@@ -3086,6 +3091,100 @@ Himmelsmasken (Schrägaufnahmen): zuerst findet eine Stufe 'Bilder vorbereiten' 
 Das DGM erzeugen: nach dem DOM ein DGM der nackten Erde (wie 'DGM erzeugen'). Höhenlinienabstand (erweitert): Höhenlinien des DGM in diesem Abstand (wie 'Höhenlinien'; 0 = keine). Reliefvisualisierungen (erweitert): die gewählten werden aus dem DGM berechnet (wie 'Reliefvisualisierung'). Beide brauchen das DGM.
 Die übrigen Parameter sind die der einzelnen Stufen (siehe deren Hilfe); 0 bedeutet automatisch.
 Ausgaben: das DOM, das Orthomosaik und der Genauigkeitsbericht (HTML) sowie die wichtigsten Kennzahlen.</translation>
+    </message>
+</context>
+<context>
+    <name>SpectralIndexAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>Input raster</source>
+        <translation>Eingaberaster</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>Index</source>
+        <translation>Index</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>NDVI</source>
+        <translation>NDVI</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>NDRE</source>
+        <translation>NDRE</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>Expression</source>
+        <translation>Ausdruck</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>NIR band number</source>
+        <translation>NIR-Kanalnummer</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>Red band number</source>
+        <translation>Rot-Kanalnummer</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>Red-edge band number</source>
+        <translation>Red-Edge-Kanalnummer</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="61"/>
+        <source>Index raster</source>
+        <translation>Indexraster</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="62"/>
+        <source>Cells with a value</source>
+        <translation>Zellen mit Wert</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="63"/>
+        <source>Lowest value</source>
+        <translation>Kleinster Wert</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="64"/>
+        <source>Highest value</source>
+        <translation>Größter Wert</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="65"/>
+        <source>Mean value</source>
+        <translation>Mittelwert</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Spectral index</source>
+        <translation>Spektralindex</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>A vegetation index of a multispectral orthomosaic or any multi-band raster (a satellite scene), to see crop marks: over a buried ditch the crop grows greener (a higher index), over a buried wall it is stressed (a lower one). NDVI is (NIR - RED) / (NIR + RED), NDRE (NIR - REDEDGE) / (NIR + REDEDGE). A cell is nodata where a band used is nodata or masked (alpha band, mask) or the denominator is zero. The raster is read in blocks, so a large one needs little memory.
+
+Which band is NIR, red or red edge is read from the raster: the band&apos;s description (NIR, Red, Red edge / REG / RE, Green / GRE, Blue), a name or wavelength in its metadata (790 nm is NIR: red 600-690 nm, red edge 690-760 nm, NIR 760-1000 nm) or its colour interpretation; the log says which band was taken for each name and why, and a missing name lists the bands the raster has.
+
+Input raster: the multi-band raster.
+Index: NDVI, NDRE or the expression below.
+Expression: a formula of the bands, by number (b1 is the first band) or by name, e.g. (b4 - b3) / (b4 + b3) or 2.5 * (NIR - RED) / (NIR + 2.4 * RED + 1); numbers, + - * / ** and parentheses, and the functions sqrt, abs, log, exp, min, max, clip(x, low, high).
+NIR band number, Red band number, Red-edge band number (advanced): the band to take for that name when the raster&apos;s band names do not say it or say it wrongly; 0 reads it from the names.
+Index raster: where to write the float32 Cloud-Optimized GeoTIFF (nodata -9999, the band described by the index and its formula).</source>
+        <translation>Ein Vegetationsindex eines multispektralen Orthomosaiks oder eines beliebigen mehrkanaligen Rasters (einer Satellitenszene), um Bewuchsmerkmale zu sehen: über einem verfüllten Graben wächst das Getreide grüner (ein höherer Index), über einer Mauer ist es gestresst (ein niedrigerer). NDVI ist (NIR - RED) / (NIR + RED), NDRE (NIR - REDEDGE) / (NIR + REDEDGE). Eine Zelle ist NoData, wo ein verwendeter Kanal NoData oder maskiert ist (Alphakanal, Maske) oder der Nenner null ist. Das Raster wird blockweise gelesen, ein großes braucht also wenig Speicher.
+
+Welcher Kanal NIR, Rot oder Red Edge ist, wird aus dem Raster gelesen: aus der Beschreibung des Kanals (NIR, Red, Red edge / REG / RE, Green / GRE, Blue), einem Namen oder einer Wellenlänge in seinen Metadaten (790 nm ist NIR: Rot 600-690 nm, Red Edge 690-760 nm, NIR 760-1000 nm) oder seiner Farbinterpretation; das Protokoll sagt, welcher Kanal für jeden Namen genommen wurde und warum, und ein fehlender Name listet die Kanäle des Rasters auf.
+
+Eingaberaster: das mehrkanalige Raster.
+Index: NDVI, NDRE oder der Ausdruck unten.
+Ausdruck: eine Formel der Kanäle, nach Nummer (b1 ist der erste Kanal) oder nach Name, z. B. (b4 - b3) / (b4 + b3) oder 2.5 * (NIR - RED) / (NIR + 2.4 * RED + 1); Zahlen, + - * / ** und Klammern sowie die Funktionen sqrt, abs, log, exp, min, max, clip(x, low, high).
+NIR-Kanalnummer, Rot-Kanalnummer, Red-Edge-Kanalnummer (erweitert): der Kanal, der für diesen Namen zu nehmen ist, wenn die Kanalnamen des Rasters ihn nicht oder falsch angeben; 0 liest ihn aus den Namen.
+Indexraster: wohin das Float32-Cloud-Optimized-GeoTIFF geschrieben wird (NoData -9999, der Kanal mit dem Index und seiner Formel beschrieben).</translation>
     </message>
 </context>
 </TS>

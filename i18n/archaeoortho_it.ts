@@ -2886,6 +2886,11 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <source>{} — {}</source>
         <translation>{} — {}</translation>
     </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="391"/>
+        <source>Spectral index</source>
+        <translation>Indice spettrale</translation>
+    </message>
 </context>
 <context>
     <name>RunPipelineAlgorithm</name>
@@ -3086,6 +3091,100 @@ Maschere del cielo (foto oblique): prima una fase 'Prepara immagini' trova il ci
 Genera il DTM: dopo il DSM, un DTM del suolo nudo (come 'Genera DTM'). Equidistanza (avanzato): curve di livello del DTM con questa equidistanza (come 'Curve di livello'; 0 = nessuna). Visualizzazioni del rilievo (avanzato): quelle scelte sono calcolate dal DTM (come 'Visualizzazione del rilievo'). Entrambe richiedono il DTM.
 Gli altri parametri sono quelli delle singole fasi (vedi il loro aiuto); 0 significa automatico.
 Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali.</translation>
+    </message>
+</context>
+<context>
+    <name>SpectralIndexAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>Input raster</source>
+        <translation>Raster di ingresso</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>Index</source>
+        <translation>Indice</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>NDVI</source>
+        <translation>NDVI</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>NDRE</source>
+        <translation>NDRE</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>Expression</source>
+        <translation>Espressione</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>NIR band number</source>
+        <translation>Numero banda NIR</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>Red band number</source>
+        <translation>Numero banda rossa</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="51"/>
+        <source>Red-edge band number</source>
+        <translation>Numero banda red edge</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="61"/>
+        <source>Index raster</source>
+        <translation>Raster dell&apos;indice</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="62"/>
+        <source>Cells with a value</source>
+        <translation>Celle con un valore</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="63"/>
+        <source>Lowest value</source>
+        <translation>Valore minimo</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="64"/>
+        <source>Highest value</source>
+        <translation>Valore massimo</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/spectral_index.py" line="65"/>
+        <source>Mean value</source>
+        <translation>Valore medio</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Spectral index</source>
+        <translation>Indice spettrale</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>A vegetation index of a multispectral orthomosaic or any multi-band raster (a satellite scene), to see crop marks: over a buried ditch the crop grows greener (a higher index), over a buried wall it is stressed (a lower one). NDVI is (NIR - RED) / (NIR + RED), NDRE (NIR - REDEDGE) / (NIR + REDEDGE). A cell is nodata where a band used is nodata or masked (alpha band, mask) or the denominator is zero. The raster is read in blocks, so a large one needs little memory.
+
+Which band is NIR, red or red edge is read from the raster: the band&apos;s description (NIR, Red, Red edge / REG / RE, Green / GRE, Blue), a name or wavelength in its metadata (790 nm is NIR: red 600-690 nm, red edge 690-760 nm, NIR 760-1000 nm) or its colour interpretation; the log says which band was taken for each name and why, and a missing name lists the bands the raster has.
+
+Input raster: the multi-band raster.
+Index: NDVI, NDRE or the expression below.
+Expression: a formula of the bands, by number (b1 is the first band) or by name, e.g. (b4 - b3) / (b4 + b3) or 2.5 * (NIR - RED) / (NIR + 2.4 * RED + 1); numbers, + - * / ** and parentheses, and the functions sqrt, abs, log, exp, min, max, clip(x, low, high).
+NIR band number, Red band number, Red-edge band number (advanced): the band to take for that name when the raster&apos;s band names do not say it or say it wrongly; 0 reads it from the names.
+Index raster: where to write the float32 Cloud-Optimized GeoTIFF (nodata -9999, the band described by the index and its formula).</source>
+        <translation>Un indice di vegetazione di un ortomosaico multispettrale o di qualsiasi raster a più bande (una scena satellitare), per vedere le tracce da vegetazione (crop marks): sopra un fossato sepolto la coltura cresce più verde (un indice più alto), sopra un muro sepolto è stressata (uno più basso). NDVI è (NIR - RED) / (NIR + RED), NDRE (NIR - REDEDGE) / (NIR + REDEDGE). Una cella è nodata dove una banda usata è nodata o mascherata (banda alfa, maschera) o il denominatore è zero. Il raster è letto a blocchi, quindi uno grande richiede poca memoria.
+
+Quale banda sia NIR, rossa o red edge è letto dal raster: dalla descrizione della banda (NIR, Red, Red edge / REG / RE, Green / GRE, Blue), da un nome o una lunghezza d&apos;onda nei suoi metadati (790 nm è NIR: rosso 600-690 nm, red edge 690-760 nm, NIR 760-1000 nm) o dalla sua interpretazione del colore; il log dice quale banda è stata presa per ogni nome e perché, e un nome mancante elenca le bande del raster.
+
+Raster di ingresso: il raster a più bande.
+Indice: NDVI, NDRE o l&apos;espressione qui sotto.
+Espressione: una formula delle bande, per numero (b1 è la prima banda) o per nome, ad es. (b4 - b3) / (b4 + b3) o 2.5 * (NIR - RED) / (NIR + 2.4 * RED + 1); numeri, + - * / ** e parentesi, e le funzioni sqrt, abs, log, exp, min, max, clip(x, low, high).
+Numero banda NIR, Numero banda rossa, Numero banda red edge (avanzati): la banda da prendere per quel nome quando i nomi delle bande del raster non la indicano o la indicano male; 0 la legge dai nomi.
+Raster dell&apos;indice: dove scrivere il GeoTIFF Cloud-Optimized float32 (nodata -9999, la banda descritta dall&apos;indice e dalla sua formula).</translation>
     </message>
 </context>
 </TS>

@@ -40,8 +40,9 @@ def algorithms():
     from .prepare_images import PrepareImagesAlgorithm
     from .relief_visualisation import ReliefVisualisationAlgorithm
     from .run_pipeline import RunPipelineAlgorithm
+    from .spectral_index import SpectralIndexAlgorithm
 
     return [AlignImagesAlgorithm(), GeoreferenceAlgorithm(), BuildDsmAlgorithm(), PrepareImagesAlgorithm(),
             AccuracyReportAlgorithm(), BuildOrthophotoAlgorithm(), OrthorectifyImageAlgorithm(),
             RunPipelineAlgorithm(), BuildDtmAlgorithm(), ReliefVisualisationAlgorithm(), ContoursAlgorithm(),
-            AutoControlAlgorithm(), DsmDifferenceAlgorithm(), FindTargetsAlgorithm()]
+            AutoControlAlgorithm(), DsmDifferenceAlgorithm(), FindTargetsAlgorithm(), SpectralIndexAlgorithm()]

@@ -16,6 +16,7 @@ from qgis.core import (
     QgsFillSymbol,
     QgsGeometryGeneratorSymbolLayer,
     QgsGradientColorRamp,
+    QgsGradientStop,
     QgsHillshadeRenderer,
     QgsLineSymbol,
     QgsMarkerSymbol,
@@ -55,12 +56,13 @@ DTM = "dtm"
 DTM_HILLSHADE = "dtmhillshade"
 RELIEF = "relief"
 CONTOURS = "contours"
+INDEX = "index"  # a spectral index (NDVI ...): over the orthomosaic it is made from
 
 # the order of a workspace's group, top to bottom: points and lines over the pictures, the orthomosaic over the
 # terrain rasters, each hillshade right over its elevation model.  A hillshade drawn with 'multiply' above the
 # orthomosaic darkened it (the DTM's, loaded last, by about 19 %: issue 36 item 16); under it, it shades only
 # its DSM or DTM, which the orthomosaic covers until it is switched off.
-GROUP_ORDER = (RESIDUALS, CAMERAS, FOOTPRINTS, CONTOURS, POINT_CLOUD, ORTHO, RELIEF, DTM_HILLSHADE, DTM, HILLSHADE,
+GROUP_ORDER = (RESIDUALS, CAMERAS, FOOTPRINTS, CONTOURS, POINT_CLOUD, INDEX, ORTHO, RELIEF, DTM_HILLSHADE, DTM, HILLSHADE,
                DSM)
 
 # residual point status (core.georef) -> colour
@@ -357,6 +359,38 @@ def style_relief(layer):
     renderer.setContrastEnhancement(ce)
     layer.setRenderer(renderer)
     _mark(layer, RELIEF)
+    layer.triggerRepaint()
+    return layer
+
+
+def style_index(layer):
+    """A spectral index in a diverging red-yellow-green ramp (RdYlGn: bare soil and stressed crop red, healthy crop
+    green) over the file's DISPLAY_MIN .. DISPLAY_MAX (-1 .. 1 for NDVI and NDRE), else its 2-98 % range; nodata
+    transparent.  Named after the index (its INDEX item: NDVI, NDRE, Index)."""
+    path = layer.source().split("|")[0]
+    meta = _file_metadata(path)
+    try:
+        lo, hi = float(meta["DISPLAY_MIN"]), float(meta["DISPLAY_MAX"])
+        if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo):
+            raise ValueError
+    except (KeyError, ValueError):
+        lo, hi = _band_range(layer)
+    ramp = QgsStyle.defaultStyle().colorRamp("RdYlGn") if QgsStyle.defaultStyle() else None
+    if ramp is None:
+        ramp = QgsGradientColorRamp(QColor("#d7191c"), QColor("#1a9641"))
+        ramp.setStops([QgsGradientStop(0.5, QColor("#ffffbf"))])
+    shader = QgsColorRampShader(lo, hi, ramp, QgsColorRampShader.Type.Interpolated,
+                                QgsColorRampShader.ClassificationMode.Continuous)
+    shader.classifyColorRamp(5, -1, layer.extent(), layer.dataProvider())
+    raster_shader = QgsRasterShader(lo, hi)
+    raster_shader.setRasterShaderFunction(shader)
+    renderer = QgsSingleBandPseudoColorRenderer(layer.dataProvider(), 1, raster_shader)
+    renderer.setClassificationMin(lo)
+    renderer.setClassificationMax(hi)
+    layer.setRenderer(renderer)
+    layer.setName(product_name(meta.get("INDEX") or QCoreApplication.translate("ResultLayers", "Spectral index"),
+                               path))
+    _mark(layer, INDEX)
     layer.triggerRepaint()
     return layer
 
@@ -759,6 +793,8 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
             layer.setName(product_name(relief_name(path), path, self.workspace))
         elif self.kind == CONTOURS:
             style_contours(layer)
+        elif self.kind == INDEX:
+            style_index(layer)
         name = _output_layer_name(self.kind)
         if name:  # not the parameter's label ("Orthomosaic (default: <workspace>/orthomosaic.tif)")
             layer.setName(product_name(name, path, self.workspace))
@@ -842,7 +878,7 @@ def register_outputs(alg, results, context):
             details = context.layerToLoadOnCompletionDetails(value)
             details.setPostProcessor(pp)
         else:
-            hint = QgsProcessingUtils.LayerHint.Raster if kind in (DSM, ORTHO, DTM, RELIEF) else (
+            hint = QgsProcessingUtils.LayerHint.Raster if kind in (DSM, ORTHO, DTM, RELIEF, INDEX) else (
                 QgsProcessingUtils.LayerHint.Vector if kind in (CAMERAS, RESIDUALS, CONTOURS) else
                 QgsProcessingUtils.LayerHint.UnknownType)
             details = QgsProcessingContext.LayerDetails(out_def.description() or name, project, name, hint)

@@ -4,7 +4,9 @@ wavelength metadata or their numbers; nodata, alpha and zero denominators; the e
 not a formula; blocks giving the result of one block; bad input refused before any work; qgis_process."""
 from __future__ import annotations
 
+import json
 import os
+import subprocess
 
 import numpy as np
 import pytest
@@ -244,6 +246,16 @@ def test_wavelength_ranges():
     assert [n for n, _, _ in WAVELENGTH_RANGES_NM] == ["BLUE", "GREEN", "RED", "REDEDGE", "NIR"]
     assert wavelength_nm("wavelength", "790") == 790 and wavelength_nm("wavelength", "0.79") == pytest.approx(790)
     assert wavelength_nm("wavelength", "790 nm") == 790 and wavelength_nm("CENTRAL_WAVELENGTH_UM", "0.842") == 842
+    # the algorithm's help states the ranges the code uses
+    import ast
+
+    source = open(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "processing_provider",
+                               "spectral_index.py"), encoding="utf-8").read()
+    help_text = next(node.value.value for node in ast.walk(ast.parse(source)) if isinstance(node, ast.Assign)
+                     and getattr(node.targets[0], "id", "") == "HELP")
+    ranges = {n: (lo, hi) for n, lo, hi in WAVELENGTH_RANGES_NM}
+    for label, name in (("red", "RED"), ("red edge", "REDEDGE"), ("NIR", "NIR")):
+        assert f"{label} {ranges[name][0]:g}-{ranges[name][1]:g} nm" in help_text, label
 
 
 def test_band_numbers_set_by_the_user(tmp_path):
@@ -379,3 +391,78 @@ def test_bad_input_refused_before_any_work(scene, tmp_path):
     with pytest.raises(SpectralError, match=r"NDVI needs two bands \(NIR and RED\), the raster .*one-band.tif has 1"):
         spectral_index(IndexOptions(one, str(out)))
     assert sorted(os.listdir(tmp_path)) == ["one-band.tif"]  # nothing written
+
+
+def test_qgis_process_runs_spectralindex(scene, tmp_path):
+    """archaeoortho:spectralindex headless: NDVI from the band names, an expression with a band number set, and a
+    bad expression refused with its message, no traceback."""
+    from tests.conftest import qgis_process
+
+    exe, env = qgis_process()
+    path, data = scene
+
+    def run(*args):
+        return subprocess.run([exe, "--json", "run", "archaeoortho:spectralindex", "--", f"INPUT={path}", *args],
+                              env=env, capture_output=True, text=True, timeout=300)
+
+    out_path = str(tmp_path / "ndvi.tif")
+    out = run("INDEX=0", f"OUTPUT={out_path}")
+    assert out.returncode == 0, out.stderr[-3000:] + out.stdout[-3000:]
+    res = json.loads(out.stdout)["results"]
+    truth = _truth(data[3], data[1])
+    assert os.path.samefile(res["OUTPUT"], out_path) and res["VALID_CELLS"] == int(np.isfinite(truth).sum())
+    assert np.nanmax(np.abs(_read(out_path) - truth)) < 1e-6
+    expr_path = str(tmp_path / "e.tif")
+    out = run("INDEX=2", "EXPRESSION=(NIR - b3) / (NIR + b3)", "NIR_BAND=4", f"OUTPUT={expr_path}")
+    assert out.returncode == 0, out.stderr[-3000:] + out.stdout[-3000:]
+    assert np.nanmax(np.abs(_read(expr_path) - _truth(data[3], data[2]))) < 1e-6
+    out = run("INDEX=2", "EXPRESSION=__import__('os').getcwd()", f"OUTPUT={tmp_path / 'bad.tif'}")
+    text = out.stdout + out.stderr
+    assert out.returncode != 0 and "Traceback" not in text and "not an allowed function" in text, text[-2000:]
+    assert not os.path.exists(tmp_path / "bad.tif")
+
+
+def test_processing_run_loads_the_index_styled(plugin, scene, tmp_path, qgis_new_project):
+    """Through the QGIS Processing API as the toolbox runs it: the index layer is loaded named 'NDVI', in a
+    red-yellow-green pseudocolour from -1 to 1; a log line names the bands taken and why."""
+    from archaeoortho.qgisio import layers
+    from processing.gui.Postprocessing import handleAlgorithmResults
+    from qgis.core import (
+        QgsApplication,
+        QgsProcessingContext,
+        QgsProcessingFeedback,
+        QgsProject,
+        QgsRasterLayer,
+    )
+
+    class Feedback(QgsProcessingFeedback):
+        def __init__(self):
+            super().__init__()
+            self.infos = []
+
+        def pushInfo(self, info):  # noqa: N802 (QGIS API name)
+            self.infos.append(info)
+
+    path, data = scene
+    project = QgsProject.instance()
+    alg = QgsApplication.processingRegistry().algorithmById("archaeoortho:spectralindex").create()
+    ctx = QgsProcessingContext()
+    ctx.setProject(project)
+    feedback = Feedback()
+    out = str(tmp_path / "ndvi.tif")
+    results, ok = alg.run({"INPUT": path, "INDEX": 0, "OUTPUT": out}, ctx, feedback)
+    assert ok, feedback.infos
+    assert results["VALID_CELLS"] == int(np.isfinite(_truth(data[3], data[1])).sum())
+    assert results["MAXIMUM"] == pytest.approx(0.55 / 0.65, abs=1e-6)  # the crop mark
+    assert any("NIR = band 4 (its description 'NIR')" in line for line in feedback.infos), feedback.infos
+    assert handleAlgorithmResults(alg, ctx, QgsProcessingFeedback(), parameters={"OUTPUT": out})
+    loaded = [lyr for lyr in project.mapLayers().values() if isinstance(lyr, QgsRasterLayer)]
+    assert [lyr.name() for lyr in loaded] == ["NDVI"]
+    lyr = loaded[0]
+    assert lyr.customProperty(layers.KIND_PROPERTY) == layers.INDEX
+    r = lyr.renderer()
+    assert r.type() == "singlebandpseudocolor"
+    assert (r.classificationMin(), r.classificationMax()) == (-1.0, 1.0)
+    items = r.shader().rasterShaderFunction().colorRampItemList()
+    low, high = items[0].color, items[-1].color
+    assert low.red() > 150 and low.green() < 100 and high.green() > 100 and high.red() < 100  # red .. green
