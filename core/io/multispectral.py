@@ -51,6 +51,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..common.errors import ArchaeoOrthoError
+from ..common.files import atomic_output
 from .images import IMAGE_EXTENSIONS, XMP_SCAN_BYTES, photo_metadata
 from .raster import RasterError, RasterFile
 
@@ -167,6 +168,7 @@ class BandInfo:
     irradiance: Optional[Irradiance] = None
     line_readout_time: Optional[float] = None
     sensor_temperature_c: Optional[float] = None
+    focal_plane_px_per_mm: Optional[Tuple[float, float]] = None
 
     @property
     def name(self) -> str:
@@ -396,6 +398,24 @@ def _band_names(tags: Dict[str, str], bands: int) -> Tuple[Optional[str], Tuple[
     return (",".join(names) or None), names
 
 
+# EXIF FocalPlaneResolutionUnit -> millimetres per unit (EXIF 2.3: 2 inch (the default), 3 cm; 4 mm and 5 um as
+# written by cameras that extend it, the Sequoia's 4 with 266.667: a 3.75 um pitch on its 4.8 x 3.6 mm sensor)
+FOCAL_PLANE_UNIT_MM = {1: None, 2: 25.4, 3: 10.0, 4: 1.0, 5: 0.001}
+
+
+def focal_plane_resolution(md: Dict[str, str]) -> Optional[Tuple[float, float]]:
+    """EXIF FocalPlaneX/YResolution in pixels per millimetre (the unit of FocalPlaneResolutionUnit converted);
+    None when absent, zero or in no unit.  Pix4D / MicaSense give the principal point and focal length in mm: this
+    turns them into pixels."""
+    x, y = _number(md, "EXIF_FocalPlaneXResolution"), _number(md, "EXIF_FocalPlaneYResolution")
+    unit = _number(md, "EXIF_FocalPlaneResolutionUnit")
+    per_unit = FOCAL_PLANE_UNIT_MM.get(int(unit) if unit is not None else 2)
+    if x is None or not per_unit or x <= 0:
+        return None
+    y = y if y is not None and y > 0 else x
+    return x / per_unit, y / per_unit
+
+
 def read_band_info(path: str) -> BandInfo:
     """The multispectral metadata of one band file (TIFF or JPEG): XMP through GDAL's ``xml:XMP`` domain, EXIF
     through :func:`core.io.images.photo_metadata`.  MultispectralError naming the file when GDAL cannot open it."""
@@ -429,7 +449,8 @@ def read_band_info(path: str) -> BandInfo:
         gain_adjustment=_number(tags, "drone-dji:SensorGainAdjustment"), exposure_s=exposure,
         iso=_number(md, "EXIF_ISOSpeedRatings", "EXIF_ISOSpeed", "EXIF_PhotographicSensitivity"),
         irradiance=irradiance(tags), line_readout_time=_number(tags, "Camera:LineReadoutTime"),
-        sensor_temperature_c=_number(tags, "Camera:SensorTemperature"))
+        sensor_temperature_c=_number(tags, "Camera:SensorTemperature"),
+        focal_plane_px_per_mm=focal_plane_resolution(md))
 
 
 # ---------------------------------------------------------------- captures
@@ -673,3 +694,34 @@ def primary_band(block: Block, sample: int = 3) -> PrimaryBand:
     scores = {name: float(np.median(v)) for name, v in values.items()}
     name = max(scores, key=lambda n: scores[n])
     return PrimaryBand(name, f"the most texture (gradient energy) over {len(picks)} capture(s)", scores)
+
+
+# ---------------------------------------------------------------- registered bands
+def write_band_stack(path: str, bands: np.ndarray, names: Sequence[str], metadata: Optional[Dict[str, str]] = None,
+                     ) -> str:
+    """Write registered bands (bands, rows, cols) as one float32 plain TIFF (no georeferencing; DEFLATE), each
+    band described by its name, NaN as nodata, atomically.  MultispectralError naming the file when it cannot be
+    written."""
+    from osgeo import gdal
+
+    gdal.UseExceptions()
+    data = np.asarray(bands, dtype=np.float32)
+    if data.ndim != 3 or data.shape[0] != len(names):
+        raise MultispectralError(f"{path}: {len(names)} band names for an array of shape {data.shape}")
+    try:
+        with atomic_output(path) as tmp:
+            ds = gdal.GetDriverByName("GTiff").Create(tmp, data.shape[2], data.shape[1], data.shape[0],
+                                                      gdal.GDT_Float32, ["COMPRESS=DEFLATE", "PREDICTOR=3",
+                                                                         "TILED=YES", "INTERLEAVE=BAND"])
+            for i, name in enumerate(names):
+                band = ds.GetRasterBand(i + 1)
+                band.SetDescription(str(name))
+                band.SetNoDataValue(float("nan"))
+                band.WriteArray(data[i])
+            if metadata:
+                ds.SetMetadata({str(k): str(v) for k, v in metadata.items()})
+            ds.FlushCache()
+            ds = None
+    except (RuntimeError, OSError) as e:
+        raise MultispectralError(f"{path}: the registered bands cannot be written ({e})") from e
+    return path
