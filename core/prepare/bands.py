@@ -1,0 +1,403 @@
+"""Band registration of one multispectral capture (issue 37): every band undistorted with its own lens model and
+turned into the ideal pinhole frame of the rig's reference band, then refined by a small residual homography.
+
+1. Model: each band's lens (``core/geometry/lens.py``: Pix4D fisheye or perspective, from the band file's tags and
+   its EXIF focal plane resolution) and its rig relative rotation R_ref^T R.  The bands of a rig are a few
+   centimetres apart: from flying height their baseline is a fraction of a pixel, so a band maps onto the
+   reference by a pure rotation (an infinite homography), done here ray by ray through the lens models: output
+   pixel -> ray of the reference pinhole -> ray of the band camera -> its pixel (one ``cv2.remap``).
+2. Residual: the bands differ radiometrically (vegetation bright in NIR, dark in red), so they are compared by
+   their gradient magnitude, which keeps edges whatever their sign or contrast.  Phase correlation (with an
+   upsampled-DFT sub-pixel peak) over a grid of windows gives a shift per window; its median and worst magnitude
+   are the registration residual reported before and after refinement.
+3. Refinement: a homography of the output grid fitted robustly to the window shifts (iterated), so that
+   what the rig's calibration leaves (a small rotation, the baseline's parallax at the scene's height, a lens
+   model's error) is taken out; the model alone is reported beside it.
+
+Pure: NumPy and OpenCV; files read through ``core/io`` (band files, :func:`core.io.multispectral.write_band_stack`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from ..common.errors import ArchaeoOrthoError, require
+from ..geometry.lens import (FisheyeLens, LensError, PerspectiveLens, PinholeLens, band_to_reference,
+                             fisheye_from_pix4d, perspective_from_pix4d)
+from ..io.multispectral import BandInfo, Capture, band_key, write_band_stack
+from ..io.raster import RasterError, RasterFile
+
+Lens = Union[FisheyeLens, PerspectiveLens, PinholeLens]
+
+
+class BandRegistrationError(ArchaeoOrthoError, ValueError):
+    """A capture whose bands cannot be registered; the message names the file and the problem."""
+
+
+@dataclass(frozen=True)
+class RegistrationOptions:
+    """``reference``: the band the others are registered onto (None: the rig's reference camera, the band
+    without rig relatives, else the first band); ``window``: side (px) of the phase-correlation windows, laid
+    on a ``grid`` (columns, rows) over the frame's central ``coverage`` fraction; ``iterations`` of the
+    refinement (0: the model only); ``min_peak``: the phase-correlation peak below which a window is not
+    trusted; ``upsample``: sub-pixel factor of the peak search."""
+    reference: Optional[str] = None
+    window: int = 160
+    grid: Tuple[int, int] = (6, 5)
+    coverage: float = 0.9
+    iterations: int = 2
+    min_peak: float = 0.06
+    upsample: int = 50
+
+    def __post_init__(self):
+        if self.window < 32:
+            raise BandRegistrationError(f"window {self.window} px: at least 32")
+        if min(self.grid) < 1 or not 0.2 <= self.coverage <= 1.0:
+            raise BandRegistrationError(f"grid {self.grid} / coverage {self.coverage}: a grid of at least 1 x 1 "
+                                        f"windows over 0.2 .. 1 of the frame")
+        if self.iterations < 0 or self.upsample < 1:
+            raise BandRegistrationError(f"iterations {self.iterations} / upsample {self.upsample}: >= 0 / >= 1")
+
+
+# ---------------------------------------------------------------- the model
+def band_lens(info: BandInfo) -> Lens:
+    """The band's lens model in pixels from its tags (Pix4D fisheye / perspective) and its EXIF focal plane
+    resolution; BandRegistrationError naming the file and what is missing."""
+    lens, res = info.lens, info.focal_plane_px_per_mm
+    if lens.kind not in ("fisheye", "perspective"):
+        raise BandRegistrationError(f"{info.name}: lens model {lens.kind!r} (Camera:ModelType): only Pix4D's "
+                                    f"'fisheye' and 'perspective' are known here")
+    missing = [n for n, v in (("Camera:PrincipalPoint", lens.principal_point_mm),
+                              ("EXIF FocalPlaneXResolution", res)) if v is None]
+    if lens.kind == "fisheye":
+        missing += [n for n, v in (("Camera:FisheyeAffineMatrix", lens.fisheye_affine),
+                                   ("Camera:FisheyePolynomial", lens.fisheye_polynomial)) if v is None]
+    elif lens.focal_length is None or (lens.focal_length_unit or "mm").lower() != "mm":
+        missing.append("Camera:PerspectiveFocalLength in mm")
+    if missing:
+        raise BandRegistrationError(f"{info.name}: its {lens.kind} lens model lacks {', '.join(missing)}")
+    try:
+        if lens.kind == "fisheye":
+            return fisheye_from_pix4d(lens.principal_point_mm, res, lens.fisheye_affine, lens.fisheye_polynomial)
+        return perspective_from_pix4d(lens.principal_point_mm, lens.focal_length, res, lens.distortion)
+    except LensError as e:
+        raise BandRegistrationError(f"{info.name}: {e}") from e
+
+
+@dataclass(frozen=True)
+class BandCamera:
+    """One band of a capture: its file, lens and the rotation of its rays into the reference camera's."""
+    name: str
+    path: str
+    lens: Lens
+    rotation: np.ndarray
+    relatives: Optional[Tuple[float, ...]]
+
+    @property
+    def rotation_deg(self) -> Tuple[float, float, float]:
+        """The rotation as small angles about x, y, z (degrees): what the model turns this band by."""
+        r = self.rotation
+        return (math.degrees(math.atan2(r[2, 1], r[2, 2])), math.degrees(math.asin(max(-1.0, min(1.0, -r[2, 0])))),
+                math.degrees(math.atan2(r[1, 0], r[0, 0])))
+
+
+def reference_band(capture: Capture, name: Optional[str] = None) -> BandInfo:
+    """The band the others are registered onto: ``name`` when given, else the band without rig relatives (the
+    rig's reference camera), else the first band; RGB frames are not bands of the rig's band cameras."""
+    bands = [b for b in capture.bands if not b.is_rgb]
+    if not bands:
+        raise BandRegistrationError(f"capture {capture.capture_id}: no band files (only RGB frames)")
+    if name is not None:
+        hit = next((b for b in bands if band_key(b.band_name) == band_key(name)), None)
+        if hit is None:
+            raise BandRegistrationError(f"capture {capture.capture_id}: no band {name!r} "
+                                        f"(bands: {', '.join(b.band_name or '?' for b in bands)})")
+        return hit
+    return next((b for b in bands if b.rig_relatives is None), bands[0])
+
+
+def band_cameras(capture: Capture, reference: Optional[str] = None) -> Tuple[List[BandCamera], BandCamera]:
+    """The capture's band cameras (RGB frames left out: another sensor, size and shutter) and the reference."""
+    ref = reference_band(capture, reference)
+    cams = []
+    for b in capture.bands:
+        if b.is_rgb:
+            continue
+        if (b.width, b.height) != (ref.width, ref.height):
+            raise BandRegistrationError(f"{b.name}: {b.width} x {b.height} px, the reference band {ref.name} "
+                                        f"{ref.width} x {ref.height}: the bands of a rig must share a frame size")
+        rot = band_to_reference(b.rig_relatives, ref.rig_relatives)
+        cams.append(BandCamera(b.band_name or b.name, b.path, band_lens(b), rot, b.rig_relatives))
+    return cams, next(c for c in cams if c.path == ref.path)
+
+
+def reference_frame(ref: BandCamera) -> PinholeLens:
+    """The ideal pinhole of the reference band: its focal length at the centre and its principal point."""
+    return PinholeLens(ref.lens.focal_px, ref.lens.cx, ref.lens.cy)
+
+
+def band_map(cam: BandCamera, frame: PinholeLens, shape: Tuple[int, int],
+             correction: Optional[np.ndarray] = None) -> Tuple[np.ndarray, np.ndarray]:
+    """Where each pixel of the output frame (rows, cols) is sampled in the band's own image: the output pixel
+    (moved by ``correction``, a 3 x 3 homography of output pixels, when given) -> reference pinhole ray -> band ray
+    (R^T) -> band pixel.  float32 maps for ``cv2.remap``; NaN-free (out of reach: -1e6, read as outside)."""
+    v, u = np.mgrid[0:shape[0], 0:shape[1]].astype(np.float64)
+    if correction is not None:
+        a = np.asarray(correction, dtype=np.float64)
+        w = a[2, 0] * u + a[2, 1] * v + a[2, 2]
+        u, v = (a[0, 0] * u + a[0, 1] * v + a[0, 2]) / w, (a[1, 0] * u + a[1, 1] * v + a[1, 2]) / w
+    rays = frame.unproject(np.stack([u, v], axis=-1)) @ cam.rotation   # row-vector form of R^T ray
+    px = cam.lens.project(rays)
+    px = np.where(np.isfinite(px), px, -1e6)
+    return px[..., 0].astype(np.float32), px[..., 1].astype(np.float32)
+
+
+def warp(image: np.ndarray, maps: Tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """The band resampled (bilinear) on the maps, float32, NaN where the map leaves the band's frame."""
+    cv2 = require("cv2", "band registration")
+    src = np.asarray(image, dtype=np.float32)
+    out = cv2.remap(src, maps[0], maps[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=np.nan)
+    h, w = src.shape
+    inside = (maps[0] >= 0) & (maps[0] <= w - 1) & (maps[1] >= 0) & (maps[1] <= h - 1)
+    out[~inside] = np.nan
+    return out
+
+
+# ---------------------------------------------------------------- measuring the residual
+def gradient_image(image: np.ndarray, sigma: float = 1.0) -> np.ndarray:
+    """Gradient magnitude of the image smoothed by a Gaussian of ``sigma`` px, NaN where the image is NaN (and
+    next to it): edges whatever the band's radiometry (sign and contrast of an edge differ between bands)."""
+    cv2 = require("cv2", "band registration")
+    a = np.asarray(image, dtype=np.float32)
+    valid = np.isfinite(a)
+    fill = float(np.nanmedian(a)) if valid.any() else 0.0
+    b = cv2.GaussianBlur(np.where(valid, a, fill), (0, 0), sigma)
+    gx, gy = cv2.Sobel(b, cv2.CV_32F, 1, 0, ksize=3), cv2.Sobel(b, cv2.CV_32F, 0, 1, ksize=3)
+    g = np.sqrt(gx * gx + gy * gy)
+    grown = cv2.erode(valid.astype(np.uint8), np.ones((5, 5), np.uint8)) > 0
+    g[~grown] = np.nan
+    return g
+
+
+def _hann(shape: Tuple[int, int]) -> np.ndarray:
+    return np.outer(np.hanning(shape[0]), np.hanning(shape[1]))
+
+
+def phase_shift(a: np.ndarray, b: np.ndarray, upsample: int = 50) -> Tuple[float, float, float]:
+    """The shift (dx, dy) with b(p + d) = a(p) by phase correlation of two equal windows (Hann-tapered, their
+    means removed), the peak refined by an upsampled DFT around it (Guizar-Sicairos et al. 2008) to 1 /
+    ``upsample`` px; and the peak's height (1 for identical windows, near 0 for unrelated ones)."""
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    win = _hann(a.shape)
+    fa, fb = np.fft.fft2((a - a.mean()) * win), np.fft.fft2((b - b.mean()) * win)
+    cross = np.conj(fa) * fb
+    cross /= np.maximum(np.abs(cross), 1e-12 * np.abs(cross).max() + 1e-30)
+    corr = np.fft.ifft2(cross).real
+    m, n = corr.shape
+    iy, ix = np.unravel_index(int(np.argmax(corr)), corr.shape)
+    py, px = (iy if iy <= m // 2 else iy - m), (ix if ix <= n // 2 else ix - n)
+    if upsample > 1:
+        offs = np.arange(-upsample, upsample + 1) / upsample
+        ey = np.exp(2j * np.pi * np.outer(py + offs, np.fft.fftfreq(m)))
+        ex = np.exp(2j * np.pi * np.outer(px + offs, np.fft.fftfreq(n)))
+        fine = (ey @ cross @ ex.T).real / (m * n)
+        jy, jx = np.unravel_index(int(np.argmax(fine)), fine.shape)
+        return float(px + offs[jx]), float(py + offs[jy]), float(fine[jy, jx])
+    return float(px), float(py), float(corr[iy, ix])
+
+
+@dataclass(frozen=True)
+class WindowShift:
+    """One window's measurement: its centre (x, y) in the output frame, the shift (dx, dy) of the band against
+    the reference there (px; b(p + d) = ref(p)) and the phase-correlation peak."""
+    x: float
+    y: float
+    dx: float
+    dy: float
+    peak: float
+
+
+def window_centres(shape: Tuple[int, int], options: RegistrationOptions) -> List[Tuple[int, int]]:
+    """Top-left corners of the grid of windows over the frame's central ``coverage``."""
+    h, w = shape
+    s = options.window
+    cols, rows = options.grid
+    x0, x1 = w * (1 - options.coverage) / 2, w - w * (1 - options.coverage) / 2 - s
+    y0, y1 = h * (1 - options.coverage) / 2, h - h * (1 - options.coverage) / 2 - s
+    xs = np.linspace(x0, max(x0, x1), cols) if cols > 1 else [0.5 * (x0 + x1)]
+    ys = np.linspace(y0, max(y0, y1), rows) if rows > 1 else [0.5 * (y0 + y1)]
+    return [(int(round(x)), int(round(y))) for y in ys for x in xs]
+
+
+def window_shifts(ref_grad: np.ndarray, grad: np.ndarray, options: RegistrationOptions) -> List[WindowShift]:
+    """Phase correlation of two gradient images over the window grid; windows with a NaN in either, or whose
+    peak is under ``min_peak`` (too little shared texture), are left out."""
+    s, out = options.window, []
+    for x, y in window_centres(ref_grad.shape, options):
+        a, b = ref_grad[y:y + s, x:x + s], grad[y:y + s, x:x + s]
+        if a.shape != (s, s) or not (np.isfinite(a).all() and np.isfinite(b).all()):
+            continue
+        dx, dy, peak = phase_shift(a, b, options.upsample)
+        if peak >= options.min_peak:
+            out.append(WindowShift(x + s / 2.0, y + s / 2.0, dx, dy, peak))
+    return out
+
+
+@dataclass(frozen=True)
+class Residual:
+    """The registration residual of a band: median and worst shift magnitude (px) over ``count`` windows, and the
+    median shift (dx, dy)."""
+    median: float
+    worst: float
+    count: int
+    median_dx: float = 0.0
+    median_dy: float = 0.0
+
+    def __str__(self) -> str:
+        if not self.count:
+            return "not measured (no window with shared texture)"
+        return (f"median {self.median:.3f} px, worst {self.worst:.3f} px over {self.count} windows "
+                f"(median shift {self.median_dx:+.3f}, {self.median_dy:+.3f})")
+
+
+def residual_of(shifts: Sequence[WindowShift]) -> Residual:
+    if not shifts:
+        return Residual(float("nan"), float("nan"), 0)
+    d = np.array([[s.dx, s.dy] for s in shifts])
+    mag = np.hypot(d[:, 0], d[:, 1])
+    return Residual(float(np.median(mag)), float(mag.max()), len(shifts), float(np.median(d[:, 0])),
+                    float(np.median(d[:, 1])))
+
+
+def fit_correction(shifts: Sequence[WindowShift], rounds: int = 3) -> np.ndarray:
+    """The 3 x 3 homography D with D p = p + d(p) fitted to the window shifts (least squares; windows beyond 3
+    robust sigmas of the fit dropped each round).  A homography because what the rig's calibration leaves is
+    mostly a small rotation, whose image in a pinhole frame is projective (a rotation about y by b moves x by
+    f b (1 + x^2 / f^2): an affine leaves the x^2 part); under 8 windows an affine, under 4 a translation,
+    the identity with none."""
+    cv2 = require("cv2", "band registration")
+    d = np.eye(3)
+    if not shifts:
+        return d
+    p = np.array([[s.x, s.y] for s in shifts])
+    q = p + np.array([[s.dx, s.dy] for s in shifts])
+    keep = np.ones(len(shifts), bool)
+    for _ in range(rounds):
+        n = int(keep.sum())
+        if n < 4:
+            d = np.eye(3)
+            d[:2, 2] = np.median(q[keep] - p[keep] if n else q - p, axis=0)
+            return d
+        if n < 8:
+            d = np.vstack([cv2.estimateAffine2D(p[keep], q[keep], method=cv2.LMEDS)[0], [0.0, 0.0, 1.0]])
+        else:
+            d = cv2.findHomography(p[keep], q[keep], 0)[0]
+        m = np.column_stack([p, np.ones(len(p))]) @ d.T
+        res = np.hypot(*(m[:, :2] / m[:, 2:] - q).T)
+        sigma = 1.4826 * np.median(res[keep]) + 0.02
+        new = res <= 3 * sigma
+        if (new == keep).all():
+            break
+        keep = new
+    return d / d[2, 2]
+
+
+# ---------------------------------------------------------------- one capture
+@dataclass
+class BandResult:
+    """What the registration did to one band: its camera, the model-only and refined residuals against the
+    reference, and the homography correcting the output grid (identity for the reference and with no
+    refinement)."""
+    camera: BandCamera
+    model_residual: Residual
+    refined_residual: Residual
+    correction: np.ndarray = field(default_factory=lambda: np.eye(3))
+
+
+@dataclass
+class RegisteredCapture:
+    """The capture's bands in the reference pinhole frame (bands, rows, cols; float32, NaN outside a band's
+    frame), their names, the frame and one :class:`BandResult` per band (reference first)."""
+    names: Tuple[str, ...]
+    bands: np.ndarray
+    frame: PinholeLens
+    reference: str
+    results: List[BandResult]
+    model_bands: Optional[np.ndarray] = None
+
+
+def read_band(path: str) -> np.ndarray:
+    """The band file's first band as float32; BandRegistrationError naming the file when it cannot be read."""
+    try:
+        with RasterFile(path, "band file") as r:
+            return r.read(1).astype(np.float32)
+    except RasterError as e:
+        raise BandRegistrationError(f"{path}: the band cannot be read ({e})") from e
+
+
+def _refine(image: np.ndarray, cam: BandCamera, frame: PinholeLens, ref_grad: np.ndarray,
+            options: RegistrationOptions, shifts: List[WindowShift]) -> Tuple[np.ndarray, np.ndarray, Residual]:
+    """The band warped with the refinement iterated ``options.iterations`` times, starting from the
+    model-only window ``shifts``: (warped, correction, residual after)."""
+    shape = ref_grad.shape
+    correction = np.eye(3)
+    warped = None
+    for _ in range(options.iterations):
+        if not shifts:
+            break
+        correction = correction @ fit_correction(shifts)
+        warped = warp(image, band_map(cam, frame, shape, correction))
+        shifts = window_shifts(ref_grad, gradient_image(warped), options)
+    if warped is None:
+        warped = warp(image, band_map(cam, frame, shape))
+    return warped, correction, residual_of(shifts)
+
+
+def register_capture(capture: Capture, options: Optional[RegistrationOptions] = None,
+                     keep_model: bool = False) -> RegisteredCapture:
+    """Register the band files of one capture (module docstring).  ``keep_model``: keep the model-only bands
+    too (for before / after pictures)."""
+    options = options or RegistrationOptions()
+    cams, ref = band_cameras(capture, options.reference)
+    frame = reference_frame(ref)
+    images = {c.path: read_band(c.path) for c in cams}
+    shape = images[ref.path].shape
+    ref_img = warp(images[ref.path], band_map(ref, frame, shape))
+    ref_grad = gradient_image(ref_img)
+    ordered = [ref] + [c for c in cams if c is not ref]
+    bands, model, results = [], [], []
+    for cam in ordered:
+        if cam is ref:
+            bands.append(ref_img)
+            model.append(ref_img)
+            zero = Residual(0.0, 0.0, 0)
+            results.append(BandResult(cam, zero, zero))
+            continue
+        model_img = warp(images[cam.path], band_map(cam, frame, shape))
+        shifts = window_shifts(ref_grad, gradient_image(model_img), options)
+        before = residual_of(shifts)
+        if options.iterations:
+            refined, correction, after = _refine(images[cam.path], cam, frame, ref_grad, options, shifts)
+        else:
+            refined, correction, after = model_img, np.eye(3), before
+        bands.append(refined)
+        model.append(model_img)
+        results.append(BandResult(cam, before, after, correction))
+    return RegisteredCapture(tuple(c.name for c in ordered), np.stack(bands), frame, ref.name, results,
+                             np.stack(model) if keep_model else None)
+
+
+def write_registered(path: str, reg: RegisteredCapture) -> str:
+    """The registered bands as one float32 plain TIFF (band names as descriptions; the reference, frame and each
+    band's residuals in its metadata)."""
+    md = {"REFERENCE_BAND": reg.reference,
+          "PINHOLE_F_CX_CY": f"{reg.frame.f:.4f},{reg.frame.cx:.4f},{reg.frame.cy:.4f}"}
+    for r in reg.results[1:]:
+        key = band_key(r.camera.name).upper()
+        md[f"{key}_RESIDUAL_MODEL_PX"] = f"{r.model_residual.median:.3f},{r.model_residual.worst:.3f}"
+        md[f"{key}_RESIDUAL_REFINED_PX"] = f"{r.refined_residual.median:.3f},{r.refined_residual.worst:.3f}"
+    return write_band_stack(path, reg.bands, reg.names, md)
