@@ -12,12 +12,31 @@ import pytest
 from osgeo import gdal
 from scipy.spatial.transform import Rotation
 
-from core.geometry.lens import (FisheyeLens, LensError, PerspectiveLens, PinholeLens, band_to_reference,
-                                fisheye_from_pix4d, perspective_from_pix4d, rig_rotation)
+from core.geometry.lens import (
+    FisheyeLens,
+    LensError,
+    PerspectiveLens,
+    PinholeLens,
+    band_to_reference,
+    fisheye_from_pix4d,
+    perspective_from_pix4d,
+    rig_rotation,
+)
 from core.io.multispectral import band_files, read_block
-from core.prepare.bands import (BandRegistrationError, RegistrationOptions, band_cameras, band_map, gradient_image,
-                                phase_shift, reference_frame, register_capture, residual_of, warp, window_shifts,
-                                write_registered)
+from core.prepare.bands import (
+    BandRegistrationError,
+    RegistrationOptions,
+    band_cameras,
+    band_map,
+    gradient_image,
+    phase_shift,
+    reference_frame,
+    register_capture,
+    residual_of,
+    warp,
+    window_shifts,
+    write_registered,
+)
 from tests.conftest import shared
 
 gdal.UseExceptions()

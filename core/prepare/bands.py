@@ -25,8 +25,15 @@ from typing import List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from ..common.errors import ArchaeoOrthoError, require
-from ..geometry.lens import (FisheyeLens, LensError, PerspectiveLens, PinholeLens, band_to_reference,
-                             fisheye_from_pix4d, perspective_from_pix4d)
+from ..geometry.lens import (
+    FisheyeLens,
+    LensError,
+    PerspectiveLens,
+    PinholeLens,
+    band_to_reference,
+    fisheye_from_pix4d,
+    perspective_from_pix4d,
+)
 from ..io.multispectral import BandInfo, Capture, band_key, write_band_stack
 from ..io.raster import RasterError, RasterFile
 
