@@ -28,6 +28,7 @@ f * distorted normalised coordinate + c.
 from __future__ import annotations
 
 import math
+import multiprocessing
 import os
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
@@ -455,6 +456,14 @@ def _epoch_changes(scene: Scene, epoch: int) -> None:
 # --------------------------------------------------------------------------------------------------
 # rendering
 # --------------------------------------------------------------------------------------------------
+
+
+_RENDERING = None  # (block, render arguments) while Block.render's forked workers run
+
+
+def _render_shot(k: int) -> str:
+    block, args = _RENDERING
+    return block._render_one(k, *args)
 
 
 def _sample(raster: np.ndarray, mx: np.ndarray, my: np.ndarray, interpolation=cv2.INTER_LINEAR) -> np.ndarray:
@@ -903,18 +912,30 @@ class SyntheticBlock:
 
     # ---- images
     def render(self, folder: str, supersample: int = 2, ext: str = ".jpg", quality: int = 95,
-               radiometry: Optional["Radiometry"] = None) -> List[str]:
+               radiometry: Optional["Radiometry"] = None, jobs: int = 1) -> List[str]:
+        """Render every shot into ``folder``; ``jobs`` > 1 renders in that many forked processes (POSIX), which
+        share the scene without copying it: the same images, written in any order."""
         os.makedirs(folder, exist_ok=True)
-        paths = []
-        for k, s in enumerate(self.shots):
-            img = render_image(self.scene, self.camera, s, supersample, seed=self.seed * 1000 + k,
-                               radiometry=radiometry)
-            path = os.path.join(folder, s.name if s.name.lower().endswith(ext) else s.name + ext)
-            params = [cv2.IMWRITE_JPEG_QUALITY, quality] if ext.lower() in (".jpg", ".jpeg") else []
-            if not cv2.imwrite(path, cv2.cvtColor(img, cv2.COLOR_GRAY2BGR), params):
-                raise OSError(f"cannot write {path}")
-            paths.append(path)
-        return paths
+        args = (folder, supersample, ext, quality, radiometry)
+        if jobs > 1 and len(self.shots) > 1 and "fork" in multiprocessing.get_all_start_methods():
+            global _RENDERING
+            _RENDERING = (self, args)
+            try:
+                with multiprocessing.get_context("fork").Pool(jobs) as pool:
+                    return pool.map(_render_shot, range(len(self.shots)), chunksize=1)
+            finally:
+                _RENDERING = None
+        return [self._render_one(k, *args) for k in range(len(self.shots))]
+
+    def _render_one(self, k: int, folder: str, supersample: int, ext: str, quality: int,
+                    radiometry: Optional["Radiometry"]) -> str:
+        s = self.shots[k]
+        img = render_image(self.scene, self.camera, s, supersample, seed=self.seed * 1000 + k, radiometry=radiometry)
+        path = os.path.join(folder, s.name if s.name.lower().endswith(ext) else s.name + ext)
+        params = [cv2.IMWRITE_JPEG_QUALITY, quality] if ext.lower() in (".jpg", ".jpeg") else []
+        if not cv2.imwrite(path, cv2.cvtColor(img, cv2.COLOR_GRAY2BGR), params):
+            raise OSError(f"cannot write {path}")
+        return path
 
     # ---- tie points and a reconstruction built from the truth
     def tie_points(self, n: int = 2000, seed: int = 5, min_views: int = 2,
