@@ -40,6 +40,8 @@ class AlignResult:
     escalation: Optional[dict] = None  # what was escalated and why (core.align.escalation), None when not needed
     intrinsics: Optional[List[dict]] = None  # per camera: mode, given values and sigmas, final values (calibrated)
     first_pass: Optional[dict] = None  # the first pass's feature settings, why, and the texture probe's figures
+    # the focal length held at the photos' own because self-calibrated it drifted (core.align.mapping.map_block)
+    focal_held: Optional[dict] = None
 
 
 def _json(obj) -> str:
@@ -62,6 +64,7 @@ class Outcome:
     first: FirstPass
     principal_point_refined: bool
     db_path: str  # the database the run worked in (the workspace's or a staged one)
+    focal_held: Optional[dict] = None  # MappingJob.focal_held
 
 
 def write_products(pycolmap, ws: Workspace, lay: Layout, run, photos: Photos, outcome: Outcome,
@@ -85,6 +88,7 @@ def write_products(pycolmap, ws: Workspace, lay: Layout, run, photos: Photos, ou
         timings={k: round(v, 3) for k, v in timings.items()}, cameras=camera_summary(rec),
         masked_images=len(outcome.masked), escalation=escalation.to_dict() if escalation else None,
         intrinsics=intrinsics_record(pycolmap, photos.groups, photos.given, rec), first_pass=outcome.first.to_dict(),
+        focal_held=outcome.focal_held,
     )
     figures = {k: v for k, v in asdict(result).items() if k not in ("workspace", "model_dir", "cameras_path")}
     figures["principal_point_refined"] = outcome.principal_point_refined

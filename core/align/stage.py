@@ -126,18 +126,18 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
         if not ordered:
             raise no_reconstruction_error(partners, len(infos), verified_pairs(pycolmap, db_path, MIN_VERIFIED_INLIERS),
                                      photos.held()[0])
-        rec = ordered[0]
-        others = block_state(ordered)[1]
-        # 5. final global bundle adjustment (the held cameras' intrinsics constant)
+        rec, others = ordered[0], block_state(ordered)[1]
+        # 5. final global bundle adjustment (the held cameras' intrinsics constant; the focal held if it drifted)
         with run.step("bundle_adjustment", save=False):
             progress.report(0.94, "final bundle adjustment")
-            pp = adjust_block(pycolmap, rec, options, progress, photos.held()[0], degenerate)
+            pp = adjust_block(pycolmap, rec, options, progress, photos.held()[0], degenerate,
+                              hold_focal=mapping_job.focal_held is not None)
         registered = {rec.images[i].name for i in rec.reg_image_ids()}
         unregistered = diagnose_unregistered(infos, registered, others, partners, degenerate)
         report_unregistered(progress, unregistered, others, len(registered))
         check_cancel(progress)
         outcome = Outcome(rec, unregistered, others, pairs, pairing_used, sorted(masks), escalation, first, pp,
-                          db_path)
+                          db_path, mapping_job.focal_held)
         result = write_products(pycolmap, ws, lay, run, photos, outcome, t_start)
     # later stages were built on the previous model: run_stage marked them stale
     progress.report(1.0, f"aligned {result.registered}/{len(infos)} images, {result.mean_reprojection_error:.3f} px")
