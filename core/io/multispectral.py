@@ -725,3 +725,62 @@ def write_band_stack(path: str, bands: np.ndarray, names: Sequence[str], metadat
     except (RuntimeError, OSError) as e:
         raise MultispectralError(f"{path}: the registered bands cannot be written ({e})") from e
     return path
+
+
+# EXIF tags a capture's multi-band photo takes from its reference band file (where it is, when, by what)
+CARRIED_EXIF = ("EXIF_GPSLatitude", "EXIF_GPSLatitudeRef", "EXIF_GPSLongitude", "EXIF_GPSLongitudeRef",
+                "EXIF_GPSAltitude", "EXIF_GPSAltitudeRef", "EXIF_GPSMapDatum", "EXIF_DateTimeOriginal",
+                "EXIF_SubSecTime_Original", "EXIF_Make", "EXIF_Model")
+
+
+def capture_exif(reference_path: str, focal_px: float, width: int, height: int) -> Dict[str, str]:
+    """The EXIF of a capture's registered multi-band photo: the reference band file's position, time and camera
+    (CARRIED_EXIF), and the pinhole frame's focal length written as core.io.images reads it back (a focal length
+    in mm over a focal plane resolution in px/mm of a ``width`` x ``height`` frame), so the alignment starts from
+    the registered frame's own focal length.  MultispectralError naming the file when it cannot be read."""
+    try:
+        with RasterFile(reference_path, "band file") as r:
+            md = photo_metadata(r)
+    except RasterError as e:
+        raise MultispectralError(f"{reference_path}: its EXIF cannot be read ({e})") from e
+    out = {k: v for k, v in md.items() if k in CARRIED_EXIF and str(v).strip()}
+    px_per_mm = 100.0  # any pitch will do: only the product f_mm * px_per_mm is read back
+    out.update({"EXIF_FocalLength": f"({focal_px / px_per_mm:.6f})", "EXIF_FocalPlaneXResolution": f"({px_per_mm:g})",
+                "EXIF_FocalPlaneYResolution": f"({px_per_mm:g})", "EXIF_FocalPlaneResolutionUnit": "4",
+                "EXIF_PixelXDimension": str(int(width)), "EXIF_PixelYDimension": str(int(height))})
+    return out
+
+
+def write_photo_stack(path: str, bands: np.ndarray, names: Sequence[str],
+                      wavelengths: Sequence[Optional[float]], exif: Dict[str, str],
+                      metadata: Optional[Dict[str, str]] = None) -> str:
+    """A capture's registered bands as one 16-bit multi-band photo (bands, rows, cols; 0 where a band does not
+    reach): each band described by its name with its central wavelength (``wavelength``, nm) in its metadata, the
+    ``exif`` tags in GDAL's EXIF domain, written atomically.  MultispectralError naming the file when it cannot be
+    written."""
+    from osgeo import gdal
+
+    gdal.UseExceptions()
+    data = np.asarray(bands)
+    if data.ndim != 3 or data.shape[0] != len(names) or len(wavelengths) != len(names):
+        raise MultispectralError(f"{path}: {len(names)} band names for an array of shape {data.shape}")
+    data = np.clip(np.nan_to_num(data.astype(np.float64), nan=0.0), 0, 65535).round().astype(np.uint16)
+    try:
+        with atomic_output(path) as tmp:
+            ds = gdal.GetDriverByName("GTiff").Create(tmp, data.shape[2], data.shape[1], data.shape[0],
+                                                      gdal.GDT_UInt16, ["COMPRESS=DEFLATE", "PREDICTOR=2",
+                                                                        "TILED=YES", "INTERLEAVE=BAND"])
+            for i, (name, nm) in enumerate(zip(names, wavelengths)):
+                band = ds.GetRasterBand(i + 1)
+                band.SetDescription(str(name))
+                if nm is not None:
+                    band.SetMetadata({"wavelength": f"{nm:g}", "wavelength_units": "nm"})
+                band.WriteArray(data[i])
+            ds.SetMetadata({str(k): str(v) for k, v in exif.items()}, "EXIF")
+            if metadata:
+                ds.SetMetadata({str(k): str(v) for k, v in metadata.items()})
+            ds.FlushCache()
+            ds = None
+    except (RuntimeError, OSError) as e:
+        raise MultispectralError(f"{path}: the capture's photo cannot be written ({e})") from e
+    return path

@@ -27,7 +27,7 @@ from .radiometry_fit import fit_radiometry
 from .seamlines import read_seamline_edits, write_seamlines
 from .surface import Dsm, fill_dsm_gaps
 from .tiles import DSM_CACHE, TileUnit, render_tile
-from .writer import RasterWriter, gdal_cache
+from .writer import RasterWriter, gdal_cache, photo_band_names
 
 # the work folders of a run, beside its output (a killed run's are removed by the next: files.clean_debris)
 WORK_PREFIX = ".ortho-work-"
@@ -182,6 +182,7 @@ def _run_tiles(prep: PreparedBlock, plan: MosaicPlan, dsm: Dsm, offset, options:
     bands, dtype = check_kind(prep.metas, prep.cameras)
     work = os.path.join(os.path.dirname(os.path.abspath(output)), ".work-" + os.path.basename(output))
     writer = RasterWriter(work, grid.width, grid.height, bands, dtype, grid.geotransform, crs)
+    writer.describe(*photo_band_names([c.path for c in prep.cameras]))  # a multispectral block's band names
     halo = 0
     if options.blending == "multiband":
         halo = 64

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import os
-from typing import Optional
+from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -21,6 +21,23 @@ def _alpha_value(dtype: str) -> Optional[float]:
     if dt.kind in "ui":
         return float(np.iinfo(dt).max)
     return None  # float images: nodata NaN instead of an alpha band
+
+
+def photo_band_names(paths: Sequence[str]) -> Tuple[List[str], List[Dict[str, str]]]:
+    """The band descriptions and band metadata the photos ``paths`` share (a multispectral capture's band names and
+    wavelengths, core.prepare.captures); ([], []) when they have none or do not agree."""
+    seen = None
+    for path in paths:
+        with RasterFile(path, "photo") as r:
+            names = tuple(r.band(i + 1).GetDescription() for i in range(r.count))
+            mds = tuple(tuple(sorted(r.metadata(i + 1).items())) for i in range(r.count))
+        if seen is None:
+            seen = (names, mds)
+        elif (names, mds) != seen:
+            return [], []
+    if not seen or not any(seen[0]):
+        return [], []
+    return list(seen[0]), [dict(m) for m in seen[1]]
 
 
 class RasterWriter:
@@ -50,6 +67,16 @@ class RasterWriter:
         else:
             for b in range(1, bands + 1):
                 self.ds.GetRasterBand(b).SetNoDataValue(float("nan"))
+
+    def describe(self, descriptions: Sequence[str], metadata: Sequence[Dict[str, str]]) -> None:
+        """Name the image bands (the photos' own band descriptions and band metadata: a multispectral capture's
+        band names and wavelengths); nothing when ``descriptions`` is empty."""
+        for b, (text, md) in enumerate(zip(descriptions[:self.bands], metadata[:self.bands])):
+            band = self.ds.GetRasterBand(b + 1)
+            if text:
+                band.SetDescription(str(text))
+            if md:
+                band.SetMetadata({str(k): str(v) for k, v in md.items()})
 
     def write(self, r0: int, c0: int, values: np.ndarray, valid: np.ndarray) -> None:
         """values (h, w, bands) float32, valid (h, w) bool."""

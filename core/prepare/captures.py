@@ -1,0 +1,128 @@
+"""Multispectral captures as multi-band photos (issue 37): every capture of a rig's band files registered
+(:mod:`core.prepare.bands`: each band undistorted with its own lens into the reference band's pinhole frame, turned
+by its rig rotation, refined by a residual homography) and written as one 16-bit multi-band photo, so that the
+block of captures goes through Align images, the DSM and the orthophoto as photos do, and the orthomosaic comes
+out with every band.
+
+The photo's bands are ordered NIR, Red, Green first (then the others in the rig's order), so that QGIS's default
+rendering of bands 1-2-3 is the false-colour NIR-R-G view in which crop marks show; each band is described by its
+name with its central wavelength in its metadata.  The photo carries the reference band file's GPS, time and
+camera, and the pinhole frame's focal length, in its EXIF (:func:`core.io.multispectral.capture_exif`).  Values
+are the bands' raw numbers (no dark level, vignetting or reflectance yet), 0 where a band does not reach.
+
+A capture that lacks a band the block has is left out with its reason (an orthomosaic needs every band in every
+photo); the block's other warnings (:func:`core.io.multispectral.check_captures`) are passed on.  The RGB camera
+of a rig (another sensor, another frame) is not stacked.
+"""
+from __future__ import annotations
+
+import dataclasses
+import os
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional, Sequence, Tuple
+
+from ..common.progress import NullProgress, Progress, check_cancel
+from ..io.multispectral import Capture, band_key, capture_exif, read_block, write_photo_stack
+from .bands import RegistrationOptions, register_capture
+from .options import PrepareError
+
+# the bands a photo starts with, in this order (band_key names): bands 1-2-3 shown as RGB are NIR-R-G
+FALSE_COLOUR_FIRST = ("nir", "red", "green")
+
+
+@dataclass(frozen=True)
+class CaptureStackOptions:
+    """``output_dir``: where the multi-band photos go (one per capture, named after its reference band file
+    without the band suffix); ``registration``: the band registration's options (its ``reference``: the band the
+    others are registered onto, default the rig's reference camera)."""
+    output_dir: str
+    registration: RegistrationOptions = field(default_factory=RegistrationOptions)
+
+
+@dataclass
+class CaptureStackResult:
+    """The photos written, their bands in order, the captures left out (capture -> why), the worst refined
+    residual per band over the captures (px), and the block's warnings."""
+    photos: List[str]
+    bands: Tuple[str, ...]
+    left_out: Dict[str, str]
+    worst_residual_px: Dict[str, float]
+    warnings: List[str]
+
+
+def stack_order(names: Sequence[str]) -> List[int]:
+    """Indices of ``names`` with NIR, Red, Green first (FALSE_COLOUR_FIRST), then the others as they come."""
+    keys = [band_key(n) for n in names]
+    first = [keys.index(k) for k in FALSE_COLOUR_FIRST if k in keys]
+    return first + [i for i in range(len(names)) if i not in first]
+
+
+def photo_name(capture: Capture) -> str:
+    """The capture's photo file name: its reference band file's name without the band suffix (IMG_..._0000_GRE.TIF
+    -> IMG_..._0000.tif), else the capture id."""
+    ref = capture.bands[0]
+    stem = os.path.splitext(ref.name)[0]
+    suffix = "_" + (ref.band_name or "")
+    for cand in (suffix, suffix.upper(), "_" + os.path.splitext(ref.name)[0].rsplit("_", 1)[-1]):
+        if len(cand) > 1 and stem.upper().endswith(cand.upper()):
+            return stem[:-len(cand)] + ".tif"
+    return "".join(c if c.isalnum() or c in "-_" else "_" for c in capture.capture_id) + ".tif"
+
+
+def _band_captures(paths: Sequence[str]):
+    """(captures without the RGB camera's frames, their band names in rig order, warnings)."""
+    block = read_block(paths)
+    captures = [dataclasses.replace(c, bands=tuple(b for b in c.bands if not b.is_rgb)) for c in block.captures]
+    captures = [c for c in captures if c.bands]
+    names = tuple(n for n in block.band_names if band_key(n) not in ("rgb", "redgreenblue"))
+    if not captures or len(names) < 2:
+        raise PrepareError(f"{len(paths)} file(s) hold no capture with two or more bands (bands seen: "
+                           f"{', '.join(block.band_names) or 'none'}): nothing to stack")
+    return captures, names, list(block.warnings)
+
+
+def _check_output(output_dir: str, paths: Sequence[str]) -> None:
+    inputs = {os.path.realpath(os.path.dirname(p)) for p in paths}
+    if os.path.realpath(output_dir) in inputs:
+        raise PrepareError(f"the output folder {output_dir} holds the band files: choose another one, so that no "
+                           "input is written over")
+
+
+def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
+                   progress: Optional[Progress] = None) -> CaptureStackResult:
+    """Register every capture of the band files ``paths`` and write it as one multi-band photo (module
+    docstring).  Errors (PrepareError, MultispectralError, BandRegistrationError) name the files, before any photo
+    is written for what the block's metadata already shows."""
+    progress = progress or NullProgress()
+    _check_output(options.output_dir, paths)
+    captures, names, warnings = _band_captures(paths)
+    os.makedirs(options.output_dir, exist_ok=True)
+    photos: List[str] = []
+    left_out: Dict[str, str] = {}
+    worst: Dict[str, float] = {}
+    order_names: Tuple[str, ...] = ()
+    for k, cap in enumerate(captures):
+        check_cancel(progress)
+        missing = [n for n in names if cap.band(n) is None]
+        if missing:
+            left_out[cap.capture_id] = (f"lacks {', '.join(missing)} (files: "
+                                        f"{', '.join(b.name for b in cap.bands)})")
+            progress.warning(f"capture {cap.capture_id} left out: {left_out[cap.capture_id]}")
+            continue
+        reg = register_capture(cap, options.registration)
+        order = stack_order(reg.names)
+        order_names = tuple(reg.names[i] for i in order)
+        infos = {b.band_name: b for b in cap.bands}
+        ref = infos[reg.reference]
+        height, width = reg.bands.shape[1:]
+        path = os.path.join(options.output_dir, photo_name(cap))
+        md = {"REFERENCE_BAND": reg.reference, "CAPTURE": cap.capture_id,
+              "BAND_FILES": ",".join(infos[n].name for n in order_names)}
+        write_photo_stack(path, reg.bands[order], order_names,
+                          [infos[n].central_wavelength_nm for n in order_names],
+                          capture_exif(ref.path, reg.frame.f, width, height), md)
+        photos.append(path)
+        for r in reg.results[1:]:
+            worst[r.camera.name] = max(worst.get(r.camera.name, 0.0), float(r.refined_residual.worst))
+        progress.report((k + 1) / len(captures), f"captures: {k + 1}/{len(captures)} stacked")
+    return CaptureStackResult(photos, order_names, left_out, worst, warnings)

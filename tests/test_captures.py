@@ -1,0 +1,120 @@
+"""core/prepare/captures.py (issue 37): a rig's captures registered and written as multi-band photos that the chain
+takes as photos (bands NIR, Red, Green first, named, wavelengths in their metadata, the capture's GPS and the
+registered frame's focal length in EXIF), and the orthomosaic's bands named after them (core.ortho.writer)."""
+from __future__ import annotations
+
+import glob
+import os
+import shutil
+
+import numpy as np
+import pytest
+from osgeo import gdal
+
+from core.io.images import read_image_info
+from core.io.raster import RasterFile
+from core.ortho.writer import RasterWriter, photo_band_names
+from core.prepare.captures import CaptureStackOptions, stack_captures, stack_order
+from core.prepare.options import PrepareError
+from tests.conftest import shared
+
+gdal.UseExceptions()
+SEQUOIA_ID = "1351F8EED82F58668D950A628B8C29BE"
+
+
+def _sample_bands():
+    return sorted(p for p in glob.glob(os.path.join(shared("sequoia_sample"), "*")) if p.upper().endswith((".TIF", ".JPG")))
+
+
+def test_the_false_colour_bands_come_first():
+    assert stack_order(["Green", "Red", "Red edge", "NIR"]) == [3, 1, 0, 2]
+    assert stack_order(["Blue", "Green", "Red", "Red edge", "NIR"]) == [4, 2, 1, 0, 3]
+    assert stack_order(["Green", "Red edge"]) == [0, 1]
+
+
+def test_the_sequoia_capture_becomes_one_photo_the_chain_reads(tmp_path):
+    """The real capture: one 4-band 16-bit photo, NIR-R-G-RE, registered to within 0.5 px (worst window), with the
+    capture's GPS and the pinhole frame's focal length read back by core.io.images as the alignment reads them."""
+    paths = _sample_bands()
+    out = tmp_path / "stacks"
+    r = stack_captures(paths, CaptureStackOptions(str(out)))
+    assert [os.path.basename(p) for p in r.photos] == ["IMG_161122_163234_0000.tif"]
+    assert r.bands == ("NIR", "Red", "Green", "Red edge") and r.left_out == {}
+    assert set(r.worst_residual_px) == {"Red", "Red edge", "NIR"} and max(r.worst_residual_px.values()) <= 0.5
+    info = read_image_info(r.photos[0])
+    band = read_image_info(os.path.join(shared("sequoia_sample"), "IMG_161122_163234_0000_GRE.TIF"))
+    assert (info.bands, info.dtype, info.width, info.height) == (4, "UInt16", 1280, 960)
+    assert info.gps == pytest.approx(band.gps)
+    assert info.focal_source == "exif_plane" and info.focal_px == pytest.approx(1067.5, abs=1.0)  # 2C/pi
+    with RasterFile(r.photos[0]) as f:
+        names = [f.band(i + 1).GetDescription() for i in range(4)]
+        wl = [f.metadata(i + 1).get("wavelength") for i in range(4)]
+        nir, green = f.read(1).astype(float), f.read(3).astype(float)
+        assert f.metadata().get("CAPTURE") == SEQUOIA_ID
+    assert names == ["NIR", "Red", "Green", "Red edge"] and wl == ["790", "660", "550", "735"]
+    raw = RasterFile(os.path.join(shared("sequoia_sample"), "IMG_161122_163234_0000_NIR.TIF"))
+    try:  # the NIR band's own numbers (resampled into the green frame): same range, not scaled
+        assert abs(np.median(nir[nir > 0]) - np.median(raw.read(1))) < 0.1 * np.median(raw.read(1))
+    finally:
+        raw.close()
+    assert (green > 0).mean() > 0.97  # the reference band fills its own frame
+
+
+def _copy_with_capture_id(src, dst, capture_id):
+    """A copy of a band file whose XMP names another capture (the rest of the file as it is)."""
+    with RasterFile(src) as r:
+        packet = r.metadata(domain="xml:XMP")
+    ds = gdal.Translate(str(dst), src)
+    ds.SetMetadata([packet[0].replace(SEQUOIA_ID, capture_id)], "xml:XMP")
+    ds = None
+    return str(dst)
+
+
+def test_a_capture_missing_a_band_is_left_out_naming_its_files(tmp_path):
+    src = tmp_path / "bands"
+    src.mkdir()
+    paths = [shutil.copy(p, src) for p in _sample_bands() if not p.upper().endswith(".JPG")]
+    for p in list(paths):
+        if not p.upper().endswith("_NIR.TIF"):
+            paths.append(_copy_with_capture_id(p, src / ("B_" + os.path.basename(p)), "SECONDCAPTURE"))
+    r = stack_captures(paths, CaptureStackOptions(str(tmp_path / "out")))
+    assert len(r.photos) == 1 and list(r.left_out) == ["SECONDCAPTURE"]
+    why = r.left_out["SECONDCAPTURE"]
+    assert "lacks NIR" in why and "B_IMG_161122_163234_0000_GRE.TIF" in why
+    assert any("SECONDCAPTURE" in w and "NIR" in w for w in r.warnings)
+
+
+def test_the_band_folder_is_never_written_into(tmp_path):
+    src = tmp_path / "bands"
+    src.mkdir()
+    paths = [shutil.copy(p, src) for p in _sample_bands()]
+    before = sorted(os.listdir(src))
+    with pytest.raises(PrepareError, match="holds the band files"):
+        stack_captures(paths, CaptureStackOptions(str(src)))
+    assert sorted(os.listdir(src)) == before
+
+
+def _photo(path, names, wavelengths):
+    ds = gdal.GetDriverByName("GTiff").Create(str(path), 8, 6, len(names), gdal.GDT_UInt16)
+    for i, (n, w) in enumerate(zip(names, wavelengths)):
+        ds.GetRasterBand(i + 1).SetDescription(n)
+        ds.GetRasterBand(i + 1).SetMetadata({"wavelength": w})
+    ds = None
+    return str(path)
+
+
+def test_the_orthomosaic_bands_are_named_after_the_photos(tmp_path):
+    a = _photo(tmp_path / "a.tif", ["NIR", "Red"], ["790", "660"])
+    b = _photo(tmp_path / "b.tif", ["NIR", "Red"], ["790", "660"])
+    c = _photo(tmp_path / "c.tif", ["Red", "NIR"], ["660", "790"])
+    names, mds = photo_band_names([a, b])
+    assert names == ["NIR", "Red"] and mds == [{"wavelength": "790"}, {"wavelength": "660"}]
+    assert photo_band_names([a, c]) == ([], [])  # photos that disagree name nothing
+    assert photo_band_names([_photo(tmp_path / "d.tif", ["", ""], ["", ""])])[0] == []
+    w = RasterWriter(str(tmp_path / "work.tif"), 16, 12, 2, "uint16", (0, 1, 0, 12, 0, -1), None)
+    w.describe(names, mds)
+    w.write(0, 0, np.ones((12, 16, 2), np.float32), np.ones((12, 16), bool))
+    w.finish(str(tmp_path / "mosaic.tif"), "DEFLATE", None)
+    with RasterFile(str(tmp_path / "mosaic.tif")) as r:
+        assert [r.band(i + 1).GetDescription() for i in range(2)] == ["NIR", "Red"]
+        assert r.metadata(1).get("wavelength") == "790"
