@@ -138,12 +138,10 @@ def _smooth_resampling(layer):
         pass
 
 
-def style_dsm(layer):
-    """Pseudocolour (Spectral, 2-98 % stretch) for a DSM layer; nodata stays transparent."""
-    _smooth_resampling(layer)
-    lo, hi = _band_range(layer)
-    ramp = _elevation_ramp()
-    shader = QgsColorRampShader(lo, hi, ramp, QgsColorRampShader.Type.Interpolated, QgsColorRampShader.ClassificationMode.Continuous)
+def _pseudocolour(layer, ramp, lo: float, hi: float) -> None:
+    """Band 1 of ``layer`` in ``ramp``, interpolated from ``lo`` to ``hi`` (five classes)."""
+    shader = QgsColorRampShader(lo, hi, ramp, QgsColorRampShader.Type.Interpolated,
+                                QgsColorRampShader.ClassificationMode.Continuous)
     shader.classifyColorRamp(5, -1, layer.extent(), layer.dataProvider())
     raster_shader = QgsRasterShader(lo, hi)
     raster_shader.setRasterShaderFunction(shader)
@@ -151,6 +149,14 @@ def style_dsm(layer):
     renderer.setClassificationMin(lo)
     renderer.setClassificationMax(hi)
     layer.setRenderer(renderer)
+
+
+def style_dsm(layer):
+    """Pseudocolour (Spectral, 2-98 % stretch) for a DSM layer; nodata stays transparent."""
+    _smooth_resampling(layer)
+    lo, hi = _band_range(layer)
+    ramp = _elevation_ramp()
+    _pseudocolour(layer, ramp, lo, hi)
     _mark(layer, DSM)
     layer.triggerRepaint()
     return layer
@@ -379,15 +385,7 @@ def style_index(layer):
     if ramp is None:
         ramp = QgsGradientColorRamp(QColor("#d7191c"), QColor("#1a9641"))
         ramp.setStops([QgsGradientStop(0.5, QColor("#ffffbf"))])
-    shader = QgsColorRampShader(lo, hi, ramp, QgsColorRampShader.Type.Interpolated,
-                                QgsColorRampShader.ClassificationMode.Continuous)
-    shader.classifyColorRamp(5, -1, layer.extent(), layer.dataProvider())
-    raster_shader = QgsRasterShader(lo, hi)
-    raster_shader.setRasterShaderFunction(shader)
-    renderer = QgsSingleBandPseudoColorRenderer(layer.dataProvider(), 1, raster_shader)
-    renderer.setClassificationMin(lo)
-    renderer.setClassificationMax(hi)
-    layer.setRenderer(renderer)
+    _pseudocolour(layer, ramp, lo, hi)
     layer.setName(product_name(meta.get("INDEX") or QCoreApplication.translate("ResultLayers", "Spectral index"),
                                path))
     _mark(layer, INDEX)

@@ -698,32 +698,46 @@ def primary_band(block: Block, sample: int = 3) -> PrimaryBand:
 
 # ---------------------------------------------------------------- registered bands
 def write_band_stack(path: str, bands: np.ndarray, names: Sequence[str], metadata: Optional[Dict[str, str]] = None,
-                     ) -> str:
-    """Write registered bands (bands, rows, cols) as one float32 plain TIFF (no georeferencing; DEFLATE), each
-    band described by its name, NaN as nodata, atomically.  MultispectralError naming the file when it cannot be
-    written."""
+                     wavelengths: Optional[Sequence[Optional[float]]] = None, exif: Optional[Dict[str, str]] = None,
+                     dtype: str = "float32") -> str:
+    """Write registered bands (bands, rows, cols) as one plain TIFF (no georeferencing; DEFLATE), atomically: each
+    band described by its name, with its central wavelength (``wavelength``, nm) in its metadata where given; the
+    ``exif`` tags in GDAL's EXIF domain.  ``float32``: NaN is nodata; ``uint16`` (a capture's photo for the chain,
+    core.prepare.captures): the values rounded and clipped to 0..65535, NaN (where a band does not reach) 0.
+    MultispectralError naming the file when it cannot be written."""
     from osgeo import gdal
 
     gdal.UseExceptions()
-    data = np.asarray(bands, dtype=np.float32)
-    if data.ndim != 3 or data.shape[0] != len(names):
+    data = np.asarray(bands)
+    wavelengths = list(wavelengths) if wavelengths is not None else [None] * len(names)
+    if data.ndim != 3 or data.shape[0] != len(names) or len(wavelengths) != len(names):
         raise MultispectralError(f"{path}: {len(names)} band names for an array of shape {data.shape}")
+    photo = dtype == "uint16"
+    if photo:
+        data = np.clip(np.nan_to_num(data.astype(np.float64), nan=0.0), 0, 65535).round().astype(np.uint16)
+    else:
+        data = data.astype(np.float32)
     try:
         with atomic_output(path) as tmp:
-            ds = gdal.GetDriverByName("GTiff").Create(tmp, data.shape[2], data.shape[1], data.shape[0],
-                                                      gdal.GDT_Float32, ["COMPRESS=DEFLATE", "PREDICTOR=3",
-                                                                         "TILED=YES", "INTERLEAVE=BAND"])
-            for i, name in enumerate(names):
+            ds = gdal.GetDriverByName("GTiff").Create(
+                tmp, data.shape[2], data.shape[1], data.shape[0], gdal.GDT_UInt16 if photo else gdal.GDT_Float32,
+                ["COMPRESS=DEFLATE", f"PREDICTOR={2 if photo else 3}", "TILED=YES", "INTERLEAVE=BAND"])
+            for i, (name, nm) in enumerate(zip(names, wavelengths)):
                 band = ds.GetRasterBand(i + 1)
                 band.SetDescription(str(name))
-                band.SetNoDataValue(float("nan"))
+                if not photo:
+                    band.SetNoDataValue(float("nan"))
+                if nm is not None:
+                    band.SetMetadata({"wavelength": f"{nm:g}", "wavelength_units": "nm"})
                 band.WriteArray(data[i])
+            if exif:
+                ds.SetMetadata({str(k): str(v) for k, v in exif.items()}, "EXIF")
             if metadata:
                 ds.SetMetadata({str(k): str(v) for k, v in metadata.items()})
             ds.FlushCache()
             ds = None
     except (RuntimeError, OSError) as e:
-        raise MultispectralError(f"{path}: the registered bands cannot be written ({e})") from e
+        raise MultispectralError(f"{path}: the bands cannot be written ({e})") from e
     return path
 
 
@@ -749,38 +763,3 @@ def capture_exif(reference_path: str, focal_px: float, width: int, height: int) 
                 "EXIF_FocalPlaneYResolution": f"({px_per_mm:g})", "EXIF_FocalPlaneResolutionUnit": "4",
                 "EXIF_PixelXDimension": str(int(width)), "EXIF_PixelYDimension": str(int(height))})
     return out
-
-
-def write_photo_stack(path: str, bands: np.ndarray, names: Sequence[str],
-                      wavelengths: Sequence[Optional[float]], exif: Dict[str, str],
-                      metadata: Optional[Dict[str, str]] = None) -> str:
-    """A capture's registered bands as one 16-bit multi-band photo (bands, rows, cols; 0 where a band does not
-    reach): each band described by its name with its central wavelength (``wavelength``, nm) in its metadata, the
-    ``exif`` tags in GDAL's EXIF domain, written atomically.  MultispectralError naming the file when it cannot be
-    written."""
-    from osgeo import gdal
-
-    gdal.UseExceptions()
-    data = np.asarray(bands)
-    if data.ndim != 3 or data.shape[0] != len(names) or len(wavelengths) != len(names):
-        raise MultispectralError(f"{path}: {len(names)} band names for an array of shape {data.shape}")
-    data = np.clip(np.nan_to_num(data.astype(np.float64), nan=0.0), 0, 65535).round().astype(np.uint16)
-    try:
-        with atomic_output(path) as tmp:
-            ds = gdal.GetDriverByName("GTiff").Create(tmp, data.shape[2], data.shape[1], data.shape[0],
-                                                      gdal.GDT_UInt16, ["COMPRESS=DEFLATE", "PREDICTOR=2",
-                                                                        "TILED=YES", "INTERLEAVE=BAND"])
-            for i, (name, nm) in enumerate(zip(names, wavelengths)):
-                band = ds.GetRasterBand(i + 1)
-                band.SetDescription(str(name))
-                if nm is not None:
-                    band.SetMetadata({"wavelength": f"{nm:g}", "wavelength_units": "nm"})
-                band.WriteArray(data[i])
-            ds.SetMetadata({str(k): str(v) for k, v in exif.items()}, "EXIF")
-            if metadata:
-                ds.SetMetadata({str(k): str(v) for k, v in metadata.items()})
-            ds.FlushCache()
-            ds = None
-    except (RuntimeError, OSError) as e:
-        raise MultispectralError(f"{path}: the capture's photo cannot be written ({e})") from e
-    return path

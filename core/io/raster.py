@@ -18,7 +18,7 @@ import math
 import os
 import struct
 from dataclasses import dataclass, field
-from typing import Iterable, Optional, Sequence, Tuple
+from typing import Iterable, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -310,6 +310,63 @@ def write_cog(path: str, array: np.ndarray, geotransform: Sequence[float], crs: 
         translate_to_cog(mem, tmp, path, progress)
         mem = None
         check_cancel(progress)
+    return path
+
+
+class RasterFrame(NamedTuple):
+    """Where a written raster lies: (rows, cols), its geotransform (None: none) and its CRS as WKT ('' : none)."""
+    shape: Tuple[int, int]
+    geotransform: Optional[Sequence[float]]
+    crs_wkt: str
+
+
+def write_float_blocks(path: str, frame: RasterFrame, label: "BandLabel", windows: Iterable[Tuple[int, int, int, int]],
+                       block_values, progress: Optional[Progress] = None, error=None, late_metadata=None) -> str:
+    """A float32 COG on ``frame`` written block by block, so the raster is never whole in memory:
+    ``block_values(r0, r1, c0, c1)`` gives each window's values (NaN = nodata, written as ``label.nodata``); they
+    go into a temporary tiled GeoTIFF beside ``path``, then into the COG (atomically).  ``label``: the band's
+    description, unit and the file's metadata; ``late_metadata()``, when given, adds items known only once every
+    block is written (a display range).  A cancel is honoured between blocks; ``error`` (DsmError by default)
+    names ``path`` when GDAL cannot write it."""
+    gdal, _ = _gdal()
+    error = error or DsmError
+    progress = progress or NullProgress()
+    (h, w), geotransform, crs_wkt = frame
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    with atomic_output(path) as tmp:
+        work = tmp + ".blocks.tif"
+        ds = band = None
+        try:
+            try:
+                ds = gdal.GetDriverByName("GTiff").Create(work, w, h, 1, gdal.GDT_Float32, [
+                    "TILED=YES", "BLOCKXSIZE=256", "BLOCKYSIZE=256", "COMPRESS=DEFLATE", "ZLEVEL=1",
+                    "BIGTIFF=IF_SAFER"])
+            except RuntimeError as e:
+                raise error(f"cannot write {path}: {e}") from e
+            if geotransform is not None:
+                ds.SetGeoTransform(tuple(float(v) for v in geotransform))
+            if crs_wkt:
+                ds.SetProjection(crs_wkt)
+            band = ds.GetRasterBand(1)
+            band.SetNoDataValue(float(label.nodata))
+            band.SetDescription(label.description)
+            if label.unit:
+                band.SetUnitType(label.unit)
+            metadata = {str(k): str(v) for k, v in (label.metadata or {}).items()}
+            ds.SetMetadata(metadata)
+            for r0, r1, c0, c1 in windows:
+                values = np.asarray(block_values(r0, r1, c0, c1), dtype=np.float32)
+                band.WriteArray(np.where(np.isfinite(values), values, np.float32(label.nodata)), c0, r0)
+                check_cancel(progress)
+            if late_metadata is not None:
+                ds.SetMetadata({**metadata, **{str(k): str(v) for k, v in late_metadata().items()}})
+            ds.FlushCache()
+            ds = band = None
+            translate_to_cog(work, tmp, path, progress, error)
+        finally:
+            ds = band = None
+            if os.path.exists(work):
+                os.remove(work)
     return path
 
 

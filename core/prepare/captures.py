@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence, Tuple
 
 from ..common.progress import NullProgress, Progress, check_cancel
-from ..io.multispectral import Capture, band_key, capture_exif, read_block, write_photo_stack
+from ..io.multispectral import Capture, band_key, capture_exif, read_block, write_band_stack
 from .bands import RegistrationOptions, register_capture
 from .options import PrepareError
 
@@ -118,9 +118,9 @@ def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
         path = os.path.join(options.output_dir, photo_name(cap))
         md = {"REFERENCE_BAND": reg.reference, "CAPTURE": cap.capture_id,
               "BAND_FILES": ",".join(infos[n].name for n in order_names)}
-        write_photo_stack(path, reg.bands[order], order_names,
-                          [infos[n].central_wavelength_nm for n in order_names],
-                          capture_exif(ref.path, reg.frame.f, width, height), md)
+        write_band_stack(path, reg.bands[order], order_names, md,
+                         [infos[n].central_wavelength_nm for n in order_names],
+                         capture_exif(ref.path, reg.frame.f, width, height), dtype="uint16")
         photos.append(path)
         for r in reg.results[1:]:
             worst[r.camera.name] = max(worst.get(r.camera.name, 0.0), float(r.refined_residual.worst))

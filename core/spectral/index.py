@@ -18,8 +18,8 @@ from typing import Dict, Iterator, Optional, Tuple
 
 import numpy as np
 
-from ..common.files import atomic_output, refuse_overwriting_inputs
-from ..common.progress import NullProgress, Progress, SubProgress, check_cancel
+from ..common.files import refuse_overwriting_inputs
+from ..common.progress import NullProgress, Progress, SubProgress
 from ..io import raster
 from .bands import BandTable, read_band_table
 from .errors import SpectralError
@@ -116,43 +116,23 @@ class _Stats:
             self.total += float(ok.sum(dtype=np.float64))
 
 
-def _create(work: str, r: raster.RasterFile, description: str, metadata: dict):
-    from osgeo import gdal
-
-    gdal.UseExceptions()
-    try:
-        ds = gdal.GetDriverByName("GTiff").Create(work, r.width, r.height, 1, gdal.GDT_Float32, [
-            "TILED=YES", f"BLOCKXSIZE={TILE}", f"BLOCKYSIZE={TILE}", "COMPRESS=DEFLATE", "ZLEVEL=1",
-            "BIGTIFF=IF_SAFER"])
-    except RuntimeError as e:
-        raise SpectralError(f"cannot write the spectral index beside {work}: {e}") from e
-    if r.geotransform is not None:
-        ds.SetGeoTransform(r.geotransform)
-    if r.crs_wkt:
-        ds.SetProjection(r.crs_wkt)
-    band = ds.GetRasterBand(1)
-    band.SetNoDataValue(NODATA)
-    band.SetDescription(description)
-    ds.SetMetadata({str(k): str(v) for k, v in metadata.items()})
-    return ds
-
-
-def _compute(r: raster.RasterFile, job: Tuple[Expression, BandTable, Dict[str, int]], ds, options: IndexOptions,
-             progress: Progress) -> _Stats:
-    """The index of every block of ``r`` into the open dataset ``ds``; its statistics."""
+def _block_values(r: raster.RasterFile, job: Tuple[Expression, BandTable, Dict[str, int]], stats: _Stats,
+                  options: IndexOptions, progress: Progress, n_blocks: int):
+    """``block_values`` for core.io.raster.write_float_blocks: the index of each window of ``r`` (NaN where a band
+    is nodata or masked), its statistics gathered in ``stats``."""
     expr, table, used = job
-    stats = _Stats()
-    windows = list(blocks(r.height, r.width, options.block_cells))
-    band = ds.GetRasterBand(1)
-    for i, window in enumerate(windows):
-        check_cancel(progress)
-        values, valid = read_block(r, table, used, window)
-        out = expr.evaluate(values)
+    done = [0]
+
+    def values(r0, r1, c0, c1):
+        vals, valid = read_block(r, table, used, (c0, r0, c1 - c0, r1 - r0))
+        out = expr.evaluate(vals)
         out[~valid] = np.nan
         stats.add(out)
-        band.WriteArray(np.where(np.isfinite(out), out, NODATA).astype(np.float32), window[0], window[1])
-        progress.report((i + 1) / len(windows), f"{options.label}: block {i + 1} of {len(windows)}")
-    return stats
+        done[0] += 1
+        progress.report(done[0] / n_blocks, f"{options.label}: block {done[0]} of {n_blocks}")
+        return out
+
+    return values
 
 
 def spectral_index(options: IndexOptions, progress: Optional[Progress] = None) -> IndexResult:
@@ -171,20 +151,17 @@ def spectral_index(options: IndexOptions, progress: Optional[Progress] = None) -
         progress.info(f"{description} of {options.input} ({r.width} x {r.height} cells): {bands_text}")
         meta = {"ARCHAEOORTHO_PRODUCT": "spectral-index", "INDEX": options.label, "FORMULA": options.formula,
                 "BANDS": bands_text, "SOURCE": os.path.abspath(options.input)}
-        with atomic_output(options.output) as tmp:
-            work = tmp + ".blocks.tif"
-            try:
-                ds = _create(work, r, description, meta)
-                stats = _compute(r, (expr, table, used), ds, options, SubProgress(progress, 0.0, 0.7))
-                lo, hi = (-1.0, 1.0) if options.index in NORMALISED else (stats.lo, stats.hi)
-                ds.SetMetadata({**ds.GetMetadata(), "DISPLAY_MIN": f"{lo:.6g}", "DISPLAY_MAX": f"{hi:.6g}"})
-                ds.FlushCache()
-                ds = None
-                raster.translate_to_cog(work, tmp, options.output, SubProgress(progress, 0.7, 1.0), SpectralError)
-            finally:
-                ds = None
-                if os.path.exists(work):
-                    os.remove(work)
+        windows = [(r0, r0 + h, c0, c0 + w) for c0, r0, w, h in blocks(r.height, r.width, options.block_cells)]
+        stats = _Stats()
+        values = _block_values(r, (expr, table, used), stats, options, SubProgress(progress, 0.0, 0.7), len(windows))
+
+        def display_range():
+            lo, hi = (-1.0, 1.0) if options.index in NORMALISED else (stats.lo, stats.hi)
+            return {"DISPLAY_MIN": f"{lo:.6g}", "DISPLAY_MAX": f"{hi:.6g}"}
+
+        raster.write_float_blocks(options.output, raster.RasterFrame((r.height, r.width), r.geotransform, r.crs_wkt),
+                                  raster.BandLabel(description, "", NODATA, meta), windows, values,
+                                  SubProgress(progress, 0.7, 1.0), SpectralError, display_range)
     if stats.n:
         result.valid, result.minimum, result.maximum, result.mean = stats.n, stats.lo, stats.hi, stats.total / stats.n
     result.log_lines.append(f"{options.label}: {result.valid} of {r.width * r.height} cells with a value, "

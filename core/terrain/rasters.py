@@ -1,7 +1,6 @@
 """Reading an elevation raster for the terrain products (checked: projected CRS, data, size) and writing them."""
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from typing import Optional, Tuple
 
@@ -174,47 +173,16 @@ def tiles(h: int, w: int, size: int):
 
 def write_float_tiles(path: str, tile_values, elev: Elevation, label: raster.BandLabel, heights: bool = True,
                       tile: int = TILE_CELLS, progress=None) -> str:
-    """A float32 COG on the grid of ``elev`` written tile by tile: ``tile_values(r0, r1, c0, c1)`` gives the
-    values (metres when ``heights``, NaN = nodata) of each tile; they go into a temporary tiled GeoTIFF beside
-    ``path``, then into the COG (atomically: core.io.raster.write_cog's options), so the raster is never whole
-    in memory; ``label`` (:class:`core.io.raster.BandLabel`): the band's description, nodata and the metadata."""
-    from osgeo import gdal
+    """A float32 COG on the grid of ``elev`` written tile by tile (core.io.raster.write_float_blocks):
+    ``tile_values(r0, r1, c0, c1)`` gives the values (metres when ``heights``, NaN = nodata) of each tile, written
+    in the grid's own unit; ``label`` (:class:`core.io.raster.BandLabel`): the band's description, nodata and the
+    metadata."""
+    def values(r0, r1, c0, c1):
+        v = np.asarray(tile_values(r0, r1, c0, c1), dtype=np.float32)
+        return v / np.float32(elev.unit) if heights and elev.unit != 1.0 else v
 
-    from ..common.files import atomic_output
-    from ..common.progress import NullProgress, check_cancel
-
-    gdal.UseExceptions()
-    progress = progress or NullProgress()
-    nodata = label.nodata
-    h, w = elev.shape
-    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    with atomic_output(path) as tmp:
-        work = tmp + ".tiles.tif"
-        try:
-            ds = gdal.GetDriverByName("GTiff").Create(work, w, h, 1, gdal.GDT_Float32, [
-                "TILED=YES", "BLOCKXSIZE=256", "BLOCKYSIZE=256", "COMPRESS=DEFLATE", "ZLEVEL=1", "BIGTIFF=IF_SAFER"])
-            ds.SetGeoTransform(tuple(float(v) for v in elev.geotransform))
-            if elev.crs_wkt:
-                ds.SetProjection(elev.crs_wkt)
-            band = ds.GetRasterBand(1)
-            band.SetNoDataValue(float(nodata))
-            band.SetDescription(label.description)
-            if label.unit:
-                band.SetUnitType(label.unit)
-            ds.SetMetadata({str(k): str(v) for k, v in (label.metadata or {}).items()})
-            for r0, r1, c0, c1 in tiles(h, w, tile):
-                values = np.asarray(tile_values(r0, r1, c0, c1), dtype=np.float32)
-                if heights and elev.unit != 1.0:
-                    values = values / np.float32(elev.unit)
-                band.WriteArray(np.where(np.isfinite(values), values, np.float32(nodata)), c0, r0)
-                check_cancel(progress)
-            ds.FlushCache()
-            ds = band = None
-            raster.translate_to_cog(work, tmp, path, progress, TerrainError)
-        finally:
-            if os.path.exists(work):
-                os.remove(work)
-    return path
+    frame = raster.RasterFrame(elev.shape, elev.geotransform, elev.crs_wkt)
+    return raster.write_float_blocks(path, frame, label, tiles(*elev.shape, tile), values, progress, TerrainError)
 
 
 def write_classes(path: str, array: np.ndarray, elev: Elevation, description: str, metadata: dict,
