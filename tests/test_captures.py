@@ -14,7 +14,7 @@ from osgeo import gdal
 from core.io.images import read_image_info
 from core.io.raster import RasterFile
 from core.ortho.writer import RasterWriter, photo_band_names
-from core.prepare.captures import CaptureStackOptions, stack_captures, stack_order
+from core.prepare.captures import CaptureStackOptions, photo_names, stack_captures, stack_order
 from core.prepare.options import PrepareError
 from tests.conftest import shared
 
@@ -30,6 +30,20 @@ def test_the_false_colour_bands_come_first():
     assert stack_order(["Green", "Red", "Red edge", "NIR"]) == [3, 1, 0, 2]
     assert stack_order(["Blue", "Green", "Red", "Red edge", "NIR"]) == [4, 2, 1, 0, 3]
     assert stack_order(["Green", "Red edge"]) == [0, 1]
+
+
+def test_captures_never_share_a_photo_name():
+    """Band folders that restart their numbering (MicaSense SET000, SET001) give two captures one file name: each then
+    takes its capture id, so neither photo is written over the other."""
+    from types import SimpleNamespace
+
+    def cap(cid, path):
+        return SimpleNamespace(capture_id=cid, bands=(SimpleNamespace(name=os.path.basename(path)),))
+
+    caps = [cap("A1", "SET000/IMG_0001_1.tif"), cap("B2", "SET001/IMG_0001_1.tif"), cap("C3", "IMG_0002_1.tif"),
+            cap("D/4", "band.tif")]
+    assert photo_names(caps) == {"A1": "IMG_0001_A1.tif", "B2": "IMG_0001_B2.tif", "C3": "IMG_0002.tif",
+                                 "D/4": "D_4.tif"}
 
 
 def test_the_sequoia_capture_becomes_one_photo_the_chain_reads(tmp_path):

@@ -57,16 +57,23 @@ def stack_order(names: Sequence[str]) -> List[int]:
     return first + [i for i in range(len(names)) if i not in first]
 
 
-def photo_name(capture: Capture) -> str:
-    """The capture's photo file name: its reference band file's name without the band suffix (IMG_..._0000_GRE.TIF
-    -> IMG_..._0000.tif), else the capture id."""
-    ref = capture.bands[0]
-    stem = os.path.splitext(ref.name)[0]
-    suffix = "_" + (ref.band_name or "")
-    for cand in (suffix, suffix.upper(), "_" + os.path.splitext(ref.name)[0].rsplit("_", 1)[-1]):
-        if len(cand) > 1 and stem.upper().endswith(cand.upper()):
-            return stem[:-len(cand)] + ".tif"
-    return "".join(c if c.isalnum() or c in "-_" else "_" for c in capture.capture_id) + ".tif"
+def _safe(text: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_" else "_" for c in text)
+
+
+def photo_names(captures: Sequence[Capture]) -> Dict[str, str]:
+    """capture id -> its photo's file name: the reference band file's name without its last ``_`` part, the band
+    (IMG_..._0000_GRE.TIF -> IMG_..._0000.tif), else the capture id; where two captures would get one name (band
+    folders that restart their numbering, as MicaSense's SET folders do) each of them takes its capture id too, so no
+    capture's photo is written over another's."""
+    names = {}
+    for cap in captures:
+        stem = os.path.splitext(cap.bands[0].name)[0]
+        names[cap.capture_id] = (stem.rsplit("_", 1)[0] if "_" in stem else _safe(cap.capture_id)) + ".tif"
+    seen: Dict[str, int] = {}
+    for name in names.values():
+        seen[name.lower()] = seen.get(name.lower(), 0) + 1
+    return {cid: (n if seen[n.lower()] == 1 else f"{n[:-4]}_{_safe(cid)}.tif") for cid, n in names.items()}
 
 
 def _band_captures(paths: Sequence[str]):
@@ -101,6 +108,7 @@ def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
     left_out: Dict[str, str] = {}
     worst: Dict[str, float] = {}
     order_names: Tuple[str, ...] = ()
+    names_of = photo_names(captures)
     for k, cap in enumerate(captures):
         check_cancel(progress)
         missing = [n for n in names if cap.band(n) is None]
@@ -115,7 +123,7 @@ def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
         infos = {b.band_name: b for b in cap.bands}
         ref = infos[reg.reference]
         height, width = reg.bands.shape[1:]
-        path = os.path.join(options.output_dir, photo_name(cap))
+        path = os.path.join(options.output_dir, names_of[cap.capture_id])
         md = {"REFERENCE_BAND": reg.reference, "CAPTURE": cap.capture_id,
               "BAND_FILES": ",".join(infos[n].name for n in order_names)}
         write_band_stack(path, reg.bands[order], order_names, md,
