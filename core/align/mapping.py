@@ -341,9 +341,10 @@ def prior_focals(pycolmap, db_path: str) -> Dict[int, float]:
 def focal_drift(rec, priors: Dict[int, float]) -> Tuple[float, Optional[int]]:
     """The largest ratio (>= 1) between a camera's focal length in ``rec`` and its prior, and that camera."""
     worst, which = 1.0, None
+    used = {im.camera_id for im in rec.images.values() if im.has_pose}
     for cid, cam in rec.cameras.items():
         f0 = priors.get(cid)
-        if f0 and f0 > 0 and cid in {im.camera_id for im in rec.images.values() if im.has_pose}:
+        if f0 and f0 > 0 and cid in used:
             f = float(cam.mean_focal_length())
             r = max(f / f0, f0 / f) if f > 0 and math.isfinite(f) else math.inf
             if r > worst:
