@@ -189,6 +189,59 @@ def test_round_pairs_rematch_what_changed_and_add_pairs_for_the_left_out():
     assert len(round_pairs(original, ["e"], [], list("abcdef"), exhaustive=True)) == 15
 
 
+def _grid_context(tmp_path, rows, cols, raw=(), positions=True, spacing=10.0):
+    """An escalation context over a ``rows`` x ``cols`` grid of photos ``spacing`` m apart (positions known or
+    not), each paired in the fast path with its right and lower neighbour, ``raw`` matches (a, b, count) in its
+    database."""
+    import core.align.escalation as esc
+
+    names = [f"S{r:02d}_{c:02d}" for r in range(rows) for c in range(cols)]
+    db = tmp_path / f"grid{rows}x{cols}{'' if positions else '-no-gps'}-{len(raw)}.db"
+    if db.exists():
+        db.unlink()
+    _sql(db, "CREATE TABLE images (image_id INTEGER, name TEXT)", "CREATE TABLE matches (pair_id INTEGER, rows INTEGER)",
+         *[f"INSERT INTO images VALUES ({k + 1}, '{n}')" for k, n in enumerate(names)],
+         *[f"INSERT INTO matches VALUES ({min(names.index(a), names.index(b)) + 1} * {esc.PAIR_ID_BASE} + "
+           f"{max(names.index(a), names.index(b)) + 1}, {c})" for a, b, c in raw])
+    original = [(f"S{r:02d}_{c:02d}", f"S{r:02d}_{c + 1:02d}") for r in range(rows) for c in range(cols - 1)]
+    original += [(f"S{r:02d}_{c:02d}", f"S{r + 1:02d}_{c:02d}") for r in range(rows - 1) for c in range(cols)]
+    xy = {f"S{r:02d}_{c:02d}": (c * spacing, r * spacing) for r in range(rows) for c in range(cols)}
+    return esc.EscalationContext(None, Extraction(str(db), str(tmp_path), [], {}), FeatureSettings(1000, 4096, 0),
+                                 str(tmp_path), names, AlignOptions(spatial_neighbours=8), original,
+                                 lambda p, s=None: [], lambda reg, oth: {}, lambda: {},
+                                 xy if positions else None)
+
+
+def test_a_large_blocks_round_pairs_each_left_out_image_with_its_own_neighbours(tmp_path):
+    """Issue 33: in a block of hundreds, the extension round's pairs grow with the images left out, not with the
+    block: each left-out image with its nearest images (by camera position) and the images it matched best,
+    never every left-out image with every other's neighbours or with every registered image."""
+    import core.align.escalation as esc
+
+    left = ["S00_00", "S00_01", "S01_00"]
+    far = "S14_19"  # a raw match far away (an image of the same ground from another strip): kept as an anchor
+    pairs_by_size = {}
+    for rows in (15, 30):
+        ctx = _grid_context(tmp_path, rows, 20, raw=[("S00_00", far, 40)])
+        assert len(ctx.order) > esc.EXTEND_MIN_IMAGES and esc.extends(ctx, [object()])
+        pairs = esc.extension_pairs(ctx, left, left + ["S01_01"], None)
+        pairs_by_size[rows] = pairs
+        assert all(a in left or b in left or "S01_01" in (a, b) for a, b in pairs)
+        for w in left:
+            mine = {b if a == w else a for a, b in pairs if w in (a, b)}
+            assert len(mine) <= ctx.options.spatial_neighbours + esc.ANCHORS_PER_IMAGE
+            assert set(esc.nearest(ctx, w, ctx.order, ctx.options.spatial_neighbours)) <= mine
+            assert max(abs(int(n[1:3]) - int(w[1:3])) for n in mine - {far}) <= 3  # nothing from across the block
+        assert ("S00_00", far) in pairs and ("S00_01", far) not in pairs
+        assert ("S01_01", "S01_02") in pairs  # an original pair of an image extracted again: matched again
+    assert pairs_by_size[15] == pairs_by_size[30]  # twice the block, the same pairs
+    # no camera positions: the nearest in file order
+    ctx = _grid_context(tmp_path, 15, 20, positions=False)
+    assert esc.nearest(ctx, "S05_10", ctx.order, 4) == ["S05_09", "S05_11", "S05_08", "S05_12"]
+    assert not esc.extends(ctx, [])  # nothing registered: no block to continue
+    assert not esc.extends(_grid_context(tmp_path, 5, 20), [object()])  # 100 images: mapped afresh
+
+
 @pytest.fixture(scope="module")
 def fast_path(small_block, tmp_path_factory):
     """The fast path alone on the small frames: (workspace, AlignResult or the AlignError)."""

@@ -191,3 +191,33 @@ def test_the_first_pass_registers_a_faint_block_without_escalation(faint_block, 
     assert record["first_pass"]["settings"]["max_features"] >= FAINT_MIN_FEATURES
     manifest = json.load(open(tmp_path / "ws" / "workspace.json"))
     assert manifest["stages"]["align"]["results"]["first_pass"] == fp.FAINT
+
+
+@pytest.mark.slow
+def test_a_large_blocks_escalation_continues_the_block(faint_block, tmp_path, monkeypatch):
+    """The escalation of a large block by extension (issue 33), on the small farmland block with the size limit
+    lowered: the photo the fast path leaves out is extracted again with its neighbours and registered into the
+    main block continued from where the fast path left it, not mapped afresh, and the poses still fit the truth."""
+    import core.align.escalation as esc
+    from core.align.stage import align
+
+    block, images = faint_block
+    monkeypatch.setattr(esc, "EXTEND_MIN_IMAGES", 5)
+    r = align(images, str(tmp_path / "ws"), AlignOptions(focal_px=block.camera.fx, texture_probe=False, num_threads=2))
+    assert r.registered == len(block.shots) and not r.other_components and r.mean_reprojection_error < 1.0
+    rounds = json.load(open(tmp_path / "ws" / "sfm" / "alignment.json"))["escalation"]["rounds"]
+    assert rounds[0]["extended"] and rounds[0]["kept"] and rounds[0]["registered_after"] == len(block.shots)
+    assert len(rounds[0]["re_extracted"]) < len(block.shots)  # the left-out photo and its neighbours, not all
+    import pycolmap
+
+    rec = pycolmap.Reconstruction(str(tmp_path / "ws" / "sfm" / "model"))
+    est = np.array([rec.find_image_with_name(n).projection_center() for n in block.names])
+    true = np.array([block.shot(n).centre for n in block.names])
+    # a similarity from the model to the truth: the camera centres within a few per cent of the block's span
+    ce, ct = est - est.mean(0), true - true.mean(0)
+    u, sv, vt = np.linalg.svd(ce.T @ ct)
+    d = np.sign(np.linalg.det(u @ vt))
+    rot = u @ np.diag([1, 1, d]) @ vt
+    scale = (sv * [1, 1, d]).sum() / (ce ** 2).sum()
+    resid = np.linalg.norm(scale * ce @ rot - ct, axis=1)
+    assert resid.max() < 0.02 * np.ptp(true[:, :2], axis=0).max()

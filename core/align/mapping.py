@@ -66,8 +66,10 @@ def verified_pairs(pycolmap, db_path, min_inliers: int) -> int:
 
 
 def run_mapping(pycolmap, job: MappingJob, options: AlignOptions, progress: Progress, hold_all: bool = False,
-                hold_focal: bool = False):
-    """The reconstructions of the database.  ``hold_all``: every camera's intrinsics are given and held
+                hold_focal: bool = False, start=None):
+    """The reconstructions of the database.  ``start``: a reconstruction to continue (incremental mapping from
+    it, whichever mapper the options name: the escalation's extension of a large block, core.align.escalation);
+    its registered images must keep the features they were registered with.  ``hold_all``: every camera's intrinsics are given and held
     (core.align.calibrated): no adjustment of the mapping refines focal length, principal point or distortion.
     ``hold_focal``: the focal lengths stay at their priors (distortion is still refined; see map_block).
     COLMAP's switches are global: with some cameras held and some estimated the mapping refines all, and the stage
@@ -76,7 +78,7 @@ def run_mapping(pycolmap, job: MappingJob, options: AlignOptions, progress: Prog
     if options.mapper == "global" and n_images <= 2:
         progress.info("mapping: two images, mapped with the incremental mapper (the global mapper needs tracks of "
                       "three or more views)")
-    elif options.mapper == "global":
+    elif options.mapper == "global" and start is None:
         return _map_global(pycolmap, job, options, progress, hold_all, hold_focal)
     opts = pycolmap.IncrementalPipelineOptions()
     if hold_all or hold_focal:
@@ -103,9 +105,17 @@ def run_mapping(pycolmap, job: MappingJob, options: AlignOptions, progress: Prog
         state["n"] += 1
         progress.report(min(1.0, state["n"] / max(1, n_images)), f"mapping: registered image {state['n']}")
 
+    input_path = ""
+    if start is not None:
+        input_path = os.path.join(job.out_dir, "start")
+        os.makedirs(input_path, exist_ok=True)
+        start.write(input_path)
+        opts.multiple_models = False
+        progress.info(f"mapping: continuing the block of {start.num_reg_images()} images")
     with CancelWatcher(progress) as token:
         recs = pycolmap.incremental_mapping(job.db_path, job.images_dir, job.out_dir, options=opts,
-                                            next_image_callback=on_next, cancellation_token=token)
+                                            input_path=input_path, next_image_callback=on_next,
+                                            cancellation_token=token)
     check_cancel(progress)
     if recs and n_images > 2:
         recs = _register_rest(pycolmap, recs, job, opts, progress, on_next)
@@ -288,15 +298,16 @@ def camera_summary(rec) -> List[dict]:
 
 def map_block(pycolmap, job: MappingJob, options: AlignOptions, progress: Progress,
               degenerate: Optional[Dict[str, str]] = None,
-              held: Optional[Tuple[Dict[int, GivenCamera], bool]] = None) -> list:
+              held: Optional[Tuple[Dict[int, GivenCamera], bool]] = None, start=None) -> list:
     """The reconstructions, largest first, without the images the mapper gave a degenerate camera: those are added
     to ``degenerate`` (name -> why; an image's entry says why a mapping last left it out).  The mapping works in
     ``job.out_dir``, removed afterwards.  ``held``: (camera id -> given interior orientation of the cameras held,
-    whether that is every camera); the held cameras come back with exactly their given values."""
+    whether that is every camera); the held cameras come back with exactly their given values.  ``start``: a
+    reconstruction the mapping continues (see run_mapping) instead of starting afresh."""
     held_ids, hold_all = held or ({}, False)
     drifted = job.focal_held is not None  # an earlier mapping of this block held the intrinsics: so does this one
-    recs = _mapped(pycolmap, job, options, progress, hold_all or drifted, drifted)
-    if not hold_all and job.focal_held is None:
+    recs = _mapped(pycolmap, job, options, progress, hold_all or drifted, drifted, start)
+    if not hold_all and job.focal_held is None and start is None:
         recs = _against_focal_drift(pycolmap, job, options, progress, recs)
     for rec in (recs.values() if recs else ()):
         restore_held(rec, held_ids)
@@ -312,11 +323,11 @@ def map_block(pycolmap, job: MappingJob, options: AlignOptions, progress: Progre
 
 
 def _mapped(pycolmap, job: MappingJob, options: AlignOptions, progress: Progress, hold_all: bool,
-            hold_focal: bool):
+            hold_focal: bool, start=None):
     shutil.rmtree(job.out_dir, ignore_errors=True)
     os.makedirs(job.out_dir)
     try:
-        return run_mapping(pycolmap, job, options, progress, hold_all=hold_all, hold_focal=hold_focal)
+        return run_mapping(pycolmap, job, options, progress, hold_all=hold_all, hold_focal=hold_focal, start=start)
     finally:
         shutil.rmtree(job.out_dir, ignore_errors=True)
 

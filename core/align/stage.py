@@ -3,8 +3,7 @@
 :func:`align` reads images from a folder and writes, in the workspace (paths from
 :class:`core.project.layout.Layout`):
 
-- ``sfm/database.db``: COLMAP database (features, matches); kept between runs so
-  a re-run after a cancel reuses the features and matches already computed;
+- ``sfm/database.db``: COLMAP database (features, matches); kept so a re-run after a cancel reuses them;
 - ``sfm/model/``: the largest reconstruction in COLMAP binary format, in the
   local model frame;
 - ``sfm/alignment.json``: figures and the list of images not registered, with why;
@@ -115,11 +114,12 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
             ordered = map_block(pycolmap, mapping_job, options, SubProgress(progress, 0.65, 0.90), degenerate,
                                 photos.held())
         ctx = EscalationContext(pycolmap, job, first.settings, lay.sfm_dir, [im.name for im in infos], options, pairs,
-                                lambda p: map_block(pycolmap, mapping_job, options, p, degenerate, photos.held()),
+                                lambda p, s=None: map_block(pycolmap, mapping_job, options, p, degenerate,
+                                                            photos.held(), s),
                                 lambda reg, oth: diagnose_unregistered(
                                     infos, reg, oth, verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS),
                                     degenerate),
-                                lambda: verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS))
+                                lambda: verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS), photos.positions)
         with run.step("escalation", save=False):
             ordered, escalation = escalate(ctx, ordered, SubProgress(progress, 0.90, 0.93))
         partners = verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS)
