@@ -230,13 +230,13 @@ Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global
 Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
         <translation>Structure from Motion: SIFT-Merkmale, Paarauswahl, robuste Zuordnung (RANSAC), inkrementelle Rekonstruktion mit Selbstkalibrierung (Brennweite, Bildhauptpunkt, Objektivverzeichnung) und eine abschließende Bündelblockausgleichung. Das Ergebnis wird im Arbeitsbereich-Ordner gespeichert, den die folgenden Schritte (Georeferenzieren, DOM erzeugen, Orthophoto erzeugen) als Eingabe nehmen. Ein erneuter Lauf setzt fort: bereits berechnete Merkmale und Zuordnungen werden wiederverwendet.
 
-Paarauswahl: &apos;auto&apos; nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren. Kamerapositionen (CSV), optional: die Positionen der Fotos in der Datei, die Georeferenzieren liest (ein GNSS-Protokoll, für Fotos ohne EXIF-GPS), wählen die Paare und die Nachbarn der geprüften Fotos statt EXIF-GPS; sie georeferenzieren den Block nicht.
-Kameramodell: &apos;AUTO&apos; schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
+Paarauswahl: 'auto' nimmt EXIF-GPS-Nachbarn, wenn die Bilder GPS tragen, sonst jedes Paar bis 100 Bilder und für größere Sätze ohne GPS aufeinanderfolgende Paare mit Schleifenpaaren. Kamerapositionen (CSV), optional: die Positionen der Fotos in der Datei, die Georeferenzieren liest (ein GNSS-Protokoll, für Fotos ohne EXIF-GPS), wählen die Paare und die Nachbarn der geprüften Fotos statt EXIF-GPS; sie georeferenzieren den Block nicht.
+Kameramodell: 'AUTO' schätzt Brennweite, Bildhauptpunkt, k1, k2, p1, p2 (OPENCV) für Kameras mit 10 oder mehr Bildern und darunter ein einfacheres radiales Modell.
 Bildgröße für die Zuordnung: die längste Seite, auf die die Bilder für die Merkmale verkleinert werden (0 = automatisch: Fotos bis 2 Megapixel unverändert, größere auf 2 Megapixel verkleinert; DOM und Orthophotos nutzen jedes Pixel). Merkmale je Bild: 0 = automatisch (etwa 4000 je Megapixel, 2048 bis 4096). Stehen beide auf 0, werden zuerst einige Fotos geprüft: wo schwache, kontrastarme Textur (gepflügte Felder) ihnen zu wenige Merkmale lässt, nimmt der erste Durchgang 8192 schwächere, wenn nötig bei bis zu doppelter Größe (das Protokoll sagt es). Affin-invariante Merkmale helfen bei Schrägaufnahmen und sind langsamer.
 Brennweite und Sensorbreite: innere Orientierung, wenn EXIF fehlt (gescannter Film): die Brennweite und die Breite der langen Bildseite in Millimetern (0 = aus EXIF / unbekannt).
 Kamerakalibrierungsdatei: die innere Orientierung einer kalibrierten Kamera (YAML/JSON von ArchaeoOrtho, innere Parameter von Orthority, OpenCV, COLMAP cameras.txt oder Metashape-XML); mehrere Kameras werden den Fotos über ihre Bildmuster, das Kameramodell oder die Bildgröße zugeordnet; ein Foto anderer Auflösung erhält sie skaliert. Eine Datei, die sich nicht lesen lässt, beendet den Lauf vor jeder Arbeit und nennt Datei, Zeile und Feld.
-Innere Orientierung: was die Ausgleichungen an einer Kamera ändern dürfen: &apos;fixed&apos; hält die gegebenen Werte durch Ausrichtung und Georeferenzierung (auch mit automatischen Passpunkten), &apos;refined&apos; lässt die Georeferenzierung sie mit den Standardabweichungen der Kalibrierung als Vorinformation verbessern, &apos;estimated&apos; kalibriert ausgehend von ihnen selbst. &apos;auto&apos; ist &apos;fixed&apos;, wo eine Kalibrierung gegeben ist (die Datei oder von &apos;Bilder vorbereiten&apos; entzerrte Filmscans), sonst &apos;estimated&apos;; ein eigenes &apos;adjust&apos; einer Kamera in der Datei geht vor. Mit &apos;fixed&apos; oder &apos;refined&apos; und ohne Datei sind Brennweite und Sensorbreite die gegebenen Werte. Protokoll, sfm/alignment.json und der Genauigkeitsbericht sagen je Kamera, was gehalten wurde.
-Rekonstruktionsverfahren (erweitert): &apos;incremental&apos; (COLMAP, Standard) oder &apos;global&apos; (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).
+Innere Orientierung: was die Ausgleichungen an einer Kamera ändern dürfen: 'fixed' hält die gegebenen Werte durch Ausrichtung und Georeferenzierung (auch mit automatischen Passpunkten), 'refined' lässt die Georeferenzierung sie mit den Standardabweichungen der Kalibrierung als Vorinformation verbessern, 'estimated' kalibriert ausgehend von ihnen selbst. 'auto' ist 'fixed', wo eine Kalibrierung gegeben ist (die Datei oder von 'Bilder vorbereiten' entzerrte Filmscans), sonst 'estimated'; ein eigenes 'adjust' einer Kamera in der Datei geht vor. Mit 'fixed' oder 'refined' und ohne Datei sind Brennweite und Sensorbreite die gegebenen Werte. Protokoll, sfm/alignment.json und der Genauigkeitsbericht sagen je Kamera, was gehalten wurde.
+Rekonstruktionsverfahren (erweitert): 'incremental' (COLMAP, Standard) oder 'global' (GLOMAP: Rotationsmittelung und globale Positionierung, bei großen Blöcken oft schneller; ein Abbruch wirkt erst, wenn es fertig ist).
 Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen Einstellungen auslassen, oder ein in Teile zerfallener Block werden mit reicheren Merkmalen (schwächeren für kontrastarme Bilder, affinen für steile Schrägaufnahmen) und mehr Paaren erneut versucht; das Protokoll und sfm/alignment.json sagen, was erneut versucht wurde und warum.</translation>
     </message>
 </context>
@@ -882,6 +882,21 @@ Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786)
         <location filename="../ui/catalog.py" line="8"/>
         <source>VAT (visualisation for archaeological topography, blend)</source>
         <translation>VAT (Visualisierung für archäologische Topographie, Mischung)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>raw</source>
+        <translation>roh (raw)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>normalised</source>
+        <translation>normalisiert (normalised)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>irradiance</source>
+        <translation>Einstrahlung (irradiance)</translation>
     </message>
 </context>
 <context>
@@ -2802,92 +2817,92 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
 <context>
     <name>ResultLayers</name>
     <message>
-        <location filename="../qgisio/layers.py" line="278"/>
+        <location filename="../qgisio/layers.py" line="286"/>
         <source>control (used)</source>
         <translation>Passpunkt (verwendet)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="279"/>
+        <location filename="../qgisio/layers.py" line="287"/>
         <source>check point</source>
         <translation>Kontrollpunkt</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="280"/>
+        <location filename="../qgisio/layers.py" line="288"/>
         <source>rejected (outlier)</source>
         <translation>verworfen (Ausreißer)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="281"/>
+        <location filename="../qgisio/layers.py" line="289"/>
         <source>not triangulated</source>
         <translation>nicht trianguliert</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="771"/>
+        <location filename="../qgisio/layers.py" line="805"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="724"/>
+        <location filename="../qgisio/layers.py" line="756"/>
         <source>DSM hillshade</source>
         <translation>DOM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="772"/>
+        <location filename="../qgisio/layers.py" line="806"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="773"/>
+        <location filename="../qgisio/layers.py" line="807"/>
         <source>Cameras</source>
         <translation>Kameras</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="736"/>
+        <location filename="../qgisio/layers.py" line="768"/>
         <source>Camera footprints</source>
         <translation>Bildfußabdrücke</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="744"/>
+        <location filename="../qgisio/layers.py" line="776"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Passpunkt-Residuen (Vektoren x{})</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="774"/>
+        <location filename="../qgisio/layers.py" line="808"/>
         <source>Point cloud</source>
         <translation>Punktwolke</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="782"/>
+        <location filename="../qgisio/layers.py" line="816"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="417"/>
+        <location filename="../qgisio/layers.py" line="449"/>
         <source>{} ({})</source>
         <translation>{} ({})</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="775"/>
+        <location filename="../qgisio/layers.py" line="809"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="751"/>
+        <location filename="../qgisio/layers.py" line="783"/>
         <source>DTM hillshade</source>
         <translation>DGM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="776"/>
+        <location filename="../qgisio/layers.py" line="810"/>
         <source>Contours</source>
         <translation>Höhenlinien</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="401"/>
+        <location filename="../qgisio/layers.py" line="433"/>
         <source>{} — {}</source>
         <translation>{} — {}</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="391"/>
+        <location filename="../qgisio/layers.py" line="389"/>
         <source>Spectral index</source>
         <translation>Spektralindex</translation>
     </message>
@@ -3185,6 +3200,59 @@ Index: NDVI, NDRE oder der Ausdruck unten.
 Ausdruck: eine Formel der Kanäle, nach Nummer (b1 ist der erste Kanal) oder nach Name, z. B. (b4 - b3) / (b4 + b3) oder 2.5 * (NIR - RED) / (NIR + 2.4 * RED + 1); Zahlen, + - * / ** und Klammern sowie die Funktionen sqrt, abs, log, exp, min, max, clip(x, low, high).
 NIR-Kanalnummer, Rot-Kanalnummer, Red-Edge-Kanalnummer (erweitert): der Kanal, der für diesen Namen zu nehmen ist, wenn die Kanalnamen des Rasters ihn nicht oder falsch angeben; 0 liest ihn aus den Namen.
 Indexraster: wohin das Float32-Cloud-Optimized-GeoTIFF geschrieben wird (NoData -9999, der Kanal mit dem Index und seiner Formel beschrieben).</translation>
+    </message>
+</context>
+<context>
+    <name>StackCapturesAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="49"/>
+        <source>Band folder</source>
+        <translation>Kanalordner</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="49"/>
+        <source>Radiometry</source>
+        <translation>Radiometrie</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="49"/>
+        <source>Reference band</source>
+        <translation>Referenzkanal</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="57"/>
+        <source>Output folder</source>
+        <translation>Ausgabeordner</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="58"/>
+        <source>Photos written</source>
+        <translation>Geschriebene Fotos</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="59"/>
+        <source>Captures left out</source>
+        <translation>Ausgelassene Aufnahmen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Stack multispectral captures</source>
+        <translation>Multispektrale Aufnahmen stapeln</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Turns the band files of a multispectral rig (Parrot Sequoia, MicaSense RedEdge / Altum, DJI P4 Multispectral / Mavic 3M: one 16-bit TIFF per band per capture) into one multi-band photo per capture, which Align images, Run pipeline and Build orthophoto take like any photo: the orthomosaic then has every band, and Spectral index makes NDVI or NDRE of it. The files of one capture are grouped by their capture id (else rig name and time); each band is undistorted with its own lens model from its metadata, turned by its rig rotation and registered onto the reference band by phase correlation on gradients. The photo&apos;s bands are NIR, Red, Green first (QGIS shows them as a false-colour NIR-R-G view), each named with its wavelength; the capture&apos;s GPS is in its EXIF. A capture missing a band is left out and named in the log; the band folder is never written into.
+
+Band folder: the folder of band files (the RGB camera&apos;s frames in it are not stacked).
+Radiometry: normalised (default) removes each band&apos;s dark level, corrects its vignetting from the file&apos;s model and normalises exposure time and gain to the block&apos;s; irradiance also divides by the sun sensor&apos;s irradiance for that band (values proportional to reflectance when the light changes during the flight); raw keeps the numbers as recorded. A band file lacking what the choice needs (an exposure time, a sun-sensor reading) stops the run before any work, naming the file. The photo&apos;s metadata says what was done (and per band the vignetting model, dark level and scale).
+Reference band (advanced): the band the others are registered onto; empty: the rig&apos;s reference camera.
+Output folder: where the multi-band photos are written (one per capture, named after its band files without the band suffix); not the band folder.</source>
+        <translation>Macht aus den Kanaldateien einer Multispektralkamera (Parrot Sequoia, MicaSense RedEdge / Altum, DJI P4 Multispectral / Mavic 3M: ein 16-Bit-TIFF je Kanal und Aufnahme) ein mehrkanaliges Foto je Aufnahme, das Bilder ausrichten, Pipeline ausführen und Orthophoto erzeugen wie jedes Foto nehmen: das Orthomosaik hat dann jeden Kanal, und Spektralindex berechnet daraus NDVI oder NDRE. Die Dateien einer Aufnahme werden nach ihrer Aufnahme-ID gruppiert (sonst nach Rig-Name und Zeit); jeder Kanal wird mit seinem eigenen Objektivmodell aus seinen Metadaten entzerrt, um seine Rig-Rotation gedreht und durch Phasenkorrelation auf Gradienten auf den Referenzkanal registriert. Die Kanäle des Fotos beginnen mit NIR, Rot, Grün (QGIS zeigt sie als Falschfarbenansicht NIR-R-G), jeder mit seiner Wellenlänge benannt; das GPS der Aufnahme steht in seinem EXIF. Eine Aufnahme, der ein Kanal fehlt, wird ausgelassen und im Protokoll genannt; in den Kanalordner wird nie geschrieben.
+
+Kanalordner: der Ordner der Kanaldateien (die Bilder der RGB-Kamera darin werden nicht gestapelt).
+Radiometrie: normalisiert (Standard) zieht von jedem Kanal seinen Dunkelwert ab, korrigiert seine Vignettierung nach dem Modell der Datei und normalisiert Belichtungszeit und Verstärkung auf die des Blocks; Einstrahlung teilt zusätzlich durch die Einstrahlung des Sonnensensors für diesen Kanal (Werte proportional zur Reflexion, wenn sich das Licht während des Flugs ändert); roh behält die Werte wie aufgenommen. Eine Kanaldatei, der fehlt, was die Wahl braucht (eine Belichtungszeit, ein Sonnensensorwert), beendet den Lauf vor jeder Arbeit und nennt die Datei. Die Metadaten des Fotos sagen, was getan wurde (und je Kanal das Vignettierungsmodell, der Dunkelwert und der Maßstab).
+Referenzkanal (erweitert): der Kanal, auf den die anderen registriert werden; leer: die Referenzkamera des Rigs.
+Ausgabeordner: wohin die mehrkanaligen Fotos geschrieben werden (eines je Aufnahme, benannt nach ihren Kanaldateien ohne die Kanalendung); nicht der Kanalordner.</translation>
     </message>
 </context>
 </TS>

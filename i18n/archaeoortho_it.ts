@@ -228,15 +228,15 @@ Camera calibration file: a calibrated camera&apos;s interior orientation (Archae
 Interior orientation: what the adjustments may change of a camera: &apos;fixed&apos; keeps the given values through the alignment and the georeference (also with automatic control), &apos;refined&apos; lets the georeference refine them with the calibration&apos;s standard deviations as priors, &apos;estimated&apos; self-calibrates from them. &apos;auto&apos; is &apos;fixed&apos; where a calibration is given (the file, or film scans restituted by Prepare images) and &apos;estimated&apos; elsewhere; a camera&apos;s own &apos;adjust&apos; in the file overrides it. With &apos;fixed&apos; or &apos;refined&apos; and no file, the focal length and sensor width are the given values. The log, sfm/alignment.json and the accuracy report say per camera what was held.
 Mapper (advanced): &apos;incremental&apos; (COLMAP, the default) or &apos;global&apos; (GLOMAP: rotation averaging and global positioning, often faster on large blocks; a Cancel takes effect only when it has finished).
 Retry images left out (advanced, on): images the fast settings leave out, or a block split into parts, are retried with richer features (fainter ones for low-contrast frames, affine-shape ones for steep obliques) and more pairs; the log and sfm/alignment.json say what was retried and why.</source>
-        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell&apos;obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella dell&apos;area di lavoro, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
+        <translation>Structure from motion: feature SIFT, selezione delle coppie, corrispondenza robusta (RANSAC), ricostruzione incrementale con autocalibrazione (focale, punto principale, distorsione dell'obiettivo) e una compensazione a stelle proiettive finale. Il risultato è salvato nella cartella dell'area di lavoro, che le fasi seguenti (Georeferenzia, Genera DSM, Genera ortofoto) prendono come input. Una nuova esecuzione riprende: feature e corrispondenze già calcolate vengono riutilizzate.
 
-Selezione delle coppie: &apos;auto&apos; usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS. Posizioni delle camere (CSV), facoltativo: le posizioni delle foto nel file che legge Georeferenzia (un registro GNSS, per foto senza GPS EXIF) scelgono le coppie e i vicini delle foto sondate al posto del GPS EXIF; non georeferenziano il blocco.
-Modello di camera: &apos;AUTO&apos; stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
+Selezione delle coppie: 'auto' usa i vicini secondo il GPS EXIF quando le immagini hanno il GPS, altrimenti ogni coppia fino a 100 immagini, e coppie sequenziali con coppie di chiusura per insiemi più grandi senza GPS. Posizioni delle camere (CSV), facoltativo: le posizioni delle foto nel file che legge Georeferenzia (un registro GNSS, per foto senza GPS EXIF) scelgono le coppie e i vicini delle foto sondate al posto del GPS EXIF; non georeferenziano il blocco.
+Modello di camera: 'AUTO' stima focale, punto principale, k1, k2, p1, p2 (OPENCV) per camere con 10 o più immagini e un modello radiale più semplice al di sotto.
 Dimensione per la corrispondenza: il lato maggiore a cui le immagini sono ridotte per le feature (0 = automatico: foto fino a 2 megapixel così come sono, quelle più grandi ridotte a 2 megapixel; il DSM e le ortofoto usano ogni pixel). Feature per immagine: 0 = automatico (circa 4000 per megapixel, da 2048 a 4096). Con entrambi a 0, alcune foto vengono prima sondate: dove una tessitura debole e poco contrastata (campi arati) lascia loro poche feature, il primo passaggio ne prende 8192 più deboli, fino al doppio della dimensione se serve (il log lo dice). Le feature invarianti affini aiutano con le prese oblique e sono più lente.
-Focale e Larghezza del sensore: orientamento interno quando manca l&apos;EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri (0 = dall&apos;EXIF / sconosciuta).
-File di calibrazione della camera: l&apos;orientamento interno di una camera calibrata (YAML/JSON di ArchaeoOrtho, parametri interni di Orthority, OpenCV, COLMAP cameras.txt o XML di Metashape); più camere sono assegnate alle foto secondo i loro modelli di nome, il modello della camera o la dimensione dell&apos;immagine; una foto di altra risoluzione la riceve scalata. Un file che non si può leggere ferma l&apos;elaborazione prima di ogni lavoro, indicando file, riga e campo.
-Orientamento interno: cosa le compensazioni possono cambiare di una camera: &apos;fixed&apos; mantiene i valori dati attraverso l&apos;allineamento e la georeferenziazione (anche con il controllo automatico), &apos;refined&apos; lascia che la georeferenziazione li affini con le deviazioni standard della calibrazione come informazione a priori, &apos;estimated&apos; si autocalibra a partire da essi. &apos;auto&apos; è &apos;fixed&apos; dove è data una calibrazione (il file, o scansioni di pellicola raddrizzate da &apos;Prepara immagini&apos;) e &apos;estimated&apos; altrove; un &apos;adjust&apos; proprio di una camera nel file ha la precedenza. Con &apos;fixed&apos; o &apos;refined&apos; e senza file, la lunghezza focale e la larghezza del sensore sono i valori dati. Il registro, sfm/alignment.json e il rapporto di accuratezza dicono per ogni camera cosa è stato mantenuto.
-Metodo di ricostruzione (avanzato): &apos;incremental&apos; (COLMAP, predefinito) o &apos;global&apos; (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).
+Focale e Larghezza del sensore: orientamento interno quando manca l'EXIF (pellicola scansionata): la focale e la larghezza del lato lungo del fotogramma, in millimetri (0 = dall'EXIF / sconosciuta).
+File di calibrazione della camera: l'orientamento interno di una camera calibrata (YAML/JSON di ArchaeoOrtho, parametri interni di Orthority, OpenCV, COLMAP cameras.txt o XML di Metashape); più camere sono assegnate alle foto secondo i loro modelli di nome, il modello della camera o la dimensione dell'immagine; una foto di altra risoluzione la riceve scalata. Un file che non si può leggere ferma l'elaborazione prima di ogni lavoro, indicando file, riga e campo.
+Orientamento interno: cosa le compensazioni possono cambiare di una camera: 'fixed' mantiene i valori dati attraverso l'allineamento e la georeferenziazione (anche con il controllo automatico), 'refined' lascia che la georeferenziazione li affini con le deviazioni standard della calibrazione come informazione a priori, 'estimated' si autocalibra a partire da essi. 'auto' è 'fixed' dove è data una calibrazione (il file, o scansioni di pellicola raddrizzate da 'Prepara immagini') e 'estimated' altrove; un 'adjust' proprio di una camera nel file ha la precedenza. Con 'fixed' o 'refined' e senza file, la lunghezza focale e la larghezza del sensore sono i valori dati. Il registro, sfm/alignment.json e il rapporto di accuratezza dicono per ogni camera cosa è stato mantenuto.
+Metodo di ricostruzione (avanzato): 'incremental' (COLMAP, predefinito) o 'global' (GLOMAP: media delle rotazioni e posizionamento globale, spesso più veloce su blocchi grandi; un annullamento ha effetto solo al termine).
 Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni rapide escludono, o un blocco diviso in parti, vengono riprovate con caratteristiche più ricche (più deboli per fotogrammi a basso contrasto, affini per oblique ripide) e più coppie; il registro e sfm/alignment.json dicono cosa è stato riprovato e perché.</translation>
     </message>
 </context>
@@ -882,6 +882,21 @@ Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:878
         <location filename="../ui/catalog.py" line="8"/>
         <source>VAT (visualisation for archaeological topography, blend)</source>
         <translation>VAT (visualizzazione per la topografia archeologica, fusione)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>raw</source>
+        <translation>grezzo (raw)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>normalised</source>
+        <translation>normalizzato (normalised)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>irradiance</source>
+        <translation>irradianza (irradiance)</translation>
     </message>
 </context>
 <context>
@@ -2802,92 +2817,92 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
 <context>
     <name>ResultLayers</name>
     <message>
-        <location filename="../qgisio/layers.py" line="278"/>
+        <location filename="../qgisio/layers.py" line="286"/>
         <source>control (used)</source>
         <translation>appoggio (usato)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="279"/>
+        <location filename="../qgisio/layers.py" line="287"/>
         <source>check point</source>
         <translation>punto di controllo</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="280"/>
+        <location filename="../qgisio/layers.py" line="288"/>
         <source>rejected (outlier)</source>
         <translation>scartato (valore anomalo)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="281"/>
+        <location filename="../qgisio/layers.py" line="289"/>
         <source>not triangulated</source>
         <translation>non triangolato</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="771"/>
+        <location filename="../qgisio/layers.py" line="805"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="724"/>
+        <location filename="../qgisio/layers.py" line="756"/>
         <source>DSM hillshade</source>
         <translation>Ombreggiatura del DSM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="772"/>
+        <location filename="../qgisio/layers.py" line="806"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="773"/>
+        <location filename="../qgisio/layers.py" line="807"/>
         <source>Cameras</source>
         <translation>Camere</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="736"/>
+        <location filename="../qgisio/layers.py" line="768"/>
         <source>Camera footprints</source>
         <translation>Impronte delle immagini</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="744"/>
+        <location filename="../qgisio/layers.py" line="776"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Residui dei punti d'appoggio (vettori x{})</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="774"/>
+        <location filename="../qgisio/layers.py" line="808"/>
         <source>Point cloud</source>
         <translation>Nuvola di punti</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="782"/>
+        <location filename="../qgisio/layers.py" line="816"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="417"/>
+        <location filename="../qgisio/layers.py" line="449"/>
         <source>{} ({})</source>
         <translation>{} ({})</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="775"/>
+        <location filename="../qgisio/layers.py" line="809"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="751"/>
+        <location filename="../qgisio/layers.py" line="783"/>
         <source>DTM hillshade</source>
         <translation>Ombreggiatura del DTM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="776"/>
+        <location filename="../qgisio/layers.py" line="810"/>
         <source>Contours</source>
         <translation>Curve di livello</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="401"/>
+        <location filename="../qgisio/layers.py" line="433"/>
         <source>{} — {}</source>
         <translation>{} — {}</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="391"/>
+        <location filename="../qgisio/layers.py" line="389"/>
         <source>Spectral index</source>
         <translation>Indice spettrale</translation>
     </message>
@@ -3138,7 +3153,7 @@ Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le ci
     <message>
         <location filename="../processing_provider/spectral_index.py" line="61"/>
         <source>Index raster</source>
-        <translation>Raster dell&apos;indice</translation>
+        <translation>Raster dell'indice</translation>
     </message>
     <message>
         <location filename="../processing_provider/spectral_index.py" line="62"/>
@@ -3178,13 +3193,66 @@ NIR band number, Red band number, Red-edge band number (advanced): the band to t
 Index raster: where to write the float32 Cloud-Optimized GeoTIFF (nodata -9999, the band described by the index and its formula).</source>
         <translation>Un indice di vegetazione di un ortomosaico multispettrale o di qualsiasi raster a più bande (una scena satellitare), per vedere le tracce da vegetazione (crop marks): sopra un fossato sepolto la coltura cresce più verde (un indice più alto), sopra un muro sepolto è stressata (uno più basso). NDVI è (NIR - RED) / (NIR + RED), NDRE (NIR - REDEDGE) / (NIR + REDEDGE). Una cella è nodata dove una banda usata è nodata o mascherata (banda alfa, maschera) o il denominatore è zero. Il raster è letto a blocchi, quindi uno grande richiede poca memoria.
 
-Quale banda sia NIR, rossa o red edge è letto dal raster: dalla descrizione della banda (NIR, Red, Red edge / REG / RE, Green / GRE, Blue), da un nome o una lunghezza d&apos;onda nei suoi metadati (790 nm è NIR: rosso 600-690 nm, red edge 690-760 nm, NIR 760-1000 nm) o dalla sua interpretazione del colore; il log dice quale banda è stata presa per ogni nome e perché, e un nome mancante elenca le bande del raster.
+Quale banda sia NIR, rossa o red edge è letto dal raster: dalla descrizione della banda (NIR, Red, Red edge / REG / RE, Green / GRE, Blue), da un nome o una lunghezza d'onda nei suoi metadati (790 nm è NIR: rosso 600-690 nm, red edge 690-760 nm, NIR 760-1000 nm) o dalla sua interpretazione del colore; il log dice quale banda è stata presa per ogni nome e perché, e un nome mancante elenca le bande del raster.
 
 Raster di ingresso: il raster a più bande.
-Indice: NDVI, NDRE o l&apos;espressione qui sotto.
+Indice: NDVI, NDRE o l'espressione qui sotto.
 Espressione: una formula delle bande, per numero (b1 è la prima banda) o per nome, ad es. (b4 - b3) / (b4 + b3) o 2.5 * (NIR - RED) / (NIR + 2.4 * RED + 1); numeri, + - * / ** e parentesi, e le funzioni sqrt, abs, log, exp, min, max, clip(x, low, high).
 Numero banda NIR, Numero banda rossa, Numero banda red edge (avanzati): la banda da prendere per quel nome quando i nomi delle bande del raster non la indicano o la indicano male; 0 la legge dai nomi.
-Raster dell&apos;indice: dove scrivere il GeoTIFF Cloud-Optimized float32 (nodata -9999, la banda descritta dall&apos;indice e dalla sua formula).</translation>
+Raster dell'indice: dove scrivere il GeoTIFF Cloud-Optimized float32 (nodata -9999, la banda descritta dall'indice e dalla sua formula).</translation>
+    </message>
+</context>
+<context>
+    <name>StackCapturesAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="49"/>
+        <source>Band folder</source>
+        <translation>Cartella delle bande</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="49"/>
+        <source>Radiometry</source>
+        <translation>Radiometria</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="49"/>
+        <source>Reference band</source>
+        <translation>Banda di riferimento</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="57"/>
+        <source>Output folder</source>
+        <translation>Cartella di uscita</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="58"/>
+        <source>Photos written</source>
+        <translation>Foto scritte</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="59"/>
+        <source>Captures left out</source>
+        <translation>Acquisizioni escluse</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Stack multispectral captures</source>
+        <translation>Impila acquisizioni multispettrali</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Turns the band files of a multispectral rig (Parrot Sequoia, MicaSense RedEdge / Altum, DJI P4 Multispectral / Mavic 3M: one 16-bit TIFF per band per capture) into one multi-band photo per capture, which Align images, Run pipeline and Build orthophoto take like any photo: the orthomosaic then has every band, and Spectral index makes NDVI or NDRE of it. The files of one capture are grouped by their capture id (else rig name and time); each band is undistorted with its own lens model from its metadata, turned by its rig rotation and registered onto the reference band by phase correlation on gradients. The photo&apos;s bands are NIR, Red, Green first (QGIS shows them as a false-colour NIR-R-G view), each named with its wavelength; the capture&apos;s GPS is in its EXIF. A capture missing a band is left out and named in the log; the band folder is never written into.
+
+Band folder: the folder of band files (the RGB camera&apos;s frames in it are not stacked).
+Radiometry: normalised (default) removes each band&apos;s dark level, corrects its vignetting from the file&apos;s model and normalises exposure time and gain to the block&apos;s; irradiance also divides by the sun sensor&apos;s irradiance for that band (values proportional to reflectance when the light changes during the flight); raw keeps the numbers as recorded. A band file lacking what the choice needs (an exposure time, a sun-sensor reading) stops the run before any work, naming the file. The photo&apos;s metadata says what was done (and per band the vignetting model, dark level and scale).
+Reference band (advanced): the band the others are registered onto; empty: the rig&apos;s reference camera.
+Output folder: where the multi-band photos are written (one per capture, named after its band files without the band suffix); not the band folder.</source>
+        <translation>Trasforma i file di banda di una camera multispettrale (Parrot Sequoia, MicaSense RedEdge / Altum, DJI P4 Multispectral / Mavic 3M: un TIFF a 16 bit per banda per acquisizione) in una foto multibanda per acquisizione, che Allinea immagini, Esegui pipeline e Crea ortofoto prendono come qualsiasi foto: l&apos;ortomosaico ha allora ogni banda, e Indice spettrale ne calcola NDVI o NDRE. I file di un&apos;acquisizione sono raggruppati per il loro ID di acquisizione (altrimenti per nome del rig e ora); ogni banda è raddrizzata con il proprio modello d&apos;obiettivo dai suoi metadati, ruotata della sua rotazione nel rig e registrata sulla banda di riferimento per correlazione di fase sui gradienti. Le bande della foto iniziano con NIR, Rosso, Verde (QGIS le mostra come vista a falsi colori NIR-R-G), ciascuna nominata con la sua lunghezza d&apos;onda; il GPS dell&apos;acquisizione è nel suo EXIF. Un&apos;acquisizione a cui manca una banda è esclusa e nominata nel registro; nella cartella delle bande non si scrive mai.
+
+Cartella delle bande: la cartella dei file di banda (le immagini della camera RGB al suo interno non sono impilate).
+Radiometria: normalizzato (predefinito) sottrae a ogni banda il suo livello di nero, ne corregge la vignettatura secondo il modello del file e normalizza tempo di esposizione e guadagno a quelli del blocco; irradianza divide inoltre per l&apos;irradianza del sensore solare per quella banda (valori proporzionali alla riflettanza quando la luce cambia durante il volo); grezzo mantiene i valori come registrati. Un file di banda privo di ciò che la scelta richiede (un tempo di esposizione, una lettura del sensore solare) ferma l&apos;esecuzione prima di ogni lavoro, nominando il file. I metadati della foto dicono cosa è stato fatto (e per banda il modello di vignettatura, il livello di nero e la scala).
+Banda di riferimento (avanzato): la banda su cui sono registrate le altre; vuoto: la camera di riferimento del rig.
+Cartella di uscita: dove sono scritte le foto multibanda (una per acquisizione, nominata come i suoi file di banda senza il suffisso della banda); non la cartella delle bande.</translation>
     </message>
 </context>
 </TS>

@@ -28,6 +28,7 @@ CHOICE_LISTS = (
                                        "INTERPOLATIONS")),
     ("core/prepare/options.py", ("FIDUCIAL_TYPES", "LAYOUT_NAMES")),
     ("core/terrain/options.py", ("VISUALISATIONS",)),
+    ("core/prepare/band_radiometry.py", ("MODES",)),
 )
 
 

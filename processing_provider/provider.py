@@ -41,8 +41,10 @@ def algorithms():
     from .relief_visualisation import ReliefVisualisationAlgorithm
     from .run_pipeline import RunPipelineAlgorithm
     from .spectral_index import SpectralIndexAlgorithm
+    from .stack_captures import StackCapturesAlgorithm
 
     return [AlignImagesAlgorithm(), GeoreferenceAlgorithm(), BuildDsmAlgorithm(), PrepareImagesAlgorithm(),
             AccuracyReportAlgorithm(), BuildOrthophotoAlgorithm(), OrthorectifyImageAlgorithm(),
             RunPipelineAlgorithm(), BuildDtmAlgorithm(), ReliefVisualisationAlgorithm(), ContoursAlgorithm(),
-            AutoControlAlgorithm(), DsmDifferenceAlgorithm(), FindTargetsAlgorithm(), SpectralIndexAlgorithm()]
+            AutoControlAlgorithm(), DsmDifferenceAlgorithm(), FindTargetsAlgorithm(), SpectralIndexAlgorithm(),
+            StackCapturesAlgorithm()]

@@ -132,3 +132,64 @@ def test_the_orthomosaic_bands_are_named_after_the_photos(tmp_path):
     with RasterFile(str(tmp_path / "mosaic.tif")) as r:
         assert [r.band(i + 1).GetDescription() for i in range(2)] == ["NIR", "Red"]
         assert r.metadata(1).get("wavelength") == "790"
+
+
+def test_the_stack_states_its_radiometry_and_corrects_the_vignetting(tmp_path):
+    """The real capture in raw and irradiance radiometry (core.prepare.band_radiometry): the photo states what was
+    done, per band the sun sensor's irradiance; the reference band (Green, in its own frame but undistorted) is
+    brightened towards the corners by its vignetting model (0.69 at the corner against 0.98 at the centre).
+    Measured: 1.13 x, 60-140 px in from the corner."""
+    paths = [p for p in _sample_bands() if not p.upper().endswith(".JPG")]
+    raw = stack_captures(paths, CaptureStackOptions(str(tmp_path / "raw"), radiometry="raw"))
+    irr = stack_captures(paths, CaptureStackOptions(str(tmp_path / "irr"), radiometry="irradiance"))
+    with RasterFile(raw.photos[0]) as a, RasterFile(irr.photos[0]) as b:
+        assert a.metadata()["RADIOMETRY"].startswith("raw DN")
+        md = b.metadata()
+        assert "sun sensor" in md["RADIOMETRY"] and md["GREEN_VIGNETTING"] == "Camera:VignettingPolynomial2D"
+        assert md["NIR_DARK_LEVEL"] == "75" and float(md["NIR_IRRADIANCE"]) > 0
+        green_raw, green = a.read(3).astype(float), b.read(3).astype(float)
+    h, w = green.shape
+    ok = (green_raw > 200) & (green > 0)
+    ratio = np.where(ok, green / np.maximum(green_raw - 74.0, 1.0), np.nan)
+    centre = np.nanmedian(ratio[h // 2 - 40:h // 2 + 40, w // 2 - 40:w // 2 + 40])
+    corner = np.nanmedian(ratio[60:140, 60:140])
+    # the window 60-140 px in from the corner: V about 0.85-0.9 there (0.69 at the corner itself)
+    assert 1.08 < corner / centre < 0.977 / 0.69
+    with pytest.raises(PrepareError, match="radiometry 'reflectance'"):
+        CaptureStackOptions(str(tmp_path / "x"), radiometry="reflectance")
+
+
+def test_qgis_process_runs_stackcaptures(tmp_path):
+    """archaeoortho:stackcaptures headless on a copy of the real capture's folder (the RGB frame in it too): one
+    4-band photo in irradiance radiometry; an empty folder and the band folder as output refused with their
+    messages, no traceback, nothing written."""
+    import json
+    import subprocess
+
+    from tests.conftest import qgis_process
+
+    exe, env = qgis_process()
+    src = tmp_path / "bands"
+    src.mkdir()
+    for p in _sample_bands():
+        shutil.copy(p, src)
+
+    def run(folder, output, *args):
+        return subprocess.run([exe, "--json", "run", "archaeoortho:stackcaptures", "--", f"INPUT={folder}",
+                               f"OUTPUT={output}", *args], env=env, capture_output=True, text=True, timeout=300)
+
+    out = run(src, tmp_path / "photos", "RADIOMETRY=2")
+    assert out.returncode == 0, out.stderr[-3000:] + out.stdout[-3000:]
+    res = json.loads(out.stdout)["results"]
+    assert (res["PHOTOS"], res["LEFT_OUT"]) == (1, 0)
+    photo = tmp_path / "photos" / "IMG_161122_163234_0000.tif"
+    with RasterFile(str(photo)) as r:
+        assert r.count == 4 and "sun sensor" in r.metadata()["RADIOMETRY"]
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    for folder, output, message in ((empty, tmp_path / "o1", "no image files"), (src, src, "holds the band files")):
+        before = sorted(os.listdir(folder))
+        out = run(folder, output)
+        text = out.stdout + out.stderr
+        assert out.returncode != 0 and message in text and "Traceback" not in text, text[-2000:]
+        assert sorted(os.listdir(folder)) == before

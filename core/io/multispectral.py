@@ -169,6 +169,13 @@ class BandInfo:
     line_readout_time: Optional[float] = None
     sensor_temperature_c: Optional[float] = None
     focal_plane_px_per_mm: Optional[Tuple[float, float]] = None
+    # the sensor's radiometric model as written: MicaSense ``RadiometricCalibration`` (a1, a2, a3), Sequoia
+    # ``SensorModel`` (A, B, C of Parrot's SEQ-AN-01); the EXIF f-number; the Sequoia sun sensor's
+    # ``IrradianceCalibrationMeasurement`` as (gain index, integration ms, ch0, ch1) rows
+    radiometric_calibration: Optional[Tuple[float, ...]] = None
+    sensor_model: Optional[Tuple[float, ...]] = None
+    f_number: Optional[float] = None
+    irradiance_calibration: Tuple[Tuple[int, int, int, int], ...] = ()
 
     @property
     def name(self) -> str:
@@ -450,7 +457,17 @@ def read_band_info(path: str) -> BandInfo:
         iso=_number(md, "EXIF_ISOSpeedRatings", "EXIF_ISOSpeed", "EXIF_PhotographicSensitivity"),
         irradiance=irradiance(tags), line_readout_time=_number(tags, "Camera:LineReadoutTime"),
         sensor_temperature_c=_number(tags, "Camera:SensorTemperature"),
-        focal_plane_px_per_mm=focal_plane_resolution(md))
+        focal_plane_px_per_mm=focal_plane_resolution(md),
+        radiometric_calibration=_vector(tags, "Camera:RadiometricCalibration"),
+        sensor_model=_vector(tags, "Camera:SensorModel"), f_number=_number(md, "EXIF_FNumber"),
+        irradiance_calibration=_calibration_rows(_vector(tags, "Camera:IrradianceCalibrationMeasurement")))
+
+
+def _calibration_rows(values: Optional[Tuple[float, ...]]) -> Tuple[Tuple[int, int, int, int], ...]:
+    """The Sequoia's ``IrradianceCalibrationMeasurement`` (gain index, integration ms, ch0, ch1, ...) as rows."""
+    if not values or len(values) % 4:
+        return ()
+    return tuple(tuple(int(v) for v in values[i:i + 4]) for i in range(0, len(values), 4))
 
 
 # ---------------------------------------------------------------- captures

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import List, Optional, Sequence, Tuple, Union
+from typing import Callable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -365,13 +365,15 @@ def _refine(image: np.ndarray, cam: BandCamera, frame: PinholeLens, ref_grad: np
 
 
 def register_capture(capture: Capture, options: Optional[RegistrationOptions] = None,
-                     keep_model: bool = False) -> RegisteredCapture:
+                     keep_model: bool = False,
+                     prepare: Optional[Callable[[str, np.ndarray], np.ndarray]] = None) -> RegisteredCapture:
     """Register the band files of one capture (module docstring).  ``keep_model``: keep the model-only bands
-    too (for before / after pictures)."""
+    too (for before / after pictures); ``prepare``: (band file, its pixels) -> the pixels registered, in the
+    band's own frame (the radiometric correction, core.prepare.band_radiometry)."""
     options = options or RegistrationOptions()
     cams, ref = band_cameras(capture, options.reference)
     frame = reference_frame(ref)
-    images = {c.path: read_band(c.path) for c in cams}
+    images = {c.path: (prepare(c.path, read_band(c.path)) if prepare else read_band(c.path)) for c in cams}
     shape = images[ref.path].shape
     ref_img = warp(images[ref.path], band_map(ref, frame, shape))
     ref_grad = gradient_image(ref_img)

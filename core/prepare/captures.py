@@ -8,7 +8,9 @@ The photo's bands are ordered NIR, Red, Green first (then the others in the rig'
 rendering of bands 1-2-3 is the false-colour NIR-R-G view in which crop marks show; each band is described by its
 name with its central wavelength in its metadata.  The photo carries the reference band file's GPS, time and
 camera, and the pinhole frame's focal length, in its EXIF (:func:`core.io.multispectral.capture_exif`).  Values
-are the bands' raw numbers (no dark level, vignetting or reflectance yet), 0 where a band does not reach.
+are, by default, each band's numbers with its dark level removed, its vignetting corrected and its exposure x gain
+normalised to the block's (``radiometry``: raw, normalised or irradiance, :mod:`core.prepare.band_radiometry`,
+stated in the photo's ``RADIOMETRY`` metadata), 0 where a band does not reach.
 
 A capture that lacks a band the block has is left out with its reason (an orthomosaic needs every band in every
 photo); the block's other warnings (:func:`core.io.multispectral.check_captures`) are passed on.  The RGB camera
@@ -22,7 +24,8 @@ from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence, Tuple
 
 from ..common.progress import NullProgress, Progress, check_cancel
-from ..io.multispectral import Capture, band_key, capture_exif, read_block, write_band_stack
+from ..io.multispectral import Capture, band_files, band_key, capture_exif, read_block, write_band_stack
+from .band_radiometry import MODES, block_scales, check_bands, correct, describe
 from .bands import RegistrationOptions, register_capture
 from .options import PrepareError
 
@@ -34,9 +37,16 @@ FALSE_COLOUR_FIRST = ("nir", "red", "green")
 class CaptureStackOptions:
     """``output_dir``: where the multi-band photos go (one per capture, named after its reference band file
     without the band suffix); ``registration``: the band registration's options (its ``reference``: the band the
-    others are registered onto, default the rig's reference camera)."""
+    others are registered onto, default the rig's reference camera); ``radiometry``: raw, normalised (dark
+    level, vignetting, exposure x gain) or irradiance (normalised and divided by the sun sensor's irradiance:
+    proportional to reflectance), core.prepare.band_radiometry."""
     output_dir: str
     registration: RegistrationOptions = field(default_factory=RegistrationOptions)
+    radiometry: str = "normalised"
+
+    def __post_init__(self):
+        if self.radiometry not in MODES:
+            raise PrepareError(f"radiometry {self.radiometry!r}: one of {', '.join(MODES)}")
 
 
 @dataclass
@@ -103,6 +113,16 @@ def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
     progress = progress or NullProgress()
     _check_output(options.output_dir, paths)
     captures, names, warnings = _band_captures(paths)
+    # the captures stacked (a capture lacking a band is left out below): their bands checked before any work
+    every_band = [b for cap in captures if all(cap.band(n) is not None for n in names) for b in cap.bands]
+    factors = check_bands(every_band, options.radiometry)  # a band lacking what the radiometry needs: before work
+    scales = block_scales(every_band, factors)
+    by_path = {b.path: b for b in every_band}
+
+    def prepare(path, pixels):
+        b = by_path[path]
+        return correct(pixels, b, factors[path], scales[b.band_name or "?"]) if path in factors else pixels
+
     os.makedirs(options.output_dir, exist_ok=True)
     photos: List[str] = []
     left_out: Dict[str, str] = {}
@@ -117,7 +137,7 @@ def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
                                         f"{', '.join(b.name for b in cap.bands)})")
             progress.warning(f"capture {cap.capture_id} left out: {left_out[cap.capture_id]}")
             continue
-        reg = register_capture(cap, options.registration)
+        reg = register_capture(cap, options.registration, prepare=prepare)
         order = stack_order(reg.names)
         order_names = tuple(reg.names[i] for i in order)
         infos = {b.band_name: b for b in cap.bands}
@@ -125,7 +145,8 @@ def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
         height, width = reg.bands.shape[1:]
         path = os.path.join(options.output_dir, names_of[cap.capture_id])
         md = {"REFERENCE_BAND": reg.reference, "CAPTURE": cap.capture_id,
-              "BAND_FILES": ",".join(infos[n].name for n in order_names)}
+              "BAND_FILES": ",".join(infos[n].name for n in order_names),
+              **describe(options.radiometry, [infos[n] for n in order_names], factors, scales)}
         write_band_stack(path, reg.bands[order], order_names, md,
                          [infos[n].central_wavelength_nm for n in order_names],
                          capture_exif(ref.path, reg.frame.f, width, height), dtype="uint16")
@@ -134,3 +155,10 @@ def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
             worst[r.camera.name] = max(worst.get(r.camera.name, 0.0), float(r.refined_residual.worst))
         progress.report((k + 1) / len(captures), f"captures: {k + 1}/{len(captures)} stacked")
     return CaptureStackResult(photos, order_names, left_out, worst, warnings)
+
+
+def stack_capture_folder(folder: str, options: CaptureStackOptions,
+                         progress: Optional[Progress] = None) -> CaptureStackResult:
+    """:func:`stack_captures` of the band files in ``folder`` (the entry of Stack multispectral captures);
+    MultispectralError naming the folder when it holds no image file."""
+    return stack_captures(band_files(folder), options, progress)
