@@ -34,6 +34,7 @@ from core.prepare.bands import (
     register_capture,
     residual_of,
     warp,
+    window_centres,
     window_shifts,
     write_registered,
 )
@@ -333,3 +334,39 @@ def test_pinhole_lens_round_trip():
     lens = PinholeLens(1000.0, 640.0, 480.0)
     px = frame_pixels(1280, 960, 16)
     assert np.abs(lens.project(lens.unproject(px)) - px).max() < 1e-9
+
+
+def test_the_window_scales_with_the_frame():
+    """No window size set: 1/6 of the frame's short side (160 px on the Sequoia's 1280 x 960 bands, as before), at
+    least 32 px; a size set is kept on any frame, one under 32 px refused naming it."""
+    opts = RegistrationOptions()
+    assert opts.window is None
+    assert opts.window_px((960, 1280)) == 160
+    assert opts.window_px((480, 640)) == 80 and opts.window_px((3000, 4000)) == 500
+    assert opts.window_px((120, 160)) == 32
+    assert RegistrationOptions(window=128).window_px((480, 640)) == 128
+    assert RegistrationOptions(window=128).window_px((3000, 4000)) == 128
+    with pytest.raises(BandRegistrationError, match="window 31 px"):
+        RegistrationOptions(window=31)
+    # the grid spans the central 0.9 of the frame with windows of that size: the last one ends at 0.95 of it
+    assert window_centres((960, 1280), opts)[-1] == (1280 - 64 - 160, 960 - 48 - 160)
+    assert window_centres((480, 640), opts)[-1] == (640 - 32 - 80, 480 - 24 - 80)
+
+
+def test_window_shifts_measured_on_windows_of_the_frame_s_scale():
+    """A 480 x 640 texture against itself moved by (2, 1) px: 30 windows of 80 px (centres 40 px from their
+    corners), each measuring the shift; a window of 128 px set keeps 128."""
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=(480, 640))
+    b = np.roll(a, (1, 2), axis=(0, 1))   # b(p + (2, 1)) = a(p)
+    opts = RegistrationOptions()
+    shifts = window_shifts(a, b, opts)
+    corners = window_centres(a.shape, opts)
+    assert len(shifts) == len(corners) == 30
+    for s, (x, y) in zip(shifts, corners):
+        assert (s.x - x, s.y - y) == (40.0, 40.0)
+        assert (s.dx, s.dy) == (pytest.approx(2.0, abs=0.05), pytest.approx(1.0, abs=0.05)) and s.peak > 0.5
+    fixed = RegistrationOptions(window=128)
+    big = window_shifts(a, b, fixed)
+    assert len(big) == 30 and {(s.x - x, s.y - y) for s, (x, y) in zip(big, window_centres(a.shape, fixed))} == {
+        (64.0, 64.0)}

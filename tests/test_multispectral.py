@@ -13,9 +13,12 @@ import pytest
 from osgeo import gdal
 
 from core.io.multispectral import (
+    INDEX_BANDS,
+    NAMED_BANDS,
     MultispectralError,
     Vignetting,
     band_files,
+    band_key,
     check_captures,
     group_captures,
     parse_xmp,
@@ -261,3 +264,18 @@ def test_primary_band_without_rgb_is_the_most_textured(tmp_path):
             files.append(write_band(tmp_path / f"{cid}_{band}.tif", xmp(attrs), exif_at(t), array=arr))
     p = primary_band(read_block(files))
     assert p.name == "NIR" and p.scores["NIR"] > 10 * p.scores["Green"] and "texture" in p.reason
+
+
+def test_the_band_name_table():
+    """NAMED_BANDS: one entry per band, its key the band_key of its name (what band files are compared by, the keys
+    INDEX_BANDS names), the wavelength ranges joining without gap or overlap; band_key itself unchanged."""
+    assert [b.name for b in NAMED_BANDS] == ["REDEDGE", "NIR", "RED", "GREEN", "BLUE"]
+    assert {b.key for b in NAMED_BANDS} == {"rededge", "nir", "red", "green", "blue"}
+    assert all(b.key == band_key(b.name) for b in NAMED_BANDS)
+    assert {k for _, needs in INDEX_BANDS for k in needs} <= {b.key for b in NAMED_BANDS}
+    ranges = sorted(b.nm for b in NAMED_BANDS)
+    assert all(lo < hi for lo, hi in ranges) and all(a[1] == b[0] for a, b in zip(ranges, ranges[1:]))
+    assert dict((b.name, b.nm) for b in NAMED_BANDS)["REDEDGE"] == (690.0, 760.0)
+    words = [w for b in NAMED_BANDS for w in b.words]
+    assert len(words) == len(set(words)) and {"reg", "re", "gre"} <= set(words)
+    assert (band_key("Red edge"), band_key("REG"), band_key("NIR 1"), band_key(None)) == ("rededge", "reg", "nir1", "")

@@ -13,6 +13,8 @@ import pytest
 from osgeo import gdal, osr
 
 from core.common.progress import Cancelled, NullProgress
+from core.io.multispectral import NAMED_BANDS
+from core.spectral import bands as spectral_bands
 from core.spectral.bands import WAVELENGTH_RANGES_NM, name_from_text, wavelength_name, wavelength_nm
 from core.spectral.errors import SpectralError
 from core.spectral.expression import parse
@@ -235,7 +237,8 @@ def test_bands_found_by_wavelength_metadata(tmp_path):
     ("NIR", "NIR"), ("nir1", "NIR"), ("Near infrared", "NIR"), ("Near-IR (840 nm)", "NIR"), ("Red", "RED"),
     ("Band 3 - Red", "RED"), ("Red edge", "REDEDGE"), ("RedEdge", "REDEDGE"), ("REG", "REDEDGE"), ("re", "REDEDGE"),
     ("GRE", "GREEN"), ("green", "GREEN"), ("Blue", "BLUE"), ("Band 4", ""), ("Shortwave infrared", ""),
-    ("Alpha", ""), ("", "")])
+    ("Alpha", ""), ("", ""), ("Infrared", "NIR"), ("Thermal infrared", ""), ("RE2", "REDEDGE"),
+    ("NIR red edge", "REDEDGE"), ("Red NIR", "NIR"), ("Green blue", "GREEN"), ("Red green", "RED")])
 def test_band_names_from_descriptions(text, name):
     assert name_from_text(text) == name
 
@@ -466,3 +469,19 @@ def test_processing_run_loads_the_index_styled(plugin, scene, tmp_path, qgis_new
     items = r.shader().rasterShaderFunction().colorRampItemList()
     low, high = items[0].color, items[-1].color
     assert low.red() > 150 and low.green() < 100 and high.green() > 100 and high.red() < 100  # red .. green
+
+
+def test_band_names_and_ranges_come_from_the_one_table():
+    """core.spectral reads names and wavelengths with core.io.multispectral's NAMED_BANDS: every word and phrase of
+    the table names its band, every range's middle is its band, the colour interpretations are its keys."""
+    assert spectral_bands.NAMED_BANDS is NAMED_BANDS
+    assert spectral_bands.BAND_NAMES == ("BLUE", "GREEN", "RED", "REDEDGE", "NIR")
+    assert WAVELENGTH_RANGES_NM == (("BLUE", 400.0, 500.0), ("GREEN", 500.0, 600.0), ("RED", 600.0, 690.0),
+                                    ("REDEDGE", 690.0, 760.0), ("NIR", 760.0, 1000.0))
+    for band in NAMED_BANDS:
+        for text in band.words + band.phrases + (band.name, band.key, f"Band 2 - {band.name.title()}"):
+            assert name_from_text(text) == band.name, text
+        assert wavelength_name(sum(band.nm) / 2) == band.name
+        assert spectral_bands.COLOURS[band.key] == band.name
+    assert spectral_bands.identify("", {}, "RedEdge")[:1] == ("REDEDGE",)
+    assert spectral_bands.identify("", {}, "Green")[:1] == ("GREEN",)

@@ -470,12 +470,43 @@ def _calibration_rows(values: Optional[Tuple[float, ...]]) -> Tuple[Tuple[int, i
     return tuple(tuple(int(v) for v in values[i:i + 4]) for i in range(0, len(values), 4))
 
 
-# ---------------------------------------------------------------- captures
+# ---------------------------------------------------------------- band names
+@dataclass(frozen=True)
+class NamedBand:
+    """A band with a name of its own (:data:`NAMED_BANDS`).  ``name``: its canonical name (as index expressions
+    write it; its :func:`band_key`, :attr:`key`, is how band files' names are compared); ``words``: the words
+    (lower case, a trailing number dropped: "NIR1") that name it in a band name or description; ``phrases``: what
+    names it wherever it stands in the text's letters run together ("Red edge", "Near-infrared"); ``nm``: its
+    centre wavelength range in nm (lo <= nm < hi)."""
+    name: str
+    words: Tuple[str, ...]
+    phrases: Tuple[str, ...]
+    nm: Tuple[float, float]
+
+    @property
+    def key(self) -> str:
+        return band_key(self.name)
+
+
+# The named bands, stated once for core.io and core.spectral (core.spectral.bands reads band descriptions, names
+# and wavelengths with it), in the order a text is matched: red edge before red (its name holds "red"), NIR
+# before the visible bands.  Centre wavelengths: Sequoia green 550, red 660, red edge 735, NIR 790; MicaSense
+# 475 / 560 / 668 / 717 / 842; Sentinel-2 B5 705, B6 740 red edge, B7 783, B8 842 NIR
+NAMED_BANDS: Tuple[NamedBand, ...] = (
+    NamedBand("REDEDGE", ("rededge", "reg", "re"), ("rededge",), (690.0, 760.0)),
+    NamedBand("NIR", ("nir",), ("nearinfrared", "nearir"), (760.0, 1000.0)),
+    NamedBand("RED", ("red",), (), (600.0, 690.0)),
+    NamedBand("GREEN", ("green", "gre"), (), (500.0, 600.0)),
+    NamedBand("BLUE", ("blue",), (), (400.0, 500.0)))
+
+
 def band_key(name: Optional[str]) -> str:
-    """A band name compared across vendors: lower case, letters and digits only ("Red edge" -> "rededge")."""
+    """A band name compared across vendors: lower case, letters and digits only ("Red edge" -> "rededge"; the
+    :attr:`NamedBand.key` of the bands of :data:`NAMED_BANDS`: "nir", "red", "rededge", "green", "blue")."""
     return re.sub(r"[^a-z0-9]", "", (name or "").lower())
 
 
+# ---------------------------------------------------------------- captures
 @dataclass(frozen=True)
 class Capture:
     """The band files of one trigger of the rig.  ``capture_id``: the files' capture id, else

@@ -6,7 +6,8 @@ metadata item (wavelength, CENTRAL_WAVELENGTH_UM, with wavelength_units; nm or Â
 :data:`WAVELENGTH_RANGES_NM`; the band's colour interpretation (red / green / blue; NIR and red edge in GDAL >=
 3.10).  A name is the band with the strongest evidence for it; two bands with equally strong evidence for one
 name are refused when that name is used, naming both.  Alpha bands (colour interpretation alpha) have no name:
-they mask the others.
+they mask the others.  The names, the words that say them and the wavelength ranges are
+:data:`core.io.multispectral.NAMED_BANDS`, shared with the band files of multispectral rigs.
 """
 from __future__ import annotations
 
@@ -15,21 +16,23 @@ from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Tuple
 
 from ..io import raster
+from ..io.multispectral import NAMED_BANDS
 from .errors import SpectralError
 from .options import BandOverrides
 
-BAND_NAMES = ("BLUE", "GREEN", "RED", "REDEDGE", "NIR")
-# the centre wavelength (nm) ranges of the named bands, stated once: Sequoia green 550, red 660, red edge 735,
-# NIR 790; MicaSense 475 / 560 / 668 / 717 / 842; Sentinel-2 B5 705, B6 740 red edge, B7 783, B8 842 NIR
-WAVELENGTH_RANGES_NM: Tuple[Tuple[str, float, float], ...] = (
-    ("BLUE", 400.0, 500.0), ("GREEN", 500.0, 600.0), ("RED", 600.0, 690.0), ("REDEDGE", 690.0, 760.0),
-    ("NIR", 760.0, 1000.0))
+_BY_WAVELENGTH = sorted(NAMED_BANDS, key=lambda b: b.nm)
+BAND_NAMES: Tuple[str, ...] = tuple(b.name for b in _BY_WAVELENGTH)  # BLUE, GREEN, RED, REDEDGE, NIR
+# the centre wavelength (nm) ranges of the named bands (NAMED_BANDS), shortest first
+WAVELENGTH_RANGES_NM: Tuple[Tuple[str, float, float], ...] = tuple((b.name, b.nm[0], b.nm[1]) for b in _BY_WAVELENGTH)
 # the kinds of evidence, strongest first
 SET, DESCRIPTION, METADATA, WAVELENGTH, COLOUR, NONE = range(6)
 EVIDENCE = {SET: "set", DESCRIPTION: "description", METADATA: "metadata", WAVELENGTH: "wavelength",
             COLOUR: "colour interpretation"}
 NAME_KEYS = ("band_name", "bandname", "name", "band", "spectral_band", "channel", "color", "colour")
-COLOURS = {"red": "RED", "green": "GREEN", "blue": "BLUE", "nir": "NIR", "rededge": "REDEDGE"}
+# GDAL colour interpretation names (lower case, no spaces: GDAL >= 3.10's "RedEdge") -> canonical name
+COLOURS = {b.key: b.name for b in NAMED_BANDS}
+# words beside "infrared" that make it another infrared than the near one
+OTHER_INFRARED = {"shortwave", "swir", "thermal", "mid", "tir"}
 
 
 @dataclass
@@ -94,16 +97,12 @@ class BandTable:
 
 def name_from_text(text: str) -> str:
     """The canonical band name a description or name item says ('Red edge', 'NIR1', 'Band 3 - Red'); ''."""
-    tokens = [re.sub(r"\d+$", "", t) for t in re.split(r"[^a-z0-9]+", text.lower()) if t]
+    tokens = {re.sub(r"\d+$", "", t) for t in re.split(r"[^a-z0-9]+", text.lower()) if t}
     joined = "".join(re.split(r"[^a-z]+", text.lower()))
-    if "rededge" in joined or {"reg", "re", "rededge"} & set(tokens):
-        return "REDEDGE"
-    if "nir" in tokens or "nearinfrared" in joined or "nearir" in joined or (
-            "infrared" in tokens and not {"shortwave", "swir", "thermal", "mid", "tir"} & set(tokens)):
-        return "NIR"
-    for token, name in (("red", "RED"), ("green", "GREEN"), ("gre", "GREEN"), ("blue", "BLUE")):
-        if token in tokens:
-            return name
+    infrared = "infrared" in tokens and not OTHER_INFRARED & tokens
+    for band in NAMED_BANDS:  # in their matching order: red edge before red, NIR before the visible bands
+        if tokens & set(band.words) or any(p in joined for p in band.phrases) or (infrared and band.name == "NIR"):
+            return band.name
     return ""
 
 
