@@ -193,3 +193,16 @@ def test_qgis_process_runs_stackcaptures(tmp_path):
         text = out.stdout + out.stderr
         assert out.returncode != 0 and message in text and "Traceback" not in text, text[-2000:]
         assert sorted(os.listdir(folder)) == before
+
+
+@pytest.mark.parametrize("bands,dtype", [(1, "uint8"), (2, "uint16"), (3, "uint8"), (4, "uint16"), (5, "uint16")])
+def test_only_the_mosaics_last_band_is_alpha(tmp_path, bands, dtype):
+    """The orthomosaic's alpha is its last band, whatever its bands: GTiff's ALPHA=YES marks the first extra
+    sample, which in a grey-interpreted multispectral mosaic (NIR, Red, ...) is band 2 -- Spectral index then
+    read the Red band as a mask."""
+    w = RasterWriter(str(tmp_path / "work.tif"), 16, 12, bands, dtype, (0, 1, 0, 12, 0, -1), None)
+    w.write(0, 0, np.ones((12, 16, bands), np.float32), np.ones((12, 16), bool))
+    w.finish(str(tmp_path / "mosaic.tif"), "DEFLATE", None)
+    with RasterFile(str(tmp_path / "mosaic.tif")) as r:
+        alpha = [r.band(i + 1).GetColorInterpretation() == gdal.GCI_AlphaBand for i in range(r.count)]
+    assert alpha == [False] * bands + [True]

@@ -57,7 +57,10 @@ class RasterWriter:
         self.ds = drv.Create(path, width, height, n, gtype, options=[
             "TILED=YES", "BLOCKXSIZE=256", "BLOCKYSIZE=256", "COMPRESS=ZSTD" if _has_zstd() else "COMPRESS=LZW",
             "BIGTIFF=IF_SAFER", "SPARSE_OK=TRUE"] + (["PHOTOMETRIC=RGB"] if bands == 3 and self.dtype == np.uint8
-                                                      else []) + (["ALPHA=YES"] if self.alpha is not None else []))
+                                                      else []) + (["ALPHA=YES"] if self.alpha is not None and
+                                                                  bands in (1, 3) else []))
+        # ALPHA=YES marks the first extra sample: the alpha after a grey band or RGB, but band 2 of a multispectral
+        # mosaic (NIR, Red, ...: Red was read as a mask); there the alpha is marked by its colour interpretation
         self.ds.SetGeoTransform(tuple(float(v) for v in geotransform))
         wkt = dsmmod.crs_to_wkt(crs) if crs else ""
         if wkt:
