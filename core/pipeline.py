@@ -29,6 +29,7 @@ from .io.gcp import GCPSet, apply_check_points, read_camera_positions, read_gcps
 from .io.images import list_images, require_images
 from .ortho.options import OrthoOptions
 from .ortho.stage import build_orthophoto_workspace
+from .prepare.captures import CaptureStackOptions, is_band_folder, stack_capture_folder
 from .prepare.options import PrepareOptions
 from .prepare.stage import prepare_images_workspace
 from .project.stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, PREPARE, RELIEF, REPORT, TERRAIN, StageError
@@ -80,6 +81,11 @@ class PipelineOptions:
     # with make_dtm: relief visualisations of the DTM (its keys: core.terrain.options.VISUALISATION_KEYS; slow)
     relief: ReliefStageOptions = field(default_factory=lambda: ReliefStageOptions(()))
     sky_masks: bool = False  # obliques: a prepare stage first (screening + sky masks), the prepared photos aligned
+    # a folder of a multispectral rig's band files (core.prepare.captures.is_band_folder): "auto" stacks every
+    # capture into one multi-band photo in <workspace>/captures first (Stack multispectral captures, with this
+    # radiometry) and the chain goes on with those; "off": the files are taken as photos
+    captures: str = "auto"
+    capture_radiometry: str = "normalised"
 
 
 @dataclass
@@ -95,6 +101,7 @@ class PipelineResult:
     dtm: object = None
     relief: object = None
     targets: object = None  # Find targets' result (core.georef.targets.stage.FindTargetsResult) when it ran
+    captures: object = None  # the band folder's stacked captures (core.prepare.captures.CaptureStackResult)
     seconds: Dict[str, float] = field(default_factory=dict)
     # CPU seconds per stage (this process and its pool workers, os.times(): load-independent, unlike ``seconds``)
     cpu_seconds: Dict[str, float] = field(default_factory=dict)
@@ -103,8 +110,24 @@ class PipelineResult:
 
 # the share of the progress bar of each stage
 FIND_TARGETS = "find targets"  # not a recorded stage: its products (georef/targets/) feed the georeference
-SPANS = {PREPARE: (0.0, 0.05), ALIGN: (0.0, 0.40), FIND_TARGETS: (0.40, 0.42), GEOREFERENCE: (0.42, 0.45), DSM: (0.45, 0.75), ORTHOPHOTO: (0.75, 0.9),
+CAPTURES = "captures"  # not a recorded stage: a band folder's captures stacked into multi-band photos
+CAPTURES_DIR = "captures"
+SPANS = {CAPTURES: (0.0, 0.05), PREPARE: (0.0, 0.05), ALIGN: (0.0, 0.40), FIND_TARGETS: (0.40, 0.42), GEOREFERENCE: (0.42, 0.45), DSM: (0.45, 0.75), ORTHOPHOTO: (0.75, 0.9),
          TERRAIN: (0.9, 0.92), RELIEF: (0.92, 0.95), REPORT: (0.95, 1.0)}
+
+
+def _stack(images_dir: str, workspace_dir: str, radiometry: str, res: "PipelineResult", progress: Progress) -> str:
+    """The band folder's captures stacked into <workspace>/captures (core.prepare.captures); returns that folder."""
+    out = os.path.join(workspace_dir, CAPTURES_DIR)
+    res.captures = stack_capture_folder(images_dir, CaptureStackOptions(out, radiometry=radiometry), progress)
+    kept = {os.path.basename(p) for p in res.captures.photos}
+    for name in os.listdir(out):  # an earlier run's photo of a capture no longer in the folder: not aligned now
+        if name.lower().endswith(".tif") and name not in kept:
+            os.unlink(os.path.join(out, name))
+    res.warnings += res.captures.warnings + [f"capture {c} left out: {why}" for c, why in res.captures.left_out.items()]
+    progress.info(f"captures: {len(res.captures.photos)} multi-band photo(s) of {', '.join(res.captures.bands)} "
+                  f"in {out} ({radiometry} radiometry)")
+    return out
 
 
 def check_inputs(images_dir: str, control: Control) -> None:
@@ -147,6 +170,9 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
                          "USE_EXIF_GPS) to georeference the block before the DSM and orthophoto; to align only, "
                          "run 'Align images'")
     check_inputs(images_dir, ctl)
+    if opt.captures not in ("auto", "off"):
+        raise StageError(f"captures {opt.captures!r}: auto (a band folder's captures stacked first) or off")
+    CaptureStackOptions(os.path.join(workspace_dir, CAPTURES_DIR), radiometry=opt.capture_radiometry)  # checked
     align_options = opt.align  # the camera positions also choose the pairs where the photos have no EXIF GPS
     if ctl.camera_positions_path and not align_options.camera_positions:
         align_options = dataclasses.replace(align_options, camera_positions=ctl.camera_positions_path)
@@ -170,14 +196,16 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
     res = PipelineResult(workspace=os.path.abspath(workspace_dir), align=None, georef=None, seconds=seconds,
                          cpu_seconds=cpu_seconds)
     aligned_from = images_dir
+    if opt.captures == "auto" and is_band_folder(images_dir):
+        aligned_from = run(CAPTURES, _stack, images_dir, workspace_dir, opt.capture_radiometry, res)
     if opt.sky_masks:  # the photos with their sky masks, so that no tie or dense point comes from the sky
-        res.prepare = run(PREPARE, prepare_images_workspace, images_dir, workspace_dir, opt.prepare)
+        res.prepare = run(PREPARE, prepare_images_workspace, aligned_from, workspace_dir, opt.prepare)
         res.warnings += res.prepare.warnings
         progress.info(f"prepare: {len(res.prepare.masks)} sky mask(s), {res.prepare.kept} of "
                       f"{len(res.prepare.images)} photos kept")
         aligned_from = res.prepare.prepared_dir
     res.align = run(ALIGN, align, aligned_from, workspace_dir, align_options,
-                    span=(SPANS[PREPARE][1], SPANS[ALIGN][1]) if opt.sky_masks else None)
+                    span=(SPANS[PREPARE][1], SPANS[ALIGN][1]) if opt.sky_masks or res.captures else None)
     gcp_path = ctl.gcp_path
     if ctl.targets_path:  # the targets found on the photos are the ground control
         res.targets = run(FIND_TARGETS, find_targets, workspace_dir,

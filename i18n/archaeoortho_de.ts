@@ -2222,7 +2222,7 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="134"/>
+        <location filename="../processing_provider/run_pipeline.py" line="137"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
@@ -2910,52 +2910,52 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Write the accuracy report</source>
         <translation>Genauigkeitsbericht schreiben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="115"/>
+        <location filename="../processing_provider/run_pipeline.py" line="118"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="116"/>
+        <location filename="../processing_provider/run_pipeline.py" line="119"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="119"/>
+        <location filename="../processing_provider/run_pipeline.py" line="122"/>
         <source>Accuracy report (HTML)</source>
         <translation>Genauigkeitsbericht (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="180"/>
+        <location filename="../processing_provider/run_pipeline.py" line="183"/>
         <source>Seconds per stage: {}</source>
         <translation>Sekunden pro Stufe: {}</translation>
     </message>
@@ -2965,122 +2965,122 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>Gesamte Verarbeitung ausführen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Ground control layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Check points</source>
         <translation>Kontrollpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Use EXIF GPS positions</source>
         <translation>EXIF-GPS-Positionen verwenden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Target CRS</source>
         <translation>Ziel-KBS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Matching image size (px)</source>
         <translation>Bildgröße für die Zuordnung (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>DSM resolution (m)</source>
         <translation>DOM-Auflösung (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Matching quality</source>
         <translation>Zuordnungsqualität</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Seam blending</source>
         <translation>Überblendung der Nähte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Parallel workers</source>
         <translation>Parallele Prozesse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Dask scheduler</source>
         <translation>Dask-Scheduler</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Build the DTM</source>
         <translation>Das DGM erzeugen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Contour interval (m, 0 = none)</source>
         <translation>Höhenlinienabstand (m, 0 = keine)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Relief visualisations</source>
         <translation>Reliefvisualisierungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="114"/>
+        <location filename="../processing_provider/run_pipeline.py" line="117"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>GCP-Pixel auf aufrechten Fotos gemessen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Sky masks (oblique photos)</source>
         <translation>Himmelsmasken (Schrägaufnahmen)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Camera calibration file</source>
         <translation>Kamerakalibrierungsdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Interior orientation</source>
         <translation>Innere Orientierung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Orthomosaic resolution (CRS units, 0 = GSD)</source>
         <translation>Orthomosaik-Auflösung (KBS-Einh., 0 = GSD)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Targets to find</source>
         <translation>Zu findende Zielmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Target kind</source>
         <translation>Art der Zielmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="141"/>
+        <location filename="../processing_provider/run_pipeline.py" line="144"/>
         <source>Give ground control (Ground control file or layer, or targets to find: GCPS, GCP_LAYER, TARGETS) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Geben Sie Passpunkte (Passpunktdatei oder Passpunktlayer oder zu findende Zielmarken: GCPS, GCP_LAYER, TARGETS) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
     </message>
@@ -3088,7 +3088,7 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <location filename="../ui/catalog.py" line="8"/>
         <source>The whole chain in one call, for batch use: Align images, Georeference, Build DSM, Build orthophoto and Accuracy report on one workspace. It calls the same functions as the single algorithms, and a re-run resumes (features, matches and dense pairs already computed are reused).
 
-Folder of images: the photos. Workspace folder: where every product is written.
+Folder of images: the photos; a folder of a multispectral rig&apos;s band files (Parrot Sequoia, MicaSense, DJI multispectral) is recognised, and its captures are first stacked into multi-band photos in &lt;workspace&gt;/captures (as &apos;Stack multispectral captures&apos;, normalised radiometry), which the chain then takes. Workspace folder: where every product is written.
 Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in &apos;Georeference&apos; (the pixel coordinates measured on the photos shown upright by their EXIF orientation).
 Targets to find (instead of a ground control file or layer): the surveyed coordinates of targets laid on the ground; after the alignment &apos;Find targets&apos; finds them on the photos and its observations are the ground control (Target kind, advanced: as in &apos;Find targets&apos;).
 Camera calibration file and Interior orientation (advanced): as in &apos;Align images&apos; (a calibrated camera held fixed through the whole chain, or refined with its standard deviations).
@@ -3098,7 +3098,7 @@ The other parameters are those of the single stages (see their help); 0 means au
 Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures.</source>
         <translation>Die gesamte Verarbeitung in einem Aufruf, für die Stapelverarbeitung: Bilder ausrichten, Georeferenzieren, DOM erzeugen, Orthophoto erzeugen und Genauigkeitsbericht in einem Arbeitsbereich. Es werden dieselben Funktionen wie in den einzelnen Algorithmen aufgerufen; ein erneuter Lauf setzt fort (bereits berechnete Merkmale, Zuordnungen und Stereopaare werden wiederverwendet).
 
-Bilderordner: die Fotos. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben werden.
+Bilderordner: die Fotos; ein Ordner mit den Kanaldateien einer Multispektralkamera (Parrot Sequoia, MicaSense, DJI Multispektral) wird erkannt, und ihre Aufnahmen werden zuerst zu mehrkanaligen Fotos in &lt;workspace&gt;/captures gestapelt (wie &apos;Multispektrale Aufnahmen stapeln&apos;, normalisierte Radiometrie), die die Kette dann nimmt. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben werden.
 Die Georeferenzierung braucht Passpunkte (eine Passpunktdatei oder ein Passpunktlayer, Kontrollpunkte werden zurückgehalten) und/oder Kamerapositionen (eine CSV-Datei der Kamerapositionen oder EXIF-GPS-Positionen verwenden): ohne sie wird die Verarbeitung abgelehnt, da ein DOM einen metrischen Maßstab und eine Lotrichtung braucht. GCP-Pixel auf aufrechten Fotos gemessen: wie bei 'Georeferenzieren' (die Pixelkoordinaten auf den Fotos gemessen, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden).
 Zu findende Zielmarken (statt einer Passpunktdatei oder eines Passpunktlayers): die vermessenen Koordinaten von am Boden ausgelegten Zielmarken; nach der Ausrichtung findet 'Zielmarken finden' sie auf den Fotos, und seine Messungen sind die Passpunkte (Art der Zielmarken, erweitert: wie in 'Zielmarken finden').
 Kamerakalibrierungsdatei und Innere Orientierung (erweitert): wie in 'Bilder ausrichten' (eine kalibrierte Kamera durch die ganze Kette festgehalten oder mit ihren Standardabweichungen verbessert).

@@ -2222,7 +2222,7 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="134"/>
+        <location filename="../processing_provider/run_pipeline.py" line="137"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
@@ -2910,52 +2910,52 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Write the accuracy report</source>
         <translation>Scrivi il rapporto di accuratezza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="115"/>
+        <location filename="../processing_provider/run_pipeline.py" line="118"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="116"/>
+        <location filename="../processing_provider/run_pipeline.py" line="119"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="119"/>
+        <location filename="../processing_provider/run_pipeline.py" line="122"/>
         <source>Accuracy report (HTML)</source>
         <translation>Rapporto di accuratezza (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="180"/>
+        <location filename="../processing_provider/run_pipeline.py" line="183"/>
         <source>Seconds per stage: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -2965,122 +2965,122 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Esegui l'intera elaborazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Ground control layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Check points</source>
         <translation>Punti di controllo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Use EXIF GPS positions</source>
         <translation>Usa le posizioni GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Target CRS</source>
         <translation>SR di destinazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Matching image size (px)</source>
         <translation>Dimensione per la corrispondenza (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>DSM resolution (m)</source>
         <translation>Risoluzione del DSM (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Matching quality</source>
         <translation>Qualità della corrispondenza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Seam blending</source>
         <translation>Sfumatura delle giunzioni</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Parallel workers</source>
         <translation>Processi paralleli</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Dask scheduler</source>
         <translation>Scheduler Dask</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Build the DTM</source>
         <translation>Genera il DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Contour interval (m, 0 = none)</source>
         <translation>Equidistanza (m, 0 = nessuna)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Relief visualisations</source>
         <translation>Visualizzazioni del rilievo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="114"/>
+        <location filename="../processing_provider/run_pipeline.py" line="117"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>Pixel dei GCP misurati sulle foto raddrizzate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Sky masks (oblique photos)</source>
         <translation>Maschere del cielo (foto oblique)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Camera calibration file</source>
         <translation>File di calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Interior orientation</source>
         <translation>Orientamento interno</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Orthomosaic resolution (CRS units, 0 = GSD)</source>
         <translation>Risoluzione ortomosaico (unità SR, 0 = GSD)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Targets to find</source>
         <translation>Target da trovare</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="82"/>
+        <location filename="../processing_provider/run_pipeline.py" line="85"/>
         <source>Target kind</source>
         <translation>Tipo di target</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="141"/>
+        <location filename="../processing_provider/run_pipeline.py" line="144"/>
         <source>Give ground control (Ground control file or layer, or targets to find: GCPS, GCP_LAYER, TARGETS) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Indicare punti di appoggio (File o Layer dei punti d'appoggio, o target da trovare: GCPS, GCP_LAYER, TARGETS) e/o posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
     </message>
@@ -3088,7 +3088,7 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <location filename="../ui/catalog.py" line="8"/>
         <source>The whole chain in one call, for batch use: Align images, Georeference, Build DSM, Build orthophoto and Accuracy report on one workspace. It calls the same functions as the single algorithms, and a re-run resumes (features, matches and dense pairs already computed are reused).
 
-Folder of images: the photos. Workspace folder: where every product is written.
+Folder of images: the photos; a folder of a multispectral rig&apos;s band files (Parrot Sequoia, MicaSense, DJI multispectral) is recognised, and its captures are first stacked into multi-band photos in &lt;workspace&gt;/captures (as &apos;Stack multispectral captures&apos;, normalised radiometry), which the chain then takes. Workspace folder: where every product is written.
 Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in &apos;Georeference&apos; (the pixel coordinates measured on the photos shown upright by their EXIF orientation).
 Targets to find (instead of a ground control file or layer): the surveyed coordinates of targets laid on the ground; after the alignment &apos;Find targets&apos; finds them on the photos and its observations are the ground control (Target kind, advanced: as in &apos;Find targets&apos;).
 Camera calibration file and Interior orientation (advanced): as in &apos;Align images&apos; (a calibrated camera held fixed through the whole chain, or refined with its standard deviations).
@@ -3098,7 +3098,7 @@ The other parameters are those of the single stages (see their help); 0 means au
 Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures.</source>
         <translation>L'intera elaborazione in una sola chiamata, per l'uso in batch: Allinea immagini, Georeferenzia, Crea DSM, Crea ortofoto e Rapporto di accuratezza su un solo spazio di lavoro. Chiama le stesse funzioni dei singoli algoritmi, e una nuova esecuzione riprende (caratteristiche, corrispondenze e coppie dense già calcolate vengono riutilizzate).
 
-Cartella delle immagini: le foto. Cartella dell'area di lavoro: dove sono scritti tutti i prodotti.
+Cartella delle immagini: le foto; una cartella di file di banda di una camera multispettrale (Parrot Sequoia, MicaSense, DJI multispettrale) è riconosciuta, e le sue acquisizioni sono prima impilate in foto multibanda in &lt;workspace&gt;/captures (come 'Impila acquisizioni multispettrali', radiometria normalizzata), che la catena poi prende. Cartella dell'area di lavoro: dove sono scritti tutti i prodotti.
 La georeferenziazione richiede punti di appoggio (un file o un layer dei punti d'appoggio, punti di controllo esclusi) e/o posizioni delle camere (un CSV delle posizioni delle camere o Usa le posizioni GPS EXIF): senza di essi l'elaborazione viene rifiutata, perché un DSM richiede una scala metrica e una direzione verticale. Pixel dei GCP misurati sulle foto raddrizzate: come in 'Georeferenzia' (le coordinate pixel misurate sulle foto mostrate diritte secondo il loro orientamento EXIF).
 Target da trovare (invece di un file o layer dei punti d'appoggio): le coordinate rilevate dei target posati a terra; dopo l'allineamento 'Trova i target' li trova nelle foto e le sue misure sono i punti d'appoggio (Tipo di target, avanzato: come in 'Trova i target').
 File di calibrazione della camera e Orientamento interno (avanzato): come in 'Allinea immagini' (una camera calibrata mantenuta fissa per tutta la catena, o affinata con le sue deviazioni standard).
@@ -3247,10 +3247,10 @@ Band folder: the folder of band files (the RGB camera&apos;s frames in it are no
 Radiometry: normalised (default) removes each band&apos;s dark level, corrects its vignetting from the file&apos;s model and normalises exposure time and gain to the block&apos;s; irradiance also divides by the sun sensor&apos;s irradiance for that band (values proportional to reflectance when the light changes during the flight); raw keeps the numbers as recorded. A band file lacking what the choice needs (an exposure time, a sun-sensor reading) stops the run before any work, naming the file. The photo&apos;s metadata says what was done (and per band the vignetting model, dark level and scale).
 Reference band (advanced): the band the others are registered onto; empty: the rig&apos;s reference camera.
 Output folder: where the multi-band photos are written (one per capture, named after its band files without the band suffix); not the band folder.</source>
-        <translation>Trasforma i file di banda di una camera multispettrale (Parrot Sequoia, MicaSense RedEdge / Altum, DJI P4 Multispectral / Mavic 3M: un TIFF a 16 bit per banda per acquisizione) in una foto multibanda per acquisizione, che Allinea immagini, Esegui pipeline e Crea ortofoto prendono come qualsiasi foto: l&apos;ortomosaico ha allora ogni banda, e Indice spettrale ne calcola NDVI o NDRE. I file di un&apos;acquisizione sono raggruppati per il loro ID di acquisizione (altrimenti per nome del rig e ora); ogni banda è raddrizzata con il proprio modello d&apos;obiettivo dai suoi metadati, ruotata della sua rotazione nel rig e registrata sulla banda di riferimento per correlazione di fase sui gradienti. Le bande della foto iniziano con NIR, Rosso, Verde (QGIS le mostra come vista a falsi colori NIR-R-G), ciascuna nominata con la sua lunghezza d&apos;onda; il GPS dell&apos;acquisizione è nel suo EXIF. Un&apos;acquisizione a cui manca una banda è esclusa e nominata nel registro; nella cartella delle bande non si scrive mai.
+        <translation>Trasforma i file di banda di una camera multispettrale (Parrot Sequoia, MicaSense RedEdge / Altum, DJI P4 Multispectral / Mavic 3M: un TIFF a 16 bit per banda per acquisizione) in una foto multibanda per acquisizione, che Allinea immagini, Esegui pipeline e Crea ortofoto prendono come qualsiasi foto: l'ortomosaico ha allora ogni banda, e Indice spettrale ne calcola NDVI o NDRE. I file di un'acquisizione sono raggruppati per il loro ID di acquisizione (altrimenti per nome del rig e ora); ogni banda è raddrizzata con il proprio modello d'obiettivo dai suoi metadati, ruotata della sua rotazione nel rig e registrata sulla banda di riferimento per correlazione di fase sui gradienti. Le bande della foto iniziano con NIR, Rosso, Verde (QGIS le mostra come vista a falsi colori NIR-R-G), ciascuna nominata con la sua lunghezza d'onda; il GPS dell'acquisizione è nel suo EXIF. Un'acquisizione a cui manca una banda è esclusa e nominata nel registro; nella cartella delle bande non si scrive mai.
 
 Cartella delle bande: la cartella dei file di banda (le immagini della camera RGB al suo interno non sono impilate).
-Radiometria: normalizzato (predefinito) sottrae a ogni banda il suo livello di nero, ne corregge la vignettatura secondo il modello del file e normalizza tempo di esposizione e guadagno a quelli del blocco; irradianza divide inoltre per l&apos;irradianza del sensore solare per quella banda (valori proporzionali alla riflettanza quando la luce cambia durante il volo); grezzo mantiene i valori come registrati. Un file di banda privo di ciò che la scelta richiede (un tempo di esposizione, una lettura del sensore solare) ferma l&apos;esecuzione prima di ogni lavoro, nominando il file. I metadati della foto dicono cosa è stato fatto (e per banda il modello di vignettatura, il livello di nero e la scala).
+Radiometria: normalizzato (predefinito) sottrae a ogni banda il suo livello di nero, ne corregge la vignettatura secondo il modello del file e normalizza tempo di esposizione e guadagno a quelli del blocco; irradianza divide inoltre per l'irradianza del sensore solare per quella banda (valori proporzionali alla riflettanza quando la luce cambia durante il volo); grezzo mantiene i valori come registrati. Un file di banda privo di ciò che la scelta richiede (un tempo di esposizione, una lettura del sensore solare) ferma l'esecuzione prima di ogni lavoro, nominando il file. I metadati della foto dicono cosa è stato fatto (e per banda il modello di vignettatura, il livello di nero e la scala).
 Banda di riferimento (avanzato): la banda su cui sono registrate le altre; vuoto: la camera di riferimento del rig.
 Cartella di uscita: dove sono scritte le foto multibanda (una per acquisizione, nominata come i suoi file di banda senza il suffisso della banda); non la cartella delle bande.</translation>
     </message>

@@ -1,7 +1,8 @@
 """A synthetic multispectral rig block through the whole chain (issue 37, tests/rig_scene.py): 10 captures of four
 fisheye bands (Sequoia form, rig rotations, per-band vignetting, light changing by +-30 % between captures, the
 exposure following it, the red edge at ISO 200 on every other capture) -> Stack multispectral captures
-(irradiance radiometry) -> Run pipeline on the stacked photos -> Spectral index (NDVI), against the scene's truth:
+(irradiance radiometry; Run pipeline does it on the band folder) -> the chain -> Spectral index (NDVI), against the
+scene's truth:
 
 - every capture registered; the mosaic keeps the four bands, named;
 - band-to-band registration in the mosaic (phase correlation on gradients, NIR / Red / Red edge on Green): median
@@ -13,6 +14,8 @@ Measured (10 captures): registration medians 0.00-0.02 px, p90 <= 0.03 px; patch
 contrast 0.0704 against the truth's 0.0708; benchmarks/rig_block.py prints the figures for 40 captures."""
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 
@@ -23,19 +26,17 @@ pytestmark = pytest.mark.slow
 def rig_run(tmp_path_factory):
     from core import pipeline
     from core.align.options import AlignOptions
-    from core.prepare.captures import CaptureStackOptions, stack_capture_folder
     from tests import rig_scene as rs
 
     root = tmp_path_factory.mktemp("rig")
     rig = rs.rig_block(n_strips=2, per_strip=5)
     bands = str(root / "bands")
     rs.render(rig, bands, supersample=1)
-    photos = str(root / "stacked" / "images")
-    stack = stack_capture_folder(bands, CaptureStackOptions(photos, radiometry="irradiance"))
-    result = pipeline.run_pipeline(photos, str(root / "ws"), pipeline.PipelineOptions(
-        align=AlignOptions(num_threads=2), make_report=False),
+    # the band folder itself: Run pipeline stacks its captures first (PipelineOptions.captures "auto")
+    result = pipeline.run_pipeline(bands, str(root / "ws"), pipeline.PipelineOptions(
+        align=AlignOptions(num_threads=2), make_report=False, capture_radiometry="irradiance"),
         pipeline.Control(camera_positions_path=str(root / "camera_positions.csv")))
-    return rig, stack, result, root
+    return rig, result.captures, result, root
 
 
 def test_the_rig_block_is_stacked_aligned_and_mosaicked_with_every_band(rig_run):
@@ -43,6 +44,8 @@ def test_the_rig_block_is_stacked_aligned_and_mosaicked_with_every_band(rig_run)
 
     rig, stack, result, _root = rig_run
     assert len(stack.photos) == len(rig.block.shots) and stack.left_out == {}
+    assert all(os.path.dirname(p) == os.path.join(result.workspace, "captures") for p in stack.photos)
+    assert "captures" in result.cpu_seconds
     assert stack.bands == ("NIR", "Red", "Green", "Red edge") and max(stack.worst_residual_px.values()) < 0.3
     assert result.align.registered == len(rig.block.shots)
     with RasterFile(result.ortho.orthomosaic) as r:
@@ -86,3 +89,19 @@ def test_the_crop_mark_shows_in_ndvi_as_in_the_truth(rig_run):
     measured = ndvi[on].mean() - ndvi[beside].mean()
     expected = truth[on].mean() - truth[beside].mean()
     assert expected > 0.05 and measured == pytest.approx(expected, rel=0.15)
+
+
+def test_only_a_band_folder_is_stacked(tmp_path):
+    """Run pipeline stacks a folder of a rig's band files, never a folder of photos: the Sequoia capture's folder
+    (its band TIFFs first) is one, Toledo's JPEGs and the capture's RGB frame alone are not."""
+    import shutil
+
+    from core.prepare.captures import is_band_folder
+    from tests.conftest import SAMPLE, shared
+
+    assert is_band_folder(shared("sequoia_sample"))
+    assert not is_band_folder(os.path.join(SAMPLE, "images"))
+    rgb = tmp_path / "rgb"
+    rgb.mkdir()
+    shutil.copy(os.path.join(shared("sequoia_sample"), "IMG_161122_163234_0000_RGB.JPG"), rgb)
+    assert not is_band_folder(str(rgb)) and not is_band_folder(str(tmp_path / "empty-or-missing"))
