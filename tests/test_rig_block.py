@@ -93,7 +93,8 @@ def test_the_crop_mark_shows_in_ndvi_as_in_the_truth(rig_run):
 
 def test_only_a_band_folder_is_stacked(tmp_path):
     """Run pipeline stacks a folder of a rig's band files, never a folder of photos: the Sequoia capture's folder
-    (its band TIFFs first) is one, Toledo's JPEGs and the capture's RGB frame alone are not."""
+    (its band TIFFs first) is one; Toledo's JPEGs, the capture's RGB frame alone and a folder of one band's files
+    (a block of NIR photos) are not."""
     import shutil
 
     from core.prepare.captures import is_band_folder
@@ -105,3 +106,8 @@ def test_only_a_band_folder_is_stacked(tmp_path):
     rgb.mkdir()
     shutil.copy(os.path.join(shared("sequoia_sample"), "IMG_161122_163234_0000_RGB.JPG"), rgb)
     assert not is_band_folder(str(rgb)) and not is_band_folder(str(tmp_path / "empty-or-missing"))
+    nir = tmp_path / "nir"  # one band's files: photos, aligned as they are
+    nir.mkdir()
+    shutil.copy(os.path.join(shared("sequoia_sample"), "IMG_161122_163234_0000_NIR.TIF"), nir)
+    shutil.copy(os.path.join(shared("sequoia_sample"), "IMG_161122_163234_0000_NIR.TIF"), nir / "IMG_2_NIR.TIF")
+    assert not is_band_folder(str(nir))

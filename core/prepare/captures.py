@@ -164,17 +164,17 @@ def stack_capture_folder(folder: str, options: CaptureStackOptions,
     return stack_captures(band_files(folder), options, progress)
 
 
-def is_band_folder(folder: str, probe: int = 3) -> bool:
-    """Does ``folder`` hold a multispectral rig's band files (the first ``probe`` image files each name one band
-    that is not RGB, with a rig name or a capture id)?  Cheap: a few files' metadata, no pixels."""
+def is_band_folder(folder: str, probe: int = 8) -> bool:
+    """Does ``folder`` hold a multispectral rig's band files: the first ``probe`` image files each name one band
+    that is not RGB, with a rig name or a capture id, and they name two bands or more (a folder of one band's files
+    is a block of photos, aligned as it is)?  Cheap: a few files' metadata, no pixels."""
     from ..io.images import list_images
     from ..io.multispectral import MultispectralError, read_band_info
 
     if not os.path.isdir(folder):
         return False
     names = list_images(folder)[:probe]
-    if not names:
-        return False
+    bands = set()
     for name in names:
         try:
             b = read_band_info(os.path.join(folder, name))
@@ -182,4 +182,5 @@ def is_band_folder(folder: str, probe: int = 3) -> bool:
             return False
         if b.is_rgb or not b.band_name or len(b.band_names) > 1 or not (b.rig_name or b.capture_id):
             return False
-    return True
+        bands.add(band_key(b.band_name))
+    return len(bands) >= 2
