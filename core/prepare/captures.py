@@ -165,9 +165,9 @@ def stack_capture_folder(folder: str, options: CaptureStackOptions,
 
 
 def is_band_folder(folder: str, probe: int = 8) -> bool:
-    """Does ``folder`` hold a multispectral rig's band files: the first ``probe`` image files each name one band
-    that is not RGB, with a rig name or a capture id, and they name two bands or more (a folder of one band's files
-    is a block of photos, aligned as it is)?  Cheap: a few files' metadata, no pixels."""
+    """Does ``folder`` hold a multispectral rig's band files: the first ``probe`` image files, the rig's RGB frames
+    aside, each name one band with a rig name or a capture id, and they name two bands or more (a folder of one
+    band's files is a block of photos, aligned as it is)?  Cheap: a few files' metadata, no pixels."""
     from ..io.images import list_images
     from ..io.multispectral import MultispectralError, read_band_info
 
@@ -180,7 +180,9 @@ def is_band_folder(folder: str, probe: int = 8) -> bool:
             b = read_band_info(os.path.join(folder, name))
         except MultispectralError:
             return False
-        if b.is_rgb or not b.band_name or len(b.band_names) > 1 or not (b.rig_name or b.capture_id):
+        if b.is_rgb:  # a rig's RGB camera beside its bands (or a folder of colour photos: no band then)
+            continue
+        if not b.band_name or len(b.band_names) > 1 or not (b.rig_name or b.capture_id):
             return False
         bands.add(band_key(b.band_name))
     return len(bands) >= 2
