@@ -73,9 +73,9 @@ ESCALATE_ALL_MAX = 20  # an affine round re-extracts and matches every image exh
 # an image of the main block tied by fewer points than COLMAP asks of an image to register it (the mapper's
 # abs_pose_min_num_inliers, 30) is "weakly tied" and escalated
 WEAK_MIN_TIES = 30
-# a block of more images is escalated by extension (the module's docstring): its left-out images alone are
-# extracted again and the mapping continues from the main block; at and below it a round re-extracts the
-# left-out images' neighbours too and maps the block afresh (the kept behaviour on Toledo-57 and the small sets)
+# a block of more images is escalated by extension (the module's docstring): each left-out image matched with its
+# own nearest images and the mapping continued from the main block; at and below it a round matches every left-out
+# image with every neighbour and maps the block afresh (the kept behaviour on Toledo-57 and the small sets)
 EXTEND_MIN_IMAGES = 100
 PAIR_ID_BASE = 2147483647  # COLMAP: pair_id = image_id1 * 2147483647 + image_id2 (image_id1 < image_id2)
 
@@ -231,6 +231,13 @@ def _model_neighbours(rec, names: Sequence[str], k: int) -> Dict[str, List[str]]
     return out
 
 
+def best_matched(counts: Dict[Tuple[str, str], int], name: str, registered) -> List[str]:
+    """The ANCHORS_PER_IMAGE images of ``registered`` that ``name`` has most raw matches with (``counts``:
+    :func:`_pair_counts`), best first."""
+    ranked = sorted(((c, r) for r in registered if (c := counts.get((name, r), 0)) > 0), reverse=True)
+    return [r for _c, r in ranked[:ANCHORS_PER_IMAGE]]
+
+
 def choose_neighbours(db_path: str, order: Sequence[str], registered: Set[str], left_out: Sequence[str],
                       rec) -> List[str]:
     """The registered images re-extracted and matched with the left-out ones: for each left-out image the
@@ -240,8 +247,7 @@ def choose_neighbours(db_path: str, order: Sequence[str], registered: Set[str], 
     index = {n: k for k, n in enumerate(order)}
     anchors: Set[str] = set()
     for w in left_out:
-        ranked = sorted(((c, r) for r in registered if (c := counts.get((w, r), 0)) > 0), reverse=True)
-        mine = [r for _c, r in ranked[:ANCHORS_PER_IMAGE]]
+        mine = best_matched(counts, w, registered)
         if len(mine) < 2:  # nothing matched: the images taken just before and after it
             near = sorted(registered, key=lambda r: abs(index.get(r, 0) - index.get(w, 0)))
             mine += [r for r in near[:2] if r not in mine]
@@ -305,11 +311,10 @@ def _better(new, old) -> bool:
     return (len(rn), -len(on), -len(weak_images(new))) > (len(ro), -len(oo), -len(weak_images(old)))
 
 
-def _round_images(ctx: EscalationContext, kind: str, registered: Set[str], left: List[str], ordered,
-                  extension: bool = False):
+def _round_images(ctx: EscalationContext, kind: str, registered: Set[str], left: List[str], ordered):
     """(neighbours, exhaustive) of a round of ``kind``: an affine round takes every image (exhaustive pairs) in
     a block of up to ESCALATE_ALL_MAX images (features of one kind on both sides of every pair)."""
-    if kind == "affine" and len(ctx.order) <= ESCALATE_ALL_MAX and not extension:
+    if kind == "affine" and len(ctx.order) <= ESCALATE_ALL_MAX:
         return [n for n in ctx.order if n in registered], True
     neighbours = choose_neighbours(ctx.db_path, ctx.order, registered, left, ordered[0] if ordered else None)
     return neighbours, False
@@ -347,10 +352,10 @@ def extension_pairs(ctx: EscalationContext, left: Sequence[str], redo: Sequence[
     touched, lset = set(redo), set(left)
     pairs: Set[Tuple[str, str]] = {(min(a, b), max(a, b)) for a, b in ctx.pairs if a in touched or b in touched}
     others = list(ctx.order)
+    registered = [n for n in others if n not in lset]
     placed = ctx.positions or {}
     for w in left:
-        ranked = sorted(((c, r) for (a, r), c in counts.items() if a == w and r not in lset and c > 0), reverse=True)
-        anchors = [r for _c, r in ranked[:ANCHORS_PER_IMAGE]]
+        anchors = best_matched(counts, w, registered)
         mine = set(anchors) | set(nearest(ctx, w, others, k))
         if rec is not None and w not in placed:
             for near in _model_neighbours(rec, anchors, MODEL_NEIGHBOURS).values():
@@ -379,7 +384,7 @@ def _run_round(ctx: EscalationContext, k: int, reason: str, ordered, left: List[
     why = {**ctx.diagnose(registered, others), **weak_images(ordered)}
     anchors = registered - set(left)  # a weakly tied image is escalated as a left-out one, not as a neighbour
     extension = extends(ctx, ordered)  # a large block: the main block continued (the module's docstring)
-    neighbours, exhaustive = _round_images(ctx, kind, anchors, left, ordered, extension)
+    neighbours, exhaustive = _round_images(ctx, kind, anchors, left, ordered)
     redo = [n for n in ctx.order if n in set(left) | set(neighbours)]
     g0 = max(ctx.job.groups, key=lambda g: g.width * g.height)
     sift = escalated_sift(ctx.options, g0.width, g0.height, kind, ctx.settings.max_features)
