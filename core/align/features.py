@@ -21,7 +21,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 from ..common.cancel import CancelWatcher
 from ..common.files import atomic_output, atomic_write_text, fingerprint
 from ..common.progress import Progress, check_cancel
-from ..io.images import CameraGroup, ImageInfo
+from ..io.images import CameraGroup, ImageError, ImageInfo, matching_grey8, read_image
 from ..prepare.masks import MaskError, find_mask, mask_file_name, png_size
 from .calibrated import GivenCamera, colmap_camera
 from .options import (
@@ -138,6 +138,40 @@ def file_hash(path: str) -> str:
     return h.hexdigest()[:16]
 
 
+FEATURE_IMAGES = "feature_images"  # sfm/<this>: the 8-bit primary-band images COLMAP extracts features from
+
+
+def feature_images(infos: Sequence[ImageInfo], sfm_dir: str) -> Tuple[Optional[str], List[str]]:
+    """The folder COLMAP reads the photos that name a primary band from (None when none does), and those photos.
+
+    A multispectral capture's stacked photo (core.prepare.captures) names the band it is matched on; COLMAP would
+    read its first three bands as a colour photo and its 16-bit values scaled down to a few grey levels.  Each
+    such photo gets an 8-bit image of its primary band (core.io.images.matching_grey8: the band stretched to
+    0..255) under its own name in ``sfm/feature_images``, the pixel grid unchanged, so keypoints are the photo's
+    pixels; a photo's image is written again when the photo is newer."""
+    from osgeo import gdal
+
+    chosen = [im for im in infos if im.primary_band]
+    folder = os.path.join(sfm_dir, FEATURE_IMAGES)
+    if not chosen:
+        shutil.rmtree(folder, ignore_errors=True)
+        return None, []
+    os.makedirs(folder, exist_ok=True)
+    for im in chosen:
+        dst = os.path.join(folder, im.name)
+        if os.path.isfile(dst) and os.path.getmtime(dst) >= os.path.getmtime(im.path):
+            continue
+        try:
+            grey = matching_grey8(read_image(im.path), im.primary_band)
+        except ImageError as e:
+            raise AlignError(str(e)) from e
+        with atomic_output(dst) as tmp:
+            ds = gdal.GetDriverByName("GTiff").Create(tmp, grey.shape[1], grey.shape[0], 1, gdal.GDT_Byte)
+            ds.GetRasterBand(1).WriteArray(grey)
+            ds = None
+    return folder, sorted(im.name for im in chosen)
+
+
 def masks_for_colmap(masks_dir: str, infos: Sequence[ImageInfo], sfm_dir: str) -> Tuple[Optional[str], Dict[str, str]]:
     """The folder to give COLMAP as ``mask_path`` (None without masks) and image -> mask file.
 
@@ -247,6 +281,9 @@ class Extraction:
     camera_ids: Dict[str, int]
     mask_path: Optional[str] = None
     masked: Sequence[str] = ()
+    # the folder of 8-bit primary-band images (feature_images) and the photos read from it instead
+    proxy_path: Optional[str] = None
+    proxied: Sequence[str] = ()
 
 
 def _extraction_options(pycolmap, settings: FeatureSettings, options: AlignOptions):
@@ -267,16 +304,19 @@ def _extraction_options(pycolmap, settings: FeatureSettings, options: AlignOptio
 
 def _extraction_blocks(job: Extraction, done, settings: FeatureSettings) -> List[Tuple[CameraGroup, List[str]]]:
     masked = set(job.masked or ())
+    proxied = set(job.proxied or ())
     todo: List[Tuple[CameraGroup, List[str]]] = []
     for g in job.groups:
         rest = [n for n in g.images if n not in done]
         scale = min(1.0, settings.image_size / max(g.width, g.height))
         size = extract_block(g.width, g.height, int(round(max(g.width, g.height) * scale)), settings.first_octave)
         # COLMAP skips an image whose mask is missing when mask_path is set: masked and unmasked images go
-        # in separate blocks (in file order), only the masked ones with mask_path
+        # in separate blocks (in file order), only the masked ones with mask_path; so do the images read from
+        # the primary-band folder
         block: List[str] = []
         for n in rest:
-            if block and (len(block) >= size or (n in masked) != (block[0] in masked)):
+            if block and (len(block) >= size or (n in masked) != (block[0] in masked)
+                          or (n in proxied) != (block[0] in proxied)):
                 todo.append((g, block))
                 block = []
             block.append(n)
@@ -307,7 +347,8 @@ def extract_features(pycolmap, job: Extraction, settings: FeatureSettings, optio
         if job.mask_path and block[0] in masked:
             ro.mask_path = job.mask_path  # <mask_path>/<image name>.png, black = no features
         with CancelWatcher(progress) as token:
-            pycolmap.extract_features(job.db_path, job.images_dir, image_names=block,
+            folder = job.proxy_path if block[0] in set(job.proxied or ()) else job.images_dir
+            pycolmap.extract_features(job.db_path, folder, image_names=block,
                                       camera_mode=pycolmap.CameraMode.SINGLE, reader_options=ro,
                                       extraction_options=eo, device=pycolmap.Device.cpu,
                                       cancellation_token=token)

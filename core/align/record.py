@@ -13,7 +13,7 @@ from ..common.progress import Progress
 from ..project.layout import Layout
 from ..project.stages import ALIGN
 from ..project.workspace import Workspace
-from .features import Extraction, database_key, file_hash, masks_for_colmap, setup_database
+from .features import Extraction, database_key, feature_images, file_hash, masks_for_colmap, setup_database
 from .firstpass import FirstPass
 from .inputs import Photos
 from .options import AlignOptions
@@ -51,7 +51,11 @@ def prepare_database(pycolmap, lay: Layout, photos: Photos, options: AlignOption
     key = database_key(groups, options, photos.images_dir, masks_key, fingerprint(photos.fingerprints), first.key())
     db_path, known_key = database_path(lay, record, key, keep_previous)
     camera_ids = setup_database(pycolmap, db_path, groups, options, key, known_key, photos.given)
-    return Extraction(db_path, photos.images_dir, groups, camera_ids, mask_path, sorted(masks)), masks
+    proxy_path, proxied = feature_images(infos, lay.sfm_dir)
+    if proxied:
+        progress.info(f"features: {len(proxied)} photo(s) matched on their primary band ({proxy_path})")
+    return Extraction(db_path, photos.images_dir, groups, camera_ids, mask_path, sorted(masks), proxy_path,
+                      proxied), masks
 
 
 def previous_alignment(ws: Workspace, lay: Layout) -> Optional[dict]:

@@ -15,7 +15,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..geometry.camera import Intrinsics, Pose
-from ..io.images import read_image
+from ..io.images import primary_band, read_image
 from .options import DenseError, DenseOptions
 
 
@@ -195,10 +195,15 @@ def _greedy_cover(cands: List[PairInfo], partners: int) -> Dict[Tuple[int, int],
 
 
 def load_scaled(view: View, scale: float) -> Tuple[np.ndarray, float, float]:
-    """Image pixels at ``scale`` and the exact (sx, sy) factors of the array obtained."""
+    """Image pixels at ``scale`` and the exact (sx, sy) factors of the array obtained; of a photo that names a
+    primary band (a multispectral capture's, core.io.images.primary_band) that band alone, the one its features
+    were matched on."""
     if not os.path.isfile(view.path):
         raise DenseError(f"image {view.path} is missing (moved since alignment?)")
     size = None if scale >= 1.0 else max(1, int(round(max(view.width, view.height) * scale)))
     img = read_image(view.path, size)
+    band = primary_band(view.path) if img.shape[2] > 1 else 0
+    if band:
+        img = img[:, :, band - 1:band]
     h, w = img.shape[:2]
     return img, w / view.width, h / view.height

@@ -48,6 +48,9 @@ class ImageInfo:
     focal_source: str = "default"  # exif35 / exif_plane / manual / default
     gps: Optional[Tuple[float, float, float]] = None  # lon, lat, ellipsoidal(ish) alt (WGS84)
     orientation: int = 1  # EXIF orientation (1-8): how a photo viewer turns the stored grid; see ORIENTATION_STEPS
+    # the band (1-based) features and dense matching are taken from, where the photo names one (a multispectral
+    # capture's stacked photo: PRIMARY_BAND, core.prepare.captures); 0 = the photo's grey (see to_grey)
+    primary_band: int = 0
 
     def to_dict(self) -> dict:
         d = asdict(self)
@@ -138,7 +141,9 @@ def read_image_info(path: str, name: Optional[str] = None, manual_focal_mm: Opti
         w, h, nb = r.width, r.height, r.count
         dtype = gdal.GetDataTypeName(r.band(1).DataType)
         md = photo_metadata(r)
-    info = ImageInfo(name=name, path=os.path.abspath(path), width=w, height=h, bands=nb, dtype=dtype)
+        primary = _primary_band(r, md)
+    info = ImageInfo(name=name, path=os.path.abspath(path), width=w, height=h, bands=nb, dtype=dtype,
+                     primary_band=primary)
     info.make = md.get("EXIF_Make", "").strip().strip("\x00")
     info.model = md.get("EXIF_Model", "").strip().strip("\x00")
     fmm = _rational(md.get("EXIF_FocalLength", ""))
@@ -192,6 +197,52 @@ def photo_metadata(r: RasterFile) -> Dict[str, str]:
     md = dict(r.metadata(domain="EXIF"))
     md.update(r.metadata())
     return md
+
+
+PRIMARY_BAND = "PRIMARY_BAND"  # a photo's metadata item naming (by its description) the band to match on
+
+
+def _primary_band(r: RasterFile, md: Dict[str, str]) -> int:
+    """The 1-based band the photo's PRIMARY_BAND item names, 0 when it names none (or no band of the photo)."""
+    name = md.get(PRIMARY_BAND, "").strip()
+    if not name or r.count < 2:
+        return 0
+    for i in range(1, r.count + 1):
+        if r.band(i).GetDescription().strip() == name:
+            return i
+    return 0
+
+
+def primary_band(path: str) -> int:
+    """The 1-based band of ``path`` its PRIMARY_BAND item names (0: none); reads the header only."""
+    with open_image(path) as r:
+        return _primary_band(r, photo_metadata(r))
+
+
+def matching_grey8(arr: np.ndarray, band: int = 0) -> np.ndarray:
+    """(rows, cols[, bands]) pixels -> the 8-bit grey that features and dense matching see: the photo's primary
+    ``band`` (1-based) where it names one, else its grey (three bands or more: Rec. 601 luminance, else the first
+    band); values other than 8-bit stretched from their 0.5 to 99.5 percentile to 0..255 (a 16-bit band
+    photo's values fill a few hundredths of the 16-bit range)."""
+    a = np.asarray(arr)
+    if a.ndim == 3 and band and band <= a.shape[2]:
+        a = a[:, :, band - 1]
+    if a.ndim == 3:
+        if a.shape[2] >= 3:
+            g = 0.299 * a[:, :, 0].astype(np.float32) + 0.587 * a[:, :, 1] + 0.114 * a[:, :, 2]
+            if a.dtype == np.uint8:
+                return np.clip(np.rint(g), 0, 255).astype(np.uint8)
+        else:
+            g = a[:, :, 0]
+    else:
+        g = a
+    if g.dtype == np.uint8:
+        return np.ascontiguousarray(g)
+    g = g.astype(np.float32)
+    finite = np.isfinite(g)
+    lo, hi = np.percentile(g[finite], [0.5, 99.5]) if finite.any() else (0.0, 1.0)
+    out = (np.nan_to_num(g, nan=lo) - lo) * (255.0 / max(float(hi - lo), 1e-6))
+    return np.ascontiguousarray(np.clip(out, 0, 255).astype(np.uint8))
 
 
 def exif_orientation(path: str) -> int:

@@ -24,7 +24,17 @@ from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence, Tuple
 
 from ..common.progress import NullProgress, Progress, check_cancel
-from ..io.multispectral import Capture, band_files, band_key, capture_exif, read_block, write_band_stack
+from ..io.images import PRIMARY_BAND  # the item naming the band the photo's features and dense matching use
+from ..io.multispectral import (
+    Block,
+    Capture,
+    band_files,
+    band_key,
+    capture_exif,
+    primary_band,
+    read_block,
+    write_band_stack,
+)
 from .band_radiometry import MODES, block_scales, check_bands, correct, describe
 from .bands import RegistrationOptions, register_capture
 from .options import PrepareError
@@ -86,16 +96,38 @@ def photo_names(captures: Sequence[Capture]) -> Dict[str, str]:
     return {cid: (n if seen[n.lower()] == 1 else f"{n[:-4]}_{_safe(cid)}.tif") for cid, n in names.items()}
 
 
+GREEN_NM = 550.0  # the band an RGB camera's grey (Rec. 601: 0.587 green) is most like
+
+
+def alignment_band(captures: Sequence[Capture], names: Sequence[str], with_rgb: bool) -> Tuple[str, str]:
+    """(the band a stacked photo's features and dense matching are taken from, why): beside a rig's RGB frames
+    (aligned in one block with them) the band nearest green (550 nm), whose grey is most like an RGB photo's;
+    else the band with the most texture (core.io.multispectral.primary_band)."""
+    if with_rgb:
+        nm = {b.band_name: b.central_wavelength_nm for cap in captures for b in cap.bands}
+        known = [n for n in names if nm.get(n) is not None]
+        if known:
+            name = min(known, key=lambda n: abs(nm[n] - GREEN_NM))
+            return name, f"nearest {GREEN_NM:g} nm ({nm[name]:g} nm): matched with the rig's RGB photos"
+        green = [n for n in names if band_key(n) == "green"]
+        if green:
+            return green[0], "the green band: matched with the rig's RGB photos"
+    p = primary_band(Block(tuple(captures), tuple(names), ()))
+    return p.name, p.reason
+
+
 def _band_captures(paths: Sequence[str]):
-    """(captures without the RGB camera's frames, their band names in rig order, warnings)."""
+    """(captures without the RGB camera's frames, their band names in rig order, warnings, the alignment band and
+    why)."""
     block = read_block(paths)
+    with_rgb = any(b.is_rgb for c in block.captures for b in c.bands)
     captures = [dataclasses.replace(c, bands=tuple(b for b in c.bands if not b.is_rgb)) for c in block.captures]
     captures = [c for c in captures if c.bands]
     names = tuple(n for n in block.band_names if band_key(n) not in ("rgb", "redgreenblue"))
     if not captures or len(names) < 2:
         raise PrepareError(f"{len(paths)} file(s) hold no capture with two or more bands (bands seen: "
                            f"{', '.join(block.band_names) or 'none'}): nothing to stack")
-    return captures, names, list(block.warnings)
+    return captures, names, list(block.warnings), alignment_band(captures, names, with_rgb)
 
 
 def _check_output(output_dir: str, paths: Sequence[str]) -> None:
@@ -112,7 +144,7 @@ def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
     is written for what the block's metadata already shows."""
     progress = progress or NullProgress()
     _check_output(options.output_dir, paths)
-    captures, names, warnings = _band_captures(paths)
+    captures, names, warnings, (primary, why) = _band_captures(paths)
     # the captures stacked (a capture lacking a band is left out below): their bands checked before any work
     every_band = [b for cap in captures if all(cap.band(n) is not None for n in names) for b in cap.bands]
     factors = check_bands(every_band, options.radiometry)  # a band lacking what the radiometry needs: before work
@@ -144,7 +176,8 @@ def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
         ref = infos[reg.reference]
         height, width = reg.bands.shape[1:]
         path = os.path.join(options.output_dir, names_of[cap.capture_id])
-        md = {"REFERENCE_BAND": reg.reference, "CAPTURE": cap.capture_id,
+        md = {"REFERENCE_BAND": reg.reference, "CAPTURE": cap.capture_id, PRIMARY_BAND: primary,
+              PRIMARY_BAND + "_REASON": why,
               "BAND_FILES": ",".join(infos[n].name for n in order_names),
               **describe(options.radiometry, [infos[n] for n in order_names], factors, scales)}
         write_band_stack(path, reg.bands[order], order_names, md,
