@@ -745,38 +745,50 @@ def primary_band(block: Block, sample: int = 3) -> PrimaryBand:
 
 
 # ---------------------------------------------------------------- registered bands
+PHOTO_DTYPES = ("uint16", "reflectance")  # the multi-band photos the chain reads (write_band_stack)
+
+
 def write_band_stack(path: str, bands: np.ndarray, names: Sequence[str], metadata: Optional[Dict[str, str]] = None,
                      wavelengths: Optional[Sequence[Optional[float]]] = None, exif: Optional[Dict[str, str]] = None,
-                     dtype: str = "float32") -> str:
+                     dtype: str = "float32", band_metadata: Optional[Sequence[Dict[str, str]]] = None) -> str:
     """Write registered bands (bands, rows, cols) as one plain TIFF (no georeferencing; DEFLATE), atomically: each
-    band described by its name, with its central wavelength (``wavelength``, nm) in its metadata where given; the
-    ``exif`` tags in GDAL's EXIF domain.  ``float32``: NaN is nodata; ``uint16`` (a capture's photo for the chain,
-    core.prepare.captures): the values rounded and clipped to 0..65535, NaN (where a band does not reach) 0.
-    MultispectralError naming the file when it cannot be written."""
+    band described by its name, with its central wavelength (``wavelength``, nm) and its ``band_metadata`` items in
+    its metadata where given; the ``exif`` tags in GDAL's EXIF domain.  ``dtype``: ``float32``, NaN nodata;
+    ``uint16`` (a capture's photo for the chain, core.prepare.captures): the values rounded and clipped to 0..65535,
+    NaN (where a band does not reach) 0; ``reflectance`` (a capture's photo in reflectance): float32, negatives 0,
+    NaN 0 and 0 declared the bands' nodata (the dense matching's stretch and the photos' readers take 0 for
+    nothing there, as in the 16-bit photos; NaN would turn its percentiles into NaN).  MultispectralError naming
+    the file when it cannot be written."""
     from osgeo import gdal
 
     gdal.UseExceptions()
     data = np.asarray(bands)
     wavelengths = list(wavelengths) if wavelengths is not None else [None] * len(names)
-    if data.ndim != 3 or data.shape[0] != len(names) or len(wavelengths) != len(names):
+    extra = list(band_metadata) if band_metadata is not None else [{}] * len(names)
+    if data.ndim != 3 or data.shape[0] != len(names) or len(wavelengths) != len(names) or len(extra) != len(names):
         raise MultispectralError(f"{path}: {len(names)} band names for an array of shape {data.shape}")
-    photo = dtype == "uint16"
-    if photo:
+    photo = dtype in PHOTO_DTYPES
+    if dtype == "uint16":
         data = np.clip(np.nan_to_num(data.astype(np.float64), nan=0.0), 0, 65535).round().astype(np.uint16)
+    elif dtype == "reflectance":
+        data = np.maximum(np.nan_to_num(data.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0), 0.0)
     else:
         data = data.astype(np.float32)
+    integer = data.dtype == np.uint16
     try:
         with atomic_output(path) as tmp:
             ds = gdal.GetDriverByName("GTiff").Create(
-                tmp, data.shape[2], data.shape[1], data.shape[0], gdal.GDT_UInt16 if photo else gdal.GDT_Float32,
-                ["COMPRESS=DEFLATE", f"PREDICTOR={2 if photo else 3}", "TILED=YES", "INTERLEAVE=BAND"])
-            for i, (name, nm) in enumerate(zip(names, wavelengths)):
+                tmp, data.shape[2], data.shape[1], data.shape[0], gdal.GDT_UInt16 if integer else gdal.GDT_Float32,
+                ["COMPRESS=DEFLATE", f"PREDICTOR={2 if integer else 3}", "TILED=YES", "INTERLEAVE=BAND"])
+            for i, (name, nm, md) in enumerate(zip(names, wavelengths, extra)):
                 band = ds.GetRasterBand(i + 1)
                 band.SetDescription(str(name))
-                if not photo:
-                    band.SetNoDataValue(float("nan"))
-                if nm is not None:
-                    band.SetMetadata({"wavelength": f"{nm:g}", "wavelength_units": "nm"})
+                if not integer:
+                    band.SetNoDataValue(0.0 if photo else float("nan"))
+                items = {"wavelength": f"{nm:g}", "wavelength_units": "nm"} if nm is not None else {}
+                items.update({str(k): str(v) for k, v in (md or {}).items()})
+                if items:
+                    band.SetMetadata(items)
                 band.WriteArray(data[i])
             if exif:
                 ds.SetMetadata({str(k): str(v) for k, v in exif.items()}, "EXIF")

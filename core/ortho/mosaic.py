@@ -7,7 +7,7 @@ import math
 import os
 import shutil
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
@@ -27,7 +27,7 @@ from .radiometry_fit import fit_radiometry
 from .seamlines import read_seamline_edits, write_seamlines
 from .surface import Dsm, fill_dsm_gaps
 from .tiles import DSM_CACHE, TileUnit, render_tile
-from .writer import RasterWriter, gdal_cache, photo_band_names
+from .writer import RasterWriter, calibrated_reflectance, gdal_cache, photo_band_names
 
 # the work folders of a run, beside its output (a killed run's are removed by the next: files.clean_debris)
 WORK_PREFIX = ".ortho-work-"
@@ -71,6 +71,11 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], crs: Optional[str], offset
     t_start = time.time()
     timings: Dict[str, float] = {}
     log: List[str] = []
+    if (options.exposure or options.radiometry) and calibrated_reflectance([c.path for c in cameras]):
+        options = replace(options, exposure=False, radiometry=False)
+        log.append("the photos hold calibrated reflectance (their bands' RADIOMETRIC_UNIT): mosaicked as they are, "
+                   "without exposure gains or the radiometric model, which would change them")
+        progress.info(log[-1])
     out_dir = os.path.dirname(os.path.abspath(output))
     os.makedirs(out_dir, exist_ok=True)
     workdir = owned_tempdir(WORK_PREFIX, out_dir)

@@ -80,7 +80,14 @@ def _read_window(path: str, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
         isz = dtype.itemsize
         buf = r.dataset.ReadRaster(x0, y0, w, h, buf_type=gdt, buf_pixel_space=bands * isz,
                                    buf_line_space=bands * isz * w, buf_band_space=isz)
-    return np.frombuffer(bytearray(buf) if isinstance(buf, bytes) else buf, dtype=dtype).reshape(h, w, bands)
+        nodata = r.band(1).GetNoDataValue() if dtype.kind == "f" else None
+    out = np.frombuffer(bytearray(buf) if isinstance(buf, bytes) else buf, dtype=dtype).reshape(h, w, bands)
+    if nodata is not None and np.isfinite(nodata):
+        # a float photo's declared nodata (a multispectral capture in reflectance: 0 where a band does not reach,
+        # core.io.multispectral.write_band_stack) read as NaN: its samples, and those interpolated from it, are
+        # then no data (core.ortho.sampling.sample_camera)
+        out[out == nodata] = np.nan
+    return out
 
 
 def image_window(path: str, meta: ImageMeta, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:

@@ -73,4 +73,9 @@ def sample_camera(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.n
         y1 = min(meta.height, int(math.ceil(v.max())) + pad + 1)
         win = image_window(cam.path, meta, x0, y0, x1, y1)
         s.values[idx] = remap_photo(win, u - x0, v - y0, interpolation)
+        if np.dtype(meta.dtype).kind == "f":  # a float photo's no data (NaN, or its nodata read as NaN): not valid
+            bad = idx[~np.isfinite(s.values[idx]).all(axis=1)]
+            s.valid[bad] = False
+            s.cost[bad] = np.inf
+            s.values[bad] = 0.0
     return s

@@ -40,6 +40,17 @@ def photo_band_names(paths: Sequence[str]) -> Tuple[List[str], List[Dict[str, st
     return list(seen[0]), [dict(m) for m in seen[1]]
 
 
+REFLECTANCE_UNIT = "reflectance"  # a photo band's RADIOMETRIC_UNIT item (core.prepare.band_radiometry.REFLECTANCE)
+
+
+def calibrated_reflectance(paths: Sequence[str]) -> bool:
+    """Do the photos hold calibrated reflectance: every band of every photo says RADIOMETRIC_UNIT reflectance (a
+    multispectral capture calibrated by its panel, core.prepare.captures)?  Their values are then mosaicked as
+    they are (core.ortho.mosaic)."""
+    _names, mds = photo_band_names(paths)
+    return bool(mds) and all(m.get("RADIOMETRIC_UNIT") == REFLECTANCE_UNIT for m in mds)
+
+
 class RasterWriter:
     """A tiled GeoTIFF that tiles are written into, then translated to a COG (atomically)."""
 

@@ -25,10 +25,21 @@ The values of a band are finally multiplied by one factor for the whole block (t
 divided out for that band), so that they stay in the band's DN range and fit the 16-bit photo the chain reads;
 what was done is stated in the photo's metadata (``RADIOMETRY`` and each band's ``RADIOMETRY_*`` items).
 
+With a **calibration panel** (a capture of a panel of known reflectance, before and / or after the flight, as
+MicaSense, DJI and Parrot ask for) that factor is instead the panel's reflectance over the panel's corrected value
+(the same correction, normalised or irradiance, measured by :func:`measure_panel`: the median of a central
+window, refused when it is saturated or not uniform), the mean over the panel captures; the values are then
+reflectance (0..1, float32 photos).  The panel's reflectance is one number for every band, per band name
+("Green=0.49,Red=0.50"), or a CSV file of band name or wavelength (nm) and reflectance, as the panel's
+calibration sheet gives it (:func:`parse_panel_reflectance`; a curve of wavelengths is interpolated at each band's
+central wavelength).
+
 Pure: NumPy; no qgis, no Qt.
 """
 from __future__ import annotations
 
+import os
+import re
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple
 
@@ -41,6 +52,21 @@ MODES = ("raw", "normalised", "irradiance")
 MODE_TEXT = {"raw": "raw DN (no radiometric correction)",
              "normalised": "DN normalised: dark level removed, vignetting corrected, exposure x gain normalised",
              "irradiance": "DN normalised and divided by the sun sensor's irradiance (proportional to reflectance)"}
+# a band's unit (each band's RADIOMETRIC_UNIT item, carried into the orthomosaic's bands; core.ortho leaves the
+# values of photos in REFLECTANCE as they are)
+UNITS = {"raw": "DN", "normalised": "normalised DN", "irradiance": "DN proportional to reflectance"}
+REFLECTANCE = "reflectance"
+PANEL_TEXT = {"normalised": "reflectance (0..1) from the calibration panel: dark level removed, vignetting "
+                            "corrected, exposure x gain normalised, scaled by the panel (the light at the panel's "
+                            "capture)",
+              "irradiance": "reflectance (0..1) from the calibration panel and the sun sensor: dark level removed, "
+                            "vignetting corrected, exposure x gain normalised, divided by the sun sensor's "
+                            "irradiance, scaled by the panel"}
+PANEL_WINDOW = 0.25  # the panel window's side, a fraction of the frame's short side (centred)
+PANEL_TOLERANCE = 0.10  # a panel pixel lies within this fraction of the window's median (or 4 noise sigmas) ...
+PANEL_OUTLIERS = 0.05  # ... but for at most this fraction of the window's pixels
+PANEL_SATURATED = 0.001  # more than this fraction of the window's pixels at the file's full scale: saturated
+PANEL_AGREEMENT = 0.03  # panel captures whose values differ by more than this: the light changed between them
 
 
 class BandRadiometryError(ArchaeoOrthoError, ValueError):
@@ -182,10 +208,12 @@ def correct(pixels: np.ndarray, info: BandInfo, factors: BandFactors, scale: flo
 
 
 def describe(mode: str, bands: Sequence[BandInfo], factors: Dict[str, BandFactors],
-             scales: Dict[str, float]) -> Dict[str, str]:
+             scales: Dict[str, float], panel: Optional[Dict[str, "PanelBand"]] = None) -> Dict[str, str]:
     """The photo's metadata items stating its radiometry: ``RADIOMETRY`` and, per band (its name's key in upper
-    case), the vignetting model used, the dark level and the block's scale."""
-    md = {"RADIOMETRY": MODE_TEXT[mode]}
+    case), the vignetting model used, the dark level and the block's scale, or with a calibration ``panel`` (band
+    name -> PanelBand) the panel's reflectance, value, factor and files."""
+    panel = {band_key(n): p for n, p in (panel or {}).items()}
+    md = {"RADIOMETRY": PANEL_TEXT[mode] if panel else MODE_TEXT[mode]}
     for b in bands:
         f = factors.get(b.path)
         if mode == "raw" or f is None:
@@ -193,9 +221,229 @@ def describe(mode: str, bands: Sequence[BandInfo], factors: Dict[str, BandFactor
         key = band_key(b.band_name).upper()
         md[f"{key}_VIGNETTING"] = f.vignetting or "none given"
         md[f"{key}_DARK_LEVEL"] = f"{f.dark_level:g}"
-        md[f"{key}_BLOCK_SCALE"] = f"{scales.get(b.band_name or '?', 1.0):.6g}"
+        p = panel.get(band_key(b.band_name))
+        if p is None:
+            md[f"{key}_BLOCK_SCALE"] = f"{scales.get(b.band_name or '?', 1.0):.6g}"
+        else:
+            md.update({f"{key}_PANEL_REFLECTANCE": f"{p.reflectance:g}", f"{key}_PANEL_VALUE": f"{p.value:.6g}",
+                       f"{key}_PANEL_FACTOR": f"{p.factor:.6g}",
+                       f"{key}_PANEL_FILES": ",".join(os.path.basename(x) for x in p.files)})
         if f.sensor_model:
             md[f"{key}_SENSOR_MODEL"] = "Parrot SEQ-AN-01 (SensorModel)"
         if f.irradiance is not None:
             md[f"{key}_IRRADIANCE"] = f"{f.irradiance:.6g}"
     return md
+
+
+def band_metadata(mode: str, panel: Optional["PanelBand"] = None) -> Dict[str, str]:
+    """A photo band's own metadata items stating its unit and radiometry (the same in every photo of the block, so
+    the orthomosaic's band carries them: core.ortho.writer.photo_band_names): ``RADIOMETRIC_UNIT`` (reflectance,
+    normalised DN, ...), ``RADIOMETRY`` and, with a panel, ``PANEL_REFLECTANCE``."""
+    if panel is None:
+        return {"RADIOMETRIC_UNIT": UNITS[mode], "RADIOMETRY": MODE_TEXT[mode]}
+    return {"RADIOMETRIC_UNIT": REFLECTANCE, "RADIOMETRY": PANEL_TEXT[mode],
+            "PANEL_REFLECTANCE": f"{panel.reflectance:g}"}
+
+
+# ---------------------------------------------------------------- calibration panel
+@dataclass(frozen=True)
+class PanelReflectance:
+    """The panel's reflectance as given: ``value`` for every band; else ``by_name`` ((band name as given, value)
+    rows, matched by core.io.multispectral.band_key) or ``curve`` ((wavelength nm, value) rows, ascending: each
+    band takes the value at its central wavelength, interpolated, up to CURVE_MARGIN_NM beyond the ends);
+    ``source``: the text or the file it came from."""
+    value: Optional[float] = None
+    by_name: Tuple[Tuple[str, float], ...] = ()
+    curve: Tuple[Tuple[float, float], ...] = ()
+    source: str = ""
+
+    def for_band(self, name: Optional[str], wavelength_nm: Optional[float]) -> Optional[float]:
+        """The reflectance of band ``name`` (central wavelength ``wavelength_nm``); None when it gives none."""
+        if self.value is not None:
+            return self.value
+        if self.by_name:
+            return next((v for n, v in self.by_name if band_key(n) == band_key(name)), None)
+        if self.curve and wavelength_nm is not None:
+            nm = [c[0] for c in self.curve]
+            if nm[0] - CURVE_MARGIN_NM <= wavelength_nm <= nm[-1] + CURVE_MARGIN_NM:
+                return float(np.interp(wavelength_nm, nm, [c[1] for c in self.curve]))
+        return None
+
+
+CURVE_MARGIN_NM = 10.0  # a band's central wavelength at most this far beyond a reflectance curve's ends
+
+
+def _reflectance_value(text: str, where: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise BandRadiometryError(f"panel reflectance {where}: {text!r} is not a number") from None
+    if not 0.0 < value <= 1.0:
+        percent = f" (a percentage? {value:g} % is {value / 100:g})" if 1.0 < value <= 100.0 else ""
+        raise BandRadiometryError(f"panel reflectance {where}: {value:g} is not a reflectance between 0 and 1"
+                                  + percent)
+    return value
+
+
+def _reflectance_rows(text: str) -> Tuple[List[Tuple[str, str]], str]:
+    """(key, value) rows of the panel's reflectance: a CSV file's rows (comma, semicolon or tab; a header row
+    and # comments skipped) or a text's items "name=value" / "name: value" separated by commas or semicolons."""
+    rows = []
+    if os.path.isfile(text):
+        try:
+            with open(text, newline="", encoding="utf-8-sig") as f:
+                lines = [ln for ln in f.read().splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+        except (OSError, UnicodeDecodeError) as e:
+            raise BandRadiometryError(f"panel reflectance file {text}: cannot be read ({e})") from e
+        for line in lines:
+            cells = [c.strip().strip('"') for c in re.split(r"[,;\t]", line) if c.strip()]
+            if len(cells) >= 2 and re.fullmatch(r"[-+0-9.eE]+", cells[1]):
+                rows.append((cells[0], cells[1]))
+        if not rows:
+            raise BandRadiometryError(f"panel reflectance file {text}: no row of a band (name or wavelength in nm) "
+                                      "and its reflectance (e.g. 'NIR,0.49' or '842,0.49')")
+        return rows, f"file {os.path.basename(text)}"
+    for item in (i.strip() for i in re.split(r"[,;]", text)):
+        m = re.fullmatch(r"(.+?)\s*[=:]\s*(.+)", item) if item else None
+        if item and m is None:
+            raise BandRadiometryError(f"panel reflectance {text!r}: {item!r} is not 'band=value' (give one number "
+                                      "for every band, band=value items, or a CSV file)")
+        if m is not None:
+            rows.append((m.group(1).strip(), m.group(2).strip()))
+    return rows, repr(text)
+
+
+def parse_panel_reflectance(text: str) -> PanelReflectance:
+    """The panel's reflectance (:class:`PanelReflectance`) from what the user gives: one number for every band
+    ("0.5"); band=value items ("Green=0.49,Red=0.50,Red edge=0.50,NIR=0.49"); or a CSV file of rows band name or
+    wavelength in nm, reflectance (a MicaSense / DJI panel's calibration sheet: "Green,0.49" or "560,0.49").
+    Reflectances are fractions (0..1].  BandRadiometryError naming what is wrong."""
+    text = (text or "").strip()
+    if not text:
+        raise BandRadiometryError("no panel reflectance given: one number for every band (e.g. 0.5), band=value "
+                                  "items or a CSV file of band,reflectance")
+    if re.fullmatch(r"[-+0-9.eE]+", text):
+        return PanelReflectance(value=_reflectance_value(text, "for every band"), source=text)
+    rows, source = _reflectance_rows(text)
+    numeric = [re.fullmatch(r"[0-9.]+(\s*nm)?", k, re.I) is not None for k, _ in rows]
+    if any(numeric) and not all(numeric):
+        raise BandRadiometryError(f"panel reflectance {source}: give bands either all by name or all by "
+                                  f"wavelength (nm), not both ({', '.join(k for k, _ in rows)})")
+    if all(numeric):
+        curve = sorted((float(re.sub(r"[^0-9.]", "", k)), _reflectance_value(v, f"at {k} ({source})"))
+                       for k, v in rows)
+        return PanelReflectance(curve=tuple(curve), source=source)
+    seen = [band_key(k) for k, _ in rows]
+    twice = sorted({k for k, _ in rows if seen.count(band_key(k)) > 1})
+    if twice:
+        raise BandRadiometryError(f"panel reflectance {source}: band {', '.join(twice)} given twice")
+    return PanelReflectance(by_name=tuple((k, _reflectance_value(v, f"of {k} ({source})")) for k, v in rows),
+                            source=source)
+
+
+def panel_for_bands(panel: PanelReflectance, bands: Sequence[BandInfo]) -> Dict[str, float]:
+    """band name -> the panel's reflectance, for the rig's bands ``bands`` (one file per band); BandRadiometryError
+    for a band named that the rig lacks, or a band of the rig the panel gives no reflectance for."""
+    names = {band_key(b.band_name): b for b in bands}
+    extra = [n for n, _ in panel.by_name if band_key(n) not in names]
+    if extra:
+        raise BandRadiometryError(f"panel reflectance {panel.source}: the rig has no band {', '.join(extra)} (its "
+                                  f"bands: {', '.join(b.band_name or '?' for b in bands)})")
+    out, lacking = {}, []
+    for b in bands:
+        value = panel.for_band(b.band_name, b.central_wavelength_nm)
+        if value is None:
+            nm = f" ({b.central_wavelength_nm:g} nm)" if b.central_wavelength_nm else " (no central wavelength)"
+            lacking.append((b.band_name or "?") + (nm if panel.curve else ""))
+        else:
+            out[b.band_name or "?"] = value
+    if lacking:
+        span = f" (its curve: {panel.curve[0][0]:g}..{panel.curve[-1][0]:g} nm)" if panel.curve else ""
+        raise BandRadiometryError(f"panel reflectance {panel.source}{span} gives none for band "
+                                  f"{', '.join(lacking)}: give every band's")
+    return out
+
+
+def panel_window(shape: Tuple[int, int], window: float) -> Tuple[slice, slice]:
+    """The panel window: a square of ``window`` x the frame's short side (at least 8 px) at the frame's centre."""
+    rows, cols = shape
+    side = max(8, min(rows, cols, int(round(window * min(rows, cols)))))
+    r0, c0 = (rows - side) // 2, (cols - side) // 2
+    return slice(r0, r0 + side), slice(c0, c0 + side)
+
+
+def measure_panel(corrected: np.ndarray, raw: np.ndarray, path: str, window: float = PANEL_WINDOW) -> float:
+    """The panel's corrected value in one panel band file: the median of the central window (:func:`panel_window`)
+    of ``corrected`` (the band's values after the flight's correction, :func:`correct` with scale 1; ``raw``: the
+    file's pixels in its own data type).  BandRadiometryError naming the file when the window is saturated (more
+    than PANEL_SATURATED of its raw pixels at the file's full scale, core.io.images.full_scale) or not uniform (more than PANEL_OUTLIERS of its
+    pixels beyond PANEL_TOLERANCE, or 4 noise sigmas where the noise is larger, of its median: no panel there, or
+    one smaller than the window), or dark."""
+    from ..io.images import full_scale
+
+    rows, cols = np.asarray(raw).shape[:2]
+    sr, sc = panel_window((rows, cols), window)
+    where = (f"the panel window (the central {sr.stop - sr.start} x {sc.stop - sc.start} px, {window:g} of the "
+             "frame's short side)")
+    raw = np.asarray(raw)
+    full = full_scale(raw) if np.issubdtype(raw.dtype, np.integer) else float("inf")  # float files: no full scale
+    saturated = float(np.mean(raw[sr, sc] >= 0.99 * full))
+    if saturated > PANEL_SATURATED:
+        raise BandRadiometryError(f"{path}: {where} is saturated ({100 * saturated:.1f} % of its pixels at "
+                                  f"{full:g}): photograph the panel with a shorter exposure (not in direct sun "
+                                  "glare)")
+    win = np.asarray(corrected, dtype=np.float64)[sr, sc]
+    median = float(np.median(win))
+    if not median > 0:
+        raise BandRadiometryError(f"{path}: {where} is dark (median {median:g} after the dark level): no panel "
+                                  "there")
+    noise = 1.4826 * float(np.median(np.abs(np.diff(win, axis=1)))) / np.sqrt(2.0)
+    tolerance = max(PANEL_TOLERANCE, 4.0 * noise / median)
+    off = float(np.mean(np.abs(win / median - 1.0) > tolerance))
+    if off > PANEL_OUTLIERS:
+        raise BandRadiometryError(f"{path}: {where} is not uniform ({100 * off:.0f} % of its pixels differ from its "
+                                  f"median by more than {100 * tolerance:.0f} %): no panel fills it. Photograph "
+                                  "the panel so that it fills the centre of the frame, or give a smaller panel "
+                                  "window")
+    return median
+
+
+@dataclass(frozen=True)
+class PanelBand:
+    """One band's calibration: the panel's ``reflectance``, its panel band files (one per panel capture) and
+    their corrected panel values (:func:`measure_panel`), and the panel captures' ids."""
+    name: str
+    reflectance: float
+    files: Tuple[str, ...]
+    values: Tuple[float, ...]
+    captures: Tuple[str, ...] = ()
+
+    @property
+    def value(self) -> float:
+        """The panel's value: the mean over the panel captures (before and after the flight)."""
+        return float(np.mean(self.values))
+
+    @property
+    def factor(self) -> float:
+        """What the band's corrected values are multiplied by to be reflectance."""
+        return self.reflectance / self.value
+
+    @property
+    def disagreement(self) -> float:
+        """How much the panel captures' values differ: max / min - 1 (0 with one capture)."""
+        return max(self.values) / min(self.values) - 1.0
+
+
+def panel_warnings(bands: Sequence[PanelBand], mode: str) -> List[str]:
+    """A warning per band whose panel captures differ by more than PANEL_AGREEMENT (the light changed between
+    them, or the panel was shaded or tilted in one)."""
+    out = []
+    for b in bands:
+        if b.disagreement > PANEL_AGREEMENT:
+            values = ", ".join(f"{os.path.basename(f)} {v:.6g}" for f, v in zip(b.files, b.values))
+            hint = ("in normalised radiometry the panel holds the light of its own capture: irradiance radiometry "
+                    "(the sun sensor) follows the light's changes" if mode == "normalised" else
+                    "was the panel shaded, tilted or dirty in one of them?")
+            out.append(f"calibration panel, band {b.name}: its captures differ by {100 * b.disagreement:.1f} % "
+                       f"({values}); their mean is used ({hint})")
+    return out

@@ -10,7 +10,12 @@ name with its central wavelength in its metadata.  The photo carries the referen
 camera, and the pinhole frame's focal length, in its EXIF (:func:`core.io.multispectral.capture_exif`).  Values
 are, by default, each band's numbers with its dark level removed, its vignetting corrected and its exposure x gain
 normalised to the block's (``radiometry``: raw, normalised or irradiance, :mod:`core.prepare.band_radiometry`,
-stated in the photo's ``RADIOMETRY`` metadata), 0 where a band does not reach.
+stated in the photo's ``RADIOMETRY`` metadata and in each band's ``RADIOMETRIC_UNIT`` and ``RADIOMETRY``), 0 where a
+band does not reach.  With a calibration panel (``panel``: the band files of one or more captures of a panel of
+known reflectance, given apart from the flight's) the photos are float32 reflectance (0..1, 0 = no data): each
+band's values are scaled by the panel's reflectance over its value (:func:`calibrate_panel`); panel files left
+among the flight's (the same files, or captures with a panel capture's id) are not stacked, and the warnings say
+so.
 
 A capture that lacks a band the block has is left out with its reason (an orthomosaic needs every band in every
 photo); the block's other warnings (:func:`core.io.multispectral.check_captures`) are passed on.  The RGB camera
@@ -35,7 +40,22 @@ from ..io.multispectral import (
     read_block,
     write_band_stack,
 )
-from .band_radiometry import MODES, block_scales, check_bands, correct, describe
+from ..io.raster import RasterFile
+from .band_radiometry import (
+    MODES,
+    PANEL_WINDOW,
+    BandRadiometryError,
+    PanelBand,
+    band_metadata,
+    block_scales,
+    check_bands,
+    correct,
+    describe,
+    measure_panel,
+    panel_for_bands,
+    panel_warnings,
+    parse_panel_reflectance,
+)
 from .bands import RegistrationOptions, register_capture
 from .options import PrepareError
 
@@ -49,25 +69,51 @@ class CaptureStackOptions:
     without the band suffix); ``registration``: the band registration's options (its ``reference``: the band the
     others are registered onto, default the rig's reference camera); ``radiometry``: raw, normalised (dark
     level, vignetting, exposure x gain) or irradiance (normalised and divided by the sun sensor's irradiance:
-    proportional to reflectance), core.prepare.band_radiometry."""
+    proportional to reflectance), core.prepare.band_radiometry; ``panel``: the band files (or folders of them) of
+    the calibration panel's captures (the photos are then reflectance, with the normalised or irradiance
+    correction), ``panel_reflectance`` the panel's reflectance (one number, band=value items or a CSV file:
+    core.prepare.band_radiometry.parse_panel_reflectance), ``panel_window`` the side of the central window the
+    panel is measured in, a fraction of the frame's short side."""
     output_dir: str
     registration: RegistrationOptions = field(default_factory=RegistrationOptions)
     radiometry: str = "normalised"
+    panel: Tuple[str, ...] = ()
+    panel_reflectance: str = ""
+    panel_window: float = PANEL_WINDOW
 
     def __post_init__(self):
         if self.radiometry not in MODES:
             raise PrepareError(f"radiometry {self.radiometry!r}: one of {', '.join(MODES)}")
+        panel = (self.panel,) if isinstance(self.panel, str) else tuple(self.panel or ())
+        object.__setattr__(self, "panel", tuple(p for p in panel if p))
+        text = (self.panel_reflectance or "").strip()
+        if self.panel and not text:
+            raise PrepareError("calibration panel captures given without the panel's reflectance (one number for "
+                               "every band, e.g. 0.5, band=value items or a CSV file of band,reflectance)")
+        if text and not self.panel:
+            raise PrepareError(f"a panel reflectance ({text}) without the panel's captures: give the panel's band "
+                               "files or their folder")
+        if self.panel and self.radiometry == "raw":
+            raise PrepareError("raw DN cannot be calibrated to reflectance by the panel: choose the normalised or "
+                               "the irradiance radiometry")
+        if not 0.02 <= float(self.panel_window) <= 1.0:
+            raise PrepareError(f"panel window {self.panel_window}: a fraction 0.02 .. 1 of the frame's short side")
+        if self.panel:
+            parse_panel_reflectance(text)  # a value that is not a reflectance: before any work
 
 
 @dataclass
 class CaptureStackResult:
     """The photos written, their bands in order, the captures left out (capture -> why), the worst refined
-    residual per band over the captures (px), and the block's warnings."""
+    residual per band over the captures (px), the block's warnings, the calibration panel per band (empty
+    without one) and the photos' unit."""
     photos: List[str]
     bands: Tuple[str, ...]
     left_out: Dict[str, str]
     worst_residual_px: Dict[str, float]
     warnings: List[str]
+    panel: Dict[str, PanelBand] = field(default_factory=dict)
+    unit: str = ""
 
 
 def stack_order(names: Sequence[str]) -> List[int]:
@@ -130,6 +176,96 @@ def _band_captures(paths: Sequence[str]):
     return captures, names, list(block.warnings), alignment_band(captures, names, with_rgb)
 
 
+def panel_files(panel: Sequence[str]) -> List[str]:
+    """The calibration panel's band files: each item of ``panel`` a band file or a folder of them (its image files);
+    PrepareError naming an item that is neither."""
+    out: List[str] = []
+    for p in panel:
+        if os.path.isdir(p):
+            out += band_files(p)
+        elif os.path.isfile(p):
+            out.append(p)
+        else:
+            raise PrepareError(f"calibration panel {p}: no such file or folder")
+    return out
+
+
+def _apart_from_panel(paths: Sequence[str], panel: Sequence[str]) -> Tuple[List[str], List[str]]:
+    """The flight's band files without the panel's own files (a panel capture left in the band folder and given
+    as the panel), and the warning saying so."""
+    own = {os.path.realpath(p) for p in panel}
+    kept = [p for p in paths if os.path.realpath(p) not in own]
+    gone = len(paths) - len(kept)
+    return kept, ([f"{gone} band file(s) of the calibration panel lie among the band files: used as the panel, not "
+                   "stacked"] if gone else [])
+
+
+def _panel_captures(panel: Sequence[str], names: Sequence[str], flight: Sequence[Capture]) -> List[Capture]:
+    """The panel's captures (RGB frames aside), checked against the flight's rig: every band of the flight, no
+    other band, the same frame size and rig name.  PrepareError naming the files otherwise."""
+    block = read_block(panel)
+    caps = [dataclasses.replace(c, bands=tuple(b for b in c.bands if not b.is_rgb)) for c in block.captures]
+    caps = [c for c in caps if c.bands]
+    if not caps:
+        raise PrepareError(f"the calibration panel's {len(panel)} file(s) hold no band file of a rig "
+                           f"({', '.join(os.path.basename(p) for p in panel[:6])})")
+    own = {band_key(b.band_name): b for c in flight for b in c.bands}
+    rigs = {b.rig_name for b in own.values()}
+    errors = []
+    for cap in caps:
+        files = ", ".join(b.name for b in cap.bands)
+        other = [b for b in cap.bands if band_key(b.band_name) not in own or b.rig_name not in rigs
+                 or (b.width, b.height) != (own[band_key(b.band_name)].width, own[band_key(b.band_name)].height)]
+        if other:
+            ref = next(iter(own.values()))
+            errors.append(f"panel capture {cap.capture_id}: "
+                          + ", ".join(f"{b.name} (band {b.band_name}, {b.width} x {b.height} px, rig {b.rig_name})"
+                                      for b in other)
+                          + f" not of the flight's camera (bands {', '.join(names)}, {ref.width} x {ref.height} px, "
+                            f"rig {ref.rig_name})")
+        missing = [n for n in names if cap.band(n) is None]
+        if missing:
+            errors.append(f"panel capture {cap.capture_id} lacks band {', '.join(missing)} (files: {files}): the "
+                          "panel is photographed in every band")
+    if errors:
+        raise PrepareError("the calibration panel cannot be used:\n- " + "\n- ".join(errors))
+    return caps
+
+
+def calibrate_panel(panel: Sequence[str], names: Sequence[str], flight: Sequence[Capture],
+                    options: CaptureStackOptions, progress: Progress) -> Tuple[Dict[str, PanelBand], List[str]]:
+    """band name -> the calibration panel's measurement (core.prepare.band_radiometry.PanelBand: the panel's
+    reflectance over its corrected value, the mean over the panel's captures), and the warnings (captures that
+    disagree).  Every panel band file is corrected as the flight's are (``options.radiometry``) and measured in
+    the central window; errors (PrepareError, BandRadiometryError) name every file at fault, before any stacking."""
+    caps = _panel_captures(panel, names, flight)
+    own = {}
+    for c in flight:
+        for b in c.bands:
+            own.setdefault(band_key(b.band_name), b)
+    reflectance = panel_for_bands(parse_panel_reflectance(options.panel_reflectance),
+                                  [own[band_key(n)] for n in names])
+    infos = [c.band(n) for c in caps for n in names]
+    factors = check_bands(infos, options.radiometry)
+    values: Dict[str, float] = {}
+    errors = []
+    for b in infos:
+        check_cancel(progress)
+        with RasterFile(b.path, "panel band file") as r:
+            raw = r.read(1)
+        try:
+            values[b.path] = measure_panel(correct(raw, b, factors[b.path]), raw, b.path, options.panel_window)
+        except BandRadiometryError as e:
+            errors.append(str(e))
+    if errors:
+        raise BandRadiometryError(f"the calibration panel cannot be measured in {len(errors)} file(s): "
+                                  + "; ".join(errors))
+    out = {n: PanelBand(n, reflectance[n], tuple(c.band(n).path for c in caps),
+                        tuple(values[c.band(n).path] for c in caps), tuple(c.capture_id for c in caps))
+           for n in names}
+    return out, panel_warnings(list(out.values()), options.radiometry)
+
+
 def _check_output(output_dir: str, paths: Sequence[str]) -> None:
     inputs = {os.path.realpath(os.path.dirname(p)) for p in paths}
     if os.path.realpath(output_dir) in inputs:
@@ -137,18 +273,45 @@ def _check_output(output_dir: str, paths: Sequence[str]) -> None:
                            "input is written over")
 
 
+def _panel_apart(captures: Sequence[Capture], panel: Dict[str, PanelBand]) -> Tuple[List[Capture], List[str]]:
+    """The flight's captures without those that are the panel's (a copy of a panel capture left in the band
+    folder: the same capture id), and the warning saying so."""
+    ids = {c for p in panel.values() for c in p.captures if c}
+    kept = [c for c in captures if c.capture_id not in ids]
+    gone = [c.capture_id for c in captures if c.capture_id in ids]
+    return kept, ([f"capture(s) {', '.join(gone)} among the band files are the calibration panel's (same capture "
+                   "id): not stacked"] if gone else [])
+
+
+def _describe_panel(panel: Dict[str, PanelBand], mode: str) -> str:
+    return (f"calibration panel ({mode} radiometry), reflectance = factor x corrected value: "
+            + "; ".join(f"{n}: panel {p.reflectance:g}, value {p.value:.6g}, factor {p.factor:.6g}"
+                        + (f", captures differ by {100 * p.disagreement:.1f} %" if len(p.values) > 1 else "")
+                        for n, p in panel.items()))
+
+
 def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
                    progress: Optional[Progress] = None) -> CaptureStackResult:
     """Register every capture of the band files ``paths`` and write it as one multi-band photo (module
-    docstring).  Errors (PrepareError, MultispectralError, BandRegistrationError) name the files, before any photo
-    is written for what the block's metadata already shows."""
+    docstring).  Errors (PrepareError, MultispectralError, BandRegistrationError, BandRadiometryError) name the
+    files, before any photo is written for what the block's metadata and the calibration panel already show."""
     progress = progress or NullProgress()
-    _check_output(options.output_dir, paths)
+    panel_paths = panel_files(options.panel)
+    _check_output(options.output_dir, list(paths) + panel_paths)
+    paths, notes = _apart_from_panel(paths, panel_paths)
     captures, names, warnings, (primary, why) = _band_captures(paths)
+    warnings += notes
+    panel: Dict[str, PanelBand] = {}
+    if panel_paths:
+        panel, more = calibrate_panel(panel_paths, names, captures, options, progress)
+        captures, notes = _panel_apart(captures, panel)
+        warnings += more + notes
+        progress.info(_describe_panel(panel, options.radiometry))
     # the captures stacked (a capture lacking a band is left out below): their bands checked before any work
     every_band = [b for cap in captures if all(cap.band(n) is not None for n in names) for b in cap.bands]
     factors = check_bands(every_band, options.radiometry)  # a band lacking what the radiometry needs: before work
     scales = block_scales(every_band, factors)
+    scales.update({n: p.factor for n, p in panel.items()})  # with a panel: reflectance
     by_path = {b.path: b for b in every_band}
 
     def prepare(path, pixels):
@@ -179,15 +342,22 @@ def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
         md = {"REFERENCE_BAND": reg.reference, "CAPTURE": cap.capture_id, PRIMARY_BAND: primary,
               PRIMARY_BAND + "_REASON": why,
               "BAND_FILES": ",".join(infos[n].name for n in order_names),
-              **describe(options.radiometry, [infos[n] for n in order_names], factors, scales)}
+              **describe(options.radiometry, [infos[n] for n in order_names], factors, scales, panel)}
+        bmd = [band_metadata(options.radiometry, _panel_of(panel, n)) for n in order_names]
         write_band_stack(path, reg.bands[order], order_names, md,
                          [infos[n].central_wavelength_nm for n in order_names],
-                         capture_exif(ref.path, reg.frame.f, width, height), dtype="uint16")
+                         capture_exif(ref.path, reg.frame.f, width, height),
+                         "reflectance" if panel else "uint16", bmd)
         photos.append(path)
         for r in reg.results[1:]:
             worst[r.camera.name] = max(worst.get(r.camera.name, 0.0), float(r.refined_residual.worst))
         progress.report((k + 1) / len(captures), f"captures: {k + 1}/{len(captures)} stacked")
-    return CaptureStackResult(photos, order_names, left_out, worst, warnings)
+    unit = band_metadata(options.radiometry, next(iter(panel.values()), None))["RADIOMETRIC_UNIT"]
+    return CaptureStackResult(photos, order_names, left_out, worst, warnings, panel, unit)
+
+
+def _panel_of(panel: Dict[str, PanelBand], name: str) -> Optional[PanelBand]:
+    return next((p for n, p in panel.items() if band_key(n) == band_key(name)), None)
 
 
 def stack_capture_folder(folder: str, options: CaptureStackOptions,
