@@ -551,6 +551,8 @@ class WoodlandBlock:
             try:
                 with multiprocessing.get_context("fork").Pool(jobs) as pool:
                     paths = pool.map(_render_shot, range(len(self.shots)), chunksize=1)
+                    pool.close()  # the workers end by themselves: no SIGTERM (pycolmap's handler would print it)
+                    pool.join()
             finally:
                 _RENDERING = None
         else:
