@@ -3098,7 +3098,7 @@ The other parameters are those of the single stages (see their help); 0 means au
 Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures.</source>
         <translation>Die gesamte Verarbeitung in einem Aufruf, für die Stapelverarbeitung: Bilder ausrichten, Georeferenzieren, DOM erzeugen, Orthophoto erzeugen und Genauigkeitsbericht in einem Arbeitsbereich. Es werden dieselben Funktionen wie in den einzelnen Algorithmen aufgerufen; ein erneuter Lauf setzt fort (bereits berechnete Merkmale, Zuordnungen und Stereopaare werden wiederverwendet).
 
-Bilderordner: die Fotos; ein Ordner mit den Kanaldateien einer Multispektralkamera (Parrot Sequoia, MicaSense, DJI Multispektral) wird erkannt, und ihre Aufnahmen werden zuerst zu mehrkanaligen Fotos in &lt;workspace&gt;/captures gestapelt (wie &apos;Multispektrale Aufnahmen stapeln&apos;, normalisierte Radiometrie), die die Kette dann nimmt. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben werden.
+Bilderordner: die Fotos; ein Ordner mit den Kanaldateien einer Multispektralkamera (Parrot Sequoia, MicaSense, DJI Multispektral) wird erkannt, und ihre Aufnahmen werden zuerst zu mehrkanaligen Fotos in &lt;workspace&gt;/captures gestapelt (wie 'Multispektrale Aufnahmen stapeln', normalisierte Radiometrie), die die Kette dann nimmt. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben werden.
 Die Georeferenzierung braucht Passpunkte (eine Passpunktdatei oder ein Passpunktlayer, Kontrollpunkte werden zurückgehalten) und/oder Kamerapositionen (eine CSV-Datei der Kamerapositionen oder EXIF-GPS-Positionen verwenden): ohne sie wird die Verarbeitung abgelehnt, da ein DOM einen metrischen Maßstab und eine Lotrichtung braucht. GCP-Pixel auf aufrechten Fotos gemessen: wie bei 'Georeferenzieren' (die Pixelkoordinaten auf den Fotos gemessen, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden).
 Zu findende Zielmarken (statt einer Passpunktdatei oder eines Passpunktlayers): die vermessenen Koordinaten von am Boden ausgelegten Zielmarken; nach der Ausrichtung findet 'Zielmarken finden' sie auf den Fotos, und seine Messungen sind die Passpunkte (Art der Zielmarken, erweitert: wie in 'Zielmarken finden').
 Kamerakalibrierungsdatei und Innere Orientierung (erweitert): wie in 'Bilder ausrichten' (eine kalibrierte Kamera durch die ganze Kette festgehalten oder mit ihren Standardabweichungen verbessert).
@@ -3205,32 +3205,32 @@ Indexraster: wohin das Float32-Cloud-Optimized-GeoTIFF geschrieben wird (NoData 
 <context>
     <name>StackCapturesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/stack_captures.py" line="49"/>
+        <location filename="../processing_provider/stack_captures.py" line="69"/>
         <source>Band folder</source>
         <translation>Kanalordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/stack_captures.py" line="49"/>
+        <location filename="../processing_provider/stack_captures.py" line="69"/>
         <source>Radiometry</source>
         <translation>Radiometrie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/stack_captures.py" line="49"/>
+        <location filename="../processing_provider/stack_captures.py" line="69"/>
         <source>Reference band</source>
         <translation>Referenzkanal</translation>
     </message>
     <message>
-        <location filename="../processing_provider/stack_captures.py" line="57"/>
+        <location filename="../processing_provider/stack_captures.py" line="82"/>
         <source>Output folder</source>
         <translation>Ausgabeordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/stack_captures.py" line="58"/>
+        <location filename="../processing_provider/stack_captures.py" line="83"/>
         <source>Photos written</source>
         <translation>Geschriebene Fotos</translation>
     </message>
     <message>
-        <location filename="../processing_provider/stack_captures.py" line="59"/>
+        <location filename="../processing_provider/stack_captures.py" line="84"/>
         <source>Captures left out</source>
         <translation>Ausgelassene Aufnahmen</translation>
     </message>
@@ -3240,17 +3240,38 @@ Indexraster: wohin das Float32-Cloud-Optimized-GeoTIFF geschrieben wird (NoData 
         <translation>Multispektrale Aufnahmen stapeln</translation>
     </message>
     <message>
+        <location filename="../processing_provider/stack_captures.py" line="69"/>
+        <source>Calibration panel folder</source>
+        <translation>Kalibrierpanel-Ordner</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="69"/>
+        <source>Panel reflectance</source>
+        <translation>Panelreflexion</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="69"/>
+        <source>Panel window</source>
+        <translation>Panelfenster</translation>
+    </message>
+    <message>
         <location filename="../ui/catalog.py" line="8"/>
         <source>Turns the band files of a multispectral rig (Parrot Sequoia, MicaSense RedEdge / Altum, DJI P4 Multispectral / Mavic 3M: one 16-bit TIFF per band per capture) into one multi-band photo per capture, which Align images, Run pipeline and Build orthophoto take like any photo: the orthomosaic then has every band, and Spectral index makes NDVI or NDRE of it. The files of one capture are grouped by their capture id (else rig name and time); each band is undistorted with its own lens model from its metadata, turned by its rig rotation and registered onto the reference band by phase correlation on gradients. The photo&apos;s bands are NIR, Red, Green first (QGIS shows them as a false-colour NIR-R-G view), each named with its wavelength; the capture&apos;s GPS is in its EXIF. A capture missing a band is left out and named in the log; the band folder is never written into.
 
 Band folder: the folder of band files (the RGB camera&apos;s frames in it are not stacked).
 Radiometry: normalised (default) removes each band&apos;s dark level, corrects its vignetting from the file&apos;s model and normalises exposure time and gain to the block&apos;s; irradiance also divides by the sun sensor&apos;s irradiance for that band (values proportional to reflectance when the light changes during the flight); raw keeps the numbers as recorded. A band file lacking what the choice needs (an exposure time, a sun-sensor reading) stops the run before any work, naming the file. The photo&apos;s metadata says what was done (and per band the vignetting model, dark level and scale).
+Calibration panel folder (optional): the band files of the calibration panel&apos;s captures (one capture of the panel of known reflectance in every band, before and / or after the flight, as MicaSense, DJI and Parrot ask for), in a folder of their own. With it the photos hold reflectance (0..1, float32, 0 where a band does not reach) instead of 16-bit numbers: each band is scaled by the panel&apos;s reflectance over the panel&apos;s value after the same radiometry (normalised: the panel fixes each band under the light of its capture; irradiance: the sun sensor follows the light&apos;s changes during the flight); before and after panels are averaged, and a warning says when they differ by more than 3 %. The panel is measured in the centre of its photo: a centre that is saturated or not uniform (no panel there) stops the run before any work, naming the file; so do a panel of another camera, a panel capture missing a band, and a panel reflectance for a band the rig lacks. Panel files left among the band files are not stacked.
+Panel reflectance: the panel&apos;s reflectance from its calibration sheet: one number for every band (0.5), per band (Green=0.49,Red=0.50,Red edge=0.50,NIR=0.49), or the path of a CSV file of rows band name or wavelength in nm, reflectance (a curve of wavelengths is interpolated at each band&apos;s centre). Needed with a calibration panel folder.
+Panel window (advanced): the side of the central square the panel is measured in, a fraction of the photo&apos;s short side (default 0.25); smaller when the panel fills less of the frame.
 Reference band (advanced): the band the others are registered onto; empty: the rig&apos;s reference camera.
 Output folder: where the multi-band photos are written (one per capture, named after its band files without the band suffix); not the band folder.</source>
         <translation>Macht aus den Kanaldateien einer Multispektralkamera (Parrot Sequoia, MicaSense RedEdge / Altum, DJI P4 Multispectral / Mavic 3M: ein 16-Bit-TIFF je Kanal und Aufnahme) ein mehrkanaliges Foto je Aufnahme, das Bilder ausrichten, Pipeline ausführen und Orthophoto erzeugen wie jedes Foto nehmen: das Orthomosaik hat dann jeden Kanal, und Spektralindex berechnet daraus NDVI oder NDRE. Die Dateien einer Aufnahme werden nach ihrer Aufnahme-ID gruppiert (sonst nach Rig-Name und Zeit); jeder Kanal wird mit seinem eigenen Objektivmodell aus seinen Metadaten entzerrt, um seine Rig-Rotation gedreht und durch Phasenkorrelation auf Gradienten auf den Referenzkanal registriert. Die Kanäle des Fotos beginnen mit NIR, Rot, Grün (QGIS zeigt sie als Falschfarbenansicht NIR-R-G), jeder mit seiner Wellenlänge benannt; das GPS der Aufnahme steht in seinem EXIF. Eine Aufnahme, der ein Kanal fehlt, wird ausgelassen und im Protokoll genannt; in den Kanalordner wird nie geschrieben.
 
 Kanalordner: der Ordner der Kanaldateien (die Bilder der RGB-Kamera darin werden nicht gestapelt).
 Radiometrie: normalisiert (Standard) zieht von jedem Kanal seinen Dunkelwert ab, korrigiert seine Vignettierung nach dem Modell der Datei und normalisiert Belichtungszeit und Verstärkung auf die des Blocks; Einstrahlung teilt zusätzlich durch die Einstrahlung des Sonnensensors für diesen Kanal (Werte proportional zur Reflexion, wenn sich das Licht während des Flugs ändert); roh behält die Werte wie aufgenommen. Eine Kanaldatei, der fehlt, was die Wahl braucht (eine Belichtungszeit, ein Sonnensensorwert), beendet den Lauf vor jeder Arbeit und nennt die Datei. Die Metadaten des Fotos sagen, was getan wurde (und je Kanal das Vignettierungsmodell, der Dunkelwert und der Maßstab).
+Kalibrierpanel-Ordner (optional): die Kanaldateien der Aufnahmen des Kalibrierpanels (eine Aufnahme des Panels bekannter Reflexion in jedem Kanal, vor und / oder nach dem Flug, wie MicaSense, DJI und Parrot es verlangen), in einem eigenen Ordner. Damit enthalten die Fotos Reflexion (0..1, float32, 0 wo ein Kanal nicht hinreicht) statt 16-Bit-Werten: jeder Kanal wird mit der Reflexion des Panels geteilt durch den Wert des Panels nach derselben Radiometrie skaliert (normalisiert: das Panel legt jeden Kanal unter dem Licht seiner Aufnahme fest; Einstrahlung: der Sonnensensor folgt den Lichtänderungen während des Flugs); Panels vor und nach dem Flug werden gemittelt, und eine Warnung sagt, wenn sie um mehr als 3 % abweichen. Das Panel wird in der Mitte seines Fotos gemessen: eine Mitte, die gesättigt oder nicht gleichmäßig ist (kein Panel dort), beendet den Lauf vor jeder Arbeit und nennt die Datei; ebenso ein Panel einer anderen Kamera, eine Panelaufnahme, der ein Kanal fehlt, und eine Panelreflexion für einen Kanal, den das Rig nicht hat. Paneldateien, die unter den Kanaldateien liegen, werden nicht gestapelt.
+Panelreflexion: die Reflexion des Panels laut seinem Kalibrierblatt: eine Zahl für jeden Kanal (0.5), je Kanal (Green=0.49,Red=0.50,Red edge=0.50,NIR=0.49) oder der Pfad einer CSV-Datei mit Zeilen Kanalname oder Wellenlänge in nm, Reflexion (eine Kurve von Wellenlängen wird an der Mitte jedes Kanals interpoliert). Nötig mit einem Kalibrierpanel-Ordner.
+Panelfenster (erweitert): die Seite des mittleren Quadrats, in dem das Panel gemessen wird, als Anteil der kurzen Seite des Fotos (Standard 0.25); kleiner, wenn das Panel weniger vom Bild füllt.
 Referenzkanal (erweitert): der Kanal, auf den die anderen registriert werden; leer: die Referenzkamera des Rigs.
 Ausgabeordner: wohin die mehrkanaligen Fotos geschrieben werden (eines je Aufnahme, benannt nach ihren Kanaldateien ohne die Kanalendung); nicht der Kanalordner.</translation>
     </message>

@@ -3205,32 +3205,32 @@ Raster dell'indice: dove scrivere il GeoTIFF Cloud-Optimized float32 (nodata -99
 <context>
     <name>StackCapturesAlgorithm</name>
     <message>
-        <location filename="../processing_provider/stack_captures.py" line="49"/>
+        <location filename="../processing_provider/stack_captures.py" line="69"/>
         <source>Band folder</source>
         <translation>Cartella delle bande</translation>
     </message>
     <message>
-        <location filename="../processing_provider/stack_captures.py" line="49"/>
+        <location filename="../processing_provider/stack_captures.py" line="69"/>
         <source>Radiometry</source>
         <translation>Radiometria</translation>
     </message>
     <message>
-        <location filename="../processing_provider/stack_captures.py" line="49"/>
+        <location filename="../processing_provider/stack_captures.py" line="69"/>
         <source>Reference band</source>
         <translation>Banda di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/stack_captures.py" line="57"/>
+        <location filename="../processing_provider/stack_captures.py" line="82"/>
         <source>Output folder</source>
         <translation>Cartella di uscita</translation>
     </message>
     <message>
-        <location filename="../processing_provider/stack_captures.py" line="58"/>
+        <location filename="../processing_provider/stack_captures.py" line="83"/>
         <source>Photos written</source>
         <translation>Foto scritte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/stack_captures.py" line="59"/>
+        <location filename="../processing_provider/stack_captures.py" line="84"/>
         <source>Captures left out</source>
         <translation>Acquisizioni escluse</translation>
     </message>
@@ -3240,17 +3240,38 @@ Raster dell'indice: dove scrivere il GeoTIFF Cloud-Optimized float32 (nodata -99
         <translation>Impila acquisizioni multispettrali</translation>
     </message>
     <message>
+        <location filename="../processing_provider/stack_captures.py" line="69"/>
+        <source>Calibration panel folder</source>
+        <translation>Cartella del pannello di calibrazione</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="69"/>
+        <source>Panel reflectance</source>
+        <translation>Riflettanza del pannello</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/stack_captures.py" line="69"/>
+        <source>Panel window</source>
+        <translation>Finestra del pannello</translation>
+    </message>
+    <message>
         <location filename="../ui/catalog.py" line="8"/>
         <source>Turns the band files of a multispectral rig (Parrot Sequoia, MicaSense RedEdge / Altum, DJI P4 Multispectral / Mavic 3M: one 16-bit TIFF per band per capture) into one multi-band photo per capture, which Align images, Run pipeline and Build orthophoto take like any photo: the orthomosaic then has every band, and Spectral index makes NDVI or NDRE of it. The files of one capture are grouped by their capture id (else rig name and time); each band is undistorted with its own lens model from its metadata, turned by its rig rotation and registered onto the reference band by phase correlation on gradients. The photo&apos;s bands are NIR, Red, Green first (QGIS shows them as a false-colour NIR-R-G view), each named with its wavelength; the capture&apos;s GPS is in its EXIF. A capture missing a band is left out and named in the log; the band folder is never written into.
 
 Band folder: the folder of band files (the RGB camera&apos;s frames in it are not stacked).
 Radiometry: normalised (default) removes each band&apos;s dark level, corrects its vignetting from the file&apos;s model and normalises exposure time and gain to the block&apos;s; irradiance also divides by the sun sensor&apos;s irradiance for that band (values proportional to reflectance when the light changes during the flight); raw keeps the numbers as recorded. A band file lacking what the choice needs (an exposure time, a sun-sensor reading) stops the run before any work, naming the file. The photo&apos;s metadata says what was done (and per band the vignetting model, dark level and scale).
+Calibration panel folder (optional): the band files of the calibration panel&apos;s captures (one capture of the panel of known reflectance in every band, before and / or after the flight, as MicaSense, DJI and Parrot ask for), in a folder of their own. With it the photos hold reflectance (0..1, float32, 0 where a band does not reach) instead of 16-bit numbers: each band is scaled by the panel&apos;s reflectance over the panel&apos;s value after the same radiometry (normalised: the panel fixes each band under the light of its capture; irradiance: the sun sensor follows the light&apos;s changes during the flight); before and after panels are averaged, and a warning says when they differ by more than 3 %. The panel is measured in the centre of its photo: a centre that is saturated or not uniform (no panel there) stops the run before any work, naming the file; so do a panel of another camera, a panel capture missing a band, and a panel reflectance for a band the rig lacks. Panel files left among the band files are not stacked.
+Panel reflectance: the panel&apos;s reflectance from its calibration sheet: one number for every band (0.5), per band (Green=0.49,Red=0.50,Red edge=0.50,NIR=0.49), or the path of a CSV file of rows band name or wavelength in nm, reflectance (a curve of wavelengths is interpolated at each band&apos;s centre). Needed with a calibration panel folder.
+Panel window (advanced): the side of the central square the panel is measured in, a fraction of the photo&apos;s short side (default 0.25); smaller when the panel fills less of the frame.
 Reference band (advanced): the band the others are registered onto; empty: the rig&apos;s reference camera.
 Output folder: where the multi-band photos are written (one per capture, named after its band files without the band suffix); not the band folder.</source>
         <translation>Trasforma i file di banda di una camera multispettrale (Parrot Sequoia, MicaSense RedEdge / Altum, DJI P4 Multispectral / Mavic 3M: un TIFF a 16 bit per banda per acquisizione) in una foto multibanda per acquisizione, che Allinea immagini, Esegui pipeline e Crea ortofoto prendono come qualsiasi foto: l'ortomosaico ha allora ogni banda, e Indice spettrale ne calcola NDVI o NDRE. I file di un'acquisizione sono raggruppati per il loro ID di acquisizione (altrimenti per nome del rig e ora); ogni banda è raddrizzata con il proprio modello d'obiettivo dai suoi metadati, ruotata della sua rotazione nel rig e registrata sulla banda di riferimento per correlazione di fase sui gradienti. Le bande della foto iniziano con NIR, Rosso, Verde (QGIS le mostra come vista a falsi colori NIR-R-G), ciascuna nominata con la sua lunghezza d'onda; il GPS dell'acquisizione è nel suo EXIF. Un'acquisizione a cui manca una banda è esclusa e nominata nel registro; nella cartella delle bande non si scrive mai.
 
 Cartella delle bande: la cartella dei file di banda (le immagini della camera RGB al suo interno non sono impilate).
 Radiometria: normalizzato (predefinito) sottrae a ogni banda il suo livello di nero, ne corregge la vignettatura secondo il modello del file e normalizza tempo di esposizione e guadagno a quelli del blocco; irradianza divide inoltre per l'irradianza del sensore solare per quella banda (valori proporzionali alla riflettanza quando la luce cambia durante il volo); grezzo mantiene i valori come registrati. Un file di banda privo di ciò che la scelta richiede (un tempo di esposizione, una lettura del sensore solare) ferma l'esecuzione prima di ogni lavoro, nominando il file. I metadati della foto dicono cosa è stato fatto (e per banda il modello di vignettatura, il livello di nero e la scala).
+Cartella del pannello di calibrazione (opzionale): i file di banda delle acquisizioni del pannello di calibrazione (un'acquisizione del pannello di riflettanza nota in ogni banda, prima e / o dopo il volo, come chiedono MicaSense, DJI e Parrot), in una cartella a sé. Con essa le foto contengono riflettanza (0..1, float32, 0 dove una banda non arriva) invece di valori a 16 bit: ogni banda è scalata dalla riflettanza del pannello divisa per il valore del pannello dopo la stessa radiometria (normalizzato: il pannello fissa ogni banda sotto la luce della sua acquisizione; irradianza: il sensore solare segue i cambiamenti di luce durante il volo); i pannelli di prima e di dopo sono mediati, e un avviso dice quando differiscono di più del 3 %. Il pannello è misurato al centro della sua foto: un centro saturo o non uniforme (nessun pannello lì) ferma l'esecuzione prima di ogni lavoro, nominando il file; così anche un pannello di un'altra camera, un'acquisizione del pannello a cui manca una banda e una riflettanza del pannello per una banda che il rig non ha. I file del pannello lasciati tra i file di banda non sono impilati.
+Riflettanza del pannello: la riflettanza del pannello dal suo foglio di calibrazione: un numero per ogni banda (0.5), per banda (Green=0.49,Red=0.50,Red edge=0.50,NIR=0.49) o il percorso di un file CSV con righe nome della banda o lunghezza d'onda in nm, riflettanza (una curva di lunghezze d'onda è interpolata al centro di ogni banda). Necessaria con una cartella del pannello di calibrazione.
+Finestra del pannello (avanzato): il lato del quadrato centrale in cui si misura il pannello, una frazione del lato corto della foto (predefinito 0.25); più piccola quando il pannello riempie meno dell'inquadratura.
 Banda di riferimento (avanzato): la banda su cui sono registrate le altre; vuoto: la camera di riferimento del rig.
 Cartella di uscita: dove sono scritte le foto multibanda (una per acquisizione, nominata come i suoi file di banda senza il suffisso della banda); non la cartella delle bande.</translation>
     </message>

@@ -232,3 +232,72 @@ def test_bad_panels_are_refused_before_any_work_naming_the_files(flight, tmp_pat
     r = stack_captures(bands[:4], CaptureStackOptions(str(out), panel=(str(small),), panel_reflectance="0.5",
                                                       panel_window=0.1))
     assert len(r.photos) == 1 and r.unit == "reflectance"
+
+
+def test_qgis_process_stacks_with_the_panel(flight, tmp_path):
+    """archaeoortho:stackcaptures headless with Calibration panel folder and Panel reflectance: reflectance photos;
+    a panel reflectance for a band the rig lacks refused with its message, no traceback, nothing written."""
+    import json
+    import subprocess
+
+    from tests.conftest import qgis_process
+
+    _rig, bands, panel, _root = flight
+    exe, env = qgis_process()
+
+    def run(output, *args):
+        return subprocess.run([exe, "--json", "run", "archaeoortho:stackcaptures", "--",
+                               f"INPUT={os.path.dirname(bands[0])}", f"OUTPUT={output}", f"PANEL={panel}", *args],
+                              env=env, capture_output=True, text=True, timeout=300)
+
+    out = run(tmp_path / "photos", "RADIOMETRY=2", "PANEL_REFLECTANCE=Green=0.5,Red=0.5,Red edge=0.5,NIR=0.5",
+              "PANEL_WINDOW=0.2")
+    assert out.returncode == 0, out.stderr[-3000:] + out.stdout[-3000:]
+    assert json.loads(out.stdout)["results"]["PHOTOS"] == 3
+    with RasterFile(str(tmp_path / "photos" / "IMG_0000.tif")) as r:
+        assert r.metadata(1)["RADIOMETRIC_UNIT"] == "reflectance"
+    out = run(tmp_path / "refused", "PANEL_REFLECTANCE=Blue=0.5")
+    text = out.stdout + out.stderr
+    assert out.returncode != 0 and "the rig has no band Blue" in text and "Traceback" not in text, text[-2000:]
+    assert not (tmp_path / "refused").exists() or not os.listdir(tmp_path / "refused")
+
+
+# ---------------------------------------------------------------- through the chain
+@pytest.mark.slow
+def test_the_orthomosaic_of_reflectance_photos_is_reflectance(tmp_path):
+    """Ten captures stacked with the panel (irradiance radiometry) -> Run pipeline on the photos -> the
+    orthomosaic: float32, each band stating reflectance, within 2 % of the true reflectance over open ground (the
+    ortho leaves the values as they are: no exposure gains, no radiometric model); NDVI of it against the truth's."""
+    from core import pipeline
+    from core.align.options import AlignOptions
+    from core.spectral.index import spectral_index
+    from core.spectral.options import IndexOptions
+    from tests import synthetic as syn
+
+    rig = rs.rig_block(n_strips=2, per_strip=5)
+    bands = rs.render(rig, str(tmp_path / "bands"), supersample=1)
+    ps.render_panel(rig, str(tmp_path / "panel"), "0", 0.5, light=1.25, seed=0)
+    ps.render_panel(rig, str(tmp_path / "panel"), "1", 0.5, light=0.8, seed=1)
+    stack = stack_captures(bands, CaptureStackOptions(str(tmp_path / "photos"), radiometry="irradiance",
+                                                      panel=(str(tmp_path / "panel"),), panel_reflectance="0.5"))
+    assert len(stack.photos) == 10
+    result = pipeline.run_pipeline(str(tmp_path / "photos"), str(tmp_path / "ws"), pipeline.PipelineOptions(
+        align=AlignOptions(num_threads=2), make_report=False),
+        pipeline.Control(camera_positions_path=str(tmp_path / "camera_positions.csv")))
+    assert result.align.registered == 10
+    assert any("calibrated reflectance" in line for line in result.ortho.log_lines)
+    with RasterFile(result.ortho.orthomosaic) as r:
+        assert r.count == 4 and r.band(1).DataType == 6  # float32, NaN = no data (no alpha band)
+        assert [r.band(i + 1).GetDescription() for i in range(4)] == ["NIR", "Red", "Green", "Red edge"]
+        assert all(r.metadata(i + 1)["RADIOMETRIC_UNIT"] == "reflectance" for i in range(4))
+    data, x, y, valid = rs._ortho_bands(result.ortho.orthomosaic)
+    ground = valid & ~rig.block.scene.near_feature(x - syn.ORIGIN[0], y - syn.ORIGIN[1], 1.5)
+    assert ground.sum() > 20000
+    errors = {b: float(np.median(v[ground] / rig.reflectance(b, x, y)[ground]) - 1.0) for b, v in data.items()}
+    assert max(abs(e) for e in errors.values()) < 0.02, errors
+    out = spectral_index(IndexOptions(input=result.ortho.orthomosaic, output=str(tmp_path / "ndvi.tif")))
+    with RasterFile(out.path) as r:
+        ndvi = r.read(1).astype(float)
+    ok = ground & np.isfinite(ndvi)
+    truth = rig.ndvi(x, y)
+    assert np.median(np.abs(ndvi[ok] - truth[ok])) < 0.01

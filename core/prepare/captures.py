@@ -299,6 +299,9 @@ def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
     panel_paths = panel_files(options.panel)
     _check_output(options.output_dir, list(paths) + panel_paths)
     paths, notes = _apart_from_panel(paths, panel_paths)
+    if panel_paths and not paths:
+        raise PrepareError(f"every band file is the calibration panel's ({', '.join(options.panel)}): put the "
+                           "panel's captures in a folder of their own, apart from the flight's band files")
     captures, names, warnings, (primary, why) = _band_captures(paths)
     warnings += notes
     panel: Dict[str, PanelBand] = {}
