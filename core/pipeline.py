@@ -11,6 +11,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import os
+import shutil
 import time
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence
@@ -27,6 +28,7 @@ from .georef.targets.options import FindTargetsOptions
 from .georef.targets.stage import find_targets
 from .io.gcp import GCPSet, apply_check_points, read_camera_positions, read_gcps, read_target_coordinates
 from .io.images import list_images, require_images
+from .io.multispectral import band_files, read_band_info
 from .ortho.options import OrthoOptions
 from .ortho.stage import build_orthophoto_workspace
 from .prepare.captures import CaptureStackOptions, is_band_folder, stack_capture_folder
@@ -102,6 +104,8 @@ class PipelineResult:
     relief: object = None
     targets: object = None  # Find targets' result (core.georef.targets.stage.FindTargetsResult) when it ran
     captures: object = None  # the band folder's stacked captures (core.prepare.captures.CaptureStackResult)
+    rgb_frames: List[str] = field(default_factory=list)  # the rig's RGB frames aligned with the captures
+    ortho_rgb: object = None  # their orthomosaic (the orthophoto stage's result), beside the captures' one
     seconds: Dict[str, float] = field(default_factory=dict)
     # CPU seconds per stage (this process and its pool workers, os.times(): load-independent, unlike ``seconds``)
     cpu_seconds: Dict[str, float] = field(default_factory=dict)
@@ -116,18 +120,62 @@ SPANS = {CAPTURES: (0.0, 0.05), PREPARE: (0.0, 0.05), ALIGN: (0.0, 0.40), FIND_T
          TERRAIN: (0.9, 0.92), RELIEF: (0.92, 0.95), REPORT: (0.95, 1.0)}
 
 
+def rig_rgb_frames(folder: str) -> List[str]:
+    """The rig's RGB frames among a band folder's files (core.io.multispectral: a three-band Red, Green, Blue
+    frame of a capture), sorted."""
+    return sorted(p for p in band_files(folder) if read_band_info(p).is_rgb)
+
+
+def _place(src: str, dst: str) -> None:
+    """``src`` at ``dst``: a hard link (no copy of the photo), else a copy; an older file there is replaced."""
+    if os.path.lexists(dst):
+        if os.path.samefile(src, dst):
+            return
+        os.unlink(dst)
+    try:
+        os.link(src, dst)
+    except OSError:
+        shutil.copy2(src, dst)
+
+
 def _stack(images_dir: str, workspace_dir: str, radiometry: str, res: "PipelineResult", progress: Progress) -> str:
-    """The band folder's captures stacked into <workspace>/captures (core.prepare.captures); returns that folder."""
+    """The band folder's captures stacked into <workspace>/captures (core.prepare.captures), the rig's RGB frames
+    beside them (aligned in one block with the captures: ``res.rgb_frames``); returns that folder."""
     out = os.path.join(workspace_dir, CAPTURES_DIR)
     res.captures = stack_capture_folder(images_dir, CaptureStackOptions(out, radiometry=radiometry), progress)
-    kept = {os.path.basename(p) for p in res.captures.photos}
-    for name in os.listdir(out):  # an earlier run's photo of a capture no longer in the folder: not aligned now
-        if name.lower().endswith(".tif") and name not in kept:
+    frames = rig_rgb_frames(images_dir)
+    for path in frames:
+        _place(path, os.path.join(out, os.path.basename(path)))
+    res.rgb_frames = [os.path.basename(p) for p in frames]
+    kept = {os.path.basename(p) for p in res.captures.photos} | set(res.rgb_frames)
+    for name in list_images(out):  # an earlier run's photo no longer in the band folder: not aligned now
+        if name not in kept:
             os.unlink(os.path.join(out, name))
     res.warnings += res.captures.warnings + [f"capture {c} left out: {why}" for c, why in res.captures.left_out.items()]
-    progress.info(f"captures: {len(res.captures.photos)} multi-band photo(s) of {', '.join(res.captures.bands)} "
+    rgb = f" and the rig's {len(frames)} RGB frame(s)" if frames else ""
+    progress.info(f"captures: {len(res.captures.photos)} multi-band photo(s) of {', '.join(res.captures.bands)}{rgb} "
                   f"in {out} ({radiometry} radiometry)")
     return out
+
+
+def _orthophotos(run, workspace_dir: str, options: OrthoOptions, res: "PipelineResult") -> None:
+    """The orthophoto stage; a band folder with the rig's RGB frames (aligned as one block, one DSM) gives two
+    mosaics of one kind each: the RGB frames' (``orthomosaic_rgb.tif`` beside the orthomosaic) first, then the
+    captures' multi-band one, the stage's record (unless IMAGES_FILTER chose the photos)."""
+    if res.captures is None or not res.rgb_frames or options.images_filter:
+        res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, options)
+        res.warnings += res.ortho.warnings
+        return
+    lo, hi = SPANS[ORTHOPHOTO]
+    mid = lo + (hi - lo) * 0.4
+    stacks = [os.path.basename(p) for p in res.captures.photos]
+    main = options.output or os.path.join(workspace_dir, "orthomosaic.tif")
+    rgb = dataclasses.replace(options, images_filter=", ".join("!" + n for n in stacks),
+                              output=os.path.splitext(main)[0] + "_rgb.tif", per_image_folder=None, seamlines=None)
+    res.ortho_rgb = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, rgb, span=(lo, mid))
+    bands = dataclasses.replace(options, images_filter=", ".join("!" + n for n in res.rgb_frames))
+    res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, bands, span=(mid, hi))
+    res.warnings += res.ortho_rgb.warnings + res.ortho.warnings
 
 
 def check_inputs(images_dir: str, control: Control) -> None:
@@ -189,8 +237,8 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
         progress.info(f"--- stage {name} ---")
         t0, c0 = time.time(), cpu_now()
         out = fn(*args, SubProgress(progress, lo, hi))
-        seconds[name] = round(time.time() - t0, 2)
-        cpu_seconds[name] = round(cpu_now() - c0, 2)
+        seconds[name] = round(seconds.get(name, 0.0) + time.time() - t0, 2)  # a stage run twice: both runs
+        cpu_seconds[name] = round(cpu_seconds.get(name, 0.0) + cpu_now() - c0, 2)
         return out
 
     res = PipelineResult(workspace=os.path.abspath(workspace_dir), align=None, georef=None, seconds=seconds,
@@ -222,8 +270,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
     res.warnings += res.georef.warnings
     res.dsm = run(DSM, build_dsm_workspace, workspace_dir, opt.dense)
     res.warnings += res.dsm.warnings
-    res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, opt.ortho)
-    res.warnings += res.ortho.warnings
+    _orthophotos(run, workspace_dir, opt.ortho, res)
     if opt.make_dtm:
         res.dtm = run(TERRAIN, build_dtm_workspace, workspace_dir, opt.terrain)
         if opt.relief.keys:

@@ -179,9 +179,77 @@ def _band_maps(rig: RigBlock, band: str, canvas: Tuple[float, float, float, floa
     return (((xn - x0) / step) - 0.5).astype(np.float32), (((yn - y0) / step) - 0.5).astype(np.float32)
 
 
-def render(rig: RigBlock, folder: str, supersample: int = 2, noise: float = 3.0) -> List[str]:
+# the rig's RGB camera (with ``rgb``): a frame RGB_SCALE x the bands' size, a slightly wider pinhole lens with a
+# little barrel distortion, 1.34 um pixels (the Sequoia's), fired RGB_DELAY_M along the track after the bands and
+# turned by RGB_TURN_DEG from the reference band (its own mount); Blue is the scene's green reflectance x 0.8
+RGB_SCALE = 1.5
+RGB_FIELD = 0.9  # its focal over the bands' focal x RGB_SCALE
+RGB_PX_PER_MM = 1000.0 / 1.34
+RGB_DELAY_M = (0.3, 0.05, 0.02)
+RGB_TURN_DEG = (0.4, -0.3, 0.6)
+RGB_DN = 1300.0  # 8-bit DN per unit of reflectance (the RGB camera's auto-exposure keeps the frames alike)
+
+
+def rgb_camera(rig: RigBlock) -> "syn.CameraModel":
+    w, h = int(round(rig.width * RGB_SCALE)), int(round(rig.height * RGB_SCALE))
+    f = rig.focal * RGB_SCALE * RGB_FIELD
+    return syn.CameraModel(w, h, f, f, w / 2.0, h / 2.0, k1=-0.04)
+
+
+def rgb_shot(shot: "syn.Shot") -> "syn.Shot":
+    """The RGB frame's pose beside the capture's reference band (the truth)."""
+    turn, _ = cv2.Rodrigues(np.radians(np.asarray(RGB_TURN_DEG, dtype=float)))
+    return syn.Shot(shot.name, turn @ shot.rotation, shot.centre + np.asarray(RGB_DELAY_M), shot.kind, shot.strip)
+
+
+def _render_rgb(rig: RigBlock, shot: "syn.Shot", k: int, supersample: int) -> np.ndarray:
+    """(rows, cols, 3) uint8 of the RGB frame of capture ``k``: Red, Green, and 0.8 x Green as blue."""
+    camera = rgb_camera(rig)
+    canvas_xn, map_x, map_y, vignetting = syn._canvas_geometry(camera, supersample)
+    scene = rig.block.scene
+    xyz = syn._ray_cast(scene, shot.centre, shot.rays(canvas_xn))
+    texture = scene.texture_raster()
+    out = []
+    for band, factor in (("Red", 1.0), ("Green", 1.0), ("Green", 0.8)):
+        scene._rasters["texture"] = rig._rasters()[band]
+        try:
+            value = syn._surface_value(scene, xyz).astype(np.float32) * factor
+        finally:
+            scene._rasters["texture"] = texture
+        value = cv2.GaussianBlur(value, (0, 0), 0.45 * supersample)
+        img = cv2.remap(value, map_x, map_y, cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE) * vignetting * RGB_DN
+        img += np.random.default_rng(5000 + k).normal(0.0, 1.5, img.shape)
+        out.append(np.clip(np.round(img), 0, 255).astype(np.uint8))
+    return np.dstack(out)
+
+
+def _rgb_xmp(capture: str) -> str:
+    return ('<x:xmpmeta xmlns:x="adobe:ns:meta/"><rdf:RDF xmlns:rdf="http://www.w3.org/1999/02/22-rdf-syntax-ns#">'
+            '<rdf:Description rdf:about="" xmlns:Camera="http://pix4d.com/camera/1.0/" Camera:RigName="SynthRig" '
+            f'Camera:CaptureUUID="{capture}"><Camera:BandName><rdf:Seq><rdf:li>Red</rdf:li><rdf:li>Green</rdf:li>'
+            '<rdf:li>Blue</rdf:li></rdf:Seq></Camera:BandName></rdf:Description></rdf:RDF></x:xmpmeta>')
+
+
+def _write_rgb(gdal, path: str, rig: RigBlock, rgb: np.ndarray, capture: str, k: int) -> None:
+    camera = rgb_camera(rig)
+    exif = {"EXIF_DateTimeOriginal": f"2024:06:01 10:{k // 60:02d}:{k % 60:02d}", "EXIF_Make": "Synth",
+            "EXIF_Model": "SynthRGB", "EXIF_FocalLength": f"{camera.fx / RGB_PX_PER_MM:.4f}",
+            "EXIF_FocalPlaneXResolution": f"{RGB_PX_PER_MM:.3f}", "EXIF_FocalPlaneYResolution": f"{RGB_PX_PER_MM:.3f}",
+            "EXIF_FocalPlaneResolutionUnit": "4"}
+    ds = gdal.GetDriverByName("GTiff").Create(path, rgb.shape[1], rgb.shape[0], 3, gdal.GDT_Byte,
+                                              ["PHOTOMETRIC=RGB", "COMPRESS=DEFLATE"])
+    for i in range(3):
+        ds.GetRasterBand(i + 1).WriteArray(rgb[:, :, i])
+    ds.SetMetadata(exif, "EXIF")
+    ds.SetMetadata([_rgb_xmp(capture)], "xml:XMP")
+    ds = None
+
+
+def render(rig: RigBlock, folder: str, supersample: int = 2, noise: float = 3.0, rgb: bool = False) -> List[str]:
     """Write every capture's four band files into ``folder`` and the captures' positions beside it; returns the
-    band files.  The photo a capture becomes is named IMG_<k>.tif (core.prepare.captures.photo_names)."""
+    band files.  The photo a capture becomes is named IMG_<k>.tif (core.prepare.captures.photo_names).  With
+    ``rgb`` each capture also has the rig's RGB frame, IMG_<k>_RGB.TIF (:func:`rgb_camera`, :func:`rgb_shot`), with
+    its position in the positions file (returned too)."""
     os.makedirs(folder, exist_ok=True)
     from osgeo import gdal
 
@@ -227,6 +295,13 @@ def render(rig: RigBlock, folder: str, supersample: int = 2, noise: float = 3.0)
             paths.append(path)
         w = shot.centre + syn.ORIGIN
         rows.append(f"IMG_{k:04d}.tif,{w[0]:.3f},{w[1]:.3f},{w[2]:.3f},0.05")
+        if rgb:
+            frame = rgb_shot(shot)
+            path = os.path.join(folder, f"IMG_{k:04d}_RGB.TIF")
+            _write_rgb(gdal, path, rig, _render_rgb(rig, frame, k, supersample), capture, k)
+            paths.append(path)
+            w = frame.centre + syn.ORIGIN
+            rows.append(f"IMG_{k:04d}_RGB.TIF,{w[0]:.3f},{w[1]:.3f},{w[2]:.3f},0.05")
     with open(os.path.join(os.path.dirname(os.path.abspath(folder)), "camera_positions.csv"), "w") as f:
         f.write(f"{syn.CRS}\nimage,x,y,z,sigma\n" + "\n".join(rows) + "\n")
     return paths
@@ -339,3 +414,38 @@ def _patch_ratios(values: np.ndarray, truth: np.ndarray, ground: np.ndarray, siz
             if ground[r0:r0 + size, c0:c0 + size].all():
                 out.append(values[r0:r0 + size, c0:c0 + size].sum() / truth[r0:r0 + size, c0:c0 + size].sum())
     return np.asarray(out, dtype=np.float64)
+
+
+def shift_to_truth(rig: RigBlock, ortho_path: str, band: int, truth_band: str = "Green",
+                   window: int = 64) -> Dict[str, object]:
+    """How far a mosaic's ``band`` (1-based; the RGB mosaic's green, the multi-band mosaic's Green) lies from where
+    the truth puts the scene: phase correlation on gradients between the band and the true ``truth_band``
+    reflectance sampled at the mosaic's cell centres, in windows of ``window`` cells over open ground (1.5 m from
+    buildings and the ditch); the median and 90th percentile of the shift's length in cells, and the cell size."""
+    from core.io.raster import RasterFile
+    from core.prepare.bands import gradient_image, phase_shift
+
+    with RasterFile(ortho_path) as r:
+        values = r.read(band).astype(np.float32)
+        valid = r.band(band).GetMaskBand().ReadAsArray() > 0
+        gt = r.geotransform
+    rows, cols = values.shape
+    jj, ii = np.meshgrid(np.arange(cols) + 0.5, np.arange(rows) + 0.5)
+    x, y = gt[0] + jj * gt[1] + ii * gt[2], gt[3] + jj * gt[4] + ii * gt[5]
+    truth = rig.reflectance(truth_band, x, y).astype(np.float32)
+    ground = valid & (values > 0) & ~rig.block.scene.near_feature(x - syn.ORIGIN[0], y - syn.ORIGIN[1], 1.5)
+    ga, gb = gradient_image(truth), gradient_image(values)
+    shifts = []
+    for r0 in range(0, rows - window, window):
+        for c0 in range(0, cols - window, window):
+            if ground[r0:r0 + window, c0:c0 + window].all():
+                dx, dy, peak = phase_shift(ga[r0:r0 + window, c0:c0 + window], gb[r0:r0 + window, c0:c0 + window])
+                if peak > 0.05:
+                    shifts.append((dx, dy))
+    v = np.asarray(shifts, dtype=float).reshape(-1, 2)
+    length = np.hypot(v[:, 0], v[:, 1])
+    return {"cell": abs(gt[1]), "windows": len(v),
+            "median": round(float(np.median(length)), 3) if len(v) else None,
+            "p90": round(float(np.percentile(length, 90)), 3) if len(v) else None,
+            # the median shift as a ground vector (m, x east, y north): where the mosaic puts the scene
+            "shift_m": tuple(round(float(c), 4) for c in np.median(v, axis=0) * (gt[1], gt[5])) if len(v) else None}

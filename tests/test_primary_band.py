@@ -8,11 +8,11 @@ import os
 import numpy as np
 
 
-def _stack(path, bands, names, primary):
+def _stack(path, bands, names, primary, dtype="uint16"):
     from core.io.multispectral import write_band_stack
 
     md = {"PRIMARY_BAND": primary} if primary else {}
-    write_band_stack(path, bands, names, md, dtype="uint16")
+    write_band_stack(path, bands, names, md, dtype=dtype)
     return path
 
 
@@ -89,3 +89,29 @@ def test_a_stacked_photo_pair_matches_on_its_primary_band(tmp_path):
     img, sx, sy = load_scaled(view, 1.0)
     assert img.shape == (60, 80, 1) and (sx, sy) == (1.0, 1.0)
     assert np.array_equal(img[:, :, 0], np.round(bands[2]).astype(np.uint16))
+
+
+def test_dense_greys_of_a_float_photo_with_no_data_keep_its_contrast():
+    """A float32 reflectance photo's NaN (no data): np.percentile over it made every pixel 0."""
+    from core.dense.fusion import _to_rgb8
+    from core.dense.stereo import _to_gray8
+
+    img = np.zeros((40, 40, 1), np.float32) + 0.1
+    img[:, 20:] = 0.4
+    img[:5] = np.nan
+    for grey in (_to_gray8(img), _to_rgb8(img)[:, :, 0]):
+        assert grey[10:, 25:].mean() - grey[10:, :15].mean() > 200
+
+
+def test_the_first_pass_reads_a_stacked_photo_on_its_primary_band(tmp_path):
+    """Align images' first pass (texture probe) sees what COLMAP sees: the primary band, also of a float photo."""
+    from core.align.firstpass import _Photos
+    from core.io.images import read_image_info
+
+    bands, names = _bands()
+    p = _stack(str(tmp_path / "a.tif"), bands.astype(np.float32) / 65535.0, names, "Green", dtype="float32")
+    info = read_image_info(p)
+    assert info.dtype == "Float32" and info.primary_band == 3
+    grey = _Photos(None, [info], 64).image("a.tif")
+    assert grey.dtype == np.uint8 and grey.shape == (48, 64)
+    assert grey[:, 34:].mean() - grey[:, :28].mean() > 200

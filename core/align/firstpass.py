@@ -38,7 +38,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 import cv2
 import numpy as np
 
-from ..io.images import ImageInfo
+from ..io.images import ImageInfo, matching_grey8, read_image
 from .features import FeatureSettings, default_settings, sift_first_octave
 from .options import (
     FAINT_MIN_FEATURES,
@@ -221,7 +221,13 @@ class _Photos:
     def image(self, name: str) -> Optional[np.ndarray]:
         if name not in self.grey:
             im = self.by_name[name]
-            self.grey[name] = read_grey(im.path, max(im.width, im.height), self.long_side)
+            # a capture's photo: its primary band, as COLMAP sees it (core.align.features.feature_images); a float
+            # photo, which OpenCV does not decode
+            if im.primary_band or im.dtype.startswith("Float"):
+                arr = read_image(im.path, max_size=self.long_side)
+                self.grey[name] = shrink(matching_grey8(arr, im.primary_band), self.long_side)
+            else:
+                self.grey[name] = read_grey(im.path, max(im.width, im.height), self.long_side)
         return self.grey[name]
 
     def sift(self, name: str, level: str, settings: FeatureSettings):

@@ -157,6 +157,8 @@ def _to_rgb8(img: np.ndarray) -> np.ndarray:
         rgb = np.repeat(img[:, :, :1], 3, axis=2)
     if rgb.dtype != np.uint8:
         rgb = rgb.astype(np.float32)
-        lo, hi = np.percentile(rgb, [0.5, 99.5])
+        finite = np.isfinite(rgb)  # a float photo's NaN (no data): neither in the stretch nor in the colours
+        lo, hi = np.percentile(rgb[finite], [0.5, 99.5]) if finite.any() else (0.0, 1.0)
+        rgb = np.nan_to_num(rgb, nan=float(lo))
         rgb = np.clip((rgb - lo) * (255.0 / max(hi - lo, 1e-6)), 0, 255).astype(np.uint8)
     return np.ascontiguousarray(rgb)

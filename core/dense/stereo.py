@@ -23,6 +23,7 @@ import numpy as np
 from ..common.errors import require
 from ..common.files import save_npz
 from ..common.parallel import check_unit_cancel
+from ..io.images import matching_grey8
 from .options import DenseError
 from .pairs import View, load_scaled
 
@@ -62,16 +63,9 @@ def equalized(img: np.ndarray) -> np.ndarray:
 
 def _to_gray8(img: np.ndarray) -> np.ndarray:
     cv2 = require("cv2", "dense matching")
-    if img.shape[2] >= 3:
-        g = cv2.cvtColor(np.ascontiguousarray(img[:, :, :3]), cv2.COLOR_RGB2GRAY) if img.dtype == np.uint8 else \
-            (0.299 * img[:, :, 0] + 0.587 * img[:, :, 1] + 0.114 * img[:, :, 2])
-    else:
-        g = img[:, :, 0]
-    if g.dtype != np.uint8:
-        g = g.astype(np.float32)
-        lo, hi = np.percentile(g, [0.5, 99.5])
-        g = np.clip((g - lo) * (255.0 / max(hi - lo, 1e-6)), 0, 255).astype(np.uint8)
-    return np.ascontiguousarray(g)
+    if img.shape[2] >= 3 and img.dtype == np.uint8:
+        return np.ascontiguousarray(cv2.cvtColor(np.ascontiguousarray(img[:, :, :3]), cv2.COLOR_RGB2GRAY))
+    return matching_grey8(img)  # 16-bit, float (NaN-safe): stretched from the 0.5 to the 99.5 percentile
 
 
 def _rect_bounds(k: np.ndarray, dist: np.ndarray, rot: np.ndarray, f: float, w: int, h: int) -> np.ndarray:
