@@ -31,7 +31,8 @@ from .io.images import list_images, require_images
 from .io.multispectral import band_files, read_band_info
 from .ortho.options import OrthoOptions
 from .ortho.stage import build_orthophoto_workspace
-from .prepare.captures import CaptureStackOptions, is_band_folder, stack_capture_folder
+from .prepare.band_radiometry import PANEL_WINDOW
+from .prepare.captures import CaptureStackOptions, is_band_folder, panel_files, stack_capture_folder
 from .prepare.options import PrepareOptions
 from .prepare.stage import prepare_images_workspace
 from .project.stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, PREPARE, RELIEF, REPORT, TERRAIN, StageError
@@ -88,6 +89,18 @@ class PipelineOptions:
     # radiometry) and the chain goes on with those; "off": the files are taken as photos
     captures: str = "auto"
     capture_radiometry: str = "normalised"
+    # the calibration panel's band files (or folders of them) and its reflectance (one number, band=value items or
+    # a CSV file), as CaptureStackOptions takes them: the stacked photos, and so the orthomosaic, are then float32
+    # reflectance; ``capture_panel_window``: the central window the panel is measured in (a fraction of the frame)
+    capture_panel: Sequence[str] = ()
+    capture_panel_reflectance: str = ""
+    capture_panel_window: float = PANEL_WINDOW
+
+    def capture_stack(self, workspace_dir: str) -> CaptureStackOptions:
+        """The options of a band folder's stacking into <workspace>/captures (checked when made: PrepareError)."""
+        return CaptureStackOptions(os.path.join(workspace_dir, CAPTURES_DIR), radiometry=self.capture_radiometry,
+                                   panel=self.capture_panel, panel_reflectance=self.capture_panel_reflectance,
+                                   panel_window=self.capture_panel_window)
 
 
 @dataclass
@@ -138,11 +151,11 @@ def _place(src: str, dst: str) -> None:
         shutil.copy2(src, dst)
 
 
-def _stack(images_dir: str, workspace_dir: str, radiometry: str, res: "PipelineResult", progress: Progress) -> str:
-    """The band folder's captures stacked into <workspace>/captures (core.prepare.captures), the rig's RGB frames
-    beside them (aligned in one block with the captures: ``res.rgb_frames``); returns that folder."""
-    out = os.path.join(workspace_dir, CAPTURES_DIR)
-    res.captures = stack_capture_folder(images_dir, CaptureStackOptions(out, radiometry=radiometry), progress)
+def _stack(images_dir: str, options: CaptureStackOptions, res: "PipelineResult", progress: Progress) -> str:
+    """The band folder's captures stacked into <workspace>/captures (core.prepare.captures, ``options``), the rig's
+    RGB frames beside them (aligned in one block with the captures: ``res.rgb_frames``); returns that folder."""
+    out, radiometry = options.output_dir, options.radiometry
+    res.captures = stack_capture_folder(images_dir, options, progress)
     frames = rig_rgb_frames(images_dir)
     for path in frames:
         _place(path, os.path.join(out, os.path.basename(path)))
@@ -201,6 +214,23 @@ def check_inputs(images_dir: str, control: Control) -> None:
         read_target_coordinates(control.targets_path, control.crs)
 
 
+def _check_stacking(images_dir: str, workspace_dir: str, opt: PipelineOptions) -> Optional[CaptureStackOptions]:
+    """The band folder's stacking options, checked before any work (a bad radiometry, panel reflectance or panel
+    path: PrepareError naming it); None where the images are not stacked (not a band folder, or captures off),
+    where a calibration panel is refused, since it would be silently ignored."""
+    if opt.captures not in ("auto", "off"):
+        raise StageError(f"captures {opt.captures!r}: auto (a band folder's captures stacked first) or off")
+    options = opt.capture_stack(workspace_dir)
+    panel_files(options.panel)  # a panel file or folder that is not there: before the stacking's reading
+    if opt.captures == "auto" and is_band_folder(images_dir):
+        return options
+    if options.panel:
+        why = "captures is off" if opt.captures == "off" else f"{images_dir} is not a folder of a rig's band files"
+        raise StageError(f"a calibration panel ({', '.join(options.panel)}) calibrates a band folder's captures, "
+                         f"but {why}: the photos would not be calibrated")
+    return None
+
+
 def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[PipelineOptions] = None,
                  control: Optional[Control] = None, progress: Optional[Progress] = None) -> PipelineResult:
     """The whole chain in one call: (prepare: sky masks ->) align -> georeference -> DSM -> orthomosaic -> report.
@@ -218,9 +248,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
                          "USE_EXIF_GPS) to georeference the block before the DSM and orthophoto; to align only, "
                          "run 'Align images'")
     check_inputs(images_dir, ctl)
-    if opt.captures not in ("auto", "off"):
-        raise StageError(f"captures {opt.captures!r}: auto (a band folder's captures stacked first) or off")
-    CaptureStackOptions(os.path.join(workspace_dir, CAPTURES_DIR), radiometry=opt.capture_radiometry)  # checked
+    stacking = _check_stacking(images_dir, workspace_dir, opt)
     align_options = opt.align  # the camera positions also choose the pairs where the photos have no EXIF GPS
     if ctl.camera_positions_path and not align_options.camera_positions:
         align_options = dataclasses.replace(align_options, camera_positions=ctl.camera_positions_path)
@@ -244,8 +272,8 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
     res = PipelineResult(workspace=os.path.abspath(workspace_dir), align=None, georef=None, seconds=seconds,
                          cpu_seconds=cpu_seconds)
     aligned_from = images_dir
-    if opt.captures == "auto" and is_band_folder(images_dir):
-        aligned_from = run(CAPTURES, _stack, images_dir, workspace_dir, opt.capture_radiometry, res)
+    if stacking is not None:
+        aligned_from = run(CAPTURES, _stack, images_dir, stacking, res)
     if opt.sky_masks:  # the photos with their sky masks, so that no tie or dense point comes from the sky
         res.prepare = run(PREPARE, prepare_images_workspace, aligned_from, workspace_dir, opt.prepare)
         res.warnings += res.prepare.warnings
