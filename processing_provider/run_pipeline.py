@@ -4,6 +4,8 @@ from qgis.core import (
     QgsProcessingOutputHtml,
     QgsProcessingOutputNumber,
     QgsProcessingOutputRasterLayer,
+    QgsProcessingParameterFile,
+    QgsProcessingParameterString,
 )
 from qgis.PyQt.QtCore import QCoreApplication
 
@@ -40,6 +42,9 @@ class RunPipelineAlgorithm(AlgorithmBase):
     DTM_ENABLED = "MAKE_DTM"
     CONTOUR_INTERVAL = "CONTOUR_INTERVAL"
     RELIEF = "RELIEF"
+    PANEL = "PANEL"
+    PANEL_REFLECTANCE = "PANEL_REFLECTANCE"
+    PANEL_WINDOW = "PANEL_WINDOW"
     GCPS_UPRIGHT = "GCPS_UPRIGHT"
     SKY_MASKS = "SKY_MASKS"
     DTM = "DTM"
@@ -60,6 +65,14 @@ class RunPipelineAlgorithm(AlgorithmBase):
         "DJI multispectral) is recognised, and its captures are first stacked into multi-band photos in "
         "<workspace>/captures (as 'Stack multispectral captures', normalised radiometry), which the chain then "
         "takes. Workspace folder: where every product is written.\n"
+        "Calibration panel folder and Panel reflectance (advanced, optional; with a band folder): as in 'Stack "
+        "multispectral captures': the band files of the calibration panel's captures, in a folder of their own, "
+        "and the panel's reflectance (one number, per band as Green=0.49,Red=0.50, or a CSV file); the stacked "
+        "photos, and so the orthomosaic, then hold reflectance (float32). A bad panel (saturated or not uniform in "
+        "its centre, another camera, a band missing, a reflectance for a band the rig lacks) stops the run before "
+        "the alignment, naming the file; so does a panel given with a folder of photos that is not a band folder. "
+        "Panel window (advanced): the side of the central square the panel is measured in, a fraction of the "
+        "photo's short side.\n"
         "Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera "
         "positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a "
         "DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in "
@@ -81,6 +94,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
         from ..core.georef.targets.options import KINDS as TARGET_KINDS
+        from ..core.prepare.band_radiometry import PANEL_WINDOW
 
         params.add(
             self,
@@ -112,7 +126,11 @@ class RunPipelineAlgorithm(AlgorithmBase):
                 params.workers(self.WORKERS, self.tr("Parallel workers")),
                 params.scheduler(self.SCHEDULER, self.tr("Dask scheduler")),
                 params.number(self.CONTOUR_INTERVAL, self.tr("Contour interval (m, 0 = none)")),
-                params.relief_choice(self.RELIEF, self.tr("Relief visualisations"))),
+                params.relief_choice(self.RELIEF, self.tr("Relief visualisations")),
+                QgsProcessingParameterFile(self.PANEL, self.tr("Calibration panel folder"),
+                                           behavior=QgsProcessingParameterFile.Behavior.Folder, optional=True),
+                QgsProcessingParameterString(self.PANEL_REFLECTANCE, self.tr("Panel reflectance"), optional=True),
+                params.number(self.PANEL_WINDOW, self.tr("Panel window"), PANEL_WINDOW, 0.02, maxValue=1.0)),
         )
         self.addOutput(QgsProcessingOutputRasterLayer(self.DTM, self.tr("DTM")))
         self.addOutput(QgsProcessingOutputRasterLayer(self.DSM, self.tr("DSM")))
@@ -173,7 +191,8 @@ class RunPipelineAlgorithm(AlgorithmBase):
                 make_dtm=self.parameterAsBoolean(p, self.DTM_ENABLED, context),
                 terrain=TerrainOptions(contour_interval=self.parameterAsDouble(p, self.CONTOUR_INTERVAL, context)),
                 relief=ReliefStageOptions(params.read_relief(self, p, self.RELIEF, context)),
-                sky_masks=self.parameterAsBoolean(p, self.SKY_MASKS, context)),
+                sky_masks=self.parameterAsBoolean(p, self.SKY_MASKS, context),
+                **self._panel(p, context)),
             control=pipeline.Control(gcp_path=gcp_path, gcps=gcps, check_points=checks,
                                      camera_positions_path=positions, use_exif_gps=use_gps, crs=crs_text,
                                      targets_path=targets,
@@ -192,3 +211,10 @@ class RunPipelineAlgorithm(AlgorithmBase):
         return dict(numbers, WORKSPACE=result.workspace, DSM=result.dsm.dsm_path,
                     ORTHOMOSAIC=result.ortho.orthomosaic, REPORT=result.report.path if result.report else None,
                     DTM=result.dtm.dtm_path if result.dtm else None)
+
+    def _panel(self, p, context):
+        """The calibration panel's PipelineOptions fields (core.prepare.captures.CaptureStackOptions checks them)."""
+        panel = self.parameterAsFile(p, self.PANEL, context).strip()
+        return {"capture_panel": (panel,) if panel else (),
+                "capture_panel_reflectance": self.parameterAsString(p, self.PANEL_REFLECTANCE, context).strip(),
+                "capture_panel_window": self.parameterAsDouble(p, self.PANEL_WINDOW, context)}
