@@ -216,8 +216,8 @@ def check_inputs(images_dir: str, control: Control) -> None:
 
 def _check_stacking(images_dir: str, workspace_dir: str, opt: PipelineOptions) -> Optional[CaptureStackOptions]:
     """The band folder's stacking options, checked before any work (a bad radiometry, panel reflectance or panel
-    path: PrepareError naming it); None where the images are not stacked (not a band folder, or captures off),
-    where a calibration panel is refused, since it would be silently ignored."""
+    path: PrepareError naming it); None where the images are not stacked (not a band folder, or captures off):
+    a calibration panel given there is refused (StageError), since it would be silently ignored."""
     if opt.captures not in ("auto", "off"):
         raise StageError(f"captures {opt.captures!r}: auto (a band folder's captures stacked first) or off")
     options = opt.capture_stack(workspace_dir)
