@@ -2222,7 +2222,7 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="155"/>
+        <location filename="../processing_provider/run_pipeline.py" line="165"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
@@ -2910,52 +2910,52 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Write the accuracy report</source>
         <translation>Genauigkeitsbericht schreiben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="136"/>
+        <location filename="../processing_provider/run_pipeline.py" line="146"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="137"/>
+        <location filename="../processing_provider/run_pipeline.py" line="147"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="140"/>
+        <location filename="../processing_provider/run_pipeline.py" line="150"/>
         <source>Accuracy report (HTML)</source>
         <translation>Genauigkeitsbericht (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="202"/>
+        <location filename="../processing_provider/run_pipeline.py" line="212"/>
         <source>Seconds per stage: {}</source>
         <translation>Sekunden pro Stufe: {}</translation>
     </message>
@@ -2965,145 +2965,151 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>Gesamte Verarbeitung ausführen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Ground control layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Check points</source>
         <translation>Kontrollpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Use EXIF GPS positions</source>
         <translation>EXIF-GPS-Positionen verwenden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Target CRS</source>
         <translation>Ziel-KBS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Matching image size (px)</source>
         <translation>Bildgröße für die Zuordnung (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>DSM resolution (m)</source>
         <translation>DOM-Auflösung (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Matching quality</source>
         <translation>Zuordnungsqualität</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Seam blending</source>
         <translation>Überblendung der Nähte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Parallel workers</source>
         <translation>Parallele Prozesse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Dask scheduler</source>
         <translation>Dask-Scheduler</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Build the DTM</source>
         <translation>Das DGM erzeugen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Contour interval (m, 0 = none)</source>
         <translation>Höhenlinienabstand (m, 0 = keine)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Relief visualisations</source>
         <translation>Reliefvisualisierungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="135"/>
+        <location filename="../processing_provider/run_pipeline.py" line="145"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>GCP-Pixel auf aufrechten Fotos gemessen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Sky masks (oblique photos)</source>
         <translation>Himmelsmasken (Schrägaufnahmen)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Camera calibration file</source>
         <translation>Kamerakalibrierungsdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Interior orientation</source>
         <translation>Innere Orientierung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Orthomosaic resolution (CRS units, 0 = GSD)</source>
         <translation>Orthomosaik-Auflösung (KBS-Einh., 0 = GSD)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Targets to find</source>
         <translation>Zu findende Zielmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Target kind</source>
         <translation>Art der Zielmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="162"/>
+        <location filename="../processing_provider/run_pipeline.py" line="172"/>
         <source>Give ground control (Ground control file or layer, or targets to find: GCPS, GCP_LAYER, TARGETS) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Geben Sie Passpunkte (Passpunktdatei oder Passpunktlayer oder zu findende Zielmarken: GCPS, GCP_LAYER, TARGETS) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Calibration panel folder</source>
         <translation>Kalibrierpanel-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Panel reflectance</source>
         <translation>Panelreflexion</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Panel window</source>
         <translation>Panelfenster</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <source>Capture radiometry</source>
+        <translation>Aufnahme-Radiometrie</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="8"/>
         <source>The whole chain in one call, for batch use: Align images, Georeference, Build DSM, Build orthophoto and Accuracy report on one workspace. It calls the same functions as the single algorithms, and a re-run resumes (features, matches and dense pairs already computed are reused).
 
-Folder of images: the photos; a folder of a multispectral rig&apos;s band files (Parrot Sequoia, MicaSense, DJI multispectral) is recognised, and its captures are first stacked into multi-band photos in &lt;workspace&gt;/captures (as &apos;Stack multispectral captures&apos;, normalised radiometry), which the chain then takes. Workspace folder: where every product is written.
+Folder of images: the photos; a folder of a multispectral rig&apos;s band files (Parrot Sequoia, MicaSense, DJI multispectral) is recognised, and its captures are first stacked into multi-band photos in &lt;workspace&gt;/captures (as &apos;Stack multispectral captures&apos;), which the chain then takes. Workspace folder: where every product is written.
+Capture radiometry (advanced; with a band folder): as Radiometry in &apos;Stack multispectral captures&apos;: normalised (default) removes each band&apos;s dark level, corrects its vignetting from the file&apos;s model and normalises exposure time and gain to the block&apos;s; irradiance also divides by the sun sensor&apos;s irradiance for that band (values proportional to reflectance when the light changes during the flight); raw keeps the numbers as recorded. A band file lacking what the choice needs (an exposure time, a sun-sensor reading) stops the run before the alignment, naming the file. A calibration panel is corrected the same way.
 Calibration panel folder and Panel reflectance (advanced, optional; with a band folder): as in &apos;Stack multispectral captures&apos;: the band files of the calibration panel&apos;s captures, in a folder of their own, and the panel&apos;s reflectance (one number, per band as Green=0.49,Red=0.50, or a CSV file); the stacked photos, and so the orthomosaic, then hold reflectance (float32). A bad panel (saturated or not uniform in its centre, another camera, a band missing, a reflectance for a band the rig lacks) stops the run before the alignment, naming the file; so does a panel given with a folder of photos that is not a band folder. Panel window (advanced): the side of the central square the panel is measured in, a fraction of the photo&apos;s short side.
 Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in &apos;Georeference&apos; (the pixel coordinates measured on the photos shown upright by their EXIF orientation).
 Targets to find (instead of a ground control file or layer): the surveyed coordinates of targets laid on the ground; after the alignment &apos;Find targets&apos; finds them on the photos and its observations are the ground control (Target kind, advanced: as in &apos;Find targets&apos;).
@@ -3114,7 +3120,8 @@ The other parameters are those of the single stages (see their help); 0 means au
 Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures.</source>
         <translation>Die gesamte Verarbeitung in einem Aufruf, für die Stapelverarbeitung: Bilder ausrichten, Georeferenzieren, DOM erzeugen, Orthophoto erzeugen und Genauigkeitsbericht in einem Arbeitsbereich. Es werden dieselben Funktionen wie in den einzelnen Algorithmen aufgerufen; ein erneuter Lauf setzt fort (bereits berechnete Merkmale, Zuordnungen und Stereopaare werden wiederverwendet).
 
-Bilderordner: die Fotos; ein Ordner mit den Kanaldateien einer Multispektralkamera (Parrot Sequoia, MicaSense, DJI Multispektral) wird erkannt, und ihre Aufnahmen werden zuerst zu mehrkanaligen Fotos in &lt;workspace&gt;/captures gestapelt (wie 'Multispektrale Aufnahmen stapeln', normalisierte Radiometrie), die die Kette dann nimmt. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben werden.
+Bilderordner: die Fotos; ein Ordner mit den Kanaldateien einer Multispektralkamera (Parrot Sequoia, MicaSense, DJI Multispektral) wird erkannt, und ihre Aufnahmen werden zuerst zu mehrkanaligen Fotos in &lt;workspace&gt;/captures gestapelt (wie 'Multispektrale Aufnahmen stapeln'), die die Kette dann nimmt. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben werden.
+Aufnahme-Radiometrie (erweitert; mit einem Kanalordner): wie Radiometrie in 'Multispektrale Aufnahmen stapeln': normalisiert (Standard) zieht von jedem Kanal seinen Dunkelwert ab, korrigiert seine Vignettierung nach dem Modell der Datei und normalisiert Belichtungszeit und Verstärkung auf die des Blocks; Einstrahlung teilt zusätzlich durch die Einstrahlung des Sonnensensors für diesen Kanal (Werte proportional zur Reflexion, wenn sich das Licht während des Flugs ändert); roh behält die Werte wie aufgenommen. Eine Kanaldatei, der fehlt, was die Wahl braucht (eine Belichtungszeit, ein Sonnensensorwert), beendet den Lauf vor der Ausrichtung und nennt die Datei. Ein Kalibrierpanel wird ebenso korrigiert.
 Kalibrierpanel-Ordner und Panelreflexion (erweitert, optional; mit einem Kanalordner): wie in 'Multispektrale Aufnahmen stapeln': die Kanaldateien der Aufnahmen des Kalibrierpanels, in einem eigenen Ordner, und die Reflexion des Panels (eine Zahl, je Kanal wie Green=0.49,Red=0.50, oder eine CSV-Datei); die gestapelten Fotos und damit das Orthomosaik enthalten dann Reflexion (float32). Ein schlechtes Panel (in seiner Mitte gesättigt oder nicht gleichmäßig, eine andere Kamera, ein fehlender Kanal, eine Reflexion für einen Kanal, den das Rig nicht hat) beendet den Lauf vor der Ausrichtung und nennt die Datei; ebenso ein Panel, das mit einem Bilderordner gegeben wird, der kein Kanalordner ist. Panelfenster (erweitert): die Seite des mittleren Quadrats, in dem das Panel gemessen wird, als Anteil der kurzen Seite des Fotos.
 Die Georeferenzierung braucht Passpunkte (eine Passpunktdatei oder ein Passpunktlayer, Kontrollpunkte werden zurückgehalten) und/oder Kamerapositionen (eine CSV-Datei der Kamerapositionen oder EXIF-GPS-Positionen verwenden): ohne sie wird die Verarbeitung abgelehnt, da ein DOM einen metrischen Maßstab und eine Lotrichtung braucht. GCP-Pixel auf aufrechten Fotos gemessen: wie bei 'Georeferenzieren' (die Pixelkoordinaten auf den Fotos gemessen, wie sie nach ihrer EXIF-Orientierung aufrecht gezeigt werden).
 Zu findende Zielmarken (statt einer Passpunktdatei oder eines Passpunktlayers): die vermessenen Koordinaten von am Boden ausgelegten Zielmarken; nach der Ausrichtung findet 'Zielmarken finden' sie auf den Fotos, und seine Messungen sind die Passpunkte (Art der Zielmarken, erweitert: wie in 'Zielmarken finden').

@@ -2222,7 +2222,7 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="155"/>
+        <location filename="../processing_provider/run_pipeline.py" line="165"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
@@ -2910,52 +2910,52 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Write the accuracy report</source>
         <translation>Scrivi il rapporto di accuratezza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="136"/>
+        <location filename="../processing_provider/run_pipeline.py" line="146"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="137"/>
+        <location filename="../processing_provider/run_pipeline.py" line="147"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="140"/>
+        <location filename="../processing_provider/run_pipeline.py" line="150"/>
         <source>Accuracy report (HTML)</source>
         <translation>Rapporto di accuratezza (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="202"/>
+        <location filename="../processing_provider/run_pipeline.py" line="212"/>
         <source>Seconds per stage: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -2965,145 +2965,151 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Esegui l'intera elaborazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Ground control layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Check points</source>
         <translation>Punti di controllo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Use EXIF GPS positions</source>
         <translation>Usa le posizioni GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Target CRS</source>
         <translation>SR di destinazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Matching image size (px)</source>
         <translation>Dimensione per la corrispondenza (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>DSM resolution (m)</source>
         <translation>Risoluzione del DSM (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Matching quality</source>
         <translation>Qualità della corrispondenza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Seam blending</source>
         <translation>Sfumatura delle giunzioni</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Parallel workers</source>
         <translation>Processi paralleli</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Dask scheduler</source>
         <translation>Scheduler Dask</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Build the DTM</source>
         <translation>Genera il DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Contour interval (m, 0 = none)</source>
         <translation>Equidistanza (m, 0 = nessuna)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Relief visualisations</source>
         <translation>Visualizzazioni del rilievo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="135"/>
+        <location filename="../processing_provider/run_pipeline.py" line="145"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>Pixel dei GCP misurati sulle foto raddrizzate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Sky masks (oblique photos)</source>
         <translation>Maschere del cielo (foto oblique)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Camera calibration file</source>
         <translation>File di calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Interior orientation</source>
         <translation>Orientamento interno</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Orthomosaic resolution (CRS units, 0 = GSD)</source>
         <translation>Risoluzione ortomosaico (unità SR, 0 = GSD)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Targets to find</source>
         <translation>Target da trovare</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Target kind</source>
         <translation>Tipo di target</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="162"/>
+        <location filename="../processing_provider/run_pipeline.py" line="172"/>
         <source>Give ground control (Ground control file or layer, or targets to find: GCPS, GCP_LAYER, TARGETS) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Indicare punti di appoggio (File o Layer dei punti d'appoggio, o target da trovare: GCPS, GCP_LAYER, TARGETS) e/o posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Calibration panel folder</source>
         <translation>Cartella del pannello di calibrazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Panel reflectance</source>
         <translation>Riflettanza del pannello</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="99"/>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
         <source>Panel window</source>
         <translation>Finestra del pannello</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <source>Capture radiometry</source>
+        <translation>Radiometria delle acquisizioni</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="8"/>
         <source>The whole chain in one call, for batch use: Align images, Georeference, Build DSM, Build orthophoto and Accuracy report on one workspace. It calls the same functions as the single algorithms, and a re-run resumes (features, matches and dense pairs already computed are reused).
 
-Folder of images: the photos; a folder of a multispectral rig&apos;s band files (Parrot Sequoia, MicaSense, DJI multispectral) is recognised, and its captures are first stacked into multi-band photos in &lt;workspace&gt;/captures (as &apos;Stack multispectral captures&apos;, normalised radiometry), which the chain then takes. Workspace folder: where every product is written.
+Folder of images: the photos; a folder of a multispectral rig&apos;s band files (Parrot Sequoia, MicaSense, DJI multispectral) is recognised, and its captures are first stacked into multi-band photos in &lt;workspace&gt;/captures (as &apos;Stack multispectral captures&apos;), which the chain then takes. Workspace folder: where every product is written.
+Capture radiometry (advanced; with a band folder): as Radiometry in &apos;Stack multispectral captures&apos;: normalised (default) removes each band&apos;s dark level, corrects its vignetting from the file&apos;s model and normalises exposure time and gain to the block&apos;s; irradiance also divides by the sun sensor&apos;s irradiance for that band (values proportional to reflectance when the light changes during the flight); raw keeps the numbers as recorded. A band file lacking what the choice needs (an exposure time, a sun-sensor reading) stops the run before the alignment, naming the file. A calibration panel is corrected the same way.
 Calibration panel folder and Panel reflectance (advanced, optional; with a band folder): as in &apos;Stack multispectral captures&apos;: the band files of the calibration panel&apos;s captures, in a folder of their own, and the panel&apos;s reflectance (one number, per band as Green=0.49,Red=0.50, or a CSV file); the stacked photos, and so the orthomosaic, then hold reflectance (float32). A bad panel (saturated or not uniform in its centre, another camera, a band missing, a reflectance for a band the rig lacks) stops the run before the alignment, naming the file; so does a panel given with a folder of photos that is not a band folder. Panel window (advanced): the side of the central square the panel is measured in, a fraction of the photo&apos;s short side.
 Georeferencing needs ground control (a Ground control file or layer, Check points held out) and/or camera positions (a Camera positions CSV or Use EXIF GPS positions): without them the pipeline refuses, since a DSM needs a metric scale and a vertical direction. GCP pixels measured on upright photos: as in &apos;Georeference&apos; (the pixel coordinates measured on the photos shown upright by their EXIF orientation).
 Targets to find (instead of a ground control file or layer): the surveyed coordinates of targets laid on the ground; after the alignment &apos;Find targets&apos; finds them on the photos and its observations are the ground control (Target kind, advanced: as in &apos;Find targets&apos;).
@@ -3114,7 +3120,8 @@ The other parameters are those of the single stages (see their help); 0 means au
 Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures.</source>
         <translation>L'intera elaborazione in una sola chiamata, per l'uso in batch: Allinea immagini, Georeferenzia, Crea DSM, Crea ortofoto e Rapporto di accuratezza su un solo spazio di lavoro. Chiama le stesse funzioni dei singoli algoritmi, e una nuova esecuzione riprende (caratteristiche, corrispondenze e coppie dense già calcolate vengono riutilizzate).
 
-Cartella delle immagini: le foto; una cartella di file di banda di una camera multispettrale (Parrot Sequoia, MicaSense, DJI multispettrale) è riconosciuta, e le sue acquisizioni sono prima impilate in foto multibanda in &lt;workspace&gt;/captures (come 'Impila acquisizioni multispettrali', radiometria normalizzata), che la catena poi prende. Cartella dell'area di lavoro: dove sono scritti tutti i prodotti.
+Cartella delle immagini: le foto; una cartella di file di banda di una camera multispettrale (Parrot Sequoia, MicaSense, DJI multispettrale) è riconosciuta, e le sue acquisizioni sono prima impilate in foto multibanda in &lt;workspace&gt;/captures (come 'Impila acquisizioni multispettrali'), che la catena poi prende. Cartella dell'area di lavoro: dove sono scritti tutti i prodotti.
+Radiometria delle acquisizioni (avanzato; con una cartella di bande): come Radiometria in 'Impila acquisizioni multispettrali': normalizzato (predefinito) sottrae a ogni banda il suo livello di nero, ne corregge la vignettatura secondo il modello del file e normalizza tempo di esposizione e guadagno a quelli del blocco; irradianza divide inoltre per l'irradianza del sensore solare per quella banda (valori proporzionali alla riflettanza quando la luce cambia durante il volo); grezzo mantiene i valori come registrati. Un file di banda privo di ciò che la scelta richiede (un tempo di esposizione, una lettura del sensore solare) ferma l'esecuzione prima dell'allineamento, nominando il file. Un pannello di calibrazione è corretto allo stesso modo.
 Cartella del pannello di calibrazione e Riflettanza del pannello (avanzato, opzionale; con una cartella di bande): come in 'Impila acquisizioni multispettrali': i file di banda delle acquisizioni del pannello di calibrazione, in una cartella a sé, e la riflettanza del pannello (un numero, per banda come Green=0.49,Red=0.50, o un file CSV); le foto impilate, e quindi l'ortomosaico, contengono allora riflettanza (float32). Un pannello non valido (saturo o non uniforme al centro, di un'altra camera, con una banda mancante, una riflettanza per una banda che il rig non ha) ferma l'esecuzione prima dell'allineamento, nominando il file; così anche un pannello dato con una cartella di foto che non è una cartella di bande. Finestra del pannello (avanzato): il lato del quadrato centrale in cui si misura il pannello, una frazione del lato corto della foto.
 La georeferenziazione richiede punti di appoggio (un file o un layer dei punti d'appoggio, punti di controllo esclusi) e/o posizioni delle camere (un CSV delle posizioni delle camere o Usa le posizioni GPS EXIF): senza di essi l'elaborazione viene rifiutata, perché un DSM richiede una scala metrica e una direzione verticale. Pixel dei GCP misurati sulle foto raddrizzate: come in 'Georeferenzia' (le coordinate pixel misurate sulle foto mostrate diritte secondo il loro orientamento EXIF).
 Target da trovare (invece di un file o layer dei punti d'appoggio): le coordinate rilevate dei target posati a terra; dopo l'allineamento 'Trova i target' li trova nelle foto e le sue misure sono i punti d'appoggio (Tipo di target, avanzato: come in 'Trova i target').

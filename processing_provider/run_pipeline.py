@@ -42,6 +42,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
     DTM_ENABLED = "MAKE_DTM"
     CONTOUR_INTERVAL = "CONTOUR_INTERVAL"
     RELIEF = "RELIEF"
+    CAPTURE_RADIOMETRY = "CAPTURE_RADIOMETRY"
     PANEL = "PANEL"
     PANEL_REFLECTANCE = "PANEL_REFLECTANCE"
     PANEL_WINDOW = "PANEL_WINDOW"
@@ -63,8 +64,15 @@ class RunPipelineAlgorithm(AlgorithmBase):
         "re-run resumes (features, matches and dense pairs already computed are reused).\n\n"
         "Folder of images: the photos; a folder of a multispectral rig's band files (Parrot Sequoia, MicaSense, "
         "DJI multispectral) is recognised, and its captures are first stacked into multi-band photos in "
-        "<workspace>/captures (as 'Stack multispectral captures', normalised radiometry), which the chain then "
-        "takes. Workspace folder: where every product is written.\n"
+        "<workspace>/captures (as 'Stack multispectral captures'), which the chain then takes. Workspace folder: "
+        "where every product is written.\n"
+        "Capture radiometry (advanced; with a band folder): as Radiometry in 'Stack multispectral captures': "
+        "normalised (default) removes each band's dark level, corrects its vignetting from the file's model and "
+        "normalises exposure time and gain to the block's; irradiance also divides by the sun sensor's irradiance "
+        "for that band (values proportional to reflectance when the light changes during the flight); raw keeps "
+        "the numbers as recorded. A band file lacking what the choice needs (an exposure time, a sun-sensor "
+        "reading) stops the run before the alignment, naming the file. A calibration panel is corrected the same "
+        "way.\n"
         "Calibration panel folder and Panel reflectance (advanced, optional; with a band folder): as in 'Stack "
         "multispectral captures': the band files of the calibration panel's captures, in a folder of their own, "
         "and the panel's reflectance (one number, per band as Green=0.49,Red=0.50, or a CSV file); the stacked "
@@ -94,7 +102,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
         from ..core.georef.targets.options import KINDS as TARGET_KINDS
-        from ..core.prepare.band_radiometry import PANEL_WINDOW
+        from ..core.prepare.band_radiometry import MODES, PANEL_WINDOW
 
         params.add(
             self,
@@ -127,6 +135,8 @@ class RunPipelineAlgorithm(AlgorithmBase):
                 params.scheduler(self.SCHEDULER, self.tr("Dask scheduler")),
                 params.number(self.CONTOUR_INTERVAL, self.tr("Contour interval (m, 0 = none)")),
                 params.relief_choice(self.RELIEF, self.tr("Relief visualisations")),
+                params.choice(self.CAPTURE_RADIOMETRY, self.tr("Capture radiometry"), MODES,
+                              default=MODES.index("normalised")),
                 QgsProcessingParameterFile(self.PANEL, self.tr("Calibration panel folder"),
                                            behavior=QgsProcessingParameterFile.Behavior.Folder, optional=True),
                 QgsProcessingParameterString(self.PANEL_REFLECTANCE, self.tr("Panel reflectance"), optional=True),
@@ -192,7 +202,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
                 terrain=TerrainOptions(contour_interval=self.parameterAsDouble(p, self.CONTOUR_INTERVAL, context)),
                 relief=ReliefStageOptions(params.read_relief(self, p, self.RELIEF, context)),
                 sky_masks=self.parameterAsBoolean(p, self.SKY_MASKS, context),
-                **self._panel(p, context)),
+                **self._captures(p, context)),
             control=pipeline.Control(gcp_path=gcp_path, gcps=gcps, check_points=checks,
                                      camera_positions_path=positions, use_exif_gps=use_gps, crs=crs_text,
                                      targets_path=targets,
@@ -212,9 +222,13 @@ class RunPipelineAlgorithm(AlgorithmBase):
                     ORTHOMOSAIC=result.ortho.orthomosaic, REPORT=result.report.path if result.report else None,
                     DTM=result.dtm.dtm_path if result.dtm else None)
 
-    def _panel(self, p, context):
-        """The calibration panel's PipelineOptions fields (core.prepare.captures.CaptureStackOptions checks them)."""
+    def _captures(self, p, context):
+        """The band folder's radiometry and calibration panel: PipelineOptions fields
+        (core.prepare.captures.CaptureStackOptions checks them)."""
+        from ..core.prepare.band_radiometry import MODES
+
         panel = self.parameterAsFile(p, self.PANEL, context).strip()
-        return {"capture_panel": (panel,) if panel else (),
+        return {"capture_radiometry": params.read_choice(self, p, self.CAPTURE_RADIOMETRY, context, MODES),
+                "capture_panel": (panel,) if panel else (),
                 "capture_panel_reflectance": self.parameterAsString(p, self.PANEL_REFLECTANCE, context).strip(),
                 "capture_panel_window": self.parameterAsDouble(p, self.PANEL_WINDOW, context)}

@@ -111,16 +111,33 @@ def test_a_bad_panel_is_refused_before_the_alignment_naming_it(flight, tmp_path)
 
 
 def test_qgis_process_run_pipeline_refuses_a_bad_panel(flight, tmp_path):
-    """archaeoortho:runpipeline headless with Calibration panel folder, Panel reflectance and Panel window: a
-    reflectance for a band the rig lacks is refused with its message, no traceback, nothing aligned."""
+    """archaeoortho:runpipeline headless with Capture radiometry, Calibration panel folder, Panel reflectance and
+    Panel window: a reflectance for a band the rig lacks is refused with its message, no traceback, nothing
+    aligned; Capture radiometry is the form's (advanced, normalised by default) and an unknown choice is refused
+    before the run."""
+    import json
+
     from tests.conftest import qgis_process
 
     _rig, root = flight
     exe, env = qgis_process()
     ws = tmp_path / "ws"
+    out = subprocess.run([exe, "--json", "help", "archaeoortho:runpipeline"], env=env, capture_output=True,
+                         text=True, timeout=300)
+    radiometry = json.loads(out.stdout)["parameters"]["CAPTURE_RADIOMETRY"]
+    assert radiometry["description"] == "Capture radiometry" and radiometry["is_advanced"], radiometry
+    assert radiometry["raw_definition"]["options"] == ["raw", "normalised", "irradiance"]
+    assert radiometry["default_value"] == 1, radiometry
     out = subprocess.run([exe, "--json", "run", "archaeoortho:runpipeline", "--", f"IMAGES={root / 'bands'}",
                           f"WORKSPACE={ws}", f"CAMERA_POSITIONS={root / 'camera_positions.csv'}",
-                          f"PANEL={root / 'panel'}", "PANEL_REFLECTANCE=Blue=0.5", "PANEL_WINDOW=0.2"],
+                          "CAPTURE_RADIOMETRY=3"], env=env, capture_output=True, text=True, timeout=300)
+    text = out.stdout + out.stderr
+    assert out.returncode != 0 and "Incorrect parameter value for CAPTURE_RADIOMETRY" in text, text[-3000:]
+    assert not ws.exists()
+    out = subprocess.run([exe, "--json", "run", "archaeoortho:runpipeline", "--", f"IMAGES={root / 'bands'}",
+                          f"WORKSPACE={ws}", f"CAMERA_POSITIONS={root / 'camera_positions.csv'}",
+                          f"PANEL={root / 'panel'}", "PANEL_REFLECTANCE=Blue=0.5", "PANEL_WINDOW=0.2",
+                          "CAPTURE_RADIOMETRY=2"],
                          env=env, capture_output=True, text=True, timeout=300)
     text = out.stdout + out.stderr
     assert out.returncode != 0 and "the rig has no band Blue" in text and "Traceback" not in text, text[-3000:]

@@ -276,6 +276,51 @@ def test_run_pipeline_passes_gcps_upright_on_to_the_georeferencing(plugin, tmp_p
         assert got["options"].gcps_upright is value
 
 
+def test_run_pipeline_capture_radiometry_as_in_stack_captures(plugin, tmp_path, monkeypatch):
+    """Run pipeline's 'Capture radiometry' (advanced) is Stack multispectral captures' Radiometry: same options,
+    normalised by default, an unknown choice refused; each choice reaches PipelineOptions.capture_radiometry (no
+    stage runs: run_pipeline is replaced by a recorder)."""
+    from archaeoortho.core import pipeline
+    from archaeoortho.core.prepare.band_radiometry import MODES
+    from qgis.core import (
+        QgsApplication,
+        QgsProcessingContext,
+        QgsProcessingException,
+        QgsProcessingFeedback,
+        QgsProcessingParameterDefinition,
+    )
+
+    registry = QgsApplication.processingRegistry()
+    alg = registry.algorithmById("archaeoortho:runpipeline").create()
+    stack_alg = registry.algorithmById("archaeoortho:stackcaptures").create()  # kept: it owns its parameters
+    stack = stack_alg.parameterDefinition("RADIOMETRY")
+    p = alg.parameterDefinition("CAPTURE_RADIOMETRY")
+    assert p is not None and p.description() == "Capture radiometry"
+    assert p.flags() & QgsProcessingParameterDefinition.Flag.FlagAdvanced
+    assert p.options() == stack.options() and p.defaultValue() == stack.defaultValue() == MODES.index("normalised")
+    assert not p.checkValueIsAcceptable(len(MODES)) and not p.checkValueIsAcceptable("sunny")
+    assert pipeline.PipelineOptions().capture_radiometry == "normalised"  # the same default as without the form
+
+    class Stop(Exception):
+        pass
+
+    seen = {}
+
+    def fake_run_pipeline(images, workspace, options=None, control=None, progress=None):
+        seen["options"] = options
+        raise Stop()
+
+    images = tmp_path / "images"
+    images.mkdir()
+    monkeypatch.setattr(pipeline, "run_pipeline", fake_run_pipeline)
+    base = {"IMAGES": str(images), "WORKSPACE": str(tmp_path / "ws"), "USE_EXIF_GPS": True}
+    for value, mode in [(None, "normalised")] + list(enumerate(MODES)):
+        parameters = dict(base) if value is None else dict(base, CAPTURE_RADIOMETRY=value)
+        with pytest.raises(QgsProcessingException, match="Stop"):
+            alg.processAlgorithm(parameters, QgsProcessingContext(), QgsProcessingFeedback())
+        assert seen.pop("options").capture_radiometry == mode, value
+
+
 def test_orthorectify_mode_options_are_translated(plugin, german):
     """The Mode drop-down of Orthorectify image is German in a German QGIS (its options were plain strings)."""
     from qgis.core import QgsApplication
