@@ -18,9 +18,10 @@ Pure: NumPy and OpenCV; files read through ``core/io`` (band files, :func:`core.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Callable, List, Optional, Sequence, Tuple, Union
+from typing import Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -33,6 +34,7 @@ from ..geometry.lens import (
     band_to_reference,
     fisheye_from_pix4d,
     perspective_from_pix4d,
+    rig_rotation,
 )
 from ..io.multispectral import BandInfo, Capture, band_key, write_band_stack
 from ..io.raster import RasterError, RasterFile
@@ -73,6 +75,19 @@ class RegistrationOptions:
                                         f"windows over 0.2 .. 1 of the frame")
         if self.iterations < 0 or self.upsample < 1:
             raise BandRegistrationError(f"iterations {self.iterations} / upsample {self.upsample}: >= 0 / >= 1")
+
+    # a band's own refinement is trusted when at least this share of the grid's windows (and MIN_TRUSTED_WINDOWS,
+    # what a homography is fitted to; all of them on a smaller grid), measured again after it, agree with it within
+    # AGREE_PX: over water, snow, a uniform field or a blurred frame the windows' phase-correlation peaks are
+    # noise (0.06 - 0.10 on 80-px windows), their shifts random, and a fit to them lands pixels off
+    TRUSTED_FRACTION = 1 / 3
+    MIN_TRUSTED_WINDOWS = 8
+    AGREE_PX = 0.5
+
+    def trusted_windows(self) -> int:
+        """How many windows must agree with a band's refinement for it to be trusted (``TRUSTED_FRACTION``)."""
+        n = self.grid[0] * self.grid[1]
+        return max(int(math.ceil(n * self.TRUSTED_FRACTION)), min(self.MIN_TRUSTED_WINDOWS, n))
 
     def window_px(self, shape: Tuple[int, int]) -> int:
         """The window's side (px) on a frame of ``shape`` (rows, cols): ``window`` when set, else
@@ -347,15 +362,24 @@ def fit_correction(shifts: Sequence[WindowShift], rounds: int = 3) -> np.ndarray
 
 
 # ---------------------------------------------------------------- one capture
+REFINED, BLOCK, MODEL = "refined", "block", "model only"  # how a band was registered (BandResult.status)
+
+
 @dataclass
 class BandResult:
-    """What the registration did to one band: its camera, the model-only and refined residuals against the
-    reference, and the homography correcting the output grid (identity for the reference and with no
-    refinement)."""
+    """What the registration did to one band: its camera, the model-only and final residuals against the
+    reference, the homography correcting the output grid (identity for the reference and the model only), how
+    (``status``: refined by its own windows, ``block``: the block's rig calibration, ``model only``; the reference:
+    ``reference``) and why (``note``), and whether its own refinement was trusted (``trusted``: enough windows agree
+    with it, :meth:`RegistrationOptions.trusted_windows`) with the capture's own correction (``own``)."""
     camera: BandCamera
     model_residual: Residual
     refined_residual: Residual
     correction: np.ndarray = field(default_factory=lambda: np.eye(3))
+    status: str = REFINED
+    note: str = ""
+    trusted: bool = True
+    own: Optional[np.ndarray] = None
 
 
 @dataclass
@@ -369,6 +393,11 @@ class RegisteredCapture:
     results: List[BandResult]
     model_bands: Optional[np.ndarray] = None
 
+    @property
+    def registration(self) -> Dict[str, str]:
+        """band name -> how it was registered (the reference left out)."""
+        return {r.camera.name: r.status for r in self.results[1:]}
+
 
 def read_band(path: str) -> np.ndarray:
     """The band file's first band as float32; BandRegistrationError naming the file when it cannot be read."""
@@ -380,9 +409,10 @@ def read_band(path: str) -> np.ndarray:
 
 
 def _refine(image: np.ndarray, cam: BandCamera, frame: PinholeLens, ref_grad: np.ndarray,
-            options: RegistrationOptions, shifts: List[WindowShift]) -> Tuple[np.ndarray, np.ndarray, Residual]:
+            options: RegistrationOptions, shifts: List[WindowShift]
+            ) -> Tuple[np.ndarray, np.ndarray, List[WindowShift]]:
     """The band warped with the refinement iterated ``options.iterations`` times, starting from the
-    model-only window ``shifts``: (warped, correction, residual after)."""
+    model-only window ``shifts``: (warped, correction, the windows measured after it)."""
     shape = ref_grad.shape
     correction = np.eye(3)
     warped = None
@@ -394,15 +424,51 @@ def _refine(image: np.ndarray, cam: BandCamera, frame: PinholeLens, ref_grad: np
         shifts = window_shifts(ref_grad, gradient_image(warped), options)
     if warped is None:
         warped = warp(image, band_map(cam, frame, shape))
-    return warped, correction, residual_of(shifts)
+    return warped, correction, shifts
+
+
+def agreeing(shifts: Sequence[WindowShift], tolerance: float) -> int:
+    """How many windows, measured after a refinement, are within ``tolerance`` px of it."""
+    return sum(1 for s in shifts if math.hypot(s.dx, s.dy) <= tolerance)
+
+
+def _register_band(image: np.ndarray, cam: BandCamera, frame: PinholeLens, ref_grad: np.ndarray,
+                   options: RegistrationOptions, calibration: Optional["RigCalibration"]
+                   ) -> Tuple[np.ndarray, np.ndarray, BandResult]:
+    """One band onto the reference: (registered, model-only, its BandResult).  Refined by its own windows when
+    they agree with the refinement (trusted) and, with a ``calibration``, it agrees with the block's; else the
+    block's correction (``calibration``), else the model only."""
+    shape = ref_grad.shape
+    model_img = warp(image, band_map(cam, frame, shape))
+    shifts = window_shifts(ref_grad, gradient_image(model_img), options)
+    before = residual_of(shifts)
+    if not options.iterations:
+        return model_img, model_img, BandResult(cam, before, before, status=MODEL, note="no refinement asked")
+    refined, correction, after = _refine(image, cam, frame, ref_grad, options, shifts)
+    agree, need = agreeing(after, options.AGREE_PX), options.trusted_windows()
+    trusted = agree >= need
+    status, note = decide(cam.name, trusted, correction, calibration,
+                          f"{agree} of {len(after)} windows agree with its refinement within "
+                          f"{options.AGREE_PX:g} px, {need} needed")
+    own = correction if trusted else None
+    if status == REFINED:
+        return refined, model_img, BandResult(cam, before, residual_of(after), correction, status, note, trusted, own)
+    if status == MODEL:
+        return model_img, model_img, BandResult(cam, before, before, np.eye(3), status, note, trusted, own)
+    block = calibration.band(cam.name).correction
+    warped = warp(image, band_map(cam, frame, shape, block))
+    res = residual_of(window_shifts(ref_grad, gradient_image(warped), options))
+    return warped, model_img, BandResult(cam, before, res, block.copy(), status, note, trusted, own)
 
 
 def register_capture(capture: Capture, options: Optional[RegistrationOptions] = None,
                      keep_model: bool = False,
-                     prepare: Optional[Callable[[str, np.ndarray], np.ndarray]] = None) -> RegisteredCapture:
+                     prepare: Optional[Callable[[str, np.ndarray], np.ndarray]] = None,
+                     calibration: Optional["RigCalibration"] = None) -> RegisteredCapture:
     """Register the band files of one capture (module docstring).  ``keep_model``: keep the model-only bands
     too (for before / after pictures); ``prepare``: (band file, its pixels) -> the pixels registered, in the
-    band's own frame (the radiometric correction, core.prepare.band_radiometry)."""
+    band's own frame (the radiometric correction, core.prepare.band_radiometry); ``calibration``: the block's rig
+    calibration (:func:`calibrate_rig`), taken by a band whose own refinement is not trusted or disagrees with it."""
     options = options or RegistrationOptions()
     cams, ref = band_cameras(capture, options.reference)
     frame = reference_frame(ref)
@@ -411,26 +477,192 @@ def register_capture(capture: Capture, options: Optional[RegistrationOptions] = 
     ref_img = warp(images[ref.path], band_map(ref, frame, shape))
     ref_grad = gradient_image(ref_img)
     ordered = [ref] + [c for c in cams if c is not ref]
-    bands, model, results = [], [], []
-    for cam in ordered:
-        if cam is ref:
-            bands.append(ref_img)
-            model.append(ref_img)
-            zero = Residual(0.0, 0.0, 0)
-            results.append(BandResult(cam, zero, zero))
-            continue
-        model_img = warp(images[cam.path], band_map(cam, frame, shape))
-        shifts = window_shifts(ref_grad, gradient_image(model_img), options)
-        before = residual_of(shifts)
-        if options.iterations:
-            refined, correction, after = _refine(images[cam.path], cam, frame, ref_grad, options, shifts)
-        else:
-            refined, correction, after = model_img, np.eye(3), before
-        bands.append(refined)
+    zero = Residual(0.0, 0.0, 0)
+    bands, model, results = [ref_img], [ref_img], [BandResult(ref, zero, zero, status="reference")]
+    for cam in ordered[1:]:
+        registered, model_img, result = _register_band(images[cam.path], cam, frame, ref_grad, options, calibration)
+        bands.append(registered)
         model.append(model_img)
-        results.append(BandResult(cam, before, after, correction))
+        results.append(result)
     return RegisteredCapture(tuple(c.name for c in ordered), np.stack(bands), frame, ref.name, results,
                              np.stack(model) if keep_model else None)
+
+
+# ---------------------------------------------------------------- the rig calibrated once for the block
+def _probes(shape: Tuple[int, int], options: RegistrationOptions, n: int = 5) -> np.ndarray:
+    """(n * n, 2) points over the frame's central ``coverage``, where corrections are compared."""
+    h, w = shape
+    m = (1 - options.coverage) / 2
+    xs, ys = np.linspace(w * m, w * (1 - m) - 1, n), np.linspace(h * m, h * (1 - m) - 1, n)
+    return np.array([(x, y) for y in ys for x in xs], dtype=np.float64)
+
+
+def displacement(correction: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """How far the homography ``correction`` moves each point (px), (n, 2)."""
+    q = np.column_stack([points, np.ones(len(points))]) @ np.asarray(correction, dtype=np.float64).T
+    return q[:, :2] / q[:, 2:] - points
+
+
+def _rotation_part(correction: np.ndarray, frame: PinholeLens) -> np.ndarray:
+    """The rotation nearest K^-1 D K (D: a correction of the output grid): the rig rotation's error it stands for."""
+    k = frame.matrix
+    q = np.linalg.inv(k) @ np.asarray(correction, dtype=np.float64) @ k
+    q /= np.cbrt(np.linalg.det(q))
+    u, _s, vt = np.linalg.svd(q)
+    return u @ vt
+
+
+def relatives_of(rotation: np.ndarray) -> Tuple[float, float, float]:
+    """The RigRelatives angles (degrees; R = Rx Ry Rz, core.geometry.lens.rig_rotation) of a rotation."""
+    r = rotation
+    return (math.degrees(math.atan2(-r[1, 2], r[2, 2])), math.degrees(math.asin(max(-1.0, min(1.0, r[0, 2])))),
+            math.degrees(math.atan2(-r[0, 1], r[0, 0])))
+
+
+@dataclass(frozen=True)
+class BandCalibration:
+    """One band's block calibration: the ``correction`` (3 x 3 homography of the output grid, as a capture's own
+    refinement) that the block's captures agree on (the median of their corrections' displacements at the probe
+    points), how far it moves the frame (``shift_px``, the largest displacement), the rotation it stands for
+    (``rotation_deg``: the turn added to the band's rig rotation, a rotation vector in degrees) and what of it is not a rotation (``remainder_px``: lens
+    model, parallax), the RigRelatives told by the metadata and those with the rotation taken in
+    (``relatives_calibrated``), the ``captures`` it rests on, their ``spread_px`` about it (1.4826 x the median of
+    each capture's largest deviation), the ``tolerance_px`` beyond which a capture's own refinement is not
+    believed, and the captures beyond it (``outliers``)."""
+    name: str
+    correction: np.ndarray
+    shift_px: float
+    rotation_deg: Tuple[float, float, float]
+    remainder_px: float
+    relatives: Optional[Tuple[float, ...]]
+    relatives_calibrated: Tuple[float, float, float]
+    captures: int
+    spread_px: float
+    tolerance_px: float
+    outliers: Tuple[str, ...] = ()
+
+    def __str__(self) -> str:
+        told = "none" if self.relatives is None else ", ".join(f"{v:+.3f}" for v in self.relatives)
+        return (f"{self.name}: {self.shift_px:.2f} px at most over the frame, a rotation of "
+                f"({', '.join(f'{v:+.3f}' for v in self.rotation_deg)}) deg (remainder {self.remainder_px:.2f} px); "
+                f"RigRelatives ({told}) -> ({', '.join(f'{v:+.3f}' for v in self.relatives_calibrated)}); "
+                f"{self.captures} captures, spread {self.spread_px:.3f} px"
+                + (f", {len(self.outliers)} beyond {self.tolerance_px:.2f} px ({', '.join(self.outliers)})"
+                   if self.outliers else ""))
+
+
+@dataclass(frozen=True)
+class RigCalibration:
+    """The rig calibrated once for the block (:func:`calibrate_rig`): per band (band_key) its
+    :class:`BandCalibration`, the probe points corrections are compared at, and the bands that could not be
+    calibrated, with why (``missing``)."""
+    reference: str
+    bands: Dict[str, BandCalibration]
+    probes: np.ndarray
+    missing: Dict[str, str] = field(default_factory=dict)
+
+    def band(self, name: str) -> Optional[BandCalibration]:
+        return self.bands.get(band_key(name))
+
+    def deviation(self, name: str, correction: np.ndarray) -> float:
+        """The largest distance (px) between where ``correction`` and the block's put the probe points."""
+        cal = self.band(name)
+        d = displacement(correction, self.probes) - displacement(cal.correction, self.probes)
+        return float(np.hypot(d[:, 0], d[:, 1]).max())
+
+    def describe(self) -> str:
+        lines = [f"rig calibration of the block (onto {self.reference}; the correction of the metadata's rig model "
+                 "that the captures' own refinements agree on):"] + [f"  {b}" for b in self.bands.values()]
+        lines += [f"  {n}: not calibrated ({why})" for n, why in self.missing.items()]
+        return "\n".join(lines)
+
+
+MIN_BLOCK_CAPTURES = 3  # a median needs at least three captures to out-vote one bad fit
+DISAGREE_SIGMAS = 5.0   # a capture's own refinement beyond this many of the block's spreads is not believed ...
+DISAGREE_FLOOR_PX = RegistrationOptions.AGREE_PX  # ... nor under the registration's own aim (half a pixel)
+
+
+def decide(name: str, trusted: bool, correction: np.ndarray, calibration: Optional[RigCalibration],
+           windows: str) -> Tuple[str, str]:
+    """(status, why) of a band: refined by its own windows when they are trusted (``windows`` says how many
+    agree) and agree with the block's calibration; the block's correction when they are too few or disagree with
+    it by more than its tolerance (a fit on repetitive texture); the model only without a calibration."""
+    cal = calibration.band(name) if calibration is not None else None
+    if not trusted:
+        if cal is None:
+            return MODEL, f"too little texture to refine ({windows}) and no rig calibration of the block"
+        return BLOCK, f"too little texture to refine ({windows}): the block's rig calibration ({cal.captures} captures)"
+    if cal is None:
+        return REFINED, windows
+    dev = calibration.deviation(name, correction)
+    if dev > cal.tolerance_px:
+        return BLOCK, (f"its own refinement is {dev:.2f} px from the block's rig calibration (tolerance "
+                       f"{cal.tolerance_px:.2f} px, spread {cal.spread_px:.3f} px over {cal.captures} captures): "
+                       "a fit on repetitive texture? The block's used")
+    return REFINED, windows
+
+
+def _calibrate_band(name: str, entries: Sequence[Tuple[str, BandResult]], frame: PinholeLens, probes: np.ndarray,
+                    reference: Optional[Tuple[float, ...]]) -> BandCalibration:
+    """One band's block calibration from its trusted captures' corrections (:class:`BandCalibration`)."""
+    cv2 = require("cv2", "band registration")
+    disp = np.stack([displacement(r.correction, probes) for _cid, r in entries])     # (captures, probes, 2)
+    keep = np.ones(len(entries), bool)
+    for _ in range(2):   # the median, the captures beyond the tolerance dropped, the median again
+        med = np.median(disp[keep], axis=0)
+        dev = np.hypot(*(disp - med).transpose(2, 0, 1)).max(axis=1)
+        spread = 1.4826 * float(np.median(dev[keep]))
+        tolerance = max(DISAGREE_SIGMAS * spread, DISAGREE_FLOOR_PX)
+        new = dev <= tolerance
+        if new.sum() < MIN_BLOCK_CAPTURES or (new == keep).all():
+            break
+        keep = new
+    h = cv2.findHomography(probes, probes + med, 0)[0]
+    h = h / h[2, 2]
+    rot = _rotation_part(h, frame)
+    k = frame.matrix
+    only_rot = k @ rot @ np.linalg.inv(k)
+    remainder = displacement(h, probes) - displacement(only_rot, probes)
+    cam = entries[0][1].camera
+    vec = cv2.Rodrigues(rot.T)[0].ravel()   # the turn added to the band's rig rotation: R' R^T = Q^T
+    calibrated = rig_rotation(reference) @ rot.T @ cam.rotation   # R' = Q^T R (band_map: rays R^T Q ray)
+    return BandCalibration(name, h, float(np.hypot(med[:, 0], med[:, 1]).max()),
+                           tuple(float(math.degrees(v)) for v in vec), float(np.hypot(*remainder.T).max()),
+                           cam.relatives, relatives_of(calibrated), int(keep.sum()), spread, tolerance,
+                           tuple(cid for (cid, _r), d in zip(entries, dev) if d > tolerance))
+
+
+def calibrate_rig(captures: Mapping[str, Sequence[BandResult]], frame: PinholeLens, shape: Tuple[int, int],
+                  options: Optional[RegistrationOptions] = None) -> RigCalibration:
+    """The rig calibrated once for the block (issue 37): the rig is rigid, so the correction each band's metadata
+    model needs is the same in every capture (the bands' baseline is a fraction of a pixel from flying height).
+    From the captures' registrations (capture id -> its BandResults, reference first, all in one reference frame
+    ``frame`` of ``shape``) each band's trusted refinements are pooled: the median of their displacements at probe
+    points over the frame, fitted by a homography; captures whose own correction lies beyond the tolerance (the
+    block's spread x DISAGREE_SIGMAS, at least half a pixel) are left out of it.  A band with fewer than
+    MIN_BLOCK_CAPTURES trusted captures is not calibrated (``missing`` says why)."""
+    options = options or RegistrationOptions()
+    probes = _probes(shape, options)
+    pooled: Dict[str, List[Tuple[str, BandResult]]] = {}
+    names: Dict[str, str] = {}
+    reference, ref_relatives = "", None
+    for cid, results in captures.items():
+        if not results:
+            continue
+        reference, ref_relatives = results[0].camera.name, results[0].camera.relatives
+        for r in results[1:]:
+            names.setdefault(band_key(r.camera.name), r.camera.name)
+            if r.trusted and r.own is not None:
+                pooled.setdefault(band_key(r.camera.name), []).append((cid, dataclasses.replace(r, correction=r.own)))
+    bands, missing = {}, {}
+    for key, name in names.items():
+        entries = pooled.get(key, [])
+        if len(entries) < MIN_BLOCK_CAPTURES:
+            missing[name] = (f"{len(entries)} capture(s) refined with trusted windows, {MIN_BLOCK_CAPTURES} "
+                             "needed")
+            continue
+        bands[key] = _calibrate_band(name, entries, frame, probes, ref_relatives)
+    return RigCalibration(reference, bands, probes, missing)
 
 
 def write_registered(path: str, reg: RegisteredCapture) -> str:
@@ -442,4 +674,5 @@ def write_registered(path: str, reg: RegisteredCapture) -> str:
         key = band_key(r.camera.name).upper()
         md[f"{key}_RESIDUAL_MODEL_PX"] = f"{r.model_residual.median:.3f},{r.model_residual.worst:.3f}"
         md[f"{key}_RESIDUAL_REFINED_PX"] = f"{r.refined_residual.median:.3f},{r.refined_residual.worst:.3f}"
+        md[f"{key}_REGISTRATION"] = r.status
     return write_band_stack(path, reg.bands, reg.names, md)

@@ -56,7 +56,16 @@ from .band_radiometry import (
     panel_warnings,
     parse_panel_reflectance,
 )
-from .bands import RegistrationOptions, register_capture
+from .bands import (
+    BLOCK,
+    REFINED,
+    RegisteredCapture,
+    RegistrationOptions,
+    RigCalibration,
+    calibrate_rig,
+    decide,
+    register_capture,
+)
 from .options import PrepareError
 
 # the bands a photo starts with, in this order (band_key names): bands 1-2-3 shown as RGB are NIR-R-G
@@ -105,8 +114,10 @@ class CaptureStackOptions:
 @dataclass
 class CaptureStackResult:
     """The photos written, their bands in order, the captures left out (capture -> why), the worst refined
-    residual per band over the captures (px), the block's warnings, the calibration panel per band (empty
-    without one) and the photos' unit."""
+    residual per band over the captures refined by their own windows (px), the block's warnings, the calibration
+    panel per band (empty without one), the photos' unit, how each capture's bands were registered (capture ->
+    band -> refined / block / model only) and the block's rig calibration (None when no band could be
+    calibrated)."""
     photos: List[str]
     bands: Tuple[str, ...]
     left_out: Dict[str, str]
@@ -114,6 +125,8 @@ class CaptureStackResult:
     warnings: List[str]
     panel: Dict[str, PanelBand] = field(default_factory=dict)
     unit: str = ""
+    registration: Dict[str, Dict[str, str]] = field(default_factory=dict)
+    rig: Optional[RigCalibration] = None
 
 
 def stack_order(names: Sequence[str]) -> List[int]:
@@ -324,9 +337,9 @@ def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
     os.makedirs(options.output_dir, exist_ok=True)
     photos: List[str] = []
     left_out: Dict[str, str] = {}
-    worst: Dict[str, float] = {}
-    order_names: Tuple[str, ...] = ()
     names_of = photo_names(captures)
+    kept: Dict[str, Tuple[Capture, str, RegisteredCapture]] = {}
+    writer = _PhotoWriter(primary, why, options.radiometry, factors, scales, panel)
     for k, cap in enumerate(captures):
         check_cancel(progress)
         missing = [n for n in names if cap.band(n) is None]
@@ -336,27 +349,99 @@ def stack_captures(paths: Sequence[str], options: CaptureStackOptions,
             progress.warning(f"capture {cap.capture_id} left out: {left_out[cap.capture_id]}")
             continue
         reg = register_capture(cap, options.registration, prepare=prepare)
+        path = writer.write(os.path.join(options.output_dir, names_of[cap.capture_id]), cap, reg)
+        kept[cap.capture_id] = (cap, path, _light(reg))
+        photos.append(path)
+        progress.report((k + 1) / len(captures), f"captures: {k + 1}/{len(captures)} stacked")
+    rig = _apply_rig(kept, options.registration, prepare, writer, progress)
+    warnings += _registration_warnings(kept, rig)
+    worst: Dict[str, float] = {}
+    for _cap, _path, reg in kept.values():
+        for r in reg.results[1:]:
+            if r.status == REFINED and r.refined_residual.count:
+                worst[r.camera.name] = max(worst.get(r.camera.name, 0.0), float(r.refined_residual.worst))
+    unit = band_metadata(options.radiometry, next(iter(panel.values()), None))["RADIOMETRIC_UNIT"]
+    return CaptureStackResult(photos, writer.order_names, left_out, worst, warnings, panel, unit,
+                              {cid: reg.registration for cid, (_c, _p, reg) in kept.items()}, rig)
+
+
+def _light(reg: RegisteredCapture) -> RegisteredCapture:
+    """The registration without its pixels (kept for the block's rig calibration)."""
+    return dataclasses.replace(reg, bands=reg.bands[:0], model_bands=None)
+
+
+@dataclass
+class _PhotoWriter:
+    """Writes one capture's registered bands as its multi-band photo (the block's radiometry and panel)."""
+    primary: str
+    why: str
+    radiometry: str
+    factors: Dict[str, object]
+    scales: Dict[str, float]
+    panel: Dict[str, PanelBand]
+    order_names: Tuple[str, ...] = ()
+
+    def write(self, path: str, cap: Capture, reg: RegisteredCapture) -> str:
         order = stack_order(reg.names)
-        order_names = tuple(reg.names[i] for i in order)
+        self.order_names = tuple(reg.names[i] for i in order)
         infos = {b.band_name: b for b in cap.bands}
         ref = infos[reg.reference]
         height, width = reg.bands.shape[1:]
-        path = os.path.join(options.output_dir, names_of[cap.capture_id])
-        md = {"REFERENCE_BAND": reg.reference, "CAPTURE": cap.capture_id, PRIMARY_BAND: primary,
-              PRIMARY_BAND + "_REASON": why,
-              "BAND_FILES": ",".join(infos[n].name for n in order_names),
-              **describe(options.radiometry, [infos[n] for n in order_names], factors, scales, panel)}
-        bmd = [band_metadata(options.radiometry, _panel_of(panel, n)) for n in order_names]
-        write_band_stack(path, reg.bands[order], order_names, md,
-                         [infos[n].central_wavelength_nm for n in order_names],
+        how = reg.registration
+        md = {"REFERENCE_BAND": reg.reference, "CAPTURE": cap.capture_id, PRIMARY_BAND: self.primary,
+              PRIMARY_BAND + "_REASON": self.why,
+              "BAND_FILES": ",".join(infos[n].name for n in self.order_names),
+              "REGISTRATION": ", ".join(f"{n}: {how[n]}" for n in self.order_names if n in how),
+              **describe(self.radiometry, [infos[n] for n in self.order_names], self.factors, self.scales,
+                         self.panel)}
+        bmd = [dict(band_metadata(self.radiometry, _panel_of(self.panel, n)),
+                    REGISTRATION=how.get(n, "reference")) for n in self.order_names]
+        write_band_stack(path, reg.bands[order], self.order_names, md,
+                         [infos[n].central_wavelength_nm for n in self.order_names],
                          capture_exif(ref.path, reg.frame.f, width, height),
-                         "reflectance" if panel else "uint16", bmd)
-        photos.append(path)
-        for r in reg.results[1:]:
-            worst[r.camera.name] = max(worst.get(r.camera.name, 0.0), float(r.refined_residual.worst))
-        progress.report((k + 1) / len(captures), f"captures: {k + 1}/{len(captures)} stacked")
-    unit = band_metadata(options.radiometry, next(iter(panel.values()), None))["RADIOMETRIC_UNIT"]
-    return CaptureStackResult(photos, order_names, left_out, worst, warnings, panel, unit)
+                         "reflectance" if self.panel else "uint16", bmd)
+        return path
+
+
+def _needs_block(reg: RegisteredCapture, rig: RigCalibration) -> bool:
+    """Does a capture registered without the block's calibration take it for a band (too little texture, or its
+    own refinement beyond the block's tolerance)?"""
+    return any(decide(r.camera.name, r.trusted, r.correction, rig, "")[0] == BLOCK for r in reg.results[1:])
+
+
+def _apply_rig(kept: Dict[str, Tuple[Capture, str, RegisteredCapture]], options: RegistrationOptions, prepare,
+               writer: "_PhotoWriter", progress: Progress) -> Optional[RigCalibration]:
+    """The rig calibrated once for the block from the captures' own refinements (core.prepare.bands.calibrate_rig),
+    reported; the captures that need it registered again with it and their photos written again (only those: the
+    others keep their own refinement, so the block costs one more registration per capture that needs it).
+    ``kept`` is updated; None when no band could be calibrated."""
+    if not kept or not options.iterations:
+        return None
+    first = next(iter(kept.values()))[2]
+    rig = calibrate_rig({cid: reg.results for cid, (_c, _p, reg) in kept.items()}, first.frame,
+                        first.bands.shape[1:], options)
+    if not rig.bands:
+        return None
+    progress.info(rig.describe())
+    for cid, (cap, path, reg) in list(kept.items()):
+        if _needs_block(reg, rig):
+            check_cancel(progress)
+            again = register_capture(cap, options, prepare=prepare, calibration=rig)
+            writer.write(path, cap, again)
+            kept[cid] = (cap, path, _light(again))
+    return rig
+
+
+def _registration_warnings(kept: Dict[str, Tuple[Capture, str, RegisteredCapture]],
+                           rig: Optional[RigCalibration]) -> List[str]:
+    """A warning per capture whose bands were not refined by their own windows, naming the capture, the bands
+    and why."""
+    out = []
+    for cid, (_cap, _path, reg) in kept.items():
+        off = [r for r in reg.results[1:] if r.status != REFINED]
+        if off:
+            out.append(f"capture {cid}: " + "; ".join(f"{r.camera.name} {r.status} ({r.note})" for r in off))
+    return out
 
 
 def _panel_of(panel: Dict[str, PanelBand], name: str) -> Optional[PanelBand]:
