@@ -12,7 +12,14 @@ turned into the ideal pinhole frame of the rig's reference band, then refined by
    are the registration residual reported before and after refinement.
 3. Refinement: a homography of the output grid fitted robustly to the window shifts (iterated), so that
    what the rig's calibration leaves (a small rotation, the baseline's parallax at the scene's height, a lens
-   model's error) is taken out; the model alone is reported beside it.
+   model's error) is taken out; the model alone is reported beside it.  It is trusted when enough windows,
+   measured again, agree with it (:meth:`RegistrationOptions.trusted_windows`): over water, snow or a blurred frame
+   the windows are noise and a fit to them lands pixels off, so the band keeps the model only.
+4. The rig calibrated once for the block (:func:`calibrate_rig`): the rig is rigid, so the captures' trusted
+   corrections of a band agree; their median is the block's correction (reported in px, as a rotation and as
+   calibrated RigRelatives, with the captures it rests on and their spread).  With it (``calibration``) a band
+   that cannot be refined, or whose refinement lies beyond the block's tolerance, takes the block's correction
+   (status ``block``; ``refined`` / ``model only`` otherwise).
 
 Pure: NumPy and OpenCV; files read through ``core/io`` (band files, :func:`core.io.multispectral.write_band_stack`).
 """

@@ -17,6 +17,11 @@ band's values are scaled by the panel's reflectance over its value (:func:`calib
 among the flight's (the same files, or captures with a panel capture's id) are not stacked, and the warnings say
 so.
 
+The rig is calibrated once for the block from the captures' own refinements (core.prepare.bands.calibrate_rig,
+reported); the captures that cannot be refined (too little texture) or disagree with it are registered again
+with it and their photos written again; each photo's ``REGISTRATION`` (and each band's) says refined / block /
+model only, and the warnings name the captures not refined by their own windows.
+
 A capture that lacks a band the block has is left out with its reason (an orthomosaic needs every band in every
 photo); the block's other warnings (:func:`core.io.multispectral.check_captures`) are passed on.  The RGB camera
 of a rig (another sensor, another frame) is not stacked.
