@@ -61,22 +61,30 @@ def test_align_extracts_the_stacks_features_from_their_primary_band(tmp_path):
     folder = tmp_path / "photos"
     folder.mkdir()
     p = _stack(str(folder / "a.tif"), bands, names, "Green")
-    q = _stack(str(folder / "b.tif"), bands, names, None)
-    infos = [read_image_info(p), read_image_info(q)]
+    q = str(folder / "b.tif")  # a plain 8-bit photo: COLMAP reads it as it is
+    from osgeo import gdal
+
+    ds = gdal.GetDriverByName("GTiff").Create(q, 80, 60, 1, gdal.GDT_Byte)
+    ds.GetRasterBand(1).WriteArray(np.full((60, 80), 90, np.uint8))
+    ds = None
+    r = _stack(str(folder / "c.tif"), bands[2:3] / 20.0, ("Green",), None)  # 16-bit, values 50..150 of 65535
+    infos = [read_image_info(p), read_image_info(q), read_image_info(r)]
     sfm = str(tmp_path / "sfm")
     path, proxied = feature_images(infos, sfm)
-    assert path == os.path.join(sfm, FEATURE_IMAGES) and proxied == ["a.tif"]
+    assert path == os.path.join(sfm, FEATURE_IMAGES) and proxied == ["a.tif", "c.tif"]
+    dim = read_image(os.path.join(path, "c.tif"))[:, :, 0]  # stretched, not the 16-bit range's 0..0
+    assert dim[:, 50:].mean() - dim[:, :30].mean() > 200
     with RasterFile(os.path.join(path, "a.tif")) as r:
         assert (r.count, r.width, r.height) == (1, 80, 60)
     grey = read_image(os.path.join(path, "a.tif"))[:, :, 0]
     assert grey[:, 50:].mean() - grey[:, :30].mean() > 200
     # the proxied photo goes into its own extraction block (read from the proxy folder)
-    group = CameraGroup(1, "k", "m", "m", 80, 60, 50.0, "default", ["a.tif", "b.tif"])
+    group = CameraGroup(1, "k", "m", "m", 80, 60, 50.0, "default", ["a.tif", "b.tif", "c.tif"])
     job = Extraction("db", str(folder), [group], {"k": 1}, proxy_path=path, proxied=proxied)
     blocks = [b for _g, b in _extraction_blocks(job, set(), FeatureSettings(80, 100, 0))]
-    assert blocks == [["a.tif"], ["b.tif"]]
-    # no photo names a band: no folder
-    assert feature_images(infos[1:], sfm) == (None, []) and not os.path.exists(path)
+    assert blocks == [["a.tif"], ["b.tif"], ["c.tif"]]
+    # only plain 8-bit photos: no folder
+    assert feature_images(infos[1:2], sfm) == (None, []) and not os.path.exists(path)
 
 
 def test_a_stacked_photo_pair_matches_on_its_primary_band(tmp_path):

@@ -142,16 +142,19 @@ FEATURE_IMAGES = "feature_images"  # sfm/<this>: the 8-bit primary-band images C
 
 
 def feature_images(infos: Sequence[ImageInfo], sfm_dir: str) -> Tuple[Optional[str], List[str]]:
-    """The folder COLMAP reads the photos that name a primary band from (None when none does), and those photos.
+    """The folder COLMAP reads the photos that are not plain 8-bit from, or that name a primary band (None when
+    there are none), and those photos.
 
     A multispectral capture's stacked photo (core.prepare.captures) names the band it is matched on; COLMAP would
-    read its first three bands as a colour photo and its 16-bit values scaled down to a few grey levels.  Each
-    such photo gets an 8-bit image of its primary band (core.io.images.matching_grey8: the band stretched to
-    0..255) under its own name in ``sfm/feature_images``, the pixel grid unchanged, so keypoints are the photo's
-    pixels; a photo's image is written again when the photo is newer."""
+    read its first three bands as a colour photo.  A 16-bit photo (a band file, a 12-bit sensor's TIFF, a scan)
+    COLMAP scales to 8 bits by its full 16-bit range: a band whose values fill a few thousand DN becomes a few
+    grey levels, and SIFT finds few features; a float photo it cannot read.  Each such photo gets an 8-bit image
+    (core.io.images.matching_grey8: its primary band, else its grey, stretched from the 0.5 to the 99.5
+    percentile to 0..255) under its own name in ``sfm/feature_images``, the pixel grid unchanged, so keypoints
+    are the photo's pixels; a photo's image is written again when the photo is newer."""
     from osgeo import gdal
 
-    chosen = [im for im in infos if im.primary_band]
+    chosen = [im for im in infos if im.primary_band or im.dtype != "Byte"]
     folder = os.path.join(sfm_dir, FEATURE_IMAGES)
     if not chosen:
         shutil.rmtree(folder, ignore_errors=True)

@@ -221,9 +221,9 @@ class _Photos:
     def image(self, name: str) -> Optional[np.ndarray]:
         if name not in self.grey:
             im = self.by_name[name]
-            # a capture's photo: its primary band, as COLMAP sees it (core.align.features.feature_images); a float
-            # photo, which OpenCV does not decode
-            if im.primary_band or im.dtype.startswith("Float"):
+            # as COLMAP sees it (core.align.features.feature_images): a photo other than 8-bit, or a capture's,
+            # stretched to 8 bits (its primary band)
+            if im.primary_band or im.dtype != "Byte":
                 arr = read_image(im.path, max_size=self.long_side)
                 self.grey[name] = shrink(matching_grey8(arr, im.primary_band), self.long_side)
             else:
