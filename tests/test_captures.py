@@ -117,6 +117,30 @@ def _photo(path, names, wavelengths):
     return str(path)
 
 
+def test_an_item_of_one_capture_does_not_unname_the_mosaic(tmp_path):
+    """Each capture's photo says how its bands were registered (refined / block, per band): the mosaic keeps the
+    band names and the items every photo shares (the unit: reflectance photos are then left as they are)."""
+    from core.ortho.writer import calibrated_reflectance
+
+    paths = []
+    for k, how in enumerate(("refined", "block", "refined")):
+        path = _photo(tmp_path / f"{k}.tif", ["NIR", "Red"], ["790", "660"])
+        ds = gdal.Open(path, gdal.GA_Update)
+        for i in (1, 2):
+            md = ds.GetRasterBand(i).GetMetadata()
+            md.update(RADIOMETRIC_UNIT="reflectance", REGISTRATION=how if i == 1 else "reference")
+            ds.GetRasterBand(i).SetMetadata(md)
+        ds = None
+        paths.append(path)
+    names, mds = photo_band_names(paths)
+    assert names == ["NIR", "Red"]
+    assert mds[0] == {"wavelength": "790", "RADIOMETRIC_UNIT": "reflectance"}
+    assert mds[1] == {"wavelength": "660", "RADIOMETRIC_UNIT": "reflectance", "REGISTRATION": "reference"}
+    assert calibrated_reflectance(paths)
+    other = _photo(tmp_path / "dn.tif", ["NIR", "Red"], ["790", "660"])  # no unit: not all reflectance
+    assert not calibrated_reflectance(paths + [other])
+
+
 def test_the_orthomosaic_bands_are_named_after_the_photos(tmp_path):
     a = _photo(tmp_path / "a.tif", ["NIR", "Red"], ["790", "660"])
     b = _photo(tmp_path / "b.tif", ["NIR", "Red"], ["790", "660"])

@@ -24,20 +24,24 @@ def _alpha_value(dtype: str) -> Optional[float]:
 
 
 def photo_band_names(paths: Sequence[str]) -> Tuple[List[str], List[Dict[str, str]]]:
-    """The band descriptions and band metadata the photos ``paths`` share (a multispectral capture's band names and
-    wavelengths, core.prepare.captures); ([], []) when they have none or do not agree."""
-    seen = None
+    """The band descriptions the photos ``paths`` share (a multispectral capture's band names, core.prepare.captures)
+    and, per band, the metadata items every photo gives alike (wavelength, unit, radiometry; an item of one capture,
+    such as how its bands were registered, is left out); ([], []) when they have no names or do not agree on them."""
+    names = None
+    shared: List[Dict[str, str]] = []
     for path in paths:
         with RasterFile(path, "photo") as r:
-            names = tuple(r.band(i + 1).GetDescription() for i in range(r.count))
-            mds = tuple(tuple(sorted(r.metadata(i + 1).items())) for i in range(r.count))
-        if seen is None:
-            seen = (names, mds)
-        elif (names, mds) != seen:
+            these = tuple(r.band(i + 1).GetDescription() for i in range(r.count))
+            mds = [dict(r.metadata(i + 1)) for i in range(r.count)]
+        if names is None:
+            names, shared = these, mds
+        elif these != names:
             return [], []
-    if not seen or not any(seen[0]):
+        else:
+            shared = [{k: v for k, v in s.items() if m.get(k) == v} for s, m in zip(shared, mds)]
+    if not names or not any(names):
         return [], []
-    return list(seen[0]), [dict(m) for m in seen[1]]
+    return list(names), shared
 
 
 REFLECTANCE_UNIT = "reflectance"  # a photo band's RADIOMETRIC_UNIT item (core.prepare.band_radiometry.REFLECTANCE)
