@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import glob
 import os
 import shutil
 import time
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Sequence
+from typing import Dict, List, Optional, Sequence, Tuple
 
 from .align.options import AlignOptions
 from .align.stage import align, check_options
@@ -28,7 +29,8 @@ from .georef.targets.options import FindTargetsOptions
 from .georef.targets.stage import find_targets
 from .io.gcp import GCPSet, apply_check_points, read_camera_positions, read_gcps, read_target_coordinates
 from .io.images import list_images, require_images
-from .io.multispectral import band_files, read_band_info
+from .io.multispectral import band_files, read_block
+from .io.raster import RasterFile
 from .ortho.options import OrthoOptions
 from .ortho.stage import build_orthophoto_workspace
 from .prepare.band_radiometry import PANEL_WINDOW
@@ -133,22 +135,54 @@ SPANS = {CAPTURES: (0.0, 0.05), PREPARE: (0.0, 0.05), ALIGN: (0.0, 0.40), FIND_T
          TERRAIN: (0.9, 0.92), RELIEF: (0.92, 0.95), REPORT: (0.95, 1.0)}
 
 
-def rig_rgb_frames(folder: str) -> List[str]:
-    """The rig's RGB frames among a band folder's files (core.io.multispectral: a three-band Red, Green, Blue
-    frame of a capture), sorted."""
-    return sorted(p for p in band_files(folder) if read_band_info(p).is_rgb)
+def rig_rgb_frames(folder: str, photos: Sequence[str]) -> Tuple[List[str], List[str]]:
+    """(the rig's RGB frames of the captures stacked into ``photos``, the band folder's other RGB frames: of a
+    calibration panel's capture, of a capture left out), each sorted (core.io.multispectral: a three-band Red,
+    Green, Blue frame of a capture)."""
+    stacked = set()
+    for path in photos:
+        with RasterFile(path, "captured photo") as r:
+            stacked.add(r.metadata().get("CAPTURE"))
+    frames, others = [], []
+    for cap in read_block(band_files(folder)).captures:
+        for b in cap.bands:
+            if b.is_rgb:
+                (frames if cap.capture_id in stacked else others).append(b.path)
+    return sorted(frames), sorted(others)
 
 
 def _place(src: str, dst: str) -> None:
-    """``src`` at ``dst``: a hard link (no copy of the photo), else a copy; an older file there is replaced."""
+    """``src`` at ``dst``: a hard link (no copy of the photo), else a copy; another file there is replaced."""
     if os.path.lexists(dst):
-        if os.path.samefile(src, dst):
-            return
+        try:
+            if os.path.samefile(src, dst):
+                return
+        except OSError:  # a dangling link left there
+            pass
         os.unlink(dst)
     try:
         os.link(src, dst)
-    except OSError:
+    except OSError:  # another file system, or links not allowed
         shutil.copy2(src, dst)
+
+
+def _frames_beside(images_dir: str, out: str, photos: Sequence[str], progress: Progress) -> List[str]:
+    """The rig's RGB frames of the stacked captures placed beside their photos in ``out`` (their names)."""
+    frames, others = rig_rgb_frames(images_dir, photos)
+    for path in others:
+        progress.warning(f"{path}: an RGB frame of a capture not stacked (a calibration panel's, or left out): "
+                         "not aligned")
+    taken = {os.path.basename(p).lower(): p for p in photos}
+    for path in frames:
+        name = os.path.basename(path)
+        if name.lower() in taken:
+            raise StageError(f"the RGB frame {path} has the name of the stacked photo {taken[name.lower()]}: "
+                             "rename the frame so that both can be aligned")
+        if any(c in name for c in ",;\n"):
+            raise StageError(f"the RGB frame {path}: a comma or semicolon in its name cannot be told apart in the "
+                             "orthophoto's image list; rename it")
+        _place(path, os.path.join(out, name))
+    return [os.path.basename(p) for p in frames]
 
 
 def _stack(images_dir: str, options: CaptureStackOptions, res: "PipelineResult", progress: Progress) -> str:
@@ -156,25 +190,28 @@ def _stack(images_dir: str, options: CaptureStackOptions, res: "PipelineResult",
     RGB frames beside them (aligned in one block with the captures: ``res.rgb_frames``); returns that folder."""
     out, radiometry = options.output_dir, options.radiometry
     res.captures = stack_capture_folder(images_dir, options, progress)
-    frames = rig_rgb_frames(images_dir)
-    for path in frames:
-        _place(path, os.path.join(out, os.path.basename(path)))
-    res.rgb_frames = [os.path.basename(p) for p in frames]
+    res.rgb_frames = _frames_beside(images_dir, out, res.captures.photos, progress)
     kept = {os.path.basename(p) for p in res.captures.photos} | set(res.rgb_frames)
     for name in list_images(out):  # an earlier run's photo no longer in the band folder: not aligned now
         if name not in kept:
             os.unlink(os.path.join(out, name))
     res.warnings += res.captures.warnings + [f"capture {c} left out: {why}" for c, why in res.captures.left_out.items()]
-    rgb = f" and the rig's {len(frames)} RGB frame(s)" if frames else ""
+    rgb = f" and the rig's {len(res.rgb_frames)} RGB frame(s)" if res.rgb_frames else ""
     progress.info(f"captures: {len(res.captures.photos)} multi-band photo(s) of {', '.join(res.captures.bands)}{rgb} "
                   f"in {out} ({radiometry} radiometry)")
     return out
 
 
+def _excluding(names: Sequence[str]) -> str:
+    """An IMAGES_FILTER (core.ortho.cameras.select_cameras) of every photo but ``names`` (taken literally)."""
+    return ", ".join("!" + glob.escape(n) for n in names)
+
+
 def _orthophotos(run, workspace_dir: str, options: OrthoOptions, res: "PipelineResult") -> None:
     """The orthophoto stage; a band folder with the rig's RGB frames (aligned as one block, one DSM) gives two
-    mosaics of one kind each: the RGB frames' (``orthomosaic_rgb.tif`` beside the orthomosaic) first, then the
-    captures' multi-band one, the stage's record (unless IMAGES_FILTER chose the photos)."""
+    mosaics of one kind each, where some of its photos are registered: the RGB frames' (``orthomosaic_rgb.tif``
+    beside the orthomosaic) first, then the captures' multi-band one, the stage's record and the workspace's
+    orthomosaic (unless IMAGES_FILTER chose the photos)."""
     if res.captures is None or not res.rgb_frames or options.images_filter:
         res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, options)
         res.warnings += res.ortho.warnings
@@ -182,13 +219,21 @@ def _orthophotos(run, workspace_dir: str, options: OrthoOptions, res: "PipelineR
     lo, hi = SPANS[ORTHOPHOTO]
     mid = lo + (hi - lo) * 0.4
     stacks = [os.path.basename(p) for p in res.captures.photos]
-    main = options.output or os.path.join(workspace_dir, "orthomosaic.tif")
-    rgb = dataclasses.replace(options, images_filter=", ".join("!" + n for n in stacks),
-                              output=os.path.splitext(main)[0] + "_rgb.tif", per_image_folder=None, seamlines=None)
-    res.ortho_rgb = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, rgb, span=(lo, mid))
-    bands = dataclasses.replace(options, images_filter=", ".join("!" + n for n in res.rgb_frames))
-    res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, bands, span=(mid, hi))
-    res.warnings += res.ortho_rgb.warnings + res.ortho.warnings
+    missing = set(res.align.unregistered) if res.align is not None else set()
+    if any(n not in missing for n in res.rgb_frames):
+        main = options.output or os.path.join(workspace_dir, "orthomosaic.tif")
+        rgb = dataclasses.replace(options, images_filter=_excluding(stacks), per_image_folder=None, seamlines=None,
+                                  output=os.path.splitext(main)[0] + "_rgb.tif")
+        res.ortho_rgb = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, rgb, span=(lo, mid))
+        res.warnings += res.ortho_rgb.warnings
+    else:
+        res.warnings.append("no RGB frame registered: no RGB orthomosaic")
+    if any(n not in missing for n in stacks):
+        bands = dataclasses.replace(options, images_filter=_excluding(res.rgb_frames))
+        res.ortho = run(ORTHOPHOTO, build_orthophoto_workspace, workspace_dir, bands, span=(mid, hi))
+        res.warnings += res.ortho.warnings
+    else:
+        res.warnings.append("no captured photo registered: no multi-band orthomosaic")
 
 
 def check_inputs(images_dir: str, control: Control) -> None:

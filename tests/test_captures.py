@@ -230,3 +230,17 @@ def test_only_the_mosaics_last_band_is_alpha(tmp_path, bands, dtype):
     with RasterFile(str(tmp_path / "mosaic.tif")) as r:
         alpha = [r.band(i + 1).GetColorInterpretation() == gdal.GCI_AlphaBand for i in range(r.count)]
     assert alpha == [False] * bands + [True]
+
+
+def test_a_dark_reflectance_pixel_is_not_nodata(tmp_path):
+    """A reflectance photo's 0 is its nodata: a pixel below the dark level (negative after it is removed) stays a
+    value, the floor; NaN (where a band does not reach) becomes 0."""
+    from core.io.multispectral import REFLECTANCE_FLOOR, write_band_stack
+
+    data = np.array([[[0.2, -0.01], [np.nan, 0.0]]], np.float32)
+    path = write_band_stack(str(tmp_path / "r.tif"), data, ["NIR"], dtype="reflectance")
+    ds = gdal.Open(path)
+    out, nodata = ds.GetRasterBand(1).ReadAsArray(), ds.GetRasterBand(1).GetNoDataValue()
+    assert nodata == 0.0 and out.dtype == np.float32
+    assert out[0, 0] == np.float32(0.2) and out[0, 1] == REFLECTANCE_FLOOR and out[1, 1] == REFLECTANCE_FLOOR
+    assert out[1, 0] == 0.0

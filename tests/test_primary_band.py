@@ -67,8 +67,8 @@ def test_align_extracts_the_stacks_features_from_their_primary_band(tmp_path):
     ds = gdal.GetDriverByName("GTiff").Create(q, 80, 60, 1, gdal.GDT_Byte)
     ds.GetRasterBand(1).WriteArray(np.full((60, 80), 90, np.uint8))
     ds = None
-    r = _stack(str(folder / "c.tif"), bands[2:3] / 20.0, ("Green",), None)  # 16-bit, values 50..150 of 65535
-    infos = [read_image_info(p), read_image_info(q), read_image_info(r)]
+    c = _stack(str(folder / "c.tif"), bands[2:3] / 20.0, ("Green",), None)  # 16-bit, values 50..150 of 65535
+    infos = [read_image_info(p), read_image_info(q), read_image_info(c)]
     sfm = str(tmp_path / "sfm")
     path, proxied = feature_images(infos, sfm)
     assert path == os.path.join(sfm, FEATURE_IMAGES) and proxied == ["a.tif", "c.tif"]
@@ -83,6 +83,13 @@ def test_align_extracts_the_stacks_features_from_their_primary_band(tmp_path):
     job = Extraction("db", str(folder), [group], {"k": 1}, proxy_path=path, proxied=proxied)
     blocks = [b for _g, b in _extraction_blocks(job, set(), FeatureSettings(80, 100, 0))]
     assert blocks == [["a.tif"], ["b.tif"], ["c.tif"]]
+    # another photo under the same name, older than the image made from the first: the image is made again
+    stamp = os.path.getmtime(os.path.join(path, "c.tif")) - 3600
+    _stack(c, bands[2:3, :, ::-1] / 20.0, ("Green",), None)  # its edge the other way round
+    os.utime(c, (stamp, stamp))
+    feature_images(infos, sfm)
+    again = read_image(os.path.join(path, "c.tif"))[:, :, 0]
+    assert again[:, :30].mean() - again[:, 50:].mean() > 200
     # only plain 8-bit photos: no folder
     assert feature_images(infos[1:2], sfm) == (None, []) and not os.path.exists(path)
 

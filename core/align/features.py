@@ -21,7 +21,15 @@ from typing import Dict, List, Optional, Sequence, Tuple
 from ..common.cancel import CancelWatcher
 from ..common.files import atomic_output, atomic_write_text, fingerprint
 from ..common.progress import Progress, check_cancel
-from ..io.images import CameraGroup, ImageError, ImageInfo, matching_grey8, read_image
+from ..io.images import (
+    CameraGroup,
+    ImageError,
+    ImageInfo,
+    matching_grey8,
+    open_image,
+    photo_fingerprint,
+    read_image,
+)
 from ..prepare.masks import MaskError, find_mask, mask_file_name, png_size
 from .calibrated import GivenCamera, colmap_camera
 from .options import (
@@ -139,6 +147,17 @@ def file_hash(path: str) -> str:
 
 
 FEATURE_IMAGES = "feature_images"  # sfm/<this>: the 8-bit primary-band images COLMAP extracts features from
+FEATURE_IMAGES_VERSION = 1  # how they are made (core.io.images.matching_grey8); part of the database's key
+FEATURE_SOURCE = "ARCHAEOORTHO_SOURCE"  # an image's item: version, its photo's fingerprint, the band it took
+
+
+def _feature_image_source(path: str) -> Optional[str]:
+    """What the feature image ``path`` was made from (None: not known, an unreadable image: made again)."""
+    try:
+        with open_image(path) as r:
+            return r.metadata().get(FEATURE_SOURCE)
+    except ImageError:
+        return None
 
 
 def feature_images(infos: Sequence[ImageInfo], sfm_dir: str) -> Tuple[Optional[str], List[str]]:
@@ -151,7 +170,8 @@ def feature_images(infos: Sequence[ImageInfo], sfm_dir: str) -> Tuple[Optional[s
     grey levels, and SIFT finds few features; a float photo it cannot read.  Each such photo gets an 8-bit image
     (core.io.images.matching_grey8: its primary band, else its grey, stretched from the 0.5 to the 99.5
     percentile to 0..255) under its own name in ``sfm/feature_images``, the pixel grid unchanged, so keypoints
-    are the photo's pixels; a photo's image is written again when the photo is newer."""
+    are the photo's pixels; an image is made again when its photo's content fingerprint, band or the way images
+    are made (FEATURE_IMAGES_VERSION) is not the one it records."""
     from osgeo import gdal
 
     chosen = [im for im in infos if im.primary_band or im.dtype != "Byte"]
@@ -162,15 +182,21 @@ def feature_images(infos: Sequence[ImageInfo], sfm_dir: str) -> Tuple[Optional[s
     os.makedirs(folder, exist_ok=True)
     for im in chosen:
         dst = os.path.join(folder, im.name)
-        if os.path.isfile(dst) and os.path.getmtime(dst) >= os.path.getmtime(im.path):
+        source = f"{FEATURE_IMAGES_VERSION}:{photo_fingerprint(im.path)}:{im.primary_band}"
+        if os.path.isfile(dst) and _feature_image_source(dst) == source:
             continue
         try:
-            grey = matching_grey8(read_image(im.path), im.primary_band)
+            if im.primary_band:  # that band alone read
+                with open_image(im.path) as r:
+                    grey = matching_grey8(r.read(im.primary_band))
+            else:
+                grey = matching_grey8(read_image(im.path))
         except ImageError as e:
             raise AlignError(str(e)) from e
         with atomic_output(dst) as tmp:
             ds = gdal.GetDriverByName("GTiff").Create(tmp, grey.shape[1], grey.shape[0], 1, gdal.GDT_Byte)
             ds.GetRasterBand(1).WriteArray(grey)
+            ds.SetMetadataItem(FEATURE_SOURCE, source)
             ds = None
     return folder, sorted(im.name for im in chosen)
 

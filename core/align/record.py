@@ -13,7 +13,15 @@ from ..common.progress import Progress
 from ..project.layout import Layout
 from ..project.stages import ALIGN
 from ..project.workspace import Workspace
-from .features import Extraction, database_key, feature_images, file_hash, masks_for_colmap, setup_database
+from .features import (
+    FEATURE_IMAGES_VERSION,
+    Extraction,
+    database_key,
+    feature_images,
+    file_hash,
+    masks_for_colmap,
+    setup_database,
+)
 from .firstpass import FirstPass
 from .inputs import Photos
 from .options import AlignOptions
@@ -48,12 +56,15 @@ def prepare_database(pycolmap, lay: Layout, photos: Photos, options: AlignOption
         record["inputs"]["masks"] = masks_key
         progress.info(f"masks: {len(masks)} of {len(infos)} images have a mask ({lay.masks_dir}): "
                       "no features where they are black")
-    key = database_key(groups, options, photos.images_dir, masks_key, fingerprint(photos.fingerprints), first.key())
+    proxy_path, proxied = feature_images(infos, lay.sfm_dir)
+    if proxied:  # their features come from the 8-bit images: a workspace's features from the photos are not reused
+        progress.info(f"features: {len(proxied)} photo(s) matched on an 8-bit image of their primary band or grey "
+                      f"({proxy_path})")
+    photos_key = fingerprint(photos.fingerprints) if not proxied else \
+        fingerprint([photos.fingerprints, FEATURE_IMAGES_VERSION, proxied])
+    key = database_key(groups, options, photos.images_dir, masks_key, photos_key, first.key())
     db_path, known_key = database_path(lay, record, key, keep_previous)
     camera_ids = setup_database(pycolmap, db_path, groups, options, key, known_key, photos.given)
-    proxy_path, proxied = feature_images(infos, lay.sfm_dir)
-    if proxied:
-        progress.info(f"features: {len(proxied)} photo(s) matched on their primary band ({proxy_path})")
     return Extraction(db_path, photos.images_dir, groups, camera_ids, mask_path, sorted(masks), proxy_path,
                       proxied), masks
 

@@ -748,6 +748,9 @@ def primary_band(block: Block, sample: int = 3) -> PrimaryBand:
 PHOTO_DTYPES = ("uint16", "reflectance")  # the multi-band photos the chain reads (write_band_stack)
 
 
+REFLECTANCE_FLOOR = np.float32(1e-6)  # the least reflectance a photo's pixel holds: 0 is its nodata
+
+
 def write_band_stack(path: str, bands: np.ndarray, names: Sequence[str], metadata: Optional[Dict[str, str]] = None,
                      wavelengths: Optional[Sequence[Optional[float]]] = None, exif: Optional[Dict[str, str]] = None,
                      dtype: str = "float32", band_metadata: Optional[Sequence[Dict[str, str]]] = None) -> str:
@@ -755,9 +758,9 @@ def write_band_stack(path: str, bands: np.ndarray, names: Sequence[str], metadat
     band described by its name, with its central wavelength (``wavelength``, nm) and its ``band_metadata`` items in
     its metadata where given; the ``exif`` tags in GDAL's EXIF domain.  ``dtype``: ``float32``, NaN nodata;
     ``uint16`` (a capture's photo for the chain, core.prepare.captures): the values rounded and clipped to 0..65535,
-    NaN (where a band does not reach) 0; ``reflectance`` (a capture's photo in reflectance): float32, negatives 0,
-    NaN 0 and 0 declared the bands' nodata (the dense matching's stretch and the photos' readers take 0 for
-    nothing there, as in the 16-bit photos; NaN would turn its percentiles into NaN).  MultispectralError naming
+    NaN (where a band does not reach) 0; ``reflectance`` (a capture's photo in reflectance): float32, NaN 0 and 0
+    declared the bands' nodata, every value at least REFLECTANCE_FLOOR (a dark pixel -- water, shadow, noise
+    below the dark level -- is dark, not nodata).  MultispectralError naming
     the file when it cannot be written."""
     from osgeo import gdal
 
@@ -771,7 +774,9 @@ def write_band_stack(path: str, bands: np.ndarray, names: Sequence[str], metadat
     if dtype == "uint16":
         data = np.clip(np.nan_to_num(data.astype(np.float64), nan=0.0), 0, 65535).round().astype(np.uint16)
     elif dtype == "reflectance":
-        data = np.maximum(np.nan_to_num(data.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0), 0.0)
+        data = data.astype(np.float32)
+        there = np.isfinite(data)  # a value, however dark, stays a value: at least REFLECTANCE_FLOOR, not nodata
+        data = np.where(there, np.maximum(data, REFLECTANCE_FLOOR), np.float32(0.0)).astype(np.float32)
     else:
         data = data.astype(np.float32)
     integer = data.dtype == np.uint16

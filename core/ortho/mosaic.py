@@ -71,11 +71,6 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], crs: Optional[str], offset
     t_start = time.time()
     timings: Dict[str, float] = {}
     log: List[str] = []
-    if (options.exposure or options.radiometry) and calibrated_reflectance([c.path for c in cameras]):
-        options = replace(options, exposure=False, radiometry=False)
-        log.append("the photos hold calibrated reflectance (their bands' RADIOMETRIC_UNIT): mosaicked as they are, "
-                   "without exposure gains or the radiometric model, which would change them")
-        progress.info(log[-1])
     out_dir = os.path.dirname(os.path.abspath(output))
     os.makedirs(out_dir, exist_ok=True)
     workdir = owned_tempdir(WORK_PREFIX, out_dir)
@@ -102,6 +97,12 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], crs: Optional[str], offset
             if dsm.reprojected:
                 log.append(f"DSM {source_dsm} reprojected on the fly into {crs}")
             bands, dtype = check_kind(prep.metas, prep.cameras)
+            # the photos the mosaic takes (read and found over the DSM by prepare_block) hold calibrated reflectance
+            if (options.exposure or options.radiometry) and calibrated_reflectance([c.path for c in prep.cameras]):
+                options = replace(options, exposure=False, radiometry=False)
+                log.append("the photos hold calibrated reflectance (their bands' RADIOMETRIC_UNIT): mosaicked as they "
+                           "are, without exposure gains or the radiometric model, which would change them")
+                progress.info(log[-1])
             grid = prep.grid
             timings["visibility"] = time.time() - t0
             unit = unit_symbol(crs)
