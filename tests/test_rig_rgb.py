@@ -71,3 +71,51 @@ def test_two_orthomosaics_on_one_dsm_where_the_truth_is(rgb_run):
     assert apart < cell / 3
     reg = rs.evaluate(rig, result.ortho.orthomosaic)["registration_px"]
     assert all(v["p90"] is not None and v["p90"] <= 0.3 for v in reg.values())
+
+
+def test_the_other_kind_is_excluded_by_names_taken_literally():
+    """The orthomosaic of one kind leaves the other kind's photos out by name, whatever characters they hold."""
+    from core import pipeline
+    from core.ortho.cameras import select_cameras
+
+    class Cam:
+        def __init__(self, name):
+            self.name, self.camera_id = name, 1
+
+    cams = [Cam(n) for n in ("IMG_1.tif", "IMG_2.tif", "IMG_?.tif", "IMG[1]_RGB.TIF", "IMG_1_RGB.TIF")]
+    chosen = select_cameras(cams, pipeline._excluding(["IMG[1]_RGB.TIF", "IMG_1_RGB.TIF"]))
+    assert [c.name for c in chosen] == ["IMG_1.tif", "IMG_2.tif", "IMG_?.tif"]
+    chosen = select_cameras(cams, pipeline._excluding(["IMG_?.tif", "IMG_1.tif", "IMG_2.tif"]))
+    assert [c.name for c in chosen] == ["IMG[1]_RGB.TIF", "IMG_1_RGB.TIF"]
+
+
+def test_only_the_stacked_captures_rgb_frames_are_aligned(tmp_path):
+    """A capture left out (a band missing: a calibration panel's shot, a misfire) brings no RGB frame into the
+    block; its frame is named in a warning; a frame named like a stacked photo is refused before the alignment."""
+    from core import pipeline
+    from core.prepare.captures import CaptureStackOptions, stack_capture_folder
+    from tests import rig_scene as rs
+
+    rig = rs.rig_block(n_strips=1, per_strip=3)
+    bands = tmp_path / "bands"
+    rs.render(rig, str(bands), supersample=1, rgb=True)
+    os.unlink(bands / "IMG_0002_NIR.TIF")
+    stack = stack_capture_folder(str(bands), CaptureStackOptions(str(tmp_path / "out")))
+    assert len(stack.photos) == 2
+    frames, others = pipeline.rig_rgb_frames(str(bands), stack.photos)
+    assert [os.path.basename(p) for p in frames] == ["IMG_0000_RGB.TIF", "IMG_0001_RGB.TIF"]
+    assert [os.path.basename(p) for p in others] == ["IMG_0002_RGB.TIF"]
+
+    class Log:
+        warnings = []
+
+        def warning(self, m):
+            self.warnings.append(m)
+
+    log = Log()
+    placed = pipeline._frames_beside(str(bands), str(tmp_path / "out"), stack.photos, log)
+    assert placed == ["IMG_0000_RGB.TIF", "IMG_0001_RGB.TIF"] and "IMG_0002_RGB.TIF" in log.warnings[0]
+    assert os.path.samefile(tmp_path / "out" / "IMG_0000_RGB.TIF", bands / "IMG_0000_RGB.TIF")
+    os.rename(bands / "IMG_0001_RGB.TIF", bands / "IMG_0001.tif")  # the stacked photo's name
+    with pytest.raises(pipeline.StageError, match="has the name of the stacked photo"):
+        pipeline._frames_beside(str(bands), str(tmp_path / "out"), stack.photos, log)
