@@ -2222,7 +2222,7 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="165"/>
+        <location filename="../processing_provider/run_pipeline.py" line="171"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
@@ -2910,52 +2910,52 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Write the accuracy report</source>
         <translation>Genauigkeitsbericht schreiben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="146"/>
+        <location filename="../processing_provider/run_pipeline.py" line="150"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="147"/>
+        <location filename="../processing_provider/run_pipeline.py" line="151"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="150"/>
+        <location filename="../processing_provider/run_pipeline.py" line="156"/>
         <source>Accuracy report (HTML)</source>
         <translation>Genauigkeitsbericht (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="212"/>
+        <location filename="../processing_provider/run_pipeline.py" line="218"/>
         <source>Seconds per stage: {}</source>
         <translation>Sekunden pro Stufe: {}</translation>
     </message>
@@ -2965,144 +2965,149 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>Gesamte Verarbeitung ausführen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Ground control layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Check points</source>
         <translation>Kontrollpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Use EXIF GPS positions</source>
         <translation>EXIF-GPS-Positionen verwenden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Target CRS</source>
         <translation>Ziel-KBS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Matching image size (px)</source>
         <translation>Bildgröße für die Zuordnung (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>DSM resolution (m)</source>
         <translation>DOM-Auflösung (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Matching quality</source>
         <translation>Zuordnungsqualität</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Seam blending</source>
         <translation>Überblendung der Nähte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Parallel workers</source>
         <translation>Parallele Prozesse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Dask scheduler</source>
         <translation>Dask-Scheduler</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Build the DTM</source>
         <translation>Das DGM erzeugen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Contour interval (m, 0 = none)</source>
         <translation>Höhenlinienabstand (m, 0 = keine)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Relief visualisations</source>
         <translation>Reliefvisualisierungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="145"/>
+        <location filename="../processing_provider/run_pipeline.py" line="149"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>GCP-Pixel auf aufrechten Fotos gemessen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Sky masks (oblique photos)</source>
         <translation>Himmelsmasken (Schrägaufnahmen)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Camera calibration file</source>
         <translation>Kamerakalibrierungsdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Interior orientation</source>
         <translation>Innere Orientierung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Orthomosaic resolution (CRS units, 0 = GSD)</source>
         <translation>Orthomosaik-Auflösung (KBS-Einh., 0 = GSD)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Targets to find</source>
         <translation>Zu findende Zielmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Target kind</source>
         <translation>Art der Zielmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="172"/>
+        <location filename="../processing_provider/run_pipeline.py" line="178"/>
         <source>Give ground control (Ground control file or layer, or targets to find: GCPS, GCP_LAYER, TARGETS) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Geben Sie Passpunkte (Passpunktdatei oder Passpunktlayer oder zu findende Zielmarken: GCPS, GCP_LAYER, TARGETS) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Calibration panel folder</source>
         <translation>Kalibrierpanel-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Panel reflectance</source>
         <translation>Panelreflexion</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Panel window</source>
         <translation>Panelfenster</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Capture radiometry</source>
         <translation>Aufnahme-Radiometrie</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="152"/>
+        <source>RGB orthomosaic (a rig&apos;s RGB frames)</source>
+        <translation>RGB-Orthomosaik (die RGB-Bilder eines Rigs)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="8"/>
@@ -3117,7 +3122,7 @@ Camera calibration file and Interior orientation (advanced): as in &apos;Align i
 Sky masks (oblique photos): first a &apos;Prepare images&apos; stage finds the sky and the horizon haze in each photo and masks them, so that no tie point or DSM point comes from the sky; the prepared photos are aligned (off by default: photos looking straight down need none).
 Build the DTM: after the DSM, a bare-earth DTM (as &apos;Build DTM&apos;). Contour interval (advanced): contour lines of the DTM at this interval (as &apos;Contours&apos;; 0 = none). Relief visualisations (advanced): those chosen are computed from the DTM (as &apos;Relief visualisation&apos;). Both need the DTM.
 The other parameters are those of the single stages (see their help); 0 means automatic.
-Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures.</source>
+Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures; with a band folder that also holds the rig&apos;s RGB frames, also RGB orthomosaic (a rig&apos;s RGB frames): those frames&apos; own orthomosaic, &lt;orthomosaic&gt;_rgb.tif beside the captures&apos; multi-band one (none when no RGB frame is registered).</source>
         <translation>Die gesamte Verarbeitung in einem Aufruf, für die Stapelverarbeitung: Bilder ausrichten, Georeferenzieren, DOM erzeugen, Orthophoto erzeugen und Genauigkeitsbericht in einem Arbeitsbereich. Es werden dieselben Funktionen wie in den einzelnen Algorithmen aufgerufen; ein erneuter Lauf setzt fort (bereits berechnete Merkmale, Zuordnungen und Stereopaare werden wiederverwendet).
 
 Bilderordner: die Fotos; ein Ordner mit den Kanaldateien einer Multispektralkamera (Parrot Sequoia, MicaSense, DJI Multispektral) wird erkannt, und ihre Aufnahmen werden zuerst zu mehrkanaligen Fotos in &lt;workspace&gt;/captures gestapelt (wie 'Multispektrale Aufnahmen stapeln'), die die Kette dann nimmt. Arbeitsbereich-Ordner: wohin alle Produkte geschrieben werden.
@@ -3129,7 +3134,7 @@ Kamerakalibrierungsdatei und Innere Orientierung (erweitert): wie in 'Bilder aus
 Himmelsmasken (Schrägaufnahmen): zuerst findet eine Stufe 'Bilder vorbereiten' den Himmel und den Dunst am Horizont in jedem Foto und maskiert sie, damit kein Verknüpfungs- oder DOM-Punkt aus dem Himmel stammt; die vorbereiteten Fotos werden ausgerichtet (standardmäßig aus: senkrecht aufgenommene Fotos brauchen keine).
 Das DGM erzeugen: nach dem DOM ein DGM der nackten Erde (wie 'DGM erzeugen'). Höhenlinienabstand (erweitert): Höhenlinien des DGM in diesem Abstand (wie 'Höhenlinien'; 0 = keine). Reliefvisualisierungen (erweitert): die gewählten werden aus dem DGM berechnet (wie 'Reliefvisualisierung'). Beide brauchen das DGM.
 Die übrigen Parameter sind die der einzelnen Stufen (siehe deren Hilfe); 0 bedeutet automatisch.
-Ausgaben: das DOM, das Orthomosaik und der Genauigkeitsbericht (HTML) sowie die wichtigsten Kennzahlen.</translation>
+Ausgaben: das DOM, das Orthomosaik und der Genauigkeitsbericht (HTML) sowie die wichtigsten Kennzahlen; mit einem Kanalordner, der auch die RGB-Bilder des Rigs enthält, zusätzlich RGB-Orthomosaik (die RGB-Bilder eines Rigs): das eigene Orthomosaik dieser Bilder, &lt;orthomosaic&gt;_rgb.tif neben dem mehrkanaligen der Aufnahmen (keines, wenn kein RGB-Bild registriert ist).</translation>
     </message>
 </context>
 <context>

@@ -2222,7 +2222,7 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="165"/>
+        <location filename="../processing_provider/run_pipeline.py" line="171"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
@@ -2910,52 +2910,52 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Write the accuracy report</source>
         <translation>Scrivi il rapporto di accuratezza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="146"/>
+        <location filename="../processing_provider/run_pipeline.py" line="150"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="147"/>
+        <location filename="../processing_provider/run_pipeline.py" line="151"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="150"/>
+        <location filename="../processing_provider/run_pipeline.py" line="156"/>
         <source>Accuracy report (HTML)</source>
         <translation>Rapporto di accuratezza (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="212"/>
+        <location filename="../processing_provider/run_pipeline.py" line="218"/>
         <source>Seconds per stage: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -2965,144 +2965,149 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Esegui l'intera elaborazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Ground control layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Check points</source>
         <translation>Punti di controllo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Use EXIF GPS positions</source>
         <translation>Usa le posizioni GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Target CRS</source>
         <translation>SR di destinazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Matching image size (px)</source>
         <translation>Dimensione per la corrispondenza (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>DSM resolution (m)</source>
         <translation>Risoluzione del DSM (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Matching quality</source>
         <translation>Qualità della corrispondenza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Seam blending</source>
         <translation>Sfumatura delle giunzioni</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Parallel workers</source>
         <translation>Processi paralleli</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Dask scheduler</source>
         <translation>Scheduler Dask</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Build the DTM</source>
         <translation>Genera il DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Contour interval (m, 0 = none)</source>
         <translation>Equidistanza (m, 0 = nessuna)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Relief visualisations</source>
         <translation>Visualizzazioni del rilievo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="145"/>
+        <location filename="../processing_provider/run_pipeline.py" line="149"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>Pixel dei GCP misurati sulle foto raddrizzate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Sky masks (oblique photos)</source>
         <translation>Maschere del cielo (foto oblique)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Camera calibration file</source>
         <translation>File di calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Interior orientation</source>
         <translation>Orientamento interno</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Orthomosaic resolution (CRS units, 0 = GSD)</source>
         <translation>Risoluzione ortomosaico (unità SR, 0 = GSD)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Targets to find</source>
         <translation>Target da trovare</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Target kind</source>
         <translation>Tipo di target</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="172"/>
+        <location filename="../processing_provider/run_pipeline.py" line="178"/>
         <source>Give ground control (Ground control file or layer, or targets to find: GCPS, GCP_LAYER, TARGETS) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Indicare punti di appoggio (File o Layer dei punti d'appoggio, o target da trovare: GCPS, GCP_LAYER, TARGETS) e/o posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Calibration panel folder</source>
         <translation>Cartella del pannello di calibrazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Panel reflectance</source>
         <translation>Riflettanza del pannello</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Panel window</source>
         <translation>Finestra del pannello</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="107"/>
+        <location filename="../processing_provider/run_pipeline.py" line="111"/>
         <source>Capture radiometry</source>
         <translation>Radiometria delle acquisizioni</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="152"/>
+        <source>RGB orthomosaic (a rig&apos;s RGB frames)</source>
+        <translation>Ortomosaico RGB (le immagini RGB di un rig)</translation>
     </message>
     <message>
         <location filename="../ui/catalog.py" line="8"/>
@@ -3117,7 +3122,7 @@ Camera calibration file and Interior orientation (advanced): as in &apos;Align i
 Sky masks (oblique photos): first a &apos;Prepare images&apos; stage finds the sky and the horizon haze in each photo and masks them, so that no tie point or DSM point comes from the sky; the prepared photos are aligned (off by default: photos looking straight down need none).
 Build the DTM: after the DSM, a bare-earth DTM (as &apos;Build DTM&apos;). Contour interval (advanced): contour lines of the DTM at this interval (as &apos;Contours&apos;; 0 = none). Relief visualisations (advanced): those chosen are computed from the DTM (as &apos;Relief visualisation&apos;). Both need the DTM.
 The other parameters are those of the single stages (see their help); 0 means automatic.
-Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures.</source>
+Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures; with a band folder that also holds the rig&apos;s RGB frames, also RGB orthomosaic (a rig&apos;s RGB frames): those frames&apos; own orthomosaic, &lt;orthomosaic&gt;_rgb.tif beside the captures&apos; multi-band one (none when no RGB frame is registered).</source>
         <translation>L'intera elaborazione in una sola chiamata, per l'uso in batch: Allinea immagini, Georeferenzia, Crea DSM, Crea ortofoto e Rapporto di accuratezza su un solo spazio di lavoro. Chiama le stesse funzioni dei singoli algoritmi, e una nuova esecuzione riprende (caratteristiche, corrispondenze e coppie dense già calcolate vengono riutilizzate).
 
 Cartella delle immagini: le foto; una cartella di file di banda di una camera multispettrale (Parrot Sequoia, MicaSense, DJI multispettrale) è riconosciuta, e le sue acquisizioni sono prima impilate in foto multibanda in &lt;workspace&gt;/captures (come 'Impila acquisizioni multispettrali'), che la catena poi prende. Cartella dell'area di lavoro: dove sono scritti tutti i prodotti.
@@ -3129,7 +3134,7 @@ File di calibrazione della camera e Orientamento interno (avanzato): come in 'Al
 Maschere del cielo (foto oblique): prima una fase 'Prepara immagini' trova il cielo e la foschia all'orizzonte in ogni foto e li maschera, perché nessun punto di legame o del DSM provenga dal cielo; si allineano le foto preparate (disattivato per impostazione predefinita: le foto nadirali non ne hanno bisogno).
 Genera il DTM: dopo il DSM, un DTM del suolo nudo (come 'Genera DTM'). Equidistanza (avanzato): curve di livello del DTM con questa equidistanza (come 'Curve di livello'; 0 = nessuna). Visualizzazioni del rilievo (avanzato): quelle scelte sono calcolate dal DTM (come 'Visualizzazione del rilievo'). Entrambe richiedono il DTM.
 Gli altri parametri sono quelli delle singole fasi (vedi il loro aiuto); 0 significa automatico.
-Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali.</translation>
+Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali; con una cartella di bande che contiene anche le immagini RGB del rig, anche Ortomosaico RGB (le immagini RGB di un rig): l'ortomosaico proprio di queste immagini, &lt;orthomosaic&gt;_rgb.tif accanto a quello multibanda delle acquisizioni (nessuno quando nessuna immagine RGB è registrata).</translation>
     </message>
 </context>
 <context>

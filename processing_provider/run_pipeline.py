@@ -53,6 +53,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
     SCHEDULER = "DASK_SCHEDULER"
     DSM = "DSM"
     ORTHOMOSAIC = "ORTHOMOSAIC"
+    ORTHOMOSAIC_RGB = "ORTHOMOSAIC_RGB"
     REPORT = "REPORT"
     NUMBERS = (("REGISTERED_IMAGES", "Registered images"), ("MEAN_REPROJECTION_ERROR", "Mean reprojection error (px)"),
                ("GCP_RMSE_XY", "Control RMSE XY (m)"), ("CHECK_RMSE_XY", "Check RMSE XY (m)"),
@@ -97,7 +98,10 @@ class RunPipelineAlgorithm(AlgorithmBase):
         "of the DTM at this interval (as 'Contours'; 0 = none). Relief visualisations (advanced): those chosen "
         "are computed from the DTM (as 'Relief visualisation'). Both need the DTM.\n"
         "The other parameters are those of the single stages (see their help); 0 means automatic.\n"
-        "Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures."
+        "Outputs: the DSM, the orthomosaic and the accuracy report (HTML), plus the key figures; with a band folder "
+        "that also holds the rig's RGB frames, also RGB orthomosaic (a rig's RGB frames): those frames' own "
+        "orthomosaic, <orthomosaic>_rgb.tif beside the captures' multi-band one (none when no RGB frame is "
+        "registered)."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802 (QGIS API name)
@@ -145,6 +149,8 @@ class RunPipelineAlgorithm(AlgorithmBase):
         self.addOutput(QgsProcessingOutputRasterLayer(self.DTM, self.tr("DTM")))
         self.addOutput(QgsProcessingOutputRasterLayer(self.DSM, self.tr("DSM")))
         self.addOutput(QgsProcessingOutputRasterLayer(self.ORTHOMOSAIC, self.tr("Orthomosaic")))
+        self.addOutput(QgsProcessingOutputRasterLayer(self.ORTHOMOSAIC_RGB,
+                                                      self.tr("RGB orthomosaic (a rig's RGB frames)")))
         # an HTML output: the toolbox dialog lists it in the Results Viewer, which opens it (a plain file output
         # was nowhere in the GUI: issue 36 item 15)
         self.addOutput(QgsProcessingOutputHtml(self.REPORT, self.tr("Accuracy report (HTML)")))
@@ -212,14 +218,17 @@ class RunPipelineAlgorithm(AlgorithmBase):
         feedback.pushInfo(self.tr("Seconds per stage: {}").format(
             ", ".join(f"{k} {v:.1f}" for k, v in result.seconds.items())))
         g = result.georef.figures
+        ortho, rgb = result.ortho, result.ortho_rgb  # either None where none of its photos registered (warned)
         numbers = {"REGISTERED_IMAGES": result.align.registered,
                    "MEAN_REPROJECTION_ERROR": result.align.mean_reprojection_error,
                    "GCP_RMSE_XY": g.get("GCP_RMSE_XY"), "CHECK_RMSE_XY": g.get("CHECK_RMSE_XY"),
                    "CHECK_RMSE_Z": g.get("CHECK_RMSE_Z"), "CAMERA_RMSE_XYZ": g.get("CAMERA_RMSE_XYZ"),
                    "DSM_VALID_FRACTION": result.dsm.valid_fraction,
-                   "ORTHO_VALID_FRACTION": result.ortho.valid_fraction}
+                   "ORTHO_VALID_FRACTION": ortho.valid_fraction if ortho is not None else None}
         return dict(numbers, WORKSPACE=result.workspace, DSM=result.dsm.dsm_path,
-                    ORTHOMOSAIC=result.ortho.orthomosaic, REPORT=result.report.path if result.report else None,
+                    ORTHOMOSAIC=ortho.orthomosaic if ortho is not None else None,
+                    ORTHOMOSAIC_RGB=rgb.orthomosaic if rgb is not None else None,
+                    REPORT=result.report.path if result.report else None,
                     DTM=result.dtm.dtm_path if result.dtm else None)
 
     def _captures(self, p, context):

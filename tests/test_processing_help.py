@@ -321,6 +321,54 @@ def test_run_pipeline_capture_radiometry_as_in_stack_captures(plugin, tmp_path, 
         assert seen.pop("options").capture_radiometry == mode, value
 
 
+def test_run_pipeline_returns_the_rgb_frames_orthomosaic(plugin, tmp_path, monkeypatch):
+    """Run pipeline declares the RGB frames' orthomosaic (a raster layer output, so that QGIS loads it) and returns
+    PipelineResult.ortho_rgb's path when there is one, None when not; a run whose captures registered none leaves
+    ORTHOMOSAIC None rather than failing after the stages (run_pipeline replaced by a stub: no stage runs)."""
+    from types import SimpleNamespace
+
+    from archaeoortho.core import pipeline
+    from qgis.core import (
+        QgsApplication,
+        QgsProcessingContext,
+        QgsProcessingFeedback,
+        QgsProcessingOutputRasterLayer,
+    )
+
+    alg = QgsApplication.processingRegistry().algorithmById("archaeoortho:runpipeline").create()
+    out = alg.outputDefinition("ORTHOMOSAIC_RGB")
+    assert isinstance(out, QgsProcessingOutputRasterLayer)
+    assert out.description() == "RGB orthomosaic (a rig's RGB frames)"
+    assert out.description() in alg.shortHelpString()  # the help names it by its label
+
+    images = tmp_path / "images"
+    images.mkdir()
+    ws = str(tmp_path / "ws")
+    main, rgb = os.path.join(ws, "orthomosaic.tif"), os.path.join(ws, "orthomosaic_rgb.tif")
+    results = []
+
+    def fake_run_pipeline(images_dir, workspace, options=None, control=None, progress=None):
+        return results.pop(0)
+
+    def result(ortho, ortho_rgb):
+        def stage(path):
+            return path and SimpleNamespace(warnings=[], valid_fraction=0.9, orthomosaic=path)
+
+        return pipeline.PipelineResult(
+            workspace=ws, align=SimpleNamespace(registered=4, mean_reprojection_error=0.5),
+            georef=SimpleNamespace(figures={}), dsm=SimpleNamespace(dsm_path=os.path.join(ws, "dsm.tif"),
+                                                                    valid_fraction=0.8),
+            ortho=stage(ortho), ortho_rgb=stage(ortho_rgb))
+
+    monkeypatch.setattr(pipeline, "run_pipeline", fake_run_pipeline)
+    parameters = {"IMAGES": str(images), "WORKSPACE": ws, "USE_EXIF_GPS": True}
+    for ortho, ortho_rgb in [(main, rgb), (main, None), (None, rgb)]:
+        results.append(result(ortho, ortho_rgb))
+        got = alg.processAlgorithm(parameters, QgsProcessingContext(), QgsProcessingFeedback())
+        assert got["ORTHOMOSAIC"] == ortho and got.get("ORTHOMOSAIC_RGB") == ortho_rgb
+        assert got["ORTHO_VALID_FRACTION"] == (0.9 if ortho else None)
+
+
 def test_orthorectify_mode_options_are_translated(plugin, german):
     """The Mode drop-down of Orthorectify image is German in a German QGIS (its options were plain strings)."""
     from qgis.core import QgsApplication
