@@ -2837,7 +2837,7 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>nicht trianguliert</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="805"/>
+        <location filename="../qgisio/layers.py" line="807"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
@@ -2847,12 +2847,12 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>DOM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="806"/>
+        <location filename="../qgisio/layers.py" line="808"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="807"/>
+        <location filename="../qgisio/layers.py" line="809"/>
         <source>Cameras</source>
         <translation>Kameras</translation>
     </message>
@@ -2867,12 +2867,12 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>Passpunkt-Residuen (Vektoren x{})</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="808"/>
+        <location filename="../qgisio/layers.py" line="810"/>
         <source>Point cloud</source>
         <translation>Punktwolke</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="816"/>
+        <location filename="../qgisio/layers.py" line="818"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
@@ -2882,7 +2882,7 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>{} ({})</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="809"/>
+        <location filename="../qgisio/layers.py" line="811"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
@@ -2892,7 +2892,7 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>DGM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="810"/>
+        <location filename="../qgisio/layers.py" line="812"/>
         <source>Contours</source>
         <translation>Höhenlinien</translation>
     </message>
@@ -2905,6 +2905,11 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <location filename="../qgisio/layers.py" line="389"/>
         <source>Spectral index</source>
         <translation>Spektralindex</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="806"/>
+        <source>RGB orthomosaic</source>
+        <translation>RGB-Orthomosaik</translation>
     </message>
 </context>
 <context>

@@ -2837,7 +2837,7 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>non triangolato</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="805"/>
+        <location filename="../qgisio/layers.py" line="807"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
@@ -2847,12 +2847,12 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Ombreggiatura del DSM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="806"/>
+        <location filename="../qgisio/layers.py" line="808"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="807"/>
+        <location filename="../qgisio/layers.py" line="809"/>
         <source>Cameras</source>
         <translation>Camere</translation>
     </message>
@@ -2867,12 +2867,12 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Residui dei punti d'appoggio (vettori x{})</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="808"/>
+        <location filename="../qgisio/layers.py" line="810"/>
         <source>Point cloud</source>
         <translation>Nuvola di punti</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="816"/>
+        <location filename="../qgisio/layers.py" line="818"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
@@ -2882,7 +2882,7 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>{} ({})</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="809"/>
+        <location filename="../qgisio/layers.py" line="811"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
@@ -2892,7 +2892,7 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Ombreggiatura del DTM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="810"/>
+        <location filename="../qgisio/layers.py" line="812"/>
         <source>Contours</source>
         <translation>Curve di livello</translation>
     </message>
@@ -2905,6 +2905,11 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <location filename="../qgisio/layers.py" line="389"/>
         <source>Spectral index</source>
         <translation>Indice spettrale</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="806"/>
+        <source>RGB orthomosaic</source>
+        <translation>Ortomosaico RGB</translation>
     </message>
 </context>
 <context>

@@ -793,7 +793,7 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
             style_contours(layer)
         elif self.kind == INDEX:
             style_index(layer)
-        name = _output_layer_name(self.kind)
+        name = _output_layer_name(self.kind, path)
         if name:  # not the parameter's label ("Orthomosaic (default: <workspace>/orthomosaic.tif)")
             layer.setName(product_name(name, path, self.workspace))
         if group:  # styled: its kind known, it takes its place in the group (a hillshade under the orthomosaic)
@@ -801,7 +801,9 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
 
 
 
-def _output_layer_name(kind):
+def _output_layer_name(kind, path=""):
+    if kind == ORTHO and os.path.basename(path).lower().endswith("_rgb.tif"):  # Run pipeline's mosaic of a rig's
+        return QCoreApplication.translate("ResultLayers", "RGB orthomosaic")  # RGB frames, beside the bands'
     names = {DSM: QCoreApplication.translate("ResultLayers", "DSM"),
              ORTHO: QCoreApplication.translate("ResultLayers", "Orthomosaic"),
              CAMERAS: QCoreApplication.translate("ResultLayers", "Cameras"),

@@ -377,3 +377,12 @@ def _render(project, layer_list, name):
     image.save(os.path.join(SCREENSHOTS, name))
     colours = {image.pixel(x, y) for x in range(0, 900, 7) for y in range(0, 700, 7)}
     assert len(colours) > 5
+
+
+def test_the_rgb_frames_mosaic_is_named_apart_from_the_bands(tmp_path, qgis_new_project):
+    """Run pipeline's two mosaics of a rig (the bands' and the RGB frames', <stem>_rgb.tif) load under two names."""
+    from archaeoortho.qgisio import layers
+
+    assert layers._output_layer_name(layers.ORTHO, str(tmp_path / "orthomosaic_rgb.tif")) == "RGB orthomosaic"
+    assert layers._output_layer_name(layers.ORTHO, str(tmp_path / "orthomosaic.tif")) == "Orthomosaic"
+    assert layers._output_layer_name(layers.DSM, str(tmp_path / "dsm_rgb.tif")) == "DSM"
