@@ -94,6 +94,7 @@ def test_only_the_stacked_captures_rgb_frames_are_aligned(tmp_path):
     block; its frame is named in a warning; a frame named like a stacked photo is refused before the alignment."""
     from core import pipeline
     from core.prepare.captures import CaptureStackOptions, stack_capture_folder
+    from core.project.stages import StageError
     from tests import rig_scene as rs
 
     rig = rs.rig_block(n_strips=1, per_strip=3)
@@ -117,5 +118,5 @@ def test_only_the_stacked_captures_rgb_frames_are_aligned(tmp_path):
     assert placed == ["IMG_0000_RGB.TIF", "IMG_0001_RGB.TIF"] and "IMG_0002_RGB.TIF" in log.warnings[0]
     assert os.path.samefile(tmp_path / "out" / "IMG_0000_RGB.TIF", bands / "IMG_0000_RGB.TIF")
     os.rename(bands / "IMG_0001_RGB.TIF", bands / "IMG_0001.tif")  # the stacked photo's name
-    with pytest.raises(pipeline.StageError, match="has the name of the stacked photo"):
+    with pytest.raises(StageError, match="has the name of the stacked photo"):
         pipeline._frames_beside(str(bands), str(tmp_path / "out"), stack.photos, log)
