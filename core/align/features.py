@@ -21,15 +21,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 from ..common.cancel import CancelWatcher
 from ..common.files import atomic_output, atomic_write_text, fingerprint
 from ..common.progress import Progress, check_cancel
-from ..io.images import (
-    CameraGroup,
-    ImageError,
-    ImageInfo,
-    matching_grey8,
-    open_image,
-    photo_fingerprint,
-    read_image,
-)
+from ..io.images import CameraGroup, ImageError, ImageInfo, open_image, photo_fingerprint, read_matching_grey8
 from ..prepare.masks import MaskError, find_mask, mask_file_name, png_size
 from .calibrated import GivenCamera, colmap_camera
 from .options import (
@@ -160,6 +152,12 @@ def _feature_image_source(path: str) -> Optional[str]:
         return None
 
 
+def feature_image_needed(im: ImageInfo) -> bool:
+    """Is a photo's features' image an 8-bit one made for COLMAP (:func:`feature_images`): a photo other than
+    8-bit, or one that names its primary band?"""
+    return bool(im.primary_band) or im.dtype != "Byte"
+
+
 def feature_images(infos: Sequence[ImageInfo], sfm_dir: str) -> Tuple[Optional[str], List[str]]:
     """The folder COLMAP reads the photos that are not plain 8-bit from, or that name a primary band (None when
     there are none), and those photos.
@@ -174,7 +172,7 @@ def feature_images(infos: Sequence[ImageInfo], sfm_dir: str) -> Tuple[Optional[s
     are made (FEATURE_IMAGES_VERSION) is not the one it records."""
     from osgeo import gdal
 
-    chosen = [im for im in infos if im.primary_band or im.dtype != "Byte"]
+    chosen = [im for im in infos if feature_image_needed(im)]
     folder = os.path.join(sfm_dir, FEATURE_IMAGES)
     if not chosen:
         shutil.rmtree(folder, ignore_errors=True)
@@ -186,11 +184,7 @@ def feature_images(infos: Sequence[ImageInfo], sfm_dir: str) -> Tuple[Optional[s
         if os.path.isfile(dst) and _feature_image_source(dst) == source:
             continue
         try:
-            if im.primary_band:  # that band alone read
-                with open_image(im.path) as r:
-                    grey = matching_grey8(r.read(im.primary_band))
-            else:
-                grey = matching_grey8(read_image(im.path))
+            grey = read_matching_grey8(im.path, im.primary_band)
         except ImageError as e:
             raise AlignError(str(e)) from e
         with atomic_output(dst) as tmp:

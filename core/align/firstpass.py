@@ -38,8 +38,8 @@ from typing import Dict, List, Optional, Sequence, Tuple
 import cv2
 import numpy as np
 
-from ..io.images import ImageInfo, matching_grey8, read_image
-from .features import FeatureSettings, default_settings, sift_first_octave
+from ..io.images import ImageInfo, read_matching_grey8
+from .features import FeatureSettings, default_settings, feature_image_needed, sift_first_octave
 from .options import (
     FAINT_MIN_FEATURES,
     FAINT_PEAK_THRESHOLD,
@@ -223,9 +223,8 @@ class _Photos:
             im = self.by_name[name]
             # as COLMAP sees it (core.align.features.feature_images): a photo other than 8-bit, or a capture's,
             # stretched to 8 bits (its primary band)
-            if im.primary_band or im.dtype != "Byte":
-                arr = read_image(im.path, max_size=self.long_side)
-                self.grey[name] = shrink(matching_grey8(arr, im.primary_band), self.long_side)
+            if feature_image_needed(im):
+                self.grey[name] = read_matching_grey8(im.path, im.primary_band, self.long_side)
             else:
                 self.grey[name] = read_grey(im.path, max(im.width, im.height), self.long_side)
         return self.grey[name]

@@ -16,6 +16,7 @@ import numpy as np
 from ..common.errors import require
 from ..common.files import save_npz
 from ..common.parallel import check_unit_cancel
+from ..io.images import stretch8
 from ..prepare.masks import read_keep
 from ..prepare.sky import horizon_keep
 from .options import DenseError
@@ -156,9 +157,5 @@ def _to_rgb8(img: np.ndarray) -> np.ndarray:
     else:
         rgb = np.repeat(img[:, :, :1], 3, axis=2)
     if rgb.dtype != np.uint8:
-        rgb = rgb.astype(np.float32)
-        finite = np.isfinite(rgb)  # a float photo's NaN (no data): neither in the stretch nor in the colours
-        lo, hi = np.percentile(rgb[finite], [0.5, 99.5]) if finite.any() else (0.0, 1.0)
-        rgb = np.nan_to_num(rgb, nan=float(lo))
-        rgb = np.clip((rgb - lo) * (255.0 / max(hi - lo, 1e-6)), 0, 255).astype(np.uint8)
+        return stretch8(rgb)  # 16-bit, float (its NaN no data left out of the stretch)
     return np.ascontiguousarray(rgb)

@@ -240,13 +240,33 @@ def matching_grey8(arr: np.ndarray, band: int = 0) -> np.ndarray:
         g = a
     if g.dtype == np.uint8:
         return np.ascontiguousarray(g)
-    g = g.astype(np.float32, copy=False)
-    step = max(1, int(np.sqrt(g.size / 4e6)))  # the percentiles from about 4 million pixels at most
+    return stretch8(g)
+
+
+def stretch8(values: np.ndarray) -> np.ndarray:
+    """(rows, cols[, bands]) values other than 8-bit -> uint8, stretched from their 0.5 to their 99.5 percentile
+    (taken over about 4 million values at most, NaN left out) to 0..255; NaN (a float photo's no data) 0."""
+    g = np.asarray(values).astype(np.float32, copy=False)
+    step = max(1, int(np.sqrt(g.shape[0] * g.shape[1] / 4e6)))
     sample = g[::step, ::step]
     sample = sample[np.isfinite(sample)]
     lo, hi = (float(v) for v in np.percentile(sample, [0.5, 99.5])) if sample.size else (0.0, 1.0)
     out = (np.nan_to_num(g, nan=lo) - np.float32(lo)) * np.float32(255.0 / max(hi - lo, 1e-6))
     return np.ascontiguousarray(np.clip(out, 0, 255).astype(np.uint8))
+
+
+def read_matching_grey8(path: str, band: int = 0, max_size: Optional[int] = None) -> np.ndarray:
+    """:func:`matching_grey8` of the photo ``path``: its ``band`` (1-based) alone where given, else every band;
+    read downscaled (GDAL average) to ``max_size`` px on its long side when larger.  ImageError naming the file
+    when it cannot be read."""
+    with open_image(path) as r:
+        shape = None
+        if max_size and max(r.width, r.height) > max_size:
+            s = max_size / max(r.width, r.height)
+            shape = (max(1, round(r.height * s)), max(1, round(r.width * s)))
+        if band:
+            return matching_grey8(r.read(band, out_shape=shape, resampling="average"))
+        return matching_grey8(np.moveaxis(r.read_bands(out_shape=shape, resampling="average"), 0, -1))
 
 
 def exif_orientation(path: str) -> int:
