@@ -22,10 +22,10 @@ export QGIS_PLUGINPATH := $(PLUGINS)
 PROCESS_ENV = PYTHONPATH="$$($(PY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])'):$$PYTHONPATH" \
               QGIS_CUSTOM_CONFIG_PATH=$(QGIS_CONFIG) QGIS_PLUGINPATH=$(PLUGINS) QT_QPA_PLATFORM=offscreen
 
-.PHONY: help setup apt venv plugin-link demo test test-qgis340 test-qgis344 process package lint transup transcompile bench clean FORCE
+.PHONY: help setup apt venv plugin-link demo test test-fast test-qgis340 test-qgis344 process package lint transup transcompile bench clean FORCE
 
 help:
-	@echo "make setup | demo | test [PYTEST_ARGS=...] | test-qgis340 | test-qgis344 [PYTEST_ARGS=...] | process ARGS='...' | package | lint | transup | transcompile | bench"
+	@echo "make setup | demo | test [PYTEST_ARGS=...] | test-fast | test-qgis340 | test-qgis344 [PYTEST_ARGS=...] | process ARGS='...' | package | lint | transup | transcompile | bench"
 
 apt: $(BUILD)/.apt-stamp
 $(BUILD)/.apt-stamp: Makefile
@@ -73,6 +73,11 @@ process: setup
 
 test: setup
 	QGIS_PROCESS=$(QGIS_PROCESS) QGIS_CUSTOM_CONFIG_PATH=$(QGIS_CONFIG) $(PY) -m pytest $(PYTEST_ARGS)
+
+# The edit-test loop: the tests every CI leg runs (tests/legs.py) less those marked slow, on both cores
+test-fast: setup
+	QGIS_PROCESS=$(QGIS_PROCESS) QGIS_CUSTOM_CONFIG_PATH=$(QGIS_CONFIG) $(PY) -m pytest -q -n 2 --dist loadfile \
+	  -m "every_leg and not slow" $(PYTEST_ARGS)
 
 # The same `make test` in a cached Debian chroot (root or sudo; see the script): QGIS 3.40 / Python 3.13 / NumPy 2
 # (Debian 13), QGIS 3.44 / Python 3.14 (Debian sid)

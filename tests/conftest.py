@@ -130,6 +130,16 @@ def pytest_sessionstart(session):
 _FAULT_FILE = {}
 
 
+def pytest_collection_modifyitems(config, items):
+    """Marks each test ``every_leg`` unless tests/legs.py names it one-leg: the chroot legs of CI run
+    ``-m every_leg`` (tests/legs.py says why each test runs where)."""
+    from tests import legs
+
+    for item in items:
+        if not legs.one_leg(item.nodeid):
+            item.add_marker(pytest.mark.every_leg)
+
+
 def pytest_sessionfinish(session, exitstatus):
     _EXIT_STATUS["status"] = int(exitstatus)
 
