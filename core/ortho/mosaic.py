@@ -22,8 +22,9 @@ from .cameras import OrthoCamera
 from .grid import box_intersects, grid_tiles
 from .options import OrthoError, OrthoOptions
 from .pixels import PHOTO_CACHE
-from .planning import MosaicPlan, plan_mosaic
-from .radiometry_fit import fit_radiometry
+from .hotspot import shadow_margin_px, shadow_zones
+from .planning import MosaicPlan, plan_mosaic, planning_gsd
+from .radiometry_fit import fit_radiometry_model, radiometry_lines
 from .seamlines import read_seamline_edits, write_seamlines
 from .surface import Dsm, fill_dsm_gaps
 from .tiles import DSM_CACHE, TileUnit, render_tile
@@ -109,8 +110,9 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], crs: Optional[str], offset
             log.append(f"{len(prep.cameras)} images, GSD {prep.gsd:.3f} {unit}, mosaic {grid.width} x {grid.height} "
                        f"cells at {grid.resolution:g} {unit} ({bands} band(s) {dtype}), blending {options.blending}")
             progress.info(log[-1])
+            fitted = _before_planning(prep, dsm, offset, crs, options, log, timings, SubProgress(progress, 0.12, 0.16))
             t0 = time.time()
-            plan = plan_mosaic(prep, dsm, offset, options, workdir, SubProgress(progress, 0.12, 0.2), edits)
+            plan = plan_mosaic(prep, dsm, offset, options, workdir, SubProgress(progress, 0.16, 0.2), edits)
             timings["planning"] = time.time() - t0
             log.append(f"seamlines: planned on cells of {plan.k * grid.resolution:.3g} m ({plan.k} mosaic cells); "
                        f"{plan.relief_blobs} raised objects, {plan.relief_reassigned} given whole to one "
@@ -121,7 +123,7 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], crs: Optional[str], offset
             for note in plan.notes:
                 log.append(note)
                 progress.info(note)
-            model, summary = _radiometry(prep, dsm, offset, plan, options, log, timings, SubProgress(progress, 0.2, 0.25))
+            model, summary = _radiometry(prep, dsm, offset, plan, fitted, log, timings, progress)
             t0 = time.time()
             n_valid, fill_cells = _run_tiles(prep, plan, dsm, offset, options,
                                              SubProgress(progress, 0.25, 0.85 if per_image_folder else 0.97), model)
@@ -161,23 +163,50 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], crs: Optional[str], offset
         shutil.rmtree(workdir, ignore_errors=True)
 
 
-def _radiometry(prep: PreparedBlock, dsm: Dsm, offset, plan: MosaicPlan, options: OrthoOptions, log: List[str],
+def _before_planning(prep: PreparedBlock, dsm: Dsm, offset, crs: Optional[str], options: OrthoOptions,
+                     log: List[str], timings: Dict[str, float], progress: Progress):
+    """The radiometric model fitted from the overlaps (when asked for) and each photo's shadow zone around its
+    antisolar point (core.ortho.hotspot: the drone's shadow and the hot spot's core, left to the other photos where
+    they see that ground), set on ``prep.cameras`` before the plan; (model, its summary) for :func:`_radiometry`."""
+    model, summary = None, {}
+    if options.radiometry:
+        t0 = time.time()
+        model, summary = fit_radiometry_model(prep, dsm, offset, options.hot_spot, SubProgress(progress, 0.0, 0.9))
+        timings["radiometry"] = time.time() - t0
+    if options.avoid_shadow:
+        margin = shadow_margin_px(options.feather_gsd if options.blending == "feather" else 0.0,
+                                  planning_gsd(prep.metas))
+        zones, shadow, lines = shadow_zones(prep.cameras, crs, model, margin)
+        for cam, zone in zip(prep.cameras, zones):
+            cam.shadow = zone
+        summary["shadow"] = shadow
+        for line in lines:
+            log.append(line)
+            progress.info(line)
+    return model, summary
+
+
+def _radiometry(prep: PreparedBlock, dsm: Dsm, offset, plan: MosaicPlan, fitted, log: List[str],
                 timings: Dict[str, float], progress: Progress):
-    """The radiometric model (core.ortho.radiometry_fit) when asked for, its lines in ``log``; with a model
-    the plan's exposure gains become the model's gains at the images' centres (the which-image layer's)."""
-    if not options.radiometry:
-        return None, {}
+    """The radiometric model fitted before the plan (``fitted``: the model and its summary) checked on the plan's
+    seams, its lines in ``log``; with a model the plan's exposure gains become the model's gains at the images'
+    centres (the which-image layer's).  (model or None, the figures for the record)."""
+    model, summary = fitted
+    shadow = summary.pop("shadow", None)
+    extra = {"shadow": shadow} if shadow is not None else {}
+    if "pairs" not in summary:  # no model was fitted (radiometry off)
+        return None, extra
     t0 = time.time()
-    model, lines = fit_radiometry(prep, dsm, offset, np.load(plan.labels_path), plan.k, plan.gains,
-                                  options.hot_spot, progress)
-    timings["radiometry"] = time.time() - t0
+    model, lines = radiometry_lines(model, summary, prep, dsm, offset, np.load(plan.labels_path), plan.k,
+                                    plan.gains)
+    timings["radiometry"] = timings.get("radiometry", 0.0) + time.time() - t0
     for line in lines:
         log.append(line)
         progress.info(line)
     if model is None:
-        return None, {}
+        return None, extra
     plan.gains = [model.scalar_gain(i) for i in range(len(prep.cameras))]
-    return model, dict(model.summary)
+    return model, {**model.summary, **extra}
 
 
 def _run_tiles(prep: PreparedBlock, plan: MosaicPlan, dsm: Dsm, offset, options: OrthoOptions, progress: Progress,

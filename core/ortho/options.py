@@ -49,6 +49,9 @@ class OrthoOptions:
     # (core.ortho.radiometry; applied only where it makes the overlaps agree better); replaces the exposure gains
     radiometry: bool = True
     hot_spot: bool = True  # with radiometry: also the sun-relative hot spot
+    # the drone's shadow: around each photo's antisolar point (the sun from EXIF time and GPS, else the hot spot the
+    # radiometry found) the mosaic takes another photo wherever one sees the ground (core.ortho.hotspot)
+    avoid_shadow: bool = True
     avoid_relief: bool = True  # keep seamlines off buildings and trees
     seam_iterations: int = 2  # passes moving the seamlines towards where the images agree (0 = off)
     seam_alpha: float = 5.0  # weight of the view cost against the seam cost in those moves

@@ -348,19 +348,24 @@ def fit_from_samples(obs: _Obs, prep: PreparedBlock, hot_spot: bool, progress: P
     return model, summary
 
 
-def fit_radiometry(prep: PreparedBlock, dsm: Dsm, offset: np.ndarray, labels: np.ndarray, k: int,
-                   gains: Sequence[float], hot_spot: bool, progress: Progress
-                   ) -> Tuple[Optional[RadiometryModel], List[str]]:
-    """The radiometric model of the mosaic (None when it is not applied) and its lines for the log; the model's
-    ``summary`` (also on a skip: in the log) holds the figures: the seam step before and after, the fitted
-    fall-off at r = 0.25, 0.5, 0.75, 1 per camera, the hot spot."""
+def fit_radiometry_model(prep: PreparedBlock, dsm: Dsm, offset: np.ndarray, hot_spot: bool, progress: Progress
+                         ) -> Tuple[Optional[RadiometryModel], Dict[str, object]]:
+    """The radiometric model fitted from the overlaps (None where it is not applied) and its summary: before the
+    mosaic is planned (the plan keeps each photo's hot spot core out where another photo sees that ground:
+    core.ortho.hotspot)."""
     from ..common.progress import SubProgress
 
-    obs = sample_overlaps(prep, dsm, offset, SubProgress(progress, 0.0, 0.4))
-    model, summary = fit_from_samples(obs, prep, hot_spot, SubProgress(progress, 0.4, 0.85))
+    obs = sample_overlaps(prep, dsm, offset, SubProgress(progress, 0.0, 0.45))
+    return fit_from_samples(obs, prep, hot_spot, SubProgress(progress, 0.45, 1.0))
+
+
+def radiometry_lines(model: Optional[RadiometryModel], summary: Dict[str, object], prep: PreparedBlock, dsm: Dsm,
+                     offset: np.ndarray, labels: np.ndarray, k: int, gains: Sequence[float]
+                     ) -> Tuple[Optional[RadiometryModel], List[str]]:
+    """The seam steps of the plan (``labels``) before and after the model, and the model (None where it makes the
+    seams worse) with its lines for the log; the model's ``summary`` holds the figures."""
     summary.update(seam_steps(model, labels, k, prep, dsm, offset, gains))
     before, after = summary["seam_step_before"], summary["seam_step_after"]
-    progress.report(1.0, "radiometry fitted")
     if model is None:
         return None, [f"radiometry left as it is: {summary.get('skipped')}; brightness step across the seams "
                       f"{100 * before:.1f} % (median)"]
@@ -384,3 +389,13 @@ def fit_radiometry(prep: PreparedBlock, dsm: Dsm, offset: np.ndarray, labels: np
                  f"; between overlapping images {100 * summary['overlap_step_before']:.1f} % -> "
                  f"{100 * summary['overlap_step_after']:.1f} %")
     return model, lines
+
+
+def fit_radiometry(prep: PreparedBlock, dsm: Dsm, offset: np.ndarray, labels: np.ndarray, k: int,
+                   gains: Sequence[float], hot_spot: bool, progress: Progress
+                   ) -> Tuple[Optional[RadiometryModel], List[str]]:
+    """The radiometric model of the mosaic (None when it is not applied) and its lines for the log; the model's
+    ``summary`` (also on a skip: in the log) holds the figures: the seam step before and after, the fitted
+    fall-off at r = 0.25, 0.5, 0.75, 1 per camera, the hot spot."""
+    model, summary = fit_radiometry_model(prep, dsm, offset, hot_spot, progress)
+    return radiometry_lines(model, summary, prep, dsm, offset, labels, k, gains)

@@ -9,6 +9,7 @@ from typing import Optional
 import numpy as np
 
 from .cameras import OrthoCamera
+from .hotspot import SHADOW_PENALTY, in_shadow
 from .pixels import ImageMeta, image_window, photo_mask, remap_photo
 from .visibility import Visibility, visibility_table
 
@@ -54,6 +55,8 @@ def camera_view(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.nda
     half_diag = 0.5 * math.hypot(cam.camera.width, cam.camera.height)
     rho = np.hypot(px[idx, 0] - cam.camera.cx, px[idx, 1] - cam.camera.cy) / half_diag
     cost[idx] = (rho * rho + (dxy / dz) ** 2).astype(np.float32)
+    if cam.shadow is not None:  # the drone's shadow and the hot spot's core: another image's where one sees it
+        cost[idx[in_shadow(cam.shadow, c, xyz[idx])]] += SHADOW_PENALTY
     return Sampled(values, ok, cost, xyz, px)
 
 

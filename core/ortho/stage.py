@@ -85,7 +85,8 @@ def build_orthophoto_workspace(workspace_dir: str, options: Optional[OrthoOption
         run.finish(outputs=outputs, results={
             "resolution": result.resolution, "gsd": result.gsd, "width": result.width, "height": result.height,
             "images": len(result.images), "valid_fraction": result.valid_fraction, "warnings": result.warnings,
-            **seam_figures(result.radiometry)})
+            **seam_figures(result.radiometry),
+            **({"drone_shadow": result.radiometry["shadow"]} if "shadow" in (result.radiometry or {}) else {})})
     return OrthoStageResult(lay.root, options.output, crs, result.resolution, result.images, result.valid_fraction,
                             options.per_image_folder, options.seamlines, result.timings, result.warnings,
                             result.log_lines, result.radiometry)
