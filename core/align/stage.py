@@ -37,7 +37,7 @@ from .escalation import EscalationContext, block_state, escalate
 from .features import extract_features, match_pairs
 from .firstpass import choose_first_pass
 from .inputs import Photos, read_folder
-from .mapping import MappingJob, adjust_block, map_block, verified_pairs, verified_partners
+from .mapping import MappingJob, adjust_block, map_block, verified_links, verified_pairs, verified_partners
 from .options import MIN_VERIFIED_INLIERS, AlignError, AlignOptions
 from .pairs import select_pairs
 from .record import STAGE, keep_previous, prepare_database, previous_alignment
@@ -118,7 +118,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
                                                             photos.held(), s),
                                 lambda reg, oth: diagnose_unregistered(
                                     infos, reg, oth, verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS),
-                                    degenerate),
+                                    degenerate, verified_links(pycolmap, db_path, MIN_VERIFIED_INLIERS)[1]),
                                 lambda: verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS), photos.positions)
         with run.step("escalation", save=False):
             ordered, escalation = escalate(ctx, ordered, SubProgress(progress, 0.90, 0.93))
@@ -133,7 +133,8 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
             pp = adjust_block(pycolmap, rec, options, progress, photos.held()[0], degenerate,
                               hold_focal=mapping_job.focal_held is not None)
         registered = {rec.images[i].name for i in rec.reg_image_ids()}
-        unregistered = diagnose_unregistered(infos, registered, others, partners, degenerate)
+        unregistered = diagnose_unregistered(infos, registered, others, partners, degenerate,
+                                             verified_links(pycolmap, db_path, MIN_VERIFIED_INLIERS)[1])
         report_unregistered(progress, unregistered, others, len(registered))
         check_cancel(progress)
         outcome = Outcome(rec, unregistered, others, pairs, pairing_used, sorted(masks), escalation, first, pp,
