@@ -4,6 +4,12 @@ coloured points.
 The depth maps are compared pixel by pixel; a pixel is kept where at least ``min_consistent`` independent
 pairs agree within a tolerance (about one disparity pixel of the weakest pair, relative to depth), its depth is
 the mean of the agreeing ones, and it is back-projected with the camera model and coloured from the image.
+
+Where only one of the image's pairs covers the ground (:func:`pair_cover`: the hull of what that pair matched;
+ground that two photos alone see, as along a strip flown at 60 % forward overlap, or a pair chosen for a part of
+the frame no other pair reaches) no second pair can confirm a pixel: there the one pair's depth is kept where it
+matched densely around the pixel (:func:`sole_pair_depth`; issue 46: 17 % of seneca_south's hull was such ground
+and all of it was interpolated).
 """
 from __future__ import annotations
 
@@ -34,6 +40,9 @@ class FuseUnit:
     out_path: str
     threads: int
     sky_margin_deg: Optional[float] = None  # drop pixels less than this far below the horizon (None: keep)
+    sole_pair: bool = True  # keep one pair's depth where no other pair of the image covers the ground ...
+    sole_region: Optional[np.ndarray] = None  # ... inside this convex polygon (local x, y; counter-clockwise): the
+    # camera centres' hull, under the block; beyond it (the block's edge, frame borders) two pairs must agree
 
 
 def sky_free(view: View, depth: np.ndarray, sky_margin_deg: Optional[float]) -> np.ndarray:
@@ -99,6 +108,64 @@ def fuse_depth_maps(maps: np.ndarray, rel_tol: np.ndarray, min_consistent: int) 
     return np.where(keep, best_v, np.nan).astype(np.float32), best_n
 
 
+COVER_STEP = 8  # a pair's cover is found on a grid of this many pixels (its hull is coarse anyway)
+COVER_SOLID = 0.25  # ... of cells at least this share matched (a streak of lone matches makes no cover)
+SOLE_WINDOW_SHARE = 1.0 / 64  # a sole pair's pixel needs SOLE_DENSITY of its window (this share of the image's
+SOLE_DENSITY = 0.5  # short side) matched: the edge of a pair's overlap and its stray matches are not kept
+
+
+def pair_cover(depth: np.ndarray) -> np.ndarray:
+    """Where a pair's depth map (NaN = none) covers its image: the convex hull of its densely matched cells
+    (COVER_STEP pixels, COVER_SOLID of them matched), the ground its two photos both see as far as the matching
+    shows; a map with no such cell covers nothing."""
+    cv2 = require("cv2", "depth fusion")
+    h, w = depth.shape
+    hs, ws = -(-h // COVER_STEP), -(-w // COVER_STEP)
+    valid = np.zeros((hs * COVER_STEP, ws * COVER_STEP), np.float32)
+    valid[:h, :w] = np.isfinite(depth)
+    cells = valid.reshape(hs, COVER_STEP, ws, COVER_STEP).mean(axis=(1, 3)) >= COVER_SOLID
+    pts = np.argwhere(cells)[:, ::-1].astype(np.int32)
+    cover = np.zeros((hs, ws), np.uint8)
+    if len(pts) >= 3:
+        cv2.fillConvexPoly(cover, cv2.convexHull(pts), 1)
+    else:
+        cover[cells] = 1
+    return np.repeat(np.repeat(cover, COVER_STEP, axis=0), COVER_STEP, axis=1)[:h, :w] > 0
+
+
+def sole_pair_depth(maps: np.ndarray) -> np.ndarray:
+    """Per pixel the depth of the one map whose pair alone covers it (:func:`pair_cover`), where that map matched
+    SOLE_DENSITY of a window of SOLE_WINDOW_SHARE of the image's short side around it; NaN elsewhere (no map,
+    or two or more that cover the pixel: there they must agree)."""
+    cv2 = require("cv2", "depth fusion")
+    k, h, w = maps.shape
+    win = max(5, int(round(min(h, w) * SOLE_WINDOW_SHARE)) | 1)
+    covers = np.stack([pair_cover(m) for m in maps])
+    n = covers.sum(axis=0)
+    out = np.full((h, w), np.nan, np.float32)
+    for m in range(k):
+        sole = covers[m] & (n == 1)
+        if not sole.any():
+            continue
+        valid = np.isfinite(maps[m])
+        dense = cv2.blur(valid.astype(np.float32), (win, win)) >= SOLE_DENSITY
+        take = sole & valid & dense
+        out[take] = maps[m][take]
+    return out
+
+
+def inside_convex(xy: np.ndarray, polygon: np.ndarray) -> np.ndarray:
+    """Which points ``xy`` (N, 2) lie inside the convex ``polygon`` (counter-clockwise vertices); a polygon of fewer
+    than 3 vertices holds none."""
+    poly = np.asarray(polygon, dtype=np.float64)
+    if len(poly) < 3:
+        return np.zeros(len(xy), bool)
+    inside = np.ones(len(xy), bool)
+    for a, b in zip(poly, np.roll(poly, -1, axis=0)):
+        inside &= (b[0] - a[0]) * (xy[:, 1] - a[1]) - (b[1] - a[1]) * (xy[:, 0] - a[0]) >= 0
+    return inside
+
+
 def backproject(view: View, k: np.ndarray, dist: np.ndarray, depth: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
     """Local-frame points of the valid pixels of a depth map (z along the optical axis) and their (rows, cols)."""
     cv2 = require("cv2", "depth fusion")
@@ -124,7 +191,7 @@ def fuse_image(unit: FuseUnit, cancel_path: Optional[str] = None) -> dict:
             maps.append(m)
             errs.append(rel_err)
     out = {"image": unit.view.name, "points": 0, "path": unit.out_path, "bbox": None}
-    if len(maps) < unit.min_consistent:
+    if len(maps) < (1 if unit.sole_pair else unit.min_consistent):
         out["note"] = f"{len(maps)} usable pair(s), {unit.min_consistent} needed"
         return out
     shapes = {m.shape for m in maps}
@@ -133,6 +200,18 @@ def fuse_image(unit: FuseUnit, cancel_path: Optional[str] = None) -> dict:
     stack = np.stack(maps)
     rel_tol = np.clip(unit.tolerance_px * np.asarray(errs, dtype=np.float64), 0.002, 0.05)
     fused, _n = fuse_depth_maps(stack, rel_tol, unit.min_consistent)
+    if unit.sole_pair:
+        sole = sole_pair_depth(stack)
+        take = ~np.isfinite(fused) & np.isfinite(sole)
+        if unit.sole_region is not None and take.any():
+            k0, dist0 = unit.view.camera_matrix(fused.shape[1] / unit.view.width, fused.shape[0] / unit.view.height)
+            xyz, (rows, cols) = backproject(unit.view, k0, dist0, np.where(take, sole, np.nan))
+            out_of = ~inside_convex(xyz[:, :2], unit.sole_region)
+            take[rows[out_of], cols[out_of]] = False
+            del xyz, rows, cols, out_of
+        fused[take] = sole[take]
+        out["sole_pair_pixels"] = int(take.sum())
+        del sole, take
     del stack, maps
     if unit.sky_margin_deg is not None or unit.view.mask_path:
         fused = sky_free(unit.view, fused, unit.sky_margin_deg)

@@ -10,8 +10,9 @@ from ..common.errors import ArchaeoOrthoError
 
 QUALITIES = {"full": 1.0, "half": 0.5, "quarter": 0.25}  # QUALITY -> image downscale for matching
 ENGINES = ("cpu", "cuda")
-CACHE_VERSION = 6  # of the per-pair depth map cache (dense/pairs-<key>/); 2: coarse-to-fine; 3: tiled pyramid;
-# 4: uint16 depth maps (x step_i / step_j), stored; 5: equalised pairs, fine_uniqueness; 6: COARSE_FLAT_PX 3
+CACHE_VERSION = 7  # of the per-pair depth map cache (dense/pairs-<key>/); 2: coarse-to-fine; 3: tiled pyramid;
+# 4: uint16 depth maps (x step_i / step_j), stored; 5: equalised pairs, fine_uniqueness; 6: COARSE_FLAT_PX 3;
+# 7: window-end minima and streaks dropped (issue 46)
 
 # options that say where the work runs, not what it computes (not recorded among the stage's parameters)
 EXECUTION_OPTIONS = ("workers", "executor", "scheduler")
@@ -49,6 +50,10 @@ class DenseOptions:
     equalize: bool = True  # local contrast equalisation (CLAHE) of each rectified pair before matching
     lr_tolerance: float = 1.0  # px
     min_consistent: int = 2  # pairs that must agree on a pixel
+    # ... except where one pair alone covers the ground of an image (fusion.sole_pair_depth: two photos alone see it,
+    # or the other pairs do not reach it): there its dense matches are kept (issue 46: 17 % of a real fixed-wing
+    # block's hull was such ground, all of it interpolated); False: every pixel needs min_consistent pairs
+    sole_pair: bool = True
     depth_tolerance_px: float = 1.0  # agreement tolerance, in disparity pixels of the weakest pair
     max_hole_cells: int = 16
     # holes inside the convex hull of the camera centres (or enclosed by data, for one strip) are filled with a smooth

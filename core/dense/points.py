@@ -192,13 +192,16 @@ def _fuse(block: DenseBlock, summaries: List[dict], pair_dir: str, options: Dens
         per_image.setdefault(p.i, []).append((path, "i", float(s.get("rel_err", 0.01))))
         per_image.setdefault(p.j, []).append((path, "j", float(s.get("rel_err", 0.01))))
     fused_dir = _fresh_fused_dir(dense_dir)
-    lonely = [views[i].name for i, m in per_image.items() if len(m) < options.min_consistent]
+    need = 1 if options.sole_pair else options.min_consistent  # a sole pair's ground needs no second pair
+    region = camera_hull(views)  # ... under the block only
+    lonely = [views[i].name for i, m in per_image.items() if len(m) < need]
     if lonely:
-        progress.info(f"{len(lonely)} image(s) are in fewer than {options.min_consistent} matched pairs and add no "
+        progress.info(f"{len(lonely)} image(s) are in fewer than {need} matched pairs and add no "
                       f"points of their own: {', '.join(lonely[:6])}{' ...' if len(lonely) > 6 else ''}")
     funits = [FuseUnit(views[i], options.scale, maps, options.depth_tolerance_px, options.min_consistent,
-                       os.path.join(fused_dir, f"{i}.npz"), threads, sky_margin_deg=options.sky_margin_deg)
-              for i, maps in sorted(per_image.items()) if len(maps) >= options.min_consistent]
+                       os.path.join(fused_dir, f"{i}.npz"), threads, sky_margin_deg=options.sky_margin_deg,
+                       sole_pair=options.sole_pair, sole_region=region)
+              for i, maps in sorted(per_image.items()) if len(maps) >= need]
     files: List[PointFile] = []
     executor = make_executor(options.workers, options.executor, options.scheduler,
                              unit_memory=unit_memory(views, options.scale))
@@ -208,6 +211,20 @@ def _fuse(block: DenseBlock, summaries: List[dict], pair_dir: str, options: Dens
             if r["points"] > 0:
                 files.append(PointFile(r["path"], tuple(r["bbox"]), r["points"], tuple(r["robust_bbox"])))
     return files
+
+
+def camera_hull(views: Dict[int, View]) -> np.ndarray:
+    """The convex hull (local x, y, counter-clockwise) of the camera centres; no vertex where they span no area
+    (one strip: no ground is under the block, and every pixel needs two pairs as before)."""
+    from .grid import convex_hull_xy
+
+    hull = convex_hull_xy(np.array([v.centre[:2] for v in views.values()]))
+    if len(hull) < 3:
+        return np.zeros((0, 2))
+    x, y = hull[:, 0], hull[:, 1]
+    area = 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+    span = float(np.ptp(x) + np.ptp(y))
+    return hull if area > 1e-3 * span * span else np.zeros((0, 2))
 
 
 def _fresh_fused_dir(dense_dir: str) -> str:

@@ -232,9 +232,11 @@ def _match_lr(left: np.ndarray, right: np.ndarray, block: int, dmin: int, num: i
     check_unit_cancel(cancel_path)
     disp_r = sgbm.compute(np.ascontiguousarray(rp[:, ::-1]), np.ascontiguousarray(lp[:, ::-1]))
     disp_r = (disp_r.astype(np.float32) / 16.0)[:, ::-1][:, pad:pad + w]
-    invalid = dmin - 0.5
-    disp_l[disp_l <= invalid] = np.nan
-    disp_r[disp_r <= invalid] = np.nan
+    # SGBM's invalid value (below dmin) and a minimum at either end of the range (the true one lies beyond it:
+    # ground the other photo does not see, matched to whatever lies at the range's end)
+    with np.errstate(invalid="ignore"):
+        for d in (disp_l, disp_r):
+            d[(d < dmin + WINDOW_END_PX) | (d > dmin + num - 1 - WINDOW_END_PX)] = np.nan
     return np.ascontiguousarray(disp_l), np.ascontiguousarray(disp_r)
 
 
@@ -250,11 +252,35 @@ def lr_checked(disp_l: np.ndarray, disp_r: np.ndarray, tolerance: float) -> np.n
     return np.where(ok, disp_l, np.nan).astype(np.float32)
 
 
+WINDOW_END_PX = 1.0  # a disparity this close to either end of its search window is a boundary minimum (issue 46:
+# the ground one photo of a pair does not see, beside the overlap, matched at the window's end: streaks of rows)
 COARSE_AGREEMENT_PX = 2.0  # a fine disparity this far outside its coarse neighbourhood's range is a blunder
 COARSE_FLAT_PX = 3.0  # a fine hole takes the coarse disparity where the coarse neighbourhood spans at most this
 # (fine pixels; under EDGE_JUMP_PX: no wall; 2 until issue 33: the coarse level's noise on faint fields exceeded it
 # and the fine level, which loses faint texture, kept its holes: farmland 88.2 -> 90.7 % measured, RMSE inside the
 # cameras' hull unchanged at 1.5 GSD)
+
+
+STREAK_ROWS = 5  # matches in runs fewer rows tall than this are dropped (no surface is a one-row streak) ...
+STREAK_STEP_PX = 1.0  # ... a run: matches each within this many disparities of the one above or below
+
+
+def without_streaks(disp: np.ndarray) -> np.ndarray:
+    """``disp`` without the matches that no STREAK_ROWS rows of agreeing matches hold (a vertical opening of the
+    matches that agree with the one above or below within STREAK_STEP_PX): SGBM aggregates along the rows, and where a pair's ground is not in the other photo (beside the
+    overlap, a frame's corner) its wrong matches form streaks a row or two tall (issue 46: seneca_south's streaks
+    of heights out of the block)."""
+    cv2 = require("cv2", "dense matching")
+    with np.errstate(invalid="ignore"):
+        link = np.abs(disp[1:] - disp[:-1]) <= STREAK_STEP_PX  # a match and the one below it agree
+    valid = np.zeros(disp.shape, np.uint8)
+    valid[1:] |= link
+    valid[:-1] |= link
+    kernel = np.ones((STREAK_ROWS, 1), np.uint8)
+    held = cv2.dilate(cv2.erode(valid, kernel), kernel) > 0
+    out = disp.copy()
+    out[~held] = np.nan
+    return out
 
 
 def coarse_to_fine(fine: np.ndarray, coarse: np.ndarray) -> np.ndarray:
@@ -468,7 +494,10 @@ def _match_tiled(level: LevelPair, prior: np.ndarray, unit: "PairUnit", cancel_p
                 sgbm = _sgbm(block, 0, tn, uq, max(1, int(round(unit.lr_tolerance))))
                 chk = sgbm.compute(lc, rc).astype(np.float32) / 16.0
                 chk[chk < -0.5] = np.nan
-            out[y0:y1, x0:x1] = chk[y0 - ya:y1 - ya, x0 - xa:x1 - xa] + lo
+            piece = chk[y0 - ya:y1 - ya, x0 - xa:x1 - xa]
+            with np.errstate(invalid="ignore"):  # a minimum at the window's end: the true one lies beyond it
+                piece[(piece < WINDOW_END_PX) | (piece > hi - lo - WINDOW_END_PX)] = np.nan
+            out[y0:y1, x0:x1] = piece + lo
             runs_done += 1
             searched += tn
     return out, {"tiles": runs_done, "skipped": skipped, "two_way": two_ways,
@@ -506,6 +535,7 @@ def _disparity(pair: LevelPair, unit: "PairUnit", cancel_path: Optional[str],
                                    edges_two_way=k == 0)
         disp = coarse_to_fine(fine, disp)
         if k == 0:
+            disp = without_streaks(disp)
             info.update(tiles=tinfo["tiles"], tiles_skipped=tinfo["skipped"], tiles_two_way=tinfo["two_way"],
                         disparities_searched=round(tinfo["disparities"], 1))
     if stats is not None:
