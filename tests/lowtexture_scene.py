@@ -202,10 +202,11 @@ def render_farm_image(scene: FarmScene, camera: syn.CameraModel, shot: syn.Shot,
 
 
 class FarmBlock(syn.SyntheticBlock):
-    def render(self, folder: str, supersample: int = 1, ext: str = ".jpg", quality: int = 92,
+    def render(self, folder: str, supersample: int = 1, ext: str = ".jpg", quality: Optional[int] = None,
                radiometry=None, keep_existing: bool = False) -> List[str]:
-        """The photos as JPEG in ``folder``; ``keep_existing``: those already there are not rendered again (an
-        interrupted rendering of a large block resumed)."""
+        """The photos as JPEG in ``folder`` (``quality``: the block's ``jpeg_quality``, else 92); ``keep_existing``:
+        those already there are not rendered again (an interrupted rendering of a large block resumed)."""
+        quality = quality or getattr(self, "jpeg_quality", None) or 92
         os.makedirs(folder, exist_ok=True)
         paths = []
         for k, s in enumerate(self.shots):
@@ -299,3 +300,42 @@ def full_block(n_strips: int = 4, per_strip: int = 10, contrast: float = 1.0) ->
     """The benchmark's block: 3600 x 2700 px (9.7 MP) at 4.9 cm GSD, ``n_strips`` x ``per_strip`` photos."""
     cam = syn.CameraModel(3600, 2700, 3060.0, 3060.0, 1803.2, 1348.9, k1=-0.05, k2=0.01, p1=0.0003, p2=-0.0002)
     return farm_block(cam, 0.049, n_strips=n_strips, per_strip=per_strip, contrast=contrast)
+
+
+def fixed_wing_block(contrast: float = 1.0, seed: int = 46, forward_overlap: float = 0.58, tilt_deg: float = 6.0,
+                     jpeg_quality: int = 85) -> FarmBlock:
+    """Issue 46: the farmland as a fixed-wing drone without a gimbal photographs it (seneca_south): the strip flown
+    along the frames' short side at ``forward_overlap`` (58 %: the ground between two photos' common part and the
+    next one's is seen by those two photos alone), frames tilted by N(0, ``tilt_deg``) about each axis, and after
+    the strip a turn: two photos with the heading turned by about 100 and 160 degrees beside its end (pairs of
+    wide baselines, B/Z 0.8-1.2, and small overlaps); saved as JPEG ``jpeg_quality``.  640 x 480 px at 3 cm GSD
+    (a test block), 4 photos in the strip."""
+    cam = syn.CameraModel(640, 480, 560.0, 560.0, 321.7, 238.4, k1=-0.06, k2=0.01, p1=0.0004, p2=-0.0003)
+    gsd = 0.03
+    rng = np.random.default_rng(seed + 1)
+    altitude = gsd * cam.fx
+    along = cam.height * gsd  # the strip runs along the frames' short side
+    base = (1.0 - forward_overlap) * along
+    n = 4
+    length = (n - 1) * base
+    margin = 0.6 * cam.width * gsd + 5.0
+    bounds = (-margin, -length / 2 - margin, margin + 0.8 * cam.width * gsd, length / 2 + margin)
+    scene = farm_scene(seed, bounds, contrast, max(0.03, min(0.1, 1.5 * gsd)),
+                       object_scale=min(1.0, 2.5 * altitude / 150.0))
+    z_fly = scene.base_z + altitude
+    shots = []
+    centres = [np.array([0.0, -length / 2 + k * base, z_fly]) for k in range(n)]
+    ups = [np.array([0.0, 1.0, 0.0])] * n  # the flight direction up in the frame: the strip along its short side
+    # after the turn: beside the strip's end, the heading turned (seneca_south's IMG_0455 and IMG_0456)
+    end = centres[-1]
+    for dx, dy, turn in ((0.55 * cam.width * gsd, -0.45 * base, 100.0), (0.7 * cam.width * gsd, 0.9 * base, 160.0)):
+        centres.append(end + np.array([dx, dy, 0.0]))
+        a = math.radians(turn)
+        ups.append(np.array([-math.sin(a), math.cos(a), 0.0]))
+    for k, (c, up) in enumerate(zip(centres, ups)):
+        c = c + rng.normal(0.0, 0.3, 3)
+        r = syn.small_rotation(rng, tilt_deg) @ syn.look_at(c, c - np.array([0.0, 0.0, 1.0]), up)
+        shots.append(syn.Shot(f"W1_{k + 1:02d}.jpg", r, c, "vertical", 1))
+    block = FarmBlock(scene, cam, shots, altitude, seed=seed)
+    block.jpeg_quality = jpeg_quality
+    return block
