@@ -25,9 +25,10 @@ class OrthoCamera:
     camera_id: int = 0
     mask_path: Optional[str] = None
     max_gsd: Optional[float] = None  # ground points this image resolves coarser than this (m/px) are not used
-    # the drone's shadow (core.ortho.hotspot): antisolar x, y, z (local frame) and radius (rad) of the view rays
-    # that cost SHADOW_PENALTY more (another image takes that ground wherever one sees it); None = none
-    shadow: Optional[Tuple[float, float, float, float]] = None
+    # the drone's shadow (core.ortho.hotspot): antisolar x, y, z (local frame), the radius (rad) of the view rays
+    # that cost SHADOW_PENALTY more (another image takes that ground wherever one sees it) and the hot spot's width
+    # (rad) of the view cost that grows towards it; None = none
+    shadow: Optional[Tuple[float, float, float, float, float]] = None
 
     def ground_resolution(self, xyz_local: np.ndarray, projected: Optional[Tuple[np.ndarray, np.ndarray]] = None
                           ) -> np.ndarray:

@@ -31,6 +31,11 @@ from typing import Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 SHADOW_PENALTY = 1000.0  # added to the view cost inside a shadow zone (finite: the photo keeps it where alone)
+# around the zone the view cost grows with the hot spot's shape, HALO_WEIGHT * exp(-theta^2 / (2 sigma^2)) (sigma: the
+# hot spot's width), so that the seam around a zone falls where the two photos' halos are alike (and the seamline
+# moves can move it), not on the zone's edge: a hard circle there showed the halo's skirt against the other photo
+# (seneca_south: 1 levels it; 3 gave so much ground to oblique neighbours that their misregistration showed)
+HALO_WEIGHT = 1.0
 SHADOW_FRACTION = 0.5  # the zone's radius: this share of the fitted hot spot's width (sigma)
 DEFAULT_RADIUS_DEG = 4.0  # the zone's radius where no hot spot was fitted (the sun from EXIF alone)
 MIN_HOT_GAIN = 0.01  # a fitted hot spot brighter than this (1 %) gives the direction
@@ -165,16 +170,18 @@ def exif_antisolar(path: str, crs: Optional[str]) -> Tuple[Optional[np.ndarray],
 
 
 def shadow_zones(cameras, crs: Optional[str], model, margin_px: float,
-                 exif_source=exif_antisolar) -> Tuple[List[Optional[Tuple[float, float, float, float]]],
+                 exif_source=exif_antisolar) -> Tuple[List[Optional[Tuple[float, ...]]],
                                                        Dict[str, object], List[str]]:
-    """Per camera its shadow zone (antisolar x, y, z in the local frame, radius in radians) or None, the summary
+    """Per camera its shadow zone (antisolar x, y, z in the local frame, radius and the halo's width in radians) or
+    None, the summary
     for the stage's record and lines for the log.  ``model``: the fitted RadiometryModel or None; ``margin_px``:
     added to each zone's radius in the photo's pixels (the feathering ramp and planning cells)."""
     fitted = None
     if model is not None and any(math.exp(h) - 1.0 > MIN_HOT_GAIN for h in model.hot):
         fitted = np.asarray(model.antisolar, dtype=float)
     base = SHADOW_FRACTION * model.hot_width if fitted is not None else math.radians(DEFAULT_RADIUS_DEG)
-    zones: List[Optional[Tuple[float, float, float, float]]] = []
+    sigma = model.hot_width if fitted is not None else 2.0 * base
+    zones: List[Optional[Tuple[float, ...]]] = []
     sources: Dict[str, int] = {}
     seen = 0
     why = ""
@@ -187,12 +194,13 @@ def shadow_zones(cameras, crs: Optional[str], model, margin_px: float,
             zones.append(None)
             continue
         radius = base + margin_px / max(cam.camera.focal, 1e-9)
-        zones.append((float(direction[0]), float(direction[1]), float(direction[2]), float(radius)))
+        zones.append((float(direction[0]), float(direction[1]), float(direction[2]), float(radius), float(sigma)))
         sources[source.split(",")[0]] = sources.get(source.split(",")[0], 0) + 1
         _px, _d, ok = cam.project(cam.centre[None, :] + 100.0 * np.asarray(direction)[None, :])
         seen += int(ok[0])
     summary: Dict[str, object] = {"images": sum(z is not None for z in zones), "in_frame": seen,
-                                  "sources": sources, "penalty": SHADOW_PENALTY}
+                                  "sources": sources, "penalty": SHADOW_PENALTY, "halo_weight": HALO_WEIGHT,
+                                  "halo_width_deg": round(math.degrees(sigma), 2)}
     if not sources:
         return zones, summary, [f"drone's shadow: no antisolar direction (EXIF: {why or 'none'}; no hot spot "
                                 "fitted): the mosaic takes the photos as they are"]
@@ -201,7 +209,8 @@ def shadow_zones(cameras, crs: Optional[str], model, margin_px: float,
     text = "; ".join(f"{n} from {s}" for s, n in sources.items())
     lines = [f"drone's shadow: the antisolar point of {summary['images']} images ({text}"
              f"{'; EXIF: ' + why if why else ''}), {seen} of them inside their frame: a zone of "
-             f"{min(radii):.1f}..{max(radii):.1f} deg around it taken from another image wherever one sees the ground"]
+             f"{min(radii):.1f}..{max(radii):.1f} deg around it taken from another image wherever one sees the ground, the view cost raised by the hot spot's shape "
+             f"({math.degrees(sigma):.0f} deg wide) around it"]
     return zones, summary, lines
 
 
@@ -211,8 +220,22 @@ def shadow_margin_px(feather_gsd: float, planning_cell_gsd: float) -> float:
     return 0.5 * feather_gsd + 2.0 * planning_cell_gsd
 
 
-def in_shadow(zone: Optional[Tuple[float, float, float, float]], centre: np.ndarray,
-              xyz_local: np.ndarray) -> np.ndarray:
+def shadow_cost(zone: Optional[Tuple[float, ...]], centre: np.ndarray, xyz_local: np.ndarray) -> np.ndarray:
+    """(N,) the view cost a photo at ``centre`` adds to local points by its shadow ``zone``: SHADOW_PENALTY within
+    the zone's radius, and HALO_WEIGHT times the hot spot's shape (its width, the zone's fifth item)."""
+    xyz = np.asarray(xyz_local, dtype=np.float64)
+    if zone is None or not len(xyz):
+        return np.zeros(len(xyz))
+    d = xyz - np.asarray(centre, dtype=np.float64)
+    cosang = (d @ np.asarray(zone[:3], dtype=np.float64)) / np.maximum(np.linalg.norm(d, axis=1), 1e-12)
+    theta = np.arccos(np.clip(cosang, -1.0, 1.0))
+    out = np.where(theta < zone[3], SHADOW_PENALTY, 0.0)
+    if len(zone) > 4 and zone[4] > 0:
+        out += HALO_WEIGHT * np.exp(-0.5 * (theta / zone[4]) ** 2)
+    return out
+
+
+def in_shadow(zone: Optional[Tuple[float, ...]], centre: np.ndarray, xyz_local: np.ndarray) -> np.ndarray:
     """(N,) bool: the local points seen by a camera at ``centre`` within its shadow ``zone``."""
     xyz = np.asarray(xyz_local, dtype=np.float64)
     if zone is None or not len(xyz):

@@ -9,7 +9,7 @@ from typing import Optional
 import numpy as np
 
 from .cameras import OrthoCamera
-from .hotspot import SHADOW_PENALTY, in_shadow
+from .hotspot import shadow_cost
 from .pixels import ImageMeta, image_window, photo_mask, remap_photo
 from .visibility import Visibility, visibility_table
 
@@ -56,7 +56,7 @@ def camera_view(cam: OrthoCamera, meta: ImageMeta, offset: np.ndarray, x: np.nda
     rho = np.hypot(px[idx, 0] - cam.camera.cx, px[idx, 1] - cam.camera.cy) / half_diag
     cost[idx] = (rho * rho + (dxy / dz) ** 2).astype(np.float32)
     if cam.shadow is not None:  # the drone's shadow and the hot spot's core: another image's where one sees it
-        cost[idx[in_shadow(cam.shadow, c, xyz[idx])]] += SHADOW_PENALTY
+        cost[idx] += shadow_cost(cam.shadow, c, xyz[idx]).astype(np.float32)
     return Sampled(values, ok, cost, xyz, px)
 
 
