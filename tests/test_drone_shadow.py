@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import os
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 
 import cv2
 import numpy as np
@@ -159,12 +159,12 @@ def test_no_cell_of_a_speck_comes_from_its_photo(specked):
 def test_sun_position_and_exif_time():
     """The sun at Seneca County, Ohio on 2013-06-04 17:37 UTC (the seneca_south photos' 13:37 local daylight time):
     about 71 deg high, due south; EXIF time only where the data gives its zone."""
-    az, el = sun_position(41.035, -83.306, datetime(2013, 6, 4, 17, 37, 29, tzinfo=timezone.utc))
+    az, el = sun_position(41.035, -83.306, datetime(2013, 6, 4, 17, 37, 29, tzinfo=UTC))
     assert abs(el - 71.4) < 0.5 and abs(az - 184.0) < 3.0
     when, _ = exif_utc_time({"EXIF_GPSDateStamp": "2013:06:04", "EXIF_GPSTimeStamp": "(17) (37) (29)"})
-    assert when == datetime(2013, 6, 4, 17, 37, 29, tzinfo=timezone.utc)
+    assert when == datetime(2013, 6, 4, 17, 37, 29, tzinfo=UTC)
     when, _ = exif_utc_time({"EXIF_DateTimeOriginal": "2013:06:04 13:37:29", "EXIF_OffsetTimeOriginal": "-04:00"})
-    assert when == datetime(2013, 6, 4, 17, 37, 29, tzinfo=timezone.utc)
+    assert when == datetime(2013, 6, 4, 17, 37, 29, tzinfo=UTC)
     when, why = exif_utc_time({"EXIF_DateTimeOriginal": "2013:06:04 13:37:29"})
     assert when is None and "time zone" in why
     d = antisolar_from_sun(180.0, 60.0, (0.0, 1.0))  # the sun due south: its light travels north and down

@@ -25,7 +25,7 @@ hot spot was fitted, plus the seam's feathering ramp and two planning cells as a
 from __future__ import annotations
 
 import math
-from datetime import datetime, timedelta, timezone
+from datetime import UTC, datetime, timedelta, timezone
 from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
@@ -44,7 +44,7 @@ MIN_HOT_GAIN = 0.01  # a fitted hot spot brighter than this (1 %) gives the dire
 def sun_position(lat_deg: float, lon_deg: float, when: datetime) -> Tuple[float, float]:
     """(azimuth from true north, clockwise; elevation), degrees, of the sun at ``when`` (timezone-aware) seen
     from (lat, lon): the almanac's low-precision formulas (about 0.1 deg, 1950..2050)."""
-    d = (when - datetime(2000, 1, 1, 12, tzinfo=timezone.utc)).total_seconds() / 86400.0
+    d = (when - datetime(2000, 1, 1, 12, tzinfo=UTC)).total_seconds() / 86400.0
     g = math.radians((357.529 + 0.98560028 * d) % 360.0)
     q = (280.459 + 0.98564736 * d) % 360.0
     lam = math.radians((q + 1.915 * math.sin(g) + 0.020 * math.sin(2 * g)) % 360.0)
@@ -88,7 +88,7 @@ def exif_utc_time(md: Dict[str, str]) -> Tuple[Optional[datetime], str]:
     date, hms = get("EXIF_GPSDateStamp"), _numbers(get("EXIF_GPSTimeStamp"))
     if date and len(hms) == 3:
         try:
-            day = datetime.strptime(date.replace("-", ":"), "%Y:%m:%d").replace(tzinfo=timezone.utc)
+            day = datetime.strptime(date.replace("-", ":"), "%Y:%m:%d").replace(tzinfo=UTC)
             return day + timedelta(hours=hms[0], minutes=hms[1], seconds=hms[2]), "EXIF GPS time (UTC)"
         except ValueError:
             pass
@@ -100,7 +100,7 @@ def exif_utc_time(md: Dict[str, str]) -> Tuple[Optional[datetime], str]:
             hm = _numbers(offset.lstrip("+-"))
             sign = -1.0 if offset.startswith("-") else 1.0
             tz = timezone(timedelta(hours=sign * hm[0], minutes=sign * (hm[1] if len(hm) > 1 else 0.0)))
-            return t.replace(tzinfo=tz).astimezone(timezone.utc), "EXIF DateTimeOriginal + OffsetTime"
+            return t.replace(tzinfo=tz).astimezone(UTC), "EXIF DateTimeOriginal + OffsetTime"
         except (ValueError, IndexError):
             pass
     if local:

@@ -20,9 +20,9 @@ from ..io import raster as dsmmod
 from .block import PreparedBlock, check_kind, prepare_block, write_camera_ortho
 from .cameras import OrthoCamera
 from .grid import box_intersects, grid_tiles
+from .hotspot import shadow_margin_px, shadow_zones
 from .options import OrthoError, OrthoOptions
 from .pixels import PHOTO_CACHE
-from .hotspot import shadow_margin_px, shadow_zones
 from .planning import MosaicPlan, plan_mosaic, planning_gsd
 from .radiometry_fit import fit_radiometry_model, radiometry_lines
 from .seamlines import read_seamline_edits, write_seamlines
