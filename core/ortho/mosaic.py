@@ -179,7 +179,8 @@ def _before_planning(prep: PreparedBlock, dsm: Dsm, offset, crs: Optional[str], 
         zones, shadow, lines = shadow_zones(prep.cameras, crs, model, margin)
         for cam, zone in zip(prep.cameras, zones):
             cam.shadow = zone
-        summary["shadow"] = shadow
+        if shadow["images"]:  # recorded where a zone was set (the record of a block without one is unchanged)
+            summary["shadow"] = shadow
         for line in lines:
             log.append(line)
             progress.info(line)
