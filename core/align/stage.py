@@ -1,21 +1,17 @@
 """The alignment stage: images -> features -> pairs -> matches -> mapping -> final bundle adjustment.
 
-:func:`align` reads images from a folder and writes, in the workspace (paths from
-:class:`core.project.layout.Layout`):
+:func:`align` reads images from a folder and writes, in the workspace (paths from :class:`core.project.layout.Layout`):
 
 - ``sfm/database.db``: COLMAP database (features, matches); kept so a re-run after a cancel reuses them;
-- ``sfm/model/``: the largest reconstruction in COLMAP binary format, in the
-  local model frame;
-- ``sfm/alignment.json``: figures and the list of images not registered, with why;
-- ``cameras.gpkg``: the camera positions (model frame).
+- ``sfm/model/``: the largest reconstruction in COLMAP binary format, in the local model frame;
+- ``sfm/alignment.json``: figures, the images not registered and why; ``cameras.gpkg``: camera positions.
 
-The algorithm modules: :mod:`.inputs` (the photos read before any work), :mod:`.firstpass` (the first pass's
-features chosen from the photos' texture), :mod:`.features` (cameras, masks, extraction, matching), :mod:`.pairs`
-(pair selection), :mod:`.mapping` (incremental or global mapping, bundle adjustment), :mod:`.escalation` (richer
-features and more pairs for the images the fast path left out, or a split block; ``escalation`` in
-``sfm/alignment.json`` says what was done per image and why), :mod:`.diagnosis` (why an image is not
-registered); :mod:`.record` (the workspace's database and record) and :mod:`.result` (the products); the options
-in :mod:`.options`.
+The algorithm modules: :mod:`.inputs` (the photos), :mod:`.firstpass` (the first pass's features from the photos'
+texture), :mod:`.features` (cameras, masks, extraction, matching), :mod:`.pairs` (pair selection), :mod:`.mapping`
+(incremental or global mapping, bundle adjustment), :mod:`.joining` (a split block's components joined by the
+photos' positions), :mod:`.escalation` (richer features and more pairs where the fast path left images out or
+split the block: ``escalation`` in ``sfm/alignment.json``), :mod:`.diagnosis` (why an image is not registered),
+:mod:`.record` and :mod:`.result` (database, record, products); the options in :mod:`.options`.
 """
 from __future__ import annotations
 
@@ -37,6 +33,7 @@ from .escalation import EscalationContext, block_state, escalate
 from .features import extract_features, match_pairs
 from .firstpass import choose_first_pass
 from .inputs import Photos, read_folder
+from .joining import join_by_positions
 from .mapping import MappingJob, adjust_block, map_block, verified_links, verified_pairs, verified_partners
 from .options import MIN_VERIFIED_INLIERS, AlignError, AlignOptions
 from .pairs import select_pairs
@@ -107,12 +104,14 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
                 progress.warning(w)
             progress.info(f"pair selection: {pairing_used}, {len(pairs)} pairs for {len(infos)} images")
             match_pairs(pycolmap, db_path, pairs, lay.sfm_dir, options, SubProgress(progress, 0.35, 0.65))
-        # 4. mapping, then escalation where the fast path left images out or split the block
+        # 4. mapping, components joined by the photos' positions, escalation where images are left out
         degenerate: Dict[str, str] = {}  # images a mapping gave a degenerate camera: name -> why
         mapping_job = MappingJob(db_path, images_dir, os.path.join(lay.sfm_dir, ".mapping"), len(infos))
         with run.step("mapping", save=False):
-            ordered = map_block(pycolmap, mapping_job, options, SubProgress(progress, 0.65, 0.90), degenerate,
+            ordered = map_block(pycolmap, mapping_job, options, SubProgress(progress, .65, .9), degenerate,
                                 photos.held())
+        with run.step("join", save=False):
+            ordered = join_by_positions(pycolmap, ordered, photos, options, mapping_job, run.record, progress)
         ctx = EscalationContext(pycolmap, job, first.settings, lay.sfm_dir, [im.name for im in infos], options, pairs,
                                 lambda p, s=None: map_block(pycolmap, mapping_job, options, p, degenerate,
                                                             photos.held(), s),
