@@ -11,7 +11,18 @@ import pytest
 
 pycolmap = pytest.importorskip("pycolmap")
 
-from core.align.joining import merged, place, position_targets, spacing, similarity  # noqa: E402
+from core.align.joining import (  # noqa: E402
+    merged,
+    place,
+    pose_priors,
+    position_targets,
+    prior_adjustment,
+    similarity,
+    spacing,
+)
+from core.align.mapping import final_bundle_adjustment  # noqa: E402
+from core.align.options import AlignOptions  # noqa: E402
+from core.common.progress import NullProgress  # noqa: E402
 
 
 def _rotation(axis, deg):
@@ -89,3 +100,56 @@ def test_position_targets_take_the_exif_altitude_only_when_every_photo_has_one()
     assert alt and t["b"][2] == 290.0
     t, alt = position_targets(infos, {"a": (0.0, 0.0), "b": (7.9, 0.0)}, True)  # a positions file: no altitude
     assert not alt and t["a"][2] == 0.0
+
+
+def _two_camera_block():
+    """A synthetic block of two cameras (5 frames each, 200 points), its true camera centres, and the same block
+    with both cameras' focal lengths 3 % off and the distortion set to 0.02."""
+    opts = pycolmap.SyntheticDatasetOptions()
+    opts.num_rigs, opts.num_cameras_per_rig, opts.num_frames_per_rig, opts.num_points3D = 2, 1, 5, 200
+    opts.sensor_from_rig_translation_stddev = opts.sensor_from_rig_rotation_stddev = 0.0
+    pycolmap.set_random_seed(5)
+    truth = pycolmap.synthesize_dataset(opts)
+    noise = pycolmap.SyntheticNoiseOptions()
+    noise.point2D_stddev = 0.5
+    pycolmap.synthesize_noise(noise, truth)
+    centres = {truth.images[i].name: np.asarray(truth.images[i].projection_center(), float)
+               for i in truth.reg_image_ids()}
+    block = pycolmap.Reconstruction(truth)
+    for cam in block.cameras.values():
+        params = np.asarray(cam.params, float)
+        params[0] *= 1.03
+        params[3] = 0.02
+        cam.params = params
+    return block, centres
+
+
+@pytest.mark.parametrize("hold", [({1}, False), ((), True)])
+def test_the_joins_adjustment_keeps_what_the_stage_holds(hold):
+    """The join's adjustment with position priors (issue 46 item 2) holds the cameras the user's calibration holds
+    (issue 32) and, where the mapping held it, the focal length (the distortion still refined), as the final
+    adjustment does; a free camera's focal length is refined."""
+    block, centres = _two_camera_block()
+    before = {cid: np.asarray(c.params, float).copy() for cid, c in block.cameras.items()}
+    prior_adjustment(pycolmap, block, pose_priors(pycolmap, block, centres, altitude=True), hold)
+    held, hold_focal = hold
+    for cid, cam in block.cameras.items():
+        after = np.asarray(cam.params, float)
+        if cid in held:
+            assert np.array_equal(after, before[cid]), (cid, before[cid], after)
+        elif hold_focal:
+            assert after[0] == before[cid][0] and after[3] != before[cid][3], (cid, before[cid], after)
+        else:
+            assert abs(after[0] / before[cid][0] - 1.0) > 0.01, (cid, before[cid], after)
+
+
+def test_the_final_adjustment_of_a_joined_block_keeps_its_position_priors():
+    """The stage's final adjustment of a joined block keeps the position priors (the block stays in the positions'
+    frame) and the held camera's intrinsics."""
+    block, centres = _two_camera_block()
+    given = np.asarray(block.cameras[1].params, float).copy()
+    final_bundle_adjustment(pycolmap, block, AlignOptions(), NullProgress(), held={1},
+                            priors=lambda r: pose_priors(pycolmap, r, centres, altitude=True))
+    assert np.array_equal(np.asarray(block.cameras[1].params, float), given)
+    err = [np.linalg.norm(block.find_image_with_name(n).projection_center() - c) for n, c in centres.items()]
+    assert max(err) < 1.0, err

@@ -30,7 +30,7 @@ import math
 import os
 import shutil
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import Collection, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -44,6 +44,11 @@ JOIN_SIGMA_Z = 10.0  # m: vertical (barometric / GPS altitude)
 JOIN_MAX_REPROJECTION = 2.0  # px: the joined block's mean reprojection error at most
 JOIN_FIRST_ANGLE = 10.0  # deg: the first triangulation's angle between a ray and its point (COLMAP's 2 after it)
 JOIN_MIN_INLIERS = 15  # 2D-3D inliers for an image registered on the joined block (the mapping's relaxed pass)
+# what the join's adjustments hold of the cameras (as core.align.mapping.adjust_block does): (the ids of the cameras
+# whose intrinsics are given and held, core.align.calibrated; whether every camera's focal length is held, the
+# mapping's focal drift, MappingJob.focal_held)
+Hold = Tuple[Collection[int], bool]
+NO_HOLD: Hold = ((), False)
 
 
 @dataclass
@@ -172,18 +177,24 @@ def pose_priors(pycolmap, rec, targets: Dict[str, np.ndarray], altitude: bool) -
     return out
 
 
-def prior_adjustment(pycolmap, rec, priors: list, refine_intrinsics: bool = True,
+def prior_adjustment(pycolmap, rec, priors: list, hold: Hold = NO_HOLD,
                      progress: Optional[Progress] = None) -> None:
-    """Bundle adjustment of every registered image and point of ``rec`` with the position ``priors``."""
+    """Bundle adjustment of every registered image and point of ``rec`` with the position ``priors``; the cameras
+    ``hold[0]`` keep their intrinsics, with ``hold[1]`` every camera its focal length (the distortion of the
+    others refined), the principal point is not refined."""
+    held, hold_focal = hold
     ba = pycolmap.BundleAdjustmentOptions()
     ba.print_summary = False
     ba.refine_principal_point = False
-    ba.refine_focal_length = ba.refine_extra_params = bool(refine_intrinsics)
+    ba.refine_focal_length = not hold_focal
     ba.ceres.loss_function_type = pycolmap.LossFunctionType.CAUCHY
     ba.ceres.solver_options.max_num_iterations = 50
     config = pycolmap.BundleAdjustmentConfig()
     for image_id in rec.reg_image_ids():
         config.add_image(image_id)
+    used = {rec.images[i].camera_id for i in rec.reg_image_ids()}
+    for cid in sorted(used & set(held)):
+        config.set_constant_cam_intrinsics(cid)
     pycolmap.ObservationManager(rec).filter_observations_with_negative_depth()
     prior_options = pycolmap.PosePriorBundleAdjustmentOptions()
     pycolmap.create_pose_prior_bundle_adjuster(ba, prior_options, config, priors, rec).solve()
@@ -218,12 +229,13 @@ def triangulated(pycolmap, rec, paths: Tuple[str, str, str], progress: Progress,
 
 
 def adjusted(pycolmap, rec, targets: Dict[str, np.ndarray], altitude: bool, paths: Tuple[str, str, str],
-             progress: Progress, angles: Sequence[float] = (JOIN_FIRST_ANGLE, 2.0)) -> None:
+             progress: Progress, angles: Sequence[float] = (JOIN_FIRST_ANGLE, 2.0), hold: Hold = NO_HOLD) -> None:
     """``rec``'s points triangulated again and adjusted with the position priors, once per angle of ``angles``
-    (the first wide: the components placed by their positions meet only within a few degrees)."""
+    (the first wide: the components placed by their positions meet only within a few degrees); ``hold``: what the
+    adjustments hold of the cameras (:func:`prior_adjustment`)."""
     for angle in angles:
         triangulated(pycolmap, rec, paths, progress, angle)
-        prior_adjustment(pycolmap, rec, pose_priors(pycolmap, rec, targets, altitude), progress=progress)
+        prior_adjustment(pycolmap, rec, pose_priors(pycolmap, rec, targets, altitude), hold, progress)
 
 
 def _correspondences(pycolmap, db, rec, image_id: int) -> Tuple[np.ndarray, np.ndarray]:
@@ -281,10 +293,13 @@ def register_rest(pycolmap, rec, db_path: str, targets: Dict[str, np.ndarray], m
 
 
 def join_components(pycolmap, ordered: list, targets: Dict[str, np.ndarray], altitude: bool,
-                    paths: Tuple[str, str, str], progress: Progress) -> Tuple[list, Optional[Join]]:
+                    paths: Tuple[str, str, str], progress: Progress, hold: Hold = NO_HOLD
+                    ) -> Tuple[list, Optional[Join]]:
     """``ordered`` (reconstructions, largest first) with its components joined into the first where the positions
     ``targets`` (name -> x, y, z metres) place them (the module's docstring); ``paths``: (database, images folder,
-    a scratch folder).  Returns (the reconstructions, largest first, the Join or None when nothing was tried)."""
+    a scratch folder); ``hold``: what the adjustments hold of the cameras (:func:`prior_adjustment`; the held
+    cameras' intrinsics come back as they went in).  Returns (the reconstructions, largest first, the Join or None
+    when nothing was tried)."""
     if len(ordered) < 2 or len(targets) < JOIN_MIN_CAMERAS:
         return ordered, None
     gap = spacing(targets)
@@ -308,11 +323,11 @@ def join_components(pycolmap, ordered: list, targets: Dict[str, np.ndarray], alt
     progress.info(f"joining {len(placed)} components by the photos' positions (fits {fits} m, photo spacing "
                   f"{gap:.1f} m)")
     joined = merged(pycolmap, placed)
-    adjusted(pycolmap, joined, targets, altitude, paths, progress)
+    adjusted(pycolmap, joined, targets, altitude, paths, progress, hold=hold)
     added = register_rest(pycolmap, joined, paths[0], targets, JOIN_MAX_FIT * gap)
     if added:
         progress.info(f"join: registered on the joined block's points: {', '.join(added)}")
-        adjusted(pycolmap, joined, targets, altitude, paths, progress, angles=(2.0,))
+        adjusted(pycolmap, joined, targets, altitude, paths, progress, angles=(2.0,), hold=hold)
     names, c, _v, t = _centres(joined, targets)
     join.joined_rms_m = fit_rms(c, t)
     join.reprojection_px = float(joined.compute_mean_reprojection_error())
@@ -342,13 +357,41 @@ def position_targets(infos, positions: Dict[str, Tuple[float, float]], from_file
             altitude)
 
 
-def join_by_positions(pycolmap, ordered: list, photos, options, job, record: dict, progress: Progress) -> list:
+@dataclass
+class PositionPriors:
+    """The position priors of a kept join, for the stage's final bundle adjustment (:meth:`of`)."""
+
+    pycolmap: object
+    targets: Dict[str, np.ndarray]
+    altitude: bool
+    block: object = None  # the joined reconstruction; None: no join kept
+    record: Optional[dict] = None  # ``join`` of sfm/alignment.json
+
+    def of(self, rec):
+        """For the final adjustment of ``rec``: a function of the reconstruction giving its position priors (the
+        sigmas of the join: JOIN_SIGMA_H, JOIN_SIGMA_Z) when ``rec`` is the joined block (an escalation round's
+        fresh mapping is in its own frame: None), else None."""
+        if self.block is None or rec is not self.block:
+            return None
+        if self.record is not None:
+            self.record["final_adjustment_priors"] = True
+        return lambda r: pose_priors(self.pycolmap, r, self.targets, self.altitude)
+
+
+def join_by_positions(pycolmap, ordered: list, photos, options, job, record: dict, progress: Progress
+                      ) -> Tuple[list, PositionPriors]:
     """The stage's join (:func:`join_components`) of the mapping's reconstructions ``ordered`` on the positions of
-    ``photos`` (core.align.inputs.Photos), on the database of ``job`` (core.align.mapping.MappingJob); what it did
-    goes to ``record["join"]``.  Returns the reconstructions, largest first."""
+    ``photos`` (core.align.inputs.Photos), on the database of ``job`` (core.align.mapping.MappingJob), holding
+    what the stage holds of the cameras (the given cameras, the focal length where it drifted in the mapping);
+    what it did goes to ``record["join"]``.  Returns (the reconstructions, largest first; the position priors
+    for the final adjustment of the joined block)."""
     targets, altitude = position_targets(photos.infos, photos.positions, bool(options.camera_positions))
     paths = (job.db_path, job.images_dir, job.out_dir.rstrip(os.sep) + "-join")
-    ordered, join = join_components(pycolmap, ordered, targets, altitude, paths, progress)
+    hold = (set(photos.held()[0]), job.focal_held is not None)
+    ordered, join = join_components(pycolmap, ordered, targets, altitude, paths, progress, hold)
+    priors = PositionPriors(pycolmap, targets, altitude)
     if join is not None:
         record["join"] = join.to_dict()
-    return ordered
+        if join.kept:
+            priors.block, priors.record = ordered[0], record["join"]
+    return ordered, priors

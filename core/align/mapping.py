@@ -6,7 +6,7 @@ import math
 import os
 import shutil
 from dataclasses import dataclass
-from typing import Collection, Dict, List, Optional, Sequence, Tuple
+from typing import Callable, Collection, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -230,10 +230,16 @@ def drop_degenerate(rec) -> Dict[str, str]:
     return dropped
 
 
+# a function of the block giving the position priors of its registered images (pycolmap.PosePrior): the final
+# adjustment of a block joined by the photos' positions keeps them (core.align.joining.PositionPriors)
+Priors = Optional[Callable[[object], list]]
+
+
 def final_bundle_adjustment(pycolmap, rec, options: AlignOptions, progress: Progress,
-                            held: Collection[int] = (), hold_focal: bool = False):
+                            held: Collection[int] = (), hold_focal: bool = False, priors: Priors = None):
     """The final global bundle adjustment; the cameras ``held`` (ids) keep their intrinsics constant, with
-    ``hold_focal`` every camera its focal length (MappingJob.focal_held).  Returns whether the principal point was
+    ``hold_focal`` every camera its focal length (MappingJob.focal_held); ``priors``: the position priors it keeps
+    (a block joined by the photos' positions; they fix the gauge).  Returns whether the principal point was
     refined (of the cameras not held)."""
     ba = pycolmap.BundleAdjustmentOptions()
     ba.print_summary = False
@@ -250,7 +256,9 @@ def final_bundle_adjustment(pycolmap, rec, options: AlignOptions, progress: Prog
         ba.refine_focal_length = ba.refine_principal_point = False
     if counts and not free:  # every camera held: the adjustment's own switches (and its cancellation token)
         ba.refine_focal_length = ba.refine_extra_params = ba.refine_principal_point = False
-    if free and any(cid in counts for cid in held):
+    if priors is not None:
+        _adjust_holding(pycolmap, rec, ba, [cid for cid in held if cid in counts], priors(rec))
+    elif free and any(cid in counts for cid in held):
         _adjust_holding(pycolmap, rec, ba, [cid for cid in held if cid in counts])
     else:
         with CancelWatcher(progress) as token:
@@ -259,16 +267,21 @@ def final_bundle_adjustment(pycolmap, rec, options: AlignOptions, progress: Prog
     return ba.refine_principal_point
 
 
-def _adjust_holding(pycolmap, rec, ba, held: Sequence[int]) -> None:
+def _adjust_holding(pycolmap, rec, ba, held: Sequence[int], priors: Optional[list] = None) -> None:
     """pycolmap.bundle_adjustment's own steps (observations behind a camera dropped, every registered image, the
-    gauge fixed on two cameras) with the ``held`` cameras' intrinsics constant (pycolmap gives this path no
-    cancellation token: a cancel takes effect when it returns)."""
+    gauge fixed on two cameras) with the ``held`` cameras' intrinsics constant; with position ``priors`` pycolmap's
+    pose-prior adjuster, the gauge fixed by the priors (pycolmap gives this path no cancellation token: a cancel
+    takes effect when it returns)."""
     pycolmap.ObservationManager(rec).filter_observations_with_negative_depth()
     config = pycolmap.BundleAdjustmentConfig()
     for image_id in rec.reg_image_ids():
         config.add_image(image_id)
     for cid in held:
         config.set_constant_cam_intrinsics(cid)
+    if priors is not None:
+        pycolmap.create_pose_prior_bundle_adjuster(ba, pycolmap.PosePriorBundleAdjustmentOptions(), config, priors,
+                                                   rec).solve()
+        return
     config.fix_gauge(pycolmap.BundleAdjustmentGauge.TWO_CAMS_FROM_WORLD)
     pycolmap.create_default_bundle_adjuster(ba, config, rec).solve()
 
@@ -398,11 +411,12 @@ def _against_focal_drift(pycolmap, job: MappingJob, options: AlignOptions, progr
 
 
 def adjust_block(pycolmap, rec, options: AlignOptions, progress: Progress, held: Collection[int],
-                 degenerate: Dict[str, str], hold_focal: bool = False) -> bool:
-    """The final global bundle adjustment (the ``held`` cameras' intrinsics constant); a camera with few points
-    that the adjustment sent off goes out (added to ``degenerate``), and the adjustment runs again, until none.
-    Returns whether the principal point was refined."""
-    pp = final_bundle_adjustment(pycolmap, rec, options, progress, held, hold_focal)
+                 degenerate: Dict[str, str], hold_focal: bool = False, priors: Priors = None) -> bool:
+    """The final global bundle adjustment (the ``held`` cameras' intrinsics constant, the position ``priors`` kept
+    where given: see final_bundle_adjustment); a camera with few points that the adjustment sent off goes out
+    (added to ``degenerate``), and the adjustment runs again, until none.  Returns whether the principal point was
+    refined."""
+    pp = final_bundle_adjustment(pycolmap, rec, options, progress, held, hold_focal, priors)
     for _ in range(rec.num_reg_images()):
         diverged = drop_degenerate(rec)
         if not diverged:
@@ -410,5 +424,5 @@ def adjust_block(pycolmap, rec, options: AlignOptions, progress: Progress, held:
         for name, why in diverged.items():
             progress.warning(f"final bundle adjustment: {name} {why}: left out of the block")
         degenerate.update(diverged)
-        pp = final_bundle_adjustment(pycolmap, rec, options, progress, held, hold_focal)
+        pp = final_bundle_adjustment(pycolmap, rec, options, progress, held, hold_focal, priors)
     return pp

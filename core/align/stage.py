@@ -111,7 +111,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
             ordered = map_block(pycolmap, mapping_job, options, SubProgress(progress, .65, .9), degenerate,
                                 photos.held())
         with run.step("join", save=False):
-            ordered = join_by_positions(pycolmap, ordered, photos, options, mapping_job, run.record, progress)
+            ordered, priors = join_by_positions(pycolmap, ordered, photos, options, mapping_job, run.record, progress)
         ctx = EscalationContext(pycolmap, job, first.settings, lay.sfm_dir, [im.name for im in infos], options, pairs,
                                 lambda p, s=None: map_block(pycolmap, mapping_job, options, p, degenerate,
                                                             photos.held(), s),
@@ -130,7 +130,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
         with run.step("bundle_adjustment", save=False):
             progress.report(0.94, "final bundle adjustment")
             pp = adjust_block(pycolmap, rec, options, progress, photos.held()[0], degenerate,
-                              hold_focal=mapping_job.focal_held is not None)
+                              hold_focal=mapping_job.focal_held is not None, priors=priors.of(rec))
         registered = {rec.images[i].name for i in rec.reg_image_ids()}
         unregistered = diagnose_unregistered(infos, registered, others, partners, degenerate,
                                              verified_links(pycolmap, db_path, MIN_VERIFIED_INLIERS)[1])
