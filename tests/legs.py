@@ -27,7 +27,9 @@ FILES = {
     "test_align_blocks.py": "core",
     "test_align_degenerate.py": "core",
     "test_align_escalation.py": "core",
+    "test_align_faint.py": "core",
     "test_align_focal_drift.py": "core",
+    "test_align_join.py": "core",
     "test_align_relaxed.py": "core",
     "test_align_texture.py": "core",
     "test_architecture.py": "install",
@@ -52,6 +54,7 @@ FILES = {
     "test_dense_lowtexture.py": "core",
     "test_dense_walls.py": "core",
     "test_dependencies.py": "install",
+    "test_drone_shadow.py": "gdal",
     "test_epochs.py": "qgis_process",
     "test_face_errors.py": "qgis",
     "test_find_targets.py": "qgis",
@@ -122,8 +125,81 @@ PLATFORM_ONLY_EVERY_LEG = (
     "test_qgis_desktop.py", "test_qgis_plugin.py", "test_processing_help.py", "test_ui_i18n.py",
 )
 
-# a file (all its tests) or file::test (all its parametrisations) -> why once is enough
+# Why once is enough, by kind of work (the cheaper tests named run the same code on every leg):
+_SFM = ("alignment end to end on a rendered or real block: the cost is COLMAP's mapping; pycolmap's wheel of each "
+        "Python and the align stage's NumPy paths run on every leg in test_align.py (the sample strip), "
+        "test_align_blocks.py, test_align_join.py and test_resection.py")
+_DENSE = ("dense matching of a rendered block end to end: the stereo, fusion and DSM writing run on every leg in "
+          "test_dense.py (the synthetic block, its COG and LAS, qgis_process) and test_dense_fill.py's units")
+_MOSAIC = ("a mosaic of a rendered block judged against its truth: the mosaic, its radiometric fit and the COG writer "
+           "run on every leg in test_ortho.py, test_seamlines.py and test_radiometry.py's units")
+_GEOREF = ("georeferencing a block aligned end to end: the adjustment runs on every leg on exact models "
+           "(test_georef.py, test_georef_synthetic.py's truth-model tests, test_bundle_solver.py)")
+_AUTOCONTROL = ("automatic control on two rendered epochs: the matching against a reference runs on every leg in "
+                "test_autocontrol_faces.py (the Processing and dock faces), test_autocontrol_national.py and "
+                "test_single_autocontrol.py")
+_RIG = ("a multispectral rig block through the whole chain: stacking, band registration and radiometry run on every "
+        "leg in test_captures.py, test_band_registration.py, test_band_radiometry.py and test_primary_band.py")
+_RASTER = ("numerical equality of a raster computed two ways at full size: the tiled code runs on every leg on the "
+           "smaller rasters of the same file")
+
 ONE_LEG = {
+    "test_align.py::test_foreign_images_are_reported_not_registered": _SFM,
+    "test_align.py::test_global_mapper_aligns_the_strip": _SFM,
+    "test_align_escalation.py::test_fast_path_fails_on_small_low_contrast_frames_and_escalation_fixes_it": _SFM,
+    "test_align_escalation.py::test_mixed_cameras_register_in_one_block": _SFM,
+    "test_align_focal_drift.py::test_garfield_registers_every_photo_and_holds_its_shape": _SFM,
+    "test_align_relaxed.py::test_the_second_pass_registers_the_steep_views_the_first_pass_left_out": _SFM,
+    "test_align_texture.py::test_faint_periodic_texture_gets_a_richer_first_pass": _SFM,
+    "test_align_texture.py::test_the_users_settings_are_not_probed": _SFM + " (shares the faint photos' rendering)",
+    "test_align_texture.py::test_the_first_pass_registers_a_faint_block_without_escalation": _SFM,
+    "test_align_texture.py::test_a_large_blocks_escalation_continues_the_block": _SFM,
+    "test_woodland_block.py::test_every_photo_of_the_woodland_block_is_registered": _SFM,
+    "test_woodland_block.py::test_camera_centres_and_reprojection_against_the_truth": _SFM,
+    "test_calibrated_cameras.py::test_a_fixed_calibration_is_held_through_alignment_and_georeference": _SFM,
+    "test_calibrated_cameras.py::test_a_wrong_start_value_moves_when_estimated": _SFM,
+    "test_calibrated_cameras.py::test_align_images_with_a_calibration_for_one_strip_holds_that_camera":
+        _SFM + "; Align images' calibration parameters are read on every leg by "
+               "test_align_images_refuses_a_mistyped_interior_orientation_and_a_bad_file",
+    "test_calibrated_cameras.py::test_four_archive_frames_keep_their_calibrated_focal_length_and_their_height": _SFM,
+    "test_calibrated_cameras.py::test_film_scans_restituted_by_prepare_images_keep_their_interior_orientation": _SFM,
+    "test_calibrated_cameras.py::test_the_automatic_control_keeps_a_fixed_camera": _AUTOCONTROL,
+    "test_obliques.py::test_orbit_sky_masks_before_alignment": _SFM,
+    "test_obliques.py::test_orbit_every_camera_registered_and_no_sky_tie_point": _SFM,
+    "test_obliques.py::test_orbit_poses_within_the_nadir_tolerances": _SFM,
+    "test_obliques.py::test_orbit_no_dense_point_from_the_sky": _SFM,
+    "test_obliques.py::test_orbit_mosaic_ground_marks_within_one_and_a_half_gsd": _SFM,
+    "test_georef_synthetic.py::test_end_to_end_five_control_points_reach_one_gsd": _GEOREF,
+    "test_georef_synthetic.py::test_end_to_end_camera_positions_only": _GEOREF,
+    "test_georef_synthetic.py::test_end_to_end_stage_names_and_ignores_an_observation_outside_the_image": _GEOREF,
+    "test_autocontrol.py": _AUTOCONTROL,
+    "test_autocontrol_orbit.py": _AUTOCONTROL,
+    "test_dense_walls.py": _DENSE,
+    "test_dense_fill.py::test_low_texture_ground_is_measured": _DENSE,
+    "test_dense_fill.py::test_low_texture_block_keeps_building_edges_sharp": _DENSE,
+    "test_dense_lowtexture.py::test_farmland_dsm_is_mostly_measured_and_near_the_truth_on_the_fields": _DENSE,
+    "test_dense_lowtexture.py::test_farmland_blunders_are_removed_and_flagged": _DENSE,
+    "test_radiometry.py::test_falloff_and_hot_spot_are_recovered": _MOSAIC,
+    "test_radiometry.py::test_seam_step_within_two_percent": _MOSAIC,
+    "test_radiometry.py::test_mosaic_against_the_true_albedo": _MOSAIC,
+    "test_radiometry.py::test_a_soft_edge_of_light_across_each_photo_is_levelled": _MOSAIC,
+    "test_archive_scene.py::test_projected_points_land_on_the_same_texture": (
+        "the archive scene's rendering checked against its own truth (scene code, not the plugin's): the scene's "
+        "reading and writing run on every leg in the file's other tests"),
+    "test_terrain_tiles.py::test_relief_by_small_tiles_equals_the_whole_raster": _RASTER,
+    "test_rig_block.py::test_the_rig_block_is_stacked_aligned_and_mosaicked_with_every_band": _RIG,
+    "test_rig_block.py::test_bands_registered_and_reflectance_steady_in_the_mosaic": _RIG,
+    "test_rig_block.py::test_the_crop_mark_shows_in_ndvi_as_in_the_truth": _RIG,
+    "test_rig_rgb.py::test_the_rgb_frames_and_the_captures_align_as_one_block": _RIG,
+    "test_rig_rgb.py::test_two_orthomosaics_on_one_dsm_where_the_truth_is": _RIG,
+    "test_rig_calibration.py::test_the_block_calibration_recovers_the_true_rig_rotations": _RIG,
+    "test_rig_calibration.py::test_a_capture_over_uniform_ground_takes_the_block_s_correction": _RIG,
+    "test_rig_calibration.py::test_a_capture_disagreeing_with_the_block_takes_its_correction_and_is_named": _RIG,
+    "test_band_registration.py::test_synthetic_rig_with_wrong_relatives_is_refined": _RIG,
+    "test_panel_calibration.py::test_the_orthomosaic_of_reflectance_photos_is_reflectance": _RIG,
+    "test_pipeline_panel.py::test_run_pipeline_with_the_panel_gives_a_reflectance_orthomosaic":
+        _RIG + "; Run pipeline's panel parameters reach qgis_process on every leg in "
+               "test_qgis_process_run_pipeline_refuses_a_bad_panel",
 }
 
 
