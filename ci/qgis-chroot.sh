@@ -12,6 +12,7 @@
 # /var/cache/archaeoortho/$SUITE) and rebuilt when missing or when its package list changed (debootstrap +
 # apt-get: about 4-6 minutes).  Each run bind-mounts the repository and ../shared (read-only; the tests look for
 # ../shared/data) at their own paths, plus /proc /dev /sys, and unmounts them on exit, also on failure.
+# BUILD_ONLY=1 builds (or checks) the chroot and stops there: .ci/run starts both builds beside the host leg.
 # Inside, `make test` keeps its venv, apt stamp and QGIS profile under build/$LEG/, apart from the host's .venv
 # and build/; the plugin link build/qgis-plugins/archaeoortho is shared (same target).
 set -euo pipefail
@@ -26,7 +27,7 @@ PYTEST_ARGS=${PYTEST_ARGS:-}
 : "${APT_PACKAGES:?set APT_PACKAGES to the apt list of the Makefile, as make test-qgis340 does}"
 
 if [ "$(id -u)" != 0 ]; then
-  exec sudo APT_PACKAGES="$APT_PACKAGES" PYTEST_ARGS="$PYTEST_ARGS" QGIS_CHROOT="$CHROOT" LEG="$LEG" \
+  exec sudo APT_PACKAGES="$APT_PACKAGES" PYTEST_ARGS="$PYTEST_ARGS" QGIS_CHROOT="$CHROOT" LEG="$LEG" BUILD_ONLY="${BUILD_ONLY:-0}" \
     SUITE="$SUITE" DEBIAN_MIRROR="$MIRROR" "${BASH_SOURCE[0]}" "$@"
 fi
 
@@ -134,6 +135,9 @@ if [ ! -f "$CHROOT/$STAMP" ] || [ "$(cat "$CHROOT/$STAMP")" != "$WANT" ]; then
   log "chroot built in $(( (SECONDS - start) / 60 )) min $(( (SECONDS - start) % 60 )) s"
 else
   log "reusing $CHROOT"
+fi
+if [ "${BUILD_ONLY:-0}" = 1 ]; then  # .ci/run builds missing chroots ahead, beside the host leg
+  exit 0
 fi
 
 host_config "$CHROOT"
