@@ -357,41 +357,42 @@ def position_targets(infos, positions: Dict[str, Tuple[float, float]], from_file
             altitude)
 
 
-@dataclass
-class PositionPriors:
-    """The position priors of a kept join, for the stage's final bundle adjustment (:meth:`of`)."""
+class PositionJoin:
+    """The stage's join (:func:`join_components`) on the positions of ``photos`` (core.align.inputs.Photos) and the
+    database of ``job`` (core.align.mapping.MappingJob), for the first mapping and for each escalation round's
+    (a round maps the block afresh: its components are joined as the first mapping's were), holding what the stage
+    holds of the cameras (the given cameras; the focal length where it drifted in the mapping).  What a join did
+    goes to ``record["join"]`` (the first mapping's) or ``record["join_escalation"]`` (the rounds'); the blocks it
+    joined are remembered for the final adjustment's position priors (:meth:`priors`)."""
 
-    pycolmap: object
-    targets: Dict[str, np.ndarray]
-    altitude: bool
-    block: object = None  # the joined reconstruction; None: no join kept
-    record: Optional[dict] = None  # ``join`` of sfm/alignment.json
+    def __init__(self, pycolmap, photos, options, job, record: dict):
+        self.pycolmap, self.photos, self.job, self.record = pycolmap, photos, job, record
+        self.targets, self.altitude = position_targets(photos.infos, photos.positions, bool(options.camera_positions))
+        self.joined: list = []  # (the joined reconstruction, its record)
 
-    def of(self, rec):
-        """For the final adjustment of ``rec``: a function of the reconstruction giving its position priors (the
-        sigmas of the join: JOIN_SIGMA_H, JOIN_SIGMA_Z) when ``rec`` is the joined block (an escalation round's
-        fresh mapping is in its own frame: None), else None."""
-        if self.block is None or rec is not self.block:
-            return None
-        if self.record is not None:
-            self.record["final_adjustment_priors"] = True
-        return lambda r: pose_priors(self.pycolmap, r, self.targets, self.altitude)
-
-
-def join_by_positions(pycolmap, ordered: list, photos, options, job, record: dict, progress: Progress
-                      ) -> Tuple[list, PositionPriors]:
-    """The stage's join (:func:`join_components`) of the mapping's reconstructions ``ordered`` on the positions of
-    ``photos`` (core.align.inputs.Photos), on the database of ``job`` (core.align.mapping.MappingJob), holding
-    what the stage holds of the cameras (the given cameras, the focal length where it drifted in the mapping);
-    what it did goes to ``record["join"]``.  Returns (the reconstructions, largest first; the position priors
-    for the final adjustment of the joined block)."""
-    targets, altitude = position_targets(photos.infos, photos.positions, bool(options.camera_positions))
-    paths = (job.db_path, job.images_dir, job.out_dir.rstrip(os.sep) + "-join")
-    hold = (set(photos.held()[0]), job.focal_held is not None)
-    ordered, join = join_components(pycolmap, ordered, targets, altitude, paths, progress, hold)
-    priors = PositionPriors(pycolmap, targets, altitude)
-    if join is not None:
-        record["join"] = join.to_dict()
+    def __call__(self, ordered: list, progress: Progress) -> list:
+        """``ordered`` (reconstructions, largest first) with its components joined where the positions place them."""
+        job = self.job
+        paths = (job.db_path, job.images_dir, job.out_dir.rstrip(os.sep) + "-join")
+        hold = (set(self.photos.held()[0]), job.focal_held is not None)
+        ordered, join = join_components(self.pycolmap, ordered, self.targets, self.altitude, paths, progress, hold)
+        if join is None:
+            return ordered
+        row = join.to_dict()
+        if "join" not in self.record:
+            self.record["join"] = row
+        else:
+            self.record.setdefault("join_escalation", []).append(row)
         if join.kept:
-            priors.block, priors.record = ordered[0], record["join"]
-    return ordered, priors
+            self.joined.append((ordered[0], row))
+        return ordered
+
+    def priors(self, rec):
+        """For the final adjustment of ``rec``: a function of the reconstruction giving its position priors (the
+        join's sigmas, JOIN_SIGMA_H and JOIN_SIGMA_Z) when ``rec`` is a block this join made, else None (a block
+        mapped in one component is in the mapper's own frame)."""
+        row = next((r for block, r in self.joined if block is rec), None)
+        if row is None:
+            return None
+        row["final_adjustment_priors"] = True
+        return lambda r: pose_priors(self.pycolmap, r, self.targets, self.altitude)

@@ -231,7 +231,7 @@ def drop_degenerate(rec) -> Dict[str, str]:
 
 
 # a function of the block giving the position priors of its registered images (pycolmap.PosePrior): the final
-# adjustment of a block joined by the photos' positions keeps them (core.align.joining.PositionPriors)
+# adjustment of a block joined by the photos' positions keeps them (core.align.joining.PositionJoin)
 Priors = Optional[Callable[[object], list]]
 
 

@@ -33,7 +33,7 @@ from .escalation import EscalationContext, block_state, escalate
 from .features import extract_features, match_pairs
 from .firstpass import choose_first_pass
 from .inputs import Photos, read_folder
-from .joining import join_by_positions
+from .joining import PositionJoin
 from .mapping import MappingJob, adjust_block, map_block, verified_links, verified_pairs, verified_partners
 from .options import MIN_VERIFIED_INLIERS, AlignError, AlignOptions
 from .pairs import select_pairs
@@ -94,8 +94,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
         db_path = job.db_path
         ws.save()
 
-        # 2. features
-        with run.step("features", save=False):
+        with run.step("features", save=False):  # 2. features
             extract_features(pycolmap, job, first.settings, options, SubProgress(progress, 0.02, 0.35))
         # 3. pairs + matching
         with run.step("matching", save=False):
@@ -110,11 +109,12 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
         with run.step("mapping", save=False):
             ordered = map_block(pycolmap, mapping_job, options, SubProgress(progress, .65, .9), degenerate,
                                 photos.held())
+        join = PositionJoin(pycolmap, photos, options, mapping_job, run.record)  # also each escalation round's
         with run.step("join", save=False):
-            ordered, priors = join_by_positions(pycolmap, ordered, photos, options, mapping_job, run.record, progress)
+            ordered = join(ordered, progress)
         ctx = EscalationContext(pycolmap, job, first.settings, lay.sfm_dir, [im.name for im in infos], options, pairs,
-                                lambda p, s=None: map_block(pycolmap, mapping_job, options, p, degenerate,
-                                                            photos.held(), s),
+                                lambda p, s=None: join(map_block(pycolmap, mapping_job, options, p, degenerate,
+                                                                 photos.held(), s), p),
                                 lambda reg, oth: diagnose_unregistered(
                                     infos, reg, oth, verified_partners(pycolmap, db_path, MIN_VERIFIED_INLIERS),
                                     degenerate, verified_links(pycolmap, db_path, MIN_VERIFIED_INLIERS)[1]),
@@ -130,7 +130,7 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
         with run.step("bundle_adjustment", save=False):
             progress.report(0.94, "final bundle adjustment")
             pp = adjust_block(pycolmap, rec, options, progress, photos.held()[0], degenerate,
-                              hold_focal=mapping_job.focal_held is not None, priors=priors.of(rec))
+                              hold_focal=mapping_job.focal_held is not None, priors=join.priors(rec))
         registered = {rec.images[i].name for i in rec.reg_image_ids()}
         unregistered = diagnose_unregistered(infos, registered, others, partners, degenerate,
                                              verified_links(pycolmap, db_path, MIN_VERIFIED_INLIERS)[1])
