@@ -63,13 +63,15 @@ class Join:
     kept: bool = False
     reason: str = ""
     left_out: List[List[str]] = field(default_factory=list)  # components not placed (too few positioned cameras)
+    left_out_rms_m: List[Optional[float]] = field(default_factory=list)  # their fits (None: too few cameras)
 
     def to_dict(self) -> dict:
         r = lambda v: None if v is None or not math.isfinite(v) else round(float(v), 3)  # noqa: E731
         return {"components": self.components, "placed_rms_m": [r(v) for v in self.placed_rms_m],
                 "joined_rms_m": r(self.joined_rms_m), "spacing_m": r(self.spacing_m),
                 "reprojection_px": r(self.reprojection_px), "kept": self.kept, "reason": self.reason,
-                "left_out": self.left_out}
+                "left_out": self.left_out,
+                "left_out_rms_m": [None if v is None else r(v) for v in self.left_out_rms_m]}
 
 
 def similarity(a: np.ndarray, b: np.ndarray) -> Tuple[float, np.ndarray, np.ndarray]:
@@ -303,7 +305,7 @@ def join_components(pycolmap, ordered: list, targets: Dict[str, np.ndarray], alt
     if len(ordered) < 2 or len(targets) < JOIN_MIN_CAMERAS:
         return ordered, None
     gap = spacing(targets)
-    placed, rms, comps, rest = [], [], [], []
+    placed, rms, comps, rest, rest_rms = [], [], [], [], []
     for k, rec in enumerate(ordered):
         names = sorted(rec.images[i].name for i in rec.reg_image_ids())
         p = place(rec, targets)
@@ -311,11 +313,12 @@ def join_components(pycolmap, ordered: list, targets: Dict[str, np.ndarray], alt
             if k == 0:
                 return ordered, None  # the main block itself cannot be placed: nothing to join it to
             rest.append(names)
+            rest_rms.append(None if p is None else p[3])
             continue
         placed.append((rec, p[:3]))
         rms.append(p[3])
         comps.append(names)
-    join = Join(comps, rms, spacing_m=gap, left_out=rest)
+    join = Join(comps, rms, spacing_m=gap, left_out=rest, left_out_rms_m=rest_rms)
     if len(placed) < 2:
         join.reason = "fewer than two components could be placed by their positions"
         return ordered, join
