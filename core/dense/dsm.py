@@ -39,8 +39,13 @@ def write_dsm(target: DsmTarget, point_files: List[PointFile], views: Dict[int, 
     check_cancel(progress)
     offset, res, gsd = target.offset, target.resolution, target.gsd
     boxes = np.array([pf.robust_bbox for pf in point_files if pf.count > 0])
-    xmin, ymin = boxes[:, 0].min() + offset[0], boxes[:, 1].min() + offset[1]
-    xmax, ymax = boxes[:, 2].max() + offset[0], boxes[:, 3].max() + offset[1]
+    centres = np.array([v.centre[:2] + offset[:2] for v in views.values()])
+    # the points' extent, and the whole camera centres' hull: its fractions are judged over all of it (issue 46: the
+    # grid was the points' extent alone, and more points at the edge widened it over hull ground measured nowhere)
+    xmin = min(boxes[:, 0].min() + offset[0], centres[:, 0].min())
+    ymin = min(boxes[:, 1].min() + offset[1], centres[:, 1].min())
+    xmax = max(boxes[:, 2].max() + offset[0], centres[:, 0].max())
+    ymax = max(boxes[:, 3].max() + offset[1], centres[:, 1].max())
     grid = raster.Grid.covering(xmin, ymin, xmax, ymax, res)
     cluster_tol = max(3 * res, 4 * gsd)
     dsm, _counts = gridding.rasterize_points(point_files, grid, offset, cluster_tol=cluster_tol,
@@ -55,7 +60,6 @@ def write_dsm(target: DsmTarget, point_files: List[PointFile], views: Dict[int, 
     dsm[removed] = np.nan
     measured = np.isfinite(dsm)
     dsm = gridding.fill_small_holes(dsm, options.max_hole_cells)
-    centres = np.array([v.centre[:2] + offset[:2] for v in views.values()])
     hull = gridding.polygon_mask(grid, gridding.convex_hull_xy(centres))
     if not hull.any():  # one strip: the hull is a line; judge (and fill) the cells the data surrounds
         hull = None

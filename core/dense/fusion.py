@@ -8,8 +8,9 @@ the mean of the agreeing ones, and it is back-projected with the camera model an
 Where only one of the image's pairs covers the ground (:func:`pair_cover`: the hull of what that pair matched;
 ground that two photos alone see, as along a strip flown at 60 % forward overlap, or a pair chosen for a part of
 the frame no other pair reaches) no second pair can confirm a pixel: there the one pair's depth is kept where it
-matched densely around the pixel (:func:`sole_pair_depth`; issue 46: 17 % of seneca_south's hull was such ground
-and all of it was interpolated).
+matched densely around the pixel, and so it is where the other pairs matched nothing and it lies near the depths
+two pairs confirmed around it (:func:`sole_pair_depth`; issue 46: 17 % of seneca_south's hull was such ground
+and all of it was interpolated); under the block only (the camera centres' hull).
 """
 from __future__ import annotations
 
@@ -112,6 +113,12 @@ COVER_STEP = 8  # a pair's cover is found on a grid of this many pixels (its hul
 COVER_SOLID = 0.25  # ... of cells at least this share matched (a streak of lone matches makes no cover)
 SOLE_WINDOW_SHARE = 1.0 / 64  # a sole pair's pixel needs SOLE_DENSITY of its window (this share of the image's
 SOLE_DENSITY = 0.5  # short side) matched: the edge of a pair's overlap and its stray matches are not kept
+# where other pairs cover a pixel but none of them matched it, one pair's depth is kept if it lies this many of its
+# disparities from the mean of the depths two pairs confirmed in a window of SUPPORT_WINDOW_SHARE of the short side
+# (SUPPORT_SHARE of that window confirmed)
+UNOPPOSED_TOLERANCE_PX = 3.0
+SUPPORT_WINDOW_SHARE = 1.0 / 32
+SUPPORT_SHARE = 0.2
 
 
 def pair_cover(depth: np.ndarray) -> np.ndarray:
@@ -133,23 +140,35 @@ def pair_cover(depth: np.ndarray) -> np.ndarray:
     return np.repeat(np.repeat(cover, COVER_STEP, axis=0), COVER_STEP, axis=1)[:h, :w] > 0
 
 
-def sole_pair_depth(maps: np.ndarray) -> np.ndarray:
-    """Per pixel the depth of the one map whose pair alone covers it (:func:`pair_cover`), where that map matched
-    SOLE_DENSITY of a window of SOLE_WINDOW_SHARE of the image's short side around it; NaN elsewhere (no map,
-    or two or more that cover the pixel: there they must agree)."""
+def sole_pair_depth(maps: np.ndarray, confirmed: np.ndarray, rel_err: np.ndarray) -> np.ndarray:
+    """Per pixel the depth of the one map that holds one where no other map does, where that map matched SOLE_DENSITY
+    of a window of SOLE_WINDOW_SHARE of the image's short side around it, and where either its pair alone covers the
+    pixel (:func:`pair_cover`: no second pair could confirm it) or the depth lies within UNOPPOSED_TOLERANCE_PX
+    disparities of that pair (``rel_err``: its relative depth error per disparity) of the depths two pairs confirmed
+    around it (``confirmed``, NaN = none; their mean over a window of SUPPORT_WINDOW_SHARE of the short side, where
+    SUPPORT_SHARE of it is confirmed): a periodic texture's wrong minimum lies a period away and is not kept.  NaN
+    elsewhere (no map, two or more that hold a depth: there they must agree)."""
     cv2 = require("cv2", "depth fusion")
     k, h, w = maps.shape
     win = max(5, int(round(min(h, w) * SOLE_WINDOW_SHARE)) | 1)
     covers = np.stack([pair_cover(m) for m in maps])
-    n = covers.sum(axis=0)
+    n_cover = covers.sum(axis=0)
+    finite = np.isfinite(maps)
+    unopposed = finite.sum(axis=0) == 1
+    have = np.isfinite(confirmed)
+    swin = max(5, int(round(min(h, w) * SUPPORT_WINDOW_SHARE)) | 1)
+    share = cv2.blur(have.astype(np.float32), (swin, swin))
+    local = cv2.blur(np.where(have, confirmed, 0.0).astype(np.float32), (swin, swin)) / np.maximum(share, 1e-6)
+    supported = share >= SUPPORT_SHARE
     out = np.full((h, w), np.nan, np.float32)
     for m in range(k):
-        sole = covers[m] & (n == 1)
-        if not sole.any():
+        cand = unopposed & finite[m]
+        if not cand.any():
             continue
-        valid = np.isfinite(maps[m])
-        dense = cv2.blur(valid.astype(np.float32), (win, win)) >= SOLE_DENSITY
-        take = sole & valid & dense
+        dense = cv2.blur(finite[m].astype(np.float32), (win, win)) >= SOLE_DENSITY
+        with np.errstate(invalid="ignore"):
+            near = supported & (np.abs(maps[m] - local) <= UNOPPOSED_TOLERANCE_PX * float(rel_err[m]) * maps[m])
+        take = cand & dense & ((covers[m] & (n_cover == 1)) | near)
         out[take] = maps[m][take]
     return out
 
@@ -201,7 +220,7 @@ def fuse_image(unit: FuseUnit, cancel_path: Optional[str] = None) -> dict:
     rel_tol = np.clip(unit.tolerance_px * np.asarray(errs, dtype=np.float64), 0.002, 0.05)
     fused, _n = fuse_depth_maps(stack, rel_tol, unit.min_consistent)
     if unit.sole_pair:
-        sole = sole_pair_depth(stack)
+        sole = sole_pair_depth(stack, fused, np.asarray(errs, dtype=np.float64))
         take = ~np.isfinite(fused) & np.isfinite(sole)
         if unit.sole_region is not None and take.any():
             k0, dist0 = unit.view.camera_matrix(fused.shape[1] / unit.view.width, fused.shape[0] / unit.view.height)

@@ -14,6 +14,12 @@ CACHE_VERSION = 7  # of the per-pair depth map cache (dense/pairs-<key>/); 2: co
 # 4: uint16 depth maps (x step_i / step_j), stored; 5: equalised pairs, fine_uniqueness; 6: COARSE_FLAT_PX 3;
 # 7: window-end minima and streaks dropped (issue 46)
 
+# the automatic flat_block spans about this many of the photo's own pixels: 7 at full quality, 5 at half as the block
+# always was (issue 46: a block of 5 px at full quality spans half the ground it spans at half, and the photos' own
+# noise and 8 px JPEG blocks weigh on it; 9 matched more of seneca_south's pairs, 0.67 -> 0.82 of their overlap, and
+# 98 % of the synthetic farmland, but took its RMSE beyond the cameras' hull from 2.6 to 3.1 GSD; 7: 97.2 %, 2.7)
+FLAT_BLOCK_PHOTO_PX = 7
+
 # options that say where the work runs, not what it computes (not recorded among the stage's parameters)
 EXECUTION_OPTIONS = ("workers", "executor", "scheduler")
 # options recorded among the stage's parameters beside the options (the outputs as absolute paths)
@@ -47,6 +53,9 @@ class DenseOptions:
     # -> 1.90 GSD and cells more than 1 m off 123 -> 0; the small one 90.5 -> 90.7 % measured, RMSE inside the
     # cameras' hull 1.47 -> 1.49 GSD, over its whole DSM 2.10 -> 2.51 GSD (its edge, fewer views)
     fine_uniqueness: int = 3
+    # SGBM's block on the coarsest level and, on the finer ones, away from the coarser level's depth edges (where
+    # block_size stays: a larger block fattens a crown or a roof); 0 = auto (flat_sgbm_block: 7 at full quality)
+    flat_block: int = 0
     equalize: bool = True  # local contrast equalisation (CLAHE) of each rectified pair before matching
     lr_tolerance: float = 1.0  # px
     min_consistent: int = 2  # pairs that must agree on a pixel
@@ -92,6 +101,12 @@ class DenseOptions:
     def scale(self) -> float:
         """The image downscale of ``quality``."""
         return QUALITIES[self.quality]
+
+    def flat_sgbm_block(self) -> int:
+        """SGBM's block away from depth edges: ``flat_block``, or one spanning about FLAT_BLOCK_PHOTO_PX of the
+        photo's own pixels (7 at full quality, 5 at half, 3 at quarter); never under :meth:`sgbm_block`; odd."""
+        block = max(self.sgbm_block(), self.flat_block or int(round(FLAT_BLOCK_PHOTO_PX * self.scale)))
+        return block + 1 if block % 2 == 0 else block
 
     def sgbm_block(self) -> int:
         """The SGBM block size: ``block_size``, or 3 at quarter quality and 5 above; always odd."""

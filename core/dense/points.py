@@ -101,7 +101,8 @@ def cpu_points(block: DenseBlock, options: DenseOptions, dense_dir: str, model_f
     def unit(p: PairInfo, out: str) -> PairUnit:
         return PairUnit(f"{p.i}-{p.j}", out, views[p.i], views[p.j], scale, xyz[p.point_idx], block_size,
                         options.uniqueness, options.lr_tolerance, threads,
-                        fine_uniqueness=options.fine_uniqueness, equalize=options.equalize)
+                        fine_uniqueness=options.fine_uniqueness, equalize=options.equalize,
+                        flat_block=options.flat_sgbm_block())
 
     units, summaries, n_reused = _cached_pairs(pairs, pair_dir, unit, progress)
     sub = SubProgress(progress, 0.02 + 0.73 * (n_reused / len(pairs)), 0.75)
@@ -128,7 +129,7 @@ def _pair_cache(dense_dir: str, model_fp: Dict[str, str], scale: float, block: i
     """The folder of this model's and these settings' depth maps (caches of others removed, partial files too)."""
     key = fingerprint({"v": CACHE_VERSION, "model": model_fp, "scale": scale, "block": block,
                        "uniq": options.uniqueness, "lr": options.lr_tolerance, "fine_uniq": options.fine_uniqueness,
-                       "equalize": options.equalize})
+                       "equalize": options.equalize, "flat_block": options.flat_sgbm_block()})
     pair_dir = os.path.join(dense_dir, f"pairs-{key}")
     for name in os.listdir(dense_dir):  # caches of other models / settings
         if name.startswith("pairs-") and name != f"pairs-{key}":

@@ -43,6 +43,7 @@ class PairUnit:
     coarse: bool = True  # coarse to fine (a pyramid, see _disparity); False: one matching over the whole range
     fine_uniqueness: int = 3  # SGBM's uniqueness ratio on the finer levels (DenseOptions.fine_uniqueness)
     equalize: bool = True  # local contrast equalisation of the rectified pair (:func:`equalized`)
+    flat_block: int = 0  # SGBM's block away from the coarser level's depth edges and at the coarsest level (0: block_size)
 
 
 CLAHE_TILE_PX = 80  # equalisation tiles of about this side (the matching scale's pixels)
@@ -491,7 +492,7 @@ def _match_tiled(level: LevelPair, prior: np.ndarray, unit: "PairUnit", cancel_p
                 chk = lr_checked(dl, dr, unit.lr_tolerance)
                 two_ways += 1
             else:
-                sgbm = _sgbm(block, 0, tn, uq, max(1, int(round(unit.lr_tolerance))))
+                sgbm = _sgbm(unit.flat_block or block, 0, tn, uq, max(1, int(round(unit.lr_tolerance))))
                 chk = sgbm.compute(lc, rc).astype(np.float32) / 16.0
                 chk[chk < -0.5] = np.nan
             piece = chk[y0 - ya:y1 - ya, x0 - xa:x1 - xa]
@@ -525,7 +526,7 @@ def _disparity(pair: LevelPair, unit: "PairUnit", cancel_path: Optional[str],
         return lo, int(16 * math.ceil(max(16, hi - lo) / 16.0))
 
     lo, n = level_range(levels)
-    cl, cr = _match_lr(pyr[levels][0], pyr[levels][1], block, lo, n, unit.uniqueness, cancel_path)
+    cl, cr = _match_lr(pyr[levels][0], pyr[levels][1], unit.flat_block or block, lo, n, unit.uniqueness, cancel_path)
     disp = lr_checked(cl, cr, unit.lr_tolerance)
     del cl, cr
     info = {"levels": levels, "coarsest_disparities": n, "coarsest_map": np.isfinite(disp)}
