@@ -132,12 +132,14 @@ _FAULT_FILE = {}
 
 def pytest_collection_modifyitems(config, items):
     """Marks each test ``every_leg`` unless tests/legs.py names it one-leg: the chroot legs of CI run
-    ``-m every_leg`` (tests/legs.py says why each test runs where)."""
+    ``-m every_leg`` (tests/legs.py says why each test runs where); the costliest files first (pytest-xdist then
+    ends both workers together)."""
     from tests import legs
 
     for item in items:
         if not legs.one_leg(item.nodeid):
             item.add_marker(pytest.mark.every_leg)
+    items.sort(key=lambda item: legs.slowest_first(item.nodeid))  # stable: a file's tests keep their order
 
 
 def pytest_sessionfinish(session, exitstatus):

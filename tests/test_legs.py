@@ -60,3 +60,10 @@ def test_one_leg_reads_node_ids_as_pytest_writes_them():
     assert legs.one_leg(f"tests/{filename}::{test}[param-1]")
     assert not legs.one_leg(f"tests/{filename}::{test}_other")
     assert not legs.one_leg("tests/test_legs.py::test_one_leg_reads_node_ids_as_pytest_writes_them")
+
+
+def test_the_costliest_files_exist_and_come_first():
+    assert len(set(legs.SLOWEST_FIRST)) == len(legs.SLOWEST_FIRST)
+    assert all(f in legs.FILES for f in legs.SLOWEST_FIRST), [f for f in legs.SLOWEST_FIRST if f not in legs.FILES]
+    first = legs.SLOWEST_FIRST[0]
+    assert legs.slowest_first(f"tests/{first}::test_x") < legs.slowest_first("tests/test_gcp.py::test_x")

@@ -52,3 +52,25 @@ def test_errors_name_the_file(tmp_path):
     rot = _tif(tmp_path / "rot.tif", np.zeros((4, 4), np.float32), gt=(0, 1, 0.2, 0, 0.1, -1))
     with pytest.raises(DsmError, match="rotated"):
         open_dsm(rot)
+
+
+def test_the_crs_is_read_when_asked_also_after_close(tmp_path):
+    """RasterFile reads the CRS's WKT on first use (a reader of many small windows opens the file for each), and
+    gives it after the file was closed too."""
+    from osgeo import gdal, osr
+
+    from core.io.raster import RasterFile
+
+    path = str(tmp_path / "utm.tif")
+    ds = gdal.GetDriverByName("GTiff").Create(path, 4, 3, 1, gdal.GDT_Float32)
+    srs = osr.SpatialReference()
+    srs.ImportFromEPSG(32633)
+    ds.SetProjection(srs.ExportToWkt())
+    ds.SetGeoTransform((500000.0, 1.0, 0.0, 4600000.0, 0.0, -1.0))
+    ds = None
+    with RasterFile(path) as r:
+        inside = r.crs_wkt
+    with RasterFile(path) as r:
+        pass
+    after = r.crs_wkt
+    assert "32633" in inside and after == inside

@@ -76,7 +76,20 @@ class RasterFile:
         self.geotransform: Optional[Tuple[float, ...]] = ds.GetGeoTransform(can_return_null=True)
         if self.geotransform is not None:
             self.geotransform = tuple(self.geotransform)
-        self.crs_wkt: str = ds.GetProjection() or ""
+        self._crs_wkt: Optional[str] = None
+
+    @property
+    def crs_wkt(self) -> str:
+        """The CRS as WKT ('' when none), read on first use: exporting it costs about a millisecond, which a
+        reader of many small windows that opens the file for each would pay every time."""
+        if self._crs_wkt is None:
+            if self._ds is None:  # asked after close (the file as it was opened: read again)
+                gdal, _ = _gdal()
+                ds = gdal.Open(self.path)
+                self._crs_wkt = (ds.GetProjection() if ds is not None else "") or ""
+            else:
+                self._crs_wkt = self._ds.GetProjection() or ""
+        return self._crs_wkt
 
     @property
     def dataset(self):

@@ -157,7 +157,7 @@ def relief(dem_path: str, keys: Sequence[str], output_dir: str, prefix: str = "d
     refuse_overwriting_inputs({f"{key} visualisation": path for key, path in targets.items()}, {what: dem_path},
                               TerrainError)
     elev = read_elevation(dem_path, what, whole=False)  # read by tiles
-    scan(elev, what, options.tile)
+    scan(elev, what)  # the data check by the default tiles: the visualisations' tiles may be far smaller
     paths, timings = {}, {}
     for i, key in enumerate(keys):
         t0 = time.time()
