@@ -197,6 +197,13 @@ ONE_LEG = {
     "test_rig_calibration.py::test_a_capture_disagreeing_with_the_block_takes_its_correction_and_is_named": _RIG,
     "test_band_registration.py::test_synthetic_rig_with_wrong_relatives_is_refined": _RIG,
     "test_panel_calibration.py::test_the_orthomosaic_of_reflectance_photos_is_reflectance": _RIG,
+    "test_pipeline.py::test_runpipeline_from_qgis_process_and_resume": (
+        "the whole chain through qgis_process and its resume: the chain's stages run on every leg in their own "
+        "files; Run pipeline's parameters reach qgis_process on every leg in test_pipeline_panel.py's "
+        "test_qgis_process_run_pipeline_refuses_a_bad_panel, the shipped model in "
+        "test_shipped_model_chains_the_stages_through_the_workspace"),
+    "test_rig_rgb.py::test_only_the_stacked_captures_rgb_frames_are_aligned": _RIG,
+    "test_drone_shadow.py::test_no_cell_of_a_speck_comes_from_its_photo": _MOSAIC,
     "test_pipeline_panel.py::test_run_pipeline_with_the_panel_gives_a_reflectance_orthomosaic":
         _RIG + "; Run pipeline's panel parameters reach qgis_process on every leg in "
                "test_qgis_process_run_pipeline_refuses_a_bad_panel",
