@@ -32,30 +32,6 @@ sys.path.insert(0, ROOT)
 DATA = os.path.join(os.path.dirname(ROOT), "shared", "data")
 
 
-def align_step(images: str, ws: str) -> None:
-    from core.align.options import AlignOptions
-    from core.align.stage import align
-    from core.common.progress import NullProgress
-    from core.georef.options import GeorefOptions
-    from core.georef.stage import georeference_workspace
-    from core.project.workspace import Workspace
-
-    try:
-        w = Workspace.open(ws)
-        if w.stage_done("georeference"):
-            print("workspace already georeferenced")
-            return
-        aligned = w.stage_done("align")
-    except Exception:  # noqa: BLE001 - no workspace yet
-        aligned = False
-    if not aligned:
-        t0 = time.time()
-        r = align(images, ws, AlignOptions(), NullProgress())
-        print(f"aligned {r.registered}/{r.images_given} in {time.time() - t0:.0f} s")
-    georeference_workspace(ws, GeorefOptions(use_exif_gps=True), progress=NullProgress())
-    print("georeferenced with EXIF GPS")
-
-
 def dsm_step(ws: str, quality: str, resume: bool, block: int = 0) -> None:
     import shutil
 
@@ -198,7 +174,9 @@ def main():
     args = ap.parse_args()
     steps = args.steps.split(",")
     if "align" in steps:
-        align_step(args.images, args.workspace)
+        from dense import ensure_georeferenced  # benchmarks/dense.py: Align images + Georeference (EXIF GPS)
+
+        ensure_georeferenced(args.images, args.workspace, None)
     if "dsm" in steps:
         dsm_step(args.workspace, args.quality, args.resume, args.block)
     if "report" in steps:

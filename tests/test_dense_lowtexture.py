@@ -119,9 +119,14 @@ CACHE = os.path.join(ROOT, "build", "test-cache", f"dense-farmland-v2-{CONTRAST:
 
 @pytest.fixture(scope="module")
 def farmland(tmp_path_factory):
-    block = lt.small_block(CONTRAST)
-    images = rendered_once(block, CACHE)
-    ws = make_workspace(str(tmp_path_factory.mktemp("farmland") / "ws"), block, images_dir=images)
+    return _built(lt.small_block(CONTRAST), CACHE, tmp_path_factory.mktemp("farmland"))
+
+
+def _built(block, cache, root):
+    """(block, DSM result, heights, source classes, x, y of the cells in the scene's frame): the block rendered
+    once into ``cache``, its DSM built at full quality in ``root``/ws."""
+    images = rendered_once(block, cache)
+    ws = make_workspace(str(root / "ws"), block, images_dir=images)
     r = dense.build_dsm_workspace(ws, DenseOptions(quality="full", workers=1))
     z, gt, _ = raster.read_dsm(r.dsm_path)
     src, _, _ = raster.read_dsm(r.source_path)
@@ -190,16 +195,7 @@ def photos_seeing(block, x, y, z) -> np.ndarray:
 
 @pytest.fixture(scope="module")
 def fixed_wing(tmp_path_factory):
-    block = lt.fixed_wing_block(CONTRAST)
-    images = rendered_once(block, FW_CACHE)
-    ws = make_workspace(str(tmp_path_factory.mktemp("fixed-wing") / "ws"), block, images_dir=images)
-    r = dense.build_dsm_workspace(ws, DenseOptions(quality="full", workers=1))
-    z, gt, _ = raster.read_dsm(r.dsm_path)
-    src, _, _ = raster.read_dsm(r.source_path)
-    h, w = z.shape
-    x, y = np.meshgrid(gt[0] + (np.arange(w) + 0.5) * gt[1] - syn.ORIGIN[0],
-                       gt[3] + (np.arange(h) + 0.5) * gt[5] - syn.ORIGIN[1])
-    return block, r, z, np.nan_to_num(src).astype(np.uint8), x, y
+    return _built(lt.fixed_wing_block(CONTRAST), FW_CACHE, tmp_path_factory.mktemp("fixed-wing"))
 
 
 def test_fixed_wing_ground_that_two_photos_alone_see_is_measured(fixed_wing):
