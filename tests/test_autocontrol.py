@@ -173,9 +173,14 @@ def test_a_reference_of_another_place_is_refused_by_name(tmp_path, epochs):
     write_cog(noise, rng.integers(1, 255, size=(src.RasterYSize, src.RasterXSize)).astype(np.float32),
               src.GetGeoTransform(), syn.CRS)
     src = None
-    with pytest.raises(AutoControlError, match="ref_ortho.tif") as e:
+    # issue 47 item 14: said as such ('0 candidate(s) kept' before), with the evidence: the matches, the footprint
+    with pytest.raises(AutoControlError, match=r"ref_ortho\.tif does not seem to show the block: over the block's "
+                       r"footprint placed by its rough camera positions \(.*\), which it covers, \d+ feature matches "
+                       r"with the block's provisional orthophoto .*, \d+ agree with one placement.* and 0 hold locally"
+                       ) as e:
         autocontrol_workspace(ws_dir, AutoControlOptions.of(FAST, reference_ortho=noise, reference_dsm=epochs[3],
                                                             prior="gps", camera_positions=cams))
+    print(f"\n{e.value}")
     assert open(lay.autocontrol_json).read() == in_use
     assert lay.autocontrol_failed_json in str(e.value) and "candidates" in json.load(open(lay.autocontrol_failed_json))
     with pytest.raises(AutoControlError, match="missing.tif"):

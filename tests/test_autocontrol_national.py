@@ -427,7 +427,7 @@ def test_a_wrong_reference_is_named_with_what_is_wrong_before_any_work(tmp_path)
         (raster("empty.tif", 64, 1, gdal.GDT_Byte, 0, nodata=0), dsm, r"orthophoto .*empty\.tif has no data"),
         (ortho, raster("nodsm.tif", 64, 1, gdal.GDT_Float32, -9999.0, nodata=-9999.0),
          r"DSM .*nodsm\.tif has no data"),
-        (ortho, ortho, r"DSM .*ortho\.tif is a picture"),
+        (ortho, ortho, r"DSM .*ortho\.tif is an image, not heights"),
         (dsm, ortho, "the references look swapped"),
     ]
     before = sorted(os.listdir(tmp_path))

@@ -198,6 +198,117 @@ def test_bad_references_are_refused_by_name_before_the_adjustment(scene, tmp_pat
     print(f"\ntarget CRS in feet: {err.value}")
 
 
+def _picture(path, like, bands=4, dtype=None, interp=True):
+    """An image over the raster ``like``'s footprint: ``bands`` bands of bytes (red/green/blue/alpha when
+    ``interp``), or of ``dtype``; the values a grey ramp."""
+    from osgeo import gdal
+
+    ref = gdal.Open(like)
+    w, h = ref.RasterXSize, ref.RasterYSize
+    ds = gdal.GetDriverByName("GTiff").Create(path, w, h, bands, dtype or gdal.GDT_Byte)
+    ds.SetGeoTransform(ref.GetGeoTransform())
+    ds.SetProjection(ref.GetProjection())
+    ramp = (np.add.outer(np.arange(h), np.arange(w)) % 250).astype(np.float32)
+    colours = [gdal.GCI_RedBand, gdal.GCI_GreenBand, gdal.GCI_BlueBand, gdal.GCI_AlphaBand]
+    for k in range(bands):
+        b = ds.GetRasterBand(k + 1)
+        b.WriteArray(ramp if k < bands - 1 or bands < 2 else np.full((h, w), 255.0, np.float32))
+        if interp and bands > 1:
+            b.SetColorInterpretation(colours[k] if bands == 4 else (gdal.GCI_GrayIndex, gdal.GCI_AlphaBand)[k])
+    ds = None
+    return path
+
+
+def test_a_picture_given_as_heights_is_refused_by_every_reader(scene, tmp_path, monkeypatch):
+    """Issue 47 item 1: the RGBA orthomosaic given to Georeference as REFERENCE_DSM was read as heights (band 1's
+    bytes: cameras raised 152 m, exit 0). One check (core.io.raster.not_heights, the terrain tools' and the
+    automatic control's) for every reader of heights: DEM control refuses it before the adjustment, the
+    co-registration (either side) and the DSM reader (the orthophoto, Orthorectify) refuse it by name; a band of
+    heights with an alpha (mask) band still reads."""
+    from osgeo import gdal
+
+    import core.georef.adjustments as adjustments
+    from core.georef.coregister import CoregError, coregister_rasters
+    from core.io.raster import DsmError, open_dsm
+
+    fine = scene[3]
+
+    def no_adjustment(*args, **kwargs):
+        raise AssertionError("the adjustment ran")
+
+    monkeypatch.setattr(adjustments, "georeference", no_adjustment)
+    rgba = _picture(str(tmp_path / "orthomosaic.tif"), fine)
+    with pytest.raises(ArchaeoOrthoError, match=r"orthomosaic\.tif is an image, not heights: 4 band\(s\) of Byte "
+                                                r"\(red/green/blue/alpha\)") as err:
+        _run(tmp_path / "ws_rgba", scene, GeorefOptions(reference_dem=rgba))
+    print(f"\nDEM control on the RGBA mosaic: {err.value}")
+    for dem, ref in ((fine, rgba), (rgba, fine)):
+        with pytest.raises(CoregError, match=r"orthomosaic\.tif is an image, not heights"):
+            coregister_rasters(dem, ref)
+    with pytest.raises(DsmError, match=r"DSM .*orthomosaic\.tif is an image, not heights"):
+        open_dsm(rgba)
+    grey_alpha = _picture(str(tmp_path / "grey_alpha.tif"), fine, bands=2)
+    with pytest.raises(DsmError, match="is an image, not heights: 2 band\\(s\\) of Byte \\(grey/alpha\\)"):
+        open_dsm(grey_alpha)
+    masked = _picture(str(tmp_path / "heights_alpha.tif"), fine, bands=2, dtype=gdal.GDT_Float32)
+    assert open_dsm(masked).width == gdal.Open(fine).RasterXSize  # heights with a mask band are heights
+
+
+def _relabelled(src, dst, unit):
+    """A copy of the raster ``src`` whose band states ``unit`` ('' : none), its values untouched."""
+    from osgeo import gdal
+
+    ds = gdal.Translate(dst, src)
+    ds.GetRasterBand(1).SetUnitType(unit)
+    ds = None
+    return dst
+
+
+def test_a_reference_dem_in_another_unit_than_it_says_is_refused_before_the_adjustment(scene, tmp_path,
+                                                                                       monkeypatch):
+    """Issue 47 item 4: a DEM in feet with no unit label was read as metres (the block tilted 36.6 mm/m, lifted
+    40.6 m, exit 0). The reference's relief over the block against the block's own names the unit before the
+    adjustment: feet without a label, metres labelled feet; the same DEM labelled right runs."""
+    import core.georef.adjustments as adjustments
+
+    _, _, _, fine, _, ref_ft, _ = scene
+
+    def no_adjustment(*args, **kwargs):
+        raise AssertionError("the adjustment ran")
+
+    monkeypatch.setattr(adjustments, "georeference", no_adjustment)
+    unlabelled = _relabelled(ref_ft, str(tmp_path / "dem_ft_nolabel.tif"), "")
+    with pytest.raises(ArchaeoOrthoError, match=r"dem_ft_nolabel\.tif seems to be in feet, not metres: its relief "
+                                                r"over the block .* is 3\.\d\d x the block's own") as err:
+        _run(tmp_path / "ws_nolabel", scene, GeorefOptions(reference_dem=unlabelled))
+    assert "gdal_edit.py -units ft" in str(err.value)
+    print(f"\nfeet without a label: {err.value}")
+    metres_as_feet = _relabelled(fine, str(tmp_path / "dem_m_as_ft.tif"), "ft")
+    with pytest.raises(ArchaeoOrthoError, match=r"dem_m_as_ft\.tif seems to be in metres, not in ft as the band's "
+                                                r"unit says: its relief over the block .* is 0\.\d\d x") as err:
+        _run(tmp_path / "ws_m_as_ft", scene, GeorefOptions(reference_dem=metres_as_feet))
+    print(f"metres labelled feet: {err.value}")
+    for right in (ref_ft, fine):  # labelled feet, and metres without a label: past the checks, to the adjustment
+        with pytest.raises(AssertionError, match="the adjustment ran"):
+            _run(tmp_path / ("ws_" + os.path.basename(right)), scene, GeorefOptions(reference_dem=right))
+
+
+def test_a_reference_dem_alone_without_gps_says_what_can_place_the_block(scene, tmp_path):
+    """Issue 47 item 13: a reference DSM alone on photos without GPS said 'no target CRS', then, with a CRS,
+    'needs at least 3 control points': say that the DEM fixes heights, tilt and dome but not where the block
+    lies, and which inputs place it (EXIF GPS, camera positions, control points; or a reference orthophoto for
+    the automatic control)."""
+    block, rec, _, _, _, ref, _ = scene
+    works = (r"(?s)reference DEM .*reference_ft\.tif fixes the block's heights, tilt and dome, not where it lies: "
+             r".*EXIF GPS \(0 of 18 photos carry any\).*camera positions \(CAMERA_POSITIONS.*ground control "
+             r"points \(GCPS or GCP_LAYER\).*reference orthophoto \(REFERENCE_ORTHO\)")
+    for crs in (None, syn.CRS):
+        ws = synthetic_workspace(tmp_path / f"ws_{crs is None}", block, rec)
+        with pytest.raises(ArchaeoOrthoError, match=works) as err:
+            georeference_workspace(ws, GeorefOptions(reference_dem=ref, crs=crs), progress=Recorder())
+        print(f"\nCRS {crs}: {err.value}")
+
+
 def test_processing_georeference_with_a_reference_dsm_alone(scene, tmp_path, qgis_app):
     """Georeference with REFERENCE_DSM and the ground marks as check points; the block placed by the photos' EXIF
     GPS (biased heights) as USE_EXIF_GPS says, compared with the same run without the DSM."""

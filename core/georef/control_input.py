@@ -87,6 +87,18 @@ def _gcps(ws: Workspace, opt: GeorefOptions, progress: Progress) -> Optional[gcp
     return gcps
 
 
+def dem_alone_hint(ws: Workspace, opt: GeorefOptions) -> str:
+    """What a reference DEM given without enough to place the block needs (issue 47 item 13: 'no target CRS',
+    then 'at least 3 control points'): the inputs that work with it, and the automatic control."""
+    images = ws.data.get("images", [])
+    gps = sum(1 for im in images if im.get("gps"))
+    return (f"the reference DEM {opt.reference_dem} fixes the block's heights, tilt and dome, not where it lies: "
+            f"give what places the block with it: the photos' EXIF GPS ({gps} of {len(images)} photos carry any), "
+            "camera positions (CAMERA_POSITIONS: a file of x, y, z per photo), or 3 or more ground control points "
+            "(GCPS or GCP_LAYER), with CRS when they have no CRS line; or give a reference orthophoto (REFERENCE_ORTHO) "
+            "with the DEM: the automatic control then finds the block on the orthophoto itself, no position needed")
+
+
 def read_control(ws: Workspace, opt: GeorefOptions, progress: Progress
                  ) -> Tuple[Optional[gcpmod.GCPSet], List[gcpmod.CameraPosition], str]:
     """The ground control in the target CRS: (GCPs, camera positions, target CRS); StageError when it is
@@ -99,6 +111,8 @@ def read_control(ws: Workspace, opt: GeorefOptions, progress: Progress
     positions_crs = gcpmod.read_camera_positions(positions_path)[0] if positions_path else None
     target = (crs or (gcps.crs if gcps is not None else None) or ws.crs or positions_crs or _default_crs(ws))
     if not target:
+        if opt.reference_dem:
+            raise StageError(f"no target CRS and nothing to place the block: {dem_alone_hint(ws, opt)}")
         raise StageError("no target CRS: give CRS, or GCPs or camera positions with a CRS line, or images with "
                          "EXIF GPS")
     if gcps is not None:
@@ -120,10 +134,12 @@ def read_control(ws: Workspace, opt: GeorefOptions, progress: Progress
     n_control = sum(1 for p in gcps.points if p.role == gcpmod.CONTROL and p.observations) if gcps else 0
     if n_control < 3 and len(cams) < 3:
         found = "; ".join(f"{p.name} ({p.role}, {p.describe_observations()})" for p in gcps.points) if gcps else "none"
+        hint = f"; {dem_alone_hint(ws, opt)}" if opt.reference_dem else ""
         raise StageError(gcpmod.with_warnings(
             f"georeferencing needs at least 3 control points (or 3 camera positions); found {n_control} control "
-            f"point(s) with observations and {len(cams)} camera position(s). Points: {found}", gcps.warnings if gcps else []))
+            f"point(s) with observations and {len(cams)} camera position(s). Points: {found}{hint}",
+            gcps.warnings if gcps else []))
     return gcps, cams, target
 
 
-__all__ = ["exif_positions", "photo_orientations", "read_control"]
+__all__ = ["dem_alone_hint", "exif_positions", "photo_orientations", "read_control"]

@@ -59,7 +59,7 @@ import numpy as np
 
 from ..common.errors import ArchaeoOrthoError
 from ..common.progress import NullProgress, Progress, check_cancel
-from ..io.raster import RasterError, RasterFile, bilinear
+from ..io.raster import RasterError, RasterFile, bilinear, check_heights
 
 OUTLIER_NMAD = 3.0  # residuals beyond this many spreads of the shortest half's centre are not stable terrain
 MAX_SLOPE_DEG = 70.0  # steeper cells (cliffs, walls) are left out of the fit
@@ -660,9 +660,10 @@ def _height_unit(band, srs, path: str) -> Tuple[float, str]:
     return 1.0, ""
 
 
-def _open_source(path: str, what: str) -> Tuple[_Source, float, List[str]]:
+def _open_source(path: str, what: str, heights: bool = True) -> Tuple[_Source, float, List[str]]:
     """(source, metres per horizontal CRS unit, messages) of a raster file; CoregError naming it when it cannot
-    be used (missing, unreadable, rotated, geographic CRS, no height)."""
+    be used (missing, unreadable, not heights (``heights``: core.io.raster.not_heights, an orthophoto given as a
+    DEM), rotated, geographic CRS, no height)."""
     _, osr = _gdal()
     try:
         raster = RasterFile(path, f"the {what}")
@@ -671,6 +672,8 @@ def _open_source(path: str, what: str) -> Tuple[_Source, float, List[str]]:
     if raster.geotransform is None:
         raise CoregError(f"the {what} {path} has no georeferencing (no geotransform)")
     name = f"{what} {path}"
+    if heights:
+        check_heights(raster.dataset, f"the {name}", CoregError)
     gt = _check_transform(raster.geotransform, name)
     wkt = raster.crs_wkt
     ds = raster.dataset
@@ -715,7 +718,7 @@ def coregister_rasters(dem_path: str, ref_path: str, *, stable_mask_path: Option
         dem.wkt = ref.wkt  # the same CRS spelt otherwise: no reprojection
     stable = None
     if stable_mask_path:
-        stable, _, _ = _open_source(stable_mask_path, "stable-terrain mask")
+        stable, _, _ = _open_source(stable_mask_path, "stable-terrain mask", heights=False)
         stable.zscale = 1.0  # 0 / 1 flags, not heights in the CRS's unit
         if not stable.wkt and ref.wkt:
             stable.wkt = ref.wkt

@@ -56,7 +56,7 @@ import numpy as np
 from ..common.errors import ArchaeoOrthoError
 from ..common.progress import NullProgress, Progress
 from ..io.gcp import CONTROL, CameraPosition, GCPSet, GroundPoint, Observation
-from ..io.raster import RasterError, RasterFile, bilinear
+from ..io.raster import RasterError, RasterFile, bilinear, check_heights_file
 from .coregister import (
     DEM_MARGIN_CELLS,
     MIN_CELLS,
@@ -259,6 +259,76 @@ def check_coverage(xyz: np.ndarray, ref_path: str, crs: str) -> Tuple[np.ndarray
     return ref, gt, messages, n
 
 
+FOOT_RATIO = 1.0 / 0.3048  # heights in feet read as metres have this many times the relief (US survey foot: 3.28083)
+
+
+def _detrended(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """``z`` less its plane (offset and tilt) by least squares over the values within OUTLIER_NMAD spreads of
+    the residuals' shortest half, iterated (a tilt of the block or of the terrain is not relief)."""
+    a = np.column_stack([np.ones_like(x), x - x.mean(), y - y.mean()])
+    inl = np.ones(len(z), dtype=bool)
+    r = z - z.mean()
+    for _ in range(10):
+        p = np.linalg.lstsq(a[inl], z[inl], rcond=None)[0]
+        r = z - a @ p
+        centre, spread = shorth(r)
+        new = np.abs(r - centre) <= OUTLIER_NMAD * max(spread, 1e-9)
+        if np.array_equal(new, inl) or new.sum() < MIN_CELLS:
+            break
+        inl = new
+    return r
+
+
+def relief_ratio(xyz: np.ndarray, ref: np.ndarray, gt: Sequence[float]) -> Tuple[float, float, int]:
+    """(the reference's relief over the block / the block's own, their correlation, points compared): the
+    heights of the block's points and the reference's under them, each less its plane (a tilt, the terrain's
+    slope), compared by their spreads (NMAD) over the points that are neither's outlier.  Unit-free: about 1
+    for a reference in the block's unit, 3.28 for heights in feet read as metres, 0.30 for metres read as feet."""
+    pts = np.asarray(xyz, dtype=float)
+    h = bilinear(ref, (pts[:, 0] - gt[0]) / gt[1] - 0.5, (pts[:, 1] - gt[3]) / gt[5] - 0.5)
+    ok = np.isfinite(h) & np.all(np.isfinite(pts), axis=1)
+    if ok.sum() < MIN_CELLS:
+        return math.nan, math.nan, int(ok.sum())
+    x, y = pts[ok, 0], pts[ok, 1]
+    rz, rh = _detrended(x, y, pts[ok, 2]), _detrended(x, y, h[ok])
+    (cz, sz), (ch, sh) = shorth(rz), shorth(rh)
+    inl = (np.abs(rz - cz) <= OUTLIER_NMAD * max(sz, 1e-9)) & (np.abs(rh - ch) <= OUTLIER_NMAD * max(sh, 1e-9))
+    if inl.sum() < MIN_CELLS or not (np.std(rz[inl]) > 0 and np.std(rh[inl]) > 0):
+        return math.nan, math.nan, int(inl.sum())
+    rho = float(np.corrcoef(rz[inl], rh[inl])[0, 1])
+    return float(nmad(rh[inl]) / max(nmad(rz[inl]), 1e-12)), rho, int(inl.sum())
+
+
+def check_height_unit(xyz: np.ndarray, ref: np.ndarray, gt: Sequence[float], ref_path: str) -> None:
+    """DemControlError when the reference's heights are evidently in another unit than it was read in (issue 47
+    item 4: a DEM in feet without a unit label, read as metres, tilted a block 36.6 mm/m and lifted it 40.6 m):
+    its relief over the block against the block's own (:func:`relief_ratio`) is nearer 3.28 (feet read as
+    metres) than 1, or nearer 0.30 (metres labelled feet), on the log scale: beyond sqrt(3.28) = 1.81 either way.
+    Judged only where the two reliefs correlate beyond 1 / sqrt(3.28) = 0.55: noise in one of them alone then
+    cannot carry the ratio across (its ratio is at most 1 / correlation), so a block on flat ground or a DTM under
+    a block of roofs (the reliefs unrelated) is never called wrong."""
+    from ..io.raster import height_unit
+
+    k, rho, n = relief_ratio(xyz, ref, gt)
+    mid = math.sqrt(FOOT_RATIO)
+    if not (math.isfinite(k) and rho > 1.0 / mid):
+        return
+    unit, metres, where = height_unit(ref_path)
+    evidence = (f"its relief over the block (each less its tilt) is {k:.2f} x the block's own, correlation "
+                f"{rho:.2f} over {n} sparse points")
+    if k > mid and not where:
+        raise DemControlError(
+            f"the reference DEM {ref_path} seems to be in feet, not metres: {evidence} (heights in feet read as "
+            f"metres give {FOOT_RATIO:.2f} x), and nothing in the file states its unit, so it was read in metres. "
+            f"Label its heights (gdal_edit.py -units ft {ref_path}, or -units 'US survey foot'; or give it a "
+            "vertical CRS in feet) or convert them to metres, and run again")
+    if k < 1.0 / mid and metres < 1.0:
+        raise DemControlError(
+            f"the reference DEM {ref_path} seems to be in metres, not in {unit} as {where} says: {evidence} "
+            f"(heights in metres read as feet give {1.0 / FOOT_RATIO:.2f} x). Correct its unit (gdal_edit.py "
+            f"-units m {ref_path}, or its vertical CRS) and run again")
+
+
 def _short(crs: str) -> str:
     return crs if len(crs) < 40 else crs[:37] + "..."
 
@@ -286,11 +356,14 @@ def precheck(rec, gcps: Optional[GCPSet], cams: Sequence[CameraPosition], option
     errors of :func:`check_coverage` before the adjustment runs.  Returns the cells under the block."""
     from .adjust import georeference
 
+    check_heights_file(ref_path, "reference DEM", DemControlError)  # an orthophoto given as the DEM (issue 47)
     check_metric(crs, ref_path)
     opt = dataclasses.replace(options, adjust=False, crs=crs)
     placed = georeference(rec, gcps, list(cams) or None, progress=NullProgress(), options=opt)
     xyz, _ = sparse_points(placed.reconstruction, placed.offset)
-    return check_coverage(xyz, ref_path, crs)[3]
+    ref, gt, _, cells = check_coverage(xyz, ref_path, crs)
+    check_height_unit(xyz[block_points(xyz)], ref, gt, ref_path)
+    return cells
 
 
 def heights_only(xyz: np.ndarray, ref: np.ndarray, gt: Sequence[float], dome: bool = True) -> CoregResult:
@@ -522,6 +595,6 @@ def _f(v) -> str:
 
 __all__ = ["DEM_PREFIX", "DemControl", "DemControlError", "HEIGHTS_BOTH", "HEIGHTS_CONTROL", "HEIGHTS_DEM",
            "after_messages",
-           "after_warning", "block_points", "cells_under", "check_coverage", "check_metric",
+           "after_warning", "block_points", "cells_under", "check_coverage", "check_height_unit", "check_metric",
            "coregister_block", "coregister_xyz", "heights_only", "dem_control", "has_height_control", "precheck",
-           "sparse_points", "track_observations", "vertical_datum", "with_dem_control"]
+           "relief_ratio", "sparse_points", "track_observations", "vertical_datum", "with_dem_control"]

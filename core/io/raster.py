@@ -170,6 +170,58 @@ class RasterFile:
         return np.stack([self.read(i, window, out_shape, resampling) for i in indices])
 
 
+# ---------------------------------------------------------------------------
+# does a raster hold heights
+# ---------------------------------------------------------------------------
+
+ELEVATION_PRODUCTS = ("dtm", "dsm", None)  # ARCHAEOORTHO_PRODUCT values that are heights (None: not ours)
+
+
+def not_heights(ds, products: bool = True) -> str:
+    """Why the GDAL dataset ``ds`` cannot hold heights ('' when it can): the one check every reader of heights
+    makes (a DSM, a DTM, a reference DEM for the terrain tools, the co-registration, DEM control, the automatic
+    control, the orthophoto): an image (red / green / blue / palette bands, three or more bands of bytes, a byte
+    band with an alpha band: an orthophoto or a rendered map given as heights) or one of the plugin's own products
+    that are not heights (the DSM's source raster, a relief visualisation, a spectral index).  A band of heights
+    with an alpha (mask) band is heights.  ``products`` False: the plugin's own products are not judged (the DSM
+    reader, :func:`read_dsm`, also reads the DTM's source band and the relief rasters as arrays)."""
+    gdal, _ = _gdal()
+    product = (ds.GetMetadata() or {}).get("ARCHAEOORTHO_PRODUCT")
+    if products and product not in ELEVATION_PRODUCTS:
+        return f"an ArchaeoOrtho {product} raster, not heights: give a DSM or DTM"
+    names = {gdal.GCI_RedBand: "red", gdal.GCI_GreenBand: "green", gdal.GCI_BlueBand: "blue",
+             gdal.GCI_AlphaBand: "alpha", gdal.GCI_PaletteIndex: "palette"}
+    bands = [ds.GetRasterBand(i + 1) for i in range(ds.RasterCount)]
+    interp = [names.get(b.GetColorInterpretation()) for b in bands]
+    byte = bands[0].DataType == gdal.GDT_Byte
+    colour = any(c in ("red", "green", "blue", "palette") for c in interp)
+    if colour or (len(bands) >= 3 and byte) or (byte and "alpha" in interp):
+        kinds = "/".join(c or "grey" for c in interp)
+        return (f"an image, not heights: {len(bands)} band(s) of {gdal.GetDataTypeName(bands[0].DataType)} "
+                f"({kinds}); an orthophoto or a rendered picture cannot be a terrain model: give a DSM or DTM (one "
+                "band of heights)")
+    return ""
+
+
+def check_heights(ds, name: str, error=None, products: bool = True) -> None:
+    """``error`` (RasterError by default) '``name`` is an image, not heights: ...' when the GDAL dataset ``ds``
+    cannot hold heights (:func:`not_heights`); ``name`` names the input and its file ('the DSM /path/x.tif')."""
+    why = not_heights(ds, products)
+    if why:
+        raise (error or RasterError)(f"{name} is {why}")
+
+
+def check_heights_file(path: str, what: str, error=None) -> None:
+    """:func:`check_heights` on the file ``path`` (``what`` it was given as: 'reference DEM'), before any work;
+    a file that cannot be opened is left to the reader that follows (it names what is wrong with it)."""
+    try:
+        r = RasterFile(path, what)
+    except RasterError:
+        return
+    with r:
+        check_heights(r.dataset, f"{what} {path}", error)
+
+
 def crs_to_wkt(crs: Optional[str]) -> str:
     """WKT of a CRS given as 'EPSG:xxxx', WKT or PROJ string; '' for None (local frame)."""
     if not crs:
@@ -493,6 +545,7 @@ def open_dsm(path: str) -> DsmInfo:
     """Check and describe a DSM raster (ours or external).  Raises DsmError with a clear message."""
     try:
         with RasterFile(path, "DSM") as r:
+            check_heights(r.dataset, f"DSM {path}", DsmError, products=False)
             gt = r.require_georeferenced()
             w, h = r.width, r.height
             xs = (gt[0], gt[0] + w * gt[1])
@@ -769,4 +822,5 @@ def read_las(path: str) -> Tuple[np.ndarray, np.ndarray, dict]:
 
 __all__ = ["Grid", "BandLabel", "write_cog", "translate_to_cog", "open_dsm", "DsmReader", "DsmInfo", "read_dsm", "write_las",
            "read_las", "DsmError", "RasterError", "RasterFile", "axis_metres",
-           "NODATA", "bilinear", "crs_to_wkt", "crs_epsg", "height_unit"]
+           "NODATA", "bilinear", "crs_to_wkt", "crs_epsg", "height_unit", "ELEVATION_PRODUCTS", "not_heights",
+           "check_heights", "check_heights_file"]

@@ -60,28 +60,11 @@ def check_north_up(path: str, what: str, gt) -> None:
         raise TerrainError(f"the {what} {path} is rotated (geotransform {gt}): warp it to a north-up grid first")
 
 
-ELEVATION_PRODUCTS = ("dtm", "dsm", None)  # ARCHAEOORTHO_PRODUCT values that are heights (None: not ours)
-
-
 def check_elevation_kind(r: raster.RasterFile, path: str, what: str) -> None:
-    """TerrainError naming the file and what it holds when the raster is of a kind that cannot be heights: an
-    image (RGB / RGBA bands, 8-bit colour, a palette: the orthomosaic given as a DSM) or one of the plugin's own
-    non-elevation products (a DSM/DTM source raster, a relief visualisation)."""
-    from osgeo import gdal
-
-    product = r.metadata().get("ARCHAEOORTHO_PRODUCT")
-    if product not in ELEVATION_PRODUCTS:
-        raise TerrainError(f"the {what} {path} is an ArchaeoOrtho {product} raster, not heights: give a DSM or DTM")
-    colours = {gdal.GCI_RedBand: "red", gdal.GCI_GreenBand: "green", gdal.GCI_BlueBand: "blue",
-               gdal.GCI_AlphaBand: "alpha", gdal.GCI_PaletteIndex: "palette"}
-    bands = [r.band(i + 1) for i in range(r.count)]
-    interp = [colours.get(b.GetColorInterpretation()) for b in bands]
-    dtype = gdal.GetDataTypeName(bands[0].DataType)
-    if any(interp) or (r.count >= 3 and dtype == "Byte"):
-        kinds = "/".join(c or "grey" for c in interp)
-        raise TerrainError(f"the {what} {path} is an image, not heights: {r.count} band(s) of {dtype} "
-                           f"({kinds}); an orthophoto or a rendered picture cannot be a terrain model: give a DSM "
-                           "or DTM (one band of heights)")
+    """TerrainError naming the file and what it holds when the raster is of a kind that cannot be heights
+    (core.io.raster.not_heights, the one check every reader of heights makes): an image (the orthomosaic given as
+    a DSM) or one of the plugin's own non-elevation products (a DSM/DTM source raster, a relief visualisation)."""
+    raster.check_heights(r.dataset, f"the {what} {path}", TerrainError)
 
 
 def check_memory(path: str, what: str, w: int, h: int, bytes_per_cell: int = PEAK_BYTES_PER_CELL) -> None:

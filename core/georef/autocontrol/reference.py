@@ -13,7 +13,7 @@ import numpy as np
 
 from ...common.errors import require
 from ...geometry.crs import CRSError, crs_identifier, is_mercator, linear_unit, transform_points, utm_epsg_for_lonlat
-from ...io.raster import DsmError, DsmReader, RasterError, RasterFile, crs_to_wkt
+from ...io.raster import DsmError, DsmReader, RasterError, RasterFile, check_heights, crs_to_wkt, not_heights
 from .errors import AutoControlError
 
 
@@ -85,30 +85,20 @@ def _is_heights(gdal, ds) -> bool:
                                                                           "foot", "feet", "us survey foot"))
 
 
-def _is_picture(gdal, ds) -> bool:
-    """Whether a raster is a picture: red / green / blue / palette bands, or three or more bands of bytes."""
-    colours = (gdal.GCI_RedBand, gdal.GCI_GreenBand, gdal.GCI_BlueBand, gdal.GCI_PaletteIndex)
-    bands = [ds.GetRasterBand(k + 1) for k in range(ds.RasterCount)]
-    return any(b.GetColorInterpretation() in colours for b in bands) or (
-        ds.RasterCount >= 3 and bands[0].DataType == gdal.GDT_Byte)
-
-
 def _check_kinds(gdal, ortho_path: str, ortho, dsm_path: str, dsm) -> None:
     """AutoControlError saying which reference is wrong and why, before any work (issue 36 item 12: these all
     ended in '0 candidate(s) kept, 4 needed'): an orthophoto that is a few pixels or has no data, a DSM that is
-    a picture or has no data, the two swapped."""
+    not heights (core.io.raster.not_heights: the check every reader of heights makes) or has no data, the two
+    swapped."""
     w, h = ortho.RasterXSize, ortho.RasterYSize
     if min(w, h) < MIN_REFERENCE_PIXELS:
         raise AutoControlError(f"reference orthophoto {ortho_path} is {w} x {h} pixels: too small to match photos "
                                f"against (at least {MIN_REFERENCE_PIXELS} x {MIN_REFERENCE_PIXELS})")
-    if _is_heights(gdal, ortho) and _is_picture(gdal, dsm):
+    if _is_heights(gdal, ortho) and not_heights(dsm):
         raise AutoControlError(f"the references look swapped: the orthophoto {ortho_path} holds heights and the "
-                               f"DSM {dsm_path} is a picture; give the orthophoto as the orthophoto and the DSM "
-                               "as the DSM")
-    if _is_picture(gdal, dsm):
-        raise AutoControlError(f"reference DSM {dsm_path} is a picture ({dsm.RasterCount} bands of "
-                               f"{gdal.GetDataTypeName(dsm.GetRasterBand(1).DataType)}), not heights: give a DSM "
-                               "or DTM (one band of heights)")
+                               f"DSM {dsm_path} is {not_heights(dsm).split(':')[0]}; give the orthophoto as the "
+                               "orthophoto and the DSM as the DSM")
+    check_heights(dsm, f"reference DSM {dsm_path}", AutoControlError)
     for what, path, ds in (("reference orthophoto", ortho_path, ortho), ("reference DSM", dsm_path, dsm)):
         try:
             ds.GetRasterBand(1).ComputeRasterMinMax(True)  # a sample (overviews); writes nothing beside the file

@@ -54,6 +54,7 @@ class CandidateSearch:
     messages: List[str]
     gsd: float
     timings: Dict[str, float] = field(default_factory=dict)
+    not_shown: str = ""  # why the reference seems not to show the block (no match holds locally), else ''
 
 
 def photo_paths(ws: Workspace, rec=None) -> Dict[str, str]:
@@ -171,6 +172,32 @@ def check_block_pixels(ext, match_gsd: float, reference: Reference, photo_gsd: f
                            "hand-picked control points")
 
 
+def not_shown(reference: Reference, box, placed: str, ms, g: float, opt: AutoControlOptions) -> str:
+    """'the reference orthophoto ... does not seem to show the block: ...' when fewer than ``opt.min_candidates``
+    matches hold locally (the per-tile affine) between the block's provisional orthophoto and the reference over the
+    block's footprint (``box``, which the reference covers: ``Reference.check_covers`` ran), else '' (issue 47
+    item 14: an orthophoto of another place ended in '0 candidate(s) kept, 4 needed').  The evidence: the matches,
+    how many agree with one placement and, for that placement, the scale and turn it would give the block, which
+    its rough positions place at scale 1, unturned, at the common resolution ``g``."""
+    if len(ms.src) >= opt.min_candidates:
+        return ""
+    unit = unit_symbol(reference.crs_wkt)
+    best = ""
+    if ms.similarity is not None and ms.n_similarity:
+        a = np.asarray(ms.similarity, dtype=float)[:, :2]
+        scale = math.sqrt(abs(float(np.linalg.det(a))))
+        turn = math.degrees(math.atan2(a[1, 0], a[0, 0]))
+        best = (f" (that placement would scale the block by {scale:.2f} and turn it {turn:.0f} degrees, where its "
+                f"{placed} place it at scale 1, unturned)")
+    return (f"the reference orthophoto {reference.ortho_path} does not seem to show the block: over the block's "
+            f"footprint placed by its {placed} ({box[0]:.0f}..{box[2]:.0f}, {box[1]:.0f}..{box[3]:.0f} {unit}), "
+            f"which it covers, {ms.n_found} feature matches with the block's provisional orthophoto at {g:.3g} {unit} "
+            f"per pixel, {ms.n_similarity} agree with one placement{best} and {len(ms.src)} hold locally (at least "
+            f"{opt.min_candidates} needed): is it an orthophoto of this site, and of a time when the ground looked "
+            "alike? Open it with the photos' positions in QGIS; when it shows another place, are its georeferencing "
+            "and the photos' GPS (or the rough positions given) right?")
+
+
 def _own_height_sigma(cands, reference: Reference, photo_gsd: float, opt: AutoControlOptions,
                       messages: List[str]) -> float:
     """The reference DSM's own height noise in the candidates' sigma Z: ``opt.dsm_sigma`` when given, else
@@ -209,8 +236,8 @@ def find_candidates(ws: Workspace, rec, reference: Reference, options: Optional[
     off = frame.offset
     box = (ext[0] + off[0] - margin, ext[1] + off[1] - margin, ext[2] + off[0] + margin, ext[3] + off[1] + margin)
     placed = "coarse match" if any(m.startswith("prior: none") for m in messages) else "rough camera positions"
-    reference.check_covers((ext[0] + off[0], ext[1] + off[1], ext[2] + off[0], ext[3] + off[1]),
-                           f"the block placed by its {placed}")
+    footprint = (ext[0] + off[0], ext[1] + off[1], ext[2] + off[0], ext[3] + off[1])
+    reference.check_covers(footprint, f"the block placed by its {placed}")
     prov = provisional_ortho(rec, frame, photos, g, SubProgress(progress, 0.2, 0.4), ext)
     t["orthophoto"] = time.time()
     ref, valid, gt = reference.grey(box, g)
@@ -241,7 +268,7 @@ def find_candidates(ws: Workspace, rec, reference: Reference, options: Optional[
                "block_reference_pixels": round(max(ext[2] - ext[0], ext[3] - ext[1]) / reference.gsd, 1),
                "dsm_sigma": own}
     timings = {k: t[k] - t["start"] for k in ("prior", "orthophoto", "matching", "photos")}
-    return CandidateSearch(cands, figures, messages, g, timings)
+    return CandidateSearch(cands, figures, messages, g, timings, not_shown(reference, footprint, placed, ms, g, opt))
 
 
-__all__ = ["CandidateSearch", "check_block_pixels", "find_candidates", "photo_paths"]
+__all__ = ["CandidateSearch", "check_block_pixels", "find_candidates", "not_shown", "photo_paths"]

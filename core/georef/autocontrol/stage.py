@@ -80,6 +80,9 @@ def autocontrol_workspace(workspace_dir: str, options: AutoControlOptions,
     # the candidates go to autocontrol-failed.json until the adjustment has succeeded: autocontrol.json stays the
     # record of the control in use (a failed run must not describe a block controlled by another)
     write_json(lay.autocontrol_failed_json, doc)
+    if len(kept) < opt.min_candidates and found.not_shown:
+        raise AutoControlError(f"automatic control: {found.not_shown} ({len(kept)} candidate(s) kept, "
+                               f"{opt.min_candidates} needed; see {lay.autocontrol_failed_json})")
     if len(kept) < opt.min_candidates:
         raise AutoControlError(f"automatic control against {opt.reference_ortho}: {len(kept)} candidate(s) kept, "
                                f"{opt.min_candidates} needed{record.coarse_hint(figures, found.gsd, opt)} "
