@@ -45,6 +45,7 @@ FILES = {
     "test_calibrated_cameras.py": "qgis",
     "test_calibration_files.py": "core",
     "test_captures.py": "qgis_process",
+    "test_control_checks.py": "gdal",
     "test_control_sigma.py": "core",
     "test_coregister.py": "gdal",
     "test_dask.py": "core",

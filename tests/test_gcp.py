@@ -482,7 +482,7 @@ def test_camera_positions_errors_and_duplicates(tmp_path):
     p = write(tmp_path, "c.txt", "a.jpg 1000 2000 100\na.jpg 1001 2001 101\n")
     ws = []
     _, cams = read_camera_positions(p, warnings=ws)
-    assert len(cams) == 1 and cams[0].x == 1000 and any(f"{p}:2" in w and "a.jpg" in w for w in ws)
+    assert len(cams) == 1 and cams[0].x == 1000 and any("lines 1 and 2" in w and "a.jpg" in w for w in ws)
     with warnings.catch_warnings(record=True) as rec:
         warnings.simplefilter("always")
         read_camera_positions(p)
@@ -493,6 +493,49 @@ def test_camera_positions_errors_and_duplicates(tmp_path):
     p = write(tmp_path, "f.txt", "image,x,y,z\na.jpg,1000,2000,-\n")
     with pytest.raises(GCPError, match=r"f\.txt:2: z is not a number"):
         read_camera_positions(p)
+
+
+def test_camera_positions_duplicate_rows_name_the_image_and_lines(tmp_path):
+    """Issue 47 item 17: an image on two rows that agree within their sigmas is warned naming the image, both
+    lines and the one used; rows farther apart than their sigmas are refused, naming the same."""
+    p = write(tmp_path, "same.csv", "EPSG:32617\nimage,x,y,z,sigma\na.jpg,274901.8,4603267.3,122,5\n"
+                                    "b.jpg,274911.8,4603267.3,122,5\na.jpg,274902.8,4603267.3,122,5\n")
+    said = []
+    _, cams = read_camera_positions(p, warnings=said)
+    assert [c.image for c in cams] == ["a.jpg", "b.jpg"] and cams[0].x == 274901.8
+    assert len(said) == 1 and "a.jpg" in said[0] and "lines 3 and 5" in said[0] and "line 3) is used" in said[0]
+    p = write(tmp_path, "apart.csv", "EPSG:32617\nimage,x,y,z,sigma\na.jpg,274901.8,4603267.3,122,5\n"
+                                     "b.jpg,274911.8,4603267.3,122,5\na.jpg,275101.8,4603267.3,122,5\n")
+    with pytest.raises(GCPError, match=r"apart\.csv: image a\.jpg is on lines 3 and 5 .*200\.00 m apart.*sigmas"):
+        read_camera_positions(p)
+
+
+def test_camera_positions_with_semicolons_and_decimal_commas(tmp_path):
+    """Issue 47 item 11: a spreadsheet's export (';' separators, decimal commas) is read; a file that mixes the
+    separators names them."""
+    p = write(tmp_path, "excel.csv", "EPSG:32617\nimage;x;y;z;sigma\n1JI_0064.JPG;274901,848;4603267,294;122,3;2,5\n"
+                                     "1JI_0065.JPG;274901,230;4603277,193;122;2\n")
+    crs, cams = read_camera_positions(p)
+    assert crs == "EPSG:32617"
+    assert [(c.image, c.x, c.y, c.z, c.sigma_xy) for c in cams] == [
+        ("1JI_0064.JPG", 274901.848, 4603267.294, 122.3, 2.5), ("1JI_0065.JPG", 274901.23, 4603277.193, 122.0, 2.0)]
+    p = write(tmp_path, "tabs.txt", "1JI_0064.JPG\t274901,848\t4603267,294\n1JI_0065.JPG\t274901,230\t4603277,193\n")
+    _, cams = read_camera_positions(p, crs="EPSG:32617")
+    assert [(c.x, c.y) for c in cams] == [(274901.848, 4603267.294), (274901.23, 4603277.193)]
+    p = write(tmp_path, "mixed.csv", "image,x,y,z\n1JI_0064.JPG;274901,848;4603267,294;122,3\n"
+                                     "1JI_0065.JPG,274901.2,4603277.1,122\n")
+    with pytest.raises(GCPError, match=r"mixed\.csv:2: .*'848;4603267'.*';'.*separat"):
+        read_camera_positions(p)
+
+
+def test_gcp_csv_with_semicolons_and_decimal_commas(tmp_path):
+    """The same spreadsheet export for a GCP CSV pair: decimal commas read where ';' separates."""
+    pts = write(tmp_path, "pts.csv", "# crs: EPSG:32617\nname;x;y;z;sigma_xy;sigma_z\nA;274901,848;4603267,294;180,5;0,02;0,05\n")
+    write(tmp_path, "pts_observations.csv", "name;image;px;py\nA;a.jpg;100,5;200,25\n")
+    gs = read_gcps(pts)
+    a = gs.by_name("A")
+    assert (a.x, a.y, a.z, a.sigma_xy, a.sigma_z) == (274901.848, 4603267.294, 180.5, 0.02, 0.05)
+    assert (a.observations[0].x, a.observations[0].y) == (100.5, 200.25)
 
 
 # ------------------------------------------------------------------ transformations

@@ -193,6 +193,7 @@ def georeference(reconstruction, gcps: Optional[GCPSet], camera_positions: Optio
     fit = _initial_similarity(run, camera_positions)
     _helmert_outliers(run, fit)
     _estimate_sigmas(run, fit)
+    _given_sigmas_held_fixed(run, fit)
     consistency = _consistency(run, fit)
     run.timings["helmert"] = time.time() - run.t_start
     run.progress.report(0.08, f"Helmert from {int(fit.helmert.inliers.sum())} {fit.source}")
@@ -454,6 +455,40 @@ def _estimate_sigmas(run: _Run, fit: _Fit) -> None:
                        if not cp.sigma_given else (cp, im) for cp, im in run.cam_pos]
     for est in run.sigma_estimates.values():
         run.progress.info(est.message())
+
+
+FIXED_SIGMA_RATIO = 100.0  # a given sigma this many times finer than the block resolves: the point is held fixed
+
+
+def _given_sigmas_held_fixed(run: _Run, fit: _Fit) -> None:
+    """Say so where control points were given sigmas far finer (``FIXED_SIGMA_RATIO``) than the block resolves at
+    them (their forward intersection at the tie points' pixel noise): the adjustment honours them, i.e. holds
+    those points fixed at their coordinates, which a sigma of 1e-9 m typed for "exact" means but a unit slip does
+    not."""
+    given = [p for p in run.usable if p.sigma_given]
+    if not given:
+        return
+    px = run.opt.gcp_pixel_sigma
+    s0 = tie_point_sigma(run.rec)
+    if math.isfinite(s0) and s0 > 0:
+        px = min(px, s0)
+    tr = fit.helmert.transform
+    views = [(run.tri[p.name].xyz, [ob.image for k, ob in enumerate(p.observations) if run.tri[p.name].used[k]])
+             for p in given]
+    fxy, fz = intersection_precision(run.rec, run.lookup, views, px, tr)
+    if not (math.isfinite(fxy) and math.isfinite(fz)):
+        return
+    fine = [p for p in given if p.sigma_xy * FIXED_SIGMA_RATIO < fxy or p.sigma_z * FIXED_SIGMA_RATIO < fz]
+    if not fine:
+        return
+    groups: Dict[Tuple[float, float], List[str]] = {}
+    for p in fine:
+        groups.setdefault((p.sigma_xy, p.sigma_z), []).append(p.name)
+    said = "; ".join(f"{', '.join(n[:8])}{f' and {len(n) - 8} more' if len(n) > 8 else ''}: sigma XY {sxy:g} m, "
+                     f"Z {sz:g} m" for (sxy, sz), n in groups.items())
+    run.warn(f"control points given sigmas far finer than the block resolves at them (about {fxy:.3f} m XY, "
+             f"{fz:.3f} m Z) - {said}: honoured as given, i.e. these points are held fixed at their coordinates; "
+             "if they are not exact to that level give their real accuracy (e.g. 0.01 m for RTK)")
 
 
 def _group_estimate(group: str, names: List[str], rows, floor, prior) -> SigmaEstimate:
@@ -751,8 +786,9 @@ def _check_crs(crs: str, warn: Callable[[str], None]) -> None:
         warn(f"CRS {crs!r} not recognised; assuming metric, right-handed coordinates")
         return
     if srs.IsGeographic():
-        raise GeorefError(f"the ground control is in a geographic CRS ({crs}); the adjustment needs metric "
-                          "coordinates: reproject the points to a projected CRS (e.g. the UTM zone)")
+        raise GeorefError(f"the control (GCPs or camera positions) is in a geographic CRS ({crs}); the adjustment "
+                          "needs metric coordinates: give a projected CRS to georeference in (e.g. the block's UTM "
+                          "zone, EPSG:326zz north / EPSG:327zz south); the control is reprojected into it")
 
 
 def _round_offset(xyz: np.ndarray) -> np.ndarray:

@@ -3,7 +3,8 @@
 ``georeference_workspace(workspace, options, progress)`` is what the Processing algorithm, the dock and the
 pipeline call; :class:`~core.georef.options.GeorefOptions` carries the inputs (GCP file or set, check points,
 camera positions, EXIF GPS, CRS) and the adjustment's settings.  It reads the aligned model and the ground
-control (``core.georef.control_input``), runs the adjustment inside ``run_stage()`` (``core.georef.adjustments``)
+control (``core.georef.control_input``, checked by ``core.georef.control_checks``: a geographic CRS, control far
+from the photos' EXIF GPS), runs the adjustment inside ``run_stage()`` (``core.georef.adjustments``)
 and saves the products through ``core.project.layout`` (``core.georef.products``: ``georef/model`` in the local
 frame, ``transform.json``, the residuals, ``control.json``, the camera layer, ``adjustment_inputs.json``).  With
 ``GeorefOptions.reference_dem`` the block is co-registered on that DEM after the adjustment and adjusted again
@@ -25,7 +26,7 @@ from ..project.workspace import Workspace
 from . import demcontrol as demmod
 from . import products
 from .adjustments import adjust_block, adjust_on_dem
-from .control_input import read_control
+from .control_checks import read_checked_control
 from .options import GeorefOptions
 
 GEOREF = GEOREFERENCE
@@ -99,7 +100,7 @@ def georeference_workspace(workspace_dir: str, options: Optional[GeorefOptions] 
         raise StageError(f"workspace {ws.root} has no aligned model: run 'Align images' first")
     rec = lay.load_aligned_model()
     opt = _with_exif_for_dem(options if options is not None else GeorefOptions(), progress)
-    gcps, cams, target = read_control(ws, opt, progress)
+    gcps, cams, target = read_checked_control(ws, opt, progress)
     opt = dataclasses.replace(opt, crs=target)
     if opt.camera_intrinsics is None:  # the alignment's calibrated cameras: fixed ones stay, refined ones get priors
         opt = dataclasses.replace(opt, camera_intrinsics=lay.camera_intrinsics())

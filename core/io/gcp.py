@@ -232,9 +232,18 @@ def _read_lines(path: PathLike) -> List[str]:
     return text.splitlines()
 
 
-def _num(tok: str, what: str, path: PathLike, lineno: int) -> float:
+_DECIMAL_COMMA = re.compile(r"^[+-]?\d*,\d+(?:[eE][+-]?\d+)?$|^[+-]?\d+,$")
+
+
+def _decimal(tok: str, decimal_comma: bool) -> str:
+    """``tok`` with a decimal comma read as a point (``274901,848`` -> ``274901.848``) when the file's separator
+    leaves the comma free for that (``;`` or tab: a spreadsheet's export in a locale that writes decimal commas)."""
+    return tok.replace(",", ".") if decimal_comma and _DECIMAL_COMMA.match(tok.strip()) else tok
+
+
+def _num(tok: str, what: str, path: PathLike, lineno: int, decimal_comma: bool = False) -> float:
     try:
-        v = float(tok)
+        v = float(_decimal(tok, decimal_comma))
     except ValueError:
         raise GCPError(f"{path}:{lineno}: {what} is not a number: {tok!r}") from None
     if not math.isfinite(v):
@@ -242,9 +251,9 @@ def _num(tok: str, what: str, path: PathLike, lineno: int) -> float:
     return v
 
 
-def _is_number(tok: str) -> bool:
+def _is_number(tok: str, decimal_comma: bool = False) -> bool:
     try:
-        return math.isfinite(float(tok))
+        return math.isfinite(float(_decimal(tok, decimal_comma)))
     except ValueError:
         return False
 
@@ -689,8 +698,9 @@ def _header_map(cells: Sequence[str], spec: Mapping[str, Sequence[str]]) -> Dict
 
 
 def _csv_table(path: PathLike, spec: Mapping[str, Sequence[str]], required: Sequence[str], what: str):
-    """-> (crs or None, crs line, column map, [(lineno, cells)]).  Leading '#' lines and a bare CRS line
-    before the header are read for a CRS."""
+    """-> (crs or None, crs line, column map, [(lineno, cells)], decimal comma).  Leading '#' lines and a bare CRS
+    line before the header are read for a CRS; the header's separator is the file's, and a ``;`` or tab separator
+    leaves the comma to decimals (a spreadsheet's export: ``274901,848``)."""
     lines = _read_lines(path)
     crs, crs_line, i = None, None, 0
     while i < len(lines):
@@ -726,7 +736,19 @@ def _csv_table(path: PathLike, spec: Mapping[str, Sequence[str]], required: Sequ
             continue
         cells = [c.strip() for c in next(csv.reader([s], delimiter=delim))]
         rows.append((ln + 1, cells))
-    return crs, crs_line, cols, rows
+    return crs, crs_line, cols, rows, delim != ","
+
+
+def csv_points_preview(path: PathLike) -> Tuple[Optional[str], List[Tuple[float, float]]]:
+    """(the CRS the points file names or None, the (x, y) of its rows that read as numbers): a look at a CSV points
+    file before its CRS is settled (``read_csv_gcps`` checks the rest)."""
+    file_crs, _, cols, rows, comma = _csv_table(path, _POINT_COLS, ("name", "x", "y", "z"), "points")
+    xy = []
+    for _ln, cells in rows:
+        x, y = (_decimal(_cell(cells, cols, k), comma) for k in ("x", "y"))
+        if _is_number(x) and _is_number(y):
+            xy.append((float(x), float(y)))
+    return file_crs, xy
 
 
 def _cell(cells: Sequence[str], cols: Mapping[str, int], key: str) -> str:
@@ -752,7 +774,7 @@ def read_csv_gcps(points_path: PathLike, observations_path: Optional[PathLike] =
     ``observations_path`` the file ``default_observations_path(points_path)`` is read if it exists.
     Validation as for ``read_odm_gcp_list``.
     """
-    file_crs, crs_line, cols, rows = _csv_table(points_path, _POINT_COLS, ("name", "x", "y", "z"), "points")
+    file_crs, crs_line, cols, rows, comma = _csv_table(points_path, _POINT_COLS, ("name", "x", "y", "z"), "points")
     given = crs or (default_crs if not file_crs else None)
     use_crs = normalize_crs(given) if given else file_crs
     if not use_crs:
@@ -768,12 +790,12 @@ def read_csv_gcps(points_path: PathLike, observations_path: Optional[PathLike] =
             raise GCPError(f"{points_path}:{lineno}: empty point name")
         if name in first_line:
             raise GCPError(f"{points_path}:{lineno}: point {name} already defined on line {first_line[name]}")
-        x, y, z = (_num(_cell(cells, cols, k), k, points_path, lineno) for k in ("x", "y", "z"))
+        x, y, z = (_num(_cell(cells, cols, k), k, points_path, lineno, comma) for k in ("x", "y", "z"))
         sig = {}
         for k in ("sx", "sy", "sxy", "sz"):
             t = _cell(cells, cols, k)
             if t:
-                v = _num(t, {"sx": "sx", "sy": "sy", "sxy": "sigma_xy", "sz": "sz"}[k], points_path, lineno)
+                v = _num(t, {"sx": "sx", "sy": "sy", "sxy": "sigma_xy", "sz": "sz"}[k], points_path, lineno, comma)
                 if v <= 0:
                     raise GCPError(f"{points_path}:{lineno}: sigma {k} must be positive, got {t!r}")
                 sig[k] = v
@@ -799,7 +821,7 @@ def read_csv_gcps(points_path: PathLike, observations_path: Optional[PathLike] =
         gs.warnings.append(f"{points_path}: no observations file ({obs_path} does not exist): the points "
                            "have no image observations")
     else:
-        _, _, ocols, orows = _csv_table(obs_path, _OBS_COLS, ("name", "image", "px", "py"), "observations")
+        _, _, ocols, orows, ocomma = _csv_table(obs_path, _OBS_COLS, ("name", "image", "px", "py"), "observations")
         for lineno, cells in orows:
             name = _cell(cells, ocols, "name")
             p = gs.by_name(name)
@@ -809,8 +831,8 @@ def read_csv_gcps(points_path: PathLike, observations_path: Optional[PathLike] =
             img = _cell(cells, ocols, "image")
             if not img:
                 raise GCPError(f"{obs_path}:{lineno}: empty image name")
-            px = _num(_cell(cells, ocols, "px"), "px", obs_path, lineno)
-            py = _num(_cell(cells, ocols, "py"), "py", obs_path, lineno)
+            px = _num(_cell(cells, ocols, "px"), "px", obs_path, lineno, ocomma)
+            py = _num(_cell(cells, ocols, "py"), "py", obs_path, lineno, ocomma)
             p.observations.append(Observation(img, px, py))
             obs_lines.setdefault(id(p), []).append(lineno)
     where = {id(p): f"{points_path}:{first_line[p.name]}" for p in gs.points}
@@ -1005,12 +1027,47 @@ _CAM_COLS = {
 }
 
 
-def _split_row(s: str) -> List[str]:
-    if "," in s:
+def _split_row(s: str, sep: Optional[str] = None) -> List[str]:
+    """The cells of a row: split at ``sep`` (the file's separator, ``_file_separator``; a tab: at blanks, as
+    before, so that tabs and spaces mixed still split), else at the first of comma, semicolon found, else at
+    blanks."""
+    if sep == ";":
+        return [c.strip() for c in s.split(sep)]
+    if sep == "," or (sep is None and "," in s):
         return [c.strip() for c in next(csv.reader([s]))]
-    if ";" in s:
+    if sep is None and ";" in s:
         return [c.strip() for c in s.split(";")]
     return s.split()
+
+
+def _file_separator(rows: Sequence[str]) -> Optional[str]:
+    """The separator of a positions file's rows (header and data, no comments or CRS line): ``;`` or a tab when
+    every row holds one (then a comma in a number is a decimal comma: a spreadsheet's export in such a locale),
+    else a comma when every row holds one, else None (blanks, or rows that differ: each row is split alone)."""
+    for sep in (";", "\t", ","):
+        if rows and all(sep in r for r in rows):
+            return sep
+    return None
+
+
+def _same_position(a: CameraPosition, b: CameraPosition) -> Tuple[bool, float, float]:
+    """(the two rows agree within their sigmas, horizontal distance, height difference)."""
+    dxy = math.hypot(a.x - b.x, a.y - b.y)
+    dz = abs(a.z - b.z) if math.isfinite(a.z) and math.isfinite(b.z) else 0.0
+    return dxy <= max(a.sigma_xy, b.sigma_xy) and dz <= max(a.sigma_z, b.sigma_z), dxy, dz
+
+
+def _position_num(tok: str, what: str, path: PathLike, lineno: int, sep: Optional[str]) -> float:
+    """A number of a positions file; a cell that still holds another separator (rows split at the wrong one)
+    names the separator and the decimal comma."""
+    try:
+        return _num(tok, what, path, lineno, sep in (";", "\t"))
+    except GCPError as e:
+        others = [n for c, n in ((";", "';'"), ("\t", "a tab")) if c in tok and c != sep]
+        if not others:
+            raise
+        raise GCPError(f"{e}: the cell holds {others[0]}, which separates some rows but not all; use one separator "
+                       "for the whole file (';' with decimal commas, as a spreadsheet exports them, is read)") from None
 
 
 def read_camera_positions(path: PathLike, default_sigma_xy: float = 5.0, default_sigma_z: float = 10.0, *,
@@ -1030,10 +1087,14 @@ def read_camera_positions(path: PathLike, default_sigma_xy: float = 5.0, default
     georeferencing then estimates their accuracy).  A missing z (e.g. ``x y image`` rows) is NaN,
     meaning unknown height: a consumer must then constrain only x and y of that camera.
 
+    The separator is the file's: ``;`` or a tab when every row holds one, and then a comma inside a number is a
+    decimal comma (``274901,848``: a spreadsheet saved in a locale that writes them).
+
     The returned CRS is the file's CRS line, else ``crs`` (None when neither: the caller's CRS, usually the
-    GCPs', is meant).  Unparsable numbers and invalid CRSs raise GCPError (file:line: reason); duplicate
-    images keep the first row and add a warning to ``warnings`` (a list you pass), or issue a Python
-    warning when no list is given.
+    GCPs', is meant).  Unparsable numbers and invalid CRSs raise GCPError (file:line: reason).  An image on two
+    rows: when the rows agree within their sigmas the first is used and a warning naming the image and both
+    lines is added to ``warnings`` (a list you pass; a Python warning when no list is given); when they do not,
+    GCPError naming the image, both lines and how far apart they are.
     """
     if not (default_sigma_xy > 0 and default_sigma_z > 0):
         raise ValueError("default sigmas must be positive")
@@ -1043,28 +1104,26 @@ def read_camera_positions(path: PathLike, default_sigma_xy: float = 5.0, default
     crs_line = None
     cols: Optional[Dict[str, int]] = None
     out: List[CameraPosition] = []
-    first_row: Dict[str, int] = {}
-    seen_content = False
-    for ln, raw in enumerate(lines, start=1):
-        s = raw.strip()
-        if not s or s.startswith("#"):
-            continue
-        if not seen_content:
-            seen_content = True
-            if looks_like_crs(s):
-                file_crs, crs_line = normalize_crs(s), ln
-                continue
-        cells = _split_row(s)
+    first_row: Dict[str, Tuple[int, CameraPosition]] = {}
+    content = [(ln, raw.strip()) for ln, raw in enumerate(lines, start=1)
+               if raw.strip() and not raw.strip().startswith("#")]
+    if content and looks_like_crs(content[0][1]):
+        file_crs, crs_line = normalize_crs(content[0][1]), content[0][0]
+        content = content[1:]
+    sep = _file_separator([s for _, s in content])
+    comma = sep in (";", "\t")  # the comma is free for decimals
+    for ln, s in content:
+        cells = _split_row(s, sep)
         if cols is None and not out:
             hm = _header_map(cells, _CAM_COLS)
-            if all(k in hm for k in ("image", "x", "y")) and not any(_is_number(c) for c in cells):
+            if all(k in hm for k in ("image", "x", "y")) and not any(_is_number(c, comma) for c in cells):
                 cols = hm
                 continue
         if cols is not None:
             image = _cell(cells, cols, "image")
             vals = {k: _cell(cells, cols, k) for k in ("x", "y", "z", "sigma", "sxy", "sz")}
         else:
-            nonnum = [k for k, c in enumerate(cells) if not _is_number(c)]
+            nonnum = [k for k, c in enumerate(cells) if not _is_number(c, comma)]
             if len(cells) < 3:
                 raise GCPError(f"{path}:{ln}: expected 'image x y [z] [sigma]' or 'x y [z] image', "
                                f"found {s!r}")
@@ -1086,24 +1145,32 @@ def read_camera_positions(path: PathLike, default_sigma_xy: float = 5.0, default
             vals = dict(zip(keys, nums))
         if not image:
             raise GCPError(f"{path}:{ln}: empty image name")
-        x = _num(vals.get("x", ""), "x", path, ln)
-        y = _num(vals.get("y", ""), "y", path, ln)
-        z = _num(vals["z"], "z", path, ln) if vals.get("z") else float("nan")
+        x = _position_num(vals.get("x", ""), "x", path, ln, sep)
+        y = _position_num(vals.get("y", ""), "y", path, ln, sep)
+        z = _position_num(vals["z"], "z", path, ln, sep) if vals.get("z") else float("nan")
         sig = {}
         for k in ("sigma", "sxy", "sz"):
             if vals.get(k):
-                v = _num(vals[k], {"sigma": "sigma", "sxy": "sigma_xy", "sz": "sigma_z"}[k], path, ln)
+                v = _position_num(vals[k], {"sigma": "sigma", "sxy": "sigma_xy", "sz": "sigma_z"}[k], path, ln, sep)
                 if v <= 0:
                     raise GCPError(f"{path}:{ln}: sigma must be positive, got {vals[k]!r}")
                 sig[k] = v
         sxy = sig.get("sxy", sig.get("sigma", default_sigma_xy))
         sz = sig.get("sz", sig.get("sigma", default_sigma_z))
+        pos = CameraPosition(image, x, y, z, sxy, sz, sigma_given=bool(sig))
         if image in first_row:
-            warn_list.append(f"{path}:{ln}: second position for image {image} (first on line "
-                             f"{first_row[image]}); keeping the first")
+            first_ln, first = first_row[image]
+            same, dxy, dz = _same_position(first, pos)
+            if not same:
+                raise GCPError(f"{path}: image {image} is on lines {first_ln} and {ln} with positions {dxy:.2f} m "
+                               f"apart horizontally, {dz:.2f} m in height: more than their sigmas (XY "
+                               f"{max(first.sigma_xy, pos.sigma_xy):g} m, Z {max(first.sigma_z, pos.sigma_z):g} m); "
+                               "keep the right row and remove the other")
+            warn_list.append(f"{path}: image {image} is on lines {first_ln} and {ln} (positions {dxy:.2f} m apart, "
+                             f"within their sigmas): the first (line {first_ln}) is used")
             continue
-        first_row[image] = ln
-        out.append(CameraPosition(image, x, y, z, sxy, sz, sigma_given=bool(sig)))
+        first_row[image] = (ln, pos)
+        out.append(pos)
     use_crs = file_crs or (normalize_crs(crs) if crs else None)
     if use_crs:
         _check_crs_for_file(use_crs, path, crs_line if file_crs else None, warn_list)
@@ -1119,7 +1186,8 @@ def read_camera_positions(path: PathLike, default_sigma_xy: float = 5.0, default
 
 __all__ = [
     "CHECK", "CONTROL", "CameraPosition", "DEFAULT_SIGMA_XY", "DEFAULT_SIGMA_Z", "GCPError", "GCPSet", "GroundPoint", "Observation", "apply_check_points",
-    "check_units", "default_observations_path", "detect_gcp_format", "gcps_from_rows", "observations_to_stored",
+    "check_units", "csv_points_preview", "default_observations_path", "detect_gcp_format", "gcps_from_rows",
+    "observations_to_stored",
     "read_camera_positions",
     "read_csv_gcps", "read_gcps", "read_odm_gcp_list", "write_csv_gcps", "write_gcps", "write_odm_gcp_list",
 ]

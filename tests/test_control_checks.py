@@ -1,0 +1,131 @@
+"""Does the control mean what it says? (issue 47 items 2, 12 and 17; core.georef.control_checks): camera positions
+and GCPs that land far from the photos' own EXIF GPS (latitude in the x column, the next UTM zone), or without GPS
+outside the CRS's area of use, are refused naming the likely cause; a geographic CRS is refused naming the UTM
+zone that fixes it; a positions file's duplicate rows are warned in the stage's log.  All on a synthetic block
+(EPSG:32633, lon 15 E lat 41.5 N) whose photos carry their true positions as EXIF GPS; the refusals come before the
+adjustment, so each test costs a second or two."""
+import numpy as np
+import pytest
+
+from core.common.progress import NullProgress
+from core.geometry.crs import transform_points
+from core.georef import stage as georef_stage
+from core.georef.options import GeorefOptions
+from core.io.gcp import write_csv_gcps
+from core.project.stages import StageError
+from core.project.workspace import Workspace
+from tests import synthetic as syn
+from tests.workspaces import synthetic_workspace
+
+
+class _Said(NullProgress):
+    def __init__(self):
+        self.warnings = []
+
+    def warning(self, message):
+        self.warnings.append(message)
+
+
+@pytest.fixture(scope="module")
+def block():
+    return syn.vertical_block(seed=1)
+
+
+def _workspace(tmp_path, block, gps=True):
+    root = synthetic_workspace(tmp_path / "ws", block, block.truth_reconstruction())
+    if gps:
+        ws = Workspace.open(root)
+        world = np.array([s.centre + syn.ORIGIN for s in block.shots])
+        lonlat = transform_points(world, syn.CRS, "EPSG:4326")
+        by = {s.name: ll for s, ll in zip(block.shots, lonlat)}
+        for im in ws.data["images"]:
+            im["gps"] = [float(v) for v in by[im["name"]]]
+        ws.save()
+    return root
+
+
+def _positions(block, tmp_path, name, crs_line, order="xy", lonlat=False, extra=()):
+    """The block's camera positions (world, 0.5 m noise) as an ``image,x,y,z`` file; ``lonlat``: in EPSG:4326;
+    ``order`` "yx": the columns swapped."""
+    cams, _ = block.camera_positions(sigma=0.5)
+    xyz = np.array([[c.x, c.y, c.z] for c in cams])
+    if lonlat:
+        xyz = transform_points(xyz, syn.CRS, "EPSG:4326")
+    rows = ([crs_line] if crs_line else []) + ["image,x,y,z"]
+    for c, p in zip(cams, xyz):
+        a, b = (p[0], p[1]) if order == "xy" else (p[1], p[0])
+        rows.append(f"{c.image},{a:.8f},{b:.8f},{p[2]:.3f}")
+    rows += list(extra)
+    path = tmp_path / name
+    path.write_text("\n".join(rows) + "\n")
+    return str(path)
+
+
+def _gcp_file(block, tmp_path, crs_line):
+    path = str(tmp_path / "gcps.csv")
+    write_csv_gcps(block.gcp_set(block.spread_control(5)), path)
+    lines = [ln for ln in open(path).read().splitlines() if not ln.startswith("# crs")]
+    with open(path, "w") as f:
+        f.write("\n".join(([f"# crs: {crs_line}"] if crs_line else []) + lines) + "\n")
+    return path
+
+
+def _refused(root, pattern, **options):
+    with pytest.raises(StageError, match=pattern) as e:
+        georef_stage.georeference_workspace(root, GeorefOptions(**options))
+    return str(e.value)
+
+
+def test_positions_with_the_latitude_in_x_are_refused_as_swapped(tmp_path, block):
+    root = _workspace(tmp_path, block)
+    p = _positions(block, tmp_path, "latlon.csv", "EPSG:4326", order="yx", lonlat=True)
+    msg = _refused(root, r"camera positions in \S*latlon\.csv \(EPSG:4326\) land [\d,]+ km from the same photos' "
+                         r"EXIF GPS", camera_positions_path=p)
+    assert "latitude and longitude look swapped" in msg
+
+
+def test_positions_and_gcps_of_another_utm_zone_are_refused_naming_the_zone(tmp_path, block):
+    root = _workspace(tmp_path, block)
+    p = _positions(block, tmp_path, "zone34.csv", "EPSG:32634")
+    msg = _refused(root, r"camera positions in \S*zone34\.csv \(EPSG:32634\) land", camera_positions_path=p,
+                   crs="EPSG:32633")
+    assert "EPSG:32633 coordinates" in msg and "wrong CRS" in msg
+    g = _gcp_file(block, tmp_path, "EPSG:32634")
+    msg = _refused(root, r"control points of the GCP file \S*gcps\.csv \(EPSG:32634\) land", gcp_path=g)
+    assert "EPSG:32633 coordinates" in msg
+
+
+def test_without_gps_positions_outside_the_crs_area_of_use_are_refused(tmp_path, block):
+    root = _workspace(tmp_path, block, gps=False)
+    p = _positions(block, tmp_path, "latlon.csv", "EPSG:4326", order="yx", lonlat=True)
+    msg = _refused(root, r"outside the area where EPSG:32633 is used", camera_positions_path=p, crs="EPSG:32633")
+    assert "swapped" in msg
+
+
+def test_a_geographic_crs_names_the_utm_zone_of_the_photos(tmp_path, block):
+    root = _workspace(tmp_path, block)
+    p = _positions(block, tmp_path, "lonlat.csv", "EPSG:4326", lonlat=True)
+    _refused(root, r"CRS=EPSG:4326 \(the CRS parameter\) is geographic.*give CRS=EPSG:32633 \(the UTM zone of the "
+                   r"photos' EXIF GPS\)", camera_positions_path=p, crs="EPSG:4326")
+    # no CRS parameter: the positions' own CRS would be the target
+    _refused(root, r"camera positions file \S*lonlat\.csv is in EPSG:4326, a geographic CRS.*CRS=EPSG:32633.*"
+                   r"camera positions are reprojected", camera_positions_path=p)
+    # metres without a CRS line, CRS=EPSG:4326: camera positions named as such, and the GCP file
+    q = _positions(block, tmp_path, "nocrs.csv", None)
+    msg = _refused(root, r"CRS=EPSG:32633", camera_positions_path=q, crs="EPSG:4326")
+    assert "camera positions in" in msg and "no CRS line" in msg and "ground control" not in msg
+    g = _gcp_file(block, tmp_path, None)
+    msg = _refused(root, r"CRS=EPSG:32633", gcp_path=g, crs="EPSG:4326")
+    assert "GCP file" in msg and "no CRS line" in msg
+
+
+def test_a_duplicate_row_is_warned_in_the_stage_log_and_good_positions_pass(tmp_path, block):
+    root = _workspace(tmp_path, block)
+    cams, _ = block.camera_positions(sigma=0.5)
+    c = cams[0]
+    p = _positions(block, tmp_path, "dup.csv", syn.CRS, extra=[f"{c.image},{c.x:.8f},{c.y:.8f},{c.z:.3f}"])
+    said = _Said()
+    result = georef_stage.georeference_workspace(root, GeorefOptions(camera_positions_path=p), said)
+    assert result.crs == syn.CRS
+    dup = [w for w in said.warnings if c.image in w and "lines 3 and" in w]
+    assert len(dup) == 1 and "is used" in dup[0], said.warnings
