@@ -277,3 +277,58 @@ def test_align_options_refuse_a_bad_value_when_made(field, value, what):
 def test_align_options_normalise_the_case_of_choices():
     o = AlignOptions(pairing="Spatial", camera_model="opencv", grouping="SINGLE")
     assert (o.pairing, o.camera_model, o.grouping) == ("spatial", "OPENCV", "single")
+
+
+def _finished_alignment(ws_dir, images):
+    """A workspace as 'Align images' leaves it on ``images`` (record, image list, fingerprints, a model folder),
+    without the seconds of a real alignment: the check below reads only these."""
+    from core.align.photos import PHOTO_FINGERPRINTS, fingerprint_photos
+    from core.io.images import scan_images
+    from core.project.layout import Layout
+    from core.project.stages import ALIGN, run_stage
+
+    ws = Workspace.create_or_open(ws_dir)
+    infos, _ = scan_images(images)
+    with run_stage(ws, ALIGN, {}) as run:
+        os.makedirs(Layout(ws).aligned_model_dir)
+        run.record[PHOTO_FINGERPRINTS] = fingerprint_photos(infos)
+        ws.data["images_dir"] = os.path.abspath(images)
+        ws.data["images"] = [im.to_dict() for im in infos]
+        run.finish(outputs={"model": "sfm/model"})
+    return ws_dir
+
+
+def _tree(root):
+    out = {}
+    for d, _, files in os.walk(root):
+        for f in files:
+            p = os.path.join(d, f)
+            with open(p, "rb") as fh:
+                out[os.path.relpath(p, root)] = fh.read()
+    return out
+
+
+def test_another_photo_folder_on_a_finished_workspace_is_refused_and_changes_nothing(tmp_path):
+    """Issue 47 item 8: 'alignimages' on a finished workspace with another folder of other photos replaced the
+    alignment without a word (the DSM, mosaic and DTM then stale); now refused before any work, naming the folder
+    the workspace belongs to and both ways on (that folder again, or a new workspace); nothing of the workspace
+    changes.  The same photos in a moved folder are the same block (allowed)."""
+    from core.align.photos import check_same_photos
+
+    mine = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:3], str(tmp_path / "site A"))
+    other = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[3:], str(tmp_path / "site B"))
+    ws_dir = _finished_alignment(str(tmp_path / "ws"), mine)
+    before = _tree(ws_dir)
+    with pytest.raises(AlignError, match=r"workspace .*ws was aligned from the photos of .*site A \(3 photos\); "
+                                         r".*site B holds none of them.*IMAGES=.*site A.*new WORKSPACE") as e:
+        align(other, ws_dir, AlignOptions(**FAST))
+    assert "replace" in str(e.value)
+    assert _tree(ws_dir) == before
+    moved = shutil.copytree(mine, str(tmp_path / "site A moved"))
+    os.remove(os.path.join(moved, TOLEDO_STRIP[0]))
+    from core.align.photos import fingerprint_photos
+    from core.io.images import scan_images
+
+    prints = fingerprint_photos(scan_images(moved)[0])
+    check_same_photos(Workspace.open(ws_dir), moved, prints)  # the same photos, moved (one left out): allowed
+    check_same_photos(Workspace.open(ws_dir), mine, {})  # the workspace's folder: allowed whatever it holds now

@@ -681,3 +681,87 @@ def test_the_automatic_control_keeps_a_fixed_camera(tmp_path, epochs):  # noqa: 
         params[label] = np.asarray(cam.params, dtype=float)
     assert np.array_equal(params["fixed"], np.asarray(block.camera.params, dtype=float))
     assert not np.array_equal(params["estimated"], np.asarray(block.camera.params, dtype=float))
+
+
+# ------------------------------------------------------------------------------------------------------------
+# issue 47: a given focal length far from the photos' EXIF, a calibration of two cameras that fit, the log line
+# ------------------------------------------------------------------------------------------------------------
+
+def _drone(name, focal_px, source, focal_mm=3.61, focal_35mm=20.0):
+    """A DJI FC300X photo as the demo's (1200 x 900 px, EXIF 3.61 mm, 20 mm in 35 mm film)."""
+    return ImageInfo(name=name, path=name, width=1200, height=900, bands=3, dtype="Byte", make="DJI", model="FC300X",
+                     focal_mm=focal_mm, focal_35mm=focal_35mm, focal_px=focal_px, focal_source=source)
+
+
+def test_a_focal_length_far_from_the_exif_one_is_refused_naming_its_35_mm_equivalent():
+    """FOCAL_MM=20 SENSOR_WIDTH_MM=6.17 INTRINSICS=fixed on photos whose EXIF says 3.61 mm (20 is the 35 mm
+    equivalent) was held fixed, the cameras 16 m off, exit 0; now refused before the alignment, naming the EXIF
+    values and the 35 mm equivalent.  The right values pass; a wrong sensor width is named; without EXIF a focal
+    length of no camera's field of view is refused."""
+    import pycolmap
+
+    def plan(focal_mm=None, sensor=None, focal_px=None, exif=True, intrinsics="fixed"):
+        px = focal_px or focal_mm / sensor * 1200.0
+        kw = {} if exif else dict(focal_mm=None, focal_35mm=None)
+        infos = [_drone(n, px, "manual", **kw) for n in ("a.jpg", "b.jpg")]
+        opts = AlignOptions(focal_mm=focal_mm, sensor_width_mm=sensor, focal_px=focal_px, intrinsics=intrinsics)
+        return plan_cameras(pycolmap, [_group(infos)], infos, [], {}, opts, NullProgress())
+
+    for mode in ("fixed", "auto"):
+        with pytest.raises(AlignError, match=r"FOCAL_MM 20 mm .*SENSOR_WIDTH_MM 6\.17 mm.* 3890 px.*5\.61 times .*"
+                                             r"EXIF focal length of a\.jpg \(3\.61 mm; 693 px from its 35 mm "
+                                             r"equivalent 20 mm; camera DJI FC300X\).*20 mm is the photos' 35 mm equivalent focal "
+                                             r"length.*FOCAL_MM=3\.61"):
+            plan(20.0, 6.17, intrinsics=mode)
+    _, given = plan(3.61, 6.17)  # the real focal length: held
+    assert given["g"].params[0] == pytest.approx(702.1, abs=0.1)
+    with pytest.raises(AlignError, match=r"FOCAL_MM 3\.61 mm agrees with the EXIF.*SENSOR_WIDTH_MM 36 mm .*sensor "
+                                         r"about 6\.25 mm"):
+        plan(3.61, 36.0)
+    with pytest.raises(AlignError, match=r"focal length of 0\.7 px on 1200 x 900 px images .*field of view"):
+        plan(focal_px=0.7, exif=False)
+    plan(focal_px=700.0, exif=False)
+
+
+def test_an_orthority_focal_in_mm_without_sensor_size_is_refused_against_the_exif(tmp_path):
+    """Orthority's focal_len 3.61 (mm) without sensor_size reads as normalised by the image width: 4,332 px on the
+    1200 px wide photos, only warned; now refused against the photos' EXIF (693 px), naming the file, the value
+    and sensor_size."""
+    import pycolmap
+
+    path = tmp_path / "int_param.yaml"
+    path.write_text("FC300X:\n  type: pinhole\n  im_size: [1200, 900]\n  focal_len: 3.61\n")
+    infos = [_drone(n, 693.3, "exif35") for n in ("a.jpg", "b.jpg")]
+    with pytest.raises(AlignError, match=r"int_param\.yaml: camera 'FC300X' gives a focal length of 4332\.0 px, "
+                                         r"6\.25 times the photos' EXIF focal length \(693\.3 px.*3\.61 mm\).*"
+                                         r"the photos' EXIF focal length in mm.*sensor_size"):
+        plan_cameras(pycolmap, [_group(infos)], infos, _read(path), {}, AlignOptions(), NullProgress())
+
+
+def test_a_colmap_file_with_two_cameras_of_the_photos_size_names_the_ambiguity(tmp_path):
+    """Two cameras of the photos' size in a COLMAP cameras.txt: 'no photo matches any of its cameras'; now the
+    message names both cameras and how to choose."""
+    import pycolmap
+
+    path = tmp_path / "cameras.txt"
+    path.write_text("1 PINHOLE 800 600 650 650 400 300\n2 PINHOLE 800 600 700 700 400 300\n")
+    infos = [_info("a.tif"), _info("b.tif")]
+    with pytest.raises(AlignError, match=r"cameras\.txt: 2 of its cameras fit the photo a\.tif \(800 x 600 px\): "
+                                         r"camera '1'.* and camera '2'.*which one .*delete the others"):
+        plan_cameras(pycolmap, [_group(infos)], infos, _read(path), {}, AlignOptions(), NullProgress())
+
+
+def test_the_log_names_a_focal_length_given_as_the_options_that_gave_it():
+    """The camera line read '(fixed,  SENSOR_WIDTH_MM)': the basename of 'FOCAL_MM / SENSOR_WIDTH_MM'."""
+    from core.align.calibrated import FOCAL_SOURCE, GivenCamera
+    from core.align.diagnosis import no_reconstruction_error as _no_reconstruction
+    from core.align.inputs import Photos
+
+    infos = [_info("a.tif", focal_px=1000.0, source="manual"), _info("b.tif", focal_px=1000.0, source="manual")]
+    given = GivenCamera("fixed", FOCAL_SOURCE, "focal length given", "SIMPLE_RADIAL", [1000.0, 400.0, 300.0, 0.0])
+    photos = Photos("/x", infos, [], [_group(infos)], {}, 0.0, {"g": given}, {})
+    log = _Log()
+    photos.log_cameras(log)
+    assert any("focal 1000.0 px (fixed, FOCAL_MM / SENSOR_WIDTH_MM)" in ln for ln in log.lines), log.lines
+    assert "focal 1000.0 px from FOCAL_MM / SENSOR_WIDTH_MM" in str(_no_reconstruction({"a.tif": 3}, 2, 1,
+                                                                                       {1: given}))

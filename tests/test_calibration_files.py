@@ -8,6 +8,7 @@ radial distortion table was generated from known k1..k3."""
 import json
 import math
 import os
+import re
 
 import numpy as np
 import pytest
@@ -515,3 +516,30 @@ def test_prepare_images_reads_the_fiducials_of_a_calibration_file():
     assert from_file.points == from_text.points and from_file.ids == from_text.ids and len(from_file.points) == 4
     with pytest.raises(ScanError, match=r"same_camera\.yaml: no camera of this calibration file gives fiducial"):
         parse_fiducial_coordinates(_data("same_camera.yaml"))
+
+
+# ---------------------------------------------------------------------------
+# issue 47 item 9: a calibration no camera can have is refused when read, before any work
+# ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("extra, expected", [
+    # k1 50, k2 -300 on a 1200 x 900 frame of 1000 px: the distorted radius turns back before the corner (it ran
+    # 221 s and two escalation rounds, then blamed the focal length)
+    ({"focal_length_px": 1000.0, "k1": 50.0, "k2": -300.0}, r"k1 = 50, k2 = -300\) folds the image"),
+    # monotonic but the corner 29 times as far: no lens
+    ({"focal_length_px": 1000.0, "k1": 50.0}, r"k1 = 50\) moves the farthest image corner 29\.1 times"),
+    # 0.7 px and 702,061 px (44-70 s before the message)
+    ({"focal_length_px": 0.7}, r"focal length of 0\.7 px on 1200 x 900 px images .*field of view of 180"),
+    ({"focal_length_px": 702061.0}, r"focal length of 702,061 px .*field of view of 0\.0979 degrees"),
+])
+def test_an_implausible_calibration_is_refused_naming_the_file_and_the_value(tmp_path, extra, expected):
+    p = tmp_path / "absurd.json"
+    p.write_text(json.dumps({"name": "FC300X", "image_size_px": [1200, 900], "principal_point_px": [600, 450],
+                             **extra}))
+    with pytest.raises(CalibrationError, match=r"^absurd\.json.*: camera 'FC300X': ") as e:
+        read_calibration(str(p))
+    assert re.search(expected, str(e.value)), str(e.value)
+    # a real wide angle's barrel (DJI Phantom 4 as Metashape gives it) and a 20 mm equivalent read
+    p.write_text(json.dumps({"name": "P4", "image_size_px": [5472, 3648], "focal_length_px": 3650.0,
+                             "k1": -0.27, "k2": 0.11, "k3": -0.03}))
+    assert read_calibration(str(p))[0].k1 == -0.27

@@ -19,6 +19,11 @@ priors on intrinsics) and lets the georeference refine them with priors at the g
 sigmas; ``estimated`` starts the self-calibration from them (today's behaviour where nothing is given).  ``auto``
 is ``fixed`` where something is given, ``estimated`` elsewhere.
 
+Before any work (issue 47): a focal length given (FOCAL_MM / SENSOR_WIDTH_MM, in pixels) or a calibration's that is
+:data:`core.geometry.plausible.FOCAL_RATIO_REFUSED` times the photos' EXIF one (either way) is refused with the likely
+cause (a 35 mm equivalent, a wrong sensor width, a focal length in mm read as normalised); a photo that two
+calibrations without patterns fit by size alone is refused naming both (the file does not say which).
+
 The alignment records per camera (``sfm/alignment.json``, ``intrinsics``: :func:`intrinsics_record`) the mode,
 the source, the given values and sigmas and the final values; the georeference reads it back
 (``core.project.layout.Layout.camera_intrinsics``).
@@ -31,6 +36,7 @@ from dataclasses import dataclass, field, replace
 from typing import Dict, List, Optional, Sequence, Tuple
 
 from ..common.progress import Progress
+from ..geometry import plausible
 from ..io.images import CameraGroup, ImageInfo
 from ..project.layout import read_json
 from .options import HELD, AlignError, AlignOptions
@@ -63,6 +69,12 @@ class GivenCamera:
     @property
     def held(self) -> bool:
         return self.mode in HELD
+
+
+def source_label(source: str) -> str:
+    """A given interior orientation's source for the log: a calibration file's name, else the source as it is
+    (``FOCAL_MM / SENSOR_WIDTH_MM``, ``scans.json``: a basename would cut the options' name in two)."""
+    return source if source in (FOCAL_SOURCE, "scans.json") else os.path.basename(source or "")
 
 
 def read_calibrations(options: AlignOptions) -> list:
@@ -115,7 +127,25 @@ def match_calibration(info: ImageInfo, cals: Sequence) -> Tuple[Optional[object]
     hit = [c for c in free if (c.width, c.height) == (info.width, info.height)]
     if len(hit) == 1:
         return hit[0], "the image size"
+    if len(hit) > 1:  # the file does not say which: guessing one holds a camera the photos may not be
+        raise AlignError(_ambiguous(info, hit))
     return None, ""
+
+
+def _ambiguous(info: ImageInfo, hit: Sequence) -> str:
+    """The message of a photo that two or more calibrations without patterns fit by size alone."""
+    source = os.path.basename(hit[0].source or "")
+    listed = "; ".join(f"{c.label()}: focal {c.fx:.1f} px" for c in hit[:-1]) + f" and {hit[-1].label()}: " \
+        f"focal {hit[-1].fx:.1f} px"
+    colmap = source.lower().endswith(".txt") and all((c.name or "").isdigit() for c in hit)
+    how = ("A COLMAP cameras file names its cameras by number only: delete the others' lines (keep the camera "
+           "these photos were taken with), or give that camera in a file of its own" if colmap else
+           f"Name the camera these photos were taken with after their EXIF camera model "
+           f"({repr(info.model) if info.model else 'the photos have none'}), or give it images patterns matching "
+           f"the photos' names (images: [...]), or delete the others")
+    return (f"calibration file {source}: {len(hit)} of its cameras fit the photo {info.name} ({info.width} x "
+            f"{info.height} px): {listed}; none is named after the photo's EXIF camera model or has images patterns "
+            f"matching it, so the file does not say which one these photos take. {how}")
 
 
 def _param_names(pycolmap, model: str) -> List[str]:
@@ -211,6 +241,7 @@ def plan_cameras(pycolmap, groups: List[CameraGroup], infos: Sequence[ImageInfo]
     given interior orientation, for the groups that have one).  AlignError when ``fixed`` or ``refined`` is asked
     and no camera has anything given."""
     by_name = {im.name: im for im in infos}
+    check_given_focal(infos, options)
     for cal in cals:
         for note in getattr(cal, "notes", None) or []:
             progress.info(f"calibration {cal.source}, {cal.label()}: {note}")
@@ -244,8 +275,75 @@ def plan_cameras(pycolmap, groups: List[CameraGroup], infos: Sequence[ImageInfo]
                 if given else "estimated (self-calibration), no calibration given")
         progress.info(f"camera {g.camera_id} ({len(g.images)} image(s), {g.width} x {g.height} px): interior "
                       f"orientation {what}")
-        _check_focal_agrees(g, given, progress)
+        _check_focal_agrees(g, given, progress, by_name[g.images[0]])
     return out, plan
+
+
+def check_given_focal(infos: Sequence[ImageInfo], options: AlignOptions) -> None:
+    """AlignError before any work when the focal length given (FOCAL_MM with SENSOR_WIDTH_MM, or in pixels) is far
+    from the photos' EXIF focal length (plausible.FOCAL_RATIO_REFUSED times either way, in mm and in pixels), with
+    the likely cause (a 35 mm equivalent given for the lens's focal length, a wrong sensor width); and when it gives
+    no camera's field of view (core.geometry.plausible.focal_problem)."""
+    seen = set()
+    for im in infos:
+        key = (im.width, im.height, im.focal_mm, im.focal_35mm)
+        if im.focal_source != "manual" or not im.focal_px or key in seen:
+            continue
+        seen.add(key)
+        problem = _given_against_exif(im, options)
+        if problem is None:  # no EXIF to compare with (or one it agrees with): a camera's field of view at least
+            problem = plausible.focal_problem(im.focal_px, im.width, im.height)
+            if problem:
+                problem = f"the focal length given ({_given_text(im, options)}): {problem}"
+        if problem:
+            raise AlignError(problem)
+
+
+def _given_text(im: ImageInfo, options: AlignOptions) -> str:
+    if options.focal_px:
+        return f"FOCAL_PX {options.focal_px:g} px"
+    if not (options.focal_mm and options.sensor_width_mm):
+        return f"{im.focal_px:.0f} px on the {im.width} x {im.height} px photos"
+    return (f"FOCAL_MM {options.focal_mm:g} mm on a sensor SENSOR_WIDTH_MM {options.sensor_width_mm:g} mm wide: "
+            f"{im.focal_px:.0f} px on the {im.width} x {im.height} px photos")
+
+
+def _given_against_exif(im: ImageInfo, options: AlignOptions) -> Optional[str]:
+    """Why the focal length given cannot be these photos' (None: it may be): far from their EXIF one."""
+    w, h, px = im.width, im.height, float(im.focal_px)
+    exif_px = im.focal_35mm / plausible.FULL_FRAME_DIAGONAL_MM * math.hypot(w, h) if im.focal_35mm else None
+    given_mm = options.focal_mm if not options.focal_px else None
+    mm_far = bool(given_mm and im.focal_mm and plausible.far_apart(given_mm, im.focal_mm))
+    px_far = bool(exif_px and plausible.far_apart(px, exif_px))
+    if not (mm_far or px_far):
+        return None
+    exif = "; ".join(v for v in (f"{im.focal_mm:g} mm" if im.focal_mm else "",
+                                 f"{exif_px:.0f} px from its 35 mm equivalent {im.focal_35mm:g} mm" if exif_px
+                                 else "") if v)
+    ratio = plausible.ratio_text(px, exif_px) if exif_px else plausible.ratio_text(given_mm, im.focal_mm)
+    camera = " ".join(v for v in (im.make, im.model) if v)
+    exif_of = f"the EXIF focal length of {im.name} ({exif}{f'; camera {camera}' if camera else ''})"
+    camera = f" (camera {camera})" if camera else ""
+    if given_mm and not mm_far and im.focal_mm:  # the focal length is right: the sensor width is not
+        sensor = im.focal_mm * max(w, h) / exif_px
+        return (f"FOCAL_MM {given_mm:g} mm agrees with the EXIF focal length of {im.name} ({im.focal_mm:g} mm), "
+                f"but with SENSOR_WIDTH_MM {options.sensor_width_mm:g} mm it makes {px:.0f} px on the {w} x {h} px "
+                f"photos, {plausible.ratio_text(px, exif_px)} the {exif_px:.0f} px the EXIF's 35 mm equivalent "
+                f"({im.focal_35mm:g} mm) gives{camera}: by the EXIF, the photos were taken on a sensor about "
+                f"{sensor:.3g} mm wide (SENSOR_WIDTH_MM is the sensor's long side in mm); check SENSOR_WIDTH_MM, or "
+                f"leave FOCAL_MM and SENSOR_WIDTH_MM empty to take the EXIF's")
+    text = f"the focal length given ({_given_text(im, options)}) is {ratio} {exif_of}. "
+    sensor_diag = (options.sensor_width_mm * math.hypot(w, h) / max(w, h)) if options.sensor_width_mm else None
+    equivalent = (im.focal_mm * plausible.FULL_FRAME_DIAGONAL_MM / sensor_diag
+                  if im.focal_mm and sensor_diag else None)
+    if given_mm and (plausible.same_value(given_mm, im.focal_35mm) or plausible.same_value(given_mm, equivalent)):
+        real = f"FOCAL_MM={im.focal_mm:g} (the EXIF FocalLength)" if im.focal_mm else "the lens's focal length"
+        return text + (f"{given_mm:g} mm is the photos' 35 mm equivalent focal length (the focal length on a 36 x 24 "
+                       f"mm frame giving the same field of view: EXIF FocalLengthIn35mmFilm), not the lens's: give "
+                       f"{real}, or leave FOCAL_MM and SENSOR_WIDTH_MM empty to take the EXIF's")
+    return text + ("Is it another camera's or lens's, or in another unit? Give the focal length of the lens these "
+                   "photos were taken with (FOCAL_MM in mm, SENSOR_WIDTH_MM the sensor's long side in mm), or leave "
+                   "them empty to take the EXIF's")
 
 
 # a calibration file's focal length further than this (relative) from the one typed in (FOCAL_MM) or read from
@@ -255,7 +353,11 @@ FOCAL_DISAGREES = 0.02
 EXIF_FOCAL_DISAGREES = 0.10
 
 
-def _check_focal_agrees(g: CameraGroup, given: Optional[GivenCamera], progress: Progress) -> None:
+def _check_focal_agrees(g: CameraGroup, given: Optional[GivenCamera], progress: Progress,
+                        info: Optional[ImageInfo] = None) -> None:
+    """A calibration's focal length against the one typed in or the photos' EXIF: a warning beyond a few percent;
+    an AlignError beyond plausible.FOCAL_RATIO_REFUSED times the EXIF one (another camera's calibration, or a
+    unit misread: Orthority's focal_len in mm without sensor_size), before any work."""
     if given is None or given.source in ("scans.json", FOCAL_SOURCE) or not g.focal_px:
         return
     if g.focal_source == "manual":
@@ -265,11 +367,30 @@ def _check_focal_agrees(g: CameraGroup, given: Optional[GivenCamera], progress: 
     else:
         return
     f = float(given.params[0])
+    if g.focal_source.startswith("exif") and plausible.far_apart(f, g.focal_px):
+        raise AlignError(_calibration_against_exif(g, given, f, info))
     if abs(g.focal_px / f - 1.0) > limit:
         progress.warning(f"camera {g.camera_id}: the calibration {os.path.basename(given.source)} gives a focal "
                          f"length of {f:.1f} px, {other} {g.focal_px:.1f} px ({100.0 * (g.focal_px / f - 1.0):+.1f} "
                          f"%); the calibration's is used: check that it is this camera's and that its units are "
                          f"right")
+
+
+def _calibration_against_exif(g: CameraGroup, given: GivenCamera, f: float, info: Optional[ImageInfo]) -> str:
+    exif_mm = info.focal_mm if info is not None else None
+    exif = f"{g.focal_px:.1f} px" + (f", {exif_mm:g} mm" if exif_mm else "")
+    what = f"camera {given.name!r}" if given.name else "its camera"
+    text = (f"calibration file {os.path.basename(given.source)}: {what} gives a focal length of {f:.1f} px, "
+            f"{plausible.ratio_text(f, g.focal_px)} the photos' EXIF focal length ({exif}) of camera {g.camera_id} "
+            f"({len(g.images)} photo(s) of {g.width} x {g.height} px, e.g. {g.images[0]}): ")
+    if plausible.same_value(f / g.width, exif_mm, 0.02):
+        return text + (f"{f:.1f} px is {f / g.width:g} times the image width, and {f / g.width:g} is the photos' "
+                       f"EXIF focal length in mm: a focal length in mm read as one normalised by the image width "
+                       f"(Orthority's focal_len without sensor_size is). Add the sensor's size in mm (sensor_size: "
+                       f"[width, height]) or give the focal length in pixels")
+    return text + ("the calibration is another camera's or lens's, or one of its values is in another unit (mm for "
+                   "pixels, another image size's pixels): check it, or align without it (the EXIF focal length is "
+                   "then the start of the self-calibration)")
 
 
 def _describe_calibration(cal) -> str:
@@ -359,5 +480,5 @@ def intrinsics_record(pycolmap, groups: Sequence[CameraGroup], plan: Dict[str, G
     return rows
 
 
-__all__ = ["FOCAL_SOURCE", "GivenCamera", "colmap_camera", "held_cameras", "intrinsics_record",
-           "match_calibration", "plan_cameras", "read_calibrations", "restore_held", "scan_interior"]
+__all__ = ["FOCAL_SOURCE", "GivenCamera", "check_given_focal", "colmap_camera", "held_cameras", "intrinsics_record",
+           "match_calibration", "plan_cameras", "read_calibrations", "restore_held", "scan_interior", "source_label"]

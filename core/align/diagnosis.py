@@ -3,12 +3,11 @@ registered (``diagnose_unregistered``, ``report_unregistered``) and the error of
 (``no_reconstruction_error``: no overlap, no initial pair, or a held calibration that is wrong)."""
 from __future__ import annotations
 
-import os
 from typing import Dict, Optional, Sequence, Set, Tuple
 
 from ..common.progress import Progress
 from ..io.images import ImageInfo
-from .calibrated import GivenCamera
+from .calibrated import GivenCamera, source_label
 from .options import MIN_VERIFIED_INLIERS, AlignError
 
 
@@ -90,7 +89,7 @@ def no_reconstruction_error(partners: Dict[str, int], n_images: int, n_pairs: in
             f" ({', '.join(isolated[:10])}{' ...' if len(isolated) > 10 else ''})")
     calibration = ""
     if held:
-        cams = "; ".join(f"camera {cid}: focal {g.params[0]:.1f} px from {os.path.basename(g.source)}"
+        cams = "; ".join(f"camera {cid}: focal {g.params[0]:.1f} px from {source_label(g.source)}"
                          for cid, g in sorted(held.items()))
         calibration = (f". The interior orientation was held as given ({cams}): a wrong focal length, pixel size "
                        "or image size in the calibration also leaves no pair to triangulate; check it, or run with "

@@ -2,7 +2,6 @@
 content fingerprints and given interior orientations."""
 from __future__ import annotations
 
-import os
 import time
 from dataclasses import dataclass
 from typing import Dict, List, Tuple
@@ -10,10 +9,10 @@ from typing import Dict, List, Tuple
 from ..common.progress import Progress, SubProgress
 from ..io.images import CameraGroup, ImageError, ImageInfo, group_cameras, scan_images
 from ..project.layout import Layout
-from .calibrated import GivenCamera, held_cameras, plan_cameras, scan_interior
+from .calibrated import GivenCamera, held_cameras, plan_cameras, scan_interior, source_label
 from .options import AlignError, AlignOptions
 from .pairs import photo_positions
-from .photos import fingerprint_photos
+from .photos import check_same_photos, fingerprint_photos
 
 
 def read_images(images_dir: str, options: AlignOptions,
@@ -52,7 +51,7 @@ class Photos:
         """One line per camera: make, model, size, the focal length given or its prior, how many images."""
         for g in self.groups:
             given = self.given.get(g.key)
-            focal = (f"focal {given.params[0]:.1f} px ({given.mode}, {os.path.basename(given.source)})"
+            focal = (f"focal {given.params[0]:.1f} px ({given.mode}, {source_label(given.source)})"
                      if given is not None else f"focal prior {g.focal_px:.1f} px ({g.focal_source})")
             progress.info(f"camera {g.camera_id}: {g.make} {g.model} {g.width}x{g.height}, {focal}, "
                           f"{len(g.images)} images")
@@ -66,10 +65,13 @@ class Photos:
 def read_folder(pycolmap, lay: Layout, images_dir: str, options: AlignOptions, calibrations: list,
                  progress: Progress) -> Photos:
     """The usable photos of ``images_dir``, their fingerprints and their cameras' given interior orientations
-    (a calibration file's, film scans' restituted by Prepare images); AlignError with fewer than two."""
+    (a calibration file's, film scans' restituted by Prepare images); AlignError with fewer than two, or with a
+    folder of other photos than those of the workspace's finished alignment (photos.check_same_photos)."""
     t0 = time.time()
     infos, skipped, groups = read_images(images_dir, options, progress)
     groups, given = plan_cameras(pycolmap, groups, infos, calibrations, scan_interior(lay.scans_json, infos),
                                  options, progress)
     positions = photo_positions(infos, options.camera_positions)
-    return Photos(images_dir, infos, skipped, groups, fingerprint_photos(infos), time.time() - t0, given, positions)
+    prints = fingerprint_photos(infos)
+    check_same_photos(lay.ws, images_dir, prints)  # another block's photos on a finished workspace: before any change
+    return Photos(images_dir, infos, skipped, groups, prints, time.time() - t0, given, positions)

@@ -17,8 +17,10 @@ import os
 from typing import Dict, List, Mapping, Sequence
 
 from ..io.images import ImageError, ImageInfo, check_image, photo_fingerprint
+from ..project.layout import Layout
 from ..project.stages import ALIGN
 from ..project.workspace import Workspace
+from .options import AlignError
 
 PHOTO_FINGERPRINTS = "photo_fingerprints"  # key of the align stage's record: {image name: fingerprint}
 
@@ -36,6 +38,34 @@ def fingerprint_photos(infos: Sequence[ImageInfo]) -> Dict[str, str]:
 
 def _list(names: Sequence[str], limit: int = 8) -> str:
     return ", ".join(names[:limit]) + (f" and {len(names) - limit} more" if len(names) > limit else "")
+
+
+def check_same_photos(ws: Workspace, images_dir: str, fingerprints: Dict[str, str]) -> None:
+    """AlignError when ``ws`` holds a finished alignment of the photos of another folder and ``images_dir`` holds
+    none of them (by content fingerprint; by name in a workspace aligned before fingerprints were recorded): an
+    alignment there would replace the block's and leave its later products stale without a word.  The
+    workspace's own folder (whatever it holds now) and the same photos moved elsewhere are a re-alignment."""
+    lay = Layout(ws)
+    recorded_dir = ws.data.get("images_dir")
+    if not recorded_dir or not lay.has_aligned_model():
+        return
+    if os.path.normcase(os.path.abspath(recorded_dir)) == os.path.normcase(os.path.abspath(images_dir)):
+        return
+    recorded = ws.stage(ALIGN).get(PHOTO_FINGERPRINTS)
+    if isinstance(recorded, dict) and recorded:
+        n_old, common = len(recorded), set(recorded.values()) & set(fingerprints.values())
+    else:
+        names = {im.get("name") for im in ws.data.get("images", []) if isinstance(im, dict)}
+        n_old, common = len(names), names & set(fingerprints)
+    if common or not n_old:
+        return
+    later = [k for k, v in ws.data.get("stages", {}).items() if k != ALIGN and (v or {}).get("status") == "done"]
+    products = f" and leave what was made from it ({', '.join(later)}) stale" if later else ""
+    raise AlignError(
+        f"workspace {ws.root} was aligned from the photos of {recorded_dir} ({n_old} photos); {images_dir} holds "
+        f"none of them ({len(fingerprints)} other photos): aligning them here would replace the workspace's "
+        f"alignment{products}. To re-align this workspace's photos, give IMAGES={recorded_dir}; to align the "
+        f"photos of {images_dir}, give a new WORKSPACE (a folder of its own)")
 
 
 def check_photos(ws: Workspace, photos: Mapping[str, str]) -> List[str]:

@@ -304,8 +304,33 @@ def calibration_for_image(calibrations: Sequence[CameraCalibration], image_name:
 
 def read_calibration(path: str) -> List[CameraCalibration]:
     """The cameras of a calibration file (ours in YAML or JSON, Orthority, OpenCV YAML/XML, COLMAP
-    cameras.txt, Metashape XML), told apart by their content."""
-    path = os.fspath(path)
+    cameras.txt, Metashape XML), told apart by their content.  A camera no lens can be (a focal length of no
+    camera's field of view, a distortion that folds the image) is refused here, before any work
+    (:func:`check_plausible`)."""
+    cals = _read_calibration(os.fspath(path))
+    for cal in cals:
+        check_plausible(cal)
+    return cals
+
+
+def check_plausible(cal: CameraCalibration) -> None:
+    """CalibrationError naming the file, the camera and the value when ``cal`` cannot be a camera's: its field of
+    view outside what a camera has, or its radial distortion folding the image or moving its corner beyond what a
+    lens does (core.geometry.plausible).  Thresholds are ratios to the image (focal length / long side,
+    normalised radii), never pixels."""
+    from ..geometry import plausible
+
+    for f in {cal.fx, cal.fy}:
+        problem = plausible.focal_problem(f, cal.width, cal.height)
+        if problem:
+            raise CalibrationError(cal.source, None, "focal", f"{cal.label()}: {problem}")
+    problem = plausible.distortion_problem(cal.fx, cal.fy, cal.cx_px, cal.cy_px, cal.width, cal.height,
+                                           (cal.k1, cal.k2, cal.k3))
+    if problem:
+        raise CalibrationError(cal.source, None, "k1", f"{cal.label()}: {problem}")
+
+
+def _read_calibration(path: str) -> List[CameraCalibration]:
     try:
         with open(path, "rb") as fh:
             raw = fh.read()

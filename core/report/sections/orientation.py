@@ -7,6 +7,7 @@ from typing import Optional
 
 import numpy as np
 
+from ...align.calibrated import source_label
 from ...common.progress import check_cancel
 from ...georef import accuracy
 from ...georef.bundle import CALIBRATION_ZERO_TERMS, given_priors
@@ -132,7 +133,7 @@ def _camera_in_mm(cid, r: dict, final: dict) -> str:
     from the image centre) given and final, where the calibration gave the pixel size; the radial distortion at
     the image corner in px."""
     name = f" '{r['name']}'" if r.get("name") else ""
-    src = os.path.basename(str(r.get("source") or ""))
+    src = source_label(str(r.get("source") or ""))
     parts = [f"camera {cid}{name} ({esc(src)}), {r['mode']}"]
     g = r["given"]
     w, h = num(r.get("width")), num(r.get("height"))
@@ -225,7 +226,7 @@ def interior_orientation(ctx: ReportContext) -> str:
                          cell(sigma[name] if r["mode"] == "refined" else None, 6), cell(value, 6), moved_cell,
                          cell(in_sigma, 2)])
         lines.append(f"<li>{_camera_in_mm(cid, r, final)}</li>")
-    modes = ", ".join(f"camera {cid}: {r['mode']} ({esc(os.path.basename(str(r.get('source') or '')))})"
+    modes = ", ".join(f"camera {cid}: {r['mode']} ({esc(source_label(str(r.get('source') or '')))})"
                       for cid, r in sorted(given.items()))
     height = _flying_height(d, given)
     if far:
