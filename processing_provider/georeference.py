@@ -157,6 +157,7 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         becomes check points."""
         from ..core.georef.autocontrol.options import PRIOR_AUTO, PRIOR_GPS, AutoControlOptions
         from ..core.georef.autocontrol.stage import autocontrol_workspace
+        from ..core.georef.options import GeorefOptions
         from ..qgisio import reference_layers as refs
 
         if ortho is None or dsm is None:
@@ -175,17 +176,13 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         if crs_text and crs_text != crs:
             feedback.pushWarning(self.tr("Target CRS {} is not used: automatic control georeferences in the "
                                          "reference orthophoto's CRS {}").format(crs_text, crs))
-        check = self.run_core(_check_points, workspace, gcp_path, gcps, checks, crs)
-        cams = None
-        if positions:
-            from ..core.io.gcp import read_camera_positions
-
-            pos_crs, cams = self.run_core(read_camera_positions, positions)
-            cams = refs.positions_in(cams, pos_crs, crs)
-        prior = PRIOR_GPS if self.parameterAsBoolean(parameters, self.USE_EXIF_GPS, context) and not cams \
+        # the given control is read and checked by core, as Georeference reads it: the points become check points
+        control = GeorefOptions(gcp_path=gcp_path, gcps=gcps, check_points=checks, camera_positions_path=positions,
+                                gcps_upright=self.parameterAsBoolean(parameters, self.GCPS_UPRIGHT, context))
+        prior = PRIOR_GPS if self.parameterAsBoolean(parameters, self.USE_EXIF_GPS, context) and not positions \
             else PRIOR_AUTO
         result = self.run_core(autocontrol_workspace, workspace, AutoControlOptions(
-            reference_ortho=ortho_path, reference_dsm=dsm_path, prior=prior, camera_positions=cams, check_points=check),
+            reference_ortho=ortho_path, reference_dsm=dsm_path, prior=prior, control=control),
             progress=FeedbackProgress(feedback, 0.1, 1.0))
         georef = result.georef
         progress.push_result(georef.warnings)
@@ -202,22 +199,6 @@ class GeoreferenceAlgorithm(AlgorithmBase):
         for n in self.NUMBERS:
             out[n] = f.get(n)
         return out
-
-
-def _check_points(workspace, gcp_path, gcps, checks, crs):
-    """The ground control given beside the automatic control, read as Georeference reads it, as check points in
-    the reference's CRS (None when none is given)."""
-    from ..core.io import gcp as gcpmod
-    from ..core.project.workspace import Workspace
-    from ..qgisio.reference_layers import as_check_points
-
-    if gcp_path:
-        ws = Workspace.open(workspace)
-        sizes = {im["name"]: (im["width"], im["height"]) for im in ws.data.get("images", [])}
-        gcps = gcpmod.read_gcps(gcp_path, image_names=list(sizes), image_sizes=sizes, default_crs=crs)
-    if gcps is not None and checks:
-        gcpmod.apply_check_points(gcps, list(checks))
-    return as_check_points(gcps, crs)
 
 
 def _fmt(v):

@@ -16,7 +16,7 @@ import pytest
 from tests import synthetic as syn
 from tests.test_autocontrol import BLOCK, CACHE, write_reference
 from tests.test_ui_dock import dock, process, wait_task  # noqa: F401 (fixtures and helpers of the dock tests)
-from tests.workspaces import set_exif_gps, synthetic_workspace
+from tests.workspaces import set_exif_gps, synthetic_workspace, write_flat_reference
 
 pytestmark = pytest.mark.usefixtures("qgis_app")
 
@@ -207,6 +207,47 @@ def test_georeference_needs_both_references(epochs, xyz_uri, tmp_path):
         alg.processAlgorithm({"WORKSPACE": ws, "REFERENCE_ORTHO": xyz_layer(xyz_uri)}, context,
                              QgsProcessingFeedback())
     assert not os.path.exists(os.path.join(ws, "georef", "reference-ortho.tif"))
+
+
+def test_georeference_with_a_reference_checks_camera_positions_as_without(tmp_path):
+    """Georeference's automatic-control mode reads the camera positions through the georeference stage's checks
+    (issue 47 item 2, issue 49: one place reads and checks control): a file with the latitude in the x column is
+    refused before the matching, with the message Georeference gives without a reference."""
+    from archaeoortho.core.geometry.crs import transform_points
+    from archaeoortho.processing_provider.georeference import GeoreferenceAlgorithm
+    from qgis.core import (
+        QgsProcessingContext,
+        QgsProcessingException,
+        QgsProcessingFeedback,
+        QgsProject,
+        QgsRasterLayer,
+    )
+
+    block = syn.vertical_block(seed=1)
+    ws = synthetic_workspace(str(tmp_path / "ws"), block, block.truth_reconstruction())
+    cams, _ = block.camera_positions(sigma=0.5)
+    set_exif_gps(ws, cams, syn.CRS)
+    lonlat = transform_points(np.array([[c.x, c.y, c.z] for c in cams]), syn.CRS, "EPSG:4326")
+    positions = tmp_path / "latlon.csv"
+    positions.write_text("EPSG:4326\nimage,x,y,z\n" + "".join(
+        f"{c.image},{p[1]:.8f},{p[0]:.8f},{c.z:.3f}\n" for c, p in zip(cams, lonlat)))
+    ortho, dsm = write_flat_reference(tmp_path / "ref", cams, syn.CRS)
+    alg = GeoreferenceAlgorithm()
+    alg.initAlgorithm()
+    context = QgsProcessingContext()
+    context.setProject(QgsProject.instance())
+
+    def refused(**more):
+        with pytest.raises(QgsProcessingException) as e:
+            alg.processAlgorithm({"WORKSPACE": ws, "CAMERA_POSITIONS": str(positions), **more}, context,
+                                 QgsProcessingFeedback())
+        return str(e.value)
+
+    plain = refused()
+    assert "latitude and longitude look swapped" in plain
+    assert refused(REFERENCE_ORTHO=QgsRasterLayer(ortho, "ortho", "gdal"),
+                   REFERENCE_DSM=QgsRasterLayer(dsm, "dsm", "gdal")) == plain
+    assert not os.path.exists(os.path.join(ws, "georef", "autocontrol-failed.json"))  # before the matching
 
 
 def test_qgis_process_georeference_with_a_web_reference(epochs, xyz_uri, tmp_path):

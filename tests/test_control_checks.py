@@ -15,7 +15,7 @@ from core.io.gcp import write_csv_gcps
 from core.project.stages import StageError
 from core.project.workspace import Workspace
 from tests import synthetic as syn
-from tests.workspaces import synthetic_workspace
+from tests.workspaces import synthetic_workspace, write_flat_reference
 
 
 class _Said(NullProgress):
@@ -129,3 +129,36 @@ def test_a_duplicate_row_is_warned_in_the_stage_log_and_good_positions_pass(tmp_
     assert result.crs == syn.CRS
     dup = [w for w in said.warnings if c.image in w and "lines 3 and" in w]
     assert len(dup) == 1 and "is used" in dup[0], said.warnings
+
+
+def test_automatic_control_reads_camera_positions_through_the_same_checks(tmp_path, block):
+    """The automatic control (a reference orthophoto and DSM) reads the camera positions and GCPs given beside it
+    through read_checked_control (issue 49: one place reads and checks control): latitude in the x column is
+    refused before the matching with the message Georeference gives without a reference, a duplicate row is
+    warned in the log, and GCPs of another UTM zone are refused as there."""
+    from core.georef.autocontrol.options import AutoControlOptions
+    from core.georef.autocontrol.stage import autocontrol_workspace
+
+    root = _workspace(tmp_path, block)
+    ortho, dsm = write_flat_reference(tmp_path / "ref", block.camera_positions(sigma=0.0)[0], syn.CRS)
+    cams, _ = block.camera_positions(sigma=0.5)
+    lat, lon = transform_points(np.array([[cams[0].x, cams[0].y, 0.0]]), syn.CRS, "EPSG:4326")[0, 1::-1]
+    p = _positions(block, tmp_path, "latlon.csv", "EPSG:4326", order="yx", lonlat=True,
+                   extra=[f"{cams[0].image},{lat:.8f},{lon:.8f},{cams[0].z:.3f}"])
+    plain = _refused(root, r"latitude and longitude look swapped", camera_positions_path=p)
+
+    def automatic(**control):
+        said = _Said()
+        with pytest.raises(StageError) as e:
+            autocontrol_workspace(root, AutoControlOptions(reference_ortho=ortho, reference_dsm=dsm,
+                                                           control=GeorefOptions(**control)), said)
+        return str(e.value), said.warnings
+
+    msg, said = automatic(camera_positions_path=p)
+    assert msg == plain
+    assert any(cams[0].image in w and "lines 3 and" in w for w in said), said
+    g = _gcp_file(block, tmp_path, "EPSG:32634")
+    plain = _refused(root, r"control points of the GCP file \S*gcps\.csv \(EPSG:32634\) land", gcp_path=g,
+                     crs=syn.CRS)
+    assert automatic(gcp_path=g)[0] == plain
+    assert not (tmp_path / "ws" / "georef" / "autocontrol-failed.json").exists()  # refused before the matching

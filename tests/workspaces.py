@@ -90,3 +90,37 @@ def rendered_once(block, cache_dir):
         block.render(images)
         open(done, "w").close()
     return images
+
+
+def write_flat_reference(folder, positions, crs, margin=100.0, gsd=1.0):
+    """(orthophoto, DSM): a random-texture RGB orthophoto and a gently sloping DSM in ``crs`` over the box of
+    ``positions`` (core.io.gcp.CameraPosition in ``crs``) plus ``margin``: a reference pair the automatic control
+    opens and accepts, for the checks made before its matching (nothing in it matches the photos)."""
+    import numpy as np
+    from osgeo import gdal, osr
+
+    xy = np.array([[c.x, c.y] for c in positions], dtype=float)
+    x0, y0 = xy.min(axis=0) - margin
+    x1, y1 = xy.max(axis=0) + margin
+    w, h = int(np.ceil((x1 - x0) / gsd)), int(np.ceil((y1 - y0) / gsd))
+    srs = osr.SpatialReference()
+    srs.SetFromUserInput(crs)
+    os.makedirs(str(folder), exist_ok=True)
+    rng = np.random.default_rng(3)
+    paths = []
+    for name, bands, dtype in (("ref_ortho.tif", 3, gdal.GDT_Byte), ("ref_dsm.tif", 1, gdal.GDT_Float32)):
+        path = os.path.join(str(folder), name)
+        ds = gdal.GetDriverByName("GTiff").Create(path, w, h, bands, dtype)
+        ds.SetGeoTransform((float(x0), gsd, 0.0, float(y1), 0.0, -gsd))
+        ds.SetProjection(srs.ExportToWkt())
+        if bands == 3:
+            for b, ci in zip(range(3), (gdal.GCI_RedBand, gdal.GCI_GreenBand, gdal.GCI_BlueBand)):
+                band = ds.GetRasterBand(b + 1)
+                band.WriteArray(rng.integers(0, 256, (h, w), dtype=np.uint8))
+                band.SetColorInterpretation(ci)
+        else:
+            yy, xx = np.mgrid[0:h, 0:w]
+            ds.GetRasterBand(1).WriteArray((100.0 + 0.02 * xx + 0.01 * yy).astype(np.float32))
+        ds = None
+        paths.append(path)
+    return paths[0], paths[1]

@@ -28,12 +28,14 @@ def autocontrol_then_prepare(root, ortho_layer, dsm_layer, check_points=None, ex
     from ..core.common.progress import SubProgress
     from ..core.georef.autocontrol.options import AutoControlOptions
     from ..core.georef.autocontrol.stage import autocontrol_workspace
+    from ..core.georef.options import GeorefOptions
     from ..qgisio import reference_layers as refs
 
     ortho, dsm = refs.resolve_references(ortho_layer, dsm_layer, root, extent=extent, extent_crs=extent_crs,
                                          progress=SubProgress(progress, 0.0, 0.1), context=context)
-    check = refs.as_check_points(check_points, refs.reference_crs(ortho))
-    result = autocontrol_workspace(root, AutoControlOptions(reference_ortho=ortho, reference_dsm=dsm, check_points=check),
+    # the dock's points: read and checked by core as the dock's georeference reads them, then check points
+    control = GeorefOptions(gcps=check_points) if check_points is not None else None
+    result = autocontrol_workspace(root, AutoControlOptions(reference_ortho=ortho, reference_dsm=dsm, control=control),
                                    SubProgress(progress, 0.1, 0.97))
     return result, layers.footprints_path(root)
 

@@ -197,7 +197,7 @@ class _Place:
             if med <= self.limit:
                 return ""
             how = "from the same photos' EXIF GPS" if images is not None else "from the photos' EXIF GPS positions"
-            return (f"land {_km(med)} {how} (median over {len(d)} {noun}; the photos'' GPS positions span {self.spread:,.0f} m, "
+            return (f"land {_km(med)} {how} (median over {len(d)} {noun}; the photos' GPS positions span {self.spread:,.0f} m, "
                     f"so more than {_km(self.limit)} is not a GPS error)")
         if self.area is None:
             return None
@@ -297,7 +297,7 @@ def check_control_location(ws: Workspace, opt: GeorefOptions, gcps: Optional[gcp
             raise StageError(f"the control points of {name} ({src}) {what}: {_cause(place, raw, src, None, utm, labelled)}")
 
 
-def _read_control(ws: Workspace, opt: GeorefOptions, progress: Progress):
+def _read_control(ws: Workspace, opt: GeorefOptions, progress: Progress, required: bool):
     """``read_control``, with the warnings the control readers issue (a camera position file's duplicate rows) put
     in the stage's log, where the user reads them (a Python warning reaches a console at best); other warnings
     go on as they came."""
@@ -305,7 +305,7 @@ def _read_control(ws: Workspace, opt: GeorefOptions, progress: Progress):
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            return read_control(ws, opt, progress)
+            return read_control(ws, opt, progress, required)
     finally:
         said = set()
         for w in caught:
@@ -318,12 +318,13 @@ def _read_control(ws: Workspace, opt: GeorefOptions, progress: Progress):
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
 
 
-def read_checked_control(ws: Workspace, opt: GeorefOptions, progress: Progress):
+def read_checked_control(ws: Workspace, opt: GeorefOptions, progress: Progress, required: bool = True):
     """``read_control``'s (GCPs, camera positions, target CRS), checked: a geographic CRS parameter refused
     before reading, control far from the photos' GPS and a geographic target after (StageError each); the
-    readers' warnings in the stage's log."""
+    readers' warnings in the stage's log.  The one reader of control files: the georeference stage and the
+    automatic control (its check points and rough positions: ``required`` False, no minimum) read through it."""
     check_crs_parameter(ws, opt)  # CRS=EPSG:4326: refused before reading, naming the UTM zone
-    gcps, cams, target = _read_control(ws, opt, progress)
+    gcps, cams, target = _read_control(ws, opt, progress, required)
     check_control_location(ws, opt, gcps, cams, target)  # lands where the photos' GPS says?
     check_target_crs(ws, opt, gcps, target)
     return gcps, cams, target

@@ -99,12 +99,14 @@ def dem_alone_hint(ws: Workspace, opt: GeorefOptions) -> str:
             "with the DEM: the automatic control then finds the block on the orthophoto itself, no position needed")
 
 
-def read_control(ws: Workspace, opt: GeorefOptions, progress: Progress
+def read_control(ws: Workspace, opt: GeorefOptions, progress: Progress, required: bool = True
                  ) -> Tuple[Optional[gcpmod.GCPSet], List[gcpmod.CameraPosition], str]:
     """The ground control in the target CRS: (GCPs, camera positions, target CRS); StageError when it is
-    not enough to georeference.  Observations in photos that are not in the workspace are left out with a
-    warning (an error when none is in one of its photos); ``opt.gcps_upright``: the pixel coordinates were
-    measured on upright photos (EXIF orientation applied) and are converted to the stored grid."""
+    not enough to georeference (``required`` False: any amount, for the automatic control, whose own candidates
+    fix the block and which takes the given points as check points and the positions as a rough position).
+    Observations in photos that are not in the workspace are left out with a warning (an error when none is in
+    one of its photos); ``opt.gcps_upright``: the pixel coordinates were measured on upright photos (EXIF
+    orientation applied) and are converted to the stored grid."""
     crs = opt.crs
     gcps = _gcps(ws, opt, progress)
     positions_path = opt.camera_positions_path
@@ -132,7 +134,7 @@ def read_control(ws: Workspace, opt: GeorefOptions, progress: Progress
             progress.warning("USE_EXIF_GPS is set but no image carries EXIF GPS")
     # a control point whose observations were all dropped (outside the image, unknown image) controls nothing
     n_control = sum(1 for p in gcps.points if p.role == gcpmod.CONTROL and p.observations) if gcps else 0
-    if n_control < 3 and len(cams) < 3:
+    if required and n_control < 3 and len(cams) < 3:
         found = "; ".join(f"{p.name} ({p.role}, {p.describe_observations()})" for p in gcps.points) if gcps else "none"
         hint = f"; {dem_alone_hint(ws, opt)}" if opt.reference_dem else ""
         raise StageError(gcpmod.with_warnings(

@@ -35,7 +35,12 @@ class AutoControlOptions:
 
     The inputs of ``autocontrol_workspace``: ``reference_ortho``, ``reference_dsm``: the reference orthophoto and
     DSM files; ``prior``: "auto" (EXIF GPS when 2 photos carry it, else none), "gps", or "none" (search rotation
-    and scale); ``camera_positions``: rough positions in the reference's CRS instead of EXIF GPS;
+    and scale); ``control``: the ground control given beside the reference, as ``GeorefOptions`` holds it (a GCP
+    file ``gcp_path`` or a set ``gcps``, ``check_points`` names, ``camera_positions_path``, ``gcps_upright``):
+    read and checked in the reference's CRS by the georeference stage's own reader
+    (``core.georef.control_checks.read_checked_control``: positions far from the photos' GPS, swapped axes,
+    duplicate rows), before the matching; its points become check points, its camera positions the rough
+    position; ``camera_positions``: rough positions already in the reference's CRS instead of EXIF GPS;
     ``check_points``: ground points evaluated as check points (role check; taken from their set's CRS into the
     reference's); ``georef``: the adjustment's options (its ``refine_intrinsics`` replaces
     ``refine_intrinsics``)."""
@@ -65,6 +70,7 @@ class AutoControlOptions:
     prior: str = PRIOR_AUTO
     camera_positions: Optional[Sequence[CameraPosition]] = None
     check_points: Optional[GCPSet] = None
+    control: Optional[GeorefOptions] = None
     georef: Optional[GeorefOptions] = None
 
     @classmethod

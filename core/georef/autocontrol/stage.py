@@ -14,6 +14,8 @@ Processing algorithm calls).
 """
 from __future__ import annotations
 
+import copy
+import dataclasses
 import os
 import time
 from dataclasses import dataclass, field
@@ -23,6 +25,7 @@ from ...common.files import remove_path
 from ...common.progress import NullProgress, Progress, SubProgress
 from ...project.layout import Layout, write_json
 from ...project.workspace import Workspace
+from ..control_checks import read_checked_control
 from ..options import GeorefOptions
 from ..stage import GeorefStageResult, georeference_workspace
 from . import record
@@ -67,6 +70,7 @@ def autocontrol_workspace(workspace_dir: str, options: AutoControlOptions,
     reference = Reference(opt.reference_ortho, opt.reference_dsm)
     t0 = time.time()
     try:
+        opt = _with_given_control(ws, opt, reference.crs, progress)  # read and checked before the matching
         found = find_candidates(ws, rec, reference, opt, SubProgress(progress, 0.0, 0.7))
     finally:
         reference.close()
@@ -106,6 +110,32 @@ def autocontrol_workspace(workspace_dir: str, options: AutoControlOptions,
     write_json(lay.autocontrol_json, doc)
     return AutoControlResult(ws.root, crs, opt.prior, found.gsd, figures, found.candidates, res, n_used,
                              res.cameras_path, timings, messages)
+
+
+def _with_given_control(ws: Workspace, opt: AutoControlOptions, crs: str, progress: Progress) -> AutoControlOptions:
+    """``opt`` with the ground control given beside the reference (``opt.control``) read, in the reference's CRS
+    ``crs``, by the georeference stage's reader and checks (``read_checked_control``: the same refusals and
+    warnings as Georeference without a reference): its points as ``check_points``, its camera positions
+    (a file) as ``camera_positions``."""
+    given = opt.control
+    if given is None:
+        return opt
+    if given.camera_positions_path and opt.camera_positions is not None:
+        raise AutoControlError("automatic control: camera positions given twice (a file and a list): give one")
+    if (given.gcp_path or given.gcps is not None) and opt.check_points is not None:
+        raise AutoControlError("automatic control: ground control given twice (as control and as check points): "
+                               "give one")
+    has_points = bool(given.gcp_path) or (given.gcps is not None and bool(given.gcps.points))
+    if not has_points and not given.camera_positions_path:
+        return opt
+    # the given set is the caller's (the dock's table): read into a copy, never moved into the reference's CRS
+    read = dataclasses.replace(given, gcps=copy.deepcopy(given.gcps), crs=crs, use_exif_gps=False,
+                               reference_dem=None)
+    gcps, cams, _ = read_checked_control(ws, read, progress, required=False)
+    for w in gcps.warnings if gcps is not None else []:
+        progress.warning(w)
+    return AutoControlOptions.of(opt, check_points=gcps if gcps is not None and gcps.points else opt.check_points,
+                                 camera_positions=cams if given.camera_positions_path else opt.camera_positions)
 
 
 __all__ = ["AutoControlResult", "autocontrol_workspace"]
