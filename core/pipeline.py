@@ -8,7 +8,6 @@
 """
 from __future__ import annotations
 
-import copy
 import dataclasses
 import glob
 import os
@@ -23,12 +22,13 @@ from .common.progress import NullProgress, Progress, SubProgress
 from .dense.options import DenseOptions
 from .dense.stage import build_dsm_workspace
 from .geometry.crs import validate_crs
+from .georef.control_checks import check_control_files
 from .georef.options import GeorefOptions
 from .georef.stage import GeorefStageResult, georeference_workspace
 from .georef.targets.options import FindTargetsOptions
 from .georef.targets.stage import find_targets
-from .io.gcp import GCPSet, apply_check_points, read_camera_positions, read_gcps, read_target_coordinates
-from .io.images import list_images, require_images
+from .io.gcp import GCPSet, read_target_coordinates
+from .io.images import folder_gps, list_images, require_images
 from .io.multispectral import band_files, read_block
 from .io.raster import RasterFile
 from .ortho.options import OrthoOptions
@@ -38,6 +38,7 @@ from .prepare.captures import CaptureStackOptions, is_band_folder, panel_files, 
 from .prepare.options import PrepareOptions
 from .prepare.stage import prepare_images_workspace
 from .project.stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, PREPARE, RELIEF, REPORT, TERRAIN, StageError
+from .project.workspace import MANIFEST, Workspace
 from .report.options import ReportOptions
 from .report.stage import build_report
 from .terrain.options import ReliefStageOptions, TerrainOptions
@@ -236,27 +237,29 @@ def _orthophotos(run, workspace_dir: str, options: OrthoOptions, res: "PipelineR
         res.warnings.append("no captured photo registered: no multi-band orthomosaic")
 
 
-def check_inputs(images_dir: str, control: Control) -> None:
+def check_inputs(images_dir: str, control: Control, workspace_dir: Optional[str] = None) -> None:
     """Read and check what the later stages take before the alignment starts (minutes of work that an unknown
     EPSG code or a bad GCP file would throw away): the image folder, the CRS, the GCP file (its CRS line, its
-    rows, the images it names, the check points) and the camera positions file.  Raises the readers' errors
-    (ImageError, CRSError, GCPError: each names the file or value and the problem)."""
-    require_images(images_dir, "IMAGES folder")  # missing, unreadable or empty: before a workspace is created
+    rows, the images it names, the check points) and the camera positions file, and what the georeference stage
+    checks of their meaning (``core.georef.control_checks.check_control_files``: a geographic CRS, control that
+    lands far from the photos' EXIF GPS, read from the image files: swapped axes, another zone).  ``workspace_dir``:
+    a re-run's workspace, whose CRS is the target where no CRS is given.  Raises the readers' errors (ImageError,
+    CRSError, GCPError) and StageError, each naming the file or value and the problem."""
+    names = require_images(images_dir, "IMAGES folder")  # missing, unreadable or empty: before a workspace is created
     if control.crs:
         validate_crs(control.crs)
-    if control.gcp_path:
-        gcps = read_gcps(control.gcp_path, image_names=list_images(images_dir), default_crs=control.crs)
-        if control.check_points:
-            apply_check_points(gcps, list(control.check_points))
-    elif control.gcps is not None and control.check_points:
-        apply_check_points(copy.deepcopy(control.gcps), list(control.check_points))
-    if control.camera_positions_path:
-        read_camera_positions(control.camera_positions_path)
     if control.targets_path:
         if control.gcp_path or control.gcps is not None:
             raise StageError("give either ground control points (GCPS) or the targets to find on the photos "
                              f"(TARGETS: {control.targets_path}), not both")
         read_target_coordinates(control.targets_path, control.crs)
+    workspace_crs = None
+    if workspace_dir and os.path.isfile(os.path.join(workspace_dir, MANIFEST)):
+        workspace_crs = Workspace.open(workspace_dir).crs
+    given = GeorefOptions(gcp_path=control.gcp_path, gcps=control.gcps, check_points=control.check_points,
+                          camera_positions_path=control.camera_positions_path, crs=control.crs)
+    # the readers' warnings (a photo's camera position twice) are said by the georeference stage, in its log
+    check_control_files(folder_gps(images_dir), given, names, workspace_crs)
 
 
 def _check_stacking(images_dir: str, workspace_dir: str, opt: PipelineOptions) -> Optional[CaptureStackOptions]:
@@ -292,7 +295,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
         raise StageError("the pipeline needs ground control (GCPS) and/or camera positions (CAMERA_POSITIONS or "
                          "USE_EXIF_GPS) to georeference the block before the DSM and orthophoto; to align only, "
                          "run 'Align images'")
-    check_inputs(images_dir, ctl)
+    check_inputs(images_dir, ctl, workspace_dir)
     stacking = _check_stacking(images_dir, workspace_dir, opt)
     align_options = opt.align  # the camera positions also choose the pairs where the photos have no EXIF GPS
     if ctl.camera_positions_path and not align_options.camera_positions:

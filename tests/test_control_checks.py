@@ -162,3 +162,142 @@ def test_automatic_control_reads_camera_positions_through_the_same_checks(tmp_pa
                      crs=syn.CRS)
     assert automatic(gcp_path=g)[0] == plain
     assert not (tmp_path / "ws" / "georef" / "autocontrol-failed.json").exists()  # refused before the matching
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# before the alignment: Run pipeline and Align images read the photos' EXIF GPS from the files (issue 47 items 2,
+# 12 and 17 "before any long work"); one photo: Orthorectify image
+# ---------------------------------------------------------------------------------------------------------------
+
+def _toledo(tmp_path, n=3):
+    """``n`` Toledo photos (EXIF GPS, UTM zone 17N) in a folder of their own, and their EXIF GPS {name: lon, lat,
+    alt}."""
+    import os
+
+    from core.io.images import read_image_info
+    from tests.conftest import SAMPLE, TOLEDO_STRIP, copy_images
+
+    folder = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:n], str(tmp_path / "photos"))
+    return folder, {n_: read_image_info(os.path.join(folder, n_)).gps for n_ in sorted(os.listdir(folder))}
+
+
+def _toledo_positions(tmp_path, gps, name, crs_line, swap=False, extra=()):
+    """The photos' EXIF GPS as an ``image,x,y,z`` file: in EPSG:4326 (``crs_line`` "EPSG:4326", ``swap``: the
+    latitude in x), else in UTM 17N under ``crs_line`` (None: no CRS line)."""
+    rows = ([crs_line] if crs_line else []) + ["image,x,y,z"]
+    for n, (lon, lat, alt) in gps.items():
+        if crs_line == "EPSG:4326":
+            a, b = (lat, lon) if swap else (lon, lat)
+        else:
+            a, b = transform_points(np.array([[lon, lat, 0.0]]), "EPSG:4326", "EPSG:32617")[0, :2]
+        rows.append(f"{n},{a:.8f},{b:.8f},{alt:.2f}")
+    path = tmp_path / name
+    path.write_text("\n".join(rows + list(extra)) + "\n")
+    return str(path)
+
+
+def test_run_pipeline_refuses_swapped_positions_before_the_alignment(tmp_path, monkeypatch):
+    """Run pipeline with camera positions whose latitude is in the x column: refused by the up-front check (the
+    photos' EXIF GPS read from the files), with the Georeference stage's message, before anything is aligned (was:
+    refused only after the alignment's minutes)."""
+    import time
+
+    from core import pipeline
+
+    images, gps = _toledo(tmp_path)
+    p = _toledo_positions(tmp_path, gps, "latlon.csv", "EPSG:4326", swap=True)
+
+    def aligned(*_a, **_k):
+        raise AssertionError("the alignment ran")
+
+    monkeypatch.setattr(pipeline, "align", aligned)
+    t0 = time.time()
+    with pytest.raises(StageError, match=r"camera positions in \S*latlon\.csv \(EPSG:4326\) land [\d,]+ km from "
+                                         r"the same photos' EXIF GPS.*latitude and longitude look swapped"):
+        pipeline.run_pipeline(images, str(tmp_path / "ws"), control=pipeline.Control(camera_positions_path=p))
+    assert time.time() - t0 < 10.0
+    assert not (tmp_path / "ws" / "sfm").exists()
+
+
+def test_run_pipeline_checks_the_zone_the_gcps_and_a_geographic_crs_before_the_alignment(tmp_path):
+    """check_inputs: positions of UTM 17N labelled 18N, GCPs labelled 18N, and CRS=EPSG:4326 are refused naming
+    EPSG:32617 (the photos' zone); the right files pass."""
+    from core.pipeline import Control, check_inputs
+
+    images, gps = _toledo(tmp_path)
+    good = _toledo_positions(tmp_path, gps, "utm.csv", "EPSG:32617")
+    check_inputs(images, Control(camera_positions_path=good))
+    zone = _toledo_positions(tmp_path, gps, "zone18.csv", "EPSG:32618")
+    with pytest.raises(StageError, match=r"camera positions in \S*zone18\.csv \(EPSG:32618\) land .*EPSG:32617"):
+        check_inputs(images, Control(camera_positions_path=zone))
+    with pytest.raises(StageError, match=r"CRS=EPSG:4326 \(the CRS parameter\) is geographic.*CRS=EPSG:32617"):
+        check_inputs(images, Control(camera_positions_path=good, crs="EPSG:4326"))
+    lon, lat, alt = next(iter(gps.values()))
+    x, y = transform_points(np.array([[lon, lat, 0.0]]), "EPSG:4326", "EPSG:32617")[0, :2]
+    names = list(gps)
+    (tmp_path / "gcps.csv").write_text("# crs: EPSG:32618\nname,x,y,z\n" + "".join(
+        f"G{k},{x + dx:.3f},{y + dy:.3f},{alt - 100:.2f}\n" for k, (dx, dy) in enumerate([(-30, -30), (30, -30),
+                                                                                         (30, 30), (-30, 30)])))
+    (tmp_path / "gcps_observations.csv").write_text("name,image,px,py\n" + "".join(
+        f"G{k},{n},{100 + 50 * k},{200 + 40 * k}\n" for k in range(4) for n in names))
+    with pytest.raises(StageError, match=r"control points of the GCP file \S*gcps\.csv \(EPSG:32618\) land .*"
+                                         r"EPSG:32617 coordinates"):
+        check_inputs(images, Control(gcp_path=str(tmp_path / "gcps.csv")))
+
+
+def test_align_images_refuses_swapped_positions_before_the_features_and_warns_duplicates(tmp_path, monkeypatch):
+    """Align images with camera positions (they choose the pairs): latitude in the x column is refused before the
+    features (was: aligned with the pairs of a South Pole block); a photo's row twice is warned in the log (was
+    read silently); a file without a CRS line is not placed (Align images has no CRS to read it in)."""
+    from core.align import stage as align_stage
+    from core.align.options import AlignError, AlignOptions
+
+    images, gps = _toledo(tmp_path)
+    first = next(iter(gps))
+
+    class Stop(Exception):
+        pass
+
+    def features(*_a, **_k):
+        raise Stop()
+
+    monkeypatch.setattr(align_stage, "extract_features", features)
+    p = _toledo_positions(tmp_path, gps, "latlon.csv", "EPSG:4326", swap=True)
+    with pytest.raises(AlignError, match=r"camera positions in \S*latlon\.csv \(EPSG:4326\) land .*latitude and "
+                                         r"longitude look swapped"):
+        align_stage.align(images, str(tmp_path / "ws"), AlignOptions(camera_positions=p))
+    assert not (tmp_path / "ws" / "sfm").exists()
+    lon, lat, alt = gps[first]
+    dup = _toledo_positions(tmp_path, gps, "dup.csv", "EPSG:4326", extra=[f"{first},{lon:.8f},{lat:.8f},{alt:.2f}"])
+    said = _Said()
+    with pytest.raises(Stop):
+        align_stage.align(images, str(tmp_path / "ws2"), AlignOptions(camera_positions=dup), said)
+    assert any(first in w and "line" in w for w in said.warnings), said.warnings
+    local = _toledo_positions(tmp_path, gps, "local.csv", None)  # UTM numbers, no CRS line: distances only
+    with pytest.raises(Stop):
+        align_stage.align(images, str(tmp_path / "ws3"), AlignOptions(camera_positions=local))
+
+
+def test_orthorectify_image_refuses_gcps_far_from_the_photos_gps(tmp_path):
+    """Orthorectify image with a GCP file of UTM 17N labelled 18N: refused naming the photo's EXIF GPS and the
+    zone, before the resection (was: the resection's own complaint about the points' spread, nothing about where
+    they are)."""
+    import os
+
+    from core.ortho.options import OrthoError, SingleImageOptions
+    from core.ortho.single import orthorectify_image
+
+    images, gps = _toledo(tmp_path, 1)
+    name, (lon, lat, alt) = next(iter(gps.items()))
+    x, y = transform_points(np.array([[lon, lat, 0.0]]), "EPSG:4326", "EPSG:32617")[0, :2]
+    (tmp_path / "gcps.csv").write_text("# crs: EPSG:32618\nname,x,y,z\n" + "".join(
+        f"G{k},{x + dx:.3f},{y + dy:.3f},{alt - 100:.2f}\n" for k, (dx, dy) in enumerate([(-30, -30), (30, -30),
+                                                                                         (30, 30), (-30, 30)])))
+    (tmp_path / "gcps_observations.csv").write_text("name,image,px,py\n" + "".join(
+        f"G{k},{name},{px},{py}\n" for k, (px, py) in enumerate([(200, 700), (1000, 700), (1000, 200), (200, 200)])))
+    out = tmp_path / "o.tif"
+    with pytest.raises(OrthoError, match=r"control points of the GCP file \S*gcps\.csv \(EPSG:32618\) land [\d,]+ km "
+                                         r"from the photo's EXIF GPS.*EPSG:32617 coordinates"):
+        orthorectify_image(SingleImageOptions(os.path.join(images, name), str(out), None, gcps=str(tmp_path / "gcps.csv"),
+                                              mode="planar", focal_px=700.0))
+    assert not out.exists()

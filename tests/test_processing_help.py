@@ -265,7 +265,7 @@ def test_run_pipeline_passes_gcps_upright_on_to_the_georeferencing(plugin, tmp_p
         got["options"] = options
         raise Stop()
 
-    monkeypatch.setattr(pipeline, "check_inputs", lambda images_dir, control: None)
+    monkeypatch.setattr(pipeline, "check_inputs", lambda *a: None)
     monkeypatch.setattr(pipeline, "align", lambda *a, progress=None, **k: None)
     monkeypatch.setattr(pipeline, "georeference_workspace", fake_georeference)
     for value in (True, False):

@@ -437,8 +437,10 @@ def test_run_pipeline_checks_a_csv_gcp_file_with_the_crs_parameter_as_its_defaul
     images = copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:2], str(tmp_path / "img"))
     names = sorted(os.listdir(images))
     obs = [f"{p},{n},{100 + 10 * k},{200 + 10 * k}" for k, p in enumerate("ABCD") for n in names]
-    lonlat = ["A,-81.0,36.14,100", "B,-80.999,36.14,101", "C,-81.0,36.141,102", "D,-80.999,36.141,103"]
+    # where the photos are (their EXIF GPS: the up-front check also compares the points with it)
+    lonlat = ["A,-83.699,41.549,100", "B,-83.698,41.549,101", "C,-83.699,41.550,102", "D,-83.698,41.550,103"]
+    utm = ["A,274900,4603200,100", "B,275000,4603200,101", "C,274900,4603300,102", "D,275000,4603300,103"]
     check_inputs(images, Control(gcp_path=_csv_gcps(tmp_path, "# crs: EPSG:4326", lonlat, obs), crs="EPSG:32617"))
-    check_inputs(images, Control(gcp_path=_csv_gcps(tmp_path, None, _UTM_ROWS, obs), crs="EPSG:32617"))
+    check_inputs(images, Control(gcp_path=_csv_gcps(tmp_path, None, utm, obs), crs="EPSG:32617"))
     with pytest.raises(gcp.GCPError, match="CRS parameter"):
-        check_inputs(images, Control(gcp_path=_csv_gcps(tmp_path, None, _UTM_ROWS, obs)))
+        check_inputs(images, Control(gcp_path=_csv_gcps(tmp_path, None, utm, obs)))

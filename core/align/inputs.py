@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Dict, List, Tuple
+from typing import Dict, List, Sequence, Tuple
 
 from ..common.progress import Progress, SubProgress
+from ..io.control_place import positions_off, usable_gps
+from ..io.gcp import read_camera_positions
 from ..io.images import CameraGroup, ImageError, ImageInfo, group_cameras, scan_images
 from ..project.layout import Layout
 from .calibrated import GivenCamera, held_cameras, plan_cameras, scan_interior, source_label
@@ -32,6 +34,22 @@ def read_images(images_dir: str, options: AlignOptions,
     except ImageError as e:
         raise AlignError(str(e)) from e
     return infos, skipped, groups
+
+
+def check_positions_file(infos: Sequence[ImageInfo], path: str, progress: Progress) -> None:
+    """A camera positions file given to the alignment (its positions choose the pairs), checked before any work:
+    its rows that name a photo twice warned in the log; a file that names its CRS compared with the photos' EXIF
+    GPS (``core.io.control_place``, the georeference stage's check: latitude and longitude swapped, another UTM
+    zone), AlignError naming the file and the likely cause.  A file without a CRS line is read in the CRS given at
+    Georeference: nothing to compare with yet."""
+    said: List[str] = []
+    crs = read_camera_positions(path, warnings=said)[0]
+    for w in said:
+        progress.warning(w)
+    if crs:
+        what = positions_off(usable_gps((im.name, im.gps) for im in infos), path, crs)
+        if what:
+            raise AlignError(what)
 
 
 @dataclass
@@ -72,6 +90,8 @@ def read_folder(pycolmap, lay: Layout, images_dir: str, options: AlignOptions, c
     groups, given = plan_cameras(pycolmap, groups, infos, calibrations, scan_interior(lay.scans_json, infos),
                                  options, progress)
     positions = photo_positions(infos, options.camera_positions)
+    if options.camera_positions:
+        check_positions_file(infos, options.camera_positions, progress)
     prints = fingerprint_photos(infos)
     check_same_photos(lay.ws, images_dir, prints)  # another block's photos on a finished workspace: before any change
     return Photos(images_dir, infos, skipped, groups, prints, time.time() - t0, given, positions)

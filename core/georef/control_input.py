@@ -45,6 +45,13 @@ def _file_positions(path: str, crs: str) -> List[gcpmod.CameraPosition]:
     return cams
 
 
+def target_crs(crs: Optional[str], gcps: Optional[gcpmod.GCPSet], workspace_crs: Optional[str],
+               positions_crs: Optional[str], photos_utm: Optional[str]) -> Optional[str]:
+    """The CRS the block is georeferenced in: the CRS parameter, else the GCPs', else the workspace's (a re-run),
+    else the camera positions file's, else the UTM zone of the photos' EXIF GPS; None when none is known."""
+    return crs or (gcps.crs if gcps is not None else None) or workspace_crs or positions_crs or photos_utm
+
+
 def _default_crs(ws: Workspace) -> Optional[str]:
     gps = [im["gps"] for im in ws.data.get("images", []) if im.get("gps")]
     if not gps:
@@ -111,7 +118,7 @@ def read_control(ws: Workspace, opt: GeorefOptions, progress: Progress, required
     gcps = _gcps(ws, opt, progress)
     positions_path = opt.camera_positions_path
     positions_crs = gcpmod.read_camera_positions(positions_path)[0] if positions_path else None
-    target = (crs or (gcps.crs if gcps is not None else None) or ws.crs or positions_crs or _default_crs(ws))
+    target = target_crs(crs, gcps, ws.crs, positions_crs, _default_crs(ws))
     if not target:
         if opt.reference_dem:
             raise StageError(f"no target CRS and nothing to place the block: {dem_alone_hint(ws, opt)}")
@@ -144,4 +151,4 @@ def read_control(ws: Workspace, opt: GeorefOptions, progress: Progress, required
     return gcps, cams, target
 
 
-__all__ = ["dem_alone_hint", "exif_positions", "photo_orientations", "read_control"]
+__all__ = ["dem_alone_hint", "exif_positions", "photo_orientations", "read_control", "target_crs"]

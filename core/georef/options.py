@@ -7,10 +7,11 @@ from dataclasses import dataclass
 from typing import Any, Dict, Optional, Sequence, Tuple
 
 from ..io.gcp import GCPSet
+from ..io.images import EXIF_GPS_SIGMA_XY
 
 INTRINSIC_GROUPS = ("focal", "principal_point", "extra")
 
-EXIF_SIGMA_XY = 3.0  # m: consumer GNSS in EXIF, the a priori sigmas of EXIF GPS camera positions
+EXIF_SIGMA_XY = EXIF_GPS_SIGMA_XY  # m: consumer GNSS in EXIF, the a priori sigmas of EXIF GPS camera positions
 EXIF_SIGMA_Z = 5.0
 FILE_POSITION_SIGMAS = (5.0, 10.0)  # m: a positions file's sigmas when the workspace did not save them
 PLACEHOLDER_SIGMA_Z = 1.0  # m: sigma Z of control points whose heights are all the same placeholder

@@ -24,6 +24,10 @@ GROUP_AUTO = "auto"
 GROUP_SINGLE = "single"
 GROUP_PER_IMAGE = "per_image"
 
+# m: the horizontal error of consumer GNSS in EXIF GPS: the a priori sigma of EXIF GPS camera positions
+# (core.georef.options.EXIF_SIGMA_XY) and the GPS error allowed when control is compared with it (core.io.control_place)
+EXIF_GPS_SIGMA_XY = 3.0
+
 FULL_FRAME_DIAGONAL_MM = math.hypot(36.0, 24.0)
 DEFAULT_FOCAL_FACTOR = 1.2  # focal = 1.2 x long side when nothing is known (COLMAP's guess)
 
@@ -152,15 +156,43 @@ def read_image_info(path: str, name: Optional[str] = None, manual_focal_mm: Opti
     info.focal_35mm = f35[0] if f35 and f35[0] > 0 else None
     info.orientation = _orientation_value(md.get("EXIF_Orientation"))
     info.focal_px, info.focal_source = _focal_prior(info, md, manual_focal_mm, manual_sensor_width_mm, manual_focal_px)
+    info.gps = _exif_gps(md)
+    return info
+
+
+def _exif_gps(md: Dict[str, str]) -> Optional[Tuple[float, float, float]]:
+    """(lon, lat, alt) of a photo's EXIF GPS tags (its metadata, :func:`photo_metadata`); None without (0, 0: none)."""
     lat = _dms(md.get("EXIF_GPSLatitude", ""), md.get("EXIF_GPSLatitudeRef", "N"))
     lon = _dms(md.get("EXIF_GPSLongitude", ""), md.get("EXIF_GPSLongitudeRef", "E"))
-    if lat is not None and lon is not None and (abs(lat) > 1e-9 or abs(lon) > 1e-9):
-        alt_v = _rational(md.get("EXIF_GPSAltitude", ""))
-        alt = alt_v[0] if alt_v else 0.0
-        if md.get("EXIF_GPSAltitudeRef", "0x00").strip() in ("0x01", "1"):
-            alt = -alt
-        info.gps = (lon, lat, alt)
-    return info
+    if lat is None or lon is None or (abs(lat) <= 1e-9 and abs(lon) <= 1e-9):
+        return None
+    alt_v = _rational(md.get("EXIF_GPSAltitude", ""))
+    alt = alt_v[0] if alt_v else 0.0
+    if md.get("EXIF_GPSAltitudeRef", "0x00").strip() in ("0x01", "1"):
+        alt = -alt
+    return lon, lat, alt
+
+
+def folder_gps(folder: str) -> Dict[str, Tuple[float, float, float]]:
+    """{name: (lon, lat, alt)} of the photos of ``folder`` (:func:`list_images`) that carry EXIF GPS, read from
+    their headers only (no pixel decoded: a second for hundreds of photos), for the checks made before the
+    alignment reads them; a photo GDAL cannot open is left out here (the alignment names it)."""
+    out: Dict[str, Tuple[float, float, float]] = {}
+    for name in list_images(folder):
+        try:
+            gps = photo_gps(os.path.join(folder, name))
+        except ImageError:
+            continue  # named by the alignment, which skips it
+        if gps is not None:
+            out[name] = gps
+    return out
+
+
+def photo_gps(path: str) -> Optional[Tuple[float, float, float]]:
+    """(lon, lat, alt) of a photo's EXIF GPS read from its header (no pixel decoded); None without.  ImageError
+    naming the file when GDAL cannot open it."""
+    with open_image(path) as r:
+        return _exif_gps(photo_metadata(r))
 
 
 # --------------------------------------------------------------------------------------------------

@@ -16,7 +16,8 @@ from ..geometry.camera import Intrinsics, Pose, opk_from_rotation, project_point
 from ..geometry.crs import transform_points
 from ..io import gcp as gcpmod
 from ..io import raster as dsmmod
-from ..io.images import ImageError, check_image, read_image_info
+from ..io.control_place import points_off
+from ..io.images import ImageError, check_image, photo_gps, read_image_info
 from ..io.vector import write_points_gpkg
 from .block import prepare_block, write_camera_ortho
 from .cameras import OrthoCamera
@@ -121,6 +122,7 @@ def orthorectify_image(options: SingleImageOptions, progress: Optional[Progress]
             raise OrthoError(str(e)) from e
     work_crs = _working_crs(single.crs, single.dsm_path, gcps, orient, run)
     ctl = _ground_control(gcps, orient, work_crs, run)
+    _check_place(options.gcps, gcps, ctl, work_crs, single.crs, image_path)
     offset, c_world = _local_frame(orient, ctl, work_crs)
     cam0, estimate = _interior(single, orient, ctl, run, image_path)
     ext = _exterior(orient, ctl, cam0, estimate, c_world, offset, run)
@@ -270,6 +272,24 @@ def _ground_control(gcps, orient: Optional[dict], work_crs: Optional[str], run: 
     if outside:
         run.warn(f"GCP observation(s) outside the {meta.width} x {meta.height} image {name}: {', '.join(outside)}")
     return ImageControl(pairs, xyz, px_all, control)
+
+
+def _check_place(given, gcps, ctl: ImageControl, work_crs: Optional[str], crs_param: Optional[str],
+                 image_path: str) -> None:
+    """OrthoError when the ground control points ``given`` (a file or a set; not the automatic control's) land far
+    from the photo's own EXIF GPS (``core.io.control_place``, the georeference stage's check: another UTM zone,
+    swapped axes), naming the likely cause; nothing to compare without GPS or a working CRS."""
+    if given is None or not work_crs or not ctl.pairs:
+        return
+    gps = photo_gps(image_path)  # the photo was opened when the run began (check_image)
+    if gps is None:
+        return
+    pts = [p for p, _ in ctl.pairs if p.role == gcpmod.CONTROL] or [p for p, _ in ctl.pairs]
+    name = f"the GCP file {given}" if isinstance(given, str) else "the ground control points given"
+    what = points_off([(os.path.basename(image_path), gps[0], gps[1])], pts, gcps.crs or work_crs, work_crs, name,
+                      labelled=not crs_param or gcps.crs != crs_param)
+    if what:
+        raise OrthoError(what)
 
 
 def _local_frame(orient: Optional[dict], ctl: ImageControl, work_crs: Optional[str]
