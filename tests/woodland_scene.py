@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 import multiprocessing
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from typing import Dict, List, Optional, Tuple
 
@@ -618,10 +618,20 @@ def write_jpeg(path: str, rgb: np.ndarray, exif: Dict[str, str], quality: int = 
 
 
 def woodland_block(seed: int = 37, camera: syn.CameraModel = CAMERA, flight: Optional[Flight] = None,
-                   n_trees: int = 20) -> WoodlandBlock:
+                   n_trees: int = 20, image_scale: float = 1.0) -> WoodlandBlock:
     """Serpentine strips along local x over a park of ``n_trees`` bare trees; image x along the track (the rows
-    read out across it), each photo turned by N(0, attitude_sigma) and turning at N(0, rate_sigma) per axis."""
+    read out across it), each photo turned by N(0, attitude_sigma) and turning at N(0, rate_sigma) per axis.
+
+    ``image_scale``: the photos' size in pixels, times ``camera``'s (the same lens: field of view and distortion;
+    the same flight; the frame still read out in the same time, ``flight.line_time`` being per row of ``camera``),
+    with the ground's texture painted at ``Woodland.texture_res`` / ``image_scale`` (as fine for the pixel)."""
     flight = flight or Flight()
+    if image_scale != 1.0:
+        f = float(image_scale)
+        small = camera.with_params(width=int(round(camera.width * f)), height=int(round(camera.height * f)),
+                                   fx=camera.fx * f, fy=camera.fy * f, cx=camera.cx * f, cy=camera.cy * f)
+        flight = replace(flight, line_time=flight.line_time * camera.height / small.height)
+        camera = small
     rng = np.random.default_rng(seed)
     xu, _ = _sub_pixels(camera, 1)
     half_x = float(np.abs(xu[..., 0]).max()) * flight.altitude  # the footprint's half sizes on flat ground
@@ -634,6 +644,7 @@ def woodland_block(seed: int = 37, camera: syn.CameraModel = CAMERA, flight: Opt
     margin = 1.25 * max(half_x, half_y) + 4.0
     bounds = (-length / 2 - margin, -width / 2 - margin, length / 2 + margin, width / 2 + margin)
     scene = make_woodland(seed, bounds, n_trees)
+    scene.texture_res /= float(image_scale)
     shots: List[Shot] = []
     gps: Dict[str, np.ndarray] = {}
     z_fly = scene.base_z + flight.altitude
