@@ -168,3 +168,19 @@ def test_a_band_without_what_the_radiometry_needs_is_named_before_work(tmp_path)
     with pytest.raises(BandRadiometryError, match=r"IMG_3_NIR\.TIF: no exposure time.*raw DN"):
         check_bands([good, no_exposure], "normalised")
     assert check_bands([no_exposure], "raw") == {}
+
+
+def test_a_panel_reflectance_row_that_is_not_a_number_is_named_with_its_line(tmp_path):
+    """Issue 47 item 16: a panel sheet's row 'Red,abc' was skipped as if it were a header (then the band had no
+    reflectance, or the sheet's other rows were used silently); it is named: file, line, value."""
+    from core.prepare.band_radiometry import parse_panel_reflectance
+
+    sheet = tmp_path / "panel.csv"
+    sheet.write_text("# RP04\nband,reflectance\nGreen,0.49\nRed,abc\nRed edge,0.50\nNIR,0.49\n")
+    with pytest.raises(BandRadiometryError, match=r"panel\.csv:4: .*Red, 'abc', is not a number"):
+        parse_panel_reflectance(str(sheet))
+    sheet.write_text("Green,0.49\nRed\nNIR,0.49\n")  # a row without its value
+    with pytest.raises(BandRadiometryError, match=r"panel\.csv:2: 'Red'.* no reflectance"):
+        parse_panel_reflectance(str(sheet))
+    sheet.write_text("band,reflectance\nGreen,0.49\nRed,0.5\n")  # the header row is still skipped
+    assert parse_panel_reflectance(str(sheet)).for_band("Red", None) == 0.5

@@ -8,9 +8,11 @@ covered or cut by the border.
 """
 import math
 import os
+import re
 import shutil
 import types
 
+import cv2
 import numpy as np
 import pytest
 
@@ -86,10 +88,14 @@ def test_the_observations_file_is_what_georeference_reads(block):
 
 
 def test_a_target_size_unlike_the_marks_leaves_them_out(block, tmp_path):
+    """Every mark left out for its size: named with the sizes measured, in metres (issue 47 item 15; was exit 0
+    with nothing found and the reason only in the review layer's notes)."""
+    from core.georef.errors import GeorefError
+
     scene, ws, csv, _ = block
-    r = find_targets(ws, FindTargetsOptions(targets=csv, target_size=5.0, output=str(tmp_path / "gcps.txt"),
+    with pytest.raises(GeorefError, match=r"no target found.*measure 0\.[3-5]\d* m on the ground .*TARGET_SIZE 5 m"):
+        find_targets(ws, FindTargetsOptions(targets=csv, target_size=5.0, output=str(tmp_path / "gcps.txt"),
                                             layer=str(tmp_path / "found.gpkg"), num_threads=2))
-    assert r.n_observations == 0 and all("size unlike the target's 5" in t.note for t in r.targets)
 
 
 @pytest.fixture(scope="module")
@@ -251,3 +257,126 @@ def test_find_targets_options_refuse_a_bad_value_when_made(kwargs, what):
         FindTargetsOptions(**kwargs)
     assert FindTargetsOptions(kind="Cross").kind == "cross"
     assert FindTargetsOptions(kind="dict_4x4_50").kind == "DICT_4X4_50"
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# issue 47: targets whose meaning is wrong (items 5, 7, 15)
+# ---------------------------------------------------------------------------------------------------------------
+
+def test_the_bar_of_a_cross_is_no_checker(block):
+    """Item 5: a point on a cross's bar passes the checker's ring test (its two edges cut every ring into four
+    alternating arcs); it does not fit the checker's template (lines through its centre) and is left out, while
+    the checkers are all found."""
+    from core.georef.targets.detect import find_checkers, local_contrast
+
+    scene = block[0]
+    crosses = [t.name for t in scene.targets if t.kind == "cross"]
+    checkers = [t.name for t in scene.targets if t.kind == "checkerboard"]
+    on_cross, found, asked = [], 0, 0
+    for name, path in scene.photos.items():
+        gray = cv2.imread(path, cv2.IMREAD_GRAYSCALE).astype(np.float32)
+        _, noise = local_contrast(gray)
+        cands = find_checkers(name, gray, noise, 8, 0.2 * min(gray.shape))
+        for t in crosses:
+            tx, ty = scene.truth[name][t]
+            on_cross += [(name, t, round(math.hypot(c.x - tx, c.y - ty), 1)) for c in cands
+                         if math.hypot(c.x - tx, c.y - ty) < 20.0]
+        for t in checkers:
+            if t in scene.visible[name]:
+                asked += 1
+                tx, ty = scene.truth[name][t]
+                found += any(math.hypot(c.x - tx, c.y - ty) < 1.0 for c in cands)
+    assert not on_cross, on_cross
+    assert asked >= 8 and found == asked
+
+
+def _targets_file(tmp_path, scene, rows=None, shift=(0.0, 0.0), name="t.csv", crs="EPSG:32611"):
+    rows = rows if rows is not None else scene.targets
+    lines = [f"# crs: {crs}", "name,x,y,z"]
+    for t in rows:
+        w = np.array([t.x, t.y, t.z]) + targets_scene.OFFSET + [*shift, 0.0]
+        lines.append(f"{t.name},{w[0]:.4f},{w[1]:.4f},{w[2]:.4f}")
+    p = tmp_path / name
+    p.write_text("\n".join(lines) + "\n")
+    return str(p)
+
+
+def _options(tmp_path, targets, **kw):
+    return FindTargetsOptions(targets=targets, output=str(tmp_path / "gcps.txt"), layer=str(tmp_path / "found.gpkg"),
+                              num_threads=2, **kw)
+
+
+def test_two_targets_are_named_as_too_few_before_any_work(block, tmp_path):
+    """Item 7: two targets ended in an IndexError in the constellation's triangles."""
+    from core.georef.errors import GeorefError
+
+    scene, ws, _, _ = block
+    two = _targets_file(tmp_path, scene, rows=[t for t in scene.targets if t.kind == "cross"])
+    with pytest.raises(GeorefError, match=r"t\.csv holds 2 target\(s\) \(cross_a, cross_b\).* three or more"):
+        find_targets(ws, _options(tmp_path, two))
+    # the constellation itself: fewer than three targets is said, not an IndexError
+    marks = constellation.Marks(np.random.default_rng(1).normal(size=(5, 3)))
+    m = constellation.match_constellation(marks, np.array([[0.0, 0.0, 0.0], [10.0, 0.0, 0.0]]), ["a", "b"])
+    assert m.names == {} and "2 target(s)" in m.reports[0] and "three" in m.reports[0]
+
+
+def test_a_header_only_file_and_targets_far_away_are_named_before_any_work(block, tmp_path):
+    """Item 15: a file with a header and no row (was: exit 0, nothing found, nothing said); targets 3,000 km off
+    (no GPS here: outside the CRS's area of use); degrees under a UTM CRS (without the GCP reader's notes about
+    observations files, which a targets file has none of)."""
+    from core.common.errors import ArchaeoOrthoError
+
+    scene, ws, _, _ = block
+    empty = tmp_path / "empty.csv"
+    empty.write_text("# crs: EPSG:32611\nname,x,y,z\n")
+    with pytest.raises(ArchaeoOrthoError, match=r"empty\.csv.* no target"):
+        find_targets(ws, _options(tmp_path, str(empty)))
+    far = _targets_file(tmp_path, scene, shift=(3.0e6, 0.0), name="far.csv")
+    with pytest.raises(ArchaeoOrthoError, match=r"far\.csv.*outside the area where EPSG:32611 is used"):
+        find_targets(ws, _options(tmp_path, far))
+    deg = tmp_path / "deg.csv"
+    deg.write_text("# crs: EPSG:32611\nname,x,y,z\n" + "".join(f"t{k},-117.{k}1,36.{k}2,0\n" for k in range(4)))
+    with pytest.raises(ArchaeoOrthoError, match=r"deg\.csv.*look like degrees") as e:
+        find_targets(ws, _options(tmp_path, str(deg)))
+    assert "observation" not in str(e.value)
+
+
+def test_targets_in_degrees_are_matched_in_metres_and_written_as_given(block, tmp_path):
+    """Item 15: targets in EPSG:4326 were matched in degrees (a degree of longitude is not one of latitude): found
+    in metres (the UTM zone of the targets), written with the coordinates given, the fit in metres."""
+    from core.geometry.crs import transform_points
+
+    scene, ws, _, ref = block
+    utm = np.array([[t.x, t.y] for t in scene.targets]) + targets_scene.OFFSET[:2]
+    ll = transform_points(utm, "EPSG:32611", "EPSG:4326")
+    p = tmp_path / "lonlat.csv"
+    p.write_text("name,x,y,z\n" + "".join(f"{t.name},{a:.9f},{b:.9f},{t.z + targets_scene.OFFSET[2]:.4f}\n"
+                                           for t, (a, b) in zip(scene.targets, ll)))
+    r = find_targets(ws, _options(tmp_path, str(p), crs="EPSG:4326"))
+    assert r.crs == "EPSG:4326" and r.fit_tolerance > 0.5  # metres: a third of the targets' spacing
+    assert {(o.image, o.name) for o in r.observations} == {(o.image, o.name) for o in ref.observations}
+    gs = gcpmod.read_gcps(r.gcps_path)
+    assert gs.crs == "EPSG:4326" and abs(gs.by_name("chk_a").x - ll[0, 0]) < 1e-8
+
+
+def test_a_kind_the_photos_do_not_show_is_named_with_what_they_show(block, tmp_path):
+    """Item 15: a target kind that is not the targets' (was: exit 0, 0 found, nothing said)."""
+    from core.georef.errors import GeorefError
+
+    scene, ws, csv, _ = block
+    with pytest.raises(GeorefError, match=r"TARGET_KIND=DICT_6X6_250.*(checkerboard|cross|circle)") as e:
+        find_targets(ws, _options(tmp_path, csv, kind="DICT_6X6_250"))
+    assert "no target found" in str(e.value)
+
+
+def test_constellation_warnings_carry_the_unit():
+    """Item 15: "target X is 4.52 from its mark" said no unit."""
+    g = np.array([[x, y, 0.0] for x in (0.0, 10.0, 20.0) for y in (0.0, 10.0, 20.0)] + [[26.0, 3.0, 0.0]])
+    rot = np.array([[0.6, -0.8, 0.0], [0.8, 0.6, 0.0], [0.0, 0.0, 1.0]])
+    model = 0.1 * g @ rot.T + [3.0, -2.0, 1.0]
+    world = g.copy()
+    world[4, :2] += [4.0, 0.0]  # one target surveyed 4 m off its mark
+    m = constellation.match_constellation(constellation.Marks(model, weights=[2.0] * 10), world,
+                                          [f"t{k}" for k in range(10)], unit="m")
+    assert any(re.search(r"target t4 is [\d.]+ m from its mark .*more than [\d.]+ m", s) for s in m.reports), \
+        m.reports

@@ -128,6 +128,28 @@ def test_sequoia_capture_holds_the_rgb_frame_and_rgb_is_primary():
     assert len(group_captures([*cap.bands], tolerance_s=0.05)) == 2
 
 
+def test_photos_of_another_camera_among_the_bands_are_named_not_taken_for_a_missing_rgb_frame():
+    """Issue 47 item 16: a folder mixing the Sequoia's band files and a drone's JPEGs (no rig name, no capture id,
+    taken at none of the rig's captures' times).  They are named (how many, which) as not the rig's band files and
+    left out; the Sequoia capture is not said to lack an "RGB" band (the JPEGs' "band")."""
+    folder = shared("sequoia_sample")
+    bands = [os.path.join(folder, f"IMG_161122_163234_0000_{b}.TIF") for b in ("GRE", "RED", "REG", "NIR")]
+    toledo = shared("toledo", "images")
+    jpegs = [os.path.join(toledo, n) for n in sorted(os.listdir(toledo))[:3]]
+    block = read_block(bands + jpegs)
+    assert [c.capture_id for c in block.captures] == [SEQUOIA_ID]
+    assert block.band_names == ("Green", "Red", "Red edge", "NIR")
+    assert not any("lacks" in w for w in block.warnings), block.warnings
+    named = [w for w in block.warnings if "3 file(s)" in w and "not band files of the rig Sequoia" in w]
+    assert len(named) == 1 and all(os.path.basename(j) in named[0] for j in jpegs), block.warnings
+    assert "DJI" in named[0] and "left out" in named[0]
+    # the rig's own RGB frame (rig name Sequoia, 68 ms after its bands) stays in its capture, unnamed
+    block = read_block(bands + [os.path.join(folder, "IMG_161122_163234_0000_RGB.JPG")] + jpegs)
+    assert block.captures[0].band_names == ("Green", "Red", "Red edge", "NIR", "RGB")
+    assert len([w for w in block.warnings if "3 file(s) are not band files" in w]) == 1, block.warnings
+    assert not any("lacks" in w for w in block.warnings), block.warnings
+
+
 # ---------------------------------------------------------------- MicaSense and DJI style (documented tags)
 def test_micasense_style_tags(tmp_path):
     packet = xmp({"MicaSense:CaptureId": "mYcApTuReId0001", "Camera:BandName": "NIR", "Camera:RigCameraIndex": "3",

@@ -680,12 +680,41 @@ def band_files(folder: str) -> List[str]:
     return files
 
 
+def _camera(b: BandInfo) -> str:
+    return " ".join(v for v in (b.make, b.model) if v) or "unknown camera"
+
+
+def not_of_the_rig(captures: Sequence[Capture]) -> Tuple[List[Capture], List[str]]:
+    """(the captures of the rig, warnings): a capture made only of colour frames that name no rig of the block's
+    band files (a drone's or a phone's photos left among a rig's bands: no rig name, no capture id, taken at none
+    of the rig's captures' times) is not the rig's; its files are named, with how many and which camera, and left
+    out, rather than taken for the rig's RGB frames (and every rig capture said to lack that "band")."""
+    rigs = {c.rig_name for c in captures if any(not b.is_rgb for b in c.bands)}
+    if not rigs:
+        return list(captures), []
+    kept, other = [], []
+    for c in captures:
+        foreign = all(b.is_rgb and b.rig_name not in rigs for b in c.bands)
+        (other if foreign else kept).append(c)
+    if not other:
+        return kept, []
+    files = [b for c in other for b in c.bands]
+    cameras = ", ".join(sorted({_camera(b) for b in files}))
+    rig = ", ".join(sorted(r or "without a rig name" for r in rigs))
+    bands = ", ".join(block_band_names(kept))
+    return kept, [f"{len(files)} file(s) are not band files of the rig {rig} (its bands: {bands}): {_names(files, 12)} "
+                  f"({cameras}: colour photos that belong to none of the rig's captures): left out"]
+
+
 def read_block(paths: Sequence[str], tolerance_s: float = DEFAULT_TIME_TOLERANCE_S) -> Block:
     """The band files read (:func:`read_band_info`), grouped into captures and checked (:func:`check_captures`:
-    MultispectralError before any work, else the block with its warnings)."""
+    MultispectralError before any work, else the block with its warnings); colour photos of another camera among
+    the files are named and left out (:func:`not_of_the_rig`)."""
     infos = [read_band_info(p) for p in paths]
-    captures = group_captures(infos, tolerance_s)
-    warnings = check_captures(infos, captures, tolerance_s)
+    grouped = group_captures(infos, tolerance_s)
+    captures, foreign = not_of_the_rig(grouped)
+    gone = {id(b) for c in grouped for b in c.bands} - {id(b) for c in captures for b in c.bands}
+    warnings = foreign + check_captures([b for b in infos if id(b) not in gone], captures, tolerance_s)
     return Block(tuple(captures), block_band_names(captures), tuple(warnings))
 
 

@@ -285,6 +285,10 @@ def _reflectance_value(text: str, where: str) -> float:
     return value
 
 
+# a sheet's header row: words such as band, name, wavelength, nm, reflectance, value
+_HEADER = re.compile(r"band|name|wave|\bnm\b|reflect|value|albedo|channel|%", re.I)
+
+
 def _reflectance_rows(text: str) -> Tuple[List[Tuple[str, str]], str]:
     """(key, value) rows of the panel's reflectance: a CSV file's rows (comma, semicolon or tab; a header row
     and # comments skipped) or a text's items "name=value" / "name: value" separated by commas or semicolons."""
@@ -292,13 +296,22 @@ def _reflectance_rows(text: str) -> Tuple[List[Tuple[str, str]], str]:
     if os.path.isfile(text):
         try:
             with open(text, newline="", encoding="utf-8-sig") as f:
-                lines = [ln for ln in f.read().splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+                lines = [(n, ln) for n, ln in enumerate(f.read().splitlines(), start=1)
+                         if ln.strip() and not ln.lstrip().startswith("#")]
         except (OSError, UnicodeDecodeError) as e:
             raise BandRadiometryError(f"panel reflectance file {text}: cannot be read ({e})") from e
-        for line in lines:
+        for k, (lineno, line) in enumerate(lines):
             cells = [c.strip().strip('"') for c in re.split(r"[,;\t]", line) if c.strip()]
             if len(cells) >= 2 and re.fullmatch(r"[-+0-9.eE]+", cells[1]):
                 rows.append((cells[0], cells[1]))
+            elif k == 0 and _HEADER.search(line):
+                continue  # the sheet's header row
+            elif len(cells) >= 2:
+                raise BandRadiometryError(f"panel reflectance file {text}:{lineno}: the reflectance of {cells[0]}, "
+                                          f"{cells[1]!r}, is not a number (row {line.strip()!r})")
+            else:
+                raise BandRadiometryError(f"panel reflectance file {text}:{lineno}: {line.strip()!r} gives a band "
+                                          "and no reflectance (rows: band name or wavelength in nm, reflectance)")
         if not rows:
             raise BandRadiometryError(f"panel reflectance file {text}: no row of a band (name or wavelength in nm) "
                                       "and its reflectance (e.g. 'NIR,0.49' or '842,0.49')")

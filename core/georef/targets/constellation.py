@@ -100,27 +100,36 @@ class Marks:
     weights: Optional[Sequence[float]] = None
 
 
+TOL_FRACTION = 0.3  # the match's tolerance: this fraction of the median distance between neighbouring targets
+MIN_MARKS = 4  # marks that must agree (three always fit some triangle)
+
+
 def match_constellation(marks: Marks, world: np.ndarray, names: Sequence[str], xy_only: bool = False,
-                        tol_fraction: float = 0.3, min_marks: int = 4, prior: Optional[Similarity] = None,
-                        prior_tol: float = 0.0) -> Constellation:
+                        prior: Optional[Similarity] = None, prior_tol: float = 0.0, unit: str = "") -> Constellation:
     """Name the marks ``marks.xyz`` (M, 3) after the targets ``world`` (K, 3) called ``names``; a mark with a
-    code names no other target.  Needs at least ``min_marks`` marks to agree (three always fit some triangle);
+    code names no other target.  Needs at least ``MIN_MARKS`` marks to agree (three always fit some triangle);
     fewer, or two hypotheses equally good with different names, name nothing.  Triangles are drawn from the
     best-evidenced marks (``marks.weights``: twice as many as targets, and four more) and a hypothesis scores
     the evidence it brings onto targets.  ``prior``: a rough model -> world similarity (EXIF GPS): a hypothesis
     that puts one of its triangle's marks further than ``prior_tol`` plus the tolerance (horizontally) from where
-    the prior puts it is not tried, nor the mirror."""
+    the prior puts it is not tried, nor the mirror.  ``unit``: the targets' unit (m, ft), said with every
+    distance reported.  Fewer than three targets form no triangle: reported, nothing named."""
     model = np.asarray(marks.xyz, dtype=float).reshape(-1, 3)
     world = np.asarray(world, dtype=float).reshape(-1, 3)
     codes = list(marks.codes) if marks.codes is not None else [None] * len(model)
     weights = marks.weights
     out = Constellation()
-    if len(world) < 2 or len(model) < 3:
+    u = f" {unit}" if unit else ""
+    if len(world) < 3:
+        out.reports.append(f"{len(world)} target(s): the marks are matched to the shape of three targets or more; "
+                           "nothing named by position")
+        return out
+    if len(model) < 3:
         out.reports.append(f"{len(model)} mark(s) triangulated and {len(world)} target(s): too few to match")
         return out
     xy = world[:, :2]
     nn = np.sort(np.linalg.norm(xy[:, None] - xy[None], axis=2), axis=1)[:, 1]
-    tol = tol_fraction * float(np.median(nn))
+    tol = TOL_FRACTION * float(np.median(nn))
     out.tolerance = tol
     centre = world.mean(0)
     wts = np.ones(len(model)) if weights is None else np.asarray(weights, dtype=float)
@@ -130,7 +139,7 @@ def match_constellation(marks: Marks, world: np.ndarray, names: Sequence[str], x
     for mirrored in (False, True):
         if mirrored and guess is not None:
             break  # the GPS fixes the handedness
-        if mirrored and best is not None and len(best[2]) >= min(min_marks, len(world)):
+        if mirrored and best is not None and len(best[2]) >= min(MIN_MARKS, len(world)):
             break  # the mirror only when the survey as given does not fit: a planar constellation fits both
         w = (world - centre) @ MIRROR.T if mirrored else world - centre
         for mt, wt in _hypotheses(model[top], w, 0.03, 4000, wts[top]):
@@ -151,18 +160,18 @@ def match_constellation(marks: Marks, world: np.ndarray, names: Sequence[str], x
                 best = (score, mirrored, key, sim)
             elif key != best[2] and (second is None or score > second[0]):
                 second = (score, mirrored, key, sim)
-    if best is None or len(best[2]) < min(min_marks, len(world)):
-        out.reports.append(f"no similarity brings {min(min_marks, len(world))} or more of the {len(model)} "
-                           f"triangulated marks onto distinct targets within {tol:.3g}: no name given")
+    if best is None or len(best[2]) < min(MIN_MARKS, len(world)):
+        out.reports.append(f"no similarity brings {min(MIN_MARKS, len(world))} or more of the {len(model)} "
+                           f"triangulated marks onto distinct targets within {tol:.3g}{u}: no name given")
         return out
     margin = 0.5 * float(np.median([wts[i] for i, _ in best[2]]))  # half a typical mark's evidence
     if second is not None and _conflict(best[2], second[2]) and second[0][0] > best[0][0] - margin:
         out.reports.append(f"two ways of naming the marks fit almost equally well ({best[0][0]:.0f} and "
-                           f"{second[0][0]:.0f} tied observations on targets within {tol:.3g}): no name given, "
+                           f"{second[0][0]:.0f} tied observations on targets within {tol:.3g}{u}): no name given, "
                            "rather than a wrong one (a regular constellation, or coordinates that disagree with the "
                            "block by about the targets' spacing); give coded targets or check the coordinates")
         return out
-    return _refit(out, Marks(model, codes, wts), world - centre, names, best, xy_only, tol)
+    return _refit(out, Marks(model, codes, wts), world - centre, names, best, xy_only, tol, u)
 
 
 def _mutual(model_w: np.ndarray, world: np.ndarray, taken: Dict[int, Tuple[int, float]], xy_only: bool,
@@ -194,7 +203,8 @@ def _conflict(a: frozenset, b: frozenset) -> bool:
     return any(mb.get(i, j) != j for i, j in a)
 
 
-def _refit(out: Constellation, marks: Marks, world_c: np.ndarray, names, best, xy_only, tol) -> Constellation:
+def _refit(out: Constellation, marks: Marks, world_c: np.ndarray, names, best, xy_only, tol,
+           u: str = "") -> Constellation:
     """The best hypothesis's similarity fitted to all its pairs (``world_c``: the targets about their centre), the
     marks named after the targets it brings them onto."""
     model, codes, evidence = marks.xyz, marks.codes, np.asarray(marks.weights, dtype=float)
@@ -213,12 +223,12 @@ def _refit(out: Constellation, marks: Marks, world_c: np.ndarray, names, best, x
                            "coordinates' axis order and CRS")
     for i, (j, d) in sorted(a.items()):
         if codes[i] is not None and codes[i] != names[j]:
-            out.reports.append(f"a mark coded or clicked as {codes[i]} sits at target {names[j]} ({d:.3g} from "
+            out.reports.append(f"a mark coded or clicked as {codes[i]} sits at target {names[j]} ({d:.3g}{u} from "
                                "it): not assigned")
             continue
         out.names[i] = names[j]
         out.residuals[i] = d
         if d > tol:
-            out.reports.append(f"target {names[j]} is {d:.3g} from its mark after the fit (more than {tol:.3g}): "
-                               "named as the only mark near it; check its coordinates")
+            out.reports.append(f"target {names[j]} is {d:.3g}{u} from its mark after the fit (more than "
+                               f"{tol:.3g}{u}): named as the only mark near it; check its coordinates")
     return out

@@ -15,7 +15,10 @@ Kinds:
     pixels, so it holds under perspective (lines stay lines).
 ``checkerboard``
     a 2 x 2 checker (an X-junction): found as a saddle of the smoothed photo (negative Hessian determinant), checked
-    by the four alternating sectors on rings around it (point-symmetric), refined by ``cv2.cornerSubPix``.
+    by the four alternating sectors on rings around it (point-symmetric), refined by ``cv2.cornerSubPix``, and
+    kept only if it fits the checker's template: its sector boundaries, followed from ring to ring, are lines
+    through its centre (``checker_misfit``: within ``CHECKER_MISFIT`` of its radius; the bar of a cross also cuts
+    every ring into four alternating arcs, but its edges pass half the bar's width from the centre).
 ``circle``
     a disc of one tone on the other: the edge found to sub-pixel along rays, an ellipse fitted to it; its
     residual keeps squares and blots out.
@@ -298,6 +301,58 @@ def _checker_extent(gray: np.ndarray, x: float, y: float, r0: float, r_max: floa
     return last
 
 
+CHECKER_MISFIT = 0.08  # the sector boundaries may pass this fraction of the mark's radius from its centre
+
+
+def _ring_boundaries(gray: np.ndarray, x: float, y: float, r: float) -> Optional[np.ndarray]:
+    """The angles (radians, sub-sample) of the tone changes on the ring of radius ``r`` around (x, y), sampled as
+    :func:`_ring_sectors` samples it; None unless there are four."""
+    n = max(32, int(4 * r))
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    v = _sample(gray, x + r * np.cos(t), y + r * np.sin(t)).ravel()
+    if not np.all(np.isfinite(v)):
+        return None
+    srt = np.sort(v)
+    mid = 0.5 * (srt[n // 10] + srt[(9 * n) // 10])
+    b = v > mid
+    k = np.nonzero(b != np.roll(b, 1))[0]
+    if len(k) != 4:
+        return None
+    v0, v1 = v[k - 1], v[k]
+    f = np.where(v1 != v0, (mid - v0) / np.where(v1 != v0, v1 - v0, 1.0), 0.5)
+    return np.mod(t[k] - (1.0 - f) * (2 * np.pi / n), 2 * np.pi)
+
+
+def checker_misfit(gray: np.ndarray, x: float, y: float, extent: float) -> Optional[float]:
+    """How far the mark at (x, y) (array coordinates) is from a checker's template, two straight lines through its
+    centre: each of its four sector boundaries followed from ring to ring (the rings :func:`_checker_extent` walks,
+    out to 0.6 of the ``extent``, where the pattern is the target's and not what surrounds it), a line fitted to
+    it, and the mean distance of the four lines from the centre as a fraction of the extent.  A checker's
+    boundaries meet at its centre (near 0); the bar of a cross, whose two edges also cut every ring into four
+    alternating arcs, gives half the bar's width over the radius.  None when a ring does not show four
+    boundaries."""
+    rings = []
+    r = 2.5
+    while r <= max(0.6 * extent, 2.5 * 1.25) * 1.0001:
+        a = _ring_boundaries(gray, x, y, r)
+        if a is None:
+            return None
+        rings.append((r, a))
+        r *= 1.25
+    ref = rings[-1][1]
+    dist = []
+    for j in range(4):
+        pts = []
+        for r, a in rings:
+            k = int(np.argmin(np.abs(np.angle(np.exp(1j * (a - ref[j]))))))
+            pts.append((r * math.cos(a[k]), r * math.sin(a[k])))
+        pts = np.array(pts)
+        c = pts.mean(0)
+        normal = np.linalg.svd(pts - c)[2][1]
+        dist.append(abs(float(c @ normal)))
+    return float(np.mean(dist)) / extent
+
+
 def find_checkers(image: str, gray: np.ndarray, noise: float, min_px: float, max_px: float) -> List[Candidate]:
     """2 x 2 checkers: saddles of the smoothed photo at scales (sigma) from ``min_px`` / 6 to ``max_px`` / 6, the
     larger ones on a pyramid level; each refined at full size (cornerSubPix) and kept if rings from 2.5 px out show
@@ -336,6 +391,9 @@ def find_checkers(image: str, gray: np.ndarray, noise: float, min_px: float, max
                 size = 2.0 * r * 1.25
                 if size < min_px:
                     continue
+                misfit = checker_misfit(gray, float(x), float(y), r)
+                if misfit is None or misfit > CHECKER_MISFIT:
+                    continue  # not a checker's X: the bar of a cross, an edge's corner
                 q = min(1.0, r / (3.0 * max(2.5, sigma)))
                 out.append(Candidate(image, float(x) + 0.5, float(y) + 0.5, CHECKERBOARD, size, q))
         sigma *= 1.6

@@ -80,28 +80,51 @@ def _loose(pred, out: Dict[str, List[Candidate]], cands: Dict[str, List[Candidat
                                f"(the survey and the block disagree there): check it")
 
 
+def _depth_near(rec, im, c: Candidate) -> Optional[float]:
+    """The depth in photo ``im`` of the ground under the mark ``c`` (seen in that photo only): the median depth of
+    the tie points that project within three mark sizes of it, else of all the photo's tie points."""
+    m = np.asarray(im.cam_from_world().matrix())
+    pts = np.array([rec.points3D[p.point3D_id].xyz for p in im.points2D if p.has_point3D()], dtype=float)
+    if not len(pts):
+        return None
+    xc = pts @ m[:, :3].T + m[:, 3]
+    xc = xc[xc[:, 2] > 0]
+    if not len(xc):
+        return None
+    cam = rec.cameras[im.camera_id]
+    f = float(cam.mean_focal_length())
+    cn = np.asarray(cam.cam_from_img(np.array([[c.x, c.y]])), dtype=float)[0, :2]
+    near = np.linalg.norm(xc[:, :2] / xc[:, 2:3] - cn, axis=1) * f < 3.0 * max(c.size_px, 4.0)
+    return float(np.median(xc[near, 2] if near.sum() >= 3 else xc[:, 2]))
+
+
 def _ground_sizes(rec, cs: Sequence[Candidate], xyz, scale: Optional[float]) -> List[Optional[float]]:
-    """Each mark's size on the ground: pixels x depth / focal length x the model's scale (None without one)."""
-    if xyz is None or scale is None:
+    """Each mark's size on the ground: pixels x depth / focal length x the model's scale (to metres; None without
+    one).  The depth is the target's triangulated point's, or for a mark seen in one photo the ground's there."""
+    if scale is None or (xyz is None and len(cs) != 1):
         return [None] * len(cs)
     lookup = {rec.image(i).name: rec.image(i) for i in rec.reg_image_ids()}
     out: List[Optional[float]] = []
     for c in cs:
         im = lookup[c.image]
         m = np.asarray(im.cam_from_world().matrix())
-        depth = float((m[:, :3] @ np.asarray(xyz) + m[:, 3])[2])
-        out.append(c.size_px * depth / float(rec.cameras[im.camera_id].mean_focal_length()) * scale)
+        depth = float((m[:, :3] @ np.asarray(xyz) + m[:, 3])[2]) if xyz is not None else _depth_near(rec, im, c)
+        out.append(None if depth is None
+                   else c.size_px * depth / float(rec.cameras[im.camera_id].mean_focal_length()) * scale)
     return out
 
 
 def observations(rec, gs, found: Dict[str, List[Candidate]], sources, tol_px: float, match: Constellation,
-                 target_size: Optional[float]) -> tuple:
-    """(FoundObservation list, TargetStatus list) of the targets ``gs``: each re-triangulated from its marks
-    ``found``; ``sources``: {id(mark): how it was found} (projected where absent)."""
+                 target_size: Optional[float], metres_per_unit: float = 1.0) -> tuple:
+    """(FoundObservation list, TargetStatus list, the sizes of the marks left out for their size) of the targets
+    ``gs``: each re-triangulated from its marks ``found``; ``sources``: {id(mark): how it was found} (projected
+    where absent).  The marks' sizes on the ground are in metres (``metres_per_unit``: of the targets' CRS), as
+    ``target_size`` is."""
     observations: List[FoundObservation] = []
     targets: List[TargetStatus] = []
+    size_dropped: List[float] = []
     track_fit = {match.names[i]: match.residuals[i] for i in match.names}
-    scale = match.similarity.scale if match.similarity is not None else None
+    scale = match.similarity.scale * metres_per_unit if match.similarity is not None else None
     for p in gs.points:
         cs = found.get(p.name, [])
         notes = []
@@ -123,14 +146,17 @@ def observations(rec, gs, found: Dict[str, List[Candidate]], sources, tol_px: fl
         if target_size:
             keep = [i for i, sz in enumerate(sizes) if sz is None or 0.5 <= sz / target_size <= 2.0]
             if len(keep) < len(cs):
-                notes.append(f"{len(cs) - len(keep)} mark(s) of a size unlike the target's {target_size:g} left out")
+                gone = [sizes[i] for i in range(len(cs)) if i not in keep]
+                notes.append(f"{len(cs) - len(keep)} mark(s) of {float(np.median(gone)):.2g} m (median) on the "
+                             f"ground, unlike the target's {target_size:g} m, left out")
+                size_dropped += gone
             cs, res, sizes = [cs[i] for i in keep], res[keep], [sizes[i] for i in keep]
         for c, r, sz in zip(cs, res, sizes):
             observations.append(FoundObservation(p.name, c.image, c.x, c.y, c.kind, c.quality, float(r), c.size_px,
                                                  sources.get(id(c), PROJECTED), size_m=sz))
         targets.append(TargetStatus(p.name, p.x, p.y, p.z, bool(cs), len(cs), track_fit.get(p.name),
                                     "; ".join(notes) or ("" if cs else "not found")))
-    return observations, targets
+    return observations, targets, size_dropped
 
 
 __all__ = ["observations", "predict"]

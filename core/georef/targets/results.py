@@ -33,7 +33,7 @@ class FoundObservation:
     size_px: float
     source: str
     found: bool = True  # found by the machine, not placed by hand (the dock's mark)
-    size_m: Optional[float] = None  # the mark's size on the ground (world units), through the constellation's scale
+    size_m: Optional[float] = None  # the mark's size on the ground (m), through the constellation's scale
 
 
 @dataclass
