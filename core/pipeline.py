@@ -237,15 +237,42 @@ def _orthophotos(run, workspace_dir: str, options: OrthoOptions, res: "PipelineR
         res.warnings.append("no captured photo registered: no multi-band orthomosaic")
 
 
-def check_inputs(images_dir: str, control: Control, workspace_dir: Optional[str] = None) -> None:
+MIN_BLOCK = 2  # photos (or a band folder's captures) taken from different positions: fewer is no block
+
+
+def check_block_size(images_dir: str, names: Sequence[str], captures: str = "auto") -> None:
+    """A block needs photos from ``MIN_BLOCK`` positions: a band folder's captures (``captures`` auto: the bands
+    and RGB frame of one capture are one position, however many files) or the folder's photos counted from the
+    file names and the band files' metadata, no pixels read; StageError naming the folder and the count before
+    the stacking and the alignment (one capture stacked and escalated for 20 s before 'no initial pair')."""
+    if captures == "auto" and is_band_folder(images_dir):
+        block = read_block(band_files(images_dir))
+        n = len(block.captures)
+        if n < MIN_BLOCK:
+            what = "one capture" if n == 1 else f"{n} captures"
+            raise StageError(f"{images_dir} holds {what} of a multispectral rig ({', '.join(block.band_names)}; "
+                             f"{len(names)} files): a block needs at least {MIN_BLOCK} captures taken from "
+                             "different positions; for a single capture, stack it with 'Stack multispectral "
+                             "captures' and use 'Orthorectify image'")
+        return
+    if len(names) < MIN_BLOCK:
+        raise StageError(f"{images_dir} holds one photo ({names[0]}): a block needs at least {MIN_BLOCK} photos "
+                         "that overlap, taken from different positions; for a single photo use 'Orthorectify "
+                         "image'")
+
+
+def check_inputs(images_dir: str, control: Control, workspace_dir: Optional[str] = None,
+                 captures: str = "auto") -> None:
     """Read and check what the later stages take before the alignment starts (minutes of work that an unknown
     EPSG code or a bad GCP file would throw away): the image folder, the CRS, the GCP file (its CRS line, its
     rows, the images it names, the check points) and the camera positions file, and what the georeference stage
     checks of their meaning (``core.georef.control_checks.check_control_files``: a geographic CRS, control that
     lands far from the photos' EXIF GPS, read from the image files: swapped axes, another zone).  ``workspace_dir``:
-    a re-run's workspace, whose CRS is the target where no CRS is given.  Raises the readers' errors (ImageError,
-    CRSError, GCPError) and StageError, each naming the file or value and the problem."""
+    a re-run's workspace, whose CRS is the target where no CRS is given; ``captures``: as PipelineOptions (a band
+    folder's captures counted for :func:`check_block_size`).  Raises the readers' errors (ImageError, CRSError,
+    GCPError, MultispectralError) and StageError, each naming the file or value and the problem."""
     names = require_images(images_dir, "IMAGES folder")  # missing, unreadable or empty: before a workspace is created
+    check_block_size(images_dir, names, captures)
     if control.crs:
         validate_crs(control.crs)
     if control.targets_path:
@@ -295,7 +322,7 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
         raise StageError("the pipeline needs ground control (GCPS) and/or camera positions (CAMERA_POSITIONS or "
                          "USE_EXIF_GPS) to georeference the block before the DSM and orthophoto; to align only, "
                          "run 'Align images'")
-    check_inputs(images_dir, ctl, workspace_dir)
+    check_inputs(images_dir, ctl, workspace_dir, opt.captures)
     stacking = _check_stacking(images_dir, workspace_dir, opt)
     align_options = opt.align  # the camera positions also choose the pairs where the photos have no EXIF GPS
     if ctl.camera_positions_path and not align_options.camera_positions:
@@ -358,4 +385,4 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
     return res
 
 
-__all__ = ["Control", "PipelineOptions", "PipelineResult", "check_inputs", "run_pipeline"]
+__all__ = ["Control", "PipelineOptions", "PipelineResult", "check_block_size", "check_inputs", "run_pipeline"]

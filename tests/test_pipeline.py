@@ -181,6 +181,7 @@ def test_the_pipeline_chains_find_targets_into_the_georeference(tmp_path, monkey
     photos = tmp_path / "photos"
     photos.mkdir()
     monkeypatch.setattr(pipeline, "require_images", lambda *a: None)
+    monkeypatch.setattr(pipeline, "check_block_size", lambda *a: None)  # no photos here: the stages are spies
     monkeypatch.setattr(pipeline, "list_images", lambda *a: [])
     res = pipeline.run_pipeline(str(photos), str(tmp_path / "ws"), pipeline.PipelineOptions(
         make_dtm=False, make_report=False), pipeline.Control(targets_path=str(targets)))
@@ -229,3 +230,32 @@ def test_the_camera_positions_also_choose_the_alignments_pairs(tmp_path, monkeyp
                               pipeline.Control(camera_positions_path=str(log)))
         assert calls["align"][2].camera_positions == expected
         assert calls["georeference_workspace"][1].camera_positions_path == str(log)
+
+
+def test_one_capture_or_one_photo_is_not_a_block(tmp_path, monkeypatch):
+    """Issue 48 item 1: a folder holding one multispectral capture (the Sequoia sample: four bands and the RGB
+    frame, taken from one position) was stacked and escalated for 21.6 s before 'no initial pair'; one photo went
+    as far as the alignment.  Both are refused before any stacking or alignment, naming the folder and the count."""
+    import shutil
+
+    from core import pipeline
+    from core.project.stages import StageError
+    from tests.conftest import shared
+
+    def no_work(*a, **k):
+        raise AssertionError("a stage ran")
+
+    monkeypatch.setattr(pipeline, "stack_capture_folder", no_work)
+    monkeypatch.setattr(pipeline, "align", no_work)
+    capture = tmp_path / "one capture"
+    shutil.copytree(shared("sequoia_sample"), capture)
+    with pytest.raises(StageError, match=r"one capture .* at least 2 captures") as e:
+        pipeline.run_pipeline(str(capture), str(tmp_path / "ws"), control=pipeline.Control(use_exif_gps=True))
+    assert str(capture) in str(e.value)
+    assert not (tmp_path / "ws").exists()
+    photo = tmp_path / "one photo"
+    copy_images(os.path.join(SAMPLE, "images"), TOLEDO_STRIP[:1], str(photo))
+    with pytest.raises(StageError, match=r"one photo .* at least 2 photos") as e:
+        pipeline.run_pipeline(str(photo), str(tmp_path / "ws"), control=pipeline.Control(use_exif_gps=True))
+    assert str(photo) in str(e.value) and TOLEDO_STRIP[0] in str(e.value)
+    assert not (tmp_path / "ws").exists()

@@ -376,3 +376,43 @@ def test_orthorectify_mode_options_are_translated(plugin, german):
     a = QgsApplication.processingRegistry().algorithmById("archaeoortho:orthorectifyimage").create()
     options = a.parameterDefinition("MODE").options()
     assert options == ["Echtes Orthofoto auf dem DOM", "Ebene Entzerrung (flaches Gelände)"]
+
+
+# features that are no one algorithm's name: each named in the plugin manager's "about" (issue 48 item 12)
+FEATURES = ("terrain", "automatic control", "targets", "multispectral", "calibration file", "DEM", "GCPs dock",
+            "qgis_process", "scanned")
+
+
+def _metadata():
+    import configparser
+
+    meta = configparser.ConfigParser(interpolation=None)
+    meta.read(os.path.join(ROOT, "metadata.txt"), encoding="utf-8")
+    return meta["general"]
+
+
+def test_the_plugin_manager_text_names_every_algorithm_and_each_release(plugin):
+    """Issue 48 item 12: metadata.txt said 0.2.0, and its about and changelog named none of the features since.
+    The about text (what the plugin manager shows) and the changelog name every algorithm the provider registers
+    by its toolbox name, so that a newly registered algorithm fails here until both say so; the changelog has an
+    entry per release, newest first, the newest being the version."""
+    from qgis.core import QgsApplication
+
+    general = _metadata()
+    version = general["version"].strip()
+    assert re.fullmatch(r"\d+\.\d+\.\d+", version), version
+    about = " ".join(general["about"].split()).lower()
+    changelog = general["changelog"]
+    releases = re.findall(r"^\s*(\d+\.\d+\.\d+)\b", changelog, flags=re.M)
+    assert releases and releases[0] == version, (version, releases)
+    key = [tuple(int(p) for p in r.split(".")) for r in releases]
+    assert key == sorted(key, reverse=True) and len(set(key)) == len(key), releases
+    entries = re.split(r"^\s*\d+\.\d+\.\d+\b.*$", changelog, flags=re.M)[1:]
+    assert all(re.search(r"^\s*- \S", e, flags=re.M) for e in entries), changelog  # each release says something
+    flat = " ".join(changelog.split()).lower()
+    provider = QgsApplication.processingRegistry().providerById("archaeoortho")
+    names = [a.displayName() for a in provider.algorithms()]
+    assert len(names) >= 16, names
+    assert [n for n in names if n.lower() not in about] == [], "named nowhere in metadata.txt's about"
+    assert [n for n in names if n.lower() not in flat] == [], "named in no release of metadata.txt's changelog"
+    assert [f for f in FEATURES if f.lower() not in about] == []

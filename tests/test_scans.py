@@ -608,3 +608,65 @@ def test_scan_options_refuse_a_bad_choice_when_made():
     with pytest.raises(PrepareError, match="unknown y axis 'upward'"):
         PrepareOptions(mask_y_axis="upward")
     assert ScanOptions(fiducial_type="Cross", layout="CORNERS").layout == "corners"
+
+
+@pytest.fixture(scope="module")
+def film8_block():
+    """The archive film camera with 8 marks (corner crosses, side marks), four scans; cached as in
+    tests/test_archive_scene.py."""
+    from tests import archive_scene as arch
+
+    return arch.archive_block("film", 4, seed=1, out_dir=os.path.join(CACHE, f"{arch.VERSION}-film4"))
+
+
+@pytest.mark.parametrize("calibrated", [True, False], ids=["certificate", "no-certificate"])
+def test_one_scan_is_prepared_alone(film8_block, calibrated, tmp_path):
+    """Issue 48 item 2: a folder with one film scan (the commonest archive case: one photo -> Orthorectify image)
+    is prepared as a set's scans are: its fiducials found within the multi-scan tests' half pixel, restituted into
+    the fiducial frame, masked; the log says that one photo is screened without a set to compare with."""
+    import shutil
+
+    from core.common.progress import NullProgress
+    from core.prepare.options import PrepareOptions, ScanOptions
+    from core.prepare.stage import prepare_images_workspace
+
+    class Log(NullProgress):
+        def __init__(self):
+            self.lines = []
+
+        def info(self, message):
+            self.lines.append(message)
+
+        def warning(self, message):
+            self.lines.append(message)
+
+    block = film8_block
+    name = block.names[2]
+    folder = tmp_path / "one scan"
+    folder.mkdir()
+    shutil.copyfile(os.path.join(block.paths["images"], name), folder / name)
+    scan = ScanOptions(fiducial_coordinates=_calibrated_text(block.camera) if calibrated else "")
+    log = Log()
+    res = prepare_images_workspace(str(folder), str(tmp_path / "ws"),
+                                   PrepareOptions(scanned_film=True, scan=scan,
+                                                  output_dir=str(tmp_path / "prepared")), log)
+    assert [q.name for q in res.images] == [name] and res.kept == 1
+    assert [n for n in os.listdir(res.prepared_dir) if n.endswith(".tif")] == [name]
+    assert len(res.masks) == 1
+    assert any("one photo" in line and "no set to compare" in line for line in log.lines + res.warnings), log.lines
+    doc = json.load(open(res.scans_path))
+    assert [s["name"] for s in doc["scans"]] == [name]
+    truth = block.fiducials_scan(name)
+    found = doc["scans"][0]["fiducials"]
+    if calibrated:
+        from core.prepare.scans import parse_fiducial_coordinates
+
+        ids = parse_fiducial_coordinates(_calibrated_text(block.camera)).ids
+        errors = {f["slot"]: math.hypot(f["x"] - truth[ids[f["slot"]]][0], f["y"] - truth[ids[f["slot"]]][1])
+                  for f in found}
+    else:  # no certificate: each found mark against the nearest true one
+        errors = {f["slot"]: min(math.hypot(f["x"] - x, f["y"] - y) for x, y in truth.values()) for f in found}
+    assert len(errors) == len(truth) == 8, (sorted(errors), sorted(truth))
+    print(f"\none scan ({'certificate' if calibrated else 'no certificate'}): fiducial errors mean "
+          f"{np.mean(list(errors.values())):.3f} px, max {max(errors.values()):.3f} px")
+    assert max(errors.values()) <= 0.5, errors

@@ -159,7 +159,8 @@ def _bad_files(folder) -> dict:
 def test_unusable_files_are_skipped_with_a_warning_as_align_does(tmp_path):
     """Issue 36 item 14: Prepare images stopped at the first unreadable file (and a 0-byte one was never named)
     where Align images skips both with a warning.  One rule: each file skipped with a warning naming it and why,
-    in the result and the stage's results; fewer than 2 usable images is refused, naming the skipped files."""
+    in the result and the stage's results; one usable image is prepared alone (issue 48), none is refused, naming
+    the skipped files."""
     from core.io.images import scan_images
     from core.prepare.options import PrepareOptions
     from core.prepare.screening import ScreeningError
@@ -177,11 +178,16 @@ def test_unusable_files_are_skipped_with_a_warning_as_align_does(tmp_path):
     _, align_rule = scan_images(str(images))  # what Align images says of the same folder
     assert [w for w in res.warnings if w in align_rule] == align_rule
     assert Workspace.open(str(tmp_path / "ws")).stage("prepare")["results"]["skipped_files"] == align_rule
-    # one usable image left: refused before any work, naming what was skipped and why
+    # one usable image left: prepared alone (issue 48 item 2: one archive frame is a valid input)
+    first = sorted(n for n in os.listdir(images) if n not in bad)[0]
     for n in os.listdir(images):
-        if n not in bad and n != sorted(os.listdir(images))[0]:
+        if n not in bad and n != first:
             os.unlink(images / n)
-    with pytest.raises(ScreeningError, match="only one usable image .* at least 2 are needed") as e:
+    one = prepare_images_workspace(str(images), str(tmp_path / "ws1"), PrepareOptions(output_dir=str(tmp_path / "o1")))
+    assert one.kept == 1 and [q.name for q in one.images] == [first]
+    # no usable image left: refused before any work, naming what was skipped and why
+    os.unlink(images / first)
+    with pytest.raises(ScreeningError, match="no usable image .* at least 1 is needed") as e:
         prepare_images_workspace(str(images), str(tmp_path / "ws2"), PrepareOptions(output_dir=str(tmp_path / "out2")))
     assert all(name in str(e.value) and why in str(e.value) for name, why in bad.items()), str(e.value)
     assert not os.path.exists(tmp_path / "out2")
@@ -285,14 +291,14 @@ def test_qgis_process_names_each_skipped_file_once_and_adds_no_error_line(tmp_pa
     assert rc == 0, text[-3000:]
     for name, why in bad.items():
         assert _mentions(text, f"{name}: {why}") == 1, (name, text[-3000:])
-    # one usable image: refused, the message printed as often as QGIS prints a native algorithm's error
-    for n in sorted(os.listdir(images))[1:]:
+    # no usable image: refused, the message printed as often as QGIS prints a native algorithm's error
+    for n in os.listdir(images):
         if n not in bad:
             os.unlink(images / n)
     rc, text = run("archaeoortho:prepareimages", "--", f"IMAGES={images}", f"WORKSPACE={tmp_path / 'ws2'}")
     assert rc != 0
     ours = _error_lines(text)
-    assert "only one usable image" in text
+    assert "no usable image" in text
     line = str(tmp_path / "line.gpkg")
     ds = ogr.GetDriverByName("GPKG").CreateDataSource(line)
     layer = ds.CreateLayer("l", None, ogr.wkbLineString)

@@ -102,15 +102,19 @@ def screening_summary(quality: Sequence[ImageQuality]) -> dict:
 def check_images(images_dir: str, progress: Progress) -> Tuple[List[str], Dict[str, Tuple[int, int]], List[str]]:
     """(usable images, their sizes, warnings naming each skipped file and why) by the rule of 'Align images'
     (:func:`core.io.images.scan_images`: every file is opened and its pixels decoded; an empty file, a file that is
-    not an image, a truncated one is skipped with a warning); ScreeningError, before any work, when fewer than 2
-    usable images remain."""
+    not an image, a truncated one is skipped with a warning); ScreeningError, before any work, when no usable image
+    remains.  One photo is prepared as several are (a single archive frame is the commonest case: one scan ->
+    Orthorectify image); the log says that its screening has no set to compare with."""
     infos, skipped = scan_images(images_dir, progress=SubProgress(progress, 0.0, 0.03))
     for w in skipped:
         progress.warning(w)
-    if len(infos) < 2:
-        found = f"only one usable image ({infos[0].name})" if infos else "no usable image"
-        why = ("; ".join(skipped)) if skipped else "no other image file"
-        raise ScreeningError(f"{found} in {images_dir}: at least 2 are needed ({why})")
+    if not infos:
+        why = ("; ".join(skipped)) if skipped else "no image file"
+        raise ScreeningError(f"no usable image in {images_dir}: at least 1 is needed ({why})")
+    if len(infos) == 1:
+        progress.info(f"one photo ({infos[0].name}): screened on its own, with no set to compare with (only the "
+                      "absolute limits: clipped highlights and shadows, dynamic range); prepared as a set's photos "
+                      "are")
     return [i.name for i in infos], {i.name: (i.width, i.height) for i in infos}, skipped
 
 
