@@ -1083,6 +1083,26 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
 <context>
     <name>GcpDock</name>
     <message>
+        <source>Report</source>
+        <translation>Bericht</translation>
+    </message>
+    <message>
+        <source>Open the workspace&apos;s accuracy report (report.html, made by Run pipeline or Accuracy report) in the web browser</source>
+        <translation>Den Genauigkeitsbericht des Arbeitsbereichs (report.html, von Run pipeline oder Accuracy report erstellt) im Webbrowser öffnen</translation>
+    </message>
+    <message>
+        <source>The workspace has no accuracy report yet: run Accuracy report (or Run pipeline)</source>
+        <translation>Der Arbeitsbereich hat noch keinen Genauigkeitsbericht: Accuracy report (oder Run pipeline) ausführen</translation>
+    </message>
+    <message>
+        <source>No web browser opened {}</source>
+        <translation>Kein Webbrowser hat {} geöffnet</translation>
+    </message>
+    <message>
+        <source>Accuracy report: {}</source>
+        <translation>Genauigkeitsbericht: {}</translation>
+    </message>
+    <message>
         <location filename="../ui/gcp_dock.py" line="82"/>
         <source>ArchaeoOrtho ground control</source>
         <translation>ArchaeoOrtho Passpunkte</translation>
@@ -1119,8 +1139,8 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
     </message>
     <message>
         <location filename="../ui/gcp_dock.py" line="182"/>
-        <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
-        <translation>Ein DOM- oder DGM-Rasterlayer (z. B. ein ALS-DOM): ein auf der Karte gemessener Punkt erhält seine Höhe daraus (bilinear). Leer: Z von Hand eingeben.</translation>
+        <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand. Only height rasters are listed (not orthophotos, hillshades or web maps).</source>
+        <translation>Ein DOM- oder DGM-Rasterlayer (z. B. ein ALS-DOM): ein auf der Karte gemessener Punkt erhält seine Höhe daraus (bilinear). Leer: Z von Hand eingeben. Nur Höhenraster werden angeboten (keine Orthofotos, Schummerungen oder Webkarten).</translation>
     </message>
     <message>
         <location filename="../ui/gcp_io.py" line="67"/>
@@ -1779,8 +1799,8 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="54"/>
-        <source>A reference DSM or DTM (heights in metres): a raster file or a WCS layer</source>
-        <translation>Ein Referenz-DOM oder -DGM (Höhen in Metern): eine Rasterdatei oder ein WCS-Layer</translation>
+        <source>A reference DSM or DTM (heights in metres): a raster file or a WCS layer. Only height rasters are listed: not orthophotos, hillshades, web maps or this workspace&apos;s own products</source>
+        <translation>Ein Referenz-DOM oder -DGM (Höhen in Metern): eine Rasterdatei oder ein WCS-Layer. Nur Höhenraster werden angeboten: keine Orthofotos, Schummerungen, Webkarten oder eigenen Produkte dieses Arbeitsbereichs</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="63"/>
@@ -2817,6 +2837,18 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
 <context>
     <name>ResultLayers</name>
     <message>
+        <source>found</source>
+        <translation>gefunden</translation>
+    </message>
+    <message>
+        <source>not found</source>
+        <translation>nicht gefunden</translation>
+    </message>
+    <message>
+        <source>Targets found</source>
+        <translation>Gefundene Zielmarken</translation>
+    </message>
+    <message>
         <location filename="../qgisio/layers.py" line="286"/>
         <source>control (used)</source>
         <translation>Passpunkt (verwendet)</translation>
@@ -3308,6 +3340,13 @@ Panelreflexion: die Reflexion des Panels laut seinem Kalibrierblatt: eine Zahl f
 Panelfenster (erweitert): die Seite des mittleren Quadrats, in dem das Panel gemessen wird, als Anteil der kurzen Seite des Fotos (Standard 0.25); kleiner, wenn das Panel weniger vom Bild füllt.
 Referenzkanal (erweitert): der Kanal, auf den die anderen registriert werden; leer: die Referenzkamera des Rigs.
 Ausgabeordner: wohin die mehrkanaligen Fotos geschrieben werden (eines je Aufnahme, benannt nach ihren Kanaldateien ohne die Kanalendung); nicht der Kanalordner.</translation>
+    </message>
+</context>
+<context>
+    <name>FolderDialog</name>
+    <message>
+        <source>The folder {} cannot be made: {}</source>
+        <translation>Der Ordner {} kann nicht angelegt werden: {}</translation>
     </message>
 </context>
 </TS>

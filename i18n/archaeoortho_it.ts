@@ -1083,6 +1083,26 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
 <context>
     <name>GcpDock</name>
     <message>
+        <source>Report</source>
+        <translation>Rapporto</translation>
+    </message>
+    <message>
+        <source>Open the workspace&apos;s accuracy report (report.html, made by Run pipeline or Accuracy report) in the web browser</source>
+        <translation>Apri il rapporto di accuratezza dello spazio di lavoro (report.html, creato da Run pipeline o Accuracy report) nel browser web</translation>
+    </message>
+    <message>
+        <source>The workspace has no accuracy report yet: run Accuracy report (or Run pipeline)</source>
+        <translation>Lo spazio di lavoro non ha ancora un rapporto di accuratezza: eseguire Accuracy report (o Run pipeline)</translation>
+    </message>
+    <message>
+        <source>No web browser opened {}</source>
+        <translation>Nessun browser web ha aperto {}</translation>
+    </message>
+    <message>
+        <source>Accuracy report: {}</source>
+        <translation>Rapporto di accuratezza: {}</translation>
+    </message>
+    <message>
         <location filename="../ui/gcp_dock.py" line="82"/>
         <source>ArchaeoOrtho ground control</source>
         <translation>ArchaeoOrtho punti d'appoggio</translation>
@@ -1119,8 +1139,8 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
     </message>
     <message>
         <location filename="../ui/gcp_dock.py" line="182"/>
-        <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand.</source>
-        <translation>Un layer raster DSM o DTM (ad es. un DSM ALS): un punto misurato sulla mappa ne prende la quota (bilineare). Vuoto: inserire Z a mano.</translation>
+        <source>A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map takes its height from it (bilinear). Empty: type Z by hand. Only height rasters are listed (not orthophotos, hillshades or web maps).</source>
+        <translation>Un layer raster DSM o DTM (ad es. un DSM ALS): un punto misurato sulla mappa ne prende la quota (bilineare). Vuoto: inserire Z a mano. Sono elencati solo raster di quote (non ortofoto, ombreggiature o mappe web).</translation>
     </message>
     <message>
         <location filename="../ui/gcp_io.py" line="67"/>
@@ -1779,8 +1799,8 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="54"/>
-        <source>A reference DSM or DTM (heights in metres): a raster file or a WCS layer</source>
-        <translation>Un DSM o DTM di riferimento (quote in metri): un file raster o un layer WCS</translation>
+        <source>A reference DSM or DTM (heights in metres): a raster file or a WCS layer. Only height rasters are listed: not orthophotos, hillshades, web maps or this workspace&apos;s own products</source>
+        <translation>Un DSM o DTM di riferimento (quote in metri): un file raster o un layer WCS. Sono elencati solo raster di quote: non ortofoto, ombreggiature, mappe web o prodotti di questo spazio di lavoro</translation>
     </message>
     <message>
         <location filename="../ui/gcp_autocontrol.py" line="63"/>
@@ -2817,6 +2837,18 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
 <context>
     <name>ResultLayers</name>
     <message>
+        <source>found</source>
+        <translation>trovato</translation>
+    </message>
+    <message>
+        <source>not found</source>
+        <translation>non trovato</translation>
+    </message>
+    <message>
+        <source>Targets found</source>
+        <translation>Target trovati</translation>
+    </message>
+    <message>
         <location filename="../qgisio/layers.py" line="286"/>
         <source>control (used)</source>
         <translation>appoggio (usato)</translation>
@@ -3308,6 +3340,13 @@ Riflettanza del pannello: la riflettanza del pannello dal suo foglio di calibraz
 Finestra del pannello (avanzato): il lato del quadrato centrale in cui si misura il pannello, una frazione del lato corto della foto (predefinito 0.25); più piccola quando il pannello riempie meno dell'inquadratura.
 Banda di riferimento (avanzato): la banda su cui sono registrate le altre; vuoto: la camera di riferimento del rig.
 Cartella di uscita: dove sono scritte le foto multibanda (una per acquisizione, nominata come i suoi file di banda senza il suffisso della banda); non la cartella delle bande.</translation>
+    </message>
+</context>
+<context>
+    <name>FolderDialog</name>
+    <message>
+        <source>The folder {} cannot be made: {}</source>
+        <translation>Impossibile creare la cartella {}: {}</translation>
     </message>
 </context>
 </TS>

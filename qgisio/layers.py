@@ -57,12 +57,13 @@ DTM_HILLSHADE = "dtmhillshade"
 RELIEF = "relief"
 CONTOURS = "contours"
 INDEX = "index"  # a spectral index (NDVI ...): over the orthomosaic it is made from
+TARGETS = "targets"  # Find targets' layer for review: every surveyed target, found or not
 
 # the order of a workspace's group, top to bottom: points and lines over the pictures, the orthomosaic over the
 # terrain rasters, each hillshade right over its elevation model.  A hillshade drawn with 'multiply' above the
 # orthomosaic darkened it (the DTM's, loaded last, by about 19 %: issue 36 item 16); under it, it shades only
 # its DSM or DTM, which the orthomosaic covers until it is switched off.
-GROUP_ORDER = (RESIDUALS, CAMERAS, FOOTPRINTS, CONTOURS, POINT_CLOUD, INDEX, ORTHO, RELIEF, DTM_HILLSHADE, DTM, HILLSHADE,
+GROUP_ORDER = (TARGETS, RESIDUALS, CAMERAS, FOOTPRINTS, CONTOURS, POINT_CLOUD, INDEX, ORTHO, RELIEF, DTM_HILLSHADE, DTM, HILLSHADE,
                DSM)
 
 # residual point status (core.georef) -> colour
@@ -313,6 +314,21 @@ def style_residuals(layer, factor=None):
     _labels(layer, """"name" || coalesce('  ' || format_number("dxy", 3) || ' m', '')""", size=8.0)
     layer.setCustomProperty("archaeoortho/exaggeration", factor if arrows else 0)
     _mark(layer, RESIDUALS)
+    layer.triggerRepaint()
+    return layer
+
+
+def style_targets(layer):
+    """Find targets' review layer: found targets green, the others red, labelled with name and observations."""
+    categories = []
+    for value, colour, label in ((1, "#1a9641", QCoreApplication.translate("ResultLayers", "found")),
+                                 (0, "#d7191c", QCoreApplication.translate("ResultLayers", "not found"))):
+        symbol = QgsMarkerSymbol.createSimple({"name": "cross2", "color": colour, "outline_color": colour,
+                                               "size": "4.0", "outline_width": "0.6"})
+        categories.append(QgsRendererCategory(value, symbol, label))
+    layer.setRenderer(QgsCategorizedSymbolRenderer("found", categories))
+    _labels(layer, """"name" || ' (' || coalesce("observations", 0) || ')'""", size=8.0)
+    _mark(layer, TARGETS)
     layer.triggerRepaint()
     return layer
 
@@ -699,6 +715,8 @@ def output_kind(output_name, path):
     ext = os.path.splitext(str(path))[1].lower()
     if "RESIDUAL" in n:
         return RESIDUALS
+    if n == "MARKS" and ext == ".gpkg":  # Find targets' layer of the targets for review
+        return TARGETS
     if "CAMERA" in n:
         return CAMERAS
     if ext in (".las", ".laz", ".copc") or "POINT_CLOUD" in n:
@@ -793,6 +811,8 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
             style_contours(layer)
         elif self.kind == INDEX:
             style_index(layer)
+        elif self.kind == TARGETS:
+            style_targets(layer)
         name = _output_layer_name(self.kind, path)
         if name:  # not the parameter's label ("Orthomosaic (default: <workspace>/orthomosaic.tif)")
             layer.setName(product_name(name, path, self.workspace))
@@ -809,7 +829,8 @@ def _output_layer_name(kind, path=""):
              CAMERAS: QCoreApplication.translate("ResultLayers", "Cameras"),
              POINT_CLOUD: QCoreApplication.translate("ResultLayers", "Point cloud"),
              DTM: QCoreApplication.translate("ResultLayers", "DTM"),
-             CONTOURS: QCoreApplication.translate("ResultLayers", "Contours")}
+             CONTOURS: QCoreApplication.translate("ResultLayers", "Contours"),
+             TARGETS: QCoreApplication.translate("ResultLayers", "Targets found")}
     return names.get(kind)
 
 
@@ -879,7 +900,7 @@ def register_outputs(alg, results, context):
             details.setPostProcessor(pp)
         else:
             hint = QgsProcessingUtils.LayerHint.Raster if kind in (DSM, ORTHO, DTM, RELIEF, INDEX) else (
-                QgsProcessingUtils.LayerHint.Vector if kind in (CAMERAS, RESIDUALS, CONTOURS) else
+                QgsProcessingUtils.LayerHint.Vector if kind in (CAMERAS, RESIDUALS, CONTOURS, TARGETS) else
                 QgsProcessingUtils.LayerHint.UnknownType)
             details = QgsProcessingContext.LayerDetails(out_def.description() or name, project, name, hint)
             details.setPostProcessor(pp)

@@ -94,6 +94,50 @@ def local_file(layer):
     return path if os.path.isfile(path) else None
 
 
+_NOT_HEIGHTS_CACHE = {}  # (file, size, mtime) -> why not heights ('' when heights): each file read once
+
+
+def layer_not_heights(layer, workspace_dir=None):
+    """Why the raster ``layer`` cannot be a reference DSM / a source of heights ('' when it can): a hillshade
+    (a picture of its DSM, listed beside it), a web map (rendered colours), a file that core/io/raster.py's
+    not_heights refuses (an orthophoto, a relief visualisation, an index), or one of the open workspace's own
+    products (``workspace_dir``: the block cannot be its own reference).  Reads a file's header only."""
+    from .layers import DTM_HILLSHADE, HILLSHADE, KIND_PROPERTY
+
+    if layer is None or not layer.isValid():
+        return ""
+    kind = layer.customProperty(KIND_PROPERTY, "")
+    if kind in (HILLSHADE, DTM_HILLSHADE):
+        return "a hillshade (a picture of its elevation model): choose the DSM or DTM layer itself"
+    path = local_file(layer)
+    if path is None:
+        provider = layer.dataProvider()
+        if provider is not None and provider.bandCount() >= 1 and provider.dataType(1) in IMAGE_TYPES:
+            return "a rendered map (colours), not heights"
+        return ""  # a WCS layer or a remote raster: judged when it is saved
+    if workspace_dir:
+        root = os.path.normcase(os.path.realpath(workspace_dir))
+        if os.path.normcase(os.path.realpath(path)).startswith(root + os.sep):
+            return "a product of this workspace: the block cannot be its own reference"
+    try:
+        st = os.stat(path)
+    except OSError:
+        return ""
+    key = (path, st.st_size, st.st_mtime_ns)
+    if key not in _NOT_HEIGHTS_CACHE:
+        from osgeo import gdal
+
+        from ..core.io.raster import not_heights
+
+        try:
+            ds = gdal.OpenEx(path, gdal.OF_RASTER | gdal.OF_READONLY)
+        except RuntimeError:  # QGIS reads it, GDAL not as a file: judged by the reader when it is used
+            ds = None
+        _NOT_HEIGHTS_CACHE[key] = not_heights(ds) if ds is not None and ds.RasterCount else ""
+        ds = None
+    return _NOT_HEIGHTS_CACHE[key]
+
+
 def describe(layer):
     return f"'{layer.name()}' ({layer.providerType()}: {layer.source()[:200]})"
 
@@ -299,7 +343,7 @@ def resolve_references(ortho_layer, dsm_layer, workspace_dir, gsd=None, extent=N
     return paths[0], paths[1]
 
 
-__all__ = ["DEFAULT_GSD", "MAX_PIXELS", "LayerSnapshot", "ReferenceLayerError", "gps_extent", "local_file",
+__all__ = ["DEFAULT_GSD", "MAX_PIXELS", "LayerSnapshot", "ReferenceLayerError", "gps_extent", "layer_not_heights", "local_file",
            "resolve_references", "save_layer", "snapshot", "target_crs"]
 
 

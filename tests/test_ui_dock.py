@@ -598,3 +598,155 @@ def test_twenty_megapixel_photo_is_drawn_from_pyramid_tiles(tmp_path):
           f"(level {level_fit}); at 1:1 {1000 * t_full:.0f} ms; pan step {1000 * t_pan:.0f} ms; "
           f"tiles made {pyr.tiles_made}")
     panel.close()
+
+
+def test_reference_dsm_pickers_list_height_rasters_only(dock, aligned_ws, tmp_path):
+    """The Reference DSM box (automatic control) and the 'Heights (Z) from' box list height rasters only: not an
+    orthophoto (RGB bytes), a hillshade (a picture of its DSM), a web map, nor the open workspace's own products
+    in the reference box; the one check of core/io/raster.py (not_heights) judges the files (issue 48 item 10)."""
+    from archaeoortho.qgisio import layers
+    from qgis.core import QgsProject, QgsRasterLayer
+
+    from tests.test_ui_layers import _raster
+
+    assert dock.open_workspace(aligned_ws)
+    project = QgsProject.instance()
+    layers.load_dsm(_raster(str(tmp_path / "als_dsm.tif"), 1, nodata=-9999), project, name="ALS DSM")
+    layers.load_orthomosaic(_raster(str(tmp_path / "ortho.tif"), 4, alpha=True), project, name="Reference ortho")
+    own = layers.workspace_layout(aligned_ws).default_dsm  # the workspace's own DSM
+    os.makedirs(os.path.dirname(own), exist_ok=True)
+    layers.load_dsm(_raster(own, 1, nodata=-9999), project, name="Own DSM")
+    process(50)
+    later = QgsRasterLayer(_raster(str(tmp_path / "scan.tif"), 3), "RGB added later")  # added after the dock opened
+    project.addMapLayer(later)
+    process(50)
+
+    def listed(combo):
+        return [combo.itemText(i) for i in range(combo.count()) if combo.itemText(i)]
+
+    assert listed(dock.auto_dsm_combo) == ["ALS DSM"], listed(dock.auto_dsm_combo)
+    assert sorted(listed(dock.dsm_combo)) == ["ALS DSM", "Own DSM"], listed(dock.dsm_combo)
+    assert "Reference ortho" in listed(dock.auto_ortho_combo)  # the orthophoto box still lists every raster
+    assert "height" in dock.auto_dsm_combo.toolTip()
+
+
+def test_a_cancelled_task_is_not_reported_failed_in_the_message_bar(qgis_iface, monkeypatch):
+    """QGIS desktop tells every task that ends unsuccessfully as 'Task failed: <description>' (a system
+    notification, in the message bar where the desktop has none): a user's Cancel was shown as a failure while
+    the dock said 'Cancelled' (issue 48 item 9).  QGIS's handler is emulated here on the same signal; a cancel
+    leaves no 'failed' notice behind, a real failure keeps it."""
+    from archaeoortho.core.common.progress import Cancelled
+    from archaeoortho.ui.tasks import CoreTask, start
+    from qgis.core import QgsApplication, QgsTask
+    from qgis.gui import QgsMessageBar
+
+    manager = QgsApplication.taskManager()
+    bar = QgsMessageBar()  # a real one: pytest-qgis's is a mock
+    monkeypatch.setattr(qgis_iface, "messageBar", lambda: bar)
+
+    def notify(task_id, status):  # what QgisApp::onTaskCompleteShowNotify does with no notification daemon
+        task = manager.task(task_id)
+        if task is not None and status == QgsTask.TaskStatus.Terminated:
+            bar.pushInfo("Task failed", task.description())
+
+    def wait_for_cancel(progress=None):
+        t0 = time.time()
+        while not progress.is_cancelled() and time.time() - t0 < 20:
+            time.sleep(0.02)
+        raise Cancelled("cancelled by the user")
+
+    def broken(progress=None):
+        raise ValueError("a bug")
+
+    ended = []
+    manager.statusChanged.connect(notify)
+    try:
+        for fn, description in ((wait_for_cancel, "ArchaeoOrtho: cancel test"), (broken, "ArchaeoOrtho: bug test")):
+            task = CoreTask(description, fn, on_error=lambda message, cancelled: ended.append(cancelled))
+            start(task)
+            process(200)
+            task.cancel() if fn is wait_for_cancel else None
+            t0 = time.time()
+            while len(ended) < (1 if fn is wait_for_cancel else 2) and time.time() - t0 < 20:
+                process(50)
+            process(100)
+    finally:
+        manager.statusChanged.disconnect(notify)
+    notices = [(item.title(), item.text()) for item in bar.items()]
+    assert ended == [True, False]
+    assert ("Task failed", "ArchaeoOrtho: cancel test") not in notices, notices
+    assert ("Task failed", "ArchaeoOrtho: bug test") in notices, notices
+
+
+def test_the_workspace_folder_dialog_takes_a_new_folder_name(tmp_path, monkeypatch):
+    """'Workspace folder (new or existing)' (New from photos...) takes a typed new folder name: Qt's folder
+    dialog said 'Directory not found' (issue 48 item 9); an existing folder is taken as before."""
+    from archaeoortho.ui.folder_dialog import FolderDialog
+    from qgis.PyQt.QtCore import QTimer
+    from qgis.PyQt.QtWidgets import QApplication, QDialog, QFileDialog, QLineEdit, QMessageBox
+
+    warned = []
+
+    def close_warning():  # Qt's C++ dialog shows its own modal QMessageBox: read and closed
+        box = QApplication.activeModalWidget()
+        if isinstance(box, QMessageBox):
+            warned.append(box.text())
+            box.close()
+
+    def typed(dialog, text):
+        dialog.setDirectory(str(tmp_path))
+        dialog.show()
+        process(50)
+        edit = dialog.findChild(QLineEdit, "fileNameEdit")
+        edit.setText(text)
+        QTimer.singleShot(300, close_warning)
+        button = dialog.choose_button() if hasattr(dialog, "choose_button") else None
+        if button is not None:  # what the user does: click Choose (Qt disabled it for a name that is no folder)
+            assert button.isEnabled(), text
+            button.click()
+        else:
+            dialog.accept()
+        process(400)
+        return dialog
+
+    plain = QFileDialog(None, "plain")  # what the dock used: a new name is refused
+    plain.setFileMode(QFileDialog.FileMode.Directory)
+    plain.setOption(QFileDialog.Option.DontUseNativeDialog, True)
+    assert typed(plain, "site_a").result() != QDialog.DialogCode.Accepted
+    assert warned and "Directory not found" in warned[0], warned
+    warned.clear()
+    d = typed(FolderDialog(None, "Workspace folder (new or existing)"), "site_b")
+    assert d.result() == QDialog.DialogCode.Accepted and not warned
+    assert os.path.normpath(d.selectedFiles()[0]) == os.path.normpath(str(tmp_path / "site_b"))
+    assert os.path.isdir(tmp_path / "site_b")
+    os.makedirs(tmp_path / "old")
+    d = typed(FolderDialog(None, "Workspace folder (new or existing)"), "old")
+    assert d.result() == QDialog.DialogCode.Accepted and not warned
+    assert os.path.normpath(d.selectedFiles()[0]) == os.path.normpath(str(tmp_path / "old"))
+
+
+def test_open_report_from_the_dock_after_a_restart(dock, aligned_ws, tmp_path, monkeypatch):
+    """The accuracy report is always at hand (issue 48 item 5): after a restart the Results Viewer is empty; the
+    dock's 'Open report' opens the workspace's report.html (or the file the report stage recorded), enabled only
+    when the workspace has one."""
+    from archaeoortho.core.project.workspace import Workspace
+    from archaeoortho.core.report.stage import report_of
+    from archaeoortho.qgisio import layers
+    from qgis.PyQt.QtGui import QDesktopServices
+
+    opened = []
+    monkeypatch.setattr(QDesktopServices, "openUrl", lambda url: opened.append(url.toLocalFile()) or True)
+    assert dock.open_workspace(aligned_ws)
+    assert not dock.act_report.isEnabled() and report_of(Workspace.open(aligned_ws)) is None
+    report = layers.workspace_layout(aligned_ws).default_report
+    with open(report, "w", encoding="utf-8") as f:
+        f.write("<html><body>report</body></html>")
+    assert dock.open_workspace(aligned_ws)  # as after a restart: the workspace opened again
+    assert dock.act_report.isEnabled()
+    dock.act_report.trigger()
+    assert [os.path.normpath(p) for p in opened] == [os.path.normpath(report)]
+    ws = Workspace.open(aligned_ws)  # a report written elsewhere (Accuracy report's OUTPUT_HTML) is found too
+    elsewhere = str(tmp_path / "site-report.html")
+    open(elsewhere, "w").close()
+    ws.data["stages"]["report"] = {"status": "done", "outputs": {"report": elsewhere}}
+    assert os.path.normpath(report_of(ws)) == os.path.normpath(elsewhere)

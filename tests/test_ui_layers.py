@@ -386,3 +386,45 @@ def test_the_rgb_frames_mosaic_is_named_apart_from_the_bands(tmp_path, qgis_new_
     assert layers._output_layer_name(layers.ORTHO, str(tmp_path / "orthomosaic_rgb.tif")) == "RGB orthomosaic"
     assert layers._output_layer_name(layers.ORTHO, str(tmp_path / "orthomosaic.tif")) == "Orthomosaic"
     assert layers._output_layer_name(layers.DSM, str(tmp_path / "dsm_rgb.tif")) == "DSM"
+
+
+def test_find_targets_from_the_toolbox_loads_the_targets_layer(plugin, tmp_path, qgis_new_project, monkeypatch):
+    """Find targets run as a Processing algorithm (runAndLoadResults: what the toolbox dialog does) loads its
+    'Targets found (for review)' layer into the workspace's group, styled: the log said 'Loading resulting layers'
+    and no layer came (issue 48 item 8).  The core call is replaced by one that writes the layer (cheap)."""
+    from archaeoortho.core.georef.targets import stage
+    from archaeoortho.core.georef.targets.results import FindTargetsResult, TargetStatus, write_products
+    from processing import runAndLoadResults
+    from qgis.core import QgsProject
+
+    ws = tmp_path / "site"
+    (ws / "georef" / "targets").mkdir(parents=True)
+    targets_csv = tmp_path / "targets.csv"
+    targets_csv.write_text("# crs: EPSG:32633\nname,x,y,z\nA,500010,4600010,100\nB,500030,4600020,101\n"
+                           "C,500020,4600040,99\n")
+
+    class _GS:
+        crs = "EPSG:32633"
+
+    def fake_find_targets(workspace, options, progress=None):
+        out = os.path.join(workspace, "georef", "targets")
+        result = FindTargetsResult("EPSG:32633", os.path.join(out, "gcp_list.txt"), os.path.join(out, "targets.gpkg"),
+                                   os.path.join(out, "targets.json"),
+                                   targets=[TargetStatus("A", 500010, 4600010, 100, True, 4, 0.01),
+                                            TargetStatus("B", 500030, 4600020, 101, True, 3, 0.02),
+                                            TargetStatus("C", 500020, 4600040, 99, False, 0, note="covered")])
+        write_products(_GS(), result)
+        return result
+
+    monkeypatch.setattr(stage, "find_targets", fake_find_targets)
+    res = runAndLoadResults("archaeoortho:findtargets", {"WORKSPACE": str(ws), "TARGETS": str(targets_csv)})
+    assert res and os.path.isfile(res["MARKS"])
+    loaded = [lyr for lyr in QgsProject.instance().mapLayers().values()
+              if os.path.normpath(lyr.source().split("|")[0]) == os.path.normpath(res["MARKS"])]
+    assert len(loaded) == 1, [lyr.name() for lyr in QgsProject.instance().mapLayers().values()]
+    layer = loaded[0]
+    assert layer.featureCount() == 3 and layer.labelsEnabled()
+    assert layer.name() == "Targets found \u2014 site"
+    node = QgsProject.instance().layerTreeRoot().findLayer(layer.id())
+    assert node.parent().name() == "ArchaeoOrtho: site"
+    _render(QgsProject.instance(), [layer], "toolbox-find-targets-layer.png")

@@ -9,7 +9,7 @@ what the stage wrote to georef/control.json (the automatic GCPs auto_NNN and the
 cameras and the automatic GCPs' residuals.  A mixin of ui.gcp_dock.GcpDock; its strings are in the dock's
 translation context.
 """
-from qgis.core import Qgis, QgsCoordinateTransformContext, QgsMapLayerProxyModel, QgsProject
+from qgis.core import Qgis, QgsCoordinateTransformContext, QgsMapLayerProxyModel, QgsProject, QgsRasterLayer
 from qgis.gui import QgsMapLayerComboBox
 from qgis.PyQt.QtCore import QCoreApplication
 from qgis.PyQt.QtWidgets import QFormLayout, QGroupBox
@@ -57,7 +57,9 @@ class GcpAutoControl:
                 "GcpDock", "A reference orthophoto: a raster file, or a WMS / XYZ layer (saved for the block's "
                            "extent, from the photos' GPS or the map extent)")),
                            (self.auto_dsm_combo, translate(
-                               "GcpDock", "A reference DSM or DTM (heights in metres): a raster file or a WCS layer"))):
+                               "GcpDock", "A reference DSM or DTM (heights in metres): a raster file or a WCS layer. "
+                                          "Only height rasters are listed: not orthophotos, hillshades, web maps "
+                                          "or this workspace's own products"))):
             combo.setFilters(QgsMapLayerProxyModel.Filter.RasterLayer)
             combo.setAllowEmptyLayer(True)
             combo.setLayer(None)
@@ -67,6 +69,34 @@ class GcpAutoControl:
         self.auto_box.toggled.connect(self._autocontrol_toggled)
         self._autocontrol_toggled(False)
         return self.auto_box
+
+    def _watch_height_layers(self):
+        """The boxes of heights (the reference DSM here, the dock's 'Heights (Z) from') list height rasters only,
+        judged by qgisio.reference_layers.layer_not_heights (core/io/raster.py's check): kept up to date as layers
+        are added and as the workspace changes (its own products are no reference)."""
+        QgsProject.instance().layersAdded.connect(self._filter_height_layers)
+        self.store.workspaceChanged.connect(self._filter_height_layers)
+        self._filter_height_layers()
+
+    def _unwatch_height_layers(self):
+        try:
+            QgsProject.instance().layersAdded.disconnect(self._filter_height_layers)
+        except (TypeError, RuntimeError):  # not connected
+            pass
+
+    def _filter_height_layers(self, *_args):
+        from ..qgisio.reference_layers import layer_not_heights
+
+        rasters = [lyr for lyr in QgsProject.instance().mapLayers().values() if isinstance(lyr, QgsRasterLayer)]
+        root = self.store.root if self.store.workspace is not None else None
+        for combo, workspace in ((self.auto_dsm_combo, root), (getattr(self, "dsm_combo", None), None)):
+            if combo is None:
+                continue
+            current = combo.currentLayer()
+            excepted = [lyr for lyr in rasters if layer_not_heights(lyr, workspace)]
+            combo.setExceptedLayerList(excepted)
+            if current is not None and current in excepted:
+                combo.setLayer(None)
 
     def _autocontrol_toggled(self, on):
         """Unticked, the box folds to its title: the combos and their labels take no room (issue 36 item 20)."""

@@ -180,7 +180,8 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoContro
         self.dsm_combo.setAllowEmptyLayer(True)
         self.dsm_combo.setLayer(None)
         self.dsm_combo.setToolTip(self.tr("A DSM or DTM raster layer (e.g. an ALS DSM): a point picked on the map "
-                                          "takes its height from it (bilinear). Empty: type Z by hand."))
+                                          "takes its height from it (bilinear). Empty: type Z by hand. Only height rasters are "
+                                          "listed (not orthophotos, hillshades or web maps)."))
         row.addWidget(self.dsm_combo, 1)
         self.crs_label = QLabel()
         row.addWidget(self.crs_label)
@@ -217,6 +218,9 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoContro
         self._build_undo_actions(w)
         self.act_results = self.toolbar2.addAction(self.tr("Load results"))
         self.act_results.setToolTip(self.tr("Add the workspace's products to the map as styled layers"))
+        self.act_report = self.toolbar2.addAction(self.tr("Report"))
+        self.act_report.setToolTip(self.tr("Open the workspace's accuracy report (report.html, made by Run pipeline "
+                                           "or Accuracy report) in the web browser"))
         for bar in (self.toolbar, self.toolbar2):
             bar.setMinimumWidth(bar.sizeHint().width())
         return self.toolbar, self.toolbar2
@@ -316,6 +320,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoContro
         self.act_export_file.triggered.connect(self.choose_export_file)
         self.act_export_layer.triggered.connect(self.choose_export_layer)
         self.act_results.triggered.connect(self.load_results_in_background)
+        self.act_report.triggered.connect(self.open_report)
         self.btn_georef.clicked.connect(self.georeference_clicked)
         self.btn_cancel.clicked.connect(self.cancel_task)
         self.tol_spin.valueChanged.connect(self._tolerance_changed)
@@ -341,6 +346,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoContro
         p.nextRequested.connect(self.confirm_and_next)
         p.filterChanged.connect(lambda _on: self._update_thumbnails())
         self._install_found_keys()  # ui/gcp_targets.py: one key confirms or rejects a found observation
+        self._watch_height_layers()  # ui/gcp_autocontrol.py: the boxes of heights list height rasters only
 
     # ------------------------------------------------------------------ messages
     def message(self, text, level=Qgis.MessageLevel.Info):
@@ -365,6 +371,31 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoContro
         except WorkspaceError as e:
             self.message(str(e), Qgis.MessageLevel.Critical)
             return False
+        return True
+
+    def report_path(self):
+        """The open workspace's accuracy report on disk (report.html or the file its report stage recorded)."""
+        if self.store.workspace is None:
+            return None
+        from ..core.report.stage import report_of
+
+        return report_of(self.store.workspace)
+
+    def open_report(self):
+        """The workspace's accuracy report in the web browser: at hand after a restart, when the Results Viewer
+        is empty (issue 48 item 5)."""
+        from qgis.PyQt.QtCore import QUrl
+        from qgis.PyQt.QtGui import QDesktopServices
+
+        path = self.report_path()
+        if path is None:
+            self.message(self.tr("The workspace has no accuracy report yet: run Accuracy report (or Run pipeline)"),
+                         Qgis.MessageLevel.Warning)
+            return False
+        if not QDesktopServices.openUrl(QUrl.fromLocalFile(path)):
+            self.message(self.tr("No web browser opened {}").format(path), Qgis.MessageLevel.Warning)
+            return False
+        self.message(self.tr("Accuracy report: {}").format(path))
         return True
 
     def _workspace_changed(self):
@@ -533,6 +564,10 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoContro
         busy = self.task is not None
         for a in (self.act_add, self.act_import_file, self.act_import_layer, self.act_results):
             a.setEnabled(has_ws)
+        report = self.report_path()
+        self.act_report.setEnabled(report is not None)
+        self.act_report.setToolTip(report or self.tr("The workspace has no accuracy report yet: run Accuracy report "
+                                                     "(or Run pipeline)"))
         for a in (self.act_remove,):
             a.setEnabled(has_ws and has_point)
         self.act_pick.setEnabled(has_ws and self.map_tool is not None)
@@ -571,6 +606,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoContro
 
     # ------------------------------------------------------------------ teardown
     def cleanup(self):
+        self._unwatch_height_layers()
         for job in list(self.__dict__.get("_refine_jobs", {}).values()):
             job.cancel()
         if self.task is not None:

@@ -175,7 +175,11 @@ class GcpTasks:
         images = QFileDialog.getExistingDirectory(self, translate("GcpDock", "Folder of photos"))
         if not images:
             return
-        ws = QFileDialog.getExistingDirectory(self, translate("GcpDock", "Workspace folder (new or existing)"))
+        from .folder_dialog import choose_folder
+
+        # a new folder's name typed in the dialog is taken (Qt's folder dialog said 'Directory not found')
+        ws = choose_folder(self, translate("GcpDock", "Workspace folder (new or existing)"),
+                           os.path.dirname(os.path.normpath(images)))
         if ws:
             self.start_alignment(images, ws)
 

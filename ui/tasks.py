@@ -3,7 +3,7 @@ stays responsive.  The result (or the error) is handed to callbacks in the main 
 import traceback
 
 from qgis.core import Qgis, QgsApplication, QgsMessageLog, QgsTask
-from qgis.PyQt.QtCore import pyqtSignal
+from qgis.PyQt.QtCore import QCoreApplication, QTimer, pyqtSignal
 
 
 class TaskProgress:
@@ -77,6 +77,14 @@ class CoreTask(QgsTask):
     def finished(self, ok):
         if not ok and self.isCanceled():
             self.was_cancelled = True
+        if not ok and self.was_cancelled:
+            # QGIS desktop tells a task that ended unsuccessfully as 'Task failed: <description>' (QgisApp's
+            # notification; in the message bar where the desktop has no notification service): a user's Cancel is
+            # no failure, and the dock says 'Cancelled'.  The notice comes with the task manager's statusChanged,
+            # before or after this call: withdrawn now and once the event loop has turned.
+            description = self.description()
+            withdraw_failed_notice(description)
+            QTimer.singleShot(0, lambda: withdraw_failed_notice(description))
         try:
             if ok and self.on_done is not None:
                 self.on_done(self.result)
@@ -100,6 +108,25 @@ class CoreTask(QgsTask):
         self.kwargs = {}
         self.on_done = self.on_error = None
         self.progress_adapter.task = None  # the cycle task <-> adapter, broken: the task dies by reference count
+
+
+QGIS_TASK_FAILED = "Task failed"  # QgisApp's title of the notice (translated by QGIS's own catalogue)
+
+
+def withdraw_failed_notice(description):
+    """Remove QGIS's 'Task failed' message-bar notice of the task ``description`` (a cancelled task); the
+    number removed."""
+    from qgis.utils import iface
+
+    bar = iface.messageBar() if iface is not None else None
+    items = list(bar.items()) if bar is not None and hasattr(bar, "items") else []  # none without a desktop
+    titles = {QGIS_TASK_FAILED, QCoreApplication.translate("QgisApp", QGIS_TASK_FAILED)}  # QGIS's, in its language
+    gone = 0
+    for item in items:
+        if item.text() == description and item.title() in titles:
+            bar.popWidget(item)
+            gone += 1
+    return gone
 
 
 def log_traceback(what, error):

@@ -136,4 +136,13 @@ def build_report(workspace_dir: str, options: Optional[ReportOptions] = None,
     return ReportResult(out, ws.root, figures, status, ctx.layers, ctx.warnings, seconds)
 
 
-__all__ = ["REPORT_FILE", "ReportResult", "build_report"]
+def report_of(ws) -> Optional[str]:
+    """The accuracy report of the Workspace ``ws`` that is on disk: the file its report stage recorded (an
+    OUTPUT_HTML given), else ``<workspace>/report.html``; None when there is none (the dock's 'Open report')."""
+    recorded = (ws.stage(STAGE).get("outputs") or {}).get("report")
+    candidates = [recorded if os.path.isabs(recorded) else os.path.join(ws.root, recorded)] if recorded else []
+    candidates.append(Layout(ws).default_report)
+    return next((os.path.abspath(p) for p in candidates if os.path.isfile(p)), None)
+
+
+__all__ = ["REPORT_FILE", "ReportResult", "build_report", "report_of"]
