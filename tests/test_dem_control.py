@@ -193,8 +193,10 @@ def test_bad_references_are_refused_by_name_before_the_adjustment(scene, tmp_pat
             _run(tmp_path / ("ws_" + os.path.basename(path)), scene, GeorefOptions(reference_dem=path))
         assert path in str(err.value), str(err.value)
         print(f"\n{os.path.basename(path)}: {err.value}")
-    with pytest.raises(ArchaeoOrthoError, match="needs a target CRS in metres; EPSG:2227 is in units of 0.3048") as err:
-        _run(tmp_path / "ws_feet", scene, GeorefOptions(reference_dem=scene[5]), crs="EPSG:2227")
+    # a target CRS in feet over the block (no EPSG code, so no area of use to refuse the positions by first)
+    feet = "+proj=tmerc +lat_0=41.5 +lon_0=15 +k=1 +x_0=0 +y_0=0 +ellps=GRS80 +units=us-ft +no_defs"
+    with pytest.raises(ArchaeoOrthoError, match="needs a target CRS in metres; .* is in units of 0.3048") as err:
+        _run(tmp_path / "ws_feet", scene, GeorefOptions(reference_dem=scene[5]), crs=feet)
     print(f"\ntarget CRS in feet: {err.value}")
 
 

@@ -17,9 +17,10 @@ import numpy as np
 import pytest
 
 from core.georef.targets import constellation
+from core.georef.targets.checks import code_names
 from core.georef.targets.detect import detect_image
 from core.georef.targets.options import FindTargetsOptions
-from core.georef.targets.stage import code_names, find_targets
+from core.georef.targets.stage import find_targets
 from core.io import gcp as gcpmod
 from core.project.layout import Layout, LayoutError
 from core.project.workspace import Workspace

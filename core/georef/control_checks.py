@@ -29,7 +29,7 @@ import numpy as np
 from ..common.progress import Progress
 from ..geometry.crs import crs_is_geographic
 from ..io import gcp as gcpmod
-from ..io.control_place import AREA_MARGIN, FAR_FACTOR, Gps, points_off, positions_off, usable_gps
+from ..io.control_place import Gps, points_off, positions_off, usable_gps
 from ..io.control_place import photos_utm as gps_utm
 from ..project.stages import StageError
 from ..project.workspace import Workspace
@@ -219,5 +219,5 @@ def check_control_files(photos_gps: Dict[str, Tuple[float, float, float]], opt: 
     return said
 
 
-__all__ = ["AREA_MARGIN", "FAR_FACTOR", "check_control_files", "check_control_location", "check_crs_parameter",
+__all__ = ["check_control_files", "check_control_location", "check_crs_parameter",
            "check_target_crs", "photos_utm", "read_checked_control"]

@@ -52,7 +52,7 @@ from .prior import Prior, gps_prior
 from .results import TIED, FindTargetsResult, keep_clicks, write_products
 from .tie import Track, on_surface, tie_candidates
 
-__all__ = ["code_names", "find_targets"]
+__all__ = ["find_targets"]
 
 
 def _prior(ws: Workspace, rec, crs: str, result: FindTargetsResult) -> Optional[Prior]:
