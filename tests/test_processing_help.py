@@ -387,7 +387,7 @@ def _metadata():
     import configparser
 
     meta = configparser.ConfigParser(interpolation=None)
-    meta.read(os.path.join(ROOT, "metadata.txt"), encoding="utf-8")
+    assert meta.read(os.path.join(ROOT, "metadata.txt"), encoding="utf-8")
     return meta["general"]
 
 

@@ -618,7 +618,7 @@ def test_reference_dsm_pickers_list_height_rasters_only(dock, aligned_ws, tmp_pa
     layers.load_dsm(_raster(own, 1, nodata=-9999), project, name="Own DSM")
     process(50)
     later = QgsRasterLayer(_raster(str(tmp_path / "scan.tif"), 3), "RGB added later")  # added after the dock opened
-    project.addMapLayer(later)
+    assert project.addMapLayer(later)
     process(50)
 
     def listed(combo):
@@ -739,8 +739,8 @@ def test_open_report_from_the_dock_after_a_restart(dock, aligned_ws, tmp_path, m
     assert dock.open_workspace(aligned_ws)
     assert not dock.act_report.isEnabled() and report_of(Workspace.open(aligned_ws)) is None
     report = layers.workspace_layout(aligned_ws).default_report
-    with open(report, "w", encoding="utf-8") as f:
-        f.write("<html><body>report</body></html>")
+    with open(report, "w", encoding="utf-8") as fh:
+        print("<html><body>report</body></html>", file=fh)
     assert dock.open_workspace(aligned_ws)  # as after a restart: the workspace opened again
     assert dock.act_report.isEnabled()
     dock.act_report.trigger()
