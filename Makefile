@@ -74,10 +74,11 @@ process: setup
 test: setup
 	QGIS_PROCESS=$(QGIS_PROCESS) QGIS_CUSTOM_CONFIG_PATH=$(QGIS_CONFIG) $(PY) -m pytest $(PYTEST_ARGS)
 
-# The edit-test loop: the tests every CI leg runs (tests/legs.py) less those marked slow, on both cores
+# The edit-test loop: the tests every CI leg runs (tests/legs.py) less those marked slow and the costliest others
+# (tests/legs.py EDIT_LOOP_LEAVES_OUT), on both cores
 test-fast: setup
 	QGIS_PROCESS=$(QGIS_PROCESS) QGIS_CUSTOM_CONFIG_PATH=$(QGIS_CONFIG) $(PY) -m pytest -q -n 2 --dist loadfile \
-	  -m "every_leg and not slow" $(PYTEST_ARGS)
+	  -m "fast and not slow" $(PYTEST_ARGS)
 
 # The same `make test` in a cached Debian chroot (root or sudo; see the script): QGIS 3.40 / Python 3.13 / NumPy 2
 # (Debian 13), QGIS 3.44 / Python 3.14 (Debian sid)

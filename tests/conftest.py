@@ -139,6 +139,8 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if not legs.one_leg(item.nodeid):
             item.add_marker(pytest.mark.every_leg)
+        if legs.in_edit_loop(item.nodeid):
+            item.add_marker(pytest.mark.fast)
     items.sort(key=lambda item: legs.slowest_first(item.nodeid))  # stable: a file's tests keep their order
 
 

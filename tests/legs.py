@@ -233,3 +233,49 @@ def one_leg(nodeid):
     path, _, rest = nodeid.partition("::")
     key = path.rsplit("/", 1)[-1] + "::" + rest.split("[", 1)[0]
     return key in ONE_LEG or path.rsplit("/", 1)[-1] in ONE_LEG
+
+
+# The edit-test loop (`make test-fast`, marker ``fast``): the tests every leg runs, less those marked slow and
+# less these, each 6 s or more in the loop (measured 7 Dec: the loop took 7 min with them, two workers); they
+# still run in `make test` and on every CI leg.
+EDIT_LOOP_LEAVES_OUT = {
+    "test_captures.py::test_qgis_process_runs_stackcaptures",  # 10 s
+    "test_captures.py::test_the_stack_states_its_radiometry_and_corrects_the_vignetting",  # 8 s
+    "test_dask.py::test_dask_products_are_identical_to_the_local_run",  # 21 s
+    "test_dem_control.py::test_automatic_control_with_a_reference_dsm_alone_is_dem_control",  # 14 s
+    "test_dem_control.py::test_processing_georeference_with_a_reference_dsm_alone",  # 8 s
+    "test_dem_control.py::test_the_reference_dem_removes_the_tilt_and_offset_of_gps_heights",  # 7 s
+    "test_dense.py::test_synthetic_dsm_accuracy",  # 12 s
+    "test_epochs.py::test_orthophoto_of_the_second_epoch_on_the_earlier_dsm",  # 8 s
+    "test_epochs.py::test_second_epoch_registered_on_the_earlier_block_with_no_gcp_and_no_prior",  # 8 s
+    "test_masks.py::test_align_extracts_no_keypoints_under_the_masks",  # 6 s
+    "test_masks.py::test_prepare_scanned_film_merges_polygons_with_the_scan_masks",  # 8 s
+    "test_obliques.py::test_render_shows_sky_where_the_truth_says",  # 7 s
+    "test_ortho.py::test_dsm_gaps_inside_the_data_are_filled_for_the_orthophoto",  # 11 s
+    "test_ortho.py::test_mosaic_is_a_cog_with_alpha_in_the_workspace",  # 23 s
+    "test_panel_calibration.py::test_a_normalised_stack_takes_the_light_of_its_panel",  # 8 s
+    "test_panel_calibration.py::test_qgis_process_stacks_with_the_panel",  # 8 s
+    "test_panel_calibration.py::test_the_stacked_photos_hold_reflectance_within_2_percent_of_the_truth",  # 13 s
+    "test_pipeline_panel.py::test_a_bad_panel_is_refused_before_the_alignment_naming_it",  # 6 s
+    "test_pipeline_panel.py::test_qgis_process_run_pipeline_refuses_a_bad_panel",  # 9 s
+    "test_reliability_photos.py::test_changed_photo_is_refused_by_the_dsm_and_the_orthophoto",  # 8 s
+    "test_scans.py::test_recovered_fiducials_within_half_a_pixel",  # 8 s
+    "test_screening.py::test_qgis_process_names_each_skipped_file_once_and_adds_no_error_line",  # 7 s
+    "test_seamlines.py::test_no_nodata_where_the_dsm_and_an_image_cover_the_cell",  # 16 s
+    "test_seamlines.py::test_qgis_process_takes_the_edited_seamlines",  # 12 s
+    "test_single_autocontrol.py::test_qgis_process_orthorectifies_with_automatic_control",  # 9 s
+    "test_single_autocontrol.py::test_single_photo_is_oriented_and_orthorectified_by_automatic_control",  # 9 s
+    "test_spectral_index.py::test_qgis_process_runs_spectralindex",  # 8 s
+    "test_terrain.py::test_qgis_process_runs_the_terrain_algorithms",  # 17 s
+    "test_ui_dock_layout.py::test_qgis_desktop_lang_de",  # 16 s
+    "test_ui_dock_layout.py::test_qgis_desktop_with_the_toolbox_and_results_viewer",  # 15 s
+    "test_ui_find_targets.py::test_one_key_confirms_or_rejects_each_found_observation",  # 6 s
+}
+
+
+def in_edit_loop(nodeid):
+    """True when the test of ``nodeid`` runs in `make test-fast`: not one-leg, not left out above (slow tests are
+    left out by the marker expression)."""
+    path, _, rest = nodeid.partition("::")
+    key = path.rsplit("/", 1)[-1] + "::" + rest.split("[", 1)[0]
+    return not one_leg(nodeid) and key not in EDIT_LOOP_LEAVES_OUT

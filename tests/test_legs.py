@@ -67,3 +67,13 @@ def test_the_costliest_files_exist_and_come_first():
     assert all(f in legs.FILES for f in legs.SLOWEST_FIRST), [f for f in legs.SLOWEST_FIRST if f not in legs.FILES]
     first = legs.SLOWEST_FIRST[0]
     assert legs.slowest_first(f"tests/{first}::test_x") < legs.slowest_first("tests/test_gcp.py::test_x")
+
+
+def test_every_test_the_edit_loop_leaves_out_exists():
+    for key in legs.EDIT_LOOP_LEAVES_OUT:
+        filename, _, test = key.partition("::")
+        assert filename in legs.FILES, f"EDIT_LOOP_LEAVES_OUT {key}: no such test file"
+        assert test in _test_functions(filename), f"EDIT_LOOP_LEAVES_OUT {key}: no test {test} in {filename}"
+    key = next(iter(legs.EDIT_LOOP_LEAVES_OUT))
+    assert not legs.in_edit_loop(f"tests/{key}[param-1]")
+    assert legs.in_edit_loop("tests/test_legs.py::test_every_test_the_edit_loop_leaves_out_exists")
