@@ -267,14 +267,18 @@ def test_qgis_process_stacks_with_the_panel(flight, tmp_path):
 def test_the_orthomosaic_of_reflectance_photos_is_reflectance(tmp_path):
     """Ten captures stacked with the panel (irradiance radiometry) -> Run pipeline on the photos -> the
     orthomosaic: float32, each band stating reflectance, within 2 % of the true reflectance over open ground (the
-    ortho leaves the values as they are: no exposure gains, no radiometric model); NDVI of it against the truth's."""
+    ortho leaves the values as they are: no exposure gains, no radiometric model); NDVI of it against the truth's.
+    The bands at half the rig's size (320 x 240 px, 19 cm cells), the DSM at quarter quality and no DTM: the
+    reflectance is the product, not the surface.  Measured: reflectance within 0.05 % in every band, NDVI's
+    median error 0.005, 134 000 cells of open ground."""
     from core import pipeline
     from core.align.options import AlignOptions
+    from core.dense.options import DenseOptions
     from core.spectral.index import spectral_index
     from core.spectral.options import IndexOptions
     from tests import synthetic as syn
 
-    rig = rs.rig_block(n_strips=2, per_strip=5)
+    rig = rs.rig_block(n_strips=2, per_strip=5, width=320, height=240)
     bands = rs.render(rig, str(tmp_path / "bands"), supersample=1)
     ps.render_panel(rig, str(tmp_path / "panel"), "0", 0.5, light=1.25, seed=0)
     ps.render_panel(rig, str(tmp_path / "panel"), "1", 0.5, light=0.8, seed=1)
@@ -282,7 +286,7 @@ def test_the_orthomosaic_of_reflectance_photos_is_reflectance(tmp_path):
                                                       panel=(str(tmp_path / "panel"),), panel_reflectance="0.5"))
     assert len(stack.photos) == 10
     result = pipeline.run_pipeline(str(tmp_path / "photos"), str(tmp_path / "ws"), pipeline.PipelineOptions(
-        align=AlignOptions(num_threads=2), make_report=False),
+        align=AlignOptions(num_threads=2), dense=DenseOptions(quality="quarter"), make_report=False, make_dtm=False),
         pipeline.Control(camera_positions_path=str(tmp_path / "camera_positions.csv")))
     assert result.align.registered == 10
     assert any("calibrated reflectance" in line for line in result.ortho.log_lines)
