@@ -278,14 +278,15 @@ def test_failed_align_rerun_leaves_the_previous_alignment(tmp_path):
     lay = Layout(ws)
     before = {"manifest": json.load(open(lay.manifest)), "db": _sha1(lay.database),
               "model": {n: _sha1(os.path.join(lay.aligned_model_dir, n)) for n in os.listdir(lay.aligned_model_dir)}}
-    # the wrong folder: three disjoint crops, nothing can be built from them
-    wrong = tmp_path / "wrong"
-    wrong.mkdir()
+    # the workspace's own folder, now holding three disjoint crops (nothing can be built from them): a re-alignment
+    # that fails (another folder sharing no photo is refused before any work: test_align.py)
+    for name in os.listdir(images):
+        os.replace(os.path.join(images, name), str(tmp_path / name))
     photo = cv2.imread(os.path.join(PHOTOS, "1JI_0076.JPG"))
     for k in range(3):
-        cv2.imwrite(str(wrong / f"crop{k}.jpg"), photo[:, k * 400:(k + 1) * 400])
+        cv2.imwrite(os.path.join(images, f"crop{k}.jpg"), photo[:, k * 400:(k + 1) * 400])
     with pytest.raises(AlignError, match="no reconstruction"):
-        align(str(wrong), ws_dir, AlignOptions(**FAST))
+        align(images, ws_dir, AlignOptions(**FAST))
     after = json.load(open(lay.manifest))
     assert after["images"] == before["manifest"]["images"] and after["images_dir"] == images
     assert after["camera_groups"] == before["manifest"]["camera_groups"]
@@ -297,7 +298,11 @@ def test_failed_align_rerun_leaves_the_previous_alignment(tmp_path):
     assert {n: _sha1(os.path.join(lay.aligned_model_dir, n)) for n in os.listdir(lay.aligned_model_dir)} == \
         before["model"]
     assert Layout(Workspace.open(ws_dir)).has_aligned_model()
-    # the right folder again: the previous database is reused as it was, the attempt note goes
+    # the right photos again: the previous database is reused as it was, the attempt note goes
+    for k in range(3):
+        os.remove(os.path.join(images, f"crop{k}.jpg"))
+    for name in PAIR:
+        os.replace(str(tmp_path / name), os.path.join(images, name))
     log = Log()
     r = align(images, ws_dir, AlignOptions(**FAST), log)
     assert r.registered == 2 and any("already extracted, reused" in m for m in log.lines)
