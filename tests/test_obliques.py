@@ -1,7 +1,8 @@
 """High obliques (issue 13, item 4): sky masks before and after alignment, no tie point and no dense point from the
 sky, per-image orthophotos limited to where their ground resolution is within a factor of their best, and a
 synthetic orbit (tests/synthetic.py: cameras circling the site at 45 and 65 degrees off nadir, the horizon and
-the sky in view at 65) aligned, georeferenced, matched and mosaicked end to end against its truth.
+the sky in view at 65) aligned, georeferenced, matched and mosaicked end to end against its truth (in photos of
+320 x 240 over an orbit 2/3 the size: ORBIT_E2E).
 
 Fast tests first (one or two rendered images, analytic cameras); the orbit end to end is marked slow."""
 import math
@@ -25,6 +26,12 @@ from tests import synthetic as syn
 
 ORBIT = dict(seed=21, per_ring=8)
 CAM = syn.ORBIT_CAMERA
+# the orbit end to end: ORBIT in photos of 320 x 240 (2/3 of ORBIT_CAMERA's side, the same field of view), the
+# orbit 2/3 the size (26.7 m high, the cameras' jitter and the ground marks' square in metres scaled with it: the
+# same view angles, horizons and sky): the GSD of the full-size orbit (0.133 m) over less of the site, less than
+# half the rendering, features and dense matching of the full-size photos
+ORBIT_E2E = dict(ORBIT, image_scale=2 / 3, altitude=40.0 * 2 / 3, position_jitter=0.5 * 2 / 3,
+                 target_jitter=3.0 * 2 / 3, gcp_half=22.0 * 2 / 3)
 
 
 def _intrinsics(c=CAM):
@@ -518,28 +525,48 @@ def test_far_field_limit_keeps_the_ground_of_a_vertical_beside_tall_objects(tmp_
 # ---------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")
-def orbit_run(orbit, tmp_path_factory):
-    """The 16 orbit images rendered and put through the pipeline with sky masks (as Run pipeline's SKY_MASKS):
-    'Prepare images' masks the sky, the prepared photos are aligned (default options: the fast path, then
-    escalation's affine-shape round for the views it leaves out), georeferenced with 5 control points, matched
-    (full quality) and mosaicked; a few minutes."""
+def e2e_orbit():
+    """The orbit of the end-to-end tests: ``orbit``'s cameras and scene in photos of 320 x 240 (ORBIT_E2E)."""
+    return syn.orbit_block(**ORBIT_E2E)
+
+
+@pytest.fixture(scope="module")
+def orbit_run(e2e_orbit, tmp_path_factory):
+    """The 16 orbit images (320 x 240) rendered and put through the pipeline with sky masks (as Run pipeline's
+    SKY_MASKS): 'Prepare images' masks the sky, the prepared photos are aligned (default options: the fast path,
+    then escalation's affine-shape round for the views it leaves out), georeferenced with 5 control points, matched
+    (half quality) and mosaicked at the nominal GSD (0.133 m) without the radiometric correction (the vignetting
+    and hot-spot fit, not what these tests look at; the exposure gains stay).  31-34 CPU seconds: rendering 10,
+    alignment 16-17 (the fast path leaves 5 steep views out, the affine round brings them in), the rest 6-7.
+
+    Measured (2 runs): 16/16 registered, 8 sky masks, the steep views' tie points 36..193 (none in the sky); check
+    points (11) xy 0.071 m (0.53 GSD), z 0.068-0.070 m (0.51-0.52 GSD); camera centres RMSE x 0.095-0.098, y
+    0.092-0.098, z 0.23-0.25 m, attitude max 0.53-0.56 deg; the true marks reprojected RMS 0.16 px, max 0.64-0.65
+    px; 92,000 dense points, none from the sky, |dz| median 0.089-0.092 m; 14 ground marks in the mosaic, RMSE
+    0.020-0.025 m (0.15-0.18 GSD).  (The full-size orbit, 480 x 360 photos 40 m high, full quality, 100 CPU s:
+    check points xy 0.26, z 0.30 GSD; centres RMSE 0.07 / 0.09 / 0.23 m; 824,000 dense points, |dz| median
+    0.046 m; marks 0.20 GSD.)
+    """
     import time
 
     from core.align.options import AlignOptions
     from core.dense.options import DenseOptions
     from core.pipeline import Control, PipelineOptions, run_pipeline
 
+    orbit = e2e_orbit
     root = tmp_path_factory.mktemp("orbit")
     ws = str(root / "ws")
-    t0 = time.time()
+    t0, c0 = time.time(), os.times()
     orbit.render(str(root / "photos"))
-    render = time.time() - t0
+    render, c1 = time.time() - t0, os.times()
     control = orbit.spread_control(5)
     res = run_pipeline(str(root / "photos"), ws, PipelineOptions(
-        align=AlignOptions(pairing="exhaustive", num_threads=2), dense=DenseOptions(quality="full"), make_report=False,
-        make_dtm=False, sky_masks=True), Control(gcps=orbit.gcp_set(control, noise_px=0.4)))
+        align=AlignOptions(pairing="exhaustive", num_threads=2), dense=DenseOptions(quality="half"),
+        ortho=OrthoOptions(resolution=orbit.gsd, radiometry=False), make_report=False, make_dtm=False,
+        sky_masks=True), Control(gcps=orbit.gcp_set(control, noise_px=0.4)))
     prep, aligned, dsm, ortho = res.prepare, res.align, res.dsm, res.ortho
-    print(f"\n[orbit] render {render:.0f} s, " + ", ".join(f"{k} {v:.0f} s" for k, v in res.seconds.items())
+    print(f"\n[orbit] render {render:.0f} s ({c1.user + c1.system - c0.user - c0.system:.1f} CPU s), "
+          + ", ".join(f"{k} {v:.0f} s ({res.cpu_seconds.get(k, 0):.1f} CPU s)" for k, v in res.seconds.items())
           + f"; registered {aligned.registered}/{len(orbit.shots)}, {aligned.num_points3d} points, reprojection "
           f"{aligned.mean_reprojection_error:.3f} px; sky masks {len(prep.masks)}; DSM {dsm.points} points; "
           f"mosaic at {ortho.resolution:g} m")
@@ -547,24 +574,30 @@ def orbit_run(orbit, tmp_path_factory):
 
 
 @pytest.mark.slow
-def test_orbit_sky_masks_before_alignment(orbit, orbit_run):
+def test_orbit_sky_masks_before_alignment(e2e_orbit, orbit_run):
+    orbit = e2e_orbit
     prep = orbit_run["prep"]
     steep = sorted(n for n, t in orbit.tilts.items() if t == 65.0)
     assert sorted(os.path.basename(m)[:-4] for m in prep.masks) == steep
     for m in prep.masks:
         name = os.path.basename(m)[:-4]
-        assert not (read_keep(m, CAM.width, CAM.height) & orbit.sky_mask(name)).any(), name
+        assert not (read_keep(m, orbit.camera.width, orbit.camera.height) & orbit.sky_mask(name)).any(), name
 
 
 @pytest.mark.slow
-def test_orbit_every_camera_registered_and_no_sky_tie_point(orbit, orbit_run):
+def test_orbit_every_camera_registered_and_no_sky_tie_point(e2e_orbit, orbit_run):
     from core.align.stage import load_model
 
+    orbit = e2e_orbit
     assert orbit_run["aligned"].registered == len(orbit.shots)
     esc = orbit_run["aligned"].escalation  # where the fast path left views out, the affine round brought them in
     assert esc is None or any(r["kind"] == "affine" and r["kept"] for r in esc["rounds"]), esc
     rec = load_model(orbit_run["ws"])
+    # the steep views keep tie points on the ground, up to the hazy band below the horizon: 50 in photos of 480 x 360,
+    # as many per pixel in these (22 in 320 x 240)
+    min_ties = round(50 * orbit.camera.width * orbit.camera.height / (480 * 360))
     n_kp = n_tie = 0
+    steep_ties = {}
     for im in rec.images.values():
         xy = np.array([p.xy for p in im.points2D])
         tie = np.array([p.has_point3D() for p in im.points2D])
@@ -572,20 +605,22 @@ def test_orbit_every_camera_registered_and_no_sky_tie_point(orbit, orbit_run):
         n_tie += int(tie.sum())
         in_sky = orbit.in_sky(im.name, xy)
         assert not in_sky.any(), f"{im.name}: {int(in_sky.sum())} keypoints in the sky"
-        steep = orbit.tilts[im.name] == 65.0
-        if steep:  # the steep views keep tie points on the ground, up to the hazy band below the horizon
-            assert tie.sum() >= 50, im.name
-    print(f"\n{n_kp} keypoints, {n_tie} observations of tie points, none in the sky")
+        if orbit.tilts[im.name] == 65.0:
+            steep_ties[im.name] = int(tie.sum())
+    print(f"\n{n_kp} keypoints, {n_tie} observations of tie points, none in the sky; the steep views' tie points "
+          f"{min(steep_ties.values())}..{max(steep_ties.values())}")
+    assert min(steep_ties.values()) >= min_ties, steep_ties
 
 
 @pytest.mark.slow
-def test_orbit_poses_within_the_nadir_tolerances(orbit, orbit_run):
+def test_orbit_poses_within_the_nadir_tolerances(e2e_orbit, orbit_run):
     """As the vertical block's end-to-end test (tests/test_georef_synthetic.py): 5 control points, check points
-    within 1 GSD (xy) and 1.5 GSD (z), GSD the nominal 40 m / 300 px (the finest these obliques see); the camera
-    centres and attitudes against the truth as well."""
+    within 1 GSD (xy) and 1.5 GSD (z), GSD the nominal 26.7 m / 200 px = 0.133 m (the finest these obliques see);
+    the camera centres and attitudes against the truth as well."""
     from core.project.layout import Layout
     from core.project.workspace import Workspace
 
+    orbit = e2e_orbit
     geo = orbit_run["geo"]
     gsd = orbit.gsd
     f = geo.figures
@@ -615,16 +650,18 @@ def test_orbit_poses_within_the_nadir_tolerances(orbit, orbit_run):
     res_px = np.array(res_px)
     print(f"true marks reprojected: {len(res_px)} observations, RMS {np.sqrt(np.mean(res_px ** 2)):.3f} px, "
           f"max {res_px.max():.3f} px")
-    # the centres lie 57-95 m from the site and their height trades off against the focal length: 4 GSD (0.53 m)
-    # is 0.6-0.9 % of that distance
+    # the centres lie 38-63 m from the site and their height trades off against the focal length: 4 GSD (0.53 m)
+    # is 0.8-1.4 % of that distance
     assert np.hypot(rmse[0], rmse[1]) <= 2.0 * gsd and float(np.linalg.norm(rmse)) <= 4.0 * gsd
     assert np.sqrt(np.mean(res_px ** 2)) <= 1.0 and res_px.max() <= 3.0
 
 
 @pytest.mark.slow
-def test_orbit_no_dense_point_from_the_sky(orbit, orbit_run):
+def test_orbit_no_dense_point_from_the_sky(e2e_orbit, orbit_run):
     from core.project.layout import Layout
     from core.project.workspace import Workspace
+
+    orbit = e2e_orbit
 
     lay = Layout(Workspace.open(orbit_run["ws"]))
     rec, transform = lay.load_georef_model()
@@ -665,7 +702,8 @@ def _mark_shift(orbit, arr, gt, xw, yw, n=32):
 
 
 @pytest.mark.slow
-def test_orbit_mosaic_ground_marks_within_one_and_a_half_gsd(orbit, orbit_run):
+def test_orbit_mosaic_ground_marks_within_one_and_a_half_gsd(e2e_orbit, orbit_run):
+    orbit = e2e_orbit
     ortho = orbit_run["ortho"]
     ds = gdal.Open(ortho.orthomosaic)
     arr = ds.ReadAsArray().astype(np.float32)
