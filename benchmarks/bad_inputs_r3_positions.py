@@ -63,6 +63,13 @@ def _georef(ws, **params):
     return ("georeference", dict({"WORKSPACE": ws}, **params))
 
 
+def _latlon_swapped(ws, tmp):
+    """A camera-positions file in EPSG:4326 from the photos' own GPS with latitude in the x column."""
+    rows = ["EPSG:4326", "image,x,y,z"] + [f"{im['name']},{im['gps'][1]:.8f},{im['gps'][0]:.8f},{im['gps'][2]}"
+                                           for im in _images(ws)]
+    return _write(os.path.join(tmp, "positions_latlon.csv"), rows)
+
+
 # ---------------------------------------------------------------------------
 # item 2: positions far from the photos' GPS (swapped axes, a wrong CRS)
 # ---------------------------------------------------------------------------
@@ -70,9 +77,7 @@ def _georef(ws, **params):
 @case(2, "camera positions in EPSG:4326 with the latitude in the x column",
       r"camera positions .*(swapped|latitude)")
 def positions_latlon_swapped(ws, tmp):
-    rows = ["EPSG:4326", "image,x,y,z"] + [f"{im['name']},{im['gps'][1]:.8f},{im['gps'][0]:.8f},{im['gps'][2]}"
-                                           for im in _images(ws)]
-    p = _write(os.path.join(tmp, "positions_latlon.csv"), rows)
+    p = _latlon_swapped(ws, tmp)
     return Spec([_georef(ws, CAMERA_POSITIONS=p)], protected=[p], check=_placed_near_gps)
 
 

@@ -7,7 +7,7 @@ reference does; run through ``qgis_process`` by ``benchmarks/bad_inputs_r3.py``.
 import os
 
 from bad_inputs import Spec, case
-from bad_inputs_r3_positions import _duplicated, _images, _model_gcps, _placed_near_gps, _write
+from bad_inputs_r3_positions import _duplicated, _latlon_swapped, _model_gcps, _placed_near_gps
 
 
 def _automatic(ws, **params):
@@ -19,9 +19,7 @@ def _automatic(ws, **params):
 @case(2, "automatic control (reference ortho + DSM) with camera positions in EPSG:4326, latitude in the x column",
       r"camera positions in \S+ \(EPSG:4326\) land .* latitude and longitude look swapped")
 def auto_positions_latlon_swapped(ws, tmp):
-    rows = ["EPSG:4326", "image,x,y,z"] + [f"{im['name']},{im['gps'][1]:.8f},{im['gps'][0]:.8f},{im['gps'][2]}"
-                                           for im in _images(ws)]
-    p = _write(os.path.join(tmp, "positions_latlon.csv"), rows)
+    p = _latlon_swapped(ws, tmp)
     return Spec([_automatic(ws, CAMERA_POSITIONS=p)], protected=[p], check=_placed_near_gps)
 
 
