@@ -21,7 +21,14 @@ Two modes:
     python benchmarks/memory.py chain --images ../shared/data/toledo_2400/images --reuse --root . \
         --stages orthophoto,terrain,relief,report
 
-(ochota_kap has no GPS: its chain ends after the alignment.)  The orthophoto stage's seam brightness step before /
+(ochota_kap has no GPS: its chain ends after the alignment.)  Each child logs its progress with the time and its
+process tree's RSS (``<workdir>/chain-0/<stage>.log``), and each stage's line names the step after which its
+peak was sampled.  Issue 46 item 3 (a 40-photo block of 3600 x 2700 photos of low-texture fields,
+``benchmarks/upscaled_set.py --turns``):
+
+    python benchmarks/upscaled_set.py ../shared/data/seneca_south/images /tmp/s23/mem40/images --mp 9.72 \
+        --turns 0,180,90,270 --count 40
+    nice -n 10 python benchmarks/memory.py chain --images /tmp/s23/mem40/images --workdir /tmp/s23/mem40/run  The orthophoto stage's seam brightness step before /
 after the radiometric correction is printed under it.
 """
 from __future__ import annotations
@@ -48,8 +55,9 @@ FOCAL_PX = [0.0]  # --focal-px, passed to the children (0: the alignment's defau
 
 # ---------------------------------------------------------------- measuring a child
 
-def measure(cmd, log_path, cwd=None, interval=0.2):
-    """(exit code, wall s, CPU s, peak RSS bytes) of ``cmd`` and its descendants."""
+def measure(cmd, log_path, cwd=None, interval=0.2, peak_at=None):
+    """(exit code, wall s, CPU s, peak RSS bytes) of ``cmd`` and its descendants; ``peak_at`` (a list) receives
+    the time (epoch s) the sampled peak was seen, to find it among the child's traced lines."""
     with open(log_path, "w") as out:
         t0 = time.time()
         proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT, cwd=cwd)
@@ -58,7 +66,11 @@ def measure(cmd, log_path, cwd=None, interval=0.2):
 
         def sample():
             while not stop.wait(interval):
-                peak[0] = max(peak[0], tree_rss(proc.pid)[0])
+                rss = tree_rss(proc.pid)[0]
+                if rss > peak[0]:
+                    peak[0] = rss
+                    if peak_at is not None:
+                        peak_at[:] = [time.time()]
 
         th = threading.Thread(target=sample, daemon=True)
         th.start()
@@ -132,12 +144,30 @@ def synthetic_dsm(path, width=7220, height=6052, cell=0.049, seed=33):
 
 # ---------------------------------------------------------------- children: one stage each
 
+def trace_progress():
+    """A progress that prints every message (reports at 5 % steps) with the epoch time and the process tree's RSS
+    then: the log shows which step of the stage the peak falls in (the parent prints the peak's time)."""
+    from core.common.progress import PrintProgress
+
+    class Trace(PrintProgress):
+        def info(self, message):
+            super().info(f"[{time.time():.1f} {tree_rss(os.getpid())[0] / GIB:5.2f} GiB] {message}")
+
+        def warning(self, message):
+            self.info(f"WARNING: {message}")
+
+        def report(self, fraction, message=""):
+            if fraction - self._last >= 0.05 or fraction >= 1.0:
+                self._last = fraction
+                self.info(f"{100 * fraction:5.1f}% {message}")
+
+    return Trace()
+
+
 def child(args):
     sys.path.insert(0, args.root)
     os.chdir(args.root)
-    from core.common.progress import NullProgress
-
-    p = NullProgress()
+    p = trace_progress()
     if args.stage == "dtm":
         from core.terrain.products import build_dtm
         build_dtm(args.src, os.path.join(args.out, "dtm.tif"), progress=p)
@@ -190,12 +220,31 @@ def run_stage(root, stage, src, out, logdir):
     cmd = [sys.executable, os.path.abspath(__file__), "--child", stage, "--src", src, "--out", out, "--root", root,
            "--focal-px", str(FOCAL_PX[0]), "--dsm-quality", DSM_QUALITY[0]]
     log = os.path.join(logdir, f"{stage}.log")
-    rc, wall, cpu, rss = measure(cmd, log)
+    peak_at = []
+    rc, wall, cpu, rss = measure(cmd, log, peak_at=peak_at)
     if rc != 0:
         with open(log) as fh:
             tail = fh.read()[-2000:]
         print(f"  {stage}: FAILED (exit {rc}), {log}:\n{tail}")
-    return {"stage": stage, "rc": rc, "wall": wall, "cpu": cpu, "rss": rss}
+    return {"stage": stage, "rc": rc, "wall": wall, "cpu": cpu, "rss": rss, "step": peak_step(log, peak_at)}
+
+
+def peak_step(log, peak_at):
+    """The last traced line of the child's log before the sampled peak: the step the peak fell in."""
+    if not peak_at:
+        return ""
+    last = ""
+    with open(log) as fh:
+        for line in fh:
+            if line.startswith("[") and " GiB] " in line:
+                try:
+                    t = float(line[1:].split()[0])
+                except ValueError:
+                    continue
+                if t > peak_at[0]:
+                    break
+                last = line.split(" GiB] ", 1)[1].strip()
+    return last[:90]
 
 
 # ---------------------------------------------------------------- comparing products
@@ -285,7 +334,8 @@ def _stages(root, args, images, ws, logdir):
     for stage in args.stages.split(","):
         r = run_stage(root, stage, images, ws, logdir)
         out.append(r)
-        print(f"  {stage:14s} {r['cpu']:8.1f} CPU-s {r['wall']:8.1f} s  peak {r['rss'] / GIB:6.2f} GiB", flush=True)
+        print(f"  {stage:14s} {r['cpu']:8.1f} CPU-s {r['wall']:8.1f} s  peak {r['rss'] / GIB:6.2f} GiB  "
+              f"(after: {r['step']})", flush=True)
         if stage == "orthophoto" and not r["rc"]:
             with open(os.path.join(logdir, "orthophoto.log")) as fh:
                 print("".join(f"    {line}" for line in fh if line.startswith("RADIOMETRY")), end="")

@@ -6,18 +6,18 @@
 - ``sfm/model/``: the largest reconstruction in COLMAP binary format, in the local model frame;
 - ``sfm/alignment.json``: figures, the images not registered and why; ``cameras.gpkg``: camera positions.
 
-The algorithm modules: :mod:`.inputs` (the photos), :mod:`.firstpass` (the first pass's features from the photos'
-texture), :mod:`.features` (cameras, masks, extraction, matching), :mod:`.pairs` (pair selection), :mod:`.mapping`
-(incremental or global mapping, bundle adjustment), :mod:`.joining` (a split block's components joined by the
-photos' positions), :mod:`.escalation` (richer features and more pairs where the fast path left images out or
-split the block: ``escalation`` in ``sfm/alignment.json``), :mod:`.diagnosis` (why an image is not registered),
-:mod:`.record` and :mod:`.result` (database, record, products); the options in :mod:`.options`.
+The algorithm modules: :mod:`.inputs` (photos), :mod:`.firstpass` (the first pass's features from the photos'
+texture), :mod:`.features` (cameras, masks, extraction, matching), :mod:`.pairs`, :mod:`.mapping` (mapping, bundle
+adjustment), :mod:`.joining` (a split block joined by the photos' positions), :mod:`.escalation` (richer features
+and pairs where the fast path left images out), :mod:`.links` (weak links matched again, guided by the block),
+:mod:`.diagnosis` (why an image is not registered), :mod:`.record`, :mod:`.result`; options in :mod:`.options`.
 """
 from __future__ import annotations
 
 import os
 import time
 from dataclasses import asdict
+from functools import partial
 from typing import Dict, Optional
 
 from ..common.cancel import load_pycolmap
@@ -34,6 +34,7 @@ from .features import extract_features, match_pairs
 from .firstpass import choose_first_pass
 from .inputs import Photos, read_folder
 from .joining import PositionJoin
+from .links import reinforce
 from .mapping import MappingJob, adjust_block, map_block, verified_links, verified_pairs, verified_partners
 from .options import MIN_VERIFIED_INLIERS, AlignError, AlignOptions
 from .pairs import select_pairs
@@ -42,9 +43,8 @@ from .result import AlignResult, Outcome, write_products
 
 
 def check_options(options: AlignOptions) -> list:
-    """The checks of the alignment's options that need no photo: AlignError for a choice out of its values,
-    CalibrationError (file, line, field) for a calibration file that cannot be read.  Returns the
-    calibrations read (core.io.calibration.CameraCalibration)."""
+    """The checks of the options that need no photo: AlignError for a choice out of its values, CalibrationError
+    (file, line, field) for a calibration file that cannot be read.  Returns the calibrations read."""
     options.check()
     return read_calibrations(options)
 
@@ -53,8 +53,8 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
           progress: Optional[Progress] = None) -> AlignResult:
     """Run the alignment stage.  Raises AlignError / ImageError / WorkspaceError / Cancelled.
 
-    A re-run that fails or is cancelled leaves a previous complete alignment as it was: the image list, the
-    database, the model and the later stages' records are replaced only when the new alignment succeeds."""
+    A re-run that fails or is cancelled leaves a previous complete alignment as it was: the image list, database,
+    model and the later stages' records are replaced only when the new alignment succeeds."""
     options = options or AlignOptions()
     progress = progress or NullProgress()
     calibrations = check_options(options)  # a mistyped choice or a bad calibration file fails before any work
@@ -66,8 +66,7 @@ def align(images_dir: str, workspace_dir: str, options: Optional[AlignOptions] =
         require_images(images_dir)  # empty: before the workspace too (issue 36 item 21: it was created)
     except ImageError as e:
         raise AlignError(str(e)) from e
-    ws = Workspace.create_or_open(workspace_dir)  # checks writability before any work
-    lay = Layout(ws)
+    lay = Layout(ws := Workspace.create_or_open(workspace_dir))  # checks writability before any work
     photos = read_folder(pycolmap, lay, images_dir, options, calibrations, progress)
     previous = previous_alignment(ws, lay)
     try:
@@ -93,11 +92,9 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
         job, masks = prepare_database(pycolmap, lay, photos, options, run.record, keep_previous, first, progress)
         db_path = job.db_path
         ws.save()
-
         with run.step("features", save=False):  # 2. features
             extract_features(pycolmap, job, first.settings, options, SubProgress(progress, 0.02, 0.35))
-        # 3. pairs + matching
-        with run.step("matching", save=False):
+        with run.step("matching", save=False):  # 3. pairs + matching
             pairs, pairing_used, pw = select_pairs(infos, options.pairing, options.spatial_neighbours, photos.positions)
             for w in pw:
                 progress.warning(w)
@@ -126,11 +123,14 @@ def _run(pycolmap, ws: Workspace, lay: Layout, photos: Photos, options: AlignOpt
             raise no_reconstruction_error(partners, len(infos), verified_pairs(pycolmap, db_path, MIN_VERIFIED_INLIERS),
                                      photos.held()[0])
         rec, others = ordered[0], block_state(ordered)[1]
-        # 5. final global bundle adjustment (the held cameras' intrinsics constant; the focal held if it drifted)
+        # 5. final bundle adjustment (held cameras constant; the focal held if it drifted), also after each links round
+        adjust = partial(adjust_block, pycolmap, rec, options, progress, photos.held()[0], degenerate,
+                         hold_focal=mapping_job.focal_held is not None, priors=join.priors(rec))
+        with run.step("links", save=False):
+            reinforce(pycolmap, rec, mapping_job, pairs, run.record, progress, adjust)
         with run.step("bundle_adjustment", save=False):
             progress.report(0.94, "final bundle adjustment")
-            pp = adjust_block(pycolmap, rec, options, progress, photos.held()[0], degenerate,
-                              hold_focal=mapping_job.focal_held is not None, priors=join.priors(rec))
+            pp = adjust()
         registered = {rec.images[i].name for i in rec.reg_image_ids()}
         unregistered = diagnose_unregistered(infos, registered, others, partners, degenerate,
                                              verified_links(pycolmap, db_path, MIN_VERIFIED_INLIERS)[1])

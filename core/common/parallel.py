@@ -63,16 +63,44 @@ def available_memory() -> Optional[int]:
     return None
 
 
+def own_memory() -> int:
+    """Bytes this process holds now (its resident set, Linux /proc/self/status), 0 where unknown."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0
+
+
+# the automatic number of workers keeps a stage -- this process and its workers, each holding one unit -- within
+# this many bytes (issue 46: at most 3 GiB a stage; the DSM's matching units of 10 MP photos at quality half hold
+# 0.36 GiB each, and one per core of a 12-core machine took the stage to 4.5 GiB). A WORKERS given is not bounded.
+STAGE_MEMORY = 3 * 2 ** 30
+UNIT_MEMORY_MARGIN = 1.1  # the units' estimates (e.g. core.dense.points.unit_memory) lie within ~10 % of their peaks
+
+
 def auto_workers(unit_memory: int = 0, max_workers: int = 0) -> int:
-    """Workers for this machine: one per core, fewer when ``unit_memory`` bytes per unit would not fit
-    in half of the available memory."""
+    """Workers for this machine: one per core, fewer when ``unit_memory`` bytes per unit would not fit in half of
+    the available memory, nor beside this process's own memory within STAGE_MEMORY (:func:`memory_workers`)."""
     n = cpu_count()
-    mem = available_memory()
-    if unit_memory > 0 and mem:
-        n = min(n, max(1, int(0.5 * mem // unit_memory)))
+    if unit_memory > 0:
+        n = min(n, memory_workers(unit_memory, available_memory(), own_memory()))
     if max_workers > 0:
         n = min(n, max_workers)
     return max(1, n)
+
+
+def memory_workers(unit_memory: int, available: Optional[int], own: int, budget: int = STAGE_MEMORY) -> int:
+    """How many units of ``unit_memory`` bytes may be in flight at once: within half of the ``available`` memory
+    (None: unknown) and, beside the ``own`` bytes of the process that waits for them, within ``budget`` (each unit
+    counted UNIT_MEMORY_MARGIN times its estimate); at least one (a unit larger than the budget still runs, alone)."""
+    room = budget - own
+    if available:
+        room = min(room, 0.5 * available)
+    return max(1, int(room // (unit_memory * UNIT_MEMORY_MARGIN)))
 
 
 def python_executable() -> Optional[str]:
@@ -176,7 +204,7 @@ def make_executor(workers: int = 0, kind: str = "auto", scheduler: Optional[str]
                   unit_memory: int = 0, connect_timeout: float = 30.0):
     """An executor for units of work.
 
-    ``workers`` 0 = one per core (bounded by ``unit_memory``); ``kind`` auto = serial for one worker,
+    ``workers`` 0 = one per core (bounded by ``unit_memory``: :func:`auto_workers`); ``kind`` auto = serial for one worker,
     else processes; ``scheduler`` = a Dask scheduler address (tcp://host:8786; default
     ``$ARCHAEOORTHO_DASK_SCHEDULER``) to use a cluster, whose workers must see the same paths (a shared
     file system) and have this plugin's ``core`` importable.  The caller shuts it down
