@@ -2,32 +2,17 @@
 import os
 
 from qgis.core import QgsApplication
-from qgis.PyQt.QtCore import QCoreApplication, QLocale, QSettings, QTranslator
+from qgis.PyQt.QtCore import QCoreApplication, QTranslator
 
 PLUGIN_DIR = os.path.dirname(__file__)
 
 
 def _locale() -> str:
-    """The two-letter language QGIS runs in, read the way QGIS applies it (call it when the plugin is set up,
-    not at import): the override of Options > General (``locale/overrideFlag`` + ``locale/userLocale``), else
-    the translation QGIS installed at start (``qgis --lang de`` sets it, QgsApplication.translation()), else (no
-    QGIS desktop: qgis_process, a script) QgsApplication.locale(), the system's language.  A ``locale/userLocale``
-    that ``qgis --lang`` left in the profile does not switch later headless runs."""
-    settings = QSettings()
-    override = str(settings.value("locale/overrideFlag", False)).lower() in ("true", "1")
-    value = str(settings.value("locale/userLocale", "") or "") if override else ""
-    if not value:
-        try:
-            app = QgsApplication.instance()
-            value = app.translation() if isinstance(app, QgsApplication) else ""
-        except Exception:  # noqa: BLE001 - no QgsApplication yet
-            value = ""
-    if not value:
-        try:
-            value = QgsApplication.locale()
-        except Exception:  # noqa: BLE001 - no QgsApplication yet
-            value = ""
-    return str(value or QLocale.system().name())[:2]
+    """The two-letter language QGIS runs in (qgisio/messages.qgis_language: the plugin's translator and the
+    report's language follow the same reading)."""
+    from .qgisio.messages import qgis_language
+
+    return qgis_language()
 
 
 class ArchaeoOrthoPlugin:
@@ -42,6 +27,8 @@ class ArchaeoOrthoPlugin:
         self.dock = None
         self.dependencies_dir = None
         self.dependencies_message = None
+        self.results_workspace = None  # the workspace a Processing run just loaded layers of (the dock follows)
+        self.group_menu = None  # "Open accuracy report" in the context menu of a workspace's layer group
         self._install_translator()
         self._activate_dependencies()
 
@@ -120,7 +107,32 @@ class ArchaeoOrthoPlugin:
         self.iface.addPluginToRasterMenu(self.tr("&ArchaeoOrtho"), self.action)
         # the Plugins toolbar is shown by default (the Raster toolbar is not)
         self.iface.addToolBarIcon(self.action)
+        from .qgisio.layers import results_notifier
+
+        results_notifier().workspaceLoaded.connect(self._workspace_from_results)
+        self._install_group_menu()
         self._offer_dependencies()
+
+    def _install_group_menu(self):
+        from .ui.workspace_menu import WorkspaceGroupMenu
+
+        self.group_menu = WorkspaceGroupMenu(self.iface)
+        self.group_menu.install()
+
+    def _workspace_from_results(self, root):
+        """A Processing run (Run pipeline from the Toolbox) loaded the layers of workspace ``root``: the dock shows
+        it (issue 48 item 4), once after the run's last layer, when the dock is next shown if it is not yet."""
+        from qgis.PyQt.QtCore import QTimer
+
+        first = self.results_workspace is None
+        self.results_workspace = root
+        if first:
+            QTimer.singleShot(0, self._follow_results_workspace)
+
+    def _follow_results_workspace(self):
+        if self.dock is not None and self.results_workspace:
+            self.dock.follow_workspace(self.results_workspace)
+            self.results_workspace = None
 
     def show_dock(self, visible=True):
         """Create the GCP dock (and its photo dock) on first use and show or hide both."""
@@ -129,37 +141,23 @@ class ArchaeoOrthoPlugin:
         if self.dock is None:
             if not visible:
                 return None
-            from qgis.PyQt.QtCore import Qt
-
+            from .ui.dock_layout import place_docks
             from .ui.gcp_dock import GcpDock
 
             self.dock = GcpDock(self.iface, parent=self.iface.mainWindow())
             self.dock.refine_in_background = True  # matching a prediction never blocks QGIS (issue 18.5)
-            self.iface.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, self.dock)
-            self.iface.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.dock.photo_dock)
+            # each a side column's height: the GCP dock a tab beside the Toolbox on the right, the photos a tab
+            # beside the Layers panel on the left; the map keeps the window's height (issue 48 item 7)
+            place_docks(self.iface.mainWindow(), self.dock, self.dock.photo_dock, add=self.iface.addDockWidget)
             self.dock.visibilityChanged.connect(self._dock_visibility)
             self.dock.setUserVisible(visible)
             self.dock.photo_dock.setUserVisible(visible)
-            self._default_dock_sizes()
+            self._follow_results_workspace()  # a run's workspace from before the dock was first shown
         self.dock.setUserVisible(visible)
         self.dock.photo_dock.setUserVisible(visible)
         if self.action is not None and self.action.isChecked() != visible:
             self.action.setChecked(visible)
         return self.dock
-
-    def _default_dock_sizes(self):
-        """First shown: the GCP dock at its default width (the key columns visible), the photo dock at a height
-        where a photo can be worked in (QGIS would give it the height of its smallest content)."""
-        from qgis.PyQt.QtCore import Qt
-
-        from .ui.gcp_dock import PHOTO_DOCK_HEIGHT
-
-        main = self.iface.mainWindow()
-        if not hasattr(main, "resizeDocks"):
-            return
-        height = min(PHOTO_DOCK_HEIGHT, max(300, int(main.height() * 0.62)))
-        main.resizeDocks([self.dock.photo_dock], [height], Qt.Orientation.Vertical)
-        main.resizeDocks([self.dock], [self.dock.sizeHint().width()], Qt.Orientation.Horizontal)
 
     def _dock_visibility(self, visible):
         if self.action is not None and not visible and self.dock is not None and not self.dock.isUserVisible():
@@ -168,6 +166,16 @@ class ArchaeoOrthoPlugin:
             self.action.blockSignals(False)
 
     def unload(self):
+        if self.iface is not None and self.action is not None:
+            from .qgisio.layers import results_notifier
+
+            try:
+                results_notifier().workspaceLoaded.disconnect(self._workspace_from_results)
+            except (TypeError, RuntimeError):  # not connected
+                pass
+        if self.group_menu is not None:
+            self.group_menu.uninstall()
+            self.group_menu = None
         if self.dock is not None:
             self.dock.cleanup()
             if self.iface is not None:

@@ -2,39 +2,62 @@
 <!DOCTYPE TS>
 <TS version="2.1">
 <context>
+    <name>@default</name>
+    <message>
+        <location filename="../ui/workspace_menu.py" line="61"/>
+        <source>ArchaeoOrtho</source>
+        <translation>ArchaeoOrtho</translation>
+    </message>
+    <message>
+        <location filename="../ui/workspace_menu.py" line="61"/>
+        <source>No web browser opened {}</source>
+        <translation>Kein Webbrowser geöffnet {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/workspace_menu.py" line="107"/>
+        <source>Open accuracy report</source>
+        <translation>Genauigkeitsbericht öffnen</translation>
+    </message>
+    <message>
+        <location filename="../ui/workspace_menu.py" line="111"/>
+        <source>Open accuracy report (none yet: run Accuracy report or Run pipeline)</source>
+        <translation>Genauigkeitsbericht öffnen (noch keiner: Genauigkeitsbericht oder Gesamte Verarbeitung ausführen)</translation>
+    </message>
+</context>
+<context>
     <name>AccuracyReportAlgorithm</name>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="71"/>
+        <location filename="../processing_provider/accuracy_report.py" line="72"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="79"/>
+        <location filename="../processing_provider/accuracy_report.py" line="80"/>
         <source>Workspace</source>
         <translation>Arbeitsbereich</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="80"/>
+        <location filename="../processing_provider/accuracy_report.py" line="81"/>
         <source>Camera precision (GeoPackage)</source>
         <translation>Genauigkeit der Kameras (GeoPackage)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="81"/>
+        <location filename="../processing_provider/accuracy_report.py" line="82"/>
         <source>Tie point precision (GeoPackage)</source>
         <translation>Genauigkeit der Verknüpfungspunkte (GeoPackage)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="82"/>
+        <location filename="../processing_provider/accuracy_report.py" line="83"/>
         <source>Sections skipped</source>
         <translation>Ausgelassene Abschnitte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="99"/>
+        <location filename="../processing_provider/accuracy_report.py" line="100"/>
         <source>section {} skipped: {}</source>
         <translation>Abschnitt {} ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="101"/>
+        <location filename="../processing_provider/accuracy_report.py" line="102"/>
         <source>report written: {} ({} s)</source>
         <translation>Bericht geschrieben: {} ({} s)</translation>
     </message>
@@ -44,12 +67,12 @@
         <translation>Genauigkeitsbericht</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="71"/>
+        <location filename="../processing_provider/accuracy_report.py" line="72"/>
         <source>Compute uncertainty</source>
         <translation>Unsicherheit berechnen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="76"/>
+        <location filename="../processing_provider/accuracy_report.py" line="77"/>
         <source>Report</source>
         <translation>Bericht</translation>
     </message>
@@ -74,12 +97,12 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
 <context>
     <name>AlgorithmBase</name>
     <message>
-        <location filename="../processing_provider/base.py" line="240"/>
+        <location filename="../processing_provider/base.py" line="269"/>
         <source>Cancelled: {}</source>
         <translation>Abgebrochen: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/base.py" line="149"/>
+        <location filename="../processing_provider/base.py" line="169"/>
         <source>Outputs not styled: {}</source>
         <translation>Ausgaben nicht gestaltet: {}</translation>
     </message>
@@ -87,6 +110,11 @@ Bericht: die Berichtsdatei (Vorgabe: &lt;workspace&gt;/report.html). Sie wird un
         <location filename="../ui/catalog.py" line="8"/>
         <source>Photogrammetry</source>
         <translation>Photogrammetrie</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/base.py" line="331"/>
+        <source>{}: cancelling (send it again to stop at once)</source>
+        <translation>{}: wird abgebrochen (erneut senden, um sofort anzuhalten)</translation>
     </message>
 </context>
 <context>
@@ -243,17 +271,17 @@ Ausgelassene Bilder erneut versuchen (erweitert, an): Bilder, die die schnellen 
 <context>
     <name>ArchaeoOrthoPlugin</name>
     <message>
-        <location filename="../plugin.py" line="114"/>
+        <location filename="../plugin.py" line="101"/>
         <source>Ground control (GCP dock)</source>
         <translation>Passpunkte (GCP-Fenster)</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="118"/>
+        <location filename="../plugin.py" line="105"/>
         <source>ArchaeoOrtho: pick ground control points on the map and in the photos</source>
         <translation>ArchaeoOrtho: Passpunkte auf der Karte und in den Fotos messen</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="180"/>
+        <location filename="../plugin.py" line="188"/>
         <source>&amp;ArchaeoOrtho</source>
         <translation>&amp;ArchaeoOrtho</translation>
     </message>
@@ -579,6 +607,124 @@ Höhenlinien: wohin die Höhenlinien geschrieben werden (Vorgabe: &lt;workspace&
     </message>
 </context>
 <context>
+    <name>BuildModelAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="63"/>
+        <source>Workspace folder (with a DSM)</source>
+        <translation>Arbeitsbereich-Ordner (mit einem DOM)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="63"/>
+        <source>Geometry</source>
+        <translation>Geometrie</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="63"/>
+        <source>Face budget (triangles at most)</source>
+        <translation>Flächenbudget (höchstens so viele Dreiecke)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="63"/>
+        <source>Files</source>
+        <translation>Dateien</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="63"/>
+        <source>Texture from the photos</source>
+        <translation>Textur aus den Fotos</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="63"/>
+        <source>Atlas size in pixels (a power of two)</source>
+        <translation>Atlasgröße in Pixeln (eine Zweierpotenz)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="63"/>
+        <source>Number of atlases at most</source>
+        <translation>Höchstens so viele Atlanten</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="76"/>
+        <source>Model folder</source>
+        <translation>Modellordner</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="78"/>
+        <source>Workspace</source>
+        <translation>Arbeitsbereich</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="79"/>
+        <source>Model (GLB)</source>
+        <translation>Modell (GLB)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="80"/>
+        <source>Model (OBJ)</source>
+        <translation>Modell (OBJ)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="81"/>
+        <source>3D Tiles (tileset.json)</source>
+        <translation>3D Tiles (tileset.json)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="82"/>
+        <source>Faces</source>
+        <translation>Flächen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="83"/>
+        <source>Share of faces textured</source>
+        <translation>Anteil texturierter Flächen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="114"/>
+        <source>3-D model in {}: {} faces, {:.0%} textured</source>
+        <translation>3-D-Modell in {}: {} Flächen, {:.0%} texturiert</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="118"/>
+        <source>{} opens in {}</source>
+        <translation>{} öffnet sich in {}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="120"/>
+        <source>QGIS {} has no 3D Tiles layers (QGIS 3.34 or newer has): open {} there or in CesiumJS, or model.glb in a glTF viewer</source>
+        <translation>QGIS {} hat keine 3D-Tiles-Layer (QGIS 3.34 oder neuer hat sie): {} dort oder in CesiumJS öffnen, oder model.glb in einem glTF-Betrachter</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Build 3-D model</source>
+        <translation>3-D-Modell erzeugen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>A textured 3-D model of the site. The DSM&apos;s surface becomes a triangle mesh within a face budget, each face textured from the photo that sees it best; it is written as a textured OBJ (+ MTL + JPEG atlases), a binary glTF (GLB, texture embedded), a PLY of the geometry and OGC 3D Tiles (tileset.json with levels of detail), all in the workspace CRS about a local origin that the files name.
+
+On QGIS 3.34 or newer the 3D Tiles open as a tiled scene layer in the workspace&apos;s group (View &gt; 3D Map View shows them over the orthomosaic); on older QGIS the log names the files and the programs that open them. A block without control (a model frame) is written as OBJ / GLB / PLY in that frame; 3D Tiles need a georeferenced block.
+
+Workspace folder: a georeferenced workspace with a DSM (run &apos;Build DSM&apos; first).
+Geometry: auto (the DSM&apos;s 2.5-D surface), dsm, or points (the fused dense points&apos; 3-D surface: not available yet).
+Face budget: the most triangles the model may have.
+Files: the formats to write.
+Texture from the photos: off for a grey model (faster).
+Atlas size and number of atlases (advanced): the texture images&apos; side in pixels and how many at most.
+Model folder: where to write the files (default: &lt;workspace&gt;/model3d; the folder is replaced whole).</source>
+        <translation>Ein texturiertes 3-D-Modell der Fundstelle. Die Oberfläche des DOM wird zu einem Dreiecksnetz innerhalb eines Flächenbudgets, jede Fläche texturiert aus dem Foto, das sie am besten sieht; geschrieben als texturiertes OBJ (+ MTL + JPEG-Atlanten), binäres glTF (GLB, Textur eingebettet), PLY der Geometrie und OGC 3D Tiles (tileset.json mit Detailstufen), alle im KBS des Arbeitsbereichs um einen lokalen Ursprung, den die Dateien nennen.
+
+Ab QGIS 3.34 öffnen sich die 3D Tiles als Tiled-Scene-Layer in der Gruppe des Arbeitsbereichs (Ansicht &gt; 3D-Kartenansicht zeigt sie über dem Orthomosaik); in älteren QGIS nennt das Protokoll die Dateien und die Programme, die sie öffnen. Ein Block ohne Passpunkte (ein Modellrahmen) wird als OBJ / GLB / PLY in diesem Rahmen geschrieben; 3D Tiles brauchen einen georeferenzierten Block.
+
+Arbeitsbereich-Ordner: ein georeferenzierter Arbeitsbereich mit DOM (zuerst 'DOM erzeugen' ausführen).
+Geometrie: auto (die 2,5-D-Oberfläche des DOM), dsm oder points (die 3-D-Oberfläche der fusionierten dichten Punkte: noch nicht verfügbar).
+Flächenbudget: die meisten Dreiecke, die das Modell haben darf.
+Dateien: die zu schreibenden Formate.
+Textur aus den Fotos: aus für ein graues Modell (schneller).
+Atlasgröße und Anzahl der Atlanten (erweitert): die Seitenlänge der Texturbilder in Pixeln und wie viele höchstens.
+Modellordner: wohin die Dateien geschrieben werden (Vorgabe: &lt;workspace&gt;/model3d; der Ordner wird als Ganzes ersetzt).</translation>
+    </message>
+</context>
+<context>
     <name>BuildOrthophotoAlgorithm</name>
     <message>
         <location filename="../processing_provider/build_orthophoto.py" line="107"/>
@@ -898,6 +1044,16 @@ Dask-Scheduler (erweitert): die Kacheln auf einem Dask-Cluster (tcp://host:8786)
         <source>irradiance</source>
         <translation>Einstrahlung (irradiance)</translation>
     </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>checkerboard</source>
+        <translation>Schachbrett (checkerboard)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>circle</source>
+        <translation>Kreis (circle)</translation>
+    </message>
 </context>
 <context>
     <name>ContoursAlgorithm</name>
@@ -933,6 +1089,824 @@ Contours: the GeoPackage to write.</source>
 Höhenraster: ein DGM oder DOM in einem projizierten KBS (Meter).
 Abstand: Meter zwischen zwei Höhenlinien (z. B. 0.5).
 Höhenlinien: das zu schreibende GeoPackage.</translation>
+    </message>
+</context>
+<context>
+    <name>CoreMessages</name>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>captures: {} multi-band photo(s) of {}{} in {} ({} radiometry)</source>
+        <translation>Aufnahmen: {} Mehrkanal-Foto(s) aus {}{} in {} (Radiometrie {})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>pipeline done</source>
+        <translation>Verarbeitung fertig</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{}: an RGB frame of a capture not stacked (a calibration panel&apos;s, or left out): not aligned</source>
+        <translation>{}: ein RGB-Bild einer nicht gestapelten Aufnahme (einer Kalibrierplatte oder ausgelassen): nicht ausgerichtet</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>--- stage {} ---</source>
+        <translation>--- Schritt {} ---</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>prepare: {} sky mask(s), {} of {} photos kept</source>
+        <translation>Vorbereiten: {} Himmelsmaske(n), {} von {} Fotos behalten</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>find targets: {} of {} targets found, {} observations</source>
+        <translation>Zielmarken finden: {} von {} Zielmarken gefunden, {} Beobachtungen</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>find targets: {}</source>
+        <translation>Zielmarken finden: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera {} ({} image(s), {} x {} px): interior orientation {}</source>
+        <translation>Kamera {} ({} Bild(er), {} x {} px): innere Orientierung {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera {}: the calibration {} gives a focal length of {} px, {} {} px ({} %); the calibration&apos;s is used: check that it is this camera&apos;s and that its units are right</source>
+        <translation>Kamera {}: die Kalibrierung {} ergibt eine Brennweite von {} px, {} {} px ({} %); die der Kalibrierung wird verwendet: prüfen Sie, ob sie zu dieser Kamera gehört und ihre Einheiten stimmen</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>calibration {}, {}: {}</source>
+        <translation>Kalibrierung {}, {}: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>calibration file {}: no photo matches {}; it is not used</source>
+        <translation>Kalibrierdatei {}: kein Foto passt zu {}; sie wird nicht verwendet</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>not registered: {}: {}</source>
+        <translation>nicht registriert: {}: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>escalation round {}: matching {} pairs</source>
+        <translation>Erweiterungsrunde {}: {} Paare werden zugeordnet</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>escalation round {}: {}: {}</source>
+        <translation>Erweiterungsrunde {}: {}: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>escalation: {} image(s) without any verified pair after round 1, not escalated further (no ground shared with the block): {}</source>
+        <translation>Erweiterung: {} Bild(er) ohne verifiziertes Paar nach Runde 1, nicht weiter erweitert (kein mit dem Block gemeinsames Gelände): {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>escalation round {}: could not put {} back ({}); a re-run extracts the features of the images of this round again</source>
+        <translation>Erweiterungsrunde {}: {} konnte nicht zurückgesetzt werden ({}); ein erneuter Lauf extrahiert die Merkmale der Bilder dieser Runde neu</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>features: {} images already extracted, reused</source>
+        <translation>Merkmale: {} Bilder bereits extrahiert, wiederverwendet</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>features: {}/{} images ({})</source>
+        <translation>Merkmale: {}/{} Bilder ({})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>matching: {} of {} pairs already matched, reused</source>
+        <translation>Zuordnung: {} von {} Paaren bereits zugeordnet, wiederverwendet</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>matching: {}/{} pairs</source>
+        <translation>Zuordnung: {}/{} Paare</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera {}: {} {} {}x{}, {}, {} images</source>
+        <translation>Kamera {}: {} {} {}x{}, {}, {} Bilder</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>joining {} components by the photos&apos; positions (fits {} m, photo spacing {} m)</source>
+        <translation>{} Teilblöcke werden über die Fotopositionen verbunden (Passung {} m, Fotoabstand {} m)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>join: {}</source>
+        <translation>Verbinden: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>join: registered on the joined block&apos;s points: {}</source>
+        <translation>Verbinden: an den Punkten des verbundenen Blocks registriert: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: {} image(s) outside the main block of {}; trying them against the finished block with {} 2D-3D inliers (first pass: {})</source>
+        <translation>Bildzuordnung: {} Bild(er) außerhalb des Hauptblocks von {}; Versuch gegen den fertigen Block mit {} 2D-3D-Inliern (erster Durchgang: {})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: {} more image(s) registered on the relaxed threshold: {}</source>
+        <translation>Bildzuordnung: {} weitere(s) Bild(er) mit gelockerter Schwelle registriert: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: global SfM (rotation averaging, global positioning, bundle adjustment)</source>
+        <translation>Bildzuordnung: globales SfM (Rotationsmittelung, globale Positionierung, Bündelausgleichung)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: global SfM done</source>
+        <translation>Bildzuordnung: globales SfM fertig</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: the self-calibrated focal length went from {} to {} px and {} of {} images registered; mapping again with the photos&apos; own focal length and the distortion held</source>
+        <translation>Bildzuordnung: die selbstkalibrierte Brennweite ging von {} auf {} px und {} von {} Bildern wurden registriert; erneute Zuordnung mit der eigenen Brennweite der Fotos und festgehaltener Verzeichnung</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: the focal length is held at the photos&apos; own ({} px; the distortion refined only by the final adjustment): self-calibrated it drifted to {} px and registered {} of {} images, held {}</source>
+        <translation>Bildzuordnung: die Brennweite wird auf der eigenen der Fotos gehalten ({} px; die Verzeichnung nur von der abschließenden Ausgleichung verfeinert): selbstkalibriert driftete sie auf {} px und registrierte {} von {} Bildern, gehalten {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: two images, mapped with the incremental mapper (the global mapper needs tracks of three or more views)</source>
+        <translation>Bildzuordnung: zwei Bilder, mit dem inkrementellen Verfahren zugeordnet (das globale braucht Spuren aus drei oder mehr Ansichten)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: registered image {}</source>
+        <translation>Bildzuordnung: Bild {} registriert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: continuing the block of {} images</source>
+        <translation>Bildzuordnung: der Block aus {} Bildern wird fortgesetzt</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: no further image registered</source>
+        <translation>Bildzuordnung: kein weiteres Bild registriert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: {} {}: left out of the block</source>
+        <translation>Bildzuordnung: {} {}: aus dem Block ausgelassen</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: with the intrinsics held {} images registered: the self-calibrated mapping is kept</source>
+        <translation>Bildzuordnung: mit festgehaltener innerer Orientierung {} Bilder registriert: die selbstkalibrierte Zuordnung bleibt</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>final bundle adjustment: {} {}: left out of the block</source>
+        <translation>abschließende Bündelausgleichung: {} {}: aus dem Block ausgelassen</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>masks: {} of {} images have a mask ({}): no features where they are black</source>
+        <translation>Masken: {} von {} Bildern haben eine Maske ({}): keine Merkmale, wo sie schwarz sind</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>features: {} photo(s) matched on an 8-bit image of their primary band or grey ({})</source>
+        <translation>Merkmale: {} Foto(s) auf einem 8-Bit-Bild ihres Hauptkanals oder in Grau zugeordnet ({})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>aligned {}/{} images, {} px</source>
+        <translation>{}/{} Bilder ausgerichtet, {} px</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>pair selection: {}, {} pairs for {} images</source>
+        <translation>Paarauswahl: {}, {} Paare für {} Bilder</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>final bundle adjustment</source>
+        <translation>abschließende Bündelausgleichung</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>DSM tile {}/{}</source>
+        <translation>DOM-Kachel {}/{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>matching: {} pairs ({} reused from a previous run), {} s per pair, {} s per megapixel, {}</source>
+        <translation>Zuordnung: {} Paare ({} aus einem früheren Lauf wiederverwendet), {} s pro Paar, {} s pro Megapixel, {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>resuming: {} of {} pairs already matched</source>
+        <translation>Fortsetzung: {} von {} Paaren bereits zugeordnet</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>pair {} + {} skipped: {}</source>
+        <translation>Paar {} + {} übersprungen: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} image(s) are in fewer than {} matched pairs and add no points of their own: {}{}</source>
+        <translation>{} Bild(er) sind in weniger als {} zugeordneten Paaren und tragen keine eigenen Punkte bei: {}{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>undistorting images (COLMAP)</source>
+        <translation>Bilder werden entzerrt (COLMAP)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>patch-match stereo (COLMAP, CUDA)</source>
+        <translation>Patch-Match-Stereo (COLMAP, CUDA)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>stereo fusion (COLMAP)</source>
+        <translation>Stereo-Fusion (COLMAP)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>pairs: {} selected from {} overlapping image pairs ({} images, quality {}, median GSD {} m, DSM resolution {} m)</source>
+        <translation>Paare: {} aus {} überlappenden Bildpaaren gewählt ({} Bilder, Qualität {}, mittlere GSD {} m, DOM-Auflösung {} m)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>DSM done</source>
+        <translation>DOM fertig</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>points: {} fused from {} images</source>
+        <translation>Punkte: {} aus {} Bildern fusioniert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>removed {}, left by a killed run</source>
+        <translation>{} entfernt, von einem abgebrochenen Lauf übrig</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>Helmert from {} {}</source>
+        <translation>Helmert aus {} {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>triangulating control points</source>
+        <translation>Passpunkte werden trianguliert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>every control point has Z = {}: treated as a placeholder, not a surveyed height; the points are taken to lie near one level surface (sigma Z {} m) and the Z figures measure the departure from that level, not height accuracy</source>
+        <translation>jeder Passpunkt hat Z = {}: als Platzhalter behandelt, nicht als gemessene Höhe; die Punkte gelten als nahe einer ebenen Fläche liegend (Sigma Z {} m), und die Z-Werte messen die Abweichung von dieser Ebene, nicht die Höhengenauigkeit</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>control points given sigmas far finer than the block resolves at them (about {} m XY, {} m Z) - {}: honoured as given, i.e. these points are held fixed at their coordinates; if they are not exact to that level give their real accuracy (e.g. 0.01 m for RTK)</source>
+        <translation>Passpunkten wurden Sigmas gegeben, die weit feiner sind, als der Block sie auflöst (etwa {} m XY, {} m Z) - {}: wie angegeben übernommen, d. h. diese Punkte werden an ihren Koordinaten festgehalten; sind sie nicht so genau, geben Sie ihre wirkliche Genauigkeit an (z. B. 0,01 m für RTK)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>estimating the accuracy of the control given without sigmas</source>
+        <translation>die Genauigkeit der ohne Sigmas angegebenen Passpunkte wird geschätzt</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>the control points&apos; sigma XY ({} m) is far below how well the block fits them: {} control points miss the rigid block by {} m (median, {} sigma), and the adjustment bends the block to fit them; if their coordinates are metre-level (handheld GPS, read off a map) give the file sigma columns of that size, or none: without sigmas their accuracy is estimated from the data</source>
+        <translation>das Sigma XY der Passpunkte ({} m) liegt weit unter der Passung des Blocks an sie: {} Passpunkte verfehlen den starren Block um {} m (Median, {} Sigma), und die Ausgleichung verbiegt den Block, um sie zu treffen; sind ihre Koordinaten nur metergenau (Hand-GPS, aus einer Karte abgelesen), geben Sie der Datei Sigma-Spalten dieser Größe oder keine: ohne Sigmas wird ihre Genauigkeit aus den Daten geschätzt</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>updating the model</source>
+        <translation>Modell wird aktualisiert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>check points</source>
+        <translation>Kontrollpunkte</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>georeferencing done</source>
+        <translation>Georeferenzierung fertig</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>control point not usable: {}</source>
+        <translation>Passpunkt nicht verwendbar: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} camera position(s) without a height (Z): they constrain X and Y only</source>
+        <translation>{} Kameraposition(en) ohne Höhe (Z): sie bestimmen nur X und Y</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>control point {}: {} m off the Helmert fit of the others, but consistent with the adjusted block ({} sigma, image residuals up to {} px): re-admitted; the block was deformed</source>
+        <translation>Passpunkt {}: {} m neben der Helmert-Passung der anderen, aber mit dem ausgeglichenen Block verträglich ({} Sigma, Bildresiduen bis {} px): wieder aufgenommen; der Block war verformt</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>no CRS given for the ground control</source>
+        <translation>kein KBS für die Passpunkte angegeben</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>CRS {} not recognised; assuming metric, right-handed coordinates</source>
+        <translation>KBS {} nicht erkannt; metrische, rechtshändige Koordinaten angenommen</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} {} is {} m off the Helmert fit of the others (threshold {} m): excluded; check its coordinates</source>
+        <translation>{} {} liegt {} m neben der Helmert-Passung der anderen (Schwelle {} m): ausgeschlossen; prüfen Sie seine Koordinaten</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>control point {} is {} m off the Helmert fit of the others (threshold {} m): left out of the first adjustment, then re-tested against the adjusted block</source>
+        <translation>Passpunkt {} liegt {} m neben der Helmert-Passung der anderen (Schwelle {} m): aus der ersten Ausgleichung ausgelassen, dann gegen den ausgeglichenen Block erneut geprüft</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>no 4 control points agree with the block within {} m: either the block is deformed or several coordinates are wrong</source>
+        <translation>keine 4 Passpunkte stimmen innerhalb von {} m mit dem Block überein: entweder ist der Block verformt oder mehrere Koordinaten sind falsch</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>control point {} disagrees with the others through the block ({} m): suspect, dropped from the adjustment</source>
+        <translation>Passpunkt {} widerspricht den anderen über den Block ({} m): verdächtig, aus der Ausgleichung genommen</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} point {}: observation at ({}, {}) lies outside image {} ({} x {} px); ignored</source>
+        <translation>Punkt ({}) {}: Beobachtung bei ({}, {}) liegt außerhalb von Bild {} ({} x {} px); ignoriert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>the block adjusted with the DEM control could not be co-registered again: {}</source>
+        <translation>der mit der DGM-Kontrolle ausgeglichene Block konnte nicht erneut koregistriert werden: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>bundle adjustment: {} iteration(s), cost {} -&gt; {}</source>
+        <translation>Bündelausgleichung: {} Iteration(en), Kosten {} -&gt; {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera(s) {}: calibrated interior orientation fixed, not refined{}</source>
+        <translation>Kamera(s) {}: kalibrierte innere Orientierung festgehalten, nicht verfeinert{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera(s) {}: interior orientation refined with priors at the calibration&apos;s values (weighted by its sigmas)</source>
+        <translation>Kamera(s) {}: innere Orientierung mit Vorinformation bei den Werten der Kalibrierung verfeinert (gewichtet mit ihren Sigmas)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>adjusting {} of {} tie points ({} of {} observations); the others are re-triangulated afterwards</source>
+        <translation>{} von {} Verknüpfungspunkten werden ausgeglichen ({} von {} Beobachtungen); die anderen werden danach neu trianguliert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>bundle adjustment</source>
+        <translation>Bündelausgleichung</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera {}: the calibration&apos;s model {} is not the model&apos;s {}: its intrinsics follow refine_intrinsics</source>
+        <translation>Kamera {}: das Modell der Kalibrierung {} ist nicht das des Modells {}: ihre innere Orientierung folgt refine_intrinsics</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera {}: only {} image(s), intrinsics kept fixed</source>
+        <translation>Kamera {}: nur {} Bild(er), innere Orientierung festgehalten</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>GCP coordinates measured on upright photos: no photo of the block is stored turned (EXIF orientation 1 or none), nothing to convert</source>
+        <translation>Passpunktkoordinaten auf aufrechten Fotos gemessen: kein Foto des Blocks ist gedreht gespeichert (EXIF-Ausrichtung 1 oder keine), nichts umzurechnen</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>USE_EXIF_GPS is set but no image carries EXIF GPS</source>
+        <translation>USE_EXIF_GPS ist gesetzt, aber kein Bild trägt EXIF-GPS</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>co-registration done</source>
+        <translation>Koregistrierung fertig</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>co-registration iteration {}: shift {}, {} m</source>
+        <translation>Koregistrierung Iteration {}: Verschiebung {}, {} m</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>georeferenced</source>
+        <translation>georeferenziert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>reference DEM {} without ground control or camera positions: the photos&apos; EXIF GPS place the block, the DEM fixes its heights, tilt and dome</source>
+        <translation>Referenz-DGM {} ohne Passpunkte oder Kamerapositionen: das EXIF-GPS der Fotos platziert den Block, das DGM bestimmt seine Höhen, Neigung und Wölbung</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>checking the reference DEM against the block</source>
+        <translation>das Referenz-DGM wird gegen den Block geprüft</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>covariance: Jacobian</source>
+        <translation>Kovarianz: Jacobi-Matrix</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>covariance: normal equations</source>
+        <translation>Kovarianz: Normalgleichungen</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>covariance: inverting the reduced system</source>
+        <translation>Kovarianz: das reduzierte System wird invertiert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>covariance: points</source>
+        <translation>Kovarianz: Punkte</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>covariance done</source>
+        <translation>Kovarianz fertig</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>automatic control: point {} of {} in the photos</source>
+        <translation>automatische Passpunkte: Punkt {} von {} in den Fotos</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>provisional orthophoto: projecting {}</source>
+        <translation>vorläufiges Orthophoto: {} wird projiziert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>provisional orthophoto: sampling {}</source>
+        <translation>vorläufiges Orthophoto: {} wird abgetastet</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>first match</source>
+        <translation>erste Zuordnung</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>looking for targets: {}</source>
+        <translation>Suche nach Zielmarken: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} candidate(s), {} tied across photos</source>
+        <translation>{} Kandidat(en), {} über Fotos verknüpft</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} target(s), {} observation(s) found</source>
+        <translation>{} Zielmarke(n), {} Beobachtung(en) gefunden</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>reading images</source>
+        <translation>Bilder werden gelesen</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>writing Cloud-Optimized GeoTIFF</source>
+        <translation>Cloud-Optimized GeoTIFF wird geschrieben</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>point cloud: {} points</source>
+        <translation>Punktwolke: {} Punkte</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>3-D model done</source>
+        <translation>3-D-Modell fertig</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mesh: {} faces (DSM grid reduced {} x)</source>
+        <translation>Netz: {} Flächen (DOM-Raster {}-fach reduziert)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>visibility in {}</source>
+        <translation>Sichtbarkeit in {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>texture from {}</source>
+        <translation>Textur aus {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>3D Tiles: level {} of {}</source>
+        <translation>3D Tiles: Stufe {} von {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{}: tile {}/{}</source>
+        <translation>{}: Kachel {}/{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>orthomosaic done</source>
+        <translation>Orthomosaik fertig</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>no DSM given: how far planar rectification is off because of relief cannot be measured</source>
+        <translation>kein DOM angegeben: wie weit die ebene Entzerrung wegen des Reliefs abweicht, kann nicht gemessen werden</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>the DSM does not cover the image&apos;s ground: planar displacement not measured</source>
+        <translation>das DOM deckt das Gelände des Bildes nicht ab: ebene Verschiebung nicht gemessen</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>planar rectification: tile {}/{}</source>
+        <translation>ebene Entzerrung: Kachel {}/{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mosaic planned</source>
+        <translation>Mosaik geplant</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>planning the mosaic: {}/{}</source>
+        <translation>Mosaik wird geplant: {}/{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>radiometry: fall-off fitted</source>
+        <translation>Radiometrie: Randabfall angepasst</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>radiometry: hot spot searched</source>
+        <translation>Radiometrie: Hotspot gesucht</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>radiometry: gain fields fitted</source>
+        <translation>Radiometrie: Verstärkungsfelder angepasst</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>radiometry: sampling {}/{}</source>
+        <translation>Radiometrie: Abtastung {}/{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera at X {} Y {} Z {}, omega {} phi {} kappa {} deg</source>
+        <translation>Kamera bei X {} Y {} Z {}, Omega {} Phi {} Kappa {} Grad</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>oriented</source>
+        <translation>orientiert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>the control / DSM CRS is geographic (degrees): {} is oriented and orthorectified in EPSG:{} (the UTM zone of the image), and the orthophoto is written in it</source>
+        <translation>das KBS der Passpunkte / des DOM ist geografisch (Grad): {} wird in EPSG:{} (der UTM-Zone des Bildes) orientiert und entzerrt, und das Orthophoto wird darin geschrieben</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>no CRS given: coordinates are taken as they are (no CRS written)</source>
+        <translation>kein KBS angegeben: die Koordinaten werden genommen, wie sie sind (kein KBS geschrieben)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>GCP observation(s) outside the {} x {} image {}: {}</source>
+        <translation>Passpunktbeobachtung(en) außerhalb des {} x {} großen Bildes {}: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} orthophoto {}: {} per cell, {} % of its cells with data</source>
+        <translation>{} Orthophoto {}: {} pro Zelle, {} % seiner Zellen mit Daten</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>done</source>
+        <translation>fertig</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>the focal length of {} is unknown (no EXIF, none given): it is estimated from the {} control points</source>
+        <translation>die Brennweite von {} ist unbekannt (kein EXIF, keine angegeben): sie wird aus den {} Passpunkten geschätzt</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>DSM {} reprojected on the fly into the working CRS</source>
+        <translation>DOM {} wird während der Verarbeitung in das Arbeits-KBS umprojiziert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>captures: {}/{} stacked</source>
+        <translation>Aufnahmen: {}/{} gestapelt</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>capture {} left out: {}</source>
+        <translation>Aufnahme {} ausgelassen: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>sky: {} of {} images show sky, hidden from the alignment</source>
+        <translation>Himmel: {} von {} Bildern zeigen Himmel, vor der Ausrichtung verborgen</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>one photo ({}): screened on its own, with no set to compare with (only the absolute limits: clipped highlights and shadows, dynamic range); prepared as a set&apos;s photos are</source>
+        <translation>ein Foto ({}): für sich allein geprüft, ohne Vergleichssatz (nur die absoluten Grenzen: überstrahlte Lichter und Schatten, Dynamikumfang); vorbereitet wie die Fotos eines Satzes</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>masks: {} polygons ({}, y {}) hide parts of {} of {} images</source>
+        <translation>Masken: {} Polygone ({}, y {}) verdecken Teile von {} von {} Bildern</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>masks: {}/{}</source>
+        <translation>Masken: {}/{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>fiducials: {}/{} scans ({}: {} marks)</source>
+        <translation>Rahmenmarken: {}/{} Scans ({}: {} Marken)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>resampling {}</source>
+        <translation>{} wird umgetastet</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>screening: {}/{} images ({})</source>
+        <translation>Prüfung: {}/{} Bilder ({})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>sky: {}</source>
+        <translation>Himmel: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>sky mask: {}: {} % of the photo (rows {}–{})</source>
+        <translation>Himmelsmaske: {}: {} % des Fotos (Zeilen {}–{})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>sky mask: {}: none, {}</source>
+        <translation>Himmelsmaske: {}: keine, {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>screened {} images: {} flagged, {} excluded</source>
+        <translation>{} Bilder geprüft: {} markiert, {} ausgeschlossen</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>writing the screening record</source>
+        <translation>das Prüfprotokoll wird geschrieben</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>reading the sparse model</source>
+        <translation>das dünne Modell wird gelesen</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>report written: {}</source>
+        <translation>Bericht geschrieben: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>report: {}</source>
+        <translation>Bericht: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>uncertainty: bundle adjustment covariance</source>
+        <translation>Unsicherheit: Kovarianz der Bündelausgleichung</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{}: block {} of {}</source>
+        <translation>{}: Block {} von {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} of {} ({} x {} cells): {}</source>
+        <translation>{} von {} ({} x {} Zellen): {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>contours</source>
+        <translation>Höhenlinien</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>DSM A read</source>
+        <translation>DOM A gelesen</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>DSM B warped onto the grid of DSM A</source>
+        <translation>DOM B auf das Raster von DOM A umgerechnet</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>DSM difference written</source>
+        <translation>DOM-Differenz geschrieben</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>ground filter: interpolating under the objects</source>
+        <translation>Bodenfilter: unter den Objekten wird interpoliert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>ground filter: window {} m</source>
+        <translation>Bodenfilter: Fenster {} m</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>ground filter: tile {} of {}</source>
+        <translation>Bodenfilter: Kachel {} von {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>ground filter: object {} of {}</source>
+        <translation>Bodenfilter: Objekt {} von {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>relief visualisation: {}</source>
+        <translation>Reliefdarstellung: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>relief visualisation: {}, tile {} of {}</source>
+        <translation>Reliefdarstellung: {}, Kachel {} von {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>saving the reference {} {}: {}</source>
+        <translation>Referenz {} {} wird gespeichert: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>reference {} saved to {} ({} % of it has data)</source>
+        <translation>Referenz {} gespeichert unter {} ({} % davon mit Daten)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>reference {} {}: {} x {} m at {} m would exceed {} pixels: saved at {} m</source>
+        <translation>Referenz {} {}: {} x {} m bei {} m würden {} Pixel überschreiten: gespeichert mit {} m</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>saving the reference {} {}</source>
+        <translation>Referenz {} {} wird gespeichert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>the photos are corrected as the orthophoto&apos;s (exposure, vignetting, hot spot)</source>
+        <translation>die Fotos werden wie für das Orthophoto korrigiert (Belichtung, Vignettierung, Hotspot)</translation>
     </message>
 </context>
 <context>
@@ -1081,24 +2055,37 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
     </message>
 </context>
 <context>
+    <name>FolderDialog</name>
+    <message>
+        <location filename="../ui/folder_dialog.py" line="47"/>
+        <source>The folder {} cannot be made: {}</source>
+        <translation>Der Ordner {} kann nicht angelegt werden: {}</translation>
+    </message>
+</context>
+<context>
     <name>GcpDock</name>
     <message>
+        <location filename="../ui/gcp_dock.py" line="221"/>
         <source>Report</source>
         <translation>Bericht</translation>
     </message>
     <message>
+        <location filename="../ui/gcp_dock.py" line="222"/>
         <source>Open the workspace&apos;s accuracy report (report.html, made by Run pipeline or Accuracy report) in the web browser</source>
         <translation>Den Genauigkeitsbericht des Arbeitsbereichs (report.html, von Run pipeline oder Accuracy report erstellt) im Webbrowser öffnen</translation>
     </message>
     <message>
+        <location filename="../ui/gcp_dock.py" line="601"/>
         <source>The workspace has no accuracy report yet: run Accuracy report (or Run pipeline)</source>
         <translation>Der Arbeitsbereich hat noch keinen Genauigkeitsbericht: Accuracy report (oder Run pipeline) ausführen</translation>
     </message>
     <message>
+        <location filename="../ui/gcp_dock.py" line="396"/>
         <source>No web browser opened {}</source>
         <translation>Kein Webbrowser hat {} geöffnet</translation>
     </message>
     <message>
+        <location filename="../ui/gcp_dock.py" line="398"/>
         <source>Accuracy report: {}</source>
         <translation>Genauigkeitsbericht: {}</translation>
     </message>
@@ -1118,7 +2105,7 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Arbeitsbereich:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="372"/>
+        <location filename="../ui/gcp_dock.py" line="429"/>
         <source>none open</source>
         <translation>keiner geöffnet</translation>
     </message>
@@ -1148,27 +2135,27 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="197"/>
+        <location filename="../ui/gcp_dock.py" line="198"/>
         <source>Add a ground point</source>
         <translation>Einen Passpunkt hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="198"/>
+        <location filename="../ui/gcp_dock.py" line="199"/>
         <source>Remove</source>
         <translation>Entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="199"/>
+        <location filename="../ui/gcp_dock.py" line="200"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Den gewählten Passpunkt mit seinen Messungen entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="193"/>
+        <location filename="../ui/gcp_placement.py" line="195"/>
         <source>Pick on map</source>
         <translation>Auf der Karte messen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="202"/>
+        <location filename="../ui/gcp_dock.py" line="203"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>In die Kartenansicht klicken, um X und Y des gewählten Punkts zu setzen (Z aus dem Höhenlayer)</translation>
     </message>
@@ -1178,207 +2165,207 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Importieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="211"/>
+        <location filename="../ui/gcp_dock.py" line="212"/>
         <source>Export</source>
         <translation>Exportieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="226"/>
+        <location filename="../ui/gcp_dock.py" line="230"/>
         <source>Undo</source>
         <translation>Rückgängig</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="227"/>
+        <location filename="../ui/gcp_dock.py" line="231"/>
         <source>Redo</source>
         <translation>Wiederholen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="237"/>
+        <location filename="../ui/gcp_dock.py" line="241"/>
         <source>Undo: {}</source>
         <translation>Rückgängig: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="239"/>
+        <location filename="../ui/gcp_dock.py" line="243"/>
         <source>Redo: {}</source>
         <translation>Wiederholen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="218"/>
+        <location filename="../ui/gcp_dock.py" line="219"/>
         <source>Load results</source>
         <translation>Ergebnisse laden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="219"/>
+        <location filename="../ui/gcp_dock.py" line="220"/>
         <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Die Produkte des Arbeitsbereichs als gestaltete Layer zur Karte hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="273"/>
+        <location filename="../ui/gcp_dock.py" line="277"/>
         <source>Residual tolerance:</source>
         <translation>Residuen-Toleranz:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="279"/>
+        <location filename="../ui/gcp_dock.py" line="283"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="288"/>
+        <location filename="../ui/gcp_dock.py" line="292"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="289"/>
+        <location filename="../ui/gcp_dock.py" line="293"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Die Ausgleichung Brennweite, Bildhauptpunkt und Verzeichnung verfeinern lassen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="296"/>
+        <location filename="../ui/gcp_dock.py" line="300"/>
         <source>Georeference</source>
         <translation>Georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="297"/>
+        <location filename="../ui/gcp_dock.py" line="301"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Die Ausgleichung mit diesen Punkten ausführen (im Hintergrund)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="298"/>
+        <location filename="../ui/gcp_dock.py" line="302"/>
         <source>Cancel</source>
         <translation>Abbrechen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="349"/>
+        <location filename="../ui/gcp_dock.py" line="355"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="356"/>
+        <location filename="../ui/gcp_dock.py" line="362"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Einen ArchaeoOrtho-Arbeitsbereich öffnen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="402"/>
+        <location filename="../ui/gcp_dock.py" line="454"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} Fotos; der Block ist noch nicht ausgerichtet: 'Bilder ausrichten' (oder 'Neu aus Fotos') ausführen, um vorhergesagte Positionen zu erhalten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="405"/>
+        <location filename="../ui/gcp_dock.py" line="457"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} Fotos, {} Passpunkte. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="281"/>
+        <location filename="../ui/gcp_placement.py" line="283"/>
         <source>no predicted positions: {}</source>
         <translation>keine vorhergesagten Positionen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="65"/>
+        <location filename="../ui/gcp_placement.py" line="66"/>
         <source>Predicted positions from the georeferenced block.</source>
         <translation>Vorhergesagte Positionen aus dem georeferenzierten Block.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="65"/>
+        <location filename="../ui/gcp_placement.py" line="66"/>
         <source>Predicted positions once a point is placed in 2 photos, and for every point once 3 points are placed.</source>
         <translation>Vorhergesagte Positionen, sobald ein Punkt in 2 Fotos gemessen ist, und für alle Punkte, sobald 3 Punkte gemessen sind.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="175"/>
+        <location filename="../ui/gcp_tasks.py" line="185"/>
         <source>Folder of photos</source>
         <translation>Fotoordner</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="178"/>
+        <location filename="../ui/gcp_tasks.py" line="191"/>
         <source>Workspace folder (new or existing)</source>
         <translation>Arbeitsbereich-Ordner (neu oder vorhanden)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="191"/>
+        <location filename="../ui/gcp_tasks.py" line="205"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
         <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="198"/>
+        <location filename="../ui/gcp_tasks.py" line="212"/>
         <source>ArchaeoOrtho: align photos</source>
         <translation>ArchaeoOrtho: Fotos ausrichten</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="545"/>
+        <location filename="../ui/gcp_dock.py" line="612"/>
         <source>CRS: {}</source>
         <translation>KBS: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="117"/>
+        <location filename="../ui/gcp_placement.py" line="119"/>
         <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Auf der Karte an die Position des gewählten Punkts klicken (Esc beendet)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="181"/>
+        <location filename="../ui/gcp_placement.py" line="183"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (aus {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="184"/>
+        <location filename="../ui/gcp_placement.py" line="186"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Keine Höhe an dieser Stelle in {}: Z bleibt unverändert</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="187"/>
+        <location filename="../ui/gcp_placement.py" line="189"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="393"/>
+        <location filename="../ui/gcp_placement.py" line="395"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="395"/>
+        <location filename="../ui/gcp_placement.py" line="397"/>
         <source>predicted</source>
         <translation>vorhergesagt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="418"/>
+        <location filename="../ui/gcp_placement.py" line="420"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Einen Passpunkt in der Tabelle wählen oder hinzufügen, dann im Foto darauf klicken.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="425"/>
+        <location filename="../ui/gcp_placement.py" line="427"/>
         <source>from the point&apos;s other observations</source>
         <translation>aus den übrigen Messungen des Punkts</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="426"/>
+        <location filename="../ui/gcp_placement.py" line="428"/>
         <source>from the georeferenced block</source>
         <translation>aus dem georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="427"/>
+        <location filename="../ui/gcp_placement.py" line="429"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>aus den bereits gemessenen Punkten (Ähnlichkeitstransformation)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="438"/>
+        <location filename="../ui/gcp_placement.py" line="440"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Gemessen bei x {:.2f}, y {:.2f}. Klicken zum Versetzen, ziehen oder Entf zum Entfernen.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="441"/>
+        <location filename="../ui/gcp_placement.py" line="443"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Vorhergesagt {}. Eingabetaste übernimmt und geht weiter (Leertaste: übernehmen), ziehen oder dorthin klicken, wo der Punkt wirklich ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="453"/>
+        <location filename="../ui/gcp_placement.py" line="455"/>
         <source>Click where {} is in this photo.</source>
         <translation>Dorthin klicken, wo {} in diesem Foto ist.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="473"/>
+        <location filename="../ui/gcp_placement.py" line="475"/>
         <source>Select or add a ground point first</source>
         <translation>Zuerst einen Passpunkt wählen oder hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="520"/>
+        <location filename="../ui/gcp_placement.py" line="522"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: jedes Foto, das ihn voraussichtlich zeigt, hat eine Messung</translation>
     </message>
@@ -1498,77 +2485,77 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>{} kann nicht zum Projekt hinzugefügt werden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="205"/>
+        <location filename="../ui/gcp_tasks.py" line="224"/>
         <source>A task of this dock is still running</source>
         <translation>Eine Aufgabe dieses Fensters läuft noch</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="228"/>
+        <location filename="../ui/gcp_tasks.py" line="247"/>
         <source>Cancelled</source>
         <translation>Abgebrochen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="244"/>
+        <location filename="../ui/gcp_tasks.py" line="263"/>
         <source>The block is not aligned yet: run Align images first</source>
         <translation>Der Block ist noch nicht ausgerichtet: zuerst 'Bilder ausrichten' ausführen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="250"/>
+        <location filename="../ui/gcp_tasks.py" line="269"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>Die Ausgleichung braucht mindestens 3 Passpunkte mit Koordinaten und Messungen; vorhanden sind {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="268"/>
+        <location filename="../ui/gcp_tasks.py" line="287"/>
         <source>Outliers left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="269"/>
+        <location filename="../ui/gcp_tasks.py" line="288"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziert in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="273"/>
+        <location filename="../ui/gcp_tasks.py" line="292"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="282"/>
+        <location filename="../ui/gcp_tasks.py" line="301"/>
         <source>Not georeferenced yet.</source>
         <translation>Noch nicht georeferenziert.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="284"/>
+        <location filename="../ui/gcp_tasks.py" line="303"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Passpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="287"/>
+        <location filename="../ui/gcp_tasks.py" line="306"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Kontrollpunkte: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="290"/>
+        <location filename="../ui/gcp_tasks.py" line="309"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>Höhen sind Platzhalter: keine Höhengenauigkeit</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="292"/>
+        <location filename="../ui/gcp_tasks.py" line="311"/>
         <source>tie points {} px</source>
         <translation>Verknüpfungspunkte {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="294"/>
+        <location filename="../ui/gcp_tasks.py" line="313"/>
         <source>edited since: re-run to update</source>
         <translation>seither bearbeitet: erneut ausführen zum Aktualisieren</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="428"/>
+        <location filename="../ui/gcp_placement.py" line="430"/>
         <source>by matching its look in another photo</source>
         <translation>durch Abgleich mit seinem Aussehen in einem anderen Foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="432"/>
+        <location filename="../ui/gcp_placement.py" line="434"/>
         <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
         <translation>(Korrelation {:.2f}, {:.0f} px von der geometrischen Vorhersage)</translation>
     </message>
@@ -1583,32 +2570,32 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Neu aus Fotos…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="205"/>
+        <location filename="../ui/gcp_dock.py" line="206"/>
         <source>From file (gcp_list.txt, CSV)…</source>
         <translation>Aus Datei (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="206"/>
+        <location filename="../ui/gcp_dock.py" line="207"/>
         <source>From a point layer…</source>
         <translation>Aus einem Punktlayer…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="209"/>
+        <location filename="../ui/gcp_dock.py" line="210"/>
         <source>To file (gcp_list.txt, CSV)…</source>
         <translation>In Datei (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="210"/>
+        <location filename="../ui/gcp_dock.py" line="211"/>
         <source>To a GeoPackage layer…</source>
         <translation>In einen GeoPackage-Layer…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="236"/>
+        <location filename="../ui/gcp_tasks.py" line="255"/>
         <source>Cancelling…</source>
         <translation>Wird abgebrochen…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="276"/>
+        <location filename="../ui/gcp_tasks.py" line="295"/>
         <source>Georeferencing with {} control points…</source>
         <translation>Georeferenzierung mit {} Passpunkten…</translation>
     </message>
@@ -1623,152 +2610,152 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Koordinaten auf aufrecht gedrehten Fotos gemessen ({} Fotos sind gedreht gespeichert: EXIF-Ausrichtung); nicht ankreuzen für das gespeicherte Pixelraster (das von COLMAP und OpenDroneMap)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="74"/>
+        <location filename="../ui/gcp_placement.py" line="75"/>
         <source>your setting</source>
         <translation>Ihre Einstellung</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="77"/>
+        <location filename="../ui/gcp_placement.py" line="78"/>
         <source>default: 3 × GSD of the georeferenced block (GSD {:.3f} m)</source>
         <translation>Vorgabe: 3 × Bodenauflösung des georeferenzierten Blocks (GSD {:.3f} m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="78"/>
+        <location filename="../ui/gcp_placement.py" line="79"/>
         <source>default</source>
         <translation>Vorgabe</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="85"/>
+        <location filename="../ui/gcp_placement.py" line="86"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red. Now: {}</source>
         <translation>Residuen bis zu diesem Wert sind grün, bis zum Dreifachen gelb, darüber rot. Jetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="95"/>
+        <location filename="../ui/gcp_placement.py" line="96"/>
         <source>Diagnosis of the adjustment:</source>
         <translation>Diagnose der Ausgleichung:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="172"/>
+        <location filename="../ui/gcp_placement.py" line="174"/>
         <source>Moved {:.2f} m (Undo: Ctrl+Z).</source>
         <translation>Um {:.2f} m verschoben (Rückgängig: Strg+Z).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="395"/>
+        <location filename="../ui/gcp_placement.py" line="397"/>
         <source>near the edge</source>
         <translation>nahe am Rand</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="444"/>
+        <location filename="../ui/gcp_placement.py" line="446"/>
         <source>{} is predicted where it cannot be placed: {}. Click where the point is if you see it, or press Enter for the next photo.</source>
         <translation>{} wird dort vorhergesagt, wo er nicht gesetzt werden kann: {}. Klicken Sie auf den Punkt, wenn Sie ihn sehen, oder drücken Sie die Eingabetaste für das nächste Foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="450"/>
+        <location filename="../ui/gcp_placement.py" line="452"/>
         <source>Click where {} is in this photo, or use Pick on map (or type X, Y, Z in the table) to have it predicted in the photos.</source>
         <translation>Klicken Sie in diesem Foto auf {}, oder nutzen Sie „Auf der Karte messen“ (oder geben Sie X, Y, Z in der Tabelle ein), damit er in den Fotos vorhergesagt wird.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="463"/>
+        <location filename="../ui/gcp_placement.py" line="465"/>
         <source>{}: the workspace has no photos to place it in.</source>
         <translation>{}: der Arbeitsbereich hat keine Fotos, in denen er gesetzt werden kann.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="465"/>
+        <location filename="../ui/gcp_placement.py" line="467"/>
         <source>{} is selected: use Pick on map or type X, Y, Z in the table, or choose a photo in the strip below and click on the point.</source>
         <translation>{} ist ausgewählt: nutzen Sie „Auf der Karte messen“ oder geben Sie X, Y, Z in der Tabelle ein, oder wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="467"/>
+        <location filename="../ui/gcp_placement.py" line="469"/>
         <source>{} is selected: choose a photo in the strip below and click on the point.</source>
         <translation>{} ist ausgewählt: wählen Sie unten ein Foto und klicken Sie auf den Punkt.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="234"/>
+        <location filename="../ui/gcp_dock.py" line="238"/>
         <source>Undo (Ctrl+Z)</source>
         <translation>Rückgängig (Strg+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="234"/>
+        <location filename="../ui/gcp_dock.py" line="238"/>
         <source>Redo (Ctrl+Shift+Z)</source>
         <translation>Wiederholen (Strg+Umschalt+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="423"/>
+        <location filename="../ui/gcp_dock.py" line="475"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px.</source>
         <translation>{} von {} Fotos ausgerichtet, mittlerer Rückprojektionsfehler {:.2f} px.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="428"/>
+        <location filename="../ui/gcp_dock.py" line="480"/>
         <source>Not aligned ({}): {}</source>
         <translation>Nicht ausgerichtet ({}): {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="429"/>
+        <location filename="../ui/gcp_dock.py" line="481"/>
         <source>(marked in the photo strip; hover for the reason)</source>
         <translation>(in der Fotoleiste markiert; der Grund steht im Tooltip)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="449"/>
+        <location filename="../ui/gcp_dock.py" line="510"/>
         <source>✗ not aligned</source>
         <translation>✗ nicht ausgerichtet</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="450"/>
+        <location filename="../ui/gcp_dock.py" line="511"/>
         <source>{}: not aligned: {}</source>
         <translation>{}: nicht ausgerichtet: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="194"/>
+        <location filename="../ui/gcp_tasks.py" line="208"/>
         <source>Not aligned: {}</source>
         <translation>Nicht ausgerichtet: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="139"/>
+        <location filename="../ui/gcp_placement.py" line="141"/>
         <source>pick on map</source>
         <translation>auf der Karte messen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="430"/>
+        <location filename="../ui/gcp_placement.py" line="432"/>
         <source>(no Z yet: at the height of the block&apos;s tie points)</source>
         <translation>(noch kein Z: auf der Höhe der Verknüpfungspunkte des Blocks)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="164"/>
+        <location filename="../ui/gcp_placement.py" line="166"/>
         <source>{} not moved</source>
         <translation>{} nicht verschoben</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="193"/>
+        <location filename="../ui/gcp_placement.py" line="195"/>
         <source>{} is placed in {} photos. Move it {:.2f} m to the picked position, or add a new point there?</source>
         <translation>{} ist in {} Fotos gesetzt. Um {:.2f} m an die gemessene Position verschieben, oder dort einen neuen Punkt anlegen?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="197"/>
+        <location filename="../ui/gcp_placement.py" line="199"/>
         <source>Move {}</source>
         <translation>{} verschieben</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="198"/>
+        <location filename="../ui/gcp_placement.py" line="200"/>
         <source>New point</source>
         <translation>Neuer Punkt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="147"/>
+        <location filename="../ui/gcp_tasks.py" line="157"/>
         <source>ArchaeoOrtho: refine {} in {}</source>
         <translation>ArchaeoOrtho: {} in {} verfeinern</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="308"/>
+        <location filename="../ui/gcp_tasks.py" line="327"/>
         <source>Results loaded</source>
         <translation>Ergebnisse geladen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="315"/>
+        <location filename="../ui/gcp_tasks.py" line="334"/>
         <source>ArchaeoOrtho: load results</source>
         <translation>ArchaeoOrtho: Ergebnisse laden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="317"/>
+        <location filename="../ui/gcp_tasks.py" line="336"/>
         <source>Loading the results…</source>
         <translation>Die Ergebnisse werden geladen…</translation>
     </message>
@@ -1783,67 +2770,67 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>{} wird geöffnet…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="45"/>
+        <location filename="../ui/gcp_autocontrol.py" line="49"/>
         <source>Automatic control from a reference orthophoto</source>
         <translation>Automatisch aus Referenz-Orthophoto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="48"/>
+        <location filename="../ui/gcp_autocontrol.py" line="52"/>
         <source>Georeference with no hand-picked GCP: the block is matched to a reference orthophoto and takes its heights from a reference DSM. The points of the table become check points.</source>
         <translation>Georeferenzieren ohne von Hand gesetzte Passpunkte: der Block wird einem Referenz-Orthophoto zugeordnet und nimmt seine Höhen aus einem Referenz-DOM. Die Punkte der Tabelle werden Kontrollpunkte.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="54"/>
+        <location filename="../ui/gcp_autocontrol.py" line="58"/>
         <source>A reference orthophoto: a raster file, or a WMS / XYZ layer (saved for the block&apos;s extent, from the photos&apos; GPS or the map extent)</source>
         <translation>Ein Referenz-Orthophoto: eine Rasterdatei oder ein WMS-/XYZ-Layer (für die Ausdehnung des Blocks gespeichert, aus dem GPS der Fotos oder der Kartenausdehnung)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="54"/>
+        <location filename="../ui/gcp_autocontrol.py" line="58"/>
         <source>A reference DSM or DTM (heights in metres): a raster file or a WCS layer. Only height rasters are listed: not orthophotos, hillshades, web maps or this workspace&apos;s own products</source>
         <translation>Ein Referenz-DOM oder -DGM (Höhen in Metern): eine Rasterdatei oder ein WCS-Layer. Nur Höhenraster werden angeboten: keine Orthofotos, Schummerungen, Webkarten oder eigenen Produkte dieses Arbeitsbereichs</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="63"/>
+        <location filename="../ui/gcp_autocontrol.py" line="69"/>
         <source>Reference orthophoto:</source>
         <translation>Referenz-Orthophoto:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="64"/>
+        <location filename="../ui/gcp_autocontrol.py" line="70"/>
         <source>Reference DSM:</source>
         <translation>Referenz-DOM:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="82"/>
+        <location filename="../ui/gcp_autocontrol.py" line="116"/>
         <source>Georeference from the reference orthophoto and DSM (in the background)</source>
         <translation>Aus Referenz-Orthophoto und -DOM georeferenzieren (im Hintergrund)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="103"/>
+        <location filename="../ui/gcp_autocontrol.py" line="137"/>
         <source>Automatic control: choose a reference orthophoto and a reference DSM layer</source>
         <translation>Automatische Passpunkte: ein Referenz-Orthophoto und einen Referenz-DOM-Layer wählen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="124"/>
+        <location filename="../ui/gcp_autocontrol.py" line="158"/>
         <source>Automatic control: {} automatic GCPs kept of {} matches; georeferenced in {}.</source>
         <translation>Automatische Passpunkte: {} automatische Passpunkte von {} Zuordnungen behalten; georeferenziert in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="127"/>
+        <location filename="../ui/gcp_autocontrol.py" line="161"/>
         <source>Check points: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</source>
         <translation>Kontrollpunkte: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="138"/>
+        <location filename="../ui/gcp_autocontrol.py" line="172"/>
         <source>ArchaeoOrtho: automatic control</source>
         <translation>ArchaeoOrtho: automatische Passpunkte</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="142"/>
+        <location filename="../ui/gcp_autocontrol.py" line="176"/>
         <source>Automatic control against {} and {}…</source>
         <translation>Automatische Passpunkte gegen {} und {}…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="154"/>
+        <location filename="../ui/gcp_autocontrol.py" line="188"/>
         <source>Automatic GCPs (residuals)</source>
         <translation>Automatische Passpunkte (Residuen)</translation>
     </message>
@@ -1878,215 +2865,245 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Vermessene Koordinaten:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="92"/>
+        <location filename="../ui/gcp_targets.py" line="93"/>
         <source>auto (crosses, checkerboards, circles, ArUco 4x4)</source>
         <translation>automatisch (Kreuze, Schachbretter, Kreise, ArUco 4x4)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="94"/>
+        <location filename="../ui/gcp_targets.py" line="95"/>
         <source>Target kind:</source>
         <translation>Art der Zielmarken:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="99"/>
+        <location filename="../ui/gcp_targets.py" line="100"/>
         <source>unknown</source>
         <translation>unbekannt</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="100"/>
+        <location filename="../ui/gcp_targets.py" line="101"/>
         <source>The target&apos;s side or diameter: marks of another size are left out</source>
         <translation>Seitenlänge oder Durchmesser der Zielmarke: Marken anderer Größe werden ausgelassen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="101"/>
+        <location filename="../ui/gcp_targets.py" line="102"/>
         <source>Target size:</source>
         <translation>Größe der Zielmarken:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="103"/>
+        <location filename="../ui/gcp_targets.py" line="104"/>
         <source>A file that names no CRS is read in {}.</source>
         <translation>Eine Datei, die kein KBS nennt, wird in {} gelesen.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="103"/>
+        <location filename="../ui/gcp_targets.py" line="104"/>
         <source>The file must name its CRS (the table and the workspace have none).</source>
         <translation>Die Datei muss ihr KBS nennen (Tabelle und Arbeitsbereich haben keines).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="156"/>
+        <location filename="../ui/gcp_targets.py" line="157"/>
         <source>Find targets on the photos…</source>
         <translation>Zielmarken auf den Fotos finden…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="157"/>
+        <location filename="../ui/gcp_targets.py" line="158"/>
         <source>Find the surveyed targets on the aligned photos (in the background): their observations fill the table, marked as found until you confirm them (Space or Enter) or reject them (Delete or R)</source>
         <translation>Die vermessenen Zielmarken auf den ausgerichteten Fotos finden (im Hintergrund): ihre Messungen füllen die Tabelle, als gefunden markiert, bis Sie sie übernehmen (Leertaste oder Eingabe) oder verwerfen (Entf oder R)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="208"/>
+        <location filename="../ui/gcp_targets.py" line="209"/>
         <source>ArchaeoOrtho: find targets</source>
         <translation>ArchaeoOrtho: Zielmarken finden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="210"/>
+        <location filename="../ui/gcp_targets.py" line="211"/>
         <source>Looking for the targets of {} on the photos…</source>
         <translation>Die Zielmarken aus {} werden auf den Fotos gesucht…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="236"/>
+        <location filename="../ui/gcp_targets.py" line="237"/>
         <source>find targets</source>
         <translation>Zielmarken finden</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="238"/>
+        <location filename="../ui/gcp_targets.py" line="239"/>
         <source>Find targets: {} of {} targets found, {} observations, in {:.0f} s.</source>
         <translation>Zielmarken finden: {} von {} Zielmarken gefunden, {} Messungen, in {:.0f} s.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="243"/>
+        <location filename="../ui/gcp_targets.py" line="244"/>
         <source>not found: {}</source>
         <translation>nicht gefunden: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="248"/>
-        <source>Space or Enter: confirm the found observation shown; Delete or R: reject it. Georeference uses the found observations that are not rejected, confirmed or not.</source>
-        <translation>Leertaste oder Eingabe: die angezeigte gefundene Messung übernehmen; Entf oder R: sie verwerfen. Georeferenzieren verwendet die nicht verworfenen gefundenen Messungen, übernommen oder nicht.</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_targets.py" line="305"/>
+        <location filename="../ui/gcp_targets.py" line="316"/>
         <source>Every found observation is confirmed or rejected</source>
         <translation>Jede gefundene Messung ist übernommen oder verworfen</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="321"/>
-        <source>Found by Find targets, not confirmed: Space or Enter confirms it, Delete or R rejects it (then the next one).</source>
-        <translation>Von Zielmarken finden gefunden, nicht übernommen: Leertaste oder Eingabe übernimmt sie, Entf oder R verwirft sie (dann die nächste).</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_targets.py" line="344"/>
+        <location filename="../ui/gcp_targets.py" line="356"/>
         <source>{} observations found by Find targets, not confirmed: {}</source>
         <translation>{} Messungen von Zielmarken finden gefunden, nicht übernommen: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="355"/>
+        <location filename="../ui/gcp_targets.py" line="367"/>
         <source>{} found observations are not confirmed yet: they are used as they are (reject the wrong ones first)</source>
         <translation>{} gefundene Messungen sind noch nicht übernommen: sie werden so verwendet, wie sie sind (verwerfen Sie zuerst die falschen)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="216"/>
+        <source>{} (automatic)</source>
+        <translation>{} (automatisch)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="218"/>
+        <source>Automatic GCP: measured by the automatic control (matched against the reference orthophoto)</source>
+        <translation>Automatischer Passpunkt: von der automatischen Passpunktsuche gemessen (mit dem Referenz-Orthofoto abgeglichen)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="221"/>
+        <source>&lt;b&gt;{}&lt;/b&gt; (automatic GCP) — {}</source>
+        <translation>&lt;b&gt;{}&lt;/b&gt; (automatischer Passpunkt) — {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="222"/>
+        <source>{} is an automatic GCP: found by the automatic control at x {:.2f}, y {:.2f} in this photo (measured in {} photos), not a prediction to place. Drag it to correct it, or press Delete to remove it from this photo.</source>
+        <translation>{} ist ein automatischer Passpunkt: von der automatischen Passpunktsuche bei x {:.2f}, y {:.2f} in diesem Foto gefunden (in {} Fotos gemessen), keine zu platzierende Vorhersage. Zum Korrigieren ziehen oder mit Entf aus diesem Foto entfernen.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="249"/>
+        <source>Space or Enter: confirm the found observation shown; Delete or R: reject it (the keys work in the table, which has the keyboard focus now, and in the photo view). Georeference uses the found observations that are not rejected, confirmed or not.</source>
+        <translation>Leertaste oder Eingabe: die gezeigte gefundene Beobachtung bestätigen; Entf oder R: sie verwerfen (die Tasten wirken in der Tabelle, die jetzt den Tastaturfokus hat, und in der Fotoansicht). Georeferenzieren verwendet die gefundenen Beobachtungen, die nicht verworfen sind, bestätigt oder nicht.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="332"/>
+        <source>Found by Find targets, not confirmed: Space or Enter confirms it, Delete or R rejects it (then the next one); the keys work in the table and in this photo view.</source>
+        <translation>Von Zielmarken finden gefunden, nicht bestätigt: Leertaste oder Eingabe bestätigt, Entf oder R verwirft (dann die nächste); die Tasten wirken in der Tabelle und in dieser Fotoansicht.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="121"/>
+        <source>{} has new results: open it once this dock&apos;s task has ended</source>
+        <translation>{} hat neue Ergebnisse: öffnen Sie ihn, sobald die Aufgabe dieses Docks beendet ist</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="218"/>
+        <source>Aligning the photos of {} into {}…</source>
+        <translation>Die Fotos von {} werden in {} ausgerichtet…</translation>
     </message>
 </context>
 <context>
     <name>GcpStore</name>
     <message>
-        <location filename="../ui/store.py" line="289"/>
+        <location filename="../ui/store.py" line="318"/>
         <source>a point named {} exists already</source>
         <translation>ein Punkt namens {} existiert bereits</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="277"/>
+        <location filename="../ui/store.py" line="306"/>
         <source>add point {}</source>
         <translation>Punkt {} hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="284"/>
+        <location filename="../ui/store.py" line="313"/>
         <source>remove point {}</source>
         <translation>Punkt {} entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="302"/>
+        <location filename="../ui/store.py" line="331"/>
         <source>set {} of {}</source>
         <translation>{} von {} setzen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="362"/>
+        <location filename="../ui/store.py" line="391"/>
         <source>place {} in {}</source>
         <translation>{} in {} messen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="370"/>
+        <location filename="../ui/store.py" line="399"/>
         <source>remove {} from {}</source>
         <translation>{} aus {} entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="511"/>
+        <location filename="../ui/store.py" line="540"/>
         <source>set CRS</source>
         <translation>KBS setzen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="330"/>
+        <location filename="../ui/store.py" line="359"/>
         <source>no position</source>
         <translation>keine Position</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="335"/>
+        <location filename="../ui/store.py" line="364"/>
         <source>({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)</source>
         <translation>({:.0f}, {:.0f}) liegt außerhalb des Fotos {} ({} × {} px)</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="342"/>
+        <location filename="../ui/store.py" line="371"/>
         <source>({:.0f}, {:.0f}) is inside the mask of {}</source>
         <translation>({:.0f}, {:.0f}) liegt in der Maske von {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="350"/>
+        <location filename="../ui/store.py" line="379"/>
         <source>{} not placed: {}</source>
         <translation>{} nicht gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="402"/>
+        <location filename="../ui/store.py" line="431"/>
         <source>{} points replaced by {} from the file</source>
         <translation>{} Punkte durch {} aus der Datei ersetzt</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="436"/>
+        <location filename="../ui/store.py" line="465"/>
         <source>added {} points: {}</source>
         <translation>{} Punkte hinzugefügt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="438"/>
+        <location filename="../ui/store.py" line="467"/>
         <source>coordinates updated from the file: {}</source>
         <translation>Koordinaten aus der Datei aktualisiert: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="440"/>
+        <location filename="../ui/store.py" line="469"/>
         <source>role set by the file: {}</source>
         <translation>Rolle von der Datei gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="442"/>
+        <location filename="../ui/store.py" line="471"/>
         <source>role kept (the file gives none): {}</source>
         <translation>Rolle beibehalten (die Datei nennt keine): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="444"/>
+        <location filename="../ui/store.py" line="473"/>
         <source>σ set by the file: {}</source>
         <translation>σ von der Datei gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="446"/>
+        <location filename="../ui/store.py" line="475"/>
         <source>{} observations added</source>
         <translation>{} Messungen hinzugefügt</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="448"/>
+        <location filename="../ui/store.py" line="477"/>
         <source>placed observations kept (the file has others): {}</source>
         <translation>gesetzte Messungen beibehalten (die Datei hat andere): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="450"/>
+        <location filename="../ui/store.py" line="479"/>
         <source>nothing changed</source>
         <translation>nichts geändert</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="459"/>
+        <location filename="../ui/store.py" line="488"/>
         <source>observations placed by hand kept (found ones not used there): {}</source>
         <translation>von Hand gesetzte Messungen beibehalten (gefundene dort nicht verwendet): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="499"/>
+        <location filename="../ui/store.py" line="528"/>
         <source>confirm {} in {}</source>
         <translation>{} in {} übernehmen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="508"/>
+        <location filename="../ui/store.py" line="537"/>
         <source>reject {} in {}</source>
         <translation>{} in {} verwerfen</translation>
     </message>
@@ -2232,7 +3249,7 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Projektionszentren (Welt)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="193"/>
+        <location filename="../processing_provider/georeference.py" line="190"/>
         <source>outlier left out: {}</source>
         <translation>Ausreißer ausgelassen: {}</translation>
     </message>
@@ -2242,7 +3259,7 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>KBS {}; Passpunkte RMSE XY {} m, Z {} m; Kontrollpunkte RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="171"/>
+        <location filename="../processing_provider/run_pipeline.py" line="178"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Dem Passpunktlayer {} fehlt das Feld '{}' (benötigt name, image, px, py)</translation>
     </message>
@@ -2322,17 +3339,17 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
         <translation>Behaltene automatische Passpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="163"/>
+        <location filename="../processing_provider/georeference.py" line="164"/>
         <source>Automatic control needs both a reference orthophoto and a reference DSM (REFERENCE_ORTHO, REFERENCE_DSM); {} is missing</source>
         <translation>Automatische Passpunkte brauchen ein Referenz-Orthophoto und ein Referenz-DOM (REFERENCE_ORTHO, REFERENCE_DSM); {} fehlt</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="176"/>
+        <location filename="../processing_provider/georeference.py" line="177"/>
         <source>Target CRS {} is not used: automatic control georeferences in the reference orthophoto&apos;s CRS {}</source>
         <translation>Ziel-KBS {} wird nicht verwendet: automatische Passpunkte georeferenzieren im KBS {} des Referenz-Orthophotos</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="197"/>
+        <location filename="../processing_provider/georeference.py" line="194"/>
         <source>Automatic control: {} automatic GCPs kept; CRS {}; check RMSE XY {} m, Z {} m</source>
         <translation>Automatische Passpunkte: {} automatische Passpunkte behalten; KBS {}; Kontroll-RMSE XY {} m, Z {} m</translation>
     </message>
@@ -2531,67 +3548,67 @@ Passpunkt-Residuen: GeoPackage der Passpunkte mit ihren Residuen in Pixeln (und 
 <context>
     <name>PhotoPanel</name>
     <message>
-        <location filename="../ui/photo_viewer.py" line="471"/>
+        <location filename="../ui/photo_viewer.py" line="472"/>
         <source>Only photos that probably see the point</source>
         <translation>Nur Fotos, die den Punkt voraussichtlich zeigen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="474"/>
+        <location filename="../ui/photo_viewer.py" line="475"/>
         <source>Fit</source>
         <translation>Einpassen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="474"/>
+        <location filename="../ui/photo_viewer.py" line="475"/>
         <source>Show the whole photo (F)</source>
         <translation>Das ganze Foto zeigen (F)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="475"/>
+        <location filename="../ui/photo_viewer.py" line="476"/>
         <source>Zoom to point</source>
         <translation>Auf Punkt zoomen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="475"/>
+        <location filename="../ui/photo_viewer.py" line="476"/>
         <source>Zoom to the observation or prediction (Z)</source>
         <translation>Auf die Messung oder Vorhersage zoomen (Z)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="477"/>
+        <location filename="../ui/photo_viewer.py" line="478"/>
         <source>Confirm</source>
         <translation>Übernehmen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="477"/>
+        <location filename="../ui/photo_viewer.py" line="478"/>
         <source>Accept the predicted position (Space)</source>
         <translation>Die vorhergesagte Position übernehmen (Leertaste)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="479"/>
+        <location filename="../ui/photo_viewer.py" line="480"/>
         <source>Confirm &amp;&amp; next</source>
         <translation>Übernehmen &amp;&amp; weiter</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="479"/>
+        <location filename="../ui/photo_viewer.py" line="480"/>
         <source>Accept the prediction and show the next photo to place (Enter)</source>
         <translation>Die Vorhersage übernehmen und das nächste zu messende Foto zeigen (Eingabetaste)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="482"/>
+        <location filename="../ui/photo_viewer.py" line="483"/>
         <source>Remove</source>
         <translation>Entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="482"/>
+        <location filename="../ui/photo_viewer.py" line="483"/>
         <source>Remove the observation in this photo (Delete)</source>
         <translation>Die Messung in diesem Foto entfernen (Entf)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="665"/>
+        <location filename="../ui/photo_viewer.py" line="683"/>
         <source>{} (predicted)</source>
         <translation>{} (vorhergesagt)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="571"/>
+        <location filename="../ui/photo_viewer.py" line="589"/>
         <source>Shown upright (EXIF orientation {}: stored {} x {} px); pixel coordinates are those of the stored grid, as COLMAP and gcp_list.txt use them</source>
         <translation>Aufrecht gezeigt (EXIF-Ausrichtung {}: gespeichert {} x {} px); die Pixelkoordinaten sind die des gespeicherten Rasters, wie COLMAP und gcp_list.txt sie verwenden</translation>
     </message>
@@ -2835,164 +3852,1235 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
     </message>
 </context>
 <context>
-    <name>ResultLayers</name>
+    <name>Report</name>
     <message>
-        <source>found</source>
-        <translation>gefunden</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>height (m)</source>
+        <translation>Höhe (m)</translation>
     </message>
     <message>
-        <source>not found</source>
-        <translation>nicht gefunden</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Summary</source>
+        <translation>Übersicht</translation>
     </message>
     <message>
-        <source>Targets found</source>
-        <translation>Gefundene Zielmarken</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Orientation quality</source>
+        <translation>Qualität der Orientierung</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="286"/>
-        <source>control (used)</source>
-        <translation>Passpunkt (verwendet)</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Georeferencing</source>
+        <translation>Georeferenzierung</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="287"/>
-        <source>check point</source>
-        <translation>Kontrollpunkt</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Uncertainty</source>
+        <translation>Unsicherheit</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="288"/>
-        <source>rejected (outlier)</source>
-        <translation>verworfen (Ausreißer)</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Products</source>
+        <translation>Produkte</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="289"/>
-        <source>not triangulated</source>
-        <translation>nicht trianguliert</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>images aligned</source>
+        <translation>Bilder ausgerichtet</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="807"/>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean reprojection error</source>
+        <translation>mittlerer Rückprojektionsfehler</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>ground sample distance</source>
+        <translation>Bodenauflösung (GSD)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>area</source>
+        <translation>Fläche</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>check RMSE XY</source>
+        <translation>Kontroll-RMSE XY</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>check RMSE Z</source>
+        <translation>Kontroll-RMSE Z</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>NSSDA horizontal 95 %</source>
+        <translation>NSSDA horizontal 95 %</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>NSSDA vertical 95 %</source>
+        <translation>NSSDA vertikal 95 %</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>ASPRS 2014 horizontal class</source>
+        <translation>ASPRS-2014-Lageklasse</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>camera position RMSE XY (the block&apos;s fit to the positions)</source>
+        <translation>RMSE XY der Kamerapositionen (Passung des Blocks an die Positionen)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>tie point σXY / σZ (median; predicted ground uncertainty, datum included)</source>
+        <translation>σXY / σZ der Verknüpfungspunkte (Median; vorhergesagte Unsicherheit am Boden, Datum eingeschlossen)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>DSM valid fraction</source>
+        <translation>gültiger Anteil des DOM</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>ArchaeoOrtho report — {}</source>
+        <translation>ArchaeoOrtho-Bericht — {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>no aligned model: run &apos;Align images&apos;</source>
+        <translation>kein ausgerichtetes Modell: 'Bilder ausrichten' ausführen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>no DSM / orthomosaic yet</source>
+        <translation>noch kein DOM / Orthomosaik</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>{} of {} images aligned, mean reprojection error {} px</source>
+        <translation>{} von {} Bildern ausgerichtet, mittlerer Rückprojektionsfehler {} px</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>generated</source>
+        <translation>erstellt</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>At a glance</source>
+        <translation>Auf einen Blick</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Skipped:</source>
+        <translation>Übersprungen:</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>automatic control points</source>
+        <translation>automatische Passpunkte</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Where the automatic GCPs lie (triangles, coloured by their horizontal residual after the adjustment), the ones the adjustment rejected (red) and the candidates dropped before it (grey): a change between the epochs, a height the DSM does not give, a point found in one photo only.</source>
+        <translation>Wo die automatischen Passpunkte liegen (Dreiecke, gefärbt nach ihrem Lageresiduum nach der Ausgleichung), die von der Ausgleichung verworfenen (rot) und die vorher ausgeschiedenen Kandidaten (grau): eine Änderung zwischen den Zeitpunkten, eine Höhe, die das DOM nicht liefert, ein Punkt, der nur in einem Foto gefunden wurde.</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>step</source>
+        <translation>Schritt</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>matches / points</source>
+        <translation>Zuordnungen / Punkte</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>dropped because</source>
+        <translation>ausgeschieden wegen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>candidates</source>
+        <translation>Kandidaten</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>dropped candidates</source>
+        <translation>ausgeschiedene Kandidaten</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>automatic GCPs (colour: XY residual)</source>
+        <translation>automatische Passpunkte (Farbe: Residuum XY)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>XY residual (m)</source>
+        <translation>Residuum XY (m)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Automatic control</source>
+        <translation>Automatische Passpunkte</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>rejected by the adjustment</source>
+        <translation>von der Ausgleichung verworfen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>set</source>
+        <translation>Satz</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>RMSE X</source>
+        <translation>RMSE X</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>RMSE Y</source>
+        <translation>RMSE Y</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>RMSE Z</source>
+        <translation>RMSE Z</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>RMSE XY</source>
+        <translation>RMSE XY</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean dX</source>
+        <translation>mittleres dX</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean dY</source>
+        <translation>mittleres dY</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean dZ</source>
+        <translation>mittleres dZ</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>name</source>
+        <translation>Name</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>role</source>
+        <translation>Rolle</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>status</source>
+        <translation>Status</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>dXY</source>
+        <translation>dXY</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>obs</source>
+        <translation>Beob.</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean px</source>
+        <translation>mittl. px</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>max px</source>
+        <translation>max. px</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>image residuals (px)</source>
+        <translation>Bildresiduen (px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>residual vectors</source>
+        <translation>Residuenvektoren</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>group</source>
+        <translation>Gruppe</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σ XY</source>
+        <translation>σ XY</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>rigid fit σ XY</source>
+        <translation>σ XY der starren Passung</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>rigid fit σ Z</source>
+        <translation>σ Z der starren Passung</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>floor XY</source>
+        <translation>Untergrenze XY</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>floor Z</source>
+        <translation>Untergrenze Z</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>placeholders</source>
+        <translation>Platzhalter</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>estimated from</source>
+        <translation>geschätzt aus</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>image σ (px)</source>
+        <translation>Bild-σ (px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>left out as suspect</source>
+        <translation>als verdächtig ausgelassen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>RMSE XY (radial)</source>
+        <translation>RMSE XY (radial)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>RMSE 3D</source>
+        <translation>RMSE 3D</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>max dXY</source>
+        <translation>max. dXY</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>max |dZ|</source>
+        <translation>max. |dZ|</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>camera centres</source>
+        <translation>Kamerazentren</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>image</source>
+        <translation>Bild</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>used</source>
+        <translation>verwendet</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>tie-point footprint</source>
+        <translation>Grundriss der Verknüpfungspunkte</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>dZ (m)</source>
+        <translation>dZ (m)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Residual vectors over the footprint</source>
+        <translation>Residuenvektoren über dem Grundriss</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Outliers and suspect points</source>
+        <translation>Ausreißer und verdächtige Punkte</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Accuracy of the control given without sigmas, estimated from the data</source>
+        <translation>Genauigkeit der ohne Sigmas angegebenen Passpunkte, aus den Daten geschätzt</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>RMSE per set</source>
+        <translation>RMSE je Satz</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Outliers, suspect points and warnings</source>
+        <translation>Ausreißer, verdächtige Punkte und Warnungen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Control and check points</source>
+        <translation>Pass- und Kontrollpunkte</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Camera-position residuals</source>
+        <translation>Residuen der Kamerapositionen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>reprojection error (px)</source>
+        <translation>Rückprojektionsfehler (px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>observations</source>
+        <translation>Beobachtungen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>track length (images per tie point)</source>
+        <translation>Spurlänge (Bilder je Verknüpfungspunkt)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>tie points</source>
+        <translation>Verknüpfungspunkte</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>reprojection error and track length histograms</source>
+        <translation>Histogramme von Rückprojektionsfehler und Spurlänge</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Left: reprojection error of every tie-point observation (clipped at the 99.5th percentile). Right: number of images per tie point.</source>
+        <translation>Links: Rückprojektionsfehler jeder Beobachtung eines Verknüpfungspunkts (beim 99,5. Perzentil abgeschnitten). Rechts: Anzahl der Bilder je Verknüpfungspunkt.</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean error (px)</source>
+        <translation>mittlerer Fehler (px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>reprojection error per image</source>
+        <translation>Rückprojektionsfehler je Bild</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Mean reprojection error (red: more than twice the median) and tie-point observations per image.</source>
+        <translation>Mittlerer Rückprojektionsfehler (rot: mehr als das Doppelte des Medians) und Beobachtungen von Verknüpfungspunkten je Bild.</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>camera</source>
+        <translation>Kamera</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mode</source>
+        <translation>Modus</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>parameter</source>
+        <translation>Parameter</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>given</source>
+        <translation>gegeben</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>final</source>
+        <translation>endgültig</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>moved</source>
+        <translation>verschoben</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>moved (σ)</source>
+        <translation>verschoben (σ)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>image × image</source>
+        <translation>Bild × Bild</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>camera positions</source>
+        <translation>Kamerapositionen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>shared tie points</source>
+        <translation>gemeinsame Verknüpfungspunkte</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>image connectivity</source>
+        <translation>Bildverknüpfung</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean reprojection error (px)</source>
+        <translation>mittlerer Rückprojektionsfehler (px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>dZ (m): adjusted − given</source>
+        <translation>dZ (m): ausgeglichen − gegeben</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Camera positions</source>
+        <translation>Kamerapositionen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Image connectivity</source>
+        <translation>Bildverknüpfung</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Interior orientation</source>
+        <translation>Innere Orientierung</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>DSM preview with hillshade (sun from the north-west, 45°).</source>
+        <translation>DOM-Vorschau mit Schummerung (Sonne aus Nordwest, 45°).</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>{} preview.</source>
+        <translation>{}-Vorschau.</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="756"/>
-        <source>DSM hillshade</source>
-        <translation>DOM-Schummerung</translation>
-    </message>
-    <message>
-        <location filename="../qgisio/layers.py" line="808"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="809"/>
-        <source>Cameras</source>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>NSSDA accuracy at 95 % confidence (FGDC-STD-007.3-1998)</source>
+        <translation>NSSDA-Genauigkeit bei 95 % Konfidenz (FGDC-STD-007.3-1998)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>ASPRS positional accuracy class</source>
+        <translation>ASPRS-Lagegenauigkeitsklasse</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>blur scores</source>
+        <translation>Schärfewerte</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Blur score per image (orange: flagged, red: excluded).</source>
+        <translation>Schärfewert je Bild (orange: markiert, rot: ausgeschlossen).</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>blur score (higher = sharper)</source>
+        <translation>Schärfewert (höher = schärfer)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>images, blurriest first</source>
+        <translation>Bilder, unschärfstes zuerst</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>blur score</source>
+        <translation>Schärfewert</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>blur / median</source>
+        <translation>Schärfe / Median</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>exposure</source>
+        <translation>Belichtung</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>dynamic range</source>
+        <translation>Dynamikumfang</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>flags</source>
+        <translation>Markierungen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>decision</source>
+        <translation>Entscheidung</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>model</source>
+        <translation>Modell</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>size (px)</source>
+        <translation>Größe (px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>images</source>
+        <translation>Bilder</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>parameters (pixels; distortion unitless)</source>
+        <translation>Parameter (Pixel; Verzeichnung ohne Einheit)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>stage</source>
+        <translation>Verarbeitungsschritt</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>parameters</source>
+        <translation>Parameter</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>why</source>
+        <translation>warum</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Image screening</source>
+        <translation>Bildprüfung</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>median</source>
+        <translation>Median</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>time</source>
+        <translation>Zeit</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>steps</source>
+        <translation>Teilschritte</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>finished</source>
+        <translation>beendet</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>{} images screened: {} flagged, {} excluded, {} kept (blurriest first).</source>
+        <translation>{} Bilder geprüft: {} markiert, {} ausgeschlossen, {} behalten (unschärfstes zuerst).</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Cameras and calibrated parameters</source>
+        <translation>Kameras und kalibrierte Parameter</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Images not aligned</source>
+        <translation>Nicht ausgerichtete Bilder</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Processing stages</source>
+        <translation>Verarbeitungsschritte</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>DTM preview</source>
+        <translation>DGM-Vorschau</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>DTM (bare earth) preview with hillshade.</source>
+        <translation>DGM (Gelände) als Vorschau mit Schummerung.</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Relief visualisations</source>
+        <translation>Reliefdarstellungen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Relief visualisations (rvt-py, RVT&apos;s default parameters scaled to the cell size), in RVT&apos;s display ranges.</source>
+        <translation>Reliefdarstellungen (rvt-py, die Standardparameter von RVT auf die Zellgröße skaliert), in den Anzeigebereichen von RVT.</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Terrain (DTM)</source>
+        <translation>Gelände (DGM)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>point standard deviations</source>
+        <translation>Standardabweichungen der Punkte</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Left: distribution of the tie points' standard deviations. Right: σZ over the block, colours clipped at the 95th percentile (precision degrades where few images overlap and away from control).</source>
+        <translation>Links: Verteilung der Standardabweichungen der Verknüpfungspunkte. Rechts: σZ über dem Block, Farben beim 95. Perzentil abgeschnitten (die Präzision sinkt, wo sich wenige Bilder überlappen, und fern von Passpunkten).</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σXY</source>
+        <translation>σXY</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>cameras</source>
         <translation>Kameras</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="768"/>
-        <source>Camera footprints</source>
-        <translation>Bildfußabdrücke</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σ rot x (°)</source>
+        <translation>σ Rot. x (°)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="776"/>
-        <source>GCP residuals (vectors x{})</source>
-        <translation>Passpunkt-Residuen (Vektoren x{})</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σ rot y (°)</source>
+        <translation>σ Rot. y (°)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="810"/>
-        <source>Point cloud</source>
-        <translation>Punktwolke</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σ rot z (°)</source>
+        <translation>σ Rot. z (°)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="818"/>
-        <source>ArchaeoOrtho: {}</source>
-        <translation>ArchaeoOrtho: {}</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σX (m)</source>
+        <translation>σX (m)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="449"/>
-        <source>{} ({})</source>
-        <translation>{} ({})</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σY (m)</source>
+        <translation>σY (m)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="811"/>
-        <source>DTM</source>
-        <translation>DGM</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σZ (m)</source>
+        <translation>σZ (m)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="783"/>
-        <source>DTM hillshade</source>
-        <translation>DGM-Schummerung</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>control</source>
+        <translation>Passpunkte</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="812"/>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Reference orthophoto</source>
+        <translation>Referenz-Orthophoto</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Reference DSM</source>
+        <translation>Referenz-DOM</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Rough position (prior)</source>
+        <translation>Grobe Position (Vorinformation)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Reference CRS</source>
+        <translation>KBS der Referenz</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Common resolution of the match</source>
+        <translation>Gemeinsame Auflösung der Zuordnung</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>CRS</source>
+        <translation>KBS</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Source of the datum</source>
+        <translation>Quelle des Datums</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Local frame offset (world = local + offset)</source>
+        <translation>Versatz des lokalen Rahmens (Welt = lokal + Versatz)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Tie-point reprojection error after the adjustment</source>
+        <translation>Rückprojektionsfehler der Verknüpfungspunkte nach der Ausgleichung</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>GCP observation reprojection error in the adjustment (mean; control held at its coordinates within its sigmas)</source>
+        <translation>Rückprojektionsfehler der Passpunktbeobachtungen in der Ausgleichung (Mittel; Passpunkte innerhalb ihrer Sigmas an ihren Koordinaten gehalten)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Mean reprojection error (mean over tie points of their mean error, as COLMAP reports it)</source>
+        <translation>Mittlerer Rückprojektionsfehler (Mittel über die Verknüpfungspunkte ihres mittleren Fehlers, wie COLMAP ihn angibt)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Reprojection error of the observations: mean / median / RMS</source>
+        <translation>Rückprojektionsfehler der Beobachtungen: Mittel / Median / RMS</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Largest reprojection error</source>
+        <translation>Größter Rückprojektionsfehler</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Track length: mean / median / max</source>
+        <translation>Spurlänge: Mittel / Median / Maximum</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Model</source>
+        <translation>Modell</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>File</source>
+        <translation>Datei</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Size</source>
+        <translation>Größe</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Resolution</source>
+        <translation>Auflösung</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Brightness step across the seamlines (median; before → after the radiometric correction)</source>
+        <translation>Helligkeitssprung über die Nahtlinien (Median; vor → nach der radiometrischen Korrektur)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Valid fraction (cells with data)</source>
+        <translation>Gültiger Anteil (Zellen mit Daten)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Valid fraction inside the camera centres&apos; convex hull (as the stage reports it)</source>
+        <translation>Gültiger Anteil innerhalb der konvexen Hülle der Kamerazentren (wie der Schritt ihn angibt)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Inside that hull: measured / interpolated (filled holes) / removed as blunders (dense/dsm-source.tif)</source>
+        <translation>Innerhalb dieser Hülle: gemessen / interpoliert (gefüllte Löcher) / als grobe Fehler entfernt (dense/dsm-source.tif)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Height range (1st–99th percentile)</source>
+        <translation>Höhenbereich (1.–99. Perzentil)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Workspace</source>
+        <translation>Arbeitsbereich</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Images folder</source>
+        <translation>Bilderordner</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Coordinate reference system</source>
+        <translation>Koordinatenbezugssystem</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Images given / aligned / not aligned</source>
+        <translation>Bilder gegeben / ausgerichtet / nicht ausgerichtet</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Tie points / image observations</source>
+        <translation>Verknüpfungspunkte / Bildbeobachtungen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Images given</source>
+        <translation>Gegebene Bilder</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Ground sample distance (median)</source>
+        <translation>Bodenauflösung (Median)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Area covered by tie points</source>
+        <translation>Von Verknüpfungspunkten bedeckte Fläche</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Ground sample distance</source>
+        <translation>Bodenauflösung</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>DSM cells on the ground (SMRF ground filter)</source>
+        <translation>DOM-Zellen am Boden (SMRF-Bodenfilter)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>DTM cells interpolated (under objects, in holes)</source>
+        <translation>Interpolierte DGM-Zellen (unter Objekten, in Löchern)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Measured / interpolated cells</source>
+        <translation>Gemessene / interpolierte Zellen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Classified point cloud</source>
+        <translation>Klassifizierte Punktwolke</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Contours</source>
         <translation>Höhenlinien</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="433"/>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Datum</source>
+        <translation>Datum</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Sigma0 (a posteriori, unit weight = 1 px)</source>
+        <translation>Sigma0 (a posteriori, Gewichtseinheit = 1 px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Redundancy</source>
+        <translation>Redundanz</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Observations / points</source>
+        <translation>Beobachtungen / Punkte</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Camera position σXY / σZ (median)</source>
+        <translation>Kameraposition σXY / σZ (Median)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Tie point σXY / σZ (median)</source>
+        <translation>Verknüpfungspunkt σXY / σZ (Median)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Tie point σXY / σZ (95th percentile)</source>
+        <translation>Verknüpfungspunkt σXY / σZ (95. Perzentil)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>GeoPackage layers</source>
+        <translation>GeoPackage-Layer</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Computed in</source>
+        <translation>Berechnet in</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>ground point residuals ({})</source>
+        <translation>Residuen der Bodenpunkte ({})</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Per camera</source>
+        <translation>Je Kamera</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>camera centres ({}); line width ∝ shared points</source>
+        <translation>Kamerazentren ({}); Linienbreite ∝ gemeinsame Punkte</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>camera positions ({})</source>
+        <translation>Kamerapositionen ({})</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean {} px</source>
+        <translation>Mittel {} px</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>median {} px</source>
+        <translation>Median {} px</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Per-image table</source>
+        <translation>Tabelle je Bild</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Screening table</source>
+        <translation>Prüftabelle</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Parameters used</source>
+        <translation>Verwendete Parameter</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>standard deviation ({})</source>
+        <translation>Standardabweichung ({})</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Per camera: standard deviations</source>
+        <translation>Je Kamera: Standardabweichungen</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Control points: adjusted standard deviations</source>
+        <translation>Passpunkte: ausgeglichene Standardabweichungen</translation>
+    </message>
+</context>
+<context>
+    <name>ResultLayers</name>
+    <message>
+        <location filename="../qgisio/layers.py" line="326"/>
+        <source>found</source>
+        <translation>gefunden</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="326"/>
+        <source>not found</source>
+        <translation>nicht gefunden</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="856"/>
+        <source>Targets found</source>
+        <translation>Gefundene Zielmarken</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="289"/>
+        <source>control (used)</source>
+        <translation>Passpunkt (verwendet)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="290"/>
+        <source>check point</source>
+        <translation>Kontrollpunkt</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="291"/>
+        <source>rejected (outlier)</source>
+        <translation>verworfen (Ausreißer)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="292"/>
+        <source>not triangulated</source>
+        <translation>nicht trianguliert</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="850"/>
+        <source>DSM</source>
+        <translation>DOM</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="796"/>
+        <source>DSM hillshade</source>
+        <translation>DOM-Schummerung</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="851"/>
+        <source>Orthomosaic</source>
+        <translation>Orthomosaik</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="852"/>
+        <source>Cameras</source>
+        <translation>Kameras</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="808"/>
+        <source>Camera footprints</source>
+        <translation>Bildfußabdrücke</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="816"/>
+        <source>GCP residuals (vectors x{})</source>
+        <translation>Passpunkt-Residuen (Vektoren x{})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="853"/>
+        <source>Point cloud</source>
+        <translation>Punktwolke</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="862"/>
+        <source>ArchaeoOrtho: {}</source>
+        <translation>ArchaeoOrtho: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="467"/>
+        <source>{} ({})</source>
+        <translation>{} ({})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="854"/>
+        <source>DTM</source>
+        <translation>DGM</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="824"/>
+        <source>DTM hillshade</source>
+        <translation>DGM-Schummerung</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="855"/>
+        <source>Contours</source>
+        <translation>Höhenlinien</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="451"/>
         <source>{} — {}</source>
         <translation>{} — {}</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="389"/>
+        <location filename="../qgisio/layers.py" line="407"/>
         <source>Spectral index</source>
         <translation>Spektralindex</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="806"/>
+        <location filename="../qgisio/layers.py" line="849"/>
         <source>RGB orthomosaic</source>
         <translation>RGB-Orthomosaik</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/scene_layers.py" line="33"/>
+        <source>3-D model</source>
+        <translation>3-D-Modell</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/legend.py" line="11"/>
+        <source>DTM (bare earth)</source>
+        <translation>DGM (Gelände)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/scene_layers.py" line="132"/>
+        <source>3D Tiles not loaded: {}</source>
+        <translation>3D Tiles nicht geladen: {}</translation>
     </message>
 </context>
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Folder of images</source>
         <translation>Bilderordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Workspace folder</source>
         <translation>Arbeitsbereich-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Camera positions (CSV)</source>
         <translation>Kamerapositionen (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Pair selection</source>
         <translation>Paarauswahl</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Camera model</source>
         <translation>Kameramodell</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Write the accuracy report</source>
         <translation>Genauigkeitsbericht schreiben</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="150"/>
+        <location filename="../processing_provider/run_pipeline.py" line="154"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="151"/>
+        <location filename="../processing_provider/run_pipeline.py" line="155"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="156"/>
+        <location filename="../processing_provider/run_pipeline.py" line="160"/>
         <source>Accuracy report (HTML)</source>
         <translation>Genauigkeitsbericht (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="218"/>
+        <location filename="../processing_provider/run_pipeline.py" line="227"/>
         <source>Seconds per stage: {}</source>
         <translation>Sekunden pro Stufe: {}</translation>
     </message>
@@ -3002,147 +5090,147 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>Gesamte Verarbeitung ausführen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Ground control file</source>
         <translation>Passpunktdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Ground control layer</source>
         <translation>Passpunktlayer</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Check points</source>
         <translation>Kontrollpunkte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Use EXIF GPS positions</source>
         <translation>EXIF-GPS-Positionen verwenden</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Target CRS</source>
         <translation>Ziel-KBS</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Matching image size (px)</source>
         <translation>Bildgröße für die Zuordnung (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Refine camera calibration</source>
         <translation>Kamerakalibrierung verfeinern</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>DSM resolution (m)</source>
         <translation>DOM-Auflösung (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Matching quality</source>
         <translation>Zuordnungsqualität</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Seam blending</source>
         <translation>Überblendung der Nähte</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Parallel workers</source>
         <translation>Parallele Prozesse</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Dask scheduler</source>
         <translation>Dask-Scheduler</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Build the DTM</source>
         <translation>Das DGM erzeugen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Contour interval (m, 0 = none)</source>
         <translation>Höhenlinienabstand (m, 0 = keine)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Relief visualisations</source>
         <translation>Reliefvisualisierungen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="149"/>
+        <location filename="../processing_provider/run_pipeline.py" line="153"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>GCP-Pixel auf aufrechten Fotos gemessen</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Sky masks (oblique photos)</source>
         <translation>Himmelsmasken (Schrägaufnahmen)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Camera calibration file</source>
         <translation>Kamerakalibrierungsdatei</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Interior orientation</source>
         <translation>Innere Orientierung</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Orthomosaic resolution (CRS units, 0 = GSD)</source>
         <translation>Orthomosaik-Auflösung (KBS-Einh., 0 = GSD)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Targets to find</source>
         <translation>Zu findende Zielmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Target kind</source>
         <translation>Art der Zielmarken</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="178"/>
+        <location filename="../processing_provider/run_pipeline.py" line="185"/>
         <source>Give ground control (Ground control file or layer, or targets to find: GCPS, GCP_LAYER, TARGETS) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Geben Sie Passpunkte (Passpunktdatei oder Passpunktlayer oder zu findende Zielmarken: GCPS, GCP_LAYER, TARGETS) und/oder Kamerapositionen (Kamerapositionen (CSV) oder EXIF-GPS-Positionen verwenden: CAMERA_POSITIONS, USE_EXIF_GPS) an: DOM und Orthophoto brauchen einen georeferenzierten Block</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Calibration panel folder</source>
         <translation>Kalibrierpanel-Ordner</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Panel reflectance</source>
         <translation>Panelreflexion</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Panel window</source>
         <translation>Panelfenster</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Capture radiometry</source>
         <translation>Aufnahme-Radiometrie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="152"/>
+        <location filename="../processing_provider/run_pipeline.py" line="156"/>
         <source>RGB orthomosaic (a rig&apos;s RGB frames)</source>
         <translation>RGB-Orthomosaik (die RGB-Bilder eines Rigs)</translation>
     </message>
@@ -3172,6 +5260,16 @@ Himmelsmasken (Schrägaufnahmen): zuerst findet eine Stufe 'Bilder vorbereiten' 
 Das DGM erzeugen: nach dem DOM ein DGM der nackten Erde (wie 'DGM erzeugen'). Höhenlinienabstand (erweitert): Höhenlinien des DGM in diesem Abstand (wie 'Höhenlinien'; 0 = keine). Reliefvisualisierungen (erweitert): die gewählten werden aus dem DGM berechnet (wie 'Reliefvisualisierung'). Beide brauchen das DGM.
 Die übrigen Parameter sind die der einzelnen Stufen (siehe deren Hilfe); 0 bedeutet automatisch.
 Ausgaben: das DOM, das Orthomosaik und der Genauigkeitsbericht (HTML) sowie die wichtigsten Kennzahlen; mit einem Kanalordner, der auch die RGB-Bilder des Rigs enthält, zusätzlich RGB-Orthomosaik (die RGB-Bilder eines Rigs): das eigene Orthomosaik dieser Bilder, &lt;orthomosaic&gt;_rgb.tif neben dem mehrkanaligen der Aufnahmen (keines, wenn kein RGB-Bild registriert ist).</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
+        <source>Build the textured 3-D model</source>
+        <translation>Das texturierte 3-D-Modell erzeugen</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="161"/>
+        <source>3-D model (3D Tiles)</source>
+        <translation>3-D-Modell (3D Tiles)</translation>
     </message>
 </context>
 <context>
@@ -3340,13 +5438,6 @@ Panelreflexion: die Reflexion des Panels laut seinem Kalibrierblatt: eine Zahl f
 Panelfenster (erweitert): die Seite des mittleren Quadrats, in dem das Panel gemessen wird, als Anteil der kurzen Seite des Fotos (Standard 0.25); kleiner, wenn das Panel weniger vom Bild füllt.
 Referenzkanal (erweitert): der Kanal, auf den die anderen registriert werden; leer: die Referenzkamera des Rigs.
 Ausgabeordner: wohin die mehrkanaligen Fotos geschrieben werden (eines je Aufnahme, benannt nach ihren Kanaldateien ohne die Kanalendung); nicht der Kanalordner.</translation>
-    </message>
-</context>
-<context>
-    <name>FolderDialog</name>
-    <message>
-        <source>The folder {} cannot be made: {}</source>
-        <translation>Der Ordner {} kann nicht angelegt werden: {}</translation>
     </message>
 </context>
 </TS>

@@ -2,39 +2,62 @@
 <!DOCTYPE TS>
 <TS version="2.1">
 <context>
+    <name>@default</name>
+    <message>
+        <location filename="../ui/workspace_menu.py" line="61"/>
+        <source>ArchaeoOrtho</source>
+        <translation>ArchaeoOrtho</translation>
+    </message>
+    <message>
+        <location filename="../ui/workspace_menu.py" line="61"/>
+        <source>No web browser opened {}</source>
+        <translation>Nessun browser web aperto {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/workspace_menu.py" line="107"/>
+        <source>Open accuracy report</source>
+        <translation>Apri il rapporto di accuratezza</translation>
+    </message>
+    <message>
+        <location filename="../ui/workspace_menu.py" line="111"/>
+        <source>Open accuracy report (none yet: run Accuracy report or Run pipeline)</source>
+        <translation>Apri il rapporto di accuratezza (ancora nessuno: esegui Rapporto di accuratezza o Esegui l'intera elaborazione)</translation>
+    </message>
+</context>
+<context>
     <name>AccuracyReportAlgorithm</name>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="71"/>
+        <location filename="../processing_provider/accuracy_report.py" line="72"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="79"/>
+        <location filename="../processing_provider/accuracy_report.py" line="80"/>
         <source>Workspace</source>
         <translation>Area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="80"/>
+        <location filename="../processing_provider/accuracy_report.py" line="81"/>
         <source>Camera precision (GeoPackage)</source>
         <translation>Precisione delle camere (GeoPackage)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="81"/>
+        <location filename="../processing_provider/accuracy_report.py" line="82"/>
         <source>Tie point precision (GeoPackage)</source>
         <translation>Precisione dei punti di legame (GeoPackage)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="82"/>
+        <location filename="../processing_provider/accuracy_report.py" line="83"/>
         <source>Sections skipped</source>
         <translation>Sezioni saltate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="99"/>
+        <location filename="../processing_provider/accuracy_report.py" line="100"/>
         <source>section {} skipped: {}</source>
         <translation>sezione {} saltata: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="101"/>
+        <location filename="../processing_provider/accuracy_report.py" line="102"/>
         <source>report written: {} ({} s)</source>
         <translation>rapporto scritto: {} ({} s)</translation>
     </message>
@@ -44,12 +67,12 @@
         <translation>Rapporto di accuratezza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="71"/>
+        <location filename="../processing_provider/accuracy_report.py" line="72"/>
         <source>Compute uncertainty</source>
         <translation>Calcola l'incertezza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/accuracy_report.py" line="76"/>
+        <location filename="../processing_provider/accuracy_report.py" line="77"/>
         <source>Report</source>
         <translation>Rapporto</translation>
     </message>
@@ -74,12 +97,12 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
 <context>
     <name>AlgorithmBase</name>
     <message>
-        <location filename="../processing_provider/base.py" line="240"/>
+        <location filename="../processing_provider/base.py" line="269"/>
         <source>Cancelled: {}</source>
         <translation>Annullato: {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/base.py" line="149"/>
+        <location filename="../processing_provider/base.py" line="169"/>
         <source>Outputs not styled: {}</source>
         <translation>Output senza stile: {}</translation>
     </message>
@@ -87,6 +110,11 @@ Rapporto: il file del rapporto (predefinito: &lt;workspace&gt;/report.html). Vie
         <location filename="../ui/catalog.py" line="8"/>
         <source>Photogrammetry</source>
         <translation>Fotogrammetria</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/base.py" line="331"/>
+        <source>{}: cancelling (send it again to stop at once)</source>
+        <translation>{}: annullamento in corso (invialo di nuovo per fermare subito)</translation>
     </message>
 </context>
 <context>
@@ -243,17 +271,17 @@ Riprova le immagini escluse (avanzato, attivo): le immagini che le impostazioni 
 <context>
     <name>ArchaeoOrthoPlugin</name>
     <message>
-        <location filename="../plugin.py" line="114"/>
+        <location filename="../plugin.py" line="101"/>
         <source>Ground control (GCP dock)</source>
         <translation>Punti d'appoggio (pannello GCP)</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="118"/>
+        <location filename="../plugin.py" line="105"/>
         <source>ArchaeoOrtho: pick ground control points on the map and in the photos</source>
         <translation>ArchaeoOrtho: misura i punti d'appoggio sulla mappa e nelle foto</translation>
     </message>
     <message>
-        <location filename="../plugin.py" line="180"/>
+        <location filename="../plugin.py" line="188"/>
         <source>&amp;ArchaeoOrtho</source>
         <translation>&amp;ArchaeoOrtho</translation>
     </message>
@@ -579,6 +607,124 @@ Curve di livello: dove scrivere le curve di livello (predefinito: &lt;workspace&
     </message>
 </context>
 <context>
+    <name>BuildModelAlgorithm</name>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="63"/>
+        <source>Workspace folder (with a DSM)</source>
+        <translation>Cartella dell'area di lavoro (con un DSM)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="63"/>
+        <source>Geometry</source>
+        <translation>Geometria</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="63"/>
+        <source>Face budget (triangles at most)</source>
+        <translation>Budget di facce (al massimo tanti triangoli)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="63"/>
+        <source>Files</source>
+        <translation>File</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="63"/>
+        <source>Texture from the photos</source>
+        <translation>Texture dalle foto</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="63"/>
+        <source>Atlas size in pixels (a power of two)</source>
+        <translation>Dimensione dell'atlante in pixel (una potenza di due)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="63"/>
+        <source>Number of atlases at most</source>
+        <translation>Numero massimo di atlanti</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="76"/>
+        <source>Model folder</source>
+        <translation>Cartella del modello</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="78"/>
+        <source>Workspace</source>
+        <translation>Area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="79"/>
+        <source>Model (GLB)</source>
+        <translation>Modello (GLB)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="80"/>
+        <source>Model (OBJ)</source>
+        <translation>Modello (OBJ)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="81"/>
+        <source>3D Tiles (tileset.json)</source>
+        <translation>3D Tiles (tileset.json)</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="82"/>
+        <source>Faces</source>
+        <translation>Facce</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="83"/>
+        <source>Share of faces textured</source>
+        <translation>Quota di facce con texture</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="114"/>
+        <source>3-D model in {}: {} faces, {:.0%} textured</source>
+        <translation>Modello 3D in {}: {} facce, {:.0%} con texture</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="118"/>
+        <source>{} opens in {}</source>
+        <translation>{} si apre in {}</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/build_model.py" line="120"/>
+        <source>QGIS {} has no 3D Tiles layers (QGIS 3.34 or newer has): open {} there or in CesiumJS, or model.glb in a glTF viewer</source>
+        <translation>QGIS {} non ha layer 3D Tiles (QGIS 3.34 o successivo li ha): apri {} lì o in CesiumJS, oppure model.glb in un visualizzatore glTF</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Build 3-D model</source>
+        <translation>Genera modello 3D</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>A textured 3-D model of the site. The DSM&apos;s surface becomes a triangle mesh within a face budget, each face textured from the photo that sees it best; it is written as a textured OBJ (+ MTL + JPEG atlases), a binary glTF (GLB, texture embedded), a PLY of the geometry and OGC 3D Tiles (tileset.json with levels of detail), all in the workspace CRS about a local origin that the files name.
+
+On QGIS 3.34 or newer the 3D Tiles open as a tiled scene layer in the workspace&apos;s group (View &gt; 3D Map View shows them over the orthomosaic); on older QGIS the log names the files and the programs that open them. A block without control (a model frame) is written as OBJ / GLB / PLY in that frame; 3D Tiles need a georeferenced block.
+
+Workspace folder: a georeferenced workspace with a DSM (run &apos;Build DSM&apos; first).
+Geometry: auto (the DSM&apos;s 2.5-D surface), dsm, or points (the fused dense points&apos; 3-D surface: not available yet).
+Face budget: the most triangles the model may have.
+Files: the formats to write.
+Texture from the photos: off for a grey model (faster).
+Atlas size and number of atlases (advanced): the texture images&apos; side in pixels and how many at most.
+Model folder: where to write the files (default: &lt;workspace&gt;/model3d; the folder is replaced whole).</source>
+        <translation>Un modello 3D con texture del sito. La superficie del DSM diventa una mesh di triangoli entro un budget di facce, ogni faccia con la texture della foto che la vede meglio; è scritto come OBJ con texture (+ MTL + atlanti JPEG), glTF binario (GLB, texture incorporata), PLY della geometria e OGC 3D Tiles (tileset.json con livelli di dettaglio), tutti nel SR dell'area di lavoro attorno a un'origine locale indicata dai file.
+
+Con QGIS 3.34 o successivo i 3D Tiles si aprono come layer di scena a tasselli nel gruppo dell'area di lavoro (Visualizza &gt; Vista mappa 3D li mostra sopra l'ortomosaico); con QGIS più vecchi il registro indica i file e i programmi che li aprono. Un blocco senza punti d'appoggio (un sistema del modello) è scritto come OBJ / GLB / PLY in quel sistema; i 3D Tiles richiedono un blocco georeferenziato.
+
+Cartella dell'area di lavoro: un'area di lavoro georeferenziata con un DSM (esegui prima 'Genera DSM').
+Geometria: auto (la superficie 2,5D del DSM), dsm o points (la superficie 3D dei punti densi fusi: non ancora disponibile).
+Budget di facce: il numero massimo di triangoli del modello.
+File: i formati da scrivere.
+Texture dalle foto: disattivata per un modello grigio (più veloce).
+Dimensione e numero degli atlanti (avanzato): il lato delle immagini di texture in pixel e quante al massimo.
+Cartella del modello: dove scrivere i file (predefinita: &lt;workspace&gt;/model3d; la cartella è sostituita per intero).</translation>
+    </message>
+</context>
+<context>
     <name>BuildOrthophotoAlgorithm</name>
     <message>
         <location filename="../processing_provider/build_orthophoto.py" line="107"/>
@@ -898,6 +1044,16 @@ Scheduler Dask (avanzato): calcola le tessere su un cluster Dask (tcp://host:878
         <source>irradiance</source>
         <translation>irradianza (irradiance)</translation>
     </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>checkerboard</source>
+        <translation>scacchiera (checkerboard)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>circle</source>
+        <translation>cerchio (circle)</translation>
+    </message>
 </context>
 <context>
     <name>ContoursAlgorithm</name>
@@ -933,6 +1089,824 @@ Contours: the GeoPackage to write.</source>
 Raster delle quote: un DTM o DSM in un SR proiettato (metri).
 Equidistanza: metri tra due curve di livello (ad es. 0.5).
 Curve di livello: il GeoPackage da scrivere.</translation>
+    </message>
+</context>
+<context>
+    <name>CoreMessages</name>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>captures: {} multi-band photo(s) of {}{} in {} ({} radiometry)</source>
+        <translation>acquisizioni: {} foto multibanda da {}{} in {} (radiometria {})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>pipeline done</source>
+        <translation>elaborazione completata</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{}: an RGB frame of a capture not stacked (a calibration panel&apos;s, or left out): not aligned</source>
+        <translation>{}: un fotogramma RGB di un'acquisizione non impilata (di un pannello di calibrazione o esclusa): non allineato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>--- stage {} ---</source>
+        <translation>--- fase {} ---</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>prepare: {} sky mask(s), {} of {} photos kept</source>
+        <translation>preparazione: {} maschere del cielo, {} di {} foto mantenute</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>find targets: {} of {} targets found, {} observations</source>
+        <translation>trova i target: {} di {} target trovati, {} osservazioni</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>find targets: {}</source>
+        <translation>trova i target: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera {} ({} image(s), {} x {} px): interior orientation {}</source>
+        <translation>camera {} ({} immagini, {} x {} px): orientamento interno {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera {}: the calibration {} gives a focal length of {} px, {} {} px ({} %); the calibration&apos;s is used: check that it is this camera&apos;s and that its units are right</source>
+        <translation>camera {}: la calibrazione {} dà una focale di {} px, {} {} px ({} %); si usa quella della calibrazione: verifica che sia di questa camera e che le sue unità siano corrette</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>calibration {}, {}: {}</source>
+        <translation>calibrazione {}, {}: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>calibration file {}: no photo matches {}; it is not used</source>
+        <translation>file di calibrazione {}: nessuna foto corrisponde a {}; non è usato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>not registered: {}: {}</source>
+        <translation>non registrata: {}: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>escalation round {}: matching {} pairs</source>
+        <translation>ciclo di estensione {}: abbinamento di {} coppie</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>escalation round {}: {}: {}</source>
+        <translation>ciclo di estensione {}: {}: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>escalation: {} image(s) without any verified pair after round 1, not escalated further (no ground shared with the block): {}</source>
+        <translation>estensione: {} immagini senza alcuna coppia verificata dopo il ciclo 1, non estese oltre (nessun terreno in comune con il blocco): {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>escalation round {}: could not put {} back ({}); a re-run extracts the features of the images of this round again</source>
+        <translation>ciclo di estensione {}: impossibile ripristinare {} ({}); una nuova esecuzione estrae di nuovo le caratteristiche delle immagini di questo ciclo</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>features: {} images already extracted, reused</source>
+        <translation>caratteristiche: {} immagini già estratte, riusate</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>features: {}/{} images ({})</source>
+        <translation>caratteristiche: {}/{} immagini ({})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>matching: {} of {} pairs already matched, reused</source>
+        <translation>abbinamento: {} di {} coppie già abbinate, riusate</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>matching: {}/{} pairs</source>
+        <translation>abbinamento: {}/{} coppie</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera {}: {} {} {}x{}, {}, {} images</source>
+        <translation>camera {}: {} {} {}x{}, {}, {} immagini</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>joining {} components by the photos&apos; positions (fits {} m, photo spacing {} m)</source>
+        <translation>unione di {} componenti tramite le posizioni delle foto (adattamento {} m, distanza tra le foto {} m)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>join: {}</source>
+        <translation>unione: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>join: registered on the joined block&apos;s points: {}</source>
+        <translation>unione: registrate sui punti del blocco unito: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: {} image(s) outside the main block of {}; trying them against the finished block with {} 2D-3D inliers (first pass: {})</source>
+        <translation>mappatura: {} immagini fuori dal blocco principale di {}; prova contro il blocco finito con {} inlier 2D-3D (primo passaggio: {})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: {} more image(s) registered on the relaxed threshold: {}</source>
+        <translation>mappatura: {} immagini in più registrate con la soglia rilassata: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: global SfM (rotation averaging, global positioning, bundle adjustment)</source>
+        <translation>mappatura: SfM globale (media delle rotazioni, posizionamento globale, compensazione a stelle proiettive)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: global SfM done</source>
+        <translation>mappatura: SfM globale completata</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: the self-calibrated focal length went from {} to {} px and {} of {} images registered; mapping again with the photos&apos; own focal length and the distortion held</source>
+        <translation>mappatura: la focale autocalibrata è passata da {} a {} px e {} di {} immagini sono state registrate; nuova mappatura con la focale delle foto e la distorsione fissata</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: the focal length is held at the photos&apos; own ({} px; the distortion refined only by the final adjustment): self-calibrated it drifted to {} px and registered {} of {} images, held {}</source>
+        <translation>mappatura: la focale è fissata a quella delle foto ({} px; la distorsione affinata solo dalla compensazione finale): autocalibrata è derivata a {} px registrando {} di {} immagini, fissata {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: two images, mapped with the incremental mapper (the global mapper needs tracks of three or more views)</source>
+        <translation>mappatura: due immagini, mappate con il metodo incrementale (quello globale richiede tracce di tre o più viste)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: registered image {}</source>
+        <translation>mappatura: immagine {} registrata</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: continuing the block of {} images</source>
+        <translation>mappatura: prosecuzione del blocco di {} immagini</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: no further image registered</source>
+        <translation>mappatura: nessun'altra immagine registrata</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: {} {}: left out of the block</source>
+        <translation>mappatura: {} {}: escluse dal blocco</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mapping: with the intrinsics held {} images registered: the self-calibrated mapping is kept</source>
+        <translation>mappatura: con l'orientamento interno fissato {} immagini registrate: si mantiene la mappatura autocalibrata</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>final bundle adjustment: {} {}: left out of the block</source>
+        <translation>compensazione finale: {} {}: escluse dal blocco</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>masks: {} of {} images have a mask ({}): no features where they are black</source>
+        <translation>maschere: {} di {} immagini hanno una maschera ({}): nessuna caratteristica dove sono nere</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>features: {} photo(s) matched on an 8-bit image of their primary band or grey ({})</source>
+        <translation>caratteristiche: {} foto abbinate su un'immagine a 8 bit della loro banda principale o in grigio ({})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>aligned {}/{} images, {} px</source>
+        <translation>{}/{} immagini allineate, {} px</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>pair selection: {}, {} pairs for {} images</source>
+        <translation>selezione delle coppie: {}, {} coppie per {} immagini</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>final bundle adjustment</source>
+        <translation>compensazione finale</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>DSM tile {}/{}</source>
+        <translation>tassello del DSM {}/{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>matching: {} pairs ({} reused from a previous run), {} s per pair, {} s per megapixel, {}</source>
+        <translation>abbinamento: {} coppie ({} riusate da un'esecuzione precedente), {} s per coppia, {} s per megapixel, {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>resuming: {} of {} pairs already matched</source>
+        <translation>ripresa: {} di {} coppie già abbinate</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>pair {} + {} skipped: {}</source>
+        <translation>coppia {} + {} saltata: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} image(s) are in fewer than {} matched pairs and add no points of their own: {}{}</source>
+        <translation>{} immagini sono in meno di {} coppie abbinate e non aggiungono punti propri: {}{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>undistorting images (COLMAP)</source>
+        <translation>rettifica delle distorsioni delle immagini (COLMAP)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>patch-match stereo (COLMAP, CUDA)</source>
+        <translation>stereo patch-match (COLMAP, CUDA)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>stereo fusion (COLMAP)</source>
+        <translation>fusione stereo (COLMAP)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>pairs: {} selected from {} overlapping image pairs ({} images, quality {}, median GSD {} m, DSM resolution {} m)</source>
+        <translation>coppie: {} scelte su {} coppie di immagini sovrapposte ({} immagini, qualità {}, GSD mediana {} m, risoluzione del DSM {} m)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>DSM done</source>
+        <translation>DSM completato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>points: {} fused from {} images</source>
+        <translation>punti: {} fusi da {} immagini</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>removed {}, left by a killed run</source>
+        <translation>rimosso {}, lasciato da un'esecuzione interrotta</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>Helmert from {} {}</source>
+        <translation>Helmert da {} {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>triangulating control points</source>
+        <translation>triangolazione dei punti d'appoggio</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>every control point has Z = {}: treated as a placeholder, not a surveyed height; the points are taken to lie near one level surface (sigma Z {} m) and the Z figures measure the departure from that level, not height accuracy</source>
+        <translation>ogni punto d'appoggio ha Z = {}: trattato come segnaposto, non come quota rilevata; i punti sono considerati vicini a un'unica superficie piana (sigma Z {} m) e i valori Z misurano lo scostamento da essa, non l'accuratezza in quota</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>control points given sigmas far finer than the block resolves at them (about {} m XY, {} m Z) - {}: honoured as given, i.e. these points are held fixed at their coordinates; if they are not exact to that level give their real accuracy (e.g. 0.01 m for RTK)</source>
+        <translation>ai punti d'appoggio sono stati dati sigma molto più fini di quanto il blocco li risolva (circa {} m XY, {} m Z) - {}: rispettati come dati, cioè questi punti sono tenuti fissi alle loro coordinate; se non sono esatti a quel livello indica la loro accuratezza reale (ad es. 0,01 m per RTK)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>estimating the accuracy of the control given without sigmas</source>
+        <translation>stima dell'accuratezza dei punti d'appoggio dati senza sigma</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>the control points&apos; sigma XY ({} m) is far below how well the block fits them: {} control points miss the rigid block by {} m (median, {} sigma), and the adjustment bends the block to fit them; if their coordinates are metre-level (handheld GPS, read off a map) give the file sigma columns of that size, or none: without sigmas their accuracy is estimated from the data</source>
+        <translation>il sigma XY dei punti d'appoggio ({} m) è molto al di sotto di come il blocco vi si adatta: {} punti d'appoggio mancano il blocco rigido di {} m (mediana, {} sigma) e la compensazione piega il blocco per adattarlo; se le loro coordinate sono al metro (GPS palmare, lette da una carta) dai al file colonne sigma di quella grandezza, o nessuna: senza sigma la loro accuratezza è stimata dai dati</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>updating the model</source>
+        <translation>aggiornamento del modello</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>check points</source>
+        <translation>punti di controllo</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>georeferencing done</source>
+        <translation>georeferenziazione completata</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>control point not usable: {}</source>
+        <translation>punto d'appoggio non utilizzabile: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} camera position(s) without a height (Z): they constrain X and Y only</source>
+        <translation>{} posizioni della camera senza quota (Z): vincolano solo X e Y</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>control point {}: {} m off the Helmert fit of the others, but consistent with the adjusted block ({} sigma, image residuals up to {} px): re-admitted; the block was deformed</source>
+        <translation>punto d'appoggio {}: a {} m dall'adattamento di Helmert degli altri, ma coerente con il blocco compensato ({} sigma, residui in immagine fino a {} px): riammesso; il blocco era deformato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>no CRS given for the ground control</source>
+        <translation>nessun SR indicato per i punti d'appoggio</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>CRS {} not recognised; assuming metric, right-handed coordinates</source>
+        <translation>SR {} non riconosciuto; si assumono coordinate metriche destrorse</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} {} is {} m off the Helmert fit of the others (threshold {} m): excluded; check its coordinates</source>
+        <translation>{} {} è a {} m dall'adattamento di Helmert degli altri (soglia {} m): escluso; controllane le coordinate</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>control point {} is {} m off the Helmert fit of the others (threshold {} m): left out of the first adjustment, then re-tested against the adjusted block</source>
+        <translation>il punto d'appoggio {} è a {} m dall'adattamento di Helmert degli altri (soglia {} m): escluso dalla prima compensazione, poi riverificato sul blocco compensato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>no 4 control points agree with the block within {} m: either the block is deformed or several coordinates are wrong</source>
+        <translation>nessun gruppo di 4 punti d'appoggio concorda con il blocco entro {} m: il blocco è deformato o diverse coordinate sono errate</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>control point {} disagrees with the others through the block ({} m): suspect, dropped from the adjustment</source>
+        <translation>il punto d'appoggio {} è in disaccordo con gli altri attraverso il blocco ({} m): sospetto, escluso dalla compensazione</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} point {}: observation at ({}, {}) lies outside image {} ({} x {} px); ignored</source>
+        <translation>punto ({}) {}: l'osservazione a ({}, {}) è fuori dall'immagine {} ({} x {} px); ignorata</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>the block adjusted with the DEM control could not be co-registered again: {}</source>
+        <translation>il blocco compensato con il controllo dal DEM non ha potuto essere coregistrato di nuovo: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>bundle adjustment: {} iteration(s), cost {} -&gt; {}</source>
+        <translation>compensazione a stelle proiettive: {} iterazioni, costo {} -&gt; {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera(s) {}: calibrated interior orientation fixed, not refined{}</source>
+        <translation>camera/e {}: orientamento interno calibrato fissato, non affinato{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera(s) {}: interior orientation refined with priors at the calibration&apos;s values (weighted by its sigmas)</source>
+        <translation>camera/e {}: orientamento interno affinato con vincoli ai valori della calibrazione (pesati con i suoi sigma)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>adjusting {} of {} tie points ({} of {} observations); the others are re-triangulated afterwards</source>
+        <translation>compensazione di {} di {} punti di legame ({} di {} osservazioni); gli altri sono ritriangolati dopo</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>bundle adjustment</source>
+        <translation>compensazione a stelle proiettive</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera {}: the calibration&apos;s model {} is not the model&apos;s {}: its intrinsics follow refine_intrinsics</source>
+        <translation>camera {}: il modello della calibrazione {} non è quello del modello {}: i suoi parametri interni seguono refine_intrinsics</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera {}: only {} image(s), intrinsics kept fixed</source>
+        <translation>camera {}: solo {} immagini, parametri interni fissati</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>GCP coordinates measured on upright photos: no photo of the block is stored turned (EXIF orientation 1 or none), nothing to convert</source>
+        <translation>coordinate dei GCP misurate su foto raddrizzate: nessuna foto del blocco è salvata ruotata (orientamento EXIF 1 o nessuno), nulla da convertire</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>USE_EXIF_GPS is set but no image carries EXIF GPS</source>
+        <translation>USE_EXIF_GPS è impostato ma nessuna immagine ha il GPS EXIF</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>co-registration done</source>
+        <translation>coregistrazione completata</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>co-registration iteration {}: shift {}, {} m</source>
+        <translation>coregistrazione iterazione {}: spostamento {}, {} m</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>georeferenced</source>
+        <translation>georeferenziato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>reference DEM {} without ground control or camera positions: the photos&apos; EXIF GPS place the block, the DEM fixes its heights, tilt and dome</source>
+        <translation>DEM di riferimento {} senza punti d'appoggio né posizioni delle camere: il GPS EXIF delle foto colloca il blocco, il DEM ne fissa quote, inclinazione e curvatura</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>checking the reference DEM against the block</source>
+        <translation>verifica del DEM di riferimento rispetto al blocco</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>covariance: Jacobian</source>
+        <translation>covarianza: jacobiano</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>covariance: normal equations</source>
+        <translation>covarianza: equazioni normali</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>covariance: inverting the reduced system</source>
+        <translation>covarianza: inversione del sistema ridotto</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>covariance: points</source>
+        <translation>covarianza: punti</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>covariance done</source>
+        <translation>covarianza completata</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>automatic control: point {} of {} in the photos</source>
+        <translation>controllo automatico: punto {} di {} nelle foto</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>provisional orthophoto: projecting {}</source>
+        <translation>ortofoto provvisoria: proiezione di {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>provisional orthophoto: sampling {}</source>
+        <translation>ortofoto provvisoria: campionamento di {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>first match</source>
+        <translation>primo abbinamento</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>looking for targets: {}</source>
+        <translation>ricerca dei target: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} candidate(s), {} tied across photos</source>
+        <translation>{} candidati, {} collegati tra le foto</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} target(s), {} observation(s) found</source>
+        <translation>{} target, {} osservazioni trovate</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>reading images</source>
+        <translation>lettura delle immagini</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>writing Cloud-Optimized GeoTIFF</source>
+        <translation>scrittura del Cloud-Optimized GeoTIFF</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>point cloud: {} points</source>
+        <translation>nuvola di punti: {} punti</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>3-D model done</source>
+        <translation>modello 3D completato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mesh: {} faces (DSM grid reduced {} x)</source>
+        <translation>mesh: {} facce (griglia del DSM ridotta {} volte)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>visibility in {}</source>
+        <translation>visibilità in {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>texture from {}</source>
+        <translation>texture da {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>3D Tiles: level {} of {}</source>
+        <translation>3D Tiles: livello {} di {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{}: tile {}/{}</source>
+        <translation>{}: tassello {}/{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>orthomosaic done</source>
+        <translation>ortomosaico completato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>no DSM given: how far planar rectification is off because of relief cannot be measured</source>
+        <translation>nessun DSM indicato: non si può misurare quanto la rettifica piana si scosti a causa del rilievo</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>the DSM does not cover the image&apos;s ground: planar displacement not measured</source>
+        <translation>il DSM non copre il terreno dell'immagine: spostamento planare non misurato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>planar rectification: tile {}/{}</source>
+        <translation>rettifica piana: tassello {}/{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>mosaic planned</source>
+        <translation>mosaico pianificato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>planning the mosaic: {}/{}</source>
+        <translation>pianificazione del mosaico: {}/{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>radiometry: fall-off fitted</source>
+        <translation>radiometria: caduta di luce stimata</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>radiometry: hot spot searched</source>
+        <translation>radiometria: hot spot cercato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>radiometry: gain fields fitted</source>
+        <translation>radiometria: campi di guadagno stimati</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>radiometry: sampling {}/{}</source>
+        <translation>radiometria: campionamento {}/{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>camera at X {} Y {} Z {}, omega {} phi {} kappa {} deg</source>
+        <translation>camera a X {} Y {} Z {}, omega {} phi {} kappa {} gradi</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>oriented</source>
+        <translation>orientato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>the control / DSM CRS is geographic (degrees): {} is oriented and orthorectified in EPSG:{} (the UTM zone of the image), and the orthophoto is written in it</source>
+        <translation>il SR dei punti d'appoggio / del DSM è geografico (gradi): {} è orientata e ortorettificata in EPSG:{} (la zona UTM dell'immagine) e l'ortofoto è scritta in esso</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>no CRS given: coordinates are taken as they are (no CRS written)</source>
+        <translation>nessun SR indicato: le coordinate sono prese come sono (nessun SR scritto)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>GCP observation(s) outside the {} x {} image {}: {}</source>
+        <translation>osservazioni di GCP fuori dall'immagine {} x {} {}: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} orthophoto {}: {} per cell, {} % of its cells with data</source>
+        <translation>{} ortofoto {}: {} per cella, {} % delle sue celle con dati</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>done</source>
+        <translation>completato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>the focal length of {} is unknown (no EXIF, none given): it is estimated from the {} control points</source>
+        <translation>la focale di {} è sconosciuta (nessun EXIF, nessuna indicata): è stimata dai {} punti d'appoggio</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>DSM {} reprojected on the fly into the working CRS</source>
+        <translation>DSM {} riproiettato al volo nel SR di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>captures: {}/{} stacked</source>
+        <translation>acquisizioni: {}/{} impilate</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>capture {} left out: {}</source>
+        <translation>acquisizione {} esclusa: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>sky: {} of {} images show sky, hidden from the alignment</source>
+        <translation>cielo: {} di {} immagini mostrano il cielo, nascosto all'allineamento</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>one photo ({}): screened on its own, with no set to compare with (only the absolute limits: clipped highlights and shadows, dynamic range); prepared as a set&apos;s photos are</source>
+        <translation>una foto ({}): controllata da sola, senza un insieme con cui confrontarla (solo i limiti assoluti: luci e ombre saturate, gamma dinamica); preparata come le foto di un insieme</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>masks: {} polygons ({}, y {}) hide parts of {} of {} images</source>
+        <translation>maschere: {} poligoni ({}, y {}) nascondono parti di {} di {} immagini</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>masks: {}/{}</source>
+        <translation>maschere: {}/{}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>fiducials: {}/{} scans ({}: {} marks)</source>
+        <translation>marche fiduciali: {}/{} scansioni ({}: {} marche)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>resampling {}</source>
+        <translation>ricampionamento di {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>screening: {}/{} images ({})</source>
+        <translation>controllo: {}/{} immagini ({})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>sky: {}</source>
+        <translation>cielo: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>sky mask: {}: {} % of the photo (rows {}–{})</source>
+        <translation>maschera del cielo: {}: {} % della foto (righe {}–{})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>sky mask: {}: none, {}</source>
+        <translation>maschera del cielo: {}: nessuna, {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>screened {} images: {} flagged, {} excluded</source>
+        <translation>{} immagini controllate: {} segnalate, {} escluse</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>writing the screening record</source>
+        <translation>scrittura del registro di controllo</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>reading the sparse model</source>
+        <translation>lettura del modello sparso</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>report written: {}</source>
+        <translation>rapporto scritto: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>report: {}</source>
+        <translation>rapporto: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>uncertainty: bundle adjustment covariance</source>
+        <translation>incertezza: covarianza della compensazione a stelle proiettive</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{}: block {} of {}</source>
+        <translation>{}: blocco {} di {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} of {} ({} x {} cells): {}</source>
+        <translation>{} di {} ({} x {} celle): {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>contours</source>
+        <translation>curve di livello</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>DSM A read</source>
+        <translation>DSM A letto</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>DSM B warped onto the grid of DSM A</source>
+        <translation>DSM B ricampionato sulla griglia del DSM A</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>DSM difference written</source>
+        <translation>differenza dei DSM scritta</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>ground filter: interpolating under the objects</source>
+        <translation>filtro del terreno: interpolazione sotto gli oggetti</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>ground filter: window {} m</source>
+        <translation>filtro del terreno: finestra {} m</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>ground filter: tile {} of {}</source>
+        <translation>filtro del terreno: tassello {} di {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>ground filter: object {} of {}</source>
+        <translation>filtro del terreno: oggetto {} di {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>relief visualisation: {}</source>
+        <translation>visualizzazione del rilievo: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>relief visualisation: {}, tile {} of {}</source>
+        <translation>visualizzazione del rilievo: {}, tassello {} di {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>saving the reference {} {}: {}</source>
+        <translation>salvataggio del riferimento {} {}: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>reference {} saved to {} ({} % of it has data)</source>
+        <translation>riferimento {} salvato in {} ({} % con dati)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>reference {} {}: {} x {} m at {} m would exceed {} pixels: saved at {} m</source>
+        <translation>riferimento {} {}: {} x {} m a {} m supererebbero {} pixel: salvato a {} m</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>saving the reference {} {}</source>
+        <translation>salvataggio del riferimento {} {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>the photos are corrected as the orthophoto&apos;s (exposure, vignetting, hot spot)</source>
+        <translation>le foto sono corrette come per l'ortofoto (esposizione, vignettatura, hot spot)</translation>
     </message>
 </context>
 <context>
@@ -1081,24 +2055,37 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
     </message>
 </context>
 <context>
+    <name>FolderDialog</name>
+    <message>
+        <location filename="../ui/folder_dialog.py" line="47"/>
+        <source>The folder {} cannot be made: {}</source>
+        <translation>Impossibile creare la cartella {}: {}</translation>
+    </message>
+</context>
+<context>
     <name>GcpDock</name>
     <message>
+        <location filename="../ui/gcp_dock.py" line="221"/>
         <source>Report</source>
         <translation>Rapporto</translation>
     </message>
     <message>
+        <location filename="../ui/gcp_dock.py" line="222"/>
         <source>Open the workspace&apos;s accuracy report (report.html, made by Run pipeline or Accuracy report) in the web browser</source>
         <translation>Apri il rapporto di accuratezza dello spazio di lavoro (report.html, creato da Run pipeline o Accuracy report) nel browser web</translation>
     </message>
     <message>
+        <location filename="../ui/gcp_dock.py" line="601"/>
         <source>The workspace has no accuracy report yet: run Accuracy report (or Run pipeline)</source>
         <translation>Lo spazio di lavoro non ha ancora un rapporto di accuratezza: eseguire Accuracy report (o Run pipeline)</translation>
     </message>
     <message>
+        <location filename="../ui/gcp_dock.py" line="396"/>
         <source>No web browser opened {}</source>
         <translation>Nessun browser web ha aperto {}</translation>
     </message>
     <message>
+        <location filename="../ui/gcp_dock.py" line="398"/>
         <source>Accuracy report: {}</source>
         <translation>Rapporto di accuratezza: {}</translation>
     </message>
@@ -1118,7 +2105,7 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Area di lavoro:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="372"/>
+        <location filename="../ui/gcp_dock.py" line="429"/>
         <source>none open</source>
         <translation>nessuna aperta</translation>
     </message>
@@ -1148,27 +2135,27 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Aggiungi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="197"/>
+        <location filename="../ui/gcp_dock.py" line="198"/>
         <source>Add a ground point</source>
         <translation>Aggiungi un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="198"/>
+        <location filename="../ui/gcp_dock.py" line="199"/>
         <source>Remove</source>
         <translation>Rimuovi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="199"/>
+        <location filename="../ui/gcp_dock.py" line="200"/>
         <source>Remove the selected ground point and its observations</source>
         <translation>Rimuovi il punto d'appoggio selezionato e le sue misure</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="193"/>
+        <location filename="../ui/gcp_placement.py" line="195"/>
         <source>Pick on map</source>
         <translation>Misura sulla mappa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="202"/>
+        <location filename="../ui/gcp_dock.py" line="203"/>
         <source>Click on the map canvas to set X and Y of the selected point (Z from the heights layer)</source>
         <translation>Fai clic sulla mappa per impostare X e Y del punto selezionato (Z dal layer delle quote)</translation>
     </message>
@@ -1178,207 +2165,207 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Importa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="211"/>
+        <location filename="../ui/gcp_dock.py" line="212"/>
         <source>Export</source>
         <translation>Esporta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="226"/>
+        <location filename="../ui/gcp_dock.py" line="230"/>
         <source>Undo</source>
         <translation>Annulla</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="227"/>
+        <location filename="../ui/gcp_dock.py" line="231"/>
         <source>Redo</source>
         <translation>Ripeti</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="237"/>
+        <location filename="../ui/gcp_dock.py" line="241"/>
         <source>Undo: {}</source>
         <translation>Annulla: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="239"/>
+        <location filename="../ui/gcp_dock.py" line="243"/>
         <source>Redo: {}</source>
         <translation>Ripeti: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="218"/>
+        <location filename="../ui/gcp_dock.py" line="219"/>
         <source>Load results</source>
         <translation>Carica risultati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="219"/>
+        <location filename="../ui/gcp_dock.py" line="220"/>
         <source>Add the workspace&apos;s products to the map as styled layers</source>
         <translation>Aggiungi i prodotti dell'area di lavoro alla mappa come layer con stile</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="273"/>
+        <location filename="../ui/gcp_dock.py" line="277"/>
         <source>Residual tolerance:</source>
         <translation>Tolleranza dei residui:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="279"/>
+        <location filename="../ui/gcp_dock.py" line="283"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red</source>
         <translation>Residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="288"/>
+        <location filename="../ui/gcp_dock.py" line="292"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="289"/>
+        <location filename="../ui/gcp_dock.py" line="293"/>
         <source>Let the adjustment refine focal length, principal point and distortion</source>
         <translation>Lascia che la compensazione affini focale, punto principale e distorsione</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="296"/>
+        <location filename="../ui/gcp_dock.py" line="300"/>
         <source>Georeference</source>
         <translation>Georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="297"/>
+        <location filename="../ui/gcp_dock.py" line="301"/>
         <source>Run the adjustment with these points (in the background)</source>
         <translation>Esegui la compensazione con questi punti (in background)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="298"/>
+        <location filename="../ui/gcp_dock.py" line="302"/>
         <source>Cancel</source>
         <translation>Interrompi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="349"/>
+        <location filename="../ui/gcp_dock.py" line="355"/>
         <source>ArchaeoOrtho</source>
         <translation>ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="356"/>
+        <location filename="../ui/gcp_dock.py" line="362"/>
         <source>Open an ArchaeoOrtho workspace</source>
         <translation>Apri un'area di lavoro ArchaeoOrtho</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="402"/>
+        <location filename="../ui/gcp_dock.py" line="454"/>
         <source>{} photos; the block is not aligned yet: run Align images (or &apos;New from photos&apos;) to get predicted positions</source>
         <translation>{} foto; il blocco non è ancora allineato: esegui 'Allinea immagini' (o 'Nuova dalle foto') per avere le posizioni previste</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="405"/>
+        <location filename="../ui/gcp_dock.py" line="457"/>
         <source>{} photos, {} ground points. {}</source>
         <translation>{} foto, {} punti d'appoggio. {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="281"/>
+        <location filename="../ui/gcp_placement.py" line="283"/>
         <source>no predicted positions: {}</source>
         <translation>nessuna posizione prevista: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="65"/>
+        <location filename="../ui/gcp_placement.py" line="66"/>
         <source>Predicted positions from the georeferenced block.</source>
         <translation>Posizioni previste dal blocco georeferenziato.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="65"/>
+        <location filename="../ui/gcp_placement.py" line="66"/>
         <source>Predicted positions once a point is placed in 2 photos, and for every point once 3 points are placed.</source>
         <translation>Posizioni previste quando un punto è misurato in 2 foto, e per tutti i punti quando ne sono misurati 3.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="175"/>
+        <location filename="../ui/gcp_tasks.py" line="185"/>
         <source>Folder of photos</source>
         <translation>Cartella delle foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="178"/>
+        <location filename="../ui/gcp_tasks.py" line="191"/>
         <source>Workspace folder (new or existing)</source>
         <translation>Cartella dell'area di lavoro (nuova o esistente)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="191"/>
+        <location filename="../ui/gcp_tasks.py" line="205"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px</source>
         <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="198"/>
+        <location filename="../ui/gcp_tasks.py" line="212"/>
         <source>ArchaeoOrtho: align photos</source>
         <translation>ArchaeoOrtho: allinea le foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="545"/>
+        <location filename="../ui/gcp_dock.py" line="612"/>
         <source>CRS: {}</source>
         <translation>SR: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="117"/>
+        <location filename="../ui/gcp_placement.py" line="119"/>
         <source>Click on the map at the selected point&apos;s position (Esc to stop)</source>
         <translation>Fai clic sulla mappa nella posizione del punto selezionato (Esc per terminare)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="181"/>
+        <location filename="../ui/gcp_placement.py" line="183"/>
         <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (from {})</source>
         <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f} (da {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="184"/>
+        <location filename="../ui/gcp_placement.py" line="186"/>
         <source>{}: X {:.3f}, Y {:.3f}. No height at this place in {}: Z left as it was</source>
         <translation>{}: X {:.3f}, Y {:.3f}. Nessuna quota in questo punto in {}: Z invariata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="187"/>
+        <location filename="../ui/gcp_placement.py" line="189"/>
         <source>{}: X {:.3f}, Y {:.3f}</source>
         <translation>{}: X {:.3f}, Y {:.3f}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="393"/>
+        <location filename="../ui/gcp_placement.py" line="395"/>
         <source>{:.1f} px</source>
         <translation>{:.1f} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="395"/>
+        <location filename="../ui/gcp_placement.py" line="397"/>
         <source>predicted</source>
         <translation>prevista</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="418"/>
+        <location filename="../ui/gcp_placement.py" line="420"/>
         <source>Select or add a ground point in the table, then click on it in the photo.</source>
         <translation>Seleziona o aggiungi un punto d'appoggio nella tabella, poi fai clic su di esso nella foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="425"/>
+        <location filename="../ui/gcp_placement.py" line="427"/>
         <source>from the point&apos;s other observations</source>
         <translation>dalle altre misure del punto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="426"/>
+        <location filename="../ui/gcp_placement.py" line="428"/>
         <source>from the georeferenced block</source>
         <translation>dal blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="427"/>
+        <location filename="../ui/gcp_placement.py" line="429"/>
         <source>from the points already placed (similarity fit)</source>
         <translation>dai punti già misurati (trasformazione di similitudine)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="438"/>
+        <location filename="../ui/gcp_placement.py" line="440"/>
         <source>Placed at x {:.2f}, y {:.2f}. Click to move it, drag it, or press Delete to remove it.</source>
         <translation>Misurato in x {:.2f}, y {:.2f}. Fai clic per spostarlo, trascinalo o premi Canc per rimuoverlo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="441"/>
+        <location filename="../ui/gcp_placement.py" line="443"/>
         <source>Predicted {}. Press Enter to accept it and go on (Space: accept), drag it, or click where the point really is.</source>
         <translation>Previsto {}. Premi Invio per accettarlo e proseguire (Spazio: accetta), trascinalo o fai clic dove si trova davvero il punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="453"/>
+        <location filename="../ui/gcp_placement.py" line="455"/>
         <source>Click where {} is in this photo.</source>
         <translation>Fai clic dove si trova {} in questa foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="473"/>
+        <location filename="../ui/gcp_placement.py" line="475"/>
         <source>Select or add a ground point first</source>
         <translation>Seleziona o aggiungi prima un punto d'appoggio</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="520"/>
+        <location filename="../ui/gcp_placement.py" line="522"/>
         <source>{}: every photo predicted to see it has an observation</source>
         <translation>{}: ogni foto in cui è previsto ha una misura</translation>
     </message>
@@ -1498,77 +2485,77 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Impossibile aggiungere {} al progetto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="205"/>
+        <location filename="../ui/gcp_tasks.py" line="224"/>
         <source>A task of this dock is still running</source>
         <translation>Un'operazione di questo pannello è ancora in corso</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="228"/>
+        <location filename="../ui/gcp_tasks.py" line="247"/>
         <source>Cancelled</source>
         <translation>Interrotto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="244"/>
+        <location filename="../ui/gcp_tasks.py" line="263"/>
         <source>The block is not aligned yet: run Align images first</source>
         <translation>Il blocco non è ancora allineato: esegui prima 'Allinea immagini'</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="250"/>
+        <location filename="../ui/gcp_tasks.py" line="269"/>
         <source>The adjustment needs at least 3 control points with coordinates and observations; there are {}</source>
         <translation>La compensazione richiede almeno 3 punti d'appoggio con coordinate e misure; ce ne sono {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="268"/>
+        <location filename="../ui/gcp_tasks.py" line="287"/>
         <source>Outliers left out: {}</source>
         <translation>Valori anomali esclusi: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="269"/>
+        <location filename="../ui/gcp_tasks.py" line="288"/>
         <source>Georeferenced in {}.</source>
         <translation>Georeferenziato in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="273"/>
+        <location filename="../ui/gcp_tasks.py" line="292"/>
         <source>ArchaeoOrtho: georeference</source>
         <translation>ArchaeoOrtho: georeferenzia</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="282"/>
+        <location filename="../ui/gcp_tasks.py" line="301"/>
         <source>Not georeferenced yet.</source>
         <translation>Non ancora georeferenziato.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="284"/>
+        <location filename="../ui/gcp_tasks.py" line="303"/>
         <source>Control: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Appoggio: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="287"/>
+        <location filename="../ui/gcp_tasks.py" line="306"/>
         <source>Check: RMSE XY {} m, Z {} m (n = {})</source>
         <translation>Controllo: RMSE XY {} m, Z {} m (n = {})</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="290"/>
+        <location filename="../ui/gcp_tasks.py" line="309"/>
         <source>heights are placeholders: no vertical accuracy</source>
         <translation>le quote sono segnaposto: nessuna accuratezza verticale</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="292"/>
+        <location filename="../ui/gcp_tasks.py" line="311"/>
         <source>tie points {} px</source>
         <translation>punti di legame {} px</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="294"/>
+        <location filename="../ui/gcp_tasks.py" line="313"/>
         <source>edited since: re-run to update</source>
         <translation>modificato da allora: riesegui per aggiornare</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="428"/>
+        <location filename="../ui/gcp_placement.py" line="430"/>
         <source>by matching its look in another photo</source>
         <translation>confrontandone l'aspetto in un'altra foto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="432"/>
+        <location filename="../ui/gcp_placement.py" line="434"/>
         <source>(correlation {:.2f}, {:.0f} px from the geometric prediction)</source>
         <translation>(correlazione {:.2f}, {:.0f} px dalla previsione geometrica)</translation>
     </message>
@@ -1583,32 +2570,32 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Nuova dalle foto…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="205"/>
+        <location filename="../ui/gcp_dock.py" line="206"/>
         <source>From file (gcp_list.txt, CSV)…</source>
         <translation>Da file (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="206"/>
+        <location filename="../ui/gcp_dock.py" line="207"/>
         <source>From a point layer…</source>
         <translation>Da un layer di punti…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="209"/>
+        <location filename="../ui/gcp_dock.py" line="210"/>
         <source>To file (gcp_list.txt, CSV)…</source>
         <translation>Su file (gcp_list.txt, CSV)…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="210"/>
+        <location filename="../ui/gcp_dock.py" line="211"/>
         <source>To a GeoPackage layer…</source>
         <translation>Su un layer GeoPackage…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="236"/>
+        <location filename="../ui/gcp_tasks.py" line="255"/>
         <source>Cancelling…</source>
         <translation>Interruzione…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="276"/>
+        <location filename="../ui/gcp_tasks.py" line="295"/>
         <source>Georeferencing with {} control points…</source>
         <translation>Georeferenziazione con {} punti d'appoggio…</translation>
     </message>
@@ -1623,152 +2610,152 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Coordinate misurate sulle foto raddrizzate ({} foto sono salvate ruotate: orientamento EXIF); lasciare deselezionato per la griglia di pixel salvata (quella di COLMAP e OpenDroneMap)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="74"/>
+        <location filename="../ui/gcp_placement.py" line="75"/>
         <source>your setting</source>
         <translation>la tua impostazione</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="77"/>
+        <location filename="../ui/gcp_placement.py" line="78"/>
         <source>default: 3 × GSD of the georeferenced block (GSD {:.3f} m)</source>
         <translation>predefinito: 3 × GSD del blocco georeferenziato (GSD {:.3f} m)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="78"/>
+        <location filename="../ui/gcp_placement.py" line="79"/>
         <source>default</source>
         <translation>predefinito</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="85"/>
+        <location filename="../ui/gcp_placement.py" line="86"/>
         <source>Residuals up to this are green, up to 3 times yellow, beyond red. Now: {}</source>
         <translation>I residui fino a questo valore sono verdi, fino al triplo gialli, oltre rossi. Ora: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="95"/>
+        <location filename="../ui/gcp_placement.py" line="96"/>
         <source>Diagnosis of the adjustment:</source>
         <translation>Diagnosi della compensazione:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="172"/>
+        <location filename="../ui/gcp_placement.py" line="174"/>
         <source>Moved {:.2f} m (Undo: Ctrl+Z).</source>
         <translation>Spostato di {:.2f} m (Annulla: Ctrl+Z).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="395"/>
+        <location filename="../ui/gcp_placement.py" line="397"/>
         <source>near the edge</source>
         <translation>vicino al bordo</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="444"/>
+        <location filename="../ui/gcp_placement.py" line="446"/>
         <source>{} is predicted where it cannot be placed: {}. Click where the point is if you see it, or press Enter for the next photo.</source>
         <translation>{} è previsto dove non può essere posizionato: {}. Fai clic sul punto se lo vedi, o premi Invio per la foto successiva.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="450"/>
+        <location filename="../ui/gcp_placement.py" line="452"/>
         <source>Click where {} is in this photo, or use Pick on map (or type X, Y, Z in the table) to have it predicted in the photos.</source>
         <translation>Fai clic su {} in questa foto, oppure usa Misura sulla mappa (o scrivi X, Y, Z nella tabella) per farlo prevedere nelle foto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="463"/>
+        <location filename="../ui/gcp_placement.py" line="465"/>
         <source>{}: the workspace has no photos to place it in.</source>
         <translation>{}: l'area di lavoro non ha foto in cui posizionarlo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="465"/>
+        <location filename="../ui/gcp_placement.py" line="467"/>
         <source>{} is selected: use Pick on map or type X, Y, Z in the table, or choose a photo in the strip below and click on the point.</source>
         <translation>{} è selezionato: usa Misura sulla mappa o scrivi X, Y, Z nella tabella, oppure scegli una foto nella striscia sotto e fai clic sul punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="467"/>
+        <location filename="../ui/gcp_placement.py" line="469"/>
         <source>{} is selected: choose a photo in the strip below and click on the point.</source>
         <translation>{} è selezionato: scegli una foto nella striscia sotto e fai clic sul punto.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="234"/>
+        <location filename="../ui/gcp_dock.py" line="238"/>
         <source>Undo (Ctrl+Z)</source>
         <translation>Annulla (Ctrl+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="234"/>
+        <location filename="../ui/gcp_dock.py" line="238"/>
         <source>Redo (Ctrl+Shift+Z)</source>
         <translation>Ripeti (Ctrl+Maiusc+Z)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="423"/>
+        <location filename="../ui/gcp_dock.py" line="475"/>
         <source>Aligned {} of {} photos, mean reprojection error {:.2f} px.</source>
         <translation>Allineate {} di {} foto, errore medio di riproiezione {:.2f} px.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="428"/>
+        <location filename="../ui/gcp_dock.py" line="480"/>
         <source>Not aligned ({}): {}</source>
         <translation>Non allineate ({}): {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="429"/>
+        <location filename="../ui/gcp_dock.py" line="481"/>
         <source>(marked in the photo strip; hover for the reason)</source>
         <translation>(segnate nella striscia delle foto; il motivo è nel suggerimento)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="449"/>
+        <location filename="../ui/gcp_dock.py" line="510"/>
         <source>✗ not aligned</source>
         <translation>✗ non allineata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_dock.py" line="450"/>
+        <location filename="../ui/gcp_dock.py" line="511"/>
         <source>{}: not aligned: {}</source>
         <translation>{}: non allineata: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="194"/>
+        <location filename="../ui/gcp_tasks.py" line="208"/>
         <source>Not aligned: {}</source>
         <translation>Non allineate: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="139"/>
+        <location filename="../ui/gcp_placement.py" line="141"/>
         <source>pick on map</source>
         <translation>misura sulla mappa</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="430"/>
+        <location filename="../ui/gcp_placement.py" line="432"/>
         <source>(no Z yet: at the height of the block&apos;s tie points)</source>
         <translation>(ancora nessuna Z: all'altezza dei punti di legame del blocco)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="164"/>
+        <location filename="../ui/gcp_placement.py" line="166"/>
         <source>{} not moved</source>
         <translation>{} non spostato</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="193"/>
+        <location filename="../ui/gcp_placement.py" line="195"/>
         <source>{} is placed in {} photos. Move it {:.2f} m to the picked position, or add a new point there?</source>
         <translation>{} è posizionato in {} foto. Spostarlo di {:.2f} m nella posizione misurata, o aggiungere lì un nuovo punto?</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="197"/>
+        <location filename="../ui/gcp_placement.py" line="199"/>
         <source>Move {}</source>
         <translation>Sposta {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_placement.py" line="198"/>
+        <location filename="../ui/gcp_placement.py" line="200"/>
         <source>New point</source>
         <translation>Nuovo punto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="147"/>
+        <location filename="../ui/gcp_tasks.py" line="157"/>
         <source>ArchaeoOrtho: refine {} in {}</source>
         <translation>ArchaeoOrtho: affina {} in {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="308"/>
+        <location filename="../ui/gcp_tasks.py" line="327"/>
         <source>Results loaded</source>
         <translation>Risultati caricati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="315"/>
+        <location filename="../ui/gcp_tasks.py" line="334"/>
         <source>ArchaeoOrtho: load results</source>
         <translation>ArchaeoOrtho: carica i risultati</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_tasks.py" line="317"/>
+        <location filename="../ui/gcp_tasks.py" line="336"/>
         <source>Loading the results…</source>
         <translation>Caricamento dei risultati…</translation>
     </message>
@@ -1783,67 +2770,67 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Apertura di {}…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="45"/>
+        <location filename="../ui/gcp_autocontrol.py" line="49"/>
         <source>Automatic control from a reference orthophoto</source>
         <translation>Controllo automatico da ortofoto</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="48"/>
+        <location filename="../ui/gcp_autocontrol.py" line="52"/>
         <source>Georeference with no hand-picked GCP: the block is matched to a reference orthophoto and takes its heights from a reference DSM. The points of the table become check points.</source>
         <translation>Georeferenziare senza punti d'appoggio scelti a mano: il blocco viene abbinato a un'ortofoto di riferimento e prende le quote da un DSM di riferimento. I punti della tabella diventano punti di controllo.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="54"/>
+        <location filename="../ui/gcp_autocontrol.py" line="58"/>
         <source>A reference orthophoto: a raster file, or a WMS / XYZ layer (saved for the block&apos;s extent, from the photos&apos; GPS or the map extent)</source>
         <translation>Un'ortofoto di riferimento: un file raster, o un layer WMS / XYZ (salvato per l'estensione del blocco, dal GPS delle foto o dall'estensione della mappa)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="54"/>
+        <location filename="../ui/gcp_autocontrol.py" line="58"/>
         <source>A reference DSM or DTM (heights in metres): a raster file or a WCS layer. Only height rasters are listed: not orthophotos, hillshades, web maps or this workspace&apos;s own products</source>
         <translation>Un DSM o DTM di riferimento (quote in metri): un file raster o un layer WCS. Sono elencati solo raster di quote: non ortofoto, ombreggiature, mappe web o prodotti di questo spazio di lavoro</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="63"/>
+        <location filename="../ui/gcp_autocontrol.py" line="69"/>
         <source>Reference orthophoto:</source>
         <translation>Ortofoto di riferimento:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="64"/>
+        <location filename="../ui/gcp_autocontrol.py" line="70"/>
         <source>Reference DSM:</source>
         <translation>DSM di riferimento:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="82"/>
+        <location filename="../ui/gcp_autocontrol.py" line="116"/>
         <source>Georeference from the reference orthophoto and DSM (in the background)</source>
         <translation>Georeferenzia dall'ortofoto e dal DSM di riferimento (in background)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="103"/>
+        <location filename="../ui/gcp_autocontrol.py" line="137"/>
         <source>Automatic control: choose a reference orthophoto and a reference DSM layer</source>
         <translation>Controllo automatico: scegliere un'ortofoto di riferimento e un layer DSM di riferimento</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="124"/>
+        <location filename="../ui/gcp_autocontrol.py" line="158"/>
         <source>Automatic control: {} automatic GCPs kept of {} matches; georeferenced in {}.</source>
         <translation>Controllo automatico: {} GCP automatici mantenuti su {} corrispondenze; georeferenziato in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="127"/>
+        <location filename="../ui/gcp_autocontrol.py" line="161"/>
         <source>Check points: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</source>
         <translation>Punti di controllo: RMSE XY {:.3f} m, Z {:.3f} m (n = {}).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="138"/>
+        <location filename="../ui/gcp_autocontrol.py" line="172"/>
         <source>ArchaeoOrtho: automatic control</source>
         <translation>ArchaeoOrtho: controllo automatico</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="142"/>
+        <location filename="../ui/gcp_autocontrol.py" line="176"/>
         <source>Automatic control against {} and {}…</source>
         <translation>Controllo automatico rispetto a {} e {}…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_autocontrol.py" line="154"/>
+        <location filename="../ui/gcp_autocontrol.py" line="188"/>
         <source>Automatic GCPs (residuals)</source>
         <translation>GCP automatici (residui)</translation>
     </message>
@@ -1878,215 +2865,245 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Coordinate rilevate:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="92"/>
+        <location filename="../ui/gcp_targets.py" line="93"/>
         <source>auto (crosses, checkerboards, circles, ArUco 4x4)</source>
         <translation>automatico (croci, scacchiere, cerchi, ArUco 4x4)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="94"/>
+        <location filename="../ui/gcp_targets.py" line="95"/>
         <source>Target kind:</source>
         <translation>Tipo di target:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="99"/>
+        <location filename="../ui/gcp_targets.py" line="100"/>
         <source>unknown</source>
         <translation>sconosciuta</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="100"/>
+        <location filename="../ui/gcp_targets.py" line="101"/>
         <source>The target&apos;s side or diameter: marks of another size are left out</source>
         <translation>Lato o diametro del target: i segni di altra dimensione vengono esclusi</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="101"/>
+        <location filename="../ui/gcp_targets.py" line="102"/>
         <source>Target size:</source>
         <translation>Dimensione dei target:</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="103"/>
+        <location filename="../ui/gcp_targets.py" line="104"/>
         <source>A file that names no CRS is read in {}.</source>
         <translation>Un file che non indica un SR viene letto in {}.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="103"/>
+        <location filename="../ui/gcp_targets.py" line="104"/>
         <source>The file must name its CRS (the table and the workspace have none).</source>
         <translation>Il file deve indicare il suo SR (la tabella e l'area di lavoro non ne hanno).</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="156"/>
+        <location filename="../ui/gcp_targets.py" line="157"/>
         <source>Find targets on the photos…</source>
         <translation>Trova i target nelle foto…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="157"/>
+        <location filename="../ui/gcp_targets.py" line="158"/>
         <source>Find the surveyed targets on the aligned photos (in the background): their observations fill the table, marked as found until you confirm them (Space or Enter) or reject them (Delete or R)</source>
         <translation>Trova i target rilevati nelle foto allineate (in background): le loro misure riempiono la tabella, segnate come trovate finché non le confermi (Spazio o Invio) o le scarti (Canc o R)</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="208"/>
+        <location filename="../ui/gcp_targets.py" line="209"/>
         <source>ArchaeoOrtho: find targets</source>
         <translation>ArchaeoOrtho: trova i target</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="210"/>
+        <location filename="../ui/gcp_targets.py" line="211"/>
         <source>Looking for the targets of {} on the photos…</source>
         <translation>Ricerca dei target di {} nelle foto…</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="236"/>
+        <location filename="../ui/gcp_targets.py" line="237"/>
         <source>find targets</source>
         <translation>trova i target</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="238"/>
+        <location filename="../ui/gcp_targets.py" line="239"/>
         <source>Find targets: {} of {} targets found, {} observations, in {:.0f} s.</source>
         <translation>Trova i target: {} di {} target trovati, {} misure, in {:.0f} s.</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="243"/>
+        <location filename="../ui/gcp_targets.py" line="244"/>
         <source>not found: {}</source>
         <translation>non trovati: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="248"/>
-        <source>Space or Enter: confirm the found observation shown; Delete or R: reject it. Georeference uses the found observations that are not rejected, confirmed or not.</source>
-        <translation>Spazio o Invio: conferma la misura trovata mostrata; Canc o R: scartala. Georeferenzia usa le misure trovate non scartate, confermate o no.</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_targets.py" line="305"/>
+        <location filename="../ui/gcp_targets.py" line="316"/>
         <source>Every found observation is confirmed or rejected</source>
         <translation>Ogni misura trovata è confermata o scartata</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="321"/>
-        <source>Found by Find targets, not confirmed: Space or Enter confirms it, Delete or R rejects it (then the next one).</source>
-        <translation>Trovata da Trova i target, non confermata: Spazio o Invio la conferma, Canc o R la scarta (poi la prossima).</translation>
-    </message>
-    <message>
-        <location filename="../ui/gcp_targets.py" line="344"/>
+        <location filename="../ui/gcp_targets.py" line="356"/>
         <source>{} observations found by Find targets, not confirmed: {}</source>
         <translation>{} misure trovate da Trova i target, non confermate: {}</translation>
     </message>
     <message>
-        <location filename="../ui/gcp_targets.py" line="355"/>
+        <location filename="../ui/gcp_targets.py" line="367"/>
         <source>{} found observations are not confirmed yet: they are used as they are (reject the wrong ones first)</source>
         <translation>{} misure trovate non sono ancora confermate: vengono usate così come sono (scarta prima quelle sbagliate)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="216"/>
+        <source>{} (automatic)</source>
+        <translation>{} (automatico)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="218"/>
+        <source>Automatic GCP: measured by the automatic control (matched against the reference orthophoto)</source>
+        <translation>GCP automatico: misurato dal controllo automatico (confrontato con l'ortofoto di riferimento)</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="221"/>
+        <source>&lt;b&gt;{}&lt;/b&gt; (automatic GCP) — {}</source>
+        <translation>&lt;b&gt;{}&lt;/b&gt; (GCP automatico) — {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_autocontrol.py" line="222"/>
+        <source>{} is an automatic GCP: found by the automatic control at x {:.2f}, y {:.2f} in this photo (measured in {} photos), not a prediction to place. Drag it to correct it, or press Delete to remove it from this photo.</source>
+        <translation>{} è un GCP automatico: trovato dal controllo automatico a x {:.2f}, y {:.2f} in questa foto (misurato in {} foto), non una previsione da collocare. Trascinalo per correggerlo o premi Canc per toglierlo da questa foto.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="249"/>
+        <source>Space or Enter: confirm the found observation shown; Delete or R: reject it (the keys work in the table, which has the keyboard focus now, and in the photo view). Georeference uses the found observations that are not rejected, confirmed or not.</source>
+        <translation>Spazio o Invio: conferma l'osservazione trovata mostrata; Canc o R: la scarta (i tasti funzionano nella tabella, che ora ha il fuoco della tastiera, e nella vista della foto). Georeferenzia usa le osservazioni trovate non scartate, confermate o no.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_targets.py" line="332"/>
+        <source>Found by Find targets, not confirmed: Space or Enter confirms it, Delete or R rejects it (then the next one); the keys work in the table and in this photo view.</source>
+        <translation>Trovata da Trova i target, non confermata: Spazio o Invio la conferma, Canc o R la scarta (poi la successiva); i tasti funzionano nella tabella e in questa vista della foto.</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="121"/>
+        <source>{} has new results: open it once this dock&apos;s task has ended</source>
+        <translation>{} ha nuovi risultati: aprila al termine dell'attività di questo pannello</translation>
+    </message>
+    <message>
+        <location filename="../ui/gcp_tasks.py" line="218"/>
+        <source>Aligning the photos of {} into {}…</source>
+        <translation>Allineamento delle foto di {} in {}…</translation>
     </message>
 </context>
 <context>
     <name>GcpStore</name>
     <message>
-        <location filename="../ui/store.py" line="289"/>
+        <location filename="../ui/store.py" line="318"/>
         <source>a point named {} exists already</source>
         <translation>esiste già un punto chiamato {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="277"/>
+        <location filename="../ui/store.py" line="306"/>
         <source>add point {}</source>
         <translation>aggiungi il punto {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="284"/>
+        <location filename="../ui/store.py" line="313"/>
         <source>remove point {}</source>
         <translation>rimuovi il punto {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="302"/>
+        <location filename="../ui/store.py" line="331"/>
         <source>set {} of {}</source>
         <translation>imposta {} di {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="362"/>
+        <location filename="../ui/store.py" line="391"/>
         <source>place {} in {}</source>
         <translation>misura {} in {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="370"/>
+        <location filename="../ui/store.py" line="399"/>
         <source>remove {} from {}</source>
         <translation>rimuovi {} da {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="511"/>
+        <location filename="../ui/store.py" line="540"/>
         <source>set CRS</source>
         <translation>imposta il SR</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="330"/>
+        <location filename="../ui/store.py" line="359"/>
         <source>no position</source>
         <translation>nessuna posizione</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="335"/>
+        <location filename="../ui/store.py" line="364"/>
         <source>({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)</source>
         <translation>({:.0f}, {:.0f}) è fuori dalla foto {} ({} × {} px)</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="342"/>
+        <location filename="../ui/store.py" line="371"/>
         <source>({:.0f}, {:.0f}) is inside the mask of {}</source>
         <translation>({:.0f}, {:.0f}) è dentro la maschera di {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="350"/>
+        <location filename="../ui/store.py" line="379"/>
         <source>{} not placed: {}</source>
         <translation>{} non posizionato: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="402"/>
+        <location filename="../ui/store.py" line="431"/>
         <source>{} points replaced by {} from the file</source>
         <translation>{} punti sostituiti da {} dal file</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="436"/>
+        <location filename="../ui/store.py" line="465"/>
         <source>added {} points: {}</source>
         <translation>aggiunti {} punti: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="438"/>
+        <location filename="../ui/store.py" line="467"/>
         <source>coordinates updated from the file: {}</source>
         <translation>coordinate aggiornate dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="440"/>
+        <location filename="../ui/store.py" line="469"/>
         <source>role set by the file: {}</source>
         <translation>ruolo impostato dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="442"/>
+        <location filename="../ui/store.py" line="471"/>
         <source>role kept (the file gives none): {}</source>
         <translation>ruolo mantenuto (il file non ne indica): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="444"/>
+        <location filename="../ui/store.py" line="473"/>
         <source>σ set by the file: {}</source>
         <translation>σ impostata dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="446"/>
+        <location filename="../ui/store.py" line="475"/>
         <source>{} observations added</source>
         <translation>{} misure aggiunte</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="448"/>
+        <location filename="../ui/store.py" line="477"/>
         <source>placed observations kept (the file has others): {}</source>
         <translation>misure posizionate mantenute (il file ne ha altre): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="450"/>
+        <location filename="../ui/store.py" line="479"/>
         <source>nothing changed</source>
         <translation>nulla è cambiato</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="459"/>
+        <location filename="../ui/store.py" line="488"/>
         <source>observations placed by hand kept (found ones not used there): {}</source>
         <translation>misure posizionate a mano mantenute (quelle trovate lì non usate): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="499"/>
+        <location filename="../ui/store.py" line="528"/>
         <source>confirm {} in {}</source>
         <translation>conferma {} in {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="508"/>
+        <location filename="../ui/store.py" line="537"/>
         <source>reject {} in {}</source>
         <translation>scarta {} in {}</translation>
     </message>
@@ -2232,7 +3249,7 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>Centri di presa (mondo)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="193"/>
+        <location filename="../processing_provider/georeference.py" line="190"/>
         <source>outlier left out: {}</source>
         <translation>valore anomalo escluso: {}</translation>
     </message>
@@ -2242,7 +3259,7 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>SR {}; appoggio RMSE XY {} m, Z {} m; controllo RMSE XY {} m, Z {} m</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="171"/>
+        <location filename="../processing_provider/run_pipeline.py" line="178"/>
         <source>GCP layer {} lacks the field &apos;{}&apos; (needs name, image, px, py)</source>
         <translation>Al layer dei punti d'appoggio {} manca il campo '{}' (servono name, image, px, py)</translation>
     </message>
@@ -2322,17 +3339,17 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
         <translation>GCP automatici mantenuti</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="163"/>
+        <location filename="../processing_provider/georeference.py" line="164"/>
         <source>Automatic control needs both a reference orthophoto and a reference DSM (REFERENCE_ORTHO, REFERENCE_DSM); {} is missing</source>
         <translation>Il controllo automatico richiede sia un'ortofoto sia un DSM di riferimento (REFERENCE_ORTHO, REFERENCE_DSM); manca {}</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="176"/>
+        <location filename="../processing_provider/georeference.py" line="177"/>
         <source>Target CRS {} is not used: automatic control georeferences in the reference orthophoto&apos;s CRS {}</source>
         <translation>Il SR di destinazione {} non è usato: il controllo automatico georeferenzia nel SR {} dell'ortofoto di riferimento</translation>
     </message>
     <message>
-        <location filename="../processing_provider/georeference.py" line="197"/>
+        <location filename="../processing_provider/georeference.py" line="194"/>
         <source>Automatic control: {} automatic GCPs kept; CRS {}; check RMSE XY {} m, Z {} m</source>
         <translation>Controllo automatico: {} GCP automatici mantenuti; SR {}; RMSE di controllo XY {} m, Z {} m</translation>
     </message>
@@ -2531,67 +3548,67 @@ Residui dei punti d'appoggio: GeoPackage dei punti d'appoggio con i loro residui
 <context>
     <name>PhotoPanel</name>
     <message>
-        <location filename="../ui/photo_viewer.py" line="471"/>
+        <location filename="../ui/photo_viewer.py" line="472"/>
         <source>Only photos that probably see the point</source>
         <translation>Solo le foto che probabilmente vedono il punto</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="474"/>
+        <location filename="../ui/photo_viewer.py" line="475"/>
         <source>Fit</source>
         <translation>Adatta</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="474"/>
+        <location filename="../ui/photo_viewer.py" line="475"/>
         <source>Show the whole photo (F)</source>
         <translation>Mostra l'intera foto (F)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="475"/>
+        <location filename="../ui/photo_viewer.py" line="476"/>
         <source>Zoom to point</source>
         <translation>Zoom sul punto</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="475"/>
+        <location filename="../ui/photo_viewer.py" line="476"/>
         <source>Zoom to the observation or prediction (Z)</source>
         <translation>Zoom sulla misura o sulla previsione (Z)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="477"/>
+        <location filename="../ui/photo_viewer.py" line="478"/>
         <source>Confirm</source>
         <translation>Conferma</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="477"/>
+        <location filename="../ui/photo_viewer.py" line="478"/>
         <source>Accept the predicted position (Space)</source>
         <translation>Accetta la posizione prevista (Spazio)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="479"/>
+        <location filename="../ui/photo_viewer.py" line="480"/>
         <source>Confirm &amp;&amp; next</source>
         <translation>Conferma &amp;&amp; avanti</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="479"/>
+        <location filename="../ui/photo_viewer.py" line="480"/>
         <source>Accept the prediction and show the next photo to place (Enter)</source>
         <translation>Accetta la previsione e mostra la prossima foto da misurare (Invio)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="482"/>
+        <location filename="../ui/photo_viewer.py" line="483"/>
         <source>Remove</source>
         <translation>Rimuovi</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="482"/>
+        <location filename="../ui/photo_viewer.py" line="483"/>
         <source>Remove the observation in this photo (Delete)</source>
         <translation>Rimuovi la misura in questa foto (Canc)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="665"/>
+        <location filename="../ui/photo_viewer.py" line="683"/>
         <source>{} (predicted)</source>
         <translation>{} (previsto)</translation>
     </message>
     <message>
-        <location filename="../ui/photo_viewer.py" line="571"/>
+        <location filename="../ui/photo_viewer.py" line="589"/>
         <source>Shown upright (EXIF orientation {}: stored {} x {} px); pixel coordinates are those of the stored grid, as COLMAP and gcp_list.txt use them</source>
         <translation>Mostrata raddrizzata (orientamento EXIF {}: salvata {} x {} px); le coordinate pixel sono quelle della griglia salvata, come le usano COLMAP e gcp_list.txt</translation>
     </message>
@@ -2835,164 +3852,1235 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
     </message>
 </context>
 <context>
-    <name>ResultLayers</name>
+    <name>Report</name>
     <message>
-        <source>found</source>
-        <translation>trovato</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>height (m)</source>
+        <translation>quota (m)</translation>
     </message>
     <message>
-        <source>not found</source>
-        <translation>non trovato</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Summary</source>
+        <translation>Riepilogo</translation>
     </message>
     <message>
-        <source>Targets found</source>
-        <translation>Target trovati</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Orientation quality</source>
+        <translation>Qualità dell'orientamento</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="286"/>
-        <source>control (used)</source>
-        <translation>appoggio (usato)</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Georeferencing</source>
+        <translation>Georeferenziazione</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="287"/>
-        <source>check point</source>
-        <translation>punto di controllo</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Uncertainty</source>
+        <translation>Incertezza</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="288"/>
-        <source>rejected (outlier)</source>
-        <translation>scartato (valore anomalo)</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Products</source>
+        <translation>Prodotti</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="289"/>
-        <source>not triangulated</source>
-        <translation>non triangolato</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>images aligned</source>
+        <translation>immagini allineate</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="807"/>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean reprojection error</source>
+        <translation>errore medio di riproiezione</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>ground sample distance</source>
+        <translation>risoluzione al suolo (GSD)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>area</source>
+        <translation>area</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>check RMSE XY</source>
+        <translation>RMSE di controllo XY</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>check RMSE Z</source>
+        <translation>RMSE di controllo Z</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>NSSDA horizontal 95 %</source>
+        <translation>NSSDA orizzontale 95 %</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>NSSDA vertical 95 %</source>
+        <translation>NSSDA verticale 95 %</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>ASPRS 2014 horizontal class</source>
+        <translation>classe orizzontale ASPRS 2014</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>camera position RMSE XY (the block&apos;s fit to the positions)</source>
+        <translation>RMSE XY delle posizioni delle camere (adattamento del blocco alle posizioni)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>tie point σXY / σZ (median; predicted ground uncertainty, datum included)</source>
+        <translation>σXY / σZ dei punti di legame (mediana; incertezza prevista al suolo, datum incluso)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>DSM valid fraction</source>
+        <translation>frazione valida del DSM</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>ArchaeoOrtho report — {}</source>
+        <translation>Rapporto ArchaeoOrtho — {}</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>no aligned model: run &apos;Align images&apos;</source>
+        <translation>nessun modello allineato: esegui 'Allinea immagini'</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>no DSM / orthomosaic yet</source>
+        <translation>ancora nessun DSM / ortomosaico</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>{} of {} images aligned, mean reprojection error {} px</source>
+        <translation>{} di {} immagini allineate, errore medio di riproiezione {} px</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>generated</source>
+        <translation>generato</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>At a glance</source>
+        <translation>In sintesi</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Skipped:</source>
+        <translation>Saltata:</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>automatic control points</source>
+        <translation>punti d'appoggio automatici</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Where the automatic GCPs lie (triangles, coloured by their horizontal residual after the adjustment), the ones the adjustment rejected (red) and the candidates dropped before it (grey): a change between the epochs, a height the DSM does not give, a point found in one photo only.</source>
+        <translation>Dove si trovano i GCP automatici (triangoli, colorati secondo il residuo orizzontale dopo la compensazione), quelli scartati dalla compensazione (rosso) e i candidati esclusi prima (grigio): un cambiamento tra le epoche, una quota che il DSM non fornisce, un punto trovato in una sola foto.</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>step</source>
+        <translation>passo</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>matches / points</source>
+        <translation>corrispondenze / punti</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>dropped because</source>
+        <translation>escluso perché</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>candidates</source>
+        <translation>candidati</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>dropped candidates</source>
+        <translation>candidati esclusi</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>automatic GCPs (colour: XY residual)</source>
+        <translation>GCP automatici (colore: residuo XY)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>XY residual (m)</source>
+        <translation>residuo XY (m)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Automatic control</source>
+        <translation>Controllo automatico</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>rejected by the adjustment</source>
+        <translation>scartati dalla compensazione</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>set</source>
+        <translation>insieme</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>RMSE X</source>
+        <translation>RMSE X</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>RMSE Y</source>
+        <translation>RMSE Y</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>RMSE Z</source>
+        <translation>RMSE Z</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>RMSE XY</source>
+        <translation>RMSE XY</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean dX</source>
+        <translation>dX medio</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean dY</source>
+        <translation>dY medio</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean dZ</source>
+        <translation>dZ medio</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>name</source>
+        <translation>nome</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>role</source>
+        <translation>ruolo</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>status</source>
+        <translation>stato</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>dXY</source>
+        <translation>dXY</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>obs</source>
+        <translation>oss.</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean px</source>
+        <translation>px medi</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>max px</source>
+        <translation>px max</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>image residuals (px)</source>
+        <translation>residui in immagine (px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>residual vectors</source>
+        <translation>vettori dei residui</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>group</source>
+        <translation>gruppo</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σ XY</source>
+        <translation>σ XY</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>rigid fit σ XY</source>
+        <translation>σ XY dell'adattamento rigido</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>rigid fit σ Z</source>
+        <translation>σ Z dell'adattamento rigido</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>floor XY</source>
+        <translation>minimo XY</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>floor Z</source>
+        <translation>minimo Z</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>placeholders</source>
+        <translation>segnaposto</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>estimated from</source>
+        <translation>stimato da</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>image σ (px)</source>
+        <translation>σ in immagine (px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>left out as suspect</source>
+        <translation>esclusi come sospetti</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>RMSE XY (radial)</source>
+        <translation>RMSE XY (radiale)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>RMSE 3D</source>
+        <translation>RMSE 3D</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>max dXY</source>
+        <translation>dXY max</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>max |dZ|</source>
+        <translation>|dZ| max</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>camera centres</source>
+        <translation>centri di presa</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>image</source>
+        <translation>immagine</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>used</source>
+        <translation>usato</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>tie-point footprint</source>
+        <translation>impronta dei punti di legame</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>dZ (m)</source>
+        <translation>dZ (m)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Residual vectors over the footprint</source>
+        <translation>Vettori dei residui sull'impronta</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Outliers and suspect points</source>
+        <translation>Valori anomali e punti sospetti</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Accuracy of the control given without sigmas, estimated from the data</source>
+        <translation>Accuratezza dei punti d'appoggio dati senza sigma, stimata dai dati</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>RMSE per set</source>
+        <translation>RMSE per insieme</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Outliers, suspect points and warnings</source>
+        <translation>Valori anomali, punti sospetti e avvisi</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Control and check points</source>
+        <translation>Punti d'appoggio e di controllo</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Camera-position residuals</source>
+        <translation>Residui delle posizioni delle camere</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>reprojection error (px)</source>
+        <translation>errore di riproiezione (px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>observations</source>
+        <translation>osservazioni</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>track length (images per tie point)</source>
+        <translation>lunghezza delle tracce (immagini per punto di legame)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>tie points</source>
+        <translation>punti di legame</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>reprojection error and track length histograms</source>
+        <translation>istogrammi dell'errore di riproiezione e della lunghezza delle tracce</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Left: reprojection error of every tie-point observation (clipped at the 99.5th percentile). Right: number of images per tie point.</source>
+        <translation>A sinistra: errore di riproiezione di ogni osservazione dei punti di legame (troncato al 99,5° percentile). A destra: numero di immagini per punto di legame.</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean error (px)</source>
+        <translation>errore medio (px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>reprojection error per image</source>
+        <translation>errore di riproiezione per immagine</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Mean reprojection error (red: more than twice the median) and tie-point observations per image.</source>
+        <translation>Errore medio di riproiezione (rosso: più del doppio della mediana) e osservazioni dei punti di legame per immagine.</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>camera</source>
+        <translation>camera</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mode</source>
+        <translation>modalità</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>parameter</source>
+        <translation>parametro</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>given</source>
+        <translation>dato</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>final</source>
+        <translation>finale</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>moved</source>
+        <translation>spostamento</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>moved (σ)</source>
+        <translation>spostamento (σ)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>image × image</source>
+        <translation>immagine × immagine</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>camera positions</source>
+        <translation>posizioni delle camere</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>shared tie points</source>
+        <translation>punti di legame condivisi</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>image connectivity</source>
+        <translation>connettività delle immagini</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean reprojection error (px)</source>
+        <translation>errore medio di riproiezione (px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>dZ (m): adjusted − given</source>
+        <translation>dZ (m): compensato − dato</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Camera positions</source>
+        <translation>Posizioni delle camere</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Image connectivity</source>
+        <translation>Connettività delle immagini</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Interior orientation</source>
+        <translation>Orientamento interno</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>DSM preview with hillshade (sun from the north-west, 45°).</source>
+        <translation>Anteprima del DSM con ombreggiatura (sole da nord-ovest, 45°).</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>{} preview.</source>
+        <translation>Anteprima: {}.</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="756"/>
-        <source>DSM hillshade</source>
-        <translation>Ombreggiatura del DSM</translation>
-    </message>
-    <message>
-        <location filename="../qgisio/layers.py" line="808"/>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="809"/>
-        <source>Cameras</source>
-        <translation>Camere</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>NSSDA accuracy at 95 % confidence (FGDC-STD-007.3-1998)</source>
+        <translation>Accuratezza NSSDA al 95 % di confidenza (FGDC-STD-007.3-1998)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="768"/>
-        <source>Camera footprints</source>
-        <translation>Impronte delle immagini</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>ASPRS positional accuracy class</source>
+        <translation>Classe di accuratezza posizionale ASPRS</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="776"/>
-        <source>GCP residuals (vectors x{})</source>
-        <translation>Residui dei punti d'appoggio (vettori x{})</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>blur scores</source>
+        <translation>valori di nitidezza</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="810"/>
-        <source>Point cloud</source>
-        <translation>Nuvola di punti</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Blur score per image (orange: flagged, red: excluded).</source>
+        <translation>Valore di nitidezza per immagine (arancione: segnalata, rosso: esclusa).</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="818"/>
-        <source>ArchaeoOrtho: {}</source>
-        <translation>ArchaeoOrtho: {}</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>blur score (higher = sharper)</source>
+        <translation>valore di nitidezza (più alto = più nitido)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="449"/>
-        <source>{} ({})</source>
-        <translation>{} ({})</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>images, blurriest first</source>
+        <translation>immagini, la più sfocata per prima</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="811"/>
-        <source>DTM</source>
-        <translation>DTM</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>blur score</source>
+        <translation>valore di nitidezza</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="783"/>
-        <source>DTM hillshade</source>
-        <translation>Ombreggiatura del DTM</translation>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>blur / median</source>
+        <translation>nitidezza / mediana</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="812"/>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>exposure</source>
+        <translation>esposizione</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>dynamic range</source>
+        <translation>gamma dinamica</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>flags</source>
+        <translation>segnalazioni</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>decision</source>
+        <translation>decisione</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>model</source>
+        <translation>modello</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>size (px)</source>
+        <translation>dimensione (px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>images</source>
+        <translation>immagini</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>parameters (pixels; distortion unitless)</source>
+        <translation>parametri (pixel; distorsione adimensionale)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>stage</source>
+        <translation>fase</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>parameters</source>
+        <translation>parametri</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>why</source>
+        <translation>perché</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Image screening</source>
+        <translation>Controllo delle immagini</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>median</source>
+        <translation>mediana</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>time</source>
+        <translation>tempo</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>steps</source>
+        <translation>passi</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>finished</source>
+        <translation>terminato</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>{} images screened: {} flagged, {} excluded, {} kept (blurriest first).</source>
+        <translation>{} immagini controllate: {} segnalate, {} escluse, {} mantenute (la più sfocata per prima).</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Cameras and calibrated parameters</source>
+        <translation>Camere e parametri calibrati</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Images not aligned</source>
+        <translation>Immagini non allineate</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Processing stages</source>
+        <translation>Fasi di elaborazione</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>DTM preview</source>
+        <translation>anteprima del DTM</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>DTM (bare earth) preview with hillshade.</source>
+        <translation>Anteprima del DTM (terreno nudo) con ombreggiatura.</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Relief visualisations</source>
+        <translation>Visualizzazioni del rilievo</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Relief visualisations (rvt-py, RVT&apos;s default parameters scaled to the cell size), in RVT&apos;s display ranges.</source>
+        <translation>Visualizzazioni del rilievo (rvt-py, i parametri predefiniti di RVT scalati alla dimensione della cella), negli intervalli di visualizzazione di RVT.</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Terrain (DTM)</source>
+        <translation>Terreno (DTM)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>point standard deviations</source>
+        <translation>deviazioni standard dei punti</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Left: distribution of the tie points' standard deviations. Right: σZ over the block, colours clipped at the 95th percentile (precision degrades where few images overlap and away from control).</source>
+        <translation>A sinistra: distribuzione delle deviazioni standard dei punti di legame. A destra: σZ sul blocco, colori troncati al 95° percentile (la precisione cala dove poche immagini si sovrappongono e lontano dai punti d'appoggio).</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σXY</source>
+        <translation>σXY</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>cameras</source>
+        <translation>camere</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σ rot x (°)</source>
+        <translation>σ rot. x (°)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σ rot y (°)</source>
+        <translation>σ rot. y (°)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σ rot z (°)</source>
+        <translation>σ rot. z (°)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σX (m)</source>
+        <translation>σX (m)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σY (m)</source>
+        <translation>σY (m)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>σZ (m)</source>
+        <translation>σZ (m)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>control</source>
+        <translation>punti d'appoggio</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Reference orthophoto</source>
+        <translation>Ortofoto di riferimento</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Reference DSM</source>
+        <translation>DSM di riferimento</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Rough position (prior)</source>
+        <translation>Posizione approssimata (a priori)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Reference CRS</source>
+        <translation>SR del riferimento</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Common resolution of the match</source>
+        <translation>Risoluzione comune dell'abbinamento</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>CRS</source>
+        <translation>SR</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Source of the datum</source>
+        <translation>Origine del datum</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Local frame offset (world = local + offset)</source>
+        <translation>Offset del sistema locale (mondo = locale + offset)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Tie-point reprojection error after the adjustment</source>
+        <translation>Errore di riproiezione dei punti di legame dopo la compensazione</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>GCP observation reprojection error in the adjustment (mean; control held at its coordinates within its sigmas)</source>
+        <translation>Errore di riproiezione delle osservazioni dei GCP nella compensazione (media; punti d'appoggio tenuti alle loro coordinate entro i loro sigma)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Mean reprojection error (mean over tie points of their mean error, as COLMAP reports it)</source>
+        <translation>Errore medio di riproiezione (media sui punti di legame del loro errore medio, come lo riporta COLMAP)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Reprojection error of the observations: mean / median / RMS</source>
+        <translation>Errore di riproiezione delle osservazioni: media / mediana / RMS</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Largest reprojection error</source>
+        <translation>Errore di riproiezione massimo</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Track length: mean / median / max</source>
+        <translation>Lunghezza delle tracce: media / mediana / massimo</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Model</source>
+        <translation>Modello</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>File</source>
+        <translation>File</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Size</source>
+        <translation>Dimensione</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Resolution</source>
+        <translation>Risoluzione</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Brightness step across the seamlines (median; before → after the radiometric correction)</source>
+        <translation>Salto di luminosità attraverso le linee di giunzione (mediana; prima → dopo la correzione radiometrica)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Valid fraction (cells with data)</source>
+        <translation>Frazione valida (celle con dati)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Valid fraction inside the camera centres&apos; convex hull (as the stage reports it)</source>
+        <translation>Frazione valida entro l'inviluppo convesso dei centri di presa (come la riporta la fase)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Inside that hull: measured / interpolated (filled holes) / removed as blunders (dense/dsm-source.tif)</source>
+        <translation>Entro tale inviluppo: misurate / interpolate (buchi riempiti) / rimosse come errori grossolani (dense/dsm-source.tif)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Height range (1st–99th percentile)</source>
+        <translation>Intervallo di quote (1°–99° percentile)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Workspace</source>
+        <translation>Area di lavoro</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Images folder</source>
+        <translation>Cartella delle immagini</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Coordinate reference system</source>
+        <translation>Sistema di riferimento delle coordinate</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Images given / aligned / not aligned</source>
+        <translation>Immagini date / allineate / non allineate</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Tie points / image observations</source>
+        <translation>Punti di legame / osservazioni in immagine</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Images given</source>
+        <translation>Immagini date</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Ground sample distance (median)</source>
+        <translation>Risoluzione al suolo (mediana)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Area covered by tie points</source>
+        <translation>Area coperta dai punti di legame</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Ground sample distance</source>
+        <translation>Risoluzione al suolo</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>DSM cells on the ground (SMRF ground filter)</source>
+        <translation>Celle del DSM al suolo (filtro del terreno SMRF)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>DTM cells interpolated (under objects, in holes)</source>
+        <translation>Celle del DTM interpolate (sotto gli oggetti, nei buchi)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Measured / interpolated cells</source>
+        <translation>Celle misurate / interpolate</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Classified point cloud</source>
+        <translation>Nuvola di punti classificata</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
         <source>Contours</source>
         <translation>Curve di livello</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="433"/>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Datum</source>
+        <translation>Datum</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Sigma0 (a posteriori, unit weight = 1 px)</source>
+        <translation>Sigma0 (a posteriori, peso unitario = 1 px)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Redundancy</source>
+        <translation>Ridondanza</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Observations / points</source>
+        <translation>Osservazioni / punti</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Camera position σXY / σZ (median)</source>
+        <translation>Posizione della camera σXY / σZ (mediana)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Tie point σXY / σZ (median)</source>
+        <translation>Punto di legame σXY / σZ (mediana)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Tie point σXY / σZ (95th percentile)</source>
+        <translation>Punto di legame σXY / σZ (95° percentile)</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>GeoPackage layers</source>
+        <translation>Layer GeoPackage</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Computed in</source>
+        <translation>Calcolato in</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>ground point residuals ({})</source>
+        <translation>residui dei punti a terra ({})</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Per camera</source>
+        <translation>Per camera</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>camera centres ({}); line width ∝ shared points</source>
+        <translation>centri di presa ({}); spessore delle linee ∝ punti condivisi</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>camera positions ({})</source>
+        <translation>posizioni delle camere ({})</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>mean {} px</source>
+        <translation>media {} px</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>median {} px</source>
+        <translation>mediana {} px</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Per-image table</source>
+        <translation>Tabella per immagine</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Screening table</source>
+        <translation>Tabella del controllo</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Parameters used</source>
+        <translation>Parametri usati</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>standard deviation ({})</source>
+        <translation>deviazione standard ({})</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Per camera: standard deviations</source>
+        <translation>Per camera: deviazioni standard</translation>
+    </message>
+    <message>
+        <location filename="../ui/catalog.py" line="8"/>
+        <source>Control points: adjusted standard deviations</source>
+        <translation>Punti d'appoggio: deviazioni standard compensate</translation>
+    </message>
+</context>
+<context>
+    <name>ResultLayers</name>
+    <message>
+        <location filename="../qgisio/layers.py" line="326"/>
+        <source>found</source>
+        <translation>trovato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="326"/>
+        <source>not found</source>
+        <translation>non trovato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="856"/>
+        <source>Targets found</source>
+        <translation>Target trovati</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="289"/>
+        <source>control (used)</source>
+        <translation>appoggio (usato)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="290"/>
+        <source>check point</source>
+        <translation>punto di controllo</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="291"/>
+        <source>rejected (outlier)</source>
+        <translation>scartato (valore anomalo)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="292"/>
+        <source>not triangulated</source>
+        <translation>non triangolato</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="850"/>
+        <source>DSM</source>
+        <translation>DSM</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="796"/>
+        <source>DSM hillshade</source>
+        <translation>Ombreggiatura del DSM</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="851"/>
+        <source>Orthomosaic</source>
+        <translation>Ortomosaico</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="852"/>
+        <source>Cameras</source>
+        <translation>Camere</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="808"/>
+        <source>Camera footprints</source>
+        <translation>Impronte delle immagini</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="816"/>
+        <source>GCP residuals (vectors x{})</source>
+        <translation>Residui dei punti d'appoggio (vettori x{})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="853"/>
+        <source>Point cloud</source>
+        <translation>Nuvola di punti</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="862"/>
+        <source>ArchaeoOrtho: {}</source>
+        <translation>ArchaeoOrtho: {}</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="467"/>
+        <source>{} ({})</source>
+        <translation>{} ({})</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="854"/>
+        <source>DTM</source>
+        <translation>DTM</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="824"/>
+        <source>DTM hillshade</source>
+        <translation>Ombreggiatura del DTM</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="855"/>
+        <source>Contours</source>
+        <translation>Curve di livello</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/layers.py" line="451"/>
         <source>{} — {}</source>
         <translation>{} — {}</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="389"/>
+        <location filename="../qgisio/layers.py" line="407"/>
         <source>Spectral index</source>
         <translation>Indice spettrale</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="806"/>
+        <location filename="../qgisio/layers.py" line="849"/>
         <source>RGB orthomosaic</source>
         <translation>Ortomosaico RGB</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/scene_layers.py" line="33"/>
+        <source>3-D model</source>
+        <translation>Modello 3D</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/legend.py" line="11"/>
+        <source>DTM (bare earth)</source>
+        <translation>DTM (terreno nudo)</translation>
+    </message>
+    <message>
+        <location filename="../qgisio/scene_layers.py" line="132"/>
+        <source>3D Tiles not loaded: {}</source>
+        <translation>3D Tiles non caricati: {}</translation>
     </message>
 </context>
 <context>
     <name>RunPipelineAlgorithm</name>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Folder of images</source>
         <translation>Cartella delle immagini</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Workspace folder</source>
         <translation>Cartella dell'area di lavoro</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Camera positions (CSV)</source>
         <translation>Posizioni delle camere (CSV)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Pair selection</source>
         <translation>Selezione delle coppie</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Camera model</source>
         <translation>Modello di camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Write the accuracy report</source>
         <translation>Scrivi il rapporto di accuratezza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="150"/>
+        <location filename="../processing_provider/run_pipeline.py" line="154"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="151"/>
+        <location filename="../processing_provider/run_pipeline.py" line="155"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="156"/>
+        <location filename="../processing_provider/run_pipeline.py" line="160"/>
         <source>Accuracy report (HTML)</source>
         <translation>Rapporto di accuratezza (HTML)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="218"/>
+        <location filename="../processing_provider/run_pipeline.py" line="227"/>
         <source>Seconds per stage: {}</source>
         <translation>Secondi per fase: {}</translation>
     </message>
@@ -3002,147 +5090,147 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>Esegui l'intera elaborazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Ground control file</source>
         <translation>File dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Ground control layer</source>
         <translation>Layer dei punti d'appoggio</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Check points</source>
         <translation>Punti di controllo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Use EXIF GPS positions</source>
         <translation>Usa le posizioni GPS EXIF</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Target CRS</source>
         <translation>SR di destinazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Matching image size (px)</source>
         <translation>Dimensione per la corrispondenza (px)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Refine camera calibration</source>
         <translation>Affina la calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>DSM resolution (m)</source>
         <translation>Risoluzione del DSM (m)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Matching quality</source>
         <translation>Qualità della corrispondenza</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Seam blending</source>
         <translation>Sfumatura delle giunzioni</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Parallel workers</source>
         <translation>Processi paralleli</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Dask scheduler</source>
         <translation>Scheduler Dask</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Build the DTM</source>
         <translation>Genera il DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Contour interval (m, 0 = none)</source>
         <translation>Equidistanza (m, 0 = nessuna)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Relief visualisations</source>
         <translation>Visualizzazioni del rilievo</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="149"/>
+        <location filename="../processing_provider/run_pipeline.py" line="153"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>GCP pixels measured on upright photos</source>
         <translation>Pixel dei GCP misurati sulle foto raddrizzate</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Sky masks (oblique photos)</source>
         <translation>Maschere del cielo (foto oblique)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Camera calibration file</source>
         <translation>File di calibrazione della camera</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Interior orientation</source>
         <translation>Orientamento interno</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Orthomosaic resolution (CRS units, 0 = GSD)</source>
         <translation>Risoluzione ortomosaico (unità SR, 0 = GSD)</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Targets to find</source>
         <translation>Target da trovare</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Target kind</source>
         <translation>Tipo di target</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="178"/>
+        <location filename="../processing_provider/run_pipeline.py" line="185"/>
         <source>Give ground control (Ground control file or layer, or targets to find: GCPS, GCP_LAYER, TARGETS) and/or camera positions (Camera positions (CSV) or Use EXIF GPS positions: CAMERA_POSITIONS, USE_EXIF_GPS): the DSM and orthophoto need a georeferenced block</source>
         <translation>Indicare punti di appoggio (File o Layer dei punti d'appoggio, o target da trovare: GCPS, GCP_LAYER, TARGETS) e/o posizioni delle camere (Posizioni delle camere (CSV) o Usa le posizioni GPS EXIF: CAMERA_POSITIONS, USE_EXIF_GPS): DSM e ortofoto richiedono un blocco georeferenziato</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Calibration panel folder</source>
         <translation>Cartella del pannello di calibrazione</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Panel reflectance</source>
         <translation>Riflettanza del pannello</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Panel window</source>
         <translation>Finestra del pannello</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="111"/>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
         <source>Capture radiometry</source>
         <translation>Radiometria delle acquisizioni</translation>
     </message>
     <message>
-        <location filename="../processing_provider/run_pipeline.py" line="152"/>
+        <location filename="../processing_provider/run_pipeline.py" line="156"/>
         <source>RGB orthomosaic (a rig&apos;s RGB frames)</source>
         <translation>Ortomosaico RGB (le immagini RGB di un rig)</translation>
     </message>
@@ -3172,6 +5260,16 @@ Maschere del cielo (foto oblique): prima una fase 'Prepara immagini' trova il ci
 Genera il DTM: dopo il DSM, un DTM del suolo nudo (come 'Genera DTM'). Equidistanza (avanzato): curve di livello del DTM con questa equidistanza (come 'Curve di livello'; 0 = nessuna). Visualizzazioni del rilievo (avanzato): quelle scelte sono calcolate dal DTM (come 'Visualizzazione del rilievo'). Entrambe richiedono il DTM.
 Gli altri parametri sono quelli delle singole fasi (vedi il loro aiuto); 0 significa automatico.
 Risultati: il DSM, l'ortomosaico e il rapporto di accuratezza (HTML), più le cifre principali; con una cartella di bande che contiene anche le immagini RGB del rig, anche Ortomosaico RGB (le immagini RGB di un rig): l'ortomosaico proprio di queste immagini, &lt;orthomosaic&gt;_rgb.tif accanto a quello multibanda delle acquisizioni (nessuno quando nessuna immagine RGB è registrata).</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="114"/>
+        <source>Build the textured 3-D model</source>
+        <translation>Genera il modello 3D con texture</translation>
+    </message>
+    <message>
+        <location filename="../processing_provider/run_pipeline.py" line="161"/>
+        <source>3-D model (3D Tiles)</source>
+        <translation>Modello 3D (3D Tiles)</translation>
     </message>
 </context>
 <context>
@@ -3340,13 +5438,6 @@ Riflettanza del pannello: la riflettanza del pannello dal suo foglio di calibraz
 Finestra del pannello (avanzato): il lato del quadrato centrale in cui si misura il pannello, una frazione del lato corto della foto (predefinito 0.25); più piccola quando il pannello riempie meno dell'inquadratura.
 Banda di riferimento (avanzato): la banda su cui sono registrate le altre; vuoto: la camera di riferimento del rig.
 Cartella di uscita: dove sono scritte le foto multibanda (una per acquisizione, nominata come i suoi file di banda senza il suffisso della banda); non la cartella delle bande.</translation>
-    </message>
-</context>
-<context>
-    <name>FolderDialog</name>
-    <message>
-        <source>The folder {} cannot be made: {}</source>
-        <translation>Impossibile creare la cartella {}: {}</translation>
     </message>
 </context>
 </TS>

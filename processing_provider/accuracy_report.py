@@ -7,6 +7,7 @@ from qgis.core import (
     QgsProcessingParameterFileDestination,
 )
 
+from ..qgisio.messages import report_language
 from . import params
 from .base import AlgorithmBase, FeedbackProgress
 
@@ -91,7 +92,7 @@ class AccuracyReportAlgorithm(AlgorithmBase):
         output = self.parameterAsFileOutput(parameters, self.OUTPUT_HTML, context) or None
         progress = FeedbackProgress(feedback)
         options = ReportOptions(uncertainty=self.parameterAsBoolean(parameters, self.UNCERTAINTY, context),
-                                output_html=output)
+                                output_html=output, language=report_language())  # headings in QGIS's language
         result = self.run_core(report.build_report, workspace, options, progress)
         progress.push_result(result.warnings)
         skipped = {k: v for k, v in result.sections.items() if v != "ok"}

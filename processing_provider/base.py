@@ -15,6 +15,8 @@ import weakref
 from qgis.core import Qgis, QgsApplication, QgsMessageLog, QgsProcessingAlgorithm, QgsProcessingException
 from qgis.PyQt.QtCore import QCoreApplication
 
+from ..qgisio.messages import translate_message
+
 HEADLESS_PLATFORMS = ("qgis_process", "server")
 
 
@@ -102,7 +104,7 @@ class FeedbackProgress:
         self.feedback.setProgress(100.0 * (self.start + (self.end - self.start) * f))
         if message and message != self._last_message:
             self._last_message = message
-            self.feedback.setProgressText(message)
+            self.feedback.setProgressText(translate_message(message))
 
     def is_cancelled(self):
         return SIGNALLED.is_set() or bool(self.feedback is not None and self.feedback.isCanceled())
@@ -110,7 +112,7 @@ class FeedbackProgress:
     def info(self, message):
         self._pushed.add(("info", message))
         if self.feedback is not None:
-            self.feedback.pushInfo(message)
+            self.feedback.pushInfo(translate_message(message))
 
     def push_result(self, warnings=(), lines=()):
         """After the core call: its result's warnings and log lines that the core did not push while it ran
@@ -127,6 +129,7 @@ class FeedbackProgress:
         self._pushed.add(("warning", message))
         if self.feedback is None:
             return
+        message = translate_message(message)  # the core's English in the user's language (qgisio/messages.py)
         if hasattr(self.feedback, "pushWarning"):
             self.feedback.pushWarning(message)
         else:  # pragma: no cover - QGIS < 3.16
@@ -325,7 +328,8 @@ class SignalCancel:
         SIGNALLED.set()
         for feedback in self.feedbacks:
             try:
-                feedback.pushWarning(f"{signal.Signals(signum).name}: cancelling (send it again to stop at once)")
+                feedback.pushWarning(QCoreApplication.translate(
+                    "AlgorithmBase", "{}: cancelling (send it again to stop at once)").format(signal.Signals(signum).name))
                 feedback.cancel()
             except Exception:  # noqa: BLE001,S110 - the flag alone cancels the core call
                 pass

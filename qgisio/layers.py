@@ -39,8 +39,10 @@ from qgis.core import (
     QgsVectorLayer,
     QgsVectorLayerSimpleLabeling,
 )
-from qgis.PyQt.QtCore import QCoreApplication
+from qgis.PyQt.QtCore import QCoreApplication, QObject, pyqtSignal
 from qgis.PyQt.QtGui import QColor, QFont
+
+from .legend import translate_band_legend
 
 KIND_PROPERTY = "archaeoortho/kind"
 PATH_PROPERTY = "archaeoortho/path"
@@ -561,6 +563,7 @@ def add_layer(project, layer, group=None, path=None):
         return None
     if node is not None:
         node.insertLayer(_index_in_group(node, layer.customProperty(KIND_PROPERTY, "")), layer)
+    translate_band_legend(project, layer)  # "Band 1: DTM (bare earth)" in the user's language (issue 48 item 6)
     return layer
 
 
@@ -735,6 +738,23 @@ def output_kind(output_name, path):
 _KEEP = []  # the post-processors must outlive the run (QGIS keeps only a raw pointer)
 
 
+class ResultsNotifier(QObject):
+    """Says which workspace a Processing run's results came from, once its layers are loaded (main thread): the
+    plugin's dock opens it (issue 48 item 4: after Run pipeline from the Toolbox the dock said 'none open')."""
+
+    workspaceLoaded = pyqtSignal(str)  # noqa: N815 (Qt signal naming)
+
+
+_NOTIFIER = []
+
+
+def results_notifier():
+    """The one ResultsNotifier of this QGIS session."""
+    if not _NOTIFIER:
+        _NOTIFIER.append(ResultsNotifier())
+    return _NOTIFIER[0]
+
+
 class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
     """Styles a loaded output layer; for a DSM adds the hillshade, for cameras the footprints."""
 
@@ -758,6 +778,8 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
             QgsMessageLog.logMessage(f"{message}\n{text}", "ArchaeoOrtho", Qgis.MessageLevel.Critical)
             if feedback is not None:
                 feedback.reportError(message, False)
+        if self.workspace:  # styled or not, the layer is the workspace's: the dock follows (the plugin hears it)
+            results_notifier().workspaceLoaded.emit(self.workspace)
 
     def _style(self, layer, context):
         project = context.project() or QgsProject.instance()
@@ -797,6 +819,7 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
             _mark(layer, POINT_CLOUD)
         elif self.kind == DTM:
             style_dtm(layer)
+            translate_band_legend(project, layer)
             remove_loaded(project, path, (DTM_HILLSHADE,))
             shade = QgsRasterLayer(path, product_name(QCoreApplication.translate("ResultLayers", "DTM hillshade"),
                                                       path, self.workspace))

@@ -81,6 +81,13 @@ def look():
     log["photo_view_height"] = d.photo_panel.view.height()
     log["screen"] = [QApplication.primaryScreen().size().width(), QApplication.primaryScreen().size().height()]
     log["dock_minimum_height"] = d.minimumSizeHint().height()
+    # room left to the map: the main window's central area, where the map canvas is (or QGIS's welcome page, which
+    # it shows instead until a layer is loaded): 145 px high with the photo dock at the bottom (issue 48 item 7)
+    central = iface.mainWindow().centralWidget()
+    log["canvas"] = [central.width(), central.height()]
+    log["photo_view"] = [d.photo_panel.view.width(), d.photo_panel.view.height()]
+    toolbox = plugins["processing"].toolbox
+    log["toolbox_shown"] = toolbox.isVisible()
     log["georef_row_bottom"] = max(w.mapToGlobal(w.rect().bottomLeft()).y() for w in (d.btn_georef, d.btn_cancel))
     log["georef_row_visible"] = d.btn_georef.isVisible() and d.btn_cancel.isVisible()
     hidden = []
@@ -99,6 +106,19 @@ def look():
     log["key_columns_hidden"] = [c for c in KEY_COLUMNS if header.sectionViewportPosition(c) < 0
                                  or header.sectionViewportPosition(c) + header.sectionSize(c) > width]
     QApplication.primaryScreen().grabWindow(0).save(os.path.join(OUT, "screen.png"))
+    save()
+    if not os.environ.get("AO_PROCESSING_DOCKS"):
+        QTimer.singleShot(300, iface.actionExit().trigger)
+        return
+    toolbox.raise_()  # the Toolbox in a tab beside the GCP dock: its list when the user brings it up
+    QTimer.singleShot(500, toolbox_raised)
+
+
+@guarded
+def toolbox_raised():
+    tree = plugins["processing"].toolbox.algorithmTree
+    log["toolbox_list_height"] = tree.height() if tree.isVisible() else 0
+    QApplication.primaryScreen().grabWindow(0).save(os.path.join(OUT, "screen-toolbox.png"))
     save()
     QTimer.singleShot(300, iface.actionExit().trigger)
 

@@ -750,3 +750,73 @@ def test_open_report_from_the_dock_after_a_restart(dock, aligned_ws, tmp_path, m
     open(elsewhere, "w").close()
     ws.data["stages"]["report"] = {"status": "done", "outputs": {"report": elsewhere}}
     assert os.path.normpath(report_of(ws)) == os.path.normpath(elsewhere)
+
+
+def test_the_dock_shows_only_the_workspace_open(dock, georef_ws, aligned_ws, monkeypatch):
+    """State belongs to the workspace shown (issue 48 item 4): another workspace opened shows its own residual
+    tolerance (the previous one's 3 x GSD stayed, labelled 'default'), none of the previous photo; 'New from
+    photos' shows the workspace being made while it aligns: not the previous one's name, table or 'Cancelled'."""
+    from archaeoortho.core.align import stage as align_stage
+    from archaeoortho.core.common.progress import Cancelled
+    from archaeoortho.ui.gcp_dock import DEFAULT_TOLERANCE
+
+    assert dock.open_workspace(georef_ws)
+    gsd_default = dock.tol_spin.value()
+    assert abs(gsd_default - DEFAULT_TOLERANCE) > 1e-3 and "GSD" in dock.tol_source.text()  # 3 x GSD
+    assert dock.photo_panel.image is not None  # the first point's photo
+    assert dock.open_workspace(aligned_ws)  # not georeferenced, no setting: the default, not the previous value
+    assert dock.tol_spin.value() == DEFAULT_TOLERANCE and dock.tol_source.text() == "(default)"
+    assert dock.photo_panel.image is None and dock.photo_panel.view.pyramid_item is None
+    dock.store.save_settings(tolerance=0.25)  # the workspace's own setting comes back with it
+    assert dock.open_workspace(georef_ws) and dock.tol_spin.value() == gsd_default
+    assert dock.open_workspace(aligned_ws) and dock.tol_spin.value() == 0.25
+
+    def waiting_align(images_dir, workspace_dir, options=None, progress=None):
+        while not progress.is_cancelled():
+            time.sleep(0.02)
+        raise Cancelled("cancelled")
+
+    monkeypatch.setattr(align_stage, "align", waiting_align)
+    assert dock.open_workspace(georef_ws) and dock.model.rowCount() > 0
+    dock.message("Cancelled")  # a cancelled run's message
+    new_ws = os.path.join(os.path.dirname(aligned_ws), "new-site")
+    assert dock.start_alignment(os.path.dirname(dock.store.images()[0]["path"]), new_ws) is not None
+    try:
+        process(100)
+        assert dock.store.workspace is None and dock.model.rowCount() == 0
+        assert dock.ws_label.text().startswith("new-site") and "Cancelled" not in dock.status.text()
+        assert os.path.basename(os.path.normpath(georef_ws)) not in dock.ws_label.text()
+    finally:
+        dock.cancel_task()
+        wait_task(dock, 30)
+    assert "Cancelled" in dock.status.text()
+
+
+def test_automatic_gcps_are_shown_as_found_not_as_predictions_to_place(dock, georef_ws, block, tmp_path):
+    """After automatic control the photo view showed 'auto_001 (predicted)' in a photo where it was not measured
+    (issue 48 item 11): an automatic GCP is shown where the automatic control measured it, labelled automatic,
+    and no prediction is offered to place it by hand."""
+    ws = shutil.copytree(georef_ws, str(tmp_path / "auto"))
+    path = os.path.join(ws, "georef", "control.json")
+    data = json.load(open(path))
+    auto = data["points"][0]  # a control point measured in two photos only: the others would be predictions
+    auto["name"] = "auto_001"
+    auto["observations"] = auto["observations"][-2:]
+    with open(path, "w") as f:
+        json.dump(data, f)
+    candidates = [{"name": "auto_001", "status": "kept"}, {"name": "auto_002", "status": "too few photos"}]
+    with open(os.path.join(ws, "georef", "autocontrol.json"), "w") as f:
+        json.dump({"format": "archaeoortho-autocontrol", "candidates": candidates}, f)
+    assert dock.open_workspace(ws)
+    assert dock.store.automatic == {"auto_001"}
+    assert dock.select_point("auto_001")
+    measured = {o["image"]: (o["x"], o["y"]) for o in auto["observations"]}
+    panel = dock.photo_panel
+    assert panel.image in measured, panel.image
+    assert dock.predictions == {} and panel.prediction is None and dock.next_photo() is None
+    assert panel.observation is not None and panel.observation.label == "auto_001 (automatic)"
+    assert "automatic GCP" in panel.hint.text() and "not a prediction" in panel.hint.text()
+    assert not panel.btn_confirm.isEnabled()
+    # an ordinary point is still predicted in the photos where it is not placed yet
+    other = dock.store.gcps.points[1].name
+    assert dock.select_point(other) and dock.predictions

@@ -86,7 +86,7 @@ def _translated_literals():
 
     out = set()
     files = [os.path.join(ROOT, f) for f in os.listdir(ROOT) if f.endswith(".py")]
-    for folder in ("ui", "processing_provider"):
+    for folder in ("ui", "processing_provider", "qgisio"):
         files += [os.path.join(ROOT, folder, f) for f in os.listdir(os.path.join(ROOT, folder)) if f.endswith(".py")]
     listed = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True)
     if listed.returncode == 0 and listed.stdout:  # a checkout: the files in the repository (not a new one in work)
@@ -227,10 +227,9 @@ def georef_ws(block, photos, tmp_path_factory):
 
 @pytest.fixture
 def default_dock(qgis_canvas, qgis_new_project):
-    """The dock and the photo dock as QGIS first shows them: the dock at its size hint in a main window's right
-    area, the photo dock at the bottom (plugin.show_dock's default sizes)."""
+    """The dock and the photo dock as QGIS first shows them (plugin.show_dock: ui/dock_layout.place_docks): the
+    dock at its size hint in a main window's right area, the photo dock on the left."""
     from archaeoortho.ui.gcp_dock import GcpDock
-    from qgis.PyQt.QtCore import Qt
     from qgis.PyQt.QtWidgets import QMainWindow
 
     win = QMainWindow()
@@ -238,11 +237,9 @@ def default_dock(qgis_canvas, qgis_new_project):
     _qgis_like(win)
     win.resize(1366, 768)
     d = GcpDock(None, qgis_canvas, parent=win)
-    win.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, d)
-    win.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, d.photo_dock)
     win.show()
     process(100)
-    _default_sizes(win, d)
+    _place(win, d)
     process(100)
     yield d
     d.cleanup()
@@ -258,17 +255,11 @@ def _qgis_like(win):
     win.setCorner(Qt.Corner.BottomRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
 
 
-def _default_sizes(win, d):
-    """What ArchaeoOrthoPlugin.show_dock does the first time (its _default_dock_sizes)."""
-    from archaeoortho.plugin import ArchaeoOrthoPlugin
+def _place(win, d):
+    """What ArchaeoOrthoPlugin.show_dock does the first time: the docks placed and sized (ui/dock_layout)."""
+    from archaeoortho.ui.dock_layout import place_docks
 
-    class _Iface:
-        def mainWindow(self):  # noqa: N802 (QGIS API name)
-            return win
-
-    p = ArchaeoOrthoPlugin.__new__(ArchaeoOrthoPlugin)
-    p.iface, p.dock = _Iface(), d
-    p._default_dock_sizes()
+    place_docks(win, d, d.photo_dock)
 
 
 def overflowing_actions(dock):
@@ -315,14 +306,13 @@ def test_layout_at_the_default_size(default_dock, georef_ws):
     assert dock.act_results.isEnabled() and dock.act_redo in dock.toolbar.actions()
     assert hidden_key_columns(dock) == []
     assert dock.table.horizontalScrollBar().value() == 0
-    assert dock.photo_panel.view.height() >= 200
-    assert dock.photo_dock.height() >= 400
+    assert dock.photo_panel.view.height() >= 200 and dock.photo_panel.view.width() >= 300
 
 
 def test_layout_in_german_at_the_default_size(qgis_canvas, qgis_new_project, georef_ws):
     """German labels are longer (Rückgängig, Exportieren, Ergebnisse laden): still nothing in an overflow."""
     from archaeoortho.ui.gcp_dock import GcpDock
-    from qgis.PyQt.QtCore import QCoreApplication, Qt, QTranslator
+    from qgis.PyQt.QtCore import QCoreApplication, QTranslator
     from qgis.PyQt.QtWidgets import QMainWindow
 
     t = QTranslator()
@@ -334,11 +324,9 @@ def test_layout_in_german_at_the_default_size(qgis_canvas, qgis_new_project, geo
         _qgis_like(win)
         win.resize(1366, 768)
         d = GcpDock(None, qgis_canvas, parent=win)
-        win.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, d)
-        win.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, d.photo_dock)
         win.show()
         process(100)
-        _default_sizes(win, d)
+        _place(win, d)
         process(100)
         assert d.btn_georef.text() == "Georeferenzieren"
         assert d.open_workspace(georef_ws)
@@ -599,6 +587,9 @@ def _qgis_desktop(georef_ws, tmp_path, lang, **env_extra):
     script = os.path.join(ROOT, "tests", "desktop_lang_script.py")
     subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1366x768x24", "qgis", "--lang", lang, "--nologo",
                     "--noversioncheck", "--code", script], env=env, capture_output=True, timeout=300)
+    keep = os.environ.get("AO_KEEP")  # a folder to keep the log and screenshots in (issue 48's walkthrough)
+    if keep:
+        shutil.copytree(out, os.path.join(keep, lang + ("-docks" if env_extra else "")), dirs_exist_ok=True)
     log = json.load(open(out / "log.json"))
     assert "error" not in log, log.get("error")
     return log, out / "screen.png"
@@ -620,8 +611,9 @@ def test_qgis_desktop_lang_de(georef_ws, tmp_path):
                                      "Zielmarken auf den Fotos finden…"]
     assert log["texts"]["georef"] == "Georeferenzieren"
     assert log["toolbar_hidden"] == [] and log["key_columns_hidden"] == []
-    assert log["photo_view_height"] >= 180
+    assert log["photo_view_height"] >= 200
     assert log["window"][0] <= 1366 and log["window"][1] <= 768  # the docks' minimum sizes fit the screen
+    assert log["canvas"][1] >= 0.75 * log["window"][1]  # the map was 145 px tall (issue 48 item 7)
     os.makedirs(SHOTS, exist_ok=True)
     shutil.copyfile(screen, os.path.join(SHOTS, "qgis-desktop-de.png"))
 
@@ -641,6 +633,9 @@ def test_qgis_desktop_with_the_toolbox_and_results_viewer(georef_ws, tmp_path):
     assert log["window"][1] <= log["screen"][1] == 768
     assert log["georef_row_visible"] and log["georef_row_bottom"] < log["screen"][1]
     assert log["texts"]["georef"] == "Georeference"
+    assert log["canvas"][1] >= 0.75 * log["window"][1]  # the map keeps the window's height (issue 48 item 7)
+    assert log["toolbox_list_height"] >= 0.4 * log["window"][1]  # the Toolbox a tab: its list the column's height
+    assert log["dock"][1] >= 0.6 * log["window"][1] and log["photo_view"][1] >= 200
 
 
 def test_open_button_reads_the_block_model_in_a_task(default_dock, georef_ws, monkeypatch):
@@ -726,18 +721,15 @@ def test_dock_fits_a_768_px_screen_beside_the_toolbox_and_results_viewer(qgis_ca
     now: with QGIS's menu, toolbars, status bar and both docks the window fits a 768 px screen, and the
     Georeference row and the status line stay in view."""
     from archaeoortho.ui.gcp_dock import GcpDock
-    from qgis.PyQt.QtCore import Qt
 
     win, others = _qgis_main_window(qgis_canvas)
     available = SCREEN_HEIGHT - WINDOW_FRAME
     d = GcpDock(None, qgis_canvas, parent=win)
     try:
-        win.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, d)
-        win.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, d.photo_dock)
         win.resize(1366, available)
         win.show()
         process(100)
-        _default_sizes(win, d)
+        _place(win, d)
         assert d.open_workspace(georef_ws)
         d.message("5 photos, 5 ground points. Predicted positions from the georeferenced block.")
         process(200)
@@ -766,6 +758,47 @@ def test_dock_fits_a_768_px_screen_beside_the_toolbox_and_results_viewer(qgis_ca
         shot = os.path.join(ROOT, "build", "screenshots", "ui", "gcp-dock-768.png")
         os.makedirs(os.path.dirname(shot), exist_ok=True)
         assert win.grab().save(shot)
+    finally:
+        d.cleanup()
+        qgis_canvas.setParent(None)
+        win.close()
+
+
+def test_the_map_keeps_most_of_a_768_px_window(qgis_canvas, qgis_new_project, georef_ws):
+    """On a 1366 x 768 screen the photo dock at the bottom left the map 145 px tall, and the GCP dock stacked
+    under the Processing Toolbox left its algorithm list a few rows (issue 48 item 7).  Each dock has a side
+    column's height now (the GCP dock a tab beside the Toolbox and the Results Viewer on the right, the photos on
+    the left): the map keeps the height between the toolbars and the status bar, the Toolbox's list gets the
+    column when its tab is up, the photo view is a photo, and closing the photo dock gives the map its room."""
+    from archaeoortho.ui.gcp_dock import GcpDock
+
+    win, (toolbox, results) = _qgis_main_window(qgis_canvas)
+    d = GcpDock(None, qgis_canvas, parent=win)
+    try:
+        win.resize(1366, SCREEN_HEIGHT - WINDOW_FRAME)
+        win.show()
+        process(100)
+        _place(win, d)
+        assert d.open_workspace(georef_ws)
+        process(200)
+        canvas, view = qgis_canvas, d.photo_panel.view
+        print(f"\n[1366 x 768] window {win.width()} x {win.height()}: map {canvas.width()} x {canvas.height()}, "
+              f"GCP dock {d.width()} x {d.height()}, photo view {view.width()} x {view.height()}")
+        assert canvas.height() >= 0.75 * win.height()  # was 145 px of 738
+        assert canvas.width() >= win.width() / 3
+        assert view.height() >= 200 and view.width() >= 300
+        assert d.height() >= 0.6 * win.height()  # the table is not squeezed under the Toolbox either
+        assert _inside(d.btn_georef, win) and _inside(view, win)
+        assert not d.visibleRegion().isEmpty()  # the GCP dock's tab is up
+        toolbox.raise_()
+        process(100)
+        tree = toolbox.algorithmTree
+        print(f"[1366 x 768] the Toolbox raised: its list {tree.height()} px high")
+        assert tree.isVisible() and tree.height() >= 0.4 * win.height()
+        width = canvas.width()
+        d.photo_dock.close()  # collapsed: the map takes the photo column's room
+        process(100)
+        assert canvas.width() >= width + 300 and not view.isVisible()
     finally:
         d.cleanup()
         qgis_canvas.setParent(None)

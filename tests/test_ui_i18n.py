@@ -1,6 +1,7 @@
 """Translations: the plugin loads i18n/archaeoortho_<lang>.qm for the QGIS locale; the dock and the toolbox
 speak German (and Italian); the .ts files are complete and the algorithms' class-attribute strings are
 in the catalog pylupdate5 reads."""
+import ast
 import os
 import shutil
 import subprocess
@@ -199,3 +200,198 @@ def test_algorithm_strings_are_in_the_catalog():
     assert out.returncode == 0, ("ui/catalog.py is out of date (an algorithm's name or help changed): "
                                  "run python3 i18n/make_catalog.py && make transup, then translate\n"
                                  + out.stdout + out.stderr)
+
+
+# --------------------------------------------------------------------------------------------------
+# issue 48 item 6: nothing the user reads stays English in a German QGIS
+# --------------------------------------------------------------------------------------------------
+
+# methods and widgets whose text argument a user reads
+USER_FACING = {"setText", "setWindowTitle", "setToolTip", "setPlaceholderText", "setSpecialValueText", "addItem",
+               "addAction", "setStatusTip", "pushInfo", "pushWarning", "reportError", "pushMessage", "pushSuccess",
+               "pushCritical", "setProgressText", "setLabelText", "setTitle", "message", "setName", "addMenu",
+               "setWhatsThis", "setHeaderLabels", "addTab", "setDescription", "showMessage", "info", "warning",
+               "critical", "information", "question", "QLabel", "QPushButton", "QCheckBox", "QGroupBox", "QAction",
+               "QToolButton", "QgsProcessingException"}
+NOT_WORDS = {"ArchaeoOrtho"}  # a name, the same in every language
+
+
+def _face_sources():
+    for folder in ("", "ui", "processing_provider", "qgisio"):
+        for name in sorted(os.listdir(os.path.join(ROOT, folder))):
+            if name.endswith(".py") and name not in ("catalog.py", "core_messages.py"):
+                yield os.path.join(folder, name)
+
+
+def _literal_text(node):
+    """What a user would read of ``node`` when it is a literal (an f-string, "...".format(), a sum or a choice of
+    literals), its fields as {}; None when it is anything else (a tr() call, a variable)."""
+    if isinstance(node, ast.Constant) and isinstance(node.value, str):
+        return node.value
+    if isinstance(node, ast.JoinedStr):
+        return "".join(v.value if isinstance(v, ast.Constant) else "{}" for v in node.values)
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr == "format":
+        return _literal_text(node.func.value)
+    if isinstance(node, ast.BinOp) and isinstance(node.op, (ast.Add, ast.Mod)):
+        parts = [_literal_text(node.left), _literal_text(node.right)]
+        return "".join(p for p in parts if p) if any(parts) else None
+    if isinstance(node, ast.IfExp):
+        parts = [_literal_text(node.body), _literal_text(node.orelse)]
+        return " | ".join(p for p in parts if p) if any(parts) else None
+    return None
+
+
+def _words(text):
+    """The words of ``text`` outside HTML tags and replacement fields."""
+    import re
+
+    text = re.sub(r"<[^>]*>|\{[^}]*\}", " ", text)
+    return [w for w in re.findall(r"[A-Za-z]{3,}", text) if w not in NOT_WORDS]
+
+
+def untranslated_literals(sources, catalogued=()):
+    """[(file:line, text)] of the literal texts given to a user-facing call (USER_FACING) without tr() or
+    translate(); a message whose template is ``catalogued`` (qgisio/core_messages.py: translated where shown)
+    is not counted."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("make_catalog", os.path.join(I18N, "make_catalog.py"))
+    catalog = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(catalog)
+    out = []
+    for rel, text in sources:
+        for node in ast.walk(ast.parse(text)):
+            if not isinstance(node, ast.Call):
+                continue
+            name = node.func.attr if isinstance(node.func, ast.Attribute) else getattr(node.func, "id", "")
+            if name not in USER_FACING:
+                continue
+            for arg in node.args:
+                literal = _literal_text(arg)
+                if literal and _words(literal) and catalog.message_template(arg) not in catalogued:
+                    out.append((f"{rel}:{node.lineno}", literal))
+    return out
+
+
+def test_no_user_facing_string_is_left_untranslated():
+    """Issue 48 item 6: the faces give no literal text to a label, a button, a log line or a message bar without
+    tr() (or the core messages' catalogue), and the check finds one (the Find targets dialog's target kinds
+    were such literals: 'checkerboard', 'circle')."""
+    from archaeoortho.qgisio.core_messages import TEMPLATES
+
+    sources = [(rel, open(os.path.join(ROOT, rel), encoding="utf-8").read()) for rel in _face_sources()]
+    assert untranslated_literals(sources, TEMPLATES) == []
+    planted = [("ui/planted.py", 'box.addItem("checkerboard")\nlabel.setText(f"{n} targets found")\n'
+                                 'bar.pushMessage(tr("Done"))\nw.setText("<b>{}</b>".format(x))\n')]
+    assert [t for _w, t in untranslated_literals(planted)] == ["checkerboard", "{} targets found"]
+
+
+def _ts_translations(lang):
+    tree = ET.parse(os.path.join(I18N, f"archaeoortho_{lang}.ts"))
+    return {(ctx.findtext("name"), m.findtext("source")): m.find("translation")
+            for ctx in tree.getroot().iter("context") for m in ctx.iter("message")}
+
+
+@pytest.mark.parametrize("lang", ["de", "it"])
+def test_core_messages_report_labels_and_target_kinds_are_translated(lang):
+    """The core's message templates (qgisio/core_messages.py), the report's headings and labels (context
+    "Report") and the target kinds are in the .ts file, translated (not 'unfinished')."""
+    from archaeoortho.qgisio.core_messages import TEMPLATES
+
+    have = _ts_translations(lang)
+    wanted = [("CoreMessages", t) for t in TEMPLATES] + [("Choices", "checkerboard"), ("Choices", "circle")]
+    wanted += [("Report", t) for t in ("At a glance", "Summary", "Control and check points", "reprojection error (px)",
+                                       "image")]
+    missing = [k for k in wanted if k not in have or not have[k].text or have[k].get("type") == "unfinished"]
+    assert missing == []
+    assert len(TEMPLATES) > 100
+
+
+def test_core_messages_and_diagnosis_read_in_german(qgis_iface, locale_setting, tmp_path):
+    """A German QGIS: the core's progress lines, log lines and the adjustment's diagnosis (English f-strings from
+    core/) are shown in German with their own names and numbers; a message from no known template stays as it is;
+    the target kinds are German in Processing's Find targets and in the dock's dialog."""
+    import archaeoortho
+    from archaeoortho.qgisio.messages import translate_message
+    from qgis.core import QgsApplication
+
+    _qm("de", tmp_path)
+    locale_setting("de")
+    p = archaeoortho.classFactory(qgis_iface)
+    try:
+        p.initProcessing()
+        assert translate_message("mapping: registered image IMG_0042.JPG") == "Bildzuordnung: Bild IMG_0042.JPG registriert"
+        assert translate_message("DSM tile 3/12") == "DOM-Kachel 3/12"
+        assert translate_message("control point G07 is 0.412 m off the Helmert fit of the others (threshold 0.150 m): "
+                                 "left out of the first adjustment, then re-tested against the adjusted block") == (
+            "Passpunkt G07 liegt 0.412 m neben der Helmert-Passung der anderen (Schwelle 0.150 m): aus der ersten "
+            "Ausgleichung ausgelassen, dann gegen den ausgeglichenen Block erneut geprüft")
+        assert translate_message("pipeline done\nDSM done") == "Verarbeitung fertig\nDOM fertig"
+        assert translate_message("something the core never says") == "something the core never says"
+        kinds = QgsApplication.processingRegistry().algorithmById("archaeoortho:findtargets") \
+            .parameterDefinition("TARGET_KIND").options()
+        assert "Schachbrett (checkerboard)" in kinds and "Kreis (circle)" in kinds
+        from archaeoortho.ui.gcp_targets import FindTargetsDialog
+
+        dialog = FindTargetsDialog()
+        shown = [dialog.kind.itemText(i) for i in range(dialog.kind.count())]
+        assert "Schachbrett (checkerboard)" in shown and "Kreis (circle)" in shown
+        assert dialog.kind.itemData(shown.index("Kreis (circle)")) == "circle"  # the core's value
+        dialog.close()
+    finally:
+        p.unload()
+    assert translate_message("DSM tile 3/12") == "DSM tile 3/12"  # no translator: the core's English
+
+
+def test_report_headings_in_the_report_language(tmp_path):
+    """The accuracy report of a German QGIS has German headings, table headings and labels (the Processing
+    algorithms pass QGIS's language as ReportOptions.language); English without one."""
+    from archaeoortho.core.project.workspace import Workspace
+    from archaeoortho.core.report import stage as report
+    from archaeoortho.core.report.labels import language, t
+    from archaeoortho.core.report.options import ReportOptions
+
+    ws = Workspace.create_or_open(str(tmp_path / "ws")).root
+    text = open(report.build_report(ws, ReportOptions(language="de_AT")).path, encoding="utf-8").read()
+    for german in ('<html lang="de">', "<h2>Auf einen Blick</h2>", "<h2>Übersicht</h2>", "<h2>Produkte</h2>",
+                   "kein ausgerichtetes Modell: 'Bilder ausrichten' ausführen", "Übersprungen:"):
+        assert german in text, german
+    assert "At a glance" not in text and "<h2>Summary</h2>" not in text
+    english = open(report.build_report(ws, ReportOptions()).path, encoding="utf-8").read()
+    assert "<h2>At a glance</h2>" in english and '<html lang="en">' in english
+    with language("it"):
+        assert t("reprojection error (px)") == "errore di riproiezione (px)"  # a figure's axis label
+    assert t("reprojection error (px)") == "reprojection error (px)"
+    with pytest.raises(Exception, match="language"):
+        ReportOptions(language="../../etc")
+
+
+def test_dtm_band_legend_in_german(qgis_iface, locale_setting, tmp_path):
+    """The DTM's legend named its band by the file's English description, "Band 1: DTM (bare earth)", in a
+    German QGIS (issue 48 item 6): the layer the plugin loads shows it translated; the file keeps its own."""
+    import archaeoortho
+    import numpy as np
+    from archaeoortho.qgisio import layers
+    from osgeo import gdal
+    from qgis.core import QgsMapLayerLegendUtils, QgsProject
+
+    path = str(tmp_path / "dtm.tif")
+    ds = gdal.GetDriverByName("GTiff").Create(path, 16, 16, 1, gdal.GDT_Float32)
+    ds.SetGeoTransform((500000.0, 1.0, 0.0, 4600000.0, 0.0, -1.0))
+    ds.GetRasterBand(1).WriteArray(np.arange(256, dtype="float32").reshape(16, 16))
+    ds.GetRasterBand(1).SetDescription("DTM (bare earth)")  # as core/terrain/products.py writes it
+    ds = None
+    _qm("de", tmp_path)
+    locale_setting("de")
+    p = archaeoortho.classFactory(qgis_iface)
+    project = QgsProject()
+    try:
+        dtm = layers.load_dtm(path, project)[0]
+        node = project.layerTreeRoot().findLayer(dtm.id())
+        labels = [QgsMapLayerLegendUtils.legendNodeUserLabel(node, i) for i in range(3)]
+        assert any("DGM (Gelände)" in label for label in labels), labels
+        assert not any("bare earth" in label for label in labels)
+        assert gdal.Open(path).GetRasterBand(1).GetDescription() == "DTM (bare earth)"
+    finally:
+        project.clear()
+        p.unload()

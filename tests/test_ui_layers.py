@@ -428,3 +428,88 @@ def test_find_targets_from_the_toolbox_loads_the_targets_layer(plugin, tmp_path,
     node = QgsProject.instance().layerTreeRoot().findLayer(layer.id())
     assert node.parent().name() == "ArchaeoOrtho: site"
     _render(QgsProject.instance(), [layer], "toolbox-find-targets-layer.png")
+
+
+def test_run_pipelines_workspace_opens_in_the_dock(plugin, aligned, qgis_new_project):
+    """After Run pipeline from the Toolbox the dock said 'none open' (issue 48 item 4): the run's layers, loaded
+    as the Toolbox dialog loads them (with our post-processor), make the dock open the run's workspace."""
+    from qgis.core import QgsProcessingContext, QgsProcessingFeedback, QgsProject, QgsRasterLayer
+
+    from tests.test_ui_dock import process
+
+    ws, _ = aligned
+    dock = plugin.show_dock(True)
+    try:
+        assert dock.store.workspace is None and dock.ws_label.text() == "none open"
+        alg = plugin.provider.algorithm("runpipeline")
+        dsm = _raster(os.path.join(ws, "dsm.tif"), 1, nodata=-9999)
+        ctx = QgsProcessingContext()
+        ctx.setProject(QgsProject.instance())
+        feedback = QgsProcessingFeedback()
+        assert alg.register_styled_outputs({"WORKSPACE": ws, "DSM": dsm}, ctx, feedback) == 1
+        details = ctx.layerToLoadOnCompletionDetails(dsm)
+        layer = QgsRasterLayer(dsm, details.name)
+        assert QgsProject.instance().addMapLayer(layer) is not None
+        details.postProcessor().postProcessLayer(layer, ctx, feedback)  # what the dialog does at the run's end
+        for _ in range(200):
+            process(50)
+            if dock.store.workspace is not None and dock.__dict__.get("_open_task") is None:
+                break
+        assert dock.store.root is not None and os.path.normpath(dock.store.root) == os.path.normpath(ws)
+        assert dock.ws_label.text() == os.path.basename(os.path.normpath(ws))
+    finally:
+        plugin.show_dock(False)
+
+
+def test_a_workspace_group_offers_its_accuracy_report(plugin, aligned, qgis_new_project, qgis_iface, monkeypatch):
+    """The workspace's layer group in the Layers panel has 'Open accuracy report' in its context menu (issue 48
+    item 5), opening the report the dock's Report button opens; disabled while there is none; other groups and
+    layers get nothing.  The right click itself on QGIS before 3.32, the menu's signal after."""
+    from archaeoortho.core.project.workspace import Workspace
+    from archaeoortho.core.report.stage import report_of
+    from archaeoortho.qgisio import layers
+    from archaeoortho.ui.workspace_menu import WorkspaceGroupMenu
+    from qgis.core import QgsProject
+    from qgis.PyQt.QtGui import QContextMenuEvent, QDesktopServices
+    from qgis.PyQt.QtWidgets import QApplication, QMenu
+
+    ws, _ = aligned
+    project = QgsProject.instance()
+    group_name = layers.workspace_group_name(ws)
+    loaded = layers.load_dsm(_raster(os.path.join(ws, "dsm.tif"), 1, nodata=-9999), project, group_name, workspace=ws)
+    assert loaded
+    user_group = project.layerTreeRoot().addGroup("my layers")
+    view = qgis_iface.layerTreeView()
+    menu_hook = plugin.group_menu
+    assert menu_hook is not None and menu_hook.view is view and menu_hook.hooked in ("signal", "viewport")
+    opened = []
+    monkeypatch.setattr(QDesktopServices, "openUrl", lambda url: opened.append(url.toLocalFile()) or True)
+    shown = []
+
+    def right_click(node):
+        """The context menu of ``node`` as QGIS shows it: its entries' (text, enabled)."""
+        index = view.node2index(node)
+        view.setCurrentIndex(index)
+        shown.clear()
+        if menu_hook.hooked == "signal":
+            menu = QMenu()
+            view.contextMenuAboutToShow.emit(menu)
+        else:
+            monkeypatch.setattr(WorkspaceGroupMenu, "_exec", staticmethod(lambda m, pos: shown.append(m)))
+            pos = view.visualRect(index).center()
+            event = QContextMenuEvent(QContextMenuEvent.Reason.Mouse, pos, view.viewport().mapToGlobal(pos))
+            QApplication.sendEvent(view.viewport(), event)
+            menu = shown[0] if shown else QMenu()
+        return menu, [(a.text(), a.isEnabled()) for a in menu.actions() if a.text()]
+
+    group = project.layerTreeRoot().findGroup(group_name)
+    _menu, entries = right_click(group)
+    assert entries == [("Open accuracy report (none yet: run Accuracy report or Run pipeline)", False)]
+    report = layers.workspace_layout(ws).default_report
+    with open(report, "w", encoding="utf-8") as fh:
+        print("<html><body>report</body></html>", file=fh)
+    menu, entries = right_click(group)
+    assert entries == [("Open accuracy report", True)]
+    next(a for a in menu.actions() if a.text() == "Open accuracy report").trigger()
+    assert [os.path.normpath(p) for p in opened] == [os.path.normpath(report_of(Workspace.open(ws)))]
+    assert right_click(user_group)[1] == [] and right_click(group.findLayers()[0])[1] == []

@@ -20,6 +20,8 @@ from .tasks import CoreTask
 
 translate = QCoreApplication.translate
 
+AUTOMATIC_COLOUR = "#0b8a5f"  # an automatic GCP's measured position in the photo (found, not placed by hand)
+
 
 def autocontrol_then_prepare(root, ortho_layer, dsm_layer, check_points=None, extent=None, extent_crs=None,
                              context=None, progress=None):
@@ -185,3 +187,40 @@ class GcpAutoControl:
             return []
         return layers.load_residuals(lay.residuals_gpkg, QgsProject.instance(), layers.workspace_group_name(
             self.store.root), name=translate("GcpDock", "Automatic GCPs (residuals)"))
+
+    # ------------------------------------------------------------------ the automatic GCPs in the photos
+    def automatic_photo(self, name):
+        """The photo to show for the automatic GCP ``name``: the one shown when it was measured there, else the
+        first photo of the strip where it was measured (issue 48 item 11: never one to place it in by hand)."""
+        point = self.store.gcps.by_name(name)
+        measured = point.images() if point is not None else []
+        if self.photo_panel.image in measured:
+            return self.photo_panel.image
+        strip = self.photo_panel.thumbnail_names()
+        return next((n for n in strip if n in measured), measured[0] if measured else None)
+
+    def show_automatic_marker(self):
+        """An automatic GCP's observation in the photo view: labelled and coloured as found by the automatic
+        control, with the hint saying where it comes from (it was shown as a prediction to place by hand)."""
+        from qgis.PyQt.QtGui import QColor
+
+        panel = self.photo_panel
+        name = self.current_name()
+        marker = panel.observation
+        if marker is None or not self.store.is_automatic(name):
+            return False
+        point = self.store.gcps.by_name(name)
+        obs = next((o for o in point.observations if o.image == panel.image), None)
+        if obs is None:
+            return False
+        marker.label = translate("GcpDock", "{} (automatic)").format(name)
+        marker.colour = QColor(AUTOMATIC_COLOUR)
+        marker.setToolTip(translate("GcpDock", "Automatic GCP: measured by the automatic control (matched against "
+                                               "the reference orthophoto)"))
+        marker.update()
+        panel.title.setText(translate("GcpDock", "<b>{}</b> (automatic GCP) \u2014 {}").format(name, panel.image))
+        panel.hint.setText(translate("GcpDock", "{} is an automatic GCP: found by the automatic control at x {:.2f}, "
+                                                "y {:.2f} in this photo (measured in {} photos), not a prediction to "
+                                                "place. Drag it to correct it, or press Delete to remove it from "
+                                                "this photo.").format(name, obs.x, obs.y, len(point.observations)))
+        return True

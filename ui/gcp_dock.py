@@ -60,11 +60,11 @@ from .store import GcpStore
 
 KEY_COLUMNS = (NAME, OBS, DXY, DZ, PX)  # visible at the dock's default width (tests/test_ui_dock_layout.py)
 DEFAULT_WIDTH = 440  # the dock's width when QGIS first shows it (its size hint)
-PHOTO_DOCK_HEIGHT = 540  # the photo dock's height when first shown (plugin.show_dock), at most 62 % of the window
 BODY_MIN_HEIGHT = 64  # the scrolled body's least height (two rows; it scrolls): the dock fits beside QGIS's own docks
 TABLE_MIN_ROWS = 4  # the GCP table never shows fewer rows (a long message squeezed it to one, issue 36 item 19)
 STATUS_LINES = 5  # the status line grows to this many lines, then scrolls
 DIAGNOSIS_LINES = 40  # the diagnosis is shown whole up to this many lines (it was cut at 100 characters)
+DEFAULT_TOLERANCE = 0.1  # m: the residual tolerance of a workspace with no setting and no georeferenced GSD
 
 
 class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoControl, QgsDockWidget):
@@ -278,7 +278,7 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoContro
         self.tol_spin = QDoubleSpinBox()
         self.tol_spin.setDecimals(3)
         self.tol_spin.setRange(0.001, 1000.0)
-        self.tol_spin.setValue(0.1)
+        self.tol_spin.setValue(DEFAULT_TOLERANCE)
         self.tol_spin.setSuffix(" m")
         self.tol_spin.setToolTip(self.tr("Residuals up to this are green, up to 3 times yellow, beyond red"))
         row.addWidget(self.tol_spin)
@@ -398,22 +398,41 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoContro
         self.message(self.tr("Accuracy report: {}").format(path))
         return True
 
+    def _reset_workspace_state(self):
+        """What the dock showed of the previous workspace goes (issue 48 item 4): its residual tolerance and
+        heights layer (each workspace's own setting, else the default), its photo, predictions and matches,
+        a finished task's progress and the results of its last runs."""
+        for job in list(self.__dict__.get("_refine_jobs", {}).values()):
+            job.cancel()
+        self.__dict__.get("_refine_jobs", {}).clear()
+        self.predictions, self.matches, self._gray, self.refused = {}, {}, {}, {}
+        self._gsd_tolerance = None
+        self.last_task_error = self.targets_result = self.auto_result = None
+        if self.task is None:
+            self.progress.setValue(0)
+        tol = self.store.settings.get("tolerance")
+        self.tol_spin.blockSignals(True)  # shown, not saved: the workspace's own value or the default
+        self.tol_spin.setValue(float(tol) if tol else DEFAULT_TOLERANCE)
+        self.tol_spin.blockSignals(False)
+        dsm_id = self.store.settings.get("dsm_layer")
+        self.dsm_combo.blockSignals(True)
+        self.dsm_combo.setLayer(QgsProject.instance().mapLayer(dsm_id) if dsm_id else None)
+        self.dsm_combo.blockSignals(False)
+        panel = self.photo_panel
+        panel.image = None  # a photo of the same name in another workspace is another photo
+        panel.view.set_pyramid(None)
+        panel.set_markers(None)
+
     def _workspace_changed(self):
+        self._reset_workspace_state()
         root = self.store.root or ""
         self.ws_label.setText(os.path.basename(os.path.normpath(root)) if root else self.tr("none open"))
         self.ws_label.setToolTip(root)
         self._show_alignment()
         photos = {im["name"]: im["path"] for im in self.store.images()}
         self.photo_panel.set_photos(photos)
-        tol = self.store.settings.get("tolerance")
-        self.load_predictor()
-        if tol:
-            self.tol_spin.blockSignals(True)
-            self.tol_spin.setValue(float(tol))
-            self.tol_spin.blockSignals(False)
-        dsm_id = self.store.settings.get("dsm_layer")
-        if dsm_id and QgsProject.instance().mapLayer(dsm_id) is not None:
-            self.dsm_combo.setLayer(QgsProject.instance().mapLayer(dsm_id))
+        self.load_predictor()  # a georeferenced block without a setting: 3 x its GSD (GcpPlacement)
+        self.show_tolerance_source()
         self.model.refresh()
         self._last_point = None  # a new workspace: its first point jumps to its photo
         if self.store.gcps.points:
@@ -429,7 +448,9 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoContro
             self._selection_changed()
         self._update_summary()
         n_img = len(photos)
-        if not self.store.stage_done(ALIGN):
+        if self.store.workspace is None:
+            self.message("")
+        elif not self.store.stage_done(ALIGN):
             self.message(self.tr("{} photos; the block is not aligned yet: run Align images (or 'New from "
                                  "photos') to get predicted positions").format(n_img))
         else:
@@ -466,6 +487,15 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoContro
         """The strip's photos: the aligned ones first, those that did not align after them (GcpPlacement)."""
         names = super().visible_photos()
         return [n for n in names if n not in self.unaligned] + [n for n in names if n in self.unaligned]
+
+    def _update_predictions(self):
+        super()._update_predictions()
+        if self.store.is_automatic(self.current_name()):
+            self.predictions = {}  # measured by the automatic control, not a point to place (issue 48 item 11)
+
+    def _update_photo(self, zoom=False):
+        super()._update_photo(zoom)
+        self.show_automatic_marker()  # ui/gcp_autocontrol.py
 
     def _update_thumbnails(self):
         super()._update_thumbnails()
@@ -524,7 +554,9 @@ class GcpDock(GcpPlacement, GcpImportExport, GcpTasks, GcpTargets, GcpAutoContro
         if name != getattr(self, "_last_point", None):
             # another point: show the photo where it is to be placed next (or its first photo)
             self._last_point = name
-            target = self.next_photo() if name else None
+            # an automatic GCP: a photo where it was measured, never one where it would be placed by hand
+            target = self.automatic_photo(name) if self.store.is_automatic(name) else (
+                self.next_photo() if name else None)
             strip = self.photo_panel.thumbnail_names()
             target = target or (strip[0] if name and strip and self.predictions else None)
             if target and target != self.photo_panel.image and self.photo_panel.show_photo(target):

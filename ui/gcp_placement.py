@@ -14,6 +14,7 @@ from qgis.PyQt.QtWidgets import QMessageBox
 
 from ..core.project.stages import ALIGN, GEOREFERENCE
 from ..qgisio import layers
+from ..qgisio.messages import translate_message
 from .raster import sample_height
 
 translate = QCoreApplication.translate
@@ -95,7 +96,8 @@ class GcpPlacement:
         title = "<b>" + translate("GcpDock", "Diagnosis of the adjustment:") + "</b>"
         listed = lines if shown is None else lines[:shown]
         more = len(lines) - len(listed)
-        return title + "<br>" + "<br>".join("\u2022 " + html.escape(t) for t in listed) + (
+        # the core's English in the user's language (qgisio/messages.py: issue 48 item 6)
+        return title + "<br>" + "<br>".join("\u2022 " + html.escape(translate_message(t)) for t in listed) + (
             f" <i>(+{more})</i>" if more else "")
 
     def show_diagnosis(self):

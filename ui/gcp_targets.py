@@ -89,8 +89,9 @@ class FindTargetsDialog(QDialog):
         form.addRow(translate("GcpDock", "Surveyed coordinates:"), self.file)
         self.kind = QComboBox(self)
         for k in KINDS:
+            # the kinds as Processing's Find targets shows them ("Choices": 'Schachbrett (checkerboard)')
             self.kind.addItem(translate("GcpDock", "auto (crosses, checkerboards, circles, ArUco 4x4)")
-                              if k == "auto" else k, k)
+                              if k == "auto" else translate("Choices", k), k)
         form.addRow(translate("GcpDock", "Target kind:"), self.kind)
         self.size_spin = QDoubleSpinBox(self)
         self.size_spin.setRange(0.0, 100.0)
@@ -246,13 +247,23 @@ class GcpTargets:
         details += list(lines)
         if self.store.found_list():
             details.append(translate("GcpDock", "Space or Enter: confirm the found observation shown; Delete or R: "
-                                                "reject it. Georeference uses the found observations that are not "
-                                                "rejected, confirmed or not."))
+                                                "reject it (the keys work in the table, which has the keyboard "
+                                                "focus now, and in the photo view). Georeference uses the found "
+                                                "observations that are not rejected, confirmed or not."))
         level = Qgis.MessageLevel.Success if result.n_observations and not result.reports and not missing \
             else Qgis.MessageLevel.Warning
         self.message("\n".join([text] + details), level)
         if self.store.found_list():
             self.show_found(*self.store.found_list()[0])
+            self._focus_found_keys()
+
+    def _focus_found_keys(self):
+        """The table takes the keyboard focus, so that Space / R act at once (they did nothing until a row was
+        clicked: issue 48 item 3); not while the user types in a text field elsewhere."""
+        from qgis.PyQt.QtWidgets import QAbstractSpinBox, QApplication, QLineEdit, QPlainTextEdit, QTextEdit
+
+        if not isinstance(QApplication.focusWidget(), (QLineEdit, QAbstractSpinBox, QTextEdit, QPlainTextEdit)):
+            self.table.setFocus(Qt.FocusReason.OtherFocusReason)
 
     # ------------------------------------------------------------------ showing and confirming
     def current_found(self):
@@ -319,7 +330,8 @@ class GcpTargets:
         if info is None:
             return None
         return found_text(info), translate("GcpDock", "Found by Find targets, not confirmed: Space or Enter "
-                                                      "confirms it, Delete or R rejects it (then the next one).")
+                                                      "confirms it, Delete or R rejects it (then the next one); "
+                                                      "the keys work in the table and in this photo view.")
 
     def _mark_found_thumbnails(self):
         """The strip's photos where the selected point has a found observation not confirmed: in blue, the

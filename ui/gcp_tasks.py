@@ -113,6 +113,16 @@ class GcpTasks:
         self.message(translate("GcpDock", "Opening {}\u2026").format(os.path.basename(os.path.normpath(folder))))
         return start(self._open_task)
 
+    def follow_workspace(self, folder):
+        """The workspace a Processing run (Run pipeline from the Toolbox) loaded results of: the dock shows it
+        (issue 48 item 4), read in a task as Open does; not while a task of this dock runs (its result would
+        land in another workspace), which is said."""
+        if self.task is not None:
+            self.message(translate("GcpDock", "{} has new results: open it once this dock's task has ended").format(
+                os.path.basename(os.path.normpath(folder))), Qgis.MessageLevel.Info)
+            return None
+        return self.open_workspace_in_background(folder)
+
     # ------------------------------------------------------------------ refinement by matching
     def _refine_later(self, key, point, image, pred):
         """Start (or find running) the matching that refines ``pred``; False to match now, in the caller.
@@ -201,6 +211,11 @@ class GcpTasks:
 
         task = CoreTask(translate("GcpDock", "ArchaeoOrtho: align photos"), align_stage.align, (images_dir, workspace_dir),
                         {"options": options}, on_done=done, on_error=self._task_failed)
+        # the dock shows the workspace being made, nothing of the one open before (issue 48 item 4)
+        self.store.close()
+        self.ws_label.setText(os.path.basename(os.path.normpath(workspace_dir)))  # the status line says that it is being aligned
+        self.ws_label.setToolTip(workspace_dir)
+        self.message(translate("GcpDock", "Aligning the photos of {} into {}\u2026").format(images_dir, workspace_dir))
         return self._start_task(task)
 
     # ------------------------------------------------------------------ adjustment

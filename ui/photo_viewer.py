@@ -31,6 +31,8 @@ from qgis.PyQt.QtWidgets import (
     QListView,
     QListWidget,
     QListWidgetItem,
+    QSizePolicy,
+    QSplitter,
     QStyleOptionGraphicsItem,
     QToolButton,
     QVBoxLayout,
@@ -464,7 +466,6 @@ class PhotoPanel(QWidget):
         self.thumbs.setWordWrap(True)
         self.thumbs.setTextElideMode(Qt.TextElideMode.ElideMiddle)
         self.thumbs.setVerticalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
-        self.thumbs.setFixedHeight(THUMB.height() + 66)
         self.thumbs.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOn)
         self.thumbs.currentItemChanged.connect(self._thumb_changed)
 
@@ -482,11 +483,17 @@ class PhotoPanel(QWidget):
         self.btn_remove = self._button(self.tr("Remove"), self.tr("Remove the observation in this photo (Delete)"),
                                        self._remove)
 
-        bar = QHBoxLayout()
-        for w in (self.btn_fit, self.btn_zoom, self.btn_confirm, self.btn_next, self.btn_remove):
+        # two rows of buttons: the panel fits the right dock column under the GCP dock (issue 48 item 7; German
+        # labels in one row made it 743 px wide)
+        bar, bar2 = QHBoxLayout(), QHBoxLayout()
+        for w in (self.btn_fit, self.btn_zoom, self.btn_remove):
             bar.addWidget(w)
+        for w in (self.btn_confirm, self.btn_next):
+            bar2.addWidget(w)
         bar.addStretch(1)
+        bar2.addStretch(1)
         heading = QHBoxLayout()  # the filter beside the title, not after the buttons: the dock fits a 1366 px screen
+        self.title.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         heading.addWidget(self.title, 1)
         heading.addWidget(self.filter_box)
         top = QWidget()
@@ -494,14 +501,25 @@ class PhotoPanel(QWidget):
         tl.setContentsMargins(0, 0, 0, 0)
         tl.addLayout(heading)
         tl.addLayout(bar)
+        tl.addLayout(bar2)
         tl.addWidget(self.view, 1)
         tl.addWidget(self.orientation_note)
         tl.addWidget(self.found_note)
         tl.addWidget(self.hint)
+        # the photo over the thumbnails, the line between them dragged: the strip folds away to give the photo room
+        self.thumbs.setMinimumHeight(1)  # (0 would mean its minimum size hint: the strip could not fold)
+        self.thumbs.setMaximumHeight(THUMB.height() + 66)
+        self.splitter = QSplitter(Qt.Orientation.Vertical, self)
+        self.splitter.addWidget(top)
+        self.splitter.addWidget(self.thumbs)
+        self.splitter.setStretchFactor(0, 1)
+        self.splitter.setStretchFactor(1, 0)
+        self.splitter.setCollapsible(0, False)
+        self.splitter.setCollapsible(1, True)
+        self.splitter.setSizes([10 ** 6, THUMB.height() + 66])
         layout = QVBoxLayout(self)
         layout.setContentsMargins(2, 2, 2, 2)
-        layout.addWidget(top, 1)
-        layout.addWidget(self.thumbs)
+        layout.addWidget(self.splitter, 1)
 
         self.view.clicked.connect(self._clicked)
         self.view.deleteRequested.connect(self._remove)

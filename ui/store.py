@@ -113,6 +113,7 @@ class GcpStore(QObject):
         self._undo_keys = UndoKeys(self.undo_stack, self)
         self.last_import_report = []  # what the last import changed (GcpStore.replace_all)
         self.found = {}  # point -> image -> what Find targets said of the observation, until confirmed
+        self.automatic = set()  # the automatic GCPs (auto_NNN) the automatic control measured: shown as found
 
     def install_undo_keys(self, *widgets):
         """Ctrl+Z / Ctrl+Shift+Z undo / redo when one of ``widgets`` has the focus."""
@@ -135,14 +136,42 @@ class GcpStore(QObject):
     def open(self, path):
         """Open a workspace folder (raises core.workspace.WorkspaceError)."""
         ws = Workspace.open(path)
-        self.workspace = ws
+        self._reset(ws)
         self.gcps, self.found = self._load_control(ws)
+        self.automatic = self._load_automatic(ws, self.gcps)
         self.settings = self._load_json(Layout(ws).editor_json) or {}
-        self.undo_stack.clear()
-        self.stale = set()
         self.load_residuals()
         self.workspaceChanged.emit()
         self.changed.emit()
+
+    def close(self):
+        """No workspace shown (a new one is being made): nothing of the previous one stays (issue 48 item 4)."""
+        self._reset(None)
+        self.load_residuals()
+        self.workspaceChanged.emit()
+        self.changed.emit()
+
+    def _reset(self, ws):
+        """Everything that belongs to a workspace, emptied: the state is the one of the workspace shown."""
+        self.workspace = ws
+        self.gcps = gcpmod.GCPSet(crs=(ws.crs or "") if ws is not None else "")
+        self.found, self.automatic, self.settings, self.stale = {}, set(), {}, set()
+        self._masks = {}
+        self.last_import_report = []
+        self.undo_stack.clear()
+
+    def _load_automatic(self, ws, gs):
+        """The names of the table's control points that are automatic GCPs: the candidates the automatic control
+        kept (georef/autocontrol.json) that the table holds with their measured observations."""
+        from ..core.georef.autocontrol.candidates import KEPT
+
+        doc = self._load_json(Layout(ws).autocontrol_json)
+        cands = doc.get("candidates") if isinstance(doc, dict) else None
+        kept = {str(c.get("name")) for c in cands or [] if isinstance(c, dict) and c.get("status") == KEPT}
+        return {p.name for p in gs.points if p.name in kept and p.role == gcpmod.CONTROL and p.observations}
+
+    def is_automatic(self, name):
+        return name in self.automatic
 
     def reload_workspace(self):
         """Re-read workspace.json (after a stage ran) without touching the GCPs."""

@@ -5,6 +5,8 @@ import traceback
 from qgis.core import Qgis, QgsApplication, QgsMessageLog, QgsTask
 from qgis.PyQt.QtCore import QCoreApplication, QTimer, pyqtSignal
 
+from ..qgisio.messages import translate_message
+
 
 class TaskProgress:
     """The core Progress protocol on top of a QgsTask."""
@@ -15,19 +17,19 @@ class TaskProgress:
 
     def report(self, fraction, message=""):
         self.task.setProgress(100.0 * min(max(float(fraction), 0.0), 1.0))
-        if message:
-            self.task.message.emit(message)
+        if message:  # the core's English in the user's language (qgisio/messages.py)
+            self.task.message.emit(translate_message(message))
 
     def is_cancelled(self):
         return self.task.isCanceled()
 
     def info(self, message):
         self.messages.append(("info", message))
-        QgsMessageLog.logMessage(message, "ArchaeoOrtho", Qgis.MessageLevel.Info)
+        QgsMessageLog.logMessage(translate_message(message), "ArchaeoOrtho", Qgis.MessageLevel.Info)
 
     def warning(self, message):
         self.messages.append(("warning", message))
-        QgsMessageLog.logMessage(message, "ArchaeoOrtho", Qgis.MessageLevel.Warning)
+        QgsMessageLog.logMessage(translate_message(message), "ArchaeoOrtho", Qgis.MessageLevel.Warning)
 
 
 class CoreTask(QgsTask):

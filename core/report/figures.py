@@ -10,6 +10,7 @@ from typing import Optional
 import numpy as np
 
 from .html import esc
+from .labels import t
 
 DPI = 96
 
@@ -22,15 +23,16 @@ def new_figure(w: float = 7.0, h: float = 4.0):
 
 
 def embed(fig, alt: str, caption: str = "", cls: str = "") -> str:
-    """The figure as an ``<figure>`` with the PNG inline (``caption`` is HTML)."""
+    """The figure as an ``<figure>`` with the PNG inline (``caption`` is HTML); ``alt`` and ``caption`` in the
+    report's language where they are catalogued (i18n/make_catalog.py collects embed()'s literal texts)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     FigureCanvasAgg(fig)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight", facecolor="white")
     data = base64.b64encode(buf.getvalue()).decode("ascii")
-    cap = f"<figcaption>{caption}</figcaption>" if caption else ""
-    return (f'<figure class="{cls}"><img alt="{esc(alt)}" src="data:image/png;base64,{data}">{cap}</figure>')
+    cap = f"<figcaption>{t(caption)}</figcaption>" if caption else ""
+    return (f'<figure class="{cls}"><img alt="{esc(t(alt))}" src="data:image/png;base64,{data}">{cap}</figure>')
 
 
 def equal_xy(ax) -> None:
@@ -102,7 +104,7 @@ def draw_dem(fig, ax, zz: np.ndarray, valid: np.ndarray, cell_x: float, cell_y: 
     rgba = np.dstack([shaded, valid.astype(float)])
     ax.imshow(rgba, extent=extent, interpolation="nearest")
     sm = cm.ScalarMappable(norm=Normalize(lo, hi), cmap="terrain")
-    fig.colorbar(sm, ax=ax, shrink=0.7, label="height (m)")
+    fig.colorbar(sm, ax=ax, shrink=0.7, label=t("height (m)"))
     return lo, hi
 
 

@@ -8,6 +8,8 @@ import html
 import math
 from typing import Any, Optional, Sequence, Tuple
 
+from .labels import t
+
 MAX_TABLE_ROWS = 400  # longer tables are cut (the GeoPackage layers hold everything)
 
 
@@ -48,8 +50,9 @@ def cell(v: Any, decimals: int = 3, key: Optional[str] = None) -> str:
 
 def table(header: Sequence[str], rows: Sequence[Sequence[str]], cls: str = "", raw: bool = True,
           limit: int = MAX_TABLE_ROWS) -> str:
-    """Rows are lists of ready HTML cells (``<td>...``) when ``raw``, else of texts to escape."""
-    out = [f'<table class="{cls}"><thead><tr>' + "".join(f"<th>{esc(h)}</th>" for h in header)
+    """Rows are lists of ready HTML cells (``<td>...``) when ``raw``, else of texts to escape; the column headings
+    in the report's language (i18n/make_catalog.py collects table()'s literal headings)."""
+    out = [f'<table class="{cls}"><thead><tr>' + "".join(f"<th>{esc(t(h))}</th>" for h in header)
            + "</tr></thead><tbody>"]
     for r in rows[:limit]:
         cells = r if raw else [f"<td>{esc(c)}</td>" for c in r]
@@ -65,7 +68,9 @@ def td(text: Any, cls: str = "") -> str:
 
 
 def kv(rows: Sequence[Tuple[str, str]]) -> str:
-    return ('<table class="kv"><tbody>' + "".join(f"<tr><th>{esc(k)}</th><td>{v}</td></tr>" for k, v in rows)
+    """(label, HTML) rows; the labels in the report's language (i18n/make_catalog.py collects the sections'
+    ("Label", value) pairs)."""
+    return ('<table class="kv"><tbody>' + "".join(f"<tr><th>{esc(t(k))}</th><td>{v}</td></tr>" for k, v in rows)
             + "</tbody></table>")
 
 

@@ -10,6 +10,7 @@ from typing import Any, Dict, List, Optional, Sequence
 
 from .context import ReportContext
 from .html import badge, duration, esc, esc_json, fmt, num
+from .labels import current_language, t
 
 # the plugin folder (metadata.txt holds the version)
 _PLUGIN_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -44,8 +45,9 @@ section.skipped h2{color:#777;border-color:#bbb}
 footer{margin-top:30px;font-size:11px;color:#777;border-top:1px solid #ddd;padding-top:6px}
 """
 
-SECTIONS = (("summary", "Summary"), ("orientation", "Orientation quality"), ("georeferencing", "Georeferencing"),
-            ("uncertainty", "Uncertainty"), ("products", "Products"))
+# the titles marked for the catalogue (t() at import is English), translated where shown
+SECTIONS = (("summary", t("Summary")), ("orientation", t("Orientation quality")),
+            ("georeferencing", t("Georeferencing")), ("uncertainty", t("Uncertainty")), ("products", t("Products")))
 
 
 def version() -> str:
@@ -68,30 +70,30 @@ def cards(fig: Dict[str, Any], georef: bool) -> str:
         cards.append(f'<div class="card"><div class="v"{k}>{value}</div><div class="l">{esc(label)}</div></div>')
 
     if fig.get("REGISTERED_IMAGES") is not None:
-        add("images aligned", f"{fig['REGISTERED_IMAGES']} / {fig.get('IMAGES')}")
+        add(t("images aligned"), f"{fig['REGISTERED_IMAGES']} / {fig.get('IMAGES')}")
     if fig.get("MEAN_REPROJECTION_ERROR") is not None:
-        add("mean reprojection error", fmt(fig["MEAN_REPROJECTION_ERROR"], 2, "px"))
+        add(t("mean reprojection error"), fmt(fig["MEAN_REPROJECTION_ERROR"], 2, "px"))
     if fig.get("GSD") is not None:
-        add("ground sample distance", fmt(fig["GSD"] * 100, 1, "cm"))
+        add(t("ground sample distance"), fmt(fig["GSD"] * 100, 1, "cm"))
     if fig.get("AREA_M2") is not None:
-        add("area", f"{fig['AREA_M2'] / 1e4:.2f} ha")
+        add(t("area"), f"{fig['AREA_M2'] / 1e4:.2f} ha")
     if fig.get("CHECK_RMSE_XY") is not None:
-        add("check RMSE XY", fmt(fig["CHECK_RMSE_XY"], 3, "m"), "check_xy")
+        add(t("check RMSE XY"), fmt(fig["CHECK_RMSE_XY"], 3, "m"), "check_xy")
     if fig.get("CHECK_RMSE_Z") is not None and fig.get("NSSDA_V") is not None:
-        add("check RMSE Z", fmt(fig["CHECK_RMSE_Z"], 3, "m"), "check_z")
+        add(t("check RMSE Z"), fmt(fig["CHECK_RMSE_Z"], 3, "m"), "check_z")
     if fig.get("NSSDA_H") is not None:
-        add("NSSDA horizontal 95 %", fmt(fig["NSSDA_H"], 3, "m"))
+        add(t("NSSDA horizontal 95 %"), fmt(fig["NSSDA_H"], 3, "m"))
     if fig.get("NSSDA_V") is not None:
-        add("NSSDA vertical 95 %", fmt(fig["NSSDA_V"], 3, "m"))
+        add(t("NSSDA vertical 95 %"), fmt(fig["NSSDA_V"], 3, "m"))
     if fig.get("ASPRS_2014_H_CLASS_CM") is not None:
-        add("ASPRS 2014 horizontal class", fmt(fig["ASPRS_2014_H_CLASS_CM"], 1, "cm"))
+        add(t("ASPRS 2014 horizontal class"), fmt(fig["ASPRS_2014_H_CLASS_CM"], 1, "cm"))
     if fig.get("CAMERA_RMSE_XY") is not None:
-        add("camera position RMSE XY (the block's fit to the positions)", fmt(fig["CAMERA_RMSE_XY"], 2, "m"))
+        add(t("camera position RMSE XY (the block's fit to the positions)"), fmt(fig["CAMERA_RMSE_XY"], 2, "m"))
     if fig.get("POINT_STD_XY_MEDIAN") is not None and georef:
-        add("tie point σXY / σZ (median; predicted ground uncertainty, datum included)",
+        add(t("tie point σXY / σZ (median; predicted ground uncertainty, datum included)"),
             f"{fmt(fig['POINT_STD_XY_MEDIAN'], 3)} / {fmt(fig.get('POINT_STD_Z_MEDIAN'), 3)} m")
     if fig.get("DSM_VALID_FRACTION") is not None:
-        add("DSM valid fraction", fmt(fig["DSM_VALID_FRACTION"], 3))
+        add(t("DSM valid fraction"), fmt(fig["DSM_VALID_FRACTION"], 3))
     return '<div class="cards">' + "".join(cards) + "</div>"
 
 
@@ -121,14 +123,14 @@ def glance_lines(ctx: ReportContext, figures: Dict[str, Any], status: Dict[str, 
     if ctx.d.rec is not None:
         n_img, n_reg = figures.get("IMAGES"), figures.get("REGISTERED_IMAGES")
         kind = "ok" if n_img and n_reg == n_img else "warn"
-        lines.insert(0, badge(kind, f"{n_reg} of {n_img} images aligned, mean reprojection error "
-                                    f"{fmt(figures.get('MEAN_REPROJECTION_ERROR'), 2)} px"))
+        lines.insert(0, badge(kind, t("{} of {} images aligned, mean reprojection error {} px").format(
+            n_reg, n_img, fmt(figures.get('MEAN_REPROJECTION_ERROR'), 2))))
     else:
-        lines.insert(0, badge("bad", "no aligned model: run 'Align images'"))
+        lines.insert(0, badge("bad", t("no aligned model: run 'Align images'")))
     if ctx.unc is not None and ctx.d.georeferenced:
         lines.append(precision_badge(ctx.unc, ctx.gsd, num(figures.get("CAMERA_RMSE_XY"))))
     if status.get("products") != "ok":
-        lines.append(badge("note", "no DSM / orthomosaic yet"))
+        lines.append(badge("note", t("no DSM / orthomosaic yet")))
     return lines
 
 
@@ -136,16 +138,16 @@ def page(root: str, figures: Dict[str, Any], status: Dict[str, str], georef: boo
          body: Sequence[str], seconds: float) -> str:
     """The whole HTML page (``body``: the sections' HTML; ``seconds``: the time the report took)."""
     now = _dt.datetime.now().astimezone().isoformat(timespec="seconds")
-    title = f"ArchaeoOrtho report — {os.path.basename(root.rstrip(os.sep))}"
-    nav = "".join(f'<a href="#{sid}">{esc(t)}</a>' for sid, t in SECTIONS)
+    title = t("ArchaeoOrtho report — {}").format(os.path.basename(root.rstrip(os.sep)))
+    nav = "".join(f'<a href="#{sid}">{esc(t(name))}</a>' for sid, name in SECTIONS)
     machine = json.dumps({"figures": figures, "sections": status}, default=str, allow_nan=False)
     return (
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+        f"<!DOCTYPE html>\n<html lang=\"{esc(current_language())}\"><head><meta charset=\"utf-8\">"
         f"<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"><title>{esc(title)}</title>"
         f"<style>{CSS}</style></head><body><main>"
-        f"<h1>{esc(title)}</h1><p class=\"sub\">{esc(root)} · generated {esc(now)} · ArchaeoOrtho "
+        f"<h1>{esc(title)}</h1><p class=\"sub\">{esc(root)} · {esc(t('generated'))} {esc(now)} · ArchaeoOrtho "
         f"{esc(version())}</p><nav>{nav}</nav>"
-        f"<section id=\"glance\"><h2>At a glance</h2>{cards(figures, georef)}<ul class=\"glance\">"
+        f"<section id=\"glance\"><h2>{esc(t('At a glance'))}</h2>{cards(figures, georef)}<ul class=\"glance\">"
         + "".join(glance) + "</ul></section>" + "".join(body)
         + f"<footer>Accuracy figures: core.accuracy (FGDC-STD-007.3-1998 NSSDA; ASPRS Positional Accuracy "
           f"Standards 2014 and 2023). Report written in {duration(seconds)}.</footer>"

@@ -40,6 +40,7 @@ from .context import ReportContext, Skip
 from .data import ReportData
 from .errors import ReportError
 from .html import esc
+from .labels import language, t
 from .options import ReportOptions
 from .page import SECTIONS, glance_lines, page
 from .sections import georeferencing, orientation, products, summary
@@ -85,11 +86,11 @@ def _sections(ctx: ReportContext, progress: Progress) -> Tuple[List[str], Dict[s
         progress.report(0.5 + 0.45 * k / len(SECTIONS), f"report: {title.lower()}")
         try:
             content = _SECTION_BUILDERS[sid](ctx)
-            body.append(f'<section id="{sid}"><h2>{esc(title)}</h2>{content}</section>')
+            body.append(f'<section id="{sid}"><h2>{esc(t(title))}</h2>{content}</section>')
             status[sid] = "ok"
         except Skip as e:
-            body.append(f'<section id="{sid}" class="skipped"><h2>{esc(title)}</h2>'
-                        f'<p class="skip">Skipped: {esc(e)}</p></section>')
+            body.append(f'<section id="{sid}" class="skipped"><h2>{esc(t(title))}</h2>'
+                        f'<p class="skip">{esc(t("Skipped:"))} {esc(e)}</p></section>')
             status[sid] = str(e)
     return body, status
 
@@ -109,9 +110,10 @@ def build_report(workspace_dir: str, options: Optional[ReportOptions] = None,
     lay = Layout(ws)
     out = _output_path(lay, output_html)
     ctx = ReportContext(ReportData(ws, SubProgress(progress, 0.0, 0.1)), progress)
-    params = {"output_html": out, "uncertainty": opts.uncertainty, "write_layers": opts.write_layers}
-    # the last stage: nothing after it to mark stale
-    with run_stage(ws, STAGE, params, invalidate=False) as run:
+    params = {"output_html": out, "uncertainty": opts.uncertainty, "write_layers": opts.write_layers,
+              "language": opts.language}
+    # the last stage: nothing after it to mark stale; headings and figure labels in the options' language
+    with run_stage(ws, STAGE, params, invalidate=False) as run, language(opts.language):
         check_cancel(progress)
         progress.report(0.1, "uncertainty: bundle adjustment covariance")
         computing = ctx.d.rec is not None and opts.uncertainty

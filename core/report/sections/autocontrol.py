@@ -15,6 +15,7 @@ from ...project.layout import read_json
 from ..context import ReportContext
 from ..figures import embed, equal_xy, new_figure
 from ..html import crs_label, esc, fmt, kv, table
+from ..labels import t
 
 _STEPS = (("matches", "matches found (ratio test)"), ("similarity_inliers", "fit one similarity (RANSAC)"),
           ("tile_inliers", "fit the affine of their tile"), ("candidates", "tied back to the photos"),
@@ -30,7 +31,7 @@ def subsection(ctx: ReportContext) -> str:
     if not cands or not any(c.get("name") in rows for c in cands):
         return ""
     f = doc.get("figures") or {}
-    parts = ["<h3>Automatic control</h3>", kv([
+    parts = ["<h3>" + esc(t("Automatic control")) + "</h3>", kv([
         ("Reference orthophoto", esc(doc.get("reference_ortho", "–"))),
         ("Reference DSM", esc(doc.get("reference_dsm", "–"))),
         ("Rough position (prior)", esc(doc.get("prior", "–"))),
@@ -59,20 +60,20 @@ def _map(cands: List[Dict[str, Any]], rows: Dict[str, Dict[str, Any]]) -> str:
     ax = fig.add_subplot(111)
     off = np.array([[c["x"], c["y"]] for c in cands if c.get("status") != "kept"], dtype=float).reshape(-1, 2)
     if len(off):
-        ax.scatter(off[:, 0], off[:, 1], s=14, c="#999999", marker="x", lw=0.8, label="dropped candidates")
+        ax.scatter(off[:, 0], off[:, 1], s=14, c="#999999", marker="x", lw=0.8, label=t("dropped candidates"))
     used = [(c, rows[c["name"]]) for c in cands if c.get("name") in rows and rows[c["name"]].get("dx") is not None]
     if used:
         xy = np.array([[c["x"], c["y"]] for c, _ in used], dtype=float)
         dxy = np.array([float(np.hypot(r["dx"], r["dy"])) for _, r in used])
         ok = np.array([r.get("status") == "used" for _, r in used])
         sc = ax.scatter(xy[ok, 0], xy[ok, 1], c=dxy[ok], cmap="viridis", s=30, marker="^", edgecolors="k",
-                        linewidths=0.4, label="automatic GCPs (colour: XY residual)")
+                        linewidths=0.4, label=t("automatic GCPs (colour: XY residual)"))
         if (~ok).any():
-            ax.scatter(xy[~ok, 0], xy[~ok, 1], s=40, c="#d62728", marker="X", label="rejected by the adjustment")
-        fig.colorbar(sc, ax=ax, shrink=0.7, label="XY residual (m)")
+            ax.scatter(xy[~ok, 0], xy[~ok, 1], s=40, c="#d62728", marker="X", label=t("rejected by the adjustment"))
+        fig.colorbar(sc, ax=ax, shrink=0.7, label=t("XY residual (m)"))
     ax.legend(fontsize=7, loc="lower left")
     equal_xy(ax)
-    ax.set_title("automatic control points", fontsize=9)
+    ax.set_title(t("automatic control points"), fontsize=9)
     return embed(fig, "automatic control points", "Where the automatic GCPs lie (triangles, coloured by their "
                  "horizontal residual after the adjustment), the ones the adjustment rejected (red) and the "
                  "candidates dropped before it (grey): a change between the epochs, a height the DSM does not "

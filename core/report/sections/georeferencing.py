@@ -10,6 +10,7 @@ import numpy as np
 from ..context import ReportContext, Skip
 from ..figures import embed, equal_xy, new_figure, nice
 from ..html import badge, cell, crs_label, esc, fmt, kv, num, table, td
+from ..labels import t
 from ..residuals import accuracy_figures, camera_position_figures, residual_rows
 from . import autocontrol
 from .standards import accuracy_statements
@@ -44,7 +45,7 @@ def section(ctx: ReportContext) -> str:
                      "vertical accuracy is stated.</p>")
     points = residual_rows(res)
     if points:
-        parts.append("<h3>Control and check points</h3>" + _points_table(ctx, points))
+        parts.append("<h3>" + esc(t("Control and check points")) + "</h3>" + _points_table(ctx, points))
         parts.append(_stats_table(ctx, stats))
         parts.append(accuracy_statements(ctx, acc))
         parts.append(_residual_plot(ctx, points))
@@ -85,7 +86,7 @@ def _sigma_estimates(ctx: ReportContext, res: Dict[str, Any]) -> str:
         ctx.figures.update({f"{pre}_SIGMA_XY": num(e.get("sigma_xy_m")), f"{pre}_SIGMA_Z": num(e.get("sigma_z_m"))})
         ctx.glance.append(badge("ok", esc(f"{grp} without sigma: accuracy estimated from the data, sigma XY "
                                           f"{fmt(e.get('sigma_xy_m'), 3)} m, Z {fmt(e.get('sigma_z_m'), 3)} m")))
-    return ("<h3>Accuracy of the control given without sigmas, estimated from the data</h3>" + table(
+    return ("<h3>" + esc(t("Accuracy of the control given without sigmas, estimated from the data")) + "</h3>" + table(
         ["group", "n", "σ XY", "σ Z", "rigid fit σ XY", "rigid fit σ Z", "floor XY", "floor Z", "placeholders",
          "estimated from", "image σ (px)", "left out as suspect"], rows)
         + '<p class="note">Metres. The files gave no sigmas for these points (or positions), so their accuracy was '
@@ -146,7 +147,7 @@ def _stats_table(ctx: ReportContext, stats: Dict[str, Dict[str, Any]]) -> str:
             ctx.figures.update({f"{pre}_N": s["n"], f"{pre}_RMSE_X": num(s["rmse_x"]),
                                  f"{pre}_RMSE_Y": num(s["rmse_y"]), f"{pre}_RMSE_Z": num(s["rmse_z"]),
                                  f"{pre}_RMSE_XY": num(s["rmse_r"])})
-    return ("<h3>RMSE per set</h3>" + table(
+    return ("<h3>" + esc(t("RMSE per set")) + "</h3>" + table(
         ["set", "n", "RMSE X", "RMSE Y", "RMSE Z", "RMSE XY (radial)", "RMSE 3D", "mean dX", "mean dY", "mean dZ",
          "max dXY", "max |dZ|"], rows) + '<p class="note">Metres. The mean is the bias of each axis.</p>')
 
@@ -160,9 +161,9 @@ def _residual_plot(ctx: ReportContext, points: Sequence[Dict[str, Any]]) -> str:
     ax = fig.add_subplot(111)
     fp = d.footprint()
     if fp is not None:
-        ax.fill(fp[:, 0], fp[:, 1], color="#eef3f8", ec="#9fb3c8", lw=0.8, label="tie-point footprint")
+        ax.fill(fp[:, 0], fp[:, 1], color="#eef3f8", ec="#9fb3c8", lw=0.8, label=t("tie-point footprint"))
     centres = d.centres()
-    ax.scatter(centres[:, 0], centres[:, 1], s=6, c="#888888", marker="s", lw=0, label="camera centres")
+    ax.scatter(centres[:, 0], centres[:, 1], s=6, c="#888888", marker="s", lw=0, label=t("camera centres"))
     xy = np.array([[p["x"], p["y"]] for p in pts], dtype=float)
     dxy = np.array([[p["dx"], p["dy"]] for p in pts], dtype=float)
     dz = np.array([p["dz"] for p in pts], dtype=float)
@@ -186,11 +187,11 @@ def _residual_plot(ctx: ReportContext, points: Sequence[Dict[str, Any]]) -> str:
     for p in pts:
         ax.annotate(p["name"], (p["x"], p["y"]), xytext=(4, 4), textcoords="offset points", fontsize=7)
     if sc is not None:
-        fig.colorbar(sc, ax=ax, shrink=0.7, label="dZ (m)")
+        fig.colorbar(sc, ax=ax, shrink=0.7, label=t("dZ (m)"))
     ax.legend(fontsize=7, loc="lower left")
     equal_xy(ax)
-    ax.set_title(f"ground point residuals ({d.crs_label})", fontsize=9)
-    return "<h3>Residual vectors over the footprint</h3>" + embed(
+    ax.set_title(t("ground point residuals ({})").format(d.crs_label), fontsize=9)
+    return "<h3>" + esc(t("Residual vectors over the footprint")) + "</h3>" + embed(
         fig, "residual vectors", f"Horizontal residual of each control (triangle) and check point (circle), "
         f"exaggerated ×{k:.3g} (key: {ref:g} m); colour: vertical residual. Systematic patterns (all arrows one "
         "way, growing towards an edge) point at a block deformation or a datum problem; a lone long arrow at a "
@@ -208,10 +209,10 @@ def _camera_residuals(ctx: ReportContext, cams: Dict[str, Any]) -> str:
         cell(s["rmse_y"], 3, "cam.rmse_y"), cell(s["rmse_z"], 3, "cam.rmse_z"),
         cell(s["rmse_r"], 3, "cam.rmse_r"), cell(s["mean_x"], 3), cell(s["mean_y"], 3),
         cell(s["mean_z"], 3)]])
-    return ("<h3>Camera-position residuals</h3>" + summary
+    return ("<h3>" + esc(t("Camera-position residuals")) + "</h3>" + summary
             + '<p class="note">Adjusted projection centre minus given position, metres (see the camera '
               "positions plot under Orientation quality). They show how well the block fits the positions, "
-              "not the accuracy of the ground.</p><details><summary>Per camera</summary>"
+              "not the accuracy of the ground.</p><details><summary>" + esc(t("Per camera")) + "</summary>"
             + table(["image", "used", "dX", "dY", "dZ", "dXY"], rows) + "</details>")
 
 
@@ -248,8 +249,8 @@ def _outliers(ctx: ReportContext, res: Dict[str, Any], acc: Dict[str, Any]) -> s
     for w in res.get("warnings") or []:
         items.append(f"<li class=\"note\">{esc(w)}</li>")
     if not items:
-        return '<h3>Outliers and suspect points</h3><p class="ok">None found.</p>'
-    return "<h3>Outliers, suspect points and warnings</h3><ul class=\"issues\">" + "".join(items) + "</ul>"
+        return '<h3>' + esc(t("Outliers and suspect points")) + '</h3><p class="ok">None found.</p>'
+    return "<h3>" + esc(t("Outliers, suspect points and warnings")) + "</h3><ul class=\"issues\">" + "".join(items) + "</ul>"
 
 
 def _glance_accuracy(ctx: ReportContext, acc: Dict[str, Any]) -> None:

@@ -20,6 +20,7 @@ from ...georef.options import (
 from ..context import ReportContext, Skip
 from ..figures import embed, equal_xy, new_figure, nice
 from ..html import badge, cell, esc, fmt, kv, num, table, td
+from ..labels import t
 from ..residuals import camera_position_figures
 
 
@@ -52,19 +53,19 @@ def section(ctx: ReportContext) -> str:
     if len(fin):
         hi = max(float(np.percentile(fin, 99.5)), 1e-3)
         ax.hist(np.clip(fin, 0, hi), bins=50, color="#4477aa")
-        ax.axvline(np.mean(fin), color="#c0392b", lw=1, label=f"mean {np.mean(fin):.2f} px")
-        ax.axvline(np.median(fin), color="k", lw=1, ls="--", label=f"median {np.median(fin):.2f} px")
+        ax.axvline(np.mean(fin), color="#c0392b", lw=1, label=t("mean {} px").format(f"{np.mean(fin):.2f}"))
+        ax.axvline(np.median(fin), color="k", lw=1, ls="--", label=t("median {} px").format(f"{np.median(fin):.2f}"))
         ax.legend(fontsize=7)
-    ax.set_xlabel("reprojection error (px)", fontsize=8)
-    ax.set_ylabel("observations", fontsize=8)
+    ax.set_xlabel(t("reprojection error (px)"), fontsize=8)
+    ax.set_ylabel(t("observations"), fontsize=8)
     ax.tick_params(labelsize=7)
     ax2 = fig.add_subplot(122)
     if len(o.track_length):
         tl = o.track_length
         top = int(min(tl.max(), np.percentile(tl, 99.5) + 1))
         ax2.hist(np.clip(tl, 2, top), bins=np.arange(1.5, top + 1.5), color="#228833")
-    ax2.set_xlabel("track length (images per tie point)", fontsize=8)
-    ax2.set_ylabel("tie points", fontsize=8)
+    ax2.set_xlabel(t("track length (images per tie point)"), fontsize=8)
+    ax2.set_ylabel(t("tie points"), fontsize=8)
     ax2.tick_params(labelsize=7)
     parts.append(embed(fig, "reprojection error and track length histograms",
                       "Left: reprojection error of every tie-point observation (clipped at the 99.5th "
@@ -77,12 +78,12 @@ def section(ctx: ReportContext) -> str:
     med = np.nanmedian(mean_img) if n else 0.0
     colours = ["#c0392b" if v > 2 * med else "#4477aa" for v in np.nan_to_num(mean_img)]
     ax.bar(range(n), np.nan_to_num(mean_img), color=colours)
-    ax.set_ylabel("mean error (px)", fontsize=8)
+    ax.set_ylabel(t("mean error (px)"), fontsize=8)
     ax.set_xticks([])
     ax.tick_params(labelsize=7)
     ax2 = fig.add_subplot(212)
     ax2.bar(range(n), n_img, color="#228833")
-    ax2.set_ylabel("observations", fontsize=8)
+    ax2.set_ylabel(t("observations"), fontsize=8)
     ax2.set_xticks(range(n))
     ax2.set_xticklabels(names if n <= 80 else [""] * n, rotation=90, fontsize=6)
     ax2.tick_params(axis="y", labelsize=7)
@@ -90,7 +91,7 @@ def section(ctx: ReportContext) -> str:
                       "Mean reprojection error (red: more than twice the median) and tie-point observations "
                       "per image."))
     rows = [[td(nm), cell(mean_img[k], 3), td(int(n_img[k]))] for k, nm in enumerate(names)]
-    parts.append("<details><summary>Per-image table</summary>"
+    parts.append("<details><summary>" + esc(t("Per-image table")) + "</summary>"
                  + table(["image", "mean reprojection error (px)", "observations"], rows) + "</details>")
     bad = [names[k] for k in range(n) if np.isfinite(mean_img[k]) and mean_img[k] > 2 * med]
     if bad:
@@ -232,7 +233,7 @@ def interior_orientation(ctx: ReportContext) -> str:
     if far:
         ctx.warnings.append("interior orientation moved beyond its given sigmas: " + "; ".join(far))
         ctx.glance.append(badge("warn", esc("calibration moved beyond " + f"{MOVED_SIGMAS:g} σ: " + "; ".join(far))))
-    return ("<h3>Interior orientation</h3>"
+    return ("<h3>" + esc(t("Interior orientation")) + "</h3>"
             + f'<p data-key="intrinsics.modes">Given calibrations: {modes}. Fixed: held at the given values through '
             "the alignment and the georeference; refined: refined in the georeference with priors at the given "
             f"values (σ from the calibration file, else {100 * REFINED_FOCAL_SIGMA:g} % of the focal length, "
@@ -258,7 +259,7 @@ def _connectivity(ctx: ReportContext) -> str:
 
     im = ax.imshow(np.where(c > 0, c, np.nan), cmap="viridis", norm=LogNorm(vmin=1, vmax=max(2, c.max())),
                    interpolation="nearest")
-    fig.colorbar(im, ax=ax, shrink=0.8, label="shared tie points")
+    fig.colorbar(im, ax=ax, shrink=0.8, label=t("shared tie points"))
     if n <= 40:
         ax.set_xticks(range(n))
         ax.set_yticks(range(n))
@@ -266,7 +267,7 @@ def _connectivity(ctx: ReportContext) -> str:
         ax.set_yticklabels(d.obs.image_names, fontsize=5)
     else:
         ax.tick_params(labelsize=6)
-    ax.set_title("image × image", fontsize=9)
+    ax.set_title(t("image × image"), fontsize=9)
     ax2 = fig.add_subplot(gs[0, 1])
     iu = np.argwhere(np.triu(c) > 0)
     if len(iu):
@@ -284,9 +285,9 @@ def _connectivity(ctx: ReportContext) -> str:
         ax2.annotate(d.obs.image_names[k], centres[k, :2], fontsize=6, color="#c0392b")
     equal_xy(ax2)
     ax2.autoscale()
-    ax2.set_title(f"camera centres ({d.unit}); line width ∝ shared points", fontsize=9)
+    ax2.set_title(t("camera centres ({}); line width ∝ shared points").format(d.unit), fontsize=9)
     n_pairs = int((np.triu(c) > 0).sum())
-    return ("<h3>Image connectivity</h3>" + embed(
+    return ("<h3>" + esc(t("Image connectivity")) + "</h3>" + embed(
         fig, "image connectivity", f"Which photos share tie points and how many: {n_pairs} connected image pairs. "
         "Images linked to at most one other image are named on the map.")
         + (f'<p class="warn">Weakly connected images: {esc(", ".join(d.obs.image_names[k] for k in weak))}</p>'
@@ -303,7 +304,7 @@ def _camera_plot(ctx: ReportContext) -> str:
     ax = fig.add_subplot(111)
     if len(tie):
         sub = tie[:: max(1, len(tie) // 20000)]
-        ax.scatter(sub[:, 0], sub[:, 1], s=0.3, c="#bbbbbb", lw=0, label="tie points")
+        ax.scatter(sub[:, 0], sub[:, 1], s=0.3, c="#bbbbbb", lw=0, label=t("tie points"))
     caption = "Camera projection centres over the tie points"
     if cams:
         rows = [r for r in cams["rows"] if r.get("dx") is not None]
@@ -316,7 +317,7 @@ def _camera_plot(ctx: ReportContext) -> str:
         lim = float(np.nanmax(np.abs(dz))) if np.any(np.isfinite(dz)) else 1.0
         sc = ax.scatter(xy[:, 0], xy[:, 1], c=np.nan_to_num(dz), cmap="RdBu_r", vmin=-lim, vmax=lim, s=28,
                         edgecolors="k", linewidths=0.4, zorder=3)
-        fig.colorbar(sc, ax=ax, shrink=0.7, label="dZ (m): adjusted − given")
+        fig.colorbar(sc, ax=ax, shrink=0.7, label=t("dZ (m): adjusted − given"))
         q = ax.quiver(xy[:, 0], xy[:, 1], dxy[:, 0] * k, dxy[:, 1] * k, angles="xy", scale_units="xy", scale=1,
                       color="#c0392b", width=0.004, zorder=4)
         ref = nice(lmax)
@@ -330,8 +331,8 @@ def _camera_plot(ctx: ReportContext) -> str:
     else:
         sc = ax.scatter(centres[:, 0], centres[:, 1], c=np.nan_to_num(mean_img), cmap="viridis", s=28,
                         edgecolors="k", linewidths=0.4, zorder=3)
-        fig.colorbar(sc, ax=ax, shrink=0.7, label="mean reprojection error (px)")
+        fig.colorbar(sc, ax=ax, shrink=0.7, label=t("mean reprojection error (px)"))
         caption += "; colour: mean reprojection error per image (no camera positions were given)."
     equal_xy(ax)
-    ax.set_title(f"camera positions ({d.crs_label or d.unit})", fontsize=9)
-    return "<h3>Camera positions</h3>" + embed(fig, "camera positions", caption)
+    ax.set_title(t("camera positions ({})").format(d.crs_label or d.unit), fontsize=9)
+    return "<h3>" + esc(t("Camera positions")) + "</h3>" + embed(fig, "camera positions", caption)

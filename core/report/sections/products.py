@@ -12,6 +12,7 @@ from ..context import ReportContext, Skip
 from ..errors import ReportError
 from ..figures import draw_dem, draw_image, embed, equal_xy, new_figure
 from ..html import esc, kv, num, raster_crs_name
+from ..labels import t
 from . import terrain
 
 
@@ -37,7 +38,7 @@ def _raster(ctx: ReportContext, path: str, title: str, dem: bool) -> str:
     try:
         ds = RasterFile(path, title.lower())
     except RasterError as e:
-        return f'<h3>{title}</h3><p class="warn">{esc(path)} cannot be read: {esc(e.__cause__ or e)}</p>'
+        return f'<h3>{esc(_shown(title))}</h3><p class="warn">{esc(path)} cannot be read: {esc(e.__cause__ or e)}</p>'
     w, h = ds.width, ds.height
     gt = ds.geotransform or (0.0, 1.0, 0.0, 0.0, 0.0, 1.0)  # GDAL's default for a raster with none
     step = max(1, int(math.ceil(max(w, h) / 900)))
@@ -91,8 +92,14 @@ def _raster(ctx: ReportContext, path: str, title: str, dem: bool) -> str:
     ctx.figures[f"{'DSM' if dem else 'ORTHO'}_RESOLUTION"] = abs(gt[1])
     equal_xy(ax)
     ax.grid(False)
-    return f"<h3>{title}</h3>" + kv(info) + embed(fig, f"{title} preview", f"{title} preview" + (
-        " with hillshade (sun from the north-west, 45°)." if dem else "."))
+    preview = (t("DSM preview with hillshade (sun from the north-west, 45°).") if dem
+               else t("{} preview.").format(_shown(title)))
+    return f"<h3>{esc(_shown(title))}</h3>" + kv(info) + embed(fig, f"{title} preview", preview)
+
+
+def _shown(title: str) -> str:
+    """A product's title in the report's language (its data keys stay English)."""
+    return {"DSM": t("DSM"), "Orthomosaic": t("Orthomosaic")}.get(title, title)
 
 
 def _seam_rows(results) -> list:

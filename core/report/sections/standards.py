@@ -6,6 +6,7 @@ from typing import Any, Dict
 
 from ..context import ReportContext
 from ..html import esc, fmt, num
+from ..labels import t
 
 ASPRS_MIN_CHECKS = {2014: 20, 2023: 30}
 NSSDA_MIN_CHECKS = 20
@@ -15,7 +16,7 @@ def accuracy_statements(ctx: ReportContext, acc: Dict[str, Any]) -> str:
     nssda = acc["nssda"]
     if nssda is None:
         return ""
-    parts = ["<h3>NSSDA accuracy at 95 % confidence (FGDC-STD-007.3-1998)</h3>"]
+    parts = ["<h3>" + esc(t("NSSDA accuracy at 95 % confidence (FGDC-STD-007.3-1998)")) + "</h3>"]
     if not acc["tested"]:
         parts.append('<p class="warn">No check points: the accuracy was <b>not tested</b>. The figures below '
                      "come from the control points' own residuals, which took part in the adjustment (not "
@@ -42,7 +43,7 @@ def accuracy_statements(ctx: ReportContext, acc: Dict[str, Any]) -> str:
         items.append("<li>No vertical accuracy: the control heights are placeholders.</li>")
     parts.append("<ul class=\"statements\">" + "".join(items) + "</ul>" + parts_note)
     if acc["asprs"]:
-        parts.append("<h3>ASPRS positional accuracy class</h3>")
+        parts.append("<h3>" + esc(t("ASPRS positional accuracy class")) + "</h3>")
         rows = []
         for ed, a in acc["asprs"].items():
             hh, vv = a["horizontal"], a["vertical"]

@@ -8,6 +8,7 @@ from ...project.stages import REPORT
 from ..context import ReportContext
 from ..figures import embed, new_figure, poly_area
 from ..html import area_text, cell, duration, esc, fmt, kv, table, td
+from ..labels import t
 
 
 def section(ctx: ReportContext) -> str:
@@ -49,7 +50,7 @@ def section(ctx: ReportContext) -> str:
     skipped = al.get("skipped_files") or []
     if unreg or skipped:
         r = [[td(n), td(w)] for n, w in sorted(unreg.items())] + [[td(s), td("not read")] for s in skipped]
-        parts.append("<h3>Images not aligned</h3>" + table(["image", "why"], r))
+        parts.append("<h3>" + esc(t("Images not aligned")) + "</h3>" + table(["image", "why"], r))
     elif d.rec is not None:
         parts.append('<p class="ok">Every image given was aligned.</p>')
     if al.get("other_components"):
@@ -65,7 +66,7 @@ def section(ctx: ReportContext) -> str:
 def _screening(ctx: ReportContext) -> str:
     s = ctx.d.screening
     if not s:
-        return ('<h3>Image screening</h3><p class="skip">Not run: the images were not screened '
+        return ('<h3>' + esc(t("Image screening")) + '</h3><p class="skip">Not run: the images were not screened '
                 "(run 'Prepare images' for blur and exposure scores).</p>")
     imgs = s.get("images", [])
     rows = []
@@ -74,8 +75,9 @@ def _screening(ctx: ReportContext) -> str:
         rows.append([td(q.get("name")), cell(q.get("blur_score"), 1), cell(q.get("blur_relative"), 2),
                      cell(q.get("exposure_score"), 2), cell(q.get("dynamic_range"), 2),
                      td(", ".join(q.get("flags") or []) or "–"), td(q.get("decision", "keep"), cls)])
-    head = (f"<h3>Image screening</h3><p>{len(imgs)} images screened: {s.get('flagged', 0)} flagged, "
-            f"{s.get('excluded', 0)} excluded, {s.get('kept', len(imgs))} kept (blurriest first).</p>")
+    head = ("<h3>" + esc(t("Image screening")) + "</h3><p>" + esc(t(
+        "{} images screened: {} flagged, {} excluded, {} kept (blurriest first).").format(
+        len(imgs), s.get('flagged', 0), s.get('excluded', 0), s.get('kept', len(imgs)))) + "</p>")
     plot = ""
     if imgs:
         fig = new_figure(7.5, 2.6)
@@ -86,13 +88,13 @@ def _screening(ctx: ReportContext) -> str:
         ax.bar(range(len(srt)), [q.get("blur_score", 0.0) for q in srt], color=colours)
         med = (s.get("median") or {}).get("blur_score")
         if med:
-            ax.axhline(med, color="k", lw=0.8, ls="--", label="median")
+            ax.axhline(med, color="k", lw=0.8, ls="--", label=t("median"))
             ax.legend(fontsize=7)
-        ax.set_ylabel("blur score (higher = sharper)", fontsize=8)
-        ax.set_xlabel("images, blurriest first", fontsize=8)
+        ax.set_ylabel(t("blur score (higher = sharper)"), fontsize=8)
+        ax.set_xlabel(t("images, blurriest first"), fontsize=8)
         ax.tick_params(labelsize=7)
         plot = embed(fig, "blur scores", "Blur score per image (orange: flagged, red: excluded).")
-    return head + plot + "<details><summary>Screening table</summary>" + table(
+    return head + plot + "<details><summary>" + esc(t("Screening table")) + "</summary>" + table(
         ["image", "blur score", "blur / median", "exposure", "dynamic range", "flags", "decision"], rows
     ) + "</details>"
 
@@ -120,7 +122,7 @@ def _cameras(ctx: ReportContext) -> str:
     note = ("Standard deviations from the bundle adjustment covariance (see Uncertainty), scaled by "
             "sigma0; “fixed”: held constant in the adjustment." if unc is not None else
             f"No standard deviations: {ctx.unc_error or 'uncertainty not computed'}.")
-    return ("<h3>Cameras and calibrated parameters</h3>"
+    return ("<h3>" + esc(t("Cameras and calibrated parameters")) + "</h3>"
             + table(["camera", "model", "size (px)", "images", "parameters (pixels; distortion unitless)"],
                      rows, cls="cams") + f'<p class="note">{esc(note)}</p>')
 
@@ -133,13 +135,13 @@ def _stages(ctx: ReportContext) -> str:
     for name, rec in stages.items():
         if name == REPORT:
             continue
-        t = rec.get("timings") or {}
-        steps = ", ".join(f"{k.replace('_', ' ')} {duration(v)}" for k, v in t.items() if k != "total")
+        timings = rec.get("timings") or {}
+        steps = ", ".join(f"{k.replace('_', ' ')} {duration(v)}" for k, v in timings.items() if k != "total")
         rows.append([td(name), td(rec.get("status", "–"), "ok" if rec.get("status") == "done" else "warn"),
-                     td(duration(t.get("total"))), td(steps or "–"), td(rec.get("finished") or "–")])
+                     td(duration(timings.get("total"))), td(steps or "–"), td(rec.get("finished") or "–")])
         params = rec.get("parameters") or {}
         prow.append([td(name), "<td>" + ", ".join(
             f"<b>{esc(k)}</b>={esc(json.dumps(v, default=str))}" for k, v in params.items()) + "</td>"])
-    return ("<h3>Processing stages</h3>" + table(["stage", "status", "time", "steps", "finished"], rows)
-            + "<details><summary>Parameters used</summary>" + table(["stage", "parameters"], prow)
+    return ("<h3>" + esc(t("Processing stages")) + "</h3>" + table(["stage", "status", "time", "steps", "finished"], rows)
+            + "<details><summary>" + esc(t("Parameters used")) + "</summary>" + table(["stage", "parameters"], prow)
             + "</details>")

@@ -15,6 +15,7 @@ from ...terrain.options import VISUALISATIONS
 from ..context import ReportContext
 from ..figures import draw_dem, embed, equal_xy, new_figure
 from ..html import esc, kv, num
+from ..labels import t
 
 _LABELS = dict(VISUALISATIONS)
 
@@ -44,7 +45,7 @@ def subsection(ctx: ReportContext) -> str:
               if os.path.isfile(lay.resolve(p))]
     if not dtm and not relief:
         return ""
-    parts = ["<h3>Terrain (DTM)</h3>"]
+    parts = ["<h3>" + esc(t("Terrain (DTM)")) + "</h3>"]
     if dtm:
         parts.append(_dtm(ctx, dtm, terrain))
     if relief:
@@ -111,6 +112,6 @@ def _relief(items: List[Tuple[str, str]]) -> str:
         ax.set_title(title, fontsize=8)
         ax.set_xticks([])
         ax.set_yticks([])
-    return ("<h3>Relief visualisations</h3><p>" + "<br>".join(names) + "</p>"
+    return ("<h3>" + esc(t("Relief visualisations")) + "</h3><p>" + "<br>".join(names) + "</p>"
             + embed(fig, "Relief visualisations", "Relief visualisations (rvt-py, RVT's default parameters scaled to "
                                                   "the cell size), in RVT's display ranges."))

@@ -12,6 +12,7 @@ from ...georef import uncertainty as unc
 from ..context import ReportContext, Skip
 from ..figures import embed, equal_xy, new_figure
 from ..html import cell, duration, esc, fmt, kv, num, table, td
+from ..labels import t
 from ..residuals import residual_rows
 
 
@@ -75,10 +76,10 @@ def section(ctx: ReportContext) -> str:
         gs = fig.add_gridspec(1, 3, wspace=0.45)
         ax = fig.add_subplot(gs[0, 0])
         hi = float(np.percentile(np.concatenate([h, z]), 99))
-        ax.hist(np.clip(h, 0, hi), bins=40, alpha=0.7, label="σXY", color="#4477aa")
-        ax.hist(np.clip(z, 0, hi), bins=40, alpha=0.6, label="σZ", color="#e69f00")
-        ax.set_xlabel(f"standard deviation ({unit})", fontsize=8)
-        ax.set_ylabel("tie points", fontsize=8)
+        ax.hist(np.clip(h, 0, hi), bins=40, alpha=0.7, label=t("σXY"), color="#4477aa")
+        ax.hist(np.clip(z, 0, hi), bins=40, alpha=0.6, label=t("σZ"), color="#e69f00")
+        ax.set_xlabel(t("standard deviation ({})").format(unit), fontsize=8)
+        ax.set_ylabel(t("tie points"), fontsize=8)
         ax.legend(fontsize=7)
         ax.tick_params(labelsize=7)
         ax2 = fig.add_subplot(gs[0, 1:])
@@ -89,13 +90,13 @@ def section(ctx: ReportContext) -> str:
                          lw=0)
         fig.colorbar(sc, ax=ax2, shrink=0.8, label=f"σZ ({unit})")
         cxy = np.array([[c["x"], c["y"]] for c in u.cameras]) + u.offset[:2]
-        ax2.scatter(cxy[:, 0], cxy[:, 1], s=12, marker="s", c="#4477aa", label="cameras")
+        ax2.scatter(cxy[:, 0], cxy[:, 1], s=12, marker="s", c="#4477aa", label=t("cameras"))
         if u.control:
             res_pts = {p["name"]: p for p in residual_rows(d.residuals or {})}
             cp = [res_pts[c["name"]] for c in u.control if c["name"] in res_pts]
             if cp:
                 ax2.scatter([p["x"] for p in cp], [p["y"] for p in cp], marker="^", s=50, c="none",
-                            edgecolors="#228833", linewidths=1.2, label="control")
+                            edgecolors="#228833", linewidths=1.2, label=t("control"))
         ax2.legend(fontsize=7, loc="lower left")
         equal_xy(ax2)
         parts.append(embed(fig, "point standard deviations",
@@ -104,12 +105,12 @@ def section(ctx: ReportContext) -> str:
                           "and away from control)."))
     rows = [[td(c["image"]), td(c["camera_id"]), cell(c["sx"], 3), cell(c["sy"], 3), cell(c["sz"], 3),
              cell(c["s_rx"], 4), cell(c["s_ry"], 4), cell(c["s_rz"], 4)] for c in u.cameras]
-    parts.append("<details><summary>Per camera: standard deviations</summary>" + table(
+    parts.append("<details><summary>" + esc(t("Per camera: standard deviations")) + "</summary>" + table(
         ["image", "camera", f"σX ({unit})", f"σY ({unit})", f"σZ ({unit})", "σ rot x (°)", "σ rot y (°)",
          "σ rot z (°)"], rows) + "<p class=\"note\">Rotations about the camera axes (x right, y down, z along "
                                  "the view).</p></details>")
     if u.control:
         rows = [[td(c["name"]), cell(c["sx"], 4), cell(c["sy"], 4), cell(c["sz"], 4)] for c in u.control]
-        parts.append("<details><summary>Control points: adjusted standard deviations</summary>"
+        parts.append("<details><summary>" + esc(t("Control points: adjusted standard deviations")) + "</summary>"
                      + table(["name", "σX (m)", "σY (m)", "σZ (m)"], rows) + "</details>")
     return "".join(parts)
