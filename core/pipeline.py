@@ -1,4 +1,5 @@
-"""The whole chain in one call: (prepare: sky masks ->) align -> georeference -> DSM -> orthomosaic -> DTM (+ relief) -> report.
+"""The whole chain in one call: (prepare: sky masks ->) align -> georeference -> DSM -> orthomosaic -> DTM (+ relief)
+-> (3-D model ->) report.
 
 ``run_pipeline`` calls each room's stage entry point in order on one workspace (``core.align.stage.align``,
 ``core.georef.stage.georeference_workspace``, ``core.dense.stage.build_dsm_workspace``,
@@ -31,13 +32,26 @@ from .io.gcp import GCPSet, read_target_coordinates
 from .io.images import folder_gps, list_images, require_images
 from .io.multispectral import band_files, read_block
 from .io.raster import RasterFile
+from .model.options import ModelOptions
+from .model.stage import stage as build_model
 from .ortho.options import OrthoOptions
 from .ortho.stage import build_orthophoto_workspace
 from .prepare.band_radiometry import PANEL_WINDOW
 from .prepare.captures import CaptureStackOptions, is_band_folder, panel_files, stack_capture_folder
 from .prepare.options import PrepareOptions
 from .prepare.stage import prepare_images_workspace
-from .project.stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, PREPARE, RELIEF, REPORT, TERRAIN, StageError
+from .project.stages import (
+    ALIGN,
+    DSM,
+    GEOREFERENCE,
+    MODEL,
+    ORTHOPHOTO,
+    PREPARE,
+    RELIEF,
+    REPORT,
+    TERRAIN,
+    StageError,
+)
 from .project.workspace import MANIFEST, Workspace
 from .report.options import ReportOptions
 from .report.stage import build_report
@@ -86,6 +100,8 @@ class PipelineOptions:
     terrain: TerrainOptions = field(default_factory=TerrainOptions)  # with make_dtm: the ground filter, contours
     # with make_dtm: relief visualisations of the DTM (its keys: core.terrain.options.VISUALISATION_KEYS; slow)
     relief: ReliefStageOptions = field(default_factory=lambda: ReliefStageOptions(()))
+    make_model: bool = False  # the textured 3-D model (Build 3-D model) after the terrain, with ``model``'s options
+    model: ModelOptions = field(default_factory=ModelOptions)
     sky_masks: bool = False  # obliques: a prepare stage first (screening + sky masks), the prepared photos aligned
     # a folder of a multispectral rig's band files (core.prepare.captures.is_band_folder): "auto" stacks every
     # capture into one multi-band photo in <workspace>/captures first (Stack multispectral captures, with this
@@ -118,6 +134,7 @@ class PipelineResult:
     report: object = None
     dtm: object = None
     relief: object = None
+    model: object = None  # the 3-D model's result (core.model.stage.ModelResult) when it ran
     targets: object = None  # Find targets' result (core.georef.targets.stage.FindTargetsResult) when it ran
     captures: object = None  # the band folder's stacked captures (core.prepare.captures.CaptureStackResult)
     rgb_frames: List[str] = field(default_factory=list)  # the rig's RGB frames aligned with the captures
@@ -133,7 +150,7 @@ FIND_TARGETS = "find targets"  # not a recorded stage: its products (georef/targ
 CAPTURES = "captures"  # not a recorded stage: a band folder's captures stacked into multi-band photos
 CAPTURES_DIR = "captures"
 SPANS = {CAPTURES: (0.0, 0.05), PREPARE: (0.0, 0.05), ALIGN: (0.0, 0.40), FIND_TARGETS: (0.40, 0.42), GEOREFERENCE: (0.42, 0.45), DSM: (0.45, 0.75), ORTHOPHOTO: (0.75, 0.9),
-         TERRAIN: (0.9, 0.92), RELIEF: (0.92, 0.95), REPORT: (0.95, 1.0)}
+         TERRAIN: (0.9, 0.92), RELIEF: (0.92, 0.94), MODEL: (0.94, 0.97), REPORT: (0.97, 1.0)}
 
 
 def rig_rgb_frames(folder: str, photos: Sequence[str]) -> Tuple[List[str], List[str]]:
@@ -378,6 +395,9 @@ def run_pipeline(images_dir: str, workspace_dir: str, options: Optional[Pipeline
         res.dtm = run(TERRAIN, build_dtm_workspace, workspace_dir, opt.terrain)
         if opt.relief.keys:
             res.relief = run(RELIEF, relief_workspace, workspace_dir, opt.relief)
+    if opt.make_model:  # before the report: a model run after it would mark it stale (STAGE_ORDER)
+        res.model = run(MODEL, build_model, workspace_dir, opt.model)
+        res.warnings += res.model.notes
     if opt.make_report:
         res.report = run(REPORT, build_report, workspace_dir, opt.report)
         res.warnings += res.report.warnings

@@ -31,6 +31,7 @@ def algorithms():
     from .auto_control import AutoControlAlgorithm
     from .build_dsm import BuildDsmAlgorithm
     from .build_dtm import BuildDtmAlgorithm
+    from .build_model import BuildModelAlgorithm
     from .build_orthophoto import BuildOrthophotoAlgorithm
     from .contours import ContoursAlgorithm
     from .dsm_difference import DsmDifferenceAlgorithm
@@ -47,4 +48,4 @@ def algorithms():
             AccuracyReportAlgorithm(), BuildOrthophotoAlgorithm(), OrthorectifyImageAlgorithm(),
             RunPipelineAlgorithm(), BuildDtmAlgorithm(), ReliefVisualisationAlgorithm(), ContoursAlgorithm(),
             AutoControlAlgorithm(), DsmDifferenceAlgorithm(), FindTargetsAlgorithm(), SpectralIndexAlgorithm(),
-            StackCapturesAlgorithm()]
+            StackCapturesAlgorithm(), BuildModelAlgorithm()]

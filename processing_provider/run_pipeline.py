@@ -1,6 +1,7 @@
 """Run pipeline: thin adapter over core.pipeline.run_pipeline (align -> georeference -> DSM -> orthomosaic -> report)."""
 from qgis.core import (
     QgsProcessingException,
+    QgsProcessingOutputFile,
     QgsProcessingOutputHtml,
     QgsProcessingOutputNumber,
     QgsProcessingOutputRasterLayer,
@@ -10,7 +11,7 @@ from qgis.core import (
 from qgis.PyQt.QtCore import QCoreApplication
 
 from . import params
-from .base import AlgorithmBase, FeedbackProgress
+from .base import AlgorithmBase, FeedbackProgress, styling_enabled
 from .params import BLENDINGS, CAMERA_MODELS, PAIRINGS, QUALITIES
 
 
@@ -40,6 +41,8 @@ class RunPipelineAlgorithm(AlgorithmBase):
     BLENDING = "BLENDING"
     REPORT_ENABLED = "MAKE_REPORT"
     DTM_ENABLED = "MAKE_DTM"
+    MODEL_ENABLED = "MAKE_MODEL"
+    MODEL_TILESET = "MODEL_TILESET"
     CONTOUR_INTERVAL = "CONTOUR_INTERVAL"
     RELIEF = "RELIEF"
     CAPTURE_RADIOMETRY = "CAPTURE_RADIOMETRY"
@@ -131,6 +134,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
             params.blending(self.BLENDING, self.tr("Seam blending")),
             params.flag(self.REPORT_ENABLED, self.tr("Write the accuracy report"), default=True),
             params.flag(self.DTM_ENABLED, self.tr("Build the DTM"), default=True),
+            params.flag(self.MODEL_ENABLED, self.tr("Build the textured 3-D model"), default=False),
             *params.advanced(
                 params.calibration_file(self.CALIBRATION, self.tr("Camera calibration file")),
                 params.intrinsics(self.INTRINSICS, self.tr("Interior orientation")),
@@ -154,6 +158,7 @@ class RunPipelineAlgorithm(AlgorithmBase):
         # an HTML output: the toolbox dialog lists it in the Results Viewer, which opens it (a plain file output
         # was nowhere in the GUI: issue 36 item 15)
         self.addOutput(QgsProcessingOutputHtml(self.REPORT, self.tr("Accuracy report (HTML)")))
+        self.addOutput(QgsProcessingOutputFile(self.MODEL_TILESET, self.tr("3-D model (3D Tiles)")))
         for name, label in self.NUMBERS:
             self.addOutput(QgsProcessingOutputNumber(name, self.tr(label)))
 
@@ -165,7 +170,9 @@ class RunPipelineAlgorithm(AlgorithmBase):
         from ..core.georef.targets.options import KINDS as TARGET_KINDS
         from ..core.georef.targets.options import FindTargetsOptions
         from ..core.ortho.options import OrthoOptions
+        from ..core.report.options import ReportOptions
         from ..core.terrain.options import ReliefStageOptions, TerrainOptions
+        from ..qgisio.messages import report_language
 
         p = parameters
         gcps = params.read_gcp_layer(self, p, self.GCP_LAYER, context, QCoreApplication.translate(
@@ -204,7 +211,9 @@ class RunPipelineAlgorithm(AlgorithmBase):
                                    blending=params.read_choice(self, p, self.BLENDING, context, BLENDINGS),
                                    workers=workers, scheduler=scheduler),
                 make_report=self.parameterAsBoolean(p, self.REPORT_ENABLED, context),
+                report=ReportOptions(language=report_language()),  # the report's headings in QGIS's language
                 make_dtm=self.parameterAsBoolean(p, self.DTM_ENABLED, context),
+                make_model=self.parameterAsBoolean(p, self.MODEL_ENABLED, context),
                 terrain=TerrainOptions(contour_interval=self.parameterAsDouble(p, self.CONTOUR_INTERVAL, context)),
                 relief=ReliefStageOptions(params.read_relief(self, p, self.RELIEF, context)),
                 sky_masks=self.parameterAsBoolean(p, self.SKY_MASKS, context),
@@ -229,7 +238,18 @@ class RunPipelineAlgorithm(AlgorithmBase):
                     ORTHOMOSAIC=ortho.orthomosaic if ortho is not None else None,
                     ORTHOMOSAIC_RGB=rgb.orthomosaic if rgb is not None else None,
                     REPORT=result.report.path if result.report else None,
-                    DTM=result.dtm.dtm_path if result.dtm else None)
+                    DTM=result.dtm.dtm_path if result.dtm else None,
+                    MODEL_TILESET=next((f for f in result.model.files if f.endswith("tileset.json")), None)
+                    if result.model else None)
+
+    def register_styled_outputs(self, results, context, feedback=None):
+        """The styled layers, and the 3-D model's 3D Tiles as a tiled scene layer (QGIS 3.34+)."""
+        count = super().register_styled_outputs(results, context, feedback)
+        if not styling_enabled():
+            return count
+        from ..qgisio.scene_layers import register_tiled_scene
+
+        return count + register_tiled_scene(results, self.MODEL_TILESET, context, feedback)
 
     def _captures(self, p, context):
         """The band folder's radiometry and calibration panel: PipelineOptions fields

@@ -70,6 +70,8 @@ FILES = {
     "test_imports.py": "install",
     "test_legs.py": "install",
     "test_masks.py": "qgis",
+    "test_model.py": "core",
+    "test_model_tiles.py": "gdal",
     "test_multispectral.py": "gdal",
     "test_obliques.py": "qgis",
     "test_orientation.py": "qgis",

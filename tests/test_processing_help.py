@@ -16,7 +16,7 @@ DIALOG_ALGORITHMS = ("alignimages", "georeference", "runpipeline", "buildorthoph
 # every algorithm of the provider: the help of each names its parameters by the form's labels
 ALL_ALGORITHMS = ("prepareimages", "alignimages", "georeference", "builddsm", "buildorthophoto", "accuracyreport",
                   "orthorectifyimage", "builddtm", "reliefvisualisation", "contours", "runpipeline", "autocontrol",
-                  "dsmdifference", "findtargets", "spectralindex", "stackcaptures")
+                  "dsmdifference", "findtargets", "spectralindex", "stackcaptures", "buildmodel")
 
 
 def _dialog(alg_id):

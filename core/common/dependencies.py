@@ -60,6 +60,10 @@ REQUIREMENTS: Tuple[Requirement, ...] = (
 # NumPy and SciPy only): it is installed with --no-deps --ignore-requires-python (tested on Python 3.11 and 3.13)
 OPTIONAL: Tuple[Requirement, ...] = (
     Requirement("rvt", "rvt-py", "2.2.3", "rvt-py (relief visualisations)", "2.2", "3"),
+    # quadric decimation of the 3-D model's mesh (core/model/geometry.py; without it a coarser grid meets the face
+    # budget): wheels for Windows, macOS (arm64, x86-64) and Linux, Python 3.10-3.14; needs NumPy only
+    Requirement("fast_simplification", "fast-simplification", "0.2.0", "fast-simplification (3-D model decimation)",
+                "0.1", "1"),
 )
 OPTIONAL_PIP_FLAGS = ("--no-deps", "--ignore-requires-python")
 

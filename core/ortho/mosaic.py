@@ -48,6 +48,7 @@ class MosaicResult:
     seamlines_path: Optional[str] = None
     gains: Dict[str, float] = field(default_factory=dict)
     radiometry: Dict[str, Any] = field(default_factory=dict)  # the fitted model's figures (core.ortho.radiometry)
+    radiometry_model: Optional[Any] = None  # the RadiometryModel applied (None: the scalar gains alone)
     timings: Dict[str, float] = field(default_factory=dict)
     warnings: List[str] = field(default_factory=list)
     log_lines: List[str] = field(default_factory=list)
@@ -154,6 +155,7 @@ def build_orthomosaic(cameras: Sequence[OrthoCamera], crs: Optional[str], offset
                                 height=grid.height, images=[c.name for c in prep.cameras],
                                 valid_fraction=valid_fraction, per_image=per_image, seamlines_path=seamlines_path,
                                 gains={c.name: g for c, g in zip(prep.cameras, plan.gains)}, radiometry=summary,
+                                radiometry_model=model,
                                 timings={k: round(v, 3) for k, v in timings.items()}, warnings=prep.warnings,
                                 log_lines=log)
     finally:

@@ -12,13 +12,14 @@ from ..align.photos import check_photos
 from ..common.files import clean_debris, file_fingerprint, fingerprint
 from ..common.progress import NullProgress, Progress
 from ..io.images import ImageError
-from ..project.layout import Layout, LayoutError
+from ..project.layout import Layout, LayoutError, write_json
 from ..project.stages import ORTHOPHOTO, run_stage
 from ..project.workspace import Workspace
 from .cameras import OrthoCamera, cameras_from_reconstruction, select_cameras
 from .mosaic import WORK_PREFIX, build_orthomosaic
 from .options import OrthoError, OrthoOptions
 from .radiometry import seam_figures
+from .radiometry_record import radiometry_record
 from .seamlines import dsm_extent, edits_fingerprint, read_seamline_edits
 
 STAGE = ORTHOPHOTO
@@ -80,6 +81,7 @@ def build_orthophoto_workspace(workspace_dir: str, options: Optional[OrthoOption
         for k_, v in result.timings.items():
             if k_ != "total":
                 lay.ws.record_timing(STAGE, k_, v)
+        write_json(lay.ortho_radiometry_json, radiometry_record(result.images, result.gains, result.radiometry_model))
         outputs = {key: lay.rel(path) for key, path in (("orthomosaic", options.output), ("per_image_folder",
                    options.per_image_folder), ("seamlines", options.seamlines)) if path}
         run.finish(outputs=outputs, results={

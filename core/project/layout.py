@@ -19,7 +19,7 @@ from typing import Any, Dict, Optional, Tuple
 from ..common.errors import ArchaeoOrthoError, require
 from ..common.files import atomic_write_text
 from .frame import GeorefFrame
-from .stages import ALIGN, DSM, GEOREFERENCE, ORTHOPHOTO, TERRAIN
+from .stages import ALIGN, DSM, GEOREFERENCE, MODEL, ORTHOPHOTO, TERRAIN
 from .workspace import Workspace
 
 # folder and file names inside a workspace (the workspace format: changing one breaks old workspaces)
@@ -54,6 +54,7 @@ DENSE_DIR = "dense"
 DSM_TIF = "dsm.tif"
 DSM_SOURCE_TIF = "dsm-source.tif"  # in dense/: 1 measured, 2 interpolated (a hole filled), 3 removed (a blunder), 0 nodata
 ORTHOMOSAIC_TIF = "orthomosaic.tif"
+ORTHO_RADIOMETRY_JSON = "orthomosaic-radiometry.json"  # the exposure gains / radiometric model applied
 REPORT_HTML = "report.html"
 UNCERTAINTY_DIR = "uncertainty"
 DTM_TIF = "dtm.tif"
@@ -62,6 +63,7 @@ DTM_SOURCE_TIF = "dtm-source.tif"  # 1 measured ground, 2 interpolated under obj
 RELIEF_DIR = "relief"
 CONTOURS_GPKG = "contours.gpkg"
 CLASSIFIED_LAS = "points-classified.las"
+MODEL3D_DIR = "model3d"  # the textured 3-D model (core.model): model.obj / .glb / .ply, atlases, 3D Tiles
 
 
 class LayoutError(ArchaeoOrthoError, RuntimeError):
@@ -312,6 +314,11 @@ class Layout:
         return self.default_orthomosaic if os.path.isfile(self.default_orthomosaic) else None
 
     @property
+    def ortho_radiometry_json(self) -> str:
+        """The orthophoto's radiometric correction (core.ortho.radiometry_record), for the model's texture."""
+        return self.path(ORTHO_RADIOMETRY_JSON)
+
+    @property
     def default_report(self) -> str:
         return self.path(REPORT_HTML)
 
@@ -355,6 +362,17 @@ class Layout:
         out = (self.ws.stage(DSM).get("outputs") or {}).get("point_cloud")
         p = self.resolve(out) if out else None
         return p if p and os.path.isfile(p) else None
+
+    # --- 3-D model -------------------------------------------------------
+    @property
+    def default_model3d_dir(self) -> str:
+        return self.path(MODEL3D_DIR)
+
+    def model3d_dir(self) -> Optional[str]:
+        """The folder of the workspace's textured 3-D model: the model stage's recorded output; None if absent."""
+        out = (self.ws.stage(MODEL).get("outputs") or {}).get("folder")
+        p = self.resolve(out) if out else None
+        return p if p and os.path.isdir(p) else None
 
     # --- helpers ---------------------------------------------------------
     def model_fingerprints(self, model_dir: Optional[str] = None, prefix: str = "model/") -> Dict[str, str]:

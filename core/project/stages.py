@@ -47,9 +47,10 @@ ORTHOPHOTO = "orthophoto"
 REPORT = "report"
 TERRAIN = "terrain"  # DTM (+ contours) from the DSM
 RELIEF = "relief"  # relief visualisations of the DTM or DSM
+MODEL = "model"  # the textured 3-D model (core.model)
 
 # the order data flows in; a stage that finishes marks the done stages after it stale
-STAGE_ORDER: List[str] = [PREPARE, ALIGN, GEOREFERENCE, DSM, ORTHOPHOTO, TERRAIN, RELIEF, REPORT]
+STAGE_ORDER: List[str] = [PREPARE, ALIGN, GEOREFERENCE, DSM, ORTHOPHOTO, TERRAIN, RELIEF, MODEL, REPORT]
 
 
 class StageError(ArchaeoOrthoError, RuntimeError):
