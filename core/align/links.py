@@ -7,11 +7,12 @@ map in one block whose two halves meet through IMG_0450 + IMG_0451 (64 verified 
 pairs across that link disagreed with the others by 5-25 times the depth tolerance (the block was bent there), and
 most of the ground the halves share was interpolated in the DSM.
 
-Once the block is mapped, each pair of registered photos that overlap on the ground (its features' rays, at the
-depth of their nearest tie points, land in the other photo) but verified few matches for that overlap
-(LINK_WEAK_SHARE of the overlapping features) is matched again: each feature only against the other photo's
-features near where the block predicts it (a radius of LINK_RADIUS_SHARE of the image's diagonal), with a ratio
-test among those (LINK_RATIO), then verified by a fundamental matrix (RANSAC, LINK_RANSAC_SHARE of the diagonal).
+Once the block is mapped, each pair of registered photos (neither an oblique view: :func:`steep_views`) that
+overlaps on the ground (its features' rays, at the depth of their nearest tie points, land in the other photo) but
+verified few matches for that overlap (LINK_WEAK_SHARE of the overlapping features) is matched again: each
+feature only against the other photo's features near where the block predicts it (a radius of LINK_RADIUS_SHARE of
+the image's diagonal), with a ratio test among those (LINK_RATIO), then verified by a fundamental matrix (RANSAC,
+LINK_RANSAC_SHARE of the diagonal).
 Where that verifies more matches than the pair had, the database's two-view geometry is replaced by it, the
 block's points are triangulated again from every verified match with the poses held, and the final bundle
 adjustment refines the poses on them; then again on the better poses (LINK_ROUNDS), until no link gains.
@@ -35,7 +36,24 @@ LINK_RATIO = 0.9  # the nearest descriptor against the second nearest within the
 LINK_NEIGHBOURS = 8  # candidates per feature (the nearest within the radius) and tie points per depth
 LINK_RANSAC_SHARE = 0.001  # of the diagonal: the fundamental matrix's RANSAC threshold (1.9 px at 1800 x 1350)
 LINK_MIN_TIES = 8  # tie points a photo needs for the depths of its features
+LINK_MAX_TILT_DEG = 30.0  # views further than this from the block's mean axis are not matched again (steep_views)
 LINK_ROUNDS = 3  # rounds of matching again (each on the poses the last one's adjustment gave)
+
+
+def steep_views(rec) -> set:
+    """The registered images whose optical axis lies more than LINK_MAX_TILT_DEG from the block's mean axis (the
+    ground's "down" in a block of vertical photos, whatever its frame): an oblique view sees the ground foreshortened
+    and turned, and a plain SIFT descriptor's nearest within the radius is too often another feature (the synthetic
+    orbits' steep views: their poses 2-3 x worse with their links matched again)."""
+    axes = {i: np.asarray(rec.images[i].cam_from_world().rotation.matrix())[2] for i in rec.reg_image_ids()}
+    if not axes:
+        return set()
+    mean = np.mean(list(axes.values()), axis=0)
+    norm = float(np.linalg.norm(mean))
+    if norm < 1e-6:
+        return set(axes)
+    limit = math.cos(math.radians(LINK_MAX_TILT_DEG))
+    return {i for i, ax in axes.items() if float(ax @ mean) / norm < limit}
 
 
 @dataclass
@@ -129,6 +147,7 @@ def weak_links(pycolmap, rec, db_path: str, pairs: Sequence[Tuple[str, str]], pr
     """Match the weak links among ``pairs`` (image names) of the registered images of ``rec`` again (the module's
     docstring) and write what verifies more into the database ``db_path``; returns the links rewritten."""
     ids = {rec.images[i].name: i for i in rec.reg_image_ids()}
+    steep = steep_views(rec)
     db = pycolmap.Database.open(db_path)
     done: List[Link] = []
     try:
@@ -144,6 +163,8 @@ def weak_links(pycolmap, rec, db_path: str, pairs: Sequence[Tuple[str, str]], pr
             if na not in ids or nb not in ids:
                 continue
             a, b = sorted((ids[na], ids[nb]))
+            if a in steep or b in steep:
+                continue
             kp_a, desc_a, ground_a = features(a)
             kp_b, desc_b, _ = features(b)
             if ground_a is None:

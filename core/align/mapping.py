@@ -87,7 +87,7 @@ def run_mapping(pycolmap, job: MappingJob, options: AlignOptions, progress: Prog
     if hold_all:
         opts.ba_refine_extra_params = False
         opts.mapper.abs_pose_refine_extra_params = False
-    opts.num_threads = mapping_threads(options.num_threads, n_images)
+    opts.num_threads = options.num_threads
     opts.random_seed = options.seed
     opts.mapper.random_seed = options.seed
     opts.triangulation.random_seed = options.seed
@@ -175,19 +175,6 @@ def min_model_size(n_images: int) -> int:
     """The smallest model the mapper keeps: 3 images (small separate components are kept so they can be
     reported by name), 2 when only two images are given (a stereo pair is a valid block)."""
     return 2 if n_images <= 2 else 3
-
-
-REPEATABLE_MAPPING_IMAGES = 60  # blocks up to this many images are mapped on one thread unless NUM_THREADS is given
-
-
-def mapping_threads(num_threads: int, n_images: int) -> int:
-    """The incremental mapper's threads: ``num_threads`` where given (> 0); else one for a block of up to
-    REPEATABLE_MAPPING_IMAGES images, so that the same photos map the same way every run (issue 46: seneca_south's
-    12 photos mapped as one block in five runs on two threads and left two photos to the escalation in a sixth,
-    which then lost another; a small block maps in seconds), and every core (-1) above."""
-    if num_threads and num_threads > 0:
-        return num_threads
-    return 1 if n_images <= REPEATABLE_MAPPING_IMAGES else -1
 
 
 def _map_global(pycolmap, job: MappingJob, options: AlignOptions, progress: Progress, hold_all: bool = False,
