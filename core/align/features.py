@@ -415,8 +415,6 @@ def match_pairs(pycolmap, db_path, pairs, work_dir, options, progress: Progress)
     mo = pycolmap.FeatureMatchingOptions()
     mo.num_threads = options.num_threads
     vo = pycolmap.TwoViewGeometryOptions()
-    vo.ransac.random_seed = options.seed  # the same verified matches from one run to the next (issue 46: a weak
-    # link verified 64, 90 or 200 matches in three runs, and the block bent across it in one of them)
     list_path = os.path.join(work_dir, "pairs-block.txt")
     for start in range(0, len(todo), size):
         check_cancel(progress)
