@@ -578,3 +578,23 @@ def test_the_cuda_engine_is_dispatched_with_the_blocks_views_and_the_layouts_fol
     n_points = 0
     with pytest.raises(DenseError, match="no consistent surface point"):
         points.dense_points(block, DenseOptions(engine="cuda"), lay, {}, NullProgress(), job)
+
+
+def test_a_camera_placed_absurdly_far_does_not_span_the_dsm():
+    """Issue 46: a photo registered on 4 points with its centre 2.3e11 m away asked for a DSM grid of 10^11 cells
+    and stopped the stage; it is left out of the grid's extent and named."""
+    from core.common.progress import NullProgress
+    from core.dense.dsm import block_centres
+
+    warnings = []
+
+    class Noting(NullProgress):
+        def warning(self, message):
+            warnings.append(message)
+
+    boxes = np.array([[0.0, 0.0, 100.0, 80.0], [20.0, 10.0, 130.0, 90.0]])
+    centres = {"a.jpg": np.array([50.0, 40.0]), "b.jpg": np.array([90.0, 45.0]), "c.jpg": np.array([-60.0, 40.0]),
+               "far.jpg": np.array([2.3e11, -4.0e10])}
+    kept = block_centres(centres, boxes, Noting())
+    assert len(kept) == 3 and np.abs(kept).max() < 1000  # c.jpg, beside the block, still spans it
+    assert len(warnings) == 1 and "far.jpg" in warnings[0]

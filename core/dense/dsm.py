@@ -31,6 +31,21 @@ class DsmTarget:
     gsd: float
 
 
+def block_centres(centres: Dict[str, np.ndarray], boxes: np.ndarray, progress: Progress) -> np.ndarray:
+    """The camera centres (name -> x, y) that span the DSM's grid and hull: those within the points' extent
+    (``boxes``: the images' robust (xmin, ymin, xmax, ymax)) grown by its own size on each side.  A camera the
+    alignment placed absurdly far (issue 46: one registered on 4 points, 2.3e11 m away) would otherwise ask for a
+    grid of 10^11 cells and stop the stage; it is named in the log instead."""
+    lo, hi = boxes[:, :2].min(axis=0), boxes[:, 2:].max(axis=0)
+    size = float(max(hi - lo))
+    keep = {n: c for n, c in centres.items() if np.all(c >= lo - size) and np.all(c <= hi + size)}
+    far = sorted(set(centres) - set(keep))
+    if far:
+        progress.warning(f"{len(far)} camera(s) lie far outside the block's dense points and are left out of the DSM's "
+                         f"extent: {', '.join(far[:6])}{' ...' if len(far) > 6 else ''} (check their alignment)")
+    return np.array(list(keep.values()) or list(centres.values())).reshape(-1, 2)
+
+
 def write_dsm(target: DsmTarget, point_files: List[PointFile], views: Dict[int, View], options: DenseOptions,
               metadata: dict, progress: Progress) -> Tuple[raster.Grid, Dict[str, float]]:
     """Rasterise the points, clean the raster, fill its holes inside the cameras' hull, write the COG and its
@@ -39,7 +54,8 @@ def write_dsm(target: DsmTarget, point_files: List[PointFile], views: Dict[int, 
     check_cancel(progress)
     offset, res, gsd = target.offset, target.resolution, target.gsd
     boxes = np.array([pf.robust_bbox for pf in point_files if pf.count > 0])
-    centres = np.array([v.centre[:2] + offset[:2] for v in views.values()])
+    centres = block_centres({v.name: v.centre[:2] + offset[:2] for v in views.values()}, boxes[:, :4] + np.tile(
+        offset[:2], 2), progress)
     # the points' extent, and the whole camera centres' hull: its fractions are judged over all of it (issue 46: the
     # grid was the points' extent alone, and more points at the edge widened it over hull ground measured nowhere)
     xmin = min(boxes[:, 0].min() + offset[0], centres[:, 0].min())
