@@ -59,6 +59,7 @@ DTM_HILLSHADE = "dtmhillshade"
 RELIEF = "relief"
 CONTOURS = "contours"
 INDEX = "index"  # a spectral index (NDVI ...): over the orthomosaic it is made from
+MODEL3D = "model3d"  # the 3-D model's 3D Tiles (a tiled scene layer, QGIS 3.34+: qgisio/scene_layers.py)
 TARGETS = "targets"  # Find targets' layer for review: every surveyed target, found or not
 
 # the order of a workspace's group, top to bottom: points and lines over the pictures, the orthomosaic over the
@@ -66,7 +67,7 @@ TARGETS = "targets"  # Find targets' layer for review: every surveyed target, fo
 # orthomosaic darkened it (the DTM's, loaded last, by about 19 %: issue 36 item 16); under it, it shades only
 # its DSM or DTM, which the orthomosaic covers until it is switched off.
 GROUP_ORDER = (TARGETS, RESIDUALS, CAMERAS, FOOTPRINTS, CONTOURS, POINT_CLOUD, INDEX, ORTHO, RELIEF, DTM_HILLSHADE, DTM, HILLSHADE,
-               DSM)
+               DSM, MODEL3D)  # the 3-D model last: in the 2-D map it would hide the orthomosaic
 
 # residual point status (core.georef) -> colour
 STATUS_COLOURS = {"used": "#1a9641", "check": "#2b83ba", "rejected": "#d7191c", "not triangulated": "#888888"}
@@ -771,13 +772,7 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
         try:
             self._style(layer, context)
         except Exception:  # noqa: BLE001 - a styling bug must never abort QGIS; it is logged, not hidden
-            import traceback
-
-            text = traceback.format_exc()
-            message = f"ArchaeoOrtho could not style the layer {layer.name()}: {text.strip().splitlines()[-1]}"
-            QgsMessageLog.logMessage(f"{message}\n{text}", "ArchaeoOrtho", Qgis.MessageLevel.Critical)
-            if feedback is not None:
-                feedback.reportError(message, False)
+            report_layer_failure("style", layer, feedback)
         if self.workspace:  # styled or not, the layer is the workspace's: the dock follows (the plugin hears it)
             results_notifier().workspaceLoaded.emit(self.workspace)
 
@@ -788,7 +783,7 @@ class StylePostProcessor(QgsProcessingLayerPostProcessorInterface):
         group = workspace_group_name(self.workspace) if self.workspace else None
         if group:  # with the workspace's other layers (the dock's Load results puts them there too), at its kind's
             # place (GROUP_ORDER): the orthomosaic over the hillshades
-            _replace_older(project, layer, path, self.kind)
+            replace_older(project, layer, path, self.kind)
             move_to_group(project, layer, group, self.kind)
         if self.kind == DSM:
             style_dsm(layer)
@@ -863,7 +858,20 @@ def workspace_group_name(workspace):
         os.path.basename(os.path.normpath(workspace)))
 
 
-def _replace_older(project, layer, path, kind):
+def report_layer_failure(action, layer, feedback=None):
+    """Log the exception being handled (with its traceback) as ArchaeoOrtho failing to ``action`` ``layer``, and
+    report it to the run's ``feedback``: a post-processor QGIS calls from C++ must never raise (it would abort
+    QGIS), and must not hide what went wrong either."""
+    import traceback
+
+    text = traceback.format_exc()
+    message = f"ArchaeoOrtho could not {action} the layer {layer.name()}: {text.strip().splitlines()[-1]}"
+    QgsMessageLog.logMessage(f"{message}\n{text}", "ArchaeoOrtho", Qgis.MessageLevel.Critical)
+    if feedback is not None:
+        feedback.reportError(message, False)
+
+
+def replace_older(project, layer, path, kind):
     """A re-run's product replaces the layer an earlier run (or Load results) loaded from the same file."""
     target = _norm(path)
     drop = [other.id() for other in project.mapLayers().values()

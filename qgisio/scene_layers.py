@@ -9,7 +9,6 @@ import os
 
 from qgis.core import (
     Qgis,
-    QgsMessageLog,
     QgsProcessingContext,
     QgsProcessingLayerPostProcessorInterface,
     QgsProject,
@@ -17,9 +16,20 @@ from qgis.core import (
 )
 from qgis.PyQt.QtCore import QCoreApplication
 
-from .layers import KIND_PROPERTY, PATH_PROPERTY, product_name, remove_loaded, workspace_group_name, workspace_of
+from .layers import (
+    KIND_PROPERTY,
+    MODEL3D,
+    PATH_PROPERTY,
+    add_layer,
+    move_to_group,
+    product_name,
+    remove_loaded,
+    replace_older,
+    report_layer_failure,
+    workspace_group_name,
+    workspace_of,
+)
 
-MODEL3D = "model3d"  # the layers' kind (KIND_PROPERTY)
 PROVIDER = "cesiumtiles"
 FIRST_VERSION = 33400  # QGIS 3.34: tiled scene layers
 
@@ -31,26 +41,6 @@ def tiled_scenes_supported():
 
 def model_layer_name(path, workspace=None):
     return product_name(QCoreApplication.translate("ResultLayers", "3-D model"), path, workspace)
-
-
-def _to_group_bottom(project, layer, group_name):
-    """Add ``layer`` (already in ``project``) to the bottom of the group ``group_name`` (made when missing)."""
-    root = project.layerTreeRoot()
-    group = root.findGroup(group_name) or root.insertGroup(0, group_name)
-    node = root.findLayer(layer.id())
-    if node is None:
-        group.addLayer(layer)
-        return
-    if node.parent() is group and group.children()[-1] is node:
-        return
-    parent = node.parent()
-    group.insertChildNode(len(group.children()), node.clone())
-    parent.removeChildNode(node)
-
-
-def _mark(layer, path):
-    layer.setCustomProperty(KIND_PROPERTY, MODEL3D)
-    layer.setCustomProperty(PATH_PROPERTY, path)
 
 
 def load_tiled_scene(path, project=None, group=None, name=None, workspace=None):
@@ -65,12 +55,8 @@ def load_tiled_scene(path, project=None, group=None, name=None, workspace=None):
     layer = QgsTiledSceneLayer(path, name or model_layer_name(path, workspace), PROVIDER)
     if not layer.isValid():
         return []
-    _mark(layer, path)
-    if project.addMapLayer(layer, not group) is None:
-        return []
-    if group:
-        _to_group_bottom(project, layer, group)
-    return [layer]
+    layer.setCustomProperty(KIND_PROPERTY, MODEL3D)
+    return [layer] if add_layer(project, layer, group, path) is not None else []  # at the group's bottom: GROUP_ORDER
 
 
 _KEEP = []  # the post-processors must outlive the run (QGIS keeps only a raw pointer)
@@ -91,23 +77,14 @@ class TiledScenePostProcessor(QgsProcessingLayerPostProcessorInterface):
         try:
             project = context.project() or QgsProject.instance()
             path = layer.source()
-            older = [other.id() for other in project.mapLayers().values() if other.id() != layer.id()
-                     and other.customProperty(KIND_PROPERTY, "") == MODEL3D
-                     and os.path.realpath(other.customProperty(PATH_PROPERTY, "")) == os.path.realpath(path)]
-            if older:
-                project.removeMapLayers(older)
-            _mark(layer, path)
+            replace_older(project, layer, path, MODEL3D)
+            layer.setCustomProperty(KIND_PROPERTY, MODEL3D)
+            layer.setCustomProperty(PATH_PROPERTY, path)
             layer.setName(model_layer_name(path, self.workspace))
             if self.workspace:
-                _to_group_bottom(project, layer, workspace_group_name(self.workspace))
+                move_to_group(project, layer, workspace_group_name(self.workspace), MODEL3D)
         except Exception:  # noqa: BLE001 - a bug here must never abort QGIS; it is logged, not hidden
-            import traceback
-
-            text = traceback.format_exc()
-            message = f"ArchaeoOrtho could not place the layer {layer.name()}: {text.strip().splitlines()[-1]}"
-            QgsMessageLog.logMessage(f"{message}\n{text}", "ArchaeoOrtho", Qgis.MessageLevel.Critical)
-            if feedback is not None:
-                feedback.reportError(message, False)
+            report_layer_failure("place", layer, feedback)
 
 
 def register_tiled_scene(results, output_name, context, feedback=None):
