@@ -163,11 +163,9 @@ class GcpStore(QObject):
     def _load_automatic(self, ws, gs):
         """The names of the table's control points that are automatic GCPs: the candidates the automatic control
         kept (georef/autocontrol.json) that the table holds with their measured observations."""
-        from ..core.georef.autocontrol.candidates import KEPT
+        from ..core.georef.autocontrol.record import kept_names
 
-        doc = self._load_json(Layout(ws).autocontrol_json)
-        cands = doc.get("candidates") if isinstance(doc, dict) else None
-        kept = {str(c.get("name")) for c in cands or [] if isinstance(c, dict) and c.get("status") == KEPT}
+        kept = kept_names(Layout(ws))
         return {p.name for p in gs.points if p.name in kept and p.role == gcpmod.CONTROL and p.observations}
 
     def is_automatic(self, name):

@@ -11,8 +11,8 @@ import numpy as np
 
 from ...geometry.crs import transform_points
 from ...io.gcp import CHECK, CONTROL, GCPSet, GroundPoint
-from ...project.layout import Layout
-from .candidates import Candidate, drop_counts
+from ...project.layout import Layout, read_json
+from .candidates import KEPT, Candidate, drop_counts
 from .options import AutoControlOptions
 
 FORMAT = "archaeoortho-autocontrol"
@@ -92,3 +92,11 @@ def _count_used(lay: Layout, names) -> int:
 
 
 __all__ = ["FORMAT", "adjustment_outcome", "coarse_hint", "control_points", "search_document"]
+
+
+def kept_names(lay: Layout) -> set:
+    """The names of the candidates the workspace's last automatic control kept as ground control
+    (georef/autocontrol.json); empty where it never ran or the record cannot be read."""
+    doc = read_json(lay.autocontrol_json)
+    cands = doc.get("candidates") if isinstance(doc, dict) else None
+    return {str(c.get("name")) for c in cands or [] if isinstance(c, dict) and c.get("status") == KEPT}
