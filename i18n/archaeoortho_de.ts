@@ -1908,6 +1908,11 @@ Höhenlinien: das zu schreibende GeoPackage.</translation>
         <source>the photos are corrected as the orthophoto&apos;s (exposure, vignetting, hot spot)</source>
         <translation>die Fotos werden wie für das Orthophoto korrigiert (Belichtung, Vignettierung, Hotspot)</translation>
     </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} camera(s) lie far outside the block&apos;s dense points and are left out of the DSM&apos;s extent: {}{} (check their alignment)</source>
+        <translation>{} Kamera(s) liegen weit außerhalb der dichten Punkte des Blocks und bleiben bei der Ausdehnung des DOM unberücksichtigt: {}{} (ihre Ausrichtung prüfen)</translation>
+    </message>
 </context>
 <context>
     <name>DsmDifferenceAlgorithm</name>
@@ -2993,117 +2998,117 @@ Ausgaben: die Messungsdatei (standardmäßig georef/targets/gcp_list.txt im Arbe
 <context>
     <name>GcpStore</name>
     <message>
-        <location filename="../ui/store.py" line="318"/>
+        <location filename="../ui/store.py" line="316"/>
         <source>a point named {} exists already</source>
         <translation>ein Punkt namens {} existiert bereits</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="306"/>
+        <location filename="../ui/store.py" line="304"/>
         <source>add point {}</source>
         <translation>Punkt {} hinzufügen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="313"/>
+        <location filename="../ui/store.py" line="311"/>
         <source>remove point {}</source>
         <translation>Punkt {} entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="331"/>
+        <location filename="../ui/store.py" line="329"/>
         <source>set {} of {}</source>
         <translation>{} von {} setzen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="391"/>
+        <location filename="../ui/store.py" line="389"/>
         <source>place {} in {}</source>
         <translation>{} in {} messen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="399"/>
+        <location filename="../ui/store.py" line="397"/>
         <source>remove {} from {}</source>
         <translation>{} aus {} entfernen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="540"/>
+        <location filename="../ui/store.py" line="538"/>
         <source>set CRS</source>
         <translation>KBS setzen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="359"/>
+        <location filename="../ui/store.py" line="357"/>
         <source>no position</source>
         <translation>keine Position</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="364"/>
+        <location filename="../ui/store.py" line="362"/>
         <source>({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)</source>
         <translation>({:.0f}, {:.0f}) liegt außerhalb des Fotos {} ({} × {} px)</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="371"/>
+        <location filename="../ui/store.py" line="369"/>
         <source>({:.0f}, {:.0f}) is inside the mask of {}</source>
         <translation>({:.0f}, {:.0f}) liegt in der Maske von {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="379"/>
+        <location filename="../ui/store.py" line="377"/>
         <source>{} not placed: {}</source>
         <translation>{} nicht gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="431"/>
+        <location filename="../ui/store.py" line="429"/>
         <source>{} points replaced by {} from the file</source>
         <translation>{} Punkte durch {} aus der Datei ersetzt</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="465"/>
+        <location filename="../ui/store.py" line="463"/>
         <source>added {} points: {}</source>
         <translation>{} Punkte hinzugefügt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="467"/>
+        <location filename="../ui/store.py" line="465"/>
         <source>coordinates updated from the file: {}</source>
         <translation>Koordinaten aus der Datei aktualisiert: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="469"/>
+        <location filename="../ui/store.py" line="467"/>
         <source>role set by the file: {}</source>
         <translation>Rolle von der Datei gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="471"/>
+        <location filename="../ui/store.py" line="469"/>
         <source>role kept (the file gives none): {}</source>
         <translation>Rolle beibehalten (die Datei nennt keine): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="473"/>
+        <location filename="../ui/store.py" line="471"/>
         <source>σ set by the file: {}</source>
         <translation>σ von der Datei gesetzt: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="475"/>
+        <location filename="../ui/store.py" line="473"/>
         <source>{} observations added</source>
         <translation>{} Messungen hinzugefügt</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="477"/>
+        <location filename="../ui/store.py" line="475"/>
         <source>placed observations kept (the file has others): {}</source>
         <translation>gesetzte Messungen beibehalten (die Datei hat andere): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="479"/>
+        <location filename="../ui/store.py" line="477"/>
         <source>nothing changed</source>
         <translation>nichts geändert</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="488"/>
+        <location filename="../ui/store.py" line="486"/>
         <source>observations placed by hand kept (found ones not used there): {}</source>
         <translation>von Hand gesetzte Messungen beibehalten (gefundene dort nicht verwendet): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="528"/>
+        <location filename="../ui/store.py" line="526"/>
         <source>confirm {} in {}</source>
         <translation>{} in {} übernehmen</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="537"/>
+        <location filename="../ui/store.py" line="535"/>
         <source>reject {} in {}</source>
         <translation>{} in {} verwerfen</translation>
     </message>
@@ -4907,117 +4912,117 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
 <context>
     <name>ResultLayers</name>
     <message>
-        <location filename="../qgisio/layers.py" line="326"/>
+        <location filename="../qgisio/layers.py" line="327"/>
         <source>found</source>
         <translation>gefunden</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="326"/>
+        <location filename="../qgisio/layers.py" line="327"/>
         <source>not found</source>
         <translation>nicht gefunden</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="856"/>
+        <location filename="../qgisio/layers.py" line="851"/>
         <source>Targets found</source>
         <translation>Gefundene Zielmarken</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="289"/>
+        <location filename="../qgisio/layers.py" line="290"/>
         <source>control (used)</source>
         <translation>Passpunkt (verwendet)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="290"/>
+        <location filename="../qgisio/layers.py" line="291"/>
         <source>check point</source>
         <translation>Kontrollpunkt</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="291"/>
+        <location filename="../qgisio/layers.py" line="292"/>
         <source>rejected (outlier)</source>
         <translation>verworfen (Ausreißer)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="292"/>
+        <location filename="../qgisio/layers.py" line="293"/>
         <source>not triangulated</source>
         <translation>nicht trianguliert</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="850"/>
+        <location filename="../qgisio/layers.py" line="845"/>
         <source>DSM</source>
         <translation>DOM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="796"/>
+        <location filename="../qgisio/layers.py" line="791"/>
         <source>DSM hillshade</source>
         <translation>DOM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="851"/>
+        <location filename="../qgisio/layers.py" line="846"/>
         <source>Orthomosaic</source>
         <translation>Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="852"/>
+        <location filename="../qgisio/layers.py" line="847"/>
         <source>Cameras</source>
         <translation>Kameras</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="808"/>
+        <location filename="../qgisio/layers.py" line="803"/>
         <source>Camera footprints</source>
         <translation>Bildfußabdrücke</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="816"/>
+        <location filename="../qgisio/layers.py" line="811"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Passpunkt-Residuen (Vektoren x{})</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="853"/>
+        <location filename="../qgisio/layers.py" line="848"/>
         <source>Point cloud</source>
         <translation>Punktwolke</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="862"/>
+        <location filename="../qgisio/layers.py" line="857"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="467"/>
+        <location filename="../qgisio/layers.py" line="468"/>
         <source>{} ({})</source>
         <translation>{} ({})</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="854"/>
+        <location filename="../qgisio/layers.py" line="849"/>
         <source>DTM</source>
         <translation>DGM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="824"/>
+        <location filename="../qgisio/layers.py" line="819"/>
         <source>DTM hillshade</source>
         <translation>DGM-Schummerung</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="855"/>
+        <location filename="../qgisio/layers.py" line="850"/>
         <source>Contours</source>
         <translation>Höhenlinien</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="451"/>
+        <location filename="../qgisio/layers.py" line="452"/>
         <source>{} — {}</source>
         <translation>{} — {}</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="407"/>
+        <location filename="../qgisio/layers.py" line="408"/>
         <source>Spectral index</source>
         <translation>Spektralindex</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="849"/>
+        <location filename="../qgisio/layers.py" line="844"/>
         <source>RGB orthomosaic</source>
         <translation>RGB-Orthomosaik</translation>
     </message>
     <message>
-        <location filename="../qgisio/scene_layers.py" line="33"/>
+        <location filename="../qgisio/scene_layers.py" line="43"/>
         <source>3-D model</source>
         <translation>3-D-Modell</translation>
     </message>
@@ -5027,7 +5032,7 @@ Reliefraster: wohin es geschrieben wird (Vorgabe: &lt;workspace&gt;/terrain/reli
         <translation>DGM (Gelände)</translation>
     </message>
     <message>
-        <location filename="../qgisio/scene_layers.py" line="132"/>
+        <location filename="../qgisio/scene_layers.py" line="111"/>
         <source>3D Tiles not loaded: {}</source>
         <translation>3D Tiles nicht geladen: {}</translation>
     </message>

@@ -1908,6 +1908,11 @@ Curve di livello: il GeoPackage da scrivere.</translation>
         <source>the photos are corrected as the orthophoto&apos;s (exposure, vignetting, hot spot)</source>
         <translation>le foto sono corrette come per l'ortofoto (esposizione, vignettatura, hot spot)</translation>
     </message>
+    <message>
+        <location filename="../qgisio/core_messages.py" line="8"/>
+        <source>{} camera(s) lie far outside the block&apos;s dense points and are left out of the DSM&apos;s extent: {}{} (check their alignment)</source>
+        <translation>{} fotocamera/e lontane dai punti densi del blocco, escluse dall&apos;estensione del DSM: {}{} (controllarne l&apos;allineamento)</translation>
+    </message>
 </context>
 <context>
     <name>DsmDifferenceAlgorithm</name>
@@ -2993,117 +2998,117 @@ Output: il file delle misure (predefinito georef/targets/gcp_list.txt nell'area 
 <context>
     <name>GcpStore</name>
     <message>
-        <location filename="../ui/store.py" line="318"/>
+        <location filename="../ui/store.py" line="316"/>
         <source>a point named {} exists already</source>
         <translation>esiste già un punto chiamato {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="306"/>
+        <location filename="../ui/store.py" line="304"/>
         <source>add point {}</source>
         <translation>aggiungi il punto {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="313"/>
+        <location filename="../ui/store.py" line="311"/>
         <source>remove point {}</source>
         <translation>rimuovi il punto {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="331"/>
+        <location filename="../ui/store.py" line="329"/>
         <source>set {} of {}</source>
         <translation>imposta {} di {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="391"/>
+        <location filename="../ui/store.py" line="389"/>
         <source>place {} in {}</source>
         <translation>misura {} in {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="399"/>
+        <location filename="../ui/store.py" line="397"/>
         <source>remove {} from {}</source>
         <translation>rimuovi {} da {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="540"/>
+        <location filename="../ui/store.py" line="538"/>
         <source>set CRS</source>
         <translation>imposta il SR</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="359"/>
+        <location filename="../ui/store.py" line="357"/>
         <source>no position</source>
         <translation>nessuna posizione</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="364"/>
+        <location filename="../ui/store.py" line="362"/>
         <source>({:.0f}, {:.0f}) is outside the photo {} ({} × {} px)</source>
         <translation>({:.0f}, {:.0f}) è fuori dalla foto {} ({} × {} px)</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="371"/>
+        <location filename="../ui/store.py" line="369"/>
         <source>({:.0f}, {:.0f}) is inside the mask of {}</source>
         <translation>({:.0f}, {:.0f}) è dentro la maschera di {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="379"/>
+        <location filename="../ui/store.py" line="377"/>
         <source>{} not placed: {}</source>
         <translation>{} non posizionato: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="431"/>
+        <location filename="../ui/store.py" line="429"/>
         <source>{} points replaced by {} from the file</source>
         <translation>{} punti sostituiti da {} dal file</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="465"/>
+        <location filename="../ui/store.py" line="463"/>
         <source>added {} points: {}</source>
         <translation>aggiunti {} punti: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="467"/>
+        <location filename="../ui/store.py" line="465"/>
         <source>coordinates updated from the file: {}</source>
         <translation>coordinate aggiornate dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="469"/>
+        <location filename="../ui/store.py" line="467"/>
         <source>role set by the file: {}</source>
         <translation>ruolo impostato dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="471"/>
+        <location filename="../ui/store.py" line="469"/>
         <source>role kept (the file gives none): {}</source>
         <translation>ruolo mantenuto (il file non ne indica): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="473"/>
+        <location filename="../ui/store.py" line="471"/>
         <source>σ set by the file: {}</source>
         <translation>σ impostata dal file: {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="475"/>
+        <location filename="../ui/store.py" line="473"/>
         <source>{} observations added</source>
         <translation>{} misure aggiunte</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="477"/>
+        <location filename="../ui/store.py" line="475"/>
         <source>placed observations kept (the file has others): {}</source>
         <translation>misure posizionate mantenute (il file ne ha altre): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="479"/>
+        <location filename="../ui/store.py" line="477"/>
         <source>nothing changed</source>
         <translation>nulla è cambiato</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="488"/>
+        <location filename="../ui/store.py" line="486"/>
         <source>observations placed by hand kept (found ones not used there): {}</source>
         <translation>misure posizionate a mano mantenute (quelle trovate lì non usate): {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="528"/>
+        <location filename="../ui/store.py" line="526"/>
         <source>confirm {} in {}</source>
         <translation>conferma {} in {}</translation>
     </message>
     <message>
-        <location filename="../ui/store.py" line="537"/>
+        <location filename="../ui/store.py" line="535"/>
         <source>reject {} in {}</source>
         <translation>scarta {} in {}</translation>
     </message>
@@ -4907,117 +4912,117 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
 <context>
     <name>ResultLayers</name>
     <message>
-        <location filename="../qgisio/layers.py" line="326"/>
+        <location filename="../qgisio/layers.py" line="327"/>
         <source>found</source>
         <translation>trovato</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="326"/>
+        <location filename="../qgisio/layers.py" line="327"/>
         <source>not found</source>
         <translation>non trovato</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="856"/>
+        <location filename="../qgisio/layers.py" line="851"/>
         <source>Targets found</source>
         <translation>Target trovati</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="289"/>
+        <location filename="../qgisio/layers.py" line="290"/>
         <source>control (used)</source>
         <translation>appoggio (usato)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="290"/>
+        <location filename="../qgisio/layers.py" line="291"/>
         <source>check point</source>
         <translation>punto di controllo</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="291"/>
+        <location filename="../qgisio/layers.py" line="292"/>
         <source>rejected (outlier)</source>
         <translation>scartato (valore anomalo)</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="292"/>
+        <location filename="../qgisio/layers.py" line="293"/>
         <source>not triangulated</source>
         <translation>non triangolato</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="850"/>
+        <location filename="../qgisio/layers.py" line="845"/>
         <source>DSM</source>
         <translation>DSM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="796"/>
+        <location filename="../qgisio/layers.py" line="791"/>
         <source>DSM hillshade</source>
         <translation>Ombreggiatura del DSM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="851"/>
+        <location filename="../qgisio/layers.py" line="846"/>
         <source>Orthomosaic</source>
         <translation>Ortomosaico</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="852"/>
+        <location filename="../qgisio/layers.py" line="847"/>
         <source>Cameras</source>
         <translation>Camere</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="808"/>
+        <location filename="../qgisio/layers.py" line="803"/>
         <source>Camera footprints</source>
         <translation>Impronte delle immagini</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="816"/>
+        <location filename="../qgisio/layers.py" line="811"/>
         <source>GCP residuals (vectors x{})</source>
         <translation>Residui dei punti d'appoggio (vettori x{})</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="853"/>
+        <location filename="../qgisio/layers.py" line="848"/>
         <source>Point cloud</source>
         <translation>Nuvola di punti</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="862"/>
+        <location filename="../qgisio/layers.py" line="857"/>
         <source>ArchaeoOrtho: {}</source>
         <translation>ArchaeoOrtho: {}</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="467"/>
+        <location filename="../qgisio/layers.py" line="468"/>
         <source>{} ({})</source>
         <translation>{} ({})</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="854"/>
+        <location filename="../qgisio/layers.py" line="849"/>
         <source>DTM</source>
         <translation>DTM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="824"/>
+        <location filename="../qgisio/layers.py" line="819"/>
         <source>DTM hillshade</source>
         <translation>Ombreggiatura del DTM</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="855"/>
+        <location filename="../qgisio/layers.py" line="850"/>
         <source>Contours</source>
         <translation>Curve di livello</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="451"/>
+        <location filename="../qgisio/layers.py" line="452"/>
         <source>{} — {}</source>
         <translation>{} — {}</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="407"/>
+        <location filename="../qgisio/layers.py" line="408"/>
         <source>Spectral index</source>
         <translation>Indice spettrale</translation>
     </message>
     <message>
-        <location filename="../qgisio/layers.py" line="849"/>
+        <location filename="../qgisio/layers.py" line="844"/>
         <source>RGB orthomosaic</source>
         <translation>Ortomosaico RGB</translation>
     </message>
     <message>
-        <location filename="../qgisio/scene_layers.py" line="33"/>
+        <location filename="../qgisio/scene_layers.py" line="43"/>
         <source>3-D model</source>
         <translation>Modello 3D</translation>
     </message>
@@ -5027,7 +5032,7 @@ Raster del rilievo: dove scriverlo (predefinito: &lt;workspace&gt;/terrain/relie
         <translation>DTM (terreno nudo)</translation>
     </message>
     <message>
-        <location filename="../qgisio/scene_layers.py" line="132"/>
+        <location filename="../qgisio/scene_layers.py" line="111"/>
         <source>3D Tiles not loaded: {}</source>
         <translation>3D Tiles non caricati: {}</translation>
     </message>

@@ -48,6 +48,7 @@ TEMPLATES = (
     QT_TRANSLATE_NOOP('CoreMessages', "aligned {}/{} images, {} px"),
     QT_TRANSLATE_NOOP('CoreMessages', "pair selection: {}, {} pairs for {} images"),
     QT_TRANSLATE_NOOP('CoreMessages', "final bundle adjustment"),
+    QT_TRANSLATE_NOOP('CoreMessages', "{} camera(s) lie far outside the block's dense points and are left out of the DSM's extent: {}{} (check their alignment)"),
     QT_TRANSLATE_NOOP('CoreMessages', "DSM tile {}/{}"),
     QT_TRANSLATE_NOOP('CoreMessages', "matching: {} pairs ({} reused from a previous run), {} s per pair, {} s per megapixel, {}"),
     QT_TRANSLATE_NOOP('CoreMessages', "resuming: {} of {} pairs already matched"),
